@@ -1,0 +1,65 @@
+"""The ``stochcable`` command line.
+
+Each sub-command lives in its own module in this package and exposes
+``register(subparsers)``, which adds its parser and sets ``func`` to a callable taking
+the parsed namespace and returning an exit code.  Modules are discovered, so adding a
+command is adding a file.  Errors a user causes are printed as one line on stderr with
+exit code 2; no traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pkgutil
+import sys
+import warnings
+from collections.abc import Sequence
+
+from ..errors import StochcableError
+
+__all__ = ["main", "build_parser"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Build the top-level parser with every sub-command module found in this package."""
+    from .. import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="stochcable",
+        description="Frequency-domain stochastic response of marine cables in random seas.",
+    )
+    parser.add_argument("--version", action="version", version=f"stochcable {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+        if info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        register = getattr(module, "register", None)
+        if register is not None:
+            register(sub)
+    return parser
+
+
+def _warning_to_stderr(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+    sys.stderr.write(f"stochcable: warning: {message}\n")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the process exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    warnings.showwarning = _warning_to_stderr
+    try:
+        return int(args.func(args) or 0)
+    except StochcableError as exc:
+        sys.stderr.write(f"stochcable {args.command}: error: {exc}\n")
+        return 2
+    except (OSError, ValueError) as exc:  # unreadable file, malformed JSON
+        sys.stderr.write(f"stochcable {args.command}: error: {exc}\n")
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
