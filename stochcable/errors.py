@@ -53,13 +53,20 @@ class InputError(StochcableError, ValueError):
         What the value must satisfy (``"must be > 0"``).
     """
 
+    _NO_VALUE = object()
+
     def __init__(self, parameter: str, value: Any, unit: str, constraint: str) -> None:
         self.parameter = parameter
         self.value = value
         self.unit = unit
         self.constraint = constraint
         unit_txt = f" [{unit}]" if unit and unit != "-" else ""
-        super().__init__(f"{parameter} = {_fmt_value(value)}{unit_txt}: {constraint}")
+        if value is InputError._NO_VALUE:
+            # a constraint between several fields: the message itself names them
+            self.value = None
+            super().__init__(f"{parameter}: {constraint}")
+        else:
+            super().__init__(f"{parameter} = {_fmt_value(value)}{unit_txt}: {constraint}")
 
 
 class ConvergenceError(StochcableError):
