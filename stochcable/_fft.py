@@ -1,0 +1,148 @@
+"""Real FFTs through cached pyfftw plans, with numpy.fft as the fallback.
+
+``rfft`` and ``irfft`` have numpy's signatures and normalization (``irfft`` divides
+by ``n``) and agree with :mod:`numpy.fft` to round-off.  With pyfftw installed, one
+FFTW plan is built per (input shape, n, axis, direction) with planner effort
+``FFTW_ESTIMATE`` (``FFTW_MEASURE`` costs ~15 s for 2^20 points and gains ~20 %;
+set ``STOCHCABLE_FFTW_EFFORT`` to change it) and kept in a small LRU cache.  Each
+plan owns aligned work buffers and a lock, so concurrent calls from worker threads are
+safe (calls on the same plan are serialized, different plans run in parallel).
+Plans use ``os.cpu_count()`` threads for transforms of 2^15 points or more.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from collections import OrderedDict
+
+import numpy as np
+
+try:  # pragma: no cover - exercised through monkeypatching in tests
+    import pyfftw as _pyfftw
+except ImportError:  # pragma: no cover
+    _pyfftw = None
+
+__all__ = ["rfft", "irfft", "backend", "clear_cache"]
+
+_MAX_PLANS = 16
+_THREAD_MIN_SIZE = 2**15
+_EFFORT = os.environ.get("STOCHCABLE_FFTW_EFFORT", "FFTW_ESTIMATE")
+
+_cache: OrderedDict[tuple, "_Plan"] = OrderedDict()
+_cache_lock = threading.Lock()
+
+
+def backend() -> str:
+    """Name of the FFT backend in use: ``"pyfftw"`` or ``"numpy"``."""
+    return "numpy" if _pyfftw is None else "pyfftw"
+
+
+def clear_cache() -> None:
+    """Drop every cached FFTW plan (frees their work buffers)."""
+    with _cache_lock:
+        _cache.clear()
+
+
+class _Plan:
+    """One FFTW plan with its aligned input buffer and a lock."""
+
+    __slots__ = ("fftw", "inp", "out_shape", "out_dtype", "lock", "scale")
+
+    def __init__(self, in_shape: tuple[int, ...], n: int, inverse: bool) -> None:
+        if inverse:
+            in_dtype, out_dtype = "complex128", "float64"
+            out_shape = in_shape[:-1] + (n,)
+        else:
+            in_dtype, out_dtype = "float64", "complex128"
+            out_shape = in_shape[:-1] + (n // 2 + 1,)
+        self.inp = _pyfftw.empty_aligned(in_shape, dtype=in_dtype)
+        out = _pyfftw.empty_aligned(out_shape, dtype=out_dtype)
+        threads = (os.cpu_count() or 1) if n >= _THREAD_MIN_SIZE else 1
+        self.fftw = _pyfftw.FFTW(
+            self.inp,
+            out,
+            axes=(len(in_shape) - 1,),
+            direction="FFTW_BACKWARD" if inverse else "FFTW_FORWARD",
+            flags=(_EFFORT, "FFTW_DESTROY_INPUT"),
+            threads=threads,
+        )
+        self.out_shape = out_shape
+        self.out_dtype = out_dtype
+        self.lock = threading.Lock()
+        self.scale = 1.0 / n if inverse else 1.0
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        out = _pyfftw.empty_aligned(self.out_shape, dtype=self.out_dtype)
+        with self.lock:
+            np.copyto(self.inp, x, casting="unsafe")
+            self.fftw.update_arrays(self.inp, out)
+            self.fftw.execute()
+        if self.scale != 1.0:
+            out *= self.scale
+        return out
+
+
+def _plan(in_shape: tuple[int, ...], n: int, inverse: bool) -> _Plan:
+    key = (in_shape, n, inverse)
+    with _cache_lock:
+        plan = _cache.get(key)
+        if plan is not None:
+            _cache.move_to_end(key)
+            return plan
+        # FFTW's planner is not thread-safe: build under the cache lock.
+        plan = _Plan(in_shape, n, inverse)
+        _cache[key] = plan
+        while len(_cache) > _MAX_PLANS:
+            _cache.popitem(last=False)
+        return plan
+
+
+def irfft(x: np.ndarray, n: int, axis: int = -1) -> np.ndarray:
+    """Inverse of :func:`rfft`: real array of length ``n`` along ``axis``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Complex half-spectrum, ``n // 2 + 1`` entries along ``axis``. [unit]
+    n : int
+        Length of the real output along ``axis``. [-]
+    axis : int, default -1
+        Transform axis. [-]
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 array, ``x[k]`` → ``(1/n) Σ_k X_k e^{2πi k j/n}`` (numpy convention). [unit]
+    """
+    x = np.asarray(x)
+    if _pyfftw is None:
+        return np.fft.irfft(x, n, axis=axis)
+    if x.shape[axis] != n // 2 + 1:
+        return np.fft.irfft(x, n, axis=axis)  # padding/truncation: rare, let numpy do it
+    xm = np.moveaxis(x, axis, -1)
+    out = _plan(xm.shape, int(n), True)(xm)
+    return np.moveaxis(out, -1, axis)
+
+
+def rfft(x: np.ndarray, axis: int = -1) -> np.ndarray:
+    """Real-input FFT along ``axis`` (numpy convention, no normalization).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Real samples. [unit]
+    axis : int, default -1
+        Transform axis. [-]
+
+    Returns
+    -------
+    numpy.ndarray
+        complex128 half-spectrum with ``n // 2 + 1`` entries along ``axis``. [unit]
+    """
+    x = np.asarray(x)
+    if _pyfftw is None or np.iscomplexobj(x):
+        return np.fft.rfft(x, axis=axis)
+    xm = np.moveaxis(x, axis, -1)
+    out = _plan(xm.shape, xm.shape[-1], False)(xm)
+    return np.moveaxis(out, -1, axis)
