@@ -73,24 +73,26 @@ def _omega_array(omega: ArrayLike) -> np.ndarray:
 
 
 def _pm_shape(w: np.ndarray, omega_p: float, scale: float) -> np.ndarray:
-    """scale · x⁻⁵ exp(−1.25 x⁻⁴), x = ω/ωp, zero where x < 0.15 (incl. ω <= 0)."""
-    out = np.zeros(w.shape)
+    """scale · x⁻⁵ exp(−1.25 x⁻⁴), x = ω/ωp, zero where x < 0.15 (incl. ω <= 0).
+
+    In-place arithmetic on one output and one work array (this runs on 2^19-point
+    grids in the sea simulation).
+    """
+    shape = w.shape
+    w = w.reshape(-1)
     x_min = _PM_X_MIN * omega_p
-    if w.size and w.min() >= x_min:  # common case: no masking
-        r = omega_p / w
-        r2 = r * r
-        r4 = r2 * r2
-        np.multiply(r4, -1.25, out=out)
-        np.exp(out, out=out)
-        out *= r4
-        out *= r
-        out *= scale
-        return out
-    mask = w >= x_min
-    r = omega_p / w[mask]
-    r4 = (r * r) ** 2
-    out[mask] = scale * r4 * r * np.exp(-1.25 * r4)
-    return out
+    out = np.maximum(w, x_min)
+    np.divide(omega_p, out, out=out)           # r = ωp/ω
+    tmp = np.multiply(out, out)
+    tmp *= tmp                                 # r⁴
+    out *= tmp                                 # r⁵
+    tmp *= -1.25
+    np.exp(tmp, out=tmp)                       # exp(−1.25 r⁴), 0.0 below x = 0.2
+    out *= tmp
+    out *= scale
+    if out.size and w.min() < x_min:
+        np.copyto(out, 0.0, where=w < x_min)
+    return out.reshape(shape)
 
 
 def spectrum_pierson_moskowitz(omega: ArrayLike, hs: float, tp: float) -> np.ndarray:

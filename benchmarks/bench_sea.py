@@ -1,0 +1,91 @@
+"""Benchmark: 2^20-sample DSA sea realization and the dispersion relation.
+
+Run: ``python benchmarks/bench_sea.py``.  Prints medians over repeated runs (timeit
+style: each sample is one call, wall clock), with pyfftw and with the numpy.fft fallback.
+Goals (docs/BENCHMARKS.md): realization <= 8 ms, dispersion of 10,000 ω <= 0.5 ms.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import statistics
+import time
+
+import numpy as np
+
+from stochcable import _fft, sea
+from stochcable.kinematics import wavenumber
+from stochcable.spectra import spectrum_jonswap, spectrum_pierson_moskowitz
+
+
+def median_ms(fn, repeat: int, warmup: int = 2) -> float:
+    for _ in range(warmup):
+        fn()
+    samples = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        samples.append(time.perf_counter() - t0)
+    return 1e3 * statistics.median(samples)
+
+
+def main() -> None:
+    n_t, dt = 2**20, 0.25
+    duration = n_t * dt
+    omega, _ = sea.frequency_grid(duration, dt)
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+          f"python {platform.python_version()}, numpy {np.__version__}")
+
+    def pm(w):
+        return spectrum_pierson_moskowitz(w, 6.0, 10.0)
+
+    def js(w):
+        return spectrum_jonswap(w, 6.0, 10.0, 3.3)
+
+    seeds = iter(range(10**6))
+    rows = []
+    for backend in ("pyfftw", "numpy"):
+        saved = _fft._pyfftw
+        if backend == "numpy":
+            _fft._pyfftw = None
+        try:
+            rows.append((f"simulate_sea PM, DSA, 2^20 samples [{backend}]",
+                         median_ms(lambda: sea.simulate_sea(pm, duration, dt, "dsa", next(seeds)), 30)))
+            rows.append((f"simulate_sea JONSWAP, DSA, 2^20 samples [{backend}]",
+                         median_ms(lambda: sea.simulate_sea(js, duration, dt, "dsa", next(seeds)), 30)))
+            rows.append((f"simulate_sea PM, NSA, 2^20 samples [{backend}]",
+                         median_ms(lambda: sea.simulate_sea(pm, duration, dt, "nsa", next(seeds)), 30)))
+            x = np.zeros(n_t // 2 + 1, complex)
+            x[1:-1] = 1.0
+            rows.append((f"  irfft alone, 2^20 [{backend}]", median_ms(lambda: _fft.irfft(x, n_t), 30)))
+        finally:
+            _fft._pyfftw = saved
+    rows.append(("  PM spectrum on 2^19+1 frequencies", median_ms(lambda: pm(omega), 30)))
+    u = np.random.default_rng(0).random(n_t // 2 - 1)
+    amp = np.ones_like(u)
+    out = np.empty(u.size, complex)
+    rows.append(("  amplitude x phasor (table + series), 2^19, 1 thread",
+                 median_ms(lambda: sea._unit_phasors_into(u, amp, out), 30)))
+    rows.append(("  amplitude x phasor, 2^19, all cores",
+                 median_ms(lambda: sea._phasors(u, amp, out), 30)))
+    rows.append(("  np.exp(-1j*theta), 2^19 (reference, not used)",
+                 median_ms(lambda: np.exp(-1j * u), 10)))
+    rng = np.random.default_rng(0)
+    rows.append(("  rng.random(2^19)", median_ms(lambda: rng.random(n_t // 2), 30)))
+
+    w = np.linspace(0.01, 3.0, 10_000)
+    rows.append(("wavenumber, 10,000 omega, h = 50 m", median_ms(lambda: wavenumber(w, 50.0), 300)))
+    rows.append(("wavenumber, 10,000 omega, h = 5 m", median_ms(lambda: wavenumber(w, 5.0), 300)))
+    rows.append(("wavenumber, 10,000 omega, deep", median_ms(lambda: wavenumber(w), 300)))
+    k = wavenumber(w, 50.0)
+    res = np.abs(9.80665 * k * np.tanh(50.0 * k) / w**2 - 1).max()
+
+    width = max(len(r[0]) for r in rows)
+    for name, ms in rows:
+        print(f"{name:<{width}}  {ms:8.3f} ms")
+    print(f"dispersion max relative residual |g k tanh(kh)/w^2 - 1| = {res:.1e}")
+
+
+if __name__ == "__main__":
+    main()

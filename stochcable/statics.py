@@ -1,0 +1,875 @@
+"""Static equilibrium of lines: elastic catenary or finite-element Newton (seed 001 §4.1).
+
+The static shape is the configuration the dynamic analysis linearizes about (seed 001
+ch. 4: "provide a stable starting configuration for a dynamic problem").  Two methods:
+
+- ``"catenary"``: the closed-form elastic catenary (:mod:`stochcable.catenary`) for a
+  single homogeneous segment between fixed points in a vertical plane, without current
+  or attachments, with seabed contact when end_a lies on the seabed;
+- ``"fe"``: a finite-element Newton solve over the mesh of 2-node straight elastic bars
+  (seed 001 §3.1) with lumped loads, for everything: several segments, clump weights
+  and buoys, current drag, seabed contact, 3-D geometry.
+
+``"auto"`` takes the catenary where it applies and the FE otherwise.  Both solve for
+the *effective* tension: the weight is the net submerged weight per unit length
+(weight in air minus the weight of displaced water), so the hydrostatic pressure field
+is folded into the load and the tension reported is the effective tension.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from scipy.linalg import LinAlgError, solve_banded
+
+from .errors import ConvergenceError, InputError
+from .mesh import LineMesh, mesh_line
+from .scene import Environment, Scene
+
+__all__ = ["LineStatics", "StaticsResult", "solve_statics", "solve_line_statics"]
+
+Method = Literal["auto", "fe", "catenary"]
+
+#: Axial stiffness factor of a slack (compressed) element: E -> eps E (seed 001 §6.2).
+SLACK_FACTOR = 1e-6
+
+_EPS = np.finfo(float).eps
+
+
+# --------------------------------------------------------------------------- results
+
+
+@dataclass(frozen=True, eq=False)
+class LineStatics:
+    """Static equilibrium of one line.
+
+    Attributes
+    ----------
+    mesh : LineMesh
+        The discretization the nodes belong to.
+    positions : ndarray, shape (n_nodes, 3)
+        Node positions, global frame, z up. [m]
+    tension : ndarray, shape (n_el,)
+        Effective tension of each element, EA (l/l0 - 1), zero for slack elements. [N]
+    node_tension : ndarray, shape (n_nodes,)
+        Effective tension at the nodes: the end-force magnitude at the two ends, the
+        mean of the two adjacent elements inside. [N]
+    force_a, force_b : ndarray, shape (3,)
+        Force the line exerts on its end supports (element force plus the loads lumped
+        at the end node), global frame. [N]
+    tension_a, tension_b : float
+        Magnitudes of ``force_a`` and ``force_b``: the end tensions. [N]
+    grounded : ndarray of bool, shape (n_nodes,)
+        Nodes in contact with the seabed.
+    touchdown : float or None
+        Unstretched arc length from end_a where the line leaves the seabed (toward
+        end_b), interpolated between nodes; None without seabed contact. [m]
+    iterations : int
+        Newton / relaxation iterations used (0 for the closed form).
+    residual : float
+        Final max |nodal residual force| divided by the reference force (total weight
+        magnitude plus largest element tension plus total drag). [-]
+    method : str
+        ``"catenary"`` or ``"fe"``.
+    """
+
+    mesh: LineMesh
+    positions: np.ndarray
+    tension: np.ndarray
+    node_tension: np.ndarray
+    force_a: np.ndarray
+    force_b: np.ndarray
+    tension_a: float
+    tension_b: float
+    grounded: np.ndarray
+    touchdown: float | None
+    iterations: int
+    residual: float
+    method: str
+
+    def to_document(self) -> dict[str, Any]:
+        """The line's entry of the result document's ``statics`` (DESIGN.md v1)."""
+        return {
+            "end_a": {"tension": float(self.tension_a),
+                      "force": [float(v) for v in self.force_a]},
+            "end_b": {"tension": float(self.tension_b),
+                      "force": [float(v) for v in self.force_b]},
+            "touchdown": None if self.touchdown is None else float(self.touchdown),
+            "nodes": self.positions.tolist(),
+            "s": self.mesh.s0.tolist(),
+            "tension": self.tension.tolist(),
+            "iterations": int(self.iterations),
+            "residual": float(self.residual),
+            "method": self.method,
+        }
+
+
+@dataclass(frozen=True)
+class StaticsResult:
+    """Static equilibrium of every line of a scene, by line name."""
+
+    lines: dict[str, LineStatics] = field(default_factory=dict)
+
+    def to_document(self) -> dict[str, Any]:
+        """The ``statics`` part of the result document (DESIGN.md v1)."""
+        return {"lines": {name: ls.to_document() for name, ls in self.lines.items()}}
+
+
+# ------------------------------------------------------------------------ public API
+
+
+def solve_statics(scene: Scene, method: Method = "auto", *, tolerance: float = 1e-10,
+                  max_iterations: int = 500) -> StaticsResult:
+    """Static equilibrium of every line of a scene.
+
+    Parameters
+    ----------
+    scene : Scene
+        The validated scene (see :func:`stochcable.scene.load_scene`).
+    method : {"auto", "fe", "catenary"}, optional
+        Solution method, see :func:`solve_line_statics`.
+    tolerance : float, optional
+        Relative residual force at convergence (FE). [-]
+    max_iterations : int, optional
+        Iteration budget per line (FE). [-]
+
+    Returns
+    -------
+    StaticsResult
+        One :class:`LineStatics` per line, by name.
+    """
+    env = scene.environment
+    out = {}
+    for line in scene.lines:
+        mesh = mesh_line(line, env.rho, env.g)
+        out[line.name] = solve_line_statics(mesh, env, method=method, tolerance=tolerance,
+                                            max_iterations=max_iterations)
+    return StaticsResult(lines=out)
+
+
+def solve_line_statics(
+    mesh: LineMesh,
+    environment: Environment,
+    method: Method = "auto",
+    initial: np.ndarray | None = None,
+    *,
+    tolerance: float = 1e-10,
+    max_iterations: int = 500,
+) -> LineStatics:
+    """Static equilibrium of one meshed line with fixed ends.
+
+    Parameters
+    ----------
+    mesh : LineMesh
+        The line's elements and nodes (:func:`stochcable.mesh.mesh_line`).
+    environment : Environment
+        Depth, fluid, gravity, current and seabed.
+    method : {"auto", "fe", "catenary"}, optional
+        ``"catenary"``: closed-form elastic catenary (one homogeneous segment between
+        fixed points, no current, no attachments, submerged; seabed contact when end_a
+        lies on the seabed), positions reported at the mesh nodes.  ``"fe"``: the
+        finite-element Newton solve.  ``"auto"`` (default): the catenary where it
+        applies, the FE otherwise.
+    initial : ndarray, shape (n_nodes, 3), optional
+        Initial node positions for the FE (the end rows are replaced by the ends). [m]
+    tolerance : float, optional
+        Convergence threshold of the max nodal residual force relative to the
+        reference force (total weight + largest tension + total drag). [-]
+    max_iterations : int, optional
+        Total iteration budget of the FE solve (Newton, relaxation and load steps). [-]
+
+    Returns
+    -------
+    LineStatics
+        Positions, effective tensions, end forces and seabed contact.
+
+    Raises
+    ------
+    InputError
+        For an unknown method, an ``initial`` of the wrong shape, or ``"catenary"``
+        asked for a line it does not apply to.
+    ConvergenceError
+        When the FE solve does not reach ``tolerance`` within ``max_iterations``; the
+        message carries the residual reached.
+
+    Notes
+    -----
+    The FE model (seed 001 §3.1, DESIGN.md "Cable model") has the interior node
+    positions as unknowns; the ends are fixed at their static positions (end motions
+    are dynamic only).  Element force from the exact elastic bar,
+    T = EA (l/l0 - 1) for l > l0 and T = eps EA (l/l0 - 1), eps = 1e-6, for a slack
+    element (E -> eps, seed 001 §6.2); consistent tangent
+    K_e = [(EA/l0) e eᵀ + (T/l)(I - e eᵀ)] ⊗ [[1, -1], [-1, 1]].
+
+    Loads, lumped half to each node of an element:
+
+    - weight: net submerged weight per unstretched length w·l0 (effective tension);
+      the part of an element above z = 0 carries the dry weight mass·g instead, by the
+      fraction of the element below the surface (tangent included);
+    - attachments: mass·g down, buoyancy up, at their nodes;
+    - steady current U(z) at the element midpoint: normal drag ½ρ Cdn D |u_n| u_n and
+      axial drag ½ρ Cdt πD |u_t| u_t per unit stretched length (a follower load whose
+      exact tangent with respect to the element direction and length is included;
+      the variation of U with depth is left out of the tangent, which makes the
+      iteration linearly rather than quadratically convergent for sheared currents);
+      attachment drag ½ρ (Cd·A) |U| U at the node;
+    - seabed (z < -depth): a one-sided linear spring, stiffness·D per unit length over
+      the node's tributary unstretched length, pushing up only.  The penetration of a
+      line lying on the bed is w/(stiffness·D).  Seabed friction is not modelled.
+
+    Solution (seed 001 §4.1): Newton–Raphson on the residual feedback form
+    (eq. 4.1.2) with a backtracking line search on the residual norm; when it stalls,
+    the viscous relaxation method (eqs. 4.1.5-4.1.8): artificial nodal damping
+    proportional to the stiffness diagonal, [K + C/Δt] ΔU = R, with 1/Δt relaxed
+    toward zero as the residual falls (switched evolution relaxation), which ends as
+    plain Newton; when that fails too, load stepping of the attachments, current and
+    weight variation along the line from the uniform-weight shape.  The tangent of a
+    line is block tridiagonal and is solved banded (O(n) per iteration).
+
+    The reachable residual is bounded below by round-off in l - l0: about
+    8·eps·max(EA/l0)·max|x| relative to the reference force; ``tolerance`` is raised
+    to that floor when it is larger (nearly inextensible, finely meshed lines).
+    """
+    if method not in ("auto", "fe", "catenary"):
+        raise InputError("method", method, "-", "must be 'auto', 'fe' or 'catenary'")
+    tolerance = float(tolerance)
+    if not (0.0 < tolerance < 1.0):
+        raise InputError("tolerance", tolerance, "-", "must be in (0, 1)")
+    if int(max_iterations) < 1:
+        raise InputError("max_iterations", max_iterations, "-", "must be >= 1")
+    if initial is not None:
+        initial = np.asarray(initial, dtype=float)
+        if initial.shape != (mesh.n_nodes, 3) or not np.isfinite(initial).all():
+            raise InputError("initial", initial, "m",
+                             f"must be finite with shape ({mesh.n_nodes}, 3)")
+
+    if method != "fe":
+        why = _catenary_inapplicable(mesh, environment)
+        if why is None:
+            out = _solve_catenary(mesh, environment)
+            if isinstance(out, LineStatics):
+                return out
+            why = out
+        if method == "catenary":
+            raise InputError("method", "catenary", "-",
+                             f"does not apply to line {mesh.name!r}: {why}; use 'fe' or 'auto'")
+    return _solve_fe(mesh, environment, initial, tolerance, int(max_iterations))
+
+
+# ---------------------------------------------------------------------- local frame
+
+
+class _Frame:
+    """Local frame: x' along the horizontal projection of end_a -> end_b, z up.
+
+    A planar problem (every load in the vertical plane through the ends) is solved with
+    two DOFs per node (x', z); otherwise with three (x', y', z).
+    """
+
+    def __init__(self, mesh: LineMesh, env: Environment, force_3d: bool = False) -> None:
+        a, b = mesh.end_a, mesh.end_b
+        h = b[:2] - a[:2]
+        hn = math.hypot(*h)
+        cur = [(p.speed * math.cos(p.heading_rad), p.speed * math.sin(p.heading_rad))
+               for p in env.current if p.speed > 0.0]
+        if hn > 1e-12 * max(1.0, mesh.length):
+            ux = h / hn
+        elif cur:
+            c = np.sum(np.asarray(cur), axis=0)
+            cn = math.hypot(*c)
+            ux = c / cn if cn > 0 else np.array([1.0, 0.0])
+        else:
+            ux = np.array([1.0, 0.0])
+        self.Q = np.array([[ux[0], ux[1], 0.0], [-ux[1], ux[0], 0.0], [0.0, 0.0, 1.0]])
+        self.origin = np.array([a[0], a[1], 0.0])
+        out_of_plane = any(abs(-ux[1] * cx + ux[0] * cy) > 1e-12 * math.hypot(cx, cy)
+                           for cx, cy in cur)
+        self.dim = 3 if (force_3d or out_of_plane) else 2
+        self.cols = [0, 1, 2] if self.dim == 3 else [0, 2]
+
+    def to_local(self, X: np.ndarray) -> np.ndarray:
+        return ((X - self.origin) @ self.Q.T)[:, self.cols]
+
+    def to_global(self, Xl: np.ndarray) -> np.ndarray:
+        full = np.zeros((Xl.shape[0], 3))
+        full[:, self.cols] = Xl
+        return full @ self.Q + self.origin
+
+    def vec_to_global(self, v: np.ndarray) -> np.ndarray:
+        full = np.zeros(3)
+        full[self.cols] = v
+        return full @ self.Q
+
+
+# -------------------------------------------------------------------------- FE model
+
+
+class _Model:
+    """Residual and banded tangent of the FE statics of one line (local frame)."""
+
+    def __init__(self, mesh: LineMesh, env: Environment, frame: _Frame) -> None:
+        self.n = mesh.n_nodes
+        self.dim = dim = frame.dim
+        self.zi = dim - 1
+        self.l0 = mesh.l0
+        self.ea = mesh.ea
+        self.w_sub = mesh.weight
+        self.w_dry = mesh.mass * env.g
+        self.node_fz = mesh.node_buoyancy - mesh.node_mass * env.g
+        self.zbed = -env.depth
+        trib_kd = 0.5 * mesh.l0 * mesh.diameter * env.seabed.stiffness
+        kb = np.zeros(self.n)
+        kb[:-1] += trib_kd
+        kb[1:] += trib_kd
+        self.kb = kb
+        # current profile in the local frame
+        pts = sorted((p for p in env.current), key=lambda p: p.z)
+        self.has_current = any(p.speed > 0 for p in pts)
+        if self.has_current:
+            self.cz = np.array([p.z for p in pts])
+            uv = np.array([[p.speed * math.cos(p.heading_rad),
+                            p.speed * math.sin(p.heading_rad), 0.0] for p in pts])
+            loc = uv @ frame.Q.T
+            self.cu = loc[:, frame.cols]  # (n_pts, dim)
+        self.c_n = 0.5 * env.rho * mesh.cd_normal * mesh.diameter
+        self.c_t = 0.5 * env.rho * mesh.cd_axial * math.pi * mesh.diameter
+        self.c_node = 0.5 * env.rho * mesh.node_drag_area
+        self.has_drag = self.has_current and (
+            bool(np.any(self.c_n > 0)) or bool(np.any(self.c_t > 0))
+            or bool(np.any(self.c_node > 0)))
+        # load-stepping base: the uniform mean weight
+        L = float(np.sum(mesh.l0))
+        self.w_mean_sub = float(np.sum(mesh.weight * mesh.l0)) / L
+        self.w_mean_dry = float(np.sum(self.w_dry * mesh.l0)) / L
+        self.beta = 1.0
+        self.conservative = not self.has_drag
+        self._band_index()
+
+    # ---- loads that do not depend on position, for the reference force
+    def weight_scale(self) -> float:
+        w = np.maximum(np.abs(self.w_sub), np.abs(self.w_dry))
+        return float(np.sum(w * self.l0) + np.sum(np.abs(self.node_fz)))
+
+    def energy(self, X: np.ndarray) -> float:
+        """Total potential energy for conservative loads (no drag); -grad = R."""
+        zi, l0 = self.zi, self.l0
+        d = X[1:] - X[:-1]
+        l = np.sqrt(np.einsum("ij,ij->i", d, d))
+        strain = l / l0 - 1.0
+        eae = np.where(strain > 0.0, self.ea, self.ea * SLACK_FACTOR)
+        z = X[:, zi]
+        za, zb = z[:-1], z[1:]
+        wet = (za <= 0.0) & (zb <= 0.0)
+        w_sub, w_dry = self.w_sub, self.w_dry
+        if self.beta != 1.0:
+            w_sub = self.w_mean_sub + self.beta * (w_sub - self.w_mean_sub)
+            w_dry = self.w_mean_dry + self.beta * (w_dry - self.w_mean_dry)
+        W = l0 * np.where(wet, w_sub, w_dry)
+        pen = np.maximum(self.zbed - z, 0.0)
+        return float(0.5 * np.sum(eae * l0 * strain**2) + np.sum(W * 0.5 * (za + zb))
+                     - self.beta * np.sum(self.node_fz * z) + 0.5 * np.sum(self.kb * pen**2))
+
+    def current(self, z: np.ndarray) -> np.ndarray:
+        u = np.empty(z.shape + (self.dim,))
+        for k in range(self.dim):
+            u[:, k] = np.interp(z, self.cz, self.cu[:, k])
+        u[z > 0.0] = 0.0
+        return u
+
+    def _band_index(self) -> None:
+        dim, nf = self.dim, self.n - 2
+        bw = 2 * dim - 1
+        self.bw = bw
+        p = np.arange(nf)[:, None, None]
+        a = np.arange(dim)[None, :, None]
+        b = np.arange(dim)[None, None, :]
+        rd = np.broadcast_to(bw + a - b, (nf, dim, dim))
+        cd = np.broadcast_to(p * dim + b, (nf, dim, dim))
+        q = np.arange(max(nf - 1, 0))[:, None, None]
+        ru = np.broadcast_to(bw + a - b - dim, (q.shape[0], dim, dim))
+        cu = np.broadcast_to((q + 1) * dim + b, (q.shape[0], dim, dim))
+        rl = np.broadcast_to(bw + dim + a - b, (q.shape[0], dim, dim))
+        cl = np.broadcast_to(q * dim + b, (q.shape[0], dim, dim))
+        self.band_rows = np.concatenate([rd.ravel(), ru.ravel(), rl.ravel()])
+        self.band_cols = np.concatenate([cd.ravel(), cu.ravel(), cl.ravel()])
+        self.diag_rows = np.full(nf * dim, bw)
+
+    def forces(self, X: np.ndarray, tangent: bool = True) -> tuple:
+        """Nodal residual forces R (n, dim) (force on each node, zero at equilibrium),
+        element tensions, drag magnitude, and the tangent blocks -dR/dX."""
+        dim, zi, l0 = self.dim, self.zi, self.l0
+        beta = self.beta
+        d = X[1:] - X[:-1]
+        l = np.sqrt(np.einsum("ij,ij->i", d, d))
+        e = d / l[:, None]
+        strain = l / l0 - 1.0
+        taut = strain > 0.0
+        eae = np.where(taut, self.ea, self.ea * SLACK_FACTOR)
+        T = eae * strain
+        Fe = T[:, None] * e
+        R = np.zeros_like(X)
+        R[:-1] += Fe
+        R[1:] -= Fe
+        # weight, wet fraction of each element
+        z = X[:, zi]
+        za, zb = z[:-1], z[1:]
+        w_sub, w_dry = self.w_sub, self.w_dry
+        if beta != 1.0:
+            w_sub = self.w_mean_sub + beta * (w_sub - self.w_mean_sub)
+            w_dry = self.w_mean_dry + beta * (w_dry - self.w_mean_dry)
+        mixed = (np.minimum(za, zb) < 0.0) & (np.maximum(za, zb) > 0.0)
+        if mixed.any():
+            dz = np.where(mixed, zb - za, 1.0)
+            f = np.where(za <= 0.0, 1.0, 0.0) * np.where(zb <= 0.0, 1.0, 0.0)
+            f = np.where(mixed, -np.minimum(za, zb) / np.abs(dz), f)
+            W = l0 * (w_dry + f * (w_sub - w_dry))
+            # derivatives of the wet fraction, mixed elements only
+            dfa = np.where(mixed, np.where(za < zb, -zb, zb) / dz**2, 0.0)
+            dfb = np.where(mixed, np.where(za < zb, za, -za) / dz**2, 0.0)
+        else:
+            wet = (za <= 0.0) & (zb <= 0.0)
+            W = l0 * np.where(wet, w_sub, w_dry)
+        R[:-1, zi] -= 0.5 * W
+        R[1:, zi] -= 0.5 * W
+        R[:, zi] += beta * self.node_fz
+        drag = 0.0
+        if self.has_drag:
+            u = self.current(0.5 * (za + zb))
+            ua = np.einsum("ij,ij->i", u, e)
+            un = u - ua[:, None] * e
+            unn = np.sqrt(np.einsum("ij,ij->i", un, un))
+            g = ((self.c_n * unn)[:, None] * un
+                 + (self.c_t * np.abs(ua) * ua)[:, None] * e)
+            Fd = beta * l[:, None] * g
+            R[:-1] += 0.5 * Fd
+            R[1:] += 0.5 * Fd
+            un_node = self.current(z)
+            Fn = beta * (self.c_node * np.sqrt(np.einsum("ij,ij->i", un_node, un_node)))[:, None] * un_node
+            R += Fn
+            drag = float(np.sum(np.sqrt(np.einsum("ij,ij->i", Fd, Fd)))
+                         + np.sum(np.abs(Fn)))
+        pen = self.zbed - z
+        contact = pen > 0.0
+        R[:, zi] += np.where(contact, self.kb * pen, 0.0)
+        if not tangent:
+            return R, T, drag, None
+        I = np.eye(dim)
+        ee = e[:, :, None] * e[:, None, :]
+        k = (eae / l0)[:, None, None] * ee + (T / l)[:, None, None] * (I - ee)
+        Kd = np.zeros((self.n, dim, dim))
+        Kd[:-1] += k
+        Kd[1:] += k
+        Ku = -k
+        Kl = -k.copy()
+        if self.has_drag:
+            # D = dF/dd = g eᵀ + (dg/de)(I - e eᵀ)
+            safe = np.where(unn > 0.0, unn, 1.0)
+            A = (unn[:, None, None] * I
+                 + np.where(unn > 0.0, 1.0 / safe, 0.0)[:, None, None]
+                 * un[:, :, None] * un[:, None, :])
+            B = e[:, :, None] * u[:, None, :] + ua[:, None, None] * I
+            dg = (-self.c_n[:, None, None] * (A @ B)
+                  + (self.c_t * np.abs(ua))[:, None, None]
+                  * (2.0 * e[:, :, None] * u[:, None, :] + ua[:, None, None] * I))
+            D = beta * (g[:, :, None] * e[:, None, :] + dg @ (I - ee))
+            Kd[:-1] += 0.5 * D
+            Kd[1:] -= 0.5 * D
+            Ku = Ku - 0.5 * D
+            Kl = Kl + 0.5 * D
+        if mixed.any():
+            dWa = 0.5 * l0 * (w_sub - w_dry) * dfa
+            dWb = 0.5 * l0 * (w_sub - w_dry) * dfb
+            Kd[:-1, zi, zi] += dWa
+            Kd[1:, zi, zi] += dWb
+            Ku[:, zi, zi] += dWb
+            Kl[:, zi, zi] += dWa
+        # nodes resting exactly on the bed get the contact stiffness too
+        Kd[:, zi, zi] += np.where(pen >= 0.0, self.kb, 0.0)
+        return R, T, drag, (Kd, Ku, Kl)
+
+    def band(self, K: tuple, lam: float) -> np.ndarray:
+        Kd, Ku, Kl = K
+        nf = self.n - 2
+        N = nf * self.dim
+        ab = np.zeros((2 * self.bw + 1, N))
+        vals = np.concatenate([Kd[1:-1].ravel(), Ku[1:-1].ravel(), Kl[1:-1].ravel()])
+        ab[self.band_rows, self.band_cols] = vals
+        if lam > 0.0:
+            diag = np.abs(ab[self.bw])
+            ab[self.bw] += lam * (diag + 1e-3 * float(np.mean(diag)))
+        return ab
+
+
+def _reference_force(model: _Model, T: np.ndarray, drag: float) -> float:
+    return model.weight_scale() + float(np.max(np.abs(T))) + drag
+
+
+class _Solver:
+    """Newton with line search, then viscous relaxation (seed 001 eqs. 4.1.5-4.1.8)."""
+
+    def __init__(self, model: _Model, tol: float, budget: int) -> None:
+        self.m = model
+        self.tol = tol
+        self.budget = budget
+        self.used = 0
+        scale = float(np.max(model.ea / model.l0))
+        self._floor_k = 8.0 * _EPS * scale
+
+    def status(self, X: np.ndarray) -> tuple[float, float, np.ndarray, tuple]:
+        R, T, drag, K = self.m.forces(X)
+        ref = _reference_force(self.m, T, drag)
+        r = float(np.max(np.abs(R[1:-1]))) / ref if self.m.n > 2 else 0.0
+        floor = self._floor_k * float(np.max(np.abs(X))) / ref
+        return r, max(self.tol, floor), R, K
+
+    def _step(self, R: np.ndarray, K: tuple, lam: float) -> np.ndarray | None:
+        ab = self.m.band(K, lam)
+        try:
+            dx = solve_banded((self.m.bw, self.m.bw), ab, R[1:-1].ravel(),
+                              overwrite_ab=True, overwrite_b=False, check_finite=False)
+        except (LinAlgError, ValueError):
+            return None
+        if not np.all(np.isfinite(dx)):
+            return None
+        return dx.reshape(-1, self.m.dim)
+
+    def solve(self, X: np.ndarray, limit: int) -> tuple[bool, np.ndarray, float]:
+        """Iterate from X; returns (converged, X, relative residual)."""
+        m = self.m
+        if m.n <= 2:
+            return True, X, 0.0
+        X = X.copy()
+        r, tol, R, K = self.status(X)
+        if r <= tol:
+            return True, X, r
+        span = float(np.sum(m.l0))
+        cap = 0.25 * span
+        lam = 0.0
+        phi = float(np.sum(R[1:-1] ** 2))
+        energy = m.energy(X) if m.conservative else math.nan
+        best = (r, X.copy())
+        for _ in range(limit):
+            if self.used >= self.budget:
+                break
+            self.used += 1
+            dx = self._step(R, K, lam)
+            if dx is None:
+                lam = max(10.0 * lam, 1e-3)
+                continue
+            big = float(np.max(np.sqrt(np.sum(dx * dx, axis=1))))
+            t = min(1.0, cap / big) if big > 0 else 1.0
+            slope = float(np.sum(R[1:-1] * dx))  # -dPi/dt along dx (conservative loads)
+            accepted = False
+            # backtracking line search: accept a decrease of the total potential energy
+            # (Armijo, when the loads are conservative) or of the residual norm
+            for _ls in range(10):
+                Xt = X.copy()
+                Xt[1:-1] += t * dx
+                Rt = m.forces(Xt, tangent=False)[0]
+                phit = float(np.sum(Rt[1:-1] ** 2))
+                if not np.isfinite(phit):
+                    t *= 0.5
+                    continue
+                if phit <= (1.0 - 1e-4 * t) * phi:
+                    accepted = True
+                elif m.conservative and slope > 0.0:
+                    et = m.energy(Xt)
+                    accepted = et <= energy - 1e-4 * t * slope
+                if accepted:
+                    break
+                t *= 0.5
+            if not accepted:
+                # Newton stalls: viscous relaxation, artificial damping C ∝ diag(K)
+                # (seed 001 eqs. 4.1.5-4.1.8), stiffened until a step is taken
+                lam = max(4.0 * lam, 1e-2)
+                continue
+            X = Xt
+            r, tol, R, K = self.status(X)
+            phi = float(np.sum(R[1:-1] ** 2))
+            if m.conservative:
+                energy = m.energy(X)
+            if r < best[0]:
+                best = (r, X.copy())
+            if r <= tol:
+                return True, X, r
+            if lam > 0.0 and _ls == 0:
+                # relax the damping toward zero (pure Newton) while full steps succeed
+                lam *= 0.3
+                if lam < 1e-6:
+                    lam = 0.0
+        return False, best[1], best[0]
+
+
+def _straight(a: np.ndarray, b: np.ndarray, frac: np.ndarray) -> np.ndarray:
+    return a + frac[:, None] * (b - a)
+
+
+def _initial_guess(mesh: LineMesh, env: Environment, frame: _Frame) -> np.ndarray:
+    """A hanging (parabolic) or straight initial shape in the local frame, (n, dim)."""
+    a = frame.to_local(mesh.end_a[None, :])[0]
+    b = frame.to_local(mesh.end_b[None, :])[0]
+    frac = mesh.s0 / mesh.length
+    chord = float(np.linalg.norm(b - a))
+    L = mesh.length
+    if L <= chord * (1.0 + 1e-9):
+        return _straight(a, b, frac)
+    guess = _catenary_guess(mesh, env, frame, a, b)
+    if guess is not None:
+        return guess
+    zi = frame.dim - 1
+    sign = 1.0 if float(np.sum(mesh.weight * mesh.l0)) >= 0.0 else -1.0
+    xi = np.linspace(0.0, 1.0, 401)
+    base = _straight(a, b, xi)
+    horizontal = abs(b[0] - a[0]) > 1e-3 * chord
+    bulge_axis = zi if horizontal else 0
+
+    def shape(delta: float) -> np.ndarray:
+        P = base.copy()
+        P[:, bulge_axis] -= (sign if horizontal else -1.0) * 4.0 * delta * xi * (1 - xi)
+        return P
+
+    def arclen(P: np.ndarray) -> float:
+        return float(np.sum(np.linalg.norm(np.diff(P, axis=0), axis=1)))
+
+    lo, hi = 0.0, L
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if arclen(shape(mid)) < L:
+            lo = mid
+        else:
+            hi = mid
+    P = shape(0.5 * (lo + hi))
+    cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
+    cum *= L / cum[-1]
+    X = np.column_stack([np.interp(mesh.s0, cum, P[:, k]) for k in range(frame.dim)])
+    X[:, zi] = np.maximum(X[:, zi], -env.depth)
+    X[0], X[-1] = a, b
+    return X
+
+
+def _catenary_guess(mesh: LineMesh, env: Environment, frame: _Frame,
+                    a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """Inextensible catenary of the line's mean weight through the ends, prestretched.
+
+    Touchdown form when end_a lies on the seabed and the free catenary would dip below
+    it.  The nodes are placed at their stretched arc length, each element carrying the
+    catenary tension, so the first tangent has transverse stiffness T/l > 0.
+    Returns None when the mean weight is not positive or the span is vertical.
+    """
+    from scipy.optimize import brentq
+
+    L = mesh.length
+    w = float(np.sum(mesh.weight * mesh.l0)
+              + np.sum(mesh.node_mass * env.g - mesh.node_buoyancy)) / L
+    zi = frame.dim - 1
+    X = float(b[0] - a[0])
+    Z = float(b[zi] - a[zi])
+    if not (w > 0.0) or X <= 1e-6 * L:
+        return None
+    on_bed = a[zi] <= -env.depth * (1.0 - 1e-9) and Z > 0.0
+    ea_mean = L / float(np.sum(mesh.l0 / mesh.ea))
+
+    def shape(length: float) -> tuple:
+        # free-hanging catenary: 2 c sinh(X / 2c) = sqrt(length² - Z²)
+        ratio = math.sqrt(length**2 - Z**2) / X
+        u = brentq(lambda v: math.sinh(v) / v - ratio, 1e-9, 700.0, xtol=1e-14)
+        c = X / (2.0 * u)
+        xm = 0.5 * X - c * math.atanh(Z / length)
+        if on_bed and xm > 0.0:
+            # touchdown: grounded length lg, suspended sqrt(Z² + 2 Z c)
+            def f(cc: float) -> float:
+                ls = math.sqrt(Z * Z + 2.0 * Z * cc)
+                return length - ls + cc * math.asinh(ls / cc) - X
+            hi = X
+            while f(hi) < 0.0 and hi < 1e12 * X:
+                hi *= 2.0
+            if f(1e-9 * X) >= 0.0:
+                raise ValueError("line longer than the span plus the depth")
+            c = brentq(f, 1e-9 * X, hi, xtol=1e-12 * X)
+            ls = math.sqrt(Z * Z + 2.0 * Z * c)
+            return c, length - ls, True
+        return c, xm, False
+
+    def curve(c: float, x0: float, grounded: bool, sigma: np.ndarray) -> tuple:
+        if grounded:
+            xs = np.where(sigma <= x0, sigma, x0 + c * np.arcsinh((sigma - x0) / c))
+            zs = np.where(sigma <= x0, 0.0, c * (np.cosh((xs - x0) / c) - 1.0))
+            tz = c * np.cosh((xs - x0) / c)
+        else:
+            s_a = c * math.sinh(-x0 / c)
+            xs = x0 + c * np.arcsinh((sigma + s_a) / c)
+            zs = c * (np.cosh((xs - x0) / c) - math.cosh(x0 / c))
+            tz = c * np.cosh((xs - x0) / c)
+        return xs, zs, w * tz
+
+    try:
+        c, x0, grounded = shape(L)
+        _, _, T = curve(c, x0, grounded, mesh.s0)
+        strain = 0.5 * (T[:-1] + T[1:]) / mesh.ea
+        sigma = np.concatenate([[0.0], np.cumsum(mesh.l0 * (1.0 + strain))])
+        c, x0, grounded = shape(float(sigma[-1]))
+        xs, zs, _ = curve(c, x0, grounded, sigma)
+    except (ValueError, ZeroDivisionError, OverflowError, RuntimeError):
+        return None
+    Xg = np.zeros((mesh.n_nodes, frame.dim))
+    Xg[:, 0] = a[0] + xs
+    Xg[:, zi] = a[zi] + zs
+    # grounded nodes at their equilibrium penetration w·l/(stiffness·D·l)
+    model_kd = env.seabed.stiffness * np.concatenate([mesh.diameter[:1], mesh.diameter])
+    pen = np.abs(w) / np.maximum(model_kd, 1e-300)
+    Xg[:, zi] = np.where(Xg[:, zi] <= -env.depth, -env.depth - pen, Xg[:, zi])
+    if not np.all(np.isfinite(Xg)):
+        return None
+    Xg[0], Xg[-1] = a, b
+    return Xg
+
+
+def _solve_fe(mesh: LineMesh, env: Environment, initial: np.ndarray | None,
+              tol: float, budget: int, force_3d: bool = False) -> LineStatics:
+    frame = _Frame(mesh, env, force_3d=force_3d)
+    model = _Model(mesh, env, frame)
+    if initial is not None:
+        X0 = frame.to_local(initial)
+    else:
+        X0 = _initial_guess(mesh, env, frame)
+    X0[0] = frame.to_local(mesh.end_a[None, :])[0]
+    X0[-1] = frame.to_local(mesh.end_b[None, :])[0]
+    solver = _Solver(model, tol, budget)
+    ok, X, r = solver.solve(X0, budget)
+    if not ok and solver.used < budget:
+        # load stepping: attachments, current and weight variation ramped from the
+        # uniform-weight problem (its shape is the hanging shape of the line)
+        beta_ok, X_ok = 0.0, X0
+        model.beta = 0.0
+        ok0, X_b, _ = solver.solve(X0, budget)
+        if ok0:
+            X_ok = X_b
+            step = 0.25
+            while beta_ok < 1.0 and solver.used < budget and step >= 1.0 / 256:
+                model.beta = min(1.0, beta_ok + step)
+                ok_s, X_s, _ = solver.solve(X_ok, 50)
+                if ok_s:
+                    beta_ok, X_ok = model.beta, X_s
+                    step = min(2.0 * step, 0.5)
+                else:
+                    step *= 0.5
+            if beta_ok >= 1.0:
+                ok, X = True, X_ok
+        model.beta = 1.0
+        if ok:
+            r = solver.status(X)[0]
+    if not ok:
+        raise ConvergenceError(
+            "statics Newton", solver.used, r, tol,
+            hint=(f"line {mesh.name!r}: check that the line can reach its ends and that "
+                  "the loads are physical, give a better initial shape, raise "
+                  "max_iterations or refine the mesh"),
+            partial=frame.to_global(X),
+        )
+    return _fe_result(mesh, env, frame, model, X, solver.used, r)
+
+
+def _fe_result(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
+               X: np.ndarray, iterations: int, r: float) -> LineStatics:
+    R, T, _, _ = model.forces(X, tangent=False)
+    fa = frame.vec_to_global(R[0])
+    fb = frame.vec_to_global(R[-1])
+    tension = np.where(T > 0.0, T, 0.0)
+    ta, tb = float(np.linalg.norm(fa)), float(np.linalg.norm(fb))
+    node_t = np.empty(mesh.n_nodes)
+    node_t[1:-1] = 0.5 * (tension[:-1] + tension[1:])
+    node_t[0], node_t[-1] = ta, tb
+    zi = frame.dim - 1
+    z = X[:, zi]
+    zbed = -env.depth
+    ztol = 1e-9 * max(env.depth, 1.0)
+    grounded = z <= zbed + ztol
+    touchdown = _touchdown(mesh, X, T, zi, grounded)
+    pos = frame.to_global(X)
+    pos[0], pos[-1] = mesh.end_a, mesh.end_b
+    return LineStatics(
+        mesh=mesh, positions=pos, tension=tension, node_tension=node_t,
+        force_a=fa, force_b=fb, tension_a=ta, tension_b=tb, grounded=grounded,
+        touchdown=touchdown, iterations=iterations, residual=r, method="fe",
+    )
+
+
+def _touchdown(mesh: LineMesh, X: np.ndarray, T: np.ndarray, zi: int,
+               grounded: np.ndarray) -> float | None:
+    """Arc length where the line leaves the seabed toward end_b.
+
+    Interpolated from the vertical tension component of the first suspended element k:
+    along a catenary V(s) = w (s - s_td), and the element tension of a lumped chain is
+    the continuous tension at the element midpoint, so s_td = s_mid,k - V_k / w_k.
+    """
+    inner = np.flatnonzero(grounded[1:-1]) + 1
+    if inner.size == 0:
+        return None
+    g = int(inner[-1])
+    if g >= mesh.n_nodes - 1 or grounded[g + 1]:
+        return float(mesh.s0[g])
+    k = g  # element from node g to g + 1
+    d = X[k + 1] - X[k]
+    vz = T[k] * d[zi] / float(np.linalg.norm(d))
+    w = mesh.weight[k]
+    s_mid = 0.5 * (mesh.s0[k] + mesh.s0[k + 1])
+    s = s_mid - vz / w if w > 0 else mesh.s0[g]
+    lo = mesh.s0[g - 1] if g >= 1 else mesh.s0[0]
+    return float(min(max(s, lo), mesh.s0[g + 1]))
+
+
+# ---------------------------------------------------------------------- catenary path
+
+
+def _catenary_inapplicable(mesh: LineMesh, env: Environment) -> str | None:
+    """None when the closed-form catenary applies to the line, else the reason."""
+    if np.unique(mesh.segment).size > 1:
+        return "it has more than one segment"
+    if np.any(mesh.node_mass != 0.0) or np.any(mesh.node_buoyancy != 0.0):
+        return "it has attachments"
+    if any(p.speed > 0.0 for p in env.current):
+        return "there is a current"
+    if not (float(mesh.weight[0]) > 0.0):
+        return "its net submerged weight is not positive"
+    if max(mesh.end_a[2], mesh.end_b[2]) > 0.0:
+        return "an end is above the still-water level"
+    if math.hypot(*(mesh.end_b[:2] - mesh.end_a[:2])) <= 1e-9 * mesh.length:
+        return "its ends are vertically aligned"
+    return None
+
+
+def _solve_catenary(mesh: LineMesh, env: Environment) -> LineStatics | str:
+    """Closed-form elastic catenary at the mesh nodes; a reason string when the free
+    catenary would pass below the seabed (contact away from end_a needs the FE)."""
+    from .catenary import catenary_line
+
+    cl = catenary_line(mesh, env)
+    sol = cl.solution
+    pos = cl.positions
+    depth = env.depth
+    ztol = 1e-9 * max(depth, 1.0)
+    if sol.touchdown <= 0.0 and float(np.min(pos[:, 2])) < -depth - ztol:
+        return "the free catenary passes below the seabed"
+    d = mesh.end_b - mesh.end_a
+    e_h = np.array([d[0], d[1], 0.0]) / math.hypot(d[0], d[1])
+    ez = np.array([0.0, 0.0, 1.0])
+    fa = sol.H * e_h + sol.V_a * ez
+    fb = -sol.H * e_h - sol.V_b * ez
+    touchdown = float(sol.touchdown) if sol.touchdown > 0.0 else None
+    grounded = pos[:, 2] <= -depth + ztol
+    if touchdown is not None:
+        grounded = grounded | (mesh.s0 <= touchdown)
+    node_t = np.asarray(cl.node_tension, dtype=float).copy()
+    node_t[0], node_t[-1] = sol.tension_a, sol.tension_b
+    return LineStatics(
+        mesh=mesh, positions=np.asarray(pos, dtype=float),
+        tension=np.asarray(cl.element_tension, dtype=float), node_tension=node_t,
+        force_a=fa, force_b=fb, tension_a=float(sol.tension_a),
+        tension_b=float(sol.tension_b), grounded=grounded, touchdown=touchdown,
+        iterations=sol.iterations,
+        residual=float(sol.residual) / max(mesh.length, float(np.linalg.norm(d))),
+        method="catenary",
+    )

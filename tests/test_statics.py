@@ -1,0 +1,232 @@
+"""Tests of stochcable.statics: FE statics against the closed-form elastic catenary
+(stochcable.catenary, Irvine 1981), conservation of force, symmetry, seed 001 §6.2."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stochcable.catenary import catenary_multisegment, catenary_solve
+from stochcable.errors import ConvergenceError, InputError
+from stochcable.mesh import mesh_line
+from stochcable.scene import load_scene
+from stochcable.statics import _solve_fe, solve_line_statics, solve_statics
+
+# DESIGN.md "Scene and result documents": the chain leg of the example scene.
+CHAIN = dict(length=850.0, ea=1.2326e9, mass=288.0, diameter=0.216, cd_normal=1.333,
+             cd_axial=0.2034, elements=100)
+
+
+def make(end_a, end_b, segments, depth=200.0, current=(), attachments=(), stiffness=3e6,
+         rho=1025.0, g=9.80665):
+    scene = load_scene({
+        "environment": {"depth": depth, "rho": rho, "g": g, "current": list(current),
+                        "seabed": {"stiffness": stiffness}},
+        "lines": [{"name": "l", "end_a": {"position": list(end_a)},
+                   "end_b": {"position": list(end_b)}, "segments": list(segments),
+                   "attachments": list(attachments)}]})
+    env = scene.environment
+    return mesh_line(scene.lines[0], env.rho, env.g), env, scene
+
+
+def fe(mesh, env, **kw):
+    return solve_line_statics(mesh, env, method="fe", **kw)
+
+
+def richardson(seg, end_a, end_b, n, **kw):
+    """FE end tensions and positions at n and 2n elements, extrapolated for O(1/n²)."""
+    out = []
+    for k in (n, 2 * n):
+        m, env, _ = make(end_a, end_b, [dict(seg, elements=k)], **kw)
+        r = fe(m, env)
+        out.append((np.array([r.tension_a, r.tension_b]), r.positions[:: k // n]))
+    (t1, p1), (t2, p2) = out
+    return (4 * t2 - t1) / 3, (4 * p2 - p1) / 3, (t1, t2)
+
+
+@pytest.mark.parametrize("case,length,end_a,end_b", [
+    ("slack", 500.0, (-400.0, 0.0, -100.0), (0.0, 0.0, -20.0)),
+    ("taut", 407.0, (-400.0, 0.0, -100.0), (0.0, 0.0, -20.0)),
+])
+def test_fe_converges_to_catenary(case, length, end_a, end_b):
+    # A chain of straight bars with the weight lumped at the nodes is not the
+    # continuous catenary: its chords are shorter than the arcs by O(l0³ κ²) each,
+    # so node positions and end tensions differ by O(1/n²).  Check the rate (error
+    # ratio 4 from n = 40 to 80) and that the Richardson extrapolation of the two
+    # meets the closed form to 1e-6 relative.
+    seg = dict(CHAIN, length=length)
+    m, env, _ = make(end_a, end_b, [seg])
+    cat = solve_line_statics(m, env, method="catenary")
+    ref_t = np.array([cat.tension_a, cat.tension_b])
+    t_ex, p_ex, (t1, t2) = richardson(seg, end_a, end_b, 40)
+    e1 = np.abs(t1 - ref_t) / ref_t
+    e2 = np.abs(t2 - ref_t) / ref_t
+    # second order: ratio between 3.5 and 4.5 (higher-order terms at n = 40)
+    assert np.all((e1 / e2 > 3.5) & (e1 / e2 < 4.5))
+    assert np.max(np.abs(t_ex - ref_t) / ref_t) < 1e-6
+    m40, env40, _ = make(end_a, end_b, [dict(seg, elements=40)])
+    cat40 = solve_line_statics(m40, env40, method="catenary")
+    assert np.max(np.abs(p_ex - cat40.positions)) < 1e-6 * length
+
+
+def test_fe_seabed_touchdown_matches_catenary():
+    # Anchor on the seabed.  The FE seabed is a penalty spring: a grounded line sinks
+    # w/(k D) into it, 3.8e-6 m with k = 3e9 Pa/m, so the stiff bed reproduces the
+    # rigid-bed catenary up to that and to the O(1/n²) discretization (Richardson).
+    end_a, end_b = (-800.0, 0.0, -200.0), (0.0, 0.0, -20.0)
+    m, env, _ = make(end_a, end_b, [CHAIN], stiffness=3e9)
+    cat = solve_line_statics(m, env, method="catenary")
+    assert cat.touchdown is not None and cat.touchdown > 300.0
+    r = fe(m, env)
+    w = float(m.weight[0])
+    pen = w / (3e9 * 0.216)
+    grounded = r.grounded[1:-1]
+    assert grounded.sum() > 10
+    # grounded nodes sit at the penalty penetration (uniform, exact for a flat line)
+    zg = r.positions[1:-1][grounded, 2]
+    assert np.allclose(zg[:-3], -200.0 - pen, rtol=0, atol=1e-9)
+    # end tensions: discretization at n = 100, 1e-4 (measured 6.5e-5)
+    assert abs(r.tension_a / cat.tension_a - 1) < 5e-5
+    assert abs(r.tension_b / cat.tension_b - 1) < 1e-4
+    # touchdown interpolated within a fraction of an element (8.5 m)
+    assert abs(r.touchdown - cat.touchdown) < 0.05 * 8.5
+
+
+def test_auto_uses_catenary_and_fe_otherwise():
+    m, env, scene = make((-400, 0, -100), (0, 0, -20), [dict(CHAIN, length=500.0)])
+    assert solve_line_statics(m, env).method == "catenary"
+    m2, env2, _ = make((-400, 0, -100), (0, 0, -20), [dict(CHAIN, length=500.0)],
+                       current=[{"z": 0.0, "speed": 0.5}])
+    assert solve_line_statics(m2, env2).method == "fe"
+    with pytest.raises(InputError, match="there is a current"):
+        solve_line_statics(m2, env2, method="catenary")
+    with pytest.raises(InputError, match="method"):
+        solve_line_statics(m, env, method="newton")
+
+
+def test_equilibrium_end_forces_balance_loads():
+    # Sum of forces on the line: supports + weight + attachments + drag = 0.  The end
+    # forces are what the line exerts, so force_a + force_b = total external load.
+    segs = [dict(CHAIN, length=300.0, elements=30), dict(CHAIN, length=200.0, elements=20)]
+    atts = [{"at": 300.0, "buoyancy": 3e5}, {"at": 100.0, "mass": 1e4}]
+    m, env, _ = make((-400, 0, -150), (0, 0, -20), segs, attachments=atts, depth=1000.0)
+    r = fe(m, env)
+    total = np.array([0.0, 0.0, -np.sum(m.weight * m.l0) + 3e5 - 1e4 * env.g])
+    scale = np.sum(np.abs(m.weight * m.l0)) + 3e5
+    # interior residual 1e-10 of the reference force, summed over 51 nodes
+    assert np.allclose(r.force_a + r.force_b, total, rtol=0, atol=1e-8 * scale)
+    assert r.residual < 1e-9
+
+
+def test_symmetric_u_shape():
+    m, env, _ = make((-200, 0, -50), (200, 0, -50), [dict(CHAIN, length=500.0, elements=50)],
+                     depth=500.0)
+    r = fe(m, env)
+    p = r.positions
+    # mirror x -> -x reverses the node order; round-off of a 1e-10 relative residual
+    assert np.allclose(p[:, 0], -p[::-1, 0], atol=1e-7)
+    assert np.allclose(p[:, 2], p[::-1, 2], atol=1e-7)
+    assert np.allclose(r.tension, r.tension[::-1], rtol=1e-8)
+    assert r.tension_a == pytest.approx(r.tension_b, rel=1e-9)
+
+
+# Seed 001 §6.2 (Tuah 1982): two segments, 500 ft and 1000 ft, from (0, 0) to
+# (1200, 500) ft, A0 = 0.0218 ft², E = 8.12e6 psf, cable 3.35 slug/ft³, water
+# 2.0 slug/ft³, a 900 lb buoy at the junction (imperial units, g = 32.174 ft/s²).
+TUAH_1982_6_2 = dict(area=0.0218, E=8.12e6, rho_c=3.35, rho_f=2.0, buoy=900.0,
+                     lengths=(500.0, 1000.0), end_b=(1200.0, 500.0))
+
+
+def test_seed_001_example_6_2_two_segments_with_buoy():
+    d = TUAH_1982_6_2
+    g = 32.174
+    diam = math.sqrt(4 * d["area"] / math.pi)
+    seg = dict(ea=d["E"] * d["area"], mass=d["rho_c"] * d["area"], diameter=diam)
+    segs = [dict(seg, length=d["lengths"][0], elements=40),
+            dict(seg, length=d["lengths"][1], elements=80)]
+    end_a = (0.0, 0.0, -600.0)
+    end_b = (d["end_b"][0], 0.0, -600.0 + d["end_b"][1])
+    m, env, _ = make(end_a, end_b, segs, depth=2000.0, rho=d["rho_f"], g=g,
+                     attachments=[{"at": 500.0, "buoyancy": d["buoy"]}])
+    r = fe(m, env)
+    w = (d["rho_c"] - d["rho_f"]) * d["area"] * g
+    ref = catenary_multisegment(d["end_b"][0], d["end_b"][1], d["lengths"], [w, w],
+                                [seg["ea"]] * 2, junction_loads=[-d["buoy"]])
+    # O(1/n²) discretization with 120 elements: 1e-4 relative (measured below 3e-5)
+    assert r.tension_a == pytest.approx(ref.tension_a, rel=1e-4)
+    assert r.tension_b == pytest.approx(ref.tension_b, rel=1e-4)
+    j = int(np.argmin(np.abs(m.s0 - 500.0)))
+    assert r.positions[j, 0] == pytest.approx(ref.junctions[0, 0], abs=0.05)
+    assert r.positions[j, 2] + 600.0 == pytest.approx(ref.junctions[0, 1], abs=0.05)
+
+
+def test_3d_line_equals_rotated_planar_one():
+    th = math.radians(37.0)
+    rot = np.array([[math.cos(th), -math.sin(th), 0], [math.sin(th), math.cos(th), 0],
+                    [0, 0, 1]])
+    a, b = np.array([-800.0, 0, -200]), np.array([0.0, 0, -20])
+    m2, env, _ = make(a, b, [CHAIN])
+    m3, env3, _ = make(rot @ a, rot @ b, [CHAIN])
+    r2 = fe(m2, env)
+    r3 = _solve_fe(m3, env3, None, 1e-10, 500, force_3d=True)  # full 3-DOF path
+    assert np.allclose(r3.positions, r2.positions @ rot.T, atol=1e-7)
+    assert r3.tension_a == pytest.approx(r2.tension_a, rel=1e-9)
+    assert np.allclose(r3.force_b, rot @ r2.force_b, atol=1e-9 * r2.tension_b)
+
+
+@pytest.mark.parametrize("name,end_a,end_b,seg,depth", [
+    ("nearly taut", (-400, 0, -100), (0, 0, -100), dict(CHAIN, length=400.0 * (1 + 1e-8) ), 200.0),
+    ("very slack, mostly grounded", (-800, 0, -200), (0, 0, -20), dict(CHAIN, length=960.0), 200.0),
+    ("nearly vertical", (-5, 0, -200), (0, 0, -20), dict(CHAIN, length=180.1), 300.0),
+    ("EA/T 1e6", (-400, 0, -100), (0, 0, -20), dict(CHAIN, length=500.0, ea=1e12), 200.0),
+    ("400 elements", (-800, 0, -200), (0, 0, -20), dict(CHAIN, elements=400), 200.0),
+])
+def test_hard_cases_match_catenary(name, end_a, end_b, seg, depth):
+    m, env, _ = make(end_a, end_b, [seg], depth=depth)
+    cat = solve_line_statics(m, env, method="catenary")
+    r = fe(m, env)
+    # FE vs continuous catenary: the lumped model resolves the end loads and the
+    # touchdown (where the last grounded node carries part of the suspended weight) to
+    # about one element weight w·l0; relative to the end tension that bounds the
+    # difference (O(1/n²) where neither occurs, see test_fe_converges_to_catenary).
+    bound = max(2e-4, float(m.weight[0] * m.l0[0]) / min(cat.tension_a, cat.tension_b))
+    assert r.tension_b == pytest.approx(cat.tension_b, rel=bound)
+    assert r.tension_a == pytest.approx(cat.tension_a, rel=bound)
+    assert np.max(np.abs(r.positions - cat.positions)) < 2e-3 * m.length
+
+
+def test_current_deflects_downstream_taut_string():
+    # A taut horizontal line across a uniform current U (heading 90 deg, +y): the
+    # drag load q = ½ρ Cd D U² per length deflects it downstream (+y), and the small-
+    # deflection string gives the midspan sag q L²/(8 T).  Weightless line
+    # (weight = 0) so the deflection is purely horizontal.
+    seg = dict(length=100.0, ea=1e7, mass=10.0, diameter=0.1, cd_normal=1.2, weight=0.0,
+               elements=50)
+    m, env, _ = make((-100.5, 0, -50), (0.5, 0, -50), [seg], depth=100.0,
+                     current=[{"z": 0.0, "speed": 1.0, "heading": 90.0}])
+    r = fe(m, env)
+    q = 0.5 * 1025.0 * 1.2 * 0.1 * 1.0**2
+    T = float(np.mean(r.tension))
+    mid = r.positions[25]
+    assert mid[1] > 0.0  # downstream
+    sag = q * 101.0**2 / (8.0 * T)
+    # string formula neglects the O((sag/L)²) stretch and obliquity: 1 % agreement
+    assert mid[1] == pytest.approx(sag, rel=1e-2)
+    assert abs(mid[2] + 50.0) < 1e-9
+
+
+def test_nonconvergence_raises_with_residual():
+    m, env, _ = make((-800, 0, -200), (0, 0, -20), [CHAIN])
+    with pytest.raises(ConvergenceError, match=r"statics Newton did not converge: residual"):
+        fe(m, env, max_iterations=1)
+
+
+def test_solve_statics_document():
+    _, _, scene = make((-800, 0, -200), (0, 0, -20), [dict(CHAIN, elements=20)])
+    doc = solve_statics(scene).to_document()
+    line = doc["lines"]["l"]
+    assert line["method"] == "catenary"
+    assert line["end_a"]["tension"] > 0 and len(line["nodes"]) == 21
+    assert len(line["tension"]) == 20 and line["touchdown"] > 0
