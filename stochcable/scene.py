@@ -541,7 +541,7 @@ class AnalysisSettings(_Doc):
 class Scene(_Doc):
     """A complete analysis: environment, sea, lines and settings (DESIGN.md v1)."""
 
-    title: str = Field(default="", max_length=200, description="Free text")
+    title: str = Field(default="", max_length=2000, description="Free text: source and assumptions")
     environment: Environment
     sea: Sea | None = None
     lines: tuple[Line, ...] = Field(min_length=1, max_length=100)
@@ -594,33 +594,40 @@ class Scene(_Doc):
 
 
 def _unit_of(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str:
-    """The unit declared on the field at ``loc`` (walking nested models), or ''."""
-    from typing import get_args, get_origin
+    """The unit declared on the field at ``loc`` (walking nested models), or ''.
+
+    Discriminated unions are followed: a path part equal to a member's ``type`` tag
+    narrows the candidates to that member.
+    """
+    from typing import get_args
 
     unit = ""
-    current: Any = model
+    candidates: list[type[BaseModel]] = [model] if model is not None else []
     for part in loc:
-        if isinstance(part, int) or current is None:
+        if isinstance(part, int) or not candidates:
             continue
-        fields = getattr(current, "model_fields", None)
-        if not fields or part not in fields:
-            # discriminator tags ('pierson_moskowitz') or unknown keys
+        tagged = [
+            c for c in candidates
+            if "type" in c.model_fields and c.model_fields["type"].default == part
+        ]
+        if tagged:
+            candidates = tagged
             continue
-        info = fields[part]
+        current = next((c for c in candidates if part in c.model_fields), None)
+        if current is None:
+            continue
+        info = current.model_fields[part]
         extra = info.json_schema_extra
         unit = extra.get("unit", "") if isinstance(extra, dict) else ""
-        ann = info.annotation
-        nxt = None
-        stack = [ann]
+        found: list[type[BaseModel]] = []
+        stack: list[Any] = [info.annotation]
         while stack:
             t = stack.pop()
             if isinstance(t, type) and issubclass(t, BaseModel):
-                nxt = t
-                break
+                found.append(t)
+                continue
             stack.extend(get_args(t))
-            if get_origin(t) is Annotated:
-                stack.extend(get_args(t)[:1])
-        current = nxt
+        candidates = found
     return unit
 
 
@@ -664,7 +671,7 @@ def input_error_from_validation(
         value = InputError._NO_VALUE
     elif isinstance(value, (list, tuple)) and len(value) > 6:
         value = f"[{len(value)} values]"
-    return InputError(path, value, _unit_of(model, clean), msg)
+    return InputError(path, value, _unit_of(model, loc), msg)
 
 
 _TAGS = {"pierson_moskowitz", "jonswap", "bretschneider", "issc", "ochi_hubble", "table"}

@@ -1,0 +1,78 @@
+"""Example scenes shipped with stochcable (package data, so an installed service can serve them).
+
+Each ``<name>.json`` is a scene document (DESIGN.md "Scene and result documents") whose
+``title`` states its source and assumptions in short; the details:
+
+- ``chain_catenary``: the v1 contract example of DESIGN.md verbatim, without the
+  (load-free) attachment: 120 mm studless chain, 288 kg/m, hydrodynamic diameter 0.216 m
+  (1.8 x nominal), EA 1.2326e9 N, 850 m from an anchor at (-800, 0, -200) m to a
+  fairlead at (0, 0, -20) m moving in surge.
+- ``tuah_1982_suspended_cable``: seed 001 (Tuah 1982) §6.2 Example 2 in ft, slug, s,
+  lbf (g = 32.174 ft/s², fluid 2.0 slug/ft³ as the seed).  Cable A0 = 0.0218 ft²
+  (D = sqrt(4 A0/π) = 0.1666 ft), E = 8.12e6 psf (EA = 177 016 lbf), density
+  3.35 slug/ft³ (mass 0.07303 slug/ft), 900 lb buoy at the junction.  The seed's span
+  (0, 0) -> (1200, 500) ft is placed at z = -1500 and -1000 ft in an assumed 2000 ft
+  depth; drag and added-mass coefficients are assumed (statics do not need them).
+- ``taut_wire``: illustrative (not from a seed).  52 mm spiral strand; unstretched
+  length 100 m between (-100, 0, -50) (on the seabed) and (0, 0, -40): the elastic
+  catenary gives T about 1.30 MN (strain 0.5 %), sag/span 1.08e-3.
+- ``inclined_guy``: seed 000 (Bliet 1984) §7.3.  The thesis's span 940.68 m and height
+  426.70 m are used for the ends; the net weight is (48.7 kg/m - ρπD²/4) g = 415.2 N/m
+  (the thesis's printed 494.98 N/m is inconsistent with its own tensions and angles);
+  CDt is taken on πD.  Sea state assumed (the thesis excites the top end only).
+- ``tuah_1982_single_leg``: seed 001 §6.5 Example 5, sea PM m0 = 28 ft²,
+  ωp = 0.5 rad/s, 200 frequencies of 0.0245 rad/s, 3 elements, DSA record 256 s at
+  0.25 s, drag linearization tolerance 0.01 (all as the seed).  The cable and depth are
+  in the seed's Figure 6.5-1 only, not in its text: assumed the §6.2 cable, 100 ft
+  depth, anchor 300 ft from the buoy, and L = 339 ft so that the horizontal tension
+  balances the seed's 100 lb wind load.  The disc buoy is not modelled (issue 6): it is
+  end_b, at its assumed 2.5 ft draft, heaving with the sea surface (heave RAO 1, which
+  the seed reports for the disc).
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+
+from ..errors import InputError
+from ..scene import Scene, load_scene
+
+__all__ = ["list_examples", "load_example"]
+
+
+def _files():
+    return resources.files(__name__)
+
+
+def list_examples() -> list[str]:
+    """Names of the example scenes (without the ``.json`` suffix), sorted."""
+    return sorted(
+        p.name[: -len(".json")] for p in _files().iterdir() if p.name.endswith(".json")
+    )
+
+
+def load_example(name: str) -> Scene:
+    """Load and validate an example scene by name.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_examples` (a trailing ``.json`` is accepted).
+
+    Returns
+    -------
+    Scene
+        The validated scene.
+
+    Raises
+    ------
+    InputError
+        For an unknown name, listing the known ones.
+    """
+    known = list_examples()
+    key = str(name)
+    if key.endswith(".json"):
+        key = key[: -len(".json")]
+    if key not in known:
+        raise InputError("example", name, "-", f"is not a known example; known: {', '.join(known)}")
+    return load_scene(_files().joinpath(f"{key}.json").read_text(encoding="utf-8"))

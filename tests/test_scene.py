@@ -1,0 +1,151 @@
+"""Tests of stochcable.scene: validation at the boundary, round trip, JSON Schema drift."""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from stochcable.errors import InputError
+from stochcable.examples import list_examples, load_example
+from stochcable.scene import Scene, load_scene, scene_json_schema
+from stochcable.schema_export import DEFAULT_SCHEMA_PATH, scene_schema_text, write_scene_schema
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture()
+def chain_doc() -> dict:
+    return load_example("chain_catenary").model_dump(mode="json")
+
+
+@pytest.mark.parametrize("name", list_examples())
+def test_examples_load_and_round_trip(name):
+    scene = load_example(name)
+    doc = scene.model_dump(mode="json")
+    again = load_scene(json.dumps(doc))
+    assert again == scene
+    assert Scene.model_validate(doc) == scene
+
+
+def test_load_scene_sources(tmp_path, chain_doc):
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(chain_doc))
+    s1, s2, s3 = load_scene(path), load_scene(str(path)), load_scene(chain_doc)
+    assert s1 == s2 == s3 and load_scene(s1) is s1
+    with pytest.raises(InputError, match=r"scene = .*cannot be read"):
+        load_scene(tmp_path / "missing.json")
+    with pytest.raises(InputError, match=r"is not valid JSON"):
+        load_scene("{not json")
+
+
+def _mutated(doc, fn):
+    d = copy.deepcopy(doc)
+    fn(d)
+    return d
+
+
+def _seg(d):
+    return d["lines"][0]["segments"][0]
+
+
+@pytest.mark.parametrize(
+    "mutate, pattern",
+    [
+        (lambda d: _seg(d).__setitem__("ea", -1.0),
+         r"^lines\[0\]\.segments\[0\]\.ea = -1\.0 \[N\]: Input should be greater than 0"),
+        (lambda d: _seg(d).__setitem__("ea", 0.0),
+         r"^lines\[0\]\.segments\[0\]\.ea = 0\.0 \[N\]: Input should be greater than 0"),
+        (lambda d: _seg(d).__setitem__("elements", 0),
+         r"^lines\[0\]\.segments\[0\]\.elements = 0: Input should be greater than or equal to 1"),
+        (lambda d: _seg(d).__setitem__("mass", float("nan")),
+         r"^lines\[0\]\.segments\[0\]\.mass = nan \[kg/m\]: Input should be a finite number"),
+        (lambda d: d["environment"].__setitem__("depth", math.inf),
+         r"^environment\.depth = inf \[m\]: Input should be a finite number"),
+        (lambda d: _seg(d).__setitem__("length", 500.0),
+         r"^lines\[0\]: the line \(500 m unstretched\) is shorter than its span \(820 m\): "
+         r"it would have to stretch 64\.0% \(> 10 %\)"),
+        (lambda d: d["lines"][0]["end_a"].__setitem__("position", [-800.0, 0.0, 5.0]),
+         r"lines\[0\]\.end_a\.position z = 5\.0 m: the anchor end \(end_a\) is above the "
+         r"still-water surface"),
+        (lambda d: d["lines"][0]["end_b"].__setitem__("position", [0.0, 0.0, -250.0]),
+         r"lines\[0\]\.end_b\.position z = -250\.0 m is below the seabed \(depth 200\.0 m\)"),
+        (lambda d: d["lines"].append(copy.deepcopy(d["lines"][0])),
+         r"line names must be unique; repeated: \['leg1'\]"),
+        (lambda d: d["sea"]["spectrum"].update({"m0": 2.0, "omega_p": 0.6}),
+         r"^sea\.spectrum: give exactly one of \(hs, tp\), \(m0, omega_p\) or wind_speed"),
+        (lambda d: d["sea"].__setitem__(
+            "spectrum", {"type": "table", "omega": [0.1, 0.3, 0.2], "density": [1, 2, 3]}),
+         r"^sea\.spectrum: omega must be >= 0 and strictly increasing"),
+        (lambda d: _seg(d).__setitem__("colour", "red"),
+         r"^lines\[0\]\.segments\[0\]\.colour = 'red': Extra inputs are not permitted"),
+        (lambda d: d.__setitem__("foo", 1), r"^foo = 1: Extra inputs are not permitted"),
+        (lambda d: d["lines"][0].__setitem__("attachments", [{"at": 900.0}]),
+         r"attachments\[0\]\.at = 900\.0 m is beyond the line length 850\.0 m"),
+        (lambda d: d["analysis"]["omega"].update({"min": 2.0, "max": 1.0}),
+         r"^analysis\.omega: max \(1\.0 rad/s\) must exceed min \(2\.0 rad/s\)"),
+    ],
+    ids=["ea<0", "ea=0", "elements<1", "nan", "inf", "too-short", "anchor-above-surface",
+         "end-below-seabed", "duplicate-names", "pm-both-forms", "table-omega",
+         "extra-field", "extra-top", "attachment-beyond", "omega-order"],
+)
+def test_validation_errors_name_path_unit_constraint(chain_doc, mutate, pattern):
+    with pytest.raises(InputError, match=pattern):
+        load_scene(_mutated(chain_doc, mutate))
+
+
+def test_input_error_attributes(chain_doc):
+    with pytest.raises(InputError) as info:
+        load_scene(_mutated(chain_doc, lambda d: _seg(d).__setitem__("ea", -1.0)))
+    err = info.value
+    assert (err.parameter, err.value, err.unit) == ("lines[0].segments[0].ea", -1.0, "N")
+    assert "greater than 0" in err.constraint
+
+
+def test_nested_spectrum_error_has_unit(chain_doc):
+    bad = _mutated(chain_doc, lambda d: d["sea"]["spectrum"].__setitem__("hs", -2.0))
+    with pytest.raises(InputError, match=r"^sea\.spectrum\.hs = -2\.0 \[m\]: Input should be"):
+        load_scene(bad)
+    bad = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"]["motion"]["surge"].__setitem__("tp", -2.0))
+    with pytest.raises(InputError, match=r"motion\.surge\.tp = -2\.0 \[s\]: Input should be"):
+        load_scene(bad)
+
+
+def test_is_planar(chain_doc):
+    assert load_scene(chain_doc).is_planar
+    moved = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"].__setitem__(
+        "position", [0.0, 5.0, -20.0]))
+    assert not load_scene(moved).is_planar
+    oblique = _mutated(chain_doc, lambda d: d["sea"].__setitem__("heading", 30.0))
+    assert not load_scene(oblique).is_planar
+    head_sea = _mutated(chain_doc, lambda d: d["sea"].__setitem__("heading", 180.0))
+    assert load_scene(head_sea).is_planar
+    cross_current = _mutated(chain_doc, lambda d: d["environment"]["current"][0].__setitem__(
+        "heading", 90.0))
+    assert not load_scene(cross_current).is_planar
+    sway = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"]["motion"].__setitem__(
+        "sway", {"type": "pierson_moskowitz", "hs": 1.0, "tp": 8.0}))
+    assert not load_scene(sway).is_planar
+
+
+def test_schema_committed_file_matches_models():
+    """Drift test: regenerate with `python -m stochcable.schema_export`."""
+    committed = (ROOT / DEFAULT_SCHEMA_PATH).read_text(encoding="utf-8")
+    assert committed == scene_schema_text(), (
+        "openapi/scene.schema.json is stale: run `python -m stochcable.schema_export`"
+    )
+
+
+def test_schema_content_and_writer(tmp_path):
+    schema = scene_json_schema()
+    assert schema["$schema"].endswith("2020-12/schema")
+    assert set(schema["required"]) == {"environment", "lines"}
+    seg = schema["$defs"]["Segment"]
+    assert seg["additionalProperties"] is False
+    assert seg["properties"]["ea"]["unit"] == "N"
+    assert seg["properties"]["ea"]["exclusiveMinimum"] == 0
+    out = write_scene_schema(tmp_path / "sub" / "scene.schema.json")
+    assert json.loads(out.read_text(encoding="utf-8")) == schema
