@@ -90,11 +90,11 @@ class PiersonMoskowitz(_SpectrumBase):
     """
 
     type: Literal["pierson_moskowitz"] = "pierson_moskowitz"
-    hs: float | None = _f("Significant wave height", "m", gt=0, default=None)
-    tp: float | None = _f("Peak period", "s", gt=0, default=None)
-    m0: float | None = _f("Zeroth spectral moment (variance)", "m²", gt=0, default=None)
-    omega_p: float | None = _f("Peak angular frequency", "rad/s", gt=0, default=None)
-    wind_speed: float | None = _f("Wind speed at 19.5 m", "m/s", gt=0, default=None)
+    hs: float | None = _f("Significant wave height", "m", ge=1e-6, le=1e4, default=None)
+    tp: float | None = _f("Peak period", "s", ge=1e-3, le=1e5, default=None)
+    m0: float | None = _f("Zeroth spectral moment (variance)", "m²", ge=6.25e-14, le=6.25e6, default=None)
+    omega_p: float | None = _f("Peak angular frequency", "rad/s", ge=2 * math.pi * 1e-5, le=2 * math.pi * 1e3, default=None)
+    wind_speed: float | None = _f("Wind speed at 19.5 m", "m/s", ge=1e-3, le=1e3, default=None)
 
     @model_validator(mode="after")
     def _one_form(self) -> "PiersonMoskowitz":
@@ -127,8 +127,8 @@ class Jonswap(_SpectrumBase):
     """JONSWAP spectrum normalized so that Hs is exact for any gamma."""
 
     type: Literal["jonswap"] = "jonswap"
-    hs: float = _f("Significant wave height", "m", gt=0)
-    tp: float = _f("Peak period", "s", gt=0)
+    hs: float = _f("Significant wave height", "m", ge=1e-6, le=1e4)
+    tp: float = _f("Peak period", "s", ge=1e-3, le=1e5)
     gamma: float = _f("Peak enhancement factor", "-", ge=1, le=20, default=3.3)
     sigma_a: float = _f("Peak width below the peak", "-", gt=0, le=1, default=0.07)
     sigma_b: float = _f("Peak width above the peak", "-", gt=0, le=1, default=0.09)
@@ -145,8 +145,8 @@ class Bretschneider(_SpectrumBase):
     """Bretschneider (two-parameter) spectrum in (hs, tp)."""
 
     type: Literal["bretschneider"] = "bretschneider"
-    hs: float = _f("Significant wave height", "m", gt=0)
-    tp: float = _f("Peak period", "s", gt=0)
+    hs: float = _f("Significant wave height", "m", ge=1e-6, le=1e4)
+    tp: float = _f("Peak period", "s", ge=1e-3, le=1e5)
 
     def spectral_density(self, omega: np.ndarray, g: float = G_STANDARD) -> np.ndarray:
         from . import spectra
@@ -158,8 +158,8 @@ class Issc(_SpectrumBase):
     """ISSC spectrum in (hs, t1), t1 the mean period Tm01."""
 
     type: Literal["issc"] = "issc"
-    hs: float = _f("Significant wave height", "m", gt=0)
-    t1: float = _f("Mean period Tm01", "s", gt=0)
+    hs: float = _f("Significant wave height", "m", ge=1e-6, le=1e4)
+    t1: float = _f("Mean period Tm01", "s", ge=1e-3, le=1e5)
 
     def spectral_density(self, omega: np.ndarray, g: float = G_STANDARD) -> np.ndarray:
         from . import spectra
@@ -171,12 +171,12 @@ class OchiHubble(_SpectrumBase):
     """Ochi–Hubble two-peak spectrum (swell + wind sea)."""
 
     type: Literal["ochi_hubble"] = "ochi_hubble"
-    hs1: float = _f("Significant wave height of the low-frequency part", "m", gt=0)
-    tp1: float = _f("Peak period of the low-frequency part", "s", gt=0)
-    lambda1: float = _f("Shape factor of the low-frequency part", "-", gt=0, le=20)
-    hs2: float = _f("Significant wave height of the high-frequency part", "m", gt=0)
-    tp2: float = _f("Peak period of the high-frequency part", "s", gt=0)
-    lambda2: float = _f("Shape factor of the high-frequency part", "-", gt=0, le=20)
+    hs1: float = _f("Significant wave height of the low-frequency part", "m", ge=1e-6, le=1e4)
+    tp1: float = _f("Peak period of the low-frequency part", "s", ge=1e-3, le=1e5)
+    lambda1: float = _f("Shape factor of the low-frequency part", "-", ge=0.01, le=100)
+    hs2: float = _f("Significant wave height of the high-frequency part", "m", ge=1e-6, le=1e4)
+    tp2: float = _f("Peak period of the high-frequency part", "s", ge=1e-3, le=1e5)
+    lambda2: float = _f("Shape factor of the high-frequency part", "-", ge=0.01, le=100)
 
     def spectral_density(self, omega: np.ndarray, g: float = G_STANDARD) -> np.ndarray:
         from . import spectra

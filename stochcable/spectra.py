@@ -49,6 +49,18 @@ __all__ = [
 G_STANDARD = 9.80665
 """Standard gravity. [m/s²]"""
 
+# Accepted parameter ranges.  Far wider than any sea (model basin to swell, metres or
+# feet), narrow enough that ωp⁴, Hs² and Γ(λ) stay finite in float64: a value outside
+# is a data error, reported as such instead of as an overflow.
+HEIGHT_RANGE = (1e-6, 1e4)
+"""Accepted significant wave heights. [m] (or the scene's length unit)"""
+PERIOD_RANGE = (1e-3, 1e5)
+"""Accepted periods (Tp, T1). [s]"""
+OMEGA_P_RANGE = (2 * math.pi / PERIOD_RANGE[1], 2 * math.pi / PERIOD_RANGE[0])
+"""Accepted peak frequencies. [rad/s]"""
+SHAPE_RANGE = (1e-2, 100.0)
+"""Accepted Ochi–Hubble shape factors λ. [-]"""
+
 PM_TZ_OVER_TP = (5.0 * math.pi / 4.0) ** -0.25
 """Tz/Tp of the Pierson–Moskowitz shape, (5π/4)^(-1/4) = 0.71040... [-]"""
 
@@ -119,8 +131,8 @@ def spectrum_pierson_moskowitz(omega: ArrayLike, hs: float, tp: float) -> np.nda
     Closed forms: m0 = Hs²/16, m_n = (Hs²/64) ωpⁿ (5/4)^(n/4) Γ(1 − n/4) for n < 4
     (:func:`moments_pierson_moskowitz`), Tz = (5π/4)^(−1/4) Tp = 0.7104 Tp, peak at ωp.
     """
-    hs = v.positive("hs", hs, "m")
-    tp = v.positive("tp", tp, "s")
+    hs = v.in_range("hs", hs, "m", *HEIGHT_RANGE)
+    tp = v.in_range("tp", tp, "s", *PERIOD_RANGE)
     w = _omega_array(omega)
     wp = 2.0 * math.pi / tp
     return _pm_shape(w, wp, 5.0 / 16.0 * hs * hs / wp)
@@ -148,8 +160,8 @@ def spectrum_pierson_moskowitz_m0(omega: ArrayLike, m0: float, omega_p: float) -
     S(ω) = 5 m0 ωp⁴ ω⁻⁵ exp[−(5/4)(ωp/ω)⁴], the PM shape with Hs = 4√m0; seed 001
     §6.5 (Fig. 6.5-6) uses m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla record).
     """
-    m0 = v.positive("m0", m0, "m²")
-    wp = v.positive("omega_p", omega_p, "rad/s")
+    m0 = v.in_range("m0", m0, "m²", HEIGHT_RANGE[0] ** 2 / 16, HEIGHT_RANGE[1] ** 2 / 16)
+    wp = v.in_range("omega_p", omega_p, "rad/s", *OMEGA_P_RANGE)
     w = _omega_array(omega)
     return _pm_shape(w, wp, 5.0 * m0 / wp)
 
@@ -178,7 +190,7 @@ def spectrum_pierson_moskowitz_wind(
     S(ω) = α g² ω⁻⁵ exp[−0.74 (g/(U ω))⁴], α = 0.0081 (Pierson & Moskowitz 1964).
     This is the PM shape with ωp = (0.74·4/5)^(1/4) g/U and m0 = α g²/(4·0.74) (g/U)⁻⁴.
     """
-    u = v.positive("wind_speed", wind_speed, "m/s")
+    u = v.in_range("wind_speed", wind_speed, "m/s", 1e-3, 1e3)
     g = v.positive("g", g, "m/s²")
     w = _omega_array(omega)
     alpha = 0.0081
@@ -251,8 +263,8 @@ def spectrum_jonswap(
     Gauss–Legendre quadrature to round-off (not the approximate 1 − 0.287 ln γ), so
     m0 = Hs²/16 for every γ, σa, σb.
     """
-    hs = v.positive("hs", hs, "m")
-    tp = v.positive("tp", tp, "s")
+    hs = v.in_range("hs", hs, "m", *HEIGHT_RANGE)
+    tp = v.in_range("tp", tp, "s", *PERIOD_RANGE)
     gamma = v.in_range("gamma", gamma, "-", lo=1.0)
     sigma_a = v.positive("sigma_a", sigma_a, "-")
     sigma_b = v.positive("sigma_b", sigma_b, "-")
@@ -314,8 +326,8 @@ def spectrum_issc(omega: ArrayLike, hs: float, t1: float) -> np.ndarray:
     PM shape with Tp = T1/0.77154 (``PM_TM01_OVER_TP``), which is used here so that
     m0 = Hs²/16 and Tm01 = T1 exactly.
     """
-    hs = v.positive("hs", hs, "m")
-    t1 = v.positive("t1", t1, "s")
+    hs = v.in_range("hs", hs, "m", *HEIGHT_RANGE)
+    t1 = v.in_range("t1", t1, "s", *PERIOD_RANGE)
     return spectrum_pierson_moskowitz(omega, hs, t1 / PM_TM01_OVER_TP)
 
 
@@ -355,9 +367,11 @@ def spectrum_ochi_hubble(
     """
     pars = []
     for j, (hs, tp, lam) in enumerate(((hs1, tp1, lambda1), (hs2, tp2, lambda2)), start=1):
-        hs = v.nonnegative(f"hs{j}", hs, "m")
-        tp = v.positive(f"tp{j}", tp, "s")
-        lam = v.positive(f"lambda{j}", lam, "-")
+        hs = v.in_range(f"hs{j}", hs, "m", 0.0, HEIGHT_RANGE[1])
+        if 0.0 < hs < HEIGHT_RANGE[0]:
+            raise InputError(f"hs{j}", hs, "m", f"must be 0 or >= {HEIGHT_RANGE[0]:g}")
+        tp = v.in_range(f"tp{j}", tp, "s", *PERIOD_RANGE)
+        lam = v.in_range(f"lambda{j}", lam, "-", *SHAPE_RANGE)
         pars.append((hs, tp, lam))
     if pars[0][0] == 0.0 and pars[1][0] == 0.0:
         raise InputError("hs1", hs1, "m", "hs1 and hs2 must not both be 0")
@@ -472,8 +486,8 @@ def moments_pierson_moskowitz(hs: float, tp: float, orders: tuple[int, ...] = (0
     numpy.ndarray
         m_n = (Hs²/64) ωpⁿ (5/4)^(n/4) Γ(1 − n/4). [m²·(rad/s)ⁿ]
     """
-    hs = v.positive("hs", hs, "m")
-    tp = v.positive("tp", tp, "s")
+    hs = v.in_range("hs", hs, "m", *HEIGHT_RANGE)
+    tp = v.in_range("tp", tp, "s", *PERIOD_RANGE)
     wp = 2.0 * math.pi / tp
     res = []
     for n in orders:
@@ -572,7 +586,7 @@ def omega_grid(tp: float, count: int = 200, omega_max: float | None = None) -> n
     numpy.ndarray
         ω_i = i ω_max/count, i = 1 … count (zero excluded). [rad/s]
     """
-    tp = v.positive("tp", tp, "s")
+    tp = v.in_range("tp", tp, "s", *PERIOD_RANGE)
     count = v.positive_int("count", count, minimum=2)
     if omega_max is None:
         omega_max = 6.0 * 2.0 * math.pi / tp

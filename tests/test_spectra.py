@@ -187,18 +187,23 @@ def test_spectral_moments_box():
 
 
 @pytest.mark.parametrize("call,match", [
-    (lambda: sp.spectrum_pierson_moskowitz([1.0], 0.0, 10), r"hs = 0.0 \[m\]: must be > 0"),
-    (lambda: sp.spectrum_pierson_moskowitz([1.0], -1.0, 10), r"hs = -1.0 \[m\]: must be > 0"),
-    (lambda: sp.spectrum_pierson_moskowitz([1.0], 6, 0.0), r"tp = 0.0 \[s\]: must be > 0"),
+    (lambda: sp.spectrum_pierson_moskowitz([1.0], 0.0, 10), r"hs = 0.0 \[m\]: must be >= 1e-06"),
+    (lambda: sp.spectrum_pierson_moskowitz([1.0], -1.0, 10), r"hs = -1.0 \[m\]: must be >= 1e-06"),
+    (lambda: sp.spectrum_pierson_moskowitz([1.0], 6, 0.0), r"tp = 0.0 \[s\]: must be >= 0.001"),
     (lambda: sp.spectrum_pierson_moskowitz([1.0], float("nan"), 10), r"hs = nan \[m\]: must be finite"),
     (lambda: sp.spectrum_pierson_moskowitz([np.inf], 6, 10), r"omega .*must be finite"),
     (lambda: sp.spectrum_jonswap([1.0], 6, 10, gamma=0.5), r"gamma = 0.5: must be >= 1"),
     (lambda: sp.spectrum_jonswap([1.0], 6, 10, sigma_a=0.0), r"sigma_a = 0.0: must be > 0"),
-    (lambda: sp.spectrum_pierson_moskowitz_m0([1.0], -2, 0.5), r"m0 = -2.*must be > 0"),
+    (lambda: sp.spectrum_pierson_moskowitz_m0([1.0], -2, 0.5), r"m0 = -2.*must be >= 6.25e-14"),
     (lambda: sp.spectrum_pierson_moskowitz_wind([1.0], 0.0), r"wind_speed = 0.0 \[m/s\]"),
-    (lambda: sp.spectrum_issc([1.0], 6, -8), r"t1 = -8 \[s\]: must be > 0"),
+    (lambda: sp.spectrum_issc([1.0], 6, -8), r"t1 = -8 \[s\]: must be >= 0.001"),
     (lambda: sp.spectrum_ochi_hubble([1.0], 0, 10, 1, 0, 5, 1), r"hs1 and hs2 must not both be 0"),
-    (lambda: sp.spectrum_ochi_hubble([1.0], 1, 10, 0, 1, 5, 1), r"lambda1 = 0: must be > 0"),
+    (lambda: sp.spectrum_ochi_hubble([1.0], 1, 10, 0, 1, 5, 1), r"lambda1 = 0: must be >= 0.01"),
+    # values that are positive but would overflow or underflow float64 (found by
+    # schemathesis through the service): rejected with the accepted range
+    (lambda: sp.spectrum_ochi_hubble([1.0], 5e-324, 10, 1, 1, 5, 1), r"hs1 = 5e-324 \[m\]: must be 0 or >= 1e-06"),
+    (lambda: sp.spectrum_pierson_moskowitz([1.0], 6, 5e-324), r"tp = 5e-324 \[s\]: must be >= 0.001"),
+    (lambda: sp.spectrum_issc([1.0], 6, 5e-324), r"t1 = 5e-324 \[s\]: must be >= 0.001"),
     (lambda: sp.spectrum_table([1.0], [0.0, 1.0, 0.5], [1, 1, 1]), r"omega_table .*strictly increasing"),
     (lambda: sp.spectrum_table([1.0], [0.0, 1.0, 1.0], [1, 1, 1]), r"omega_table .*strictly increasing"),
     (lambda: sp.spectrum_table([1.0], [-1.0, 1.0], [1, 1]), r"omega_table .*must be >= 0"),

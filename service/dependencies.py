@@ -1,0 +1,28 @@
+"""Request dependencies (``Annotated`` aliases for route signatures)."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import Depends, Request
+
+from .encoding import negotiate
+from .limits import Runner
+from .settings import Settings
+
+__all__ = ["SettingsDep", "RunnerDep", "MediaTypeDep", "get_settings", "get_runner"]
+
+
+def get_settings(request: Request) -> Settings:
+    """The settings the application was created with."""
+    return request.app.state.settings
+
+
+def get_runner(request: Request) -> Runner:
+    """The application's bounded thread runner."""
+    return request.app.state.runner
+
+
+SettingsDep = Annotated[Settings, Depends(get_settings)]
+RunnerDep = Annotated[Runner, Depends(get_runner)]
+MediaTypeDep = Annotated[str, Depends(negotiate)]

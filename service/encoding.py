@@ -1,0 +1,174 @@
+"""Response encodings: JSON by default, NPY or CSV for large arrays.
+
+Content negotiation on ``Accept``:
+
+* ``application/json`` (default, also for ``*/*`` or no header);
+* ``application/x-npy``: one NumPy ``.npy`` file holding a 1-D structured array of
+  float64 columns (``numpy.load(io.BytesIO(body))``; field names as the CSV header);
+* ``text/csv``: a header row with the column names, then one row per sample
+  (``%.17g``, round-trips float64).
+
+The column layouts are documented on each endpoint.  Scalars that do not fit in
+columns (the statistics) travel in the ``X-Stochcable-Stats`` header as compact JSON
+for the binary and CSV encodings.  Large JSON answers are gzip-compressed when the
+client accepts it (NPY is never compressed: float noise does not compress and gzip
+would cost more than the transfer).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from fastapi import Request
+from starlette.exceptions import HTTPException
+from starlette.responses import Response
+
+from .schemas import ErrorResponse
+
+__all__ = [
+    "JSON",
+    "NPY",
+    "CSV",
+    "STATS_HEADER",
+    "negotiate",
+    "json_response",
+    "columns_response",
+    "array_responses",
+    "error_responses",
+]
+
+JSON = "application/json"
+NPY = "application/x-npy"
+CSV = "text/csv"
+STATS_HEADER = "X-Stochcable-Stats"
+_SUPPORTED = (JSON, NPY, CSV)
+
+
+def negotiate(request: Request) -> str:
+    """The media type to answer with, from the request's ``Accept`` header.
+
+    Raises a 406 HTTPException when ``Accept`` names only unsupported types.
+    """
+    accept = request.headers.get("accept", "")
+    if not accept.strip():
+        return JSON
+    best, best_q = None, 0.0
+    for order, part in enumerate(accept.split(",")):
+        fields = [f.strip() for f in part.split(";")]
+        media = fields[0].lower()
+        q = 1.0
+        for param in fields[1:]:
+            if param.startswith("q="):
+                try:
+                    q = float(param[2:])
+                except ValueError:
+                    q = 0.0
+        if media in ("*/*", "application/*", "", "application/json"):
+            media = JSON
+        elif media == "text/*":
+            media = CSV
+        if media in _SUPPORTED and q > best_q:
+            best, best_q = media, q
+    if best is None:
+        raise HTTPException(406, f"cannot answer with {accept!r}; supported: "
+                                 f"{', '.join(_SUPPORTED)}")
+    return best
+
+
+def _plain(obj: Any) -> Any:
+    """numpy arrays and scalars to JSON types; non-finite scalars (an infinite period)
+    to null; a non-finite array entry raises NumericalError."""
+    if isinstance(obj, Mapping):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, np.ndarray):
+        if obj.dtype.kind in "fc" and not np.isfinite(obj).all():
+            from .errors import NumericalError
+
+            raise NumericalError("the result contains non-finite values (NaN or inf)")
+        return obj.tolist()
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, (np.floating, float)):
+        x = float(obj)
+        return x if math.isfinite(x) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+def json_response(payload: Mapping[str, Any], status_code: int = 200) -> Response:
+    """JSON answer built directly from numpy arrays (skips per-float pydantic checks)."""
+    body = json.dumps(_plain(payload), allow_nan=False, separators=(",", ":"))
+    return Response(body.encode(), status_code=status_code, media_type=JSON)
+
+
+def _stats_header(stats: Mapping[str, Any] | None) -> dict[str, str]:
+    if not stats:
+        return {}
+    return {STATS_HEADER: json.dumps(_plain(stats), allow_nan=False, separators=(",", ":"))}
+
+
+def columns_response(columns: Mapping[str, np.ndarray], media_type: str,
+                     stats: Mapping[str, Any] | None = None) -> Response:
+    """NPY (structured array) or CSV answer of equal-length float columns."""
+    names = list(columns)
+    arrays = [np.asarray(columns[n], dtype=np.float64) for n in names]
+    if not all(np.isfinite(a).all() for a in arrays):
+        from .errors import NumericalError
+
+        raise NumericalError("the result contains non-finite values (NaN or inf)")
+    headers = _stats_header(stats)
+    if media_type == NPY:
+        dtype = np.dtype([(n, "<f8") for n in names])
+        rec = np.empty(arrays[0].shape[0], dtype=dtype)
+        for n, a in zip(names, arrays):
+            rec[n] = a
+        head = io.BytesIO()
+        np.lib.format.write_array_header_1_0(
+            head, {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False,
+                   "shape": rec.shape})
+        return Response(head.getvalue() + rec.data.cast("B"), media_type=NPY,
+                        headers=headers)
+    buf = io.StringIO()
+    buf.write(",".join(names) + "\n")
+    np.savetxt(buf, np.column_stack(arrays), delimiter=",", fmt="%.17g")
+    return Response(buf.getvalue(), media_type=CSV, headers=headers)
+
+
+_ERRORS: dict[int, dict[str, Any]] = {
+    404: {"model": ErrorResponse, "description": "Unknown resource"},
+    406: {"model": ErrorResponse, "description": "Accept names no supported media type"},
+    413: {"model": ErrorResponse,
+          "description": "Request body over STOCHCABLE_MAX_BODY_BYTES"},
+    422: {"model": ErrorResponse,
+          "description": "Invalid input (field path, value, unit, constraint), a size bound "
+          "exceeded (type limit_exceeded, naming the STOCHCABLE_* setting) or a solver "
+          "failure"},
+    504: {"model": ErrorResponse,
+          "description": "Queueing plus computation over STOCHCABLE_MAX_RUN_SECONDS"},
+}
+
+
+def error_responses(*codes: int) -> dict[int | str, Any]:
+    """OpenAPI ``responses`` entries for the given error status codes."""
+    return {code: _ERRORS[code] for code in codes}
+
+
+def array_responses(model: Any, layout: str, *codes: int) -> dict[int | str, Any]:
+    """OpenAPI ``responses`` of an endpoint answering JSON, NPY or CSV, plus errors."""
+    ok = {
+        "model": model,
+        "description": "JSON by default; with `Accept: application/x-npy` a NumPy .npy "
+        "file of a 1-D structured float64 array, with `Accept: text/csv` CSV with a header "
+        f"row. {layout}",
+        "content": {
+            NPY: {"schema": {"type": "string", "format": "binary"}},
+            CSV: {"schema": {"type": "string"}},
+        },
+    }
+    return {200: ok, **error_responses(406, *codes)}

@@ -1,0 +1,233 @@
+"""Exception handlers: every error answer is ``{"detail": [ErrorItem, ...]}``.
+
+Mapping (never 500 for client input):
+
+=====================================  ======  ==============================
+exception                              status  ``type``
+=====================================  ======  ==============================
+RequestValidationError (bad JSON,      422     pydantic's type (``json_invalid``,
+wrong type, NaN, out of bounds)                ``greater_than``, ...)
+:class:`~stochcable.errors.InputError`  422     ``input_error``
+:class:`~service.limits.LimitExceeded`  422     ``limit_exceeded``
+ConvergenceError                       422     ``convergence_error``
+SolverError, other StochcableError     422     ``solver_error``
+FloatingPointError, non-finite result  422     ``numerical_error``
+:class:`~service.limits.BodyTooLarge`   413     ``body_too_large``
+:class:`~service.limits.RunTimeExceeded` 504   ``run_time_exceeded``
+HTTPException (404, 405, 406, ...)     as is   ``http_error`` / ``not_found``
+=====================================  ======  ==============================
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import typing
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from pydantic import BaseModel
+from starlette.exceptions import HTTPException as StarletteHTTPException
+from starlette.responses import JSONResponse
+
+from stochcable.errors import ConvergenceError, InputError, SolverError, StochcableError
+
+from .limits import BodyTooLarge, LimitExceeded, RunTimeExceeded
+
+__all__ = ["install_error_handlers", "error_response", "NotFound", "NumericalError"]
+
+
+class NumericalError(Exception):
+    """A computation produced non-finite numbers from accepted input (HTTP 422)."""
+
+
+class NotFound(StarletteHTTPException):
+    """A resource (an example name) that does not exist (HTTP 404)."""
+
+    def __init__(self, loc: list[str | int], message: str) -> None:
+        self.loc = loc
+        super().__init__(404, message)
+
+
+def _json_safe(value: Any) -> bool:
+    if value is None or isinstance(value, (bool, int, str)):
+        return not isinstance(value, str) or len(value) <= 200
+    if isinstance(value, float):
+        return math.isfinite(value)
+    return False
+
+
+def error_response(status: int, loc: list[str | int], msg: str, type_: str,
+                   headers: dict[str, str] | None = None, **extra: Any) -> JSONResponse:
+    """A ``{"detail": [item]}`` JSON answer with one error item."""
+    item = {"loc": loc, "msg": msg, "type": type_}
+    item.update({k: v for k, v in extra.items() if v is not None})
+    return JSONResponse({"detail": [item]}, status_code=status, headers=headers)
+
+
+# ------------------------------------------------------------ field paths and units
+
+_TOKEN = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
+
+
+def _loc_from_parameter(parameter: str) -> list[str | int]:
+    """'lines[0].segments[1].ea' -> ['lines', 0, 'segments', 1, 'ea']."""
+    out: list[str | int] = []
+    for name, index in _TOKEN.findall(parameter):
+        out.append(int(index) if index else name)
+    return out
+
+
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    """Pydantic model classes reachable in a type annotation (unions, tuples, lists)."""
+    found: list[type[BaseModel]] = []
+    stack = [annotation]
+    while stack:
+        t = stack.pop()
+        if isinstance(t, type) and issubclass(t, BaseModel):
+            found.append(t)
+            continue
+        stack.extend(typing.get_args(t))
+    return found
+
+
+def _field_unit(model: type[BaseModel] | None, path: list[str | int]) -> tuple[str, str]:
+    """(dotted parameter path, unit) of a field location in ``model``.
+
+    Discriminator tags in pydantic locations (``spectrum.pierson_moskowitz.hs``) select
+    the union member and are dropped from the path.
+    """
+    candidates = [model] if model is not None else []
+    unit = ""
+    clean: list[str | int] = []
+    for part in path:
+        if isinstance(part, int):
+            clean.append(part)
+            continue
+        hit = next((c for c in candidates if part in c.model_fields), None)
+        if hit is None:
+            tagged = [
+                c for c in candidates
+                if "type" in c.model_fields and c.model_fields["type"].default == part
+            ]
+            if tagged:
+                candidates = tagged
+                continue
+            clean.append(part)
+            candidates = []
+            unit = ""
+            continue
+        clean.append(part)
+        info = hit.model_fields[part]
+        extra = info.json_schema_extra
+        unit = extra.get("unit", "") if isinstance(extra, dict) else ""
+        candidates = _models_in(info.annotation)
+    text = ""
+    for part in clean:
+        text += f"[{part}]" if isinstance(part, int) else (("." if text else "") + str(part))
+    return text, unit
+
+
+def _body_model(request: Request) -> type[BaseModel] | None:
+    route = request.scope.get("route")
+    field = getattr(route, "body_field", None)
+    annotation = getattr(getattr(field, "field_info", None), "annotation", None)
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    return None
+
+
+# ------------------------------------------------------------------ handlers
+
+
+async def _validation_handler(request: Request, exc: RequestValidationError) -> JSONResponse:
+    model = _body_model(request)
+    items = []
+    for err in exc.errors():
+        loc = list(err.get("loc", ()))
+        item: dict[str, Any] = {"loc": loc, "msg": str(err.get("msg", "invalid")),
+                                "type": str(err.get("type", "value_error"))}
+        if err.get("type") == "json_invalid":
+            item["parameter"] = "body"  # loc[1] is the character offset
+        elif loc and loc[0] == "body":
+            parameter, unit = _field_unit(model, loc[1:])
+            item["parameter"] = parameter or "body"
+            if unit:
+                item["unit"] = unit
+        elif loc:
+            item["parameter"] = ".".join(str(p) for p in loc[1:]) or str(loc[0])
+        if "input" in err and _json_safe(err["input"]):
+            item["input"] = err["input"]
+        ctx = err.get("ctx")
+        if isinstance(ctx, dict):
+            item["ctx"] = {k: (v if _json_safe(v) else str(v)) for k, v in ctx.items()}
+        items.append(item)
+    return JSONResponse({"detail": items}, status_code=422)
+
+
+async def _input_error_handler(request: Request, exc: InputError) -> JSONResponse:
+    value = exc.value if _json_safe(exc.value) else None
+    return error_response(422, ["body", *_loc_from_parameter(exc.parameter)], str(exc),
+                          "input_error", parameter=exc.parameter, unit=exc.unit or None,
+                          input=value)
+
+
+async def _limit_handler(request: Request, exc: LimitExceeded) -> JSONResponse:
+    value = exc.value if _json_safe(exc.value) else None
+    return error_response(422, ["body", *_loc_from_parameter(exc.parameter)], str(exc),
+                          "limit_exceeded", parameter=exc.parameter, input=value,
+                          limit=exc.limit, setting=exc.env)
+
+
+async def _convergence_handler(request: Request, exc: ConvergenceError) -> JSONResponse:
+    residual = exc.residual if _json_safe(float(exc.residual)) else None
+    return error_response(422, ["body"], str(exc), "convergence_error", solver=exc.solver,
+                          iterations=exc.iterations, residual=residual,
+                          tolerance=exc.tolerance)
+
+
+async def _solver_handler(request: Request, exc: StochcableError) -> JSONResponse:
+    return error_response(422, ["body"], str(exc), "solver_error")
+
+
+_NUMERICAL_HINT = ("an input is outside the range the model handles numerically (check "
+                   "magnitudes and units: periods, heights, frequencies, depth)")
+
+
+async def _numerical_handler(request: Request, exc: Exception) -> JSONResponse:
+    return error_response(422, ["body"], f"{exc}: {_NUMERICAL_HINT}", "numerical_error")
+
+
+async def _body_too_large_handler(request: Request, exc: BodyTooLarge) -> JSONResponse:
+    return error_response(413, ["body"], str(exc), "body_too_large", limit=exc.limit,
+                          setting=exc.env)
+
+
+async def _run_time_handler(request: Request, exc: RunTimeExceeded) -> JSONResponse:
+    return error_response(504, [], str(exc), "run_time_exceeded", limit=exc.limit,
+                          setting=exc.env)
+
+
+async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+    loc = getattr(exc, "loc", [])
+    type_ = "not_found" if exc.status_code == 404 else "http_error"
+    detail = exc.detail if isinstance(exc.detail, str) else json.dumps(exc.detail)
+    return error_response(exc.status_code, loc, detail, type_,
+                          headers=dict(exc.headers) if exc.headers else None)
+
+
+def install_error_handlers(app: FastAPI) -> None:
+    """Register the handlers on ``app`` (the most specific exception classes win)."""
+    app.add_exception_handler(RequestValidationError, _validation_handler)
+    app.add_exception_handler(InputError, _input_error_handler)
+    app.add_exception_handler(LimitExceeded, _limit_handler)
+    app.add_exception_handler(ConvergenceError, _convergence_handler)
+    app.add_exception_handler(SolverError, _solver_handler)
+    app.add_exception_handler(StochcableError, _solver_handler)
+    app.add_exception_handler(NumericalError, _numerical_handler)
+    app.add_exception_handler(FloatingPointError, _numerical_handler)
+    app.add_exception_handler(BodyTooLarge, _body_too_large_handler)
+    app.add_exception_handler(RunTimeExceeded, _run_time_handler)
+    app.add_exception_handler(StarletteHTTPException, _http_handler)

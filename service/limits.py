@@ -1,0 +1,282 @@
+"""Resource limits: sizes of a request, body size, concurrency and run time.
+
+Policy (documented in the README "Service" section):
+
+* a request body over ``max_body_bytes`` answers **413**, checked on ``Content-Length``
+  and again on the bytes actually streamed (chunked uploads);
+* a well-formed request whose work exceeds a size bound (``max_samples``,
+  ``max_frequencies``, ``max_points``, ``max_elements``) answers **422** with
+  ``type: "limit_exceeded"``, naming the bound and its environment variable;
+* computations run in worker threads, at most ``max_concurrency`` at once per process
+  (the rest queue); a request whose queueing plus computation exceeds
+  ``max_run_seconds`` answers **504** ``type: "run_time_exceeded"``.  Python cannot stop
+  a thread: the computation finishes in the background but keeps its concurrency slot
+  until then, so an overloaded server sheds load instead of piling up work.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import math
+import time
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+import anyio
+import numpy as np
+from starlette.exceptions import HTTPException
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from .settings import Settings
+
+__all__ = [
+    "LimitExceeded",
+    "RunTimeExceeded",
+    "BodyTooLarge",
+    "BodySizeLimitMiddleware",
+    "check_samples",
+    "check_frequencies",
+    "check_points",
+    "check_elements",
+    "sample_count",
+    "Runner",
+]
+
+T = TypeVar("T")
+_log = logging.getLogger("stochcable.service")
+
+
+class LimitExceeded(Exception):
+    """A request asks for more work than a configured bound allows (HTTP 422)."""
+
+    def __init__(self, parameter: str, value: Any, limit: Any, setting: str, what: str) -> None:
+        self.parameter = parameter
+        self.value = value
+        self.limit = limit
+        self.setting = setting
+        self.env = Settings.env_name(setting)
+        super().__init__(f"{what} exceeds the limit of {limit} ({self.env})")
+
+
+class RunTimeExceeded(Exception):
+    """Queueing plus computation took longer than ``max_run_seconds`` (HTTP 504)."""
+
+    def __init__(self, limit: float) -> None:
+        self.limit = limit
+        self.env = Settings.env_name("max_run_seconds")
+        super().__init__(
+            f"the computation did not finish within the limit of {limit:g} s ({self.env}); "
+            "ask for less (shorter duration, fewer samples or frequencies) or retry later"
+        )
+
+
+class BodyTooLarge(HTTPException):
+    """The request body is larger than ``max_body_bytes`` (HTTP 413).
+
+    An HTTPException so that FastAPI re-raises it from its body reader unchanged.
+    """
+
+    def __init__(self, size: int | None, limit: int) -> None:
+        self.size = size
+        self.limit = limit
+        self.env = Settings.env_name("max_body_bytes")
+        got = f"{size} bytes" if size is not None else "the request body"
+        super().__init__(413, f"{got} exceeds the limit of {limit} bytes ({self.env})")
+
+    def __str__(self) -> str:
+        return str(self.detail)
+
+
+# ----------------------------------------------------------------- size checks
+
+
+def sample_count(duration: float, dt: float) -> int:
+    """Number of samples duration/dt of a record, rounded to the nearest integer. [-]"""
+    return int(round(duration / dt)) if math.isfinite(duration / dt) else 2**63
+
+
+def check_samples(duration: float, dt: float, n_points: int, settings: Settings) -> int:
+    """Raise LimitExceeded when duration/dt (× points) exceeds ``max_samples``."""
+    n = sample_count(duration, dt)
+    if n > settings.max_samples:
+        raise LimitExceeded("duration", duration, settings.max_samples, "max_samples",
+                            f"duration/dt = {n} samples")
+    if n_points > 1 and n * n_points > settings.max_samples:
+        raise LimitExceeded(
+            "points", n_points, settings.max_samples, "max_samples",
+            f"duration/dt × points = {n} × {n_points} = {n * n_points} kinematics samples",
+        )
+    return n
+
+
+def check_frequencies(count: int, settings: Settings, parameter: str = "omega.count") -> None:
+    """Raise LimitExceeded when a frequency grid is larger than ``max_frequencies``."""
+    if count > settings.max_frequencies:
+        raise LimitExceeded(parameter, count, settings.max_frequencies, "max_frequencies",
+                            f"{parameter} = {count} frequencies")
+
+
+def check_points(count: int, settings: Settings) -> None:
+    """Raise LimitExceeded when more than ``max_points`` kinematics points are asked."""
+    if count > settings.max_points:
+        raise LimitExceeded("points", count, settings.max_points, "max_points",
+                            f"{count} points")
+
+
+def check_elements(count: int, settings: Settings) -> None:
+    """Raise LimitExceeded when a scene has more finite elements than ``max_elements``.
+
+    For ``POST /v1/analyses``: ``check_elements(sum(line.elements for line in
+    scene.lines), settings)``.
+    """
+    if count > settings.max_elements:
+        raise LimitExceeded("lines", count, settings.max_elements, "max_elements",
+                            f"{count} finite elements")
+
+
+# ------------------------------------------------------------------ body size
+
+
+class BodySizeLimitMiddleware:
+    """ASGI middleware answering 413 to bodies over ``max_bytes``.
+
+    ``Content-Length`` is checked before the application runs; the streamed size is
+    counted while the application reads, so a chunked or lying upload is cut at the
+    limit too (the application sees :class:`BodyTooLarge`, mapped to 413).
+    """
+
+    def __init__(self, app: ASGIApp, max_bytes: int) -> None:
+        self.app = app
+        self.max_bytes = max_bytes
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        for key, value in scope.get("headers", ()):
+            if key == b"content-length":
+                try:
+                    size = int(value)
+                except ValueError:
+                    size = None
+                if size is not None and size > self.max_bytes:
+                    from .errors import error_response
+
+                    exc = BodyTooLarge(size, self.max_bytes)
+                    resp = error_response(413, ["body"], str(exc), "body_too_large",
+                                          limit=self.max_bytes, setting=exc.env)
+                    await resp(scope, receive, send)
+                    return
+        received = 0
+        started = False
+        limit = self.max_bytes
+
+        async def limited_receive() -> Message:
+            nonlocal received
+            message = await receive()
+            if message["type"] == "http.request":
+                received += len(message.get("body", b""))
+                if received > limit:
+                    raise BodyTooLarge(None, limit)
+            return message
+
+        async def watched_send(message: Message) -> None:
+            nonlocal started
+            started = started or message["type"] == "http.response.start"
+            await send(message)
+
+        try:
+            await self.app(scope, limited_receive, watched_send)
+        except BodyTooLarge as exc:  # read outside FastAPI's handlers: answer here
+            if started:
+                raise
+            from .errors import error_response
+
+            resp = error_response(413, ["body"], str(exc), "body_too_large",
+                                  limit=exc.limit, setting=exc.env)
+            await resp(scope, receive, send)
+
+
+# ------------------------------------------------------------- run time bound
+
+
+class Runner:
+    """Runs blocking computations in threads, ``max_concurrency`` at a time, bounded in time.
+
+    One runner per application (``app.state.runner``).  :meth:`run` awaits the result
+    or raises :class:`RunTimeExceeded` after ``max_run_seconds`` (queueing included).
+    A computation still queued at its deadline never starts; one already running
+    finishes in the background, holding its slot.
+    """
+
+    def __init__(self, settings: Settings) -> None:
+        self.max_concurrency = settings.max_concurrency
+        self.max_run_seconds = settings.max_run_seconds
+        self._limiter: anyio.CapacityLimiter | None = None
+        self._threads: anyio.CapacityLimiter | None = None
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._background: set[asyncio.Future[Any]] = set()
+
+    @property
+    def limiter(self) -> anyio.CapacityLimiter:
+        # created lazily inside the event loop that uses it (again if the loop changed,
+        # as when one app serves several TestClient sessions)
+        loop = asyncio.get_running_loop()
+        if self._limiter is None or self._loop is not loop:
+            self._loop = loop
+            self._limiter = anyio.CapacityLimiter(self.max_concurrency)
+            # the worker threads get their own pool of the same size, apart from the
+            # default one FastAPI uses for sync dependencies
+            self._threads = anyio.CapacityLimiter(self.max_concurrency)
+        return self._limiter
+
+    async def run(self, func: Callable[..., T], *args: Any) -> T:
+        """``func(*args)`` in a worker thread, bounded in concurrency and time."""
+        deadline = time.monotonic() + self.max_run_seconds
+        limiter, threads = self.limiter, self._threads
+
+        async def job() -> Any:
+            async with limiter:
+                if time.monotonic() >= deadline:  # timed out while queued: skip
+                    return None
+                return await anyio.to_thread.run_sync(_checked, func, *args,
+                                                      limiter=threads)
+
+        task = asyncio.ensure_future(job())
+        self._background.add(task)
+        task.add_done_callback(self._finished)
+        try:
+            return await asyncio.wait_for(asyncio.shield(task), self.max_run_seconds)
+        except asyncio.TimeoutError:
+            raise RunTimeExceeded(self.max_run_seconds) from None
+
+    def _finished(self, task: asyncio.Future[Any]) -> None:
+        self._background.discard(task)
+        if not task.cancelled():
+            task.exception()  # retrieved: an abandoned failure is not "never retrieved"
+
+
+def _checked(func: Callable[..., T], *args: Any) -> T:
+    """Call ``func`` in the numerical policy of the service.
+
+    Floating-point overflow, invalid operations and division by zero raise instead of
+    producing inf/NaN silently (underflow to zero stays allowed); numpy's errstate is
+    context-local, so this does not leak into other threads.  Arithmetic and plain
+    ValueErrors escaping the core from accepted input (extreme magnitudes such as
+    denormal periods) become :class:`~service.errors.NumericalError` (HTTP 422), logged
+    with their traceback: a client input never answers 500.  Domain errors
+    (:class:`~stochcable.errors.StochcableError`, including InputError) pass unchanged.
+    """
+    from stochcable.errors import StochcableError
+
+    from .errors import NumericalError
+
+    try:
+        with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
+            return func(*args)
+    except StochcableError:
+        raise
+    except (ArithmeticError, ValueError) as exc:
+        _log.warning("numerical failure on accepted input", exc_info=True)
+        raise NumericalError(f"{type(exc).__name__}: {exc}") from exc

@@ -1,0 +1,71 @@
+"""POST /v1/sea/realizations: a random sea realization (DSA/NSA) and its kinematics."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from fastapi import APIRouter
+from starlette.responses import Response
+
+from stochcable.kinematics import kinematics_timeseries
+from stochcable.sea import simulate_sea
+
+from ..dependencies import MediaTypeDep, RunnerDep, SettingsDep
+from ..encoding import JSON, array_responses, columns_response, json_response
+from ..limits import check_points, check_samples
+from ..schemas import RealizationRequest, RealizationResponse
+
+router = APIRouter(prefix="/v1", tags=["sea"])
+
+_LAYOUT = (
+    "Columns: time [s], elevation [m], then for each point p = 0, 1, ... "
+    "velocity_p_x, velocity_p_y, velocity_p_z [m/s] and acceleration_p_x, "
+    "acceleration_p_y, acceleration_p_z [m/s²]; the statistics as JSON in the "
+    "X-Stochcable-Stats header."
+)
+
+
+@router.post("/sea/realizations", operation_id="simulate_sea",
+             response_model=RealizationResponse,
+             responses=array_responses(RealizationResponse, _LAYOUT, 413, 422, 504),
+             summary="Simulate a random sea realization and its wave kinematics")
+async def simulate_sea_realization(body: RealizationRequest, settings: SettingsDep,
+                                   runner: RunnerDep, media: MediaTypeDep) -> Response:
+    """η(t) by :func:`stochcable.sea.simulate_sea` (seed 001 §5.1; duration/dt must be an
+    even number of samples) and, at ``points``, the velocity and acceleration by
+    :func:`stochcable.kinematics.kinematics_timeseries` from the same amplitudes.
+    Use ``Accept: application/x-npy`` for long records."""
+    n_points = len(body.points) if body.points else 0
+    check_points(n_points, settings)
+    check_samples(body.duration, body.dt, n_points, settings)
+    return await runner.run(_realization, body, media)
+
+
+def _realization(body: RealizationRequest, media: str) -> Response:
+    spectrum, g = body.spectrum, body.g
+
+    def density(w: np.ndarray) -> np.ndarray:
+        return spectrum.spectral_density(w, g)
+
+    sea = simulate_sea(density, body.duration, body.dt, method=body.method, rng=body.seed)
+    # target variance: the Riemann sum over the simulated lines m = 1 … N-1 (X_0 = X_N = 0)
+    elevation = sea.elevation
+    stats = {"variance": float(np.dot(elevation, elevation) / elevation.size),
+             "m0": float(density(sea.omega[1:-1]).sum() * sea.d_omega)}
+    kin = None
+    if body.points:
+        kin = kinematics_timeseries(sea, np.asarray(body.points, dtype=float),
+                                    math.radians(body.heading), body.depth_or_inf(), g)
+    if media == JSON:
+        payload = {"time": sea.time, "elevation": sea.elevation, "stats": stats}
+        if kin is not None:
+            payload["kinematics"] = {"velocity": kin[0], "acceleration": kin[1]}
+        return json_response(payload)
+    columns = {"time": sea.time, "elevation": sea.elevation}
+    if kin is not None:
+        for name, arr in (("velocity", kin[0]), ("acceleration", kin[1])):
+            for p in range(arr.shape[0]):
+                for c, axis in enumerate("xyz"):
+                    columns[f"{name}_{p}_{axis}"] = arr[p, c]
+    return columns_response(columns, media, stats)

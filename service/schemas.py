@@ -1,0 +1,246 @@
+"""Request and response wrappers of the HTTP API (v1).
+
+Thin wrappers only: the spectrum documents are the core's models
+(:data:`stochcable.scene.Spectrum`, a discriminated union on ``type``), the frequency
+grid is :class:`stochcable.scene.OmegaGrid`, the time-series settings are
+:class:`stochcable.scene.TimeSeriesSettings` and the example documents are
+:class:`stochcable.scene.Scene` - one schema for the Python API, the CLI and the
+service.  Every field carries its unit in brackets in its description.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from stochcable import scene as sc
+from stochcable.scene import G_STANDARD, OmegaGrid, Spectrum, TimeSeriesSettings
+
+__all__ = [
+    "ErrorItem",
+    "ErrorResponse",
+    "HealthResponse",
+    "VersionResponse",
+    "SpectrumRequest",
+    "SpectrumStats",
+    "SpectrumResponse",
+    "RealizationRequest",
+    "RealizationStats",
+    "Kinematics",
+    "RealizationResponse",
+    "ExampleSummary",
+    "default_omega",
+    "DEFAULT_OMEGA_COUNT",
+]
+
+DEFAULT_OMEGA_COUNT = 200
+"""Size of the default frequency grid of ``POST /v1/spectra``. [-]"""
+
+
+def _f(description: str, unit: str, **kw: Any) -> Any:
+    """Field whose description ends with the unit in brackets (as the scene models)."""
+    return Field(description=f"{description} [{unit}]", json_schema_extra={"unit": unit}, **kw)
+
+
+class _Request(BaseModel):
+    # the scene models' policy: immutable, unknown fields rejected, NaN/inf rejected
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+
+class _Response(BaseModel):
+    model_config = ConfigDict(frozen=True)
+
+
+# ---------------------------------------------------------------------- errors
+
+
+class ErrorItem(BaseModel):
+    """One error, in the shape of FastAPI's validation errors plus a few fields."""
+
+    model_config = ConfigDict(extra="allow")
+
+    loc: list[str | int] = Field(description="Where: 'body', 'path' or 'query', then the "
+                                             "field path")
+    msg: str = Field(description="What is wrong and what the constraint is")
+    type: str = Field(description="Error kind: a pydantic error type, or input_error, "
+                                  "limit_exceeded, body_too_large, run_time_exceeded, "
+                                  "convergence_error, solver_error, not_found, http_error")
+    parameter: str | None = Field(default=None, description="Dotted field path (or core "
+                                                            "parameter name)")
+    unit: str | None = Field(default=None, description="Unit of the parameter")
+
+
+class ErrorResponse(BaseModel):
+    """Every error answer: a list of errors under ``detail``."""
+
+    detail: list[ErrorItem]
+
+
+# ---------------------------------------------------------------------- health
+
+
+class HealthResponse(_Response):
+    """Liveness answer."""
+
+    status: Literal["ok"] = "ok"
+
+
+class VersionResponse(_Response):
+    """Versions of the library and of the HTTP API."""
+
+    stochcable: str = Field(description="Version of the stochcable package")
+    api: Literal["v1"] = Field(default="v1", description="Version of the HTTP API")
+
+
+# --------------------------------------------------------------------- spectra
+
+_G_FIELD = _f("Gravitational acceleration (used by the wind-speed Pierson-Moskowitz form)",
+              "m/s²", gt=0, default=G_STANDARD)
+
+
+class SpectrumRequest(_Request):
+    """A spectrum document and the grid to sample it on."""
+
+    spectrum: Spectrum = Field(description="Spectrum document (DESIGN.md 'Wave spectra')")
+    omega: OmegaGrid | None = Field(
+        default=None,
+        description="Frequency grid; by default 200 frequencies up to 6 times the peak "
+        "frequency (the table's own range for a table spectrum)",
+    )
+    g: float = _G_FIELD
+
+    def omega_values(self) -> np.ndarray:
+        """The frequency grid of the request. [rad/s]"""
+        if self.omega is not None:
+            return self.omega.values()
+        return default_omega(self.spectrum, self.g)
+
+    def omega_count(self) -> int:
+        """Number of frequencies the request asks for. [-]"""
+        return self.omega.count if self.omega is not None else DEFAULT_OMEGA_COUNT
+
+
+def _peak_period(spectrum: Any, g: float) -> float:
+    """Shortest peak period of a spectrum document. [s]"""
+    from stochcable import spectra
+
+    if isinstance(spectrum, sc.PiersonMoskowitz):
+        if spectrum.tp is not None:
+            return spectrum.tp
+        if spectrum.omega_p is not None:
+            return 2.0 * math.pi / spectrum.omega_p
+        # S ∝ ω⁻⁵ exp[−0.74 (g/Uω)⁴] peaks at ω = (4·0.74/5)^(1/4) g/U
+        return 2.0 * math.pi * spectrum.wind_speed / ((4.0 * 0.74 / 5.0) ** 0.25 * g)
+    if isinstance(spectrum, sc.Issc):
+        return spectrum.t1 / spectra.PM_TM01_OVER_TP  # ISSC has the PM shape
+    if isinstance(spectrum, sc.OchiHubble):
+        return min(spectrum.tp1, spectrum.tp2)
+    return float(spectrum.tp)
+
+
+def default_omega(spectrum: Any, g: float = G_STANDARD) -> np.ndarray:
+    """Default grid of a spectrum document: :func:`stochcable.spectra.omega_grid` of its
+    (shortest) peak period, or 200 points over a table's range. [rad/s]"""
+    from stochcable import spectra
+
+    if isinstance(spectrum, sc.TableSpectrum):
+        return np.linspace(spectrum.omega[0], spectrum.omega[-1], DEFAULT_OMEGA_COUNT)
+    return spectra.omega_grid(_peak_period(spectrum, g), DEFAULT_OMEGA_COUNT)
+
+
+_INF_NOTE = "; null when infinite (a moment is zero on the grid)"
+
+
+class SpectrumStats(_Response):
+    """Moments (trapezoid rule on the grid) and derived statistics of the spectrum."""
+
+    m0: float = _f("Zeroth moment, the variance", "unit²")
+    m1: float = _f("First moment", "unit²·rad/s")
+    m2: float = _f("Second moment", "unit²·(rad/s)²")
+    m3: float = _f("Third moment", "unit²·(rad/s)³")
+    m4: float = _f("Fourth moment", "unit²·(rad/s)⁴")
+    hs: float = _f("Significant height 4·sqrt(m0)", "unit")
+    tz: float | None = _f("Mean zero-upcrossing period 2π·sqrt(m0/m2)" + _INF_NOTE, "s")
+    tm01: float | None = _f("Mean period 2π·m0/m1" + _INF_NOTE, "s")
+    tp: float | None = _f("Peak period 2π/ω at the largest density on the grid" + _INF_NOTE,
+                          "s")
+    bandwidth: float = _f("Cartwright–Longuet-Higgins bandwidth sqrt(1 − m2²/(m0·m4))", "-")
+
+
+class SpectrumResponse(_Response):
+    """The sampled spectrum and its statistics."""
+
+    omega: list[float] = _f("Angular frequencies", "rad/s")
+    density: list[float] = _f("One-sided spectral density", "unit²·s/rad")
+    stats: SpectrumStats
+
+
+# ------------------------------------------------------------------------- sea
+
+Point = Annotated[
+    tuple[float, float, float],
+    Field(description="Point (x, y, z), z up from the still-water level [m]"),
+]
+
+
+class RealizationRequest(TimeSeriesSettings):
+    """A random sea realization (seed 001 §5.1) and, optionally, its wave kinematics.
+
+    ``method``, ``duration``, ``dt`` and ``seed`` are those of the scene's
+    ``analysis.timeseries``.  The number of samples is duration/dt.
+    """
+
+    spectrum: Spectrum = Field(description="Sea spectrum document")
+    g: float = _f("Gravitational acceleration", "m/s²", gt=0, default=G_STANDARD)
+    points: list[Point] | None = Field(
+        default=None, min_length=1,
+        description="Points (x, y, z) where the wave velocity and acceleration are "
+        "wanted; points above z = 0 get zero kinematics [m]",
+    )
+    heading: float = _f("Direction the waves travel toward, from +x toward +y", "deg",
+                        ge=-360.0, le=360.0, default=0.0)
+    depth: float | None = _f("Water depth; null or absent for deep water", "m", gt=0,
+                             default=None)
+
+    def depth_or_inf(self) -> float:
+        """Water depth, ``inf`` for deep water. [m]"""
+        return math.inf if self.depth is None else self.depth
+
+
+class RealizationStats(_Response):
+    """Statistics of the realization against the spectrum."""
+
+    variance: float = _f("Variance of the simulated elevation (mean square about 0)", "m²")
+    m0: float = _f("Variance the simulation targets: the sum of S(ω_m)·Δω over the "
+                   "simulation frequencies (DSA reproduces it exactly)", "m²")
+
+
+class Kinematics(_Response):
+    """Wave particle velocity and acceleration time series at the requested points."""
+
+    velocity: list[list[list[float]]] = _f(
+        "Velocity, indexed [point][component x, y, z][sample]", "m/s")
+    acceleration: list[list[list[float]]] = _f(
+        "Acceleration, indexed [point][component x, y, z][sample]", "m/s²")
+
+
+class RealizationResponse(_Response):
+    """A sea surface elevation time series (and kinematics when points were given)."""
+
+    time: list[float] = _f("Sample times t_n = n·dt", "s")
+    elevation: list[float] = _f("Surface elevation η(t_n)", "m")
+    stats: RealizationStats
+    kinematics: Kinematics | None = None
+
+
+# -------------------------------------------------------------------- examples
+
+
+class ExampleSummary(_Response):
+    """An example scene shipped with stochcable."""
+
+    name: str = Field(description="Name to use in GET /v1/examples/{name}")
+    title: str = Field(description="The scene's title")

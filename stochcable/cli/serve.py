@@ -1,0 +1,61 @@
+"""``stochcable serve``: run the HTTP service (FastAPI app ``service.app:app``) with uvicorn."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+__all__ = ["register", "run"]
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``serve`` sub-command."""
+    p = subparsers.add_parser(
+        "serve",
+        help="run the HTTP service",
+        description="Run the stochcable HTTP service with uvicorn. Limits are read from "
+        "STOCHCABLE_* environment variables (STOCHCABLE_MAX_SAMPLES, "
+        "STOCHCABLE_MAX_BODY_BYTES, STOCHCABLE_MAX_RUN_SECONDS, ...).",
+    )
+    p.add_argument("--host", default=None,
+                   help="interface to bind (default STOCHCABLE_HOST or 127.0.0.1)")
+    p.add_argument("--port", type=int, default=None,
+                   help="TCP port (default STOCHCABLE_PORT or 8000)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes (default STOCHCABLE_WORKERS or 1)")
+    p.add_argument("--log-level", default="info",
+                   choices=["critical", "error", "warning", "info", "debug"],
+                   help="uvicorn log level (default info)")
+    p.set_defaults(func=run)
+
+
+def banner(host: str, port: int) -> str:
+    """The line printed on start: where the service and its interactive docs are."""
+    shown = f"[{host}]" if ":" in host else host
+    base = f"http://{shown}:{port}"
+    return (f"stochcable service on {base} — docs at {base}/docs, "
+            f"example: curl {base}/v1/examples\n")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Start uvicorn; returns when the server stops."""
+    import uvicorn
+
+    from service.settings import Settings
+
+    from ..errors import InputError
+
+    settings = Settings()
+    host = args.host if args.host is not None else settings.host
+    port = args.port if args.port is not None else settings.port
+    workers = args.workers if args.workers is not None else settings.workers
+    if not 0 <= port <= 65535:
+        raise InputError("--port", port, "-", "must be in 0 … 65535")
+    if workers < 1:
+        raise InputError("--workers", workers, "-", "must be >= 1")
+    # each worker process imports service.app:app and reads the STOCHCABLE_* variables
+    sys.stderr.write(banner(host, port))
+    sys.stderr.flush()
+    uvicorn.run("service.app:app", host=host, port=port, workers=workers,
+                log_level=args.log_level)
+    return 0

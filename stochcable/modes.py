@@ -1,0 +1,405 @@
+"""Natural modes of a line about its static shape: K φ = ω² M_T φ (DESIGN.md "Modes").
+
+The generalized symmetric eigenproblem on the free DOFs of an :class:`~stochcable.fem.FEModel`
+is solved by one of three methods:
+
+- ``"dense"``: LAPACK ``eigh`` with ``subset_by_index`` (robust; O(n³)).
+- ``"banded"``: ARPACK shift-invert Lanczos (``eigsh``) with the shifted matrix
+  factored by banded Cholesky (``cholesky_banded``; O(n·b²) per factorization and
+  O(n·b) per solve).
+- ``"sparse"``: ARPACK shift-invert with a sparse LU (``splu``).
+
+``"auto"`` takes ``"dense"`` up to ``DENSE_MAX_DOF`` free DOFs (in the largest
+decoupled block) and ``"banded"`` above (crossover measured in
+benchmarks/bench_modes.py).  Before solving, the DOF components that the matrices do not
+couple (for a line in the x–z plane, y is decoupled from x and z; for a vertical
+line all three are) are split into independent smaller problems, which also makes exact
+in-plane/out-of-plane degeneracies harmless.  The Lanczos results are checked with a
+Sturm count (the inertia of K − θM_T, Sylvester's law): if the number of eigenvalues
+below the gap after the last requested mode differs from the number found, the block is
+re-solved densely, so modes near a crossover are never dropped or duplicated.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ._validate import positive_int
+from .errors import InputError, SolverError
+from .fem import FEModel, scene_fe_models
+
+__all__ = ["DENSE_MAX_DOF", "Modes", "natural_modes", "modes_of_scene", "plane_normal"]
+
+#: Largest free-DOF block solved densely by ``method="auto"`` (benchmarks/bench_modes.py:
+#: dense eigh wins below ~250 DOFs for 30 modes on 2 cores).
+DENSE_MAX_DOF = 250
+#: Energy fraction thresholds of the plane classification.
+PLANE_TOL = 1.0e-3
+# Relative size below which a matrix entry is round-off, not a coupling.
+_COUPLING_TOL = 1.0e-13
+
+
+@dataclass(frozen=True, eq=False)
+class Modes:
+    """Natural modes of one line.
+
+    Attributes
+    ----------
+    omega : ndarray, shape (count,)
+        Natural angular frequencies, ascending. [rad/s]
+    shapes : ndarray, shape (n_dof, count)
+        Mode shapes on all model DOFs (zeros at prescribed DOFs), normalized so that
+        φᵀ M_T φ = 1 with M_T the mass used (M, plus Ma when ``added_mass``). [kg^-1/2]
+    plane : ndarray of str, shape (count,)
+        "in-plane", "out-of-plane" or "mixed" with respect to the vertical plane of the
+        line (normal :attr:`normal`); every mode of a 2-D model is "in-plane".
+    out_of_plane : ndarray, shape (count,)
+        Fraction of the modal kinetic energy in the out-of-plane component. [-]
+    normal : ndarray, shape (3,)
+        Unit normal of the line's vertical plane. [-]
+    method : str
+        Eigen-solver used ("dense", "banded", "sparse", or a combination "a+b").
+    added_mass : bool
+        Whether the added mass is in M_T.
+    """
+
+    omega: np.ndarray
+    shapes: np.ndarray
+    plane: np.ndarray
+    out_of_plane: np.ndarray
+    normal: np.ndarray
+    method: str
+    added_mass: bool
+
+    @property
+    def count(self) -> int:
+        """Number of modes."""
+        return int(self.omega.size)
+
+    @property
+    def period(self) -> np.ndarray:
+        """Natural periods 2π/ω (inf for a zero frequency). [s]"""
+        with np.errstate(divide="ignore"):
+            return np.where(self.omega > 0, 2.0 * np.pi / np.where(self.omega > 0,
+                                                                    self.omega, 1.0), np.inf)
+
+    def to_document(self) -> dict[str, list]:
+        """{"omega": [rad/s], "period": [s] (null for a zero frequency), "plane": [...]}."""
+        period = [float(p) if np.isfinite(p) else None for p in self.period]
+        return {
+            "omega": [float(w) for w in self.omega],
+            "period": period,
+            "plane": [str(p) for p in self.plane],
+        }
+
+
+# ------------------------------------------------------------------ plane geometry
+
+
+def plane_normal(positions: np.ndarray) -> np.ndarray:
+    """Unit normal of the vertical plane of a line.
+
+    Parameters
+    ----------
+    positions : array_like, shape (n_nodes, 3)
+        Node positions. [m]
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        ẑ × (horizontal chord), normalized; for a vertical chord, the horizontal
+        direction of least spread of the nodes; +y when the line has no horizontal
+        extent at all.
+    """
+    p = np.asarray(positions, dtype=float)
+    scale = max(float(np.ptp(p, axis=0).max()), 1.0)
+    chord = p[-1] - p[0]
+    h = np.array([chord[0], chord[1], 0.0])
+    if np.linalg.norm(h) > 1e-9 * scale:
+        n = np.cross([0.0, 0.0, 1.0], h)
+        return n / np.linalg.norm(n)
+    q = p[:, :2] - p[:, :2].mean(axis=0)
+    if np.abs(q).max() <= 1e-9 * scale:
+        return np.array([0.0, 1.0, 0.0])
+    _, vecs = np.linalg.eigh(q.T @ q)
+    return np.array([vecs[0, 0], vecs[1, 0], 0.0])  # least-spread horizontal direction
+
+
+# ------------------------------------------------------------------------ solvers
+
+
+def _component_groups(d: int, a: sp.csr_array, b: sp.csr_array) -> list[list[int]]:
+    """Components (DOF index mod d) grouped by coupling in A or B (union-find)."""
+    parent = list(range(d))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    for mat in (a, b):
+        coo = sp.coo_array(mat)
+        ci, cj = coo.row % d, coo.col % d
+        # entries at round-off level (after the rotation into the line's plane) do
+        # not couple
+        nz = np.abs(coo.data) > _COUPLING_TOL * np.abs(coo.data).max(initial=0.0)
+        pairs = np.unique(np.stack([ci[nz], cj[nz]]), axis=1)
+        for i, j in pairs.T:
+            ri, rj = find(int(i)), find(int(j))
+            if ri != rj:
+                parent[ri] = rj
+    groups: dict[int, list[int]] = {}
+    for c in range(d):
+        groups.setdefault(find(c), []).append(c)
+    return list(groups.values())
+
+
+def _solve_dense(a: sp.csr_array, b: sp.csr_array, k: int) -> tuple[np.ndarray, np.ndarray]:
+    n = a.shape[0]
+    if k < n:
+        return sla.eigh(a.toarray(), b.toarray(), subset_by_index=[0, k - 1],
+                        check_finite=False)
+    return sla.eigh(a.toarray(), b.toarray(), check_finite=False)
+
+
+def _shift(a: sp.csr_array, b: sp.csr_array) -> float:
+    """A negative shift of the order of the lowest eigenvalue (A − σB is then SPD)."""
+    da, db = a.diagonal(), b.diagonal()
+    ratio = da / np.where(db > 0, db, np.inf)
+    pos = ratio[ratio > 0]
+    if pos.size == 0:
+        return -1.0
+    n = max(a.shape[0], 1)
+    return -float(pos.min()) / n**2 - 1e-300
+
+
+def _banded_opinv(a: sp.csr_array, b: sp.csr_array, sigma: float, u: int) -> Any:
+    from .fem import _to_upper_banded
+
+    ab = _to_upper_banded((a - sigma * b).tocsr(), u)
+    c = sla.cholesky_banded(ab, lower=False, check_finite=False)
+    n = a.shape[0]
+    return spla.LinearOperator((n, n), dtype=float,
+                               matvec=lambda x: sla.cho_solve_banded((c, False), x,
+                                                                     check_finite=False))
+
+
+def _solve_lanczos(a: sp.csr_array, b: sp.csr_array, k: int, method: str,
+                   u: int) -> tuple[np.ndarray, np.ndarray]:
+    n = a.shape[0]
+    sigma = _shift(a, b)
+    kk = min(k + 2, n - 1)  # two beyond the request: a gap for the Sturm check
+    if method == "banded":
+        try:
+            opinv = _banded_opinv(a, b, sigma, u)
+        except np.linalg.LinAlgError:
+            opinv = None  # not SPD (should not happen with T >= 0): use LU
+    else:
+        opinv = None
+    v0 = np.ones(n) / np.sqrt(n)  # deterministic start vector
+    ncv = min(n, max(2 * kk + 1, kk + 20))
+    lam, vec = spla.eigsh(a, k=kk, M=b, sigma=sigma, which="LM", OPinv=opinv, v0=v0,
+                          ncv=ncv, tol=1e-13, mode="normal")
+    order = np.argsort(lam)
+    lam, vec = lam[order], vec[:, order]
+    # Sturm check: exactly k eigenvalues below the gap after the k-th.
+    theta = 0.5 * (lam[k - 1] + lam[k]) if kk > k else lam[k - 1] * (1 + 1e-8) + 1e-300
+    if _count_below(a, b, theta) != k or lam[k - 1] == lam[k]:
+        raise _SturmMismatch
+    return lam[:k], vec[:, :k]
+
+
+class _SturmMismatch(Exception):
+    pass
+
+
+def _count_below(a: sp.csr_array, b: sp.csr_array, theta: float) -> int:
+    """Number of eigenvalues of (A, B) below theta: negative pivots of LDLᵀ(A − θB)."""
+    s = (a - theta * b).tocsc()
+    lu = spla.splu(s, permc_spec="NATURAL", diag_pivot_thresh=0.0,
+                   options={"SymmetricMode": True})
+    if not (np.array_equal(lu.perm_r, np.arange(s.shape[0]))
+            and np.array_equal(lu.perm_c, np.arange(s.shape[0]))):
+        return int((sla.eigvalsh(s.toarray(), b.toarray()) < theta).sum())
+    return int((lu.U.diagonal() < 0).sum())
+
+
+def _solve_block(a, b, k, method, u):
+    n = a.shape[0]
+    if method == "auto":
+        method = "dense" if n <= DENSE_MAX_DOF else "banded"
+    if method == "dense" or k >= n - 2:
+        lam, vec = _solve_dense(a, b, k)
+        return lam, vec, "dense"
+    try:
+        lam, vec = _solve_lanczos(a, b, k, method, u)
+        return lam, vec, method
+    except (_SturmMismatch, spla.ArpackNoConvergence, spla.ArpackError):
+        lam, vec = _solve_dense(a, b, k)
+        return lam, vec, "dense"
+
+
+def natural_modes(
+    model: FEModel,
+    count: int | None = None,
+    added_mass: bool = True,
+    method: Literal["auto", "dense", "banded", "sparse"] = "auto",
+) -> Modes:
+    """Lowest natural modes of a line model.
+
+    Parameters
+    ----------
+    model : FEModel
+        The linear model (:func:`stochcable.fem.assemble`).
+    count : int, optional
+        Number of modes, lowest first; default all free DOFs (min(count, n_free) are
+        returned).
+    added_mass : bool
+        Include the added mass in the modal mass (modes in water) or not (in air).
+    method : {"auto", "dense", "banded", "sparse"}
+        Eigen-solver; see the module docstring.
+
+    Returns
+    -------
+    Modes
+        Frequencies, mass-normalized shapes and plane classification.
+
+    Notes
+    -----
+    Solves K_ff φ = ω² M_T,ff φ on the free DOFs (DESIGN.md "Modes"; seed 000 ch. 3
+    for the closed forms it reproduces).  Eigenvalues below zero by round-off are
+    reported as ω = 0.  The out-of-plane fraction of a mode is
+    E_n/(E_n + E_p), E = uᵀ M_T u of the displacement projected on the plane normal n
+    (E_n) and on the plane (E_p); "in-plane" below ``PLANE_TOL``, "out-of-plane"
+    above 1 − ``PLANE_TOL``, "mixed" between.
+    """
+    if not isinstance(model, FEModel):
+        raise InputError("model", type(model).__name__, "-", "must be an FEModel")
+    if method not in ("auto", "dense", "banded", "sparse"):
+        raise InputError("method", method, "-", "must be auto, dense, banded or sparse")
+    n_free = model.free.size
+    if n_free == 0:
+        raise InputError("model", "no free DOFs", "-", "needs at least one free node")
+    k_req = n_free if count is None else positive_int("count", count)
+    mt = (model.M + model.Ma).tocsr() if added_mass else model.M
+    a, _ = model.partition(model.K)
+    b, _ = model.partition(mt)
+
+    d = model.dim
+    normal = plane_normal(model.positions)
+    rot = None
+    if d == 3:
+        # Rotate about z so that the line's vertical plane is the local x–z plane: a
+        # planar line's out-of-plane DOFs then decouple exactly from the in-plane ones.
+        r = np.array([[normal[1], normal[0], 0.0],
+                      [-normal[0], normal[1], 0.0],
+                      [0.0, 0.0, 1.0]])  # columns: local x, y (= normal), z
+        if not np.allclose(r, np.eye(3), rtol=0.0, atol=1e-15):
+            rot = sp.csr_array(sp.kron(sp.eye_array(n_free // 3), r, format="csr"))
+            a = (rot.T @ a @ rot).tocsr()
+            b = (rot.T @ b @ rot).tocsr()
+    comp_of_free = np.arange(n_free) % d
+    lams, vecs, idxs, used = [], [], [], []
+    for group in _component_groups(d, a, b):
+        sel = np.flatnonzero(np.isin(comp_of_free, group))
+        ag = a[sel][:, sel].tocsr()
+        bg = b[sel][:, sel].tocsr()
+        k = min(k_req, sel.size)
+        u = 2 * len(group) - 1
+        lam, vec, m = _solve_block(ag, bg, k, method, u)
+        lams.append(lam)
+        vecs.append(vec)
+        idxs.append(sel)
+        used.append(m)
+
+    lam_all = np.concatenate(lams)
+    order = np.argsort(lam_all, kind="stable")[: min(k_req, n_free)]
+    k = order.size
+    local = np.zeros((n_free, k))
+    starts = np.cumsum([0] + [v.shape[1] for v in vecs])
+    for col, j in enumerate(order):
+        g = int(np.searchsorted(starts, j, side="right") - 1)
+        local[idxs[g], col] = vecs[g][:, j - starts[g]]
+    shapes = np.zeros((model.n_dof, k))
+    shapes[model.free] = local if rot is None else rot @ local
+    lam = lam_all[order]
+    scale = max(float(np.abs(lam).max()), 1e-300)
+    if (lam < -1e-8 * scale).any():
+        raise SolverError(
+            f"negative eigenvalue {lam.min():.3e} rad²/s²: the stiffness is not positive "
+            "semi-definite (check the static tensions)"
+        )
+    omega = np.sqrt(np.clip(lam, 0.0, None))
+
+    # Mass normalization and a deterministic sign (largest component positive).
+    mts = mt @ shapes
+    norm = np.sqrt(np.einsum("ij,ij->j", shapes, mts))
+    shapes = shapes / norm
+    big = np.argmax(np.abs(shapes), axis=0)
+    shapes = shapes * np.sign(shapes[big, np.arange(k)])
+
+    frac = _out_of_plane_fraction(model, mt, shapes, normal)
+    plane = np.where(frac <= PLANE_TOL, "in-plane",
+                     np.where(frac >= 1.0 - PLANE_TOL, "out-of-plane", "mixed"))
+    return Modes(
+        omega=omega,
+        shapes=shapes,
+        plane=plane.astype(str),
+        out_of_plane=frac,
+        normal=normal,
+        method="+".join(sorted(set(used))),
+        added_mass=bool(added_mass),
+    )
+
+
+def _out_of_plane_fraction(model: FEModel, mt: Any, shapes: np.ndarray,
+                           normal: np.ndarray) -> np.ndarray:
+    if model.dim == 2:
+        return np.zeros(shapes.shape[1])
+    d = model.dim
+    u = shapes.reshape(model.n_nodes, d, -1)
+    un = np.einsum("c,ncj->nj", normal, u)
+    pn = (normal[None, :, None] * un[:, None, :]).reshape(model.n_dof, -1)
+    pp = shapes - pn
+    en = np.einsum("ij,ij->j", pn, mt @ pn)
+    ep = np.einsum("ij,ij->j", pp, mt @ pp)
+    tot = en + ep
+    return np.where(tot > 0, en / np.where(tot > 0, tot, 1.0), 0.0)
+
+
+def modes_of_scene(
+    scene: Any,
+    count: int | None = None,
+    dim: int = 3,
+    added_mass: bool = True,
+) -> dict[str, Modes]:
+    """Natural modes of every line of a scene about its static equilibrium.
+
+    Parameters
+    ----------
+    scene : Scene, mapping, JSON string or path
+        The scene document (:func:`stochcable.scene.load_scene`).
+    count : int, optional
+        Modes per line; default all.
+    dim : {2, 3}
+        3 (default) lists in-plane and out-of-plane modes, classified; 2 keeps the
+        in-plane modes of lines in the x–z plane only.
+    added_mass : bool
+        Modes in water (with added mass) or in air.
+
+    Returns
+    -------
+    dict of str to Modes
+        Per line name, in scene order.
+    """
+    if count is not None:
+        count = positive_int("count", count)
+    models = scene_fe_models(scene, dim=dim)
+    return {name: natural_modes(model, count=count, added_mass=added_mass)
+            for name, model in models.items()}

@@ -1,0 +1,64 @@
+"""``stochcable serve``: starts uvicorn, announces the docs URL, answers /health."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+
+import httpx
+
+from stochcable.cli import main
+from stochcable.cli.serve import banner
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_banner_names_the_docs_and_an_example():
+    text = banner("127.0.0.1", 8000)
+    assert "http://127.0.0.1:8000/docs" in text
+    assert "curl http://127.0.0.1:8000/v1/examples" in text
+    assert "http://[::1]:8000/docs" in banner("::1", 8000)
+
+
+def test_bad_port_is_a_one_line_error(capsys):
+    assert main(["serve", "--port", "70000"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == "stochcable serve: error: --port = 70000: must be in 0 … 65535"
+
+
+def test_serve_starts_uvicorn_and_answers():
+    port = _free_port()
+    env = {**os.environ, "STOCHCABLE_MAX_SAMPLES": "1024"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "stochcable", "serve", "--port", str(port),
+         "--log-level", "warning"],
+        stderr=subprocess.PIPE, text=True, env=env,
+    )
+    try:
+        first = proc.stderr.readline()
+        assert f"docs at http://127.0.0.1:{port}/docs" in first
+        deadline = time.monotonic() + 15.0
+        while True:
+            try:
+                resp = httpx.get(f"http://127.0.0.1:{port}/health", timeout=1.0)
+                break
+            except httpx.TransportError:
+                assert time.monotonic() < deadline, "server did not answer within 15 s"
+                assert proc.poll() is None, proc.stderr.read()
+                time.sleep(0.1)
+        assert resp.json() == {"status": "ok"}
+        # the worker read the limits from the environment
+        resp = httpx.post(f"http://127.0.0.1:{port}/v1/sea/realizations", json={
+            "spectrum": {"type": "jonswap", "hs": 2.0, "tp": 8.0},
+            "duration": 2048.0, "dt": 1.0})
+        assert "limit of 1024 (STOCHCABLE_MAX_SAMPLES)" in resp.text
+    finally:
+        proc.terminate()
+        proc.wait(10.0)

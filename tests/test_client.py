@@ -1,0 +1,123 @@
+"""stochcable.client against a real uvicorn server on a free loopback port: the
+client returns the same objects and numbers as the local API and clear errors."""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+
+import numpy as np
+import pytest
+import uvicorn
+
+import stochcable
+from service.app import create_app
+from service.settings import Settings
+from stochcable.client import Client, ClientError, ServiceError
+from stochcable.kinematics import kinematics_timeseries
+from stochcable.scene import Jonswap, OmegaGrid, Scene
+from stochcable.sea import simulate_sea
+from stochcable.spectra import SpectrumStatistics, spectrum_statistics
+
+JONSWAP = Jonswap(hs=4.0, tp=8.0)
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def base_url():
+    port = _free_port()
+    config = uvicorn.Config(create_app(Settings(max_samples=2**16)), host="127.0.0.1",
+                            port=port, log_level="warning", lifespan="off")
+    server = uvicorn.Server(config)
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 10.0
+    while not server.started:
+        if time.monotonic() > deadline or not thread.is_alive():
+            pytest.fail("uvicorn did not start within 10 s")
+        time.sleep(0.02)
+    yield f"http://127.0.0.1:{port}"
+    server.should_exit = True
+    thread.join(10.0)
+
+
+@pytest.fixture
+def client(base_url):
+    with Client(base_url, timeout=30.0) as c:
+        yield c
+
+
+def test_health_and_version(client):
+    assert client.health() == {"status": "ok"}
+    assert client.version() == {"stochcable": stochcable.__version__, "api": "v1"}
+
+
+def test_spectrum_returns_the_core_statistics(client):
+    grid = OmegaGrid(min=0.1, max=4.0, count=300)
+    res = client.spectrum(JONSWAP, omega=grid)
+    omega = grid.values()
+    density = JONSWAP.spectral_density(omega)
+    assert isinstance(res.stats, SpectrumStatistics)
+    assert res.stats == spectrum_statistics(omega, density)  # exact: JSON floats round-trip
+    assert np.array_equal(res.omega, omega) and np.array_equal(res.density, density)
+
+
+def test_spectrum_from_a_plain_document(client):
+    res = client.spectrum({"type": "pierson_moskowitz", "m0": 28.0, "omega_p": 0.5})
+    # seed 001 §6.5: m0 = 28 ft²; the default grid (to 6 wp) keeps all but ~0.05 %
+    assert res.stats.m0 == pytest.approx(28.0, rel=1e-3)
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_realization_equals_the_local_simulation(client, binary):
+    points = [[0.0, 0.0, -3.0], [20.0, 5.0, -15.0]]
+    res = client.realization(JONSWAP, duration=512.0, dt=0.25, method="nsa", seed=11,
+                             points=points, heading=45.0, depth=40.0, binary=binary)
+    sea = simulate_sea(JONSWAP.spectral_density, 512.0, 0.25, method="nsa", rng=11)
+    vel, acc = kinematics_timeseries(sea, np.array(points), np.radians(45.0), 40.0)
+    assert np.array_equal(res.time, sea.time)
+    assert np.array_equal(res.elevation, sea.elevation)
+    assert np.array_equal(res.velocity, vel) and np.array_equal(res.acceleration, acc)
+    # mean square of the record = sum a_m^2/2 (Parseval), to rounding of 2048 terms
+    assert res.variance == pytest.approx(sea.variance_grid, rel=1e-12)
+    assert res.dt == 0.25
+
+
+def test_input_error_raises_client_error_with_path_and_unit(client):
+    with pytest.raises(ClientError, match=r"HTTP 422: spectrum\.hs \[m\]: Input should be "
+                                          r"greater than or equal to 0.000001") as info:
+        client.spectrum({"type": "jonswap", "hs": -1.0, "tp": 8.0})
+    assert info.value.status == 422
+    assert info.value.detail[0]["parameter"] == "spectrum.hs"
+    assert isinstance(info.value, stochcable.StochcableError)
+
+
+def test_limit_raises_client_error_naming_the_bound(client):
+    with pytest.raises(ClientError, match=r"duration/dt = 131072 samples exceeds the limit "
+                                          r"of 65536 \(STOCHCABLE_MAX_SAMPLES\)"):
+        client.realization(JONSWAP, duration=32768.0, dt=0.25)
+
+
+def test_unreachable_service_raises_service_error():
+    with Client(f"http://127.0.0.1:{_free_port()}", timeout=2.0) as c:
+        with pytest.raises(ServiceError, match="cannot reach") as info:
+            c.health()
+    assert info.value.status is None and not isinstance(info.value, ClientError)
+
+
+def test_examples(client):
+    examples = pytest.importorskip("stochcable.examples")
+    if not hasattr(examples, "list_examples"):
+        pytest.skip("stochcable.examples.list_examples not written yet")
+    names = [e.name for e in client.examples()]
+    assert names == examples.list_examples()
+    scene = client.example(names[0])
+    assert isinstance(scene, Scene) and scene == examples.load_example(names[0])
+    with pytest.raises(ClientError, match=r"HTTP 404: unknown example 'nope'; known examples"):
+        client.example("nope")
