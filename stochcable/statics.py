@@ -189,8 +189,9 @@ def solve_line_statics(
     Raises
     ------
     InputError
-        For an unknown method, an ``initial`` of the wrong shape, or ``"catenary"``
-        asked for a line it does not apply to.
+        For an unknown method, an ``initial`` of the wrong shape, ``"catenary"``
+        asked for a line it does not apply to, or a line whose static shape is
+        undetermined (see Notes).
     ConvergenceError
         When the FE solve does not reach ``tolerance`` within ``max_iterations``; the
         message carries the residual reached.
@@ -220,14 +221,27 @@ def solve_line_statics(
       the node's tributary unstretched length, pushing up only.  The penetration of a
       line lying on the bed is w/(stiffness·D).  Seabed friction is not modelled.
 
+    Start: the exact equilibrium of the lumped chain without drag (a two-unknown
+    shooting on (H, V_0), seabed contact from end_a included, see ``_chain_guess``),
+    which is the FE solution itself for planar lines without current; a parabola when
+    it does not apply (vertical span, contact away from end_a).
+
     Solution (seed 001 §4.1): Newton–Raphson on the residual feedback form
-    (eq. 4.1.2) with a backtracking line search on the residual norm; when it stalls,
-    the viscous relaxation method (eqs. 4.1.5-4.1.8): artificial nodal damping
-    proportional to the stiffness diagonal, [K + C/Δt] ΔU = R, with 1/Δt relaxed
-    toward zero as the residual falls (switched evolution relaxation), which ends as
-    plain Newton; when that fails too, load stepping of the attachments, current and
-    weight variation along the line from the uniform-weight shape.  The tangent of a
-    line is block tridiagonal and is solved banded (O(n) per iteration).
+    (eq. 4.1.2) with a backtracking line search that accepts a decrease of the residual
+    norm or of the potential energy with the drag frozen at the current iterate (the
+    exact energy without current); when no step is accepted, the viscous relaxation
+    method (eqs. 4.1.5-4.1.8): artificial nodal damping proportional to the stiffness
+    diagonal, [K + C/Δt] ΔU = R, with 1/Δt relaxed toward zero as full steps succeed,
+    which ends as plain Newton.  With current, the full-load attempt gets a quarter of
+    the budget and then the drag is load-stepped from the current-free equilibrium.
+    The tangent of a line is block tridiagonal and is solved banded (O(n) per
+    iteration).
+
+    Undetermined shapes are refused up front (InputError): without current, a line
+    with end_a on the frictionless seabed longer than its horizontal span plus its
+    vertical hanging length (the slack lies on the bed with zero horizontal tension and
+    can slide), and a weightless slack line.  Otherwise the iteration count is bounded
+    by ``max_iterations`` and a ConvergenceError names the line.
 
     The reachable residual is bounded below by round-off in l - l0: about
     8·eps·max(EA/l0)·max|x| relative to the reference force; ``tolerance`` is raised
@@ -246,6 +260,7 @@ def solve_line_statics(
             raise InputError("initial", initial, "m",
                              f"must be finite with shape ({mesh.n_nodes}, 3)")
 
+    _check_determined(mesh, environment)
     if method != "fe":
         why = _catenary_inapplicable(mesh, environment)
         if why is None:
@@ -257,6 +272,51 @@ def solve_line_statics(
             raise InputError("method", "catenary", "-",
                              f"does not apply to line {mesh.name!r}: {why}; use 'fe' or 'auto'")
     return _solve_fe(mesh, environment, initial, tolerance, int(max_iterations))
+
+
+def _check_determined(mesh: LineMesh, env: Environment) -> None:
+    """Raise InputError for a line whose static shape is undetermined.
+
+    Without current and with the loads all downward:
+
+    - a weightless line longer than the distance between its ends (no load fixes the
+      slack shape);
+    - a line with end_a on the frictionless seabed that is longer than its horizontal
+      span X plus the shortest hanging length l_v that reaches end_b's height Z
+      (l_v = 2Z / (1 + sqrt(1 + 2 w Z / EA)), the elastic vertical line of the segment
+      at end_b, w its net weight): the surplus would lie slack on the bed with zero
+      horizontal tension, and with no seabed friction (not modelled) its horizontal
+      position is undetermined.  Both ends on the bed is the case Z = 0.
+    """
+    if any(p.speed > 0.0 for p in env.current):
+        return
+    if np.any(mesh.weight < 0.0) or np.any(mesh.node_buoyancy - mesh.node_mass * env.g > 0.0):
+        return
+    L = mesh.length
+    d = mesh.end_b - mesh.end_a
+    X = math.hypot(d[0], d[1])
+    Z = float(d[2])
+    chord = math.hypot(X, Z)
+    if (np.all(mesh.weight == 0.0) and np.all(mesh.node_mass == 0.0)
+            and L > chord * (1.0 + 1e-12)):
+        raise InputError(
+            f"lines[{mesh.name!r}].length", L, "m",
+            f"a weightless line longer than the distance between its ends ({chord:.6g} m) "
+            "has an undetermined slack shape; shorten it or give it a weight")
+    on_bed = mesh.end_a[2] <= -env.depth * (1.0 - 1e-9)
+    if not on_bed or Z < 0.0 or not np.any(mesh.weight > 0.0):
+        return
+    w, ea = float(mesh.weight[-1]), float(mesh.ea[-1])
+    lv = 2.0 * Z / (1.0 + math.sqrt(1.0 + 2.0 * w * Z / ea))
+    if L >= X + lv:
+        raise InputError(
+            f"lines[{mesh.name!r}].length", L, "m",
+            f"the line is longer than its horizontal span plus its vertical hanging length "
+            f"({X:.6g} m + {lv:.6g} m = {X + lv:.6g} m) with end_a on the seabed: the "
+            "surplus lies slack on the seabed with zero horizontal tension, and without "
+            "seabed friction (not modelled) the horizontal position of a fully slack "
+            f"grounded line is undetermined; shorten the line below {X + lv:.6g} m or move "
+            "the ends apart")
 
 
 # ---------------------------------------------------------------------- local frame
@@ -340,12 +400,8 @@ class _Model:
         self.has_drag = self.has_current and (
             bool(np.any(self.c_n > 0)) or bool(np.any(self.c_t > 0))
             or bool(np.any(self.c_node > 0)))
-        # load-stepping base: the uniform mean weight
-        L = float(np.sum(mesh.l0))
-        self.w_mean_sub = float(np.sum(mesh.weight * mesh.l0)) / L
-        self.w_mean_dry = float(np.sum(self.w_dry * mesh.l0)) / L
+        # load-stepping factor of the drag (1 = full current)
         self.beta = 1.0
-        self.conservative = not self.has_drag
         self._band_index()
 
     # ---- loads that do not depend on position, for the reference force
@@ -354,7 +410,7 @@ class _Model:
         return float(np.sum(w * self.l0) + np.sum(np.abs(self.node_fz)))
 
     def energy(self, X: np.ndarray) -> float:
-        """Total potential energy for conservative loads (no drag); -grad = R."""
+        """Potential energy of the conservative loads (all but drag); -grad = R - drag."""
         zi, l0 = self.zi, self.l0
         d = X[1:] - X[:-1]
         l = np.sqrt(np.einsum("ij,ij->i", d, d))
@@ -363,14 +419,10 @@ class _Model:
         z = X[:, zi]
         za, zb = z[:-1], z[1:]
         wet = (za <= 0.0) & (zb <= 0.0)
-        w_sub, w_dry = self.w_sub, self.w_dry
-        if self.beta != 1.0:
-            w_sub = self.w_mean_sub + self.beta * (w_sub - self.w_mean_sub)
-            w_dry = self.w_mean_dry + self.beta * (w_dry - self.w_mean_dry)
-        W = l0 * np.where(wet, w_sub, w_dry)
+        W = l0 * np.where(wet, self.w_sub, self.w_dry)
         pen = np.maximum(self.zbed - z, 0.0)
         return float(0.5 * np.sum(eae * l0 * strain**2) + np.sum(W * 0.5 * (za + zb))
-                     - self.beta * np.sum(self.node_fz * z) + 0.5 * np.sum(self.kb * pen**2))
+                     - np.sum(self.node_fz * z) + 0.5 * np.sum(self.kb * pen**2))
 
     def current(self, z: np.ndarray) -> np.ndarray:
         u = np.empty(z.shape + (self.dim,))
@@ -417,9 +469,6 @@ class _Model:
         z = X[:, zi]
         za, zb = z[:-1], z[1:]
         w_sub, w_dry = self.w_sub, self.w_dry
-        if beta != 1.0:
-            w_sub = self.w_mean_sub + beta * (w_sub - self.w_mean_sub)
-            w_dry = self.w_mean_dry + beta * (w_dry - self.w_mean_dry)
         mixed = (np.minimum(za, zb) < 0.0) & (np.maximum(za, zb) > 0.0)
         if mixed.any():
             dz = np.where(mixed, zb - za, 1.0)
@@ -434,7 +483,7 @@ class _Model:
             W = l0 * np.where(wet, w_sub, w_dry)
         R[:-1, zi] -= 0.5 * W
         R[1:, zi] -= 0.5 * W
-        R[:, zi] += beta * self.node_fz
+        R[:, zi] += self.node_fz
         drag = 0.0
         if self.has_drag:
             u = self.current(0.5 * (za + zb))
@@ -449,6 +498,10 @@ class _Model:
             un_node = self.current(z)
             Fn = beta * (self.c_node * np.sqrt(np.einsum("ij,ij->i", un_node, un_node)))[:, None] * un_node
             R += Fn
+            self.drag_nodes = np.zeros_like(X)
+            self.drag_nodes[:-1] += 0.5 * Fd
+            self.drag_nodes[1:] += 0.5 * Fd
+            self.drag_nodes += Fn
             drag = float(np.sum(np.sqrt(np.einsum("ij,ij->i", Fd, Fd)))
                          + np.sum(np.abs(Fn)))
         pen = self.zbed - z
@@ -549,7 +602,8 @@ class _Solver:
         cap = 0.25 * span
         lam = 0.0
         phi = float(np.sum(R[1:-1] ** 2))
-        energy = m.energy(X) if m.conservative else math.nan
+        energy = m.energy(X)
+        fd = m.drag_nodes.copy() if m.has_drag else None
         best = (r, X.copy())
         for _ in range(limit):
             if self.used >= self.budget:
@@ -561,7 +615,7 @@ class _Solver:
                 continue
             big = float(np.max(np.sqrt(np.sum(dx * dx, axis=1))))
             t = min(1.0, cap / big) if big > 0 else 1.0
-            slope = float(np.sum(R[1:-1] * dx))  # -dPi/dt along dx (conservative loads)
+            slope = float(np.sum(R[1:-1] * dx))  # -dPi/dt along dx
             accepted = False
             # backtracking line search: accept a decrease of the total potential energy
             # (Armijo, when the loads are conservative) or of the residual norm
@@ -575,8 +629,12 @@ class _Solver:
                     continue
                 if phit <= (1.0 - 1e-4 * t) * phi:
                     accepted = True
-                elif m.conservative and slope > 0.0:
+                elif slope > 0.0:
+                    # energy with the drag frozen at X (its work t·Fd·dx): exact for
+                    # conservative loads, a local merit of the follower drag
                     et = m.energy(Xt)
+                    if fd is not None:
+                        et -= t * float(np.sum(fd[1:-1] * dx))
                     accepted = et <= energy - 1e-4 * t * slope
                 if accepted:
                     break
@@ -589,8 +647,9 @@ class _Solver:
             X = Xt
             r, tol, R, K = self.status(X)
             phi = float(np.sum(R[1:-1] ** 2))
-            if m.conservative:
-                energy = m.energy(X)
+            energy = m.energy(X)
+            if fd is not None:
+                fd = m.drag_nodes.copy()
             if r < best[0]:
                 best = (r, X.copy())
             if r <= tol:
@@ -607,7 +666,8 @@ def _straight(a: np.ndarray, b: np.ndarray, frac: np.ndarray) -> np.ndarray:
     return a + frac[:, None] * (b - a)
 
 
-def _initial_guess(mesh: LineMesh, env: Environment, frame: _Frame) -> np.ndarray:
+def _initial_guess(mesh: LineMesh, env: Environment, frame: _Frame,
+                   model: _Model) -> np.ndarray:
     """A hanging (parabolic) or straight initial shape in the local frame, (n, dim)."""
     a = frame.to_local(mesh.end_a[None, :])[0]
     b = frame.to_local(mesh.end_b[None, :])[0]
@@ -616,7 +676,7 @@ def _initial_guess(mesh: LineMesh, env: Environment, frame: _Frame) -> np.ndarra
     L = mesh.length
     if L <= chord * (1.0 + 1e-9):
         return _straight(a, b, frac)
-    guess = _catenary_guess(mesh, env, frame, a, b)
+    guess = _chain_guess(mesh, env, frame, model, a, b)
     if guess is not None:
         return guess
     zi = frame.dim - 1
@@ -650,81 +710,224 @@ def _initial_guess(mesh: LineMesh, env: Environment, frame: _Frame) -> np.ndarra
     return X
 
 
-def _catenary_guess(mesh: LineMesh, env: Environment, frame: _Frame,
-                    a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
-    """Inextensible catenary of the line's mean weight through the ends, prestretched.
+def _chain_guess(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
+                 a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """Exact equilibrium of the lumped chain without drag: a two-unknown shooting.
 
-    Touchdown form when end_a lies on the seabed and the free catenary would dip below
-    it.  The nodes are placed at their stretched arc length, each element carrying the
-    catenary tension, so the first tangent has transverse stiffness T/l > 0.
-    Returns None when the mean weight is not positive or the span is vertical.
+    With the loads lumped at the nodes and no current, the element forces of the FE
+    model satisfy F_k = F_{k-1} + P_k (node equilibrium), so every element carries the
+    same horizontal component H and a vertical component V_k = V_0 + sum_{i<=k} P_i,
+    P_i the net downward node load (half the weight of the two adjacent elements,
+    attachment mass·g minus buoyancy).  Each element then has the direction (H, V_k)/T_k
+    and the stretched length l0 (1 + T_k/EA): the discrete (lumped) elastic catenary.
+    With end_a on the seabed the elements before the first one with V_k > 0 lie on the
+    bed (V_k -> 0, the virtual-V_a form of :mod:`stochcable.catenary`, continuous at
+    first contact), each grounded node at its contact penetration (load / (k·D·l)).
+    (H, V_0) are found by damped Newton on the closure at end_b, started from the
+    continuous catenary of the mean weight (:func:`stochcable.catenary.catenary_solve`),
+    or, when the kinks of the closure stall it, by nested bracketing
+    (:func:`_chain_closure`).  The weights follow the wet fraction of each element at
+    the shape found (re-solved up to three times).  Drag is ignored (a start only).
+
+    Unlike the continuous catenary sampled at the nodes, whose chords are shorter than
+    its arcs by l0³κ²/24 (strains of -5e-3 near a sharp touchdown, i.e. slack elements
+    with no transverse stiffness), this start has the right element lengths and is the
+    FE solution itself for planar lines without current (up to the penetration tilt),
+    so Newton ends in a few quadratic steps.
+
+    Returns None for a vertical span, a line that would pass below the seabed away from
+    end_a, or when the closure Newton fails; the caller falls back to a parabola.
     """
-    from scipy.optimize import brentq
+    from .catenary import catenary_solve
 
-    L = mesh.length
-    w = float(np.sum(mesh.weight * mesh.l0)
-              + np.sum(mesh.node_mass * env.g - mesh.node_buoyancy)) / L
     zi = frame.dim - 1
     X = float(b[0] - a[0])
     Z = float(b[zi] - a[zi])
-    if not (w > 0.0) or X <= 1e-6 * L:
+    L = mesh.length
+    if X <= 1e-6 * L:
         return None
-    on_bed = a[zi] <= -env.depth * (1.0 - 1e-9) and Z > 0.0
-    ea_mean = L / float(np.sum(mesh.l0 / mesh.ea))
+    zbed = model.zbed
+    on_bed = (a[zi] <= zbed * (1.0 - 1e-9) and Z > 0.0 and env.seabed.stiffness > 0.0)
+    l0, ea = mesh.l0, mesh.ea
+    kb = np.where(model.kb > 0.0, model.kb, np.inf)
 
-    def shape(length: float) -> tuple:
-        # free-hanging catenary: 2 c sinh(X / 2c) = sqrt(length² - Z²)
-        ratio = math.sqrt(length**2 - Z**2) / X
-        u = brentq(lambda v: math.sinh(v) / v - ratio, 1e-9, 700.0, xtol=1e-14)
-        c = X / (2.0 * u)
-        xm = 0.5 * X - c * math.atanh(Z / length)
-        if on_bed and xm > 0.0:
-            # touchdown: grounded length lg, suspended sqrt(Z² + 2 Z c)
-            def f(cc: float) -> float:
-                ls = math.sqrt(Z * Z + 2.0 * Z * cc)
-                return length - ls + cc * math.asinh(ls / cc) - X
-            hi = X
-            while f(hi) < 0.0 and hi < 1e12 * X:
-                hi *= 2.0
-            if f(1e-9 * X) >= 0.0:
-                raise ValueError("line longer than the span plus the depth")
-            c = brentq(f, 1e-9 * X, hi, xtol=1e-12 * X)
-            ls = math.sqrt(Z * Z + 2.0 * Z * c)
-            return c, length - ls, True
-        return c, xm, False
+    def loads(W: np.ndarray) -> np.ndarray:
+        P = -model.node_fz.copy()
+        P[:-1] += 0.5 * W
+        P[1:] += 0.5 * W
+        return P
 
-    def curve(c: float, x0: float, grounded: bool, sigma: np.ndarray) -> tuple:
-        if grounded:
-            xs = np.where(sigma <= x0, sigma, x0 + c * np.arcsinh((sigma - x0) / c))
-            zs = np.where(sigma <= x0, 0.0, c * (np.cosh((xs - x0) / c) - 1.0))
-            tz = c * np.cosh((xs - x0) / c)
+    def shoot(H: float, V0: float, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        V = V0 + np.concatenate([[0.0], np.cumsum(P[1:-1])])  # element k
+        zs = np.full(mesh.n_nodes, np.nan)
+        if on_bed:
+            pos = np.flatnonzero(V > 0.0)
+            k_star = int(pos[0]) if pos.size else V.size
+            Ve = np.where(np.arange(V.size) < k_star, 0.0, V)
+            # contact force of the grounded nodes 1..k_star (the last one carries the
+            # part of its load not taken by the first suspended element)
+            contact = P.copy()
+            if k_star < V.size:
+                contact[k_star] = P[k_star] - V[k_star]
+            pen = np.maximum(contact, 0.0) / kb
         else:
-            s_a = c * math.sinh(-x0 / c)
-            xs = x0 + c * np.arcsinh((sigma + s_a) / c)
-            zs = c * (np.cosh((xs - x0) / c) - math.cosh(x0 / c))
-            tz = c * np.cosh((xs - x0) / c)
-        return xs, zs, w * tz
+            k_star, Ve, pen = 0, V, np.zeros(mesh.n_nodes)
+        T = np.sqrt(H * H + Ve * Ve)
+        c = l0 * (1.0 + T / ea)
+        x = a[0] + np.concatenate([[0.0], np.cumsum(c * H / T)])
+        dz = c * Ve / T
+        z = np.empty(mesh.n_nodes)
+        z[0] = a[zi]
+        z[1:k_star + 1] = zbed - pen[1:k_star + 1]
+        if k_star < V.size:
+            z[k_star + 1:] = z[k_star] + np.cumsum(dz[k_star:])
+        return x, z
 
-    try:
-        c, x0, grounded = shape(L)
-        _, _, T = curve(c, x0, grounded, mesh.s0)
-        strain = 0.5 * (T[:-1] + T[1:]) / mesh.ea
-        sigma = np.concatenate([[0.0], np.cumsum(mesh.l0 * (1.0 + strain))])
-        c, x0, grounded = shape(float(sigma[-1]))
-        xs, zs, _ = curve(c, x0, grounded, sigma)
-    except (ValueError, ZeroDivisionError, OverflowError, RuntimeError):
-        return None
+    W = l0 * model.w_sub
+    P = loads(W)
+    scale = max(L, 1.0)
+    for _pass in range(3):
+        HV = _chain_newton(shoot, P, float(b[0]), float(b[zi]), X, Z, L, l0, ea,
+                           on_bed, scale)
+        if HV is None:
+            HV = _chain_closure(shoot, P, float(b[0]), float(b[zi]), scale)
+        if HV is None:
+            return None
+        x, z = shoot(HV[0], HV[1], P)
+        # weight of the elements by their wet fraction at this shape, then re-solve
+        za, zb = z[:-1], z[1:]
+        span_z = np.where(za != zb, zb - za, 1.0)
+        f = np.where((za <= 0.0) & (zb <= 0.0), 1.0, 0.0)
+        mixed = (np.minimum(za, zb) < 0.0) & (np.maximum(za, zb) > 0.0)
+        f = np.where(mixed, -np.minimum(za, zb) / np.abs(span_z), f)
+        W_new = l0 * (model.w_dry + f * (model.w_sub - model.w_dry))
+        if np.allclose(W_new, W, rtol=1e-12, atol=0.0):
+            break
+        W = W_new
+        P = loads(W)
     Xg = np.zeros((mesh.n_nodes, frame.dim))
-    Xg[:, 0] = a[0] + xs
-    Xg[:, zi] = a[zi] + zs
-    # grounded nodes at their equilibrium penetration w·l/(stiffness·D·l)
-    model_kd = env.seabed.stiffness * np.concatenate([mesh.diameter[:1], mesh.diameter])
-    pen = np.abs(w) / np.maximum(model_kd, 1e-300)
-    Xg[:, zi] = np.where(Xg[:, zi] <= -env.depth, -env.depth - pen, Xg[:, zi])
+    Xg[:, 0] = x
+    Xg[:, zi] = z
     if not np.all(np.isfinite(Xg)):
         return None
+    if float(np.min(z[1:-1], initial=0.0)) < zbed - 10.0 * float(np.max(
+            np.abs(P) / kb, initial=0.0)) - 1e-9 * max(env.depth, 1.0):
+        return None  # passes through the seabed away from end_a
     Xg[0], Xg[-1] = a, b
     return Xg
+
+
+def _chain_newton(shoot, P: np.ndarray, xb: float, zb: float, X: float, Z: float,
+                  L: float, l0: np.ndarray, ea: np.ndarray, on_bed: bool,
+                  scale: float) -> tuple[float, float] | None:
+    """(H, V_0) of the lumped chain by damped Newton on the end closure, started from
+    the continuous catenary of the mean weight; None when it fails (kinks where an
+    element lifts off the bed can stall it; :func:`_chain_closure` then brackets)."""
+    from .catenary import catenary_solve
+
+    w_mean = float(np.sum(P)) / L
+    try:
+        sol = catenary_solve(X, Z, L, w_mean, L / float(np.sum(l0 / ea)),
+                             seabed=on_bed and w_mean > 0.0)
+    except (InputError, ConvergenceError, ValueError):
+        return None
+    fscale = max(abs(w_mean) * L, sol.H, 1.0)
+    H = max(sol.H, 1e-9 * fscale)
+    V0 = (sol.V_a if sol.touchdown <= 0.0 else -w_mean * sol.touchdown) + 0.5 * P[0]
+    u = np.array([math.log(H), V0])
+
+    def resid(uu: np.ndarray) -> np.ndarray:
+        x, z = shoot(math.exp(uu[0]), uu[1], P)
+        return np.array([x[-1] - xb, z[-1] - zb])
+
+    r = resid(u)
+    nr = float(np.max(np.abs(r)))
+    for _it in range(30):
+        if nr <= 1e-12 * scale:
+            return math.exp(u[0]), float(u[1])
+        J = np.empty((2, 2))
+        for j, hstep in enumerate((1e-7, 1e-7 * fscale)):
+            du = np.zeros(2)
+            du[j] = hstep
+            J[:, j] = (resid(u + du) - resid(u - du)) / (2.0 * hstep)
+        try:
+            d = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            return None
+        d[0] = float(np.clip(d[0], -2.0, 2.0))
+        t = 1.0
+        for _ls in range(20):
+            rn = resid(u + t * d)
+            nrn = float(np.max(np.abs(rn)))
+            if np.isfinite(nrn) and nrn < nr:
+                break
+            t *= 0.5
+        else:
+            return None
+        u, r, nr = u + t * d, rn, nrn
+    return None
+
+
+def _chain_closure(shoot, P: np.ndarray, xb: float, zb: float,
+                   scale: float) -> tuple[float, float] | None:
+    """(H, V_0) of the lumped chain reaching (xb, zb): nested monotone root finding.
+
+    For fixed H the end elevation increases monotonically with V_0 (every element
+    turns upward); with the elevation closed, the end abscissa increases with H.  Both
+    closures are continuous but only piecewise smooth (an element lifts off the bed at
+    a kink), so bracketing (Brent) is used instead of Newton.  None when no bracket.
+    """
+    from scipy.optimize import brentq
+
+    load = float(np.sum(np.abs(P))) + 1.0
+    tol = 1e-13 * scale
+
+    def v0_of(H: float) -> float | None:
+        lo, hi = -2.0 * load - H, 2.0 * load + H
+        flo = shoot(H, lo, P)[1][-1] - zb
+        fhi = shoot(H, hi, P)[1][-1] - zb
+        k = 0
+        while flo > 0.0 and k < 30:
+            lo, k = 4.0 * lo, k + 1
+            flo = shoot(H, lo, P)[1][-1] - zb
+        while fhi < 0.0 and k < 60:
+            hi, k = 4.0 * hi, k + 1
+            fhi = shoot(H, hi, P)[1][-1] - zb
+        if not (flo <= 0.0 <= fhi):
+            return None
+        return brentq(lambda v: shoot(H, v, P)[1][-1] - zb, lo, hi, xtol=1e-15 * load,
+                      rtol=4 * _EPS, maxiter=200)
+
+    def gx(logh: float) -> float:
+        H = math.exp(logh)
+        v0 = v0_of(H)
+        if v0 is None:
+            raise ValueError("no bracket")
+        return shoot(H, v0, P)[0][-1] - xb
+
+    try:
+        lo, hi = math.log(1e-6 * load), math.log(load)
+        glo, ghi = gx(lo), gx(hi)
+        k = 0
+        while ghi < 0.0 and k < 40:
+            hi, k = hi + 2.0, k + 1
+            ghi = gx(hi)
+        while glo > 0.0 and k < 60:
+            lo, k = lo - 4.0, k + 1
+            glo = gx(lo)
+        if not (glo <= 0.0 <= ghi):
+            return None
+        logh = brentq(gx, lo, hi, xtol=1e-14, rtol=4 * _EPS, maxiter=200)
+        H = math.exp(logh)
+        v0 = v0_of(H)
+    except (ValueError, ZeroDivisionError, OverflowError, RuntimeError):
+        return None
+    if v0 is None:
+        return None
+    x, z = shoot(H, v0, P)
+    if not (abs(x[-1] - xb) <= 1e-8 * scale and abs(z[-1] - zb) <= 1e-8 * scale):
+        return None
+    return H, v0
 
 
 def _solve_fe(mesh: LineMesh, env: Environment, initial: np.ndarray | None,
@@ -734,42 +937,55 @@ def _solve_fe(mesh: LineMesh, env: Environment, initial: np.ndarray | None,
     if initial is not None:
         X0 = frame.to_local(initial)
     else:
-        X0 = _initial_guess(mesh, env, frame)
+        X0 = _initial_guess(mesh, env, frame, model)
     X0[0] = frame.to_local(mesh.end_a[None, :])[0]
     X0[-1] = frame.to_local(mesh.end_b[None, :])[0]
     solver = _Solver(model, tol, budget)
-    ok, X, r = solver.solve(X0, budget)
-    if not ok and solver.used < budget:
-        # load stepping: attachments, current and weight variation ramped from the
-        # uniform-weight problem (its shape is the hanging shape of the line)
-        beta_ok, X_ok = 0.0, X0
-        model.beta = 0.0
-        ok0, X_b, _ = solver.solve(X0, budget)
-        if ok0:
-            X_ok = X_b
-            step = 0.25
-            while beta_ok < 1.0 and solver.used < budget and step >= 1.0 / 256:
-                model.beta = min(1.0, beta_ok + step)
-                ok_s, X_s, _ = solver.solve(X_ok, 50)
-                if ok_s:
-                    beta_ok, X_ok = model.beta, X_s
-                    step = min(2.0 * step, 0.5)
-                else:
-                    step *= 0.5
-            if beta_ok >= 1.0:
-                ok, X = True, X_ok
-        model.beta = 1.0
-        if ok:
-            r = solver.status(X)[0]
+    # with current, a first attempt at full load gets a quarter of the budget; the
+    # rest goes to load stepping of the drag from the equilibrium without current
+    ok, X, r = solver.solve(X0, budget // 4 if model.has_drag else budget)
+    if not ok and model.has_drag and solver.used < budget:
+        X, r, ok = _drag_stepping(solver, model, X0, budget)
     if not ok:
+        note = ""
+        if model.has_drag and bool(np.any(X[1:-1, frame.dim - 1] < model.zbed)):
+            note = ("; part of the line lies on the seabed, where no friction is modelled: "
+                    "drag on a grounded slack part may have no horizontal restoring force")
         raise ConvergenceError(
             "statics Newton", solver.used, r, tol,
             hint=(f"line {mesh.name!r}: check that the line can reach its ends and that "
                   "the loads are physical, give a better initial shape, raise "
-                  "max_iterations or refine the mesh"),
+                  f"max_iterations or refine the mesh{note}"),
             partial=frame.to_global(X),
         )
     return _fe_result(mesh, env, frame, model, X, solver.used, r)
+
+
+def _drag_stepping(solver: "_Solver", model: _Model, X0: np.ndarray,
+                   budget: int) -> tuple[np.ndarray, float, bool]:
+    """Load stepping of the current (seed 001 §4.1, eq. 4.1.2 applied per increment).
+
+    The drag is scaled by a factor beta (model.beta) raised from 0 (the equilibrium
+    without current, whose start is the exact lumped chain) to 1; each increment is
+    solved by Newton from the previous equilibrium, the step doubled after a success
+    (up to 0.5) and halved after a failure (down to 1/256).  Returns the last state,
+    its residual and whether beta = 1 was reached.
+    """
+    beta_ok = 0.0
+    model.beta = 0.0
+    ok, X_ok, r = solver.solve(X0, budget)
+    step = 0.25
+    while ok and beta_ok < 1.0 and solver.used < budget and step >= 1.0 / 256:
+        model.beta = min(1.0, beta_ok + step)
+        ok_s, X_s, r = solver.solve(X_ok, 50)
+        if ok_s:
+            beta_ok, X_ok = model.beta, X_s
+            step = min(2.0 * step, 0.5)
+        else:
+            step *= 0.5
+    model.beta = 1.0
+    r = solver.status(X_ok)[0]
+    return X_ok, r, bool(ok and beta_ok >= 1.0)
 
 
 def _fe_result(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
