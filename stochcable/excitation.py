@@ -1,0 +1,390 @@
+"""Excitation of a line: independent input channels and the hydrodynamic matrices.
+
+The linear system of a line about its static shape (seed 001 eqs. 5.1, 5.2.6) is
+
+    M_T Ü + (C_d + C_s) U̇ + K U = C_d V + B_I A          (all DOFs, U total motion)
+
+with V, A the fluid velocity and acceleration at the nodes, C_d the linearized drag
+damping (which also multiplies V: the drag acts on the relative velocity V − U̇),
+B_I the Morison inertia matrix ρ(πD²/4)(1 + Can)(I − eeᵀ) per unit length and C_s the
+seabed damping.  The end DOFs are prescribed: U = [U_f; u_b] and the free rows read
+
+    (K_ff − ω² M_T,ff + iω C_ff) U_f = [C_d V + B_I A]_f − (K_fb − ω² M_T,fb + iω C_fb) u_b.
+
+Input channels
+--------------
+The excitation is split into mutually independent (uncorrelated) input channels, each
+with a one-sided input spectrum S_i(ω) [m²·s/rad] and a description per unit input
+(:class:`Channel`):
+
+- ``"sea"`` (when the scene has a sea): per metre of wave amplitude, the wave particle
+  velocity and acceleration at every node (:func:`stochcable.kinematics.wave_kinematics`
+  at the static node positions, heading, depth, g), plus the end motions given as RAO
+  tables, which are coherent with the waves and therefore belong to the same channel.
+  RAO phases are relative to the wave elevation at the global origin (x = y = 0), the
+  reference of the kinematics' phase P = e^{−ik(x cos β + y sin β)}.
+- ``"<end>.<dof>"`` (``"end_b.surge"``, …): each end-motion *spectrum* DOF is its own
+  channel with a unit prescribed displacement of that end along x (surge), y (sway) or
+  z (heave).  These channels are taken as uncorrelated with the sea and with each other
+  (the scene gives no cross-spectra); a vessel motion correlated with the waves must be
+  given as an RAO table.
+
+Response spectra are then S_x(ω) = Σ_i |H_{x,i}(ω)|² S_i(ω).
+
+Distribution over the elements
+------------------------------
+The drag damping and the inertia load are distributed over each element like the
+model's mass (consistent [[1/3, 1/6], [1/6, 1/3]]·l0 by default, lumped [[1/2, 0],
+[0, 1/2]]·l0 when the model is lumped), with the element direction constant over the
+element, so the matrices are symmetric (the non-symmetry the seed avoids by lumping,
+seed 001 §3.2.a, comes from nodal direction cosines).  Lengths are the unstretched
+lengths l0, as the added mass of :mod:`stochcable.fem`, so that a line moving with the
+fluid (Ü = A) feels exactly the Froude–Krylov force ρ(πD²/4)(I − eeᵀ)A.  Attachments
+(buoys, clumps) get the isotropic inertia load (buoyancy/g + added mass)·A and an
+isotropic linear drag B·(V − U̇) on their node.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+import scipy.sparse as sp
+
+from .errors import InputError
+from .kinematics import wave_kinematics
+from .scene import Environment, Line, Scene
+
+__all__ = [
+    "Channel",
+    "line_channels",
+    "element_frames",
+    "inertia_matrix",
+    "drag_matrix",
+    "channel_loads",
+    "prescribed_motion",
+    "embed",
+    "current_at_elements",
+    "current_at_nodes",
+]
+
+_DOF_AXIS = {"surge": 0, "sway": 1, "heave": 2}
+_CONSISTENT = np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
+_LUMPED = np.array([[0.5, 0.0], [0.0, 0.5]])
+
+
+@dataclass(frozen=True, eq=False)
+class Channel:
+    """One independent input of a line's linear system, per unit input.
+
+    Attributes
+    ----------
+    name : str
+        ``"sea"`` or ``"end_a.surge"`` … ``"end_b.heave"``.
+    kind : {"sea", "end_motion", "none"}
+        The sea (waves and RAO end motions), one end-motion spectrum DOF, or a
+        placeholder with a zero spectrum (a line without excitation).
+    omega : ndarray, shape (n_omega,)
+        Frequencies the arrays below are sampled at. [rad/s]
+    spectrum : ndarray, shape (n_omega,)
+        One-sided input spectrum S_i(ω). [m²·s/rad]
+    density : callable
+        ω -> S_i(ω) (for time-series synthesis on another grid). [m²·s/rad]
+    velocity : ndarray or None, complex, shape (n_omega, n_nodes, 3)
+        Fluid velocity at the nodes per unit input (None: no fluid motion). [(m/s)/m]
+    acceleration : ndarray or None, complex, shape (n_omega, n_nodes, 3)
+        Fluid acceleration at the nodes per unit input. [(m/s²)/m]
+    motion_a, motion_b : ndarray or None, complex, shape (n_omega, 3)
+        Prescribed displacement (x, y, z) of end_a / end_b per unit input. [m/m]
+    """
+
+    name: str
+    kind: Literal["sea", "end_motion", "none"]
+    omega: np.ndarray
+    spectrum: np.ndarray
+    density: Callable[[np.ndarray], np.ndarray]
+    velocity: np.ndarray | None = None
+    acceleration: np.ndarray | None = None
+    motion_a: np.ndarray | None = None
+    motion_b: np.ndarray | None = None
+
+
+def _spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
+    def density(w: np.ndarray) -> np.ndarray:
+        w = np.asarray(w, dtype=float)
+        out = np.zeros_like(w)
+        pos = w > 0
+        out[pos] = spec.spectral_density(w[pos], g)
+        return out
+
+    return density
+
+
+def line_channels(
+    scene: Scene, line: Line, positions: np.ndarray, omega: np.ndarray
+) -> tuple[Channel, ...]:
+    """Input channels of one line sampled on ``omega``.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (environment, sea).
+    line : Line
+        The line (its end motions).
+    positions : ndarray, shape (n_nodes, 3)
+        Static node positions, where the wave kinematics are evaluated. [m]
+    omega : ndarray, shape (n_omega,)
+        Frequencies, > 0. [rad/s]
+
+    Returns
+    -------
+    tuple of Channel
+        ``"sea"`` first (if the scene has a sea), then one channel per end-motion
+        spectrum DOF in the order end_a, end_b × surge, sway, heave.
+
+    Raises
+    ------
+    InputError
+        If an end motion is an RAO table but the scene has no sea.
+
+    Notes
+    -----
+    Kinematics: seed 001 eqs. 5.2.8–5.2.11 (:func:`stochcable.kinematics.wave_kinematics`).
+    """
+    env = scene.environment
+    w = np.asarray(omega, dtype=float)
+    channels: list[Channel] = []
+    raos = {}
+    for end in ("end_a", "end_b"):
+        m = getattr(line, end).motion
+        if m is not None and m.rao is not None:
+            if scene.sea is None:
+                raise InputError(
+                    f"lines[{line.name}].{end}.motion.rao", "RAO table", "-",
+                    "an RAO is relative to the sea: the scene needs a 'sea' (or give the "
+                    "end motion as spectra per DOF)",
+                )
+            raos[end] = np.ascontiguousarray(m.rao.transfer(w).T)  # (n_omega, 3)
+    if scene.sea is not None:
+        density = _spectrum_callable(scene.sea.spectrum, env.g)
+        # nodes resting on a penalty seabed sit slightly below z = -depth: evaluate
+        # the kinematics on the seabed there
+        pts = np.array(positions, dtype=float)
+        pts[:, 2] = np.maximum(pts[:, 2], -env.depth)
+        kin = wave_kinematics(w, pts, scene.sea.heading_rad, env.depth, env.g)
+        channels.append(Channel(
+            name="sea", kind="sea", omega=w, spectrum=density(w), density=density,
+            velocity=np.ascontiguousarray(np.transpose(kin.velocity, (2, 0, 1))),
+            acceleration=np.ascontiguousarray(np.transpose(kin.acceleration, (2, 0, 1))),
+            motion_a=raos.get("end_a"), motion_b=raos.get("end_b"),
+        ))
+    for end in ("end_a", "end_b"):
+        m = getattr(line, end).motion
+        if m is None or m.rao is not None:
+            continue
+        for dof, axis in _DOF_AXIS.items():
+            spec = getattr(m, dof)
+            if spec is None:
+                continue
+            density = _spectrum_callable(spec, env.g)
+            unit = np.zeros((w.size, 3), dtype=complex)
+            unit[:, axis] = 1.0
+            channels.append(Channel(
+                name=f"{end}.{dof}", kind="end_motion", omega=w, spectrum=density(w),
+                density=density,
+                motion_a=unit if end == "end_a" else None,
+                motion_b=unit if end == "end_b" else None,
+            ))
+    return tuple(channels)
+
+
+# ------------------------------------------------------------------ element geometry
+
+
+def element_frames(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Unit tangent and two unit normals of every element, global frame.
+
+    Parameters
+    ----------
+    positions : ndarray, shape (n_nodes, 3)
+        Static node positions. [m]
+
+    Returns
+    -------
+    e, n1, n2 : ndarray, shape (n_el, 3)
+        Tangent (node j to j+1); n2 the horizontal normal e × ẑ normalized (ŷ for a
+        vertical element), out of the plane for a line in a vertical plane; n1 = n2 × e,
+        the normal in the element's vertical plane. [-]
+    """
+    d = np.diff(positions, axis=0)
+    e = d / np.linalg.norm(d, axis=1)[:, None]
+    n2 = np.cross(e, np.array([0.0, 0.0, 1.0]))
+    nn = np.linalg.norm(n2, axis=1)
+    vertical = nn < 1e-12
+    n2 = np.where(vertical[:, None], np.array([0.0, 1.0, 0.0]), n2 / np.where(vertical, 1.0, nn)[:, None])
+    n1 = np.cross(n2, e)
+    return e, n1, n2
+
+
+def embed(model: Any, values: np.ndarray) -> np.ndarray:
+    """Model-DOF vectors (..., n_dof) -> node vectors (..., n_nodes, 3), zeros off-model."""
+    lead = values.shape[:-1]
+    out = np.zeros(lead + (model.n_nodes, 3), dtype=values.dtype)
+    out[..., list(model.components)] = values.reshape(lead + (model.n_nodes, model.dim))
+    return out
+
+
+def _to_dofs(model: Any, node_vectors: np.ndarray) -> np.ndarray:
+    """Node vectors (..., n_nodes, 3) -> model-DOF vectors (..., n_dof)."""
+    sub = node_vectors[..., list(model.components)]
+    return sub.reshape(sub.shape[:-2] + (model.n_dof,))
+
+
+def _assemble(model: Any, blocks3: np.ndarray, node_diag: np.ndarray | None) -> sp.csr_array:
+    """Assemble per-unit-length 3×3 element matrices (n_el, 3, 3) times the mass
+    distribution pattern·l0, plus an isotropic per-node diagonal, on the model DOFs."""
+    comps = list(model.components)
+    d = model.dim
+    b = blocks3[:, comps][:, :, comps] * model.l0[:, None, None]
+    pattern = _LUMPED if getattr(model, "mass_matrix", "consistent") == "lumped" else _CONSISTENT
+    n_el = b.shape[0]
+    el = np.empty((n_el, 2 * d, 2 * d))
+    for a in range(2):
+        for c in range(2):
+            el[:, a * d:(a + 1) * d, c * d:(c + 1) * d] = pattern[a, c] * b
+    base = d * np.arange(n_el)[:, None] + np.arange(d)[None, :]
+    dofs = np.hstack([base, base + d])
+    k = 2 * d
+    rows = np.broadcast_to(dofs[:, :, None], (n_el, k, k)).ravel()
+    cols = np.broadcast_to(dofs[:, None, :], (n_el, k, k)).ravel()
+    data = el.ravel()
+    if node_diag is not None and np.any(node_diag):
+        diag = np.repeat(node_diag, d)
+        nz = np.flatnonzero(diag)
+        rows = np.concatenate([rows, nz])
+        cols = np.concatenate([cols, nz])
+        data = np.concatenate([data, diag[nz]])
+    a = sp.coo_array((data, (rows, cols)), shape=(model.n_dof, model.n_dof)).tocsr()
+    a.sum_duplicates()
+    return a
+
+
+def inertia_matrix(model: Any, g: float) -> sp.csr_array:
+    """Morison inertia matrix B_I: load = B_I·A for nodal fluid accelerations A.
+
+    Parameters
+    ----------
+    model : FEModel
+        The line model (positions, mesh, rho, mass distribution).
+    g : float
+        Gravity, to turn attachment buoyancy into displaced mass. [m/s²]
+
+    Returns
+    -------
+    scipy.sparse.csr_array, shape (n_dof, n_dof)
+        [kg]
+
+    Notes
+    -----
+    Per unit length ρ(πD²/4)(1 + Can)(I − eeᵀ) (seed 001 eq. 5.2.1, the B_I C_M term,
+    C_M = 1 + Can); per attachment (buoyancy/g + added mass)·I.
+    """
+    mesh = model.mesh
+    e, _, _ = element_frames(model.positions)
+    coef = model.rho * math.pi * mesh.diameter**2 / 4.0 * (1.0 + mesh.ca_normal)
+    blocks = coef[:, None, None] * (np.eye(3)[None] - e[:, :, None] * e[:, None, :])
+    node = mesh.node_buoyancy / g + mesh.node_added_mass
+    return _assemble(model, blocks, node)
+
+
+def drag_matrix(
+    model: Any,
+    b_normal: np.ndarray,
+    b_axial: np.ndarray,
+    b_node: np.ndarray | None = None,
+) -> sp.csr_array:
+    """Linearized drag damping matrix C_d of a line.
+
+    Parameters
+    ----------
+    model : FEModel
+        The line model.
+    b_normal : ndarray, shape (n_el,) or (n_el, 2, 2)
+        Normal linear drag per unit length: a scalar per element (isotropic in the
+        normal plane) or a 2×2 matrix in the element's (n1, n2) normal basis
+        (:func:`element_frames`). [N·s/m²]
+    b_axial : ndarray, shape (n_el,)
+        Axial linear drag per unit length. [N·s/m²]
+    b_node : ndarray, shape (n_nodes,), optional
+        Isotropic linear drag of the attachments. [N·s/m]
+
+    Returns
+    -------
+    scipy.sparse.csr_array, shape (n_dof, n_dof)
+        [N·s/m]
+
+    Notes
+    -----
+    Per unit length B_n(I − eeᵀ) + B_t eeᵀ (seed 001 eq. 5.2.1 with B_DL, B_DT of
+    eq. 5.2.2), or N B Nᵀ + B_t eeᵀ with N = [n1 n2] for the vector form.
+    """
+    e, n1, n2 = element_frames(model.positions)
+    eet = e[:, :, None] * e[:, None, :]
+    bn = np.asarray(b_normal, dtype=float)
+    if bn.ndim == 1:
+        blocks = bn[:, None, None] * (np.eye(3)[None] - eet)
+    else:
+        nmat = np.stack([n1, n2], axis=2)  # (n_el, 3, 2)
+        blocks = nmat @ bn @ np.swapaxes(nmat, 1, 2)
+    blocks = blocks + np.asarray(b_axial, dtype=float)[:, None, None] * eet
+    return _assemble(model, blocks, b_node)
+
+
+def prescribed_motion(model: Any, channels: tuple[Channel, ...], n_omega: int) -> np.ndarray:
+    """Prescribed displacements of the fixed DOFs, shape (n_omega, n_fixed, n_ch). [m/unit]"""
+    n_ch = len(channels)
+    nodes = np.zeros((n_omega, n_ch, model.n_nodes, 3), dtype=complex)
+    for i, ch in enumerate(channels):
+        if ch.motion_a is not None:
+            nodes[:, i, 0, :] = ch.motion_a
+        if ch.motion_b is not None:
+            nodes[:, i, -1, :] = ch.motion_b
+    u = _to_dofs(model, nodes)  # (n_omega, n_ch, n_dof)
+    return np.ascontiguousarray(np.swapaxes(u[:, :, model.fixed], 1, 2))
+
+
+def channel_loads(
+    model: Any,
+    channels: tuple[Channel, ...],
+    c_drag: sp.csr_array,
+    b_inertia: sp.csr_array,
+) -> np.ndarray:
+    """Fluid loads C_d·V + B_I·A on all DOFs, shape (n_omega, n_dof, n_ch). [N/unit]
+
+    The prescribed end motion is not included (it enters through the coupling blocks
+    of the dynamic matrix, see the module docstring).
+    """
+    n_omega = channels[0].omega.size if channels else 0
+    out = np.zeros((n_omega, model.n_dof, len(channels)), dtype=complex)
+    for i, ch in enumerate(channels):
+        if ch.velocity is not None:
+            v = _to_dofs(model, ch.velocity)  # (n_omega, n_dof)
+            out[:, :, i] += (c_drag @ v.T).T
+        if ch.acceleration is not None:
+            a = _to_dofs(model, ch.acceleration)
+            out[:, :, i] += (b_inertia @ a.T).T
+    return out
+
+
+def current_at_elements(environment: Environment, positions: np.ndarray) -> np.ndarray:
+    """Current velocity at the element midpoints, shape (n_el, 3). [m/s]"""
+    mid = 0.5 * (positions[1:] + positions[:-1])
+    return environment.current_velocity(mid[:, 2])
+
+
+def current_at_nodes(environment: Environment, positions: np.ndarray) -> np.ndarray:
+    """Current velocity at the nodes, shape (n_nodes, 3). [m/s]"""
+    return environment.current_velocity(positions[:, 2])

@@ -1,0 +1,435 @@
+"""Result objects of :func:`stochcable.analysis.analyze` and the v1 result document.
+
+Everything is a frozen dataclass holding numpy arrays; :meth:`Result.to_document`
+returns the JSON-ready result document of DESIGN.md ("Scene and result documents",
+v1 contract) plus extra keys.  Transfer functions and response spectra live on the
+Python objects (:class:`LineResult`); the document carries statistics, the end-tension
+spectra and a window of the time series.
+
+Conventions (DESIGN.md): SI, ω in rad/s, one-sided spectra S(ω) [unit²·s/rad],
+harmonic quantities Re{X e^{iωt}}, transfer functions per unit input of each channel
+(metre of wave amplitude for the sea, metre of end motion for an end-motion
+spectrum channel).  Channels are mutually independent, so a response spectrum is
+S_x(ω) = Σ_i |H_{x,i}(ω)|² S_i(ω).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "THREE_HOURS",
+    "ResponseStats",
+    "LinearizationRecord",
+    "LineResult",
+    "TimeSeries",
+    "Result",
+    "stats_from_spectrum",
+]
+
+THREE_HOURS = 10800.0
+"""Storm duration of the ``mpm_3h`` statistic. [s]"""
+
+# Number of time samples of the time-series window put in the result document.
+DOCUMENT_WINDOW = 2048
+
+
+@dataclass(frozen=True)
+class ResponseStats:
+    """Statistics of one Gaussian response: static mean + zero-mean dynamic part.
+
+    Attributes
+    ----------
+    mean : float
+        Static (mean) value. [unit]
+    std : float
+        Standard deviation of the dynamic part, √m0. [unit]
+    m0, m1, m2, m4 : float
+        Spectral moments ∫ωⁿ S dω (trapezoid on the analysis grid). [unit²·(rad/s)ⁿ]
+    tz : float
+        Mean zero-upcrossing period 2π√(m0/m2) (0 for a zero process). [s]
+    significant : float
+        Significant value 2σ (DESIGN.md "Outputs"). [unit]
+    bandwidth : float
+        Spectral bandwidth √(1 − m2²/(m0 m4)). [-]
+    mpm_3h : float
+        mean + Rayleigh most probable maximum of the dynamic part over three hours,
+        σ√(2 ln(10800/Tz)). [unit]
+    mpm : float
+        mean + the same over the scene's ``analysis.duration``. [unit]
+    expected_max : float
+        mean + expected maximum over ``analysis.duration``. [unit]
+    """
+
+    mean: float
+    std: float
+    m0: float
+    m1: float
+    m2: float
+    m4: float
+    tz: float
+    significant: float
+    bandwidth: float
+    mpm_3h: float
+    mpm: float
+    expected_max: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict of the fields."""
+        return {k: float(getattr(self, k)) for k in
+                ("mean", "std", "tz", "mpm_3h", "significant", "m0", "m1", "m2", "m4",
+                 "bandwidth", "mpm", "expected_max")}
+
+
+def stats_from_spectrum(
+    omega: np.ndarray, density: np.ndarray, mean: float, duration: float
+) -> ResponseStats:
+    """Statistics of a response from its one-sided spectrum on the analysis grid.
+
+    Parameters
+    ----------
+    omega : ndarray, shape (n,)
+        Frequency grid. [rad/s]
+    density : ndarray, shape (n,)
+        One-sided spectrum of the dynamic part. [unit²·s/rad]
+    mean : float
+        Static value of the response. [unit]
+    duration : float
+        Storm duration for ``mpm`` and ``expected_max``. [s]
+
+    Returns
+    -------
+    ResponseStats
+
+    Notes
+    -----
+    :func:`stochcable.statistics.response_statistics` (trapezoid moments, Rayleigh
+    maxima); mpm_3h = mean + σ√(2 ln(10800/Tz)) (DESIGN.md "Outputs").
+    """
+    from .statistics import response_statistics
+
+    st = response_statistics(omega, density, THREE_HOURS)
+    sd = st if duration == THREE_HOURS else response_statistics(omega, density, duration)
+    mean = float(mean)
+    return ResponseStats(
+        mean=mean, std=float(st.std), m0=float(st.m0), m1=float(st.m1), m2=float(st.m2),
+        m4=float(st.m4), tz=float(st.tz), significant=float(st.significant),
+        bandwidth=float(st.bandwidth), mpm_3h=mean + float(st.mpm),
+        mpm=mean + float(sd.mpm), expected_max=mean + float(sd.expected_max),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class LinearizationRecord:
+    """The drag-linearization fixed point of one line (seed 001 §5.3 steps 5–13).
+
+    Attributes
+    ----------
+    method : str
+        ``"seed"``, ``"vector"`` or ``"harmonic"``.
+    converged : bool
+        Whether the relative change of every σ fell below the tolerance.
+    iterations : int
+        Number of response evaluations. [-]
+    relative_change : float
+        Final max relative change of the σ. [-]
+    history : tuple of float
+        Relative change after each iteration. [-]
+    tolerance : float
+        Tolerance asked for. [-]
+    sigma_normal, sigma_axial : ndarray, shape (n_el,)
+        Final σ of the normal and axial relative velocity at element midpoints. [m/s]
+    b_normal, b_axial : ndarray, shape (n_el,)
+        Final linear drag coefficients per unit length (normal: the trace/2 of the
+        normal-plane matrix for the vector form). [N·s/m²]
+    """
+
+    method: str
+    converged: bool
+    iterations: int
+    relative_change: float
+    history: tuple[float, ...]
+    tolerance: float
+    sigma_normal: np.ndarray
+    sigma_axial: np.ndarray
+    b_normal: np.ndarray
+    b_axial: np.ndarray
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "method": self.method,
+            "converged": bool(self.converged),
+            "iterations": int(self.iterations),
+            "relative_change": float(self.relative_change),
+            "tolerance": float(self.tolerance),
+            "history": [float(h) for h in self.history],
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class LineResult:
+    """Frequency-domain response of one line.
+
+    Attributes
+    ----------
+    name : str
+        Line name.
+    omega : ndarray, shape (n_omega,)
+        Analysis frequencies. [rad/s]
+    channels : tuple of str
+        Names of the independent input channels (``"sea"``, ``"end_b.surge"``, …).
+    input_spectra : ndarray, shape (n_ch, n_omega)
+        One-sided input spectrum of each channel. [m²·s/rad]
+    s_nodes : ndarray, shape (n_nodes,)
+        Unstretched arc length of the nodes from end_a. [m]
+    s_elements : ndarray, shape (n_el,)
+        Unstretched arc length of the element midpoints. [m]
+    positions : ndarray, shape (n_nodes, 3)
+        Static node positions. [m]
+    motion_transfer : ndarray, complex, shape (n_ch, n_nodes, 3, n_omega)
+        Total node displacement (prescribed end motion + response) per unit input. [m/m]
+    tension_transfer : ndarray, complex, shape (n_ch, n_el, n_omega)
+        Dynamic effective tension of each element per unit input. [N/m]
+    end_tension_transfer : dict {"end_a", "end_b"} of ndarray (n_ch, n_omega)
+        Dynamic change of the magnitude of the force on each support per unit input
+        (from the reaction rows of the finite-element equations). [N/m]
+    end_force_transfer : dict {"end_a", "end_b"} of ndarray (n_ch, 3, n_omega)
+        Dynamic force of the line on each support, global x, y, z, per unit input. [N/m]
+    tension_mean : ndarray, shape (n_el,)
+        Static effective tension per element. [N]
+    tension_std : ndarray, shape (n_el,)
+        σ of the dynamic effective tension per element. [N]
+    motion_std : ndarray, shape (n_nodes, 3)
+        σ of the x, y, z node displacements. [m]
+    end_a, end_b : ResponseStats
+        Statistics of the end tensions. [N]
+    linearization : LinearizationRecord
+    modes_omega : ndarray
+        Natural frequencies computed for the line about its static shape (with added
+        mass, in the model's plane for a 2-D model). [rad/s]
+    modes_listed : int
+        How many of them the document lists (those up to 2.5·ω_max, at least 10). [-]
+    n_modes : int or None
+        Modes kept by the Foss solve (None for the direct solve). [-]
+    statics, model, modes : objects
+        The statics result of the line, its finite-element model and modes (for
+        inspection and re-use).
+    """
+
+    name: str
+    omega: np.ndarray
+    channels: tuple[str, ...]
+    input_spectra: np.ndarray
+    s_nodes: np.ndarray
+    s_elements: np.ndarray
+    positions: np.ndarray
+    motion_transfer: np.ndarray
+    tension_transfer: np.ndarray
+    end_tension_transfer: dict[str, np.ndarray]
+    end_force_transfer: dict[str, np.ndarray]
+    tension_mean: np.ndarray
+    tension_std: np.ndarray
+    motion_std: np.ndarray
+    end_a: ResponseStats
+    end_b: ResponseStats
+    linearization: LinearizationRecord
+    modes_omega: np.ndarray
+    modes_listed: int
+    n_modes: int | None
+    statics: Any = None
+    model: Any = None
+    modes: Any = None
+
+    @property
+    def listed_modes(self) -> np.ndarray:
+        """The natural frequencies the document lists. [rad/s]"""
+        return np.asarray(self.modes_omega)[: self.modes_listed]
+
+    # ---------------------------------------------------------------- spectra
+    def _spectrum(self, transfer: np.ndarray) -> np.ndarray:
+        """Σ_i |H_i|² S_i over the channel axis (axis 0)."""
+        s = self.input_spectra.reshape((self.input_spectra.shape[0],)
+                                       + (1,) * (transfer.ndim - 2) + (-1,))
+        return np.sum(np.abs(transfer) ** 2 * s, axis=0)
+
+    def end_force_std(self, end: str) -> np.ndarray:
+        """σ of the x, y, z force on the support at ``end``, shape (3,). [N]"""
+        dens = self._spectrum(self.end_force_transfer[end])
+        return np.sqrt(np.trapezoid(dens, self.omega, axis=-1))
+
+    def end_tension_spectrum(self, end: str) -> np.ndarray:
+        """One-sided spectrum of the tension at ``end`` ("end_a" or "end_b"). [N²·s/rad]"""
+        return self._spectrum(self.end_tension_transfer[end])
+
+    @property
+    def tension_spectrum(self) -> np.ndarray:
+        """Spectrum of the element effective tensions, shape (n_el, n_omega). [N²·s/rad]"""
+        return self._spectrum(self.tension_transfer)
+
+    @property
+    def motion_spectrum(self) -> np.ndarray:
+        """Spectrum of the node displacements, shape (n_nodes, 3, n_omega). [m²·s/rad]"""
+        return self._spectrum(self.motion_transfer)
+
+    def to_document(self) -> dict[str, Any]:
+        """The line's part of the result document."""
+        return {
+            "end_a": {"tension": self.end_a.as_dict(),
+                      "force_std": self.end_force_std("end_a").tolist()},
+            "end_b": {"tension": self.end_b.as_dict(),
+                      "force_std": self.end_force_std("end_b").tolist()},
+            "tension": {
+                "s": self.s_elements.tolist(),
+                "std": self.tension_std.tolist(),
+                "mean": self.tension_mean.tolist(),
+            },
+            "motion": {"s": self.s_nodes.tolist(), "std": self.motion_std.tolist()},
+            "spectra": {
+                "omega": self.omega.tolist(),
+                "end_a": {"tension": self.end_tension_spectrum("end_a").tolist()},
+                "end_b": {"tension": self.end_tension_spectrum("end_b").tolist()},
+            },
+            "channels": list(self.channels),
+            "linearization": self.linearization.as_dict(),
+            "modes": {"omega": self.listed_modes.tolist(), "kept": self.n_modes},
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class TimeSeries:
+    """One realization of the sea (and of each end-motion channel) and the responses.
+
+    All series share the time axis and the complex amplitudes of their channels, so
+    elevation, motions and tensions are mutually consistent (DESIGN.md "Random sea
+    simulation").
+
+    Attributes
+    ----------
+    time : ndarray, shape (N_t,)
+        Sample times. [s]
+    method : str
+        ``"dsa"`` or ``"nsa"``.
+    seed : int
+        Root seed; channel k uses ``np.random.SeedSequence(seed).spawn(n)[k]``.
+    elevation : ndarray or None, shape (N_t,)
+        Wave elevation at the origin (None without a sea). [m]
+    end_motion : dict
+        ``{"line.end_b.surge": series}`` for end-motion spectrum channels. [m]
+    end_tension : dict
+        ``{line: {"end_a": series, "end_b": series}}`` total tension mean + dynamic. [N]
+    omega : ndarray, shape (N+1,)
+        Realization grid ω_m = mΔω. [rad/s]
+    channels : dict
+        ``{line: (channel names)}``, the order of the transfer arrays.
+    end_tension_transfer : dict
+        ``{line: {"end_a": H, "end_b": H}}``, H of shape (n_ch, N+1) on ``omega``
+        (zero outside the analysis band), the transfer functions synthesized. [N/unit]
+    """
+
+    time: np.ndarray
+    method: str
+    seed: int
+    elevation: np.ndarray | None
+    end_motion: dict[str, np.ndarray]
+    end_tension: dict[str, dict[str, np.ndarray]]
+    omega: np.ndarray
+    channels: dict[str, tuple[str, ...]]
+    end_tension_transfer: dict[str, dict[str, np.ndarray]]
+
+    def to_document(self, full: bool = False) -> dict[str, Any]:
+        """Document part: the first :data:`DOCUMENT_WINDOW` samples, or all if ``full``."""
+        n = self.time.size if full else min(self.time.size, DOCUMENT_WINDOW)
+        doc: dict[str, Any] = {
+            "method": self.method,
+            "seed": int(self.seed),
+            "dt": float(self.time[1] - self.time[0]) if self.time.size > 1 else 0.0,
+            "samples": int(self.time.size),
+            "window": int(n),
+            "time": self.time[:n].tolist(),
+            "elevation": None if self.elevation is None else self.elevation[:n].tolist(),
+            "end_motion": {k: v[:n].tolist() for k, v in self.end_motion.items()},
+            "lines": {
+                name: {end: {"tension": s[:n].tolist()} for end, s in ends.items()}
+                for name, ends in self.end_tension.items()
+            },
+        }
+        return doc
+
+
+@dataclass(frozen=True, eq=False)
+class Result:
+    """Result of :func:`stochcable.analysis.analyze`.
+
+    Attributes
+    ----------
+    scene : Scene
+        The analysed scene.
+    statics : StaticsResult
+        Static equilibrium of every line.
+    lines : dict of LineResult
+        Frequency-domain response per line name.
+    timeseries : TimeSeries or None
+        Present when ``analysis.timeseries`` is set.
+    timing : dict of float
+        Wall-clock seconds per stage (``total_s``, ``statics_s``, ``model_s``,
+        ``modes_s``, ``linearization_s``, ``solve_s``, ``outputs_s``,
+        ``timeseries_s``). [s]
+    warnings : tuple of str
+        Messages of the warnings raised during the analysis.
+    """
+
+    scene: Any
+    statics: Any
+    lines: dict[str, LineResult]
+    timeseries: TimeSeries | None
+    timing: dict[str, float]
+    warnings: tuple[str, ...] = field(default_factory=tuple)
+
+    @property
+    def converged(self) -> bool:
+        """Whether the drag linearization converged on every line."""
+        return all(r.linearization.converged for r in self.lines.values())
+
+    @property
+    def linearization(self) -> dict[str, Any]:
+        """Aggregate record: converged on all lines, max iterations, max change."""
+        recs = [r.linearization for r in self.lines.values()]
+        return {
+            "converged": all(r.converged for r in recs),
+            "iterations": max((r.iterations for r in recs), default=0),
+            "relative_change": max((r.relative_change for r in recs), default=0.0),
+        }
+
+    def to_document(self, timeseries: str = "window") -> dict[str, Any]:
+        """The v1 result document (DESIGN.md), JSON-ready.
+
+        Parameters
+        ----------
+        timeseries : {"window", "full", "none"}
+            Put the first 2048 samples of the time series, all of them, or none.
+        """
+        if hasattr(self.statics, "to_document"):
+            statics_doc = self.statics.to_document()
+        else:  # pragma: no cover - statics always has it
+            statics_doc = {}
+        first = next(iter(self.lines.values()))
+        doc: dict[str, Any] = {
+            "statics": statics_doc,
+            "modes": {
+                "omega": first.listed_modes.tolist(),
+                "lines": {k: v.listed_modes.tolist() for k, v in self.lines.items()},
+            },
+            "linearization": {
+                **self.linearization,
+                "lines": {k: v.linearization.as_dict() for k, v in self.lines.items()},
+            },
+            "lines": {k: v.to_document() for k, v in self.lines.items()},
+            "timing": {k: float(v) for k, v in self.timing.items()},
+            "warnings": list(self.warnings),
+        }
+        if self.timeseries is not None and timeseries != "none":
+            doc["timeseries"] = self.timeseries.to_document(full=timeseries == "full")
+        return doc

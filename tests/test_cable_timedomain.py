@@ -1,0 +1,334 @@
+"""Tests of the nonlinear time-domain reference (stochcable.cable_timedomain).
+
+Every check compares the time-domain (TD) simulation with something independent: the
+statics module (static start), the frequency-domain finite-element matrices of
+:mod:`stochcable.fem` / :mod:`stochcable.excitation` solved directly (harmonic and
+linear-limit tests), and :func:`stochcable.analysis.analyze` (statistics and the
+synthesized series of the same realization).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stochcable.cable_timedomain import newmark_period_error, simulate_line_timedomain
+from stochcable.errors import ConvergenceError, InputError, ResolutionWarning
+from stochcable.fem import assemble
+from stochcable.mesh import mesh_line
+from stochcable.scene import load_scene
+from stochcable.statics import solve_statics
+
+
+# ---------------------------------------------------------------------------- scenes
+
+
+def _taut(elements=10, hs=2.0, tp=8.0, cd=1.2, motion=None, current=0.0, ts=None,
+          omega_max=3.0):
+    """A taut tether (~1.05 MN, first transverse mode 5.1 rad/s) in 100 m of water."""
+    line = {"name": "tether", "end_a": {"position": [0.0, 0.0, -100.0]},
+            "end_b": {"position": [20.0, 0.0, -10.0]},
+            "segments": [{"length": 92.0, "ea": 5e8, "mass": 40.0, "diameter": 0.1,
+                          "cd_normal": cd, "cd_axial": 0.0, "ca_normal": 1.0,
+                          "elements": elements}]}
+    if motion is not None:
+        line["end_b"]["motion"] = motion
+    sc = {"environment": {"depth": 100.0}, "lines": [line],
+          "analysis": {"solver": "direct",
+                       "omega": {"min": 0.05, "max": omega_max, "count": 300}}}
+    if current:
+        sc["environment"]["current"] = [{"z": 0.0, "speed": current}]
+    if hs:
+        sc["sea"] = {"spectrum": {"type": "pierson_moskowitz", "hs": hs, "tp": tp}}
+    if ts is not None:
+        sc["analysis"]["timeseries"] = ts
+    return load_scene(sc)
+
+
+def _chain(elements=20, hs=6.0, tp=10.0, surge=2.0, ts=None):
+    """The DESIGN.md chain catenary (850 m, 200 m depth) with fairlead surge."""
+    line = {"name": "leg1", "end_a": {"position": [-800.0, 0.0, -200.0]},
+            "end_b": {"position": [0.0, 0.0, -20.0]},
+            "segments": [{"length": 850.0, "ea": 1.2326e9, "mass": 288.0,
+                          "diameter": 0.216, "cd_normal": 1.333, "cd_axial": 0.2034,
+                          "ca_normal": 1.0, "elements": elements}]}
+    if surge:
+        line["end_b"]["motion"] = {"surge": {"type": "pierson_moskowitz", "hs": surge,
+                                             "tp": tp}}
+    sc = {"environment": {"depth": 200.0, "seabed": {"stiffness": 3e6, "damping": 3e5}},
+          "lines": [line],
+          "analysis": {"solver": "direct",
+                       "omega": {"min": 0.05, "max": 3.0, "count": 300}}}
+    if hs:
+        sc["sea"] = {"spectrum": {"type": "pierson_moskowitz", "hs": hs, "tp": tp}}
+    if ts is not None:
+        sc["analysis"]["timeseries"] = ts
+    return load_scene(sc)
+
+
+def _fem(scene, hist, dim=2):
+    """The frequency-domain FE model assembled about the TD static start."""
+    env = scene.environment
+    mesh = mesh_line(scene.lines[0], env.rho, env.g)
+    return mesh, assemble(mesh, hist.static_positions, hist.static_tension, env.rho,
+                          dim=dim)
+
+
+def _harmonic_amplitude(x, t, omega, start):
+    """Complex amplitude X of x ≈ Re{X e^{iωt}} by projection on an integer number of
+    periods after ``start`` (free vibrations at other frequencies average out)."""
+    sel = np.flatnonzero(t >= start - 1e-9)
+    n_per = int((t[-1] - t[sel[0]]) * omega / (2 * math.pi))
+    sel = sel[t[sel] < t[sel[0]] + n_per * 2 * math.pi / omega - 1e-9]
+    return 2.0 * np.mean(x[sel] * np.exp(-1j * omega * t[sel]))
+
+
+# ------------------------------------------------------------------- static start
+
+
+def test_static_start_stays_at_equilibrium():
+    n_t, dt_sea = 160, 0.25
+    scene = _chain(elements=20, hs=0.0, surge=0.0, ts={"duration": n_t * dt_sea, "dt": dt_sea})
+    zero = {"b": np.zeros((3, n_t // 2 + 1), dtype=complex)}
+    hist = simulate_line_timedomain(scene, end_realizations=zero, dt=0.1, ramp=5.0)
+    # Newton never needs to iterate: the start is this model's own equilibrium to
+    # 1e-3 of the Newton tolerance, so the drift is bounded by an unbalanced force of
+    # at most that tolerance accelerating the lightest node (mass m·l0) over the run:
+    # |u| <= tol·t²/(2 m_min).
+    m_min = 288.0 * 850.0 / 20
+    bound = hist.tolerance * hist.t[-1] ** 2 / (2 * m_min)
+    assert np.all(hist.iterations == 0)
+    assert np.abs(hist.displacements).max() <= bound
+    assert np.abs(hist.tension_b - hist.tension_b[0]).max() <= 1e-6 * hist.tension_b[0]
+    # The re-equilibrated start agrees with the FE statics (an independent Newton
+    # solve): nodes within 5 mm (the smooth seabed contact rests p0/2 = 1.9 mm deeper
+    # than the statics' linear penalty), end tension within 0.1 %.
+    st = solve_statics(scene, method="fe").lines["leg1"]
+    assert np.abs(hist.static_positions - st.positions).max() < 5e-3
+    assert hist.tension_b[0] == pytest.approx(st.tension_b, rel=1e-3)
+    assert hist.tension_a[0] == pytest.approx(st.tension_a, rel=1e-3)
+
+
+# --------------------------------------------------------------- harmonic response
+
+
+def test_harmonic_end_motion_matches_fe_transfer_function():
+    # 5 mm surge of end_b at ω = 3.14 rad/s (0.62 of the first mode), Cd = 0: linear
+    # but undamped, with a step Δt = 0.125 s that makes the Newmark frequency error
+    # visible: (ωΔt)²/12 = 1.3 %.
+    t_l, dt_sea, m, amp = 200.0, 0.25, 100, 0.005
+    scene = _taut(hs=0.0, cd=0.0, ts={"duration": t_l, "dt": dt_sea})
+    n_t = int(t_l / dt_sea)
+    omega = 2 * math.pi / t_l * np.arange(n_t // 2 + 1)
+    w = omega[m]
+    c = np.zeros((3, omega.size), dtype=complex)
+    c[0, m] = n_t / 2 * amp  # x_b(t) = amp cos ωt
+    with pytest.warns(ResolutionWarning, match=r"period error .* use dt <="):
+        hist = simulate_line_timedomain(scene, dt=0.125, end_realizations={"b": c},
+                                        ramp=20.0)
+    assert hist.dt == pytest.approx(0.125)
+    mesh, fe = _fem(scene, hist)
+    K, M = fe.K.toarray(), (fe.M + fe.Ma).toarray()
+    f, p = fe.free, fe.fixed
+    up = np.zeros(p.size, dtype=complex)
+    up[-2] = amp  # end_b, x
+
+    def fd(w_free):
+        a = K[np.ix_(f, f)] - w_free**2 * M[np.ix_(f, f)]
+        rhs = -(K[np.ix_(f, p)] - w**2 * M[np.ix_(f, p)]) @ up
+        u = np.zeros(fe.n_dof, dtype=complex)
+        u[f] = np.linalg.solve(a, rhs)
+        return u.reshape(-1, 2)
+
+    exact = fd(w)
+    # Average acceleration = trapezoidal rule: the free DOFs' steady state is the
+    # transfer function at the warped frequency (2/Δt) tan(ωΔt/2); the prescribed end
+    # is exact at every step.
+    warped = fd(2.0 / hist.dt * math.tan(w * hist.dt / 2.0))
+    for node in (3, 5, 8):
+        x_td = _harmonic_amplitude(hist.displacements[:, node, 0], hist.t, w, 50.0)
+        # nonlinearity at 5 mm on a 92 m line under 1 MN (tension change 0.5 %): 1e-3
+        assert abs(x_td - warped[node, 0]) <= 1e-3 * abs(warped[node, 0])
+        # against the exact FE transfer function: within the Newmark frequency error,
+        # |H(ω̃) − H(ω)| (≈ |dH/dω|·ω·(ωΔt)²/12), plus the same 1e-3
+        assert abs(x_td - exact[node, 0]) <= (abs(warped[node, 0] - exact[node, 0])
+                                              + 1e-3 * abs(exact[node, 0]))
+        # and that error is real (0.9–2.2 % here): the test sees the frequency warping
+        assert abs(warped[node, 0] - exact[node, 0]) > 0.005 * abs(exact[node, 0])
+
+
+def test_newmark_period_error_closed_form():
+    # ΔT/T = x/(2 arctan(x/2)) − 1 = x²/12 − x⁴/180 + O(x⁶) (trapezoidal rule);
+    # at x = 0.3 the x⁶ term is ~1e-6 of the result
+    x = 0.3
+    assert newmark_period_error(x, 1.0) == pytest.approx(x**2 / 12 - x**4 / 180, rel=1e-4)
+    # Δt enters only through ωΔt
+    assert newmark_period_error(3.0, 0.1) == pytest.approx(newmark_period_error(x, 1.0))
+    assert newmark_period_error(0.0, 1.0) == 0.0
+
+
+# -------------------------------------------------- same realization, linear limit
+
+
+def _fd_series_fem(scene, hist):
+    """Direct solve (K − ω²M + iωC)U = C V + B_I A of the FE matrices on the
+    realization grid, synthesized with the realization's coefficients."""
+    from stochcable.excitation import drag_matrix, inertia_matrix
+    from stochcable.kinematics import wave_kinematics
+    from stochcable.sea import synthesize
+
+    env = scene.environment
+    real = hist._meta["realization"]
+    mesh, fe = _fem(scene, hist)
+    u0 = env.current[0].speed
+    e = fe.tangents
+    un = np.array([u0, 0.0]) - (e @ np.array([u0, 0.0]))[:, None] * e
+    # in the plane the normal drag linearized about the current is exactly
+    # d(|u|u)/du = 2|U_n| along the single in-plane normal
+    cn = 0.5 * env.rho * mesh.cd_normal * mesh.diameter
+    C = drag_matrix(fe, 2 * cn * np.linalg.norm(un, axis=1), np.zeros(mesh.n_elements)).toarray()
+    K, M = fe.K.toarray(), (fe.M + fe.Ma).toarray()
+    BI = inertia_matrix(fe, env.g).toarray()
+    w = np.asarray(real.omega)
+    kin = wave_kinematics(w, hist.static_positions, 0.0, env.depth, env.g)
+    A = kin.acceleration[:, [0, 2], :].reshape(-1, w.size)
+    V = kin.velocity[:, [0, 2], :].reshape(-1, w.size)
+    F = BI @ A + C @ V
+    f = fe.free
+    D = (K[np.ix_(f, f)][None] - w[:, None, None] ** 2 * M[np.ix_(f, f)][None]
+         + 1j * w[:, None, None] * C[np.ix_(f, f)][None])
+    U = np.zeros((fe.n_dof, w.size), dtype=complex)
+    U[f] = np.linalg.solve(D, F[f].T[..., None])[..., 0].T
+    return synthesize(real, U), kin, real
+
+
+def test_linear_limit_same_realization_equals_fe_synthesis():
+    # Tiny waves (Hs 0.1 m) on a 1 m/s current: the drag ½ρCdD|U+v|(U+v) is linear in
+    # v to O(v/U) (the seed's Taylor expansion, eq. 3.2.a.6), and the current's linear
+    # damping lets the ramp's free vibrations die out.
+    u0 = 1.0
+    scene = _taut(hs=0.1, cd=1.2, current=u0, ts={"duration": 256.0, "dt": 0.25, "seed": 7})
+    hist = simulate_line_timedomain(scene)
+    x_fd, kin, real = _fd_series_fem(scene, hist)
+    k = round(real.dt / hist.dt)
+    td = hist.displacements[::k][: real.n_samples]
+    sel = real.time >= hist.ramp
+    # expected error: drag nonlinearity σ_v/U (σ_v the wave velocity σ at the top
+    # node), plus the Newmark period error at the highest excitation frequency
+    from stochcable.sea import synthesize
+
+    sigma_v = synthesize(real, kin.velocity[-2, 0]).std()
+    tol = sigma_v / u0 + newmark_period_error(hist._meta["omega_max"], hist.dt)
+    assert tol < 0.05
+    for node in (3, 5, 8):
+        a, b = td[sel, node, 0], x_fd[2 * node, sel]
+        assert (a - b).std() <= tol * b.std()
+        # the series are the same realization: correlation close to one
+        assert np.corrcoef(a, b)[0, 1] > 1 - tol
+
+
+def test_linear_limit_same_realization_equals_analysis_series():
+    # The product's own synthesized end-tension series (analyze, same seed, same
+    # band) against the TD end tension: the same realization drives both.
+    from stochcable.analysis import analyze
+
+    scene = _taut(hs=0.1, cd=1.2, current=1.0,
+                  ts={"duration": 256.0, "dt": 0.25, "seed": 7})
+    res = analyze(scene)
+    ts = res.timeseries
+    hist = simulate_line_timedomain(scene, band=(0.05, 3.0))
+    k = round(0.25 / hist.dt)
+    sel = ts.time >= hist.ramp
+    for end in ("a", "b"):
+        fd = np.asarray(ts.end_tension["tether"][f"end_{end}"])[sel]
+        td = (hist.tension_a if end == "a" else hist.tension_b)[::k][: ts.time.size][sel]
+        a, b = td - td.mean(), fd - fd.mean()
+        # rms difference within the drag nonlinearity σ_v/U ≈ 1 % (see above)
+        assert (a - b).std() <= 0.01 * b.std()
+        assert a.std() == pytest.approx(b.std(), rel=0.01)
+
+
+# ------------------------------------------------- statistics: linearization error
+
+
+def _sigma_sampling_error(omega, spectrum, record):
+    """Relative standard deviation of σ̂ from one record of a Gaussian process:
+    var(σ̂)/σ² ≈ 1/(2 N_eff), N_eff = T / ∫ρ²dτ, ∫ρ²dτ = π ∫S²dω / m0²."""
+    m0 = np.trapezoid(spectrum, omega)
+    corr = math.pi * np.trapezoid(spectrum**2, omega) / m0**2
+    return math.sqrt(corr / (2.0 * record))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["taut", "chain"])
+def test_sigma_frequency_domain_vs_time_domain(case):
+    # Random sea + random end_b surge; FD σ (analyze, linearized drag) against the
+    # nonlinear TD σ averaged over 3 seeds (DSA) of 300 s (taut) / 400 s (chain).
+    if case == "taut":
+        scene = _taut(hs=4.0, tp=8.0, motion={"surge": {"type": "pierson_moskowitz",
+                                                        "hs": 1.0, "tp": 8.0}})
+        duration, node = 300.0, -2
+    else:
+        scene = _chain(elements=20)
+        duration, node = 400.0, -2
+    res = analyze_scene(scene)
+    lr = next(iter(res.lines.values()))
+    seeds = (1, 2, 3)
+    hists = [simulate_line_timedomain(scene, duration=duration, seed=s, band=(0.05, 3.0))
+             for s in seeds]
+    record = duration - hists[0].ramp
+    # Linearization error allowed: 10 % on σ of end tension and in-plane motion of the
+    # node next to the fairlead — the accuracy the statistical linearization is
+    # expected to have for drag-dominated response (seed 004; measured here 1–5 %).
+    lin = 0.10
+    for end in ("a", "b"):
+        s_fd = getattr(lr, f"end_{end}").std
+        s_td = np.mean([h.tension_statistics(end)["std"] for h in hists])
+        samp = _sigma_sampling_error(lr.omega, lr.end_tension_spectrum(f"end_{end}"), record)
+        # 3 standard errors of the mean of 3 records, plus the linearization allowance
+        assert abs(s_td - s_fd) <= (3 * samp / math.sqrt(len(seeds)) + lin) * s_fd
+    spec = lr.motion_spectrum[node, 0]
+    s_fd = lr.motion_std[node, 0]
+    s_td = np.mean([h.motion_std()[node, 0] for h in hists])
+    samp = _sigma_sampling_error(lr.omega, spec, record)
+    assert abs(s_td - s_fd) <= (3 * samp / math.sqrt(len(seeds)) + lin) * s_fd
+
+
+def analyze_scene(scene):
+    from stochcable.analysis import analyze
+
+    return analyze(scene)
+
+
+# ------------------------------------------------------------------------ errors
+
+
+def test_unknown_line_and_bad_inputs():
+    scene = _taut(hs=1.0, ts={"duration": 64.0, "dt": 0.25})
+    with pytest.raises(InputError, match=r"line_name = 'nope'.*must be one of \['tether'\]"):
+        simulate_line_timedomain(scene, "nope")
+    with pytest.raises(InputError, match=r"ramp = 100.0 \[s\]: must be shorter than the duration"):
+        simulate_line_timedomain(scene, ramp=100.0)
+    with pytest.raises(InputError, match=r"duration = 100.0 \[s\]: must be <= the realization's length 64 s"):
+        from stochcable.sea import simulate_sea
+
+        real = simulate_sea(lambda w: np.exp(-((w - 1.0) ** 2)) * 1e-3, 64.0, 0.25, rng=1)
+        simulate_line_timedomain(scene, realization=real, duration=100.0)
+    with pytest.raises(InputError, match=r"end_realizations\['b'\].*shape \(3, 129\)"):
+        simulate_line_timedomain(scene, end_realizations={"b": np.zeros((3, 5))})
+    no_excitation = _taut(hs=0.0, ts={"duration": 64.0, "dt": 0.25})
+    with pytest.raises(InputError, match="needs a sea or a prescribed end motion"):
+        simulate_line_timedomain(no_excitation)
+
+
+def test_newton_failure_reports_step_and_residual():
+    # one Newton iteration allowed: the chain's touchdown and drag need 2–4 per step,
+    # so a step fails, naming the step, time and residual
+    scene = _chain(ts={"duration": 64.0, "dt": 0.25})
+    with pytest.raises(ConvergenceError,
+                       match=r"time-domain Newton at step \d+ \(t = [\d.]+ s\) did not "
+                             r"converge: residual .* reduce dt") as exc:
+        simulate_line_timedomain(scene, max_iterations=1)
+    assert exc.value.partial["t"].size >= 1

@@ -1,0 +1,87 @@
+"""Tests of ``stochcable analyze``."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from stochcable.cli import main
+
+SCENE = {
+    "environment": {"depth": 100.0},
+    "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}, "heading": 0.0},
+    "lines": [{
+        "name": "leg1",
+        "end_a": {"position": [-400.0, 0.0, -100.0]},
+        "end_b": {"position": [0.0, 0.0, -10.0],
+                  "motion": {"surge": {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}}},
+        "segments": [{"length": 450.0, "ea": 5.0e8, "mass": 100.0, "diameter": 0.1,
+                      "cd_normal": 2.4, "cd_axial": 1.15, "elements": 12}],
+    }],
+    "analysis": {"omega": {"min": 0.1, "max": 2.0, "count": 40},
+                 "timeseries": {"method": "dsa", "duration": 100.0, "dt": 0.5, "seed": 1}},
+}
+
+
+@pytest.fixture()
+def scene_file(tmp_path):
+    p = tmp_path / "scene.json"
+    p.write_text(json.dumps(SCENE))
+    return p
+
+
+def test_analyze_writes_the_v1_result_document_and_plots(scene_file, tmp_path, capsys):
+    out = tmp_path / "result.json"
+    figs = tmp_path / "figs"
+    rc = main(["analyze", str(scene_file), "--format", "json", "-o", str(out),
+               "--plot", str(figs), "--progress"])
+    assert rc == 0
+    err = capsys.readouterr().err
+    assert "statics" in err and "iteration 1" in err and "done" in err
+    doc = json.loads(out.read_text())
+    # DESIGN.md v1 result document keys
+    st = doc["statics"]["lines"]["leg1"]
+    assert {"end_a", "end_b", "touchdown", "nodes"} <= set(st)
+    assert st["end_b"]["tension"] > 0
+    assert isinstance(doc["modes"]["omega"], list)
+    assert {"converged", "iterations", "relative_change"} <= set(doc["linearization"])
+    line = doc["lines"]["leg1"]
+    for end in ("end_a", "end_b"):
+        assert {"mean", "std", "tz", "mpm_3h"} <= set(line[end]["tension"])
+        assert math.isfinite(line[end]["tension"]["mpm_3h"])
+    assert {"s", "std"} <= set(line["tension"]) and {"s", "std"} <= set(line["motion"])
+    assert len(line["spectra"]["omega"]) == 40
+    assert {"total_s", "statics_s", "solve_s"} <= set(doc["timing"])
+    assert doc["timeseries"]["samples"] == 200
+    names = sorted(p.name for p in figs.iterdir())
+    assert names == ["leg1_end_tension_spectra.png", "leg1_tension_std.png", "timeseries.png"]
+    assert all((figs / n).stat().st_size > 1000 for n in names)
+
+
+def test_analyze_prints_to_stdout_without_progress(scene_file, capsys):
+    rc = main(["analyze", str(scene_file), "--timeseries", "none"])
+    assert rc == 0
+    captured = capsys.readouterr()
+    doc = json.loads(captured.out)
+    assert "timeseries" not in doc
+    assert "stochcable analyze:" not in captured.err  # no progress: stderr not a TTY
+
+
+def test_analyze_bad_scene_is_one_line_error(tmp_path, capsys):
+    bad = dict(SCENE, lines=[dict(SCENE["lines"][0], segments=[
+        dict(SCENE["lines"][0]["segments"][0], ea=-1.0)])])
+    p = tmp_path / "bad.json"
+    p.write_text(json.dumps(bad))
+    rc = main(["analyze", str(p)])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "lines[0].segments[0].ea" in err and "N" in err
+
+
+def test_analyze_missing_file(tmp_path, capsys):
+    rc = main(["analyze", str(tmp_path / "nope.json")])
+    assert rc == 2
+    assert "cannot be read" in capsys.readouterr().err

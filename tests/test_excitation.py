@@ -1,0 +1,168 @@
+"""Tests of stochcable.excitation: input channels and hydrodynamic matrices."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stochcable import analysis as an
+from stochcable.errors import InputError
+from stochcable.excitation import (
+    drag_matrix,
+    element_frames,
+    inertia_matrix,
+    line_channels,
+    prescribed_motion,
+)
+from stochcable.kinematics import wave_kinematics
+from stochcable.scene import load_scene
+from stochcable.statics import solve_statics
+
+RHO = 1025.0
+G = 9.80665
+
+
+def straight_doc(*, sea=True, motion=None, heading=20.0, attachments=()):
+    """An inclined taut weightless straight line (3-D: out of the x-z plane)."""
+    end_b = {"position": [60.0, 30.0, -20.0]}
+    if motion is not None:
+        end_b["motion"] = motion
+    doc = {
+        "environment": {"depth": 100.0, "rho": RHO, "g": G},
+        "lines": [{
+            "name": "l",
+            "end_a": {"position": [0.0, 0.0, -80.0]},
+            "end_b": end_b,
+            "segments": [{"length": 89.0, "ea": 1.0e8, "mass": 20.0, "diameter": 0.2,
+                          "cd_normal": 1.2, "cd_axial": 0.3, "ca_normal": 0.8,
+                          "weight": 0.0, "elements": 9}],
+            "attachments": list(attachments),
+        }],
+        "analysis": {"omega": {"min": 0.2, "max": 1.5, "count": 7}},
+    }
+    if sea:
+        doc["sea"] = {"spectrum": {"type": "pierson_moskowitz", "hs": 3.0, "tp": 8.0},
+                      "heading": heading}
+    return doc
+
+
+def built(doc):
+    scene = load_scene(doc)
+    st = solve_statics(scene).lines["l"]
+    system = an.build_line_system(scene, scene.lines[0], st)
+    return scene, system
+
+
+def test_inertia_matrix_rigid_acceleration_gives_morison_force():
+    """A uniform fluid acceleration a on a straight line: total force
+    ρ(πD²/4)(1+Ca)·L0·(I − eeᵀ)a (seed 001 eq. 5.2.1), plus the attachment's
+    (buoyancy/g + added mass)·a."""
+    # neutrally buoyant attachment, so the weightless line stays straight
+    att = {"at": 40.0, "mass": 500.0, "buoyancy": 500.0 * G, "added_mass": 300.0}
+    scene, system = built(straight_doc(attachments=[att]))
+    model = system.model
+    b = inertia_matrix(model, G)
+    a = np.array([0.3, -0.2, 0.5])
+    force = (b @ np.tile(a, model.n_nodes)).reshape(-1, 3).sum(axis=0)
+    e = element_frames(model.positions)[0][0]
+    line = RHO * math.pi * 0.2**2 / 4 * 1.8 * 89.0 * (a - e * (e @ a))
+    node = (500.0 + 300.0) * a
+    np.testing.assert_allclose(force, line + node, rtol=1e-12)
+    # symmetric (element direction constant over the element)
+    assert abs(b - b.T).max() == 0.0
+
+
+def test_inertia_minus_added_mass_is_froude_krylov():
+    """Ü = A (line moving with the fluid): B_I A − Ma A = ρ(πD²/4)(I − eeᵀ)A per length."""
+    scene, system = built(straight_doc())
+    model = system.model
+    b = inertia_matrix(model, G)
+    a = np.tile(np.array([0.0, 1.0, 0.0]), model.n_nodes)
+    fk = ((b - model.Ma) @ a).reshape(-1, 3).sum(axis=0)
+    e = element_frames(model.positions)[0][0]
+    expected = RHO * math.pi * 0.2**2 / 4 * 89.0 * (np.array([0, 1.0, 0]) - e * e[1])
+    np.testing.assert_allclose(fk, expected, rtol=1e-12)
+
+
+def test_drag_matrix_uniform_velocity_and_vector_form():
+    scene, system = built(straight_doc())
+    model = system.model
+    n_el = model.n_elements
+    bn, bt = 37.0, 5.0
+    c = drag_matrix(model, np.full(n_el, bn), np.full(n_el, bt))
+    v = np.array([0.4, 0.1, -0.3])
+    force = (c @ np.tile(v, model.n_nodes)).reshape(-1, 3).sum(axis=0)
+    e = element_frames(model.positions)[0][0]
+    vt = e * (e @ v)
+    np.testing.assert_allclose(force, 89.0 * (bn * (v - vt) + bt * vt), rtol=1e-12)
+    # the 2×2 normal-plane form with B = bn I equals the scalar form
+    c2 = drag_matrix(model, np.broadcast_to(bn * np.eye(2), (n_el, 2, 2)), np.full(n_el, bt))
+    assert abs(c2 - c).max() < 1e-12 * bn * 89.0
+
+
+def test_element_frames_are_orthonormal_and_n2_out_of_plane():
+    pos = np.array([[0, 0, -50.0], [10, 0, -40.0], [20, 0, -35.0], [20, 0, -20.0]])
+    e, n1, n2 = element_frames(pos)
+    for a in (e, n1, n2):
+        np.testing.assert_allclose(np.linalg.norm(a, axis=1), 1.0, rtol=1e-14)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", e, n1), 0.0, atol=1e-15)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", e, n2), 0.0, atol=1e-15)
+    np.testing.assert_allclose(np.abs(n2[:, 1]), 1.0)  # x-z line: n2 = ±y (vertical too)
+
+
+def test_channels_order_kinematics_and_prescribed_motion():
+    motion = {"surge": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 9.0},
+              "heave": {"type": "jonswap", "hs": 0.5, "tp": 7.0}}
+    doc = straight_doc(motion=motion)
+    scene, system = built(doc)
+    w = scene.analysis.omega.values()
+    chans = line_channels(scene, scene.lines[0], system.positions, w)
+    assert [c.name for c in chans] == ["sea", "end_b.surge", "end_b.heave"]
+    sea = chans[0]
+    kin = wave_kinematics(w, system.positions, math.radians(20.0), 100.0, G)
+    np.testing.assert_array_equal(sea.velocity, np.transpose(kin.velocity, (2, 0, 1)))
+    np.testing.assert_array_equal(sea.acceleration, np.transpose(kin.acceleration, (2, 0, 1)))
+    np.testing.assert_allclose(sea.spectrum, scene.sea.spectrum.spectral_density(w, G))
+    np.testing.assert_allclose(chans[2].spectrum,
+                               scene.lines[0].end_b.motion.heave.spectral_density(w, G))
+    ub = prescribed_motion(system.model, chans, w.size)  # (n_w, n_fixed=6, n_ch)
+    assert np.all(ub[:, :, 0] == 0)
+    np.testing.assert_array_equal(ub[:, :, 1], np.tile([0, 0, 0, 1, 0, 0], (w.size, 1)))
+    np.testing.assert_array_equal(ub[:, :, 2], np.tile([0, 0, 0, 0, 0, 1], (w.size, 1)))
+
+
+def test_rao_end_motion_is_part_of_the_sea_channel():
+    rao = {"rao": {"omega": [0.1, 2.0], "heave": {"re": [1.0, 0.0], "im": [0.0, 0.5]}}}
+    scene, system = built(straight_doc(motion=rao))
+    w = np.array([0.1, 1.05, 2.0])
+    chans = line_channels(scene, scene.lines[0], system.positions, w)
+    assert [c.name for c in chans] == ["sea"]
+    np.testing.assert_allclose(chans[0].motion_b[:, 2], [1.0, 0.5 + 0.25j, 0.5j])
+    assert chans[0].motion_a is None
+
+
+def test_rao_without_sea_names_the_field():
+    rao = {"rao": {"omega": [0.1, 2.0], "surge": {"re": [1.0, 1.0], "im": [0.0, 0.0]}}}
+    scene, system = built(straight_doc(sea=False, motion=rao))
+    with pytest.raises(InputError, match=r"lines\[l\]\.end_b\.motion\.rao.*needs a 'sea'"):
+        line_channels(scene, scene.lines[0], system.positions, np.array([0.5]))
+
+
+def test_sigma_of_line_at_rest_is_fluid_velocity_sigma():
+    """Seed step 5 (cable at rest): σ_n² + σ_t² = ∫ S |v_mid|² dω, v_mid the mean of the
+    node kinematics, computed here independently by the trapezoid rule."""
+    scene, system = built(straight_doc())
+    w = np.linspace(0.3, 1.8, 31)
+    chans = line_channels(scene, scene.lines[0], system.positions, w)
+    sig = an.relative_velocity_sigmas(system, chans, None, "seed")
+    n = system.model.n_elements
+    kin = wave_kinematics(w, system.positions, math.radians(20.0), 100.0, G).velocity
+    vmid = 0.5 * (kin[1:] + kin[:-1])  # (n_el, 3, n_w)
+    s = scene.sea.spectrum.spectral_density(w, G)
+    total = np.trapezoid(np.sum(np.abs(vmid) ** 2, axis=1) * s, w, axis=-1)
+    np.testing.assert_allclose(sig[:n] ** 2 + sig[n:2 * n] ** 2, total, rtol=1e-12)
+    e = element_frames(system.positions)[0]
+    axial = np.trapezoid(np.abs(np.einsum("ekw,ek->ew", vmid, e)) ** 2 * s, w, axis=-1)
+    np.testing.assert_allclose(sig[n:2 * n] ** 2, axial, rtol=1e-12)
