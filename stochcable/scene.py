@@ -48,6 +48,7 @@ __all__ = [
     "OmegaGrid",
     "LinearizationSettings",
     "TimeSeriesSettings",
+    "StructuralDamping",
     "AnalysisSettings",
     "Scene",
     "load_scene",
@@ -523,6 +524,13 @@ class TimeSeriesSettings(_Doc):
     seed: int = Field(default=1, ge=0, description="Random seed (numpy PCG64)")
 
 
+class StructuralDamping(_Doc):
+    """Rayleigh structural damping C_s = alpha·M + beta·K (added to the drag damping)."""
+
+    alpha: float = _f("Mass-proportional coefficient", "1/s", ge=0, default=0.0)
+    beta: float = _f("Stiffness-proportional coefficient", "s", ge=0, default=0.0)
+
+
 class AnalysisSettings(_Doc):
     """How to solve: frequencies, solver, modes, linearization, time series."""
 
@@ -533,6 +541,7 @@ class AnalysisSettings(_Doc):
         default="auto", description="Number of modes kept, or auto from the frequency content"
     )
     linearization: LinearizationSettings = Field(default_factory=LinearizationSettings)
+    structural_damping: StructuralDamping = Field(default_factory=StructuralDamping)
     timeseries: TimeSeriesSettings | None = None
     duration: float = _f("Storm duration for extreme-value statistics", "s", gt=0,
                          default=10800.0)
