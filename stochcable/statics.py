@@ -991,18 +991,25 @@ def _drag_stepping(solver: "_Solver", model: _Model, X0: np.ndarray,
 def _fe_result(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
                X: np.ndarray, iterations: int, r: float) -> LineStatics:
     R, T, _, _ = model.forces(X, tangent=False)
-    fa = frame.vec_to_global(R[0])
-    fb = frame.vec_to_global(R[-1])
-    tension = np.where(T > 0.0, T, 0.0)
-    ta, tb = float(np.linalg.norm(fa)), float(np.linalg.norm(fb))
-    node_t = np.empty(mesh.n_nodes)
-    node_t[1:-1] = 0.5 * (tension[:-1] + tension[1:])
-    node_t[0], node_t[-1] = ta, tb
     zi = frame.dim - 1
     z = X[:, zi]
     zbed = -env.depth
     ztol = 1e-9 * max(env.depth, 1.0)
     grounded = z <= zbed + ztol
+    # An end node resting on the seabed: the bed, not the support, carries the weight
+    # lumped on that node, so the end force is the line's own (continuous) end force.
+    Ra, Rb = R[0].copy(), R[-1].copy()
+    if grounded[0]:
+        Ra[zi] += 0.5 * mesh.l0[0] * mesh.weight[0]
+    if grounded[-1]:
+        Rb[zi] += 0.5 * mesh.l0[-1] * mesh.weight[-1]
+    fa = frame.vec_to_global(Ra)
+    fb = frame.vec_to_global(Rb)
+    tension = np.where(T > 0.0, T, 0.0)
+    ta, tb = float(np.linalg.norm(fa)), float(np.linalg.norm(fb))
+    node_t = np.empty(mesh.n_nodes)
+    node_t[1:-1] = 0.5 * (tension[:-1] + tension[1:])
+    node_t[0], node_t[-1] = ta, tb
     touchdown = _touchdown(mesh, X, T, zi, grounded)
     pos = frame.to_global(X)
     pos[0], pos[-1] = mesh.end_a, mesh.end_b

@@ -87,8 +87,11 @@ def test_fe_seabed_touchdown_matches_catenary():
     # grounded nodes sit at the penalty penetration (uniform, exact for a flat line)
     zg = r.positions[1:-1][grounded, 2]
     assert np.allclose(zg[:-3], -200.0 - pen, rtol=0, atol=1e-9)
-    # end tensions: discretization at n = 100, 1e-4 (measured 6.5e-5)
-    assert abs(r.tension_a / cat.tension_a - 1) < 5e-5
+    # end tensions: O(1/n²) discretization of the suspended part at n = 100 sets H to
+    # about 1e-4 (measured 9.3e-5 at the anchor, where the grounded end force is the
+    # first element's tension H, the seabed carrying the weight lumped on the anchor)
+    assert abs(r.tension_a / cat.tension_a - 1) < 1.5e-4
+    assert abs(r.force_a[2]) < 1e-6 * r.tension_a  # horizontal pull only, as the catenary
     assert abs(r.tension_b / cat.tension_b - 1) < 1e-4
     # touchdown interpolated within a fraction of an element (8.5 m)
     assert abs(r.touchdown - cat.touchdown) < 0.05 * 8.5
