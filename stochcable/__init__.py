@@ -16,7 +16,32 @@ from .errors import (
     StochcableError,
 )
 
+# The pipeline's top-level entry points, imported on first use so that
+# ``import stochcable`` (and the CLI's start-up) stays light.
+_LAZY = {
+    "analyze": ("analysis", "analyze"),
+    "load_scene": ("scene", "load_scene"),
+    "Scene": ("scene", "Scene"),
+    "solve_statics": ("statics", "solve_statics"),
+    "natural_modes": ("modes", "natural_modes"),
+    "simulate_sea": ("sea", "simulate_sea"),
+    "load_example": ("examples", "load_example"),
+}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        module, attr = _LAZY[name]
+        value = getattr(importlib.import_module(f".{module}", __name__), attr)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'stochcable' has no attribute {name!r}")
+
+
 __all__ = [
+    *_LAZY,
     "__version__",
     "StochcableError",
     "InputError",

@@ -220,6 +220,8 @@ def test_planar_scene_in_3d_equals_2d_and_has_no_out_of_plane_motion():
     doc = chain_doc(elements=16, omega_count=40)
     scene, sys2, chans = system_and_channels(doc, dim=2)
     _, sys3, _ = system_and_channels(doc, dim=3)
+    # all modes in both (auto would truncate the 45-DOF 3-D model but not the 2-D one)
+    sys2, sys3 = with_all_modes(sys2, "foss"), with_all_modes(sys3, "foss")
     lin2 = an.linearize(sys2, chans, scene.analysis)
     lin3 = an.linearize(sys3, chans, scene.analysis)
     assert lin2.record.iterations == lin3.record.iterations
@@ -493,3 +495,97 @@ def test_strong_current_drag_tends_to_steady_drag_tangent():
     # σ_n/U_n < 3 %: E|v| = U(1 + σ²/U² + ...) within 1e-3 relative
     assert np.all(rec.sigma_normal < 0.03 * u_n)
     np.testing.assert_allclose(rec.b_normal, ref, rtol=1e-3)
+
+
+# --------------------------------------------------- Rayleigh structural damping
+
+
+def test_rayleigh_damping_equals_independent_linear_solve():
+    """Cd = 0, no current, no seabed contact: the transfer functions are the linear
+    solve of (K − ω²M_T + iω(αM_T + βK))U = F, built here from the FE matrices and the
+    sparse load assembly of stochcable.excitation (independent of the block solver)."""
+    from stochcable.excitation import channel_loads, inertia_matrix, prescribed_motion
+
+    doc = chain_doc(grounded=False, sea=True, surge=True, elements=12, omega_count=25)
+    for seg in doc["lines"][0]["segments"]:
+        seg["cd_normal"] = 0.0
+        seg["cd_axial"] = 0.0
+    alpha, beta = 0.02, 0.01
+    doc["analysis"]["structural_damping"] = {"alpha": alpha, "beta": beta}
+    scene, system, chans = system_and_channels(doc)
+    model = system.model
+    assert not model.grounded.any()
+    K = model.K.toarray()
+    MT = (model.M + model.Ma).toarray()
+    C = alpha * MT + beta * K
+    w = chans[0].omega
+    F = channel_loads(model, chans, 0.0 * model.K, inertia_matrix(model, 9.80665))
+    ub = prescribed_motion(model, chans, w.size)
+    free, fixed = model.free, model.fixed
+    Z = K[None] - w[:, None, None] ** 2 * MT[None] + 1j * w[:, None, None] * C[None]
+    rhs = F[:, free] - Z[:, free][:, :, fixed] @ ub
+    u_ref = np.linalg.solve(Z[:, free][:, :, free], rhs)
+    lin = an.linearize(system, chans, scene.analysis)
+    assert np.all(lin.damping.b_normal == 0.0) and np.all(lin.damping.b_axial == 0.0)
+    for solver in ("direct", "foss"):
+        sysx = with_all_modes(system, solver)
+        resp = an.solve(sysx, chans, lin.damping)
+        # two exact solves of a 22-DOF system (LU vs Foss eigenvectors): round-off
+        u = resp.displacement[:, free]
+        assert np.max(np.abs(u - u_ref)) <= 1e-9 * np.max(np.abs(u_ref)), solver
+        np.testing.assert_array_equal(resp.displacement[:, fixed], ub)
+        # support forces: −[Z U − F] on the end rows
+        u_all = np.zeros((w.size, model.n_dof, len(chans)), dtype=complex)
+        u_all[:, free], u_all[:, fixed] = u_ref, ub
+        ref_f = -(Z[:, fixed] @ u_all - F[:, fixed])
+        assert np.max(np.abs(resp.support_force - ref_f)) <= 1e-8 * np.max(np.abs(ref_f))
+    # analyze() reaches the same system: end tension σ with and without all modes
+    res = an.analyze(doc)
+    assert res.lines["chain"].linearization.converged
+
+
+def test_rayleigh_damped_taut_string_first_mode_peak():
+    """Weightless taut string, Cd = Ca = 0, heave of end_b, evaluated at the first
+    natural frequency ω1 = πc/L: the midspan amplitude is the quasi-static 1/2 plus
+    the damped modal oscillator at resonance, q = Γ(ω1² − iαω1)/(2iζ1ω1²) with
+    Γ = 2/π (participation of the linear shape x/L in sin(πx/L)) and
+    2ζ1ω1 = α + βω1² (Rayleigh)."""
+    ea, l0, span, m = 1.0e7, 99.0, 100.0, 10.0
+    n_el = 100
+    alpha, beta = 0.01, 2.0e-4
+    doc = {
+        "environment": {"depth": 200.0},
+        "lines": [{
+            "name": "string",
+            "end_a": {"position": [0.0, 0.0, -50.0]},
+            "end_b": {"position": [span, 0.0, -50.0], "motion": {"heave": PM_SURGE}},
+            "segments": [{"length": l0, "ea": ea, "mass": m, "diameter": 0.05,
+                          "cd_normal": 0.0, "cd_axial": 0.0, "ca_normal": 0.0,
+                          "weight": 0.0, "elements": n_el}],
+        }],
+        "analysis": {"omega": {"min": 0.5, "max": 2.5, "count": 9}, "solver": "direct",
+                     "structural_damping": {"alpha": alpha, "beta": beta}},
+    }
+    scene, system, _ = system_and_channels(doc)
+    tension = ea * (span / l0 - 1.0)
+    c = math.sqrt(tension / (m * l0 / span))
+    w1 = math.pi * c / span
+    zeta = 0.5 * (alpha / w1 + beta * w1)
+    assert 1e-3 < zeta < 1e-2  # light damping: the resonant term dominates
+    gamma = 2.0 / math.pi
+    q = gamma * (w1**2 - 1j * alpha * w1) / (2j * zeta * w1**2)
+    expected = abs(0.5 + q)
+    chans = line_channels(scene, scene.lines[0], system.positions, np.array([w1]))
+    damping = an.drag_coefficients(system, np.zeros(2 * n_el), "seed")
+    for solver in ("direct", "foss"):
+        resp = an.solve(dataclasses.replace(system, solver=solver), chans, damping)
+        mid = resp.displacement[0, 2 * (n_el // 2) + 1, 0]
+        # non-resonant modes 3, 5, … add ~Γ3/8 ≈ 0.03 (4e-4 of |q| ≈ 60), FE frequency
+        # error (kh)²/24 ≈ 4e-5 of ω1 moves the peak by 4e-5/ζ ≈ 1 % in phase, < 1e-4
+        # in magnitude: 2e-3
+        assert abs(mid) == pytest.approx(expected, rel=2e-3), solver
+    # and without structural damping the same frequency is an undamped resonance
+    undamped = dataclasses.replace(system, structural_damping=(0.0, 0.0))
+    with pytest.raises(SolverError, match="singular|resonance"):
+        an.solve(undamped, line_channels(scene, scene.lines[0], system.positions,
+                                         np.array([system.modes.omega[0]])), damping)

@@ -18,8 +18,10 @@ from stochcable.solvers import (
     foss_transfer,
     matrix_bandwidth,
     modal_basis,
+    solve_block_tridiagonal,
     solve_direct,
     solve_modal,
+    tridiagonal_blocks,
 )
 
 
@@ -304,3 +306,101 @@ def test_shape_and_value_errors():
         solve_modal(K, M, None, np.ones((3, 4)), w, method="modal")
     with pytest.raises(SolverError, match="negative eigenvalue"):
         modal_basis(-K, M)
+
+
+# ------------------------------------------------------- block-tridiagonal direct
+
+
+def _block_line(n_nodes, b, rng, *, slack=(), ea=1e9, tension=1e5, m=100.0, damping=1.0):
+    """Fixed-fixed line of n_nodes free nodes with b DOFs each, random directions:
+    K, M, C block-tridiagonal (element stiffness (EA/l) eeᵀ + (T/l)(I − eeᵀ))."""
+    n_el = n_nodes + 1
+    e = rng.standard_normal((n_el, b))
+    e /= np.linalg.norm(e, axis=1)[:, None]
+    l = 10.0
+    eet = e[:, :, None] * e[:, None, :]
+    ea_el = np.full(n_el, ea)
+    t_el = np.full(n_el, tension)
+    for j in slack:  # slack element: 1e-6 EA, no tension (as stochcable.fem)
+        ea_el[j], t_el[j] = 1e-6 * ea, 0.0
+    k = (ea_el / l)[:, None, None] * eet + (t_el / l)[:, None, None] * (np.eye(b) - eet)
+    n = n_nodes * b
+    K, M, C = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n))
+    for j in range(n_el):
+        for a, sa in ((j - 1, 1.0), (j, -1.0)):  # element j joins free nodes j-1 and j
+            for c, sc in ((j - 1, 1.0), (j, -1.0)):
+                if 0 <= a < n_nodes and 0 <= c < n_nodes:
+                    blk = sa * sc * k[j]
+                    mb = (m * l / 3.0 if a == c else m * l / 6.0) * np.eye(b)
+                    K[a * b:(a + 1) * b, c * b:(c + 1) * b] += blk
+                    M[a * b:(a + 1) * b, c * b:(c + 1) * b] += mb
+                    C[a * b:(a + 1) * b, c * b:(c + 1) * b] += damping * mb / m
+    return K, M, C
+
+
+@pytest.mark.parametrize("b, n_nodes, slack", [(2, 39, ()), (3, 39, ()), (3, 40, (0, 7, 8, 20)),
+                                               (2, 30, tuple(range(5, 25)))])
+def test_block_tridiagonal_equals_dense_direct(b, n_nodes, slack):
+    """Chain-like lines in 2-D and 3-D, also with slack elements (1e-6 EA, T = 0:
+    tiny stiffness, nearly singular K), across resonances with light damping."""
+    rng = np.random.default_rng(b * 100 + n_nodes + len(slack))
+    K, M, C = _block_line(n_nodes, b, rng, slack=slack, damping=1e-3)
+    wn, _ = modal_basis(K, M)
+    # grid through the first resonances, including points on natural frequencies;
+    # consecutive slack elements leave a node without transverse stiffness (a zero
+    # natural frequency, singular at ω = 0 only), so the grid starts above 0
+    wn = wn[wn > 1e-6 * wn.max()]
+    w = np.concatenate([np.linspace(0.01 * wn[0], 1.2 * wn[8], 60), wn[:6]])
+    F = _loads(w.size, n_nodes * b, rng, n_rhs=3)
+    ref = solve_direct(K, M, C, F, w, method="dense")
+    u = solve_block_tridiagonal(K, M, C, F, w, b)
+    # both are backward-stable LU (pivoted); the forward error is cond·eps, and at
+    # the lightly damped resonances (damping ratio ~1e-4) cond ~ 1e9-1e10: 1e-5
+    # relative difference, and the backward error (solver-independent) at round-off
+    assert _rel(u, ref) < 1e-5
+    Z = K - w[:, None, None] ** 2 * M + 1j * w[:, None, None] * C
+    res = np.linalg.norm(Z @ u - F, axis=(1, 2))
+    scale = np.linalg.norm(Z, axis=(1, 2)) * np.linalg.norm(u, axis=(1, 2))
+    assert np.max(res / scale) < 1e-14  # backward error at round-off
+    # blocks as input give the same answer; sparse input too
+    blocks = [tridiagonal_blocks(x, b) for x in (K, M, C)]
+    np.testing.assert_array_equal(solve_block_tridiagonal(*blocks, F, w, b), u)
+    u_sp = solve_block_tridiagonal(sp.csr_matrix(K), sp.csr_matrix(M), sp.csr_matrix(C), F, w, b)
+    assert _rel(u_sp, u) < 1e-14
+
+
+def test_block_tridiagonal_800_elements_and_blocks_roundtrip():
+    rng = np.random.default_rng(8)
+    b, n_nodes = 3, 799
+    K, M, C = _block_line(n_nodes, b, rng, damping=0.05)
+    Ks, Ms, Cs = (sp.csr_matrix(x) for x in (K, M, C))
+    w = np.linspace(0.05, 3.0, 9)
+    F = _loads(w.size, n_nodes * b, rng, n_rhs=2)
+    ref = solve_direct(Ks, Ms, Cs, F, w, method="sparse")  # SuperLU, independent
+    u = solve_block_tridiagonal(Ks, Ms, Cs, F, w, b)
+    assert _rel(u, ref) < 1e-8  # two pivoted LUs of a 2397-DOF system (cond ~1e7)
+    d, lo, up = tridiagonal_blocks(Ks, b)
+    np.testing.assert_array_equal(d[1], K[3:6, 3:6])
+    np.testing.assert_array_equal(lo[1], K[3:6, 0:3])
+    np.testing.assert_array_equal(up[1], K[3:6, 6:9])
+    assert not lo[0].any() and not up[-1].any()
+
+
+def test_block_tridiagonal_errors():
+    K, M = _chain(6, k=100.0)
+    w = np.array([0.1, 1.0])
+    F = np.ones((2, 6))
+    with pytest.raises(InputError, match=r"block-tridiagonal with 2x2 blocks"):
+        solve_block_tridiagonal(K + 0.1 * np.eye(6, k=4), M, None, F, w, 2)
+    with pytest.raises(InputError, match=r"multiple of block_size = 4"):
+        solve_block_tridiagonal(K, M, None, F, w, 4)
+    with pytest.raises(InputError, match=r"block-tridiagonal"):
+        tridiagonal_blocks(K + 0.1 * np.eye(6, k=4), 2)
+    wn, _ = modal_basis(K, M)
+    # mode 3 is symmetric (mode 2 is orthogonal to the uniform load and is not hit)
+    with pytest.raises(SolverError, match=rf"omega = {wn[2]:.6g} rad/s.*mode 3"):
+        solve_block_tridiagonal(K, M, None, F, np.array([0.5, wn[2]]), 2)
+    # the 2-D shape of F gives a 2-D answer equal to solve_direct
+    u = solve_block_tridiagonal(K, M, 0.1 * M, F, w, 2)
+    assert u.shape == (2, 6)
+    assert _rel(u, solve_direct(K, M, 0.1 * M, F, w, method="dense")) < 1e-13
