@@ -104,7 +104,8 @@ def wavenumber(omega: ArrayLike, depth: float = np.inf, g: float = G_STANDARD) -
         raise InputError("omega", omega, "rad/s", f"must be >= 0 (entry {i} is {w.ravel()[i]:g})")
     h = _depth(depth)
     g = v.positive("g", g, "m/s²")
-    return _wavenumber(w, h, g)
+    # the in-place kernels need arrays: a scalar ω goes through as shape (1,)
+    return _wavenumber(np.atleast_1d(w), h, g).reshape(w.shape)
 
 
 def _wavenumber(w: np.ndarray, h: float, g: float) -> np.ndarray:

@@ -189,3 +189,13 @@ def test_kinematics_timeseries_variance():
     # w(t) at the surface is dη/dt: compare with the spectral derivative of η
     deta = np.fft.irfft(1j * real.omega * real.coefficients, real.n_samples)
     np.testing.assert_allclose(vel[0, 2], deta, atol=1e-13)
+
+
+@pytest.mark.parametrize("depth", [10.0, np.inf])
+def test_wavenumber_scalar_omega_keeps_scalar_shape(depth):
+    # array_like includes a scalar (found by the hard-case suite: the in-place kernel
+    # failed on 0-d input in finite depth); the residual of ω² = g k tanh(kh) is checked
+    k = wavenumber(0.45, depth)
+    assert np.shape(k) == ()
+    th = 1.0 if np.isinf(depth) else math.tanh(float(k) * depth)
+    assert 9.80665 * float(k) * th == pytest.approx(0.45**2, rel=1e-14)
