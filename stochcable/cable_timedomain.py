@@ -895,7 +895,14 @@ def _integrate(model: _LineModel, xs: np.ndarray, u_cur: np.ndarray, u_wave, f_i
     fd0, _, _ = model.drag(X, V, e, u_cur, jacobian=False)
     fb0, _, _ = model.seabed(X, V)
     R0 = (model.internal_force(X, e, T) - model.f_gravity - fd0 - fb0).reshape(-1)
-    ten_a[0], ten_b[0] = np.linalg.norm(R0[:d]), np.linalg.norm(R0[N - d:])
+    # An end node resting on the seabed: the bed carries the load lumped on it, so the
+    # end tension is the line's own end force, as in the statics (stochcable.statics).
+    fgr = model.f_gravity.reshape(n, d)
+    zbed_tol = 1e-9 * max(model.depth, 1.0)
+    carry_a = fgr[0] if xs[0, -1] <= -model.depth + zbed_tol else np.zeros(d)
+    carry_b = fgr[-1] if xs[-1, -1] <= -model.depth + zbed_tol else np.zeros(d)
+    ten_a[0] = np.linalg.norm(R0[:d] + carry_a)
+    ten_b[0] = np.linalg.norm(R0[N - d:] + carry_b)
     ten_el[0] = T
     M_band_f = model.M_band[:, fr]
     M = model.M_sparse
@@ -976,7 +983,8 @@ def _integrate(model: _LineModel, xs: np.ndarray, u_cur: np.ndarray, u_wave, f_i
         X, V, A = Xn.reshape(n, d).copy(), Vn.reshape(n, d).copy(), An.reshape(n, d).copy()
         pos[k] = X
         # support reactions: the residual rows of the prescribed end nodes
-        ten_a[k], ten_b[k] = np.linalg.norm(R[:d]), np.linalg.norm(R[N - d:])
+        ten_a[k] = np.linalg.norm(R[:d] + carry_a)
+        ten_b[k] = np.linalg.norm(R[N - d:] + carry_b)
         if k % every == 0:
             ten_el[k // every] = T
     return pos, (ten_a, ten_b, ten_el), iters, maxres

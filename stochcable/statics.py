@@ -1000,9 +1000,9 @@ def _fe_result(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
     # lumped on that node, so the end force is the line's own (continuous) end force.
     Ra, Rb = R[0].copy(), R[-1].copy()
     if grounded[0]:
-        Ra[zi] += 0.5 * mesh.l0[0] * mesh.weight[0]
+        Ra[zi] += 0.5 * mesh.l0[0] * mesh.weight[0] - model.node_fz[0]
     if grounded[-1]:
-        Rb[zi] += 0.5 * mesh.l0[-1] * mesh.weight[-1]
+        Rb[zi] += 0.5 * mesh.l0[-1] * mesh.weight[-1] - model.node_fz[-1]
     fa = frame.vec_to_global(Ra)
     fb = frame.vec_to_global(Rb)
     tension = np.where(T > 0.0, T, 0.0)
