@@ -61,7 +61,6 @@ banded Jacobian assembly is specific to the line topology.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -71,7 +70,7 @@ from scipy import sparse
 
 from . import _fft
 from . import _validate as _v
-from .errors import ConvergenceError, InputError, ResolutionWarning
+from .errors import ConvergenceError, InputError, ResolutionWarning, warn
 from .mesh import LineMesh, mesh_line
 from .scene import Environment, Line, Scene, load_scene
 
@@ -798,7 +797,7 @@ def simulate_line_timedomain(
     err = newmark_period_error(wmax, h)
     if err > PERIOD_ERROR_TOLERANCE:
         dt_ok = 2.0 * math.sqrt(3.0 * PERIOD_ERROR_TOLERANCE) / wmax
-        warnings.warn(
+        warn(
             f"time step {h:.4g} s gives a Newmark period error (omega dt)^2/12 = {err:.2%} "
             f"at the highest excitation frequency {wmax:.4g} rad/s (> "
             f"{PERIOD_ERROR_TOLERANCE:.0%}); use dt <= {dt_ok:.4g} s",

@@ -8,6 +8,10 @@ maps :class:`StochcableError` subclasses to HTTP 422 answers.
 
 from __future__ import annotations
 
+import threading
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 __all__ = [
@@ -17,6 +21,8 @@ __all__ = [
     "SolverError",
     "PhysicsWarning",
     "ResolutionWarning",
+    "warn",
+    "collect_warnings",
 ]
 
 
@@ -121,3 +127,51 @@ class PhysicsWarning(UserWarning):
 
 class ResolutionWarning(UserWarning):
     """A discretization (time step, frequency grid, elements) is too coarse for the input."""
+
+
+# ----------------------------------------------------------------- warning collection
+#
+# The analysis reports its warnings in the result document as well as through Python's
+# warnings machinery.  ``warnings.catch_warnings`` is process-global (before Python
+# 3.14), so two analyses in two threads (the service) would lose or swap each other's
+# warnings; a thread-local sink does not.
+
+_local = threading.local()
+
+
+def warn(message: str, category: type[Warning] = PhysicsWarning, stacklevel: int = 2) -> None:
+    """Issue a warning and record it in the calling thread's :func:`collect_warnings`.
+
+    Parameters
+    ----------
+    message : str
+        The warning text: the threshold crossed and the fix.
+    category : type of Warning, optional
+        PhysicsWarning (default), ResolutionWarning or another Warning subclass.
+    stacklevel : int, optional
+        As for :func:`warnings.warn`, counted from the caller of this function.
+    """
+    sinks = getattr(_local, "sinks", None)
+    if sinks:
+        for sink in sinks:
+            sink.append(category(message))
+    warnings.warn(message, category, stacklevel=stacklevel + 1)
+
+
+@contextmanager
+def collect_warnings() -> Iterator[list[Warning]]:
+    """Collect the warnings :func:`warn` issues in this thread inside the block.
+
+    The warnings are still issued normally (shown or filtered by the caller's
+    warning filters); the list is an additional, thread-safe record.  Blocks nest:
+    an inner block's warnings also reach the outer one.
+    """
+    sink: list[Warning] = []
+    sinks = getattr(_local, "sinks", None)
+    if sinks is None:
+        sinks = _local.sinks = []
+    sinks.append(sink)
+    try:
+        yield sink
+    finally:
+        sinks.remove(sink)

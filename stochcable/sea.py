@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 import os
 import threading
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
@@ -35,7 +34,7 @@ from numpy.typing import ArrayLike
 
 from . import _fft
 from . import _validate as v
-from .errors import InputError, ResolutionWarning
+from .errors import InputError, ResolutionWarning, warn
 
 __all__ = [
     "frequency_grid",
@@ -292,7 +291,7 @@ def _nyquist_check(density: Callable, omega_nyq: float, d_omega: float, m0_grid:
         fix = (f"the spectrum still holds more than {NYQUIST_LOSS_TOLERANCE:.1%} of m0 above "
                f"{100 * omega_nyq:.4g} rad/s; use dt <= {math.pi / (100 * omega_nyq):.4g} s "
                "or a spectrum with a decaying tail")
-    warnings.warn(
+    warn(
         f"{frac:.2%} of the spectrum's m0 lies above the Nyquist frequency "
         f"pi/dt = {omega_nyq:.4g} rad/s and is not simulated; {fix}",
         ResolutionWarning,
@@ -360,17 +359,14 @@ def simulate_sea(
         bad = np.flatnonzero(~(np.isfinite(s) & (s >= 0)))[0]
         raise InputError("density", density, "m²·s/rad",
                          f"must return finite values >= 0 (S({omega[bad]:.6g} rad/s) = {s[bad]})")
-    if s is omega or not s.flags.writeable or np.shares_memory(s, omega):
-        s = s.copy()
     m0_grid = float(s[1:n].sum()) * d_omega
     if m0_grid <= 0.0:
         raise InputError("density", density, "m²·s/rad",
                          f"is zero at every grid frequency {d_omega:.4g} … {n * d_omega:.4g} rad/s")
     _nyquist_check(density, n * d_omega, d_omega, m0_grid)
 
-    # amplitude × N_t/2, in place in s (owned)
-    amp = s[1:n]
-    amp *= (2.0 if method_l == "dsa" else 1.0) * d_omega
+    # amplitude × N_t/2 in a new array: the callable's array is never written to
+    amp = s[1:n] * ((2.0 if method_l == "dsa" else 1.0) * d_omega)
     np.sqrt(amp, out=amp)
     amp *= 0.5 * n_t
     u = gen.random(n - 1)

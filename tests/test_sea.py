@@ -284,3 +284,13 @@ def test_long_record_coefficients_parallel_path():
     ref = real.n_samples / 2 * np.sqrt(2 * pm(real.omega[1:n]) * real.d_omega) * np.exp(-1j * theta)
     # table × Taylor series vs libm: < 4 ulp of |X|
     np.testing.assert_allclose(real.coefficients[1:n], ref, rtol=1e-15 * 4, atol=0)
+
+
+def test_simulate_sea_does_not_modify_the_density_array():
+    # "never mutate inputs": a callable returning a cached array (found by the service
+    # helper) must get it back unchanged
+    omega, _ = sea.frequency_grid(64.0, 0.5)
+    cached = spectrum_pierson_moskowitz(omega, 2.0, 8.0)
+    before = cached.copy()
+    sea.simulate_sea(lambda w: cached, 64.0, 0.5, method="nsa", rng=3)
+    np.testing.assert_array_equal(cached, before)
