@@ -19,13 +19,18 @@ from stochcable import __version__
 from . import routers
 from .encoding import NPY
 from .errors import install_error_handlers
-from .limits import BodySizeLimitMiddleware, Runner
+from .limits import BodySizeLimitMiddleware, Runner, ServerTimingMiddleware
 from .settings import Settings
 
-__all__ = ["create_app", "app", "GZIP_MINIMUM_BYTES"]
+__all__ = ["create_app", "app", "GZIP_MINIMUM_BYTES", "GZIP_LEVEL"]
 
 GZIP_MINIMUM_BYTES = 16 * 1024
 """JSON/CSV answers larger than this are gzip-compressed for clients accepting gzip. [bytes]"""
+
+GZIP_LEVEL = 1
+"""gzip level: on the float text of the answers level 1 is 4–5x faster than level 5 for
+a 4 % larger body (chain_catenary result document, 192 kB: 1.7 ms → 94 kB at level 1,
+7.9 ms → 90 kB at level 5; docs/BENCHMARKS.md "Service")."""
 
 _DESCRIPTION = """\
 Frequency-domain stochastic response of marine cables in random seas (stochcable).
@@ -40,8 +45,14 @@ naming the `STOCHCABLE_*` setting) and solver failures; 413 for bodies over
 `STOCHCABLE_MAX_BODY_BYTES`; 504 when queueing plus computation exceed
 `STOCHCABLE_MAX_RUN_SECONDS`.
 
-Large arrays: send `Accept: application/x-npy` (a NumPy .npy structured array) or
-`Accept: text/csv`.
+Analyses: `POST /v1/analyses` takes the scene document (the same as
+`stochcable analyze SCENE.json`; examples at `GET /v1/examples/{name}`) and answers the
+v1 result document, e.g.
+`curl -s localhost:8000/v1/examples/chain_catenary | curl -s -X POST
+localhost:8000/v1/analyses -H 'Content-Type: application/json' -d @-`.
+
+Large arrays: send `Accept: application/x-npy` (a NumPy .npy structured array, without
+the time column: t_n = n·dt) or `Accept: text/csv`.
 """
 
 
@@ -82,10 +93,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     for router in _routers():
         app.include_router(router)
     app.add_middleware(
-        GZipMiddleware, minimum_size=GZIP_MINIMUM_BYTES, compresslevel=5,
+        GZipMiddleware, minimum_size=GZIP_MINIMUM_BYTES, compresslevel=GZIP_LEVEL,
         exclude_content_types=(*DEFAULT_EXCLUDED_CONTENT_TYPES, NPY),
     )
     app.add_middleware(BodySizeLimitMiddleware, max_bytes=settings.max_body_bytes)
+    app.add_middleware(ServerTimingMiddleware)
     return app
 
 

@@ -4,7 +4,8 @@ Content negotiation on ``Accept``:
 
 * ``application/json`` (default, also for ``*/*`` or no header);
 * ``application/x-npy``: one NumPy ``.npy`` file holding a 1-D structured array of
-  float64 columns (``numpy.load(io.BytesIO(body))``; field names as the CSV header);
+  float64 columns (``numpy.load(io.BytesIO(body))``; field names as the CSV header,
+  except that a uniform time column is left out: t_n = n·dt);
 * ``text/csv``: a header row with the column names, then one row per sample
   (``%.17g``, round-trips float64).
 
@@ -113,6 +114,24 @@ def _stats_header(stats: Mapping[str, Any] | None) -> dict[str, str]:
     return {STATS_HEADER: json.dumps(_plain(stats), allow_nan=False, separators=(",", ":"))}
 
 
+class _NpyResponse(Response):
+    """A .npy answer sent as its header then the array's own buffer (no joined copy)."""
+
+    media_type = NPY
+
+    def __init__(self, head: bytes, payload: memoryview, headers: Mapping[str, str]) -> None:
+        super().__init__(b"", media_type=NPY, headers=dict(headers))
+        self._head, self._payload = head, payload
+        self.headers["content-length"] = str(len(head) + payload.nbytes)
+
+    async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
+        await send({"type": "http.response.start", "status": self.status_code,
+                    "headers": self.raw_headers})
+        await send({"type": "http.response.body", "body": self._head, "more_body": True})
+        await send({"type": "http.response.body", "body": self._payload,
+                    "more_body": False})
+
+
 def columns_response(columns: Mapping[str, np.ndarray], media_type: str,
                      stats: Mapping[str, Any] | None = None) -> Response:
     """NPY (structured array) or CSV answer of equal-length float columns."""
@@ -125,15 +144,17 @@ def columns_response(columns: Mapping[str, np.ndarray], media_type: str,
     headers = _stats_header(stats)
     if media_type == NPY:
         dtype = np.dtype([(n, "<f8") for n in names])
-        rec = np.empty(arrays[0].shape[0], dtype=dtype)
-        for n, a in zip(names, arrays):
-            rec[n] = a
+        if len(arrays) == 1 and arrays[0].flags.c_contiguous and arrays[0].dtype == "<f8":
+            rec = arrays[0].view(dtype)  # one column: the same bytes, no copy
+        else:
+            rec = np.empty(arrays[0].shape[0], dtype=dtype)
+            for n, a in zip(names, arrays):
+                rec[n] = a
         head = io.BytesIO()
         np.lib.format.write_array_header_1_0(
             head, {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False,
                    "shape": rec.shape})
-        return Response(head.getvalue() + rec.data.cast("B"), media_type=NPY,
-                        headers=headers)
+        return _NpyResponse(head.getvalue(), rec.data.cast("B"), headers)
     buf = io.StringIO()
     buf.write(",".join(names) + "\n")
     np.savetxt(buf, np.column_stack(arrays), delimiter=",", fmt="%.17g")

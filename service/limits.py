@@ -11,12 +11,15 @@ Policy (documented in the README "Service" section):
   (the rest queue); a request whose queueing plus computation exceeds
   ``max_run_seconds`` answers **504** ``type: "run_time_exceeded"``.  Python cannot stop
   a thread: the computation finishes in the background but keeps its concurrency slot
-  until then, so an overloaded server sheds load instead of piling up work.
+  until then, so an overloaded server sheds load instead of piling up work.  An
+  analysis (``POST /v1/analyses``) stops earlier: its progress callback raises at the
+  next stage or drag-linearization iteration after the deadline.
 """
 
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 import math
 import time
@@ -35,10 +38,12 @@ __all__ = [
     "RunTimeExceeded",
     "BodyTooLarge",
     "BodySizeLimitMiddleware",
+    "ServerTimingMiddleware",
     "check_samples",
     "check_frequencies",
     "check_points",
     "check_elements",
+    "check_scene",
     "sample_count",
     "Runner",
 ]
@@ -135,6 +140,25 @@ def check_elements(count: int, settings: Settings) -> None:
                             f"{count} finite elements")
 
 
+def check_scene(scene: Any, settings: Settings) -> None:
+    """Raise LimitExceeded when an analysis scene asks for more work than the bounds.
+
+    Checked before solving, in this order: total finite elements of all lines
+    (``max_elements``), the analysis frequency count ``analysis.omega.count``
+    (``max_frequencies``) and the time-series length ``analysis.timeseries.duration /
+    dt`` (``max_samples``).
+    """
+    check_elements(sum(line.elements for line in scene.lines), settings)
+    check_frequencies(scene.analysis.omega.count, settings, "analysis.omega.count")
+    ts = scene.analysis.timeseries
+    if ts is not None:
+        n = sample_count(ts.duration, ts.dt)
+        if n > settings.max_samples:
+            raise LimitExceeded("analysis.timeseries.duration", ts.duration,
+                                settings.max_samples, "max_samples",
+                                f"analysis.timeseries duration/dt = {n} samples")
+
+
 # ------------------------------------------------------------------ body size
 
 
@@ -198,6 +222,34 @@ class BodySizeLimitMiddleware:
             await resp(scope, receive, send)
 
 
+class ServerTimingMiddleware:
+    """ASGI middleware adding ``Server-Timing: app;dur=<ms>`` to every answer.
+
+    The duration runs from the request's arrival to the start of the answer: body
+    reading, validation, queueing, computation and encoding; what a client measures
+    beyond it is transfer and its own decoding (benchmarks/bench_service.py).
+    """
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        t0 = time.perf_counter()
+
+        async def timed_send(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                ms = 1e3 * (time.perf_counter() - t0)
+                headers = list(message.get("headers", ()))
+                headers.append((b"server-timing", f"app;dur={ms:.2f}".encode()))
+                message = {**message, "headers": headers}
+            await send(message)
+
+        await self.app(scope, receive, timed_send)
+
+
 # ------------------------------------------------------------- run time bound
 
 
@@ -207,7 +259,9 @@ class Runner:
     One runner per application (``app.state.runner``).  :meth:`run` awaits the result
     or raises :class:`RunTimeExceeded` after ``max_run_seconds`` (queueing included).
     A computation still queued at its deadline never starts; one already running
-    finishes in the background, holding its slot.
+    finishes in the background, holding its slot.  Computations given the same
+    ``exclusive`` name run one at a time, queueing *before* they take a slot, so they
+    never hold slots the other endpoints need while they wait for each other.
     """
 
     def __init__(self, settings: Settings) -> None:
@@ -217,6 +271,7 @@ class Runner:
         self._threads: anyio.CapacityLimiter | None = None
         self._loop: asyncio.AbstractEventLoop | None = None
         self._background: set[asyncio.Future[Any]] = set()
+        self._gates: dict[str, anyio.Lock] = {}
 
     @property
     def limiter(self) -> anyio.CapacityLimiter:
@@ -229,18 +284,37 @@ class Runner:
             # the worker threads get their own pool of the same size, apart from the
             # default one FastAPI uses for sync dependencies
             self._threads = anyio.CapacityLimiter(self.max_concurrency)
+            self._gates = {}
         return self._limiter
 
-    async def run(self, func: Callable[..., T], *args: Any) -> T:
-        """``func(*args)`` in a worker thread, bounded in concurrency and time."""
+    def _gate(self, name: str | None) -> Any:
+        if name is None:
+            return contextlib.nullcontext()
+        if name not in self._gates:
+            self._gates[name] = anyio.Lock()
+        return self._gates[name]
+
+    async def run(self, func: Callable[..., T], *args: Any, strict_fp: bool = True,
+                  exclusive: str | None = None) -> T:
+        """``func(*args)`` in a worker thread, bounded in concurrency and time.
+
+        ``exclusive``: computations of the same name run one at a time (see the class).
+
+        ``strict_fp`` (default) makes floating-point overflow, invalid operations and
+        division by zero raise (see :func:`_checked`); with False the computation runs
+        under numpy's default error state, exactly as the library runs it locally (the
+        analyses: their results must equal ``analyze()``'s, and the core handles its
+        own non-finite intermediates).
+        """
         deadline = time.monotonic() + self.max_run_seconds
         limiter, threads = self.limiter, self._threads
+        gate = self._gate(exclusive)
 
         async def job() -> Any:
-            async with limiter:
+            async with gate, limiter:
                 if time.monotonic() >= deadline:  # timed out while queued: skip
                     return None
-                return await anyio.to_thread.run_sync(_checked, func, *args,
+                return await anyio.to_thread.run_sync(_checked, strict_fp, func, *args,
                                                       limiter=threads)
 
         task = asyncio.ensure_future(job())
@@ -257,15 +331,16 @@ class Runner:
             task.exception()  # retrieved: an abandoned failure is not "never retrieved"
 
 
-def _checked(func: Callable[..., T], *args: Any) -> T:
+def _checked(strict_fp: bool, func: Callable[..., T], *args: Any) -> T:
     """Call ``func`` in the numerical policy of the service.
 
-    Floating-point overflow, invalid operations and division by zero raise instead of
-    producing inf/NaN silently (underflow to zero stays allowed); numpy's errstate is
-    context-local, so this does not leak into other threads.  Arithmetic and plain
-    ValueErrors escaping the core from accepted input (extreme magnitudes such as
-    denormal periods) become :class:`~service.errors.NumericalError` (HTTP 422), logged
-    with their traceback: a client input never answers 500.  Domain errors
+    With ``strict_fp``, floating-point overflow, invalid operations and division by
+    zero raise instead of producing inf/NaN silently (underflow to zero stays allowed);
+    numpy's errstate is context-local, so this does not leak into other threads.
+    Arithmetic and plain ValueErrors escaping the core from accepted input (extreme
+    magnitudes such as denormal periods) become :class:`~service.errors.NumericalError`
+    (HTTP 422), logged with their traceback: a client input never answers 500.  Domain
+    errors
     (:class:`~stochcable.errors.StochcableError`, including InputError) pass unchanged.
     """
     from stochcable.errors import StochcableError
@@ -273,6 +348,8 @@ def _checked(func: Callable[..., T], *args: Any) -> T:
     from .errors import NumericalError
 
     try:
+        if not strict_fp:
+            return func(*args)
         with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
             return func(*args)
     except StochcableError:

@@ -32,6 +32,12 @@ __all__ = [
     "Kinematics",
     "RealizationResponse",
     "ExampleSummary",
+    "TensionStatistics",
+    "EndResult",
+    "LineLinearization",
+    "LineDocument",
+    "TimeSeriesDocument",
+    "AnalysisResponse",
     "default_omega",
     "DEFAULT_OMEGA_COUNT",
 ]
@@ -52,6 +58,11 @@ class _Request(BaseModel):
 
 class _Response(BaseModel):
     model_config = ConfigDict(frozen=True)
+
+
+class _Open(BaseModel):
+    # parts of the result document: more fields may be added (DESIGN.md v1 contract)
+    model_config = ConfigDict(frozen=True, extra="allow")
 
 
 # ---------------------------------------------------------------------- errors
@@ -244,3 +255,149 @@ class ExampleSummary(_Response):
 
     name: str = Field(description="Name to use in GET /v1/examples/{name}")
     title: str = Field(description="The scene's title")
+
+
+# -------------------------------------------------------------------- analyses
+#
+# The result document is built by the core (stochcable.results.Result.to_document);
+# these models only document it (the route serializes the core's dict directly).
+# Every part allows extra fields: the v1 contract lets the core add fields, never
+# rename them.  Keyed by line name where the structure is dynamic.
+
+
+class TensionStatistics(_Open):
+    """Statistics of an end's effective tension: static mean plus Gaussian dynamic part
+    (seed 001 §5.3; stochcable.results.ResponseStats)."""
+
+    mean: float = _f("Static (mean) effective tension", "N")
+    std: float = _f("Standard deviation σ = √m0 of the dynamic tension", "N")
+    tz: float = _f("Mean zero-upcrossing period 2π√(m0/m2); 0 for a zero process", "s")
+    mpm_3h: float = _f("mean + Rayleigh most probable maximum of the dynamic part over "
+                       "three hours, σ√(2 ln(10800/Tz))", "N")
+    significant: float | None = _f("Significant value 2σ", "N", default=None)
+    m0: float | None = _f("Zeroth spectral moment", "N²", default=None)
+    m1: float | None = _f("First spectral moment", "N²·rad/s", default=None)
+    m2: float | None = _f("Second spectral moment", "N²·(rad/s)²", default=None)
+    m4: float | None = _f("Fourth spectral moment", "N²·(rad/s)⁴", default=None)
+    bandwidth: float | None = _f("Spectral bandwidth √(1 − m2²/(m0·m4))", "-", default=None)
+    mpm: float | None = _f("mean + most probable maximum over analysis.duration", "N",
+                           default=None)
+    expected_max: float | None = _f("mean + expected maximum over analysis.duration", "N",
+                                    default=None)
+
+
+class EndResult(_Open):
+    """Dynamic response at one end (support) of a line."""
+
+    tension: TensionStatistics
+    force_std: list[float] | None = _f("σ of the x, y, z force on the support", "N",
+                                       default=None)
+
+
+class TensionAlongLine(_Open):
+    """Effective tension along the line, per element."""
+
+    s: list[float] = _f("Unstretched arc length of the element midpoints from end_a", "m")
+    std: list[float] = _f("σ of the dynamic effective tension", "N")
+    mean: list[float] | None = _f("Static effective tension", "N", default=None)
+
+
+class MotionAlongLine(_Open):
+    """Node motions along the line."""
+
+    s: list[float] = _f("Unstretched arc length of the nodes from end_a", "m")
+    std: list[list[float]] = _f("σ of the x, y, z node displacements, per node", "m")
+
+
+class LineLinearization(_Open):
+    """Drag-linearization fixed point of one line (seed 001 §5.3 steps 5–13)."""
+
+    converged: bool = Field(description="Whether every σ changed less than the tolerance")
+    iterations: int = _f("Number of response evaluations", "-")
+    relative_change: float = _f("Final largest relative change of the σ", "-")
+    method: str | None = Field(default=None, description="seed, vector or harmonic")
+    tolerance: float | None = _f("Tolerance asked for", "-", default=None)
+    history: list[float] | None = _f("Relative change after each iteration", "-",
+                                     default=None)
+
+
+class LineModes(_Open):
+    """Natural frequencies of one line about its static shape."""
+
+    omega: list[float] = _f("Natural frequencies listed (with added mass)", "rad/s")
+    kept: int | None = _f("Modes kept by the Foss solve; null for the direct solve", "-",
+                          default=None)
+
+
+class LineDocument(_Open):
+    """Frequency-domain response of one line: statistics, distributions, spectra."""
+
+    end_a: EndResult
+    end_b: EndResult
+    tension: TensionAlongLine
+    motion: MotionAlongLine
+    spectra: dict[str, Any] | None = Field(
+        default=None, description="omega [rad/s] and the one-sided end-tension spectra "
+        "{end_a: {tension: [...]}, end_b: ...} [N²·s/rad]")
+    channels: list[str] | None = Field(default=None,
+                                       description="Independent input channels (sea, "
+                                       "end_b.surge, ...)")
+    linearization: LineLinearization | None = None
+    modes: LineModes | None = None
+
+
+class ModesSummary(_Open):
+    """Natural frequencies: of the first line, and by line name."""
+
+    omega: list[float] = _f("Natural frequencies of the first line", "rad/s")
+    lines: dict[str, list[float]] | None = _f("Natural frequencies by line name", "rad/s",
+                                              default=None)
+
+
+class LinearizationSummary(_Open):
+    """Aggregate drag-linearization record over the lines."""
+
+    converged: bool = Field(description="Whether the linearization converged on every line")
+    iterations: int = _f("Largest number of iterations of a line", "-")
+    relative_change: float = _f("Largest final relative change", "-")
+    lines: dict[str, LineLinearization] | None = None
+
+
+class StaticsDocument(_Open):
+    """Static equilibrium by line name: end tensions and forces [N], touchdown arc
+    length [m] (null when the line does not touch the seabed), node positions [m]."""
+
+    lines: dict[str, dict[str, Any]]
+
+
+class TimeSeriesDocument(_Open):
+    """A window (or all) of one realization of the sea and of the responses."""
+
+    method: str = Field(description="dsa or nsa")
+    seed: int = Field(description="Root random seed")
+    dt: float = _f("Time step", "s")
+    samples: int = _f("Length of the whole realization", "-")
+    window: int = _f("Samples in this document", "-")
+    time: list[float] = _f("Sample times", "s")
+    elevation: list[float] | None = _f("Wave elevation at the origin; null without a sea",
+                                       "m")
+    end_motion: dict[str, list[float]] = _f("Prescribed end motions by channel "
+                                            "(line.end_b.surge, ...)", "m or rad")
+    lines: dict[str, dict[str, dict[str, list[float]]]] = _f(
+        "Total end tensions {line: {end_a: {tension: [...]}, end_b: ...}}", "N")
+
+
+class AnalysisResponse(_Open):
+    """The v1 result document (DESIGN.md "Scene and result documents"), identical to
+    ``stochcable analyze SCENE.json`` and to ``analyze(scene).to_document()``."""
+
+    statics: StaticsDocument
+    modes: ModesSummary
+    linearization: LinearizationSummary
+    lines: dict[str, LineDocument] = Field(description="Response by line name")
+    timing: dict[str, float] = _f("Wall-clock time per stage (total_s, statics_s, ...)", "s")
+    warnings: list[str] = Field(description="Physics and resolution warnings of the "
+                                            "analysis (threshold and fix in each message)")
+    timeseries: TimeSeriesDocument | None = Field(
+        default=None, description="Present when the scene has analysis.timeseries and the "
+        "timeseries query parameter is not none")

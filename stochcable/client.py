@@ -7,8 +7,16 @@
 5.997...
 
 Methods return the objects of the local API where one exists
-(:class:`~stochcable.spectra.SpectrumStatistics`, :class:`~stochcable.scene.Scene`)
-and small frozen dataclasses of numpy arrays otherwise.  An HTTP failure raises
+(:class:`~stochcable.spectra.SpectrumStatistics`, :class:`~stochcable.scene.Scene`,
+:class:`~stochcable.results.ResponseStats`) and small frozen dataclasses of numpy
+arrays otherwise.  :meth:`Client.analyze` returns an :class:`AnalysisDocument`: the
+result document (a read-only mapping, exactly ``analyze(scene).to_document()``) with
+typed accessors named as on the local :class:`~stochcable.results.Result`::
+
+    >>> with Client() as c:                                    # doctest: +SKIP
+    ...     res = c.analyze(c.example("chain_catenary"))
+    ...     res.lines["leg1"].end_b.std, res.lines["leg1"].tension_std.max()
+  An HTTP failure raises
 :class:`ClientError` (4xx: the request was refused; the message names the field,
 value, unit and constraint) or :class:`ServiceError` (5xx, or the service cannot be
 reached), both :class:`~stochcable.errors.StochcableError`.
@@ -19,14 +27,17 @@ from __future__ import annotations
 import io
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import httpx
 import numpy as np
 
 from .errors import StochcableError
+from .results import ResponseStats
 from .scene import G_STANDARD, OmegaGrid, Scene
 from .spectra import SpectrumStatistics
 
@@ -37,10 +48,14 @@ __all__ = [
     "SpectrumResult",
     "RealizationResult",
     "ExampleInfo",
+    "AnalysisDocument",
+    "LineDocument",
+    "TimeSeriesWindow",
 ]
 
 _NPY = "application/x-npy"
 _STATS_HEADER = "X-Stochcable-Stats"
+_WARNINGS_HEADER = "X-Stochcable-Warnings"
 
 
 class ServiceError(StochcableError):
@@ -94,10 +109,10 @@ class RealizationResult:
 
     Attributes
     ----------
-    time : numpy.ndarray
-        Sample times, shape (N_t,). [s]
     elevation : numpy.ndarray
         Surface elevation, shape (N_t,). [m]
+    dt : float
+        Time step. [s]
     variance : float
         Mean square of the elevation. [m²]
     m0 : float
@@ -106,19 +121,22 @@ class RealizationResult:
         Wave velocity at the points, shape (n_points, 3, N_t). [m/s]
     acceleration : numpy.ndarray or None
         Wave acceleration at the points, shape (n_points, 3, N_t). [m/s²]
+    time : numpy.ndarray
+        Sample times t_n = n·dt, shape (N_t,), computed on first access (as
+        :attr:`stochcable.sea.SeaRealization.time`). [s]
     """
 
-    time: np.ndarray
     elevation: np.ndarray
+    dt: float
     variance: float
     m0: float
     velocity: np.ndarray | None = None
     acceleration: np.ndarray | None = None
 
-    @property
-    def dt(self) -> float:
-        """Time step. [s]"""
-        return float(self.time[1] - self.time[0])
+    @cached_property
+    def time(self) -> np.ndarray:
+        """Sample times t_n = n·dt. [s]"""
+        return self.dt * np.arange(self.elevation.shape[-1])
 
 
 @dataclass(frozen=True)
@@ -127,6 +145,258 @@ class ExampleInfo:
 
     name: str
     title: str
+
+
+def _array(value: Any) -> np.ndarray:
+    return np.asarray(value, dtype=float)
+
+
+def _response_stats(doc: Mapping[str, Any]) -> ResponseStats:
+    """The core's ResponseStats from its ``as_dict()`` (JSON floats round-trip)."""
+    from dataclasses import fields
+
+    return ResponseStats(**{f.name: float(doc[f.name]) for f in fields(ResponseStats)})
+
+
+@dataclass(frozen=True, eq=False)
+class LineDocument:
+    """One line of an analysis result, named as on :class:`~stochcable.results.LineResult`.
+
+    Attributes
+    ----------
+    name : str
+        Line name.
+    end_a, end_b : ResponseStats
+        Statistics of the end tensions (the core's objects, equal to the local ones). [N]
+    end_a_force_std, end_b_force_std : numpy.ndarray
+        σ of the x, y, z force on each support, shape (3,). [N]
+    s_elements : numpy.ndarray
+        Arc length of the element midpoints from end_a. [m]
+    tension_mean, tension_std : numpy.ndarray
+        Static effective tension and σ of its dynamic part per element. [N]
+    s_nodes : numpy.ndarray
+        Arc length of the nodes from end_a. [m]
+    motion_std : numpy.ndarray
+        σ of the x, y, z node displacements, shape (n_nodes, 3). [m]
+    omega : numpy.ndarray
+        Analysis frequencies. [rad/s]
+    channels : tuple of str
+        Independent input channels (``"sea"``, ``"end_b.surge"``, ...).
+    listed_modes : numpy.ndarray
+        Natural frequencies listed in the document. [rad/s]
+    n_modes : int or None
+        Modes kept by the Foss solve (None for the direct solve). [-]
+    linearization : dict
+        The line's drag-linearization record (converged, iterations, ...).
+    document : dict
+        The line's part of the result document.
+    """
+
+    name: str
+    end_a: ResponseStats
+    end_b: ResponseStats
+    end_a_force_std: np.ndarray
+    end_b_force_std: np.ndarray
+    s_elements: np.ndarray
+    tension_mean: np.ndarray
+    tension_std: np.ndarray
+    s_nodes: np.ndarray
+    motion_std: np.ndarray
+    omega: np.ndarray
+    channels: tuple[str, ...]
+    listed_modes: np.ndarray
+    n_modes: int | None
+    linearization: Mapping[str, Any]
+    document: Mapping[str, Any]
+
+    def end_tension_spectrum(self, end: str) -> np.ndarray:
+        """One-sided spectrum of the tension at ``end`` ("end_a" or "end_b"). [N²·s/rad]"""
+        return _array(self.document["spectra"][end]["tension"])
+
+    @property
+    def end_b_tension_std(self) -> float:
+        """σ of the dynamic tension at end_b (the fairlead, usually). [N]"""
+        return self.end_b.std
+
+    @property
+    def end_a_tension_std(self) -> float:
+        """σ of the dynamic tension at end_a. [N]"""
+        return self.end_a.std
+
+    @classmethod
+    def from_document(cls, name: str, doc: Mapping[str, Any]) -> "LineDocument":
+        """Build from the line's part of the result document."""
+        tension, motion = doc["tension"], doc["motion"]
+        spectra = doc.get("spectra") or {}
+        modes = doc.get("modes") or {}
+        return cls(
+            name=name,
+            end_a=_response_stats(doc["end_a"]["tension"]),
+            end_b=_response_stats(doc["end_b"]["tension"]),
+            end_a_force_std=_array(doc["end_a"].get("force_std", ())),
+            end_b_force_std=_array(doc["end_b"].get("force_std", ())),
+            s_elements=_array(tension["s"]),
+            tension_mean=_array(tension.get("mean", ())),
+            tension_std=_array(tension["std"]),
+            s_nodes=_array(motion["s"]),
+            motion_std=_array(motion["std"]).reshape(-1, 3),
+            omega=_array(spectra.get("omega", ())),
+            channels=tuple(doc.get("channels", ())),
+            listed_modes=_array(modes.get("omega", ())),
+            n_modes=modes.get("kept"),
+            linearization=doc.get("linearization", {}),
+            document=doc,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class TimeSeriesWindow:
+    """The time series of an analysis document (a window, or all with ``"full"``).
+
+    Attributes
+    ----------
+    time : numpy.ndarray
+        Sample times, shape (window,). [s]
+    elevation : numpy.ndarray or None
+        Wave elevation at the origin (None without a sea). [m]
+    end_motion : dict of numpy.ndarray
+        ``{"line.end_b.surge": series}`` prescribed end motions. [m or rad]
+    end_tension : dict
+        ``{line: {"end_a": series, "end_b": series}}`` total tensions. [N]
+    method : str
+        ``"dsa"`` or ``"nsa"``.
+    seed : int
+        Root random seed.
+    dt : float
+        Time step. [s]
+    samples : int
+        Length of the whole realization (the window may be shorter). [-]
+    """
+
+    time: np.ndarray
+    elevation: np.ndarray | None
+    end_motion: dict[str, np.ndarray]
+    end_tension: dict[str, dict[str, np.ndarray]]
+    method: str
+    seed: int
+    dt: float
+    samples: int
+
+    @classmethod
+    def from_document(cls, doc: Mapping[str, Any]) -> "TimeSeriesWindow":
+        """Build from the ``timeseries`` part of the result document."""
+        elev = doc.get("elevation")
+        return cls(
+            time=_array(doc["time"]),
+            elevation=None if elev is None else _array(elev),
+            end_motion={k: _array(v) for k, v in doc.get("end_motion", {}).items()},
+            end_tension={line: {end: _array(v["tension"]) for end, v in ends.items()}
+                         for line, ends in doc.get("lines", {}).items()},
+            method=str(doc["method"]), seed=int(doc["seed"]), dt=float(doc["dt"]),
+            samples=int(doc["samples"]),
+        )
+
+
+class AnalysisDocument(Mapping[str, Any]):
+    """The result document of ``POST /v1/analyses`` with typed accessors.
+
+    A read-only mapping equal to ``analyze(scene).to_document(timeseries)`` of the
+    local API (apart from the ``timing`` values), plus accessors named as on
+    :class:`~stochcable.results.Result`: ``lines[name]`` is a :class:`LineDocument`
+    (``.end_b`` the core's :class:`~stochcable.results.ResponseStats`,
+    ``.tension_std`` a numpy array, ...), ``timeseries`` a :class:`TimeSeriesWindow`.
+    Transfer functions and full response spectra are not in the document: run
+    :func:`stochcable.analysis.analyze` locally for those.
+
+    Attributes
+    ----------
+    document : dict
+        The parsed JSON document.
+    lines : dict of LineDocument
+        Response by line name.
+    timeseries : TimeSeriesWindow or None
+        The time series, when the scene asks for them and ``timeseries != "none"``.
+    warnings : tuple of str
+        Warnings of the analysis.
+    """
+
+    def __init__(self, document: Mapping[str, Any]) -> None:
+        self._doc = dict(document)
+        self.lines: dict[str, LineDocument] = {
+            name: LineDocument.from_document(name, part)
+            for name, part in self._doc["lines"].items()
+        }
+        ts = self._doc.get("timeseries")
+        self.timeseries = None if ts is None else TimeSeriesWindow.from_document(ts)
+        self.warnings: tuple[str, ...] = tuple(self._doc.get("warnings", ()))
+
+    # Mapping interface: the document itself
+    def __getitem__(self, key: str) -> Any:
+        return self._doc[key]
+
+    def __iter__(self):
+        return iter(self._doc)
+
+    def __len__(self) -> int:
+        return len(self._doc)
+
+    def __repr__(self) -> str:
+        return (f"AnalysisDocument(lines={list(self.lines)}, converged={self.converged}, "
+                f"warnings={len(self.warnings)})")
+
+    @property
+    def document(self) -> dict[str, Any]:
+        """The parsed JSON result document."""
+        return self._doc
+
+    @property
+    def converged(self) -> bool:
+        """Whether the drag linearization converged on every line."""
+        return bool(self._doc["linearization"]["converged"])
+
+    @property
+    def linearization(self) -> dict[str, Any]:
+        """Aggregate record: converged on all lines, max iterations, max change."""
+        return self._doc["linearization"]
+
+    @property
+    def statics(self) -> dict[str, Any]:
+        """The ``statics`` part: end tensions, touchdown, node positions by line."""
+        return self._doc["statics"]
+
+    @property
+    def timing(self) -> dict[str, float]:
+        """Wall-clock seconds per stage, measured on the server. [s]"""
+        return self._doc["timing"]
+
+
+_WIDE_READ_BYTES = 4 << 20
+
+
+@contextmanager
+def _wide_reads(resp: httpx.Response) -> Iterator[None]:
+    """While reading ``resp``'s body, read the socket 4 MiB at a time.
+
+    httpcore reads HTTP/1.1 bodies 64 KiB at a time and h11 copies its buffer on every
+    read: an 8 MiB .npy answer then costs about 40 ms of client CPU, against 5-10 ms
+    with 1-4 MiB reads (docs/BENCHMARKS.md "Service").  The size is set on the
+    connection object carrying this response only, and restored afterwards (small
+    answers keep small reads); when httpx/httpcore internals differ, nothing changes.
+    """
+    conn: Any = resp.stream
+    for attr in ("_stream", "_httpcore_stream", "_stream", "_connection"):
+        conn = getattr(conn, attr, None)
+        if conn is None:
+            break
+    before = getattr(conn, "READ_NUM_BYTES", None)
+    if not isinstance(before, int):
+        yield
+        return
+    conn.READ_NUM_BYTES = max(before, _WIDE_READ_BYTES)
+    try:
+        yield
+    finally:
+        conn.READ_NUM_BYTES = before
 
 
 def _load_npy(content: bytes) -> np.ndarray:
@@ -209,7 +479,16 @@ class Client:
         if accept == _NPY:
             headers["Accept-Encoding"] = "identity"  # float noise does not compress
         try:
-            resp = self._http.request(method, path, json=json_body, headers=headers)
+            request = self._http.build_request(method, path, json=json_body, headers=headers)
+            resp = self._http.send(request, stream=True)
+            try:
+                if accept == _NPY:
+                    with _wide_reads(resp):
+                        resp.read()
+                else:
+                    resp.read()
+            finally:
+                resp.close()
         except httpx.TimeoutException as exc:
             raise ServiceError(None, f"{method} {self.base_url}{path} timed out ({exc})") from None
         except httpx.TransportError as exc:
@@ -302,13 +581,14 @@ class Client:
                 vel = np.array([[rec[f"velocity_{p}_{a}"] for a in "xyz"] for p in range(n)])
                 acc = np.array([[rec[f"acceleration_{p}_{a}"] for a in "xyz"]
                                 for p in range(n)])
-            return RealizationResult(np.ascontiguousarray(rec["time"]),
-                                     np.ascontiguousarray(rec["elevation"]),
-                                     float(stats["variance"]), float(stats["m0"]), vel, acc)
+            # the .npy answer has no time column: t_n = n·dt (RealizationResult.time)
+            elevation = np.ascontiguousarray(rec["elevation"])  # a view for one column
+            return RealizationResult(elevation, float(dt), float(stats["variance"]),
+                                     float(stats["m0"]), vel, acc)
         data = resp.json()
         kin = data.get("kinematics")
         return RealizationResult(
-            np.asarray(data["time"], dtype=float), np.asarray(data["elevation"], dtype=float),
+            np.asarray(data["elevation"], dtype=float), float(dt),
             float(data["stats"]["variance"]), float(data["stats"]["m0"]),
             None if kin is None else np.asarray(kin["velocity"], dtype=float),
             None if kin is None else np.asarray(kin["acceleration"], dtype=float),
@@ -325,3 +605,40 @@ class Client:
 
         data = self._request("GET", f"/v1/examples/{quote(name, safe='')}").json()
         return Scene.model_validate(data)
+
+    def analyze(self, scene: Scene | Mapping[str, Any],
+                timeseries: str = "window") -> AnalysisDocument:
+        """``POST /v1/analyses``: run the analysis of a scene on the service.
+
+        Parameters
+        ----------
+        scene : Scene or mapping
+            The scene document (:class:`~stochcable.scene.Scene`, a dict, or
+            ``client.example(name)``).
+        timeseries : {"window", "full", "none"}
+            Time series in the document: the first 2048 samples, all, or none.
+
+        Returns
+        -------
+        AnalysisDocument
+            The result document (equal to ``analyze(scene).to_document(timeseries)``
+            apart from timing) with typed accessors.
+
+        Raises
+        ------
+        ClientError
+            422: invalid scene (field path, unit, constraint), a size bound exceeded,
+            or the solver failed (e.g. the drag linearization did not converge: the
+            message says why and what to change).
+        ServiceError
+            504 when the analysis exceeds the service's run-time bound, 5xx, timeout
+            or unreachable service.
+        """
+        if timeseries not in ("window", "full", "none"):
+            from .errors import InputError
+
+            raise InputError("timeseries", timeseries, "-",
+                             "must be 'window', 'full' or 'none'")
+        body = scene.model_dump(mode="json") if isinstance(scene, Scene) else _document(scene)
+        resp = self._request("POST", f"/v1/analyses?timeseries={timeseries}", json_body=body)
+        return AnalysisDocument(resp.json())

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shlex
 import socket
 import subprocess
 import sys
@@ -23,8 +24,23 @@ def _free_port() -> int:
 def test_banner_names_the_docs_and_an_example():
     text = banner("127.0.0.1", 8000)
     assert "http://127.0.0.1:8000/docs" in text
-    assert "curl http://127.0.0.1:8000/v1/examples" in text
+    assert ("curl -s http://127.0.0.1:8000/v1/examples/chain_catenary | curl -s -X POST "
+            "http://127.0.0.1:8000/v1/analyses -H 'Content-Type: application/json' -d @-"
+            in text)
     assert "http://[::1]:8000/docs" in banner("::1", 8000)
+    # a wildcard bind address is announced, but the example request goes to loopback
+    assert "curl -s http://127.0.0.1:80/v1/examples" in banner("0.0.0.0", 80)
+
+
+def _run_banner_pipeline(line: str) -> httpx.Response:
+    """Execute the banner's ``curl A | curl -X POST B -H H -d @-`` with httpx."""
+    get, post = (shlex.split(part) for part in line.split("try:", 1)[1].split("|"))
+    assert get[:2] == ["curl", "-s"] and post[:4] == ["curl", "-s", "-X", "POST"]
+    scene = httpx.get(get[2], timeout=30.0)
+    assert scene.status_code == 200, scene.text
+    name, value = post[post.index("-H") + 1].split(": ")
+    assert post[-2:] == ["-d", "@-"]
+    return httpx.post(post[4], content=scene.content, headers={name: value}, timeout=60.0)
 
 
 def test_bad_port_is_a_one_line_error(capsys):
@@ -35,7 +51,7 @@ def test_bad_port_is_a_one_line_error(capsys):
 
 def test_serve_starts_uvicorn_and_answers():
     port = _free_port()
-    env = {**os.environ, "STOCHCABLE_MAX_SAMPLES": "1024"}
+    env = {**os.environ, "STOCHCABLE_MAX_SAMPLES": "4096"}
     proc = subprocess.Popen(
         [sys.executable, "-m", "stochcable", "serve", "--port", str(port),
          "--log-level", "warning"],
@@ -44,6 +60,7 @@ def test_serve_starts_uvicorn_and_answers():
     try:
         first = proc.stderr.readline()
         assert f"docs at http://127.0.0.1:{port}/docs" in first
+        example = proc.stderr.readline()
         deadline = time.monotonic() + 15.0
         while True:
             try:
@@ -57,8 +74,12 @@ def test_serve_starts_uvicorn_and_answers():
         # the worker read the limits from the environment
         resp = httpx.post(f"http://127.0.0.1:{port}/v1/sea/realizations", json={
             "spectrum": {"type": "jonswap", "hs": 2.0, "tp": 8.0},
-            "duration": 2048.0, "dt": 1.0})
-        assert "limit of 1024 (STOCHCABLE_MAX_SAMPLES)" in resp.text
+            "duration": 8192.0, "dt": 1.0})
+        assert "limit of 4096 (STOCHCABLE_MAX_SAMPLES)" in resp.text
+        # the example request the start-up message shows works as printed
+        resp = _run_banner_pipeline(example)
+        assert resp.status_code == 200, resp.text
+        assert resp.json()["lines"]["leg1"]["end_b"]["tension"]["std"] > 0
     finally:
         proc.terminate()
         proc.wait(10.0)

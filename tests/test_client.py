@@ -3,19 +3,25 @@ client returns the same objects and numbers as the local API and clear errors.""
 
 from __future__ import annotations
 
+import json
 import socket
 import threading
 import time
 
+import httpx
 import numpy as np
 import pytest
 import uvicorn
 
 import stochcable
+import stochcable.errors
 from service.app import create_app
 from service.settings import Settings
-from stochcable.client import Client, ClientError, ServiceError
+from stochcable.analysis import analyze
+from stochcable.client import AnalysisDocument, Client, ClientError, ServiceError
+from stochcable.examples import load_example
 from stochcable.kinematics import kinematics_timeseries
+from stochcable.results import ResponseStats
 from stochcable.scene import Jonswap, OmegaGrid, Scene
 from stochcable.sea import simulate_sea
 from stochcable.spectra import SpectrumStatistics, spectrum_statistics
@@ -33,7 +39,8 @@ def _free_port() -> int:
 def base_url():
     port = _free_port()
     config = uvicorn.Config(create_app(Settings(max_samples=2**16)), host="127.0.0.1",
-                            port=port, log_level="warning", lifespan="off")
+                            port=port, log_level="warning", lifespan="off",
+                            timeout_graceful_shutdown=2)
     server = uvicorn.Server(config)
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
@@ -121,3 +128,111 @@ def test_examples(client):
     assert isinstance(scene, Scene) and scene == examples.load_example(names[0])
     with pytest.raises(ClientError, match=r"HTTP 404: unknown example 'nope'; known examples"):
         client.example("nope")
+
+
+# ------------------------------------------------------------------ analyses
+
+
+@pytest.fixture(scope="module")
+def chain_local():
+    return analyze(load_example("chain_catenary"))
+
+
+def _without_timing(doc) -> dict:
+    out = json.loads(json.dumps(dict(doc)))
+    out.pop("timing")
+    return out
+
+
+def test_readme_pipeline_get_the_example_and_post_it(base_url, chain_local):
+    # curl -s .../v1/examples/chain_catenary | curl -s -X POST .../v1/analyses
+    #      -H 'Content-Type: application/json' -d @-      (the start-up message)
+    scene = httpx.get(f"{base_url}/v1/examples/chain_catenary", timeout=30.0).content
+    resp = httpx.post(f"{base_url}/v1/analyses", content=scene, timeout=60.0,
+                      headers={"Content-Type": "application/json"})
+    assert resp.status_code == 200, resp.text
+    assert _without_timing(resp.json()) == _without_timing(chain_local.to_document())
+
+
+def test_analyze_returns_the_local_objects(client, chain_local):
+    res = client.analyze(client.example("chain_catenary"))
+    assert isinstance(res, AnalysisDocument)
+    # the document itself equals the local one (JSON floats round-trip exactly)
+    assert _without_timing(res) == _without_timing(chain_local.to_document())
+    line, local = res.lines["leg1"], chain_local.lines["leg1"]
+    assert isinstance(line.end_b, ResponseStats)
+    assert line.end_b == local.end_b and line.end_a == local.end_a
+    assert line.end_b_tension_std == local.end_b.std > 0
+    for name in ("tension_std", "tension_mean", "s_elements", "s_nodes", "motion_std",
+                 "omega", "listed_modes"):
+        assert np.array_equal(getattr(line, name), getattr(local, name)), name
+    assert np.array_equal(line.end_tension_spectrum("end_b"),
+                          local.end_tension_spectrum("end_b"))
+    assert line.channels == local.channels and line.n_modes == local.n_modes
+    assert res.converged and res.warnings == chain_local.warnings
+    ts, local_ts = res.timeseries, chain_local.timeseries
+    n = ts.time.size  # the first 2048 samples of 2400
+    assert n == 2048 and ts.samples == local_ts.time.size
+    assert np.array_equal(ts.elevation, local_ts.elevation[:n])
+    assert np.array_equal(ts.end_tension["leg1"]["end_b"],
+                          local_ts.end_tension["leg1"]["end_b"][:n])
+
+
+def test_analyze_from_a_plain_document_without_timeseries(client):
+    doc = load_example("taut_wire").model_dump(mode="json")
+    res = client.analyze(doc, timeseries="none")
+    assert res.timeseries is None and "timeseries" not in res
+    assert res.lines["wire"].end_b == analyze(doc).lines["wire"].end_b
+
+
+def test_analyze_unconverged_raises_client_error_with_the_reason(client):
+    doc = load_example("tuah_1982_single_leg").model_dump(mode="json")
+    doc["analysis"]["linearization"]["max_iterations"] = 1
+    with pytest.raises(ClientError, match=r"HTTP 422: drag linearization of line 'leg' did "
+                                          r"not converge.*max_iterations") as info:
+        client.analyze(doc)
+    assert info.value.detail[0]["type"] == "convergence_error"
+
+
+def test_analyze_bad_timeseries_mode_is_refused_locally(client):
+    with pytest.raises(stochcable.errors.InputError, match="timeseries = 'all'"):
+        client.analyze({}, timeseries="all")
+
+
+def test_analyze_timeout_raises_service_error(base_url):
+    with Client(base_url, timeout=0.001) as c:
+        with pytest.raises(ServiceError, match="timed out") as info:
+            c.analyze(load_example("chain_catenary"))
+    assert info.value.status is None and not isinstance(info.value, ClientError)
+
+
+def test_binary_answers_are_read_in_wide_socket_reads(base_url, monkeypatch):
+    # httpcore's default 64 KiB reads cost ~4x the time of the 8 MiB .npy transfer
+    # (docs/BENCHMARKS.md "Service"); this fails when httpx/httpcore internals change
+    # so that the client's widening no longer applies
+    import stochcable.client as client_module
+
+    seen = []
+    original = client_module._wide_reads
+
+    def spy(resp):
+        cm = original(resp)
+
+        class Watch:
+            def __enter__(self):
+                cm.__enter__()
+                conn = resp.stream._stream._httpcore_stream._stream._connection
+                seen.append(conn.READ_NUM_BYTES)
+
+            def __exit__(self, *exc):
+                return cm.__exit__(*exc)
+
+        return Watch()
+
+    monkeypatch.setattr(client_module, "_wide_reads", spy)
+    with Client(base_url, timeout=30.0) as c:
+        res = c.realization(JONSWAP, duration=64.0, dt=0.25)
+        conns = [pc._connection for pc in c._http._transport._pool.connections]
+    assert seen == [4 << 20] and res.elevation.size == 256
+    # restored afterwards: JSON answers on the same connection keep 64 KiB reads
+    assert [x.READ_NUM_BYTES for x in conns] == [64 * 1024]

@@ -14,6 +14,7 @@ OPERATIONS = {
     ("post", "/v1/sea/realizations"): "simulate_sea",
     ("get", "/v1/examples"): "list_examples",
     ("get", "/v1/examples/{name}"): "get_example",
+    ("post", "/v1/analyses"): "run_analysis",
 }
 
 
@@ -61,6 +62,7 @@ def test_every_numeric_field_states_its_unit():
     # integer identifiers without a physical unit, error locations, and the scene's
     # ComplexTable whose unit depends on where it is used (stochcable/scene.py)
     allowed = {"TimeSeriesSettings.seed", "RealizationRequest.seed", "AnalysisSettings.modes",
+               "TimeSeriesDocument.seed",
                "ErrorItem.loc", "ValidationError.loc", "ComplexTable.re", "ComplexTable.im"}
     assert sorted(set(missing) - allowed) == []
 
@@ -72,3 +74,22 @@ def test_error_answers_are_documented():
         assert code in post
     assert post["422"]["content"]["application/json"]["schema"]["$ref"].endswith("ErrorResponse")
     assert "application/x-npy" in post["200"]["content"]
+
+
+def test_analyses_are_documented_with_the_scene_and_the_result_models():
+    doc = openapi_document()
+    post = doc["paths"]["/v1/analyses"]["post"]
+    body = post["requestBody"]["content"]["application/json"]
+    assert body["schema"]["$ref"].endswith("/Scene")  # the core's model, not a copy
+    assert "chain_catenary" in body["examples"]  # "Try it out" in /docs runs an example
+    ok = post["responses"]["200"]
+    assert ok["content"]["application/json"]["schema"]["$ref"].endswith("AnalysisResponse")
+    assert "X-Stochcable-Warnings" in ok["headers"]
+    for code in ("413", "422", "504"):
+        assert post["responses"][code]["content"]["application/json"]["schema"][
+            "$ref"].endswith("ErrorResponse")
+    params = {p["name"]: p for p in post["parameters"]}
+    assert params["timeseries"]["schema"]["enum"] == ["window", "full", "none"]
+    result = doc["components"]["schemas"]["AnalysisResponse"]
+    assert set(result["required"]) == {"statics", "modes", "linearization", "lines",
+                                       "timing", "warnings"}

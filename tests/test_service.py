@@ -60,7 +60,11 @@ def _only_error(resp, status=422) -> dict:
 
 
 def test_health_and_version(client):
-    assert client.get("/health").json() == {"status": "ok"}
+    resp = client.get("/health")
+    assert resp.json() == {"status": "ok"}
+    # the service's own time, for clients telling it from transfer time
+    assert resp.headers["server-timing"].startswith("app;dur=")
+    assert float(resp.headers["server-timing"].split("dur=")[1]) >= 0.0
     assert client.get("/version").json() == {"stochcable": stochcable.__version__, "api": "v1"}
 
 
@@ -245,6 +249,22 @@ def test_dsa_variance_equals_the_target_m0(client):
     assert np.mean(np.square(data["elevation"])) == pytest.approx(stats["m0"], rel=1e-12)
 
 
+def test_single_column_npy_is_the_elevation(client):
+    body = _realization_body(method="nsa")
+    resp = client.post("/v1/sea/realizations", json=body,
+                       headers={"Accept": "application/x-npy"})
+    rec = np.load(io.BytesIO(resp.content), allow_pickle=False)
+    sea = _local(body)
+    assert rec.dtype.names == ("elevation",) and np.array_equal(rec["elevation"],
+                                                                 sea.elevation)
+    # m0 is the Riemann sum of S over the simulated lines m = 1 … N-1 (independent
+    # evaluation here; the service reuses the simulation's own S values)
+    spec = _spectrum_model(PM)
+    m0 = spec.spectral_density(sea.omega[1:-1]).sum() * sea.d_omega
+    assert json.loads(resp.headers["x-stochcable-stats"])["m0"] == pytest.approx(m0,
+                                                                                 rel=1e-15)
+
+
 def test_realization_kinematics_equal_the_core(client):
     points = [[0.0, 0.0, -5.0], [10.0, 3.0, -20.0], [0.0, 0.0, 1.0]]
     body = _realization_body(points=points, heading=30.0, depth=50.0, g=9.81)
@@ -263,15 +283,16 @@ def test_realization_npy_and_csv_layouts(client):
     js = client.post("/v1/sea/realizations", json=body).json()
     resp = client.post("/v1/sea/realizations", json=body, headers={"Accept": "application/x-npy"})
     rec = np.load(io.BytesIO(resp.content), allow_pickle=False)
-    names = ["time", "elevation"] + [f"{q}_{p}_{a}" for q in ("velocity", "acceleration")
-                                     for p in range(2) for a in "xyz"]
-    assert list(rec.dtype.names) == names
+    names = ["elevation"] + [f"{q}_{p}_{a}" for q in ("velocity", "acceleration")
+                             for p in range(2) for a in "xyz"]
+    assert list(rec.dtype.names) == names  # NPY: no time column, t_n = n·dt
+    assert (np.arange(rec.size) * body["dt"]).tolist() == js["time"]
     assert rec["elevation"].tolist() == js["elevation"]
     assert rec["acceleration_1_z"].tolist() == js["kinematics"]["acceleration"][1][2]
     assert json.loads(resp.headers["x-stochcable-stats"]) == js["stats"]
     resp = client.post("/v1/sea/realizations", json=body, headers={"Accept": "text/csv"})
     rows = list(csv.reader(io.StringIO(resp.text)))
-    assert rows[0] == names and len(rows) == 1 + 512
+    assert rows[0] == ["time", *names] and len(rows) == 1 + 512
     assert [float(r[3]) for r in rows[1:]] == js["kinematics"]["velocity"][0][1]
 
 

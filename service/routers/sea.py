@@ -12,14 +12,15 @@ from stochcable.kinematics import kinematics_timeseries
 from stochcable.sea import simulate_sea
 
 from ..dependencies import MediaTypeDep, RunnerDep, SettingsDep
-from ..encoding import JSON, array_responses, columns_response, json_response
+from ..encoding import JSON, NPY, array_responses, columns_response, json_response
 from ..limits import check_points, check_samples
 from ..schemas import RealizationRequest, RealizationResponse
 
 router = APIRouter(prefix="/v1", tags=["sea"])
 
 _LAYOUT = (
-    "Columns: time [s], elevation [m], then for each point p = 0, 1, ... "
+    "Columns: time [s] (CSV only: in the NPY answer the sample times are t_n = n·dt, "
+    "n = 0, 1, ..., not sent), elevation [m], then for each point p = 0, 1, ... "
     "velocity_p_x, velocity_p_y, velocity_p_z [m/s] and acceleration_p_x, "
     "acceleration_p_y, acceleration_p_z [m/s²]; the statistics as JSON in the "
     "X-Stochcable-Stats header."
@@ -49,7 +50,9 @@ def _realization(body: RealizationRequest, media: str) -> Response:
         return spectrum.spectral_density(w, g)
 
     sea = simulate_sea(density, body.duration, body.dt, method=body.method, rng=body.seed)
-    # target variance: the Riemann sum over the simulated lines m = 1 … N-1 (X_0 = X_N = 0)
+    # target variance: the Riemann sum over the simulated lines m = 1 … N-1 (X_0 = X_N = 0).
+    # S is evaluated again (about 2 ms for 2^19 lines): simulate_sea overwrites its own
+    # S array in place with the amplitudes, so it cannot be reused.
     elevation = sea.elevation
     stats = {"variance": float(np.dot(elevation, elevation) / elevation.size),
              "m0": float(density(sea.omega[1:-1]).sum() * sea.d_omega)}
@@ -62,7 +65,9 @@ def _realization(body: RealizationRequest, media: str) -> Response:
         if kin is not None:
             payload["kinematics"] = {"velocity": kin[0], "acceleration": kin[1]}
         return json_response(payload)
-    columns = {"time": sea.time, "elevation": sea.elevation}
+    # NPY: no time column (t_n = n·dt): it would double the answer for one known column
+    columns = {"elevation": sea.elevation} if media == NPY else {
+        "time": sea.time, "elevation": sea.elevation}
     if kin is not None:
         for name, arr in (("velocity", kin[0]), ("acceleration", kin[1])):
             for p in range(arr.shape[0]):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-__all__ = ["register", "run"]
+__all__ = ["register", "run", "banner", "EXAMPLE"]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -29,12 +29,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+EXAMPLE = "chain_catenary"
+"""Bundled example scene analysed by the request the start-up message shows."""
+
+
 def banner(host: str, port: int) -> str:
-    """The line printed on start: where the service and its interactive docs are."""
+    """The message printed on start: where the service and its interactive docs are,
+    and a copy-pasteable request analysing a bundled example scene."""
     shown = f"[{host}]" if ":" in host else host
     base = f"http://{shown}:{port}"
-    return (f"stochcable service on {base} — docs at {base}/docs, "
-            f"example: curl {base}/v1/examples\n")
+    # a wildcard bind address is not a destination: the example goes to loopback
+    local = {"0.0.0.0": "127.0.0.1", "": "127.0.0.1", "::": "[::1]"}.get(host, shown)
+    url = f"http://{local}:{port}"
+    return (f"stochcable service on {base} — docs at {base}/docs\n"
+            f"try: curl -s {url}/v1/examples/{EXAMPLE} | curl -s -X POST "
+            f"{url}/v1/analyses -H 'Content-Type: application/json' -d @-\n")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -1,0 +1,340 @@
+"""POST /v1/analyses in-process (FastAPI TestClient): the result document equals the
+core's analyze(scene).to_document() and the CLI's output, the limits answer 413/422
+naming the bound, solver failures answer 422 with the reason, the run-time bound stops
+an abandoned analysis, and concurrent analyses keep their own warnings."""
+
+from __future__ import annotations
+
+import copy
+import json
+import threading
+import time
+import warnings
+
+import pytest
+from fastapi.testclient import TestClient
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import stochcable.analysis
+from service.app import create_app
+from service.routers.analyses import WARNINGS_HEADER
+from service.schemas import AnalysisResponse
+from service.settings import Settings
+from stochcable.analysis import analyze
+from stochcable.cli import main as cli_main
+from stochcable.examples import list_examples, load_example
+
+CHAIN = "chain_catenary"  # the README / banner example: sea + end motion, time series
+SMALL = "tuah_1982_single_leg"  # 3 elements, time series, ~20 ms: for the limit tests
+
+
+def _doc(name: str) -> dict:
+    return load_example(name).model_dump(mode="json")
+
+
+def _plain(doc: dict) -> dict:
+    """The document as JSON gives it back, without the (run-dependent) timing."""
+    out = json.loads(json.dumps(doc))
+    out.pop("timing")
+    return out
+
+
+def _err(resp, status=422) -> dict:
+    assert resp.status_code == status, resp.text
+    return resp.json()["detail"][0]
+
+
+@pytest.fixture(scope="module")
+def client() -> TestClient:
+    with TestClient(create_app(Settings())) as c:
+        yield c
+
+
+@pytest.fixture(scope="module")
+def small() -> TestClient:
+    limits = Settings(max_elements=3, max_frequencies=200, max_samples=1024,
+                      max_body_bytes=4096)
+    with TestClient(create_app(limits)) as c:
+        yield c
+
+
+@pytest.fixture(scope="module")
+def chain_answer(client):
+    """GET the example, POST it back: the pipeline the start-up message shows."""
+    scene = client.get(f"/v1/examples/{CHAIN}").json()
+    return client.post("/v1/analyses", json=scene)
+
+
+# ------------------------------------------------------------------ equality
+
+
+def test_example_pipeline_equals_the_core_and_the_cli(chain_answer, tmp_path):
+    assert chain_answer.status_code == 200, chain_answer.text
+    doc = chain_answer.json()
+    local = analyze(load_example(CHAIN)).to_document()
+    # the same computation on the same input: equal to the last bit, timing aside
+    assert _plain(doc) == _plain(local)
+    assert set(doc["timing"]) == set(local["timing"])
+    out = tmp_path / "result.json"
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(_doc(CHAIN)), encoding="utf-8")
+    assert cli_main(["analyze", str(path), "--format", "json", "-o", str(out)]) == 0
+    assert _plain(doc) == _plain(json.loads(out.read_text(encoding="utf-8")))
+
+
+@pytest.mark.parametrize("name", [n for n in list_examples() if n != CHAIN])
+def test_every_example_equals_the_core(client, name):
+    resp = client.post("/v1/analyses", json=_doc(name))
+    assert resp.status_code == 200, resp.text
+    assert _plain(resp.json()) == _plain(analyze(load_example(name)).to_document())
+
+
+def test_document_conforms_to_the_response_model(chain_answer):
+    doc = chain_answer.json()
+    model = AnalysisResponse.model_validate(doc)
+    # the v1 contract keys (DESIGN.md "Scene and result documents")
+    assert model.lines["leg1"].end_b.tension.std > 0
+    assert model.statics.lines["leg1"]["end_b"]["tension"] > 0
+    assert set(doc) >= {"statics", "modes", "linearization", "lines", "timing", "warnings",
+                        "timeseries"}
+
+
+def test_warnings_are_listed_and_counted_in_a_header(chain_answer, client):
+    doc = chain_answer.json()
+    # the chain's end-motion spectrum drives tension spectra the 2 rad/s grid cuts
+    assert any("raise analysis.omega.max" in w for w in doc["warnings"])
+    assert chain_answer.headers[WARNINGS_HEADER] == str(len(doc["warnings"]))
+    quiet = client.post("/v1/analyses", json=_doc("taut_wire"))
+    assert quiet.json()["warnings"] == [] and quiet.headers[WARNINGS_HEADER] == "0"
+
+
+def test_large_document_is_gzipped(chain_answer):
+    assert chain_answer.headers.get("content-encoding") == "gzip"  # TestClient accepts gzip
+
+
+@pytest.mark.parametrize("mode", ["full", "none"])
+def test_timeseries_query_parameter(small, mode):
+    scene = _doc(SMALL)
+    doc = small.post(f"/v1/analyses?timeseries={mode}", json=scene).json()
+    local = analyze(load_example(SMALL)).to_document(timeseries=mode)
+    assert _plain(doc) == _plain(local)
+    if mode == "none":
+        assert "timeseries" not in doc
+    else:  # 256 s at 0.25 s: all 1024 samples (the window would be min(1024, 2048) too)
+        assert doc["timeseries"]["window"] == doc["timeseries"]["samples"] == 1024
+
+
+def test_bad_timeseries_parameter_names_it(small):
+    err = _err(small.post("/v1/analyses?timeseries=all", json=_doc(SMALL)))
+    assert err["loc"] == ["query", "timeseries"] and err["parameter"] == "timeseries"
+    assert "'window', 'full' or 'none'" in err["msg"]
+
+
+# -------------------------------------------------------------------- limits
+
+
+def test_element_limit_names_the_bound(small):
+    scene = _doc(SMALL)
+    assert small.post("/v1/analyses", json=scene).status_code == 200  # 3 = the bound
+    scene["lines"][0]["segments"][0]["elements"] = 4
+    err = _err(small.post("/v1/analyses", json=scene))
+    assert err["type"] == "limit_exceeded" and err["setting"] == "STOCHCABLE_MAX_ELEMENTS"
+    assert err["msg"] == "4 finite elements exceeds the limit of 3 (STOCHCABLE_MAX_ELEMENTS)"
+    assert err["loc"] == ["body", "lines"]
+
+
+def test_frequency_limit_names_the_bound(small):
+    scene = _doc(SMALL)
+    scene["analysis"]["omega"]["count"] = 201
+    err = _err(small.post("/v1/analyses", json=scene))
+    assert err["msg"] == ("analysis.omega.count = 201 frequencies exceeds the limit of 200 "
+                          "(STOCHCABLE_MAX_FREQUENCIES)")
+    assert err["loc"] == ["body", "analysis", "omega", "count"] and err["limit"] == 200
+
+
+def test_sample_limit_names_the_bound(small):
+    scene = _doc(SMALL)
+    scene["analysis"]["timeseries"]["duration"] = 512.0  # 2048 samples at 0.25 s
+    err = _err(small.post("/v1/analyses", json=scene))
+    assert err["msg"] == ("analysis.timeseries duration/dt = 2048 samples exceeds the limit "
+                          "of 1024 (STOCHCABLE_MAX_SAMPLES)")
+    assert err["loc"] == ["body", "analysis", "timeseries", "duration"]
+
+
+def test_body_limit_is_413(small):
+    body = json.dumps(_doc(SMALL)) + " " * 4096
+    resp = small.post("/v1/analyses", content=body,
+                      headers={"Content-Type": "application/json"})
+    err = _err(resp, 413)
+    assert "exceeds the limit of 4096 bytes (STOCHCABLE_MAX_BODY_BYTES)" in err["msg"]
+
+
+# ------------------------------------------------------------- solver failures
+
+
+def test_unconverged_linearization_is_422_with_the_reason(small):
+    scene = _doc(SMALL)
+    scene["analysis"]["linearization"]["max_iterations"] = 1
+    err = _err(small.post("/v1/analyses", json=scene))
+    assert err["type"] == "convergence_error" and err["iterations"] == 1
+    assert err["solver"] == "drag linearization of line 'leg'"
+    assert "did not converge" in err["msg"] and "max_iterations" in err["msg"]
+    # allow_unconverged: the flagged partial result instead (DESIGN.md)
+    scene["analysis"]["linearization"]["allow_unconverged"] = True
+    doc = small.post("/v1/analyses", json=scene).json()
+    assert doc["linearization"]["converged"] is False
+    assert doc["linearization"]["iterations"] == 1
+
+
+def test_core_input_error_is_422_with_the_path(small):
+    scene = _doc(SMALL)
+    scene["analysis"]["linearization"]["method"] = "harmonic"
+    scene["environment"]["current"] = [{"z": 0.0, "speed": 1.0, "heading": 0.0}]
+    err = _err(small.post("/v1/analyses", json=scene))
+    assert err["type"] == "input_error"
+    assert err["loc"] == ["body", "analysis", "linearization", "method"]
+    assert "no current term" in err["msg"]
+
+
+def test_validation_error_names_the_field_path_and_unit(small):
+    scene = _doc(SMALL)
+    scene["lines"][0]["segments"][0]["ea"] = -1.0
+    err = _err(small.post("/v1/analyses", json=scene))
+    assert err["parameter"] == "lines[0].segments[0].ea" and err["unit"] == "N"
+    assert err["msg"] == "Input should be greater than 0"
+
+
+# -------------------------------------------------------- run time, concurrency
+
+
+def test_abandoned_analysis_stops_at_its_next_progress_call(monkeypatch):
+    calls = {"n": 0, "stopped": threading.Event()}
+
+    def endless(scene, *, statics=None, progress=None):  # an analysis that never ends
+        try:
+            while True:
+                calls["n"] += 1
+                progress("linearization", {"iteration": calls["n"]})
+                time.sleep(0.01)
+        finally:
+            calls["stopped"].set()
+
+    monkeypatch.setattr(stochcable.analysis, "analyze", endless)
+    with TestClient(create_app(Settings(max_run_seconds=0.3, max_concurrency=1))) as c:
+        t0 = time.perf_counter()
+        err = _err(c.post("/v1/analyses", json=_doc(SMALL)), 504)
+        assert err["setting"] == "STOCHCABLE_MAX_RUN_SECONDS"
+        assert time.perf_counter() - t0 < 3.0  # 0.3 s bound + TestClient overhead
+        # the worker stops instead of holding the only slot forever
+        assert calls["stopped"].wait(3.0)
+        monkeypatch.undo()
+        resp = c.post("/v1/analyses", json=_doc("tuah_1982_suspended_cable"))
+        assert resp.status_code == 200, resp.text
+
+
+def test_queued_analyses_do_not_hold_the_slots_of_other_endpoints(monkeypatch):
+    release = threading.Event()
+
+    def blocked(scene, *, statics=None, progress=None):  # an analysis that waits
+        while not release.wait(0.01):
+            progress("linearization", {})
+        return analyze(scene)
+
+    monkeypatch.setattr(stochcable.analysis, "analyze", blocked)
+    app = create_app(Settings(max_concurrency=2, max_run_seconds=10.0))
+    with TestClient(app) as c:
+        out: dict[int, object] = {}
+
+        def post(i: int) -> None:
+            out[i] = c.post("/v1/analyses", json=_doc("tuah_1982_suspended_cable"))
+
+        threads = [threading.Thread(target=post, args=(i,)) for i in range(3)]
+        for t in threads:
+            t.start()
+        time.sleep(0.3)  # one analysis runs (1 of 2 slots), two wait for their turn
+        t0 = time.perf_counter()
+        resp = c.post("/v1/spectra", json={"spectrum": {"type": "jonswap", "hs": 2.0,
+                                                        "tp": 8.0}})
+        assert resp.status_code == 200 and time.perf_counter() - t0 < 2.0
+        release.set()
+        for t in threads:
+            t.join(30.0)
+    assert [out[i].status_code for i in range(3)] == [200, 200, 200]
+
+
+def test_concurrent_analyses_keep_their_own_warnings(client):
+    # analyze() records warnings with warnings.catch_warnings (process-global state):
+    # the service runs one analysis at a time so overlapping requests neither swap
+    # their warnings nor leave the process's warning filters altered
+    filters = list(warnings.filters)
+    names = ["tuah_1982_suspended_cable", "taut_wire", "tuah_1982_suspended_cable",
+             "taut_wire"]
+    out: dict[int, object] = {}
+
+    def post(i: int) -> None:
+        out[i] = client.post("/v1/analyses", json=_doc(names[i]))
+
+    threads = [threading.Thread(target=post, args=(i,)) for i in range(len(names))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30.0)
+    for i, name in enumerate(names):
+        got = out[i].json()["warnings"]
+        if name == "taut_wire":
+            assert got == []
+        else:
+            assert len(got) == 1 and "has no excitation" in got[0]
+    assert warnings.filters == filters
+
+
+# ----------------------------------------------- generated scenes never fail 5xx
+
+
+@st.composite
+def _perturbed_scenes(draw):
+    """Example scenes with perturbed properties: reach statics and the solver (the
+    schemathesis scenes almost never do), all within the small test limits."""
+    name = draw(st.sampled_from(["taut_wire", "tuah_1982_single_leg", "inclined_guy"]))
+    doc = copy.deepcopy(_doc(name))
+    line = doc["lines"][0]
+    seg = line["segments"][0]
+    factor = st.floats(0.05, 20.0)
+    seg["ea"] *= draw(factor)
+    seg["mass"] *= draw(factor)
+    seg["diameter"] *= draw(factor)
+    seg["elements"] = draw(st.integers(1, 30))
+    seg["cd_normal"] = draw(st.floats(0.0, 3.0))
+    line["end_b"]["position"][1] = draw(st.sampled_from([0.0, 15.0]))
+    doc["environment"]["current"] = [{"z": 0.0, "speed": draw(st.floats(0.0, 2.0)),
+                                      "heading": draw(st.floats(-180.0, 180.0))}]
+    hs = draw(st.floats(0.1, 15.0))
+    doc["sea"] = {"spectrum": {"type": "jonswap", "hs": hs, "tp": draw(st.floats(3.0, 20.0))},
+                  "heading": draw(st.floats(-180.0, 180.0))}
+    a = doc["analysis"]
+    a["omega"] = {"min": draw(st.floats(0.01, 0.5)), "max": draw(st.floats(0.6, 6.0)),
+                  "count": draw(st.integers(2, 120)),
+                  "spacing": draw(st.sampled_from(["linear", "log"]))}
+    a["solver"] = draw(st.sampled_from(["foss", "direct"]))
+    a["modes"] = draw(st.sampled_from(["auto", 1, 5]))
+    a["linearization"]["method"] = draw(st.sampled_from(["seed", "vector"]))
+    a["linearization"]["allow_unconverged"] = draw(st.booleans())
+    return doc
+
+
+_GENERATED_APP = create_app(Settings(max_run_seconds=10.0))
+
+
+@settings(max_examples=12, deadline=None, derandomize=True, database=None,
+          suppress_health_check=list(HealthCheck))
+@given(scene=_perturbed_scenes())
+def test_generated_scenes_answer_a_document_or_a_reason(scene):
+    with TestClient(_GENERATED_APP, raise_server_exceptions=False) as c:
+        resp = c.post("/v1/analyses", json=scene)
+    assert resp.status_code in (200, 422), resp.text
+    if resp.status_code == 200:
+        AnalysisResponse.model_validate(resp.json())
+    else:
+        assert resp.json()["detail"][0]["type"] in (
+            "input_error", "convergence_error", "solver_error", "value_error")
