@@ -42,10 +42,11 @@ element's δT when those are small (tested).
 
 from __future__ import annotations
 
+import contextlib
 import math
+import threading
 import time
-import warnings
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -53,7 +54,15 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .errors import ConvergenceError, InputError, PhysicsWarning, ResolutionWarning, SolverError
+from .errors import (
+    ConvergenceError,
+    InputError,
+    PhysicsWarning,
+    ResolutionWarning,
+    SolverError,
+    collect_warnings,
+    warn,
+)
 from .excitation import (
     Channel,
     current_at_elements,
@@ -66,13 +75,16 @@ from .excitation import (
 )
 from .fem import FEModel, build_fe_model
 from .linearization import (
+    FixedPointResult,
     drag_linear_current,
     drag_linear_harmonic,
+    borgman_variance_ratio,
     drag_linear_vector,
     fixed_point,
 )
 from .modes import Modes, natural_modes
 from .results import (
+    LineIndicators,
     LinearizationRecord,
     LineResult,
     Result,
@@ -84,10 +96,10 @@ from .sea import frequency_grid, simulate_sea, synthesize
 from .solvers import (
     DefectivePencilWarning,
     _band_from_blocks,
+    _foss_decomposition,
+    _foss_transfer_modal,
     _solve_band_stacked,
     auto_mode_count,
-    foss_decomposition,
-    foss_transfer,
     solve_direct,
     tridiagonal_blocks,
 )
@@ -104,6 +116,7 @@ __all__ = [
     "solve",
     "relative_velocity_sigmas",
     "linearize",
+    "line_indicators",
     "line_result",
     "element_tension_transfer",
     "simulate_timeseries",
@@ -126,12 +139,67 @@ iteration, relative change, …)."""
 # solver is exact and costs about as much as 20-mode Foss.
 AUTO_ALL_MODES = 40
 AUTO_MODE_FACTOR = 5.0
+# Mixing of the Anderson-accelerated steps of the drag fixed point (the plain steps use
+# analysis.linearization.relaxation): undamped Anderson saves one iteration on the
+# chain, the taut wire, the guy and a 3-D chain (docs/BENCHMARKS.md "Response analysis").
+ANDERSON_MIXING = 1.0
 # First batch of modes computed when looking for the auto count (doubled as needed).
 _MODE_BATCH = 40
 
 
 def _noop(stage: str, info: Mapping[str, Any]) -> None:
     return None
+
+
+# ------------------------------------------------------------------ BLAS threads
+#
+# The engine's dense linear algebra is small (eigenproblems, LU and products of at most
+# a few hundred rows, per line).  Multi-threaded OpenBLAS makes such calls slower even on
+# a quiet machine and 5-10x slower when the cores are busy (docs/BENCHMARKS.md
+# "Response analysis"), so the analysis of small models runs with one BLAS thread
+# (threadpoolctl, applied to numpy's and scipy's OpenBLAS alike).
+
+#: Largest model (degrees of freedom of the largest line, 3 per node) analysed with
+#: one BLAS thread.
+SMALL_MODEL_DOF = 2000
+
+_blas_lock = threading.Lock()
+_blas_state: dict[str, Any] = {"depth": 0, "limiter": None}
+
+
+@contextlib.contextmanager
+def _single_blas_thread(active: bool = True) -> Iterator[None]:
+    """Limit BLAS to one thread inside the block (re-entrant and thread-safe: the first
+    entrant sets the limit, the last one to leave restores the previous setting).
+
+    A fresh ``threadpoolctl.threadpool_limits`` per outermost entry (≈ 1 ms): a
+    ThreadpoolController cached across calls failed to apply the limit from a worker
+    thread once pyfftw's OpenMP runtime was loaded (threadpoolctl 3.6, two OpenBLAS
+    copies), which made service (thread) and library results differ in the last bits."""
+    if not active:
+        yield
+        return
+    with _blas_lock:
+        if _blas_state["depth"] == 0:
+            try:
+                from threadpoolctl import threadpool_limits
+
+                _blas_state["limiter"] = threadpool_limits(limits=1, user_api="blas")
+            except Exception:  # noqa: BLE001 - no threadpoolctl: run unlimited
+                _blas_state["limiter"] = None
+        _blas_state["depth"] += 1
+    try:
+        yield
+    finally:
+        with _blas_lock:
+            _blas_state["depth"] -= 1
+            if _blas_state["depth"] == 0 and _blas_state["limiter"] is not None:
+                _blas_state["limiter"].restore_original_limits()
+                _blas_state["limiter"] = None
+
+
+def _is_small(scene: Scene) -> bool:
+    return max(3 * (line.elements + 1) for line in scene.lines) <= SMALL_MODEL_DOF
 
 
 # ------------------------------------------------------------------------ the system
@@ -221,8 +289,14 @@ class Damping:
         Axial drag per unit length. [N·s/m²]
     b_node : ndarray, shape (n_nodes,)
         Attachment drag. [N·s/m]
-    matrix : scipy.sparse.csr_array
-        Drag damping matrix C_d on all DOFs (without the seabed damping). [N·s/m]
+    model : FEModel
+        The line model the drag belongs to (for :attr:`matrix`).
+
+    Notes
+    -----
+    The solves use node blocks of the drag, never a sparse matrix;
+    :attr:`matrix` is assembled on first access only (it used to be built at
+    every linearization iteration).
     """
 
     method: str
@@ -230,10 +304,19 @@ class Damping:
     b_normal: np.ndarray
     b_axial: np.ndarray
     b_node: np.ndarray
-    matrix: sp.csr_array
+    model: Any = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_cache", {})
+
+    @property
+    def matrix(self) -> sp.csr_array:
+        """Drag damping matrix C_d on all DOFs (without the seabed damping), assembled
+        on first access (:func:`stochcable.excitation.drag_matrix`). [N·s/m]"""
+        if "matrix" not in self._cache:
+            self._cache["matrix"] = drag_matrix(self.model, self.b_normal, self.b_axial,
+                                                self.b_node)
+        return self._cache["matrix"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -421,7 +504,7 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
     b_t = np.atleast_1d(np.asarray(b_t, dtype=float))
     return Damping(
         method=method, sigma=np.asarray(sigma, dtype=float).copy(), b_normal=b_n,
-        b_axial=b_t, b_node=b_node, matrix=drag_matrix(model, b_n, b_t, b_node),
+        b_axial=b_t, b_node=b_node, model=model,
     )
 
 
@@ -721,28 +804,46 @@ def _base(system: "LineSystem", prep: _Prep, inp: _Inputs) -> tuple[np.ndarray, 
     return inp.cache[key]
 
 
-def _solve_nodes(system: "LineSystem", inp: _Inputs, damping: Damping
-                 ) -> tuple[np.ndarray, _Blk]:
-    """Total displacement (n_nodes, d, n_w, n_ch) and C = C_s + C_d."""
+def _solve_free(system: "LineSystem", inp: _Inputs, damping: Damping
+                ) -> tuple[np.ndarray, _Blk]:
+    """Dynamic part on the free nodes, (n_nodes − 2, d, n_w, n_ch), and C = C_s + C_d.
+
+    The total displacement is U = U_p + [0; u_f; 0] with U_p of :func:`_base`."""
     prep = _prep(system)
     d = prep.d
     w = inp.omega
     cd = _drag_blocks(system, damping)
     c = _add(prep.S, cd)
-    u_p, f0, y = _base(system, prep, inp)
-    rhs = f0 if y is None else f0 + _matvec(cd, y)
-    u = u_p.copy()
+    _, f0, y = _base(system, prep, inp)
+    if y is None:
+        rhs = f0
+    else:
+        rhs = _matvec(cd, y)
+        rhs += f0
     if system.solver == "direct":
         rhs_f = _to_freq(rhs[1:-1])
         bC = prep.bS + _free_band(cd)
         u_f = _solve_band_stacked(prep.bK, prep.bM, bC, rhs_f, w, 2 * d - 1, 2 * d - 1,
                                   (system.model.K, system.model.M))
         _check_line_conditioning(system, prep, bC, w, rhs_f, u_f)
-        u[1:-1] = _from_freq(u_f, d)
-    else:
-        u_f = _foss_free(system, prep, c, prep._free_rows(rhs), w)
-        u[1:-1] += u_f.reshape(prep.n - 2, d, *u_f.shape[1:])
-    return u, c
+        return np.ascontiguousarray(_from_freq(u_f, d)), c
+    u_f = _foss_free(system, prep, c, prep._free_rows(rhs), w)
+    return u_f.reshape(prep.n - 2, d, *u_f.shape[1:]), c
+
+
+def _total(system: "LineSystem", inp: _Inputs, u_free: np.ndarray) -> np.ndarray:
+    """Total displacement (n_nodes, d, n_w, n_ch) from the free-node dynamic part."""
+    prep = _prep(system)
+    u = _base(system, prep, inp)[0].copy()
+    u[1:-1] += u_free
+    return u
+
+
+def _solve_nodes(system: "LineSystem", inp: _Inputs, damping: Damping
+                 ) -> tuple[np.ndarray, _Blk]:
+    """Total displacement (n_nodes, d, n_w, n_ch) and C = C_s + C_d."""
+    u_f, c = _solve_free(system, inp, damping)
+    return _total(system, inp, u_f), c
 
 
 def _check_line_conditioning(system, prep, bC, w, f, u) -> None:
@@ -766,6 +867,14 @@ def _check_line_conditioning(system, prep, bC, w, f, u) -> None:
         raise _singular_error(K, M, float(w[k]), float(est[k]))
 
 
+def _real_gemm(a: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Real (p, q) matrix times complex (q, k) C-contiguous matrix as ONE real product
+    on the interleaved (q, 2k) view (numpy would upcast ``a`` to complex: 4x the
+    work)."""
+    q, k = x.shape
+    return (a @ x.view(float).reshape(q, 2 * k)).view(complex)
+
+
 def _foss_free(system: "LineSystem", prep: _Prep, c: _Blk, rhs: np.ndarray,
                w: np.ndarray) -> np.ndarray:
     """Foss modal solve on the free DOFs, rhs (n_free_dof, n_w, n_ch), with the static
@@ -776,21 +885,23 @@ def _foss_free(system: "LineSystem", prep: _Prep, c: _Blk, rhs: np.ndarray,
     nf, n_w, n_ch = rhs.shape
     ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
     ch = 0.5 * (ch + ch.T)
-    flat = rhs.reshape(nf, n_w * n_ch)
-    fh = np.ascontiguousarray(np.moveaxis((phi.T @ flat).reshape(m, n_w, n_ch), 1, 0))
+    flat = np.ascontiguousarray(rhs).reshape(nf, n_w * n_ch)
+    fh = _real_gemm(phi.T, flat)  # (m, n_w·n_ch), mode-major
     z = None
     try:
-        foss = foss_decomposition(mh, ch, kh)
+        foss = _foss_decomposition(mh, ch, kh)
     except SolverError as exc:
-        warnings.warn(f"{exc}; falling back to the direct solve in modal coordinates",
+        warn(f"{exc}; falling back to the direct solve in modal coordinates",
                       DefectivePencilWarning, stacklevel=3)
     else:
-        z = foss_transfer(foss, fh, w)
+        z = _foss_transfer_modal(foss, fh, w, n_ch)
     if z is None:
-        z = solve_direct(kh, mh, ch, fh, w, method="dense")
-    u = phi @ np.moveaxis(z, 0, 1).reshape(m, n_w * n_ch)
+        fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
+        z3 = solve_direct(kh, mh, ch, fh3, w, method="dense")
+        z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
+    u = _real_gemm(phi, np.ascontiguousarray(z))
     if m < nf:
-        u = u + prep.residual(system, flat)
+        u += prep.residual(system, flat)
     return u.reshape(nf, n_w, n_ch)
 
 
@@ -812,9 +923,12 @@ def _reactions(system: "LineSystem", prep: _Prep, c: _Blk, u: np.ndarray,
     return -np.concatenate([ra, rb], axis=1)
 
 
-def _response(system: "LineSystem", inp: _Inputs, damping: Damping) -> Response:
+def _response(system: "LineSystem", inp: _Inputs, damping: Damping,
+              solved: tuple[np.ndarray, _Blk] | None = None) -> Response:
+    """Response with reactions and end tensions; ``solved`` = (u, C) of a solve already
+    done with this ``damping`` (:func:`_solve_nodes`) skips the solve."""
     prep = _prep(system)
-    u, c = _solve_nodes(system, inp, damping)
+    u, c = _solve_nodes(system, inp, damping) if solved is None else solved
     f_all = _loads(prep, inp, _drag_blocks(system, damping))
     n, d, n_w, n_ch = u.shape
     support = _reactions(system, prep, c, u, f_all, inp.omega)
@@ -968,6 +1082,65 @@ def relative_velocity_sigmas(
     return _sigmas(system, inp, u, method)
 
 
+def _proj_rows(system: LineSystem, method: str) -> np.ndarray:
+    """Half the projection rows of the midpoint velocity, (n_el, k, d): e, n1 (and n2
+    in 3-D, and (n1 + n2)/√2 for "vector" in 3-D), on the model components."""
+    key = ("proj", method)
+    if key not in system._cache:
+        model = system.model
+        comps = list(model.components)
+        e, n1, n2 = system.frames
+        rows = [e, n1]
+        if model.dim == 3:
+            rows.append(n2)
+            if method == "vector":
+                rows.append((n1 + n2) / math.sqrt(2.0))
+        system._cache[key] = np.ascontiguousarray(0.5 * np.stack(rows, axis=1)[:, :, comps])
+    return system._cache[key]
+
+
+def _project_mid(pr: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Projected element-midpoint values of node vectors x (n_nodes, d, n_w, n_ch):
+    (n_el, k, n_w·n_ch) complex (real products on the interleaved view)."""
+    n, d = x.shape[:2]
+    xf = np.ascontiguousarray(x).reshape(n, d, -1).view(float)
+    out = pr @ xf[1:]
+    out += pr @ xf[:-1]
+    return out.view(complex)
+
+
+def _sigma_vector(system: LineSystem, var: np.ndarray, s_node: np.ndarray,
+                  method: str) -> np.ndarray:
+    """The σ vector (layout of :func:`drag_coefficients`) from the variances of the
+    projected midpoint relative velocity, var (n_el, k) for the rows of
+    :func:`_proj_rows`."""
+    v_t, v1 = var[:, 0], var[:, 1]
+    v2 = var[:, 2] if var.shape[1] > 2 else np.zeros_like(v1)
+    if method == "vector":
+        v3 = var[:, 3] if var.shape[1] > 3 else 0.5 * v1
+        normal = [np.sqrt(v1), np.sqrt(v2), np.sqrt(v3)]
+    else:
+        normal = [np.sqrt(v1 + v2)]
+    return np.concatenate(normal + [np.sqrt(v_t), s_node])
+
+
+def _weighted_var(x: np.ndarray, inp: _Inputs) -> np.ndarray:
+    """Σ_k weight_k |x_k|² over the last axis (n_w·n_ch) of a complex array."""
+    if "w2" not in inp.cache:
+        inp.cache["w2"] = np.repeat(inp.weights.ravel(), 2)
+    xf = x.view(float)
+    return (xf * xf) @ inp.cache["w2"]
+
+
+def _node_sigmas(system: LineSystem, inp: _Inputs, vr_nodes: np.ndarray) -> np.ndarray:
+    """σ of the total relative velocity of the attachment nodes, vr_nodes of shape
+    (n_drag_nodes, d, n_w, n_ch)."""
+    if vr_nodes.shape[0] == 0:
+        return np.zeros(0)
+    flat = np.ascontiguousarray(vr_nodes).reshape(vr_nodes.shape[0], -1)
+    return np.sqrt(_weighted_var(flat, inp))
+
+
 def _sigmas(system: LineSystem, inp: _Inputs, u: np.ndarray | None, method: str) -> np.ndarray:
     """σ vector from node displacements u (n_nodes, d, n_w, n_ch) (None: at rest)."""
     model = system.model
@@ -980,42 +1153,46 @@ def _sigmas(system: LineSystem, inp: _Inputs, u: np.ndarray | None, method: str)
         vr = (-1j * w)[:, None] * u
         if inp.velocity is not None:
             vr = vr + inp.velocity
-    mid = 0.5 * (vr[1:] + vr[:-1])  # (n_el, d, n_w, n_ch)
-    comps = list(model.components)
-    e, n1, n2 = (x[:, comps] for x in system.frames)
-    wflat = inp.weights.ravel()
+    var = _weighted_var(_project_mid(_proj_rows(system, method), vr), inp)
+    return _sigma_vector(system, var, _node_sigmas(system, inp, vr[system.drag_nodes]),
+                         method)
 
-    flat = mid.reshape(mid.shape[0], mid.shape[1], -1)
 
-    def proj(v: np.ndarray) -> np.ndarray:  # (n_el, n_w·n_ch)
-        out = v[:, 0, None] * flat[:, 0]
-        for k in range(1, v.shape[1]):
-            out += v[:, k, None] * flat[:, k]
-        return out
+def _sigmas_free(system: LineSystem, inp: _Inputs, u_free: np.ndarray,
+                 method: str) -> np.ndarray:
+    """σ vector from the free-node dynamic part of :func:`_solve_free`.
 
-    def var(x: np.ndarray) -> np.ndarray:  # x (m, n_w·n_ch)
-        return (x.real**2 + x.imag**2) @ wflat
-
-    p_t, p_1 = proj(e), proj(n1)
-    s_t = np.sqrt(var(p_t))
-    v1 = var(p_1)
-    if model.dim == 2:
-        p_2, v2 = None, np.zeros(model.n_elements)
-    else:
-        p_2 = proj(n2)
-        v2 = var(p_2)
-    if method == "vector":
-        v3 = var((p_1 + p_2) / math.sqrt(2.0)) if p_2 is not None else 0.5 * v1
-        normal = [np.sqrt(v1), np.sqrt(v2), np.sqrt(v3)]
-    else:
-        normal = [np.sqrt(v1 + v2)]
+    The relative velocity is Y − iω u_f with Y = V − iω U_p (:func:`_base`), whose
+    midpoint projections are cached per inputs and solver: one stacked real
+    product per iteration."""
+    prep = _prep(system)
+    key = ("yproj", system.solver, method)
+    if key not in inp.cache:
+        u_p, _, y = _base(system, prep, inp)
+        if y is None:
+            y = np.zeros(u_p.shape, dtype=complex)
+        wcol = np.repeat(-1j * inp.omega, inp.weights.shape[1])
+        inp.cache[key] = (_project_mid(_proj_rows(system, method), y), wcol, y)
+    yp, wcol, y = inp.cache[key]
+    pr = _proj_rows(system, method)
+    n_f, d = u_free.shape[:2]
+    uf = np.ascontiguousarray(u_free).reshape(n_f, d, -1).view(float)
+    pu = np.zeros(yp.shape, dtype=complex)
+    pf = pu.view(float)
+    pf[1:] += pr[1:] @ uf
+    pf[:-1] += pr[:-1] @ uf
+    pu *= wcol
+    pu += yp
+    var = _weighted_var(pu, inp)
     idx = system.drag_nodes
+    s_node = np.zeros(0)
     if idx.size:
-        vn = vr[idx].reshape(idx.size * model.dim, -1)
-        s_node = np.sqrt(var(vn).reshape(idx.size, model.dim).sum(axis=1))
-    else:
-        s_node = np.zeros(0)
-    return np.concatenate(normal + [s_t, s_node])
+        u_node = np.zeros((idx.size,) + u_free.shape[1:], dtype=complex)
+        inner = (idx > 0) & (idx < prep.n - 1)
+        u_node[inner] = u_free[idx[inner] - 1]
+        vr = y[idx] + wcol.reshape(u_free.shape[2:]) * u_node
+        s_node = _node_sigmas(system, inp, vr)
+    return _sigma_vector(system, var, s_node, method)
 
 
 def _quasi_static(system: LineSystem, inp: _Inputs) -> np.ndarray | None:
@@ -1073,8 +1250,13 @@ def linearize(
     -----
     Start (step 5): the fluid velocity relative to the line at rest — or, for end
     motions, relative to the line following its ends quasi-statically, so an
-    end-motion-only scene does not start undamped.  Convergence: the relative change
-    of every σ (:func:`stochcable.linearization.fixed_point`) below the tolerance.
+    end-motion-only scene does not start undamped.  The σ of the response to that
+    drag (the first iteration) start the fixed-point iteration unmixed; then plain
+    steps use ``relaxation`` and Anderson steps the mixing ``ANDERSON_MIXING`` (1).
+    Convergence: the relative change of every σ
+    (:func:`stochcable.linearization.fixed_point`) below the tolerance; the record
+    counts every response evaluation, the first included.  The last evaluation's
+    solve is reused for the outputs (no extra solve).
     """
     lin = settings.linearization
     method = lin.method
@@ -1084,42 +1266,63 @@ def linearize(
                          "the harmonic (regular-wave) form has no current term: use "
                          "'seed' or 'vector' with a current")
     inp = _inputs(system, channels)
-    x0 = _sigmas(system, inp, _quasi_static(system, inp), method)
-    state: dict[str, Any] = {"it": 0}
+    x_rest = _sigmas(system, inp, _quasi_static(system, inp), method)
+    state: dict[str, Any] = {"it": 0, "change": np.inf}
     cache: dict[str, Any] = {}
 
     def update(x: np.ndarray) -> np.ndarray:
         damping = drag_coefficients(system, x, method)
         t0 = time.perf_counter()
-        u, _ = _solve_nodes(system, inp, damping)  # outputs only at the end
+        u_f, c = _solve_free(system, inp, damping)  # outputs only at the end
         if timing is not None:
             timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
-        new = _sigmas(system, inp, u, method)
+        new = _sigmas_free(system, inp, u_f, method)
         state["it"] += 1
         den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)), 1e-300))
         change = float(np.max(np.abs(new - x) / den, initial=0.0))
+        state["change"] = change
         progress("linearization", {"line": system.name, "iteration": state["it"],
                                    "change": change})
         cache["damping"], cache["sigma"] = damping, new
+        cache["solved"] = (u_f, c)
         return new
 
     name = f"drag linearization of line '{system.name}'"
-    try:
-        fp = fixed_point(
-            update, x0, tol=lin.tolerance, max_iterations=lin.max_iterations,
-            relaxation=lin.relaxation,
-            method="anderson" if lin.acceleration == "anderson" else "relaxed",
-            allow_unconverged=lin.allow_unconverged, name=name,
-        )
-    except ConvergenceError as exc:
-        raise ConvergenceError(
-            name, exc.iterations, exc.residual, exc.tolerance,
-            hint="increase analysis.linearization.max_iterations, lower relaxation, or "
-                 "set allow_unconverged to get a flagged result",
-            partial=exc.partial,
-        ) from None
+    hint = ("increase analysis.linearization.max_iterations, lower relaxation, or set "
+            "allow_unconverged to get a flagged result")
+    # Step 5: the at-rest (quasi-static) σ are a guess, not an iterate: their response
+    # starts the iteration unmixed (one iteration fewer than relaxing toward the guess
+    # on the chain, taut wire and 3-D benchmarks; same fixed point).
+    x0 = update(x_rest)
+    change0 = state["change"]
+    if not np.all(np.isfinite(x0)):
+        raise ConvergenceError(name, 1, float("nan"), lin.tolerance,
+                               hint="the first response gave non-finite σ")
+    if change0 <= lin.tolerance or lin.max_iterations == 1:
+        fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance, (change0,))
+        if not fp.converged and not lin.allow_unconverged:
+            raise ConvergenceError(name, 1, change0, lin.tolerance, hint=hint, partial=fp)
+    else:
+        try:
+            fp = fixed_point(
+                update, x0, tol=lin.tolerance, max_iterations=lin.max_iterations - 1,
+                relaxation=lin.relaxation,
+                method="anderson" if lin.acceleration == "anderson" else "relaxed",
+                mixing=ANDERSON_MIXING, allow_unconverged=lin.allow_unconverged,
+                name=name,
+            )
+        except ConvergenceError as exc:
+            partial = exc.partial
+            if isinstance(partial, FixedPointResult):
+                partial = FixedPointResult(partial.x, partial.iterations + 1,
+                                           partial.relative_change, False,
+                                           (change0,) + partial.history)
+            raise ConvergenceError(name, exc.iterations + 1, exc.residual, exc.tolerance,
+                                   hint=hint, partial=partial) from None
+        fp = FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
+                              (change0,) + fp.history)
     if not fp.converged:
-        warnings.warn(
+        warn(
             f"{name} did not converge: relative change {fp.relative_change:.3e} after "
             f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "
             "flagged unconverged (increase analysis.linearization.max_iterations)",
@@ -1127,7 +1330,9 @@ def linearize(
         )
     damping = cache["damping"]
     t0 = time.perf_counter()
-    resp = _response(system, inp, damping)  # transfer functions of the recorded drag
+    # transfer functions of the recorded drag: the last update() solved with it
+    u_f, c = cache["solved"]
+    resp = _response(system, inp, damping, (_total(system, inp, u_f), c))
     if timing is not None:
         timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
     parts = _split_sigma(system, cache["sigma"], method)
@@ -1195,7 +1400,7 @@ def _resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) -
            "the mode has no damping: add drag or seabed damping (no analysis.omega grid "
            "resolves an undamped peak)")
     more = f" and {len(bad) - 1} more mode(s)" if len(bad) > 1 else ""
-    warnings.warn(
+    warn(
         f"line '{system.name}': the frequency grid (spacing {dw:.3g} rad/s near "
         f"{wj:.4g} rad/s) does not resolve mode {j + 1} at {wj:.4g} rad/s, whose "
         f"half-power bandwidth is {b:.3g} rad/s{more}; the resonance peak may be missed: "
@@ -1215,7 +1420,7 @@ def _tail_check(line: str, end: str, w: np.ndarray, dens: np.ndarray, m0: float)
         return
     ratio = float(dens[-1] * w[-1] / m0)
     if ratio > TAIL_FRACTION:
-        warnings.warn(
+        warn(
             f"line '{line}': the {end} tension spectrum at the top of the grid "
             f"(omega.max = {w[-1]:.4g} rad/s) is still S·ω = {ratio:.2g} m0 "
             f"(threshold {TAIL_FRACTION:g}): the grid cuts the response and σ is "
@@ -1230,6 +1435,198 @@ def _listed_modes(omega_n: np.ndarray, w_top: float) -> int:
     2.5·ω_max, at least min(10, available)."""
     wn = np.asarray(omega_n)
     return int(max(np.count_nonzero(wn <= 2.5 * w_top), min(10, wn.size)))
+
+
+# ------------------------------------------------------------------ quality indicators
+
+#: Snap flag: mean − SNAP_SIGMAS·σ of the tension below zero at an element or end.
+SNAP_SIGMAS = 3.0
+#: Resonance flag: modal damping ratio below this inside the excitation band.
+RESONANCE_DAMPING_RATIO = 0.01
+#: The excitation band: where some input spectrum exceeds this fraction of its peak.
+BAND_FRACTION = 0.01
+#: Large-motion flag: node motion σ above this fraction of the line's sag.
+MOTION_SAG_FRACTION = 0.1
+
+
+def _normal_acceleration_sigma(system: LineSystem, channels: tuple[Channel, ...],
+                               omega: np.ndarray) -> np.ndarray:
+    """σ of the fluid acceleration normal to each element at its midpoint. [m/s²]"""
+    e = system.frames[0]
+    q = _trapezoid_weights(omega)
+    var = np.zeros(system.model.n_elements)
+    for ch in channels:
+        if ch.acceleration is None:
+            continue
+        a = 0.5 * (ch.acceleration[:, 1:] + ch.acceleration[:, :-1])  # (n_w, n_el, 3)
+        tang = np.einsum("wec,ec->we", a, e)
+        dens = np.sum(np.abs(a) ** 2, axis=2) - np.abs(tang) ** 2
+        var += np.clip(dens, 0.0, None).T @ (q * ch.spectrum)
+    return np.sqrt(var)
+
+
+def _modal_damping_ratios(system: LineSystem, damping: Damping) -> np.ndarray:
+    """ζ_j = φ_jᵀCφ_j/(2ω_j) of the computed modes (mass-normalized φ). [-]"""
+    prep = _prep(system)
+    c = _add(prep.S, _drag_blocks(system, damping))
+    phi = system.modes.shapes[system.model.free]
+    band = np.einsum("ij,ij->j", phi, prep._free_rows(_matvec(c, prep._nodes(phi))))
+    wn = np.asarray(system.modes.omega)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(wn > 0, band / (2.0 * np.where(wn > 0, wn, 1.0)), np.inf)
+
+
+def line_indicators(
+    system: LineSystem,
+    channels: tuple[Channel, ...],
+    linearization: Linearization,
+    tension_std: np.ndarray,
+    motion_std: np.ndarray,
+    end_stats: Mapping[str, Any],
+) -> LineIndicators:
+    """Quality indicators of the linear model of one line, with PhysicsWarnings.
+
+    Parameters
+    ----------
+    system : LineSystem
+    channels : tuple of Channel
+        Inputs on the analysis grid (their spectra define the excitation band).
+    linearization : Linearization
+        The converged drag (its record's σ and B).
+    tension_std : ndarray, shape (n_el,)
+        σ of the dynamic element tension. [N]
+    motion_std : ndarray, shape (n_nodes, 3)
+        σ of the node motions. [m]
+    end_stats : mapping {"end_a", "end_b"} of ResponseStats
+        End-tension statistics (mean and std). [N]
+
+    Returns
+    -------
+    LineIndicators
+
+    Warns
+    -----
+    PhysicsWarning
+        - snap: T_mean − 3σ_T < 0 at an element or end ("snap loads likely; the
+          linear model is out of its depth");
+        - resonance: a mode inside the excitation band (some input spectrum above
+          1 % of its peak) with modal damping ratio ζ < 1 %, named;
+        - large motion: a node motion σ above 10 % of the sag.
+
+    Notes
+    -----
+    Borgman ratio per element: :func:`stochcable.linearization.borgman_variance_ratio`
+    of the normal relative velocity (σ_n of the record, mean = the normal current).
+    Drag/inertia: :func:`stochcable.linearization.drag_inertia_ratio` in the form
+    B_n σ_n / (ρ C_M (πD²/4) σ_an), B_n the record's normal coefficient, σ_an the σ
+    of the fluid acceleration normal to the element (the sea channel).
+    Modal damping ζ_j = φ_jᵀCφ_j/(2ω_j) with C = drag + seabed + structural damping
+    (the diagonal of the modal damping; the coupling terms are ignored).
+    Large motion: the tangent model (seed 001 §3) is linear about the static shape;
+    the geometric stiffness of a sagging line depends on its sag at first order
+    (T ≈ wL²/8·1/sag for a shallow catenary), so a motion σ of 10 % of the sag (a
+    3σ excursion of 30 %) changes the stiffness by about as much as a linear model
+    can tolerate; the sag is the largest distance of the static shape from the
+    chord.  The diameter ratio is reported, not flagged (large motion over D means
+    drag-dominated loading, the domain of the drag linearization).
+    """
+    model = system.model
+    mesh = model.mesh
+    rec = linearization.record
+    name = system.name
+    flags: list[str] = []
+    e = system.frames[0]
+    uc = system.current_el
+    u_t = np.einsum("ij,ij->i", uc, e)
+    u_n = np.linalg.norm(uc - u_t[:, None] * e, axis=1)
+    borgman = np.atleast_1d(borgman_variance_ratio(rec.sigma_normal, u_n))
+    w = linearization.response.omega
+    s_an = _normal_acceleration_sigma(system, channels, w)
+    drag_sigma = rec.b_normal * rec.sigma_normal
+    inertia_sigma = (model.rho * (1.0 + mesh.ca_normal) * math.pi * mesh.diameter**2 / 4.0
+                     * s_an)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d_i = np.where(inertia_sigma > 0, drag_sigma / np.where(inertia_sigma > 0,
+                                                                 inertia_sigma, 1.0),
+                       np.where(drag_sigma > 0, np.inf, 0.0))
+    # snap
+    st = system.statics
+    t_mean = np.asarray(st.tension, dtype=float)
+    means = np.concatenate([t_mean, [end_stats["end_a"].mean, end_stats["end_b"].mean]])
+    sigmas = np.concatenate([tension_std, [end_stats["end_a"].std, end_stats["end_b"].std]])
+    low = means - SNAP_SIGMAS * sigmas
+    with np.errstate(divide="ignore", invalid="ignore"):
+        margins = np.where(np.abs(means) > 0, low / np.abs(np.where(means != 0, means, 1.0)),
+                           np.where(low < 0, -np.inf, 0.0))
+    k = int(np.argmin(margins))
+    snap_margin = float(margins[k])
+    snap = bool(np.any(low < 0))
+    if snap:
+        flags.append("snap")
+        where = ("end_a" if k == t_mean.size else "end_b" if k == t_mean.size + 1
+                 else f"element {k + 1} (s = {0.5 * (mesh.s0[k] + mesh.s0[k + 1]):.4g} m)")
+        warn(
+            f"line '{name}': the dynamic tension σ ({sigmas[k]:.4g} N at {where}) exceeds "
+            f"1/{SNAP_SIGMAS:g} of the mean tension ({means[k]:.4g} N): mean − "
+            f"{SNAP_SIGMAS:g}σ < 0, snap loads likely; the linear model is out of its "
+            "depth (threshold mean − 3σ >= 0): use a nonlinear time-domain analysis "
+            "(stochcable.cable_timedomain) or increase the pretension",
+            PhysicsWarning, stacklevel=3,
+        )
+    # near-undamped resonance inside the excitation band
+    resonances: list[dict[str, Any]] = []
+    wn = np.asarray(system.modes.omega)
+    spectra = [c.spectrum for c in channels if np.any(c.spectrum > 0)]
+    if spectra and wn.size:
+        inside = np.zeros(wn.size, dtype=bool)
+        for spec in spectra:
+            in_band = np.interp(wn, w, spec, left=0.0, right=0.0) >= BAND_FRACTION * spec.max()
+            inside |= in_band
+        zeta = _modal_damping_ratios(system, linearization.damping)
+        for j in np.flatnonzero(inside & (zeta < RESONANCE_DAMPING_RATIO)):
+            resonances.append({"mode": int(j + 1), "omega": float(wn[j]),
+                               "damping_ratio": float(zeta[j])})
+    if resonances:
+        flags.append("resonance")
+        r0 = resonances[0]
+        more = f" and {len(resonances) - 1} more" if len(resonances) > 1 else ""
+        warn(
+            f"line '{name}': mode {r0['mode']} ({r0['omega']:.4g} rad/s){more} lies in the "
+            f"excitation band with modal damping ratio {r0['damping_ratio']:.2%} "
+            f"(threshold {RESONANCE_DAMPING_RATIO:.0%}): a near-undamped resonance whose "
+            "response is set by damping the model may not represent; check the drag "
+            "coefficients and add structural damping (analysis.structural_damping) or "
+            "seabed damping where physical",
+            PhysicsWarning, stacklevel=3,
+        )
+    # large motions
+    pos = model.positions
+    chord = pos[-1] - pos[0]
+    cn = float(np.linalg.norm(chord))
+    rel = pos - pos[0]
+    if cn > 0:
+        rel = rel - np.outer(rel @ (chord / cn), chord / cn)
+    sag = float(np.max(np.linalg.norm(rel, axis=1)))
+    m_std = np.linalg.norm(motion_std, axis=1)
+    m_max = float(m_std.max()) if m_std.size else 0.0
+    to_sag = m_max / sag if sag > 0 else (np.inf if m_max > 0 else 0.0)
+    to_d = m_max / float(np.max(mesh.diameter))
+    if to_sag > MOTION_SAG_FRACTION:
+        flags.append("large_motion")
+        j = int(np.argmax(m_std))
+        warn(
+            f"line '{name}': the motion σ at node {j + 1} ({m_max:.3g} m) is "
+            f"{to_sag:.2g} of the line's sag ({sag:.3g} m), above the threshold "
+            f"{MOTION_SAG_FRACTION:g}: the linearization about the static shape is "
+            "doubtful; check with a nonlinear time-domain analysis "
+            "(stochcable.cable_timedomain)",
+            PhysicsWarning, stacklevel=3,
+        )
+    return LineIndicators(
+        borgman_ratio=borgman, drag_inertia_ratio=d_i, snap_margin=snap_margin,
+        snap_risk=snap, resonances=tuple(resonances), motion_std_max=m_max, sag=sag,
+        motion_to_sag=float(to_sag), motion_to_diameter=to_d, flags=tuple(flags),
+    )
 
 
 def line_result(
@@ -1272,6 +1669,11 @@ def line_result(
         _tail_check(system.name, end, w, dens, stats[end].m0)
     if np.any(spectra > 0):  # nothing to resolve without excitation
         _resolution_check(system, linearization.damping, w)
+    tension_std = np.sqrt(np.trapezoid(s_ten, w, axis=-1))
+    motion_std = np.sqrt(np.trapezoid(s_mot, w, axis=-1))
+    indicators = (None if linearization.record is None else
+                  line_indicators(system, channels, linearization, tension_std, motion_std,
+                                  stats))
     comps = list(model.components)
     d = model.dim
     end_force = {}
@@ -1292,8 +1694,8 @@ def line_result(
         end_tension_transfer=dict(resp.end_tension),
         end_force_transfer=end_force,
         tension_mean=np.asarray(st.tension, dtype=float).copy(),
-        tension_std=np.sqrt(np.trapezoid(s_ten, w, axis=-1)),
-        motion_std=np.sqrt(np.trapezoid(s_mot, w, axis=-1)),
+        tension_std=tension_std,
+        motion_std=motion_std,
         end_a=stats["end_a"],
         end_b=stats["end_b"],
         linearization=linearization.record,
@@ -1303,6 +1705,7 @@ def line_result(
         statics=st,
         model=model,
         modes=system.modes,
+        indicators=indicators,
     )
 
 
@@ -1463,12 +1866,16 @@ def analyze(
         raise InputError("analysis.linearization.method", "harmonic", "-",
                          "the harmonic (regular-wave) form has no current term: use "
                          "'seed' or 'vector' with a current")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    # Warnings are issued as they arise and also recorded for the result document by
+    # a thread-local collector (warnings.catch_warnings is process-global before
+    # Python 3.14, so concurrent analyses in service threads would swap them).
+    with collect_warnings() as caught, _single_blas_thread(_is_small(scene)):
         progress("statics", {})
         t0 = time.perf_counter()
         if statics is None:
-            statics = solve_statics(scene)
+            # the FE equilibrium, not the closed-form catenary: the dynamic model is
+            # linearized about it, so it must be an equilibrium of the same FE model
+            statics = solve_statics(scene, method="fe")
         timing["statics_s"] = time.perf_counter() - t0
         systems: dict[str, LineSystem] = {}
         lines: dict[str, LineResult] = {}
@@ -1481,7 +1888,7 @@ def analyze(
             timing["model_s"] += time.perf_counter() - t0
             systems[line.name] = system
             if not channels:
-                warnings.warn(
+                warn(
                     f"line '{line.name}' has no excitation (no sea and no end motion): its "
                     "dynamic response is zero; add a 'sea' or an end 'motion'",
                     PhysicsWarning, stacklevel=2,
@@ -1505,15 +1912,8 @@ def analyze(
             timing["timeseries_s"] = time.perf_counter() - t0
     messages: list[str] = []
     for w in caught:
-        text = str(w.message)
-        if text not in messages:
-            messages.append(text)
-            module = None
-            if "stochcable" in str(w.filename):
-                from pathlib import Path
-
-                module = "stochcable." + Path(str(w.filename)).stem
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, module=module)
+        if str(w) not in messages:
+            messages.append(str(w))
     timing["total_s"] = time.perf_counter() - t_start
     progress("done", {"total_s": timing["total_s"]})
     return Result(scene=scene, statics=statics, lines=lines, timeseries=ts, timing=timing,

@@ -15,6 +15,7 @@ S_x(ω) = Σ_i |H_{x,i}(ω)|² S_i(ω).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -24,6 +25,7 @@ __all__ = [
     "THREE_HOURS",
     "ResponseStats",
     "LinearizationRecord",
+    "LineIndicators",
     "LineResult",
     "TimeSeries",
     "Result",
@@ -169,6 +171,79 @@ class LinearizationRecord:
         }
 
 
+
+def _finite_or_none(x: float) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+@dataclass(frozen=True, eq=False)
+class LineIndicators:
+    """Quality indicators of the linear model of one line (GitHub issue 7).
+
+    Attributes
+    ----------
+    borgman_ratio : ndarray, shape (n_el,)
+        Var(B v)/Var(½ρCdD|v|v) of the normal drag per element for the Gaussian
+        normal relative velocity with the element's normal current
+        (:func:`stochcable.linearization.borgman_variance_ratio`; 0.849 without
+        current). [-]
+    drag_inertia_ratio : ndarray, shape (n_el,)
+        σ of the linearized normal drag force over σ of the Morison inertia force
+        ρ C_M (πD²/4) a_n of the sea per element (inf without fluid acceleration;
+        :func:`stochcable.linearization.drag_inertia_ratio`). [-]
+    snap_margin : float
+        min over elements and ends of (T_mean − 3σ_T)/|T_mean|; below 0 the linear
+        model predicts slack (snap loads likely). [-]
+    snap_risk : bool
+        ``snap_margin < 0``.
+    resonances : tuple of dict
+        Modes inside the excitation band with modal damping ratio below 1 %:
+        ``{"mode": j (1-based), "omega": ω_j [rad/s], "damping_ratio": ζ_j [-]}``.
+    motion_std_max : float
+        Largest node motion σ (magnitude of the x, y, z σ). [m]
+    sag : float
+        Largest distance of the static shape from the chord of the ends. [m]
+    motion_to_sag : float
+        motion_std_max / sag (inf for a straight line). [-]
+    motion_to_diameter : float
+        motion_std_max / largest diameter. [-]
+    flags : tuple of str
+        Raised flags: ``"snap"``, ``"resonance"``, ``"large_motion"``.
+    """
+
+    borgman_ratio: np.ndarray
+    drag_inertia_ratio: np.ndarray
+    snap_margin: float
+    snap_risk: bool
+    resonances: tuple[dict[str, Any], ...]
+    motion_std_max: float
+    sag: float
+    motion_to_sag: float
+    motion_to_diameter: float
+    flags: tuple[str, ...]
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (non-finite numbers as None)."""
+        br, di = self.borgman_ratio, self.drag_inertia_ratio
+        return {
+            "borgman_ratio": {"min": _finite_or_none(br.min()) if br.size else None,
+                              "max": _finite_or_none(br.max()) if br.size else None,
+                              "elements": [_finite_or_none(x) for x in br]},
+            "drag_inertia_ratio": {
+                "min": _finite_or_none(di.min()) if di.size else None,
+                "max": _finite_or_none(di.max()) if di.size else None,
+                "elements": [_finite_or_none(x) for x in di]},
+            "snap": {"risk": bool(self.snap_risk),
+                     "margin": _finite_or_none(self.snap_margin)},
+            "resonances": [dict(r) for r in self.resonances],
+            "motion": {"std_max": float(self.motion_std_max), "sag": float(self.sag),
+                       "to_sag": _finite_or_none(self.motion_to_sag),
+                       "to_diameter": _finite_or_none(self.motion_to_diameter)},
+            "flags": list(self.flags),
+        }
+
+
 @dataclass(frozen=True, eq=False)
 class LineResult:
     """Frequency-domain response of one line.
@@ -217,6 +292,8 @@ class LineResult:
     statics, model, modes : objects
         The statics result of the line, its finite-element model and modes (for
         inspection and re-use).
+    indicators : LineIndicators or None
+        Quality indicators of the linear model (None when not computed).
     """
 
     name: str
@@ -242,6 +319,7 @@ class LineResult:
     statics: Any = None
     model: Any = None
     modes: Any = None
+    indicators: LineIndicators | None = None
 
     @property
     def listed_modes(self) -> np.ndarray:
@@ -295,6 +373,7 @@ class LineResult:
             "channels": list(self.channels),
             "linearization": self.linearization.as_dict(),
             "modes": {"omega": self.listed_modes.tolist(), "kept": self.n_modes},
+            "indicators": None if self.indicators is None else self.indicators.as_dict(),
         }
 
 

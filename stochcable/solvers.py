@@ -30,7 +30,6 @@ frequency and the mode; no function returns inf or NaN.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -38,9 +37,10 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.linalg import lapack
 
 from . import _validate as _v
-from .errors import InputError, PhysicsWarning, SolverError
+from .errors import InputError, PhysicsWarning, SolverError, warn
 
 __all__ = [
     "DefectivePencilWarning",
@@ -677,9 +677,13 @@ class FossModes:
         ``a_j = theta_j^T A theta_j`` (plain transpose).
     weights : ndarray, complex, shape (2n, n)
         ``G^{-1} chi^T`` with ``G = Theta^T A Theta`` (``= diag(a)`` up to
-        round-off; the full ``G`` keeps repeated eigenvalues exact).
+        round-off; the full ``G`` keeps repeated eigenvalues exact), computed as
+        ``Theta^{-1} [Mhat^{-1}; 0]`` (the same matrix, see
+        :func:`foss_decomposition`).
     condition : float
-        Condition number of the column-normalized eigenvector matrix. [-]
+        LAPACK ``gecon`` estimate of the 1-norm condition number of the
+        column-normalized eigenvector matrix (within a factor ``2n`` of the
+        2-norm one). [-]
     """
 
     lambdas: np.ndarray
@@ -710,8 +714,8 @@ def foss_decomposition(
     Raises
     ------
     SolverError
-        If the pencil is (nearly) defective — eigenvector matrix condition number
-        above ``DEFECTIVE_CONDITION`` (1e7), e.g. a critically damped mode, where
+        If the pencil is (nearly) defective — estimated eigenvector matrix condition
+        number above ``DEFECTIVE_CONDITION`` (1e7), e.g. a critically damped mode, where
         some ``a_j`` vanish — or ``Mhat`` is not positive definite.
 
     Notes
@@ -729,6 +733,13 @@ def foss_decomposition(
     ``(i w A + B)^{-1} = Theta (i w - Lambda)^{-1} G^{-1} Theta^T`` valid for any
     non-defective pencil — which reduces to ``1/a_j`` when the eigenvalues are
     distinct.
+
+    Cost: one real ``geev`` of size 2n and one complex LU of ``Theta``.  The LU
+    serves twice: ``gecon`` estimates the condition number from it (O(n²), instead
+    of an SVD, which cost as much as the eigenproblem), and the weights are
+    ``G^{-1} chi^T = Theta^{-1} A^{-1} Theta^{-T} Theta^T [0; I]
+    = Theta^{-1} [Mhat^{-1}; 0]``, so ``G`` is never formed;
+    ``a_j = 2 lambda_j chi_j^T Mhat chi_j + chi_j^T Chat chi_j`` (seed eq. 5.3.18).
     """
     Mh = _v.float_array("Mhat", Mhat, "kg", ndim=2)
     n = Mh.shape[0]
@@ -737,30 +748,49 @@ def foss_decomposition(
     for name, arr in (("Mhat", Mh), ("Chat", Ch), ("Khat", Kh)):
         if arr.shape != (n, n):
             raise InputError(name, arr, "-", f"must have shape ({n}, {n})")
-    Z = np.zeros((n, n))
-    A = np.block([[Z, Mh], [Mh, Ch]])
+    return _foss_decomposition(Mh, Ch, Kh)
+
+
+def _foss_decomposition(Mh: np.ndarray, Ch: np.ndarray, Kh: np.ndarray) -> FossModes:
+    """:func:`foss_decomposition` without validation (float arrays of shape (n, n))."""
+    n = Mh.shape[0]
     try:
-        mc = sla.cho_factor(Mh)
+        mc = sla.cho_factor(Mh, check_finite=False)
     except np.linalg.LinAlgError:
         raise SolverError("Foss eigenproblem: Mhat is not positive definite") from None
     # A^{-1}(-B) = [[-M^-1 C, -M^-1 K], [I, 0]] acting on theta = [lambda chi; chi]:
     # a standard eigenproblem (LAPACK geev), 3-5x faster than QZ on the pencil
-    S = np.block([[-sla.cho_solve(mc, Ch), -sla.cho_solve(mc, Kh)], [np.eye(n), Z]])
-    lam, theta = sla.eig(S, check_finite=False)
+    S = np.zeros((2 * n, 2 * n))
+    S[:n, :n] = -sla.cho_solve(mc, Ch, check_finite=False)
+    S[:n, n:] = -sla.cho_solve(mc, Kh, check_finite=False)
+    S[n:, :n] = np.eye(n)
+    lam, theta = sla.eig(S, check_finite=False, overwrite_a=True)
     if not np.all(np.isfinite(lam)):  # pragma: no cover - S is finite
         raise SolverError("Foss eigenproblem produced non-finite eigenvalues")
-    theta = theta / np.linalg.norm(theta, axis=0)
-    cond = float(np.linalg.cond(theta))
+    theta /= np.linalg.norm(theta, axis=0)
+    # One LU of the column-normalized eigenvector matrix gives both the condition
+    # estimate (LAPACK gecon, 1-norm) and the weights Theta^{-1} A^{-1} [0; I].
+    lu, piv = sla.lu_factor(theta, check_finite=False)
+    if np.any(np.diagonal(lu) == 0.0):
+        cond = np.inf
+    else:
+        rcond, _ = lapack.zgecon(lu, float(np.abs(theta).sum(axis=0).max()), norm="1")
+        cond = 1.0 / rcond if rcond > 0 else np.inf
     if not np.isfinite(cond) or cond > DEFECTIVE_CONDITION:
         raise SolverError(
             f"Foss eigenproblem is (nearly) defective: eigenvector condition number "
             f"{cond:.2e} > {DEFECTIVE_CONDITION:.0e} (a critically damped mode, a_j ~ 0); "
             "use the direct modal solve (solve_modal(method='modal_direct'))"
         )
-    G = theta.T @ A @ theta
     chi = theta[n:]
-    weights = np.linalg.solve(G, chi.T)
-    return FossModes(lam, chi, np.diagonal(G).copy(), weights, cond)
+    # A^{-1} [0; I] = [M^{-1}; 0] (A = [[0, M], [M, C]])
+    rhs = np.zeros((2 * n, n), dtype=complex)
+    rhs[:n] = sla.cho_solve(mc, np.eye(n), check_finite=False)
+    weights = sla.lu_solve((lu, piv), rhs, check_finite=False)
+    # a_j = theta_j^T A theta_j = 2 lambda_j chi_j^T M chi_j + chi_j^T C chi_j
+    a = (2.0 * lam * np.einsum("ij,ij->j", chi, Mh @ chi)
+         + np.einsum("ij,ij->j", chi, Ch @ chi))
+    return FossModes(lam, chi, a, weights, float(cond))
 
 
 def _mode_of_pair(foss: FossModes, j: int) -> int:
@@ -799,20 +829,34 @@ def foss_transfer(foss: FossModes, F_hat: np.ndarray, omega: np.ndarray) -> np.n
     w = _v.float_array("omega", omega, "rad/s", nonnegative=True)
     n = foss.chi.shape[0]
     f, squeeze = _loads(F_hat, n, w.size)
+    n_w, _, r = f.shape
+    fm = np.ascontiguousarray(np.moveaxis(f, 0, 1)).reshape(n, n_w * r)
+    z = _foss_transfer_modal(foss, fm, w, r)
+    z = np.moveaxis(z.reshape(n, n_w, r), 1, 0)
+    return z[:, :, 0] if squeeze else z
+
+
+def _foss_transfer_modal(foss: FossModes, f: np.ndarray, w: np.ndarray, r: int) -> np.ndarray:
+    """:func:`foss_transfer` in the mode-major layout, no validation.
+
+    ``f`` complex (n, n_w·r) with column ``k·r + c`` = frequency k, right-hand side c;
+    returns z in the same layout: two matrix products (BLAS gemm) for all
+    frequencies and right-hand sides."""
     lam = foss.lambdas
-    den = 1j * w[:, None] - lam[None, :]
-    scale = np.maximum(np.abs(lam)[None, :], w[:, None])
+    den = 1j * w[None, :] - lam[:, None]  # (2n, n_w)
+    scale = np.maximum(np.abs(lam)[:, None], w[None, :])
     bad = np.abs(den) <= 1e-12 * scale
     if bad.any():
-        k, j = (int(x[0]) for x in np.nonzero(bad))
+        j, k = (int(x[0]) for x in np.nonzero(bad))
         raise SolverError(
             f"undamped resonance at omega = {w[k]:.6g} rad/s: Foss eigenvalue "
             f"lambda = {lam[j]:.6g} of modal coordinate {_mode_of_pair(foss, j)} has no "
             "damping; add damping or remove this frequency from the grid"
         )
-    p = foss.weights @ f  # (2n, n) @ (n_omega, n, r)
-    z = foss.chi @ (p / den[:, :, None])
-    return z[:, :, 0] if squeeze else z
+    p = foss.weights @ f  # (2n, n_w·r)
+    p = p.reshape(lam.size, w.size, r)
+    p /= den[:, :, None]
+    return foss.chi @ p.reshape(lam.size, -1)
 
 
 # ---------------------------------------------------------------------------------
@@ -923,7 +967,7 @@ def solve_modal(
         try:
             foss = foss_decomposition(Mh, Ch, Kh)
         except SolverError as exc:
-            warnings.warn(
+            warn(
                 f"{exc}; falling back to the direct solve in modal coordinates",
                 DefectivePencilWarning, stacklevel=2,
             )

@@ -738,8 +738,6 @@ def _chain_guess(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
     Returns None for a vertical span, a line that would pass below the seabed away from
     end_a, or when the closure Newton fails; the caller falls back to a parabola.
     """
-    from .catenary import catenary_solve
-
     zi = frame.dim - 1
     X = float(b[0] - a[0])
     Z = float(b[zi] - a[zi])
@@ -759,7 +757,6 @@ def _chain_guess(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
 
     def shoot(H: float, V0: float, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         V = V0 + np.concatenate([[0.0], np.cumsum(P[1:-1])])  # element k
-        zs = np.full(mesh.n_nodes, np.nan)
         if on_bed:
             pos = np.flatnonzero(V > 0.0)
             k_star = int(pos[0]) if pos.size else V.size
@@ -880,7 +877,6 @@ def _chain_closure(shoot, P: np.ndarray, xb: float, zb: float,
     from scipy.optimize import brentq
 
     load = float(np.sum(np.abs(P))) + 1.0
-    tol = 1e-13 * scale
 
     def v0_of(H: float) -> float | None:
         lo, hi = -2.0 * load - H, 2.0 * load + H

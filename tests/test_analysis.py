@@ -589,3 +589,21 @@ def test_rayleigh_damped_taut_string_first_mode_peak():
     with pytest.raises(SolverError, match="singular|resonance"):
         an.solve(undamped, line_channels(scene, scene.lines[0], system.positions,
                                          np.array([system.modes.omega[0]])), damping)
+
+
+def test_damping_matrix_is_assembled_lazily_and_equals_drag_matrix():
+    from stochcable.excitation import drag_matrix
+
+    import json
+    from pathlib import Path
+
+    path = Path(an.__file__).parent / "examples" / "chain_catenary.json"
+    scene = load_scene(json.loads(path.read_text()))
+    st = solve_statics(scene)
+    line = scene.lines[0]
+    system = an.build_line_system(scene, line, st.lines[line.name])
+    n_el = system.model.n_elements
+    damping = an.drag_coefficients(system, np.linspace(0.1, 0.5, 2 * n_el), "seed")
+    assert "matrix" not in damping._cache  # nothing assembled in the iteration
+    ref = drag_matrix(system.model, damping.b_normal, damping.b_axial, damping.b_node)
+    assert abs(damping.matrix - ref).max() == 0.0  # the same assembly, exactly

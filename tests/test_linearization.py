@@ -307,3 +307,22 @@ def test_fixed_point_keeps_nonnegative_and_handles_zero_components():
         fixed_point(update, [1.0, 1.0, 1.0], relaxation=1.5)
     with pytest.raises(InputError, match="x0"):
         fixed_point(update, [-1.0, 1.0, 1.0])
+
+
+def test_fixed_point_anderson_mixing_parameter():
+    # linear contraction x = A x + b (spectral radius 0.6): same fixed point with any
+    # mixing; mixing=None is the old behaviour (mixing = relaxation)
+    rng = np.random.default_rng(11)
+    q, _ = np.linalg.qr(rng.standard_normal((6, 6)))
+    a = q @ np.diag([0.6, -0.5, 0.3, 0.2, -0.1, 0.05]) @ q.T
+    b = rng.uniform(1.0, 2.0, 6)
+    exact = np.linalg.solve(np.eye(6) - a, b)
+    runs = {}
+    for mix in (None, 0.5, 1.0):
+        r = fixed_point(lambda x: a @ x + b, np.abs(b), tol=1e-10, relaxation=0.5,
+                        mixing=mix)
+        np.testing.assert_allclose(r.x, exact, rtol=1e-8)  # tol 1e-10 on the change
+        runs[mix] = r
+    assert runs[None].history == runs[0.5].history
+    with pytest.raises(InputError, match="mixing"):
+        fixed_point(lambda x: x, [1.0], mixing=0.0)

@@ -1,0 +1,243 @@
+"""Linearization quality indicators (GitHub issue 7 item 3): Borgman variance ratio,
+drag/inertia size, snap, near-undamped resonance and large-motion flags."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import json
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from stochcable.analysis import (
+    analyze,
+    build_line_system,
+    line_indicators,
+    linearize,
+)
+from stochcable.errors import InputError, PhysicsWarning
+from stochcable.excitation import line_channels
+from stochcable.linearization import borgman_variance_ratio, drag_inertia_ratio
+from stochcable.scene import load_scene
+from stochcable.statics import solve_statics
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "stochcable" / "examples"
+# Zero-mean Gaussian: Var(Bv)/Var(c v|v|) = (8/pi) c² σ⁴ / (3 c² σ⁴) (Borgman 1972)
+BORGMAN_ZERO_MEAN = 8.0 / (3.0 * math.pi)
+
+
+def _doc(name: str) -> dict:
+    d = json.loads((EXAMPLES / f"{name}.json").read_text())
+    d["analysis"].pop("timeseries", None)
+    return d
+
+
+def _analyze_quiet(doc: dict):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return analyze(doc)
+
+
+# ------------------------------------------------------------------ Borgman ratio
+
+
+def test_borgman_ratio_zero_mean_is_8_over_3pi():
+    sig = np.array([1e-3, 0.2, 1.0, 7.0])
+    # exact closed form, any σ: only round-off
+    np.testing.assert_allclose(borgman_variance_ratio(sig), BORGMAN_ZERO_MEAN, rtol=1e-14)
+
+
+def _moments_by_quadrature(mu: float) -> float:
+    """Var(Bv)/Var(v|v|) for v ~ N(mu, 1) by adaptive quadrature split at the kink."""
+    pdf = lambda v: math.exp(-0.5 * (v - mu) ** 2) / math.sqrt(2 * math.pi)  # noqa: E731
+
+    def e(f):
+        lo, hi = mu - 12.0, mu + 12.0
+        pts = [0.0] if lo < 0.0 < hi else None
+        return integrate.quad(lambda v: f(v) * pdf(v), lo, hi, points=pts,
+                              epsabs=0, epsrel=1e-13, limit=200)[0]
+
+    e_abs = e(abs)
+    e_vv = e(lambda v: v * abs(v))
+    e_v4 = e(lambda v: v**4)
+    return 4.0 * e_abs**2 / (e_v4 - e_vv**2)
+
+
+@pytest.mark.parametrize("mu", [0.3, 0.76, 1.5, 4.0, 8.0, 9.0, 20.0])
+def test_borgman_ratio_with_current_matches_quadrature(mu):
+    got = borgman_variance_ratio(0.5, 0.5 * mu)  # only U/σ matters
+    # quadrature to ~1e-12; the closed form's erf/exp to round-off
+    assert got == pytest.approx(_moments_by_quadrature(mu), rel=1e-9)
+    assert got == pytest.approx(borgman_variance_ratio(0.5, -0.5 * mu), rel=1e-14)
+
+
+def test_borgman_ratio_with_current_matches_monte_carlo():
+    rng = np.random.default_rng(20240607)
+    sigma, u = 0.4, 0.3
+    n = 2_000_000
+    v = u + sigma * rng.standard_normal(n)
+    c = 0.5 * 1025.0 * 1.2 * 0.1
+    b = 2.0 * c * np.mean(np.abs(v))  # B = ρ Cd D E|v| = 2c E|v|
+    ratio_mc = np.var(b * v) / np.var(c * v * np.abs(v))
+    # relative sampling error of a variance ~ sqrt(Var(x²)/n)/Var(x); the v|v| tail
+    # (kurtosis ~ 10) gives ~ 2e-3 at n = 2e6: 5 standard errors
+    assert borgman_variance_ratio(sigma, u) == pytest.approx(ratio_mc, rel=1e-2)
+
+
+def test_borgman_ratio_limits_and_range():
+    # σ → 0 with a current: a small fluctuation about U is linear (ratio 1);
+    # σ = U = 0: the zero-mean value by scale invariance
+    assert borgman_variance_ratio(0.0, 0.5) == 1.0
+    assert borgman_variance_ratio(0.0, 0.0) == pytest.approx(BORGMAN_ZERO_MEAN, rel=1e-14)
+    # continuity across the switch to the large-|U|/σ form (8.5): smooth to 1e-10
+    lo, hi = borgman_variance_ratio(1.0, [8.5 - 1e-9, 8.5 + 1e-9])
+    assert hi == pytest.approx(lo, rel=1e-9)
+    mu = np.linspace(0.0, 30.0, 3001)
+    r = borgman_variance_ratio(np.ones_like(mu), mu)
+    assert r.min() == pytest.approx(0.8222, abs=1e-4) and r.max() < 1.0
+    with pytest.raises(InputError, match="sigma.*m/s"):
+        borgman_variance_ratio(-1.0)
+
+
+# ------------------------------------------------------------ drag / inertia
+
+
+def test_drag_inertia_ratio_closed_form_and_thin_vs_thick_cylinder():
+    # deep-water narrow-band wave of ω = 0.6 rad/s, σ_v = 1 m/s: σ_a = ω σ_v
+    rho, cd, cm, w, sv = 1025.0, 1.2, 2.0, 0.6, 1.0
+    sa = w * sv
+    for d in (0.05, 0.5, 2.0, 10.0):
+        kc = sv * (2 * math.pi / w) / d
+        expected = math.sqrt(8 / math.pi) / math.pi**2 * cd / cm * kc
+        assert drag_inertia_ratio(rho, cd, cm, d, sv, sa) == pytest.approx(expected,
+                                                                         rel=1e-13)
+    thin = drag_inertia_ratio(rho, cd, cm, 0.05, sv, sa)
+    thick = drag_inertia_ratio(rho, cd, cm, 10.0, sv, sa)
+    # KC_σ 209 vs 1.05: drag-dominated (20.3) vs inertia-dominated (0.10), ratio ∝ 1/D
+    assert thin > 10.0 and thick < 0.15
+    assert thin / thick == pytest.approx(200.0, rel=1e-13)
+    # no fluid acceleration: inertia force zero
+    assert drag_inertia_ratio(rho, cd, cm, 0.1, 1.0, 0.0) == math.inf
+    assert drag_inertia_ratio(rho, cd, cm, 0.1, 0.0, 0.0) == 0.0
+
+
+def test_drag_inertia_in_analysis_scales_like_sigma_squared_over_diameter():
+    # the same taut wire, diameter x 4 and mass raised to keep the net weight (so the
+    # static shape, hence σ_a of the fluid, is the same: near the seabed the vertical
+    # kinematics grow linearly with height): B_n ∝ D σ_n and the inertia force
+    # ∝ D² σ_a, so ratio·D/σ_n² is unchanged
+    doc = _doc("taut_wire")
+    thick = copy.deepcopy(doc)
+    seg = thick["lines"][0]["segments"][0]
+    d1 = seg["diameter"]
+    seg["diameter"] = 4.0 * d1
+    seg["mass"] += doc["environment"]["rho"] * math.pi / 4.0 * (seg["diameter"]**2 - d1**2)
+    l1 = _analyze_quiet(doc).lines["wire"]
+    l4 = _analyze_quiet(thick).lines["wire"]
+    q1 = l1.indicators.drag_inertia_ratio / l1.linearization.sigma_normal**2
+    q4 = 4.0 * l4.indicators.drag_inertia_ratio / l4.linearization.sigma_normal**2
+    np.testing.assert_allclose(l4.positions, l1.positions, atol=1e-6)
+    # same σ_a; b_n and σ_n of the record differ by the linearization tolerance 1e-4
+    np.testing.assert_allclose(q4, q1, rtol=3e-4)
+    # and the thin wire is the more drag-dominated one
+    assert np.all(l1.indicators.drag_inertia_ratio > 3.0 * l4.indicators.drag_inertia_ratio)
+
+
+# ------------------------------------------------------------------------ flags
+
+
+def test_tuah_6_5_sigma_exceeds_mean_tension_gives_snap_warning():
+    doc = _doc("tuah_1982_single_leg")
+    with pytest.warns(PhysicsWarning, match=r"snap loads likely; the linear model is out "
+                                            r"of its depth \(threshold mean − 3σ >= 0\)"):
+        res = analyze(doc)
+    line = next(iter(res.lines.values()))
+    assert line.end_a.std > line.end_a.mean  # the seed's case σ_T > T_mean
+    ind = line.indicators
+    assert ind.snap_risk and "snap" in ind.flags and ind.snap_margin < 0
+    doc_ind = res.to_document()["lines"][line.name]["indicators"]
+    assert doc_ind["snap"]["risk"] is True and "snap" in doc_ind["flags"]
+
+
+def test_chain_has_no_snap_resonance_or_motion_flag():
+    res = _analyze_quiet(_doc("chain_catenary"))
+    ind = res.lines["leg1"].indicators
+    assert ind.flags == () and not ind.snap_risk and ind.snap_margin > 0.5
+    assert not any("snap" in w or "excitation band" in w for w in res.warnings)
+    # current on the line: per-element ratios between the zero-mean value and 1
+    assert ind.borgman_ratio.min() >= 0.8221 and ind.borgman_ratio.max() <= 1.0
+    json.dumps(res.to_document())  # JSON-ready (inf -> None)
+
+
+def test_near_undamped_resonance_flag_fires_and_is_cured_by_damping():
+    doc = _doc("inclined_guy")
+    with pytest.warns(PhysicsWarning, match=r"mode 2 \(1\.193 rad/s\) lies in the "
+                                            r"excitation band with modal damping ratio"
+                                            r".*threshold 1%"):
+        res = analyze(doc)
+    ind = res.lines["guy"].indicators
+    assert "resonance" in ind.flags
+    r = ind.resonances[0]
+    assert r["mode"] == 2 and r["damping_ratio"] < 0.01
+    # Rayleigh alpha adds ζ = alpha/(2ω) = 2.1 % at 1.19 rad/s: no flag any more
+    damped = copy.deepcopy(doc)
+    damped["analysis"]["structural_damping"] = {"alpha": 0.05, "beta": 0.0}
+    res2 = _analyze_quiet(damped)
+    assert "resonance" not in res2.lines["guy"].indicators.flags
+    assert not any("excitation band" in w for w in res2.warnings)
+
+
+def _chain_parts():
+    scene = load_scene(_doc("chain_catenary"))
+    st = solve_statics(scene)
+    line = scene.lines[0]
+    system = build_line_system(scene, line, st.lines[line.name])
+    chans = line_channels(scene, line, system.positions, scene.analysis.omega.values())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        lin = linearize(system, chans, scene.analysis)
+    return system, chans, lin
+
+
+def test_large_motion_flag_threshold_against_sag():
+    system, chans, lin = _chain_parts()
+    res = _analyze_quiet(_doc("chain_catenary")).lines["leg1"]
+    stats = {"end_a": res.end_a, "end_b": res.end_b}
+    sag = res.indicators.sag
+    # the chain spans 800 m x 180 m with 850 m of chain: sag of order 100 m
+    assert 50.0 < sag < 200.0
+    n = system.model.n_nodes
+    for frac, fires in ((0.12, True), (0.08, False)):
+        mot = np.zeros((n, 3))
+        mot[n // 2, 0] = frac * sag
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            ind = line_indicators(system, chans, lin, res.tension_std, mot, stats)
+        msgs = [str(w.message) for w in caught if issubclass(w.category, PhysicsWarning)]
+        assert ind.motion_to_sag == pytest.approx(frac, rel=1e-12)
+        assert ("large_motion" in ind.flags) is fires
+        assert any("of the line's sag" in m and "threshold 0.1" in m for m in msgs) is fires
+
+
+def test_snap_flag_fires_at_an_element_and_not_below_threshold():
+    system, chans, lin = _chain_parts()
+    res = _analyze_quiet(_doc("chain_catenary")).lines["leg1"]
+    t = np.asarray(res.tension_mean)
+    k = t.size // 2
+    for factor, fires in ((0.34, True), (0.32, False)):
+        std = np.zeros_like(t)
+        std[k] = factor * t[k]  # 3σ = 1.02 T or 0.96 T
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            ind = line_indicators(system, chans, lin, std, np.zeros((t.size + 1, 3)),
+                                  {"end_a": dataclasses.replace(res.end_a, std=0.0),
+                                   "end_b": dataclasses.replace(res.end_b, std=0.0)})
+        msgs = [str(w.message) for w in caught]
+        assert ind.snap_risk is fires
+        assert any(f"element {k + 1}" in m and "snap loads likely" in m for m in msgs) is fires
+        assert ind.snap_margin == pytest.approx(1.0 - 3.0 * factor, rel=1e-12)
