@@ -79,6 +79,11 @@ def main() -> None:
     warnings.simplefilter("ignore")
     doc = base_doc()
 
+    import os
+
+    load = os.getloadavg()[0]
+    print(f"load average (1 min) {load:.2f}" + ("" if load < 1.5 else
+                                               "  -- machine busy: timings inflated"))
     print("== analyze() on the reference chain (no time series) ==")
     print(f"{'case':<22}{'median ms':>10}{'min ms':>9}  stage shares (median)")
     for name, d in (("foss, modes auto", doc),
