@@ -23,7 +23,6 @@ from __future__ import annotations
 import json
 import math
 import re
-import typing
 from typing import Any
 
 from fastapi import FastAPI, Request
@@ -33,6 +32,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import JSONResponse
 
 from stochcable.errors import ConvergenceError, InputError, SolverError, StochcableError
+from stochcable.scene import field_path_and_unit
 
 from .limits import BodyTooLarge, LimitExceeded, RunTimeExceeded
 
@@ -80,56 +80,6 @@ def _loc_from_parameter(parameter: str) -> list[str | int]:
     return out
 
 
-def _models_in(annotation: Any) -> list[type[BaseModel]]:
-    """Pydantic model classes reachable in a type annotation (unions, tuples, lists)."""
-    found: list[type[BaseModel]] = []
-    stack = [annotation]
-    while stack:
-        t = stack.pop()
-        if isinstance(t, type) and issubclass(t, BaseModel):
-            found.append(t)
-            continue
-        stack.extend(typing.get_args(t))
-    return found
-
-
-def _field_unit(model: type[BaseModel] | None, path: list[str | int]) -> tuple[str, str]:
-    """(dotted parameter path, unit) of a field location in ``model``.
-
-    Discriminator tags in pydantic locations (``spectrum.pierson_moskowitz.hs``) select
-    the union member and are dropped from the path.
-    """
-    candidates = [model] if model is not None else []
-    unit = ""
-    clean: list[str | int] = []
-    for part in path:
-        if isinstance(part, int):
-            clean.append(part)
-            continue
-        hit = next((c for c in candidates if part in c.model_fields), None)
-        if hit is None:
-            tagged = [
-                c for c in candidates
-                if "type" in c.model_fields and c.model_fields["type"].default == part
-            ]
-            if tagged:
-                candidates = tagged
-                continue
-            clean.append(part)
-            candidates = []
-            unit = ""
-            continue
-        clean.append(part)
-        info = hit.model_fields[part]
-        extra = info.json_schema_extra
-        unit = extra.get("unit", "") if isinstance(extra, dict) else ""
-        candidates = _models_in(info.annotation)
-    text = ""
-    for part in clean:
-        text += f"[{part}]" if isinstance(part, int) else (("." if text else "") + str(part))
-    return text, unit
-
-
 def _body_model(request: Request) -> type[BaseModel] | None:
     route = request.scope.get("route")
     field = getattr(route, "body_field", None)
@@ -152,7 +102,7 @@ async def _validation_handler(request: Request, exc: RequestValidationError) -> 
         if err.get("type") == "json_invalid":
             item["parameter"] = "body"  # loc[1] is the character offset
         elif loc and loc[0] == "body":
-            parameter, unit = _field_unit(model, loc[1:])
+            parameter, unit = field_path_and_unit(model, loc[1:])
             item["parameter"] = parameter or "body"
             if unit:
                 item["unit"] = unit

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
@@ -53,6 +53,7 @@ __all__ = [
     "Scene",
     "load_scene",
     "scene_json_schema",
+    "field_path_and_unit",
 ]
 
 G_STANDARD = 9.80665  # standard gravity [m/s²]
@@ -602,18 +603,32 @@ class Scene(_Doc):
 # ---------------------------------------------------------------------- boundary
 
 
-def _unit_of(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str:
-    """The unit declared on the field at ``loc`` (walking nested models), or ''.
+def field_path_and_unit(model: type[BaseModel] | None, loc: Sequence[Any]) -> tuple[str, str]:
+    """Dotted path and declared unit of the field at a pydantic error location.
 
-    Discriminated unions are followed: a path part equal to a member's ``type`` tag
-    narrows the candidates to that member.
+    Parameters
+    ----------
+    model : pydantic model class or None
+        The model the location is relative to.
+    loc : sequence of str and int
+        A pydantic error location, e.g. ``("sea", "spectrum", "jonswap", "hs")``.
+
+    Returns
+    -------
+    path : str
+        ``"sea.spectrum.hs"``: discriminator tags (a union member's ``type`` default)
+        and pydantic's validator labels are dropped, list indices become ``[i]``.
+    unit : str
+        The unit in the field's ``json_schema_extra`` (``"m"``), or ``""``.
     """
     from typing import get_args
 
     unit = ""
     candidates: list[type[BaseModel]] = [model] if model is not None else []
+    out = ""
     for part in loc:
-        if isinstance(part, int) or not candidates:
+        if isinstance(part, int):
+            out += f"[{part}]"
             continue
         tagged = [
             c for c in candidates
@@ -622,8 +637,12 @@ def _unit_of(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str:
         if tagged:
             candidates = tagged
             continue
+        if isinstance(part, str) and part.startswith("function-"):
+            continue
+        out += ("." if out else "") + str(part)
         current = next((c for c in candidates if part in c.model_fields), None)
         if current is None:
+            candidates, unit = [], ""
             continue
         info = current.model_fields[part]
         extra = info.json_schema_extra
@@ -637,17 +656,7 @@ def _unit_of(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str:
                 continue
             stack.extend(get_args(t))
         candidates = found
-    return unit
-
-
-def _loc_to_path(loc: tuple[Any, ...]) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += ("." if out else "") + str(part)
-    return out or "scene"
+    return out, unit
 
 
 def input_error_from_validation(
@@ -663,10 +672,8 @@ def input_error_from_validation(
         if not any(o != lc and o[: len(lc)] == lc for o in locs)
     ] or errors
     err = leaves[0]
-    loc = tuple(err.get("loc", ()))
-    # drop discriminator tags from the path: they are the spectrum type, not a field
-    clean = tuple(p for p in loc if isinstance(p, int) or not _is_tag(p))
-    path = _loc_to_path(clean)
+    path, unit = field_path_and_unit(model, tuple(err.get("loc", ())))
+    path = path or "scene"
     if prefix:
         path = f"{prefix}.{path}" if path != "scene" else prefix
     msg = str(err.get("msg", "invalid"))
@@ -680,14 +687,7 @@ def input_error_from_validation(
         value = InputError._NO_VALUE
     elif isinstance(value, (list, tuple)) and len(value) > 6:
         value = f"[{len(value)} values]"
-    return InputError(path, value, _unit_of(model, loc), msg)
-
-
-_TAGS = {"pierson_moskowitz", "jonswap", "bretschneider", "issc", "ochi_hubble", "table"}
-
-
-def _is_tag(part: Any) -> bool:
-    return isinstance(part, str) and (part in _TAGS or part.startswith("function-"))
+    return InputError(path, value, unit, msg)
 
 
 def load_scene(source: Scene | Mapping[str, Any] | str | Path) -> Scene:
