@@ -458,6 +458,9 @@ class Result:
         ``timeseries_s``). [s]
     warnings : tuple of str
         Messages of the warnings raised during the analysis.
+    fidelity : FidelityPlan or None
+        The settings chosen by adaptive fidelity (``analysis.fidelity``), with their
+        reasons and error estimates; ``scene`` is then the scene they produced.
     """
 
     scene: Any
@@ -466,6 +469,7 @@ class Result:
     timeseries: TimeSeries | None
     timing: dict[str, float]
     warnings: tuple[str, ...] = field(default_factory=tuple)
+    fidelity: Any = None
 
     @property
     def converged(self) -> bool:
@@ -509,6 +513,8 @@ class Result:
             "timing": {k: float(v) for k, v in self.timing.items()},
             "warnings": list(self.warnings),
         }
+        if self.fidelity is not None:
+            doc["fidelity"] = self.fidelity.to_document()
         if self.timeseries is not None and timeseries != "none":
             doc["timeseries"] = self.timeseries.to_document(full=timeseries == "full")
         return doc

@@ -49,6 +49,7 @@ __all__ = [
     "LinearizationSettings",
     "TimeSeriesSettings",
     "StructuralDamping",
+    "FidelitySettings",
     "AnalysisSettings",
     "Scene",
     "load_scene",
@@ -532,6 +533,15 @@ class StructuralDamping(_Doc):
     beta: float = _f("Stiffness-proportional coefficient", "s", ge=0, default=0.0)
 
 
+class FidelitySettings(_Doc):
+    """Adaptive fidelity: the engine chooses elements, frequencies, modes and tolerance."""
+
+    target_error: float = _f(
+        "Target relative error of the response standard deviations", "-", gt=0, le=0.5,
+        default=0.01,
+    )
+
+
 class AnalysisSettings(_Doc):
     """How to solve: frequencies, solver, modes, linearization, time series."""
 
@@ -543,6 +553,12 @@ class AnalysisSettings(_Doc):
     )
     linearization: LinearizationSettings = Field(default_factory=LinearizationSettings)
     structural_damping: StructuralDamping = Field(default_factory=StructuralDamping)
+    fidelity: FidelitySettings | None = Field(
+        default=None,
+        description="When set, the engine chooses elements, frequency grid, modes and "
+        "tolerance itself for this target error (the other settings are replaced); the "
+        "choices and their error estimates are reported under 'fidelity'",
+    )
     timeseries: TimeSeriesSettings | None = None
     duration: float = _f("Storm duration for extreme-value statistics", "s", gt=0,
                          default=10800.0)

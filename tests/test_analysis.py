@@ -504,7 +504,7 @@ def test_rayleigh_damping_equals_independent_linear_solve():
     """Cd = 0, no current, no seabed contact: the transfer functions are the linear
     solve of (K − ω²M_T + iω(αM_T + βK))U = F, built here from the FE matrices and the
     sparse load assembly of stochcable.excitation (independent of the block solver)."""
-    from stochcable.excitation import channel_loads, inertia_matrix, prescribed_motion
+    from stochcable.excitation import prescribed_motion, wave_loads
 
     doc = chain_doc(grounded=False, sea=True, surge=True, elements=12, omega_count=25)
     for seg in doc["lines"][0]["segments"]:
@@ -519,7 +519,8 @@ def test_rayleigh_damping_equals_independent_linear_solve():
     MT = (model.M + model.Ma).toarray()
     C = alpha * MT + beta * K
     w = chans[0].omega
-    F = channel_loads(model, chans, 0.0 * model.K, inertia_matrix(model, 9.80665))
+    n_el = model.n_elements
+    F = wave_loads(model, chans, np.zeros(n_el), np.zeros(n_el), g=9.80665)
     ub = prescribed_motion(model, chans, w.size)
     free, fixed = model.free, model.fixed
     Z = K[None] - w[:, None, None] ** 2 * MT[None] + 1j * w[:, None, None] * C[None]
