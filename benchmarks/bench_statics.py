@@ -61,10 +61,7 @@ def main() -> None:
             print(f"{n:8d} {t2 * 1e3:9.2f} {t3 * 1e3:11.2f} {r.iterations:5d} "
                   f"{tc * 1e3:9.2f} {r.tension_b / c.tension_b - 1:13.2e} "
                   f"{r.tension_a / c.tension_a - 1:13.2e} {dtd:9.3f}")
-    try:
-        import moorpy  # noqa: F401
-    except ImportError:
-        print("moorpy not installed: comparison skipped")
+    print("\n(MoorPy's catenary on the same line: python benchmarks/bench_moorpy.py)")
 
 
 if __name__ == "__main__":

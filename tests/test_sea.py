@@ -294,3 +294,125 @@ def test_simulate_sea_does_not_modify_the_density_array():
     before = cached.copy()
     sea.simulate_sea(lambda w: cached, 64.0, 0.5, method="nsa", rng=3)
     np.testing.assert_array_equal(cached, before)
+
+
+# --- reproducibility pins -------------------------------------------------------------
+# Values computed with the implementation of git 47a3978 (pyfftw backend, FFTW_ESTIMATE),
+# before any speed work on simulate_sea: a given seed must keep giving the same
+# realization, whatever is optimized later.
+# The rational spectrum is built from IEEE-exact operations only (no exp), so its
+# coefficients are pinned exactly (they involve only +, ×, √, floor and the phase
+# table); PM involves np.exp, whose SIMD implementation may differ by an ulp between
+# CPUs, and the elevation goes through an FFT whose rounding depends on the backend and
+# plan, so those are pinned to 1e-13 relative to the record's largest |value| — a
+# change of the draw order, the phases or the amplitudes changes them at O(1).
+
+
+def _rational_density(w):
+    r = 1.0 / (1.0 + 25.0 * (w - 0.6) ** 2)
+    return r * r
+
+
+PINNED_REALIZATIONS = {
+    # (density, duration, dt, method, seed): ({m: X_m}, {n: eta_n})
+    "dsa": ((_rational_density, 2**18 * 0.1, 0.1, "dsa", 2024),
+            {1: 129.0395488998607 + 256.55857165234784j,
+             2: -63.884002244818596 - 280.1983014533145j,
+             4095: 484.0013217561319 + 385.32499864669893j,
+             65537: 0.5022350125020892 - 0.02402144275174565j,
+             131071: 0.10868521943061807 + 0.05290292617847558j},
+            {0: 0.3586032398176004, 1: 0.3573702800451186, 99999: 0.21413946814707613,
+             262143: 0.35485515791411026}),
+    "nsa": ((_rational_density, 2**18 * 0.1, 0.1, "nsa", 2024),
+            {1: 50.6160349705762 + 100.63564035576334j,
+             2: -82.17961505619674 - 360.4437377700637j,
+             4095: 377.6666127281104 + 300.6694000552465j,
+             65537: 0.22203492366846264 - 0.010619727966034631j,
+             131071: 0.018389439715516296 + 0.008951126720174974j},
+            {0: 0.2347583604810836, 1: 0.2160820433105237, 99999: 0.0801422112249818,
+             262143: 0.24850132598633087}),
+    "pm": ((lambda w: spectrum_pierson_moskowitz(w, 2.0, 8.0), 600.0, 0.5, "dsa", 1),
+           {100: 6.770147453717832 + 43.26199640417681j,
+            300: -1.7160276886093002 - 2.952442714809495j,
+            599: 0.36132860794029653 - 0.48847335546932635j},
+           {0: -0.005437874490355412, 1: 0.05521784773983335, 100: -0.24977981314472641,
+            1199: -0.16683778816619355}),
+}
+
+
+@pytest.mark.parametrize("case", sorted(PINNED_REALIZATIONS))
+def test_seeded_realization_is_pinned(case):
+    (density, duration, dt, method, seed), coeffs, elevs = PINNED_REALIZATIONS[case]
+    real = sea.simulate_sea(density, duration, dt, method, seed)
+    got_c = np.array([real.coefficients[m] for m in coeffs])
+    want_c = np.array(list(coeffs.values()))
+    if case == "pm":
+        np.testing.assert_allclose(got_c, want_c, rtol=1e-13)   # np.exp may differ by an ulp
+    else:
+        np.testing.assert_array_equal(got_c, want_c)           # IEEE-exact arithmetic only
+    scale = np.abs(real.elevation).max()
+    got_e = np.array([real.elevation[n] for n in elevs])
+    np.testing.assert_allclose(got_e, list(elevs.values()), rtol=0, atol=1e-13 * scale)
+
+
+def test_seeded_realization_independent_of_parallel_split(monkeypatch):
+    # the chunked/threaded kernel gives the same bits as a single-threaded run
+    density, duration, dt, method, seed = PINNED_REALIZATIONS["nsa"][0]
+    a = sea.simulate_sea(density, duration, dt, method, seed)
+    monkeypatch.setattr(sea.os, "cpu_count", lambda: 1)
+    b = sea.simulate_sea(density, duration, dt, method, seed)
+    np.testing.assert_array_equal(a.coefficients, b.coefficients)
+
+
+@pytest.mark.parametrize("method,draws", [("dsa", 1), ("nsa", 3)])
+def test_generator_argument_advanced_by_the_draws_only(method, draws):
+    # a caller's Generator ends where the documented draws leave it: N−1 uniforms (DSA)
+    # or N−1 uniforms + 2(N−1) normals (NSA); 2^18 samples take the parallel kernel
+    duration, dt = 2**18 * 0.1, 0.1
+    n = 2**17
+    gen = np.random.default_rng(5)
+    real = sea.simulate_sea(_rational_density, duration, dt, method, gen)
+    ref = np.random.default_rng(5)
+    ref.random(n - 1)
+    if method == "nsa":
+        ref.standard_normal(2 * (n - 1))
+    assert gen.bit_generator.state == ref.bit_generator.state
+    assert real.seed is None
+    np.testing.assert_array_equal(
+        real.coefficients, sea.simulate_sea(_rational_density, duration, dt, method, 5).coefficients)
+
+
+def test_generator_untouched_when_the_density_is_rejected():
+    # validation happens before a caller's generator is drawn from
+    gen = np.random.default_rng(6)
+    before = gen.bit_generator.state
+    with pytest.raises(InputError, match=r"must return finite values >= 0"):
+        sea.simulate_sea(lambda w: -_rational_density(w), 2**18 * 0.1, 0.1, rng=gen)
+    assert gen.bit_generator.state == before
+
+
+def test_concurrent_realizations_equal_sequential_ones():
+    # concurrent calls share the phasor thread pool and the FFTW plan (serialized by its
+    # lock): every realization must equal its sequential twin bit for bit
+    density, duration, dt = _rational_density, 2**17 * 0.1, 0.1
+    seeds = list(range(6))
+    ref = {s: sea.simulate_sea(density, duration, dt, "nsa" if s % 2 else "dsa", s)
+           for s in seeds}
+    got = {}
+
+    def work(s):
+        got[s] = sea.simulate_sea(density, duration, dt, "nsa" if s % 2 else "dsa", s)
+
+    ts = [threading.Thread(target=work, args=(s,)) for s in seeds]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    for s in seeds:
+        np.testing.assert_array_equal(got[s].coefficients, ref[s].coefficients)
+        np.testing.assert_array_equal(got[s].elevation, ref[s].elevation)
+    # the returned arrays never alias a work buffer that a later call overwrites
+    a = sea.simulate_sea(density, duration, dt, "dsa", 0)
+    c0 = a.coefficients.copy()
+    sea.simulate_sea(density, duration, dt, "dsa", 1)
+    np.testing.assert_array_equal(a.coefficients, c0)
