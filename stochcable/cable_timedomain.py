@@ -17,8 +17,7 @@ Model (the same finite-element discretization as the frequency-domain model):
 - Consistent mass m l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ I (seed eq. 3.1.12) plus the normal
   added mass Can ρ (πD²/4) l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ (I − e₀e₀ᵀ) and attachment
   masses.  The added mass is evaluated about the *static* tangents e₀ so the mass
-  matrix is constant (as in the frequency-domain model); so is the wave-inertia load
-  ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ) a_wave.
+  matrix is constant (as in the frequency-domain model).
 - Net weight (gravity minus buoyancy) per length and attachment weight/buoyancy as in
   the statics (elements above z = 0 keep the submerged weight); a one-sided seabed
   penalty spring k·D and dashpot c·D per unit length (per unit contact area times the
@@ -26,14 +25,34 @@ Model (the same finite-element discretization as the frequency-domain model):
   tributary length, blended in smoothly over the static penetration p₀ = w/(kD)
   (:meth:`_LineModel.seabed`), the dashpot's engagement lagged by one step: a kinked
   contact law makes Newton cycle when a node lands within a step.
-- Morison drag with the relative velocity v_r = U_current + v_wave − u̇ (seed eqs.
-  3.2.a.2–3.2.a.5), normal ½ρ Cdn D |v_rn| v_rn and axial ½ρ Cdt πD |v_rt| v_rt, with
-  the *instantaneous* element tangent e; nodal force densities are distributed with the
-  consistent weights l0 [[1/3, 1/6], [1/6, 1/3]] (linear interpolation of the force
-  density between the nodes).  Attachments add ½ρ (Cd·A) |v_r| v_r.
-- Wave kinematics (velocity, acceleration) are evaluated at the *static* node
-  positions, which is consistent with linear wave theory and with the frequency-domain
-  model (the error is second order in the motion).  Above z = 0 they are zero.
+- Wave loads use the load model of the frequency-domain analysis
+  (:func:`stochcable.excitation.wave_loads`), the wave kinematics taken at the
+  *static* positions (linear wave theory; the error is second order in the motion;
+  zero above z = 0):
+
+  * wave inertia (linear in the kinematics) — **exact** along each straight element:
+    node i of element j gets l0_j ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ)·∫₀¹ N_i a dξ with the
+    closed-form consistent moments of
+    :func:`stochcable.excitation.element_wave_kinematics` (split at the waterline),
+    synthesized in time with the realization's coefficients like any transfer
+    function; attachments get (buoyancy/g + added mass)·a at their node.
+  * Morison drag with the relative velocity v_r = U_current + v_wave − u̇ (seed eqs.
+    3.2.a.2–3.2.a.5), normal ½ρ Cdn D |v_rn| v_rn and axial ½ρ Cdt πD |v_rt| v_rt with
+    the *instantaneous* element tangent e — **quadrature**: v_r is formed at
+    :data:`GAUSS_POINTS` Gauss–Legendre points ξ_g per element (fluid velocity of
+    :func:`stochcable.kinematics.wave_kinematics` and the current profile at the
+    static quadrature points, structural velocity interpolated linearly between the
+    nodes) and the consistent nodal load is l0 Σ_g w_g N_i(ξ_g) f(v_r(ξ_g)),
+    N_a = 1 − ξ, N_b = ξ; the Newton tangent uses the same quadrature.  Exact
+    (to rounding) when f(v_r(ξ)) is a polynomial of degree <= 2·GAUSS_POINTS − 2 in ξ,
+    e.g. v_r linear in ξ with a fixed direction and sign (tested); in the linear limit
+    about a current uniform over the element the structural-velocity part is the
+    consistent damping matrix l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ ∂f/∂v_r of the
+    frequency-domain model exactly; the wave part
+    carries the Gauss error of e^{kz} over the element (small unless k·Δz of an
+    element near the surface is several units at frequencies carrying energy), and
+    the |v_r| kink and the waterline crossing are not resolved exactly.
+    Attachments add ½ρ (Cd·A) |v_r| v_r with the nodal fluid velocity.
 - Ends are prescribed: end-motion spectra are realized per channel with independent
   seeds (``SeedSequence(seed).spawn``) or RAO × sea coefficients, synthesized by FFT to
   displacement, velocity (iω) and acceleration (−ω²) on the simulation grid.
@@ -80,6 +99,7 @@ __all__ = [
     "SLACK_STIFFNESS_RATIO",
     "PERIOD_ERROR_TOLERANCE",
     "newmark_period_error",
+    "GAUSS_POINTS",
 ]
 
 SLACK_STIFFNESS_RATIO = 1e-6
@@ -91,6 +111,9 @@ scheme at the highest excitation frequency before a ResolutionWarning. [-]"""
 
 _ENERGY_QUANTILE = 0.99  # fraction of excitation variance below the "highest" frequency
 _CONSISTENT = np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
+GAUSS_POINTS = 3
+"""Gauss–Legendre points per element of the drag quadrature. [-]"""
+
 _DRAG_EPS = 1e-9  # regularization of |v| in the drag Jacobian [m/s]
 _BACKTRACK = 12  # largest number of step halvings in a Newton line search
 
@@ -287,8 +310,19 @@ class _LineModel:
         m_struct = (mesh.mass * mesh.l0)[:, None, None] * I
         m_add = (mesh.ca_normal * env.rho * area * mesh.l0)[:, None, None] * P0
         mw = ((1.0 + mesh.ca_normal) * env.rho * area * mesh.l0)[:, None, None] * P0
-        node_mw = (mesh.node_buoyancy / env.g + mesh.node_added_mass)[:, None, None] * np.eye(d)[None]
         self.P0 = P0
+        # wave inertia: per element l0·ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ) (acts on the exact
+        # element moments ∫N_i a dξ), per attachment (buoyancy/g + added mass) (on a_node)
+        self.inertia_el = mw                                              # (ne, d, d)
+        self.node_mw = mesh.node_buoyancy / env.g + mesh.node_added_mass  # (n,)
+        # drag quadrature: Gauss–Legendre points ξ_g on [0, 1], weights w_g (Σ = 1),
+        # shape functions N_a = 1 − ξ, N_b = ξ at the points
+        xg, wg = np.polynomial.legendre.leggauss(GAUSS_POINTS)
+        self.gauss_xi = 0.5 * (xg + 1.0)
+        self.gauss_w = 0.5 * wg
+        self.gauss_N = np.stack([1.0 - self.gauss_xi, self.gauss_xi], axis=1)  # (ng, 2)
+        # Σ_g w_g N_a N_c N (= the consistent [[1/3, 1/6], [1/6, 1/3]] for ng >= 2)
+        self._gauss_wNN = np.einsum("g,ga,gc->gac", self.gauss_w, self.gauss_N, self.gauss_N)
 
         # banded/sparse index maps -------------------------------------------------
         self.u = u = 2 * d - 1                       # half bandwidth
@@ -315,7 +349,6 @@ class _LineModel:
         mel = el_matrix(m_struct + m_add)
         self.M_band = self._band(mel, node_m)
         self.M_sparse = self._sparse(mel, node_m)
-        self.Mw_sparse = self._sparse(el_matrix(mw), node_mw)
         self.free = slice(d, self.N - d)
 
     # ---- assembly helpers
@@ -367,23 +400,34 @@ class _LineModel:
         return out.reshape(self.ne, 2 * d, 2 * d)
 
     # ---- drag, attachments and seabed
+    def gauss_points(self, X: np.ndarray) -> np.ndarray:
+        """Positions of the drag quadrature points, shape (ne, ng, X.shape[1]). [m]"""
+        N = self.gauss_N
+        return N[None, :, 0, None] * X[:-1, None, :] + N[None, :, 1, None] * X[1:, None, :]
+
     def drag(self, X: np.ndarray, V: np.ndarray, e: np.ndarray, u_fluid: np.ndarray,
-             jacobian: bool):
-        """Drag nodal forces (n, d) and the element/node blocks of −∂F/∂u̇."""
+             u_gauss: np.ndarray, jacobian: bool):
+        """Drag nodal forces (n, d) and the element/node blocks of −∂F/∂u̇.
+
+        ``u_fluid`` (n, d): fluid velocity at the nodes (attachment drag);
+        ``u_gauss`` (ne, ng, d): fluid velocity at the element quadrature points.
+        The element drag is the consistent load F_a = l0 Σ_g w_g N_a(ξ_g) f(v_r(ξ_g)),
+        v_r(ξ_g) = u_gauss − (N_a u̇_a + N_b u̇_b); its velocity Jacobian
+        −∂F_a/∂u̇_c = l0 Σ_g w_g N_a N_c ∂f/∂v_r uses the same quadrature.
+        """
         d = self.dim
-        vr = u_fluid - V                                  # (n, d)
         F = np.zeros_like(X)
         c_el = None
         if np.any(self.cn) or np.any(self.ct):
-            # relative velocity at the two nodes of each element: (ne, 2, d)
-            w = np.stack([vr[:-1], vr[1:]], axis=1)
-            s = np.einsum("ead,ed->ea", w, e)              # axial component
+            # relative velocity at the quadrature points: (ne, ng, d)
+            w = u_gauss - self.gauss_points(V)
+            s = np.einsum("egd,ed->eg", w, e)              # axial component
             wn = w - s[:, :, None] * e[:, None, :]
-            mag = np.sqrt(np.einsum("ead,ead->ea", wn, wn) + _DRAG_EPS**2)
+            mag = np.sqrt(np.einsum("egd,egd->eg", wn, wn) + _DRAG_EPS**2)
             f = (self.cn[:, None] * mag)[:, :, None] * wn + \
                 (self.ct[:, None] * np.abs(s) * s)[:, :, None] * e[:, None, :]
-            # consistent distribution: F_b = l0 Σ_a W_ab f_a
-            nodal = self.l0[:, None, None] * np.einsum("ab,ead->ebd", _CONSISTENT, f)
+            nodal = self.l0[:, None, None] * np.einsum(
+                "g,ga,egd->ead", self.gauss_w, self.gauss_N, f)
             F[:-1] += nodal[:, 0]
             F[1:] += nodal[:, 1]
             if jacobian:
@@ -392,13 +436,13 @@ class _LineModel:
                     (self.cn[:, None, None, None] * wn[:, :, :, None] * wn[:, :, None, :]
                      / mag[:, :, None, None]) + \
                     (2.0 * self.ct[:, None] * np.abs(s))[:, :, None, None] * \
-                    (e[:, None, :, None] * e[:, None, None, :])      # (ne, a, d, d)
-                # block (b, a) = l0 W_ab J_a
-                blk = self.l0[:, None, None, None, None] * \
-                    _CONSISTENT.T[None, :, :, None, None] * J[:, None, :, :, :]
-                c_el = blk.transpose(0, 1, 3, 2, 4).reshape(self.ne, 2 * d, 2 * d)
+                    (e[:, None, :, None] * e[:, None, None, :])      # (ne, ng, d, d)
+                # block (a, c) = l0 Σ_g w_g N_a N_c J_g
+                blk = np.einsum("gac,egij->eaicj", self._gauss_wNN, J)
+                c_el = (self.l0[:, None, None] * blk.reshape(self.ne, 2 * d, 2 * d))
         c_nd = np.zeros((self.n, d, d)) if jacobian else None
         if np.any(self.node_cda):
+            vr = u_fluid - V
             mag = np.sqrt(np.einsum("nd,nd->n", vr, vr) + _DRAG_EPS**2)
             F += (self.node_cda * mag)[:, None] * vr
             if jacobian:
@@ -453,7 +497,8 @@ class _LineModel:
 
 
 def _static_equilibrium(model: _LineModel, X: np.ndarray, u_current: np.ndarray,
-                        f_ref: float, tol: float, max_iter: int = 200) -> tuple[np.ndarray, float]:
+                        u_current_gauss: np.ndarray, f_ref: float, tol: float,
+                        max_iter: int = 200) -> tuple[np.ndarray, float]:
     """Newton (with backtracking) on the static residual of this model, from ``X``.
 
     The start is the statics module's solution; this re-solve removes the small
@@ -466,7 +511,7 @@ def _static_equilibrium(model: _LineModel, X: np.ndarray, u_current: np.ndarray,
 
     def residual(Xc):
         e, l, T, ea = model.elements(Xc)
-        fd, _, _ = model.drag(Xc, zeros, e, u_current, jacobian=False)
+        fd, _, _ = model.drag(Xc, zeros, e, u_current, u_current_gauss, jacobian=False)
         fb, kb, _ = model.seabed(Xc, zeros)
         r = model.internal_force(Xc, e, T) - model.f_gravity - fd - fb
         return r.ravel()[fr], (e, l, T, ea, kb)
@@ -568,14 +613,43 @@ def _upsample(coeff: np.ndarray, n_t: int, k: int, dtype_factor: np.ndarray | No
     return _fft.irfft(big * k, n_fine)
 
 
-@dataclass(frozen=True)
-class _Excitation:
-    t: np.ndarray                     # (n_steps+1,)
-    ramp: np.ndarray                  # r(t)
-    u_wave: np.ndarray | None         # (n_t, n, d) wave velocity, ramped
-    f_inertia: np.ndarray | None      # (n_t, N) wave inertia nodal load, ramped
-    end_disp: dict                    # node index -> (x, v, a) arrays (n_t, d)
-    omega_max: float
+def _wave_series(model: _LineModel, x_static: np.ndarray, omega: np.ndarray, X: np.ndarray,
+                 heading: float, env: Environment, ax: np.ndarray, n_t: int, k_up: int,
+                 sl: np.ndarray, r: np.ndarray):
+    """Wave excitation on the simulation steps, ramped by ``r``.
+
+    Returns the fluid velocity at the nodes (n_steps+1, n, d) (attachment drag), at
+    the drag quadrature points (n_steps+1, ne, ng, d), and the wave-inertia nodal load
+    (n_steps+1, N): per element l0·ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ)·∫₀¹ N_i a dξ with the
+    exact element moments of :func:`stochcable.excitation.element_wave_kinematics`
+    (the load of :func:`stochcable.excitation.wave_loads`), plus the attachments'
+    (buoyancy/g + added mass)·a_node.  All are linear transfer functions per unit wave
+    amplitude at the static positions, synthesized with the realization's coefficients.
+    """
+    from .excitation import element_wave_kinematics
+    from .kinematics import wave_kinematics
+
+    pts = np.array(x_static, dtype=float)
+    pts[:, 2] = np.maximum(pts[:, 2], -env.depth)  # nodes pressed into the seabed
+    gp = model.gauss_points(pts).reshape(-1, 3)
+    kin = wave_kinematics(omega, np.vstack([pts, gp]), heading, env.depth, env.g)
+    vel = np.einsum("pcw,cd->pdw", kin.velocity, ax)           # (n + ne·ng, d, n_w)
+    acc_n = np.einsum("ncw,cd->ndw", kin.acceleration[: model.n], ax)
+    el = element_wave_kinematics(omega, pts, heading, env.depth, env.g)
+    mom = el.acceleration @ ax                                  # (n_w, ne, 2, d)
+    f_el = np.einsum("eij,wesj->wesi", model.inertia_el, mom)  # (n_w, ne, 2, d)
+    f_nodes = np.zeros((omega.size, model.n, model.dim), dtype=complex)
+    f_nodes[:, :-1] += f_el[:, :, 0]
+    f_nodes[:, 1:] += f_el[:, :, 1]
+    f_nodes += model.node_mw[None, :, None] * np.moveaxis(acc_n, 2, 0)
+    coeff = np.concatenate([vel, np.moveaxis(f_nodes, 0, 2)], axis=0) * X  # (p, d, n_w)
+    series = _upsample(coeff, n_t, k_up)[..., sl] * r             # (p, d, n_steps+1)
+    series = np.moveaxis(series, 2, 0)                             # (n_steps+1, p, d)
+    n, ne = model.n, model.ne
+    u_nodes = series[:, :n]
+    u_gauss = series[:, n:n + gp.shape[0]].reshape(-1, ne, model.gauss_xi.size, model.dim)
+    f_in = np.ascontiguousarray(series[:, n + gp.shape[0]:]).reshape(-1, model.N)
+    return u_nodes, u_gauss, f_in
 
 
 def _half_cosine(t: np.ndarray, t_r: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -816,10 +890,13 @@ def simulate_line_timedomain(
     x3 = _statics_guess(scene, line, mesh, statics)
     model0 = _LineModel(mesh, env, x3 @ ax, dim)
     u_cur = env.current_velocity(x3[:, 2]) @ ax                     # (n, d)
+    # current at the drag quadrature points (of the statics shape; the profile is
+    # interpolated in z, the points move millimetres in the re-solve)
+    u_cur_g = env.current_velocity(model0.gauss_points(x3)[..., 2]) @ ax   # (ne, ng, d)
     e0, _, T0, _ = model0.elements(x3 @ ax)
     f_ref = max(float(np.abs(T0).max()), float(np.abs(model0.f_gravity).max()), 1e-12)
     tol_abs = tolerance * f_ref
-    xs, _ = _static_equilibrium(model0, x3 @ ax, u_cur, f_ref,
+    xs, _ = _static_equilibrium(model0, x3 @ ax, u_cur, u_cur_g, f_ref,
                                 max(1e-3 * tol_abs, 1e-11 * f_ref))
     model = _LineModel(mesh, env, xs, dim)  # added mass about the re-solved tangents
 
@@ -828,22 +905,12 @@ def simulate_line_timedomain(
     n_fine = k_up * n_t
     sl = np.arange(n_steps + 1) % n_fine  # the realization is periodic in T_L
     u_wave = None
+    u_wave_g = None
     f_in = None
     x_static_3 = xs @ ax.T
     if realization is not None:
-        from . import kinematics as _kin
-
-        pts = x_static_3.copy()
-        pts[:, 2] = np.maximum(pts[:, 2], -env.depth)  # nodes pressed into the seabed
-        kin = _kin.wave_kinematics(omega, pts, scene.sea.heading_rad,
-                                   env.depth, env.g)
-        vel, acc = kin.velocity, kin.acceleration
-        X = X_sea
-        vt = _upsample(np.asarray(vel) * X, n_t, k_up)[..., sl]   # (n, 3, n_t)
-        at = _upsample(np.asarray(acc) * X, n_t, k_up)[..., sl]
-        u_wave = np.einsum("nct,cd->tnd", vt, ax) * r[:, None, None]
-        a_loc = np.einsum("nct,cd->tnd", at, ax) * r[:, None, None]
-        f_in = (model.Mw_sparse @ a_loc.reshape(t.size, -1).T).T   # (n_t, N)
+        u_wave, u_wave_g, f_in = _wave_series(model, x_static_3, omega, X_sea, scene.sea.heading_rad,
+                                              env, ax, n_t, k_up, sl, r)
     end_disp = {}
     for key, c in ends.items():
         node = 0 if key == "a" else mesh.n_nodes - 1
@@ -855,7 +922,8 @@ def simulate_line_timedomain(
         ar = r[:, None] * a_ + 2.0 * r1[:, None] * v_ + r2[:, None] * x_
         end_disp[node] = (xr, vr, ar)
 
-    hist = _integrate(model, xs, u_cur, u_wave, f_in, end_disp, t, h, tol_abs,
+    hist = _integrate(model, xs, u_cur, u_cur_g, u_wave, u_wave_g, f_in, end_disp, t, h,
+                      tol_abs,
                       max_iterations, element_every)
     pos, ten_el, iters, maxres = hist
     pos3 = pos @ ax.T + (0.0 if dim == 3 else np.array([0.0, 1.0, 0.0]) * x3[0, 1])
@@ -872,9 +940,9 @@ def simulate_line_timedomain(
     )
 
 
-def _integrate(model: _LineModel, xs: np.ndarray, u_cur: np.ndarray, u_wave, f_in,
-               end_disp: dict, t: np.ndarray, h: float, tol: float, max_it: int,
-               every: int):
+def _integrate(model: _LineModel, xs: np.ndarray, u_cur: np.ndarray, u_cur_g: np.ndarray,
+               u_wave, u_wave_g, f_in, end_disp: dict, t: np.ndarray, h: float, tol: float,
+               max_it: int, every: int):
     """Newmark average acceleration with Newton iterations (seed 001 eqs. 4.2.7–4.2.11)."""
     d, n, N = model.dim, model.n, model.N
     fr = model.free
@@ -891,7 +959,7 @@ def _integrate(model: _LineModel, xs: np.ndarray, u_cur: np.ndarray, u_wave, f_i
     A = np.zeros_like(X)
     pos[0] = X
     e, _, T, _ = model.elements(X)
-    fd0, _, _ = model.drag(X, V, e, u_cur, jacobian=False)
+    fd0, _, _ = model.drag(X, V, e, u_cur, u_cur_g, jacobian=False)
     fb0, _, _ = model.seabed(X, V)
     R0 = (model.internal_force(X, e, T) - model.f_gravity - fd0 - fb0).reshape(-1)
     # An end node resting on the seabed: the bed carries the load lumped on it, so the
@@ -923,6 +991,7 @@ def _integrate(model: _LineModel, xs: np.ndarray, u_cur: np.ndarray, u_wave, f_i
             Vn[sl] = ve[k]
             An[sl] = ae[k]
         uf = u_cur if u_wave is None else u_cur + u_wave[k]
+        ug = u_cur_g if u_wave_g is None else u_cur_g + u_wave_g[k]
         fi = None if f_in is None else f_in[k]
         s_bed = model.contact_blend(X)
 
@@ -934,7 +1003,7 @@ def _integrate(model: _LineModel, xs: np.ndarray, u_cur: np.ndarray, u_wave, f_i
             Xm = Xn.reshape(n, d)
             Vm = Vn.reshape(n, d)
             e, l, T, ea = model.elements(Xm)
-            fd, c_el, c_nd = model.drag(Xm, Vm, e, uf, jacobian=jac)
+            fd, c_el, c_nd = model.drag(Xm, Vm, e, uf, ug, jacobian=jac)
             fb, kb, cb = model.seabed(Xm, Vm, s_bed)
             R = (M @ An) + (model.internal_force(Xm, e, T) - fg - fd - fb).reshape(-1)
             if fi is not None:
