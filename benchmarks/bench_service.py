@@ -141,15 +141,15 @@ def bench_realization(base: str, repeats: int) -> dict:
             "bytes": 8 * N_BIG + 128}  # the elevation column only (t_n = n·dt)
 
 
-def bench_health_under_load(base: str, n: int, heavy_clients: int) -> dict:
+def _health_while(base: str, n: int, heavy_clients: int, post) -> dict:
+    """/health latency while ``heavy_clients`` threads call ``post(client)`` in a loop."""
     stop = threading.Event()
     heavy_done = [0]
 
     def heavy() -> None:
-        headers = {"Accept": "application/x-npy", "Accept-Encoding": "identity"}
         with httpx.Client(base_url=base, timeout=120.0) as c:
             while not stop.is_set():
-                c.post("/v1/sea/realizations", json=_big_body(), headers=headers)
+                post(c)
                 heavy_done[0] += 1
 
     threads = [threading.Thread(target=heavy, daemon=True) for _ in range(heavy_clients)]
@@ -168,6 +168,12 @@ def bench_health_under_load(base: str, n: int, heavy_clients: int) -> dict:
         t.join(120.0)
     return {"p50": _pct(lat, 50), "p99": _pct(lat, 99), "max": max(lat),
             "heavy": heavy_done[0]}
+
+
+def bench_health_under_load(base: str, n: int, heavy_clients: int) -> dict:
+    headers = {"Accept": "application/x-npy", "Accept-Encoding": "identity"}
+    return _health_while(base, n, heavy_clients, lambda c: c.post(
+        "/v1/sea/realizations", json=_big_body(), headers=headers))
 
 
 def _chain_body() -> bytes:
@@ -223,33 +229,10 @@ def bench_analyses(base: str, n: int, workers: int) -> dict:
 
 
 def bench_health_under_analyses(base: str, n: int, heavy_clients: int) -> dict:
-    stop = threading.Event()
-    heavy_done = [0]
     body = _chain_body()
-
-    def heavy() -> None:
-        with httpx.Client(base_url=base, timeout=120.0) as c:
-            while not stop.is_set():
-                c.post("/v1/analyses", content=body,
-                       headers={"Content-Type": "application/json"}).raise_for_status()
-                heavy_done[0] += 1
-
-    threads = [threading.Thread(target=heavy, daemon=True) for _ in range(heavy_clients)]
-    for t in threads:
-        t.start()
-    time.sleep(0.5)
-    lat = []
-    with httpx.Client(base_url=base, timeout=30.0) as c:
-        for _ in range(n):
-            t0 = time.perf_counter()
-            c.get("/health").raise_for_status()
-            lat.append(time.perf_counter() - t0)
-            time.sleep(0.01)
-    stop.set()
-    for t in threads:
-        t.join(120.0)
-    return {"p50": _pct(lat, 50), "p99": _pct(lat, 99), "max": max(lat),
-            "heavy": heavy_done[0]}
+    return _health_while(base, n, heavy_clients, lambda c: c.post(
+        "/v1/analyses", content=body,
+        headers={"Content-Type": "application/json"}).raise_for_status())
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -136,22 +136,32 @@ def test_undamped_resonance_on_the_grid_is_a_solver_error():
 # --------------------------------------------------------- taut string, closed form
 
 
-def test_taut_string_end_motion_matches_closed_form():
-    """Weightless taut string, Cd = Ca = 0, heave of end_b: u(x) = sin kx / sin kL."""
-    ea, l0, span, m = 1.0e7, 99.0, 100.0, 10.0
-    n_el = 200
-    doc = {
+# Weightless taut string (Cd = Ca = 0) between (0, 0, -50) and (SPAN, 0, -50) with a
+# heave spectrum at end_b: the closed-form cases below (sin kx / sin kL, damped mode).
+STRING_EA, STRING_L0, STRING_SPAN, STRING_M = 1.0e7, 99.0, 100.0, 10.0
+
+
+def _taut_string_doc(n_el: int, analysis: dict) -> dict:
+    return {
         "environment": {"depth": 200.0},
         "lines": [{
             "name": "string",
             "end_a": {"position": [0.0, 0.0, -50.0]},
-            "end_b": {"position": [span, 0.0, -50.0], "motion": {"heave": PM_SURGE}},
-            "segments": [{"length": l0, "ea": ea, "mass": m, "diameter": 0.05,
-                          "cd_normal": 0.0, "cd_axial": 0.0, "ca_normal": 0.0,
-                          "weight": 0.0, "elements": n_el}],
+            "end_b": {"position": [STRING_SPAN, 0.0, -50.0], "motion": {"heave": PM_SURGE}},
+            "segments": [{"length": STRING_L0, "ea": STRING_EA, "mass": STRING_M,
+                          "diameter": 0.05, "cd_normal": 0.0, "cd_axial": 0.0,
+                          "ca_normal": 0.0, "weight": 0.0, "elements": n_el}],
         }],
-        "analysis": {"omega": {"min": 0.5, "max": 2.5, "count": 9}, "solver": "direct"},
+        "analysis": analysis,
     }
+
+
+def test_taut_string_end_motion_matches_closed_form():
+    """Weightless taut string, Cd = Ca = 0, heave of end_b: u(x) = sin kx / sin kL."""
+    ea, l0, span, m = STRING_EA, STRING_L0, STRING_SPAN, STRING_M
+    n_el = 200
+    doc = _taut_string_doc(n_el, {"omega": {"min": 0.5, "max": 2.5, "count": 9},
+                                  "solver": "direct"})
     scene, system, chans = system_and_channels(doc)
     tension = ea * (span / l0 - 1.0)
     np.testing.assert_allclose(system.model.tension, tension, rtol=1e-9)
@@ -551,22 +561,12 @@ def test_rayleigh_damped_taut_string_first_mode_peak():
     the damped modal oscillator at resonance, q = Γ(ω1² − iαω1)/(2iζ1ω1²) with
     Γ = 2/π (participation of the linear shape x/L in sin(πx/L)) and
     2ζ1ω1 = α + βω1² (Rayleigh)."""
-    ea, l0, span, m = 1.0e7, 99.0, 100.0, 10.0
+    ea, l0, span, m = STRING_EA, STRING_L0, STRING_SPAN, STRING_M
     n_el = 100
     alpha, beta = 0.01, 2.0e-4
-    doc = {
-        "environment": {"depth": 200.0},
-        "lines": [{
-            "name": "string",
-            "end_a": {"position": [0.0, 0.0, -50.0]},
-            "end_b": {"position": [span, 0.0, -50.0], "motion": {"heave": PM_SURGE}},
-            "segments": [{"length": l0, "ea": ea, "mass": m, "diameter": 0.05,
-                          "cd_normal": 0.0, "cd_axial": 0.0, "ca_normal": 0.0,
-                          "weight": 0.0, "elements": n_el}],
-        }],
-        "analysis": {"omega": {"min": 0.5, "max": 2.5, "count": 9}, "solver": "direct",
-                     "structural_damping": {"alpha": alpha, "beta": beta}},
-    }
+    doc = _taut_string_doc(n_el, {"omega": {"min": 0.5, "max": 2.5, "count": 9},
+                                  "solver": "direct",
+                                  "structural_damping": {"alpha": alpha, "beta": beta}})
     scene, system, _ = system_and_channels(doc)
     tension = ea * (span / l0 - 1.0)
     c = math.sqrt(tension / (m * l0 / span))
