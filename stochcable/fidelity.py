@@ -21,7 +21,12 @@ Band (ω_min, ω_max)
     :data:`PILOT_INPUT_FRACTION` outside it) and is doubled up to
     :data:`PILOT_EXTENSIONS` times while the response tail beyond its top is not
     bounded or its top is below twice the ω_max it gives (a power-law extrapolation
-    misses resonances in the tail).  Tail model beyond the pilot's top ω_t: S(ω) = S(ω_t)(ω/ω_t)^(-p), p fitted
+    misses resonances in the tail).  Four doublings reach the axial regime of a chain
+    driven by a PM (ω⁻⁵) fairlead motion: its tension spectrum decays like ω⁻¹ up to
+    the first axial resonances (≈ 15 rad/s on chain_catenary) and like ω^-2…ω^-3
+    beyond (axial impedance, T ∝ ωx); two doublings stopped at 26.6 rad/s, in the ω⁻¹
+    regime, and could not bound the band.  Tail model beyond the pilot's top ω_t:
+    S(ω) = S(ω_t)(ω/ω_t)^(-p), p fitted
     to the top fifth (in log ω) of the pilot's spectrum; truncated variance
     S(ω_t)·ω_t/(p − 1) for p > 1 + :data:`MIN_TAIL_EXCESS`, else *unbounded* (reported:
     the linear model's σ then depends on the band).  ω_max is the lowest frequency
@@ -46,7 +51,13 @@ Elements
     variance-weighted one, so k is taken at the response's mean frequency
     ω₂ = √(m₂/m₀) (pilot) with ⟨1/c²⟩ over the suspended length: h ≤ √(24 ε_el)/(ω₂
     √⟨1/c²⟩), and h ≤ :data:`CUTOFF_KH`/k(ω_max) so no resonance of the band is
-    spurious.  Touchdown: h ≤ suspended length · √ε_el.  Wave loads: kinematics are
+    spurious.  Touchdown: a node at the static touchdown (:func:`static_touchdowns`;
+    the segment is split there) — the linear model's contact state is the static one,
+    so a touchdown inside an element errs on the suspended length at first order
+    (tuah_1982_single_leg: fairlead σ −3.3 %, +2.0 %, −0.8 %, +0.5 % at 56, 112, 224,
+    448 uniform elements, not converging like (kh)²) — and h ≤ suspended length · √ε_el
+    (with the node in place the error is second order: +0.33 %, +0.09 % at 28, 56
+    elements).  Wave loads: kinematics are
     taken at the nodes and interpolated linearly, so an element of length h
     integrates e^{kz − ikx} with a relative error of about (kh)²/12: elements above the
     depth where e^{kz} < ε_el (k at the sea's ω₂) get h ≤ √(12 ε_el)/k (on the taut
@@ -86,6 +97,7 @@ __all__ = [
     "points_per_bandwidth",
     "choose_fidelity",
     "apply_fidelity",
+    "static_touchdowns",
 ]
 
 #: Shares of the target error given to each part (sum 1). [-]
@@ -98,7 +110,10 @@ PILOT_INPUT_FRACTION = 1e-4
 PILOT_LOW_FRACTION = 1e-9
 #: Times the pilot's top frequency is doubled while the response tail is unbounded or
 #: the pilot does not reach twice the ω_max it gives.
-PILOT_EXTENSIONS = 2
+PILOT_EXTENSIONS = 4
+#: Elements of the finite-element statics that locates a touchdown (when the closed
+#: form does not apply and the scene's mesh is coarser). [-]
+TOUCHDOWN_ELEMENTS = 200
 #: Pilot frequencies (log spaced). [-]
 PILOT_COUNT = 200
 #: Pilot mesh: kh at the pilot's top frequency (frequency error (kh)²/24 ≈ 4 %). [-]
@@ -432,13 +447,17 @@ def _input_band(scene: Scene, fraction: float) -> tuple[float, float, dict[str, 
 # ------------------------------------------------------------------------- meshing
 
 
-def _segment_geometry(scene: Scene, statics: Any) -> dict[str, list[dict[str, Any]]]:
+def _segment_geometry(scene: Scene, statics: Any,
+                      touchdown: dict[str, float | None] | None = None
+                      ) -> dict[str, list[dict[str, Any]]]:
     """Per line and segment: length, ⟨1/c²⟩ over the suspended part, suspended length,
-    arc-length interval and node z (for the wave-load rule)."""
+    arc-length interval, node z (for the wave-load rule) and the static touchdown
+    (``touchdown`` overrides the statics' own, e.g. from a finer model)."""
     rho = scene.environment.rho
     out: dict[str, list[dict[str, Any]]] = {}
     for line in scene.lines:
         st = statics.lines[line.name]
+        s_td = (touchdown or {}).get(line.name, st.touchdown)
         mesh = st.mesh
         grounded_el = st.grounded[1:] & st.grounded[:-1]
         susp_line = float(np.sum(mesh.l0[~grounded_el]))
@@ -460,10 +479,55 @@ def _segment_geometry(scene: Scene, statics: Any) -> dict[str, list[dict[str, An
             segs.append({"length": seg.length, "inv_c2": inv_c2,
                          "suspended": float(np.sum(l0f)), "line_suspended": susp_line,
                          "s0": s_start, "s1": s_start + seg.length,
-                         "grounded_any": bool(np.any(grounded_el[sel]))})
+                         "grounded_any": bool(np.any(grounded_el[sel])),
+                         "touchdown": s_td})
             s_start += seg.length
         out[line.name] = segs
         out[line.name + "\0nodes"] = [(mesh.s0, st.positions[:, 2])]  # type: ignore[list-item]
+    return out
+
+
+def static_touchdowns(scene: Scene | Any) -> dict[str, float | None]:
+    """Static touchdown of every line, for placing a node there.
+
+    Parameters
+    ----------
+    scene : Scene or document
+        The scene.
+
+    Returns
+    -------
+    dict of str to float or None
+        Per line name, the unstretched arc length from end_a where the line leaves the
+        seabed (None without seabed contact). [m]
+
+    Notes
+    -----
+    The closed-form elastic catenary where it applies, else the finite-element statics
+    on a mesh of at least :data:`TOUCHDOWN_ELEMENTS` elements (the scene's own mesh may
+    be coarse: its 3-element FE statics puts the touchdown of tuah_1982_single_leg at
+    157 ft instead of 165.7 ft), whose touchdown is interpolated from the vertical
+    tension of the first suspended element (:mod:`stochcable.statics`).
+    """
+    from .statics import solve_statics
+
+    scene = load_scene(scene)
+    auto = solve_statics(scene)
+    out: dict[str, float | None] = {}
+    refine: dict[str, tuple[tuple[int, float, int], ...]] = {}
+    for line in scene.lines:
+        st = auto.lines[line.name]
+        out[line.name] = st.touchdown
+        n = sum(seg.elements for seg in line.segments)
+        if st.touchdown is not None and st.method == "fe" and n < TOUCHDOWN_ELEMENTS:
+            f = TOUCHDOWN_ELEMENTS / n
+            refine[line.name] = tuple(
+                (i, seg.length, max(1, int(math.ceil(seg.elements * f))))
+                for i, seg in enumerate(line.segments))
+    if refine:
+        fine = solve_statics(_segments_scene(scene, refine, {}), method="fe")
+        for name in refine:
+            out[name] = fine.lines[name].touchdown
     return out
 
 
@@ -504,8 +568,8 @@ def _mesh_rules(scene: Scene, geo: dict, w2: float, wmax: float, eps_el: float,
             kh_eff = (h * w2 * math.sqrt(g["inv_c2"])) if g["inv_c2"] > 0 else 0.0
             e_seg = kh_eff**2 / 24.0 + (min(h, dz_load) * k_load) ** 2 / 12.0 \
                 if (k_load and not exact) else kh_eff**2 / 24.0
-            # wave-load rule: split off the part above z_load
-            split = None
+            # wave-load rule: the part above z_load gets h ≤ dz_load
+            wet_part = None  # (a, b) arc-length interval of the finely meshed top part
             if k_load and not exact:
                 sel = (s_nodes >= g["s0"] - 1e-9) & (s_nodes <= g["s1"] + 1e-9)
                 ss, zz = s_nodes[sel], z_nodes[sel]
@@ -526,25 +590,48 @@ def _mesh_rules(scene: Scene, geo: dict, w2: float, wmax: float, eps_el: float,
                         j = int(np.flatnonzero(~wet)[0])
                         l_top = ss[j] - g["s0"]
                     if dz_load < h and 0.0 < l_top < g["length"]:
-                        split = (top_end, float(l_top), dz_load)
-            if split is None:
+                        wet_part = ((g["s1"] - l_top, g["s1"]) if top_end
+                                    else (g["s0"], g["s0"] + l_top))
+            # touchdown rule: a node at the static touchdown.  The linear model's contact
+            # state is the static one (grounded nodes on the seabed springs), so a
+            # touchdown inside an element puts an O(h) error on the suspended length;
+            # measured on tuah_1982_single_leg: fairlead σ −3.3 %, +2.0 %, −0.8 %, +0.5 %
+            # at 56, 112, 224, 448 uniform elements, +0.09 %, +0.03 % at 56, 112 with a
+            # node at the touchdown (then the √ε rule above bounds it).
+            s_td = g.get("touchdown")
+            cut_td = (s_td is not None and g["s0"] + 1e-6 * g["length"] < s_td
+                      < g["s1"] - 1e-6 * g["length"])
+            if wet_part is None and not cut_td:
                 new.append((i, g["length"], n))
                 choices.append(Choice(path, n, rule + f"; h = {g['length'] / n:.3g} m",
                                       e_seg))
                 err = max(err, e_seg)
                 continue
-            top_end, l_top, h_top = split
-            n_top = max(1, int(math.ceil(l_top / h_top - 1e-9)))
-            l_rest = g["length"] - l_top
-            n_rest = max(1, int(math.ceil(l_rest / h - 1e-9)))
-            parts = [(i, l_rest, n_rest), (i, l_top, n_top)]
-            new.extend(parts if top_end else parts[::-1])
+            cuts = sorted({g["s0"], g["s1"]}
+                          | ({wet_part[0], wet_part[1]} if wet_part else set())
+                          | ({float(s_td)} if cut_td else set()))
+            parts, counts = [], []
+            for a, b in zip(cuts[:-1], cuts[1:]):
+                if b - a <= 1e-9 * g["length"]:
+                    continue
+                in_wet = wet_part is not None and wet_part[0] - 1e-9 <= a and \
+                    b <= wet_part[1] + 1e-9
+                hp = min(h, dz_load) if in_wet else h
+                m = max(1, int(math.ceil((b - a) / hp - 1e-9)))
+                parts.append((i, float(b - a), m))
+                counts.append(m)
+            new.extend(parts)
+            why = []
+            if wet_part is not None:
+                why.append(f"wave-load depth {z_load:.3g} m (e^(kz) < {eps_el:.2g}, k = "
+                           f"{k_load:.3g} rad/m): the part above it with h ≤ "
+                           f"√(12·{eps_el / 2:.2g})/k = {dz_load:.3g} m")
+            if cut_td:
+                why.append(f"a node at the static touchdown s = {float(s_td):.4g} m")
             choices.append(Choice(
-                path, [n_rest, n_top] if top_end else [n_top, n_rest],
-                f"split at the wave-load depth {z_load:.3g} m (e^(kz) < {eps_el:.2g}, k = "
-                f"{k_load:.3g} rad/m): top {l_top:.4g} m with h ≤ √(12·{eps_el / 2:.2g})/k = "
-                f"{dz_load:.3g} m ({n_top} elements), rest {l_rest:.4g} m by {rule} "
-                f"({n_rest} elements)", e_seg))
+                path, counts,
+                "split at " + " and ".join(why) + f"; elsewhere {rule} (lengths "
+                + ", ".join(f"{L:.4g}" for _, L, _ in parts) + " m)", e_seg))
             err = max(err, e_seg)
         out[line.name] = tuple(new)
     return out, choices, err
@@ -672,7 +759,7 @@ def choose_fidelity(scene: Scene | Any, target_error: float = 0.01, *,
     choices: list[Choice] = []
     env = scene.environment
     statics = solve_statics(scene, method="fe")
-    geo = _segment_geometry(scene, statics)
+    geo = _segment_geometry(scene, statics, static_touchdowns(scene))
     # --- input band and the load wavenumber
     w_lo_in, w_hi_in, per = _input_band(scene, PILOT_INPUT_FRACTION)
     w_lo_in = min(w_lo_in, _input_band(scene, PILOT_LOW_FRACTION)[0])

@@ -400,3 +400,55 @@ def _element_rows(model, X, V, e, u_n, u_g, j):
     u_g2[j] = u_g[j]
     F, _, _ = model.drag(X, V, e, u_n, u_g2, jacobian=False)
     return F.reshape(-1)[2 * j: 2 * j + 4]
+
+
+# ------------------------------------------------------------------ stationarity
+
+
+def _history(t, tension):
+    """A CableTimeHistory holding only end tensions (the stationarity check's input)."""
+    from stochcable.cable_timedomain import CableTimeHistory
+
+    n = t.size
+    return CableTimeHistory(
+        line="l", t=t, positions=np.zeros((n, 2, 3)), static_positions=np.zeros((2, 3)),
+        tension_a=tension, tension_b=tension, element_tension=np.zeros((n, 1)),
+        element_time=t, static_tension=np.zeros(1), iterations=np.zeros(n, dtype=int),
+        max_residual=0.0, tolerance=1.0, dt=float(t[1] - t[0]), ramp=0.0,
+        s0=np.zeros(2), _meta={"omega_peak": 0.5})
+
+
+def test_stationarity_ratio_of_stationary_and_diverged_records():
+    rng = np.random.default_rng(7)
+    t = 0.125 * np.arange(4800)  # 600 s, 9 windows of 5 peak periods (12.6 s)
+    # stationary Gaussian narrow-band noise: window σ's scatter by the chi distribution
+    # of ~60 s windows of a 0.1 rad/s wide band (about ±20 %): ratio well below 8
+    w = rng.uniform(0.45, 0.55, 200)
+    x = np.sum(np.cos(np.outer(t, w) + rng.uniform(0, 2 * np.pi, 200)), axis=1)
+    ratio, _, w_dom = _history(t, 1e3 + x).stationarity_ratio()
+    assert 1.0 <= ratio < 3.0
+    bin_ = 2 * np.pi / (600.0 / 9)  # FFT resolution of a window [rad/s]
+    assert 0.45 - bin_ <= w_dom <= 0.55 + bin_
+    # from t = 300 s a persistent oscillation at 18.9 rad/s (ωΔt = 2.36), 30× larger:
+    # the tuah_1982_single_leg blow-up at Δt = 0.125 s
+    y = x + np.where(t >= 300.0, 30.0 * np.std(x) * np.sin(18.9 * t), 0.0)
+    ratio, t_jump, w_dom = _history(t, 1e3 + y).stationarity_ratio()
+    assert ratio > 8.0 and t_jump >= 300.0 - 600.0 / 9
+    assert w_dom == pytest.approx(18.9, abs=bin_)
+
+
+def test_diverged_snap_record_is_reported():
+    """tuah_1982_single_leg on its 3-element mesh, seed 3, Δt = 0.125 s (the automatic
+    step): the line goes slack and taut at every wave crest; from t ≈ 260 s the two
+    inner nodes rattle axially at 18.9 rad/s (ωΔt = 2.36: the average-acceleration
+    scheme pumps this under-resolved oscillation at the slack/taut switches) and the
+    fairlead tension σ jumps from ≈ 360 lbf to ≈ 1.1e4 lbf.  The same seed at Δt/4
+    gives 340 lbf (benchmarks/speed_vs_error.py reruns such seeds).  About 4 s."""
+    from stochcable.examples import load_example
+
+    scene = load_example("tuah_1982_single_leg")
+    with pytest.warns(ResolutionWarning, match=r"not stationary.*18\.\d+ rad/s.*rerun with dt"):
+        h = simulate_line_timedomain(scene, duration=600.0, seed=3, band=(0.0245, 9.8))
+    assert h.dt == pytest.approx(0.125)
+    assert h.stationarity_ratio()[0] > 8.0
+    assert np.all(np.isfinite(h.tension_b))

@@ -2,9 +2,11 @@
 with finite, checked numbers or a clear error — never inf/NaN or a silent wrong answer.
 
 Cases: nearly taut line (sag/span 1e-3), very slack line (most of it on the seabed),
-nearly vertical tether, very light and very heavy drag, deep (3000 m) and very shallow
-(10 m, small kh) water, a log frequency grid from 1e-4 to 1e2 rad/s, a 2^20-sample
-time series, a 400-element line, imperial units with a buoy.  Budget: the whole file
+tension → 0 at the anchor (the line's length at the limit span + drop), nearly vertical
+tether, mode crossover (horizontal) against veering (inclined cable, Irvine–Caughey,
+seed 000 §3.8.7), very light and very heavy drag, deep (3000 m) and very shallow (10 m,
+small kh) water, a log frequency grid from 1e-4 to 1e2 rad/s, 2^20- and 2^22-sample time
+series, 400- and 800-element lines, imperial units with a buoy.  Budget: the whole file
 under ~40 s on 2 cores (durations in the comments are measured on the CI machine).
 """
 
@@ -18,7 +20,8 @@ import numpy as np
 import pytest
 
 from stochcable.analysis import analyze, build_line_system, drag_coefficients
-from stochcable.errors import InputError, ResolutionWarning, SolverError
+from stochcable.errors import (InputError, PhysicsWarning, ResolutionWarning,
+                              SolverError)
 from stochcable.examples import load_example
 from stochcable.kinematics import wavenumber
 
@@ -136,6 +139,44 @@ def test_very_slack_line_mostly_on_the_seabed():
                         res_d.lines["l"].end_tension_transfer[end]) < 1e-8
 
 
+def test_tension_to_zero_at_the_anchor_end_flags_snap():
+    """Length 488 m for a 400 m span and a 90 m drop (limit 490 m, beyond which the
+    shape is undetermined, see above): the horizontal tension, hence the tension at the
+    grounded anchor (no seabed friction: T_a = H), goes to zero; the line hangs
+    vertically from the fairlead.  The numbers stay finite and the snap indicator fires
+    at the anchor end (mean − 3σ < 0 there)."""
+    w = (100.0 - 1025.0 * math.pi * 0.1**2 / 4.0) * 9.80665  # submerged weight [N/m]
+    taut = analyze(chain(length=480.0, elements=40))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = analyze(chain(length=488.0, elements=40))
+    assert_finite(res)
+    line, st = res.lines["l"], res.statics.lines["l"]
+    t_a0 = taut.statics.lines["l"].tension_a
+    # H → 0: 2.2 kN at 480 m, a few N (the slack grounded elements' reduced EA) at 488 m
+    assert t_a0 > 1.0e3
+    assert st.tension_a < 1e-3 * t_a0
+    assert st.tension_a < 1e-4 * st.tension_b
+    # vertical equilibrium of the suspended part: T_b = w × its length, which lies
+    # between the 90 m drop and the drop plus the element containing the touchdown
+    # (12.2 m); the touchdown estimate makes it tighter than that bound
+    h_el = 488.0 / 40
+    assert w * 90.0 <= st.tension_b <= w * (90.0 + h_el)
+    assert st.tension_b == pytest.approx(w * (488.0 - st.touchdown), rel=1e-3)
+    # the linear model says it is out of its depth at the anchor end
+    ind = line.indicators
+    assert ind.snap_risk and "snap" in ind.flags and ind.snap_margin < 0.0
+    # the element at the anchor has (numerically) zero mean tension: it is the one named
+    assert line.tension_mean[0] - 3.0 * line.tension_std[0] < 0.0
+    snap = [str(w_.message) for w_ in caught if issubclass(w_.category, PhysicsWarning)
+            and "snap loads likely" in str(w_.message)]
+    assert snap and "at element 1 (" in snap[0], [str(w_.message) for w_ in caught]
+    # ... and not at the taut 480 m line
+    assert "snap" not in taut.lines["l"].indicators.flags
+    # the fairlead tension σ hardly notices (the hanging part is the same 90 m)
+    assert line.end_b.std == pytest.approx(taut.lines["l"].end_b.std, rel=0.2)
+
+
 def test_nearly_vertical_tether():
     """A taut tether from the seabed at 200 m to z = -10 m, 2 m horizontal offset."""
     doc = {
@@ -163,6 +204,126 @@ def test_nearly_vertical_tether():
     # the tether surges (waves) much more than it heaves (axially stiff)
     mid = 15
     assert a.motion_std[mid, 0] > 10.0 * a.motion_std[mid, 2]
+
+
+# ------------------------------------------------------------- crossover / veering
+
+# Seed 000 (Bliet 1984) §3.8.7, eq. 3.116 and figure 3-11: Irvine's shallow-sag theory
+# applied to an inclined cable with H* = H/cos φ (tension along the chord) and
+# λ*² = (w₀L/H*)² (EA/H*) cos²φ predicts the crossover of the first symmetric and
+# antisymmetric in-plane modes at λ*² = 4π², as for a horizontal cable; the
+# perturbation solution for the inclined cable instead predicts hybrid modes and *no*
+# crossing: the two curves approach and veer away, each continuing the other's.  Scene
+# as in figure 3-11: φ = 30°, w₀L/H* = 0.5; its horizontal twin (φ = 0) crosses.
+VEER_CHORD, VEER_H_STAR, VEER_MASS, VEER_WL_H = 1000.0, 1.0e5, 10.0, 0.5
+VEER_LAMBDA2 = np.linspace(28.0, 52.0, 13)  # λ*² targets around 4π² = 39.5
+
+
+def _veer_doc(phi_deg: float, lam2: float) -> dict:
+    """Chord L at angle φ, chord tension ≈ H*, EA for the target λ*² (40 elements,
+    deep below the sea: the modes are the subject)."""
+    phi = math.radians(phi_deg)
+    w = VEER_WL_H * VEER_H_STAR / VEER_CHORD
+    ea = lam2 * VEER_H_STAR / (VEER_WL_H**2 * math.cos(phi) ** 2)
+    sag = w * math.cos(phi) * VEER_CHORD**2 / (8.0 * VEER_H_STAR)  # normal to the chord
+    arc = VEER_CHORD * (1.0 + 8.0 / 3.0 * (sag / VEER_CHORD) ** 2)
+    za = -1500.0
+    return {
+        "environment": {"depth": 2000.0},
+        "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 10.0},
+                "heading": 0.0},
+        "lines": [{
+            "name": "c",
+            "end_a": {"position": [0.0, 0.0, za]},
+            "end_b": {"position": [VEER_CHORD * math.cos(phi), 0.0,
+                                   za + VEER_CHORD * math.sin(phi)]},
+            "segments": [{"length": arc / (1.0 + VEER_H_STAR / ea), "ea": ea,
+                          "mass": VEER_MASS, "diameter": 0.1, "cd_normal": 1.2,
+                          "cd_axial": 0.0, "ca_normal": 0.0, "weight": w,
+                          "elements": 40}],
+        }],
+        "analysis": {"omega": {"min": 0.2, "max": 1.0, "count": 5}, "solver": "direct"},
+    }
+
+
+def _veer_sweep(phi_deg: float) -> np.ndarray:
+    """Rows (λ*² of the solved statics, ω₁/ω_a, ω₂/ω_a, symmetry of mode 1, of mode 2),
+    ω_a = 2π/L √(H*/m) the first antisymmetric string frequency; symmetry index
+    Σ u_n(s) u_n(L − s)/Σ u_n² of the displacement normal to the chord (+1 symmetric,
+    −1 antisymmetric)."""
+    phi = math.radians(phi_deg)
+    w = VEER_WL_H * VEER_H_STAR / VEER_CHORD
+    rows = []
+    for lam2 in VEER_LAMBDA2:
+        doc = _veer_doc(phi_deg, lam2)
+        with warnings.catch_warnings():
+            # undamped deep cable: the resonance warnings are right and not the subject
+            warnings.simplefilter("ignore", ResolutionWarning)
+            warnings.simplefilter("ignore", PhysicsWarning)
+            res = analyze(doc)
+        line = res.lines["c"]
+        h_star = abs(float(res.statics.lines["c"].force_a[0])) / math.cos(phi)
+        ea = doc["lines"][0]["segments"][0]["ea"]
+        lam2_act = (w * VEER_CHORD / h_star) ** 2 * ea / h_star * math.cos(phi) ** 2
+        w_a = 2.0 * math.pi / VEER_CHORD * math.sqrt(h_star / VEER_MASS)
+        model, shapes = line.model, line.modes.shapes
+        d = model.dim
+        sym = []
+        for j in range(2):
+            un = (-math.sin(phi) * shapes[model.dof(0, "x")::d, j]
+                  + math.cos(phi) * shapes[model.dof(0, "z")::d, j])
+            sym.append(float(un @ un[::-1] / (un @ un)))
+        rows.append((lam2_act, *(line.modes_omega[:2] / w_a), *sym))
+    return np.array(rows)
+
+
+@pytest.fixture(scope="module")
+def veering():
+    # 26 analyses of 40 elements: about 1.5 s
+    return {0.0: _veer_sweep(0.0), 30.0: _veer_sweep(30.0)}
+
+
+def test_horizontal_cable_modes_cross_at_lambda2_4pi2(veering):
+    lam2, w1, w2, s1, s2 = veering[0.0].T
+    # pure symmetric / antisymmetric modes (the horizontal cable is symmetric)
+    assert np.all(np.abs(s1) > 0.99) and np.all(np.abs(s2) > 0.99)
+    # mode 1 is symmetric below the crossover and antisymmetric above: they cross
+    assert s1[0] > 0 and s1[-1] < 0
+    assert np.count_nonzero(np.diff(np.sign(s1))) == 1
+    # the signed gap ω_sym − ω_anti changes sign at the crossover; its root
+    # (linear interpolation) is 4π² up to the shallow-sag theory's neglected
+    # O(8 (d/L)²) = 3 % (d/L = w₀L/8H* = 1/16; seed 000 eq. 3.116)
+    gap = np.where(s1 > 0, w1 - w2, w2 - w1)
+    k = int(np.flatnonzero(np.diff(np.sign(gap)))[0])
+    root = lam2[k] - gap[k] * (lam2[k + 1] - lam2[k]) / (gap[k + 1] - gap[k])
+    assert root / (4.0 * math.pi**2) == pytest.approx(1.0, abs=0.04)
+    # far from it the frequencies are Irvine's: the antisymmetric one is ω_a (1 %: sag)
+    anti = np.where(s1 < 0, w1, w2)
+    np.testing.assert_allclose(anti, 1.0, atol=0.02)
+
+
+def test_inclined_cable_modes_veer_without_crossing(veering):
+    lam2, w1, w2, s1, s2 = veering[30.0].T
+    lam2_h, w1_h, w2_h, s1_h, _ = veering[0.0].T
+    gap = w2 - w1
+    # no crossing: the gap stays open over the whole sweep (measured minimum 0.076 ω_a),
+    # while the horizontal twin's closes (its sorted gap is 3e-4 ω_a next to the
+    # crossover, the sweep's 2-unit λ² step times the slope of a closing gap)
+    assert gap.min() > 0.05
+    assert np.min(w2_h - w1_h) < 0.2 * gap.min()
+    # the minimum gap is interior, at 4π² within the shallow-sag theory's O(8(d/L)²)
+    k = int(np.argmin(gap))
+    assert 0 < k < gap.size - 1
+    c2, c1, _ = np.polyfit(lam2[k - 1:k + 2], gap[k - 1:k + 2], 2)
+    lam2_min = -c1 / (2.0 * c2)
+    assert lam2_min / (4.0 * math.pi**2) == pytest.approx(1.0, abs=0.04)
+    # hybrid modes near the veering, and the curves exchange their character: mode 1
+    # is symmetric-like at low λ*², antisymmetric-like at high λ*² (and mode 2 the
+    # reverse), continuously (no sign jump of the index between neighbours > 0.5)
+    assert abs(s1[k]) < 0.3 and abs(s2[k]) < 0.3
+    assert s1[0] > 0.8 and s1[-1] < -0.5
+    assert s2[0] < -0.8 and s2[-1] > 0.5
+    assert np.max(np.abs(np.diff(s1))) < 0.5
 
 
 # ------------------------------------------------------------------------- damping
@@ -319,6 +480,39 @@ def test_long_record_2_pow_20_samples():
     assert math.sqrt(np.mean(dyn**2)) == pytest.approx(res.lines["l"].end_b.std, rel=0.01)
 
 
+@pytest.mark.slow
+def test_long_record_2_pow_22_samples_nsa_variance_within_sampling_error():
+    """2^22 samples (dt = 0.25 s, 12 days) with random amplitudes (NSA): finite, and the
+    record's variance is the realization grid's spectral m0 = Σ|H|²SΔω within the NSA
+    sampling error.  Measured on the 2-core VM: 2.9 s alone, 9.5 s with four other
+    jobs; peak memory 1.8 GB (tracemalloc peak 1.76 GB inside analyze()'s synthesis,
+    0.27 GB held by the result)."""
+    n_t = 2**22
+    doc = chain(elements=10, omega={"min": 0.2, "max": 1.6, "count": 60})
+    doc["analysis"]["timeseries"] = {"method": "nsa", "duration": n_t * 0.25, "dt": 0.25,
+                                     "seed": 5}
+    res = analyze(doc)
+    ts = res.timeseries
+    assert ts.time.size == n_t
+    x = ts.end_tension["l"]["end_b"]
+    assert np.all(np.isfinite(x)) and np.all(np.isfinite(ts.elevation))
+    dyn = x - res.statics.lines["l"].tension_b
+    h = ts.end_tension_transfer["l"]["end_b"][0]
+    s = np.zeros_like(ts.omega)
+    s[1:-1] = res.scene.sea.spectrum.spectral_density(ts.omega[1:-1])
+    m_k = np.abs(h) ** 2 * s * ts.omega[1]  # variance per spectral line
+    m0 = float(m_k.sum())
+    # NSA: each line's power is exponential with mean m_k, so the record's variance has
+    # the relative standard deviation √Σm_k²/Σm_k (0.38 % here); 4 of them (seeded)
+    sd = math.sqrt(float(np.sum(m_k**2))) / m0
+    assert 1e-3 < sd < 1e-2
+    assert np.mean(dyn**2) == pytest.approx(m0, rel=4.0 * sd)
+    # ... and the analysis σ: the 60-point trapezoid (1 %, see the 2^20 test) plus the
+    # sampling error of σ (half that of the variance)
+    assert math.sqrt(np.mean(dyn**2)) == pytest.approx(res.lines["l"].end_b.std,
+                                                       rel=0.01 + 2.0 * sd)
+
+
 # ------------------------------------------------------------------------- big model
 
 
@@ -337,6 +531,32 @@ def test_400_element_line_direct_vs_foss():
     assert a.end_b.std == pytest.approx(b.end_b.std, rel=0.05)
     assert a.end_a.std == pytest.approx(b.end_a.std, rel=0.05)
     np.testing.assert_allclose(a.tension_mean, b.tension_mean, rtol=1e-12)
+
+
+def test_800_element_line_converges_to_the_200_element_answer():
+    """800 elements (1598 free DOFs), direct solve: finite, and the σ of the end
+    tensions agree with 200- and 400-element models within the discretization error.
+    The dominant error of this grounded chain is the touchdown's position inside an
+    element (the linear model's contact state is the static one): first order, about
+    h/L_s of the tension σ (L_s the suspended length; measured constant ≈ 1 on
+    tuah_1982_single_leg, see stochcable.fidelity); the string dispersion (kh)²/24 is
+    < 1e-4 here."""
+    omega = {"min": 0.1, "max": 2.0, "count": 40}
+    res = {n: analyze(chain(elements=n, solver="direct", omega=omega))
+           for n in (200, 400, 800)}
+    assert_finite(res[800])
+    fine = res[800].lines["l"]
+    assert fine.model.free.size == 2 * 799
+    l_s = 450.0 - res[800].statics.lines["l"].touchdown  # ≈ 123 m
+    for end in ("end_a", "end_b"):
+        s200, s400, s800 = (getattr(res[n].lines["l"], end).std for n in (200, 400, 800))
+        # measured end_a 1.3 %, end_b 0.2 % against the bound h₂₀₀/L_s = 1.8 %
+        assert s200 == pytest.approx(s800, rel=(450.0 / 200) / l_s)
+        assert abs(s800 - s400) <= abs(s400 - s200)  # converging
+    # statics: the mean tensions of the three meshes agree to the touchdown's O(h)
+    # share of the grounded length's contribution (measured 1e-4)
+    t_b = [res[n].statics.lines["l"].tension_b for n in (200, 400, 800)]
+    assert t_b[0] == pytest.approx(t_b[2], rel=1e-3)
 
 
 # ------------------------------------------------------------------------ imperial

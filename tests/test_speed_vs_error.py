@@ -4,6 +4,7 @@ errors, and errors that shrink as the setting approaches the converged reference
 
 from __future__ import annotations
 
+import copy
 import importlib.util
 import math
 import sys
@@ -120,3 +121,25 @@ def test_scene_document_does_not_mutate():
     assert doc["lines"][0]["segments"][0]["elements"] == 5
     assert doc["analysis"]["omega"]["count"] == 50
     assert doc["analysis"]["omega"]["max"] == 2 * base["analysis"]["omega"]["max"]
+
+
+def test_reference_ladder_puts_a_node_at_the_touchdown():
+    # tuah_1982_single_leg lies on the seabed from the anchor to s = 165.7 ft (closed-form
+    # catenary): the ladder meshes are split there so that the element ladder converges
+    # (uniform meshes oscillate at first order, see stochcable.fidelity)
+    from stochcable.fidelity import static_touchdowns
+    from stochcable.scene import load_scene
+
+    base = sve.base_document("tuah_1982_single_leg")
+    before = copy.deepcopy(base)
+    s_td = static_touchdowns(load_scene(base))["leg"]
+    doc = sve.split_at_touchdown(sve.scene_document(
+        base, sve.Setting("x", "reference", elements=4.0)), s_td)
+    assert base == before  # not mutated
+    segs = doc["lines"][0]["segments"]
+    assert [s["length"] for s in segs] == pytest.approx([s_td, 339.0 - s_td], rel=1e-12)
+    assert sum(s["elements"] for s in segs) == 12 and min(s["elements"] for s in segs) >= 1
+    st = load_scene(doc)  # a valid scene
+    assert st.lines[0].length == pytest.approx(339.0)
+    # no touchdown: unchanged
+    assert sve.split_at_touchdown(base, None) is base
