@@ -133,11 +133,17 @@ class _NpyResponse(Response):
 
 
 def columns_response(columns: Mapping[str, np.ndarray], media_type: str,
-                     stats: Mapping[str, Any] | None = None) -> Response:
-    """NPY (structured array) or CSV answer of equal-length float columns."""
+                     stats: Mapping[str, Any] | None = None,
+                     finite: tuple[str, ...] = ()) -> Response:
+    """NPY (structured array) or CSV answer of equal-length float columns.
+
+    ``finite`` names columns the caller has already found finite (their check is
+    skipped); every other column is checked and a non-finite value raises
+    NumericalError.
+    """
     names = list(columns)
     arrays = [np.asarray(columns[n], dtype=np.float64) for n in names]
-    if not all(np.isfinite(a).all() for a in arrays):
+    if not all(n in finite or np.isfinite(a).all() for n, a in zip(names, arrays)):
         from .errors import NumericalError
 
         raise NumericalError("the result contains non-finite values (NaN or inf)")

@@ -205,6 +205,45 @@ def _single_blas_thread(active: bool = True) -> Iterator[None]:
                 _blas_state["limiter"] = None
 
 
+# ------------------------------------------------------------------ allocator
+#
+# The solve works on complex arrays of n_nodes·dim·n_omega·n_channels entries (≈ 0.5 MB
+# on the reference chain), fresh temporaries in every iteration.  glibc's malloc hands
+# such blocks back to the kernel whenever the top of the heap is freed (trim threshold
+# ≈ 2 × the dynamic mmap threshold) and the kernel zero-fills the pages again on the
+# next allocation: on the reference chain those page faults were a third of the analysis
+# time (≈ 42 → 28 ms, docs/BENCHMARKS.md "Response analysis").  A heap top pad of
+# ``MALLOC_TOP_PAD`` keeps that much freed memory mapped instead (process-wide, set once
+# on the first analysis; glibc only; the environment variable ``STOCHCABLE_MALLOC_TUNING=0``
+# or an explicit ``MALLOC_TOP_PAD_`` leaves the allocator alone).
+
+#: Heap top pad set by :func:`_tune_allocator`. [bytes]
+MALLOC_TOP_PAD = 32 * 1024 * 1024
+_M_TOP_PAD = -2  # mallopt parameter number (glibc malloc.h)
+_allocator_state = {"done": False}
+
+
+def _tune_allocator() -> None:
+    """Set glibc's M_TOP_PAD once per process (no effect elsewhere or when disabled)."""
+    if _allocator_state["done"]:
+        return
+    _allocator_state["done"] = True
+    import os
+    import sys
+
+    if (not sys.platform.startswith("linux")
+            or os.environ.get("STOCHCABLE_MALLOC_TUNING", "1") == "0"
+            or "MALLOC_TOP_PAD_" in os.environ):
+        return
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6")
+        libc.mallopt(ctypes.c_int(_M_TOP_PAD), ctypes.c_int(MALLOC_TOP_PAD))
+    except (OSError, AttributeError):  # not glibc (musl, ...): leave malloc alone
+        pass
+
+
 def _is_small(scene: Scene) -> bool:
     return max(3 * (line.elements + 1) for line in scene.lines) <= SMALL_MODEL_DOF
 
@@ -545,10 +584,12 @@ def _element_load(b: np.ndarray, mom: np.ndarray) -> np.ndarray:
     (n_nodes, d, ...)."""
     n_el, _, d = mom.shape[:3]
     mf = np.ascontiguousarray(mom).reshape(n_el, 2, d, -1).view(float)
-    r = np.einsum("eij,esjn->esin", b, mf)   # 5x faster than stacked d×d matmuls
-    out = np.zeros((n_el + 1, d, mf.shape[-1]))
-    out[:-1] += r[:, 0]
-    out[1:] += r[:, 1]
+    # side-major output (contiguous r[0], r[1]); 5x faster than stacked d×d matmuls
+    r = np.einsum("eij,esjn->sein", b, mf)
+    out = np.empty((n_el + 1, d, mf.shape[-1]))
+    out[:-1] = r[0]
+    out[-1] = 0.0
+    out[1:] += r[1]
     return out.view(complex).reshape((n_el + 1, d) + mom.shape[3:])
 
 
@@ -887,9 +928,12 @@ def _solve_free(system: "LineSystem", inp: _Inputs, damping: Damping
     c = _add(prep.S, cd)
     _, f0, q = _base(system, prep, inp)
     rhs = _drag_load(system, inp, damping)   # a fresh array (f0 is cached: no +=)
-    rhs = f0 if rhs is None else rhs + f0
+    if rhs is None:
+        rhs = f0.copy()
+    else:
+        rhs += f0
     if q is not None:
-        rhs = rhs + _matvec(cd, q)
+        rhs += _matvec(cd, q)
     if system.solver == "direct":
         rhs_f = _to_freq(rhs[1:-1])
         bC = prep.bS + _free_band(cd)
@@ -1222,12 +1266,18 @@ def _element_variance(system: LineSystem, inp: _Inputs, method: str,
     c0, mw = _fluid_terms(system, inp, method)
     if q is None:
         return c0
-    qt = np.swapaxes(q, 2, 3)
-    gram = (q * _w2(inp)) @ qt                        # Σ w q_i q_j, (n_el, k, 2, 2)
-    var = c0 + np.einsum("ekij,ij->ek", gram, _GRAM)
+    # (|q_a|² + |q_b|² + Re(q̄_a q_b))/3 = ((q_a + q_b)·q_a + q_b·q_b)/3 on the real
+    # views: one elementwise pass and one matrix-vector product with the weights
+    # (the stacked (2 × 2N)(2N × 2) products of the Gram matrix were 2-3x slower)
+    qa, qb = q[:, :, 0], q[:, :, 1]
+    t = qa + qb
+    t *= qa
+    t += qb * qb
+    var = c0 + (t @ _w2(inp)) * _GRAM[0, 0]
     if mw is not None:
-        cross = mw @ qt                                # Σ w m_i q_j
-        var += 2.0 * (cross[..., 0, 0] + cross[..., 1, 1])
+        n_el, k = q.shape[:2]
+        var += 2.0 * np.einsum("ekn,ekn->ek", mw.reshape(n_el, k, -1),
+                               q.reshape(n_el, k, -1))  # Σ w (m_a q_a + m_b q_b)
     return var
 
 
@@ -2087,6 +2137,7 @@ def analyze(
     # Warnings are issued as they arise and also recorded for the result document by
     # a thread-local collector (warnings.catch_warnings is process-global before
     # Python 3.14, so concurrent analyses in service threads would swap them).
+    _tune_allocator()
     with collect_warnings() as caught, _single_blas_thread(_is_small(scene)):
         progress("statics", {})
         t0 = time.perf_counter()
@@ -2098,7 +2149,14 @@ def analyze(
         systems: dict[str, LineSystem] = {}
         lines: dict[str, LineResult] = {}
         dampings: dict[str, Damping] = {}
-        for line in scene.lines:
+        bodies: dict[str, Any] = {}
+        if scene.bodies:
+            # lines attached to bodies are solved together with them (issue 6)
+            from .coupled_analysis import analyze_coupled
+
+            lines, bodies, systems, dampings = analyze_coupled(scene, statics, settings,
+                                                               progress, timing)
+        for line in (() if scene.bodies else scene.lines):
             progress("model", {"line": line.name})
             t0 = time.perf_counter()
             system = build_line_system(scene, line, statics.lines[line.name], settings=settings)
@@ -2142,7 +2200,7 @@ def analyze(
         warn(text, PhysicsWarning)
         messages.insert(0, text)
     return Result(scene=scene, statics=statics, lines=lines, timeseries=ts, timing=timing,
-                  warnings=tuple(messages), fidelity=plan)
+                  warnings=tuple(messages), fidelity=plan, bodies=bodies)
 
 
 def _silent_channel(omega: np.ndarray) -> tuple[Channel, ...]:

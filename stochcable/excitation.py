@@ -275,20 +275,21 @@ def _phi1_psi(x: np.ndarray, want_psi: bool = True) -> tuple[np.ndarray, np.ndar
     Series (Horner, ``_SERIES_TERMS`` terms) for |x| < ``_SERIES_RADIUS``, where the
     closed forms cancel; closed forms (with expm1) elsewhere."""
     small = np.abs(x) < _SERIES_RADIUS
-    phi = np.empty_like(x)
-    psi = np.empty_like(x) if want_psi else None
+    # closed forms everywhere (no gather/scatter of the large part), then the series
+    # over the small entries (where the closed forms cancel, 0/0 at x = 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        em1 = np.expm1(x)
+        phi = em1 / x
+        psi = None
+        if want_psi:
+            psi = em1 * (x - 1.0)
+            psi += x
+            psi /= x * x                                   # ((x − 1)e^x + 1)/x²
     if small.any():
         xs = x[small]
         phi[small] = _series(xs, _PHI1_COEF)
         if want_psi:
             psi[small] = _series(xs, _PSI_COEF)
-    large = ~small
-    if large.any():
-        xl = x[large]
-        em1 = np.expm1(xl)
-        phi[large] = em1 / xl
-        if want_psi:
-            psi[large] = ((xl - 1.0) * em1 + xl) / (xl * xl)   # ((x − 1)e^x + 1)/x²
     return phi, psi
 
 
@@ -436,6 +437,14 @@ def element_wave_kinematics(
     return _element_kinematics(w, k, pts, beta, h, g)
 
 
+def _complex(re: np.ndarray, im: np.ndarray) -> np.ndarray:
+    """re + i·im in one pass (no complex temporaries)."""
+    out = np.empty(re.shape, dtype=complex)
+    out.real = re
+    out.imag = im
+    return out
+
+
 def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float,
                         h: float, g: float) -> ElementKinematics:
     """:func:`element_wave_kinematics` without validation."""
@@ -451,10 +460,10 @@ def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: flo
     p, q = np.clip(p, 0.0, 1.0)[:, None], np.clip(q, 0.0, 1.0)[:, None]
     length = q - p
     dz = np.multiply.outer(zb - za, k)
-    phase0 = -1j * np.multiply.outer(chi[:-1], k)
-    dphase = -1j * np.multiply.outer(chi[1:] - chi[:-1], k)
+    phase0 = -np.multiply.outer(chi[:-1], k)   # imaginary parts of the exponents
+    dphase = -np.multiply.outer(chi[1:] - chi[:-1], k)
     kza = np.multiply.outer(za, k)
-    ma1, mb1 = _exp_moments(kza + phase0, dz + dphase, p, q)
+    ma1, mb1 = _exp_moments(_complex(kza, phase0), _complex(dz, dphase), p, q)
     k1 = _exp_integral(2.0 * kza, 2.0 * dz, p, q)            # ∫ e^{2kz} dξ
     zero_w = w == 0.0
     z_ends = (za[:, None] + (zb - za)[:, None] * np.hstack([p, q]))   # (n_el, 2)
@@ -468,7 +477,7 @@ def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: flo
         ends = 2.0 * e1_ends * (w * w)
     else:
         e2a = -np.multiply.outer(za + 2.0 * h, k)
-        ma2, mb2 = _exp_moments(e2a + phase0, -dz + dphase, p, q)
+        ma2, mb2 = _exp_moments(_complex(e2a, phase0), _complex(-dz, dphase), p, q)
         k2 = _exp_integral(2.0 * e2a, -2.0 * dz, p, q)      # ∫ e^{−2k(z+2h)} dξ
         den = -np.expm1(-2.0 * k * h)
         with np.errstate(divide="ignore", invalid="ignore"):

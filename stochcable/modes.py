@@ -149,8 +149,11 @@ def _component_groups(d: int, a: sp.csr_array, b: sp.csr_array) -> list[list[int
         # entries at round-off level (after the rotation into the line's plane) do
         # not couple
         nz = np.abs(coo.data) > _COUPLING_TOL * np.abs(coo.data).max(initial=0.0)
-        pairs = np.unique(np.stack([ci[nz], cj[nz]]), axis=1)
-        for i, j in pairs.T:
+        # the distinct component pairs (i, j) as flat indices i·d + j (a 1-D count is
+        # ~10x faster than np.unique(axis=1) on the stacked pairs)
+        flat = np.flatnonzero(np.bincount((ci[nz] * d + cj[nz]).astype(np.intp),
+                                          minlength=d * d))
+        for i, j in zip(*np.divmod(flat, d)):
             ri, rj = find(int(i)), find(int(j))
             if ri != rj:
                 parent[ri] = rj
@@ -160,12 +163,19 @@ def _component_groups(d: int, a: sp.csr_array, b: sp.csr_array) -> list[list[int
     return list(groups.values())
 
 
+#: Up to this many DOFs (or when a quarter of the spectrum or more is requested) the
+#: dense path computes the whole spectrum (LAPACK sygvd) and keeps the lowest k: about
+#: 2x faster than the subset driver (sygvr) on the 78-DOF reference chain.
+_DENSE_FULL_DOF = 200
+
+
 def _solve_dense(a: sp.csr_array, b: sp.csr_array, k: int) -> tuple[np.ndarray, np.ndarray]:
     n = a.shape[0]
-    if k < n:
+    if k < n and (n > _DENSE_FULL_DOF and 4 * k < n):
         return sla.eigh(a.toarray(), b.toarray(), subset_by_index=[0, k - 1],
                         check_finite=False)
-    return sla.eigh(a.toarray(), b.toarray(), check_finite=False)
+    lam, vec = sla.eigh(a.toarray(), b.toarray(), check_finite=False)
+    return lam[:k], vec[:, :k]
 
 
 def _shift(a: sp.csr_array, b: sp.csr_array) -> float:
@@ -308,8 +318,11 @@ def natural_modes(
     lams, vecs, idxs, used = [], [], [], []
     for group in _component_groups(d, a, b):
         sel = np.flatnonzero(np.isin(comp_of_free, group))
-        ag = a[sel][:, sel].tocsr()
-        bg = b[sel][:, sel].tocsr()
+        if sel.size == n_free:  # one coupled group: no slicing
+            ag, bg = a, b
+        else:
+            ag = a[sel][:, sel].tocsr()
+            bg = b[sel][:, sel].tocsr()
         k = min(k_req, sel.size)
         u = 2 * len(group) - 1
         lam, vec, m = _solve_block(ag, bg, k, method, u)

@@ -27,6 +27,7 @@ __all__ = [
     "LinearizationRecord",
     "LineIndicators",
     "LineResult",
+    "BodyResult",
     "TimeSeries",
     "Result",
     "stats_from_spectrum",
@@ -377,6 +378,85 @@ class LineResult:
         }
 
 
+
+@dataclass(frozen=True, eq=False)
+class BodyResult:
+    """Frequency-domain motion of one rigid body (GitHub issue 6).
+
+    Attributes
+    ----------
+    name : str
+        Body name.
+    dofs : tuple of str
+        DOF names in order: ``("surge", "sway", "heave", "roll", "pitch", "yaw")``, or
+        ``("surge", "heave", "pitch")`` for a planar body (pitch about +y).
+    omega : ndarray, shape (n_omega,)
+        Analysis frequencies. [rad/s]
+    channels : tuple of str
+        Input channels (the coupled group's: ``"sea"``, ``"<line>.<end>.<dof>"``).
+    input_spectra : ndarray, shape (n_ch, n_omega)
+        One-sided input spectrum of each channel. [m²·s/rad]
+    motion_transfer : ndarray, complex, shape (n_ch, d, n_omega)
+        Motion of the reference point per unit input: translations [m/m], small
+        rotations about the global axes [rad/m].
+    motion : dict of str to ResponseStats
+        Statistics per DOF; mean = the static pose (position [m], rotation [rad]).
+    prescribed : bool
+        True for a vessel whose motion is its RAO (not solved for).
+    drag_sigma : ndarray or None, shape (3,)
+        σ of the relative velocity at the drag point along x, y, z. [m/s]
+    drag_coefficient : ndarray or None, shape (3,)
+        Linear drag coefficient per direction at the drag point. [N·s/m]
+    modes : CoupledModes or None
+        Natural modes of the coupled group the body belongs to.
+    """
+
+    name: str
+    dofs: tuple[str, ...]
+    omega: np.ndarray
+    channels: tuple[str, ...]
+    input_spectra: np.ndarray
+    motion_transfer: np.ndarray
+    motion: dict[str, ResponseStats]
+    prescribed: bool = False
+    drag_sigma: np.ndarray | None = None
+    drag_coefficient: np.ndarray | None = None
+    modes: Any = None
+
+    @property
+    def motion_spectrum(self) -> np.ndarray:
+        """Spectrum of each DOF, shape (d, n_omega). [m²·s/rad, rad²·s/rad]"""
+        return np.einsum("cdw,cw->dw", np.abs(self.motion_transfer) ** 2, self.input_spectra)
+
+    @property
+    def motion_std(self) -> np.ndarray:
+        """σ of each DOF, shape (d,). [m, rad]"""
+        return np.array([self.motion[k].std for k in self.dofs])
+
+    def to_document(self) -> dict[str, Any]:
+        """The body's part of the result document: per DOF the statistics (rotations
+        in rad, plus ``std_deg`` in degrees), the spectra, the modes."""
+        motion = {}
+        for k in self.dofs:
+            d = self.motion[k].as_dict()
+            if k in ("roll", "pitch", "yaw"):
+                d["std_deg"] = math.degrees(d["std"])
+            motion[k] = d
+        return {
+            "prescribed": bool(self.prescribed),
+            "dofs": list(self.dofs),
+            "motion": motion,
+            "spectra": {"omega": self.omega.tolist(),
+                        **{k: s.tolist() for k, s in zip(self.dofs, self.motion_spectrum)}},
+            "channels": list(self.channels),
+            "drag": None if self.drag_sigma is None else {
+                "sigma": self.drag_sigma.tolist(),
+                "coefficient": (None if self.drag_coefficient is None
+                                else self.drag_coefficient.tolist())},
+            "modes": None if self.modes is None else self.modes.as_dict(),
+        }
+
+
 @dataclass(frozen=True, eq=False)
 class TimeSeries:
     """One realization of the sea (and of each end-motion channel) and the responses.
@@ -461,6 +541,8 @@ class Result:
     fidelity : FidelityPlan or None
         The settings chosen by adaptive fidelity (``analysis.fidelity``), with their
         reasons and error estimates; ``scene`` is then the scene they produced.
+    bodies : dict of BodyResult
+        Motion of every rigid body by name (empty without bodies).
     """
 
     scene: Any
@@ -470,6 +552,7 @@ class Result:
     timing: dict[str, float]
     warnings: tuple[str, ...] = field(default_factory=tuple)
     fidelity: Any = None
+    bodies: dict[str, BodyResult] = field(default_factory=dict)
 
     @property
     def converged(self) -> bool:
@@ -515,6 +598,8 @@ class Result:
         }
         if self.fidelity is not None:
             doc["fidelity"] = self.fidelity.to_document()
+        if self.bodies:
+            doc["bodies"] = {k: v.to_document() for k, v in self.bodies.items()}
         if self.timeseries is not None and timeseries != "none":
             doc["timeseries"] = self.timeseries.to_document(full=timeseries == "full")
         return doc

@@ -22,7 +22,8 @@ from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError,
+                      model_validator)
 
 from .errors import InputError
 
@@ -41,10 +42,18 @@ __all__ = [
     "ComplexTable",
     "MotionRao",
     "EndMotion",
+    "BodyAttachment",
     "End",
     "Segment",
     "Attachment",
     "Line",
+    "BodyExcitation",
+    "BodyHydrodynamics",
+    "BodyHydrodynamicsFile",
+    "VesselMotion",
+    "Body",
+    "BODY_DOFS",
+    "PLANAR_BODY_DOFS",
     "OmegaGrid",
     "LinearizationSettings",
     "TimeSeriesSettings",
@@ -385,11 +394,35 @@ class EndMotion(_Doc):
         return self
 
 
-class End(_Doc):
-    """A line end: fixed at ``position`` unless a ``motion`` is prescribed about it."""
+class BodyAttachment(_Doc):
+    """Where a line end is fixed to a body (the end follows the body's rigid motion)."""
 
-    position: tuple[float, float, float] = _f("Position (x, y, z), z up", "m")
+    body: str = Field(min_length=1, max_length=64, description="Name of the body")
+    point: tuple[float, float, float] = _f(
+        "Attachment point relative to the body reference point, global axes, at the "
+        "static pose", "m", default=(0.0, 0.0, 0.0))
+
+
+class End(_Doc):
+    """A line end: fixed at ``position`` unless a ``motion`` is prescribed about it, or
+    attached to a body (``attach``), which then carries it (seed 001 eqs. 3.3.6–3.3.7)."""
+
+    position: tuple[float, float, float] | None = _f("Position (x, y, z), z up", "m",
+                                                     default=None)
     motion: EndMotion | None = None
+    attach: BodyAttachment | None = None
+
+    @model_validator(mode="after")
+    def _position_or_attach(self) -> "End":
+        if self.attach is None and self.position is None:
+            raise ValueError("give the end's position or attach it to a body")
+        if self.attach is not None and self.position is not None:
+            raise ValueError("give position or attach, not both (an attached end's "
+                             "position is the body position plus attach.point)")
+        if self.attach is not None and self.motion is not None:
+            raise ValueError("an end attached to a body cannot have a motion: the body "
+                             "moves it (give the body a 'prescribed' motion instead)")
+        return self
 
 
 class Segment(_Doc):
@@ -456,18 +489,263 @@ class Line(_Doc):
                 raise ValueError(
                     f"attachments[{i}].at = {a.at} m is beyond the line length {total} m"
                 )
-        span = math.dist(self.end_a.position, self.end_b.position)
-        if span == 0.0:
-            raise ValueError("end_a and end_b are at the same position")
-        # Strain needed to reach the span if the line were straight: a line that must
-        # stretch more than 10 % is a data error (EA or length in the wrong unit).
-        strain = span / total - 1.0
-        if strain > 0.1:
-            raise ValueError(
-                f"the line ({total:g} m unstretched) is shorter than its span "
-                f"({span:g} m): it would have to stretch {strain:.1%} (> 10 %)"
-            )
+        if self.end_a.position is not None and self.end_b.position is not None:
+            # attached ends: checked by Scene._check_scene with the body positions
+            _check_span(self.end_a.position, self.end_b.position, total)
         return self
+
+
+def _check_span(a: Sequence[float], b: Sequence[float], total: float) -> None:
+    span = math.dist(a, b)
+    if span == 0.0:
+        raise ValueError("end_a and end_b are at the same position")
+    # Strain needed to reach the span if the line were straight: a line that must
+    # stretch more than 10 % is a data error (EA or length in the wrong unit).
+    strain = span / total - 1.0
+    if strain > 0.1:
+        raise ValueError(
+            f"the line ({total:g} m unstretched) is shorter than its span "
+            f"({span:g} m): it would have to stretch {strain:.1%} (> 10 %)"
+        )
+
+
+# --------------------------------------------------------------------------- bodies
+
+#: Rigid-body DOF names (global axes, rotations about the reference point), as
+#: :data:`stochcable.bodies.SPATIAL_DOFS`; planar scenes use the x–z subset.
+BODY_DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+PLANAR_BODY_DOFS = ("surge", "heave", "pitch")
+
+Matrix = tuple[tuple[float, ...], ...]
+Vec3 = tuple[float, float, float]
+
+
+class BodyExcitation(_Doc):
+    """Wave excitation table of a body (docs/BODIES.md JSON table format)."""
+
+    heading: tuple[float, ...] = _f("Wave headings, increasing, spanning < 360", "deg",
+                                    min_length=1)
+    re: tuple[Matrix, ...] = _f("Real part, (n_heading, n_dof, n_omega), per unit wave "
+                                "amplitude, e^{+iωt}", "N/m, N·m/m")
+    im: tuple[Matrix, ...] = _f("Imaginary part, shape as re", "N/m, N·m/m")
+
+
+class BodyHydrodynamics(_Doc):
+    """Hydrodynamic coefficients over ω, inline (the JSON table of docs/BODIES.md).
+
+    Checked with :func:`stochcable.body_data.read_table` (shapes, symmetry within
+    2 %, non-negative damping diagonal).
+    """
+
+    dofs: tuple[str, ...] | None = Field(
+        default=None, description="DOF order: the six (default) or surge, heave, pitch")
+    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s",
+                                  min_length=1)
+    added_mass: tuple[Matrix, ...] = _f("Added mass (n_omega, d, d) about the reference "
+                                        "point", "kg, kg·m, kg·m²")
+    radiation_damping: tuple[Matrix, ...] = _f("Radiation damping (n_omega, d, d)",
+                                               "N·s/m, N·s, N·m·s")
+    excitation: BodyExcitation | None = None
+    hydrostatic_stiffness: Matrix | None = _f("Hydrostatic restoring (d, d), weight terms "
+                                              "included", "N/m, N, N·m/rad", default=None)
+    reference_point: Vec3 | None = _f("Reference point of the table (informative)", "m",
+                                      default=None)
+
+    @model_validator(mode="after")
+    def _check_table(self) -> "BodyHydrodynamics":
+        from .body_data import read_table
+
+        try:
+            read_table(self.table())
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+        return self
+
+    def table(self) -> dict[str, Any]:
+        """The table as a mapping for :func:`stochcable.body_data.read_table`."""
+        return self.model_dump(mode="python", exclude_none=True)
+
+    @property
+    def planar(self) -> bool:
+        """True for a (surge, heave, pitch) table."""
+        return self.dofs is not None and len(self.dofs) == 3
+
+
+class BodyHydrodynamicsFile(_Doc):
+    """Hydrodynamic coefficients in a file: Capytaine NetCDF (.nc) or a JSON table.
+
+    A relative path is relative to the scene file (:func:`load_scene` makes it
+    absolute); the HTTP service refuses files (``load_scene(..., allow_files=False)``).
+    """
+
+    file: str = Field(min_length=1, max_length=4096,
+                      description="Path of a Capytaine .nc or JSON table file")
+
+
+class VesselMotion(_Doc):
+    """A prescribed (vessel) body motion: 6-DOF RAOs per unit wave amplitude.
+
+    Translations in m/m, rotations in rad/m, about the body reference point, for the
+    scene's sea heading (v1: no heading dimension); zero outside the table.  The
+    body is not solved for: lines attached to it see the end motion T(r)·ξ (seed 001
+    eqs. 3.3.6–3.3.7), nothing couples back.
+    """
+
+    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s",
+                                  min_length=2)
+    surge: ComplexTable | None = None
+    sway: ComplexTable | None = None
+    heave: ComplexTable | None = None
+    roll: ComplexTable | None = None
+    pitch: ComplexTable | None = None
+    yaw: ComplexTable | None = None
+
+    @model_validator(mode="after")
+    def _check(self) -> "VesselMotion":
+        w = np.asarray(self.omega)
+        if w[0] < 0 or (np.diff(w) <= 0).any():
+            raise ValueError("omega must be >= 0 and strictly increasing")
+        given = {k: getattr(self, k) for k in BODY_DOFS}
+        if all(v is None for v in given.values()):
+            raise ValueError(f"give at least one of {', '.join(BODY_DOFS)}")
+        for k, v in given.items():
+            if v is not None and len(v.re) != len(self.omega):
+                raise ValueError(f"{k} has {len(v.re)} values but omega has "
+                                 f"{len(self.omega)}")
+        return self
+
+    def transfer(self, omega: np.ndarray) -> np.ndarray:
+        """RAO per unit wave amplitude at ``omega``, shape (6, n), zero outside the
+        table. [m/m, rad/m]"""
+        omega = np.asarray(omega, dtype=float)
+        out = np.zeros((6, omega.size), dtype=complex)
+        w = np.asarray(self.omega)
+        for i, k in enumerate(BODY_DOFS):
+            t = getattr(self, k)
+            if t is None:
+                continue
+            v = t.values()
+            out[i] = np.interp(omega, w, v.real, 0.0, 0.0) + 1j * np.interp(
+                omega, w, v.imag, 0.0, 0.0)
+        return out
+
+    @property
+    def out_of_plane(self) -> bool:
+        """True when a sway, roll or yaw RAO is non-zero."""
+        return any(getattr(self, k) is not None and np.any(getattr(self, k).values() != 0)
+                   for k in ("sway", "roll", "yaw"))
+
+
+def _hydro_kind(v: Any) -> str:
+    """Discriminator of Body.hydrodynamics: a mapping with 'file' is a file reference."""
+    if isinstance(v, Mapping):
+        return "file" if "file" in v else "table"
+    return "file" if isinstance(v, BodyHydrodynamicsFile) else "table"
+
+
+class Body(_Doc):
+    """A large rigid body (buoy, disc, vessel; seed 001 §3.2.c, eq. 3.2.c.20).
+
+    DOFs and signs as :mod:`stochcable.bodies`: (surge, sway, heave, roll, pitch, yaw)
+    about the reference point ``position``, global axes; in a planar scene (surge,
+    heave, pitch).  Matrices are 6×6, or 3×3 (surge, heave, pitch) in a planar scene.
+    Explicit constant ``added_mass``, ``radiation_damping``, ``hydrostatic_stiffness``
+    replace the corresponding matrix of ``hydrodynamics``.
+
+    Statics: the weight m·g acts at ``cog``.  With ``displaced_volume`` the buoyancy
+    ρ g ∇ acts at ``centre_of_buoyancy`` (exact for a submerged body; for a floating
+    one the ``hydrostatic_stiffness`` adds the restoring about ``position``); without
+    it the body is taken as freely floating in equilibrium at ``position``, restored
+    by ``hydrostatic_stiffness`` only.
+    """
+
+    name: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.\-]+$",
+                      description="Unique body name (letters, digits, _ . -)")
+    position: Vec3 = _f("Reference point at the static pose (initial guess of the "
+                        "statics for a free body)", "m")
+    mass: float = _f("Mass", "kg", gt=0)
+    inertia: Matrix | None = _f("Inertia tensor about the centre of gravity, global axes, "
+                                "3×3", "kg·m²", default=None)
+    cog: Vec3 = _f("Centre of gravity relative to the reference point", "m",
+                   default=(0.0, 0.0, 0.0))
+    added_mass: Matrix | None = _f("Constant added mass", "kg, kg·m, kg·m²", default=None)
+    radiation_damping: Matrix | None = _f("Constant radiation damping",
+                                          "N·s/m, N·s, N·m·s", default=None)
+    hydrostatic_stiffness: Matrix | None = _f(
+        "Hydrostatic restoring about the reference point, weight terms included",
+        "N/m, N, N·m/rad", default=None)
+    extra_stiffness: Matrix | None = _f("Additional linear stiffness", "N/m, N, N·m/rad",
+                                        default=None)
+    extra_damping: Matrix | None = _f("Additional linear damping", "N·s/m, N·s, N·m·s",
+                                      default=None)
+    hydrodynamics: Annotated[
+        Union[Annotated[BodyHydrodynamicsFile, Tag("file")],
+              Annotated[BodyHydrodynamics, Tag("table")]],
+        Discriminator(_hydro_kind)] | None = Field(
+        default=None, description="Frequency-dependent coefficients: inline table or file")
+    displaced_volume: float | None = _f("Displaced volume for the static buoyancy", "m³",
+                                        ge=0, default=None)
+    centre_of_buoyancy: Vec3 = _f("Centre of buoyancy relative to the reference point",
+                                  "m", default=(0.0, 0.0, 0.0))
+    drag_area: Vec3 = _f("Drag coefficient times area, Cd·A, for flow along x, y, z",
+                         "m²", default=(0.0, 0.0, 0.0))
+    drag_point: Vec3 = _f("Point of application of the drag relative to the reference "
+                          "point", "m", default=(0.0, 0.0, 0.0))
+    wind_force: Vec3 = _f("Static wind force at the reference point (seed 001 §6.5)", "N",
+                          default=(0.0, 0.0, 0.0))
+    wind_moment: Vec3 = _f("Static wind moment about the reference point", "N·m",
+                           default=(0.0, 0.0, 0.0))
+    extrapolation: Literal["error", "hold"] = Field(
+        default="error", description="Outside the frequencies of the hydrodynamic table: "
+        "refuse, or hold the end values")
+    prescribed: VesselMotion | None = Field(
+        default=None, description="Prescribed motion (a vessel): the body is not solved "
+        "for; its static pose is position, no rotation")
+    fixed_dofs: tuple[Literal["surge", "sway", "heave", "roll", "pitch", "yaw"], ...] = \
+        Field(default=(), description="DOFs held fixed (statics and dynamics), e.g. yaw "
+              "of a buoy on one line")
+
+    @model_validator(mode="after")
+    def _check_body(self) -> "Body":
+        for k in ("added_mass", "radiation_damping", "hydrostatic_stiffness",
+                  "extra_stiffness", "extra_damping"):
+            m = getattr(self, k)
+            if m is None:
+                continue
+            n = len(m)
+            if n not in (3, 6) or any(len(row) != n for row in m):
+                raise ValueError(f"{k} must be a 6×6 or (planar) 3×3 matrix")
+        if self.inertia is not None and (len(self.inertia) != 3
+                                         or any(len(r) != 3 for r in self.inertia)):
+            raise ValueError("inertia must be a 3×3 tensor")
+        if any(v < 0 for v in self.drag_area):
+            raise ValueError(f"drag_area = {list(self.drag_area)} m²: must be >= 0")
+        if len(set(self.fixed_dofs)) != len(self.fixed_dofs):
+            raise ValueError("fixed_dofs are repeated")
+        return self
+
+    @property
+    def planar_data(self) -> bool:
+        """True when a matrix or the table is 3×3 (surge, heave, pitch)."""
+        mats = [getattr(self, k) for k in ("added_mass", "radiation_damping",
+                                           "hydrostatic_stiffness", "extra_stiffness",
+                                           "extra_damping")]
+        if any(m is not None and len(m) == 3 for m in mats):
+            return True
+        h = self.hydrodynamics
+        return isinstance(h, BodyHydrodynamics) and h.planar
+
+    @property
+    def out_of_plane(self) -> bool:
+        """True when the body leaves the x–z plane: y of its points, sway forces,
+        roll/yaw moments, out-of-plane vessel RAOs."""
+        tol = 1e-9
+        ys = [self.position[1], self.cog[1], self.centre_of_buoyancy[1],
+              self.drag_point[1], self.wind_force[1], self.wind_moment[0],
+              self.wind_moment[2]]
+        if any(abs(v) > tol for v in ys):
+            return True
+        return self.prescribed is not None and self.prescribed.out_of_plane
 
 
 # ------------------------------------------------------------------------- analysis
@@ -571,6 +849,8 @@ class Scene(_Doc):
     environment: Environment
     sea: Sea | None = None
     lines: tuple[Line, ...] = Field(min_length=1, max_length=100)
+    bodies: tuple[Body, ...] = Field(default=(), max_length=100,
+                                     description="Large rigid bodies the lines attach to")
     analysis: AnalysisSettings = Field(default_factory=AnalysisSettings)
 
     @model_validator(mode="after")
@@ -579,31 +859,133 @@ class Scene(_Doc):
         dup = {n for n in names if names.count(n) > 1}
         if dup:
             raise ValueError(f"line names must be unique; repeated: {sorted(dup)}")
+        bnames = [b.name for b in self.bodies]
+        dup = {n for n in bnames if bnames.count(n) > 1}
+        if dup:
+            raise ValueError(f"body names must be unique; repeated: {sorted(dup)}")
+        bodies = {b.name: b for b in self.bodies}
         depth = self.environment.depth
         for i, ln in enumerate(self.lines):
             for end in ("end_a", "end_b"):
-                z = getattr(ln, end).position[2]
+                e = getattr(ln, end)
+                if e.attach is not None:
+                    if e.attach.body not in bodies:
+                        raise ValueError(
+                            f"lines[{i}].{end}.attach.body = {e.attach.body!r}: no body of "
+                            f"that name; bodies: {bnames}")
+                    continue
+                z = e.position[2]
                 if z < -depth * (1 + 1e-9):
                     raise ValueError(
                         f"lines[{i}].{end}.position z = {z} m is below the seabed "
                         f"(depth {depth} m)"
                     )
-            za = ln.end_a.position[2]
-            if za > 0.0:
-                raise ValueError(
-                    f"lines[{i}].end_a.position z = {za} m: the anchor end (end_a) is "
-                    "above the still-water surface (z must be <= 0)"
-                )
+            if ln.end_a.attach is None:
+                za = ln.end_a.position[2]
+                if za > 0.0:
+                    raise ValueError(
+                        f"lines[{i}].end_a.position z = {za} m: the anchor end (end_a) is "
+                        "above the still-water surface (z must be <= 0)"
+                    )
+            if ln.end_a.attach is not None or ln.end_b.attach is not None:
+                try:
+                    _check_span(self.end_position(ln, "end_a"), self.end_position(ln, "end_b"),
+                                ln.length)
+                except ValueError as exc:
+                    raise ValueError(f"lines[{i}]: {exc}") from None
+        if self.bodies:
+            planar = self.is_planar
+            for j, b in enumerate(self.bodies):
+                if b.planar_data and not planar:
+                    raise ValueError(
+                        f"bodies[{j}] ({b.name!r}) has 3×3 (surge, heave, pitch) data but "
+                        "the scene is not planar (a line, body, sea or current leaves the "
+                        "x–z plane): give 6×6 matrices and a 6-DOF table")
+                if planar:
+                    bad = [d for d in b.fixed_dofs if d not in PLANAR_BODY_DOFS]
+                    if bad:
+                        raise ValueError(
+                            f"bodies[{j}].fixed_dofs {bad}: the scene is planar, its bodies "
+                            f"have only {list(PLANAR_BODY_DOFS)}")
         return self
+
+    @property
+    def uses_files(self) -> bool:
+        """True when a body's hydrodynamics refers to a file (refused by the service)."""
+        return any(isinstance(b.hydrodynamics, BodyHydrodynamicsFile) for b in self.bodies)
+
+    def body(self, name: str) -> "Body":
+        """The body called ``name``."""
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise InputError("body", name, "-", f"no body of that name; bodies: "
+                         f"{[b.name for b in self.bodies]}")
+
+    def end_position(self, line: "Line | str", end: Literal["end_a", "end_b"],
+                     poses: Mapping[str, Any] | None = None) -> np.ndarray:
+        """Position of a line end, shape (3,). [m]
+
+        Parameters
+        ----------
+        line : Line or str
+            The line or its name.
+        end : {"end_a", "end_b"}
+        poses : mapping of body name to pose, optional
+            Body poses: objects with ``position`` (3,) [m] and ``rotation`` (3,)
+            rotation vector [rad] (:class:`stochcable.body_statics.BodyStatics`), or
+            ``(position, rotation)`` pairs.  Default: the bodies' ``position``, no
+            rotation.
+
+        Returns
+        -------
+        ndarray, shape (3,)
+            ``end.position``, or for an attached end X + R(θ)·r (seed 001 eq. 3.3.6
+            to first order), X, θ the body pose and r ``attach.point``. [m]
+        """
+        if isinstance(line, str):
+            found = [ln for ln in self.lines if ln.name == line]
+            if not found:
+                raise InputError("line", line, "-", "no line of that name")
+            line = found[0]
+        e = getattr(line, end)
+        if e.attach is None:
+            return np.asarray(e.position, dtype=float)
+        name = e.attach.body
+        r = np.asarray(e.attach.point, dtype=float)
+        pose = None if poses is None else poses.get(name)
+        if pose is None:
+            return np.asarray(self.body(name).position, dtype=float) + r
+        if hasattr(pose, "position"):
+            x, rot = pose.position, pose.rotation
+        else:
+            x, rot = pose
+        return np.asarray(x, dtype=float) + rotate(np.asarray(rot, dtype=float), r)
+
+    def resolved_line(self, line: "Line", poses: Mapping[str, Any] | None = None) -> "Line":
+        """The line with its attached ends replaced by fixed positions at ``poses``
+        (:meth:`end_position`), for the code that needs ``end.position``."""
+        upd = {}
+        for end in ("end_a", "end_b"):
+            if getattr(line, end).attach is not None:
+                p = self.end_position(line, end, poses)
+                upd[end] = End(position=tuple(float(v) for v in p))
+        return line.model_copy(update=upd) if upd else line
 
     @property
     def is_planar(self) -> bool:
         """True when every line, the sea, current and end motions lie in one vertical
         plane through the x axis (y = 0, headings 0 or 180 deg), so a 2-D model suffices."""
         tol = 1e-9
-        for ln in self.lines:
-            if abs(ln.end_a.position[1]) > tol or abs(ln.end_b.position[1]) > tol:
+        for b in self.bodies:
+            if b.out_of_plane:
                 return False
+        for ln in self.lines:
+            for end in ("end_a", "end_b"):
+                e = getattr(ln, end)
+                y = e.position[1] if e.attach is None else e.attach.point[1]
+                if abs(y) > tol:
+                    return False
             for end in (ln.end_a, ln.end_b):
                 m = end.motion
                 if m is not None and (m.sway is not None or (m.rao is not None and m.rao.sway is not None)):
@@ -655,6 +1037,16 @@ def field_path_and_unit(model: type[BaseModel] | None, loc: Sequence[Any]) -> tu
             continue
         if isinstance(part, str) and part.startswith("function-"):
             continue
+        if part in ("file", "table") and any(
+                c in (BodyHydrodynamicsFile, BodyHydrodynamics) for c in candidates) \
+                and not any(part in c.model_fields for c in candidates
+                            if c is not BodyHydrodynamicsFile):
+            if part == "table":
+                candidates = [BodyHydrodynamics]
+                continue
+            if out.endswith("hydrodynamics"):
+                candidates = [BodyHydrodynamicsFile]
+                continue
         out += ("." if out else "") + str(part)
         current = next((c for c in candidates if part in c.model_fields), None)
         if current is None:
@@ -706,13 +1098,28 @@ def input_error_from_validation(
     return InputError(path, value, unit, msg)
 
 
-def load_scene(source: Scene | Mapping[str, Any] | str | Path) -> Scene:
+def rotate(rotation: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """R(θ)·r for a rotation vector θ (Rodrigues' formula). [m]"""
+    th = float(np.linalg.norm(rotation))
+    if th == 0.0:
+        return np.array(r, dtype=float)
+    k = rotation / th
+    return (r * math.cos(th) + np.cross(k, r) * math.sin(th)
+            + k * float(k @ r) * (1.0 - math.cos(th)))
+
+
+def load_scene(source: Scene | Mapping[str, Any] | str | Path, *,
+               allow_files: bool = True) -> Scene:
     """Validate a scene given as a model, a mapping, a JSON string or a path to a file.
 
     Parameters
     ----------
     source : Scene, mapping, str or path
         The scene document. A ``str`` that does not start with ``{`` is a file path.
+    allow_files : bool, optional
+        Accept bodies whose ``hydrodynamics`` is a ``{"file": ...}`` (the HTTP
+        service passes False).  Relative paths are made absolute against the scene
+        file's folder (a path source) or the working folder; the file must exist.
 
     Returns
     -------
@@ -725,12 +1132,14 @@ def load_scene(source: Scene | Mapping[str, Any] | str | Path) -> Scene:
         Naming the first offending field path, its value, unit and constraint.
     """
     if isinstance(source, Scene):
-        return source
+        return _check_files(source, allow_files)
+    base = Path.cwd()
     if isinstance(source, (str, Path)):
         text = str(source)
         if isinstance(source, Path) or not text.lstrip().startswith("{"):
             try:
                 text = Path(source).read_text(encoding="utf-8")
+                base = Path(source).resolve().parent
             except OSError as exc:
                 raise InputError("scene", str(source), "-",
                                  f"cannot be read ({exc.strerror})") from None
@@ -742,9 +1151,35 @@ def load_scene(source: Scene | Mapping[str, Any] | str | Path) -> Scene:
     else:
         data = source
     try:
-        return Scene.model_validate(data)
+        scene = Scene.model_validate(data)
     except ValidationError as exc:
         raise input_error_from_validation(exc, Scene) from None
+    return _check_files(scene, allow_files, base)
+
+
+def _check_files(scene: Scene, allow_files: bool, base: Path | None = None) -> Scene:
+    """Refuse or resolve the bodies' hydrodynamics files (see :func:`load_scene`)."""
+    if not scene.uses_files:
+        return scene
+    bodies = list(scene.bodies)
+    for i, b in enumerate(bodies):
+        h = b.hydrodynamics
+        if not isinstance(h, BodyHydrodynamicsFile):
+            continue
+        where = f"bodies[{i}].hydrodynamics.file"
+        if not allow_files:
+            raise InputError(where, h.file, "-", "files are not accepted here: give the "
+                             "coefficient table inline (docs/BODIES.md JSON table)")
+        p = Path(h.file)
+        if not p.is_absolute():
+            p = (base if base is not None else Path.cwd()) / p
+        if not p.is_file():
+            raise InputError(where, h.file, "-", f"file not found (looked for {p})")
+        if str(p) != h.file:
+            bodies[i] = b.model_copy(update={"hydrodynamics": BodyHydrodynamicsFile(file=str(p))})
+    if bodies == list(scene.bodies):
+        return scene
+    return scene.model_copy(update={"bodies": tuple(bodies)})
 
 
 def scene_json_schema() -> dict[str, Any]:

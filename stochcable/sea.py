@@ -22,6 +22,7 @@ DSA and NSA realizations with the same seed therefore share their phases.
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import threading
@@ -48,11 +49,9 @@ __all__ = [
 NYQUIST_LOSS_TOLERANCE = 1e-3
 """Fraction of m0 above the Nyquist frequency π/Δt that triggers a ResolutionWarning. [-]"""
 
-_TABLE_BITS = 11
+_TABLE_BITS = 13
 _TABLE_SIZE = 1 << _TABLE_BITS
-_TABLE = np.exp(2j * np.pi * np.arange(_TABLE_SIZE) / _TABLE_SIZE)
-_TAB_C = np.ascontiguousarray(_TABLE.real)
-_TAB_S = np.ascontiguousarray(_TABLE.imag)
+_TABLE = -np.exp(2j * np.pi * np.arange(_TABLE_SIZE) / _TABLE_SIZE)   # −e^{2πij/2^13}
 _CHUNK = 32768
 _PARALLEL_MIN = 2**16
 _pool = None
@@ -60,8 +59,9 @@ _pool_lock = threading.Lock()
 
 
 def _executor():
-    """Module thread pool (os.cpu_count() workers) for the phasor kernel; numpy
-    releases the GIL inside ufunc loops, so the chunks run in parallel."""
+    """Module thread pool (os.cpu_count() workers) for the helpers of simulate_sea
+    (the random draws, then chunks of the coefficient kernel; numpy releases the GIL
+    inside its loops)."""
     global _pool
     with _pool_lock:
         if _pool is None:
@@ -134,6 +134,9 @@ class SeaRealization:
         ``"dsa"`` or ``"nsa"``. [-]
     seed : int or None
         The integer seed if one was given (``None`` for a Generator or fresh entropy). [-]
+    m0 : float
+        Target variance Σ_{m=1}^{N−1} S(ω_m)Δω of the simulated lines (NaN when not
+        known, e.g. a realization built by hand). [m²]
 
     Notes
     -----
@@ -147,6 +150,7 @@ class SeaRealization:
     dt: float
     method: str
     seed: int | None = None
+    m0: float = math.nan
 
     @property
     def n_samples(self) -> int:
@@ -190,77 +194,128 @@ def _resolve_rng(rng) -> tuple[np.random.Generator, int | None]:  # noqa: ANN001
     raise InputError("rng", rng, "-", "must be a numpy Generator, a non-negative int seed or None")
 
 
-def _unit_phasors_into(u: np.ndarray, amp: np.ndarray, out: np.ndarray) -> None:
-    """out = amp · e^{−iθ}, θ = π − 2πu, i.e. −amp · e^{2πiu}, without calling cos/sin.
+_scratch = threading.local()
 
-    e^{2πiu} = T[j] · e^{iδ}, j = ⌊2048u⌋, δ = 2π(2048u − j)/2048 ∈ [0, 3.07e-3): a
-    2048-entry table times Taylor series of cos δ, sin δ to δ⁶, δ⁷ (truncation
-    < 2e-22); |error| < 2e-16 per entry.  Processed in cache-sized chunks.
+
+def _buffers(size: int) -> list[np.ndarray]:
+    """Per-thread scratch arrays of the coefficient kernel (kept between calls)."""
+    bufs = getattr(_scratch, "bufs", None)
+    if bufs is None or bufs[0].shape[0] < size:
+        bufs = ([np.empty(size) for _ in range(5)] + [np.empty(size, dtype=np.intp)]
+                + [np.empty(size, dtype=np.complex128) for _ in range(2)])
+        _scratch.bufs = bufs
+    return bufs
+
+
+def _phasor_chunk(u: np.ndarray, s: np.ndarray, c2: float, out: np.ndarray,
+                  gain: np.ndarray | None, fft_in: np.ndarray, scale: float) -> None:
+    """out = a·e^{−iθ}, a = √(c2·S) (× gain), θ = π − 2πu, without calling cos/sin;
+    fft_in = out·scale (the FFT's work array, filled while the chunk is in cache).
+
+    −e^{2πiu} = T[j] · e^{iδ}, T[j] = −e^{2πij/8192}, j = ⌊8192u⌋,
+    δ = 2π(8192u − j)/8192 ∈ [0, 7.7e-4): a table times cos δ ≈ 1 − δ²/2 + δ⁴/24,
+    sin δ ≈ δ(1 − δ²/6) (truncation δ⁶/720 < 3e-22, δ⁵/120 < 3e-18); |error| ≲ 3e-16
+    relative per entry.  The amplitude multiplies e^{iδ} before the one complex product
+    with the table.  One cache-sized chunk (≤ _CHUNK entries) on the calling thread.
     """
-    n = u.shape[0]
-    B = min(_CHUNK, n)
-    s = np.empty(B)
-    j = np.empty(B, dtype=np.intp)
-    d2 = np.empty(B)
-    c = np.empty(B)
-    sn = np.empty(B)
-    ta = np.empty(B)
-    tb = np.empty(B)
-    w = np.empty(B)
-    k = 2.0 * math.pi / _TABLE_SIZE
-    ov = out.view(np.float64)
-    for a in range(0, n, B):
-        b = min(a + B, n)
-        m = b - a
-        s_, j_, d2_, c_, sn_, ta_, tb_, w_ = (x[:m] for x in (s, j, d2, c, sn, ta, tb, w))
-        np.multiply(u[a:b], float(_TABLE_SIZE), out=s_)
-        np.floor(s_, out=w_)
-        np.copyto(j_, w_, casting="unsafe")
-        np.subtract(s_, w_, out=s_)
-        s_ *= k                               # δ
-        np.multiply(s_, s_, out=d2_)          # δ²
-        # cos δ = 1 − δ²/2 + δ⁴/24 − δ⁶/720
-        np.multiply(d2_, -1.0 / 720.0, out=c_)
-        c_ += 1.0 / 24.0
-        c_ *= d2_
-        c_ -= 0.5
-        c_ *= d2_
-        c_ += 1.0
-        # sin δ = δ(1 − δ²/6 + δ⁴/120 − δ⁶/5040)
-        np.multiply(d2_, -1.0 / 5040.0, out=sn_)
-        sn_ += 1.0 / 120.0
-        sn_ *= d2_
-        sn_ -= 1.0 / 6.0
-        sn_ *= d2_
-        sn_ += 1.0
-        sn_ *= s_
-        np.take(_TAB_C, j_, out=ta_)
-        np.take(_TAB_S, j_, out=tb_)
-        am = amp[a:b]
-        # −amp (ta + i tb)(c + i sn): real = amp (tb sn − ta c), imag = −amp (ta sn + tb c)
-        np.multiply(tb_, sn_, out=w_)
-        np.multiply(ta_, c_, out=s_)
-        w_ -= s_
-        np.multiply(w_, am, out=ov[2 * a:2 * b:2])
-        np.multiply(ta_, sn_, out=w_)
-        np.multiply(tb_, c_, out=s_)
-        w_ += s_
-        w_ *= am
-        np.negative(w_, out=ov[2 * a + 1:2 * b:2])
+    m = u.shape[0]
+    x_, w_, d2_, c_, amp, j_, e, t = (b[:m] for b in _buffers(_CHUNK))
+    np.multiply(u, float(_TABLE_SIZE), out=x_)
+    np.floor(x_, out=w_)
+    np.copyto(j_, w_, casting="unsafe")
+    np.subtract(x_, w_, out=x_)
+    x_ *= 2.0 * math.pi / _TABLE_SIZE     # δ
+    np.multiply(x_, x_, out=d2_)          # δ²
+    np.multiply(s, c2, out=amp)
+    np.sqrt(amp, out=amp)
+    if gain is not None:
+        amp *= gain
+    ev = e.view(np.float64)
+    np.multiply(d2_, 1.0 / 24.0, out=c_)  # cos δ = 1 + δ²(−1/2 + δ²/24)
+    c_ -= 0.5
+    c_ *= d2_
+    c_ += 1.0
+    np.multiply(c_, amp, out=ev[0::2])
+    np.multiply(d2_, -1.0 / 6.0, out=c_)  # sin δ = δ(1 − δ²/6)
+    c_ += 1.0
+    c_ *= x_
+    np.multiply(c_, amp, out=ev[1::2])
+    np.take(_TABLE, j_, out=t)
+    np.multiply(t, e, out=out)
+    np.multiply(out.view(np.float64), scale, out=fft_in.view(np.float64))
 
 
-def _phasors(u: np.ndarray, amp: np.ndarray, out: np.ndarray) -> None:
-    """_unit_phasors_into split over the CPU cores for long records (same result)."""
-    n = u.shape[0]
-    workers = os.cpu_count() or 1
-    if n < _PARALLEL_MIN or workers < 2:
-        _unit_phasors_into(u, amp, out)
-        return
-    edges = [n * i // workers for i in range(workers + 1)]
-    futs = [_executor().submit(_unit_phasors_into, u[a:b], amp[a:b], out[a:b])
-            for a, b in zip(edges[:-1], edges[1:])]
-    for f in futs:
-        f.result()
+class _Synthesis:
+    """Draws, coefficients and FFT input of one realization, shared by two threads.
+
+    A pool thread makes the random draws (in the documented order) while the caller's
+    thread evaluates the spectrum; then both take chunks of the coefficient kernel
+    (amplitudes, phasors, FFT input) from a shared counter.  The helper waits (without
+    holding the GIL) rather than starting on the kernel early: many short kernel calls
+    would make the caller's large spectrum operations queue for the GIL.  Chunk
+    boundaries are fixed multiples of _CHUNK and every entry gets the same operations
+    whichever thread computes it, so the result does not depend on the split.
+    """
+
+    def __init__(self, gen: np.random.Generator, lines: int, nsa: bool,
+                 coeff: np.ndarray, fft_in: np.ndarray, scale: float) -> None:
+        self.gen, self.lines, self.nsa = gen, lines, nsa
+        self.coeff, self.fft_in, self.scale = coeff, fft_in, scale
+        self.u = np.empty(lines)
+        self.gain: np.ndarray | None = None      # NSA: √(α² + β²)
+        self.s: np.ndarray | None = None         # S(ω_m), m = 1 … N−1
+        self.c2 = 0.0                            # a_m N_t/2 = √(c2 S(ω_m))
+        self.edges = list(range(0, lines, _CHUNK)) + [lines]
+        self._next = itertools.count()
+        self._draw_lock = threading.Lock()
+        self._drawn = False
+        self._state = gen.bit_generator.state
+        self.cancelled = False
+        self.ready = threading.Event()           # set once s and c2 are final
+
+    def draw(self) -> None:
+        """All random draws, once, by whichever thread gets here first."""
+        with self._draw_lock:
+            if self._drawn:
+                return
+            self._drawn = True
+            self.gen.random(out=self.u)
+            if self.nsa:
+                alpha = self.gen.standard_normal(self.lines)
+                beta = self.gen.standard_normal(self.lines)
+                self.gain = np.hypot(alpha, beta, out=alpha)
+
+    def cancel(self) -> None:
+        """Stop the work and leave the caller's generator where it was."""
+        with self._draw_lock:
+            self.cancelled = True
+            if self._drawn:
+                self.gen.bit_generator.state = self._state
+            self._drawn = True
+        self.ready.set()
+
+    def start(self, s: np.ndarray, c2: float) -> None:
+        """Hand over the spectrum lines and the amplitude factor; the kernel may start."""
+        self.s, self.c2 = s, c2
+        self.ready.set()
+
+    def work(self) -> None:
+        """Draw (if nobody has), wait for the spectrum, then take chunks until none is left."""
+        self.draw()
+        self.ready.wait()
+        edges, coeff, u, s, c2 = self.edges, self.coeff, self.u, self.s, self.c2
+        gain, fft_in, scale = self.gain, self.fft_in, self.scale
+        last = len(edges) - 1
+        # the caller's thread validates S while a helper may already run the kernel:
+        # on invalid S (discarded, then rejected) √ of a negative must stay silent
+        with np.errstate(invalid="ignore"):
+            while not self.cancelled:
+                i = next(self._next)
+                if i >= last:
+                    return
+                a, b = edges[i], edges[i + 1]
+                _phasor_chunk(u[a:b], s[a:b], c2, coeff[a:b],
+                              None if gain is None else gain[a:b], fft_in[a:b], scale)
 
 
 def _nyquist_check(density: Callable, omega_nyq: float, d_omega: float, m0_grid: float) -> None:
@@ -338,7 +393,10 @@ def simulate_sea(
     Seed eqs. 5.1.1–5.1.5 with the amplitude constants of DESIGN.md (the seed's
     5.1.3a,b are the two-sided magnitudes, half of a_m): DSA a_m = √(2SΔω),
     NSA a_m = √(SΔω)√(α²+β²); X_m = (N_t/2) a_m e^{−iθ_m}; η = irfft(X, N_t).
-    The order of the random draws is given in the module docstring.
+    The order of the random draws is given in the module docstring.  For 2^16 lines or
+    more, a module pool thread makes the draws while S is evaluated and shares the
+    coefficient kernel; the result is the same bits whatever the split (and with one
+    CPU).  ``SeaRealization.m0`` is the target Σ_{m=1}^{N−1} S(ω_m)Δω.
     """
     if not callable(density):
         raise InputError("density", density, "m²·s/rad", "must be a callable omega -> S(omega)")
@@ -350,36 +408,49 @@ def simulate_sea(
     n = n_t // 2
     d_omega = 2.0 * math.pi / float(duration)
     dt_eff = float(duration) / n_t
-    omega = d_omega * np.arange(n + 1)
-    s = np.asarray(density(omega), dtype=float)
-    if s.shape != omega.shape:
-        raise InputError("density", density, "m²·s/rad",
-                         f"must return an array of shape {omega.shape}, got {s.shape}")
-    if not np.isfinite(s).all() or (s < 0).any():
-        bad = np.flatnonzero(~(np.isfinite(s) & (s >= 0)))[0]
-        raise InputError("density", density, "m²·s/rad",
-                         f"must return finite values >= 0 (S({omega[bad]:.6g} rad/s) = {s[bad]})")
-    m0_grid = float(s[1:n].sum()) * d_omega
-    if m0_grid <= 0.0:
-        raise InputError("density", density, "m²·s/rad",
-                         f"is zero at every grid frequency {d_omega:.4g} … {n * d_omega:.4g} rad/s")
-    _nyquist_check(density, n * d_omega, d_omega, m0_grid)
-
-    # amplitude × N_t/2 in a new array: the callable's array is never written to
-    amp = s[1:n] * ((2.0 if method_l == "dsa" else 1.0) * d_omega)
-    np.sqrt(amp, out=amp)
-    amp *= 0.5 * n_t
-    u = gen.random(n - 1)
-    if method_l == "nsa":
-        alpha = gen.standard_normal(n - 1)
-        beta = gen.standard_normal(n - 1)
-        np.hypot(alpha, beta, out=alpha)
-        amp *= alpha
+    nsa = method_l == "nsa"
     coeff = np.empty(n + 1, dtype=np.complex128)
-    coeff[0] = 0.0
-    coeff[n] = 0.0
-    _phasors(u, amp, coeff[1:n])
-    elevation = _fft.irfft(coeff, n_t)
+    fft_in = _fft.irfft_input(n_t)           # the FFT's work array (destroyed by it)
+    coeff[0] = coeff[n] = fft_in[0] = fft_in[n] = 0.0
+    # X_m/N_t goes into the FFT input (exact for N_t = 2^k), so the FFT output is η
+    job = _Synthesis(gen, n - 1, nsa, coeff[1:n], fft_in[1:n], 1.0 / n_t)
+    helper = None
+    if n - 1 >= _PARALLEL_MIN and (os.cpu_count() or 1) >= 2:
+        helper = _executor().submit(job.work)   # the draws meanwhile, then kernel chunks
+    try:
+        omega = np.arange(n + 1, dtype=np.float64)
+        omega *= d_omega
+        s = np.asarray(density(omega), dtype=float)
+        if s.shape != omega.shape:
+            raise InputError("density", density, "m²·s/rad",
+                             f"must return an array of shape {omega.shape}, got {s.shape}")
+        # a_m N_t/2 = √(c2 S_m), c2 = (2 or 1)·Δω·(N_t/2)², computed chunk by chunk in
+        # the kernel (the callable's array is only read).  The helper may start on it
+        # now; this thread validates S meanwhile and discards the work if S is invalid.
+        job.start(s[1:n], (1.0 if nsa else 2.0) * d_omega * (0.5 * n_t) ** 2)
+        m0_grid = float(s[1:n].sum()) * d_omega
+        if not (math.isfinite(m0_grid) and math.isfinite(s[0]) and math.isfinite(s[n])
+                and s.min() >= 0.0):
+            bad = np.flatnonzero(~(np.isfinite(s) & (s >= 0)))
+            if bad.size:
+                raise InputError("density", density, "m²·s/rad",
+                                 f"must return finite values >= 0 "
+                                 f"(S({omega[bad[0]]:.6g} rad/s) = {s[bad[0]]})")
+        if m0_grid <= 0.0:
+            raise InputError("density", density, "m²·s/rad",
+                             f"is zero at every grid frequency {d_omega:.4g} … "
+                             f"{n * d_omega:.4g} rad/s")
+        _nyquist_check(density, n * d_omega, d_omega, m0_grid)
+    except BaseException:
+        job.cancel()
+        if helper is not None and not helper.cancel():
+            helper.result()
+        raise
+    job.work()
+    # a helper still queued (pool busy with other calls) has nothing left to do
+    if helper is not None and not helper.cancel():
+        helper.result()
+    elevation = _fft.irfft_overwrite(fft_in, n_t)
     return SeaRealization(
         elevation=_readonly(elevation),
         omega=_readonly(omega),
@@ -388,6 +459,7 @@ def simulate_sea(
         dt=dt_eff,
         method=method_l,
         seed=seed,
+        m0=m0_grid,
     )
 
 

@@ -109,13 +109,20 @@ class LineStatics:
 
 @dataclass(frozen=True)
 class StaticsResult:
-    """Static equilibrium of every line of a scene, by line name."""
+    """Static equilibrium of every line of a scene, by line name, and of its bodies
+    (:class:`stochcable.body_statics.BodyStatics`, by body name; empty without bodies)."""
 
     lines: dict[str, LineStatics] = field(default_factory=dict)
+    bodies: dict[str, Any] = field(default_factory=dict)
 
     def to_document(self) -> dict[str, Any]:
-        """The ``statics`` part of the result document (DESIGN.md v1)."""
-        return {"lines": {name: ls.to_document() for name, ls in self.lines.items()}}
+        """The ``statics`` part of the result document (DESIGN.md v1); ``"bodies"``
+        only when the scene has bodies."""
+        doc: dict[str, Any] = {"lines": {name: ls.to_document()
+                                         for name, ls in self.lines.items()}}
+        if self.bodies:
+            doc["bodies"] = {name: b.to_document() for name, b in self.bodies.items()}
+        return doc
 
 
 # ------------------------------------------------------------------------ public API
@@ -139,9 +146,18 @@ def solve_statics(scene: Scene, method: Method = "auto", *, tolerance: float = 1
     Returns
     -------
     StaticsResult
-        One :class:`LineStatics` per line, by name.
+        One :class:`LineStatics` per line, by name; with bodies, one
+        :class:`~stochcable.body_statics.BodyStatics` per body and the lines solved with
+        their attached ends at the body poses
+        (:func:`stochcable.body_statics.solve_body_statics`).
     """
     env = scene.environment
+    if scene.bodies:
+        from .body_statics import solve_body_statics
+
+        lines, bodies = solve_body_statics(scene, method, tolerance=tolerance,
+                                           max_iterations=max_iterations)
+        return StaticsResult(lines=lines, bodies=bodies)
     out = {}
     for line in scene.lines:
         mesh = mesh_line(line, env.rho, env.g)

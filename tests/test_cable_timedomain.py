@@ -9,6 +9,9 @@ synthesized series of the same realization).
 
 from __future__ import annotations
 
+import re
+import warnings
+
 import math
 
 import numpy as np
@@ -438,17 +441,35 @@ def test_stationarity_ratio_of_stationary_and_diverged_records():
 
 
 def test_diverged_snap_record_is_reported():
-    """tuah_1982_single_leg on its 3-element mesh, seed 3, Δt = 0.125 s (the automatic
-    step): the line goes slack and taut at every wave crest; from t ≈ 260 s the two
-    inner nodes rattle axially at 18.9 rad/s (ωΔt = 2.36: the average-acceleration
-    scheme pumps this under-resolved oscillation at the slack/taut switches) and the
-    fairlead tension σ jumps from ≈ 360 lbf to ≈ 1.1e4 lbf.  The same seed at Δt/4
-    gives 340 lbf (benchmarks/speed_vs_error.py reruns such seeds).  About 4 s."""
+    """tuah_1982_single_leg on its 3-element mesh at Δt = 0.125 s (the automatic step):
+    the line goes slack and taut at every wave crest and in some seeds the two inner
+    nodes start to rattle axially at ≈ 18.9 rad/s (ωΔt = 2.36: the average-acceleration
+    scheme pumps this under-resolved oscillation at the slack/taut switches); the
+    fairlead tension σ then jumps from ≈ 360 lbf to ≈ 1e4 lbf.  Which seeds blow up is
+    chaotic — it changed from seeds 3, 6, 8 to seed 4 of 1–8 when the sea kernel's last
+    bits changed — so the test takes the first seed of 1–8 that does (3/8 and 1/8 seen)
+    and checks the warning, the frequency and that Δt/4 cures it.  About 4–15 s."""
     from stochcable.examples import load_example
 
     scene = load_example("tuah_1982_single_leg")
-    with pytest.warns(ResolutionWarning, match=r"not stationary.*18\.\d+ rad/s.*rerun with dt"):
-        h = simulate_line_timedomain(scene, duration=600.0, seed=3, band=(0.0245, 9.8))
+    for seed in range(1, 9):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            h = simulate_line_timedomain(scene, duration=600.0, seed=seed,
+                                         band=(0.0245, 9.8))
+        flagged = [str(w.message) for w in caught
+                   if issubclass(w.category, ResolutionWarning) and "not stationary" in str(w.message)]
+        ratio = h.stationarity_ratio()[0]
+        # the warning fires exactly when the ratio passes the threshold
+        assert bool(flagged) == (ratio > 8.0)
+        if flagged:
+            break
+    else:
+        pytest.fail("no seed of 1-8 blew up at dt = 0.125 s: the snap case lost its point")
+    assert re.search(r"not stationary.*1[89]\.\d+ rad/s.*rerun with dt", flagged[0])
     assert h.dt == pytest.approx(0.125)
-    assert h.stationarity_ratio()[0] > 8.0
     assert np.all(np.isfinite(h.tension_b))
+    # the same seed at a quarter of the step stays stationary
+    fine = simulate_line_timedomain(scene, duration=600.0, seed=seed, band=(0.0245, 9.8),
+                                    dt=0.125 / 4)
+    assert fine.stationarity_ratio()[0] < 8.0

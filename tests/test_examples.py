@@ -18,7 +18,8 @@ ROOT = Path(__file__).resolve().parents[1]
 PKG = ROOT / "stochcable" / "examples"
 
 EXPECTED = {"chain_catenary", "tuah_1982_suspended_cable", "taut_wire", "inclined_guy",
-            "tuah_1982_single_leg"}
+            "tuah_1982_single_leg", "tuah_1982_disc_buoy_single_leg",
+            "tuah_1982_disc_buoy_three_legs"}
 
 
 def test_list_and_load():

@@ -7,6 +7,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from stochcable.errors import InputError
@@ -149,3 +150,81 @@ def test_schema_content_and_writer(tmp_path):
     assert seg["properties"]["ea"]["exclusiveMinimum"] == 0
     out = write_scene_schema(tmp_path / "sub" / "scene.schema.json")
     assert json.loads(out.read_text(encoding="utf-8")) == schema
+
+
+# ------------------------------------------------------------------ bodies (issue 6)
+
+
+@pytest.fixture()
+def disc_doc() -> dict:
+    return load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json",
+                                                                      exclude_none=True)
+
+
+def test_body_end_validation(disc_doc):
+    neither = _mutated(disc_doc, lambda d: d["lines"][0].__setitem__("end_b", {}))
+    with pytest.raises(InputError, match=r"lines\[0\]\.end_b: give the end's position or "
+                                         r"attach it to a body"):
+        load_scene(neither)
+    moving = _mutated(disc_doc, lambda d: d["lines"][0]["end_b"].__setitem__(
+        "motion", {"heave": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 8.0}}))
+    with pytest.raises(InputError, match=r"an end attached to a body cannot have a motion"):
+        load_scene(moving)
+    dup = _mutated(disc_doc, lambda d: d["bodies"].append(copy.deepcopy(d["bodies"][0])))
+    with pytest.raises(InputError, match=r"body names must be unique; repeated: \['disc'\]"):
+        load_scene(dup)
+    # the span check uses the body position for attached ends
+    far = _mutated(disc_doc, lambda d: d["bodies"][0].__setitem__("position", [200.0, 0, 0]))
+    with pytest.raises(InputError, match=r"lines\[0\]: the line \(339 m unstretched\) is "
+                                         r"shorter than its span"):
+        load_scene(far)
+    bad_table = _mutated(disc_doc, lambda d: d["bodies"][0]["hydrodynamics"][
+        "radiation_damping"][0][0].__setitem__(0, -5.0))
+    with pytest.raises(InputError, match=r"bodies\[0\]\.hydrodynamics: radiation_damping .*"
+                                         r"must be >= 0"):
+        load_scene(bad_table)
+
+
+def test_body_scene_geometry_and_planarity(disc_doc):
+    scene = load_scene(disc_doc)
+    assert scene.is_planar and not scene.uses_files
+    np.testing.assert_allclose(scene.end_position("leg", "end_b"), [0.0, 0.0, -2.5])
+    # pitch +0.1 rad about +y: the point 2.5 below the reference moves toward -x
+    p = scene.end_position("leg", "end_b", {"disc": ([1.0, 0.0, 0.0], [0.0, 0.1, 0.0])})
+    np.testing.assert_allclose(p, [1.0 - 2.5 * math.sin(0.1), 0.0, -2.5 * math.cos(0.1)])
+    line = scene.resolved_line(scene.lines[0])
+    assert line.end_b.position == (0.0, 0.0, -2.5) and line.end_b.attach is None
+    # a vessel sway RAO, a body off the plane, an attachment off the plane: not planar
+    vessel = {"omega": [0.1, 2.0], "sway": {"re": [0.1, 0.1], "im": [0.0, 0.0]}}
+    for fn in (lambda d: d["bodies"][0].__setitem__("prescribed", vessel),
+               lambda d: d["bodies"][0].__setitem__("wind_force", [0.0, 5.0, 0.0]),
+               lambda d: d["lines"][0]["end_b"]["attach"].__setitem__("point", [0, 1.0, -2.5])):
+        d = _mutated(disc_doc, fn)
+        d["bodies"][0] = _six_dof(d["bodies"][0])
+        assert not load_scene(d).is_planar
+
+
+def _six_dof(body: dict) -> dict:
+    """The planar disc body with 6×6 constant matrices and no table."""
+    b = copy.deepcopy(body)
+    b.pop("hydrodynamics")
+    for k in ("added_mass", "radiation_damping", "hydrostatic_stiffness"):
+        m3 = np.asarray(b[k])
+        m6 = np.zeros((6, 6))
+        m6[np.ix_([0, 2, 4], [0, 2, 4])] = m3
+        b[k] = m6.tolist()
+    return b
+
+
+def test_vessel_motion_transfer():
+    from stochcable.scene import VesselMotion
+
+    v = VesselMotion(omega=(0.5, 1.0), heave={"re": [1.0, 0.5], "im": [0.0, 1.0]},
+                     pitch={"re": [0.0, 0.2], "im": [0.0, 0.0]})
+    t = v.transfer(np.array([0.1, 0.75, 1.0, 2.0]))
+    assert t.shape == (6, 4)
+    np.testing.assert_allclose(t[2], [0.0, 0.75 + 0.5j, 0.5 + 1j, 0.0])  # zero outside
+    np.testing.assert_allclose(t[4], [0.0, 0.1, 0.2, 0.0])
+    assert not t[[0, 1, 3, 5]].any() and not v.out_of_plane
+    with pytest.raises(ValueError, match="give at least one of surge"):
+        VesselMotion(omega=(0.5, 1.0))

@@ -353,3 +353,28 @@ def test_unknown_example_is_404_listing_the_names(client):
     assert err["type"] == "not_found" and err["loc"] == ["path", "name"]
     for name in examples.list_examples():
         assert name in err["msg"]
+
+
+def test_mean_square_matches_the_direct_sum():
+    # the realization's "variance" stat: chunked sum of squares (no BLAS, no temporary)
+    # against np.mean(x²), over several chunks and a partial last one; both sum the same
+    # squares in different orders -> round-off only (1e-13 relative)
+    from service.routers.sea import _SQUARE_CHUNK, _mean_square
+
+    x = np.random.default_rng(3).standard_normal(2 * _SQUARE_CHUNK + 123)
+    assert _mean_square(x) == pytest.approx(np.mean(x * x), rel=1e-13)
+    assert math.isnan(_mean_square(np.array([1.0, np.nan])))
+
+
+def test_columns_response_checks_the_columns_not_declared_finite():
+    from service.encoding import NPY, columns_response
+    from service.errors import NumericalError
+
+    good, bad = np.ones(4), np.array([0.0, np.inf, 1.0, 2.0])
+    with pytest.raises(NumericalError, match="non-finite"):
+        columns_response({"elevation": good, "velocity_0_x": bad}, NPY)
+    # declaring one column finite skips only that column's check
+    with pytest.raises(NumericalError, match="non-finite"):
+        columns_response({"elevation": good, "velocity_0_x": bad}, NPY, finite=("elevation",))
+    resp = columns_response({"elevation": good}, NPY, finite=("elevation",))
+    assert int(resp.headers["content-length"]) > 4 * 8

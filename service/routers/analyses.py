@@ -11,7 +11,7 @@ from typing import Annotated, Any, Literal
 from fastapi import APIRouter, Body, Query
 from starlette.responses import Response
 
-from stochcable.scene import Scene
+from stochcable.scene import Scene, load_scene
 
 from ..dependencies import RunnerDep, SettingsDep
 from ..encoding import JSON, error_responses
@@ -83,6 +83,8 @@ async def run_analysis(
     Try it: ``curl -s localhost:8000/v1/examples/chain_catenary | curl -s -X POST
     localhost:8000/v1/analyses -H 'Content-Type: application/json' -d @-``
     """
+    # coefficient files would be read from the server's file system: inline tables only
+    load_scene(scene, allow_files=False)
     check_scene(scene, settings)
     deadline = time.monotonic() + settings.max_run_seconds
     body, n_warnings = await runner.run(_analysis, scene, timeseries, deadline,

@@ -28,6 +28,29 @@ Each ``<name>.json`` is a scene document (DESIGN.md "Scene and result documents"
   balances the seed's 100 lb wind load.  The disc buoy is not modelled (issue 6): it is
   end_b, at its assumed 2.5 ft draft, heaving with the sea surface (heave RAO 1, which
   the seed reports for the disc).
+- ``tuah_1982_disc_buoy_single_leg``: seed 001 §6.5 Example 5 with the disc buoy as a
+  body (issue 6), planar (surge, heave, pitch), ft-slug-lbf, sea and frequencies as
+  ``tuah_1982_single_leg``, the seed's static wind load of 100 lb along +x.  The
+  figures' numbers are not in the seed text; assumed: depth 100 ft, the §6.2 cable
+  (EA 177 016 lbf, 0.07303 slug/ft, D 0.1666 ft), L 339 ft, 3 elements, anchor at
+  (-300, 0, -100) ft, the line attached at the disc bottom (0, 0, -2.5) ft.  Disc
+  radius 5 ft, draft 2.5 ft (∇ = 196.35 ft³), uniform (CoG = CoB = -1.25 ft below the
+  waterline reference point), mass = (ρ g ∇ - 150 lbf)/g (the cable's vertical pull,
+  the statics settle the rest), inertia of a uniform cylinder.  Hudspeth's (1980)
+  coefficients are not in the seed: constant added mass (the seed's §5.2 also assumes
+  it constant) surge 0.5 ρ∇, heave 4/3 ρa³, pitch 8/45 ρa⁵ (half the deeply submerged
+  disc values); radiation damping 10 % of critical in heave and pitch, none in surge;
+  hydrostatics ρ g A_wp in heave, ρ g (I_wp + ∇ z_B) - m g z_G in pitch; excitation
+  the Froude–Krylov force of the cylinder (side and bottom pressure of the incident
+  wave, finite-depth profile) for heading 0 only, in an inline table over
+  0 … 6 rad/s ("hold" outside); body drag Cd 1.0 on 10 ft × 2.5 ft in surge at the
+  CoB.  Solver "direct".
+- ``tuah_1982_disc_buoy_three_legs``: seed 001 §6.7 Example 7 ("cable, fluid and wave
+  data are the same as for Example 5"): the same disc (6 DOF) with three identical
+  legs at 120° (leg1 toward -x, upwind), anchors 305 ft from the centre at -100 ft,
+  each leg attached at the disc rim (5 ft out, 2.5 ft down) facing its anchor (rim
+  attachments give the yaw restoring), mass (ρ g ∇ - 450 lbf)/g, wind 100 lb along +x
+  kept from Example 5.
 """
 
 from __future__ import annotations

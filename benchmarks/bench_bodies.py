@@ -1,0 +1,135 @@
+"""Benchmark of the coupled lines–bodies analysis (issue 6, "Bodies and moving ends").
+
+A buoy (6 DOF, constant added mass and radiation damping, drag) on three chain legs
+at 0/120/240 deg, 40 elements per leg (3-D), 200 frequencies on [0.1, 2] rad/s,
+JONSWAP Hs 3 m Tp 9 s.  Timed: the whole dynamic analysis of the group
+with the statics (lines and the buoy pose, stochcable.statics) and without them
+(:func:`stochcable.coupled_analysis.analyze_coupled`: models, channels, coupled drag
+linearization, coupled modes, line and body outputs), with one BLAS thread as
+``analyze()`` runs small models, for the direct and the Foss ("auto") solvers.  For
+scale: the same three legs analysed independently, fairleads fixed at their static
+positions.  Then a cProfile breakdown of one full coupled analysis (direct).
+
+
+Run:  python benchmarks/bench_bodies.py [--repeat N] [--profile]
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import io
+import math
+import pstats
+import statistics
+import time
+import warnings
+from stochcable.analysis import _single_blas_thread, build_line_system, line_result, linearize
+from stochcable.coupled_analysis import analyze_coupled
+from stochcable.excitation import line_channels
+from stochcable.scene import load_scene
+from stochcable.statics import solve_statics
+
+
+def scene_doc(solver: str = "direct", n_el: int = 40, count: int = 200) -> dict:
+    lines = []
+    for i in range(3):
+        a = math.radians(120.0 * i)
+        lines.append({
+            "name": f"leg{i + 1}",
+            "end_a": {"position": [300.0 * math.cos(a), 300.0 * math.sin(a), -100.0]},
+            "end_b": {"attach": {"body": "buoy",
+                                 "point": [5.0 * math.cos(a), 5.0 * math.sin(a), -2.0]}},
+            "segments": [{"length": 330.0, "ea": 5e8, "mass": 100.0, "diameter": 0.1,
+                          "elements": n_el}]})
+    diag = lambda v: [[v[i] if i == j else 0.0 for j in range(6)] for i in range(6)]  # noqa: E731
+    body = {"name": "buoy", "position": [0.0, 0.0, 0.0], "mass": 2.0e4,
+            "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
+            "added_mass": diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]),
+            "radiation_damping": diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]),
+            "hydrostatic_stiffness": diag([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]),
+            "drag_area": [4.0, 4.0, 8.0], "drag_point": [0.0, 0.0, -1.0]}
+    return {"environment": {"depth": 100.0},
+            "sea": {"spectrum": {"type": "jonswap", "hs": 3.0, "tp": 9.0}, "heading": 0.0},
+            "bodies": [body], "lines": lines,
+            "analysis": {"omega": {"min": 0.1, "max": 2.0, "count": count},
+                         "solver": solver}}
+
+
+def run_coupled(scene, statics=None):
+    """Statics (when not given) and the coupled dynamics, one BLAS thread."""
+    timing: dict[str, float] = {}
+    with _single_blas_thread():
+        if statics is None:
+            statics = solve_statics(scene, method="fe")
+        out = analyze_coupled(scene, statics, scene.analysis, timing=timing)
+    return out, timing
+
+
+def independent_scene(scene, statics):
+    """The three legs alone with their fairleads fixed at the static attachments."""
+    doc = scene_doc(scene.analysis.solver)
+    doc.pop("bodies")
+    for ln in doc["lines"]:
+        ln["end_b"] = {"position": statics.lines[ln["name"]].positions[-1].tolist()}
+    return load_scene(doc)
+
+
+def run_independent(scene, statics):
+    w = scene.analysis.omega.values()
+    with _single_blas_thread():
+        for line in scene.lines:
+            s = build_line_system(scene, line, statics.lines[line.name])
+            ch = line_channels(scene, line, s.positions, w)
+            line_result(s, ch, linearize(s, ch, scene.analysis), scene.analysis)
+
+
+def median_time(fn, repeat: int) -> tuple[float, float]:
+    fn()  # warm-up
+    t = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        t.append(time.perf_counter() - t0)
+    return statistics.median(t), min(t)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--profile", action="store_true")
+    args = ap.parse_args()
+    warnings.simplefilter("ignore")
+    for solver in ("direct", "foss"):
+        scene = load_scene(scene_doc(solver))
+        med_s, _ = median_time(lambda: solve_statics(scene, method="fe"), args.repeat)
+        statics = solve_statics(scene, method="fe")
+        (lines, bodies, _, _), timing = run_coupled(scene, statics)
+        med_f, best_f = median_time(lambda: run_coupled(scene), args.repeat)
+        med, best = median_time(lambda: run_coupled(scene, statics), args.repeat)
+        ind = independent_scene(scene, statics)
+        ind_st = solve_statics(ind, method="fe")
+        med_i, _ = median_time(lambda: run_independent(ind, ind_st), args.repeat)
+        rec = lines["leg1"].linearization
+        print(f"{solver:6s}: full (statics + dynamics) {1e3 * med_f:7.1f} ms median "
+              f"({1e3 * best_f:.1f} min); dynamics {1e3 * med:.1f} ms ({1e3 * best:.1f} min), "
+              f"{rec.iterations} iterations; statics {1e3 * med_s:.1f} ms; "
+              f"the legs alone (fairleads fixed) {1e3 * med_i:.1f} ms")
+        print("        stages: " + ", ".join(f"{k} {1e3 * v:.1f} ms" for k, v in timing.items()))
+        print(f"        buoy surge/heave/pitch σ = {bodies['buoy'].motion_std[[0, 2, 4]]}, "
+              f"leg1/leg2 fairlead tension σ = {lines['leg1'].end_b.std:.1f} / "
+              f"{lines['leg2'].end_b.std:.1f} N")
+    if args.profile:
+        scene = load_scene(scene_doc("direct"))
+        run_coupled(scene)
+        pr = cProfile.Profile()
+        pr.enable()
+        run_coupled(scene)
+        pr.disable()
+        s = io.StringIO()
+        pstats.Stats(pr, stream=s).sort_stats("tottime").print_stats(14)
+        print(s.getvalue())
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1174 @@
+"""Coupled dynamics of lines and large rigid bodies (seed 001 §3.2.c, §3.3, ch. 5).
+
+Lines attached to a freely moving body are solved together with it: one drag
+linearization loop over every attached line and body, the response at every frequency
+by substructuring, the outputs of each line as :func:`stochcable.analysis.line_result`
+gives them and the body motions as :class:`stochcable.results.BodyResult`.
+
+Substructuring (exact at every frequency)
+-----------------------------------------
+Each attached line keeps its own finite-element model with both end nodes
+prescribed (:func:`stochcable.analysis.build_line_system`).  Its response is linear in
+the motion u_e of its attached end nodes:
+
+    U = U_0 + G u_e,        F_end = R_0 + R_e u_e,
+
+with U_0, R_0 the response and the dynamic end forces of the line with the attached
+ends held (sea, moving unattached ends), and G, R_e those of unit end motions (d extra
+right-hand sides of the same solve: the "unit channels").  The rigid link u_e = T(r) ξ
+(seed 001 eqs. 3.3.6–3.3.7, :func:`stochcable.bodies.rigid_link_matrix`) and the
+transformed body equation (seed 001 eq. 3.2.c.20 with eqs. 3.3.8–3.3.10) give, per
+frequency,
+
+    [K_B − ω²(M_B + A(ω)) + iω(B(ω) + C_B) − Σ Tᵀ R_e T] ξ
+        = F_exc + Tdᵀ diag(b) v + Σ Tᵀ R_0,
+
+a dense (n_b × n_b) solve (Td, b, v: the drag point's rigid link, linear drag and
+fluid velocity); then U follows.  This is the Schur complement of the
+coupled system of :func:`stochcable.bodies.couple` on the body DOFs (tested equal to
+:func:`stochcable.bodies.solve_coupled_direct`), with the line interiors solved by the
+line machinery: banded direct solve (``solver="direct"``) or Foss modal superposition
+with the static correction of the truncated modes (``solver="foss"``, seed 001 §5.3;
+the unit end motions use the quasi-static split of :func:`stochcable.analysis.solve`).
+
+Frequency-dependent added mass and radiation damping
+----------------------------------------------------
+Because the body DOFs are always condensed exactly at every ω, the body's A(ω), B(ω)
+are exact under both solvers; "foss" only approximates the line interiors (exact
+when all modes are kept).  No constant-matrix freezing is needed for the response.
+The coupled *modes* (:func:`coupled_modes`) do need constant matrices: K and
+M + A(ω_ref) of :func:`stochcable.bodies.constant_matrices`, ω_ref the peak of the sea
+spectrum (documented on :class:`CoupledModes`).
+
+Drag linearization
+------------------
+The fixed-point variable is the concatenation of every attached line's σ vector
+(:func:`stochcable.analysis.drag_coefficients` layout) and, per body with a drag area,
+the σ of the relative velocity (fluid − body) at its drag point along x, y, z
+(:func:`stochcable.bodies.body_drag_damping`: b = ρ·CdA·E|v|, seed 001 eq. 5.2.2 form
+with the current).  The iteration mirrors :func:`stochcable.analysis.linearize`: the
+start is the fluid velocity relative to lines and bodies at rest (lines following
+their moving unattached ends quasi-statically), the first response starts the
+Anderson-accelerated iteration unmixed.  The record is one for the whole group.
+
+Vessel-driven ends
+------------------
+An end attached to a *prescribed* body (a vessel with a motion RAO ξ_RAO) moves with
+the RAO u = T(r)·ξ_RAO (three translations; the rotations move it through the arm r)
+coherently with the sea: it is the sea channel's end motion of an otherwise
+independent line (:func:`fairlead_motion`), no coupling back.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+
+from .analysis import (
+    ANDERSON_MIXING,
+    Damping,
+    Linearization,
+    LineSystem,
+    Progress,
+    Response,
+    _drag_blocks,
+    _end_tension,
+    _inputs,
+    _noop,
+    _prep,
+    _quasi_static,
+    _reactions,
+    _sigmas,
+    _solve_free,
+    _split_sigma,
+    _to_freq,
+    _total,
+    _trapezoid_weights,
+    drag_coefficients,
+    line_result,
+)
+from .bodies import (
+    PLANAR_INDEX,
+    LineLink,
+    RigidBody,
+    attachment_geometric_stiffness,
+    constant_matrices,
+    couple,
+    rigid_link_matrix,
+)
+from .errors import ConvergenceError, InputError, PhysicsWarning, SolverError, warn
+from .excitation import Channel
+from .linearization import (
+    FixedPointResult,
+    drag_linear_current,
+    drag_linear_harmonic,
+    fixed_point,
+)
+from .results import BodyResult, LinearizationRecord, LineResult, stats_from_spectrum
+
+__all__ = [
+    "CoupledLine",
+    "BodyLoads",
+    "CoupledModes",
+    "CoupledLinearization",
+    "fairlead_motion",
+    "body_loads",
+    "body_gravity_stiffness",
+    "linearize_coupled",
+    "coupled_modes",
+    "coupled_results",
+    "body_result",
+    "analyze_coupled",
+]
+
+#: Modes listed: those up to this factor times the top of the grid, at least
+#: ``MIN_LISTED_MODES`` (as the line listing of :mod:`stochcable.analysis`).
+LISTED_MODE_FACTOR = 2.5
+MIN_LISTED_MODES = 10
+# Coupled DOFs up to which the modes are a dense generalized eigenproblem.
+_DENSE_MODES = 1500
+
+
+# ------------------------------------------------------------------------ inputs
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledLine:
+    """A line of a coupled group: its system, channels and body attachments.
+
+    Parameters
+    ----------
+    system : LineSystem
+        The line about its static shape, both end nodes prescribed
+        (:func:`stochcable.analysis.build_line_system`).
+    channels : tuple of Channel
+        The group's input channels in the group order, sampled on the analysis grid,
+        as seen by this line: fluid kinematics and the motion of its *unattached*
+        ends (channels that do not concern the line carry only the spectrum).
+    end_a, end_b : str, optional
+        Name of the (free) body the end is attached to; None: the end stays
+        prescribed (fixed or moving with its channels).
+    """
+
+    system: LineSystem
+    channels: tuple[Channel, ...]
+    end_a: str | None = None
+    end_b: str | None = None
+
+    @property
+    def name(self) -> str:
+        return self.system.name
+
+    def attached(self) -> list[tuple[int, str]]:
+        """(end index 0/1, body name) of the attached ends."""
+        return [(k, b) for k, b in enumerate((self.end_a, self.end_b)) if b is not None]
+
+
+@dataclass(frozen=True, eq=False)
+class BodyLoads:
+    """Wave inputs of one body per channel.
+
+    Parameters
+    ----------
+    force : ndarray, complex, shape (n_omega, d, n_ch)
+        Wave excitation per unit input (:func:`stochcable.bodies.body_excitation`).
+        [N/m, N·m/m]
+    velocity : ndarray, complex, shape (n_omega, 3, n_ch)
+        Fluid velocity at the drag point per unit input. [(m/s)/m]
+    current : ndarray, shape (3,)
+        Current at the drag point (the mean relative velocity). [m/s]
+    """
+
+    force: np.ndarray
+    velocity: np.ndarray
+    current: np.ndarray
+
+
+def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
+    """Motion of a point of a prescribed (vessel) body from its 6-DOF RAO.
+
+    Parameters
+    ----------
+    rao : array_like, complex, shape (n_omega, 6)
+        Vessel motion per unit wave amplitude (surge, sway, heave [m/m], roll, pitch,
+        yaw [rad/m]) about its reference point, global axes.
+    r : array_like, shape (3,)
+        The point relative to the reference point at the static pose. [m]
+
+    Returns
+    -------
+    ndarray, complex, shape (n_omega, 3)
+        u = T(r)·ξ = ξ_t + θ × r (seed 001 eqs. 3.3.6–3.3.7). [m/m]
+    """
+    a = np.asarray(rao, dtype=complex)
+    if a.ndim != 2 or a.shape[1] != 6:
+        raise InputError("rao", a.shape, "m/m", "must have shape (n_omega, 6)")
+    t = rigid_link_matrix(r)
+    return a @ t.T
+
+
+def body_loads(body: RigidBody, channels: Sequence[Channel], omega: np.ndarray,
+               sea: Any, environment: Any) -> BodyLoads:
+    """Excitation force and drag-point fluid velocity of a body per channel.
+
+    Parameters
+    ----------
+    body : RigidBody
+    channels : sequence of Channel
+        The group's channels (only ``kind == "sea"`` loads the body).
+    omega : ndarray, shape (n_omega,)
+        [rad/s]
+    sea : Sea or None
+        The scene's sea (heading).
+    environment : Environment
+        depth, g, current.
+
+    Returns
+    -------
+    BodyLoads
+        The sea channel: ``body_excitation(body, ω, β, k)`` (phase moved to the global
+        wave phase) and the linear wave velocity at the drag point
+        (:func:`stochcable.kinematics.wave_kinematics`, zero above z = 0).
+    """
+    from .bodies import body_excitation
+    from .kinematics import wave_kinematics, wavenumber
+
+    w = np.asarray(omega, dtype=float)
+    n_ch = len(channels)
+    d = body.n_dof
+    force = np.zeros((w.size, d, n_ch), dtype=complex)
+    vel = np.zeros((w.size, 3, n_ch), dtype=complex)
+    point = body.position + body.drag_point
+    for i, ch in enumerate(channels):
+        if ch.kind != "sea" or sea is None:
+            continue
+        beta = sea.heading_rad
+        k = wavenumber(w, environment.depth, environment.g)
+        force[:, :, i] = body_excitation(body, w, beta, wavenumber=k)
+        if np.any(body.drag_area > 0):
+            p = point.copy()
+            p[2] = max(p[2], -environment.depth)
+            kin = wave_kinematics(w, p, beta, environment.depth, environment.g)
+            vel[:, :, i] = kin.velocity[0].T
+    cur = np.asarray(environment.current_velocity(np.array([min(point[2], 0.0)]))[0],
+                     dtype=float)
+    return BodyLoads(force=force, velocity=vel, current=cur)
+
+
+def body_gravity_stiffness(body: RigidBody, displaced_volume: float,
+                           centre_of_buoyancy: Any, rho: float, g: float) -> np.ndarray:
+    """Restoring of the weight and the buoyancy of a body when it rotates.
+
+    Parameters
+    ----------
+    body : RigidBody
+        Mass and centre of gravity ``cog`` (relative to the reference point).
+    displaced_volume : float
+        Displaced volume ∇. [m³]
+    centre_of_buoyancy : array_like, shape (3,)
+        Centre of buoyancy relative to the reference point. [m]
+    rho, g : float
+        Water density [kg/m³] and gravity [m/s²].
+
+    Returns
+    -------
+    ndarray, shape (d, d)
+        Σ −[F]×[r]× over the weight F = (0, 0, −m g) at the CoG and the buoyancy
+        (0, 0, ρ g ∇) at the CoB (:func:`stochcable.bodies.attachment_geometric_stiffness`):
+        roll and pitch restoring ρ g ∇ z_B − m g z_G (the metacentric terms of a
+        fully submerged body, option (a) of docs/BODIES.md "Symmetry"). [N·m/rad]
+
+    Notes
+    -----
+    No waterplane terms: a surface-piercing body needs its ``hydrostatic_stiffness``
+    (which already contains these gravity terms, WAMIT convention).
+    """
+    w = np.array([0.0, 0.0, -body.mass * g])
+    b = np.array([0.0, 0.0, rho * g * float(displaced_volume)])
+    cob = np.asarray(centre_of_buoyancy, dtype=float)
+    return (attachment_geometric_stiffness(w, body.cog, body.planar)
+            + attachment_geometric_stiffness(b, cob, body.planar))
+
+
+# ------------------------------------------------------------------- linearization
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledLinearization:
+    """Outcome of :func:`linearize_coupled`.
+
+    Attributes
+    ----------
+    lines : dict of str to Linearization
+        Per line: its drag, its record (the group's iteration history with the
+        line's σ and B) and the coupled response (attached ends moving with the
+        bodies) per physical channel.
+    body_motion : dict of str to ndarray, complex, shape (n_omega, d, n_ch)
+        Body response per unit input. [m/unit, rad/unit]
+    body_sigma : dict of str to ndarray, shape (3,)
+        σ of the relative velocity at the drag point along x, y, z. [m/s]
+    body_drag : dict of str to ndarray, shape (3,)
+        Linear drag coefficient per direction at the drag point. [N·s/m]
+    converged, iterations, relative_change, history, tolerance
+        The group's fixed-point record.
+    """
+
+    lines: dict[str, Linearization]
+    body_motion: dict[str, np.ndarray]
+    body_sigma: dict[str, np.ndarray]
+    body_drag: dict[str, np.ndarray]
+    converged: bool
+    iterations: int
+    relative_change: float
+    history: tuple[float, ...]
+    tolerance: float
+
+
+def _zero_density(w: np.ndarray) -> np.ndarray:
+    return np.zeros_like(np.asarray(w, dtype=float))
+
+
+def _unit_channels(cl: CoupledLine) -> tuple[Channel, ...]:
+    """d unit end-motion channels per attached end (zero spectrum)."""
+    model = cl.system.model
+    comps = list(model.components)
+    w = cl.channels[0].omega
+    out = []
+    for k, _ in cl.attached():
+        for j, c in enumerate(comps):
+            m = np.zeros((w.size, 3), dtype=complex)
+            m[:, c] = 1.0
+            out.append(Channel(name=f"unit.{k}.{j}", kind="end_motion", omega=w,
+                               spectrum=np.zeros(w.size), density=_zero_density,
+                               motion_a=m if k == 0 else None,
+                               motion_b=m if k == 1 else None))
+    return tuple(out)
+
+
+class _Group:
+    """Frequency-independent data of a coupled group."""
+
+    def __init__(self, lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
+                 loads: Mapping[str, BodyLoads], rho: float,
+                 channels: Sequence[Channel]) -> None:
+        self.lines = tuple(lines)
+        self.bodies = tuple(bodies)
+        self.rho = rho
+        names = [b.name for b in bodies]
+        if len(set(names)) != len(names):
+            raise InputError("bodies", names, "-", "body names must be unique")
+        self.by_name = {b.name: b for b in bodies}
+        off, k = {}, 0
+        for b in bodies:
+            off[b.name] = k
+            k += b.n_dof
+        self.off = off
+        self.nb = k
+        self.channels = tuple(channels)
+        self.n_ch = len(channels)
+        self.omega = channels[0].omega
+        self.weights = (_trapezoid_weights(self.omega)[:, None]
+                        * np.stack([c.spectrum for c in channels], axis=1))
+        self.sizes: dict[str, int] = {}
+        # per line: augmented inputs, link matrix T_l (d·n_att, nb), attached rows
+        self.inp, self.inp_phys, self.tmat, self.rows = {}, {}, {}, {}
+        geo = {b.name: np.zeros((b.n_dof, b.n_dof)) for b in bodies}
+        for cl in self.lines:
+            if [c.name for c in cl.channels] != [c.name for c in channels]:
+                raise InputError(f"lines[{cl.name}].channels", [c.name for c in cl.channels],
+                                 "-", "every line of a group needs the group's channels")
+            model = cl.system.model
+            d = model.dim
+            att = cl.attached()
+            t = np.zeros((d * len(att), self.nb))
+            rows = []
+            for i, (k, bname) in enumerate(att):
+                if bname not in self.by_name:
+                    raise InputError(f"lines[{cl.name}].{('end_a', 'end_b')[k]}", bname, "-",
+                                     f"is not a body; bodies: {names}")
+                body = self.by_name[bname]
+                if (d == 2) != body.planar:
+                    raise InputError(f"lines[{cl.name}]", bname, "-",
+                                     f"a {d}-D line model needs a "
+                                     f"{'planar' if d == 2 else '6-DOF'} body")
+                node = 0 if k == 0 else model.n_nodes - 1
+                r = model.positions[node] - body.position
+                tl = rigid_link_matrix(r, planar=body.planar)
+                t[i * d:(i + 1) * d, off[bname]:off[bname] + body.n_dof] = tl
+                st = cl.system.statics
+                f = np.asarray(st.force_a if k == 0 else st.force_b, dtype=float)
+                geo[bname] += attachment_geometric_stiffness(f, r, body.planar)
+                rows.extend(range(k * d, (k + 1) * d))
+            self.tmat[cl.name] = t
+            self.rows[cl.name] = np.asarray(rows, dtype=int)
+            self.inp[cl.name] = _inputs(cl.system, tuple(cl.channels) + _unit_channels(cl))
+            # the physical channels alone, for the σ (the unit channels weigh zero)
+            self.inp_phys[cl.name] = _inputs(cl.system, tuple(cl.channels))
+        self.geometric = geo
+        nb = self.nb
+        self.kb = np.zeros((nb, nb))
+        self.mb = np.zeros((nb, nb))
+        self.cb = np.zeros((nb, nb))
+        for b in bodies:
+            s = slice(off[b.name], off[b.name] + b.n_dof)
+            self.kb[s, s] = b.hydrostatic_stiffness + b.extra_stiffness + geo[b.name]
+            self.mb[s, s] = b.mass_matrix()
+            self.cb[s, s] = b.extra_damping
+        w = self.omega
+        a = np.zeros((w.size, nb, nb))
+        bb = np.zeros((w.size, nb, nb))
+        for b in bodies:
+            s = slice(off[b.name], off[b.name] + b.n_dof)
+            a[:, s, s] = b.added_mass_at(w)
+            bb[:, s, s] = b.radiation_damping_at(w)
+        w2 = (w * w)[:, None, None]
+        iw = (1j * w)[:, None, None]
+        self.z_body = self.kb[None] - w2 * (self.mb[None] + a) + iw * (self.cb[None] + bb)
+        # body loads (n_w, nb, n_ch), drag-point maps
+        self.f_body = np.zeros((w.size, nb, self.n_ch), dtype=complex)
+        self.drag = [b for b in bodies if np.any(b.drag_area > 0)]
+        self.loads = dict(loads)
+        for b in bodies:
+            ld = loads.get(b.name)
+            if ld is not None:
+                s = slice(off[b.name], off[b.name] + b.n_dof)
+                self.f_body[:, s, :] = ld.force
+        self.emb = {}   # (6, d) embedding of a body's DOFs among the six
+        for b in bodies:
+            e = np.eye(6)
+            self.emb[b.name] = e[:, list(PLANAR_INDEX)] if b.planar else e
+
+    # ------------------------------------------------------------------ σ layout
+    def split(self, x: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        out, k = {}, 0
+        for cl in self.lines:
+            n = self.sizes[cl.name]
+            out[cl.name] = x[k:k + n]
+            k += n
+        body = {}
+        for b in self.drag:
+            body[b.name] = x[k:k + 3]
+            k += 3
+        return out, body
+
+
+def _body_drag(body: RigidBody, rho: float, sigma: np.ndarray, mean: np.ndarray,
+               method: str) -> tuple[np.ndarray, np.ndarray]:
+    """Linear drag per direction b (3,) and the damping Tᵀdiag(b)T on the body DOFs."""
+    if method == "harmonic":
+        b = np.asarray(drag_linear_harmonic(rho, body.drag_area, 1.0, math.sqrt(2.0) * sigma),
+                       dtype=float)
+    else:
+        b = np.asarray(drag_linear_current(rho, body.drag_area, 1.0, sigma, mean), dtype=float)
+    t = rigid_link_matrix(body.drag_point)
+    c = t.T @ (b[:, None] * t)
+    if body.planar:
+        c = c[np.ix_(PLANAR_INDEX, PLANAR_INDEX)]
+    return np.broadcast_to(b, (3,)).copy(), c
+
+
+def _body_sigma(g: _Group, body: RigidBody, xi: np.ndarray | None) -> np.ndarray:
+    """σ of the relative velocity at the drag point, (3,), ξ (n_w, nb, n_ch) or None."""
+    v = g.loads[body.name].velocity if body.name in g.loads else np.zeros(
+        (g.omega.size, 3, g.n_ch), dtype=complex)
+    if xi is not None:
+        s = slice(g.off[body.name], g.off[body.name] + body.n_dof)
+        t = rigid_link_matrix(body.drag_point) @ g.emb[body.name]  # (3, d)
+        v = v - (1j * g.omega)[:, None, None] * np.einsum("ij,wjc->wic", t, xi[:, s, :])
+    var = np.einsum("wic,wc->i", np.abs(v) ** 2, g.weights)
+    return np.sqrt(np.clip(var, 0.0, None))
+
+
+def _solve_group(g: _Group, line_damping: Mapping[str, Damping],
+                 body_c: np.ndarray, body_b: Mapping[str, np.ndarray],
+                 timing: dict[str, float] | None
+                 ) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], np.ndarray]:
+    """One coupled solve for given drag: per line the combined node displacements
+    (n_nodes, d, n_w, n_ch) and support forces (n_w, 2d, n_ch); the body motion
+    (n_w, nb, n_ch)."""
+    t0 = time.perf_counter()
+    w = g.omega
+    n_ch = g.n_ch
+    iw = (1j * w)[:, None, None]
+    s = g.z_body + iw * body_c[None]
+    rhs = g.f_body.copy()
+    for b in g.drag:
+        bb = body_b[b.name]
+        t = rigid_link_matrix(b.drag_point)
+        gen = g.emb[b.name].T @ (t.T * bb[None, :])     # (d, 3)
+        sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
+        rhs[:, sl, :] += np.einsum("ij,wjc->wic", gen, g.loads[b.name].velocity)
+    parts = {}
+    for cl in g.lines:
+        system = cl.system
+        inp = g.inp[cl.name]
+        damping = line_damping[cl.name]
+        u_f, c = _solve_free(system, inp, damping)
+        u = _total(system, inp, u_f)
+        sup = _reactions(system, _prep(system), c, u, _end_loads(system, inp, damping), w)
+        rows = g.rows[cl.name]
+        t = g.tmat[cl.name]
+        r0 = sup[:, rows, :n_ch]
+        re = sup[:, rows, n_ch:]
+        s = s - t.T[None] @ re @ t[None]
+        rhs = rhs + t.T[None] @ r0
+        parts[cl.name] = (u, sup)
+    if g.nb:
+        xi = _solve_body(s, rhs, w)
+    else:
+        xi = np.zeros((w.size, 0, n_ch), dtype=complex)
+    out = {}
+    for cl in g.lines:
+        u, sup = parts[cl.name]
+        t = g.tmat[cl.name]
+        ue = t[None] @ xi                                     # (n_w, d·n_att, n_ch)
+        uc = u[..., :n_ch] + (u[..., None, n_ch:] @ ue)[..., 0, :]
+        sc = sup[:, :, :n_ch] + sup[:, :, n_ch:] @ ue
+        out[cl.name] = (uc, sc)
+    if timing is not None:
+        timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
+    return out, xi
+
+
+def _end_loads(system: LineSystem, inp: Any, damping: Damping) -> np.ndarray:
+    """Fluid loads on the two end nodes only, (2, d, n_w, n_ch): what the reaction rows
+    of :func:`stochcable.analysis._reactions` read of :func:`stochcable.analysis._loads`
+    (element 0's share on node 0, the last element's on the last node)."""
+    f = inp.inertia_load[[0, -1]].copy()
+    if inp.moments is not None:
+        _drag_blocks(system, damping)
+        b = damping._cache["elements"]
+        m = inp.moments
+        f[0] += np.einsum("ij,jwc->iwc", b[0], m[0, 0])
+        f[1] += np.einsum("ij,jwc->iwc", b[-1], m[-1, 1])
+    if inp.velocity is not None and np.any(damping.b_node):
+        f += damping.b_node[[0, -1], None, None, None] * inp.velocity[[0, -1]]
+    return f
+
+
+def _solve_body(s: np.ndarray, g: np.ndarray, w: np.ndarray) -> np.ndarray:
+    try:
+        x = np.linalg.solve(s, g)
+    except np.linalg.LinAlgError:
+        x = None
+    if x is None or not np.all(np.isfinite(x)):
+        raise SolverError("coupled body solve: the body impedance (with the condensed "
+                          "lines) is singular at some frequency (an undamped body "
+                          "resonance or a DOF without restoring); add damping or "
+                          "stiffness to the body")
+    return x
+
+
+def linearize_coupled(
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    settings: Any,
+    *,
+    rho: float,
+    loads: Mapping[str, BodyLoads] | None = None,
+    channels: Sequence[Channel] | None = None,
+    progress: Progress | None = None,
+    timing: dict[str, float] | None = None,
+) -> CoupledLinearization:
+    """Drag linearization and response of lines coupled through rigid bodies.
+
+    Parameters
+    ----------
+    lines : sequence of CoupledLine
+        The lines of the group (at least one; all with the same channels).
+    bodies : sequence of RigidBody
+        The free bodies of the group (static pose as ``position``).
+    settings : AnalysisSettings
+        ``linearization`` (method, tolerance, max_iterations, relaxation,
+        acceleration, allow_unconverged).
+    rho : float
+        Water density for the body drag. [kg/m³]
+    loads : mapping of body name to BodyLoads, optional
+        Wave inputs of the bodies (default none).
+    channels : sequence of Channel, optional
+        The group's channels (names, spectra, grid); default those of the first
+        line; required for bodies without lines (a body on springs).
+    progress : callable, optional
+        ``progress("linearization", {"group", "iteration", "change"})``.
+    timing : dict, optional
+        Accumulates ``solve_s``. [s]
+
+    Returns
+    -------
+    CoupledLinearization
+
+    Raises
+    ------
+    ConvergenceError
+        When the σ do not settle (unless ``allow_unconverged``).
+    SolverError
+        A singular body impedance (undamped resonance).
+
+    Notes
+    -----
+    Module docstring: substructuring, fixed point (seed 001 §5.3 steps 5–13 over all
+    lines and bodies).
+    """
+    lin = settings.linearization
+    method = lin.method
+    progress = _noop if progress is None else progress
+    if channels is None:
+        if not lines:
+            raise InputError("channels", None, "-",
+                             "a group without lines needs its channels")
+        channels = lines[0].channels
+    if not lines and not bodies:
+        raise InputError("lines", 0, "-", "a coupled group needs a line or a body")
+    g = _Group(lines, bodies, loads or {}, rho, channels)
+    names = ", ".join(cl.name for cl in g.lines)
+    gname = f"coupled drag linearization of lines {names} and bodies " \
+            f"{', '.join(b.name for b in g.bodies)}"
+    # start: lines at rest (quasi-static on their moving ends), bodies at rest
+    parts = []
+    for cl in g.lines:
+        inp = g.inp_phys[cl.name]
+        parts.append(_sigmas(cl.system, inp, _quasi_static(cl.system, inp), method))
+    g.sizes = {cl.name: p.size for cl, p in zip(g.lines, parts)}
+    for b in g.drag:
+        parts.append(_body_sigma(g, b, None))
+    x_rest = np.concatenate(parts) if parts else np.zeros(0)
+    state: dict[str, Any] = {"it": 0}
+    cache: dict[str, Any] = {}
+
+    def update(x: np.ndarray) -> np.ndarray:
+        ls, bs = g.split(x)
+        damp = {cl.name: drag_coefficients(cl.system, ls[cl.name], method) for cl in g.lines}
+        body_c = np.zeros((g.nb, g.nb))
+        body_b = {}
+        for b in g.drag:
+            bb, c = _body_drag(b, rho, bs[b.name], g.loads[b.name].current
+                               if b.name in g.loads else np.zeros(3), method)
+            sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
+            body_c[sl, sl] += c
+            body_b[b.name] = bb
+        sol, xi = _solve_group(g, damp, body_c, body_b, timing)
+        new = []
+        for cl in g.lines:
+            new.append(_sigmas(cl.system, g.inp_phys[cl.name], sol[cl.name][0], method))
+        for b in g.drag:
+            new.append(_body_sigma(g, b, xi))
+        new = np.concatenate(new) if new else np.zeros(0)
+        state["it"] += 1
+        den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)),
+                                                 1e-300))
+        change = float(np.max(np.abs(new - x) / den, initial=0.0))
+        state["change"] = change
+        progress("linearization", {"group": names, "iteration": state["it"],
+                                   "change": change})
+        cache.update(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
+        return new
+
+    hint = ("increase analysis.linearization.max_iterations, lower relaxation, or set "
+            "allow_unconverged to get a flagged result")
+    x0 = update(x_rest)
+    change0 = state["change"]
+    if not np.all(np.isfinite(x0)):
+        raise ConvergenceError(gname, 1, float("nan"), lin.tolerance,
+                               hint="the first response gave non-finite σ")
+    if change0 <= lin.tolerance or lin.max_iterations == 1 or x0.size == 0:
+        fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance or x0.size == 0,
+                              (change0,))
+        if not fp.converged and not lin.allow_unconverged:
+            raise ConvergenceError(gname, 1, change0, lin.tolerance, hint=hint, partial=fp)
+    else:
+        try:
+            fp = fixed_point(
+                update, x0, tol=lin.tolerance, max_iterations=lin.max_iterations - 1,
+                relaxation=lin.relaxation,
+                method="anderson" if lin.acceleration == "anderson" else "relaxed",
+                mixing=ANDERSON_MIXING, allow_unconverged=lin.allow_unconverged,
+                name=gname,
+            )
+        except ConvergenceError as exc:
+            raise ConvergenceError(gname, exc.iterations + 1, exc.residual, exc.tolerance,
+                                   hint=hint, partial=exc.partial) from None
+        fp = FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
+                              (change0,) + fp.history)
+    if not fp.converged:
+        warn(f"{gname} did not converge: relative change {fp.relative_change:.3e} after "
+             f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "
+             "flagged unconverged (increase analysis.linearization.max_iterations)",
+             PhysicsWarning, stacklevel=2)
+    ls, bs = g.split(cache["sigma"])
+    out = {}
+    for cl in g.lines:
+        system = cl.system
+        damping = cache["damping"][cl.name]
+        uc, sc = cache["sol"][cl.name]
+        resp = Response(omega=g.omega, displacement=_to_freq(uc), support_force=sc,
+                        end_tension=_end_tension(system, sc))
+        parts_ = _split_sigma(system, ls[cl.name], method)
+        if method == "vector":
+            sig_n = np.sqrt(parts_["normal"][0] ** 2 + parts_["normal"][1] ** 2)
+            b_n = 0.5 * np.trace(damping.b_normal, axis1=1, axis2=2)
+        else:
+            sig_n, b_n = parts_["normal"][0], damping.b_normal
+        record = LinearizationRecord(
+            method=method, converged=fp.converged, iterations=fp.iterations,
+            relative_change=fp.relative_change, history=fp.history,
+            tolerance=lin.tolerance, sigma_normal=sig_n, sigma_axial=parts_["axial"],
+            b_normal=b_n, b_axial=damping.b_axial)
+        out[cl.name] = Linearization(damping=damping, record=record, response=resp)
+    xi = cache["xi"]
+    motion = {b.name: xi[:, g.off[b.name]:g.off[b.name] + b.n_dof, :].copy()
+              for b in g.bodies}
+    return CoupledLinearization(
+        lines=out, body_motion=motion,
+        body_sigma={b.name: bs[b.name].copy() for b in g.drag},
+        body_drag={k: v.copy() for k, v in cache["body_b"].items()},
+        converged=fp.converged, iterations=fp.iterations,
+        relative_change=fp.relative_change, history=fp.history, tolerance=lin.tolerance)
+
+
+# ------------------------------------------------------------------------ modes
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledModes:
+    """Natural modes of a coupled group (undamped, constant matrices).
+
+    Attributes
+    ----------
+    omega : ndarray, shape (n,)
+        Natural frequencies, lowest first. [rad/s]
+    body_fraction : ndarray, shape (n,)
+        Share of each mass-normalized mode's kinetic energy in the body DOFs,
+        φ_Jᵀ(Mφ)_J. [-]
+    body_shapes : dict of str to ndarray, shape (d, n)
+        Body part of each mode shape (mass-normalized). [m·kg^-1/2, rad·kg^-1/2]
+    omega_ref : float
+        Frequency at which the bodies' added mass was frozen. [rad/s]
+    asymmetry : float
+        max|K − Kᵀ|/max|K| of the coupled stiffness (its symmetric part is used). [-]
+    """
+
+    omega: np.ndarray
+    body_fraction: np.ndarray
+    body_shapes: dict[str, np.ndarray]
+    omega_ref: float
+    asymmetry: float
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"omega": self.omega.tolist(), "body_fraction": self.body_fraction.tolist(),
+                "omega_ref": float(self.omega_ref), "asymmetry": float(self.asymmetry)}
+
+
+def coupled_modes(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
+                  omega_ref: float, omega_top: float) -> CoupledModes:
+    """Natural modes of lines and bodies coupled by rigid links.
+
+    Parameters
+    ----------
+    lines : sequence of CoupledLine
+    bodies : sequence of RigidBody
+    omega_ref : float
+        Frequency of the added mass A(ω_ref) (spectral peak). [rad/s]
+    omega_top : float
+        Top of the analysis grid: modes up to 2.5·omega_top are listed, at least 10.
+        [rad/s]
+
+    Returns
+    -------
+    CoupledModes
+
+    Notes
+    -----
+    K φ = ω²(M + A(ω_ref)) φ on the assembled system of
+    :func:`stochcable.bodies.couple` (:func:`~stochcable.bodies.constant_matrices`),
+    the symmetric part of K (the attachment geometric stiffness is antisymmetric by
+    ½[Σ r × F]× when the static moments on a body are not balanced by the model's own
+    terms; :attr:`CoupledModes.asymmetry`).  Dense LAPACK up to 1500 DOFs, else
+    shift-invert Lanczos.
+    """
+    links = [LineLink(cl.name, cl.system.model, end_a=cl.end_a, end_b=cl.end_b,
+                      force_a=cl.system.statics.force_a if cl.end_a else None,
+                      force_b=cl.system.statics.force_b if cl.end_b else None)
+             for cl in lines]
+    system = couple(links, bodies)
+    K, M, _ = constant_matrices(system, omega_ref)
+    asym = system.asymmetry()
+    ks = 0.5 * (K + K.T)
+    n = system.n_dof
+    top = (LISTED_MODE_FACTOR * omega_top) ** 2
+    if n <= _DENSE_MODES:
+        kd, md = ks.toarray(), M.toarray()
+        md = 0.5 * (md + md.T)
+        lam, phi = sla.eigh(kd, md, subset_by_value=(-np.inf, top), driver="gvx")
+        if lam.size < min(MIN_LISTED_MODES, n):
+            lam, phi = sla.eigh(kd, md, subset_by_index=(0, min(MIN_LISTED_MODES, n) - 1))
+    else:
+        from scipy.sparse.linalg import eigsh
+
+        k = min(max(MIN_LISTED_MODES, 20), n - 2)
+        lam, phi = eigsh(ks.tocsc(), k=k, M=M.tocsc(), sigma=0.0, which="LM")
+        order = np.argsort(lam)
+        lam, phi = lam[order], phi[:, order]
+    J = system.body_index
+    mphi = M @ phi
+    frac = np.einsum("jn,jn->n", phi[J], mphi[J]) if J.size else np.zeros(lam.size)
+    shapes = {b.name: phi[system.body_dofs[b.name]].copy() for b in bodies}
+    return CoupledModes(omega=np.sqrt(np.clip(lam, 0.0, None)),
+                        body_fraction=np.clip(frac, 0.0, 1.0), body_shapes=shapes,
+                        omega_ref=float(omega_ref), asymmetry=asym)
+
+
+# --------------------------------------------------------------------- results
+
+
+def coupled_results(
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    linearization: CoupledLinearization,
+    settings: Any,
+    *,
+    static_pose: Mapping[str, np.ndarray] | None = None,
+    modes: CoupledModes | None = None,
+    channels: Sequence[Channel] | None = None,
+) -> tuple[dict[str, LineResult], dict[str, BodyResult]]:
+    """Line and body results of a coupled group.
+
+    Parameters
+    ----------
+    lines : sequence of CoupledLine
+    bodies : sequence of RigidBody
+    linearization : CoupledLinearization
+    settings : AnalysisSettings
+        ``duration`` for the maxima.
+    static_pose : mapping of body name to ndarray (d,), optional
+        Static value of each body DOF (position and rotation components), the
+        statistics' mean (default: the body position, zero rotation). [m, rad]
+    modes : CoupledModes, optional
+        Listed on every body result.
+    channels : sequence of Channel, optional
+        The group's channels (default those of the first line).
+
+    Returns
+    -------
+    (lines, bodies) : dict of LineResult, dict of BodyResult
+    """
+    out_lines = {}
+    for cl in lines:
+        out_lines[cl.name] = line_result(cl.system, cl.channels,
+                                         linearization.lines[cl.name], settings)
+    ch = tuple(lines[0].channels if channels is None else channels)
+    spectra = np.stack([c.spectrum for c in ch])
+    w = ch[0].omega
+    out_bodies = {}
+    for b in bodies:
+        h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)
+        if static_pose is not None and b.name in static_pose:
+            mean = np.asarray(static_pose[b.name], dtype=float)
+        else:
+            full = np.concatenate([b.position, np.zeros(3)])
+            mean = full[list(PLANAR_INDEX)] if b.planar else full
+        out_bodies[b.name] = body_result(b.name, b.dof_names, w, tuple(c.name for c in ch),
+                                         spectra, h, mean, settings.duration,
+                                         sigma=linearization.body_sigma.get(b.name),
+                                         drag=linearization.body_drag.get(b.name),
+                                         modes=modes, prescribed=False)
+    return out_lines, out_bodies
+
+
+def body_result(name: str, dofs: Sequence[str], omega: np.ndarray,
+                channels: tuple[str, ...], spectra: np.ndarray, transfer: np.ndarray,
+                mean: np.ndarray, duration: float, *, sigma: Any = None, drag: Any = None,
+                modes: CoupledModes | None = None, prescribed: bool = False) -> BodyResult:
+    """Statistics of a body's motion from its transfer functions (see BodyResult)."""
+    dens = np.einsum("cdw,cw->dw", np.abs(transfer) ** 2, spectra)
+    stats = {dof: stats_from_spectrum(omega, dens[i], float(mean[i]), duration)
+             for i, dof in enumerate(dofs)}
+    return BodyResult(name=name, dofs=tuple(dofs), omega=np.asarray(omega).copy(),
+                      channels=tuple(channels), input_spectra=np.asarray(spectra).copy(),
+                      motion_transfer=transfer, motion=stats, prescribed=prescribed,
+                      drag_sigma=None if sigma is None else np.asarray(sigma).copy(),
+                      drag_coefficient=None if drag is None else np.asarray(drag).copy(),
+                      modes=modes)
+
+
+# ------------------------------------------------------------------------ scene
+
+
+def analyze_coupled(scene: Any, statics: Any, settings: Any,
+                    progress: Progress | None = None,
+                    timing: dict[str, float] | None = None, *,
+                    rigid_bodies: Mapping[str, RigidBody] | None = None) -> tuple[
+                        dict[str, LineResult], dict[str, BodyResult],
+                        dict[str, LineSystem], dict[str, Damping]]:
+    """Frequency-domain analysis of a scene with bodies (the ``analyze`` branch).
+
+    Parameters
+    ----------
+    scene : Scene
+        A validated scene with ``bodies``.
+    statics : StaticsResult
+        Its static equilibrium (lines with attached ends at the body poses, and
+        ``statics.bodies``).
+    settings : AnalysisSettings
+    progress : callable, optional
+    timing : dict, optional
+        Accumulates ``model_s``, ``linearization_s``, ``solve_s``, ``outputs_s``. [s]
+    rigid_bodies : mapping of str to RigidBody, optional
+        The bodies as RigidBody (default
+        :func:`stochcable.body_scene.scene_rigid_bodies`); their ``position`` is
+        replaced by the static pose of ``statics.bodies`` when present.
+
+    Returns
+    -------
+    lines : dict of LineResult
+        Every line of the scene, in scene order.
+    bodies : dict of BodyResult
+        Every body (prescribed ones with their RAO motion).
+    systems : dict of LineSystem
+        The line systems of the lines NOT coupled to a free body (for the time
+        series; coupled lines are not in it).
+    dampings : dict of Damping
+        Their converged drag.
+
+    Notes
+    -----
+    Lines attached to no free body: the independent path of
+    :mod:`stochcable.analysis` (linearize, line_result), an end on a prescribed
+    body moving with :func:`fairlead_motion` in the sea channel.  Each connected
+    component of free bodies and their lines is one coupled group
+    (:func:`linearize_coupled`, :func:`coupled_modes`, :func:`coupled_results`).
+    """
+    from .analysis import _silent_channel, build_line_system, linearize
+    from .excitation import line_channels
+
+    progress = _noop if progress is None else progress
+    timing = {} if timing is None else timing
+    for key in ("model_s", "linearization_s", "solve_s", "outputs_s"):
+        timing.setdefault(key, 0.0)
+    omega = settings.omega.values()
+    env = scene.environment
+    t0 = time.perf_counter()
+    if rigid_bodies is None:
+        from .body_scene import scene_rigid_bodies
+
+        rigid_bodies = scene_rigid_bodies(scene)
+    rigid = dict(rigid_bodies)
+    body_docs = {b.name: b for b in scene.bodies}
+    prescribed = {n for n, b in body_docs.items() if getattr(b, "prescribed", None) is not None}
+    bstat = getattr(statics, "bodies", {}) or {}
+    free: dict[str, RigidBody] = {}
+    pose: dict[str, np.ndarray] = {}
+    for name in body_docs:
+        if name in prescribed:
+            continue
+        if name not in rigid:
+            raise InputError("rigid_bodies", name, "-", "a free body has no RigidBody")
+        body = rigid[name]
+        if name in bstat:
+            pos = np.asarray(bstat[name].position, dtype=float)
+            rot = np.asarray(bstat[name].rotation, dtype=float)
+        else:
+            pos, rot = np.asarray(body.position, dtype=float), np.zeros(3)
+        full = np.concatenate([pos, rot])
+        pose[name] = full[list(PLANAR_INDEX)] if body.planar else full
+        extra = body.extra_stiffness
+        if not np.any(body.hydrostatic_stiffness):
+            # no hydrostatic matrix: the statics apply the weight at the CoG and the
+            # buoyancy (if a displaced volume is given) at the CoB exactly
+            # (stochcable.body_statics), so their rotation restoring belongs to the
+            # linearization (body_gravity_stiffness); a hydrostatic matrix already
+            # holds these gravity terms (WAMIT convention)
+            vol = getattr(body_docs[name], "displaced_volume", None) or 0.0
+            cob = getattr(body_docs[name], "centre_of_buoyancy", None)
+            extra = extra + body_gravity_stiffness(
+                body, vol, np.zeros(3) if cob is None else cob, env.rho, env.g)
+        free[name] = dataclasses.replace(body, position=pos, extra_stiffness=extra)
+    # vessel RAOs on the grid
+    vessel_rao = {n: _vessel_rao(body_docs[n].prescribed, omega) for n in prescribed}
+    systems: dict[str, LineSystem] = {}
+    chans: dict[str, tuple[Channel, ...]] = {}
+    attach: dict[str, dict[str, str]] = {}
+    for line in scene.lines:
+        system = build_line_system(scene, line, statics.lines[line.name], settings=settings)
+        ch = line_channels(scene, line, system.positions, omega)
+        att = {}
+        for k, end in enumerate(("end_a", "end_b")):
+            a = getattr(getattr(line, end), "attach", None)
+            if a is None:
+                continue
+            if a.body in prescribed:
+                node = 0 if k == 0 else system.model.n_nodes - 1
+                r = system.positions[node] - np.asarray(body_docs[a.body].position, float)
+                mot = fairlead_motion(vessel_rao[a.body], r)
+                if scene.sea is None:
+                    raise InputError(f"bodies[{a.body}].prescribed", "RAO table", "-",
+                                     "a vessel motion RAO is relative to the sea: the scene "
+                                     "needs a 'sea'")
+                ch = tuple(dataclasses.replace(c, **{f"motion_{end[-1]}": mot})
+                           if c.kind == "sea" else c for c in ch)
+            else:
+                att[end] = a.body
+        systems[line.name] = system
+        chans[line.name] = ch
+        attach[line.name] = att
+    timing["model_s"] += time.perf_counter() - t0
+    # connected groups of free bodies
+    parent = {n: n for n in free}
+
+    def root(n: str) -> str:
+        while parent[n] != n:
+            n = parent[n]
+        return n
+
+    for line in scene.lines:
+        bs = list(attach[line.name].values())
+        for b in bs[1:]:
+            parent[root(b)] = root(bs[0])
+    lines_out: dict[str, LineResult] = {}
+    bodies_out: dict[str, BodyResult] = {}
+    ind_systems: dict[str, LineSystem] = {}
+    dampings: dict[str, Damping] = {}
+    groups: dict[str, list[str]] = {}
+    for line in scene.lines:
+        if attach[line.name]:
+            groups.setdefault(root(next(iter(attach[line.name].values()))), []).append(line.name)
+    for line in scene.lines:
+        if attach[line.name]:
+            continue
+        system, ch = systems[line.name], chans[line.name]
+        if not ch:
+            warn(f"line '{line.name}' has no excitation (no sea and no end motion): its "
+                 "dynamic response is zero; add a 'sea' or an end 'motion'",
+                 PhysicsWarning, stacklevel=2)
+            ch = _silent_channel(omega)
+        t1 = time.perf_counter()
+        lin = linearize(system, ch, settings, progress=progress, timing=timing)
+        timing["linearization_s"] += time.perf_counter() - t1
+        t1 = time.perf_counter()
+        lines_out[line.name] = line_result(system, ch, lin, settings)
+        timing["outputs_s"] += time.perf_counter() - t1
+        ind_systems[line.name] = system
+        dampings[line.name] = lin.damping
+    for rootname, lnames in groups.items():
+        gbodies = [free[n] for n in free if root(n) == rootname]
+        group_ch = _group_channels(lnames, chans, omega)
+        cls = [CoupledLine(systems[n], group_ch[n], end_a=attach[n].get("end_a"),
+                           end_b=attach[n].get("end_b")) for n in lnames]
+        first = cls[0].channels
+        loads = {b.name: body_loads(b, first, omega, scene.sea, env) for b in gbodies}
+        t1 = time.perf_counter()
+        clin = linearize_coupled(cls, gbodies, settings, rho=env.rho, loads=loads,
+                                 progress=progress, timing=timing)
+        timing["linearization_s"] += time.perf_counter() - t1
+        t1 = time.perf_counter()
+        w_ref = _reference_omega(first, omega)
+        modes = coupled_modes(cls, gbodies, w_ref, float(omega[-1]))
+        lo, bo = coupled_results(cls, gbodies, clin, settings, static_pose=pose, modes=modes)
+        timing["outputs_s"] += time.perf_counter() - t1
+        lines_out.update(lo)
+        bodies_out.update(bo)
+    for n in free:  # free-floating bodies without lines: the body alone
+        if n in bodies_out:
+            continue
+        if scene.sea is None:
+            warn(f"body '{n}' has no lines and there is no sea: its motion is zero",
+                 PhysicsWarning, stacklevel=2)
+            continue
+        from .excitation import _spectrum_callable
+
+        dens = _spectrum_callable(scene.sea.spectrum, env.g)
+        sea_ch = (Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega),
+                          density=dens),)
+        b = free[n]
+        t1 = time.perf_counter()
+        clin = linearize_coupled([], [b], settings, rho=env.rho, channels=sea_ch,
+                                 loads={n: body_loads(b, sea_ch, omega, scene.sea, env)},
+                                 progress=progress, timing=timing)
+        timing["linearization_s"] += time.perf_counter() - t1
+        _, bo = coupled_results([], [b], clin, settings, static_pose=pose, channels=sea_ch)
+        bodies_out.update(bo)
+    if groups and getattr(settings, "timeseries", None) is not None:
+        coupled = sorted(n for names in groups.values() for n in names)
+        warn(f"time series are not simulated for lines coupled to bodies ({', '.join(coupled)}): "
+             "they are missing from the time series; their statistics and spectra are "
+             "in the result", PhysicsWarning, stacklevel=2)
+    for n in prescribed:
+        if scene.sea is None:
+            continue
+        h = vessel_rao[n].T[None]   # (1, 6, n_w)
+        sea = np.atleast_2d(scene.sea.spectrum.spectral_density(omega, env.g))
+        dofs = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+        mean = np.concatenate([np.asarray(body_docs[n].position, float), np.zeros(3)])
+        bodies_out[n] = body_result(n, dofs, omega, ("sea",), sea, h, mean,
+                                    settings.duration, prescribed=True)
+    ordered = {line.name: lines_out[line.name] for line in scene.lines}
+    ordered_b = {b.name: bodies_out[b.name] for b in scene.bodies if b.name in bodies_out}
+    return ordered, ordered_b, ind_systems, dampings
+
+
+def _reference_omega(channels: Sequence[Channel], omega: np.ndarray) -> float:
+    """Peak of the sea spectrum on the grid (else of the first channel, else the grid
+    middle): where frequency-dependent added mass is frozen for the modes."""
+    for c in channels:
+        if c.kind == "sea" and np.any(c.spectrum > 0):
+            return float(omega[int(np.argmax(c.spectrum))])
+    for c in channels:
+        if np.any(c.spectrum > 0):
+            return float(omega[int(np.argmax(c.spectrum))])
+    return float(omega[omega.size // 2])
+
+
+def _group_channels(lnames: Sequence[str], chans: Mapping[str, tuple[Channel, ...]],
+                    omega: np.ndarray) -> dict[str, tuple[Channel, ...]]:
+    """Align the lines' channels on the group list: "sea" then "<line>.<end>.<dof>"."""
+    order: list[tuple[str, str, Channel]] = []
+    sea = None
+    for n in lnames:
+        for c in chans[n]:
+            if c.kind == "sea":
+                sea = c
+            else:
+                order.append((n, f"{n}.{c.name}", c))
+    out = {}
+    for n in lnames:
+        own = {c.name: c for c in chans[n]}
+        lst = []
+        if sea is not None:
+            lst.append(own.get("sea", dataclasses.replace(
+                sea, velocity=None, acceleration=None, motion_a=None, motion_b=None,
+                element_velocity=None, element_velocity_square=None,
+                element_end_square=None)))
+        for owner, full, c in order:
+            if owner == n:
+                lst.append(dataclasses.replace(c, name=full))
+            else:
+                lst.append(Channel(name=full, kind="end_motion", omega=c.omega,
+                                   spectrum=c.spectrum, density=c.density))
+        if not lst:
+            lst = [Channel(name="none", kind="none", omega=omega,
+                           spectrum=np.zeros(omega.size), density=_zero_density)]
+        out[n] = tuple(lst)
+    return out
+
+
+def _vessel_rao(motion: Any, omega: np.ndarray) -> np.ndarray:
+    """6-DOF vessel RAO (n_omega, 6) on the grid from a scene VesselMotion (zero
+    outside its table, as end-motion RAOs)."""
+    if hasattr(motion, "transfer"):  # (6, n_omega), as MotionRao.transfer's (3, n)
+        return np.asarray(motion.transfer(omega), dtype=complex).T
+    out = np.zeros((omega.size, 6), dtype=complex)
+    w = np.asarray(motion.omega, dtype=float)
+    for i, k in enumerate(("surge", "sway", "heave", "roll", "pitch", "yaw")):
+        tab = getattr(motion, k, None)
+        if tab is None:
+            continue
+        v = tab.values()
+        out[:, i] = (np.interp(omega, w, v.real, 0.0, 0.0)
+                     + 1j * np.interp(omega, w, v.imag, 0.0, 0.0))
+    return out
