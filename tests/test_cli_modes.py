@@ -58,3 +58,16 @@ def test_modes_errors(scene_file, tmp_path, capsys):
     assert "--count = 0: must be an integer >= 1" in capsys.readouterr().err
     assert main(["modes", str(tmp_path / "missing.json")]) == 2
     assert "cannot be read" in capsys.readouterr().err
+
+
+def test_modes_of_a_scene_with_bodies_say_the_ends_are_held(tmp_path, capsys):
+    from stochcable.examples import load_example
+
+    out = tmp_path / "m.json"
+    scene = tmp_path / "three_legs.json"
+    scene.write_text(load_example("tuah_1982_disc_buoy_three_legs").model_dump_json())
+    assert main(["modes", str(scene), "--count", "3", "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "ends held at their static positions" in err and "bodies.<name>.modes" in err
+    doc = json.loads(out.read_text())
+    assert set(doc["modes"]["lines"]) == {"leg1", "leg2", "leg3"}

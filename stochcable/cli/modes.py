@@ -61,7 +61,16 @@ def run(args: argparse.Namespace) -> int:
 
     count = positive_int("--count", args.count)
     plt = require_matplotlib() if args.plot else None
-    models = scene_fe_models(args.scene, dim=args.dim)
+    from ..errors import PhysicsWarning, warn
+    from ..scene import load_scene
+
+    scene = load_scene(args.scene)
+    if scene.bodies:
+        warn("the scene has bodies: these are the modes of each line with its ends held "
+             "at their static positions; the coupled modes of lines and bodies are in "
+             "the result of 'stochcable analyze' under bodies.<name>.modes",
+             PhysicsWarning)
+    models = scene_fe_models(scene, dim=args.dim)
     modes = {name: natural_modes(model, count=count, added_mass=not args.in_air)
              for name, model in models.items()}
     lines = {name: m.to_document() for name, m in modes.items()}
