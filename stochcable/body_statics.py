@@ -7,14 +7,18 @@ generalized force on a body about its reference point is
     Q(q) = Σ_lines [F_ℓ; (R r_ℓ) × F_ℓ] + Q_grav + Q_hydro + Q_wind + Q_drag,
 
 F_ℓ the static force a line exerts on its end at X + R(θ)·r_ℓ (each line solved by
-:func:`stochcable.statics.solve_line_statics` with that end fixed, warm-started from
-its previous shape), and Newton's method solves Q = 0 with the tangent stiffness
-K = −dQ/dq: the condensed end stiffness of every line (Schur complement of its FE
-tangent over the interior DOFs, :func:`stochcable.bodies.couple`) including the
-attachment geometric term −[F]×[r]× (seed 001 eqs. 3.3.8–3.3.10 linearized about the
-static state), the hydrostatic matrix, and the geometric terms of the point forces
-whose moment arm rotates (weight, buoyancy, drag).  K at the solution is reported as
-the quasi-static mooring + hydrostatic stiffness.
+:func:`stochcable.statics.solve_line_statics` with that end fixed), and Newton's
+method solves Q = 0 with the tangent stiffness K = −dQ/dq: the condensed end stiffness
+of every line (Schur complement K_bb − K_bf K_ff⁻¹ K_fb of its FE tangent, the matrix
+of :func:`stochcable.fem.build_fe_model`, over the interior DOFs: one banded solve)
+including the attachment geometric term −[F]×[r]× (seed 001 eqs. 3.3.8–3.3.10
+linearized about the static state), the hydrostatic matrix, and the geometric terms
+of the point forces whose moment arm rotates (weight, buoyancy, drag).  K is exact, so
+the iteration converges quadratically.  K at the solution is reported as the
+quasi-static mooring + hydrostatic stiffness.  Each FE line of a Newton trial is
+warm-started from its shape at the current iterate plus the first-order interior motion
+−K_ff⁻¹ K_fb δx_ends of the same condensation (the static-condensation predictor), which
+usually leaves one or two line Newton steps (a cold start if that start fails).
 
 Body loads (seed 001 eq. 3.2.c.20, the static F̄):
 
@@ -39,23 +43,21 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
+from scipy.linalg import solve_banded
 
 from .bodies import (
     PLANAR_DOFS,
     PLANAR_INDEX,
     SPATIAL_DOFS,
-    LineLink,
     RigidBody,
     attachment_geometric_stiffness,
-    couple,
 )
 from ._validate import positive, positive_int
 from .errors import ConvergenceError, InputError
-from .fem import build_fe_model
+from .fem import _stiffness_blocks
 from .mesh import mesh_line
 from .scene import Scene, rotate
+from .statics import _block_band_indices
 
 __all__ = ["BodyStatics", "solve_body_statics", "body_static_load",
            "mooring_stiffness"]
@@ -239,8 +241,17 @@ def mooring_stiffness(scene: Scene, lines: dict[str, Any], poses: dict[str, np.n
         central differences of the closed-form catenary for a catenary-solved one (so
         that the stiffness is that of the statics actually solved). [N/m, N, N·m/rad]
     """
+    return _mooring_stiffness(scene, lines, poses, bodies, planar, method, tolerance)[0]
+
+
+def _mooring_stiffness(scene: Scene, lines: dict[str, Any], poses: dict[str, np.ndarray],
+                       bodies: list[str], planar: bool, method: str, tolerance: float
+                       ) -> tuple[np.ndarray, dict[str, tuple[list[str], np.ndarray]]]:
+    """:func:`mooring_stiffness` and, by line name, the ends on the bodies and the
+    interior map S of :func:`_end_condensation` (FE-solved lines only)."""
     from .bodies import rigid_link_matrix
 
+    maps: dict[str, tuple[list[str], np.ndarray]] = {}
     d = 3 if planar else 6
     n = len(bodies) * d
     K = np.zeros((n, n))
@@ -253,7 +264,10 @@ def mooring_stiffness(scene: Scene, lines: dict[str, Any], poses: dict[str, np.n
         if not ends:
             continue
         ls = lines[ln.name]
-        ke = _end_stiffness(scene, ln, ls, [e for e, _ in ends], planar, method, tolerance)
+        names = [e for e, _ in ends]
+        ke, smap = _end_condensation(scene, ln, ls, names, planar, method, tolerance)
+        if smap is not None:
+            maps[ln.name] = (names, smap)
         c = 2 if planar else 3
         comps = [0, 2] if planar else [0, 1, 2]
         tmat = []
@@ -269,34 +283,31 @@ def mooring_stiffness(scene: Scene, lines: dict[str, Any], poses: dict[str, np.n
                 kpq = ke[p_ * c:(p_ + 1) * c, q_ * c:(q_ + 1) * c]
                 i, j = block[bp], block[bq]
                 K[i:i + d, j:j + d] += tmat[p_].T @ kpq @ tmat[q_]
-    return K
+    return K, maps
 
 
-def _end_stiffness(scene: Scene, line: Any, ls: Any, ends: list[str], planar: bool,
-                   method: str, tolerance: float) -> np.ndarray:
-    """−dF/dx of the given ends of a line (2 or 3 components each), the other end held."""
+def _end_condensation(scene: Scene, line: Any, ls: Any, ends: list[str], planar: bool,
+                      method: str, tolerance: float
+                      ) -> tuple[np.ndarray, np.ndarray | None]:
+    """Condensed end stiffness K_e = −dF/dx of the given ends of a line (2 or 3
+    components each, the other end held) and, for an FE-solved line, the interior map S.
+
+    K_e = K_bb − K_bf K_ff⁻¹ K_fb over the FE tangent K of :mod:`stochcable.fem`
+    (the matrix :func:`stochcable.fem.build_fe_model` assembles: element tangents
+    (EA/l0) e eᵀ + (T/l)(I − e eᵀ), slack elements with EA·``SLACK_EA_RATIO`` and no
+    tension, seabed springs on the grounded nodes), in the global components (x, z)
+    planar or (x, y, z); S = K_ff⁻¹ K_fb, shape (n_interior·c, c·n_ends), gives the
+    first-order interior displacement −S δx_ends when the ends move (the predictor of
+    the warm start).  K_ff is block tridiagonal: one banded solve.  For a
+    catenary-solved line, central differences of the closed form and S = None.
+    """
     from .statics import solve_line_statics
 
     env = scene.environment
     comps = [0, 2] if planar else [0, 1, 2]
     c = len(comps)
     if ls.method == "fe":
-        model = build_fe_model(ls, env, dim=2 if planar else 3)
-        links = LineLink(line.name, model, **{e: f"_{e}" for e in ends})
-        dummies = [RigidBody(f"_{e}", ls.positions[0 if e == "end_a" else -1], 0.0,
-                             planar=planar) for e in ends]
-        s = couple([links], dummies, geometric_stiffness=False)
-        kk = sp.csc_array(s.K)
-        tr = [0, 1] if planar else [0, 1, 2]
-        bidx = np.concatenate([s.body_dofs[f"_{e}"][tr] for e in ends])
-        fidx = np.asarray(s.line_dofs[line.name])
-        kbb = kk[np.ix_(bidx, bidx)].toarray()
-        if fidx.size == 0:
-            return kbb
-        kff = sp.csc_array(kk[np.ix_(fidx, fidx)])
-        kfb = kk[np.ix_(fidx, bidx)].toarray()
-        kbf = kk[np.ix_(bidx, fidx)].toarray()
-        return kbb - kbf @ spla.splu(kff).solve(kfb)
+        return _fe_condensation(ls, env, ends, comps)
     # closed form: central differences of the end forces
     mesh = ls.mesh
     h = 1e-5 * max(mesh.length, 1.0)
@@ -312,7 +323,55 @@ def _end_stiffness(scene: Scene, line: Any, ls: Any, ends: list[str], planar: bo
                 fs.append(np.concatenate([(l2.force_a if p == "end_a" else l2.force_b)[comps]
                                           for p in ends]))
             out[:, q_ * c + k] = -(fs[0] - fs[1]) / (2.0 * h)
-    return out
+    return out, None
+
+
+def _fe_condensation(ls: Any, env: Any, ends: list[str], comps: list[int]
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """K_e and S of :func:`_end_condensation` for an FE-solved line."""
+    c = len(comps)
+    mesh = ls.mesh
+    n = mesh.n_nodes
+    pos = np.asarray(ls.positions, dtype=float)[:, comps]
+    dd = pos[1:] - pos[:-1]
+    ll = np.sqrt(np.einsum("ij,ij->i", dd, dd))
+    k = _stiffness_blocks(dd / ll[:, None], ll, mesh.l0, mesh.ea,
+                          np.asarray(ls.tension, dtype=float))  # (n_el, c, c)
+    diag = np.zeros((n, c, c))
+    diag[:-1] += k
+    diag[1:] += k
+    trib = np.zeros(n)
+    half = 0.5 * mesh.diameter * mesh.l0
+    trib[:-1] += half
+    trib[1:] += half
+    zc = comps.index(2)
+    diag[:, zc, zc] += env.seabed.stiffness * np.where(ls.grounded, trib, 0.0)
+    node = {"end_a": 0, "end_b": n - 1}
+    ne = len(ends)
+    kbb = np.zeros((ne * c, ne * c))
+    for p_, e in enumerate(ends):
+        kbb[p_ * c:(p_ + 1) * c, p_ * c:(p_ + 1) * c] = diag[node[e]]
+    nf = n - 2
+    if nf == 0:
+        if ne == 2:
+            kbb[:c, c:] = -k[0]
+            kbb[c:, :c] = -k[0]
+        return kbb, np.zeros((0, ne * c))
+    # K_fb: the element next to each end couples it to its neighbour node
+    kfb = np.zeros((nf * c, ne * c))
+    for p_, e in enumerate(ends):
+        if e == "end_a":
+            kfb[:c, p_ * c:(p_ + 1) * c] = -k[0]
+        else:
+            kfb[(nf - 1) * c:, p_ * c:(p_ + 1) * c] = -k[-1]
+    bw = 2 * c - 1
+    rows, cols = _block_band_indices(nf, c)
+    ab = np.zeros((2 * bw + 1, nf * c))
+    # diagonal blocks of the interior nodes, then the couplings −k_i (i = 1 … n−3)
+    ab[rows, cols] = np.concatenate([diag[1:-1].ravel(), (-k[1:-1]).ravel(),
+                                     (-k[1:-1]).ravel()])
+    S = solve_banded((bw, bw), ab, kfb, overwrite_ab=True, check_finite=False)
+    return kbb - kfb.T @ S, S
 
 
 # ---------------------------------------------------------------------- the solver
@@ -381,21 +440,43 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
                                                 max_iterations=max_iterations)
     meshes = {ln.name: mesh_line(scene.resolved_line(ln), env.rho, env.g) for ln in moving}
 
-    def solve_lines(pz: dict[str, np.ndarray]) -> dict[str, Any]:
+    comps = [0, 2] if planar else [0, 1, 2]
+    c = len(comps)
+
+    def solve_lines(pz: dict[str, np.ndarray], base: dict[str, Any] | None = None,
+                    maps: dict[str, tuple[list[str], np.ndarray]] | None = None
+                    ) -> dict[str, Any]:
+        """The moving lines at the poses pz, each FE line warm-started from its shape
+        in ``base`` plus the first-order interior motion −S δx_ends (``maps``, the
+        static condensation of its tangent); a cold start if that fails."""
         out = {}
         pm = _pose_map(pz)
         for ln in moving:
             mesh = dataclasses.replace(meshes[ln.name],
                                        end_a=scene.end_position(ln, "end_a", pm),
                                        end_b=scene.end_position(ln, "end_b", pm))
-            prev = lines.get(ln.name)
+            prev = None if base is None else base.get(ln.name)
             init = None
             if prev is not None and prev.method == "fe":
                 init = prev.positions.copy()
+                m = None if maps is None else maps.get(ln.name)
+                if m is not None and m[1].size:
+                    ends, smap = m
+                    dxb = np.concatenate([
+                        (mesh.end_a if e == "end_a" else mesh.end_b)[comps]
+                        - prev.positions[0 if e == "end_a" else -1, comps] for e in ends])
+                    init[1:-1, comps] -= (smap @ dxb).reshape(-1, c)
                 init[0], init[-1] = mesh.end_a, mesh.end_b
-            out[ln.name] = solve_line_statics(mesh, env, method=method, initial=init,
-                                              tolerance=tolerance,
-                                              max_iterations=max_iterations)
+            try:
+                out[ln.name] = solve_line_statics(mesh, env, method=method, initial=init,
+                                                  tolerance=tolerance,
+                                                  max_iterations=max_iterations)
+            except ConvergenceError:
+                if init is None:
+                    raise
+                out[ln.name] = solve_line_statics(mesh, env, method=method,
+                                                  tolerance=tolerance,
+                                                  max_iterations=max_iterations)
         return out
 
     # active unknowns
@@ -413,8 +494,10 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
             np.zeros(0)
 
     def forces(pz: dict[str, np.ndarray], ls: dict[str, Any]
-               ) -> tuple[np.ndarray, np.ndarray, dict[str, dict[str, np.ndarray]]]:
-        """Generalized forces (n_free·d,), stiffness (n_free·d)², line forces."""
+               ) -> tuple[np.ndarray, np.ndarray, dict[str, dict[str, np.ndarray]],
+                          dict[str, tuple[list[str], np.ndarray]]]:
+        """Generalized forces (n_free·d,), stiffness (n_free·d)², line forces, and the
+        lines' interior maps (:func:`_mooring_stiffness`)."""
         Q = np.zeros(len(free) * d)
         K = np.zeros((len(free) * d, len(free) * d))
         lf: dict[str, dict[str, np.ndarray]] = {b.name: {} for b in scene.bodies}
@@ -441,9 +524,11 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
                 _reduce(pz[nm], planar) - _reduce(
                     np.concatenate([np.asarray(scene.body(nm).position, float),
                                     np.zeros(3)]), planar))
+        maps: dict[str, tuple[list[str], np.ndarray]] = {}
         if free:
-            K += mooring_stiffness(scene, allls, pz, free, planar, method, tolerance)
-        return Q, K, lf
+            km, maps = _mooring_stiffness(scene, allls, pz, free, planar, method, tolerance)
+            K += km
+        return Q, K, lf, maps
 
     # scales
     fref = 0.0
@@ -482,7 +567,7 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
         fref = max(fref, float(lines_all[ln.name].tension.max(initial=0.0)),
                    float(lines_all[ln.name].tension_a), float(lines_all[ln.name].tension_b))
     fref = fref if fref > 0.0 else 1.0
-    Q, K, lf = forces(poses, ls)
+    Q, K, lf, maps = forces(poses, ls)
     it = 0
     r = scaled(Q)
     if free and sel.size:
@@ -503,15 +588,15 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
                 i = pos_in_block[nm] * d
                 trial[nm] = trial[nm] + _full(step * dq[i:i + d], planar)
             try:
-                ls_t = solve_lines(trial)
-                Q_t, K_t, lf_t = forces(trial, ls_t)
+                ls_t = solve_lines(trial, ls, maps)
+                Q_t, K_t, lf_t, maps_t = forces(trial, ls_t)
             except (ConvergenceError, InputError):
                 # a line that cannot reach or goes slack at the trial pose: shorter step
                 step *= 0.5
                 continue
             r_t = scaled(Q_t)
             if r_t < r or step < 1.0 / 1024:
-                poses, ls, Q, K, lf, r = trial, ls_t, Q_t, K_t, lf_t, r_t
+                poses, ls, Q, K, lf, maps, r = trial, ls_t, Q_t, K_t, lf_t, maps_t, r_t
                 accepted = True
                 break
             step *= 0.5

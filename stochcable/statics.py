@@ -18,6 +18,7 @@ is folded into the load and the tension reported is the effective tension.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -451,19 +452,7 @@ class _Model:
         dim, nf = self.dim, self.n - 2
         bw = 2 * dim - 1
         self.bw = bw
-        p = np.arange(nf)[:, None, None]
-        a = np.arange(dim)[None, :, None]
-        b = np.arange(dim)[None, None, :]
-        rd = np.broadcast_to(bw + a - b, (nf, dim, dim))
-        cd = np.broadcast_to(p * dim + b, (nf, dim, dim))
-        q = np.arange(max(nf - 1, 0))[:, None, None]
-        ru = np.broadcast_to(bw + a - b - dim, (q.shape[0], dim, dim))
-        cu = np.broadcast_to((q + 1) * dim + b, (q.shape[0], dim, dim))
-        rl = np.broadcast_to(bw + dim + a - b, (q.shape[0], dim, dim))
-        cl = np.broadcast_to(q * dim + b, (q.shape[0], dim, dim))
-        self.band_rows = np.concatenate([rd.ravel(), ru.ravel(), rl.ravel()])
-        self.band_cols = np.concatenate([cd.ravel(), cu.ravel(), cl.ravel()])
-        self.diag_rows = np.full(nf * dim, bw)
+        self.band_rows, self.band_cols = _block_band_indices(nf, dim)
 
     def forces(self, X: np.ndarray, tangent: bool = True) -> tuple:
         """Nodal residual forces R (n, dim) (force on each node, zero at equilibrium),
@@ -570,6 +559,30 @@ class _Model:
             diag = np.abs(ab[self.bw])
             ab[self.bw] += lam * (diag + 1e-3 * float(np.mean(diag)))
         return ab
+
+
+@functools.lru_cache(maxsize=64)
+def _block_band_indices(nf: int, dim: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns in LAPACK general banded storage (l = u = 2·dim − 1) of the
+    entries of a block-tridiagonal matrix of nf × nf blocks dim × dim, in the order:
+    the diagonal blocks, the upper blocks (q, q + 1), the lower blocks (q + 1, q), each
+    block row-major (``A[i, j] -> ab[bw + i − j, j]``).  Cached (read-only arrays)."""
+    bw = 2 * dim - 1
+    p = np.arange(nf)[:, None, None]
+    a = np.arange(dim)[None, :, None]
+    b = np.arange(dim)[None, None, :]
+    rd = np.broadcast_to(bw + a - b, (nf, dim, dim))
+    cd = np.broadcast_to(p * dim + b, (nf, dim, dim))
+    q = np.arange(max(nf - 1, 0))[:, None, None]
+    ru = np.broadcast_to(bw + a - b - dim, (q.shape[0], dim, dim))
+    cu = np.broadcast_to((q + 1) * dim + b, (q.shape[0], dim, dim))
+    rl = np.broadcast_to(bw + dim + a - b, (q.shape[0], dim, dim))
+    cl = np.broadcast_to(q * dim + b, (q.shape[0], dim, dim))
+    rows = np.concatenate([rd.ravel(), ru.ravel(), rl.ravel()])
+    cols = np.concatenate([cd.ravel(), cu.ravel(), cl.ravel()])
+    rows.flags.writeable = False
+    cols.flags.writeable = False
+    return rows, cols
 
 
 def _reference_force(model: _Model, T: np.ndarray, drag: float) -> float:

@@ -9,6 +9,7 @@ the linear stiffness estimate of a small wind offset (with its quadratic error).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 import math
 
@@ -18,8 +19,9 @@ from scipy.spatial.transform import Rotation
 
 from stochcable.body_scene import scene_rigid_bodies
 from stochcable.body_statics import BodyStatics, body_static_load, solve_body_statics
-from stochcable.errors import InputError
+from stochcable.errors import ConvergenceError, InputError
 from stochcable.examples import load_example
+from stochcable.fem import build_fe_model
 from stochcable.mesh import mesh_line
 from stochcable.scene import load_scene
 from stochcable.statics import solve_line_statics, solve_statics
@@ -315,3 +317,103 @@ def test_slack_start_and_unheld_body_errors():
     with pytest.raises(ConvergenceError, match=r"body statics Newton did not converge: "
                                                r"residual .*undetermined position"):
         solve_statics(load_scene(d))
+
+
+# ------------------------------------------------- Newton and the condensed tangent
+
+
+def _buoy_spread_doc(n_el: int = 40, position=(10.0, 5.0, 0.0)) -> dict:
+    """The benchmark scene of benchmarks/bench_bodies.py: a 2e4 kg buoy (K_h heave
+    1.26e5 N/m) on three 330 m chain legs at 0/120/240°, anchors 300 m out on the
+    seabed at 100 m depth, started off its equilibrium."""
+    lines = []
+    for i in range(3):
+        a = math.radians(120.0 * i)
+        lines.append({
+            "name": f"leg{i + 1}",
+            "end_a": {"position": [300.0 * math.cos(a), 300.0 * math.sin(a), -100.0]},
+            "end_b": {"attach": {"body": "buoy",
+                                 "point": [5.0 * math.cos(a), 5.0 * math.sin(a), -2.0]}},
+            "segments": [{"length": 330.0, "ea": 5e8, "mass": 100.0, "diameter": 0.1,
+                          "elements": n_el}]})
+    kh = [[0.0] * 6 for _ in range(6)]
+    for i, v in enumerate([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]):
+        kh[i][i] = v
+    body = {"name": "buoy", "position": list(position), "mass": 2.0e4,
+            "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
+            "hydrostatic_stiffness": kh}
+    return {"environment": {"depth": 100.0}, "bodies": [body], "lines": lines}
+
+
+def test_body_newton_converges_quadratically():
+    """The Jacobian (condensed FE end stiffness + attachment geometric terms + K_h) is
+    the exact derivative of the generalized force, so the residual sequence of Newton
+    satisfies r_{k+1} <= C r_k² (measured C ≈ 1.5 here; an inexact Jacobian converges
+    linearly, r_{k+1} ≈ ρ r_k, and fails the bound once r_k < ρ/C)."""
+    scene = load_scene(_buoy_spread_doc())
+    res = []
+    for k in range(1, 7):
+        try:
+            solve_body_statics(scene, "fe", max_body_iterations=k, body_tolerance=1e-14)
+        except ConvergenceError as exc:
+            res.append(exc.residual)
+        else:
+            break
+    # pairs above the round-off floor of the line statics (tolerance 1e-10 of the line
+    # reference force, ~1e-11 relative to the body reference force)
+    pairs = [(a, b) for a, b in zip(res, res[1:]) if b > 1e-10]
+    assert len(pairs) >= 3, res
+    for a, b in pairs:
+        # C ≈ 1.5 measured; 10 leaves room for platform round-off
+        assert b <= 10.0 * a * a, res
+    assert res[-1] < 1e-10
+
+
+def _dense_end_stiffness(ls, env, ends, planar):
+    """K_bb − K_bf K_ff⁻¹ K_fb of build_fe_model's sparse K, dense (second method)."""
+    model = build_fe_model(ls, env, dim=2 if planar else 3)
+    k = model.K.toarray()
+    c = model.dim
+    n = ls.mesh.n_nodes
+    b = np.concatenate([np.arange(c) + (0 if e == "end_a" else (n - 1) * c) for e in ends])
+    f = np.arange(c, (n - 1) * c)
+    return k[np.ix_(b, b)] - k[np.ix_(b, f)] @ np.linalg.solve(k[np.ix_(f, f)],
+                                                               k[np.ix_(f, b)])
+
+
+@pytest.mark.parametrize("planar", [False, True])
+@pytest.mark.parametrize("ends", [["end_b"], ["end_a", "end_b"]])
+def test_end_condensation_matches_dense_schur(planar, ends):
+    """The banded condensation of the line tangent equals the dense Schur complement
+    of stochcable.fem's assembled K (grounded nodes and seabed springs included), and
+    its interior map predicts the re-solved shape to second order in the end motion."""
+    from stochcable.body_statics import _end_condensation
+
+    # buoy at its symmetric pose: leg1 in the x–z plane (planar model), leg2 at 120°
+    # (3-D); the end motions below keep the seabed contact set (a node lifting off is
+    # a kink of the one-sided contact, where the predictor is only first order)
+    scene = load_scene(_buoy_spread_doc(n_el=20, position=(0.0, 0.0, 0.0)))
+    env = scene.environment
+    ln = scene.lines[0 if planar else 1]
+    mesh = mesh_line(scene.resolved_line(ln), env.rho, env.g)
+    ls = solve_line_statics(mesh, env, method="fe", tolerance=1e-12)
+    assert ls.grounded.sum() >= 3  # the seabed springs enter the condensation
+    ke, smap = _end_condensation(scene, ln, ls, ends, planar, "fe", 1e-10)
+    ref = _dense_end_stiffness(ls, env, ends, planar)
+    # two factorizations of the same ~1e7 N/m matrix: round-off level
+    np.testing.assert_allclose(ke, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+    comps = [0, 2] if planar else [0, 1, 2]
+    c = len(comps)
+    direction = np.array([0.6, 0.0 if planar else -0.3, 0.74])
+    errs = []
+    for h in (0.4, 0.2):
+        dx = h * direction
+        moved = {e: getattr(mesh, e) + (dx if e in ends else 0.0)
+                 for e in ("end_a", "end_b")}
+        mesh2 = dataclasses.replace(mesh, **moved)
+        ls2 = solve_line_statics(mesh2, env, method="fe", tolerance=1e-12)
+        dxb = np.concatenate([dx[comps] for _ in ends])
+        pred = ls.positions[1:-1, comps] - (smap @ dxb).reshape(-1, c)
+        errs.append(np.abs(pred - ls2.positions[1:-1, comps]).max())
+    # first-order predictor: the error quarters when the end motion halves (±30 %)
+    assert 0.25 * 0.7 < errs[1] / errs[0] < 0.25 * 1.3, errs
