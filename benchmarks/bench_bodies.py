@@ -8,7 +8,10 @@ with the statics (lines and the buoy pose, stochcable.statics) and without them
 linearization, coupled modes, line and body outputs), with one BLAS thread as
 ``analyze()`` runs small models, for the direct and the Foss ("auto") solvers.  For
 scale: the same three legs analysed independently, fairleads fixed at their static
-positions.  Then a cProfile breakdown of one full coupled analysis (direct).
+positions.  The dynamics are also timed without the coarse start of the drag
+linearization (``COARSE_MIN_FREQUENCIES`` raised), with the largest relative change
+of the buoy motion σ and the fairlead/anchor tension σ it makes.  Then a cProfile
+breakdown of one full coupled analysis (direct).
 
 
 Run:  python benchmarks/bench_bodies.py [--repeat N] [--profile]
@@ -25,6 +28,9 @@ import statistics
 import time
 import warnings
 from stochcable.analysis import _single_blas_thread, build_line_system, line_result, linearize
+import numpy as np
+
+import stochcable.coupled_analysis as coupled_analysis
 from stochcable.coupled_analysis import analyze_coupled
 from stochcable.excitation import line_channels
 from stochcable.scene import load_scene
@@ -84,6 +90,24 @@ def run_independent(scene, statics):
             line_result(s, ch, linearize(s, ch, scene.analysis), scene.analysis)
 
 
+def key_results(lines, bodies):
+    """Buoy surge/heave/pitch σ and every leg's fairlead and anchor tension σ."""
+    return np.r_[bodies["buoy"].motion_std[[0, 2, 4]],
+                 [lines[n].end_b.std for n in lines], [lines[n].end_a.std for n in lines]]
+
+
+def without_coarse_start(scene, statics, repeat):
+    """Dynamics median time and results with the coarse start switched off."""
+    saved = coupled_analysis.COARSE_MIN_FREQUENCIES
+    coupled_analysis.COARSE_MIN_FREQUENCIES = 10**9
+    try:
+        (lines, bodies, _, _), _ = run_coupled(scene, statics)
+        med, _ = median_time(lambda: run_coupled(scene, statics), repeat)
+    finally:
+        coupled_analysis.COARSE_MIN_FREQUENCIES = saved
+    return med, lines, bodies
+
+
 def median_time(fn, repeat: int) -> tuple[float, float]:
     fn()  # warm-up
     t = []
@@ -115,6 +139,12 @@ def main() -> None:
               f"({1e3 * best_f:.1f} min); dynamics {1e3 * med:.1f} ms ({1e3 * best:.1f} min), "
               f"{rec.iterations} iterations; statics {1e3 * med_s:.1f} ms; "
               f"the legs alone (fairleads fixed) {1e3 * med_i:.1f} ms")
+        med_nc, l_nc, b_nc = without_coarse_start(scene, statics, args.repeat)
+        ref = key_results(l_nc, b_nc)
+        diff = np.max(np.abs(key_results(lines, bodies) / ref - 1.0))
+        print(f"        without the coarse start: dynamics {1e3 * med_nc:.1f} ms, "
+              f"{l_nc['leg1'].linearization.iterations} iterations; max relative change "
+              f"of the buoy σ and tension σ with it {diff:.1e}")
         print("        stages: " + ", ".join(f"{k} {1e3 * v:.1f} ms" for k, v in timing.items()))
         print(f"        buoy surge/heave/pitch σ = {bodies['buoy'].motion_std[[0, 2, 4]]}, "
               f"leg1/leg2 fairlead tension σ = {lines['leg1'].end_b.std:.1f} / "

@@ -29,7 +29,9 @@ coupled system of :func:`stochcable.bodies.couple` on the body DOFs (tested equa
 :func:`stochcable.bodies.solve_coupled_direct`), with the line interiors solved by the
 line machinery: banded direct solve (``solver="direct"``) or Foss modal superposition
 with the static correction of the truncated modes (``solver="foss"``, seed 001 §5.3;
-the unit end motions use the quasi-static split of :func:`stochcable.analysis.solve`).
+the unit end motions use the quasi-static split of :func:`stochcable.analysis.solve`;
+their constant split U_p makes their loads ω²·M_T U_p − iω·C U_p, so their modal
+loads and static correction are closed-form columns, :func:`_foss_unit_split`).
 
 Frequency-dependent added mass and radiation damping
 ----------------------------------------------------
@@ -50,6 +52,23 @@ with the current).  The iteration mirrors :func:`stochcable.analysis.linearize`:
 start is the fluid velocity relative to lines and bodies at rest (lines following
 their moving unattached ends quasi-statically), the first response starts the
 Anderson-accelerated iteration unmixed.  The record is one for the whole group.
+
+Coarse start
+------------
+On a grid of at least ``COARSE_MIN_FREQUENCIES`` points the iteration first runs on
+a frequency subset (every ``COARSE_STRIDE``-th frequency, the last one, and every
+frequency whose spectral weight is at least ``_COARSE_PEAK_SHARE`` of a channel's
+largest: the spectral peak at full resolution; the σ integrals are the trapezoid rule
+on that non-uniform grid) to ``COARSE_TOLERANCE_FACTOR`` times the tolerance.  Its
+fixed point only supplies the start: the full-grid iteration then runs, first step
+unmixed, until the usual convergence test passes on the full grid, so the answer is
+the full-grid fixed point (tested equal within the tolerance to ``coarse=False``).
+On the three-leg benchmark the coarse σ are within 0.5 % of the full-grid ones and
+the full grid needs 2 evaluations instead of 7 (docs/BENCHMARKS.md, "Bodies").  The
+record's ``iterations`` and ``history`` list the coarse evaluations first.  Used by
+default for groups with a direct-solver line (a direct iteration costs in proportion
+to the frequency count; a Foss one is dominated by its per-line eigenproblem, so
+there the coarse stage saves nothing: measured 252 vs 242 ms on the benchmark).
 
 Vessel-driven ends
 ------------------
@@ -78,13 +97,18 @@ from .analysis import (
     LineSystem,
     Progress,
     Response,
+    _add,
+    _base,
     _drag_blocks,
+    _drag_load,
     _end_tension,
     _inputs,
+    _matvec,
     _noop,
     _prep,
     _quasi_static,
     _reactions,
+    _real_gemm,
     _sigmas,
     _solve_free,
     _split_sigma,
@@ -112,6 +136,7 @@ from .linearization import (
     fixed_point,
 )
 from .results import BodyResult, LinearizationRecord, LineResult, stats_from_spectrum
+from .solvers import _foss_decomposition, _foss_transfer_modal
 
 __all__ = [
     "CoupledLine",
@@ -510,7 +535,10 @@ def _solve_group(g: _Group, line_damping: Mapping[str, Damping],
         system = cl.system
         inp = g.inp[cl.name]
         damping = line_damping[cl.name]
-        u_f, c = _solve_free(system, inp, damping)
+        solved = None
+        if system.solver != "direct":
+            solved = _foss_unit_split(system, g.inp_phys[cl.name], inp, damping)
+        u_f, c = _solve_free(system, inp, damping) if solved is None else solved
         u = _total(system, inp, u_f)
         sup = _reactions(system, _prep(system), c, u, _end_loads(system, inp, damping), w)
         rows = g.rows[cl.name]
@@ -529,12 +557,72 @@ def _solve_group(g: _Group, line_damping: Mapping[str, Damping],
         u, sup = parts[cl.name]
         t = g.tmat[cl.name]
         ue = t[None] @ xi                                     # (n_w, d·n_att, n_ch)
-        uc = u[..., :n_ch] + (u[..., None, n_ch:] @ ue)[..., 0, :]
+        uc = u[..., :n_ch] + np.einsum("ndwj,wjc->ndwc", u[..., n_ch:], ue)
         sc = sup[:, :, :n_ch] + sup[:, :, n_ch:] @ ue
         out[cl.name] = (uc, sc)
     if timing is not None:
         timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
     return out, xi
+
+
+def _foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Damping
+                     ) -> tuple[np.ndarray, Any] | None:
+    """:func:`stochcable.analysis._solve_free` (Foss) of the physical channels plus the
+    unit end-motion channels, the unit columns in closed form.
+
+    A unit end motion e_j moves the line by the constant U_p,j (the end and its exact
+    static following, :func:`stochcable.analysis._base`), so its free-row load is
+    ω²·[M_T U_p,j]_f − iω·[C U_p,j]_f: its modal load, its static correction and the
+    drag load need no per-frequency products over the nodes; one Foss decomposition
+    serves both.  The same linear system as the plain call to round-off; None (use the
+    plain call) when the pencil is defective (its fallback and warning).
+    """
+    prep = _prep(system)
+    w = inp.omega
+    n_ch = inp_phys.weights.shape[1]
+    n_e = inp.weights.shape[1] - n_ch
+    cd = _drag_blocks(system, damping)
+    c = _add(prep.S, cd)
+    phi, mh, kh = prep.modal(system)
+    ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
+    try:
+        foss = _foss_decomposition(mh, 0.5 * (ch + ch.T), kh)
+    except SolverError:
+        return None
+    m, nf = phi.shape[1], phi.shape[0]
+    n_w = w.size
+    # physical channels: the free-row load of _solve_free
+    _, f0, q = _base(system, prep, inp_phys)
+    rhs = _drag_load(system, inp_phys, damping)
+    if rhs is None:
+        rhs = f0.copy()
+    else:
+        rhs += f0
+    if q is not None:
+        rhs += _matvec(cd, q)
+    flat = np.ascontiguousarray(prep._free_rows(rhs)).reshape(nf, n_w * n_ch)
+    u_p = _real_gemm(phi, np.ascontiguousarray(
+        _foss_transfer_modal(foss, _real_gemm(phi.T, flat), w, n_ch)))
+    # unit channels: U_p,j constant (node vectors (n, d, n_e))
+    key = ("unit_up", n_ch)
+    if key not in inp.cache:
+        up = np.ascontiguousarray(_base(system, prep, inp)[0][:, :, 0, n_ch:].real)
+        inp.cache[key] = (up, prep._free_rows(_matvec(prep.MT, up)))
+    up, a = inp.cache[key]
+    b = prep._free_rows(_matvec(c, up))
+    ah, bh = phi.T @ a, phi.T @ b                              # (m, n_e)
+    fe = ((w * w)[None, :, None] * ah[:, None, :]
+          - (1j * w)[None, :, None] * bh[:, None, :])          # (m, n_w, n_e)
+    u_e = _real_gemm(phi, np.ascontiguousarray(
+        _foss_transfer_modal(foss, fe.reshape(m, n_w * n_e), w, n_e)))
+    u_e = u_e.reshape(nf, n_w, n_e)
+    if m < nf:
+        u_p += prep.residual(system, flat)
+        st = prep.residual(system, np.concatenate([a, b], axis=1).astype(complex))
+        u_e += ((w * w)[None, :, None] * st[:, None, :n_e]
+                - (1j * w)[None, :, None] * st[:, None, n_e:])
+    u = np.concatenate([u_p.reshape(nf, n_w, n_ch), u_e], axis=2)
+    return u.reshape(prep.n - 2, prep.d, n_w, n_ch + n_e), c
 
 
 def _end_loads(system: LineSystem, inp: Any, damping: Damping) -> np.ndarray:
@@ -566,6 +654,93 @@ def _solve_body(s: np.ndarray, g: np.ndarray, w: np.ndarray) -> np.ndarray:
     return x
 
 
+#: Coarse start: every COARSE_STRIDE-th frequency (plus the spectral peak
+#: neighbourhood at full resolution), used when the grid has at least
+#: COARSE_MIN_FREQUENCIES points; the coarse iteration stops at
+#: COARSE_TOLERANCE_FACTOR times the linearization tolerance.
+COARSE_STRIDE = 4
+COARSE_MIN_FREQUENCIES = 64
+COARSE_TOLERANCE_FACTOR = 10.0
+# Spectral-peak neighbourhood kept at full resolution: weights above this share of
+# the largest weight of any channel.
+_COARSE_PEAK_SHARE = 0.05
+
+
+def _coarse_subset(g: _Group) -> np.ndarray | None:
+    """Indices of the coarse-start grid (None: the grid is too small)."""
+    n = g.omega.size
+    if n < COARSE_MIN_FREQUENCIES:
+        return None
+    keep = np.zeros(n, dtype=bool)
+    keep[::COARSE_STRIDE] = True
+    keep[-1] = True
+    wmax = np.max(g.weights, axis=0)
+    ok = wmax > 0
+    if np.any(ok):
+        keep |= np.any(g.weights[:, ok] >= _COARSE_PEAK_SHARE * wmax[ok], axis=1)
+    idx = np.flatnonzero(keep)
+    return idx if idx.size < 0.75 * n else None
+
+
+_CHANNEL_ARRAYS = ("velocity", "acceleration", "motion_a", "motion_b", "element_velocity",
+                   "element_velocity_square", "element_end_square")
+
+
+def _sliced_channel(c: Channel, idx: np.ndarray) -> Channel:
+    """The channel on the frequencies ``omega[idx]`` (every array's first axis)."""
+    kw = {k: getattr(c, k)[idx] for k in _CHANNEL_ARRAYS if getattr(c, k) is not None}
+    return dataclasses.replace(c, omega=c.omega[idx], spectrum=c.spectrum[idx], **kw)
+
+
+def _sliced_line(cl: CoupledLine, idx: np.ndarray) -> CoupledLine:
+    return dataclasses.replace(cl, channels=tuple(_sliced_channel(c, idx)
+                                                  for c in cl.channels))
+
+
+def _sliced_loads(ld: BodyLoads, idx: np.ndarray) -> BodyLoads:
+    return BodyLoads(force=ld.force[idx], velocity=ld.velocity[idx], current=ld.current)
+
+
+def _make_update(g: _Group, method: str, rho: float, state: dict[str, Any],
+                 cache: dict[str, Any], progress: Progress, names: str,
+                 timing: dict[str, float] | None) -> Any:
+    """The fixed-point map σ -> σ(response to the drag of σ) of a group; ``state``
+    holds the evaluation count and the last relative change, ``cache`` the last
+    drag, solution and σ."""
+    state.setdefault("it", 0)
+
+    def update(x: np.ndarray) -> np.ndarray:
+        ls, bs = g.split(x)
+        damp = {cl.name: drag_coefficients(cl.system, ls[cl.name], method) for cl in g.lines}
+        body_c = np.zeros((g.nb, g.nb))
+        body_b = {}
+        for b in g.drag:
+            bb, c = _body_drag(b, rho, bs[b.name], g.loads[b.name].current
+                               if b.name in g.loads else np.zeros(3), method)
+            sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
+            body_c[sl, sl] += c
+            body_b[b.name] = bb
+        sol, xi = _solve_group(g, damp, body_c, body_b, timing)
+        new = []
+        for cl in g.lines:
+            new.append(_sigmas(cl.system, g.inp_phys[cl.name], sol[cl.name][0], method))
+        for b in g.drag:
+            new.append(_body_sigma(g, b, xi))
+        new = np.concatenate(new) if new else np.zeros(0)
+        state["it"] += 1
+        den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)),
+                                                 1e-300))
+        change = float(np.max(np.abs(new - x) / den, initial=0.0))
+        state["change"] = change
+        progress("linearization", {"group": names, "iteration": state["it"],
+                                   "change": change})
+        cache.update(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
+        return new
+
+    update.state = state  # type: ignore[attr-defined]
+    return update
+
+
 def linearize_coupled(
     lines: Sequence[CoupledLine],
     bodies: Sequence[RigidBody],
@@ -576,6 +751,7 @@ def linearize_coupled(
     channels: Sequence[Channel] | None = None,
     progress: Progress | None = None,
     timing: dict[str, float] | None = None,
+    coarse: bool | None = None,
 ) -> CoupledLinearization:
     """Drag linearization and response of lines coupled through rigid bodies.
 
@@ -599,6 +775,12 @@ def linearize_coupled(
         ``progress("linearization", {"group", "iteration", "change"})``.
     timing : dict, optional
         Accumulates ``solve_s``. [s]
+    coarse : bool, optional
+        Start the full-grid iteration from the fixed point of a frequency subset
+        (module docstring, "Coarse start"); False iterates on the full grid only.
+        Default: when a line of the group uses the direct solver (whose cost is
+        proportional to the frequency count; a Foss iteration is dominated by its
+        frequency-independent eigenproblem, where the coarse stage does not pay).
 
     Returns
     -------
@@ -641,61 +823,61 @@ def linearize_coupled(
     x_rest = np.concatenate(parts) if parts else np.zeros(0)
     state: dict[str, Any] = {"it": 0}
     cache: dict[str, Any] = {}
-
-    def update(x: np.ndarray) -> np.ndarray:
-        ls, bs = g.split(x)
-        damp = {cl.name: drag_coefficients(cl.system, ls[cl.name], method) for cl in g.lines}
-        body_c = np.zeros((g.nb, g.nb))
-        body_b = {}
-        for b in g.drag:
-            bb, c = _body_drag(b, rho, bs[b.name], g.loads[b.name].current
-                               if b.name in g.loads else np.zeros(3), method)
-            sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
-            body_c[sl, sl] += c
-            body_b[b.name] = bb
-        sol, xi = _solve_group(g, damp, body_c, body_b, timing)
-        new = []
-        for cl in g.lines:
-            new.append(_sigmas(cl.system, g.inp_phys[cl.name], sol[cl.name][0], method))
-        for b in g.drag:
-            new.append(_body_sigma(g, b, xi))
-        new = np.concatenate(new) if new else np.zeros(0)
-        state["it"] += 1
-        den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)),
-                                                 1e-300))
-        change = float(np.max(np.abs(new - x) / den, initial=0.0))
-        state["change"] = change
-        progress("linearization", {"group": names, "iteration": state["it"],
-                                   "change": change})
-        cache.update(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
-        return new
-
     hint = ("increase analysis.linearization.max_iterations, lower relaxation, or set "
             "allow_unconverged to get a flagged result")
+    fixed = dict(relaxation=lin.relaxation,
+                 method="anderson" if lin.acceleration == "anderson" else "relaxed",
+                 mixing=ANDERSON_MIXING)
+    # coarse stage (module docstring "Coarse start"): the fixed point of a frequency
+    # subset supplies the start of the full-grid iteration; its history is kept
+    coarse_hist: tuple[float, ...] = ()
+    if coarse is None:
+        coarse = any(cl.system.solver == "direct" for cl in g.lines)
+    idx = _coarse_subset(g) if coarse and x_rest.size else None
+    if idx is not None:
+        gc = _Group([_sliced_line(cl, idx) for cl in g.lines], g.bodies,
+                    {k: _sliced_loads(v, idx) for k, v in g.loads.items()}, rho,
+                    [_sliced_channel(c, idx) for c in g.channels])
+        gc.sizes = g.sizes
+        upd_c = _make_update(gc, method, rho, state, {}, progress, names, None)
+        xc = upd_c(x_rest)
+        hc: tuple[float, ...] = (upd_c.state["change"],)
+        if np.all(np.isfinite(xc)) and hc[0] > lin.tolerance * COARSE_TOLERANCE_FACTOR:
+            try:
+                fc = fixed_point(upd_c, xc, tol=lin.tolerance * COARSE_TOLERANCE_FACTOR,
+                                 max_iterations=lin.max_iterations, allow_unconverged=True,
+                                 name=gname + " (coarse start)", **fixed)
+                xc, hc = fc.x, hc + tuple(fc.history)
+            except ConvergenceError:  # pragma: no cover - allow_unconverged
+                pass
+        if np.all(np.isfinite(xc)):
+            x_rest, coarse_hist = xc, hc
+    update = _make_update(g, method, rho, state, cache, progress, names, timing)
+    n_c = len(coarse_hist)
     x0 = update(x_rest)
     change0 = state["change"]
     if not np.all(np.isfinite(x0)):
-        raise ConvergenceError(gname, 1, float("nan"), lin.tolerance,
+        raise ConvergenceError(gname, n_c + 1, float("nan"), lin.tolerance,
                                hint="the first response gave non-finite σ")
     if change0 <= lin.tolerance or lin.max_iterations == 1 or x0.size == 0:
         fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance or x0.size == 0,
                               (change0,))
         if not fp.converged and not lin.allow_unconverged:
-            raise ConvergenceError(gname, 1, change0, lin.tolerance, hint=hint, partial=fp)
+            raise ConvergenceError(gname, n_c + 1, change0, lin.tolerance, hint=hint,
+                                   partial=fp)
     else:
         try:
             fp = fixed_point(
                 update, x0, tol=lin.tolerance, max_iterations=lin.max_iterations - 1,
-                relaxation=lin.relaxation,
-                method="anderson" if lin.acceleration == "anderson" else "relaxed",
-                mixing=ANDERSON_MIXING, allow_unconverged=lin.allow_unconverged,
-                name=gname,
+                allow_unconverged=lin.allow_unconverged, name=gname, **fixed,
             )
         except ConvergenceError as exc:
-            raise ConvergenceError(gname, exc.iterations + 1, exc.residual, exc.tolerance,
-                                   hint=hint, partial=exc.partial) from None
+            raise ConvergenceError(gname, n_c + exc.iterations + 1, exc.residual,
+                                   exc.tolerance, hint=hint, partial=exc.partial) from None
         fp = FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
                               (change0,) + fp.history)
+    fp = FixedPointResult(fp.x, n_c + fp.iterations, fp.relative_change, fp.converged,
+                          coarse_hist + fp.history)
     if not fp.converged:
         warn(f"{gname} did not converge: relative change {fp.relative_change:.3e} after "
              f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "

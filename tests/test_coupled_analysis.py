@@ -664,3 +664,95 @@ def test_scene_three_leg_example_mirror_symmetry():
     # mirrored legs: statics symmetric to its 1e-10 tolerance, fixed point 1e-4
     assert lines["leg2"].end_b.std == pytest.approx(lines["leg3"].end_b.std, rel=1e-5)
     assert b.motion["heave"].mean == pytest.approx(statics.bodies[name].position[2])
+
+
+# ------------------------------------------------------------------ coarse start
+
+
+@pytest.mark.parametrize("solver", ["direct", "foss"])
+def test_coarse_start_gives_the_full_grid_fixed_point(solver):
+    """The coarse-subset stage only supplies the start: with and without it the
+    iteration ends at the same full-grid fixed point.  Both stop at a relative σ
+    change below tol = 1e-8 with a contraction ≈ 0.1, so each is within ~tol of the
+    fixed point: σ and the outputs agree to 1e-6 (100·tol, margin for the transfer
+    functions' amplification of the σ error)."""
+    from stochcable.coupled_analysis import _coarse_subset, _Group
+
+    body = _buoy()
+    scene, cls, loads = _group(_mooring_doc(count=96, solver=solver, tol=1e-8), body)
+    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    idx = _coarse_subset(g)
+    assert idx is not None and 24 <= idx.size < 0.75 * 96
+    assert idx[-1] == 95 and int(np.argmax(g.weights[:, 0])) in idx  # peak kept
+    full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads,
+                             coarse=False)
+    fast = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads, coarse=True)
+    assert full.converged and fast.converged
+    assert fast.history[-1] <= 1e-8 and len(fast.history) == fast.iterations
+    # the coarse stage ran (its evaluations head the history) and the default uses
+    # it for direct lines only
+    assert fast.iterations > 2 and fast.history[:2] != full.history[:2]
+    auto = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)
+    assert auto.history == (fast.history if solver == "direct" else full.history)
+    for n in ("leg1", "leg2"):
+        sig = full.lines[n].damping.sigma
+        np.testing.assert_allclose(fast.lines[n].damping.sigma, sig, rtol=1e-6,
+                                   atol=1e-9 * sig.max())
+        np.testing.assert_allclose(fast.lines[n].response.support_force,
+                                   full.lines[n].response.support_force, rtol=1e-6,
+                                   atol=1e-6 * np.abs(full.lines[n].response
+                                                      .support_force).max())
+    # the sway σ is round-off (heading 0): absolute tolerance at 1e-9 of the largest
+    np.testing.assert_allclose(fast.body_sigma["buoy"], full.body_sigma["buoy"], rtol=1e-6,
+                               atol=1e-9 * full.body_sigma["buoy"].max())
+    np.testing.assert_allclose(fast.body_motion["buoy"], full.body_motion["buoy"],
+                               rtol=1e-6, atol=1e-6 * np.abs(full.body_motion["buoy"]).max())
+
+
+def test_coarse_subset_skipped_on_small_grids(mooring_direct):
+    """40 frequencies (< COARSE_MIN_FREQUENCIES): no coarse stage."""
+    from stochcable.coupled_analysis import COARSE_MIN_FREQUENCIES, _coarse_subset, _Group
+
+    scene, cls, loads, body, lin = mooring_direct
+    assert cls[0].channels[0].omega.size < COARSE_MIN_FREQUENCIES
+    assert _coarse_subset(_Group(cls, [body], loads, RHO, cls[0].channels)) is None
+
+
+def test_sliced_channel_inputs_equal_the_subset_of_the_full_inputs(mooring_direct):
+    """A channel restricted to a frequency subset gives the full channel's loads at
+    those frequencies (every array sliced along its frequency axis)."""
+    from stochcable.coupled_analysis import _sliced_channel
+
+    scene, cls, loads, body, lin = mooring_direct
+    s = cls[0].system
+    idx = np.array([0, 3, 7, 20, 39])
+    full = _inputs(s, cls[0].channels)
+    sub = _inputs(s, tuple(_sliced_channel(c, idx) for c in cls[0].channels))
+    np.testing.assert_array_equal(sub.omega, full.omega[idx])
+    np.testing.assert_allclose(sub.inertia_load, full.inertia_load[:, :, idx], rtol=1e-13)
+    np.testing.assert_allclose(sub.moments, full.moments[..., idx, :], rtol=1e-13)
+
+
+@pytest.mark.parametrize("modes", [8, "auto"])
+def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
+    """The Foss line solve of the coupled group with the unit end-motion columns in
+    closed form (ω²·M_T U_p − iω·C U_p loads, their static correction as two columns)
+    is the plain analysis._solve_free of the augmented channels: the same linear
+    system, so equal to round-off (1e-10 of the largest entry), truncated (8 of 27
+    modes, static correction on) or not."""
+    from stochcable.analysis import _solve_free, drag_coefficients
+    from stochcable.coupled_analysis import _foss_unit_split, _Group
+
+    body = _buoy()
+    scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
+    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    cl = cls[0]
+    s = cl.system
+    assert s.solver == "foss"
+    assert (s.n_modes < s.model.free.size) == (modes == 8)
+    # a drag of a plausible size: σ = 0.3 m/s on every element
+    damp = drag_coefficients(s, np.full(2 * s.model.n_elements, 0.3), "seed")
+    got, _ = _foss_unit_split(s, g.inp_phys[cl.name], g.inp[cl.name], damp)
+    ref, _ = _solve_free(s, g.inp[cl.name], damp)
+    assert got.shape == ref.shape and got.shape[-1] == 4  # sea + 3 unit columns
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
