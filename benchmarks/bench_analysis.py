@@ -98,8 +98,15 @@ def main() -> None:
         text = ", ".join(f"{k[:-2]} {1e3 * v:.1f} ms ({100 * v / tot:.0f} %)"
                          for k, v in share.items())
         it = res.lines["leg1"].linearization.iterations
+        coarse = []  # the coarse start's evaluations are reported through progress
+
+        def count(stage, info):
+            if stage == "linearization" and info.get("coarse_iteration"):
+                coarse.append(info["coarse_iteration"])
+
+        analyze(load_scene(d), progress=count)
         print(f"{name:<22}{1e3 * med:>10.1f}{1e3 * mn:>9.1f}{1e3 * cpu:>9.1f}  {text}; "
-              f"{it} iterations")
+              f"{it} full-grid + {len(coarse)} coarse iterations")
 
     print("\n== error versus setting ==")
     print("ref A: 320 el, direct, the example's grid (200 ω on [0.05, 2]) — isolates "

@@ -1,0 +1,162 @@
+"""The coarse start of the drag linearization (stochcable.analysis, "Coarse start"):
+the frequency-subset fixed point only supplies the start, the answer is the full-grid
+fixed point; narrow resonances are kept at full resolution; the subset quadrature; the
+single-BLAS-thread limit in worker threads."""
+
+from __future__ import annotations
+
+import json
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stochcable.analysis as an
+from stochcable.excitation import line_channels
+from stochcable.scene import load_scene
+from stochcable.statics import solve_statics
+
+EXAMPLE = Path(an.__file__).resolve().parent / "examples" / "chain_catenary.json"
+
+
+def _chain(**env) -> tuple:
+    doc = json.loads(EXAMPLE.read_text())
+    doc["analysis"].pop("timeseries", None)
+    doc["environment"].update(env)
+    scene = load_scene(doc)
+    line = scene.lines[0]
+    st = solve_statics(scene, method="fe")
+    system = an.build_line_system(scene, line, st.lines[line.name])
+    omega = scene.analysis.omega.values()
+    return scene, system, line_channels(scene, line, system.positions, omega)
+
+
+@pytest.fixture(scope="module")
+def chain():
+    return _chain()
+
+
+def _sigma(lin) -> np.ndarray:
+    return np.r_[lin.record.sigma_normal, lin.record.sigma_axial]
+
+
+def _tight(scene):
+    lin = scene.analysis.linearization.model_copy(update={"tolerance": 1e-10})
+    return scene.analysis.model_copy(update={"linearization": lin})
+
+
+@pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning")  # the cut tail
+def test_coarse_start_converges_to_the_full_grid_fixed_point(chain):
+    scene, system, ch = chain
+    coarse = an.linearize(system, ch, scene.analysis)
+    full = an.linearize(system, ch, scene.analysis, coarse=False)
+    ref = an.linearize(system, ch, _tight(scene), coarse=False)
+    tol = scene.analysis.linearization.tolerance
+    # the coarse stage ran on a real subset and is recorded apart from the record
+    assert coarse.coarse is not None and full.coarse is None
+    assert coarse.coarse.frequencies <= an.COARSE_MAX_FRACTION * ch[0].omega.size
+    assert coarse.coarse.converged and coarse.coarse.iterations == len(coarse.coarse.history)
+    # the record: full-grid evaluations only, the usual test passed on the full grid
+    rec = coarse.record
+    assert rec.converged and rec.iterations == len(rec.history) >= 1
+    assert rec.history[-1] == rec.relative_change <= tol
+    assert rec.iterations < full.record.iterations  # the point of the coarse start
+    # same fixed point: both within the tolerance of the tight one (the map
+    # contracts by <= 0.5 per step here, so the distance is <= 2 tol; round-off aside)
+    s_ref = _sigma(ref)
+    for lin in (coarse, full):
+        assert np.max(np.abs(_sigma(lin) / s_ref - 1)) < 2 * tol
+    # the outputs: end tension σ (the benchmark quantities) within 1e-4 relative
+    out_c = an.line_result(system, ch, coarse, scene.analysis)
+    out_f = an.line_result(system, ch, full, scene.analysis)
+    for end in ("end_a", "end_b"):
+        a, b = getattr(out_c, end).std, getattr(out_f, end).std
+        assert abs(a / b - 1) < 1e-4
+
+
+def test_small_grid_has_no_coarse_stage(chain):
+    scene, system, ch = chain
+    w = ch[0].omega[::4]  # 50 frequencies < COARSE_MIN_FREQUENCIES
+    assert w.size < an.COARSE_MIN_FREQUENCIES
+    sub = line_channels(scene, system.line, system.positions, w)
+    lin = an.linearize(system, sub, scene.analysis)
+    assert lin.coarse is None
+    assert lin.record.iterations == an.linearize(system, sub, scene.analysis,
+                                                 coarse=False).record.iterations
+
+
+def test_interpolatory_weights_integrate_cubics_as_the_full_grid():
+    # a log grid and a subset with an irregular dense patch: the weights must give the
+    # full grid's trapezoid sum of any cubic exactly (interpolation of a cubic by a
+    # 4-point Lagrange stencil is exact), and not of a quartic (the test can fail)
+    w = np.geomspace(0.05, 3.0, 157)
+    idx = np.unique(np.r_[np.arange(0, 157, 4), 156, np.arange(60, 75)])
+    q = an._trapezoid_weights(w)
+    wts = an._interpolatory_weights(w, idx)
+    for f in (np.ones_like, lambda x: x, lambda x: 2 - x**2, lambda x: x**3 - x):
+        assert wts @ f(w[idx]) == pytest.approx(q @ f(w), rel=1e-12, abs=1e-12)
+    quartic = (w - 1.0) ** 4
+    assert abs(wts @ quartic[idx] - q @ quartic) > 1e-8
+    # against the subset's own trapezoid rule on a smooth spectrum-like integrand
+    f = w**-5 * np.exp(-1.25 * (0.6 / w) ** 4) * 1e2
+    trap = an._trapezoid_weights(w[idx]) @ f[idx]
+    assert abs(wts @ f[idx] / (q @ f) - 1) < 0.1 * abs(trap / (q @ f) - 1)
+
+
+def test_narrow_resonance_is_not_missed_by_the_coarse_subset():
+    # no current and no seabed dashpots: with 3 % of the converged drag the in-band
+    # modes (0.84, 1.23, 1.74 rad/s) have half-power bandwidths of ~0.013 rad/s, below
+    # two coarse spacings (0.078 rad/s)
+    scene, system, ch = _chain(current=[], seabed={"stiffness": 3e6, "damping": 0.0})
+    lin = an.linearize(system, ch, scene.analysis, coarse=False)
+    weak = an.drag_coefficients(system, 0.03 * lin.damping.sigma, "seed")
+    inp = an._inputs(system, ch)
+    w = inp.omega
+    idx = an._coarse_subset(system, inp, weak)
+    assert idx is not None
+    wn = system.modes.omega
+    for wj in wn[(wn > w[0]) & (wn < w[-1])]:
+        k = int(np.argmin(np.abs(w - wj)))
+        window = np.arange(k - an.COARSE_STEP, k + an.COARSE_STEP + 1)
+        assert np.isin(window, idx).all()  # full resolution around the resonance
+    u, _ = an._solve_free(system, inp, weak)
+    full = an._sigmas_free(system, inp, u, "seed")
+
+    def err(sel: np.ndarray) -> float:
+        sub = an._subset_inputs(system, ch, inp, sel)
+        s = an._sigmas_free(system, sub, np.ascontiguousarray(u[:, :, sel]), "seed")
+        return float(np.max(np.abs(s - full)) / np.max(full))
+
+    # the uniform subset misses the peaks (tens of %), the windowed one does not
+    # (measured 0.6 %: the tails between the coarse points remain)
+    assert err(an._uniform_subset(w.size)) > 0.1
+    assert err(idx) < 0.02
+    # and the linearization of that line still ends at the full-grid fixed point
+    c = an.linearize(system, ch, scene.analysis)
+    f = an.linearize(system, ch, scene.analysis, coarse=False)
+    tol = scene.analysis.linearization.tolerance
+    assert np.max(np.abs(_sigma(c) / _sigma(f) - 1)) < 4 * tol  # each within 2 tol
+
+
+def test_single_blas_thread_applies_in_worker_threads():
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+
+    def blas_threads() -> list[int]:
+        return [d["num_threads"] for d in threadpoolctl.threadpool_info()
+                if d["user_api"] == "blas"]
+
+    before = blas_threads()
+    seen: dict[str, list[int]] = {}
+    with an._single_blas_thread():  # the main thread first (it used to keep control)
+        seen["main"] = blas_threads()
+
+    def work() -> None:
+        with an._single_blas_thread():
+            seen["worker"] = blas_threads()
+
+    t = threading.Thread(target=work)
+    t.start()
+    t.join()
+    assert all(n == 1 for n in seen["main"]) and all(n == 1 for n in seen["worker"])
+    assert blas_threads() == before  # restored
