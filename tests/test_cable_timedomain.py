@@ -9,7 +9,6 @@ synthesized series of the same realization).
 
 from __future__ import annotations
 
-import re
 import warnings
 
 import math
@@ -440,36 +439,30 @@ def test_stationarity_ratio_of_stationary_and_diverged_records():
     assert w_dom == pytest.approx(18.9, abs=bin_)
 
 
-def test_diverged_snap_record_is_reported():
-    """tuah_1982_single_leg on its 3-element mesh at Δt = 0.125 s (the automatic step):
-    the line goes slack and taut at every wave crest and in some seeds the two inner
-    nodes start to rattle axially at ≈ 18.9 rad/s (ωΔt = 2.36: the average-acceleration
-    scheme pumps this under-resolved oscillation at the slack/taut switches); the
-    fairlead tension σ then jumps from ≈ 360 lbf to ≈ 1e4 lbf.  Which seeds blow up is
-    chaotic — it changed from seeds 3, 6, 8 to seed 4 of 1–8 when the sea kernel's last
-    bits changed — so the test takes the first seed of 1–8 that does (3/8 and 1/8 seen)
-    and checks the warning, the frequency and that Δt/4 cures it.  About 4–15 s."""
+def test_nonstationary_record_warning_is_wired(monkeypatch):
+    """tuah_1982_single_leg on its 3-element mesh at Δt = 0.125 s (the automatic step)
+    goes slack and taut at every wave crest.  In some seeds the two inner nodes then
+    start to rattle axially at ≈ 18.9 rad/s (ωΔt = 2.36: the average-acceleration
+    scheme pumps this under-resolved oscillation at the slack/taut switches) and the
+    fairlead tension σ jumps from ≈ 360 to ≈ 1e4 lbf (ratio 37–52).  Which seeds blow
+    up is chaotic: seeds 3, 6, 8 of 1–8 at one commit, seed 4 at the next, none after
+    a 1e-10 change of the statics — so no seed is pinned here.  The detector itself is
+    tested on synthetic records above; this test checks that a real run applies it:
+    the warning fires exactly when the window ratio passes the threshold (lowered
+    below the measured ratio of a stationary run), with the dominant frequency and the
+    step advice.  About 3 s."""
+    import stochcable.cable_timedomain as ctd
     from stochcable.examples import load_example
 
     scene = load_example("tuah_1982_single_leg")
-    for seed in range(1, 9):
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            h = simulate_line_timedomain(scene, duration=600.0, seed=seed,
-                                         band=(0.0245, 9.8))
-        flagged = [str(w.message) for w in caught
-                   if issubclass(w.category, ResolutionWarning) and "not stationary" in str(w.message)]
-        ratio = h.stationarity_ratio()[0]
-        # the warning fires exactly when the ratio passes the threshold
-        assert bool(flagged) == (ratio > 8.0)
-        if flagged:
-            break
-    else:
-        pytest.fail("no seed of 1-8 blew up at dt = 0.125 s: the snap case lost its point")
-    assert re.search(r"not stationary.*1[89]\.\d+ rad/s.*rerun with dt", flagged[0])
-    assert h.dt == pytest.approx(0.125)
-    assert np.all(np.isfinite(h.tension_b))
-    # the same seed at a quarter of the step stays stationary
-    fine = simulate_line_timedomain(scene, duration=600.0, seed=seed, band=(0.0245, 9.8),
-                                    dt=0.125 / 4)
-    assert fine.stationarity_ratio()[0] < 8.0
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        h = simulate_line_timedomain(scene, duration=600.0, seed=1, band=(0.0245, 9.8))
+    ratio = h.stationarity_ratio()[0]
+    flagged = [w for w in caught if "not stationary" in str(w.message)]
+    # seed 1 measures 1.4-1.5: stationary, so no warning at the real threshold
+    assert ratio < ctd.NONSTATIONARY_RATIO and not flagged
+    monkeypatch.setattr(ctd, "NONSTATIONARY_RATIO", 0.9 * ratio)
+    with pytest.warns(ResolutionWarning,
+                      match=r"not stationary.*\d rad/s \(omega dt = .*rerun with dt <="):
+        simulate_line_timedomain(scene, duration=600.0, seed=1, band=(0.0245, 9.8))

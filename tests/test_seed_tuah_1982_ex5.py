@@ -133,11 +133,13 @@ def test_seed_dsa_realization_has_the_expected_spectrum(result):
 
 def test_seed_drag_linearization_converges_within_eight_iterations(result):
     """SEED_ITERATIONS: tolerance 0.01, the seed needed eight (plain) iterations; the
-    Anderson-accelerated fixed point needs no more."""
+    Anderson-accelerated fixed point needs no more.  The record counts full-grid
+    evaluations only: since the coarse-grid start (analysis.linearize, coarse=True)
+    supplies the starting σ, one full-grid evaluation may already pass the test."""
     rec = result.lines["leg"].linearization
     assert rec.converged
     assert rec.tolerance == TUAH_1982_EX5["drag_tolerance"]
-    assert 2 <= rec.iterations <= TUAH_1982_EX5["drag_iterations"]
+    assert 1 <= rec.iterations <= TUAH_1982_EX5["drag_iterations"]
     assert rec.relative_change < rec.tolerance
 
 
