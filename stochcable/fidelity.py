@@ -447,14 +447,25 @@ def _input_band(scene: Scene, fraction: float) -> tuple[float, float, dict[str, 
 # ------------------------------------------------------------------------- meshing
 
 
+@dataclass(frozen=True, eq=False)
+class _LineGeometry:
+    """Static geometry of one line for the element rules: per segment a dict (length,
+    ⟨1/c²⟩, suspended lengths, arc-length interval, touchdown), and the nodes' arc
+    length and z (for the wave-load rule). [m]"""
+
+    segments: list[dict[str, Any]]
+    s_nodes: np.ndarray
+    z_nodes: np.ndarray
+
+
 def _segment_geometry(scene: Scene, statics: Any,
                       touchdown: dict[str, float | None] | None = None
-                      ) -> dict[str, list[dict[str, Any]]]:
+                      ) -> dict[str, _LineGeometry]:
     """Per line and segment: length, ⟨1/c²⟩ over the suspended part, suspended length,
     arc-length interval, node z (for the wave-load rule) and the static touchdown
     (``touchdown`` overrides the statics' own, e.g. from a finer model)."""
     rho = scene.environment.rho
-    out: dict[str, list[dict[str, Any]]] = {}
+    out: dict[str, _LineGeometry] = {}
     for line in scene.lines:
         st = statics.lines[line.name]
         s_td = (touchdown or {}).get(line.name, st.touchdown)
@@ -482,8 +493,7 @@ def _segment_geometry(scene: Scene, statics: Any,
                          "grounded_any": bool(np.any(grounded_el[sel])),
                          "touchdown": s_td})
             s_start += seg.length
-        out[line.name] = segs
-        out[line.name + "\0nodes"] = [(mesh.s0, st.positions[:, 2])]  # type: ignore[list-item]
+        out[line.name] = _LineGeometry(segs, np.asarray(mesh.s0), st.positions[:, 2].copy())
     return out
 
 
@@ -531,7 +541,7 @@ def static_touchdowns(scene: Scene | Any) -> dict[str, float | None]:
     return out
 
 
-def _mesh_rules(scene: Scene, geo: dict, w2: float, wmax: float, eps_el: float,
+def _mesh_rules(scene: Scene, geo: dict[str, _LineGeometry], w2: float, wmax: float, eps_el: float,
                 k_load: float | None, exact: bool
                 ) -> tuple[dict[str, tuple[tuple[int, float, int], ...]], list[Choice], float]:
     """Segments (source, length, elements) per line by the element rules."""
@@ -544,8 +554,8 @@ def _mesh_rules(scene: Scene, geo: dict, w2: float, wmax: float, eps_el: float,
     z_load = (math.log(1.0 / eps_el) / k_load) if k_load else 0.0
     dz_load = math.sqrt(12.0 * eps_el / 2.0) / k_load if k_load else math.inf
     for line in scene.lines:
-        segs = geo[line.name]
-        s_nodes, z_nodes = geo[line.name + "\0nodes"][0]
+        segs = geo[line.name].segments
+        s_nodes, z_nodes = geo[line.name].s_nodes, geo[line.name].z_nodes
         new: list[tuple[int, float, int]] = []
         for i, (seg, g) in enumerate(zip(line.segments, segs)):
             path = f"lines[{line.name}].segments[{i}].elements"
@@ -685,7 +695,7 @@ def _modal_bandwidths(line_result: Any, scene: Scene) -> tuple[np.ndarray, np.nd
     return wn, np.maximum(band, 0.0)
 
 
-def _pilot(scene: Scene, statics: Any, geo: dict, w_lo: float, w_top: float,
+def _pilot(scene: Scene, statics: Any, geo: dict[str, _LineGeometry], w_lo: float, w_top: float,
            w2_guess: float, k_load: float | None, exact: bool) -> tuple[Any, dict, float]:
     from .analysis import analyze
 
