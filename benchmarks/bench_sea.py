@@ -1,6 +1,9 @@
 """Benchmark: 2^20-sample DSA sea realization and the dispersion relation.
 
-Run: ``python benchmarks/bench_sea.py``.  Prints the median and the minimum over repeated
+Run: ``python benchmarks/bench_sea.py [--tune]``.  ``--tune`` first measures the
+2^20-point FFTW plans and saves them as wisdom (``stochcable._fft.tune``, 15–35 s; the
+file is ``stochcable._fft.wisdom_path()``, set ``STOCHCABLE_FFTW_WISDOM`` to choose it or
+to an empty value to run without wisdom).  Prints the median and the minimum over repeated
 runs (timeit style: each sample is one call, wall clock), with pyfftw and with the
 numpy.fft fallback, the load average before and after, and the minor page faults of one
 realization in the steady state (result dropped, as in the timing loop) and when the
@@ -14,6 +17,7 @@ from __future__ import annotations
 
 import os
 import platform
+import sys
 import resource
 import statistics
 import time
@@ -58,6 +62,13 @@ def main() -> None:
           f"python {platform.python_version()}, numpy {np.__version__}")
     print("load average before: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     print(f"OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY')}")
+    if "--tune" in sys.argv[1:]:
+        t0 = time.perf_counter()
+        _fft.tune(n_t)
+        print(f"FFTW plans of 2^20 points measured in {time.perf_counter() - t0:.1f} s")
+    wis = _fft.wisdom_path()
+    print("FFTW wisdom: " + ("off" if wis is None else
+                             f"{wis} ({'present' if os.path.exists(wis) else 'none'})"))
 
     def pm(w):
         return spectrum_pierson_moskowitz(w, 6.0, 10.0)

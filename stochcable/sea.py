@@ -22,6 +22,7 @@ DSA and NSA realizations with the same seed therefore share their phases.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import os
@@ -54,6 +55,8 @@ _TABLE_SIZE = 1 << _TABLE_BITS
 _TABLE = -np.exp(2j * np.pi * np.arange(_TABLE_SIZE) / _TABLE_SIZE)   # −e^{2πij/2^13}
 _CHUNK = 32768
 _PARALLEL_MIN = 2**16
+_SPECTRUM_PIECES = 8
+_GRID_CACHE_SIZE = 4
 _pool = None
 _pool_lock = threading.Lock()
 
@@ -111,6 +114,18 @@ def _sample_count(duration: float, dt: float) -> int:
 def _readonly(a: np.ndarray) -> np.ndarray:
     a.setflags(write=False)
     return a
+
+
+@functools.lru_cache(maxsize=_GRID_CACHE_SIZE)
+def _grid(n: int, d_omega: float) -> np.ndarray:
+    """Read-only ω_m = mΔω, m = 0 … n, shared by the realizations on that grid.
+
+    Cached (the last few (n, Δω)): building and first touching a 2^19-point grid costs
+    0.2–0.5 ms per call; the array is read-only, so realizations may share it.
+    """
+    omega = np.arange(n + 1, dtype=np.float64)
+    omega *= d_omega
+    return _readonly(omega)
 
 
 @dataclass(frozen=True, eq=False)
@@ -195,6 +210,35 @@ def _resolve_rng(rng) -> tuple[np.random.Generator, int | None]:  # noqa: ANN001
 
 
 _scratch = threading.local()
+_WORK_POOL_BYTES = 64 * 2**20
+_work_pool: list[tuple[tuple[int, str], tuple[np.ndarray, np.ndarray, np.ndarray]]] = []
+_work_lock = threading.Lock()
+
+
+def _work_arrays(n_t: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Work arrays of one call: draws u (N−1), S on the grid (N+1), FFT input (N+1).
+
+    None of them is part of a result (the FFT destroys its input), so :func:`_give_back`
+    keeps them for the next call of the same size: 2^20 samples would otherwise
+    page-fault 16 MiB of fresh memory in, call after call.  A call owns its set until
+    it gives it back; concurrent calls get different sets.
+    """
+    key = (n_t, _fft.backend())          # the FFT input must suit the backend's alignment
+    with _work_lock:
+        for i in range(len(_work_pool) - 1, -1, -1):
+            if _work_pool[i][0] == key:
+                return _work_pool.pop(i)[1]
+    n = n_t // 2
+    return np.empty(n - 1), np.empty(n + 1), _fft.irfft_input(n_t)
+
+
+def _give_back(n_t: int, arrays: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
+    """Keep a call's work arrays for reuse (the 8 most recent sets, ≤ 64 MiB in all)."""
+    with _work_lock:
+        _work_pool.append(((n_t, _fft.backend()), arrays))
+        while (len(_work_pool) > 8
+               or sum(a.nbytes for _, arrs in _work_pool for a in arrs) > _WORK_POOL_BYTES):
+            _work_pool.pop(0)
 
 
 def _buffers(size: int) -> list[np.ndarray]:
@@ -240,28 +284,35 @@ def _phasor_chunk(u: np.ndarray, s: np.ndarray, c2: float, out: np.ndarray,
     c_ += 1.0
     c_ *= x_
     np.multiply(c_, amp, out=ev[1::2])
-    np.take(_TABLE, j_, out=t)
+    np.take(_TABLE, j_, out=t, mode="wrap")   # 0 <= j < 8192: no wrap; "wrap" skips the checks
     np.multiply(t, e, out=out)
     np.multiply(out.view(np.float64), scale, out=fft_in.view(np.float64))
 
 
 class _Synthesis:
-    """Draws, coefficients and FFT input of one realization, shared by two threads.
+    """Draws, spectrum, coefficients and FFT input of one realization, on two threads.
 
     A pool thread makes the random draws (in the documented order) while the caller's
-    thread evaluates the spectrum; then both take chunks of the coefficient kernel
+    thread evaluates the spectrum on pieces of the grid; once the helper has drawn, it
+    takes the remaining pieces too.  Then both take chunks of the coefficient kernel
     (amplitudes, phasors, FFT input) from a shared counter.  The helper waits (without
     holding the GIL) rather than starting on the kernel early: many short kernel calls
     would make the caller's large spectrum operations queue for the GIL.  Chunk
     boundaries are fixed multiples of _CHUNK and every entry gets the same operations
-    whichever thread computes it, so the result does not depend on the split.
+    whichever thread computes it, so the result does not depend on the split; the
+    density is a pointwise function of ω, so its pieces give the values of one call
+    (a density that does not return one value per ω of a piece, or raises, is called
+    again on the whole grid by the caller, which then reports the error).
     """
 
     def __init__(self, gen: np.random.Generator, lines: int, nsa: bool,
-                 coeff: np.ndarray, fft_in: np.ndarray, scale: float) -> None:
+                 coeff: np.ndarray, fft_in: np.ndarray, scale: float,
+                 density: Callable | None = None, omega: np.ndarray | None = None,
+                 pieces: int = 1, u: np.ndarray | None = None,
+                 s_grid: np.ndarray | None = None) -> None:
         self.gen, self.lines, self.nsa = gen, lines, nsa
         self.coeff, self.fft_in, self.scale = coeff, fft_in, scale
-        self.u = np.empty(lines)
+        self.u = np.empty(lines) if u is None else u
         self.gain: np.ndarray | None = None      # NSA: √(α² + β²)
         self.s: np.ndarray | None = None         # S(ω_m), m = 1 … N−1
         self.c2 = 0.0                            # a_m N_t/2 = √(c2 S(ω_m))
@@ -272,6 +323,46 @@ class _Synthesis:
         self._state = gen.bit_generator.state
         self.cancelled = False
         self.ready = threading.Event()           # set once s and c2 are final
+        # S(ω) on the whole grid, evaluated piece by piece (see spectrum())
+        self.density, self.omega = density, omega
+        size = 0 if density is None or omega is None else omega.shape[0]
+        self.s_grid = np.empty(size) if s_grid is None or s_grid.shape[0] != size else s_grid
+        self.piece_edges = [size * k // pieces for k in range(pieces + 1)] if size else [0]
+        self._next_piece = itertools.count()
+        self._pieces_done = 0
+        self.piece_failed = False
+        self.s_ready = threading.Event()         # set once every piece is done
+        self._piece_lock = threading.Lock()
+        self.errstate = np.geterr()              # the caller's floating-point error modes
+
+    def spectrum(self) -> None:
+        """Evaluate S on grid pieces from a shared counter until none is left.
+
+        Each piece is written into ``s_grid``; a failure (an exception, a wrong shape)
+        only sets ``piece_failed``: the caller then evaluates S on the whole grid itself.
+        """
+        edges = self.piece_edges
+        last = len(edges) - 1
+        with np.errstate(**self.errstate):
+            while True:
+                i = next(self._next_piece)
+                if i >= last:
+                    return
+                try:
+                    if not (self.piece_failed or self.cancelled):
+                        a, b = edges[i], edges[i + 1]
+                        si = np.asarray(self.density(self.omega[a:b]), dtype=float)
+                        if si.shape == (b - a,):
+                            self.s_grid[a:b] = si
+                        else:
+                            self.piece_failed = True
+                except Exception:  # noqa: BLE001 - reported by the caller's full call
+                    self.piece_failed = True
+                finally:
+                    with self._piece_lock:
+                        self._pieces_done += 1
+                        if self._pieces_done == last:
+                            self.s_ready.set()
 
     def draw(self) -> None:
         """All random draws, once, by whichever thread gets here first."""
@@ -300,8 +391,9 @@ class _Synthesis:
         self.ready.set()
 
     def work(self) -> None:
-        """Draw (if nobody has), wait for the spectrum, then take chunks until none is left."""
+        """Draw (if nobody has), help with S, wait for it, then take chunks until none is left."""
         self.draw()
+        self.spectrum()
         self.ready.wait()
         edges, coeff, u, s, c2 = self.edges, self.coeff, self.u, self.s, self.c2
         gain, fft_in, scale = self.gain, self.fft_in, self.scale
@@ -366,8 +458,10 @@ def simulate_sea(
     Parameters
     ----------
     density : callable
-        One-sided spectrum ω → S(ω), vectorized over a 1-D array, e.g.
-        ``lambda w: spectrum_jonswap(w, 6.0, 10.0)``. [m²·s/rad]
+        One-sided spectrum ω → S(ω), a pointwise function vectorized over a 1-D
+        (read-only) array, e.g. ``lambda w: spectrum_jonswap(w, 6.0, 10.0)``; for
+        2^16 lines or more it is called on pieces of the grid from two threads, so it
+        must be thread-safe (numpy functions are). [m²·s/rad]
     duration : float
         Record length T_L (= the period of the realization). [s]
     dt : float
@@ -394,9 +488,14 @@ def simulate_sea(
     5.1.3a,b are the two-sided magnitudes, half of a_m): DSA a_m = √(2SΔω),
     NSA a_m = √(SΔω)√(α²+β²); X_m = (N_t/2) a_m e^{−iθ_m}; η = irfft(X, N_t).
     The order of the random draws is given in the module docstring.  For 2^16 lines or
-    more, a module pool thread makes the draws while S is evaluated and shares the
-    coefficient kernel; the result is the same bits whatever the split (and with one
-    CPU).  ``SeaRealization.m0`` is the target Σ_{m=1}^{N−1} S(ω_m)Δω.
+    more, a module pool thread makes the draws while the caller evaluates S on pieces
+    of the grid, takes the remaining pieces, and shares the coefficient kernel; the
+    result is the same bits whatever the split (and with one CPU, where S is one call
+    on the whole grid).  A density that does not return one value per ω of a piece,
+    or raises on one, is called again on the whole grid by the caller thread (its
+    errors are reported from there).  The grid ω is cached per (N, Δω) and read-only:
+    realizations on one grid share it.  ``SeaRealization.m0`` is the target
+    Σ_{m=1}^{N−1} S(ω_m)Δω.
     """
     if not callable(density):
         raise InputError("density", density, "m²·s/rad", "must be a callable omega -> S(omega)")
@@ -410,17 +509,27 @@ def simulate_sea(
     dt_eff = float(duration) / n_t
     nsa = method_l == "nsa"
     coeff = np.empty(n + 1, dtype=np.complex128)
-    fft_in = _fft.irfft_input(n_t)           # the FFT's work array (destroyed by it)
+    work = _work_arrays(n_t)
+    u, s_work, fft_in = work                 # fft_in: the FFT's work array (destroyed by it)
     coeff[0] = coeff[n] = fft_in[0] = fft_in[n] = 0.0
     # X_m/N_t goes into the FFT input (exact for N_t = 2^k), so the FFT output is η
-    job = _Synthesis(gen, n - 1, nsa, coeff[1:n], fft_in[1:n], 1.0 / n_t)
+    omega = _grid(n, d_omega)
+    parallel = n - 1 >= _PARALLEL_MIN and (os.cpu_count() or 1) >= 2
+    job = _Synthesis(gen, n - 1, nsa, coeff[1:n], fft_in[1:n], 1.0 / n_t,
+                     density if parallel else None, omega, _SPECTRUM_PIECES, u, s_work)
     helper = None
-    if n - 1 >= _PARALLEL_MIN and (os.cpu_count() or 1) >= 2:
-        helper = _executor().submit(job.work)   # the draws meanwhile, then kernel chunks
+    if parallel:
+        # the draws meanwhile, then pieces of S, then kernel chunks
+        helper = _executor().submit(job.work)
     try:
-        omega = np.arange(n + 1, dtype=np.float64)
-        omega *= d_omega
-        s = np.asarray(density(omega), dtype=float)
+        s = None
+        if parallel:
+            job.spectrum()
+            job.s_ready.wait()
+            if not job.piece_failed:
+                s = job.s_grid
+        if s is None:
+            s = np.asarray(density(omega), dtype=float)
         if s.shape != omega.shape:
             raise InputError("density", density, "m²·s/rad",
                              f"must return an array of shape {omega.shape}, got {s.shape}")
@@ -451,9 +560,10 @@ def simulate_sea(
     if helper is not None and not helper.cancel():
         helper.result()
     elevation = _fft.irfft_overwrite(fft_in, n_t)
+    _give_back(n_t, work)
     return SeaRealization(
         elevation=_readonly(elevation),
-        omega=_readonly(omega),
+        omega=omega,
         coefficients=_readonly(coeff),
         d_omega=d_omega,
         dt=dt_eff,

@@ -449,3 +449,193 @@ def test_concurrent_realizations_equal_sequential_ones():
     c0 = a.coefficients.copy()
     sea.simulate_sea(density, duration, dt, "dsa", 1)
     np.testing.assert_array_equal(a.coefficients, c0)
+
+
+# --- spectrum evaluated on grid pieces by two threads (issue 2) -------------------------
+
+def _jonswap_density(w):
+    return spectrum_jonswap(w, 6.0, 10.0, 3.3)
+
+
+@pytest.mark.parametrize("density", [pm, _jonswap_density, _rational_density])
+def test_spectrum_pieces_give_the_bits_of_one_call(monkeypatch, density):
+    # 2^18 samples: S is evaluated on 8 pieces of the grid, shared by the caller and a
+    # pool thread; with one CPU it is one call on the whole grid.  A pointwise density
+    # (np.exp's SIMD lanes included) must give the same coefficients bit for bit.
+    duration, dt = 2**18 * 0.1, 0.1
+    a = sea.simulate_sea(density, duration, dt, "dsa", 31)
+    monkeypatch.setattr(sea.os, "cpu_count", lambda: 1)
+    b = sea.simulate_sea(density, duration, dt, "dsa", 31)
+    np.testing.assert_array_equal(a.coefficients, b.coefficients)
+    np.testing.assert_array_equal(a.elevation, b.elevation)
+    assert a.m0 == b.m0
+
+
+def test_spectrum_pieces_fall_back_to_one_call():
+    # a callable that ignores its argument (returns the whole-grid array) does not give
+    # one value per ω of a piece: the caller evaluates it once on the whole grid
+    duration, dt = 2**18 * 0.1, 0.1
+    omega, _ = sea.frequency_grid(duration, dt)
+    full = _rational_density(omega)
+    calls = []
+
+    def cached(w):
+        calls.append(w.shape[0])
+        return full
+
+    a = sea.simulate_sea(cached, duration, dt, "dsa", 4)
+    b = sea.simulate_sea(_rational_density, duration, dt, "dsa", 4)
+    np.testing.assert_array_equal(a.coefficients, b.coefficients)
+    assert omega.size in calls                       # the whole-grid call happened
+    # a wrong shape is reported for the whole grid, as without pieces
+    with pytest.raises(InputError,
+                       match=rf"must return an array of shape \({omega.size},\), got \(3,\)"):
+        sea.simulate_sea(lambda w: np.ones(3), duration, dt, rng=4)
+
+
+def test_spectrum_piece_error_is_raised_by_the_caller():
+    # a density that raises on the upper frequencies (pieces the pool thread may take):
+    # the error reaches the caller, and a caller's Generator is left untouched
+    duration, dt = 2**18 * 0.1, 0.1
+    limit = 0.9 * math.pi / dt
+
+    def picky(w):
+        if w.size and w.max() > limit:
+            raise InputError("omega", float(w.max()), "rad/s", f"must be <= {limit:g}")
+        return _rational_density(w)
+
+    gen = np.random.default_rng(8)
+    before = gen.bit_generator.state
+    with pytest.raises(InputError, match=r"omega = 31\.4\d* \[rad/s\]: must be <= 28\.27"):
+        sea.simulate_sea(picky, duration, dt, rng=gen)
+    assert gen.bit_generator.state == before
+
+
+def test_spectrum_pieces_use_the_callers_floating_point_modes():
+    # np.errstate is per thread: a piece computed on a pool thread must follow the
+    # caller's modes (here divide="raise": the piece fails, the caller's call raises)
+    omega = sea._grid(2**17, 0.01)
+
+    def dens(w):
+        return 1.0 / w        # 1/0 at ω = 0
+
+    with np.errstate(divide="raise"):
+        job = sea._Synthesis(np.random.default_rng(0), 2**17 - 1, False,
+                             np.empty(2**17 - 1, complex), np.empty(2**17 - 1, complex), 1.0,
+                             dens, omega, 4)
+    with np.errstate(divide="ignore"):      # this thread's modes must not matter
+        t = threading.Thread(target=job.spectrum)
+        t.start()
+        t.join()
+    assert job.s_ready.is_set() and job.piece_failed
+    with np.errstate(divide="ignore"):
+        job = sea._Synthesis(np.random.default_rng(0), 2**17 - 1, False,
+                             np.empty(2**17 - 1, complex), np.empty(2**17 - 1, complex), 1.0,
+                             dens, omega, 4)
+    with np.errstate(divide="raise"):
+        t = threading.Thread(target=job.spectrum)
+        t.start()
+        t.join()
+    assert job.s_ready.is_set() and not job.piece_failed
+    np.testing.assert_array_equal(job.s_grid[1:], 1.0 / omega[1:])
+
+
+def test_grid_is_shared_read_only_and_exact():
+    # the ω grid is cached per (N, Δω): realizations on one grid share one read-only
+    # array with the values of frequency_grid
+    a = sea.simulate_sea(pm, 2**17 * 0.1, 0.1, rng=1)
+    b = sea.simulate_sea(pm, 2**17 * 0.1, 0.1, "nsa", rng=2)
+    assert a.omega is b.omega and not a.omega.flags.writeable
+    np.testing.assert_array_equal(a.omega, sea.frequency_grid(2**17 * 0.1, 0.1)[0])
+    with pytest.raises(ValueError, match="read-only"):
+        sea.simulate_sea(lambda w: w.__imul__(0.0), 64.0, 0.5, rng=1)
+
+
+# --- FFTW wisdom (_fft.tune, wisdom_path) ------------------------------------------------
+
+@pytest.fixture
+def fresh_fft_state(monkeypatch, tmp_path):
+    """Plans and wisdom of this test only (file under tmp_path, nothing in ~/.cache)."""
+    path = tmp_path / "cache" / "fftw_wisdom.txt"
+    monkeypatch.setenv("STOCHCABLE_FFTW_WISDOM", str(path))
+    monkeypatch.setattr(_fft, "_wisdom_loaded", False)
+    _fft.clear_cache()
+    yield path
+    _fft.clear_cache()
+
+
+def test_wisdom_path_from_environment(monkeypatch, tmp_path):
+    monkeypatch.setenv("STOCHCABLE_FFTW_WISDOM", str(tmp_path / "w.txt"))
+    assert _fft.wisdom_path() == str(tmp_path / "w.txt")
+    monkeypatch.setenv("STOCHCABLE_FFTW_WISDOM", "")
+    assert _fft.wisdom_path() is None                      # switched off
+    monkeypatch.delenv("STOCHCABLE_FFTW_WISDOM")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert _fft.wisdom_path() == str(tmp_path / "stochcable" / "fftw_wisdom.txt")
+
+
+def test_tune_writes_wisdom_and_measured_plans_agree(fresh_fft_state):
+    n = 4096
+    rng = np.random.default_rng(3)
+    x = rng.standard_normal(n)
+    X = np.fft.rfft(x)
+    est = _fft.irfft(X, n)                                  # FFTW_ESTIMATE plan
+    assert _fft.tune(n) == str(fresh_fft_state)
+    text = fresh_fft_state.read_text()
+    assert text.startswith("(fftw-3") and "fftw_wisdom" in text
+    # the measured plans are the cached ones now, and agree with numpy to round-off
+    meas = _fft.irfft(X, n)
+    np.testing.assert_allclose(meas, np.fft.irfft(X, n), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(meas, est, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(_fft.rfft(x), X, rtol=0, atol=1e-12 * math.sqrt(n))
+    # a new process state reads the file before its first plan
+    _fft.clear_cache()
+    _fft._wisdom_loaded = False
+    _fft.irfft(X, n)
+    assert _fft._wisdom_loaded
+
+
+def test_unreadable_wisdom_file_is_ignored(fresh_fft_state):
+    fresh_fft_state.parent.mkdir(parents=True)
+    fresh_fft_state.write_bytes(b"not fftw wisdom\x00\xff")
+    X = np.fft.rfft(np.arange(64.0))
+    np.testing.assert_allclose(_fft.irfft(X, 64), np.arange(64.0), atol=1e-12)
+
+
+@pytest.mark.parametrize("kw,match", [
+    ({"n_samples": 1}, r"n_samples = 1: must be an integer >= 2"),
+    ({"n_samples": [64, 2.5]}, r"n_samples = 2.5: must be an integer"),
+    ({"n_samples": 64, "effort": "FFTW_ESTIMATE"},
+     r"effort = 'FFTW_ESTIMATE': must be 'FFTW_MEASURE'"),
+])
+def test_tune_errors(kw, match):
+    with pytest.raises(InputError, match=match):
+        _fft.tune(**kw)
+
+
+def test_measured_plans_saved_when_effort_is_raised(fresh_fft_state, monkeypatch):
+    # STOCHCABLE_FFTW_EFFORT above ESTIMATE: each new plan is written to the wisdom file;
+    # an unwritable location does not break the transform
+    monkeypatch.setattr(_fft, "_EFFORT", "FFTW_MEASURE")
+    X = np.fft.rfft(np.arange(256.0))
+    np.testing.assert_allclose(_fft.irfft(X, 256), np.arange(256.0), atol=1e-12)
+    assert "fftw_wisdom" in fresh_fft_state.read_text()
+    blocker = fresh_fft_state.parent / "file"
+    blocker.write_text("")
+    monkeypatch.setenv("STOCHCABLE_FFTW_WISDOM", str(blocker / "wisdom.txt"))  # parent is a file
+    np.testing.assert_allclose(_fft.irfft(X[:65], 128), np.fft.irfft(X[:65], 128), atol=1e-12)
+
+
+def test_work_arrays_follow_the_fft_backend(monkeypatch):
+    # reused work arrays are kept per backend: a numpy-fallback call must not hand its
+    # (unaligned) FFT input to a later pyfftw plan; both agree to FFT round-off
+    density, duration, dt = _rational_density, 2**17 * 0.1, 0.1
+    a = sea.simulate_sea(density, duration, dt, "dsa", 12)
+    with monkeypatch.context() as m:
+        m.setattr(_fft, "_pyfftw", None)
+        b = sea.simulate_sea(density, duration, dt, "dsa", 12)
+    c = sea.simulate_sea(density, duration, dt, "dsa", 12)
+    np.testing.assert_array_equal(a.coefficients, b.coefficients)
+    np.testing.assert_array_equal(a.elevation, c.elevation)
+    # irfft of 2^17 points, numpy vs FFTW: ~1e-16 of max |η| per sample, 1e-14 with margin
+    np.testing.assert_allclose(b.elevation, a.elevation, rtol=0, atol=1e-14 * np.abs(a.elevation).max())
