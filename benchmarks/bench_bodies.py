@@ -11,10 +11,13 @@ scale: the same three legs analysed independently, fairleads fixed at their stat
 positions.  The dynamics are also timed without the coarse start of the drag
 linearization (``COARSE_MIN_FREQUENCIES`` raised), with the largest relative change
 of the buoy motion σ and the fairlead/anchor tension σ it makes.  Then a cProfile
-breakdown of one full coupled analysis (direct).
+breakdown of one full coupled analysis (direct).  ``--ab``: only an interleaved A/B
+of the reference paths (node-level Foss lines, full coupled-mode eigenproblem) against
+the fast ones (pass E3, docs/BENCHMARKS.md), wall and process time.  ``--threads-ab``:
+only an interleaved A/B of the per-line thread pool off and on (pass E4).
 
 
-Run:  python benchmarks/bench_bodies.py [--repeat N] [--profile]
+Run:  python benchmarks/bench_bodies.py [--repeat N] [--profile] [--ab] [--threads-ab]
 """
 
 from __future__ import annotations
@@ -27,7 +30,8 @@ import pstats
 import statistics
 import time
 import warnings
-from stochcable.analysis import _single_blas_thread, build_line_system, line_result, linearize
+from stochcable.analysis import (_single_blas_thread, _tune_allocator, build_line_system,
+                                 line_result, linearize)
 import numpy as np
 
 import stochcable.coupled_analysis as coupled_analysis
@@ -63,7 +67,10 @@ def scene_doc(solver: str = "direct", n_el: int = 40, count: int = 200) -> dict:
 
 
 def run_coupled(scene, statics=None):
-    """Statics (when not given) and the coupled dynamics, one BLAS thread."""
+    """Statics (when not given) and the coupled dynamics, one BLAS thread and glibc's
+    heap top pad as ``analyze()`` runs them (pass E4: the earlier passes timed without
+    the pad, ≈ 6 % slower from page faults)."""
+    _tune_allocator()
     timing: dict[str, float] = {}
     with _single_blas_thread():
         if statics is None:
@@ -108,6 +115,93 @@ def without_coarse_start(scene, statics, repeat):
     return med, lines, bodies
 
 
+def reference_paths(on: bool) -> None:
+    """Switch the issue-6 pass E3 fast paths off (the reference: node-level Foss lines,
+    the full coupled-mode eigenproblem) or on."""
+    coupled_analysis._MODAL_FOSS = not on
+    coupled_analysis._CB_MIN_RATIO = 1e9 if on else 1.5
+
+
+def fast_paths_ab(repeat: int) -> None:
+    """Interleaved A/B in one process: the reference paths against the fast ones,
+    full analysis (statics + dynamics) and dynamics alone, medians of wall and process
+    time, and the largest relative change of the buoy σ and tension σ."""
+    for solver in ("foss", "direct"):
+        scene = load_scene(scene_doc(solver))
+        statics = solve_statics(scene, method="fe")
+        keys = {}
+        for ref in (True, False):
+            reference_paths(ref)
+            (lines, bodies, _, _), _ = run_coupled(scene, statics)
+            keys[ref] = key_results(lines, bodies)
+            run_coupled(scene)  # warm-up
+        t = {(r, k): [] for r in (True, False) for k in ("fw", "fp", "dw", "dp")}
+        for _ in range(repeat):
+            for ref in (True, False):
+                reference_paths(ref)
+                w0, p0 = time.perf_counter(), time.process_time()
+                run_coupled(scene)
+                t[ref, "fw"].append(time.perf_counter() - w0)
+                t[ref, "fp"].append(time.process_time() - p0)
+                w0, p0 = time.perf_counter(), time.process_time()
+                run_coupled(scene, statics)
+                t[ref, "dw"].append(time.perf_counter() - w0)
+                t[ref, "dp"].append(time.process_time() - p0)
+        reference_paths(False)
+        for ref in (True, False):
+            med = {k: 1e3 * statistics.median(t[ref, k]) for k in ("fw", "fp", "dw", "dp")}
+            print(f"{solver:6s} {'reference' if ref else 'fast     '}: full {med['fw']:.1f} ms "
+                  f"(process {med['fp']:.1f}), dynamics {med['dw']:.1f} ms "
+                  f"(process {med['dp']:.1f}), medians of {repeat}")
+        diff = np.max(np.abs(keys[False] / keys[True] - 1.0))
+        print(f"        max relative change of the buoy σ and tension σ: {diff:.1e}")
+
+
+def threads_ab(repeat: int) -> None:
+    """Interleaved A/B in one process: the per-line thread pool (stochcable._parallel,
+    pass E4) off (``STOCHCABLE_THREADS=1``) and on (2 threads), full analysis and
+    dynamics, medians of wall and process time (with threads the process time can
+    exceed the wall time), and the largest relative change of the key σ (0: same
+    bits)."""
+    import os
+
+    saved = os.environ.get("STOCHCABLE_THREADS")
+    try:
+        for solver in ("foss", "direct"):
+            scene = load_scene(scene_doc(solver))
+            statics = solve_statics(scene, method="fe")
+            keys = {}
+            for th in ("1", "2"):
+                os.environ["STOCHCABLE_THREADS"] = th
+                (lines, bodies, _, _), _ = run_coupled(scene, statics)
+                keys[th] = key_results(lines, bodies)
+                run_coupled(scene)  # warm-up
+            t = {(th, k): [] for th in ("1", "2") for k in ("fw", "fp", "dw", "dp")}
+            for _ in range(repeat):
+                for th in ("1", "2"):
+                    os.environ["STOCHCABLE_THREADS"] = th
+                    w0, p0 = time.perf_counter(), time.process_time()
+                    run_coupled(scene)
+                    t[th, "fw"].append(time.perf_counter() - w0)
+                    t[th, "fp"].append(time.process_time() - p0)
+                    w0, p0 = time.perf_counter(), time.process_time()
+                    run_coupled(scene, statics)
+                    t[th, "dw"].append(time.perf_counter() - w0)
+                    t[th, "dp"].append(time.process_time() - p0)
+            for th in ("1", "2"):
+                med = {k: 1e3 * statistics.median(t[th, k]) for k in ("fw", "fp", "dw", "dp")}
+                print(f"{solver:6s} {th} thread{'s' if th != '1' else ' '}: full "
+                      f"{med['fw']:.1f} ms (process {med['fp']:.1f}), dynamics "
+                      f"{med['dw']:.1f} ms (process {med['dp']:.1f}), medians of {repeat}")
+            diff = np.max(np.abs(keys["2"] / keys["1"] - 1.0))
+            print(f"        max relative change of the buoy σ and tension σ: {diff:.1e}")
+    finally:
+        if saved is None:
+            os.environ.pop("STOCHCABLE_THREADS", None)
+        else:
+            os.environ["STOCHCABLE_THREADS"] = saved
+
+
 def median_time(fn, repeat: int) -> tuple[float, float]:
     fn()  # warm-up
     t = []
@@ -122,8 +216,20 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--ab", action="store_true",
+                    help="only the interleaved A/B of the reference and the fast paths")
+    ap.add_argument("--threads-ab", action="store_true",
+                    help="only the interleaved A/B of the per-line thread pool off/on")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
+    if args.ab:
+        with _single_blas_thread():
+            fast_paths_ab(max(args.repeat, 9))
+        return
+    if args.threads_ab:
+        with _single_blas_thread():
+            threads_ab(max(args.repeat, 11))
+        return
     for solver in ("direct", "foss"):
         scene = load_scene(scene_doc(solver))
         med_s, _ = median_time(lambda: solve_statics(scene, method="fe"), args.repeat)

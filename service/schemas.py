@@ -385,6 +385,9 @@ class TimeSeriesDocument(_Open):
                                             "(line.end_b.surge, ...)", "m or rad")
     lines: dict[str, dict[str, dict[str, list[float]]]] = _f(
         "Total end tensions {line: {end_a: {tension: [...]}, end_b: ...}}", "N")
+    bodies: dict[str, dict[str, dict[str, list[float]]]] | None = Field(
+        default=None, description="Body motions {body: {motion: {surge: [...], ...}}}, "
+        "static pose plus dynamic part, for scenes with bodies. [m, rad]")
 
 
 class AnalysisResponse(_Open):

@@ -76,6 +76,7 @@ element's δT when those are small (tested).
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 import threading
 import time
@@ -373,7 +374,8 @@ class LineSystem:
     solver : str
         ``"foss"`` or ``"direct"``.
     b_inertia : scipy.sparse.csr_array
-        Morison inertia matrix (:func:`stochcable.excitation.inertia_matrix`). [kg]
+        Morison inertia matrix (:func:`stochcable.excitation.inertia_matrix`),
+        a property assembled on first access. [kg]
     frames : tuple of ndarray
         Element tangent and normals (e, n1, n2), each (n_el, 3).
     current_el : ndarray, shape (n_el, 3)
@@ -401,7 +403,6 @@ class LineSystem:
     modes: Modes
     n_modes: int
     solver: str
-    b_inertia: sp.csr_array
     frames: tuple[np.ndarray, np.ndarray, np.ndarray]
     current_el: np.ndarray
     current_node: np.ndarray
@@ -415,6 +416,15 @@ class LineSystem:
     @property
     def name(self) -> str:
         return self.line.name
+
+    @property
+    def b_inertia(self) -> sp.csr_array:
+        """Morison inertia matrix (:func:`stochcable.excitation.inertia_matrix`),
+        assembled on first access (the solves use element blocks; only hand-built
+        channels with nodal accelerations need it). [kg]"""
+        if "b_inertia" not in self._cache:
+            self._cache["b_inertia"] = inertia_matrix(self.model, self.environment.g)
+        return self._cache["b_inertia"]
 
     @property
     def positions(self) -> np.ndarray:
@@ -588,7 +598,6 @@ def build_line_system(
         modes=modes,
         n_modes=n_modes,
         solver=settings.solver,
-        b_inertia=inertia_matrix(model, env.g),
         frames=frames,
         current_el=current_at_elements(env, model.positions),
         current_node=current_at_nodes(env, model.positions),
@@ -649,10 +658,12 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
     rho = model.rho
     e, n1, n2 = system.frames
     parts = _split_sigma(system, np.asarray(sigma, dtype=float), method)
-    uc = system.current_el
-    u_t = np.einsum("ij,ij->i", uc, e)
-    u_nvec = uc - u_t[:, None] * e
-    u_n = np.linalg.norm(u_nvec, axis=1)
+    if "current_split" not in system._cache:  # drag-independent: once per line
+        uc = system.current_el
+        u_t = np.einsum("ij,ij->i", uc, e)
+        u_nvec = uc - u_t[:, None] * e
+        system._cache["current_split"] = (u_t, u_nvec, np.linalg.norm(u_nvec, axis=1))
+    u_t, u_nvec, u_n = system._cache["current_split"]
     d = mesh.diameter
     if method == "vector":
         s1, s2, s3 = parts["normal"]
@@ -675,9 +686,10 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
         # the iteration's σ are finite and >= 0: skip the public validation (a third
         # of this function's time, called at every iteration); anything else goes
         # through drag_linear_current and its error messages
-        clean = bool(np.all(np.isfinite(parts["normal"][0]))
-                     and np.all(parts["normal"][0] >= 0)
-                     and np.all(np.isfinite(parts["axial"])) and np.all(parts["axial"] >= 0))
+        sn, st = parts["normal"][0], parts["axial"]
+        # finite and >= 0 (NaN fails the comparison; +inf is caught by the sum)
+        clean = bool((sn >= 0).all() and (st >= 0).all()
+                     and math.isfinite(float(sn.sum()) + float(st.sum())))
         current = _drag_current if clean else drag_linear_current
         b_n = current(rho, mesh.cd_normal, d, parts["normal"][0], u_n)
         b_t = current(rho, mesh.cd_axial, math.pi * d, parts["axial"], u_t)
@@ -719,6 +731,10 @@ def _blocks_of(a: Any, d: int) -> _Blk:
     (scipy's COO conversion and checks were ≈ 0.8 ms of every analysis of the
     reference chain); anything else, or entries outside the pattern, goes through
     that function (same values, its error messages)."""
+    stash = getattr(a, "_node_blocks", None)  # assembled from node blocks (fem)
+    if (stash is not None and stash[1].shape[1:] == (d, d) and stash[0].shape == a.data.shape
+            and np.array_equal(stash[0], a.data)):
+        return stash[1].copy(), stash[2].copy()
     if (isinstance(a, (sp.csr_array, sp.csr_matrix)) and a.has_canonical_format
             and a.shape[0] == a.shape[1] and a.shape[0] % d == 0):
         n = a.shape[0]
@@ -766,7 +782,12 @@ def _blocks_of_elements(model: FEModel, blocks3: np.ndarray,
                         node_diag: np.ndarray | None) -> _Blk:
     """Node blocks of per-unit-length element matrices (n_el, 3, 3) distributed like the
     model's mass (as :func:`stochcable.excitation.drag_matrix` assembles them)."""
-    b = _element_blocks(model, blocks3)
+    return _distribute(model, _element_blocks(model, blocks3), node_diag)
+
+
+def _distribute(model: FEModel, b: np.ndarray, node_diag: np.ndarray | None) -> _Blk:
+    """:func:`_blocks_of_elements` of the element blocks b (n_el, d, d) (l0
+    included, :func:`_element_blocks`)."""
     pat = (np.array([[0.5, 0.0], [0.0, 0.5]]) if model.mass_matrix == "lumped" else
            np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]]))
     D = np.zeros((model.n_nodes, model.dim, model.dim))
@@ -831,17 +852,42 @@ class _Prep:
                              "one free node")
         alpha, beta = system.structural_damping
         self.d, self.n = d, n
+        self._system = system
         self.K = _blocks_of(model.K, d)
-        self.MT = _blocks_of((model.M + model.Ma).tocsr(), d)
+        bm, bma = _blocks_of(model.M, d), _blocks_of(model.Ma, d)
+        # M_T = M + Ma entry by entry (the blocks of the CSR sum, to the bit)
+        self.MT = (bm[0] + bma[0], bm[1] + bma[1])
         seabed = _blocks_of(model.Cs, d)
         # structural damping: seabed dashpots + Rayleigh alpha·M_T + beta·K
         self.S = _add(seabed, self.MT, self.K, scale=(1.0, alpha, beta))
-        self.BI = _blocks_of(system.b_inertia, d)
-        self.bK, self.bM, self.bS = (_free_band(x) for x in (self.K, self.MT, self.S))
-        self.norm_K = float(np.sqrt(np.sum(self.bK**2)))
-        self.norm_M = float(np.sqrt(np.sum(self.bM**2)))
+        self.bK = _free_band(self.K)
         self._modal: dict[int, Any] = {}
         self._chol: Any = None
+
+    # used by the direct solve, its conditioning check and hand-built channels only:
+    # computed on first use (≈ 0.2 ms of every Foss analysis of the reference chain)
+    @functools.cached_property
+    def BI(self) -> _Blk:
+        """Node blocks of the Morison inertia matrix (nodal accelerations)."""
+        return _blocks_of(self._system.b_inertia, self.d)
+
+    @functools.cached_property
+    def bM(self) -> np.ndarray:
+        """Band storage of the free–free M_T."""
+        return _free_band(self.MT)
+
+    @functools.cached_property
+    def bS(self) -> np.ndarray:
+        """Band storage of the free–free structural damping."""
+        return _free_band(self.S)
+
+    @functools.cached_property
+    def norm_K(self) -> float:
+        return float(np.sqrt(np.sum(self.bK**2)))
+
+    @functools.cached_property
+    def norm_M(self) -> float:
+        return float(np.sqrt(np.sum(self.bM**2)))
 
     # K_ff^-1 by banded Cholesky (K_ff is SPD: tensions > 0 or slack EA > 0)
     def k_solve(self, rhs: np.ndarray) -> np.ndarray:
@@ -888,6 +934,26 @@ class _Prep:
             kfb[-d:, d:] = self.K[1][-1].T
             self._modal["follower"] = -self.k_solve(kfb)
         return self._modal["follower"]
+
+    def end_basis(self, direct: bool) -> tuple[np.ndarray, ...]:
+        """(G, M_T G, C_s G, K G) as (n_nodes·d, 2d) real matrices: the node
+        displacements U_p = G u_b of unit end displacements u_b (end_a's d components,
+        then end_b's) — zero inside for the direct solve, the static following
+        (:meth:`follower`) inside for Foss — and their products with M_T, the
+        structural damping and K (K G only for the direct solve)."""
+        key = ("end_basis", bool(direct))
+        if key not in self._modal:
+            d, n = self.d, self.n
+            g = np.zeros((n, d, 2 * d))
+            g[0, :, :d] = np.eye(d)
+            g[-1, :, d:] = np.eye(d)
+            if not direct:
+                g[1:-1] = self.follower().reshape(n - 2, d, 2 * d)
+            flat = (n * d, 2 * d)
+            self._modal[key] = (g.reshape(flat), _matvec(self.MT, g).reshape(flat),
+                                _matvec(self.S, g).reshape(flat),
+                                _matvec(self.K, g).reshape(flat) if direct else None)
+        return self._modal[key]
 
     def modal(self, system: "LineSystem") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(Φ_f, M̂, K̂) of the kept modes on the free DOFs."""
@@ -939,7 +1005,7 @@ def _inertia_elements(system: "LineSystem") -> tuple[np.ndarray, np.ndarray]:
     if "inertia_el" not in system._cache:
         from .excitation import _inertia_blocks
 
-        blocks, node = _inertia_blocks(system.model, system.environment.g)
+        blocks, node = _inertia_blocks(system.model, system.environment.g, system.frames[0])
         system._cache["inertia_el"] = (_element_blocks(system.model, blocks), node)
     return system._cache["inertia_el"]
 
@@ -957,8 +1023,11 @@ def _inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> _Inputs:
     square = None
     inertia = np.zeros(shape, dtype=complex)
     b_in, node_mass = _inertia_elements(system)
+    # the nodal fluid velocity only drives the attachments' drag (b_node): without
+    # attachment drag areas it is never used (and not built)
+    attached = system.drag_nodes.size > 0
     for i, ch in enumerate(channels):
-        if ch.velocity is not None:
+        if ch.velocity is not None and attached:
             if vel is None:
                 vel = np.zeros(shape, dtype=complex)
             vel[..., i] = np.transpose(ch.velocity[..., comps], (1, 2, 0))
@@ -967,7 +1036,8 @@ def _inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> _Inputs:
             if mom is None:
                 mom = np.zeros((model.n_elements, 2, model.dim, n_w, n_ch), dtype=complex)
             mom[..., i] = np.transpose(m[..., comps], (1, 2, 3, 0))
-            sq = element_mean_square(ch)[:, :, comps][:, :, :, comps]
+            # the d × d part in one gather (two chained ones were 0.1-0.4 ms)
+            sq = element_mean_square(ch)[:, :, np.array(comps)[:, None], comps]
             sq = np.einsum("weij,w->eij", sq, weights[:, i])
             square = sq if square is None else square + sq
         if ch.element_velocity is not None:
@@ -992,18 +1062,31 @@ def _inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> _Inputs:
 def _drag_blocks(system: "LineSystem", damping: Damping) -> _Blk:
     cache = damping._cache
     if "blocks" not in cache:
-        e = system.frames[0]
-        eet = e[:, :, None] * e[:, None, :]
+        model = system.model
         bn = damping.b_normal
         if bn.ndim == 1:
-            b3 = bn[:, None, None] * (np.eye(3)[None] - eet)
+            # B_n(I − eeᵀ) + B_t eeᵀ entry by entry on the model components only (the
+            # same numbers as the 3×3 blocks sliced), eeᵀ cached per line
+            if "eet" not in system._cache:
+                comps = list(model.components)
+                e = system.frames[0][:, comps]
+                eet = e[:, :, None] * e[:, None, :]
+                system._cache["eet"] = (eet, np.eye(len(comps))[None] - eet,
+                                        model.l0[:, None, None])
+            eet, ieet, l0 = system._cache["eet"]
+            el = bn[:, None, None] * ieet
+            el += damping.b_axial[:, None, None] * eet
+            el *= l0
         else:
+            e = system.frames[0]
+            eet = e[:, :, None] * e[:, None, :]
             _, n1, n2 = system.frames
             nmat = np.stack([n1, n2], axis=2)
             b3 = nmat @ bn @ np.swapaxes(nmat, 1, 2)
-        b3 = b3 + damping.b_axial[:, None, None] * eet
-        cache["blocks"] = _blocks_of_elements(system.model, b3, damping.b_node)
-        cache["elements"] = _element_blocks(system.model, b3)
+            b3 = b3 + damping.b_axial[:, None, None] * eet
+            el = _element_blocks(model, b3)
+        cache["elements"] = el
+        cache["blocks"] = _distribute(model, el, damping.b_node)
     return cache["blocks"]
 
 
@@ -1027,6 +1110,23 @@ def _loads(system: "LineSystem", inp: _Inputs, damping: Damping) -> np.ndarray:
     (n_nodes, d, n_w, n_ch)."""
     f = _drag_load(system, inp, damping)
     return inp.inertia_load if f is None else inp.inertia_load + f
+
+
+def _end_loads(system: "LineSystem", inp: _Inputs, damping: Damping) -> np.ndarray:
+    """:func:`_loads` at the two end nodes only, (2, d, n_w, n_ch): all that the
+    reactions (:func:`_reactions`) read of it — element 0's share on node 0, the last
+    element's on the last node (the whole-line load was 0.2 ms of the chain)."""
+    f = None
+    if inp.moments is not None:
+        _drag_blocks(system, damping)
+        b = damping._cache["elements"]
+        f = np.stack([np.einsum("ij,jwc->iwc", b[0], inp.moments[0, 0]),
+                      np.einsum("ij,jwc->iwc", b[-1], inp.moments[-1, 1])])
+    if inp.velocity is not None and np.any(damping.b_node):
+        fn = damping.b_node[[0, -1], None, None, None] * inp.velocity[[0, -1]]
+        f = fn if f is None else f + fn
+    ends = inp.inertia_load[[0, -1]]
+    return ends if f is None else ends + f
 
 
 def _end_nodes(inp: _Inputs, n: int, d: int) -> np.ndarray:
@@ -1071,18 +1171,102 @@ def _base(system: "LineSystem", prep: _Prep, inp: _Inputs) -> tuple[np.ndarray, 
     key = system.solver
     if key not in inp.cache:
         w = inp.omega
-        u = _end_nodes(inp, prep.n, prep.d)
-        if inp.ub is not None and system.solver != "direct":
-            ub = inp.ub.reshape(2 * prep.d, *inp.ub.shape[2:])
-            u[1:-1] = np.einsum("fb,bwc->fwc", prep.follower(), ub).reshape(u[1:-1].shape)
-        f0 = inp.inertia_load
-        if inp.ub is not None:
-            f0 = f0 - _dynamic(prep, prep.S, w, u)
-            if system.solver == "direct":
-                f0 = f0 - _matvec(prep.K, u)
-        q = None if inp.ub is None else (-1j * w)[:, None] * u
+        if inp.ub is None:
+            u = _end_nodes(inp, prep.n, prep.d)
+            f0, q = inp.inertia_load, None
+        else:
+            # U_p = G u_b with G (n_nodes, d, 2d) the unit end displacements (and their
+            # static following): M_T U_p, C_s U_p, K U_p are (M_T G) u_b, … — small
+            # products with the cached M_T G, C_s G, K G instead of block products of
+            # the (n_nodes, d, n_w·n_ch) vectors (0.3 ms per grid on the chain)
+            direct = system.solver == "direct"
+            g, mg, sg, kg = prep.end_basis(direct)
+            # only the channels that move an end (the sea without RAOs does not): the
+            # others have U_p = 0, F0 = F_I
+            act = _moving_channels(inp)
+            ub = inp.ub if act is None else inp.ub[..., act]
+            ubf = np.ascontiguousarray(ub.reshape(2 * prep.d, -1))
+            shape = (prep.n, prep.d) + ub.shape[2:]
+
+            def times(b: np.ndarray) -> np.ndarray:
+                return _real_gemm(b, ubf).reshape(shape)
+
+            inertia = inp.inertia_load if act is None else inp.inertia_load[..., act]
+            u = times(g)
+            f0 = inertia - (-(w * w)[:, None] * times(mg) + (1j * w)[:, None] * times(sg))
+            if direct:
+                f0 = f0 - times(kg)
+            q = (-1j * w)[:, None] * u
+            if act is not None:  # back to all channels
+                full = (prep.n, prep.d) + inp.ub.shape[2:]
+                u_all, q_all = np.zeros(full, dtype=complex), np.zeros(full, dtype=complex)
+                f0_all = inp.inertia_load.copy()
+                u_all[..., act], q_all[..., act], f0_all[..., act] = u, q, f0
+                u, q, f0 = u_all, q_all, f0_all
         inp.cache[key] = (u, f0, q)
     return inp.cache[key]
+
+
+def _moving_channels(inp: _Inputs) -> np.ndarray | None:
+    """Indices of the channels with a nonzero end motion, or None when all have one."""
+    moving = np.any(inp.ub.reshape(-1, inp.ub.shape[-1]) != 0, axis=0)
+    return None if moving.all() else np.flatnonzero(moving)
+
+
+def _drag_inputs(system: "LineSystem", prep: _Prep, inp: _Inputs
+                 ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Drag-independent parts of the drag load on the free rows, F_d(V) + C_d Q of
+    :func:`_base`, cached per inputs and solver: the element moments
+    W_s = ∫N_s v dξ + Σ_t P_st Q_t (P the mass pattern of the drag,
+    :func:`_blocks_of_elements`), so that both terms are ONE element load
+    Σ_el l0·B·W (:func:`_element_load`), and the attachment velocity V + Q at the
+    nodes (n_nodes, d, n_w, n_ch); None where absent."""
+    key = ("drag_inputs", system.solver)
+    if key not in inp.cache:
+        _, _, q = _base(system, prep, inp)
+        wm = None
+        if q is not None:
+            pat = (np.array([[0.5, 0.0], [0.0, 0.5]])
+                   if system.model.mass_matrix == "lumped" else
+                   np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]]))
+            act = _moving_channels(inp)  # Q = 0 for the others: W = the moments
+            qa = q if act is None else q[..., act]
+            w_q = np.empty((prep.n - 1, 2) + qa.shape[1:], dtype=complex)
+            for side in range(2):
+                w_q[:, side] = pat[side, 0] * qa[:-1]
+                w_q[:, side] += pat[side, 1] * qa[1:]
+            if inp.moments is not None:
+                w_q += inp.moments if act is None else inp.moments[..., act]
+            if act is None:
+                wm = w_q
+            else:
+                wm = (inp.moments.copy() if inp.moments is not None else
+                      np.zeros((prep.n - 1, 2) + q.shape[1:], dtype=complex))
+                wm[..., act] = w_q
+        elif inp.moments is not None:
+            wm = inp.moments
+        vq = inp.velocity
+        if q is not None and system.drag_nodes.size:  # V + Q: attachments only
+            vq = q if vq is None else vq + q
+        inp.cache[key] = (wm, vq)
+    return inp.cache[key]
+
+
+def _free_load(system: "LineSystem", prep: _Prep, inp: _Inputs, damping: Damping
+               ) -> np.ndarray:
+    """The load of :func:`_solve_free`, F0 + F_d(V) + C_d Q (:func:`_base`), on all
+    nodes (n_nodes, d, n_w, n_ch), a fresh array."""
+    _, f0, _ = _base(system, prep, inp)
+    wm, vq = _drag_inputs(system, prep, inp)
+    if wm is None:
+        rhs = f0.copy()
+    else:
+        _drag_blocks(system, damping)
+        rhs = _element_load(damping._cache["elements"], wm)
+        rhs += f0
+    if vq is not None and np.any(damping.b_node):
+        rhs += damping.b_node[:, None, None, None] * vq
+    return rhs
 
 
 def _solve_free(system: "LineSystem", inp: _Inputs, damping: Damping, *,
@@ -1097,14 +1281,7 @@ def _solve_free(system: "LineSystem", inp: _Inputs, damping: Damping, *,
     w = inp.omega
     cd = _drag_blocks(system, damping)
     c = _add(prep.S, cd)
-    _, f0, q = _base(system, prep, inp)
-    rhs = _drag_load(system, inp, damping)   # a fresh array (f0 is cached: no +=)
-    if rhs is None:
-        rhs = f0.copy()
-    else:
-        rhs += f0
-    if q is not None:
-        rhs += _matvec(cd, q)
+    rhs = _free_load(system, prep, inp, damping)
     if system.solver == "direct":
         rhs_f = _to_freq(rhs[1:-1])
         bC = prep.bS + _free_band(cd)
@@ -1193,7 +1370,10 @@ def _foss_free(system: "LineSystem", prep: _Prep, c: _Blk, rhs: np.ndarray,
         # falls back on the full grid, which has the checks)
         fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
         wz = w[:, None, None]
-        z3 = np.linalg.solve(kh - wz * wz * mh + 1j * wz * ch, fh3)
+        key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂: drag-independent, per grid
+        if key not in prep._modal:
+            prep._modal[key] = kh - wz * wz * mh
+        z3 = np.linalg.solve(prep._modal[key] + 1j * wz * ch, fh3)
         z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
     elif z is None:
         fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
@@ -1209,18 +1389,26 @@ def _reactions(system: "LineSystem", prep: _Prep, c: _Blk, u: np.ndarray,
                f_all: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Dynamic force of the line on the supports, (n_w, 2d, n_ch):
     −[(K − ω²M_T + iωC)U − F]_end rows, u and f_all in the node layout."""
-    w2 = (w * w)[:, None, None]
-    iw = (1j * w)[:, None, None]
+    d = u.shape[1]
+    shape = u.shape[1:]  # (d, n_w, n_ch)
+    ua, ua1 = (np.ascontiguousarray(u[i]).reshape(d, -1).view(float) for i in (0, 1))
+    ub, ub1 = (np.ascontiguousarray(u[i]).reshape(d, -1).view(float) for i in (-1, -2))
 
-    def z(k: int, i: int) -> np.ndarray:
-        """Block of Z(ω), (n_w, d, d): k = 0 diagonal of node i, 1 off-diagonal O[i]."""
-        return prep.K[k][i][None] - w2 * prep.MT[k][i][None] + iw * c[k][i][None]
+    def rows(x: _Blk) -> tuple[np.ndarray, np.ndarray]:
+        """(X U) at the end nodes' rows for real node blocks X, each (d, n_w, n_ch):
+        real d × d products on the interleaved views (the complex (n_w, d, d)
+        impedance blocks and their einsums were 0.3 ms of the chain)."""
+        ra = x[0][0] @ ua + x[1][0].T @ ua1
+        rb = x[0][-1] @ ub + x[1][-1] @ ub1
+        return tuple(np.ascontiguousarray(r).view(complex).reshape(shape) for r in (ra, rb))
 
-    ra = (np.einsum("wpq,qwc->wpc", z(0, 0), u[0])
-          + np.einsum("wqp,qwc->wpc", z(1, 0), u[1]) - np.moveaxis(f_all[0], 1, 0))
-    rb = (np.einsum("wpq,qwc->wpc", z(0, -1), u[-1])
-          + np.einsum("wpq,qwc->wpc", z(1, -1), u[-2]) - np.moveaxis(f_all[-1], 1, 0))
-    return -np.concatenate([ra, rb], axis=1)
+    ww = (w * w)[:, None]
+    iw = (1j * w)[:, None]
+    out = []
+    for k, (rk, rm, rc) in enumerate(zip(rows(prep.K), rows(prep.MT), rows(c))):
+        r = rk - ww * rm + iw * rc - f_all[0 if k == 0 else -1]
+        out.append(np.moveaxis(r, 1, 0))  # (n_w, d, n_ch)
+    return -np.concatenate(out, axis=1)
 
 
 def _response(system: "LineSystem", inp: _Inputs, damping: Damping,
@@ -1229,9 +1417,7 @@ def _response(system: "LineSystem", inp: _Inputs, damping: Damping,
     done with this ``damping`` (:func:`_solve_nodes`) skips the solve."""
     prep = _prep(system)
     u, c = _solve_nodes(system, inp, damping) if solved is None else solved
-    f_all = _loads(system, inp, damping)
-    n, d, n_w, n_ch = u.shape
-    support = _reactions(system, prep, c, u, f_all, inp.omega)
+    support = _reactions(system, prep, c, u, _end_loads(system, inp, damping), inp.omega)
     disp = _to_freq(u)
     return Response(omega=inp.omega, displacement=disp, support_force=support,
                     end_tension=_end_tension(system, support))
@@ -1429,11 +1615,17 @@ def _fluid_terms(system: LineSystem, inp: _Inputs, method: str
         if inp.moments is None:
             inp.cache[key] = (np.zeros(pr.shape[:2]), None)
         else:
-            c0 = np.einsum("eki,eij,ekj->ek", pr, inp.square, pr)
-            n_el, _, d = inp.moments.shape[:3]
-            mf = np.ascontiguousarray(inp.moments).reshape(n_el, 2, d, -1).view(float)
-            m = np.stack([pr @ mf[:, 0], pr @ mf[:, 1]], axis=2)
-            inp.cache[key] = (c0, m * _w2(inp))
+            c0 = np.sum((pr @ inp.square) * pr, axis=2)  # r·S·r (5x the einsum's speed)
+            n_el = inp.moments.shape[0]
+            mkey = ("fluid_m", method)
+            if mkey not in inp.cache:  # (a subset's are sliced from its full grid's)
+                d = inp.moments.shape[2]
+                mf = np.ascontiguousarray(inp.moments).reshape(n_el, 2, d, -1).view(float)
+                inp.cache[mkey] = pr[:, None] @ mf  # (n_el, side, k, 2N): one product
+            m = inp.cache[mkey]
+            mw = np.empty((n_el, pr.shape[1], 2, m.shape[-1]))
+            np.multiply(np.swapaxes(m, 1, 2), _w2(inp), out=mw)
+            inp.cache[key] = (c0, mw)
     return inp.cache[key]
 
 
@@ -1501,8 +1693,12 @@ def _node_sigmas(system: LineSystem, inp: _Inputs, vr_nodes: np.ndarray) -> np.n
     (n_drag_nodes, d, n_w, n_ch)."""
     if vr_nodes.shape[0] == 0:
         return np.zeros(0)
-    flat = np.ascontiguousarray(vr_nodes).reshape(vr_nodes.shape[0], -1)
-    return np.sqrt(_weighted_var(flat, inp))
+    n, d = vr_nodes.shape[:2]
+    # the weighted mean square per node and component, summed over the components
+    # (flattening the components into the frequency axis mismatched the weights: every
+    # scene with an attachment drag area and a sea failed)
+    flat = np.ascontiguousarray(vr_nodes).reshape(n * d, -1)
+    return np.sqrt(_weighted_var(flat, inp).reshape(n, d).sum(axis=1))
 
 
 def _sigmas(system: LineSystem, inp: _Inputs, u: np.ndarray | None, method: str) -> np.ndarray:
@@ -1522,16 +1718,14 @@ def _sigmas(system: LineSystem, inp: _Inputs, u: np.ndarray | None, method: str)
     return _sigma_vector(system, var, _node_sigmas(system, inp, vr), method)
 
 
-def _sigmas_free(system: LineSystem, inp: _Inputs, u_free: np.ndarray,
-                 method: str) -> np.ndarray:
-    """σ vector from the free-node dynamic part of :func:`_solve_free`.
-
-    The structure's velocity is that of U_p (:func:`_base`, cached projections) plus
-    iω u_f: two stacked real products per iteration."""
-    prep = _prep(system)
-    pr = _proj_rows(system, method)
+def _qproj(system: LineSystem, inp: _Inputs, method: str) -> tuple:
+    """Drag-independent parts of :func:`_sigmas_free`, cached per inputs, solver and
+    method: the projections of Q = −iω U_p at the element ends (the real view of
+    :func:`_project_ends`, None without end motion), the factors −iω per column
+    (n_w·n_ch,) and the attachments' V + Q (n_drag_nodes, d, n_w, n_ch)."""
     key = ("qproj", system.solver, method)
     if key not in inp.cache:
+        prep = _prep(system)
         _, _, q = _base(system, prep, inp)
         wcol = np.repeat(-1j * inp.omega, inp.weights.shape[1])
         idx = system.drag_nodes
@@ -1542,8 +1736,19 @@ def _sigmas_free(system: LineSystem, inp: _Inputs, u_free: np.ndarray,
             inp.cache[key] = (None, wcol, y)
         else:
             y += q[idx]
-            inp.cache[key] = (_project_ends(pr, q), wcol, y)
-    q_p, wcol, y = inp.cache[key]
+            inp.cache[key] = (_project_ends(_proj_rows(system, method), q), wcol, y)
+    return inp.cache[key]
+
+
+def _sigmas_free(system: LineSystem, inp: _Inputs, u_free: np.ndarray,
+                 method: str) -> np.ndarray:
+    """σ vector from the free-node dynamic part of :func:`_solve_free`.
+
+    The structure's velocity is that of U_p (:func:`_base`, cached projections) plus
+    iω u_f: two stacked real products per iteration."""
+    prep = _prep(system)
+    pr = _proj_rows(system, method)
+    q_p, wcol, y = _qproj(system, inp, method)
     n_f, d = u_free.shape[:2]
     qf = np.ascontiguousarray(u_free).reshape(n_f, d, -1) * wcol
     qff = qf.view(float)
@@ -1567,6 +1772,18 @@ def _sigmas_free(system: LineSystem, inp: _Inputs, u_free: np.ndarray,
     return _sigma_vector(system, var, s_node, method)
 
 
+def _rest_sigmas(system: LineSystem, inp: _Inputs, method: str) -> np.ndarray:
+    """The σ of the start (step 5): the fluid velocity relative to the line following
+    its ends quasi-statically, :func:`_sigmas` of :func:`_quasi_static`.  For Foss
+    that motion is U_p of :func:`_base`, whose projections :func:`_qproj` has cached
+    (the same numbers)."""
+    if system.solver == "direct":
+        return _sigmas(system, inp, _quasi_static(system, inp), method)
+    q_p, _, y = _qproj(system, inp, method)
+    return _sigma_vector(system, _element_variance(system, inp, method, q_p),
+                         _node_sigmas(system, inp, y), method)
+
+
 def _quasi_static(system: LineSystem, inp: _Inputs) -> np.ndarray | None:
     """Node displacements of the line following its prescribed ends quasi-statically,
     U_f = −K_ff⁻¹K_fb u_b, (n_omega, n_nodes, d, n_ch); None without end motion."""
@@ -1574,8 +1791,8 @@ def _quasi_static(system: LineSystem, inp: _Inputs) -> np.ndarray | None:
         return None
     prep = _prep(system)
     u = _end_nodes(inp, prep.n, prep.d)
-    ub = inp.ub.reshape(2 * prep.d, *inp.ub.shape[2:])
-    u[1:-1] = np.einsum("fb,bwc->fwc", prep.follower(), ub).reshape(u[1:-1].shape)
+    ub = np.ascontiguousarray(inp.ub.reshape(2 * prep.d, -1))
+    u[1:-1] = _real_gemm(prep.follower(), ub).reshape(u[1:-1].shape)
     return u
 
 
@@ -1608,11 +1825,16 @@ def _interpolatory_weights(omega: np.ndarray, idx: np.ndarray) -> np.ndarray:
     lo = np.clip(pos - order // 2, 0, n_sub - order)
     nodes = lo[:, None] + np.arange(order)  # (n_omega, order) stencil of each point
     x = ws[nodes]
-    basis = np.ones(nodes.shape)
-    for a in range(order):  # Lagrange basis, vectorized over the frequencies
-        for b in range(order):
-            if a != b:
-                basis[:, a] *= (omega - x[:, b]) / (x[:, a] - x[:, b])
+    # Lagrange basis, vectorized over the frequencies and the stencil: the ratios
+    # r_ab = (ω − x_b)/(x_a − x_b) (r_aa = 1), multiplied in the order b = 0, 1, …
+    # (the same products as a loop over a and b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = (omega[:, None, None] - x[:, None, :]) / (x[:, :, None] - x[:, None, :])
+    idx_a = np.arange(order)
+    r[:, idx_a, idx_a] = 1.0
+    basis = r[:, :, 0].copy()
+    for b in range(1, order):
+        basis *= r[:, :, b]
     return np.bincount(nodes.ravel(), weights=(q[:, None] * basis).ravel(),
                        minlength=n_sub)
 
@@ -1678,15 +1900,43 @@ def _subset_inputs(system: LineSystem, channels: tuple[Channel, ...], inp: _Inpu
     for i, ch in enumerate(channels):
         if ch.element_velocity is None and ch.velocity is None:
             continue  # as _inputs: the mean square goes with the element moments
-        sq = element_mean_square(ch)[idx][:, :, comps][:, :, :, comps]
+        sq = element_mean_square(ch)[idx]
+        sq = sq[:, :, np.array(comps)[:, None], comps]  # one gather of the d × d part
         sq = np.einsum("weij,w->eij", sq, weights[:, i])
         square = sq if square is None else square + sq
 
     def take(a: np.ndarray | None, axis: int) -> np.ndarray | None:
         return None if a is None else np.take(a, idx, axis=axis)
 
-    return _Inputs(inp.omega[idx], take(inp.velocity, 2), take(inp.inertia_load, 2),
-                   take(inp.ub, 2), weights, take(inp.moments, 3), square)
+    sub = _Inputs(inp.omega[idx], take(inp.velocity, 2), take(inp.inertia_load, 2),
+                  take(inp.ub, 2), weights, take(inp.moments, 3), square)
+    # The drag-independent, per-frequency arrays the full grid has already computed
+    # (:func:`_base`, :func:`_drag_inputs`, :func:`_qproj`, the projected moments of
+    # :func:`_fluid_terms`) are the same numbers at the subset's frequencies: sliced,
+    # not recomputed (0.3 ms of the chain's coarse start).
+    n_w, n_ch = inp.weights.shape
+
+    def take_view(a: np.ndarray | None) -> np.ndarray | None:
+        """Slice the interleaved (n_w·n_ch·2) last axis of a real view."""
+        if a is None:
+            return None
+        lead = a.shape[:-1]
+        return np.ascontiguousarray(np.take(a.reshape(lead + (n_w, 2 * n_ch)), idx,
+                                            axis=len(lead))).reshape(lead + (-1,))
+
+    for key, val in inp.cache.items():
+        if key in ("foss", "direct"):
+            u, f0, q = val
+            sub.cache[key] = (take(u, 2), take(f0, 2), take(q, 2))
+        elif key[0] == "drag_inputs":
+            sub.cache[key] = (take(val[0], 3), take(val[1], 2))
+        elif key[0] == "fluid_m":
+            sub.cache[key] = take_view(val)
+        elif key[0] == "qproj":
+            q_p, wcol, y = val
+            sub.cache[key] = (take_view(q_p), np.ascontiguousarray(
+                wcol.reshape(n_w, n_ch)[idx]).ravel(), take(y, 2))
+    return sub
 
 
 def _uniform_subset(n: int) -> np.ndarray:
@@ -1716,11 +1966,16 @@ def _coarse_start(
         # the drag of the vector form with a current is a quadrature per element
         # (≈ 15 ms on the chain), not frequency work: a coarse grid saves nothing
         return None, None
+    # the full grid's drag-independent arrays first (needed by its iteration anyway):
+    # the subsets slice them (_subset_inputs)
+    _qproj(system, inp, method)
+    _drag_inputs(system, _prep(system), inp)
+    _fluid_terms(system, inp, method)
     # the at-rest start on the uniform part of the subset, whose drag decides which
     # resonances are narrow
     base = _uniform_subset(n)
     sub = _subset_inputs(system, channels, inp, base)
-    x_rest = _sigmas(system, sub, _quasi_static(system, sub), method)
+    x_rest = _rest_sigmas(system, sub, method)
     if not np.all(np.isfinite(x_rest)):
         return None, None
     first = drag_coefficients(system, x_rest, method)
@@ -1864,7 +2119,7 @@ def linearize(
     x_start, stage = (_coarse_start(system, channels, inp, settings, progress, timing)
                       if coarse else (None, None))
     if x_start is None:
-        x_start = _sigmas(system, inp, _quasi_static(system, inp), method)
+        x_start = _rest_sigmas(system, inp, method)
     x0 = update(x_start)
     change0 = state["change"]
     if not np.all(np.isfinite(x0)):
@@ -1934,34 +2189,49 @@ def element_tension_transfer(system: LineSystem, response: Response) -> np.ndarr
 
     model = system.model
     mesh = model.mesh
-    u = response.displacement.reshape(response.omega.size, model.n_nodes, model.dim, -1)
-    du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, dim, n_ch)
+    n_w = response.omega.size
+    u = response.displacement.reshape(n_w, model.n_nodes, model.dim, -1)
+    # e·(u_b − u_a) one component at a time, frequencies last (long inner loops; the
+    # complex einsum was 0.4 ms on the chain, the frequency-major layout 0.25)
+    u = np.ascontiguousarray(np.transpose(u, (3, 1, 2, 0)))  # (n_ch, n_nodes, dim, n_w)
+    t = model.tangents
+    out = t[None, :, 0, None] * (u[:, 1:, 0] - u[:, :-1, 0])  # (n_ch, n_el, n_w)
+    for k in range(1, model.dim):
+        out += t[None, :, k, None] * (u[:, 1:, k] - u[:, :-1, k])
     ea = np.where(model.slack, SLACK_EA_RATIO * mesh.ea, mesh.ea)
-    stretch = np.einsum("wedc,ed->cew", du, model.tangents)
-    return (ea / model.l0)[None, :, None] * stretch
+    out *= (ea / model.l0)[None, :, None]
+    return out
+
+
+def _modal_bandwidths(system: LineSystem, damping: Damping) -> np.ndarray:
+    """φ_jᵀCφ_j of every computed mode (mass-normalized φ; C = structural damping +
+    ``damping``): the half-power bandwidth 2ζ_jω_j, (n_modes,), cached on the damping
+    (the resolution check and the indicators both use it). [rad/s]"""
+    if "modal_band" not in damping._cache:
+        prep = _prep(system)
+        c = _add(prep.S, _drag_blocks(system, damping))
+        phi = np.ascontiguousarray(system.modes.shapes[system.model.free])
+        damping._cache["modal_band"] = np.einsum(
+            "ij,ij->j", phi, prep._free_rows(_matvec(c, prep._nodes(phi))))
+    return damping._cache["modal_band"]
 
 
 def _resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) -> None:
     """ResolutionWarning for natural frequencies inside the grid that the grid cannot
     resolve: nearest grid point farther than the local spacing, or a half-power
     bandwidth (2ζω_j ≈ φ_jᵀCφ_j for mass-normalized φ) narrower than the local spacing."""
-    model = system.model
     modes = system.modes
     wn = np.asarray(modes.omega)
     inside = np.flatnonzero((wn >= omega[0]) & (wn <= omega[-1]))
     if inside.size == 0 or omega.size < 2:
         return
-    prep = _prep(system)
-    c = _add(prep.S, _drag_blocks(system, damping))
-    phi = modes.shapes[model.free][:, inside]
-    band = np.einsum("ij,ij->j", phi, prep._free_rows(_matvec(c, prep._nodes(phi))))
+    band = _modal_bandwidths(system, damping)[inside]
     spacing = np.gradient(omega)
-    bad = []
-    for j, b in zip(inside, band):
-        k = int(np.argmin(np.abs(omega - wn[j])))
-        dist = abs(omega[k] - wn[j])
-        if dist > spacing[k] or spacing[k] > b:
-            bad.append((j, wn[j], b, spacing[k]))
+    # nearest grid point of every mode inside at once (the first of equals, as argmin)
+    near = np.argmin(np.abs(omega[None, :] - wn[inside][:, None]), axis=1)
+    dist = np.abs(omega[near] - wn[inside])
+    flagged = (dist > spacing[near]) | (spacing[near] > band)
+    bad = [(j, wn[j], b, spacing[k]) for j, b, k, f in zip(inside, band, near, flagged) if f]
     if not bad:
         return
     j, wj, b, dw = bad[0]
@@ -2092,22 +2362,23 @@ def _normal_acceleration_sigma(system: LineSystem, channels: tuple[Channel, ...]
     ω²(tr S − eᵀSe), S = ∫₀¹ Re(v vᴴ) dξ (:func:`element_mean_square`). [m/s²]"""
     e = system.frames[0]
     q = _trapezoid_weights(omega)
-    var = np.zeros(system.model.n_elements)
+    n_el = system.model.n_elements
+    var = np.zeros(n_el)
+    # tr S − eᵀSe = Σ_ij S_ij (I − eeᵀ)_ij: one product over the 9 entries (the trace
+    # and a three-operand einsum were 0.2 ms on the chain)
+    proj = (np.eye(3)[None] - e[:, :, None] * e[:, None, :]).reshape(n_el, 9)
     for ch in channels:
         sq = element_mean_square(ch)
         if sq is None:
             continue
-        dens = (np.trace(sq, axis1=2, axis2=3) - np.einsum("weij,ei,ej->we", sq, e, e))
+        dens = np.einsum("wek,ek->we", sq.reshape(sq.shape[0], n_el, 9), proj)
         var += np.clip(dens, 0.0, None).T @ (q * ch.spectrum * omega**2)
     return np.sqrt(var)
 
 
 def _modal_damping_ratios(system: LineSystem, damping: Damping) -> np.ndarray:
     """ζ_j = φ_jᵀCφ_j/(2ω_j) of the computed modes (mass-normalized φ). [-]"""
-    prep = _prep(system)
-    c = _add(prep.S, _drag_blocks(system, damping))
-    phi = system.modes.shapes[system.model.free]
-    band = np.einsum("ij,ij->j", phi, prep._free_rows(_matvec(c, prep._nodes(phi))))
+    band = _modal_bandwidths(system, damping)
     wn = np.asarray(system.modes.omega)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(wn > 0, band / (2.0 * np.where(wn > 0, wn, 1.0)), np.inf)
@@ -2292,8 +2563,11 @@ def line_result(
     w = resp.omega
     n_ch = len(channels)
     spectra = np.stack([c.spectrum for c in channels]) if n_ch else np.zeros((0, w.size))
-    u_nodes = embed(model, np.moveaxis(resp.displacement, 2, 1))  # (n_w, n_ch, n_nodes, 3)
-    motion_h = np.transpose(u_nodes, (1, 2, 3, 0))  # (n_ch, n_nodes, 3, n_w)
+    # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the frequency-major
+    # layout and transposing made every later pass strided)
+    motion_h = np.zeros((n_ch, model.n_nodes, 3, w.size), dtype=resp.displacement.dtype)
+    motion_h[:, :, list(model.components)] = np.transpose(
+        resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch), (3, 1, 2, 0))
     tension_h = element_tension_transfer(system, resp)
     s_mot = np.einsum("cnkw,cw->nkw", np.abs(motion_h) ** 2, spectra)
     s_ten = np.einsum("cew,cw->ew", np.abs(tension_h) ** 2, spectra)
@@ -2356,18 +2630,25 @@ def simulate_timeseries(
     dampings: Mapping[str, Damping],
     settings: TimeSeriesSettings,
     *,
+    coupled: tuple[Any, ...] = (),
     timing: dict[str, float] | None = None,
 ) -> TimeSeries:
-    """One realization of every input channel and the end-tension time series.
+    """One realization of every input channel and the end-tension and body-motion
+    time series.
 
     Parameters
     ----------
     scene : Scene
     systems : mapping of LineSystem by line name
+        The independent lines (not attached to a free body).
     dampings : mapping of Damping by line name
-        The converged linear drag of each line.
+        The converged linear drag of each of them.
     settings : TimeSeriesSettings
         method (dsa/nsa), duration, dt, seed.
+    coupled : tuple of CoupledGroup, optional
+        The converged coupled groups of a scene with bodies
+        (:attr:`stochcable.coupled_analysis.CoupledAnalysis.groups`): their lines' end
+        tensions and their free bodies' motions are synthesized too.
     timing : dict, optional
         Accumulates ``solve_s``.
 
@@ -2379,18 +2660,36 @@ def simulate_timeseries(
     -----
     The sea: :func:`stochcable.sea.simulate_sea` with ``rng=seed`` (so η is the
     realization a stand-alone simulation with that seed gives).  End-motion spectrum
-    channels, in the order lines × (end_a, end_b) × (surge, sway, heave), use the
-    independent generators ``np.random.default_rng(c)`` for
-    ``c in np.random.SeedSequence(seed).spawn(n)``.  Responses are
-    :func:`stochcable.sea.synthesize` of the transfer functions solved on the
-    realization grid ω_m = mΔω, restricted to the analysis band [omega.min, omega.max]
-    (zero outside, as the response spectra are), so η, end motions and tensions of one
-    realization are mutually consistent (seed 001 §5.1, eq. 5.3.29 and step 14).
+    channels, in the order of the scene's lines (independent and coupled alike) ×
+    (end_a, end_b) × (surge, sway, heave), use the independent generators
+    ``np.random.default_rng(c)`` for ``c in np.random.SeedSequence(seed).spawn(n)``.
+    Responses are :func:`stochcable.sea.synthesize` of the transfer functions solved
+    on the realization grid ω_m = mΔω, restricted to the analysis band
+    [omega.min, omega.max] (zero outside, as the response spectra are), so η, end
+    motions, tensions and body motions of one realization are mutually consistent
+    (seed 001 §5.1, eq. 5.3.29 and step 14).  Independent lines: :func:`solve` with
+    their converged drag; an end on a vessel moves with the vessel RAO in the sea
+    channel.  Coupled groups: the group's linear system at its converged drag
+    (lines' Damping, bodies' drag σ) solved on the band
+    (:func:`stochcable.coupled_timeseries.coupled_group_transfer`).  Vessels: their
+    RAO times the sea.  The band is solved in chunks of frequencies, so only the
+    end tensions and body motions of the whole band are held
+    (:mod:`stochcable.coupled_timeseries`, "Memory").
     """
+    from .coupled_analysis import _scene_line_channels
+    from .coupled_timeseries import (
+        CHUNK_BYTES,
+        coupled_group_transfer,
+        frequency_chunks,
+        line_entry_bytes,
+        vessel_raos,
+    )
+
     seed = int(settings.seed)
     omega_r, _ = frequency_grid(settings.duration, settings.dt)
     grid = scene.analysis.omega
     band = np.flatnonzero((omega_r >= grid.min) & (omega_r <= grid.max) & (omega_r > 0))
+    w_band = omega_r[band]
     env = scene.environment
     sea_real = None
     if scene.sea is not None:
@@ -2404,47 +2703,118 @@ def simulate_timeseries(
 
         sea_real = simulate_sea(sea_density, settings.duration, settings.dt,
                                 settings.method, rng=seed)
-    # channels per line on the band of the realization grid
-    chans = {}
-    for name, system in systems.items():
-        chans[name] = line_channels(scene, system.line, system.positions, omega_r[band]) \
-            if band.size else ()
-    motion_keys = [(name, ch.name) for name in systems for ch in chans[name]
+    groups = tuple(coupled)
+    all_systems = dict(systems)
+    for grp in groups:
+        all_systems.update(grp.systems)
+    scene_order = [ln.name for ln in scene.lines if ln.name in all_systems]
+    names = scene_order + [n for n in all_systems if n not in scene_order]
+
+    def channels_on(name: str, w: np.ndarray) -> tuple[Channel, ...]:
+        """The line's channels on w (an end on a vessel moves in the sea channel)."""
+        system = all_systems[name]
+        ch, _ = _scene_line_channels(scene, system.line, system, w, vessel_raos(scene, w))
+        return ch
+
+    # channel names and densities of every line (scene order) from one frequency
+    probe = {n: channels_on(n, w_band[:1]) if band.size else () for n in names}
+    motion_keys = [(name, ch.name) for name, chs in probe.items() for ch in chs
                    if ch.kind == "end_motion"]
     children = np.random.SeedSequence(seed).spawn(len(motion_keys)) if motion_keys else []
     reals: dict[tuple[str, str], Any] = {}
     for (name, cname), child in zip(motion_keys, children):
-        ch = next(c for c in chans[name] if c.name == cname)
+        ch = next(c for c in probe[name] if c.name == cname)
         reals[(name, cname)] = simulate_sea(ch.density, settings.duration, settings.dt,
                                             settings.method, rng=np.random.default_rng(child))
     end_motion = {f"{name}.{cname}": np.asarray(r.elevation) for (name, cname), r in reals.items()}
+    n_t = int(round(settings.duration / settings.dt))
+
+    def full(h: np.ndarray) -> np.ndarray:
+        """Band values (..., n_band) -> the realization grid (..., N+1), zero outside."""
+        out = np.zeros(h.shape[:-1] + (omega_r.size,), dtype=complex)
+        out[..., band] = h
+        return out
+
+    def synthesized(h: np.ndarray, kinds: tuple[str, ...],
+                    sources: tuple[tuple[str, str] | None, ...]) -> np.ndarray:
+        """Σ over channels of synthesize(realization, H), H (n_ch, ..., N+1)."""
+        y = np.zeros(h.shape[1:-1] + (n_t,))
+        for i, (kind, src) in enumerate(zip(kinds, sources)):
+            real = sea_real if kind == "sea" else reals.get(src) if src else None
+            if real is not None:
+                y += synthesize(real, h[i])
+        return y
+
     end_tension: dict[str, dict[str, np.ndarray]] = {}
     transfer: dict[str, dict[str, np.ndarray]] = {}
-    n_t = int(round(settings.duration / settings.dt))
+    chan_names: dict[str, tuple[str, ...]] = {}
     for name, system in systems.items():
-        st = system.statics
-        series = {"end_a": np.full(n_t, float(st.tension_a)),
-                  "end_b": np.full(n_t, float(st.tension_b))}
+        chs = probe.get(name, ())
         tr = {}
-        if chans[name]:
-            resp = solve(system, chans[name], dampings[name], timing)
-            for end in ("end_a", "end_b"):
-                h = np.zeros((len(chans[name]), omega_r.size), dtype=complex)
-                h[:, band] = resp.end_tension[end]
-                tr[end] = h
-                for i, ch in enumerate(chans[name]):
-                    real = sea_real if ch.kind == "sea" else reals[(name, ch.name)]
-                    series[end] = series[end] + synthesize(real, h[i])
-        end_tension[name] = series
+        if chs:
+            n_ch = len(chs)
+            h = {e: np.zeros((n_ch, band.size), dtype=complex) for e in ("end_a", "end_b")}
+            entry = line_entry_bytes(system.model, n_ch)
+            for sl in frequency_chunks(band.size, entry, CHUNK_BYTES):
+                resp = solve(system, channels_on(name, w_band[sl]), dampings[name], timing)
+                for e in h:
+                    h[e][:, sl] = resp.end_tension[e]
+            tr = {e: full(v) for e, v in h.items()}
+        kinds = tuple(c.kind for c in chs)
+        src = tuple((name, c.name) for c in chs)
+        st = system.statics
+        end_tension[name] = {
+            e: float(t) + (synthesized(tr[e], kinds, src) if tr else 0.0) + np.zeros(n_t)
+            for e, t in (("end_a", st.tension_a), ("end_b", st.tension_b))}
         transfer[name] = tr
+        chan_names[name] = tuple(c.name for c in chs)
+    body_motion: dict[str, dict[str, np.ndarray]] = {}
+    body_transfer: dict[str, np.ndarray] = {}
+    body_channels: dict[str, tuple[str, ...]] = {}
+    for grp in groups:
+        gt = coupled_group_transfer(scene, grp, w_band, timing=timing) if band.size else None
+        for name in grp.lines:
+            st = grp.systems[name].statics
+            tr = {} if gt is None else {e: full(v) for e, v in gt.end_tension[name].items()}
+            end_tension[name] = {
+                e: float(t) + (synthesized(tr[e], gt.kinds, gt.sources) if tr else 0.0)
+                + np.zeros(n_t) for e, t in (("end_a", st.tension_a), ("end_b", st.tension_b))}
+            transfer[name] = tr
+            chan_names[name] = () if gt is None else gt.channels
+        for b in grp.bodies:
+            mean = grp.pose[b.name]
+            h = (np.zeros((0, b.n_dof, omega_r.size), dtype=complex) if gt is None
+                 else full(gt.body_motion[b.name]))
+            y = (synthesized(h, gt.kinds, gt.sources) if gt is not None
+                 else np.zeros((b.n_dof, n_t)))
+            body_motion[b.name] = {k: float(mean[i]) + y[i] for i, k in enumerate(b.dof_names)}
+            body_transfer[b.name] = h
+            body_channels[b.name] = () if gt is None else gt.channels
+    vessels = [b for b in (getattr(scene, "bodies", ()) or ())
+               if getattr(b, "prescribed", None) is not None]
+    for b in vessels:
+        if sea_real is None:
+            continue
+        h = full(vessel_raos(scene, w_band)[b.name].T)[None]      # (1, 6, N+1)
+        y = synthesized(h, ("sea",), (None,))
+        mean = np.concatenate([np.asarray(b.position, dtype=float), np.zeros(3)])
+        body_motion[b.name] = {k: float(mean[i]) + y[i] for i, k in enumerate(
+            ("surge", "sway", "heave", "roll", "pitch", "yaw"))}
+        body_transfer[b.name] = h
+        body_channels[b.name] = ("sea",)
+    order = [n for n in names if n in end_tension]
+    body_order = [b.name for b in (getattr(scene, "bodies", ()) or ()) if b.name in body_motion]
     time_axis = (np.asarray(sea_real.time) if sea_real is not None
                  else (settings.duration / n_t) * np.arange(n_t))
     return TimeSeries(
         time=time_axis, method=settings.method, seed=seed,
         elevation=None if sea_real is None else np.asarray(sea_real.elevation),
-        end_motion=end_motion, end_tension=end_tension, omega=omega_r,
-        channels={name: tuple(c.name for c in chans[name]) for name in systems},
-        end_tension_transfer=transfer,
+        end_motion=end_motion, end_tension={n: end_tension[n] for n in order},
+        omega=omega_r, channels={n: chan_names[n] for n in order},
+        end_tension_transfer={n: transfer[n] for n in order},
+        body_motion={n: body_motion[n] for n in body_order},
+        body_channels={n: body_channels[n] for n in body_order},
+        body_motion_transfer={n: body_transfer[n] for n in body_order},
     )
 
 
@@ -2540,8 +2910,8 @@ def analyze(
             # lines attached to bodies are solved together with them (issue 6)
             from .coupled_analysis import analyze_coupled
 
-            lines, bodies, systems, dampings = analyze_coupled(scene, statics, settings,
-                                                               progress, timing)
+            coupled = analyze_coupled(scene, statics, settings, progress, timing)
+            lines, bodies, systems, dampings = coupled
         for line in (() if scene.bodies else scene.lines):
             progress("model", {"line": line.name})
             t0 = time.perf_counter()
@@ -2570,6 +2940,7 @@ def analyze(
             progress("timeseries", {})
             t0 = time.perf_counter()
             ts = simulate_timeseries(scene, systems, dampings, settings.timeseries,
+                                     coupled=coupled.groups if scene.bodies else (),
                                      timing=timing)
             timing["timeseries_s"] = time.perf_counter() - t0
     messages: list[str] = []

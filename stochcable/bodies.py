@@ -366,6 +366,10 @@ class RigidBody:
         Additional linear stiffness and damping (e.g. a PTO, viscous roll damping).
     planar : bool
         Three DOFs (surge, heave, pitch) in the x–z plane instead of six.
+    fixed_dofs : sequence of str, optional
+        Names of DOFs held fixed (among ``dof_names``; default none): a constraint
+        ξ_j ≡ 0 in the coupled dynamics (:mod:`stochcable.coupled_analysis`), as the
+        body statics hold them.
 
     Notes
     -----
@@ -389,6 +393,7 @@ class RigidBody:
     extra_stiffness: Any = None
     extra_damping: Any = None
     planar: bool = False
+    fixed_dofs: Any = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -437,6 +442,25 @@ class RigidBody:
             raise InputError("drag_area", da, "m²", "must be >= 0")
         put(self, "drag_area", da)
         put(self, "drag_point", _vec3("drag_point", self.drag_point, "m"))
+        fixed = () if self.fixed_dofs is None else self.fixed_dofs
+        if isinstance(fixed, str):
+            fixed = (fixed,)
+        fixed = tuple(fixed)
+        names = PLANAR_DOFS if self.planar else SPATIAL_DOFS
+        bad = [f for f in fixed if f not in names]
+        if bad:
+            raise InputError("fixed_dofs", list(fixed), "-",
+                             f"must name DOFs of the body among {list(names)}; unknown {bad}")
+        if len(set(fixed)) != len(fixed):
+            raise InputError("fixed_dofs", list(fixed), "-", "must not repeat a DOF")
+        put(self, "fixed_dofs", fixed)
+
+    @property
+    def free_index(self) -> np.ndarray:
+        """Indices (in ``dof_names`` order) of the DOFs not in ``fixed_dofs``."""
+        names = self.dof_names
+        return np.array([i for i, n in enumerate(names) if n not in self.fixed_dofs],
+                        dtype=int)
 
     @property
     def n_dof(self) -> int:

@@ -43,7 +43,8 @@ def rigid_body_from_scene(body: Body, *, planar: bool, environment: Environment,
         Position = ``body.position`` (the static pose is in the statics result), mass,
         inertia about the CoG, cog, added mass and radiation damping (tables over ω
         when ``hydrodynamics`` is given, else the constant matrices), hydrostatic
-        stiffness, excitation table, drag area and point, extra stiffness and damping.
+        stiffness, excitation table, drag area and point, extra stiffness and damping,
+        fixed DOFs (held in the coupled dynamics as in the statics).
 
     Raises
     ------
@@ -57,6 +58,7 @@ def rigid_body_from_scene(body: Body, *, planar: bool, environment: Environment,
         "drag_point": body.drag_point,
         "extra_stiffness": body.extra_stiffness,
         "extra_damping": body.extra_damping,
+        "fixed_dofs": tuple(body.fixed_dofs),
     }
     for k in ("added_mass", "radiation_damping", "hydrostatic_stiffness"):
         if getattr(body, k) is not None:
@@ -87,7 +89,7 @@ def rigid_body_from_scene(body: Body, *, planar: bool, environment: Environment,
 
 _FIELDS = ("name", "position", "mass", "inertia", "cog", "added_mass", "radiation_damping",
            "hydrostatic_stiffness", "excitation", "excitation_point", "drag_area",
-           "drag_point", "extra_stiffness", "extra_damping", "planar")
+           "drag_point", "extra_stiffness", "extra_damping", "planar", "fixed_dofs")
 
 
 def scene_rigid_bodies(scene: Scene, base_path: str | Path | None = None

@@ -29,7 +29,7 @@ import json
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
 
@@ -263,6 +263,9 @@ class TimeSeriesWindow:
         ``{"line.end_b.surge": series}`` prescribed end motions. [m or rad]
     end_tension : dict
         ``{line: {"end_a": series, "end_b": series}}`` total tensions. [N]
+    body_motion : dict
+        ``{body: {dof: series}}`` body motions, static pose plus dynamic part (empty
+        for scenes without bodies). [m, rad]
     method : str
         ``"dsa"`` or ``"nsa"``.
     seed : int
@@ -281,6 +284,7 @@ class TimeSeriesWindow:
     seed: int
     dt: float
     samples: int
+    body_motion: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
 
     @classmethod
     def from_document(cls, doc: Mapping[str, Any]) -> "TimeSeriesWindow":
@@ -294,6 +298,8 @@ class TimeSeriesWindow:
                          for line, ends in doc.get("lines", {}).items()},
             method=str(doc["method"]), seed=int(doc["seed"]), dt=float(doc["dt"]),
             samples=int(doc["samples"]),
+            body_motion={name: {dof: _array(v) for dof, v in b.get("motion", {}).items()}
+                         for name, b in (doc.get("bodies") or {}).items()},
         )
 
 

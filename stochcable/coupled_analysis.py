@@ -32,6 +32,20 @@ with the static correction of the truncated modes (``solver="foss"``, seed 001 �
 the unit end motions use the quasi-static split of :func:`stochcable.analysis.solve`;
 their constant split U_p makes their loads ω²·M_T U_p − iω·C U_p, so their modal
 loads and static correction are closed-form columns, :func:`_foss_unit_split`).
+A Foss line stays in the coordinates of its Foss (state) modes until the body solve
+(:class:`_FossLine`): R_0 and R_e need the end nodes and their neighbours only, and
+the one combined response P_0 + P_e u_e is reconstructed on the nodes afterwards —
+the same linear system, reassociated (tested equal to the node-level path to
+round-off, tests/test_coupled_reduction.py).  The lines' Foss decompositions of one
+evaluation (:func:`_foss_state`) may run on a thread pool, opt-in with
+``STOCHCABLE_THREADS`` (:mod:`stochcable._parallel`; the same bits as serially).
+
+Fixed body DOFs
+---------------
+``RigidBody.fixed_dofs`` are constraints: the body equation above is solved on the
+free DOFs only (rows and columns of the fixed ones dropped) and ξ_j ≡ 0 for a fixed
+j, under both solvers; :func:`coupled_modes` lists the modes of the constrained
+system.
 
 Frequency-dependent added mass and radiation damping
 ----------------------------------------------------
@@ -89,6 +103,7 @@ from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
+from scipy.linalg import lapack
 
 from .analysis import (
     ANDERSON_MIXING,
@@ -135,8 +150,14 @@ from .linearization import (
     drag_linear_harmonic,
     fixed_point,
 )
+from ._parallel import line_map
 from .results import BodyResult, LinearizationRecord, LineResult, stats_from_spectrum
-from .solvers import _foss_decomposition, _foss_transfer_modal
+from .solvers import (
+    DEFECTIVE_CONDITION,
+    FossModes,
+    _foss_decomposition,
+    _foss_transfer_modal,
+)
 
 __all__ = [
     "CoupledLine",
@@ -377,6 +398,21 @@ def _unit_channels(cl: CoupledLine) -> tuple[Channel, ...]:
     return tuple(out)
 
 
+class _LazyInputs(dict):
+    """Line name -> inputs of its channels plus its unit end-motion channels, built
+    on first access."""
+
+    def __init__(self, lines: Sequence[CoupledLine]) -> None:
+        super().__init__()
+        self._lines = {cl.name: cl for cl in lines}
+
+    def __missing__(self, name: str) -> Any:
+        cl = self._lines[name]
+        value = _inputs(cl.system, tuple(cl.channels) + _unit_channels(cl))
+        self[name] = value
+        return value
+
+
 class _Group:
     """Frequency-independent data of a coupled group."""
 
@@ -396,14 +432,19 @@ class _Group:
             k += b.n_dof
         self.off = off
         self.nb = k
+        # body DOFs not held by ``RigidBody.fixed_dofs`` (the fixed ones are ξ ≡ 0)
+        self.body_free = np.array([off[b.name] + i for b in bodies for i in b.free_index],
+                                  dtype=int)
         self.channels = tuple(channels)
         self.n_ch = len(channels)
         self.omega = channels[0].omega
         self.weights = (_trapezoid_weights(self.omega)[:, None]
                         * np.stack([c.spectrum for c in channels], axis=1))
         self.sizes: dict[str, int] = {}
-        # per line: augmented inputs, link matrix T_l (d·n_att, nb), attached rows
-        self.inp, self.inp_phys, self.tmat, self.rows = {}, {}, {}, {}
+        # per line: augmented inputs (built on first use: only the node-level paths
+        # need them), link matrix T_l (d·n_att, nb), attached rows
+        self.inp: dict[str, Any] = _LazyInputs(self.lines)
+        self.inp_phys, self.tmat, self.rows = {}, {}, {}
         geo = {b.name: np.zeros((b.n_dof, b.n_dof)) for b in bodies}
         for cl in self.lines:
             if [c.name for c in cl.channels] != [c.name for c in channels]:
@@ -433,9 +474,9 @@ class _Group:
                 rows.extend(range(k * d, (k + 1) * d))
             self.tmat[cl.name] = t
             self.rows[cl.name] = np.asarray(rows, dtype=int)
-            self.inp[cl.name] = _inputs(cl.system, tuple(cl.channels) + _unit_channels(cl))
-            # the physical channels alone, for the σ (the unit channels weigh zero)
-            self.inp_phys[cl.name] = _inputs(cl.system, tuple(cl.channels))
+        # the physical channels alone, for the σ (the unit channels weigh zero)
+        self.inp_phys = {cl.name: _inputs(cl.system, tuple(cl.channels))
+                         for cl in self.lines}
         self.geometric = geo
         nb = self.nb
         self.kb = np.zeros((nb, nb))
@@ -530,39 +571,74 @@ def _solve_group(g: _Group, line_damping: Mapping[str, Damping],
         gen = g.emb[b.name].T @ (t.T * bb[None, :])     # (d, 3)
         sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
         rhs[:, sl, :] += np.einsum("ij,wjc->wic", gen, g.loads[b.name].velocity)
-    parts = {}
-    for cl in g.lines:
-        system = cl.system
-        inp = g.inp[cl.name]
-        damping = line_damping[cl.name]
-        solved = None
-        if system.solver != "direct":
-            solved = _foss_unit_split(system, g.inp_phys[cl.name], inp, damping)
-        u_f, c = _solve_free(system, inp, damping) if solved is None else solved
-        u = _total(system, inp, u_f)
-        sup = _reactions(system, _prep(system), c, u, _end_loads(system, inp, damping), w)
-        rows = g.rows[cl.name]
+    # the lines are independent until the body solve: their Foss decompositions (the
+    # LAPACK eigenproblems, GIL released) may run on the thread pool (opt-in,
+    # stochcable._parallel), the rest serially (many small NumPy steps that hold the
+    # GIL: pooled they cost more CPU than they overlap, docs/BENCHMARKS.md pass E4);
+    # summed in line order, the same bits with or without the pool
+    modal = [cl for cl in g.lines if cl.system.solver != "direct" and _MODAL_FOSS]
+    states = dict(zip([cl.name for cl in modal], line_map(
+        lambda cl: _foss_state(cl.system, line_damping[cl.name]), modal)))
+    done = [_line_part(g, cl, line_damping[cl.name], states.get(cl.name))
+            for cl in g.lines]
+    parts: dict[str, Any] = {}
+    for cl, (part, r0, re) in zip(g.lines, done):
         t = g.tmat[cl.name]
-        r0 = sup[:, rows, :n_ch]
-        re = sup[:, rows, n_ch:]
         s = s - t.T[None] @ re @ t[None]
         rhs = rhs + t.T[None] @ r0
-        parts[cl.name] = (u, sup)
-    if g.nb:
-        xi = _solve_body(s, rhs, w)
+        parts[cl.name] = part
+    free = g.body_free
+    if free.size == g.nb:
+        xi = _solve_body(s, rhs, w) if g.nb else np.zeros((w.size, 0, n_ch), dtype=complex)
     else:
-        xi = np.zeros((w.size, 0, n_ch), dtype=complex)
+        # fixed DOFs: the constraint ξ_j ≡ 0, the free rows and columns solved
+        xi = np.zeros((w.size, g.nb, n_ch), dtype=complex)
+        if free.size:
+            xi[:, free, :] = _solve_body(s[:, free[:, None], free[None, :]],
+                                         rhs[:, free, :], w)
     out = {}
     for cl in g.lines:
-        u, sup = parts[cl.name]
         t = g.tmat[cl.name]
         ue = t[None] @ xi                                     # (n_w, d·n_att, n_ch)
+        part = parts[cl.name]
+        if isinstance(part, _FossLine):
+            out[cl.name] = part.combine(ue)
+            continue
+        u, sup = part
         uc = u[..., :n_ch] + np.einsum("ndwj,wjc->ndwc", u[..., n_ch:], ue)
         sc = sup[:, :, :n_ch] + sup[:, :, n_ch:] @ ue
         out[cl.name] = (uc, sc)
     if timing is not None:
         timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
     return out, xi
+
+
+def _line_part(g: _Group, cl: CoupledLine, damping: Damping, state: Any = None
+               ) -> tuple[Any, np.ndarray, np.ndarray]:
+    """One line of :func:`_solve_group` before the body solve: its part (a
+    :class:`_FossLine`, or the node-level (u, support) with the unit columns) and its
+    end reactions R_0 (n_w, |rows|, n_ch), R_e (n_w, |rows|, n_e) on the attached rows;
+    ``state``: the line's :func:`_foss_state` when already computed."""
+    system = cl.system
+    rows = g.rows[cl.name]
+    n_ch = g.n_ch
+    if system.solver != "direct" and _MODAL_FOSS:
+        try:
+            part = _FossLine(system, g.inp_phys[cl.name], damping,
+                             tuple(k for k, _ in cl.attached()), state)
+        except SolverError:   # defective pencil: the plain solve's fallback
+            pass
+        else:
+            r0, re = part.reactions(rows)
+            return part, r0, re
+    inp = g.inp[cl.name]
+    solved = None
+    if system.solver != "direct":
+        solved = _foss_unit_split(system, g.inp_phys[cl.name], inp, damping)
+    u_f, c = _solve_free(system, inp, damping) if solved is None else solved
+    u = _total(system, inp, u_f)
+    sup = _reactions(system, _prep(system), c, u, _end_loads(system, inp, damping), g.omega)
+    return (u, sup), sup[:, rows, :n_ch], sup[:, rows, n_ch:]
 
 
 def _foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Damping
@@ -623,6 +699,199 @@ def _foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Dampi
                 - (1j * w)[None, :, None] * st[:, None, n_e:])
     u = np.concatenate([u_p.reshape(nf, n_w, n_ch), u_e], axis=2)
     return u.reshape(prep.n - 2, prep.d, n_w, n_ch + n_e), c
+
+
+def _foss_decomposition_nogil(mh: np.ndarray, ch: np.ndarray, kh: np.ndarray
+                              ) -> FossModes:
+    """:func:`stochcable.solvers._foss_decomposition` with NumPy's ``geev``.
+
+    The same LAPACK routine on the same matrix (the same bits here), but NumPy's
+    linalg gufuncs release the GIL while SciPy's f2py ``geev`` wrapper holds it
+    (scipy/scipy#12436: ``threadsafe`` is not applied to every LAPACK wrapper), so
+    the lines' eigenproblems of a group overlap on the thread pool
+    (:mod:`stochcable._parallel`; measured: 4 × 78×78 ``eig`` on 2 threads, SciPy
+    no overlap, NumPy 1.6× faster).  The rest — Cholesky of M̂, the condition check
+    and the weights by one LU of the column-normalized eigenvectors — is the
+    solver's, line for line (those SciPy wrappers release the GIL).
+    """
+    n = mh.shape[0]
+    try:
+        mc = sla.cho_factor(mh, check_finite=False)
+    except np.linalg.LinAlgError:
+        raise SolverError("Foss eigenproblem: Mhat is not positive definite") from None
+    minv = sla.cho_solve(mc, np.hstack([ch, kh, np.eye(n)]), check_finite=False)
+    S = np.zeros((2 * n, 2 * n))
+    S[:n] = -minv[:, : 2 * n]
+    S[n:, :n] = np.eye(n)
+    lam, theta = np.linalg.eig(S)
+    if not np.all(np.isfinite(lam)):  # pragma: no cover - S is finite
+        raise SolverError("Foss eigenproblem produced non-finite eigenvalues")
+    # SciPy's layout (complex, Fortran order): the column norms then sum in the
+    # same order, so the whole decomposition is the solver's to the bit
+    theta = np.asfortranarray(theta, dtype=complex)
+    lam = lam.astype(complex, copy=False)
+    theta /= np.linalg.norm(theta, axis=0)
+    lu, piv = sla.lu_factor(theta, check_finite=False)
+    if np.any(np.diagonal(lu) == 0.0):
+        cond = np.inf
+    else:
+        rcond, _ = lapack.zgecon(lu, float(np.abs(theta).sum(axis=0).max()), norm="1")
+        cond = 1.0 / rcond if rcond > 0 else np.inf
+    if not np.isfinite(cond) or cond > DEFECTIVE_CONDITION:
+        raise SolverError(
+            f"Foss eigenproblem is (nearly) defective: eigenvector condition number "
+            f"{cond:.2e} > {DEFECTIVE_CONDITION:.0e} (a critically damped mode, a_j ~ 0); "
+            "use the direct modal solve (solve_modal(method='modal_direct'))"
+        )
+    chi = theta[n:]
+    rhs = np.zeros((2 * n, n), dtype=complex)
+    rhs[:n] = minv[:, 2 * n:]
+    weights = sla.lu_solve((lu, piv), rhs, check_finite=False)
+    a = (2.0 * lam * np.einsum("ij,ij->j", chi, mh @ chi)
+         + np.einsum("ij,ij->j", chi, ch @ chi))
+    return FossModes(lam, chi, a, weights, float(cond))
+
+
+def _foss_state(system: LineSystem, damping: Damping) -> tuple[Any, Any, FossModes | None]:
+    """The drag blocks C_d, the damping C = S + C_d and the Foss decomposition of a
+    line's kept modes (None when the pencil is defective): the frequency-independent
+    start of :class:`_FossLine`, the part :func:`_solve_group` runs on the thread
+    pool (its LAPACK ``geev`` releases the GIL, :func:`_foss_decomposition_nogil`)."""
+    prep = _prep(system)
+    cd = _drag_blocks(system, damping)
+    c = _add(prep.S, cd)
+    phi, mh, kh = prep.modal(system)
+    ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
+    try:
+        foss = _foss_decomposition_nogil(mh, 0.5 * (ch + ch.T), kh)
+    except SolverError:
+        foss = None
+    return cd, c, foss
+
+
+#: Foss lines of a group kept in modal coordinates until the body solve
+#: (:class:`_FossLine`); False: the node-level path of :func:`_foss_unit_split` (the
+#: reference of the tests, the same linear system).
+_MODAL_FOSS = True
+
+
+class _FossLine:
+    """A Foss line of a group in the coordinates of its Foss (state) modes.
+
+    The same linear system as :func:`_foss_unit_split` + :func:`stochcable.analysis.
+    _reactions`, reordered: the physical channels' state-modal response P_0 (2m, n_w,
+    n_ch) and the unit end motions' P_e (2m, n_w, n_e) are kept (the latter in closed
+    form, ``(ω²·W âh − iω·W b̂h)/(iω − λ)``, W the Foss weights); the end reactions
+    need the displacement of the end nodes and their neighbours only (two rows of
+    Φχ); after the body solve, :meth:`combine` forms P_0 + P_e u_e and reconstructs
+    the one combined response on all nodes (σ, support forces).  Raises SolverError
+    when the Foss pencil is defective (the caller falls back to the plain solve).
+    """
+
+    def __init__(self, system: LineSystem, inp: Any, damping: Damping,
+                 ends: tuple[int, ...], state: Any = None) -> None:
+        prep = _prep(system)
+        w = inp.omega
+        n_w, n_ch = inp.weights.shape
+        d, n = prep.d, prep.n
+        cd, c, foss = _foss_state(system, damping) if state is None else state
+        if foss is None:
+            raise SolverError("Foss eigenproblem is (nearly) defective")
+        phi, _, _ = prep.modal(system)
+        m, nf = phi.shape[1], phi.shape[0]
+        lam = foss.lambdas
+        den = 1j * w[None, :] - lam[:, None]                      # (2m, n_w)
+        bad = np.abs(den) <= 1e-12 * np.maximum(np.abs(lam)[:, None], w[None, :])
+        if bad.any():   # the message of solvers._foss_transfer_modal
+            _foss_transfer_modal(foss, np.zeros((m, n_w), dtype=complex), w, 1)
+        # physical channels: the free-row load of _solve_free
+        u_p, f0, q = _base(system, prep, inp)
+        rhs = _drag_load(system, inp, damping)
+        if rhs is None:
+            rhs = f0.copy()
+        else:
+            rhs += f0
+        if q is not None:
+            rhs += _matvec(cd, q)
+        flat = np.ascontiguousarray(prep._free_rows(rhs)).reshape(nf, n_w * n_ch)
+        p0 = (foss.weights @ _real_gemm(phi.T, flat)).reshape(2 * m, n_w, n_ch)
+        p0 /= den[:, :, None]
+        # unit end motions: the constant static following U_p,j of each attached end DOF
+        key = ("unit_follow", ends)
+        if key not in inp.cache:
+            n_e = d * len(ends)
+            ub = np.zeros((2 * d, n_e))
+            for i, k in enumerate(ends):
+                ub[k * d:(k + 1) * d, i * d:(i + 1) * d] = np.eye(d)
+            up = np.zeros((n, d, n_e))
+            up[0], up[-1] = ub[:d], ub[d:]
+            up[1:-1] = (prep.follower() @ ub).reshape(n - 2, d, n_e)
+            a = prep._free_rows(_matvec(prep.MT, up))
+            st_a = prep.residual(system, a.astype(complex)).real if m < nf else None
+            inp.cache[key] = (up, phi.T @ a, st_a)
+        up, ah, st_a = inp.cache[key]
+        b = prep._free_rows(_matvec(c, up))
+        n_e = up.shape[2]
+        wa, wb = foss.weights @ ah, foss.weights @ (phi.T @ b)      # (2m, n_e)
+        rden = 1.0 / den
+        w2, iw = w * w, 1j * w
+        self.res0 = self.st = None
+        if m < nf:
+            self.res0 = prep.residual(system, flat).reshape(nf, n_w, n_ch)
+            st_b = prep.residual(system, b.astype(complex)).real
+            self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))   # (nf, 2 n_e)
+        # end nodes and their neighbours: nodes 0, 1, n-2, n-1
+        adj = np.r_[np.arange(d), np.arange(nf - d, nf)]
+        y_adj = phi[adj] @ foss.chi                                  # (2d, 2m)
+        u4 = u_p[[0, 1, -2, -1]].copy()
+        v = (y_adj @ p0.reshape(2 * m, -1)).reshape(2, d, n_w, n_ch)
+        if self.res0 is not None:
+            v += self.res0[adj].reshape(2, d, n_w, n_ch)
+        u4[1:3] += v
+        u4e = np.empty((4, d, n_w, n_e), dtype=complex)
+        u4e[...] = up[[0, 1, -2, -1]][:, :, None, :]
+        # the unit columns' P_e = (ω² W âh − iω W b̂h)/(iω − λ) seen through y_adj
+        ya = (y_adj[:, None, :] * wa.T[None]).reshape(2 * d * n_e, 2 * m) @ rden
+        yb = (y_adj[:, None, :] * wb.T[None]).reshape(2 * d * n_e, 2 * m) @ rden
+        ve = (w2 * ya - iw * yb).reshape(2, d, n_e, n_w)
+        if self.st is not None:
+            sa, sb = st_a[adj], st_b[adj]                            # (2d, n_e)
+            ve += (w2[None, None] * sa[:, :, None]
+                   - iw[None, None] * sb[:, :, None]).reshape(2, d, n_e, n_w)
+        u4e[1:3] += ve.transpose(0, 1, 3, 2)
+        f_end = _end_loads(system, inp, damping)
+        self.sup0 = _reactions(system, prep, c, u4, f_end, w)       # (n_w, 2d, n_ch)
+        self.supe = _reactions(system, prep, c, u4e, np.zeros((2, d, n_w, n_e), complex), w)
+        self.inp, self.phi, self.chi, self.rden = inp, phi, foss.chi, rden
+        self.p0, self.wa, self.wb, self.up, self.u_p = p0, wa, wb, up, u_p
+
+    def reactions(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """R_0 (n_w, |rows|, n_ch) and R_e (n_w, |rows|, n_e) on the attached rows."""
+        return self.sup0[:, rows, :], self.supe[:, rows, :]
+
+    def combine(self, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Node displacements (n_nodes, d, n_w, n_ch) and support forces (n_w, 2d,
+        n_ch) of the line whose attached ends move by ``ue`` (n_w, n_e, n_ch)."""
+        m2, n_w, n_ch = self.p0.shape
+        nf = self.phi.shape[0]
+        n, d, n_e = self.up.shape
+        w = self.inp.omega
+        w2 = (w * w)[None, :, None]
+        iw = (1j * w)[None, :, None]
+        uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))       # (n_e, n_w, n_ch)
+        flat_e = uet.reshape(n_e, n_w * n_ch)
+        ga = (self.wa @ flat_e).reshape(m2, n_w, n_ch)
+        gb = (self.wb @ flat_e).reshape(m2, n_w, n_ch)
+        pc = self.p0 + (w2 * ga - iw * gb) * self.rden[:, :, None]
+        uf = _real_gemm(self.phi, np.ascontiguousarray(self.chi @ pc.reshape(m2, -1)))
+        if self.res0 is not None:
+            x = np.concatenate([w2 * uet, -iw * uet], axis=0).reshape(2 * n_e, -1)
+            uf += self.res0.reshape(nf, -1) + _real_gemm(self.st, x)
+        uc = self.u_p.copy()
+        uc[1:-1] += uf.reshape(n - 2, d, n_w, n_ch)
+        uc += _real_gemm(self.up.reshape(n * d, n_e), flat_e).reshape(n, d, n_w, n_ch)
+        sc = self.sup0 + self.supe @ ue
+        return uc, sc
 
 
 def _end_loads(system: LineSystem, inp: Any, damping: Damping) -> np.ndarray:
@@ -813,10 +1082,9 @@ def linearize_coupled(
     gname = f"coupled drag linearization of lines {names} and bodies " \
             f"{', '.join(b.name for b in g.bodies)}"
     # start: lines at rest (quasi-static on their moving ends), bodies at rest
-    parts = []
-    for cl in g.lines:
-        inp = g.inp_phys[cl.name]
-        parts.append(_sigmas(cl.system, inp, _quasi_static(cl.system, inp), method))
+    parts = [_sigmas(cl.system, g.inp_phys[cl.name],
+                     _quasi_static(cl.system, g.inp_phys[cl.name]), method)
+             for cl in g.lines]
     g.sizes = {cl.name: p.size for cl, p in zip(g.lines, parts)}
     for b in g.drag:
         parts.append(_body_sigma(g, b, None))
@@ -948,18 +1216,25 @@ class CoupledModes:
 
 
 def coupled_modes(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
-                  omega_ref: float, omega_top: float) -> CoupledModes:
+                  omega_ref: float, omega_top: float, *,
+                  method: str = "auto") -> CoupledModes:
     """Natural modes of lines and bodies coupled by rigid links.
 
     Parameters
     ----------
     lines : sequence of CoupledLine
     bodies : sequence of RigidBody
+        Their ``fixed_dofs`` are constraints (ξ_j ≡ 0): the modes are those of the
+        constrained system, the fixed rows of ``body_shapes`` are zero.
     omega_ref : float
         Frequency of the added mass A(ω_ref) (spectral peak). [rad/s]
     omega_top : float
         Top of the analysis grid: modes up to 2.5·omega_top are listed, at least 10.
         [rad/s]
+    method : {"auto", "full", "reduced"}
+        "full": the assembled system; "reduced": the Craig–Bampton reduction;
+        "auto": reduced when every line's highest fixed-end mode is at least
+        ``_CB_MIN_RATIO`` times the listing top, else full.
 
     Returns
     -------
@@ -971,9 +1246,56 @@ def coupled_modes(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
     :func:`stochcable.bodies.couple` (:func:`~stochcable.bodies.constant_matrices`),
     the symmetric part of K (the attachment geometric stiffness is antisymmetric by
     ½[Σ r × F]× when the static moments on a body are not balanced by the model's own
-    terms; :attr:`CoupledModes.asymmetry`).  Dense LAPACK up to 1500 DOFs, else
-    shift-invert Lanczos.
+    terms; :attr:`CoupledModes.asymmetry`).  Full: dense LAPACK up to 1500 DOFs, else
+    shift-invert Lanczos.  Reduced (Craig–Bampton): each line's free DOFs are
+    x_f = Φ q + G T ξ, Φ its fixed-end modes (all computed), G = −K_ff⁻¹K_fe its
+    static following of the attached ends, T the rigid links; the eigenproblem of
+    Lᵀ K L, Lᵀ M L over (q of every line, ξ) is a Rayleigh–Ritz projection of the
+    full one (upper bounds; on the three-leg benchmark the listed frequencies agree
+    within 1e-4 relative, tests/test_coupled_analysis.py).
     """
+    if method not in ("auto", "full", "reduced"):
+        raise InputError("method", method, "-", "must be 'auto', 'full' or 'reduced'")
+    top = (LISTED_MODE_FACTOR * omega_top) ** 2
+    if method == "auto":
+        ok = bool(lines) and all(
+            cl.system.modes is not None and cl.system.modes.count
+            and float(np.max(cl.system.modes.omega)) >= _CB_MIN_RATIO * math.sqrt(top)
+            and cl.system.model.free.size == (cl.system.model.n_nodes - 2)
+            * cl.system.model.dim for cl in lines)
+        method = "reduced" if ok else "full"
+    if method == "reduced":
+        return _coupled_modes_reduced(lines, bodies, omega_ref, top)
+    return _coupled_modes_full(lines, bodies, omega_ref, top)
+
+
+#: Craig–Bampton coupled modes ("auto") when every line's highest fixed-end mode is at
+#: least this factor above the top listed frequency.
+_CB_MIN_RATIO = 1.5
+
+
+def _fixed_body_rows(bodies: Sequence[RigidBody], body_dofs: Mapping[str, np.ndarray]
+                     ) -> np.ndarray:
+    """Coupled indices of the fixed body DOFs."""
+    out = [body_dofs[b.name][i] for b in bodies
+           for i, n in enumerate(b.dof_names) if n in b.fixed_dofs]
+    return np.asarray(out, dtype=int)
+
+
+def _listed_eigh(kd: np.ndarray, md: np.ndarray, top: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    n = kd.shape[0]
+    if n == 0:
+        return np.zeros(0), np.zeros((0, 0))
+    lam, phi = sla.eigh(kd, md, subset_by_value=(-np.inf, top), driver="gvx")
+    if lam.size < min(MIN_LISTED_MODES, n):
+        lam, phi = sla.eigh(kd, md, subset_by_index=(0, min(MIN_LISTED_MODES, n) - 1))
+    return lam, phi
+
+
+def _coupled_modes_full(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
+                        omega_ref: float, top: float) -> CoupledModes:
+    """:func:`coupled_modes` on the assembled system (the reference)."""
     links = [LineLink(cl.name, cl.system.model, end_a=cl.end_a, end_b=cl.end_b,
                       force_a=cl.system.statics.force_a if cl.end_a else None,
                       force_b=cl.system.statics.force_b if cl.end_b else None)
@@ -983,24 +1305,109 @@ def coupled_modes(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
     asym = system.asymmetry()
     ks = 0.5 * (K + K.T)
     n = system.n_dof
-    top = (LISTED_MODE_FACTOR * omega_top) ** 2
-    if n <= _DENSE_MODES:
+    keep = np.setdiff1d(np.arange(n), _fixed_body_rows(bodies, system.body_dofs))
+    ks, M = ks[keep][:, keep], M[keep][:, keep]
+    nk = keep.size
+    if nk <= _DENSE_MODES:
         kd, md = ks.toarray(), M.toarray()
         md = 0.5 * (md + md.T)
-        lam, phi = sla.eigh(kd, md, subset_by_value=(-np.inf, top), driver="gvx")
-        if lam.size < min(MIN_LISTED_MODES, n):
-            lam, phi = sla.eigh(kd, md, subset_by_index=(0, min(MIN_LISTED_MODES, n) - 1))
+        lam, phi = _listed_eigh(kd, md, top)
     else:
         from scipy.sparse.linalg import eigsh
 
-        k = min(max(MIN_LISTED_MODES, 20), n - 2)
+        k = min(max(MIN_LISTED_MODES, 20), nk - 2)
         lam, phi = eigsh(ks.tocsc(), k=k, M=M.tocsc(), sigma=0.0, which="LM")
         order = np.argsort(lam)
         lam, phi = lam[order], phi[:, order]
-    J = system.body_index
     mphi = M @ phi
-    frac = np.einsum("jn,jn->n", phi[J], mphi[J]) if J.size else np.zeros(lam.size)
-    shapes = {b.name: phi[system.body_dofs[b.name]].copy() for b in bodies}
+    full = np.zeros((n, lam.size))
+    full[keep] = phi
+    mfull = np.zeros((n, lam.size))
+    mfull[keep] = mphi
+    J = system.body_index
+    frac = np.einsum("jn,jn->n", full[J], mfull[J]) if J.size else np.zeros(lam.size)
+    shapes = {b.name: full[system.body_dofs[b.name]].copy() for b in bodies}
+    return CoupledModes(omega=np.sqrt(np.clip(lam, 0.0, None)),
+                        body_fraction=np.clip(frac, 0.0, 1.0), body_shapes=shapes,
+                        omega_ref=float(omega_ref), asymmetry=asym)
+
+
+def _coupled_modes_reduced(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
+                           omega_ref: float, top: float) -> CoupledModes:
+    """:func:`coupled_modes` by the Craig–Bampton reduction (its Notes)."""
+    by_name = {b.name: b for b in bodies}
+    off, nb = {}, 0
+    for b in bodies:
+        off[b.name] = nb
+        nb += b.n_dof
+    kb, mb = np.zeros((nb, nb)), np.zeros((nb, nb))
+    for b in bodies:
+        sl = slice(off[b.name], off[b.name] + b.n_dof)
+        kb[sl, sl] = b.hydrostatic_stiffness + b.extra_stiffness
+        mb[sl, sl] = b.mass_matrix() + b.added_mass_at(np.array([omega_ref]))[0]
+    parts = []          # per line: (L (n_dof, m + nb), K, M, end rows, T rows)
+    top_k = 0.0
+    kb_lines = np.zeros((nb, nb))
+    m_tot = 0
+    for cl in lines:
+        model = cl.system.model
+        d, nn = model.dim, model.n_nodes
+        phi = np.asarray(cl.system.modes.shapes)[model.free]
+        m = phi.shape[1]
+        t = np.zeros((2 * d, nb))
+        for k, bname in cl.attached():
+            body = by_name[bname]
+            node = 0 if k == 0 else nn - 1
+            r = model.positions[node] - body.position
+            t[k * d:(k + 1) * d, off[bname]:off[bname] + body.n_dof] = rigid_link_matrix(
+                r, planar=body.planar)
+            st = cl.system.statics
+            f = np.asarray(st.force_a if k == 0 else st.force_b, dtype=float)
+            sl = slice(off[bname], off[bname] + body.n_dof)
+            kb[sl, sl] += attachment_geometric_stiffness(f, r, body.planar)
+        ends = np.r_[np.arange(d), np.arange((nn - 1) * d, nn * d)]
+        kd_ = model.K.toarray()
+        md_ = (model.M + model.Ma).toarray()
+        # the assembled (physical) coupling, for the asymmetry measure of the full K
+        lp = np.zeros((model.n_dof, model.free.size + nb))
+        lp[model.free, np.arange(model.free.size)] = 1.0
+        lp[ends, model.free.size:] = t
+        kp = lp.T @ kd_ @ lp
+        top_k = max(top_k, float(np.abs(kp[:model.free.size]).max(initial=0.0)))
+        kb_lines += kp[model.free.size:, model.free.size:]
+        ell = np.zeros((model.n_dof, m + nb))
+        ell[model.free, :m] = phi
+        ell[model.free, m:] = _prep(cl.system).follower() @ t
+        ell[ends, m:] = t
+        parts.append((ell, kd_, md_, ends, t, m_tot, m))
+        m_tot += m
+    kfull_b = kb_lines + kb
+    top_k = max(top_k, float(np.abs(kfull_b).max(initial=0.0)))
+    asym = float(np.abs(kfull_b - kfull_b.T).max(initial=0.0) / top_k) if top_k > 0 else 0.0
+    n = m_tot + nb
+    kr, mr = np.zeros((n, n)), np.zeros((n, n))
+    for ell, kd_, md_, _, _, o, m in parts:
+        idx = np.r_[np.arange(o, o + m), np.arange(m_tot, n)]
+        kr[np.ix_(idx, idx)] += ell.T @ kd_ @ ell
+        mr[np.ix_(idx, idx)] += ell.T @ md_ @ ell
+    kr[m_tot:, m_tot:] += kb
+    mr[m_tot:, m_tot:] += mb
+    fixed = m_tot + _fixed_body_rows(bodies, {b.name: np.arange(off[b.name], off[b.name]
+                                                                 + b.n_dof) for b in bodies})
+    keep = np.setdiff1d(np.arange(n), fixed)
+    ks = 0.5 * (kr + kr.T)[np.ix_(keep, keep)]
+    ms = 0.5 * (mr + mr.T)[np.ix_(keep, keep)]
+    lam, z = _listed_eigh(ks, ms, top)
+    zf = np.zeros((n, lam.size))
+    zf[keep] = z
+    xi = zf[m_tot:]
+    # (M φ) on the body DOFs of the full system: Σ Tᵀ (M_line u)_ends + M_B ξ
+    mxi = mb @ xi
+    for ell, _, md_, ends, t, o, m in parts:
+        u = ell @ np.r_[zf[o:o + m], xi]
+        mxi += t.T @ (md_[ends] @ u)
+    frac = np.einsum("jn,jn->n", xi, mxi) if nb else np.zeros(lam.size)
+    shapes = {b.name: xi[off[b.name]:off[b.name] + b.n_dof].copy() for b in bodies}
     return CoupledModes(omega=np.sqrt(np.clip(lam, 0.0, None)),
                         body_fraction=np.clip(frac, 0.0, 1.0), body_shapes=shapes,
                         omega_ref=float(omega_ref), asymmetry=asym)
@@ -1085,9 +1492,8 @@ def body_result(name: str, dofs: Sequence[str], omega: np.ndarray,
 def analyze_coupled(scene: Any, statics: Any, settings: Any,
                     progress: Progress | None = None,
                     timing: dict[str, float] | None = None, *,
-                    rigid_bodies: Mapping[str, RigidBody] | None = None) -> tuple[
-                        dict[str, LineResult], dict[str, BodyResult],
-                        dict[str, LineSystem], dict[str, Damping]]:
+                    rigid_bodies: Mapping[str, RigidBody] | None = None
+                    ) -> CoupledAnalysis:
     """Frequency-domain analysis of a scene with bodies (the ``analyze`` branch).
 
     Parameters
@@ -1108,15 +1514,13 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
 
     Returns
     -------
-    lines : dict of LineResult
-        Every line of the scene, in scene order.
-    bodies : dict of BodyResult
-        Every body (prescribed ones with their RAO motion).
-    systems : dict of LineSystem
-        The line systems of the lines NOT coupled to a free body (for the time
-        series; coupled lines are not in it).
-    dampings : dict of Damping
-        Their converged drag.
+    CoupledAnalysis
+        Unpacks as ``lines, bodies, systems, dampings``:  every line's LineResult in
+        scene order; every body's BodyResult (prescribed ones with their RAO motion);
+        the LineSystem and converged Damping of the lines NOT coupled to a free body.
+        ``groups`` holds the converged state of each coupled group (and of each
+        free-floating body without lines) for the time series
+        (:func:`stochcable.coupled_timeseries.coupled_group_transfer`).
 
     Notes
     -----
@@ -1127,7 +1531,6 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
     (:func:`linearize_coupled`, :func:`coupled_modes`, :func:`coupled_results`).
     """
     from .analysis import _silent_channel, build_line_system, linearize
-    from .excitation import line_channels
 
     progress = _noop if progress is None else progress
     timing = {} if timing is None else timing
@@ -1178,24 +1581,7 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
     attach: dict[str, dict[str, str]] = {}
     for line in scene.lines:
         system = build_line_system(scene, line, statics.lines[line.name], settings=settings)
-        ch = line_channels(scene, line, system.positions, omega)
-        att = {}
-        for k, end in enumerate(("end_a", "end_b")):
-            a = getattr(getattr(line, end), "attach", None)
-            if a is None:
-                continue
-            if a.body in prescribed:
-                node = 0 if k == 0 else system.model.n_nodes - 1
-                r = system.positions[node] - np.asarray(body_docs[a.body].position, float)
-                mot = fairlead_motion(vessel_rao[a.body], r)
-                if scene.sea is None:
-                    raise InputError(f"bodies[{a.body}].prescribed", "RAO table", "-",
-                                     "a vessel motion RAO is relative to the sea: the scene "
-                                     "needs a 'sea'")
-                ch = tuple(dataclasses.replace(c, **{f"motion_{end[-1]}": mot})
-                           if c.kind == "sea" else c for c in ch)
-            else:
-                att[end] = a.body
+        ch, att = _scene_line_channels(scene, line, system, omega, vessel_rao)
         systems[line.name] = system
         chans[line.name] = ch
         attach[line.name] = att
@@ -1217,6 +1603,7 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
     ind_systems: dict[str, LineSystem] = {}
     dampings: dict[str, Damping] = {}
     groups: dict[str, list[str]] = {}
+    states: list[CoupledGroup] = []
     for line in scene.lines:
         if attach[line.name]:
             groups.setdefault(root(next(iter(attach[line.name].values()))), []).append(line.name)
@@ -1255,6 +1642,7 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
         timing["outputs_s"] += time.perf_counter() - t1
         lines_out.update(lo)
         bodies_out.update(bo)
+        states.append(_group_state(lnames, systems, attach, gbodies, pose, clin))
     for n in free:  # free-floating bodies without lines: the body alone
         if n in bodies_out:
             continue
@@ -1275,11 +1663,7 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
         timing["linearization_s"] += time.perf_counter() - t1
         _, bo = coupled_results([], [b], clin, settings, static_pose=pose, channels=sea_ch)
         bodies_out.update(bo)
-    if groups and getattr(settings, "timeseries", None) is not None:
-        coupled = sorted(n for names in groups.values() for n in names)
-        warn(f"time series are not simulated for lines coupled to bodies ({', '.join(coupled)}): "
-             "they are missing from the time series; their statistics and spectra are "
-             "in the result", PhysicsWarning, stacklevel=2)
+        states.append(_group_state([], systems, attach, [b], pose, clin))
     for n in prescribed:
         if scene.sea is None:
             continue
@@ -1291,7 +1675,7 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
                                     settings.duration, prescribed=True)
     ordered = {line.name: lines_out[line.name] for line in scene.lines}
     ordered_b = {b.name: bodies_out[b.name] for b in scene.bodies if b.name in bodies_out}
-    return ordered, ordered_b, ind_systems, dampings
+    return CoupledAnalysis(ordered, ordered_b, ind_systems, dampings, tuple(states))
 
 
 def _reference_omega(channels: Sequence[Channel], omega: np.ndarray) -> float:
@@ -1354,3 +1738,112 @@ def _vessel_rao(motion: Any, omega: np.ndarray) -> np.ndarray:
         out[:, i] = (np.interp(omega, w, v.real, 0.0, 0.0)
                      + 1j * np.interp(omega, w, v.imag, 0.0, 0.0))
     return out
+
+
+def _scene_line_channels(scene: Any, line: Any, system: LineSystem, omega: np.ndarray,
+                         vessel_rao: Mapping[str, np.ndarray]
+                         ) -> tuple[tuple[Channel, ...], dict[str, str]]:
+    """A scene line's input channels on ``omega`` and its ends on free bodies.
+
+    Channels as :func:`stochcable.excitation.line_channels`, with each end attached to
+    a prescribed body (a key of ``vessel_rao``: its 6-DOF RAO on ``omega``) moving with
+    :func:`fairlead_motion` inside the sea channel; returns also ``{end: body}`` for
+    the ends attached to free bodies (they are solved with the body)."""
+    from .excitation import line_channels
+
+    body_docs = {b.name: b for b in getattr(scene, "bodies", ()) or ()}
+    ch = line_channels(scene, line, system.positions, omega)
+    att: dict[str, str] = {}
+    for k, end in enumerate(("end_a", "end_b")):
+        a = getattr(getattr(line, end), "attach", None)
+        if a is None:
+            continue
+        if a.body not in vessel_rao:
+            att[end] = a.body
+            continue
+        if scene.sea is None:
+            raise InputError(f"bodies[{a.body}].prescribed", "RAO table", "-",
+                             "a vessel motion RAO is relative to the sea: the scene "
+                             "needs a 'sea'")
+        node = 0 if k == 0 else system.model.n_nodes - 1
+        r = system.positions[node] - np.asarray(body_docs[a.body].position, float)
+        mot = fairlead_motion(vessel_rao[a.body], r)
+        ch = tuple(dataclasses.replace(c, **{f"motion_{end[-1]}": mot})
+                   if c.kind == "sea" else c for c in ch)
+    return ch, att
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledGroup:
+    """Converged state of one coupled group: what re-solving it on another frequency
+    grid needs (the time series, :mod:`stochcable.coupled_timeseries`).
+
+    Attributes
+    ----------
+    lines : tuple of str
+        The group's lines in scene order (empty for a free-floating body).
+    systems : dict of str to LineSystem
+        Their systems (both end nodes prescribed).
+    attach : dict of str to dict
+        Per line ``{end: body}`` of its ends on the group's free bodies.
+    bodies : tuple of RigidBody
+        The free bodies at their static pose (``position``), with the gravity
+        restoring of :func:`body_gravity_stiffness` in ``extra_stiffness``.
+    pose : dict of str to ndarray, shape (d,)
+        Static value of each body DOF (position and rotation). [m, rad]
+    dampings : dict of str to Damping
+        The converged linear drag of each line.
+    body_drag : dict of str to ndarray, shape (3,)
+        Linear drag per direction at the drag point of each body with a drag area,
+        the one the converged response was solved with
+        (:attr:`CoupledLinearization.body_drag`). [N·s/m]
+    """
+
+    lines: tuple[str, ...]
+    systems: dict[str, LineSystem]
+    attach: dict[str, dict[str, str]]
+    bodies: tuple[RigidBody, ...]
+    pose: dict[str, np.ndarray]
+    dampings: dict[str, Damping]
+    body_drag: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledAnalysis:
+    """Outcome of :func:`analyze_coupled`; unpacks as the 4-tuple
+    ``lines, bodies, systems, dampings``.
+
+    Attributes
+    ----------
+    lines : dict of str to LineResult
+        Every line of the scene, in scene order.
+    bodies : dict of str to BodyResult
+        Every body (prescribed ones with their RAO motion).
+    systems : dict of str to LineSystem
+        The lines NOT coupled to a free body (independent path).
+    dampings : dict of str to Damping
+        Their converged drag.
+    groups : tuple of CoupledGroup
+        Each coupled group, then each free-floating body without lines.
+    """
+
+    lines: dict[str, LineResult]
+    bodies: dict[str, BodyResult]
+    systems: dict[str, LineSystem]
+    dampings: dict[str, Damping]
+    groups: tuple[CoupledGroup, ...] = ()
+
+    def __iter__(self) -> Any:
+        return iter((self.lines, self.bodies, self.systems, self.dampings))
+
+
+def _group_state(lnames: Sequence[str], systems: Mapping[str, LineSystem],
+                 attach: Mapping[str, Mapping[str, str]], bodies: Sequence[RigidBody],
+                 pose: Mapping[str, np.ndarray], clin: CoupledLinearization
+                 ) -> CoupledGroup:
+    return CoupledGroup(
+        lines=tuple(lnames), systems={n: systems[n] for n in lnames},
+        attach={n: dict(attach[n]) for n in lnames}, bodies=tuple(bodies),
+        pose={b.name: np.asarray(pose[b.name], dtype=float).copy() for b in bodies},
+        dampings={n: clin.lines[n].damping for n in lnames},
+        body_drag={k: np.asarray(v, dtype=float).copy() for k, v in clin.body_drag.items()})

@@ -23,6 +23,7 @@ gives LAPACK upper banded storage and :meth:`FEModel.dense` a dense copy.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -354,14 +355,39 @@ class FEModel:
             raise InputError("node", node, "-", f"must be in 0…{self.n_nodes - 1}")
         return self.dim * (i % self.n_nodes) + c
 
+    @functools.cached_property
+    def _mass_total(self) -> sp.csr_array:
+        """M + Ma (CSR), computed once per model (the modes and the solves use it).
+
+        Assembled matrices share one pattern: the sum entry by entry on it (the same
+        numbers as scipy's sum, which also drops the entries that cancel to 0; 0.1 ms)."""
+        m, ma = self.M, self.Ma
+        if (isinstance(m, sp.csr_array) and isinstance(ma, sp.csr_array)
+                and m.shape == ma.shape and np.array_equal(m.indptr, ma.indptr)
+                and np.array_equal(m.indices, ma.indices)):
+            return sp.csr_array((m.data + ma.data, m.indices.copy(), m.indptr.copy()),
+                                shape=m.shape)
+        return (m + ma).tocsr()
+
     def _matrix(self, matrix: str | Any) -> Any:
         if isinstance(matrix, str):
             if matrix not in ("K", "M", "Ma", "Cs", "MT"):
                 raise InputError("matrix", matrix, "-", "must be K, M, Ma, Cs or MT")
             if matrix == "MT":
-                return (self.M + self.Ma).tocsr()
+                return self._mass_total.copy()
             return getattr(self, matrix)
         return matrix
+
+    def _free_free(self, matrix: Any) -> Any:
+        """The free–free block of :meth:`partition` (no validation); by slicing when
+        the free DOFs are one contiguous range (both ends prescribed), ≈ 3x faster
+        than the fancy indexing."""
+        free = self.free
+        if (sp.issparse(matrix) and free.size
+                and int(free[-1]) - int(free[0]) + 1 == free.size):
+            lo, hi = int(free[0]), int(free[-1]) + 1
+            return matrix.tocsr()[lo:hi][:, lo:hi].tocsr()
+        return self.partition(matrix)[0]
 
     def partition(self, matrix: str | Any) -> tuple[Any, Any]:
         """Free–free and free–prescribed blocks of a model matrix.
@@ -429,6 +455,42 @@ def _assemble_sparse(blocks: np.ndarray, dofs: np.ndarray, n_dof: int,
         data = np.concatenate([data, node_diag[nz]])
     a = sp.coo_array((data, (rows, cols)), shape=(n_dof, n_dof)).tocsr()
     a.sum_duplicates()
+    return a
+
+
+def _chain_csr(blocks: np.ndarray, n_nodes: int, dim: int,
+               diag: np.ndarray | None = None) -> sp.csr_array:
+    """Canonical CSR of element matrices (n_el, 2d, 2d) on consecutive nodes (element j
+    joins nodes j and j + 1, node-major DOFs), plus a diagonal (n_dof,).
+
+    The same matrix as the COO assembly of :func:`_assemble_sparse` (same pattern: the
+    full node blocks of the block-tridiagonal band, explicit zeros kept), built from
+    the node blocks directly: no COO conversion or duplicate sorting (≈ 0.1 ms per
+    matrix on the 40-element chain against ≈ 0.3)."""
+    d = dim
+    n = n_nodes
+    diag_b = np.zeros((n, d, d))
+    diag_b[:-1] += blocks[:, :d, :d]   # node a of element j: node j
+    diag_b[1:] += blocks[:, d:, d:]    # node b of element j: node j + 1
+    if diag is not None:
+        diag_b[:, np.arange(d), np.arange(d)] += diag.reshape(n, d)
+    # rows of node i: [lower (node i-1) | diagonal (node i) | upper (node i+1)]
+    data = np.zeros((n, d, 3, d))
+    data[1:, :, 0] = blocks[:, d:, :d]
+    data[:, :, 1] = diag_b
+    data[:-1, :, 2] = blocks[:, :d, d:]
+    cols = (np.arange(-1, 2)[:, None] + np.arange(n)[:, None, None]) * d + np.arange(d)
+    cols = np.broadcast_to(cols[:, None], (n, d, 3, d))  # (node, row comp, side, comp)
+    keep = np.ones((n, d, 3, d), dtype=bool)
+    keep[0, :, 0] = False
+    keep[-1, :, 2] = False
+    counts = keep.reshape(n * d, -1).sum(axis=1)
+    indptr = np.zeros(n * d + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    a = sp.csr_array((data[keep], cols[keep].astype(np.int64), indptr), shape=(n * d, n * d))
+    # the node blocks (diagonal, O[j] = A[j+1, j]) for the analysis' block solves, with
+    # a copy of the entries to detect a later in-place change (then they are re-read)
+    a._node_blocks = (a.data.copy(), diag_b, np.ascontiguousarray(blocks[:, d:, :d]))
     return a
 
 
@@ -525,7 +587,6 @@ def assemble(
     e = d / l[:, None]
     lumped = mass_matrix == "lumped"
     n_dof = dim * n_nodes
-    dofs = _element_dofs(n_el, dim)
 
     k_el = _expand(_stiffness_blocks(e, l, mesh.l0, mesh.ea, ten), _STIFF_PATTERN)
     m_el = _expand((mesh.l0 * mesh.mass)[:, None, None] * np.eye(dim)[None],
@@ -546,11 +607,15 @@ def assemble(
     m_diag = np.repeat(mesh.node_mass, dim)
     ma_diag = np.repeat(mesh.node_added_mass, dim)
 
-    K = _assemble_sparse(k_el, dofs, n_dof, k_diag)
-    M = _assemble_sparse(m_el, dofs, n_dof, m_diag)
-    Ma = _assemble_sparse(ma_el, dofs, n_dof, ma_diag)
-    Cs = sp.csr_array(sp.diags_array(c_diag, format="csr")) if c_diag.any() else \
-        sp.csr_array((n_dof, n_dof))
+    K = _chain_csr(k_el, n_nodes, dim, k_diag)
+    M = _chain_csr(m_el, n_nodes, dim, m_diag)
+    Ma = _chain_csr(ma_el, n_nodes, dim, ma_diag)
+    if c_diag.any():  # the nonzero diagonal entries only (as sp.diags_array gave)
+        nz = c_diag != 0.0
+        Cs = sp.csr_array((c_diag[nz], np.flatnonzero(nz).astype(np.int32),
+                           np.r_[0, np.cumsum(nz)].astype(np.int32)), shape=(n_dof, n_dof))
+    else:
+        Cs = sp.csr_array((n_dof, n_dof))
 
     fixed_mask = np.zeros(n_nodes, dtype=bool)
     fixed_mask[list(fixed_set)] = True

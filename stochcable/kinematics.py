@@ -182,6 +182,36 @@ def _depth_ratios(k: np.ndarray, z: np.ndarray, h: float) -> tuple[np.ndarray, n
     return ch, sh, cc
 
 
+def _nodal_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float,
+                      h: float, g: float) -> tuple[np.ndarray, ...]:
+    """:func:`wave_kinematics` without validation or pressure (validated frequencies,
+    their wavenumbers k, points): the elevation phase (P, W), cosh k(z+h)/cosh kh
+    (P, W), the dry points (P,), the velocity and the acceleration (P, 3, W)."""
+    cb, sb = math.cos(beta), math.sin(beta)
+    z = pts[:, 2]
+    xi = pts[:, 0] * cb + pts[:, 1] * sb
+    phase = np.exp(-1j * np.multiply.outer(xi, k))          # (P, W)
+    wet = z <= 0.0
+    zc = np.minimum(z, 0.0)
+    ch, sh, cc = _depth_ratios(k, zc, h)
+    zero_w = w == 0.0
+    if zero_w.any():
+        ch[:, zero_w] = 0.0 if math.isinf(h) else math.sqrt(g / h)
+        sh[:, zero_w] = 0.0
+    uh = ch * w if not zero_w.any() else np.where(zero_w, ch, ch * w)
+    uh = uh * phase
+    uz = 1j * (sh * w) * phase
+    dry = ~wet
+    uh[dry] = 0.0
+    uz[dry] = 0.0
+    vel = np.empty((pts.shape[0], 3, w.size), dtype=np.complex128)
+    vel[:, 0] = uh * cb
+    vel[:, 1] = uh * sb
+    vel[:, 2] = uz
+    acc = vel * (1j * w)
+    return phase, cc, dry, vel, acc
+
+
 def wave_kinematics(
     omega: ArrayLike,
     points: ArrayLike,
@@ -237,29 +267,9 @@ def wave_kinematics(
                          f"z must be >= -depth = {-h:g} (point {i} has z = {z[i]:g})")
 
     k = _wavenumber(w, h, g)
-    cb, sb = math.cos(beta), math.sin(beta)
-    xi = pts[:, 0] * cb + pts[:, 1] * sb
-    phase = np.exp(-1j * np.multiply.outer(xi, k))          # (P, W)
-    wet = z <= 0.0
-    zc = np.minimum(z, 0.0)
-    ch, sh, cc = _depth_ratios(k, zc, h)
-    zero_w = w == 0.0
-    if zero_w.any():
-        ch[:, zero_w] = 0.0 if math.isinf(h) else math.sqrt(g / h)
-        sh[:, zero_w] = 0.0
-    uh = ch * w if not zero_w.any() else np.where(zero_w, ch, ch * w)
-    uh = uh * phase
-    uz = 1j * (sh * w) * phase
-    dry = ~wet
-    uh[dry] = 0.0
-    uz[dry] = 0.0
+    phase, cc, dry, vel, acc = _nodal_kinematics(w, k, pts, beta, h, g)
     pressure = cc * phase
     pressure[dry] = 0.0
-    vel = np.empty((pts.shape[0], 3, w.size), dtype=np.complex128)
-    vel[:, 0] = uh * cb
-    vel[:, 1] = uh * sb
-    vel[:, 2] = uz
-    acc = vel * (1j * w)
     for a in (w, k, pts, phase, vel, acc, pressure):
         a.setflags(write=False)
     return WaveKinematics(

@@ -472,7 +472,9 @@ class TimeSeries:
     method : str
         ``"dsa"`` or ``"nsa"``.
     seed : int
-        Root seed; channel k uses ``np.random.SeedSequence(seed).spawn(n)[k]``.
+        Root seed: the sea uses ``rng=seed``; end-motion spectrum channel k (every
+        line in scene order × end_a, end_b × surge, sway, heave) uses
+        ``np.random.SeedSequence(seed).spawn(n)[k]``.
     elevation : ndarray or None, shape (N_t,)
         Wave elevation at the origin (None without a sea). [m]
     end_motion : dict
@@ -482,10 +484,23 @@ class TimeSeries:
     omega : ndarray, shape (N+1,)
         Realization grid ω_m = mΔω. [rad/s]
     channels : dict
-        ``{line: (channel names)}``, the order of the transfer arrays.
+        ``{line: (channel names)}``, the order of the transfer arrays: the line's
+        own (``"sea"``, ``"end_b.surge"``) for an independent line, its coupled
+        group's (``"sea"``, ``"<line>.<end>.<dof>"``) for a line on a free body.
     end_tension_transfer : dict
         ``{line: {"end_a": H, "end_b": H}}``, H of shape (n_ch, N+1) on ``omega``
         (zero outside the analysis band), the transfer functions synthesized. [N/unit]
+    body_motion : dict
+        ``{body: {dof: series}}`` motion of each body's reference point, static pose
+        plus dynamic part, in the body's DOF names (``BodyResult.dofs``): positions
+        [m], small rotations about the global axes [rad].  Free bodies from the
+        coupled solve, prescribed bodies (vessels) from their RAO.
+    body_channels : dict
+        ``{body: (channel names)}``, the order of the body transfer arrays (the
+        coupled group's channels; ``("sea",)`` for a vessel).
+    body_motion_transfer : dict
+        ``{body: H}``, H of shape (n_ch, d, N+1) on ``omega`` (zero outside the
+        analysis band), the transfer functions synthesized. [m/unit, rad/unit]
     """
 
     time: np.ndarray
@@ -497,6 +512,9 @@ class TimeSeries:
     omega: np.ndarray
     channels: dict[str, tuple[str, ...]]
     end_tension_transfer: dict[str, dict[str, np.ndarray]]
+    body_motion: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    body_channels: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    body_motion_transfer: dict[str, np.ndarray] = field(default_factory=dict)
 
     def to_document(self, full: bool = False) -> dict[str, Any]:
         """Document part: the first :data:`DOCUMENT_WINDOW` samples, or all if ``full``."""
@@ -515,6 +533,11 @@ class TimeSeries:
                 for name, ends in self.end_tension.items()
             },
         }
+        if self.body_motion:
+            # {body: {"motion": {dof: [...]}}} (rad for rotations), as the result's
+            # "bodies" part
+            doc["bodies"] = {name: {"motion": {k: s[:n].tolist() for k, s in dofs.items()}}
+                             for name, dofs in self.body_motion.items()}
         return doc
 
 

@@ -454,9 +454,33 @@ class _Model:
         self.bw = bw
         self.band_rows, self.band_cols = _block_band_indices(nf, dim)
 
+    _memo: dict | None = None
+
     def forces(self, X: np.ndarray, tangent: bool = True) -> tuple:
         """Nodal residual forces R (n, dim) (force on each node, zero at equilibrium),
-        element tensions, drag magnitude, and the tangent blocks -dR/dX."""
+        element tensions, drag magnitude, and the tangent blocks -dR/dX.
+
+        The residual of the last position is remembered: the Newton iteration asks for
+        it twice at every accepted point (line search, then with the tangent) and the
+        result once more; a repeated call (same X and drag factor) reuses it and only
+        adds the tangent (the same numbers, ≈ 0.4 ms of the reference chain's
+        statics)."""
+        memo = self._memo
+        if (memo is not None and memo["beta"] == self.beta and memo["X"].shape == X.shape
+                and np.array_equal(memo["X"], X)):
+            if self.has_drag:
+                self.drag_nodes = memo["drag_nodes"].copy()
+            R = memo["R"].copy()
+        else:
+            memo = self._residual(X)
+            self._memo = memo
+            R = memo["R"].copy()
+        if not tangent:
+            return R, memo["T"], memo["drag"], None
+        return R, memo["T"], memo["drag"], self._tangent(memo)
+
+    def _residual(self, X: np.ndarray) -> dict:
+        """The residual part of :meth:`forces` and the intermediates of the tangent."""
         dim, zi, l0 = self.dim, self.zi, self.l0
         beta = self.beta
         d = X[1:] - X[:-1]
@@ -512,8 +536,25 @@ class _Model:
         pen = self.zbed - z
         contact = pen > 0.0
         R[:, zi] += np.where(contact, self.kb * pen, 0.0)
-        if not tangent:
-            return R, T, drag, None
+        st = {"X": X.copy(), "beta": beta, "R": R, "T": T, "drag": drag, "e": e, "l": l,
+              "eae": eae, "mixed": mixed, "pen": pen}
+        if mixed.any():
+            st["dfa"], st["dfb"] = dfa, dfb
+        if self.has_drag:
+            st.update(u=u, ua=ua, un=un, unn=unn, g=g, drag_nodes=self.drag_nodes.copy())
+        return st
+
+    def _tangent(self, st: dict) -> tuple:
+        """Tangent blocks (Kd, Ku, Kl) = −dR/dX from the intermediates of
+        :meth:`_residual`."""
+        dim, zi, l0 = self.dim, self.zi, self.l0
+        beta = st["beta"]
+        e, l, eae, T, mixed, pen = (st[k] for k in ("e", "l", "eae", "T", "mixed", "pen"))
+        w_sub, w_dry = self.w_sub, self.w_dry
+        if self.has_drag:
+            u, ua, un, unn, g = (st[k] for k in ("u", "ua", "un", "unn", "g"))
+        if mixed.any():
+            dfa, dfb = st["dfa"], st["dfb"]
         I = np.eye(dim)
         ee = e[:, :, None] * e[:, None, :]
         k = (eae / l0)[:, None, None] * ee + (T / l)[:, None, None] * (I - ee)
@@ -546,7 +587,7 @@ class _Model:
             Kl[:, zi, zi] += dWa
         # nodes resting exactly on the bed get the contact stiffness too
         Kd[:, zi, zi] += np.where(pen >= 0.0, self.kb, 0.0)
-        return R, T, drag, (Kd, Ku, Kl)
+        return Kd, Ku, Kl
 
     def band(self, K: tuple, lam: float) -> np.ndarray:
         Kd, Ku, Kl = K
@@ -784,12 +825,17 @@ def _chain_guess(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
         P[1:] += 0.5 * W
         return P
 
+    memo: dict[str, Any] = {"P": None}
+    element_index = np.arange(mesh.n_elements)
+
     def shoot(H: float, V0: float, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        V = V0 + np.concatenate([[0.0], np.cumsum(P[1:-1])])  # element k
+        if memo["P"] is not P:  # the load sums of P, once per P (same numbers)
+            memo["P"], memo["cum"] = P, np.concatenate([[0.0], np.cumsum(P[1:-1])])
+        V = V0 + memo["cum"]  # element k
         if on_bed:
             pos = np.flatnonzero(V > 0.0)
             k_star = int(pos[0]) if pos.size else V.size
-            Ve = np.where(np.arange(V.size) < k_star, 0.0, V)
+            Ve = np.where(element_index < k_star, 0.0, V)
             # contact force of the grounded nodes 1..k_star (the last one carries the
             # part of its load not taken by the first suspended element)
             contact = P.copy()

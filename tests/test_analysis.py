@@ -608,3 +608,157 @@ def test_damping_matrix_is_assembled_lazily_and_equals_drag_matrix():
     assert "matrix" not in damping._cache  # nothing assembled in the iteration
     ref = drag_matrix(system.model, damping.b_normal, damping.b_axial, damping.b_node)
     assert abs(damping.matrix - ref).max() == 0.0  # the same assembly, exactly
+
+
+# --------------------------------------------- speed pass: same numbers, other route
+# (issue 4, docs/BENCHMARKS.md "Response analysis", fifth pass).  Each fast route is
+# checked against the computation it replaced.
+
+
+@pytest.fixture(scope="module")
+def chain_parts():
+    scene, system, chans = system_and_channels(chain_doc(elements=16, omega_count=100))
+    inp = an._inputs(system, chans)
+    x = an._rest_sigmas(system, inp, "seed")
+    damping = an.drag_coefficients(system, x, "seed")
+    return scene, system, chans, inp, damping
+
+
+def test_node_block_stash_follows_in_place_changes(chain_parts):
+    """_blocks_of reads the node blocks fem stashed on its matrices; a matrix changed in
+    place afterwards is read again from its CSR entries."""
+    _, system, _, _, _ = chain_parts
+    model = system.model
+    d = model.dim
+    k = model.K.copy()  # a copy carries no stash: the CSR route
+    k._node_blocks = model.K._node_blocks
+    ref = an._blocks_of(model.K.copy(), d)
+    got = an._blocks_of(k, d)
+    for g_, r_ in zip(got, ref):
+        np.testing.assert_array_equal(g_, r_)
+    k.data *= 2.0  # changed in place: the stash no longer matches its entries
+    for g_, r_ in zip(an._blocks_of(k, d), ref):
+        np.testing.assert_array_equal(g_, 2.0 * r_)
+
+
+def test_base_load_equals_block_products(chain_parts):
+    """_base builds M_T U_p, C_s U_p from the cached products with the unit end
+    displacements, and only for the channels that move an end; against the block
+    products of the whole U_p (the route it replaced): 1e-13 of the largest load
+    (round-off of sums in another order)."""
+    _, system, _, inp, _ = chain_parts
+    prep = an._prep(system)
+    u, f0, q = an._base(system, prep, inp)
+    u_ref = an._quasi_static(system, inp)  # Foss: U_p is the quasi-static following
+    np.testing.assert_allclose(u, u_ref, rtol=0, atol=1e-14 * np.abs(u_ref).max())
+    f0_ref = inp.inertia_load - an._dynamic(prep, prep.S, inp.omega, u_ref)
+    np.testing.assert_allclose(f0, f0_ref, rtol=0, atol=1e-13 * np.abs(f0_ref).max())
+    np.testing.assert_array_equal(u[..., 0], 0.0)  # the sea channel moves no end
+    np.testing.assert_array_equal(f0[..., 0], inp.inertia_load[..., 0])
+
+
+def test_free_load_equals_drag_load_plus_damping_of_end_motion(chain_parts):
+    """_free_load merges F_d(V) and C_d Q into one element load of combined moments;
+    against the two loads of the route it replaced: 1e-13 of the largest."""
+    _, system, _, inp, damping = chain_parts
+    prep = an._prep(system)
+    _, f0, q = an._base(system, prep, inp)
+    ref = an._drag_load(system, inp, damping) + f0 + an._matvec(
+        an._drag_blocks(system, damping), q)
+    got = an._free_load(system, prep, inp, damping)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
+
+
+def test_rest_sigmas_equal_quasi_static_sigmas(chain_parts):
+    """The start σ from the cached projections (Foss) are _sigmas of the quasi-static
+    motion, to the bit."""
+    _, system, _, inp, _ = chain_parts
+    ref = an._sigmas(system, inp, an._quasi_static(system, inp), "seed")
+    np.testing.assert_array_equal(an._rest_sigmas(system, inp, "seed"), ref)
+
+
+def test_subset_caches_are_the_subset_computation(chain_parts):
+    """The coarse subset slices the full grid's drag-independent arrays; computed on
+    the subset directly they are the same (1e-15: products in other batch sizes)."""
+    _, system, chans, inp, _ = chain_parts
+    prep = an._prep(system)
+    an._qproj(system, inp, "seed")
+    an._drag_inputs(system, prep, inp)
+    an._fluid_terms(system, inp, "seed")
+    idx = an._uniform_subset(inp.omega.size)
+    sliced = an._subset_inputs(system, chans, inp, idx)
+    fresh = an._subset_inputs(system, chans, an._inputs(system, chans), idx)
+    assert ("qproj", "foss", "seed") in sliced.cache and not fresh.cache
+
+    def close(a, b):
+        if a is None or b is None:
+            assert a is None and b is None
+        else:
+            scale = float(np.abs(b).max(initial=0.0))
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-15 * scale)
+
+    for fn in (lambda i: an._base(system, prep, i), lambda i: an._drag_inputs(system, prep, i),
+               lambda i: an._qproj(system, i, "seed"),
+               lambda i: an._fluid_terms(system, i, "seed")):
+        for a, b in zip(fn(sliced), fn(fresh)):
+            close(a, b)
+
+
+def test_reactions_and_tension_transfer_equal_their_direct_formulas(chain_parts):
+    """End reactions from real block products (_reactions) against the impedance blocks
+    Z = K − ω²M_T + iωC applied to U with the whole-line loads; the element tension
+    transfer against the einsum e·(u_b − u_a)·EA/l0: 1e-12 of the largest (the end rows
+    sum stiffness terms much larger than their sum)."""
+    _, system, chans, inp, damping = chain_parts
+    prep = an._prep(system)
+    u_f, c = an._solve_free(system, inp, damping)
+    u = an._total(system, inp, u_f)
+    w = inp.omega
+    got = an._reactions(system, prep, c, u, an._end_loads(system, inp, damping), w)
+    f_all = an._loads(system, inp, damping)
+    w2, iw = (w * w)[:, None, None], (1j * w)[:, None, None]
+
+    def z(k, i):
+        return prep.K[k][i][None] - w2 * prep.MT[k][i][None] + iw * c[k][i][None]
+
+    ra = (np.einsum("wpq,qwc->wpc", z(0, 0), u[0]) + np.einsum("wqp,qwc->wpc", z(1, 0), u[1])
+          - np.moveaxis(f_all[0], 1, 0))
+    rb = (np.einsum("wpq,qwc->wpc", z(0, -1), u[-1])
+          + np.einsum("wpq,qwc->wpc", z(1, -1), u[-2]) - np.moveaxis(f_all[-1], 1, 0))
+    ref = -np.concatenate([ra, rb], axis=1)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    resp = an._response(system, inp, damping, (u, c))
+    model = system.model
+    uu = resp.displacement.reshape(w.size, model.n_nodes, model.dim, -1)
+    ref_t = (model.mesh.ea / model.l0)[None, :, None] * np.einsum(
+        "wedc,ed->cew", uu[:, 1:] - uu[:, :-1], model.tangents)
+    got_t = an.element_tension_transfer(system, resp)
+    np.testing.assert_allclose(got_t, ref_t, rtol=0, atol=1e-14 * np.abs(ref_t).max())
+
+
+def test_attachment_drag_sigma_is_the_total_relative_velocity_sigma():
+    """An attachment with a drag area under a sea: its linearization σ is that of the
+    total relative velocity V − iωU at its node (trapezoid over ω, all components, all
+    channels), computed here from the response and the channels' nodal velocities
+    (the σ used to flatten the components into the frequency axis and failed)."""
+    doc = chain_doc(elements=12, omega_count=60)
+    doc["lines"][0]["attachments"] = [{"at": 300.0, "mass": 500.0, "buoyancy": 2.0e4,
+                                       "drag_area": 2.0, "added_mass": 300.0}]
+    scene, system, chans = system_and_channels(doc)
+    node = int(system.drag_nodes[0])
+    lin = an.linearize(system, chans, scene.analysis)
+    sig = an.relative_velocity_sigmas(system, chans, lin.response, "seed")
+    w = chans[0].omega
+    u = lin.response.displacement.reshape(w.size, system.model.n_nodes, system.model.dim, -1)
+    comps = list(system.model.components)
+    var = 0.0
+    for i, ch in enumerate(chans):
+        v = np.zeros((w.size, system.model.dim), dtype=complex)
+        if ch.velocity is not None:
+            v = ch.velocity[:, node][:, comps]
+        rel = v - 1j * w[:, None] * u[:, node, :, i]
+        var += np.trapezoid(ch.spectrum * np.sum(np.abs(rel) ** 2, axis=1), w)
+    # the same sums in another order: round-off
+    assert sig[-1] == pytest.approx(math.sqrt(var), rel=1e-12)
+    res = an.analyze(doc)
+    assert np.isfinite(res.lines["chain"].end_b.std)

@@ -405,3 +405,23 @@ def test_catenary_line_rejects_multisegment_and_attachments():
     )
     with pytest.raises(InputError, match=r"without loaded attachments"):
         catenary_line(line, base.environment)
+
+
+def test_scalar_closure_kernel_is_the_array_kernel():
+    """The float kernel of the closure Newton (catenary._kernel_scalar, the speed pass
+    of issue 4) returns the array kernel's numbers to the bit on every branch: V0, V1 of
+    one sign (both signs), opposite signs, a zero end force, the asinh(d)/d series
+    (|d| < 1e-6: w → 0), an inextensible line (c = 0)."""
+    cases = [
+        (3.0e5, 2.0e5, 2500.0, 850.0, 1.0 / 1.2e9),    # both up
+        (3.0e5, -4.0e6, 2500.0, 850.0, 1.0 / 1.2e9),   # both down
+        (3.0e5, -1.0e6, 2500.0, 850.0, 1.0 / 1.2e9),   # opposite signs
+        (3.0e5, 0.0, 2500.0, 850.0, 1.0 / 1.2e9),      # zero force at the start
+        (3.0e5, 1.0e4, 1e-9, 850.0, 1.0 / 1.2e9),      # series branch of asinh(d)/d
+        (5.0e3, -2.0e3, 10.0, 100.0, 0.0),             # inextensible
+        (1.0, 0.0, 0.0, 10.0, 1e-6),                   # weightless, V0 = V1 = 0
+    ]
+    for H, V0, w, ls, c in cases:
+        fast = cat._kernel_scalar(H, V0, w, ls, c)
+        ref = tuple(float(x) for x in cat._kernel(H, V0, w, ls, c))
+        assert fast == ref, (H, V0, w, ls, c)

@@ -7,6 +7,7 @@ import json
 import socket
 import threading
 import time
+import warnings
 
 import httpx
 import numpy as np
@@ -188,6 +189,26 @@ def test_analyze_from_a_plain_document_without_timeseries(client):
     res = client.analyze(doc, timeseries="none")
     assert res.timeseries is None and "timeseries" not in res
     assert_close_documents(res.lines["wire"].end_b.as_dict(), analyze(doc).lines["wire"].end_b.as_dict())
+
+
+def test_analyze_bodies_scene_returns_body_motion_series(client):
+    """The time-series window of a scene with a body carries the body's motion per DOF,
+    equal to the local realization's first samples (same seed, round-off from BLAS)."""
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
+    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 64.0, "dt": 0.5,
+                                     "seed": 2}
+    res = client.analyze(doc)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        local = analyze(doc).timeseries
+    ts = res.timeseries
+    assert set(ts.body_motion) == {"disc"}
+    assert list(ts.body_motion["disc"]) == ["surge", "heave", "pitch"]
+    for dof, series in ts.body_motion["disc"].items():
+        want = local.body_motion["disc"][dof][:series.size]
+        np.testing.assert_allclose(series, want, rtol=1e-10,
+                                   atol=1e-10 * np.abs(want).max(), err_msg=dof)
+    assert np.std(ts.body_motion["disc"]["heave"]) > 0
 
 
 def test_analyze_unconverged_raises_client_error_with_the_reason(client):

@@ -109,7 +109,11 @@ def _group(doc, body):
 @pytest.fixture(scope="module")
 def mooring_direct():
     body = _buoy()
-    scene, cls, loads = _group(_mooring_doc(), body)
+    # tolerance 1e-7: the buoy's sway σ is zero by symmetry (heading 0) and carries
+    # round-off (~1e-15 m/s) of the mirrored legs; against the convergence floor
+    # (1e-6 × the largest σ) that is a relative-change noise of ~1e-9–1e-8, which
+    # stalls a 1e-10 iteration (the comparisons below use rtol ≥ 1e-7 / 1e-5)
+    scene, cls, loads = _group(_mooring_doc(tol=1e-7), body)
     lin = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)
     return scene, cls, loads, body, lin
 
@@ -756,3 +760,150 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     ref, _ = _solve_free(s, g.inp[cl.name], damp)
     assert got.shape == ref.shape and got.shape[-1] == 4  # sea + 3 unit columns
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+
+
+# ------------------------------------------------------------- fixed body DOFs
+
+
+def test_all_dofs_fixed_equals_lines_with_fixed_fairleads():
+    """A buoy with all six DOFs in ``fixed_dofs`` holds its fairleads: each leg is the
+    independent analysis (stochcable.analysis.linearize) of the leg with its fairlead
+    fixed at the same static point; the body does not move."""
+    body = _buoy(fixed_dofs=("surge", "sway", "heave", "roll", "pitch", "yaw"))
+    scene, cls, loads = _group(_mooring_doc(), body)
+    lin = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)
+    assert np.all(lin.body_motion["buoy"] == 0.0)   # a constraint, exactly zero
+    lo, _ = coupled_results(cls, [body], lin, scene.analysis)
+    for cl in cls:
+        ref = line_result(cl.system, cl.channels,
+                          linearize(cl.system, cl.channels, scene.analysis), scene.analysis)
+        got = lo[cl.name]
+        # both fixed points converged to 1e-10 relative (the group's jointly)
+        for end in ("end_a", "end_b"):
+            assert getattr(got, end).std == pytest.approx(getattr(ref, end).std, rel=1e-8)
+        np.testing.assert_allclose(got.tension_std, ref.tension_std, rtol=1e-8)
+        np.testing.assert_allclose(got.motion_transfer, ref.motion_transfer, rtol=1e-8,
+                                   atol=1e-10 * np.abs(ref.motion_transfer).max())
+
+
+def test_fixed_heave_on_springs_closed_form():
+    """6-DOF body on coupled springs with heave fixed: ξ_heave ≡ 0 and the other five
+    DOFs solve the 5×5 system of Z = K − ω²(M + A) + iωB without the heave row and
+    column (written out here), not the 6×6 one."""
+    w = np.linspace(0.2, 3.0, 25)
+    rng = np.random.default_rng(7)
+    a = rng.normal(size=(6, 6))
+    ks = np.diag([2e4, 3e4, 8e4, 2e5, 3e5, 1e5]) + 2e3 * (a + a.T)
+    A = np.diag([800.0, 900.0, 1200.0, 3e3, 3e3, 1e3])
+    A[0, 2] = A[2, 0] = 150.0      # heave couples to surge: fixing heave matters
+    B = np.diag([60.0, 60.0, 90.0, 200.0, 200.0, 50.0])
+    f = (1e4 * np.exp(0.3j * w)[None] * np.arange(1, 7)[:, None]).astype(complex)
+    body = RigidBody("b", [0.0, 0.0, -3.0], 5e3, inertia=np.diag([2e4, 2e4, 3e4]),
+                     cog=[0.2, 0.1, -0.5], added_mass=A, radiation_damping=B,
+                     extra_stiffness=ks, fixed_dofs=["heave"],
+                     excitation=ExcitationTable(w, [0.0], f[None]))
+    spec = np.exp(-((w - 1.0) ** 2))
+    ch = (_sea_channel(w, spec),)
+    ld = BodyLoads(force=f.T[:, :, None], velocity=np.zeros((w.size, 3, 1), complex),
+                   current=np.zeros(3))
+    lin = linearize_coupled([], [body], _settings(), rho=RHO, loads={"b": ld}, channels=ch)
+    keep = [0, 1, 3, 4, 5]
+    M = body.mass_matrix() + A
+    z = ks[None] - w[:, None, None] ** 2 * M[None] + 1j * w[:, None, None] * B[None]
+    expected = np.zeros((w.size, 6), complex)
+    expected[:, keep] = np.linalg.solve(z[:, keep][:, :, keep], f.T[:, keep, None])[..., 0]
+    xi = lin.body_motion["b"][:, :, 0]
+    assert np.all(xi[:, 2] == 0.0)
+    # round-off of a 5×5 solve
+    np.testing.assert_allclose(xi, expected, rtol=1e-11, atol=1e-14 * np.abs(expected).max())
+    # and it is not the unconstrained answer (the test can fail)
+    free = np.linalg.solve(z, f.T[:, :, None])[..., 0]
+    assert np.max(np.abs(free[:, 0] - expected[:, 0])) > 1e-3 * np.abs(expected[:, 0]).max()
+    _, bo = coupled_results([], [body], lin, _settings(), channels=ch)
+    assert bo["b"].motion["heave"].std == 0.0
+
+
+def test_fixed_dofs_direct_equals_foss_all_modes():
+    """Yaw and roll fixed: the direct and the all-modes Foss coupled analyses solve the
+    same constrained system (fixed point converged to 1e-7, the Foss round-off
+    floor of test_foss_all_modes_equals_direct_and_truncated_close)."""
+    body = _buoy(fixed_dofs=("roll", "yaw"))
+    out = {}
+    for solver, modes in (("direct", "auto"), ("foss", 27)):
+        sc, c, ld = _group(_mooring_doc(solver=solver, modes=modes, tol=1e-7), body)
+        assert c[0].system.solver == solver
+        lin = linearize_coupled(c, [body], sc.analysis, rho=RHO, loads=ld)
+        out[solver] = lin.body_motion["buoy"]
+    for x in out.values():
+        assert np.all(x[:, [3, 5]] == 0.0)
+    np.testing.assert_allclose(out["foss"], out["direct"], rtol=1e-5,
+                               atol=1e-6 * np.abs(out["direct"]).max())
+
+
+@pytest.mark.parametrize("method", ["full", "reduced"])
+def test_fixed_dofs_modes_are_the_constrained_eigenproblem(mooring_direct, method):
+    """Coupled modes with heave and yaw fixed: the frequencies of the dense constrained
+    eigenproblem (the assembled K, M of stochcable.bodies.couple without the fixed
+    rows and columns); the fixed DOFs are zero in the shapes."""
+    import scipy.linalg as sla
+
+    from stochcable.bodies import constant_matrices
+
+    scene, cls, _, body0, _ = mooring_direct
+    body = dataclasses.replace(body0, fixed_dofs=("heave", "yaw"))
+    links = [LineLink(cl.name, cl.system.model, end_b="buoy",
+                      force_b=cl.system.statics.force_b) for cl in cls]
+    system = couple(links, [body])
+    K, M, _ = constant_matrices(system, 0.7)
+    keep = np.setdiff1d(np.arange(system.n_dof), system.body_dofs["buoy"][[2, 5]])
+    k = 0.5 * (K + K.T).toarray()[np.ix_(keep, keep)]
+    m = M.toarray()[np.ix_(keep, keep)]
+    ref = np.sqrt(sla.eigh(k, m, eigvals_only=True))
+    got = coupled_modes(cls, [body], 0.7, 2.0, method=method)
+    n = got.omega.size
+    assert n >= 10
+    # full: the same dense eigenproblem; reduced: Craig–Bampton with all 27 modes of
+    # each 10-element leg, an exact change of basis: both round-off of eigh (the
+    # truncated reduction is tested in tests/test_coupled_reduction.py)
+    tol = 1e-9
+    np.testing.assert_allclose(got.omega, ref[:n], rtol=tol)
+    assert np.all(got.omega >= ref[:n] * (1 - 1e-9))
+    assert np.all(got.body_shapes["buoy"][[2, 5]] == 0.0)
+    unconstrained = coupled_modes(cls, [body0], 0.7, 2.0, method="full")
+    assert not np.allclose(unconstrained.omega[:n], got.omega, rtol=1e-3)
+
+
+def test_fixed_dofs_validation_and_scene():
+    """RigidBody.fixed_dofs: names of the body's DOFs, no repeats; the scene's
+    Body.fixed_dofs reach the RigidBody (body_scene)."""
+    with pytest.raises(InputError, match="fixed_dofs.*unknown"):
+        _buoy(fixed_dofs=("heave", "twist"))
+    with pytest.raises(InputError, match="fixed_dofs.*repeat"):
+        _buoy(fixed_dofs=("heave", "heave"))
+    with pytest.raises(InputError, match="fixed_dofs.*unknown"):
+        _buoy(planar=True, added_mass=None, radiation_damping=None,
+              hydrostatic_stiffness=None, fixed_dofs=("yaw",))
+    assert _buoy(fixed_dofs="yaw").fixed_dofs == ("yaw",)
+    np.testing.assert_array_equal(_buoy(fixed_dofs=("sway", "yaw")).free_index, [0, 2, 3, 4])
+    from stochcable.body_scene import scene_rigid_bodies
+
+    doc = _mooring_doc()
+    doc["bodies"] = [{"name": "buoy", "position": [0.0, 0.0, 0.0], "mass": 2.0e4,
+                      "fixed_dofs": ["yaw", "roll"]}]
+    rb = scene_rigid_bodies(load_scene(doc))["buoy"]
+    assert rb.fixed_dofs == ("yaw", "roll")
+    # end to end: the fairleads on the buoy, an oblique sea; roll and yaw stay zero
+    doc = _mooring_doc(heading=30.0, tol=1e-4)
+    for ln in doc["lines"]:
+        p = ln["end_b"].pop("position")
+        ln["end_b"]["attach"] = {"body": "buoy", "point": p}
+    doc["bodies"] = [{"name": "buoy", "position": [0.0, 0.0, 0.0], "mass": 2.0e4,
+                      "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
+                      "added_mass": np.diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]).tolist(),
+                      "radiation_damping": np.diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]).tolist(),
+                      "hydrostatic_stiffness": np.diag([0, 0, 1.26e5, 1e5, 1e5, 0]).tolist(),
+                      "fixed_dofs": ["roll", "yaw"]}]
+    sc = load_scene(doc)
+    _, bodies, _, _ = analyze_coupled(sc, solve_statics(sc, method="fe"), sc.analysis)
+    std = bodies["buoy"].motion_std
+    assert std[3] == 0.0 and std[5] == 0.0 and np.all(std[[0, 1, 2, 4]] > 0)

@@ -174,3 +174,35 @@ def test_sigma_of_line_at_rest_is_element_mean_of_fluid_velocity_sigma():
     # ~1e-15; the rest is round-off
     np.testing.assert_allclose(sig[:n] ** 2 + sig[n:2 * n] ** 2, total, rtol=1e-12)
     np.testing.assert_allclose(sig[n:2 * n] ** 2, axial, rtol=1e-12)
+
+
+def test_fully_wet_exp_moments_are_the_general_formula():
+    """_exp_moments drops the factors 1 and 0 when every element is wet over its whole
+    length (the speed pass of issue 4); the general expressions give the same numbers
+    to the bit (x·1 and 0 + x are exact), growing and decaying exponents alike."""
+    from stochcable.excitation import _complex, _exp_moments, _phi1_psi
+    from stochcable.kinematics import _wavenumber
+
+    def general(e0, alpha, p, q):  # the formula for any wet part [p, q]
+        length = q - p
+        grow = alpha.real >= 0.0
+        c = np.where(grow, q, p)
+        s = np.where(grow, -1.0, 1.0)
+        f1, f2 = _phi1_psi(s * alpha * length)
+        ref = np.exp(e0 + alpha * c)
+        t1 = length * f1
+        t2 = s * (length * length) * f2
+        return ref * ((1.0 - c) * t1 - t2), ref * (c * t1 + t2)
+
+    rng = np.random.default_rng(11)
+    k = _wavenumber(np.linspace(0.05, 3.0, 60), 200.0, 9.80665)
+    za = rng.uniform(-200.0, -1.0, 25)
+    zb = np.minimum(za + rng.uniform(-8.0, 8.0, 25), -0.5)
+    chi = rng.uniform(-800.0, 0.0, 26)
+    p, q = np.zeros((25, 1)), np.ones((25, 1))
+    for sign in (1.0, -1.0):
+        e0 = _complex(np.multiply.outer(za, k), -np.multiply.outer(chi[:-1], k))
+        alpha = _complex(sign * np.multiply.outer(zb - za, k),
+                         -np.multiply.outer(chi[1:] - chi[:-1], k))
+        for got, ref in zip(_exp_moments(e0, alpha, p, q), general(e0, alpha, p, q)):
+            np.testing.assert_array_equal(got, ref)

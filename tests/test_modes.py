@@ -490,3 +490,43 @@ def test_modes_of_scene_weightless_string():
     m2 = modes_of_scene(TAUT_SCENE, count=3, dim=2)["taut"]
     np.testing.assert_allclose(m2.omega, ref[::2], rtol=4e-4)
     assert (m2.plane == "in-plane").all()
+
+
+@pytest.mark.parametrize("dim, rotate", [(2, False), (3, False), (3, True)])
+def test_dense_blocks_and_sparse_blocks_give_the_same_modes(dim, rotate):
+    """natural_modes takes the dense solver's blocks straight from the dense matrices
+    when the line lies in the x–z plane (the speed pass of issue 4); the sparse slices
+    (the path of a rotated plane, and of any line before) must give the same modes to
+    the bit: a line rotated about z has the same frequencies to round-off, and the
+    component grouping of dense and sparse matrices is the same."""
+    from stochcable.modes import _component_groups
+
+    mesh, pos, ten = shallow_parabola(12, SPAN, SAG, H_IRVINE, 8.0 * H_IRVINE * SAG / SPAN / G,
+                                      G, ea=1e7)
+    if rotate:
+        c, s = np.cos(0.7), np.sin(0.7)
+        pos = pos @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+    model = assemble(mesh, pos, ten, RHO, dim=dim)
+    dense = natural_modes(model, 8, method="dense")
+    auto = natural_modes(model, 8)
+    np.testing.assert_array_equal(dense.omega, auto.omega)
+    np.testing.assert_array_equal(dense.shapes, auto.shapes)
+    a, b = model._free_free(model.K), model._free_free(model._mass_total)
+    assert _component_groups(dim, a.toarray(), b.toarray()) == _component_groups(dim, a, b)
+    if not rotate:  # the eigenvalues of the partition's (sparse) blocks; eigvals_only
+        # takes another LAPACK path than the vectors: 1e-13 (round-off of 8 modes)
+        from scipy.linalg import eigh
+
+        groups = _component_groups(dim, a, b)
+        lam = np.sort(np.concatenate([eigh(
+            model.partition("K")[0].toarray()[np.ix_(sel, sel)],
+            model.partition("MT")[0].toarray()[np.ix_(sel, sel)], eigvals_only=True)
+            for sel in (np.flatnonzero(np.isin(np.arange(a.shape[0]) % dim, g))
+                        for g in groups)]))
+        np.testing.assert_allclose(dense.omega, np.sqrt(lam[:8]), rtol=1e-13)
+    if dim == 3 and not rotate:
+        assert _component_groups(3, a, b) == [[0, 2], [1]]  # in-plane and out-of-plane
+    if rotate:  # the planar line's modes, rotated: the same frequencies (round-off)
+        flat = natural_modes(assemble(mesh, pos @ np.array(
+            [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), ten, RHO, dim=3), 8)
+        np.testing.assert_allclose(dense.omega, flat.omega, rtol=1e-10)

@@ -1,12 +1,14 @@
 """POST /v1/analyses with rigid bodies (issue 6): the service answers the same document
-as the core for a buoy on three legs, and refuses a coefficient file (it would be read
-from the server's file system) with 422 naming the field."""
+as the core for a buoy on three legs, refuses a coefficient file (it would be read
+from the server's file system) with 422 naming the field, and carries the time series
+of a coupled line and of its body (timeseries.bodies)."""
 
 from __future__ import annotations
 
 import json
 import warnings
 
+import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
@@ -52,3 +54,29 @@ def test_coefficient_file_refused_with_422(client, tmp_path):
     text = r.text
     assert "bodies[0].hydrodynamics.file" in text
     assert "files are not accepted here" in text
+
+
+def test_bodies_scene_with_timeseries_document_carries_body_series(client):
+    """The disc buoy on one leg with analysis.timeseries: the service document has the
+    coupled leg's tensions and the body's motion series (timeseries.bodies.<name>.motion
+    per DOF), equal to the core's."""
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
+    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 128.0, "dt": 0.5,
+                                     "seed": 4}
+    r = client.post("/v1/analyses", json=doc)
+    assert r.status_code == 200, r.text
+    got = _plain(r.json())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = analyze(doc)
+    want = _plain(res.to_document())
+    ts = got["timeseries"]
+    assert set(ts["lines"]) == {"leg"} and set(ts["bodies"]) == {"disc"}
+    motion = ts["bodies"]["disc"]["motion"]
+    assert list(motion) == ["surge", "heave", "pitch"]
+    assert all(len(v) == ts["window"] == 256 for v in motion.values())
+    # the series move about the static pose (not a constant)
+    assert np.std(motion["heave"]) > 0.0 and np.std(ts["lines"]["leg"]["end_b"]["tension"]) > 0
+    assert not any("time series are not simulated" in m for m in got["warnings"])
+    # BLAS threads may differ between the service thread and the caller: round-off
+    assert_close_documents(got, want)

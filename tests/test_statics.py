@@ -384,3 +384,38 @@ def test_load_stepping_rescues_drag_dominated_line():
     assert r.residual < 1e-10 and r.iterations > 500 // 4  # went through the stepping
     drag = _drag_on_line(r, m, env, env.current_velocity)
     assert r.force_a[0] + r.force_b[0] == pytest.approx(drag[0], rel=1e-6)
+
+
+def test_repeated_residual_reuses_the_same_numbers():
+    """_Model.forces remembers the residual of the last position (the Newton iteration
+    asks twice per accepted point): a repeated call returns the numbers of a fresh
+    model to the bit, with or without the tangent, also with current drag (whose nodal
+    drag forces the line search reads) and after the drag factor changes."""
+    from stochcable.statics import _Frame, _initial_guess, _Model
+
+    seg = dict(CHAIN, elements=20)
+    m, env, _ = make((-800, 0, -200), (0, 0, -20), [seg],
+                     current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}])
+
+    frame = _Frame(m, env)
+    b = _Model(m, env, frame)
+    x = _initial_guess(m, env, frame, b)
+    x2 = x.copy()
+    x2[1:-1, -1] += 0.1
+    for beta in (1.0, 0.5):
+        b.beta = beta
+        for X in (x, x2):
+            b.forces(X, tangent=False)           # remembered without the tangent ...
+            got = b.forces(X.copy())             # ... then asked again with it
+            drag_nodes = b.drag_nodes.copy()
+            ref = _Model(m, env, _Frame(m, env))  # fresh: no memory
+            ref.beta = beta
+            want = ref.forces(X)
+            for g_, w_ in zip(got[:2], want[:2]):
+                np.testing.assert_array_equal(g_, w_)
+            assert got[2] == want[2]
+            for g_, w_ in zip(got[3], want[3]):
+                np.testing.assert_array_equal(g_, w_)
+            np.testing.assert_array_equal(drag_nodes, ref.drag_nodes)
+            got[0][:] = 0.0  # callers may change the returned residual
+            np.testing.assert_array_equal(b.forces(X, tangent=False)[0], want[0])

@@ -1,0 +1,269 @@
+"""Fast paths of the coupled dynamics (stochcable.coupled_analysis, issue 6 speed).
+
+Each fast path is the same linear system as a reference kept reachable:
+- Foss lines in modal coordinates (``_FossLine``, ``_MODAL_FOSS``) against the node-level
+  path (:func:`stochcable.coupled_analysis._foss_unit_split` + reactions), at a given
+  drag and through the whole drag fixed point;
+- coupled modes by Craig–Bampton reduction (``coupled_modes(method="reduced")``)
+  against the assembled system (``method="full"``): a Rayleigh–Ritz projection, exact
+  when every line mode is kept, otherwise upper bounds within a stated tolerance.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stochcable.coupled_analysis as ca
+from stochcable.analysis import build_line_system, drag_coefficients
+from stochcable.bodies import RigidBody
+from stochcable.coupled_analysis import (
+    CoupledLine,
+    _Group,
+    _solve_group,
+    body_loads,
+    coupled_modes,
+    linearize_coupled,
+)
+from stochcable.excitation import line_channels
+from stochcable.scene import load_scene
+from stochcable.statics import solve_statics
+
+sys.path.insert(0, str(Path(__file__).parent))
+from test_coupled_analysis import RHO, _buoy, _group, _mooring_doc  # noqa: E402
+
+
+@pytest.fixture
+def node_level(monkeypatch):
+    """Switch the Foss lines to the node-level reference path."""
+    def use(flag: bool) -> None:
+        monkeypatch.setattr(ca, "_MODAL_FOSS", flag)
+    return use
+
+
+def _solve_both(g, node_level, sigma=0.3, body_b=(2e3, 2e3, 4e3)):
+    damp = {cl.name: drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements,
+                                                          sigma), "seed")
+            for cl in g.lines}
+    bb = {b.name: np.asarray(body_b, float) for b in g.drag}
+    bc = np.zeros((g.nb, g.nb))
+    for cl in g.lines:   # the modal path runs (no silent fallback to the reference)
+        ca._FossLine(cl.system, g.inp_phys[cl.name], damp[cl.name],
+                     tuple(k for k, _ in cl.attached()))
+    out = []
+    for flag in (False, True):
+        node_level(flag)
+        out.append(_solve_group(g, damp, bc, bb, None))
+    return out
+
+
+def _assert_same(ref, got):
+    (sol_r, xi_r), (sol_g, xi_g) = ref, got
+    # the same linear system, products reassociated: round-off (1e-10 of the largest)
+    np.testing.assert_allclose(xi_g, xi_r, rtol=0, atol=1e-10 * np.abs(xi_r).max())
+    for name, (u, s) in sol_r.items():
+        ug, sg = sol_g[name]
+        assert ug.shape == u.shape and sg.shape == s.shape
+        np.testing.assert_allclose(ug, u, rtol=0, atol=1e-10 * np.abs(u).max())
+        np.testing.assert_allclose(sg, s, rtol=0, atol=1e-10 * np.abs(s).max())
+
+
+@pytest.mark.parametrize("modes", [8, "auto", 27])
+def test_modal_foss_lines_equal_node_level_path(node_level, modes):
+    """Three legs on a 6-DOF buoy, truncated (8 of 27 modes: static correction on) or
+    all modes: the modal-coordinate line solve gives the node-level one's
+    displacements, support forces and body motion."""
+    body = _buoy()
+    scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
+    assert cls[0].system.solver == "foss"
+    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    ref, got = _solve_both(g, node_level)
+    _assert_same(ref, got)
+
+
+def _planar_two_body_group():
+    """A planar leg between two planar bodies (both ends attached) and a tether from
+    body A whose other end moves with its own heave spectrum: exercises the
+    attached-end pair (0, 1), truncated modes (6), two channels and a moving
+    unattached end."""
+    doc = {"environment": {"depth": 50.0},
+           "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}},
+           "lines": [{"name": "link", "end_a": {"position": [-60.0, 0.0, -20.0]},
+                      "end_b": {"position": [0.0, 0.0, -5.0]},
+                      "segments": [{"length": 66.0, "ea": 1e9, "mass": 80.0,
+                                    "diameter": 0.09, "elements": 12}]},
+                     {"name": "tether", "end_a": {"position": [20.0, 0.0, -45.0]},
+                      "end_b": {"position": [0.0, 0.0, -5.0],
+                                "motion": {"heave": {"type": "jonswap", "hs": 0.5,
+                                                     "tp": 8.0}}},
+                      "segments": [{"length": 45.0, "ea": 1e9, "mass": 50.0,
+                                    "diameter": 0.05, "elements": 8}]}],
+           "analysis": {"omega": {"min": 0.2, "max": 2.5, "count": 30}, "solver": "foss",
+                        "modes": 6}}
+    scene = load_scene(doc)
+    st = solve_statics(scene, method="fe")
+    w = scene.analysis.omega.values()
+    a = RigidBody("A", [-60.0, 0.0, -19.0], 3e3, inertia=np.diag([0.0, 2e3, 0.0]),
+                  extra_stiffness=np.diag([1e4, 2e4, 3e4]), planar=True,
+                  radiation_damping=np.diag([50.0, 50.0, 50.0]),
+                  drag_area=[1.0, 0.0, 2.0])
+    b = RigidBody("B", [1.0, 0.0, -4.0], 2e3, inertia=np.diag([0.0, 1e3, 0.0]),
+                  extra_stiffness=np.diag([2e4, 2e4, 1e4]), planar=True,
+                  radiation_damping=np.diag([40.0, 40.0, 40.0]))
+    link = scene.lines[0]
+    s = build_line_system(scene, link, st.lines["link"])
+    tether = scene.lines[1]
+    s2 = build_line_system(scene, tether, st.lines["tether"])
+    ch2 = line_channels(scene, tether, s2.positions, w)
+    ch1 = line_channels(scene, link, s.positions, w)
+    # the group's channels: the sea and the tether's end motion (silent for the link)
+    from stochcable.excitation import Channel
+
+    names = [c.name for c in ch2]
+    ch1 = tuple(list(ch1) + [Channel(name=c.name, kind="end_motion", omega=c.omega,
+                                     spectrum=c.spectrum, density=c.density)
+                             for c in ch2 if c.kind != "sea"])
+    assert [c.name for c in ch1] == names
+    cls = [CoupledLine(s, ch1, end_a="A", end_b="B"),
+           CoupledLine(s2, ch2, end_a="A")]
+    loads = {x.name: body_loads(x, ch1, w, scene.sea, scene.environment) for x in (a, b)}
+    return cls, [a, b], loads
+
+
+def test_modal_foss_equal_node_level_planar_two_bodies(node_level):
+    cls, bodies, loads = _planar_two_body_group()
+    assert all(cl.system.solver == "foss" and cl.system.model.dim == 2 for cl in cls)
+    assert cls[1].system.n_modes < cls[1].system.model.free.size
+    g = _Group(cls, bodies, loads, RHO, cls[0].channels)
+    # the sea and the tether's independent end motion: two channels, U_p of the
+    # second not zero
+    assert g.n_ch == 2 and cls[1].channels[1].motion_b is not None
+    ref, got = _solve_both(g, node_level)
+    _assert_same(ref, got)
+
+
+def test_modal_foss_fixed_point_equals_node_level(node_level):
+    """Through the whole drag fixed point (tolerance 1e-4): the same iterates up to
+    round-off, so the same iteration count and σ, body motion to ~1e-10."""
+    body = _buoy()
+    scene, cls, loads = _group(_mooring_doc(solver="foss", tol=1e-4), body)
+    out = []
+    for flag in (False, True):
+        node_level(flag)
+        out.append(linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads))
+    ref, got = out
+    assert got.iterations == ref.iterations
+    # round-off carried through ~5 iterations of a contraction
+    np.testing.assert_allclose(got.body_motion["buoy"], ref.body_motion["buoy"], rtol=0,
+                               atol=1e-9 * np.abs(ref.body_motion["buoy"]).max())
+    for n, lin in ref.lines.items():
+        np.testing.assert_allclose(got.lines[n].damping.sigma, lin.damping.sigma,
+                                   rtol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def benchmark_legs():
+    """The benchmark's legs (40 elements, 40 computed modes up to ~10.5 rad/s)."""
+    body = _buoy()
+    scene, cls, _ = _group(_mooring_doc(n_el=40, count=20, solver="foss"), body)
+    return cls, body
+
+
+def test_reduced_modes_within_tolerance_of_full(benchmark_legs):
+    """Craig–Bampton with the 40 computed line modes (top ≈ 10.5 rad/s) against the
+    assembled 363-DOF problem, listing to 2.5·2 = 5 rad/s: the same count, every
+    frequency an upper bound within 1e-3 relative (measured 3.3e-4, the highest
+    modes), body energy fractions within 3e-3 (measured 1e-3), same asymmetry."""
+    cls, body = benchmark_legs
+    assert float(cls[0].system.modes.omega.max()) < 11.0
+    full = coupled_modes(cls, [body], 0.7, 2.0, method="full")
+    red = coupled_modes(cls, [body], 0.7, 2.0, method="reduced")
+    assert red.omega.size == full.omega.size >= 10
+    np.testing.assert_allclose(red.omega, full.omega, rtol=1e-3)
+    assert np.all(red.omega >= full.omega * (1 - 1e-9))   # Rayleigh–Ritz: from above
+    np.testing.assert_allclose(red.body_fraction, full.body_fraction, atol=3e-3)
+    assert red.asymmetry == pytest.approx(full.asymmetry, rel=1e-6, abs=1e-14)
+    # the body shapes span the same motions: |⟨φ_r, φ_f⟩_body| close to the norms for
+    # the lowest (well separated, body-dominated) mode
+    for k in (2,):
+        a, b = red.body_shapes["buoy"][:, k], full.body_shapes["buoy"][:, k]
+        assert abs(a @ b) == pytest.approx(math.sqrt((a @ a) * (b @ b)), rel=1e-3)
+
+
+def test_auto_uses_the_reduction_only_below_its_cutoff(benchmark_legs):
+    """"auto": reduced when every line's highest computed mode is ≥ 1.5× the listing
+    top (10.5 ≥ 1.5·5), the full problem otherwise (top 2.5·6 = 15 rad/s)."""
+    cls, body = benchmark_legs
+    auto = coupled_modes(cls, [body], 0.7, 2.0)
+    red = coupled_modes(cls, [body], 0.7, 2.0, method="reduced")
+    np.testing.assert_array_equal(auto.omega, red.omega)
+    auto_hi = coupled_modes(cls, [body], 0.7, 6.0)
+    full_hi = coupled_modes(cls, [body], 0.7, 6.0, method="full")
+    np.testing.assert_array_equal(auto_hi.omega, full_hi.omega)
+    with pytest.raises(Exception, match="method"):
+        coupled_modes(cls, [body], 0.7, 2.0, method="exact")
+
+
+@pytest.mark.parametrize("solver", ["foss", "direct"])
+def test_threaded_lines_give_the_same_bits_as_serial(monkeypatch, solver):
+    """The lines' Foss decompositions on the thread pool (stochcable._parallel; Foss
+    lines only, direct lines have none) against ``STOCHCABLE_THREADS=1``: the same
+    computation per line, summed in line order, so the same bits (not a
+    tolerance)."""
+    import stochcable._parallel as par
+    from stochcable.analysis import _single_blas_thread
+
+    body = _buoy()
+    scene, cls, loads = _group(_mooring_doc(solver=solver, tol=1e-4), body)
+    used = []
+    real = par._executor
+
+    def spy(n):
+        used.append(n)
+        return real(n)
+
+    monkeypatch.setattr(par, "_executor", spy)
+    out = []
+    for threads in ("1", "2"):
+        monkeypatch.setenv("STOCHCABLE_THREADS", threads)
+        with _single_blas_thread():
+            out.append(linearize_coupled(cls, [body], scene.analysis, rho=RHO,
+                                         loads=loads))
+        # the pool ran only when allowed, and only for Foss lines
+        assert bool(used) == (threads == "2" and solver == "foss")
+    ref, got = out
+    assert got.iterations == ref.iterations
+    np.testing.assert_array_equal(got.body_motion["buoy"], ref.body_motion["buoy"])
+    for n, lin in ref.lines.items():
+        np.testing.assert_array_equal(got.lines[n].damping.sigma, lin.damping.sigma)
+        np.testing.assert_array_equal(got.lines[n].response.displacement,
+                                      lin.response.displacement)
+
+
+def test_gil_free_foss_decomposition_equals_the_solver():
+    """``_foss_decomposition_nogil`` (NumPy's geev, GIL released) against
+    ``solvers._foss_decomposition`` (SciPy's geev) on a line's kept modes with drag:
+    the same LAPACK routine on the same matrix, the same layout for the column norms
+    (measured: identical bits); 1e-12 of the largest entry allows another LAPACK build."""
+    from stochcable.analysis import _add, _drag_blocks, _matvec, _prep
+    from stochcable.solvers import _foss_decomposition
+
+    body = _buoy()
+    _, cls, _ = _group(_mooring_doc(solver="foss", tol=1e-4), body)
+    system = cls[0].system
+    prep = _prep(system)
+    damping = drag_coefficients(system, np.full(2 * system.model.n_elements, 0.3), "seed")
+    c = _add(prep.S, _drag_blocks(system, damping))
+    phi, mh, kh = prep.modal(system)
+    ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
+    ch = 0.5 * (ch + ch.T)
+    ref = _foss_decomposition(mh, ch, kh)
+    got = ca._foss_decomposition_nogil(mh, ch, kh)
+    for a, b in ((got.lambdas, ref.lambdas), (got.chi, ref.chi), (got.weights, ref.weights),
+                 (got.a, ref.a)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.abs(b).max())
+    assert got.condition == pytest.approx(ref.condition, rel=1e-9)
