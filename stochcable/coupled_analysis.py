@@ -701,69 +701,19 @@ def _foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Dampi
     return u.reshape(prep.n - 2, prep.d, n_w, n_ch + n_e), c
 
 
-def _foss_decomposition_nogil(mh: np.ndarray, ch: np.ndarray, kh: np.ndarray
-                              ) -> FossModes:
-    """:func:`stochcable.solvers._foss_decomposition` with NumPy's ``geev``.
-
-    The same LAPACK routine on the same matrix (the same bits here), but NumPy's
-    linalg gufuncs release the GIL while SciPy's f2py ``geev`` wrapper holds it
-    (scipy/scipy#12436: ``threadsafe`` is not applied to every LAPACK wrapper), so
-    the lines' eigenproblems of a group overlap on the thread pool
-    (:mod:`stochcable._parallel`; measured: 4 × 78×78 ``eig`` on 2 threads, SciPy
-    no overlap, NumPy 1.6× faster).  The rest — Cholesky of M̂, the condition check
-    and the weights by one LU of the column-normalized eigenvectors — is the
-    solver's, line for line (those SciPy wrappers release the GIL).
-    """
-    n = mh.shape[0]
-    try:
-        mc = sla.cho_factor(mh, check_finite=False)
-    except np.linalg.LinAlgError:
-        raise SolverError("Foss eigenproblem: Mhat is not positive definite") from None
-    minv = sla.cho_solve(mc, np.hstack([ch, kh, np.eye(n)]), check_finite=False)
-    S = np.zeros((2 * n, 2 * n))
-    S[:n] = -minv[:, : 2 * n]
-    S[n:, :n] = np.eye(n)
-    lam, theta = np.linalg.eig(S)
-    if not np.all(np.isfinite(lam)):  # pragma: no cover - S is finite
-        raise SolverError("Foss eigenproblem produced non-finite eigenvalues")
-    # SciPy's layout (complex, Fortran order): the column norms then sum in the
-    # same order, so the whole decomposition is the solver's to the bit
-    theta = np.asfortranarray(theta, dtype=complex)
-    lam = lam.astype(complex, copy=False)
-    theta /= np.linalg.norm(theta, axis=0)
-    lu, piv = sla.lu_factor(theta, check_finite=False)
-    if np.any(np.diagonal(lu) == 0.0):
-        cond = np.inf
-    else:
-        rcond, _ = lapack.zgecon(lu, float(np.abs(theta).sum(axis=0).max()), norm="1")
-        cond = 1.0 / rcond if rcond > 0 else np.inf
-    if not np.isfinite(cond) or cond > DEFECTIVE_CONDITION:
-        raise SolverError(
-            f"Foss eigenproblem is (nearly) defective: eigenvector condition number "
-            f"{cond:.2e} > {DEFECTIVE_CONDITION:.0e} (a critically damped mode, a_j ~ 0); "
-            "use the direct modal solve (solve_modal(method='modal_direct'))"
-        )
-    chi = theta[n:]
-    rhs = np.zeros((2 * n, n), dtype=complex)
-    rhs[:n] = minv[:, 2 * n:]
-    weights = sla.lu_solve((lu, piv), rhs, check_finite=False)
-    a = (2.0 * lam * np.einsum("ij,ij->j", chi, mh @ chi)
-         + np.einsum("ij,ij->j", chi, ch @ chi))
-    return FossModes(lam, chi, a, weights, float(cond))
-
-
 def _foss_state(system: LineSystem, damping: Damping) -> tuple[Any, Any, FossModes | None]:
     """The drag blocks C_d, the damping C = S + C_d and the Foss decomposition of a
     line's kept modes (None when the pencil is defective): the frequency-independent
     start of :class:`_FossLine`, the part :func:`_solve_group` runs on the thread
-    pool (its LAPACK ``geev`` releases the GIL, :func:`_foss_decomposition_nogil`)."""
+    pool (NumPy's LAPACK ``geev`` in :func:`stochcable.solvers._foss_decomposition`
+    releases the GIL)."""
     prep = _prep(system)
     cd = _drag_blocks(system, damping)
     c = _add(prep.S, cd)
     phi, mh, kh = prep.modal(system)
     ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
     try:
-        foss = _foss_decomposition_nogil(mh, 0.5 * (ch + ch.T), kh)
+        foss = _foss_decomposition(mh, 0.5 * (ch + ch.T), kh)
     except SolverError:
         foss = None
     return cd, c, foss

@@ -765,9 +765,16 @@ def _foss_decomposition(Mh: np.ndarray, Ch: np.ndarray, Kh: np.ndarray) -> FossM
     S = np.zeros((2 * n, 2 * n))
     S[:n] = -minv[:, : 2 * n]
     S[n:, :n] = np.eye(n)
-    lam, theta = sla.eig(S, check_finite=False, overwrite_a=True)
+    # NumPy's geev: the same LAPACK routine as scipy.linalg.eig, but its gufunc
+    # releases the GIL (SciPy's f2py wrapper holds it, scipy/scipy#12436), so the
+    # lines of a coupled group decompose concurrently (stochcable._parallel)
+    lam, theta = np.linalg.eig(S)
     if not np.all(np.isfinite(lam)):  # pragma: no cover - S is finite
         raise SolverError("Foss eigenproblem produced non-finite eigenvalues")
+    # SciPy's layout (complex, Fortran order), so the column norms sum in the same
+    # order as before the switch: the decomposition is the same to the bit
+    theta = np.asfortranarray(theta, dtype=complex)
+    lam = lam.astype(complex, copy=False)
     theta /= np.linalg.norm(theta, axis=0)
     # One LU of the column-normalized eigenvector matrix gives both the condition
     # estimate (LAPACK gecon, 1-norm) and the weights Theta^{-1} A^{-1} [0; I].

@@ -244,11 +244,11 @@ def test_threaded_lines_give_the_same_bits_as_serial(monkeypatch, solver):
                                       lin.response.displacement)
 
 
-def test_gil_free_foss_decomposition_equals_the_solver():
-    """``_foss_decomposition_nogil`` (NumPy's geev, GIL released) against
-    ``solvers._foss_decomposition`` (SciPy's geev) on a line's kept modes with drag:
-    the same LAPACK routine on the same matrix, the same layout for the column norms
-    (measured: identical bits); 1e-12 of the largest entry allows another LAPACK build."""
+def test_foss_decomposition_of_a_line_with_drag_solves_the_quadratic_eigenproblem():
+    """``solvers._foss_decomposition`` (NumPy's geev, which releases the GIL for the
+    thread pool) on a line's kept modes with drag: every pair satisfies
+    (λ²M̂ + λĈ + K̂)χ = 0 to 1e-10 of the terms' size (round-off of a 78×78 geev with
+    condition ≈ the printed one), and the pairs come in complex conjugates."""
     from stochcable.analysis import _add, _drag_blocks, _matvec, _prep
     from stochcable.solvers import _foss_decomposition
 
@@ -261,9 +261,15 @@ def test_gil_free_foss_decomposition_equals_the_solver():
     phi, mh, kh = prep.modal(system)
     ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
     ch = 0.5 * (ch + ch.T)
-    ref = _foss_decomposition(mh, ch, kh)
-    got = ca._foss_decomposition_nogil(mh, ch, kh)
-    for a, b in ((got.lambdas, ref.lambdas), (got.chi, ref.chi), (got.weights, ref.weights),
-                 (got.a, ref.a)):
-        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.abs(b).max())
-    assert got.condition == pytest.approx(ref.condition, rel=1e-9)
+    got = _foss_decomposition(mh, ch, kh)
+    lam, chi = got.lambdas, got.chi
+    res = (lam**2 * (mh @ chi) + lam * (ch @ chi) + kh @ chi)
+    # normwise backward error of each pair (element-wise would divide round-off by
+    # the ~0 entries of localized modes)
+    norm = np.linalg.norm
+    scale = (np.abs(lam) ** 2 * norm(mh, 2) + np.abs(lam) * norm(ch, 2)
+             + norm(kh, 2)) * norm(chi, axis=0)
+    assert np.max(norm(res, axis=0) / scale) < 1e-10
+    np.testing.assert_allclose(np.sort_complex(lam), np.sort_complex(lam.conj()),
+                               rtol=1e-10)
+
