@@ -25,6 +25,8 @@ import time
 import warnings
 from pathlib import Path
 
+from _host import host_line
+
 from stochcable.analysis import analyze
 from stochcable.scene import load_scene
 
@@ -84,6 +86,7 @@ def main() -> None:
     import os
 
     load = os.getloadavg()[0]
+    print(host_line())
     print(f"load average (1 min) {load:.2f}" + ("" if load < 1.5 else
                                                "  -- machine busy: timings inflated"))
     print("== analyze() on the reference chain (no time series) ==")

@@ -30,6 +30,8 @@ import pstats
 import statistics
 import time
 import warnings
+
+from _host import host_line
 from stochcable.analysis import (_single_blas_thread, _tune_allocator, build_line_system,
                                  line_result, linearize)
 import numpy as np
@@ -222,6 +224,7 @@ def main() -> None:
                     help="only the interleaved A/B of the per-line thread pool off/on")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
+    print(host_line())
     if args.ab:
         with _single_blas_thread():
             fast_paths_ab(max(args.repeat, 9))

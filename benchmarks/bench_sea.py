@@ -24,6 +24,8 @@ import time
 
 import numpy as np
 
+from _host import host_line
+
 from stochcable import _fft, sea
 from stochcable.kinematics import wavenumber
 from stochcable.spectra import spectrum_jonswap, spectrum_pierson_moskowitz
@@ -61,6 +63,7 @@ def main() -> None:
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"python {platform.python_version()}, numpy {np.__version__}")
     print("load average before: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
+    print(host_line())
     print(f"OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY')}")
     if "--tune" in sys.argv[1:]:
         t0 = time.perf_counter()

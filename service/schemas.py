@@ -404,3 +404,10 @@ class AnalysisResponse(_Open):
     timeseries: TimeSeriesDocument | None = Field(
         default=None, description="Present when the scene has analysis.timeseries and the "
         "timeseries query parameter is not none")
+    units: dict[str, str] | None = Field(
+        default=None, description="Unit labels of the scene's consistent unit system, read "
+        "off environment.g (stochcable.units): system (SI, foot-slug-second or "
+        "consistent), length, mass, force, time")
+    bodies: dict[str, dict[str, Any]] | None = Field(
+        default=None, description="Motion of each body (scenes with bodies): per DOF the "
+        "statistics, spectra and RAOs, plus the coupled modes (docs/BODIES.md)")

@@ -126,7 +126,7 @@ from .results import (
     LineResult,
     Result,
     TimeSeries,
-    stats_from_spectrum,
+    _stats_from_validated,
 )
 from .scene import AnalysisSettings, Line, Scene, TimeSeriesSettings, load_scene
 from .sea import frequency_grid, simulate_sea, synthesize
@@ -141,6 +141,7 @@ from .solvers import (
     tridiagonal_blocks,
 )
 from .statics import LineStatics, StaticsResult, solve_statics
+from .units import unit_labels
 
 __all__ = [
     "Progress",
@@ -687,9 +688,10 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
         # of this function's time, called at every iteration); anything else goes
         # through drag_linear_current and its error messages
         sn, st = parts["normal"][0], parts["axial"]
-        # finite and >= 0 (NaN fails the comparison; +inf is caught by the sum)
-        clean = bool((sn >= 0).all() and (st >= 0).all()
-                     and math.isfinite(float(sn.sum()) + float(st.sum())))
+        # finite and >= 0 (NaN fails the comparison; +inf is caught by the sum): the
+        # normal and axial σ are the leading part of the σ vector, checked at once
+        lead = np.asarray(sigma, dtype=float)[: sn.size + st.size]
+        clean = bool((lead >= 0).all() and math.isfinite(float(lead.sum())))
         current = _drag_current if clean else drag_linear_current
         b_n = current(rho, mesh.cd_normal, d, parts["normal"][0], u_n)
         b_t = current(rho, mesh.cd_axial, math.pi * d, parts["axial"], u_t)
@@ -799,6 +801,9 @@ def _distribute(model: FEModel, b: np.ndarray, node_diag: np.ndarray | None) -> 
 
 
 def _add(*blks: _Blk, scale: tuple[float, ...] | None = None) -> _Blk:
+    if scale is None and len(blks) == 2:  # the per-iteration C_s + C_d: one add each
+        (d0, o0), (d1, o1) = blks
+        return d0 + d1, o0 + o1
     s = (1.0,) * len(blks) if scale is None else scale
     return (sum(c * b[0] for c, b in zip(s, blks)), sum(c * b[1] for c, b in zip(s, blks)))
 
@@ -1027,7 +1032,7 @@ def _inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> _Inputs:
     # attachment drag areas it is never used (and not built)
     attached = system.drag_nodes.size > 0
     for i, ch in enumerate(channels):
-        if ch.velocity is not None and attached:
+        if attached and ch.velocity is not None:  # (the sea's is computed on access)
             if vel is None:
                 vel = np.zeros(shape, dtype=complex)
             vel[..., i] = np.transpose(ch.velocity[..., comps], (1, 2, 0))
@@ -1043,7 +1048,7 @@ def _inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> _Inputs:
         if ch.element_velocity is not None:
             # exact along the elements: l0·C_I(I − eeᵀ)·iω∫N_i v dξ, plus attachments
             inertia[..., i] = _element_load(b_in, mom[..., i] * (1j * w))
-            if np.any(node_mass):
+            if np.any(node_mass) and ch.acceleration is not None:
                 inertia[..., i] += (node_mass[:, None, None]
                                     * np.transpose(ch.acceleration[..., comps], (1, 2, 0)))
         elif ch.acceleration is not None:  # hand-built channel: nodal interpolation
@@ -1148,6 +1153,12 @@ def _dynamic(prep: _Prep, c: _Blk, w: np.ndarray, x: np.ndarray) -> np.ndarray:
 def _to_freq(x: np.ndarray) -> np.ndarray:
     """Free node vectors (n_f, d, n_w, k) -> (n_w, n_f·d, k), contiguous."""
     n_f, d, n_w, k = x.shape
+    if x.dtype == complex and x.flags.c_contiguous and k > 0:
+        # the k channels of one (node, component, ω) move as one block: a 2-D transpose
+        # of k·16-byte items (numpy's copy of 16-byte items in k-pairs was 2x slower)
+        item = np.dtype((np.void, 16 * k))
+        v = x.reshape(n_f * d, n_w, k).view(item)[..., 0]  # (n_f·d, n_w)
+        return np.ascontiguousarray(v.T).view(complex).reshape(n_w, n_f * d, k)
     return np.ascontiguousarray(np.transpose(x, (2, 0, 1, 3))).reshape(n_w, n_f * d, k)
 
 
@@ -1373,7 +1384,10 @@ def _foss_free(system: "LineSystem", prep: _Prep, c: _Blk, rhs: np.ndarray,
         key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂: drag-independent, per grid
         if key not in prep._modal:
             prep._modal[key] = kh - wz * wz * mh
-        z3 = np.linalg.solve(prep._modal[key] + 1j * wz * ch, fh3)
+        # the matrices are symmetric to the bit (K̂, M̂, Ĉ symmetrized): passed as
+        # their transposes, whose memory is the column-major layout LAPACK takes, so
+        # numpy's copy into it is contiguous (the same matrices and bits, ≈ 10 % faster)
+        z3 = np.linalg.solve((prep._modal[key] + 1j * wz * ch).transpose(0, 2, 1), fh3)
         z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
     elif z is None:
         fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
@@ -1994,9 +2008,10 @@ def _coarse_start(
             timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
         new = _sigmas_free(system, sub, u_f, method)
         count[0] += 1
-        progress("linearization", {"line": system.name, "iteration": 0,
-                                   "coarse_iteration": count[0],
-                                   "change": _relative_change(new, x)})
+        if progress is not _noop:  # (the change is for the callback only)
+            progress("linearization", {"line": system.name, "iteration": 0,
+                                       "coarse_iteration": count[0],
+                                       "change": _relative_change(new, x)})
         return new
 
     tol = COARSE_TOLERANCE_RATIO * lin.tolerance
@@ -2297,6 +2312,7 @@ def _surface_resolution_check(system: LineSystem, channels: tuple[Channel, ...],
     seg = int(mesh.segment[j])
     n_seg = int(np.count_nonzero(mesh.segment == seg))
     pos = system.positions
+    units = unit_labels(system.environment.g)
     za, zb = float(min(pos[j, 2], 0.0)), float(min(pos[j + 1, 2], 0.0))
     dz = abs(zb - za)
     shrink = math.log(SURFACE_TARGET_RATIO) / math.log(r) if math.isfinite(r) else 0.0
@@ -2306,12 +2322,12 @@ def _surface_resolution_check(system: LineSystem, channels: tuple[Channel, ...],
     others = f" ({more} more element(s) likewise)" if more > 0 else ""
     warn(
         f"line '{system.name}': the wave-velocity σ varies by a factor {r:.3g} along "
-        f"element {j + 1} (z from {za:.4g} to {zb:.4g} m; threshold "
+        f"element {j + 1} (z from {za:.4g} to {zb:.4g} {units.length}; threshold "
         f"{SURFACE_SIGMA_RATIO:g}){others}, but the drag linearization takes one drag "
         "coefficient per element (seed 001 eq. 5.2.2): the element is long against the "
         "decay depth of the wave kinematics and the response there carries an error of "
-        f"several %; use {need}, or elements spanning at most {dz * shrink:.3g} m of "
-        "depth near the surface",
+        f"several %; use {need}, or elements spanning at most {dz * shrink:.3g} "
+        f"{units.length} of depth near the surface",
         ResolutionWarning, stacklevel=3,
     )
 
@@ -2469,15 +2485,18 @@ def line_indicators(
     k = int(np.argmin(margins))
     snap_margin = float(margins[k])
     snap = bool(np.any(low < 0))
+    units = unit_labels(system.environment.g)
     if snap:
         flags.append("snap")
         where = ("end_a" if k == t_mean.size else "end_b" if k == t_mean.size + 1
-                 else f"element {k + 1} (s = {0.5 * (mesh.s0[k] + mesh.s0[k + 1]):.4g} m)")
+                 else f"element {k + 1} (s = {0.5 * (mesh.s0[k] + mesh.s0[k + 1]):.4g} "
+                      f"{units.length})")
         warn(
-            f"line '{name}': the dynamic tension σ ({sigmas[k]:.4g} N at {where}) exceeds "
-            f"1/{SNAP_SIGMAS:g} of the mean tension ({means[k]:.4g} N): mean − "
-            f"{SNAP_SIGMAS:g}σ < 0, snap loads likely; the linear model is out of its "
-            "depth (threshold mean − 3σ >= 0): use a nonlinear time-domain analysis "
+            f"line '{name}': the dynamic tension σ ({sigmas[k]:.4g} {units.force} at "
+            f"{where}) exceeds 1/{SNAP_SIGMAS:g} of the mean tension ({means[k]:.4g} "
+            f"{units.force}): mean − {SNAP_SIGMAS:g}σ < 0, snap loads likely; the linear "
+            "model is out of its depth (threshold mean − 3σ >= 0): use a nonlinear "
+            "time-domain analysis "
             "(stochcable.cable_timedomain) or increase the pretension",
             PhysicsWarning, stacklevel=3,
         )
@@ -2523,9 +2542,9 @@ def line_indicators(
         flags.append("large_motion")
         j = int(np.argmax(m_std))
         warn(
-            f"line '{name}': the motion σ at node {j + 1} ({m_max:.3g} m) is "
-            f"{to_sag:.2g} of the line's sag ({sag:.3g} m), above the threshold "
-            f"{MOTION_SAG_FRACTION:g}: the linearization about the static shape is "
+            f"line '{name}': the motion σ at node {j + 1} ({m_max:.3g} {units.length}) "
+            f"is {to_sag:.2g} of the line's sag ({sag:.3g} {units.length}), above the "
+            f"threshold {MOTION_SAG_FRACTION:g}: the linearization about the static shape is "
             "doubtful; check with a nonlinear time-domain analysis "
             "(stochcable.cable_timedomain)",
             PhysicsWarning, stacklevel=3,
@@ -2576,7 +2595,7 @@ def line_result(
     stats = {}
     for end, mean in (("end_a", st.tension_a), ("end_b", st.tension_b)):
         dens = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
-        stats[end] = stats_from_spectrum(w, dens, float(mean), settings.duration)
+        stats[end] = _stats_from_validated(w, dens, float(mean), settings.duration)
         _tail_check(system.name, end, w, dens, stats[end].m0)
     if np.any(spectra > 0):  # nothing to resolve without excitation
         _resolution_check(system, linearization.damping, w)

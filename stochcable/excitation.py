@@ -72,7 +72,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
@@ -104,6 +104,33 @@ __all__ = [
 _DOF_AXIS = {"surge": 0, "sway": 1, "heave": 2}
 _CONSISTENT = np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
 _LUMPED = np.array([[0.5, 0.0], [0.0, 0.5]])
+
+
+class _LazyNodal:
+    """A :class:`Channel` field (``velocity``/``acceleration``) that, when left None
+    while the channel has a ``nodal`` callable, is computed from it on first access
+    (both fields at once) and kept: the sea's nodal kinematics only drive the
+    attachments' drag and inertia, which most lines do not have (0.35 ms of the
+    chain).  A dataclass descriptor field: the default is None and ``__init__`` stores
+    the value through :meth:`__set__`."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._key = "_" + name
+
+    def __get__(self, obj: Any, objtype: Any = None) -> Any:
+        if obj is None:
+            return None  # the dataclass default
+        d = obj.__dict__
+        val = d.get(self._key)
+        if val is None and d.get("nodal") is not None:
+            if d.get("_velocity") is None and d.get("_acceleration") is None:
+                vel, acc = d["nodal"]()
+                d["_velocity"], d["_acceleration"] = vel, acc
+            val = d.get(self._key)
+        return val
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__[self._key] = value
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,6 +165,10 @@ class Channel:
     element_end_square : ndarray or None, real, shape (n_omega, n_el, 2)
         |v|² at the ends of each element's wet part
         (:attr:`ElementKinematics.end_square`). [(m/s)²/m²]
+    nodal : callable or None
+        ``nodal() -> (velocity, acceleration)``: computes the nodal kinematics on first
+        access of ``velocity`` or ``acceleration`` when both were left None (the sea
+        channel of :func:`line_channels`); None: the fields are as given.
     """
 
     name: str
@@ -145,13 +176,15 @@ class Channel:
     omega: np.ndarray
     spectrum: np.ndarray
     density: Callable[[np.ndarray], np.ndarray]
-    velocity: np.ndarray | None = None
-    acceleration: np.ndarray | None = None
+    velocity: np.ndarray | None = _LazyNodal()  # type: ignore[assignment]
+    acceleration: np.ndarray | None = _LazyNodal()  # type: ignore[assignment]
     motion_a: np.ndarray | None = None
     motion_b: np.ndarray | None = None
     element_velocity: np.ndarray | None = None
     element_velocity_square: np.ndarray | None = None
     element_end_square: np.ndarray | None = None
+    nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(
+        default=None, repr=False)
 
 
 def _spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
@@ -220,18 +253,11 @@ def line_channels(
         pts = np.array(positions, dtype=float)
         pts[:, 2] = np.maximum(pts[:, 2], -env.depth)
         el = element_wave_kinematics(w, pts, scene.sea.heading_rad, env.depth, env.g)
-        # the nodal kinematics of wave_kinematics from the validated frequencies,
-        # points and wavenumbers of the element kinematics (no second validation,
-        # wavenumber solve or pressure)
-        _, _, _, vel, acc = _nodal_kinematics(el.omega, el.wavenumber, el.positions,
-                                              el.heading, el.depth, env.g)
         channels.append(Channel(
             name="sea", kind="sea", omega=w, spectrum=density(w), density=density,
-            velocity=np.ascontiguousarray(np.transpose(vel, (2, 0, 1))),
-            acceleration=np.ascontiguousarray(np.transpose(acc, (2, 0, 1))),
             motion_a=raos.get("end_a"), motion_b=raos.get("end_b"),
             element_velocity=el.velocity, element_velocity_square=el.velocity_square,
-            element_end_square=el.end_square,
+            element_end_square=el.end_square, nodal=_sea_nodal(el, env.g),
         ))
     for end in ("end_a", "end_b"):
         m = getattr(line, end).motion
@@ -251,6 +277,21 @@ def line_channels(
                 motion_b=unit if end == "end_b" else None,
             ))
     return tuple(channels)
+
+
+def _sea_nodal(el: "ElementKinematics", g: float
+               ) -> Callable[[], tuple[np.ndarray, np.ndarray]]:
+    """The sea channel's nodal velocity and acceleration (n_omega, n_nodes, 3), on
+    demand: :func:`stochcable.kinematics.wave_kinematics` from the validated
+    frequencies, points and wavenumbers of the element kinematics (no second
+    validation, wavenumber solve or pressure)."""
+    def nodal() -> tuple[np.ndarray, np.ndarray]:
+        _, _, _, vel, acc = _nodal_kinematics(el.omega, el.wavenumber, el.positions,
+                                              el.heading, el.depth, g)
+        return (np.ascontiguousarray(np.transpose(vel, (2, 0, 1))),
+                np.ascontiguousarray(np.transpose(acc, (2, 0, 1))))
+
+    return nodal
 
 
 # ------------------------------------------------- wave kinematics along the elements

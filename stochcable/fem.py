@@ -458,6 +458,26 @@ def _assemble_sparse(blocks: np.ndarray, dofs: np.ndarray, n_dof: int,
     return a
 
 
+@functools.lru_cache(maxsize=64)
+def _chain_pattern(n: int, d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """CSR pattern of :func:`_chain_csr` for n nodes of d DOFs (the same for K, M and
+    Ma and for every model of that size; read-only, cached): the flat positions of the
+    kept entries in the (node, row comp, side, comp) array, the column indices and the
+    row pointers (int64)."""
+    cols = (np.arange(-1, 2)[:, None] + np.arange(n)[:, None, None]) * d + np.arange(d)
+    cols = np.broadcast_to(cols[:, None], (n, d, 3, d))  # (node, row comp, side, comp)
+    keep = np.ones((n, d, 3, d), dtype=bool)
+    keep[0, :, 0] = False
+    keep[-1, :, 2] = False
+    counts = keep.reshape(n * d, -1).sum(axis=1)
+    indptr = np.zeros(n * d + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    out = (np.flatnonzero(keep), cols[keep].astype(np.int64), indptr)
+    for x in out:
+        x.setflags(write=False)
+    return out
+
+
 def _chain_csr(blocks: np.ndarray, n_nodes: int, dim: int,
                diag: np.ndarray | None = None) -> sp.csr_array:
     """Canonical CSR of element matrices (n_el, 2d, 2d) on consecutive nodes (element j
@@ -479,15 +499,9 @@ def _chain_csr(blocks: np.ndarray, n_nodes: int, dim: int,
     data[1:, :, 0] = blocks[:, d:, :d]
     data[:, :, 1] = diag_b
     data[:-1, :, 2] = blocks[:, :d, d:]
-    cols = (np.arange(-1, 2)[:, None] + np.arange(n)[:, None, None]) * d + np.arange(d)
-    cols = np.broadcast_to(cols[:, None], (n, d, 3, d))  # (node, row comp, side, comp)
-    keep = np.ones((n, d, 3, d), dtype=bool)
-    keep[0, :, 0] = False
-    keep[-1, :, 2] = False
-    counts = keep.reshape(n * d, -1).sum(axis=1)
-    indptr = np.zeros(n * d + 1, dtype=np.int64)
-    np.cumsum(counts, out=indptr[1:])
-    a = sp.csr_array((data[keep], cols[keep].astype(np.int64), indptr), shape=(n * d, n * d))
+    sel, indices, indptr = _chain_pattern(n, d)
+    a = sp.csr_array((data.reshape(-1)[sel], indices.copy(), indptr.copy()),
+                     shape=(n * d, n * d))
     # the node blocks (diagonal, O[j] = A[j+1, j]) for the analysis' block solves, with
     # a copy of the entries to detect a later in-place change (then they are re-read)
     a._node_blocks = (a.data.copy(), diag_b, np.ascontiguousarray(blocks[:, d:, :d]))

@@ -101,6 +101,10 @@ def drag_linear_seed(
 def _mean_abs_gaussian(sigma: np.ndarray, mean: np.ndarray) -> np.ndarray:
     """E|v| for v ~ N(mean, sigma^2); sigma >= 0, handles sigma = 0 exactly."""
     sigma, mean = np.broadcast_arrays(sigma, mean)
+    if not mean.any():
+        # no current: σ·√(2/π), the general form's value to the bit (exp(0) = 1,
+        # mean·erf(0) = +0) without its exp and erf (most of the drag update's time)
+        return np.where(sigma > 0, sigma * _SQRT_2_OVER_PI, 0.0)
     pos = sigma > 0
     s_safe = np.where(pos, sigma, 1.0)
     ratio = np.where(pos, mean / s_safe, 0.0)

@@ -122,7 +122,10 @@ def plane_normal(positions: np.ndarray) -> np.ndarray:
     chord = p[-1] - p[0]
     h = np.array([chord[0], chord[1], 0.0])
     if np.linalg.norm(h) > 1e-9 * scale:
-        n = np.cross([0.0, 0.0, 1.0], h)
+        # ẑ × h written out: the products and differences of np.cross([0, 0, 1], h)
+        # in its order (the same bits, signed zeros included), without its generic path
+        h0, h1 = float(h[0]), float(h[1])
+        n = np.array([0.0 * 0.0 - 1.0 * h1, 1.0 * h0 - 0.0 * 0.0, 0.0 * h1 - 0.0 * h0])
         return n / np.linalg.norm(n)
     q = p[:, :2] - p[:, :2].mean(axis=0)
     if np.abs(q).max() <= 1e-9 * scale:

@@ -21,6 +21,8 @@ from typing import Any
 
 import numpy as np
 
+from .units import unit_labels
+
 __all__ = [
     "THREE_HOURS",
     "ResponseStats",
@@ -116,6 +118,23 @@ def stats_from_spectrum(
 
     st = response_statistics(omega, density, THREE_HOURS)
     sd = st if duration == THREE_HOURS else response_statistics(omega, density, duration)
+    return _response_stats(st, sd, mean)
+
+
+def _stats_from_validated(omega: np.ndarray, density: np.ndarray, mean: float,
+                          duration: float) -> ResponseStats:
+    """:func:`stats_from_spectrum` of a validated grid and spectrum (the analysis grid,
+    validated once at the boundary; a 1-D float density >= 0 of its size, duration
+    > 0): no second validation per call."""
+    from .statistics import _statistics
+
+    st = _statistics(omega, density, THREE_HOURS)
+    sd = st if duration == THREE_HOURS else _statistics(omega, density, float(duration))
+    return _response_stats(st, sd, mean)
+
+
+def _response_stats(st: Any, sd: Any, mean: float) -> ResponseStats:
+    """ResponseStats from the statistics over three hours (st) and the duration (sd)."""
     mean = float(mean)
     return ResponseStats(
         mean=mean, std=float(st.std), m0=float(st.m0), m1=float(st.m1), m2=float(st.m2),
@@ -599,6 +618,12 @@ class Result:
         ----------
         timeseries : {"window", "full", "none"}
             Put the first 2048 samples of the time series, all of them, or none.
+
+        Notes
+        -----
+        ``units`` names the scene's consistent unit system and its labels
+        (:func:`stochcable.units.unit_labels` of ``environment.g``: SI, or ft, slug,
+        lbf for the seeds' imperial examples); every number is in that system.
         """
         if hasattr(self.statics, "to_document"):
             statics_doc = self.statics.to_document()
@@ -619,6 +644,11 @@ class Result:
             "timing": {k: float(v) for k, v in self.timing.items()},
             "warnings": list(self.warnings),
         }
+        env = getattr(self.scene, "environment", None)
+        if env is not None:
+            # the labels of the scene's consistent unit system (SI or ft/slug/lbf,
+            # read off g): the numbers above are in these units
+            doc["units"] = unit_labels(env.g).as_dict()
         if self.fidelity is not None:
             doc["fidelity"] = self.fidelity.to_document()
         if self.bodies:

@@ -672,7 +672,9 @@ class _Solver:
         cap = 0.25 * span
         lam = 0.0
         phi = float(np.sum(R[1:-1] ** 2))
-        energy = m.energy(X)
+        # the energy at X only matters when a trial step fails the residual test: on
+        # demand (Newton from the chain start takes full steps, 0.1 ms of energies)
+        energy: float | None = None
         fd = m.drag_nodes.copy() if m.has_drag else None
         best = (r, X.copy())
         for _ in range(limit):
@@ -705,6 +707,8 @@ class _Solver:
                     et = m.energy(Xt)
                     if fd is not None:
                         et -= t * float(np.sum(fd[1:-1] * dx))
+                    if energy is None:
+                        energy = m.energy(X)
                     accepted = et <= energy - 1e-4 * t * slope
                 if accepted:
                     break
@@ -717,7 +721,7 @@ class _Solver:
             X = Xt
             r, tol, R, K = self.status(X)
             phi = float(np.sum(R[1:-1] ** 2))
-            energy = m.energy(X)
+            energy = None
             if fd is not None:
                 fd = m.drag_nodes.copy()
             if r < best[0]:
@@ -780,6 +784,79 @@ def _initial_guess(mesh: LineMesh, env: Environment, frame: _Frame,
     return X
 
 
+def _chain_shots(mesh: LineMesh, model: _Model, a: np.ndarray, zi: int, on_bed: bool,
+                 kb: np.ndarray) -> tuple[Any, Any]:
+    """The shots of :func:`_chain_guess`: ``shoot(H, V0, P) -> (x, z)`` the node
+    coordinates of the lumped chain from end ``a`` with horizontal force H, first
+    element vertical force V0 and node loads P; ``shoot_ends(H, V0, P)`` the end node
+    (x[-1], z[-1]) of several shots at once, (n, 2), the same numbers."""
+    l0, ea = mesh.l0, mesh.ea
+    zbed = model.zbed
+    memo: dict[str, Any] = {"P": None}
+    element_index = np.arange(mesh.n_elements)
+
+    def shoot(H: float, V0: float, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if memo["P"] is not P:  # the load sums of P, once per P (same numbers)
+            memo["P"], memo["cum"] = P, np.concatenate([[0.0], np.cumsum(P[1:-1])])
+        V = V0 + memo["cum"]  # element k
+        if on_bed:
+            pos = np.flatnonzero(V > 0.0)
+            k_star = int(pos[0]) if pos.size else V.size
+            Ve = np.where(element_index < k_star, 0.0, V)
+            # contact force of the grounded nodes 1..k_star (the last one carries the
+            # part of its load not taken by the first suspended element)
+            contact = P.copy()
+            if k_star < V.size:
+                contact[k_star] = P[k_star] - V[k_star]
+            pen = np.maximum(contact, 0.0) / kb
+        else:
+            k_star, Ve, pen = 0, V, np.zeros(mesh.n_nodes)
+        T = np.sqrt(H * H + Ve * Ve)
+        c = l0 * (1.0 + T / ea)
+        x = a[0] + np.concatenate([[0.0], np.cumsum(c * H / T)])
+        dz = c * Ve / T
+        z = np.empty(mesh.n_nodes)
+        z[0] = a[zi]
+        z[1:k_star + 1] = zbed - pen[1:k_star + 1]
+        if k_star < V.size:
+            z[k_star + 1:] = z[k_star] + np.cumsum(dz[k_star:])
+        return x, z
+
+    def shoot_ends(H: np.ndarray, V0: np.ndarray, P: np.ndarray) -> np.ndarray:
+        """The end node (x[-1], z[-1]) of :func:`shoot` for several (H, V0) at once,
+        (n, 2): the same operations row by row (real +, ×, /, √ and running sums, exact
+        whatever the batch), so the same bits as ``shoot``'s last node."""
+        if memo["P"] is not P:
+            memo["P"], memo["cum"] = P, np.concatenate([[0.0], np.cumsum(P[1:-1])])
+        V = V0[:, None] + memo["cum"]  # (n, n_el)
+        n_el = V.shape[1]
+        zlast = np.full(V0.size, a[zi])
+        if on_bed:
+            lifted = V > 0.0
+            k_star = np.where(lifted.any(axis=1), np.argmax(lifted, axis=1), n_el)
+            Ve = np.where(element_index[None, :] < k_star[:, None], 0.0, V)
+            for i, k in enumerate(k_star.tolist()):
+                if k > 0:  # the node where the suspended part starts, on the bed
+                    contact = P[k] - V[i, k] if k < n_el else P[k]
+                    zlast[i] = zbed - max(contact, 0.0) / kb[k]
+        else:
+            k_star, Ve = np.zeros(V0.size, dtype=int), V
+        Hc = H[:, None]
+        T = np.sqrt(Hc * Hc + Ve * Ve)
+        c = l0 * (1.0 + T / ea)
+        out = np.empty((V0.size, 2))
+        out[:, 0] = a[0] + np.cumsum(c * Hc / T, axis=1)[:, -1]
+        # z: the running sum from the first suspended element (zeros before it add
+        # nothing: 0 + 0 + … + dz_k = dz_k exactly)
+        dz = np.where(element_index[None, :] >= k_star[:, None], c * Ve / T, 0.0)
+        out[:, 1] = zlast + np.cumsum(dz, axis=1)[:, -1]
+        # all elements on the bed: no suspended sum (the end node is on the bed)
+        out[k_star >= n_el, 1] = zlast[k_star >= n_el]
+        return out
+
+    return shoot, shoot_ends
+
+
 def _chain_guess(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
                  a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
     """Exact equilibrium of the lumped chain without drag: a two-unknown shooting.
@@ -825,42 +902,14 @@ def _chain_guess(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
         P[1:] += 0.5 * W
         return P
 
-    memo: dict[str, Any] = {"P": None}
-    element_index = np.arange(mesh.n_elements)
-
-    def shoot(H: float, V0: float, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        if memo["P"] is not P:  # the load sums of P, once per P (same numbers)
-            memo["P"], memo["cum"] = P, np.concatenate([[0.0], np.cumsum(P[1:-1])])
-        V = V0 + memo["cum"]  # element k
-        if on_bed:
-            pos = np.flatnonzero(V > 0.0)
-            k_star = int(pos[0]) if pos.size else V.size
-            Ve = np.where(element_index < k_star, 0.0, V)
-            # contact force of the grounded nodes 1..k_star (the last one carries the
-            # part of its load not taken by the first suspended element)
-            contact = P.copy()
-            if k_star < V.size:
-                contact[k_star] = P[k_star] - V[k_star]
-            pen = np.maximum(contact, 0.0) / kb
-        else:
-            k_star, Ve, pen = 0, V, np.zeros(mesh.n_nodes)
-        T = np.sqrt(H * H + Ve * Ve)
-        c = l0 * (1.0 + T / ea)
-        x = a[0] + np.concatenate([[0.0], np.cumsum(c * H / T)])
-        dz = c * Ve / T
-        z = np.empty(mesh.n_nodes)
-        z[0] = a[zi]
-        z[1:k_star + 1] = zbed - pen[1:k_star + 1]
-        if k_star < V.size:
-            z[k_star + 1:] = z[k_star] + np.cumsum(dz[k_star:])
-        return x, z
+    shoot, shoot_ends = _chain_shots(mesh, model, a, zi, on_bed, kb)
 
     W = l0 * model.w_sub
     P = loads(W)
     scale = max(L, 1.0)
     for _pass in range(3):
         HV = _chain_newton(shoot, P, float(b[0]), float(b[zi]), X, Z, L, l0, ea,
-                           on_bed, scale)
+                           on_bed, scale, shoot_ends)
         if HV is None:
             HV = _chain_closure(shoot, P, float(b[0]), float(b[zi]), scale)
         if HV is None:
@@ -891,10 +940,12 @@ def _chain_guess(mesh: LineMesh, env: Environment, frame: _Frame, model: _Model,
 
 def _chain_newton(shoot, P: np.ndarray, xb: float, zb: float, X: float, Z: float,
                   L: float, l0: np.ndarray, ea: np.ndarray, on_bed: bool,
-                  scale: float) -> tuple[float, float] | None:
+                  scale: float, shoot_ends: Any = None) -> tuple[float, float] | None:
     """(H, V_0) of the lumped chain by damped Newton on the end closure, started from
     the continuous catenary of the mean weight; None when it fails (kinks where an
-    element lifts off the bed can stall it; :func:`_chain_closure` then brackets)."""
+    element lifts off the bed can stall it; :func:`_chain_closure` then brackets).
+    ``shoot_ends(H, V0, P)``: the end nodes of several shots at once (the four shots
+    of the central-difference Jacobian in one call, the same numbers)."""
     from .catenary import catenary_solve
 
     w_mean = float(np.sum(P)) / L
@@ -918,10 +969,23 @@ def _chain_newton(shoot, P: np.ndarray, xb: float, zb: float, X: float, Z: float
         if nr <= 1e-12 * scale:
             return math.exp(u[0]), float(u[1])
         J = np.empty((2, 2))
-        for j, hstep in enumerate((1e-7, 1e-7 * fscale)):
-            du = np.zeros(2)
-            du[j] = hstep
-            J[:, j] = (resid(u + du) - resid(u - du)) / (2.0 * hstep)
+        steps = (1e-7, 1e-7 * fscale)
+        if shoot_ends is not None:
+            pts = []
+            for j, hstep in enumerate(steps):
+                du = np.zeros(2)
+                du[j] = hstep
+                pts += [u + du, u - du]
+            ends = shoot_ends(np.array([math.exp(p[0]) for p in pts]),
+                              np.array([p[1] for p in pts]), P)
+            ends -= np.array([xb, zb])
+            for j, hstep in enumerate(steps):
+                J[:, j] = (ends[2 * j] - ends[2 * j + 1]) / (2.0 * hstep)
+        else:
+            for j, hstep in enumerate(steps):
+                du = np.zeros(2)
+                du[j] = hstep
+                J[:, j] = (resid(u + du) - resid(u - du)) / (2.0 * hstep)
         try:
             d = np.linalg.solve(J, -r)
         except np.linalg.LinAlgError:

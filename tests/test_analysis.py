@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import re
 import warnings
 
 import numpy as np
@@ -762,3 +763,58 @@ def test_attachment_drag_sigma_is_the_total_relative_velocity_sigma():
     assert sig[-1] == pytest.approx(math.sqrt(var), rel=1e-12)
     res = an.analyze(doc)
     assert np.isfinite(res.lines["chain"].end_b.std)
+
+
+def _scene_without_timeseries(name: str):
+    from stochcable.examples import load_example
+
+    scene = load_scene(load_example(name))
+    return scene.model_copy(update={"analysis": scene.analysis.model_copy(
+        update={"timeseries": None})})
+
+
+def test_warnings_and_document_use_the_scene_units_in_feet(monkeypatch) -> None:
+    """Tuah (1982) single leg is in feet, slugs and pounds-force (g = 32.17 ft/s²): the
+    snap, element-resolution and large-motion warnings give its forces in lbf and
+    lengths in ft (they said N and m), and the result document names the system."""
+    from stochcable.units import FOOT_SLUG_SECOND
+
+    # a zero sag threshold forces the large-motion warning, so all three are checked
+    monkeypatch.setattr(an, "MOTION_SAG_FRACTION", 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = an.analyze(_scene_without_timeseries("tuah_1982_single_leg"))
+    snap = [m for m in res.warnings if "dynamic tension σ" in m]
+    surface = [m for m in res.warnings if "wave-velocity σ varies" in m]
+    motion = [m for m in res.warnings if "motion σ at node" in m]
+    assert len(snap) == len(surface) == len(motion) == 1, res.warnings
+    assert re.search(r"\d lbf at end_a\)", snap[0]) and "mean tension (" in snap[0]
+    assert re.search(r"\(\d[^)]* lbf\): mean", snap[0])
+    assert re.search(r"to -?\d[\d.]* ft; threshold", surface[0])
+    assert re.search(r"at most [\d.e+-]+ ft of depth", surface[0])
+    assert re.search(r"\(\d[^)]* ft\) is .* sag \(\d[^)]* ft\)", motion[0])
+    for m in snap + surface + motion:
+        assert not re.search(r"\d (N|m)\b", m), m  # no SI label left
+    assert res.to_document()["units"] == FOOT_SLUG_SECOND.as_dict()
+
+
+def test_result_document_names_si_units() -> None:
+    doc = an.analyze(_scene_without_timeseries("taut_wire")).to_document()
+    assert doc["units"] == {"system": "SI", "length": "m", "mass": "kg", "force": "N",
+                            "time": "s"}
+
+
+def test_pipeline_statistics_equal_the_validated_public_function() -> None:
+    """The analysis' end statistics skip the second validation of its grid
+    (results._stats_from_validated) and equal results.stats_from_spectrum to the bit; the
+    public function still rejects a bad grid with its message."""
+    from stochcable.results import _stats_from_validated, stats_from_spectrum
+
+    rng = np.random.default_rng(5)
+    w = np.linspace(0.05, 2.0, 120)
+    dens = rng.uniform(0.0, 1.0, w.size) ** 2
+    for duration in (10800.0, 3600.0):
+        assert (_stats_from_validated(w, dens, 12.5, duration).as_dict()
+                == stats_from_spectrum(w, dens, 12.5, duration).as_dict())
+    with pytest.raises(InputError, match="omega"):
+        stats_from_spectrum(w[::-1], dens, 0.0, 10800.0)

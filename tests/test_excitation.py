@@ -206,3 +206,44 @@ def test_fully_wet_exp_moments_are_the_general_formula():
                          -np.multiply.outer(chi[1:] - chi[:-1], k))
         for got, ref in zip(_exp_moments(e0, alpha, p, q), general(e0, alpha, p, q)):
             np.testing.assert_array_equal(got, ref)
+
+
+def test_sea_nodal_kinematics_are_computed_on_first_access_only():
+    """The sea channel's nodal velocity/acceleration (used by attachments only) are
+    computed when first read, once for both fields, and equal the nodal kinematics of
+    stochcable.kinematics.wave_kinematics; explicit fields are kept as given."""
+    import dataclasses
+
+    from stochcable.excitation import Channel
+
+    scene, system = built(straight_doc())
+    w = scene.analysis.omega.values()
+    sea = line_channels(scene, scene.lines[0], system.positions, w)[0]
+    assert sea.nodal is not None and sea.__dict__["_velocity"] is None  # not yet built
+    calls = []
+    nodal = sea.nodal
+
+    def counted():
+        calls.append(1)
+        return nodal()
+
+    lazy = Channel(name="sea", kind="sea", omega=w, spectrum=sea.spectrum,
+                   density=sea.density, nodal=counted)
+    assert calls == []
+    acc = lazy.acceleration
+    vel = lazy.velocity
+    assert len(calls) == 1 and lazy.velocity is vel and lazy.acceleration is acc
+    kin = wave_kinematics(w, system.positions, math.radians(20.0), 100.0, G)
+    np.testing.assert_array_equal(vel, np.transpose(kin.velocity, (2, 0, 1)))
+    np.testing.assert_array_equal(acc, np.transpose(kin.acceleration, (2, 0, 1)))
+    given = Channel(name="x", kind="sea", omega=w, spectrum=np.zeros_like(w),
+                    density=np.zeros_like, velocity=vel, nodal=counted)
+    assert given.velocity is vel and given.acceleration is None and len(calls) == 1
+    plain = Channel(name="x", kind="sea", omega=w, spectrum=np.zeros_like(w),
+                    density=np.zeros_like)
+    assert plain.velocity is None and plain.acceleration is None
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        lazy.velocity = vel
+    # dataclasses.replace reads the fields: the copy carries the computed arrays
+    copy = dataclasses.replace(lazy, name="y")
+    assert copy.velocity is vel and len(calls) == 1

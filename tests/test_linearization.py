@@ -326,3 +326,18 @@ def test_fixed_point_anderson_mixing_parameter():
     assert runs[None].history == runs[0.5].history
     with pytest.raises(InputError, match="mixing"):
         fixed_point(lambda x: x, [1.0], mixing=0.0)
+
+
+def test_current_form_without_current_is_the_seed_form_to_the_bit():
+    """E|v| = σ√(2/π) for a zero-mean Gaussian: drag_linear_current with no current
+    (its shortcut) against drag_linear_seed, and σ = 0 gives no drag."""
+    rng = np.random.default_rng(3)
+    sigma = np.r_[0.0, rng.uniform(0.0, 3.0, 200), 1e-300]
+    got = drag_linear_current(1025.0, 1.2, 0.1, sigma, np.zeros_like(sigma))
+    # the general expression's value: σ·√(2/π)·e⁰ + 0·erf(0)
+    expected = 1025.0 * 1.2 * 0.1 * np.where(sigma > 0, sigma * math.sqrt(2.0 / math.pi),
+                                              0.0)
+    np.testing.assert_array_equal(got, expected)
+    np.testing.assert_allclose(got, drag_linear_seed(1025.0, 1.2, 0.1, sigma),
+                               rtol=4e-16)  # √(8/π)·½ against √(2/π): one rounding
+    assert got[0] == 0.0

@@ -419,3 +419,37 @@ def test_repeated_residual_reuses_the_same_numbers():
             np.testing.assert_array_equal(drag_nodes, ref.drag_nodes)
             got[0][:] = 0.0  # callers may change the returned residual
             np.testing.assert_array_equal(b.forces(X, tangent=False)[0], want[0])
+
+
+def test_chain_shots_batched_end_equals_single_shots() -> None:
+    """The batched end closure of the chain start (the central-difference Jacobian's
+    four shots in one call) gives the last node of each single shot to the bit, for
+    shots lifting off the bed at the anchor, part-way, and not at all (all grounded),
+    on and off the seabed."""
+    from stochcable.examples import load_example
+    from stochcable.statics import _chain_shots, _Frame, _Model
+
+    scene = load_scene(load_example("chain_catenary"))
+    env = scene.environment
+    mesh = mesh_line(scene.lines[0], env.rho, env.g)
+    frame = _Frame(mesh, env)
+    model = _Model(mesh, env, frame)
+    a = frame.to_local(mesh.end_a[None, :])[0]
+    zi = frame.dim - 1
+    kb = np.where(model.kb > 0.0, model.kb, np.inf)
+    P = -model.node_fz.copy()
+    W = mesh.l0 * model.w_sub
+    P[:-1] += 0.5 * W
+    P[1:] += 0.5 * W
+    total = float(np.sum(P))
+    rng = np.random.default_rng(11)
+    H = np.exp(rng.uniform(np.log(1e-3 * total), np.log(10.0 * total), 60))
+    # V0 from all lifted (> 0) through lifting part-way to never lifting (< -total)
+    V0 = np.r_[rng.uniform(-1.5 * total, 0.5 * total, 57), 0.2 * total, -0.5 * total,
+               -2.0 * total]
+    for on_bed in (True, False):
+        shoot, shoot_ends = _chain_shots(mesh, model, a, zi, on_bed, kb)
+        ends = shoot_ends(H, V0, P)
+        single = np.array([[shoot(h, v, P)[0][-1], shoot(h, v, P)[1][-1]]
+                           for h, v in zip(H, V0)])
+        assert np.array_equal(ends, single)  # bit-equal: the same float operations

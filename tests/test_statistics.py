@@ -158,3 +158,21 @@ def test_input_errors():
         response_statistics(w, np.ones(5), duration=0.0)
     with pytest.raises(InputError, match=r"density .*>= 0"):
         response_statistics(w, -np.ones(5))
+
+
+@pytest.mark.parametrize("duration", [10800.0, 600.0, 0.5])
+def test_single_spectrum_equals_the_batched_form_to_the_bit(duration):
+    """One spectrum (the scalar path) against the same spectrum as a row of a 2-D
+    density (the array path): the same statistics to the bit, including the zero cases
+    (m0 = 0, m2 = 0 through a spectrum only at ω = 0, N < 1)."""
+    rng = np.random.default_rng(7)
+    w = np.r_[0.0, np.sort(rng.uniform(0.01, 4.0, 150))]
+    cases = [rng.uniform(0.0, 2.0, w.size) ** 3, np.zeros(w.size),
+             np.r_[1.0, np.zeros(w.size - 1)], np.exp(-((w - 1.0) / 0.05) ** 2)]
+    for s in cases:
+        one = response_statistics(w, s, duration)
+        row = response_statistics(w, s[None, :], duration)
+        for f in ("m0", "m1", "m2", "m4", "std", "tz", "significant", "bandwidth", "mpm",
+                  "expected_max", "n_cycles"):
+            assert isinstance(getattr(one, f), float)
+            assert getattr(one, f) == float(getattr(row, f)[0]), f
