@@ -19,12 +19,12 @@ would cost more than the transfer).
 from __future__ import annotations
 
 import io
-import json
 import math
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+import orjson
 from fastapi import Request
 from starlette.exceptions import HTTPException
 from starlette.responses import Response
@@ -41,6 +41,8 @@ __all__ = [
     "columns_response",
     "array_responses",
     "error_responses",
+    "dumps",
+    "all_finite",
 ]
 
 JSON = "application/json"
@@ -102,16 +104,51 @@ def _plain(obj: Any) -> Any:
     return obj
 
 
+def all_finite(obj: Any) -> bool:
+    """True when every float in a JSON-ready document (dicts, lists, numbers, strings,
+    None) is finite.
+
+    A list of numbers is checked by its sum (finite iff every term is, unless finite
+    terms overflow, which then takes the element-wise path): one C loop per list, so
+    a 200 kB result document costs ~0.1 ms.
+    """
+    if isinstance(obj, float):
+        return math.isfinite(obj)
+    if isinstance(obj, Mapping):
+        return all(all_finite(v) for v in obj.values())
+    if isinstance(obj, (list, tuple)):
+        try:
+            if math.isfinite(sum(obj)):
+                return True
+        except (TypeError, OverflowError):
+            pass
+        return all(all_finite(v) for v in obj)
+    return True
+
+
+def dumps(obj: Any) -> bytes:
+    """Compact JSON bytes of a JSON-ready document (orjson: ~10× the standard
+    library's encoder on float lists; shortest round-trip float text, as ``json``).
+
+    Non-finite floats raise NumericalError (orjson would write them as null): the
+    service never answers NaN or a silently nulled number.
+    """
+    if not all_finite(obj):
+        from .errors import NumericalError
+
+        raise NumericalError("the result document contains non-finite values (NaN or inf)")
+    return orjson.dumps(obj)
+
+
 def json_response(payload: Mapping[str, Any], status_code: int = 200) -> Response:
     """JSON answer built directly from numpy arrays (skips per-float pydantic checks)."""
-    body = json.dumps(_plain(payload), allow_nan=False, separators=(",", ":"))
-    return Response(body.encode(), status_code=status_code, media_type=JSON)
+    return Response(dumps(_plain(payload)), status_code=status_code, media_type=JSON)
 
 
 def _stats_header(stats: Mapping[str, Any] | None) -> dict[str, str]:
     if not stats:
         return {}
-    return {STATS_HEADER: json.dumps(_plain(stats), allow_nan=False, separators=(",", ":"))}
+    return {STATS_HEADER: dumps(_plain(stats)).decode()}
 
 
 class _NpyResponse(Response):

@@ -8,6 +8,7 @@ import gzip
 import io
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -378,3 +379,36 @@ def test_columns_response_checks_the_columns_not_declared_finite():
         columns_response({"elevation": good, "velocity_0_x": bad}, NPY, finite=("elevation",))
     resp = columns_response({"elevation": good}, NPY, finite=("elevation",))
     assert int(resp.headers["content-length"]) > 4 * 8
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+@pytest.mark.parametrize("where", ["scalar", "list", "nested", "mixed"])
+def test_dumps_refuses_non_finite_anywhere_in_a_document(bad, where):
+    """orjson would write NaN/inf as null: the service's encoder refuses them instead,
+    wherever they sit (a scalar, a float list, a list of lists, a list with None)."""
+    from service.encoding import dumps
+    from service.errors import NumericalError
+
+    docs = {"scalar": {"a": {"b": bad}},
+            "list": {"a": [1.0, 2.0, bad]},
+            "nested": {"a": [[1.0, 2.0], [3.0, bad]]},
+            "mixed": {"a": [None, "x", 1, bad]}}
+    with pytest.raises(NumericalError, match="non-finite"):
+        dumps(docs[where])
+
+
+def test_dumps_equals_the_standard_encoder_after_parsing():
+    """orjson text parses to the same document as json.dumps' (shortest round-trip
+    floats both): the result document of the chain example, time series included; and
+    finite sums that overflow (1e308 + 1e308) take the element-wise path, not an error."""
+    import json
+
+    from service.encoding import dumps
+    from stochcable.analysis import analyze
+    from stochcable.examples import load_example
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        doc = analyze(load_example("chain_catenary")).to_document(timeseries="window")
+    assert json.loads(dumps(doc)) == json.loads(json.dumps(doc, allow_nan=False))
+    assert json.loads(dumps({"x": [1e308, 1e308]})) == {"x": [1e308, 1e308]}

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import threading
 import time
 from collections.abc import Mapping
@@ -14,8 +13,7 @@ from starlette.responses import Response
 from stochcable.scene import Scene, load_scene
 
 from ..dependencies import RunnerDep, SettingsDep
-from ..encoding import JSON, error_responses
-from ..errors import NumericalError
+from ..encoding import JSON, dumps, error_responses
 from ..limits import RunTimeExceeded, check_scene
 from ..schemas import AnalysisResponse
 
@@ -120,9 +118,5 @@ def _analysis(scene: Scene, timeseries: str, deadline: float,
         except _Abandoned:
             raise RunTimeExceeded(limit) from None
     doc = result.to_document(timeseries=timeseries)
-    try:
-        text = json.dumps(doc, allow_nan=False, separators=(",", ":"))
-    except ValueError:
-        raise NumericalError("the result document contains non-finite values "
-                             "(NaN or inf)") from None
-    return text.encode(), len(doc.get("warnings", ()))
+    # NumericalError for non-finite values (never NaN or a nulled number in a 200)
+    return dumps(doc), len(doc.get("warnings", ()))
