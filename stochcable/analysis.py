@@ -105,7 +105,6 @@ from .excitation import (
     element_frames,
     element_mean_square,
     element_moments,
-    embed,
     inertia_matrix,
     line_channels,
 )

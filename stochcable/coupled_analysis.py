@@ -103,7 +103,6 @@ from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.linalg import lapack
 
 from .analysis import (
     ANDERSON_MIXING,
@@ -153,7 +152,6 @@ from .linearization import (
 from ._parallel import line_map
 from .results import BodyResult, LinearizationRecord, LineResult, stats_from_spectrum
 from .solvers import (
-    DEFECTIVE_CONDITION,
     FossModes,
     _foss_decomposition,
     _foss_transfer_modal,

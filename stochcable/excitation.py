@@ -80,7 +80,7 @@ import scipy.sparse as sp
 
 from .errors import InputError
 from . import _validate as v
-from .kinematics import G_STANDARD, _depth, _nodal_kinematics, _wavenumber, wave_kinematics
+from .kinematics import G_STANDARD, _depth, _nodal_kinematics, _wavenumber
 from .scene import Environment, Line, Scene
 
 __all__ = [

@@ -481,7 +481,7 @@ class _Model:
 
     def _residual(self, X: np.ndarray) -> dict:
         """The residual part of :meth:`forces` and the intermediates of the tangent."""
-        dim, zi, l0 = self.dim, self.zi, self.l0
+        zi, l0 = self.zi, self.l0
         beta = self.beta
         d = X[1:] - X[:-1]
         l = np.sqrt(np.einsum("ij,ij->i", d, d))
