@@ -1192,7 +1192,9 @@ def solve_coupled_direct(
     Notes
     -----
     The direct solve of DESIGN.md "Solution" with the body's frequency-dependent added
-    mass and radiation damping (seed 001 eq. 3.2.c.20) exact at every ω.  The Foss
+    mass and radiation damping (seed 001 eq. 3.2.c.20) exact at every ω.  A body's
+    ``fixed_dofs`` are constraints: those DOFs are removed from the system and their
+    motion is exactly zero (their loads are reactions, not inputs).  The Foss
     decomposition needs constant matrices (:func:`constant_matrices`) and is exact
     only where A and B are constant.
     """
@@ -1218,6 +1220,17 @@ def solve_coupled_direct(
                 raise
             x = _solve_dense(system, f, w)
     return x[:, :, 0] if squeeze else x
+
+
+def _free_body(system: CoupledSystem) -> tuple[np.ndarray, np.ndarray]:
+    """Global indices of the free body DOFs and, among ``body_index``, their positions
+    (the bodies' ``fixed_dofs`` removed)."""
+    J = system.body_index
+    pos = np.concatenate([system.body_dofs[b.name][b.free_index] for b in system.bodies]
+                         ) if system.bodies else np.zeros(0, dtype=int)
+    where = np.searchsorted(J, pos) if np.all(np.diff(J) > 0) else np.array(
+        [int(np.flatnonzero(J == p)[0]) for p in pos], dtype=int)
+    return pos.astype(int), where.astype(int)
 
 
 def _body_z(system: CoupledSystem, w: np.ndarray) -> np.ndarray:
@@ -1268,14 +1281,22 @@ def _solve_dense(system: CoupledSystem, f: np.ndarray, w: np.ndarray) -> np.ndar
     z = k[None] - w2 * m[None] + iw * c[None]
     if J.size:
         z[np.ix_(np.arange(w.size), J, J)] += -w2 * a + iw * b
-    return _solve_small(z, f, w, "coupled direct solve")
+    free, _ = _free_body(system)
+    keep = np.setdiff1d(np.arange(n), np.setdiff1d(J, free))   # fixed body DOFs out
+    if keep.size == n:
+        return _solve_small(z, f, w, "coupled direct solve")
+    x = np.zeros_like(f)
+    x[:, keep, :] = _solve_small(z[:, keep][:, :, keep], f[:, keep, :], w,
+                                 "coupled direct solve")
+    return x
 
 
 def _solve_schur(system: CoupledSystem, f: np.ndarray, w: np.ndarray) -> np.ndarray:
     from .solvers import solve_direct
 
     n_w, n, n_rhs = f.shape
-    J = system.body_index
+    # the free body DOFs only: fixed ones stay exactly zero (constraints)
+    J, where = _free_body(system)
     nb = J.size
     x = np.zeros_like(f)
     w2 = (w * w)[:, None, None]
@@ -1287,7 +1308,7 @@ def _solve_schur(system: CoupledSystem, f: np.ndarray, w: np.ndarray) -> np.ndar
                 + iw * _block(system.C, rows, cols).toarray()[None])
 
     if nb:
-        s = _body_z(system, w)
+        s = _body_z(system, w)[:, where][:, :, where]
         g = f[:, J, :].copy()
     back = []  # (line DOFs, Z_II⁻¹ Z_IJ) for the back-substitution
     for ln in system.lines:

@@ -317,6 +317,46 @@ def _two_line_system(symmetric=True, tables=False):
     return couple(links, [body])
 
 
+def _two_line_system_fixed(fixed=(), penalty=0.0):
+    """The symmetric two-line system of _two_line_system(tables=True) with body DOFs
+    held by ``fixed_dofs`` or by a ``penalty`` spring on those DOFs instead."""
+    import dataclasses
+
+    s = _two_line_system(tables=True)
+    body = s.bodies[0]
+    names = list(body.dof_names)
+    extra = np.zeros((6, 6))
+    for d in fixed:
+        extra[names.index(d), names.index(d)] = penalty
+    new = dataclasses.replace(body, fixed_dofs=() if penalty else tuple(fixed),
+                              extra_stiffness=extra)
+    links = [LineLink(ln.name, ln.model, end_b="buoy", damping=ln.damping)
+             for ln in s.lines]
+    return couple(links, [new])
+
+
+@pytest.mark.parametrize("method", ["schur", "dense"])
+def test_fixed_dofs_are_constraints_in_the_monolithic_solve(method):
+    """Body heave and pitch held by fixed_dofs: exactly zero motion, and the other DOFs
+    and the lines equal the limit of a stiff spring on those DOFs (an independent
+    method). A spring k_p leaves a motion O(F/k_p): with k_p = 1e12 N/m against
+    line/body stiffnesses ≤ 1e7, the difference is ≤ 1e-5 of the response."""
+    fixed = ("heave", "pitch")
+    s = _two_line_system_fixed(fixed)
+    p = _two_line_system_fixed(fixed, penalty=1e12)
+    w = np.array([0.3, 1.3, 2.6])
+    rng = np.random.default_rng(5)
+    F = rng.standard_normal((w.size, s.n_dof)) + 1j * rng.standard_normal((w.size, s.n_dof))
+    x = solve_coupled_direct(s, F, w, method=method)
+    xp = solve_coupled_direct(p, F, w, method=method)
+    rows = [int(s.body_dofs["buoy"][list(s.bodies[0].dof_names).index(d)]) for d in fixed]
+    assert np.all(x[:, rows] == 0.0)
+    np.testing.assert_allclose(x, xp, atol=1e-5 * np.abs(x).max())
+    # and the constraint changed the answer (the test can fail)
+    free = solve_coupled_direct(_two_line_system(tables=True), F, w, method=method)
+    assert np.abs(free - x).max() > 1e-2 * np.abs(x).max()
+
+
 def test_coupled_matrices_symmetric_when_moments_balance():
     """Symmetric two-line mooring (Σ r × F = 0): K, M, C symmetric; one line alone
     leaves the moment r × F unbalanced and K is not symmetric (the check can fail)."""
