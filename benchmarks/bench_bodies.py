@@ -141,14 +141,7 @@ def fast_paths_ab(repeat: int) -> None:
         for _ in range(repeat):
             for ref in (True, False):
                 reference_paths(ref)
-                w0, p0 = time.perf_counter(), time.process_time()
-                run_coupled(scene)
-                t[ref, "fw"].append(time.perf_counter() - w0)
-                t[ref, "fp"].append(time.process_time() - p0)
-                w0, p0 = time.perf_counter(), time.process_time()
-                run_coupled(scene, statics)
-                t[ref, "dw"].append(time.perf_counter() - w0)
-                t[ref, "dp"].append(time.process_time() - p0)
+                _time_full_and_dynamics(scene, statics, t, ref)
         reference_paths(False)
         for ref in (True, False):
             med = {k: 1e3 * statistics.median(t[ref, k]) for k in ("fw", "fp", "dw", "dp")}
@@ -157,6 +150,16 @@ def fast_paths_ab(repeat: int) -> None:
                   f"(process {med['dp']:.1f}), medians of {repeat}")
         diff = np.max(np.abs(keys[False] / keys[True] - 1.0))
         print(f"        max relative change of the buoy σ and tension σ: {diff:.1e}")
+
+
+def _time_full_and_dynamics(scene, statics, t: dict, key) -> None:  # noqa: ANN001
+    """One timed full analysis (with statics) and one dynamics-only run, appended to
+    ``t[key, "fw"/"fp"/"dw"/"dp"]`` (wall and process time). [s]"""
+    for kind, st in (("f", None), ("d", statics)):
+        w0, p0 = time.perf_counter(), time.process_time()
+        run_coupled(scene, st)
+        t[key, kind + "w"].append(time.perf_counter() - w0)
+        t[key, kind + "p"].append(time.process_time() - p0)
 
 
 def threads_ab(repeat: int) -> None:
@@ -182,14 +185,7 @@ def threads_ab(repeat: int) -> None:
             for _ in range(repeat):
                 for th in ("1", "2"):
                     os.environ["STOCHCABLE_THREADS"] = th
-                    w0, p0 = time.perf_counter(), time.process_time()
-                    run_coupled(scene)
-                    t[th, "fw"].append(time.perf_counter() - w0)
-                    t[th, "fp"].append(time.process_time() - p0)
-                    w0, p0 = time.perf_counter(), time.process_time()
-                    run_coupled(scene, statics)
-                    t[th, "dw"].append(time.perf_counter() - w0)
-                    t[th, "dp"].append(time.process_time() - p0)
+                    _time_full_and_dynamics(scene, statics, t, th)
             for th in ("1", "2"):
                 med = {k: 1e3 * statistics.median(t[th, k]) for k in ("fw", "fp", "dw", "dp")}
                 print(f"{solver:6s} {th} thread{'s' if th != '1' else ' '}: full "

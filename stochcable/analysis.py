@@ -2176,19 +2176,28 @@ def linearize(
     resp = _response(system, inp, damping, (_total(system, inp, u_f), c))
     if timing is not None:
         timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
-    parts = _split_sigma(system, cache["sigma"], method)
+    record = linearization_record(system, cache["sigma"], damping, fp, lin.tolerance, method)
+    return Linearization(damping=damping, record=record, response=resp, coarse=stage)
+
+
+def linearization_record(system: LineSystem, sigma: np.ndarray, damping: Damping, fp: Any,
+                         tolerance: float, method: str) -> LinearizationRecord:
+    """The record of a converged (or flagged) drag fixed point of one line: the
+    iteration history of ``fp`` (a FixedPointResult), the final σ (the
+    :func:`drag_coefficients` layout) split into normal and axial, and the linear
+    drag (the vector form reports σ_n = |σ| and b_n = trace/2 of its 2×2 blocks)."""
+    parts = _split_sigma(system, sigma, method)
     if method == "vector":
         sig_n = np.sqrt(parts["normal"][0] ** 2 + parts["normal"][1] ** 2)
         b_n = 0.5 * np.trace(damping.b_normal, axis1=1, axis2=2)
     else:
         sig_n, b_n = parts["normal"][0], damping.b_normal
-    record = LinearizationRecord(
+    return LinearizationRecord(
         method=method, converged=fp.converged, iterations=fp.iterations,
-        relative_change=fp.relative_change, history=fp.history, tolerance=lin.tolerance,
+        relative_change=fp.relative_change, history=fp.history, tolerance=tolerance,
         sigma_normal=sig_n, sigma_axial=parts["axial"], b_normal=b_n,
         b_axial=damping.b_axial,
     )
-    return Linearization(damping=damping, record=record, response=resp, coarse=stage)
 
 
 # ------------------------------------------------------------------------- outputs

@@ -97,6 +97,12 @@ def _kernel(H, V0, w, ls, c):
         j_opp = (V1 / T1 - V0 / T0) / wsafe
         S1 = np.where(same, s1_same, s1_opp)  # ∫ H/T ds
         J = np.where(same, j_same, j_opp)  # ∫ H²/T³ ds
+    return _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c)
+
+
+def _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c) -> tuple:  # noqa: ANN001
+    """The branch-free end of :func:`_kernel` and :func:`_kernel_scalar` (arrays or
+    floats alike): spans and Jacobian from S1 = ∫ H/T ds and J = ∫ H²/T³ ds."""
     S2 = ls * (V0 + V1) / (T0 + T1)  # ∫ V/T ds
     K = -H * ls * (V0 + V1) / (T0 * T1 * (T0 + T1))  # ∫ −HV/T³ ds
     x = H * c * ls + S1
@@ -129,13 +135,7 @@ def _kernel_scalar(H: float, V0: float, w: float, ls: float, c: float) -> tuple:
         wsafe = w if w != 0.0 else 1.0
         S1 = (H / wsafe) * (float(np.arcsinh(V1 / H)) - float(np.arcsinh(V0 / H)))
         J = (V1 / T1 - V0 / T0) / wsafe
-    S2 = ls * (V0 + V1) / (T0 + T1)  # ∫ V/T ds
-    K = -H * ls * (V0 + V1) / (T0 * T1 * (T0 + T1))  # ∫ −HV/T³ ds
-    x = H * c * ls + S1
-    z = c * (V0 * ls + 0.5 * w * ls * ls) + S2
-    dxdH = c * ls + S1 / H - J
-    dzdV = c * ls + J
-    return x, z, dxdH, K, K, dzdV
+    return _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c)
 
 
 def _closure(H, Va, L, w, c, seabed):

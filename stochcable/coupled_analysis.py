@@ -114,7 +114,8 @@ from .analysis import (
     _add,
     _base,
     _drag_blocks,
-    _drag_load,
+    _end_loads,
+    _free_load,
     _end_tension,
     _inputs,
     _matvec,
@@ -125,12 +126,12 @@ from .analysis import (
     _real_gemm,
     _sigmas,
     _solve_free,
-    _split_sigma,
     _to_freq,
     _total,
     _trapezoid_weights,
     drag_coefficients,
     line_result,
+    linearization_record,
 )
 from .bodies import (
     PLANAR_INDEX,
@@ -150,7 +151,7 @@ from .linearization import (
     fixed_point,
 )
 from ._parallel import line_map
-from .results import BodyResult, LinearizationRecord, LineResult, stats_from_spectrum
+from .results import BodyResult, LineResult, stats_from_spectrum
 from .solvers import (
     FossModes,
     _foss_decomposition,
@@ -655,25 +656,14 @@ def _foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Dampi
     w = inp.omega
     n_ch = inp_phys.weights.shape[1]
     n_e = inp.weights.shape[1] - n_ch
-    cd = _drag_blocks(system, damping)
-    c = _add(prep.S, cd)
-    phi, mh, kh = prep.modal(system)
-    ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
-    try:
-        foss = _foss_decomposition(mh, 0.5 * (ch + ch.T), kh)
-    except SolverError:
+    _, c, foss = _foss_state(system, damping)
+    if foss is None:
         return None
+    phi, _, _ = prep.modal(system)
     m, nf = phi.shape[1], phi.shape[0]
     n_w = w.size
     # physical channels: the free-row load of _solve_free
-    _, f0, q = _base(system, prep, inp_phys)
-    rhs = _drag_load(system, inp_phys, damping)
-    if rhs is None:
-        rhs = f0.copy()
-    else:
-        rhs += f0
-    if q is not None:
-        rhs += _matvec(cd, q)
+    rhs = _free_load(system, prep, inp_phys, damping)
     flat = np.ascontiguousarray(prep._free_rows(rhs)).reshape(nf, n_w * n_ch)
     u_p = _real_gemm(phi, np.ascontiguousarray(
         _foss_transfer_modal(foss, _real_gemm(phi.T, flat), w, n_ch)))
@@ -742,7 +732,7 @@ class _FossLine:
         w = inp.omega
         n_w, n_ch = inp.weights.shape
         d, n = prep.d, prep.n
-        cd, c, foss = _foss_state(system, damping) if state is None else state
+        _, c, foss = _foss_state(system, damping) if state is None else state
         if foss is None:
             raise SolverError("Foss eigenproblem is (nearly) defective")
         phi, _, _ = prep.modal(system)
@@ -753,14 +743,8 @@ class _FossLine:
         if bad.any():   # the message of solvers._foss_transfer_modal
             _foss_transfer_modal(foss, np.zeros((m, n_w), dtype=complex), w, 1)
         # physical channels: the free-row load of _solve_free
-        u_p, f0, q = _base(system, prep, inp)
-        rhs = _drag_load(system, inp, damping)
-        if rhs is None:
-            rhs = f0.copy()
-        else:
-            rhs += f0
-        if q is not None:
-            rhs += _matvec(cd, q)
+        u_p = _base(system, prep, inp)[0]
+        rhs = _free_load(system, prep, inp, damping)
         flat = np.ascontiguousarray(prep._free_rows(rhs)).reshape(nf, n_w * n_ch)
         p0 = (foss.weights @ _real_gemm(phi.T, flat)).reshape(2 * m, n_w, n_ch)
         p0 /= den[:, :, None]
@@ -840,22 +824,6 @@ class _FossLine:
         uc += _real_gemm(self.up.reshape(n * d, n_e), flat_e).reshape(n, d, n_w, n_ch)
         sc = self.sup0 + self.supe @ ue
         return uc, sc
-
-
-def _end_loads(system: LineSystem, inp: Any, damping: Damping) -> np.ndarray:
-    """Fluid loads on the two end nodes only, (2, d, n_w, n_ch): what the reaction rows
-    of :func:`stochcable.analysis._reactions` read of :func:`stochcable.analysis._loads`
-    (element 0's share on node 0, the last element's on the last node)."""
-    f = inp.inertia_load[[0, -1]].copy()
-    if inp.moments is not None:
-        _drag_blocks(system, damping)
-        b = damping._cache["elements"]
-        m = inp.moments
-        f[0] += np.einsum("ij,jwc->iwc", b[0], m[0, 0])
-        f[1] += np.einsum("ij,jwc->iwc", b[-1], m[-1, 1])
-    if inp.velocity is not None and np.any(damping.b_node):
-        f += damping.b_node[[0, -1], None, None, None] * inp.velocity[[0, -1]]
-    return f
 
 
 def _solve_body(s: np.ndarray, g: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -1107,17 +1075,8 @@ def linearize_coupled(
         uc, sc = cache["sol"][cl.name]
         resp = Response(omega=g.omega, displacement=_to_freq(uc), support_force=sc,
                         end_tension=_end_tension(system, sc))
-        parts_ = _split_sigma(system, ls[cl.name], method)
-        if method == "vector":
-            sig_n = np.sqrt(parts_["normal"][0] ** 2 + parts_["normal"][1] ** 2)
-            b_n = 0.5 * np.trace(damping.b_normal, axis1=1, axis2=2)
-        else:
-            sig_n, b_n = parts_["normal"][0], damping.b_normal
-        record = LinearizationRecord(
-            method=method, converged=fp.converged, iterations=fp.iterations,
-            relative_change=fp.relative_change, history=fp.history,
-            tolerance=lin.tolerance, sigma_normal=sig_n, sigma_axial=parts_["axial"],
-            b_normal=b_n, b_axial=damping.b_axial)
+        record = linearization_record(system, ls[cl.name], damping, fp, lin.tolerance,
+                                      method)
         out[cl.name] = Linearization(damping=damping, record=record, response=resp)
     xi = cache["xi"]
     motion = {b.name: xi[:, g.off[b.name]:g.off[b.name] + b.n_dof, :].copy()

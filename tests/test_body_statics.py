@@ -14,6 +14,7 @@ import json
 import math
 
 import numpy as np
+from _scenes import three_chain_legs
 import pytest
 from scipy.spatial.transform import Rotation
 
@@ -326,16 +327,7 @@ def _buoy_spread_doc(n_el: int = 40, position=(10.0, 5.0, 0.0)) -> dict:
     """The benchmark scene of benchmarks/bench_bodies.py: a 2e4 kg buoy (K_h heave
     1.26e5 N/m) on three 330 m chain legs at 0/120/240°, anchors 300 m out on the
     seabed at 100 m depth, started off its equilibrium."""
-    lines = []
-    for i in range(3):
-        a = math.radians(120.0 * i)
-        lines.append({
-            "name": f"leg{i + 1}",
-            "end_a": {"position": [300.0 * math.cos(a), 300.0 * math.sin(a), -100.0]},
-            "end_b": {"attach": {"body": "buoy",
-                                 "point": [5.0 * math.cos(a), 5.0 * math.sin(a), -2.0]}},
-            "segments": [{"length": 330.0, "ea": 5e8, "mass": 100.0, "diameter": 0.1,
-                          "elements": n_el}]})
+    lines = three_chain_legs(n_el, attach="buoy")
     kh = [[0.0] * 6 for _ in range(6)]
     for i, v in enumerate([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]):
         kh[i][i] = v

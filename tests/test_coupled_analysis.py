@@ -15,6 +15,7 @@ import dataclasses
 import math
 
 import numpy as np
+from _scenes import three_chain_legs
 import pytest
 from scipy.spatial.transform import Rotation
 
@@ -63,15 +64,7 @@ def _settings():
 def _mooring_doc(heading=0.0, n_el=10, count=40, solver="direct", modes="auto", tol=1e-10):
     """Three chain legs at 0/120/240 deg from anchors at radius 300 m to fairleads at
     radius 5 m, z = -2 m, around a buoy at the origin; 100 m depth."""
-    lines = []
-    for i in range(3):
-        a = math.radians(120.0 * i)
-        lines.append({
-            "name": f"leg{i + 1}",
-            "end_a": {"position": [300.0 * math.cos(a), 300.0 * math.sin(a), -100.0]},
-            "end_b": {"position": [5.0 * math.cos(a), 5.0 * math.sin(a), -2.0]},
-            "segments": [{"length": 330.0, "ea": 5e8, "mass": 100.0, "diameter": 0.1,
-                          "elements": n_el}]})
+    lines = three_chain_legs(n_el)
     return {"environment": {"depth": 100.0},
             "sea": {"spectrum": {"type": "jonswap", "hs": 3.0, "tp": 9.0},
                     "heading": heading},
