@@ -453,13 +453,13 @@ def test_log_grid_from_1e_minus_4_to_1e2():
 # ---------------------------------------------------------------------- time series
 
 
-@pytest.mark.slow
-def test_long_record_2_pow_20_samples():
-    """2^20 samples (dt = 0.25 s, 73 h): finite, and the DSA variance of the tension is
-    the grid sum Σ|H|²SΔω exactly, which is the analysis σ² up to the grid."""
-    n_t = 2**20
+def _long_record(n_t: int, method: str):
+    """The chain (10 elements, 60 ω on [0.2, 1.6]) with an n_t-sample record at
+    dt = 0.25 s: the result, the dynamic fairlead tension series, its transfer H on
+    the realization grid and the sea spectrum S there (zero at ω = 0 and Nyquist),
+    after checking the record is finite and complete."""
     doc = chain(elements=10, omega={"min": 0.2, "max": 1.6, "count": 60})
-    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": n_t * 0.25, "dt": 0.25,
+    doc["analysis"]["timeseries"] = {"method": method, "duration": n_t * 0.25, "dt": 0.25,
                                      "seed": 5}
     res = analyze(doc)
     ts = res.timeseries
@@ -468,9 +468,16 @@ def test_long_record_2_pow_20_samples():
     assert np.all(np.isfinite(x)) and np.all(np.isfinite(ts.elevation))
     dyn = x - res.statics.lines["l"].tension_b
     h = ts.end_tension_transfer["l"]["end_b"][0]
-    spec = res.scene.sea.spectrum
     s = np.zeros_like(ts.omega)
-    s[1:-1] = spec.spectral_density(ts.omega[1:-1])
+    s[1:-1] = res.scene.sea.spectrum.spectral_density(ts.omega[1:-1])
+    return res, ts, dyn, h, s
+
+
+@pytest.mark.slow
+def test_long_record_2_pow_20_samples():
+    """2^20 samples (dt = 0.25 s, 73 h): finite, and the DSA variance of the tension is
+    the grid sum Σ|H|²SΔω exactly, which is the analysis σ² up to the grid."""
+    res, ts, dyn, h, s = _long_record(2**20, "dsa")
     d_omega = ts.omega[1]
     # DSA: exact up to round-off of a 2^20 FFT
     assert np.mean(dyn**2) == pytest.approx(float(np.sum(np.abs(h) ** 2 * s) * d_omega),
@@ -487,19 +494,7 @@ def test_long_record_2_pow_22_samples_nsa_variance_within_sampling_error():
     sampling error.  Measured on the 2-core VM: 2.9 s alone, 9.5 s with four other
     jobs; peak memory 1.8 GB (tracemalloc peak 1.76 GB inside analyze()'s synthesis,
     0.27 GB held by the result)."""
-    n_t = 2**22
-    doc = chain(elements=10, omega={"min": 0.2, "max": 1.6, "count": 60})
-    doc["analysis"]["timeseries"] = {"method": "nsa", "duration": n_t * 0.25, "dt": 0.25,
-                                     "seed": 5}
-    res = analyze(doc)
-    ts = res.timeseries
-    assert ts.time.size == n_t
-    x = ts.end_tension["l"]["end_b"]
-    assert np.all(np.isfinite(x)) and np.all(np.isfinite(ts.elevation))
-    dyn = x - res.statics.lines["l"].tension_b
-    h = ts.end_tension_transfer["l"]["end_b"][0]
-    s = np.zeros_like(ts.omega)
-    s[1:-1] = res.scene.sea.spectrum.spectral_density(ts.omega[1:-1])
+    res, ts, dyn, h, s = _long_record(2**22, "nsa")
     m_k = np.abs(h) ** 2 * s * ts.omega[1]  # variance per spectral line
     m0 = float(m_k.sum())
     # NSA: each line's power is exponential with mean m_k, so the record's variance has
