@@ -33,6 +33,7 @@ from starlette.responses import JSONResponse
 
 from stochcable.errors import ConvergenceError, InputError, SolverError, StochcableError
 from stochcable.scene import field_path_and_unit
+from stochcable.units import labels_of_document
 
 from .limits import BodyTooLarge, LimitExceeded, RunTimeExceeded
 
@@ -92,8 +93,16 @@ def _body_model(request: Request) -> type[BaseModel] | None:
 # ------------------------------------------------------------------ handlers
 
 
+def _scene_of(body: Any) -> Any:
+    """The scene document inside a request body (the body itself, or its ``scene``)."""
+    if isinstance(body, dict) and "environment" not in body and isinstance(body.get("scene"), dict):
+        return body["scene"]
+    return body
+
+
 async def _validation_handler(request: Request, exc: RequestValidationError) -> JSONResponse:
     model = _body_model(request)
+    labels = labels_of_document(_scene_of(getattr(exc, "body", None)))
     items = []
     for err in exc.errors():
         loc = list(err.get("loc", ()))
@@ -105,7 +114,7 @@ async def _validation_handler(request: Request, exc: RequestValidationError) -> 
             parameter, unit = field_path_and_unit(model, loc[1:])
             item["parameter"] = parameter or "body"
             if unit:
-                item["unit"] = unit
+                item["unit"] = labels.convert(unit)
         elif loc:
             item["parameter"] = ".".join(str(p) for p in loc[1:]) or str(loc[0])
         if "input" in err and _json_safe(err["input"]):

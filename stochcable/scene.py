@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal, Union
@@ -26,6 +27,7 @@ from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, Validati
                       model_validator)
 
 from .errors import InputError
+from .units import UnitLabels, labels_of_document
 
 __all__ = [
     "PiersonMoskowitz",
@@ -1067,10 +1069,19 @@ def field_path_and_unit(model: type[BaseModel] | None, loc: Sequence[Any]) -> tu
     return out, unit
 
 
+#: A number followed by an SI unit symbol in a validator's message ("-120 m", "5 m²").
+_QUOTED_UNIT = re.compile(r"([\d\]] )((?:kg|m|N)(?:[²³]|/m|/s)?)(?![\w/·])")
+
+
 def input_error_from_validation(
-    exc: ValidationError, model: type[BaseModel], prefix: str = ""
+    exc: ValidationError, model: type[BaseModel], prefix: str = "",
+    labels: UnitLabels | None = None,
 ) -> InputError:
-    """Convert the first error of a pydantic ValidationError into an InputError."""
+    """Convert the first error of a pydantic ValidationError into an InputError.
+
+    ``labels``: the scene's unit system (:func:`stochcable.units.labels_of_document`);
+    the field's SI unit label is given in it (default SI).
+    """
     errors = exc.errors(include_url=False)
     locs = [tuple(e.get("loc", ())) for e in errors]
     # pydantic repeats a nested failure at every enclosing tuple ("should have at least
@@ -1081,12 +1092,17 @@ def input_error_from_validation(
     ] or errors
     err = leaves[0]
     path, unit = field_path_and_unit(model, tuple(err.get("loc", ())))
+    if labels is not None:
+        unit = labels.convert(unit)
     path = path or "scene"
     if prefix:
         path = f"{prefix}.{path}" if path != "scene" else prefix
     msg = str(err.get("msg", "invalid"))
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
+    if labels is not None and labels.system != "SI":
+        # the validators' own messages quote values with SI symbols ("z = -120 m")
+        msg = _QUOTED_UNIT.sub(lambda mt: mt.group(1) + labels.convert(mt.group(2)), msg)
     more = len(leaves) - 1
     if more:
         msg += f" (and {more} more error{'s' if more > 1 else ''})"
@@ -1153,7 +1169,8 @@ def load_scene(source: Scene | Mapping[str, Any] | str | Path, *,
     try:
         scene = Scene.model_validate(data)
     except ValidationError as exc:
-        raise input_error_from_validation(exc, Scene) from None
+        raise input_error_from_validation(exc, Scene,
+                                          labels=labels_of_document(data)) from None
     return _check_files(scene, allow_files, base)
 
 

@@ -200,11 +200,16 @@ def test_core_input_error_is_422_with_the_path(small):
 
 
 def test_validation_error_names_the_field_path_and_unit(small):
+    # SMALL is in feet (g = 32.174 ft/s²): the unit is given in its system
     scene = _doc(SMALL)
     scene["lines"][0]["segments"][0]["ea"] = -1.0
     err = _err(small.post("/v1/analyses", json=scene))
-    assert err["parameter"] == "lines[0].segments[0].ea" and err["unit"] == "N"
+    assert err["parameter"] == "lines[0].segments[0].ea" and err["unit"] == "lbf"
     assert err["msg"] == "Input should be greater than 0"
+    scene = _doc(CHAIN)   # SI
+    scene["lines"][0]["segments"][0]["ea"] = -1.0
+    err = _err(small.post("/v1/analyses", json=scene))
+    assert err["parameter"] == "lines[0].segments[0].ea" and err["unit"] == "N"
 
 
 # -------------------------------------------------------- run time, concurrency
