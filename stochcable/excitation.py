@@ -345,7 +345,16 @@ def _phi1_psi(x: np.ndarray, want_psi: bool = True) -> tuple[np.ndarray, np.ndar
     return phi, psi
 
 
-def _exp_moments(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray
+def _moment_argument(alpha: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """The argument x of φ1 and ψ in :func:`_exp_moments` (Re x <= 0)."""
+    s = np.where(alpha.real >= 0.0, -1.0, 1.0)
+    if np.all(p == 0.0) and np.all(q == 1.0):
+        return s * alpha
+    return s * alpha * (q - p)
+
+
+def _exp_moments(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray,
+                 phi_psi: tuple[np.ndarray, np.ndarray] | None = None
                  ) -> tuple[np.ndarray, np.ndarray]:
     """∫_p^q (1 − ξ) e^{e0 + αξ} dξ and ∫_p^q ξ e^{e0 + αξ} dξ, elementwise.
 
@@ -353,7 +362,8 @@ def _exp_moments(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray
     Re α >= 0, else p), so with t = |ξ − c|, x = −α(q − p) or α(q − p) (Re x <= 0):
     ∫_p^q e^{…} = e^{e0 + αc} L φ1(x) and ∫_p^q ξ e^{…} = e^{e0 + αc}(c L φ1(x) ± L² ψ(x)),
     L = q − p — never an overflow, whatever α·L (the integrand's largest value
-    e^{Re(e0 + αc)} is <= 1 for wave kinematics).  L = 0 gives zeros."""
+    e^{Re(e0 + αc)} is <= 1 for wave kinematics).  L = 0 gives zeros.  ``phi_psi``:
+    (φ1(x), ψ(x)) when the caller has them (x of :func:`_moment_argument`)."""
     length = q - p
     grow = alpha.real >= 0.0
     s = np.where(grow, -1.0, 1.0)
@@ -361,27 +371,29 @@ def _exp_moments(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray
         # every element wet over its whole length (L = 1, c = 0 or 1): the general
         # expressions below with the factors 1 and 0 dropped — the same numbers
         # (x·1 and 0 + x are exact), a third fewer complex passes
-        f1, f2 = _phi1_psi(s * alpha)
+        f1, f2 = _phi1_psi(s * alpha) if phi_psi is None else phi_psi
         ref = np.exp(np.where(grow, e0 + alpha, e0))
         d12 = f1 - f2
         return ref * np.where(grow, f2, d12), ref * np.where(grow, d12, f2)
     c = np.where(grow, q, p)
-    f1, f2 = _phi1_psi(s * alpha * length)
+    f1, f2 = _phi1_psi(s * alpha * length) if phi_psi is None else phi_psi
     ref = np.exp(e0 + alpha * c)
     t1 = length * f1
     t2 = s * (length * length) * f2
     return ref * ((1.0 - c) * t1 - t2), ref * (c * t1 + t2)
 
 
-def _exp_integral(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray
-                  ) -> np.ndarray:
+def _exp_integral(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray,
+                  phi: np.ndarray | None = None) -> np.ndarray:
     """∫_p^q e^{e0 + αξ} dξ for real e0, α (as :func:`_exp_moments`, factored at the
-    larger endpoint)."""
+    larger endpoint).  ``phi``: φ1 of the argument −|α|(q − p) when the caller has it
+    (the same for α and −α)."""
     length = q - p
     grow = alpha >= 0.0
     c = np.where(grow, q, p)
-    f1, _ = _phi1_psi(np.where(grow, -alpha, alpha) * length, want_psi=False)
-    return np.exp(e0 + alpha * c) * length * f1
+    if phi is None:
+        phi, _ = _phi1_psi(np.where(grow, -alpha, alpha) * length, want_psi=False)
+    return np.exp(e0 + alpha * c) * length * phi
 
 
 @dataclass(frozen=True, eq=False)
@@ -525,8 +537,12 @@ def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: flo
     phase0 = -np.multiply.outer(k, chi[:-1])   # imaginary parts of the exponents
     dphase = -np.multiply.outer(k, chi[1:] - chi[:-1])
     kza = np.multiply.outer(k, za)
-    ma1, mb1 = _exp_moments(_complex(kza, phase0), _complex(dz, dphase), p, q)
-    k1 = _exp_integral(2.0 * kza, 2.0 * dz, p, q)            # ∫ e^{2kz} dξ
+    alpha1 = _complex(dz, dphase)
+    f12 = _phi1_psi(_moment_argument(alpha1, p, q))
+    ma1, mb1 = _exp_moments(_complex(kza, phase0), alpha1, p, q, f12)
+    two_dz = 2.0 * dz
+    phi_k, _ = _phi1_psi(np.where(two_dz >= 0.0, -two_dz, two_dz) * length, want_psi=False)
+    k1 = _exp_integral(2.0 * kza, two_dz, p, q, phi_k)      # ∫ e^{2kz} dξ
     zero_w = w == 0.0
     z_ends = (za[:, None] + (zb - za)[:, None] * np.hstack([p.T, q.T]))   # (n_el, 2)
     z_ends = np.minimum(z_ends, 0.0)
@@ -539,8 +555,16 @@ def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: flo
         ends = 2.0 * e1_ends * (w * w)[:, None, None]
     else:
         e2a = -np.multiply.outer(k, za + 2.0 * h)
-        ma2, mb2 = _exp_moments(_complex(e2a, phase0), _complex(-dz, dphase), p, q)
-        k2 = _exp_integral(2.0 * e2a, -2.0 * dz, p, q)      # ∫ e^{−2k(z+2h)} dξ
+        # the second exponent's slope −dz + i·dphase: where dz ≠ 0 the sign s of
+        # _exp_moments flips with Re α, so its argument is the conjugate of the first
+        # one's and so are φ1 and ψ (exp, products, quotients and the series commute
+        # with conjugation in IEEE arithmetic); where dz = 0 it is the same argument
+        # (up to the sign of a zero real part).  Tested equal to the direct evaluation.
+        flip = dz != 0.0
+        f12_2 = tuple(np.where(flip, f.conj(), f) for f in f12)
+        ma2, mb2 = _exp_moments(_complex(e2a, phase0), _complex(-dz, dphase), p, q, f12_2)
+        # ∫ e^{−2k(z+2h)} dξ: its φ1 argument −|2dz|·L is the first one's
+        k2 = _exp_integral(2.0 * e2a, -two_dz, p, q, phi_k)
         den = -np.expm1(-2.0 * k * h)
         with np.errstate(divide="ignore", invalid="ignore"):
             c = np.where(zero_w, 0.0, w / np.where(zero_w, 1.0, den))

@@ -11,10 +11,14 @@ is solved by one of three methods:
 
 ``"auto"`` takes ``"dense"`` up to ``DENSE_MAX_DOF`` free DOFs (in the largest
 decoupled block) and ``"banded"`` above (crossover measured in
-benchmarks/bench_modes.py).  Before solving, the DOF components that the matrices do not
-couple (for a line in the x–z plane, y is decoupled from x and z; for a vertical
-line all three are) are split into independent smaller problems, which also makes exact
-in-plane/out-of-plane degeneracies harmless.  The Lanczos results are checked with a
+benchmarks/bench_modes.py).  When every block is solved densely (``"dense"``, or
+``"auto"`` with at most ``DENSE_MAX_DOF`` free DOFs) the free–free matrices are taken
+dense from the start and rotated by node blocks, in the order of the sparse products
+of the other path (the same numbers to the bit, docs/BENCHMARKS.md pass E6).
+Before solving, the DOF components that the matrices do not couple (for a line in the
+x–z plane, y is decoupled from x and z; for a vertical line all three are) are split
+into independent smaller problems, which also makes exact in-plane/out-of-plane
+degeneracies harmless.  The Lanczos results are checked with a
 Sturm count (the inertia of K − θM_T, Sylvester's law): if the number of eigenvalues
 below the gap after the last requested mode differs from the number found, the block is
 re-solved densely, so modes near a crossover are never dropped or duplicated.
@@ -191,13 +195,26 @@ def _component_groups(d: int, a: sp.csr_array, b: sp.csr_array) -> list[list[int
 _DENSE_FULL_DOF = 200
 
 
+#: LAPACK dsygvd: the driver of ``scipy.linalg.eigh(a, b)`` for the whole spectrum.
+_SYGVD = sla.get_lapack_funcs(("sygvd",), (np.zeros((1, 1)),))[0]
+
+
 def _solve_dense(a: Any, b: Any, k: int) -> tuple[np.ndarray, np.ndarray]:
     n = a.shape[0]
     a = a.toarray() if sp.issparse(a) else a
     b = b.toarray() if sp.issparse(b) else b
     if k < n and (n > _DENSE_FULL_DOF and 4 * k < n):
         return sla.eigh(a, b, subset_by_index=[0, k - 1], check_finite=False)
-    lam, vec = sla.eigh(a, b, check_finite=False)
+    if n == 0 or a.dtype != np.float64 or b.dtype != np.float64:
+        lam, vec = sla.eigh(a, b, check_finite=False)
+        return lam[:k], vec[:, :k]
+    # the call scipy.linalg.eigh(a, b) makes (dsygvd, lower triangle, no workspace
+    # arguments): the same numbers without ≈ 40 µs of its argument handling
+    lam, vec, info = _SYGVD(a, b, itype=1, jobz="V", uplo="L")
+    if info != 0:
+        raise np.linalg.LinAlgError(
+            f"dsygvd failed (info = {info}): the mass matrix is not positive definite "
+            "or the eigenvalue iteration did not converge")
     return lam[:k], vec[:, :k]
 
 
@@ -278,6 +295,46 @@ def _solve_block(a, b, k, method, u):
         return lam, vec, "dense"
 
 
+def _dense_free(model: FEModel, matrix: Any) -> np.ndarray:
+    """Dense free–free block of a sparse model matrix (a slice when the free DOFs are
+    one contiguous range, as with both ends prescribed)."""
+    full = matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix)
+    free = model.free
+    if int(free[-1]) - int(free[0]) + 1 == free.size:
+        lo, hi = int(free[0]), int(free[-1]) + 1
+        return np.ascontiguousarray(full[lo:hi, lo:hi])
+    return full[np.ix_(free, free)]
+
+
+def _rotate_dense(a: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Rᵀ A R with R = diag(r, r, …) (3×3 node blocks), A dense (3·n_b)².
+
+    The sums run in the order of the sparse products ``(rot.T @ a) @ rot`` of the
+    sparse path (ascending inner index, left to right), so the result is that
+    product's to the bit: a term with a zero entry of r adds a signed zero, which
+    leaves a sum unchanged."""
+    nb = a.shape[0] // 3
+    a4 = a.reshape(nb, 3, nb, 3)
+    t = np.empty_like(a4)
+    for i in range(3):  # (Rᵀ A)[·, i, ·, l] = Σ_k r[k, i] A[·, k, ·, l]
+        t[:, i] = r[0, i] * a4[:, 0] + r[1, i] * a4[:, 1] + r[2, i] * a4[:, 2]
+    out = np.empty_like(a4)
+    for j in range(3):  # (T R)[·, i, ·, j] = Σ_l T[·, i, ·, l] r[l, j]
+        out[:, :, :, j] = (t[:, :, :, 0] * r[0, j] + t[:, :, :, 1] * r[1, j]
+                           + t[:, :, :, 2] * r[2, j])
+    return out.reshape(a.shape)
+
+
+def _unrotate_dense(x: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """R x with R = diag(r, r, …), x (3·n_b, k): the sums of the sparse ``rot @ x``."""
+    nb = x.shape[0] // 3
+    x3 = x.reshape(nb, 3, -1)
+    out = np.empty_like(x3)
+    for i in range(3):
+        out[:, i] = r[i, 0] * x3[:, 0] + r[i, 1] * x3[:, 1] + r[i, 2] * x3[:, 2]
+    return out.reshape(x.shape)
+
+
 def natural_modes(
     model: FEModel,
     count: int | None = None,
@@ -323,37 +380,42 @@ def natural_modes(
     mt = model._mass_total if added_mass else model.M
     d = model.dim
     normal = plane_normal(model.positions)
-    planar_frame = d == 2 or np.allclose(
-        [[normal[1], normal[0], 0.0], [-normal[0], normal[1], 0.0], [0.0, 0.0, 1.0]],
-        np.eye(3), rtol=0.0, atol=1e-15)
-    free = model.free
-    if (planar_frame and (method == "dense" or (method == "auto" and n_free <= DENSE_MAX_DOF))
-            and int(free[-1]) - int(free[0]) + 1 == n_free):
-        # the dense eigensolver's blocks sliced from the dense matrices directly: the
-        # same numbers as the sparse slices' toarray(), without slicing fresh CSR
-        # matrices (0.15 ms on the 40-element chain)
-        lo, hi = int(free[0]), int(free[-1]) + 1
-        a = model.K.toarray()[lo:hi, lo:hi]
-        b = mt.toarray()[lo:hi, lo:hi]
+    # the rotation below is the identity to 1e-15 (np.allclose(r, I, rtol=0,
+    # atol=1e-15) written out: |ny − 1|, |nx| <= 1e-15)
+    planar_frame = d == 2 or (abs(normal[1] - 1.0) <= 1e-15 and abs(normal[0]) <= 1e-15)
+    dense = method == "dense" or (method == "auto" and n_free <= DENSE_MAX_DOF)
+    rz = np.array([[normal[1], normal[0], 0.0],
+                   [-normal[0], normal[1], 0.0],
+                   [0.0, 0.0, 1.0]]) if d == 3 else None  # columns: local x, y (= normal), z
+    rotate = d == 3 and not planar_frame
+    rot = None
+    if dense:
+        # every block is solved densely: dense free–free matrices from the start (the
+        # same numbers as the sparse slices' toarray()), rotated by node blocks in
+        # _rotate_dense (the same sums as the sparse R^T A R); no sparse slicing,
+        # Kronecker product or sparse products (≈ 2 ms per 40-element 3-D line)
+        a = _dense_free(model, model.K)
+        b = _dense_free(model, mt)
         method = "dense"
+        if rotate:
+            a = _rotate_dense(a, rz)
+            b = _rotate_dense(b, rz)
     else:
         a = model._free_free(model.K)
         b = model._free_free(mt)
-    rot = None
-    if d == 3:
-        # Rotate about z so that the line's vertical plane is the local x–z plane: a
-        # planar line's out-of-plane DOFs then decouple exactly from the in-plane ones.
-        r = np.array([[normal[1], normal[0], 0.0],
-                      [-normal[0], normal[1], 0.0],
-                      [0.0, 0.0, 1.0]])  # columns: local x, y (= normal), z
-        if not np.allclose(r, np.eye(3), rtol=0.0, atol=1e-15):
-            rot = sp.csr_array(sp.kron(sp.eye_array(n_free // 3), r, format="csr"))
+        if rotate:
+            # Rotate about z so that the line's vertical plane is the local x–z plane:
+            # a planar line's out-of-plane DOFs then decouple exactly from the in-plane
+            # ones.
+            rot = sp.csr_array(sp.kron(sp.eye_array(n_free // 3), rz, format="csr"))
             a = (rot.T @ a @ rot).tocsr()
             b = (rot.T @ b @ rot).tocsr()
     comp_of_free = np.arange(n_free) % d
     lams, vecs, idxs, used = [], [], [], []
     for group in _component_groups(d, a, b):
-        sel = np.flatnonzero(np.isin(comp_of_free, group))
+        in_group = np.zeros(d, dtype=bool)
+        in_group[group] = True
+        sel = np.flatnonzero(in_group[comp_of_free])
         if sel.size == n_free:  # one coupled group: no slicing
             ag, bg = a, b
         elif not sp.issparse(a):
@@ -381,7 +443,9 @@ def natural_modes(
         kept = np.flatnonzero(r >= 0)
         local[np.ix_(idxs[g], r[kept])] = vec[:, kept]
     shapes = np.zeros((model.n_dof, k))
-    shapes[model.free] = local if rot is None else rot @ local
+    if rotate:
+        local = _unrotate_dense(local, rz) if rot is None else rot @ local
+    shapes[model.free] = local
     lam = lam_all[order]
     scale = max(float(np.abs(lam).max()), 1e-300)
     if (lam < -1e-8 * scale).any():

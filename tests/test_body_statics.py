@@ -409,3 +409,37 @@ def test_end_condensation_matches_dense_schur(planar, ends):
         errs.append(np.abs(pred - ls2.positions[1:-1, comps]).max())
     # first-order predictor: the error quarters when the end motion halves (±30 %)
     assert 0.25 * 0.7 < errs[1] / errs[0] < 0.25 * 1.3, errs
+
+
+def test_cross3_is_numpy_cross_to_the_bit():
+    """The body Newton's moment arm × force (_cross3, issue 6 pass E6) is np.cross's
+    products and differences: the same bits, signed zeros included."""
+    from stochcable.body_statics import _cross3
+
+    rng = np.random.default_rng(17)
+    for _ in range(200):
+        a, b = rng.standard_normal(3) * 10.0 ** rng.uniform(-3, 3), rng.standard_normal(3)
+        a[rng.integers(3)] = 0.0
+        got, want = _cross3(a, b), np.cross(a, b)
+        assert np.array_equal(got, want)
+        assert np.array_equal(np.signbit(got), np.signbit(want))
+
+
+def test_reported_stiffness_is_the_public_mooring_stiffness_at_the_pose():
+    """The statics' memoized end positions (issue 6 pass E6) are those of
+    Scene.end_position: the reported body stiffness at a rotated, offset pose is the
+    body's own stiffness plus mooring_stiffness (which asks the scene) to the bit."""
+    from stochcable.body_statics import mooring_stiffness
+
+    scene = _spread(wind=(40.0, 25.0, 0.0))
+    st = solve_statics(scene, method="fe")
+    b = st.bodies["disc"]
+    assert np.abs(b.rotation).max() > 0.0 and np.abs(b.position[:2]).max() > 1e-3
+    pose = np.concatenate([b.position, b.rotation])
+    rigid = scene_rigid_bodies(scene)["disc"]
+    _, own = body_static_load(scene, "disc", pose, rigid)
+    k = np.zeros((6, 6))
+    k += own
+    k += np.asarray(rigid.extra_stiffness, float)
+    k += mooring_stiffness(scene, st.lines, {"disc": pose}, ["disc"], False, "fe")
+    np.testing.assert_array_equal(b.stiffness, k)

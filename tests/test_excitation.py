@@ -247,3 +247,46 @@ def test_sea_nodal_kinematics_are_computed_on_first_access_only():
     # dataclasses.replace reads the fields: the copy carries the computed arrays
     copy = dataclasses.replace(lazy, name="y")
     assert copy.velocity is vel and len(calls) == 1
+
+
+def test_second_exponent_shares_phi_psi_by_conjugation():
+    """The finite-depth kinematics take φ1, ψ of the second exponent (slope −dz + i·dφ)
+    as the conjugates of the first one's where dz ≠ 0 and as themselves where dz = 0,
+    and the φ1 of ∫e^{−2k(z+2h)} as that of ∫e^{2kz} (issue 6 pass E6): the moments
+    equal those of their own φ1, ψ to the bit, for rising, sinking and horizontal
+    elements, at ω = 0, fully wet (the short path) and partly wet (the general one)."""
+    from stochcable.excitation import (_complex, _exp_integral, _exp_moments,
+                                       _moment_argument, _phi1_psi)
+    from stochcable.kinematics import _wavenumber
+
+    rng = np.random.default_rng(13)
+    h = 150.0
+    k = _wavenumber(np.r_[0.0, np.linspace(0.05, 3.0, 40)], h, 9.80665)
+    za = rng.uniform(-h, -1.0, 30)
+    zb = za + rng.uniform(-6.0, 6.0, 30)
+    zb[::5] = za[::5]                       # horizontal elements: dz = 0
+    zb = np.minimum(zb, -0.5)
+    chi = rng.uniform(-500.0, 0.0, 31)
+    chi[3] = chi[2]                          # an element across the waves: dφ = 0
+    dz = np.multiply.outer(k, zb - za)
+    dphase = -np.multiply.outer(k, chi[1:] - chi[:-1])
+    phase0 = -np.multiply.outer(k, chi[:-1])
+    e2a = -np.multiply.outer(k, za + 2.0 * h)
+    partly = (np.full((1, 30), 0.0), rng.uniform(0.2, 1.0, (1, 30)))
+    for p, q in ((np.zeros((1, 30)), np.ones((1, 30))), partly):
+        alpha1 = _complex(dz, dphase)
+        f12 = _phi1_psi(_moment_argument(alpha1, p, q))
+        f12_2 = tuple(np.where(dz != 0.0, f.conj(), f) for f in f12)
+        alpha2 = _complex(-dz, dphase)
+        e0 = _complex(e2a, phase0)
+        for got, want in zip(_exp_moments(e0, alpha2, p, q, f12_2),
+                             _exp_moments(e0, alpha2, p, q)):
+            np.testing.assert_array_equal(got, want)
+        two_dz = 2.0 * dz
+        phi_k, _ = _phi1_psi(np.where(two_dz >= 0.0, -two_dz, two_dz) * (q - p),
+                             want_psi=False)
+        np.testing.assert_array_equal(_exp_integral(2.0 * e2a, -two_dz, p, q, phi_k),
+                                      _exp_integral(2.0 * e2a, -two_dz, p, q))
+        np.testing.assert_array_equal(
+            _exp_moments(_complex(np.multiply.outer(k, za), phase0), alpha1, p, q, f12),
+            _exp_moments(_complex(np.multiply.outer(k, za), phase0), alpha1, p, q))

@@ -530,3 +530,67 @@ def test_dense_blocks_and_sparse_blocks_give_the_same_modes(dim, rotate):
         flat = natural_modes(assemble(mesh, pos @ np.array(
             [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), ten, RHO, dim=3), 8)
         np.testing.assert_allclose(dense.omega, flat.omega, rtol=1e-10)
+
+
+@pytest.mark.parametrize("shape", ["rotated plane", "non-planar"])
+def test_dense_rotation_path_is_the_sparse_path_to_the_bit(shape, monkeypatch):
+    """The dense path of natural_modes (issue 6 pass E6: dense free–free blocks rotated
+    by node blocks, _rotate_dense/_unrotate_dense) gives the modes of the sparse path
+    (Kronecker rotation, sparse products and slices, the path of every small 3-D line
+    before) to the bit, with the same dense eigensolver: the rotation sums run in the
+    sparse products' order.  A line in a rotated vertical plane (two decoupled blocks)
+    and a non-planar line (one coupled block)."""
+    import scipy.sparse as sp
+
+    import stochcable.modes as md
+
+    mesh, pos, ten = shallow_parabola(12, SPAN, SAG, H_IRVINE, 8.0 * H_IRVINE * SAG / SPAN / G,
+                                      G, ea=1e7)
+    c, s = np.cos(2.1), np.sin(2.1)
+    pos = pos @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
+    if shape == "non-planar":  # bow the interior nodes out of the chord's plane
+        pos = pos.copy()
+        pos[1:-1, 0] += 0.3 * np.sin(np.linspace(0.0, np.pi, pos.shape[0])[1:-1])
+    model = assemble(mesh, pos, ten, RHO, dim=3)
+    fast = natural_modes(model, 8)
+    # the sparse path with the dense eigensolver: what "auto" ran before the pass
+    solve_block = md._solve_block
+    monkeypatch.setattr(md, "DENSE_MAX_DOF", -1)
+    monkeypatch.setattr(md, "_solve_block",
+                        lambda a, b, k, method, u: solve_block(a, b, k, "dense", u))
+    ref = natural_modes(model, 8)
+    monkeypatch.undo()
+    assert fast.method == ref.method == "dense"
+    np.testing.assert_array_equal(fast.omega, ref.omega)
+    np.testing.assert_array_equal(fast.shapes, ref.shapes)
+    np.testing.assert_array_equal(fast.out_of_plane, ref.out_of_plane)
+    assert list(fast.plane) == list(ref.plane)
+    # and the kernels themselves against the sparse products
+    r = np.array([[fast.normal[1], fast.normal[0], 0.0],
+                  [-fast.normal[0], fast.normal[1], 0.0], [0.0, 0.0, 1.0]])
+    a = model._free_free(model.K)
+    rot = sp.csr_array(sp.kron(sp.eye_array(a.shape[0] // 3), r, format="csr"))
+    np.testing.assert_array_equal(md._rotate_dense(a.toarray(), r),
+                                  (rot.T @ a @ rot).toarray())
+    x = np.random.default_rng(3).standard_normal((a.shape[0], 5))
+    np.testing.assert_array_equal(md._unrotate_dense(x, r), rot @ x)
+
+
+def test_direct_sygvd_is_scipy_eigh():
+    """_solve_dense calls LAPACK dsygvd as scipy.linalg.eigh(a, b) does (same routine,
+    same arguments): the same eigenpairs to the bit; a mass matrix that is not positive
+    definite raises LinAlgError with the reason."""
+    from scipy.linalg import eigh
+
+    from stochcable.modes import _solve_dense
+
+    rng = np.random.default_rng(5)
+    for n, k in ((78, 40), (39, 39), (5, 2)):
+        x, y = rng.standard_normal((n, n)), rng.standard_normal((n, n))
+        a, b = x @ x.T, y @ y.T + n * np.eye(n)
+        lam, vec = _solve_dense(a, b, k)
+        lr, vr = eigh(a, b, check_finite=False)
+        np.testing.assert_array_equal(lam, lr[:k])
+        np.testing.assert_array_equal(vec, vr[:, :k])
+    with pytest.raises(np.linalg.LinAlgError, match="not positive definite"):
+        _solve_dense(np.eye(3), -np.eye(3), 2)

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.catenary import catenary_multisegment, catenary_solve
+from stochcable.catenary import catenary_multisegment
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.mesh import mesh_line
 from stochcable.scene import load_scene
@@ -453,3 +453,50 @@ def test_chain_shots_batched_end_equals_single_shots() -> None:
         single = np.array([[shoot(h, v, P)[0][-1], shoot(h, v, P)[1][-1]]
                            for h, v in zip(H, V0)])
         assert np.array_equal(ends, single)  # bit-equal: the same float operations
+
+
+def test_banded_solve_is_scipy_solve_banded():
+    """_banded_solve calls LAPACK gbsv as scipy.linalg.solve_banded does after its
+    checks (issue 6 pass E6: ≈ 40 banded solves per body statics): the same solution
+    to the bit for one and several right-hand sides; a singular matrix raises
+    LinAlgError."""
+    from scipy.linalg import LinAlgError, solve_banded
+
+    from stochcable.statics import _banded_solve
+
+    rng = np.random.default_rng(7)
+    for bw, n, nrhs in ((3, 40, None), (5, 117, None), (5, 117, 3)):
+        band = rng.standard_normal((2 * bw + 1, n))
+        band[bw] += 4.0 * bw  # diagonally dominant: a regular matrix
+        b = rng.standard_normal(n if nrhs is None else (n, nrhs))
+        ab = np.zeros((3 * bw + 1, n), order="F")
+        ab[bw:] = band
+        got = _banded_solve(ab, b, bw)
+        np.testing.assert_array_equal(got, solve_banded((bw, bw), band, b))
+    singular = np.zeros((3 * 3 + 1, 6), order="F")
+    with pytest.raises(LinAlgError, match="singular"):
+        _banded_solve(singular, np.ones(6), 3)
+
+
+def test_converged_status_skips_the_tangent_and_solves_the_same():
+    """The Newton asks its status without the tangent (issue 6 pass E6: a converged
+    point needs none) and builds it from the residual memo before a step: the status
+    numbers are those with the tangent, and the tangent built afterwards is a fresh
+    model's to the bit (with current drag, whose nodal forces the line search reads)."""
+    from stochcable.statics import _Frame, _initial_guess, _Model, _Solver
+
+    seg = dict(CHAIN, elements=20)
+    m, env, _ = make((-800, 0, -200), (0, 0, -20), [seg],
+                     current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}])
+    frame = _Frame(m, env)
+    model = _Model(m, env, frame)
+    x = _initial_guess(m, env, frame, model)
+    lazy = _Solver(model, 1e-10, 100).status(x, tangent=False)
+    assert lazy[3] is None
+    tangent = model.forces(x)[3]
+    ref_model = _Model(m, env, _Frame(m, env))
+    full = _Solver(ref_model, 1e-10, 100).status(x)
+    assert lazy[:2] == full[:2]
+    np.testing.assert_array_equal(lazy[2], full[2])
+    for got, want in zip(tangent, full[3]):
+        np.testing.assert_array_equal(got, want)
