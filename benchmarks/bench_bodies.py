@@ -15,9 +15,12 @@ breakdown of one full coupled analysis (direct).  ``--ab``: only an interleaved 
 of the reference paths (node-level Foss lines, full coupled-mode eigenproblem) against
 the fast ones (pass E3, docs/BENCHMARKS.md), wall and process time.  ``--threads-ab``:
 only an interleaved A/B of the per-line thread pool off and on (pass E4).
+``--coarse-ab``: only an interleaved A/B of the coarse start off and on (pass E5:
+defect-corrected coarse stage), with the evaluation counts.
 
 
 Run:  python benchmarks/bench_bodies.py [--repeat N] [--profile] [--ab] [--threads-ab]
+      [--coarse-ab]
 """
 
 from __future__ import annotations
@@ -200,6 +203,45 @@ def threads_ab(repeat: int) -> None:
             os.environ["STOCHCABLE_THREADS"] = saved
 
 
+def coarse_ab(repeat: int) -> None:
+    """Interleaved A/B in one process: the coarse start of the drag linearization off
+    (``COARSE_MIN_FREQUENCIES`` raised) and on, full analysis and dynamics, medians
+    of wall and process time, the evaluations and the largest relative change of the
+    key σ."""
+    saved = coupled_analysis.COARSE_MIN_FREQUENCIES
+
+    def use(on: bool) -> None:
+        coupled_analysis.COARSE_MIN_FREQUENCIES = saved if on else 10**9
+
+    try:
+        for solver in ("foss", "direct"):
+            scene = load_scene(scene_doc(solver))
+            statics = solve_statics(scene, method="fe")
+            keys = {}
+            for on in (False, True):
+                use(on)
+                (lines, bodies, _, _), _ = run_coupled(scene, statics)
+                keys[on] = key_results(lines, bodies)
+                rec = lines["leg1"].linearization
+                print(f"{solver:6s} coarse {'on ' if on else 'off'}: {rec.iterations} "
+                      f"evaluations, history {', '.join(f'{h:.1e}' for h in rec.history)}")
+                run_coupled(scene)  # warm-up
+            t = {(on, k): [] for on in (False, True) for k in ("fw", "fp", "dw", "dp")}
+            for _ in range(repeat):
+                for on in (False, True):
+                    use(on)
+                    _time_full_and_dynamics(scene, statics, t, on)
+            for on in (False, True):
+                med = {k: 1e3 * statistics.median(t[on, k]) for k in ("fw", "fp", "dw", "dp")}
+                print(f"{solver:6s} coarse {'on ' if on else 'off'}: full {med['fw']:.1f} ms "
+                      f"(process {med['fp']:.1f}), dynamics {med['dw']:.1f} ms "
+                      f"(process {med['dp']:.1f}), medians of {repeat}")
+            diff = np.max(np.abs(keys[True] / keys[False] - 1.0))
+            print(f"        max relative change of the buoy σ and tension σ: {diff:.1e}")
+    finally:
+        coupled_analysis.COARSE_MIN_FREQUENCIES = saved
+
+
 def median_time(fn, repeat: int) -> tuple[float, float]:
     fn()  # warm-up
     t = []
@@ -218,9 +260,16 @@ def main() -> None:
                     help="only the interleaved A/B of the reference and the fast paths")
     ap.add_argument("--threads-ab", action="store_true",
                     help="only the interleaved A/B of the per-line thread pool off/on")
+    ap.add_argument("--coarse-ab", action="store_true",
+                    help="only the interleaved A/B of the coarse start off/on")
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     print(host_line())
+    if args.coarse_ab:
+        with _single_blas_thread():
+            coarse_ab(max(args.repeat, 9))
+        print(host_line())
+        return
     if args.ab:
         with _single_blas_thread():
             fast_paths_ab(max(args.repeat, 9))

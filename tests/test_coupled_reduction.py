@@ -11,6 +11,7 @@ Each fast path is the same linear system as a reference kept reachable:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from pathlib import Path
@@ -273,3 +274,163 @@ def test_foss_decomposition_of_a_line_with_drag_solves_the_quadratic_eigenproble
     np.testing.assert_allclose(np.sort_complex(lam), np.sort_complex(lam.conj()),
                                rtol=1e-10)
 
+
+
+# ------------------------------------------------------- coarse stage (pass E5)
+
+
+def _solve_modal_direct(g, sigma=0.3, body_b=(2e3, 2e3, 4e3)):
+    """The group solve with Foss lines by their Foss decomposition (:class:`_FossLine`)
+    and by the per-frequency modal solve of the coarse stage (:class:`_ModalLine`)."""
+    damp = {cl.name: drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements,
+                                                          sigma), "seed")
+            for cl in g.lines}
+    bb = {b.name: np.asarray(body_b, float) for b in g.drag}
+    bc = np.zeros((g.nb, g.nb))
+    out = []
+    for flag in (False, True):
+        g.modal_direct = flag
+        out.append(_solve_group(g, damp, bc, bb, None))
+    g.modal_direct = False
+    return out
+
+
+@pytest.mark.parametrize("modes", [8, "auto"])
+def test_modal_direct_lines_equal_foss_lines(modes):
+    """The coarse stage's line solve (modal equations per frequency, batched LU) is the
+    same modal system as Foss's diagonalization: equal displacements, support forces
+    and body motion to round-off (1e-10 of the largest), truncated (static
+    correction on) and all modes."""
+    body = _buoy()
+    scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
+    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    ref, got = _solve_modal_direct(g)
+    _assert_same(ref, got)
+
+
+def test_modal_direct_equal_foss_planar_two_bodies():
+    """As above on the planar two-body group (both ends attached, a second channel
+    with a moving unattached end, truncated modes)."""
+    cls, bodies, loads = _planar_two_body_group()
+    g = _Group(cls, bodies, loads, RHO, cls[0].channels)
+    ref, got = _solve_modal_direct(g)
+    _assert_same(ref, got)
+
+
+# ------------------------------------------------- coarse evaluation cost (pass E5c)
+
+
+def _coarse_update(g, idx, x=None):
+    """The coarse group of ``g`` on ``idx`` and its map evaluated at ``x`` (default
+    the rest σ scaled up, so the drag is not tiny)."""
+    gc = ca._coarse_group(g, idx)
+    rest = [ca._sigmas(cl.system, g.inp_phys[cl.name],
+                       ca._quasi_static(cl.system, g.inp_phys[cl.name]), "seed")
+            for cl in g.lines]
+    gc.sizes = {cl.name: p.size for cl, p in zip(g.lines, rest)}
+    rest += [ca._body_sigma(g, b, None) for b in g.drag]
+    x = 3.0 * np.concatenate(rest) if x is None else x
+    upd = ca._make_update(gc, "seed", RHO, {}, {}, ca._noop, "g", None)
+    return gc, upd, x
+
+
+@pytest.mark.parametrize("modes", [8, "auto"])
+def test_modal_line_cache_gives_the_same_bits(modes):
+    """The drag-independent arrays kept per line across the coarse evaluations
+    (``_Group.modal_cache``): a solve at a second drag with the cache filled by a
+    first one is bit-identical to the same solve on a fresh group (the cache holds
+    nothing that depends on the drag)."""
+    body = _buoy()
+    _, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
+    damp = [{cl.name: drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements,
+                                                           s), "seed") for cl in cls}
+            for s in (0.05, 0.4)]
+    bb = {body.name: np.array([2e3, 2e3, 4e3])}
+    bc = np.zeros((6, 6))
+    g1 = _Group(cls, [body], loads, RHO, cls[0].channels)
+    g2 = _Group(cls, [body], loads, RHO, cls[0].channels)
+    g1.modal_direct = g2.modal_direct = True
+    _solve_group(g1, damp[0], bc, bb, None)
+    assert all(g1.modal_cache[cl.name] for cl in cls)
+    sol1, xi1 = _solve_group(g1, damp[1], bc, bb, None)
+    assert not g2.modal_cache
+    sol2, xi2 = _solve_group(g2, damp[1], bc, bb, None)
+    np.testing.assert_array_equal(xi1, xi2)
+    for name, (u, s) in sol2.items():
+        np.testing.assert_array_equal(sol1[name][0], u)
+        np.testing.assert_array_equal(sol1[name][1], s)
+
+
+def test_coarse_group_leaves_out_negligible_weights(monkeypatch):
+    """The coarse group leaves out the subset frequencies whose σ weight is at most
+    ``COARSE_NEGLIGIBLE`` of the largest (the JONSWAP's empty low-frequency tail: 3
+    of 25 on the test mooring), keeping the other weights to the bit, and its map
+    gives the σ of the whole subset: the dropped terms weigh ≤ 1e-12 of the largest
+    (with |H|² at those frequencies not above 1e2 × the weighted mean: 1e-10)."""
+    body = _buoy(drag_area=[4.0, 4.0, 8.0])
+    _, cls, loads = _group(_mooring_doc(count=96, solver="foss"), body)
+    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    idx = ca._coarse_subset(g)
+    gc, upd, x = _coarse_update(g, idx)
+    monkeypatch.setattr(ca, "COARSE_NEGLIGIBLE", -1.0)   # keep every frequency
+    gall, upd_all, _ = _coarse_update(g, idx)
+    assert gall.omega.size == idx.size and gc.omega.size == idx.size - 3
+    kept = np.isin(gall.omega, gc.omega)
+    np.testing.assert_array_equal(gc.weights, gall.weights[kept])
+    assert np.all(np.abs(gall.weights[~kept]) <= 1e-12 * np.abs(gall.weights).max())
+    for cl in cls:
+        np.testing.assert_array_equal(gc.inp_phys[cl.name].weights,
+                                      gall.inp_phys[cl.name].weights[kept])
+        np.testing.assert_array_equal(gc.inp_phys[cl.name].square,
+                                      gall.inp_phys[cl.name].square)
+    np.testing.assert_allclose(upd(x), upd_all(x), rtol=1e-10)
+
+
+def test_sliced_channel_keeps_nodal_kinematics_lazy():
+    """A channel whose nodal kinematics are computed on first use (``nodal``) is sliced
+    without computing them; the sliced channel's velocity and acceleration, on first
+    access, are the full channel's at the subset (bit-identical)."""
+    body = _buoy()
+    _, cls, _ = _group(_mooring_doc(count=40, solver="foss"), body)
+    sea = cls[0].channels[0]
+    calls = []
+
+    def nodal():
+        calls.append(1)
+        return sea.nodal()
+
+    lazy = dataclasses.replace(sea, velocity=None, acceleration=None, nodal=nodal)
+    idx = np.arange(0, 40, 3)
+    sub = ca._sliced_channel(lazy, idx)
+    assert not calls
+    np.testing.assert_array_equal(sub.velocity, sea.velocity[idx])
+    np.testing.assert_array_equal(sub.acceleration, sea.acceleration[idx])
+    assert len(calls) == 1
+    np.testing.assert_array_equal(sub.element_velocity, sea.element_velocity[idx])
+
+
+@pytest.mark.parametrize("top", [0.5, 40.0, 1e9])
+def test_listed_eigh_whole_driver_equals_subset_driver(top):
+    """``_listed_eigh`` below ``_ALL_EIGH_MAX`` (every eigenpair by ``gvd``, then the
+    listed ones) against the subset driver ``gvx`` on a random SPD pencil (n = 60,
+    eigenvalues 0.047–167; 5 below 0.5, 38 below 40, none within 1 % of a top): the same listed count, the
+    eigenvalues to 1e-10 relative (round-off of two LAPACK drivers), M-orthonormal
+    vectors; below 10 listed, the lowest 10 (top 0.5)."""
+    import scipy.linalg as sla
+
+    rng = np.random.default_rng(7)
+    n = 60
+    a = rng.standard_normal((n, n))
+    md = a @ a.T / n + np.eye(n)
+    b = rng.standard_normal((n, n))
+    kd = b @ b.T + 0.1 * np.eye(n)
+    assert n <= ca._ALL_EIGH_MAX
+    lam, phi = ca._listed_eigh(kd, md, top)
+    ref = sla.eigh(kd, md, subset_by_value=(-np.inf, top), driver="gvx", eigvals_only=True)
+    if ref.size < ca.MIN_LISTED_MODES:
+        ref = sla.eigh(kd, md, eigvals_only=True)[:ca.MIN_LISTED_MODES]
+    assert lam.size == ref.size
+    np.testing.assert_allclose(lam, ref, rtol=1e-10)
+    # mass-normalized eigenvectors: round-off of an n = 60 factorization
+    np.testing.assert_allclose(phi.T @ md @ phi, np.eye(lam.size), atol=1e-10)
+    np.testing.assert_allclose(kd @ phi, md @ phi * lam, atol=1e-8 * np.abs(kd).max())

@@ -175,7 +175,8 @@ def test_body_end_validation(disc_doc):
         load_scene(dup)
     # the span check uses the body position for attached ends
     far = _mutated(disc_doc, lambda d: d["bodies"][0].__setitem__("position", [200.0, 0, 0]))
-    with pytest.raises(InputError, match=r"lines\[0\]: the line \(339 m unstretched\) is "
+    # the disc scene is in feet (g = 32.174 ft/s²): the message quotes its lengths in ft
+    with pytest.raises(InputError, match=r"lines\[0\]: the line \(339 ft unstretched\) is "
                                          r"shorter than its span"):
         load_scene(far)
     bad_table = _mutated(disc_doc, lambda d: d["bodies"][0]["hydrodynamics"][
