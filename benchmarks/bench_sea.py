@@ -9,6 +9,9 @@ numpy.fft fallback, the load average before and after, and the minor page faults
 realization in the steady state (result dropped, as in the timing loop) and when the
 caller keeps its realizations.
 Goals (docs/BENCHMARKS.md): realization <= 8 ms, dispersion of 10,000 ω <= 0.5 ms.
+The coefficient kernel is compiled with numba when it is installed (the first
+realization of >= 2^16 lines imports numba and loads the kernel: time printed); the rows
+marked [numpy kernel] run the same realizations with STOCHCABLE_NUMBA=0.
 stochcable._fft sets OMP_WAIT_POLICY=PASSIVE unless the environment sets a policy: the
 numbers depend on it (see docs/BENCHMARKS.md).
 """
@@ -69,6 +72,18 @@ def main() -> None:
         t0 = time.perf_counter()
         _fft.tune(n_t)
         print(f"FFTW plans of 2^20 points measured in {time.perf_counter() - t0:.1f} s")
+    t0 = time.perf_counter()
+    compiled = sea._compiled_kernel()
+    t_load = time.perf_counter() - t0
+    if compiled is None:
+        print("coefficient kernel: numpy (numba not installed or STOCHCABLE_NUMBA=0)")
+    else:
+        import numba
+        from stochcable import _kernels
+
+        print(f"coefficient kernel: numba {numba.__version__} (import + kernel "
+              f"{'load from cache' if _kernels.CACHED else 'compile, no cache'}: "
+              f"{1e3 * t_load:.0f} ms)")
     wis = _fft.wisdom_path()
     print("FFTW wisdom: " + ("off" if wis is None else
                              f"{wis} ({'present' if os.path.exists(wis) else 'none'})"))
@@ -81,6 +96,20 @@ def main() -> None:
 
     seeds = iter(range(10**6))
     rows = []
+
+    def numpy_kernel(fn):  # the same call with STOCHCABLE_NUMBA=0 (NumPy kernel)
+        def run():
+            os.environ["STOCHCABLE_NUMBA"] = "0"
+            try:
+                return fn()
+            finally:
+                os.environ.pop("STOCHCABLE_NUMBA")
+        return run
+
+    if compiled is not None and "STOCHCABLE_NUMBA" not in os.environ:
+        rows.append(("simulate_sea PM, DSA, 2^20 samples [pyfftw, numpy kernel]",
+                     median_ms(numpy_kernel(
+                         lambda: sea.simulate_sea(pm, duration, dt, "dsa", next(seeds))), 30)))
     for backend in ("pyfftw", "numpy"):
         saved = _fft._pyfftw
         if backend == "numpy":
@@ -108,8 +137,19 @@ def main() -> None:
             b = min(a + sea._CHUNK, u.size)
             sea._phasor_chunk(u[a:b], s_lines[a:b], 1.0, out[a:b], None, fft_in[a:b], 1.0)
 
-    rows.append(("  coefficient kernel (table + series), 2^19, 1 thread",
+    rows.append(("  coefficient kernel (table + series), 2^19, 1 thread [numpy]",
                  median_ms(kernel, 30)))
+    if compiled is not None:
+        jbuf, empty = np.empty(sea._CHUNK), np.empty(0)
+
+        def kernel_numba() -> None:  # the same, compiled
+            for a in range(0, u.size, sea._CHUNK):
+                b = min(a + sea._CHUNK, u.size)
+                compiled(u[a:b], s_lines[a:b], 1.0, empty, empty, sea._TABLE, out[a:b],
+                         fft_in[a:b], 1.0, jbuf)
+
+        rows.append(("  coefficient kernel (table + series), 2^19, 1 thread [numba]",
+                     median_ms(kernel_numba, 30)))
     rows.append(("  np.exp(-1j*theta), 2^19 (reference, not used)",
                  median_ms(lambda: np.exp(-1j * u), 10)))
     rng = np.random.default_rng(0)

@@ -57,8 +57,12 @@ _CHUNK = 32768
 _PARALLEL_MIN = 2**16
 _SPECTRUM_PIECES = 8
 _GRID_CACHE_SIZE = 4
+_COMPILED_MIN = 2**16                    # lines from which the numba kernel is used
+_NUMBA_ENV = "STOCHCABLE_NUMBA"
 _pool = None
 _pool_lock = threading.Lock()
+_compiled_state: list = []               # [kernel or None] once the import was tried
+_compiled_lock = threading.Lock()
 
 
 def _executor():
@@ -73,6 +77,40 @@ def _executor():
             _pool = ThreadPoolExecutor(max_workers=os.cpu_count() or 1,
                                        thread_name_prefix="stochcable-sea")
         return _pool
+
+
+def _compiled_kernel() -> Callable | None:
+    """The numba coefficient kernel (:mod:`stochcable._kernels`), or ``None``.
+
+    ``None`` when numba is not installed, when ``STOCHCABLE_NUMBA=0``, or when numba
+    fails to compile it (a UserWarning says so, once per process); callers then use the
+    NumPy kernel :func:`_phasor_chunk`: the same bits where numpy's complex multiply
+    uses fused multiply-adds (x86-64 with FMA3, as on the reference machine), else
+    ≲ 1 ulp of |X| apart.  The first call of a process imports numba
+    and loads (or compiles) the kernel, on the calling thread (0.5–1 s).
+    """
+    if os.environ.get(_NUMBA_ENV, "").strip() == "0":
+        return None
+    if _compiled_state:
+        return _compiled_state[0]
+    with _compiled_lock:
+        if not _compiled_state:
+            kernel = None
+            try:
+                from . import _kernels
+
+                kernel = _kernels.phasor_chunk     # compiled (or loaded) at import
+            except ImportError:          # numba not installed (or not for this numpy)
+                kernel = None
+            except Exception as exc:  # noqa: BLE001 - any numba/LLVM failure: fall back
+                import warnings
+
+                warnings.warn(f"stochcable: the compiled sea kernel is unavailable ({exc!r}); "
+                              f"using the NumPy kernel (same results, slower; set "
+                              f"{_NUMBA_ENV}=0 to skip numba)", UserWarning, stacklevel=3)
+                kernel = None
+            _compiled_state.append(kernel)
+    return _compiled_state[0]
 
 
 def frequency_grid(duration: float, dt: float) -> tuple[np.ndarray, float]:
@@ -261,6 +299,7 @@ def _phasor_chunk(u: np.ndarray, s: np.ndarray, c2: float, out: np.ndarray,
     sin δ ≈ δ(1 − δ²/6) (truncation δ⁶/720 < 3e-22, δ⁵/120 < 3e-18); |error| ≲ 3e-16
     relative per entry.  The amplitude multiplies e^{iδ} before the one complex product
     with the table.  One cache-sized chunk (≤ _CHUNK entries) on the calling thread.
+    :func:`stochcable._kernels.phasor_chunk` is the compiled equivalent (same operations).
     """
     m = u.shape[0]
     x_, w_, d2_, c_, amp, j_, e, t = (b[:m] for b in _buffers(_CHUNK))
@@ -303,19 +342,32 @@ class _Synthesis:
     density is a pointwise function of ω, so its pieces give the values of one call
     (a density that does not return one value per ω of a piece, or raises, is called
     again on the whole grid by the caller, which then reports the error).
+
+    With the compiled kernel (``kernel``, GIL released) and a known amplitude factor
+    ``c2`` the work is pipelined instead: whichever thread evaluates a piece of S runs
+    the kernel on that piece's lines at once (still in cache) if the draws are done, else
+    queues the piece for later (:meth:`drain`).  The one barrier before the FFT is then
+    the end of the kernel work, and the caller validates S while the helper finishes.
     """
 
     def __init__(self, gen: np.random.Generator, lines: int, nsa: bool,
                  coeff: np.ndarray, fft_in: np.ndarray, scale: float,
                  density: Callable | None = None, omega: np.ndarray | None = None,
                  pieces: int = 1, u: np.ndarray | None = None,
-                 s_grid: np.ndarray | None = None) -> None:
+                 s_grid: np.ndarray | None = None, kernel: Callable | None = None,
+                 c2: float = 0.0) -> None:
         self.gen, self.lines, self.nsa = gen, lines, nsa
+        self.kernel = kernel                     # compiled kernel, or None for NumPy's
+        # pipelined: S piece -> kernel on its lines, same thread (compiled kernel only)
+        self.pipelined = kernel is not None and density is not None and omega is not None
+        self.drawn = threading.Event()           # set once every draw is made
+        self._deferred: list[tuple[int, int]] = []   # line ranges waiting for the draws
         self.coeff, self.fft_in, self.scale = coeff, fft_in, scale
         self.u = np.empty(lines) if u is None else u
-        self.gain: np.ndarray | None = None      # NSA: √(α² + β²)
+        self.gain: np.ndarray | None = None      # NSA: √(α² + β²) (NumPy kernel)
+        self.alpha = self.beta = np.empty(0)     # NSA: α, β (compiled kernel: fused hypot)
         self.s: np.ndarray | None = None         # S(ω_m), m = 1 … N−1
-        self.c2 = 0.0                            # a_m N_t/2 = √(c2 S(ω_m))
+        self.c2 = c2                             # a_m N_t/2 = √(c2 S(ω_m))
         self.edges = list(range(0, lines, _CHUNK)) + [lines]
         self._next = itertools.count()
         self._draw_lock = threading.Lock()
@@ -363,6 +415,36 @@ class _Synthesis:
                         self._pieces_done += 1
                         if self._pieces_done == last:
                             self.s_ready.set()
+                if self.pipelined and not (self.piece_failed or self.cancelled):
+                    # lines m = 1 … N−1 of grid points [a, b): line index m − 1
+                    la, lb = max(a, 1) - 1, min(b, self.lines + 1) - 1
+                    if lb > la:
+                        if self.drawn.is_set():
+                            self._kernel_lines(la, lb)
+                        else:
+                            with self._piece_lock:
+                                self._deferred.append((la, lb))
+
+    def _kernel_lines(self, a: int, b: int) -> None:
+        """Compiled kernel on lines [a, b) with S from ``s_grid``, in _CHUNK sub-chunks."""
+        kernel, u, s, c2 = self.kernel, self.u, self.s_grid, self.c2
+        alpha, beta, coeff, fft_in = self.alpha, self.beta, self.coeff, self.fft_in
+        nsa = alpha.shape[0] > 0
+        jbuf = _buffers(_CHUNK)[0]
+        for c in range(a, b, _CHUNK):
+            d = min(c + _CHUNK, b)
+            kernel(u[c:d], s[c + 1:d + 1], c2, alpha[c:d] if nsa else alpha,
+                   beta[c:d] if nsa else beta, _TABLE, coeff[c:d], fft_in[c:d],
+                   self.scale, jbuf)
+
+    def drain(self) -> None:
+        """Run the kernel on the queued pieces (the draws must be done)."""
+        while not (self.cancelled or self.piece_failed):
+            with self._piece_lock:
+                if not self._deferred:
+                    return
+                a, b = self._deferred.pop()
+            self._kernel_lines(a, b)
 
     def draw(self) -> None:
         """All random draws, once, by whichever thread gets here first."""
@@ -374,7 +456,11 @@ class _Synthesis:
             if self.nsa:
                 alpha = self.gen.standard_normal(self.lines)
                 beta = self.gen.standard_normal(self.lines)
-                self.gain = np.hypot(alpha, beta, out=alpha)
+                if self.kernel is None:
+                    self.gain = np.hypot(alpha, beta, out=alpha)
+                else:
+                    self.alpha, self.beta = alpha, beta
+            self.drawn.set()
 
     def cancel(self) -> None:
         """Stop the work and leave the caller's generator where it was."""
@@ -391,13 +477,31 @@ class _Synthesis:
         self.ready.set()
 
     def work(self) -> None:
-        """Draw (if nobody has), help with S, wait for it, then take chunks until none is left."""
+        """Draw (if nobody has), help with S, wait for it, then take chunks until none is left.
+
+        Pipelined: draw, take S pieces (each followed by its kernel), then queued pieces.
+        """
         self.draw()
         self.spectrum()
+        if self.pipelined:
+            self.drain()
+            return
         self.ready.wait()
         edges, coeff, u, s, c2 = self.edges, self.coeff, self.u, self.s, self.c2
         gain, fft_in, scale = self.gain, self.fft_in, self.scale
         last = len(edges) - 1
+        if self.kernel is not None:
+            # compiled, GIL released: √ of a negative S (discarded) gives NaN silently
+            kernel, alpha, beta, jbuf = self.kernel, self.alpha, self.beta, _buffers(_CHUNK)[0]
+            nsa = alpha.shape[0] > 0
+            while not self.cancelled:
+                i = next(self._next)
+                if i >= last:
+                    return
+                a, b = edges[i], edges[i + 1]
+                kernel(u[a:b], s[a:b], c2, alpha[a:b] if nsa else alpha,
+                       beta[a:b] if nsa else beta, _TABLE, coeff[a:b], fft_in[a:b], scale, jbuf)
+            return
         # the caller's thread validates S while a helper may already run the kernel:
         # on invalid S (discarded, then rejected) √ of a negative must stay silent
         with np.errstate(invalid="ignore"):
@@ -495,7 +599,10 @@ def simulate_sea(
     or raises on one, is called again on the whole grid by the caller thread (its
     errors are reported from there).  The grid ω is cached per (N, Δω) and read-only:
     realizations on one grid share it.  ``SeaRealization.m0`` is the target
-    Σ_{m=1}^{N−1} S(ω_m)Δω.
+    Σ_{m=1}^{N−1} S(ω_m)Δω.  From 2^16 lines on, the coefficient kernel is the numba
+    one of :mod:`stochcable._kernels` when numba is installed (the first such call of
+    a process imports numba: 0.5–1 s); ``STOCHCABLE_NUMBA=0`` selects the NumPy kernel
+    (the same operations; the same bits on x86-64 with FMA3).
     """
     if not callable(density):
         raise InputError("density", density, "m²·s/rad", "must be a callable omega -> S(omega)")
@@ -515,8 +622,13 @@ def simulate_sea(
     # X_m/N_t goes into the FFT input (exact for N_t = 2^k), so the FFT output is η
     omega = _grid(n, d_omega)
     parallel = n - 1 >= _PARALLEL_MIN and (os.cpu_count() or 1) >= 2
+    kernel = _compiled_kernel() if n - 1 >= _COMPILED_MIN else None
+    # a_m N_t/2 = √(c2 S_m), c2 = (2 or 1)·Δω·(N_t/2)², computed chunk by chunk in
+    # the kernel (the callable's array is only read)
+    c2 = (1.0 if nsa else 2.0) * d_omega * (0.5 * n_t) ** 2
     job = _Synthesis(gen, n - 1, nsa, coeff[1:n], fft_in[1:n], 1.0 / n_t,
-                     density if parallel else None, omega, _SPECTRUM_PIECES, u, s_work)
+                     density if parallel else None, omega, _SPECTRUM_PIECES, u, s_work,
+                     kernel, c2)
     helper = None
     if parallel:
         # the draws meanwhile, then pieces of S, then kernel chunks
@@ -528,15 +640,21 @@ def simulate_sea(
             job.s_ready.wait()
             if not job.piece_failed:
                 s = job.s_grid
+            elif job.pipelined:
+                # kernel pieces may have run on part of S: let the helper stop (or
+                # drop it if still queued), then redo the whole kernel from the full
+                # call's S (chunk scheme; this thread draws if nobody has)
+                if not helper.cancel():
+                    helper.result()
+                job.pipelined = False
         if s is None:
             s = np.asarray(density(omega), dtype=float)
         if s.shape != omega.shape:
             raise InputError("density", density, "m²·s/rad",
                              f"must return an array of shape {omega.shape}, got {s.shape}")
-        # a_m N_t/2 = √(c2 S_m), c2 = (2 or 1)·Δω·(N_t/2)², computed chunk by chunk in
-        # the kernel (the callable's array is only read).  The helper may start on it
-        # now; this thread validates S meanwhile and discards the work if S is invalid.
-        job.start(s[1:n], (1.0 if nsa else 2.0) * d_omega * (0.5 * n_t) ** 2)
+        # The helper may start on the kernel now (pipelined: it already has); this
+        # thread validates S meanwhile and discards the work if S is invalid.
+        job.start(s[1:n], c2)
         m0_grid = float(s[1:n].sum()) * d_omega
         if not (math.isfinite(m0_grid) and math.isfinite(s[0]) and math.isfinite(s[n])
                 and s.min() >= 0.0):

@@ -3,13 +3,20 @@
 from __future__ import annotations
 
 import math
+import os
+import pathlib
 import re
+import shutil
+import subprocess
+import sys
 import threading
+import types
 import warnings
 
 import numpy as np
 import pytest
 
+import stochcable
 from stochcable import _fft, sea
 from stochcable.errors import InputError, ResolutionWarning
 from stochcable.spectra import spectrum_jonswap, spectrum_pierson_moskowitz, spectrum_pierson_moskowitz_m0
@@ -639,3 +646,194 @@ def test_work_arrays_follow_the_fft_backend(monkeypatch):
     np.testing.assert_array_equal(a.elevation, c.elevation)
     # irfft of 2^17 points, numpy vs FFTW: ~1e-16 of max |η| per sample, 1e-14 with margin
     np.testing.assert_allclose(b.elevation, a.elevation, rtol=0, atol=1e-14 * np.abs(a.elevation).max())
+
+
+# --- compiled (numba) coefficient kernel (issue 2, third pass) -------------------------
+
+def _numpy_complex_product_is_fused() -> bool:
+    """Whether numpy's complex multiply rounds like fma(a_r, b_r, −a_i b_i) (FMA3/NEON).
+
+    Checked against exact rational arithmetic on 256 random products: fused and
+    unfused roundings differ on about half of them, so this cannot pass by chance.
+    """
+    from fractions import Fraction
+
+    r = np.random.default_rng(0).standard_normal((4, 256))
+    a, b = r[0] + 1j * r[1], r[2] + 1j * r[3]
+    p = a * b
+    fused = [float(Fraction(x.real) * Fraction(y.real) - Fraction(float(x.imag * y.imag)))
+             for x, y in zip(a, b)]
+    return bool(np.array_equal(p.real, fused))
+
+
+def _kernel_inputs(n: int = 70_001):
+    rng = np.random.default_rng(17)
+    u = rng.random(n)
+    u[:6] = [0.0, 1.0 - 2.0**-53, 0.5, 2.0**-40, 0.25, (8191.0 + 0.5) / 8192.0]  # table ends
+    s = spectrum_pierson_moskowitz(np.linspace(0.0, 12.0, n), 6.0, 10.0)   # 0 … 1e-300 … max
+    s[10:20] = 0.0
+    return u, s, rng.standard_normal(n), rng.standard_normal(n)
+
+
+def test_compiled_kernel_equals_numpy_kernel():
+    # the compiled kernel performs the NumPy kernel's operations in the same order
+    # (no fast-math); the complex product is written with the two fused multiply-adds
+    # numpy's SIMD loop uses on x86-64 with FMA3 (detected at run time), so there the
+    # bits are equal (measured on the reference machine: 0 differing entries of 70,001,
+    # DSA and NSA); an unfused numpy product may round differently: ≲ 1 ulp of |X|,
+    # 1e-15 relative (~4.5 ulp) allowed
+    kernels = pytest.importorskip("stochcable._kernels")
+    u, s, alpha, beta = _kernel_inputs()
+    n, c2, scale = u.size, 2.0 * 0.003 * 2.0**38, 2.0**-20
+    empty = np.empty(0)
+    exact = _numpy_complex_product_is_fused()
+    for nsa in (False, True):
+        ref_out, ref_in = np.empty(n, complex), np.empty(n, complex)
+        gain = np.hypot(alpha, beta) if nsa else None
+        for a in range(0, n, sea._CHUNK):
+            b = min(a + sea._CHUNK, n)
+            sea._phasor_chunk(u[a:b], s[a:b], c2, ref_out[a:b],
+                              None if gain is None else gain[a:b], ref_in[a:b], scale)
+        out, fin = np.empty(n, complex), np.empty(n, complex)
+        jbuf = np.empty(n)
+        kernels.phasor_chunk(u, s, c2, alpha if nsa else empty, beta if nsa else empty,
+                             sea._TABLE, out, fin, scale, jbuf)
+        assert np.count_nonzero(ref_out == 0) == np.count_nonzero(s[:n] == 0)
+        np.testing.assert_allclose(out, ref_out, rtol=1e-15, atol=0)
+        np.testing.assert_allclose(fin, ref_in, rtol=1e-15, atol=0)
+        if exact:
+            np.testing.assert_array_equal(out, ref_out)
+            np.testing.assert_array_equal(fin, ref_in)
+
+
+@pytest.mark.parametrize("method", ["dsa", "nsa"])
+def test_realization_with_and_without_numba(monkeypatch, method):
+    # STOCHCABLE_NUMBA=0 selects the NumPy kernel (and the non-pipelined scheme): the
+    # same realization to 1e-15 relative (bit for bit where numpy's complex product is
+    # fused, see above); 2^18 samples = 2^17 − 1 lines, above the compiled-kernel limit
+    pytest.importorskip("numba")
+    monkeypatch.delenv("STOCHCABLE_NUMBA", raising=False)
+    duration, dt = 2**18 * 0.1, 0.1
+    a = sea.simulate_sea(pm, duration, dt, method, 40)
+    assert sea._compiled_kernel() is not None
+    monkeypatch.setenv("STOCHCABLE_NUMBA", "0")
+    assert sea._compiled_kernel() is None
+    b = sea.simulate_sea(pm, duration, dt, method, 40)
+    np.testing.assert_allclose(a.coefficients, b.coefficients, rtol=1e-15, atol=0)
+    # same FFT plan: the elevation follows the coefficients (≲ 1e-16 of max |η| if not equal)
+    np.testing.assert_allclose(a.elevation, b.elevation, rtol=0,
+                               atol=1e-15 * np.abs(b.elevation).max())
+    assert a.m0 == b.m0
+    if _numpy_complex_product_is_fused():
+        np.testing.assert_array_equal(a.coefficients, b.coefficients)
+        np.testing.assert_array_equal(a.elevation, b.elevation)
+
+
+def test_numba_missing_or_failing_falls_back(monkeypatch):
+    duration, dt = 2**18 * 0.1, 0.1             # 2^17 − 1 lines: the compiled kernel's range
+    monkeypatch.delenv("STOCHCABLE_NUMBA", raising=False)
+    ref = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
+    # numba not installed: silently the NumPy kernel
+    monkeypatch.setattr(sea, "_compiled_state", [])
+    monkeypatch.delattr(stochcable, "_kernels", raising=False)
+    monkeypatch.setitem(sys.modules, "stochcable._kernels", None)     # import -> ImportError
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        a = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
+    assert sea._compiled_state == [None]
+    np.testing.assert_array_equal(a.coefficients, ref.coefficients)
+    # numba present but the kernel unusable (e.g. an LLVM error): one warning, NumPy kernel
+    monkeypatch.setattr(sea, "_compiled_state", [])
+    broken = types.ModuleType("stochcable._kernels")                   # no phasor_chunk
+    monkeypatch.setitem(sys.modules, "stochcable._kernels", broken)
+    monkeypatch.setattr(stochcable, "_kernels", broken, raising=False)
+    with pytest.warns(UserWarning, match=r"compiled sea kernel is unavailable .*"
+                                         r"using the NumPy kernel .*STOCHCABLE_NUMBA=0"):
+        b = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
+    np.testing.assert_array_equal(b.coefficients, ref.coefficients)
+
+
+def test_pipelined_kernel_redone_when_a_piece_fails():
+    # pieces of S are followed at once by the compiled kernel on their lines; when a later
+    # piece fails (here: wrong shape above 20 rad/s) the caller evaluates S on the whole
+    # grid and the kernel is redone from it: the realization of the plain density
+    duration, dt = 2**18 * 0.1, 0.1
+    omega, _ = sea.frequency_grid(duration, dt)
+
+    def odd(w):
+        if w.size != omega.size and w.max() > 20.0:
+            return np.ones(3)
+        return _rational_density(w)
+
+    ref = sea.simulate_sea(_rational_density, duration, dt, "nsa", 21)
+    got = sea.simulate_sea(odd, duration, dt, "nsa", 21)
+    np.testing.assert_array_equal(got.coefficients, ref.coefficients)
+    np.testing.assert_array_equal(got.elevation, ref.elevation)
+    # a density returning its own read-only array (one call on the whole grid)
+    full = _readonly_copy(_rational_density(omega))
+    got = sea.simulate_sea(lambda w: full, duration, dt, "nsa", 21)
+    np.testing.assert_array_equal(got.coefficients, ref.coefficients)
+
+
+def _readonly_copy(a):
+    a = a.copy()
+    a.setflags(write=False)
+    return a
+
+
+_LAZY_SCRIPT = r"""
+import contextlib, io, sys
+import stochcable, stochcable.sea as sea
+from stochcable.cli import main
+from service.app import create_app
+create_app()
+with contextlib.redirect_stdout(io.StringIO()):
+    rc = main(["spectrum", "pm", "--hs", "4", "--tp", "9"])
+assert rc == 0, rc
+sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**16 * 0.1, 0.1, rng=1)   # 2^15 - 1 lines
+print("before", "numba" in sys.modules)
+sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**17 * 0.1, 0.1, rng=1)   # 2^16 - 1 lines
+sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**17 * 0.1 + 0.2, 0.1, rng=1)   # 2^16 lines
+print("after", "numba" in sys.modules, sea._compiled_state[0] is not None)
+"""
+
+
+def test_numba_imported_only_by_large_realizations():
+    # import stochcable, the CLI's `spectrum`, the service app and realizations below
+    # 2^16 lines must not pay numba's import (~0.2 s) and kernel load (~0.4 s)
+    try:
+        import numba  # noqa: F401
+        numba_present = True
+    except ImportError:
+        numba_present = False
+    env = {k: v for k, v in os.environ.items() if k != "STOCHCABLE_NUMBA"}
+    out = subprocess.run([sys.executable, "-c", _LAZY_SCRIPT], capture_output=True, text=True,
+                         cwd=str(pathlib.Path(sea.__file__).parents[1]), env=env, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["before", "False", "after", str(numba_present), str(numba_present)]
+
+
+def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
+    # a read-only install: no writable __pycache__ next to _kernels.py (here a file of that
+    # name, which even root cannot write into), NUMBA_CACHE_DIR and the user cache
+    # unusable: one UserWarning, the kernel compiled in memory, the same realization
+    pytest.importorskip("numba")
+    pkg = tmp_path / "stochcable"
+    shutil.copytree(pathlib.Path(sea.__file__).parent, pkg,
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    (pkg / "__pycache__").write_text("")
+    env = dict(os.environ, PYTHONPATH=str(tmp_path), PYTHONDONTWRITEBYTECODE="1",
+               NUMBA_CACHE_DIR="/dev/null/numba", XDG_CACHE_HOME="/dev/null/xdg",
+               HOME="/dev/null")
+    env.pop("STOCHCABLE_NUMBA", None)
+    script = ("import warnings, numpy as np, stochcable.sea as sea, stochcable._kernels as k\n"
+              "r = sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**18 * 0.1, 0.1, 'dsa', 3)\n"
+              "print(sea.__file__, k.CACHED, repr(complex(r.coefficients[12345])))\n")
+    out = subprocess.run([sys.executable, "-W", "always", "-c", script], env=env,
+                         capture_output=True, text=True, cwd=str(tmp_path), timeout=180)
+    assert out.returncode == 0, out.stderr
+    path, cached, value = out.stdout.split(maxsplit=2)
+    assert path == str(pkg / "sea.py") and cached == "False"
+    assert re.search(r"UserWarning: stochcable: no writable numba cache directory", out.stderr)
+    ref = sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**18 * 0.1, 0.1, "dsa", 3)
+    assert complex(value.strip()) == ref.coefficients[12345]
