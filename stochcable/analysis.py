@@ -2239,6 +2239,22 @@ def _modal_bandwidths(system: LineSystem, damping: Damping) -> np.ndarray:
     return damping._cache["modal_band"]
 
 
+def _nearest_spacing(omega: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance of each x (inside the increasing grid) to its nearest grid point and
+    the local spacing there, ``np.gradient(omega)`` at that point (central difference
+    inside, one-sided at the ends; the same bits), without the (n_x, n_omega) argmin
+    matrix: the nearest point is one of the two around the insertion point (the lower
+    of two equidistant ones, as argmin). [rad/s]"""
+    n = omega.size
+    hi = np.searchsorted(omega, x)
+    lo = np.maximum(hi - 1, 0)
+    d_lo, d_hi = np.abs(omega[lo] - x), np.abs(omega[hi] - x)
+    near = np.where(d_lo <= d_hi, lo, hi)
+    a, b = np.maximum(near - 1, 0), np.minimum(near + 1, n - 1)
+    spacing = (omega[b] - omega[a]) / np.where((near > 0) & (near < n - 1), 2.0, 1.0)
+    return np.minimum(d_lo, d_hi), spacing
+
+
 def _resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) -> None:
     """ResolutionWarning for natural frequencies inside the grid that the grid cannot
     resolve: nearest grid point farther than the local spacing, or a half-power
@@ -2249,12 +2265,9 @@ def _resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) -
     if inside.size == 0 or omega.size < 2:
         return
     band = _modal_bandwidths(system, damping)[inside]
-    spacing = np.gradient(omega)
-    # nearest grid point of every mode inside at once (the first of equals, as argmin)
-    near = np.argmin(np.abs(omega[None, :] - wn[inside][:, None]), axis=1)
-    dist = np.abs(omega[near] - wn[inside])
-    flagged = (dist > spacing[near]) | (spacing[near] > band)
-    bad = [(j, wn[j], b, spacing[k]) for j, b, k, f in zip(inside, band, near, flagged) if f]
+    dist, spacing = _nearest_spacing(omega, wn[inside])
+    flagged = (dist > spacing) | (spacing > band)
+    bad = [(j, wn[j], b, dw) for j, b, dw, f in zip(inside, band, spacing, flagged) if f]
     if not bad:
         return
     j, wj, b, dw = bad[0]
@@ -2290,12 +2303,14 @@ SURFACE_MATTERS_FRACTION = 0.25
 
 
 def _surface_resolution_check(system: LineSystem, channels: tuple[Channel, ...],
-                              omega: np.ndarray) -> None:
+                              omega: np.ndarray, q: np.ndarray | None = None) -> None:
     """ResolutionWarning when the wave-velocity σ varies by more than
     ``SURFACE_SIGMA_RATIO`` along an element that matters (larger end σ at least
     ``SURFACE_MATTERS_FRACTION`` of the line's largest): one drag coefficient per element
-    cannot follow it (the wave loads are integrated exactly; the linearized B is not)."""
-    q = _trapezoid_weights(omega)
+    cannot follow it (the wave loads are integrated exactly; the linearized B is not).
+    ``q``: the trapezoid weights of ``omega`` when the caller has them."""
+    if q is None:
+        q = _trapezoid_weights(omega)
     var = None
     for ch in channels:
         if ch.element_end_square is None or not np.any(ch.spectrum > 0):
@@ -2467,10 +2482,13 @@ def line_indicators(
     rec = linearization.record
     name = system.name
     flags: list[str] = []
-    e = system.frames[0]
-    uc = system.current_el
-    u_t = np.einsum("ij,ij->i", uc, e)
-    u_n = np.linalg.norm(uc - u_t[:, None] * e, axis=1)
+    if "current_split" not in system._cache:  # as drag_coefficients: once per line
+        e = system.frames[0]
+        uc = system.current_el
+        u_t = np.einsum("ij,ij->i", uc, e)
+        u_nvec = uc - u_t[:, None] * e
+        system._cache["current_split"] = (u_t, u_nvec, np.linalg.norm(u_nvec, axis=1))
+    u_n = system._cache["current_split"][2]
     borgman = np.atleast_1d(borgman_variance_ratio(rec.sigma_normal, u_n))
     w = linearization.response.omega
     s_an = _normal_acceleration_sigma(system, channels, w)
@@ -2535,13 +2553,15 @@ def line_indicators(
             PhysicsWarning, stacklevel=3,
         )
     # large motions
-    pos = model.positions
-    chord = pos[-1] - pos[0]
-    cn = float(np.linalg.norm(chord))
-    rel = pos - pos[0]
-    if cn > 0:
-        rel = rel - np.outer(rel @ (chord / cn), chord / cn)
-    sag = float(np.max(np.linalg.norm(rel, axis=1)))
+    if "sag" not in system._cache:  # of the static shape: once per line
+        pos = model.positions
+        chord = pos[-1] - pos[0]
+        cn = float(np.linalg.norm(chord))
+        rel = pos - pos[0]
+        if cn > 0:
+            rel = rel - np.outer(rel @ (chord / cn), chord / cn)
+        system._cache["sag"] = float(np.max(np.linalg.norm(rel, axis=1)))
+    sag = system._cache["sag"]
     m_std = np.linalg.norm(motion_std, axis=1)
     m_max = float(m_std.max()) if m_std.size else 0.0
     to_sag = m_max / sag if sag > 0 else (np.inf if m_max > 0 else 0.0)
@@ -2592,12 +2612,21 @@ def line_result(
     spectra = np.stack([c.spectrum for c in channels]) if n_ch else np.zeros((0, w.size))
     # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the frequency-major
     # layout and transposing made every later pass strided)
-    motion_h = np.zeros((n_ch, model.n_nodes, 3, w.size), dtype=resp.displacement.dtype)
-    motion_h[:, :, list(model.components)] = np.transpose(
-        resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch), (3, 1, 2, 0))
+    u_h = np.transpose(resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch),
+                       (3, 1, 2, 0))
+    if tuple(model.components) == (0, 1, 2):  # 3-D: no zero components to embed
+        motion_h = np.ascontiguousarray(u_h)
+    else:
+        motion_h = np.zeros((n_ch, model.n_nodes, 3, w.size), dtype=resp.displacement.dtype)
+        motion_h[:, :, list(model.components)] = u_h
     tension_h = element_tension_transfer(system, resp)
-    s_mot = np.einsum("cnkw,cw->nkw", np.abs(motion_h) ** 2, spectra)
-    s_ten = np.einsum("cew,cw->ew", np.abs(tension_h) ** 2, spectra)
+    # σ² = Σ_c ∫|H_c|² S_c dω as one weighted reduction with the trapezoid weights q
+    # (the response spectra are not kept; the same trapezoid rule as np.trapezoid up
+    # to round-off, ≈ 0.1 ms a line less than the spectra and two trapezoids)
+    q = _trapezoid_weights(w)
+    sq = spectra * q
+    tension_std = np.sqrt(np.einsum("cew,cw->e", np.abs(tension_h) ** 2, sq))
+    motion_std = np.sqrt(np.einsum("cnkw,cw->nk", np.abs(motion_h) ** 2, sq))
     st = system.statics
     s0 = model.mesh.s0
     stats = {}
@@ -2607,9 +2636,7 @@ def line_result(
         _tail_check(system.name, end, w, dens, stats[end].m0)
     if np.any(spectra > 0):  # nothing to resolve without excitation
         _resolution_check(system, linearization.damping, w)
-        _surface_resolution_check(system, channels, w)
-    tension_std = np.sqrt(np.trapezoid(s_ten, w, axis=-1))
-    motion_std = np.sqrt(np.trapezoid(s_mot, w, axis=-1))
+        _surface_resolution_check(system, channels, w, q)
     indicators = (None if linearization.record is None else
                   line_indicators(system, channels, linearization, tension_std, motion_std,
                                   stats))

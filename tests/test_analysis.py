@@ -818,3 +818,19 @@ def test_pipeline_statistics_equal_the_validated_public_function() -> None:
                 == stats_from_spectrum(w, dens, 12.5, duration).as_dict())
     with pytest.raises(InputError, match="omega"):
         stats_from_spectrum(w[::-1], dens, 0.0, 10800.0)
+
+
+def test_nearest_spacing_equals_argmin_and_gradient():
+    """The resolution check's nearest grid point and local spacing (searchsorted, pass
+    E7) against the dense argmin and np.gradient they replace: the same bits, on a
+    non-uniform grid, at the grid ends, on grid points and at exact midpoints (ties
+    go to the lower point, as argmin)."""
+    rng = np.random.default_rng(7)
+    omega = np.cumsum(rng.uniform(0.01, 0.1, 50)) + 0.1
+    mids = 0.5 * (omega[1:] + omega[:-1])
+    x = np.concatenate([omega[[0, 1, -2, -1]], mids[::7], rng.uniform(omega[0], omega[-1], 200)])
+    dist, spacing = an._nearest_spacing(omega, x)
+    near = np.argmin(np.abs(omega[None, :] - x[:, None]), axis=1)
+    # exact equality: the same subtractions and divisions as np.argmin/np.gradient
+    np.testing.assert_array_equal(dist, np.abs(omega[near] - x))
+    np.testing.assert_array_equal(spacing, np.gradient(omega)[near])
