@@ -853,8 +853,7 @@ class _FossLine:
         """Node displacements (n_nodes, d, n_w, n_ch) and support forces (n_w, 2d,
         n_ch) of the line whose attached ends move by ``ue`` (n_w, n_e, n_ch)."""
         m2, n_w, n_ch = self.p0.shape
-        nf = self.phi.shape[0]
-        n, d, n_e = self.up.shape
+        n_e = self.up.shape[2]
         w = self.inp.omega
         w2 = (w * w)[None, :, None]
         iw = (1j * w)[None, :, None]
@@ -864,14 +863,7 @@ class _FossLine:
         gb = (self.wb @ flat_e).reshape(m2, n_w, n_ch)
         pc = self.p0 + (w2 * ga - iw * gb) * self.rden[:, :, None]
         uf = _real_gemm(self.phi, np.ascontiguousarray(self.chi @ pc.reshape(m2, -1)))
-        if self.res0 is not None:
-            x = np.concatenate([w2 * uet, -iw * uet], axis=0).reshape(2 * n_e, -1)
-            uf += self.res0.reshape(nf, -1) + _real_gemm(self.st, x)
-        uc = self.u_p.copy()
-        uc[1:-1] += uf.reshape(n - 2, d, n_w, n_ch)
-        uc += _real_gemm(self.up.reshape(n * d, n_e), flat_e).reshape(n, d, n_w, n_ch)
-        sc = self.sup0 + self.supe @ ue
-        return uc, sc
+        return _assemble_line(self, uf, ue, uet)
 
 
 class _ModalLine:
@@ -974,24 +966,34 @@ class _ModalLine:
     def combine(self, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """As :meth:`_FossLine.combine`."""
         n_w, m, n_ch = self.z0.shape
-        nf = self.phi.shape[0]
-        n, d, n_e = self.up.shape
-        w = self.inp.omega
         z = self.z0 + self.ze @ ue                                      # (n_w, m, n_ch)
         zf = np.ascontiguousarray(np.transpose(z, (1, 0, 2))).reshape(m, n_w * n_ch)
         uf = _real_gemm(self.phi, zf)
         uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))       # (n_e, n_w, n_ch)
-        flat_e = uet.reshape(n_e, n_w * n_ch)
-        if self.res0 is not None:
-            w2 = (w * w)[None, :, None]
-            iw = (1j * w)[None, :, None]
-            x = np.concatenate([w2 * uet, -iw * uet], axis=0).reshape(2 * n_e, -1)
-            uf += self.res0.reshape(nf, -1) + _real_gemm(self.st, x)
-        uc = self.u_p.copy()
-        uc[1:-1] += uf.reshape(n - 2, d, n_w, n_ch)
-        uc += _real_gemm(self.up.reshape(n * d, n_e), flat_e).reshape(n, d, n_w, n_ch)
-        sc = self.sup0 + self.supe @ ue
-        return uc, sc
+        return _assemble_line(self, uf, ue, uet)
+
+
+def _assemble_line(part: Any, uf: np.ndarray, ue: np.ndarray, uet: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The tail of :meth:`_FossLine.combine` and :meth:`_ModalLine.combine`: the free
+    rows' modal displacement ``uf`` (nf, n_w·n_ch) plus the truncated modes' static
+    correction (physical and unit channels), the static following of the end motions
+    ``ue`` (n_w, n_e, n_ch; ``uet`` its (n_e, n_w, n_ch) copy) and the base response:
+    node displacements (n_nodes, d, n_w, n_ch) and support forces (n_w, 2d, n_ch)."""
+    n, d, n_e = part.up.shape
+    n_w, n_ch = ue.shape[0], ue.shape[2]
+    flat_e = uet.reshape(n_e, n_w * n_ch)
+    if part.res0 is not None:
+        w = part.inp.omega
+        w2 = (w * w)[None, :, None]
+        iw = (1j * w)[None, :, None]
+        x = np.concatenate([w2 * uet, -iw * uet], axis=0).reshape(2 * n_e, -1)
+        uf += part.res0.reshape(uf.shape[0], -1) + _real_gemm(part.st, x)
+    uc = part.u_p.copy()
+    uc[1:-1] += uf.reshape(n - 2, d, n_w, n_ch)
+    uc += _real_gemm(part.up.reshape(n * d, n_e), flat_e).reshape(n, d, n_w, n_ch)
+    sc = part.sup0 + part.supe @ ue
+    return uc, sc
 
 
 def _solve_body(s: np.ndarray, g: np.ndarray, w: np.ndarray) -> np.ndarray:
