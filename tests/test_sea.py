@@ -837,3 +837,67 @@ def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
     assert re.search(r"UserWarning: stochcable: no writable numba cache directory", out.stderr)
     ref = sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**18 * 0.1, 0.1, "dsa", 3)
     assert complex(value.strip()) == ref.coefficients[12345]
+
+
+# --- fourth issue-2 pass: S checked piece by piece, lazy seeding, cached cpu count --------
+
+@pytest.mark.parametrize("bad_at", [0, 5, 40_000, 2**17 - 1, 2**17])
+@pytest.mark.parametrize("bad", [np.nan, -1e-300, -np.inf])
+def test_parallel_path_rejects_one_bad_value_in_any_piece(bad_at, bad):
+    # 2^18 samples: S comes in 8 pieces from two threads and its minimum is taken piece
+    # by piece (a NaN in one piece must not be hidden by a smaller value in a later
+    # one); one bad value anywhere, in either the first or the last piece, is reported
+    # with its frequency, and a caller's Generator is left untouched
+    duration, dt = 2**18 * 0.1, 0.1
+    omega, _ = sea.frequency_grid(duration, dt)
+
+    def dens(w):
+        s = _rational_density(w)
+        hit = np.flatnonzero(w == omega[bad_at])
+        s[hit] = bad
+        return s
+
+    gen = np.random.default_rng(9)
+    before = gen.bit_generator.state
+    with pytest.raises(InputError, match=rf"S\({omega[bad_at]:.6g} rad/s\) = {bad}"):
+        sea.simulate_sea(dens, duration, dt, rng=gen)
+    assert gen.bit_generator.state == before
+    with pytest.raises(InputError, match=r"must return finite values >= 0"):
+        sea.simulate_sea(dens, duration, dt, "nsa", rng=3)
+
+
+def test_piece_minimum_keeps_a_nan():
+    # the running minimum over pieces: NaN (first piece) survives smaller later values
+    omega = np.linspace(0.0, 1.0, 2**17)
+
+    def dens(w):
+        s = 1.0 - w
+        s[w == 0.0] = np.nan
+        return s
+
+    job = sea._Synthesis(0, 2**17 - 1, False, np.empty(2**17 - 1, complex),
+                         np.empty(2**17 - 1, complex), 1.0, dens, omega, 4)
+    job.spectrum()
+    assert math.isnan(job.piece_min)
+    job = sea._Synthesis(0, 2**17 - 1, False, np.empty(2**17 - 1, complex),
+                         np.empty(2**17 - 1, complex), 1.0, lambda w: 1.0 - w, omega, 4)
+    job.spectrum()
+    assert job.piece_min == 0.0            # exact: 1 − 1
+
+
+def test_int_seed_generator_built_lazily_by_the_draws():
+    # an int seed reaches the draws unbuilt; the draws use default_rng(seed)
+    job = sea._Synthesis(11, 5, True, np.empty(5, complex), np.empty(5, complex), 1.0)
+    assert job.gen == 11
+    job.draw()
+    ref = np.random.default_rng(11)
+    np.testing.assert_array_equal(job.u, ref.random(5))
+    np.testing.assert_array_equal(job.gain, np.hypot(ref.standard_normal(5), ref.standard_normal(5)))
+    job.cancel()                           # a private generator: nothing to restore
+
+
+def test_cpu_count_is_asked_again_when_replaced(monkeypatch):
+    monkeypatch.setattr(sea.os, "cpu_count", lambda: 7)
+    assert sea._cpu_count() == 7
+    monkeypatch.setattr(sea.os, "cpu_count", lambda: None)
+    assert sea._cpu_count() == 1
