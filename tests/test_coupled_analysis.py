@@ -980,3 +980,34 @@ def test_warm_step_is_the_fixed_point_of_an_affine_map():
     np.testing.assert_allclose(_warm_step(pairs, r), exact, rtol=1e-10)
     # one pair: the plain step r·G(x)
     np.testing.assert_allclose(_warm_step(pairs[:1], r), r * (a @ xs[0] + b), rtol=1e-14)
+
+
+def test_large_static_body_rotation_is_flagged():
+    """The body data are used at the input orientation: a static heel above
+    STATIC_ROTATION_LIMIT gets a PhysicsWarning with the angle and the fix; the
+    examples (0.45° and 0.12°) get none."""
+    import warnings
+
+    from stochcable.analysis import analyze
+    from stochcable.coupled_analysis import STATIC_ROTATION_LIMIT
+    from stochcable.errors import PhysicsWarning
+    from stochcable.examples import load_example
+    from stochcable.scene import load_scene
+
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json",
+                                                                     exclude_none=True)
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        small = analyze(load_scene(doc))
+    assert not [w for w in rec if "static rotation" in str(w.message)]
+    assert float(abs(small.statics.bodies["disc"].rotation[1])) < STATIC_ROTATION_LIMIT
+    # a pitch moment of ≈ 0.13 rad × the pitch stiffness 31,399 lbf·ft/rad heels it ≈ 7.6°
+    doc["bodies"][0]["wind_moment"] = [0.0, 4000.0, 0.0]
+    with pytest.warns(PhysicsWarning, match=r"body 'disc': its static rotation is 7\.6\d°.*"
+                                            r"above 5°.*give the body's data at its static "
+                                            r"orientation") as rec:
+        big = analyze(load_scene(doc))
+    heel = float(big.statics.bodies["disc"].rotation[1])
+    assert heel > STATIC_ROTATION_LIMIT
+    assert f"{math.degrees(heel):.3g}°" in str(
+        next(w.message for w in rec if "static rotation" in str(w.message)))
