@@ -6,8 +6,9 @@ JONSWAP Hs 3 m Tp 9 s.  Timed: the whole dynamic analysis of the group
 with the statics (lines and the buoy pose, stochcable.statics) and without them
 (:func:`stochcable.coupled_analysis.analyze_coupled`: models, channels, coupled drag
 linearization, coupled modes, line and body outputs), with one BLAS thread as
-``analyze()`` runs small models, for the direct and the Foss ("auto") solvers.  For
-scale: the same three legs analysed independently, fairleads fixed at their static
+``analyze()`` runs small models, for the direct and the Foss ("auto") solvers, and
+the whole ``analyze()`` call (scene to result: statics, dynamics, warnings,
+indicators).  For scale: the same three legs analysed independently, fairleads fixed at their static
 positions.  The dynamics are also timed without the coarse start of the drag
 linearization (``COARSE_MIN_FREQUENCIES`` raised), with the largest relative change
 of the buoy motion σ and the fairlead/anchor tension σ it makes.  Then a cProfile
@@ -35,8 +36,8 @@ import time
 import warnings
 
 from _host import host_line
-from stochcable.analysis import (_single_blas_thread, _tune_allocator, build_line_system,
-                                 line_result, linearize)
+from stochcable.analysis import (_single_blas_thread, _tune_allocator, analyze,
+                                 build_line_system, line_result, linearize)
 import numpy as np
 
 import stochcable.coupled_analysis as coupled_analysis
@@ -284,6 +285,7 @@ def main() -> None:
         statics = solve_statics(scene, method="fe")
         (lines, bodies, _, _), timing = run_coupled(scene, statics)
         med_f, best_f = median_time(lambda: run_coupled(scene), args.repeat)
+        med_a, best_a = median_time(lambda: analyze(scene), args.repeat)
         med, best = median_time(lambda: run_coupled(scene, statics), args.repeat)
         ind = independent_scene(scene, statics)
         ind_st = solve_statics(ind, method="fe")
@@ -293,6 +295,8 @@ def main() -> None:
               f"({1e3 * best_f:.1f} min); dynamics {1e3 * med:.1f} ms ({1e3 * best:.1f} min), "
               f"{rec.iterations} iterations; statics {1e3 * med_s:.1f} ms; "
               f"the legs alone (fairleads fixed) {1e3 * med_i:.1f} ms")
+        print(f"        through analyze() (scene to result, warnings and indicators): "
+              f"{1e3 * med_a:.1f} ms median ({1e3 * best_a:.1f} min)")
         med_nc, l_nc, b_nc = without_coarse_start(scene, statics, args.repeat)
         ref = key_results(l_nc, b_nc)
         diff = np.max(np.abs(key_results(lines, bodies) / ref - 1.0))
