@@ -335,11 +335,13 @@ def _coarse_update(g, idx, x=None):
 
 
 @pytest.mark.parametrize("modes", [8, "auto"])
-def test_modal_line_cache_gives_the_same_bits(modes):
-    """The drag-independent arrays kept per line across the coarse evaluations
-    (``_Group.modal_cache``): a solve at a second drag with the cache filled by a
-    first one is bit-identical to the same solve on a fresh group (the cache holds
-    nothing that depends on the drag)."""
+@pytest.mark.parametrize("stage", ["coarse", "full"])
+def test_line_part_cache_gives_the_same_bits(stage, modes):
+    """The drag-independent arrays kept per line across the evaluations
+    (``_Group.modal_cache`` of the coarse stage's :class:`_ModalLine`,
+    ``_Group.foss_cache`` of the full grid's :class:`_FossLine`): a solve at a second
+    drag with the cache filled by a first one is bit-identical to the same solve on a
+    fresh group (the cache holds nothing that depends on the drag)."""
     body = _buoy()
     _, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
     damp = [{cl.name: drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements,
@@ -349,38 +351,14 @@ def test_modal_line_cache_gives_the_same_bits(modes):
     bc = np.zeros((6, 6))
     g1 = _Group(cls, [body], loads, RHO, cls[0].channels)
     g2 = _Group(cls, [body], loads, RHO, cls[0].channels)
-    g1.modal_direct = g2.modal_direct = True
-    _solve_group(g1, damp[0], bc, bb, None)
-    assert all(g1.modal_cache[cl.name] for cl in cls)
-    sol1, xi1 = _solve_group(g1, damp[1], bc, bb, None)
-    assert not g2.modal_cache
-    sol2, xi2 = _solve_group(g2, damp[1], bc, bb, None)
-    np.testing.assert_array_equal(xi1, xi2)
-    for name, (u, s) in sol2.items():
-        np.testing.assert_array_equal(sol1[name][0], u)
-        np.testing.assert_array_equal(sol1[name][1], s)
-
-
-@pytest.mark.parametrize("modes", [8, "auto"])
-def test_foss_line_cache_gives_the_same_bits(modes):
-    """The drag-independent arrays kept per line across the full-grid evaluations
-    (``_Group.foss_cache``, :class:`_FossLine`): a solve at a second drag with the
-    cache filled by a first one is bit-identical to the same solve on a fresh group
-    (the cache holds nothing that depends on the drag)."""
-    body = _buoy()
-    _, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
-    damp = [{cl.name: drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements,
-                                                           s), "seed") for cl in cls}
-            for s in (0.05, 0.4)]
-    bb = {body.name: np.array([2e3, 2e3, 4e3])}
-    bc = np.zeros((6, 6))
-    g1 = _Group(cls, [body], loads, RHO, cls[0].channels)
-    g2 = _Group(cls, [body], loads, RHO, cls[0].channels)
+    g1.modal_direct = g2.modal_direct = stage == "coarse"
+    used, other = ("modal_cache", "foss_cache") if stage == "coarse" else \
+        ("foss_cache", "modal_cache")
     sol0, _ = _solve_group(g1, damp[0], bc, bb, None)
-    assert all(g1.foss_cache[cl.name] for cl in cls)
-    assert not g1.modal_cache
+    assert all(getattr(g1, used)[cl.name] for cl in cls)
+    assert not getattr(g1, other)
     sol1, xi1 = _solve_group(g1, damp[1], bc, bb, None)
-    assert not g2.foss_cache
+    assert not getattr(g2, used)
     sol2, xi2 = _solve_group(g2, damp[1], bc, bb, None)
     np.testing.assert_array_equal(xi1, xi2)
     for name, (u, s) in sol2.items():
