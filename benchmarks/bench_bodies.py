@@ -34,6 +34,7 @@ import pstats
 import statistics
 import time
 import warnings
+from typing import Any
 
 from _host import host_line
 from stochcable.analysis import (_single_blas_thread, _tune_allocator, analyze,
@@ -128,32 +129,38 @@ def reference_paths(on: bool) -> None:
     coupled_analysis._CB_MIN_RATIO = 1e9 if on else 1.5
 
 
-def fast_paths_ab(repeat: int) -> None:
-    """Interleaved A/B in one process: the reference paths against the fast ones,
-    full analysis (statics + dynamics) and dynamics alone, medians of wall and process
-    time, and the largest relative change of the buoy σ and tension σ."""
+def interleaved_ab(repeat: int, variants: dict[str, Any], reference: str,
+                   history: bool = False) -> None:
+    """Interleaved A/B in one process, per solver: each variant (a label and a
+    function that switches it on) in turn, full analysis (statics + dynamics) and
+    dynamics alone, medians of wall and process time (with threads the process time
+    can exceed the wall time), and the largest relative change of the buoy σ and
+    tension σ of each variant against ``reference`` (0: same bits).  ``history``:
+    print each variant's evaluation count and history."""
     for solver in ("foss", "direct"):
         scene = load_scene(scene_doc(solver))
         statics = solve_statics(scene, method="fe")
         keys = {}
-        for ref in (True, False):
-            reference_paths(ref)
+        for label, use in variants.items():
+            use()
             (lines, bodies, _, _), _ = run_coupled(scene, statics)
-            keys[ref] = key_results(lines, bodies)
+            keys[label] = key_results(lines, bodies)
+            if history:
+                rec = lines["leg1"].linearization
+                print(f"{solver:6s} {label}: {rec.iterations} evaluations, history "
+                      f"{', '.join(f'{h:.1e}' for h in rec.history)}")
             run_coupled(scene)  # warm-up
-        t = {(r, k): [] for r in (True, False) for k in ("fw", "fp", "dw", "dp")}
+        t = {(v, k): [] for v in variants for k in ("fw", "fp", "dw", "dp")}
         for _ in range(repeat):
-            for ref in (True, False):
-                reference_paths(ref)
-                _time_full_and_dynamics(scene, statics, t, ref)
-        reference_paths(False)
-        for ref in (True, False):
-            med = {k: 1e3 * statistics.median(t[ref, k]) for k in ("fw", "fp", "dw", "dp")}
-            print(f"{solver:6s} {'reference' if ref else 'fast     '}: full {med['fw']:.1f} ms "
-                  f"(process {med['fp']:.1f}), dynamics {med['dw']:.1f} ms "
-                  f"(process {med['dp']:.1f}), medians of {repeat}")
-        diff = np.max(np.abs(keys[False] / keys[True] - 1.0))
-        print(f"        max relative change of the buoy σ and tension σ: {diff:.1e}")
+            for label, use in variants.items():
+                use()
+                _time_full_and_dynamics(scene, statics, t, label)
+        for label in variants:
+            med = {k: 1e3 * statistics.median(t[label, k]) for k in ("fw", "fp", "dw", "dp")}
+            diff = np.max(np.abs(keys[label] / keys[reference] - 1.0))
+            print(f"{solver:6s} {label}: full {med['fw']:.1f} ms (process {med['fp']:.1f}), "
+                  f"dynamics {med['dw']:.1f} ms (process {med['dp']:.1f}), medians of "
+                  f"{repeat}; max relative change of the key σ vs {reference}: {diff:.1e}")
 
 
 def _time_full_and_dynamics(scene, statics, t: dict, key) -> None:  # noqa: ANN001
@@ -166,37 +173,29 @@ def _time_full_and_dynamics(scene, statics, t: dict, key) -> None:  # noqa: ANN0
         t[key, kind + "p"].append(time.process_time() - p0)
 
 
+def fast_paths_ab(repeat: int) -> None:
+    """The reference paths (node-level Foss lines, full coupled-mode eigenproblem)
+    against the fast ones (pass E3)."""
+    try:
+        interleaved_ab(repeat, {"reference": lambda: reference_paths(True),
+                                "fast     ": lambda: reference_paths(False)}, "reference")
+    finally:
+        reference_paths(False)
+
+
 def threads_ab(repeat: int) -> None:
-    """Interleaved A/B in one process: the per-line thread pool (stochcable._parallel,
-    pass E4) off (``STOCHCABLE_THREADS=1``) and on (2 threads), full analysis and
-    dynamics, medians of wall and process time (with threads the process time can
-    exceed the wall time), and the largest relative change of the key σ (0: same
-    bits)."""
+    """The per-line thread pool (stochcable._parallel, pass E4) off
+    (``STOCHCABLE_THREADS=1``) and on (2 threads)."""
     import os
 
     saved = os.environ.get("STOCHCABLE_THREADS")
+
+    def threads(n: str) -> Any:
+        return lambda: os.environ.__setitem__("STOCHCABLE_THREADS", n)
+
     try:
-        for solver in ("foss", "direct"):
-            scene = load_scene(scene_doc(solver))
-            statics = solve_statics(scene, method="fe")
-            keys = {}
-            for th in ("1", "2"):
-                os.environ["STOCHCABLE_THREADS"] = th
-                (lines, bodies, _, _), _ = run_coupled(scene, statics)
-                keys[th] = key_results(lines, bodies)
-                run_coupled(scene)  # warm-up
-            t = {(th, k): [] for th in ("1", "2") for k in ("fw", "fp", "dw", "dp")}
-            for _ in range(repeat):
-                for th in ("1", "2"):
-                    os.environ["STOCHCABLE_THREADS"] = th
-                    _time_full_and_dynamics(scene, statics, t, th)
-            for th in ("1", "2"):
-                med = {k: 1e3 * statistics.median(t[th, k]) for k in ("fw", "fp", "dw", "dp")}
-                print(f"{solver:6s} {th} thread{'s' if th != '1' else ' '}: full "
-                      f"{med['fw']:.1f} ms (process {med['fp']:.1f}), dynamics "
-                      f"{med['dw']:.1f} ms (process {med['dp']:.1f}), medians of {repeat}")
-            diff = np.max(np.abs(keys["2"] / keys["1"] - 1.0))
-            print(f"        max relative change of the buoy σ and tension σ: {diff:.1e}")
+        interleaved_ab(repeat, {"1 thread ": threads("1"), "2 threads": threads("2")},
+                       "1 thread ")
     finally:
         if saved is None:
             os.environ.pop("STOCHCABLE_THREADS", None)
@@ -205,40 +204,17 @@ def threads_ab(repeat: int) -> None:
 
 
 def coarse_ab(repeat: int) -> None:
-    """Interleaved A/B in one process: the coarse start of the drag linearization off
-    (``COARSE_MIN_FREQUENCIES`` raised) and on, full analysis and dynamics, medians
-    of wall and process time, the evaluations and the largest relative change of the
-    key σ."""
+    """The coarse start of the drag linearization off (``COARSE_MIN_FREQUENCIES``
+    raised) and on, with the evaluations of each."""
     saved = coupled_analysis.COARSE_MIN_FREQUENCIES
 
-    def use(on: bool) -> None:
-        coupled_analysis.COARSE_MIN_FREQUENCIES = saved if on else 10**9
+    def coarse(on: bool) -> Any:
+        return lambda: setattr(coupled_analysis, "COARSE_MIN_FREQUENCIES",
+                               saved if on else 10**9)
 
     try:
-        for solver in ("foss", "direct"):
-            scene = load_scene(scene_doc(solver))
-            statics = solve_statics(scene, method="fe")
-            keys = {}
-            for on in (False, True):
-                use(on)
-                (lines, bodies, _, _), _ = run_coupled(scene, statics)
-                keys[on] = key_results(lines, bodies)
-                rec = lines["leg1"].linearization
-                print(f"{solver:6s} coarse {'on ' if on else 'off'}: {rec.iterations} "
-                      f"evaluations, history {', '.join(f'{h:.1e}' for h in rec.history)}")
-                run_coupled(scene)  # warm-up
-            t = {(on, k): [] for on in (False, True) for k in ("fw", "fp", "dw", "dp")}
-            for _ in range(repeat):
-                for on in (False, True):
-                    use(on)
-                    _time_full_and_dynamics(scene, statics, t, on)
-            for on in (False, True):
-                med = {k: 1e3 * statistics.median(t[on, k]) for k in ("fw", "fp", "dw", "dp")}
-                print(f"{solver:6s} coarse {'on ' if on else 'off'}: full {med['fw']:.1f} ms "
-                      f"(process {med['fp']:.1f}), dynamics {med['dw']:.1f} ms "
-                      f"(process {med['dp']:.1f}), medians of {repeat}")
-            diff = np.max(np.abs(keys[True] / keys[False] - 1.0))
-            print(f"        max relative change of the buoy σ and tension σ: {diff:.1e}")
+        interleaved_ab(repeat, {"coarse off": coarse(False), "coarse on ": coarse(True)},
+                       "coarse off", history=True)
     finally:
         coupled_analysis.COARSE_MIN_FREQUENCIES = saved
 
