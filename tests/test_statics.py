@@ -386,20 +386,26 @@ def test_load_stepping_rescues_drag_dominated_line():
     assert r.force_a[0] + r.force_b[0] == pytest.approx(drag[0], rel=1e-6)
 
 
+def _chain_in_current():
+    """A 20-element chain in a 0.5 m/s current: its mesh, environment, frame, private
+    FE statics model and the initial guess (for the model-level tests below)."""
+    from stochcable.statics import _Frame, _initial_guess, _Model
+
+    m, env, _ = make((-800, 0, -200), (0, 0, -20), [dict(CHAIN, elements=20)],
+                     current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}])
+    frame = _Frame(m, env)
+    model = _Model(m, env, frame)
+    return m, env, frame, model, _initial_guess(m, env, frame, model)
+
+
 def test_repeated_residual_reuses_the_same_numbers():
     """_Model.forces remembers the residual of the last position (the Newton iteration
     asks twice per accepted point): a repeated call returns the numbers of a fresh
     model to the bit, with or without the tangent, also with current drag (whose nodal
     drag forces the line search reads) and after the drag factor changes."""
-    from stochcable.statics import _Frame, _initial_guess, _Model
+    from stochcable.statics import _Frame, _Model
 
-    seg = dict(CHAIN, elements=20)
-    m, env, _ = make((-800, 0, -200), (0, 0, -20), [seg],
-                     current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}])
-
-    frame = _Frame(m, env)
-    b = _Model(m, env, frame)
-    x = _initial_guess(m, env, frame, b)
+    m, env, frame, b, x = _chain_in_current()
     x2 = x.copy()
     x2[1:-1, -1] += 0.1
     for beta in (1.0, 0.5):
@@ -483,14 +489,9 @@ def test_converged_status_skips_the_tangent_and_solves_the_same():
     point needs none) and builds it from the residual memo before a step: the status
     numbers are those with the tangent, and the tangent built afterwards is a fresh
     model's to the bit (with current drag, whose nodal forces the line search reads)."""
-    from stochcable.statics import _Frame, _initial_guess, _Model, _Solver
+    from stochcable.statics import _Frame, _Model, _Solver
 
-    seg = dict(CHAIN, elements=20)
-    m, env, _ = make((-800, 0, -200), (0, 0, -20), [seg],
-                     current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}])
-    frame = _Frame(m, env)
-    model = _Model(m, env, frame)
-    x = _initial_guess(m, env, frame, model)
+    m, env, frame, model, x = _chain_in_current()
     lazy = _Solver(model, 1e-10, 100).status(x, tangent=False)
     assert lazy[3] is None
     tangent = model.forces(x)[3]
