@@ -1439,14 +1439,6 @@ def _response(system: "LineSystem", inp: _Inputs, damping: Damping,
 # --------------------------------------------------------------------------- solve
 
 
-def _rows_times(a: Any, x: np.ndarray) -> np.ndarray:
-    """Sparse/dense (m, n) times (n_omega, n, k) -> (n_omega, m, k)."""
-    n_w, n, k = x.shape
-    flat = np.moveaxis(x, 0, 1).reshape(n, n_w * k)
-    out = a @ flat
-    return np.moveaxis(np.asarray(out).reshape(-1, n_w, k), 1, 0)
-
-
 def solve(
     system: LineSystem,
     channels: tuple[Channel, ...],

@@ -1198,9 +1198,7 @@ def _make_update(g: _Group, method: str, rho: float, state: dict[str, Any],
             new.append(_body_sigma(g, b, xi))
         new = np.concatenate(new) if new else np.zeros(0)
         state["it"] += 1
-        den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)),
-                                                 1e-300))
-        change = float(np.max(np.abs(new - x) / den, initial=0.0))
+        change = _relative_change(new, x)
         state["change"] = change
         progress("linearization", {"group": names, "iteration": state["it"],
                                    "change": change})
