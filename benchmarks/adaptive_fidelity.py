@@ -1,5 +1,5 @@
 """Adaptive fidelity (issue 7, item 2): the settings chosen by
-:func:`stochcable.fidelity.choose_fidelity` against a converged reference.
+:func:`stochcable.fidelity.planner.choose_fidelity` against a converged reference.
 
 For each example scene and target (1 %, 5 %): plan (its wall time includes the statics
 and the pilot analysis), apply, analyze (median wall time), and compare the σ of the
@@ -24,10 +24,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from speed_vs_error import base_document, quantities_fd  # noqa: E402
 
-from stochcable.analysis import analyze  # noqa: E402
-from stochcable.fidelity import apply_fidelity, choose_fidelity  # noqa: E402
-from stochcable.mesh import mesh_line  # noqa: E402
-from stochcable.scene import load_scene  # noqa: E402
+from stochcable.dynamics.line import analyze  # noqa: E402
+from stochcable.fidelity.planner import apply_fidelity, choose_fidelity  # noqa: E402
+from stochcable.line.mesh import mesh_line  # noqa: E402
+from stochcable.scene.model import load_scene  # noqa: E402
 
 SCENES = ("taut_wire", "chain_catenary", "inclined_guy", "tuah_1982_single_leg")
 TARGETS = (0.01, 0.05)

@@ -3,8 +3,8 @@
 A buoy (6 DOF, constant added mass and radiation damping, drag) on three chain legs
 at 0/120/240 deg, 40 elements per leg (3-D), 200 frequencies on [0.1, 2] rad/s,
 JONSWAP Hs 3 m Tp 9 s.  Timed: the whole dynamic analysis of the group
-with the statics (lines and the buoy pose, stochcable.statics) and without them
-(:func:`stochcable.coupled_analysis.analyze_coupled`: models, channels, coupled drag
+with the statics (lines and the buoy pose, stochcable.line.statics) and without them
+(:func:`stochcable.dynamics.coupled.analyze_coupled`: models, channels, coupled drag
 linearization, coupled modes, line and body outputs), with one BLAS thread as
 ``analyze()`` runs small models, for the direct and the Foss ("auto") solvers, and
 the whole ``analyze()`` call (scene to result: statics, dynamics, warnings,
@@ -37,15 +37,15 @@ import warnings
 from typing import Any
 
 from _host import host_line
-from stochcable.analysis import (_single_blas_thread, _tune_allocator, analyze,
+from stochcable.dynamics.line import (_single_blas_thread, _tune_allocator, analyze,
                                  build_line_system, line_result, linearize)
 import numpy as np
 
-import stochcable.coupled_analysis as coupled_analysis
-from stochcable.coupled_analysis import analyze_coupled
-from stochcable.excitation import line_channels
-from stochcable.scene import load_scene
-from stochcable.statics import solve_statics
+import stochcable.dynamics.coupled as coupled_analysis
+from stochcable.dynamics.coupled import analyze_coupled
+from stochcable.dynamics.loads import line_channels
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import solve_statics
 
 
 def scene_doc(solver: str = "direct", n_el: int = 40, count: int = 200) -> dict:
@@ -184,7 +184,7 @@ def fast_paths_ab(repeat: int) -> None:
 
 
 def threads_ab(repeat: int) -> None:
-    """The per-line thread pool (stochcable._parallel, pass E4) off
+    """The per-line thread pool (stochcable.runtime, pass E4) off
     (``STOCHCABLE_THREADS=1``) and on (2 threads)."""
     import os
 

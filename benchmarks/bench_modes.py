@@ -20,9 +20,9 @@ import time
 
 import numpy as np
 
-from stochcable.fem import assemble, build_fe_model
-from stochcable.modes import natural_modes
-from stochcable.scene import load_scene
+from stochcable.line.fem import assemble, build_fe_model
+from stochcable.line.modes import natural_modes
+from stochcable.scene.model import load_scene
 
 
 def chain_scene(elements: int, heading_deg: float = 0.0) -> dict:
@@ -63,7 +63,7 @@ def main() -> None:
     global _USE_MIN
     _USE_MIN = args.min
     repeat = 5 if args.quick else 21
-    from stochcable.statics import solve_statics
+    from stochcable.line.statics import solve_statics
 
     scene = load_scene(chain_scene(100))
     env = scene.environment

@@ -1,8 +1,8 @@
 """Benchmark: 2^20-sample DSA sea realization and the dispersion relation.
 
 Run: ``python benchmarks/bench_sea.py [--tune]``.  ``--tune`` first measures the
-2^20-point FFTW plans and saves them as wisdom (``stochcable._fft.tune``, 15–35 s; the
-file is ``stochcable._fft.wisdom_path()``, set ``STOCHCABLE_FFTW_WISDOM`` to choose it or
+2^20-point FFTW plans and saves them as wisdom (``stochcable.sea.fft.tune``, 15–35 s; the
+file is ``stochcable.sea.fft.wisdom_path()``, set ``STOCHCABLE_FFTW_WISDOM`` to choose it or
 to an empty value to run without wisdom).  Prints the median and the minimum over repeated
 runs (timeit style: each sample is one call, wall clock), with pyfftw and with the
 numpy.fft fallback, the load average before and after, and the minor page faults of one
@@ -12,7 +12,7 @@ Goals (docs/BENCHMARKS.md): realization <= 8 ms, dispersion of 10,000 ω <= 0.5 
 The coefficient kernel is compiled with numba when it is installed (the first
 realization of >= 2^16 lines imports numba and loads the kernel: time printed); the rows
 marked [numpy kernel] run the same realizations with STOCHCABLE_NUMBA=0.
-stochcable._fft sets OMP_WAIT_POLICY=PASSIVE unless the environment sets a policy: the
+stochcable.sea.fft sets OMP_WAIT_POLICY=PASSIVE unless the environment sets a policy: the
 numbers depend on it (see docs/BENCHMARKS.md).
 """
 
@@ -29,9 +29,10 @@ import numpy as np
 
 from _host import host_line
 
-from stochcable import _fft, sea
-from stochcable.kinematics import wavenumber
-from stochcable.spectra import spectrum_jonswap, spectrum_pierson_moskowitz
+from stochcable.sea import fft as _fft
+from stochcable.sea import realization as sea
+from stochcable.sea.kinematics import wavenumber
+from stochcable.sea.spectra import spectrum_jonswap, spectrum_pierson_moskowitz
 
 
 def median_ms(fn, repeat: int, warmup: int = 2) -> tuple[float, float]:
@@ -79,7 +80,7 @@ def main() -> None:
         print("coefficient kernel: numpy (numba not installed or STOCHCABLE_NUMBA=0)")
     else:
         import numba
-        from stochcable import _kernels
+        from stochcable.sea import kernels as _kernels
 
         print(f"coefficient kernel: numba {numba.__version__} (import + kernel "
               f"{'load from cache' if _kernels.CACHED else 'compile, no cache'}: "

@@ -7,11 +7,11 @@ load generator does not share the server's GIL), then measures:
    requests and the throughput of a few concurrent clients.  Goal: p50 <= 5 ms.
 2. A 2^20-sample realization (``duration = 2^20·0.25 s``, ``dt = 0.25 s``) answered as
    NumPy .npy (``Accept: application/x-npy``), round trip including decoding, against
-   the library's own :func:`stochcable.sea.simulate_sea` time.  Goal: within 2x.
+   the library's own :func:`stochcable.sea.realization.simulate_sea` time.  Goal: within 2x.
 3. ``GET /health`` latency while clients keep asking for that realization.
 4. ``POST /v1/analyses`` of the bundled ``chain_catenary`` scene (the start-up
    message's example): p50/p99 latency of sequential requests (JSON decoded) against
-   the library's own :func:`stochcable.analysis.analyze` in this process (goal: p50
+   the library's own :func:`stochcable.dynamics.line.analyze` in this process (goal: p50
    within 1.5x), the throughput of 4 concurrent clients, and ``GET /health`` latency
    while 2 clients keep posting analyses.
 
@@ -108,8 +108,8 @@ def _big_body() -> dict:
 
 
 def bench_realization(base: str, repeats: int) -> dict:
-    from stochcable.scene import PiersonMoskowitz
-    from stochcable.sea import simulate_sea
+    from stochcable.scene.model import PiersonMoskowitz
+    from stochcable.sea.realization import simulate_sea
 
     spec = PiersonMoskowitz(**{k: v for k, v in PM.items() if k != "type"})
     local = []
@@ -186,7 +186,7 @@ def _chain_body() -> bytes:
 def bench_analyses(base: str, n: int, workers: int) -> dict:
     import warnings
 
-    from stochcable.analysis import analyze
+    from stochcable.dynamics.line import analyze
     from stochcable.examples import load_example
 
     scene = load_example("chain_catenary")

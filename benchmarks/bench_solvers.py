@@ -1,4 +1,4 @@
-"""Benchmark of the frequency-domain solvers (stochcable.solvers).
+"""Benchmark of the frequency-domain solvers (stochcable.dynamics.solvers).
 
 A 40-element 3-D line (120 DOF: 40 free nodes x 3, end A pinned, end B on a stiff
 spring), consistent mass plus normal added mass, a lumped linearized drag damping
@@ -17,7 +17,7 @@ import time
 
 import numpy as np
 
-from stochcable.solvers import (
+from stochcable.dynamics.solvers import (
     foss_decomposition,
     foss_transfer,
     matrix_bandwidth,

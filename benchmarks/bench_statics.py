@@ -3,7 +3,7 @@
 Cases: the DESIGN.md chain leg (850 m, 3-D, end_b off the x axis) and the very slack
 leg (960 m over an 800 m span, most of the line on the seabed), forced FE, for 20 to
 800 elements: median time, Newton iterations, relative error of the end_b tension and
-touchdown difference against the catenary (stochcable.catenary; the FE-catenary gap is
+touchdown difference against the catenary (stochcable.line.catenary; the FE-catenary gap is
 the O(1/n²) lumping error plus, with seabed contact, the touchdown resolution).
 
 Run: python benchmarks/bench_statics.py
@@ -14,9 +14,9 @@ from __future__ import annotations
 import statistics
 import time
 
-from stochcable.mesh import mesh_line
-from stochcable.scene import load_scene
-from stochcable.statics import _solve_fe, solve_line_statics
+from stochcable.line.mesh import mesh_line
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import _solve_fe, solve_line_statics
 
 CASES = {
     "chain 850 m": (850.0, [-640.0, -480.0, -200.0]),

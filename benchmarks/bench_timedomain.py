@@ -22,7 +22,7 @@ import numpy as np
 
 
 def _scene(elements: int):
-    from stochcable.scene import load_scene
+    from stochcable.scene.model import load_scene
 
     return load_scene({
         "environment": {"depth": 200.0, "seabed": {"stiffness": 3e6, "damping": 3e5}},
@@ -45,8 +45,8 @@ def _rel_sampling_error(omega, s, record):
 
 
 def main(argv: list[str] | None = None) -> int:
-    from stochcable.analysis import analyze
-    from stochcable.cable_timedomain import simulate_line_timedomain
+    from stochcable.dynamics.line import analyze
+    from stochcable.reference.cable import simulate_line_timedomain
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--elements", type=int, default=40)

@@ -24,12 +24,12 @@ fairlead-adjacent node (linearly interpolated for other meshes) — against
     element ladder ×1, ×2, ×4, ×8 with Richardson extrapolation when the last three
     steps converge monotonically (else the finest level); on a grounded line every
     ladder mesh has a node at the static touchdown
-    (:func:`stochcable.fidelity.static_touchdowns`): the linear model's contact state
+    (:func:`stochcable.fidelity.planner.static_touchdowns`): the linear model's contact state
     is the static one, and a touchdown inside an element makes the ladder oscillate at
     first order (tuah_1982_single_leg: 24 uniform elements are 8 % off); its
     convergence is shown (element steps, a half-count grid on the finest mesh and a
     4·ω_max grid);
-(b) the nonlinear time-domain reference (:func:`stochcable.cable_timedomain.
+(b) the nonlinear time-domain reference (:func:`stochcable.reference.cable.
     simulate_line_timedomain`, Newmark average acceleration, same mesh family) over
     several seeds of 600 s, excitation band [ω_min, 2·ω_max]: mean σ_TD with its 95 %
     Student-t confidence interval, and the FD/TD ratio with its interval.
@@ -241,8 +241,8 @@ def timed_analysis(doc: dict[str, Any], repeats: int, budget_s: float
     Runs at least once and at most ``repeats`` times, stopping early once the calls
     have taken ``budget_s`` seconds in total.
     """
-    from stochcable.analysis import analyze
-    from stochcable.scene import load_scene
+    from stochcable.dynamics.line import analyze
+    from stochcable.scene.model import load_scene
 
     scene = load_scene(doc)
     times: list[float] = []
@@ -337,8 +337,8 @@ def _rel(x: float, ref: float) -> float:
 def converged_reference(name: str, base: dict[str, Any], s_star: float, *,
                         quick: bool = False, progress: Progress = _silent) -> Reference:
     """The converged FD reference of an example (see the module docstring)."""
-    from stochcable.fidelity import static_touchdowns
-    from stochcable.scene import load_scene
+    from stochcable.fidelity.planner import static_touchdowns
+    from stochcable.scene.model import load_scene
 
     c0 = int(base["analysis"]["omega"]["count"])
     count = (8 if not quick else 2) * c0
@@ -397,9 +397,9 @@ def td_reference(name: str, base: dict[str, Any], s_star: float, *, seeds: int,
                  duration: float, mesh_factor: float, count: int,
                  progress: Progress = _silent) -> TDReference:
     """Nonlinear TD statistics over ``seeds`` seeds and the FD answer on the same mesh."""
-    from stochcable.cable_timedomain import NONSTATIONARY_RATIO, simulate_line_timedomain
+    from stochcable.reference.cable import NONSTATIONARY_RATIO, simulate_line_timedomain
     from stochcable.errors import ConvergenceError
-    from stochcable.scene import load_scene
+    from stochcable.scene.model import load_scene
     from scipy import stats
 
     s = Setting("td", "reference", elements=mesh_factor, omega_max_factor=2.0,
@@ -707,7 +707,7 @@ SCENE_NOTES = {
         "pump an axial rattle of the two inner nodes at the slack–taut switches (18.9 "
         "rad/s, ωΔt = 2.4) in some seeds: the record jumps to a persistent tension σ ≈ "
         "1e4 lbf; such records are detected (window σ ratio above "
-        "stochcable.cable_timedomain.NONSTATIONARY_RATIO) and rerun at Δt/4 (listed "
+        "stochcable.reference.cable.NONSTATIONARY_RATIO) and rerun at Δt/4 (listed "
         "below). Averaging three such seeds in gave FD/TD = 0.103 in an earlier version "
         "of this report."),
 }

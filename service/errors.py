@@ -32,8 +32,8 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import JSONResponse
 
 from stochcable.errors import ConvergenceError, InputError, SolverError, StochcableError
-from stochcable.scene import field_path_and_unit
-from stochcable.units import labels_of_document
+from stochcable.scene.model import field_path_and_unit
+from stochcable.scene.units import labels_of_document
 
 from .limits import BodyTooLarge, LimitExceeded, RunTimeExceeded
 

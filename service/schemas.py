@@ -1,10 +1,10 @@
 """Request and response wrappers of the HTTP API (v1).
 
 Thin wrappers only: the spectrum documents are the core's models
-(:data:`stochcable.scene.Spectrum`, a discriminated union on ``type``), the frequency
-grid is :class:`stochcable.scene.OmegaGrid`, the time-series settings are
-:class:`stochcable.scene.TimeSeriesSettings` and the example documents are
-:class:`stochcable.scene.Scene` - one schema for the Python API, the CLI and the
+(:data:`stochcable.scene.model.Spectrum`, a discriminated union on ``type``), the frequency
+grid is :class:`stochcable.scene.model.OmegaGrid`, the time-series settings are
+:class:`stochcable.scene.model.TimeSeriesSettings` and the example documents are
+:class:`stochcable.scene.model.Scene` - one schema for the Python API, the CLI and the
 service.  Every field carries its unit in brackets in its description.
 """
 
@@ -16,8 +16,8 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from stochcable import scene as sc
-from stochcable.scene import G_STANDARD, OmegaGrid, Spectrum, TimeSeriesSettings
+from stochcable.scene import model as sc
+from stochcable.scene.model import G_STANDARD, OmegaGrid, Spectrum, TimeSeriesSettings
 
 __all__ = [
     "ErrorItem",
@@ -136,7 +136,7 @@ class SpectrumRequest(_Request):
 
 def _peak_period(spectrum: Any, g: float) -> float:
     """Shortest peak period of a spectrum document. [s]"""
-    from stochcable import spectra
+    from stochcable.sea import spectra
 
     if isinstance(spectrum, sc.PiersonMoskowitz):
         if spectrum.tp is not None:
@@ -153,9 +153,9 @@ def _peak_period(spectrum: Any, g: float) -> float:
 
 
 def default_omega(spectrum: Any, g: float = G_STANDARD) -> np.ndarray:
-    """Default grid of a spectrum document: :func:`stochcable.spectra.omega_grid` of its
+    """Default grid of a spectrum document: :func:`stochcable.sea.spectra.omega_grid` of its
     (shortest) peak period, or 200 points over a table's range. [rad/s]"""
-    from stochcable import spectra
+    from stochcable.sea import spectra
 
     if isinstance(spectrum, sc.TableSpectrum):
         return np.linspace(spectrum.omega[0], spectrum.omega[-1], DEFAULT_OMEGA_COUNT)
@@ -259,7 +259,7 @@ class ExampleSummary(_Response):
 
 # -------------------------------------------------------------------- analyses
 #
-# The result document is built by the core (stochcable.results.Result.to_document);
+# The result document is built by the core (stochcable.results.documents.Result.to_document);
 # these models only document it (the route serializes the core's dict directly).
 # Every part allows extra fields: the v1 contract lets the core add fields, never
 # rename them.  Keyed by line name where the structure is dynamic.
@@ -267,7 +267,7 @@ class ExampleSummary(_Response):
 
 class TensionStatistics(_Open):
     """Statistics of an end's effective tension: static mean plus Gaussian dynamic part
-    (seed 001 §5.3; stochcable.results.ResponseStats)."""
+    (seed 001 §5.3; stochcable.results.documents.ResponseStats)."""
 
     mean: float = _f("Static (mean) effective tension", "N")
     std: float = _f("Standard deviation σ = √m0 of the dynamic tension", "N")
@@ -406,7 +406,7 @@ class AnalysisResponse(_Open):
         "timeseries query parameter is not none")
     units: dict[str, str] | None = Field(
         default=None, description="Unit labels of the scene's consistent unit system, read "
-        "off environment.g (stochcable.units): system (SI, foot-slug-second or "
+        "off environment.g (stochcable.scene.units): system (SI, foot-slug-second or "
         "consistent), length, mass, force, time")
     bodies: dict[str, dict[str, Any]] | None = Field(
         default=None, description="Motion of each body (scenes with bodies): per DOF the "

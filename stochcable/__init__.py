@@ -6,8 +6,8 @@ time series.  Conventions (SI, rad/s, one-sided spectra, Re{X e^{iwt}}, z up) ar
 the README and DESIGN.md.
 """
 
-from ._version import __version__
-from .errors import (
+from stochcable._version import __version__
+from stochcable.errors import (
     ConvergenceError,
     InputError,
     PhysicsWarning,
@@ -19,12 +19,12 @@ from .errors import (
 # The pipeline's top-level entry points, imported on first use so that
 # ``import stochcable`` (and the CLI's start-up) stays light.
 _LAZY = {
-    "analyze": ("analysis", "analyze"),
-    "load_scene": ("scene", "load_scene"),
-    "Scene": ("scene", "Scene"),
-    "solve_statics": ("statics", "solve_statics"),
-    "natural_modes": ("modes", "natural_modes"),
-    "simulate_sea": ("sea", "simulate_sea"),
+    "analyze": ("dynamics.line", "analyze"),
+    "load_scene": ("scene.model", "load_scene"),
+    "Scene": ("scene.model", "Scene"),
+    "solve_statics": ("line.statics", "solve_statics"),
+    "natural_modes": ("line.modes", "natural_modes"),
+    "simulate_sea": ("sea.realization", "simulate_sea"),
     "load_example": ("examples", "load_example"),
 }
 

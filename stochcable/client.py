@@ -7,11 +7,11 @@
 5.997...
 
 Methods return the objects of the local API where one exists
-(:class:`~stochcable.spectra.SpectrumStatistics`, :class:`~stochcable.scene.Scene`,
-:class:`~stochcable.results.ResponseStats`) and small frozen dataclasses of numpy
+(:class:`~stochcable.sea.spectra.SpectrumStatistics`, :class:`~stochcable.scene.model.Scene`,
+:class:`~stochcable.results.documents.ResponseStats`) and small frozen dataclasses of numpy
 arrays otherwise.  :meth:`Client.analyze` returns an :class:`AnalysisDocument`: the
 result document (a read-only mapping, exactly ``analyze(scene).to_document()``) with
-typed accessors named as on the local :class:`~stochcable.results.Result`::
+typed accessors named as on the local :class:`~stochcable.results.documents.Result`::
 
     >>> with Client() as c:                                    # doctest: +SKIP
     ...     res = c.analyze(c.example("chain_catenary"))
@@ -36,10 +36,10 @@ from typing import Any
 import httpx
 import numpy as np
 
-from .errors import StochcableError
-from .results import ResponseStats
-from .scene import G_STANDARD, OmegaGrid, Scene
-from .spectra import SpectrumStatistics
+from stochcable.errors import StochcableError
+from stochcable.results.documents import ResponseStats
+from stochcable.scene.model import G_STANDARD, OmegaGrid, Scene
+from stochcable.sea.spectra import SpectrumStatistics
 
 __all__ = [
     "Client",
@@ -123,7 +123,7 @@ class RealizationResult:
         Wave acceleration at the points, shape (n_points, 3, N_t). [m/s²]
     time : numpy.ndarray
         Sample times t_n = n·dt, shape (N_t,), computed on first access (as
-        :attr:`stochcable.sea.SeaRealization.time`). [s]
+        :attr:`stochcable.sea.realization.SeaRealization.time`). [s]
     """
 
     elevation: np.ndarray
@@ -160,7 +160,7 @@ def _response_stats(doc: Mapping[str, Any]) -> ResponseStats:
 
 @dataclass(frozen=True, eq=False)
 class LineDocument:
-    """One line of an analysis result, named as on :class:`~stochcable.results.LineResult`.
+    """One line of an analysis result, named as on :class:`~stochcable.results.documents.LineResult`.
 
     Attributes
     ----------
@@ -308,11 +308,11 @@ class AnalysisDocument(Mapping[str, Any]):
 
     A read-only mapping equal to ``analyze(scene).to_document(timeseries)`` of the
     local API (apart from the ``timing`` values), plus accessors named as on
-    :class:`~stochcable.results.Result`: ``lines[name]`` is a :class:`LineDocument`
-    (``.end_b`` the core's :class:`~stochcable.results.ResponseStats`,
+    :class:`~stochcable.results.documents.Result`: ``lines[name]`` is a :class:`LineDocument`
+    (``.end_b`` the core's :class:`~stochcable.results.documents.ResponseStats`,
     ``.tension_std`` a numpy array, ...), ``timeseries`` a :class:`TimeSeriesWindow`.
     Transfer functions and full response spectra are not in the document: run
-    :func:`stochcable.analysis.analyze` locally for those.
+    :func:`stochcable.dynamics.line.analyze` locally for those.
 
     Attributes
     ----------
@@ -559,7 +559,7 @@ class Client:
             Spectral amplitude model.
         seed : int
             Random seed (numpy PCG64); the same seed gives the same record as
-            :func:`stochcable.sea.simulate_sea` locally.
+            :func:`stochcable.sea.realization.simulate_sea` locally.
         g : float
             Gravitational acceleration. [m/s²]
         points : array_like, optional
@@ -619,7 +619,7 @@ class Client:
         Parameters
         ----------
         scene : Scene or mapping
-            The scene document (:class:`~stochcable.scene.Scene`, a dict, or
+            The scene document (:class:`~stochcable.scene.model.Scene`, a dict, or
             ``client.example(name)``).
         timeseries : {"window", "full", "none"}
             Time series in the document: the first 2048 samples, all, or none.
@@ -641,7 +641,7 @@ class Client:
             or unreachable service.
         """
         if timeseries not in ("window", "full", "none"):
-            from .errors import InputError
+            from stochcable.errors import InputError
 
             raise InputError("timeseries", timeseries, "-",
                              "must be 'window', 'full' or 'none'")

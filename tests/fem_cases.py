@@ -1,6 +1,6 @@
 """Analytic static shapes for the finite-element and modal tests (owned with test_fem.py).
 
-Each builder returns (mesh, positions, tension) ready for :func:`stochcable.fem.assemble`.
+Each builder returns (mesh, positions, tension) ready for :func:`stochcable.line.fem.assemble`.
 The meshes are built directly (not from a scene) so that the prestress, the mass per
 length and the geometry are exactly those of the closed-form references.
 """
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stochcable.mesh import LineMesh
+from stochcable.line.mesh import LineMesh
 
 
 def uniform_mesh(

@@ -1,4 +1,4 @@
-"""Tests of the analysis pipeline (stochcable.analysis, stochcable.results)."""
+"""Tests of the analysis pipeline (stochcable.dynamics.line, stochcable.results.documents)."""
 
 from __future__ import annotations
 
@@ -11,12 +11,12 @@ import warnings
 import numpy as np
 import pytest
 
-from stochcable import analysis as an
+from stochcable.dynamics import line as an
 from stochcable.errors import ConvergenceError, InputError, ResolutionWarning, SolverError
-from stochcable.excitation import line_channels
-from stochcable.modes import natural_modes
-from stochcable.scene import load_scene
-from stochcable.statics import solve_statics
+from stochcable.dynamics.loads import line_channels
+from stochcable.line.modes import natural_modes
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import solve_statics
 
 # The fairlead surge spectra below have a PM ω⁻⁵ tail, so the tension spectra are cut by
 # the 2 rad/s grids (ResolutionWarning, tested in test_grid_cutting_the_response_warns);
@@ -218,7 +218,7 @@ def test_dsa_timeseries_variance_equals_spectrum_sum():
         assert np.mean(x**2) == pytest.approx(expected, rel=1e-10)
         assert abs(np.mean(x)) < 1e-9 * math.sqrt(expected)
     # the elevation is the stand-alone realization with the same seed
-    from stochcable.sea import simulate_sea
+    from stochcable.sea.realization import simulate_sea
     eta = simulate_sea(lambda w: np.where(w > 0, scene.sea.spectrum.spectral_density(
         np.where(w > 0, w, 1.0), scene.environment.g), 0.0), 400.0, 0.5, "dsa", rng=7)
     np.testing.assert_allclose(ts.elevation, eta.elevation, rtol=0, atol=1e-12)
@@ -514,8 +514,8 @@ def test_strong_current_drag_tends_to_steady_drag_tangent():
 def test_rayleigh_damping_equals_independent_linear_solve():
     """Cd = 0, no current, no seabed contact: the transfer functions are the linear
     solve of (K − ω²M_T + iω(αM_T + βK))U = F, built here from the FE matrices and the
-    sparse load assembly of stochcable.excitation (independent of the block solver)."""
-    from stochcable.excitation import prescribed_motion, wave_loads
+    sparse load assembly of stochcable.dynamics.loads (independent of the block solver)."""
+    from stochcable.dynamics.loads import prescribed_motion, wave_loads
 
     doc = chain_doc(grounded=False, sea=True, surge=True, elements=12, omega_count=25)
     for seg in doc["lines"][0]["segments"]:
@@ -594,12 +594,12 @@ def test_rayleigh_damped_taut_string_first_mode_peak():
 
 
 def test_damping_matrix_is_assembled_lazily_and_equals_drag_matrix():
-    from stochcable.excitation import drag_matrix
+    from stochcable.dynamics.loads import drag_matrix
 
     import json
     from pathlib import Path
 
-    path = Path(an.__file__).parent / "examples" / "chain_catenary.json"
+    path = Path(an.__file__).parents[1] / "examples" / "chain_catenary.json"
     scene = load_scene(json.loads(path.read_text()))
     st = solve_statics(scene)
     line = scene.lines[0]
@@ -777,7 +777,7 @@ def test_warnings_and_document_use_the_scene_units_in_feet(monkeypatch) -> None:
     """Tuah (1982) single leg is in feet, slugs and pounds-force (g = 32.17 ft/s²): the
     snap, element-resolution and large-motion warnings give its forces in lbf and
     lengths in ft (they said N and m), and the result document names the system."""
-    from stochcable.units import FOOT_SLUG_SECOND
+    from stochcable.scene.units import FOOT_SLUG_SECOND
 
     # a zero sag threshold forces the large-motion warning, so all three are checked
     monkeypatch.setattr(an, "MOTION_SAG_FRACTION", 0.0)
@@ -808,7 +808,7 @@ def test_pipeline_statistics_equal_the_validated_public_function() -> None:
     """The analysis' end statistics skip the second validation of its grid
     (results._stats_from_validated) and equal results.stats_from_spectrum to the bit; the
     public function still rejects a bad grid with its message."""
-    from stochcable.results import _stats_from_validated, stats_from_spectrum
+    from stochcable.results.documents import _stats_from_validated, stats_from_spectrum
 
     rng = np.random.default_rng(5)
     w = np.linspace(0.05, 2.0, 120)

@@ -1,4 +1,4 @@
-"""Validation of :func:`stochcable.analysis.analyze` against independent references
+"""Validation of :func:`stochcable.dynamics.line.analyze` against independent references
 (GitHub issue 4, "Must be shown by tests"): the realization's convolution identity,
 Foss at a mode crossover (Irvine's λ² = 4π², seed 000) and with exactly repeated
 eigenvalues (taut wire), the Cd = 0 limit against the closed-form transfer function of
@@ -16,9 +16,9 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.analysis import analyze
-from stochcable.kinematics import wave_kinematics
-from stochcable.sea import simulate_sea, synthesize
+from stochcable.dynamics.line import analyze
+from stochcable.sea.kinematics import wave_kinematics
+from stochcable.sea.realization import simulate_sea, synthesize
 
 # Undamped and lightly damped test cases put natural frequencies inside the grid on
 # purpose; the ResolutionWarning they raise is tested in tests/test_analysis.py.
@@ -273,7 +273,7 @@ def test_taut_wire_3d_repeated_pairs_foss_equals_direct():
     w = foss.modes_omega
     # the transverse pairs are exactly repeated (round-off of the eigensolver)
     tension = 1.0e8 * (200.0 / 199.8 - 1.0)
-    # structural and added mass both per unstretched length (stochcable.fem)
+    # structural and added mass both per unstretched length (stochcable.line.fem)
     m = (20.0 + 1025.0 * math.pi * 0.1**2 / 4.0) * 199.8 / 200.0
     c = math.sqrt(tension / m)
     h = 200.0 / 20
@@ -471,7 +471,7 @@ def _normal_velocity_sigma_and_amplitude(res, name: str) -> tuple[np.ndarray, np
     a, b = pos[:-1], pos[1:]
     pts = a[:, None, :] + xi[None, :, None] * (b - a)[:, None, :]  # (n_el, q, 3)
     # grounded nodes rest a penalty penetration w/(kD) below z = -depth: the
-    # kinematics are evaluated at the seabed there, as stochcable.excitation does
+    # kinematics are evaluated at the seabed there, as stochcable.dynamics.loads does
     flat = pts.reshape(-1, 3).copy()
     flat[:, 2] = np.maximum(flat[:, 2], -env.depth)
     kin = wave_kinematics(w, flat, scene.sea.heading_rad, env.depth, env.g)

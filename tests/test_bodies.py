@@ -1,11 +1,11 @@
-"""Rigid bodies and their rigid-link coupling to lines (stochcable.bodies).
+"""Rigid bodies and their rigid-link coupling to lines (stochcable.bodies.rigid).
 
 Independent checks: closed-form transfer functions of bodies on springs (matrices
 written out by hand); the rigid link against finite rotations (scipy Rotation); the
 rigid-body mass matrix against the kinetic energy of a cloud of point masses; the
 infinite-mass limit against the line with a prescribed end; symmetry and reciprocity
 of the coupled matrices; the attachment geometric stiffness against central finite
-differences of the line statics (stochcable.statics) at rotated and displaced body
+differences of the line statics (stochcable.line.statics) at rotated and displaced body
 poses; the Schur direct solve against the dense one.
 """
 
@@ -19,7 +19,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from fem_cases import taut_string, uniform_mesh
-from stochcable.bodies import (
+from stochcable.bodies.rigid import (
     ExcitationTable,
     FrequencyTable,
     LineLink,
@@ -36,10 +36,10 @@ from stochcable.bodies import (
     solve_coupled_direct,
 )
 from stochcable.errors import InputError, SolverError
-from stochcable.fem import assemble, build_fe_model
-from stochcable.mesh import mesh_line
-from stochcable.scene import Environment, Line
-from stochcable.statics import solve_line_statics
+from stochcable.line.fem import assemble, build_fe_model
+from stochcable.line.mesh import mesh_line
+from stochcable.scene.model import Environment, Line
+from stochcable.line.statics import solve_line_statics
 
 RHO = 1025.0
 

@@ -1,4 +1,4 @@
-"""Hydrodynamic coefficient readers (stochcable.body_data).
+"""Hydrodynamic coefficient readers (stochcable.bodies.data).
 
 Independent checks: a dataset written with xarray in Capytaine's layout (names from
 capytaine.io.xarray.assemble_dataset) read back exactly, complex split and merged, DOFs
@@ -17,8 +17,8 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.bodies import body_excitation
-from stochcable.body_data import (
+from stochcable.bodies.rigid import body_excitation
+from stochcable.bodies.data import (
     body_from_hydrodynamics,
     load_hydrodynamics,
     read_capytaine,

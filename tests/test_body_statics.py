@@ -1,4 +1,4 @@
-"""Tests of stochcable.body_statics: static equilibrium of bodies and their lines.
+"""Tests of stochcable.bodies.statics: static equilibrium of bodies and their lines.
 
 Checked against: the closed form of a buoy on a vertical elastic tether; central
 finite differences of the statics for the reported stiffness; the independent
@@ -18,14 +18,14 @@ from _scenes import three_chain_legs
 import pytest
 from scipy.spatial.transform import Rotation
 
-from stochcable.body_scene import scene_rigid_bodies
-from stochcable.body_statics import BodyStatics, body_static_load, solve_body_statics
+from stochcable.bodies.from_scene import scene_rigid_bodies
+from stochcable.bodies.statics import BodyStatics, body_static_load, solve_body_statics
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.examples import load_example
-from stochcable.fem import build_fe_model
-from stochcable.mesh import mesh_line
-from stochcable.scene import load_scene
-from stochcable.statics import solve_line_statics, solve_statics
+from stochcable.line.fem import build_fe_model
+from stochcable.line.mesh import mesh_line
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import solve_line_statics, solve_statics
 
 RHO, G = 1025.0, 9.80665
 
@@ -377,9 +377,9 @@ def _dense_end_stiffness(ls, env, ends, planar):
 @pytest.mark.parametrize("ends", [["end_b"], ["end_a", "end_b"]])
 def test_end_condensation_matches_dense_schur(planar, ends):
     """The banded condensation of the line tangent equals the dense Schur complement
-    of stochcable.fem's assembled K (grounded nodes and seabed springs included), and
+    of stochcable.line.fem's assembled K (grounded nodes and seabed springs included), and
     its interior map predicts the re-solved shape to second order in the end motion."""
-    from stochcable.body_statics import _end_condensation
+    from stochcable.bodies.statics import _end_condensation
 
     # buoy at its symmetric pose: leg1 in the x–z plane (planar model), leg2 at 120°
     # (3-D); the end motions below keep the seabed contact set (a node lifting off is
@@ -414,7 +414,7 @@ def test_end_condensation_matches_dense_schur(planar, ends):
 def test_cross3_is_numpy_cross_to_the_bit():
     """The body Newton's moment arm × force (_cross3, issue 6 pass E6) is np.cross's
     products and differences: the same bits, signed zeros included."""
-    from stochcable.body_statics import _cross3
+    from stochcable.bodies.statics import _cross3
 
     rng = np.random.default_rng(17)
     for _ in range(200):
@@ -429,7 +429,7 @@ def test_reported_stiffness_is_the_public_mooring_stiffness_at_the_pose():
     """The statics' memoized end positions (issue 6 pass E6) are those of
     Scene.end_position: the reported body stiffness at a rotated, offset pose is the
     body's own stiffness plus mooring_stiffness (which asks the scene) to the bit."""
-    from stochcable.body_statics import mooring_stiffness
+    from stochcable.bodies.statics import mooring_stiffness
 
     scene = _spread(wind=(40.0, 25.0, 0.0))
     st = solve_statics(scene, method="fe")

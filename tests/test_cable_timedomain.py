@@ -1,9 +1,9 @@
-"""Tests of the nonlinear time-domain reference (stochcable.cable_timedomain).
+"""Tests of the nonlinear time-domain reference (stochcable.reference.cable).
 
 Every check compares the time-domain (TD) simulation with something independent: the
 statics module (static start), the frequency-domain finite-element matrices of
-:mod:`stochcable.fem` / :mod:`stochcable.excitation` solved directly (harmonic and
-linear-limit tests), and :func:`stochcable.analysis.analyze` (statistics and the
+:mod:`stochcable.line.fem` / :mod:`stochcable.dynamics.loads` solved directly (harmonic and
+linear-limit tests), and :func:`stochcable.dynamics.line.analyze` (statistics and the
 synthesized series of the same realization).
 """
 
@@ -16,12 +16,12 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.cable_timedomain import newmark_period_error, simulate_line_timedomain
+from stochcable.reference.cable import newmark_period_error, simulate_line_timedomain
 from stochcable.errors import ConvergenceError, InputError, ResolutionWarning
-from stochcable.fem import assemble
-from stochcable.mesh import mesh_line
-from stochcable.scene import load_scene
-from stochcable.statics import solve_statics
+from stochcable.line.fem import assemble
+from stochcable.line.mesh import mesh_line
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import solve_statics
 
 
 # ---------------------------------------------------------------------------- scenes
@@ -179,10 +179,10 @@ def _fd_series_fem(scene, hist):
     synthesized with the realization's coefficients; F the Morison inertia and
     linearized drag loads integrated exactly along the elements
     (excitation.wave_loads with the element_wave_kinematics moments)."""
-    from stochcable.excitation import (Channel, drag_matrix, element_wave_kinematics,
+    from stochcable.dynamics.loads import (Channel, drag_matrix, element_wave_kinematics,
                                        wave_loads)
-    from stochcable.kinematics import wave_kinematics
-    from stochcable.sea import synthesize
+    from stochcable.sea.kinematics import wave_kinematics
+    from stochcable.sea.realization import synthesize
 
     env = scene.environment
     real = hist._meta["realization"]
@@ -226,7 +226,7 @@ def test_linear_limit_same_realization_equals_fe_synthesis():
     sel = real.time >= hist.ramp
     # expected error: drag nonlinearity σ_v/U (σ_v the wave velocity σ at the top
     # node), plus the Newmark period error at the highest excitation frequency
-    from stochcable.sea import synthesize
+    from stochcable.sea.realization import synthesize
 
     sigma_v = synthesize(real, kin.velocity[-2, 0]).std()
     tol = sigma_v / u0 + newmark_period_error(hist._meta["omega_max"], hist.dt)
@@ -241,7 +241,7 @@ def test_linear_limit_same_realization_equals_fe_synthesis():
 def test_linear_limit_same_realization_equals_analysis_series():
     # The product's own synthesized end-tension series (analyze, same seed, same
     # band) against the TD end tension: the same realization drives both.
-    from stochcable.analysis import analyze
+    from stochcable.dynamics.line import analyze
 
     scene = _taut(hs=0.1, cd=1.2, current=1.0,
                   ts={"duration": 256.0, "dt": 0.25, "seed": 7})
@@ -306,7 +306,7 @@ def test_sigma_frequency_domain_vs_time_domain(case):
 
 
 def analyze_scene(scene):
-    from stochcable.analysis import analyze
+    from stochcable.dynamics.line import analyze
 
     return analyze(scene)
 
@@ -321,7 +321,7 @@ def test_unknown_line_and_bad_inputs():
     with pytest.raises(InputError, match=r"ramp = 100.0 \[s\]: must be shorter than the duration"):
         simulate_line_timedomain(scene, ramp=100.0)
     with pytest.raises(InputError, match=r"duration = 100.0 \[s\]: must be <= the realization's length 64 s"):
-        from stochcable.sea import simulate_sea
+        from stochcable.sea.realization import simulate_sea
 
         real = simulate_sea(lambda w: np.exp(-((w - 1.0) ** 2)) * 1e-3, 64.0, 0.25, rng=1)
         simulate_line_timedomain(scene, realization=real, duration=100.0)
@@ -353,7 +353,7 @@ def test_drag_quadrature_is_the_consistent_integral():
     # c_n (α + βξ)² (−n) and the consistent nodal load has the closed form
     # F_a = −c_n l0 n ∫(1 − ξ)(α + βξ)² dξ = −c_n l0 n (α²/2 + αβ/3 + β²/12),
     # F_b = −c_n l0 n (α²/2 + 2αβ/3 + β²/4) (degree 3: 3-point Gauss is exact).
-    from stochcable.cable_timedomain import _LineModel
+    from stochcable.reference.cable import _LineModel
 
     scene = _taut(hs=0.0, cd=1.2)
     env = scene.environment
@@ -409,7 +409,7 @@ def _element_rows(model, X, V, e, u_n, u_g, j):
 
 def _history(t, tension):
     """A CableTimeHistory holding only end tensions (the stationarity check's input)."""
-    from stochcable.cable_timedomain import CableTimeHistory
+    from stochcable.reference.cable import CableTimeHistory
 
     n = t.size
     return CableTimeHistory(
@@ -451,7 +451,7 @@ def test_nonstationary_record_warning_is_wired(monkeypatch):
     the warning fires exactly when the window ratio passes the threshold (lowered
     below the measured ratio of a stationary run), with the dominant frequency and the
     step advice.  About 3 s."""
-    import stochcable.cable_timedomain as ctd
+    import stochcable.reference.cable as ctd
     from stochcable.examples import load_example
 
     scene = load_example("tuah_1982_single_leg")

@@ -1,4 +1,4 @@
-"""Tests of stochcable.catenary: the closed-form elastic catenary (Irvine 1981).
+"""Tests of stochcable.line.catenary: the closed-form elastic catenary (Irvine 1981).
 
 Independent references: numerical quadrature of the cable equations dx/ds = H/T + H/EA,
 dz/ds = V/T + V/EA (a second method for every closure), the classic inextensible
@@ -16,8 +16,8 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 
 from references import BLIET_1984_GUY, TUAH_1982_EX2, TUAH_1982_EX2_ELASTIC_CATENARY
-from stochcable import catenary as cat
-from stochcable.catenary import (
+from stochcable.line import catenary as cat
+from stochcable.line.catenary import (
     catenary_from_top_tension,
     catenary_line,
     catenary_multisegment,
@@ -25,8 +25,8 @@ from stochcable.catenary import (
 )
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.examples import load_example
-from stochcable.mesh import mesh_line
-from stochcable.scene import Attachment
+from stochcable.line.mesh import mesh_line
+from stochcable.scene.model import Attachment
 
 CHAIN_W = (288.0 - 1025.0 * math.pi * 0.216**2 / 4.0) * 9.80665  # DESIGN.md chain [N/m]
 CHAIN_EA = 1.2326e9

@@ -9,7 +9,7 @@ import pytest
 
 from stochcable.cli import main
 
-pytest.importorskip("stochcable.statics")
+pytest.importorskip("stochcable.line.statics")
 
 from test_modes import TAUT_SCENE, taut_scene_reference  # noqa: E402
 

@@ -19,14 +19,14 @@ import stochcable.errors
 from service.app import create_app
 from service.settings import Settings
 from _compare import assert_close_documents
-from stochcable.analysis import analyze
+from stochcable.dynamics.line import analyze
 from stochcable.client import AnalysisDocument, Client, ClientError, ServiceError
 from stochcable.examples import load_example
-from stochcable.kinematics import kinematics_timeseries
-from stochcable.results import ResponseStats
-from stochcable.scene import Jonswap, OmegaGrid, Scene
-from stochcable.sea import simulate_sea
-from stochcable.spectra import SpectrumStatistics, spectrum_statistics
+from stochcable.sea.kinematics import kinematics_timeseries
+from stochcable.results.documents import ResponseStats
+from stochcable.scene.model import Jonswap, OmegaGrid, Scene
+from stochcable.sea.realization import simulate_sea
+from stochcable.sea.spectra import SpectrumStatistics, spectrum_statistics
 
 JONSWAP = Jonswap(hs=4.0, tp=8.0)
 

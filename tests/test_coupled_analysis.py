@@ -1,10 +1,10 @@
-"""Coupled lines–bodies dynamics (stochcable.coupled_analysis).
+"""Coupled lines–bodies dynamics (stochcable.dynamics.coupled).
 
 Independent checks: a body on springs against its transfer function written out by
 hand (and its drag fixed point against the seed's linearized-drag formula); the
 infinite-mass limit against the independent line analysis with the equivalent
-prescribed end motion (stochcable.analysis); the substructured solve against the
-assembled coupled system of stochcable.bodies (couple + solve_coupled_direct); Foss
+prescribed end motion (stochcable.dynamics.line); the substructured solve against the
+assembled coupled system of stochcable.bodies.rigid (couple + solve_coupled_direct); Foss
 with all modes against direct; the 120° symmetry of a three-leg mooring; the vessel
 fairlead motion against finite rotations.
 """
@@ -19,7 +19,7 @@ from _scenes import three_chain_legs
 import pytest
 from scipy.spatial.transform import Rotation
 
-from stochcable.analysis import (
+from stochcable.dynamics.line import (
     _inputs,
     _loads,
     _to_freq,
@@ -27,7 +27,7 @@ from stochcable.analysis import (
     line_result,
     linearize,
 )
-from stochcable.bodies import (
+from stochcable.bodies.rigid import (
     ExcitationTable,
     LineLink,
     RigidBody,
@@ -36,7 +36,7 @@ from stochcable.bodies import (
     expand_line,
     solve_coupled_direct,
 )
-from stochcable.coupled_analysis import (
+from stochcable.dynamics.coupled import (
     BodyLoads,
     CoupledLine,
     body_loads,
@@ -46,9 +46,9 @@ from stochcable.coupled_analysis import (
     linearize_coupled,
 )
 from stochcable.errors import InputError
-from stochcable.excitation import Channel, line_channels
-from stochcable.scene import load_scene
-from stochcable.statics import solve_statics
+from stochcable.dynamics.loads import Channel, line_channels
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import solve_statics
 
 RHO = 1025.0
 
@@ -211,7 +211,7 @@ def _single_leg_doc(motion=None):
 def test_infinite_body_mass_equals_line_with_moving_end():
     """A planar body of mass 1e15 kg excited by F = −ω²M ξ moves with ξ; its line
     must equal the independent analysis of the line whose end moves with the RAO
-    T(r)ξ (stochcable.analysis, the existing moving-end path)."""
+    T(r)ξ (stochcable.dynamics.line, the existing moving-end path)."""
     scene = load_scene(_single_leg_doc())
     w = scene.analysis.omega.values()
     xi = np.stack([0.6 * np.exp(0.7j * w), 0.9 + 0.1j * w, 0.02j * np.ones_like(w)])
@@ -254,7 +254,7 @@ def test_infinite_body_mass_equals_line_with_moving_end():
 
 def test_substructure_equals_assembled_coupled_system(mooring_direct):
     """The substructured response at the converged drag equals the assembled system
-    of stochcable.bodies (couple + coupled_load + solve_coupled_direct, dense)."""
+    of stochcable.bodies.rigid (couple + coupled_load + solve_coupled_direct, dense)."""
     scene, cls, loads, body, lin = mooring_direct
     w = scene.analysis.omega.values()
     links, line_loads = [], {}
@@ -265,11 +265,11 @@ def test_substructure_equals_assembled_coupled_system(mooring_direct):
                               damping=damp.matrix))
         inp = _inputs(cl.system, cl.channels)
         line_loads[cl.name] = _to_freq(_loads(cl.system, inp, damp))
-    from stochcable.coupled_analysis import _body_drag
+    from stochcable.dynamics.coupled import _body_drag
 
     bb, cdrag = _body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
     system = couple(links, [body], body_damping={"buoy": cdrag})
-    from stochcable.bodies import rigid_link_matrix
+    from stochcable.bodies.rigid import rigid_link_matrix
 
     t = rigid_link_matrix(body.drag_point)
     fb = loads["buoy"].force + np.einsum("ij,wjc->wic", t.T * bb[None], loads["buoy"].velocity)
@@ -314,7 +314,7 @@ def test_foss_all_modes_equals_direct_and_truncated_close(mooring_direct):
 def test_frequency_dependent_tables_exact_in_both_solvers(mooring_direct):
     """With A(ω), B(ω) tables both solvers stay exact on the body: the direct and the
     all-modes Foss analysis agree (no frozen matrices)."""
-    from stochcable.bodies import FrequencyTable
+    from stochcable.bodies.rigid import FrequencyTable
 
     scene, cls, loads, body0, lin_const = mooring_direct
     tw = np.array([0.05, 1.0, 2.5])
@@ -441,8 +441,8 @@ def test_errors(mooring_direct):
 
 from types import SimpleNamespace  # noqa: E402
 
-from stochcable.coupled_analysis import analyze_coupled  # noqa: E402
-from stochcable.results import Result  # noqa: E402
+from stochcable.dynamics.coupled import analyze_coupled  # noqa: E402
+from stochcable.results.documents import Result  # noqa: E402
 
 
 def _attached_scene(scene, attach, bodies):
@@ -569,7 +569,7 @@ def test_free_floating_body_without_lines_closed_form():
     statics = solve_statics(scene, method="fe")
     lines, bodies, _, _ = analyze_coupled(fake, statics, scene.analysis,
                                           rigid_bodies={"float": body})
-    from stochcable.kinematics import wavenumber
+    from stochcable.sea.kinematics import wavenumber
 
     k = wavenumber(w, scene.environment.depth)
     expected = f[0, 2] * np.exp(-1j * k * 100.0) / (k33 - w**2 * (m + a33) + 1j * w * b33)
@@ -581,7 +581,7 @@ def test_free_floating_body_without_lines_closed_form():
 def test_body_gravity_stiffness_metacentric_terms():
     """Weight at the CoG and buoyancy at the CoB give roll/pitch restoring
     ρg∇z_B − m g z_G (hand formula), nothing on translations or yaw."""
-    from stochcable.coupled_analysis import body_gravity_stiffness
+    from stochcable.dynamics.coupled import body_gravity_stiffness
 
     m, zg, zb, vol, g = 3e4, -1.5, -0.4, 40.0, 9.81
     body = RigidBody("s", [0, 0, -10.0], m, cog=[0.0, 0.0, zg])
@@ -668,7 +668,7 @@ def test_scene_three_leg_example_mirror_symmetry():
 
 def _count_full_evaluations(monkeypatch, n_omega):
     """Count the group solves on the full grid of ``n_omega`` frequencies."""
-    import stochcable.coupled_analysis as ca
+    import stochcable.dynamics.coupled as ca
 
     count = [0]
     solve = ca._solve_group
@@ -688,7 +688,7 @@ def test_coarse_start_gives_the_full_grid_fixed_point(solver, monkeypatch):
     change below tol = 1e-8 with a contraction ≈ 0.1, so each is within ~tol of the
     fixed point: σ and the outputs agree to 1e-6 (100·tol, margin for the transfer
     functions' amplification of the σ error)."""
-    from stochcable.coupled_analysis import _coarse_subset, _Group
+    from stochcable.dynamics.coupled import _coarse_subset, _Group
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver=solver, tol=1e-8), body)
@@ -728,7 +728,7 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
     mooring: the stride-4 subset's σ are ~4 % off, the corrected rounds gain ~30x
     each), with or without the rounds' warm step, and the answer is the full-grid
     fixed point within the tolerance."""
-    import stochcable.coupled_analysis as ca
+    import stochcable.dynamics.coupled as ca
 
     monkeypatch.setattr(ca, "_WARM_ROUNDS", warm)
     body = _buoy()
@@ -749,7 +749,7 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
 
 def test_coarse_subset_skipped_on_small_grids(mooring_direct):
     """40 frequencies (< COARSE_MIN_FREQUENCIES): no coarse stage."""
-    from stochcable.coupled_analysis import COARSE_MIN_FREQUENCIES, _coarse_subset, _Group
+    from stochcable.dynamics.coupled import COARSE_MIN_FREQUENCIES, _coarse_subset, _Group
 
     scene, cls, loads, body, lin = mooring_direct
     assert cls[0].channels[0].omega.size < COARSE_MIN_FREQUENCIES
@@ -759,7 +759,7 @@ def test_coarse_subset_skipped_on_small_grids(mooring_direct):
 def test_sliced_channel_inputs_equal_the_subset_of_the_full_inputs(mooring_direct):
     """A channel restricted to a frequency subset gives the full channel's loads at
     those frequencies (every array sliced along its frequency axis)."""
-    from stochcable.coupled_analysis import _sliced_channel
+    from stochcable.dynamics.coupled import _sliced_channel
 
     scene, cls, loads, body, lin = mooring_direct
     s = cls[0].system
@@ -778,8 +778,8 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     is the plain analysis._solve_free of the augmented channels: the same linear
     system, so equal to round-off (1e-10 of the largest entry), truncated (8 of 27
     modes, static correction on) or not."""
-    from stochcable.analysis import _solve_free, drag_coefficients
-    from stochcable.coupled_analysis import _foss_unit_split, _Group
+    from stochcable.dynamics.line import _solve_free, drag_coefficients
+    from stochcable.dynamics.coupled import _foss_unit_split, _Group
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
@@ -801,7 +801,7 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
 
 def test_all_dofs_fixed_equals_lines_with_fixed_fairleads():
     """A buoy with all six DOFs in ``fixed_dofs`` holds its fairleads: each leg is the
-    independent analysis (stochcable.analysis.linearize) of the leg with its fairlead
+    independent analysis (stochcable.dynamics.line.linearize) of the leg with its fairlead
     fixed at the same static point; the body does not move."""
     body = _buoy(fixed_dofs=("surge", "sway", "heave", "roll", "pitch", "yaw"))
     scene, cls, loads = _group(_mooring_doc(), body)
@@ -877,11 +877,11 @@ def test_fixed_dofs_direct_equals_foss_all_modes():
 @pytest.mark.parametrize("method", ["full", "reduced"])
 def test_fixed_dofs_modes_are_the_constrained_eigenproblem(mooring_direct, method):
     """Coupled modes with heave and yaw fixed: the frequencies of the dense constrained
-    eigenproblem (the assembled K, M of stochcable.bodies.couple without the fixed
+    eigenproblem (the assembled K, M of stochcable.bodies.rigid.couple without the fixed
     rows and columns); the fixed DOFs are zero in the shapes."""
     import scipy.linalg as sla
 
-    from stochcable.bodies import constant_matrices
+    from stochcable.bodies.rigid import constant_matrices
 
     scene, cls, _, body0, _ = mooring_direct
     body = dataclasses.replace(body0, fixed_dofs=("heave", "yaw"))
@@ -919,7 +919,7 @@ def test_fixed_dofs_validation_and_scene():
               hydrostatic_stiffness=None, fixed_dofs=("yaw",))
     assert _buoy(fixed_dofs="yaw").fixed_dofs == ("yaw",)
     np.testing.assert_array_equal(_buoy(fixed_dofs=("sway", "yaw")).free_index, [0, 2, 3, 4])
-    from stochcable.body_scene import scene_rigid_bodies
+    from stochcable.bodies.from_scene import scene_rigid_bodies
 
     doc = _mooring_doc()
     doc["bodies"] = [{"name": "buoy", "position": [0.0, 0.0, 0.0], "mass": 2.0e4,
@@ -946,7 +946,7 @@ def test_fixed_dofs_validation_and_scene():
 def test_coarse_start_falls_back_to_the_full_grid(monkeypatch):
     """A coarse model that fails (a singular modal impedance) is skipped: the full-grid
     iteration alone runs, the same evaluations as ``coarse=False``."""
-    import stochcable.coupled_analysis as ca
+    import stochcable.dynamics.coupled as ca
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver="foss", tol=1e-4), body)
@@ -967,7 +967,7 @@ def test_warm_step_is_the_fixed_point_of_an_affine_map():
     step over secant pairs: for an affine map y -> r·(A y + b) in n dimensions, n + 1
     affinely independent pairs give its fixed point exactly (closed form
     (I − diag(r) A)⁻¹ diag(r) b; tolerance: round-off of a 3×3 solve)."""
-    from stochcable.coupled_analysis import _warm_step
+    from stochcable.dynamics.coupled import _warm_step
 
     rng = np.random.default_rng(3)
     a = 0.3 * rng.standard_normal((3, 3))
@@ -988,11 +988,11 @@ def test_large_static_body_rotation_is_flagged():
     examples (0.45° and 0.12°) get none."""
     import warnings
 
-    from stochcable.analysis import analyze
-    from stochcable.coupled_analysis import STATIC_ROTATION_LIMIT
+    from stochcable.dynamics.line import analyze
+    from stochcable.dynamics.coupled import STATIC_ROTATION_LIMIT
     from stochcable.errors import PhysicsWarning
     from stochcable.examples import load_example
-    from stochcable.scene import load_scene
+    from stochcable.scene.model import load_scene
 
     doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json",
                                                                      exclude_none=True)

@@ -1,5 +1,5 @@
-"""Time series of lines coupled to bodies and of the bodies (stochcable.coupled_timeseries,
-stochcable.analysis.simulate_timeseries with ``coupled=``; GitHub issue 6).
+"""Time series of lines coupled to bodies and of the bodies (stochcable.dynamics.coupled_timeseries,
+stochcable.dynamics.line.simulate_timeseries with ``coupled=``; GitHub issue 6).
 
 Independent checks: the DSA variance of every series against the band sum of the
 response spectrum of the transfer synthesized (Parseval, round-off) and against the
@@ -7,7 +7,7 @@ frequency-domain σ of the Result (a separate solve on the analysis grid); the s
 against the direct O(N²) circular convolution of η and of the end-motion realization
 with the impulse responses of the Result's transfer functions (seed 001 §5.1: one
 realization drives everything); the infinitely heavy (fixed) body against the line
-with a fixed fairlead (stochcable.analysis, the independent path); NSA variances
+with a fixed fairlead (stochcable.dynamics.line, the independent path); NSA variances
 against their exact sampling distribution; the chunked solve against the one-piece
 solve; the vessel (prescribed body) and its riser against the RAO.
 
@@ -26,11 +26,11 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from stochcable.analysis import analyze
-from stochcable.coupled_timeseries import coupled_group_transfer, frequency_chunks
+from stochcable.dynamics.line import analyze
+from stochcable.dynamics.coupled_timeseries import coupled_group_transfer, frequency_chunks
 from stochcable.errors import InputError
 from stochcable.examples import load_example
-from stochcable.sea import simulate_sea
+from stochcable.sea.realization import simulate_sea
 
 # The example's 3-element leg has large motions (its warnings are the subject of
 # other tests); the grid cuts the PM end-motion tail on purpose.
@@ -387,7 +387,7 @@ def test_chunked_solve_equals_one_piece(dsa_result):
     """The band solved in chunks of 64 frequencies equals the one-piece solve (the
     solve is independent per frequency: round-off)."""
     res, _ = dsa_result
-    from stochcable.coupled_analysis import analyze_coupled
+    from stochcable.dynamics.coupled import analyze_coupled
 
     scene = res.scene
     out = analyze_coupled(scene, res.statics, scene.analysis)
@@ -406,7 +406,7 @@ def test_chunked_solve_equals_one_piece(dsa_result):
 
 def test_group_transfer_refuses_bad_frequencies(dsa_result):
     res, _ = dsa_result
-    from stochcable.coupled_analysis import analyze_coupled
+    from stochcable.dynamics.coupled import analyze_coupled
 
     (group,) = analyze_coupled(res.scene, res.statics, res.scene.analysis).groups
     with pytest.raises(InputError, match=r"omega.*rad/s"):

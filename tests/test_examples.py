@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 
 from references import BLIET_1984_GUY, TUAH_1982_EX2, TUAH_1982_EX5
-from stochcable.catenary import catenary_line
+from stochcable.line.catenary import catenary_line
 from stochcable.errors import InputError
 from stochcable.examples import list_examples, load_example
-from stochcable.mesh import mesh_line
+from stochcable.line.mesh import mesh_line
 
 ROOT = Path(__file__).resolve().parents[1]
 PKG = ROOT / "stochcable" / "examples"

@@ -1,4 +1,4 @@
-"""Tests of stochcable.excitation: input channels and hydrodynamic matrices."""
+"""Tests of stochcable.dynamics.loads: input channels and hydrodynamic matrices."""
 
 from __future__ import annotations
 
@@ -7,18 +7,18 @@ import math
 import numpy as np
 import pytest
 
-from stochcable import analysis as an
+from stochcable.dynamics import line as an
 from stochcable.errors import InputError
-from stochcable.excitation import (
+from stochcable.dynamics.loads import (
     drag_matrix,
     element_frames,
     inertia_matrix,
     line_channels,
     prescribed_motion,
 )
-from stochcable.kinematics import wave_kinematics
-from stochcable.scene import load_scene
-from stochcable.statics import solve_statics
+from stochcable.sea.kinematics import wave_kinematics
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import solve_statics
 
 RHO = 1025.0
 G = 9.80665
@@ -180,8 +180,8 @@ def test_fully_wet_exp_moments_are_the_general_formula():
     """_exp_moments drops the factors 1 and 0 when every element is wet over its whole
     length (the speed pass of issue 4); the general expressions give the same numbers
     to the bit (x·1 and 0 + x are exact), growing and decaying exponents alike."""
-    from stochcable.excitation import _complex, _exp_moments, _phi1_psi
-    from stochcable.kinematics import _wavenumber
+    from stochcable.dynamics.loads import _complex, _exp_moments, _phi1_psi
+    from stochcable.sea.kinematics import _wavenumber
 
     def general(e0, alpha, p, q):  # the formula for any wet part [p, q]
         length = q - p
@@ -211,10 +211,10 @@ def test_fully_wet_exp_moments_are_the_general_formula():
 def test_sea_nodal_kinematics_are_computed_on_first_access_only():
     """The sea channel's nodal velocity/acceleration (used by attachments only) are
     computed when first read, once for both fields, and equal the nodal kinematics of
-    stochcable.kinematics.wave_kinematics; explicit fields are kept as given."""
+    stochcable.sea.kinematics.wave_kinematics; explicit fields are kept as given."""
     import dataclasses
 
-    from stochcable.excitation import Channel
+    from stochcable.dynamics.loads import Channel
 
     scene, system = built(straight_doc())
     w = scene.analysis.omega.values()
@@ -255,9 +255,9 @@ def test_second_exponent_shares_phi_psi_by_conjugation():
     and the φ1 of ∫e^{−2k(z+2h)} as that of ∫e^{2kz} (issue 6 pass E6): the moments
     equal those of their own φ1, ψ to the bit, for rising, sinking and horizontal
     elements, at ω = 0, fully wet (the short path) and partly wet (the general one)."""
-    from stochcable.excitation import (_complex, _exp_integral, _exp_moments,
+    from stochcable.dynamics.loads import (_complex, _exp_integral, _exp_moments,
                                        _moment_argument, _phi1_psi)
-    from stochcable.kinematics import _wavenumber
+    from stochcable.sea.kinematics import _wavenumber
 
     rng = np.random.default_rng(13)
     h = 150.0

@@ -1,4 +1,4 @@
-"""Finite-element model (stochcable.fem): element matrices, assembly, partition.
+"""Finite-element model (stochcable.line.fem): element matrices, assembly, partition.
 
 Independent checks: the element stiffness against a central finite difference of the
 element end force T(l)·e with T = EA(l − l0)/l0 (its exact derivative, seed 001
@@ -17,7 +17,7 @@ import scipy.sparse as sp
 
 from fem_cases import hanging_chain, shallow_parabola, taut_string, uniform_mesh
 from stochcable.errors import InputError
-from stochcable.fem import (
+from stochcable.line.fem import (
     SLACK_EA_RATIO,
     FEModel,
     assemble,
@@ -26,8 +26,8 @@ from stochcable.fem import (
     element_mass,
     element_stiffness,
 )
-from stochcable.modes import natural_modes
-from stochcable.scene import Environment, Seabed
+from stochcable.line.modes import natural_modes
+from stochcable.scene.model import Environment, Seabed
 
 RHO = 1025.0
 G = 9.80665
@@ -231,8 +231,8 @@ def test_build_fe_model_from_line_statics():
 
 
 def test_build_fe_model_with_solved_statics():
-    statics = pytest.importorskip("stochcable.statics")
-    from stochcable.scene import load_scene
+    statics = pytest.importorskip("stochcable.line.statics")
+    from stochcable.scene.model import load_scene
 
     scene = load_scene({
         "environment": {"depth": 200.0},
@@ -283,7 +283,7 @@ def test_chain_csr_equals_the_coo_assembly(dim):
     the COO assembly it replaced (fem._assemble_sparse): the same pattern (explicit
     zeros kept) and the same entries; the diagonal blocks sum two element blocks and a
     nodal diagonal in another order, so 1e-15 relative (a few ulp)."""
-    from stochcable.fem import _assemble_sparse, _chain_csr, _element_dofs
+    from stochcable.line.fem import _assemble_sparse, _chain_csr, _element_dofs
 
     rng = np.random.default_rng(7)
     n_el = 6

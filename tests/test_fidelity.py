@@ -1,4 +1,4 @@
-"""Tests of stochcable.fidelity: the rules on constructed cases, immutability, and the
+"""Tests of stochcable.fidelity.planner: the rules on constructed cases, immutability, and the
 error of the chosen settings against a finer reference on two example scenes."""
 
 from __future__ import annotations
@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from stochcable.analysis import analyze
+from stochcable.dynamics.line import analyze
 from stochcable.errors import InputError
 from stochcable.examples import load_example
-from stochcable.fidelity import (BUDGET, CUTOFF_KH, FidelityPlan, apply_fidelity,
+from stochcable.fidelity.planner import (BUDGET, CUTOFF_KH, FidelityPlan, apply_fidelity,
                                  choose_fidelity, elements_wavelength,
                                  points_per_bandwidth, spectrum_tail_frequency)
-from stochcable.scene import load_scene
-from stochcable.spectra import spectrum_pierson_moskowitz
-from stochcable.statics import solve_statics
+from stochcable.scene.model import load_scene
+from stochcable.sea.spectra import spectrum_pierson_moskowitz
+from stochcable.line.statics import solve_statics
 
 
 def _string_frequencies(n_el: int, length: float, c: float) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Hard cases through :func:`stochcable.analysis.analyze` (GitHub issue 4): each ends
+"""Hard cases through :func:`stochcable.dynamics.line.analyze` (GitHub issue 4): each ends
 with finite, checked numbers or a clear error — never inf/NaN or a silent wrong answer.
 
 Cases: nearly taut line (sag/span 1e-3), very slack line (most of it on the seabed),
@@ -19,11 +19,11 @@ import warnings
 import numpy as np
 import pytest
 
-from stochcable.analysis import analyze, build_line_system, drag_coefficients
+from stochcable.dynamics.line import analyze, build_line_system, drag_coefficients
 from stochcable.errors import (InputError, PhysicsWarning, ResolutionWarning,
                               SolverError)
 from stochcable.examples import load_example
-from stochcable.kinematics import wavenumber
+from stochcable.sea.kinematics import wavenumber
 
 PM = {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}
 
@@ -394,7 +394,7 @@ def test_deep_water_3000_m():
     # short waves do not reach the deep part: at the grid's top (2 rad/s, k = 0.41/m)
     # the fluid velocity below 1000 m is e^{kz} < 1e-100 (exponential form: no
     # overflow of cosh/sinh with kh ~ 1200)
-    from stochcable.excitation import line_channels
+    from stochcable.dynamics.loads import line_channels
 
     sea = line_channels(res.scene, res.scene.lines[0], line.positions, line.omega)[0]
     z = line.positions[:, 2]
@@ -534,7 +534,7 @@ def test_800_element_line_converges_to_the_200_element_answer():
     The dominant error of this grounded chain is the touchdown's position inside an
     element (the linear model's contact state is the static one): first order, about
     h/L_s of the tension σ (L_s the suspended length; measured constant ≈ 1 on
-    tuah_1982_single_leg, see stochcable.fidelity); the string dispersion (kh)²/24 is
+    tuah_1982_single_leg, see stochcable.fidelity.planner); the string dispersion (kh)²/24 is
     < 1e-4 here."""
     omega = {"min": 0.1, "max": 2.0, "count": 40}
     res = {n: analyze(chain(elements=n, solver="direct", omega=omega))

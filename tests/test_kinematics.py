@@ -1,4 +1,4 @@
-"""Tests of stochcable.kinematics: dispersion and linear wave kinematics (seed 001 §5.2)."""
+"""Tests of stochcable.sea.kinematics: dispersion and linear wave kinematics (seed 001 §5.2)."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
-from stochcable import sea
+from stochcable.sea import realization as sea
 from stochcable.errors import InputError
-from stochcable.kinematics import kinematics_timeseries, wave_kinematics, wavenumber
-from stochcable.spectra import spectrum_pierson_moskowitz
+from stochcable.sea.kinematics import kinematics_timeseries, wave_kinematics, wavenumber
+from stochcable.sea.spectra import spectrum_pierson_moskowitz
 
 G = 9.80665
 

@@ -1,4 +1,4 @@
-"""Tests of stochcable.linearization: drag linearization formulas and the fixed point."""
+"""Tests of stochcable.dynamics.linearization: drag linearization formulas and the fixed point."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.linearization import (
+from stochcable.dynamics.linearization import (
     drag_linear_current,
     drag_linear_harmonic,
     drag_linear_seed,
@@ -16,7 +16,7 @@ from stochcable.linearization import (
     fixed_point,
     mean_drag_gaussian,
 )
-from stochcable.solvers import solve_direct
+from stochcable.dynamics.solvers import solve_direct
 
 RHO, CD, DIAM = 1025.0, 1.2, 0.1
 KAPPA = 0.5 * RHO * CD * DIAM  # 1/2 rho Cd D [N s^2/m^3]

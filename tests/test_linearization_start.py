@@ -1,4 +1,4 @@
-"""The coarse start of the drag linearization (stochcable.analysis, "Coarse start"):
+"""The coarse start of the drag linearization (stochcable.dynamics.line, "Coarse start"):
 the frequency-subset fixed point only supplies the start, the answer is the full-grid
 fixed point; narrow resonances are kept at full resolution; the subset quadrature; the
 single-BLAS-thread limit in worker threads."""
@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import stochcable.analysis as an
-from stochcable.excitation import line_channels
-from stochcable.scene import load_scene
-from stochcable.statics import solve_statics
+import stochcable.dynamics.line as an
+from stochcable.dynamics.loads import line_channels
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import solve_statics
 
-EXAMPLE = Path(an.__file__).resolve().parent / "examples" / "chain_catenary.json"
+EXAMPLE = Path(an.__file__).resolve().parents[1] / "examples" / "chain_catenary.json"
 
 
 def _chain(**env) -> tuple:

@@ -1,4 +1,4 @@
-"""Tests of stochcable.mesh: node arc lengths, attachments on nodes, element properties."""
+"""Tests of stochcable.line.mesh: node arc lengths, attachments on nodes, element properties."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.mesh import mesh_line
-from stochcable.scene import Attachment, End, Line, Segment
+from stochcable.line.mesh import mesh_line
+from stochcable.scene.model import Attachment, End, Line, Segment
 
 RHO, G = 1025.0, 9.80665
 

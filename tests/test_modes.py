@@ -1,4 +1,4 @@
-"""Natural modes (stochcable.modes) against closed forms and an independent ODE solution.
+"""Natural modes (stochcable.line.modes) against closed forms and an independent ODE solution.
 
 References
 ----------
@@ -20,8 +20,8 @@ from scipy.special import jn_zeros
 
 from fem_cases import hanging_chain, shallow_parabola, taut_string, uniform_mesh
 from stochcable.errors import InputError
-from stochcable.fem import assemble
-from stochcable.modes import Modes, natural_modes
+from stochcable.line.fem import assemble
+from stochcable.line.modes import Modes, natural_modes
 
 # Bliet 1984, §7.2 string (T = 1.0e6 N, m = 48.7 kg/m, L = 1036.32 m), eq. 3.5 values
 # (the thesis prints 0.434, 0.861: 0.861 is a misprint of nπ/L√(T/m) = 0.8688).
@@ -479,8 +479,8 @@ def taut_scene_reference(n: int = 3) -> np.ndarray:
 
 
 def test_modes_of_scene_weightless_string():
-    pytest.importorskip("stochcable.statics")
-    from stochcable.modes import modes_of_scene
+    pytest.importorskip("stochcable.line.statics")
+    from stochcable.line.modes import modes_of_scene
 
     m = modes_of_scene(TAUT_SCENE, count=6)["taut"]
     ref = np.repeat(taut_scene_reference(3), 2)
@@ -499,7 +499,7 @@ def test_dense_blocks_and_sparse_blocks_give_the_same_modes(dim, rotate):
     (the path of a rotated plane, and of any line before) must give the same modes to
     the bit: a line rotated about z has the same frequencies to round-off, and the
     component grouping of dense and sparse matrices is the same."""
-    from stochcable.modes import _component_groups
+    from stochcable.line.modes import _component_groups
 
     mesh, pos, ten = shallow_parabola(12, SPAN, SAG, H_IRVINE, 8.0 * H_IRVINE * SAG / SPAN / G,
                                       G, ea=1e7)
@@ -542,7 +542,7 @@ def test_dense_rotation_path_is_the_sparse_path_to_the_bit(shape, monkeypatch):
     and a non-planar line (one coupled block)."""
     import scipy.sparse as sp
 
-    import stochcable.modes as md
+    import stochcable.line.modes as md
 
     mesh, pos, ten = shallow_parabola(12, SPAN, SAG, H_IRVINE, 8.0 * H_IRVINE * SAG / SPAN / G,
                                       G, ea=1e7)
@@ -582,7 +582,7 @@ def test_direct_sygvd_is_scipy_eigh():
     definite raises LinAlgError with the reason."""
     from scipy.linalg import eigh
 
-    from stochcable.modes import _solve_dense
+    from stochcable.line.modes import _solve_dense
 
     rng = np.random.default_rng(5)
     for n, k in ((78, 40), (39, 39), (5, 2)):

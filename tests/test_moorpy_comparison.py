@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from stochcable import analyze, load_example
-from stochcable.statics import solve_statics
+from stochcable.line.statics import solve_statics
 
 mp = pytest.importorskip("moorpy")
 
@@ -56,7 +56,7 @@ def test_static_end_tensions_match_moorpy():
     # an anchor on the bed): equal to MoorPy's solver tolerance (measured 2.4e-6)
     line = _moorpy_line()
     line.staticSolve(reset=True)
-    from stochcable.scene import load_scene
+    from stochcable.scene.model import load_scene
 
     ours = solve_statics(load_scene(_scene(motion=False)), method="catenary").lines["leg1"]
     assert ours.tension_a == pytest.approx(float(line.TA), rel=1e-5)

@@ -1,4 +1,4 @@
-"""Tests of stochcable._parallel (per-line work of a coupled group on a thread pool).
+"""Tests of stochcable.runtime (per-line work of a coupled group on a thread pool).
 
 Independent checks: the serial loop (same bits), the calling thread's warning
 collector, the environment switch and the BLAS gate.
@@ -11,8 +11,8 @@ import threading
 import numpy as np
 import pytest
 
-from stochcable import _parallel
-from stochcable.analysis import _single_blas_thread
+from stochcable import runtime as _parallel
+from stochcable.dynamics.line import _single_blas_thread
 from stochcable.errors import PhysicsWarning, SolverError, collect_warnings, warn
 
 

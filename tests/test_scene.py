@@ -1,4 +1,4 @@
-"""Tests of stochcable.scene: validation at the boundary, round trip, JSON Schema drift."""
+"""Tests of stochcable.scene.model: validation at the boundary, round trip, JSON Schema drift."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ import pytest
 
 from stochcable.errors import InputError
 from stochcable.examples import list_examples, load_example
-from stochcable.scene import Scene, load_scene, scene_json_schema
-from stochcable.schema_export import DEFAULT_SCHEMA_PATH, scene_schema_text, write_scene_schema
+from stochcable.scene.model import Scene, load_scene, scene_json_schema
+from stochcable.scene.schema import DEFAULT_SCHEMA_PATH, scene_schema_text, write_scene_schema
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -133,10 +133,10 @@ def test_is_planar(chain_doc):
 
 
 def test_schema_committed_file_matches_models():
-    """Drift test: regenerate with `python -m stochcable.schema_export`."""
+    """Drift test: regenerate with `python -m stochcable.scene.schema`."""
     committed = (ROOT / DEFAULT_SCHEMA_PATH).read_text(encoding="utf-8")
     assert committed == scene_schema_text(), (
-        "openapi/scene.schema.json is stale: run `python -m stochcable.schema_export`"
+        "openapi/scene.schema.json is stale: run `python -m stochcable.scene.schema`"
     )
 
 
@@ -218,7 +218,7 @@ def _six_dof(body: dict) -> dict:
 
 
 def test_vessel_motion_transfer():
-    from stochcable.scene import VesselMotion
+    from stochcable.scene.model import VesselMotion
 
     v = VesselMotion(omega=(0.5, 1.0), heave={"re": [1.0, 0.5], "im": [0.0, 1.0]},
                      pitch={"re": [0.0, 0.2], "im": [0.0, 0.0]})

@@ -1,4 +1,4 @@
-"""Tests of stochcable.sea (DSA/NSA simulation, seed 001 §5.1) and stochcable._fft."""
+"""Tests of stochcable.sea.realization (DSA/NSA simulation, seed 001 §5.1) and stochcable.sea.fft."""
 
 from __future__ import annotations
 
@@ -17,9 +17,10 @@ import numpy as np
 import pytest
 
 import stochcable
-from stochcable import _fft, sea
+from stochcable.sea import fft as _fft
+from stochcable.sea import realization as sea
 from stochcable.errors import InputError, ResolutionWarning
-from stochcable.spectra import spectrum_jonswap, spectrum_pierson_moskowitz, spectrum_pierson_moskowitz_m0
+from stochcable.sea.spectra import spectrum_jonswap, spectrum_pierson_moskowitz, spectrum_pierson_moskowitz_m0
 
 # Seed 001 §6.5 (Tuah 1982): PM with m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla),
 # 256 s at Δt = 0.25 s = 1024 points, Δω = 0.0245 rad/s; imperial units, g = 32.174 ft/s².
@@ -682,7 +683,7 @@ def test_compiled_kernel_equals_numpy_kernel():
     # bits are equal (measured on the reference machine: 0 differing entries of 70,001,
     # DSA and NSA); an unfused numpy product may round differently: ≲ 1 ulp of |X|,
     # 1e-15 relative (~4.5 ulp) allowed
-    kernels = pytest.importorskip("stochcable._kernels")
+    kernels = pytest.importorskip("stochcable.sea.kernels")
     u, s, alpha, beta = _kernel_inputs()
     n, c2, scale = u.size, 2.0 * 0.003 * 2.0**38, 2.0**-20
     empty = np.empty(0)
@@ -735,8 +736,8 @@ def test_numba_missing_or_failing_falls_back(monkeypatch):
     ref = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
     # numba not installed: silently the NumPy kernel
     monkeypatch.setattr(sea, "_compiled_state", [])
-    monkeypatch.delattr(stochcable, "_kernels", raising=False)
-    monkeypatch.setitem(sys.modules, "stochcable._kernels", None)     # import -> ImportError
+    monkeypatch.delattr(stochcable.sea, "kernels", raising=False)
+    monkeypatch.setitem(sys.modules, "stochcable.sea.kernels", None)     # import -> ImportError
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         a = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
@@ -744,9 +745,9 @@ def test_numba_missing_or_failing_falls_back(monkeypatch):
     np.testing.assert_array_equal(a.coefficients, ref.coefficients)
     # numba present but the kernel unusable (e.g. an LLVM error): one warning, NumPy kernel
     monkeypatch.setattr(sea, "_compiled_state", [])
-    broken = types.ModuleType("stochcable._kernels")                   # no phasor_chunk
-    monkeypatch.setitem(sys.modules, "stochcable._kernels", broken)
-    monkeypatch.setattr(stochcable, "_kernels", broken, raising=False)
+    broken = types.ModuleType("stochcable.sea.kernels")                   # no phasor_chunk
+    monkeypatch.setitem(sys.modules, "stochcable.sea.kernels", broken)
+    monkeypatch.setattr(stochcable.sea, "kernels", broken, raising=False)
     with pytest.warns(UserWarning, match=r"compiled sea kernel is unavailable .*"
                                          r"using the NumPy kernel .*STOCHCABLE_NUMBA=0"):
         b = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
@@ -783,7 +784,7 @@ def _readonly_copy(a):
 
 _LAZY_SCRIPT = r"""
 import contextlib, io, sys
-import stochcable, stochcable.sea as sea
+import stochcable, stochcable.sea.realization as sea
 from stochcable.cli import main
 from service.app import create_app
 create_app()
@@ -808,7 +809,7 @@ def test_numba_imported_only_by_large_realizations():
         numba_present = False
     env = {k: v for k, v in os.environ.items() if k != "STOCHCABLE_NUMBA"}
     out = subprocess.run([sys.executable, "-c", _LAZY_SCRIPT], capture_output=True, text=True,
-                         cwd=str(pathlib.Path(sea.__file__).parents[1]), env=env, timeout=120)
+                         cwd=str(pathlib.Path(sea.__file__).parents[2]), env=env, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["before", "False", "after", str(numba_present), str(numba_present)]
 
@@ -819,21 +820,21 @@ def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
     # unusable: one UserWarning, the kernel compiled in memory, the same realization
     pytest.importorskip("numba")
     pkg = tmp_path / "stochcable"
-    shutil.copytree(pathlib.Path(sea.__file__).parent, pkg,
+    shutil.copytree(pathlib.Path(sea.__file__).parents[1], pkg,
                     ignore=shutil.ignore_patterns("__pycache__"))
-    (pkg / "__pycache__").write_text("")
+    (pkg / "sea" / "__pycache__").write_text("")
     env = dict(os.environ, PYTHONPATH=str(tmp_path), PYTHONDONTWRITEBYTECODE="1",
                NUMBA_CACHE_DIR="/dev/null/numba", XDG_CACHE_HOME="/dev/null/xdg",
                HOME="/dev/null")
     env.pop("STOCHCABLE_NUMBA", None)
-    script = ("import warnings, numpy as np, stochcable.sea as sea, stochcable._kernels as k\n"
+    script = ("import warnings, numpy as np, stochcable.sea.realization as sea, stochcable.sea.kernels as k\n"
               "r = sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**18 * 0.1, 0.1, 'dsa', 3)\n"
               "print(sea.__file__, k.CACHED, repr(complex(r.coefficients[12345])))\n")
     out = subprocess.run([sys.executable, "-W", "always", "-c", script], env=env,
                          capture_output=True, text=True, cwd=str(tmp_path), timeout=180)
     assert out.returncode == 0, out.stderr
     path, cached, value = out.stdout.split(maxsplit=2)
-    assert path == str(pkg / "sea.py") and cached == "False"
+    assert path == str(pkg / "sea" / "realization.py") and cached == "False"
     assert re.search(r"UserWarning: stochcable: no writable numba cache directory", out.stderr)
     ref = sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**18 * 0.1, 0.1, "dsa", 3)
     assert complex(value.strip()) == ref.coefficients[12345]

@@ -19,10 +19,10 @@ from service.app import create_app
 from service.schemas import default_omega
 from service.settings import Settings
 from stochcable.errors import ConvergenceError, SolverError
-from stochcable.kinematics import kinematics_timeseries
-from stochcable.scene import PiersonMoskowitz, Spectrum
-from stochcable.sea import simulate_sea
-from stochcable.spectra import spectrum_statistics
+from stochcable.sea.kinematics import kinematics_timeseries
+from stochcable.scene.model import PiersonMoskowitz, Spectrum
+from stochcable.sea.realization import simulate_sea
+from stochcable.sea.spectra import spectrum_statistics
 
 PM = {"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0}
 SPECTRA = [
@@ -404,7 +404,7 @@ def test_dumps_equals_the_standard_encoder_after_parsing():
     import json
 
     from service.encoding import dumps
-    from stochcable.analysis import analyze
+    from stochcable.dynamics.line import analyze
     from stochcable.examples import load_example
 
     with warnings.catch_warnings():

@@ -1,4 +1,4 @@
-"""Tests of stochcable.solvers: direct, banded/sparse, modal, Foss."""
+"""Tests of stochcable.dynamics.solvers: direct, banded/sparse, modal, Foss."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import pytest
 import scipy.sparse as sp
 
 from stochcable.errors import InputError, SolverError
-from stochcable.linearization import drag_linear_seed
-from stochcable.solvers import (
+from stochcable.dynamics.linearization import drag_linear_seed
+from stochcable.dynamics.solvers import (
     DefectivePencilWarning,
     auto_mode_count,
     foss_decomposition,
@@ -26,7 +26,7 @@ from stochcable.solvers import (
 
 
 # Foss must really be used (no silent fallback) except where a test expects the warning
-pytestmark = pytest.mark.filterwarnings("error::stochcable.solvers.DefectivePencilWarning")
+pytestmark = pytest.mark.filterwarnings("error::stochcable.dynamics.solvers.DefectivePencilWarning")
 
 
 def _rel(a, b):
@@ -321,7 +321,7 @@ def _block_line(n_nodes, b, rng, *, slack=(), ea=1e9, tension=1e5, m=100.0, damp
     eet = e[:, :, None] * e[:, None, :]
     ea_el = np.full(n_el, ea)
     t_el = np.full(n_el, tension)
-    for j in slack:  # slack element: 1e-6 EA, no tension (as stochcable.fem)
+    for j in slack:  # slack element: 1e-6 EA, no tension (as stochcable.line.fem)
         ea_el[j], t_el[j] = 1e-6 * ea, 0.0
     k = (ea_el / l)[:, None, None] * eet + (t_el / l)[:, None, None] * (np.eye(b) - eet)
     n = n_nodes * b

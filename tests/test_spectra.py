@@ -1,4 +1,4 @@
-"""Tests of stochcable.spectra against closed forms and independent quadrature."""
+"""Tests of stochcable.sea.spectra against closed forms and independent quadrature."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import minimize_scalar
 
-from stochcable import spectra as sp
+from stochcable.sea import spectra as sp
 from stochcable.errors import InputError
 
 # Published constants (rounded in their sources)

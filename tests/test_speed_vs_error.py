@@ -126,9 +126,9 @@ def test_scene_document_does_not_mutate():
 def test_reference_ladder_puts_a_node_at_the_touchdown():
     # tuah_1982_single_leg lies on the seabed from the anchor to s = 165.7 ft (closed-form
     # catenary): the ladder meshes are split there so that the element ladder converges
-    # (uniform meshes oscillate at first order, see stochcable.fidelity)
-    from stochcable.fidelity import static_touchdowns
-    from stochcable.scene import load_scene
+    # (uniform meshes oscillate at first order, see stochcable.fidelity.planner)
+    from stochcable.fidelity.planner import static_touchdowns
+    from stochcable.scene.model import load_scene
 
     base = sve.base_document("tuah_1982_single_leg")
     before = copy.deepcopy(base)

@@ -1,5 +1,5 @@
-"""Tests of stochcable.statics: FE statics against the closed-form elastic catenary
-(stochcable.catenary, Irvine 1981), conservation of force, symmetry, seed 001 §6.2."""
+"""Tests of stochcable.line.statics: FE statics against the closed-form elastic catenary
+(stochcable.line.catenary, Irvine 1981), conservation of force, symmetry, seed 001 §6.2."""
 
 from __future__ import annotations
 
@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.catenary import catenary_multisegment
+from stochcable.line.catenary import catenary_multisegment
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.mesh import mesh_line
-from stochcable.scene import load_scene
-from stochcable.statics import _solve_fe, solve_line_statics, solve_statics
+from stochcable.line.mesh import mesh_line
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import _solve_fe, solve_line_statics, solve_statics
 
 # DESIGN.md "Scene and result documents": the chain leg of the example scene.
 CHAIN = dict(length=850.0, ea=1.2326e9, mass=288.0, diameter=0.216, cd_normal=1.333,
@@ -370,7 +370,7 @@ def test_load_stepping_rescues_drag_dominated_line():
     # A light line (net weight 19 N/m) in a 2 m/s current (drag 370 N/m): full-load
     # Newton from the hanging shape stalls (checked: residual > 1e-3 after 500
     # iterations); ramping the drag from the current-free equilibrium converges.
-    from stochcable.statics import _Frame, _initial_guess, _Model, _Solver
+    from stochcable.line.statics import _Frame, _initial_guess, _Model, _Solver
 
     seg = dict(length=600.0, ea=1e8, mass=20.0, diameter=0.15, elements=60)
     m, env, _ = make((-400, 0, -100), (0, 0, -20), [seg],
@@ -389,7 +389,7 @@ def test_load_stepping_rescues_drag_dominated_line():
 def _chain_in_current():
     """A 20-element chain in a 0.5 m/s current: its mesh, environment, frame, private
     FE statics model and the initial guess (for the model-level tests below)."""
-    from stochcable.statics import _Frame, _initial_guess, _Model
+    from stochcable.line.statics import _Frame, _initial_guess, _Model
 
     m, env, _ = make((-800, 0, -200), (0, 0, -20), [dict(CHAIN, elements=20)],
                      current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}])
@@ -403,7 +403,7 @@ def test_repeated_residual_reuses_the_same_numbers():
     asks twice per accepted point): a repeated call returns the numbers of a fresh
     model to the bit, with or without the tangent, also with current drag (whose nodal
     drag forces the line search reads) and after the drag factor changes."""
-    from stochcable.statics import _Frame, _Model
+    from stochcable.line.statics import _Frame, _Model
 
     m, env, frame, b, x = _chain_in_current()
     x2 = x.copy()
@@ -433,7 +433,7 @@ def test_chain_shots_batched_end_equals_single_shots() -> None:
     shots lifting off the bed at the anchor, part-way, and not at all (all grounded),
     on and off the seabed."""
     from stochcable.examples import load_example
-    from stochcable.statics import _chain_shots, _Frame, _Model
+    from stochcable.line.statics import _chain_shots, _Frame, _Model
 
     scene = load_scene(load_example("chain_catenary"))
     env = scene.environment
@@ -468,7 +468,7 @@ def test_banded_solve_is_scipy_solve_banded():
     LinAlgError."""
     from scipy.linalg import LinAlgError, solve_banded
 
-    from stochcable.statics import _banded_solve
+    from stochcable.line.statics import _banded_solve
 
     rng = np.random.default_rng(7)
     for bw, n, nrhs in ((3, 40, None), (5, 117, None), (5, 117, 3)):
@@ -489,7 +489,7 @@ def test_converged_status_skips_the_tangent_and_solves_the_same():
     point needs none) and builds it from the residual memo before a step: the status
     numbers are those with the tangent, and the tangent built afterwards is a fresh
     model's to the bit (with current drag, whose nodal forces the line search reads)."""
-    from stochcable.statics import _Frame, _Model, _Solver
+    from stochcable.line.statics import _Frame, _Model, _Solver
 
     m, env, frame, model, x = _chain_in_current()
     lazy = _Solver(model, 1e-10, 100).status(x, tangent=False)

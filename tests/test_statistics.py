@@ -1,4 +1,4 @@
-"""Tests of stochcable.statistics: response spectra, moments and maxima."""
+"""Tests of stochcable.results.statistics: response spectra, moments and maxima."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from scipy import special
 
 from stochcable.errors import InputError
-from stochcable.statistics import (
+from stochcable.results.statistics import (
     cross_spectrum,
     response_spectrum,
     response_statistics,

@@ -1,4 +1,4 @@
-"""Tests of stochcable.timedomain: Newmark average acceleration with Newton iterations."""
+"""Tests of stochcable.sea.timeseries: Newmark average acceleration with Newton iterations."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.linearization import drag_linear_seed, fixed_point
-from stochcable.solvers import solve_direct
-from stochcable.statistics import response_statistics
-from stochcable.timedomain import LinearSystem, NonlinearSystem, newmark
+from stochcable.dynamics.linearization import drag_linear_seed, fixed_point
+from stochcable.dynamics.solvers import solve_direct
+from stochcable.results.statistics import response_statistics
+from stochcable.sea.timeseries import LinearSystem, NonlinearSystem, newmark
 
 
 def test_linear_sdof_matches_discrete_closed_form():

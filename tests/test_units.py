@@ -1,10 +1,10 @@
-"""Unit labels inferred from a scene's gravity (stochcable.units)."""
+"""Unit labels inferred from a scene's gravity (stochcable.scene.units)."""
 
 from __future__ import annotations
 
 import pytest
 
-from stochcable.units import FOOT_SLUG_SECOND, SI, unit_labels
+from stochcable.scene.units import FOOT_SLUG_SECOND, SI, unit_labels
 
 
 @pytest.mark.parametrize("g", [9.80665, 9.81, 9.8])
@@ -32,7 +32,7 @@ def test_unrecognised_gravity_gets_generic_labels(g: float) -> None:
 
 def test_examples_in_feet_are_labelled_in_feet() -> None:
     from stochcable.examples import load_example
-    from stochcable.scene import load_scene
+    from stochcable.scene.model import load_scene
 
     feet = load_scene(load_example("tuah_1982_single_leg"))
     metric = load_scene(load_example("chain_catenary"))
@@ -70,7 +70,7 @@ def test_generic_labels_convert_to_words() -> None:
     (None, "SI"),
 ])
 def test_labels_of_a_document_that_may_be_invalid(doc, system: str) -> None:
-    from stochcable.units import labels_of_document
+    from stochcable.scene.units import labels_of_document
 
     assert labels_of_document(doc).system == system
 
@@ -81,7 +81,7 @@ def test_scene_validation_messages_use_the_scene_units() -> None:
 
     from stochcable.errors import InputError
     from stochcable.examples import load_example
-    from stochcable.scene import load_scene
+    from stochcable.scene.model import load_scene
 
     feet = load_example("tuah_1982_single_leg").model_dump(mode="json", exclude_none=True)
     bad = copy.deepcopy(feet)
@@ -104,7 +104,7 @@ def test_validator_messages_quote_values_in_the_scene_units() -> None:
     feet gets them in feet (and an SI scene keeps them)."""
     from stochcable.errors import InputError
     from stochcable.examples import load_example
-    from stochcable.scene import load_scene
+    from stochcable.scene.model import load_scene
 
     for name, unit in (("tuah_1982_single_leg", "ft"), ("chain_catenary", "m")):
         doc = load_example(name).model_dump(mode="json", exclude_none=True)

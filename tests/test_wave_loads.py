@@ -1,4 +1,4 @@
-"""Wave loads integrated exactly along the elements (stochcable.excitation.
+"""Wave loads integrated exactly along the elements (stochcable.dynamics.loads.
 element_wave_kinematics, wave_loads) and the element-mean σ of the drag linearization."""
 
 from __future__ import annotations
@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from scipy.integrate import quad_vec
 
-from stochcable import analysis as an
+from stochcable.dynamics import line as an
 from stochcable.errors import InputError, ResolutionWarning
 from stochcable.examples import load_example
-from stochcable.excitation import (
+from stochcable.dynamics.loads import (
     Channel,
     channel_loads,
     drag_matrix,
@@ -24,9 +24,9 @@ from stochcable.excitation import (
     line_channels,
     wave_loads,
 )
-from stochcable.kinematics import wave_kinematics, wavenumber
-from stochcable.scene import load_scene
-from stochcable.statics import solve_statics
+from stochcable.sea.kinematics import wave_kinematics, wavenumber
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import solve_statics
 
 G = 9.80665
 RHO = 1025.0

@@ -7,7 +7,7 @@ from typing import Annotated
 
 from fastapi import APIRouter, Path
 
-from stochcable.scene import Scene
+from stochcable.scene.model import Scene
 
 from ..encoding import error_responses
 from ..errors import NotFound

@@ -8,8 +8,8 @@ import numpy as np
 from fastapi import APIRouter
 from starlette.responses import Response
 
-from stochcable.kinematics import kinematics_timeseries
-from stochcable.sea import simulate_sea
+from stochcable.sea.kinematics import kinematics_timeseries
+from stochcable.sea.realization import simulate_sea
 
 from ..dependencies import MediaTypeDep, RunnerDep, SettingsDep
 from ..encoding import JSON, NPY, array_responses, columns_response, json_response
@@ -33,9 +33,9 @@ _LAYOUT = (
              summary="Simulate a random sea realization and its wave kinematics")
 async def simulate_sea_realization(body: RealizationRequest, settings: SettingsDep,
                                    runner: RunnerDep, media: MediaTypeDep) -> Response:
-    """η(t) by :func:`stochcable.sea.simulate_sea` (seed 001 §5.1; duration/dt must be an
+    """η(t) by :func:`stochcable.sea.realization.simulate_sea` (seed 001 §5.1; duration/dt must be an
     even number of samples) and, at ``points``, the velocity and acceleration by
-    :func:`stochcable.kinematics.kinematics_timeseries` from the same amplitudes.
+    :func:`stochcable.sea.kinematics.kinematics_timeseries` from the same amplitudes.
     Use ``Accept: application/x-npy`` for long records."""
     n_points = len(body.points) if body.points else 0
     check_points(n_points, settings)

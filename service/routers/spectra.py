@@ -5,7 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter
 from starlette.responses import Response
 
-from stochcable.spectra import spectrum_statistics
+from stochcable.sea.spectra import spectrum_statistics
 
 from ..dependencies import MediaTypeDep, RunnerDep, SettingsDep
 from ..encoding import JSON, array_responses, columns_response, json_response
@@ -24,7 +24,7 @@ _LAYOUT = ("Columns: omega [rad/s], density [unit²·s/rad]; the statistics as J
 async def compute_spectrum(body: SpectrumRequest, settings: SettingsDep, runner: RunnerDep,
                            media: MediaTypeDep) -> Response:
     """S(ω) of the spectrum document on the grid, with m0…m4, Hs, Tz, Tm01, Tp and the
-    bandwidth, exactly as :func:`stochcable.spectra.spectrum_statistics` gives them."""
+    bandwidth, exactly as :func:`stochcable.sea.spectra.spectrum_statistics` gives them."""
     check_frequencies(body.omega_count(), settings)
     return await runner.run(_spectrum, body, media)
 

@@ -16,14 +16,14 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-from ..errors import StochcableError
+from stochcable.errors import StochcableError
 
 __all__ = ["main", "build_parser"]
 
 
 def build_parser() -> argparse.ArgumentParser:
     """Build the top-level parser with every sub-command module found in this package."""
-    from .. import __version__
+    from stochcable import __version__
 
     parser = argparse.ArgumentParser(
         prog="stochcable",

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
+from stochcable.errors import InputError
 
 __all__ = ["to_jsonable", "write_json", "write_columns", "require_matplotlib", "read_json_file"]
 

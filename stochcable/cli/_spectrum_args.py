@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from .. import _validate as v
-from .. import spectra
-from ..errors import InputError
+from stochcable import validation as v
+from stochcable.sea import spectra
+from stochcable.errors import InputError
 
 __all__ = ["SPECTRUM_TYPES", "add_spectrum_arguments", "SpectrumChoice", "spectrum_from_args"]
 

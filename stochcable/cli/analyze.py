@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ._output import require_matplotlib, write_json
+from stochcable.cli._output import require_matplotlib, write_json
 
 __all__ = ["register", "run"]
 
@@ -68,8 +68,8 @@ class _StderrProgress:
 
 def run(args: argparse.Namespace) -> int:
     """Run the analysis and write the result document (and figures)."""
-    from ..analysis import analyze
-    from ..scene import load_scene
+    from stochcable.dynamics.line import analyze
+    from stochcable.scene.model import load_scene
 
     scene = load_scene(Path(args.scene))
     show = args.progress or (hasattr(sys.stderr, "isatty") and sys.stderr.isatty())

@@ -25,7 +25,7 @@ import argparse
 
 import numpy as np
 
-from ._output import require_matplotlib, write_json
+from stochcable.cli._output import require_matplotlib, write_json
 
 __all__ = ["register", "run"]
 
@@ -55,14 +55,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``stochcable modes``; returns the exit code."""
-    from .._validate import positive_int
-    from ..fem import scene_fe_models
-    from ..modes import natural_modes
+    from stochcable.validation import positive_int
+    from stochcable.line.fem import scene_fe_models
+    from stochcable.line.modes import natural_modes
 
     count = positive_int("--count", args.count)
     plt = require_matplotlib() if args.plot else None
-    from ..errors import PhysicsWarning, warn
-    from ..scene import load_scene
+    from stochcable.errors import PhysicsWarning, warn
+    from stochcable.scene.model import load_scene
 
     scene = load_scene(args.scene)
     if scene.bodies:

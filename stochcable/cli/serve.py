@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
 
     from service.settings import Settings
 
-    from ..errors import InputError
+    from stochcable.errors import InputError
 
     settings = Settings()
     host = args.host if args.host is not None else settings.host

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-from .. import _validate as v
-from ..errors import InputError
-from ..sea import simulate_sea
-from ._output import require_matplotlib, write_columns, write_json
-from ._spectrum_args import add_spectrum_arguments, spectrum_from_args
+from stochcable import validation as v
+from stochcable.errors import InputError
+from stochcable.sea.realization import simulate_sea
+from stochcable.cli._output import require_matplotlib, write_columns, write_json
+from stochcable.cli._spectrum_args import add_spectrum_arguments, spectrum_from_args
 
 UNITS = {"time": "s", "elevation": "m", "variance": "m^2", "m0": "m^2", "m0_grid": "m^2",
          "dt": "s", "duration": "s"}

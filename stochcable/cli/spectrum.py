@@ -6,10 +6,10 @@ import argparse
 
 import numpy as np
 
-from .. import _validate as v
-from ..spectra import spectrum_statistics
-from ._output import require_matplotlib, write_columns, write_json
-from ._spectrum_args import add_spectrum_arguments, spectrum_from_args
+from stochcable import validation as v
+from stochcable.sea.spectra import spectrum_statistics
+from stochcable.cli._output import require_matplotlib, write_columns, write_json
+from stochcable.cli._spectrum_args import add_spectrum_arguments, spectrum_from_args
 
 UNITS = {"omega": "rad/s", "density": "m^2*s/rad", "m0": "m^2", "m1": "m^2*rad/s",
          "m2": "m^2*(rad/s)^2", "m3": "m^2*(rad/s)^3", "m4": "m^2*(rad/s)^4",

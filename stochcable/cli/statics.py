@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from ..scene import load_scene
-from ..statics import StaticsResult, solve_statics
-from ._output import require_matplotlib, write_json
+from stochcable.scene.model import load_scene
+from stochcable.line.statics import StaticsResult, solve_statics
+from stochcable.cli._output import require_matplotlib, write_json
 
 __all__ = ["register", "run"]
 

@@ -57,8 +57,8 @@ from __future__ import annotations
 
 from importlib import resources
 
-from ..errors import InputError
-from ..scene import Scene, load_scene
+from stochcable.errors import InputError
+from stochcable.scene.model import Scene, load_scene
 
 __all__ = ["list_examples", "load_example"]
 

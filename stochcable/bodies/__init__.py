@@ -1,0 +1,1 @@
+"""Rigid bodies: mass and hydrodynamic data, their coupling to lines, body statics."""

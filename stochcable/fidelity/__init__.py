@@ -1,0 +1,2 @@
+"""Adaptive fidelity: elements, frequencies, modes and tolerance chosen for an error
+target."""

@@ -1,0 +1,853 @@
+"""Closed-form elastic catenary (Irvine 1981) with optional frictionless seabed contact.
+
+One homogeneous, linearly elastic segment hangs between two fixed points in a vertical
+plane.  Local coordinates: ``end_a`` at (0, 0), ``end_b`` at (X, Z), x horizontal from
+end_a toward end_b, z up.  Unstretched arc length s runs from end_a (s = 0) to end_b
+(s = L).  The tension vector at s has the horizontal component H (constant) and the
+vertical component V(s) = V_a + w s, w the net submerged weight per unit length
+(positive downward).  The tension is T(s) = sqrt(H² + V(s)²) (effective tension).
+
+Closure: seed 000 (Bliet 1984) eqs. (2.5)–(2.6), the 2-D static equations without
+current, integrated in closed form as in Irvine (1981), *Cable Structures*, ch. 2::
+
+    x(s) = H s / EA + ∫₀ˢ H / T ds'   = H s/EA + (H/w)[asinh(V(s)/H) − asinh(V_a/H)]
+    z(s) = (V_a s + w s²/2) / EA + ∫₀ˢ V / T ds' = (V_a s + w s²/2)/EA + (T(s) − T_a)/w
+
+With seabed contact (end_a on the seabed, frictionless), a grounded length L_B lies flat
+from end_a with constant tension H and zero vertical force; the suspended part above the
+touchdown point starts with V = 0.  Writing L_B = −V_a/w for a (virtual) V_a < 0 makes the
+closure continuous and continuously differentiable across first contact, so one Newton
+iteration on (H, V_a) covers both regimes.
+
+The integrals are evaluated as divided differences (no 1/w cancellation), so the
+weightless limit w → 0, the vertical limit H → 0 and taut lines (EA/T up to 1e6 and
+more) are all accurate to round-off.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Union
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from stochcable import validation as v
+from stochcable.errors import ConvergenceError, InputError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from stochcable.line.mesh import LineMesh
+    from stochcable.scene.model import Environment, Line
+
+__all__ = [
+    "MAX_STRAIN",
+    "CatenarySolution",
+    "MultiSegmentSolution",
+    "CatenaryLine",
+    "catenary_solve",
+    "catenary_from_top_tension",
+    "catenary_multisegment",
+    "catenary_line",
+]
+
+#: Largest strain a line may need to reach its span (as the scene's validation). [-]
+MAX_STRAIN = 0.1
+
+_TOL = 1e-12  # closure tolerance, relative to max(length, chord)
+_MAXIT = 200
+
+
+# ----------------------------------------------------------------------------- kernel
+
+
+def _asinhc(d: np.ndarray) -> np.ndarray:
+    """asinh(d)/d, 1 at d = 0."""
+    d = np.asarray(d, dtype=float)
+    small = np.abs(d) < 1e-6
+    safe = np.where(small, 1.0, d)
+    return np.where(small, 1.0 - d * d / 6.0, np.arcsinh(safe) / safe)
+
+
+def _kernel(H, V0, w, ls, c):
+    """Suspended stretch of length ``ls`` starting with vertical force ``V0``.
+
+    Returns x, z (spans of the stretch) and the partial derivatives dx/dH, dx/dV0,
+    dz/dH, dz/dV0 at fixed ``ls`` (the Jacobian is symmetric: it is the Hessian of the
+    complementary energy).  ``c`` = 1/EA (0 for an inextensible line).  H > 0.
+    All arguments broadcast.
+    """
+    H = np.asarray(H, dtype=float)
+    V0 = np.asarray(V0, dtype=float)
+    ls = np.asarray(ls, dtype=float)
+    V1 = V0 + w * ls
+    T0 = np.hypot(H, V0)
+    T1 = np.hypot(H, V1)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        same = V0 * V1 >= 0.0
+        both0 = (V0 == 0.0) & (V1 == 0.0)
+        den = V1 * T0 + V0 * T1
+        q = np.where(both0, 1.0 / H, (V0 + V1) / np.where(den == 0.0, 1.0, den))
+        # same-sign branch (no cancellation: V0, V1 of one sign)
+        s1_same = ls * H * q * _asinhc(w * ls * q)
+        j_same = ls * H * H * q / (T0 * T1)
+        # opposite-sign branch (w != 0 there and |w ls| >= |V0|, |V1|: no cancellation)
+        wsafe = w if w != 0.0 else 1.0
+        s1_opp = (H / wsafe) * (np.arcsinh(V1 / H) - np.arcsinh(V0 / H))
+        j_opp = (V1 / T1 - V0 / T0) / wsafe
+        S1 = np.where(same, s1_same, s1_opp)  # ∫ H/T ds
+        J = np.where(same, j_same, j_opp)  # ∫ H²/T³ ds
+    return _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c)
+
+
+def _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c) -> tuple:  # noqa: ANN001
+    """The branch-free end of :func:`_kernel` and :func:`_kernel_scalar` (arrays or
+    floats alike): spans and Jacobian from S1 = ∫ H/T ds and J = ∫ H²/T³ ds."""
+    S2 = ls * (V0 + V1) / (T0 + T1)  # ∫ V/T ds
+    K = -H * ls * (V0 + V1) / (T0 * T1 * (T0 + T1))  # ∫ −HV/T³ ds
+    x = H * c * ls + S1
+    z = c * (V0 * ls + 0.5 * w * ls * ls) + S2
+    dxdH = c * ls + S1 / H - J
+    dzdV = c * ls + J
+    return x, z, dxdH, K, K, dzdV
+
+
+def _kernel_scalar(H: float, V0: float, w: float, ls: float, c: float) -> tuple:
+    """:func:`_kernel` for Python floats: the same formulas and branches as float
+    arithmetic (the closure Newton evaluates it a few times per solve, where numpy's
+    per-call overhead on 0-d arrays dominated, ≈ 0.2 ms of every chain statics).
+    hypot and asinh stay numpy's (math's may differ in the last bit), so the results
+    are the array kernel's to the bit."""
+    V1 = V0 + w * ls
+    T0 = float(np.hypot(H, V0))
+    T1 = float(np.hypot(H, V1))
+    if V0 * V1 >= 0.0:  # same-sign branch (no cancellation: V0, V1 of one sign)
+        if V0 == 0.0 and V1 == 0.0:
+            q = 1.0 / H
+        else:
+            den = V1 * T0 + V0 * T1
+            q = (V0 + V1) / (1.0 if den == 0.0 else den)
+        dd = w * ls * q
+        asinhc = 1.0 - dd * dd / 6.0 if abs(dd) < 1e-6 else float(np.arcsinh(dd)) / dd
+        S1 = ls * H * q * asinhc  # ∫ H/T ds
+        J = ls * H * H * q / (T0 * T1)  # ∫ H²/T³ ds
+    else:  # opposite signs (w != 0 there and |w ls| >= |V0|, |V1|: no cancellation)
+        wsafe = w if w != 0.0 else 1.0
+        S1 = (H / wsafe) * (float(np.arcsinh(V1 / H)) - float(np.arcsinh(V0 / H)))
+        J = (V1 / T1 - V0 / T0) / wsafe
+    return _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c)
+
+
+def _closure(H, Va, L, w, c, seabed):
+    """Spans (X, Z) and the Jacobian d(X, Z)/d(H, Va) of the whole segment."""
+    H, Va, L, w, c = float(H), float(Va), float(L), float(w), float(c)
+    if not (math.isfinite(H) and math.isfinite(Va)) or H <= 0.0:
+        kernel = _kernel  # numpy's inf/nan semantics (the line search rejects them)
+    else:
+        kernel = _kernel_scalar
+    if seabed and Va < 0.0:
+        lb = -Va / w  # may exceed L inside the iteration: the closure stays smooth
+        x, z, a, b, cc, d = kernel(H, 0.0, w, L - lb, c)
+        return float(x + lb * (1.0 + H * c)), float(z), np.array(
+            [[a + lb * c, b], [cc, d]], dtype=float
+        )
+    x, z, a, b, cc, d = kernel(H, Va, w, L, c)
+    return float(x), float(z), np.array([[a, b], [cc, d]], dtype=float)
+
+
+# --------------------------------------------------------------------------- results
+
+
+@dataclass(frozen=True)
+class CatenarySolution:
+    """Static equilibrium of one elastic catenary segment.
+
+    Attributes
+    ----------
+    H : float
+        Horizontal tension component, constant along the line. [N]
+    V_a : float
+        Vertical tension component at end_a, positive when the line pulls end_a
+        upward (zero when the line lies on the seabed at end_a). [N]
+    V_b : float
+        Vertical tension component at end_b, positive when the line pulls end_b
+        downward. [N]
+    tension_a, tension_b : float
+        Effective tension at end_a and end_b. [N]
+    grounded_length : float
+        Horizontal (stretched) length of line lying on the seabed, 0 without
+        contact. [m]
+    touchdown : float
+        Unstretched arc length from end_a of the touchdown point, 0 without
+        contact. [m]
+    iterations : int
+        Newton iterations used.
+    horizontal_span, vertical_span, length, weight, ea : float
+        The inputs: X [m], Z [m], L [m], w [N/m], EA [N].
+    seabed : bool
+        Whether contact with the seabed z = 0 (local) was allowed.
+    residual : float
+        Largest closure error at the solution. [m]
+    """
+
+    H: float
+    V_a: float
+    V_b: float
+    tension_a: float
+    tension_b: float
+    grounded_length: float
+    touchdown: float
+    iterations: int
+    horizontal_span: float
+    vertical_span: float
+    length: float
+    weight: float
+    ea: float
+    seabed: bool = False
+    residual: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("H", "V_a", "V_b", "tension_a", "tension_b", "grounded_length",
+                     "touchdown", "horizontal_span", "vertical_span", "length", "weight",
+                     "ea", "residual"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+        object.__setattr__(self, "iterations", int(self.iterations))
+        object.__setattr__(self, "seabed", bool(self.seabed))
+
+    @property
+    def grounded(self) -> bool:
+        """True when part of the line lies on the seabed."""
+        return self.touchdown > 0.0
+
+    @property
+    def angle_a(self) -> float:
+        """Angle of the line at end_a above the horizontal. [rad]"""
+        return math.atan2(self.V_a, self.H)
+
+    @property
+    def angle_b(self) -> float:
+        """Angle of the line at end_b above the horizontal. [rad]"""
+        return math.atan2(self.V_b, self.H)
+
+    def profile(self, s: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position and tension at unstretched arc lengths ``s`` from end_a.
+
+        Parameters
+        ----------
+        s : array_like
+            Unstretched arc lengths, 0 <= s <= length. [m]
+
+        Returns
+        -------
+        x, z : ndarray
+            Local coordinates (end_a at the origin, z up). [m]
+        tension : ndarray
+            Effective tension. [N]
+        """
+        s_arr = np.asarray(s, dtype=float)
+        s_c = np.clip(s_arr, 0.0, self.length)
+        c = 0.0 if math.isinf(self.ea) else 1.0 / self.ea
+        H, w = self.H, self.weight
+        if H == 0.0:
+            return _vertical_profile(s_c, self.V_a, w, c)
+        lb = self.touchdown
+        if lb > 0.0:
+            sig = np.maximum(s_c - lb, 0.0)
+            xk, zk, *_ = _kernel(H, 0.0, w, sig, c)
+            on = s_c <= lb
+            x = np.where(on, s_c * (1.0 + H * c), lb * (1.0 + H * c) + xk)
+            z = np.where(on, 0.0, zk)
+            t = np.where(on, H, np.hypot(H, w * sig))
+            return x, z, t
+        xk, zk, *_ = _kernel(H, self.V_a, w, s_c, c)
+        return xk, zk, np.hypot(H, self.V_a + w * s_c)
+
+
+def _vertical_profile(s, Va, w, c):
+    """Profile of a vertical line (H = 0), possibly folded where V changes sign."""
+    V = Va + w * s
+    # ∫ sgn(V)(1 + c|V|) ds' = ∫ (sgn V + c V) ds' ; sgn integral via the root s*.
+    if w != 0.0:
+        s_star = -Va / w
+    else:
+        s_star = math.inf
+    sg0 = 1.0 if (Va > 0.0 or (Va == 0.0 and w >= 0.0)) else -1.0
+    if 0.0 < s_star:
+        before = np.minimum(s, s_star)
+        after = np.maximum(s - s_star, 0.0)
+        sgn_int = sg0 * before - sg0 * after
+    else:
+        sgn_int = sg0 * s
+    z = sgn_int + c * (Va * s + 0.5 * w * s * s)
+    x = np.zeros_like(s)
+    return x, z, np.abs(V)
+
+
+@dataclass(frozen=True)
+class MultiSegmentSolution:
+    """Static equilibrium of a chain of elastic catenary segments (no seabed contact).
+
+    Attributes
+    ----------
+    H : float
+        Horizontal tension component. [N]
+    V_start, V_end : ndarray, shape (n_segments,)
+        Vertical tension component at the start and end of each segment. [N]
+    tension_a, tension_b : float
+        Effective tension at end_a and end_b. [N]
+    junctions : ndarray, shape (n_segments - 1, 2)
+        Local (x, z) of the junctions. [m]
+    iterations : int
+        Newton iterations used.
+    lengths, weights, eas : ndarray
+        Segment data: L [m], w [N/m], EA [N].
+    residual : float
+        Largest closure error at the solution. [m]
+    """
+
+    H: float
+    V_start: np.ndarray
+    V_end: np.ndarray
+    tension_a: float
+    tension_b: float
+    junctions: np.ndarray
+    iterations: int
+    lengths: np.ndarray
+    weights: np.ndarray
+    eas: np.ndarray
+    residual: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("H", "tension_a", "tension_b", "residual"):
+            object.__setattr__(self, name, float(getattr(self, name)))
+
+    def profile(self, s: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Local (x, z) and tension at unstretched arc lengths ``s`` from end_a. [m, m, N]
+
+        At a junction itself the tension of the segment ending there is returned.
+        """
+        s = np.asarray(s, dtype=float)
+        edges = np.concatenate([[0.0], np.cumsum(self.lengths)])
+        s_c = np.clip(s, 0.0, edges[-1])
+        k = np.clip(np.searchsorted(edges, s_c, side="left") - 1, 0, self.lengths.size - 1)
+        origin = np.vstack([[0.0, 0.0], self.junctions])
+        sl = s_c - edges[k]
+        c = np.where(np.isinf(self.eas), 0.0, 1.0 / self.eas)
+        x = np.empty_like(s_c)
+        z = np.empty_like(s_c)
+        for j in range(self.lengths.size):
+            m = k == j
+            if not m.any():
+                continue
+            xk, zk, *_ = _kernel(self.H, self.V_start[j], float(self.weights[j]), sl[m], c[j])
+            x[m] = origin[j, 0] + xk
+            z[m] = origin[j, 1] + zk
+        t = np.hypot(self.H, self.V_start[k] + self.weights[k] * sl)
+        return x, z, t
+
+
+# ----------------------------------------------------------------------- validation
+
+
+def _check_common(horizontal_span, vertical_span, length, weight, ea):
+    X = v.nonnegative("horizontal_span", horizontal_span, "m")
+    Z = v.finite_scalar("vertical_span", vertical_span, "m")
+    L = v.positive("length", length, "m")
+    w = v.finite_scalar("weight", weight, "N/m")
+    try:
+        ea_f = float(ea)
+    except (TypeError, ValueError):
+        raise InputError("ea", ea, "N", "must be a real number") from None
+    if math.isnan(ea_f) or ea_f <= 0.0 or ea_f == -math.inf:
+        raise InputError("ea", ea, "N", "must be > 0 (math.inf for an inextensible line)")
+    return X, Z, L, w, ea_f
+
+
+def _too_short(L, chord, ea):
+    if math.isinf(ea):
+        if chord >= L:
+            raise InputError(
+                "length", L, "m",
+                f"an inextensible line must be longer than the distance between its ends "
+                f"({chord:.6g} m)",
+            )
+    elif chord > L * (1.0 + MAX_STRAIN):
+        raise InputError(
+            "length", L, "m",
+            f"is shorter than the distance between the ends ({chord:.6g} m): the line "
+            f"would have to stretch {chord / L - 1.0:.1%} (> {MAX_STRAIN:.0%})",
+        )
+
+
+# ---------------------------------------------------------------------------- solve
+
+
+def _initial_guess(X, Z, L, w, c):
+    """Start for Newton: the inextensible catenary estimate of Peyrot & Goulois (1979)
+    for slack lines, a parabolic elastic estimate for taut ones."""
+    chord = math.hypot(X, Z)
+    slack = (L - chord) / chord if chord > 0 else math.inf
+    if slack > 0.02 and X > 0.0:
+        lam = math.sqrt(3.0 * max((L * L - Z * Z) / (X * X) - 1.0, 1e-12))
+        H0 = abs(w) * X / (2.0 * lam)
+        Vb0 = 0.5 * w * (Z / math.tanh(lam) + L)
+        return max(H0, 1e-12 * abs(w) * L), Vb0 - w * L
+    # taut: L (1 + T c) − chord = (w X)² chord / (24 T²), increasing in T
+    wx = abs(w) * X
+
+    def f(T):
+        return L * (1.0 + T * c) - chord - wx * wx * chord / (24.0 * T * T)
+
+    lo, hi = 1e-300, 1.0
+    while f(hi) < 0.0 and hi < 1e300:
+        hi *= 10.0
+    lo = hi / 10.0
+    while f(lo) > 0.0 and lo > 1e-300:
+        lo /= 10.0
+    for _ in range(200):
+        mid = math.sqrt(lo * hi) if lo > 0 else 0.5 * hi
+        if f(mid) > 0.0:
+            hi = mid
+        else:
+            lo = mid
+        if hi / max(lo, 1e-300) < 1.0 + 1e-6:
+            break
+    T = hi
+    return max(T * X / chord, 1e-12 * T), T * Z / chord - 0.5 * w * L
+
+
+def _newton(H, Va, X, Z, L, w, c, seabed, scale):
+    """Damped Newton on the closure equations; returns (H, Va, iterations, residual)."""
+    tol = _TOL * scale
+
+    def resid(H_, Va_):
+        x, z, J = _closure(H_, Va_, L, w, c, seabed)
+        return np.array([x - X, z - Z]), J
+
+    r, J = resid(H, Va)
+    nr = float(np.max(np.abs(r)))
+    it = 0
+    for it in range(1, _MAXIT + 1):
+        if nr <= tol:
+            return H, Va, it - 1, nr
+        try:
+            d = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            d = -r * (np.abs(w) * L + H) / scale
+        t = 1.0
+        if H + d[0] <= 0.1 * H:  # keep H > 0: at most a factor 10 decrease per step
+            t = 0.9 * H / -d[0]
+        best = None
+        for _ in range(60):
+            Hn, Vn = H + t * d[0], Va + t * d[1]
+            rn, Jn = resid(Hn, Vn)
+            nrn = float(np.max(np.abs(rn)))
+            if np.isfinite(nrn) and (nrn < nr or nrn <= tol):
+                best = (Hn, Vn, rn, Jn, nrn)
+                break
+            t *= 0.5
+        if best is None:
+            break
+        H, Va, r, J, nr = best
+    if nr <= tol:
+        return H, Va, it, nr
+    raise ConvergenceError(
+        "elastic catenary Newton", it, nr, tol,
+        hint="check that the line length, weight and EA are consistent with the spans",
+        partial=(H, Va),
+    )
+
+
+def _vertical_solve(Z, L, w, c, seabed):
+    """H = 0: solve z(L) = Z for V_a (monotone increasing)."""
+
+    def zend(Va):
+        return float(_vertical_profile(np.array(L), Va, w, c)[1])
+
+    Tsc = abs(w) * L + (1.0 / c if c > 0 else 0.0) * 1e-3 + 1.0
+    lo, hi = -abs(w) * L - Tsc, abs(w) * L + Tsc
+    while zend(hi) < Z:
+        hi = 2.0 * hi + Tsc
+    while zend(lo) > Z:
+        lo = 2.0 * lo - Tsc
+    for it in range(1, 400):
+        mid = 0.5 * (lo + hi)
+        if zend(mid) < Z:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 4e-16 * max(abs(hi), abs(lo), 1e-300):
+            break
+    Va = 0.5 * (lo + hi)
+    if seabed and Va < 0.0:
+        raise InputError(
+            "horizontal_span", 0.0, "m",
+            "a vertical slack line on the seabed would pile up at end_a; no catenary "
+            "equilibrium (give a horizontal span or a shorter line)",
+        )
+    return Va, it, abs(zend(Va) - Z)
+
+
+def catenary_solve(
+    horizontal_span: float,
+    vertical_span: float,
+    length: float,
+    weight: float,
+    ea: float,
+    seabed: bool = False,
+) -> CatenarySolution:
+    """Elastic catenary of one homogeneous segment between two fixed points.
+
+    Parameters
+    ----------
+    horizontal_span : float
+        Horizontal distance X from end_a to end_b, >= 0. [m]
+    vertical_span : float
+        Height Z of end_b above end_a (negative when end_b is lower). [m]
+    length : float
+        Unstretched length L. [m]
+    weight : float
+        Net submerged weight per unit length w, positive downward; negative for a
+        buoyant line, 0 for a weightless (straight, taut) line. [N/m]
+    ea : float
+        Axial stiffness EA; ``math.inf`` for an inextensible line. [N]
+    seabed : bool, optional
+        Allow frictionless contact with the seabed through end_a (the plane z = 0 of
+        the local frame): the line lies on it from end_a to the touchdown point where
+        the vertical force vanishes.  Only for w > 0; needs vertical_span > 0.
+
+    Returns
+    -------
+    CatenarySolution
+        Tensions, touchdown and a vectorized ``profile(s)``.
+
+    Raises
+    ------
+    InputError
+        Invalid input; a line that would stretch more than 10 % (``MAX_STRAIN``) to
+        reach its span; a weightless slack line; a slack line on the seabed with too
+        small a horizontal span (it would pile up).
+    ConvergenceError
+        Newton did not reach the closure tolerance (1e-12 of the length).
+
+    Notes
+    -----
+    Closure equations of the elastic catenary (Irvine 1981, ch. 2; seed 000 eqs.
+    (2.5)–(2.6) integrated with T = H/cos φ, eq. (3.28)) with the seabed extension of the grounded length
+    L_B = L − V_b/w carrying the constant tension H.  Solved by Newton on (H, V_a) with
+    an analytic, symmetric Jacobian, a backtracking line search and H kept positive.
+    The start is the inextensible estimate of Peyrot & Goulois (1979) (λ from
+    (L² − Z²)/X² = 1 + λ²/3) for slack lines and a parabolic elastic estimate for taut
+    ones.  The closure integrals ∫H/T ds and ∫V/T ds are evaluated as divided
+    differences, exact in the weightless (w → 0) and vertical (H → 0) limits.
+    A horizontal span of exactly 0 gives H = 0 (vertical, possibly folded line).
+    """
+    X, Z, L, w, ea = _check_common(horizontal_span, vertical_span, length, weight, ea)
+    c = 0.0 if math.isinf(ea) else 1.0 / ea
+    chord = math.hypot(X, Z)
+    if chord == 0.0:
+        raise InputError("horizontal_span", X, "m",
+                         "end_a and end_b coincide (horizontal and vertical span are 0)")
+    _too_short(L, chord, ea)
+    seabed = bool(seabed)
+    if seabed and w <= 0.0:
+        seabed = False  # a weightless or buoyant line does not rest on the seabed
+    if seabed and Z <= 0.0:
+        raise InputError("vertical_span", Z, "m",
+                         "must be > 0 with seabed contact (end_b above the seabed)")
+    if w == 0.0:
+        if chord <= L:
+            raise InputError("weight", w, "N/m",
+                             "a weightless line must be taut (length < distance between "
+                             "the ends); its slack shape is undetermined")
+        T = (chord / L - 1.0) / c
+        H, Va = T * X / chord, T * Z / chord
+        return CatenarySolution(H, Va, Va, T, T, 0.0, 0.0, 0, X, Z, L, w, ea, seabed, 0.0)
+    if seabed:
+        # H → 0 limit: vertical suspended part of length Ls with Z = Ls + c w Ls²/2.
+        ls_min = 2.0 * Z / (1.0 + math.sqrt(1.0 + 2.0 * c * w * Z))
+        if ls_min < L and X <= L - ls_min:
+            raise InputError(
+                "horizontal_span", X, "m",
+                f"must be > {L - ls_min:.6g} m: with seabed contact a line this slack "
+                "would pile up on the seabed (frictionless catenary has no solution)",
+            )
+    if X == 0.0:
+        Va, it, res = _vertical_solve(Z, L, w, c, seabed)
+        Vb = Va + w * L
+        return CatenarySolution(0.0, Va, Vb, abs(Va), abs(Vb), 0.0, 0.0, it, X, Z, L, w,
+                                ea, seabed, res)
+    H0, Va0 = _initial_guess(X, Z, L, w, c)
+    scale = max(L, chord)
+    H, Va, it, res = _newton(H0, Va0, X, Z, L, w, c, seabed, scale)
+    Vb = Va + w * L
+    if seabed and Va < 0.0:
+        lb = min(-Va / w, L)
+        return CatenarySolution(H, 0.0, Vb, H, math.hypot(H, Vb), lb * (1.0 + H * c), lb,
+                                it, X, Z, L, w, ea, seabed, res)
+    return CatenarySolution(H, Va, Vb, math.hypot(H, Va), math.hypot(H, Vb), 0.0, 0.0,
+                            it, X, Z, L, w, ea, seabed, res)
+
+
+def catenary_from_top_tension(
+    vertical_span: float,
+    length: float,
+    weight: float,
+    ea: float,
+    tension_b: float,
+    seabed: bool = False,
+) -> CatenarySolution:
+    """Elastic catenary whose tension at end_b is prescribed; the horizontal span follows.
+
+    Parameters
+    ----------
+    vertical_span : float
+        Height of end_b above end_a, > 0. [m]
+    length : float
+        Unstretched length. [m]
+    weight : float
+        Net submerged weight per unit length, > 0. [N/m]
+    ea : float
+        Axial stiffness (``math.inf`` for inextensible). [N]
+    tension_b : float
+        Effective tension at end_b. [N]
+    seabed : bool, optional
+        Allow seabed contact at end_a (see :func:`catenary_solve`).
+
+    Returns
+    -------
+    CatenarySolution
+        The solution, with ``horizontal_span`` the span found.
+
+    Raises
+    ------
+    InputError
+        When no horizontal span gives ``tension_b`` (too small to lift the line).
+
+    Notes
+    -----
+    With T_b given, V_b = sqrt(T_b² − H²), and the vertical closure z(L; H) = Z is one
+    equation in H on (0, T_b) solved by bisection refined with Brent's method; the
+    horizontal closure then gives the span, which :func:`catenary_solve` re-solves for a
+    consistent result.
+    """
+    from scipy.optimize import brentq
+
+    Z = v.positive("vertical_span", vertical_span, "m")
+    L = v.positive("length", length, "m")
+    w = v.positive("weight", weight, "N/m")
+    Tb = v.positive("tension_b", tension_b, "N")
+    _, _, _, _, ea = _check_common(0.0, Z, L, w, ea)
+    c = 0.0 if math.isinf(ea) else 1.0 / ea
+
+    def spans(H):
+        Vb = math.sqrt(max(Tb * Tb - H * H, 0.0))
+        Va = Vb - w * L
+        x, z, _ = _closure(H, Va, L, w, c, seabed)
+        return x, z
+
+    lo, hi = Tb * 1e-9, Tb * (1.0 - 1e-12)
+    flo, fhi = spans(lo)[1] - Z, spans(hi)[1] - Z
+    if flo * fhi > 0.0:
+        raise InputError("tension_b", Tb, "N",
+                         f"no horizontal span gives this end_b tension for a vertical span "
+                         f"of {Z:g} m (the line is too heavy or too long for it)")
+    H = brentq(lambda h: spans(h)[1] - Z, lo, hi, xtol=1e-14 * Tb, rtol=1e-15, maxiter=500)
+    X = spans(H)[0]
+    return catenary_solve(X, Z, L, w, ea, seabed=seabed)
+
+
+def catenary_multisegment(
+    horizontal_span: float,
+    vertical_span: float,
+    lengths: ArrayLike,
+    weights: ArrayLike,
+    eas: ArrayLike,
+    junction_loads: ArrayLike | None = None,
+) -> MultiSegmentSolution:
+    """Chain of elastic catenary segments with point loads at the junctions.
+
+    Parameters
+    ----------
+    horizontal_span : float
+        Horizontal distance from end_a to end_b, > 0. [m]
+    vertical_span : float
+        Height of end_b above end_a. [m]
+    lengths : array_like, shape (n,)
+        Unstretched segment lengths from end_a. [m]
+    weights : array_like, shape (n,)
+        Net submerged weight per unit length of each segment (positive down). [N/m]
+    eas : array_like, shape (n,)
+        Axial stiffness of each segment. [N]
+    junction_loads : array_like, shape (n - 1,), optional
+        Net downward point force at each junction (clump weight positive, buoy
+        negative). [N]
+
+    Returns
+    -------
+    MultiSegmentSolution
+
+    Notes
+    -----
+    The vertical tension component jumps by the junction load across each junction
+    (node equilibrium, seed 001 §6.2 buoy of 900 lb); H is constant.  The spans are
+    the sums of the segments' closures (Irvine 1981, ch. 2) and the Jacobian the
+    sum of theirs; damped Newton on (H, V_a) as in :func:`catenary_solve`, started from
+    the single-segment solution with the average weight.  No seabed contact.
+    """
+    X = v.positive("horizontal_span", horizontal_span, "m")
+    Z = v.finite_scalar("vertical_span", vertical_span, "m")
+    Ls = v.float_array("lengths", lengths, "m", positive=True)
+    n = Ls.size
+    ws = v.float_array("weights", weights, "N/m")
+    if ws.size != n:
+        raise InputError("weights", weights, "N/m", f"must have {n} entries (one per segment)")
+    eas_a = np.asarray(eas, dtype=float).reshape(-1)
+    if eas_a.size != n or np.isnan(eas_a).any() or (eas_a <= 0).any():
+        raise InputError("eas", eas, "N", f"must be {n} values > 0")
+    if junction_loads is None:
+        P = np.zeros(n - 1)
+    else:
+        P = v.float_array("junction_loads", junction_loads, "N", min_size=0)
+    if P.size != n - 1:
+        raise InputError("junction_loads", junction_loads, "N",
+                         f"must have {n - 1} entries (one per junction)")
+    cs = np.where(np.isinf(eas_a), 0.0, 1.0 / eas_a)
+    L = float(Ls.sum())
+    chord = math.hypot(X, Z)
+    ea_eq = L / float(np.sum(Ls * cs)) if np.sum(Ls * cs) > 0 else math.inf
+    _too_short(L, chord, ea_eq)
+    # V at the start of each segment = Va + offsets
+    offsets = np.concatenate([[0.0], np.cumsum(ws[:-1] * Ls[:-1] + P)])
+
+    def closure(H, Va):
+        xs = zs = 0.0
+        J = np.zeros((2, 2))
+        for j in range(n):
+            x, z, a, b, cc, d = _kernel(H, Va + offsets[j], float(ws[j]), Ls[j], cs[j])
+            xs += float(x)
+            zs += float(z)
+            J += np.array([[a, b], [cc, d]], dtype=float)
+        return np.array([xs - X, zs - Z]), J
+
+    w_avg = (float(np.sum(ws * Ls)) + float(P.sum())) / L
+    if abs(w_avg) <= 1e-6 * float(np.max(np.abs(ws), initial=0.0)):
+        w_avg = float(np.mean(np.abs(ws))) or 1.0  # a start only
+    try:
+        s0 = catenary_solve(X, Z, L, w_avg, ea_eq)
+        H, Va = s0.H, s0.V_a
+    except (InputError, ConvergenceError):
+        H, Va = _initial_guess(X, Z, L, w_avg if w_avg != 0 else 1.0, 1.0 / ea_eq)
+    scale = max(L, chord)
+    tol = _TOL * scale
+    r, J = closure(H, Va)
+    nr = float(np.max(np.abs(r)))
+    it = 0
+    for it in range(1, _MAXIT + 1):
+        if nr <= tol:
+            break
+        d = np.linalg.solve(J, -r)
+        t = 1.0
+        if H + d[0] <= 0.1 * H:
+            t = 0.9 * H / -d[0]
+        for _ in range(60):
+            rn, Jn = closure(H + t * d[0], Va + t * d[1])
+            nrn = float(np.max(np.abs(rn)))
+            if np.isfinite(nrn) and nrn < nr:
+                break
+            t *= 0.5
+        else:
+            break
+        H, Va, r, J, nr = H + t * d[0], Va + t * d[1], rn, Jn, nrn
+    if nr > tol:
+        raise ConvergenceError("multi-segment catenary Newton", it, nr, tol,
+                               partial=(H, Va))
+    V_start = Va + offsets
+    V_end = V_start + ws * Ls
+    junctions = np.zeros((n - 1, 2))
+    px = pz = 0.0
+    for j in range(n - 1):
+        x, z, *_ = _kernel(H, V_start[j], float(ws[j]), Ls[j], cs[j])
+        px += float(x)
+        pz += float(z)
+        junctions[j] = (px, pz)
+    return MultiSegmentSolution(
+        H=H, V_start=V_start, V_end=V_end, tension_a=math.hypot(H, V_start[0]),
+        tension_b=math.hypot(H, V_end[-1]), junctions=junctions, iterations=it,
+        lengths=Ls, weights=ws, eas=eas_a, residual=nr,
+    )
+
+
+# ------------------------------------------------------------------------------ 3-D
+
+
+@dataclass(frozen=True, eq=False)
+class CatenaryLine:
+    """A catenary solution placed in 3-D along a mesh.
+
+    Attributes
+    ----------
+    solution : CatenarySolution
+        The 2-D solution in the vertical plane through both ends.
+    positions : ndarray, shape (n_nodes, 3)
+        Node positions at the mesh's unstretched arc lengths ``s0``. [m]
+    element_tension : ndarray, shape (n_elements,)
+        Effective tension at each element's mid arc length. [N]
+    node_tension : ndarray, shape (n_nodes,)
+        Effective tension at the nodes. [N]
+    """
+
+    solution: CatenarySolution
+    positions: np.ndarray
+    element_tension: np.ndarray
+    node_tension: np.ndarray
+
+
+def catenary_line(
+    mesh_or_line: Union["LineMesh", "Line"], environment: "Environment"
+) -> CatenaryLine:
+    """Closed-form statics of a one-segment line without attachments, in 3-D.
+
+    Parameters
+    ----------
+    mesh_or_line : LineMesh or Line
+        The line (meshed with ``environment``'s rho and g when a Line is given).
+    environment : Environment
+        Depth, rho, g; seabed contact is used when end_a lies on the seabed.
+
+    Returns
+    -------
+    CatenaryLine
+        Node positions at the mesh's ``s0`` and element tensions at mid arc length.
+
+    Raises
+    ------
+    InputError
+        For lines with more than one segment or with attachments carrying load.
+    """
+    from stochcable.line.mesh import LineMesh, mesh_line
+
+    if isinstance(mesh_or_line, LineMesh):
+        mesh = mesh_or_line
+    else:
+        mesh = mesh_line(mesh_or_line, environment.rho, environment.g)
+    if np.unique(mesh.segment).size != 1:
+        raise InputError(f"line {mesh.name!r}.segments", int(np.unique(mesh.segment).size),
+                         "-", "the closed-form catenary needs exactly one segment")
+    if (np.any(mesh.node_mass != 0.0) or np.any(mesh.node_buoyancy != 0.0)):
+        raise InputError(f"line {mesh.name!r}.attachments", "mass/buoyancy", "-",
+                         "the closed-form catenary needs a line without loaded attachments")
+    a, b = mesh.end_a, mesh.end_b
+    d = b - a
+    X = float(math.hypot(d[0], d[1]))
+    Z = float(d[2])
+    e_h = np.array([d[0], d[1], 0.0]) / X if X > 0.0 else np.array([1.0, 0.0, 0.0])
+    depth = environment.depth
+    on_seabed = abs(a[2] + depth) <= 1e-9 * depth
+    sol = catenary_solve(X, Z, mesh.length, float(mesh.weight[0]), float(mesh.ea[0]),
+                         seabed=on_seabed)
+    x, z, t = sol.profile(mesh.s0)
+    pos = a[None, :] + x[:, None] * e_h[None, :] + z[:, None] * np.array([0.0, 0.0, 1.0])
+    mid = 0.5 * (mesh.s0[1:] + mesh.s0[:-1])
+    _, _, t_mid = sol.profile(mid)
+    return CatenaryLine(solution=sol, positions=pos, element_tension=t_mid, node_tension=t)

@@ -1,0 +1,1 @@
+"""Result objects, response statistics and the result document."""

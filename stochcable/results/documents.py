@@ -1,0 +1,658 @@
+"""Result objects of :func:`stochcable.dynamics.line.analyze` and the v1 result document.
+
+Everything is a frozen dataclass holding numpy arrays; :meth:`Result.to_document`
+returns the JSON-ready result document of DESIGN.md ("Scene and result documents",
+v1 contract) plus extra keys.  Transfer functions and response spectra live on the
+Python objects (:class:`LineResult`); the document carries statistics, the end-tension
+spectra and a window of the time series.
+
+Conventions (DESIGN.md): SI, ω in rad/s, one-sided spectra S(ω) [unit²·s/rad],
+harmonic quantities Re{X e^{iωt}}, transfer functions per unit input of each channel
+(metre of wave amplitude for the sea, metre of end motion for an end-motion
+spectrum channel).  Channels are mutually independent, so a response spectrum is
+S_x(ω) = Σ_i |H_{x,i}(ω)|² S_i(ω).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from stochcable.scene.units import unit_labels
+
+__all__ = [
+    "THREE_HOURS",
+    "ResponseStats",
+    "LinearizationRecord",
+    "LineIndicators",
+    "LineResult",
+    "BodyResult",
+    "TimeSeries",
+    "Result",
+    "stats_from_spectrum",
+]
+
+THREE_HOURS = 10800.0
+"""Storm duration of the ``mpm_3h`` statistic. [s]"""
+
+# Number of time samples of the time-series window put in the result document.
+DOCUMENT_WINDOW = 2048
+
+
+@dataclass(frozen=True)
+class ResponseStats:
+    """Statistics of one Gaussian response: static mean + zero-mean dynamic part.
+
+    Attributes
+    ----------
+    mean : float
+        Static (mean) value. [unit]
+    std : float
+        Standard deviation of the dynamic part, √m0. [unit]
+    m0, m1, m2, m4 : float
+        Spectral moments ∫ωⁿ S dω (trapezoid on the analysis grid). [unit²·(rad/s)ⁿ]
+    tz : float
+        Mean zero-upcrossing period 2π√(m0/m2) (0 for a zero process). [s]
+    significant : float
+        Significant value 2σ (DESIGN.md "Outputs"). [unit]
+    bandwidth : float
+        Spectral bandwidth √(1 − m2²/(m0 m4)). [-]
+    mpm_3h : float
+        mean + Rayleigh most probable maximum of the dynamic part over three hours,
+        σ√(2 ln(10800/Tz)). [unit]
+    mpm : float
+        mean + the same over the scene's ``analysis.duration``. [unit]
+    expected_max : float
+        mean + expected maximum over ``analysis.duration``. [unit]
+    """
+
+    mean: float
+    std: float
+    m0: float
+    m1: float
+    m2: float
+    m4: float
+    tz: float
+    significant: float
+    bandwidth: float
+    mpm_3h: float
+    mpm: float
+    expected_max: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict of the fields."""
+        return {k: float(getattr(self, k)) for k in
+                ("mean", "std", "tz", "mpm_3h", "significant", "m0", "m1", "m2", "m4",
+                 "bandwidth", "mpm", "expected_max")}
+
+
+def stats_from_spectrum(
+    omega: np.ndarray, density: np.ndarray, mean: float, duration: float
+) -> ResponseStats:
+    """Statistics of a response from its one-sided spectrum on the analysis grid.
+
+    Parameters
+    ----------
+    omega : ndarray, shape (n,)
+        Frequency grid. [rad/s]
+    density : ndarray, shape (n,)
+        One-sided spectrum of the dynamic part. [unit²·s/rad]
+    mean : float
+        Static value of the response. [unit]
+    duration : float
+        Storm duration for ``mpm`` and ``expected_max``. [s]
+
+    Returns
+    -------
+    ResponseStats
+
+    Notes
+    -----
+    :func:`stochcable.results.statistics.response_statistics` (trapezoid moments, Rayleigh
+    maxima); mpm_3h = mean + σ√(2 ln(10800/Tz)) (DESIGN.md "Outputs").
+    """
+    from stochcable.results.statistics import response_statistics
+
+    st = response_statistics(omega, density, THREE_HOURS)
+    sd = st if duration == THREE_HOURS else response_statistics(omega, density, duration)
+    return _response_stats(st, sd, mean)
+
+
+def _stats_from_validated(omega: np.ndarray, density: np.ndarray, mean: float,
+                          duration: float) -> ResponseStats:
+    """:func:`stats_from_spectrum` of a validated grid and spectrum (the analysis grid,
+    validated once at the boundary; a 1-D float density >= 0 of its size, duration
+    > 0): no second validation per call."""
+    from stochcable.results.statistics import _statistics
+
+    st = _statistics(omega, density, THREE_HOURS)
+    sd = st if duration == THREE_HOURS else _statistics(omega, density, float(duration))
+    return _response_stats(st, sd, mean)
+
+
+def _response_stats(st: Any, sd: Any, mean: float) -> ResponseStats:
+    """ResponseStats from the statistics over three hours (st) and the duration (sd)."""
+    mean = float(mean)
+    return ResponseStats(
+        mean=mean, std=float(st.std), m0=float(st.m0), m1=float(st.m1), m2=float(st.m2),
+        m4=float(st.m4), tz=float(st.tz), significant=float(st.significant),
+        bandwidth=float(st.bandwidth), mpm_3h=mean + float(st.mpm),
+        mpm=mean + float(sd.mpm), expected_max=mean + float(sd.expected_max),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class LinearizationRecord:
+    """The drag-linearization fixed point of one line (seed 001 §5.3 steps 5–13).
+
+    Attributes
+    ----------
+    method : str
+        ``"seed"``, ``"vector"`` or ``"harmonic"``.
+    converged : bool
+        Whether the relative change of every σ fell below the tolerance.
+    iterations : int
+        Number of response evaluations. [-]
+    relative_change : float
+        Final max relative change of the σ. [-]
+    history : tuple of float
+        Relative change after each iteration. [-]
+    tolerance : float
+        Tolerance asked for. [-]
+    sigma_normal, sigma_axial : ndarray, shape (n_el,)
+        Final σ of the normal and axial relative velocity at element midpoints. [m/s]
+    b_normal, b_axial : ndarray, shape (n_el,)
+        Final linear drag coefficients per unit length (normal: the trace/2 of the
+        normal-plane matrix for the vector form). [N·s/m²]
+    """
+
+    method: str
+    converged: bool
+    iterations: int
+    relative_change: float
+    history: tuple[float, ...]
+    tolerance: float
+    sigma_normal: np.ndarray
+    sigma_axial: np.ndarray
+    b_normal: np.ndarray
+    b_axial: np.ndarray
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "method": self.method,
+            "converged": bool(self.converged),
+            "iterations": int(self.iterations),
+            "relative_change": float(self.relative_change),
+            "tolerance": float(self.tolerance),
+            "history": [float(h) for h in self.history],
+        }
+
+
+
+def _finite_or_none(x: float) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+@dataclass(frozen=True, eq=False)
+class LineIndicators:
+    """Quality indicators of the linear model of one line (GitHub issue 7).
+
+    Attributes
+    ----------
+    borgman_ratio : ndarray, shape (n_el,)
+        Var(B v)/Var(½ρCdD|v|v) of the normal drag per element for the Gaussian
+        normal relative velocity with the element's normal current
+        (:func:`stochcable.dynamics.linearization.borgman_variance_ratio`; 0.849 without
+        current). [-]
+    drag_inertia_ratio : ndarray, shape (n_el,)
+        σ of the linearized normal drag force over σ of the Morison inertia force
+        ρ C_M (πD²/4) a_n of the sea per element (inf without fluid acceleration;
+        :func:`stochcable.dynamics.linearization.drag_inertia_ratio`). [-]
+    snap_margin : float
+        min over elements and ends of (T_mean − 3σ_T)/|T_mean|; below 0 the linear
+        model predicts slack (snap loads likely). [-]
+    snap_risk : bool
+        ``snap_margin < 0``.
+    resonances : tuple of dict
+        Modes inside the excitation band with modal damping ratio below 1 %:
+        ``{"mode": j (1-based), "omega": ω_j [rad/s], "damping_ratio": ζ_j [-]}``.
+    motion_std_max : float
+        Largest node motion σ (magnitude of the x, y, z σ). [m]
+    sag : float
+        Largest distance of the static shape from the chord of the ends. [m]
+    motion_to_sag : float
+        motion_std_max / sag (inf for a straight line). [-]
+    motion_to_diameter : float
+        motion_std_max / largest diameter. [-]
+    flags : tuple of str
+        Raised flags: ``"snap"``, ``"resonance"``, ``"large_motion"``.
+    """
+
+    borgman_ratio: np.ndarray
+    drag_inertia_ratio: np.ndarray
+    snap_margin: float
+    snap_risk: bool
+    resonances: tuple[dict[str, Any], ...]
+    motion_std_max: float
+    sag: float
+    motion_to_sag: float
+    motion_to_diameter: float
+    flags: tuple[str, ...]
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (non-finite numbers as None)."""
+        br, di = self.borgman_ratio, self.drag_inertia_ratio
+        return {
+            "borgman_ratio": {"min": _finite_or_none(br.min()) if br.size else None,
+                              "max": _finite_or_none(br.max()) if br.size else None,
+                              "elements": [_finite_or_none(x) for x in br]},
+            "drag_inertia_ratio": {
+                "min": _finite_or_none(di.min()) if di.size else None,
+                "max": _finite_or_none(di.max()) if di.size else None,
+                "elements": [_finite_or_none(x) for x in di]},
+            "snap": {"risk": bool(self.snap_risk),
+                     "margin": _finite_or_none(self.snap_margin)},
+            "resonances": [dict(r) for r in self.resonances],
+            "motion": {"std_max": float(self.motion_std_max), "sag": float(self.sag),
+                       "to_sag": _finite_or_none(self.motion_to_sag),
+                       "to_diameter": _finite_or_none(self.motion_to_diameter)},
+            "flags": list(self.flags),
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class LineResult:
+    """Frequency-domain response of one line.
+
+    Attributes
+    ----------
+    name : str
+        Line name.
+    omega : ndarray, shape (n_omega,)
+        Analysis frequencies. [rad/s]
+    channels : tuple of str
+        Names of the independent input channels (``"sea"``, ``"end_b.surge"``, …).
+    input_spectra : ndarray, shape (n_ch, n_omega)
+        One-sided input spectrum of each channel. [m²·s/rad]
+    s_nodes : ndarray, shape (n_nodes,)
+        Unstretched arc length of the nodes from end_a. [m]
+    s_elements : ndarray, shape (n_el,)
+        Unstretched arc length of the element midpoints. [m]
+    positions : ndarray, shape (n_nodes, 3)
+        Static node positions. [m]
+    motion_transfer : ndarray, complex, shape (n_ch, n_nodes, 3, n_omega)
+        Total node displacement (prescribed end motion + response) per unit input. [m/m]
+    tension_transfer : ndarray, complex, shape (n_ch, n_el, n_omega)
+        Dynamic effective tension of each element per unit input. [N/m]
+    end_tension_transfer : dict {"end_a", "end_b"} of ndarray (n_ch, n_omega)
+        Dynamic change of the magnitude of the force on each support per unit input
+        (from the reaction rows of the finite-element equations). [N/m]
+    end_force_transfer : dict {"end_a", "end_b"} of ndarray (n_ch, 3, n_omega)
+        Dynamic force of the line on each support, global x, y, z, per unit input. [N/m]
+    tension_mean : ndarray, shape (n_el,)
+        Static effective tension per element. [N]
+    tension_std : ndarray, shape (n_el,)
+        σ of the dynamic effective tension per element. [N]
+    motion_std : ndarray, shape (n_nodes, 3)
+        σ of the x, y, z node displacements. [m]
+    end_a, end_b : ResponseStats
+        Statistics of the end tensions. [N]
+    linearization : LinearizationRecord
+    modes_omega : ndarray
+        Natural frequencies computed for the line about its static shape (with added
+        mass, in the model's plane for a 2-D model). [rad/s]
+    modes_listed : int
+        How many of them the document lists (those up to 2.5·ω_max, at least 10). [-]
+    n_modes : int or None
+        Modes kept by the Foss solve (None for the direct solve). [-]
+    statics, model, modes : objects
+        The statics result of the line, its finite-element model and modes (for
+        inspection and re-use).
+    indicators : LineIndicators or None
+        Quality indicators of the linear model (None when not computed).
+    """
+
+    name: str
+    omega: np.ndarray
+    channels: tuple[str, ...]
+    input_spectra: np.ndarray
+    s_nodes: np.ndarray
+    s_elements: np.ndarray
+    positions: np.ndarray
+    motion_transfer: np.ndarray
+    tension_transfer: np.ndarray
+    end_tension_transfer: dict[str, np.ndarray]
+    end_force_transfer: dict[str, np.ndarray]
+    tension_mean: np.ndarray
+    tension_std: np.ndarray
+    motion_std: np.ndarray
+    end_a: ResponseStats
+    end_b: ResponseStats
+    linearization: LinearizationRecord
+    modes_omega: np.ndarray
+    modes_listed: int
+    n_modes: int | None
+    statics: Any = None
+    model: Any = None
+    modes: Any = None
+    indicators: LineIndicators | None = None
+
+    @property
+    def listed_modes(self) -> np.ndarray:
+        """The natural frequencies the document lists. [rad/s]"""
+        return np.asarray(self.modes_omega)[: self.modes_listed]
+
+    # ---------------------------------------------------------------- spectra
+    def _spectrum(self, transfer: np.ndarray) -> np.ndarray:
+        """Σ_i |H_i|² S_i over the channel axis (axis 0)."""
+        s = self.input_spectra.reshape((self.input_spectra.shape[0],)
+                                       + (1,) * (transfer.ndim - 2) + (-1,))
+        return np.sum(np.abs(transfer) ** 2 * s, axis=0)
+
+    def end_force_std(self, end: str) -> np.ndarray:
+        """σ of the x, y, z force on the support at ``end``, shape (3,). [N]"""
+        dens = self._spectrum(self.end_force_transfer[end])
+        return np.sqrt(np.trapezoid(dens, self.omega, axis=-1))
+
+    def end_tension_spectrum(self, end: str) -> np.ndarray:
+        """One-sided spectrum of the tension at ``end`` ("end_a" or "end_b"). [N²·s/rad]"""
+        return self._spectrum(self.end_tension_transfer[end])
+
+    @property
+    def tension_spectrum(self) -> np.ndarray:
+        """Spectrum of the element effective tensions, shape (n_el, n_omega). [N²·s/rad]"""
+        return self._spectrum(self.tension_transfer)
+
+    @property
+    def motion_spectrum(self) -> np.ndarray:
+        """Spectrum of the node displacements, shape (n_nodes, 3, n_omega). [m²·s/rad]"""
+        return self._spectrum(self.motion_transfer)
+
+    def to_document(self) -> dict[str, Any]:
+        """The line's part of the result document."""
+        return {
+            "end_a": {"tension": self.end_a.as_dict(),
+                      "force_std": self.end_force_std("end_a").tolist()},
+            "end_b": {"tension": self.end_b.as_dict(),
+                      "force_std": self.end_force_std("end_b").tolist()},
+            "tension": {
+                "s": self.s_elements.tolist(),
+                "std": self.tension_std.tolist(),
+                "mean": self.tension_mean.tolist(),
+            },
+            "motion": {"s": self.s_nodes.tolist(), "std": self.motion_std.tolist()},
+            "spectra": {
+                "omega": self.omega.tolist(),
+                "end_a": {"tension": self.end_tension_spectrum("end_a").tolist()},
+                "end_b": {"tension": self.end_tension_spectrum("end_b").tolist()},
+            },
+            "channels": list(self.channels),
+            "linearization": self.linearization.as_dict(),
+            "modes": {"omega": self.listed_modes.tolist(), "kept": self.n_modes},
+            "indicators": None if self.indicators is None else self.indicators.as_dict(),
+        }
+
+
+
+@dataclass(frozen=True, eq=False)
+class BodyResult:
+    """Frequency-domain motion of one rigid body (GitHub issue 6).
+
+    Attributes
+    ----------
+    name : str
+        Body name.
+    dofs : tuple of str
+        DOF names in order: ``("surge", "sway", "heave", "roll", "pitch", "yaw")``, or
+        ``("surge", "heave", "pitch")`` for a planar body (pitch about +y).
+    omega : ndarray, shape (n_omega,)
+        Analysis frequencies. [rad/s]
+    channels : tuple of str
+        Input channels (the coupled group's: ``"sea"``, ``"<line>.<end>.<dof>"``).
+    input_spectra : ndarray, shape (n_ch, n_omega)
+        One-sided input spectrum of each channel. [m²·s/rad]
+    motion_transfer : ndarray, complex, shape (n_ch, d, n_omega)
+        Motion of the reference point per unit input: translations [m/m], small
+        rotations about the global axes [rad/m].
+    motion : dict of str to ResponseStats
+        Statistics per DOF; mean = the static pose (position [m], rotation [rad]).
+    prescribed : bool
+        True for a vessel whose motion is its RAO (not solved for).
+    drag_sigma : ndarray or None, shape (3,)
+        σ of the relative velocity at the drag point along x, y, z. [m/s]
+    drag_coefficient : ndarray or None, shape (3,)
+        Linear drag coefficient per direction at the drag point. [N·s/m]
+    modes : CoupledModes or None
+        Natural modes of the coupled group the body belongs to.
+    """
+
+    name: str
+    dofs: tuple[str, ...]
+    omega: np.ndarray
+    channels: tuple[str, ...]
+    input_spectra: np.ndarray
+    motion_transfer: np.ndarray
+    motion: dict[str, ResponseStats]
+    prescribed: bool = False
+    drag_sigma: np.ndarray | None = None
+    drag_coefficient: np.ndarray | None = None
+    modes: Any = None
+
+    @property
+    def motion_spectrum(self) -> np.ndarray:
+        """Spectrum of each DOF, shape (d, n_omega). [m²·s/rad, rad²·s/rad]"""
+        return np.einsum("cdw,cw->dw", np.abs(self.motion_transfer) ** 2, self.input_spectra)
+
+    @property
+    def motion_std(self) -> np.ndarray:
+        """σ of each DOF, shape (d,). [m, rad]"""
+        return np.array([self.motion[k].std for k in self.dofs])
+
+    def to_document(self) -> dict[str, Any]:
+        """The body's part of the result document: per DOF the statistics (rotations
+        in rad, plus ``std_deg`` in degrees), the spectra, the modes."""
+        motion = {}
+        for k in self.dofs:
+            d = self.motion[k].as_dict()
+            if k in ("roll", "pitch", "yaw"):
+                d["std_deg"] = math.degrees(d["std"])
+            motion[k] = d
+        return {
+            "prescribed": bool(self.prescribed),
+            "dofs": list(self.dofs),
+            "motion": motion,
+            "spectra": {"omega": self.omega.tolist(),
+                        **{k: s.tolist() for k, s in zip(self.dofs, self.motion_spectrum)}},
+            "channels": list(self.channels),
+            "drag": None if self.drag_sigma is None else {
+                "sigma": self.drag_sigma.tolist(),
+                "coefficient": (None if self.drag_coefficient is None
+                                else self.drag_coefficient.tolist())},
+            "modes": None if self.modes is None else self.modes.as_dict(),
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class TimeSeries:
+    """One realization of the sea (and of each end-motion channel) and the responses.
+
+    All series share the time axis and the complex amplitudes of their channels, so
+    elevation, motions and tensions are mutually consistent (DESIGN.md "Random sea
+    simulation").
+
+    Attributes
+    ----------
+    time : ndarray, shape (N_t,)
+        Sample times. [s]
+    method : str
+        ``"dsa"`` or ``"nsa"``.
+    seed : int
+        Root seed: the sea uses ``rng=seed``; end-motion spectrum channel k (every
+        line in scene order × end_a, end_b × surge, sway, heave) uses
+        ``np.random.SeedSequence(seed).spawn(n)[k]``.
+    elevation : ndarray or None, shape (N_t,)
+        Wave elevation at the origin (None without a sea). [m]
+    end_motion : dict
+        ``{"line.end_b.surge": series}`` for end-motion spectrum channels. [m]
+    end_tension : dict
+        ``{line: {"end_a": series, "end_b": series}}`` total tension mean + dynamic. [N]
+    omega : ndarray, shape (N+1,)
+        Realization grid ω_m = mΔω. [rad/s]
+    channels : dict
+        ``{line: (channel names)}``, the order of the transfer arrays: the line's
+        own (``"sea"``, ``"end_b.surge"``) for an independent line, its coupled
+        group's (``"sea"``, ``"<line>.<end>.<dof>"``) for a line on a free body.
+    end_tension_transfer : dict
+        ``{line: {"end_a": H, "end_b": H}}``, H of shape (n_ch, N+1) on ``omega``
+        (zero outside the analysis band), the transfer functions synthesized. [N/unit]
+    body_motion : dict
+        ``{body: {dof: series}}`` motion of each body's reference point, static pose
+        plus dynamic part, in the body's DOF names (``BodyResult.dofs``): positions
+        [m], small rotations about the global axes [rad].  Free bodies from the
+        coupled solve, prescribed bodies (vessels) from their RAO.
+    body_channels : dict
+        ``{body: (channel names)}``, the order of the body transfer arrays (the
+        coupled group's channels; ``("sea",)`` for a vessel).
+    body_motion_transfer : dict
+        ``{body: H}``, H of shape (n_ch, d, N+1) on ``omega`` (zero outside the
+        analysis band), the transfer functions synthesized. [m/unit, rad/unit]
+    """
+
+    time: np.ndarray
+    method: str
+    seed: int
+    elevation: np.ndarray | None
+    end_motion: dict[str, np.ndarray]
+    end_tension: dict[str, dict[str, np.ndarray]]
+    omega: np.ndarray
+    channels: dict[str, tuple[str, ...]]
+    end_tension_transfer: dict[str, dict[str, np.ndarray]]
+    body_motion: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    body_channels: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    body_motion_transfer: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def to_document(self, full: bool = False) -> dict[str, Any]:
+        """Document part: the first :data:`DOCUMENT_WINDOW` samples, or all if ``full``."""
+        n = self.time.size if full else min(self.time.size, DOCUMENT_WINDOW)
+        doc: dict[str, Any] = {
+            "method": self.method,
+            "seed": int(self.seed),
+            "dt": float(self.time[1] - self.time[0]) if self.time.size > 1 else 0.0,
+            "samples": int(self.time.size),
+            "window": int(n),
+            "time": self.time[:n].tolist(),
+            "elevation": None if self.elevation is None else self.elevation[:n].tolist(),
+            "end_motion": {k: v[:n].tolist() for k, v in self.end_motion.items()},
+            "lines": {
+                name: {end: {"tension": s[:n].tolist()} for end, s in ends.items()}
+                for name, ends in self.end_tension.items()
+            },
+        }
+        if self.body_motion:
+            # {body: {"motion": {dof: [...]}}} (rad for rotations), as the result's
+            # "bodies" part
+            doc["bodies"] = {name: {"motion": {k: s[:n].tolist() for k, s in dofs.items()}}
+                             for name, dofs in self.body_motion.items()}
+        return doc
+
+
+@dataclass(frozen=True, eq=False)
+class Result:
+    """Result of :func:`stochcable.dynamics.line.analyze`.
+
+    Attributes
+    ----------
+    scene : Scene
+        The analysed scene.
+    statics : StaticsResult
+        Static equilibrium of every line.
+    lines : dict of LineResult
+        Frequency-domain response per line name.
+    timeseries : TimeSeries or None
+        Present when ``analysis.timeseries`` is set.
+    timing : dict of float
+        Wall-clock seconds per stage (``total_s``, ``statics_s``, ``model_s``,
+        ``modes_s``, ``linearization_s``, ``solve_s``, ``outputs_s``,
+        ``timeseries_s``). [s]
+    warnings : tuple of str
+        Messages of the warnings raised during the analysis.
+    fidelity : FidelityPlan or None
+        The settings chosen by adaptive fidelity (``analysis.fidelity``), with their
+        reasons and error estimates; ``scene`` is then the scene they produced.
+    bodies : dict of BodyResult
+        Motion of every rigid body by name (empty without bodies).
+    """
+
+    scene: Any
+    statics: Any
+    lines: dict[str, LineResult]
+    timeseries: TimeSeries | None
+    timing: dict[str, float]
+    warnings: tuple[str, ...] = field(default_factory=tuple)
+    fidelity: Any = None
+    bodies: dict[str, BodyResult] = field(default_factory=dict)
+
+    @property
+    def converged(self) -> bool:
+        """Whether the drag linearization converged on every line."""
+        return all(r.linearization.converged for r in self.lines.values())
+
+    @property
+    def linearization(self) -> dict[str, Any]:
+        """Aggregate record: converged on all lines, max iterations, max change."""
+        recs = [r.linearization for r in self.lines.values()]
+        return {
+            "converged": all(r.converged for r in recs),
+            "iterations": max((r.iterations for r in recs), default=0),
+            "relative_change": max((r.relative_change for r in recs), default=0.0),
+        }
+
+    def to_document(self, timeseries: str = "window") -> dict[str, Any]:
+        """The v1 result document (DESIGN.md), JSON-ready.
+
+        Parameters
+        ----------
+        timeseries : {"window", "full", "none"}
+            Put the first 2048 samples of the time series, all of them, or none.
+
+        Notes
+        -----
+        ``units`` names the scene's consistent unit system and its labels
+        (:func:`stochcable.scene.units.unit_labels` of ``environment.g``: SI, or ft, slug,
+        lbf for the seeds' imperial examples); every number is in that system.
+        """
+        if hasattr(self.statics, "to_document"):
+            statics_doc = self.statics.to_document()
+        else:  # pragma: no cover - statics always has it
+            statics_doc = {}
+        first = next(iter(self.lines.values()))
+        doc: dict[str, Any] = {
+            "statics": statics_doc,
+            "modes": {
+                "omega": first.listed_modes.tolist(),
+                "lines": {k: v.listed_modes.tolist() for k, v in self.lines.items()},
+            },
+            "linearization": {
+                **self.linearization,
+                "lines": {k: v.linearization.as_dict() for k, v in self.lines.items()},
+            },
+            "lines": {k: v.to_document() for k, v in self.lines.items()},
+            "timing": {k: float(v) for k, v in self.timing.items()},
+            "warnings": list(self.warnings),
+        }
+        env = getattr(self.scene, "environment", None)
+        if env is not None:
+            # the labels of the scene's consistent unit system (SI or ft/slug/lbf,
+            # read off g): the numbers above are in these units
+            doc["units"] = unit_labels(env.g).as_dict()
+        if self.fidelity is not None:
+            doc["fidelity"] = self.fidelity.to_document()
+        if self.bodies:
+            doc["bodies"] = {k: v.to_document() for k, v in self.bodies.items()}
+        if self.timeseries is not None and timeseries != "none":
+            doc["timeseries"] = self.timeseries.to_document(full=timeseries == "full")
+        return doc
