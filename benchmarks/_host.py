@@ -9,6 +9,10 @@ The probe is two fixed workloads, each the minimum of 7 runs (the minimum is the
 least load-sensitive statistic): a pure-Python loop (what Python-heavy stages such as
 the model assembly and small-array kernels pay) and a NumPy/LAPACK kernel of the
 size of the analyses' per-line work (78×78 real geev, as in a Foss decomposition).
+
+Importing it also applies :func:`stochcable.runtime.configure` (one BLAS thread for
+small models, the allocator pad, passive OpenMP waiting): the benchmarks measure with
+the settings of the command line and the service.
 """
 
 from __future__ import annotations
@@ -16,6 +20,10 @@ from __future__ import annotations
 import time
 
 import numpy as np
+
+from stochcable import runtime
+
+runtime.configure()
 
 __all__ = ["host_probe", "host_line"]
 

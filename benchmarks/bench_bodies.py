@@ -37,8 +37,8 @@ import warnings
 from typing import Any
 
 from _host import host_line
-from stochcable.dynamics.line import (_single_blas_thread, _tune_allocator, analyze,
-                                 build_line_system, line_result, linearize)
+from stochcable.dynamics.line import analyze, build_line_system, line_result, linearize
+from stochcable.runtime import single_blas_thread
 import numpy as np
 
 import stochcable.dynamics.coupled as coupled_analysis
@@ -77,9 +77,8 @@ def run_coupled(scene, statics=None):
     """Statics (when not given) and the coupled dynamics, one BLAS thread and glibc's
     heap top pad as ``analyze()`` runs them (pass E4: the earlier passes timed without
     the pad, ≈ 6 % slower from page faults)."""
-    _tune_allocator()
     timing: dict[str, float] = {}
-    with _single_blas_thread():
+    with single_blas_thread():
         if statics is None:
             statics = solve_statics(scene, method="fe")
         out = analyze_coupled(scene, statics, scene.analysis, timing=timing)
@@ -97,7 +96,7 @@ def independent_scene(scene, statics):
 
 def run_independent(scene, statics):
     w = scene.analysis.omega.values()
-    with _single_blas_thread():
+    with single_blas_thread():
         for line in scene.lines:
             s = build_line_system(scene, line, statics.lines[line.name])
             ch = line_channels(scene, line, s.positions, w)
@@ -243,16 +242,16 @@ def main() -> None:
     warnings.simplefilter("ignore")
     print(host_line())
     if args.coarse_ab:
-        with _single_blas_thread():
+        with single_blas_thread():
             coarse_ab(max(args.repeat, 9))
         print(host_line())
         return
     if args.ab:
-        with _single_blas_thread():
+        with single_blas_thread():
             fast_paths_ab(max(args.repeat, 9))
         return
     if args.threads_ab:
-        with _single_blas_thread():
+        with single_blas_thread():
             threads_ab(max(args.repeat, 11))
         return
     for solver in ("direct", "foss"):

@@ -14,7 +14,7 @@ import pkgutil
 from fastapi import FastAPI
 from starlette.middleware.gzip import DEFAULT_EXCLUDED_CONTENT_TYPES, GZipMiddleware
 
-from stochcable import __version__
+from stochcable import __version__, runtime
 
 from . import routers
 from .encoding import NPY
@@ -80,6 +80,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         The application (settings in ``app.state.settings``).
     """
     settings = settings if settings is not None else Settings()
+    runtime.configure()  # the service's process settings (stochcable.runtime)
     app = FastAPI(
         title="stochcable",
         version=__version__,

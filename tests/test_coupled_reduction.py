@@ -219,7 +219,7 @@ def test_threaded_lines_give_the_same_bits_as_serial(monkeypatch, solver):
     computation per line, summed in line order, so the same bits (not a
     tolerance)."""
     import stochcable.runtime as par
-    from stochcable.dynamics.line import _single_blas_thread
+    from stochcable.runtime import single_blas_thread
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(solver=solver, tol=1e-4), body)
@@ -234,7 +234,7 @@ def test_threaded_lines_give_the_same_bits_as_serial(monkeypatch, solver):
     out = []
     for threads in ("1", "2"):
         monkeypatch.setenv("STOCHCABLE_THREADS", threads)
-        with _single_blas_thread():
+        with single_blas_thread():
             out.append(linearize_coupled(cls, [body], scene.analysis, rho=RHO,
                                          loads=loads))
         # the pool ran only when allowed, and only for Foss lines

@@ -6,7 +6,6 @@ single-BLAS-thread limit in worker threads."""
 from __future__ import annotations
 
 import json
-import threading
 from pathlib import Path
 
 import numpy as np
@@ -139,24 +138,3 @@ def test_narrow_resonance_is_not_missed_by_the_coarse_subset():
     assert np.max(np.abs(_sigma(c) / _sigma(f) - 1)) < 4 * tol  # each within 2 tol
 
 
-def test_single_blas_thread_applies_in_worker_threads():
-    threadpoolctl = pytest.importorskip("threadpoolctl")
-
-    def blas_threads() -> list[int]:
-        return [d["num_threads"] for d in threadpoolctl.threadpool_info()
-                if d["user_api"] == "blas"]
-
-    before = blas_threads()
-    seen: dict[str, list[int]] = {}
-    with an._single_blas_thread():  # the main thread first (it used to keep control)
-        seen["main"] = blas_threads()
-
-    def work() -> None:
-        with an._single_blas_thread():
-            seen["worker"] = blas_threads()
-
-    t = threading.Thread(target=work)
-    t.start()
-    t.join()
-    assert all(n == 1 for n in seen["main"]) and all(n == 1 for n in seen["worker"])
-    assert blas_threads() == before  # restored

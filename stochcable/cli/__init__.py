@@ -16,6 +16,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 
+from stochcable import runtime
 from stochcable.errors import StochcableError
 
 __all__ = ["main", "build_parser"]
@@ -51,6 +52,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     warnings.showwarning = _warning_to_stderr
+    runtime.configure()  # the command line's process settings (stochcable.runtime)
     try:
         return int(args.func(args) or 0)
     except StochcableError as exc:

@@ -75,12 +75,10 @@ element's δT when those are small (tested).
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import math
-import threading
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -88,6 +86,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from stochcable import runtime
 from stochcable.errors import (
     ConvergenceError,
     InputError,
@@ -199,157 +198,8 @@ def _noop(stage: str, info: Mapping[str, Any]) -> None:
     return None
 
 
-# ------------------------------------------------------------------ BLAS threads
-#
-# The engine's dense linear algebra is small (eigenproblems, LU and products of at most
-# a few hundred rows, per line).  Multi-threaded OpenBLAS makes such calls slower even on
-# a quiet machine and 5-10x slower when the cores are busy (docs/BENCHMARKS.md
-# "Response analysis"), so the analysis of small models runs with one BLAS thread
-# (threadpoolctl, applied to numpy's and scipy's OpenBLAS alike).
-
-#: Largest model (degrees of freedom of the largest line, 3 per node) analysed with
-#: one BLAS thread.
-SMALL_MODEL_DOF = 2000
-
-_blas_lock = threading.Lock()
-_blas_state: dict[str, Any] = {"depth": 0, "limiter": None, "controller": None,
-                               "modules": -1}
-
-
-def _blas_controller() -> Any:
-    """The BLAS libraries of the process (a ``threadpoolctl.ThreadpoolController``
-    restricted to user_api "blas"), cached; re-scanned when modules were imported
-    since the last scan (an extension module may load another BLAS copy).  The scan
-    reads /proc/self/maps (≈ 1.3 ms on the reference chain, 5 % of an analysis), the
-    cached controller's limit costs ≈ 15 µs.  Call with ``_blas_lock`` held."""
-    import sys
-
-    n_mod = len(sys.modules)
-    if _blas_state["controller"] is None or _blas_state["modules"] != n_mod:
-        from threadpoolctl import ThreadpoolController
-
-        _blas_state["controller"] = ThreadpoolController().select(user_api="blas")
-        _blas_state["modules"] = n_mod
-    return _blas_state["controller"]
-
-
-def _release_openblas(ctl: Any) -> None:
-    """Let any thread set the OpenBLAS limits again: threadpoolctl >= 3.8 gives one
-    thread at a time control of OpenBLAS's process-wide pool and releases it only in
-    ``__exit__`` of its own context managers; ``_single_blas_thread`` counts its entries
-    across threads itself, so it takes and releases control explicitly (before, the
-    first thread that ever limited kept control for good and analyses in service
-    worker threads silently ran with all BLAS threads)."""
-    for lib in ctl.lib_controllers:
-        clear = getattr(type(lib), "clear_controlling_thread", None)
-        if clear is not None:
-            clear(force=True)
-
-
-def _limit_blas() -> Any:
-    """Limit every BLAS library to one thread; returns the limiter (None when they
-    all ran single-threaded already or without threadpoolctl).  Call with
-    ``_blas_lock`` held."""
-    try:
-        ctl = _blas_controller()
-        if all(lib.num_threads == 1 for lib in ctl.lib_controllers):
-            return None  # nothing to limit (e.g. OPENBLAS_NUM_THREADS=1)
-        _release_openblas(ctl)
-        limiter = ctl.limit(limits=1, user_api="blas")
-        if any(lib.num_threads != 1 for lib in ctl.lib_controllers):
-            # the cached controller could not limit (unexpected): the previous,
-            # slower way, a fresh scan of the loaded libraries
-            limiter.restore_original_limits()
-            _release_openblas(ctl)
-            from threadpoolctl import threadpool_limits
-
-            limiter = threadpool_limits(limits=1, user_api="blas")
-            _blas_state["controller"] = None
-        return limiter
-    except Exception:  # noqa: BLE001 - no (usable) threadpoolctl: run unlimited
-        return None
-
-
-@contextlib.contextmanager
-def _single_blas_thread(active: bool = True) -> Iterator[None]:
-    """Limit BLAS to one thread inside the block (re-entrant and thread-safe: the first
-    entrant sets the limit, the last one to leave restores the previous setting).
-
-    OpenBLAS's pool is process-wide, so the limit holds while any thread is inside;
-    the entries are counted here across threads.  History: a fresh
-    ``threadpoolctl.threadpool_limits`` per outermost entry (≈ 1.3 ms) used to replace
-    a cached controller that "failed to apply the limit from a worker thread"; the
-    cause was threadpoolctl's controlling-thread rule (see :func:`_release_openblas`),
-    which defeated the fresh limiter too.  Now: a cached controller
-    (:func:`_blas_controller`), control taken and released explicitly, the limit
-    checked after setting it (tests/test_analysis.py, main and worker threads)."""
-    if not active:
-        yield
-        return
-    with _blas_lock:
-        if _blas_state["depth"] == 0:
-            _blas_state["limiter"] = _limit_blas()
-        _blas_state["depth"] += 1
-    try:
-        yield
-    finally:
-        with _blas_lock:
-            _blas_state["depth"] -= 1
-            if _blas_state["depth"] == 0 and _blas_state["limiter"] is not None:
-                limiter = _blas_state["limiter"]
-                _blas_state["limiter"] = None
-                try:
-                    ctl = _blas_state["controller"]
-                    if ctl is not None:
-                        _release_openblas(ctl)
-                    limiter.restore_original_limits()
-                    if ctl is not None:
-                        _release_openblas(ctl)
-                except Exception:  # noqa: BLE001 - leave the limit rather than fail
-                    pass
-
-
-# ------------------------------------------------------------------ allocator
-#
-# The solve works on complex arrays of n_nodes·dim·n_omega·n_channels entries (≈ 0.5 MB
-# on the reference chain), fresh temporaries in every iteration.  glibc's malloc hands
-# such blocks back to the kernel whenever the top of the heap is freed (trim threshold
-# ≈ 2 × the dynamic mmap threshold) and the kernel zero-fills the pages again on the
-# next allocation: on the reference chain those page faults were a third of the analysis
-# time (≈ 42 → 28 ms, docs/BENCHMARKS.md "Response analysis").  A heap top pad of
-# ``MALLOC_TOP_PAD`` keeps that much freed memory mapped instead (process-wide, set once
-# on the first analysis; glibc only; the environment variable ``STOCHCABLE_MALLOC_TUNING=0``
-# or an explicit ``MALLOC_TOP_PAD_`` leaves the allocator alone).
-
-#: Heap top pad set by :func:`_tune_allocator`. [bytes]
-MALLOC_TOP_PAD = 32 * 1024 * 1024
-_M_TOP_PAD = -2  # mallopt parameter number (glibc malloc.h)
-_allocator_state = {"done": False}
-
-
-def _tune_allocator() -> None:
-    """Set glibc's M_TOP_PAD once per process (no effect elsewhere or when disabled)."""
-    if _allocator_state["done"]:
-        return
-    _allocator_state["done"] = True
-    import os
-    import sys
-
-    if (not sys.platform.startswith("linux")
-            or os.environ.get("STOCHCABLE_MALLOC_TUNING", "1") == "0"
-            or "MALLOC_TOP_PAD_" in os.environ):
-        return
-    try:
-        import ctypes
-
-        libc = ctypes.CDLL("libc.so.6")
-        libc.mallopt(ctypes.c_int(_M_TOP_PAD), ctypes.c_int(MALLOC_TOP_PAD))
-    except (OSError, AttributeError):  # not glibc (musl, ...): leave malloc alone
-        pass
-
-
 def _is_small(scene: Scene) -> bool:
-    return max(3 * (line.elements + 1) for line in scene.lines) <= SMALL_MODEL_DOF
+    return max(3 * (line.elements + 1) for line in scene.lines) <= runtime.SMALL_MODEL_DOF
 
 
 # ------------------------------------------------------------------------ the system
@@ -2939,8 +2789,7 @@ def analyze(
     # Warnings are issued as they arise and also recorded for the result document by
     # a thread-local collector (warnings.catch_warnings is process-global before
     # Python 3.14, so concurrent analyses in service threads would swap them).
-    _tune_allocator()
-    with collect_warnings() as caught, _single_blas_thread(_is_small(scene)):
+    with collect_warnings() as caught, runtime.analysis_blas(_is_small(scene)):
         progress("statics", {})
         t0 = time.perf_counter()
         if statics is None:

@@ -29,13 +29,8 @@ import numpy as np
 from stochcable import validation as v
 from stochcable.errors import InputError
 
-# pyfftw's FFTW runs its threads through OpenMP (libgomp).  With libgomp's default wait
-# policy the worker thread spins for a while after every parallel transform and takes
-# the second core from the caller's next numpy work: a 2^20-sample realization (FFT +
-# two-thread coefficient kernel) took 10.9–12 ms median instead of 9.1–9.8 ms on the
-# 2-core reference machine (docs/BENCHMARKS.md).  Passive waiting is set unless the user
-# chose a policy; it only takes effect if no OpenMP runtime was loaded before.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# pyfftw's FFTW runs its threads through OpenMP (libgomp): its wait policy is set by
+# stochcable.runtime.configure() (the CLI and the service), not on import.
 
 try:  # pragma: no cover - exercised through monkeypatching in tests
     import pyfftw as _pyfftw

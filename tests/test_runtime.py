@@ -1,0 +1,216 @@
+"""Tests of stochcable.runtime: the explicit process settings (configure, the BLAS
+limit, the allocator) and the per-line thread pool.
+
+Independent checks: threadpoolctl's own view of the BLAS libraries, the environment,
+a fresh interpreter for what a plain import does, the serial loop (same bits), the
+calling thread's warning collector, the environment switch and the BLAS gate.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+
+from stochcable import runtime
+from stochcable import runtime as _parallel
+from stochcable.runtime import single_blas_thread
+from stochcable.errors import PhysicsWarning, SolverError, collect_warnings, warn
+
+
+def _eig_item(seed: int) -> tuple[np.ndarray, str]:
+    rng = np.random.default_rng(seed)
+    a = rng.normal(size=(60, 60))
+    return np.linalg.eigvals(a), threading.current_thread().name
+
+
+def _count_pool(monkeypatch) -> list[int]:
+    """Count the pool hand-offs of line_map (the items then go to whichever thread
+    is free first)."""
+    used: list[int] = []
+    real = _parallel._executor
+
+    def spy(n):
+        used.append(n)
+        return real(n)
+
+    monkeypatch.setattr(_parallel, "_executor", spy)
+    return used
+
+
+def test_same_bits_and_order_as_the_loop(monkeypatch):
+    monkeypatch.setenv("STOCHCABLE_THREADS", "2")
+    used = _count_pool(monkeypatch)
+    serial = [_eig_item(s)[0] for s in range(5)]
+    with single_blas_thread():
+        out = _parallel.line_map(_eig_item, range(5))
+    assert used == [1]   # the calling thread and one pool worker
+    assert [np.array_equal(a, b) for (a, _), b in zip(out, serial)] == [True] * 5
+
+
+def test_disabled_by_the_environment_and_outside_single_blas(monkeypatch):
+    used = _count_pool(monkeypatch)
+    monkeypatch.setenv("STOCHCABLE_THREADS", "1")
+    main = threading.current_thread().name
+    with single_blas_thread():
+        assert {n for _, n in _parallel.line_map(_eig_item, range(3))} == {main}
+    monkeypatch.setenv("STOCHCABLE_THREADS", "2")
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    # BLAS not limited to one thread here: no pool (no oversubscription)
+    assert {n for _, n in _parallel.line_map(_eig_item, range(3))} == {main}
+    # one item: no pool
+    with single_blas_thread():
+        assert _parallel.line_map(_eig_item, [0])[0][1] == main
+    assert used == []
+    monkeypatch.setenv("STOCHCABLE_THREADS", "junk")
+    assert _parallel.thread_count() == 1
+
+
+def test_no_nesting_warnings_forwarded_and_first_exception(monkeypatch):
+    monkeypatch.setenv("STOCHCABLE_THREADS", "2")
+
+    def inner(i: int) -> bool:
+        return _parallel.pool_active()
+
+    def outer(i: int) -> list[str]:
+        warn(f"item {i}", PhysicsWarning)
+        # a nested map runs in the thread of the item itself
+        names = {threading.current_thread().name}
+        _parallel.line_map(lambda j: names.add(threading.current_thread().name), range(3))
+        assert len(names) == 1
+        return _parallel.line_map(inner, range(2))
+
+    with single_blas_thread(), collect_warnings() as outer_caught, \
+            collect_warnings() as caught, pytest.warns(PhysicsWarning):
+        out = _parallel.line_map(outer, range(3))
+    assert out == [[True, True]] * 3
+    # forwarded to every collector of the calling thread, once each, in item order
+    # (whichever thread ran the item)
+    assert [str(w) for w in caught] == ["item 0", "item 1", "item 2"]
+    assert [str(w) for w in outer_caught] == ["item 0", "item 1", "item 2"]
+
+    def fails(i: int) -> int:
+        if i >= 1:
+            raise SolverError(f"item {i} failed")
+        return i
+
+    with single_blas_thread(), pytest.raises(SolverError, match="item 1 failed"):
+        _parallel.line_map(fails, range(3))
+
+
+def test_default_is_no_pool(monkeypatch):
+    """Opt-in (module docstring: measured gain only on an idle machine)."""
+    monkeypatch.delenv("STOCHCABLE_THREADS", raising=False)
+    assert _parallel.thread_count() == 1
+    monkeypatch.setenv("STOCHCABLE_THREADS", "0")
+    assert _parallel.thread_count() == 1
+    monkeypatch.setenv("STOCHCABLE_THREADS", "3")
+    assert _parallel.thread_count() == 3
+
+
+def test_single_blas_thread_applies_in_worker_threads():
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+
+    def blas_threads() -> list[int]:
+        return [d["num_threads"] for d in threadpoolctl.threadpool_info()
+                if d["user_api"] == "blas"]
+
+    before = blas_threads()
+    seen: dict[str, list[int]] = {}
+    with runtime.single_blas_thread():  # the main thread first (it used to keep control)
+        seen["main"] = blas_threads()
+
+    def work() -> None:
+        with runtime.single_blas_thread():
+            seen["worker"] = blas_threads()
+
+    t = threading.Thread(target=work)
+    t.start()
+    t.join()
+    assert all(n == 1 for n in seen["main"]) and all(n == 1 for n in seen["worker"])
+    assert blas_threads() == before  # restored
+
+
+_PLAIN_IMPORT = """
+import json, os, sys
+import threadpoolctl
+before = os.environ.get("OMP_WAIT_POLICY")
+import stochcable
+from stochcable.examples import load_example
+from stochcable import runtime
+seen = []
+def progress(stage, info):
+    if stage == "linearization" and not seen:
+        seen.append([d["num_threads"] for d in threadpoolctl.threadpool_info()
+                     if d["user_api"] == "blas"])
+stochcable.analyze(load_example("taut_wire"), progress=progress)
+after = os.environ.get("OMP_WAIT_POLICY")
+runtime.configure()
+configured = []
+def progress2(stage, info):
+    if stage == "linearization" and not configured:
+        configured.append([d["num_threads"] for d in threadpoolctl.threadpool_info()
+                           if d["user_api"] == "blas"])
+stochcable.analyze(load_example("taut_wire"), progress=progress2)
+print(json.dumps({"before": before, "after": after, "during": seen[0],
+                  "allocator": runtime._allocator_state["done"],
+                  "omp": os.environ.get("OMP_WAIT_POLICY"),
+                  "configured": configured[0],
+                  "restored": [d["num_threads"] for d in threadpoolctl.threadpool_info()
+                               if d["user_api"] == "blas"]}))
+"""
+
+
+def test_library_changes_no_process_setting_until_configured():
+    # a fresh interpreter with two BLAS threads allowed: a plain `import stochcable` and
+    # an analysis leave OMP_WAIT_POLICY, the allocator and the BLAS threads alone;
+    # runtime.configure() then gives the small model one BLAS thread during the
+    # analysis, restored afterwards, and sets the passive OpenMP policy
+    pytest.importorskip("threadpoolctl")
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("OMP_WAIT_POLICY", "MALLOC_TOP_PAD_", "STOCHCABLE_MALLOC_TUNING")}
+    env.update(OPENBLAS_NUM_THREADS="2", OMP_NUM_THREADS="2")
+    out = subprocess.run([sys.executable, "-c", _PLAIN_IMPORT], capture_output=True,
+                         text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr
+    got = json.loads(out.stdout)
+    assert got["before"] is None and got["after"] is None
+    if not got["during"]:
+        pytest.skip("no BLAS library visible to threadpoolctl")
+    assert max(got["during"]) == 2          # the process's own setting, untouched
+    assert got["configured"] == [1] * len(got["configured"])
+    assert max(got["restored"]) == 2
+    assert got["omp"] == "PASSIVE"
+    assert got["allocator"] is (sys.platform.startswith("linux"))
+
+
+def test_configure_switches_and_env_policy_respected(monkeypatch):
+    monkeypatch.setenv("OMP_WAIT_POLICY", "ACTIVE")
+    saved = runtime.configured()
+    try:
+        runtime.configure(small_model_blas=False, allocator=False)
+        assert runtime.configured() == {"configured": True, "small_model_blas": False}
+        assert os.environ["OMP_WAIT_POLICY"] == "ACTIVE"   # the user's choice stays
+        runtime.configure()
+        assert runtime.configured()["small_model_blas"] is True
+    finally:
+        runtime._settings.update(saved)
+
+
+def test_cli_and_service_configure_the_process():
+    # the command line and the service apply the settings at start
+    code = ("import sys; from stochcable import runtime; from stochcable.cli import main;"
+            "main(['spectrum', 'pm', '--hs', '2', '--tp', '8', '--format', 'json', '-o',"
+            " '/dev/null']); a = runtime.configured()['configured'];"
+            "runtime._settings['configured'] = False;"
+            "import service.app; print(a, runtime.configured()['configured'])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "True"]
