@@ -353,14 +353,14 @@ def test_drag_quadrature_is_the_consistent_integral():
     # c_n (α + βξ)² (−n) and the consistent nodal load has the closed form
     # F_a = −c_n l0 n ∫(1 − ξ)(α + βξ)² dξ = −c_n l0 n (α²/2 + αβ/3 + β²/12),
     # F_b = −c_n l0 n (α²/2 + 2αβ/3 + β²/4) (degree 3: 3-point Gauss is exact).
-    from stochcable.reference.cable import _LineModel
+    from stochcable.reference.cable_model import LineModel
 
     scene = _taut(hs=0.0, cd=1.2)
     env = scene.environment
     mesh = mesh_line(scene.lines[0], env.rho, env.g)
     s = mesh.s0 / mesh.s0[-1]
     X = np.stack([20.0 * s, -100.0 + 90.0 * s], axis=1)
-    model = _LineModel(mesh, env, X, 2)
+    model = LineModel(mesh, env, X, 2)
     e, _, _, _ = model.elements(X)
     n = np.stack([-e[:, 1], e[:, 0]], axis=1)
     speed = 0.3 + 0.05 * np.arange(mesh.n_nodes)          # > 0: no sign change
