@@ -13,12 +13,19 @@ import scipy.linalg
 from stochcable.dynamics.line import analyze
 from stochcable.errors import InputError
 from stochcable.examples import load_example
-from stochcable.fidelity import (BUDGET, CUTOFF_KH, FidelityPlan, apply_fidelity,
-                                 choose_fidelity, elements_wavelength,
-                                 points_per_bandwidth, spectrum_tail_frequency)
+from stochcable.fidelity import (
+    BUDGET,
+    CUTOFF_KH,
+    FidelityPlan,
+    apply_fidelity,
+    choose_fidelity,
+    elements_wavelength,
+    points_per_bandwidth,
+    spectrum_tail_frequency,
+)
+from stochcable.line.statics import solve_statics
 from stochcable.scene.model import load_scene
 from stochcable.sea.spectra import spectrum_pierson_moskowitz
-from stochcable.line.statics import solve_statics
 
 
 def _string_frequencies(n_el: int, length: float, c: float) -> np.ndarray:
