@@ -1,21 +1,25 @@
-"""Exception handlers: every error answer is ``{"detail": [ErrorItem, ...]}``.
+"""The service's exceptions and their handlers: every error answer is
+``{"detail": [ErrorItem, ...]}``.
+
+The exception types live here, below the modules that raise them
+(:mod:`service.limits`, the routers), so no module imports its way back up.
 
 Mapping (never 500 for client input):
 
-=====================================  ======  ==============================
-exception                              status  ``type``
-=====================================  ======  ==============================
-RequestValidationError (bad JSON,      422     pydantic's type (``json_invalid``,
-wrong type, NaN, out of bounds)                ``greater_than``, ...)
-:class:`~stochcable.errors.InputError`  422     ``input_error``
-:class:`~service.limits.LimitExceeded`  422     ``limit_exceeded``
-ConvergenceError                       422     ``convergence_error``
-SolverError, other StochcableError     422     ``solver_error``
-FloatingPointError, non-finite result  422     ``numerical_error``
-:class:`~service.limits.BodyTooLarge`   413     ``body_too_large``
-:class:`~service.limits.RunTimeExceeded` 504   ``run_time_exceeded``
-HTTPException (404, 405, 406, ...)     as is   ``http_error`` / ``not_found``
-=====================================  ======  ==============================
+=======================================  ======  ==============================
+exception                                status  ``type``
+=======================================  ======  ==============================
+RequestValidationError (bad JSON,        422     pydantic's type (``json_invalid``,
+wrong type, NaN, out of bounds)                  ``greater_than``, ...)
+:class:`~stochcable.errors.InputError`   422     ``input_error``
+:class:`LimitExceeded`                   422     ``limit_exceeded``
+ConvergenceError                         422     ``convergence_error``
+SolverError, other StochcableError       422     ``solver_error``
+FloatingPointError, non-finite result    422     ``numerical_error``
+:class:`BodyTooLarge`                    413     ``body_too_large``
+:class:`RunTimeExceeded`                 504     ``run_time_exceeded``
+HTTPException (404, 405, 406, ...)       as is   ``http_error`` / ``not_found``
+=======================================  ======  ==============================
 """
 
 from __future__ import annotations
@@ -35,9 +39,61 @@ from stochcable.errors import ConvergenceError, InputError, SolverError, Stochca
 from stochcable.scene.model import field_path_and_unit
 from stochcable.scene.units import labels_of_document
 
-from .limits import BodyTooLarge, LimitExceeded, RunTimeExceeded
+from .settings import Settings
 
-__all__ = ["install_error_handlers", "error_response", "NotFound", "NumericalError"]
+__all__ = [
+    "install_error_handlers",
+    "error_response",
+    "NotFound",
+    "NumericalError",
+    "LimitExceeded",
+    "RunTimeExceeded",
+    "BodyTooLarge",
+]
+
+
+# ------------------------------------------------------------------ exceptions
+
+
+class LimitExceeded(Exception):
+    """A request asks for more work than a configured bound allows (HTTP 422)."""
+
+    def __init__(self, parameter: str, value: Any, limit: Any, setting: str, what: str) -> None:
+        self.parameter = parameter
+        self.value = value
+        self.limit = limit
+        self.setting = setting
+        self.env = Settings.env_name(setting)
+        super().__init__(f"{what} exceeds the limit of {limit} ({self.env})")
+
+
+class RunTimeExceeded(Exception):
+    """Queueing plus computation took longer than ``max_run_seconds`` (HTTP 504)."""
+
+    def __init__(self, limit: float) -> None:
+        self.limit = limit
+        self.env = Settings.env_name("max_run_seconds")
+        super().__init__(
+            f"the computation did not finish within the limit of {limit:g} s ({self.env}); "
+            "ask for less (shorter duration, fewer samples or frequencies) or retry later"
+        )
+
+
+class BodyTooLarge(StarletteHTTPException):
+    """The request body is larger than ``max_body_bytes`` (HTTP 413).
+
+    An HTTPException so that FastAPI re-raises it from its body reader unchanged.
+    """
+
+    def __init__(self, size: int | None, limit: int) -> None:
+        self.size = size
+        self.limit = limit
+        self.env = Settings.env_name("max_body_bytes")
+        got = f"{size} bytes" if size is not None else "the request body"
+        super().__init__(413, f"{got} exceeds the limit of {limit} bytes ({self.env})")
+
+    def __str__(self) -> str:
+        return str(self.detail)
 
 
 class NumericalError(Exception):

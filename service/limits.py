@@ -28,15 +28,14 @@ from typing import Any, TypeVar
 
 import anyio
 import numpy as np
-from starlette.exceptions import HTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from stochcable.errors import StochcableError
+
+from .errors import BodyTooLarge, LimitExceeded, NumericalError, RunTimeExceeded, error_response
 from .settings import Settings
 
 __all__ = [
-    "LimitExceeded",
-    "RunTimeExceeded",
-    "BodyTooLarge",
     "BodySizeLimitMiddleware",
     "ServerTimingMiddleware",
     "check_samples",
@@ -50,47 +49,6 @@ __all__ = [
 
 T = TypeVar("T")
 _log = logging.getLogger("stochcable.service")
-
-
-class LimitExceeded(Exception):
-    """A request asks for more work than a configured bound allows (HTTP 422)."""
-
-    def __init__(self, parameter: str, value: Any, limit: Any, setting: str, what: str) -> None:
-        self.parameter = parameter
-        self.value = value
-        self.limit = limit
-        self.setting = setting
-        self.env = Settings.env_name(setting)
-        super().__init__(f"{what} exceeds the limit of {limit} ({self.env})")
-
-
-class RunTimeExceeded(Exception):
-    """Queueing plus computation took longer than ``max_run_seconds`` (HTTP 504)."""
-
-    def __init__(self, limit: float) -> None:
-        self.limit = limit
-        self.env = Settings.env_name("max_run_seconds")
-        super().__init__(
-            f"the computation did not finish within the limit of {limit:g} s ({self.env}); "
-            "ask for less (shorter duration, fewer samples or frequencies) or retry later"
-        )
-
-
-class BodyTooLarge(HTTPException):
-    """The request body is larger than ``max_body_bytes`` (HTTP 413).
-
-    An HTTPException so that FastAPI re-raises it from its body reader unchanged.
-    """
-
-    def __init__(self, size: int | None, limit: int) -> None:
-        self.size = size
-        self.limit = limit
-        self.env = Settings.env_name("max_body_bytes")
-        got = f"{size} bytes" if size is not None else "the request body"
-        super().__init__(413, f"{got} exceeds the limit of {limit} bytes ({self.env})")
-
-    def __str__(self) -> str:
-        return str(self.detail)
 
 
 # ----------------------------------------------------------------- size checks
@@ -185,8 +143,6 @@ class BodySizeLimitMiddleware:
                 except ValueError:
                     size = None
                 if size is not None and size > self.max_bytes:
-                    from .errors import error_response
-
                     exc = BodyTooLarge(size, self.max_bytes)
                     resp = error_response(413, ["body"], str(exc), "body_too_large",
                                           limit=self.max_bytes, setting=exc.env)
@@ -215,8 +171,6 @@ class BodySizeLimitMiddleware:
         except BodyTooLarge as exc:  # read outside FastAPI's handlers: answer here
             if started:
                 raise
-            from .errors import error_response
-
             resp = error_response(413, ["body"], str(exc), "body_too_large",
                                   limit=exc.limit, setting=exc.env)
             await resp(scope, receive, send)
@@ -343,10 +297,6 @@ def _checked(strict_fp: bool, func: Callable[..., T], *args: Any) -> T:
     errors
     (:class:`~stochcable.errors.StochcableError`, including InputError) pass unchanged.
     """
-    from stochcable.errors import StochcableError
-
-    from .errors import NumericalError
-
     try:
         if not strict_fp:
             return func(*args)

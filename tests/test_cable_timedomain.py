@@ -9,20 +9,18 @@ synthesized series of the same realization).
 
 from __future__ import annotations
 
-import warnings
-
 import math
+import warnings
 
 import numpy as np
 import pytest
 
-from stochcable.reference.cable import newmark_period_error, simulate_line_timedomain
 from stochcable.errors import ConvergenceError, InputError, ResolutionWarning
 from stochcable.line.fem import assemble
 from stochcable.line.mesh import mesh_line
-from stochcable.scene.model import load_scene
 from stochcable.line.statics import solve_statics
-
+from stochcable.reference.cable import newmark_period_error, simulate_line_timedomain
+from stochcable.scene.model import load_scene
 
 # ---------------------------------------------------------------------------- scenes
 
@@ -179,8 +177,7 @@ def _fd_series_fem(scene, hist):
     synthesized with the realization's coefficients; F the Morison inertia and
     linearized drag loads integrated exactly along the elements
     (excitation.wave_loads with the element_wave_kinematics moments)."""
-    from stochcable.dynamics.loads import (Channel, drag_matrix, element_wave_kinematics,
-                                       wave_loads)
+    from stochcable.dynamics.loads import Channel, drag_matrix, element_wave_kinematics, wave_loads
     from stochcable.sea.kinematics import wave_kinematics
     from stochcable.sea.realization import synthesize
 
@@ -320,7 +317,8 @@ def test_unknown_line_and_bad_inputs():
         simulate_line_timedomain(scene, "nope")
     with pytest.raises(InputError, match=r"ramp = 100.0 \[s\]: must be shorter than the duration"):
         simulate_line_timedomain(scene, ramp=100.0)
-    with pytest.raises(InputError, match=r"duration = 100.0 \[s\]: must be <= the realization's length 64 s"):
+    with pytest.raises(InputError, match=r"duration = 100.0 \[s\]: must be <= the "
+                                         r"realization's length 64 s"):
         from stochcable.sea.realization import simulate_sea
 
         real = simulate_sea(lambda w: np.exp(-((w - 1.0) ** 2)) * 1e-3, 64.0, 0.25, rng=1)
@@ -353,14 +351,14 @@ def test_drag_quadrature_is_the_consistent_integral():
     # c_n (α + βξ)² (−n) and the consistent nodal load has the closed form
     # F_a = −c_n l0 n ∫(1 − ξ)(α + βξ)² dξ = −c_n l0 n (α²/2 + αβ/3 + β²/12),
     # F_b = −c_n l0 n (α²/2 + 2αβ/3 + β²/4) (degree 3: 3-point Gauss is exact).
-    from stochcable.reference.cable import _LineModel
+    from stochcable.reference.cable_model import LineModel
 
     scene = _taut(hs=0.0, cd=1.2)
     env = scene.environment
     mesh = mesh_line(scene.lines[0], env.rho, env.g)
     s = mesh.s0 / mesh.s0[-1]
     X = np.stack([20.0 * s, -100.0 + 90.0 * s], axis=1)
-    model = _LineModel(mesh, env, X, 2)
+    model = LineModel(mesh, env, X, 2)
     e, _, _, _ = model.elements(X)
     n = np.stack([-e[:, 1], e[:, 0]], axis=1)
     speed = 0.3 + 0.05 * np.arange(mesh.n_nodes)          # > 0: no sign change

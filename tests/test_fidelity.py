@@ -1,4 +1,4 @@
-"""Tests of stochcable.fidelity.planner: the rules on constructed cases, immutability, and the
+"""Tests of stochcable.fidelity: the rules on constructed cases, immutability, and the
 error of the chosen settings against a finer reference on two example scenes."""
 
 from __future__ import annotations
@@ -13,12 +13,19 @@ import scipy.linalg
 from stochcable.dynamics.line import analyze
 from stochcable.errors import InputError
 from stochcable.examples import load_example
-from stochcable.fidelity.planner import (BUDGET, CUTOFF_KH, FidelityPlan, apply_fidelity,
-                                 choose_fidelity, elements_wavelength,
-                                 points_per_bandwidth, spectrum_tail_frequency)
+from stochcable.fidelity import (
+    BUDGET,
+    CUTOFF_KH,
+    FidelityPlan,
+    apply_fidelity,
+    choose_fidelity,
+    elements_wavelength,
+    points_per_bandwidth,
+    spectrum_tail_frequency,
+)
+from stochcable.line.statics import solve_statics
 from stochcable.scene.model import load_scene
 from stochcable.sea.spectra import spectrum_pierson_moskowitz
-from stochcable.line.statics import solve_statics
 
 
 def _string_frequencies(n_el: int, length: float, c: float) -> np.ndarray:
@@ -105,7 +112,7 @@ def _taut_scene(wmax_note: str = "") -> dict:
 
 def test_plan_elements_follow_the_wavelength_rule_on_a_taut_string():
     scene = load_scene(_taut_scene())
-    plan = choose_fidelity(scene, 0.01)
+    plan = choose_fidelity(scene, 0.01, evaluate=analyze)
     st = solve_statics(scene, method="fe").lines["s"]
     seg = scene.lines[0].segments[0]
     m_t = seg.mass + seg.ca_normal * scene.environment.rho * math.pi * seg.diameter**2 / 4
@@ -128,7 +135,7 @@ def test_plan_elements_follow_the_wavelength_rule_on_a_taut_string():
 def test_apply_fidelity_does_not_mutate_and_applies_the_plan():
     scene = load_example("taut_wire")
     before = scene.model_dump(mode="json")
-    plan = choose_fidelity(scene, 0.05)
+    plan = choose_fidelity(scene, 0.05, evaluate=analyze)
     new = apply_fidelity(scene, plan)
     assert scene.model_dump(mode="json") == before
     assert new is not scene
@@ -146,6 +153,25 @@ def test_apply_fidelity_does_not_mutate_and_applies_the_plan():
     assert all({"setting", "value", "reason", "error"} <= set(c) for c in doc["choices"])
 
 
+def test_the_pilot_analysis_is_the_callable_passed_in():
+    # the planner does not import the analysis: the orchestrator passes it
+    from stochcable.fidelity.pilot import PILOT_COUNT
+
+    calls = []
+
+    def evaluate(sc):
+        calls.append(sc)
+        return analyze(sc)
+
+    scene = load_example("taut_wire")
+    plan = choose_fidelity(scene, 0.05, evaluate=evaluate)
+    assert len(calls) == plan.pilot["extensions"] + 1
+    for sc in calls:
+        a = sc.analysis
+        assert (a.solver, a.timeseries, a.omega.count) == ("direct", None, PILOT_COUNT)
+    assert calls[-1].analysis.omega.max == plan.pilot["omega_max"]
+
+
 def test_apply_fidelity_rejects_a_non_plan():
     with pytest.raises(InputError, match="must be a FidelityPlan"):
         apply_fidelity(load_example("taut_wire"), {"omega_max": 2.0})
@@ -153,7 +179,7 @@ def test_apply_fidelity_rejects_a_non_plan():
 
 def test_choose_fidelity_rejects_a_bad_target():
     with pytest.raises(InputError, match="target_error"):
-        choose_fidelity(load_example("taut_wire"), 0.0)
+        choose_fidelity(load_example("taut_wire"), 0.0, evaluate=analyze)
 
 
 def _sigmas(result) -> np.ndarray:
@@ -170,7 +196,7 @@ def test_chosen_settings_meet_the_target_against_a_finer_reference(name, target)
     scene = load_example(name)
     scene = scene.model_copy(update={"analysis": scene.analysis.model_copy(
         update={"timeseries": None})})
-    plan = choose_fidelity(scene, target)
+    plan = choose_fidelity(scene, target, evaluate=analyze)
     assert isinstance(plan, FidelityPlan) and plan.tail_bounded
     got = _sigmas(analyze(apply_fidelity(scene, plan)))
     # reference: direct, tolerance 1e-8, 2× the plan's elements in every segment, band
@@ -198,7 +224,7 @@ def test_chain_surge_tail_is_bounded_once_the_pilot_reaches_the_axial_regime():
     # is bounded, must find that tail (it stopped at 26.6 rad/s with two doublings,
     # where the slope is still ≈ -1, and flagged the band as unbounded)
     scene = load_example("chain_catenary")
-    plan = choose_fidelity(scene, 0.01)
+    plan = choose_fidelity(scene, 0.01, evaluate=analyze)
     assert plan.tail_bounded
     assert plan.pilot["omega_max"] >= 2.0 * plan.omega_max  # the pilot covers 2·ω_max
     # 1 % of the fairlead tension variance lies above 26.6 rad/s: the band must go on
@@ -215,7 +241,7 @@ def test_touchdown_gets_a_node():
     # splits the segment at the static touchdown (closed-form catenary: 165.67 ft;
     # the example's 3-element FE statics says 157 ft)
     scene = load_example("tuah_1982_single_leg")
-    plan = choose_fidelity(scene, 0.05)
+    plan = choose_fidelity(scene, 0.05, evaluate=analyze)
     (i0, l0, n0), (i1, l1, n1) = plan.segments["leg"]
     s_td = solve_statics(scene, method="catenary").lines["leg"].touchdown
     assert (i0, i1) == (0, 0)

@@ -11,7 +11,8 @@ from fastapi.testclient import TestClient
 
 from service.app import create_app
 from service.dependencies import RunnerDep
-from service.limits import LimitExceeded, check_elements
+from service.errors import LimitExceeded
+from service.limits import check_elements
 from service.settings import Settings
 
 PM = {"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0}

@@ -14,7 +14,8 @@ from stochcable.scene.model import Scene, load_scene
 
 from ..dependencies import RunnerDep, SettingsDep
 from ..encoding import JSON, dumps, error_responses
-from ..limits import RunTimeExceeded, check_scene
+from ..errors import RunTimeExceeded
+from ..limits import check_scene
 from ..schemas import AnalysisResponse
 
 __all__ = ["router", "WARNINGS_HEADER"]

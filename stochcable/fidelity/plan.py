@@ -1,0 +1,119 @@
+"""The fidelity plan: the settings chosen for a target error, each with its reason and
+its error estimate (:func:`stochcable.fidelity.planner.choose_fidelity` makes it,
+:func:`stochcable.fidelity.planner.apply_fidelity` applies it)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Choice", "FidelityPlan"]
+
+
+@dataclass(frozen=True)
+class Choice:
+    """One setting of a plan.
+
+    Attributes
+    ----------
+    setting : str
+        Scene path of the setting ("analysis.omega.max", "lines[leg].segments[0].elements").
+    value : Any
+        The value chosen.
+    reason : str
+        Rule and numbers that gave it.
+    error : float
+        Estimated relative error of σ this setting leaves. [-]
+    """
+
+    setting: str
+    value: Any
+    reason: str
+    error: float = 0.0
+
+    def to_document(self) -> dict[str, Any]:
+        return {"setting": self.setting, "value": _plain(self.value), "reason": self.reason,
+                "error": float(self.error)}
+
+
+@dataclass(frozen=True)
+class FidelityPlan:
+    """Settings chosen for a target error, each with its reason.
+
+    Attributes
+    ----------
+    target_error : float
+        Target relative error of the response σ. [-]
+    omega_min, omega_max : float
+        Frequency band. [rad/s]
+    omega_count : int
+        Points of the linear grid (finest spacing needed anywhere). [-]
+    omega_values : tuple of float
+        Non-uniform grid: base linear grid plus refinements around lightly damped
+        modes. [rad/s]
+    segments : dict of str to tuple
+        Per line, the new segments as (source segment index, length [m], elements).
+    solver : str
+        "foss" or "direct".
+    modes : "auto" or int
+        Kept modes (Foss).
+    tolerance : float
+        Linearization tolerance. [-]
+    choices : tuple of Choice
+        Every choice with its reason and error estimate.
+    error_estimate : dict of str to float
+        Estimate per part ("band", "grid", "elements", "modes", "linearization") and
+        "total" (their sum). [-]
+    cost : dict of str to float
+        "elements", "frequencies" (of the grid applied) and "elements_x_frequencies".
+    omega_response : float
+        ω₂ = √(m₂/m₀) of the pilot's response spectra (largest), used by the
+        element rule. [rad/s]
+    tail_bounded : bool
+        False when a response spectrum still decays slower than ω⁻¹·²⁵ at the pilot's
+        top: σ then depends on the band and the band estimate is a lower bound.
+    pilot : dict
+        The pilot analysis: elements, band, count, wall time [s].
+    """
+
+    target_error: float
+    omega_min: float
+    omega_max: float
+    omega_count: int
+    omega_values: tuple[float, ...]
+    segments: dict[str, tuple[tuple[int, float, int], ...]]
+    solver: str
+    modes: Any
+    tolerance: float
+    choices: tuple[Choice, ...]
+    error_estimate: dict[str, float]
+    cost: dict[str, float]
+    tail_bounded: bool = True
+    omega_response: float = 0.0
+    pilot: dict[str, Any] = field(default_factory=dict)
+
+    def to_document(self) -> dict[str, Any]:
+        """Plain JSON-ready form (for the result document's "fidelity")."""
+        return {
+            "target_error": self.target_error,
+            "omega": {"min": self.omega_min, "max": self.omega_max,
+                      "count": self.omega_count, "values_count": len(self.omega_values)},
+            "segments": {k: [list(s) for s in v] for k, v in self.segments.items()},
+            "solver": self.solver, "modes": self.modes, "tolerance": self.tolerance,
+            "choices": [c.to_document() for c in self.choices],
+            "error_estimate": dict(self.error_estimate), "cost": dict(self.cost),
+            "tail_bounded": self.tail_bounded, "omega_response": self.omega_response,
+            "pilot": _plain(self.pilot),
+        }
+
+
+def _plain(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {k: _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    return x
