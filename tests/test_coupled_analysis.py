@@ -265,9 +265,9 @@ def test_substructure_equals_assembled_coupled_system(mooring_direct):
                               damping=damp.matrix))
         inp = _inputs(cl.system, cl.channels)
         line_loads[cl.name] = _to_freq(_loads(cl.system, inp, damp))
-    from stochcable.dynamics.coupled import _body_drag
+    from stochcable.dynamics.coupled.group import linear_body_drag
 
-    bb, cdrag = _body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
+    bb, cdrag = linear_body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
     system = couple(links, [body], body_damping={"buoy": cdrag})
     from stochcable.bodies.rigid import rigid_link_matrix
 
@@ -668,16 +668,16 @@ def test_scene_three_leg_example_mirror_symmetry():
 
 def _count_full_evaluations(monkeypatch, n_omega):
     """Count the group solves on the full grid of ``n_omega`` frequencies."""
-    import stochcable.dynamics.coupled as ca
+    import stochcable.dynamics.coupled.group as cg
 
     count = [0]
-    solve = ca._solve_group
+    solve = cg.solve_group
 
     def counted(g, *args):
         count[0] += g.omega.size == n_omega
         return solve(g, *args)
 
-    monkeypatch.setattr(ca, "_solve_group", counted)
+    monkeypatch.setattr(cg, "solve_group", counted)
     return count
 
 
@@ -688,12 +688,13 @@ def test_coarse_start_gives_the_full_grid_fixed_point(solver, monkeypatch):
     change below tol = 1e-8 with a contraction ≈ 0.1, so each is within ~tol of the
     fixed point: σ and the outputs agree to 1e-6 (100·tol, margin for the transfer
     functions' amplification of the σ error)."""
-    from stochcable.dynamics.coupled import _coarse_subset, _Group
+    from stochcable.dynamics.coupled.coarse import coarse_subset
+    from stochcable.dynamics.coupled.group import GroupSystem
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver=solver, tol=1e-8), body)
-    g = _Group(cls, [body], loads, RHO, cls[0].channels)
-    idx = _coarse_subset(g)
+    g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
+    idx = coarse_subset(g)
     np.testing.assert_array_equal(idx, np.r_[np.arange(0, 96, 4), 95])
     full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads,
                              coarse=False)
@@ -728,9 +729,9 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
     mooring: the stride-4 subset's σ are ~4 % off, the corrected rounds gain ~30x
     each), with or without the rounds' warm step, and the answer is the full-grid
     fixed point within the tolerance."""
-    import stochcable.dynamics.coupled as ca
+    import stochcable.dynamics.coupled.coarse as cc
 
-    monkeypatch.setattr(ca, "_WARM_ROUNDS", warm)
+    monkeypatch.setattr(cc, "_WARM_ROUNDS", warm)
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver=solver, tol=1e-4), body)
     full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads,
@@ -749,17 +750,18 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
 
 def test_coarse_subset_skipped_on_small_grids(mooring_direct):
     """40 frequencies (< COARSE_MIN_FREQUENCIES): no coarse stage."""
-    from stochcable.dynamics.coupled import COARSE_MIN_FREQUENCIES, _coarse_subset, _Group
+    from stochcable.dynamics.coupled.coarse import COARSE_MIN_FREQUENCIES, coarse_subset
+    from stochcable.dynamics.coupled.group import GroupSystem
 
     scene, cls, loads, body, lin = mooring_direct
     assert cls[0].channels[0].omega.size < COARSE_MIN_FREQUENCIES
-    assert _coarse_subset(_Group(cls, [body], loads, RHO, cls[0].channels)) is None
+    assert coarse_subset(GroupSystem(cls, [body], loads, RHO, cls[0].channels)) is None
 
 
 def test_sliced_channel_inputs_equal_the_subset_of_the_full_inputs(mooring_direct):
     """A channel restricted to a frequency subset gives the full channel's loads at
     those frequencies (every array sliced along its frequency axis)."""
-    from stochcable.dynamics.coupled import _sliced_channel
+    from stochcable.dynamics.coupled.coarse import _sliced_channel
 
     scene, cls, loads, body, lin = mooring_direct
     s = cls[0].system
@@ -779,18 +781,19 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     system, so equal to round-off (1e-10 of the largest entry), truncated (8 of 27
     modes, static correction on) or not."""
     from stochcable.dynamics.line import _solve_free, drag_coefficients
-    from stochcable.dynamics.coupled import _foss_unit_split, _Group
+    from stochcable.dynamics.coupled.group import GroupSystem
+    from stochcable.dynamics.coupled.lineparts import foss_unit_split
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
-    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     cl = cls[0]
     s = cl.system
     assert s.solver == "foss"
     assert (s.n_modes < s.model.free.size) == (modes == 8)
     # a drag of a plausible size: σ = 0.3 m/s on every element
     damp = drag_coefficients(s, np.full(2 * s.model.n_elements, 0.3), "seed")
-    got, _ = _foss_unit_split(s, g.inp_phys[cl.name], g.inp[cl.name], damp)
+    got, _ = foss_unit_split(s, g.inp_phys[cl.name], g.inp[cl.name], damp)
     ref, _ = _solve_free(s, g.inp[cl.name], damp)
     assert got.shape == ref.shape and got.shape[-1] == 4  # sea + 3 unit columns
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
@@ -946,7 +949,7 @@ def test_fixed_dofs_validation_and_scene():
 def test_coarse_start_falls_back_to_the_full_grid(monkeypatch):
     """A coarse model that fails (a singular modal impedance) is skipped: the full-grid
     iteration alone runs, the same evaluations as ``coarse=False``."""
-    import stochcable.dynamics.coupled as ca
+    import stochcable.dynamics.coupled.lineparts as cp
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver="foss", tol=1e-4), body)
@@ -956,7 +959,7 @@ def test_coarse_start_falls_back_to_the_full_grid(monkeypatch):
     def fail(*args, **kwargs):
         raise np.linalg.LinAlgError("Singular matrix")
 
-    monkeypatch.setattr(ca, "_ModalLine", fail)
+    monkeypatch.setattr(cp, "ModalLine", fail)
     fast = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)
     assert fast.history == full.history
     np.testing.assert_array_equal(fast.body_sigma["buoy"], full.body_sigma["buoy"])
@@ -967,7 +970,7 @@ def test_warm_step_is_the_fixed_point_of_an_affine_map():
     step over secant pairs: for an affine map y -> r·(A y + b) in n dimensions, n + 1
     affinely independent pairs give its fixed point exactly (closed form
     (I − diag(r) A)⁻¹ diag(r) b; tolerance: round-off of a 3×3 solve)."""
-    from stochcable.dynamics.coupled import _warm_step
+    from stochcable.dynamics.coupled.coarse import _warm_step
 
     rng = np.random.default_rng(3)
     a = 0.3 * rng.standard_normal((3, 3))
@@ -989,7 +992,7 @@ def test_large_static_body_rotation_is_flagged():
     import warnings
 
     from stochcable.dynamics.line import analyze
-    from stochcable.dynamics.coupled import STATIC_ROTATION_LIMIT
+    from stochcable.dynamics.coupled.model import STATIC_ROTATION_LIMIT
     from stochcable.errors import PhysicsWarning
     from stochcable.examples import load_example
     from stochcable.scene.model import load_scene
