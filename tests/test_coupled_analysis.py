@@ -1014,3 +1014,115 @@ def test_large_static_body_rotation_is_flagged():
     assert heel > STATIC_ROTATION_LIMIT
     assert f"{math.degrees(heel):.3g}°" in str(
         next(w.message for w in rec if "static rotation" in str(w.message)))
+
+
+# ------------------------------------------------------------ build once, solve many
+
+
+def _assert_same_results(got, ref, rtol, path="result", seen=None):
+    """Every public number of two result objects (dataclasses, mappings, sequences,
+    arrays) agrees to ``rtol`` of the array's largest entry (``rtol=0``: equal);
+    private attributes (caches) are not compared."""
+    import dataclasses as dc
+
+    import scipy.sparse as sp
+
+    seen = set() if seen is None else seen
+    if got is ref or (id(got), id(ref)) in seen:
+        return
+    seen.add((id(got), id(ref)))
+    if isinstance(ref, (np.ndarray, sp.sparray, sp.spmatrix)) or np.isscalar(ref) and (
+            isinstance(ref, (int, float, complex, np.number)) and not isinstance(ref, bool)):
+        a = np.asarray(got.toarray() if sp.issparse(got) else got)
+        b = np.asarray(ref.toarray() if sp.issparse(ref) else ref)
+        assert a.shape == b.shape, path
+        if rtol == 0 or b.dtype.kind not in "fc":
+            np.testing.assert_array_equal(a, b, err_msg=path)
+        else:
+            scale = float(np.max(np.abs(b), initial=0.0))
+            np.testing.assert_allclose(a, b, rtol=rtol, atol=rtol * scale, err_msg=path)
+    elif dc.is_dataclass(ref):
+        assert type(got) is type(ref), path
+        for f in dc.fields(ref):
+            if not f.name.startswith("_"):
+                _assert_same_results(getattr(got, f.name), getattr(ref, f.name), rtol,
+                                     f"{path}.{f.name}", seen)
+    elif isinstance(ref, dict):
+        assert list(got) == list(ref), path
+        for k in ref:
+            _assert_same_results(got[k], ref[k], rtol, f"{path}[{k!r}]", seen)
+    elif isinstance(ref, (list, tuple)):
+        assert len(got) == len(ref), path
+        for i, (a, b) in enumerate(zip(got, ref)):
+            _assert_same_results(a, b, rtol, f"{path}[{i}]", seen)
+    elif hasattr(ref, "__dict__") and not callable(ref):
+        for k, v in vars(ref).items():
+            if not k.startswith("_"):
+                _assert_same_results(getattr(got, k), v, rtol, f"{path}.{k}", seen)
+    elif not callable(ref):
+        assert got == ref, path
+
+
+def _frequency_dependent(bodies, scale=0.3):
+    """The bodies with their added mass tabulated over ω (A·(1 + scale·ω/5), held
+    outside [0, 5] rad/s): coupled modes that depend on the sea's ω_ref."""
+    from stochcable.bodies.rigid import FrequencyTable
+
+    w = np.array([0.0, 2.5, 5.0])
+    out = {}
+    for n, b in bodies.items():
+        a = np.asarray(b.added_mass, dtype=float)
+        out[n] = dataclasses.replace(b, added_mass=FrequencyTable(
+            w, np.stack([a * (1.0 + scale * x / 5.0) for x in w]), extrapolation="hold"))
+    return out
+
+
+@pytest.mark.parametrize("name,table", [("tuah_1982_disc_buoy_single_leg", False),
+                                        ("tuah_1982_disc_buoy_three_legs", False),
+                                        ("tuah_1982_disc_buoy_single_leg", True)])
+def test_one_model_solved_for_two_seas_equals_two_fresh_analyses(name, table):
+    """build_coupled once, solve_coupled for two sea states (another spectrum; the
+    examples' excitation tables have one heading): each result equals a fresh analyze_coupled of
+    the scene with that sea (1e-12 of each array's largest entry: the same
+    operations), and a second solve for the first sea is identical to the first (a
+    solve changes nothing in the model).  With a constant added mass the model holds
+    the coupled modes (their ω_ref set per sea); tabulated over ω (``table``), each
+    solve computes them at its sea's spectral peak."""
+    from stochcable.bodies.from_scene import scene_rigid_bodies
+    from stochcable.dynamics.coupled import build_coupled, solve_coupled
+    from stochcable.examples import load_example
+
+    scene = load_scene(load_example(name).model_dump(mode="json", exclude_none=True))
+    statics = solve_statics(scene, method="fe")
+    rigid = scene_rigid_bodies(scene)
+    if table:
+        rigid = _frequency_dependent(rigid)
+    spec = scene.sea.spectrum.model_copy(update={"m0": 12.0, "omega_p": 0.8})
+    seas = [scene.sea, scene.sea.model_copy(update={"spectrum": spec})]
+    model = build_coupled(scene, statics, scene.analysis, rigid_bodies=rigid)
+    assert all((g.modes is None) == table for g in model.groups)
+    got = [solve_coupled(model, sea) for sea in seas]
+    for sea, res in zip(seas, got):
+        fresh = analyze_coupled(scene.model_copy(update={"sea": sea}), statics,
+                                scene.analysis, rigid_bodies=rigid)
+        _assert_same_results(res, fresh, 1e-12)
+    w_refs = [res.bodies["disc"].modes.omega_ref for res in got]
+    assert w_refs[0] != w_refs[1]
+    again = solve_coupled(model, scene)   # a Scene: its sea
+    _assert_same_results(again, got[0], 0.0)
+    assert got[1].lines[scene.lines[0].name].tension_std.max() != pytest.approx(
+        got[0].lines[scene.lines[0].name].tension_std.max(), rel=1e-3)
+
+
+def test_solve_coupled_needs_the_model_grid():
+    """Settings on another grid than the model's are refused."""
+    from stochcable.dynamics.coupled import build_coupled, solve_coupled
+    from stochcable.examples import load_example
+
+    scene = load_scene(load_example("tuah_1982_disc_buoy_single_leg").model_dump(
+        mode="json", exclude_none=True))
+    model = build_coupled(scene, solve_statics(scene, method="fe"), scene.analysis)
+    other = scene.analysis.model_copy(update={"omega": scene.analysis.omega.model_copy(
+        update={"count": 50})})
+    with pytest.raises(InputError, match="grid the model was built on"):
+        solve_coupled(model, None, other)
