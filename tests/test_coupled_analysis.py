@@ -1126,3 +1126,54 @@ def test_solve_coupled_needs_the_model_grid():
         update={"count": 50})})
     with pytest.raises(InputError, match="grid the model was built on"):
         solve_coupled(model, None, other)
+
+
+# ------------------------------------------------ modal damping of the coupled modes
+
+
+@pytest.mark.parametrize("method", ["full", "reduced"])
+def test_coupled_mode_line_shares_complete_the_mass_normalization(mooring_direct, method):
+    """The line parts of the mass-normalized coupled modes (``line_shapes``, on all
+    nodes, attached ends moving with the body): Σ_l u_lᵀ(M + M_a)_l u_l +
+    ξᵀ(M_B + A(ω_ref))ξ = 1 for every mode (round-off of the eigen-solve), under both
+    the assembled and the reduced eigenproblem; the ends not on the body are at rest."""
+    from stochcable.dynamics.coupled.modes import line_mode_shares
+
+    scene, cls, loads, body, _ = mooring_direct
+    m = coupled_modes(cls, [body], 0.7, 2.0, method=method)
+    shares = line_mode_shares(m, cls)
+    xi = m.body_shapes["buoy"]
+    mb = body.mass_matrix() + body.added_mass_at(np.array([0.7]))[0]
+    total = sum(shares.values()) + np.einsum("jk,jk->k", xi, mb @ xi)
+    np.testing.assert_allclose(total, 1.0, rtol=1e-9)
+    for cl in cls:
+        np.testing.assert_array_equal(m.line_shapes[cl.name][0], 0.0)   # anchor
+        assert np.abs(m.line_shapes[cl.name][-1]).max() > 0              # fairlead
+
+
+def test_coupled_bandwidths_tend_to_the_fixed_end_ones_under_a_heavy_body():
+    """One leg on a body 10⁶ times heavier (its end all but held): the line-dominated
+    coupled modes are the leg's fixed-end modes and their modal damping φᵀCφ
+    (:func:`coupled_modal_bandwidths`) the fixed-end one of
+    :func:`stochcable.dynamics.line._modal_bandwidths` (1e-4; measured ≤ 8e-6 with
+    body energy fractions ≤ 1e-5 in those modes)."""
+    from stochcable.dynamics.coupled.modes import coupled_modal_bandwidths
+    from stochcable.dynamics.line import _modal_bandwidths, drag_coefficients
+
+    heavy = _buoy(mass=2.0e10, inertia=np.diag([5e10, 5e10, 8e10]),
+                  hydrostatic_stiffness=np.diag([1e9, 1e9, 1.26e11, 1e11, 1e11, 1e9]))
+    scene, cls, _ = _group(_mooring_doc(), heavy)
+    cl = cls[0]
+    damp = drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements, 0.3),
+                             "seed")
+    m = coupled_modes([cl], [heavy], 0.7, 2.0, method="full")
+    band = coupled_modal_bandwidths(m, [cl], [heavy], {cl.name: damp})
+    fixed_w = np.asarray(cl.system.modes.omega)
+    fixed_b = _modal_bandwidths(cl.system, damp)
+    checked = 0
+    for k, w in enumerate(m.omega):
+        j = int(np.argmin(np.abs(fixed_w - w)))
+        if abs(fixed_w[j] - w) <= 1e-5 * w and m.body_fraction[k] < 1e-3:
+            assert band[k] == pytest.approx(fixed_b[j], rel=1e-4)
+            checked += 1
+    assert checked >= 12

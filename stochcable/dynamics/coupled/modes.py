@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -28,11 +28,19 @@ from stochcable.bodies.rigid import (
     couple,
     rigid_link_matrix,
 )
+from stochcable.dynamics.coupled.group import body_drag_matrix
 from stochcable.dynamics.coupled.inputs import CoupledLine
-from stochcable.dynamics.line import _prep
+from stochcable.dynamics.line import _add, _drag_blocks, _matvec, _prep
 from stochcable.errors import InputError
 
-__all__ = ["LISTED_MODE_FACTOR", "MIN_LISTED_MODES", "CoupledModes", "coupled_modes"]
+__all__ = [
+    "LISTED_MODE_FACTOR",
+    "MIN_LISTED_MODES",
+    "CoupledModes",
+    "coupled_modal_bandwidths",
+    "coupled_modes",
+    "line_mode_shares",
+]
 
 #: Modes listed: those up to this factor times the top of the grid, at least
 #: ``MIN_LISTED_MODES`` (as the line listing of :mod:`stochcable.dynamics.line`).
@@ -64,6 +72,10 @@ class CoupledModes:
         Frequency at which the bodies' added mass was frozen. [rad/s]
     asymmetry : float
         max|K − Kᵀ|/max|K| of the coupled stiffness (its symmetric part is used). [-]
+    line_shapes : dict of str to ndarray, shape (n_nodes, d, n)
+        Line part of each mode shape on all the line's nodes (attached ends moving
+        with the bodies, the others at rest; mass-normalized over the group).
+        [m·kg^-1/2]
     """
 
     omega: np.ndarray
@@ -71,6 +83,7 @@ class CoupledModes:
     body_shapes: dict[str, np.ndarray]
     omega_ref: float
     asymmetry: float
+    line_shapes: dict[str, np.ndarray] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
         return {"omega": self.omega.tolist(), "body_fraction": self.body_fraction.tolist(),
@@ -196,9 +209,11 @@ def _coupled_modes_full(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody
     J = system.body_index
     frac = np.einsum("jn,jn->n", full[J], mfull[J]) if J.size else np.zeros(lam.size)
     shapes = {b.name: full[system.body_dofs[b.name]].copy() for b in bodies}
+    lshapes = {cl.name: np.asarray(system.link_maps[cl.name][0] @ full).reshape(
+        cl.system.model.n_nodes, cl.system.model.dim, lam.size) for cl in lines}
     return CoupledModes(omega=np.sqrt(np.clip(lam, 0.0, None)),
                         body_fraction=np.clip(frac, 0.0, 1.0), body_shapes=shapes,
-                        omega_ref=float(omega_ref), asymmetry=asym)
+                        omega_ref=float(omega_ref), asymmetry=asym, line_shapes=lshapes)
 
 
 def _coupled_modes_reduced(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
@@ -246,14 +261,16 @@ def _coupled_modes_reduced(lines: Sequence[CoupledLine], bodies: Sequence[RigidB
     xi = zf[m_tot:]
     # (M φ) on the body DOFs of the full system: Σ Tᵀ (M_line u)_ends + M_B ξ
     mxi = mb @ xi
-    for ell, _, md_, ends, t, o, m in parts:
+    lshapes = {}
+    for cl, (ell, _, md_, ends, t, o, m) in zip(lines, parts):
         u = ell @ np.r_[zf[o:o + m], xi]
         mxi += t.T @ (md_[ends] @ u)
+        lshapes[cl.name] = u.reshape(cl.system.model.n_nodes, cl.system.model.dim, lam.size)
     frac = np.einsum("jn,jn->n", xi, mxi) if nb else np.zeros(lam.size)
     shapes = {b.name: xi[off[b.name]:off[b.name] + b.n_dof].copy() for b in bodies}
     return CoupledModes(omega=np.sqrt(np.clip(lam, 0.0, None)),
                         body_fraction=np.clip(frac, 0.0, 1.0), body_shapes=shapes,
-                        omega_ref=float(omega_ref), asymmetry=asym)
+                        omega_ref=float(omega_ref), asymmetry=asym, line_shapes=lshapes)
 
 
 def _reduced_line(cl: CoupledLine, by_name: Mapping[str, RigidBody],
@@ -295,3 +312,80 @@ def _reduced_line(cl: CoupledLine, by_name: Mapping[str, RigidBody],
     ell[model.free, m:] = _prep(cl.system).follower() @ t
     ell[ends, m:] = t
     return (ell, kd_, md_, ends, t, offset, m), k_top, k_ends
+
+
+# ------------------------------------------------- modal damping of the coupled modes
+
+
+def coupled_modal_bandwidths(modes: CoupledModes, lines: Sequence[CoupledLine],
+                             bodies: Sequence[RigidBody], line_damping: Mapping[str, Any],
+                             body_drag: Mapping[str, np.ndarray] | None = None
+                             ) -> np.ndarray:
+    """Half-power bandwidths 2ζ_nω_n of the coupled modes: the diagonal of the modal
+    damping.
+
+    Parameters
+    ----------
+    modes : CoupledModes
+        With ``line_shapes`` (:func:`coupled_modes`).
+    lines : sequence of CoupledLine
+        The group's lines.
+    bodies : sequence of RigidBody
+        Its free bodies (``extra_damping``, radiation damping, drag point).
+    line_damping : mapping of str to Damping
+        The converged linear drag of each line.
+    body_drag : mapping of str to ndarray, shape (3,), optional
+        The converged linear drag per direction at each body's drag point. [N·s/m]
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        φ_nᵀCφ_n over the group (mass-normalized φ): per line its structural, seabed
+        and drag damping on all its nodes (the attached ends moving with the bodies,
+        as :func:`stochcable.dynamics.line._modal_bandwidths` does on the free nodes of
+        a line with fixed ends), per body C_B + B(ω_ref) + Tdᵀ diag(b) Td. [rad/s]
+
+    Notes
+    -----
+    ζ_n = bandwidth/(2ω_n) is the modal damping ratio of the coupled mode (the
+    coupling terms of the modal damping ignored, as for a single line).  The
+    radiation damping is frozen at ``modes.omega_ref`` with the added mass.
+    """
+    band = np.zeros(modes.omega.size)
+    for cl in lines:
+        u = modes.line_shapes[cl.name]
+        prep = _prep(cl.system)
+        c = _add(prep.S, _drag_blocks(cl.system, line_damping[cl.name]))
+        band += np.einsum("ndk,ndk->k", u, _matvec(c, u))
+    body_drag = {} if body_drag is None else body_drag
+    for b in bodies:
+        c = b.extra_damping + b.radiation_damping_at(np.array([modes.omega_ref]))[0]
+        if b.name in body_drag:
+            c = c + body_drag_matrix(b, np.asarray(body_drag[b.name], dtype=float))
+        xi = modes.body_shapes[b.name]
+        band += np.einsum("jk,jk->k", xi, c @ xi)
+    return band
+
+
+def line_mode_shares(modes: CoupledModes, lines: Sequence[CoupledLine]
+                     ) -> dict[str, np.ndarray]:
+    """Share of each coupled mode's kinetic energy in each line.
+
+    Parameters
+    ----------
+    modes : CoupledModes
+        With ``line_shapes``.
+    lines : sequence of CoupledLine
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n,)
+        u_lᵀ (M + M_a)_l u_l of each mass-normalized mode over the line's nodes;
+        Σ_l share_l + ξᵀ(M_B + A(ω_ref))ξ = 1. [-]
+    """
+    out = {}
+    for cl in lines:
+        model = cl.system.model
+        u = modes.line_shapes[cl.name].reshape(model.n_dof, -1)
+        out[cl.name] = np.einsum("ik,ik->k", u, (model.M + model.Ma) @ u)
+    return out
