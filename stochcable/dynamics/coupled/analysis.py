@@ -13,6 +13,7 @@ channel.  Each connected component of free bodies and their lines is one coupled
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import time
 from collections.abc import Mapping, Sequence
@@ -235,7 +236,11 @@ def _with_sea(scene: Any, sea: Any) -> Any:
         return scene
     if hasattr(sea, "lines"):   # a Scene: its sea
         sea = sea.sea
-    return scene.model_copy(update={"sea": sea})
+    if hasattr(scene, "model_copy"):   # the frozen pydantic Scene
+        return scene.model_copy(update={"sea": sea})
+    out = copy.copy(scene)             # a stand-in scene object
+    out.sea = sea
+    return out
 
 
 def _solve_line(model: CoupledModel, name: str, ch: tuple[Channel, ...], settings: Any,

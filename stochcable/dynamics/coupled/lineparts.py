@@ -292,23 +292,7 @@ class FossLine:
         if bad.any():   # the message of solvers._foss_transfer_modal
             _foss_transfer_modal(foss, np.zeros((m, n_w), dtype=complex), w, 1)
         w2, iw = w * w, 1j * w
-        if not cache:
-            # the drag-independent arrays; kept in ``cache`` (one per line of the
-            # group) for the later evaluations
-            cache = {} if cache is None else cache
-            cache["u_p"] = u_p = _base(system, prep, inp)[0]
-            up, _, st_a = cache["follow"] = _unit_follow(system, inp, ends)
-            n_e = up.shape[2]
-            # end nodes and their neighbours: nodes 0, 1, n-2, n-1
-            cache["adj"] = adj = np.r_[np.arange(d), np.arange(nf - d, nf)]
-            cache["pa"] = phi[adj]
-            cache["u4"] = u_p[[0, 1, -2, -1]]
-            up4 = np.empty((4, d, n_w, n_e), dtype=complex)
-            up4[...] = up[[0, 1, -2, -1]][:, :, None, :]
-            cache["up4"] = up4
-            cache["w2sa"] = (None if st_a is None
-                             else w2[None, None] * st_a[adj][:, :, None])  # (2d, n_e, n_w)
-            cache["zero_e"] = np.zeros((2, d, n_w, n_e), complex)     # read only
+        cache = _foss_cache(system, prep, inp, ends, phi, cache)
         u_p = cache["u_p"]
         up, ah, st_a = cache["follow"]
         adj = cache["adj"]
@@ -405,28 +389,12 @@ class ModalLine:
         n_w, n_ch = inp.weights.shape
         d = prep.d
         c = _add(prep.S, _drag_blocks(system, damping))
-        phi, mh, kh = prep.modal(system)
+        phi, _, _ = prep.modal(system)
         m, nf = phi.shape[1], phi.shape[0]
-        w2, iw = w * w, 1j * w
-        if not cache:
-            # the drag-independent arrays; kept in ``cache`` (one per line of the
-            # coarse group) for the later coarse evaluations
-            cache = {} if cache is None else cache
-            cache["u_p"] = _base(system, prep, inp)[0]
-            up, ah, st_a = cache["follow"] = _unit_follow(system, inp, ends)
-            cache["w2ah"] = w2[:, None, None] * ah[None]
-            cache["adj"] = adj = np.r_[np.arange(d), np.arange(nf - d, nf)]
-            cache["pa"] = phi[adj]
-            cache["u4"] = cache["u_p"][[0, 1, -2, -1]]
-            cache["up4"] = up[[0, 1, -2, -1]][:, :, None, :]
-            cache["w2sa"] = (None if st_a is None
-                             else w2[None, :, None] * st_a[adj][:, None, :])
-            key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂, as analysis._foss_free
-            if key not in prep._modal:
-                prep._modal[key] = kh - (w2[:, None, None]) * mh
-            cache["kmm"] = prep._modal[key]
+        iw = 1j * w
+        cache = _modal_cache(system, prep, inp, ends, cache)
         u_p = cache["u_p"]
-        up, ah, st_a = cache["follow"]
+        up, _, st_a = cache["follow"]
         ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
         rhs = _free_load(system, prep, inp, damping)
         flat = np.ascontiguousarray(prep._free_rows(rhs)).reshape(nf, n_w * n_ch)
@@ -484,6 +452,67 @@ class ModalLine:
         uf = _real_gemm(self.phi, zf)
         uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))       # (n_e, n_w, n_ch)
         return _assemble_line(self, uf, ue, uet)
+
+
+def _foss_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
+                phi: np.ndarray, cache: dict[str, Any] | None) -> dict[str, Any]:
+    """The drag-independent arrays of a :class:`FossLine`, filled into ``cache`` (one
+    per line of the group) on the first evaluation and kept for the later ones: the
+    base response, the static following of the attached ends, the rows of the end
+    nodes and their neighbours (nodes 0, 1, n-2, n-1) of Φ, of the base response and
+    of the static following, ω²·[static correction of âh] at those rows."""
+    if cache:
+        return cache
+    cache = {} if cache is None else cache
+    w = inp.omega
+    n_w = inp.weights.shape[0]
+    d = prep.d
+    nf = phi.shape[0]
+    w2 = w * w
+    cache["u_p"] = u_p = _base(system, prep, inp)[0]
+    up, _, st_a = cache["follow"] = _unit_follow(system, inp, ends)
+    n_e = up.shape[2]
+    # end nodes and their neighbours: nodes 0, 1, n-2, n-1
+    cache["adj"] = adj = np.r_[np.arange(d), np.arange(nf - d, nf)]
+    cache["pa"] = phi[adj]
+    cache["u4"] = u_p[[0, 1, -2, -1]]
+    up4 = np.empty((4, d, n_w, n_e), dtype=complex)
+    up4[...] = up[[0, 1, -2, -1]][:, :, None, :]
+    cache["up4"] = up4
+    cache["w2sa"] = (None if st_a is None
+                     else w2[None, None] * st_a[adj][:, :, None])  # (2d, n_e, n_w)
+    cache["zero_e"] = np.zeros((2, d, n_w, n_e), complex)     # read only
+    return cache
+
+
+def _modal_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
+                 cache: dict[str, Any] | None) -> dict[str, Any]:
+    """The drag-independent arrays of a :class:`ModalLine`, filled into ``cache`` (one
+    per line of the coarse group) on the first coarse evaluation and kept for the
+    later ones: the base response, the static following and its mass loads, K̂ − ω²M̂,
+    the end-node rows."""
+    if cache:
+        return cache
+    cache = {} if cache is None else cache
+    w = inp.omega
+    d = prep.d
+    phi, mh, kh = prep.modal(system)
+    m, nf = phi.shape[1], phi.shape[0]
+    w2 = w * w
+    cache["u_p"] = _base(system, prep, inp)[0]
+    up, ah, st_a = cache["follow"] = _unit_follow(system, inp, ends)
+    cache["w2ah"] = w2[:, None, None] * ah[None]
+    cache["adj"] = adj = np.r_[np.arange(d), np.arange(nf - d, nf)]
+    cache["pa"] = phi[adj]
+    cache["u4"] = cache["u_p"][[0, 1, -2, -1]]
+    cache["up4"] = up[[0, 1, -2, -1]][:, :, None, :]
+    cache["w2sa"] = (None if st_a is None
+                     else w2[None, :, None] * st_a[adj][:, None, :])
+    key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂, as analysis._foss_free
+    if key not in prep._modal:
+        prep._modal[key] = kh - (w2[:, None, None]) * mh
+    cache["kmm"] = prep._modal[key]
+    return cache
 
 
 def _assemble_line(part: Any, uf: np.ndarray, ue: np.ndarray, uet: np.ndarray
