@@ -265,9 +265,9 @@ def test_substructure_equals_assembled_coupled_system(mooring_direct):
                               damping=damp.matrix))
         inp = _inputs(cl.system, cl.channels)
         line_loads[cl.name] = _to_freq(_loads(cl.system, inp, damp))
-    from stochcable.dynamics.coupled import _body_drag
+    from stochcable.dynamics.coupled.group import linear_body_drag
 
-    bb, cdrag = _body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
+    bb, cdrag = linear_body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
     system = couple(links, [body], body_damping={"buoy": cdrag})
     from stochcable.bodies.rigid import rigid_link_matrix
 
@@ -668,16 +668,16 @@ def test_scene_three_leg_example_mirror_symmetry():
 
 def _count_full_evaluations(monkeypatch, n_omega):
     """Count the group solves on the full grid of ``n_omega`` frequencies."""
-    import stochcable.dynamics.coupled as ca
+    import stochcable.dynamics.coupled.group as cg
 
     count = [0]
-    solve = ca._solve_group
+    solve = cg.solve_group
 
     def counted(g, *args):
         count[0] += g.omega.size == n_omega
         return solve(g, *args)
 
-    monkeypatch.setattr(ca, "_solve_group", counted)
+    monkeypatch.setattr(cg, "solve_group", counted)
     return count
 
 
@@ -688,12 +688,13 @@ def test_coarse_start_gives_the_full_grid_fixed_point(solver, monkeypatch):
     change below tol = 1e-8 with a contraction ≈ 0.1, so each is within ~tol of the
     fixed point: σ and the outputs agree to 1e-6 (100·tol, margin for the transfer
     functions' amplification of the σ error)."""
-    from stochcable.dynamics.coupled import _coarse_subset, _Group
+    from stochcable.dynamics.coupled.coarse import coarse_subset
+    from stochcable.dynamics.coupled.group import GroupSystem
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver=solver, tol=1e-8), body)
-    g = _Group(cls, [body], loads, RHO, cls[0].channels)
-    idx = _coarse_subset(g)
+    g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
+    idx = coarse_subset(g)
     np.testing.assert_array_equal(idx, np.r_[np.arange(0, 96, 4), 95])
     full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads,
                              coarse=False)
@@ -728,9 +729,9 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
     mooring: the stride-4 subset's σ are ~4 % off, the corrected rounds gain ~30x
     each), with or without the rounds' warm step, and the answer is the full-grid
     fixed point within the tolerance."""
-    import stochcable.dynamics.coupled as ca
+    import stochcable.dynamics.coupled.coarse as cc
 
-    monkeypatch.setattr(ca, "_WARM_ROUNDS", warm)
+    monkeypatch.setattr(cc, "_WARM_ROUNDS", warm)
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver=solver, tol=1e-4), body)
     full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads,
@@ -749,17 +750,18 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
 
 def test_coarse_subset_skipped_on_small_grids(mooring_direct):
     """40 frequencies (< COARSE_MIN_FREQUENCIES): no coarse stage."""
-    from stochcable.dynamics.coupled import COARSE_MIN_FREQUENCIES, _coarse_subset, _Group
+    from stochcable.dynamics.coupled.coarse import COARSE_MIN_FREQUENCIES, coarse_subset
+    from stochcable.dynamics.coupled.group import GroupSystem
 
     scene, cls, loads, body, lin = mooring_direct
     assert cls[0].channels[0].omega.size < COARSE_MIN_FREQUENCIES
-    assert _coarse_subset(_Group(cls, [body], loads, RHO, cls[0].channels)) is None
+    assert coarse_subset(GroupSystem(cls, [body], loads, RHO, cls[0].channels)) is None
 
 
 def test_sliced_channel_inputs_equal_the_subset_of_the_full_inputs(mooring_direct):
     """A channel restricted to a frequency subset gives the full channel's loads at
     those frequencies (every array sliced along its frequency axis)."""
-    from stochcable.dynamics.coupled import _sliced_channel
+    from stochcable.dynamics.coupled.coarse import _sliced_channel
 
     scene, cls, loads, body, lin = mooring_direct
     s = cls[0].system
@@ -779,18 +781,19 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     system, so equal to round-off (1e-10 of the largest entry), truncated (8 of 27
     modes, static correction on) or not."""
     from stochcable.dynamics.line import _solve_free, drag_coefficients
-    from stochcable.dynamics.coupled import _foss_unit_split, _Group
+    from stochcable.dynamics.coupled.group import GroupSystem
+    from stochcable.dynamics.coupled.lineparts import foss_unit_split
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
-    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     cl = cls[0]
     s = cl.system
     assert s.solver == "foss"
     assert (s.n_modes < s.model.free.size) == (modes == 8)
     # a drag of a plausible size: σ = 0.3 m/s on every element
     damp = drag_coefficients(s, np.full(2 * s.model.n_elements, 0.3), "seed")
-    got, _ = _foss_unit_split(s, g.inp_phys[cl.name], g.inp[cl.name], damp)
+    got, _ = foss_unit_split(s, g.inp_phys[cl.name], g.inp[cl.name], damp)
     ref, _ = _solve_free(s, g.inp[cl.name], damp)
     assert got.shape == ref.shape and got.shape[-1] == 4  # sea + 3 unit columns
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
@@ -946,7 +949,7 @@ def test_fixed_dofs_validation_and_scene():
 def test_coarse_start_falls_back_to_the_full_grid(monkeypatch):
     """A coarse model that fails (a singular modal impedance) is skipped: the full-grid
     iteration alone runs, the same evaluations as ``coarse=False``."""
-    import stochcable.dynamics.coupled as ca
+    import stochcable.dynamics.coupled.lineparts as cp
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver="foss", tol=1e-4), body)
@@ -956,7 +959,7 @@ def test_coarse_start_falls_back_to_the_full_grid(monkeypatch):
     def fail(*args, **kwargs):
         raise np.linalg.LinAlgError("Singular matrix")
 
-    monkeypatch.setattr(ca, "_ModalLine", fail)
+    monkeypatch.setattr(cp, "ModalLine", fail)
     fast = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)
     assert fast.history == full.history
     np.testing.assert_array_equal(fast.body_sigma["buoy"], full.body_sigma["buoy"])
@@ -967,7 +970,7 @@ def test_warm_step_is_the_fixed_point_of_an_affine_map():
     step over secant pairs: for an affine map y -> r·(A y + b) in n dimensions, n + 1
     affinely independent pairs give its fixed point exactly (closed form
     (I − diag(r) A)⁻¹ diag(r) b; tolerance: round-off of a 3×3 solve)."""
-    from stochcable.dynamics.coupled import _warm_step
+    from stochcable.dynamics.coupled.coarse import _warm_step
 
     rng = np.random.default_rng(3)
     a = 0.3 * rng.standard_normal((3, 3))
@@ -989,7 +992,7 @@ def test_large_static_body_rotation_is_flagged():
     import warnings
 
     from stochcable.dynamics.line import analyze
-    from stochcable.dynamics.coupled import STATIC_ROTATION_LIMIT
+    from stochcable.dynamics.coupled.model import STATIC_ROTATION_LIMIT
     from stochcable.errors import PhysicsWarning
     from stochcable.examples import load_example
     from stochcable.scene.model import load_scene
@@ -1011,3 +1014,166 @@ def test_large_static_body_rotation_is_flagged():
     assert heel > STATIC_ROTATION_LIMIT
     assert f"{math.degrees(heel):.3g}°" in str(
         next(w.message for w in rec if "static rotation" in str(w.message)))
+
+
+# ------------------------------------------------------------ build once, solve many
+
+
+def _assert_same_results(got, ref, rtol, path="result", seen=None):
+    """Every public number of two result objects (dataclasses, mappings, sequences,
+    arrays) agrees to ``rtol`` of the array's largest entry (``rtol=0``: equal);
+    private attributes (caches) are not compared."""
+    import dataclasses as dc
+
+    import scipy.sparse as sp
+
+    seen = set() if seen is None else seen
+    if got is ref or (id(got), id(ref)) in seen:
+        return
+    seen.add((id(got), id(ref)))
+    if isinstance(ref, (np.ndarray, sp.sparray, sp.spmatrix)) or np.isscalar(ref) and (
+            isinstance(ref, (int, float, complex, np.number)) and not isinstance(ref, bool)):
+        a = np.asarray(got.toarray() if sp.issparse(got) else got)
+        b = np.asarray(ref.toarray() if sp.issparse(ref) else ref)
+        assert a.shape == b.shape, path
+        if rtol == 0 or b.dtype.kind not in "fc":
+            np.testing.assert_array_equal(a, b, err_msg=path)
+        else:
+            scale = float(np.max(np.abs(b), initial=0.0))
+            np.testing.assert_allclose(a, b, rtol=rtol, atol=rtol * scale, err_msg=path)
+    elif dc.is_dataclass(ref):
+        assert type(got) is type(ref), path
+        for f in dc.fields(ref):
+            if not f.name.startswith("_"):
+                _assert_same_results(getattr(got, f.name), getattr(ref, f.name), rtol,
+                                     f"{path}.{f.name}", seen)
+    elif isinstance(ref, dict):
+        assert list(got) == list(ref), path
+        for k in ref:
+            _assert_same_results(got[k], ref[k], rtol, f"{path}[{k!r}]", seen)
+    elif isinstance(ref, (list, tuple)):
+        assert len(got) == len(ref), path
+        for i, (a, b) in enumerate(zip(got, ref)):
+            _assert_same_results(a, b, rtol, f"{path}[{i}]", seen)
+    elif hasattr(ref, "__dict__") and not callable(ref):
+        for k, v in vars(ref).items():
+            if not k.startswith("_"):
+                _assert_same_results(getattr(got, k), v, rtol, f"{path}.{k}", seen)
+    elif not callable(ref):
+        assert got == ref, path
+
+
+def _frequency_dependent(bodies, scale=0.3):
+    """The bodies with their added mass tabulated over ω (A·(1 + scale·ω/5), held
+    outside [0, 5] rad/s): coupled modes that depend on the sea's ω_ref."""
+    from stochcable.bodies.rigid import FrequencyTable
+
+    w = np.array([0.0, 2.5, 5.0])
+    out = {}
+    for n, b in bodies.items():
+        a = np.asarray(b.added_mass, dtype=float)
+        out[n] = dataclasses.replace(b, added_mass=FrequencyTable(
+            w, np.stack([a * (1.0 + scale * x / 5.0) for x in w]), extrapolation="hold"))
+    return out
+
+
+@pytest.mark.parametrize("name,table", [("tuah_1982_disc_buoy_single_leg", False),
+                                        ("tuah_1982_disc_buoy_three_legs", False),
+                                        ("tuah_1982_disc_buoy_single_leg", True)])
+def test_one_model_solved_for_two_seas_equals_two_fresh_analyses(name, table):
+    """build_coupled once, solve_coupled for two sea states (another spectrum; the
+    examples' excitation tables have one heading): each result equals a fresh analyze_coupled of
+    the scene with that sea (1e-12 of each array's largest entry: the same
+    operations), and a second solve for the first sea is identical to the first (a
+    solve changes nothing in the model).  With a constant added mass the model holds
+    the coupled modes (their ω_ref set per sea); tabulated over ω (``table``), each
+    solve computes them at its sea's spectral peak."""
+    from stochcable.bodies.from_scene import scene_rigid_bodies
+    from stochcable.dynamics.coupled import build_coupled, solve_coupled
+    from stochcable.examples import load_example
+
+    scene = load_scene(load_example(name).model_dump(mode="json", exclude_none=True))
+    statics = solve_statics(scene, method="fe")
+    rigid = scene_rigid_bodies(scene)
+    if table:
+        rigid = _frequency_dependent(rigid)
+    spec = scene.sea.spectrum.model_copy(update={"m0": 12.0, "omega_p": 0.8})
+    seas = [scene.sea, scene.sea.model_copy(update={"spectrum": spec})]
+    model = build_coupled(scene, statics, scene.analysis, rigid_bodies=rigid)
+    assert all((g.modes is None) == table for g in model.groups)
+    got = [solve_coupled(model, sea) for sea in seas]
+    for sea, res in zip(seas, got):
+        fresh = analyze_coupled(scene.model_copy(update={"sea": sea}), statics,
+                                scene.analysis, rigid_bodies=rigid)
+        _assert_same_results(res, fresh, 1e-12)
+    w_refs = [res.bodies["disc"].modes.omega_ref for res in got]
+    assert w_refs[0] != w_refs[1]
+    again = solve_coupled(model, scene)   # a Scene: its sea
+    _assert_same_results(again, got[0], 0.0)
+    assert got[1].lines[scene.lines[0].name].tension_std.max() != pytest.approx(
+        got[0].lines[scene.lines[0].name].tension_std.max(), rel=1e-3)
+
+
+def test_solve_coupled_needs_the_model_grid():
+    """Settings on another grid than the model's are refused."""
+    from stochcable.dynamics.coupled import build_coupled, solve_coupled
+    from stochcable.examples import load_example
+
+    scene = load_scene(load_example("tuah_1982_disc_buoy_single_leg").model_dump(
+        mode="json", exclude_none=True))
+    model = build_coupled(scene, solve_statics(scene, method="fe"), scene.analysis)
+    other = scene.analysis.model_copy(update={"omega": scene.analysis.omega.model_copy(
+        update={"count": 50})})
+    with pytest.raises(InputError, match="grid the model was built on"):
+        solve_coupled(model, None, other)
+
+
+# ------------------------------------------------ modal damping of the coupled modes
+
+
+@pytest.mark.parametrize("method", ["full", "reduced"])
+def test_coupled_mode_line_shares_complete_the_mass_normalization(mooring_direct, method):
+    """The line parts of the mass-normalized coupled modes (``line_shapes``, on all
+    nodes, attached ends moving with the body): Σ_l u_lᵀ(M + M_a)_l u_l +
+    ξᵀ(M_B + A(ω_ref))ξ = 1 for every mode (round-off of the eigen-solve), under both
+    the assembled and the reduced eigenproblem; the ends not on the body are at rest."""
+    from stochcable.dynamics.coupled.modes import line_mode_shares
+
+    scene, cls, loads, body, _ = mooring_direct
+    m = coupled_modes(cls, [body], 0.7, 2.0, method=method)
+    shares = line_mode_shares(m, cls)
+    xi = m.body_shapes["buoy"]
+    mb = body.mass_matrix() + body.added_mass_at(np.array([0.7]))[0]
+    total = sum(shares.values()) + np.einsum("jk,jk->k", xi, mb @ xi)
+    np.testing.assert_allclose(total, 1.0, rtol=1e-9)
+    for cl in cls:
+        np.testing.assert_array_equal(m.line_shapes[cl.name][0], 0.0)   # anchor
+        assert np.abs(m.line_shapes[cl.name][-1]).max() > 0              # fairlead
+
+
+def test_coupled_bandwidths_tend_to_the_fixed_end_ones_under_a_heavy_body():
+    """One leg on a body 10⁶ times heavier (its end all but held): the line-dominated
+    coupled modes are the leg's fixed-end modes and their modal damping φᵀCφ
+    (:func:`coupled_modal_bandwidths`) the fixed-end one of
+    :func:`stochcable.dynamics.line._modal_bandwidths` (1e-4; measured ≤ 8e-6 with
+    body energy fractions ≤ 1e-5 in those modes)."""
+    from stochcable.dynamics.coupled.modes import coupled_modal_bandwidths
+    from stochcable.dynamics.line import _modal_bandwidths, drag_coefficients
+
+    heavy = _buoy(mass=2.0e10, inertia=np.diag([5e10, 5e10, 8e10]),
+                  hydrostatic_stiffness=np.diag([1e9, 1e9, 1.26e11, 1e11, 1e11, 1e9]))
+    scene, cls, _ = _group(_mooring_doc(), heavy)
+    cl = cls[0]
+    damp = drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements, 0.3),
+                             "seed")
+    m = coupled_modes([cl], [heavy], 0.7, 2.0, method="full")
+    band = coupled_modal_bandwidths(m, [cl], [heavy], {cl.name: damp})
+    fixed_w = np.asarray(cl.system.modes.omega)
+    fixed_b = _modal_bandwidths(cl.system, damp)
+    checked = 0
+    for k, w in enumerate(m.omega):
+        j = int(np.argmin(np.abs(fixed_w - w)))
+        if abs(fixed_w[j] - w) <= 1e-5 * w and m.body_fraction[k] < 1e-3:
+            assert band[k] == pytest.approx(fixed_b[j], rel=1e-4)
+            checked += 1
+    assert checked >= 12

@@ -1,8 +1,8 @@
 """Fast paths of the coupled dynamics (stochcable.dynamics.coupled, issue 6 speed).
 
 Each fast path is the same linear system as a reference kept reachable:
-- Foss lines in modal coordinates (``_FossLine``, ``_MODAL_FOSS``) against the node-level
-  path (:func:`stochcable.dynamics.coupled._foss_unit_split` + reactions), at a given
+- Foss lines in modal coordinates (``FossLine``, ``lineparts._MODAL_FOSS``) against the node-level
+  path (:func:`stochcable.dynamics.coupled.lineparts.foss_unit_split` + reactions), at a given
   drag and through the whole drag fixed point;
 - coupled modes by Craig–Bampton reduction (``coupled_modes(method="reduced")``)
   against the assembled system (``method="full"``): a Rayleigh–Ritz projection, exact
@@ -19,17 +19,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import stochcable.dynamics.coupled as ca
-from stochcable.dynamics.line import build_line_system, drag_coefficients
+import stochcable.dynamics.coupled.coarse as cc
+import stochcable.dynamics.coupled.group as cg
+import stochcable.dynamics.coupled.lineparts as cp
+import stochcable.dynamics.coupled.modes as cm
+from stochcable.dynamics.line import (
+    _noop,
+    _quasi_static,
+    _sigmas,
+    build_line_system,
+    drag_coefficients,
+)
 from stochcable.bodies.rigid import RigidBody
 from stochcable.dynamics.coupled import (
     CoupledLine,
-    _Group,
-    _solve_group,
     body_loads,
     coupled_modes,
     linearize_coupled,
 )
+from stochcable.dynamics.coupled.group import GroupSystem, solve_group
 from stochcable.dynamics.loads import line_channels
 from stochcable.scene.model import load_scene
 from stochcable.line.statics import solve_statics
@@ -42,7 +50,7 @@ from test_coupled_analysis import RHO, _buoy, _group, _mooring_doc  # noqa: E402
 def node_level(monkeypatch):
     """Switch the Foss lines to the node-level reference path."""
     def use(flag: bool) -> None:
-        monkeypatch.setattr(ca, "_MODAL_FOSS", flag)
+        monkeypatch.setattr(cp, "_MODAL_FOSS", flag)
     return use
 
 
@@ -53,12 +61,12 @@ def _solve_both(g, node_level, sigma=0.3, body_b=(2e3, 2e3, 4e3)):
     bb = {b.name: np.asarray(body_b, float) for b in g.drag}
     bc = np.zeros((g.nb, g.nb))
     for cl in g.lines:   # the modal path runs (no silent fallback to the reference)
-        ca._FossLine(cl.system, g.inp_phys[cl.name], damp[cl.name],
+        cp.FossLine(cl.system, g.inp_phys[cl.name], damp[cl.name],
                      tuple(k for k, _ in cl.attached()))
     out = []
     for flag in (False, True):
         node_level(flag)
-        out.append(_solve_group(g, damp, bc, bb, None))
+        out.append(solve_group(g, damp, bc, bb, None))
     return out
 
 
@@ -81,7 +89,7 @@ def test_modal_foss_lines_equal_node_level_path(node_level, modes):
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
     assert cls[0].system.solver == "foss"
-    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     ref, got = _solve_both(g, node_level)
     _assert_same(ref, got)
 
@@ -139,7 +147,7 @@ def test_modal_foss_equal_node_level_planar_two_bodies(node_level):
     cls, bodies, loads = _planar_two_body_group()
     assert all(cl.system.solver == "foss" and cl.system.model.dim == 2 for cl in cls)
     assert cls[1].system.n_modes < cls[1].system.model.free.size
-    g = _Group(cls, bodies, loads, RHO, cls[0].channels)
+    g = GroupSystem(cls, bodies, loads, RHO, cls[0].channels)
     # the sea and the tether's independent end motion: two channels, U_p of the
     # second not zero
     assert g.n_ch == 2 and cls[1].channels[1].motion_b is not None
@@ -293,7 +301,7 @@ def _solve_modal_direct(g, sigma=0.3, body_b=(2e3, 2e3, 4e3)):
     out = []
     for flag in (False, True):
         g.modal_direct = flag
-        out.append(_solve_group(g, damp, bc, bb, None))
+        out.append(solve_group(g, damp, bc, bb, None))
     g.modal_direct = False
     return out
 
@@ -306,7 +314,7 @@ def test_modal_direct_lines_equal_foss_lines(modes):
     correction on) and all modes."""
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
-    g = _Group(cls, [body], loads, RHO, cls[0].channels)
+    g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     ref, got = _solve_modal_direct(g)
     _assert_same(ref, got)
 
@@ -315,7 +323,7 @@ def test_modal_direct_equal_foss_planar_two_bodies():
     """As above on the planar two-body group (both ends attached, a second channel
     with a moving unattached end, truncated modes)."""
     cls, bodies, loads = _planar_two_body_group()
-    g = _Group(cls, bodies, loads, RHO, cls[0].channels)
+    g = GroupSystem(cls, bodies, loads, RHO, cls[0].channels)
     ref, got = _solve_modal_direct(g)
     _assert_same(ref, got)
 
@@ -326,14 +334,14 @@ def test_modal_direct_equal_foss_planar_two_bodies():
 def _coarse_update(g, idx, x=None):
     """The coarse group of ``g`` on ``idx`` and its map evaluated at ``x`` (default
     the rest σ scaled up, so the drag is not tiny)."""
-    gc = ca._coarse_group(g, idx)
-    rest = [ca._sigmas(cl.system, g.inp_phys[cl.name],
-                       ca._quasi_static(cl.system, g.inp_phys[cl.name]), "seed")
+    gc = cc._coarse_group(g, idx)
+    rest = [_sigmas(cl.system, g.inp_phys[cl.name],
+                       _quasi_static(cl.system, g.inp_phys[cl.name]), "seed")
             for cl in g.lines]
     gc.sizes = {cl.name: p.size for cl, p in zip(g.lines, rest)}
-    rest += [ca._body_sigma(g, b, None) for b in g.drag]
+    rest += [cg.body_sigma(g, b, None) for b in g.drag]
     x = 3.0 * np.concatenate(rest) if x is None else x
-    upd = ca._make_update(gc, "seed", RHO, {}, {}, ca._noop, "g", None)
+    upd = cg.sigma_update(gc, "seed", RHO, {}, {}, _noop, "g", None)
     return gc, upd, x
 
 
@@ -341,8 +349,8 @@ def _coarse_update(g, idx, x=None):
 @pytest.mark.parametrize("stage", ["coarse", "full"])
 def test_line_part_cache_gives_the_same_bits(stage, modes):
     """The drag-independent arrays kept per line across the evaluations
-    (``_Group.modal_cache`` of the coarse stage's :class:`_ModalLine`,
-    ``_Group.foss_cache`` of the full grid's :class:`_FossLine`): a solve at a second
+    (``GroupSystem.modal_cache`` of the coarse stage's :class:`ModalLine`,
+    ``GroupSystem.foss_cache`` of the full grid's :class:`FossLine`): a solve at a second
     drag with the cache filled by a first one is bit-identical to the same solve on a
     fresh group (the cache holds nothing that depends on the drag)."""
     body = _buoy()
@@ -352,17 +360,17 @@ def test_line_part_cache_gives_the_same_bits(stage, modes):
             for s in (0.05, 0.4)]
     bb = {body.name: np.array([2e3, 2e3, 4e3])}
     bc = np.zeros((6, 6))
-    g1 = _Group(cls, [body], loads, RHO, cls[0].channels)
-    g2 = _Group(cls, [body], loads, RHO, cls[0].channels)
+    g1 = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
+    g2 = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     g1.modal_direct = g2.modal_direct = stage == "coarse"
     used, other = ("modal_cache", "foss_cache") if stage == "coarse" else \
         ("foss_cache", "modal_cache")
-    sol0, _ = _solve_group(g1, damp[0], bc, bb, None)
+    sol0, _ = solve_group(g1, damp[0], bc, bb, None)
     assert all(getattr(g1, used)[cl.name] for cl in cls)
     assert not getattr(g1, other)
-    sol1, xi1 = _solve_group(g1, damp[1], bc, bb, None)
+    sol1, xi1 = solve_group(g1, damp[1], bc, bb, None)
     assert not getattr(g2, used)
-    sol2, xi2 = _solve_group(g2, damp[1], bc, bb, None)
+    sol2, xi2 = solve_group(g2, damp[1], bc, bb, None)
     np.testing.assert_array_equal(xi1, xi2)
     for name, (u, s) in sol2.items():
         np.testing.assert_array_equal(sol1[name][0], u)
@@ -379,10 +387,10 @@ def test_coarse_group_leaves_out_negligible_weights(monkeypatch):
     (with |H|² at those frequencies not above 1e2 × the weighted mean: 1e-10)."""
     body = _buoy(drag_area=[4.0, 4.0, 8.0])
     _, cls, loads = _group(_mooring_doc(count=96, solver="foss"), body)
-    g = _Group(cls, [body], loads, RHO, cls[0].channels)
-    idx = ca._coarse_subset(g)
+    g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
+    idx = cc.coarse_subset(g)
     gc, upd, x = _coarse_update(g, idx)
-    monkeypatch.setattr(ca, "COARSE_NEGLIGIBLE", -1.0)   # keep every frequency
+    monkeypatch.setattr(cc, "COARSE_NEGLIGIBLE", -1.0)   # keep every frequency
     gall, upd_all, _ = _coarse_update(g, idx)
     assert gall.omega.size == idx.size and gc.omega.size == idx.size - 3
     kept = np.isin(gall.omega, gc.omega)
@@ -411,7 +419,7 @@ def test_sliced_channel_keeps_nodal_kinematics_lazy():
 
     lazy = dataclasses.replace(sea, velocity=None, acceleration=None, nodal=nodal)
     idx = np.arange(0, 40, 3)
-    sub = ca._sliced_channel(lazy, idx)
+    sub = cc._sliced_channel(lazy, idx)
     assert not calls
     np.testing.assert_array_equal(sub.velocity, sea.velocity[idx])
     np.testing.assert_array_equal(sub.acceleration, sea.acceleration[idx])
@@ -434,11 +442,11 @@ def test_listed_eigh_whole_driver_equals_subset_driver(top):
     md = a @ a.T / n + np.eye(n)
     b = rng.standard_normal((n, n))
     kd = b @ b.T + 0.1 * np.eye(n)
-    assert n <= ca._ALL_EIGH_MAX
-    lam, phi = ca._listed_eigh(kd, md, top)
+    assert n <= cm._ALL_EIGH_MAX
+    lam, phi = cm._listed_eigh(kd, md, top)
     ref = sla.eigh(kd, md, subset_by_value=(-np.inf, top), driver="gvx", eigvals_only=True)
-    if ref.size < ca.MIN_LISTED_MODES:
-        ref = sla.eigh(kd, md, eigvals_only=True)[:ca.MIN_LISTED_MODES]
+    if ref.size < cm.MIN_LISTED_MODES:
+        ref = sla.eigh(kd, md, eigvals_only=True)[:cm.MIN_LISTED_MODES]
     assert lam.size == ref.size
     np.testing.assert_allclose(lam, ref, rtol=1e-10)
     # mass-normalized eigenvectors: round-off of an n = 60 factorization

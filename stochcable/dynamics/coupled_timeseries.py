@@ -8,7 +8,7 @@ For a coupled group (lines attached to free bodies, :mod:`stochcable.dynamics.co
 the drag linearization is done once on the analysis grid; with its converged linear
 drag (the lines' :class:`~stochcable.dynamics.line.Damping`, the bodies' drag σ) the group is
 a linear system, solved here again on the realization band by the same substructured
-solve (:func:`stochcable.dynamics.coupled._solve_group`): the channels and the body
+solve (:func:`stochcable.dynamics.coupled.group.solve_group`): the channels and the body
 loads are evaluated on the band, the lines' support forces give the end tensions
 (:func:`stochcable.dynamics.line._end_tension`) and the body equation the motion ξ.
 
@@ -31,22 +31,26 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as v
-from stochcable.dynamics.line import _end_tension
-from stochcable.dynamics.coupled import (
-    CoupledGroup,
+from stochcable.dynamics.coupled.analysis import CoupledGroup
+from stochcable.dynamics.coupled.group import GroupSystem, body_drag_matrix, solve_group
+from stochcable.dynamics.coupled.inputs import (
     CoupledLine,
-    _Group,
-    _group_channels,
-    _scene_line_channels,
-    _solve_group,
-    _vessel_rao,
     body_loads,
+    group_channels,
+    scene_line_channels,
+    vessel_rao,
 )
-from stochcable.bodies.rigid import PLANAR_INDEX, rigid_link_matrix
+from stochcable.dynamics.line import _end_tension
 from stochcable.dynamics.loads import Channel, _spectrum_callable
 
-__all__ = ["GroupTransfer", "coupled_group_transfer", "frequency_chunks",
-           "line_entry_bytes", "vessel_raos", "CHUNK_BYTES"]
+__all__ = [
+    "CHUNK_BYTES",
+    "GroupTransfer",
+    "coupled_group_transfer",
+    "frequency_chunks",
+    "line_entry_bytes",
+    "vessel_raos",
+]
 
 #: Target size of the node arrays alive while one chunk of frequencies is solved. [B]
 CHUNK_BYTES = 48 * 2**20
@@ -117,7 +121,7 @@ def frequency_chunks(n_omega: int, entry_bytes: int, budget: int = CHUNK_BYTES
 def vessel_raos(scene: Any, omega: np.ndarray) -> dict[str, np.ndarray]:
     """6-DOF RAO (n_omega, 6) of every prescribed body (vessel) of the scene on
     ``omega`` (zero outside its table). [m/m, rad/m]"""
-    return {b.name: _vessel_rao(b.prescribed, omega)
+    return {b.name: vessel_rao(b.prescribed, omega)
             for b in (getattr(scene, "bodies", ()) or ())
             if getattr(b, "prescribed", None) is not None}
 
@@ -127,17 +131,17 @@ def _scene_line(scene: Any, name: str) -> Any:
 
 
 def _group_on(scene: Any, group: CoupledGroup, omega: np.ndarray
-              ) -> tuple[_Group, tuple[str, ...], tuple[tuple[str, str] | None, ...]]:
+              ) -> tuple[GroupSystem, tuple[str, ...], tuple[tuple[str, str] | None, ...]]:
     """The group's solve data on ``omega``: channels of every line (vessel ends in the
     sea channel), aligned on the group list as the analysis does, and body loads."""
     env = scene.environment
     vessel = vessel_raos(scene, omega)
     chans: dict[str, tuple[Channel, ...]] = {}
     for n in group.lines:
-        chans[n], _ = _scene_line_channels(scene, _scene_line(scene, n), group.systems[n],
+        chans[n], _ = scene_line_channels(scene, _scene_line(scene, n), group.systems[n],
                                            omega, vessel)
     if group.lines:
-        gch = _group_channels(group.lines, chans, omega)
+        gch = group_channels(group.lines, chans, omega)
         cls = [CoupledLine(group.systems[n], gch[n], end_a=group.attach[n].get("end_a"),
                            end_b=group.attach[n].get("end_b")) for n in group.lines]
         channels = cls[0].channels
@@ -150,7 +154,7 @@ def _group_on(scene: Any, group: CoupledGroup, omega: np.ndarray
            if c.kind == "end_motion"}
     sources = tuple(own.get(c.name) if c.kind == "end_motion" else None for c in channels)
     loads = {b.name: body_loads(b, channels, omega, scene.sea, env) for b in group.bodies}
-    return (_Group(cls, group.bodies, loads, env.rho, channels),
+    return (GroupSystem(cls, group.bodies, loads, env.rho, channels),
             tuple(c.kind for c in channels), sources)
 
 
@@ -193,7 +197,7 @@ def coupled_group_transfer(scene: Any, group: CoupledGroup, omega: Any, *,
     scene : Scene
         The scene the group belongs to (environment, sea, line end motions, vessels).
     group : CoupledGroup
-        The group's converged state (:attr:`stochcable.dynamics.coupled.CoupledAnalysis.groups`).
+        The group's converged state (:attr:`stochcable.dynamics.coupled.analysis.CoupledAnalysis.groups`).
     omega : array_like, shape (n_omega,)
         Frequencies, > 0 (the realization band). [rad/s]
     budget : int, optional
@@ -240,16 +244,12 @@ def coupled_group_transfer(scene: Any, group: CoupledGroup, omega: Any, *,
         body_b: dict[str, np.ndarray] = {}
         for b in g.drag:
             # the drag the converged response used, as a damping on the body DOFs:
-            # Tᵀ diag(b) T at the drag point (as coupled_analysis._body_drag)
+            # Tᵀ diag(b) T at the drag point
             bb = group.body_drag[b.name]
-            t = rigid_link_matrix(b.drag_point)
-            c = t.T @ (bb[:, None] * t)
-            if b.planar:
-                c = c[np.ix_(PLANAR_INDEX, PLANAR_INDEX)]
             s = slice(g.off[b.name], g.off[b.name] + b.n_dof)
-            body_c[s, s] += c
+            body_c[s, s] += body_drag_matrix(b, bb)
             body_b[b.name] = bb
-        sol, xi = _solve_group(g, group.dampings, body_c, body_b, timing)
+        sol, xi = solve_group(g, group.dampings, body_c, body_b, timing)
         for n in group.lines:
             et = _end_tension(group.systems[n], sol[n][1])
             for e in ("end_a", "end_b"):

@@ -1,0 +1,256 @@
+"""The coupled drag linearization: one fixed point over every line and body of a
+group (seed 001 §5.3 steps 5–13, eq. 5.2.2).
+
+The fixed-point variable is the concatenation of every attached line's σ vector
+(:func:`stochcable.dynamics.line.drag_coefficients` layout) and, per body with a drag
+area, the σ of the relative velocity (fluid − body) at its drag point along x, y, z
+(:func:`stochcable.dynamics.coupled.group.linear_body_drag`: b = ρ·CdA·E|v|, seed 001
+eq. 5.2.2 form with the current).  The iteration mirrors
+:func:`stochcable.dynamics.line.linearize`: the start is the fluid velocity relative to
+lines and bodies at rest (lines following their moving unattached ends
+quasi-statically), the first response starts the Anderson-accelerated iteration
+unmixed.  The record is one for the whole group.  On fine grids the start is the
+fixed point of a frequency subset, corrected by the full/coarse defect
+(:mod:`stochcable.dynamics.coupled.coarse`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from stochcable.bodies.rigid import RigidBody
+from stochcable.dynamics.coupled.coarse import (
+    COARSE_MIN_TOLERANCE,
+    CoarseStart,
+    coarse_subset,
+)
+from stochcable.dynamics.coupled.group import GroupSystem, body_sigma, sigma_update
+from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine
+from stochcable.dynamics.line import (
+    ANDERSON_MIXING,
+    Linearization,
+    Progress,
+    Response,
+    _end_tension,
+    _noop,
+    _quasi_static,
+    _sigmas,
+    _to_freq,
+    linearization_record,
+)
+from stochcable.dynamics.linearization import FixedPointResult, fixed_point
+from stochcable.dynamics.loads import Channel
+from stochcable.errors import ConvergenceError, InputError, PhysicsWarning, warn
+
+__all__ = ["CoupledLinearization", "linearize_coupled"]
+
+_HINT = ("increase analysis.linearization.max_iterations, lower relaxation, or set "
+         "allow_unconverged to get a flagged result")
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledLinearization:
+    """Outcome of :func:`linearize_coupled`.
+
+    Attributes
+    ----------
+    lines : dict of str to Linearization
+        Per line: its drag, its record (the group's iteration history with the
+        line's σ and B) and the coupled response (attached ends moving with the
+        bodies) per physical channel.
+    body_motion : dict of str to ndarray, complex, shape (n_omega, d, n_ch)
+        Body response per unit input. [m/unit, rad/unit]
+    body_sigma : dict of str to ndarray, shape (3,)
+        σ of the relative velocity at the drag point along x, y, z. [m/s]
+    body_drag : dict of str to ndarray, shape (3,)
+        Linear drag coefficient per direction at the drag point. [N·s/m]
+    converged, iterations, relative_change, history, tolerance
+        The group's fixed-point record.
+    """
+
+    lines: dict[str, Linearization]
+    body_motion: dict[str, np.ndarray]
+    body_sigma: dict[str, np.ndarray]
+    body_drag: dict[str, np.ndarray]
+    converged: bool
+    iterations: int
+    relative_change: float
+    history: tuple[float, ...]
+    tolerance: float
+
+
+def linearize_coupled(
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    settings: Any,
+    *,
+    rho: float,
+    loads: Mapping[str, BodyLoads] | None = None,
+    channels: Sequence[Channel] | None = None,
+    progress: Progress | None = None,
+    timing: dict[str, float] | None = None,
+    coarse: bool | None = None,
+) -> CoupledLinearization:
+    """Drag linearization and response of lines coupled through rigid bodies.
+
+    Parameters
+    ----------
+    lines : sequence of CoupledLine
+        The lines of the group (at least one; all with the same channels).
+    bodies : sequence of RigidBody
+        The free bodies of the group (static pose as ``position``).
+    settings : AnalysisSettings
+        ``linearization`` (method, tolerance, max_iterations, relaxation,
+        acceleration, allow_unconverged).
+    rho : float
+        Water density for the body drag. [kg/m³]
+    loads : mapping of body name to BodyLoads, optional
+        Wave inputs of the bodies (default none).
+    channels : sequence of Channel, optional
+        The group's channels (names, spectra, grid); default those of the first
+        line; required for bodies without lines (a body on springs).
+    progress : callable, optional
+        ``progress("linearization", {"group", "iteration", "change"})``.
+    timing : dict, optional
+        Accumulates ``solve_s``. [s]
+    coarse : bool, optional
+        Start the full-grid iteration from the fixed point of a frequency subset and
+        correct it by the full/coarse defect (:mod:`stochcable.dynamics.coupled.coarse`);
+        False iterates on the full grid only.  Default: when the tolerance is at
+        least ``COARSE_MIN_TOLERANCE`` (1e-6), under both solvers; skipped on grids
+        below ``COARSE_MIN_FREQUENCIES``.
+
+    Returns
+    -------
+    CoupledLinearization
+
+    Raises
+    ------
+    ConvergenceError
+        When the σ do not settle (unless ``allow_unconverged``).
+    SolverError
+        A singular body impedance (undamped resonance).
+
+    Notes
+    -----
+    Module docstrings: the substructured solve
+    (:mod:`stochcable.dynamics.coupled.group`), the fixed point (seed 001 §5.3 steps
+    5–13 over all lines and bodies).
+    """
+    lin = settings.linearization
+    method = lin.method
+    progress = _noop if progress is None else progress
+    if channels is None:
+        if not lines:
+            raise InputError("channels", None, "-",
+                             "a group without lines needs its channels")
+        channels = lines[0].channels
+    if not lines and not bodies:
+        raise InputError("lines", 0, "-", "a coupled group needs a line or a body")
+    g = GroupSystem(lines, bodies, loads or {}, rho, channels)
+    names = ", ".join(cl.name for cl in g.lines)
+    gname = f"coupled drag linearization of lines {names} and bodies " \
+            f"{', '.join(b.name for b in g.bodies)}"
+    x_rest = _rest_start(g, method)
+    state: dict[str, Any] = {"it": 0}
+    cache: dict[str, Any] = {}
+    fixed = {"relaxation": lin.relaxation,
+             "method": "anderson" if lin.acceleration == "anderson" else "relaxed",
+             "mixing": ANDERSON_MIXING}
+    # coarse stage (stochcable.dynamics.coupled.coarse): the fixed point of a frequency
+    # subset supplies the start of the full-grid iteration; its history is kept
+    if coarse is None:
+        coarse = lin.tolerance >= COARSE_MIN_TOLERANCE
+    idx = coarse_subset(g) if coarse and x_rest.size else None
+    stage = None
+    if idx is not None:
+        stage = CoarseStart(g, idx, method, rho, state, progress, names, lin, fixed, gname)
+        x_coarse = stage.start(x_rest)
+        if x_coarse is None:
+            stage = None
+        else:
+            x_rest = x_coarse
+    update = sigma_update(g, method, rho, state, cache, progress, names, timing)
+    x0 = update(x_rest)
+    change0 = state["change"]
+    rounds = 0
+    if stage is not None:
+        x0, change0, rounds = stage.correct(update, state, x0, change0)
+    coarse_hist = () if stage is None else stage.history
+    fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), lin, gname, fixed)
+    fp = FixedPointResult(fp.x, len(coarse_hist) + fp.iterations, fp.relative_change,
+                          fp.converged, coarse_hist + fp.history)
+    if not fp.converged:
+        warn(f"{gname} did not converge: relative change {fp.relative_change:.3e} after "
+             f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "
+             "flagged unconverged (increase analysis.linearization.max_iterations)",
+             PhysicsWarning, stacklevel=2)
+    return _outcome(g, cache, fp, lin.tolerance, method)
+
+
+def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
+    """σ of lines at rest (quasi-static on their moving ends) and bodies at rest;
+    sets ``g.sizes``. [m/s]"""
+    parts = [_sigmas(cl.system, g.inp_phys[cl.name],
+                     _quasi_static(cl.system, g.inp_phys[cl.name]), method)
+             for cl in g.lines]
+    g.sizes = {cl.name: p.size for cl, p in zip(g.lines, parts)}
+    for b in g.drag:
+        parts.append(body_sigma(g, b, None))
+    return np.concatenate(parts) if parts else np.zeros(0)
+
+
+def _full_grid(update: Any, x0: np.ndarray, change0: float, rounds: int, n_c: int,
+               lin: Any, gname: str, fixed: dict[str, Any]) -> FixedPointResult:
+    """The full-grid iteration from the output ``x0`` (relative change ``change0``) of
+    its first evaluation after ``rounds`` correction rounds and ``n_c`` coarse-stage
+    entries: its record (first evaluation included, coarse stage not)."""
+    if not np.all(np.isfinite(x0)):
+        raise ConvergenceError(gname, n_c + 1, float("nan"), lin.tolerance,
+                               hint="the first response gave non-finite σ")
+    if change0 <= lin.tolerance or lin.max_iterations == 1 or x0.size == 0:
+        fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance or x0.size == 0,
+                              (change0,))
+        if not fp.converged and not lin.allow_unconverged:
+            raise ConvergenceError(gname, n_c + 1, change0, lin.tolerance, hint=_HINT,
+                                   partial=fp)
+        return fp
+    try:
+        fp = fixed_point(
+            update, x0, tol=lin.tolerance,
+            max_iterations=lin.max_iterations - 1 - rounds,
+            allow_unconverged=lin.allow_unconverged, name=gname, **fixed,
+        )
+    except ConvergenceError as exc:
+        raise ConvergenceError(gname, n_c + exc.iterations + 1, exc.residual,
+                               exc.tolerance, hint=_HINT, partial=exc.partial) from None
+    return FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
+                            (change0,) + fp.history)
+
+
+def _outcome(g: GroupSystem, cache: Mapping[str, Any], fp: FixedPointResult,
+             tolerance: float, method: str) -> CoupledLinearization:
+    """The record of the converged group from its last evaluation ``cache``."""
+    ls, bs = g.split(cache["sigma"])
+    out = {}
+    for cl in g.lines:
+        system = cl.system
+        damping = cache["damping"][cl.name]
+        uc, sc = cache["sol"][cl.name]
+        resp = Response(omega=g.omega, displacement=_to_freq(uc), support_force=sc,
+                        end_tension=_end_tension(system, sc))
+        record = linearization_record(system, ls[cl.name], damping, fp, tolerance, method)
+        out[cl.name] = Linearization(damping=damping, record=record, response=resp)
+    xi = cache["xi"]
+    motion = {b.name: xi[:, g.off[b.name]:g.off[b.name] + b.n_dof, :].copy()
+              for b in g.bodies}
+    return CoupledLinearization(
+        lines=out, body_motion=motion,
+        body_sigma={b.name: bs[b.name].copy() for b in g.drag},
+        body_drag={k: v.copy() for k, v in cache["body_b"].items()},
+        converged=fp.converged, iterations=fp.iterations,
+        relative_change=fp.relative_change, history=fp.history, tolerance=tolerance)

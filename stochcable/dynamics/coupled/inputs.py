@@ -1,0 +1,394 @@
+"""Inputs of a coupled group: its lines, the body loads, vessel-driven ends and the
+group's channels (seed 001 §3.2.c, §3.3).
+
+A coupled group (:mod:`stochcable.dynamics.coupled`) is solved on one list of input
+channels: ``"sea"`` first, then ``"<line>.<end>.<dof>"`` for the end-motion spectra of
+the lines' unattached ends (:func:`group_channels`).  Each line sees every channel of
+the group (the ones that do not concern it carry only their spectrum).
+
+Vessel-driven ends
+------------------
+An end attached to a *prescribed* body (a vessel with a motion RAO ξ_RAO) moves with
+the RAO u = T(r)·ξ_RAO (three translations; the rotations move it through the arm r)
+coherently with the sea: it is the sea channel's end motion of an otherwise
+independent line (:func:`fairlead_motion`, :func:`scene_line_channels`), no coupling
+back.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from stochcable.bodies.rigid import (
+    RigidBody,
+    attachment_geometric_stiffness,
+    rigid_link_matrix,
+)
+from stochcable.dynamics.line import LineSystem
+from stochcable.dynamics.loads import Channel
+from stochcable.errors import InputError
+
+__all__ = [
+    "BodyLoads",
+    "CoupledLine",
+    "body_gravity_stiffness",
+    "body_loads",
+    "fairlead_motion",
+    "group_channels",
+    "reference_omega",
+    "scene_line_channels",
+    "unit_channels",
+    "vessel_rao",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class CoupledLine:
+    """A line of a coupled group: its system, channels and body attachments.
+
+    Parameters
+    ----------
+    system : LineSystem
+        The line about its static shape, both end nodes prescribed
+        (:func:`stochcable.dynamics.line.build_line_system`).
+    channels : tuple of Channel
+        The group's input channels in the group order, sampled on the analysis grid,
+        as seen by this line: fluid kinematics and the motion of its *unattached*
+        ends (channels that do not concern the line carry only the spectrum).
+    end_a, end_b : str, optional
+        Name of the (free) body the end is attached to; None: the end stays
+        prescribed (fixed or moving with its channels).
+    """
+
+    system: LineSystem
+    channels: tuple[Channel, ...]
+    end_a: str | None = None
+    end_b: str | None = None
+
+    @property
+    def name(self) -> str:
+        return self.system.name
+
+    def attached(self) -> list[tuple[int, str]]:
+        """(end index 0/1, body name) of the attached ends."""
+        return [(k, b) for k, b in enumerate((self.end_a, self.end_b)) if b is not None]
+
+
+@dataclass(frozen=True, eq=False)
+class BodyLoads:
+    """Wave inputs of one body per channel.
+
+    Parameters
+    ----------
+    force : ndarray, complex, shape (n_omega, d, n_ch)
+        Wave excitation per unit input (:func:`stochcable.bodies.rigid.body_excitation`).
+        [N/m, N·m/m]
+    velocity : ndarray, complex, shape (n_omega, 3, n_ch)
+        Fluid velocity at the drag point per unit input. [(m/s)/m]
+    current : ndarray, shape (3,)
+        Current at the drag point (the mean relative velocity). [m/s]
+    """
+
+    force: np.ndarray
+    velocity: np.ndarray
+    current: np.ndarray
+
+
+def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
+    """Motion of a point of a prescribed (vessel) body from its 6-DOF RAO.
+
+    Parameters
+    ----------
+    rao : array_like, complex, shape (n_omega, 6)
+        Vessel motion per unit wave amplitude (surge, sway, heave [m/m], roll, pitch,
+        yaw [rad/m]) about its reference point, global axes.
+    r : array_like, shape (3,)
+        The point relative to the reference point at the static pose. [m]
+
+    Returns
+    -------
+    ndarray, complex, shape (n_omega, 3)
+        u = T(r)·ξ = ξ_t + θ × r (seed 001 eqs. 3.3.6–3.3.7). [m/m]
+    """
+    a = np.asarray(rao, dtype=complex)
+    if a.ndim != 2 or a.shape[1] != 6:
+        raise InputError("rao", a.shape, "m/m", "must have shape (n_omega, 6)")
+    t = rigid_link_matrix(r)
+    return a @ t.T
+
+
+def body_loads(body: RigidBody, channels: Sequence[Channel], omega: np.ndarray,
+               sea: Any, environment: Any) -> BodyLoads:
+    """Excitation force and drag-point fluid velocity of a body per channel.
+
+    Parameters
+    ----------
+    body : RigidBody
+    channels : sequence of Channel
+        The group's channels (only ``kind == "sea"`` loads the body).
+    omega : ndarray, shape (n_omega,)
+        [rad/s]
+    sea : Sea or None
+        The scene's sea (heading).
+    environment : Environment
+        depth, g, current.
+
+    Returns
+    -------
+    BodyLoads
+        The sea channel: ``body_excitation(body, ω, β, k)`` (phase moved to the global
+        wave phase) and the linear wave velocity at the drag point
+        (:func:`stochcable.sea.kinematics.wave_kinematics`, zero above z = 0).
+    """
+    from stochcable.bodies.rigid import body_excitation
+    from stochcable.sea.kinematics import wave_kinematics, wavenumber
+
+    w = np.asarray(omega, dtype=float)
+    n_ch = len(channels)
+    d = body.n_dof
+    force = np.zeros((w.size, d, n_ch), dtype=complex)
+    vel = np.zeros((w.size, 3, n_ch), dtype=complex)
+    point = body.position + body.drag_point
+    for i, ch in enumerate(channels):
+        if ch.kind != "sea" or sea is None:
+            continue
+        beta = sea.heading_rad
+        k = wavenumber(w, environment.depth, environment.g)
+        force[:, :, i] = body_excitation(body, w, beta, wavenumber=k)
+        if np.any(body.drag_area > 0):
+            p = point.copy()
+            p[2] = max(p[2], -environment.depth)
+            kin = wave_kinematics(w, p, beta, environment.depth, environment.g)
+            vel[:, :, i] = kin.velocity[0].T
+    cur = np.asarray(environment.current_velocity(np.array([min(point[2], 0.0)]))[0],
+                     dtype=float)
+    return BodyLoads(force=force, velocity=vel, current=cur)
+
+
+def body_gravity_stiffness(body: RigidBody, displaced_volume: float,
+                           centre_of_buoyancy: Any, rho: float, g: float) -> np.ndarray:
+    """Restoring of the weight and the buoyancy of a body when it rotates.
+
+    Parameters
+    ----------
+    body : RigidBody
+        Mass and centre of gravity ``cog`` (relative to the reference point).
+    displaced_volume : float
+        Displaced volume ∇. [m³]
+    centre_of_buoyancy : array_like, shape (3,)
+        Centre of buoyancy relative to the reference point. [m]
+    rho, g : float
+        Water density [kg/m³] and gravity [m/s²].
+
+    Returns
+    -------
+    ndarray, shape (d, d)
+        Σ −[F]×[r]× over the weight F = (0, 0, −m g) at the CoG and the buoyancy
+        (0, 0, ρ g ∇) at the CoB (:func:`stochcable.bodies.rigid.attachment_geometric_stiffness`):
+        roll and pitch restoring ρ g ∇ z_B − m g z_G (the metacentric terms of a
+        fully submerged body, option (a) of docs/BODIES.md "Symmetry"). [N·m/rad]
+
+    Notes
+    -----
+    No waterplane terms: a surface-piercing body needs its ``hydrostatic_stiffness``
+    (which already contains these gravity terms, WAMIT convention).
+    """
+    w = np.array([0.0, 0.0, -body.mass * g])
+    b = np.array([0.0, 0.0, rho * g * float(displaced_volume)])
+    cob = np.asarray(centre_of_buoyancy, dtype=float)
+    return (attachment_geometric_stiffness(w, body.cog, body.planar)
+            + attachment_geometric_stiffness(b, cob, body.planar))
+
+
+def _zero_density(w: np.ndarray) -> np.ndarray:
+    return np.zeros_like(np.asarray(w, dtype=float))
+
+
+def unit_channels(cl: CoupledLine) -> tuple[Channel, ...]:
+    """The unit end-motion channels of a line's attached ends.
+
+    Parameters
+    ----------
+    cl : CoupledLine
+
+    Returns
+    -------
+    tuple of Channel
+        d channels per attached end (``"unit.<end index>.<component>"``, kind
+        ``"end_motion"``, zero spectrum): a unit motion [m] of one component of the
+        end node at every frequency, the extra right-hand sides G, R_e of the
+        substructuring (:mod:`stochcable.dynamics.coupled.group`).
+    """
+    model = cl.system.model
+    comps = list(model.components)
+    w = cl.channels[0].omega
+    out = []
+    for k, _ in cl.attached():
+        for j, c in enumerate(comps):
+            m = np.zeros((w.size, 3), dtype=complex)
+            m[:, c] = 1.0
+            out.append(Channel(name=f"unit.{k}.{j}", kind="end_motion", omega=w,
+                               spectrum=np.zeros(w.size), density=_zero_density,
+                               motion_a=m if k == 0 else None,
+                               motion_b=m if k == 1 else None))
+    return tuple(out)
+
+
+def reference_omega(channels: Sequence[Channel], omega: np.ndarray) -> float:
+    """Frequency at which frequency-dependent added mass is frozen for the modes.
+
+    Parameters
+    ----------
+    channels : sequence of Channel
+        The group's channels (their spectra on ``omega``).
+    omega : ndarray, shape (n_omega,)
+        The analysis grid. [rad/s]
+
+    Returns
+    -------
+    float
+        The peak of the sea spectrum on the grid, else of the first channel with a
+        nonzero spectrum, else the grid middle. [rad/s]
+    """
+    for c in channels:
+        if c.kind == "sea" and np.any(c.spectrum > 0):
+            return float(omega[int(np.argmax(c.spectrum))])
+    for c in channels:
+        if np.any(c.spectrum > 0):
+            return float(omega[int(np.argmax(c.spectrum))])
+    return float(omega[omega.size // 2])
+
+
+def group_channels(lnames: Sequence[str], chans: Mapping[str, tuple[Channel, ...]],
+                   omega: np.ndarray) -> dict[str, tuple[Channel, ...]]:
+    """Align the lines' channels on the group's channel list.
+
+    Parameters
+    ----------
+    lnames : sequence of str
+        The group's lines in scene order.
+    chans : mapping of str to tuple of Channel
+        Each line's own channels (:func:`scene_line_channels`).
+    omega : ndarray, shape (n_omega,)
+        The grid (for the ``"none"`` channel of a group without excitation). [rad/s]
+
+    Returns
+    -------
+    dict of str to tuple of Channel
+        Per line the group's list: ``"sea"``, then ``"<line>.<end>.<dof>"`` of every
+        line's end motions; channels of another line carry only their spectrum.
+    """
+    order: list[tuple[str, str, Channel]] = []
+    sea = None
+    for n in lnames:
+        for c in chans[n]:
+            if c.kind == "sea":
+                sea = c
+            else:
+                order.append((n, f"{n}.{c.name}", c))
+    out = {}
+    for n in lnames:
+        own = {c.name: c for c in chans[n]}
+        lst = []
+        if sea is not None:
+            lst.append(own.get("sea", dataclasses.replace(
+                sea, velocity=None, acceleration=None, motion_a=None, motion_b=None,
+                element_velocity=None, element_velocity_square=None,
+                element_end_square=None)))
+        for owner, full, c in order:
+            if owner == n:
+                lst.append(dataclasses.replace(c, name=full))
+            else:
+                lst.append(Channel(name=full, kind="end_motion", omega=c.omega,
+                                   spectrum=c.spectrum, density=c.density))
+        if not lst:
+            lst = [Channel(name="none", kind="none", omega=omega,
+                           spectrum=np.zeros(omega.size), density=_zero_density)]
+        out[n] = tuple(lst)
+    return out
+
+
+def vessel_rao(motion: Any, omega: np.ndarray) -> np.ndarray:
+    """A vessel's 6-DOF motion RAO on the grid.
+
+    Parameters
+    ----------
+    motion : VesselMotion
+        The scene's prescribed body motion (a table, or an object with ``transfer``).
+    omega : ndarray, shape (n_omega,)
+        [rad/s]
+
+    Returns
+    -------
+    ndarray, complex, shape (n_omega, 6)
+        Surge, sway, heave [m/m], roll, pitch, yaw [rad/m]; zero outside the table
+        (as end-motion RAOs).
+    """
+    if hasattr(motion, "transfer"):  # (6, n_omega), as MotionRao.transfer's (3, n)
+        return np.asarray(motion.transfer(omega), dtype=complex).T
+    out = np.zeros((omega.size, 6), dtype=complex)
+    w = np.asarray(motion.omega, dtype=float)
+    for i, k in enumerate(("surge", "sway", "heave", "roll", "pitch", "yaw")):
+        tab = getattr(motion, k, None)
+        if tab is None:
+            continue
+        v = tab.values()
+        out[:, i] = (np.interp(omega, w, v.real, 0.0, 0.0)
+                     + 1j * np.interp(omega, w, v.imag, 0.0, 0.0))
+    return out
+
+
+def scene_line_channels(scene: Any, line: Any, system: LineSystem, omega: np.ndarray,
+                        vessel_rao: Mapping[str, np.ndarray]
+                        ) -> tuple[tuple[Channel, ...], dict[str, str]]:
+    """A scene line's input channels on ``omega`` and its ends on free bodies.
+
+    Parameters
+    ----------
+    scene : Scene
+        Environment, sea, bodies.
+    line : Line
+        The scene line (its end attachments and motions).
+    system : LineSystem
+        Its system (static node positions).
+    omega : ndarray, shape (n_omega,)
+        [rad/s]
+    vessel_rao : mapping of str to ndarray, complex, shape (n_omega, 6)
+        The prescribed bodies' RAOs on ``omega`` (:func:`vessel_rao`).
+
+    Returns
+    -------
+    channels : tuple of Channel
+        As :func:`stochcable.dynamics.loads.line_channels`, each end attached to a
+        prescribed body moving with :func:`fairlead_motion` inside the sea channel.
+    attach : dict of str to str
+        ``{end: body}`` of the ends attached to free bodies (solved with the body).
+    """
+    from stochcable.dynamics.loads import line_channels
+
+    body_docs = {b.name: b for b in getattr(scene, "bodies", ()) or ()}
+    ch = line_channels(scene, line, system.positions, omega)
+    att: dict[str, str] = {}
+    for k, end in enumerate(("end_a", "end_b")):
+        a = getattr(getattr(line, end), "attach", None)
+        if a is None:
+            continue
+        if a.body not in vessel_rao:
+            att[end] = a.body
+            continue
+        if scene.sea is None:
+            raise InputError(f"bodies[{a.body}].prescribed", "RAO table", "-",
+                             "a vessel motion RAO is relative to the sea: the scene "
+                             "needs a 'sea'")
+        node = 0 if k == 0 else system.model.n_nodes - 1
+        r = system.positions[node] - np.asarray(body_docs[a.body].position, float)
+        mot = fairlead_motion(vessel_rao[a.body], r)
+        ch = tuple(dataclasses.replace(c, **{f"motion_{end[-1]}": mot})
+                   if c.kind == "sea" else c for c in ch)
+    return ch, att
+

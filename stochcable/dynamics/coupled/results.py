@@ -1,0 +1,89 @@
+"""Results of a coupled group: the lines' results and the bodies' motion statistics
+(seed 001 §5.1, spectral moments and maxima)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from stochcable.bodies.rigid import PLANAR_INDEX, RigidBody
+from stochcable.dynamics.coupled.fixedpoint import CoupledLinearization
+from stochcable.dynamics.coupled.inputs import CoupledLine
+from stochcable.dynamics.coupled.modes import CoupledModes
+from stochcable.dynamics.line import line_result
+from stochcable.dynamics.loads import Channel
+from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
+
+__all__ = ["body_result", "coupled_results"]
+
+
+def coupled_results(
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    linearization: CoupledLinearization,
+    settings: Any,
+    *,
+    static_pose: Mapping[str, np.ndarray] | None = None,
+    modes: CoupledModes | None = None,
+    channels: Sequence[Channel] | None = None,
+) -> tuple[dict[str, LineResult], dict[str, BodyResult]]:
+    """Line and body results of a coupled group.
+
+    Parameters
+    ----------
+    lines : sequence of CoupledLine
+    bodies : sequence of RigidBody
+    linearization : CoupledLinearization
+    settings : AnalysisSettings
+        ``duration`` for the maxima.
+    static_pose : mapping of body name to ndarray (d,), optional
+        Static value of each body DOF (position and rotation components), the
+        statistics' mean (default: the body position, zero rotation). [m, rad]
+    modes : CoupledModes, optional
+        Listed on every body result.
+    channels : sequence of Channel, optional
+        The group's channels (default those of the first line).
+
+    Returns
+    -------
+    (lines, bodies) : dict of LineResult, dict of BodyResult
+    """
+    out_lines = {}
+    for cl in lines:
+        out_lines[cl.name] = line_result(cl.system, cl.channels,
+                                         linearization.lines[cl.name], settings)
+    ch = tuple(lines[0].channels if channels is None else channels)
+    spectra = np.stack([c.spectrum for c in ch])
+    w = ch[0].omega
+    out_bodies = {}
+    for b in bodies:
+        h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)
+        if static_pose is not None and b.name in static_pose:
+            mean = np.asarray(static_pose[b.name], dtype=float)
+        else:
+            full = np.concatenate([b.position, np.zeros(3)])
+            mean = full[list(PLANAR_INDEX)] if b.planar else full
+        out_bodies[b.name] = body_result(b.name, b.dof_names, w, tuple(c.name for c in ch),
+                                         spectra, h, mean, settings.duration,
+                                         sigma=linearization.body_sigma.get(b.name),
+                                         drag=linearization.body_drag.get(b.name),
+                                         modes=modes, prescribed=False)
+    return out_lines, out_bodies
+
+
+def body_result(name: str, dofs: Sequence[str], omega: np.ndarray,
+                channels: tuple[str, ...], spectra: np.ndarray, transfer: np.ndarray,
+                mean: np.ndarray, duration: float, *, sigma: Any = None, drag: Any = None,
+                modes: CoupledModes | None = None, prescribed: bool = False) -> BodyResult:
+    """Statistics of a body's motion from its transfer functions (see BodyResult)."""
+    dens = np.einsum("cdw,cw->dw", np.abs(transfer) ** 2, spectra)
+    stats = {dof: stats_from_spectrum(omega, dens[i], float(mean[i]), duration)
+             for i, dof in enumerate(dofs)}
+    return BodyResult(name=name, dofs=tuple(dofs), omega=np.asarray(omega).copy(),
+                      channels=tuple(channels), input_spectra=np.asarray(spectra).copy(),
+                      motion_transfer=transfer, motion=stats, prescribed=prescribed,
+                      drag_sigma=None if sigma is None else np.asarray(sigma).copy(),
+                      drag_coefficient=None if drag is None else np.asarray(drag).copy(),
+                      modes=modes)
