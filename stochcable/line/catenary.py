@@ -49,6 +49,8 @@ __all__ = [
     "catenary_from_top_tension",
     "catenary_multisegment",
     "catenary_line",
+    "elastic_catenary",
+    "catenary_on_mesh",
 ]
 
 #: Largest strain a line may need to reach its span (as the scene's validation). [-]
@@ -543,6 +545,17 @@ def catenary_solve(
     A horizontal span of exactly 0 gives H = 0 (vertical, possibly folded line).
     """
     X, Z, L, w, ea = _check_common(horizontal_span, vertical_span, length, weight, ea)
+    return elastic_catenary(X, Z, L, w, ea, bool(seabed))
+
+
+def elastic_catenary(X: float, Z: float, L: float, w: float, ea: float,
+                     seabed: bool) -> CatenarySolution:
+    """:func:`catenary_solve` for inputs already checked: floats, X >= 0 and Z, w
+    finite, L > 0, EA > 0 (``math.inf`` inextensible) [m, m, m, N/m, N].  For the inner
+    loops (the lumped-chain start of the FE statics, the line statics at every body
+    pose, the multi-segment start).  Raises as :func:`catenary_solve` when the line
+    cannot hang between the ends (too short, coincident ends, a weightless slack line,
+    a slack line piling up on the seabed) and when Newton does not converge."""
     c = 0.0 if math.isinf(ea) else 1.0 / ea
     chord = math.hypot(X, Z)
     if chord == 0.0:
@@ -654,7 +667,7 @@ def catenary_from_top_tension(
                          f"of {Z:g} m (the line is too heavy or too long for it)")
     H = brentq(lambda h: spans(h)[1] - Z, lo, hi, xtol=1e-14 * Tb, rtol=1e-15, maxiter=500)
     X = spans(H)[0]
-    return catenary_solve(X, Z, L, w, ea, seabed=seabed)
+    return elastic_catenary(X, Z, L, w, ea, bool(seabed))
 
 
 def catenary_multisegment(
@@ -734,7 +747,7 @@ def catenary_multisegment(
     if abs(w_avg) <= 1e-6 * float(np.max(np.abs(ws), initial=0.0)):
         w_avg = float(np.mean(np.abs(ws))) or 1.0  # a start only
     try:
-        s0 = catenary_solve(X, Z, L, w_avg, ea_eq)
+        s0 = elastic_catenary(X, Z, L, w_avg, ea_eq, False)
         H, Va = s0.H, s0.V_a
     except (InputError, ConvergenceError):
         H, Va = _initial_guess(X, Z, L, w_avg if w_avg != 0 else 1.0, 1.0 / ea_eq)
@@ -837,6 +850,12 @@ def catenary_line(
     if (np.any(mesh.node_mass != 0.0) or np.any(mesh.node_buoyancy != 0.0)):
         raise InputError(f"line {mesh.name!r}.attachments", "mass/buoyancy", "-",
                          "the closed-form catenary needs a line without loaded attachments")
+    return catenary_on_mesh(mesh, environment)
+
+
+def catenary_on_mesh(mesh: "LineMesh", environment: "Environment") -> CatenaryLine:
+    """:func:`catenary_line` of a mesh already known to have one segment and no loaded
+    attachment (the line statics checks that before it takes the closed form)."""
     a, b = mesh.end_a, mesh.end_b
     d = b - a
     X = float(math.hypot(d[0], d[1]))
@@ -844,8 +863,8 @@ def catenary_line(
     e_h = np.array([d[0], d[1], 0.0]) / X if X > 0.0 else np.array([1.0, 0.0, 0.0])
     depth = environment.depth
     on_seabed = abs(a[2] + depth) <= 1e-9 * depth
-    sol = catenary_solve(X, Z, mesh.length, float(mesh.weight[0]), float(mesh.ea[0]),
-                         seabed=on_seabed)
+    sol = elastic_catenary(X, Z, float(mesh.length), float(mesh.weight[0]),
+                           float(mesh.ea[0]), bool(on_seabed))
     x, z, t = sol.profile(mesh.s0)
     pos = a[None, :] + x[:, None] * e_h[None, :] + z[:, None] * np.array([0.0, 0.0, 1.0])
     mid = 0.5 * (mesh.s0[1:] + mesh.s0[:-1])

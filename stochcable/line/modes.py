@@ -36,9 +36,9 @@ import scipy.sparse.linalg as spla
 
 from stochcable.validation import positive_int
 from stochcable.errors import InputError, SolverError
-from stochcable.line.fem import FEModel, scene_fe_models
+from stochcable.line.fem import FEModel
 
-__all__ = ["DENSE_MAX_DOF", "Modes", "natural_modes", "modes_of_scene", "plane_normal"]
+__all__ = ["DENSE_MAX_DOF", "Modes", "natural_modes", "plane_normal"]
 
 #: Largest free-DOF block solved densely by ``method="auto"`` (benchmarks/bench_modes.py:
 #: dense eigh wins below ~250 DOFs for 30 modes on 2 cores).
@@ -489,35 +489,3 @@ def _out_of_plane_fraction(model: FEModel, mt: Any, shapes: np.ndarray,
     ep = np.einsum("ij,ij->j", pp, mt @ pp)
     tot = en + ep
     return np.where(tot > 0, en / np.where(tot > 0, tot, 1.0), 0.0)
-
-
-def modes_of_scene(
-    scene: Any,
-    count: int | None = None,
-    dim: int = 3,
-    added_mass: bool = True,
-) -> dict[str, Modes]:
-    """Natural modes of every line of a scene about its static equilibrium.
-
-    Parameters
-    ----------
-    scene : Scene, mapping, JSON string or path
-        The scene document (:func:`stochcable.scene.model.load_scene`).
-    count : int, optional
-        Modes per line; default all.
-    dim : {2, 3}
-        3 (default) lists in-plane and out-of-plane modes, classified; 2 keeps the
-        in-plane modes of lines in the x–z plane only.
-    added_mass : bool
-        Modes in water (with added mass) or in air.
-
-    Returns
-    -------
-    dict of str to Modes
-        Per line name, in scene order.
-    """
-    if count is not None:
-        count = positive_int("count", count)
-    models = scene_fe_models(scene, dim=dim)
-    return {name: natural_modes(model, count=count, added_mass=added_mass)
-            for name, model in models.items()}
