@@ -28,12 +28,8 @@ from typing import Any, Literal
 import numpy as np
 
 from stochcable.validation import nonnegative
-from stochcable.bodies.rigid import (
-    SPATIAL_DOFS,
-    ExcitationTable,
-    FrequencyTable,
-    RigidBody,
-)
+from stochcable.bodies.rigid import SPATIAL_DOFS, RigidBody
+from stochcable.bodies.tables import ExcitationTable, FrequencyTable
 from stochcable.errors import InputError
 from stochcable.scene.tables import SYMMETRY_TOLERANCE, checked_table, parse_table
 
@@ -96,17 +92,17 @@ class Hydrodynamics:
         return len(self.dofs) == 3
 
     def added_mass_table(self, extrapolation: Literal["error", "hold"] = "error") -> FrequencyTable:
-        """The added mass as a :class:`~stochcable.bodies.rigid.FrequencyTable`."""
+        """The added mass as a :class:`~stochcable.bodies.tables.FrequencyTable`."""
         return FrequencyTable(self.omega, self.added_mass, extrapolation)
 
     def radiation_damping_table(self, extrapolation: Literal["error", "hold"] = "error"
                                 ) -> FrequencyTable:
-        """The radiation damping as a :class:`~stochcable.bodies.rigid.FrequencyTable`."""
+        """The radiation damping as a :class:`~stochcable.bodies.tables.FrequencyTable`."""
         return FrequencyTable(self.omega, self.radiation_damping, extrapolation)
 
     def excitation_table(self, extrapolation: Literal["error", "hold"] = "error"
                          ) -> ExcitationTable | None:
-        """The excitation as an :class:`~stochcable.bodies.rigid.ExcitationTable` (None if absent)."""
+        """The excitation as an :class:`~stochcable.bodies.tables.ExcitationTable` (None if absent)."""
         if self.excitation is None:
             return None
         return ExcitationTable(self.omega, self.heading, self.excitation, extrapolation)
