@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.line.catenary import catenary_multisegment
+from stochcable.line.multisegment import catenary_multisegment
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.mesh import mesh_line
 from stochcable.scene.model import load_scene

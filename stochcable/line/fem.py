@@ -492,7 +492,7 @@ def build_fe_model(
     Parameters
     ----------
     line_statics : LineStatics
-        One line of :func:`stochcable.line.statics.solve_statics`: ``mesh``, ``positions``
+        One line of :func:`stochcable.statics.solve_statics`: ``mesh``, ``positions``
         (n_nodes, 3), ``tension`` (n_el,) effective tension, ``grounded`` (n_nodes,).
     environment : Environment
         Water density and seabed contact model.

@@ -34,9 +34,7 @@ from stochcable.scene.analysis_settings import (
     StructuralDamping,
     TimeSeriesSettings,
 )
-from stochcable.scene.base import G_STANDARD as G_STANDARD
-from stochcable.scene.base import RHO_SEAWATER as RHO_SEAWATER
-from stochcable.scene.base import _Doc
+from stochcable.scene.base import G_STANDARD, RHO_SEAWATER, _Doc
 from stochcable.scene.bodies import (
     BODY_DOFS,
     PLANAR_BODY_DOFS,
@@ -70,6 +68,8 @@ from stochcable.scene.spectra import (
 from stochcable.scene.units import UnitLabels, labels_of_document
 
 __all__ = [
+    "G_STANDARD",
+    "RHO_SEAWATER",
     "PiersonMoskowitz",
     "Jonswap",
     "Bretschneider",

@@ -113,11 +113,11 @@ def checked_table(dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source,
     ref = np.zeros(3) if ref is None else float_array("reference_point", ref, "m")
     if ref.shape != (3,):
         raise InputError("reference_point", ref.shape, "m", "must be (x, y, z)")
-    return dict(dofs=tuple(dofs), omega=w.copy(), added_mass=am, radiation_damping=bd,
-                heading=h, excitation=exc, hydrostatic_stiffness=hs,
-                reference_point=ref.copy(),
-                excitation_point=np.asarray(exc_point, dtype=float).copy(),
-                source=source)
+    return {"dofs": tuple(dofs), "omega": w.copy(), "added_mass": am,
+            "radiation_damping": bd, "heading": h, "excitation": exc,
+            "hydrostatic_stiffness": hs, "reference_point": ref.copy(),
+            "excitation_point": np.asarray(exc_point, dtype=float).copy(),
+            "source": source}
 
 
 def parse_table(
