@@ -249,7 +249,49 @@ def couple(
     if len(set(lnames)) != len(lnames):
         raise InputError("lines", lnames, "-", "line names must be unique")
     by_name = {b.name: b for b in bodies}
+    line_dofs, body_dofs, n = _dof_layout(lines, bodies)
 
+    geo = {b.name: np.zeros((b.n_dof, b.n_dof)) for b in bodies}
+    plans = []
+    for ln in lines:
+        attached, geometric = _attachments(ln, by_name, g, geometric_stiffness)
+        for bname, kg in geometric:
+            geo[bname] = geo[bname] + kg
+        plans.append((ln, attached))
+    pres: dict[str, np.ndarray] = {}
+    maps: dict[str, tuple[sp.csr_array, sp.csr_array]] = {}
+    n_p = 0
+    for ln, attached in plans:
+        L, P = _link_maps(ln.model, attached, line_dofs[ln.name], body_dofs, n)
+        pres[ln.name] = np.arange(n_p, n_p + P.shape[1])
+        n_p += P.shape[1]
+        maps[ln.name] = (L, P)
+
+    bd = {} if body_damping is None else dict(body_damping)
+    for key in bd:
+        if key not in by_name:
+            raise InputError("body_damping", key, "-", f"is not a body; bodies: {names}")
+
+    def total(getter: Any, body_part: Any) -> tuple[sp.csr_array, sp.csr_array]:
+        return _sum_links(getter, body_part, lines, bodies, maps, pres, body_dofs, n, n_p)
+
+    K, K_p = total(lambda ln: ln.model.K,
+                   lambda b: b.hydrostatic_stiffness + b.extra_stiffness + geo[b.name])
+    M, M_p = total(lambda ln: (ln.model.M + ln.model.Ma).tocsr(), lambda b: b.mass_matrix())
+    C, C_p = total(_line_damping, lambda b: b.extra_damping + (
+        square_matrix(f"body_damping[{b.name}]", bd[b.name], b.n_dof, "N·s/m") if b.name in bd
+        else 0.0))
+    for a in (K, M, C, K_p, M_p, C_p):
+        a.eliminate_zeros()
+    return CoupledSystem(K=K, M=M, C=C, K_p=K_p, M_p=M_p, C_p=C_p, bodies=bodies,
+                         lines=lines, line_dofs=line_dofs, body_dofs=body_dofs,
+                         prescribed_dofs=pres, link_maps=maps, geometric=geo)
+
+
+def _dof_layout(lines: tuple[LineLink, ...], bodies: tuple[RigidBody, ...]
+                ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], int]:
+    """Indices in x of each line's free DOFs and each body's DOFs (lines first), and
+    the number n of coupled DOFs."""
     n_free = sum(int(ln.model.free.size) for ln in lines)
     n = n_free + sum(b.n_dof for b in bodies)
     line_dofs: dict[str, np.ndarray] = {}
@@ -261,124 +303,124 @@ def couple(
     for b in bodies:
         body_dofs[b.name] = np.arange(k, k + b.n_dof)
         k += b.n_dof
+    return line_dofs, body_dofs, n
 
-    geo = {b.name: np.zeros((b.n_dof, b.n_dof)) for b in bodies}
-    pres: dict[str, np.ndarray] = {}
-    maps: dict[str, tuple[sp.csr_array, sp.csr_array]] = {}
-    plans = []
-    n_p = 0
+
+def _attachments(ln: LineLink, by_name: dict[str, RigidBody], g: float | None,
+                 geometric_stiffness: bool
+                 ) -> tuple[dict[int, tuple[RigidBody, np.ndarray]],
+                            list[tuple[str, np.ndarray]]]:
+    """The checked body attachments of a line: end node -> (body, arm r), and, with
+    ``geometric_stiffness``, per attached end the body's attachment geometric stiffness
+    of the static end force (:func:`stochcable.bodies.rigid.attachment_geometric_stiffness`)."""
+    model = ln.model
+    if not isinstance(model, FEModel):
+        raise InputError(f"lines[{ln.name}].model", type(model).__name__, "-",
+                         "must be a stochcable.line.fem.FEModel")
+    names = list(by_name)
+    fixed_nodes = set((model.fixed // model.dim).tolist())
+    attached: dict[int, tuple[RigidBody, np.ndarray]] = {}
+    geometric: list[tuple[str, np.ndarray]] = []
+    for end, node in (("end_a", 0), ("end_b", model.n_nodes - 1)):
+        bname = getattr(ln, end)
+        if bname is None:
+            continue
+        if bname not in by_name:
+            raise InputError(f"lines[{ln.name}].{end}", bname, "-",
+                             f"is not a body; bodies: {names}")
+        body = by_name[bname]
+        if node not in fixed_nodes:
+            raise InputError(f"lines[{ln.name}].{end}", bname, "-",
+                             "the end node is free in the model: build it with the end "
+                             "prescribed (fixed_nodes)")
+        if (model.dim == 2) != body.planar:
+            raise InputError(f"lines[{ln.name}].{end}", bname, "-",
+                             f"a {model.dim}-D line model needs a "
+                             f"{'planar' if model.dim == 2 else '6-DOF'} body")
+        r = model.positions[node] - body.position
+        if body.planar and abs(r[1]) > _SYM_TOL * max(1.0, float(np.abs(r).max())):
+            raise InputError(f"lines[{ln.name}].{end}", r.tolist(), "m",
+                             "a planar body's attachment must lie in its x–z plane")
+        fgiven = getattr(ln, "force_a" if end == "end_a" else "force_b")
+        f = (_model_end_force(model, end, g) if fgiven is None
+             else float_array(f"lines[{ln.name}].force_{end[-1]}", fgiven, "N"))
+        if f.shape != (3,):
+            raise InputError(f"lines[{ln.name}].force_{end[-1]}", f.shape, "N",
+                             "must have 3 components")
+        if geometric_stiffness:
+            geometric.append((bname, attachment_geometric_stiffness(f, r, body.planar)))
+        attached[node] = (body, r)
+    return attached, geometric
+
+
+def _link_maps(model: FEModel, attached: dict[int, tuple[RigidBody, np.ndarray]],
+               free_dofs: np.ndarray, body_dofs: dict[str, np.ndarray], n: int
+               ) -> tuple[sp.csr_array, sp.csr_array]:
+    """The sparse maps u_line = L x + P p of a line: identity from its free DOFs,
+    T(r) from the body DOFs on an attached end node (seed 001 eqs. 3.3.6–3.3.7), P on
+    its still-prescribed DOFs (model order)."""
+    d = model.dim
+    rows, cols, vals = [], [], []
+    # free DOFs: identity
+    rows.append(model.free)
+    cols.append(free_dofs)
+    vals.append(np.ones(model.free.size))
+    still = []
+    for dof in model.fixed:
+        node = int(dof // d)
+        if node in attached:
+            continue
+        still.append(int(dof))
+    for node, (body, r) in attached.items():
+        t = rigid_link_matrix(r, planar=body.planar)  # (d, n_b)
+        ii, jj = np.nonzero(t)
+        rows.append(d * node + ii)
+        cols.append(body_dofs[body.name][jj])
+        vals.append(t[ii, jj])
+    L = sp.csr_array((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                     shape=(model.n_dof, n))
+    still_arr = np.asarray(still, dtype=int)
+    P = sp.csr_array((np.ones(still_arr.size), (still_arr, np.arange(still_arr.size))),
+                     shape=(model.n_dof, still_arr.size))
+    return L, P
+
+
+def _sum_links(getter: Any, body_part: Any, lines: tuple[LineLink, ...],
+               bodies: tuple[RigidBody, ...],
+               maps: dict[str, tuple[sp.csr_array, sp.csr_array]],
+               pres: dict[str, np.ndarray], body_dofs: dict[str, np.ndarray], n: int,
+               n_p: int) -> tuple[sp.csr_array, sp.csr_array]:
+    """Σ L_ℓᵀ A_ℓ L_ℓ + the body blocks, and Σ L_ℓᵀ A_ℓ P_ℓ (seed 001 eq. 3.3.10),
+    A_ℓ = ``getter(line)``, the body blocks ``body_part(body)``."""
+    acc = sp.csr_array((n, n))
+    acc_p = sp.csr_array((n, n_p))
     for ln in lines:
-        model = ln.model
-        if not isinstance(model, FEModel):
-            raise InputError(f"lines[{ln.name}].model", type(model).__name__, "-",
-                             "must be a stochcable.line.fem.FEModel")
-        fixed_nodes = set((model.fixed // model.dim).tolist())
-        attached: dict[int, tuple[RigidBody, np.ndarray]] = {}
-        for end, node in (("end_a", 0), ("end_b", model.n_nodes - 1)):
-            bname = getattr(ln, end)
-            if bname is None:
-                continue
-            if bname not in by_name:
-                raise InputError(f"lines[{ln.name}].{end}", bname, "-",
-                                 f"is not a body; bodies: {names}")
-            body = by_name[bname]
-            if node not in fixed_nodes:
-                raise InputError(f"lines[{ln.name}].{end}", bname, "-",
-                                 "the end node is free in the model: build it with the end "
-                                 "prescribed (fixed_nodes)")
-            if (model.dim == 2) != body.planar:
-                raise InputError(f"lines[{ln.name}].{end}", bname, "-",
-                                 f"a {model.dim}-D line model needs a "
-                                 f"{'planar' if model.dim == 2 else '6-DOF'} body")
-            r = model.positions[node] - body.position
-            if body.planar and abs(r[1]) > _SYM_TOL * max(1.0, float(np.abs(r).max())):
-                raise InputError(f"lines[{ln.name}].{end}", r.tolist(), "m",
-                                 "a planar body's attachment must lie in its x–z plane")
-            fgiven = getattr(ln, "force_a" if end == "end_a" else "force_b")
-            f = (_model_end_force(model, end, g) if fgiven is None
-                 else float_array(f"lines[{ln.name}].force_{end[-1]}", fgiven, "N"))
-            if f.shape != (3,):
-                raise InputError(f"lines[{ln.name}].force_{end[-1]}", f.shape, "N",
-                                 "must have 3 components")
-            if geometric_stiffness:
-                geo[bname] = geo[bname] + attachment_geometric_stiffness(f, r, body.planar)
-            attached[node] = (body, r)
-        plans.append((ln, attached))
+        L, P = maps[ln.name]
+        a = getter(ln)
+        LtA = (L.T @ a).tocsr()
+        acc = acc + LtA @ L
+        pp = sp.csr_array((n, n_p))
+        if P.shape[1]:
+            blk = (LtA @ P).tocoo()
+            off = int(pres[ln.name][0])
+            pp = sp.csr_array((blk.data, (blk.row, blk.col + off)), shape=(n, n_p))
+        acc_p = acc_p + pp
+    for b in bodies:
+        idx = body_dofs[b.name]
+        blk = sp.coo_array(body_part(b))
+        acc = acc + sp.csr_array((blk.data, (idx[blk.row], idx[blk.col])), shape=(n, n))
+    return acc.tocsr(), acc_p.tocsr()
 
-    for ln, attached in plans:
-        model = ln.model
-        d = model.dim
-        rows, cols, vals = [], [], []
-        # free DOFs: identity
-        rows.append(model.free)
-        cols.append(line_dofs[ln.name])
-        vals.append(np.ones(model.free.size))
-        still = []
-        for dof in model.fixed:
-            node = int(dof // d)
-            if node in attached:
-                continue
-            still.append(int(dof))
-        for node, (body, r) in attached.items():
-            t = rigid_link_matrix(r, planar=body.planar)  # (d, n_b)
-            ii, jj = np.nonzero(t)
-            rows.append(d * node + ii)
-            cols.append(body_dofs[body.name][jj])
-            vals.append(t[ii, jj])
-        L = sp.csr_array((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(model.n_dof, n))
-        still_arr = np.asarray(still, dtype=int)
-        P = sp.csr_array((np.ones(still_arr.size), (still_arr, np.arange(still_arr.size))),
-                         shape=(model.n_dof, still_arr.size))
-        pres[ln.name] = np.arange(n_p, n_p + still_arr.size)
-        n_p += still_arr.size
-        maps[ln.name] = (L, P)
 
-    def total(getter, body_part) -> tuple[sp.csr_array, sp.csr_array]:
-        acc = sp.csr_array((n, n))
-        acc_p = sp.csr_array((n, n_p))
-        for ln in lines:
-            L, P = maps[ln.name]
-            a = getter(ln)
-            LtA = (L.T @ a).tocsr()
-            acc = acc + LtA @ L
-            pp = sp.csr_array((n, n_p))
-            if P.shape[1]:
-                blk = (LtA @ P).tocoo()
-                off = int(pres[ln.name][0])
-                pp = sp.csr_array((blk.data, (blk.row, blk.col + off)), shape=(n, n_p))
-            acc_p = acc_p + pp
-        for b in bodies:
-            idx = body_dofs[b.name]
-            blk = sp.coo_array(body_part(b))
-            acc = acc + sp.csr_array((blk.data, (idx[blk.row], idx[blk.col])), shape=(n, n))
-        return acc.tocsr(), acc_p.tocsr()
-
-    bd = {} if body_damping is None else dict(body_damping)
-    for key in bd:
-        if key not in by_name:
-            raise InputError("body_damping", key, "-", f"is not a body; bodies: {names}")
-
-    def line_c(ln: LineLink) -> Any:
-        if ln.damping is None:
-            return ln.model.Cs
-        c = ln.damping
-        if c.shape != (ln.model.n_dof, ln.model.n_dof):
-            raise InputError(f"lines[{ln.name}].damping", c.shape, "N·s/m",
-                             f"must be ({ln.model.n_dof}, {ln.model.n_dof})")
-        return sp.csr_array(ln.model.Cs + sp.csr_array(c))
-
-    K, K_p = total(lambda ln: ln.model.K,
-                   lambda b: b.hydrostatic_stiffness + b.extra_stiffness + geo[b.name])
-    M, M_p = total(lambda ln: (ln.model.M + ln.model.Ma).tocsr(), lambda b: b.mass_matrix())
-    C, C_p = total(line_c, lambda b: b.extra_damping + (
-        square_matrix(f"body_damping[{b.name}]", bd[b.name], b.n_dof, "N·s/m") if b.name in bd
-        else 0.0))
-    for a in (K, M, C, K_p, M_p, C_p):
-        a.eliminate_zeros()
-    return CoupledSystem(K=K, M=M, C=C, K_p=K_p, M_p=M_p, C_p=C_p, bodies=bodies,
-                         lines=lines, line_dofs=line_dofs, body_dofs=body_dofs,
-                         prescribed_dofs=pres, link_maps=maps, geometric=geo)
+def _line_damping(ln: LineLink) -> Any:
+    """The line's seabed damping plus its link damping (all model DOFs)."""
+    if ln.damping is None:
+        return ln.model.Cs
+    c = ln.damping
+    if c.shape != (ln.model.n_dof, ln.model.n_dof):
+        raise InputError(f"lines[{ln.name}].damping", c.shape, "N·s/m",
+                         f"must be ({ln.model.n_dof}, {ln.model.n_dof})")
+    return sp.csr_array(ln.model.Cs + sp.csr_array(c))
 
 
 # ------------------------------------------------------------------------- loads
