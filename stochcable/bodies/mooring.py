@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.bodies.rigid import attachment_geometric_stiffness, rigid_link_matrix
+from stochcable.bodies.rigid import geometric_stiffness, link_matrix
 from stochcable.line.banded import banded_solve, block_band_indices
 from stochcable.line.elements import stiffness_blocks
 from stochcable.line.statics import check_statics_options, line_statics
@@ -94,11 +94,11 @@ def mooring_stiffness_and_maps(scene: Scene, lines: dict[str, Any],
         for end, bname in ends:
             r = (scene.end_position(ln, end, pm) if end_position is None
                  else end_position(ln, end, poses)) - poses[bname][:3]
-            t = rigid_link_matrix(r, planar)
+            t = link_matrix(r, planar)
             tmat.append(t[comps] if t.shape[0] == 3 and planar else t)
             f = ls.force_a if end == "end_a" else ls.force_b
             i = block[bname]
-            K[i:i + d, i:i + d] += attachment_geometric_stiffness(f, r, planar)
+            K[i:i + d, i:i + d] += geometric_stiffness(f, r, planar)
         for p_, (_, bp) in enumerate(ends):
             for q_, (_, bq) in enumerate(ends):
                 kpq = ke[p_ * c:(p_ + 1) * c, q_ * c:(q_ + 1) * c]

@@ -53,6 +53,8 @@ __all__ = [
     "rigid_link_matrix",
     "rigid_body_mass_matrix",
     "attachment_geometric_stiffness",
+    "link_matrix",
+    "geometric_stiffness",
     "body_excitation",
     "square_matrix",
 ]
@@ -383,15 +385,23 @@ def rigid_link_matrix(r: Any, planar: bool = False) -> np.ndarray:
     """
     a = float_array("r", r, "m")
     if planar:
+        if a.shape not in ((3,), (2,)):
+            raise InputError("r", a.shape, "m", "must be (x, y, z) or (x, z) when planar")
+    elif a.shape != (3,):
+        raise InputError("r", a.shape, "m", "must have 3 components (x, y, z)")
+    return link_matrix(a, planar)
+
+
+def link_matrix(a: np.ndarray, planar: bool) -> np.ndarray:
+    """:func:`rigid_link_matrix` of a checked point: a finite float array ``a`` of
+    shape (3,), or (3,) or (2,) = (x, z) when planar [m].  For the inner loops (the
+    body statics at every trial pose)."""
+    if planar:
         if a.shape == (3,):
             rx, rz = a[0], a[2]
-        elif a.shape == (2,):
-            rx, rz = a
         else:
-            raise InputError("r", a.shape, "m", "must be (x, y, z) or (x, z) when planar")
+            rx, rz = a
         return np.array([[1.0, 0.0, rz], [0.0, 1.0, -rx]])
-    if a.shape != (3,):
-        raise InputError("r", a.shape, "m", "must have 3 components (x, y, z)")
     t = np.zeros((3, 6))
     t[:, :3] = np.eye(3)
     t[:, 3:] = -skew(a)
@@ -431,6 +441,13 @@ def attachment_geometric_stiffness(force: Any, r: Any, planar: bool = False) -> 
     a = float_array("r", r, "m")
     if f.shape != (3,) or a.shape != (3,):
         raise InputError("force", f.shape, "N", "force and r must have 3 components")
+    return geometric_stiffness(f, a, planar)
+
+
+def geometric_stiffness(f: np.ndarray, a: np.ndarray, planar: bool) -> np.ndarray:
+    """:func:`attachment_geometric_stiffness` of a checked force ``f`` [N] and point
+    ``a`` [m], finite float arrays of shape (3,).  For the inner loops (the body
+    statics at every trial pose)."""
     k = np.zeros((6, 6))
     k[3:, 3:] = float(f @ a) * np.eye(3) - np.outer(a, f)
     if planar:

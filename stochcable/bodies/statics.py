@@ -50,7 +50,7 @@ from stochcable.bodies.rigid import (
     PLANAR_INDEX,
     SPATIAL_DOFS,
     RigidBody,
-    attachment_geometric_stiffness,
+    geometric_stiffness,
 )
 from stochcable.validation import positive, positive_int
 from stochcable.errors import ConvergenceError, InputError
@@ -213,7 +213,7 @@ def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _geo6(force: np.ndarray, arm: np.ndarray) -> np.ndarray:
-    return attachment_geometric_stiffness(force, arm, False)
+    return geometric_stiffness(force, arm, False)
 
 
 # ---------------------------------------------------------------------- the solver
