@@ -177,19 +177,7 @@ def read_capytaine(
     Added mass and damping are real and need no change.  Seed 001 eqs. 3.2.c.16–17
     define the same quantities (f_lj = −ω² m_a + iω c, C_l).
     """
-    xr = _require_xarray()
-    if isinstance(source, xr.Dataset):
-        ds, name = source, "xarray.Dataset"
-    else:
-        path = Path(source)
-        if not path.is_file():
-            raise InputError("source", str(source), "-", "file not found")
-        ds, name = xr.open_dataset(path), str(path)
-    try:
-        ds = ds.load()
-    finally:
-        if not isinstance(source, xr.Dataset):
-            ds.close()
+    ds, name = _open_dataset(source)
     if "complex" in ds.dims:
         for v in list(ds.data_vars):
             if "complex" in ds[v].dims:
@@ -206,22 +194,72 @@ def read_capytaine(
     if freq_dim is None:
         raise InputError("source", name, "-", "has a single scalar omega: at least one "
                          "frequency dimension is needed")
-
-    def squeeze_extra(da, keep):
-        for dim in list(da.dims):
-            if dim in keep:
-                continue
-            if da.sizes[dim] != 1:
-                raise InputError("source", name, "-",
-                                 f"variable '{da.name}' varies over '{dim}' "
-                                 f"({da.sizes[dim]} values): select one before reading")
-            da = da.isel({dim: 0})
-        return da
-
     if "forward_speed" in ds.coords:
         fs = np.atleast_1d(ds["forward_speed"].values)
         if np.any(fs != 0):
             raise InputError("forward_speed", fs.tolist(), "m/s", "must be 0 (no forward speed)")
+    sel, sel_i = _capytaine_dofs(ds)
+
+    order = np.argsort(ds["omega"].values)
+    w = np.asarray(ds["omega"].values, dtype=float)[order]
+
+    def matrices(var):
+        da = _squeeze_extra(ds[var], (freq_dim, "influenced_dof", "radiating_dof"), name)
+        da = da.sel(influenced_dof=sel_i, radiating_dof=sel)
+        return np.asarray(da.transpose(freq_dim, "influenced_dof", "radiating_dof").values,
+                          dtype=float)[order]
+
+    am = matrices("added_mass")
+    bd = matrices("radiation_damping")
+    heading, exc = _capytaine_excitation(ds, name, freq_dim, sel_i, order)
+    hs = None
+    if "hydrostatic_stiffness" in ds:
+        da = _squeeze_extra(ds["hydrostatic_stiffness"], ("influenced_dof", "radiating_dof"),
+                            name)
+        hs = np.asarray(da.sel(influenced_dof=sel_i, radiating_dof=sel)
+                        .transpose("influenced_dof", "radiating_dof").values, dtype=float)
+    ref = np.zeros(3)
+    if "rotation_center" in ds:
+        ref = np.asarray(ds["rotation_center"].values, dtype=float).reshape(3)
+    return _build(tuple(SPATIAL_DOFS), w, am, bd, heading, exc, hs, ref, -ref[:2],
+                  f"capytaine:{name}", nonnegative("symmetry_tolerance", symmetry_tolerance, "-"))
+
+
+def _open_dataset(source: Any) -> tuple[Any, str]:
+    """The dataset, loaded (a file is closed after loading), and its name."""
+    xr = _require_xarray()
+    if isinstance(source, xr.Dataset):
+        ds, name = source, "xarray.Dataset"
+    else:
+        path = Path(source)
+        if not path.is_file():
+            raise InputError("source", str(source), "-", "file not found")
+        ds, name = xr.open_dataset(path), str(path)
+    try:
+        ds = ds.load()
+    finally:
+        if not isinstance(source, xr.Dataset):
+            ds.close()
+    return ds, name
+
+
+def _squeeze_extra(da: Any, keep: tuple[str, ...], name: str) -> Any:
+    """``da`` without its dimensions other than ``keep``, each of which must have one
+    value (InputError naming the dataset ``name`` otherwise)."""
+    for dim in list(da.dims):
+        if dim in keep:
+            continue
+        if da.sizes[dim] != 1:
+            raise InputError("source", name, "-",
+                             f"variable '{da.name}' varies over '{dim}' "
+                             f"({da.sizes[dim]} values): select one before reading")
+        da = da.isel({dim: 0})
+    return da
+
+
+def _capytaine_dofs(ds: Any) -> tuple[list[str], list[str]]:
+    """The dataset's radiating and influenced DOF labels of the six rigid-body DOFs, in
+    the library's order (any case)."""
     dofs_present = [str(v) for v in ds["radiating_dof"].values]
     lower = {v.lower(): v for v in dofs_present}
     missing = [d for d in _CAPYTAINE_DOFS if d.lower() not in lower]
@@ -233,54 +271,35 @@ def read_capytaine(
     if any(d.lower() not in infl for d in _CAPYTAINE_DOFS):
         raise InputError("influenced_dof", list(infl.values()), "-",
                          "must include the six rigid-body DOFs")
-    sel_i = [infl[d.lower()] for d in _CAPYTAINE_DOFS]
+    return sel, [infl[d.lower()] for d in _CAPYTAINE_DOFS]
 
-    order = np.argsort(ds["omega"].values)
-    w = np.asarray(ds["omega"].values, dtype=float)[order]
 
-    def matrices(var):
-        da = squeeze_extra(ds[var], (freq_dim, "influenced_dof", "radiating_dof"))
-        da = da.sel(influenced_dof=sel_i, radiating_dof=sel)
-        return np.asarray(da.transpose(freq_dim, "influenced_dof", "radiating_dof").values,
-                          dtype=float)[order]
-
-    am = matrices("added_mass")
-    bd = matrices("radiation_damping")
-
-    heading = exc = None
+def _capytaine_excitation(ds: Any, name: str, freq_dim: str, sel_i: list[str],
+                          order: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Headings [rad] (one turn from the first, increasing) and the excitation
+    (n_h, 6, n_w), conjugated to e^{+iωt} (read_capytaine's Notes); None, None without
+    an excitation (or diffraction + Froude–Krylov) force."""
     if "excitation_force" in ds:
         fx = ds["excitation_force"]
     elif "diffraction_force" in ds and "Froude_Krylov_force" in ds:
         fx = ds["diffraction_force"] + ds["Froude_Krylov_force"]
         fx.name = "excitation_force"
     else:
-        fx = None
-    if fx is not None:
-        fx = squeeze_extra(fx, (freq_dim, "wave_direction", "influenced_dof"))
-        if "wave_direction" not in fx.dims:
-            fx = fx.expand_dims("wave_direction")
-            hvals = np.atleast_1d(ds["wave_direction"].values) if "wave_direction" in ds.coords \
-                else np.zeros(1)
-        else:
-            hvals = np.asarray(fx["wave_direction"].values, dtype=float)
-        fx = fx.sel(influenced_dof=sel_i).transpose("wave_direction", "influenced_dof", freq_dim)
-        vals = np.conj(np.asarray(fx.values, dtype=complex))[:, :, order]
-        two_pi = 2.0 * math.pi
-        hw = np.asarray(hvals, dtype=float)
-        hw = hw[0] + (hw - hw[0]) % two_pi  # one turn from the first heading
-        ho = np.argsort(hw)
-        heading, exc = hw[ho], vals[ho]
-
-    hs = None
-    if "hydrostatic_stiffness" in ds:
-        da = squeeze_extra(ds["hydrostatic_stiffness"], ("influenced_dof", "radiating_dof"))
-        hs = np.asarray(da.sel(influenced_dof=sel_i, radiating_dof=sel)
-                        .transpose("influenced_dof", "radiating_dof").values, dtype=float)
-    ref = np.zeros(3)
-    if "rotation_center" in ds:
-        ref = np.asarray(ds["rotation_center"].values, dtype=float).reshape(3)
-    return _build(tuple(SPATIAL_DOFS), w, am, bd, heading, exc, hs, ref, -ref[:2],
-                  f"capytaine:{name}", nonnegative("symmetry_tolerance", symmetry_tolerance, "-"))
+        return None, None
+    fx = _squeeze_extra(fx, (freq_dim, "wave_direction", "influenced_dof"), name)
+    if "wave_direction" not in fx.dims:
+        fx = fx.expand_dims("wave_direction")
+        hvals = np.atleast_1d(ds["wave_direction"].values) if "wave_direction" in ds.coords \
+            else np.zeros(1)
+    else:
+        hvals = np.asarray(fx["wave_direction"].values, dtype=float)
+    fx = fx.sel(influenced_dof=sel_i).transpose("wave_direction", "influenced_dof", freq_dim)
+    vals = np.conj(np.asarray(fx.values, dtype=complex))[:, :, order]
+    two_pi = 2.0 * math.pi
+    hw = np.asarray(hvals, dtype=float)
+    hw = hw[0] + (hw - hw[0]) % two_pi  # one turn from the first heading
+    ho = np.argsort(hw)
+    return hw[ho], vals[ho]
 
 
 # ------------------------------------------------------------------ JSON table
