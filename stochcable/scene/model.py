@@ -11,6 +11,14 @@ Units are consistent units, SI by default (m, kg, s, N, rad/s); the seeds' imper
 examples run unchanged when ``g`` and ``rho`` are given in feet and slugs.  Headings
 in the document are in degrees (the document is an edge); the models expose radians
 (``heading_rad``) to the core.
+
+The parts of the document are modelled in :mod:`~stochcable.scene.spectra`,
+:mod:`~stochcable.scene.environment`, :mod:`~stochcable.scene.lines`,
+:mod:`~stochcable.scene.bodies` (with :mod:`~stochcable.scene.tables`, the
+hydrodynamic tables) and :mod:`~stochcable.scene.analysis_settings`; this module holds
+the :class:`Scene`, :func:`load_scene` and the conversion of validation errors, and
+re-exports every model (``from stochcable.scene.model import Line`` and
+``from stochcable.scene import Line`` both work).
 """
 
 from __future__ import annotations
