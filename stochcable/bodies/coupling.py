@@ -11,8 +11,9 @@ zero on a still-prescribed end) and P_ℓ the map from the prescribed DOFs p,
 
 and the same for M and C: the line end DOFs are eliminated in favour of the body DOFs
 (K_cc = Tᵀ K_bb T, K_fc = K_fb T).  The frequency response is
-Z(ω) x = F with Z(ω) = K − ω²(M + A(ω)) + iω(C + B(ω)) (:func:`stochcable.reference.bodies.solve_coupled_direct`, the
-independent dense/Schur check of the engine).
+Z(ω) x = F with Z(ω) = K − ω²(M + A(ω)) + iω(C + B(ω))
+(:func:`stochcable.reference.bodies.solve_coupled_direct`, the independent dense/Schur
+check of the engine).
 """
 
 from __future__ import annotations
@@ -212,7 +213,8 @@ def couple(
         The bodies (unique names); their dimensions must match the line models'
         (planar bodies with 2-D models, 6-DOF bodies with 3-D models).
     body_damping : mapping of str to array_like (d, d), optional
-        Additional damping per body name (e.g. :func:`body_drag_damping`). [N·s/m, …]
+        Additional damping per body name (e.g.
+        :func:`stochcable.reference.bodies.body_drag_damping`). [N·s/m, …]
     geometric_stiffness : bool
         Add the attachment geometric stiffness of the line end forces
         (:func:`attachment_geometric_stiffness`); default True.
@@ -522,7 +524,8 @@ def expand_line(system: CoupledSystem, name: str, x: Any, p: Any | None = None) 
     name : str
         Line name.
     x : array_like, shape (n_w, n[, k])
-        Coupled response (:func:`solve_coupled_direct`). [m, rad]
+        Coupled response (:func:`stochcable.reference.bodies.solve_coupled_direct`).
+        [m, rad]
     p : array_like, shape (n_w, n_p[, k]), optional
         Prescribed displacements (zero when None). [m]
 
@@ -563,8 +566,8 @@ def constant_matrices(system: CoupledSystem, omega_ref: float
     -----
     Modal superposition and the Foss decomposition (seed 001 §5.3) need constant
     matrices; with A(ω), B(ω) varying they are exact only at ω_ref, so the direct
-    solve (:func:`solve_coupled_direct`) is the reference whenever
-    ``system.frequency_dependent``.
+    solve (:func:`stochcable.reference.bodies.solve_coupled_direct`) is the reference
+    whenever ``system.frequency_dependent``.
     """
     w = nonnegative("omega_ref", omega_ref, "rad/s")
     a, b = system.body_hydrodynamics(np.array([w]))

@@ -181,7 +181,9 @@ class RigidBody:
         (default the reference point itself). [m]
     drag_area : array_like, shape (3,), optional
         Quadratic drag Cd·A for relative velocities along x, y and z (a Morison
-        element on the body), linearized by :func:`body_drag_damping`. [m²]
+        element on the body), linearized as
+        :func:`stochcable.reference.bodies.body_drag_damping` (the engine's drag
+        linearization, :mod:`stochcable.dynamics.coupled`). [m²]
     drag_point : array_like, shape (3,), optional
         Point of application of the drag, relative to the reference point. [m]
     extra_stiffness, extra_damping : array_like (d, d), optional

@@ -85,7 +85,7 @@ def solve_coupled_direct(
     ----------
     system : CoupledSystem
     F : array_like, complex, shape (n_w, n) or (n_w, n, k)
-        Loads (:func:`coupled_load`). [N, N·m]
+        Loads (:func:`stochcable.bodies.coupling.coupled_load`). [N, N·m]
     omega : array_like, shape (n_w,)
         Angular frequencies. [rad/s]
     method : {"auto", "schur", "dense"}
@@ -111,7 +111,8 @@ def solve_coupled_direct(
     mass and radiation damping (seed 001 eq. 3.2.c.20) exact at every ω.  A body's
     ``fixed_dofs`` are constraints: those DOFs are removed from the system and their
     motion is exactly zero (their loads are reactions, not inputs).  The Foss
-    decomposition needs constant matrices (:func:`constant_matrices`) and is exact
+    decomposition needs constant matrices
+    (:func:`stochcable.bodies.coupling.constant_matrices`) and is exact
     only where A and B are constant.
     """
     w = float_array("omega", omega, "rad/s", nonnegative=True)
