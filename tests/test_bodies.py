@@ -19,22 +19,23 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from fem_cases import taut_string, uniform_mesh
-from stochcable.bodies.rigid import (
-    ExcitationTable,
-    FrequencyTable,
+from stochcable.bodies.coupling import (
     LineLink,
-    RigidBody,
-    attachment_geometric_stiffness,
-    body_drag_damping,
-    body_excitation,
     constant_matrices,
     couple,
     coupled_load,
     expand_line,
+)
+from stochcable.bodies.rigid import (
+    ExcitationTable,
+    FrequencyTable,
+    RigidBody,
+    attachment_geometric_stiffness,
+    body_excitation,
     rigid_body_mass_matrix,
     rigid_link_matrix,
-    solve_coupled_direct,
 )
+from stochcable.reference.bodies import body_drag_damping, solve_coupled_direct
 from stochcable.errors import InputError, SolverError
 from stochcable.line.fem import assemble, build_fe_model
 from stochcable.line.mesh import mesh_line

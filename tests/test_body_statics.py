@@ -25,7 +25,8 @@ from stochcable.examples import load_example
 from stochcable.line.fem import build_fe_model
 from stochcable.line.mesh import mesh_line
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_line_statics, solve_statics
+from stochcable.line.statics import solve_line_statics
+from stochcable.statics import solve_statics
 
 RHO, G = 1025.0, 9.80665
 
@@ -379,7 +380,7 @@ def test_end_condensation_matches_dense_schur(planar, ends):
     """The banded condensation of the line tangent equals the dense Schur complement
     of stochcable.line.fem's assembled K (grounded nodes and seabed springs included), and
     its interior map predicts the re-solved shape to second order in the end motion."""
-    from stochcable.bodies.statics import _end_condensation
+    from stochcable.bodies.mooring import end_condensation
 
     # buoy at its symmetric pose: leg1 in the x–z plane (planar model), leg2 at 120°
     # (3-D); the end motions below keep the seabed contact set (a node lifting off is
@@ -390,7 +391,7 @@ def test_end_condensation_matches_dense_schur(planar, ends):
     mesh = mesh_line(scene.resolved_line(ln), env.rho, env.g)
     ls = solve_line_statics(mesh, env, method="fe", tolerance=1e-12)
     assert ls.grounded.sum() >= 3  # the seabed springs enter the condensation
-    ke, smap = _end_condensation(scene, ln, ls, ends, planar, "fe", 1e-10)
+    ke, smap = end_condensation(scene, ln, ls, ends, planar, "fe", 1e-10)
     ref = _dense_end_stiffness(ls, env, ends, planar)
     # two factorizations of the same ~1e7 N/m matrix: round-off level
     np.testing.assert_allclose(ke, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
@@ -429,7 +430,7 @@ def test_reported_stiffness_is_the_public_mooring_stiffness_at_the_pose():
     """The statics' memoized end positions (issue 6 pass E6) are those of
     Scene.end_position: the reported body stiffness at a rotated, offset pose is the
     body's own stiffness plus mooring_stiffness (which asks the scene) to the bit."""
-    from stochcable.bodies.statics import mooring_stiffness
+    from stochcable.bodies.mooring import mooring_stiffness
 
     scene = _spread(wind=(40.0, 25.0, 0.0))
     st = solve_statics(scene, method="fe")

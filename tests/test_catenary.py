@@ -17,12 +17,13 @@ from scipy.optimize import brentq
 
 from references import BLIET_1984_GUY, TUAH_1982_EX2, TUAH_1982_EX2_ELASTIC_CATENARY
 from stochcable.line import catenary as cat
+from stochcable.line import catenary_kernel
 from stochcable.line.catenary import (
     catenary_from_top_tension,
     catenary_line,
-    catenary_multisegment,
     catenary_solve,
 )
+from stochcable.line.multisegment import catenary_multisegment
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.examples import load_example
 from stochcable.line.mesh import mesh_line
@@ -289,7 +290,7 @@ def test_error_paths():
 
 
 def test_convergence_error_reports_residual(monkeypatch):
-    monkeypatch.setattr(cat, "_MAXIT", 1)
+    monkeypatch.setattr(cat, "MAX_NEWTON", 1)
     with pytest.raises(ConvergenceError, match=r"elastic catenary Newton did not converge: "
                                                r"residual \d\.\d+e[+-]\d+ after 1 iterations"):
         catenary_solve(800.0, 180.0, 850.0, CHAIN_W, CHAIN_EA, seabed=True)
@@ -408,7 +409,7 @@ def test_catenary_line_rejects_multisegment_and_attachments():
 
 
 def test_scalar_closure_kernel_is_the_array_kernel():
-    """The float kernel of the closure Newton (catenary._kernel_scalar, the speed pass
+    """The float kernel of the closure Newton (catenary_kernel.kernel_scalar, the speed pass
     of issue 4) returns the array kernel's numbers to the bit on every branch: V0, V1 of
     one sign (both signs), opposite signs, a zero end force, the asinh(d)/d series
     (|d| < 1e-6: w → 0), an inextensible line (c = 0)."""
@@ -422,6 +423,6 @@ def test_scalar_closure_kernel_is_the_array_kernel():
         (1.0, 0.0, 0.0, 10.0, 1e-6),                   # weightless, V0 = V1 = 0
     ]
     for H, V0, w, ls, c in cases:
-        fast = cat._kernel_scalar(H, V0, w, ls, c)
-        ref = tuple(float(x) for x in cat._kernel(H, V0, w, ls, c))
+        fast = catenary_kernel.kernel_scalar(H, V0, w, ls, c)
+        ref = tuple(float(x) for x in catenary_kernel.kernel(H, V0, w, ls, c))
         assert fast == ref, (H, V0, w, ls, c)

@@ -231,7 +231,7 @@ def test_build_fe_model_from_line_statics():
 
 
 def test_build_fe_model_with_solved_statics():
-    statics = pytest.importorskip("stochcable.line.statics")
+    statics = pytest.importorskip("stochcable.statics")
     from stochcable.scene.model import load_scene
 
     scene = load_scene({
@@ -279,11 +279,11 @@ def test_assemble_error_paths():
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_chain_csr_equals_the_coo_assembly(dim):
-    """fem._chain_csr (node blocks straight into CSR, the speed pass of issue 4) against
+    """fem.chain_csr (node blocks straight into CSR, the speed pass of issue 4) against
     the COO assembly it replaced (fem._assemble_sparse): the same pattern (explicit
     zeros kept) and the same entries; the diagonal blocks sum two element blocks and a
     nodal diagonal in another order, so 1e-15 relative (a few ulp)."""
-    from stochcable.line.fem import _assemble_sparse, _chain_csr, _element_dofs
+    from stochcable.line.fem import _assemble_sparse, _element_dofs, chain_csr
 
     rng = np.random.default_rng(7)
     n_el = 6
@@ -291,7 +291,7 @@ def test_chain_csr_equals_the_coo_assembly(dim):
     blocks[:, 0, dim] = 0.0  # explicit zeros stay in the pattern
     diag = np.where(rng.random(dim * (n_el + 1)) < 0.5, rng.normal(size=dim * (n_el + 1)), 0.0)
     for node_diag in (None, diag):
-        a = _chain_csr(blocks, n_el + 1, dim, node_diag)
+        a = chain_csr(blocks, n_el + 1, dim, node_diag)
         b = _assemble_sparse(blocks, _element_dofs(n_el, dim), dim * (n_el + 1), node_diag)
         assert a.has_canonical_format
         np.testing.assert_array_equal(a.indptr, b.indptr)

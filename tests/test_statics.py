@@ -8,11 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.line.catenary import catenary_multisegment
+from stochcable.line.multisegment import catenary_multisegment
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.mesh import mesh_line
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import _solve_fe, solve_line_statics, solve_statics
+from stochcable.line.statics import solve_fe, solve_line_statics
+from stochcable.statics import solve_statics
 
 # DESIGN.md "Scene and result documents": the chain leg of the example scene.
 CHAIN = dict(length=850.0, ea=1.2326e9, mass=288.0, diameter=0.216, cd_normal=1.333,
@@ -173,7 +174,7 @@ def test_3d_line_equals_rotated_planar_one():
     m2, env, _ = make(a, b, [CHAIN])
     m3, env3, _ = make(rot @ a, rot @ b, [CHAIN])
     r2 = fe(m2, env)
-    r3 = _solve_fe(m3, env3, None, 1e-10, 500, force_3d=True)  # full 3-DOF path
+    r3 = solve_fe(m3, env3, None, 1e-10, 500, force_3d=True)  # full 3-DOF path
     assert np.allclose(r3.positions, r2.positions @ rot.T, atol=1e-7)
     assert r3.tension_a == pytest.approx(r2.tension_a, rel=1e-9)
     assert np.allclose(r3.force_b, rot @ r2.force_b, atol=1e-9 * r2.tension_b)
@@ -370,15 +371,16 @@ def test_load_stepping_rescues_drag_dominated_line():
     # A light line (net weight 19 N/m) in a 2 m/s current (drag 370 N/m): full-load
     # Newton from the hanging shape stalls (checked: residual > 1e-3 after 500
     # iterations); ramping the drag from the current-free equilibrium converges.
-    from stochcable.line.statics import _Frame, _initial_guess, _Model, _Solver
+    from stochcable.line.chain import initial_guess
+    from stochcable.line.equilibrium import LocalFrame, StaticsModel, StaticsSolver
 
     seg = dict(length=600.0, ea=1e8, mass=20.0, diameter=0.15, elements=60)
     m, env, _ = make((-400, 0, -100), (0, 0, -20), [seg],
                      current=[{"z": 0.0, "speed": 2.0, "heading": 0.0}])
-    frame = _Frame(m, env)
-    model = _Model(m, env, frame)
-    solver = _Solver(model, 1e-10, 500)
-    ok, _, r_direct = solver.solve(_initial_guess(m, env, frame, model), 500)
+    frame = LocalFrame(m, env)
+    model = StaticsModel(m, env, frame)
+    solver = StaticsSolver(model, 1e-10, 500)
+    ok, _, r_direct = solver.solve(initial_guess(m, env, frame, model), 500)
     assert not ok and r_direct > 1e-3
     r = fe(m, env)
     assert r.residual < 1e-10 and r.iterations > 500 // 4  # went through the stepping
@@ -389,21 +391,22 @@ def test_load_stepping_rescues_drag_dominated_line():
 def _chain_in_current():
     """A 20-element chain in a 0.5 m/s current: its mesh, environment, frame, private
     FE statics model and the initial guess (for the model-level tests below)."""
-    from stochcable.line.statics import _Frame, _initial_guess, _Model
+    from stochcable.line.chain import initial_guess
+    from stochcable.line.equilibrium import LocalFrame, StaticsModel
 
     m, env, _ = make((-800, 0, -200), (0, 0, -20), [dict(CHAIN, elements=20)],
                      current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}])
-    frame = _Frame(m, env)
-    model = _Model(m, env, frame)
-    return m, env, frame, model, _initial_guess(m, env, frame, model)
+    frame = LocalFrame(m, env)
+    model = StaticsModel(m, env, frame)
+    return m, env, frame, model, initial_guess(m, env, frame, model)
 
 
 def test_repeated_residual_reuses_the_same_numbers():
-    """_Model.forces remembers the residual of the last position (the Newton iteration
+    """StaticsModel.forces remembers the residual of the last position (the Newton iteration
     asks twice per accepted point): a repeated call returns the numbers of a fresh
     model to the bit, with or without the tangent, also with current drag (whose nodal
     drag forces the line search reads) and after the drag factor changes."""
-    from stochcable.line.statics import _Frame, _Model
+    from stochcable.line.equilibrium import LocalFrame, StaticsModel
 
     m, env, frame, b, x = _chain_in_current()
     x2 = x.copy()
@@ -414,7 +417,7 @@ def test_repeated_residual_reuses_the_same_numbers():
             b.forces(X, tangent=False)           # remembered without the tangent ...
             got = b.forces(X.copy())             # ... then asked again with it
             drag_nodes = b.drag_nodes.copy()
-            ref = _Model(m, env, _Frame(m, env))  # fresh: no memory
+            ref = StaticsModel(m, env, LocalFrame(m, env))  # fresh: no memory
             ref.beta = beta
             want = ref.forces(X)
             for g_, w_ in zip(got[:2], want[:2]):
@@ -433,13 +436,14 @@ def test_chain_shots_batched_end_equals_single_shots() -> None:
     shots lifting off the bed at the anchor, part-way, and not at all (all grounded),
     on and off the seabed."""
     from stochcable.examples import load_example
-    from stochcable.line.statics import _chain_shots, _Frame, _Model
+    from stochcable.line.chain import chain_shots
+    from stochcable.line.equilibrium import LocalFrame, StaticsModel
 
     scene = load_scene(load_example("chain_catenary"))
     env = scene.environment
     mesh = mesh_line(scene.lines[0], env.rho, env.g)
-    frame = _Frame(mesh, env)
-    model = _Model(mesh, env, frame)
+    frame = LocalFrame(mesh, env)
+    model = StaticsModel(mesh, env, frame)
     a = frame.to_local(mesh.end_a[None, :])[0]
     zi = frame.dim - 1
     kb = np.where(model.kb > 0.0, model.kb, np.inf)
@@ -454,7 +458,7 @@ def test_chain_shots_batched_end_equals_single_shots() -> None:
     V0 = np.r_[rng.uniform(-1.5 * total, 0.5 * total, 57), 0.2 * total, -0.5 * total,
                -2.0 * total]
     for on_bed in (True, False):
-        shoot, shoot_ends = _chain_shots(mesh, model, a, zi, on_bed, kb)
+        shoot, shoot_ends = chain_shots(mesh, model, a, zi, on_bed, kb)
         ends = shoot_ends(H, V0, P)
         single = np.array([[shoot(h, v, P)[0][-1], shoot(h, v, P)[1][-1]]
                            for h, v in zip(H, V0)])
@@ -462,13 +466,13 @@ def test_chain_shots_batched_end_equals_single_shots() -> None:
 
 
 def test_banded_solve_is_scipy_solve_banded():
-    """_banded_solve calls LAPACK gbsv as scipy.linalg.solve_banded does after its
+    """banded_solve calls LAPACK gbsv as scipy.linalg.solve_banded does after its
     checks (issue 6 pass E6: ≈ 40 banded solves per body statics): the same solution
     to the bit for one and several right-hand sides; a singular matrix raises
     LinAlgError."""
     from scipy.linalg import LinAlgError, solve_banded
 
-    from stochcable.line.statics import _banded_solve
+    from stochcable.line.banded import banded_solve
 
     rng = np.random.default_rng(7)
     for bw, n, nrhs in ((3, 40, None), (5, 117, None), (5, 117, 3)):
@@ -477,11 +481,11 @@ def test_banded_solve_is_scipy_solve_banded():
         b = rng.standard_normal(n if nrhs is None else (n, nrhs))
         ab = np.zeros((3 * bw + 1, n), order="F")
         ab[bw:] = band
-        got = _banded_solve(ab, b, bw)
+        got = banded_solve(ab, b, bw)
         np.testing.assert_array_equal(got, solve_banded((bw, bw), band, b))
     singular = np.zeros((3 * 3 + 1, 6), order="F")
     with pytest.raises(LinAlgError, match="singular"):
-        _banded_solve(singular, np.ones(6), 3)
+        banded_solve(singular, np.ones(6), 3)
 
 
 def test_converged_status_skips_the_tangent_and_solves_the_same():
@@ -489,14 +493,14 @@ def test_converged_status_skips_the_tangent_and_solves_the_same():
     point needs none) and builds it from the residual memo before a step: the status
     numbers are those with the tangent, and the tangent built afterwards is a fresh
     model's to the bit (with current drag, whose nodal forces the line search reads)."""
-    from stochcable.line.statics import _Frame, _Model, _Solver
+    from stochcable.line.equilibrium import LocalFrame, StaticsModel, StaticsSolver
 
     m, env, frame, model, x = _chain_in_current()
-    lazy = _Solver(model, 1e-10, 100).status(x, tangent=False)
+    lazy = StaticsSolver(model, 1e-10, 100).status(x, tangent=False)
     assert lazy[3] is None
     tangent = model.forces(x)[3]
-    ref_model = _Model(m, env, _Frame(m, env))
-    full = _Solver(ref_model, 1e-10, 100).status(x)
+    ref_model = StaticsModel(m, env, LocalFrame(m, env))
+    full = StaticsSolver(ref_model, 1e-10, 100).status(x)
     assert lazy[:2] == full[:2]
     np.testing.assert_array_equal(lazy[2], full[2])
     for got, want in zip(tangent, full[3]):

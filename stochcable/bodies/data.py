@@ -6,7 +6,8 @@ made to evaluate [them]").  Two sources are read here into one
 :class:`Hydrodynamics` record:
 
 - a Capytaine dataset (NetCDF file or ``xarray.Dataset``), :func:`read_capytaine`;
-- a plain JSON table, :func:`read_table` (format in docs/BODIES.md and below).
+- a plain JSON table, :func:`read_table` (format in docs/BODIES.md and
+  :mod:`stochcable.scene.tables`, which reads and checks it for the scene too).
 
 :func:`body_from_hydrodynamics` turns a record into a :class:`~stochcable.bodies.rigid.RigidBody`.
 
@@ -14,29 +15,10 @@ Conventions of the record (those of the library, DESIGN.md): ω in rad/s, headin
 rad (direction of travel from +x toward +y), DOFs (surge, sway, heave, roll, pitch, yaw)
 about the reference point (or (surge, heave, pitch) for a planar table), complex
 amplitudes of Re{X e^{iωt}}, excitation per unit wave amplitude.
-
-JSON table format
------------------
-::
-
-    {"dofs": ["surge", "sway", "heave", "roll", "pitch", "yaw"],   # optional; or
-                                                  # ["surge", "heave", "pitch"]
-     "omega": [w1, w2, ...],                      # rad/s, strictly increasing
-     "added_mass": [[[...], ...], ...],           # (n_omega, d, d) kg, kg·m, kg·m²
-     "radiation_damping": [[[...], ...], ...],    # (n_omega, d, d) N·s/m, N·s, N·m·s
-     "excitation": {"heading": [b1, ...],         # deg, strictly increasing
-                    "re": [[[...], ...], ...],    # (n_heading, d, n_omega) N/m, N·m/m
-                    "im": [[[...], ...], ...]},   # phase: e^{+iωt}, wave crest at the
-                                                  # reference point
-     "hydrostatic_stiffness": [[...], ...],       # optional (d, d) N/m, N, N·m
-     "reference_point": [x, y, z]}                # optional, informative [m]
-
-A matrix entry A[i][j] is the force in DOF i due to a unit motion of DOF j.
 """
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -45,15 +27,11 @@ from typing import Any, Literal
 
 import numpy as np
 
-from stochcable.validation import float_array, nonnegative
-from stochcable.bodies.rigid import (
-    PLANAR_DOFS,
-    SPATIAL_DOFS,
-    ExcitationTable,
-    FrequencyTable,
-    RigidBody,
-)
+from stochcable.validation import nonnegative
+from stochcable.bodies.rigid import SPATIAL_DOFS, RigidBody
+from stochcable.bodies.tables import ExcitationTable, FrequencyTable
 from stochcable.errors import InputError
+from stochcable.scene.tables import SYMMETRY_TOLERANCE, checked_table, parse_table
 
 __all__ = [
     "Hydrodynamics",
@@ -63,12 +41,6 @@ __all__ = [
     "body_from_hydrodynamics",
     "SYMMETRY_TOLERANCE",
 ]
-
-#: Largest accepted |A − Aᵀ| relative to max|A| (BEM matrices on coarse meshes are
-#: symmetric only to a few per mille); the matrices are then symmetrized.
-SYMMETRY_TOLERANCE = 2.0e-2
-#: A damping diagonal below −this·max|B| is an error (round-off negatives are zeroed).
-NEGATIVE_DAMPING_TOLERANCE = 1.0e-6
 
 # Capytaine's names of the rigid-body DOFs (capytaine.rigid_body_dofs).
 _CAPYTAINE_DOFS = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
@@ -120,91 +92,28 @@ class Hydrodynamics:
         return len(self.dofs) == 3
 
     def added_mass_table(self, extrapolation: Literal["error", "hold"] = "error") -> FrequencyTable:
-        """The added mass as a :class:`~stochcable.bodies.rigid.FrequencyTable`."""
+        """The added mass as a :class:`~stochcable.bodies.tables.FrequencyTable`."""
         return FrequencyTable(self.omega, self.added_mass, extrapolation)
 
     def radiation_damping_table(self, extrapolation: Literal["error", "hold"] = "error"
                                 ) -> FrequencyTable:
-        """The radiation damping as a :class:`~stochcable.bodies.rigid.FrequencyTable`."""
+        """The radiation damping as a :class:`~stochcable.bodies.tables.FrequencyTable`."""
         return FrequencyTable(self.omega, self.radiation_damping, extrapolation)
 
     def excitation_table(self, extrapolation: Literal["error", "hold"] = "error"
                          ) -> ExcitationTable | None:
-        """The excitation as an :class:`~stochcable.bodies.rigid.ExcitationTable` (None if absent)."""
+        """The excitation as an :class:`~stochcable.bodies.tables.ExcitationTable` (None if absent)."""
         if self.excitation is None:
             return None
         return ExcitationTable(self.omega, self.heading, self.excitation, extrapolation)
 
-
 # ---------------------------------------------------------------------- checks
 
 
-def _check_matrices(name: str, a: np.ndarray, omega: np.ndarray, unit: str,
-                    damping: bool, tol: float) -> np.ndarray:
-    """Symmetry (and non-negative diagonal) per frequency; returns the symmetrized copy."""
-    if not np.isfinite(a).all():
-        k = int(np.flatnonzero(~np.isfinite(a).reshape(a.shape[0], -1).all(axis=1))[0])
-        raise InputError(name, f"non-finite at omega = {omega[k]:g} rad/s", unit, "must be finite")
-    top = np.abs(a).max(axis=(1, 2))
-    asym = np.abs(a - np.swapaxes(a, 1, 2)).max(axis=(1, 2))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        rel = np.where(top > 0, asym / np.where(top > 0, top, 1.0), 0.0)
-    if (rel > tol).any():
-        k = int(np.argmax(rel))
-        raise InputError(name, f"max|A − Aᵀ|/max|A| = {rel[k]:.3g} at omega = {omega[k]:g} rad/s",
-                         unit, f"must be symmetric within {tol:g} of the largest entry")
-    out = 0.5 * (a + np.swapaxes(a, 1, 2))
-    if damping:
-        diag = np.einsum("wii->wi", out)
-        neg = diag < -NEGATIVE_DAMPING_TOLERANCE * np.maximum(top, 1e-300)[:, None]
-        if neg.any():
-            k, i = (int(v[0]) for v in np.nonzero(neg))
-            raise InputError(name, f"diagonal entry {i} = {diag[k, i]:.6g} at omega = "
-                             f"{omega[k]:g} rad/s", unit,
-                             "must be >= 0 (radiation damping dissipates energy)")
-        idx = np.arange(out.shape[1])
-        out[:, idx, idx] = np.maximum(diag, 0.0)
-    return out
-
-
 def _build(dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source, tol) -> Hydrodynamics:
-    d = len(dofs)
-    w = float_array("omega", omega, "rad/s", nonnegative=True, increasing=True)
-    am = np.asarray(am, dtype=float)
-    bd = np.asarray(bd, dtype=float)
-    for name, a, unit in (("added_mass", am, "kg"), ("radiation_damping", bd, "N·s/m")):
-        if a.ndim != 3 or a.shape[1:] != (d, d):
-            raise InputError(name, a.shape, unit, f"must have shape (n_omega, {d}, {d})")
-        if a.shape[0] != w.size:
-            raise InputError(name, a.shape, unit,
-                             f"has {a.shape[0]} frequencies but omega has {w.size}: give one "
-                             "matrix per frequency")
-    am = _check_matrices("added_mass", am, w, "kg", False, tol)
-    bd = _check_matrices("radiation_damping", bd, w, "N·s/m", True, tol)
-    h = None
-    if exc is not None:
-        if heading is None:
-            raise InputError("excitation.heading", None, "rad", "must be given with the excitation")
-        h = float_array("excitation.heading", heading, "rad", increasing=True)
-        exc = np.asarray(exc, dtype=complex)
-        if exc.shape != (h.size, d, w.size):
-            raise InputError("excitation", exc.shape, "N/m",
-                             f"must have shape (n_heading={h.size}, {d}, n_omega={w.size})")
-        if not np.isfinite(exc).all():
-            raise InputError("excitation", "non-finite", "N/m", "must be finite")
-    if hs is not None:
-        hs = float_array("hydrostatic_stiffness", hs, "N/m", ndim=2)
-        if hs.shape != (d, d):
-            raise InputError("hydrostatic_stiffness", hs.shape, "N/m", f"must be ({d}, {d})")
-    ref = np.zeros(3) if ref is None else float_array("reference_point", ref, "m")
-    if ref.shape != (3,):
-        raise InputError("reference_point", ref.shape, "m", "must be (x, y, z)")
-    return Hydrodynamics(dofs=tuple(dofs), omega=w.copy(), added_mass=am, radiation_damping=bd,
-                         heading=h, excitation=exc, hydrostatic_stiffness=hs,
-                         reference_point=ref.copy(),
-                         excitation_point=np.asarray(exc_point, dtype=float).copy(),
-                         source=source)
-
+    """The checked record (:func:`stochcable.scene.tables.checked_table`)."""
+    return Hydrodynamics(**checked_table(dofs, omega, am, bd, heading, exc, hs, ref,
+                                         exc_point, source, tol))
 
 # ------------------------------------------------------------------- Capytaine
 
@@ -268,19 +177,7 @@ def read_capytaine(
     Added mass and damping are real and need no change.  Seed 001 eqs. 3.2.c.16–17
     define the same quantities (f_lj = −ω² m_a + iω c, C_l).
     """
-    xr = _require_xarray()
-    if isinstance(source, xr.Dataset):
-        ds, name = source, "xarray.Dataset"
-    else:
-        path = Path(source)
-        if not path.is_file():
-            raise InputError("source", str(source), "-", "file not found")
-        ds, name = xr.open_dataset(path), str(path)
-    try:
-        ds = ds.load()
-    finally:
-        if not isinstance(source, xr.Dataset):
-            ds.close()
+    ds, name = _open_dataset(source)
     if "complex" in ds.dims:
         for v in list(ds.data_vars):
             if "complex" in ds[v].dims:
@@ -297,22 +194,72 @@ def read_capytaine(
     if freq_dim is None:
         raise InputError("source", name, "-", "has a single scalar omega: at least one "
                          "frequency dimension is needed")
-
-    def squeeze_extra(da, keep):
-        for dim in list(da.dims):
-            if dim in keep:
-                continue
-            if da.sizes[dim] != 1:
-                raise InputError("source", name, "-",
-                                 f"variable '{da.name}' varies over '{dim}' "
-                                 f"({da.sizes[dim]} values): select one before reading")
-            da = da.isel({dim: 0})
-        return da
-
     if "forward_speed" in ds.coords:
         fs = np.atleast_1d(ds["forward_speed"].values)
         if np.any(fs != 0):
             raise InputError("forward_speed", fs.tolist(), "m/s", "must be 0 (no forward speed)")
+    sel, sel_i = _capytaine_dofs(ds)
+
+    order = np.argsort(ds["omega"].values)
+    w = np.asarray(ds["omega"].values, dtype=float)[order]
+
+    def matrices(var):
+        da = _squeeze_extra(ds[var], (freq_dim, "influenced_dof", "radiating_dof"), name)
+        da = da.sel(influenced_dof=sel_i, radiating_dof=sel)
+        return np.asarray(da.transpose(freq_dim, "influenced_dof", "radiating_dof").values,
+                          dtype=float)[order]
+
+    am = matrices("added_mass")
+    bd = matrices("radiation_damping")
+    heading, exc = _capytaine_excitation(ds, name, freq_dim, sel_i, order)
+    hs = None
+    if "hydrostatic_stiffness" in ds:
+        da = _squeeze_extra(ds["hydrostatic_stiffness"], ("influenced_dof", "radiating_dof"),
+                            name)
+        hs = np.asarray(da.sel(influenced_dof=sel_i, radiating_dof=sel)
+                        .transpose("influenced_dof", "radiating_dof").values, dtype=float)
+    ref = np.zeros(3)
+    if "rotation_center" in ds:
+        ref = np.asarray(ds["rotation_center"].values, dtype=float).reshape(3)
+    return _build(tuple(SPATIAL_DOFS), w, am, bd, heading, exc, hs, ref, -ref[:2],
+                  f"capytaine:{name}", nonnegative("symmetry_tolerance", symmetry_tolerance, "-"))
+
+
+def _open_dataset(source: Any) -> tuple[Any, str]:
+    """The dataset, loaded (a file is closed after loading), and its name."""
+    xr = _require_xarray()
+    if isinstance(source, xr.Dataset):
+        ds, name = source, "xarray.Dataset"
+    else:
+        path = Path(source)
+        if not path.is_file():
+            raise InputError("source", str(source), "-", "file not found")
+        ds, name = xr.open_dataset(path), str(path)
+    try:
+        ds = ds.load()
+    finally:
+        if not isinstance(source, xr.Dataset):
+            ds.close()
+    return ds, name
+
+
+def _squeeze_extra(da: Any, keep: tuple[str, ...], name: str) -> Any:
+    """``da`` without its dimensions other than ``keep``, each of which must have one
+    value (InputError naming the dataset ``name`` otherwise)."""
+    for dim in list(da.dims):
+        if dim in keep:
+            continue
+        if da.sizes[dim] != 1:
+            raise InputError("source", name, "-",
+                             f"variable '{da.name}' varies over '{dim}' "
+                             f"({da.sizes[dim]} values): select one before reading")
+        da = da.isel({dim: 0})
+    return da
+
+
+def _capytaine_dofs(ds: Any) -> tuple[list[str], list[str]]:
+    """The dataset's radiating and influenced DOF labels of the six rigid-body DOFs, in
+    the library's order (any case)."""
     dofs_present = [str(v) for v in ds["radiating_dof"].values]
     lower = {v.lower(): v for v in dofs_present}
     missing = [d for d in _CAPYTAINE_DOFS if d.lower() not in lower]
@@ -324,54 +271,35 @@ def read_capytaine(
     if any(d.lower() not in infl for d in _CAPYTAINE_DOFS):
         raise InputError("influenced_dof", list(infl.values()), "-",
                          "must include the six rigid-body DOFs")
-    sel_i = [infl[d.lower()] for d in _CAPYTAINE_DOFS]
+    return sel, [infl[d.lower()] for d in _CAPYTAINE_DOFS]
 
-    order = np.argsort(ds["omega"].values)
-    w = np.asarray(ds["omega"].values, dtype=float)[order]
 
-    def matrices(var):
-        da = squeeze_extra(ds[var], (freq_dim, "influenced_dof", "radiating_dof"))
-        da = da.sel(influenced_dof=sel_i, radiating_dof=sel)
-        return np.asarray(da.transpose(freq_dim, "influenced_dof", "radiating_dof").values,
-                          dtype=float)[order]
-
-    am = matrices("added_mass")
-    bd = matrices("radiation_damping")
-
-    heading = exc = None
+def _capytaine_excitation(ds: Any, name: str, freq_dim: str, sel_i: list[str],
+                          order: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Headings [rad] (one turn from the first, increasing) and the excitation
+    (n_h, 6, n_w), conjugated to e^{+iωt} (read_capytaine's Notes); None, None without
+    an excitation (or diffraction + Froude–Krylov) force."""
     if "excitation_force" in ds:
         fx = ds["excitation_force"]
     elif "diffraction_force" in ds and "Froude_Krylov_force" in ds:
         fx = ds["diffraction_force"] + ds["Froude_Krylov_force"]
         fx.name = "excitation_force"
     else:
-        fx = None
-    if fx is not None:
-        fx = squeeze_extra(fx, (freq_dim, "wave_direction", "influenced_dof"))
-        if "wave_direction" not in fx.dims:
-            fx = fx.expand_dims("wave_direction")
-            hvals = np.atleast_1d(ds["wave_direction"].values) if "wave_direction" in ds.coords \
-                else np.zeros(1)
-        else:
-            hvals = np.asarray(fx["wave_direction"].values, dtype=float)
-        fx = fx.sel(influenced_dof=sel_i).transpose("wave_direction", "influenced_dof", freq_dim)
-        vals = np.conj(np.asarray(fx.values, dtype=complex))[:, :, order]
-        two_pi = 2.0 * math.pi
-        hw = np.asarray(hvals, dtype=float)
-        hw = hw[0] + (hw - hw[0]) % two_pi  # one turn from the first heading
-        ho = np.argsort(hw)
-        heading, exc = hw[ho], vals[ho]
-
-    hs = None
-    if "hydrostatic_stiffness" in ds:
-        da = squeeze_extra(ds["hydrostatic_stiffness"], ("influenced_dof", "radiating_dof"))
-        hs = np.asarray(da.sel(influenced_dof=sel_i, radiating_dof=sel)
-                        .transpose("influenced_dof", "radiating_dof").values, dtype=float)
-    ref = np.zeros(3)
-    if "rotation_center" in ds:
-        ref = np.asarray(ds["rotation_center"].values, dtype=float).reshape(3)
-    return _build(tuple(SPATIAL_DOFS), w, am, bd, heading, exc, hs, ref, -ref[:2],
-                  f"capytaine:{name}", nonnegative("symmetry_tolerance", symmetry_tolerance, "-"))
+        return None, None
+    fx = _squeeze_extra(fx, (freq_dim, "wave_direction", "influenced_dof"), name)
+    if "wave_direction" not in fx.dims:
+        fx = fx.expand_dims("wave_direction")
+        hvals = np.atleast_1d(ds["wave_direction"].values) if "wave_direction" in ds.coords \
+            else np.zeros(1)
+    else:
+        hvals = np.asarray(fx["wave_direction"].values, dtype=float)
+    fx = fx.sel(influenced_dof=sel_i).transpose("wave_direction", "influenced_dof", freq_dim)
+    vals = np.conj(np.asarray(fx.values, dtype=complex))[:, :, order]
+    two_pi = 2.0 * math.pi
+    hw = np.asarray(hvals, dtype=float)
+    hw = hw[0] + (hw - hw[0]) % two_pi  # one turn from the first heading
+    ho = np.argsort(hw)
+    return hw[ho], vals[ho]
 
 
 # ------------------------------------------------------------------ JSON table
@@ -403,83 +331,7 @@ def read_table(
         Missing keys, missing frequencies or headings, wrong shapes, non-symmetric
         matrices, negative damping diagonal.
     """
-    if isinstance(source, Mapping):
-        doc, name = source, "table"
-    else:
-        text = str(source)
-        p = Path(text) if len(text) < 4096 and not text.lstrip().startswith("{") else None
-        if p is not None:
-            if not p.is_file():
-                raise InputError("source", text, "-", "file not found")
-            text, name = p.read_text(), str(p)
-        else:
-            name = "table"
-        try:
-            doc = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputError("source", name, "-", f"is not valid JSON ({exc.msg} at line "
-                             f"{exc.lineno})") from None
-    if not isinstance(doc, Mapping):
-        raise InputError("source", type(doc).__name__, "-", "must be a JSON object")
-    known = {"dofs", "omega", "added_mass", "radiation_damping", "excitation",
-             "hydrostatic_stiffness", "reference_point", "title"}
-    extra = sorted(set(doc) - known)
-    if extra:
-        raise InputError("source", extra, "-", f"unknown keys; allowed: {sorted(known)}")
-    dofs = tuple(str(d).lower() for d in doc.get("dofs", SPATIAL_DOFS))
-    if dofs not in (tuple(SPATIAL_DOFS), tuple(PLANAR_DOFS)):
-        raise InputError("dofs", list(dofs), "-",
-                         f"must be {list(SPATIAL_DOFS)} or {list(PLANAR_DOFS)}")
-    for req in ("omega", "added_mass", "radiation_damping"):
-        if req not in doc:
-            raise InputError(req, None, "-", "is missing from the table")
-    w = float_array("omega", doc["omega"], "rad/s", nonnegative=True, increasing=True)
-    am = _array3("added_mass", doc["added_mass"], "kg")
-    bd = _array3("radiation_damping", doc["radiation_damping"], "N·s/m")
-    for nm, a in (("added_mass", am), ("radiation_damping", bd)):
-        if a.shape[0] != w.size:
-            raise InputError(nm, a.shape, "-", f"has {a.shape[0]} frequencies but omega has "
-                             f"{w.size}: give one matrix per frequency")
-    heading = exc = None
-    if doc.get("excitation") is not None:
-        e = doc["excitation"]
-        if not isinstance(e, Mapping):
-            raise InputError("excitation", type(e).__name__, "-",
-                             "must be an object with heading, re, im")
-        for req in ("heading", "re", "im"):
-            if req not in e:
-                raise InputError(f"excitation.{req}", None, "-", "is missing from the table")
-        hd = float_array("excitation.heading", e["heading"], "deg", increasing=True)
-        if hd[-1] - hd[0] >= 360.0:
-            raise InputError("excitation.heading", hd.tolist(), "deg", "must span less than 360")
-        heading = np.radians(hd)
-        re = _array3("excitation.re", e["re"], "N/m")
-        im = _array3("excitation.im", e["im"], "N/m")
-        if re.shape != im.shape:
-            raise InputError("excitation.im", im.shape, "N/m",
-                             f"must have the shape of excitation.re {re.shape}")
-        if re.shape[0] != heading.size:
-            raise InputError("excitation.re", re.shape, "N/m",
-                             f"has {re.shape[0]} headings but excitation.heading has "
-                             f"{heading.size}")
-        if re.shape[2] != w.size:
-            raise InputError("excitation.re", re.shape, "N/m",
-                             f"has {re.shape[2]} frequencies but omega has {w.size}")
-        exc = re + 1j * im
-    return _build(dofs, w, am, bd, heading, exc, doc.get("hydrostatic_stiffness"),
-                  doc.get("reference_point"), np.zeros(2), f"table:{name}",
-                  nonnegative("symmetry_tolerance", symmetry_tolerance, "-"))
-
-
-def _array3(name: str, value: Any, unit: str) -> np.ndarray:
-    try:
-        a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(name, "ragged or non-numeric", unit,
-                         "must be a regular 3-D array of numbers") from None
-    if a.ndim != 3:
-        raise InputError(name, a.shape, unit, f"must be a 3-D array (got {a.ndim}-D)")
-    return a
+    return Hydrodynamics(**parse_table(source, symmetry_tolerance=symmetry_tolerance))
 
 
 def load_hydrodynamics(path: str | Path, **kw: Any) -> Hydrodynamics:

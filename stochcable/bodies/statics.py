@@ -38,25 +38,25 @@ Prescribed bodies (vessels) are not solved for: their pose is ``position``, no r
 
 from __future__ import annotations
 
-import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from stochcable.bodies.from_scene import rigid_body_from_scene, scene_rigid_bodies
+from stochcable.bodies.mooring import mooring_stiffness, mooring_stiffness_and_maps, pose_map
 from stochcable.bodies.rigid import (
     PLANAR_DOFS,
     PLANAR_INDEX,
     SPATIAL_DOFS,
     RigidBody,
-    attachment_geometric_stiffness,
+    geometric_stiffness,
 )
 from stochcable.validation import positive, positive_int
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.line.fem import _stiffness_blocks
 from stochcable.line.mesh import mesh_line
+from stochcable.line.statics import check_statics_options, line_statics
 from stochcable.scene.model import Scene, rotate
-from stochcable.line.statics import _banded_solve, _block_band_indices
 
 __all__ = ["BodyStatics", "solve_body_statics", "body_static_load",
            "mooring_stiffness"]
@@ -160,8 +160,6 @@ def body_static_load(scene: Scene, name: str, pose: Any, rigid: RigidBody | None
     -----
     Load model: module docstring.
     """
-    from stochcable.bodies.from_scene import rigid_body_from_scene
-
     b = scene.body(name)
     env = scene.environment
     rho, g = env.rho, env.g
@@ -215,174 +213,7 @@ def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _geo6(force: np.ndarray, arm: np.ndarray) -> np.ndarray:
-    return attachment_geometric_stiffness(force, arm, False)
-
-
-def mooring_stiffness(scene: Scene, lines: dict[str, Any], poses: dict[str, np.ndarray],
-                      bodies: list[str], planar: bool, method: str = "auto",
-                      tolerance: float = 1e-10) -> np.ndarray:
-    """Quasi-static stiffness of the lines on the free bodies' DOFs.
-
-    Parameters
-    ----------
-    scene : Scene
-    lines : dict of str to LineStatics
-        The lines' statics at the poses.
-    poses : dict of str to ndarray (6,)
-        Body poses (X, θ).
-    bodies : list of str
-        The free bodies, in the order of the result's blocks.
-    planar : bool
-    method : str
-        Line statics method, for the finite differences of catenary lines.
-    tolerance : float
-        Their statics tolerance. [-]
-
-    Returns
-    -------
-    ndarray, shape (n_b·d, n_b·d)
-        −dQ_lines/dq = Σ Tᵀ K_e T − [F]×[r]× (seed 001 eqs. 3.3.8–3.3.10 and the
-        attachment geometric term, :func:`stochcable.bodies.rigid.attachment_geometric_stiffness`),
-        K_e = −dF_end/dx_end the condensed end stiffness of each line: the Schur
-        complement of its FE tangent over the interior DOFs for an FE-solved line, the
-        central differences of the closed-form catenary for a catenary-solved one (so
-        that the stiffness is that of the statics actually solved). [N/m, N, N·m/rad]
-    """
-    return _mooring_stiffness(scene, lines, poses, bodies, planar, method, tolerance)[0]
-
-
-def _mooring_stiffness(scene: Scene, lines: dict[str, Any], poses: dict[str, np.ndarray],
-                       bodies: list[str], planar: bool, method: str, tolerance: float,
-                       end_position: Any = None
-                       ) -> tuple[np.ndarray, dict[str, tuple[list[str], np.ndarray]]]:
-    """:func:`mooring_stiffness` and, by line name, the ends on the bodies and the
-    interior map S of :func:`_end_condensation` (FE-solved lines only).
-    ``end_position(line, end, poses)``: the end positions (default
-    ``scene.end_position`` at ``poses``)."""
-    from stochcable.bodies.rigid import rigid_link_matrix
-
-    maps: dict[str, tuple[list[str], np.ndarray]] = {}
-    d = 3 if planar else 6
-    n = len(bodies) * d
-    K = np.zeros((n, n))
-    block = {nm: i * d for i, nm in enumerate(bodies)}
-    pm = _pose_map(poses)
-    for ln in scene.lines:
-        ends = [(end, getattr(ln, end).attach.body) for end in ("end_a", "end_b")
-                if getattr(ln, end).attach is not None
-                and getattr(ln, end).attach.body in block]
-        if not ends:
-            continue
-        ls = lines[ln.name]
-        names = [e for e, _ in ends]
-        ke, smap = _end_condensation(scene, ln, ls, names, planar, method, tolerance)
-        if smap is not None:
-            maps[ln.name] = (names, smap)
-        c = 2 if planar else 3
-        comps = [0, 2] if planar else [0, 1, 2]
-        tmat = []
-        for end, bname in ends:
-            r = (scene.end_position(ln, end, pm) if end_position is None
-                 else end_position(ln, end, poses)) - poses[bname][:3]
-            t = rigid_link_matrix(r, planar)
-            tmat.append(t[comps] if t.shape[0] == 3 and planar else t)
-            f = ls.force_a if end == "end_a" else ls.force_b
-            i = block[bname]
-            K[i:i + d, i:i + d] += attachment_geometric_stiffness(f, r, planar)
-        for p_, (_, bp) in enumerate(ends):
-            for q_, (_, bq) in enumerate(ends):
-                kpq = ke[p_ * c:(p_ + 1) * c, q_ * c:(q_ + 1) * c]
-                i, j = block[bp], block[bq]
-                K[i:i + d, j:j + d] += tmat[p_].T @ kpq @ tmat[q_]
-    return K, maps
-
-
-def _end_condensation(scene: Scene, line: Any, ls: Any, ends: list[str], planar: bool,
-                      method: str, tolerance: float
-                      ) -> tuple[np.ndarray, np.ndarray | None]:
-    """Condensed end stiffness K_e = −dF/dx of the given ends of a line (2 or 3
-    components each, the other end held) and, for an FE-solved line, the interior map S.
-
-    K_e = K_bb − K_bf K_ff⁻¹ K_fb over the FE tangent K of :mod:`stochcable.line.fem`
-    (the matrix :func:`stochcable.line.fem.build_fe_model` assembles: element tangents
-    (EA/l0) e eᵀ + (T/l)(I − e eᵀ), slack elements with EA·``SLACK_EA_RATIO`` and no
-    tension, seabed springs on the grounded nodes), in the global components (x, z)
-    planar or (x, y, z); S = K_ff⁻¹ K_fb, shape (n_interior·c, c·n_ends), gives the
-    first-order interior displacement −S δx_ends when the ends move (the predictor of
-    the warm start).  K_ff is block tridiagonal: one banded solve.  For a
-    catenary-solved line, central differences of the closed form and S = None.
-    """
-    from stochcable.line.statics import solve_line_statics
-
-    env = scene.environment
-    comps = [0, 2] if planar else [0, 1, 2]
-    c = len(comps)
-    if ls.method == "fe":
-        return _fe_condensation(ls, env, ends, comps)
-    # closed form: central differences of the end forces
-    mesh = ls.mesh
-    h = 1e-5 * max(mesh.length, 1.0)
-    out = np.zeros((len(ends) * c, len(ends) * c))
-    for q_, e in enumerate(ends):
-        for k, comp in enumerate(comps):
-            fs = []
-            for sgn in (1.0, -1.0):
-                pos = getattr(mesh, e).copy()
-                pos[comp] += sgn * h
-                m2 = dataclasses.replace(mesh, **{e: pos})
-                l2 = solve_line_statics(m2, env, method=method, tolerance=tolerance)
-                fs.append(np.concatenate([(l2.force_a if p == "end_a" else l2.force_b)[comps]
-                                          for p in ends]))
-            out[:, q_ * c + k] = -(fs[0] - fs[1]) / (2.0 * h)
-    return out, None
-
-
-def _fe_condensation(ls: Any, env: Any, ends: list[str], comps: list[int]
-                     ) -> tuple[np.ndarray, np.ndarray]:
-    """K_e and S of :func:`_end_condensation` for an FE-solved line."""
-    c = len(comps)
-    mesh = ls.mesh
-    n = mesh.n_nodes
-    pos = np.asarray(ls.positions, dtype=float)[:, comps]
-    dd = pos[1:] - pos[:-1]
-    ll = np.sqrt(np.einsum("ij,ij->i", dd, dd))
-    k = _stiffness_blocks(dd / ll[:, None], ll, mesh.l0, mesh.ea,
-                          np.asarray(ls.tension, dtype=float))  # (n_el, c, c)
-    diag = np.zeros((n, c, c))
-    diag[:-1] += k
-    diag[1:] += k
-    trib = np.zeros(n)
-    half = 0.5 * mesh.diameter * mesh.l0
-    trib[:-1] += half
-    trib[1:] += half
-    zc = comps.index(2)
-    diag[:, zc, zc] += env.seabed.stiffness * np.where(ls.grounded, trib, 0.0)
-    node = {"end_a": 0, "end_b": n - 1}
-    ne = len(ends)
-    kbb = np.zeros((ne * c, ne * c))
-    for p_, e in enumerate(ends):
-        kbb[p_ * c:(p_ + 1) * c, p_ * c:(p_ + 1) * c] = diag[node[e]]
-    nf = n - 2
-    if nf == 0:
-        if ne == 2:
-            kbb[:c, c:] = -k[0]
-            kbb[c:, :c] = -k[0]
-        return kbb, np.zeros((0, ne * c))
-    # K_fb: the element next to each end couples it to its neighbour node
-    kfb = np.zeros((nf * c, ne * c))
-    for p_, e in enumerate(ends):
-        if e == "end_a":
-            kfb[:c, p_ * c:(p_ + 1) * c] = -k[0]
-        else:
-            kfb[(nf - 1) * c:, p_ * c:(p_ + 1) * c] = -k[-1]
-    bw = 2 * c - 1
-    rows, cols = _block_band_indices(nf, c)
-    ab = np.zeros((3 * bw + 1, nf * c), order="F")  # gbsv's layout (_banded_solve)
-    # diagonal blocks of the interior nodes, then the couplings −k_i (i = 1 … n−3)
-    ab[rows + bw, cols] = np.concatenate([diag[1:-1].ravel(), (-k[1:-1]).ravel(),
-                                          (-k[1:-1]).ravel()])
-    S = _banded_solve(ab, kfb, bw)
-    return kbb - kfb.T @ S, S
+    return geometric_stiffness(force, arm, False)
 
 
 # ---------------------------------------------------------------------- the solver
@@ -427,57 +258,147 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
     Module docstring; docs/BODIES.md §Statics.  Seed 001 §4.1 (static configuration
     as the starting state), eq. 3.2.c.20 (static force F̄), eqs. 3.3.6–3.3.10.
     """
-    from stochcable.bodies.from_scene import scene_rigid_bodies
-    from stochcable.line.statics import solve_line_statics
-
     body_tolerance = positive("body_tolerance", body_tolerance, "-")
     max_body_iterations = positive_int("max_body_iterations", max_body_iterations)
-    env = scene.environment
-    planar = scene.is_planar
-    d = 3 if planar else 6
-    dofs = PLANAR_DOFS if planar else SPATIAL_DOFS
-    rigid = scene_rigid_bodies(scene)
-    free = [b.name for b in scene.bodies if b.prescribed is None]
+    method, tolerance, max_iterations = check_statics_options(method, tolerance,
+                                                              max_iterations)
+    pb = _BodyPoses(scene, method, tolerance, max_iterations)
     poses = {b.name: np.concatenate([np.asarray(b.position, float), np.zeros(3)])
              for b in scene.bodies}
-    attached = {ln.name: {end: getattr(ln, end).attach.body for end in ("end_a", "end_b")
-                          if getattr(ln, end).attach is not None} for ln in scene.lines}
-    moving = [ln for ln in scene.lines if any(b in free for b in attached[ln.name].values())]
-    lines: dict[str, Any] = {}
-    for ln in scene.lines:
-        if ln not in moving:
-            mesh = mesh_line(scene.resolved_line(ln, _pose_map(poses)), env.rho, env.g)
-            lines[ln.name] = solve_line_statics(mesh, env, method=method, tolerance=tolerance,
-                                                max_iterations=max_iterations)
-    meshes = {ln.name: mesh_line(scene.resolved_line(ln), env.rho, env.g) for ln in moving}
+    fixed = pb.fixed_lines(poses)
+    state = pb.first_state(poses, fixed)
+    if pb.free and pb.sel.size:
+        _check_determined(state.K, pb.sel, pb.active, pb.free, pb.d, pb.planar, pb.lref,
+                          pb.dofs)
+    it = 0
+    while state.r > body_tolerance and it < max_body_iterations and pb.sel.size:
+        it += 1
+        trial = _newton_step(pb, fixed, state)
+        if trial is None:
+            break
+        state = trial
+    if state.r > body_tolerance:
+        raise ConvergenceError(
+            "body statics Newton", it, state.r, body_tolerance,
+            hint=("check that the lines can hold the bodies (weight, buoyancy, wind): "
+                  "a body held only by lines slack on the frictionless seabed has an "
+                  "undetermined position; give initial positions near equilibrium, "
+                  "raise max_body_iterations or give fixed_dofs for DOFs without "
+                  "restoring"),
+            partial={nm: state.poses[nm].copy() for nm in pb.free},
+        )
+    lines = {**fixed, **state.lines}
+    return {ln.name: lines[ln.name] for ln in scene.lines}, pb.results(state, it)
 
-    comps = [0, 2] if planar else [0, 1, 2]
-    c = len(comps)
-    end_memo: dict[tuple, np.ndarray] = {}
 
-    def end_pos(ln: Any, end: str, pz: dict[str, np.ndarray]) -> np.ndarray:
-        """``scene.end_position(ln, end, _pose_map(pz))``, memoized on the attached
+@dataclass(frozen=True, eq=False)
+class _State:
+    """An iterate of the body statics Newton: the poses (X, θ) by body, the moving
+    lines' statics there, the generalized force Q and stiffness K on the free DOFs,
+    the line forces on every body, the lines' interior maps and the scaled residual."""
+
+    poses: dict[str, np.ndarray]
+    lines: dict[str, Any]
+    Q: np.ndarray
+    K: np.ndarray
+    line_forces: dict[str, dict[str, np.ndarray]]
+    maps: dict[str, tuple[list[str], np.ndarray]]
+    r: float
+
+
+class _BodyPoses:
+    """The body statics of a scene: unknowns, lines, forces and scales.
+
+    The free bodies (not prescribed) carry d = 6 DOFs (3 planar), minus their
+    ``fixed_dofs`` (the active unknowns ``sel``); the moving lines are those attached to
+    a free body, re-solved at every trial pose; the other lines are solved once.
+    """
+
+    def __init__(self, scene: Scene, method: str, tolerance: float,
+                 max_iterations: int) -> None:
+        self.scene = scene
+        self.method, self.tolerance, self.max_iterations = method, tolerance, max_iterations
+        self.env = env = scene.environment
+        self.planar = planar = scene.is_planar
+        self.d = d = 3 if planar else 6
+        self.dofs = PLANAR_DOFS if planar else SPATIAL_DOFS
+        self.rigid = scene_rigid_bodies(scene)
+        self.free = free = [b.name for b in scene.bodies if b.prescribed is None]
+        self.attached = {ln.name: {end: getattr(ln, end).attach.body
+                                   for end in ("end_a", "end_b")
+                                   if getattr(ln, end).attach is not None}
+                         for ln in scene.lines}
+        self.moving = [ln for ln in scene.lines
+                       if any(b in free for b in self.attached[ln.name].values())]
+        self.meshes = {ln.name: mesh_line(scene.resolved_line(ln), env.rho, env.g)
+                       for ln in self.moving}
+        self.comps = [0, 2] if planar else [0, 1, 2]
+        self.c = len(self.comps)
+        self._end_memo: dict[tuple, np.ndarray] = {}
+        # active unknowns
+        self.active: list[tuple[str, int]] = []
+        for nm in free:
+            fixed = set(scene.body(nm).fixed_dofs)
+            for k, dn in enumerate(self.dofs):
+                if dn not in fixed:
+                    self.active.append((nm, k))
+        self.pos_in_block = {nm: i for i, nm in enumerate(free)}
+        self.sel = np.array([self.pos_in_block[nm] * d + k for nm, k in self.active],
+                            dtype=int)
+        self.fref, self.lref = self._scales()
+
+    def _scales(self) -> tuple[float, float]:
+        """Reference force (the largest body load; the line tensions are added by
+        :meth:`first_state`) and reference length (the largest body arm). [N, m]"""
+        env = self.env
+        fref = 0.0
+        lref = 0.0
+        for b in self.scene.bodies:
+            fref = max(fref, b.mass * env.g, env.rho * env.g * (b.displaced_volume or 0.0),
+                       float(np.linalg.norm(b.wind_force)))
+            for v in (b.cog, b.centre_of_buoyancy, b.drag_point):
+                lref = max(lref, float(np.linalg.norm(v)))
+        for ln in self.scene.lines:
+            for end in ("end_a", "end_b"):
+                a = getattr(ln, end).attach
+                if a is not None:
+                    lref = max(lref, float(np.linalg.norm(a.point)))
+        return fref, (lref if lref > 0.0 else 1.0)
+
+    def _line(self, mesh: Any, initial: np.ndarray | None = None) -> Any:
+        return line_statics(mesh, self.env, self.method, initial, self.tolerance,
+                            self.max_iterations)
+
+    def fixed_lines(self, poses: dict[str, np.ndarray]) -> dict[str, Any]:
+        """The statics of the lines no free body moves, solved once."""
+        env = self.env
+        return {ln.name: self._line(mesh_line(self.scene.resolved_line(ln, pose_map(poses)),
+                                              env.rho, env.g))
+                for ln in self.scene.lines if ln not in self.moving}
+
+    def end_pos(self, ln: Any, end: str, pz: dict[str, np.ndarray]) -> np.ndarray:
+        """``scene.end_position(ln, end, pose_map(pz))``, memoized on the attached
         body's pose (the lines' solve, the forces and the stiffness ask for the same
         ends at the same trial pose)."""
         a = getattr(ln, end).attach
         key = (ln.name, end, None if a is None or a.body not in pz
                else pz[a.body].tobytes())
-        hit = end_memo.get(key)
+        hit = self._end_memo.get(key)
         if hit is None:
-            hit = end_memo[key] = scene.end_position(ln, end, _pose_map(pz))
+            hit = self._end_memo[key] = self.scene.end_position(ln, end, pose_map(pz))
         return hit.copy()
 
-    def solve_lines(pz: dict[str, np.ndarray], base: dict[str, Any] | None = None,
+    def solve_lines(self, pz: dict[str, np.ndarray], base: dict[str, Any] | None = None,
                     maps: dict[str, tuple[list[str], np.ndarray]] | None = None
                     ) -> dict[str, Any]:
         """The moving lines at the poses pz, each FE line warm-started from its shape
         in ``base`` plus the first-order interior motion −S δx_ends (``maps``, the
         static condensation of its tangent); a cold start if that fails."""
+        comps, c = self.comps, self.c
         out = {}
-        for ln in moving:
-            mesh = dataclasses.replace(meshes[ln.name],
-                                       end_a=end_pos(ln, "end_a", pz),
-                                       end_b=end_pos(ln, "end_b", pz))
+        for ln in self.moving:
+            mesh = replace(self.meshes[ln.name], end_a=self.end_pos(ln, "end_a", pz),
+                           end_b=self.end_pos(ln, "end_b", pz))
             prev = None if base is None else base.get(ln.name)
             init = None
             if prev is not None and prev.method == "fe":
@@ -491,50 +412,63 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
                     init[1:-1, comps] -= (smap @ dxb).reshape(-1, c)
                 init[0], init[-1] = mesh.end_a, mesh.end_b
             try:
-                out[ln.name] = solve_line_statics(mesh, env, method=method, initial=init,
-                                                  tolerance=tolerance,
-                                                  max_iterations=max_iterations)
+                out[ln.name] = self._line(mesh, init)
             except ConvergenceError:
                 if init is None:
                     raise
-                out[ln.name] = solve_line_statics(mesh, env, method=method,
-                                                  tolerance=tolerance,
-                                                  max_iterations=max_iterations)
+                out[ln.name] = self._line(mesh)
         return out
 
-    # active unknowns
-    active: list[tuple[str, int]] = []
-    for nm in free:
-        fixed = set(scene.body(nm).fixed_dofs)
-        for k, dn in enumerate(dofs):
-            if dn not in fixed:
-                active.append((nm, k))
-    pos_in_block = {nm: i for i, nm in enumerate(free)}
-    sel = np.array([pos_in_block[nm] * d + k for nm, k in active], dtype=int)
+    def first_state(self, poses: dict[str, np.ndarray], fixed: dict[str, Any]) -> _State:
+        """The moving lines at the initial poses (InputError naming the poses when a
+        line cannot hang there), the reference force raised to their tensions, and the
+        forces there."""
+        try:
+            ls = self.solve_lines(poses)
+        except InputError as exc:
+            where = ", ".join(f"{nm} at {np.round(poses[nm][:3], 6).tolist()}"
+                              for nm in self.free)
+            raise InputError(exc.parameter, exc.value, exc.unit,
+                             f"{exc.constraint} (at the initial body positions: {where}; "
+                             "give positions near equilibrium with the lines neither slack "
+                             "on the seabed nor over-stretched)") from None
+        fref = self.fref
+        for ln in self.moving:
+            s = ls[ln.name]
+            fref = max(fref, float(s.tension.max(initial=0.0)), float(s.tension_a),
+                       float(s.tension_b))
+        self.fref = fref if fref > 0.0 else 1.0
+        return self.state(poses, ls, fixed)
 
-    def q_of(pz: dict[str, np.ndarray]) -> np.ndarray:
-        return np.concatenate([_reduce(pz[nm], planar) for nm in free]) if free else \
-            np.zeros(0)
+    def state(self, pz: dict[str, np.ndarray], ls: dict[str, Any],
+              fixed: dict[str, Any]) -> _State:
+        """The iterate at the poses pz with the moving lines ``ls`` solved there."""
+        Q, K, lf, maps = self.forces(pz, ls, fixed)
+        return _State(poses=pz, lines=ls, Q=Q, K=K, line_forces=lf, maps=maps,
+                      r=self.scaled(Q))
 
-    def forces(pz: dict[str, np.ndarray], ls: dict[str, Any]
+    def forces(self, pz: dict[str, np.ndarray], ls: dict[str, Any], fixed: dict[str, Any]
                ) -> tuple[np.ndarray, np.ndarray, dict[str, dict[str, np.ndarray]],
                           dict[str, tuple[list[str], np.ndarray]]]:
         """Generalized forces (n_free·d,), stiffness (n_free·d)², line forces, and the
-        lines' interior maps (:func:`_mooring_stiffness`)."""
+        lines' interior maps (:func:`stochcable.bodies.mooring.mooring_stiffness_and_maps`)."""
+        scene, planar, d = self.scene, self.planar, self.d
+        free, pos_in_block, rigid = self.free, self.pos_in_block, self.rigid
         Q = np.zeros(len(free) * d)
         K = np.zeros((len(free) * d, len(free) * d))
         lf: dict[str, dict[str, np.ndarray]] = {b.name: {} for b in scene.bodies}
-        allls = {**lines, **ls}
+        allls = {**fixed, **ls}
         for ln in scene.lines:
-            for end, bname in attached[ln.name].items():
+            attached = self.attached[ln.name]
+            for end, bname in attached.items():
                 f = np.asarray(getattr(allls[ln.name], "force_" + end[-1]), dtype=float)
-                key = ln.name if len(attached[ln.name]) == 1 or \
-                    len(set(attached[ln.name].values())) == 2 else f"{ln.name}.{end}"
+                key = ln.name if len(attached) == 1 or \
+                    len(set(attached.values())) == 2 else f"{ln.name}.{end}"
                 lf[bname][key] = f
                 if bname not in pos_in_block:
                     continue
                 p = pz[bname]
-                arm = end_pos(ln, end, pz) - p[:3]
+                arm = self.end_pos(ln, end, pz) - p[:3]
                 i = pos_in_block[bname] * d
                 Q[i:i + d] += _reduce(np.concatenate([f, _cross3(arm, f)]), planar)
         for nm in free:
@@ -549,113 +483,73 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
                                     np.zeros(3)]), planar))
         maps: dict[str, tuple[list[str], np.ndarray]] = {}
         if free:
-            km, maps = _mooring_stiffness(scene, allls, pz, free, planar, method, tolerance,
-                                          end_position=end_pos)
+            km, maps = mooring_stiffness_and_maps(scene, allls, pz, free, planar,
+                                                  self.method, self.tolerance,
+                                                  end_position=self.end_pos)
             K += km
         return Q, K, lf, maps
 
-    # scales
-    fref = 0.0
-    lref = 0.0
-    for b in scene.bodies:
-        fref = max(fref, b.mass * env.g, env.rho * env.g * (b.displaced_volume or 0.0),
-                   float(np.linalg.norm(b.wind_force)))
-        for v in (b.cog, b.centre_of_buoyancy, b.drag_point):
-            lref = max(lref, float(np.linalg.norm(v)))
-    for ln in scene.lines:
-        for end in ("end_a", "end_b"):
-            a = getattr(ln, end).attach
-            if a is not None:
-                lref = max(lref, float(np.linalg.norm(a.point)))
-    lref = lref if lref > 0.0 else 1.0
-
-    def scaled(Q: np.ndarray) -> float:
+    def scaled(self, Q: np.ndarray) -> float:
+        """max |Q| over the active DOFs / the reference force, the moments divided by
+        the reference length too. [-]"""
         if Q.size == 0:
             return 0.0
-        qq = Q.reshape(len(free), d).copy()
-        rot = [2] if planar else [3, 4, 5]
-        qq[:, rot] /= lref
+        qq = Q.reshape(len(self.free), self.d).copy()
+        rot = [2] if self.planar else [3, 4, 5]
+        qq[:, rot] /= self.lref
+        sel = self.sel
         qq = qq.reshape(-1)[sel] if sel.size else qq.reshape(-1)[:0]
-        return float(np.abs(qq).max(initial=0.0)) / fref
+        return float(np.abs(qq).max(initial=0.0)) / self.fref
 
+    def results(self, state: _State, iterations: int) -> dict[str, BodyStatics]:
+        """The BodyStatics of every body at the final iterate."""
+        d = self.d
+        out: dict[str, BodyStatics] = {}
+        for b in self.scene.bodies:
+            p = state.poses[b.name]
+            if b.name in self.pos_in_block:
+                i = self.pos_in_block[b.name] * d
+                st = state.K[i:i + d, i:i + d].copy()
+                res, iters = state.r, iterations
+            else:
+                st, res, iters = np.zeros((d, d)), 0.0, 0
+            out[b.name] = BodyStatics(
+                name=b.name, position=p[:3].copy(), rotation=p[3:].copy(),
+                line_forces=state.line_forces[b.name], iterations=iters, residual=res,
+                stiffness=st, dofs=self.dofs, prescribed=b.prescribed is not None)
+        return out
+
+
+def _newton_step(pb: _BodyPoses, fixed: dict[str, Any], state: _State) -> _State | None:
+    """One Newton step on the active DOFs, K δq = Q, with a backtracking line search
+    (halving up to 12 times) that accepts a lower residual (or the last, tiny step);
+    a trial pose where a line cannot reach or goes slack is a shorter step.  None when
+    no step is accepted."""
+    sel, d = pb.sel, pb.d
+    Ka = state.K[np.ix_(sel, sel)]
     try:
-        ls = solve_lines(poses)
-    except InputError as exc:
-        where = ", ".join(f"{nm} at {np.round(poses[nm][:3], 6).tolist()}" for nm in free)
-        raise InputError(exc.parameter, exc.value, exc.unit,
-                         f"{exc.constraint} (at the initial body positions: {where}; give "
-                         "positions near equilibrium with the lines neither slack on the "
-                         "seabed nor over-stretched)") from None
-    lines_all = {**lines, **ls}
-    for ln in moving:
-        fref = max(fref, float(lines_all[ln.name].tension.max(initial=0.0)),
-                   float(lines_all[ln.name].tension_a), float(lines_all[ln.name].tension_b))
-    fref = fref if fref > 0.0 else 1.0
-    Q, K, lf, maps = forces(poses, ls)
-    it = 0
-    r = scaled(Q)
-    if free and sel.size:
-        _check_determined(K, sel, active, free, d, planar, lref, dofs)
-    while r > body_tolerance and it < max_body_iterations and sel.size:
-        it += 1
-        Ka = K[np.ix_(sel, sel)]
+        dq_a = np.linalg.solve(Ka, state.Q[sel])
+    except np.linalg.LinAlgError:
+        dq_a = np.linalg.lstsq(Ka, state.Q[sel], rcond=None)[0]
+    dq = np.zeros(len(pb.free) * d)
+    dq[sel] = dq_a
+    step = 1.0
+    for _ in range(12):
+        trial = {nm: p.copy() for nm, p in state.poses.items()}
+        for nm in pb.free:
+            i = pb.pos_in_block[nm] * d
+            trial[nm] = trial[nm] + _full(step * dq[i:i + d], pb.planar)
         try:
-            dq_a = np.linalg.solve(Ka, Q[sel])
-        except np.linalg.LinAlgError:
-            dq_a = np.linalg.lstsq(Ka, Q[sel], rcond=None)[0]
-        dq = np.zeros(len(free) * d)
-        dq[sel] = dq_a
-        step, accepted = 1.0, False
-        for _ in range(12):
-            trial = {nm: p.copy() for nm, p in poses.items()}
-            for nm in free:
-                i = pos_in_block[nm] * d
-                trial[nm] = trial[nm] + _full(step * dq[i:i + d], planar)
-            try:
-                ls_t = solve_lines(trial, ls, maps)
-                Q_t, K_t, lf_t, maps_t = forces(trial, ls_t)
-            except (ConvergenceError, InputError):
-                # a line that cannot reach or goes slack at the trial pose: shorter step
-                step *= 0.5
-                continue
-            r_t = scaled(Q_t)
-            if r_t < r or step < 1.0 / 1024:
-                poses, ls, Q, K, lf, maps, r = trial, ls_t, Q_t, K_t, lf_t, maps_t, r_t
-                accepted = True
-                break
+            ls_t = pb.solve_lines(trial, state.lines, state.maps)
+            new = pb.state(trial, ls_t, fixed)
+        except (ConvergenceError, InputError):
+            # a line that cannot reach or goes slack at the trial pose: shorter step
             step *= 0.5
-        if not accepted:
-            break
-        lines.update(ls)
-    lines.update(ls)
-    if r > body_tolerance:
-        raise ConvergenceError(
-            "body statics Newton", it, r, body_tolerance,
-            hint=("check that the lines can hold the bodies (weight, buoyancy, wind): "
-                  "a body held only by lines slack on the frictionless seabed has an "
-                  "undetermined position; give initial positions near equilibrium, "
-                  "raise max_body_iterations or give fixed_dofs for DOFs without "
-                  "restoring"),
-            partial={nm: poses[nm].copy() for nm in free},
-        )
-    out: dict[str, BodyStatics] = {}
-    for b in scene.bodies:
-        p = poses[b.name]
-        if b.name in pos_in_block:
-            i = pos_in_block[b.name] * d
-            st = K[i:i + d, i:i + d].copy()
-            res, iters = r, it
-        else:
-            st, res, iters = np.zeros((d, d)), 0.0, 0
-        out[b.name] = BodyStatics(
-            name=b.name, position=p[:3].copy(), rotation=p[3:].copy(),
-            line_forces=lf[b.name], iterations=iters, residual=res, stiffness=st,
-            dofs=dofs, prescribed=b.prescribed is not None)
-    return {ln.name: lines[ln.name] for ln in scene.lines}, out
-
-
-def _pose_map(poses: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    return {nm: (p[:3], p[3:]) for nm, p in poses.items()}
+            continue
+        if new.r < state.r or step < 1.0 / 1024:
+            return new
+        step *= 0.5
+    return None
 
 
 def _check_determined(K: np.ndarray, sel: np.ndarray, active: list[tuple[str, int]],

@@ -1,2 +1,10 @@
 """One line: mesh, closed-form catenary, static equilibrium, finite-element model and
-natural modes (seed 001 ch. 4; seed 000 for the modes)."""
+natural modes (seed 001 ch. 4; seed 000 for the modes).
+
+``mesh`` (elements and nodes) · ``catenary`` (closed-form elastic catenary; its closure
+integrals in ``catenary_kernel``, the multi-segment chain in ``multisegment``) ·
+``statics`` (one line's static equilibrium: ``equilibrium`` the FE residual, tangent
+and Newton solver, ``chain`` its start, ``banded`` the banded solves) · ``elements``
+and ``fem`` (the finite-element model about the static shape) · ``modes``.  The
+scene-level statics, with bodies, is :mod:`stochcable.statics`.
+"""

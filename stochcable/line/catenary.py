@@ -35,6 +35,13 @@ from numpy.typing import ArrayLike
 
 from stochcable import validation as v
 from stochcable.errors import ConvergenceError, InputError
+from stochcable.line.catenary_kernel import (
+    CLOSURE_TOL,
+    MAX_NEWTON,
+    closure,
+    kernel,
+    vertical_profile,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from stochcable.line.mesh import LineMesh
@@ -43,116 +50,18 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "MAX_STRAIN",
     "CatenarySolution",
-    "MultiSegmentSolution",
     "CatenaryLine",
     "catenary_solve",
     "catenary_from_top_tension",
-    "catenary_multisegment",
     "catenary_line",
+    "elastic_catenary",
+    "catenary_on_mesh",
+    "check_reach",
+    "newton_start",
 ]
 
 #: Largest strain a line may need to reach its span (as the scene's validation). [-]
 MAX_STRAIN = 0.1
-
-_TOL = 1e-12  # closure tolerance, relative to max(length, chord)
-_MAXIT = 200
-
-
-# ----------------------------------------------------------------------------- kernel
-
-
-def _asinhc(d: np.ndarray) -> np.ndarray:
-    """asinh(d)/d, 1 at d = 0."""
-    d = np.asarray(d, dtype=float)
-    small = np.abs(d) < 1e-6
-    safe = np.where(small, 1.0, d)
-    return np.where(small, 1.0 - d * d / 6.0, np.arcsinh(safe) / safe)
-
-
-def _kernel(H, V0, w, ls, c):
-    """Suspended stretch of length ``ls`` starting with vertical force ``V0``.
-
-    Returns x, z (spans of the stretch) and the partial derivatives dx/dH, dx/dV0,
-    dz/dH, dz/dV0 at fixed ``ls`` (the Jacobian is symmetric: it is the Hessian of the
-    complementary energy).  ``c`` = 1/EA (0 for an inextensible line).  H > 0.
-    All arguments broadcast.
-    """
-    H = np.asarray(H, dtype=float)
-    V0 = np.asarray(V0, dtype=float)
-    ls = np.asarray(ls, dtype=float)
-    V1 = V0 + w * ls
-    T0 = np.hypot(H, V0)
-    T1 = np.hypot(H, V1)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        same = V0 * V1 >= 0.0
-        both0 = (V0 == 0.0) & (V1 == 0.0)
-        den = V1 * T0 + V0 * T1
-        q = np.where(both0, 1.0 / H, (V0 + V1) / np.where(den == 0.0, 1.0, den))
-        # same-sign branch (no cancellation: V0, V1 of one sign)
-        s1_same = ls * H * q * _asinhc(w * ls * q)
-        j_same = ls * H * H * q / (T0 * T1)
-        # opposite-sign branch (w != 0 there and |w ls| >= |V0|, |V1|: no cancellation)
-        wsafe = w if w != 0.0 else 1.0
-        s1_opp = (H / wsafe) * (np.arcsinh(V1 / H) - np.arcsinh(V0 / H))
-        j_opp = (V1 / T1 - V0 / T0) / wsafe
-        S1 = np.where(same, s1_same, s1_opp)  # ∫ H/T ds
-        J = np.where(same, j_same, j_opp)  # ∫ H²/T³ ds
-    return _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c)
-
-
-def _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c) -> tuple:  # noqa: ANN001
-    """The branch-free end of :func:`_kernel` and :func:`_kernel_scalar` (arrays or
-    floats alike): spans and Jacobian from S1 = ∫ H/T ds and J = ∫ H²/T³ ds."""
-    S2 = ls * (V0 + V1) / (T0 + T1)  # ∫ V/T ds
-    K = -H * ls * (V0 + V1) / (T0 * T1 * (T0 + T1))  # ∫ −HV/T³ ds
-    x = H * c * ls + S1
-    z = c * (V0 * ls + 0.5 * w * ls * ls) + S2
-    dxdH = c * ls + S1 / H - J
-    dzdV = c * ls + J
-    return x, z, dxdH, K, K, dzdV
-
-
-def _kernel_scalar(H: float, V0: float, w: float, ls: float, c: float) -> tuple:
-    """:func:`_kernel` for Python floats: the same formulas and branches as float
-    arithmetic (the closure Newton evaluates it a few times per solve, where numpy's
-    per-call overhead on 0-d arrays dominated, ≈ 0.2 ms of every chain statics).
-    hypot and asinh stay numpy's (math's may differ in the last bit), so the results
-    are the array kernel's to the bit."""
-    V1 = V0 + w * ls
-    T0 = float(np.hypot(H, V0))
-    T1 = float(np.hypot(H, V1))
-    if V0 * V1 >= 0.0:  # same-sign branch (no cancellation: V0, V1 of one sign)
-        if V0 == 0.0 and V1 == 0.0:
-            q = 1.0 / H
-        else:
-            den = V1 * T0 + V0 * T1
-            q = (V0 + V1) / (1.0 if den == 0.0 else den)
-        dd = w * ls * q
-        asinhc = 1.0 - dd * dd / 6.0 if abs(dd) < 1e-6 else float(np.arcsinh(dd)) / dd
-        S1 = ls * H * q * asinhc  # ∫ H/T ds
-        J = ls * H * H * q / (T0 * T1)  # ∫ H²/T³ ds
-    else:  # opposite signs (w != 0 there and |w ls| >= |V0|, |V1|: no cancellation)
-        wsafe = w if w != 0.0 else 1.0
-        S1 = (H / wsafe) * (float(np.arcsinh(V1 / H)) - float(np.arcsinh(V0 / H)))
-        J = (V1 / T1 - V0 / T0) / wsafe
-    return _kernel_spans(H, V0, V1, T0, T1, S1, J, w, ls, c)
-
-
-def _closure(H, Va, L, w, c, seabed):
-    """Spans (X, Z) and the Jacobian d(X, Z)/d(H, Va) of the whole segment."""
-    H, Va, L, w, c = float(H), float(Va), float(L), float(w), float(c)
-    if not (math.isfinite(H) and math.isfinite(Va)) or H <= 0.0:
-        kernel = _kernel  # numpy's inf/nan semantics (the line search rejects them)
-    else:
-        kernel = _kernel_scalar
-    if seabed and Va < 0.0:
-        lb = -Va / w  # may exceed L inside the iteration: the closure stays smooth
-        x, z, a, b, cc, d = kernel(H, 0.0, w, L - lb, c)
-        return float(x + lb * (1.0 + H * c)), float(z), np.array(
-            [[a + lb * c, b], [cc, d]], dtype=float
-        )
-    x, z, a, b, cc, d = kernel(H, Va, w, L, c)
-    return float(x), float(z), np.array([[a, b], [cc, d]], dtype=float)
 
 
 # --------------------------------------------------------------------------- results
@@ -249,101 +158,18 @@ class CatenarySolution:
         c = 0.0 if math.isinf(self.ea) else 1.0 / self.ea
         H, w = self.H, self.weight
         if H == 0.0:
-            return _vertical_profile(s_c, self.V_a, w, c)
+            return vertical_profile(s_c, self.V_a, w, c)
         lb = self.touchdown
         if lb > 0.0:
             sig = np.maximum(s_c - lb, 0.0)
-            xk, zk, *_ = _kernel(H, 0.0, w, sig, c)
+            xk, zk, *_ = kernel(H, 0.0, w, sig, c)
             on = s_c <= lb
             x = np.where(on, s_c * (1.0 + H * c), lb * (1.0 + H * c) + xk)
             z = np.where(on, 0.0, zk)
             t = np.where(on, H, np.hypot(H, w * sig))
             return x, z, t
-        xk, zk, *_ = _kernel(H, self.V_a, w, s_c, c)
+        xk, zk, *_ = kernel(H, self.V_a, w, s_c, c)
         return xk, zk, np.hypot(H, self.V_a + w * s_c)
-
-
-def _vertical_profile(s, Va, w, c):
-    """Profile of a vertical line (H = 0), possibly folded where V changes sign."""
-    V = Va + w * s
-    # ∫ sgn(V)(1 + c|V|) ds' = ∫ (sgn V + c V) ds' ; sgn integral via the root s*.
-    if w != 0.0:
-        s_star = -Va / w
-    else:
-        s_star = math.inf
-    sg0 = 1.0 if (Va > 0.0 or (Va == 0.0 and w >= 0.0)) else -1.0
-    if 0.0 < s_star:
-        before = np.minimum(s, s_star)
-        after = np.maximum(s - s_star, 0.0)
-        sgn_int = sg0 * before - sg0 * after
-    else:
-        sgn_int = sg0 * s
-    z = sgn_int + c * (Va * s + 0.5 * w * s * s)
-    x = np.zeros_like(s)
-    return x, z, np.abs(V)
-
-
-@dataclass(frozen=True)
-class MultiSegmentSolution:
-    """Static equilibrium of a chain of elastic catenary segments (no seabed contact).
-
-    Attributes
-    ----------
-    H : float
-        Horizontal tension component. [N]
-    V_start, V_end : ndarray, shape (n_segments,)
-        Vertical tension component at the start and end of each segment. [N]
-    tension_a, tension_b : float
-        Effective tension at end_a and end_b. [N]
-    junctions : ndarray, shape (n_segments - 1, 2)
-        Local (x, z) of the junctions. [m]
-    iterations : int
-        Newton iterations used.
-    lengths, weights, eas : ndarray
-        Segment data: L [m], w [N/m], EA [N].
-    residual : float
-        Largest closure error at the solution. [m]
-    """
-
-    H: float
-    V_start: np.ndarray
-    V_end: np.ndarray
-    tension_a: float
-    tension_b: float
-    junctions: np.ndarray
-    iterations: int
-    lengths: np.ndarray
-    weights: np.ndarray
-    eas: np.ndarray
-    residual: float = 0.0
-
-    def __post_init__(self) -> None:
-        for name in ("H", "tension_a", "tension_b", "residual"):
-            object.__setattr__(self, name, float(getattr(self, name)))
-
-    def profile(self, s: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Local (x, z) and tension at unstretched arc lengths ``s`` from end_a. [m, m, N]
-
-        At a junction itself the tension of the segment ending there is returned.
-        """
-        s = np.asarray(s, dtype=float)
-        edges = np.concatenate([[0.0], np.cumsum(self.lengths)])
-        s_c = np.clip(s, 0.0, edges[-1])
-        k = np.clip(np.searchsorted(edges, s_c, side="left") - 1, 0, self.lengths.size - 1)
-        origin = np.vstack([[0.0, 0.0], self.junctions])
-        sl = s_c - edges[k]
-        c = np.where(np.isinf(self.eas), 0.0, 1.0 / self.eas)
-        x = np.empty_like(s_c)
-        z = np.empty_like(s_c)
-        for j in range(self.lengths.size):
-            m = k == j
-            if not m.any():
-                continue
-            xk, zk, *_ = _kernel(self.H, self.V_start[j], float(self.weights[j]), sl[m], c[j])
-            x[m] = origin[j, 0] + xk
-            z[m] = origin[j, 1] + zk
-        t = np.hypot(self.H, self.V_start[k] + self.weights[k] * sl)
-        return x, z, t
 
 
 # ----------------------------------------------------------------------- validation
@@ -363,7 +189,7 @@ def _check_common(horizontal_span, vertical_span, length, weight, ea):
     return X, Z, L, w, ea_f
 
 
-def _too_short(L, chord, ea):
+def check_reach(L, chord, ea):
     if math.isinf(ea):
         if chord >= L:
             raise InputError(
@@ -382,7 +208,7 @@ def _too_short(L, chord, ea):
 # ---------------------------------------------------------------------------- solve
 
 
-def _initial_guess(X, Z, L, w, c):
+def newton_start(X, Z, L, w, c):
     """Start for Newton: the inextensible catenary estimate of Peyrot & Goulois (1979)
     for slack lines, a parabolic elastic estimate for taut ones."""
     chord = math.hypot(X, Z)
@@ -418,16 +244,16 @@ def _initial_guess(X, Z, L, w, c):
 
 def _newton(H, Va, X, Z, L, w, c, seabed, scale):
     """Damped Newton on the closure equations; returns (H, Va, iterations, residual)."""
-    tol = _TOL * scale
+    tol = CLOSURE_TOL * scale
 
     def resid(H_, Va_):
-        x, z, J = _closure(H_, Va_, L, w, c, seabed)
+        x, z, J = closure(H_, Va_, L, w, c, seabed)
         return np.array([x - X, z - Z]), J
 
     r, J = resid(H, Va)
     nr = float(np.max(np.abs(r)))
     it = 0
-    for it in range(1, _MAXIT + 1):
+    for it in range(1, MAX_NEWTON + 1):
         if nr <= tol:
             return H, Va, it - 1, nr
         try:
@@ -462,7 +288,7 @@ def _vertical_solve(Z, L, w, c, seabed):
     """H = 0: solve z(L) = Z for V_a (monotone increasing)."""
 
     def zend(Va):
-        return float(_vertical_profile(np.array(L), Va, w, c)[1])
+        return float(vertical_profile(np.array(L), Va, w, c)[1])
 
     Tsc = abs(w) * L + (1.0 / c if c > 0 else 0.0) * 1e-3 + 1.0
     lo, hi = -abs(w) * L - Tsc, abs(w) * L + Tsc
@@ -543,12 +369,23 @@ def catenary_solve(
     A horizontal span of exactly 0 gives H = 0 (vertical, possibly folded line).
     """
     X, Z, L, w, ea = _check_common(horizontal_span, vertical_span, length, weight, ea)
+    return elastic_catenary(X, Z, L, w, ea, bool(seabed))
+
+
+def elastic_catenary(X: float, Z: float, L: float, w: float, ea: float,
+                     seabed: bool) -> CatenarySolution:
+    """:func:`catenary_solve` for inputs already checked: floats, X >= 0 and Z, w
+    finite, L > 0, EA > 0 (``math.inf`` inextensible) [m, m, m, N/m, N].  For the inner
+    loops (the lumped-chain start of the FE statics, the line statics at every body
+    pose, the multi-segment start).  Raises as :func:`catenary_solve` when the line
+    cannot hang between the ends (too short, coincident ends, a weightless slack line,
+    a slack line piling up on the seabed) and when Newton does not converge."""
     c = 0.0 if math.isinf(ea) else 1.0 / ea
     chord = math.hypot(X, Z)
     if chord == 0.0:
         raise InputError("horizontal_span", X, "m",
                          "end_a and end_b coincide (horizontal and vertical span are 0)")
-    _too_short(L, chord, ea)
+    check_reach(L, chord, ea)
     seabed = bool(seabed)
     if seabed and w <= 0.0:
         seabed = False  # a weightless or buoyant line does not rest on the seabed
@@ -577,7 +414,7 @@ def catenary_solve(
         Vb = Va + w * L
         return CatenarySolution(0.0, Va, Vb, abs(Va), abs(Vb), 0.0, 0.0, it, X, Z, L, w,
                                 ea, seabed, res)
-    H0, Va0 = _initial_guess(X, Z, L, w, c)
+    H0, Va0 = newton_start(X, Z, L, w, c)
     scale = max(L, chord)
     H, Va, it, res = _newton(H0, Va0, X, Z, L, w, c, seabed, scale)
     Vb = Va + w * L
@@ -643,7 +480,7 @@ def catenary_from_top_tension(
     def spans(H):
         Vb = math.sqrt(max(Tb * Tb - H * H, 0.0))
         Va = Vb - w * L
-        x, z, _ = _closure(H, Va, L, w, c, seabed)
+        x, z, _ = closure(H, Va, L, w, c, seabed)
         return x, z
 
     lo, hi = Tb * 1e-9, Tb * (1.0 - 1e-12)
@@ -654,128 +491,7 @@ def catenary_from_top_tension(
                          f"of {Z:g} m (the line is too heavy or too long for it)")
     H = brentq(lambda h: spans(h)[1] - Z, lo, hi, xtol=1e-14 * Tb, rtol=1e-15, maxiter=500)
     X = spans(H)[0]
-    return catenary_solve(X, Z, L, w, ea, seabed=seabed)
-
-
-def catenary_multisegment(
-    horizontal_span: float,
-    vertical_span: float,
-    lengths: ArrayLike,
-    weights: ArrayLike,
-    eas: ArrayLike,
-    junction_loads: ArrayLike | None = None,
-) -> MultiSegmentSolution:
-    """Chain of elastic catenary segments with point loads at the junctions.
-
-    Parameters
-    ----------
-    horizontal_span : float
-        Horizontal distance from end_a to end_b, > 0. [m]
-    vertical_span : float
-        Height of end_b above end_a. [m]
-    lengths : array_like, shape (n,)
-        Unstretched segment lengths from end_a. [m]
-    weights : array_like, shape (n,)
-        Net submerged weight per unit length of each segment (positive down). [N/m]
-    eas : array_like, shape (n,)
-        Axial stiffness of each segment. [N]
-    junction_loads : array_like, shape (n - 1,), optional
-        Net downward point force at each junction (clump weight positive, buoy
-        negative). [N]
-
-    Returns
-    -------
-    MultiSegmentSolution
-
-    Notes
-    -----
-    The vertical tension component jumps by the junction load across each junction
-    (node equilibrium, seed 001 §6.2 buoy of 900 lb); H is constant.  The spans are
-    the sums of the segments' closures (Irvine 1981, ch. 2) and the Jacobian the
-    sum of theirs; damped Newton on (H, V_a) as in :func:`catenary_solve`, started from
-    the single-segment solution with the average weight.  No seabed contact.
-    """
-    X = v.positive("horizontal_span", horizontal_span, "m")
-    Z = v.finite_scalar("vertical_span", vertical_span, "m")
-    Ls = v.float_array("lengths", lengths, "m", positive=True)
-    n = Ls.size
-    ws = v.float_array("weights", weights, "N/m")
-    if ws.size != n:
-        raise InputError("weights", weights, "N/m", f"must have {n} entries (one per segment)")
-    eas_a = np.asarray(eas, dtype=float).reshape(-1)
-    if eas_a.size != n or np.isnan(eas_a).any() or (eas_a <= 0).any():
-        raise InputError("eas", eas, "N", f"must be {n} values > 0")
-    if junction_loads is None:
-        P = np.zeros(n - 1)
-    else:
-        P = v.float_array("junction_loads", junction_loads, "N", min_size=0)
-    if P.size != n - 1:
-        raise InputError("junction_loads", junction_loads, "N",
-                         f"must have {n - 1} entries (one per junction)")
-    cs = np.where(np.isinf(eas_a), 0.0, 1.0 / eas_a)
-    L = float(Ls.sum())
-    chord = math.hypot(X, Z)
-    ea_eq = L / float(np.sum(Ls * cs)) if np.sum(Ls * cs) > 0 else math.inf
-    _too_short(L, chord, ea_eq)
-    # V at the start of each segment = Va + offsets
-    offsets = np.concatenate([[0.0], np.cumsum(ws[:-1] * Ls[:-1] + P)])
-
-    def closure(H, Va):
-        xs = zs = 0.0
-        J = np.zeros((2, 2))
-        for j in range(n):
-            x, z, a, b, cc, d = _kernel(H, Va + offsets[j], float(ws[j]), Ls[j], cs[j])
-            xs += float(x)
-            zs += float(z)
-            J += np.array([[a, b], [cc, d]], dtype=float)
-        return np.array([xs - X, zs - Z]), J
-
-    w_avg = (float(np.sum(ws * Ls)) + float(P.sum())) / L
-    if abs(w_avg) <= 1e-6 * float(np.max(np.abs(ws), initial=0.0)):
-        w_avg = float(np.mean(np.abs(ws))) or 1.0  # a start only
-    try:
-        s0 = catenary_solve(X, Z, L, w_avg, ea_eq)
-        H, Va = s0.H, s0.V_a
-    except (InputError, ConvergenceError):
-        H, Va = _initial_guess(X, Z, L, w_avg if w_avg != 0 else 1.0, 1.0 / ea_eq)
-    scale = max(L, chord)
-    tol = _TOL * scale
-    r, J = closure(H, Va)
-    nr = float(np.max(np.abs(r)))
-    it = 0
-    for it in range(1, _MAXIT + 1):
-        if nr <= tol:
-            break
-        d = np.linalg.solve(J, -r)
-        t = 1.0
-        if H + d[0] <= 0.1 * H:
-            t = 0.9 * H / -d[0]
-        for _ in range(60):
-            rn, Jn = closure(H + t * d[0], Va + t * d[1])
-            nrn = float(np.max(np.abs(rn)))
-            if np.isfinite(nrn) and nrn < nr:
-                break
-            t *= 0.5
-        else:
-            break
-        H, Va, r, J, nr = H + t * d[0], Va + t * d[1], rn, Jn, nrn
-    if nr > tol:
-        raise ConvergenceError("multi-segment catenary Newton", it, nr, tol,
-                               partial=(H, Va))
-    V_start = Va + offsets
-    V_end = V_start + ws * Ls
-    junctions = np.zeros((n - 1, 2))
-    px = pz = 0.0
-    for j in range(n - 1):
-        x, z, *_ = _kernel(H, V_start[j], float(ws[j]), Ls[j], cs[j])
-        px += float(x)
-        pz += float(z)
-        junctions[j] = (px, pz)
-    return MultiSegmentSolution(
-        H=H, V_start=V_start, V_end=V_end, tension_a=math.hypot(H, V_start[0]),
-        tension_b=math.hypot(H, V_end[-1]), junctions=junctions, iterations=it,
-        lengths=Ls, weights=ws, eas=eas_a, residual=nr,
-    )
+    return elastic_catenary(X, Z, L, w, ea, bool(seabed))
 
 
 # ------------------------------------------------------------------------------ 3-D
@@ -837,6 +553,12 @@ def catenary_line(
     if (np.any(mesh.node_mass != 0.0) or np.any(mesh.node_buoyancy != 0.0)):
         raise InputError(f"line {mesh.name!r}.attachments", "mass/buoyancy", "-",
                          "the closed-form catenary needs a line without loaded attachments")
+    return catenary_on_mesh(mesh, environment)
+
+
+def catenary_on_mesh(mesh: "LineMesh", environment: "Environment") -> CatenaryLine:
+    """:func:`catenary_line` of a mesh already known to have one segment and no loaded
+    attachment (the line statics checks that before it takes the closed form)."""
     a, b = mesh.end_a, mesh.end_b
     d = b - a
     X = float(math.hypot(d[0], d[1]))
@@ -844,8 +566,8 @@ def catenary_line(
     e_h = np.array([d[0], d[1], 0.0]) / X if X > 0.0 else np.array([1.0, 0.0, 0.0])
     depth = environment.depth
     on_seabed = abs(a[2] + depth) <= 1e-9 * depth
-    sol = catenary_solve(X, Z, mesh.length, float(mesh.weight[0]), float(mesh.ea[0]),
-                         seabed=on_seabed)
+    sol = elastic_catenary(X, Z, float(mesh.length), float(mesh.weight[0]),
+                           float(mesh.ea[0]), bool(on_seabed))
     x, z, t = sol.profile(mesh.s0)
     pos = a[None, :] + x[:, None] * e_h[None, :] + z[:, None] * np.array([0.0, 0.0, 1.0])
     mid = 0.5 * (mesh.s0[1:] + mesh.s0[:-1])

@@ -33,6 +33,19 @@ import scipy.sparse as sp
 
 from stochcable.validation import float_array, positive
 from stochcable.errors import InputError
+from stochcable.line.elements import (
+    CONSISTENT_PATTERN,
+    LUMPED_PATTERN,
+    SLACK_EA_RATIO,
+    STIFFNESS_PATTERN,
+    added_mass_elements,
+    check_dim,
+    element_added_mass,
+    element_mass,
+    element_stiffness,
+    expand_blocks,
+    stiffness_blocks,
+)
 from stochcable.line.mesh import LineMesh
 from stochcable.scene.model import Environment, Seabed
 
@@ -44,201 +57,12 @@ __all__ = [
     "element_added_mass",
     "assemble",
     "build_fe_model",
-    "scene_fe_models",
+    "chain_csr",
 ]
-
-#: Slack elements (T <= 0) keep this fraction of their EA and no geometric stiffness,
-#: so K stays positive semi-definite and a slack stretch only loses its stiffness
-#: ("E -> epsilon", DESIGN.md "Cable model").
-SLACK_EA_RATIO = 1.0e-6
 
 _AXES = {"x": 0, "y": 1, "z": 2}
 # Tolerance (relative to the line's size) for "the line lies in the x–z plane".
 _PLANE_TOL = 1.0e-9
-
-
-# --------------------------------------------------------------------- element level
-
-
-def _stiffness_blocks(e: np.ndarray, l: np.ndarray, l0: np.ndarray, ea: np.ndarray,
-                      tension: np.ndarray) -> np.ndarray:
-    """Node-block k (n_el, d, d) of K_e = k ⊗ [[1, -1], [-1, 1]] (no validation)."""
-    slack = tension <= 0.0
-    t_eff = np.where(slack, 0.0, tension)
-    ea_eff = np.where(slack, SLACK_EA_RATIO * ea, ea)
-    d = e.shape[1]
-    eet = e[:, :, None] * e[:, None, :]
-    eye = np.eye(d)
-    return (ea_eff / l0)[:, None, None] * eet + (t_eff / l)[:, None, None] * (eye - eet)
-
-
-def _expand(block: np.ndarray, pattern: np.ndarray) -> np.ndarray:
-    """(n_el, d, d) block ⊗ 2×2 pattern -> (n_el, 2d, 2d), node-a DOFs first."""
-    n, d, _ = block.shape
-    out = np.empty((n, 2 * d, 2 * d))
-    for a in range(2):
-        for b in range(2):
-            out[:, a * d:(a + 1) * d, b * d:(b + 1) * d] = pattern[a, b] * block
-    return out
-
-
-_STIFF_PATTERN = np.array([[1.0, -1.0], [-1.0, 1.0]])
-_CONSISTENT = np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
-_LUMPED = np.array([[0.5, 0.0], [0.0, 0.5]])
-
-
-def element_stiffness(
-    positions_a: np.ndarray,
-    positions_b: np.ndarray,
-    l0: np.ndarray,
-    ea: np.ndarray,
-    tension: np.ndarray,
-) -> np.ndarray:
-    """Exact tangent stiffness of straight 2-node cable elements.
-
-    Parameters
-    ----------
-    positions_a, positions_b : array_like, shape (n_el, d)
-        Positions of the first and second node of each element, d = 2 or 3. [m]
-    l0 : array_like, shape (n_el,)
-        Unstretched element length. [m]
-    ea : array_like, shape (n_el,)
-        Axial stiffness. [N]
-    tension : array_like, shape (n_el,)
-        Effective tension of each element in the static state. [N]
-
-    Returns
-    -------
-    ndarray, shape (n_el, 2d, 2d)
-        Element stiffness, DOFs ordered (node a components, node b components). [N/m]
-
-    Notes
-    -----
-    With current length l, unit vector e from node a to node b and tension T,
-
-        K_e = [(EA/l0) e eᵀ + (T/l)(I − e eᵀ)] ⊗ [[1, −1], [−1, 1]],
-
-    the derivative of the element end force T(l) e with T = EA (l − l0)/l0 (seed 001
-    eqs. 3.1.8–3.1.11 with the pseudo-Hookean law; DESIGN.md "Cable model").  A slack
-    element (T <= 0) gets T -> 0 and EA -> ``SLACK_EA_RATIO``·EA: it carries no
-    geometric stiffness and nearly no axial stiffness, and K stays positive
-    semi-definite.
-    """
-    pa = float_array("positions_a", positions_a, "m", ndim=2)
-    pb = float_array("positions_b", positions_b, "m", ndim=2)
-    if pa.shape != pb.shape or pa.shape[1] not in (2, 3):
-        raise InputError("positions_b", pb.shape, "-",
-                         f"must have the shape of positions_a {pa.shape}, with 2 or 3 columns")
-    n = pa.shape[0]
-    l0 = float_array("l0", l0, "m", positive=True)
-    ea = float_array("ea", ea, "N", positive=True)
-    tension = float_array("tension", tension, "N")
-    for name, arr in (("l0", l0), ("ea", ea), ("tension", tension)):
-        if arr.shape != (n,):
-            raise InputError(name, arr.shape, "-", f"must have one value per element ({n})")
-    d = pb - pa
-    l = np.linalg.norm(d, axis=1)
-    if (l <= 0.0).any():
-        i = int(np.flatnonzero(l <= 0.0)[0])
-        raise InputError("positions_b", pb[i], "m",
-                         f"element {i} has zero length (its nodes coincide)")
-    e = d / l[:, None]
-    return _expand(_stiffness_blocks(e, l, l0, ea, tension), _STIFF_PATTERN)
-
-
-def element_mass(
-    l0: np.ndarray, mass: np.ndarray, dim: int = 3, lumped: bool = False
-) -> np.ndarray:
-    """Structural mass matrices of 2-node cable elements.
-
-    Parameters
-    ----------
-    l0 : array_like, shape (n_el,)
-        Unstretched element length. [m]
-    mass : array_like, shape (n_el,)
-        Mass per unit (unstretched) length. [kg/m]
-    dim : {2, 3}
-        Number of displacement components per node.
-    lumped : bool
-        Lumped (half the element mass on each node) instead of consistent.
-
-    Returns
-    -------
-    ndarray, shape (n_el, 2·dim, 2·dim)
-        Element mass matrices. [kg]
-
-    Notes
-    -----
-    Consistent mass m l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ I (seed 001 eq. 3.1.12, whose
-    C_L·ρA/λ_C is m·l0).  Lumped mass m l0 [[1/2, 0], [0, 1/2]] ⊗ I.
-    """
-    l0 = float_array("l0", l0, "m", positive=True)
-    mass = float_array("mass", mass, "kg/m", nonnegative=True)
-    dim = _check_dim(dim)
-    block = (l0 * mass)[:, None, None] * np.eye(dim)[None]
-    return _expand(block, _LUMPED if lumped else _CONSISTENT)
-
-
-def element_added_mass(
-    tangents: np.ndarray,
-    l0: np.ndarray,
-    ca_normal: np.ndarray,
-    diameter: np.ndarray,
-    rho: float,
-    lumped: bool = False,
-) -> np.ndarray:
-    """Normal added-mass matrices of 2-node cable elements.
-
-    Parameters
-    ----------
-    tangents : array_like, shape (n_el, d)
-        Unit vector along each element, d = 2 or 3. [-]
-    l0 : array_like, shape (n_el,)
-        Unstretched element length. [m]
-    ca_normal : array_like, shape (n_el,)
-        Normal added-mass coefficient. [-]
-    diameter : array_like, shape (n_el,)
-        Hydrodynamic diameter. [m]
-    rho : float
-        Water density. [kg/m³]
-    lumped : bool
-        Lumped instead of consistent distribution.
-
-    Returns
-    -------
-    ndarray, shape (n_el, 2d, 2d)
-        Element added-mass matrices. [kg]
-
-    Notes
-    -----
-    Per unit length Can ρ πD²/4 (I − e eᵀ) (seed 001 eq. 3.2.a.2, the −(C_M − 1) ü_N
-    term; DESIGN.md "Cable model"), distributed like the structural mass (consistent
-    [[1/3, 1/6], [1/6, 1/3]] or lumped) over the unstretched length, as the mass per
-    length is.  No tangential added mass.
-    """
-    e = float_array("tangents", tangents, "-", ndim=2)
-    n, d = e.shape
-    l0 = float_array("l0", l0, "m", positive=True)
-    ca = float_array("ca_normal", ca_normal, "-", nonnegative=True)
-    dia = float_array("diameter", diameter, "m", nonnegative=True)
-    rho = positive("rho", rho, "kg/m³")
-    for name, arr in (("l0", l0), ("ca_normal", ca), ("diameter", dia)):
-        if arr.shape != (n,):
-            raise InputError(name, arr.shape, "-", f"must have one value per element ({n})")
-    return _added_mass_elements(e, l0, ca, dia, rho, lumped)
-
-
-def _added_mass_elements(e, l0, ca, dia, rho, lumped):
-    d = e.shape[1]
-    ma = ca * rho * np.pi * dia**2 / 4.0 * l0
-    block = ma[:, None, None] * (np.eye(d)[None] - e[:, :, None] * e[:, None, :])
-    return _expand(block, _LUMPED if lumped else _CONSISTENT)
-
-
-def _check_dim(dim: Any) -> int:
-    if isinstance(dim, bool) or dim not in (2, 3):
-        raise InputError("dim", dim, "-", "must be 2 (in-plane x–z) or 3")
-    return int(dim)
 
 
 # ---------------------------------------------------------------------- the model
@@ -460,7 +284,7 @@ def _assemble_sparse(blocks: np.ndarray, dofs: np.ndarray, n_dof: int,
 
 @functools.lru_cache(maxsize=64)
 def _chain_pattern(n: int, d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """CSR pattern of :func:`_chain_csr` for n nodes of d DOFs (the same for K, M and
+    """CSR pattern of :func:`chain_csr` for n nodes of d DOFs (the same for K, M and
     Ma and for every model of that size; read-only, cached): the flat positions of the
     kept entries in the (node, row comp, side, comp) array, the column indices and the
     row pointers (int64)."""
@@ -478,7 +302,7 @@ def _chain_pattern(n: int, d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return out
 
 
-def _chain_csr(blocks: np.ndarray, n_nodes: int, dim: int,
+def chain_csr(blocks: np.ndarray, n_nodes: int, dim: int,
                diag: np.ndarray | None = None) -> sp.csr_array:
     """Canonical CSR of element matrices (n_el, 2d, 2d) on consecutive nodes (element j
     joins nodes j and j + 1, node-major DOFs), plus a diagonal (n_dof,).
@@ -556,7 +380,7 @@ def assemble(
     :func:`element_added_mass`; attachment masses and added masses (isotropic) are
     lumped on their nodes.  Seabed: see :class:`FEModel`.
     """
-    dim = _check_dim(dim)
+    dim = check_dim(dim)
     if mass_matrix not in ("consistent", "lumped"):
         raise InputError("mass_matrix", mass_matrix, "-", "must be 'consistent' or 'lumped'")
     rho = positive("rho", rho, "kg/m³")
@@ -602,10 +426,10 @@ def assemble(
     lumped = mass_matrix == "lumped"
     n_dof = dim * n_nodes
 
-    k_el = _expand(_stiffness_blocks(e, l, mesh.l0, mesh.ea, ten), _STIFF_PATTERN)
-    m_el = _expand((mesh.l0 * mesh.mass)[:, None, None] * np.eye(dim)[None],
-                   _LUMPED if lumped else _CONSISTENT)
-    ma_el = _added_mass_elements(e, mesh.l0, mesh.ca_normal, mesh.diameter, rho, lumped)
+    k_el = expand_blocks(stiffness_blocks(e, l, mesh.l0, mesh.ea, ten), STIFFNESS_PATTERN)
+    m_el = expand_blocks((mesh.l0 * mesh.mass)[:, None, None] * np.eye(dim)[None],
+                   LUMPED_PATTERN if lumped else CONSISTENT_PATTERN)
+    ma_el = added_mass_elements(e, mesh.l0, mesh.ca_normal, mesh.diameter, rho, lumped)
 
     # Seabed: vertical springs/dashpots on grounded nodes, tributary D·l0/2 per element.
     trib = np.zeros(n_nodes)
@@ -621,9 +445,9 @@ def assemble(
     m_diag = np.repeat(mesh.node_mass, dim)
     ma_diag = np.repeat(mesh.node_added_mass, dim)
 
-    K = _chain_csr(k_el, n_nodes, dim, k_diag)
-    M = _chain_csr(m_el, n_nodes, dim, m_diag)
-    Ma = _chain_csr(ma_el, n_nodes, dim, ma_diag)
+    K = chain_csr(k_el, n_nodes, dim, k_diag)
+    M = chain_csr(m_el, n_nodes, dim, m_diag)
+    Ma = chain_csr(ma_el, n_nodes, dim, ma_diag)
     if c_diag.any():  # the nonzero diagonal entries only (as sp.diags_array gave)
         nz = c_diag != 0.0
         Cs = sp.csr_array((c_diag[nz], np.flatnonzero(nz).astype(np.int32),
@@ -668,7 +492,7 @@ def build_fe_model(
     Parameters
     ----------
     line_statics : LineStatics
-        One line of :func:`stochcable.line.statics.solve_statics`: ``mesh``, ``positions``
+        One line of :func:`stochcable.statics.solve_statics`: ``mesh``, ``positions``
         (n_nodes, 3), ``tension`` (n_el,) effective tension, ``grounded`` (n_nodes,).
     environment : Environment
         Water density and seabed contact model.
@@ -703,39 +527,3 @@ def build_fe_model(
         fixed_nodes=(0, -1),
         mass_matrix=mass_matrix,
     )
-
-
-def scene_fe_models(
-    scene: Any,
-    dim: int | None = None,
-    mass_matrix: Literal["consistent", "lumped"] = "consistent",
-) -> dict[str, FEModel]:
-    """Solve the statics of a scene and build the model of every line.
-
-    Parameters
-    ----------
-    scene : Scene, mapping, JSON string or path
-        The scene document (:func:`stochcable.scene.model.load_scene`).
-    dim : {2, 3}, optional
-        Model dimension; when None, 2 if ``scene.is_planar`` else 3.
-    mass_matrix : {"consistent", "lumped"}
-        Mass distribution.
-
-    Returns
-    -------
-    dict of str to FEModel
-        Per line name, in scene order.
-    """
-    from stochcable.scene.model import load_scene
-    from stochcable.line.statics import solve_statics  # lazy: the statics solver is a heavier import
-
-    sc = load_scene(scene)
-    if dim is None:
-        dim = 2 if sc.is_planar else 3
-    dim = _check_dim(dim)
-    statics = solve_statics(sc)
-    return {
-        line.name: build_fe_model(statics.lines[line.name], sc.environment, dim=dim,
-                                  mass_matrix=mass_matrix)
-        for line in sc.lines
-    }

@@ -36,9 +36,9 @@ import scipy.sparse.linalg as spla
 
 from stochcable.validation import positive_int
 from stochcable.errors import InputError, SolverError
-from stochcable.line.fem import FEModel, scene_fe_models
+from stochcable.line.fem import FEModel
 
-__all__ = ["DENSE_MAX_DOF", "Modes", "natural_modes", "modes_of_scene", "plane_normal"]
+__all__ = ["DENSE_MAX_DOF", "Modes", "natural_modes", "plane_normal"]
 
 #: Largest free-DOF block solved densely by ``method="auto"`` (benchmarks/bench_modes.py:
 #: dense eigh wins below ~250 DOFs for 30 modes on 2 cores).
@@ -388,60 +388,12 @@ def natural_modes(
                    [-normal[0], normal[1], 0.0],
                    [0.0, 0.0, 1.0]]) if d == 3 else None  # columns: local x, y (= normal), z
     rotate = d == 3 and not planar_frame
-    rot = None
-    if dense:
-        # every block is solved densely: dense free–free matrices from the start (the
-        # same numbers as the sparse slices' toarray()), rotated by node blocks in
-        # _rotate_dense (the same sums as the sparse R^T A R); no sparse slicing,
-        # Kronecker product or sparse products (≈ 2 ms per 40-element 3-D line)
-        a = _dense_free(model, model.K)
-        b = _dense_free(model, mt)
-        method = "dense"
-        if rotate:
-            a = _rotate_dense(a, rz)
-            b = _rotate_dense(b, rz)
-    else:
-        a = model._free_free(model.K)
-        b = model._free_free(mt)
-        if rotate:
-            # Rotate about z so that the line's vertical plane is the local x–z plane:
-            # a planar line's out-of-plane DOFs then decouple exactly from the in-plane
-            # ones.
-            rot = sp.csr_array(sp.kron(sp.eye_array(n_free // 3), rz, format="csr"))
-            a = (rot.T @ a @ rot).tocsr()
-            b = (rot.T @ b @ rot).tocsr()
-    comp_of_free = np.arange(n_free) % d
-    lams, vecs, idxs, used = [], [], [], []
-    for group in _component_groups(d, a, b):
-        in_group = np.zeros(d, dtype=bool)
-        in_group[group] = True
-        sel = np.flatnonzero(in_group[comp_of_free])
-        if sel.size == n_free:  # one coupled group: no slicing
-            ag, bg = a, b
-        elif not sp.issparse(a):
-            ag, bg = a[np.ix_(sel, sel)], b[np.ix_(sel, sel)]
-        else:
-            ag = a[sel][:, sel].tocsr()
-            bg = b[sel][:, sel].tocsr()
-        k = min(k_req, sel.size)
-        u = 2 * len(group) - 1
-        lam, vec, m = _solve_block(ag, bg, k, method, u)
-        lams.append(lam)
-        vecs.append(vec)
-        idxs.append(sel)
-        used.append(m)
-
+    a, b, rot, method = _free_matrices(model, mt, dense, method, rz if rotate else None)
+    lams, vecs, idxs, used = _solve_groups(a, b, d, k_req, method)
     lam_all = np.concatenate(lams)
     order = np.argsort(lam_all, kind="stable")[: min(k_req, n_free)]
     k = order.size
-    local = np.zeros((n_free, k))
-    starts = np.cumsum([0] + [v.shape[1] for v in vecs])
-    rank = np.full(lam_all.size, -1)
-    rank[order] = np.arange(k)  # output column of each group eigenvector (-1: dropped)
-    for g, vec in enumerate(vecs):  # one block copy per group (not per column)
-        r = rank[starts[g]:starts[g + 1]]
-        kept = np.flatnonzero(r >= 0)
-        local[np.ix_(idxs[g], r[kept])] = vec[:, kept]
+    local = _group_columns(vecs, idxs, lam_all, order, n_free)
     shapes = np.zeros((model.n_dof, k))
     if rotate:
         local = _unrotate_dense(local, rz) if rot is None else rot @ local
@@ -476,6 +428,79 @@ def natural_modes(
     )
 
 
+def _free_matrices(model: FEModel, mt: Any, dense: bool, method: str, rz: Any
+                   ) -> tuple[Any, Any, Any, str]:
+    """K_ff and M_T,ff, dense or sparse, rotated about z by ``rz`` (3-D lines off the
+    x–z plane; None: not rotated) so that the line's vertical plane is the local x–z
+    plane: a planar line's out-of-plane DOFs then decouple exactly from the in-plane
+    ones.  Returns (a, b, the sparse rotation or None, the method)."""
+    rot = None
+    if dense:
+        # every block is solved densely: dense free–free matrices from the start (the
+        # same numbers as the sparse slices' toarray()), rotated by node blocks in
+        # _rotate_dense (the same sums as the sparse R^T A R); no sparse slicing,
+        # Kronecker product or sparse products (≈ 2 ms per 40-element 3-D line)
+        a = _dense_free(model, model.K)
+        b = _dense_free(model, mt)
+        method = "dense"
+        if rz is not None:
+            a = _rotate_dense(a, rz)
+            b = _rotate_dense(b, rz)
+    else:
+        a = model._free_free(model.K)
+        b = model._free_free(mt)
+        if rz is not None:
+            rot = sp.csr_array(sp.kron(sp.eye_array(model.free.size // 3), rz, format="csr"))
+            a = (rot.T @ a @ rot).tocsr()
+            b = (rot.T @ b @ rot).tocsr()
+    return a, b, rot, method
+
+
+def _solve_groups(a: Any, b: Any, d: int, k_req: int, method: str
+                  ) -> tuple[list, list, list, list]:
+    """The lowest ``k_req`` eigenpairs of every group of coupled components
+    (:func:`_component_groups`): eigenvalues, vectors, their free-DOF indices and the
+    solver used, per group."""
+    n_free = a.shape[0]
+    comp_of_free = np.arange(n_free) % d
+    lams, vecs, idxs, used = [], [], [], []
+    for group in _component_groups(d, a, b):
+        in_group = np.zeros(d, dtype=bool)
+        in_group[group] = True
+        sel = np.flatnonzero(in_group[comp_of_free])
+        if sel.size == n_free:  # one coupled group: no slicing
+            ag, bg = a, b
+        elif not sp.issparse(a):
+            ag, bg = a[np.ix_(sel, sel)], b[np.ix_(sel, sel)]
+        else:
+            ag = a[sel][:, sel].tocsr()
+            bg = b[sel][:, sel].tocsr()
+        k = min(k_req, sel.size)
+        u = 2 * len(group) - 1
+        lam, vec, m = _solve_block(ag, bg, k, method, u)
+        lams.append(lam)
+        vecs.append(vec)
+        idxs.append(sel)
+        used.append(m)
+    return lams, vecs, idxs, used
+
+
+def _group_columns(vecs: list, idxs: list, lam_all: np.ndarray, order: np.ndarray,
+                   n_free: int) -> np.ndarray:
+    """The kept group eigenvectors as columns (n_free, k) in the order ``order`` of
+    the concatenated eigenvalues: one block copy per group (not per column)."""
+    k = order.size
+    local = np.zeros((n_free, k))
+    starts = np.cumsum([0] + [v.shape[1] for v in vecs])
+    rank = np.full(lam_all.size, -1)
+    rank[order] = np.arange(k)  # output column of each group eigenvector (-1: dropped)
+    for g, vec in enumerate(vecs):
+        r = rank[starts[g]:starts[g + 1]]
+        kept = np.flatnonzero(r >= 0)
+        local[np.ix_(idxs[g], r[kept])] = vec[:, kept]
+    return local
+
+
 def _out_of_plane_fraction(model: FEModel, mt: Any, shapes: np.ndarray,
                            normal: np.ndarray) -> np.ndarray:
     if model.dim == 2:
@@ -489,35 +514,3 @@ def _out_of_plane_fraction(model: FEModel, mt: Any, shapes: np.ndarray,
     ep = np.einsum("ij,ij->j", pp, mt @ pp)
     tot = en + ep
     return np.where(tot > 0, en / np.where(tot > 0, tot, 1.0), 0.0)
-
-
-def modes_of_scene(
-    scene: Any,
-    count: int | None = None,
-    dim: int = 3,
-    added_mass: bool = True,
-) -> dict[str, Modes]:
-    """Natural modes of every line of a scene about its static equilibrium.
-
-    Parameters
-    ----------
-    scene : Scene, mapping, JSON string or path
-        The scene document (:func:`stochcable.scene.model.load_scene`).
-    count : int, optional
-        Modes per line; default all.
-    dim : {2, 3}
-        3 (default) lists in-plane and out-of-plane modes, classified; 2 keeps the
-        in-plane modes of lines in the x–z plane only.
-    added_mass : bool
-        Modes in water (with added mass) or in air.
-
-    Returns
-    -------
-    dict of str to Modes
-        Per line name, in scene order.
-    """
-    if count is not None:
-        count = positive_int("count", count)
-    models = scene_fe_models(scene, dim=dim)
-    return {name: natural_modes(model, count=count, added_mass=added_mass)
-            for name, model in models.items()}

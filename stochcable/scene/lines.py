@@ -1,0 +1,211 @@
+"""Lines of the scene: ends (fixed, moving or attached to a body), segments and
+attachments (clump weights, buoys)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from stochcable.scene.base import _Doc, _f
+from stochcable.scene.spectra import Spectrum
+
+__all__ = ["ComplexTable", "MotionRao", "EndMotion", "BodyAttachment", "End", "Segment",
+           "Attachment", "Line", "check_span"]
+
+
+class ComplexTable(_Doc):
+    """Complex values as separate real and imaginary parts."""
+
+    re: tuple[float, ...]
+    im: tuple[float, ...]
+
+    @model_validator(mode="after")
+    def _same_length(self) -> "ComplexTable":
+        if len(self.re) != len(self.im):
+            raise ValueError(f"re ({len(self.re)}) and im ({len(self.im)}) differ in length")
+        return self
+
+    def values(self) -> np.ndarray:
+        """The complex values."""
+        return np.asarray(self.re) + 1j * np.asarray(self.im)
+
+
+class MotionRao(_Doc):
+    """End motion RAOs relative to the sea: metres of motion per metre of wave amplitude."""
+
+    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s",
+                                  min_length=2)
+    surge: ComplexTable | None = None
+    sway: ComplexTable | None = None
+    heave: ComplexTable | None = None
+
+    @model_validator(mode="after")
+    def _check(self) -> "MotionRao":
+        w = np.asarray(self.omega)
+        if w[0] < 0 or (np.diff(w) <= 0).any():
+            raise ValueError("omega must be >= 0 and strictly increasing")
+        given = {k: getattr(self, k) for k in ("surge", "sway", "heave")}
+        if all(v is None for v in given.values()):
+            raise ValueError("give at least one of surge, sway, heave")
+        for k, v in given.items():
+            if v is not None and len(v.re) != len(self.omega):
+                raise ValueError(
+                    f"{k} has {len(v.re)} values but omega has {len(self.omega)}"
+                )
+        return self
+
+    def transfer(self, omega: np.ndarray) -> np.ndarray:
+        """Motion per unit wave amplitude at ``omega``, shape (3, n), zero outside the table."""
+        omega = np.asarray(omega, dtype=float)
+        out = np.zeros((3, omega.size), dtype=complex)
+        w = np.asarray(self.omega)
+        for i, k in enumerate(("surge", "sway", "heave")):
+            t = getattr(self, k)
+            if t is None:
+                continue
+            v = t.values()
+            out[i] = np.interp(omega, w, v.real, 0.0, 0.0) + 1j * np.interp(
+                omega, w, v.imag, 0.0, 0.0
+            )
+        return out
+
+
+class EndMotion(_Doc):
+    """Prescribed motion of a line end.
+
+    Either independent motion spectra per translational DOF (``surge``, ``sway``,
+    ``heave``: spectrum documents in metres) or an RAO table relative to the sea
+    (``rao``), not both.
+    """
+
+    surge: Spectrum | None = None
+    sway: Spectrum | None = None
+    heave: Spectrum | None = None
+    rao: MotionRao | None = None
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> "EndMotion":
+        spectra_given = any(getattr(self, k) is not None for k in ("surge", "sway", "heave"))
+        if spectra_given and self.rao is not None:
+            raise ValueError("give motion spectra (surge/sway/heave) or rao, not both")
+        if not spectra_given and self.rao is None:
+            raise ValueError("give at least one of surge, sway, heave or rao")
+        return self
+
+
+class BodyAttachment(_Doc):
+    """Where a line end is fixed to a body (the end follows the body's rigid motion)."""
+
+    body: str = Field(min_length=1, max_length=64, description="Name of the body")
+    point: tuple[float, float, float] = _f(
+        "Attachment point relative to the body reference point, global axes, at the "
+        "static pose", "m", default=(0.0, 0.0, 0.0))
+
+
+class End(_Doc):
+    """A line end: fixed at ``position`` unless a ``motion`` is prescribed about it, or
+    attached to a body (``attach``), which then carries it (seed 001 eqs. 3.3.6–3.3.7)."""
+
+    position: tuple[float, float, float] | None = _f("Position (x, y, z), z up", "m",
+                                                     default=None)
+    motion: EndMotion | None = None
+    attach: BodyAttachment | None = None
+
+    @model_validator(mode="after")
+    def _position_or_attach(self) -> "End":
+        if self.attach is None and self.position is None:
+            raise ValueError("give the end's position or attach it to a body")
+        if self.attach is not None and self.position is not None:
+            raise ValueError("give position or attach, not both (an attached end's "
+                             "position is the body position plus attach.point)")
+        if self.attach is not None and self.motion is not None:
+            raise ValueError("an end attached to a body cannot have a motion: the body "
+                             "moves it (give the body a 'prescribed' motion instead)")
+        return self
+
+
+class Segment(_Doc):
+    """A homogeneous stretch of line."""
+
+    length: float = _f("Unstretched length", "m", gt=0)
+    ea: float = _f("Axial stiffness EA", "N", gt=0)
+    mass: float = _f("Mass per unit length in air", "kg/m", gt=0)
+    diameter: float = _f("Hydrodynamic (volume-equivalent) diameter", "m", gt=0)
+    cd_normal: float = _f("Normal drag coefficient, on the diameter", "-", ge=0, default=1.2)
+    cd_axial: float = _f("Axial drag coefficient, on pi·diameter (as MoorDyn's CdAx)", "-",
+                         ge=0, default=0.0)
+    ca_normal: float = _f("Normal added-mass coefficient", "-", ge=0, default=1.0)
+    weight: float | None = _f(
+        "Net submerged weight per unit length, overriding (mass - rho·pi·D²/4)·g; "
+        "negative for buoyant line", "N/m", default=None,
+    )
+    elements: int = _f("Number of finite elements", "-", ge=1, le=100_000, default=20)
+
+    def submerged_weight(self, rho: float, g: float) -> float:
+        """Net weight per unit length in water. [N/m]"""
+        if self.weight is not None:
+            return self.weight
+        return (self.mass - rho * math.pi * self.diameter**2 / 4.0) * g
+
+
+class Attachment(_Doc):
+    """A point mass (clump weight) and/or buoy at an arc length of the line."""
+
+    at: float = _f("Unstretched arc length from end_a", "m", ge=0)
+    mass: float = _f("Mass in air", "kg", ge=0, default=0.0)
+    buoyancy: float = _f("Upward buoyancy force (weight of displaced water)", "N", ge=0,
+                         default=0.0)
+    added_mass: float = _f("Added mass, all directions", "kg", ge=0, default=0.0)
+    drag_area: float = _f("Drag coefficient times projected area, Cd·A", "m²", ge=0,
+                          default=0.0)
+
+
+class Line(_Doc):
+    """A line from end_a (the anchor or lower end) to end_b, of one or more segments."""
+
+    name: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.\-]+$",
+                      description="Unique line name (letters, digits, _ . -)")
+    end_a: End
+    end_b: End
+    segments: tuple[Segment, ...] = Field(min_length=1, max_length=1000)
+    attachments: tuple[Attachment, ...] = Field(default=(), max_length=10_000)
+
+    @property
+    def length(self) -> float:
+        """Total unstretched length. [m]"""
+        return float(sum(s.length for s in self.segments))
+
+    @property
+    def elements(self) -> int:
+        """Total number of finite elements."""
+        return int(sum(s.elements for s in self.segments))
+
+    @model_validator(mode="after")
+    def _check_line(self) -> "Line":
+        total = self.length
+        for i, a in enumerate(self.attachments):
+            if a.at > total * (1 + 1e-12):
+                raise ValueError(
+                    f"attachments[{i}].at = {a.at} m is beyond the line length {total} m"
+                )
+        if self.end_a.position is not None and self.end_b.position is not None:
+            # attached ends: checked by Scene._check_scene with the body positions
+            check_span(self.end_a.position, self.end_b.position, total)
+        return self
+
+
+def check_span(a: Sequence[float], b: Sequence[float], total: float) -> None:
+    span = math.dist(a, b)
+    if span == 0.0:
+        raise ValueError("end_a and end_b are at the same position")
+    # Strain needed to reach the span if the line were straight: a line that must
+    # stretch more than 10 % is a data error (EA or length in the wrong unit).
+    strain = span / total - 1.0
+    if strain > 0.1:
+        raise ValueError(
+            f"the line ({total:g} m unstretched) is shorter than its span "
+            f"({span:g} m): it would have to stretch {strain:.1%} (> 10 %)"
+        )
