@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from speed_vs_error import base_document, quantities_fd  # noqa: E402
 
-from stochcable.dynamics.line import analyze  # noqa: E402
+from stochcable.analysis import analyze  # noqa: E402
 from stochcable.fidelity.planner import apply_fidelity, choose_fidelity  # noqa: E402
 from stochcable.line.mesh import mesh_line  # noqa: E402
 from stochcable.scene.model import load_scene  # noqa: E402

@@ -37,7 +37,10 @@ import warnings
 from typing import Any
 
 from _host import host_line
-from stochcable.dynamics.line import analyze, build_line_system, line_result, linearize
+from stochcable.analysis import analyze
+from stochcable.dynamics.fixedpoint import linearize
+from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.system import build_line_system
 from stochcable.runtime import single_blas_thread
 import numpy as np
 

@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.scene.model import load_scene
 from stochcable.line.statics import solve_statics
 
@@ -244,7 +244,7 @@ def main() -> None:
         # wrapped; MoorPy lumps the mass, stochcable's default is consistent
         import functools
 
-        from stochcable.dynamics import line as analysis
+        from stochcable.dynamics import system as analysis
 
         original = analysis.build_fe_model
         analysis.build_fe_model = functools.partial(original, mass_matrix="lumped")

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.dynamics import line as an
+from stochcable.dynamics import system as dsystem
+from stochcable.dynamics import variance as dvariance
 from stochcable.errors import InputError
 from stochcable.dynamics.loads import (
     drag_matrix,
@@ -51,7 +52,7 @@ def straight_doc(*, sea=True, motion=None, heading=20.0, attachments=()):
 def built(doc):
     scene = load_scene(doc)
     st = solve_statics(scene).lines["l"]
-    system = an.build_line_system(scene, scene.lines[0], st)
+    system = dsystem.build_line_system(scene, scene.lines[0], st)
     return scene, system
 
 
@@ -157,7 +158,7 @@ def test_sigma_of_line_at_rest_is_element_mean_of_fluid_velocity_sigma():
     scene, system = built(straight_doc())
     w = np.linspace(0.3, 1.8, 31)
     chans = line_channels(scene, scene.lines[0], system.positions, w)
-    sig = an.relative_velocity_sigmas(system, chans, None, "seed")
+    sig = dvariance.relative_velocity_sigmas(system, chans, None, "seed")
     n = system.model.n_elements
     pos = system.positions
     xg, wg = np.polynomial.legendre.leggauss(12)

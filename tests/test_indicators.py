@@ -14,12 +14,10 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from stochcable.dynamics.line import (
-    analyze,
-    build_line_system,
-    line_indicators,
-    linearize,
-)
+from stochcable.analysis import analyze
+from stochcable.dynamics.fixedpoint import linearize
+from stochcable.dynamics.indicators import line_indicators
+from stochcable.dynamics.system import build_line_system
 from stochcable.errors import InputError, PhysicsWarning
 from stochcable.dynamics.loads import line_channels
 from stochcable.dynamics.linearization import borgman_variance_ratio, drag_inertia_ratio

@@ -98,7 +98,7 @@ def drag_linear_seed(
     return _out(_SQRT_8_OVER_PI * 0.5 * rho_ * cd_ * d_ * s_)
 
 
-def _mean_abs_gaussian(sigma: np.ndarray, mean: np.ndarray) -> np.ndarray:
+def mean_abs_gaussian(sigma: np.ndarray, mean: np.ndarray) -> np.ndarray:
     """E|v| for v ~ N(mean, sigma^2); sigma >= 0, handles sigma = 0 exactly."""
     sigma, mean = np.broadcast_arrays(sigma, mean)
     if not mean.any():
@@ -159,7 +159,7 @@ def drag_linear_current(
     d_ = _nonneg_array("diameter", diameter, "m")
     s_ = _nonneg_array("sigma", sigma, "m/s")
     u_ = _finite_array("mean", mean, "m/s")
-    return _out(rho_ * cd_ * d_ * _mean_abs_gaussian(s_, u_))
+    return _out(rho_ * cd_ * d_ * mean_abs_gaussian(s_, u_))
 
 
 def mean_drag_gaussian(
@@ -545,7 +545,7 @@ def drag_inertia_ratio(
     sv = _nonneg_array("sigma_velocity", sigma_velocity, "m/s")
     sa = _nonneg_array("sigma_acceleration", sigma_acceleration, "m/s^2")
     u_ = _finite_array("mean", mean, "m/s")
-    drag = rho_ * cd_ * d_ * _mean_abs_gaussian(sv, u_) * sv
+    drag = rho_ * cd_ * d_ * mean_abs_gaussian(sv, u_) * sv
     inertia = rho_ * cm_ * math.pi * d_**2 / 4.0 * sa
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(inertia > 0, drag / np.where(inertia > 0, inertia, 1.0),

@@ -749,7 +749,7 @@ def inertia_matrix(model: Any, g: float) -> sp.csr_array:
     Per unit length ρ(πD²/4)(1 + Can)(I − eeᵀ) (seed 001 eq. 5.2.1, the B_I C_M term,
     C_M = 1 + Can); per attachment (buoyancy/g + added mass)·I.
     """
-    blocks, node = _inertia_blocks(model, g)
+    blocks, node = inertia_blocks(model, g)
     return _assemble(model, blocks, node)
 
 
@@ -787,7 +787,7 @@ def drag_matrix(
     return _assemble(model, _drag_blocks3(model, b_normal, b_axial), b_node)
 
 
-def _inertia_blocks(model: Any, g: float, e: np.ndarray | None = None
+def inertia_blocks(model: Any, g: float, e: np.ndarray | None = None
                     ) -> tuple[np.ndarray, np.ndarray]:
     """Morison inertia per unit length (n_el, 3, 3) and per attachment node (n_nodes,);
     ``e`` the element tangents when already at hand (:func:`element_frames`)."""
@@ -853,7 +853,7 @@ def wave_loads(
     """
     n_omega = channels[0].omega.size if channels else 0
     out = np.zeros((n_omega, model.n_dof, len(channels)), dtype=complex)
-    inertia, node_mass = _inertia_blocks(model, g)
+    inertia, node_mass = inertia_blocks(model, g)
     drag = _drag_blocks3(model, b_normal, b_axial)
     bnode = np.zeros(model.n_nodes) if b_node is None else np.asarray(b_node, dtype=float)
     l0 = model.l0[:, None, None]
