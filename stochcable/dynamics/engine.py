@@ -206,7 +206,7 @@ def build_engine(
             timing["model_s"] += time.perf_counter() - t0
     timing["build_s"] = time.perf_counter() - t_start  # (in each result's total_s)
     return Engine(scene=scene, statics=statics, systems=systems, timing=timing,
-                  warnings=_messages((), caught))
+                  warnings=tuple(_messages((), caught)))
 
 
 def _with_sea(scene: Scene, sea: Sea | Mapping[str, Any] | None) -> Scene:
