@@ -294,14 +294,26 @@ def _coarse_start(
         return None, None
     if idx.size != base.size:
         sub = subset_inputs(system, channels, inp, idx)
+    fp = _coarse_fixed_point(system, sub, first, x_rest, lin, progress, timing)
+    if fp is None:
+        return None, None
+    return fp.x, CoarseStage(int(idx.size), fp.iterations, fp.history, fp.converged)
+
+
+def _coarse_fixed_point(system: LineSystem, sub: LineInputs, first: Damping,
+                        x_rest: np.ndarray, lin: Any, progress: Progress,
+                        timing: dict[str, float] | None) -> FixedPointResult | None:
+    """The fixed point on the subset inputs ``sub`` from the at-rest σ ``x_rest`` (whose
+    drag is ``first``) to ``COARSE_TOLERANCE_RATIO`` times the tolerance, unconverged
+    allowed; None when it breaks down (non-finite σ, a singular subset solve)."""
+    method = lin.method
     count = [0]
 
     def update(x: np.ndarray) -> np.ndarray:
         damping = first if x is x_rest else drag_coefficients(system, x, method)
         t0 = time.perf_counter()
         u_f, _ = solve_free(system, sub, damping, modal_direct=True)
-        if timing is not None:
-            timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
+        _add_time(timing, t0)
         new = sigmas_from_free(system, sub, u_f, method)
         count[0] += 1
         if progress is not noop_progress:  # (the change is for the callback only)
@@ -315,22 +327,20 @@ def _coarse_start(
         x0 = update(x_rest)  # unmixed first step, as on the full grid
         change0 = relative_change(x0, x_rest)
         if not np.all(np.isfinite(x0)):
-            return None, None
+            return None
         if change0 <= tol:
-            fp = FixedPointResult(x0, 1, change0, True, (change0,))
-        else:
-            fp = fixed_point(
-                update, x0, tol=tol, max_iterations=lin.max_iterations,
-                relaxation=lin.relaxation,
-                method="anderson" if lin.acceleration == "anderson" else "relaxed",
-                mixing=ANDERSON_MIXING, allow_unconverged=True,
-                name=f"coarse start of the drag linearization of line '{system.name}'",
-            )
-            fp = FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change,
-                                  fp.converged, (change0,) + fp.history)
+            return FixedPointResult(x0, 1, change0, True, (change0,))
+        fp = fixed_point(
+            update, x0, tol=tol, max_iterations=lin.max_iterations,
+            relaxation=lin.relaxation,
+            method="anderson" if lin.acceleration == "anderson" else "relaxed",
+            mixing=ANDERSON_MIXING, allow_unconverged=True,
+            name=f"coarse start of the drag linearization of line '{system.name}'",
+        )
     except (ConvergenceError, SolverError, np.linalg.LinAlgError):
-        return None, None  # non-finite σ or a singular subset solve
-    return fp.x, CoarseStage(int(idx.size), fp.iterations, fp.history, fp.converged)
+        return None  # non-finite σ or a singular subset solve
+    return FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
+                            (change0,) + fp.history)
 
 
 def linearize(
@@ -401,28 +411,8 @@ def linearize(
                          "the harmonic (regular-wave) form has no current term: use "
                          "'seed' or 'vector' with a current")
     inp = line_inputs(system, channels)
-    state: dict[str, Any] = {"it": 0, "change": np.inf}
-    cache: dict[str, Any] = {}
-
-    def update(x: np.ndarray) -> np.ndarray:
-        damping = drag_coefficients(system, x, method)
-        t0 = time.perf_counter()
-        u_f, c = solve_free(system, inp, damping)  # outputs only at the end
-        if timing is not None:
-            timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
-        new = sigmas_from_free(system, inp, u_f, method)
-        state["it"] += 1
-        change = relative_change(new, x)
-        state["change"] = change
-        progress("linearization", {"line": system.name, "iteration": state["it"],
-                                   "change": change})
-        cache["damping"], cache["sigma"] = damping, new
-        cache["solved"] = (u_f, c)
-        return new
-
+    step = _Step(system, inp, method, progress, timing)
     name = f"drag linearization of line '{system.name}'"
-    hint = ("increase analysis.linearization.max_iterations, lower relaxation, or set "
-            "allow_unconverged to get a flagged result")
     # Step 5: the at-rest (quasi-static) σ are a guess, not an iterate: their response
     # starts the iteration unmixed (one iteration fewer than relaxing toward the guess
     # on the chain, taut wire and 3-D benchmarks; same fixed point).  The coarse stage
@@ -431,34 +421,7 @@ def linearize(
                       if coarse else (None, None))
     if x_start is None:
         x_start = rest_sigmas(system, inp, method)
-    x0 = update(x_start)
-    change0 = state["change"]
-    if not np.all(np.isfinite(x0)):
-        raise ConvergenceError(name, 1, float("nan"), lin.tolerance,
-                               hint="the first response gave non-finite σ")
-    if change0 <= lin.tolerance or lin.max_iterations == 1:
-        fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance, (change0,))
-        if not fp.converged and not lin.allow_unconverged:
-            raise ConvergenceError(name, 1, change0, lin.tolerance, hint=hint, partial=fp)
-    else:
-        try:
-            fp = fixed_point(
-                update, x0, tol=lin.tolerance, max_iterations=lin.max_iterations - 1,
-                relaxation=lin.relaxation,
-                method="anderson" if lin.acceleration == "anderson" else "relaxed",
-                mixing=ANDERSON_MIXING, allow_unconverged=lin.allow_unconverged,
-                name=name,
-            )
-        except ConvergenceError as exc:
-            partial = exc.partial
-            if isinstance(partial, FixedPointResult):
-                partial = FixedPointResult(partial.x, partial.iterations + 1,
-                                           partial.relative_change, False,
-                                           (change0,) + partial.history)
-            raise ConvergenceError(name, exc.iterations + 1, exc.residual, exc.tolerance,
-                                   hint=hint, partial=partial) from None
-        fp = FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
-                              (change0,) + fp.history)
+    fp = _full_grid_fixed_point(step, step(x_start), lin, name)
     if not fp.converged:
         warn(
             f"{name} did not converge: relative change {fp.relative_change:.3e} after "
@@ -466,15 +429,85 @@ def linearize(
             "flagged unconverged (increase analysis.linearization.max_iterations)",
             PhysicsWarning, stacklevel=2,
         )
-    damping = cache["damping"]
     t0 = time.perf_counter()
-    # transfer functions of the recorded drag: the last update() solved with it
-    u_f, c = cache["solved"]
-    resp = line_response(system, inp, damping, (total_displacement(system, inp, u_f), c))
+    # transfer functions of the recorded drag: the last step solved with it
+    u_f, c = step.solved
+    resp = line_response(system, inp, step.damping,
+                         (total_displacement(system, inp, u_f), c))
+    _add_time(timing, t0)
+    record = linearization_record(system, step.sigma, step.damping, fp, lin.tolerance,
+                                  method)
+    return Linearization(damping=step.damping, record=record, response=resp, coarse=stage)
+
+
+def _add_time(timing: dict[str, float] | None, t0: float) -> None:
+    """Add the time since ``t0`` to ``timing["solve_s"]`` (when timing is kept)."""
     if timing is not None:
         timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
-    record = linearization_record(system, cache["sigma"], damping, fp, lin.tolerance, method)
-    return Linearization(damping=damping, record=record, response=resp, coarse=stage)
+
+
+class _Step:
+    """One full-grid step of the drag fixed point, σ -> drag -> response -> new σ,
+    keeping the last drag, σ and solve (the outputs reuse them: no extra solve)."""
+
+    def __init__(self, system: LineSystem, inp: LineInputs, method: str,
+                 progress: Progress, timing: dict[str, float] | None) -> None:
+        self.system, self.inp, self.method = system, inp, method
+        self.progress, self.timing = progress, timing
+        self.iterations = 0
+        self.change = np.inf
+        self.damping: Damping | None = None
+        self.sigma: np.ndarray | None = None
+        self.solved: tuple[np.ndarray, Any] | None = None
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        system = self.system
+        damping = drag_coefficients(system, x, self.method)
+        t0 = time.perf_counter()
+        u_f, c = solve_free(system, self.inp, damping)  # outputs only at the end
+        _add_time(self.timing, t0)
+        new = sigmas_from_free(system, self.inp, u_f, self.method)
+        self.iterations += 1
+        self.change = relative_change(new, x)
+        self.progress("linearization", {"line": system.name, "iteration": self.iterations,
+                                        "change": self.change})
+        self.damping, self.sigma, self.solved = damping, new, (u_f, c)
+        return new
+
+
+def _full_grid_fixed_point(step: _Step, x0: np.ndarray, lin: Any, name: str
+                           ) -> FixedPointResult:
+    """The fixed point from the first step's σ ``x0`` (its change in ``step.change``),
+    the first step counted in the iterations and the history."""
+    change0 = step.change
+    hint = ("increase analysis.linearization.max_iterations, lower relaxation, or set "
+            "allow_unconverged to get a flagged result")
+    if not np.all(np.isfinite(x0)):
+        raise ConvergenceError(name, 1, float("nan"), lin.tolerance,
+                               hint="the first response gave non-finite σ")
+    if change0 <= lin.tolerance or lin.max_iterations == 1:
+        fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance, (change0,))
+        if not fp.converged and not lin.allow_unconverged:
+            raise ConvergenceError(name, 1, change0, lin.tolerance, hint=hint, partial=fp)
+        return fp
+    try:
+        fp = fixed_point(
+            step, x0, tol=lin.tolerance, max_iterations=lin.max_iterations - 1,
+            relaxation=lin.relaxation,
+            method="anderson" if lin.acceleration == "anderson" else "relaxed",
+            mixing=ANDERSON_MIXING, allow_unconverged=lin.allow_unconverged,
+            name=name,
+        )
+    except ConvergenceError as exc:
+        partial = exc.partial
+        if isinstance(partial, FixedPointResult):
+            partial = FixedPointResult(partial.x, partial.iterations + 1,
+                                       partial.relative_change, False,
+                                       (change0,) + partial.history)
+        raise ConvergenceError(name, exc.iterations + 1, exc.residual, exc.tolerance,
+                               hint=hint, partial=partial) from None
+    return FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
+                            (change0,) + fp.history)
 
 
 def linearization_record(system: LineSystem, sigma: np.ndarray, damping: Damping, fp: Any,
