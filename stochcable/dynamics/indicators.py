@@ -28,6 +28,7 @@ from stochcable.dynamics.loads import (
     Channel,
     element_mean_square,
 )
+from stochcable.dynamics.variance import current_split
 from stochcable.dynamics.system import (
     Damping,
     Linearization,
@@ -288,20 +289,28 @@ def line_indicators(
     chord.  The diameter ratio is reported, not flagged (large motion over D means
     drag-dominated loading, the domain of the drag linearization).
     """
+    w = linearization.response.omega
+    borgman, d_i = _drag_ratios(system, channels, linearization.record, w)
+    snap_margin, snap = _snap(system, tension_std, end_stats)
+    resonances = _resonances(system, channels, linearization.damping, w)
+    m_max, sag, to_sag, to_d = _large_motion(system, motion_std)
+    flags = (["snap"] if snap else []) + (["resonance"] if resonances else []) + (
+        ["large_motion"] if to_sag > MOTION_SAG_FRACTION else [])
+    return LineIndicators(
+        borgman_ratio=borgman, drag_inertia_ratio=d_i, snap_margin=snap_margin,
+        snap_risk=snap, resonances=tuple(resonances), motion_std_max=m_max, sag=sag,
+        motion_to_sag=float(to_sag), motion_to_diameter=to_d, flags=tuple(flags),
+    )
+
+
+def _drag_ratios(system: LineSystem, channels: tuple[Channel, ...], rec: Any,
+                 w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Borgman variance ratio and drag/inertia ratio per element (:func:`line_indicators`
+    Notes). [-]"""
     model = system.model
     mesh = model.mesh
-    rec = linearization.record
-    name = system.name
-    flags: list[str] = []
-    if "current_split" not in system._cache:  # as drag_coefficients: once per line
-        e = system.frames[0]
-        uc = system.current_el
-        u_t = np.einsum("ij,ij->i", uc, e)
-        u_nvec = uc - u_t[:, None] * e
-        system._cache["current_split"] = (u_t, u_nvec, np.linalg.norm(u_nvec, axis=1))
-    u_n = system._cache["current_split"][2]
+    u_n = current_split(system)[2]
     borgman = np.atleast_1d(borgman_variance_ratio(rec.sigma_normal, u_n))
-    w = linearization.response.omega
     s_an = _normal_acceleration_sigma(system, channels, w)
     drag_sigma = rec.b_normal * rec.sigma_normal
     inertia_sigma = (model.rho * (1.0 + mesh.ca_normal) * math.pi * mesh.diameter**2 / 4.0
@@ -310,9 +319,15 @@ def line_indicators(
         d_i = np.where(inertia_sigma > 0, drag_sigma / np.where(inertia_sigma > 0,
                                                                  inertia_sigma, 1.0),
                        np.where(drag_sigma > 0, np.inf, 0.0))
-    # snap
-    st = system.statics
-    t_mean = np.asarray(st.tension, dtype=float)
+    return borgman, d_i
+
+
+def _snap(system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, Any]
+          ) -> tuple[float, bool]:
+    """Snap margin min (mean − 3σ)/|mean| over the elements and ends, and whether some
+    mean − 3σ < 0 (PhysicsWarning naming the worst place)."""
+    mesh = system.model.mesh
+    t_mean = np.asarray(system.statics.tension, dtype=float)
     means = np.concatenate([t_mean, [end_stats["end_a"].mean, end_stats["end_b"].mean]])
     sigmas = np.concatenate([tension_std, [end_stats["end_a"].std, end_stats["end_b"].std]])
     low = means - SNAP_SIGMAS * sigmas
@@ -320,24 +335,28 @@ def line_indicators(
         margins = np.where(np.abs(means) > 0, low / np.abs(np.where(means != 0, means, 1.0)),
                            np.where(low < 0, -np.inf, 0.0))
     k = int(np.argmin(margins))
-    snap_margin = float(margins[k])
     snap = bool(np.any(low < 0))
-    units = unit_labels(system.environment.g)
     if snap:
-        flags.append("snap")
+        units = unit_labels(system.environment.g)
         where = ("end_a" if k == t_mean.size else "end_b" if k == t_mean.size + 1
                  else f"element {k + 1} (s = {0.5 * (mesh.s0[k] + mesh.s0[k + 1]):.4g} "
                       f"{units.length})")
         warn(
-            f"line '{name}': the dynamic tension σ ({sigmas[k]:.4g} {units.force} at "
-            f"{where}) exceeds 1/{SNAP_SIGMAS:g} of the mean tension ({means[k]:.4g} "
+            f"line '{system.name}': the dynamic tension σ ({sigmas[k]:.4g} {units.force} "
+            f"at {where}) exceeds 1/{SNAP_SIGMAS:g} of the mean tension ({means[k]:.4g} "
             f"{units.force}): mean − {SNAP_SIGMAS:g}σ < 0, snap loads likely; the linear "
             "model is out of its depth (threshold mean − 3σ >= 0): use a nonlinear "
             "time-domain analysis "
             "(stochcable.reference.cable) or increase the pretension",
-            PhysicsWarning, stacklevel=3,
+            PhysicsWarning, stacklevel=4,
         )
-    # near-undamped resonance inside the excitation band
+    return float(margins[k]), snap
+
+
+def _resonances(system: LineSystem, channels: tuple[Channel, ...], damping: Damping,
+                w: np.ndarray) -> list[dict[str, Any]]:
+    """Modes inside the excitation band with a modal damping ratio below
+    ``RESONANCE_DAMPING_RATIO`` (PhysicsWarning naming the first)."""
     resonances: list[dict[str, Any]] = []
     wn = np.asarray(system.modes.omega)
     spectra = [c.spectrum for c in channels if np.any(c.spectrum > 0)]
@@ -346,24 +365,31 @@ def line_indicators(
         for spec in spectra:
             in_band = np.interp(wn, w, spec, left=0.0, right=0.0) >= BAND_FRACTION * spec.max()
             inside |= in_band
-        zeta = _modal_damping_ratios(system, linearization.damping)
+        zeta = _modal_damping_ratios(system, damping)
         for j in np.flatnonzero(inside & (zeta < RESONANCE_DAMPING_RATIO)):
             resonances.append({"mode": int(j + 1), "omega": float(wn[j]),
                                "damping_ratio": float(zeta[j])})
     if resonances:
-        flags.append("resonance")
         r0 = resonances[0]
         more = f" and {len(resonances) - 1} more" if len(resonances) > 1 else ""
         warn(
-            f"line '{name}': mode {r0['mode']} ({r0['omega']:.4g} rad/s){more} lies in the "
-            f"excitation band with modal damping ratio {r0['damping_ratio']:.2%} "
+            f"line '{system.name}': mode {r0['mode']} ({r0['omega']:.4g} rad/s){more} lies "
+            f"in the excitation band with modal damping ratio {r0['damping_ratio']:.2%} "
             f"(threshold {RESONANCE_DAMPING_RATIO:.0%}): a near-undamped resonance whose "
             "response is set by damping the model may not represent; check the drag "
             "coefficients and add structural damping (analysis.structural_damping) or "
             "seabed damping where physical",
-            PhysicsWarning, stacklevel=3,
+            PhysicsWarning, stacklevel=4,
         )
-    # large motions
+    return resonances
+
+
+def _large_motion(system: LineSystem, motion_std: np.ndarray
+                  ) -> tuple[float, float, float, float]:
+    """Largest node motion σ [m], the sag of the static shape [m] (largest distance
+    from the chord, once per line), and their ratio and the ratio to the diameter
+    (PhysicsWarning above ``MOTION_SAG_FRACTION`` of the sag)."""
+    model = system.model
     if "sag" not in system._cache:  # of the static shape: once per line
         pos = model.positions
         chord = pos[-1] - pos[0]
@@ -376,20 +402,16 @@ def line_indicators(
     m_std = np.linalg.norm(motion_std, axis=1)
     m_max = float(m_std.max()) if m_std.size else 0.0
     to_sag = m_max / sag if sag > 0 else (np.inf if m_max > 0 else 0.0)
-    to_d = m_max / float(np.max(mesh.diameter))
+    to_d = m_max / float(np.max(model.mesh.diameter))
     if to_sag > MOTION_SAG_FRACTION:
-        flags.append("large_motion")
+        units = unit_labels(system.environment.g)
         j = int(np.argmax(m_std))
         warn(
-            f"line '{name}': the motion σ at node {j + 1} ({m_max:.3g} {units.length}) "
-            f"is {to_sag:.2g} of the line's sag ({sag:.3g} {units.length}), above the "
-            f"threshold {MOTION_SAG_FRACTION:g}: the linearization about the static shape is "
-            "doubtful; check with a nonlinear time-domain analysis "
-            "(stochcable.reference.cable)",
-            PhysicsWarning, stacklevel=3,
+            f"line '{system.name}': the motion σ at node {j + 1} ({m_max:.3g} "
+            f"{units.length}) is {to_sag:.2g} of the line's sag ({sag:.3g} "
+            f"{units.length}), above the threshold {MOTION_SAG_FRACTION:g}: the "
+            "linearization about the static shape is doubtful; check with a nonlinear "
+            "time-domain analysis (stochcable.reference.cable)",
+            PhysicsWarning, stacklevel=4,
         )
-    return LineIndicators(
-        borgman_ratio=borgman, drag_inertia_ratio=d_i, snap_margin=snap_margin,
-        snap_risk=snap, resonances=tuple(resonances), motion_std_max=m_max, sag=sag,
-        motion_to_sag=float(to_sag), motion_to_diameter=to_d, flags=tuple(flags),
-    )
+    return m_max, sag, to_sag, to_d

@@ -60,6 +60,19 @@ def _drag_current(rho: float, cd: Any, diameter: Any, sigma: np.ndarray,
     return rho * np.asarray(cd, dtype=float) * diameter * mean_abs_gaussian(sigma, mean)
 
 
+def current_split(system: LineSystem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The current at the element midpoints split along the element: axial U·e
+    (n_el,), the normal vector U − (U·e)e (n_el, 3) and its magnitude (n_el,),
+    computed once per line (drag-independent). [m/s]"""
+    if "current_split" not in system._cache:
+        e = system.frames[0]
+        uc = system.current_el
+        u_t = np.einsum("ij,ij->i", uc, e)
+        u_nvec = uc - u_t[:, None] * e
+        system._cache["current_split"] = (u_t, u_nvec, np.linalg.norm(u_nvec, axis=1))
+    return system._cache["current_split"]
+
+
 def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Damping:
     """Linear drag of a line from the σ of its relative velocities.
 
@@ -92,12 +105,7 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
     rho = model.rho
     e, n1, n2 = system.frames
     parts = split_sigma(system, np.asarray(sigma, dtype=float), method)
-    if "current_split" not in system._cache:  # drag-independent: once per line
-        uc = system.current_el
-        u_t = np.einsum("ij,ij->i", uc, e)
-        u_nvec = uc - u_t[:, None] * e
-        system._cache["current_split"] = (u_t, u_nvec, np.linalg.norm(u_nvec, axis=1))
-    u_t, u_nvec, u_n = system._cache["current_split"]
+    u_t, u_nvec, u_n = current_split(system)
     d = mesh.diameter
     if method == "vector":
         s1, s2, s3 = parts["normal"]
