@@ -13,6 +13,8 @@ tensions are computed with the response (:mod:`stochcable.dynamics.solve`).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from stochcable.dynamics.blocks import (
@@ -97,15 +99,7 @@ def line_result(
     w = resp.omega
     n_ch = len(channels)
     spectra = np.stack([c.spectrum for c in channels]) if n_ch else np.zeros((0, w.size))
-    # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the frequency-major
-    # layout and transposing made every later pass strided)
-    u_h = np.transpose(resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch),
-                       (3, 1, 2, 0))
-    if tuple(model.components) == (0, 1, 2):  # 3-D: no zero components to embed
-        motion_h = np.ascontiguousarray(u_h)
-    else:
-        motion_h = np.zeros((n_ch, model.n_nodes, 3, w.size), dtype=resp.displacement.dtype)
-        motion_h[:, :, list(model.components)] = u_h
+    motion_h = _motion_transfer(model, resp, n_ch)
     tension_h = element_tension_transfer(system, resp)
     # σ² = Σ_c ∫|H_c|² S_c dω as one weighted reduction with the trapezoid weights q
     # (the response spectra are not kept; the same trapezoid rule as np.trapezoid up
@@ -127,13 +121,7 @@ def line_result(
     indicators = (None if linearization.record is None else
                   line_indicators(system, channels, linearization, tension_std, motion_std,
                                   stats))
-    comps = list(model.components)
-    d = model.dim
-    end_force = {}
-    for k, end in enumerate(("end_a", "end_b")):
-        f = np.zeros((n_ch, 3, w.size), dtype=complex)
-        f[:, comps, :] = np.transpose(resp.support_force[:, k * d:(k + 1) * d, :], (2, 1, 0))
-        end_force[end] = f
+    end_force = _end_force_transfer(model, resp, n_ch)
     return LineResult(
         name=system.name,
         omega=w,
@@ -160,3 +148,31 @@ def line_result(
         modes=system.modes,
         indicators=indicators,
     )
+
+
+def _motion_transfer(model: Any, resp: Response, n_ch: int) -> np.ndarray:
+    """Node motion transfer functions on x, y, z, (n_ch, n_nodes, 3, n_omega) (zero on
+    the components a 2-D model lacks). [m/unit]"""
+    w = resp.omega
+    # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the frequency-major
+    # layout and transposing made every later pass strided)
+    u_h = np.transpose(resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch),
+                       (3, 1, 2, 0))
+    if tuple(model.components) == (0, 1, 2):  # 3-D: no zero components to embed
+        return np.ascontiguousarray(u_h)
+    motion_h = np.zeros((n_ch, model.n_nodes, 3, w.size), dtype=resp.displacement.dtype)
+    motion_h[:, :, list(model.components)] = u_h
+    return motion_h
+
+
+def _end_force_transfer(model: Any, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
+    """Support force transfer functions on x, y, z per end, (n_ch, 3, n_omega). [N/unit]"""
+    comps = list(model.components)
+    d = model.dim
+    w = resp.omega
+    end_force = {}
+    for k, end in enumerate(("end_a", "end_b")):
+        f = np.zeros((n_ch, 3, w.size), dtype=complex)
+        f[:, comps, :] = np.transpose(resp.support_force[:, k * d:(k + 1) * d, :], (2, 1, 0))
+        end_force[end] = f
+    return end_force
