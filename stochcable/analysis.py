@@ -24,7 +24,7 @@ Choices (see the functions for details)
 - Drag damping and added mass distributed like the model mass (consistent by default),
   element direction constant per element (:mod:`stochcable.dynamics.loads`).
 - Wave loads (Morison inertia and linearized drag) integrated exactly along each
-  element's wet part (:func:`stochcable.dynamics.loads.element_wave_kinematics`), B
+  element's wet part (:func:`stochcable.dynamics.element_kinematics.element_wave_kinematics`), B
   constant per element.
 - The σ of the relative velocity of an element is its element mean square
   (:func:`stochcable.dynamics.variance.relative_velocity_sigmas`).

@@ -17,12 +17,12 @@ from stochcable.dynamics import blocks as dblocks
 from stochcable.dynamics import variance as dvariance
 from stochcable.errors import InputError, ResolutionWarning
 from stochcable.examples import load_example
+from stochcable.dynamics.element_kinematics import element_wave_kinematics
 from stochcable.dynamics.loads import (
     Channel,
     channel_loads,
     drag_matrix,
     element_frames,
-    element_wave_kinematics,
     inertia_matrix,
     line_channels,
     wave_loads,

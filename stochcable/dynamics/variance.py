@@ -187,7 +187,7 @@ def relative_velocity_sigmas(
     transfer function of the relative velocity v(ξ) − iωU(ξ) along the element, r
     the element's e (axial) or normals n1, n2; the scalar form uses
     σ_n² = σ_n1² + σ_n2².  The fluid part is integrated exactly
-    (:func:`stochcable.dynamics.loads.element_wave_kinematics`: the wet part only), the
+    (:func:`stochcable.dynamics.element_kinematics.element_wave_kinematics`: the wet part only), the
     structural displacement U(ξ) is the element's linear interpolation, so the
     ξ-integral is closed-form (:func:`_element_variance`).  The drag coefficient B is
     then constant over the element (eq. 5.2.2 with this σ).  Attachments: the nodal
