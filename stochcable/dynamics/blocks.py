@@ -21,10 +21,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from stochcable.dynamics.solvers import (
-    _band_from_blocks,
-    tridiagonal_blocks,
-)
+from stochcable.dynamics.solvers import band_from_blocks, tridiagonal_blocks
 from stochcable.dynamics.system import (
     LineSystem,
 )
@@ -151,7 +148,7 @@ def free_band(blk: NodeBlocks) -> np.ndarray:
     upper = np.zeros((n_f, d, d))
     lower[1:] = inner
     upper[:-1] = np.swapaxes(inner, 1, 2)
-    return _band_from_blocks((D[1:-1], lower, upper))
+    return band_from_blocks((D[1:-1], lower, upper))
 
 
 def block_matvec(blk: NodeBlocks, x: np.ndarray) -> np.ndarray:

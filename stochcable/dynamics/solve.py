@@ -39,13 +39,15 @@ from stochcable.dynamics.line_loads import (
 from stochcable.dynamics.loads import (
     Channel,
 )
+from stochcable.dynamics.modal_solvers import (
+    DefectivePencilWarning,
+    foss_modes,
+    foss_transfer_modal,
+)
 from stochcable.dynamics.solvers import (
     SINGULAR_CONDITION,
-    DefectivePencilWarning,
-    _foss_decomposition,
-    _foss_transfer_modal,
-    _singular_error,
-    _solve_band_stacked,
+    singular_error,
+    solve_band_stacked,
     solve_direct,
 )
 from stochcable.dynamics.system import (
@@ -80,7 +82,7 @@ def solve_free(system: "LineSystem", inp: LineInputs, damping: Damping, *,
     if system.solver == "direct":
         rhs_f = to_freq(rhs[1:-1])
         bC = prep.bS + free_band(cd)
-        u_f = _solve_band_stacked(prep.bK, prep.bM, bC, rhs_f, w, 2 * d - 1, 2 * d - 1,
+        u_f = solve_band_stacked(prep.bK, prep.bM, bC, rhs_f, w, 2 * d - 1, 2 * d - 1,
                                   (system.model.K, system.model.M))
         _check_line_conditioning(system, prep, bC, w, rhs_f, u_f)
         return np.ascontiguousarray(from_freq(u_f, d)), c
@@ -118,14 +120,14 @@ def _check_line_conditioning(system, prep, bC, w, f, u) -> None:
     if bad.size:
         k = int(bad[np.argmax(est[bad])])
         K, M = system.model.partition("K")[0], system.model.partition("MT")[0]
-        raise _singular_error(K, M, float(w[k]), float(est[k]))
+        raise singular_error(K, M, float(w[k]), float(est[k]))
 
 
 def _foss_free(system: "LineSystem", prep: LinePrep, c: NodeBlocks, rhs: np.ndarray,
                w: np.ndarray, modal_direct: bool = False) -> np.ndarray:
     """Foss modal solve on the free DOFs, rhs (n_free_dof, n_w, n_ch), with the static
     correction of the truncated modes (seed 001 §5.3;
-    :func:`stochcable.dynamics.solvers.foss_decomposition`).
+    :func:`stochcable.dynamics.modal_solvers.foss_decomposition`).
 
     ``modal_direct``: the modal equations (K̂ − ω²M̂ + iωĈ)z = Φᵀf solved per frequency
     (batched dense LU) instead of by the Foss eigenproblem: the same response to
@@ -142,12 +144,12 @@ def _foss_free(system: "LineSystem", prep: LinePrep, c: NodeBlocks, rhs: np.ndar
     z = None
     if not modal_direct:
         try:
-            foss = _foss_decomposition(mh, ch, kh)
+            foss = foss_modes(mh, ch, kh)
         except SolverError as exc:
             warn(f"{exc}; falling back to the direct solve in modal coordinates",
                  DefectivePencilWarning, stacklevel=3)
         else:
-            z = _foss_transfer_modal(foss, fh, w, n_ch)
+            z = foss_transfer_modal(foss, fh, w, n_ch)
     if z is None and modal_direct:
         # batched LU without the conditioning estimate of solve_direct: a singular
         # frequency raises LinAlgError or gives non-finite σ (the coarse start then

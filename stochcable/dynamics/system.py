@@ -25,9 +25,7 @@ from stochcable.dynamics.loads import (
     element_frames,
     inertia_matrix,
 )
-from stochcable.dynamics.solvers import (
-    auto_mode_count,
-)
+from stochcable.dynamics.modal_solvers import auto_mode_count
 from stochcable.line.fem import FEModel, build_fe_model
 from stochcable.line.modes import Modes, natural_modes
 from stochcable.line.statics import LineStatics
