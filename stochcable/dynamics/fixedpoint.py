@@ -49,10 +49,7 @@ from stochcable.dynamics.line_loads import (
     drag_inputs,
     line_inputs,
 )
-from stochcable.dynamics.linearization import (
-    FixedPointResult,
-    fixed_point,
-)
+from stochcable.dynamics.iteration import fixed_point, FixedPointResult
 from stochcable.dynamics.loads import (
     Channel,
     element_mean_square,
@@ -111,7 +108,7 @@ COARSE_MAX_FRACTION = 0.35
 
 def relative_change(new: np.ndarray, x: np.ndarray) -> float:
     """max_i |new_i − x_i| / max(|new_i|, 1e-6·max|new|): the convergence measure of
-    :func:`stochcable.dynamics.linearization.fixed_point`."""
+    :func:`stochcable.dynamics.iteration.fixed_point`."""
     den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)), 1e-300))
     return float(np.max(np.abs(new - x) / den, initial=0.0))
 
@@ -398,7 +395,7 @@ def linearize(
     response to the start's drag (the first iteration) start the fixed-point
     iteration unmixed; then plain steps use ``relaxation`` and Anderson steps the
     mixing ``ANDERSON_MIXING`` (1).  Convergence: the relative change of every σ
-    (:func:`stochcable.dynamics.linearization.fixed_point`) below the tolerance on the full
+    (:func:`stochcable.dynamics.iteration.fixed_point`) below the tolerance on the full
     grid; the record counts every full-grid response evaluation, the first included
     (the coarse ones are in :attr:`Linearization.coarse`).  The last evaluation's
     solve is reused for the outputs (no extra solve).
