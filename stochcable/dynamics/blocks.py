@@ -222,7 +222,10 @@ class LinePrep:
         # structural damping: seabed dashpots + Rayleigh alpha·M_T + beta·K
         self.S = add_blocks(seabed, self.MT, self.K, scale=(1.0, alpha, beta))
         self.bK = free_band(self.K)
-        self._modal: dict[int, Any] = {}
+        #: frequency-independent arrays computed on first use (modal matrices, residual
+        #: flexibility, end basis, …), keyed by what they depend on
+        self.cache: dict[Any, Any] = {}
+        self._modal = self.cache  # old name, used by dynamics.coupled until it is rewritten
         self._chol: Any = None
 
     # used by the direct solve, its conditioning check and hand-built channels only:
@@ -277,10 +280,10 @@ class LinePrep:
         if nf > _DENSE_FLEX:
             return self.k_solve(rhs) - phi @ np.linalg.solve(kh, phi.T @ rhs)
         key = ("flex", phi.shape[1])
-        if key not in self._modal:
+        if key not in self.cache:
             flex = self.k_solve(np.eye(nf)) - phi @ np.linalg.solve(kh, phi.T)
-            self._modal[key] = 0.5 * (flex + flex.T)
-        flex = self._modal[key]
+            self.cache[key] = 0.5 * (flex + flex.T)
+        flex = self.cache[key]
         k = rhs.shape[1]
         out = flex @ np.ascontiguousarray(rhs).view(float).reshape(nf, 2 * k)
         return out.view(complex)
@@ -288,13 +291,13 @@ class LinePrep:
     def follower(self) -> np.ndarray:
         """G with U_f = G u_b the static following of the end displacements,
         G = −K_ff⁻¹K_fb, shape (n_free_dof, 2d)."""
-        if "follower" not in self._modal:
+        if "follower" not in self.cache:
             d, n = self.d, self.n
             kfb = np.zeros(((n - 2) * d, 2 * d))
             kfb[:d, :d] = self.K[1][0]
             kfb[-d:, d:] = self.K[1][-1].T
-            self._modal["follower"] = -self.k_solve(kfb)
-        return self._modal["follower"]
+            self.cache["follower"] = -self.k_solve(kfb)
+        return self.cache["follower"]
 
     def end_basis(self, direct: bool) -> tuple[np.ndarray, ...]:
         """(G, M_T G, C_s G, K G) as (n_nodes·d, 2d) real matrices: the node
@@ -303,7 +306,7 @@ class LinePrep:
         (:meth:`follower`) inside for Foss — and their products with M_T, the
         structural damping and K (K G only for the direct solve)."""
         key = ("end_basis", bool(direct))
-        if key not in self._modal:
+        if key not in self.cache:
             d, n = self.d, self.n
             g = np.zeros((n, d, 2 * d))
             g[0, :, :d] = np.eye(d)
@@ -311,32 +314,36 @@ class LinePrep:
             if not direct:
                 g[1:-1] = self.follower().reshape(n - 2, d, 2 * d)
             flat = (n * d, 2 * d)
-            self._modal[key] = (g.reshape(flat), block_matvec(self.MT, g).reshape(flat),
+            self.cache[key] = (g.reshape(flat), block_matvec(self.MT, g).reshape(flat),
                                 block_matvec(self.S, g).reshape(flat),
                                 block_matvec(self.K, g).reshape(flat) if direct else None)
-        return self._modal[key]
+        return self.cache[key]
 
     def modal(self, system: "LineSystem") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(Φ_f, M̂, K̂) of the kept modes on the free DOFs."""
         m = int(system.n_modes)
-        if m not in self._modal:
+        if m not in self.cache:
             phi = np.ascontiguousarray(system.modes.shapes[system.model.free][:, :m])
-            x = self._nodes(phi)
-            mh = phi.T @ self._free_rows(block_matvec(self.MT, x))
-            kh = phi.T @ self._free_rows(block_matvec(self.K, x))
-            self._modal[m] = (phi, 0.5 * (mh + mh.T), 0.5 * (kh + kh.T))
-        return self._modal[m]
+            x = self.nodes(phi)
+            mh = phi.T @ self.free_rows(block_matvec(self.MT, x))
+            kh = phi.T @ self.free_rows(block_matvec(self.K, x))
+            self.cache[m] = (phi, 0.5 * (mh + mh.T), 0.5 * (kh + kh.T))
+        return self.cache[m]
 
-    def _nodes(self, free: np.ndarray) -> np.ndarray:
+    def nodes(self, free: np.ndarray) -> np.ndarray:
         """(n_free_dof, k) -> node vectors (n_nodes, d, k) with zero ends."""
         k = free.shape[1]
         x = np.zeros((self.n, self.d, k), dtype=free.dtype)
         x[1:-1] = free.reshape(self.n - 2, self.d, k)
         return x
 
-    def _free_rows(self, y: np.ndarray) -> np.ndarray:
+    def free_rows(self, y: np.ndarray) -> np.ndarray:
         """Node vectors (n_nodes, d, ...) -> free rows (n_free_dof, ...)."""
         return y[1:-1].reshape(((self.n - 2) * self.d,) + y.shape[2:])
+
+    # old names, used by dynamics.coupled until it is rewritten (rename table)
+    _nodes = nodes
+    _free_rows = free_rows
 
 
 def line_prep(system: "LineSystem") -> LinePrep:

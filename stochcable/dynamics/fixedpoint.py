@@ -184,7 +184,7 @@ def _coarse_subset(system: LineSystem, inp: LineInputs, damping: Damping
         prep = line_prep(system)
         c = add_blocks(prep.S, drag_blocks(system, damping))
         phi = system.modes.shapes[system.model.free][:, inside]
-        band = np.einsum("ij,ij->j", phi, prep._free_rows(block_matvec(c, prep._nodes(phi))))
+        band = np.einsum("ij,ij->j", phi, prep.free_rows(block_matvec(c, prep.nodes(phi))))
         near = np.clip(np.searchsorted(w, wn[inside]), 1, n - 1)
         near -= (wn[inside] - w[near - 1]) < (w[near] - wn[inside])  # nearest point
         centers.append(near[band < 2.0 * coarse_spacing[near]])

@@ -54,7 +54,7 @@ def _modal_bandwidths(system: LineSystem, damping: Damping) -> np.ndarray:
         c = add_blocks(prep.S, drag_blocks(system, damping))
         phi = np.ascontiguousarray(system.modes.shapes[system.model.free])
         damping._cache["modal_band"] = np.einsum(
-            "ij,ij->j", phi, prep._free_rows(block_matvec(c, prep._nodes(phi))))
+            "ij,ij->j", phi, prep.free_rows(block_matvec(c, prep.nodes(phi))))
     return damping._cache["modal_band"]
 
 

@@ -169,7 +169,9 @@ class Channel:
         default=None, repr=False)
 
 
-def _spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
+def spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
+    """ω -> S(ω) of a scene spectrum ``spec`` (one-sided, zero at ω <= 0), ω in
+    [rad/s], S in [m²·s/rad]; ``g`` [m/s²] for the spectra that need it."""
     def density(w: np.ndarray) -> np.ndarray:
         w = np.asarray(w, dtype=float)
         out = np.zeros_like(w)
@@ -229,7 +231,7 @@ def line_channels(
                 )
             raos[end] = np.ascontiguousarray(m.rao.transfer(w).T)  # (n_omega, 3)
     if scene.sea is not None:
-        density = _spectrum_callable(scene.sea.spectrum, env.g)
+        density = spectrum_callable(scene.sea.spectrum, env.g)
         # nodes resting on a penalty seabed sit slightly below z = -depth: evaluate
         # the kinematics on the seabed there
         pts = np.array(positions, dtype=float)
@@ -249,7 +251,7 @@ def line_channels(
             spec = getattr(m, dof)
             if spec is None:
                 continue
-            density = _spectrum_callable(spec, env.g)
+            density = spectrum_callable(spec, env.g)
             unit = np.zeros((w.size, 3), dtype=complex)
             unit[:, axis] = 1.0
             channels.append(Channel(

@@ -86,7 +86,7 @@ def solve_free(system: "LineSystem", inp: LineInputs, damping: Damping, *,
                                   (system.model.K, system.model.M))
         _check_line_conditioning(system, prep, bC, w, rhs_f, u_f)
         return np.ascontiguousarray(from_freq(u_f, d)), c
-    u_f = _foss_free(system, prep, c, prep._free_rows(rhs), w, modal_direct=modal_direct)
+    u_f = _foss_free(system, prep, c, prep.free_rows(rhs), w, modal_direct=modal_direct)
     return u_f.reshape(prep.n - 2, d, *u_f.shape[1:]), c
 
 
@@ -137,7 +137,7 @@ def _foss_free(system: "LineSystem", prep: LinePrep, c: NodeBlocks, rhs: np.ndar
     phi, mh, kh = prep.modal(system)
     m = phi.shape[1]
     nf, n_w, n_ch = rhs.shape
-    ch = phi.T @ prep._free_rows(block_matvec(c, prep._nodes(phi)))
+    ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
     ch = 0.5 * (ch + ch.T)
     flat = np.ascontiguousarray(rhs).reshape(nf, n_w * n_ch)
     fh = real_gemm(phi.T, flat)  # (m, n_w·n_ch), mode-major
@@ -157,12 +157,12 @@ def _foss_free(system: "LineSystem", prep: LinePrep, c: NodeBlocks, rhs: np.ndar
         fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
         wz = w[:, None, None]
         key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂: drag-independent, per grid
-        if key not in prep._modal:
-            prep._modal[key] = kh - wz * wz * mh
+        if key not in prep.cache:
+            prep.cache[key] = kh - wz * wz * mh
         # the matrices are symmetric to the bit (K̂, M̂, Ĉ symmetrized): passed as
         # their transposes, whose memory is the column-major layout LAPACK takes, so
         # numpy's copy into it is contiguous (the same matrices and bits, ≈ 10 % faster)
-        z3 = np.linalg.solve((prep._modal[key] + 1j * wz * ch).transpose(0, 2, 1), fh3)
+        z3 = np.linalg.solve((prep.cache[key] + 1j * wz * ch).transpose(0, 2, 1), fh3)
         z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
     elif z is None:
         fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
