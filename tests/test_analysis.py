@@ -1,4 +1,4 @@
-"""Tests of the analysis pipeline (stochcable.dynamics.line, stochcable.results.documents)."""
+"""Tests of the analysis pipeline (stochcable.analysis, stochcable.dynamics.*, stochcable.results.documents)."""
 
 from __future__ import annotations
 

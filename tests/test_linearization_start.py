@@ -1,4 +1,4 @@
-"""The coarse start of the drag linearization (stochcable.dynamics.line, "Coarse start"):
+"""The coarse start of the drag linearization (stochcable.dynamics.fixedpoint, "Coarse start"):
 the frequency-subset fixed point only supplies the start, the answer is the full-grid
 fixed point; narrow resonances are kept at full resolution; the subset quadrature; the
 single-BLAS-thread limit in worker threads."""

@@ -35,6 +35,7 @@ from stochcable.line.fem import FEModel
 
 
 def trapezoid_weights(w: np.ndarray) -> np.ndarray:
+    """Trapezoid-rule weights q of the grid w (Σ q_j f(w_j) ≈ ∫f dω), (n_omega,). [rad/s]"""
     q = np.zeros_like(w)
     if w.size > 1:
         dw = np.diff(w)
@@ -131,6 +132,7 @@ def distribute(model: FEModel, b: np.ndarray, node_diag: np.ndarray | None) -> N
 
 
 def add_blocks(*blks: NodeBlocks, scale: tuple[float, ...] | None = None) -> NodeBlocks:
+    """Σ scale_i·A_i of node blocks (D, O) (scale 1 by default)."""
     if scale is None and len(blks) == 2:  # the per-iteration C_s + C_d: one add each
         (d0, o0), (d1, o1) = blks
         return d0 + d1, o0 + o1
@@ -247,10 +249,12 @@ class LinePrep:
 
     @functools.cached_property
     def norm_K(self) -> float:
+        """Frobenius norm of the free–free K band (the conditioning estimate). [N/m]"""
         return float(np.sqrt(np.sum(self.bK**2)))
 
     @functools.cached_property
     def norm_M(self) -> float:
+        """Frobenius norm of the free–free M_T band (the conditioning estimate). [kg]"""
         return float(np.sqrt(np.sum(self.bM**2)))
 
     # K_ff^-1 by banded Cholesky (K_ff is SPD: tensions > 0 or slack EA > 0)
@@ -347,6 +351,7 @@ class LinePrep:
 
 
 def line_prep(system: "LineSystem") -> LinePrep:
+    """The :class:`LinePrep` of a line, built on first use and cached on the system."""
     cache = system._cache
     if "prep" not in cache:
         cache["prep"] = LinePrep(system)

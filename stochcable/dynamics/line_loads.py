@@ -62,6 +62,10 @@ def _inertia_elements(system: "LineSystem") -> tuple[np.ndarray, np.ndarray]:
 
 
 def line_inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> LineInputs:
+    """The channels of a line in the node layout (:class:`LineInputs`), sampled on the
+    channels' common grid: fluid velocity at the attachment nodes, Morison inertia load
+    (exact along the elements, seed 001 eq. 5.2.6), end displacements, trapezoid ×
+    spectrum weights and the consistent element moments of the fluid velocity."""
     model = system.model
     prep = line_prep(system)
     comps = list(model.components)
@@ -111,6 +115,9 @@ def line_inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> LineInpu
 
 
 def drag_blocks(system: "LineSystem", damping: Damping) -> NodeBlocks:
+    """Node blocks of the drag damping C_d (:func:`stochcable.dynamics.loads.drag_matrix`
+    on the model components), cached on ``damping`` with its element blocks
+    (``damping._cache["elements"]``). [N·s/m]"""
     cache = damping._cache
     if "blocks" not in cache:
         model = system.model

@@ -55,6 +55,7 @@ _MODE_BATCH = 40
 
 
 def noop_progress(stage: str, info: Mapping[str, Any]) -> None:
+    """The progress callback that does nothing (the default of every stage)."""
     return None
 
 
@@ -121,6 +122,7 @@ class LineSystem:
 
     @property
     def name(self) -> str:
+        """The line's name."""
         return self.line.name
 
     @property

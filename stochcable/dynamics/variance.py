@@ -46,6 +46,8 @@ from stochcable.dynamics.system import (
 
 
 def split_sigma(system: LineSystem, x: np.ndarray, method: str) -> dict[str, np.ndarray]:
+    """The σ vector (:func:`drag_coefficients` layout) split into "normal" (k, n_el),
+    "axial" (n_el,) and "node" (n_drag_nodes,) views, k = 3 for "vector" else 1. [m/s]"""
     n = system.model.n_elements
     k = 3 if method == "vector" else 1
     parts = {"normal": x[: k * n].reshape(k, n), "axial": x[k * n:(k + 1) * n],
