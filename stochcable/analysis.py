@@ -52,7 +52,7 @@ from stochcable.line.statics import StaticsResult
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, load_scene
 
-__all__ = ["analyze", "build_engine", "Engine"]
+__all__ = ["Engine", "analyze", "build_engine"]
 
 
 def analyze(

@@ -9,9 +9,9 @@ import warnings
 
 import numpy as np
 import pytest
+from _compare import assert_close_documents
 
 import stochcable
-from _compare import assert_close_documents
 from stochcable.analysis import analyze
 from stochcable.dynamics import engine as dengine
 from stochcable.dynamics.engine import Engine, build_engine

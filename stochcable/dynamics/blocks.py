@@ -204,7 +204,7 @@ _DENSE_FLEX = 600
 class LinePrep:
     """Frequency-independent arrays of one line for the block-banded solves."""
 
-    def __init__(self, system: "LineSystem") -> None:
+    def __init__(self, system: LineSystem) -> None:
         model = system.model
         d = model.dim
         n = model.n_nodes
@@ -275,7 +275,7 @@ class LinePrep:
                                                 check_finite=False))
         return sla.cho_solve_banded(c, rhs, check_finite=False)
 
-    def residual(self, system: "LineSystem", rhs: np.ndarray) -> np.ndarray:
+    def residual(self, system: LineSystem, rhs: np.ndarray) -> np.ndarray:
         """Static correction of the truncated modes, (K_ff⁻¹ − Φ K̂⁻¹ Φᵀ) rhs, rhs of
         shape (n_free_dof, k) complex: an explicit dense residual flexibility (one
         matrix product) up to ``_DENSE_FLEX`` free DOFs, else the banded Cholesky."""
@@ -323,7 +323,7 @@ class LinePrep:
                                 block_matvec(self.K, g).reshape(flat) if direct else None)
         return self.cache[key]
 
-    def modal(self, system: "LineSystem") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def modal(self, system: LineSystem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(Φ_f, M̂, K̂) of the kept modes on the free DOFs."""
         m = int(system.n_modes)
         if m not in self.cache:
@@ -350,7 +350,7 @@ class LinePrep:
     _free_rows = free_rows
 
 
-def line_prep(system: "LineSystem") -> LinePrep:
+def line_prep(system: LineSystem) -> LinePrep:
     """The :class:`LinePrep` of a line, built on first use and cached on the system."""
     cache = system._cache
     if "prep" not in cache:

@@ -43,13 +43,13 @@ from stochcable.dynamics.blocks import (
     line_prep,
     trapezoid_weights,
 )
+from stochcable.dynamics.iteration import FixedPointResult, fixed_point
 from stochcable.dynamics.line_loads import (
     LineInputs,
     drag_blocks,
     drag_inputs,
     line_inputs,
 )
-from stochcable.dynamics.iteration import fixed_point, FixedPointResult
 from stochcable.dynamics.loads import (
     Channel,
     element_mean_square,

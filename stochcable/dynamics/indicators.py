@@ -28,12 +28,12 @@ from stochcable.dynamics.loads import (
     Channel,
     element_mean_square,
 )
-from stochcable.dynamics.variance import current_split
 from stochcable.dynamics.system import (
     Damping,
     Linearization,
     LineSystem,
 )
+from stochcable.dynamics.variance import current_split
 from stochcable.errors import (
     PhysicsWarning,
     ResolutionWarning,

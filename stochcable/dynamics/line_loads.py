@@ -52,7 +52,7 @@ class LineInputs:
     cache: dict = field(default_factory=dict)  # drag-independent loads per solver
 
 
-def _inertia_elements(system: "LineSystem") -> tuple[np.ndarray, np.ndarray]:
+def _inertia_elements(system: LineSystem) -> tuple[np.ndarray, np.ndarray]:
     """Morison inertia l0·ρ(πD²/4)(1 + Can)(I − eeᵀ) per element on the model
     components (n_el, d, d) and the attachments' (buoyancy/g + added mass) (n_nodes,)."""
     if "inertia_el" not in system._cache:
@@ -61,7 +61,7 @@ def _inertia_elements(system: "LineSystem") -> tuple[np.ndarray, np.ndarray]:
     return system._cache["inertia_el"]
 
 
-def line_inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> LineInputs:
+def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs:
     """The channels of a line in the node layout (:class:`LineInputs`), sampled on the
     channels' common grid: fluid velocity at the attachment nodes, Morison inertia load
     (exact along the elements, seed 001 eq. 5.2.6), end displacements, trapezoid ×
@@ -114,7 +114,7 @@ def line_inputs(system: "LineSystem", channels: tuple[Channel, ...]) -> LineInpu
     return LineInputs(w, vel, inertia, ub, weights, mom, square)
 
 
-def drag_blocks(system: "LineSystem", damping: Damping) -> NodeBlocks:
+def drag_blocks(system: LineSystem, damping: Damping) -> NodeBlocks:
     """Node blocks of the drag damping C_d (:func:`stochcable.dynamics.loads.drag_matrix`
     on the model components), cached on ``damping`` with its element blocks
     (``damping._cache["elements"]``). [N·s/m]"""
@@ -148,7 +148,7 @@ def drag_blocks(system: "LineSystem", damping: Damping) -> NodeBlocks:
     return cache["blocks"]
 
 
-def _drag_load(system: "LineSystem", inp: LineInputs, damping: Damping) -> np.ndarray | None:
+def _drag_load(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndarray | None:
     """Linearized drag load of the fluid velocity, Σ_el l0·B·∫N_i v dξ + b_node·V_node,
     node vectors (n_nodes, d, n_w, n_ch); None without fluid velocity."""
     if inp.velocity is None and inp.moments is None:
@@ -163,14 +163,14 @@ def _drag_load(system: "LineSystem", inp: LineInputs, damping: Damping) -> np.nd
     return f
 
 
-def fluid_loads(system: "LineSystem", inp: LineInputs, damping: Damping) -> np.ndarray:
+def fluid_loads(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndarray:
     """Fluid loads (drag of the fluid velocity + Morison inertia) on all nodes,
     (n_nodes, d, n_w, n_ch)."""
     f = _drag_load(system, inp, damping)
     return inp.inertia_load if f is None else inp.inertia_load + f
 
 
-def end_loads(system: "LineSystem", inp: LineInputs, damping: Damping) -> np.ndarray:
+def end_loads(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndarray:
     """:func:`fluid_loads` at the two end nodes only, (2, d, n_w, n_ch): all that the
     reactions (:func:`reactions`) read of it — element 0's share on node 0, the last
     element's on the last node (the whole-line load was 0.2 ms of the chain)."""
@@ -198,7 +198,7 @@ def end_nodes(inp: LineInputs, n: int, d: int) -> np.ndarray:
     return x
 
 
-def base_motion(system: "LineSystem", prep: LinePrep, inp: LineInputs) -> tuple[np.ndarray, ...]:
+def base_motion(system: LineSystem, prep: LinePrep, inp: LineInputs) -> tuple[np.ndarray, ...]:
     """Drag-independent parts of the free-row load, cached per inputs and solver.
 
     The load on the free rows is  F0 + F_d(V) + C_d Q  with  Q = −iω U_p, F_d(V) the
@@ -254,7 +254,7 @@ def _moving_channels(inp: LineInputs) -> np.ndarray | None:
     return None if moving.all() else np.flatnonzero(moving)
 
 
-def drag_inputs(system: "LineSystem", prep: LinePrep, inp: LineInputs
+def drag_inputs(system: LineSystem, prep: LinePrep, inp: LineInputs
                  ) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Drag-independent parts of the drag load on the free rows, F_d(V) + C_d Q of
     :func:`base_motion`, cached per inputs and solver: the element moments
@@ -293,7 +293,7 @@ def drag_inputs(system: "LineSystem", prep: LinePrep, inp: LineInputs
     return inp.cache[key]
 
 
-def free_load(system: "LineSystem", prep: LinePrep, inp: LineInputs, damping: Damping
+def free_load(system: LineSystem, prep: LinePrep, inp: LineInputs, damping: Damping
                ) -> np.ndarray:
     """The load of :func:`solve_free`, F0 + F_d(V) + C_d Q (:func:`base_motion`), on all
     nodes (n_nodes, d, n_w, n_ch), a fresh array."""

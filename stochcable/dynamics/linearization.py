@@ -23,13 +23,13 @@ from stochcable import validation as _v
 from stochcable.errors import InputError
 
 __all__ = [
-    "drag_linear_seed",
-    "drag_linear_current",
-    "mean_drag_gaussian",
-    "drag_linear_vector",
-    "drag_linear_harmonic",
     "borgman_variance_ratio",
     "drag_inertia_ratio",
+    "drag_linear_current",
+    "drag_linear_harmonic",
+    "drag_linear_seed",
+    "drag_linear_vector",
+    "mean_drag_gaussian",
 ]
 
 _SQRT_2_OVER_PI = math.sqrt(2.0 / math.pi)

@@ -62,25 +62,28 @@ from typing import Any, Literal
 import numpy as np
 import scipy.sparse as sp
 
+from stochcable.dynamics.element_kinematics import (
+    ElementKinematics,
+    element_wave_kinematics,
+)
 from stochcable.errors import InputError
-from stochcable.sea.kinematics import G_STANDARD, _nodal_kinematics
 from stochcable.scene.model import Environment, Line, Scene
-from stochcable.dynamics.element_kinematics import ElementKinematics, element_wave_kinematics
+from stochcable.sea.kinematics import G_STANDARD, _nodal_kinematics
 
 __all__ = [
     "Channel",
-    "element_moments",
-    "element_mean_square",
-    "wave_loads",
-    "line_channels",
-    "element_frames",
-    "inertia_matrix",
-    "drag_matrix",
     "channel_loads",
-    "prescribed_motion",
-    "embed",
     "current_at_elements",
     "current_at_nodes",
+    "drag_matrix",
+    "element_frames",
+    "element_mean_square",
+    "element_moments",
+    "embed",
+    "inertia_matrix",
+    "line_channels",
+    "prescribed_motion",
+    "wave_loads",
 ]
 
 _DOF_AXIS = {"surge": 0, "sway": 1, "heave": 2}
@@ -263,7 +266,7 @@ def line_channels(
     return tuple(channels)
 
 
-def _sea_nodal(el: "ElementKinematics", g: float
+def _sea_nodal(el: ElementKinematics, g: float
                ) -> Callable[[], tuple[np.ndarray, np.ndarray]]:
     """The sea channel's nodal velocity and acceleration (n_omega, n_nodes, 3), on
     demand: :func:`stochcable.sea.kinematics.wave_kinematics` from the validated
@@ -397,7 +400,9 @@ def _assemble(model: Any, blocks3: np.ndarray, node_diag: np.ndarray | None) -> 
     for a in range(2):
         for c in range(2):
             el[:, a * d:(a + 1) * d, c * d:(c + 1) * d] = pattern[a, c] * b
-    from stochcable.line.fem import _chain_csr  # the node blocks straight into CSR (no COO sort)
+    from stochcable.line.fem import (
+        _chain_csr,  # the node blocks straight into CSR (no COO sort)
+    )
 
     diag = np.repeat(node_diag, d) if node_diag is not None and np.any(node_diag) else None
     return _chain_csr(el, model.n_nodes, d, diag)

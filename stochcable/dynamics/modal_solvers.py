@@ -25,7 +25,6 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from stochcable import validation as _v
-from stochcable.errors import InputError, PhysicsWarning, SolverError, warn
 from stochcable.dynamics.solvers import (
     Matrix,
     as_matrix,
@@ -35,17 +34,18 @@ from stochcable.dynamics.solvers import (
     solve_dense_batched,
     system_matrices,
 )
+from stochcable.errors import InputError, PhysicsWarning, SolverError, warn
 
 __all__ = [
     "DefectivePencilWarning",
-    "modal_basis",
     "FossModes",
+    "auto_mode_count",
     "foss_decomposition",
     "foss_modes",
     "foss_transfer",
     "foss_transfer_modal",
+    "modal_basis",
     "solve_modal",
-    "auto_mode_count",
 ]
 
 #: Eigenvector condition number above which the Foss pencil is treated as defective.

@@ -66,7 +66,7 @@ def _dynamic(prep: LinePrep, c: NodeBlocks, w: np.ndarray, x: np.ndarray) -> np.
     return (-(w * w)[:, None] * block_matvec(prep.MT, x) + (1j * w)[:, None] * block_matvec(c, x))
 
 
-def solve_free(system: "LineSystem", inp: LineInputs, damping: Damping, *,
+def solve_free(system: LineSystem, inp: LineInputs, damping: Damping, *,
                 modal_direct: bool = False) -> tuple[np.ndarray, NodeBlocks]:
     """Dynamic part on the free nodes, (n_nodes − 2, d, n_w, n_ch), and C = C_s + C_d.
 
@@ -90,7 +90,7 @@ def solve_free(system: "LineSystem", inp: LineInputs, damping: Damping, *,
     return u_f.reshape(prep.n - 2, d, *u_f.shape[1:]), c
 
 
-def total_displacement(system: "LineSystem", inp: LineInputs, u_free: np.ndarray) -> np.ndarray:
+def total_displacement(system: LineSystem, inp: LineInputs, u_free: np.ndarray) -> np.ndarray:
     """Total displacement (n_nodes, d, n_w, n_ch) from the free-node dynamic part."""
     prep = line_prep(system)
     u = base_motion(system, prep, inp)[0].copy()
@@ -98,7 +98,7 @@ def total_displacement(system: "LineSystem", inp: LineInputs, u_free: np.ndarray
     return u
 
 
-def _solve_nodes(system: "LineSystem", inp: LineInputs, damping: Damping
+def _solve_nodes(system: LineSystem, inp: LineInputs, damping: Damping
                  ) -> tuple[np.ndarray, NodeBlocks]:
     """Total displacement (n_nodes, d, n_w, n_ch) and C = C_s + C_d."""
     u_f, c = solve_free(system, inp, damping)
@@ -123,7 +123,7 @@ def _check_line_conditioning(system, prep, bC, w, f, u) -> None:
         raise singular_error(K, M, float(w[k]), float(est[k]))
 
 
-def _foss_free(system: "LineSystem", prep: LinePrep, c: NodeBlocks, rhs: np.ndarray,
+def _foss_free(system: LineSystem, prep: LinePrep, c: NodeBlocks, rhs: np.ndarray,
                w: np.ndarray, modal_direct: bool = False) -> np.ndarray:
     """Foss modal solve on the free DOFs, rhs (n_free_dof, n_w, n_ch), with the static
     correction of the truncated modes (seed 001 §5.3;
@@ -174,7 +174,7 @@ def _foss_free(system: "LineSystem", prep: LinePrep, c: NodeBlocks, rhs: np.ndar
     return u.reshape(nf, n_w, n_ch)
 
 
-def reactions(system: "LineSystem", prep: LinePrep, c: NodeBlocks, u: np.ndarray,
+def reactions(system: LineSystem, prep: LinePrep, c: NodeBlocks, u: np.ndarray,
                f_all: np.ndarray, w: np.ndarray) -> np.ndarray:
     """Dynamic force of the line on the supports, (n_w, 2d, n_ch):
     −[(K − ω²M_T + iωC)U − F]_end rows, u and f_all in the node layout."""
@@ -200,7 +200,7 @@ def reactions(system: "LineSystem", prep: LinePrep, c: NodeBlocks, u: np.ndarray
     return -np.concatenate(out, axis=1)
 
 
-def line_response(system: "LineSystem", inp: LineInputs, damping: Damping,
+def line_response(system: LineSystem, inp: LineInputs, damping: Damping,
               solved: tuple[np.ndarray, NodeBlocks] | None = None) -> Response:
     """Response with reactions and end tensions; ``solved`` = (u, C) of a solve already
     done with this ``damping`` (:func:`_solve_nodes`) skips the solve."""

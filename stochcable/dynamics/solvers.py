@@ -38,10 +38,10 @@ from stochcable import validation as _v
 from stochcable.errors import InputError, SolverError
 
 __all__ = [
+    "matrix_bandwidth",
+    "solve_block_tridiagonal",
     "solve_direct",
     "tridiagonal_blocks",
-    "solve_block_tridiagonal",
-    "matrix_bandwidth",
 ]
 
 #: A solve whose estimated condition number exceeds this is treated as singular.

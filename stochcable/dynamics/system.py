@@ -56,7 +56,6 @@ _MODE_BATCH = 40
 
 def noop_progress(stage: str, info: Mapping[str, Any]) -> None:
     """The progress callback that does nothing (the default of every stage)."""
-    return None
 
 
 # ------------------------------------------------------------------------ the system

@@ -244,8 +244,8 @@ def _independent_lines(scene: Scene, systems: Mapping[str, LineSystem],
             for sl in frequency_chunks(syn.band.size, entry, CHUNK_BYTES):
                 resp = solve(system, _channels_on(scene, system, syn.w_band[sl]),
                              dampings[name], timing)
-                for e in h:
-                    h[e][:, sl] = resp.end_tension[e]
+                for e, he in h.items():
+                    he[:, sl] = resp.end_tension[e]
             tr = {e: syn.full(v) for e, v in h.items()}
         out.add_line(name, system.statics, tr, syn, tuple(c.kind for c in chs),
                      tuple((name, c.name) for c in chs), tuple(c.name for c in chs))

@@ -105,7 +105,7 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
     model = system.model
     mesh = model.mesh
     rho = model.rho
-    e, n1, n2 = system.frames
+    _, n1, n2 = system.frames
     parts = split_sigma(system, np.asarray(sigma, dtype=float), method)
     u_t, u_nvec, u_n = current_split(system)
     d = mesh.diameter
