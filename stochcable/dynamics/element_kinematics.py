@@ -36,7 +36,7 @@ import numpy as np
 
 from stochcable import validation as v
 from stochcable.errors import InputError
-from stochcable.sea.kinematics import G_STANDARD, _depth, _wavenumber
+from stochcable.sea.kinematics import G_STANDARD, wavenumber
 
 __all__ = ["ElementKinematics", "element_wave_kinematics"]
 
@@ -243,14 +243,14 @@ def element_wave_kinematics(
         raise InputError("positions", positions, "m", "must have shape (n_nodes >= 2, 3)")
     pts = v.float_array("positions", pts, "m", ndim=2)
     beta = v.finite_scalar("heading", heading, "rad")
-    h = _depth(depth)
-    g = v.positive("g", g, "m/s²")
+    # depth and g validated by wavenumber (sea.kinematics' messages, in this order)
+    k = wavenumber(w, depth, g)
+    h, g = float(depth), float(g)
     z = pts[:, 2]
     if not math.isinf(h) and (z < -h).any():
         i = int(np.flatnonzero(z < -h)[0])
         raise InputError("positions", positions, "m",
                          f"z must be >= -depth = {-h:g} (node {i} has z = {z[i]:g})")
-    k = _wavenumber(w, h, g)
     return _element_kinematics(w, k, pts, beta, h, g)
 
 
