@@ -45,7 +45,7 @@ from stochcable.results.documents import (
 from stochcable.scene.units import unit_labels
 
 
-def _modal_bandwidths(system: LineSystem, damping: Damping) -> np.ndarray:
+def modal_bandwidths(system: LineSystem, damping: Damping) -> np.ndarray:
     """φ_jᵀCφ_j of every computed mode (mass-normalized φ; C = structural damping +
     ``damping``): the half-power bandwidth 2ζ_jω_j, (n_modes,), cached on the damping
     (the resolution check and the indicators both use it). [rad/s]"""
@@ -83,7 +83,7 @@ def resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) ->
     inside = np.flatnonzero((wn >= omega[0]) & (wn <= omega[-1]))
     if inside.size == 0 or omega.size < 2:
         return
-    band = _modal_bandwidths(system, damping)[inside]
+    band = modal_bandwidths(system, damping)[inside]
     dist, spacing = _nearest_spacing(omega, wn[inside])
     flagged = (dist > spacing) | (spacing > band)
     bad = [(j, wn[j], b, dw) for j, b, dw, f in zip(inside, band, spacing, flagged) if f]
@@ -229,7 +229,7 @@ def _normal_acceleration_sigma(system: LineSystem, channels: tuple[Channel, ...]
 
 def _modal_damping_ratios(system: LineSystem, damping: Damping) -> np.ndarray:
     """ζ_j = φ_jᵀCφ_j/(2ω_j) of the computed modes (mass-normalized φ). [-]"""
-    band = _modal_bandwidths(system, damping)
+    band = modal_bandwidths(system, damping)
     wn = np.asarray(system.modes.omega)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(wn > 0, band / (2.0 * np.where(wn > 0, wn, 1.0)), np.inf)
