@@ -42,14 +42,10 @@ the unstretched lengths l0, as the added mass of :mod:`stochcable.line.fem`, so 
 moving with a uniform fluid (Ü = A) feels exactly the Froude–Krylov force
 ρ(πD²/4)(I − eeᵀ)A.  Attachments (buoys, clumps) get the isotropic inertia load
 (buoyancy/g + added mass)·A and an isotropic linear drag B·(V − U̇) on their node.
-
-Wave loads integrated exactly along the elements
-------------------------------------------------
-The sea channel carries the consistent moments ∫ N_i v dξ and the element mean square
-∫ Re(v vᴴ) dξ of the wave velocity, integrated in closed form over the wet part of each
-element (:mod:`stochcable.dynamics.element_kinematics`); :func:`element_moments` and
-:func:`element_mean_square` return them, or the linear interpolation of the nodal
-kinematics for channels built by hand.
+The sea channel carries the wave velocity's consistent moments ∫ N_i v dξ and element
+mean square ∫ Re(v vᴴ) dξ integrated exactly along the elements
+(:mod:`stochcable.dynamics.element_kinematics`), read by :func:`element_moments` and
+:func:`element_mean_square` (hand-built channels: the nodal kinematics interpolated).
 """
 
 from __future__ import annotations
