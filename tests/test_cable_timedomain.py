@@ -3,7 +3,7 @@
 Every check compares the time-domain (TD) simulation with something independent: the
 statics module (static start), the frequency-domain finite-element matrices of
 :mod:`stochcable.line.fem` / :mod:`stochcable.dynamics.loads` solved directly (harmonic and
-linear-limit tests), and :func:`stochcable.dynamics.line.analyze` (statistics and the
+linear-limit tests), and :func:`stochcable.analysis.analyze` (statistics and the
 synthesized series of the same realization).
 """
 
@@ -179,8 +179,8 @@ def _fd_series_fem(scene, hist):
     synthesized with the realization's coefficients; F the Morison inertia and
     linearized drag loads integrated exactly along the elements
     (excitation.wave_loads with the element_wave_kinematics moments)."""
-    from stochcable.dynamics.loads import (Channel, drag_matrix, element_wave_kinematics,
-                                       wave_loads)
+    from stochcable.dynamics.element_kinematics import element_wave_kinematics
+    from stochcable.dynamics.loads import Channel, drag_matrix, wave_loads
     from stochcable.sea.kinematics import wave_kinematics
     from stochcable.sea.realization import synthesize
 
@@ -241,7 +241,7 @@ def test_linear_limit_same_realization_equals_fe_synthesis():
 def test_linear_limit_same_realization_equals_analysis_series():
     # The product's own synthesized end-tension series (analyze, same seed, same
     # band) against the TD end tension: the same realization drives both.
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
 
     scene = _taut(hs=0.1, cd=1.2, current=1.0,
                   ts={"duration": 256.0, "dt": 0.25, "seed": 7})
@@ -306,7 +306,7 @@ def test_sigma_frequency_domain_vs_time_domain(case):
 
 
 def analyze_scene(scene):
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
 
     return analyze(scene)
 

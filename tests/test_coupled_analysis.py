@@ -19,14 +19,11 @@ from _scenes import three_chain_legs
 import pytest
 from scipy.spatial.transform import Rotation
 
-from stochcable.dynamics.line import (
-    _inputs,
-    _loads,
-    _to_freq,
-    build_line_system,
-    line_result,
-    linearize,
-)
+from stochcable.dynamics.blocks import to_freq as _to_freq
+from stochcable.dynamics.fixedpoint import linearize
+from stochcable.dynamics.line_loads import fluid_loads as _loads, line_inputs as _inputs
+from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.system import build_line_system
 from stochcable.bodies.rigid import (
     ExcitationTable,
     LineLink,
@@ -778,7 +775,8 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     is the plain analysis._solve_free of the augmented channels: the same linear
     system, so equal to round-off (1e-10 of the largest entry), truncated (8 of 27
     modes, static correction on) or not."""
-    from stochcable.dynamics.line import _solve_free, drag_coefficients
+    from stochcable.dynamics.solve import solve_free as _solve_free
+    from stochcable.dynamics.variance import drag_coefficients
     from stochcable.dynamics.coupled import _foss_unit_split, _Group
 
     body = _buoy()
@@ -988,7 +986,7 @@ def test_large_static_body_rotation_is_flagged():
     examples (0.45° and 0.12°) get none."""
     import warnings
 
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
     from stochcable.dynamics.coupled import STATIC_ROTATION_LIMIT
     from stochcable.errors import PhysicsWarning
     from stochcable.examples import load_example

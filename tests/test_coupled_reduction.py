@@ -20,7 +20,8 @@ import numpy as np
 import pytest
 
 import stochcable.dynamics.coupled as ca
-from stochcable.dynamics.line import build_line_system, drag_coefficients
+from stochcable.dynamics.system import build_line_system
+from stochcable.dynamics.variance import drag_coefficients
 from stochcable.bodies.rigid import RigidBody
 from stochcable.dynamics.coupled import (
     CoupledLine,
@@ -253,8 +254,13 @@ def test_foss_decomposition_of_a_line_with_drag_solves_the_quadratic_eigenproble
     thread pool) on a line's kept modes with drag: every pair satisfies
     (λ²M̂ + λĈ + K̂)χ = 0 to 1e-10 of the terms' size (round-off of a 78×78 geev with
     condition ≈ the printed one), and the pairs come in complex conjugates."""
-    from stochcable.dynamics.line import _add, _drag_blocks, _matvec, _prep
-    from stochcable.dynamics.solvers import _foss_decomposition
+    from stochcable.dynamics.blocks import (
+        add_blocks as _add,
+        block_matvec as _matvec,
+        line_prep as _prep,
+    )
+    from stochcable.dynamics.line_loads import drag_blocks as _drag_blocks
+    from stochcable.dynamics.modal_solvers import foss_modes as _foss_decomposition
 
     body = _buoy()
     _, cls, _ = _group(_mooring_doc(solver="foss", tol=1e-4), body)

@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.dynamics.coupled_timeseries import coupled_group_transfer, frequency_chunks
 from stochcable.errors import InputError
 from stochcable.examples import load_example

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.errors import InputError
 from stochcable.examples import load_example
 from stochcable.fidelity.planner import (BUDGET, CUTOFF_KH, FidelityPlan, apply_fidelity,

@@ -697,7 +697,7 @@ def _modal_bandwidths(line_result: Any, scene: Scene) -> tuple[np.ndarray, np.nd
 
 def _pilot(scene: Scene, statics: Any, geo: dict[str, _LineGeometry], w_lo: float, w_top: float,
            w2_guess: float, k_load: float | None, exact: bool) -> tuple[Any, dict, float]:
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
 
     eps_pilot = PILOT_KH**2 / 24.0
     segs, _, _ = _mesh_rules(scene, geo, w_top, w_top, eps_pilot, k_load, exact)

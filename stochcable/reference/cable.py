@@ -681,7 +681,7 @@ def _wave_series(model: _LineModel, x_static: np.ndarray, omega: np.ndarray, X: 
     (buoyancy/g + added mass)·a_node.  All are linear transfer functions per unit wave
     amplitude at the static positions, synthesized with the realization's coefficients.
     """
-    from stochcable.dynamics.loads import element_wave_kinematics
+    from stochcable.dynamics.element_kinematics import element_wave_kinematics
     from stochcable.sea.kinematics import wave_kinematics
 
     pts = np.array(x_static, dtype=float)
