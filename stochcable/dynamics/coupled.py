@@ -119,36 +119,46 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
-from stochcable.dynamics.line import (
+from stochcable.dynamics.blocks import (
+    add_blocks as _add,
+    block_matvec as _matvec,
+    line_prep as _prep,
+    real_gemm as _real_gemm,
+    to_freq as _to_freq,
+    trapezoid_weights as _trapezoid_weights,
+)
+from stochcable.dynamics.fixedpoint import (
     ANDERSON_MIXING,
+    interpolatory_weights as _interpolatory_weights,
+    linearization_record,
+    subset_inputs as _subset_inputs,
+)
+from stochcable.dynamics.line_loads import (
+    base_motion as _base,
+    drag_blocks as _drag_blocks,
+    end_loads as _end_loads,
+    free_load as _free_load,
+    line_inputs as _inputs,
+)
+from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.solve import (
+    end_tension_from_support as _end_tension,
+    reactions as _reactions,
+    solve_free as _solve_free,
+    total_displacement as _total,
+)
+from stochcable.dynamics.system import (
     Damping,
     Linearization,
     LineSystem,
+    noop_progress as _noop,
     Progress,
     Response,
-    _add,
-    _base,
-    _drag_blocks,
-    _end_loads,
-    _free_load,
-    _end_tension,
-    _inputs,
-    _interpolatory_weights,
-    _matvec,
-    _noop,
-    _prep,
-    _quasi_static,
-    _reactions,
-    _real_gemm,
-    _sigmas,
-    _solve_free,
-    _subset_inputs,
-    _to_freq,
-    _total,
-    _trapezoid_weights,
+)
+from stochcable.dynamics.variance import (
     drag_coefficients,
-    line_result,
-    linearization_record,
+    quasi_static_motion as _quasi_static,
+    sigmas_from_nodes as _sigmas,
 )
 from stochcable.bodies.rigid import (
     PLANAR_INDEX,
@@ -161,18 +171,14 @@ from stochcable.bodies.rigid import (
 )
 from stochcable.errors import ConvergenceError, InputError, PhysicsWarning, SolverError, warn
 from stochcable.dynamics.loads import Channel
-from stochcable.dynamics.linearization import (
-    FixedPointResult,
-    drag_linear_current,
-    drag_linear_harmonic,
-    fixed_point,
-)
+from stochcable.dynamics.iteration import fixed_point, FixedPointResult
+from stochcable.dynamics.linearization import drag_linear_current, drag_linear_harmonic
 from stochcable.runtime import line_map
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
-from stochcable.dynamics.solvers import (
+from stochcable.dynamics.modal_solvers import (
+    foss_modes as _foss_decomposition,
+    foss_transfer_modal as _foss_transfer_modal,
     FossModes,
-    _foss_decomposition,
-    _foss_transfer_modal,
 )
 
 __all__ = [
@@ -1811,7 +1817,9 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
     component of free bodies and their lines is one coupled group
     (:func:`linearize_coupled`, :func:`coupled_modes`, :func:`coupled_results`).
     """
-    from stochcable.dynamics.line import _silent_channel, build_line_system, linearize
+    from stochcable.dynamics.fixedpoint import linearize
+    from stochcable.dynamics.line_loads import silent_channel as _silent_channel
+    from stochcable.dynamics.system import build_line_system
 
     progress = _noop if progress is None else progress
     timing = {} if timing is None else timing
@@ -1932,7 +1940,7 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
             warn(f"body '{n}' has no lines and there is no sea: its motion is zero",
                  PhysicsWarning, stacklevel=2)
             continue
-        from stochcable.dynamics.loads import _spectrum_callable
+        from stochcable.dynamics.loads import spectrum_callable as _spectrum_callable
 
         dens = _spectrum_callable(scene.sea.spectrum, env.g)
         sea_ch = (Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega),

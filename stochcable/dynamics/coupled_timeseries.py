@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as v
-from stochcable.dynamics.line import _end_tension
+from stochcable.dynamics.solve import end_tension_from_support as _end_tension
 from stochcable.dynamics.coupled import (
     CoupledGroup,
     CoupledLine,
@@ -43,7 +43,7 @@ from stochcable.dynamics.coupled import (
     body_loads,
 )
 from stochcable.bodies.rigid import PLANAR_INDEX, rigid_link_matrix
-from stochcable.dynamics.loads import Channel, _spectrum_callable
+from stochcable.dynamics.loads import Channel, spectrum_callable as _spectrum_callable
 
 __all__ = ["GroupTransfer", "coupled_group_transfer", "frequency_chunks",
            "line_entry_bytes", "vessel_raos", "CHUNK_BYTES"]
