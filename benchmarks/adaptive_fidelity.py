@@ -24,8 +24,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from speed_vs_error import base_document, quantities_fd  # noqa: E402
 
-from stochcable.dynamics.line import analyze  # noqa: E402
-from stochcable.fidelity.planner import apply_fidelity, choose_fidelity  # noqa: E402
+from stochcable.analysis import analyze  # noqa: E402
+from stochcable.analysis import analyze  # noqa: E402
+from stochcable.fidelity import apply_fidelity, choose_fidelity  # noqa: E402
 from stochcable.line.mesh import mesh_line  # noqa: E402
 from stochcable.scene.model import load_scene  # noqa: E402
 
@@ -74,7 +75,7 @@ def main(names) -> int:
             plans = {}
             for tgt in TARGETS:
                 t0 = time.perf_counter()
-                plans[tgt] = choose_fidelity(base, tgt)
+                plans[tgt] = choose_fidelity(base, tgt, evaluate=analyze)
                 plans[tgt] = (plans[tgt], time.perf_counter() - t0)
             p1 = plans[TARGETS[0]][0]
             ref4, t4, el4, c4 = reference(base, p1, 4)

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from _host import host_line
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.scene.model import load_scene
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "stochcable" / "examples" / "chain_catenary.json"

@@ -37,7 +37,10 @@ import warnings
 from typing import Any
 
 from _host import host_line
-from stochcable.dynamics.line import analyze, build_line_system, line_result, linearize
+from stochcable.analysis import analyze
+from stochcable.dynamics.fixedpoint import linearize
+from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.system import build_line_system
 from stochcable.runtime import single_blas_thread
 import numpy as np
 
@@ -45,7 +48,7 @@ import stochcable.dynamics.coupled as coupled_analysis
 from stochcable.dynamics.coupled import analyze_coupled
 from stochcable.dynamics.loads import line_channels
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
 
 def scene_doc(solver: str = "direct", n_el: int = 40, count: int = 200) -> dict:

@@ -63,7 +63,7 @@ def main() -> None:
     global _USE_MIN
     _USE_MIN = args.min
     repeat = 5 if args.quick else 21
-    from stochcable.line.statics import solve_statics
+    from stochcable.statics import solve_statics
 
     scene = load_scene(chain_scene(100))
     env = scene.environment

@@ -40,9 +40,9 @@ from pathlib import Path
 
 import numpy as np
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "stochcable" / "examples" / "chain_catenary.json"
 DEPTH, RHO, G = 200.0, 1025.0, 9.80665
@@ -244,7 +244,7 @@ def main() -> None:
         # wrapped; MoorPy lumps the mass, stochcable's default is consistent
         import functools
 
-        from stochcable.dynamics import line as analysis
+        from stochcable.dynamics import system as analysis
 
         original = analysis.build_fe_model
         analysis.build_fe_model = functools.partial(original, mass_matrix="lumped")

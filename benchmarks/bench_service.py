@@ -11,7 +11,7 @@ load generator does not share the server's GIL), then measures:
 3. ``GET /health`` latency while clients keep asking for that realization.
 4. ``POST /v1/analyses`` of the bundled ``chain_catenary`` scene (the start-up
    message's example): p50/p99 latency of sequential requests (JSON decoded) against
-   the library's own :func:`stochcable.dynamics.line.analyze` in this process (goal: p50
+   the library's own :func:`stochcable.analysis.analyze` in this process (goal: p50
    within 1.5x), the throughput of 4 concurrent clients, and ``GET /health`` latency
    while 2 clients keep posting analyses.
 
@@ -186,7 +186,7 @@ def _chain_body() -> bytes:
 def bench_analyses(base: str, n: int, workers: int) -> dict:
     import warnings
 
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
     from stochcable.examples import load_example
 
     scene = load_example("chain_catenary")

@@ -17,14 +17,13 @@ import time
 
 import numpy as np
 
-from stochcable.dynamics.solvers import (
+from stochcable.dynamics.modal_solvers import (
     foss_decomposition,
     foss_transfer,
-    matrix_bandwidth,
     modal_basis,
-    solve_direct,
     solve_modal,
 )
+from stochcable.dynamics.solvers import matrix_bandwidth, solve_direct
 
 
 def line_model(n_el: int = 40, length: float = 850.0, ea: float = 1.2326e9,

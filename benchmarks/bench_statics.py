@@ -16,7 +16,7 @@ import time
 
 from stochcable.line.mesh import mesh_line
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import _solve_fe, solve_line_statics
+from stochcable.line.statics import solve_fe, solve_line_statics
 
 CASES = {
     "chain 850 m": (850.0, [-640.0, -480.0, -200.0]),
@@ -53,7 +53,7 @@ def main() -> None:
         for n in (20, 50, 100, 200, 400, 800):
             mesh, env = chain(length, end_a, n)
             t2 = median_time(lambda: solve_line_statics(mesh, env, method="fe"))
-            t3 = median_time(lambda: _solve_fe(mesh, env, None, 1e-10, 500, force_3d=True))
+            t3 = median_time(lambda: solve_fe(mesh, env, None, 1e-10, 500, force_3d=True))
             tc = median_time(lambda: solve_line_statics(mesh, env, method="catenary"))
             r = solve_line_statics(mesh, env, method="fe")
             c = solve_line_statics(mesh, env, method="catenary")

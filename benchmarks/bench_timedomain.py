@@ -45,7 +45,7 @@ def _rel_sampling_error(omega, s, record):
 
 
 def main(argv: list[str] | None = None) -> int:
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
     from stochcable.reference.cable import simulate_line_timedomain
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])

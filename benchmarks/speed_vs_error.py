@@ -241,7 +241,7 @@ def timed_analysis(doc: dict[str, Any], repeats: int, budget_s: float
     Runs at least once and at most ``repeats`` times, stopping early once the calls
     have taken ``budget_s`` seconds in total.
     """
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
     from stochcable.scene.model import load_scene
 
     scene = load_scene(doc)

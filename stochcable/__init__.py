@@ -19,7 +19,8 @@ from stochcable.errors import (
 # The pipeline's top-level entry points, imported on first use so that
 # ``import stochcable`` (and the CLI's start-up) stays light.
 _LAZY = {
-    "analyze": ("dynamics.line", "analyze"),
+    "analyze": ("analysis", "analyze"),
+    "build_engine": ("dynamics.engine", "build_engine"),
     "load_scene": ("scene.model", "load_scene"),
     "Scene": ("scene.model", "Scene"),
     "solve_statics": ("line.statics", "solve_statics"),

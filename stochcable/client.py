@@ -312,7 +312,7 @@ class AnalysisDocument(Mapping[str, Any]):
     (``.end_b`` the core's :class:`~stochcable.results.documents.ResponseStats`,
     ``.tension_std`` a numpy array, ...), ``timeseries`` a :class:`TimeSeriesWindow`.
     Transfer functions and full response spectra are not in the document: run
-    :func:`stochcable.dynamics.line.analyze` locally for those.
+    :func:`stochcable.analysis.analyze` locally for those.
 
     Attributes
     ----------

@@ -40,7 +40,7 @@ Per-line work of a coupled group on a small thread pool (issue 6, bodies speed).
 The lines of a coupled group are independent inside one drag-linearization
 evaluation until the body solve.  :func:`line_map` can run such per-line work on a
 module-level thread pool, created on first use.  It is used for the lines' Foss
-decompositions (:func:`stochcable.dynamics.coupled._foss_state`): LAPACK ``geev``
+decompositions (:func:`stochcable.dynamics.coupled.lineparts.foss_state`): LAPACK ``geev``
 through NumPy releases the GIL, so two cores overlap the lines' eigenproblems.
 
 Opt-in
@@ -59,7 +59,7 @@ When the pool is used
 Only when all of these hold (else the plain loop, in the calling thread):
 
 - more than one item and ``STOCHCABLE_THREADS`` > 1 (at most that many threads);
-- BLAS runs single-threaded (inside :func:`stochcable.dynamics.line._single_blas_thread`,
+- BLAS runs single-threaded (inside :func:`single_blas_thread`,
   where ``analyze()`` runs small models, or ``OPENBLAS_NUM_THREADS`` /
   ``OMP_NUM_THREADS`` = 1): a large model parallelizes inside BLAS instead, and
   pool threads each running multi-threaded BLAS would oversubscribe the cores;

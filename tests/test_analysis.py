@@ -1,4 +1,4 @@
-"""Tests of the analysis pipeline (stochcable.dynamics.line, stochcable.results.documents)."""
+"""Tests of the analysis pipeline (stochcable.analysis, stochcable.dynamics.*, stochcable.results.documents)."""
 
 from __future__ import annotations
 
@@ -11,12 +11,20 @@ import warnings
 import numpy as np
 import pytest
 
-from stochcable.dynamics import line as an
+from stochcable import analysis
+from stochcable.dynamics import system as dsystem
+from stochcable.dynamics import blocks as dblocks
+from stochcable.dynamics import line_loads as dloads
+from stochcable.dynamics import solve as dsolve
+from stochcable.dynamics import variance as dvariance
+from stochcable.dynamics import fixedpoint as dfixedpoint
+from stochcable.dynamics import indicators as dindicators
+from stochcable.dynamics import outputs as doutputs
 from stochcable.errors import ConvergenceError, InputError, ResolutionWarning, SolverError
 from stochcable.dynamics.loads import line_channels
 from stochcable.line.modes import natural_modes
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
 # The fairlead surge spectra below have a PM ω⁻⁵ tail, so the tension spectra are cut by
 # the 2 rad/s grids (ResolutionWarning, tested in test_grid_cutting_the_response_warns);
@@ -56,13 +64,13 @@ def chain_doc(*, grounded: bool = True, sea: bool = True, surge: bool = True,
 def system_and_channels(doc: dict, *, dim: int | None = None, statics_method: str = "auto"):
     scene = load_scene(doc)
     st = solve_statics(scene, method=statics_method).lines[scene.lines[0].name]
-    system = an.build_line_system(scene, scene.lines[0], st, dim=dim)
+    system = dsystem.build_line_system(scene, scene.lines[0], st, dim=dim)
     chans = line_channels(scene, scene.lines[0], system.positions,
                           scene.analysis.omega.values())
     return scene, system, chans
 
 
-def with_all_modes(system: an.LineSystem, solver: str) -> an.LineSystem:
+def with_all_modes(system: dsystem.LineSystem, solver: str) -> dsystem.LineSystem:
     n = int(system.model.free.size)
     return dataclasses.replace(system, modes=natural_modes(system.model, n), n_modes=n,
                                solver=solver)
@@ -76,9 +84,9 @@ def test_foss_with_all_modes_equals_direct(heading, dim):
     doc = chain_doc(heading=heading, elements=16, omega_count=40)
     scene, system, chans = system_and_channels(doc)
     assert system.model.dim == dim  # planar -> 2-D, oblique sea -> 3-D
-    lin = an.linearize(system, chans, scene.analysis)
-    foss = an.solve(with_all_modes(system, "foss"), chans, lin.damping)
-    direct = an.solve(with_all_modes(system, "direct"), chans, lin.damping)
+    lin = dfixedpoint.linearize(system, chans, scene.analysis)
+    foss = dsolve.solve(with_all_modes(system, "foss"), chans, lin.damping)
+    direct = dsolve.solve(with_all_modes(system, "direct"), chans, lin.damping)
     scale = np.max(np.abs(direct.displacement))
     # round-off of a 2n-dimensional QZ eigen-decomposition vs LU: 1e-8 relative
     assert np.max(np.abs(foss.displacement - direct.displacement)) <= 1e-8 * scale
@@ -90,23 +98,23 @@ def test_foss_with_all_modes_equals_direct(heading, dim):
 def test_truncated_foss_converges_to_direct():
     doc = chain_doc(sea=True, surge=True, elements=16, omega_count=40)
     scene, system, chans = system_and_channels(doc)
-    lin = an.linearize(system, chans, scene.analysis)
-    ref = an.solve(with_all_modes(system, "direct"), chans, lin.damping).end_tension["end_b"]
+    lin = dfixedpoint.linearize(system, chans, scene.analysis)
+    ref = dsolve.solve(with_all_modes(system, "direct"), chans, lin.damping).end_tension["end_b"]
     errors = []
     for n in (4, 12, 24):
         sysn = dataclasses.replace(with_all_modes(system, "foss"), n_modes=n)
-        h = an.solve(sysn, chans, lin.damping).end_tension["end_b"]
+        h = dsolve.solve(sysn, chans, lin.damping).end_tension["end_b"]
         errors.append(np.max(np.abs(h - ref)) / np.max(np.abs(ref)))
     # more modes never worse; with the quasi-static split of the end motion and the
     # static correction, 24 of 30 modes is within 1e-3
     assert errors[0] >= errors[1] >= errors[2]
     assert errors[2] < 1e-3
-    # the count an.AUTO_MODE_FACTOR x omega_max (used by "auto" for large models)
+    # the count dsystem.AUTO_MODE_FACTOR x omega_max (used by "auto" for large models)
     # keeps the end-tension σ within 5 %: truncation is slow for drag-dominated lines
     # (the static correction ignores the drag coupling of the truncated modes)
-    n_auto = int(np.count_nonzero(system.modes.omega <= an.AUTO_MODE_FACTOR * 2.0))
+    n_auto = int(np.count_nonzero(system.modes.omega <= dsystem.AUTO_MODE_FACTOR * 2.0))
     sys_auto = dataclasses.replace(with_all_modes(system, "foss"), n_modes=n_auto)
-    h = an.solve(sys_auto, chans, lin.damping).end_tension["end_b"]
+    h = dsolve.solve(sys_auto, chans, lin.damping).end_tension["end_b"]
     spectra = np.stack([c.spectrum for c in chans])
     w = chans[0].omega
 
@@ -128,10 +136,10 @@ def test_undamped_resonance_on_the_grid_is_a_solver_error():
     scene, system, _ = system_and_channels(doc)
     w = np.array([0.5 * system.modes.omega[0], system.modes.omega[0]])
     chans = line_channels(scene, scene.lines[0], system.positions, w)
-    damping = an.drag_coefficients(system, np.zeros(2 * system.model.n_elements), "seed")
+    damping = dvariance.drag_coefficients(system, np.zeros(2 * system.model.n_elements), "seed")
     for solver in ("direct", "foss"):
         with pytest.raises(SolverError, match=r"(?i)resonance|singular"):
-            an.solve(dataclasses.replace(system, solver=solver), chans, damping)
+            dsolve.solve(dataclasses.replace(system, solver=solver), chans, damping)
 
 
 # --------------------------------------------------------- taut string, closed form
@@ -166,14 +174,14 @@ def test_taut_string_end_motion_matches_closed_form():
     scene, system, chans = system_and_channels(doc)
     tension = ea * (span / l0 - 1.0)
     np.testing.assert_allclose(system.model.tension, tension, rtol=1e-9)
-    damping = an.drag_coefficients(system, np.zeros(2 * n_el), "seed")
+    damping = dvariance.drag_coefficients(system, np.zeros(2 * n_el), "seed")
     assert damping.matrix.nnz == 0 or np.all(damping.matrix.data == 0.0)
     # frequencies between the resonances k L = pi and 2 pi (c = sqrt(T/m') with the
     # mass per stretched length m' = m l0 / span)
     c = math.sqrt(tension / (m * l0 / span))
     w = np.array([0.5, 0.8, 1.4, 1.7]) * math.pi * c / span
     chans = line_channels(scene, scene.lines[0], system.positions, w)
-    resp = an.solve(system, chans, damping)
+    resp = dsolve.solve(system, chans, damping)
     x = system.positions[:, 0]
     k = w[:, None] / c
     exact = np.sin(k * x) / np.sin(k * span)
@@ -192,7 +200,7 @@ def test_undamped_mode_on_coarse_grid_warns():
         seg["cd_axial"] = 0.0
     doc["environment"]["seabed"]["damping"] = 0.0
     with pytest.warns(ResolutionWarning, match=r"does not resolve mode \d+ .*analysis.omega"):
-        an.analyze(doc)
+        analysis.analyze(doc)
 
 
 # ------------------------------------------------------------- DSA time series
@@ -202,7 +210,7 @@ def test_dsa_timeseries_variance_equals_spectrum_sum():
     doc = chain_doc(sea=True, surge=False, elements=12, omega_count=40)
     doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 400.0, "dt": 0.5,
                                      "seed": 7}
-    res = an.analyze(doc)
+    res = analysis.analyze(doc)
     ts = res.timeseries
     scene = res.scene
     d_omega = ts.omega[1] - ts.omega[0]
@@ -233,11 +241,11 @@ def test_planar_scene_in_3d_equals_2d_and_has_no_out_of_plane_motion():
     _, sys3, _ = system_and_channels(doc, dim=3)
     # all modes in both (auto would truncate the 45-DOF 3-D model but not the 2-D one)
     sys2, sys3 = with_all_modes(sys2, "foss"), with_all_modes(sys3, "foss")
-    lin2 = an.linearize(sys2, chans, scene.analysis)
-    lin3 = an.linearize(sys3, chans, scene.analysis)
+    lin2 = dfixedpoint.linearize(sys2, chans, scene.analysis)
+    lin3 = dfixedpoint.linearize(sys3, chans, scene.analysis)
     assert lin2.record.iterations == lin3.record.iterations
-    r2 = an.line_result(sys2, chans, lin2, scene.analysis)
-    r3 = an.line_result(sys3, chans, lin3, scene.analysis)
+    r2 = doutputs.line_result(sys2, chans, lin2, scene.analysis)
+    r3 = doutputs.line_result(sys3, chans, lin3, scene.analysis)
     # same physics, same iteration path: agreement to round-off amplified by the solves
     np.testing.assert_allclose(r3.tension_std, r2.tension_std, rtol=1e-8)
     np.testing.assert_allclose(r3.motion_std, r2.motion_std, rtol=1e-8, atol=1e-14)
@@ -255,10 +263,10 @@ def test_vector_form_equals_seed_form_for_in_plane_velocity():
     doc = chain_doc(elements=12, omega_count=30)
     # tight tolerance: the two iterate different vectors, so they agree to ~tolerance
     doc["analysis"]["linearization"] = {"method": "seed", "tolerance": 1e-8}
-    base = an.analyze(doc)
+    base = analysis.analyze(doc)
     doc_v = copy.deepcopy(doc)
     doc_v["analysis"]["linearization"] = {"method": "vector", "tolerance": 1e-8}
-    vec = an.analyze(doc_v)
+    vec = analysis.analyze(doc_v)
     a, b = base.lines["chain"], vec.lines["chain"]
     # recorded b_normal of the vector form is trace/2 = (B11 + B11/2)/2 here
     np.testing.assert_allclose(b.linearization.b_normal, 0.75 * a.linearization.b_normal,
@@ -274,7 +282,7 @@ def chain_result():
     doc = chain_doc(elements=30, omega_count=80)
     doc["analysis"]["timeseries"] = {"method": "nsa", "duration": 200.0, "dt": 0.5,
                                      "seed": 3}
-    return an.analyze(doc)
+    return analysis.analyze(doc)
 
 
 def test_chain_runs_end_to_end_with_finite_statistics(chain_result):
@@ -312,10 +320,10 @@ def test_chain_fairlead_tension_sigma_plausible(chain_result):
     orders of magnitude (which a unit or 2π error would)."""
     lr = chain_result.lines["chain"]
     scene = chain_result.scene
-    system = an.build_line_system(scene, scene.lines[0], chain_result.statics.lines["chain"])
+    system = dsystem.build_line_system(scene, scene.lines[0], chain_result.statics.lines["chain"])
     w0 = np.array([1e-3])
     chans = line_channels(scene, scene.lines[0], system.positions, w0)
-    resp = an.solve(system, chans, an.drag_coefficients(
+    resp = dsolve.solve(system, chans, dvariance.drag_coefficients(
         system, np.zeros(2 * system.model.n_elements), "seed"))
     k_t = abs(resp.end_tension["end_b"][chans.index(
         next(c for c in chans if c.name == "end_b.surge")), 0])
@@ -341,8 +349,8 @@ def _fd_end_tension(doc: dict, method: str, delta: float = 0.01) -> float:
 def _low_frequency_transfer(doc: dict, method: str) -> complex:
     scene, system, _ = system_and_channels(doc, statics_method=method)
     chans = line_channels(scene, scene.lines[0], system.positions, np.array([1e-3]))
-    damping = an.drag_coefficients(system, np.zeros(2 * system.model.n_elements), "seed")
-    return an.solve(system, chans, damping).end_tension["end_b"][0, 0]
+    damping = dvariance.drag_coefficients(system, np.zeros(2 * system.model.n_elements), "seed")
+    return dsolve.solve(system, chans, damping).end_tension["end_b"][0, 0]
 
 
 def test_quasi_static_fairlead_tension_matches_catenary_stiffness():
@@ -373,13 +381,13 @@ def test_end_reaction_tends_to_end_element_tension():
     for n_el in (10, 40):
         doc = chain_doc(grounded=False, sea=False, elements=n_el, omega_count=20)
         scene, system, chans = system_and_channels(doc)
-        lin = an.linearize(system, chans, scene.analysis)
-        et = an.element_tension_transfer(system, lin.response)
+        lin = dfixedpoint.linearize(system, chans, scene.analysis)
+        et = doutputs.element_tension_transfer(system, lin.response)
         ref = lin.response.end_tension["end_b"][0]
         diffs.append(np.max(np.abs(et[0, -1] - ref)) / np.max(np.abs(ref)))
         ch0 = line_channels(scene, scene.lines[0], system.positions, np.array([1e-3]))
-        r0 = an.solve(system, ch0, lin.damping)
-        e0 = an.element_tension_transfer(system, r0)[0, -1, 0]
+        r0 = dsolve.solve(system, ch0, lin.damping)
+        e0 = doutputs.element_tension_transfer(system, r0)[0, -1, 0]
         t0 = r0.end_tension["end_b"][0, 0]
         lows.append(abs(e0 - t0) / abs(t0))
     # quasi-static: only the rotation of the end node's share of the weight differs,
@@ -398,7 +406,7 @@ def test_unconverged_linearization_raises():
     with pytest.raises(ConvergenceError,
                        match=r"drag linearization of line 'chain' did not converge.*"
                              r"after 1 iterations.*max_iterations"):
-        an.analyze(doc)
+        analysis.analyze(doc)
 
 
 def test_unconverged_linearization_flagged_when_allowed():
@@ -407,7 +415,7 @@ def test_unconverged_linearization_flagged_when_allowed():
                                         "allow_unconverged": True}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = an.analyze(doc)
+        res = analysis.analyze(doc)
     assert res.converged is False
     d = res.to_document()
     assert d["linearization"]["converged"] is False
@@ -421,7 +429,7 @@ def test_harmonic_form_with_current_is_rejected():
     doc["environment"]["current"] = [{"z": 0.0, "speed": 0.5}]
     doc["analysis"]["linearization"] = {"method": "harmonic"}
     with pytest.raises(InputError, match="harmonic.*current"):
-        an.analyze(doc)
+        analysis.analyze(doc)
 
 
 def test_rao_without_sea_is_rejected():
@@ -430,7 +438,7 @@ def test_rao_without_sea_is_rejected():
                                                   "surge": {"re": [1.0, 1.0],
                                                             "im": [0.0, 0.0]}}}
     with pytest.raises(InputError, match="needs a 'sea'"):
-        an.analyze(doc)
+        analysis.analyze(doc)
 
 
 def test_support_forces_balance_quasi_statically():
@@ -439,10 +447,10 @@ def test_support_forces_balance_quasi_statically():
     doc = chain_doc(grounded=False, sea=False, elements=20)
     scene, system, _ = system_and_channels(doc)
     chans = line_channels(scene, scene.lines[0], system.positions, np.array([1e-4, 2e-4]))
-    damping = an.drag_coefficients(system, np.zeros(2 * system.model.n_elements), "seed")
-    lin = an.Linearization(damping=damping, record=None,
-                           response=an.solve(system, chans, damping))
-    res = an.line_result(system, chans, lin, scene.analysis)
+    damping = dvariance.drag_coefficients(system, np.zeros(2 * system.model.n_elements), "seed")
+    lin = dsystem.Linearization(damping=damping, record=None,
+                           response=dsolve.solve(system, chans, damping))
+    res = doutputs.line_result(system, chans, lin, scene.analysis)
     fa = res.end_force_transfer["end_a"][0, :, 0]
     fb = res.end_force_transfer["end_b"][0, :, 0]
     # inertia ω² M_total U_mean at 1e-4 rad/s: ~1e-8 of the force
@@ -459,10 +467,10 @@ def test_grid_cutting_the_response_warns():
     doc = chain_doc(sea=False, elements=12, omega_count=60)
     with pytest.warns(ResolutionWarning, match=r"end_b tension spectrum .* raise "
                                                r"analysis.omega.max"):
-        short = an.analyze(doc)
+        short = analysis.analyze(doc)
     doc["analysis"]["omega"]["max"] = 6.0
     doc["analysis"]["omega"]["count"] = 180
-    long = an.analyze(doc)
+    long = analysis.analyze(doc)
     assert long.lines["chain"].end_b.std > 1.05 * short.lines["chain"].end_b.std
 
 
@@ -471,8 +479,8 @@ def test_rao_end_motion_adds_coherently_to_the_wave_loads():
     H_waves + RAO(ω)·H_unit-surge (complex sum, not a sum of variances)."""
     doc = chain_doc(sea=True, surge=True, elements=12, omega_count=20)
     scene, system, chans = system_and_channels(doc)
-    lin = an.linearize(system, chans, scene.analysis)
-    base = an.solve(system, chans, lin.damping).end_tension["end_b"]  # [sea, surge]
+    lin = dfixedpoint.linearize(system, chans, scene.analysis)
+    base = dsolve.solve(system, chans, lin.damping).end_tension["end_b"]  # [sea, surge]
     w = chans[0].omega
     rao_re, rao_im = np.cos(w) * 0.8, -0.3 * w
     doc_r = copy.deepcopy(doc)
@@ -482,7 +490,7 @@ def test_rao_end_motion_adds_coherently_to_the_wave_loads():
     scene_r = load_scene(doc_r)
     chans_r = line_channels(scene_r, scene_r.lines[0], system.positions, w)
     assert [c.name for c in chans_r] == ["sea"]
-    with_rao = an.solve(dataclasses.replace(system, line=scene_r.lines[0]), chans_r,
+    with_rao = dsolve.solve(dataclasses.replace(system, line=scene_r.lines[0]), chans_r,
                         lin.damping).end_tension["end_b"][0]
     expected = base[0] + (rao_re + 1j * rao_im) * base[1]
     # linear superposition: round-off only
@@ -495,7 +503,7 @@ def test_strong_current_drag_tends_to_steady_drag_tangent():
     doc = chain_doc(grounded=False, sea=True, surge=False, elements=12, omega_count=20)
     doc["sea"]["spectrum"] = {"type": "pierson_moskowitz", "hs": 0.05, "tp": 9.0}
     doc["environment"]["current"] = [{"z": 0.0, "speed": 1.5, "heading": 0.0}]
-    res = an.analyze(doc)
+    res = analysis.analyze(doc)
     rec = res.lines["chain"].linearization
     pos = res.lines["chain"].positions
     e = np.diff(pos, axis=0)
@@ -537,11 +545,11 @@ def test_rayleigh_damping_equals_independent_linear_solve():
     Z = K[None] - w[:, None, None] ** 2 * MT[None] + 1j * w[:, None, None] * C[None]
     rhs = F[:, free] - Z[:, free][:, :, fixed] @ ub
     u_ref = np.linalg.solve(Z[:, free][:, :, free], rhs)
-    lin = an.linearize(system, chans, scene.analysis)
+    lin = dfixedpoint.linearize(system, chans, scene.analysis)
     assert np.all(lin.damping.b_normal == 0.0) and np.all(lin.damping.b_axial == 0.0)
     for solver in ("direct", "foss"):
         sysx = with_all_modes(system, solver)
-        resp = an.solve(sysx, chans, lin.damping)
+        resp = dsolve.solve(sysx, chans, lin.damping)
         # two exact solves of a 22-DOF system (LU vs Foss eigenvectors): round-off
         u = resp.displacement[:, free]
         assert np.max(np.abs(u - u_ref)) <= 1e-9 * np.max(np.abs(u_ref)), solver
@@ -552,7 +560,7 @@ def test_rayleigh_damping_equals_independent_linear_solve():
         ref_f = -(Z[:, fixed] @ u_all - F[:, fixed])
         assert np.max(np.abs(resp.support_force - ref_f)) <= 1e-8 * np.max(np.abs(ref_f))
     # analyze() reaches the same system: end tension σ with and without all modes
-    res = an.analyze(doc)
+    res = analysis.analyze(doc)
     assert res.lines["chain"].linearization.converged
 
 
@@ -578,9 +586,9 @@ def test_rayleigh_damped_taut_string_first_mode_peak():
     q = gamma * (w1**2 - 1j * alpha * w1) / (2j * zeta * w1**2)
     expected = abs(0.5 + q)
     chans = line_channels(scene, scene.lines[0], system.positions, np.array([w1]))
-    damping = an.drag_coefficients(system, np.zeros(2 * n_el), "seed")
+    damping = dvariance.drag_coefficients(system, np.zeros(2 * n_el), "seed")
     for solver in ("direct", "foss"):
-        resp = an.solve(dataclasses.replace(system, solver=solver), chans, damping)
+        resp = dsolve.solve(dataclasses.replace(system, solver=solver), chans, damping)
         mid = resp.displacement[0, 2 * (n_el // 2) + 1, 0]
         # non-resonant modes 3, 5, … add ~Γ3/8 ≈ 0.03 (4e-4 of |q| ≈ 60), FE frequency
         # error (kh)²/24 ≈ 4e-5 of ω1 moves the peak by 4e-5/ζ ≈ 1 % in phase, < 1e-4
@@ -589,7 +597,7 @@ def test_rayleigh_damped_taut_string_first_mode_peak():
     # and without structural damping the same frequency is an undamped resonance
     undamped = dataclasses.replace(system, structural_damping=(0.0, 0.0))
     with pytest.raises(SolverError, match="singular|resonance"):
-        an.solve(undamped, line_channels(scene, scene.lines[0], system.positions,
+        dsolve.solve(undamped, line_channels(scene, scene.lines[0], system.positions,
                                          np.array([system.modes.omega[0]])), damping)
 
 
@@ -599,13 +607,13 @@ def test_damping_matrix_is_assembled_lazily_and_equals_drag_matrix():
     import json
     from pathlib import Path
 
-    path = Path(an.__file__).parents[1] / "examples" / "chain_catenary.json"
+    path = Path(dsystem.__file__).parents[1] / "examples" / "chain_catenary.json"
     scene = load_scene(json.loads(path.read_text()))
     st = solve_statics(scene)
     line = scene.lines[0]
-    system = an.build_line_system(scene, line, st.lines[line.name])
+    system = dsystem.build_line_system(scene, line, st.lines[line.name])
     n_el = system.model.n_elements
-    damping = an.drag_coefficients(system, np.linspace(0.1, 0.5, 2 * n_el), "seed")
+    damping = dvariance.drag_coefficients(system, np.linspace(0.1, 0.5, 2 * n_el), "seed")
     assert "matrix" not in damping._cache  # nothing assembled in the iteration
     ref = drag_matrix(system.model, damping.b_normal, damping.b_axial, damping.b_node)
     assert abs(damping.matrix - ref).max() == 0.0  # the same assembly, exactly
@@ -619,9 +627,9 @@ def test_damping_matrix_is_assembled_lazily_and_equals_drag_matrix():
 @pytest.fixture(scope="module")
 def chain_parts():
     scene, system, chans = system_and_channels(chain_doc(elements=16, omega_count=100))
-    inp = an._inputs(system, chans)
-    x = an._rest_sigmas(system, inp, "seed")
-    damping = an.drag_coefficients(system, x, "seed")
+    inp = dloads.line_inputs(system, chans)
+    x = dvariance.rest_sigmas(system, inp, "seed")
+    damping = dvariance.drag_coefficients(system, x, "seed")
     return scene, system, chans, inp, damping
 
 
@@ -633,12 +641,12 @@ def test_node_block_stash_follows_in_place_changes(chain_parts):
     d = model.dim
     k = model.K.copy()  # a copy carries no stash: the CSR route
     k._node_blocks = model.K._node_blocks
-    ref = an._blocks_of(model.K.copy(), d)
-    got = an._blocks_of(k, d)
+    ref = dblocks.node_blocks(model.K.copy(), d)
+    got = dblocks.node_blocks(k, d)
     for g_, r_ in zip(got, ref):
         np.testing.assert_array_equal(g_, r_)
     k.data *= 2.0  # changed in place: the stash no longer matches its entries
-    for g_, r_ in zip(an._blocks_of(k, d), ref):
+    for g_, r_ in zip(dblocks.node_blocks(k, d), ref):
         np.testing.assert_array_equal(g_, 2.0 * r_)
 
 
@@ -648,11 +656,11 @@ def test_base_load_equals_block_products(chain_parts):
     products of the whole U_p (the route it replaced): 1e-13 of the largest load
     (round-off of sums in another order)."""
     _, system, _, inp, _ = chain_parts
-    prep = an._prep(system)
-    u, f0, q = an._base(system, prep, inp)
-    u_ref = an._quasi_static(system, inp)  # Foss: U_p is the quasi-static following
+    prep = dblocks.line_prep(system)
+    u, f0, q = dloads.base_motion(system, prep, inp)
+    u_ref = dvariance.quasi_static_motion(system, inp)  # Foss: U_p is the quasi-static following
     np.testing.assert_allclose(u, u_ref, rtol=0, atol=1e-14 * np.abs(u_ref).max())
-    f0_ref = inp.inertia_load - an._dynamic(prep, prep.S, inp.omega, u_ref)
+    f0_ref = inp.inertia_load - dsolve._dynamic(prep, prep.S, inp.omega, u_ref)
     np.testing.assert_allclose(f0, f0_ref, rtol=0, atol=1e-13 * np.abs(f0_ref).max())
     np.testing.assert_array_equal(u[..., 0], 0.0)  # the sea channel moves no end
     np.testing.assert_array_equal(f0[..., 0], inp.inertia_load[..., 0])
@@ -662,11 +670,11 @@ def test_free_load_equals_drag_load_plus_damping_of_end_motion(chain_parts):
     """_free_load merges F_d(V) and C_d Q into one element load of combined moments;
     against the two loads of the route it replaced: 1e-13 of the largest."""
     _, system, _, inp, damping = chain_parts
-    prep = an._prep(system)
-    _, f0, q = an._base(system, prep, inp)
-    ref = an._drag_load(system, inp, damping) + f0 + an._matvec(
-        an._drag_blocks(system, damping), q)
-    got = an._free_load(system, prep, inp, damping)
+    prep = dblocks.line_prep(system)
+    _, f0, q = dloads.base_motion(system, prep, inp)
+    ref = dloads._drag_load(system, inp, damping) + f0 + dblocks.block_matvec(
+        dloads.drag_blocks(system, damping), q)
+    got = dloads.free_load(system, prep, inp, damping)
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
 
 
@@ -674,21 +682,21 @@ def test_rest_sigmas_equal_quasi_static_sigmas(chain_parts):
     """The start σ from the cached projections (Foss) are _sigmas of the quasi-static
     motion, to the bit."""
     _, system, _, inp, _ = chain_parts
-    ref = an._sigmas(system, inp, an._quasi_static(system, inp), "seed")
-    np.testing.assert_array_equal(an._rest_sigmas(system, inp, "seed"), ref)
+    ref = dvariance.sigmas_from_nodes(system, inp, dvariance.quasi_static_motion(system, inp), "seed")
+    np.testing.assert_array_equal(dvariance.rest_sigmas(system, inp, "seed"), ref)
 
 
 def test_subset_caches_are_the_subset_computation(chain_parts):
     """The coarse subset slices the full grid's drag-independent arrays; computed on
     the subset directly they are the same (1e-15: products in other batch sizes)."""
     _, system, chans, inp, _ = chain_parts
-    prep = an._prep(system)
-    an._qproj(system, inp, "seed")
-    an._drag_inputs(system, prep, inp)
-    an._fluid_terms(system, inp, "seed")
-    idx = an._uniform_subset(inp.omega.size)
-    sliced = an._subset_inputs(system, chans, inp, idx)
-    fresh = an._subset_inputs(system, chans, an._inputs(system, chans), idx)
+    prep = dblocks.line_prep(system)
+    dvariance.end_motion_projections(system, inp, "seed")
+    dloads.drag_inputs(system, prep, inp)
+    dvariance.fluid_terms(system, inp, "seed")
+    idx = dfixedpoint._uniform_subset(inp.omega.size)
+    sliced = dfixedpoint.subset_inputs(system, chans, inp, idx)
+    fresh = dfixedpoint.subset_inputs(system, chans, dloads.line_inputs(system, chans), idx)
     assert ("qproj", "foss", "seed") in sliced.cache and not fresh.cache
 
     def close(a, b):
@@ -698,9 +706,9 @@ def test_subset_caches_are_the_subset_computation(chain_parts):
             scale = float(np.abs(b).max(initial=0.0))
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-15 * scale)
 
-    for fn in (lambda i: an._base(system, prep, i), lambda i: an._drag_inputs(system, prep, i),
-               lambda i: an._qproj(system, i, "seed"),
-               lambda i: an._fluid_terms(system, i, "seed")):
+    for fn in (lambda i: dloads.base_motion(system, prep, i), lambda i: dloads.drag_inputs(system, prep, i),
+               lambda i: dvariance.end_motion_projections(system, i, "seed"),
+               lambda i: dvariance.fluid_terms(system, i, "seed")):
         for a, b in zip(fn(sliced), fn(fresh)):
             close(a, b)
 
@@ -711,12 +719,12 @@ def test_reactions_and_tension_transfer_equal_their_direct_formulas(chain_parts)
     transfer against the einsum e·(u_b − u_a)·EA/l0: 1e-12 of the largest (the end rows
     sum stiffness terms much larger than their sum)."""
     _, system, chans, inp, damping = chain_parts
-    prep = an._prep(system)
-    u_f, c = an._solve_free(system, inp, damping)
-    u = an._total(system, inp, u_f)
+    prep = dblocks.line_prep(system)
+    u_f, c = dsolve.solve_free(system, inp, damping)
+    u = dsolve.total_displacement(system, inp, u_f)
     w = inp.omega
-    got = an._reactions(system, prep, c, u, an._end_loads(system, inp, damping), w)
-    f_all = an._loads(system, inp, damping)
+    got = dsolve.reactions(system, prep, c, u, dloads.end_loads(system, inp, damping), w)
+    f_all = dloads.fluid_loads(system, inp, damping)
     w2, iw = (w * w)[:, None, None], (1j * w)[:, None, None]
 
     def z(k, i):
@@ -728,12 +736,12 @@ def test_reactions_and_tension_transfer_equal_their_direct_formulas(chain_parts)
           + np.einsum("wpq,qwc->wpc", z(1, -1), u[-2]) - np.moveaxis(f_all[-1], 1, 0))
     ref = -np.concatenate([ra, rb], axis=1)
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
-    resp = an._response(system, inp, damping, (u, c))
+    resp = dsolve.line_response(system, inp, damping, (u, c))
     model = system.model
     uu = resp.displacement.reshape(w.size, model.n_nodes, model.dim, -1)
     ref_t = (model.mesh.ea / model.l0)[None, :, None] * np.einsum(
         "wedc,ed->cew", uu[:, 1:] - uu[:, :-1], model.tangents)
-    got_t = an.element_tension_transfer(system, resp)
+    got_t = doutputs.element_tension_transfer(system, resp)
     np.testing.assert_allclose(got_t, ref_t, rtol=0, atol=1e-14 * np.abs(ref_t).max())
 
 
@@ -747,8 +755,8 @@ def test_attachment_drag_sigma_is_the_total_relative_velocity_sigma():
                                        "drag_area": 2.0, "added_mass": 300.0}]
     scene, system, chans = system_and_channels(doc)
     node = int(system.drag_nodes[0])
-    lin = an.linearize(system, chans, scene.analysis)
-    sig = an.relative_velocity_sigmas(system, chans, lin.response, "seed")
+    lin = dfixedpoint.linearize(system, chans, scene.analysis)
+    sig = dvariance.relative_velocity_sigmas(system, chans, lin.response, "seed")
     w = chans[0].omega
     u = lin.response.displacement.reshape(w.size, system.model.n_nodes, system.model.dim, -1)
     comps = list(system.model.components)
@@ -761,7 +769,7 @@ def test_attachment_drag_sigma_is_the_total_relative_velocity_sigma():
         var += np.trapezoid(ch.spectrum * np.sum(np.abs(rel) ** 2, axis=1), w)
     # the same sums in another order: round-off
     assert sig[-1] == pytest.approx(math.sqrt(var), rel=1e-12)
-    res = an.analyze(doc)
+    res = analysis.analyze(doc)
     assert np.isfinite(res.lines["chain"].end_b.std)
 
 
@@ -780,10 +788,10 @@ def test_warnings_and_document_use_the_scene_units_in_feet(monkeypatch) -> None:
     from stochcable.scene.units import FOOT_SLUG_SECOND
 
     # a zero sag threshold forces the large-motion warning, so all three are checked
-    monkeypatch.setattr(an, "MOTION_SAG_FRACTION", 0.0)
+    monkeypatch.setattr(dindicators, "MOTION_SAG_FRACTION", 0.0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = an.analyze(_scene_without_timeseries("tuah_1982_single_leg"))
+        res = analysis.analyze(_scene_without_timeseries("tuah_1982_single_leg"))
     snap = [m for m in res.warnings if "dynamic tension σ" in m]
     surface = [m for m in res.warnings if "wave-velocity σ varies" in m]
     motion = [m for m in res.warnings if "motion σ at node" in m]
@@ -799,22 +807,22 @@ def test_warnings_and_document_use_the_scene_units_in_feet(monkeypatch) -> None:
 
 
 def test_result_document_names_si_units() -> None:
-    doc = an.analyze(_scene_without_timeseries("taut_wire")).to_document()
+    doc = analysis.analyze(_scene_without_timeseries("taut_wire")).to_document()
     assert doc["units"] == {"system": "SI", "length": "m", "mass": "kg", "force": "N",
                             "time": "s"}
 
 
 def test_pipeline_statistics_equal_the_validated_public_function() -> None:
     """The analysis' end statistics skip the second validation of its grid
-    (results._stats_from_validated) and equal results.stats_from_spectrum to the bit; the
+    (results.stats_from_validated) and equal results.stats_from_spectrum to the bit; the
     public function still rejects a bad grid with its message."""
-    from stochcable.results.documents import _stats_from_validated, stats_from_spectrum
+    from stochcable.results.documents import stats_from_validated, stats_from_spectrum
 
     rng = np.random.default_rng(5)
     w = np.linspace(0.05, 2.0, 120)
     dens = rng.uniform(0.0, 1.0, w.size) ** 2
     for duration in (10800.0, 3600.0):
-        assert (_stats_from_validated(w, dens, 12.5, duration).as_dict()
+        assert (stats_from_validated(w, dens, 12.5, duration).as_dict()
                 == stats_from_spectrum(w, dens, 12.5, duration).as_dict())
     with pytest.raises(InputError, match="omega"):
         stats_from_spectrum(w[::-1], dens, 0.0, 10800.0)
@@ -829,7 +837,7 @@ def test_nearest_spacing_equals_argmin_and_gradient():
     omega = np.cumsum(rng.uniform(0.01, 0.1, 50)) + 0.1
     mids = 0.5 * (omega[1:] + omega[:-1])
     x = np.concatenate([omega[[0, 1, -2, -1]], mids[::7], rng.uniform(omega[0], omega[-1], 200)])
-    dist, spacing = an._nearest_spacing(omega, x)
+    dist, spacing = dindicators._nearest_spacing(omega, x)
     near = np.argmin(np.abs(omega[None, :] - x[:, None]), axis=1)
     # exact equality: the same subtractions and divisions as np.argmin/np.gradient
     np.testing.assert_array_equal(dist, np.abs(omega[near] - x))

@@ -1,4 +1,4 @@
-"""Validation of :func:`stochcable.dynamics.line.analyze` against independent references
+"""Validation of :func:`stochcable.analysis.analyze` against independent references
 (GitHub issue 4, "Must be shown by tests"): the realization's convolution identity,
 Foss at a mode crossover (Irvine's λ² = 4π², seed 000) and with exactly repeated
 eigenvalues (taut wire), the Cd = 0 limit against the closed-form transfer function of
@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.sea.kinematics import wave_kinematics
 from stochcable.sea.realization import simulate_sea, synthesize
 

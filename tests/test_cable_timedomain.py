@@ -3,7 +3,7 @@
 Every check compares the time-domain (TD) simulation with something independent: the
 statics module (static start), the frequency-domain finite-element matrices of
 :mod:`stochcable.line.fem` / :mod:`stochcable.dynamics.loads` solved directly (harmonic and
-linear-limit tests), and :func:`stochcable.dynamics.line.analyze` (statistics and the
+linear-limit tests), and :func:`stochcable.analysis.analyze` (statistics and the
 synthesized series of the same realization).
 """
 
@@ -18,7 +18,7 @@ import pytest
 from stochcable.errors import ConvergenceError, InputError, ResolutionWarning
 from stochcable.line.fem import assemble
 from stochcable.line.mesh import mesh_line
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 from stochcable.reference.cable import newmark_period_error, simulate_line_timedomain
 from stochcable.scene.model import load_scene
 
@@ -238,7 +238,7 @@ def test_linear_limit_same_realization_equals_fe_synthesis():
 def test_linear_limit_same_realization_equals_analysis_series():
     # The product's own synthesized end-tension series (analyze, same seed, same
     # band) against the TD end tension: the same realization drives both.
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
 
     scene = _taut(hs=0.1, cd=1.2, current=1.0,
                   ts={"duration": 256.0, "dt": 0.25, "seed": 7})
@@ -303,7 +303,7 @@ def test_sigma_frequency_domain_vs_time_domain(case):
 
 
 def analyze_scene(scene):
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
 
     return analyze(scene)
 

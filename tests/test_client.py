@@ -19,7 +19,7 @@ import stochcable.errors
 from service.app import create_app
 from service.settings import Settings
 from _compare import assert_close_documents
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.client import AnalysisDocument, Client, ClientError, ServiceError
 from stochcable.examples import load_example
 from stochcable.sea.kinematics import kinematics_timeseries

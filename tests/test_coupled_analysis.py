@@ -19,23 +19,14 @@ from _scenes import three_chain_legs
 import pytest
 from scipy.spatial.transform import Rotation
 
-from stochcable.dynamics.line import (
-    _inputs,
-    _loads,
-    _to_freq,
-    build_line_system,
-    line_result,
-    linearize,
-)
-from stochcable.bodies.rigid import (
-    ExcitationTable,
-    LineLink,
-    RigidBody,
-    couple,
-    coupled_load,
-    expand_line,
-    solve_coupled_direct,
-)
+from stochcable.dynamics.line_loads import line_inputs, fluid_loads
+from stochcable.dynamics.blocks import to_freq
+from stochcable.dynamics.system import build_line_system
+from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.fixedpoint import linearize
+from stochcable.bodies.rigid import ExcitationTable, RigidBody
+from stochcable.bodies.coupling import LineLink, couple, coupled_load, expand_line
+from stochcable.reference.bodies import solve_coupled_direct
 from stochcable.dynamics.coupled import (
     BodyLoads,
     CoupledLine,
@@ -48,7 +39,7 @@ from stochcable.dynamics.coupled import (
 from stochcable.errors import InputError
 from stochcable.dynamics.loads import Channel, line_channels
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
 RHO = 1025.0
 
@@ -263,8 +254,8 @@ def test_substructure_equals_assembled_coupled_system(mooring_direct):
         links.append(LineLink(cl.name, cl.system.model, end_b="buoy",
                               force_b=cl.system.statics.force_b,
                               damping=damp.matrix))
-        inp = _inputs(cl.system, cl.channels)
-        line_loads[cl.name] = _to_freq(_loads(cl.system, inp, damp))
+        inp = line_inputs(cl.system, cl.channels)
+        line_loads[cl.name] = to_freq(fluid_loads(cl.system, inp, damp))
     from stochcable.dynamics.coupled.group import linear_body_drag
 
     bb, cdrag = linear_body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
@@ -766,8 +757,8 @@ def test_sliced_channel_inputs_equal_the_subset_of_the_full_inputs(mooring_direc
     scene, cls, loads, body, lin = mooring_direct
     s = cls[0].system
     idx = np.array([0, 3, 7, 20, 39])
-    full = _inputs(s, cls[0].channels)
-    sub = _inputs(s, tuple(_sliced_channel(c, idx) for c in cls[0].channels))
+    full = line_inputs(s, cls[0].channels)
+    sub = line_inputs(s, tuple(_sliced_channel(c, idx) for c in cls[0].channels))
     np.testing.assert_array_equal(sub.omega, full.omega[idx])
     np.testing.assert_allclose(sub.inertia_load, full.inertia_load[:, :, idx], rtol=1e-13)
     np.testing.assert_allclose(sub.moments, full.moments[..., idx, :], rtol=1e-13)
@@ -780,7 +771,8 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     is the plain analysis._solve_free of the augmented channels: the same linear
     system, so equal to round-off (1e-10 of the largest entry), truncated (8 of 27
     modes, static correction on) or not."""
-    from stochcable.dynamics.line import _solve_free, drag_coefficients
+    from stochcable.dynamics.solve import solve_free
+    from stochcable.dynamics.variance import drag_coefficients
     from stochcable.dynamics.coupled.group import GroupSystem
     from stochcable.dynamics.coupled.lineparts import foss_unit_split
 
@@ -794,7 +786,7 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     # a drag of a plausible size: σ = 0.3 m/s on every element
     damp = drag_coefficients(s, np.full(2 * s.model.n_elements, 0.3), "seed")
     got, _ = foss_unit_split(s, g.inp_phys[cl.name], g.inp[cl.name], damp)
-    ref, _ = _solve_free(s, g.inp[cl.name], damp)
+    ref, _ = solve_free(s, g.inp[cl.name], damp)
     assert got.shape == ref.shape and got.shape[-1] == 4  # sea + 3 unit columns
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
 
@@ -804,7 +796,7 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
 
 def test_all_dofs_fixed_equals_lines_with_fixed_fairleads():
     """A buoy with all six DOFs in ``fixed_dofs`` holds its fairleads: each leg is the
-    independent analysis (stochcable.dynamics.line.linearize) of the leg with its fairlead
+    independent analysis (stochcable.dynamics.fixedpoint.linearize) of the leg with its fairlead
     fixed at the same static point; the body does not move."""
     body = _buoy(fixed_dofs=("surge", "sway", "heave", "roll", "pitch", "yaw"))
     scene, cls, loads = _group(_mooring_doc(), body)
@@ -884,7 +876,7 @@ def test_fixed_dofs_modes_are_the_constrained_eigenproblem(mooring_direct, metho
     rows and columns); the fixed DOFs are zero in the shapes."""
     import scipy.linalg as sla
 
-    from stochcable.bodies.rigid import constant_matrices
+    from stochcable.bodies.coupling import constant_matrices
 
     scene, cls, _, body0, _ = mooring_direct
     body = dataclasses.replace(body0, fixed_dofs=("heave", "yaw"))
@@ -991,7 +983,7 @@ def test_large_static_body_rotation_is_flagged():
     examples (0.45° and 0.12°) get none."""
     import warnings
 
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
     from stochcable.dynamics.coupled.model import STATIC_ROTATION_LIMIT
     from stochcable.errors import PhysicsWarning
     from stochcable.examples import load_example
@@ -1155,10 +1147,11 @@ def test_coupled_bandwidths_tend_to_the_fixed_end_ones_under_a_heavy_body():
     """One leg on a body 10⁶ times heavier (its end all but held): the line-dominated
     coupled modes are the leg's fixed-end modes and their modal damping φᵀCφ
     (:func:`coupled_modal_bandwidths`) the fixed-end one of
-    :func:`stochcable.dynamics.line._modal_bandwidths` (1e-4; measured ≤ 8e-6 with
+    :func:`stochcable.dynamics.indicators.modal_bandwidths` (1e-4; measured ≤ 8e-6 with
     body energy fractions ≤ 1e-5 in those modes)."""
     from stochcable.dynamics.coupled.modes import coupled_modal_bandwidths
-    from stochcable.dynamics.line import _modal_bandwidths, drag_coefficients
+    from stochcable.dynamics.indicators import modal_bandwidths
+    from stochcable.dynamics.variance import drag_coefficients
 
     heavy = _buoy(mass=2.0e10, inertia=np.diag([5e10, 5e10, 8e10]),
                   hydrostatic_stiffness=np.diag([1e9, 1e9, 1.26e11, 1e11, 1e11, 1e9]))
@@ -1169,7 +1162,7 @@ def test_coupled_bandwidths_tend_to_the_fixed_end_ones_under_a_heavy_body():
     m = coupled_modes([cl], [heavy], 0.7, 2.0, method="full")
     band = coupled_modal_bandwidths(m, [cl], [heavy], {cl.name: damp})
     fixed_w = np.asarray(cl.system.modes.omega)
-    fixed_b = _modal_bandwidths(cl.system, damp)
+    fixed_b = modal_bandwidths(cl.system, damp)
     checked = 0
     for k, w in enumerate(m.omega):
         j = int(np.argmin(np.abs(fixed_w - w)))

@@ -23,13 +23,8 @@ import stochcable.dynamics.coupled.coarse as cc
 import stochcable.dynamics.coupled.group as cg
 import stochcable.dynamics.coupled.lineparts as cp
 import stochcable.dynamics.coupled.modes as cm
-from stochcable.dynamics.line import (
-    _noop,
-    _quasi_static,
-    _sigmas,
-    build_line_system,
-    drag_coefficients,
-)
+from stochcable.dynamics.system import noop_progress, build_line_system
+from stochcable.dynamics.variance import quasi_static_motion, sigmas_from_nodes, drag_coefficients
 from stochcable.bodies.rigid import RigidBody
 from stochcable.dynamics.coupled import (
     CoupledLine,
@@ -40,7 +35,7 @@ from stochcable.dynamics.coupled import (
 from stochcable.dynamics.coupled.group import GroupSystem, solve_group
 from stochcable.dynamics.loads import line_channels
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
 sys.path.insert(0, str(Path(__file__).parent))
 from test_coupled_analysis import RHO, _buoy, _group, _mooring_doc  # noqa: E402
@@ -261,19 +256,20 @@ def test_foss_decomposition_of_a_line_with_drag_solves_the_quadratic_eigenproble
     thread pool) on a line's kept modes with drag: every pair satisfies
     (λ²M̂ + λĈ + K̂)χ = 0 to 1e-10 of the terms' size (round-off of a 78×78 geev with
     condition ≈ the printed one), and the pairs come in complex conjugates."""
-    from stochcable.dynamics.line import _add, _drag_blocks, _matvec, _prep
-    from stochcable.dynamics.solvers import _foss_decomposition
+    from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep
+    from stochcable.dynamics.line_loads import drag_blocks
+    from stochcable.dynamics.modal_solvers import foss_modes
 
     body = _buoy()
     _, cls, _ = _group(_mooring_doc(solver="foss", tol=1e-4), body)
     system = cls[0].system
-    prep = _prep(system)
+    prep = line_prep(system)
     damping = drag_coefficients(system, np.full(2 * system.model.n_elements, 0.3), "seed")
-    c = _add(prep.S, _drag_blocks(system, damping))
+    c = add_blocks(prep.S, drag_blocks(system, damping))
     phi, mh, kh = prep.modal(system)
-    ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
+    ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
     ch = 0.5 * (ch + ch.T)
-    got = _foss_decomposition(mh, ch, kh)
+    got = foss_modes(mh, ch, kh)
     lam, chi = got.lambdas, got.chi
     res = (lam**2 * (mh @ chi) + lam * (ch @ chi) + kh @ chi)
     # normwise backward error of each pair (element-wise would divide round-off by
@@ -335,13 +331,13 @@ def _coarse_update(g, idx, x=None):
     """The coarse group of ``g`` on ``idx`` and its map evaluated at ``x`` (default
     the rest σ scaled up, so the drag is not tiny)."""
     gc = cc._coarse_group(g, idx)
-    rest = [_sigmas(cl.system, g.inp_phys[cl.name],
-                       _quasi_static(cl.system, g.inp_phys[cl.name]), "seed")
+    rest = [sigmas_from_nodes(cl.system, g.inp_phys[cl.name],
+                       quasi_static_motion(cl.system, g.inp_phys[cl.name]), "seed")
             for cl in g.lines]
     gc.sizes = {cl.name: p.size for cl, p in zip(g.lines, rest)}
     rest += [cg.body_sigma(g, b, None) for b in g.drag]
     x = 3.0 * np.concatenate(rest) if x is None else x
-    upd = cg.sigma_update(gc, "seed", RHO, {}, {}, _noop, "g", None)
+    upd = cg.sigma_update(gc, "seed", RHO, {}, {}, noop_progress, "g", None)
     return gc, upd, x
 
 

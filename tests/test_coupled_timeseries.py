@@ -1,5 +1,5 @@
 """Time series of lines coupled to bodies and of the bodies (stochcable.dynamics.coupled_timeseries,
-stochcable.dynamics.line.simulate_timeseries with ``coupled=``; GitHub issue 6).
+stochcable.dynamics.timeseries.simulate_timeseries with ``coupled=``; GitHub issue 6).
 
 Independent checks: the DSA variance of every series against the band sum of the
 response spectrum of the transfer synthesized (Parseval, round-off) and against the
@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.dynamics.coupled_timeseries import coupled_group_transfer, frequency_chunks
 from stochcable.errors import InputError
 from stochcable.examples import load_example

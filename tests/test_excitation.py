@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.dynamics import line as an
+from stochcable.dynamics import system as dsystem
+from stochcable.dynamics import variance as dvariance
 from stochcable.errors import InputError
 from stochcable.dynamics.loads import (
     drag_matrix,
@@ -18,7 +19,7 @@ from stochcable.dynamics.loads import (
 )
 from stochcable.sea.kinematics import wave_kinematics
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
 RHO = 1025.0
 G = 9.80665
@@ -51,7 +52,7 @@ def straight_doc(*, sea=True, motion=None, heading=20.0, attachments=()):
 def built(doc):
     scene = load_scene(doc)
     st = solve_statics(scene).lines["l"]
-    system = an.build_line_system(scene, scene.lines[0], st)
+    system = dsystem.build_line_system(scene, scene.lines[0], st)
     return scene, system
 
 
@@ -157,7 +158,7 @@ def test_sigma_of_line_at_rest_is_element_mean_of_fluid_velocity_sigma():
     scene, system = built(straight_doc())
     w = np.linspace(0.3, 1.8, 31)
     chans = line_channels(scene, scene.lines[0], system.positions, w)
-    sig = an.relative_velocity_sigmas(system, chans, None, "seed")
+    sig = dvariance.relative_velocity_sigmas(system, chans, None, "seed")
     n = system.model.n_elements
     pos = system.positions
     xg, wg = np.polynomial.legendre.leggauss(12)
@@ -180,7 +181,7 @@ def test_fully_wet_exp_moments_are_the_general_formula():
     """_exp_moments drops the factors 1 and 0 when every element is wet over its whole
     length (the speed pass of issue 4); the general expressions give the same numbers
     to the bit (x·1 and 0 + x are exact), growing and decaying exponents alike."""
-    from stochcable.dynamics.loads import _complex, _exp_moments, _phi1_psi
+    from stochcable.dynamics.element_kinematics import _complex, _exp_moments, _phi1_psi
     from stochcable.sea.kinematics import _wavenumber
 
     def general(e0, alpha, p, q):  # the formula for any wet part [p, q]
@@ -255,8 +256,9 @@ def test_second_exponent_shares_phi_psi_by_conjugation():
     and the φ1 of ∫e^{−2k(z+2h)} as that of ∫e^{2kz} (issue 6 pass E6): the moments
     equal those of their own φ1, ψ to the bit, for rising, sinking and horizontal
     elements, at ω = 0, fully wet (the short path) and partly wet (the general one)."""
-    from stochcable.dynamics.loads import (_complex, _exp_integral, _exp_moments,
-                                       _moment_argument, _phi1_psi)
+    from stochcable.dynamics.element_kinematics import (_complex, _exp_integral,
+                                                        _exp_moments, _moment_argument,
+                                                        _phi1_psi)
     from stochcable.sea.kinematics import _wavenumber
 
     rng = np.random.default_rng(13)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.errors import InputError
 from stochcable.examples import load_example
 from stochcable.fidelity import (
@@ -23,7 +23,7 @@ from stochcable.fidelity import (
     points_per_bandwidth,
     spectrum_tail_frequency,
 )
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 from stochcable.scene.model import load_scene
 from stochcable.sea.spectra import spectrum_pierson_moskowitz
 
@@ -259,7 +259,8 @@ def test_analyze_honours_the_fidelity_request():
     # report the plan, and meet the target; the taut wire's example settings are
     # within 0.7 % of its converged reference (docs/ACCURACY.md), so a 5 % target must
     # land within 5 % + 0.7 % of them
-    from stochcable import analyze, load_example
+    from stochcable.analysis import analyze
+    from stochcable.examples import load_example
 
     base = load_example("taut_wire")
     doc = base.model_dump(mode="json")

@@ -1,4 +1,4 @@
-"""Hard cases through :func:`stochcable.dynamics.line.analyze` (GitHub issue 4): each ends
+"""Hard cases through :func:`stochcable.analysis.analyze` (GitHub issue 4): each ends
 with finite, checked numbers or a clear error — never inf/NaN or a silent wrong answer.
 
 Cases: nearly taut line (sag/span 1e-3), very slack line (most of it on the seabed),
@@ -19,7 +19,9 @@ import warnings
 import numpy as np
 import pytest
 
-from stochcable.dynamics.line import analyze, build_line_system, drag_coefficients
+from stochcable.analysis import analyze
+from stochcable.dynamics.system import build_line_system
+from stochcable.dynamics.variance import drag_coefficients
 from stochcable.errors import (InputError, PhysicsWarning, ResolutionWarning,
                               SolverError)
 from stochcable.examples import load_example

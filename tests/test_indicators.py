@@ -14,17 +14,15 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from stochcable.dynamics.line import (
-    analyze,
-    build_line_system,
-    line_indicators,
-    linearize,
-)
+from stochcable.analysis import analyze
+from stochcable.dynamics.fixedpoint import linearize
+from stochcable.dynamics.indicators import line_indicators
+from stochcable.dynamics.system import build_line_system
 from stochcable.errors import InputError, PhysicsWarning
 from stochcable.dynamics.loads import line_channels
 from stochcable.dynamics.linearization import borgman_variance_ratio, drag_inertia_ratio
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "stochcable" / "examples"
 # Zero-mean Gaussian: Var(Bv)/Var(c v|v|) = (8/pi) c² σ⁴ / (3 c² σ⁴) (Borgman 1972)

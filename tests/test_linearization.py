@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from stochcable.errors import ConvergenceError, InputError
+from stochcable.dynamics.iteration import fixed_point
 from stochcable.dynamics.linearization import (
     drag_linear_current,
     drag_linear_harmonic,
     drag_linear_seed,
     drag_linear_vector,
-    fixed_point,
     mean_drag_gaussian,
 )
 from stochcable.dynamics.solvers import solve_direct

@@ -1,4 +1,4 @@
-"""The coarse start of the drag linearization (stochcable.dynamics.line, "Coarse start"):
+"""The coarse start of the drag linearization (stochcable.dynamics.fixedpoint, "Coarse start"):
 the frequency-subset fixed point only supplies the start, the answer is the full-grid
 fixed point; narrow resonances are kept at full resolution; the subset quadrature; the
 single-BLAS-thread limit in worker threads."""
@@ -11,12 +11,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import stochcable.dynamics.line as an
+from stochcable.dynamics import system as dsystem
+from stochcable.dynamics import blocks as dblocks
+from stochcable.dynamics import line_loads as dloads
+from stochcable.dynamics import solve as dsolve
+from stochcable.dynamics import variance as dvariance
+from stochcable.dynamics import fixedpoint as dfixedpoint
+from stochcable.dynamics import outputs as doutputs
 from stochcable.dynamics.loads import line_channels
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
-EXAMPLE = Path(an.__file__).resolve().parents[1] / "examples" / "chain_catenary.json"
+EXAMPLE = Path(dsystem.__file__).resolve().parents[1] / "examples" / "chain_catenary.json"
 
 
 def _chain(**env) -> tuple:
@@ -26,7 +32,7 @@ def _chain(**env) -> tuple:
     scene = load_scene(doc)
     line = scene.lines[0]
     st = solve_statics(scene, method="fe")
-    system = an.build_line_system(scene, line, st.lines[line.name])
+    system = dsystem.build_line_system(scene, line, st.lines[line.name])
     omega = scene.analysis.omega.values()
     return scene, system, line_channels(scene, line, system.positions, omega)
 
@@ -48,13 +54,13 @@ def _tight(scene):
 @pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning")  # the cut tail
 def test_coarse_start_converges_to_the_full_grid_fixed_point(chain):
     scene, system, ch = chain
-    coarse = an.linearize(system, ch, scene.analysis)
-    full = an.linearize(system, ch, scene.analysis, coarse=False)
-    ref = an.linearize(system, ch, _tight(scene), coarse=False)
+    coarse = dfixedpoint.linearize(system, ch, scene.analysis)
+    full = dfixedpoint.linearize(system, ch, scene.analysis, coarse=False)
+    ref = dfixedpoint.linearize(system, ch, _tight(scene), coarse=False)
     tol = scene.analysis.linearization.tolerance
     # the coarse stage ran on a real subset and is recorded apart from the record
     assert coarse.coarse is not None and full.coarse is None
-    assert coarse.coarse.frequencies <= an.COARSE_MAX_FRACTION * ch[0].omega.size
+    assert coarse.coarse.frequencies <= dfixedpoint.COARSE_MAX_FRACTION * ch[0].omega.size
     assert coarse.coarse.converged and coarse.coarse.iterations == len(coarse.coarse.history)
     # the record: full-grid evaluations only, the usual test passed on the full grid
     rec = coarse.record
@@ -67,8 +73,8 @@ def test_coarse_start_converges_to_the_full_grid_fixed_point(chain):
     for lin in (coarse, full):
         assert np.max(np.abs(_sigma(lin) / s_ref - 1)) < 2 * tol
     # the outputs: end tension σ (the benchmark quantities) within 1e-4 relative
-    out_c = an.line_result(system, ch, coarse, scene.analysis)
-    out_f = an.line_result(system, ch, full, scene.analysis)
+    out_c = doutputs.line_result(system, ch, coarse, scene.analysis)
+    out_f = doutputs.line_result(system, ch, full, scene.analysis)
     for end in ("end_a", "end_b"):
         a, b = getattr(out_c, end).std, getattr(out_f, end).std
         assert abs(a / b - 1) < 1e-4
@@ -77,11 +83,11 @@ def test_coarse_start_converges_to_the_full_grid_fixed_point(chain):
 def test_small_grid_has_no_coarse_stage(chain):
     scene, system, ch = chain
     w = ch[0].omega[::4]  # 50 frequencies < COARSE_MIN_FREQUENCIES
-    assert w.size < an.COARSE_MIN_FREQUENCIES
+    assert w.size < dfixedpoint.COARSE_MIN_FREQUENCIES
     sub = line_channels(scene, system.line, system.positions, w)
-    lin = an.linearize(system, sub, scene.analysis)
+    lin = dfixedpoint.linearize(system, sub, scene.analysis)
     assert lin.coarse is None
-    assert lin.record.iterations == an.linearize(system, sub, scene.analysis,
+    assert lin.record.iterations == dfixedpoint.linearize(system, sub, scene.analysis,
                                                  coarse=False).record.iterations
 
 
@@ -91,15 +97,15 @@ def test_interpolatory_weights_integrate_cubics_as_the_full_grid():
     # 4-point Lagrange stencil is exact), and not of a quartic (the test can fail)
     w = np.geomspace(0.05, 3.0, 157)
     idx = np.unique(np.r_[np.arange(0, 157, 4), 156, np.arange(60, 75)])
-    q = an._trapezoid_weights(w)
-    wts = an._interpolatory_weights(w, idx)
+    q = dblocks.trapezoid_weights(w)
+    wts = dfixedpoint.interpolatory_weights(w, idx)
     for f in (np.ones_like, lambda x: x, lambda x: 2 - x**2, lambda x: x**3 - x):
         assert wts @ f(w[idx]) == pytest.approx(q @ f(w), rel=1e-12, abs=1e-12)
     quartic = (w - 1.0) ** 4
     assert abs(wts @ quartic[idx] - q @ quartic) > 1e-8
     # against the subset's own trapezoid rule on a smooth spectrum-like integrand
     f = w**-5 * np.exp(-1.25 * (0.6 / w) ** 4) * 1e2
-    trap = an._trapezoid_weights(w[idx]) @ f[idx]
+    trap = dblocks.trapezoid_weights(w[idx]) @ f[idx]
     assert abs(wts @ f[idx] / (q @ f) - 1) < 0.1 * abs(trap / (q @ f) - 1)
 
 
@@ -108,32 +114,32 @@ def test_narrow_resonance_is_not_missed_by_the_coarse_subset():
     # modes (0.84, 1.23, 1.74 rad/s) have half-power bandwidths of ~0.013 rad/s, below
     # two coarse spacings (0.078 rad/s)
     scene, system, ch = _chain(current=[], seabed={"stiffness": 3e6, "damping": 0.0})
-    lin = an.linearize(system, ch, scene.analysis, coarse=False)
-    weak = an.drag_coefficients(system, 0.03 * lin.damping.sigma, "seed")
-    inp = an._inputs(system, ch)
+    lin = dfixedpoint.linearize(system, ch, scene.analysis, coarse=False)
+    weak = dvariance.drag_coefficients(system, 0.03 * lin.damping.sigma, "seed")
+    inp = dloads.line_inputs(system, ch)
     w = inp.omega
-    idx = an._coarse_subset(system, inp, weak)
+    idx = dfixedpoint._coarse_subset(system, inp, weak)
     assert idx is not None
     wn = system.modes.omega
     for wj in wn[(wn > w[0]) & (wn < w[-1])]:
         k = int(np.argmin(np.abs(w - wj)))
-        window = np.arange(k - an.COARSE_STEP, k + an.COARSE_STEP + 1)
+        window = np.arange(k - dfixedpoint.COARSE_STEP, k + dfixedpoint.COARSE_STEP + 1)
         assert np.isin(window, idx).all()  # full resolution around the resonance
-    u, _ = an._solve_free(system, inp, weak)
-    full = an._sigmas_free(system, inp, u, "seed")
+    u, _ = dsolve.solve_free(system, inp, weak)
+    full = dvariance.sigmas_from_free(system, inp, u, "seed")
 
     def err(sel: np.ndarray) -> float:
-        sub = an._subset_inputs(system, ch, inp, sel)
-        s = an._sigmas_free(system, sub, np.ascontiguousarray(u[:, :, sel]), "seed")
+        sub = dfixedpoint.subset_inputs(system, ch, inp, sel)
+        s = dvariance.sigmas_from_free(system, sub, np.ascontiguousarray(u[:, :, sel]), "seed")
         return float(np.max(np.abs(s - full)) / np.max(full))
 
     # the uniform subset misses the peaks (tens of %), the windowed one does not
     # (measured 0.6 %: the tails between the coarse points remain)
-    assert err(an._uniform_subset(w.size)) > 0.1
+    assert err(dfixedpoint._uniform_subset(w.size)) > 0.1
     assert err(idx) < 0.02
     # and the linearization of that line still ends at the full-grid fixed point
-    c = an.linearize(system, ch, scene.analysis)
-    f = an.linearize(system, ch, scene.analysis, coarse=False)
+    c = dfixedpoint.linearize(system, ch, scene.analysis)
+    f = dfixedpoint.linearize(system, ch, scene.analysis, coarse=False)
     tol = scene.analysis.linearization.tolerance
     assert np.max(np.abs(_sigma(c) / _sigma(f) - 1)) < 4 * tol  # each within 2 tol
 

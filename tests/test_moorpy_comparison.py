@@ -16,8 +16,9 @@ import math
 import numpy as np
 import pytest
 
-from stochcable import analyze, load_example
-from stochcable.line.statics import solve_statics
+from stochcable.analysis import analyze
+from stochcable.examples import load_example
+from stochcable.statics import solve_statics
 
 mp = pytest.importorskip("moorpy")
 

@@ -1,5 +1,5 @@
 """Seed 001 (Tuah 1982) §6.5 Example 5, the one-leg single-point mooring in feet,
-through :func:`stochcable.dynamics.line.analyze` (example ``tuah_1982_single_leg``).
+through :func:`stochcable.analysis.analyze` (example ``tuah_1982_single_leg``).
 
 The example scene is lines only: the disc buoy is end_b heaving with the sea (RAO 1),
 so the seed's findings about the disc's surge and pitch resonances (its Figs 6.5-7, -9)
@@ -32,7 +32,7 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.examples import load_example
 
 # Seed 001 §6.5 (quoted in the module docstring).

@@ -404,7 +404,7 @@ def test_dumps_equals_the_standard_encoder_after_parsing():
     import json
 
     from service.encoding import dumps
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
     from stochcable.examples import load_example
 
     with warnings.catch_warnings():

@@ -16,13 +16,13 @@ from fastapi.testclient import TestClient
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import stochcable.dynamics.line
+import stochcable.analysis
 from service.app import create_app
 from service.routers.analyses import WARNINGS_HEADER
 from service.schemas import AnalysisResponse
 from service.settings import Settings
 from _compare import assert_close_documents
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.cli import main as cli_main
 from stochcable.examples import list_examples, load_example
 
@@ -227,7 +227,7 @@ def test_abandoned_analysis_stops_at_its_next_progress_call(monkeypatch):
         finally:
             calls["stopped"].set()
 
-    monkeypatch.setattr(stochcable.dynamics.line, "analyze", endless)
+    monkeypatch.setattr(stochcable.analysis, "analyze", endless)
     with TestClient(create_app(Settings(max_run_seconds=0.3, max_concurrency=1))) as c:
         t0 = time.perf_counter()
         err = _err(c.post("/v1/analyses", json=_doc(SMALL)), 504)
@@ -248,7 +248,7 @@ def test_queued_analyses_do_not_hold_the_slots_of_other_endpoints(monkeypatch):
             progress("linearization", {})
         return analyze(scene)
 
-    monkeypatch.setattr(stochcable.dynamics.line, "analyze", blocked)
+    monkeypatch.setattr(stochcable.analysis, "analyze", blocked)
     app = create_app(Settings(max_concurrency=2, max_run_seconds=10.0))
     with TestClient(app) as c:
         out: dict[int, object] = {}

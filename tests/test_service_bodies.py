@@ -15,7 +15,7 @@ from fastapi.testclient import TestClient
 from _compare import assert_close_documents
 from service.app import create_app
 from service.settings import Settings
-from stochcable.dynamics.line import analyze
+from stochcable.analysis import analyze
 from stochcable.examples import load_example
 
 THREE_LEGS = "tuah_1982_disc_buoy_three_legs"

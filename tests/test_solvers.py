@@ -11,22 +11,24 @@ import scipy.sparse as sp
 
 from stochcable.errors import InputError, SolverError
 from stochcable.dynamics.linearization import drag_linear_seed
-from stochcable.dynamics.solvers import (
-    DefectivePencilWarning,
+from stochcable.dynamics.modal_solvers import (
     auto_mode_count,
+    DefectivePencilWarning,
     foss_decomposition,
     foss_transfer,
-    matrix_bandwidth,
     modal_basis,
+    solve_modal,
+)
+from stochcable.dynamics.solvers import (
+    matrix_bandwidth,
     solve_block_tridiagonal,
     solve_direct,
-    solve_modal,
     tridiagonal_blocks,
 )
 
 
 # Foss must really be used (no silent fallback) except where a test expects the warning
-pytestmark = pytest.mark.filterwarnings("error::stochcable.dynamics.solvers.DefectivePencilWarning")
+pytestmark = pytest.mark.filterwarnings("error::stochcable.dynamics.modal_solvers.DefectivePencilWarning")
 
 
 def _rel(a, b):

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.dynamics.linearization import drag_linear_seed, fixed_point
+from stochcable.dynamics.iteration import fixed_point
+from stochcable.dynamics.linearization import drag_linear_seed
 from stochcable.dynamics.solvers import solve_direct
 from stochcable.results.statistics import response_statistics
 from stochcable.sea.timeseries import LinearSystem, NonlinearSystem, newmark

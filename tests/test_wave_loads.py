@@ -11,22 +11,25 @@ import numpy as np
 import pytest
 from scipy.integrate import quad_vec
 
-from stochcable.dynamics import line as an
+from stochcable import analysis
+from stochcable.dynamics import system as dsystem
+from stochcable.dynamics import blocks as dblocks
+from stochcable.dynamics import variance as dvariance
 from stochcable.errors import InputError, ResolutionWarning
 from stochcable.examples import load_example
+from stochcable.dynamics.element_kinematics import element_wave_kinematics
 from stochcable.dynamics.loads import (
     Channel,
     channel_loads,
     drag_matrix,
     element_frames,
-    element_wave_kinematics,
     inertia_matrix,
     line_channels,
     wave_loads,
 )
 from stochcable.sea.kinematics import wave_kinematics, wavenumber
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 
 G = 9.80665
 RHO = 1025.0
@@ -146,7 +149,7 @@ def vertical_doc(top: float, depth: float | None, elements: int) -> dict:
 def line_model(doc):
     scene = load_scene(doc)
     st = solve_statics(scene).lines["l"]
-    system = an.build_line_system(scene, scene.lines[0], st, dim=3)
+    system = dsystem.build_line_system(scene, scene.lines[0], st, dim=3)
     w = scene.analysis.omega.values()
     return scene, system, line_channels(scene, scene.lines[0], system.positions, w)
 
@@ -275,12 +278,12 @@ def test_element_mean_sigma_with_moving_structure_equals_quadrature():
     rng = np.random.default_rng(3)
     u = rng.normal(size=(w.size, model.n_dof, 1)) + 1j * rng.normal(size=(w.size, model.n_dof, 1))
     u *= 0.05
-    sig = an.relative_velocity_sigmas(system, chans, None, "vector", displacement=u)
+    sig = dvariance.relative_velocity_sigmas(system, chans, None, "vector", displacement=u)
     n = model.n_elements
     e, n1, n2 = element_frames(model.positions)
     rows = np.stack([e, n1, n2, (n1 + n2) / math.sqrt(2)], axis=1)  # (n_el, 4, 3)
     un = u[:, :, 0].reshape(w.size, model.n_nodes, 3)
-    qweights = an._trapezoid_weights(w) * chans[0].spectrum
+    qweights = dblocks.trapezoid_weights(w) * chans[0].spectrum
     xg, wg = np.polynomial.legendre.leggauss(24)
     var = np.zeros((n, 4))
     pos = model.positions
@@ -325,7 +328,7 @@ def test_inclined_guy_converges_and_warns_only_when_coarse():
     for n in (40, 80, 160, 320):
         with warnings.catch_warnings(record=True) as rec:
             warnings.simplefilter("always")
-            res = an.analyze(guy_doc(n))
+            res = analysis.analyze(guy_doc(n))
         sig.append(res.lines["guy"].end_b.std)
         warned.append(any(issubclass(r.category, ResolutionWarning)
                           and "wave-velocity σ varies" in str(r.message) for r in rec))
@@ -340,7 +343,7 @@ def test_surface_warning_message_names_threshold_and_fix():
     with pytest.warns(ResolutionWarning, match=r"line 'guy': the wave-velocity σ varies by a "
                       r"factor 2\.\d+ along element 40 .*threshold 2\).*use at least \d+ "
                       r"elements on segment 0 \(now 40\)"):
-        an.analyze(guy_doc(40))
+        analysis.analyze(guy_doc(40))
 
 
 def test_chain_changes_less_than_its_discretization_error():
@@ -351,7 +354,7 @@ def test_chain_changes_less_than_its_discretization_error():
     doc["analysis"]["timeseries"] = None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ResolutionWarning)
-        res = an.analyze(copy.deepcopy(doc))
+        res = analysis.analyze(copy.deepcopy(doc))
     std = next(iter(res.lines.values())).end_b.std
     # the numbers of the docstring, to 0.1 % (Foss auto, same grid)
     assert abs(std / 118478.0 - 1) < 1e-3

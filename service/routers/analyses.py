@@ -1,4 +1,4 @@
-"""POST /v1/analyses: run :func:`stochcable.dynamics.line.analyze` on a scene document."""
+"""POST /v1/analyses: run :func:`stochcable.analysis.analyze` on a scene document."""
 
 from __future__ import annotations
 
@@ -65,7 +65,7 @@ async def run_analysis(
         description="Time series in the document: the first 2048 samples (window), "
         "all of them (full) or none; only when the scene has analysis.timeseries")] = "window",
 ) -> Response:
-    """The v1 result document of :func:`stochcable.dynamics.line.analyze` (seed 001 ch. 5):
+    """The v1 result document of :func:`stochcable.analysis.analyze` (seed 001 ch. 5):
     identical to ``stochcable analyze SCENE.json`` and ``analyze(scene).to_document()``
     apart from the ``timing`` values.
 
@@ -103,7 +103,7 @@ def _analysis(scene: Scene, timeseries: str, deadline: float,
     Past ``deadline`` (``limit`` seconds after the request arrived) the work stops
     with RunTimeExceeded; the Runner has normally answered 504 already.
     """
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
 
     def progress(stage: str, info: Mapping[str, Any]) -> None:
         # called at every stage and linearization iteration: an analysis whose request

@@ -68,7 +68,7 @@ class _StderrProgress:
 
 def run(args: argparse.Namespace) -> int:
     """Run the analysis and write the result document (and figures)."""
-    from stochcable.dynamics.line import analyze
+    from stochcable.analysis import analyze
     from stochcable.scene.model import load_scene
 
     scene = load_scene(Path(args.scene))

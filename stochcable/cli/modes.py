@@ -56,7 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``stochcable modes``; returns the exit code."""
     from stochcable.validation import positive_int
-    from stochcable.line.fem import scene_fe_models
+    from stochcable.statics import scene_fe_models
     from stochcable.line.modes import natural_modes
 
     count = positive_int("--count", args.count)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from stochcable.scene.model import load_scene
-from stochcable.line.statics import StaticsResult, solve_statics
+from stochcable.statics import StaticsResult, solve_statics
 from stochcable.cli._output import require_matplotlib, write_json
 
 __all__ = ["register", "run"]

@@ -1,16 +1,16 @@
 """Lines coupled to bodies on the realization grid: the transfer functions of the time
 series (seed 001 §5.1, eq. 5.3.29 and step 14).
 
-The time series of :func:`stochcable.dynamics.line.simulate_timeseries` are the synthesis
+The time series of :func:`stochcable.dynamics.timeseries.simulate_timeseries` are the synthesis
 (:func:`stochcable.sea.realization.synthesize`) of transfer functions solved on the realization
 grid ω_m = mΔω inside the analysis band, driven by the same complex amplitudes as η.
 For a coupled group (lines attached to free bodies, :mod:`stochcable.dynamics.coupled`)
 the drag linearization is done once on the analysis grid; with its converged linear
-drag (the lines' :class:`~stochcable.dynamics.line.Damping`, the bodies' drag σ) the group is
+drag (the lines' :class:`~stochcable.dynamics.system.Damping`, the bodies' drag σ) the group is
 a linear system, solved here again on the realization band by the same substructured
 solve (:func:`stochcable.dynamics.coupled.group.solve_group`): the channels and the body
 loads are evaluated on the band, the lines' support forces give the end tensions
-(:func:`stochcable.dynamics.line._end_tension`) and the body equation the motion ξ.
+(:func:`stochcable.dynamics.solve.end_tension_from_support`) and the body equation the motion ξ.
 
 Memory
 ------
@@ -40,8 +40,8 @@ from stochcable.dynamics.coupled.inputs import (
     scene_line_channels,
     vessel_rao,
 )
-from stochcable.dynamics.line import _end_tension
-from stochcable.dynamics.loads import Channel, _spectrum_callable
+from stochcable.dynamics.solve import end_tension_from_support
+from stochcable.dynamics.loads import Channel, spectrum_callable
 
 __all__ = [
     "CHUNK_BYTES",
@@ -146,7 +146,7 @@ def _group_on(scene: Any, group: CoupledGroup, omega: np.ndarray
                            end_b=group.attach[n].get("end_b")) for n in group.lines]
         channels = cls[0].channels
     else:  # a free-floating body: the sea alone (analyze_coupled)
-        dens = _spectrum_callable(scene.sea.spectrum, env.g)
+        dens = spectrum_callable(scene.sea.spectrum, env.g)
         channels = (Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega),
                             density=dens),)
         cls = []
@@ -251,7 +251,7 @@ def coupled_group_transfer(scene: Any, group: CoupledGroup, omega: Any, *,
             body_b[b.name] = bb
         sol, xi = solve_group(g, group.dampings, body_c, body_b, timing)
         for n in group.lines:
-            et = _end_tension(group.systems[n], sol[n][1])
+            et = end_tension_from_support(group.systems[n], sol[n][1])
             for e in ("end_a", "end_b"):
                 end_t[n][e][:, sl] = et[e]
         for b in group.bodies:

@@ -42,30 +42,10 @@ the unstretched lengths l0, as the added mass of :mod:`stochcable.line.fem`, so 
 moving with a uniform fluid (Ü = A) feels exactly the Froude–Krylov force
 ρ(πD²/4)(I − eeᵀ)A.  Attachments (buoys, clumps) get the isotropic inertia load
 (buoyancy/g + added mass)·A and an isotropic linear drag B·(V − U̇) on their node.
-
-Wave loads integrated exactly along the elements
-------------------------------------------------
-The wave kinematics decay like e^{kz} with depth and turn like e^{−ikx} along the wave:
-over an element much longer than 1/k (near the surface at high frequency) their linear
-interpolation between the nodes is far off (the inclined guy of docs/ACCURACY.md: its
-26 m top element at z = 0 against 1/k = 0.6 m at 4 rad/s overestimated the fairlead
-tension σ by 77 %).  Along a straight element from node a to node b, ξ = s/l ∈ [0, 1],
-the kinematics per unit amplitude are sums of exponentials e^{E(ξ)} with E linear in
-ξ (deep water: E = k z(ξ) − i k χ(ξ), χ = x cos β + y sin β; finite depth: cosh and
-sinh as two exponentials).  :func:`element_wave_kinematics` integrates them in closed
-form over the wet part of each element (split at z = 0; the dry part gets no load):
-
-- the consistent (work-equivalent) moments ∫ N_a v dξ, ∫ N_b v dξ with N_a = 1 − ξ,
-  N_b = ξ, so the element's Morison load on node i is
-  l0·[ρ(πD²/4)(1 + Can)(I − eeᵀ)·iω + B_n(I − eeᵀ) + B_t eeᵀ]·∫ N_i v dξ
-  (:func:`wave_loads`; B constant per element);
-- the element mean square ∫ Re(v vᴴ) dξ, from which the drag linearization takes the
-  σ of the relative velocity as an element mean (:mod:`stochcable.dynamics.line`).
-
-The moments are the exact consistent load for both mass-matrix options: for a uniform
-field they equal the lumped ½·l0 weights, so the Froude–Krylov balance above holds
-either way.  Channels without these element data (built by hand) fall back on the
-linear interpolation of their nodal kinematics with the model's mass pattern.
+The sea channel carries the wave velocity's consistent moments ∫ N_i v dξ and element
+mean square ∫ Re(v vᴴ) dξ integrated exactly along the elements
+(:mod:`stochcable.dynamics.element_kinematics`), read by :func:`element_moments` and
+:func:`element_mean_square` (hand-built channels: the nodal kinematics interpolated).
 """
 
 from __future__ import annotations
@@ -78,27 +58,28 @@ from typing import Any, Literal
 import numpy as np
 import scipy.sparse as sp
 
+from stochcable.dynamics.element_kinematics import (
+    ElementKinematics,
+    element_wave_kinematics,
+)
 from stochcable.errors import InputError
-from stochcable import validation as v
-from stochcable.sea.kinematics import G_STANDARD, _depth, _nodal_kinematics, _wavenumber
 from stochcable.scene.model import Environment, Line, Scene
+from stochcable.sea.kinematics import G_STANDARD, _nodal_kinematics
 
 __all__ = [
     "Channel",
-    "ElementKinematics",
-    "element_wave_kinematics",
-    "element_moments",
-    "element_mean_square",
-    "wave_loads",
-    "line_channels",
-    "element_frames",
-    "inertia_matrix",
-    "drag_matrix",
     "channel_loads",
-    "prescribed_motion",
-    "embed",
     "current_at_elements",
     "current_at_nodes",
+    "drag_matrix",
+    "element_frames",
+    "element_mean_square",
+    "element_moments",
+    "embed",
+    "inertia_matrix",
+    "line_channels",
+    "prescribed_motion",
+    "wave_loads",
 ]
 
 _DOF_AXIS = {"surge": 0, "sway": 1, "heave": 2}
@@ -187,7 +168,9 @@ class Channel:
         default=None, repr=False)
 
 
-def _spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
+def spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
+    """ω -> S(ω) of a scene spectrum ``spec`` (one-sided, zero at ω <= 0), ω in
+    [rad/s], S in [m²·s/rad]; ``g`` [m/s²] for the spectra that need it."""
     def density(w: np.ndarray) -> np.ndarray:
         w = np.asarray(w, dtype=float)
         out = np.zeros_like(w)
@@ -247,7 +230,7 @@ def line_channels(
                 )
             raos[end] = np.ascontiguousarray(m.rao.transfer(w).T)  # (n_omega, 3)
     if scene.sea is not None:
-        density = _spectrum_callable(scene.sea.spectrum, env.g)
+        density = spectrum_callable(scene.sea.spectrum, env.g)
         # nodes resting on a penalty seabed sit slightly below z = -depth: evaluate
         # the kinematics on the seabed there
         pts = np.array(positions, dtype=float)
@@ -267,7 +250,7 @@ def line_channels(
             spec = getattr(m, dof)
             if spec is None:
                 continue
-            density = _spectrum_callable(spec, env.g)
+            density = spectrum_callable(spec, env.g)
             unit = np.zeros((w.size, 3), dtype=complex)
             unit[:, axis] = 1.0
             channels.append(Channel(
@@ -279,7 +262,7 @@ def line_channels(
     return tuple(channels)
 
 
-def _sea_nodal(el: "ElementKinematics", g: float
+def _sea_nodal(el: ElementKinematics, g: float
                ) -> Callable[[], tuple[np.ndarray, np.ndarray]]:
     """The sea channel's nodal velocity and acceleration (n_omega, n_nodes, 3), on
     demand: :func:`stochcable.sea.kinematics.wave_kinematics` from the validated
@@ -292,316 +275,6 @@ def _sea_nodal(el: "ElementKinematics", g: float
                 np.ascontiguousarray(np.transpose(acc, (2, 0, 1))))
 
     return nodal
-
-
-# ------------------------------------------------- wave kinematics along the elements
-
-# |x| below which φ1 and ψ are summed as series (full relative precision; above it the
-# closed forms lose at most ~1e-16·(1 + |e^x|)/|x| absolutely, harmless as |e^x| <= 1).
-_SERIES_RADIUS = 0.5
-# 15 terms: the remainder x^15/16! < 2e-18 for |x| < 0.5.
-_SERIES_TERMS = 15
-_PHI1_COEF = np.array([1.0 / math.factorial(n + 1) for n in range(_SERIES_TERMS)])
-_PSI_COEF = np.array([1.0 / (math.factorial(n) * (n + 2)) for n in range(_SERIES_TERMS)])
-
-
-def _series(x: np.ndarray, coef: np.ndarray) -> np.ndarray:
-    out = np.full(x.shape, coef[-1], dtype=x.dtype)
-    for c in coef[-2::-1]:
-        out *= x
-        out += c
-    return out
-
-
-def _phi1_psi(x: np.ndarray, want_psi: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-    """φ1(x) = ∫₀¹ e^{xu} du = (e^x − 1)/x and ψ(x) = ∫₀¹ u e^{xu} du
-    = ((x − 1)e^x + 1)/x², elementwise for Re x <= 0 (real or complex).
-
-    Series (Horner, ``_SERIES_TERMS`` terms) for |x| < ``_SERIES_RADIUS``, where the
-    closed forms cancel; closed forms (with expm1) elsewhere."""
-    small = np.abs(x) < _SERIES_RADIUS
-    # closed forms everywhere (no gather/scatter of the large part), then the series
-    # over the small entries (where the closed forms cancel, 0/0 at x = 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        if np.iscomplexobj(x):
-            # e^x − 1 where the closed forms are kept (|x| >= 0.5, Re x <= 0: |e^x − 1|
-            # >= 0.49, so the subtraction costs at most ~3 ulp); numpy's complex expm1
-            # is 2.4x slower than its exp (0.27 ms per call on the chain)
-            em1 = np.exp(x)
-            em1 -= 1.0
-        else:
-            em1 = np.expm1(x)
-        phi = em1 / x
-        psi = None
-        if want_psi:
-            psi = em1 * (x - 1.0)
-            psi += x
-            psi /= x * x                                   # ((x − 1)e^x + 1)/x²
-    if small.any():
-        xs = x[small]
-        phi[small] = _series(xs, _PHI1_COEF)
-        if want_psi:
-            psi[small] = _series(xs, _PSI_COEF)
-    return phi, psi
-
-
-def _moment_argument(alpha: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """The argument x of φ1 and ψ in :func:`_exp_moments` (Re x <= 0)."""
-    s = np.where(alpha.real >= 0.0, -1.0, 1.0)
-    if np.all(p == 0.0) and np.all(q == 1.0):
-        return s * alpha
-    return s * alpha * (q - p)
-
-
-def _exp_moments(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray,
-                 phi_psi: tuple[np.ndarray, np.ndarray] | None = None
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """∫_p^q (1 − ξ) e^{e0 + αξ} dξ and ∫_p^q ξ e^{e0 + αξ} dξ, elementwise.
-
-    The exponential is factored at the endpoint c where Re(e0 + αξ) is largest (q when
-    Re α >= 0, else p), so with t = |ξ − c|, x = −α(q − p) or α(q − p) (Re x <= 0):
-    ∫_p^q e^{…} = e^{e0 + αc} L φ1(x) and ∫_p^q ξ e^{…} = e^{e0 + αc}(c L φ1(x) ± L² ψ(x)),
-    L = q − p — never an overflow, whatever α·L (the integrand's largest value
-    e^{Re(e0 + αc)} is <= 1 for wave kinematics).  L = 0 gives zeros.  ``phi_psi``:
-    (φ1(x), ψ(x)) when the caller has them (x of :func:`_moment_argument`)."""
-    length = q - p
-    grow = alpha.real >= 0.0
-    s = np.where(grow, -1.0, 1.0)
-    if np.all(p == 0.0) and np.all(q == 1.0):
-        # every element wet over its whole length (L = 1, c = 0 or 1): the general
-        # expressions below with the factors 1 and 0 dropped — the same numbers
-        # (x·1 and 0 + x are exact), a third fewer complex passes
-        f1, f2 = _phi1_psi(s * alpha) if phi_psi is None else phi_psi
-        ref = np.exp(np.where(grow, e0 + alpha, e0))
-        d12 = f1 - f2
-        return ref * np.where(grow, f2, d12), ref * np.where(grow, d12, f2)
-    c = np.where(grow, q, p)
-    f1, f2 = _phi1_psi(s * alpha * length) if phi_psi is None else phi_psi
-    ref = np.exp(e0 + alpha * c)
-    t1 = length * f1
-    t2 = s * (length * length) * f2
-    return ref * ((1.0 - c) * t1 - t2), ref * (c * t1 + t2)
-
-
-def _exp_integral(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray,
-                  phi: np.ndarray | None = None) -> np.ndarray:
-    """∫_p^q e^{e0 + αξ} dξ for real e0, α (as :func:`_exp_moments`, factored at the
-    larger endpoint).  ``phi``: φ1 of the argument −|α|(q − p) when the caller has it
-    (the same for α and −α)."""
-    length = q - p
-    grow = alpha >= 0.0
-    c = np.where(grow, q, p)
-    if phi is None:
-        phi, _ = _phi1_psi(np.where(grow, -alpha, alpha) * length, want_psi=False)
-    return np.exp(e0 + alpha * c) * length * phi
-
-
-@dataclass(frozen=True, eq=False)
-class ElementKinematics:
-    """Linear wave kinematics integrated along straight elements, per unit amplitude.
-
-    Attributes
-    ----------
-    omega : ndarray, shape (n_omega,)
-        [rad/s]
-    wavenumber : ndarray, shape (n_omega,)
-        [rad/m]
-    positions : ndarray, shape (n_nodes, 3)
-        Node positions; element j joins nodes j and j + 1. [m]
-    heading : float
-        [rad]
-    depth : float
-        [m]
-    wet_fraction : ndarray, shape (n_el,)
-        Fraction of each element below z = 0 (only that part is loaded). [-]
-    velocity : ndarray, complex, shape (n_omega, n_el, 2, 3)
-        ∫₀¹ N_a v dξ and ∫₀¹ N_b v dξ (N_a = 1 − ξ, N_b = ξ, ξ = s/l), v = 0 above
-        z = 0. [(m/s)/m]
-    velocity_square : ndarray, real, shape (n_omega, n_el, 3, 3)
-        ∫₀¹ Re(v vᴴ) dξ, the element mean of the velocity's second moment. [(m/s)²/m²]
-    end_square : ndarray, real, shape (n_omega, n_el, 2)
-        |v|² at the two ends of each element's wet part (the lower-ξ end first; the
-        waterline point for an element crossing it; 0 for a dry element). [(m/s)²/m²]
-    """
-
-    omega: np.ndarray
-    wavenumber: np.ndarray
-    positions: np.ndarray
-    heading: float
-    depth: float
-    wet_fraction: np.ndarray
-    velocity: np.ndarray
-    velocity_square: np.ndarray
-    end_square: np.ndarray
-
-    @property
-    def acceleration(self) -> np.ndarray:
-        """∫ N_i a dξ = iω ∫ N_i v dξ, shape (n_omega, n_el, 2, 3). [(m/s²)/m]"""
-        return self.velocity * (1j * self.omega)[:, None, None, None]
-
-
-def element_wave_kinematics(
-    omega: Any,
-    positions: Any,
-    heading: float = 0.0,
-    depth: float = np.inf,
-    g: float = G_STANDARD,
-) -> ElementKinematics:
-    """Linear wave kinematics integrated exactly along the straight elements of a line.
-
-    Parameters
-    ----------
-    omega : array_like
-        Angular frequencies, >= 0, 1-D. [rad/s]
-    positions : array_like
-        Node positions (x, y, z), shape (n_nodes, 3), n_nodes >= 2; element j joins
-        nodes j and j + 1; z >= −depth. [m]
-    heading : float, default 0.0
-        Wave heading β from +x toward +y. [rad]
-    depth : float, default inf
-        Water depth h. [m]
-    g : float, default 9.80665
-        Acceleration of gravity. [m/s²]
-
-    Returns
-    -------
-    ElementKinematics
-        Consistent moments and element mean square of the fluid velocity.
-
-    Raises
-    ------
-    InputError
-        Invalid frequencies, positions (shape, below the seabed), heading, depth or g.
-
-    Notes
-    -----
-    Kinematics of seed 001 eqs. 5.2.8–5.2.11 in the DESIGN.md convention
-    (:func:`stochcable.sea.kinematics.wave_kinematics`): with χ = x cos β + y sin β,
-    E₁ = k z − i k χ, E₂ = −k(z + 2h) − i k χ and D = 1 − e^{−2kh},
-
-        u_h = ω (e^{E₁} + e^{E₂})/D (along β),   u_z = iω (e^{E₁} − e^{E₂})/D,
-
-    (deep water: D = 1 and no E₂ term).  Along the element r(ξ) = r_a + ξ(r_b − r_a)
-    each E is linear in ξ, so the moments ∫ N_i e^{E(ξ)} dξ over the wet part
-    ξ ∈ [p, q] (z(ξ) <= 0; the element is split at the waterline) are closed forms
-    (:func:`_exp_moments`, series near α·L = 0, no overflow for large |α|·L).  The
-    mean square uses |u_h|² = ω² (e^{2E₁ᵣ} + 2e^{−2kh} + e^{2E₂ᵣ})/D² and
-    |u_z|² = ω² (e^{2E₁ᵣ} − 2e^{−2kh} + e^{2E₂ᵣ})/D² (E_ᵣ the real parts; the phases of
-    the two terms coincide): its absolute error is ~1e-16 of the largest |v|² on the
-    element (the vertical part in very shallow water, kh < 1e-4, carries a relative
-    error ~1e-16/(kh)²).  At ω = 0 the finite-depth horizontal velocity takes its limit
-    √(g/h), as in :func:`~stochcable.sea.kinematics.wave_kinematics`.
-    """
-    w = v.float_array("omega", omega, "rad/s", nonnegative=True)
-    pts = np.asarray(positions, dtype=float)
-    if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] < 2:
-        raise InputError("positions", positions, "m", "must have shape (n_nodes >= 2, 3)")
-    pts = v.float_array("positions", pts, "m", ndim=2)
-    beta = v.finite_scalar("heading", heading, "rad")
-    h = _depth(depth)
-    g = v.positive("g", g, "m/s²")
-    z = pts[:, 2]
-    if not math.isinf(h) and (z < -h).any():
-        i = int(np.flatnonzero(z < -h)[0])
-        raise InputError("positions", positions, "m",
-                         f"z must be >= -depth = {-h:g} (node {i} has z = {z[i]:g})")
-    k = _wavenumber(w, h, g)
-    return _element_kinematics(w, k, pts, beta, h, g)
-
-
-def _complex(re: np.ndarray, im: np.ndarray) -> np.ndarray:
-    """re + i·im in one pass (no complex temporaries)."""
-    out = np.empty(re.shape, dtype=complex)
-    out.real = re
-    out.imag = im
-    return out
-
-
-def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float,
-                        h: float, g: float) -> ElementKinematics:
-    """:func:`element_wave_kinematics` without validation."""
-    cb, sb = math.cos(beta), math.sin(beta)
-    za, zb = pts[:-1, 2], pts[1:, 2]
-    chi = pts[:, 0] * cb + pts[:, 1] * sb
-    # wet part ξ ∈ [p, q] of each element (z <= 0 wet, as the nodal kinematics)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cross = np.where(za != zb, za / (za - zb), 0.0)
-    wet_a, wet_b = za <= 0.0, zb <= 0.0
-    p = np.where(wet_a, 0.0, np.where(wet_b, cross, 0.0))
-    q = np.where(wet_b, 1.0, np.where(wet_a, cross, 0.0))
-    # frequency-major (n_w, n_el) arrays throughout: the outputs' layout, so they are
-    # written without transposes (the same products, operands swapped)
-    p, q = np.clip(p, 0.0, 1.0)[None, :], np.clip(q, 0.0, 1.0)[None, :]
-    length = q - p
-    dz = np.multiply.outer(k, zb - za)
-    phase0 = -np.multiply.outer(k, chi[:-1])   # imaginary parts of the exponents
-    dphase = -np.multiply.outer(k, chi[1:] - chi[:-1])
-    kza = np.multiply.outer(k, za)
-    alpha1 = _complex(dz, dphase)
-    f12 = _phi1_psi(_moment_argument(alpha1, p, q))
-    ma1, mb1 = _exp_moments(_complex(kza, phase0), alpha1, p, q, f12)
-    two_dz = 2.0 * dz
-    phi_k, _ = _phi1_psi(np.where(two_dz >= 0.0, -two_dz, two_dz) * length, want_psi=False)
-    k1 = _exp_integral(2.0 * kza, two_dz, p, q, phi_k)      # ∫ e^{2kz} dξ
-    zero_w = w == 0.0
-    z_ends = (za[:, None] + (zb - za)[:, None] * np.hstack([p.T, q.T]))   # (n_el, 2)
-    z_ends = np.minimum(z_ends, 0.0)
-    e1_ends = np.exp(2.0 * np.multiply.outer(k, z_ends))             # (n_w, n_el, 2)
-    if math.isinf(h):
-        coef = w.astype(complex)[:, None]
-        mh = (ma1 * coef, mb1 * coef)
-        mz = (ma1 * (1j * w)[:, None], mb1 * (1j * w)[:, None])
-        ch2 = sh2 = k1 * (w * w)[:, None]
-        ends = 2.0 * e1_ends * (w * w)[:, None, None]
-    else:
-        e2a = -np.multiply.outer(k, za + 2.0 * h)
-        # the second exponent's slope −dz + i·dphase: where dz ≠ 0 the sign s of
-        # _exp_moments flips with Re α, so its argument is the conjugate of the first
-        # one's and so are φ1 and ψ (exp, products, quotients and the series commute
-        # with conjugation in IEEE arithmetic); where dz = 0 it is the same argument
-        # (up to the sign of a zero real part).  Tested equal to the direct evaluation.
-        flip = dz != 0.0
-        f12_2 = tuple(np.where(flip, f.conj(), f) for f in f12)
-        ma2, mb2 = _exp_moments(_complex(e2a, phase0), _complex(-dz, dphase), p, q, f12_2)
-        # ∫ e^{−2k(z+2h)} dξ: its φ1 argument −|2dz|·L is the first one's
-        k2 = _exp_integral(2.0 * e2a, -two_dz, p, q, phi_k)
-        den = -np.expm1(-2.0 * k * h)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            c = np.where(zero_w, 0.0, w / np.where(zero_w, 1.0, den))
-            cross2 = (2.0 * np.exp(-2.0 * k * h))[:, None] * length
-            c2 = (c * c)[:, None]
-            ch2 = (k1 + k2 + cross2) * c2
-            sh2 = np.clip(k1 + k2 - cross2, 0.0, None) * c2
-        e2_ends = np.exp(-2.0 * np.multiply.outer(k, z_ends + 2.0 * h))
-        ends = 2.0 * (e1_ends + e2_ends) * c2[:, :, None]        # ω²(ch² + sh²)
-        mh = ((ma1 + ma2) * c[:, None], (mb1 + mb2) * c[:, None])
-        ic = (1j * c)[:, None]
-        mz = ((ma1 - ma2) * ic, (mb1 - mb2) * ic)
-        if zero_w.any():  # long-wave limit: u_h = √(g/h) uniform, u_z = 0
-            u0 = math.sqrt(g / h)
-            side_b = 0.5 * (q * q - p * p)
-            mh[0][zero_w, :] = u0 * (length - side_b)
-            mh[1][zero_w, :] = u0 * side_b
-            ch2[zero_w, :] = u0 * u0 * length
-            ends[zero_w] = u0 * u0
-    n_w, n_el = ma1.shape
-    vel = np.empty((n_w, n_el, 2, 3), dtype=complex)
-    for side in range(2):
-        vel[:, :, side, 0] = mh[side] * cb
-        vel[:, :, side, 1] = mh[side] * sb
-        vel[:, :, side, 2] = mz[side]
-    sq = np.zeros((n_w, n_el, 3, 3))
-    sq[:, :, 0, 0] = ch2 * (cb * cb)
-    sq[:, :, 1, 1] = ch2 * (sb * sb)
-    sq[:, :, 0, 1] = sq[:, :, 1, 0] = ch2 * (cb * sb)
-    sq[:, :, 2, 2] = sh2
-    wet = length[0]
-    ends = np.where((length > 0.0)[:, :, None], ends, 0.0)
-    for a in (w, k, pts, wet, vel, sq, ends):
-        a.setflags(write=False)
-    return ElementKinematics(omega=w, wavenumber=k, positions=pts, heading=beta, depth=h,
-                             wet_fraction=wet, velocity=vel, velocity_square=sq,
-                             end_square=ends)
 
 
 def element_moments(model: Any, channel: Channel) -> np.ndarray | None:
@@ -723,10 +396,10 @@ def _assemble(model: Any, blocks3: np.ndarray, node_diag: np.ndarray | None) -> 
     for a in range(2):
         for c in range(2):
             el[:, a * d:(a + 1) * d, c * d:(c + 1) * d] = pattern[a, c] * b
-    from stochcable.line.fem import _chain_csr  # the node blocks straight into CSR (no COO sort)
+    from stochcable.line.fem import chain_csr
 
     diag = np.repeat(node_diag, d) if node_diag is not None and np.any(node_diag) else None
-    return _chain_csr(el, model.n_nodes, d, diag)
+    return chain_csr(el, model.n_nodes, d, diag)
 
 
 def inertia_matrix(model: Any, g: float) -> sp.csr_array:
@@ -749,7 +422,7 @@ def inertia_matrix(model: Any, g: float) -> sp.csr_array:
     Per unit length ρ(πD²/4)(1 + Can)(I − eeᵀ) (seed 001 eq. 5.2.1, the B_I C_M term,
     C_M = 1 + Can); per attachment (buoyancy/g + added mass)·I.
     """
-    blocks, node = _inertia_blocks(model, g)
+    blocks, node = inertia_blocks(model, g)
     return _assemble(model, blocks, node)
 
 
@@ -787,7 +460,7 @@ def drag_matrix(
     return _assemble(model, _drag_blocks3(model, b_normal, b_axial), b_node)
 
 
-def _inertia_blocks(model: Any, g: float, e: np.ndarray | None = None
+def inertia_blocks(model: Any, g: float, e: np.ndarray | None = None
                     ) -> tuple[np.ndarray, np.ndarray]:
     """Morison inertia per unit length (n_el, 3, 3) and per attachment node (n_nodes,);
     ``e`` the element tangents when already at hand (:func:`element_frames`)."""
@@ -853,7 +526,7 @@ def wave_loads(
     """
     n_omega = channels[0].omega.size if channels else 0
     out = np.zeros((n_omega, model.n_dof, len(channels)), dtype=complex)
-    inertia, node_mass = _inertia_blocks(model, g)
+    inertia, node_mass = inertia_blocks(model, g)
     drag = _drag_blocks3(model, b_normal, b_axial)
     bnode = np.zeros(model.n_nodes) if b_node is None else np.asarray(b_node, dtype=float)
     l0 = model.l0[:, None, None]

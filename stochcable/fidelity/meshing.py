@@ -13,7 +13,7 @@ import numpy as np
 
 from stochcable.fidelity.plan import Choice
 from stochcable.fidelity.rules import CUTOFF_KH
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 from stochcable.scene.model import Scene, load_scene
 
 __all__ = [

@@ -55,7 +55,7 @@ from stochcable.fidelity.rules import (
     tail_exponent,
     union_grid,
 )
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 from stochcable.scene.model import OmegaGrid, Scene, load_scene
 
 __all__ = [
@@ -70,7 +70,7 @@ __all__ = [
 
 
 def choose_fidelity(scene: Scene | Any, target_error: float = 0.01, *,
-                    evaluate: Evaluate | None = None,
+                    evaluate: Evaluate,
                     exact_wave_integration: bool = False,
                     allow_grid_values: bool | None = None) -> FidelityPlan:
     """Settings that meet a target error of the response σ at the least cost.
@@ -86,9 +86,7 @@ def choose_fidelity(scene: Scene | Any, target_error: float = 0.01, *,
         The pilot analysis: the frequency-domain analysis of a scene, without a fidelity
         request (the orchestrator passes :func:`stochcable.analyze`; the scenes it is
         given have ``analysis.fidelity`` None when ``scene`` has).  Its result is read
-        as described in :mod:`stochcable.fidelity.pilot`.  Transitional: when omitted,
-        ``stochcable.dynamics.line.analyze`` (to be removed once the orchestrator
-        passes it; then required).
+        as described in :mod:`stochcable.fidelity.pilot`.
     exact_wave_integration : bool, default False
         Whether the engine integrates the wave loads exactly over each element (then the
         wave-load element rule is dropped).
@@ -113,8 +111,6 @@ def choose_fidelity(scene: Scene | Any, target_error: float = 0.01, *,
     share = {k: v * eps for k, v in BUDGET.items()}
     if allow_grid_values is None:
         allow_grid_values = grid_values_supported()
-    if evaluate is None:
-        evaluate = _transitional_evaluate
     statics = solve_statics(scene, method="fe")
     geo = segment_geometry(scene, statics, static_touchdowns(scene))
     inputs = input_summary(scene)
@@ -145,15 +141,6 @@ def choose_fidelity(scene: Scene | Any, target_error: float = 0.01, *,
         tail_bounded=bool(pilot.bounded), omega_response=float(band.omega2),
         pilot=pilot.info,
     )
-
-
-def _transitional_evaluate(scene: Scene) -> Any:
-    """TRANSITIONAL (issue 13): the pilot analysis when the caller passes none.  Remove
-    once the orchestrator (stochcable.analysis) passes ``evaluate``; this is the only
-    import of the analysis from this package."""
-    from stochcable.dynamics.line import analyze
-
-    return analyze(scene)
 
 
 # ------------------------------------------------------------------------- band

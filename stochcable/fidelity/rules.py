@@ -117,7 +117,7 @@ MIN_TAIL_EXCESS = 0.25
 CUTOFF_KH = 1.5
 #: Modal truncation error ≈ MODE_ERROR_CONSTANT/F² with the static correction. [-]
 MODE_ERROR_CONSTANT = 0.06
-#: Engine's "auto" factor (stochcable.dynamics.line.AUTO_MODE_FACTOR). [-]
+#: Engine's "auto" factor (stochcable.dynamics.system.AUTO_MODE_FACTOR). [-]
 AUTO_FACTOR = 5.0
 #: Above this many kept modes the direct solver is chosen. [-]
 DIRECT_MODES = 40

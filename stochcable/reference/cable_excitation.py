@@ -156,7 +156,7 @@ def band_limited(grid: ExcitationGrid, ends: dict[str, np.ndarray],
 
 
 def spectrum_density(spec: Any, g: float):
-    """ω -> S(ω) with S(0) = 0 (as :mod:`stochcable.dynamics.line` samples it)."""
+    """ω -> S(ω) with S(0) = 0 (as :mod:`stochcable.dynamics` samples it)."""
     def density(w: np.ndarray) -> np.ndarray:
         w = np.asarray(w, dtype=float)
         out = np.zeros_like(w)
@@ -170,7 +170,7 @@ def spectrum_density(spec: Any, g: float):
 def end_motion_generators(scene: Scene, seed: int) -> dict[tuple[str, str, str], Any]:
     """The generator of every end-motion spectrum channel, keyed (line, end, dof).
 
-    The rule of :func:`stochcable.dynamics.line.simulate_timeseries`: channels in the order
+    The rule of :func:`stochcable.dynamics.timeseries.simulate_timeseries`: channels in the order
     lines × (end_a, end_b) × (surge, sway, heave), channel k drawing from
     ``default_rng(SeedSequence(seed).spawn(n)[k])``.
     """
@@ -208,7 +208,7 @@ def wave_series(model: LineModel, x_static: np.ndarray, omega: np.ndarray, X: np
     Returns the fluid velocity at the nodes (n_steps+1, n, d) (attachment drag), at
     the drag quadrature points (n_steps+1, ne, ng, d), and the wave-inertia nodal load
     (n_steps+1, N): per element l0·ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ)·∫₀¹ N_i a dξ with the
-    exact element moments of :func:`stochcable.dynamics.loads.element_wave_kinematics`
+    exact element moments of :func:`stochcable.dynamics.element_kinematics.element_wave_kinematics`
     (the load of :func:`stochcable.dynamics.loads.wave_loads`), plus the attachments'
     (buoyancy/g + added mass)·a_node.  All are linear transfer functions per unit wave
     amplitude at the static positions, synthesized with the realization's coefficients.

@@ -29,7 +29,7 @@ Model (the same finite-element discretization as the frequency-domain model):
   * wave inertia (linear in the kinematics) — **exact** along each straight element:
     node i of element j gets l0_j ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ)·∫₀¹ N_i a dξ with the
     closed-form consistent moments of
-    :func:`stochcable.dynamics.loads.element_wave_kinematics` (split at the waterline),
+    :func:`stochcable.dynamics.element_kinematics.element_wave_kinematics` (split at the waterline),
     synthesized in time with the realization's coefficients like any transfer
     function; attachments get (buoyancy/g + added mass)·a at their node.
   * Morison drag with the relative velocity v_r = U_current + v_wave − u̇ (seed eqs.
@@ -65,7 +65,7 @@ from scipy import sparse
 
 from stochcable.errors import ConvergenceError
 from stochcable.line.mesh import LineMesh
-from stochcable.line.statics import solve_statics
+from stochcable.statics import solve_statics
 from stochcable.scene.model import Environment, Line, Scene
 
 __all__ = [

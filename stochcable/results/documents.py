@@ -1,4 +1,4 @@
-"""Result objects of :func:`stochcable.dynamics.line.analyze` and the v1 result document.
+"""Result objects of :func:`stochcable.analysis.analyze` and the v1 result document.
 
 Everything is a frozen dataclass holding numpy arrays; :meth:`Result.to_document`
 returns the JSON-ready result document of DESIGN.md ("Scene and result documents",
@@ -33,6 +33,7 @@ __all__ = [
     "TimeSeries",
     "Result",
     "stats_from_spectrum",
+    "stats_from_validated",
 ]
 
 THREE_HOURS = 10800.0
@@ -121,8 +122,8 @@ def stats_from_spectrum(
     return _response_stats(st, sd, mean)
 
 
-def _stats_from_validated(omega: np.ndarray, density: np.ndarray, mean: float,
-                          duration: float) -> ResponseStats:
+def stats_from_validated(omega: np.ndarray, density: np.ndarray, mean: float,
+                         duration: float) -> ResponseStats:
     """:func:`stats_from_spectrum` of a validated grid and spectrum (the analysis grid,
     validated once at the boundary; a 1-D float density >= 0 of its size, duration
     > 0): no second validation per call."""
@@ -562,7 +563,7 @@ class TimeSeries:
 
 @dataclass(frozen=True, eq=False)
 class Result:
-    """Result of :func:`stochcable.dynamics.line.analyze`.
+    """Result of :func:`stochcable.analysis.analyze`.
 
     Attributes
     ----------

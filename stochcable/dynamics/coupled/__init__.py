@@ -2,7 +2,7 @@
 
 Lines attached to a freely moving body are solved together with it: one drag
 linearization loop over every attached line and body, the response at every frequency
-by substructuring, the outputs of each line as :func:`stochcable.dynamics.line.line_result`
+by substructuring, the outputs of each line as :func:`stochcable.dynamics.outputs.line_result`
 gives them and the body motions as :class:`stochcable.results.documents.BodyResult`.
 
 Modules, lowest first (each imports only the ones above it):
@@ -46,9 +46,6 @@ from stochcable.dynamics.coupled.inputs import (
 from stochcable.dynamics.coupled.model import CoupledModel, build_coupled
 from stochcable.dynamics.coupled.modes import CoupledModes, coupled_modes
 from stochcable.dynamics.coupled.results import body_result, coupled_results
-
-# the name stochcable.dynamics.line imports today (until its import is rewritten)
-_scene_line_channels = scene_line_channels
 
 __all__ = [
     "BodyLoads",

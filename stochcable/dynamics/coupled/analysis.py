@@ -3,7 +3,7 @@
 
 :func:`analyze_coupled` is :func:`~stochcable.dynamics.coupled.model.build_coupled`
 then :func:`solve_coupled`.  Lines attached to no free body take the independent path
-of :mod:`stochcable.dynamics.line` (linearize, line_result), an end on a prescribed
+of :mod:`stochcable.dynamics` (linearize, line_result), an end on a prescribed
 body moving with :func:`~stochcable.dynamics.coupled.inputs.fairlead_motion` in the sea
 channel.  Each connected component of free bodies and their lines is one coupled group
 (:func:`~stochcable.dynamics.coupled.fixedpoint.linearize_coupled`,
@@ -37,7 +37,7 @@ from stochcable.dynamics.coupled.inputs import (
 from stochcable.dynamics.coupled.model import CoupledModel, ModelGroup, build_coupled
 from stochcable.dynamics.coupled.modes import coupled_modes
 from stochcable.dynamics.coupled.results import body_result, coupled_results
-from stochcable.dynamics.line import Damping, LineSystem, Progress, _noop
+from stochcable.dynamics.system import Damping, LineSystem, Progress, noop_progress
 from stochcable.dynamics.loads import Channel
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.results.documents import BodyResult, LineResult
@@ -195,7 +195,7 @@ def solve_coupled(model: CoupledModel, sea: Any = None, settings: Any = None,
         raise InputError("settings.omega", settings.omega, "rad/s",
                          "must be the grid the model was built on")
     scene = _with_sea(model.scene, sea)
-    progress = _noop if progress is None else progress
+    progress = noop_progress if progress is None else progress
     timing = {} if timing is None else timing
     for key in _TIMES:
         timing.setdefault(key, 0.0)
@@ -247,14 +247,16 @@ def _solve_line(model: CoupledModel, name: str, ch: tuple[Channel, ...], setting
                 progress: Progress, timing: dict[str, float]
                 ) -> tuple[LineResult, Damping]:
     """A line attached to no free body: the independent path."""
-    from stochcable.dynamics.line import _silent_channel, line_result, linearize
+    from stochcable.dynamics.line_loads import silent_channel
+    from stochcable.dynamics.outputs import line_result
+    from stochcable.dynamics.fixedpoint import linearize
 
     system = model.systems[name]
     if not ch:
         warn(f"line '{name}' has no excitation (no sea and no end motion): its "
              "dynamic response is zero; add a 'sea' or an end 'motion'",
              PhysicsWarning, stacklevel=4)
-        ch = _silent_channel(model.omega)
+        ch = silent_channel(model.omega)
     t1 = time.perf_counter()
     lin = linearize(system, ch, settings, progress=progress, timing=timing)
     timing["linearization_s"] += time.perf_counter() - t1
@@ -298,14 +300,14 @@ def _solve_lonely(model: CoupledModel, scene: Any, name: str, settings: Any,
                   ) -> tuple[BodyResult, CoupledGroup] | None:
     """A free-floating body without lines: the body alone in the sea (None without
     a sea)."""
-    from stochcable.dynamics.loads import _spectrum_callable
+    from stochcable.dynamics.loads import spectrum_callable
 
     if scene.sea is None:
         warn(f"body '{name}' has no lines and there is no sea: its motion is zero",
              PhysicsWarning, stacklevel=4)
         return None
     omega, env = model.omega, scene.environment
-    dens = _spectrum_callable(scene.sea.spectrum, env.g)
+    dens = spectrum_callable(scene.sea.spectrum, env.g)
     sea_ch = (Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega),
                       density=dens),)
     b = model.free[name]

@@ -5,8 +5,8 @@ On a grid of at least ``COARSE_MIN_FREQUENCIES`` points the iteration first runs
 a frequency subset G (every ``COARSE_STRIDE``-th frequency and the last) to
 ``COARSE_TOLERANCE_FACTOR`` times the tolerance.  The σ integrals on the subset are
 the full grid's trapezoid rule on the cubic interpolant of the integrand
-(:func:`stochcable.dynamics.line._interpolatory_weights`, as the single-line coarse start
-of :mod:`stochcable.dynamics.line`); subset frequencies whose σ weight is at most
+(:func:`stochcable.dynamics.fixedpoint.interpolatory_weights`, as the single-line coarse start
+of :mod:`stochcable.dynamics`); subset frequencies whose σ weight is at most
 ``COARSE_NEGLIGIBLE`` (1e-12) of the largest in every channel (the spectrum's empty
 tail) are then left out (their σ contributions are below round-off).  A Foss line
 solves its modal equations per frequency there
@@ -43,8 +43,9 @@ import numpy as np
 
 from stochcable.dynamics.coupled.group import GroupSystem, relative_change, sigma_update
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine
-from stochcable.dynamics.line import Progress, _interpolatory_weights, _subset_inputs
-from stochcable.dynamics.linearization import fixed_point
+from stochcable.dynamics.system import Progress
+from stochcable.dynamics.fixedpoint import interpolatory_weights, subset_inputs
+from stochcable.dynamics.iteration import fixed_point
 from stochcable.dynamics.loads import Channel
 from stochcable.errors import ConvergenceError, SolverError
 
@@ -131,14 +132,14 @@ def _warm_step(pairs: Sequence[tuple[np.ndarray, np.ndarray]], ratio: np.ndarray
 def _coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
     """The group on the frequencies ``g.omega[idx]``: σ integrals by the full grid's
     trapezoid rule on the subset's cubic interpolant
-    (:func:`stochcable.dynamics.line._interpolatory_weights`), the lines' inputs sliced
-    from the full grid's (:func:`stochcable.dynamics.line._subset_inputs`), Foss lines
+    (:func:`stochcable.dynamics.fixedpoint.interpolatory_weights`), the lines' inputs sliced
+    from the full grid's (:func:`stochcable.dynamics.fixedpoint.subset_inputs`), Foss lines
     solved per frequency in modal coordinates (:class:`~stochcable.dynamics.coupled.lineparts.ModalLine`); the frequencies
     of negligible σ weight (``COARSE_NEGLIGIBLE``) left out after the weights are
     formed."""
     spectra = np.stack([c.spectrum for c in g.channels], axis=1)[idx]
-    weights = _interpolatory_weights(g.omega, idx)[:, None] * spectra
-    inp = {cl.name: _subset_inputs(cl.system, tuple(cl.channels), g.inp_phys[cl.name], idx)
+    weights = interpolatory_weights(g.omega, idx)[:, None] * spectra
+    inp = {cl.name: subset_inputs(cl.system, tuple(cl.channels), g.inp_phys[cl.name], idx)
            for cl in g.lines}
     # frequencies whose σ weight is negligible in every channel (the spectrum's empty
     # tail) are dropped after the weights are formed: the other weights, the mean
@@ -148,7 +149,7 @@ def _coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
     if 4 <= keep.size < idx.size:
         for cl in g.lines:
             sub = inp[cl.name]
-            rows = _subset_inputs(cl.system, _sliced_line(cl, idx).channels, sub, keep)
+            rows = subset_inputs(cl.system, _sliced_line(cl, idx).channels, sub, keep)
             inp[cl.name] = dataclasses.replace(rows, weights=sub.weights[keep],
                                                square=sub.square)
         idx, weights = idx[keep], weights[keep]
@@ -218,7 +219,7 @@ class CoarseStart:
     lin : LinearizationSettings
         ``tolerance``, ``max_iterations``.
     fixed : dict
-        Keyword arguments of :func:`stochcable.dynamics.linearization.fixed_point`
+        Keyword arguments of :func:`stochcable.dynamics.iteration.fixed_point`
         (relaxation, method, mixing).
     gname : str
         The iteration's name in messages.

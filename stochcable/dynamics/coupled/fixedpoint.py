@@ -2,11 +2,11 @@
 group (seed 001 §5.3 steps 5–13, eq. 5.2.2).
 
 The fixed-point variable is the concatenation of every attached line's σ vector
-(:func:`stochcable.dynamics.line.drag_coefficients` layout) and, per body with a drag
+(:func:`stochcable.dynamics.variance.drag_coefficients` layout) and, per body with a drag
 area, the σ of the relative velocity (fluid − body) at its drag point along x, y, z
 (:func:`stochcable.dynamics.coupled.group.linear_body_drag`: b = ρ·CdA·E|v|, seed 001
 eq. 5.2.2 form with the current).  The iteration mirrors
-:func:`stochcable.dynamics.line.linearize`: the start is the fluid velocity relative to
+:func:`stochcable.dynamics.fixedpoint.linearize`: the start is the fluid velocity relative to
 lines and bodies at rest (lines following their moving unattached ends
 quasi-statically), the first response starts the Anderson-accelerated iteration
 unmixed.  The record is one for the whole group.  On fine grids the start is the
@@ -30,19 +30,12 @@ from stochcable.dynamics.coupled.coarse import (
 )
 from stochcable.dynamics.coupled.group import GroupSystem, body_sigma, sigma_update
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine
-from stochcable.dynamics.line import (
-    ANDERSON_MIXING,
-    Linearization,
-    Progress,
-    Response,
-    _end_tension,
-    _noop,
-    _quasi_static,
-    _sigmas,
-    _to_freq,
-    linearization_record,
-)
-from stochcable.dynamics.linearization import FixedPointResult, fixed_point
+from stochcable.dynamics.fixedpoint import ANDERSON_MIXING, linearization_record
+from stochcable.dynamics.system import Linearization, Progress, Response, noop_progress
+from stochcable.dynamics.solve import end_tension_from_support
+from stochcable.dynamics.variance import quasi_static_motion, sigmas_from_nodes
+from stochcable.dynamics.blocks import to_freq
+from stochcable.dynamics.iteration import FixedPointResult, fixed_point
 from stochcable.dynamics.loads import Channel
 from stochcable.errors import ConvergenceError, InputError, PhysicsWarning, warn
 
@@ -143,7 +136,7 @@ def linearize_coupled(
     """
     lin = settings.linearization
     method = lin.method
-    progress = _noop if progress is None else progress
+    progress = noop_progress if progress is None else progress
     if channels is None:
         if not lines:
             raise InputError("channels", None, "-",
@@ -195,8 +188,8 @@ def linearize_coupled(
 def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
     """σ of lines at rest (quasi-static on their moving ends) and bodies at rest;
     sets ``g.sizes``. [m/s]"""
-    parts = [_sigmas(cl.system, g.inp_phys[cl.name],
-                     _quasi_static(cl.system, g.inp_phys[cl.name]), method)
+    parts = [sigmas_from_nodes(cl.system, g.inp_phys[cl.name],
+                     quasi_static_motion(cl.system, g.inp_phys[cl.name]), method)
              for cl in g.lines]
     g.sizes = {cl.name: p.size for cl, p in zip(g.lines, parts)}
     for b in g.drag:
@@ -241,8 +234,8 @@ def _outcome(g: GroupSystem, cache: Mapping[str, Any], fp: FixedPointResult,
         system = cl.system
         damping = cache["damping"][cl.name]
         uc, sc = cache["sol"][cl.name]
-        resp = Response(omega=g.omega, displacement=_to_freq(uc), support_force=sc,
-                        end_tension=_end_tension(system, sc))
+        resp = Response(omega=g.omega, displacement=to_freq(uc), support_force=sc,
+                        end_tension=end_tension_from_support(system, sc))
         record = linearization_record(system, ls[cl.name], damping, fp, tolerance, method)
         out[cl.name] = Linearization(damping=damping, record=record, response=resp)
     xi = cache["xi"]

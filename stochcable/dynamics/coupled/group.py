@@ -50,14 +50,10 @@ from stochcable.bodies.rigid import (
 )
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine, unit_channels
 from stochcable.dynamics.coupled.lineparts import FossLine, ModalLine, line_parts
-from stochcable.dynamics.line import (
-    Damping,
-    Progress,
-    _inputs,
-    _sigmas,
-    _trapezoid_weights,
-    drag_coefficients,
-)
+from stochcable.dynamics.system import Damping, Progress
+from stochcable.dynamics.line_loads import line_inputs
+from stochcable.dynamics.variance import sigmas_from_nodes, drag_coefficients
+from stochcable.dynamics.blocks import trapezoid_weights
 from stochcable.dynamics.linearization import drag_linear_current, drag_linear_harmonic
 from stochcable.dynamics.loads import Channel
 from stochcable.errors import InputError, SolverError
@@ -83,7 +79,7 @@ class _LazyInputs(dict):
 
     def __missing__(self, name: str) -> Any:
         cl = self._lines[name]
-        value = _inputs(cl.system, tuple(cl.channels) + unit_channels(cl))
+        value = line_inputs(cl.system, tuple(cl.channels) + unit_channels(cl))
         self[name] = value
         return value
 
@@ -168,7 +164,7 @@ class GroupSystem:
         self.channels = tuple(channels)
         self.n_ch = len(channels)
         self.omega = channels[0].omega
-        self.weights = (_trapezoid_weights(self.omega)[:, None]
+        self.weights = (trapezoid_weights(self.omega)[:, None]
                         * np.stack([c.spectrum for c in channels], axis=1)
                         if weights is None else weights)
         self.sizes: dict[str, int] = {}
@@ -178,7 +174,7 @@ class GroupSystem:
         self.inp_phys, self.tmat, self.rows = {}, {}, {}
         self.geometric = self._link_lines(names)
         # the physical channels alone, for the σ (the unit channels weigh zero)
-        self.inp_phys = ({cl.name: _inputs(cl.system, tuple(cl.channels))
+        self.inp_phys = ({cl.name: line_inputs(cl.system, tuple(cl.channels))
                           for cl in self.lines} if inp_phys is None else dict(inp_phys))
         self._body_matrices()
         # body loads (n_w, nb, n_ch), drag-point maps
@@ -454,7 +450,7 @@ def _solve_body(s: np.ndarray, g: np.ndarray) -> np.ndarray:
 
 
 def relative_change(new: np.ndarray, x: np.ndarray) -> float:
-    """The convergence measure of :func:`stochcable.dynamics.linearization.fixed_point`.
+    """The convergence measure of :func:`stochcable.dynamics.iteration.fixed_point`.
 
     Parameters
     ----------
@@ -481,7 +477,7 @@ def sigma_update(g: GroupSystem, method: str, rho: float, state: dict[str, Any],
     g : GroupSystem
         Its ``sizes`` set (the σ layout of :meth:`GroupSystem.split`).
     method : str
-        Drag linearization method (:func:`stochcable.dynamics.line.drag_coefficients`).
+        Drag linearization method (:func:`stochcable.dynamics.variance.drag_coefficients`).
     rho : float
         Water density. [kg/m³]
     state : dict
@@ -519,7 +515,7 @@ def sigma_update(g: GroupSystem, method: str, rho: float, state: dict[str, Any],
         sol, xi = solve_group(g, damp, body_c, body_b, timing)
         new = []
         for cl in g.lines:
-            new.append(_sigmas(cl.system, g.inp_phys[cl.name], sol[cl.name][0], method))
+            new.append(sigmas_from_nodes(cl.system, g.inp_phys[cl.name], sol[cl.name][0], method))
         for b in g.drag:
             new.append(body_sigma(g, b, xi))
         new = np.concatenate(new) if new else np.zeros(0)

@@ -29,7 +29,7 @@ from stochcable.bodies.rigid import (
     attachment_geometric_stiffness,
     rigid_link_matrix,
 )
-from stochcable.dynamics.line import LineSystem
+from stochcable.dynamics.system import LineSystem
 from stochcable.dynamics.loads import Channel
 from stochcable.errors import InputError
 
@@ -55,7 +55,7 @@ class CoupledLine:
     ----------
     system : LineSystem
         The line about its static shape, both end nodes prescribed
-        (:func:`stochcable.dynamics.line.build_line_system`).
+        (:func:`stochcable.dynamics.system.build_line_system`).
     channels : tuple of Channel
         The group's input channels in the group order, sampled on the analysis grid,
         as seen by this line: fluid kinematics and the motion of its *unattached*

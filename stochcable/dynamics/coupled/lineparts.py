@@ -1,7 +1,7 @@
 """The lines of a coupled group before the body solve (seed 001 §3.3, §5.3).
 
 Each attached line keeps its own finite-element model with both end nodes prescribed
-(:func:`stochcable.dynamics.line.build_line_system`); its response is linear in the
+(:func:`stochcable.dynamics.system.build_line_system`); its response is linear in the
 motion u_e of its attached end nodes,
 
     U = U_0 + G u_e,        F_end = R_0 + R_e u_e,
@@ -32,26 +32,11 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.line import (
-    Damping,
-    LineSystem,
-    _add,
-    _base,
-    _drag_blocks,
-    _end_loads,
-    _free_load,
-    _matvec,
-    _prep,
-    _reactions,
-    _real_gemm,
-    _solve_free,
-    _total,
-)
-from stochcable.dynamics.solvers import (
-    FossModes,
-    _foss_decomposition,
-    _foss_transfer_modal,
-)
+from stochcable.dynamics.system import Damping, LineSystem
+from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep, real_gemm
+from stochcable.dynamics.line_loads import base_motion, drag_blocks, end_loads, free_load
+from stochcable.dynamics.solve import reactions, solve_free, total_displacement
+from stochcable.dynamics.modal_solvers import FossModes, foss_modes, foss_transfer_modal
 from stochcable.errors import SolverError
 from stochcable.runtime import line_map
 
@@ -120,15 +105,15 @@ def _line_part(g: Any, cl: Any, damping: Damping, state: Any = None
     solved = None
     if system.solver != "direct":
         solved = foss_unit_split(system, g.inp_phys[cl.name], inp, damping)
-    u_f, c = _solve_free(system, inp, damping) if solved is None else solved
-    u = _total(system, inp, u_f)
-    sup = _reactions(system, _prep(system), c, u, _end_loads(system, inp, damping), g.omega)
+    u_f, c = solve_free(system, inp, damping) if solved is None else solved
+    u = total_displacement(system, inp, u_f)
+    sup = reactions(system, line_prep(system), c, u, end_loads(system, inp, damping), g.omega)
     return (u, sup), sup[:, rows, :n_ch], sup[:, rows, n_ch:]
 
 
 def foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Damping
                     ) -> tuple[np.ndarray, Any] | None:
-    """:func:`stochcable.dynamics.line._solve_free` (Foss) of the physical channels plus the
+    """:func:`stochcable.dynamics.solve.solve_free` (Foss) of the physical channels plus the
     unit end-motion channels, the unit columns in closed form.
 
     Parameters
@@ -149,13 +134,13 @@ def foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Dampin
     Notes
     -----
     A unit end motion e_j moves the line by the constant U_p,j (the end and its exact
-    static following, :func:`stochcable.dynamics.line._base`), so its free-row load is
+    static following, :func:`stochcable.dynamics.line_loads.base_motion`), so its free-row load is
     ω²·[M_T U_p,j]_f − iω·[C U_p,j]_f: its modal load, its static correction and the
     drag load need no per-frequency products over the nodes; one Foss decomposition
     serves both.  The same linear system as the plain call to round-off; None (use the
     plain call) when the pencil is defective (its fallback and warning).
     """
-    prep = _prep(system)
+    prep = line_prep(system)
     w = inp.omega
     n_ch = inp_phys.weights.shape[1]
     n_e = inp.weights.shape[1] - n_ch
@@ -165,23 +150,23 @@ def foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Dampin
     phi, _, _ = prep.modal(system)
     m, nf = phi.shape[1], phi.shape[0]
     n_w = w.size
-    # physical channels: the free-row load of _solve_free
-    rhs = _free_load(system, prep, inp_phys, damping)
-    flat = np.ascontiguousarray(prep._free_rows(rhs)).reshape(nf, n_w * n_ch)
-    u_p = _real_gemm(phi, np.ascontiguousarray(
-        _foss_transfer_modal(foss, _real_gemm(phi.T, flat), w, n_ch)))
+    # physical channels: the free-row load of solve_free
+    rhs = free_load(system, prep, inp_phys, damping)
+    flat = np.ascontiguousarray(prep.free_rows(rhs)).reshape(nf, n_w * n_ch)
+    u_p = real_gemm(phi, np.ascontiguousarray(
+        foss_transfer_modal(foss, real_gemm(phi.T, flat), w, n_ch)))
     # unit channels: U_p,j constant (node vectors (n, d, n_e))
     key = ("unit_up", n_ch)
     if key not in inp.cache:
-        up = np.ascontiguousarray(_base(system, prep, inp)[0][:, :, 0, n_ch:].real)
-        inp.cache[key] = (up, prep._free_rows(_matvec(prep.MT, up)))
+        up = np.ascontiguousarray(base_motion(system, prep, inp)[0][:, :, 0, n_ch:].real)
+        inp.cache[key] = (up, prep.free_rows(block_matvec(prep.MT, up)))
     up, a = inp.cache[key]
-    b = prep._free_rows(_matvec(c, up))
+    b = prep.free_rows(block_matvec(c, up))
     ah, bh = phi.T @ a, phi.T @ b                              # (m, n_e)
     fe = ((w * w)[None, :, None] * ah[:, None, :]
           - (1j * w)[None, :, None] * bh[:, None, :])          # (m, n_w, n_e)
-    u_e = _real_gemm(phi, np.ascontiguousarray(
-        _foss_transfer_modal(foss, fe.reshape(m, n_w * n_e), w, n_e)))
+    u_e = real_gemm(phi, np.ascontiguousarray(
+        foss_transfer_modal(foss, fe.reshape(m, n_w * n_e), w, n_e)))
     u_e = u_e.reshape(nf, n_w, n_e)
     if m < nf:
         u_p += prep.residual(system, flat)
@@ -210,15 +195,15 @@ def foss_state(system: LineSystem, damping: Damping) -> tuple[Any, Any, FossMode
     Notes
     -----
     The part :func:`line_parts` runs on the thread pool (NumPy's LAPACK ``geev`` in
-    :func:`stochcable.dynamics.solvers._foss_decomposition` releases the GIL).
+    :func:`stochcable.dynamics.modal_solvers.foss_modes` releases the GIL).
     """
-    prep = _prep(system)
-    cd = _drag_blocks(system, damping)
-    c = _add(prep.S, cd)
+    prep = line_prep(system)
+    cd = drag_blocks(system, damping)
+    c = add_blocks(prep.S, cd)
     phi, mh, kh = prep.modal(system)
-    ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
+    ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
     try:
-        foss = _foss_decomposition(mh, 0.5 * (ch + ch.T), kh)
+        foss = foss_modes(mh, 0.5 * (ch + ch.T), kh)
     except SolverError:
         foss = None
     return cd, c, foss
@@ -232,7 +217,7 @@ def _unit_follow(system: LineSystem, inp: Any, ends: tuple[int, ...]
     cached on the inputs ``inp``."""
     key = ("unit_follow", ends)
     if key not in inp.cache:
-        prep = _prep(system)
+        prep = line_prep(system)
         d, n = prep.d, prep.n
         phi, _, _ = prep.modal(system)
         m, nf = phi.shape[1], phi.shape[0]
@@ -243,7 +228,7 @@ def _unit_follow(system: LineSystem, inp: Any, ends: tuple[int, ...]
         up = np.zeros((n, d, n_e))
         up[0], up[-1] = ub[:d], ub[d:]
         up[1:-1] = (prep.follower() @ ub).reshape(n - 2, d, n_e)
-        a = prep._free_rows(_matvec(prep.MT, up))
+        a = prep.free_rows(block_matvec(prep.MT, up))
         st_a = prep.residual(system, a.astype(complex)).real if m < nf else None
         inp.cache[key] = (up, phi.T @ a, st_a)
     return inp.cache[key]
@@ -260,7 +245,7 @@ class FossLine:
     §5.3).
 
     The same linear system as :func:`foss_unit_split` + :func:`stochcable.dynamics.line.
-    _reactions`, reordered: the physical channels' state-modal response P_0 (2m, n_w,
+    reactions`, reordered: the physical channels' state-modal response P_0 (2m, n_w,
     n_ch) and the unit end motions' P_e (2m, n_w, n_e) are kept (the latter in closed
     form, ``(ω²·W âh − iω·W b̂h)/(iω − λ)``, W the Foss weights); the end reactions
     need the displacement of the end nodes and their neighbours only (two rows of
@@ -277,7 +262,7 @@ class FossLine:
     def __init__(self, system: LineSystem, inp: Any, damping: Damping,
                  ends: tuple[int, ...], state: Any = None,
                  cache: dict[str, Any] | None = None) -> None:
-        prep = _prep(system)
+        prep = line_prep(system)
         w = inp.omega
         n_w, n_ch = inp.weights.shape
         d = prep.d
@@ -290,19 +275,19 @@ class FossLine:
         den = 1j * w[None, :] - lam[:, None]                      # (2m, n_w)
         bad = np.abs(den) <= 1e-12 * np.maximum(np.abs(lam)[:, None], w[None, :])
         if bad.any():   # the message of solvers._foss_transfer_modal
-            _foss_transfer_modal(foss, np.zeros((m, n_w), dtype=complex), w, 1)
+            foss_transfer_modal(foss, np.zeros((m, n_w), dtype=complex), w, 1)
         w2, iw = w * w, 1j * w
         cache = _foss_cache(system, prep, inp, ends, phi, cache)
         u_p = cache["u_p"]
         up, ah, st_a = cache["follow"]
         adj = cache["adj"]
-        # physical channels: the free-row load of _solve_free
-        rhs = _free_load(system, prep, inp, damping)
-        flat = np.ascontiguousarray(prep._free_rows(rhs)).reshape(nf, n_w * n_ch)
-        p0 = (foss.weights @ _real_gemm(phi.T, flat)).reshape(2 * m, n_w, n_ch)
+        # physical channels: the free-row load of solve_free
+        rhs = free_load(system, prep, inp, damping)
+        flat = np.ascontiguousarray(prep.free_rows(rhs)).reshape(nf, n_w * n_ch)
+        p0 = (foss.weights @ real_gemm(phi.T, flat)).reshape(2 * m, n_w, n_ch)
         p0 /= den[:, :, None]
         # unit end motions: the constant static following U_p,j of each attached end DOF
-        b = prep._free_rows(_matvec(c, up))
+        b = prep.free_rows(block_matvec(c, up))
         n_e = up.shape[2]
         # W âh and W b̂h as the two blocks of one (2m, 2 n_e) product: each column of a
         # product is that of the separate one (the same sums, tested to the bit)
@@ -331,9 +316,9 @@ class FossLine:
             sb = st_b[adj]                                           # (2d, n_e)
             ve += (cache["w2sa"] - iw[None, None] * sb[:, :, None]).reshape(2, d, n_e, n_w)
         u4e[1:3] += ve.transpose(0, 1, 3, 2)
-        f_end = _end_loads(system, inp, damping)
-        self.sup0 = _reactions(system, prep, c, u4, f_end, w)       # (n_w, 2d, n_ch)
-        self.supe = _reactions(system, prep, c, u4e, cache["zero_e"], w)
+        f_end = end_loads(system, inp, damping)
+        self.sup0 = reactions(system, prep, c, u4, f_end, w)       # (n_w, 2d, n_ch)
+        self.supe = reactions(system, prep, c, u4e, cache["zero_e"], w)
         self.inp, self.phi, self.chi, self.rden = inp, phi, foss.chi, rden
         self.p0, self.wab, self.up, self.u_p = p0, wab, up, u_p
         self.w2, self.iw = (w2)[None, :, None], iw[None, :, None]
@@ -359,7 +344,7 @@ class FossLine:
         pc -= self.iw * gb
         pc *= self.rden[:, :, None]
         pc += self.p0
-        uf = _real_gemm(self.phi, np.ascontiguousarray(self.chi @ pc.reshape(m2, -1)))
+        uf = real_gemm(self.phi, np.ascontiguousarray(self.chi @ pc.reshape(m2, -1)))
         return _assemble_line(self, uf, ue, uet)
 
 
@@ -384,25 +369,25 @@ class ModalLine:
 
     def __init__(self, system: LineSystem, inp: Any, damping: Damping,
                  ends: tuple[int, ...], cache: dict[str, Any] | None = None) -> None:
-        prep = _prep(system)
+        prep = line_prep(system)
         w = inp.omega
         n_w, n_ch = inp.weights.shape
         d = prep.d
-        c = _add(prep.S, _drag_blocks(system, damping))
+        c = add_blocks(prep.S, drag_blocks(system, damping))
         phi, _, _ = prep.modal(system)
         m, nf = phi.shape[1], phi.shape[0]
         iw = 1j * w
         cache = _modal_cache(system, prep, inp, ends, cache)
         u_p = cache["u_p"]
         up, _, st_a = cache["follow"]
-        ch = phi.T @ prep._free_rows(_matvec(c, prep._nodes(phi)))
-        rhs = _free_load(system, prep, inp, damping)
-        flat = np.ascontiguousarray(prep._free_rows(rhs)).reshape(nf, n_w * n_ch)
-        b = prep._free_rows(_matvec(c, up))
+        ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
+        rhs = free_load(system, prep, inp, damping)
+        flat = np.ascontiguousarray(prep.free_rows(rhs)).reshape(nf, n_w * n_ch)
+        b = prep.free_rows(block_matvec(c, up))
         bh = phi.T @ b
         n_e = up.shape[2]
         f = np.empty((n_w, m, n_ch + n_e), dtype=complex)
-        f[:, :, :n_ch] = _real_gemm(phi.T, flat).reshape(m, n_w, n_ch).transpose(1, 0, 2)
+        f[:, :, :n_ch] = real_gemm(phi.T, flat).reshape(m, n_w, n_ch).transpose(1, 0, 2)
         f[:, :, n_ch:] = cache["w2ah"] - iw[:, None, None] * bh[None]
         # symmetric matrices passed as their transposes (LAPACK's column-major layout,
         # as analysis._foss_free)
@@ -435,9 +420,9 @@ class ModalLine:
             ve += (cache["w2sa"] - iw[None, :, None] * sb[:, None, :]
                    ).reshape(2, d, n_w, n_e)
         u4e[1:3] += ve
-        f_end = _end_loads(system, inp, damping)
-        self.sup0 = _reactions(system, prep, c, u4, f_end, w)
-        self.supe = _reactions(system, prep, c, u4e, np.zeros((2, d, n_w, n_e), complex), w)
+        f_end = end_loads(system, inp, damping)
+        self.sup0 = reactions(system, prep, c, u4, f_end, w)
+        self.supe = reactions(system, prep, c, u4e, np.zeros((2, d, n_w, n_e), complex), w)
         self.inp, self.phi, self.z0, self.ze, self.up, self.u_p = inp, phi, z0, ze, up, u_p
 
     def reactions(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -449,7 +434,7 @@ class ModalLine:
         n_w, m, n_ch = self.z0.shape
         z = self.z0 + self.ze @ ue                                      # (n_w, m, n_ch)
         zf = np.ascontiguousarray(np.transpose(z, (1, 0, 2))).reshape(m, n_w * n_ch)
-        uf = _real_gemm(self.phi, zf)
+        uf = real_gemm(self.phi, zf)
         uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))       # (n_e, n_w, n_ch)
         return _assemble_line(self, uf, ue, uet)
 
@@ -469,7 +454,7 @@ def _foss_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
     d = prep.d
     nf = phi.shape[0]
     w2 = w * w
-    cache["u_p"] = u_p = _base(system, prep, inp)[0]
+    cache["u_p"] = u_p = base_motion(system, prep, inp)[0]
     up, _, st_a = cache["follow"] = _unit_follow(system, inp, ends)
     n_e = up.shape[2]
     # end nodes and their neighbours: nodes 0, 1, n-2, n-1
@@ -499,7 +484,7 @@ def _modal_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
     phi, mh, kh = prep.modal(system)
     m, nf = phi.shape[1], phi.shape[0]
     w2 = w * w
-    cache["u_p"] = _base(system, prep, inp)[0]
+    cache["u_p"] = base_motion(system, prep, inp)[0]
     up, ah, st_a = cache["follow"] = _unit_follow(system, inp, ends)
     cache["w2ah"] = w2[:, None, None] * ah[None]
     cache["adj"] = adj = np.r_[np.arange(d), np.arange(nf - d, nf)]
@@ -509,9 +494,9 @@ def _modal_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
     cache["w2sa"] = (None if st_a is None
                      else w2[None, :, None] * st_a[adj][:, None, :])
     key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂, as analysis._foss_free
-    if key not in prep._modal:
-        prep._modal[key] = kh - (w2[:, None, None]) * mh
-    cache["kmm"] = prep._modal[key]
+    if key not in prep.cache:
+        prep.cache[key] = kh - (w2[:, None, None]) * mh
+    cache["kmm"] = prep.cache[key]
     return cache
 
 
@@ -530,9 +515,9 @@ def _assemble_line(part: Any, uf: np.ndarray, ue: np.ndarray, uet: np.ndarray
         w2 = (w * w)[None, :, None]
         iw = (1j * w)[None, :, None]
         x = np.concatenate([w2 * uet, -iw * uet], axis=0).reshape(2 * n_e, -1)
-        uf += part.res0.reshape(uf.shape[0], -1) + _real_gemm(part.st, x)
+        uf += part.res0.reshape(uf.shape[0], -1) + real_gemm(part.st, x)
     uc = part.u_p.copy()
     uc[1:-1] += uf.reshape(n - 2, d, n_w, n_ch)
-    uc += _real_gemm(part.up.reshape(n * d, n_e), flat_e).reshape(n, d, n_w, n_ch)
+    uc += real_gemm(part.up.reshape(n * d, n_e), flat_e).reshape(n, d, n_w, n_ch)
     sc = part.sup0 + part.supe @ ue
     return uc, sc

@@ -29,7 +29,7 @@ from stochcable.dynamics.coupled.inputs import (
     vessel_rao,
 )
 from stochcable.dynamics.coupled.modes import CoupledModes, coupled_modes
-from stochcable.dynamics.line import LineSystem
+from stochcable.dynamics.system import LineSystem
 from stochcable.errors import InputError, PhysicsWarning, warn
 
 __all__ = ["STATIC_ROTATION_LIMIT", "CoupledModel", "ModelGroup", "build_coupled"]
@@ -146,7 +146,7 @@ def build_coupled(scene: Any, statics: Any, settings: Any, *,
     PhysicsWarning
         A body's static rotation above ``STATIC_ROTATION_LIMIT``.
     """
-    from stochcable.dynamics.line import build_line_system
+    from stochcable.dynamics.system import build_line_system
 
     t0 = time.perf_counter()
     omega = settings.omega.values()

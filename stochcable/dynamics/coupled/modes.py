@@ -20,17 +20,12 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
-from stochcable.bodies.rigid import (
-    LineLink,
-    RigidBody,
-    attachment_geometric_stiffness,
-    constant_matrices,
-    couple,
-    rigid_link_matrix,
-)
+from stochcable.bodies.coupling import LineLink, constant_matrices, couple
+from stochcable.bodies.rigid import RigidBody, attachment_geometric_stiffness, rigid_link_matrix
 from stochcable.dynamics.coupled.group import body_drag_matrix
 from stochcable.dynamics.coupled.inputs import CoupledLine
-from stochcable.dynamics.line import _add, _drag_blocks, _matvec, _prep
+from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep
+from stochcable.dynamics.line_loads import drag_blocks
 from stochcable.errors import InputError
 
 __all__ = [
@@ -43,7 +38,7 @@ __all__ = [
 ]
 
 #: Modes listed: those up to this factor times the top of the grid, at least
-#: ``MIN_LISTED_MODES`` (as the line listing of :mod:`stochcable.dynamics.line`).
+#: ``MIN_LISTED_MODES`` (as the line listing of :mod:`stochcable.dynamics`).
 LISTED_MODE_FACTOR = 2.5
 MIN_LISTED_MODES = 10
 # Coupled DOFs up to which the modes are a dense generalized eigenproblem.
@@ -309,7 +304,7 @@ def _reduced_line(cl: CoupledLine, by_name: Mapping[str, RigidBody],
     k_ends = t.T @ kd_[np.ix_(ends, ends)] @ t
     ell = np.zeros((model.n_dof, m + nb))
     ell[model.free, :m] = phi
-    ell[model.free, m:] = _prep(cl.system).follower() @ t
+    ell[model.free, m:] = line_prep(cl.system).follower() @ t
     ell[ends, m:] = t
     return (ell, kd_, md_, ends, t, offset, m), k_top, k_ends
 
@@ -342,7 +337,7 @@ def coupled_modal_bandwidths(modes: CoupledModes, lines: Sequence[CoupledLine],
     ndarray, shape (n,)
         φ_nᵀCφ_n over the group (mass-normalized φ): per line its structural, seabed
         and drag damping on all its nodes (the attached ends moving with the bodies,
-        as :func:`stochcable.dynamics.line._modal_bandwidths` does on the free nodes of
+        as :func:`stochcable.dynamics.indicators.modal_bandwidths` does on the free nodes of
         a line with fixed ends), per body C_B + B(ω_ref) + Tdᵀ diag(b) Td. [rad/s]
 
     Notes
@@ -354,9 +349,9 @@ def coupled_modal_bandwidths(modes: CoupledModes, lines: Sequence[CoupledLine],
     band = np.zeros(modes.omega.size)
     for cl in lines:
         u = modes.line_shapes[cl.name]
-        prep = _prep(cl.system)
-        c = _add(prep.S, _drag_blocks(cl.system, line_damping[cl.name]))
-        band += np.einsum("ndk,ndk->k", u, _matvec(c, u))
+        prep = line_prep(cl.system)
+        c = add_blocks(prep.S, drag_blocks(cl.system, line_damping[cl.name]))
+        band += np.einsum("ndk,ndk->k", u, block_matvec(c, u))
     body_drag = {} if body_drag is None else body_drag
     for b in bodies:
         c = b.extra_damping + b.radiation_damping_at(np.array([modes.omega_ref]))[0]

@@ -12,7 +12,7 @@ from stochcable.bodies.rigid import PLANAR_INDEX, RigidBody
 from stochcable.dynamics.coupled.fixedpoint import CoupledLinearization
 from stochcable.dynamics.coupled.inputs import CoupledLine
 from stochcable.dynamics.coupled.modes import CoupledModes
-from stochcable.dynamics.line import line_result
+from stochcable.dynamics.outputs import line_result
 from stochcable.dynamics.loads import Channel
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 

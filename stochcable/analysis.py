@@ -1,0 +1,143 @@
+"""The analysis pipeline (seed 001 ch. 5, Tuah 1982): scene -> statics -> FE model ->
+excitation -> drag linearization -> solve -> results.
+
+:func:`analyze` runs the whole pipeline through the engine seam
+(:mod:`stochcable.dynamics.engine`): build the sea-independent model once, then solve
+it for the scene's sea state.  Each stage is a public function that an engineer can
+inspect or replace::
+
+    statics = solve_statics(scene, method="fe")           # stochcable.line.statics
+    system  = build_line_system(scene, line, statics.lines[line.name])  # dynamics.system
+    chans   = line_channels(scene, line, system.positions, omega)   # dynamics.loads
+    lin     = linearize(system, chans, scene.analysis)    # dynamics.fixedpoint
+    resp    = solve(system, chans, lin.damping)           # dynamics.solve
+    out     = line_result(system, chans, lin, scene.analysis)       # dynamics.outputs
+
+Lines not attached to a free body are independent: each is linearized and solved on
+its own; lines on bodies are solved together with them
+(:mod:`stochcable.dynamics.coupled`).  The sea channel of all lines shares one
+realization in the time series (:mod:`stochcable.dynamics.timeseries`).
+
+Choices (see the functions for details)
+---------------------------------------
+- Model: 2-D (x–z) when ``scene.is_planar``, else 3-D; both ends prescribed.
+- Drag damping and added mass distributed like the model mass (consistent by default),
+  element direction constant per element (:mod:`stochcable.dynamics.loads`).
+- Wave loads (Morison inertia and linearized drag) integrated exactly along each
+  element's wet part (:func:`stochcable.dynamics.element_kinematics.element_wave_kinematics`), B
+  constant per element.
+- The σ of the relative velocity of an element is its element mean square
+  (:func:`stochcable.dynamics.variance.relative_velocity_sigmas`).
+- ``modes="auto"`` (Foss): all modes up to ``AUTO_ALL_MODES`` free DOFs, else those up
+  to ``AUTO_MODE_FACTOR``·ω_max (:mod:`stochcable.dynamics.system`); moving ends use
+  the quasi-static split (:func:`stochcable.dynamics.solve.solve`).
+- Drag linearization: a coarse start on a frequency subset, then the full grid
+  (:mod:`stochcable.dynamics.fixedpoint`).
+- Time series: the first 2048 samples go in the document (``to_document(timeseries=
+  "full")`` for all); the full series are on
+  :class:`~stochcable.results.documents.TimeSeries`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Mapping
+from typing import Any
+
+from stochcable.fidelity import apply_fidelity, choose_fidelity
+from stochcable.dynamics.engine import Engine, build_engine
+from stochcable.dynamics.system import Progress, noop_progress
+from stochcable.errors import PhysicsWarning, warn
+from stochcable.statics import StaticsResult
+from stochcable.results.documents import Result
+from stochcable.scene.model import Scene, load_scene
+
+__all__ = ["Engine", "analyze", "build_engine"]
+
+
+def analyze(
+    scene: Scene | Mapping[str, Any] | str,
+    *,
+    statics: StaticsResult | None = None,
+    progress: Progress | None = None,
+) -> Result:
+    """Stochastic response of every line of a scene (seed 001 ch. 5).
+
+    Parameters
+    ----------
+    scene : Scene, mapping, JSON string or path
+        The scene document (validated by :func:`stochcable.scene.model.load_scene`).
+    statics : StaticsResult, optional
+        A precomputed static equilibrium (default: the FE equilibrium of
+        :func:`stochcable.statics.solve_statics`; ignored under adaptive
+        fidelity, which changes the mesh).
+    progress : callable, optional
+        ``progress(stage, info)`` (see :data:`stochcable.dynamics.system.Progress`).
+
+    Returns
+    -------
+    Result
+        Statics, modes, linearization record, transfer functions, spectra,
+        statistics, time series, timing and warnings.
+
+    Raises
+    ------
+    InputError
+        Invalid scene.
+    ConvergenceError
+        Statics or drag linearization did not converge (unless
+        ``analysis.linearization.allow_unconverged``, which returns a flagged result).
+    SolverError
+        An undamped resonance on the frequency grid.
+
+    Notes
+    -----
+    Pipeline: adaptive fidelity (when ``analysis.fidelity`` is set: the mesh, grid,
+    modes and tolerance the target error needs) -> :func:`build_engine` (statics, FE
+    model about the static shape, modes) -> :meth:`Engine.solve` for the scene's sea
+    (input channels, drag linearization, direct or Foss response, spectra
+    S_x = Σ_i |H_{x,i}|² S_i and statistics, time series).
+    """
+    t_start = time.perf_counter()
+    scene = load_scene(scene)
+    progress = noop_progress if progress is None else progress
+    plan = None
+    if scene.analysis.fidelity is not None:
+        scene, plan = _plan_fidelity(scene, progress)
+        statics = None  # the mesh changed
+    result = build_engine(scene, statics=statics, progress=progress).solve(progress=progress)
+    if plan is None:
+        return result
+    return _with_plan(result, plan, time.perf_counter() - t_start)
+
+
+def _plan_fidelity(scene: Scene, progress: Progress) -> tuple[Scene, Any]:
+    """The scene with the settings adaptive fidelity chose, and the plan."""
+    progress("fidelity", {})
+    target = scene.analysis.fidelity.target_error
+    # the planner runs pilot analyses of the scene: without the request itself
+    base = scene.model_copy(update={
+        "analysis": scene.analysis.model_copy(update={"fidelity": None})})
+    # exact_wave_integration stays False: its element rule alone can leave a short
+    # line with a single element (no free node); the surface rule is conservative
+    # with the exact loads (see the closing note of issue 7)
+    plan = choose_fidelity(base, target, evaluate=analyze)
+    return apply_fidelity(base, plan), plan
+
+
+def _with_plan(result: Result, plan: Any, total_s: float) -> Result:
+    """The result with its fidelity plan, the planning time in ``total_s``, and the
+    warning of an unbounded response tail first."""
+    messages = list(result.warnings)
+    if not plan.tail_bounded:
+        text = ("adaptive fidelity could not bound the response tail above "
+                f"{plan.omega_max:.3g} rad/s: the target error is not guaranteed (an input "
+                "spectrum with a slowly decaying tail, e.g. an end-motion spectrum without "
+                "a vessel RAO, drives tension up to high frequency)")
+        warn(text, PhysicsWarning)
+        messages.insert(0, text)
+    timing = dict(result.timing)
+    timing["total_s"] = total_s
+    return dataclasses.replace(result, warnings=tuple(messages), fidelity=plan,
+                               timing=timing)

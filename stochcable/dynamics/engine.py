@@ -1,0 +1,269 @@
+"""Build once, solve per sea state: the seam between the sea-independent model of a
+scene and its response to one sea state (seed 001 ch. 5).
+
+:func:`build_engine` does everything that does not depend on the sea: the static
+equilibrium (all nonlinearities), the finite-element model of every independent line
+about it, its natural modes and the drag-independent arrays of the block-banded solves
+(:class:`~stochcable.dynamics.blocks.LinePrep`; the banded Cholesky of K_ff and the
+modal matrices are computed on first use and then kept on the line's
+:class:`~stochcable.dynamics.system.LineSystem`).  :meth:`Engine.solve` does the rest
+for one sea state: the input channels (Morison loads, end motions), the drag fixed
+point (:func:`~stochcable.dynamics.fixedpoint.linearize`), the response
+(:func:`~stochcable.dynamics.solve.solve`), the outputs and the time series::
+
+    engine = build_engine(scene)            # statics, FE models, modes
+    for sea in sea_states:                  # Sea documents (or None: the scene's own)
+        result = engine.solve(sea)
+
+A sea state is a :class:`~stochcable.scene.model.Sea` document (spectrum and heading);
+the current, the end motions and the settings are the scene's.  ``solve`` mutates no
+state that changes its answer: solving the same sea twice gives identical results, and
+``engine.solve(sea)`` gives the result of ``analyze`` on the scene with that sea.
+
+Scenes with bodies: the statics are built once; the coupled systems (lines and bodies
+solved together, :func:`stochcable.dynamics.coupled.analyze_coupled`) are built at
+every solve for now.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from pydantic import ValidationError
+
+from stochcable import runtime
+from stochcable.dynamics.blocks import line_prep
+from stochcable.dynamics.fixedpoint import linearize
+from stochcable.dynamics.line_loads import silent_channel
+from stochcable.dynamics.loads import line_channels
+from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.system import (
+    Damping,
+    LineSystem,
+    Progress,
+    build_line_system,
+    noop_progress,
+)
+from stochcable.dynamics.timeseries import simulate_timeseries
+from stochcable.errors import InputError, PhysicsWarning, collect_warnings, warn
+from stochcable.statics import StaticsResult, solve_statics
+from stochcable.results.documents import LineResult, Result
+from stochcable.scene.model import Scene, Sea, input_error_from_validation, load_scene
+
+__all__ = ["Engine", "build_engine"]
+
+#: Stage times of a result, zero until the stage runs. [s]
+_STAGES = ("statics_s", "model_s", "linearization_s", "solve_s", "outputs_s", "timeseries_s")
+
+
+def is_small(scene: Scene) -> bool:
+    """Whether every line of ``scene`` is small enough for one BLAS thread
+    (:data:`stochcable.runtime.SMALL_MODEL_DOF`, 3 DOFs per node)."""
+    return max(3 * (line.elements + 1) for line in scene.lines) <= runtime.SMALL_MODEL_DOF
+
+
+@dataclass(frozen=True, eq=False)
+class Engine:
+    """The sea-independent model of a scene (:func:`build_engine`).
+
+    Attributes
+    ----------
+    scene : Scene
+        The scene it was built for (its sea is the default of :meth:`solve`).
+    statics : StaticsResult
+        Static equilibrium of every line (and body).
+    systems : mapping of LineSystem by line name
+        The independent lines' linear models (empty for a scene with bodies: the
+        coupled systems are built per solve).
+    timing : mapping of float
+        ``statics_s``, ``model_s`` and ``build_s`` (the whole build) of the build. [s]
+    warnings : tuple of str
+        Messages of the warnings raised by the build (repeated in every result).
+    """
+
+    scene: Scene
+    statics: StaticsResult
+    systems: Mapping[str, LineSystem]
+    timing: Mapping[str, float]
+    warnings: tuple[str, ...]
+
+    def solve(self, sea: Sea | Mapping[str, Any] | None = None, *,
+              progress: Progress | None = None) -> Result:
+        """Stochastic response of the scene to one sea state.
+
+        Parameters
+        ----------
+        sea : Sea, mapping or None, optional
+            The sea state (a ``Sea`` document: spectrum and heading); None takes the
+            scene's own sea.
+        progress : callable, optional
+            ``progress(stage, info)`` (:data:`~stochcable.dynamics.system.Progress`):
+            "linearization", "outputs", "timeseries", "done".
+
+        Returns
+        -------
+        Result
+            As :func:`stochcable.analysis.analyze` of the scene with this sea;
+            ``timing`` holds the build's ``statics_s`` and ``model_s`` (the channel
+            assembly of this sea added to ``model_s``) and ``total_s`` = build + solve.
+
+        Raises
+        ------
+        InputError
+            An invalid sea document.
+        ConvergenceError, SolverError
+            As :func:`stochcable.analysis.analyze`.
+        """
+        t_start = time.perf_counter()
+        scene = _with_sea(self.scene, sea)
+        progress = noop_progress if progress is None else progress
+        timing = {k: 0.0 for k in _STAGES}
+        timing.update(self.timing)
+        with collect_warnings() as caught, runtime.analysis_blas(is_small(scene)):
+            if scene.bodies:
+                # lines attached to bodies are solved together with them (issue 6)
+                from stochcable.dynamics.coupled import analyze_coupled
+
+                coupled = analyze_coupled(scene, self.statics, scene.analysis, progress,
+                                          timing)
+                lines, bodies, systems, dampings = coupled
+                groups = coupled.groups
+            else:
+                systems, groups, bodies = dict(self.systems), (), {}
+                lines, dampings = _solve_lines(scene, systems, progress, timing)
+            ts = None
+            if scene.analysis.timeseries is not None:
+                progress("timeseries", {})
+                t0 = time.perf_counter()
+                ts = simulate_timeseries(scene, systems, dampings, scene.analysis.timeseries,
+                                         coupled=groups, timing=timing)
+                timing["timeseries_s"] = time.perf_counter() - t0
+        messages = _messages(self.warnings, caught)
+        timing["total_s"] = timing.pop("build_s") + time.perf_counter() - t_start
+        progress("done", {"total_s": timing["total_s"]})
+        return Result(scene=scene, statics=self.statics, lines=lines, timeseries=ts,
+                      timing=timing, warnings=tuple(messages), bodies=bodies)
+
+
+def build_engine(
+    scene: Scene | Mapping[str, Any] | str,
+    *,
+    statics: StaticsResult | None = None,
+    progress: Progress | None = None,
+) -> Engine:
+    """The sea-independent model of a scene: statics, FE models, modes.
+
+    Parameters
+    ----------
+    scene : Scene, mapping, JSON string or path
+        The scene document (validated by :func:`stochcable.scene.model.load_scene`).
+    statics : StaticsResult, optional
+        A precomputed static equilibrium (default: the FE equilibrium of
+        :func:`stochcable.statics.solve_statics`).
+    progress : callable, optional
+        ``progress(stage, info)``: "statics", then "model" per independent line.
+
+    Returns
+    -------
+    Engine
+
+    Raises
+    ------
+    InputError
+        Invalid scene, or the harmonic drag form with a current.
+    ConvergenceError
+        The statics did not converge.
+    """
+    t_start = time.perf_counter()
+    scene = load_scene(scene)
+    progress = noop_progress if progress is None else progress
+    settings = scene.analysis
+    if settings.linearization.method == "harmonic" and any(
+            p.speed > 0 for p in scene.environment.current):
+        raise InputError("analysis.linearization.method", "harmonic", "-",
+                         "the harmonic (regular-wave) form has no current term: use "
+                         "'seed' or 'vector' with a current")
+    timing = {"statics_s": 0.0, "model_s": 0.0}
+    systems: dict[str, LineSystem] = {}
+    with collect_warnings() as caught, runtime.analysis_blas(is_small(scene)):
+        progress("statics", {})
+        t0 = time.perf_counter()
+        if statics is None:
+            # the FE equilibrium, not the closed-form catenary: the dynamic model is
+            # linearized about it, so it must be an equilibrium of the same FE model
+            statics = solve_statics(scene, method="fe")
+        timing["statics_s"] = time.perf_counter() - t0
+        for line in (() if scene.bodies else scene.lines):
+            progress("model", {"line": line.name})
+            t0 = time.perf_counter()
+            system = build_line_system(scene, line, statics.lines[line.name],
+                                       settings=settings)
+            line_prep(system)  # node blocks and band storage of K, M_T, C_s
+            systems[line.name] = system
+            timing["model_s"] += time.perf_counter() - t0
+    timing["build_s"] = time.perf_counter() - t_start  # (in each result's total_s)
+    return Engine(scene=scene, statics=statics, systems=systems, timing=timing,
+                  warnings=tuple(_messages((), caught)))
+
+
+def _with_sea(scene: Scene, sea: Sea | Mapping[str, Any] | None) -> Scene:
+    """``scene`` with its sea replaced by ``sea`` (validated); None: unchanged."""
+    if sea is None:
+        return scene
+    if not isinstance(sea, Sea):
+        try:
+            sea = Sea.model_validate(sea)
+        except ValidationError as exc:
+            raise input_error_from_validation(exc, Sea, prefix="sea") from None
+    return scene.model_copy(update={"sea": sea})
+
+
+def _solve_lines(scene: Scene, systems: Mapping[str, LineSystem], progress: Progress,
+                 timing: dict[str, float]
+                 ) -> tuple[dict[str, LineResult], dict[str, Damping]]:
+    """Channels, drag fixed point and outputs of every independent line."""
+    lines: dict[str, LineResult] = {}
+    dampings: dict[str, Damping] = {}
+    for line in scene.lines:
+        lines[line.name], dampings[line.name] = _solve_line(
+            scene, line, systems[line.name], progress, timing)
+    return lines, dampings
+
+
+def _solve_line(scene: Scene, line: Any, system: LineSystem, progress: Progress,
+                timing: dict[str, float]) -> tuple[LineResult, Damping]:
+    """One independent line: its channels (the sea-dependent loads, timed with the
+    model), the drag linearization and the outputs."""
+    settings = scene.analysis
+    omega = settings.omega.values()
+    t0 = time.perf_counter()
+    channels = line_channels(scene, line, system.positions, omega)
+    timing["model_s"] += time.perf_counter() - t0
+    if not channels:
+        warn(
+            f"line '{line.name}' has no excitation (no sea and no end motion): its "
+            "dynamic response is zero; add a 'sea' or an end 'motion'",
+            PhysicsWarning, stacklevel=3,
+        )
+        channels = silent_channel(omega)
+    progress("linearization", {"line": line.name, "iteration": 0})
+    t0 = time.perf_counter()
+    lin = linearize(system, channels, settings, progress=progress, timing=timing)
+    timing["linearization_s"] += time.perf_counter() - t0
+    progress("outputs", {"line": line.name})
+    t0 = time.perf_counter()
+    result = line_result(system, channels, lin, settings)
+    timing["outputs_s"] += time.perf_counter() - t0
+    return result, lin.damping
+
+
+def _messages(first: tuple[str, ...], caught: list[Warning]) -> list[str]:
+    """The distinct warning messages, ``first`` (the build's) leading."""
+    messages = list(first)
+    for w in caught:
+        if str(w) not in messages:
+            messages.append(str(w))
+    return messages

@@ -1,0 +1,417 @@
+"""Checks and quality indicators of the linear model of one line: resolution of the
+natural frequencies by the grid, of the wave kinematics by the mesh near the surface,
+of the response tail by ω_max, and the snap / resonance / large-motion indicators
+(:func:`line_indicators`), each with its warning.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from stochcable.dynamics.blocks import (
+    add_blocks,
+    block_matvec,
+    line_prep,
+    trapezoid_weights,
+)
+from stochcable.dynamics.line_loads import (
+    drag_blocks,
+)
+from stochcable.dynamics.linearization import (
+    borgman_variance_ratio,
+)
+from stochcable.dynamics.loads import (
+    Channel,
+    element_mean_square,
+)
+from stochcable.dynamics.system import (
+    Damping,
+    Linearization,
+    LineSystem,
+)
+from stochcable.dynamics.variance import current_split
+from stochcable.errors import (
+    PhysicsWarning,
+    ResolutionWarning,
+    warn,
+)
+from stochcable.results.documents import (
+    LineIndicators,
+)
+from stochcable.scene.units import unit_labels
+
+
+def modal_bandwidths(system: LineSystem, damping: Damping) -> np.ndarray:
+    """φ_jᵀCφ_j of every computed mode (mass-normalized φ; C = structural damping +
+    ``damping``): the half-power bandwidth 2ζ_jω_j, (n_modes,), cached on the damping
+    (the resolution check and the indicators both use it). [rad/s]"""
+    if "modal_band" not in damping._cache:
+        prep = line_prep(system)
+        c = add_blocks(prep.S, drag_blocks(system, damping))
+        phi = np.ascontiguousarray(system.modes.shapes[system.model.free])
+        damping._cache["modal_band"] = np.einsum(
+            "ij,ij->j", phi, prep.free_rows(block_matvec(c, prep.nodes(phi))))
+    return damping._cache["modal_band"]
+
+
+def _nearest_spacing(omega: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance of each x (inside the increasing grid) to its nearest grid point and
+    the local spacing there, ``np.gradient(omega)`` at that point (central difference
+    inside, one-sided at the ends; the same bits), without the (n_x, n_omega) argmin
+    matrix: the nearest point is one of the two around the insertion point (the lower
+    of two equidistant ones, as argmin). [rad/s]"""
+    n = omega.size
+    hi = np.searchsorted(omega, x)
+    lo = np.maximum(hi - 1, 0)
+    d_lo, d_hi = np.abs(omega[lo] - x), np.abs(omega[hi] - x)
+    near = np.where(d_lo <= d_hi, lo, hi)
+    a, b = np.maximum(near - 1, 0), np.minimum(near + 1, n - 1)
+    spacing = (omega[b] - omega[a]) / np.where((near > 0) & (near < n - 1), 2.0, 1.0)
+    return np.minimum(d_lo, d_hi), spacing
+
+
+def resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) -> None:
+    """ResolutionWarning for natural frequencies inside the grid that the grid cannot
+    resolve: nearest grid point farther than the local spacing, or a half-power
+    bandwidth (2ζω_j ≈ φ_jᵀCφ_j for mass-normalized φ) narrower than the local spacing."""
+    modes = system.modes
+    wn = np.asarray(modes.omega)
+    inside = np.flatnonzero((wn >= omega[0]) & (wn <= omega[-1]))
+    if inside.size == 0 or omega.size < 2:
+        return
+    band = modal_bandwidths(system, damping)[inside]
+    dist, spacing = _nearest_spacing(omega, wn[inside])
+    flagged = (dist > spacing) | (spacing > band)
+    bad = [(j, wn[j], b, dw) for j, b, dw, f in zip(inside, band, spacing, flagged) if f]
+    if not bad:
+        return
+    j, wj, b, dw = bad[0]
+    width = omega[-1] - omega[0]
+    need = int(math.ceil(width / max(b, 1e-12 * wj))) + 1 if b > 0 else None
+    fix = (f"use analysis.omega.count >= {need} (or refine the grid around {wj:.4g} rad/s)"
+           if need is not None and need < 10**7 else
+           "the mode has no damping: add drag or seabed damping (no analysis.omega grid "
+           "resolves an undamped peak)")
+    more = f" and {len(bad) - 1} more mode(s)" if len(bad) > 1 else ""
+    warn(
+        f"line '{system.name}': the frequency grid (spacing {dw:.3g} rad/s near "
+        f"{wj:.4g} rad/s) does not resolve mode {j + 1} at {wj:.4g} rad/s, whose "
+        f"half-power bandwidth is {b:.3g} rad/s{more}; the resonance peak may be missed: "
+        f"{fix}",
+        ResolutionWarning, stacklevel=3,
+    )
+
+
+#: Largest ratio of the wave-velocity σ at the two ends of an element's wet part before
+#: :func:`surface_resolution_check` warns.  The drag linearization takes one B ∝ σ per
+#: element (seed 001 eq. 5.2.2) while σ decays like e^{k̄z} from the surface; on the
+#: inclined guy (docs/ACCURACY.md) the ratio of its top element is 2.18 / 1.59 / 1.32 /
+#: 1.17 at 40 / 80 / 160 / 320 elements, and the fairlead tension σ is off its
+#: 320-element value by +8.6 / +2.9 / +0.46 % (with uniform B the 40-element value is
+#: within 0.7 %: the loads themselves are exact).
+SURFACE_SIGMA_RATIO = 2.0
+#: Ratio the warning's fix aims at (≈ 3 % on the guy's fairlead tension σ).
+SURFACE_TARGET_RATIO = 1.5
+#: Elements whose larger end σ is below this fraction of the line's largest are not
+#: checked (their drag hardly loads the line).
+SURFACE_MATTERS_FRACTION = 0.25
+
+
+def surface_resolution_check(system: LineSystem, channels: tuple[Channel, ...],
+                              omega: np.ndarray, q: np.ndarray | None = None) -> None:
+    """ResolutionWarning when the wave-velocity σ varies by more than
+    ``SURFACE_SIGMA_RATIO`` along an element that matters (larger end σ at least
+    ``SURFACE_MATTERS_FRACTION`` of the line's largest): one drag coefficient per element
+    cannot follow it (the wave loads are integrated exactly; the linearized B is not).
+    ``q``: the trapezoid weights of ``omega`` when the caller has them."""
+    if q is None:
+        q = trapezoid_weights(omega)
+    var = None
+    for ch in channels:
+        if ch.element_end_square is None or not np.any(ch.spectrum > 0):
+            continue
+        v_ = np.einsum("wes,w->es", ch.element_end_square, q * ch.spectrum)
+        var = v_ if var is None else var + v_
+    if var is None:
+        return
+    sig = np.sqrt(np.clip(var, 0.0, None))
+    hi, lo = sig.max(axis=1), sig.min(axis=1)
+    top = float(hi.max())
+    if top <= 0.0:
+        return
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(lo > 0, hi / np.where(lo > 0, lo, 1.0), np.inf)
+    bad = (hi >= SURFACE_MATTERS_FRACTION * top) & (ratio > SURFACE_SIGMA_RATIO)
+    if not bad.any():
+        return
+    j = int(np.argmax(np.where(bad, ratio, 0.0)))
+    r = float(ratio[j])
+    mesh = system.model.mesh
+    seg = int(mesh.segment[j])
+    n_seg = int(np.count_nonzero(mesh.segment == seg))
+    pos = system.positions
+    units = unit_labels(system.environment.g)
+    za, zb = float(min(pos[j, 2], 0.0)), float(min(pos[j + 1, 2], 0.0))
+    dz = abs(zb - za)
+    shrink = math.log(SURFACE_TARGET_RATIO) / math.log(r) if math.isfinite(r) else 0.0
+    need = (f"at least {int(math.ceil(n_seg / shrink))} elements on segment {seg} "
+            f"(now {n_seg})" if shrink > 0 else "more elements")
+    more = int(np.count_nonzero(bad)) - 1
+    others = f" ({more} more element(s) likewise)" if more > 0 else ""
+    warn(
+        f"line '{system.name}': the wave-velocity σ varies by a factor {r:.3g} along "
+        f"element {j + 1} (z from {za:.4g} to {zb:.4g} {units.length}; threshold "
+        f"{SURFACE_SIGMA_RATIO:g}){others}, but the drag linearization takes one drag "
+        "coefficient per element (seed 001 eq. 5.2.2): the element is long against the "
+        "decay depth of the wave kinematics and the response there carries an error of "
+        f"several %; use {need}, or elements spanning at most {dz * shrink:.3g} "
+        f"{units.length} of depth near the surface",
+        ResolutionWarning, stacklevel=3,
+    )
+
+
+# Fraction of m0 that S(ω_max)·ω_max may reach before the grid is said to cut the
+# response spectrum (an ω⁻⁵ tail beyond ω_max holds S·ω/4 of it).
+TAIL_FRACTION = 0.05
+
+
+def tail_check(line: str, end: str, w: np.ndarray, dens: np.ndarray, m0: float) -> None:
+    """ResolutionWarning when the end-tension spectrum is still large at ω_max."""
+    if m0 <= 0.0:
+        return
+    ratio = float(dens[-1] * w[-1] / m0)
+    if ratio > TAIL_FRACTION:
+        warn(
+            f"line '{line}': the {end} tension spectrum at the top of the grid "
+            f"(omega.max = {w[-1]:.4g} rad/s) is still S·ω = {ratio:.2g} m0 "
+            f"(threshold {TAIL_FRACTION:g}): the grid cuts the response and σ is "
+            "underestimated; raise analysis.omega.max (end motion spectra with an ω⁻⁵ "
+            "tail drive inertia loads whose spectrum decays only like ω⁻¹)",
+            ResolutionWarning, stacklevel=3,
+        )
+
+
+# ------------------------------------------------------------------ quality indicators
+
+#: Snap flag: mean − SNAP_SIGMAS·σ of the tension below zero at an element or end.
+SNAP_SIGMAS = 3.0
+#: Resonance flag: modal damping ratio below this inside the excitation band.
+RESONANCE_DAMPING_RATIO = 0.01
+#: The excitation band: where some input spectrum exceeds this fraction of its peak.
+BAND_FRACTION = 0.01
+#: Large-motion flag: node motion σ above this fraction of the line's sag.
+MOTION_SAG_FRACTION = 0.1
+
+
+def _normal_acceleration_sigma(system: LineSystem, channels: tuple[Channel, ...],
+                               omega: np.ndarray) -> np.ndarray:
+    """σ of the fluid acceleration normal to each element, element mean square
+    ω²(tr S − eᵀSe), S = ∫₀¹ Re(v vᴴ) dξ (:func:`element_mean_square`). [m/s²]"""
+    e = system.frames[0]
+    q = trapezoid_weights(omega)
+    n_el = system.model.n_elements
+    var = np.zeros(n_el)
+    # tr S − eᵀSe = Σ_ij S_ij (I − eeᵀ)_ij: one product over the 9 entries (the trace
+    # and a three-operand einsum were 0.2 ms on the chain)
+    proj = (np.eye(3)[None] - e[:, :, None] * e[:, None, :]).reshape(n_el, 9)
+    for ch in channels:
+        sq = element_mean_square(ch)
+        if sq is None:
+            continue
+        dens = np.einsum("wek,ek->we", sq.reshape(sq.shape[0], n_el, 9), proj)
+        var += np.clip(dens, 0.0, None).T @ (q * ch.spectrum * omega**2)
+    return np.sqrt(var)
+
+
+def _modal_damping_ratios(system: LineSystem, damping: Damping) -> np.ndarray:
+    """ζ_j = φ_jᵀCφ_j/(2ω_j) of the computed modes (mass-normalized φ). [-]"""
+    band = modal_bandwidths(system, damping)
+    wn = np.asarray(system.modes.omega)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(wn > 0, band / (2.0 * np.where(wn > 0, wn, 1.0)), np.inf)
+
+
+def line_indicators(
+    system: LineSystem,
+    channels: tuple[Channel, ...],
+    linearization: Linearization,
+    tension_std: np.ndarray,
+    motion_std: np.ndarray,
+    end_stats: Mapping[str, Any],
+) -> LineIndicators:
+    """Quality indicators of the linear model of one line, with PhysicsWarnings.
+
+    Parameters
+    ----------
+    system : LineSystem
+    channels : tuple of Channel
+        Inputs on the analysis grid (their spectra define the excitation band).
+    linearization : Linearization
+        The converged drag (its record's σ and B).
+    tension_std : ndarray, shape (n_el,)
+        σ of the dynamic element tension. [N]
+    motion_std : ndarray, shape (n_nodes, 3)
+        σ of the node motions. [m]
+    end_stats : mapping {"end_a", "end_b"} of ResponseStats
+        End-tension statistics (mean and std). [N]
+
+    Returns
+    -------
+    LineIndicators
+
+    Warns
+    -----
+    PhysicsWarning
+        - snap: T_mean − 3σ_T < 0 at an element or end ("snap loads likely; the
+          linear model is out of its depth");
+        - resonance: a mode inside the excitation band (some input spectrum above
+          1 % of its peak) with modal damping ratio ζ < 1 %, named;
+        - large motion: a node motion σ above 10 % of the sag.
+
+    Notes
+    -----
+    Borgman ratio per element: :func:`stochcable.dynamics.linearization.borgman_variance_ratio`
+    of the normal relative velocity (σ_n of the record, mean = the normal current).
+    Drag/inertia: :func:`stochcable.dynamics.linearization.drag_inertia_ratio` in the form
+    B_n σ_n / (ρ C_M (πD²/4) σ_an), B_n the record's normal coefficient, σ_an the σ
+    of the fluid acceleration normal to the element (the sea channel).
+    Modal damping ζ_j = φ_jᵀCφ_j/(2ω_j) with C = drag + seabed + structural damping
+    (the diagonal of the modal damping; the coupling terms are ignored).
+    Large motion: the tangent model (seed 001 §3) is linear about the static shape;
+    the geometric stiffness of a sagging line depends on its sag at first order
+    (T ≈ wL²/8·1/sag for a shallow catenary), so a motion σ of 10 % of the sag (a
+    3σ excursion of 30 %) changes the stiffness by about as much as a linear model
+    can tolerate; the sag is the largest distance of the static shape from the
+    chord.  The diameter ratio is reported, not flagged (large motion over D means
+    drag-dominated loading, the domain of the drag linearization).
+    """
+    w = linearization.response.omega
+    borgman, d_i = _drag_ratios(system, channels, linearization.record, w)
+    snap_margin, snap = _snap(system, tension_std, end_stats)
+    resonances = _resonances(system, channels, linearization.damping, w)
+    m_max, sag, to_sag, to_d = _large_motion(system, motion_std)
+    flags = (["snap"] if snap else []) + (["resonance"] if resonances else []) + (
+        ["large_motion"] if to_sag > MOTION_SAG_FRACTION else [])
+    return LineIndicators(
+        borgman_ratio=borgman, drag_inertia_ratio=d_i, snap_margin=snap_margin,
+        snap_risk=snap, resonances=tuple(resonances), motion_std_max=m_max, sag=sag,
+        motion_to_sag=float(to_sag), motion_to_diameter=to_d, flags=tuple(flags),
+    )
+
+
+def _drag_ratios(system: LineSystem, channels: tuple[Channel, ...], rec: Any,
+                 w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Borgman variance ratio and drag/inertia ratio per element (:func:`line_indicators`
+    Notes). [-]"""
+    model = system.model
+    mesh = model.mesh
+    u_n = current_split(system)[2]
+    borgman = np.atleast_1d(borgman_variance_ratio(rec.sigma_normal, u_n))
+    s_an = _normal_acceleration_sigma(system, channels, w)
+    drag_sigma = rec.b_normal * rec.sigma_normal
+    inertia_sigma = (model.rho * (1.0 + mesh.ca_normal) * math.pi * mesh.diameter**2 / 4.0
+                     * s_an)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d_i = np.where(inertia_sigma > 0, drag_sigma / np.where(inertia_sigma > 0,
+                                                                 inertia_sigma, 1.0),
+                       np.where(drag_sigma > 0, np.inf, 0.0))
+    return borgman, d_i
+
+
+def _snap(system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, Any]
+          ) -> tuple[float, bool]:
+    """Snap margin min (mean − 3σ)/|mean| over the elements and ends, and whether some
+    mean − 3σ < 0 (PhysicsWarning naming the worst place)."""
+    mesh = system.model.mesh
+    t_mean = np.asarray(system.statics.tension, dtype=float)
+    means = np.concatenate([t_mean, [end_stats["end_a"].mean, end_stats["end_b"].mean]])
+    sigmas = np.concatenate([tension_std, [end_stats["end_a"].std, end_stats["end_b"].std]])
+    low = means - SNAP_SIGMAS * sigmas
+    with np.errstate(divide="ignore", invalid="ignore"):
+        margins = np.where(np.abs(means) > 0, low / np.abs(np.where(means != 0, means, 1.0)),
+                           np.where(low < 0, -np.inf, 0.0))
+    k = int(np.argmin(margins))
+    snap = bool(np.any(low < 0))
+    if snap:
+        units = unit_labels(system.environment.g)
+        where = ("end_a" if k == t_mean.size else "end_b" if k == t_mean.size + 1
+                 else f"element {k + 1} (s = {0.5 * (mesh.s0[k] + mesh.s0[k + 1]):.4g} "
+                      f"{units.length})")
+        warn(
+            f"line '{system.name}': the dynamic tension σ ({sigmas[k]:.4g} {units.force} "
+            f"at {where}) exceeds 1/{SNAP_SIGMAS:g} of the mean tension ({means[k]:.4g} "
+            f"{units.force}): mean − {SNAP_SIGMAS:g}σ < 0, snap loads likely; the linear "
+            "model is out of its depth (threshold mean − 3σ >= 0): use a nonlinear "
+            "time-domain analysis "
+            "(stochcable.reference.cable) or increase the pretension",
+            PhysicsWarning, stacklevel=4,
+        )
+    return float(margins[k]), snap
+
+
+def _resonances(system: LineSystem, channels: tuple[Channel, ...], damping: Damping,
+                w: np.ndarray) -> list[dict[str, Any]]:
+    """Modes inside the excitation band with a modal damping ratio below
+    ``RESONANCE_DAMPING_RATIO`` (PhysicsWarning naming the first)."""
+    resonances: list[dict[str, Any]] = []
+    wn = np.asarray(system.modes.omega)
+    spectra = [c.spectrum for c in channels if np.any(c.spectrum > 0)]
+    if spectra and wn.size:
+        inside = np.zeros(wn.size, dtype=bool)
+        for spec in spectra:
+            in_band = np.interp(wn, w, spec, left=0.0, right=0.0) >= BAND_FRACTION * spec.max()
+            inside |= in_band
+        zeta = _modal_damping_ratios(system, damping)
+        for j in np.flatnonzero(inside & (zeta < RESONANCE_DAMPING_RATIO)):
+            resonances.append({"mode": int(j + 1), "omega": float(wn[j]),
+                               "damping_ratio": float(zeta[j])})
+    if resonances:
+        r0 = resonances[0]
+        more = f" and {len(resonances) - 1} more" if len(resonances) > 1 else ""
+        warn(
+            f"line '{system.name}': mode {r0['mode']} ({r0['omega']:.4g} rad/s){more} lies "
+            f"in the excitation band with modal damping ratio {r0['damping_ratio']:.2%} "
+            f"(threshold {RESONANCE_DAMPING_RATIO:.0%}): a near-undamped resonance whose "
+            "response is set by damping the model may not represent; check the drag "
+            "coefficients and add structural damping (analysis.structural_damping) or "
+            "seabed damping where physical",
+            PhysicsWarning, stacklevel=4,
+        )
+    return resonances
+
+
+def _large_motion(system: LineSystem, motion_std: np.ndarray
+                  ) -> tuple[float, float, float, float]:
+    """Largest node motion σ [m], the sag of the static shape [m] (largest distance
+    from the chord, once per line), and their ratio and the ratio to the diameter
+    (PhysicsWarning above ``MOTION_SAG_FRACTION`` of the sag)."""
+    model = system.model
+    if "sag" not in system._cache:  # of the static shape: once per line
+        pos = model.positions
+        chord = pos[-1] - pos[0]
+        cn = float(np.linalg.norm(chord))
+        rel = pos - pos[0]
+        if cn > 0:
+            rel = rel - np.outer(rel @ (chord / cn), chord / cn)
+        system._cache["sag"] = float(np.max(np.linalg.norm(rel, axis=1)))
+    sag = system._cache["sag"]
+    m_std = np.linalg.norm(motion_std, axis=1)
+    m_max = float(m_std.max()) if m_std.size else 0.0
+    to_sag = m_max / sag if sag > 0 else (np.inf if m_max > 0 else 0.0)
+    to_d = m_max / float(np.max(model.mesh.diameter))
+    if to_sag > MOTION_SAG_FRACTION:
+        units = unit_labels(system.environment.g)
+        j = int(np.argmax(m_std))
+        warn(
+            f"line '{system.name}': the motion σ at node {j + 1} ({m_max:.3g} "
+            f"{units.length}) is {to_sag:.2g} of the line's sag ({sag:.3g} "
+            f"{units.length}), above the threshold {MOTION_SAG_FRACTION:g}: the "
+            "linearization about the static shape is doubtful; check with a nonlinear "
+            "time-domain analysis (stochcable.reference.cable)",
+            PhysicsWarning, stacklevel=4,
+        )
+    return m_max, sag, to_sag, to_d

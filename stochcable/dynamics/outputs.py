@@ -1,0 +1,178 @@
+"""Outputs of one line: transfer functions, spectra and statistics
+(:func:`line_result`) and the dynamic effective tension per element.
+
+Dynamic effective tension
+-------------------------
+Per element δT = (EA/l0)·e·(u_b − u_a), the first-order change of T = EA(l/l0 − 1)
+(seed 001 eqs. 3.1.8–3.1.11: the K_NL part of the tangent stiffness).  The "geometric"
+term (T/l)(I − eeᵀ)Δu of the tangent stiffness rotates the element force; it changes
+its direction, not its magnitude, and contributes to the tension only at second order,
+so it is not part of δT.  Slack elements (T <= 0) use the model's reduced EA.  The end
+tensions are computed with the response (:mod:`stochcable.dynamics.solve`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from stochcable.dynamics.blocks import (
+    trapezoid_weights,
+)
+from stochcable.dynamics.indicators import (
+    line_indicators,
+    resolution_check,
+    surface_resolution_check,
+    tail_check,
+)
+from stochcable.dynamics.loads import (
+    Channel,
+)
+from stochcable.dynamics.system import (
+    Linearization,
+    LineSystem,
+    Response,
+)
+from stochcable.line.fem import SLACK_EA_RATIO
+from stochcable.results.documents import (
+    LineResult,
+    stats_from_validated,
+)
+from stochcable.scene.model import AnalysisSettings
+
+# ------------------------------------------------------------------------- outputs
+
+
+def element_tension_transfer(system: LineSystem, response: Response) -> np.ndarray:
+    """Dynamic effective tension per element, (n_ch, n_el, n_omega). [N/unit]
+
+    δT = (EA/l0)·e·(u_{j+1} − u_j) (module docstring), EA reduced for slack elements.
+    """
+
+    model = system.model
+    mesh = model.mesh
+    n_w = response.omega.size
+    u = response.displacement.reshape(n_w, model.n_nodes, model.dim, -1)
+    # e·(u_b − u_a) one component at a time, frequencies last (long inner loops; the
+    # complex einsum was 0.4 ms on the chain, the frequency-major layout 0.25)
+    u = np.ascontiguousarray(np.transpose(u, (3, 1, 2, 0)))  # (n_ch, n_nodes, dim, n_w)
+    t = model.tangents
+    out = t[None, :, 0, None] * (u[:, 1:, 0] - u[:, :-1, 0])  # (n_ch, n_el, n_w)
+    for k in range(1, model.dim):
+        out += t[None, :, k, None] * (u[:, 1:, k] - u[:, :-1, k])
+    ea = np.where(model.slack, SLACK_EA_RATIO * mesh.ea, mesh.ea)
+    out *= (ea / model.l0)[None, :, None]
+    return out
+
+
+def _listed_modes(omega_n: np.ndarray, w_top: float) -> int:
+    """How many natural frequencies the document lists: those up to
+    2.5·ω_max, at least min(10, available)."""
+    wn = np.asarray(omega_n)
+    return int(max(np.count_nonzero(wn <= 2.5 * w_top), min(10, wn.size)))
+
+
+def line_result(
+    system: LineSystem,
+    channels: tuple[Channel, ...],
+    linearization: Linearization,
+    settings: AnalysisSettings,
+) -> LineResult:
+    """Transfer functions, spectra and statistics of one line.
+
+    Parameters
+    ----------
+    system : LineSystem
+    channels : tuple of Channel
+    linearization : Linearization
+        Its ``response`` is used.
+    settings : AnalysisSettings
+        ``duration`` for the maxima.
+
+    Returns
+    -------
+    LineResult
+    """
+    model = system.model
+    resp = linearization.response
+    w = resp.omega
+    n_ch = len(channels)
+    spectra = np.stack([c.spectrum for c in channels]) if n_ch else np.zeros((0, w.size))
+    motion_h = _motion_transfer(model, resp, n_ch)
+    tension_h = element_tension_transfer(system, resp)
+    # σ² = Σ_c ∫|H_c|² S_c dω as one weighted reduction with the trapezoid weights q
+    # (the response spectra are not kept; the same trapezoid rule as np.trapezoid up
+    # to round-off, ≈ 0.1 ms a line less than the spectra and two trapezoids)
+    q = trapezoid_weights(w)
+    sq = spectra * q
+    tension_std = np.sqrt(np.einsum("cew,cw->e", np.abs(tension_h) ** 2, sq))
+    motion_std = np.sqrt(np.einsum("cnkw,cw->nk", np.abs(motion_h) ** 2, sq))
+    st = system.statics
+    s0 = model.mesh.s0
+    stats = {}
+    for end, mean in (("end_a", st.tension_a), ("end_b", st.tension_b)):
+        dens = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
+        stats[end] = stats_from_validated(w, dens, float(mean), settings.duration)
+        tail_check(system.name, end, w, dens, stats[end].m0)
+    if np.any(spectra > 0):  # nothing to resolve without excitation
+        resolution_check(system, linearization.damping, w)
+        surface_resolution_check(system, channels, w, q)
+    indicators = (None if linearization.record is None else
+                  line_indicators(system, channels, linearization, tension_std, motion_std,
+                                  stats))
+    end_force = _end_force_transfer(model, resp, n_ch)
+    return LineResult(
+        name=system.name,
+        omega=w,
+        channels=tuple(c.name for c in channels),
+        input_spectra=spectra,
+        s_nodes=s0.copy(),
+        s_elements=0.5 * (s0[1:] + s0[:-1]),
+        positions=model.positions.copy(),
+        motion_transfer=motion_h,
+        tension_transfer=tension_h,
+        end_tension_transfer=dict(resp.end_tension),
+        end_force_transfer=end_force,
+        tension_mean=np.asarray(st.tension, dtype=float).copy(),
+        tension_std=tension_std,
+        motion_std=motion_std,
+        end_a=stats["end_a"],
+        end_b=stats["end_b"],
+        linearization=linearization.record,
+        modes_omega=np.asarray(system.modes.omega).copy(),
+        modes_listed=_listed_modes(system.modes.omega, float(w[-1])),
+        n_modes=system.n_modes if system.solver == "foss" else None,
+        statics=st,
+        model=model,
+        modes=system.modes,
+        indicators=indicators,
+    )
+
+
+def _motion_transfer(model: Any, resp: Response, n_ch: int) -> np.ndarray:
+    """Node motion transfer functions on x, y, z, (n_ch, n_nodes, 3, n_omega) (zero on
+    the components a 2-D model lacks). [m/unit]"""
+    w = resp.omega
+    # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the frequency-major
+    # layout and transposing made every later pass strided)
+    u_h = np.transpose(resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch),
+                       (3, 1, 2, 0))
+    if tuple(model.components) == (0, 1, 2):  # 3-D: no zero components to embed
+        return np.ascontiguousarray(u_h)
+    motion_h = np.zeros((n_ch, model.n_nodes, 3, w.size), dtype=resp.displacement.dtype)
+    motion_h[:, :, list(model.components)] = u_h
+    return motion_h
+
+
+def _end_force_transfer(model: Any, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
+    """Support force transfer functions on x, y, z per end, (n_ch, 3, n_omega). [N/unit]"""
+    comps = list(model.components)
+    d = model.dim
+    w = resp.omega
+    end_force = {}
+    for k, end in enumerate(("end_a", "end_b")):
+        f = np.zeros((n_ch, 3, w.size), dtype=complex)
+        f[:, comps, :] = np.transpose(resp.support_force[:, k * d:(k + 1) * d, :], (2, 1, 0))
+        end_force[end] = f
+    return end_force
