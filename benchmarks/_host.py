@@ -47,12 +47,16 @@ def host_probe() -> dict[str, float]:
         78×78 real matrix (seeded); both minima of 7 runs.
     """
     a = np.random.default_rng(0).standard_normal((78, 78))
-    return {"python_ms": 1e3 * _best(lambda: sum(range(10**6))),
-            "geev_ms": 1e3 * _best(lambda: np.linalg.eig(a))}
+    return {
+        "python_ms": 1e3 * _best(lambda: sum(range(10**6))),
+        "geev_ms": 1e3 * _best(lambda: np.linalg.eig(a)),
+    }
 
 
 def host_line() -> str:
     """One printable line with the probe."""
     p = host_probe()
-    return (f"host probe: python sum(range(1e6)) {p['python_ms']:.1f} ms, "
-            f"78x78 geev {p['geev_ms']:.2f} ms (min of 7; compare runs by these)")
+    return (
+        f"host probe: python sum(range(1e6)) {p['python_ms']:.1f} ms, "
+        f"78x78 geev {p['geev_ms']:.2f} ms (min of 7; compare runs by these)"
+    )

@@ -56,8 +56,14 @@ print(json.dumps(out))
 def _run(tree: Path, calls: int, bench: Path, example: Path) -> dict[str, float]:
     env = dict(os.environ, PYTHONPATH=str(tree))
     code = _SNIPPET.format(bench=str(bench), example=str(example), calls=calls)
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         env=env, cwd=str(tree), check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=str(tree),
+        check=True,
+    )
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -76,8 +82,11 @@ def main() -> int:
             got = _run(tree.resolve(), args.calls, tree.resolve() / "benchmarks", example)
             for k, v in got.items():
                 res[side].setdefault(k, []).append(v)
-            print(f"round {r + 1} {side}: " + ", ".join(f"{k} {1e3 * v:.1f} ms"
-                                                       for k, v in got.items()), flush=True)
+            print(
+                f"round {r + 1} {side}: "
+                + ", ".join(f"{k} {1e3 * v:.1f} ms" for k, v in got.items()),
+                flush=True,
+            )
     for k in res["A"]:
         a = statistics.median(res["A"][k])
         b = statistics.median(res["B"][k])

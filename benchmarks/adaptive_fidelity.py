@@ -25,7 +25,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from speed_vs_error import base_document, quantities_fd  # noqa: E402
 
 from stochcable.analysis import analyze  # noqa: E402
-from stochcable.analysis import analyze  # noqa: E402
 from stochcable.fidelity import apply_fidelity, choose_fidelity  # noqa: E402
 from stochcable.line.mesh import mesh_line  # noqa: E402
 from stochcable.scene.model import load_scene  # noqa: E402
@@ -56,8 +55,18 @@ def reference(scene, plan, factor: int):
     count = min(8000, int((wmax - wmin) / dw) + 1)
     segs = {k: tuple((i, L, factor * n) for i, L, n in v) for k, v in plan.segments.items()}
     from dataclasses import replace
-    p2 = replace(plan, segments=segs, omega_min=wmin, omega_max=wmax, omega_count=count,
-                 solver="direct", modes="auto", tolerance=1e-8, choices=())
+
+    p2 = replace(
+        plan,
+        segments=segs,
+        omega_min=wmin,
+        omega_max=wmax,
+        omega_count=count,
+        solver="direct",
+        modes="auto",
+        tolerance=1e-8,
+        choices=(),
+    )
     sc = apply_fidelity(scene, p2)
     lin = sc.analysis.linearization.model_copy(update={"max_iterations": 500})
     sc = sc.model_copy(update={"analysis": sc.analysis.model_copy(update={"linearization": lin})})
@@ -84,28 +93,57 @@ def main(names) -> int:
             conv = max(abs(q2[q] / q4[q] - 1) for q in QUANT)
             dres, dt = timed(base)
             qd = quantities_fd(dres, s_star)
-            rows.append((name, "example default", "-", f"{base.lines[0].elements} el, "
-                         f"{base.analysis.omega.count} ω to {base.analysis.omega.max:g}",
-                         "-", dt, [qd[q] / q4[q] - 1 for q in QUANT], t4, el4, c4, conv))
+            rows.append(
+                (
+                    name,
+                    "example default",
+                    "-",
+                    f"{base.lines[0].elements} el, "
+                    f"{base.analysis.omega.count} ω to {base.analysis.omega.max:g}",
+                    "-",
+                    dt,
+                    [qd[q] / q4[q] - 1 for q in QUANT],
+                    t4,
+                    el4,
+                    c4,
+                    conv,
+                )
+            )
             for tgt in TARGETS:
                 plan, tp = plans[tgt]
                 sc = apply_fidelity(base, plan)
                 res, ta = timed(sc)
                 qa = quantities_fd(res, s_star)
-                setting = (f"{int(plan.cost['elements'])} el "
-                           f"{[n for _, _, n in next(iter(plan.segments.values()))]}, "
-                           f"{plan.omega_count} ω on [{plan.omega_min:.3g}, "
-                           f"{plan.omega_max:.3g}], {plan.solver}"
-                           + (f" modes {plan.modes}" if plan.solver == "foss" else "")
-                           + f", tol {plan.tolerance:.0e}"
-                           + ("" if plan.tail_bounded else ", tail unbounded"))
-                rows.append((name, f"{tgt:.0%}", f"{plan.error_estimate['total']:.2%}",
-                             setting, tp, ta, [qa[q] / q4[q] - 1 for q in QUANT],
-                             t4, el4, c4, conv))
+                setting = (
+                    f"{int(plan.cost['elements'])} el "
+                    f"{[n for _, _, n in next(iter(plan.segments.values()))]}, "
+                    f"{plan.omega_count} ω on [{plan.omega_min:.3g}, "
+                    f"{plan.omega_max:.3g}], {plan.solver}"
+                    + (f" modes {plan.modes}" if plan.solver == "foss" else "")
+                    + f", tol {plan.tolerance:.0e}"
+                    + ("" if plan.tail_bounded else ", tail unbounded")
+                )
+                rows.append(
+                    (
+                        name,
+                        f"{tgt:.0%}",
+                        f"{plan.error_estimate['total']:.2%}",
+                        setting,
+                        tp,
+                        ta,
+                        [qa[q] / q4[q] - 1 for q in QUANT],
+                        t4,
+                        el4,
+                        c4,
+                        conv,
+                    )
+                )
             print(f"done {name}", file=sys.stderr)
-    print("| scene | target | estimate | chosen settings | plan time | analysis time | "
-          "error fairlead / anchor / motion | uniform fine model (time, elements, ω) | "
-          "its ×2→×4 change |")
+    print(
+        "| scene | target | estimate | chosen settings | plan time | analysis time | "
+        "error fairlead / anchor / motion | uniform fine model (time, elements, ω) | "
+        "its ×2→×4 change |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         name, tgt, est, setting = r[:4]
@@ -114,9 +152,11 @@ def main(names) -> int:
         else:
             tp, ta, err, t4, el4, c4, conv = r[4], r[5], r[6], r[7], r[8], r[9], r[10]
         tps = tp if isinstance(tp, str) else f"{tp * 1e3:.0f} ms"
-        print(f"| {name} | {tgt} | {est} | {setting} | {tps} | {ta * 1e3:.0f} ms | "
-              + " / ".join(f"{e:+.2%}" for e in err)
-              + f" | {t4:.2f} s, {el4}, {c4} | {conv:.2%} |")
+        print(
+            f"| {name} | {tgt} | {est} | {setting} | {tps} | {ta * 1e3:.0f} ms | "
+            + " / ".join(f"{e:+.2%}" for e in err)
+            + f" | {t4:.2f} s, {el4}, {c4} | {conv:.2%} |"
+        )
     return 0
 
 

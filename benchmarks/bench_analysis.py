@@ -39,8 +39,9 @@ def base_doc() -> dict:
     return doc
 
 
-def variant(doc: dict, *, elements=None, modes=None, count=None, solver=None,
-            omega_max=None) -> dict:
+def variant(
+    doc: dict, *, elements=None, modes=None, count=None, solver=None, omega_max=None
+) -> dict:
     d = copy.deepcopy(doc)
     if elements is not None:
         d["lines"][0]["segments"][0]["elements"] = elements
@@ -87,19 +88,24 @@ def main() -> None:
 
     load = os.getloadavg()[0]
     print(host_line())
-    print(f"load average (1 min) {load:.2f}" + ("" if load < 1.5 else
-                                               "  -- machine busy: timings inflated"))
+    print(
+        f"load average (1 min) {load:.2f}"
+        + ("" if load < 1.5 else "  -- machine busy: timings inflated")
+    )
     print("== analyze() on the reference chain (no time series) ==")
     print(f"{'case':<22}{'median ms':>10}{'min ms':>9}{'cpu ms':>9}  stage shares (median)")
-    for name, d in (("foss, modes auto", doc),
-                    ("foss, all modes", variant(doc, modes=78)),
-                    ("direct", variant(doc, solver="direct"))):
+    for name, d in (
+        ("foss, modes auto", doc),
+        ("foss, all modes", variant(doc, modes=78)),
+        ("direct", variant(doc, solver="direct")),
+    ):
         res, med, mn, stages, cpu = timed(d, repeat)
         keys = ("statics_s", "model_s", "linearization_s", "outputs_s")
         share = {k: statistics.median(s[k] for s in stages) for k in keys}
         tot = statistics.median(s["total_s"] for s in stages)
-        text = ", ".join(f"{k[:-2]} {1e3 * v:.1f} ms ({100 * v / tot:.0f} %)"
-                         for k, v in share.items())
+        text = ", ".join(
+            f"{k[:-2]} {1e3 * v:.1f} ms ({100 * v / tot:.0f} %)" for k, v in share.items()
+        )
         it = res.lines["leg1"].linearization.iterations
         coarse = []  # the coarse start's evaluations are reported through progress
 
@@ -108,28 +114,35 @@ def main() -> None:
                 coarse.append(info["coarse_iteration"])
 
         analyze(load_scene(d), progress=count)
-        print(f"{name:<22}{1e3 * med:>10.1f}{1e3 * mn:>9.1f}{1e3 * cpu:>9.1f}  {text}; "
-              f"{it} full-grid + {len(coarse)} coarse iterations")
+        print(
+            f"{name:<22}{1e3 * med:>10.1f}{1e3 * mn:>9.1f}{1e3 * cpu:>9.1f}  {text}; "
+            f"{it} full-grid + {len(coarse)} coarse iterations"
+        )
 
     print("\n== error versus setting ==")
-    print("ref A: 320 el, direct, the example's grid (200 ω on [0.05, 2]) — isolates "
-          "elements and modes")
+    print(
+        "ref A: 320 el, direct, the example's grid (200 ω on [0.05, 2]) — isolates "
+        "elements and modes"
+    )
     print("ref B: 320 el, direct, 800 ω on [0.05, 4] — converged, includes the cut-off")
     ref_a, *_ = timed(variant(doc, elements=320, solver="direct"), 1)
-    ref_b, *_ = timed(variant(doc, elements=320, solver="direct", count=800,
-                                   omega_max=4.0), 1)
+    ref_b, *_ = timed(variant(doc, elements=320, solver="direct", count=800, omega_max=4.0), 1)
     refs = {"A": sigmas(ref_a), "B": sigmas(ref_b)}
     for k, (a, b) in refs.items():
         print(f"ref {k} σ_T: anchor {a:.1f} N, fairlead {b:.1f} N")
-    print(f"{'setting':<36}{'ref':>4}{'median ms':>10}{'min ms':>9}{'err anchor':>12}"
-          f"{'err fairlead':>14}")
+    print(
+        f"{'setting':<36}{'ref':>4}{'median ms':>10}{'min ms':>9}{'err anchor':>12}"
+        f"{'err fairlead':>14}"
+    )
 
     def row(label: str, d: dict, ref: str) -> None:
         res, med, mn, *_ = timed(d, max(1, repeat // 3))
         a, b = sigmas(res)
         ra, rb = refs[ref]
-        print(f"{label:<36}{ref:>4}{1e3 * med:>10.1f}{1e3 * mn:>9.1f}{a / ra - 1:>+12.2e}"
-              f"{b / rb - 1:>+14.2e}")
+        print(
+            f"{label:<36}{ref:>4}{1e3 * med:>10.1f}{1e3 * mn:>9.1f}{a / ra - 1:>+12.2e}"
+            f"{b / rb - 1:>+14.2e}"
+        )
 
     for n in (10, 20, 40, 80) if args.quick else (10, 20, 40, 80, 160):
         row(f"elements {n} (foss auto)", variant(doc, elements=n), "A")
@@ -140,8 +153,7 @@ def main() -> None:
     for c in (50, 100, 200, 400):
         row(f"omega count {c} on [0.05, 2] (40 el)", variant(doc, count=c), "B")
     for c in (200, 400, 800):
-        row(f"omega count {c} on [0.05, 4] (40 el)", variant(doc, count=c, omega_max=4.0),
-            "B")
+        row(f"omega count {c} on [0.05, 4] (40 el)", variant(doc, count=c, omega_max=4.0), "B")
 
 
 if __name__ == "__main__":

@@ -36,17 +36,17 @@ import time
 import warnings
 from typing import Any
 
+import numpy as np
 from _host import host_line
+
+import stochcable.dynamics.coupled as coupled_analysis
 from stochcable.analysis import analyze
+from stochcable.dynamics.coupled import analyze_coupled
 from stochcable.dynamics.fixedpoint import linearize
+from stochcable.dynamics.loads import line_channels
 from stochcable.dynamics.outputs import line_result
 from stochcable.dynamics.system import build_line_system
 from stochcable.runtime import single_blas_thread
-import numpy as np
-
-import stochcable.dynamics.coupled as coupled_analysis
-from stochcable.dynamics.coupled import analyze_coupled
-from stochcable.dynamics.loads import line_channels
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
@@ -55,25 +55,40 @@ def scene_doc(solver: str = "direct", n_el: int = 40, count: int = 200) -> dict:
     lines = []
     for i in range(3):
         a = math.radians(120.0 * i)
-        lines.append({
-            "name": f"leg{i + 1}",
-            "end_a": {"position": [300.0 * math.cos(a), 300.0 * math.sin(a), -100.0]},
-            "end_b": {"attach": {"body": "buoy",
-                                 "point": [5.0 * math.cos(a), 5.0 * math.sin(a), -2.0]}},
-            "segments": [{"length": 330.0, "ea": 5e8, "mass": 100.0, "diameter": 0.1,
-                          "elements": n_el}]})
+        lines.append(
+            {
+                "name": f"leg{i + 1}",
+                "end_a": {"position": [300.0 * math.cos(a), 300.0 * math.sin(a), -100.0]},
+                "end_b": {
+                    "attach": {
+                        "body": "buoy",
+                        "point": [5.0 * math.cos(a), 5.0 * math.sin(a), -2.0],
+                    }
+                },
+                "segments": [
+                    {"length": 330.0, "ea": 5e8, "mass": 100.0, "diameter": 0.1, "elements": n_el}
+                ],
+            }
+        )
     diag = lambda v: [[v[i] if i == j else 0.0 for j in range(6)] for i in range(6)]  # noqa: E731
-    body = {"name": "buoy", "position": [0.0, 0.0, 0.0], "mass": 2.0e4,
-            "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
-            "added_mass": diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]),
-            "radiation_damping": diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]),
-            "hydrostatic_stiffness": diag([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]),
-            "drag_area": [4.0, 4.0, 8.0], "drag_point": [0.0, 0.0, -1.0]}
-    return {"environment": {"depth": 100.0},
-            "sea": {"spectrum": {"type": "jonswap", "hs": 3.0, "tp": 9.0}, "heading": 0.0},
-            "bodies": [body], "lines": lines,
-            "analysis": {"omega": {"min": 0.1, "max": 2.0, "count": count},
-                         "solver": solver}}
+    body = {
+        "name": "buoy",
+        "position": [0.0, 0.0, 0.0],
+        "mass": 2.0e4,
+        "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
+        "added_mass": diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]),
+        "radiation_damping": diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]),
+        "hydrostatic_stiffness": diag([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]),
+        "drag_area": [4.0, 4.0, 8.0],
+        "drag_point": [0.0, 0.0, -1.0],
+    }
+    return {
+        "environment": {"depth": 100.0},
+        "sea": {"spectrum": {"type": "jonswap", "hs": 3.0, "tp": 9.0}, "heading": 0.0},
+        "bodies": [body],
+        "lines": lines,
+        "analysis": {"omega": {"min": 0.1, "max": 2.0, "count": count}, "solver": solver},
+    }
 
 
 def run_coupled(scene, statics=None):
@@ -108,8 +123,11 @@ def run_independent(scene, statics):
 
 def key_results(lines, bodies):
     """Buoy surge/heave/pitch σ and every leg's fairlead and anchor tension σ."""
-    return np.r_[bodies["buoy"].motion_std[[0, 2, 4]],
-                 [lines[n].end_b.std for n in lines], [lines[n].end_a.std for n in lines]]
+    return np.r_[
+        bodies["buoy"].motion_std[[0, 2, 4]],
+        [lines[n].end_b.std for n in lines],
+        [lines[n].end_a.std for n in lines],
+    ]
 
 
 def without_coarse_start(scene, statics, repeat):
@@ -131,8 +149,9 @@ def reference_paths(on: bool) -> None:
     coupled_analysis._CB_MIN_RATIO = 1e9 if on else 1.5
 
 
-def interleaved_ab(repeat: int, variants: dict[str, Any], reference: str,
-                   history: bool = False) -> None:
+def interleaved_ab(
+    repeat: int, variants: dict[str, Any], reference: str, history: bool = False
+) -> None:
     """Interleaved A/B in one process, per solver: each variant (a label and a
     function that switches it on) in turn, full analysis (statics + dynamics) and
     dynamics alone, medians of wall and process time (with threads the process time
@@ -149,8 +168,10 @@ def interleaved_ab(repeat: int, variants: dict[str, Any], reference: str,
             keys[label] = key_results(lines, bodies)
             if history:
                 rec = lines["leg1"].linearization
-                print(f"{solver:6s} {label}: {rec.iterations} evaluations, history "
-                      f"{', '.join(f'{h:.1e}' for h in rec.history)}")
+                print(
+                    f"{solver:6s} {label}: {rec.iterations} evaluations, history "
+                    f"{', '.join(f'{h:.1e}' for h in rec.history)}"
+                )
             run_coupled(scene)  # warm-up
         t = {(v, k): [] for v in variants for k in ("fw", "fp", "dw", "dp")}
         for _ in range(repeat):
@@ -160,9 +181,11 @@ def interleaved_ab(repeat: int, variants: dict[str, Any], reference: str,
         for label in variants:
             med = {k: 1e3 * statistics.median(t[label, k]) for k in ("fw", "fp", "dw", "dp")}
             diff = np.max(np.abs(keys[label] / keys[reference] - 1.0))
-            print(f"{solver:6s} {label}: full {med['fw']:.1f} ms (process {med['fp']:.1f}), "
-                  f"dynamics {med['dw']:.1f} ms (process {med['dp']:.1f}), medians of "
-                  f"{repeat}; max relative change of the key σ vs {reference}: {diff:.1e}")
+            print(
+                f"{solver:6s} {label}: full {med['fw']:.1f} ms (process {med['fp']:.1f}), "
+                f"dynamics {med['dw']:.1f} ms (process {med['dp']:.1f}), medians of "
+                f"{repeat}; max relative change of the key σ vs {reference}: {diff:.1e}"
+            )
 
 
 def _time_full_and_dynamics(scene, statics, t: dict, key) -> None:  # noqa: ANN001
@@ -179,8 +202,14 @@ def fast_paths_ab(repeat: int) -> None:
     """The reference paths (node-level Foss lines, full coupled-mode eigenproblem)
     against the fast ones (pass E3)."""
     try:
-        interleaved_ab(repeat, {"reference": lambda: reference_paths(True),
-                                "fast     ": lambda: reference_paths(False)}, "reference")
+        interleaved_ab(
+            repeat,
+            {
+                "reference": lambda: reference_paths(True),
+                "fast     ": lambda: reference_paths(False),
+            },
+            "reference",
+        )
     finally:
         reference_paths(False)
 
@@ -196,8 +225,7 @@ def threads_ab(repeat: int) -> None:
         return lambda: os.environ.__setitem__("STOCHCABLE_THREADS", n)
 
     try:
-        interleaved_ab(repeat, {"1 thread ": threads("1"), "2 threads": threads("2")},
-                       "1 thread ")
+        interleaved_ab(repeat, {"1 thread ": threads("1"), "2 threads": threads("2")}, "1 thread ")
     finally:
         if saved is None:
             os.environ.pop("STOCHCABLE_THREADS", None)
@@ -211,12 +239,15 @@ def coarse_ab(repeat: int) -> None:
     saved = coupled_analysis.COARSE_MIN_FREQUENCIES
 
     def coarse(on: bool) -> Any:
-        return lambda: setattr(coupled_analysis, "COARSE_MIN_FREQUENCIES",
-                               saved if on else 10**9)
+        return lambda: setattr(coupled_analysis, "COARSE_MIN_FREQUENCIES", saved if on else 10**9)
 
     try:
-        interleaved_ab(repeat, {"coarse off": coarse(False), "coarse on ": coarse(True)},
-                       "coarse off", history=True)
+        interleaved_ab(
+            repeat,
+            {"coarse off": coarse(False), "coarse on ": coarse(True)},
+            "coarse off",
+            history=True,
+        )
     finally:
         coupled_analysis.COARSE_MIN_FREQUENCIES = saved
 
@@ -235,12 +266,21 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--profile", action="store_true")
-    ap.add_argument("--ab", action="store_true",
-                    help="only the interleaved A/B of the reference and the fast paths")
-    ap.add_argument("--threads-ab", action="store_true",
-                    help="only the interleaved A/B of the per-line thread pool off/on")
-    ap.add_argument("--coarse-ab", action="store_true",
-                    help="only the interleaved A/B of the coarse start off/on")
+    ap.add_argument(
+        "--ab",
+        action="store_true",
+        help="only the interleaved A/B of the reference and the fast paths",
+    )
+    ap.add_argument(
+        "--threads-ab",
+        action="store_true",
+        help="only the interleaved A/B of the per-line thread pool off/on",
+    )
+    ap.add_argument(
+        "--coarse-ab",
+        action="store_true",
+        help="only the interleaved A/B of the coarse start off/on",
+    )
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     print(host_line())
@@ -269,22 +309,30 @@ def main() -> None:
         ind_st = solve_statics(ind, method="fe")
         med_i, _ = median_time(lambda: run_independent(ind, ind_st), args.repeat)
         rec = lines["leg1"].linearization
-        print(f"{solver:6s}: full (statics + dynamics) {1e3 * med_f:7.1f} ms median "
-              f"({1e3 * best_f:.1f} min); dynamics {1e3 * med:.1f} ms ({1e3 * best:.1f} min), "
-              f"{rec.iterations} iterations; statics {1e3 * med_s:.1f} ms; "
-              f"the legs alone (fairleads fixed) {1e3 * med_i:.1f} ms")
-        print(f"        through analyze() (scene to result, warnings and indicators): "
-              f"{1e3 * med_a:.1f} ms median ({1e3 * best_a:.1f} min)")
+        print(
+            f"{solver:6s}: full (statics + dynamics) {1e3 * med_f:7.1f} ms median "
+            f"({1e3 * best_f:.1f} min); dynamics {1e3 * med:.1f} ms ({1e3 * best:.1f} min), "
+            f"{rec.iterations} iterations; statics {1e3 * med_s:.1f} ms; "
+            f"the legs alone (fairleads fixed) {1e3 * med_i:.1f} ms"
+        )
+        print(
+            f"        through analyze() (scene to result, warnings and indicators): "
+            f"{1e3 * med_a:.1f} ms median ({1e3 * best_a:.1f} min)"
+        )
         med_nc, l_nc, b_nc = without_coarse_start(scene, statics, args.repeat)
         ref = key_results(l_nc, b_nc)
         diff = np.max(np.abs(key_results(lines, bodies) / ref - 1.0))
-        print(f"        without the coarse start: dynamics {1e3 * med_nc:.1f} ms, "
-              f"{l_nc['leg1'].linearization.iterations} iterations; max relative change "
-              f"of the buoy σ and tension σ with it {diff:.1e}")
+        print(
+            f"        without the coarse start: dynamics {1e3 * med_nc:.1f} ms, "
+            f"{l_nc['leg1'].linearization.iterations} iterations; max relative change "
+            f"of the buoy σ and tension σ with it {diff:.1e}"
+        )
         print("        stages: " + ", ".join(f"{k} {1e3 * v:.1f} ms" for k, v in timing.items()))
-        print(f"        buoy surge/heave/pitch σ = {bodies['buoy'].motion_std[[0, 2, 4]]}, "
-              f"leg1/leg2 fairlead tension σ = {lines['leg1'].end_b.std:.1f} / "
-              f"{lines['leg2'].end_b.std:.1f} N")
+        print(
+            f"        buoy surge/heave/pitch σ = {bodies['buoy'].motion_std[[0, 2, 4]]}, "
+            f"leg1/leg2 fairlead tension σ = {lines['leg1'].end_b.std:.1f} / "
+            f"{lines['leg2'].end_b.std:.1f} N"
+        )
     if args.profile:
         scene = load_scene(scene_doc("direct"))
         run_coupled(scene)

@@ -28,15 +28,30 @@ from stochcable.scene.model import load_scene
 def chain_scene(elements: int, heading_deg: float = 0.0) -> dict:
     c, s = np.cos(np.radians(heading_deg)), np.sin(np.radians(heading_deg))
     return {
-        "environment": {"depth": 200.0, "rho": 1025.0,
-                        "seabed": {"stiffness": 3.0e6, "damping": 3.0e5}},
-        "lines": [{"name": "leg1",
-                   "end_a": {"position": [-800.0 * c, -800.0 * s, -200.0]},
-                   "end_b": {"position": [0.0, 0.0, -20.0]},
-                   "segments": [{"length": 850.0, "ea": 1.2326e9, "mass": 288.0,
-                                 "diameter": 0.216, "cd_normal": 1.333,
-                                 "cd_axial": 0.2034, "ca_normal": 1.0,
-                                 "elements": elements}]}],
+        "environment": {
+            "depth": 200.0,
+            "rho": 1025.0,
+            "seabed": {"stiffness": 3.0e6, "damping": 3.0e5},
+        },
+        "lines": [
+            {
+                "name": "leg1",
+                "end_a": {"position": [-800.0 * c, -800.0 * s, -200.0]},
+                "end_b": {"position": [0.0, 0.0, -20.0]},
+                "segments": [
+                    {
+                        "length": 850.0,
+                        "ea": 1.2326e9,
+                        "mass": 288.0,
+                        "diameter": 0.216,
+                        "cd_normal": 1.333,
+                        "cd_axial": 0.2034,
+                        "ca_normal": 1.0,
+                        "elements": elements,
+                    }
+                ],
+            }
+        ],
     }
 
 
@@ -57,8 +72,11 @@ _USE_MIN = False
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="fewer repeats and sizes")
-    parser.add_argument("--min", action="store_true",
-                        help="report the minimum instead of the median (loaded machine)")
+    parser.add_argument(
+        "--min",
+        action="store_true",
+        help="report the minimum instead of the median (loaded machine)",
+    )
     args = parser.parse_args()
     global _USE_MIN
     _USE_MIN = args.min
@@ -76,23 +94,40 @@ def main() -> None:
     model = build_fe_model(ls, env, dim=3)
     print("DESIGN example chain, 100 elements, 3-D, 30 modes (ms)")
     print(f"  statics                 {median_ms(lambda: solve_statics(scene), repeat):8.2f}")
-    print(f"  assemble                {median_ms(lambda: build_fe_model(ls, env, dim=3), repeat):8.2f}")
-    print(f"  30 modes (auto: {natural_modes(model, count=30).method:6s}) "
-          f"{median_ms(lambda: natural_modes(model, count=30), repeat):8.2f}")
+    print(
+        f"  assemble                {median_ms(lambda: build_fe_model(ls, env, dim=3), repeat):8.2f}"
+    )
+    print(
+        f"  30 modes (auto: {natural_modes(model, count=30).method:6s}) "
+        f"{median_ms(lambda: natural_modes(model, count=30), repeat):8.2f}"
+    )
     print(f"  statics+assemble+modes  {median_ms(pipeline, repeat):8.2f}")
 
     sizes = (20, 50, 100, 200, 400, 800) if not args.quick else (20, 100, 400)
-    for heading, title in ((0.0, "chain in the x–z plane"),
-                           (35.0, "chain in a vertical plane at 35° (one coupled block)")):
+    for heading, title in (
+        (0.0, "chain in the x–z plane"),
+        (35.0, "chain in a vertical plane at 35° (one coupled block)"),
+    ):
         print(f"\n{title}: assemble and 30 modes vs elements (ms)")
-        print(f"  {'n_el':>5} {'n_dof':>6} {'assemble':>9} {'dense':>8} {'banded':>8} "
-              f"{'sparse':>8} {'auto':>8}")
+        print(
+            f"  {'n_el':>5} {'n_dof':>6} {'assemble':>9} {'dense':>8} {'banded':>8} "
+            f"{'sparse':>8} {'auto':>8}"
+        )
         for n in sizes:
             ls = solve_statics(load_scene(chain_scene(n, heading))).lines["leg1"]
             model = build_fe_model(ls, env, dim=3)
-            t_asm = median_ms(lambda: assemble(ls.mesh, ls.positions, ls.tension, env.rho,
-                                               dim=3, grounded=ls.grounded,
-                                               seabed=env.seabed), repeat)
+            t_asm = median_ms(
+                lambda: assemble(
+                    ls.mesh,
+                    ls.positions,
+                    ls.tension,
+                    env.rho,
+                    dim=3,
+                    grounded=ls.grounded,
+                    seabed=env.seabed,
+                ),
+                repeat,
+            )
             row = []
             for method in ("dense", "banded", "sparse", "auto"):
                 if method == "dense" and model.free.size > 1300:
@@ -100,8 +135,7 @@ def main() -> None:
                     continue
                 r = max(3, repeat // 4) if method == "dense" and n >= 400 else repeat
                 row.append(median_ms(lambda: natural_modes(model, count=30, method=method), r))
-            print(f"  {n:5d} {model.n_dof:6d} {t_asm:9.2f} " +
-                  " ".join(f"{t:8.2f}" for t in row))
+            print(f"  {n:5d} {model.n_dof:6d} {t_asm:9.2f} " + " ".join(f"{t:8.2f}" for t in row))
 
 
 if __name__ == "__main__":

@@ -87,16 +87,27 @@ def static_scene(elements: int) -> dict:
 
 # --- MoorPy ---------------------------------------------------------------------------
 
+
 def moorpy_system(segments: int, g: float = G):
     import moorpy as mp
 
     ms = mp.System(depth=DEPTH, rho=RHO, g=g)
     ms.addPoint(1, np.array(ANCHOR))
     ms.addPoint(1, np.array(FAIRLEAD))
-    line_type = dict(name="chain", m=MASS, d_vol=DIAMETER, EA=EA,
-                     w=(MASS - math.pi / 4 * DIAMETER**2 * RHO) * g,
-                     Cd=CDN, CdAx=CDT * math.pi, Ca=CAN, CaAx=0.0, MBL=0.0, cost=0.0,
-                     material="chain")
+    line_type = dict(
+        name="chain",
+        m=MASS,
+        d_vol=DIAMETER,
+        EA=EA,
+        w=(MASS - math.pi / 4 * DIAMETER**2 * RHO) * g,
+        Cd=CDN,
+        CdAx=CDT * math.pi,
+        Ca=CAN,
+        CaAx=0.0,
+        MBL=0.0,
+        cost=0.0,
+        material="chain",
+    )
     line = ms.addLine(LENGTH, line_type, nSegs=segments, pointA=1, pointB=2)
     ms.initialize()
     return ms, line
@@ -111,26 +122,43 @@ def moorpy_statics(repeat: int) -> dict:
         t_med, t_min, _ = timed(lambda: line.staticSolve(reset=True), repeat)
         t_prof, _, _ = timed(lambda: line.staticSolve(reset=True, profiles=1), repeat)
         t_init, _, _ = timed(ms.initialize, max(3, repeat // 4))
-        out[g] = dict(TA=float(line.TA), TB=float(line.TB), LBot=float(line.LBot),
-                      HF=float(line.HF), VF=float(line.VF), t=t_med, t_min=t_min,
-                      t_profiles=t_prof, t_initialize=t_init, w=float(line.w))
+        out[g] = dict(
+            TA=float(line.TA),
+            TB=float(line.TB),
+            LBot=float(line.LBot),
+            HF=float(line.HF),
+            VF=float(line.VF),
+            t=t_med,
+            t_min=t_min,
+            t_profiles=t_prof,
+            t_initialize=t_init,
+            w=float(line.w),
+        )
     # seabed friction: Line.staticSolve sets cb = −depth − z_A = 0 for an anchor on the
     # seabed (MoorPy 1.3), so friction is shown through the catenary function directly
     w = out[G]["w"]
     for cb in (0.0, 0.3, 1.0):
         fAH, fAV, fBH, fBV, info = catenary(800.0, 180.0, LENGTH, EA, w, CB=cb, Tol=1e-6)
-        out[f"cb={cb}"] = dict(TA=math.hypot(fAH, fAV), TB=math.hypot(fBH, fBV),
-                               LBot=float(info["LBot"]))
+        out[f"cb={cb}"] = dict(
+            TA=math.hypot(fAH, fAV), TB=math.hypot(fBH, fBV), LBot=float(info["LBot"])
+        )
     return out
 
 
-def moorpy_dynamics(omega: np.ndarray, s_surge: np.ndarray, segments: int,
-                    kbot: float, cbot: float, tol: float, repeat: int) -> dict:
+def moorpy_dynamics(
+    omega: np.ndarray,
+    s_surge: np.ndarray,
+    segments: int,
+    kbot: float,
+    cbot: float,
+    tol: float,
+    repeat: int,
+) -> dict:
     ms, line = moorpy_system(segments)
     n_w = omega.size
     rao_a = np.zeros((n_w, 3))
     rao_b = np.zeros((n_w, 3))
-    rao_b[:, 0] = 1.0       # fairlead surge per unit of the "wave" whose spectrum is S_surge
+    rao_b[:, 0] = 1.0  # fairlead surge per unit of the "wave" whose spectrum is S_surge
 
     def run():
         # conv_time=False: MoorPy prints nothing; iterations are counted below
@@ -151,11 +179,19 @@ def moorpy_dynamics(omega: np.ndarray, s_surge: np.ndarray, segments: int,
     if repeat > 0:
         t_med, t_min, res = timed(run, repeat)
     T_amp, T_psd, T_std, s, r_static, r_dyn, r_tot, X = res
-    return dict(std_a=float(T_std[0]), std_b=float(T_std[-1]), t=t_med, t_min=t_min,
-                solves=calls[0], T_mean_a=float(line.TA), T_mean_b=float(line.TB))
+    return dict(
+        std_a=float(T_std[0]),
+        std_b=float(T_std[-1]),
+        t=t_med,
+        t_min=t_min,
+        solves=calls[0],
+        T_mean_a=float(line.TA),
+        T_mean_b=float(line.TB),
+    )
 
 
 # --- stochcable -----------------------------------------------------------------------
+
 
 def stochcable_statics(repeat: int) -> dict:
     out = {}
@@ -164,8 +200,13 @@ def stochcable_statics(repeat: int) -> dict:
         for method in ("catenary", "fe"):
             t_med, t_min, res = timed(lambda: solve_statics(scene, method=method), repeat)
             ls = res.lines["leg1"]
-            out[(method, n)] = dict(TA=float(ls.tension_a), TB=float(ls.tension_b),
-                                    touchdown=ls.touchdown, t=t_med, t_min=t_min)
+            out[(method, n)] = dict(
+                TA=float(ls.tension_a),
+                TB=float(ls.tension_b),
+                touchdown=ls.touchdown,
+                t=t_med,
+                t_min=t_min,
+            )
     return out
 
 
@@ -175,70 +216,98 @@ def stochcable_dynamics(elements: int, repeat: int) -> dict:
         warnings.simplefilter("always")
         t_med, t_min, res = timed(lambda: analyze(scene), repeat)
     line = res.lines["leg1"]
-    return dict(std_a=float(line.end_a.std), std_b=float(line.end_b.std),
-                el_std_a=float(line.tension_std[0]), el_std_b=float(line.tension_std[-1]),
-                mean_a=float(line.end_a.mean), mean_b=float(line.end_b.mean),
-                t=t_med, t_min=t_min, iterations=line.linearization.iterations,
-                omega=np.asarray(line.omega), s_in=np.asarray(line.input_spectra[0]),
-                warnings=sorted({type(w.message).__name__ for w in caught}))
+    return dict(
+        std_a=float(line.end_a.std),
+        std_b=float(line.end_b.std),
+        el_std_a=float(line.tension_std[0]),
+        el_std_b=float(line.tension_std[-1]),
+        mean_a=float(line.end_a.mean),
+        mean_b=float(line.end_b.mean),
+        t=t_med,
+        t_min=t_min,
+        iterations=line.linearization.iterations,
+        omega=np.asarray(line.omega),
+        s_in=np.asarray(line.input_spectra[0]),
+        warnings=sorted({type(w.message).__name__ for w in caught}),
+    )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="fewer repetitions")
-    parser.add_argument("--diagnose", action="store_true",
-                        help="also run stochcable with a lumped mass matrix (MoorPy's)")
+    parser.add_argument(
+        "--diagnose",
+        action="store_true",
+        help="also run stochcable with a lumped mass matrix (MoorPy's)",
+    )
     args = parser.parse_args()
     rep_fast, rep_slow = (5, 2) if args.quick else (41, 7)
-    print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} "
-          f"{os.getloadavg()[2]:.2f}")
+    print(
+        f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}"
+    )
     try:
         import moorpy  # noqa: F401
+
         have_moorpy = True
     except ImportError:
         have_moorpy = False
-        print("MoorPy not importable: the MoorPy columns are skipped "
-              "(pip install moorpy to compare)")
+        print(
+            "MoorPy not importable: the MoorPy columns are skipped (pip install moorpy to compare)"
+        )
 
     # 1. statics ---------------------------------------------------------------------
     print("\n1. Statics, end tensions [kN], touchdown [m from the anchor], time [ms] (median/min)")
     sc = stochcable_statics(rep_fast)
     for (method, n), r in sc.items():
         td = float("nan") if r["touchdown"] is None else r["touchdown"]
-        print(f"  stochcable {method:8s} {n:3d} el  T_a {r['TA'] / 1e3:9.3f}  T_b {r['TB'] / 1e3:9.3f}"
-              f"  touchdown {td:7.2f}  {1e3 * r['t']:7.3f} / {1e3 * r['t_min']:.3f} ms")
+        print(
+            f"  stochcable {method:8s} {n:3d} el  T_a {r['TA'] / 1e3:9.3f}  T_b {r['TB'] / 1e3:9.3f}"
+            f"  touchdown {td:7.2f}  {1e3 * r['t']:7.3f} / {1e3 * r['t_min']:.3f} ms"
+        )
     if have_moorpy:
         mp_st = moorpy_statics(rep_fast)
         cat = sc[("catenary", 40)]
         for g in (G, 9.81):
             r = mp_st[g]
-            print(f"  MoorPy staticSolve g={g:<7}  T_a {r['TA'] / 1e3:9.3f}  T_b {r['TB'] / 1e3:9.3f}"
-                  f"  touchdown {r['LBot']:7.2f}  {1e3 * r['t']:7.3f} / {1e3 * r['t_min']:.3f} ms"
-                  f"  (with profiles {1e3 * r['t_profiles']:.3f} ms, System.initialize"
-                  f" {1e3 * r['t_initialize']:.3f} ms)")
-            print(f"      vs stochcable catenary: T_a {r['TA'] / cat['TA'] - 1:+.2e}, "
-                  f"T_b {r['TB'] / cat['TB'] - 1:+.2e}, touchdown "
-                  f"{r['LBot'] - cat['touchdown']:+.3f} m")
+            print(
+                f"  MoorPy staticSolve g={g:<7}  T_a {r['TA'] / 1e3:9.3f}  T_b {r['TB'] / 1e3:9.3f}"
+                f"  touchdown {r['LBot']:7.2f}  {1e3 * r['t']:7.3f} / {1e3 * r['t_min']:.3f} ms"
+                f"  (with profiles {1e3 * r['t_profiles']:.3f} ms, System.initialize"
+                f" {1e3 * r['t_initialize']:.3f} ms)"
+            )
+            print(
+                f"      vs stochcable catenary: T_a {r['TA'] / cat['TA'] - 1:+.2e}, "
+                f"T_b {r['TB'] / cat['TB'] - 1:+.2e}, touchdown "
+                f"{r['LBot'] - cat['touchdown']:+.3f} m"
+            )
         for cb in (0.0, 0.3, 1.0):
             r = mp_st[f"cb={cb}"]
-            print(f"  MoorPy catenary(), seabed friction cb={cb}: T_a {r['TA'] / 1e3:9.3f}  "
-                  f"T_b {r['TB'] / 1e3:9.3f}  L_bottom {r['LBot']:.2f}")
+            print(
+                f"  MoorPy catenary(), seabed friction cb={cb}: T_a {r['TA'] / 1e3:9.3f}  "
+                f"T_b {r['TB'] / 1e3:9.3f}  L_bottom {r['LBot']:.2f}"
+            )
 
     # 2. dynamics --------------------------------------------------------------------
     print("\n2. Fairlead surge PM Hs 2 m Tp 10 s, no sea/current: tension σ [kN], time [ms]")
     st = stochcable_dynamics(40, rep_slow)
     omega, s_in = st["omega"], st["s_in"]
     sigma_x = math.sqrt(np.trapezoid(s_in, omega))
-    print(f"  grid {omega.size} ω on [{omega[0]:.3g}, {omega[-1]:.3g}] rad/s, "
-          f"σx on the grid {sigma_x:.4f} m (trapezoid)")
-    print(f"  stochcable analyze, 40 el: end σ_a {st['std_a'] / 1e3:.3f}, σ_b {st['std_b'] / 1e3:.3f}; "
-          f"end elements σ_a {st['el_std_a'] / 1e3:.3f}, σ_b {st['el_std_b'] / 1e3:.3f}; "
-          f"{st['iterations']} iterations; {1e3 * st['t']:.1f} / {1e3 * st['t_min']:.1f} ms; "
-          f"warnings {st['warnings']}")
+    print(
+        f"  grid {omega.size} ω on [{omega[0]:.3g}, {omega[-1]:.3g}] rad/s, "
+        f"σx on the grid {sigma_x:.4f} m (trapezoid)"
+    )
+    print(
+        f"  stochcable analyze, 40 el: end σ_a {st['std_a'] / 1e3:.3f}, σ_b {st['std_b'] / 1e3:.3f}; "
+        f"end elements σ_a {st['el_std_a'] / 1e3:.3f}, σ_b {st['el_std_b'] / 1e3:.3f}; "
+        f"{st['iterations']} iterations; {1e3 * st['t']:.1f} / {1e3 * st['t_min']:.1f} ms; "
+        f"warnings {st['warnings']}"
+    )
     st160 = stochcable_dynamics(160, max(2, rep_slow // 2))
-    print(f"  stochcable analyze, 160 el: end σ_a {st160['std_a'] / 1e3:.3f}, "
-          f"σ_b {st160['std_b'] / 1e3:.3f}; end elements σ_a {st160['el_std_a'] / 1e3:.3f}, "
-          f"σ_b {st160['el_std_b'] / 1e3:.3f}; {1e3 * st160['t']:.1f} ms")
+    print(
+        f"  stochcable analyze, 160 el: end σ_a {st160['std_a'] / 1e3:.3f}, "
+        f"σ_b {st160['std_b'] / 1e3:.3f}; end elements σ_a {st160['el_std_a'] / 1e3:.3f}, "
+        f"σ_b {st160['el_std_b'] / 1e3:.3f}; {1e3 * st160['t']:.1f} ms"
+    )
     if args.diagnose:
         # diagnostic only: analyze() has no mass-matrix option, so its FE builder is
         # wrapped; MoorPy lumps the mass, stochcable's default is consistent
@@ -251,32 +320,53 @@ def main() -> None:
         try:
             for n in (40, 160):
                 r = stochcable_dynamics(n, 1)
-                print(f"  stochcable, lumped mass, {n} el: end σ_a {r['std_a'] / 1e3:.3f}, "
-                      f"σ_b {r['std_b'] / 1e3:.3f}; end elements σ_a {r['el_std_a'] / 1e3:.3f}, "
-                      f"σ_b {r['el_std_b'] / 1e3:.3f}")
+                print(
+                    f"  stochcable, lumped mass, {n} el: end σ_a {r['std_a'] / 1e3:.3f}, "
+                    f"σ_b {r['std_b'] / 1e3:.3f}; end elements σ_a {r['el_std_a'] / 1e3:.3f}, "
+                    f"σ_b {r['el_std_b'] / 1e3:.3f}"
+                )
         finally:
             analysis.build_fe_model = original
     if not have_moorpy:
         return
     ds = LENGTH / 40
     cases = [
-        ("MoorPy 40 seg, kbot = k·D·Δs, tol 0.01 (default)", 40, K_BED * DIAMETER * ds,
-         C_BED * DIAMETER * ds, 0.01),
-        ("MoorPy 40 seg, kbot = k·D·Δs, tol 1e-4", 40, K_BED * DIAMETER * ds,
-         C_BED * DIAMETER * ds, 1e-4),
+        (
+            "MoorPy 40 seg, kbot = k·D·Δs, tol 0.01 (default)",
+            40,
+            K_BED * DIAMETER * ds,
+            C_BED * DIAMETER * ds,
+            0.01,
+        ),
+        (
+            "MoorPy 40 seg, kbot = k·D·Δs, tol 1e-4",
+            40,
+            K_BED * DIAMETER * ds,
+            C_BED * DIAMETER * ds,
+            1e-4,
+        ),
         ("MoorPy 40 seg, kbot = 3e6 N/m, cbot = 3e5 N·s/m, tol 0.01", 40, K_BED, C_BED, 0.01),
-        ("MoorPy 160 seg, kbot = k·D·Δs, tol 1e-4", 160, K_BED * DIAMETER * LENGTH / 160,
-         C_BED * DIAMETER * LENGTH / 160, 1e-4),
+        (
+            "MoorPy 160 seg, kbot = k·D·Δs, tol 1e-4",
+            160,
+            K_BED * DIAMETER * LENGTH / 160,
+            C_BED * DIAMETER * LENGTH / 160,
+            1e-4,
+        ),
     ]
     for name, seg, kb, cb, tol in cases:
         # 160 segments: ≈ 23 s per solve (dense per-frequency solves), timed once
         r = moorpy_dynamics(omega, s_in, seg, kb, cb, tol, rep_slow if seg == 40 else 0)
         ref = st if seg == 40 else st160
-        print(f"  {name}: σ_a {r['std_a'] / 1e3:.3f}, σ_b {r['std_b'] / 1e3:.3f}; "
-              f"{r['solves']} linear solves (= iterations); {1e3 * r['t']:.0f} / {1e3 * r['t_min']:.0f} ms")
-        print(f"      MoorPy / stochcable − 1: vs end elements σ_a {r['std_a'] / ref['el_std_a'] - 1:+.3f}, "
-              f"σ_b {r['std_b'] / ref['el_std_b'] - 1:+.3f}; vs end reactions "
-              f"σ_a {r['std_a'] / ref['std_a'] - 1:+.3f}, σ_b {r['std_b'] / ref['std_b'] - 1:+.3f}")
+        print(
+            f"  {name}: σ_a {r['std_a'] / 1e3:.3f}, σ_b {r['std_b'] / 1e3:.3f}; "
+            f"{r['solves']} linear solves (= iterations); {1e3 * r['t']:.0f} / {1e3 * r['t_min']:.0f} ms"
+        )
+        print(
+            f"      MoorPy / stochcable − 1: vs end elements σ_a {r['std_a'] / ref['el_std_a'] - 1:+.3f}, "
+            f"σ_b {r['std_b'] / ref['el_std_b'] - 1:+.3f}; vs end reactions "
+            f"σ_a {r['std_a'] / ref['std_a'] - 1:+.3f}, σ_b {r['std_b'] / ref['std_b'] - 1:+.3f}"
+        )
 
 
 if __name__ == "__main__":

@@ -20,13 +20,12 @@ from __future__ import annotations
 
 import os
 import platform
-import sys
 import resource
 import statistics
+import sys
 import time
 
 import numpy as np
-
 from _host import host_line
 
 from stochcable.sea import fft as _fft
@@ -64,8 +63,10 @@ def main() -> None:
     n_t, dt = 2**20, 0.25
     duration = n_t * dt
     omega, _ = sea.frequency_grid(duration, dt)
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-          f"python {platform.python_version()}, numpy {np.__version__}")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"python {platform.python_version()}, numpy {np.__version__}"
+    )
     print("load average before: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     print(host_line())
     print(f"OMP_WAIT_POLICY={os.environ.get('OMP_WAIT_POLICY')}")
@@ -80,14 +81,19 @@ def main() -> None:
         print("coefficient kernel: numpy (numba not installed or STOCHCABLE_NUMBA=0)")
     else:
         import numba
+
         from stochcable.sea import kernels as _kernels
 
-        print(f"coefficient kernel: numba {numba.__version__} (import + kernel "
-              f"{'load from cache' if _kernels.CACHED else 'compile, no cache'}: "
-              f"{1e3 * t_load:.0f} ms)")
+        print(
+            f"coefficient kernel: numba {numba.__version__} (import + kernel "
+            f"{'load from cache' if _kernels.CACHED else 'compile, no cache'}: "
+            f"{1e3 * t_load:.0f} ms)"
+        )
     wis = _fft.wisdom_path()
-    print("FFTW wisdom: " + ("off" if wis is None else
-                             f"{wis} ({'present' if os.path.exists(wis) else 'none'})"))
+    print(
+        "FFTW wisdom: "
+        + ("off" if wis is None else f"{wis} ({'present' if os.path.exists(wis) else 'none'})")
+    )
 
     def pm(w):
         return spectrum_pierson_moskowitz(w, 6.0, 10.0)
@@ -105,26 +111,46 @@ def main() -> None:
                 return fn()
             finally:
                 os.environ.pop("STOCHCABLE_NUMBA")
+
         return run
 
     if compiled is not None and "STOCHCABLE_NUMBA" not in os.environ:
-        rows.append(("simulate_sea PM, DSA, 2^20 samples [pyfftw, numpy kernel]",
-                     median_ms(numpy_kernel(
-                         lambda: sea.simulate_sea(pm, duration, dt, "dsa", next(seeds))), 30)))
+        rows.append(
+            (
+                "simulate_sea PM, DSA, 2^20 samples [pyfftw, numpy kernel]",
+                median_ms(
+                    numpy_kernel(lambda: sea.simulate_sea(pm, duration, dt, "dsa", next(seeds))), 30
+                ),
+            )
+        )
     for backend in ("pyfftw", "numpy"):
         saved = _fft._pyfftw
         if backend == "numpy":
             _fft._pyfftw = None
         try:
-            rows.append((f"simulate_sea PM, DSA, 2^20 samples [{backend}]",
-                         median_ms(lambda: sea.simulate_sea(pm, duration, dt, "dsa", next(seeds)), 30)))
-            rows.append((f"simulate_sea JONSWAP, DSA, 2^20 samples [{backend}]",
-                         median_ms(lambda: sea.simulate_sea(js, duration, dt, "dsa", next(seeds)), 30)))
-            rows.append((f"simulate_sea PM, NSA, 2^20 samples [{backend}]",
-                         median_ms(lambda: sea.simulate_sea(pm, duration, dt, "nsa", next(seeds)), 30)))
+            rows.append(
+                (
+                    f"simulate_sea PM, DSA, 2^20 samples [{backend}]",
+                    median_ms(lambda: sea.simulate_sea(pm, duration, dt, "dsa", next(seeds)), 30),
+                )
+            )
+            rows.append(
+                (
+                    f"simulate_sea JONSWAP, DSA, 2^20 samples [{backend}]",
+                    median_ms(lambda: sea.simulate_sea(js, duration, dt, "dsa", next(seeds)), 30),
+                )
+            )
+            rows.append(
+                (
+                    f"simulate_sea PM, NSA, 2^20 samples [{backend}]",
+                    median_ms(lambda: sea.simulate_sea(pm, duration, dt, "nsa", next(seeds)), 30),
+                )
+            )
             x = np.zeros(n_t // 2 + 1, complex)
             x[1:-1] = 1.0
-            rows.append((f"  irfft alone, 2^20 [{backend}]", median_ms(lambda: _fft.irfft(x, n_t), 30)))
+            rows.append(
+                (f"  irfft alone, 2^20 [{backend}]", median_ms(lambda: _fft.irfft(x, n_t), 30))
+            )
         finally:
             _fft._pyfftw = saved
     rows.append(("  PM spectrum on 2^19+1 frequencies", median_ms(lambda: pm(omega), 30)))
@@ -138,21 +164,37 @@ def main() -> None:
             b = min(a + sea._CHUNK, u.size)
             sea._phasor_chunk(u[a:b], s_lines[a:b], 1.0, out[a:b], None, fft_in[a:b], 1.0)
 
-    rows.append(("  coefficient kernel (table + series), 2^19, 1 thread [numpy]",
-                 median_ms(kernel, 30)))
+    rows.append(
+        ("  coefficient kernel (table + series), 2^19, 1 thread [numpy]", median_ms(kernel, 30))
+    )
     if compiled is not None:
         jbuf, empty = np.empty(sea._CHUNK), np.empty(0)
 
         def kernel_numba() -> None:  # the same, compiled
             for a in range(0, u.size, sea._CHUNK):
                 b = min(a + sea._CHUNK, u.size)
-                compiled(u[a:b], s_lines[a:b], 1.0, empty, empty, sea._TABLE, out[a:b],
-                         fft_in[a:b], 1.0, jbuf)
+                compiled(
+                    u[a:b],
+                    s_lines[a:b],
+                    1.0,
+                    empty,
+                    empty,
+                    sea._TABLE,
+                    out[a:b],
+                    fft_in[a:b],
+                    1.0,
+                    jbuf,
+                )
 
-        rows.append(("  coefficient kernel (table + series), 2^19, 1 thread [numba]",
-                     median_ms(kernel_numba, 30)))
-    rows.append(("  np.exp(-1j*theta), 2^19 (reference, not used)",
-                 median_ms(lambda: np.exp(-1j * u), 10)))
+        rows.append(
+            (
+                "  coefficient kernel (table + series), 2^19, 1 thread [numba]",
+                median_ms(kernel_numba, 30),
+            )
+        )
+    rows.append(
+        ("  np.exp(-1j*theta), 2^19 (reference, not used)", median_ms(lambda: np.exp(-1j * u), 10))
+    )
     rng = np.random.default_rng(0)
     rows.append(("  rng.random(2^19)", median_ms(lambda: rng.random(n_t // 2), 30)))
 
@@ -169,9 +211,11 @@ def main() -> None:
         print(f"{name:<{width}}  {med:8.3f} ms {low:8.3f} ms")
     print(f"dispersion max relative residual |g k tanh(kh)/w^2 - 1| = {res:.1e}")
     one = lambda: sea.simulate_sea(pm, duration, dt, "dsa", next(seeds))  # noqa: E731
-    print(f"minor page faults per 2^20 realization: {minor_faults(one, 10, False):.0f} "
-          f"(result dropped), {minor_faults(one, 10, True):.0f} (results kept; "
-          f"4 KiB pages, fewer where transparent huge pages apply)")
+    print(
+        f"minor page faults per 2^20 realization: {minor_faults(one, 10, False):.0f} "
+        f"(result dropped), {minor_faults(one, 10, True):.0f} (results kept; "
+        f"4 KiB pages, fewer where transparent huge pages apply)"
+    )
     print("load average after: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
 
 

@@ -48,9 +48,21 @@ def _free_port() -> int:
 def _start_server(port: int) -> subprocess.Popen:
     env = {**os.environ, "STOCHCABLE_MAX_SAMPLES": str(2**22)}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "uvicorn", "service.app:app", "--host", "127.0.0.1",
-         "--port", str(port), "--log-level", "warning", "--no-access-log"],
-        env=env, stderr=subprocess.DEVNULL,
+        [
+            sys.executable,
+            "-m",
+            "uvicorn",
+            "service.app:app",
+            "--host",
+            "127.0.0.1",
+            "--port",
+            str(port),
+            "--log-level",
+            "warning",
+            "--no-access-log",
+        ],
+        env=env,
+        stderr=subprocess.DEVNULL,
     )
     deadline = time.monotonic() + 30.0
     while time.monotonic() < deadline:
@@ -99,8 +111,11 @@ def bench_spectra(base: str, n: int, workers: int) -> dict:
     with ThreadPoolExecutor(workers) as pool:
         list(pool.map(one, range(workers)))
     wall = time.perf_counter() - t0
-    return {"p50": _pct(lat, 50), "p99": _pct(lat, 99),
-            "throughput": workers * (n // workers) / wall}
+    return {
+        "p50": _pct(lat, 50),
+        "p99": _pct(lat, 99),
+        "throughput": workers * (n // workers) / wall,
+    }
 
 
 def _big_body() -> dict:
@@ -131,15 +146,22 @@ def bench_realization(base: str, repeats: int) -> dict:
     headers = {"Accept": "application/x-npy", "Accept-Encoding": "identity"}
     with httpx.Client(base_url=base, timeout=120.0) as c:
         for _ in range(repeats):
-            server.append(_server_s(c.post("/v1/sea/realizations", json=_big_body(),
-                                           headers=headers)))
+            server.append(
+                _server_s(c.post("/v1/sea/realizations", json=_big_body(), headers=headers))
+            )
     # first call plans the FFT; the minimum is the least disturbed by other load
     local_t, remote_t = min(local[1:]), min(remote[1:])
     local_med, remote_med = float(np.median(local[1:])), float(np.median(remote[1:]))
-    return {"local": local_t, "remote": remote_t, "ratio": remote_t / local_t,
-            "local_median": local_med, "server": min(server),
-            "remote_median": remote_med, "ratio_median": remote_med / local_med,
-            "bytes": 8 * N_BIG + 128}  # the elevation column only (t_n = n·dt)
+    return {
+        "local": local_t,
+        "remote": remote_t,
+        "ratio": remote_t / local_t,
+        "local_median": local_med,
+        "server": min(server),
+        "remote_median": remote_med,
+        "ratio_median": remote_med / local_med,
+        "bytes": 8 * N_BIG + 128,
+    }  # the elevation column only (t_n = n·dt)
 
 
 def _health_while(base: str, n: int, heavy_clients: int, post) -> dict:
@@ -167,14 +189,17 @@ def _health_while(base: str, n: int, heavy_clients: int, post) -> dict:
     stop.set()
     for t in threads:
         t.join(120.0)
-    return {"p50": _pct(lat, 50), "p99": _pct(lat, 99), "max": max(lat),
-            "heavy": heavy_done[0]}
+    return {"p50": _pct(lat, 50), "p99": _pct(lat, 99), "max": max(lat), "heavy": heavy_done[0]}
 
 
 def bench_health_under_load(base: str, n: int, heavy_clients: int) -> dict:
     headers = {"Accept": "application/x-npy", "Accept-Encoding": "identity"}
-    return _health_while(base, n, heavy_clients, lambda c: c.post(
-        "/v1/sea/realizations", json=_big_body(), headers=headers))
+    return _health_while(
+        base,
+        n,
+        heavy_clients,
+        lambda c: c.post("/v1/sea/realizations", json=_big_body(), headers=headers),
+    )
 
 
 def _chain_body() -> bytes:
@@ -223,24 +248,36 @@ def bench_analyses(base: str, n: int, workers: int) -> dict:
     with ThreadPoolExecutor(workers) as pool:
         list(pool.map(one, range(workers)))
     wall = time.perf_counter() - t0
-    return {"p50": _pct(lat, 50), "p99": _pct(lat, 99), "local_p50": _pct(local, 50),
-            "local_p99": _pct(local, 99), "ratio": _pct(lat, 50) / _pct(local, 50),
-            "server_p50": _pct(server, 50),
-            "throughput": workers * per_worker / wall}
+    return {
+        "p50": _pct(lat, 50),
+        "p99": _pct(lat, 99),
+        "local_p50": _pct(local, 50),
+        "local_p99": _pct(local, 99),
+        "ratio": _pct(lat, 50) / _pct(local, 50),
+        "server_p50": _pct(server, 50),
+        "throughput": workers * per_worker / wall,
+    }
 
 
 def bench_health_under_analyses(base: str, n: int, heavy_clients: int) -> dict:
     body = _chain_body()
-    return _health_while(base, n, heavy_clients, lambda c: c.post(
-        "/v1/analyses", content=body,
-        headers={"Content-Type": "application/json"}).raise_for_status())
+    return _health_while(
+        base,
+        n,
+        heavy_clients,
+        lambda c: c.post(
+            "/v1/analyses", content=body, headers={"Content-Type": "application/json"}
+        ).raise_for_status(),
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--requests", type=int, default=400,
-                        help="sequential /v1/spectra requests (default 400)")
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "--requests", type=int, default=400, help="sequential /v1/spectra requests (default 400)"
+    )
     parser.add_argument("--quick", action="store_true", help="fewer repetitions")
     args = parser.parse_args(argv)
     n = 100 if args.quick else max(20, args.requests)
@@ -251,29 +288,39 @@ def main(argv: list[str] | None = None) -> int:
     proc = _start_server(port)
     try:
         s = bench_spectra(base, n, workers=4)
-        print(f"POST /v1/spectra        p50 {_fmt_ms(s['p50'])}  p99 {_fmt_ms(s['p99'])}  "
-              f"throughput {s['throughput']:7.0f} req/s (4 clients)   goal p50 <= 5 ms: "
-              f"{'ok' if s['p50'] <= 5e-3 else 'MISSED'}")
+        print(
+            f"POST /v1/spectra        p50 {_fmt_ms(s['p50'])}  p99 {_fmt_ms(s['p99'])}  "
+            f"throughput {s['throughput']:7.0f} req/s (4 clients)   goal p50 <= 5 ms: "
+            f"{'ok' if s['p50'] <= 5e-3 else 'MISSED'}"
+        )
         r = bench_realization(base, repeats)
-        print(f"2^20-sample realization  library {_fmt_ms(r['local'])}  service npy "
-              f"{_fmt_ms(r['remote'])}  ratio {r['ratio']:5.2f}  ({r['bytes'] / 2**20:.1f} MiB)"
-              f"   goal <= 2x: {'ok' if r['ratio'] <= 2.0 else 'MISSED'}   (medians: "
-              f"library {_fmt_ms(r['local_median'])}, service {_fmt_ms(r['remote_median'])}, "
-              f"ratio {r['ratio_median']:5.2f}); "
-              f"server-side time (Server-Timing) {_fmt_ms(r['server'])}")
+        print(
+            f"2^20-sample realization  library {_fmt_ms(r['local'])}  service npy "
+            f"{_fmt_ms(r['remote'])}  ratio {r['ratio']:5.2f}  ({r['bytes'] / 2**20:.1f} MiB)"
+            f"   goal <= 2x: {'ok' if r['ratio'] <= 2.0 else 'MISSED'}   (medians: "
+            f"library {_fmt_ms(r['local_median'])}, service {_fmt_ms(r['remote_median'])}, "
+            f"ratio {r['ratio_median']:5.2f}); "
+            f"server-side time (Server-Timing) {_fmt_ms(r['server'])}"
+        )
         h = bench_health_under_load(base, 100 if args.quick else 200, heavy_clients=2)
-        print(f"GET /health under load   p50 {_fmt_ms(h['p50'])}  p99 {_fmt_ms(h['p99'])}  "
-              f"max {_fmt_ms(h['max'])}  ({h['heavy']} heavy realizations meanwhile)")
+        print(
+            f"GET /health under load   p50 {_fmt_ms(h['p50'])}  p99 {_fmt_ms(h['p99'])}  "
+            f"max {_fmt_ms(h['max'])}  ({h['heavy']} heavy realizations meanwhile)"
+        )
         a = bench_analyses(base, 10 if args.quick else 30, workers=4)
-        print(f"POST /v1/analyses chain  p50 {_fmt_ms(a['p50'])}  p99 {_fmt_ms(a['p99'])}  "
-              f"library analyze() p50 {_fmt_ms(a['local_p50'])}  p99 "
-              f"{_fmt_ms(a['local_p99'])}  ratio {a['ratio']:5.2f}   goal <= 1.5x: "
-              f"{'ok' if a['ratio'] <= 1.5 else 'MISSED'}   throughput "
-              f"{a['throughput']:5.2f} analyses/s (4 clients); server-side p50 "
-              f"{_fmt_ms(a['server_p50'])}")
+        print(
+            f"POST /v1/analyses chain  p50 {_fmt_ms(a['p50'])}  p99 {_fmt_ms(a['p99'])}  "
+            f"library analyze() p50 {_fmt_ms(a['local_p50'])}  p99 "
+            f"{_fmt_ms(a['local_p99'])}  ratio {a['ratio']:5.2f}   goal <= 1.5x: "
+            f"{'ok' if a['ratio'] <= 1.5 else 'MISSED'}   throughput "
+            f"{a['throughput']:5.2f} analyses/s (4 clients); server-side p50 "
+            f"{_fmt_ms(a['server_p50'])}"
+        )
         h = bench_health_under_analyses(base, 100 if args.quick else 200, heavy_clients=2)
-        print(f"GET /health under analyses p50 {_fmt_ms(h['p50'])}  p99 {_fmt_ms(h['p99'])}  "
-              f"max {_fmt_ms(h['max'])}  ({h['heavy']} analyses meanwhile)")
+        print(
+            f"GET /health under analyses p50 {_fmt_ms(h['p50'])}  p99 {_fmt_ms(h['p99'])}  "
+            f"max {_fmt_ms(h['max'])}  ({h['heavy']} analyses meanwhile)"
+        )
     finally:
         proc.terminate()
         try:

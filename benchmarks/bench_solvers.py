@@ -26,9 +26,17 @@ from stochcable.dynamics.modal_solvers import (
 from stochcable.dynamics.solvers import matrix_bandwidth, solve_direct
 
 
-def line_model(n_el: int = 40, length: float = 850.0, ea: float = 1.2326e9,
-               mass: float = 288.0, diameter: float = 0.216, tension: float = 1.5e6,
-               rho: float = 1025.0, can: float = 1.0, b_drag: float = 400.0):
+def line_model(
+    n_el: int = 40,
+    length: float = 850.0,
+    ea: float = 1.2326e9,
+    mass: float = 288.0,
+    diameter: float = 0.216,
+    tension: float = 1.5e6,
+    rho: float = 1025.0,
+    can: float = 1.0,
+    b_drag: float = 400.0,
+):
     """Straight inclined 3-D line: K, M, C (dense, banded pattern) with 3 n_el DOF."""
     l0 = length / n_el
     e = np.array([0.97, 0.0, 0.243])
@@ -75,8 +83,10 @@ def main(argv: list[str] | None = None) -> int:
     rng = np.random.default_rng(0)
     F = rng.standard_normal((w.size, n)) + 1j * rng.standard_normal((w.size, n))
     lo, up = matrix_bandwidth(K, M, C)
-    print(f"model: {n} DOF, bandwidth (l, u) = ({lo}, {up}), {w.size} frequencies, "
-          f"median of {args.repeat}")
+    print(
+        f"model: {n} DOF, bandwidth (l, u) = ({lo}, {up}), {w.size} frequencies, "
+        f"median of {args.repeat}"
+    )
     t_ref, ref = timed(lambda: solve_direct(K, M, C, F, w, method="dense"), args.repeat)
 
     def err(u):
@@ -91,8 +101,12 @@ def main(argv: list[str] | None = None) -> int:
     wn, phi = basis
     for nm in (n, 40, 20, 10):
         for meth in ("foss", "modal_direct"):
-            t, u = timed(lambda nm=nm, meth=meth: solve_modal(
-                K, M, C, F, w, n_modes=nm, method=meth, basis=(wn, phi)), args.repeat)
+            t, u = timed(
+                lambda nm=nm, meth=meth: solve_modal(
+                    K, M, C, F, w, n_modes=nm, method=meth, basis=(wn, phi)
+                ),
+                args.repeat,
+            )
             rows.append((f"solve_modal {meth:12s} {nm:3d} modes (+static corr.)", t, err(u)))
     Mh, Ch, Kh = phi.T @ M @ phi, phi.T @ C @ phi, phi.T @ K @ phi
     t_dec, fm = timed(lambda: foss_decomposition(Mh, Ch, Kh), args.repeat)
@@ -104,8 +118,10 @@ def main(argv: list[str] | None = None) -> int:
     for name, t, e in rows:
         etxt = "" if np.isnan(e) else f"   rel. error {e:.1e}"
         print(f"{name:{width}s}  {1e3 * t:9.2f} ms{etxt}")
-    print(f"natural frequencies: {wn[0]:.3f} .. {wn[-1]:.1f} rad/s; "
-          f"modes below 2.5 x 2 rad/s: {int(np.sum(wn <= 5.0))}")
+    print(
+        f"natural frequencies: {wn[0]:.3f} .. {wn[-1]:.1f} rad/s; "
+        f"modes below 2.5 x 2 rad/s: {int(np.sum(wn <= 5.0))}"
+    )
     return 0
 
 

@@ -59,8 +59,7 @@ from typing import Any
 
 import numpy as np
 
-SCENES: tuple[str, ...] = ("taut_wire", "chain_catenary", "inclined_guy",
-                           "tuah_1982_single_leg")
+SCENES: tuple[str, ...] = ("taut_wire", "chain_catenary", "inclined_guy", "tuah_1982_single_leg")
 QUANTITIES: tuple[str, ...] = ("T_fairlead", "T_anchor", "motion")
 QUANTITY_TEXT = {
     "T_fairlead": "fairlead (end_b) tension σ",
@@ -70,10 +69,18 @@ QUANTITY_TEXT = {
 # Element factor of the time-domain model per scene: the coarsest level of the FD
 # element ladder whose next refinement changes the tension σ by < ~2 % (full run;
 # measured with this script) — the TD costs grow with the element count.
-TD_MESH = {"taut_wire": 2.0, "chain_catenary": 2.0, "inclined_guy": 4.0,
-           "tuah_1982_single_leg": 1.0}
-TD_DEFAULT_SCENES: tuple[str, ...] = ("taut_wire", "chain_catenary", "inclined_guy",
-                                      "tuah_1982_single_leg")
+TD_MESH = {
+    "taut_wire": 2.0,
+    "chain_catenary": 2.0,
+    "inclined_guy": 4.0,
+    "tuah_1982_single_leg": 1.0,
+}
+TD_DEFAULT_SCENES: tuple[str, ...] = (
+    "taut_wire",
+    "chain_catenary",
+    "inclined_guy",
+    "tuah_1982_single_leg",
+)
 REF_TOLERANCE = 1e-8  # linearization tolerance of the references [-]
 CI_LEVEL = 0.95
 
@@ -134,8 +141,9 @@ def base_document(name: str) -> dict[str, Any]:
     return doc
 
 
-def scene_document(base: dict[str, Any], s: Setting, *, max_iterations: int = 500
-                   ) -> dict[str, Any]:
+def scene_document(
+    base: dict[str, Any], s: Setting, *, max_iterations: int = 500
+) -> dict[str, Any]:
     """The example document with setting ``s`` applied (the input is not mutated)."""
     d = copy.deepcopy(base)
     for seg in d["lines"][0]["segments"]:
@@ -170,8 +178,10 @@ def split_at_touchdown(doc: dict[str, Any], touchdown: float | None) -> dict[str
         if s0 + 1e-6 * length < touchdown < s0 + length * (1.0 - 1e-6):
             a = touchdown - s0
             n_a = min(max(1, round(n * a / length)), max(1, n - 1))
-            out += [dict(seg, length=a, elements=n_a),
-                    dict(seg, length=length - a, elements=max(1, n - n_a))]
+            out += [
+                dict(seg, length=a, elements=n_a),
+                dict(seg, length=length - a, elements=max(1, n - n_a)),
+            ]
         else:
             out.append(seg)
         s0 += length
@@ -195,22 +205,54 @@ def sweep_settings(base: dict[str, Any], quick: bool = False) -> list[Setting]:
         for c in counts:
             if wf == 1.0 and c == c0:
                 continue
-            out.append(Setting((f"{c} ω to ω_max" if wf == 1.0 else f"{c} ω to {wf:g}·ω_max"), "grid", count=c, omega_max_factor=wf))
+            out.append(
+                Setting(
+                    (f"{c} ω to ω_max" if wf == 1.0 else f"{c} ω to {wf:g}·ω_max"),
+                    "grid",
+                    count=c,
+                    omega_max_factor=wf,
+                )
+            )
     if not quick:
         out.append(Setting("log spacing", "spacing", spacing="log"))
-        out.append(Setting(f"log, {2 * c0} ω to 2·ω_max", "spacing", spacing="log",
-                           count=2 * c0, omega_max_factor=2.0))
+        out.append(
+            Setting(
+                f"log, {2 * c0} ω to 2·ω_max",
+                "spacing",
+                spacing="log",
+                count=2 * c0,
+                omega_max_factor=2.0,
+            )
+        )
     tols = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6) if not quick else (1e-2, 1e-6)
-    out += [Setting(f"tolerance {t:.0e}", "tolerance", tolerance=t)
-            for t in tols if not math.isclose(t, tol0)]
+    out += [
+        Setting(f"tolerance {t:.0e}", "tolerance", tolerance=t)
+        for t in tols
+        if not math.isclose(t, tol0)
+    ]
     combos = ((0.5, 400), (2.0, 400), (2.0, 800), (4.0, 800)) if not quick else ((2.0, 400),)
     for f, c in combos:
-        out.append(Setting(f"×{f:g} el, {c} ω to 2·ω_max", "combined", elements=f,
-                           count=c, omega_max_factor=2.0))
+        out.append(
+            Setting(
+                f"×{f:g} el, {c} ω to 2·ω_max",
+                "combined",
+                elements=f,
+                count=c,
+                omega_max_factor=2.0,
+            )
+        )
     if not quick:
-        out.append(Setting("×4 el, direct, 800 ω to 2·ω_max, tol 1e-6", "combined",
-                           elements=4.0, count=800, omega_max_factor=2.0, solver="direct",
-                           tolerance=1e-6))
+        out.append(
+            Setting(
+                "×4 el, direct, 800 ω to 2·ω_max, tol 1e-6",
+                "combined",
+                elements=4.0,
+                count=800,
+                omega_max_factor=2.0,
+                solver="direct",
+                tolerance=1e-6,
+            )
+        )
     return out
 
 
@@ -221,21 +263,25 @@ def quantities_fd(result: Any, s_star: float) -> dict[str, float]:
     """Fairlead/anchor tension σ [N] and motion σ at arc length ``s_star`` [m]."""
     line = next(iter(result.lines.values()))
     comp = [np.interp(s_star, line.s_nodes, line.motion_std[:, k]) for k in range(3)]
-    return {"T_fairlead": float(line.end_b.std), "T_anchor": float(line.end_a.std),
-            "motion": float(np.sqrt(np.sum(np.square(comp))))}
+    return {
+        "T_fairlead": float(line.end_b.std),
+        "T_anchor": float(line.end_a.std),
+        "motion": float(np.sqrt(np.sum(np.square(comp)))),
+    }
 
 
 def quantities_td(history: Any, s_star: float) -> dict[str, float]:
     """The same three quantities from a time-domain history (after its ramp)."""
     ms = history.motion_std()
     comp = [np.interp(s_star, history.s0, ms[:, k]) for k in range(3)]
-    return {"T_fairlead": history.tension_statistics("b")["std"],
-            "T_anchor": history.tension_statistics("a")["std"],
-            "motion": float(np.sqrt(np.sum(np.square(comp))))}
+    return {
+        "T_fairlead": history.tension_statistics("b")["std"],
+        "T_anchor": history.tension_statistics("a")["std"],
+        "motion": float(np.sqrt(np.sum(np.square(comp)))),
+    }
 
 
-def timed_analysis(doc: dict[str, Any], repeats: int, budget_s: float
-                   ) -> tuple[Any, float, int]:
+def timed_analysis(doc: dict[str, Any], repeats: int, budget_s: float) -> tuple[Any, float, int]:
     """analyze() of ``doc``: (last result, median wall time [s], repeats done).
 
     Runs at least once and at most ``repeats`` times, stopping early once the calls
@@ -334,8 +380,14 @@ def _rel(x: float, ref: float) -> float:
     return x / ref - 1.0 if ref != 0.0 else float("nan")
 
 
-def converged_reference(name: str, base: dict[str, Any], s_star: float, *,
-                        quick: bool = False, progress: Progress = _silent) -> Reference:
+def converged_reference(
+    name: str,
+    base: dict[str, Any],
+    s_star: float,
+    *,
+    quick: bool = False,
+    progress: Progress = _silent,
+) -> Reference:
     """The converged FD reference of an example (see the module docstring)."""
     from stochcable.fidelity.planner import static_touchdowns
     from stochcable.scene.model import load_scene
@@ -347,22 +399,35 @@ def converged_reference(name: str, base: dict[str, Any], s_star: float, *,
     s_td = static_touchdowns(load_scene(base)).get(base["lines"][0]["name"])
 
     def run(label: str, f: float, wf: float, c: int, used: bool) -> LadderStep:
-        s = Setting(label, "reference", elements=f, omega_max_factor=wf, count=c,
-                    solver="direct", tolerance=REF_TOLERANCE)
+        s = Setting(
+            label,
+            "reference",
+            elements=f,
+            omega_max_factor=wf,
+            count=c,
+            solver="direct",
+            tolerance=REF_TOLERANCE,
+        )
         doc = split_at_touchdown(scene_document(base, s), s_td)
         res, t, _ = timed_analysis(doc, 1, 0.0)
         line = next(iter(res.lines.values()))
         if not line.linearization.converged:  # pragma: no cover - reported, not hidden
             raise RuntimeError(f"{name}: reference '{label}' did not converge")
-        step = LadderStep(label, int(line.s_nodes.size - 1), c, doc["analysis"]["omega"]["max"],
-                          quantities_fd(res, s_star), t, used)
+        step = LadderStep(
+            label,
+            int(line.s_nodes.size - 1),
+            c,
+            doc["analysis"]["omega"]["max"],
+            quantities_fd(res, s_star),
+            t,
+            used,
+        )
         steps.append(step)
         progress(f"  ref {label}: {t:.2f} s")
         return step
 
     ladder = [run(f"elements ×{f:g}", f, 2.0, count, True) for f in factors]
-    half = run(f"elements ×{factors[-1]:g}, {count // 2} ω", factors[-1], 2.0, count // 2,
-               False)
+    half = run(f"elements ×{factors[-1]:g}, {count // 2} ω", factors[-1], 2.0, count // 2, False)
     wide = run(f"elements ×2, {2 * count} ω to 4·ω_max", 2.0, 4.0, 2 * count, False)
     values, unc, method = {}, {}, {}
     for q in QUANTITIES:
@@ -379,31 +444,54 @@ def converged_reference(name: str, base: dict[str, Any], s_star: float, *,
             e_el = abs(corr / values[q])
         else:
             values[q] = fine
-            method[q] = "finest level (last steps not monotone)" if p is None else \
-                f"finest level (observed order {p:.1f} out of range)"
+            method[q] = (
+                "finest level (last steps not monotone)"
+                if p is None
+                else f"finest level (observed order {p:.1f} out of range)"
+            )
             e_el = abs(d2 / fine) if fine else float("nan")
         e_grid = abs(_rel(fine, half.values[q]))
         unc[q] = e_el + e_grid
     ref2 = ladder[1]  # ×2 elements at 2·ω_max, same Δω as `wide`
     return Reference(
-        values=values, uncertainty=unc, method=method, steps=tuple(steps),
-        omega_max=ladder[-1].omega_max, count=count,
+        values=values,
+        uncertainty=unc,
+        method=method,
+        steps=tuple(steps),
+        omega_max=ladder[-1].omega_max,
+        count=count,
         wmax_change={q: _rel(wide.values[q], ref2.values[q]) for q in QUANTITIES},
         count_change={q: _rel(ladder[-1].values[q], half.values[q]) for q in QUANTITIES},
     )
 
 
-def td_reference(name: str, base: dict[str, Any], s_star: float, *, seeds: int,
-                 duration: float, mesh_factor: float, count: int,
-                 progress: Progress = _silent) -> TDReference:
+def td_reference(
+    name: str,
+    base: dict[str, Any],
+    s_star: float,
+    *,
+    seeds: int,
+    duration: float,
+    mesh_factor: float,
+    count: int,
+    progress: Progress = _silent,
+) -> TDReference:
     """Nonlinear TD statistics over ``seeds`` seeds and the FD answer on the same mesh."""
-    from stochcable.reference.cable import NONSTATIONARY_RATIO, simulate_line_timedomain
-    from stochcable.errors import ConvergenceError
-    from stochcable.scene.model import load_scene
     from scipy import stats
 
-    s = Setting("td", "reference", elements=mesh_factor, omega_max_factor=2.0,
-                count=count, solver="direct", tolerance=REF_TOLERANCE)
+    from stochcable.errors import ConvergenceError
+    from stochcable.reference.cable import NONSTATIONARY_RATIO, simulate_line_timedomain
+    from stochcable.scene.model import load_scene
+
+    s = Setting(
+        "td",
+        "reference",
+        elements=mesh_factor,
+        omega_max_factor=2.0,
+        count=count,
+        solver="direct",
+        tolerance=REF_TOLERANCE,
+    )
     doc = scene_document(base, s)
     scene = load_scene(doc)
     om = doc["analysis"]["omega"]
@@ -427,12 +515,15 @@ def td_reference(name: str, base: dict[str, Any], s_star: float, *, seeds: int,
             ratio, t_jump, w_dom = h.stationarity_ratio()
             if ratio > NONSTATIONARY_RATIO:
                 dt0 = h.dt
-                h = simulate_line_timedomain(scene, duration=duration, seed=seed, band=band,
-                                             dt=dt0 / 4.0)
+                h = simulate_line_timedomain(
+                    scene, duration=duration, seed=seed, band=band, dt=dt0 / 4.0
+                )
                 ratio2 = h.stationarity_ratio()[0]
-                note = (f"seed {seed}: not stationary at Δt = {dt0:g} s (window σ ratio "
-                        f"{ratio:.3g} from t = {t_jump:.0f} s, oscillation at "
-                        f"{w_dom:.3g} rad/s, ωΔt = {w_dom * dt0:.2f})")
+                note = (
+                    f"seed {seed}: not stationary at Δt = {dt0:g} s (window σ ratio "
+                    f"{ratio:.3g} from t = {t_jump:.0f} s, oscillation at "
+                    f"{w_dom:.3g} rad/s, ωΔt = {w_dom * dt0:.2f})"
+                )
                 if ratio2 > NONSTATIONARY_RATIO:
                     failures.append(note + f", still at Δt = {h.dt:g} s (ratio {ratio2:.3g})")
                     progress(f"  TD seed {seed}: diverged, excluded")
@@ -460,18 +551,35 @@ def td_reference(name: str, base: dict[str, Any], s_star: float, *, seeds: int,
         else:
             hw[q] = float("nan")
     elements = sum(seg["elements"] for seg in doc["lines"][0]["segments"])
-    return TDReference(elements=elements, seeds=n, duration=duration,
-                       record=duration - ramp, dt=dt, band=band,
-                       per_seed={q: tuple(v) for q, v in per.items()}, mean=mean,
-                       halfwidth=hw, fd_same_mesh=fd_q,
-                       wall_s=statistics.median(walls) if walls else float("nan"),
-                       failures=tuple(failures), refined=tuple(refined))
+    return TDReference(
+        elements=elements,
+        seeds=n,
+        duration=duration,
+        record=duration - ramp,
+        dt=dt,
+        band=band,
+        per_seed={q: tuple(v) for q, v in per.items()},
+        mean=mean,
+        halfwidth=hw,
+        fd_same_mesh=fd_q,
+        wall_s=statistics.median(walls) if walls else float("nan"),
+        failures=tuple(failures),
+        refined=tuple(refined),
+    )
 
 
-def study_scene(name: str, *, quick: bool = False, td: bool = True, td_seeds: int = 8,
-                td_duration: float = 600.0, repeats: int | None = None,
-                budget_s: float | None = None, settings: Sequence[Setting] | None = None,
-                progress: Progress = _silent) -> SceneStudy:
+def study_scene(
+    name: str,
+    *,
+    quick: bool = False,
+    td: bool = True,
+    td_seeds: int = 8,
+    td_duration: float = 600.0,
+    repeats: int | None = None,
+    budget_s: float | None = None,
+    settings: Sequence[Setting] | None = None,
+    progress: Progress = _silent,
+) -> SceneStudy:
     """Sweep the settings of one example and measure time and errors.
 
     Parameters
@@ -508,11 +616,15 @@ def study_scene(name: str, *, quick: bool = False, td: bool = True, td_seeds: in
     s_star = float(next(iter(res0.lines.values())).s_nodes[-2])
     ref = converged_reference(name, base, s_star, quick=quick, progress=progress)
     a = base["analysis"]
-    default = {"elements": [seg["elements"] for seg in base["lines"][0]["segments"]],
-               "omega": a["omega"], "solver": a["solver"], "modes": a["modes"],
-               "tolerance": a["linearization"]["tolerance"]}
+    default = {
+        "elements": [seg["elements"] for seg in base["lines"][0]["segments"]],
+        "omega": a["omega"],
+        "solver": a["solver"],
+        "modes": a["modes"],
+        "tolerance": a["linearization"]["tolerance"],
+    }
     rows: list[Row] = []
-    for s in (settings if settings is not None else sweep_settings(base, quick)):
+    for s in settings if settings is not None else sweep_settings(base, quick):
         doc = scene_document(base, s)
         n_el = sum(seg["elements"] for seg in doc["lines"][0]["segments"])
         n_om = int(doc["analysis"]["omega"]["count"])
@@ -520,27 +632,59 @@ def study_scene(name: str, *, quick: bool = False, td: bool = True, td_seeds: in
         try:
             res, t, n = timed_analysis(doc, repeats, budget_s)
         except Exception as exc:  # a failing setting is a result, not a crash
-            rows.append(Row(s, n_el, n_om, w_max, None, 0, float("nan"), 0,
-                            {q: float("nan") for q in QUANTITIES},
-                            {q: float("nan") for q in QUANTITIES},
-                            failure=f"{type(exc).__name__}: {str(exc)[:160]}"))
+            rows.append(
+                Row(
+                    s,
+                    n_el,
+                    n_om,
+                    w_max,
+                    None,
+                    0,
+                    float("nan"),
+                    0,
+                    {q: float("nan") for q in QUANTITIES},
+                    {q: float("nan") for q in QUANTITIES},
+                    failure=f"{type(exc).__name__}: {str(exc)[:160]}",
+                )
+            )
             progress(f"  {s.label}: FAILED {exc}")
             continue
         line = next(iter(res.lines.values()))
         vals = quantities_fd(res, s_star)
-        rows.append(Row(s, n_el, n_om, w_max, line.n_modes, int(line.linearization.iterations),
-                        t, n, vals, {q: _rel(vals[q], ref.values[q]) for q in QUANTITIES}))
+        rows.append(
+            Row(
+                s,
+                n_el,
+                n_om,
+                w_max,
+                line.n_modes,
+                int(line.linearization.iterations),
+                t,
+                n,
+                vals,
+                {q: _rel(vals[q], ref.values[q]) for q in QUANTITIES},
+            )
+        )
         progress(f"  {s.label}: {1e3 * t:.1f} ms, err T_b {rows[-1].err_ref['T_fairlead']:+.2e}")
     tdr = None
     note = ""
     if td:
         progress(f"{name}: time-domain reference")
-        tdr = td_reference(name, base, s_star, seeds=td_seeds, duration=td_duration,
-                           mesh_factor=TD_MESH.get(name, 1.0), count=ref.count,
-                           progress=progress)
+        tdr = td_reference(
+            name,
+            base,
+            s_star,
+            seeds=td_seeds,
+            duration=td_duration,
+            mesh_factor=TD_MESH.get(name, 1.0),
+            count=ref.count,
+            progress=progress,
+        )
         if tdr.seeds:
-            rows = [replace(r, err_td={q: _rel(r.values[q], tdr.mean[q]) for q in QUANTITIES})
-                    for r in rows]
+            rows = [
+                replace(r, err_td={q: _rel(r.values[q], tdr.mean[q]) for q in QUANTITIES})
+                for r in rows
+            ]
     else:
         note = "time-domain reference not run for this scene"
     return SceneStudy(name, title, default, s_star, tuple(rows), ref, tdr, note)
@@ -555,9 +699,15 @@ class Study:
     load_after: tuple[float, float, float]
 
 
-def run_study(scenes: Sequence[str] = SCENES, *, quick: bool = False,
-              td_scenes: Sequence[str] | None = None, td_seeds: int | None = None,
-              td_duration: float | None = None, progress: Progress = _silent) -> Study:
+def run_study(
+    scenes: Sequence[str] = SCENES,
+    *,
+    quick: bool = False,
+    td_scenes: Sequence[str] | None = None,
+    td_seeds: int | None = None,
+    td_duration: float | None = None,
+    progress: Progress = _silent,
+) -> Study:
     """Run :func:`study_scene` for every scene (the TD reference for ``td_scenes``)."""
     if td_scenes is None:
         td_scenes = ("taut_wire", "chain_catenary") if quick else TD_DEFAULT_SCENES
@@ -565,8 +715,17 @@ def run_study(scenes: Sequence[str] = SCENES, *, quick: bool = False,
     td_duration = td_duration if td_duration is not None else (300.0 if quick else 600.0)
     load0 = os.getloadavg()
     t0 = time.perf_counter()
-    out = [study_scene(n, quick=quick, td=n in td_scenes, td_seeds=td_seeds,
-                       td_duration=td_duration, progress=progress) for n in scenes]
+    out = [
+        study_scene(
+            n,
+            quick=quick,
+            td=n in td_scenes,
+            td_seeds=td_seeds,
+            td_duration=td_duration,
+            progress=progress,
+        )
+        for n in scenes
+    ]
     return Study(tuple(out), quick, time.perf_counter() - t0, load0, os.getloadavg())
 
 
@@ -575,8 +734,11 @@ def run_study(scenes: Sequence[str] = SCENES, *, quick: bool = False,
 
 def pareto_front(times: Sequence[float], errors: Sequence[float]) -> list[int]:
     """Indices of the non-dominated points (less time and less error), by time."""
-    pts = [(t, e, i) for i, (t, e) in enumerate(zip(times, errors))
-           if np.isfinite(t) and np.isfinite(e)]
+    pts = [
+        (t, e, i)
+        for i, (t, e) in enumerate(zip(times, errors))
+        if np.isfinite(t) and np.isfinite(e)
+    ]
     pts.sort(key=lambda p: (p[0], p[1]))
     front, best = [], math.inf
     for t, e, i in pts:
@@ -610,27 +772,49 @@ def _plot_scene(sc: SceneStudy, path: Path) -> None:
                 if g == "default":
                     continue
                 idx = [i for i, r in enumerate(rows) if r.setting.group == g]
-                ax.scatter([t[i] for i in idx], [e[i] for i in idx], s=22, color=colors[g],
-                           label=g, zorder=3)
+                ax.scatter(
+                    [t[i] for i in idx],
+                    [e[i] for i in idx],
+                    s=22,
+                    color=colors[g],
+                    label=g,
+                    zorder=3,
+                )
             front = pareto_front(t, e)
             ft = [t[i] for i in front] + [max(t)]
             fe = [e[i] for i in front] + [e[front[-1]]]
-            ax.step(ft, fe, where="post", color="k",
-                    lw=1, alpha=0.7, label="Pareto front", zorder=2)
+            ax.step(
+                ft, fe, where="post", color="k", lw=1, alpha=0.7, label="Pareto front", zorder=2
+            )
             d = next(i for i, r in enumerate(rows) if r.setting.group == "default")
-            ax.scatter([t[d]], [e[d]], s=180, marker="*", color="red", edgecolor="k",
-                       label="default (example)", zorder=4)
+            ax.scatter(
+                [t[d]],
+                [e[d]],
+                s=180,
+                marker="*",
+                color="red",
+                edgecolor="k",
+                label="default (example)",
+                zorder=4,
+            )
             if kind == "ref":
                 u = sc.reference.uncertainty[q]
-                ax.axhline(max(u, _FLOOR), color="grey", ls="--", lw=1,
-                           label="reference uncertainty")
+                ax.axhline(
+                    max(u, _FLOOR), color="grey", ls="--", lw=1, label="reference uncertainty"
+                )
                 ax.set_title(f"{QUANTITY_TEXT[q]}\nvs converged FD reference", fontsize=9)
             else:
                 hw = sc.td.halfwidth[q] / sc.td.mean[q]
-                ax.axhline(hw, color="grey", ls=":", lw=1.5,
-                           label=f"TD {int(CI_LEVEL * 100)} % CI half-width")
-                ax.set_title(f"{QUANTITY_TEXT[q]}\nvs nonlinear TD ({sc.td.seeds} seeds)",
-                             fontsize=9)
+                ax.axhline(
+                    hw,
+                    color="grey",
+                    ls=":",
+                    lw=1.5,
+                    label=f"TD {int(CI_LEVEL * 100)} % CI half-width",
+                )
+                ax.set_title(
+                    f"{QUANTITY_TEXT[q]}\nvs nonlinear TD ({sc.td.seeds} seeds)", fontsize=9
+                )
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
@@ -664,9 +848,11 @@ def _pct(x: float) -> str:
     return f"{x:+.1e}"
 
 
-def cheapest(rows: Sequence[Row], quantities: Sequence[str], target: float,
-             kind: str = "ref") -> Row | None:
+def cheapest(
+    rows: Sequence[Row], quantities: Sequence[str], target: float, kind: str = "ref"
+) -> Row | None:
     """The fastest row whose |error| on every one of ``quantities`` is <= ``target``."""
+
     def ok_(r: Row) -> bool:
         err = r.err_ref if kind == "ref" else r.err_td
         return all(abs(err.get(q, math.nan)) <= target for q in quantities)
@@ -680,14 +866,16 @@ SCENE_NOTES = {
         "The fairlead tension σ is a fraction of a newton on a 1.3 MN mean: the linear "
         "model's dynamic tension is first order in the axial motion only, while the "
         "nonlinear TD also carries the second-order stretch due to the transverse motion; "
-        "this is the likely cause of FD/TD < 1 on the tension (not on the motion)."),
+        "this is the likely cause of FD/TD < 1 on the tension (not on the motion)."
+    ),
     "chain_catenary": (
         "The prescribed fairlead surge is a Pierson–Moskowitz spectrum with an ω⁻⁵ tail; "
         "the inertia tension it drives has a spectrum decaying only like ω⁻¹, so the "
         "tension σ keeps growing with ω_max (the ResolutionWarning of analyze() says so). "
         "A real vessel's motion is cut by its RAO; here the reference is defined for the "
         "band [ω_min, 2·ω_max] and the TD is driven by the same band. Seabed contact is "
-        "nodal, so the touchdown point jumps between nodes as the mesh changes."),
+        "nodal, so the touchdown point jumps between nodes as the mesh changes."
+    ),
     "inclined_guy": (
         "end_b is at the still-water level (z = 0). Wave kinematics are evaluated at the "
         "nodes and distributed over the elements, so the top element (14 m tall at 40 "
@@ -695,7 +883,8 @@ SCENE_NOTES = {
         "length 1/k (2.5 m at 2 rad/s). Checked while writing this script: the end_b "
         "tension variance above 2 rad/s falls from 2.2e4 to 2.5e3 to 77 N² at 40/80/160 "
         "elements and the 1–2 rad/s band changes by ×5. Elements in the splash zone should "
-        "be shorter than about g/ω_max²; the example's 40 elements are far too coarse."),
+        "be shorter than about g/ω_max²; the example's 40 elements are far too coarse."
+    ),
     "tuah_1982_single_leg": (
         "The buoy is not modelled (no bodies yet): end_b heaves with the sea surface (RAO "
         "1). The line goes nearly slack in the TD (minimum tension ≈ 0), which the linear "
@@ -709,59 +898,76 @@ SCENE_NOTES = {
         "1e4 lbf; such records are detected (window σ ratio above "
         "stochcable.reference.cable.NONSTATIONARY_RATIO) and rerun at Δt/4 (listed "
         "below). Averaging three such seeds in gave FD/TD = 0.103 in an earlier version "
-        "of this report."),
+        "of this report."
+    ),
 }
 
 
 def _reading(sc: SceneStudy) -> list[str]:
     rows = [r for r in sc.rows if r.failure is None]
     d = next(r for r in rows if r.setting.group == "default")
-    out = [f"- Default (the example's settings): {1e3 * d.time_s:.0f} ms; error vs the "
-           f"converged FD reference: fairlead {_pct(d.err_ref['T_fairlead'])}, anchor "
-           f"{_pct(d.err_ref['T_anchor'])}, motion {_pct(d.err_ref['motion'])}."]
-    for qs, what in ((("T_fairlead",), "fairlead tension σ"),
-                     (QUANTITIES, "all three quantities")):
+    out = [
+        f"- Default (the example's settings): {1e3 * d.time_s:.0f} ms; error vs the "
+        f"converged FD reference: fairlead {_pct(d.err_ref['T_fairlead'])}, anchor "
+        f"{_pct(d.err_ref['T_anchor'])}, motion {_pct(d.err_ref['motion'])}."
+    ]
+    for qs, what in ((("T_fairlead",), "fairlead tension σ"), (QUANTITIES, "all three quantities")):
         found: dict[float, Row | None] = {t: cheapest(rows, qs, t) for t in (0.01, 0.05)}
         for target in (0.01, 0.05):
             r = found[target]
             if target == 0.05 and r is found[0.01]:
                 continue  # the 1 % answer already holds for 5 %
             if r is None:
-                out.append(f"- {100 * target:g} % on {what}: no swept setting reaches it "
-                           "(only the reference ladder does, see below).")
+                out.append(
+                    f"- {100 * target:g} % on {what}: no swept setting reaches it "
+                    "(only the reference ladder does, see below)."
+                )
                 continue
             worst = max(abs(r.err_ref[q]) for q in QUANTITIES)
-            out.append(f"- To get {100 * target:g} % on {what} you need "
-                       f"**{r.setting.label}** ({r.elements} elements, {r.n_omega} ω to "
-                       f"{_g(r.omega_max)} rad/s); it costs {1e3 * r.time_s:.0f} ms "
-                       f"({r.time_s / d.time_s:.1f}× the default)"
-                       + (f"; worst error of the three quantities there {_pct(worst)}."
-                          if len(qs) == 1 else "."))
+            out.append(
+                f"- To get {100 * target:g} % on {what} you need "
+                f"**{r.setting.label}** ({r.elements} elements, {r.n_omega} ω to "
+                f"{_g(r.omega_max)} rad/s); it costs {1e3 * r.time_s:.0f} ms "
+                f"({r.time_s / d.time_s:.1f}× the default)"
+                + (
+                    f"; worst error of the three quantities there {_pct(worst)}."
+                    if len(qs) == 1
+                    else "."
+                )
+            )
     u = sc.reference.uncertainty["T_fairlead"]
     if u > 0.005:
-        out.append(f"- The reference itself is known to ±{_pct(u).lstrip('+')} on the fairlead "
-                   "tension σ only: smaller errors in the table are not resolved.")
+        out.append(
+            f"- The reference itself is known to ±{_pct(u).lstrip('+')} on the fairlead "
+            "tension σ only: smaller errors in the table are not resolved."
+        )
     el = [st for st in sc.reference.steps if st.used]
     for q in ("T_fairlead",):
         v = np.array([st.values[q] for st in el])
         dv = np.diff(v)
         if dv.size >= 2 and np.any(dv[:-1] * dv[1:] < 0):
-            out.append(f"- Element convergence of the {QUANTITY_TEXT[q]} is **not monotone** "
-                       "(successive refinements change sign: "
-                       + ", ".join(f"{st.elements} el {_g(st.values[q], 6)}" for st in el)
-                       + "); an error estimate from two meshes can be misleading here.")
+            out.append(
+                f"- Element convergence of the {QUANTITY_TEXT[q]} is **not monotone** "
+                "(successive refinements change sign: "
+                + ", ".join(f"{st.elements} el {_g(st.values[q], 6)}" for st in el)
+                + "); an error estimate from two meshes can be misleading here."
+            )
     wm = sc.reference.wmax_change["T_fairlead"]
     if abs(wm) > 0.01:
-        out.append(f"- Raising ω_max from 2× to 4× the example's still changes the "
-                   f"fairlead tension σ by {_pct(wm)}: the σ of this band-limited quantity "
-                   "depends on the band; the reference is defined for "
-                   f"[ω_min, {_g(sc.reference.omega_max)}] rad/s.")
+        out.append(
+            f"- Raising ω_max from 2× to 4× the example's still changes the "
+            f"fairlead tension σ by {_pct(wm)}: the σ of this band-limited quantity "
+            "depends on the band; the reference is defined for "
+            f"[ω_min, {_g(sc.reference.omega_max)}] rad/s."
+        )
     if sc.td is not None and sc.td.seeds:
         r_ = sc.td.fd_same_mesh["T_fairlead"] / sc.td.mean["T_fairlead"]
-        out.append(f"- Linearization: FD/TD for the fairlead tension σ = {r_:.3f} "
-                   f"({_ratio_ci(sc.td, 'T_fairlead')}); errors of a setting smaller than "
-                   "this are below what the linear method can promise against the "
-                   "nonlinear model.")
+        out.append(
+            f"- Linearization: FD/TD for the fairlead tension σ = {r_:.3f} "
+            f"({_ratio_ci(sc.td, 'T_fairlead')}); errors of a setting smaller than "
+            "this are below what the linear method can promise against the "
+            "nonlinear model."
+        )
     return out
 
 
@@ -776,23 +982,29 @@ def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
     """The report text (Markdown)."""
     import numpy as _np
     import scipy as _sp
+
     import stochcable
 
     L: list[str] = []
     L.append("# Speed versus accuracy of the frequency-domain analysis")
     L.append("")
-    L.append("Generated by `python benchmarks/speed_vs_error.py"
-             + (" --quick" if study.quick else "") + "` (issue 7, item 1). Do not edit by "
-             "hand: re-run the script.")
+    L.append(
+        "Generated by `python benchmarks/speed_vs_error.py"
+        + (" --quick" if study.quick else "")
+        + "` (issue 7, item 1). Do not edit by "
+        "hand: re-run the script."
+    )
     L.append("")
-    L.append(f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python "
-             f"{platform.python_version()}, numpy {_np.__version__}, scipy {_sp.__version__}, "
-             f"stochcable {getattr(stochcable, '__version__', '?')}. "
-             f"Load average (1, 5, 15 min) before the run "
-             f"{', '.join(f'{x:.2f}' for x in study.load_before)}, after "
-             f"{', '.join(f'{x:.2f}' for x in study.load_after)} (other helpers were "
-             f"working on the machine; times are medians and vary by ±30 % between runs). "
-             f"Whole run {study.wall_s:.0f} s.")
+    L.append(
+        f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python "
+        f"{platform.python_version()}, numpy {_np.__version__}, scipy {_sp.__version__}, "
+        f"stochcable {getattr(stochcable, '__version__', '?')}. "
+        f"Load average (1, 5, 15 min) before the run "
+        f"{', '.join(f'{x:.2f}' for x in study.load_before)}, after "
+        f"{', '.join(f'{x:.2f}' for x in study.load_after)} (other helpers were "
+        f"working on the machine; times are medians and vary by ±30 % between runs). "
+        f"Whole run {study.wall_s:.0f} s."
+    )
     L.append("")
     L.append("## What is measured and how")
     L.append("")
@@ -833,7 +1045,9 @@ def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
     L.append("")
     L.append("## Summary")
     L.append("")
-    L.append("| scene | default time | same with solver direct | default error (fairlead / anchor / motion) | cheapest ≤ 1 % fairlead | its time | FD/TD fairlead (95 % CI) |")
+    L.append(
+        "| scene | default time | same with solver direct | default error (fairlead / anchor / motion) | cheapest ≤ 1 % fairlead | its time | FD/TD fairlead (95 % CI) |"
+    )
     L.append("|---|---|---|---|---|---|---|")
     for sc in study.scenes:
         rows = [r for r in sc.rows if r.failure is None]
@@ -841,16 +1055,20 @@ def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
         c = cheapest(rows, ("T_fairlead",), 0.01)
         td = "not run"
         if sc.td is not None and sc.td.seeds:
-            td = (f"{sc.td.fd_same_mesh['T_fairlead'] / sc.td.mean['T_fairlead']:.3f} "
-                  f"({_ratio_ci(sc.td, 'T_fairlead')})")
+            td = (
+                f"{sc.td.fd_same_mesh['T_fairlead'] / sc.td.mean['T_fairlead']:.3f} "
+                f"({_ratio_ci(sc.td, 'T_fairlead')})"
+            )
         elif sc.td is not None:
             td = "TD failed"
         dr = next((r for r in rows if r.setting.label == "direct"), None)
-        L.append(f"| {sc.name} | {1e3 * d.time_s:.0f} ms | "
-                 f"{f'{1e3 * dr.time_s:.0f} ms' if dr else '—'} | {_pct(d.err_ref['T_fairlead'])} / "
-                 f"{_pct(d.err_ref['T_anchor'])} / {_pct(d.err_ref['motion'])} | "
-                 f"{c.setting.label if c else 'none swept'} | "
-                 f"{f'{1e3 * c.time_s:.0f} ms' if c else '—'} | {td} |")
+        L.append(
+            f"| {sc.name} | {1e3 * d.time_s:.0f} ms | "
+            f"{f'{1e3 * dr.time_s:.0f} ms' if dr else '—'} | {_pct(d.err_ref['T_fairlead'])} / "
+            f"{_pct(d.err_ref['T_anchor'])} / {_pct(d.err_ref['motion'])} | "
+            f"{c.setting.label if c else 'none swept'} | "
+            f"{f'{1e3 * c.time_s:.0f} ms' if c else '—'} | {td} |"
+        )
     L.append("")
     for sc in study.scenes:
         L += _scene_section(sc, plot_dir_rel)
@@ -861,11 +1079,13 @@ def _scene_section(sc: SceneStudy, plot_dir_rel: str) -> list[str]:
     ref = sc.reference
     om = sc.default["omega"]
     L = [f"## {sc.name}", "", f"*{sc.title}*", ""]
-    L.append(f"Example settings (the default): elements {sc.default['elements']}, "
-             f"{om['count']} ω on [{_g(om['min'])}, {_g(om['max'])}] rad/s ({om['spacing']}), "
-             f"solver {sc.default['solver']}, modes {sc.default['modes']}, tolerance "
-             f"{sc.default['tolerance']:g}. Motion point: s = {_g(sc.s_star, 6)} (unstretched "
-             "arc length from end_a, scene units).")
+    L.append(
+        f"Example settings (the default): elements {sc.default['elements']}, "
+        f"{om['count']} ω on [{_g(om['min'])}, {_g(om['max'])}] rad/s ({om['spacing']}), "
+        f"solver {sc.default['solver']}, modes {sc.default['modes']}, tolerance "
+        f"{sc.default['tolerance']:g}. Motion point: s = {_g(sc.s_star, 6)} (unstretched "
+        "arc length from end_a, scene units)."
+    )
     L.append("")
     L.append(f"![error versus time, {sc.name}]({plot_dir_rel}/{sc.name}.png)")
     L.append("")
@@ -880,37 +1100,49 @@ def _scene_section(sc: SceneStudy, plot_dir_rel: str) -> list[str]:
     L.append("| run | elements | ω count | ω_max | fairlead σ | anchor σ | motion σ | time |")
     L.append("|---|---|---|---|---|---|---|---|")
     for st in ref.steps:
-        L.append(f"| {st.label} | {st.elements} | {st.n_omega} | {_g(st.omega_max)} | "
-                 f"{_g(st.values['T_fairlead'], 7)} | {_g(st.values['T_anchor'], 7)} | "
-                 f"{_g(st.values['motion'], 7)} | {st.time_s:.2f} s |")
-    L.append(f"| **reference** | | {ref.count} | {_g(ref.omega_max)} | "
-             f"**{_g(ref.values['T_fairlead'], 7)}** | **{_g(ref.values['T_anchor'], 7)}** | "
-             f"**{_g(ref.values['motion'], 7)}** | |")
+        L.append(
+            f"| {st.label} | {st.elements} | {st.n_omega} | {_g(st.omega_max)} | "
+            f"{_g(st.values['T_fairlead'], 7)} | {_g(st.values['T_anchor'], 7)} | "
+            f"{_g(st.values['motion'], 7)} | {st.time_s:.2f} s |"
+        )
+    L.append(
+        f"| **reference** | | {ref.count} | {_g(ref.omega_max)} | "
+        f"**{_g(ref.values['T_fairlead'], 7)}** | **{_g(ref.values['T_anchor'], 7)}** | "
+        f"**{_g(ref.values['motion'], 7)}** | |"
+    )
     L.append("")
     L.append("| quantity | how | uncertainty | half count → count | 2·ω_max → 4·ω_max |")
     L.append("|---|---|---|---|---|")
     for q in QUANTITIES:
-        L.append(f"| {QUANTITY_TEXT[q]} | {ref.method[q]} | {_pct(ref.uncertainty[q])} | "
-                 f"{_pct(ref.count_change[q])} | {_pct(ref.wmax_change[q])} |")
+        L.append(
+            f"| {QUANTITY_TEXT[q]} | {ref.method[q]} | {_pct(ref.uncertainty[q])} | "
+            f"{_pct(ref.count_change[q])} | {_pct(ref.wmax_change[q])} |"
+        )
     L.append("")
     if sc.td is not None:
         td = sc.td
         L.append("### Nonlinear time-domain reference")
         L.append("")
         if td.seeds:
-            L.append(f"TD mesh {td.elements} elements, {td.seeds} seeds × {td.duration:g} s "
-                     f"(record {td.record:.0f} s after the ramp), Δt = {td.dt:.4g} s, band "
-                     f"[{_g(td.band[0])}, {_g(td.band[1])}] rad/s, {td.wall_s:.1f} s wall "
-                     "per seed (median).")
+            L.append(
+                f"TD mesh {td.elements} elements, {td.seeds} seeds × {td.duration:g} s "
+                f"(record {td.record:.0f} s after the ramp), Δt = {td.dt:.4g} s, band "
+                f"[{_g(td.band[0])}, {_g(td.band[1])}] rad/s, {td.wall_s:.1f} s wall "
+                "per seed (median)."
+            )
             L.append("")
-            L.append("| quantity | σ_TD mean | 95 % CI | FD same mesh | FD/TD (95 % CI) | FD reference / TD |")
+            L.append(
+                "| quantity | σ_TD mean | 95 % CI | FD same mesh | FD/TD (95 % CI) | FD reference / TD |"
+            )
             L.append("|---|---|---|---|---|---|")
             for q in QUANTITIES:
                 m, hw = td.mean[q], td.halfwidth[q]
-                L.append(f"| {QUANTITY_TEXT[q]} | {_g(m, 5)} | {_g(m - hw, 5)} – {_g(m + hw, 5)} "
-                         f"(±{_g(100 * hw / m, 2)} %) | {_g(td.fd_same_mesh[q], 5)} | "
-                         f"{td.fd_same_mesh[q] / m:.3f} ({_ratio_ci(td, q)}) | "
-                         f"{ref.values[q] / m:.3f} |")
+                L.append(
+                    f"| {QUANTITY_TEXT[q]} | {_g(m, 5)} | {_g(m - hw, 5)} – {_g(m + hw, 5)} "
+                    f"(±{_g(100 * hw / m, 2)} %) | {_g(td.fd_same_mesh[q], 5)} | "
+                    f"{td.fd_same_mesh[q] / m:.3f} ({_ratio_ci(td, q)}) | "
+                    f"{ref.values[q] / m:.3f} |"
+                )
         else:
             L.append("The time-domain reference did not run: " + "; ".join(td.failures))
         if td.failures and td.seeds:
@@ -918,16 +1150,20 @@ def _scene_section(sc: SceneStudy, plot_dir_rel: str) -> list[str]:
             L.append("Failed seeds (excluded): " + "; ".join(td.failures))
         if td.refined:
             L.append("")
-            L.append("Diverged seeds rerun with a quarter of the step (the rerun is "
-                     "averaged in, not the diverged record): " + "; ".join(td.refined))
+            L.append(
+                "Diverged seeds rerun with a quarter of the step (the rerun is "
+                "averaged in, not the diverged record): " + "; ".join(td.refined)
+            )
         L.append("")
     elif sc.td_note:
         L += [f"*{sc.td_note}.*", ""]
     L.append("### All settings")
     L.append("")
     has_td = sc.td is not None and sc.td.seeds > 0
-    head = ("| setting | elements | ω count to ω_max | modes kept | it. | time ms (n) | fairlead σ | "
-            "err ref: fairlead | anchor | motion |")
+    head = (
+        "| setting | elements | ω count to ω_max | modes kept | it. | time ms (n) | fairlead σ | "
+        "err ref: fairlead | anchor | motion |"
+    )
     sep = "|---|---|---|---|---|---|---|---|---|---|"
     if has_td:
         head += " err TD: fairlead | anchor | motion |"
@@ -935,18 +1171,24 @@ def _scene_section(sc: SceneStudy, plot_dir_rel: str) -> list[str]:
     L += [head, sep]
     for r in sc.rows:
         if r.failure is not None:
-            L.append(f"| {r.setting.label} | {r.elements} | {r.n_omega} | failed: "
-                     f"{r.failure.replace('|', '/')} |")
+            L.append(
+                f"| {r.setting.label} | {r.elements} | {r.n_omega} | failed: "
+                f"{r.failure.replace('|', '/')} |"
+            )
             continue
         mk = "**" if r.setting.group == "default" else ""
-        line = (f"| {mk}{r.setting.label}{mk} | {r.elements} | {r.n_omega} to {_g(r.omega_max)} | "
-                f"{r.modes_kept if r.modes_kept is not None else 'direct'} | {r.iterations} | "
-                f"{1e3 * r.time_s:.1f} ({r.repeats}) | {_g(r.values['T_fairlead'], 6)} | "
-                f"{_pct(r.err_ref['T_fairlead'])} | {_pct(r.err_ref['T_anchor'])} | "
-                f"{_pct(r.err_ref['motion'])} |")
+        line = (
+            f"| {mk}{r.setting.label}{mk} | {r.elements} | {r.n_omega} to {_g(r.omega_max)} | "
+            f"{r.modes_kept if r.modes_kept is not None else 'direct'} | {r.iterations} | "
+            f"{1e3 * r.time_s:.1f} ({r.repeats}) | {_g(r.values['T_fairlead'], 6)} | "
+            f"{_pct(r.err_ref['T_fairlead'])} | {_pct(r.err_ref['T_anchor'])} | "
+            f"{_pct(r.err_ref['motion'])} |"
+        )
         if has_td:
-            line += (f" {_pct(r.err_td['T_fairlead'])} | {_pct(r.err_td['T_anchor'])} | "
-                     f"{_pct(r.err_td['motion'])} |")
+            line += (
+                f" {_pct(r.err_td['T_fairlead'])} | {_pct(r.err_td['T_anchor'])} | "
+                f"{_pct(r.err_td['motion'])} |"
+            )
         L.append(line)
     L.append("")
     return L
@@ -968,14 +1210,24 @@ def write_report(study: Study, out: Path) -> list[Path]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true",
-                    help="smaller sweep, cheaper references, TD on taut_wire and chain_catenary (~1 min)")
-    ap.add_argument("--out", type=Path,
-                    default=Path(__file__).resolve().parents[1] / "docs" / "ACCURACY.md",
-                    help="Markdown report path (plots go to <dir>/accuracy/)")
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="smaller sweep, cheaper references, TD on taut_wire and chain_catenary (~1 min)",
+    )
+    ap.add_argument(
+        "--out",
+        type=Path,
+        default=Path(__file__).resolve().parents[1] / "docs" / "ACCURACY.md",
+        help="Markdown report path (plots go to <dir>/accuracy/)",
+    )
     ap.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES))
-    ap.add_argument("--td-scenes", nargs="*", default=None,
-                    help="scenes with the time-domain reference (default: all; quick: taut_wire chain_catenary)")
+    ap.add_argument(
+        "--td-scenes",
+        nargs="*",
+        default=None,
+        help="scenes with the time-domain reference (default: all; quick: taut_wire chain_catenary)",
+    )
     ap.add_argument("--td-seeds", type=int, default=None)
     ap.add_argument("--td-duration", type=float, default=None)
     args = ap.parse_args(argv)
@@ -984,9 +1236,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stderr.write(msg + "\n")
         sys.stderr.flush()
 
-    study = run_study(args.scenes, quick=args.quick, td_scenes=args.td_scenes,
-                      td_seeds=args.td_seeds, td_duration=args.td_duration,
-                      progress=progress)
+    study = run_study(
+        args.scenes,
+        quick=args.quick,
+        td_scenes=args.td_scenes,
+        td_seeds=args.td_seeds,
+        td_duration=args.td_duration,
+        progress=progress,
+    )
     for p in write_report(study, args.out):
         progress(f"wrote {p}")
     progress(f"total {study.wall_s:.0f} s")

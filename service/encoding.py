@@ -78,8 +78,9 @@ def negotiate(request: Request) -> str:
         if media in _SUPPORTED and q > best_q:
             best, best_q = media, q
     if best is None:
-        raise HTTPException(406, f"cannot answer with {accept!r}; supported: "
-                                 f"{', '.join(_SUPPORTED)}")
+        raise HTTPException(
+            406, f"cannot answer with {accept!r}; supported: {', '.join(_SUPPORTED)}"
+        )
     return best
 
 
@@ -162,16 +163,19 @@ class _NpyResponse(Response):
         self.headers["content-length"] = str(len(head) + payload.nbytes)
 
     async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
-        await send({"type": "http.response.start", "status": self.status_code,
-                    "headers": self.raw_headers})
+        await send(
+            {"type": "http.response.start", "status": self.status_code, "headers": self.raw_headers}
+        )
         await send({"type": "http.response.body", "body": self._head, "more_body": True})
-        await send({"type": "http.response.body", "body": self._payload,
-                    "more_body": False})
+        await send({"type": "http.response.body", "body": self._payload, "more_body": False})
 
 
-def columns_response(columns: Mapping[str, np.ndarray], media_type: str,
-                     stats: Mapping[str, Any] | None = None,
-                     finite: tuple[str, ...] = ()) -> Response:
+def columns_response(
+    columns: Mapping[str, np.ndarray],
+    media_type: str,
+    stats: Mapping[str, Any] | None = None,
+    finite: tuple[str, ...] = (),
+) -> Response:
     """NPY (structured array) or CSV answer of equal-length float columns.
 
     ``finite`` names columns the caller has already found finite (their check is
@@ -195,8 +199,13 @@ def columns_response(columns: Mapping[str, np.ndarray], media_type: str,
                 rec[n] = a
         head = io.BytesIO()
         np.lib.format.write_array_header_1_0(
-            head, {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False,
-                   "shape": rec.shape})
+            head,
+            {
+                "descr": np.lib.format.dtype_to_descr(dtype),
+                "fortran_order": False,
+                "shape": rec.shape,
+            },
+        )
         return _NpyResponse(head.getvalue(), rec.data.cast("B"), headers)
     buf = io.StringIO()
     buf.write(",".join(names) + "\n")
@@ -207,14 +216,17 @@ def columns_response(columns: Mapping[str, np.ndarray], media_type: str,
 _ERRORS: dict[int, dict[str, Any]] = {
     404: {"model": ErrorResponse, "description": "Unknown resource"},
     406: {"model": ErrorResponse, "description": "Accept names no supported media type"},
-    413: {"model": ErrorResponse,
-          "description": "Request body over STOCHCABLE_MAX_BODY_BYTES"},
-    422: {"model": ErrorResponse,
-          "description": "Invalid input (field path, value, unit, constraint), a size bound "
-          "exceeded (type limit_exceeded, naming the STOCHCABLE_* setting) or a solver "
-          "failure"},
-    504: {"model": ErrorResponse,
-          "description": "Queueing plus computation over STOCHCABLE_MAX_RUN_SECONDS"},
+    413: {"model": ErrorResponse, "description": "Request body over STOCHCABLE_MAX_BODY_BYTES"},
+    422: {
+        "model": ErrorResponse,
+        "description": "Invalid input (field path, value, unit, constraint), a size bound "
+        "exceeded (type limit_exceeded, naming the STOCHCABLE_* setting) or a solver "
+        "failure",
+    },
+    504: {
+        "model": ErrorResponse,
+        "description": "Queueing plus computation over STOCHCABLE_MAX_RUN_SECONDS",
+    },
 }
 
 

@@ -116,8 +116,14 @@ def _json_safe(value: Any) -> bool:
     return False
 
 
-def error_response(status: int, loc: list[str | int], msg: str, type_: str,
-                   headers: dict[str, str] | None = None, **extra: Any) -> JSONResponse:
+def error_response(
+    status: int,
+    loc: list[str | int],
+    msg: str,
+    type_: str,
+    headers: dict[str, str] | None = None,
+    **extra: Any,
+) -> JSONResponse:
     """A ``{"detail": [item]}`` JSON answer with one error item."""
     item = {"loc": loc, "msg": msg, "type": type_}
     item.update({k: v for k, v in extra.items() if v is not None})
@@ -162,8 +168,11 @@ async def _validation_handler(request: Request, exc: RequestValidationError) -> 
     items = []
     for err in exc.errors():
         loc = list(err.get("loc", ()))
-        item: dict[str, Any] = {"loc": loc, "msg": str(err.get("msg", "invalid")),
-                                "type": str(err.get("type", "value_error"))}
+        item: dict[str, Any] = {
+            "loc": loc,
+            "msg": str(err.get("msg", "invalid")),
+            "type": str(err.get("type", "value_error")),
+        }
         if err.get("type") == "json_invalid":
             item["parameter"] = "body"  # loc[1] is the character offset
         elif loc and loc[0] == "body":
@@ -184,31 +193,53 @@ async def _validation_handler(request: Request, exc: RequestValidationError) -> 
 
 async def _input_error_handler(request: Request, exc: InputError) -> JSONResponse:
     value = exc.value if _json_safe(exc.value) else None
-    return error_response(422, ["body", *_loc_from_parameter(exc.parameter)], str(exc),
-                          "input_error", parameter=exc.parameter, unit=exc.unit or None,
-                          input=value)
+    return error_response(
+        422,
+        ["body", *_loc_from_parameter(exc.parameter)],
+        str(exc),
+        "input_error",
+        parameter=exc.parameter,
+        unit=exc.unit or None,
+        input=value,
+    )
 
 
 async def _limit_handler(request: Request, exc: LimitExceeded) -> JSONResponse:
     value = exc.value if _json_safe(exc.value) else None
-    return error_response(422, ["body", *_loc_from_parameter(exc.parameter)], str(exc),
-                          "limit_exceeded", parameter=exc.parameter, input=value,
-                          limit=exc.limit, setting=exc.env)
+    return error_response(
+        422,
+        ["body", *_loc_from_parameter(exc.parameter)],
+        str(exc),
+        "limit_exceeded",
+        parameter=exc.parameter,
+        input=value,
+        limit=exc.limit,
+        setting=exc.env,
+    )
 
 
 async def _convergence_handler(request: Request, exc: ConvergenceError) -> JSONResponse:
     residual = exc.residual if _json_safe(float(exc.residual)) else None
-    return error_response(422, ["body"], str(exc), "convergence_error", solver=exc.solver,
-                          iterations=exc.iterations, residual=residual,
-                          tolerance=exc.tolerance)
+    return error_response(
+        422,
+        ["body"],
+        str(exc),
+        "convergence_error",
+        solver=exc.solver,
+        iterations=exc.iterations,
+        residual=residual,
+        tolerance=exc.tolerance,
+    )
 
 
 async def _solver_handler(request: Request, exc: StochcableError) -> JSONResponse:
     return error_response(422, ["body"], str(exc), "solver_error")
 
 
-_NUMERICAL_HINT = ("an input is outside the range the model handles numerically (check "
-                   "magnitudes and units: periods, heights, frequencies, depth)")
+_NUMERICAL_HINT = (
+    "an input is outside the range the model handles numerically (check "
+    "magnitudes and units: periods, heights, frequencies, depth)"
+)
 
 
 async def _numerical_handler(request: Request, exc: Exception) -> JSONResponse:
@@ -216,21 +247,22 @@ async def _numerical_handler(request: Request, exc: Exception) -> JSONResponse:
 
 
 async def _body_too_large_handler(request: Request, exc: BodyTooLarge) -> JSONResponse:
-    return error_response(413, ["body"], str(exc), "body_too_large", limit=exc.limit,
-                          setting=exc.env)
+    return error_response(
+        413, ["body"], str(exc), "body_too_large", limit=exc.limit, setting=exc.env
+    )
 
 
 async def _run_time_handler(request: Request, exc: RunTimeExceeded) -> JSONResponse:
-    return error_response(504, [], str(exc), "run_time_exceeded", limit=exc.limit,
-                          setting=exc.env)
+    return error_response(504, [], str(exc), "run_time_exceeded", limit=exc.limit, setting=exc.env)
 
 
 async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONResponse:
     loc = getattr(exc, "loc", [])
     type_ = "not_found" if exc.status_code == 404 else "http_error"
     detail = exc.detail if isinstance(exc.detail, str) else json.dumps(exc.detail)
-    return error_response(exc.status_code, loc, detail, type_,
-                          headers=dict(exc.headers) if exc.headers else None)
+    return error_response(
+        exc.status_code, loc, detail, type_, headers=dict(exc.headers) if exc.headers else None
+    )
 
 
 def install_error_handlers(app: FastAPI) -> None:

@@ -63,11 +63,15 @@ def check_samples(duration: float, dt: float, n_points: int, settings: Settings)
     """Raise LimitExceeded when duration/dt (× points) exceeds ``max_samples``."""
     n = sample_count(duration, dt)
     if n > settings.max_samples:
-        raise LimitExceeded("duration", duration, settings.max_samples, "max_samples",
-                            f"duration/dt = {n} samples")
+        raise LimitExceeded(
+            "duration", duration, settings.max_samples, "max_samples", f"duration/dt = {n} samples"
+        )
     if n_points > 1 and n * n_points > settings.max_samples:
         raise LimitExceeded(
-            "points", n_points, settings.max_samples, "max_samples",
+            "points",
+            n_points,
+            settings.max_samples,
+            "max_samples",
             f"duration/dt × points = {n} × {n_points} = {n * n_points} kinematics samples",
         )
     return n
@@ -76,15 +80,19 @@ def check_samples(duration: float, dt: float, n_points: int, settings: Settings)
 def check_frequencies(count: int, settings: Settings, parameter: str = "omega.count") -> None:
     """Raise LimitExceeded when a frequency grid is larger than ``max_frequencies``."""
     if count > settings.max_frequencies:
-        raise LimitExceeded(parameter, count, settings.max_frequencies, "max_frequencies",
-                            f"{parameter} = {count} frequencies")
+        raise LimitExceeded(
+            parameter,
+            count,
+            settings.max_frequencies,
+            "max_frequencies",
+            f"{parameter} = {count} frequencies",
+        )
 
 
 def check_points(count: int, settings: Settings) -> None:
     """Raise LimitExceeded when more than ``max_points`` kinematics points are asked."""
     if count > settings.max_points:
-        raise LimitExceeded("points", count, settings.max_points, "max_points",
-                            f"{count} points")
+        raise LimitExceeded("points", count, settings.max_points, "max_points", f"{count} points")
 
 
 def check_elements(count: int, settings: Settings) -> None:
@@ -94,8 +102,9 @@ def check_elements(count: int, settings: Settings) -> None:
     scene.lines), settings)``.
     """
     if count > settings.max_elements:
-        raise LimitExceeded("lines", count, settings.max_elements, "max_elements",
-                            f"{count} finite elements")
+        raise LimitExceeded(
+            "lines", count, settings.max_elements, "max_elements", f"{count} finite elements"
+        )
 
 
 def check_scene(scene: Any, settings: Settings) -> None:
@@ -112,9 +121,13 @@ def check_scene(scene: Any, settings: Settings) -> None:
     if ts is not None:
         n = sample_count(ts.duration, ts.dt)
         if n > settings.max_samples:
-            raise LimitExceeded("analysis.timeseries.duration", ts.duration,
-                                settings.max_samples, "max_samples",
-                                f"analysis.timeseries duration/dt = {n} samples")
+            raise LimitExceeded(
+                "analysis.timeseries.duration",
+                ts.duration,
+                settings.max_samples,
+                "max_samples",
+                f"analysis.timeseries duration/dt = {n} samples",
+            )
 
 
 # ------------------------------------------------------------------ body size
@@ -144,8 +157,14 @@ class BodySizeLimitMiddleware:
                     size = None
                 if size is not None and size > self.max_bytes:
                     exc = BodyTooLarge(size, self.max_bytes)
-                    resp = error_response(413, ["body"], str(exc), "body_too_large",
-                                          limit=self.max_bytes, setting=exc.env)
+                    resp = error_response(
+                        413,
+                        ["body"],
+                        str(exc),
+                        "body_too_large",
+                        limit=self.max_bytes,
+                        setting=exc.env,
+                    )
                     await resp(scope, receive, send)
                     return
         received = 0
@@ -171,8 +190,9 @@ class BodySizeLimitMiddleware:
         except BodyTooLarge as exc:  # read outside FastAPI's handlers: answer here
             if started:
                 raise
-            resp = error_response(413, ["body"], str(exc), "body_too_large",
-                                  limit=exc.limit, setting=exc.env)
+            resp = error_response(
+                413, ["body"], str(exc), "body_too_large", limit=exc.limit, setting=exc.env
+            )
             await resp(scope, receive, send)
 
 
@@ -248,8 +268,13 @@ class Runner:
             self._gates[name] = anyio.Lock()
         return self._gates[name]
 
-    async def run(self, func: Callable[..., T], *args: Any, strict_fp: bool = True,
-                  exclusive: str | None = None) -> T:
+    async def run(
+        self,
+        func: Callable[..., T],
+        *args: Any,
+        strict_fp: bool = True,
+        exclusive: str | None = None,
+    ) -> T:
         """``func(*args)`` in a worker thread, bounded in concurrency and time.
 
         ``exclusive``: computations of the same name run one at a time (see the class).
@@ -268,8 +293,9 @@ class Runner:
             async with gate, limiter:
                 if time.monotonic() >= deadline:  # timed out while queued: skip
                     return None
-                return await anyio.to_thread.run_sync(_checked, strict_fp, func, *args,
-                                                      limiter=threads)
+                return await anyio.to_thread.run_sync(
+                    _checked, strict_fp, func, *args, limiter=threads
+                )
 
         task = asyncio.ensure_future(job())
         self._background.add(task)

@@ -38,10 +38,12 @@ def render(document: dict[str, Any]) -> str:
 def main(argv: list[str] | None = None) -> int:
     """Command-line entry point; returns the exit code."""
     parser = argparse.ArgumentParser(prog="python -m service.openapi", description=__doc__)
-    parser.add_argument("--output", type=Path, default=DEFAULT_PATH,
-                        help=f"file to write (default {DEFAULT_PATH})")
-    parser.add_argument("--check", action="store_true",
-                        help="compare instead of writing; exit 1 when they differ")
+    parser.add_argument(
+        "--output", type=Path, default=DEFAULT_PATH, help=f"file to write (default {DEFAULT_PATH})"
+    )
+    parser.add_argument(
+        "--check", action="store_true", help="compare instead of writing; exit 1 when they differ"
+    )
     args = parser.parse_args(argv)
     text = render(openapi_document())
     if args.check:

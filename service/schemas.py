@@ -73,14 +73,18 @@ class ErrorItem(BaseModel):
 
     model_config = ConfigDict(extra="allow")
 
-    loc: list[str | int] = Field(description="Where: 'body', 'path' or 'query', then the "
-                                             "field path")
+    loc: list[str | int] = Field(
+        description="Where: 'body', 'path' or 'query', then the field path"
+    )
     msg: str = Field(description="What is wrong and what the constraint is")
-    type: str = Field(description="Error kind: a pydantic error type, or input_error, "
-                                  "limit_exceeded, body_too_large, run_time_exceeded, "
-                                  "convergence_error, solver_error, not_found, http_error")
-    parameter: str | None = Field(default=None, description="Dotted field path (or core "
-                                                            "parameter name)")
+    type: str = Field(
+        description="Error kind: a pydantic error type, or input_error, "
+        "limit_exceeded, body_too_large, run_time_exceeded, "
+        "convergence_error, solver_error, not_found, http_error"
+    )
+    parameter: str | None = Field(
+        default=None, description="Dotted field path (or core parameter name)"
+    )
     unit: str | None = Field(default=None, description="Unit of the parameter")
 
 
@@ -108,8 +112,12 @@ class VersionResponse(_Response):
 
 # --------------------------------------------------------------------- spectra
 
-_G_FIELD = _f("Gravitational acceleration (used by the wind-speed Pierson-Moskowitz form)",
-              "m/s²", gt=0, default=G_STANDARD)
+_G_FIELD = _f(
+    "Gravitational acceleration (used by the wind-speed Pierson-Moskowitz form)",
+    "m/s²",
+    gt=0,
+    default=G_STANDARD,
+)
 
 
 class SpectrumRequest(_Request):
@@ -176,8 +184,7 @@ class SpectrumStats(_Response):
     hs: float = _f("Significant height 4·sqrt(m0)", "unit")
     tz: float | None = _f("Mean zero-upcrossing period 2π·sqrt(m0/m2)" + _INF_NOTE, "s")
     tm01: float | None = _f("Mean period 2π·m0/m1" + _INF_NOTE, "s")
-    tp: float | None = _f("Peak period 2π/ω at the largest density on the grid" + _INF_NOTE,
-                          "s")
+    tp: float | None = _f("Peak period 2π/ω at the largest density on the grid" + _INF_NOTE, "s")
     bandwidth: float = _f("Cartwright–Longuet-Higgins bandwidth sqrt(1 − m2²/(m0·m4))", "-")
 
 
@@ -207,14 +214,19 @@ class RealizationRequest(TimeSeriesSettings):
     spectrum: Spectrum = Field(description="Sea spectrum document")
     g: float = _f("Gravitational acceleration", "m/s²", gt=0, default=G_STANDARD)
     points: list[Point] | None = Field(
-        default=None, min_length=1,
+        default=None,
+        min_length=1,
         description="Points (x, y, z) where the wave velocity and acceleration are "
         "wanted; points above z = 0 get zero kinematics [m]",
     )
-    heading: float = _f("Direction the waves travel toward, from +x toward +y", "deg",
-                        ge=-360.0, le=360.0, default=0.0)
-    depth: float | None = _f("Water depth; null or absent for deep water", "m", gt=0,
-                             default=None)
+    heading: float = _f(
+        "Direction the waves travel toward, from +x toward +y",
+        "deg",
+        ge=-360.0,
+        le=360.0,
+        default=0.0,
+    )
+    depth: float | None = _f("Water depth; null or absent for deep water", "m", gt=0, default=None)
 
     def depth_or_inf(self) -> float:
         """Water depth, ``inf`` for deep water. [m]"""
@@ -225,17 +237,22 @@ class RealizationStats(_Response):
     """Statistics of the realization against the spectrum."""
 
     variance: float = _f("Variance of the simulated elevation (mean square about 0)", "m²")
-    m0: float = _f("Variance the simulation targets: the sum of S(ω_m)·Δω over the "
-                   "simulation frequencies (DSA reproduces it exactly)", "m²")
+    m0: float = _f(
+        "Variance the simulation targets: the sum of S(ω_m)·Δω over the "
+        "simulation frequencies (DSA reproduces it exactly)",
+        "m²",
+    )
 
 
 class Kinematics(_Response):
     """Wave particle velocity and acceleration time series at the requested points."""
 
     velocity: list[list[list[float]]] = _f(
-        "Velocity, indexed [point][component x, y, z][sample]", "m/s")
+        "Velocity, indexed [point][component x, y, z][sample]", "m/s"
+    )
     acceleration: list[list[list[float]]] = _f(
-        "Acceleration, indexed [point][component x, y, z][sample]", "m/s²")
+        "Acceleration, indexed [point][component x, y, z][sample]", "m/s²"
+    )
 
 
 class RealizationResponse(_Response):
@@ -272,26 +289,28 @@ class TensionStatistics(_Open):
     mean: float = _f("Static (mean) effective tension", "N")
     std: float = _f("Standard deviation σ = √m0 of the dynamic tension", "N")
     tz: float = _f("Mean zero-upcrossing period 2π√(m0/m2); 0 for a zero process", "s")
-    mpm_3h: float = _f("mean + Rayleigh most probable maximum of the dynamic part over "
-                       "three hours, σ√(2 ln(10800/Tz))", "N")
+    mpm_3h: float = _f(
+        "mean + Rayleigh most probable maximum of the dynamic part over "
+        "three hours, σ√(2 ln(10800/Tz))",
+        "N",
+    )
     significant: float | None = _f("Significant value 2σ", "N", default=None)
     m0: float | None = _f("Zeroth spectral moment", "N²", default=None)
     m1: float | None = _f("First spectral moment", "N²·rad/s", default=None)
     m2: float | None = _f("Second spectral moment", "N²·(rad/s)²", default=None)
     m4: float | None = _f("Fourth spectral moment", "N²·(rad/s)⁴", default=None)
     bandwidth: float | None = _f("Spectral bandwidth √(1 − m2²/(m0·m4))", "-", default=None)
-    mpm: float | None = _f("mean + most probable maximum over analysis.duration", "N",
-                           default=None)
-    expected_max: float | None = _f("mean + expected maximum over analysis.duration", "N",
-                                    default=None)
+    mpm: float | None = _f("mean + most probable maximum over analysis.duration", "N", default=None)
+    expected_max: float | None = _f(
+        "mean + expected maximum over analysis.duration", "N", default=None
+    )
 
 
 class EndResult(_Open):
     """Dynamic response at one end (support) of a line."""
 
     tension: TensionStatistics
-    force_std: list[float] | None = _f("σ of the x, y, z force on the support", "N",
-                                       default=None)
+    force_std: list[float] | None = _f("σ of the x, y, z force on the support", "N", default=None)
 
 
 class TensionAlongLine(_Open):
@@ -317,16 +336,16 @@ class LineLinearization(_Open):
     relative_change: float = _f("Final largest relative change of the σ", "-")
     method: str | None = Field(default=None, description="seed, vector or harmonic")
     tolerance: float | None = _f("Tolerance asked for", "-", default=None)
-    history: list[float] | None = _f("Relative change after each iteration", "-",
-                                     default=None)
+    history: list[float] | None = _f("Relative change after each iteration", "-", default=None)
 
 
 class LineModes(_Open):
     """Natural frequencies of one line about its static shape."""
 
     omega: list[float] = _f("Natural frequencies listed (with added mass)", "rad/s")
-    kept: int | None = _f("Modes kept by the Foss solve; null for the direct solve", "-",
-                          default=None)
+    kept: int | None = _f(
+        "Modes kept by the Foss solve; null for the direct solve", "-", default=None
+    )
 
 
 class LineDocument(_Open):
@@ -337,11 +356,13 @@ class LineDocument(_Open):
     tension: TensionAlongLine
     motion: MotionAlongLine
     spectra: dict[str, Any] | None = Field(
-        default=None, description="omega [rad/s] and the one-sided end-tension spectra "
-        "{end_a: {tension: [...]}, end_b: ...} [N²·s/rad]")
-    channels: list[str] | None = Field(default=None,
-                                       description="Independent input channels (sea, "
-                                       "end_b.surge, ...)")
+        default=None,
+        description="omega [rad/s] and the one-sided end-tension spectra "
+        "{end_a: {tension: [...]}, end_b: ...} [N²·s/rad]",
+    )
+    channels: list[str] | None = Field(
+        default=None, description="Independent input channels (sea, end_b.surge, ...)"
+    )
     linearization: LineLinearization | None = None
     modes: LineModes | None = None
 
@@ -350,8 +371,9 @@ class ModesSummary(_Open):
     """Natural frequencies: of the first line, and by line name."""
 
     omega: list[float] = _f("Natural frequencies of the first line", "rad/s")
-    lines: dict[str, list[float]] | None = _f("Natural frequencies by line name", "rad/s",
-                                              default=None)
+    lines: dict[str, list[float]] | None = _f(
+        "Natural frequencies by line name", "rad/s", default=None
+    )
 
 
 class LinearizationSummary(_Open):
@@ -379,15 +401,18 @@ class TimeSeriesDocument(_Open):
     samples: int = _f("Length of the whole realization", "-")
     window: int = _f("Samples in this document", "-")
     time: list[float] = _f("Sample times", "s")
-    elevation: list[float] | None = _f("Wave elevation at the origin; null without a sea",
-                                       "m")
-    end_motion: dict[str, list[float]] = _f("Prescribed end motions by channel "
-                                            "(line.end_b.surge, ...)", "m or rad")
+    elevation: list[float] | None = _f("Wave elevation at the origin; null without a sea", "m")
+    end_motion: dict[str, list[float]] = _f(
+        "Prescribed end motions by channel (line.end_b.surge, ...)", "m or rad"
+    )
     lines: dict[str, dict[str, dict[str, list[float]]]] = _f(
-        "Total end tensions {line: {end_a: {tension: [...]}, end_b: ...}}", "N")
+        "Total end tensions {line: {end_a: {tension: [...]}, end_b: ...}}", "N"
+    )
     bodies: dict[str, dict[str, dict[str, list[float]]]] | None = Field(
-        default=None, description="Body motions {body: {motion: {surge: [...], ...}}}, "
-        "static pose plus dynamic part, for scenes with bodies. [m, rad]")
+        default=None,
+        description="Body motions {body: {motion: {surge: [...], ...}}}, "
+        "static pose plus dynamic part, for scenes with bodies. [m, rad]",
+    )
 
 
 class AnalysisResponse(_Open):
@@ -399,15 +424,23 @@ class AnalysisResponse(_Open):
     linearization: LinearizationSummary
     lines: dict[str, LineDocument] = Field(description="Response by line name")
     timing: dict[str, float] = _f("Wall-clock time per stage (total_s, statics_s, ...)", "s")
-    warnings: list[str] = Field(description="Physics and resolution warnings of the "
-                                            "analysis (threshold and fix in each message)")
+    warnings: list[str] = Field(
+        description="Physics and resolution warnings of the "
+        "analysis (threshold and fix in each message)"
+    )
     timeseries: TimeSeriesDocument | None = Field(
-        default=None, description="Present when the scene has analysis.timeseries and the "
-        "timeseries query parameter is not none")
+        default=None,
+        description="Present when the scene has analysis.timeseries and the "
+        "timeseries query parameter is not none",
+    )
     units: dict[str, str] | None = Field(
-        default=None, description="Unit labels of the scene's consistent unit system, read "
+        default=None,
+        description="Unit labels of the scene's consistent unit system, read "
         "off environment.g (stochcable.scene.units): system (SI, foot-slug-second or "
-        "consistent), length, mass, force, time")
+        "consistent), length, mass, force, time",
+    )
     bodies: dict[str, dict[str, Any]] | None = Field(
-        default=None, description="Motion of each body (scenes with bodies): per DOF the "
-        "statistics, spectra and RAOs, plus the coupled modes (docs/BODIES.md)")
+        default=None,
+        description="Motion of each body (scenes with bodies): per DOF the "
+        "statistics, spectra and RAOs, plus the coupled modes (docs/BODIES.md)",
+    )

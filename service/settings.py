@@ -23,11 +23,13 @@ class Settings(BaseSettings):
     port: int = Field(default=8000, ge=0, le=65535, description="TCP port")
     workers: int = Field(default=1, ge=1, le=256, description="uvicorn worker processes")
     max_body_bytes: int = Field(
-        default=16 * 1024 * 1024, ge=1024,
+        default=16 * 1024 * 1024,
+        ge=1024,
         description="Largest request body accepted; larger answers 413 [bytes]",
     )
     max_samples: int = Field(
-        default=2**22, ge=16,
+        default=2**22,
+        ge=16,
         description="Largest time-series length duration/dt, times the number of "
         "kinematics points when points are given [-]",
     )
@@ -41,12 +43,15 @@ class Settings(BaseSettings):
         default=256, ge=1, description="Largest number of kinematics points of one request [-]"
     )
     max_run_seconds: float = Field(
-        default=60.0, gt=0,
+        default=60.0,
+        gt=0,
         description="Wall-clock bound of one computation, queueing included; over it the "
         "request answers 504 [s]",
     )
     max_concurrency: int = Field(
-        default=4, ge=1, le=1024,
+        default=4,
+        ge=1,
+        le=1024,
         description="Computations running at once per worker process; the rest queue [-]",
     )
 

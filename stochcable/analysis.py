@@ -45,13 +45,13 @@ import time
 from collections.abc import Mapping
 from typing import Any
 
-from stochcable.fidelity import apply_fidelity, choose_fidelity
 from stochcable.dynamics.engine import Engine, build_engine
 from stochcable.dynamics.system import Progress, noop_progress
 from stochcable.errors import PhysicsWarning, warn
-from stochcable.statics import StaticsResult
+from stochcable.fidelity import apply_fidelity, choose_fidelity
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, load_scene
+from stochcable.statics import StaticsResult
 
 __all__ = ["Engine", "analyze", "build_engine"]
 
@@ -117,8 +117,9 @@ def _plan_fidelity(scene: Scene, progress: Progress) -> tuple[Scene, Any]:
     progress("fidelity", {})
     target = scene.analysis.fidelity.target_error
     # the planner runs pilot analyses of the scene: without the request itself
-    base = scene.model_copy(update={
-        "analysis": scene.analysis.model_copy(update={"fidelity": None})})
+    base = scene.model_copy(
+        update={"analysis": scene.analysis.model_copy(update={"fidelity": None})}
+    )
     # exact_wave_integration stays False: its element rule alone can leave a short
     # line with a single element (no free node); the surface rule is conservative
     # with the exact loads (see the closing note of issue 7)
@@ -131,13 +132,14 @@ def _with_plan(result: Result, plan: Any, total_s: float) -> Result:
     warning of an unbounded response tail first."""
     messages = list(result.warnings)
     if not plan.tail_bounded:
-        text = ("adaptive fidelity could not bound the response tail above "
-                f"{plan.omega_max:.3g} rad/s: the target error is not guaranteed (an input "
-                "spectrum with a slowly decaying tail, e.g. an end-motion spectrum without "
-                "a vessel RAO, drives tension up to high frequency)")
+        text = (
+            "adaptive fidelity could not bound the response tail above "
+            f"{plan.omega_max:.3g} rad/s: the target error is not guaranteed (an input "
+            "spectrum with a slowly decaying tail, e.g. an end-motion spectrum without "
+            "a vessel RAO, drives tension up to high frequency)"
+        )
         warn(text, PhysicsWarning)
         messages.insert(0, text)
     timing = dict(result.timing)
     timing["total_s"] = total_s
-    return dataclasses.replace(result, warnings=tuple(messages), fidelity=plan,
-                               timing=timing)
+    return dataclasses.replace(result, warnings=tuple(messages), fidelity=plan, timing=timing)

@@ -71,8 +71,9 @@ class ServiceError(StochcableError):
         The error items of the answer (``loc``, ``msg``, ``type``, ``parameter``, ...).
     """
 
-    def __init__(self, status: int | None, message: str,
-                 detail: Sequence[Mapping[str, Any]] = ()) -> None:
+    def __init__(
+        self, status: int | None, message: str, detail: Sequence[Mapping[str, Any]] = ()
+    ) -> None:
         self.status = status
         self.message = message
         self.detail = [dict(d) for d in detail]
@@ -224,7 +225,7 @@ class LineDocument:
         return self.end_a.std
 
     @classmethod
-    def from_document(cls, name: str, doc: Mapping[str, Any]) -> "LineDocument":
+    def from_document(cls, name: str, doc: Mapping[str, Any]) -> LineDocument:
         """Build from the line's part of the result document."""
         tension, motion = doc["tension"], doc["motion"]
         spectra = doc.get("spectra") or {}
@@ -287,19 +288,25 @@ class TimeSeriesWindow:
     body_motion: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
 
     @classmethod
-    def from_document(cls, doc: Mapping[str, Any]) -> "TimeSeriesWindow":
+    def from_document(cls, doc: Mapping[str, Any]) -> TimeSeriesWindow:
         """Build from the ``timeseries`` part of the result document."""
         elev = doc.get("elevation")
         return cls(
             time=_array(doc["time"]),
             elevation=None if elev is None else _array(elev),
             end_motion={k: _array(v) for k, v in doc.get("end_motion", {}).items()},
-            end_tension={line: {end: _array(v["tension"]) for end, v in ends.items()}
-                         for line, ends in doc.get("lines", {}).items()},
-            method=str(doc["method"]), seed=int(doc["seed"]), dt=float(doc["dt"]),
+            end_tension={
+                line: {end: _array(v["tension"]) for end, v in ends.items()}
+                for line, ends in doc.get("lines", {}).items()
+            },
+            method=str(doc["method"]),
+            seed=int(doc["seed"]),
+            dt=float(doc["dt"]),
             samples=int(doc["samples"]),
-            body_motion={name: {dof: _array(v) for dof, v in b.get("motion", {}).items()}
-                         for name, b in (doc.get("bodies") or {}).items()},
+            body_motion={
+                name: {dof: _array(v) for dof, v in b.get("motion", {}).items()}
+                for name, b in (doc.get("bodies") or {}).items()
+            },
         )
 
 
@@ -347,8 +354,10 @@ class AnalysisDocument(Mapping[str, Any]):
         return len(self._doc)
 
     def __repr__(self) -> str:
-        return (f"AnalysisDocument(lines={list(self.lines)}, converged={self.converged}, "
-                f"warnings={len(self.warnings)})")
+        return (
+            f"AnalysisDocument(lines={list(self.lines)}, converged={self.converged}, "
+            f"warnings={len(self.warnings)})"
+        )
 
     @property
     def document(self) -> dict[str, Any]:
@@ -436,8 +445,11 @@ def _message(detail: Any, fallback: str) -> tuple[str, list[dict[str, Any]]]:
             msg = str(d.get("msg", ""))
             param = d.get("parameter")
             # InputError/limit messages already start with the parameter
-            if param and d.get("type") not in ("input_error", "limit_exceeded") \
-                    and not msg.startswith(str(param)):
+            if (
+                param
+                and d.get("type") not in ("input_error", "limit_exceeded")
+                and not msg.startswith(str(param))
+            ):
                 unit = f" [{d['unit']}]" if d.get("unit") else ""
                 msg = f"{param}{unit}: {msg}"
             parts.append(msg)
@@ -460,12 +472,21 @@ class Client:
         Custom transport (tests, proxies).
     """
 
-    def __init__(self, base_url: str = "http://127.0.0.1:8000", timeout: float = 60.0, *,
-                 headers: Mapping[str, str] | None = None,
-                 transport: httpx.BaseTransport | None = None) -> None:
+    def __init__(
+        self,
+        base_url: str = "http://127.0.0.1:8000",
+        timeout: float = 60.0,
+        *,
+        headers: Mapping[str, str] | None = None,
+        transport: httpx.BaseTransport | None = None,
+    ) -> None:
         self.base_url = base_url.rstrip("/")
-        self._http = httpx.Client(base_url=self.base_url, timeout=timeout,
-                                  headers=dict(headers or {}), transport=transport)
+        self._http = httpx.Client(
+            base_url=self.base_url,
+            timeout=timeout,
+            headers=dict(headers or {}),
+            transport=transport,
+        )
 
     # ---------------------------------------------------------------- plumbing
 
@@ -473,14 +494,15 @@ class Client:
         """Close the connection pool."""
         self._http.close()
 
-    def __enter__(self) -> "Client":
+    def __enter__(self) -> Client:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def _request(self, method: str, path: str, *, json_body: Any = None,
-                 accept: str = "application/json") -> httpx.Response:
+    def _request(
+        self, method: str, path: str, *, json_body: Any = None, accept: str = "application/json"
+    ) -> httpx.Response:
         headers = {"Accept": accept}
         if accept == _NPY:
             headers["Accept-Encoding"] = "identity"  # float noise does not compress
@@ -520,8 +542,12 @@ class Client:
         """``GET /version``: ``{"stochcable": ..., "api": "v1"}``."""
         return self._request("GET", "/version").json()
 
-    def spectrum(self, spectrum: Any, omega: OmegaGrid | Mapping[str, Any] | None = None,
-                 g: float = G_STANDARD) -> SpectrumResult:
+    def spectrum(
+        self,
+        spectrum: Any,
+        omega: OmegaGrid | Mapping[str, Any] | None = None,
+        g: float = G_STANDARD,
+    ) -> SpectrumResult:
         """``POST /v1/spectra``: sample a spectrum document and get its statistics.
 
         Parameters
@@ -538,15 +564,25 @@ class Client:
             body["omega"] = _document(omega)
         data = self._request("POST", "/v1/spectra", json_body=body).json()
         stats = {k: (math.inf if v is None else float(v)) for k, v in data["stats"].items()}
-        return SpectrumResult(np.asarray(data["omega"], dtype=float),
-                              np.asarray(data["density"], dtype=float),
-                              SpectrumStatistics(**stats))
+        return SpectrumResult(
+            np.asarray(data["omega"], dtype=float),
+            np.asarray(data["density"], dtype=float),
+            SpectrumStatistics(**stats),
+        )
 
-    def realization(self, spectrum: Any, duration: float = 600.0, dt: float = 0.25,
-                    method: str = "dsa", seed: int = 1, g: float = G_STANDARD,
-                    points: Sequence[Sequence[float]] | np.ndarray | None = None,
-                    heading: float = 0.0, depth: float | None = None,
-                    binary: bool = True) -> RealizationResult:
+    def realization(
+        self,
+        spectrum: Any,
+        duration: float = 600.0,
+        dt: float = 0.25,
+        method: str = "dsa",
+        seed: int = 1,
+        g: float = G_STANDARD,
+        points: Sequence[Sequence[float]] | np.ndarray | None = None,
+        heading: float = 0.0,
+        depth: float | None = None,
+        binary: bool = True,
+    ) -> RealizationResult:
         """``POST /v1/sea/realizations``: a DSA/NSA sea realization and its kinematics.
 
         Parameters
@@ -571,9 +607,16 @@ class Client:
         binary : bool, default True
             Transfer as NumPy .npy (fast, exact) instead of JSON.
         """
-        body: dict[str, Any] = {"spectrum": _document(spectrum), "duration": duration,
-                                "dt": dt, "method": method, "seed": seed, "g": g,
-                                "heading": heading, "depth": depth}
+        body: dict[str, Any] = {
+            "spectrum": _document(spectrum),
+            "duration": duration,
+            "dt": dt,
+            "method": method,
+            "seed": seed,
+            "g": g,
+            "heading": heading,
+            "depth": depth,
+        }
         if points is not None:
             body["points"] = np.asarray(points, dtype=float).reshape(-1, 3).tolist()
         accept = _NPY if binary else "application/json"
@@ -585,25 +628,28 @@ class Client:
             if points is not None:
                 n = len(body["points"])
                 vel = np.array([[rec[f"velocity_{p}_{a}"] for a in "xyz"] for p in range(n)])
-                acc = np.array([[rec[f"acceleration_{p}_{a}"] for a in "xyz"]
-                                for p in range(n)])
+                acc = np.array([[rec[f"acceleration_{p}_{a}"] for a in "xyz"] for p in range(n)])
             # the .npy answer has no time column: t_n = n·dt (RealizationResult.time)
             elevation = np.ascontiguousarray(rec["elevation"])  # a view for one column
-            return RealizationResult(elevation, float(dt), float(stats["variance"]),
-                                     float(stats["m0"]), vel, acc)
+            return RealizationResult(
+                elevation, float(dt), float(stats["variance"]), float(stats["m0"]), vel, acc
+            )
         data = resp.json()
         kin = data.get("kinematics")
         return RealizationResult(
-            np.asarray(data["elevation"], dtype=float), float(dt),
-            float(data["stats"]["variance"]), float(data["stats"]["m0"]),
+            np.asarray(data["elevation"], dtype=float),
+            float(dt),
+            float(data["stats"]["variance"]),
+            float(data["stats"]["m0"]),
             None if kin is None else np.asarray(kin["velocity"], dtype=float),
             None if kin is None else np.asarray(kin["acceleration"], dtype=float),
         )
 
     def examples(self) -> list[ExampleInfo]:
         """``GET /v1/examples``: names and titles of the example scenes."""
-        return [ExampleInfo(d["name"], d["title"])
-                for d in self._request("GET", "/v1/examples").json()]
+        return [
+            ExampleInfo(d["name"], d["title"]) for d in self._request("GET", "/v1/examples").json()
+        ]
 
     def example(self, name: str) -> Scene:
         """``GET /v1/examples/{name}``: the example scene, validated locally."""
@@ -612,8 +658,9 @@ class Client:
         data = self._request("GET", f"/v1/examples/{quote(name, safe='')}").json()
         return Scene.model_validate(data)
 
-    def analyze(self, scene: Scene | Mapping[str, Any],
-                timeseries: str = "window") -> AnalysisDocument:
+    def analyze(
+        self, scene: Scene | Mapping[str, Any], timeseries: str = "window"
+    ) -> AnalysisDocument:
         """``POST /v1/analyses``: run the analysis of a scene on the service.
 
         Parameters
@@ -643,8 +690,7 @@ class Client:
         if timeseries not in ("window", "full", "none"):
             from stochcable.errors import InputError
 
-            raise InputError("timeseries", timeseries, "-",
-                             "must be 'window', 'full' or 'none'")
+            raise InputError("timeseries", timeseries, "-", "must be 'window', 'full' or 'none'")
         body = scene.model_dump(mode="json") if isinstance(scene, Scene) else _document(scene)
         resp = self._request("POST", f"/v1/analyses?timeseries={timeseries}", json_body=body)
         return AnalysisDocument(resp.json())

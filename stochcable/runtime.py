@@ -96,14 +96,23 @@ from typing import Any, TypeVar
 
 from stochcable import errors as _errors
 
-__all__ = ["configure", "configured", "analysis_blas", "single_blas_thread", "line_map",
-           "thread_count", "SMALL_MODEL_DOF", "MALLOC_TOP_PAD"]
+__all__ = [
+    "configure",
+    "configured",
+    "analysis_blas",
+    "single_blas_thread",
+    "line_map",
+    "thread_count",
+    "SMALL_MODEL_DOF",
+    "MALLOC_TOP_PAD",
+]
 
 _settings = {"small_model_blas": False, "configured": False}
 
 
-def configure(*, small_model_blas: bool = True, allocator: bool = True,
-              omp_wait_policy: bool = True) -> None:
+def configure(
+    *, small_model_blas: bool = True, allocator: bool = True, omp_wait_policy: bool = True
+) -> None:
     """Apply the process-wide settings of the command line and the service.
 
     Parameters
@@ -152,8 +161,7 @@ def analysis_blas(small: bool) -> contextlib.AbstractContextManager[None]:
 SMALL_MODEL_DOF = 2000
 
 _blas_lock = threading.Lock()
-_blas_state: dict[str, Any] = {"depth": 0, "limiter": None, "controller": None,
-                               "modules": -1}
+_blas_state: dict[str, Any] = {"depth": 0, "limiter": None, "controller": None, "modules": -1}
 
 
 def _blas_controller() -> Any:
@@ -274,9 +282,11 @@ def _tune_allocator() -> None:
     _allocator_state["done"] = True
     import sys
 
-    if (not sys.platform.startswith("linux")
-            or os.environ.get("STOCHCABLE_MALLOC_TUNING", "1") == "0"
-            or "MALLOC_TOP_PAD_" in os.environ):
+    if (
+        not sys.platform.startswith("linux")
+        or os.environ.get("STOCHCABLE_MALLOC_TUNING", "1") == "0"
+        or "MALLOC_TOP_PAD_" in os.environ
+    ):
         return
     try:
         import ctypes
@@ -314,8 +324,9 @@ def _blas_single() -> bool:
     # any thread is inside)
     if _blas_state["depth"] > 0:
         return True
-    return any(os.environ.get(k, "").strip() == "1"
-               for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"))
+    return any(
+        os.environ.get(k, "").strip() == "1" for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")
+    )
 
 
 def _executor(n: int) -> ThreadPoolExecutor:
@@ -330,8 +341,13 @@ def _executor(n: int) -> ThreadPoolExecutor:
         return _pool
 
 
-def _drain(fn: Callable[[T], R], items: list[T], out: list[Any], state: dict[str, Any],
-           lock: threading.Lock) -> None:
+def _drain(
+    fn: Callable[[T], R],
+    items: list[T],
+    out: list[Any],
+    state: dict[str, Any],
+    lock: threading.Lock,
+) -> None:
     """Take the next unstarted item until none is left (the caller and the workers
     share the items dynamically); each result is (value, exception, warnings)."""
     was = getattr(_worker, "active", False)
@@ -389,4 +405,3 @@ def line_map(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
 def pool_active() -> bool:
     """True while this thread runs an item of a pooled map (for tests). [-]"""
     return bool(getattr(_worker, "active", False))
-

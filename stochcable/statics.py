@@ -38,15 +38,15 @@ class StaticsResult:
     def to_document(self) -> dict[str, Any]:
         """The ``statics`` part of the result document (DESIGN.md v1); ``"bodies"``
         only when the scene has bodies."""
-        doc: dict[str, Any] = {"lines": {name: ls.to_document()
-                                         for name, ls in self.lines.items()}}
+        doc: dict[str, Any] = {"lines": {name: ls.to_document() for name, ls in self.lines.items()}}
         if self.bodies:
             doc["bodies"] = {name: b.to_document() for name, b in self.bodies.items()}
         return doc
 
 
-def solve_statics(scene: Scene, method: Method = "auto", *, tolerance: float = 1e-10,
-                  max_iterations: int = 500) -> StaticsResult:
+def solve_statics(
+    scene: Scene, method: Method = "auto", *, tolerance: float = 1e-10, max_iterations: int = 500
+) -> StaticsResult:
     """Static equilibrium of every line of a scene.
 
     Parameters
@@ -76,22 +76,20 @@ def solve_statics(scene: Scene, method: Method = "auto", *, tolerance: float = 1
     ConvergenceError
         A line or the body poses did not converge.
     """
-    method, tolerance, max_iterations = check_statics_options(method, tolerance,
-                                                              max_iterations)
+    method, tolerance, max_iterations = check_statics_options(method, tolerance, max_iterations)
     env = scene.environment
     if scene.bodies:
         from stochcable.bodies.statics import solve_body_statics  # the heavier import
 
-        lines, bodies = solve_body_statics(scene, method, tolerance=tolerance,
-                                           max_iterations=max_iterations)
+        lines, bodies = solve_body_statics(
+            scene, method, tolerance=tolerance, max_iterations=max_iterations
+        )
         return StaticsResult(lines=lines, bodies=bodies)
     out = {}
     for line in scene.lines:
         mesh = mesh_line(line, env.rho, env.g)
         out[line.name] = line_statics(mesh, env, method, None, tolerance, max_iterations)
     return StaticsResult(lines=out)
-
-
 
 
 def scene_fe_models(
@@ -121,8 +119,9 @@ def scene_fe_models(
     dim = check_dim(dim)
     statics = solve_statics(sc)
     return {
-        line.name: build_fe_model(statics.lines[line.name], sc.environment, dim=dim,
-                                  mass_matrix=mass_matrix)
+        line.name: build_fe_model(
+            statics.lines[line.name], sc.environment, dim=dim, mass_matrix=mass_matrix
+        )
         for line in sc.lines
     }
 
@@ -155,5 +154,7 @@ def modes_of_scene(
     if count is not None:
         count = positive_int("count", count)
     models = scene_fe_models(scene, dim=dim)
-    return {name: natural_modes(model, count=count, added_mass=added_mass)
-            for name, model in models.items()}
+    return {
+        name: natural_modes(model, count=count, added_mass=added_mass)
+        for name, model in models.items()
+    }

@@ -119,7 +119,9 @@ def float_array(
     if increasing and arr.size > 1 and not (np.diff(arr) > 0).all():
         i = int(np.flatnonzero(np.diff(arr) <= 0)[0])
         raise InputError(
-            name, value, unit,
+            name,
+            value,
+            unit,
             f"must be strictly increasing (entry {i + 1} = {arr[i + 1]:g} follows {arr[i]:g})",
         )
     return arr

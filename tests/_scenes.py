@@ -14,11 +14,18 @@ def three_chain_legs(n_el: int, attach: str | None = None) -> list[dict]:
     for i in range(3):
         a = math.radians(120.0 * i)
         fair = [5.0 * math.cos(a), 5.0 * math.sin(a), -2.0]
-        lines.append({
-            "name": f"leg{i + 1}",
-            "end_a": {"position": [300.0 * math.cos(a), 300.0 * math.sin(a), -100.0]},
-            "end_b": ({"position": fair} if attach is None
-                      else {"attach": {"body": attach, "point": fair}}),
-            "segments": [{"length": 330.0, "ea": 5e8, "mass": 100.0, "diameter": 0.1,
-                          "elements": n_el}]})
+        lines.append(
+            {
+                "name": f"leg{i + 1}",
+                "end_a": {"position": [300.0 * math.cos(a), 300.0 * math.sin(a), -100.0]},
+                "end_b": (
+                    {"position": fair}
+                    if attach is None
+                    else {"attach": {"body": attach, "point": fair}}
+                ),
+                "segments": [
+                    {"length": 330.0, "ea": 5e8, "mass": 100.0, "diameter": 0.1, "elements": n_el}
+                ],
+            }
+        )
     return lines

@@ -28,16 +28,29 @@ def uniform_mesh(
     f = np.ones(n_el)
     z = np.zeros(n_el + 1)
     return LineMesh(
-        name=name, s0=s0, l0=l0, ea=ea * f, mass=mass * f, diameter=diameter * f,
-        cd_normal=1.2 * f, cd_axial=0.0 * f, ca_normal=ca_normal * f, weight=weight * f,
-        segment=np.zeros(n_el, dtype=int), node_mass=z.copy(), node_buoyancy=z.copy(),
-        node_added_mass=z.copy(), node_drag_area=z.copy(),
-        end_a=np.zeros(3), end_b=np.zeros(3),
+        name=name,
+        s0=s0,
+        l0=l0,
+        ea=ea * f,
+        mass=mass * f,
+        diameter=diameter * f,
+        cd_normal=1.2 * f,
+        cd_axial=0.0 * f,
+        ca_normal=ca_normal * f,
+        weight=weight * f,
+        segment=np.zeros(n_el, dtype=int),
+        node_mass=z.copy(),
+        node_buoyancy=z.copy(),
+        node_added_mass=z.copy(),
+        node_drag_area=z.copy(),
+        end_a=np.zeros(3),
+        end_b=np.zeros(3),
     )
 
 
-def taut_string(n_el: int, length: float, tension: float, mass: float, ea: float,
-                direction=(1.0, 0.0, 0.0)):
+def taut_string(
+    n_el: int, length: float, tension: float, mass: float, ea: float, direction=(1.0, 0.0, 0.0)
+):
     """Straight string along ``direction``; l0 = l so m is per current length."""
     d = np.asarray(direction, float) / np.linalg.norm(direction)
     s = np.linspace(0.0, length, n_el + 1)
@@ -57,8 +70,9 @@ def hanging_chain(n_el: int, length: float, mass: float, g: float, ea: float):
     return mesh, pos, mass * g * (length - mid)
 
 
-def shallow_parabola(n_el: int, span: float, sag_ratio: float, h: float, mass: float,
-                     g: float, ea: float):
+def shallow_parabola(
+    n_el: int, span: float, sag_ratio: float, h: float, mass: float, g: float, ea: float
+):
     """Horizontal cable of span ``span``, parabolic sag d = sag_ratio·span, in x–z.
 
     Nodes uniform in x; horizontal tension component H = h, element tension

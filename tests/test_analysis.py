@@ -12,16 +12,16 @@ import numpy as np
 import pytest
 
 from stochcable import analysis
-from stochcable.dynamics import system as dsystem
 from stochcable.dynamics import blocks as dblocks
-from stochcable.dynamics import line_loads as dloads
-from stochcable.dynamics import solve as dsolve
-from stochcable.dynamics import variance as dvariance
 from stochcable.dynamics import fixedpoint as dfixedpoint
 from stochcable.dynamics import indicators as dindicators
+from stochcable.dynamics import line_loads as dloads
 from stochcable.dynamics import outputs as doutputs
-from stochcable.errors import ConvergenceError, InputError, ResolutionWarning, SolverError
+from stochcable.dynamics import solve as dsolve
+from stochcable.dynamics import system as dsystem
+from stochcable.dynamics import variance as dvariance
 from stochcable.dynamics.loads import line_channels
+from stochcable.errors import ConvergenceError, InputError, ResolutionWarning, SolverError
 from stochcable.line.modes import natural_modes
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
@@ -35,8 +35,15 @@ PM_SEA = {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}
 PM_SURGE = {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}
 
 
-def chain_doc(*, grounded: bool = True, sea: bool = True, surge: bool = True,
-              heading: float = 0.0, elements: int = 30, omega_count: int = 80) -> dict:
+def chain_doc(
+    *,
+    grounded: bool = True,
+    sea: bool = True,
+    surge: bool = True,
+    heading: float = 0.0,
+    elements: int = 30,
+    omega_count: int = 80,
+) -> dict:
     """A studless-chain-like catenary in 100 m (grounded) or 300 m of water."""
     depth = 100.0 if grounded else 300.0
     anchor_z = -100.0 if grounded else -200.0
@@ -46,14 +53,25 @@ def chain_doc(*, grounded: bool = True, sea: bool = True, surge: bool = True,
         end_b["motion"] = {"surge": PM_SURGE}
     doc = {
         "environment": {"depth": depth, "seabed": {"stiffness": 3.0e5, "damping": 1.0e3}},
-        "lines": [{
-            "name": "chain",
-            "end_a": {"position": [-400.0, 0.0, anchor_z]},
-            "end_b": end_b,
-            "segments": [{"length": length, "ea": 5.0e8, "mass": 100.0, "diameter": 0.1,
-                          "cd_normal": 2.4, "cd_axial": 1.15, "ca_normal": 1.0,
-                          "elements": elements}],
-        }],
+        "lines": [
+            {
+                "name": "chain",
+                "end_a": {"position": [-400.0, 0.0, anchor_z]},
+                "end_b": end_b,
+                "segments": [
+                    {
+                        "length": length,
+                        "ea": 5.0e8,
+                        "mass": 100.0,
+                        "diameter": 0.1,
+                        "cd_normal": 2.4,
+                        "cd_axial": 1.15,
+                        "ca_normal": 1.0,
+                        "elements": elements,
+                    }
+                ],
+            }
+        ],
         "analysis": {"omega": {"min": 0.1, "max": 2.0, "count": omega_count}},
     }
     if sea:
@@ -65,15 +83,15 @@ def system_and_channels(doc: dict, *, dim: int | None = None, statics_method: st
     scene = load_scene(doc)
     st = solve_statics(scene, method=statics_method).lines[scene.lines[0].name]
     system = dsystem.build_line_system(scene, scene.lines[0], st, dim=dim)
-    chans = line_channels(scene, scene.lines[0], system.positions,
-                          scene.analysis.omega.values())
+    chans = line_channels(scene, scene.lines[0], system.positions, scene.analysis.omega.values())
     return scene, system, chans
 
 
 def with_all_modes(system: dsystem.LineSystem, solver: str) -> dsystem.LineSystem:
     n = int(system.model.free.size)
-    return dataclasses.replace(system, modes=natural_modes(system.model, n), n_modes=n,
-                               solver=solver)
+    return dataclasses.replace(
+        system, modes=natural_modes(system.model, n), n_modes=n, solver=solver
+    )
 
 
 # ----------------------------------------------------------------- direct vs Foss
@@ -153,14 +171,26 @@ STRING_EA, STRING_L0, STRING_SPAN, STRING_M = 1.0e7, 99.0, 100.0, 10.0
 def _taut_string_doc(n_el: int, analysis: dict) -> dict:
     return {
         "environment": {"depth": 200.0},
-        "lines": [{
-            "name": "string",
-            "end_a": {"position": [0.0, 0.0, -50.0]},
-            "end_b": {"position": [STRING_SPAN, 0.0, -50.0], "motion": {"heave": PM_SURGE}},
-            "segments": [{"length": STRING_L0, "ea": STRING_EA, "mass": STRING_M,
-                          "diameter": 0.05, "cd_normal": 0.0, "cd_axial": 0.0,
-                          "ca_normal": 0.0, "weight": 0.0, "elements": n_el}],
-        }],
+        "lines": [
+            {
+                "name": "string",
+                "end_a": {"position": [0.0, 0.0, -50.0]},
+                "end_b": {"position": [STRING_SPAN, 0.0, -50.0], "motion": {"heave": PM_SURGE}},
+                "segments": [
+                    {
+                        "length": STRING_L0,
+                        "ea": STRING_EA,
+                        "mass": STRING_M,
+                        "diameter": 0.05,
+                        "cd_normal": 0.0,
+                        "cd_axial": 0.0,
+                        "ca_normal": 0.0,
+                        "weight": 0.0,
+                        "elements": n_el,
+                    }
+                ],
+            }
+        ],
         "analysis": analysis,
     }
 
@@ -169,8 +199,9 @@ def test_taut_string_end_motion_matches_closed_form():
     """Weightless taut string, Cd = Ca = 0, heave of end_b: u(x) = sin kx / sin kL."""
     ea, l0, span, m = STRING_EA, STRING_L0, STRING_SPAN, STRING_M
     n_el = 200
-    doc = _taut_string_doc(n_el, {"omega": {"min": 0.5, "max": 2.5, "count": 9},
-                                  "solver": "direct"})
+    doc = _taut_string_doc(
+        n_el, {"omega": {"min": 0.5, "max": 2.5, "count": 9}, "solver": "direct"}
+    )
     scene, system, chans = system_and_channels(doc)
     tension = ea * (span / l0 - 1.0)
     np.testing.assert_allclose(system.model.tension, tension, rtol=1e-9)
@@ -208,8 +239,7 @@ def test_undamped_mode_on_coarse_grid_warns():
 
 def test_dsa_timeseries_variance_equals_spectrum_sum():
     doc = chain_doc(sea=True, surge=False, elements=12, omega_count=40)
-    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 400.0, "dt": 0.5,
-                                     "seed": 7}
+    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 400.0, "dt": 0.5, "seed": 7}
     res = analysis.analyze(doc)
     ts = res.timeseries
     scene = res.scene
@@ -217,8 +247,10 @@ def test_dsa_timeseries_variance_equals_spectrum_sum():
     s = np.zeros_like(ts.omega)
     s[1:-1] = scene.sea.spectrum.spectral_density(ts.omega[1:-1], scene.environment.g)
     assert ts.channels["chain"] == ("sea",)
-    for end, mean in (("end_a", res.statics.lines["chain"].tension_a),
-                      ("end_b", res.statics.lines["chain"].tension_b)):
+    for end, mean in (
+        ("end_a", res.statics.lines["chain"].tension_a),
+        ("end_b", res.statics.lines["chain"].tension_b),
+    ):
         x = ts.end_tension["chain"][end] - mean
         h = ts.end_tension_transfer["chain"][end][0]
         expected = float(np.sum(np.abs(h) ** 2 * s) * d_omega)
@@ -227,8 +259,18 @@ def test_dsa_timeseries_variance_equals_spectrum_sum():
         assert abs(np.mean(x)) < 1e-9 * math.sqrt(expected)
     # the elevation is the stand-alone realization with the same seed
     from stochcable.sea.realization import simulate_sea
-    eta = simulate_sea(lambda w: np.where(w > 0, scene.sea.spectrum.spectral_density(
-        np.where(w > 0, w, 1.0), scene.environment.g), 0.0), 400.0, 0.5, "dsa", rng=7)
+
+    eta = simulate_sea(
+        lambda w: np.where(
+            w > 0,
+            scene.sea.spectrum.spectral_density(np.where(w > 0, w, 1.0), scene.environment.g),
+            0.0,
+        ),
+        400.0,
+        0.5,
+        "dsa",
+        rng=7,
+    )
     np.testing.assert_allclose(ts.elevation, eta.elevation, rtol=0, atol=1e-12)
 
 
@@ -252,8 +294,7 @@ def test_planar_scene_in_3d_equals_2d_and_has_no_out_of_plane_motion():
     assert r3.end_b.std == pytest.approx(r2.end_b.std, rel=1e-8)
     # sway: zero up to round-off of the modal basis (which may mix degenerate in- and
     # out-of-plane modes)
-    assert np.max(np.abs(r3.motion_transfer[:, :, 1])) <= 1e-12 * np.max(
-        np.abs(r3.motion_transfer))
+    assert np.max(np.abs(r3.motion_transfer[:, :, 1])) <= 1e-12 * np.max(np.abs(r3.motion_transfer))
     assert np.all(r2.motion_std[:, 1] == 0.0)
 
 
@@ -269,8 +310,12 @@ def test_vector_form_equals_seed_form_for_in_plane_velocity():
     vec = analysis.analyze(doc_v)
     a, b = base.lines["chain"], vec.lines["chain"]
     # recorded b_normal of the vector form is trace/2 = (B11 + B11/2)/2 here
-    np.testing.assert_allclose(b.linearization.b_normal, 0.75 * a.linearization.b_normal,
-                               rtol=1e-7, atol=1e-9 * a.linearization.b_normal.max())
+    np.testing.assert_allclose(
+        b.linearization.b_normal,
+        0.75 * a.linearization.b_normal,
+        rtol=1e-7,
+        atol=1e-9 * a.linearization.b_normal.max(),
+    )
     np.testing.assert_allclose(b.tension_std, a.tension_std, rtol=1e-7)
 
 
@@ -280,8 +325,7 @@ def test_vector_form_equals_seed_form_for_in_plane_velocity():
 @pytest.fixture(scope="module")
 def chain_result():
     doc = chain_doc(elements=30, omega_count=80)
-    doc["analysis"]["timeseries"] = {"method": "nsa", "duration": 200.0, "dt": 0.5,
-                                     "seed": 3}
+    doc["analysis"]["timeseries"] = {"method": "nsa", "duration": 200.0, "dt": 0.5, "seed": 3}
     return analysis.analyze(doc)
 
 
@@ -300,7 +344,8 @@ def test_chain_runs_end_to_end_with_finite_statistics(chain_result):
         assert t["std"] > 0.0
         # mpm_3h = mean + sigma sqrt(2 ln(10800/Tz)) (DESIGN.md)
         assert t["mpm_3h"] == pytest.approx(
-            t["mean"] + t["std"] * math.sqrt(2 * math.log(10800.0 / t["tz"])), rel=1e-12)
+            t["mean"] + t["std"] * math.sqrt(2 * math.log(10800.0 / t["tz"])), rel=1e-12
+        )
         assert t["tz"] == pytest.approx(2 * math.pi * math.sqrt(t["m0"] / t["m2"]), rel=1e-12)
     n_el = res.lines["chain"].tension_std.size
     assert len(line["tension"]["s"]) == len(line["tension"]["std"]) == n_el
@@ -310,8 +355,7 @@ def test_chain_runs_end_to_end_with_finite_statistics(chain_result):
     # fairlead motion std is the prescribed surge: Hs/4 = 0.5 m on the analysis band
     lr = res.lines["chain"]
     band = lr.input_spectra[lr.channels.index("end_b.surge")]
-    assert lr.motion_std[-1, 0] == pytest.approx(
-        math.sqrt(np.trapezoid(band, lr.omega)), rel=1e-12)
+    assert lr.motion_std[-1, 0] == pytest.approx(math.sqrt(np.trapezoid(band, lr.omega)), rel=1e-12)
 
 
 def test_chain_fairlead_tension_sigma_plausible(chain_result):
@@ -323,10 +367,14 @@ def test_chain_fairlead_tension_sigma_plausible(chain_result):
     system = dsystem.build_line_system(scene, scene.lines[0], chain_result.statics.lines["chain"])
     w0 = np.array([1e-3])
     chans = line_channels(scene, scene.lines[0], system.positions, w0)
-    resp = dsolve.solve(system, chans, dvariance.drag_coefficients(
-        system, np.zeros(2 * system.model.n_elements), "seed"))
-    k_t = abs(resp.end_tension["end_b"][chans.index(
-        next(c for c in chans if c.name == "end_b.surge")), 0])
+    resp = dsolve.solve(
+        system,
+        chans,
+        dvariance.drag_coefficients(system, np.zeros(2 * system.model.n_elements), "seed"),
+    )
+    k_t = abs(
+        resp.end_tension["end_b"][chans.index(next(c for c in chans if c.name == "end_b.surge")), 0]
+    )
     sigma_x = lr.motion_std[-1, 0]
     ratio = lr.end_b.std / (k_t * sigma_x)
     assert 0.3 < ratio < 10.0, ratio
@@ -403,16 +451,21 @@ def test_end_reaction_tends_to_end_element_tension():
 def test_unconverged_linearization_raises():
     doc = chain_doc(elements=10, omega_count=20)
     doc["analysis"]["linearization"] = {"max_iterations": 1, "tolerance": 1e-8}
-    with pytest.raises(ConvergenceError,
-                       match=r"drag linearization of line 'chain' did not converge.*"
-                             r"after 1 iterations.*max_iterations"):
+    with pytest.raises(
+        ConvergenceError,
+        match=r"drag linearization of line 'chain' did not converge.*"
+        r"after 1 iterations.*max_iterations",
+    ):
         analysis.analyze(doc)
 
 
 def test_unconverged_linearization_flagged_when_allowed():
     doc = chain_doc(elements=10, omega_count=20)
-    doc["analysis"]["linearization"] = {"max_iterations": 1, "tolerance": 1e-8,
-                                        "allow_unconverged": True}
+    doc["analysis"]["linearization"] = {
+        "max_iterations": 1,
+        "tolerance": 1e-8,
+        "allow_unconverged": True,
+    }
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = analysis.analyze(doc)
@@ -434,9 +487,9 @@ def test_harmonic_form_with_current_is_rejected():
 
 def test_rao_without_sea_is_rejected():
     doc = chain_doc(sea=False, surge=False, elements=10, omega_count=20)
-    doc["lines"][0]["end_b"]["motion"] = {"rao": {"omega": [0.1, 2.0],
-                                                  "surge": {"re": [1.0, 1.0],
-                                                            "im": [0.0, 0.0]}}}
+    doc["lines"][0]["end_b"]["motion"] = {
+        "rao": {"omega": [0.1, 2.0], "surge": {"re": [1.0, 1.0], "im": [0.0, 0.0]}}
+    }
     with pytest.raises(InputError, match="needs a 'sea'"):
         analysis.analyze(doc)
 
@@ -448,8 +501,9 @@ def test_support_forces_balance_quasi_statically():
     scene, system, _ = system_and_channels(doc)
     chans = line_channels(scene, scene.lines[0], system.positions, np.array([1e-4, 2e-4]))
     damping = dvariance.drag_coefficients(system, np.zeros(2 * system.model.n_elements), "seed")
-    lin = dsystem.Linearization(damping=damping, record=None,
-                           response=dsolve.solve(system, chans, damping))
+    lin = dsystem.Linearization(
+        damping=damping, record=None, response=dsolve.solve(system, chans, damping)
+    )
     res = doutputs.line_result(system, chans, lin, scene.analysis)
     fa = res.end_force_transfer["end_a"][0, :, 0]
     fb = res.end_force_transfer["end_b"][0, :, 0]
@@ -465,8 +519,11 @@ def test_grid_cutting_the_response_warns():
     """Fairlead surge with a PM tail: the inertia-driven tension spectrum decays like
     ω⁻¹, so a grid ending at 2 rad/s cuts it; extending the grid raises σ."""
     doc = chain_doc(sea=False, elements=12, omega_count=60)
-    with pytest.warns(ResolutionWarning, match=r"end_b tension spectrum .* raise "
-                                               r"analysis.omega.max"):
+    with pytest.warns(
+        ResolutionWarning,
+        match=r"end_b tension spectrum .* raise "
+        r"analysis.omega.max",
+    ):
         short = analysis.analyze(doc)
     doc["analysis"]["omega"]["max"] = 6.0
     doc["analysis"]["omega"]["count"] = 180
@@ -484,14 +541,15 @@ def test_rao_end_motion_adds_coherently_to_the_wave_loads():
     w = chans[0].omega
     rao_re, rao_im = np.cos(w) * 0.8, -0.3 * w
     doc_r = copy.deepcopy(doc)
-    doc_r["lines"][0]["end_b"]["motion"] = {"rao": {"omega": w.tolist(),
-                                                    "surge": {"re": rao_re.tolist(),
-                                                              "im": rao_im.tolist()}}}
+    doc_r["lines"][0]["end_b"]["motion"] = {
+        "rao": {"omega": w.tolist(), "surge": {"re": rao_re.tolist(), "im": rao_im.tolist()}}
+    }
     scene_r = load_scene(doc_r)
     chans_r = line_channels(scene_r, scene_r.lines[0], system.positions, w)
     assert [c.name for c in chans_r] == ["sea"]
-    with_rao = dsolve.solve(dataclasses.replace(system, line=scene_r.lines[0]), chans_r,
-                        lin.damping).end_tension["end_b"][0]
+    with_rao = dsolve.solve(
+        dataclasses.replace(system, line=scene_r.lines[0]), chans_r, lin.damping
+    ).end_tension["end_b"][0]
     expected = base[0] + (rao_re + 1j * rao_im) * base[1]
     # linear superposition: round-off only
     np.testing.assert_allclose(with_rao, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
@@ -573,9 +631,14 @@ def test_rayleigh_damped_taut_string_first_mode_peak():
     ea, l0, span, m = STRING_EA, STRING_L0, STRING_SPAN, STRING_M
     n_el = 100
     alpha, beta = 0.01, 2.0e-4
-    doc = _taut_string_doc(n_el, {"omega": {"min": 0.5, "max": 2.5, "count": 9},
-                                  "solver": "direct",
-                                  "structural_damping": {"alpha": alpha, "beta": beta}})
+    doc = _taut_string_doc(
+        n_el,
+        {
+            "omega": {"min": 0.5, "max": 2.5, "count": 9},
+            "solver": "direct",
+            "structural_damping": {"alpha": alpha, "beta": beta},
+        },
+    )
     scene, system, _ = system_and_channels(doc)
     tension = ea * (span / l0 - 1.0)
     c = math.sqrt(tension / (m * l0 / span))
@@ -597,15 +660,20 @@ def test_rayleigh_damped_taut_string_first_mode_peak():
     # and without structural damping the same frequency is an undamped resonance
     undamped = dataclasses.replace(system, structural_damping=(0.0, 0.0))
     with pytest.raises(SolverError, match="singular|resonance"):
-        dsolve.solve(undamped, line_channels(scene, scene.lines[0], system.positions,
-                                         np.array([system.modes.omega[0]])), damping)
+        dsolve.solve(
+            undamped,
+            line_channels(
+                scene, scene.lines[0], system.positions, np.array([system.modes.omega[0]])
+            ),
+            damping,
+        )
 
 
 def test_damping_matrix_is_assembled_lazily_and_equals_drag_matrix():
-    from stochcable.dynamics.loads import drag_matrix
-
     import json
     from pathlib import Path
+
+    from stochcable.dynamics.loads import drag_matrix
 
     path = Path(dsystem.__file__).parents[1] / "examples" / "chain_catenary.json"
     scene = load_scene(json.loads(path.read_text()))
@@ -672,8 +740,11 @@ def test_free_load_equals_drag_load_plus_damping_of_end_motion(chain_parts):
     _, system, _, inp, damping = chain_parts
     prep = dblocks.line_prep(system)
     _, f0, q = dloads.base_motion(system, prep, inp)
-    ref = dloads._drag_load(system, inp, damping) + f0 + dblocks.block_matvec(
-        dloads.drag_blocks(system, damping), q)
+    ref = (
+        dloads._drag_load(system, inp, damping)
+        + f0
+        + dblocks.block_matvec(dloads.drag_blocks(system, damping), q)
+    )
     got = dloads.free_load(system, prep, inp, damping)
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-13 * np.abs(ref).max())
 
@@ -682,7 +753,9 @@ def test_rest_sigmas_equal_quasi_static_sigmas(chain_parts):
     """The start σ from the cached projections (Foss) are _sigmas of the quasi-static
     motion, to the bit."""
     _, system, _, inp, _ = chain_parts
-    ref = dvariance.sigmas_from_nodes(system, inp, dvariance.quasi_static_motion(system, inp), "seed")
+    ref = dvariance.sigmas_from_nodes(
+        system, inp, dvariance.quasi_static_motion(system, inp), "seed"
+    )
     np.testing.assert_array_equal(dvariance.rest_sigmas(system, inp, "seed"), ref)
 
 
@@ -706,9 +779,12 @@ def test_subset_caches_are_the_subset_computation(chain_parts):
             scale = float(np.abs(b).max(initial=0.0))
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-15 * scale)
 
-    for fn in (lambda i: dloads.base_motion(system, prep, i), lambda i: dloads.drag_inputs(system, prep, i),
-               lambda i: dvariance.end_motion_projections(system, i, "seed"),
-               lambda i: dvariance.fluid_terms(system, i, "seed")):
+    for fn in (
+        lambda i: dloads.base_motion(system, prep, i),
+        lambda i: dloads.drag_inputs(system, prep, i),
+        lambda i: dvariance.end_motion_projections(system, i, "seed"),
+        lambda i: dvariance.fluid_terms(system, i, "seed"),
+    ):
         for a, b in zip(fn(sliced), fn(fresh)):
             close(a, b)
 
@@ -730,17 +806,24 @@ def test_reactions_and_tension_transfer_equal_their_direct_formulas(chain_parts)
     def z(k, i):
         return prep.K[k][i][None] - w2 * prep.MT[k][i][None] + iw * c[k][i][None]
 
-    ra = (np.einsum("wpq,qwc->wpc", z(0, 0), u[0]) + np.einsum("wqp,qwc->wpc", z(1, 0), u[1])
-          - np.moveaxis(f_all[0], 1, 0))
-    rb = (np.einsum("wpq,qwc->wpc", z(0, -1), u[-1])
-          + np.einsum("wpq,qwc->wpc", z(1, -1), u[-2]) - np.moveaxis(f_all[-1], 1, 0))
+    ra = (
+        np.einsum("wpq,qwc->wpc", z(0, 0), u[0])
+        + np.einsum("wqp,qwc->wpc", z(1, 0), u[1])
+        - np.moveaxis(f_all[0], 1, 0)
+    )
+    rb = (
+        np.einsum("wpq,qwc->wpc", z(0, -1), u[-1])
+        + np.einsum("wpq,qwc->wpc", z(1, -1), u[-2])
+        - np.moveaxis(f_all[-1], 1, 0)
+    )
     ref = -np.concatenate([ra, rb], axis=1)
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
     resp = dsolve.line_response(system, inp, damping, (u, c))
     model = system.model
     uu = resp.displacement.reshape(w.size, model.n_nodes, model.dim, -1)
     ref_t = (model.mesh.ea / model.l0)[None, :, None] * np.einsum(
-        "wedc,ed->cew", uu[:, 1:] - uu[:, :-1], model.tangents)
+        "wedc,ed->cew", uu[:, 1:] - uu[:, :-1], model.tangents
+    )
     got_t = doutputs.element_tension_transfer(system, resp)
     np.testing.assert_allclose(got_t, ref_t, rtol=0, atol=1e-14 * np.abs(ref_t).max())
 
@@ -751,8 +834,9 @@ def test_attachment_drag_sigma_is_the_total_relative_velocity_sigma():
     channels), computed here from the response and the channels' nodal velocities
     (the σ used to flatten the components into the frequency axis and failed)."""
     doc = chain_doc(elements=12, omega_count=60)
-    doc["lines"][0]["attachments"] = [{"at": 300.0, "mass": 500.0, "buoyancy": 2.0e4,
-                                       "drag_area": 2.0, "added_mass": 300.0}]
+    doc["lines"][0]["attachments"] = [
+        {"at": 300.0, "mass": 500.0, "buoyancy": 2.0e4, "drag_area": 2.0, "added_mass": 300.0}
+    ]
     scene, system, chans = system_and_channels(doc)
     node = int(system.drag_nodes[0])
     lin = dfixedpoint.linearize(system, chans, scene.analysis)
@@ -777,8 +861,9 @@ def _scene_without_timeseries(name: str):
     from stochcable.examples import load_example
 
     scene = load_scene(load_example(name))
-    return scene.model_copy(update={"analysis": scene.analysis.model_copy(
-        update={"timeseries": None})})
+    return scene.model_copy(
+        update={"analysis": scene.analysis.model_copy(update={"timeseries": None})}
+    )
 
 
 def test_warnings_and_document_use_the_scene_units_in_feet(monkeypatch) -> None:
@@ -808,22 +893,23 @@ def test_warnings_and_document_use_the_scene_units_in_feet(monkeypatch) -> None:
 
 def test_result_document_names_si_units() -> None:
     doc = analysis.analyze(_scene_without_timeseries("taut_wire")).to_document()
-    assert doc["units"] == {"system": "SI", "length": "m", "mass": "kg", "force": "N",
-                            "time": "s"}
+    assert doc["units"] == {"system": "SI", "length": "m", "mass": "kg", "force": "N", "time": "s"}
 
 
 def test_pipeline_statistics_equal_the_validated_public_function() -> None:
     """The analysis' end statistics skip the second validation of its grid
     (results.stats_from_validated) and equal results.stats_from_spectrum to the bit; the
     public function still rejects a bad grid with its message."""
-    from stochcable.results.documents import stats_from_validated, stats_from_spectrum
+    from stochcable.results.documents import stats_from_spectrum, stats_from_validated
 
     rng = np.random.default_rng(5)
     w = np.linspace(0.05, 2.0, 120)
     dens = rng.uniform(0.0, 1.0, w.size) ** 2
     for duration in (10800.0, 3600.0):
-        assert (stats_from_validated(w, dens, 12.5, duration).as_dict()
-                == stats_from_spectrum(w, dens, 12.5, duration).as_dict())
+        assert (
+            stats_from_validated(w, dens, 12.5, duration).as_dict()
+            == stats_from_spectrum(w, dens, 12.5, duration).as_dict()
+        )
     with pytest.raises(InputError, match="omega"):
         stats_from_spectrum(w[::-1], dens, 0.0, 10800.0)
 

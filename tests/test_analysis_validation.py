@@ -41,14 +41,25 @@ def _conv_doc() -> dict:
     return {
         "environment": {"depth": 100.0, "seabed": {"stiffness": 3.0e5, "damping": 1.0e3}},
         "sea": {"spectrum": PM_SEA, "heading": 0.0},
-        "lines": [{
-            "name": "chain",
-            "end_a": {"position": [-400.0, 0.0, -100.0]},
-            "end_b": {"position": [0.0, 0.0, -10.0]},
-            "segments": [{"length": 450.0, "ea": 5.0e8, "mass": 100.0, "diameter": 0.1,
-                          "cd_normal": 2.4, "cd_axial": 1.15, "ca_normal": 1.0,
-                          "elements": 12}],
-        }],
+        "lines": [
+            {
+                "name": "chain",
+                "end_a": {"position": [-400.0, 0.0, -100.0]},
+                "end_b": {"position": [0.0, 0.0, -10.0]},
+                "segments": [
+                    {
+                        "length": 450.0,
+                        "ea": 5.0e8,
+                        "mass": 100.0,
+                        "diameter": 0.1,
+                        "cd_normal": 2.4,
+                        "cd_axial": 1.15,
+                        "ca_normal": 1.0,
+                        "elements": 12,
+                    }
+                ],
+            }
+        ],
         "analysis": {
             "omega": {"min": m1 * d_omega, "max": m2 * d_omega, "count": m2 - m1 + 1},
             "solver": "direct",
@@ -74,7 +85,7 @@ def _on_realization_grid(res, values: np.ndarray) -> np.ndarray:
     ts = res.timeseries
     m1, m2 = CONV_M
     full = np.zeros(ts.omega.size, dtype=complex)
-    full[m1:m2 + 1] = values
+    full[m1 : m2 + 1] = values
     return full
 
 
@@ -84,16 +95,17 @@ def test_grids_coincide_and_the_series_used_the_result_transfer(conv_result):
     line = res.lines["chain"]
     m1, m2 = CONV_M
     # the analysis grid is the realization grid up to the last bit of linspace
-    np.testing.assert_allclose(line.omega, ts.omega[m1:m2 + 1], rtol=1e-13)
+    np.testing.assert_allclose(line.omega, ts.omega[m1 : m2 + 1], rtol=1e-13)
     for end in ("end_a", "end_b"):
         h_ts = ts.end_tension_transfer["chain"][end][0]
         # zero outside the analysis band, as the response spectra are
-        assert np.all(h_ts[:m1] == 0.0) and np.all(h_ts[m2 + 1:] == 0.0)
+        assert np.all(h_ts[:m1] == 0.0) and np.all(h_ts[m2 + 1 :] == 0.0)
         ref = line.end_tension_transfer[end][0]
         # two separate solves of the same linear system at frequencies equal to ~1 ulp:
         # agreement to round-off amplified by the linear solves
-        np.testing.assert_allclose(h_ts[m1:m2 + 1], ref, rtol=1e-9,
-                                   atol=1e-12 * np.max(np.abs(ref)))
+        np.testing.assert_allclose(
+            h_ts[m1 : m2 + 1], ref, rtol=1e-9, atol=1e-12 * np.max(np.abs(ref))
+        )
 
 
 @pytest.mark.parametrize("end", ["end_a", "end_b"])
@@ -107,8 +119,11 @@ def test_tension_series_is_the_circular_convolution_of_eta(conv_result, end):
     assert n_t == round(CONV_T / CONV_DT)
     eta = ts.elevation
     h_t = np.fft.irfft(_on_realization_grid(res, line.end_tension_transfer[end][0]), n_t)
-    mean = res.statics.lines["chain"].tension_a if end == "end_a" else \
-        res.statics.lines["chain"].tension_b
+    mean = (
+        res.statics.lines["chain"].tension_a
+        if end == "end_a"
+        else res.statics.lines["chain"].tension_b
+    )
     y = ts.end_tension["chain"][end] - mean
     expected = _circular_convolution(h_t, eta)
     scale = float(np.max(np.abs(expected)))
@@ -172,18 +187,32 @@ def _irvine_doc(*, solver: str = "foss", modes="auto") -> dict:
     l0 = ls / (1.0 + IRVINE_H / IRVINE_EA_FE_CROSSOVER)  # parabolic arc length, unstretched
     return {
         "environment": {"depth": 1000.0},
-        "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 4.0, "tp": 10.0},
-                "heading": 0.0},
-        "lines": [{
-            "name": "c",
-            "end_a": {"position": [0.0, 0.0, -30.0]},
-            "end_b": {"position": [IRVINE_SPAN, 0.0, -30.0]},
-            "segments": [{"length": l0, "ea": IRVINE_EA_FE_CROSSOVER, "mass": 10.0,
-                          "diameter": 0.1, "cd_normal": 1.2, "cd_axial": 0.0,
-                          "ca_normal": 1.0, "weight": IRVINE_W, "elements": 30}],
-        }],
-        "analysis": {"omega": {"min": 0.2, "max": 2.0, "count": 60}, "solver": solver,
-                     "modes": modes},
+        "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 4.0, "tp": 10.0}, "heading": 0.0},
+        "lines": [
+            {
+                "name": "c",
+                "end_a": {"position": [0.0, 0.0, -30.0]},
+                "end_b": {"position": [IRVINE_SPAN, 0.0, -30.0]},
+                "segments": [
+                    {
+                        "length": l0,
+                        "ea": IRVINE_EA_FE_CROSSOVER,
+                        "mass": 10.0,
+                        "diameter": 0.1,
+                        "cd_normal": 1.2,
+                        "cd_axial": 0.0,
+                        "ca_normal": 1.0,
+                        "weight": IRVINE_W,
+                        "elements": 30,
+                    }
+                ],
+            }
+        ],
+        "analysis": {
+            "omega": {"min": 0.2, "max": 2.0, "count": 60},
+            "solver": solver,
+            "modes": modes,
+        },
     }
 
 
@@ -201,7 +230,9 @@ def test_irvine_crossover_is_the_scene(irvine_direct):
     line = res.lines["c"]
     st = res.statics.lines["c"]
     h = abs(float(st.force_a[0]))
-    lam2 = (IRVINE_W * IRVINE_SPAN / h) ** 2 * IRVINE_SPAN / (h * IRVINE_SPAN / IRVINE_EA_FE_CROSSOVER)
+    lam2 = (
+        (IRVINE_W * IRVINE_SPAN / h) ** 2 * IRVINE_SPAN / (h * IRVINE_SPAN / IRVINE_EA_FE_CROSSOVER)
+    )
     # Irvine's λ² (L_e ≈ L for 1 % sag) is 4π² up to the FE discretization (0.3 %)
     assert lam2 / (4.0 * math.pi**2) == pytest.approx(1.0, abs=6e-3)
     w1, w2 = line.modes_omega[:2]
@@ -233,8 +264,12 @@ def test_irvine_crossover_truncated_foss_converges(irvine_direct):
     for n in counts:
         line = analyze(_irvine_doc(solver="foss", modes=n)).lines["c"]
         assert line.n_modes == n
-        errors.append(max(_rel(line.end_tension_transfer[e], ref.end_tension_transfer[e])
-                          for e in ("end_a", "end_b")))
+        errors.append(
+            max(
+                _rel(line.end_tension_transfer[e], ref.end_tension_transfer[e])
+                for e in ("end_a", "end_b")
+            )
+        )
     # measured 0.148, 0.016, 8.6e-4, 4.6e-4, 1.5e-5: strictly monotone (each count is a
     # different converged drag fixed point, so "nearly" would be allowed; it is strict)
     assert all(a > b for a, b in zip(errors, errors[1:])), errors
@@ -251,18 +286,32 @@ WIRE_ALL_MODES = 3 * 19  # 3-D, 19 free nodes
 def _wire_doc(*, solver: str) -> dict:
     return {
         "environment": {"depth": 500.0},
-        "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 4.0, "tp": 10.0},
-                "heading": 30.0},
-        "lines": [{
-            "name": "w",
-            "end_a": {"position": [0.0, 0.0, -20.0]},
-            "end_b": {"position": [200.0, 0.0, -20.0]},
-            "segments": [{"length": 199.8, "ea": 1.0e8, "mass": 20.0, "diameter": 0.1,
-                          "cd_normal": 1.2, "cd_axial": 0.1, "ca_normal": 1.0,
-                          "weight": 0.0, "elements": 20}],
-        }],
-        "analysis": {"omega": {"min": 0.2, "max": 2.0, "count": 50}, "solver": solver,
-                     "modes": WIRE_ALL_MODES},
+        "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 4.0, "tp": 10.0}, "heading": 30.0},
+        "lines": [
+            {
+                "name": "w",
+                "end_a": {"position": [0.0, 0.0, -20.0]},
+                "end_b": {"position": [200.0, 0.0, -20.0]},
+                "segments": [
+                    {
+                        "length": 199.8,
+                        "ea": 1.0e8,
+                        "mass": 20.0,
+                        "diameter": 0.1,
+                        "cd_normal": 1.2,
+                        "cd_axial": 0.1,
+                        "ca_normal": 1.0,
+                        "weight": 0.0,
+                        "elements": 20,
+                    }
+                ],
+            }
+        ],
+        "analysis": {
+            "omega": {"min": 0.2, "max": 2.0, "count": 50},
+            "solver": solver,
+            "modes": WIRE_ALL_MODES,
+        },
     }
 
 
@@ -309,32 +358,56 @@ def test_taut_wire_3d_repeated_pairs_foss_equals_direct():
 STRING_EA, STRING_L0, STRING_SPAN, STRING_M, STRING_N = 1.0e7, 99.0, 100.0, 10.0, 60
 
 
-def _string_doc(*, solver: str, alpha: float = 0.0, beta: float = 0.0,
-                modes: int | str = "auto") -> dict:
+def _string_doc(
+    *, solver: str, alpha: float = 0.0, beta: float = 0.0, modes: int | str = "auto"
+) -> dict:
     tension = STRING_EA * (STRING_SPAN / STRING_L0 - 1.0)
     c = math.sqrt(tension / (STRING_M * STRING_L0 / STRING_SPAN))
     w1 = math.pi * c / STRING_SPAN
     return {
         "environment": {"depth": 200.0, "seabed": {"stiffness": 3.0e6, "damping": 0.0}},
-        "lines": [{
-            "name": "s",
-            "end_a": {"position": [0.0, 0.0, -50.0]},
-            "end_b": {"position": [STRING_SPAN, 0.0, -50.0],
-                      "motion": {"heave": {"type": "pierson_moskowitz", "hs": 2.0,
-                                           "tp": 2.0 * math.pi / (1.2 * w1)}}},
-            "segments": [{"length": STRING_L0, "ea": STRING_EA, "mass": STRING_M,
-                          "diameter": 0.05, "cd_normal": 0.0, "cd_axial": 0.0,
-                          "ca_normal": 0.0, "weight": 0.0, "elements": STRING_N}],
-        }],
+        "lines": [
+            {
+                "name": "s",
+                "end_a": {"position": [0.0, 0.0, -50.0]},
+                "end_b": {
+                    "position": [STRING_SPAN, 0.0, -50.0],
+                    "motion": {
+                        "heave": {
+                            "type": "pierson_moskowitz",
+                            "hs": 2.0,
+                            "tp": 2.0 * math.pi / (1.2 * w1),
+                        }
+                    },
+                },
+                "segments": [
+                    {
+                        "length": STRING_L0,
+                        "ea": STRING_EA,
+                        "mass": STRING_M,
+                        "diameter": 0.05,
+                        "cd_normal": 0.0,
+                        "cd_axial": 0.0,
+                        "ca_normal": 0.0,
+                        "weight": 0.0,
+                        "elements": STRING_N,
+                    }
+                ],
+            }
+        ],
         # grid 0.5 … 1.7 ω1 in steps of 0.3 ω1: between the resonances kL = π, 2π
-        "analysis": {"omega": {"min": 0.5 * w1, "max": 1.7 * w1, "count": 5},
-                     "solver": solver, "modes": modes,
-                     "structural_damping": {"alpha": alpha, "beta": beta}},
+        "analysis": {
+            "omega": {"min": 0.5 * w1, "max": 1.7 * w1, "count": 5},
+            "solver": solver,
+            "modes": modes,
+            "structural_damping": {"alpha": alpha, "beta": beta},
+        },
     }
 
 
-def _string_closed_forms(omega: np.ndarray, x: np.ndarray, alpha: float = 0.0,
-                         beta: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def _string_closed_forms(
+    omega: np.ndarray, x: np.ndarray, alpha: float = 0.0, beta: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
     """(continuum, discrete) heave transfer functions, shape (n_omega, n_nodes)."""
     tension = STRING_EA * (STRING_SPAN / STRING_L0 - 1.0)
     c2 = tension / (STRING_M * STRING_L0 / STRING_SPAN)
@@ -402,8 +475,10 @@ def test_cd_zero_rayleigh_damped_string_matches_closed_form(solver, modes):
     line = res.lines["s"]
     h_damped = line.motion_transfer[0, :, 2, :].T
     if np.array_equal(h_damped, plain.motion_transfer[0, :, 2, :].T):
-        pytest.skip("analysis.structural_damping has no effect on the response yet "
-                    "(detected: identical transfer functions with and without it)")
+        pytest.skip(
+            "analysis.structural_damping has no effect on the response yet "
+            "(detected: identical transfer functions with and without it)"
+        )
     x = line.positions[:, 0]
     continuum, discrete = _string_closed_forms(line.omega, x, alpha, beta)
     scale = np.max(np.abs(discrete))
@@ -428,18 +503,33 @@ def _harmonic_doc(method: str = "harmonic") -> dict:
     peak = m0 / HARM_HALF  # triangle of half-width HARM_HALF has area peak·HARM_HALF
     return {
         "environment": {"depth": 150.0},
-        "sea": {"spectrum": {"type": "table",
-                             "omega": [HARM_W0 - HARM_HALF, HARM_W0, HARM_W0 + HARM_HALF],
-                             "density": [0.0, peak, 0.0]},
-                "heading": 0.0},
-        "lines": [{
-            "name": "riser",
-            "end_a": {"position": [-60.0, 0.0, -150.0]},
-            "end_b": {"position": [0.0, 0.0, -5.0]},
-            "segments": [{"length": 170.0, "ea": 2.0e8, "mass": 60.0, "diameter": 0.2,
-                          "cd_normal": 1.2, "cd_axial": 0.05, "ca_normal": 1.0,
-                          "elements": 20}],
-        }],
+        "sea": {
+            "spectrum": {
+                "type": "table",
+                "omega": [HARM_W0 - HARM_HALF, HARM_W0, HARM_W0 + HARM_HALF],
+                "density": [0.0, peak, 0.0],
+            },
+            "heading": 0.0,
+        },
+        "lines": [
+            {
+                "name": "riser",
+                "end_a": {"position": [-60.0, 0.0, -150.0]},
+                "end_b": {"position": [0.0, 0.0, -5.0]},
+                "segments": [
+                    {
+                        "length": 170.0,
+                        "ea": 2.0e8,
+                        "mass": 60.0,
+                        "diameter": 0.2,
+                        "cd_normal": 1.2,
+                        "cd_axial": 0.05,
+                        "ca_normal": 1.0,
+                        "elements": 20,
+                    }
+                ],
+            }
+        ],
         "analysis": {
             # grid of 0.001 rad/s across the triangle (25 points on it)
             "omega": {"min": HARM_W0 - HARM_HALF, "max": HARM_W0 + HARM_HALF, "count": 25},
@@ -523,9 +613,9 @@ def test_harmonic_and_seed_differ_by_the_form_ratio(harmonic_result):
     record satisfies its own form (checked above for harmonic, here for seed)."""
     seed = analyze(_harmonic_doc("seed")).lines["riser"].linearization
     rho, cd, d = 1025.0, 1.2, 0.2
-    np.testing.assert_allclose(seed.b_normal,
-                               math.sqrt(8.0 / math.pi) * 0.5 * rho * cd * d * seed.sigma_normal,
-                               rtol=1e-7)
+    np.testing.assert_allclose(
+        seed.b_normal, math.sqrt(8.0 / math.pi) * 0.5 * rho * cd * d * seed.sigma_normal, rtol=1e-7
+    )
     harm = harmonic_result.lines["riser"].linearization
     ratio = harm.b_normal / harm.sigma_normal / (seed.b_normal / seed.sigma_normal)
     np.testing.assert_allclose(ratio, 4.0 / (3.0 * math.sqrt(math.pi)), rtol=1e-7)

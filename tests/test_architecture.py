@@ -37,16 +37,13 @@ FUNCTION_LIMIT = 150
 
 # Today's offenders (issue 13 in progress), path -> lines now.  Only remove entries; the
 # number is the most the module may have until it is split.
-LONG_MODULES: dict[str, int] = {
-}
+LONG_MODULES: dict[str, int] = {}
 
 # path::qualified name -> lines of code now.  Only remove entries.
-LONG_FUNCTIONS: dict[str, int] = {
-}
+LONG_FUNCTIONS: dict[str, int] = {}
 
 # (importer, module, private name) -> what should replace it.  Only remove entries.
-PRIVATE_IMPORTS: dict[tuple[str, str, str], str] = {
-}
+PRIVATE_IMPORTS: dict[tuple[str, str, str], str] = {}
 
 
 # ---------------------------------------------------------------------------- source
@@ -142,18 +139,29 @@ def _private_import_violations() -> list[tuple[tuple[str, str, str], str]]:
                 if _private(part):
                     parent = ".".join(parts[:i])
                     if not (m.name == parent or m.name.startswith(parent + ".")):
-                        found.append(((m.rel, ".".join(parts[: i + 1]), part),
-                                      f"{m.rel}:{imp.line}: imports the private module "
-                                      f"{'.'.join(parts[: i + 1])} from outside {parent}"))
+                        found.append(
+                            (
+                                (m.rel, ".".join(parts[: i + 1]), part),
+                                f"{m.rel}:{imp.line}: imports the private module "
+                                f"{'.'.join(parts[: i + 1])} from outside {parent}",
+                            )
+                        )
                     break
             else:
                 # a private name from a module of another unit
-                if (imp.name is not None and _private(imp.name)
-                        and _unit(imp.module) != _unit(m.name)):
-                    found.append(((m.rel, imp.module, imp.name),
-                                  f"{m.rel}:{imp.line}: imports the private name "
-                                  f"{imp.name} from {imp.module} (another unit than "
-                                  f"{_unit(m.name)})"))
+                if (
+                    imp.name is not None
+                    and _private(imp.name)
+                    and _unit(imp.module) != _unit(m.name)
+                ):
+                    found.append(
+                        (
+                            (m.rel, imp.module, imp.name),
+                            f"{m.rel}:{imp.line}: imports the private name "
+                            f"{imp.name} from {imp.module} (another unit than "
+                            f"{_unit(m.name)})",
+                        )
+                    )
     return found
 
 
@@ -183,16 +191,24 @@ def _private_attribute_violations() -> list[tuple[tuple[str, str, str], str]]:
             target = attr = None
             if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name):
                 target, attr = node.value.id, node.attr
-            elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
-                  and node.func.id in ("getattr", "setattr", "hasattr") and len(node.args) >= 2
-                  and isinstance(node.args[0], ast.Name)
-                  and isinstance(node.args[1], ast.Constant)
-                  and isinstance(node.args[1].value, str)):
+            elif (
+                isinstance(node, ast.Call)
+                and isinstance(node.func, ast.Name)
+                and node.func.id in ("getattr", "setattr", "hasattr")
+                and len(node.args) >= 2
+                and isinstance(node.args[0], ast.Name)
+                and isinstance(node.args[1], ast.Constant)
+                and isinstance(node.args[1].value, str)
+            ):
                 target, attr = node.args[0].id, node.args[1].value
             if target in aliases and _private(attr) and _unit(aliases[target]) != _unit(m.name):
-                found.append(((m.rel, aliases[target], attr),
-                              f"{m.rel}:{node.lineno}: uses the private name {attr} of "
-                              f"{aliases[target]} (another unit than {_unit(m.name)})"))
+                found.append(
+                    (
+                        (m.rel, aliases[target], attr),
+                        f"{m.rel}:{node.lineno}: uses the private name {attr} of "
+                        f"{aliases[target]} (another unit than {_unit(m.name)})",
+                    )
+                )
     return found
 
 
@@ -202,10 +218,13 @@ def test_no_private_names_imported_across_subpackages():
     assert not new, (
         "private names reached across subpackages: make the name public (documented) in "
         "the module that owns it, or move the code to the subpackage that uses it:\n  "
-        + "\n  ".join(new))
+        + "\n  ".join(new)
+    )
     stale = sorted(set(PRIVATE_IMPORTS) - {key for key, _ in found})
-    assert not stale, ("remove these entries from PRIVATE_IMPORTS in "
-                       f"tests/test_architecture.py (no longer imported): {stale}")
+    assert not stale, (
+        "remove these entries from PRIVATE_IMPORTS in "
+        f"tests/test_architecture.py (no longer imported): {stale}"
+    )
 
 
 # -------------------------------------------------------------------- (b) module size
@@ -221,15 +240,19 @@ def test_modules_are_at_most_the_line_limit():
     for rel, n in sorted(sizes.items()):
         allowed = LONG_MODULES.get(rel, MODULE_LIMIT)
         if n > allowed:
-            how = ("split it" if rel not in LONG_MODULES
-                   else f"it is on the allow-list at {allowed} lines and may not grow")
+            how = (
+                "split it"
+                if rel not in LONG_MODULES
+                else f"it is on the allow-list at {allowed} lines and may not grow"
+            )
             problems.append(f"{rel}:1: {n} lines > {allowed} ({how})")
-    assert not problems, (f"modules over {MODULE_LIMIT} lines:\n  " + "\n  ".join(problems))
-    stale = sorted(rel for rel in LONG_MODULES
-                   if rel not in sizes or sizes[rel] <= MODULE_LIMIT)
-    assert not stale, ("remove these entries from LONG_MODULES in "
-                       f"tests/test_architecture.py (gone or within {MODULE_LIMIT} lines): "
-                       f"{stale}")
+    assert not problems, f"modules over {MODULE_LIMIT} lines:\n  " + "\n  ".join(problems)
+    stale = sorted(rel for rel in LONG_MODULES if rel not in sizes or sizes[rel] <= MODULE_LIMIT)
+    assert not stale, (
+        "remove these entries from LONG_MODULES in "
+        f"tests/test_architecture.py (gone or within {MODULE_LIMIT} lines): "
+        f"{stale}"
+    )
 
 
 # ------------------------------------------------------------------ (c) function size
@@ -250,8 +273,11 @@ def _code_lines(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
     """Lines from the def to the end, without the docstring."""
     span = node.end_lineno - node.lineno + 1
     first = node.body[0]
-    if (isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant)
-            and isinstance(first.value.value, str)):
+    if (
+        isinstance(first, ast.Expr)
+        and isinstance(first.value, ast.Constant)
+        and isinstance(first.value.value, str)
+    ):
         span -= first.end_lineno - first.lineno + 1
     return span
 
@@ -267,41 +293,53 @@ def test_functions_are_at_most_the_line_limit():
     for key, n in sorted(sizes.items()):
         allowed = LONG_FUNCTIONS.get(key, FUNCTION_LIMIT)
         if n > allowed:
-            how = ("split it into steps" if key not in LONG_FUNCTIONS
-                   else f"it is on the allow-list at {allowed} lines and may not grow")
-            problems.append(f"{where[key]}: {key.split('::')[1]} has {n} lines of code "
-                            f"> {allowed} ({how})")
-    assert not problems, (f"functions over {FUNCTION_LIMIT} lines of code:\n  "
-                          + "\n  ".join(problems))
+            how = (
+                "split it into steps"
+                if key not in LONG_FUNCTIONS
+                else f"it is on the allow-list at {allowed} lines and may not grow"
+            )
+            problems.append(
+                f"{where[key]}: {key.split('::')[1]} has {n} lines of code > {allowed} ({how})"
+            )
+    assert not problems, f"functions over {FUNCTION_LIMIT} lines of code:\n  " + "\n  ".join(
+        problems
+    )
     stale = sorted(k for k in LONG_FUNCTIONS if k not in sizes or sizes[k] <= FUNCTION_LIMIT)
-    assert not stale, ("remove these entries from LONG_FUNCTIONS in "
-                       f"tests/test_architecture.py (gone or within {FUNCTION_LIMIT} lines): "
-                       f"{stale}")
+    assert not stale, (
+        "remove these entries from LONG_FUNCTIONS in "
+        f"tests/test_architecture.py (gone or within {FUNCTION_LIMIT} lines): "
+        f"{stale}"
+    )
 
 
 # -------------------------------------------------------------- the checks themselves
 
 
-@pytest.mark.parametrize("source, importer, expected", [
-    ("from stochcable.dynamics.line import _x", "stochcable.results.documents", 1),
-    ("from stochcable.dynamics.line import _x", "stochcable.dynamics.coupled", 0),
-    ("def f():\n    from stochcable.errors import _local", "stochcable.runtime", 1),
-    ("from stochcable.errors import __version__", "stochcable.runtime", 0),
-    ("from stochcable.cli._output import write_json", "stochcable.cli.analyze", 0),
-    ("from stochcable.cli._output import write_json", "stochcable.client", 1),
-    ("from stochcable.cli import _output", "stochcable.client", 1),
-    ("from .._output import write_json", "stochcable.cli.sub.mod", 0),
-    ("from ..errors import _hidden", "service.routers.sea", 1),
-    ("from numpy import _private", "stochcable.sea.fft", 0),
-    ("from stochcable.dynamics import engine as a\na._state", "stochcable.runtime", 1),
-    ("from stochcable.dynamics import engine as a\ngetattr(a, '_state', 0)", "stochcable.runtime",
-     1),
-    ("import stochcable.dynamics.engine as a\na.public", "stochcable.runtime", 0),
-])
+@pytest.mark.parametrize(
+    "source, importer, expected",
+    [
+        ("from stochcable.dynamics.line import _x", "stochcable.results.documents", 1),
+        ("from stochcable.dynamics.line import _x", "stochcable.dynamics.coupled", 0),
+        ("def f():\n    from stochcable.errors import _local", "stochcable.runtime", 1),
+        ("from stochcable.errors import __version__", "stochcable.runtime", 0),
+        ("from stochcable.cli._output import write_json", "stochcable.cli.analyze", 0),
+        ("from stochcable.cli._output import write_json", "stochcable.client", 1),
+        ("from stochcable.cli import _output", "stochcable.client", 1),
+        ("from .._output import write_json", "stochcable.cli.sub.mod", 0),
+        ("from ..errors import _hidden", "service.routers.sea", 1),
+        ("from numpy import _private", "stochcable.sea.fft", 0),
+        ("from stochcable.dynamics import engine as a\na._state", "stochcable.runtime", 1),
+        (
+            "from stochcable.dynamics import engine as a\ngetattr(a, '_state', 0)",
+            "stochcable.runtime",
+            1,
+        ),
+        ("import stochcable.dynamics.engine as a\na.public", "stochcable.runtime", 0),
+    ],
+)
 def test_private_import_rule_on_snippets(monkeypatch, source, importer, expected):
     this = sys.modules[__name__]
-    m = Module(importer, Path("x.py"), importer.replace(".", "/") + ".py", ast.parse(source),
-               False)
+    m = Module(importer, Path("x.py"), importer.replace(".", "/") + ".py", ast.parse(source), False)
     monkeypatch.setattr(this, "MODULES", [m])
     monkeypatch.setattr(this, "MODULE_NAMES", MODULE_NAMES | {"stochcable.cli._output"})
     assert len(_private_import_violations() + _private_attribute_violations()) == expected

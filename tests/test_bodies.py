@@ -16,9 +16,9 @@ import math
 
 import numpy as np
 import pytest
+from fem_cases import taut_string, uniform_mesh
 from scipy.spatial.transform import Rotation
 
-from fem_cases import taut_string, uniform_mesh
 from stochcable.bodies.coupling import (
     LineLink,
     constant_matrices,
@@ -35,12 +35,12 @@ from stochcable.bodies.rigid import (
     rigid_body_mass_matrix,
     rigid_link_matrix,
 )
-from stochcable.reference.bodies import body_drag_damping, solve_coupled_direct
 from stochcable.errors import InputError, SolverError
 from stochcable.line.fem import assemble, build_fe_model
 from stochcable.line.mesh import mesh_line
-from stochcable.scene.model import Environment, Line
 from stochcable.line.statics import solve_line_statics
+from stochcable.reference.bodies import body_drag_damping, solve_coupled_direct
+from stochcable.scene.model import Environment, Line
 
 RHO = 1025.0
 
@@ -58,9 +58,14 @@ def _string_model(start, end, n_el, tension, mass, ea, dim=3):
 
 def _diag_body(planar=False, **kw):
     n = 3 if planar else 6
-    base = dict(name="b", position=[0.0, 0.0, 0.0], mass=2.0e3,
-                inertia=np.diag([3.0e3, 4.0e3, 5.0e3]),
-                hydrostatic_stiffness=np.diag(np.linspace(1.0e4, 6.0e4, n)), planar=planar)
+    base = dict(
+        name="b",
+        position=[0.0, 0.0, 0.0],
+        mass=2.0e3,
+        inertia=np.diag([3.0e3, 4.0e3, 5.0e3]),
+        hydrostatic_stiffness=np.diag(np.linspace(1.0e4, 6.0e4, n)),
+        planar=planar,
+    )
     base.update(kw)
     return RigidBody(**base)
 
@@ -74,19 +79,28 @@ def test_heave_one_dof_closed_form_with_tables():
     tw = np.array([0.2, 0.8, 1.4, 2.0])
     a33 = np.array([900.0, 700.0, 650.0, 600.0])
     b33 = np.array([10.0, 400.0, 250.0, 100.0])
-    A = np.zeros((4, 6, 6)); A[:, 2, 2] = a33
-    B = np.zeros((4, 6, 6)); B[:, 2, 2] = b33
+    A = np.zeros((4, 6, 6))
+    A[:, 2, 2] = a33
+    B = np.zeros((4, 6, 6))
+    B[:, 2, 2] = b33
     for i in (0, 1, 3, 4, 5):  # the other DOFs: constant, irrelevant to heave
         A[:, i, i] = 100.0
         B[:, i, i] = 50.0
     m, k33 = 1500.0, 3.0e4
     hs = np.diag([1e3, 1e3, k33, 1e4, 1e4, 1e3])
-    body = RigidBody("buoy", [0, 0, 0], m, inertia=np.eye(3) * 800.0,
-                     added_mass=FrequencyTable(tw, A), radiation_damping=FrequencyTable(tw, B),
-                     hydrostatic_stiffness=hs)
+    body = RigidBody(
+        "buoy",
+        [0, 0, 0],
+        m,
+        inertia=np.eye(3) * 800.0,
+        added_mass=FrequencyTable(tw, A),
+        radiation_damping=FrequencyTable(tw, B),
+        hydrostatic_stiffness=hs,
+    )
     system = couple([], [body])
     w = np.array([0.2, 0.5, 1.1, 1.7, 2.0])
-    F = np.zeros((w.size, 6), complex); F[:, 2] = 1.0
+    F = np.zeros((w.size, 6), complex)
+    F[:, 2] = 1.0
     x = solve_coupled_direct(system, F, w)
     a = np.interp(w, tw, a33)
     b = np.interp(w, tw, b33)
@@ -125,20 +139,35 @@ def test_planar_three_dof_with_spring_line_closed_form():
     A = np.array([[800.0, 0.0, 150.0], [0.0, 1200.0, 0.0], [150.0, 0.0, 3000.0]])
     B = np.array([[60.0, 0.0, 5.0], [0.0, 90.0, 0.0], [5.0, 0.0, 200.0]])
     P = np.array([10.0, 0.0, -3.0])
-    body = RigidBody("disc", P, m, inertia=np.diag([0.0, iyy, 0.0]), cog=[cx, 0.0, cz],
-                     added_mass=A, radiation_damping=B,
-                     hydrostatic_stiffness=np.diag([0.0, k33, k55]), planar=True)
+    body = RigidBody(
+        "disc",
+        P,
+        m,
+        inertia=np.diag([0.0, iyy, 0.0]),
+        cog=[cx, 0.0, cz],
+        added_mass=A,
+        radiation_damping=B,
+        hydrostatic_stiffness=np.diag([0.0, k33, k55]),
+        planar=True,
+    )
     att = P + [rx, 0.0, h]
     mesh = uniform_mesh(1, L, EA, 0.0)
     model = assemble(mesh, np.array([att - [L, 0.0, 0.0], att]), np.array([T]), RHO, dim=2)
     system = couple([LineLink("spring", model, end_b="disc")], [body])
     ka, kt = EA / L, T / L
-    M_hand = np.array([[m, 0.0, m * cz],
-                       [0.0, m, -m * cx],
-                       [m * cz, -m * cx, iyy + m * (cx**2 + cz**2)]]) + A
-    K_hand = np.array([[ka, 0.0, ka * h],
-                       [0.0, k33 + kt, -kt * rx],
-                       [ka * h, -kt * rx, k55 + ka * h**2 + kt * rx**2 - T * rx]])
+    M_hand = (
+        np.array(
+            [[m, 0.0, m * cz], [0.0, m, -m * cx], [m * cz, -m * cx, iyy + m * (cx**2 + cz**2)]]
+        )
+        + A
+    )
+    K_hand = np.array(
+        [
+            [ka, 0.0, ka * h],
+            [0.0, k33 + kt, -kt * rx],
+            [ka * h, -kt * rx, k55 + ka * h**2 + kt * rx**2 - T * rx],
+        ]
+    )
     w = np.linspace(0.2, 4.0, 9)
     Z = K_hand[None] - w[:, None, None] ** 2 * M_hand[None] + 1j * w[:, None, None] * B[None]
     H_hand = np.linalg.inv(Z)
@@ -200,8 +229,12 @@ def test_mass_matrix_equals_point_mass_cloud():
     I_G = sum(mi * (di @ di * np.eye(3) - np.outer(di, di)) for mi, di in zip(ms, d))
     # round-off
     np.testing.assert_allclose(rigid_body_mass_matrix(m, I_G, c), M_ref, rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(rigid_body_mass_matrix(m, I_G, c, planar=True),
-                               M_ref[np.ix_([0, 2, 4], [0, 2, 4])], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(
+        rigid_body_mass_matrix(m, I_G, c, planar=True),
+        M_ref[np.ix_([0, 2, 4], [0, 2, 4])],
+        rtol=1e-12,
+        atol=1e-12,
+    )
 
 
 # ----------------------------------------------------------- coupling: the limits
@@ -241,14 +274,17 @@ def test_infinite_body_mass_gives_prescribed_end_motion():
     for mass in (1.0e9, 1.0e11):
         model, body, r = _body_on_string(mass)
         system = couple([LineLink("s", model, end_b="heavy")], [body])
-        F = coupled_load(system, w, body_loads={"heavy": -(w**2)[:, None] * (body.mass_matrix() @ q0)[None]})
+        F = coupled_load(
+            system, w, body_loads={"heavy": -(w**2)[:, None] * (body.mass_matrix() @ q0)[None]}
+        )
         x = solve_coupled_direct(system, F, w)
         u = expand_line(system, "s", x)
         ref = _prescribed_end_solve(model, (rigid_link_matrix(r) @ q0)[None].repeat(w.size, 0), w)
         errs.append(np.abs(u - ref).max() / np.abs(ref).max())
         # the line's reaction perturbs the body by ~ k_line/(ω² m) relative, ω >= 1 rad/s
-        np.testing.assert_allclose(x[:, system.body_dofs["heavy"]], q0[None].repeat(3, 0),
-                                   rtol=10.0 * k_line / mass)
+        np.testing.assert_allclose(
+            x[:, system.body_dofs["heavy"]], q0[None].repeat(3, 0), rtol=10.0 * k_line / mass
+        )
     # 1/m convergence: 100 times the mass, ~100 times smaller error
     assert errs[1] < 10.0 * k_line / 1.0e11
     assert errs[0] / errs[1] > 50.0
@@ -274,8 +310,9 @@ def test_stiff_body_and_moving_anchor_equal_line_with_prescribed_ends():
         Z = (model.K - wk**2 * (model.M + model.Ma)).toarray()
         up = np.concatenate([ua, np.zeros(3)])
         ref[k, model.fixed] = up
-        ref[k, model.free] = np.linalg.solve(Z[np.ix_(model.free, model.free)],
-                                             -Z[np.ix_(model.free, model.fixed)] @ up)
+        ref[k, model.free] = np.linalg.solve(
+            Z[np.ix_(model.free, model.free)], -Z[np.ix_(model.free, model.fixed)] @ up
+        )
     # body compliance 1e-16 m/N times line end forces ~1e3 N/m·m: relative ~1e-10
     np.testing.assert_allclose(u, ref, atol=1e-9 * np.abs(ref).max())
 
@@ -302,16 +339,23 @@ def _two_line_system(symmetric=True, tables=False):
     body_kw = {}
     if tables:
         tw = np.array([0.1, 1.0, 3.0])
-        A = np.array([np.diag([500.0, 500.0, 800.0, 300.0, 300.0, 100.0]) * s for s in (1.2, 1.0, 0.8)])
+        A = np.array(
+            [np.diag([500.0, 500.0, 800.0, 300.0, 300.0, 100.0]) * s for s in (1.2, 1.0, 0.8)]
+        )
         A[:, 0, 4] = A[:, 4, 0] = 40.0
         Bt = np.array([np.diag([5.0, 5.0, 80.0, 3.0, 3.0, 1.0]) * s for s in (0.1, 1.0, 0.3)])
         body_kw = dict(added_mass=FrequencyTable(tw, A), radiation_damping=FrequencyTable(tw, Bt))
-    body = RigidBody("buoy", [0.0, 0.0, 0.0], 800.0, inertia=np.diag([300.0, 300.0, 200.0]),
-                     cog=[0.0, 0.0, -0.3], hydrostatic_stiffness=np.diag([0, 0, 2e4, 5e3, 5e3, 0]),
-                     **body_kw)
+    body = RigidBody(
+        "buoy",
+        [0.0, 0.0, 0.0],
+        800.0,
+        inertia=np.diag([300.0, 300.0, 200.0]),
+        cog=[0.0, 0.0, -0.3],
+        hydrostatic_stiffness=np.diag([0, 0, 2e4, 5e3, 5e3, 0]),
+        **body_kw,
+    )
     m1 = _string_model([-30.0, 0, z], [-1.0, 0, z], 6, 5.0e3, 2.0, 1.0e7)
-    links = [LineLink("left", m1, end_b="buoy",
-                      damping=0.05 * (m1.M + m1.Ma) + 1e-3 * m1.K)]
+    links = [LineLink("left", m1, end_b="buoy", damping=0.05 * (m1.M + m1.Ma) + 1e-3 * m1.K)]
     if symmetric:
         m2 = _string_model([30.0, 0, z], [1.0, 0, z], 6, 5.0e3, 2.0, 1.0e7)
         links.append(LineLink("right", m2, end_b="buoy", damping=0.05 * (m2.M + m2.Ma)))
@@ -329,10 +373,10 @@ def _two_line_system_fixed(fixed=(), penalty=0.0):
     extra = np.zeros((6, 6))
     for d in fixed:
         extra[names.index(d), names.index(d)] = penalty
-    new = dataclasses.replace(body, fixed_dofs=() if penalty else tuple(fixed),
-                              extra_stiffness=extra)
-    links = [LineLink(ln.name, ln.model, end_b="buoy", damping=ln.damping)
-             for ln in s.lines]
+    new = dataclasses.replace(
+        body, fixed_dofs=() if penalty else tuple(fixed), extra_stiffness=extra
+    )
+    links = [LineLink(ln.name, ln.model, end_b="buoy", damping=ln.damping) for ln in s.lines]
     return couple(links, [new])
 
 
@@ -396,17 +440,20 @@ def test_reciprocity_and_schur_equals_dense():
 
 def _hanging_line(att, planar):
     env = Environment(depth=500.0)
-    line = Line(name="leg", end_a={"position": [-60.0, 0.0, -80.0]},
-                end_b={"position": list(att)},
-                segments=[{"length": 110.0, "ea": 5.0e7, "mass": 40.0, "diameter": 0.08,
-                           "elements": 12}])
+    line = Line(
+        name="leg",
+        end_a={"position": [-60.0, 0.0, -80.0]},
+        end_b={"position": list(att)},
+        segments=[{"length": 110.0, "ea": 5.0e7, "mass": 40.0, "diameter": 0.08, "elements": 12}],
+    )
     mesh = mesh_line(line, env.rho, env.g)
     return env, mesh
 
 
 def _end_force(env, mesh, xb):
-    ls = solve_line_statics(dataclasses.replace(mesh, end_b=np.asarray(xb, float)), env,
-                            method="fe", tolerance=1e-13)
+    ls = solve_line_statics(
+        dataclasses.replace(mesh, end_b=np.asarray(xb, float)), env, method="fe", tolerance=1e-13
+    )
     return ls.force_b
 
 
@@ -425,8 +472,9 @@ def test_geometric_stiffness_matches_statics_finite_differences(planar):
     idx = [0, 2, 4] if planar else list(range(6))
 
     def condensed(geo):
-        s = couple([LineLink("leg", model, end_b="b", force_b=ls.force_b)], [body],
-                   geometric_stiffness=geo)
+        s = couple(
+            [LineLink("leg", model, end_b="b", force_b=ls.force_b)], [body], geometric_stiffness=geo
+        )
         K = s.K.toarray()
         f, b = s.line_dofs["leg"], s.body_dofs["b"]
         return K[np.ix_(b, b)] - K[np.ix_(b, f)] @ np.linalg.solve(K[np.ix_(f, f)], K[np.ix_(f, b)])
@@ -538,8 +586,9 @@ def test_couple_errors():
 
 
 def test_undamped_resonance_raises():
-    body = _diag_body(planar=True, mass=1.0, inertia=np.eye(3),
-                      hydrostatic_stiffness=np.diag([4.0, 4.0, 4.0]))
+    body = _diag_body(
+        planar=True, mass=1.0, inertia=np.eye(3), hydrostatic_stiffness=np.diag([4.0, 4.0, 4.0])
+    )
     s = couple([], [body])
     with pytest.raises(SolverError, match="omega = 2 rad/s"):
         solve_coupled_direct(s, np.ones((1, 3)), [2.0])
@@ -557,5 +606,6 @@ def test_end_force_from_model_matches_statics():
     given = couple([LineLink("leg", model, end_b="b", force_b=ls.force_b)], [body])
     derived = couple([LineLink("leg", model, end_b="b")], [body], g=env.g)
     # statics converged to 1e-13 of the reference force
-    np.testing.assert_allclose(derived.geometric["b"], given.geometric["b"],
-                               atol=1e-9 * np.abs(given.geometric["b"]).max())
+    np.testing.assert_allclose(
+        derived.geometric["b"], given.geometric["b"], atol=1e-9 * np.abs(given.geometric["b"]).max()
+    )

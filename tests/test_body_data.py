@@ -17,13 +17,13 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.bodies.rigid import body_excitation
 from stochcable.bodies.data import (
     body_from_hydrodynamics,
     load_hydrodynamics,
     read_capytaine,
     read_table,
 )
+from stochcable.bodies.rigid import body_excitation
 from stochcable.errors import InputError
 
 DOFS = ["Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw"]
@@ -43,14 +43,24 @@ def _capytaine_like(rng, n_w=4, headings=(0.0, math.pi / 2)):
     bd = np.array([_spd(rng, 6, 10.0) for _ in w])
     fx = rng.normal(size=(n_w, len(headings), 6)) + 1j * rng.normal(size=(n_w, len(headings), 6))
     ds = xr.Dataset(
-        {"added_mass": (("omega", "influenced_dof", "radiating_dof"), am),
-         "radiation_damping": (("omega", "influenced_dof", "radiating_dof"), bd),
-         "diffraction_force": (("omega", "wave_direction", "influenced_dof"), 0.25 * fx),
-         "Froude_Krylov_force": (("omega", "wave_direction", "influenced_dof"), 0.75 * fx),
-         "hydrostatic_stiffness": (("influenced_dof", "radiating_dof"), np.diag(np.arange(6.0)))},
-        coords={"omega": w, "wave_direction": list(headings), "radiating_dof": DOFS,
-                "influenced_dof": DOFS, "rotation_center": ("space_coordinate", [1.0, 2.0, -0.5]),
-                "g": 9.81, "rho": 1025.0, "water_depth": np.inf, "forward_speed": 0.0},
+        {
+            "added_mass": (("omega", "influenced_dof", "radiating_dof"), am),
+            "radiation_damping": (("omega", "influenced_dof", "radiating_dof"), bd),
+            "diffraction_force": (("omega", "wave_direction", "influenced_dof"), 0.25 * fx),
+            "Froude_Krylov_force": (("omega", "wave_direction", "influenced_dof"), 0.75 * fx),
+            "hydrostatic_stiffness": (("influenced_dof", "radiating_dof"), np.diag(np.arange(6.0))),
+        },
+        coords={
+            "omega": w,
+            "wave_direction": list(headings),
+            "radiating_dof": DOFS,
+            "influenced_dof": DOFS,
+            "rotation_center": ("space_coordinate", [1.0, 2.0, -0.5]),
+            "g": 9.81,
+            "rho": 1025.0,
+            "water_depth": np.inf,
+            "forward_speed": 0.0,
+        },
     )
     return ds, w, am, bd, fx
 
@@ -99,7 +109,9 @@ def test_read_capytaine_errors():
     neg["radiation_damping"] = (neg["radiation_damping"].dims, b)
     with pytest.raises(InputError, match=r"diagonal entry 2 .* at omega = 0.9 rad/s.*must be >= 0"):
         read_capytaine(neg)
-    with pytest.raises(InputError, match=r"must include the six rigid-body DOFs; missing \['Yaw'\]"):
+    with pytest.raises(
+        InputError, match=r"must include the six rigid-body DOFs; missing \['Yaw'\]"
+    ):
         read_capytaine(ds.isel(radiating_dof=slice(0, 5)))
     moving = ds.assign_coords(forward_speed=1.0)
     with pytest.raises(InputError, match="must be 0"):
@@ -112,13 +124,24 @@ def test_read_capytaine_errors():
 def _cylinder_dataset(center_x):
     cpt = pytest.importorskip("capytaine")
     xr = pytest.importorskip("xarray")
-    mesh = cpt.mesh_vertical_cylinder(length=3.0, radius=1.0, center=(center_x, 0.0, -0.5),
-                                      resolution=(3, 16, 6))
-    body = cpt.FloatingBody(mesh=mesh, dofs=cpt.rigid_body_dofs(rotation_center=(center_x, 0, 0)),
-                            center_of_mass=(center_x, 0, -0.5)).immersed_part()
-    test = xr.Dataset(coords={"omega": [0.2, 0.8, 1.4], "wave_direction": [0.0, math.pi / 4],
-                              "radiating_dof": list(body.dofs), "water_depth": [np.inf],
-                              "rho": [1025.0], "g": [9.81]})
+    mesh = cpt.mesh_vertical_cylinder(
+        length=3.0, radius=1.0, center=(center_x, 0.0, -0.5), resolution=(3, 16, 6)
+    )
+    body = cpt.FloatingBody(
+        mesh=mesh,
+        dofs=cpt.rigid_body_dofs(rotation_center=(center_x, 0, 0)),
+        center_of_mass=(center_x, 0, -0.5),
+    ).immersed_part()
+    test = xr.Dataset(
+        coords={
+            "omega": [0.2, 0.8, 1.4],
+            "wave_direction": [0.0, math.pi / 4],
+            "radiating_dof": list(body.dofs),
+            "water_depth": [np.inf],
+            "rho": [1025.0],
+            "g": [9.81],
+        }
+    )
     return cpt.BEMSolver().fill_dataset(test, body, hydrostatics=True)
 
 
@@ -154,7 +177,9 @@ def test_capytaine_cylinder_phase_convention(tmp_path):
         if beta == 0.0:
             assert np.abs(r5 - r0 * np.conj(shift)).max() > 0.1 * np.abs(r0).max()
     # translation invariance of the radiation matrices about each body's own centre
-    np.testing.assert_allclose(h5.added_mass, h0.added_mass, atol=1e-6 * np.abs(h0.added_mass).max())
+    np.testing.assert_allclose(
+        h5.added_mass, h0.added_mass, atol=1e-6 * np.abs(h0.added_mass).max()
+    )
     # long waves (ω = 0.2, kR = 0.004): heave → ρ g A_wp (Froude–Krylov), in phase
     f = body_excitation(b0, w, 0.0)
     awp = math.pi * 1.0**2
@@ -170,14 +195,17 @@ def test_capytaine_cylinder_phase_convention(tmp_path):
 def _table(rng, d=6, n_w=3, n_h=2):
     w = [0.4, 0.9, 1.6][:n_w]
     return {
-        "dofs": ["surge", "sway", "heave", "roll", "pitch", "yaw"] if d == 6
+        "dofs": ["surge", "sway", "heave", "roll", "pitch", "yaw"]
+        if d == 6
         else ["surge", "heave", "pitch"],
         "omega": w,
         "added_mass": [_spd(rng, d, 50.0).tolist() for _ in w],
         "radiation_damping": [_spd(rng, d, 5.0).tolist() for _ in w],
-        "excitation": {"heading": [0.0, 45.0][:n_h],
-                       "re": rng.normal(size=(n_h, d, n_w)).tolist(),
-                       "im": rng.normal(size=(n_h, d, n_w)).tolist()},
+        "excitation": {
+            "heading": [0.0, 45.0][:n_h],
+            "re": rng.normal(size=(n_h, d, n_w)).tolist(),
+            "im": rng.normal(size=(n_h, d, n_w)).tolist(),
+        },
         "hydrostatic_stiffness": np.diag(np.arange(1.0, d + 1)).tolist(),
     }
 
@@ -194,24 +222,37 @@ def test_read_table_file_and_body(tmp_path):
     np.testing.assert_allclose(h.excitation, exc, rtol=1e-15)
     body = body_from_hydrodynamics(h, "buoy", [0, 0, 0], 500.0, planar=True)
     # planar reduction: surge, heave, pitch rows/columns of the 6×6 table
-    np.testing.assert_allclose(body.added_mass_at([0.9])[0],
-                               np.array(doc["added_mass"][1])[np.ix_([0, 2, 4], [0, 2, 4])])
+    np.testing.assert_allclose(
+        body.added_mass_at([0.9])[0], np.array(doc["added_mass"][1])[np.ix_([0, 2, 4], [0, 2, 4])]
+    )
     np.testing.assert_allclose(body_excitation(body, [0.4], 0.0)[0], exc[0][[0, 2, 4], 0])
     planar = read_table(json.dumps(_table(rng, d=3)))
     assert planar.planar and planar.added_mass.shape == (3, 3, 3)
 
 
-@pytest.mark.parametrize("mutate, match", [
-    (lambda d: d.pop("omega"), r"omega = None: is missing from the table"),
-    (lambda d: d.update(omega=[0.4, 0.9]), r"added_mass = \(3, 6, 6\).*has 3 frequencies but "
-                                           r"omega has 2"),
-    (lambda d: d["excitation"].pop("heading"), r"excitation.heading = None: is missing"),
-    (lambda d: d["excitation"].update(heading=[0.0]), r"has 2 headings but excitation.heading has 1"),
-    (lambda d: d.update(added_mass=np.ones((3, 6, 5)).tolist()), r"must have shape \(n_omega, 6, 6\)"),
-    (lambda d: d.update(dofs=["surge", "pitch"]), r"dofs = .*must be \["),
-    (lambda d: d.update(omega=[0.9, 0.4, 1.6]), r"omega .* strictly increasing"),
-    (lambda d: d.update(colour="red"), r"unknown keys"),
-])
+@pytest.mark.parametrize(
+    "mutate, match",
+    [
+        (lambda d: d.pop("omega"), r"omega = None: is missing from the table"),
+        (
+            lambda d: d.update(omega=[0.4, 0.9]),
+            r"added_mass = \(3, 6, 6\).*has 3 frequencies but "
+            r"omega has 2",
+        ),
+        (lambda d: d["excitation"].pop("heading"), r"excitation.heading = None: is missing"),
+        (
+            lambda d: d["excitation"].update(heading=[0.0]),
+            r"has 2 headings but excitation.heading has 1",
+        ),
+        (
+            lambda d: d.update(added_mass=np.ones((3, 6, 5)).tolist()),
+            r"must have shape \(n_omega, 6, 6\)",
+        ),
+        (lambda d: d.update(dofs=["surge", "pitch"]), r"dofs = .*must be \["),
+        (lambda d: d.update(omega=[0.9, 0.4, 1.6]), r"omega .* strictly increasing"),
+        (lambda d: d.update(colour="red"), r"unknown keys"),
+    ],
+)
 def test_read_table_errors(mutate, match):
     rng = np.random.default_rng(12)
     doc = _table(rng)
@@ -229,7 +270,8 @@ def test_read_table_symmetry_and_damping_checks():
     with pytest.raises(InputError, match=r"at omega = 1.6 rad/s.*must be symmetric within"):
         read_table(doc)
     assert read_table(doc, symmetry_tolerance=0.2).added_mass[2, 0, 1] == pytest.approx(
-        0.5 * (a[2, 0, 1] + a[2, 1, 0]))
+        0.5 * (a[2, 0, 1] + a[2, 1, 0])
+    )
     doc = _table(rng)
     b = np.array(doc["radiation_damping"])
     b[0, 5, 5] = -1.0

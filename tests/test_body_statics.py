@@ -14,8 +14,8 @@ import json
 import math
 
 import numpy as np
-from _scenes import three_chain_legs
 import pytest
+from _scenes import three_chain_legs
 from scipy.spatial.transform import Rotation
 
 from stochcable.bodies.from_scene import scene_rigid_bodies
@@ -24,8 +24,8 @@ from stochcable.errors import ConvergenceError, InputError
 from stochcable.examples import load_example
 from stochcable.line.fem import build_fe_model
 from stochcable.line.mesh import mesh_line
-from stochcable.scene.model import load_scene
 from stochcable.line.statics import solve_line_statics
+from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
 RHO, G = 1025.0, 9.80665
@@ -33,14 +33,28 @@ RHO, G = 1025.0, 9.80665
 
 def _tether_doc(planar: bool = True, **body) -> dict:
     """Submerged buoy (∇ = 3 m³, 1000 kg) on a vertical 79 m tether from z = -100 m."""
-    b = {"name": "buoy", "position": [0.0, 0.0, -19.9], "mass": 1000.0,
-         "displaced_volume": 3.0, "cog": [0.0, 0.0, -0.5], **body}
-    return {"environment": {"depth": 100.0, "rho": RHO, "g": G},
-            "bodies": [b],
-            "lines": [{"name": "tether", "end_a": {"position": [0.0, 0.0, -100.0]},
-                       "end_b": {"attach": {"body": "buoy", "point": [0.0, 0.0, -1.0]}},
-                       "segments": [{"length": 79.0, "ea": 1.0e7, "mass": 5.0,
-                                     "diameter": 0.05, "elements": 10}]}]}
+    b = {
+        "name": "buoy",
+        "position": [0.0, 0.0, -19.9],
+        "mass": 1000.0,
+        "displaced_volume": 3.0,
+        "cog": [0.0, 0.0, -0.5],
+        **body,
+    }
+    return {
+        "environment": {"depth": 100.0, "rho": RHO, "g": G},
+        "bodies": [b],
+        "lines": [
+            {
+                "name": "tether",
+                "end_a": {"position": [0.0, 0.0, -100.0]},
+                "end_b": {"attach": {"body": "buoy", "point": [0.0, 0.0, -1.0]}},
+                "segments": [
+                    {"length": 79.0, "ea": 1.0e7, "mass": 5.0, "diameter": 0.05, "elements": 10}
+                ],
+            }
+        ],
+    }
 
 
 def test_vertical_tether_closed_form():
@@ -54,13 +68,13 @@ def test_vertical_tether_closed_form():
     L, ea = 79.0, 1.0e7
     z_attach = -100.0 + L + (t_top * L - w * L**2 / 2) / ea
     # line statics to 1e-10 of the reference force and body Newton to 1e-8
-    np.testing.assert_allclose(b.line_forces["tether"], [0.0, 0.0, -t_top], rtol=1e-8,
-                               atol=1e-8 * t_top)
+    np.testing.assert_allclose(
+        b.line_forces["tether"], [0.0, 0.0, -t_top], rtol=1e-8, atol=1e-8 * t_top
+    )
     np.testing.assert_allclose(b.position, [0.0, 0.0, z_attach + 1.0], atol=1e-8)
     np.testing.assert_allclose(b.rotation, 0.0, atol=1e-12)
     assert st.lines["tether"].tension_b == pytest.approx(t_top, rel=1e-8)
-    np.testing.assert_allclose(st.lines["tether"].positions[-1], [0.0, 0.0, z_attach],
-                               atol=1e-8)
+    np.testing.assert_allclose(st.lines["tether"].positions[-1], [0.0, 0.0, z_attach], atol=1e-8)
     # pitch stiffness: weight below the reference (m g 0.5) plus the tension acting
     # 1 m below it (T·1, the geometric term) plus the tether's lateral stiffness × arm²
     k = b.stiffness
@@ -80,8 +94,11 @@ def test_vertical_tether_3d_yaw_undetermined_then_fixed():
     doc["bodies"][0]["cog"] = [0.0, 1e-3, -0.5]  # leaves the x–z plane: 6 DOF
     scene = load_scene(doc)
     assert not scene.is_planar
-    with pytest.raises(InputError, match=r"bodies\[buoy\]\.yaw .*no restoring force.*"
-                                         r"fixed_dofs"):
+    with pytest.raises(
+        InputError,
+        match=r"bodies\[buoy\]\.yaw .*no restoring force.*"
+        r"fixed_dofs",
+    ):
         solve_statics(scene)
     doc["bodies"][0]["fixed_dofs"] = ["yaw"]
     st = solve_statics(load_scene(doc))
@@ -115,8 +132,9 @@ def _generalized_force(scene, name, pose6, tol=1e-11):
     return q
 
 
-@pytest.mark.parametrize("example", ["tuah_1982_disc_buoy_single_leg",
-                                     "tuah_1982_disc_buoy_three_legs"])
+@pytest.mark.parametrize(
+    "example", ["tuah_1982_disc_buoy_single_leg", "tuah_1982_disc_buoy_three_legs"]
+)
 def test_stiffness_matches_finite_differences(example):
     """BodyStatics.stiffness = −dQ/dq by central differences of the statics.
 
@@ -133,8 +151,9 @@ def test_stiffness_matches_finite_differences(example):
     for j in idx:
         e = np.zeros(6)
         e[j] = h[j]
-        kfd[:, j] = -(_generalized_force(scene, "disc", q0 + e)
-                      - _generalized_force(scene, "disc", q0 - e)) / (2 * h[j])
+        kfd[:, j] = -(
+            _generalized_force(scene, "disc", q0 + e) - _generalized_force(scene, "disc", q0 - e)
+        ) / (2 * h[j])
     kfd = kfd[np.ix_(idx, idx)]
     # entries compared on the scale sqrt(K_ii K_jj) (surge ~0.5 lbf/ft next to heave
     # ~5000 lbf/ft): statics noise 1e-11·F/h ~ 2e-6 lbf/ft, truncation (h/300 ft)²
@@ -165,8 +184,7 @@ def test_equilibrium_residual_independent():
 
 
 def _spread(wind=(0.0, 0.0, 0.0)):
-    doc = load_example("tuah_1982_disc_buoy_three_legs").model_dump(mode="json",
-                                                                     exclude_none=True)
+    doc = load_example("tuah_1982_disc_buoy_three_legs").model_dump(mode="json", exclude_none=True)
     doc["bodies"][0]["wind_force"] = list(wind)
     return load_scene(doc)
 
@@ -212,8 +230,10 @@ def test_three_leg_small_wind_offset_matches_linear_stiffness(direction):
 def test_prescribed_body_holds_its_lines():
     """A vessel (prescribed) body: its lines end at position + point, not solved."""
     doc = _tether_doc()
-    doc["bodies"][0]["prescribed"] = {"omega": [0.1, 2.0],
-                                      "heave": {"re": [1.0, 1.0], "im": [0.0, 0.0]}}
+    doc["bodies"][0]["prescribed"] = {
+        "omega": [0.1, 2.0],
+        "heave": {"re": [1.0, 1.0], "im": [0.0, 0.0]},
+    }
     doc["bodies"][0]["position"] = [0.0, 0.0, -19.5]
     st = solve_statics(load_scene(doc))
     b = st.bodies["buoy"]
@@ -232,25 +252,37 @@ def test_scene_errors_messages():
     doc = _tether_doc()
     bad = copy.deepcopy(doc)
     bad["lines"][0]["end_b"]["attach"]["body"] = "nope"
-    with pytest.raises(InputError, match=r"lines\[0\]\.end_b\.attach\.body = 'nope': no "
-                                         r"body of that name; bodies: \['buoy'\]"):
+    with pytest.raises(
+        InputError,
+        match=r"lines\[0\]\.end_b\.attach\.body = 'nope': no "
+        r"body of that name; bodies: \['buoy'\]",
+    ):
         load_scene(bad)
     bad = copy.deepcopy(doc)
     bad["lines"][0]["end_b"]["position"] = [0.0, 0.0, -21.0]
-    with pytest.raises(InputError, match=r"lines\[0\]\.end_b: give position or attach, "
-                                         r"not both"):
+    with pytest.raises(
+        InputError,
+        match=r"lines\[0\]\.end_b: give position or attach, "
+        r"not both",
+    ):
         load_scene(bad)
     bad = copy.deepcopy(doc)
     bad["bodies"][0]["hydrodynamics"] = {"file": "disc.nc"}
-    with pytest.raises(InputError, match=r"bodies\[0\]\.hydrodynamics\.file = 'disc\.nc': "
-                                         r"files are not accepted here"):
+    with pytest.raises(
+        InputError,
+        match=r"bodies\[0\]\.hydrodynamics\.file = 'disc\.nc': "
+        r"files are not accepted here",
+    ):
         load_scene(bad, allow_files=False)
     # non-planar body (y ≠ 0) with planar (3×3) data
     bad = copy.deepcopy(doc)
     bad["bodies"][0]["position"] = [0.0, 2.0, -19.9]
     bad["bodies"][0]["extra_stiffness"] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
-    with pytest.raises(InputError, match=r"bodies\[0\] \('buoy'\) has 3×3 \(surge, heave, "
-                                         r"pitch\) data but the scene is not planar"):
+    with pytest.raises(
+        InputError,
+        match=r"bodies\[0\] \('buoy'\) has 3×3 \(surge, heave, "
+        r"pitch\) data but the scene is not planar",
+    ):
         load_scene(bad)
 
 
@@ -260,8 +292,11 @@ def test_undetermined_pose_names_the_dof():
     doc = _tether_doc(cog=[0.0, 0.0, 0.0])
     doc["lines"][0]["end_b"]["attach"]["point"] = [0.0, 0.0, 0.0]
     doc["bodies"][0]["position"] = [0.0, 0.0, -20.9]
-    with pytest.raises(InputError, match=r"bodies\[buoy\]\.pitch = .*has no restoring "
-                                         r"force.*fixed_dofs"):
+    with pytest.raises(
+        InputError,
+        match=r"bodies\[buoy\]\.pitch = .*has no restoring "
+        r"force.*fixed_dofs",
+    ):
         solve_statics(load_scene(doc))
     doc["bodies"][0]["fixed_dofs"] = ["pitch"]
     b = solve_statics(load_scene(doc)).bodies["buoy"]
@@ -283,16 +318,27 @@ def test_hydrodynamics_file_relative_to_scene(tmp_path):
     a = scene_rigid_bodies(loaded)["disc"]
     b = scene_rigid_bodies(scene)["disc"]
     np.testing.assert_array_equal(a.excitation.values, b.excitation.values)
-    with pytest.raises(InputError, match=r"bodies\[0\]\.hydrodynamics\.file = "
-                                         r"'sub/disc\.json': file not found"):
+    with pytest.raises(
+        InputError,
+        match=r"bodies\[0\]\.hydrodynamics\.file = "
+        r"'sub/disc\.json': file not found",
+    ):
         load_scene(json.dumps(doc))  # relative to the working folder: not there
 
 
 def test_body_statics_document():
     st = solve_statics(load_example("tuah_1982_disc_buoy_single_leg"))
     d = st.to_document()["bodies"]["disc"]
-    assert set(d) == {"position", "rotation", "line_forces", "iterations", "residual",
-                      "dofs", "stiffness", "prescribed"}
+    assert set(d) == {
+        "position",
+        "rotation",
+        "line_forces",
+        "iterations",
+        "residual",
+        "dofs",
+        "stiffness",
+        "prescribed",
+    }
     assert d["dofs"] == ["surge", "heave", "pitch"] and len(d["stiffness"]) == 3
     assert isinstance(st.bodies["disc"], BodyStatics)
     # the 100 lb wind is carried by the line's horizontal pull (body residual 1e-8 of
@@ -308,16 +354,21 @@ def test_slack_start_and_unheld_body_errors():
     no horizontal restoring): ConvergenceError with the residual."""
     doc = _tether_doc()
     doc["bodies"][0]["position"] = [0.0, 0.0, -20.5]
-    with pytest.raises(InputError, match=r"lines\['tether'\]\.length = 79.*at the initial "
-                                         r"body positions: buoy at \[0\.0, 0\.0, -20\.5\]"):
+    with pytest.raises(
+        InputError,
+        match=r"lines\['tether'\]\.length = 79.*at the initial "
+        r"body positions: buoy at \[0\.0, 0\.0, -20\.5\]",
+    ):
         solve_statics(load_scene(doc))
     from stochcable.errors import ConvergenceError
 
-    d = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json",
-                                                                  exclude_none=True)
+    d = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json", exclude_none=True)
     d["bodies"][0]["wind_force"] = [0.0, 0.0, 0.0]
-    with pytest.raises(ConvergenceError, match=r"body statics Newton did not converge: "
-                                               r"residual .*undetermined position"):
+    with pytest.raises(
+        ConvergenceError,
+        match=r"body statics Newton did not converge: "
+        r"residual .*undetermined position",
+    ):
         solve_statics(load_scene(d))
 
 
@@ -332,9 +383,13 @@ def _buoy_spread_doc(n_el: int = 40, position=(10.0, 5.0, 0.0)) -> dict:
     kh = [[0.0] * 6 for _ in range(6)]
     for i, v in enumerate([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]):
         kh[i][i] = v
-    body = {"name": "buoy", "position": list(position), "mass": 2.0e4,
-            "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
-            "hydrostatic_stiffness": kh}
+    body = {
+        "name": "buoy",
+        "position": list(position),
+        "mass": 2.0e4,
+        "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
+        "hydrostatic_stiffness": kh,
+    }
     return {"environment": {"depth": 100.0}, "bodies": [body], "lines": lines}
 
 
@@ -370,8 +425,7 @@ def _dense_end_stiffness(ls, env, ends, planar):
     n = ls.mesh.n_nodes
     b = np.concatenate([np.arange(c) + (0 if e == "end_a" else (n - 1) * c) for e in ends])
     f = np.arange(c, (n - 1) * c)
-    return k[np.ix_(b, b)] - k[np.ix_(b, f)] @ np.linalg.solve(k[np.ix_(f, f)],
-                                                               k[np.ix_(f, b)])
+    return k[np.ix_(b, b)] - k[np.ix_(b, f)] @ np.linalg.solve(k[np.ix_(f, f)], k[np.ix_(f, b)])
 
 
 @pytest.mark.parametrize("planar", [False, True])
@@ -401,8 +455,7 @@ def test_end_condensation_matches_dense_schur(planar, ends):
     errs = []
     for h in (0.4, 0.2):
         dx = h * direction
-        moved = {e: getattr(mesh, e) + (dx if e in ends else 0.0)
-                 for e in ("end_a", "end_b")}
+        moved = {e: getattr(mesh, e) + (dx if e in ends else 0.0) for e in ("end_a", "end_b")}
         mesh2 = dataclasses.replace(mesh, **moved)
         ls2 = solve_line_statics(mesh2, env, method="fe", tolerance=1e-12)
         dxb = np.concatenate([dx[comps] for _ in ends])

@@ -18,26 +18,39 @@ import pytest
 from stochcable.errors import ConvergenceError, InputError, ResolutionWarning
 from stochcable.line.fem import assemble
 from stochcable.line.mesh import mesh_line
-from stochcable.statics import solve_statics
 from stochcable.reference.cable import newmark_period_error, simulate_line_timedomain
 from stochcable.scene.model import load_scene
+from stochcable.statics import solve_statics
 
 # ---------------------------------------------------------------------------- scenes
 
 
-def _taut(elements=10, hs=2.0, tp=8.0, cd=1.2, motion=None, current=0.0, ts=None,
-          omega_max=3.0):
+def _taut(elements=10, hs=2.0, tp=8.0, cd=1.2, motion=None, current=0.0, ts=None, omega_max=3.0):
     """A taut tether (~1.05 MN, first transverse mode 5.1 rad/s) in 100 m of water."""
-    line = {"name": "tether", "end_a": {"position": [0.0, 0.0, -100.0]},
-            "end_b": {"position": [20.0, 0.0, -10.0]},
-            "segments": [{"length": 92.0, "ea": 5e8, "mass": 40.0, "diameter": 0.1,
-                          "cd_normal": cd, "cd_axial": 0.0, "ca_normal": 1.0,
-                          "elements": elements}]}
+    line = {
+        "name": "tether",
+        "end_a": {"position": [0.0, 0.0, -100.0]},
+        "end_b": {"position": [20.0, 0.0, -10.0]},
+        "segments": [
+            {
+                "length": 92.0,
+                "ea": 5e8,
+                "mass": 40.0,
+                "diameter": 0.1,
+                "cd_normal": cd,
+                "cd_axial": 0.0,
+                "ca_normal": 1.0,
+                "elements": elements,
+            }
+        ],
+    }
     if motion is not None:
         line["end_b"]["motion"] = motion
-    sc = {"environment": {"depth": 100.0}, "lines": [line],
-          "analysis": {"solver": "direct",
-                       "omega": {"min": 0.05, "max": omega_max, "count": 300}}}
+    sc = {
+        "environment": {"depth": 100.0},
+        "lines": [line],
+        "analysis": {"solver": "direct", "omega": {"min": 0.05, "max": omega_max, "count": 300}},
+    }
     if current:
         sc["environment"]["current"] = [{"z": 0.0, "speed": current}]
     if hs:
@@ -49,18 +62,30 @@ def _taut(elements=10, hs=2.0, tp=8.0, cd=1.2, motion=None, current=0.0, ts=None
 
 def _chain(elements=20, hs=6.0, tp=10.0, surge=2.0, ts=None):
     """The DESIGN.md chain catenary (850 m, 200 m depth) with fairlead surge."""
-    line = {"name": "leg1", "end_a": {"position": [-800.0, 0.0, -200.0]},
-            "end_b": {"position": [0.0, 0.0, -20.0]},
-            "segments": [{"length": 850.0, "ea": 1.2326e9, "mass": 288.0,
-                          "diameter": 0.216, "cd_normal": 1.333, "cd_axial": 0.2034,
-                          "ca_normal": 1.0, "elements": elements}]}
+    line = {
+        "name": "leg1",
+        "end_a": {"position": [-800.0, 0.0, -200.0]},
+        "end_b": {"position": [0.0, 0.0, -20.0]},
+        "segments": [
+            {
+                "length": 850.0,
+                "ea": 1.2326e9,
+                "mass": 288.0,
+                "diameter": 0.216,
+                "cd_normal": 1.333,
+                "cd_axial": 0.2034,
+                "ca_normal": 1.0,
+                "elements": elements,
+            }
+        ],
+    }
     if surge:
-        line["end_b"]["motion"] = {"surge": {"type": "pierson_moskowitz", "hs": surge,
-                                             "tp": tp}}
-    sc = {"environment": {"depth": 200.0, "seabed": {"stiffness": 3e6, "damping": 3e5}},
-          "lines": [line],
-          "analysis": {"solver": "direct",
-                       "omega": {"min": 0.05, "max": 3.0, "count": 300}}}
+        line["end_b"]["motion"] = {"surge": {"type": "pierson_moskowitz", "hs": surge, "tp": tp}}
+    sc = {
+        "environment": {"depth": 200.0, "seabed": {"stiffness": 3e6, "damping": 3e5}},
+        "lines": [line],
+        "analysis": {"solver": "direct", "omega": {"min": 0.05, "max": 3.0, "count": 300}},
+    }
     if hs:
         sc["sea"] = {"spectrum": {"type": "pierson_moskowitz", "hs": hs, "tp": tp}}
     if ts is not None:
@@ -72,8 +97,7 @@ def _fem(scene, hist, dim=2):
     """The frequency-domain FE model assembled about the TD static start."""
     env = scene.environment
     mesh = mesh_line(scene.lines[0], env.rho, env.g)
-    return mesh, assemble(mesh, hist.static_positions, hist.static_tension, env.rho,
-                          dim=dim)
+    return mesh, assemble(mesh, hist.static_positions, hist.static_tension, env.rho, dim=dim)
 
 
 def _harmonic_amplitude(x, t, omega, start):
@@ -126,8 +150,7 @@ def test_harmonic_end_motion_matches_fe_transfer_function():
     c = np.zeros((3, omega.size), dtype=complex)
     c[0, m] = n_t / 2 * amp  # x_b(t) = amp cos ωt
     with pytest.warns(ResolutionWarning, match=r"period error .* use dt <="):
-        hist = simulate_line_timedomain(scene, dt=0.125, end_realizations={"b": c},
-                                        ramp=20.0)
+        hist = simulate_line_timedomain(scene, dt=0.125, end_realizations={"b": c}, ramp=20.0)
     assert hist.dt == pytest.approx(0.125)
     mesh, fe = _fem(scene, hist)
     K, M = fe.K.toarray(), (fe.M + fe.Ma).toarray()
@@ -153,8 +176,9 @@ def test_harmonic_end_motion_matches_fe_transfer_function():
         assert abs(x_td - warped[node, 0]) <= 1e-3 * abs(warped[node, 0])
         # against the exact FE transfer function: within the Newmark frequency error,
         # |H(ω̃) − H(ω)| (≈ |dH/dω|·ω·(ωΔt)²/12), plus the same 1e-3
-        assert abs(x_td - exact[node, 0]) <= (abs(warped[node, 0] - exact[node, 0])
-                                              + 1e-3 * abs(exact[node, 0]))
+        assert abs(x_td - exact[node, 0]) <= (
+            abs(warped[node, 0] - exact[node, 0]) + 1e-3 * abs(exact[node, 0])
+        )
         # and that error is real (0.9–2.2 % here): the test sees the frequency warping
         assert abs(warped[node, 0] - exact[node, 0]) > 0.005 * abs(exact[node, 0])
 
@@ -196,15 +220,23 @@ def _fd_series_fem(scene, hist):
     w = np.asarray(real.omega)
     kin = wave_kinematics(w, hist.static_positions, 0.0, env.depth, env.g)
     el = element_wave_kinematics(w, hist.static_positions, 0.0, env.depth, env.g)
-    ch = Channel(name="sea", kind="sea", omega=w, spectrum=np.zeros(w.size),
-                 density=np.zeros_like,
-                 velocity=np.transpose(kin.velocity, (2, 0, 1)),
-                 acceleration=np.transpose(kin.acceleration, (2, 0, 1)),
-                 element_velocity=el.velocity)
+    ch = Channel(
+        name="sea",
+        kind="sea",
+        omega=w,
+        spectrum=np.zeros(w.size),
+        density=np.zeros_like,
+        velocity=np.transpose(kin.velocity, (2, 0, 1)),
+        acceleration=np.transpose(kin.acceleration, (2, 0, 1)),
+        element_velocity=el.velocity,
+    )
     F = wave_loads(fe, (ch,), b_n, np.zeros(mesh.n_elements), g=env.g)[:, :, 0].T
     f = fe.free
-    D = (K[np.ix_(f, f)][None] - w[:, None, None] ** 2 * M[np.ix_(f, f)][None]
-         + 1j * w[:, None, None] * C[np.ix_(f, f)][None])
+    D = (
+        K[np.ix_(f, f)][None]
+        - w[:, None, None] ** 2 * M[np.ix_(f, f)][None]
+        + 1j * w[:, None, None] * C[np.ix_(f, f)][None]
+    )
     U = np.zeros((fe.n_dof, w.size), dtype=complex)
     U[f] = np.linalg.solve(D, F[f].T[..., None])[..., 0].T
     return synthesize(real, U), kin, real
@@ -240,8 +272,7 @@ def test_linear_limit_same_realization_equals_analysis_series():
     # band) against the TD end tension: the same realization drives both.
     from stochcable.analysis import analyze
 
-    scene = _taut(hs=0.1, cd=1.2, current=1.0,
-                  ts={"duration": 256.0, "dt": 0.25, "seed": 7})
+    scene = _taut(hs=0.1, cd=1.2, current=1.0, ts={"duration": 256.0, "dt": 0.25, "seed": 7})
     res = analyze(scene)
     ts = res.timeseries
     hist = simulate_line_timedomain(scene, band=(0.05, 3.0))
@@ -273,8 +304,9 @@ def test_sigma_frequency_domain_vs_time_domain(case):
     # Random sea + random end_b surge; FD σ (analyze, linearized drag) against the
     # nonlinear TD σ averaged over 3 seeds (DSA) of 300 s (taut) / 400 s (chain).
     if case == "taut":
-        scene = _taut(hs=4.0, tp=8.0, motion={"surge": {"type": "pierson_moskowitz",
-                                                        "hs": 1.0, "tp": 8.0}})
+        scene = _taut(
+            hs=4.0, tp=8.0, motion={"surge": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 8.0}}
+        )
         duration, node = 300.0, -2
     else:
         scene = _chain(elements=20)
@@ -282,8 +314,9 @@ def test_sigma_frequency_domain_vs_time_domain(case):
     res = analyze_scene(scene)
     lr = next(iter(res.lines.values()))
     seeds = (1, 2, 3)
-    hists = [simulate_line_timedomain(scene, duration=duration, seed=s, band=(0.05, 3.0))
-             for s in seeds]
+    hists = [
+        simulate_line_timedomain(scene, duration=duration, seed=s, band=(0.05, 3.0)) for s in seeds
+    ]
     record = duration - hists[0].ramp
     # Linearization error allowed: 10 % on σ of end tension and in-plane motion of the
     # node next to the fairlead — the accuracy the statistical linearization is
@@ -317,8 +350,11 @@ def test_unknown_line_and_bad_inputs():
         simulate_line_timedomain(scene, "nope")
     with pytest.raises(InputError, match=r"ramp = 100.0 \[s\]: must be shorter than the duration"):
         simulate_line_timedomain(scene, ramp=100.0)
-    with pytest.raises(InputError, match=r"duration = 100.0 \[s\]: must be <= the "
-                                         r"realization's length 64 s"):
+    with pytest.raises(
+        InputError,
+        match=r"duration = 100.0 \[s\]: must be <= the "
+        r"realization's length 64 s",
+    ):
         from stochcable.sea.realization import simulate_sea
 
         real = simulate_sea(lambda w: np.exp(-((w - 1.0) ** 2)) * 1e-3, 64.0, 0.25, rng=1)
@@ -334,9 +370,11 @@ def test_newton_failure_reports_step_and_residual():
     # one Newton iteration allowed: the chain's touchdown and drag need 2–4 per step,
     # so a step fails, naming the step, time and residual
     scene = _chain(ts={"duration": 64.0, "dt": 0.25})
-    with pytest.raises(ConvergenceError,
-                       match=r"time-domain Newton at step \d+ \(t = [\d.]+ s\) did not "
-                             r"converge: residual .* reduce dt") as exc:
+    with pytest.raises(
+        ConvergenceError,
+        match=r"time-domain Newton at step \d+ \(t = [\d.]+ s\) did not "
+        r"converge: residual .* reduce dt",
+    ) as exc:
         simulate_line_timedomain(scene, max_iterations=1)
     assert exc.value.partial["t"].size >= 1
 
@@ -361,7 +399,7 @@ def test_drag_quadrature_is_the_consistent_integral():
     model = LineModel(mesh, env, X, 2)
     e, _, _, _ = model.elements(X)
     n = np.stack([-e[:, 1], e[:, 0]], axis=1)
-    speed = 0.3 + 0.05 * np.arange(mesh.n_nodes)          # > 0: no sign change
+    speed = 0.3 + 0.05 * np.arange(mesh.n_nodes)  # > 0: no sign change
     ne = mesh.n_elements
     zero_n = np.zeros_like(X)
     zero_g = np.zeros((ne, model.gauss_xi.size, 2))
@@ -387,10 +425,13 @@ def test_drag_quadrature_is_the_consistent_integral():
     for col in range(4):
         dV = np.zeros_like(X)
         dV.reshape(-1)[2 * j + col] = h
-        fd_col = -(_element_rows(model, X, V + dV, e, zero_n, zero_g, j)
-                   - _element_rows(model, X, V - dV, e, zero_n, zero_g, j)) / (2 * h)
-        np.testing.assert_allclose(c_el[j][:, col], fd_col, rtol=1e-6,
-                                   atol=1e-6 * abs(c_el[j]).max())
+        fd_col = -(
+            _element_rows(model, X, V + dV, e, zero_n, zero_g, j)
+            - _element_rows(model, X, V - dV, e, zero_n, zero_g, j)
+        ) / (2 * h)
+        np.testing.assert_allclose(
+            c_el[j][:, col], fd_col, rtol=1e-6, atol=1e-6 * abs(c_el[j]).max()
+        )
 
 
 def _element_rows(model, X, V, e, u_n, u_g, j):
@@ -399,7 +440,7 @@ def _element_rows(model, X, V, e, u_n, u_g, j):
     u_g2 = model.gauss_points(V).copy()
     u_g2[j] = u_g[j]
     F, _, _ = model.drag(X, V, e, u_n, u_g2, jacobian=False)
-    return F.reshape(-1)[2 * j: 2 * j + 4]
+    return F.reshape(-1)[2 * j : 2 * j + 4]
 
 
 # ------------------------------------------------------------------ stationarity
@@ -411,11 +452,23 @@ def _history(t, tension):
 
     n = t.size
     return CableTimeHistory(
-        line="l", t=t, positions=np.zeros((n, 2, 3)), static_positions=np.zeros((2, 3)),
-        tension_a=tension, tension_b=tension, element_tension=np.zeros((n, 1)),
-        element_time=t, static_tension=np.zeros(1), iterations=np.zeros(n, dtype=int),
-        max_residual=0.0, tolerance=1.0, dt=float(t[1] - t[0]), ramp=0.0,
-        s0=np.zeros(2), _meta={"omega_peak": 0.5})
+        line="l",
+        t=t,
+        positions=np.zeros((n, 2, 3)),
+        static_positions=np.zeros((2, 3)),
+        tension_a=tension,
+        tension_b=tension,
+        element_tension=np.zeros((n, 1)),
+        element_time=t,
+        static_tension=np.zeros(1),
+        iterations=np.zeros(n, dtype=int),
+        max_residual=0.0,
+        tolerance=1.0,
+        dt=float(t[1] - t[0]),
+        ramp=0.0,
+        s0=np.zeros(2),
+        _meta={"omega_peak": 0.5},
+    )
 
 
 def test_stationarity_ratio_of_stationary_and_diverged_records():
@@ -461,6 +514,7 @@ def test_nonstationary_record_warning_is_wired(monkeypatch):
     # seed 1 measures 1.4-1.5: stationary, so no warning at the real threshold
     assert ratio < ctd.NONSTATIONARY_RATIO and not flagged
     monkeypatch.setattr(ctd, "NONSTATIONARY_RATIO", 0.9 * ratio)
-    with pytest.warns(ResolutionWarning,
-                      match=r"not stationary.*\d rad/s \(omega dt = .*rerun with dt <="):
+    with pytest.warns(
+        ResolutionWarning, match=r"not stationary.*\d rad/s \(omega dt = .*rerun with dt <="
+    ):
         simulate_line_timedomain(scene, duration=600.0, seed=1, band=(0.0245, 9.8))

@@ -12,10 +12,12 @@ import math
 
 import numpy as np
 import pytest
+from references import BLIET_1984_GUY, TUAH_1982_EX2, TUAH_1982_EX2_ELASTIC_CATENARY
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from references import BLIET_1984_GUY, TUAH_1982_EX2, TUAH_1982_EX2_ELASTIC_CATENARY
+from stochcable.errors import ConvergenceError, InputError
+from stochcable.examples import load_example
 from stochcable.line import catenary as cat
 from stochcable.line import catenary_kernel
 from stochcable.line.catenary import (
@@ -23,10 +25,8 @@ from stochcable.line.catenary import (
     catenary_line,
     catenary_solve,
 )
-from stochcable.line.multisegment import catenary_multisegment
-from stochcable.errors import ConvergenceError, InputError
-from stochcable.examples import load_example
 from stochcable.line.mesh import mesh_line
+from stochcable.line.multisegment import catenary_multisegment
 from stochcable.scene.model import Attachment
 
 CHAIN_W = (288.0 - 1025.0 * math.pi * 0.216**2 / 4.0) * 9.80665  # DESIGN.md chain [N/m]
@@ -53,8 +53,9 @@ def spans_by_quadrature(H, V0, w, length, ea):
 def check_closure_by_quadrature(sol, rtol):
     """x(L), z(L) integrated numerically from the solution's (H, V) equal the spans."""
     lb = sol.touchdown
-    x, z = spans_by_quadrature(sol.H, 0.0 if lb > 0 else sol.V_a, sol.weight,
-                               sol.length - lb, sol.ea)
+    x, z = spans_by_quadrature(
+        sol.H, 0.0 if lb > 0 else sol.V_a, sol.weight, sol.length - lb, sol.ea
+    )
     c = 0.0 if math.isinf(sol.ea) else 1.0 / sol.ea
     x += lb * (1.0 + sol.H * c)
     scale = max(sol.length, math.hypot(sol.horizontal_span, sol.vertical_span))
@@ -116,8 +117,9 @@ def test_inextensible_limit_matches_classic_catenary():
     a = sol.H / w
     x0 = -a * math.asinh(sol.V_a / sol.H)  # abscissa of the (virtual) lowest point
     x, z, _ = sol.profile(np.linspace(0.0, 200.0, 41))
-    np.testing.assert_allclose(z, a * (np.cosh((x - x0) / a) - math.cosh(x0 / a)),
-                               atol=1e-10 * 200.0)
+    np.testing.assert_allclose(
+        z, a * (np.cosh((x - x0) / a) - math.cosh(x0 / a)), atol=1e-10 * 200.0
+    )
     # and an elastic line with EA -> infinity tends to it (difference O(T/EA) = 1e-12)
     stiff = catenary_solve(150.0, 60.0, 200.0, w, 1e15)
     assert stiff.H == pytest.approx(sol.H, rel=1e-9)
@@ -291,8 +293,11 @@ def test_error_paths():
 
 def test_convergence_error_reports_residual(monkeypatch):
     monkeypatch.setattr(cat, "MAX_NEWTON", 1)
-    with pytest.raises(ConvergenceError, match=r"elastic catenary Newton did not converge: "
-                                               r"residual \d\.\d+e[+-]\d+ after 1 iterations"):
+    with pytest.raises(
+        ConvergenceError,
+        match=r"elastic catenary Newton did not converge: "
+        r"residual \d\.\d+e[+-]\d+ after 1 iterations",
+    ):
         catenary_solve(800.0, 180.0, 850.0, CHAIN_W, CHAIN_EA, seabed=True)
 
 
@@ -316,8 +321,9 @@ def test_bliet_1984_inclined_guy():
     assert sol.tension_a == pytest.approx(g["bottom_tension"], rel=2e-4)
     # The printed net weight 494.98 N/m contradicts the printed results (documented
     # seed inconsistency): it gives angles off by ~2 deg.
-    bad = catenary_from_top_tension(g["depth"], g["length"], g["net_weight_printed"],
-                                    g["ea"], g["top_tension"])
+    bad = catenary_from_top_tension(
+        g["depth"], g["length"], g["net_weight_printed"], g["ea"], g["top_tension"]
+    )
     assert abs(math.degrees(bad.angle_a) - g["angle_bottom_deg"]) > 1.0
 
 
@@ -401,9 +407,7 @@ def test_catenary_line_rejects_multisegment_and_attachments():
     with pytest.raises(InputError, match=r"needs exactly one segment"):
         catenary_line(scene.lines[0], scene.environment)
     base = load_example("chain_catenary")
-    line = base.lines[0].model_copy(
-        update={"attachments": (Attachment(at=400.0, buoyancy=1e4),)}
-    )
+    line = base.lines[0].model_copy(update={"attachments": (Attachment(at=400.0, buoyancy=1e4),)})
     with pytest.raises(InputError, match=r"without loaded attachments"):
         catenary_line(line, base.environment)
 
@@ -414,13 +418,13 @@ def test_scalar_closure_kernel_is_the_array_kernel():
     one sign (both signs), opposite signs, a zero end force, the asinh(d)/d series
     (|d| < 1e-6: w → 0), an inextensible line (c = 0)."""
     cases = [
-        (3.0e5, 2.0e5, 2500.0, 850.0, 1.0 / 1.2e9),    # both up
-        (3.0e5, -4.0e6, 2500.0, 850.0, 1.0 / 1.2e9),   # both down
-        (3.0e5, -1.0e6, 2500.0, 850.0, 1.0 / 1.2e9),   # opposite signs
-        (3.0e5, 0.0, 2500.0, 850.0, 1.0 / 1.2e9),      # zero force at the start
-        (3.0e5, 1.0e4, 1e-9, 850.0, 1.0 / 1.2e9),      # series branch of asinh(d)/d
-        (5.0e3, -2.0e3, 10.0, 100.0, 0.0),             # inextensible
-        (1.0, 0.0, 0.0, 10.0, 1e-6),                   # weightless, V0 = V1 = 0
+        (3.0e5, 2.0e5, 2500.0, 850.0, 1.0 / 1.2e9),  # both up
+        (3.0e5, -4.0e6, 2500.0, 850.0, 1.0 / 1.2e9),  # both down
+        (3.0e5, -1.0e6, 2500.0, 850.0, 1.0 / 1.2e9),  # opposite signs
+        (3.0e5, 0.0, 2500.0, 850.0, 1.0 / 1.2e9),  # zero force at the start
+        (3.0e5, 1.0e4, 1e-9, 850.0, 1.0 / 1.2e9),  # series branch of asinh(d)/d
+        (5.0e3, -2.0e3, 10.0, 100.0, 0.0),  # inextensible
+        (1.0, 0.0, 0.0, 10.0, 1e-6),  # weightless, V0 = V1 = 0
     ]
     for H, V0, w, ls, c in cases:
         fast = catenary_kernel.kernel_scalar(H, V0, w, ls, c)

@@ -12,16 +12,31 @@ from stochcable.cli import main
 SCENE = {
     "environment": {"depth": 100.0},
     "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}, "heading": 0.0},
-    "lines": [{
-        "name": "leg1",
-        "end_a": {"position": [-400.0, 0.0, -100.0]},
-        "end_b": {"position": [0.0, 0.0, -10.0],
-                  "motion": {"surge": {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}}},
-        "segments": [{"length": 450.0, "ea": 5.0e8, "mass": 100.0, "diameter": 0.1,
-                      "cd_normal": 2.4, "cd_axial": 1.15, "elements": 12}],
-    }],
-    "analysis": {"omega": {"min": 0.1, "max": 2.0, "count": 40},
-                 "timeseries": {"method": "dsa", "duration": 100.0, "dt": 0.5, "seed": 1}},
+    "lines": [
+        {
+            "name": "leg1",
+            "end_a": {"position": [-400.0, 0.0, -100.0]},
+            "end_b": {
+                "position": [0.0, 0.0, -10.0],
+                "motion": {"surge": {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}},
+            },
+            "segments": [
+                {
+                    "length": 450.0,
+                    "ea": 5.0e8,
+                    "mass": 100.0,
+                    "diameter": 0.1,
+                    "cd_normal": 2.4,
+                    "cd_axial": 1.15,
+                    "elements": 12,
+                }
+            ],
+        }
+    ],
+    "analysis": {
+        "omega": {"min": 0.1, "max": 2.0, "count": 40},
+        "timeseries": {"method": "dsa", "duration": 100.0, "dt": 0.5, "seed": 1},
+    },
 }
 
 
@@ -35,8 +50,19 @@ def scene_file(tmp_path):
 def test_analyze_writes_the_v1_result_document_and_plots(scene_file, tmp_path, capsys):
     out = tmp_path / "result.json"
     figs = tmp_path / "figs"
-    rc = main(["analyze", str(scene_file), "--format", "json", "-o", str(out),
-               "--plot", str(figs), "--progress"])
+    rc = main(
+        [
+            "analyze",
+            str(scene_file),
+            "--format",
+            "json",
+            "-o",
+            str(out),
+            "--plot",
+            str(figs),
+            "--progress",
+        ]
+    )
     assert rc == 0
     err = capsys.readouterr().err
     assert "statics" in err and "iteration 1" in err and "done" in err
@@ -70,8 +96,10 @@ def test_analyze_prints_to_stdout_without_progress(scene_file, capsys):
 
 
 def test_analyze_bad_scene_is_one_line_error(tmp_path, capsys):
-    bad = dict(SCENE, lines=[dict(SCENE["lines"][0], segments=[
-        dict(SCENE["lines"][0]["segments"][0], ea=-1.0)])])
+    bad = dict(
+        SCENE,
+        lines=[dict(SCENE["lines"][0], segments=[dict(SCENE["lines"][0]["segments"][0], ea=-1.0)])],
+    )
     p = tmp_path / "bad.json"
     p.write_text(json.dumps(bad))
     rc = main(["analyze", str(p)])

@@ -18,8 +18,9 @@ def run(capsys, *argv):
 
 
 def test_spectrum_pm_json(capsys):
-    code, out, err = run(capsys, "spectrum", "pm", "--hs", "6", "--tp", "10", "--omega-max", "6",
-                         "--count", "3000")
+    code, out, err = run(
+        capsys, "spectrum", "pm", "--hs", "6", "--tp", "10", "--omega-max", "6", "--count", "3000"
+    )
     assert code == 0
     d = json.loads(out)
     w = np.array(d["omega"])
@@ -41,16 +42,44 @@ def test_spectrum_peak_in_hz_and_rad_s_agree(capsys):
 
 
 def test_spectrum_other_types_and_csv(capsys, tmp_path):
-    for argv in (["issc", "--hs", "4", "--t1", "7"], ["bretschneider", "--hs", "4", "--tp", "9"],
-                 ["pm", "--wind-speed", "15"], ["pm", "--m0", "28", "--omega-p", "0.5"],
-                 ["ochi-hubble", "--hs1", "3", "--tp1", "15", "--lambda1", "2", "--hs2", "4",
-                  "--tp2", "8", "--lambda2", "1"]):
+    for argv in (
+        ["issc", "--hs", "4", "--t1", "7"],
+        ["bretschneider", "--hs", "4", "--tp", "9"],
+        ["pm", "--wind-speed", "15"],
+        ["pm", "--m0", "28", "--omega-p", "0.5"],
+        [
+            "ochi-hubble",
+            "--hs1",
+            "3",
+            "--tp1",
+            "15",
+            "--lambda1",
+            "2",
+            "--hs2",
+            "4",
+            "--tp2",
+            "8",
+            "--lambda2",
+            "1",
+        ],
+    ):
         code, out, err = run(capsys, "spectrum", *argv)
         assert code == 0, err
     table = tmp_path / "s.csv"
     table.write_text("omega,density\n0.2,0\n0.5,2\n1.0,0\n")
-    code, out, err = run(capsys, "spectrum", "table", "--table", str(table), "--format", "csv",
-                         "--omega-max", "1.0", "--count", "10")
+    code, out, err = run(
+        capsys,
+        "spectrum",
+        "table",
+        "--table",
+        str(table),
+        "--format",
+        "csv",
+        "--omega-max",
+        "1.0",
+        "--count",
+        "10",
+    )
     assert code == 0, err
     rows = out.strip().splitlines()
     assert rows[0] == "omega,density" and len(rows) == 11
@@ -60,8 +89,25 @@ def test_spectrum_other_types_and_csv(capsys, tmp_path):
 
 def test_simulate_seed_case_json(capsys, tmp_path):
     out = tmp_path / "eta.json"
-    code, _, err = run(capsys, "simulate", "pm", "--m0", "28", "--omega-p", "0.5", "--duration", "256",
-                       "--dt", "0.25", "--method", "dsa", "--seed", "1", "-o", str(out))
+    code, _, err = run(
+        capsys,
+        "simulate",
+        "pm",
+        "--m0",
+        "28",
+        "--omega-p",
+        "0.5",
+        "--duration",
+        "256",
+        "--dt",
+        "0.25",
+        "--method",
+        "dsa",
+        "--seed",
+        "1",
+        "-o",
+        str(out),
+    )
     assert code == 0, err
     d = json.loads(out.read_text())
     assert len(d["time"]) == len(d["elevation"]) == 1024
@@ -73,10 +119,46 @@ def test_simulate_seed_case_json(capsys, tmp_path):
 
 def test_simulate_csv_npy_and_reproducible(capsys, tmp_path):
     f1, f2 = tmp_path / "a.npy", tmp_path / "b.csv"
-    assert run(capsys, "simulate", "jonswap", "--hs", "2", "--tp", "7", "--seed", "4", "--method",
-               "nsa", "--format", "npy", "-o", str(f1))[0] == 0
-    assert run(capsys, "simulate", "jonswap", "--hs", "2", "--tp", "7", "--seed", "4", "--method",
-               "nsa", "--format", "csv", "-o", str(f2))[0] == 0
+    assert (
+        run(
+            capsys,
+            "simulate",
+            "jonswap",
+            "--hs",
+            "2",
+            "--tp",
+            "7",
+            "--seed",
+            "4",
+            "--method",
+            "nsa",
+            "--format",
+            "npy",
+            "-o",
+            str(f1),
+        )[0]
+        == 0
+    )
+    assert (
+        run(
+            capsys,
+            "simulate",
+            "jonswap",
+            "--hs",
+            "2",
+            "--tp",
+            "7",
+            "--seed",
+            "4",
+            "--method",
+            "nsa",
+            "--format",
+            "csv",
+            "-o",
+            str(f2),
+        )[0]
+        == 0
+    )
     a = np.load(f1)
     b = np.loadtxt(f2, delimiter=",", skiprows=1)
     np.testing.assert_array_equal(a["elevation"], b[:, 1])
@@ -89,28 +171,70 @@ def test_plot(capsys, tmp_path):
     assert run(capsys, "spectrum", "pm", "--hs", "6", "--tp", "10", "--plot", str(png))[0] == 0
     assert png.stat().st_size > 1000
     png2 = tmp_path / "e.png"
-    assert run(capsys, "simulate", "pm", "--hs", "6", "--tp", "10", "--seed", "1", "--plot", str(png2),
-               "-o", str(tmp_path / "x.json"))[0] == 0
+    assert (
+        run(
+            capsys,
+            "simulate",
+            "pm",
+            "--hs",
+            "6",
+            "--tp",
+            "10",
+            "--seed",
+            "1",
+            "--plot",
+            str(png2),
+            "-o",
+            str(tmp_path / "x.json"),
+        )[0]
+        == 0
+    )
     assert png2.stat().st_size > 1000
 
 
-@pytest.mark.parametrize("argv,flag", [
-    (["spectrum", "pm", "--hs", "-6", "--tp", "10"], "--hs = -6.0 [m]: must be > 0"),
-    (["spectrum", "pm", "--hs", "6", "--tp", "0"], "--tp = 0.0 [s]: must be > 0"),
-    (["spectrum", "pm", "--hs", "6"], "--tp = None [s]: is required for the pm spectrum"),
-    (["spectrum", "pm", "--tp", "10"], "--hs = None: is required for the pm spectrum"),
-    (["spectrum", "pm", "--hs", "6", "--tp", "10", "--fp", "0.1"], "--fp = 0.1: give only one of"),
-    (["spectrum", "pm", "--hs", "nan", "--tp", "10"], "--hs = nan [m]: must be finite"),
-    (["spectrum", "jonswap", "--hs", "6", "--tp", "10", "--gamma", "0.5"], "--gamma = 0.5: must be >= 1"),
-    (["spectrum", "pm", "--hs", "6", "--tp", "10", "--count", "1"], "--count = 1: must be an integer >= 2"),
-    (["spectrum", "pm", "--hs", "6", "--tp", "10", "--omega-max", "-1"], "--omega-max = -1.0 [rad/s]"),
-    (["spectrum", "table", "--table", "/nonexistent.csv"], "--table = '/nonexistent.csv': cannot be read"),
-    (["simulate", "pm", "--hs", "6", "--tp", "10", "--duration", "255.75"],
-     "--duration = 255.75 [s]: --duration/--dt = 1023 must be an even integer >= 2"),
-    (["simulate", "pm", "--hs", "6", "--tp", "10", "--dt", "0"], "--dt = 0.0 [s]: must be > 0"),
-    (["simulate", "pm", "--hs", "6", "--tp", "10", "--format", "npy"], "--output = None: is required"),
-    (["simulate", "pm", "--hs", "6", "--tp", "10", "--seed", "-3"], "--seed = -3: must be >= 0"),
-])
+@pytest.mark.parametrize(
+    "argv,flag",
+    [
+        (["spectrum", "pm", "--hs", "-6", "--tp", "10"], "--hs = -6.0 [m]: must be > 0"),
+        (["spectrum", "pm", "--hs", "6", "--tp", "0"], "--tp = 0.0 [s]: must be > 0"),
+        (["spectrum", "pm", "--hs", "6"], "--tp = None [s]: is required for the pm spectrum"),
+        (["spectrum", "pm", "--tp", "10"], "--hs = None: is required for the pm spectrum"),
+        (
+            ["spectrum", "pm", "--hs", "6", "--tp", "10", "--fp", "0.1"],
+            "--fp = 0.1: give only one of",
+        ),
+        (["spectrum", "pm", "--hs", "nan", "--tp", "10"], "--hs = nan [m]: must be finite"),
+        (
+            ["spectrum", "jonswap", "--hs", "6", "--tp", "10", "--gamma", "0.5"],
+            "--gamma = 0.5: must be >= 1",
+        ),
+        (
+            ["spectrum", "pm", "--hs", "6", "--tp", "10", "--count", "1"],
+            "--count = 1: must be an integer >= 2",
+        ),
+        (
+            ["spectrum", "pm", "--hs", "6", "--tp", "10", "--omega-max", "-1"],
+            "--omega-max = -1.0 [rad/s]",
+        ),
+        (
+            ["spectrum", "table", "--table", "/nonexistent.csv"],
+            "--table = '/nonexistent.csv': cannot be read",
+        ),
+        (
+            ["simulate", "pm", "--hs", "6", "--tp", "10", "--duration", "255.75"],
+            "--duration = 255.75 [s]: --duration/--dt = 1023 must be an even integer >= 2",
+        ),
+        (["simulate", "pm", "--hs", "6", "--tp", "10", "--dt", "0"], "--dt = 0.0 [s]: must be > 0"),
+        (
+            ["simulate", "pm", "--hs", "6", "--tp", "10", "--format", "npy"],
+            "--output = None: is required",
+        ),
+        (
+            ["simulate", "pm", "--hs", "6", "--tp", "10", "--seed", "-3"],
+            "--seed = -3: must be >= 0",
+        ),
+    ],
+)
 def test_bad_input_exit_2_one_line(capsys, argv, flag):
     code, out, err = run(capsys, *argv)
     assert code == 2
@@ -119,11 +243,14 @@ def test_bad_input_exit_2_one_line(capsys, argv, flag):
     assert flag in lines[0]
 
 
-@pytest.mark.parametrize("content,flag", [
-    ("omega,density\n0.5,1\n0.2,1\n", "--table omega"),
-    ("omega,density\n0.2,1\n0.5,-1\n", "--table density"),
-    ("0.2,1\n0.5\n", "--table"),
-])
+@pytest.mark.parametrize(
+    "content,flag",
+    [
+        ("omega,density\n0.5,1\n0.2,1\n", "--table omega"),
+        ("omega,density\n0.2,1\n0.5,-1\n", "--table density"),
+        ("0.2,1\n0.5\n", "--table"),
+    ],
+)
 def test_bad_table(capsys, tmp_path, content, flag):
     f = tmp_path / "t.csv"
     f.write_text(content)
@@ -132,7 +259,20 @@ def test_bad_table(capsys, tmp_path, content, flag):
 
 
 def test_coarse_dt_warns_on_stderr(capsys):
-    code, out, err = run(capsys, "simulate", "pm", "--hs", "6", "--tp", "10", "--dt", "1.5",
-                         "--duration", "300", "--seed", "1")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "pm",
+        "--hs",
+        "6",
+        "--tp",
+        "10",
+        "--dt",
+        "1.5",
+        "--duration",
+        "300",
+        "--seed",
+        "1",
+    )
     assert code == 0
     assert "warning:" in err and "above the Nyquist frequency" in err and "use dt <=" in err

@@ -24,9 +24,10 @@ def _free_port() -> int:
 def test_banner_names_the_docs_and_an_example():
     text = banner("127.0.0.1", 8000)
     assert "http://127.0.0.1:8000/docs" in text
-    assert ("curl -s http://127.0.0.1:8000/v1/examples/chain_catenary | curl -s -X POST "
-            "http://127.0.0.1:8000/v1/analyses -H 'Content-Type: application/json' -d @-"
-            in text)
+    assert (
+        "curl -s http://127.0.0.1:8000/v1/examples/chain_catenary | curl -s -X POST "
+        "http://127.0.0.1:8000/v1/analyses -H 'Content-Type: application/json' -d @-" in text
+    )
     assert "http://[::1]:8000/docs" in banner("::1", 8000)
     # a wildcard bind address is announced, but the example request goes to loopback
     assert "curl -s http://127.0.0.1:80/v1/examples" in banner("0.0.0.0", 80)
@@ -53,9 +54,19 @@ def test_serve_starts_uvicorn_and_answers():
     port = _free_port()
     env = {**os.environ, "STOCHCABLE_MAX_SAMPLES": "4096"}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "stochcable", "serve", "--port", str(port),
-         "--log-level", "warning"],
-        stderr=subprocess.PIPE, text=True, env=env,
+        [
+            sys.executable,
+            "-m",
+            "stochcable",
+            "serve",
+            "--port",
+            str(port),
+            "--log-level",
+            "warning",
+        ],
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
     )
     try:
         first = proc.stderr.readline()
@@ -72,9 +83,14 @@ def test_serve_starts_uvicorn_and_answers():
                 time.sleep(0.1)
         assert resp.json() == {"status": "ok"}
         # the worker read the limits from the environment
-        resp = httpx.post(f"http://127.0.0.1:{port}/v1/sea/realizations", json={
-            "spectrum": {"type": "jonswap", "hs": 2.0, "tp": 8.0},
-            "duration": 8192.0, "dt": 1.0})
+        resp = httpx.post(
+            f"http://127.0.0.1:{port}/v1/sea/realizations",
+            json={
+                "spectrum": {"type": "jonswap", "hs": 2.0, "tp": 8.0},
+                "duration": 8192.0,
+                "dt": 1.0,
+            },
+        )
         assert "limit of 4096 (STOCHCABLE_MAX_SAMPLES)" in resp.text
         # the example request the start-up message shows works as printed
         resp = _run_banner_pipeline(example)

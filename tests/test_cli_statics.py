@@ -10,10 +10,16 @@ from stochcable.cli import main
 
 SCENE = {
     "environment": {"depth": 200.0},
-    "lines": [{"name": "leg1", "end_a": {"position": [-800.0, -100.0, -200.0]},
-               "end_b": {"position": [0.0, 0.0, -20.0]},
-               "segments": [{"length": 850.0, "ea": 1.2326e9, "mass": 288.0,
-                             "diameter": 0.216, "elements": 20}]}],
+    "lines": [
+        {
+            "name": "leg1",
+            "end_a": {"position": [-800.0, -100.0, -200.0]},
+            "end_b": {"position": [0.0, 0.0, -20.0]},
+            "segments": [
+                {"length": 850.0, "ea": 1.2326e9, "mass": 288.0, "diameter": 0.216, "elements": 20}
+            ],
+        }
+    ],
 }
 
 

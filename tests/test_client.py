@@ -13,18 +13,18 @@ import httpx
 import numpy as np
 import pytest
 import uvicorn
+from _compare import assert_close_documents
 
 import stochcable
 import stochcable.errors
 from service.app import create_app
 from service.settings import Settings
-from _compare import assert_close_documents
 from stochcable.analysis import analyze
 from stochcable.client import AnalysisDocument, Client, ClientError, ServiceError
 from stochcable.examples import load_example
-from stochcable.sea.kinematics import kinematics_timeseries
 from stochcable.results.documents import ResponseStats
 from stochcable.scene.model import Jonswap, OmegaGrid, Scene
+from stochcable.sea.kinematics import kinematics_timeseries
 from stochcable.sea.realization import simulate_sea
 from stochcable.sea.spectra import SpectrumStatistics, spectrum_statistics
 
@@ -40,9 +40,14 @@ def _free_port() -> int:
 @pytest.fixture(scope="module")
 def base_url():
     port = _free_port()
-    config = uvicorn.Config(create_app(Settings(max_samples=2**16)), host="127.0.0.1",
-                            port=port, log_level="warning", lifespan="off",
-                            timeout_graceful_shutdown=2)
+    config = uvicorn.Config(
+        create_app(Settings(max_samples=2**16)),
+        host="127.0.0.1",
+        port=port,
+        log_level="warning",
+        lifespan="off",
+        timeout_graceful_shutdown=2,
+    )
     server = uvicorn.Server(config)
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
@@ -86,8 +91,17 @@ def test_spectrum_from_a_plain_document(client):
 @pytest.mark.parametrize("binary", [True, False])
 def test_realization_equals_the_local_simulation(client, binary):
     points = [[0.0, 0.0, -3.0], [20.0, 5.0, -15.0]]
-    res = client.realization(JONSWAP, duration=512.0, dt=0.25, method="nsa", seed=11,
-                             points=points, heading=45.0, depth=40.0, binary=binary)
+    res = client.realization(
+        JONSWAP,
+        duration=512.0,
+        dt=0.25,
+        method="nsa",
+        seed=11,
+        points=points,
+        heading=45.0,
+        depth=40.0,
+        binary=binary,
+    )
     sea = simulate_sea(JONSWAP.spectral_density, 512.0, 0.25, method="nsa", rng=11)
     vel, acc = kinematics_timeseries(sea, np.array(points), np.radians(45.0), 40.0)
     assert np.array_equal(res.time, sea.time)
@@ -99,8 +113,11 @@ def test_realization_equals_the_local_simulation(client, binary):
 
 
 def test_input_error_raises_client_error_with_path_and_unit(client):
-    with pytest.raises(ClientError, match=r"HTTP 422: spectrum\.hs \[m\]: Input should be "
-                                          r"greater than or equal to 0.000001") as info:
+    with pytest.raises(
+        ClientError,
+        match=r"HTTP 422: spectrum\.hs \[m\]: Input should be "
+        r"greater than or equal to 0.000001",
+    ) as info:
         client.spectrum({"type": "jonswap", "hs": -1.0, "tp": 8.0})
     assert info.value.status == 422
     assert info.value.detail[0]["parameter"] == "spectrum.hs"
@@ -108,8 +125,11 @@ def test_input_error_raises_client_error_with_path_and_unit(client):
 
 
 def test_limit_raises_client_error_naming_the_bound(client):
-    with pytest.raises(ClientError, match=r"duration/dt = 131072 samples exceeds the limit "
-                                          r"of 65536 \(STOCHCABLE_MAX_SAMPLES\)"):
+    with pytest.raises(
+        ClientError,
+        match=r"duration/dt = 131072 samples exceeds the limit "
+        r"of 65536 \(STOCHCABLE_MAX_SAMPLES\)",
+    ):
         client.realization(JONSWAP, duration=32768.0, dt=0.25)
 
 
@@ -150,8 +170,12 @@ def test_readme_pipeline_get_the_example_and_post_it(base_url, chain_local):
     # curl -s .../v1/examples/chain_catenary | curl -s -X POST .../v1/analyses
     #      -H 'Content-Type: application/json' -d @-      (the start-up message)
     scene = httpx.get(f"{base_url}/v1/examples/chain_catenary", timeout=30.0).content
-    resp = httpx.post(f"{base_url}/v1/analyses", content=scene, timeout=60.0,
-                      headers={"Content-Type": "application/json"})
+    resp = httpx.post(
+        f"{base_url}/v1/analyses",
+        content=scene,
+        timeout=60.0,
+        headers={"Content-Type": "application/json"},
+    )
     assert resp.status_code == 200, resp.text
     assert_close_documents(_without_timing(resp.json()), _without_timing(chain_local.to_document()))
 
@@ -167,36 +191,49 @@ def test_analyze_returns_the_local_objects(client, chain_local):
         assert_close_documents(getattr(line, end).as_dict(), getattr(local, end).as_dict())
     assert line.end_b_tension_std == pytest.approx(local.end_b.std, rel=1e-10)
     assert local.end_b.std > 0
-    for name in ("tension_std", "tension_mean", "s_elements", "s_nodes", "motion_std",
-                 "omega", "listed_modes"):
-        np.testing.assert_allclose(getattr(line, name), getattr(local, name), rtol=1e-10,
-                                   atol=0, err_msg=name)
-    np.testing.assert_allclose(line.end_tension_spectrum("end_b"),
-                               local.end_tension_spectrum("end_b"), rtol=1e-10)
+    for name in (
+        "tension_std",
+        "tension_mean",
+        "s_elements",
+        "s_nodes",
+        "motion_std",
+        "omega",
+        "listed_modes",
+    ):
+        np.testing.assert_allclose(
+            getattr(line, name), getattr(local, name), rtol=1e-10, atol=0, err_msg=name
+        )
+    np.testing.assert_allclose(
+        line.end_tension_spectrum("end_b"), local.end_tension_spectrum("end_b"), rtol=1e-10
+    )
     assert line.channels == local.channels and line.n_modes == local.n_modes
     assert res.converged and res.warnings == chain_local.warnings
     ts, local_ts = res.timeseries, chain_local.timeseries
     n = ts.time.size  # the first 2048 samples of 2400
     assert n == 2048 and ts.samples == local_ts.time.size
     assert np.array_equal(ts.elevation, local_ts.elevation[:n])  # no BLAS involved
-    np.testing.assert_allclose(ts.end_tension["leg1"]["end_b"],
-                               local_ts.end_tension["leg1"]["end_b"][:n], rtol=1e-10,
-                               atol=1e-10 * np.abs(local_ts.end_tension["leg1"]["end_b"]).max())
+    np.testing.assert_allclose(
+        ts.end_tension["leg1"]["end_b"],
+        local_ts.end_tension["leg1"]["end_b"][:n],
+        rtol=1e-10,
+        atol=1e-10 * np.abs(local_ts.end_tension["leg1"]["end_b"]).max(),
+    )
 
 
 def test_analyze_from_a_plain_document_without_timeseries(client):
     doc = load_example("taut_wire").model_dump(mode="json")
     res = client.analyze(doc, timeseries="none")
     assert res.timeseries is None and "timeseries" not in res
-    assert_close_documents(res.lines["wire"].end_b.as_dict(), analyze(doc).lines["wire"].end_b.as_dict())
+    assert_close_documents(
+        res.lines["wire"].end_b.as_dict(), analyze(doc).lines["wire"].end_b.as_dict()
+    )
 
 
 def test_analyze_bodies_scene_returns_body_motion_series(client):
     """The time-series window of a scene with a body carries the body's motion per DOF,
     equal to the local realization's first samples (same seed, round-off from BLAS)."""
     doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
-    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 64.0, "dt": 0.5,
-                                     "seed": 2}
+    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 64.0, "dt": 0.5, "seed": 2}
     res = client.analyze(doc)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -205,17 +242,21 @@ def test_analyze_bodies_scene_returns_body_motion_series(client):
     assert set(ts.body_motion) == {"disc"}
     assert list(ts.body_motion["disc"]) == ["surge", "heave", "pitch"]
     for dof, series in ts.body_motion["disc"].items():
-        want = local.body_motion["disc"][dof][:series.size]
-        np.testing.assert_allclose(series, want, rtol=1e-10,
-                                   atol=1e-10 * np.abs(want).max(), err_msg=dof)
+        want = local.body_motion["disc"][dof][: series.size]
+        np.testing.assert_allclose(
+            series, want, rtol=1e-10, atol=1e-10 * np.abs(want).max(), err_msg=dof
+        )
     assert np.std(ts.body_motion["disc"]["heave"]) > 0
 
 
 def test_analyze_unconverged_raises_client_error_with_the_reason(client):
     doc = load_example("tuah_1982_single_leg").model_dump(mode="json")
     doc["analysis"]["linearization"]["max_iterations"] = 1
-    with pytest.raises(ClientError, match=r"HTTP 422: drag linearization of line 'leg' did "
-                                          r"not converge.*max_iterations") as info:
+    with pytest.raises(
+        ClientError,
+        match=r"HTTP 422: drag linearization of line 'leg' did "
+        r"not converge.*max_iterations",
+    ) as info:
         client.analyze(doc)
     assert info.value.detail[0]["type"] == "convergence_error"
 

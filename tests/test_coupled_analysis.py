@@ -15,18 +15,13 @@ import dataclasses
 import math
 
 import numpy as np
-from _scenes import three_chain_legs
 import pytest
+from _scenes import three_chain_legs
 from scipy.spatial.transform import Rotation
 
-from stochcable.dynamics.line_loads import line_inputs, fluid_loads
-from stochcable.dynamics.blocks import to_freq
-from stochcable.dynamics.system import build_line_system
-from stochcable.dynamics.outputs import line_result
-from stochcable.dynamics.fixedpoint import linearize
-from stochcable.bodies.rigid import ExcitationTable, RigidBody
 from stochcable.bodies.coupling import LineLink, couple, coupled_load, expand_line
-from stochcable.reference.bodies import solve_coupled_direct
+from stochcable.bodies.rigid import ExcitationTable, RigidBody
+from stochcable.dynamics.blocks import to_freq
 from stochcable.dynamics.coupled import (
     BodyLoads,
     CoupledLine,
@@ -36,8 +31,13 @@ from stochcable.dynamics.coupled import (
     fairlead_motion,
     linearize_coupled,
 )
-from stochcable.errors import InputError
+from stochcable.dynamics.fixedpoint import linearize
+from stochcable.dynamics.line_loads import fluid_loads, line_inputs
 from stochcable.dynamics.loads import Channel, line_channels
+from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.system import build_line_system
+from stochcable.errors import InputError
+from stochcable.reference.bodies import solve_coupled_direct
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
@@ -56,22 +56,31 @@ def _mooring_doc(heading=0.0, n_el=10, count=40, solver="direct", modes="auto", 
     """Three chain legs at 0/120/240 deg from anchors at radius 300 m to fairleads at
     radius 5 m, z = -2 m, around a buoy at the origin; 100 m depth."""
     lines = three_chain_legs(n_el)
-    return {"environment": {"depth": 100.0},
-            "sea": {"spectrum": {"type": "jonswap", "hs": 3.0, "tp": 9.0},
-                    "heading": heading},
-            "lines": lines,
-            "analysis": {"omega": {"min": 0.1, "max": 2.0, "count": count},
-                         "solver": solver, "modes": modes,
-                         "linearization": {"tolerance": tol, "max_iterations": 200}}}
+    return {
+        "environment": {"depth": 100.0},
+        "sea": {"spectrum": {"type": "jonswap", "hs": 3.0, "tp": 9.0}, "heading": heading},
+        "lines": lines,
+        "analysis": {
+            "omega": {"min": 0.1, "max": 2.0, "count": count},
+            "solver": solver,
+            "modes": modes,
+            "linearization": {"tolerance": tol, "max_iterations": 200},
+        },
+    }
 
 
 def _buoy(**kw):
-    base = dict(name="buoy", position=[0.0, 0.0, 0.0], mass=2.0e4,
-                inertia=np.diag([5e4, 5e4, 8e4]),
-                added_mass=np.diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]),
-                radiation_damping=np.diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]),
-                hydrostatic_stiffness=np.diag([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]),
-                drag_area=[4.0, 4.0, 8.0], drag_point=[0.0, 0.0, -1.0])
+    base = dict(
+        name="buoy",
+        position=[0.0, 0.0, 0.0],
+        mass=2.0e4,
+        inertia=np.diag([5e4, 5e4, 8e4]),
+        added_mass=np.diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]),
+        radiation_damping=np.diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]),
+        hydrostatic_stiffness=np.diag([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]),
+        drag_area=[4.0, 4.0, 8.0],
+        drag_point=[0.0, 0.0, -1.0],
+    )
     base.update(kw)
     return RigidBody(**base)
 
@@ -83,10 +92,8 @@ def _group(doc, body):
     cls = []
     for line in scene.lines:
         s = build_line_system(scene, line, statics.lines[line.name])
-        cls.append(CoupledLine(s, line_channels(scene, line, s.positions, omega),
-                               end_b=body.name))
-    loads = {body.name: body_loads(body, cls[0].channels, omega, scene.sea,
-                                   scene.environment)}
+        cls.append(CoupledLine(s, line_channels(scene, line, s.positions, omega), end_b=body.name))
+    loads = {body.name: body_loads(body, cls[0].channels, omega, scene.sea, scene.environment)}
     return scene, cls, loads
 
 
@@ -105,6 +112,7 @@ def mooring_direct():
 def _sea_channel(w, spectrum):
     def dens(x):
         return np.interp(x, w, spectrum)
+
     return Channel(name="sea", kind="sea", omega=w, spectrum=spectrum, density=dens)
 
 
@@ -121,18 +129,32 @@ def test_planar_body_on_springs_closed_form():
     Ks = np.array([[2e4, 0.0, 1e3], [0.0, 8e4, 0.0], [1e3, 0.0, 3e5]])
     w = np.linspace(0.2, 3.0, 30)
     f = np.stack([1e4 * np.exp(0.3j * w), 2e4 + 0j * w, 5e3j * w])  # (3, n_w)
-    body = RigidBody("disc", [0.0, 0.0, -2.0], m, inertia=np.diag([0.0, iyy, 0.0]),
-                     cog=[cx, 0.0, cz], added_mass=A, radiation_damping=B,
-                     extra_stiffness=Ks, planar=True,
-                     excitation=ExcitationTable(w, [0.0], f[None]))
+    body = RigidBody(
+        "disc",
+        [0.0, 0.0, -2.0],
+        m,
+        inertia=np.diag([0.0, iyy, 0.0]),
+        cog=[cx, 0.0, cz],
+        added_mass=A,
+        radiation_damping=B,
+        extra_stiffness=Ks,
+        planar=True,
+        excitation=ExcitationTable(w, [0.0], f[None]),
+    )
     spec = np.exp(-((w - 1.0) ** 2))
     ch = (_sea_channel(w, spec),)
-    ld = BodyLoads(force=f.T[:, :, None].astype(complex),
-                   velocity=np.zeros((w.size, 3, 1), complex), current=np.zeros(3))
-    lin = linearize_coupled([], [body], _settings(), rho=RHO, loads={"disc": ld},
-                            channels=ch)
-    M_hand = np.array([[m, 0.0, m * cz], [0.0, m, -m * cx],
-                       [m * cz, -m * cx, iyy + m * (cx**2 + cz**2)]]) + A
+    ld = BodyLoads(
+        force=f.T[:, :, None].astype(complex),
+        velocity=np.zeros((w.size, 3, 1), complex),
+        current=np.zeros(3),
+    )
+    lin = linearize_coupled([], [body], _settings(), rho=RHO, loads={"disc": ld}, channels=ch)
+    M_hand = (
+        np.array(
+            [[m, 0.0, m * cz], [0.0, m, -m * cx], [m * cz, -m * cx, iyy + m * (cx**2 + cz**2)]]
+        )
+        + A
+    )
     z = Ks[None] - w[:, None, None] ** 2 * M_hand[None] + 1j * w[:, None, None] * B[None]
     expected = np.linalg.solve(z, f.T[:, :, None])
     # round-off of a 3×3 solve
@@ -141,7 +163,8 @@ def test_planar_body_on_springs_closed_form():
     dens = np.abs(expected[:, 1, 0]) ** 2 * spec
     # trapezoid of the same density
     assert bo["disc"].motion["heave"].std == pytest.approx(
-        math.sqrt(np.trapezoid(dens, w)), rel=1e-12)
+        math.sqrt(np.trapezoid(dens, w)), rel=1e-12
+    )
     assert bo["disc"].motion["heave"].mean == pytest.approx(-2.0)
 
 
@@ -151,21 +174,32 @@ def test_body_drag_fixed_point_seed_form():
     σ of the relative velocity, and H = (F + b v)/(K − ω²(m + A) + iω(B + b))."""
     w = np.linspace(0.2, 2.0, 60)
     m, a33, b33, k33, cda = 1.0e4, 5e3, 2e3, 1.2e5, 10.0
-    body = RigidBody("b", [0, 0, -5.0], m, inertia=np.eye(3) * 1e4,
-                     added_mass=np.diag([1e3, 1e3, a33, 1e3, 1e3, 1e3]),
-                     radiation_damping=np.diag([0, 0, b33, 0, 0, 0]),
-                     extra_stiffness=np.diag([1e4, 1e4, k33, 1e5, 1e5, 1e5]),
-                     drag_area=[0.0, 0.0, cda])
+    body = RigidBody(
+        "b",
+        [0, 0, -5.0],
+        m,
+        inertia=np.eye(3) * 1e4,
+        added_mass=np.diag([1e3, 1e3, a33, 1e3, 1e3, 1e3]),
+        radiation_damping=np.diag([0, 0, b33, 0, 0, 0]),
+        extra_stiffness=np.diag([1e4, 1e4, k33, 1e5, 1e5, 1e5]),
+        drag_area=[0.0, 0.0, cda],
+    )
     fz = 3e4 * np.exp(-0.5j * w)
     vz = 0.8j * w
     force = np.zeros((w.size, 6, 1), complex)
     force[:, 2, 0] = fz
     vel = np.zeros((w.size, 3, 1), complex)
     vel[:, 2, 0] = vz
-    spec = 2.0 * np.exp(-((w - 0.9) / 0.2) ** 2)
+    spec = 2.0 * np.exp(-(((w - 0.9) / 0.2) ** 2))
     ch = (_sea_channel(w, spec),)
-    lin = linearize_coupled([], [body], _settings(), rho=RHO, channels=ch,
-                            loads={"b": BodyLoads(force, vel, np.zeros(3))})
+    lin = linearize_coupled(
+        [],
+        [body],
+        _settings(),
+        rho=RHO,
+        channels=ch,
+        loads={"b": BodyLoads(force, vel, np.zeros(3))},
+    )
     b = lin.body_drag["b"][2]
     h = lin.body_motion["b"][:, 2, 0]
     expected = (fz + b * vz) / (k33 - w**2 * (m + a33) + 1j * w * (b33 + b))
@@ -188,15 +222,25 @@ def _single_leg_doc(motion=None):
     end_b = {"position": [0.0, 0.0, -5.0]}
     if motion is not None:
         end_b["motion"] = {"rao": motion}
-    return {"environment": {"depth": 50.0},
-            "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}},
-            "lines": [{"name": "leg", "end_a": {"position": [-200.0, 0.0, -50.0]},
-                       "end_b": end_b,
-                       "segments": [{"length": 215.0, "ea": 1e9, "mass": 80.0,
-                                     "diameter": 0.09, "elements": 12}]}],
-            "analysis": {"omega": {"min": 0.2, "max": 2.5, "count": 50},
-                         "solver": "direct",
-                         "linearization": {"tolerance": 1e-11, "max_iterations": 200}}}
+    return {
+        "environment": {"depth": 50.0},
+        "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}},
+        "lines": [
+            {
+                "name": "leg",
+                "end_a": {"position": [-200.0, 0.0, -50.0]},
+                "end_b": end_b,
+                "segments": [
+                    {"length": 215.0, "ea": 1e9, "mass": 80.0, "diameter": 0.09, "elements": 12}
+                ],
+            }
+        ],
+        "analysis": {
+            "omega": {"min": 0.2, "max": 2.5, "count": 50},
+            "solver": "direct",
+            "linearization": {"tolerance": 1e-11, "max_iterations": 200},
+        },
+    }
 
 
 def test_infinite_body_mass_equals_line_with_moving_end():
@@ -207,12 +251,18 @@ def test_infinite_body_mass_equals_line_with_moving_end():
     w = scene.analysis.omega.values()
     xi = np.stack([0.6 * np.exp(0.7j * w), 0.9 + 0.1j * w, 0.02j * np.ones_like(w)])
     big = 1e15
-    pos = np.array([0.0, 0.0, -4.0])     # fairlead r = (0, 0, -1)
+    pos = np.array([0.0, 0.0, -4.0])  # fairlead r = (0, 0, -1)
     M = np.diag([big, big, big])
     F = -(w**2)[None, :] * (M @ xi)
-    body = RigidBody("heavy", pos, big, inertia=np.diag([big, big, big]), planar=True,
-                     excitation=ExcitationTable(w, [0.0], F[None]),
-                     excitation_point=[-pos[0], -pos[1]])
+    body = RigidBody(
+        "heavy",
+        pos,
+        big,
+        inertia=np.diag([big, big, big]),
+        planar=True,
+        excitation=ExcitationTable(w, [0.0], F[None]),
+        excitation_point=[-pos[0], -pos[1]],
+    )
     statics = solve_statics(scene, method="fe")
     line = scene.lines[0]
     s = build_line_system(scene, line, statics.lines["leg"])
@@ -223,10 +273,12 @@ def test_infinite_body_mass_equals_line_with_moving_end():
     # body follows ξ to |line reaction| / (ω² m) < 1e6 / (0.04·1e15)
     np.testing.assert_allclose(lin.body_motion["heavy"][:, :, 0], xi.T, rtol=1e-7)
     lo, _ = coupled_results([cl], [body], lin, scene.analysis)
-    u = xi[0] + (-1.0) * xi[2], xi[1]          # T(r) ξ, r = (0, 0, -1): u_x = ξ1 + r_z θ
-    rao = {"omega": w.tolist(),
-           "surge": {"re": u[0].real.tolist(), "im": u[0].imag.tolist()},
-           "heave": {"re": u[1].real.tolist(), "im": u[1].imag.tolist()}}
+    u = xi[0] + (-1.0) * xi[2], xi[1]  # T(r) ξ, r = (0, 0, -1): u_x = ξ1 + r_z θ
+    rao = {
+        "omega": w.tolist(),
+        "surge": {"re": u[0].real.tolist(), "im": u[0].imag.tolist()},
+        "heave": {"re": u[1].real.tolist(), "im": u[1].imag.tolist()},
+    }
     ref_scene = load_scene(_single_leg_doc(rao))
     rs = build_line_system(ref_scene, ref_scene.lines[0], statics.lines["leg"])
     ch = line_channels(ref_scene, ref_scene.lines[0], rs.positions, w)
@@ -236,8 +288,7 @@ def test_infinite_body_mass_equals_line_with_moving_end():
     for end in ("end_a", "end_b"):
         assert getattr(got, end).std == pytest.approx(getattr(ref, end).std, rel=1e-6)
     np.testing.assert_allclose(got.tension_std, ref.tension_std, rtol=1e-6)
-    np.testing.assert_allclose(got.motion_transfer, ref.motion_transfer, rtol=1e-6,
-                               atol=1e-9)
+    np.testing.assert_allclose(got.motion_transfer, ref.motion_transfer, rtol=1e-6, atol=1e-9)
 
 
 # ------------------------------------------------ second method: assembled system
@@ -251,9 +302,15 @@ def test_substructure_equals_assembled_coupled_system(mooring_direct):
     links, line_loads = [], {}
     for cl in cls:
         damp = lin.lines[cl.name].damping
-        links.append(LineLink(cl.name, cl.system.model, end_b="buoy",
-                              force_b=cl.system.statics.force_b,
-                              damping=damp.matrix))
+        links.append(
+            LineLink(
+                cl.name,
+                cl.system.model,
+                end_b="buoy",
+                force_b=cl.system.statics.force_b,
+                damping=damp.matrix,
+            )
+        )
         inp = line_inputs(cl.system, cl.channels)
         line_loads[cl.name] = to_freq(fluid_loads(cl.system, inp, damp))
     from stochcable.dynamics.coupled.group import linear_body_drag
@@ -268,8 +325,7 @@ def test_substructure_equals_assembled_coupled_system(mooring_direct):
     x = solve_coupled_direct(system, F, w, method="dense")
     xb = x[:, system.body_dofs["buoy"]]
     # two exact solves of the same linear system: round-off of dense LU (cond ~1e8)
-    np.testing.assert_allclose(lin.body_motion["buoy"], xb, rtol=1e-7,
-                               atol=1e-9 * np.abs(xb).max())
+    np.testing.assert_allclose(lin.body_motion["buoy"], xb, rtol=1e-7, atol=1e-9 * np.abs(xb).max())
     for cl in cls:
         u = expand_line(system, cl.name, x)
         got = lin.lines[cl.name].response.displacement
@@ -283,23 +339,31 @@ def test_foss_all_modes_equals_direct_and_truncated_close(mooring_direct):
     scene, cls, loads, body, lin = mooring_direct
     n_free = cls[0].system.model.free.size
     lo_d, bo_d = coupled_results(cls, [body], lin, scene.analysis)
-    ref = np.array([lo_d[n].end_b.std for n in lo_d] + [lo_d[n].end_a.std for n in lo_d]
-                   + list(bo_d["buoy"].motion_std[[0, 2, 4]]))
+    ref = np.array(
+        [lo_d[n].end_b.std for n in lo_d]
+        + [lo_d[n].end_a.std for n in lo_d]
+        + list(bo_d["buoy"].motion_std[[0, 2, 4]])
+    )
     for modes, rtol in ((n_free, 1e-5), (15, 5e-3)):
         # all modes: the same linear system; the Foss eigenvectors' round-off stalls the
         # fixed point near 1e-8, so it is converged to 1e-7 here
-        sc_f, cls_f, loads_f = _group(_mooring_doc(solver="foss", modes=modes, tol=1e-7),
-                                      body)
+        sc_f, cls_f, loads_f = _group(_mooring_doc(solver="foss", modes=modes, tol=1e-7), body)
         assert cls_f[0].system.solver == "foss"
         lin_f = linearize_coupled(cls_f, [body], sc_f.analysis, rho=RHO, loads=loads_f)
         lo_f, bo_f = coupled_results(cls_f, [body], lin_f, scene.analysis)
-        got = np.array([lo_f[n].end_b.std for n in lo_f] + [lo_f[n].end_a.std for n in lo_f]
-                       + list(bo_f["buoy"].motion_std[[0, 2, 4]]))
+        got = np.array(
+            [lo_f[n].end_b.std for n in lo_f]
+            + [lo_f[n].end_a.std for n in lo_f]
+            + list(bo_f["buoy"].motion_std[[0, 2, 4]])
+        )
         np.testing.assert_allclose(got, ref, rtol=rtol)
         if modes == n_free:
-            np.testing.assert_allclose(lin_f.body_motion["buoy"], lin.body_motion["buoy"],
-                                       rtol=1e-5,
-                                       atol=1e-6 * np.abs(lin.body_motion["buoy"]).max())
+            np.testing.assert_allclose(
+                lin_f.body_motion["buoy"],
+                lin.body_motion["buoy"],
+                rtol=1e-5,
+                atol=1e-6 * np.abs(lin.body_motion["buoy"]).max(),
+            )
 
 
 def test_frequency_dependent_tables_exact_in_both_solvers(mooring_direct):
@@ -311,18 +375,22 @@ def test_frequency_dependent_tables_exact_in_both_solvers(mooring_direct):
     tw = np.array([0.05, 1.0, 2.5])
     A = np.stack([body0.added_mass * s for s in (1.5, 1.0, 0.7)])
     B = np.stack([body0.radiation_damping * s for s in (0.2, 1.0, 0.4)])
-    body = dataclasses.replace(body0, added_mass=FrequencyTable(tw, A),
-                               radiation_damping=FrequencyTable(tw, B))
+    body = dataclasses.replace(
+        body0, added_mass=FrequencyTable(tw, A), radiation_damping=FrequencyTable(tw, B)
+    )
     out = []
     for solver, modes in (("direct", "auto"), ("foss", cls[0].system.model.free.size)):
         sc, c, ld = _group(_mooring_doc(solver=solver, modes=modes, tol=1e-7), body)
         out.append(linearize_coupled(c, [body], sc.analysis, rho=RHO, loads=ld))
     # all modes kept: the same linear system, fixed points to 1e-7 (see above)
-    np.testing.assert_allclose(out[1].body_motion["buoy"], out[0].body_motion["buoy"],
-                               rtol=1e-5, atol=1e-6 * np.abs(out[0].body_motion["buoy"]).max())
+    np.testing.assert_allclose(
+        out[1].body_motion["buoy"],
+        out[0].body_motion["buoy"],
+        rtol=1e-5,
+        atol=1e-6 * np.abs(out[0].body_motion["buoy"]).max(),
+    )
     # and the tables do matter: constant matrices give another answer
-    assert not np.allclose(out[0].body_motion["buoy"], lin_const.body_motion["buoy"],
-                           rtol=1e-3)
+    assert not np.allclose(out[0].body_motion["buoy"], lin_const.body_motion["buoy"], rtol=1e-3)
 
 
 # ------------------------------------------------------------------ symmetry
@@ -445,14 +513,27 @@ def _attached_scene(scene, attach, bodies):
             continue
         end, body, point = attach[ln.name]
         ends = {e: getattr(ln, e) for e in ("end_a", "end_b")}
-        ends[end] = SimpleNamespace(position=ends[end].position, motion=None,
-                                    attach=SimpleNamespace(body=body, point=point))
-        lines.append(SimpleNamespace(name=ln.name, segments=ln.segments,
-                                     attachments=ln.attachments, elements=ln.elements,
-                                     length=ln.length, **ends))
-    return SimpleNamespace(environment=scene.environment, sea=scene.sea,
-                           analysis=scene.analysis, is_planar=scene.is_planar,
-                           lines=tuple(lines), bodies=tuple(bodies))
+        ends[end] = SimpleNamespace(
+            position=ends[end].position, motion=None, attach=SimpleNamespace(body=body, point=point)
+        )
+        lines.append(
+            SimpleNamespace(
+                name=ln.name,
+                segments=ln.segments,
+                attachments=ln.attachments,
+                elements=ln.elements,
+                length=ln.length,
+                **ends,
+            )
+        )
+    return SimpleNamespace(
+        environment=scene.environment,
+        sea=scene.sea,
+        analysis=scene.analysis,
+        is_planar=scene.is_planar,
+        lines=tuple(lines),
+        bodies=tuple(bodies),
+    )
 
 
 class _Vessel:
@@ -470,23 +551,28 @@ def test_analyze_coupled_scene_equals_group_and_document(mooring_direct):
     results (linearize_coupled), a body document with rad and deg, and a Result."""
     scene, cls, loads, body, lin = mooring_direct
     statics = solve_statics(scene, method="fe")
-    fake = _attached_scene(scene, {f"leg{i}": ("end_b", "buoy", None) for i in (1, 2, 3)},
-                           [SimpleNamespace(name="buoy", position=(0.0, 0.0, 0.0),
-                                            prescribed=None)])
+    fake = _attached_scene(
+        scene,
+        {f"leg{i}": ("end_b", "buoy", None) for i in (1, 2, 3)},
+        [SimpleNamespace(name="buoy", position=(0.0, 0.0, 0.0), prescribed=None)],
+    )
     timing = {}
-    lines, bodies, systems, damp = analyze_coupled(fake, statics, scene.analysis,
-                                                   timing=timing,
-                                                   rigid_bodies={"buoy": body})
+    lines, bodies, systems, damp = analyze_coupled(
+        fake, statics, scene.analysis, timing=timing, rigid_bodies={"buoy": body}
+    )
     assert list(lines) == ["leg1", "leg2", "leg3"] and systems == {} and damp == {}
     # the same computation
-    np.testing.assert_allclose(bodies["buoy"].motion_transfer,
-                               np.transpose(lin.body_motion["buoy"], (2, 1, 0)), rtol=1e-12)
+    np.testing.assert_allclose(
+        bodies["buoy"].motion_transfer, np.transpose(lin.body_motion["buoy"], (2, 1, 0)), rtol=1e-12
+    )
     doc = bodies["buoy"].to_document()
     assert doc["motion"]["pitch"]["std_deg"] == pytest.approx(
-        math.degrees(doc["motion"]["pitch"]["std"]))
+        math.degrees(doc["motion"]["pitch"]["std"])
+    )
     assert doc["modes"]["omega"][0] > 0 and not doc["prescribed"]
-    res = Result(scene=scene, statics=statics, lines=lines, timeseries=None, timing=timing,
-                 bodies=bodies)
+    res = Result(
+        scene=scene, statics=statics, lines=lines, timeseries=None, timing=timing, bodies=bodies
+    )
     full = res.to_document(timeseries="none")
     assert set(full["bodies"]) == {"buoy"} and "lines" in full
     assert "bodies" not in dataclasses.replace(res, bodies={}).to_document("none")
@@ -499,28 +585,44 @@ def test_vessel_fairlead_equals_end_motion_rao():
     r = np.array([-3.0, 1.0, -4.0])
     vpos = np.array([2.0, -1.0, -1.0])
     fair = vpos + r
-    rao = [lambda w: 0.5 * np.exp(0.4j * w) + 0 * w, lambda w: 0.2j + 0 * w,
-           lambda w: 0.9 + 0.1j * w, lambda w: 0.01 + 0 * w,
-           lambda w: 0.02j * w, lambda w: -0.005 + 0 * w]
-    doc = {"environment": {"depth": 60.0},
-           "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}, "heading": 30.0},
-           "lines": [{"name": "riser", "end_a": {"position": [-150.0, 40.0, -60.0]},
-                      "end_b": {"position": fair.tolist()},
-                      "segments": [{"length": 175.0, "ea": 8e8, "mass": 90.0,
-                                    "diameter": 0.1, "elements": 12}]}],
-           "analysis": {"omega": {"min": 0.2, "max": 2.0, "count": 40},
-                        "solver": "direct"}}
+    rao = [
+        lambda w: 0.5 * np.exp(0.4j * w) + 0 * w,
+        lambda w: 0.2j + 0 * w,
+        lambda w: 0.9 + 0.1j * w,
+        lambda w: 0.01 + 0 * w,
+        lambda w: 0.02j * w,
+        lambda w: -0.005 + 0 * w,
+    ]
+    doc = {
+        "environment": {"depth": 60.0},
+        "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}, "heading": 30.0},
+        "lines": [
+            {
+                "name": "riser",
+                "end_a": {"position": [-150.0, 40.0, -60.0]},
+                "end_b": {"position": fair.tolist()},
+                "segments": [
+                    {"length": 175.0, "ea": 8e8, "mass": 90.0, "diameter": 0.1, "elements": 12}
+                ],
+            }
+        ],
+        "analysis": {"omega": {"min": 0.2, "max": 2.0, "count": 40}, "solver": "direct"},
+    }
     scene = load_scene(doc)
     w = scene.analysis.omega.values()
     statics = solve_statics(scene, method="fe")
     vessel = SimpleNamespace(name="ship", position=tuple(vpos), prescribed=_Vessel(rao))
     fake = _attached_scene(scene, {"riser": ("end_b", "ship", tuple(r))}, [vessel])
-    lines, bodies, systems, damp = analyze_coupled(fake, statics, scene.analysis,
-                                                   rigid_bodies={})
-    xi = np.stack([f(w) for f in rao])                          # (6, n_w)
-    u = xi[:3] + np.cross(xi[3:].T, r).T                         # θ × r
-    mot = {"omega": w.tolist(), **{k: {"re": u[i].real.tolist(), "im": u[i].imag.tolist()}
-                                   for i, k in enumerate(("surge", "sway", "heave"))}}
+    lines, bodies, systems, damp = analyze_coupled(fake, statics, scene.analysis, rigid_bodies={})
+    xi = np.stack([f(w) for f in rao])  # (6, n_w)
+    u = xi[:3] + np.cross(xi[3:].T, r).T  # θ × r
+    mot = {
+        "omega": w.tolist(),
+        **{
+            k: {"re": u[i].real.tolist(), "im": u[i].imag.tolist()}
+            for i, k in enumerate(("surge", "sway", "heave"))
+        },
+    }
     doc["lines"][0]["end_b"]["motion"] = {"rao": mot}
     ref_scene = load_scene(doc)
     rs = build_line_system(ref_scene, ref_scene.lines[0], statics.lines["riser"])
@@ -529,9 +631,8 @@ def test_vessel_fairlead_equals_end_motion_rao():
     got = lines["riser"]
     # the same path with the same end motion up to round-off of the cross product
     assert got.end_b.std == pytest.approx(ref.end_b.std, rel=1e-10)
-    np.testing.assert_allclose(got.motion_transfer, ref.motion_transfer, rtol=1e-10,
-                               atol=1e-14)
-    assert "riser" in systems and "riser" in damp          # the independent path
+    np.testing.assert_allclose(got.motion_transfer, ref.motion_transfer, rtol=1e-10, atol=1e-14)
+    assert "riser" in systems and "riser" in damp  # the independent path
     v = bodies["ship"]
     assert v.prescribed and v.dofs[3] == "roll"
     np.testing.assert_allclose(v.motion_transfer[0], xi, rtol=1e-14)
@@ -550,16 +651,23 @@ def test_free_floating_body_without_lines_closed_form():
     k33, m, a33, b33 = 2e5, 1e4, 6e3, 4e3
     f = np.zeros((1, 6, w.size), complex)
     f[0, 2] = k33 * (1.0 - 0.1 * w**2)
-    body = RigidBody("float", [100.0, 0.0, 0.0], m, inertia=np.eye(3) * 1e4,
-                     added_mass=np.diag([1e3, 1e3, a33, 1e3, 1e3, 1e3]),
-                     radiation_damping=np.diag([1e2, 1e2, b33, 1e2, 1e2, 1e2]),
-                     hydrostatic_stiffness=np.diag([0.0, 0.0, k33, 1e5, 1e5, 0.0]),
-                     excitation=ExcitationTable(w, [0.0], f))
-    fake = _attached_scene(scene, {}, [SimpleNamespace(name="float", position=(100.0, 0, 0),
-                                                       prescribed=None)])
+    body = RigidBody(
+        "float",
+        [100.0, 0.0, 0.0],
+        m,
+        inertia=np.eye(3) * 1e4,
+        added_mass=np.diag([1e3, 1e3, a33, 1e3, 1e3, 1e3]),
+        radiation_damping=np.diag([1e2, 1e2, b33, 1e2, 1e2, 1e2]),
+        hydrostatic_stiffness=np.diag([0.0, 0.0, k33, 1e5, 1e5, 0.0]),
+        excitation=ExcitationTable(w, [0.0], f),
+    )
+    fake = _attached_scene(
+        scene, {}, [SimpleNamespace(name="float", position=(100.0, 0, 0), prescribed=None)]
+    )
     statics = solve_statics(scene, method="fe")
-    lines, bodies, _, _ = analyze_coupled(fake, statics, scene.analysis,
-                                          rigid_bodies={"float": body})
+    lines, bodies, _, _ = analyze_coupled(
+        fake, statics, scene.analysis, rigid_bodies={"float": body}
+    )
     from stochcable.sea.kinematics import wavenumber
 
     k = wavenumber(w, scene.environment.depth)
@@ -581,8 +689,7 @@ def test_body_gravity_stiffness_metacentric_terms():
     expected[3, 3] = expected[4, 4] = RHO * g * vol * zb - m * g * zg
     # exact arithmetic of the same products
     np.testing.assert_allclose(k, expected, rtol=1e-14, atol=1e-9)
-    kp = body_gravity_stiffness(dataclasses.replace(body, planar=True), vol,
-                                [0.0, 0.0, zb], RHO, g)
+    kp = body_gravity_stiffness(dataclasses.replace(body, planar=True), vol, [0.0, 0.0, zb], RHO, g)
     assert kp.shape == (3, 3) and kp[2, 2] == pytest.approx(expected[4, 4], rel=1e-14)
 
 
@@ -596,19 +703,43 @@ def test_scene_vessel_fairlead_equals_end_motion_rao():
     r = np.array([-3.0, 1.0, -4.0])
     vpos = np.array([2.0, -1.0, -1.0])
     w_t = np.linspace(0.1, 3.0, 30)
-    xi = np.stack([0.5 * np.exp(0.4j * w_t), 0.2j + 0 * w_t, 0.9 + 0.1j * w_t,
-                   0.01 + 0 * w_t, 0.02j * w_t, -0.005 + 0 * w_t])
-    tab = {k: {"re": xi[i].real.tolist(), "im": xi[i].imag.tolist()} for i, k in
-           enumerate(("surge", "sway", "heave", "roll", "pitch", "yaw"))}
-    doc = {"environment": {"depth": 60.0},
-           "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}, "heading": 30.0},
-           "bodies": [{"name": "ship", "position": vpos.tolist(), "mass": 1e7,
-                       "prescribed": {"omega": w_t.tolist(), **tab}}],
-           "lines": [{"name": "riser", "end_a": {"position": [-150.0, 40.0, -60.0]},
-                      "end_b": {"attach": {"body": "ship", "point": r.tolist()}},
-                      "segments": [{"length": 175.0, "ea": 8e8, "mass": 90.0,
-                                    "diameter": 0.1, "elements": 12}]}],
-           "analysis": {"omega": {"min": 0.2, "max": 2.0, "count": 40}, "solver": "direct"}}
+    xi = np.stack(
+        [
+            0.5 * np.exp(0.4j * w_t),
+            0.2j + 0 * w_t,
+            0.9 + 0.1j * w_t,
+            0.01 + 0 * w_t,
+            0.02j * w_t,
+            -0.005 + 0 * w_t,
+        ]
+    )
+    tab = {
+        k: {"re": xi[i].real.tolist(), "im": xi[i].imag.tolist()}
+        for i, k in enumerate(("surge", "sway", "heave", "roll", "pitch", "yaw"))
+    }
+    doc = {
+        "environment": {"depth": 60.0},
+        "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}, "heading": 30.0},
+        "bodies": [
+            {
+                "name": "ship",
+                "position": vpos.tolist(),
+                "mass": 1e7,
+                "prescribed": {"omega": w_t.tolist(), **tab},
+            }
+        ],
+        "lines": [
+            {
+                "name": "riser",
+                "end_a": {"position": [-150.0, 40.0, -60.0]},
+                "end_b": {"attach": {"body": "ship", "point": r.tolist()}},
+                "segments": [
+                    {"length": 175.0, "ea": 8e8, "mass": 90.0, "diameter": 0.1, "elements": 12}
+                ],
+            }
+        ],
+        "analysis": {"omega": {"min": 0.2, "max": 2.0, "count": 40}, "solver": "direct"},
+    }
     scene = load_scene(doc)
     statics = solve_statics(scene, method="fe")
     np.testing.assert_allclose(statics.lines["riser"].positions[-1], vpos + r, atol=1e-9)
@@ -617,11 +748,23 @@ def test_scene_vessel_fairlead_equals_end_motion_rao():
     x = scene.bodies[0].prescribed.transfer(w)
     u = x[:3] + np.cross(x[3:].T, r).T
     ref_doc = {**doc, "bodies": []}
-    ref_doc["lines"] = [{**doc["lines"][0], "end_b": {
-        "position": (vpos + r).tolist(),
-        "motion": {"rao": {"omega": w.tolist(), **{
-            k: {"re": u[i].real.tolist(), "im": u[i].imag.tolist()}
-            for i, k in enumerate(("surge", "sway", "heave"))}}}}}]
+    ref_doc["lines"] = [
+        {
+            **doc["lines"][0],
+            "end_b": {
+                "position": (vpos + r).tolist(),
+                "motion": {
+                    "rao": {
+                        "omega": w.tolist(),
+                        **{
+                            k: {"re": u[i].real.tolist(), "im": u[i].imag.tolist()}
+                            for i, k in enumerate(("surge", "sway", "heave"))
+                        },
+                    }
+                },
+            },
+        }
+    ]
     ref_scene = load_scene(ref_doc)
     rs = build_line_system(ref_scene, ref_scene.lines[0], statics.lines["riser"])
     ch = line_channels(ref_scene, ref_scene.lines[0], rs.positions, w)
@@ -638,14 +781,18 @@ def test_scene_three_leg_example_mirror_symmetry():
     yaw; the statics pose is the statistics' mean."""
     from pathlib import Path
 
-    path = (Path(__file__).resolve().parents[1] / "stochcable" / "examples"
-            / "tuah_1982_disc_buoy_three_legs.json")
+    path = (
+        Path(__file__).resolve().parents[1]
+        / "stochcable"
+        / "examples"
+        / "tuah_1982_disc_buoy_three_legs.json"
+    )
     scene = load_scene(path)
     if scene.sea is None or abs(scene.sea.heading) > 0:
         pytest.skip("the example is not at heading 0")
     statics = solve_statics(scene, method="fe")
     lines, bodies, _, _ = analyze_coupled(scene, statics, scene.analysis)
-    (name, b), = bodies.items()
+    ((name, b),) = bodies.items()
     s = b.motion_std
     # mirror symmetry: round-off against the surge σ
     assert max(s[1], s[3], s[5]) < 1e-8 * s[0]
@@ -687,8 +834,7 @@ def test_coarse_start_gives_the_full_grid_fixed_point(solver, monkeypatch):
     g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     idx = coarse_subset(g)
     np.testing.assert_array_equal(idx, np.r_[np.arange(0, 96, 4), 95])
-    full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads,
-                             coarse=False)
+    full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads, coarse=False)
     fast = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads, coarse=True)
     assert full.converged and fast.converged
     assert fast.history[-1] <= 1e-8 and len(fast.history) == fast.iterations
@@ -699,21 +845,31 @@ def test_coarse_start_gives_the_full_grid_fixed_point(solver, monkeypatch):
     assert auto.history == full.history
     for n in ("leg1", "leg2"):
         sig = full.lines[n].damping.sigma
-        np.testing.assert_allclose(fast.lines[n].damping.sigma, sig, rtol=1e-6,
-                                   atol=1e-9 * sig.max())
-        np.testing.assert_allclose(fast.lines[n].response.support_force,
-                                   full.lines[n].response.support_force, rtol=1e-6,
-                                   atol=1e-6 * np.abs(full.lines[n].response
-                                                      .support_force).max())
+        np.testing.assert_allclose(
+            fast.lines[n].damping.sigma, sig, rtol=1e-6, atol=1e-9 * sig.max()
+        )
+        np.testing.assert_allclose(
+            fast.lines[n].response.support_force,
+            full.lines[n].response.support_force,
+            rtol=1e-6,
+            atol=1e-6 * np.abs(full.lines[n].response.support_force).max(),
+        )
     # the sway σ is round-off (heading 0): absolute tolerance at 1e-9 of the largest
-    np.testing.assert_allclose(fast.body_sigma["buoy"], full.body_sigma["buoy"], rtol=1e-6,
-                               atol=1e-9 * full.body_sigma["buoy"].max())
-    np.testing.assert_allclose(fast.body_motion["buoy"], full.body_motion["buoy"],
-                               rtol=1e-6, atol=1e-6 * np.abs(full.body_motion["buoy"]).max())
+    np.testing.assert_allclose(
+        fast.body_sigma["buoy"],
+        full.body_sigma["buoy"],
+        rtol=1e-6,
+        atol=1e-9 * full.body_sigma["buoy"].max(),
+    )
+    np.testing.assert_allclose(
+        fast.body_motion["buoy"],
+        full.body_motion["buoy"],
+        rtol=1e-6,
+        atol=1e-6 * np.abs(full.body_motion["buoy"]).max(),
+    )
 
 
-@pytest.mark.parametrize("solver,warm", [("direct", True), ("foss", True),
-                                         ("foss", False)])
+@pytest.mark.parametrize("solver,warm", [("direct", True), ("foss", True), ("foss", False)])
 def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
     """At the default tolerance 1e-4 the coarse start with its defect correction needs
     fewer full-grid evaluations than the plain iteration (measured 3 against 6 on this
@@ -725,18 +881,25 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
     monkeypatch.setattr(cc, "_WARM_ROUNDS", warm)
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver=solver, tol=1e-4), body)
-    full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads,
-                             coarse=False)
+    full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads, coarse=False)
     n_full = _count_full_evaluations(monkeypatch, 96)
     fast = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)
     assert fast.converged and fast.history[-1] <= 1e-4
     assert 1 <= n_full[0] <= full.iterations - 2
     # both within ~tol of the fixed point (contraction ≈ 0.1): 1e-3 = 10·tol
     for n in ("leg1", "leg2"):
-        np.testing.assert_allclose(fast.lines[n].damping.sigma, full.lines[n].damping.sigma,
-                                   rtol=1e-3, atol=1e-6 * full.lines[n].damping.sigma.max())
-    np.testing.assert_allclose(fast.body_sigma["buoy"], full.body_sigma["buoy"], rtol=1e-3,
-                               atol=1e-6 * full.body_sigma["buoy"].max())
+        np.testing.assert_allclose(
+            fast.lines[n].damping.sigma,
+            full.lines[n].damping.sigma,
+            rtol=1e-3,
+            atol=1e-6 * full.lines[n].damping.sigma.max(),
+        )
+    np.testing.assert_allclose(
+        fast.body_sigma["buoy"],
+        full.body_sigma["buoy"],
+        rtol=1e-3,
+        atol=1e-6 * full.body_sigma["buoy"].max(),
+    )
 
 
 def test_coarse_subset_skipped_on_small_grids(mooring_direct):
@@ -771,10 +934,10 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     is the plain analysis._solve_free of the augmented channels: the same linear
     system, so equal to round-off (1e-10 of the largest entry), truncated (8 of 27
     modes, static correction on) or not."""
-    from stochcable.dynamics.solve import solve_free
-    from stochcable.dynamics.variance import drag_coefficients
     from stochcable.dynamics.coupled.group import GroupSystem
     from stochcable.dynamics.coupled.lineparts import foss_unit_split
+    from stochcable.dynamics.solve import solve_free
+    from stochcable.dynamics.variance import drag_coefficients
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
@@ -801,18 +964,26 @@ def test_all_dofs_fixed_equals_lines_with_fixed_fairleads():
     body = _buoy(fixed_dofs=("surge", "sway", "heave", "roll", "pitch", "yaw"))
     scene, cls, loads = _group(_mooring_doc(), body)
     lin = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)
-    assert np.all(lin.body_motion["buoy"] == 0.0)   # a constraint, exactly zero
+    assert np.all(lin.body_motion["buoy"] == 0.0)  # a constraint, exactly zero
     lo, _ = coupled_results(cls, [body], lin, scene.analysis)
     for cl in cls:
-        ref = line_result(cl.system, cl.channels,
-                          linearize(cl.system, cl.channels, scene.analysis), scene.analysis)
+        ref = line_result(
+            cl.system,
+            cl.channels,
+            linearize(cl.system, cl.channels, scene.analysis),
+            scene.analysis,
+        )
         got = lo[cl.name]
         # both fixed points converged to 1e-10 relative (the group's jointly)
         for end in ("end_a", "end_b"):
             assert getattr(got, end).std == pytest.approx(getattr(ref, end).std, rel=1e-8)
         np.testing.assert_allclose(got.tension_std, ref.tension_std, rtol=1e-8)
-        np.testing.assert_allclose(got.motion_transfer, ref.motion_transfer, rtol=1e-8,
-                                   atol=1e-10 * np.abs(ref.motion_transfer).max())
+        np.testing.assert_allclose(
+            got.motion_transfer,
+            ref.motion_transfer,
+            rtol=1e-8,
+            atol=1e-10 * np.abs(ref.motion_transfer).max(),
+        )
 
 
 def test_fixed_heave_on_springs_closed_form():
@@ -824,17 +995,26 @@ def test_fixed_heave_on_springs_closed_form():
     a = rng.normal(size=(6, 6))
     ks = np.diag([2e4, 3e4, 8e4, 2e5, 3e5, 1e5]) + 2e3 * (a + a.T)
     A = np.diag([800.0, 900.0, 1200.0, 3e3, 3e3, 1e3])
-    A[0, 2] = A[2, 0] = 150.0      # heave couples to surge: fixing heave matters
+    A[0, 2] = A[2, 0] = 150.0  # heave couples to surge: fixing heave matters
     B = np.diag([60.0, 60.0, 90.0, 200.0, 200.0, 50.0])
     f = (1e4 * np.exp(0.3j * w)[None] * np.arange(1, 7)[:, None]).astype(complex)
-    body = RigidBody("b", [0.0, 0.0, -3.0], 5e3, inertia=np.diag([2e4, 2e4, 3e4]),
-                     cog=[0.2, 0.1, -0.5], added_mass=A, radiation_damping=B,
-                     extra_stiffness=ks, fixed_dofs=["heave"],
-                     excitation=ExcitationTable(w, [0.0], f[None]))
+    body = RigidBody(
+        "b",
+        [0.0, 0.0, -3.0],
+        5e3,
+        inertia=np.diag([2e4, 2e4, 3e4]),
+        cog=[0.2, 0.1, -0.5],
+        added_mass=A,
+        radiation_damping=B,
+        extra_stiffness=ks,
+        fixed_dofs=["heave"],
+        excitation=ExcitationTable(w, [0.0], f[None]),
+    )
     spec = np.exp(-((w - 1.0) ** 2))
     ch = (_sea_channel(w, spec),)
-    ld = BodyLoads(force=f.T[:, :, None], velocity=np.zeros((w.size, 3, 1), complex),
-                   current=np.zeros(3))
+    ld = BodyLoads(
+        force=f.T[:, :, None], velocity=np.zeros((w.size, 3, 1), complex), current=np.zeros(3)
+    )
     lin = linearize_coupled([], [body], _settings(), rho=RHO, loads={"b": ld}, channels=ch)
     keep = [0, 1, 3, 4, 5]
     M = body.mass_matrix() + A
@@ -865,8 +1045,9 @@ def test_fixed_dofs_direct_equals_foss_all_modes():
         out[solver] = lin.body_motion["buoy"]
     for x in out.values():
         assert np.all(x[:, [3, 5]] == 0.0)
-    np.testing.assert_allclose(out["foss"], out["direct"], rtol=1e-5,
-                               atol=1e-6 * np.abs(out["direct"]).max())
+    np.testing.assert_allclose(
+        out["foss"], out["direct"], rtol=1e-5, atol=1e-6 * np.abs(out["direct"]).max()
+    )
 
 
 @pytest.mark.parametrize("method", ["full", "reduced"])
@@ -880,8 +1061,10 @@ def test_fixed_dofs_modes_are_the_constrained_eigenproblem(mooring_direct, metho
 
     scene, cls, _, body0, _ = mooring_direct
     body = dataclasses.replace(body0, fixed_dofs=("heave", "yaw"))
-    links = [LineLink(cl.name, cl.system.model, end_b="buoy",
-                      force_b=cl.system.statics.force_b) for cl in cls]
+    links = [
+        LineLink(cl.name, cl.system.model, end_b="buoy", force_b=cl.system.statics.force_b)
+        for cl in cls
+    ]
     system = couple(links, [body])
     K, M, _ = constant_matrices(system, 0.7)
     keep = np.setdiff1d(np.arange(system.n_dof), system.body_dofs["buoy"][[2, 5]])
@@ -910,15 +1093,21 @@ def test_fixed_dofs_validation_and_scene():
     with pytest.raises(InputError, match="fixed_dofs.*repeat"):
         _buoy(fixed_dofs=("heave", "heave"))
     with pytest.raises(InputError, match="fixed_dofs.*unknown"):
-        _buoy(planar=True, added_mass=None, radiation_damping=None,
-              hydrostatic_stiffness=None, fixed_dofs=("yaw",))
+        _buoy(
+            planar=True,
+            added_mass=None,
+            radiation_damping=None,
+            hydrostatic_stiffness=None,
+            fixed_dofs=("yaw",),
+        )
     assert _buoy(fixed_dofs="yaw").fixed_dofs == ("yaw",)
     np.testing.assert_array_equal(_buoy(fixed_dofs=("sway", "yaw")).free_index, [0, 2, 3, 4])
     from stochcable.bodies.from_scene import scene_rigid_bodies
 
     doc = _mooring_doc()
-    doc["bodies"] = [{"name": "buoy", "position": [0.0, 0.0, 0.0], "mass": 2.0e4,
-                      "fixed_dofs": ["yaw", "roll"]}]
+    doc["bodies"] = [
+        {"name": "buoy", "position": [0.0, 0.0, 0.0], "mass": 2.0e4, "fixed_dofs": ["yaw", "roll"]}
+    ]
     rb = scene_rigid_bodies(load_scene(doc))["buoy"]
     assert rb.fixed_dofs == ("yaw", "roll")
     # end to end: the fairleads on the buoy, an oblique sea; roll and yaw stay zero
@@ -926,12 +1115,18 @@ def test_fixed_dofs_validation_and_scene():
     for ln in doc["lines"]:
         p = ln["end_b"].pop("position")
         ln["end_b"]["attach"] = {"body": "buoy", "point": p}
-    doc["bodies"] = [{"name": "buoy", "position": [0.0, 0.0, 0.0], "mass": 2.0e4,
-                      "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
-                      "added_mass": np.diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]).tolist(),
-                      "radiation_damping": np.diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]).tolist(),
-                      "hydrostatic_stiffness": np.diag([0, 0, 1.26e5, 1e5, 1e5, 0]).tolist(),
-                      "fixed_dofs": ["roll", "yaw"]}]
+    doc["bodies"] = [
+        {
+            "name": "buoy",
+            "position": [0.0, 0.0, 0.0],
+            "mass": 2.0e4,
+            "inertia": [[5e4, 0, 0], [0, 5e4, 0], [0, 0, 8e4]],
+            "added_mass": np.diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]).tolist(),
+            "radiation_damping": np.diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]).tolist(),
+            "hydrostatic_stiffness": np.diag([0, 0, 1.26e5, 1e5, 1e5, 0]).tolist(),
+            "fixed_dofs": ["roll", "yaw"],
+        }
+    ]
     sc = load_scene(doc)
     _, bodies, _, _ = analyze_coupled(sc, solve_statics(sc, method="fe"), sc.analysis)
     std = bodies["buoy"].motion_std
@@ -945,8 +1140,7 @@ def test_coarse_start_falls_back_to_the_full_grid(monkeypatch):
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver="foss", tol=1e-4), body)
-    full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads,
-                             coarse=False)
+    full = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads, coarse=False)
 
     def fail(*args, **kwargs):
         raise np.linalg.LinAlgError("Singular matrix")
@@ -971,7 +1165,7 @@ def test_warm_step_is_the_fixed_point_of_an_affine_map():
     xs = rng.uniform(0.5, 1.5, (4, 3))
     pairs = [(x, a @ x + b) for x in xs]
     exact = np.linalg.solve(np.eye(3) - r[:, None] * a, r * b)
-    assert np.all(exact > 0)   # the step clips at zero (σ ≥ 0)
+    assert np.all(exact > 0)  # the step clips at zero (σ ≥ 0)
     np.testing.assert_allclose(_warm_step(pairs, r), exact, rtol=1e-10)
     # one pair: the plain step r·G(x)
     np.testing.assert_allclose(_warm_step(pairs[:1], r), r * (a @ xs[0] + b), rtol=1e-14)
@@ -989,8 +1183,7 @@ def test_large_static_body_rotation_is_flagged():
     from stochcable.examples import load_example
     from stochcable.scene.model import load_scene
 
-    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json",
-                                                                     exclude_none=True)
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json", exclude_none=True)
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
         small = analyze(load_scene(doc))
@@ -998,14 +1191,18 @@ def test_large_static_body_rotation_is_flagged():
     assert float(abs(small.statics.bodies["disc"].rotation[1])) < STATIC_ROTATION_LIMIT
     # a pitch moment of ≈ 0.13 rad × the pitch stiffness 31,399 lbf·ft/rad heels it ≈ 7.6°
     doc["bodies"][0]["wind_moment"] = [0.0, 4000.0, 0.0]
-    with pytest.warns(PhysicsWarning, match=r"body 'disc': its static rotation is 7\.6\d°.*"
-                                            r"above 5°.*give the body's data at its static "
-                                            r"orientation") as rec:
+    with pytest.warns(
+        PhysicsWarning,
+        match=r"body 'disc': its static rotation is 7\.6\d°.*"
+        r"above 5°.*give the body's data at its static "
+        r"orientation",
+    ) as rec:
         big = analyze(load_scene(doc))
     heel = float(big.statics.bodies["disc"].rotation[1])
     assert heel > STATIC_ROTATION_LIMIT
     assert f"{math.degrees(heel):.3g}°" in str(
-        next(w.message for w in rec if "static rotation" in str(w.message)))
+        next(w.message for w in rec if "static rotation" in str(w.message))
+    )
 
 
 # ------------------------------------------------------------ build once, solve many
@@ -1023,8 +1220,11 @@ def _assert_same_results(got, ref, rtol, path="result", seen=None):
     if got is ref or (id(got), id(ref)) in seen:
         return
     seen.add((id(got), id(ref)))
-    if isinstance(ref, (np.ndarray, sp.sparray, sp.spmatrix)) or np.isscalar(ref) and (
-            isinstance(ref, (int, float, complex, np.number)) and not isinstance(ref, bool)):
+    if (
+        isinstance(ref, (np.ndarray, sp.sparray, sp.spmatrix))
+        or np.isscalar(ref)
+        and (isinstance(ref, (int, float, complex, np.number)) and not isinstance(ref, bool))
+    ):
         a = np.asarray(got.toarray() if sp.issparse(got) else got)
         b = np.asarray(ref.toarray() if sp.issparse(ref) else ref)
         assert a.shape == b.shape, path
@@ -1037,8 +1237,9 @@ def _assert_same_results(got, ref, rtol, path="result", seen=None):
         assert type(got) is type(ref), path
         for f in dc.fields(ref):
             if not f.name.startswith("_"):
-                _assert_same_results(getattr(got, f.name), getattr(ref, f.name), rtol,
-                                     f"{path}.{f.name}", seen)
+                _assert_same_results(
+                    getattr(got, f.name), getattr(ref, f.name), rtol, f"{path}.{f.name}", seen
+                )
     elif isinstance(ref, dict):
         assert list(got) == list(ref), path
         for k in ref:
@@ -1064,14 +1265,23 @@ def _frequency_dependent(bodies, scale=0.3):
     out = {}
     for n, b in bodies.items():
         a = np.asarray(b.added_mass, dtype=float)
-        out[n] = dataclasses.replace(b, added_mass=FrequencyTable(
-            w, np.stack([a * (1.0 + scale * x / 5.0) for x in w]), extrapolation="hold"))
+        out[n] = dataclasses.replace(
+            b,
+            added_mass=FrequencyTable(
+                w, np.stack([a * (1.0 + scale * x / 5.0) for x in w]), extrapolation="hold"
+            ),
+        )
     return out
 
 
-@pytest.mark.parametrize("name,table", [("tuah_1982_disc_buoy_single_leg", False),
-                                        ("tuah_1982_disc_buoy_three_legs", False),
-                                        ("tuah_1982_disc_buoy_single_leg", True)])
+@pytest.mark.parametrize(
+    "name,table",
+    [
+        ("tuah_1982_disc_buoy_single_leg", False),
+        ("tuah_1982_disc_buoy_three_legs", False),
+        ("tuah_1982_disc_buoy_single_leg", True),
+    ],
+)
 def test_one_model_solved_for_two_seas_equals_two_fresh_analyses(name, table):
     """build_coupled once, solve_coupled for two sea states (another spectrum; the
     examples' excitation tables have one heading): each result equals a fresh analyze_coupled of
@@ -1095,15 +1305,17 @@ def test_one_model_solved_for_two_seas_equals_two_fresh_analyses(name, table):
     assert all((g.modes is None) == table for g in model.groups)
     got = [solve_coupled(model, sea) for sea in seas]
     for sea, res in zip(seas, got):
-        fresh = analyze_coupled(scene.model_copy(update={"sea": sea}), statics,
-                                scene.analysis, rigid_bodies=rigid)
+        fresh = analyze_coupled(
+            scene.model_copy(update={"sea": sea}), statics, scene.analysis, rigid_bodies=rigid
+        )
         _assert_same_results(res, fresh, 1e-12)
     w_refs = [res.bodies["disc"].modes.omega_ref for res in got]
     assert w_refs[0] != w_refs[1]
-    again = solve_coupled(model, scene)   # a Scene: its sea
+    again = solve_coupled(model, scene)  # a Scene: its sea
     _assert_same_results(again, got[0], 0.0)
     assert got[1].lines[scene.lines[0].name].tension_std.max() != pytest.approx(
-        got[0].lines[scene.lines[0].name].tension_std.max(), rel=1e-3)
+        got[0].lines[scene.lines[0].name].tension_std.max(), rel=1e-3
+    )
 
 
 def test_solve_coupled_needs_the_model_grid():
@@ -1111,11 +1323,13 @@ def test_solve_coupled_needs_the_model_grid():
     from stochcable.dynamics.coupled import build_coupled, solve_coupled
     from stochcable.examples import load_example
 
-    scene = load_scene(load_example("tuah_1982_disc_buoy_single_leg").model_dump(
-        mode="json", exclude_none=True))
+    scene = load_scene(
+        load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json", exclude_none=True)
+    )
     model = build_coupled(scene, solve_statics(scene, method="fe"), scene.analysis)
-    other = scene.analysis.model_copy(update={"omega": scene.analysis.omega.model_copy(
-        update={"count": 50})})
+    other = scene.analysis.model_copy(
+        update={"omega": scene.analysis.omega.model_copy(update={"count": 50})}
+    )
     with pytest.raises(InputError, match="grid the model was built on"):
         solve_coupled(model, None, other)
 
@@ -1139,8 +1353,8 @@ def test_coupled_mode_line_shares_complete_the_mass_normalization(mooring_direct
     total = sum(shares.values()) + np.einsum("jk,jk->k", xi, mb @ xi)
     np.testing.assert_allclose(total, 1.0, rtol=1e-9)
     for cl in cls:
-        np.testing.assert_array_equal(m.line_shapes[cl.name][0], 0.0)   # anchor
-        assert np.abs(m.line_shapes[cl.name][-1]).max() > 0              # fairlead
+        np.testing.assert_array_equal(m.line_shapes[cl.name][0], 0.0)  # anchor
+        assert np.abs(m.line_shapes[cl.name][-1]).max() > 0  # fairlead
 
 
 def test_coupled_bandwidths_tend_to_the_fixed_end_ones_under_a_heavy_body():
@@ -1153,12 +1367,14 @@ def test_coupled_bandwidths_tend_to_the_fixed_end_ones_under_a_heavy_body():
     from stochcable.dynamics.indicators import modal_bandwidths
     from stochcable.dynamics.variance import drag_coefficients
 
-    heavy = _buoy(mass=2.0e10, inertia=np.diag([5e10, 5e10, 8e10]),
-                  hydrostatic_stiffness=np.diag([1e9, 1e9, 1.26e11, 1e11, 1e11, 1e9]))
+    heavy = _buoy(
+        mass=2.0e10,
+        inertia=np.diag([5e10, 5e10, 8e10]),
+        hydrostatic_stiffness=np.diag([1e9, 1e9, 1.26e11, 1e11, 1e11, 1e9]),
+    )
     scene, cls, _ = _group(_mooring_doc(), heavy)
     cl = cls[0]
-    damp = drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements, 0.3),
-                             "seed")
+    damp = drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements, 0.3), "seed")
     m = coupled_modes([cl], [heavy], 0.7, 2.0, method="full")
     band = coupled_modal_bandwidths(m, [cl], [heavy], {cl.name: damp})
     fixed_w = np.asarray(cl.system.modes.omega)

@@ -23,8 +23,6 @@ import stochcable.dynamics.coupled.coarse as cc
 import stochcable.dynamics.coupled.group as cg
 import stochcable.dynamics.coupled.lineparts as cp
 import stochcable.dynamics.coupled.modes as cm
-from stochcable.dynamics.system import noop_progress, build_line_system
-from stochcable.dynamics.variance import quasi_static_motion, sigmas_from_nodes, drag_coefficients
 from stochcable.bodies.rigid import RigidBody
 from stochcable.dynamics.coupled import (
     CoupledLine,
@@ -34,6 +32,8 @@ from stochcable.dynamics.coupled import (
 )
 from stochcable.dynamics.coupled.group import GroupSystem, solve_group
 from stochcable.dynamics.loads import line_channels
+from stochcable.dynamics.system import build_line_system, noop_progress
+from stochcable.dynamics.variance import drag_coefficients, quasi_static_motion, sigmas_from_nodes
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
@@ -44,20 +44,26 @@ from test_coupled_analysis import RHO, _buoy, _group, _mooring_doc  # noqa: E402
 @pytest.fixture
 def node_level(monkeypatch):
     """Switch the Foss lines to the node-level reference path."""
+
     def use(flag: bool) -> None:
         monkeypatch.setattr(cp, "_MODAL_FOSS", flag)
+
     return use
 
 
 def _solve_both(g, node_level, sigma=0.3, body_b=(2e3, 2e3, 4e3)):
-    damp = {cl.name: drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements,
-                                                          sigma), "seed")
-            for cl in g.lines}
+    damp = {
+        cl.name: drag_coefficients(
+            cl.system, np.full(2 * cl.system.model.n_elements, sigma), "seed"
+        )
+        for cl in g.lines
+    }
     bb = {b.name: np.asarray(body_b, float) for b in g.drag}
     bc = np.zeros((g.nb, g.nb))
-    for cl in g.lines:   # the modal path runs (no silent fallback to the reference)
-        cp.FossLine(cl.system, g.inp_phys[cl.name], damp[cl.name],
-                     tuple(k for k, _ in cl.attached()))
+    for cl in g.lines:  # the modal path runs (no silent fallback to the reference)
+        cp.FossLine(
+            cl.system, g.inp_phys[cl.name], damp[cl.name], tuple(k for k, _ in cl.attached())
+        )
     out = []
     for flag in (False, True):
         node_level(flag)
@@ -94,30 +100,54 @@ def _planar_two_body_group():
     body A whose other end moves with its own heave spectrum: exercises the
     attached-end pair (0, 1), truncated modes (6), two channels and a moving
     unattached end."""
-    doc = {"environment": {"depth": 50.0},
-           "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}},
-           "lines": [{"name": "link", "end_a": {"position": [-60.0, 0.0, -20.0]},
-                      "end_b": {"position": [0.0, 0.0, -5.0]},
-                      "segments": [{"length": 66.0, "ea": 1e9, "mass": 80.0,
-                                    "diameter": 0.09, "elements": 12}]},
-                     {"name": "tether", "end_a": {"position": [20.0, 0.0, -45.0]},
-                      "end_b": {"position": [0.0, 0.0, -5.0],
-                                "motion": {"heave": {"type": "jonswap", "hs": 0.5,
-                                                     "tp": 8.0}}},
-                      "segments": [{"length": 45.0, "ea": 1e9, "mass": 50.0,
-                                    "diameter": 0.05, "elements": 8}]}],
-           "analysis": {"omega": {"min": 0.2, "max": 2.5, "count": 30}, "solver": "foss",
-                        "modes": 6}}
+    doc = {
+        "environment": {"depth": 50.0},
+        "sea": {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 7.0}},
+        "lines": [
+            {
+                "name": "link",
+                "end_a": {"position": [-60.0, 0.0, -20.0]},
+                "end_b": {"position": [0.0, 0.0, -5.0]},
+                "segments": [
+                    {"length": 66.0, "ea": 1e9, "mass": 80.0, "diameter": 0.09, "elements": 12}
+                ],
+            },
+            {
+                "name": "tether",
+                "end_a": {"position": [20.0, 0.0, -45.0]},
+                "end_b": {
+                    "position": [0.0, 0.0, -5.0],
+                    "motion": {"heave": {"type": "jonswap", "hs": 0.5, "tp": 8.0}},
+                },
+                "segments": [
+                    {"length": 45.0, "ea": 1e9, "mass": 50.0, "diameter": 0.05, "elements": 8}
+                ],
+            },
+        ],
+        "analysis": {"omega": {"min": 0.2, "max": 2.5, "count": 30}, "solver": "foss", "modes": 6},
+    }
     scene = load_scene(doc)
     st = solve_statics(scene, method="fe")
     w = scene.analysis.omega.values()
-    a = RigidBody("A", [-60.0, 0.0, -19.0], 3e3, inertia=np.diag([0.0, 2e3, 0.0]),
-                  extra_stiffness=np.diag([1e4, 2e4, 3e4]), planar=True,
-                  radiation_damping=np.diag([50.0, 50.0, 50.0]),
-                  drag_area=[1.0, 0.0, 2.0])
-    b = RigidBody("B", [1.0, 0.0, -4.0], 2e3, inertia=np.diag([0.0, 1e3, 0.0]),
-                  extra_stiffness=np.diag([2e4, 2e4, 1e4]), planar=True,
-                  radiation_damping=np.diag([40.0, 40.0, 40.0]))
+    a = RigidBody(
+        "A",
+        [-60.0, 0.0, -19.0],
+        3e3,
+        inertia=np.diag([0.0, 2e3, 0.0]),
+        extra_stiffness=np.diag([1e4, 2e4, 3e4]),
+        planar=True,
+        radiation_damping=np.diag([50.0, 50.0, 50.0]),
+        drag_area=[1.0, 0.0, 2.0],
+    )
+    b = RigidBody(
+        "B",
+        [1.0, 0.0, -4.0],
+        2e3,
+        inertia=np.diag([0.0, 1e3, 0.0]),
+        extra_stiffness=np.diag([2e4, 2e4, 1e4]),
+        planar=True,
+        radiation_damping=np.diag([40.0, 40.0, 40.0]),
+    )
     link = scene.lines[0]
     s = build_line_system(scene, link, st.lines["link"])
     tether = scene.lines[1]
@@ -128,12 +158,22 @@ def _planar_two_body_group():
     from stochcable.dynamics.loads import Channel
 
     names = [c.name for c in ch2]
-    ch1 = tuple(list(ch1) + [Channel(name=c.name, kind="end_motion", omega=c.omega,
-                                     spectrum=c.spectrum, density=c.density)
-                             for c in ch2 if c.kind != "sea"])
+    ch1 = tuple(
+        list(ch1)
+        + [
+            Channel(
+                name=c.name,
+                kind="end_motion",
+                omega=c.omega,
+                spectrum=c.spectrum,
+                density=c.density,
+            )
+            for c in ch2
+            if c.kind != "sea"
+        ]
+    )
     assert [c.name for c in ch1] == names
-    cls = [CoupledLine(s, ch1, end_a="A", end_b="B"),
-           CoupledLine(s2, ch2, end_a="A")]
+    cls = [CoupledLine(s, ch1, end_a="A", end_b="B"), CoupledLine(s2, ch2, end_a="A")]
     loads = {x.name: body_loads(x, ch1, w, scene.sea, scene.environment) for x in (a, b)}
     return cls, [a, b], loads
 
@@ -162,14 +202,22 @@ def test_modal_foss_fixed_point_equals_node_level(node_level):
     ref, got = out
     assert got.iterations == ref.iterations
     # round-off carried through ~5 iterations of a contraction
-    np.testing.assert_allclose(got.body_motion["buoy"], ref.body_motion["buoy"], rtol=0,
-                               atol=1e-9 * np.abs(ref.body_motion["buoy"]).max())
+    np.testing.assert_allclose(
+        got.body_motion["buoy"],
+        ref.body_motion["buoy"],
+        rtol=0,
+        atol=1e-9 * np.abs(ref.body_motion["buoy"]).max(),
+    )
     # σ of near-still elements (≈ 1e-8 m/s against ≈ 0.3 m/s on the line) carry the
     # round-off of the whole line's sums: compared to 1e-9 of the line's largest σ too
     # (a 1e-9 relative miss on the 1e-8 entry was seen on one CPU)
     for n, lin in ref.lines.items():
-        np.testing.assert_allclose(got.lines[n].damping.sigma, lin.damping.sigma,
-                                   rtol=1e-9, atol=1e-9 * lin.damping.sigma.max())
+        np.testing.assert_allclose(
+            got.lines[n].damping.sigma,
+            lin.damping.sigma,
+            rtol=1e-9,
+            atol=1e-9 * lin.damping.sigma.max(),
+        )
 
 
 @pytest.fixture(scope="module")
@@ -191,7 +239,7 @@ def test_reduced_modes_within_tolerance_of_full(benchmark_legs):
     red = coupled_modes(cls, [body], 0.7, 2.0, method="reduced")
     assert red.omega.size == full.omega.size >= 10
     np.testing.assert_allclose(red.omega, full.omega, rtol=1e-3)
-    assert np.all(red.omega >= full.omega * (1 - 1e-9))   # Rayleigh–Ritz: from above
+    assert np.all(red.omega >= full.omega * (1 - 1e-9))  # Rayleigh–Ritz: from above
     np.testing.assert_allclose(red.body_fraction, full.body_fraction, atol=3e-3)
     assert red.asymmetry == pytest.approx(full.asymmetry, rel=1e-6, abs=1e-14)
     # the body shapes span the same motions: |⟨φ_r, φ_f⟩_body| close to the norms for
@@ -202,7 +250,7 @@ def test_reduced_modes_within_tolerance_of_full(benchmark_legs):
 
 
 def test_auto_uses_the_reduction_only_below_its_cutoff(benchmark_legs):
-    """"auto": reduced when every line's highest computed mode is ≥ 1.5× the listing
+    """ "auto": reduced when every line's highest computed mode is ≥ 1.5× the listing
     top (10.5 ≥ 1.5·5), the full problem otherwise (top 2.5·6 = 15 rad/s)."""
     cls, body = benchmark_legs
     auto = coupled_modes(cls, [body], 0.7, 2.0)
@@ -238,8 +286,7 @@ def test_threaded_lines_give_the_same_bits_as_serial(monkeypatch, solver):
     for threads in ("1", "2"):
         monkeypatch.setenv("STOCHCABLE_THREADS", threads)
         with single_blas_thread():
-            out.append(linearize_coupled(cls, [body], scene.analysis, rho=RHO,
-                                         loads=loads))
+            out.append(linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads))
         # the pool ran only when allowed, and only for Foss lines
         assert bool(used) == (threads == "2" and solver == "foss")
     ref, got = out
@@ -247,8 +294,7 @@ def test_threaded_lines_give_the_same_bits_as_serial(monkeypatch, solver):
     np.testing.assert_array_equal(got.body_motion["buoy"], ref.body_motion["buoy"])
     for n, lin in ref.lines.items():
         np.testing.assert_array_equal(got.lines[n].damping.sigma, lin.damping.sigma)
-        np.testing.assert_array_equal(got.lines[n].response.displacement,
-                                      lin.response.displacement)
+        np.testing.assert_array_equal(got.lines[n].response.displacement, lin.response.displacement)
 
 
 def test_foss_decomposition_of_a_line_with_drag_solves_the_quadratic_eigenproblem():
@@ -271,16 +317,15 @@ def test_foss_decomposition_of_a_line_with_drag_solves_the_quadratic_eigenproble
     ch = 0.5 * (ch + ch.T)
     got = foss_modes(mh, ch, kh)
     lam, chi = got.lambdas, got.chi
-    res = (lam**2 * (mh @ chi) + lam * (ch @ chi) + kh @ chi)
+    res = lam**2 * (mh @ chi) + lam * (ch @ chi) + kh @ chi
     # normwise backward error of each pair (element-wise would divide round-off by
     # the ~0 entries of localized modes)
     norm = np.linalg.norm
-    scale = (np.abs(lam) ** 2 * norm(mh, 2) + np.abs(lam) * norm(ch, 2)
-             + norm(kh, 2)) * norm(chi, axis=0)
+    scale = (np.abs(lam) ** 2 * norm(mh, 2) + np.abs(lam) * norm(ch, 2) + norm(kh, 2)) * norm(
+        chi, axis=0
+    )
     assert np.max(norm(res, axis=0) / scale) < 1e-10
-    np.testing.assert_allclose(np.sort_complex(lam), np.sort_complex(lam.conj()),
-                               rtol=1e-10)
-
+    np.testing.assert_allclose(np.sort_complex(lam), np.sort_complex(lam.conj()), rtol=1e-10)
 
 
 # ------------------------------------------------------- coarse stage (pass E5)
@@ -289,9 +334,12 @@ def test_foss_decomposition_of_a_line_with_drag_solves_the_quadratic_eigenproble
 def _solve_modal_direct(g, sigma=0.3, body_b=(2e3, 2e3, 4e3)):
     """The group solve with Foss lines by their Foss decomposition (:class:`_FossLine`)
     and by the per-frequency modal solve of the coarse stage (:class:`_ModalLine`)."""
-    damp = {cl.name: drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements,
-                                                          sigma), "seed")
-            for cl in g.lines}
+    damp = {
+        cl.name: drag_coefficients(
+            cl.system, np.full(2 * cl.system.model.n_elements, sigma), "seed"
+        )
+        for cl in g.lines
+    }
     bb = {b.name: np.asarray(body_b, float) for b in g.drag}
     bc = np.zeros((g.nb, g.nb))
     out = []
@@ -331,9 +379,15 @@ def _coarse_update(g, idx, x=None):
     """The coarse group of ``g`` on ``idx`` and its map evaluated at ``x`` (default
     the rest σ scaled up, so the drag is not tiny)."""
     gc = cc._coarse_group(g, idx)
-    rest = [sigmas_from_nodes(cl.system, g.inp_phys[cl.name],
-                       quasi_static_motion(cl.system, g.inp_phys[cl.name]), "seed")
-            for cl in g.lines]
+    rest = [
+        sigmas_from_nodes(
+            cl.system,
+            g.inp_phys[cl.name],
+            quasi_static_motion(cl.system, g.inp_phys[cl.name]),
+            "seed",
+        )
+        for cl in g.lines
+    ]
     gc.sizes = {cl.name: p.size for cl, p in zip(g.lines, rest)}
     rest += [cg.body_sigma(g, b, None) for b in g.drag]
     x = 3.0 * np.concatenate(rest) if x is None else x
@@ -351,16 +405,23 @@ def test_line_part_cache_gives_the_same_bits(stage, modes):
     fresh group (the cache holds nothing that depends on the drag)."""
     body = _buoy()
     _, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
-    damp = [{cl.name: drag_coefficients(cl.system, np.full(2 * cl.system.model.n_elements,
-                                                           s), "seed") for cl in cls}
-            for s in (0.05, 0.4)]
+    damp = [
+        {
+            cl.name: drag_coefficients(
+                cl.system, np.full(2 * cl.system.model.n_elements, s), "seed"
+            )
+            for cl in cls
+        }
+        for s in (0.05, 0.4)
+    ]
     bb = {body.name: np.array([2e3, 2e3, 4e3])}
     bc = np.zeros((6, 6))
     g1 = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     g2 = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     g1.modal_direct = g2.modal_direct = stage == "coarse"
-    used, other = ("modal_cache", "foss_cache") if stage == "coarse" else \
-        ("foss_cache", "modal_cache")
+    used, other = (
+        ("modal_cache", "foss_cache") if stage == "coarse" else ("foss_cache", "modal_cache")
+    )
     sol0, _ = solve_group(g1, damp[0], bc, bb, None)
     assert all(getattr(g1, used)[cl.name] for cl in cls)
     assert not getattr(g1, other)
@@ -386,17 +447,17 @@ def test_coarse_group_leaves_out_negligible_weights(monkeypatch):
     g = GroupSystem(cls, [body], loads, RHO, cls[0].channels)
     idx = cc.coarse_subset(g)
     gc, upd, x = _coarse_update(g, idx)
-    monkeypatch.setattr(cc, "COARSE_NEGLIGIBLE", -1.0)   # keep every frequency
+    monkeypatch.setattr(cc, "COARSE_NEGLIGIBLE", -1.0)  # keep every frequency
     gall, upd_all, _ = _coarse_update(g, idx)
     assert gall.omega.size == idx.size and gc.omega.size == idx.size - 3
     kept = np.isin(gall.omega, gc.omega)
     np.testing.assert_array_equal(gc.weights, gall.weights[kept])
     assert np.all(np.abs(gall.weights[~kept]) <= 1e-12 * np.abs(gall.weights).max())
     for cl in cls:
-        np.testing.assert_array_equal(gc.inp_phys[cl.name].weights,
-                                      gall.inp_phys[cl.name].weights[kept])
-        np.testing.assert_array_equal(gc.inp_phys[cl.name].square,
-                                      gall.inp_phys[cl.name].square)
+        np.testing.assert_array_equal(
+            gc.inp_phys[cl.name].weights, gall.inp_phys[cl.name].weights[kept]
+        )
+        np.testing.assert_array_equal(gc.inp_phys[cl.name].square, gall.inp_phys[cl.name].square)
     np.testing.assert_allclose(upd(x), upd_all(x), rtol=1e-10)
 
 
@@ -442,7 +503,7 @@ def test_listed_eigh_whole_driver_equals_subset_driver(top):
     lam, phi = cm._listed_eigh(kd, md, top)
     ref = sla.eigh(kd, md, subset_by_value=(-np.inf, top), driver="gvx", eigvals_only=True)
     if ref.size < cm.MIN_LISTED_MODES:
-        ref = sla.eigh(kd, md, eigvals_only=True)[:cm.MIN_LISTED_MODES]
+        ref = sla.eigh(kd, md, eigvals_only=True)[: cm.MIN_LISTED_MODES]
     assert lam.size == ref.size
     np.testing.assert_allclose(lam, ref, rtol=1e-10)
     # mass-normalized eigenvectors: round-off of an n = 60 factorization

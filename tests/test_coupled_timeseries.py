@@ -34,8 +34,10 @@ from stochcable.sea.realization import simulate_sea
 
 # The example's 3-element leg has large motions (its warnings are the subject of
 # other tests); the grid cuts the PM end-motion tail on purpose.
-pytestmark = [pytest.mark.filterwarnings("ignore::stochcable.errors.PhysicsWarning"),
-              pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning")]
+pytestmark = [
+    pytest.mark.filterwarnings("ignore::stochcable.errors.PhysicsWarning"),
+    pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning"),
+]
 
 T_L, DT, M = 256.0, 0.5, (2, 160)
 D_OMEGA = 2.0 * math.pi / T_L
@@ -44,40 +46,74 @@ SINGLE_LEG = "tuah_1982_disc_buoy_single_leg"
 FP_TOLERANCE = 1e-11
 
 
-def _doc(method: str = "dsa", seed: int = 5, *, vessel: bool = True,
-         anchor_motion: bool = True, floating: bool = False) -> dict:
+def _doc(
+    method: str = "dsa",
+    seed: int = 5,
+    *,
+    vessel: bool = True,
+    anchor_motion: bool = True,
+    floating: bool = False,
+) -> dict:
     """Disc buoy on one leg (free, planar), the leg's anchor surging with a PM
     spectrum, (``vessel``) a riser hanging from a prescribed vessel and (``floating``)
     a second disc without lines, held in surge by a spring."""
     doc = copy.deepcopy(load_example(SINGLE_LEG).model_dump(mode="json"))
-    doc["analysis"]["omega"] = {"min": M[0] * D_OMEGA, "max": M[1] * D_OMEGA,
-                                "count": M[1] - M[0] + 1}
+    doc["analysis"]["omega"] = {
+        "min": M[0] * D_OMEGA,
+        "max": M[1] * D_OMEGA,
+        "count": M[1] - M[0] + 1,
+    }
     doc["analysis"]["linearization"] = {"tolerance": FP_TOLERANCE, "max_iterations": 200}
-    doc["analysis"]["timeseries"] = {"method": method, "duration": T_L, "dt": DT,
-                                     "seed": seed}
+    doc["analysis"]["timeseries"] = {"method": method, "duration": T_L, "dt": DT, "seed": seed}
     doc["lines"][0]["segments"][0]["elements"] = 6
     if anchor_motion:
         doc["lines"][0]["end_a"]["motion"] = {
-            "surge": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 9.0}}
+            "surge": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 9.0}
+        }
     if floating:
         b = copy.deepcopy(doc["bodies"][0])
-        b.update(name="float", position=[100.0, 0.0, 0.0], wind_force=[0.0, 0.0, 0.0],
-                 extra_stiffness=[[50.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+        b.update(
+            name="float",
+            position=[100.0, 0.0, 0.0],
+            wind_force=[0.0, 0.0, 0.0],
+            extra_stiffness=[[50.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
+        )
         doc["bodies"].append(b)
     if vessel:
         w = np.linspace(0.01, 5.0, 60)
-        rao = {"surge": 0.8 * np.exp(-0.3j * w) / (1 + w**2),
-               "heave": 1.0 / (1 + (w / 0.9) ** 4) + 0j,
-               "pitch": 0.02j * w * np.exp(-w)}
-        doc["bodies"].append({
-            "name": "ship", "position": [300.0, 0.0, 0.0], "mass": 1e6,
-            "prescribed": {"omega": w.tolist(), **{
-                k: {"re": v.real.tolist(), "im": v.imag.tolist()} for k, v in rao.items()}}})
-        doc["lines"].append({
-            "name": "riser", "end_a": {"position": [500.0, 0.0, -100.0]},
-            "end_b": {"attach": {"body": "ship", "point": [10.0, 0.0, -5.0]}},
-            "segments": [{"length": 260.0, "ea": 1.0e6, "mass": 0.5, "diameter": 0.2,
-                          "cd_normal": 1.2, "elements": 8}]})
+        rao = {
+            "surge": 0.8 * np.exp(-0.3j * w) / (1 + w**2),
+            "heave": 1.0 / (1 + (w / 0.9) ** 4) + 0j,
+            "pitch": 0.02j * w * np.exp(-w),
+        }
+        doc["bodies"].append(
+            {
+                "name": "ship",
+                "position": [300.0, 0.0, 0.0],
+                "mass": 1e6,
+                "prescribed": {
+                    "omega": w.tolist(),
+                    **{k: {"re": v.real.tolist(), "im": v.imag.tolist()} for k, v in rao.items()},
+                },
+            }
+        )
+        doc["lines"].append(
+            {
+                "name": "riser",
+                "end_a": {"position": [500.0, 0.0, -100.0]},
+                "end_b": {"attach": {"body": "ship", "point": [10.0, 0.0, -5.0]}},
+                "segments": [
+                    {
+                        "length": 260.0,
+                        "ea": 1.0e6,
+                        "mass": 0.5,
+                        "diameter": 0.2,
+                        "cd_normal": 1.2,
+                        "elements": 8,
+                    }
+                ],
+            }
+        )
     return doc
 
 
@@ -132,16 +168,28 @@ def _series(res):
     out = []
     for end in ("end_a", "end_b"):
         mean = getattr(res.lines["leg"], end).mean
-        out.append((f"leg.{end}", ts.end_tension["leg"][end] - mean,
-                    ts.end_tension_transfer["leg"][end], ts.channels["leg"],
-                    res.lines["leg"].end_tension_spectrum(end)))
+        out.append(
+            (
+                f"leg.{end}",
+                ts.end_tension["leg"][end] - mean,
+                ts.end_tension_transfer["leg"][end],
+                ts.channels["leg"],
+                res.lines["leg"].end_tension_spectrum(end),
+            )
+        )
     for body in res.timeseries.body_motion:
         b = res.bodies[body]
         spec = b.motion_spectrum
         for i, dof in enumerate(b.dofs):
-            out.append((f"{body}.{dof}", ts.body_motion[body][dof] - b.motion[dof].mean,
-                        ts.body_motion_transfer[body][:, i], ts.body_channels[body],
-                        spec[i]))
+            out.append(
+                (
+                    f"{body}.{dof}",
+                    ts.body_motion[body][dof] - b.motion[dof].mean,
+                    ts.body_motion_transfer[body][:, i],
+                    ts.body_channels[body],
+                    spec[i],
+                )
+            )
     return out
 
 
@@ -158,7 +206,7 @@ def test_dsa_variance_equals_band_sum_and_result_sigma(sea_only_result):
     for label, x, h, names, s_fd in _series(res):
         s_in = _channel_spectra(res, names)
         band_sum = float(np.sum(np.abs(h) ** 2 * s_in) * D_OMEGA)
-        if band_sum == 0.0:        # the ship's sway, roll, yaw (planar RAO)
+        if band_sum == 0.0:  # the ship's sway, roll, yaw (planar RAO)
             assert np.all(x == 0.0), label
             continue
         # DSA: the record's variance is the band sum of |H|²SΔω exactly (Parseval over
@@ -171,10 +219,12 @@ def test_dsa_variance_equals_band_sum_and_result_sigma(sea_only_result):
         # exact on this grid); the spectra come from two solves of the same linear
         # system at the same drag: round-off
         sigma = res.lines["leg"] if label.startswith("leg") else None
-        m0 = (getattr(sigma, label[4:]).m0 if sigma is not None
-              else res.bodies[label.split(".")[0]].motion[label.split(".")[1]].m0)
-        assert m0 + 0.5 * D_OMEGA * (s_fd[0] + s_fd[-1]) == pytest.approx(band_sum,
-                                                                         rel=1e-9), label
+        m0 = (
+            getattr(sigma, label[4:]).m0
+            if sigma is not None
+            else res.bodies[label.split(".")[0]].motion[label.split(".")[1]].m0
+        )
+        assert m0 + 0.5 * D_OMEGA * (s_fd[0] + s_fd[-1]) == pytest.approx(band_sum, rel=1e-9), label
         checked += 1
     # both leg ends, the 3 DOFs of the disc, the line-less float and the ship
     assert checked == 2 + 3 + 3 + 3
@@ -185,21 +235,37 @@ def test_dsa_three_leg_buoy_in_3d():
     with motion has the DSA variance of its band sum and the Result's σ² plus the end
     half-weights (as above); the mirror-symmetric sway, roll, yaw stay ~0."""
     doc = load_example("tuah_1982_disc_buoy_three_legs").model_dump(mode="json")
-    doc["analysis"]["omega"] = {"min": M[0] * D_OMEGA, "max": M[1] * D_OMEGA,
-                                "count": M[1] - M[0] + 1}
+    doc["analysis"]["omega"] = {
+        "min": M[0] * D_OMEGA,
+        "max": M[1] * D_OMEGA,
+        "count": M[1] - M[0] + 1,
+    }
     doc["analysis"]["timeseries"] = {"method": "dsa", "duration": T_L, "dt": DT, "seed": 2}
     res = analyze(doc)
     ts = res.timeseries
     s_sea = _sea_density(res)
     b = res.bodies["disc"]
-    items = [(ts.end_tension[n][e] - getattr(res.lines[n], e).mean,
-              ts.end_tension_transfer[n][e][0], getattr(res.lines[n], e).m0,
-              res.lines[n].end_tension_spectrum(e)) for n in res.lines
-             for e in ("end_a", "end_b")]
+    items = [
+        (
+            ts.end_tension[n][e] - getattr(res.lines[n], e).mean,
+            ts.end_tension_transfer[n][e][0],
+            getattr(res.lines[n], e).m0,
+            res.lines[n].end_tension_spectrum(e),
+        )
+        for n in res.lines
+        for e in ("end_a", "end_b")
+    ]
     spec = b.motion_spectrum
-    items += [(ts.body_motion["disc"][k] - b.motion[k].mean,
-               ts.body_motion_transfer["disc"][0, i], b.motion[k].m0, spec[i])
-              for i, k in enumerate(b.dofs) if k in ("surge", "heave", "pitch")]
+    items += [
+        (
+            ts.body_motion["disc"][k] - b.motion[k].mean,
+            ts.body_motion_transfer["disc"][0, i],
+            b.motion[k].m0,
+            spec[i],
+        )
+        for i, k in enumerate(b.dofs)
+        if k in ("surge", "heave", "pitch")
+    ]
     for x, h, m0, s_fd in items:
         band_sum = float(np.sum(np.abs(h) ** 2 * s_sea) * D_OMEGA)
         # Parseval (round-off) and the trapezoid + end half-weights (two solves of one
@@ -218,7 +284,7 @@ def test_transfer_outside_the_band_is_zero_and_warning_is_gone(dsa_result):
     assert ts.channels["leg"] == ("sea", "leg.end_a.surge")
     assert ts.body_channels == {"disc": ("sea", "leg.end_a.surge"), "ship": ("sea",)}
     for h in (ts.end_tension_transfer["leg"]["end_b"], ts.body_motion_transfer["disc"]):
-        assert np.all(h[..., :M[0]] == 0.0) and np.all(h[..., M[1] + 1:] == 0.0)
+        assert np.all(h[..., : M[0]] == 0.0) and np.all(h[..., M[1] + 1 :] == 0.0)
     assert not any("time series are not simulated" in m for m in messages)
     assert set(ts.end_tension) == {"leg", "riser"}
 
@@ -254,17 +320,19 @@ def test_coupled_tension_is_the_convolution_of_eta_and_the_anchor_motion(dsa_res
     assert line.channels == ts.channels["leg"]
     n_t = ts.time.size
     y = ts.end_tension["leg"][end] - getattr(line, end).mean
-    expected = sum(_circular_convolution(np.fft.irfft(_on_grid(res, h), n_t), x)
-                   for h, x in zip(line.end_tension_transfer[end],
-                                   _inputs(res, line.channels)))
+    expected = sum(
+        _circular_convolution(np.fft.irfft(_on_grid(res, h), n_t), x)
+        for h, x in zip(line.end_tension_transfer[end], _inputs(res, line.channels))
+    )
     scale = float(np.max(np.abs(expected)))
     assert scale > 0.0
     # round-off: FFTs vs the direct sum, two solves of the same system (1e-9 above);
     # a wrong channel order or realization (seed scheme) is an O(1) error
     np.testing.assert_allclose(y, expected, rtol=0, atol=1e-9 * scale)
-    swapped = sum(_circular_convolution(np.fft.irfft(_on_grid(res, h), n_t), x)
-                  for h, x in zip(line.end_tension_transfer[end],
-                                  _inputs(res, line.channels)[::-1]))
+    swapped = sum(
+        _circular_convolution(np.fft.irfft(_on_grid(res, h), n_t), x)
+        for h, x in zip(line.end_tension_transfer[end], _inputs(res, line.channels)[::-1])
+    )
     assert np.max(np.abs(swapped - y)) > 0.1 * scale
 
 
@@ -277,8 +345,10 @@ def test_body_motion_is_the_convolution_of_its_inputs(dsa_result, body):
     n_t = ts.time.size
     for i, dof in enumerate(b.dofs):
         y = ts.body_motion[body][dof] - b.motion[dof].mean
-        expected = sum(_circular_convolution(np.fft.irfft(_on_grid(res, h), n_t), x)
-                       for h, x in zip(b.motion_transfer[:, i], _inputs(res, b.channels)))
+        expected = sum(
+            _circular_convolution(np.fft.irfft(_on_grid(res, h), n_t), x)
+            for h, x in zip(b.motion_transfer[:, i], _inputs(res, b.channels))
+        )
         scale = float(np.max(np.abs(expected)))
         if scale == 0.0:
             assert np.all(y == 0.0)
@@ -298,8 +368,13 @@ def test_vessel_riser_series_moves_with_the_vessel(dsa_result):
     np.testing.assert_allclose(h, ref, rtol=1e-9, atol=1e-12 * np.max(np.abs(ref)))
     # the elevation is the stand-alone realization with the seed
     spec, g = res.scene.sea.spectrum, res.scene.environment.g
-    eta = simulate_sea(lambda w: np.where(w > 0, spec.spectral_density(
-        np.where(w > 0, w, 1.0), g), 0.0), T_L, DT, "dsa", rng=5)
+    eta = simulate_sea(
+        lambda w: np.where(w > 0, spec.spectral_density(np.where(w > 0, w, 1.0), g), 0.0),
+        T_L,
+        DT,
+        "dsa",
+        rng=5,
+    )
     np.testing.assert_allclose(ts.elevation, eta.elevation, rtol=0, atol=1e-12)
 
 
@@ -310,10 +385,17 @@ def _fixed_body_docs():
     doc = _doc(vessel=False)
     body = doc["bodies"][0]
     big = 1e15
-    body.update(mass=big, inertia=np.diag([big] * 3).tolist(), hydrodynamics=None,
-                added_mass=None, radiation_damping=None, drag_area=[0.0, 0.0, 0.0],
-                wind_force=[0.0, 0.0, 0.0], displaced_volume=None,
-                fixed_dofs=["surge", "heave", "pitch"])
+    body.update(
+        mass=big,
+        inertia=np.diag([big] * 3).tolist(),
+        hydrodynamics=None,
+        added_mass=None,
+        radiation_damping=None,
+        drag_area=[0.0, 0.0, 0.0],
+        wind_force=[0.0, 0.0, 0.0],
+        displaced_volume=None,
+        fixed_dofs=["surge", "heave", "pitch"],
+    )
     ref = copy.deepcopy(doc)
     ref.pop("bodies")
     return doc, ref
@@ -330,8 +412,9 @@ def test_fixed_heavy_body_gives_the_fixed_fairlead_series():
     ts, tr = res.timeseries, rref.timeseries
     assert ts.channels["leg"] == ("sea", "leg.end_a.surge")
     assert tr.channels["leg"] == ("sea", "end_a.surge")
-    np.testing.assert_array_equal(ts.end_motion["leg.end_a.surge"],
-                                  tr.end_motion["leg.end_a.surge"])
+    np.testing.assert_array_equal(
+        ts.end_motion["leg.end_a.surge"], tr.end_motion["leg.end_a.surge"]
+    )
     for end in ("end_a", "end_b"):
         a, b = ts.end_tension["leg"][end], tr.end_tension["leg"][end]
         scale = float(np.std(b))
@@ -361,11 +444,17 @@ def test_nsa_variance_within_its_sampling_band():
         ts = res.timeseries
         s_sea = _sea_density(res)
         for key, x, h in (
-                ("heave", ts.body_motion["disc"]["heave"]
-                 - res.bodies["disc"].motion["heave"].mean,
-                 ts.body_motion_transfer["disc"][0, 1]),
-                ("tension", ts.end_tension["leg"]["end_b"] - res.lines["leg"].end_b.mean,
-                 ts.end_tension_transfer["leg"]["end_b"][0])):
+            (
+                "heave",
+                ts.body_motion["disc"]["heave"] - res.bodies["disc"].motion["heave"].mean,
+                ts.body_motion_transfer["disc"][0, 1],
+            ),
+            (
+                "tension",
+                ts.end_tension["leg"]["end_b"] - res.lines["leg"].end_b.mean,
+                ts.end_tension_transfer["leg"]["end_b"][0],
+            ),
+        ):
             c = np.abs(h) ** 2 * s_sea * D_OMEGA
             nu = 2.0 * c.sum() ** 2 / np.sum(c**2)
             lo, hi = stats.chi2.ppf([5e-4, 1 - 5e-4], nu) / nu
@@ -396,9 +485,12 @@ def test_chunked_solve_equals_one_piece(dsa_result):
     whole = coupled_group_transfer(scene, group, w, budget=2**40)
     parts = coupled_group_transfer(scene, group, w, budget=1)
     assert len(list(frequency_chunks(w.size, 10**9, 1))) == math.ceil(w.size / 64)
-    np.testing.assert_allclose(parts.body_motion["disc"], whole.body_motion["disc"],
-                               rtol=1e-12, atol=1e-14 * np.max(np.abs(
-                                   whole.body_motion["disc"])))
+    np.testing.assert_allclose(
+        parts.body_motion["disc"],
+        whole.body_motion["disc"],
+        rtol=1e-12,
+        atol=1e-14 * np.max(np.abs(whole.body_motion["disc"])),
+    )
     for end in ("end_a", "end_b"):
         a, b = parts.end_tension["leg"][end], whole.end_tension["leg"][end]
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-14 * np.max(np.abs(b)))
@@ -422,5 +514,7 @@ def test_document_has_the_body_series(dsa_result):
     assert list(doc["bodies"]["disc"]["motion"]) == ["surge", "heave", "pitch"]
     assert len(doc["bodies"]["ship"]["motion"]["roll"]) == doc["window"]
     assert set(doc["lines"]) == {"leg", "riser"}
-    np.testing.assert_array_equal(doc["bodies"]["disc"]["motion"]["heave"],
-                                  res.timeseries.body_motion["disc"]["heave"][:doc["window"]])
+    np.testing.assert_array_equal(
+        doc["bodies"]["disc"]["motion"]["heave"],
+        res.timeseries.body_motion["disc"]["heave"][: doc["window"]],
+    )

@@ -66,8 +66,7 @@ def _count_builds(monkeypatch) -> dict[str, int]:
 
 def test_analyze_is_build_then_solve():
     doc = _doc("taut_wire")
-    assert_close_documents(_plain(build_engine(doc).solve()), _plain(analyze(doc)),
-                           rtol=1e-12)
+    assert_close_documents(_plain(build_engine(doc).solve()), _plain(analyze(doc)), rtol=1e-12)
     assert stochcable.build_engine is build_engine
 
 
@@ -79,9 +78,9 @@ def test_two_sea_states_match_fresh_analyses_and_build_once(monkeypatch):
     engine = build_engine(doc)
     assert isinstance(engine, Engine) and len(engine.systems) == 1
     assert calls == {"statics": 1, "model": 1}
-    got_2 = engine.solve(SEA_2)                  # a mapping ...
-    got_1 = engine.solve()                       # ... and the scene's own sea
-    assert calls == {"statics": 1, "model": 1}   # nothing rebuilt
+    got_2 = engine.solve(SEA_2)  # a mapping ...
+    got_1 = engine.solve()  # ... and the scene's own sea
+    assert calls == {"statics": 1, "model": 1}  # nothing rebuilt
     assert_close_documents(_plain(got_1), fresh_1, rtol=1e-12)
     assert_close_documents(_plain(got_2), fresh_2, rtol=1e-12)
     assert got_2.scene.sea == Sea.model_validate(SEA_2)
@@ -94,8 +93,7 @@ def test_different_hs_on_a_single_line():
     engine = build_engine(doc)
     small = {**doc["sea"], "spectrum": {**spec, "hs": 0.5 * spec["hs"]}}
     res_small, res = engine.solve(Sea.model_validate(small)), engine.solve()
-    assert_close_documents(_plain(res_small), _plain(analyze(_with_sea(doc, small))),
-                           rtol=1e-12)
+    assert_close_documents(_plain(res_small), _plain(analyze(_with_sea(doc, small))), rtol=1e-12)
     name = next(iter(res.lines))
     # drag makes the response sublinear in Hs, but it does grow with it
     assert 0.0 < res_small.lines[name].end_b.std < res.lines[name].end_b.std
@@ -113,7 +111,7 @@ def test_scene_with_bodies(monkeypatch):
     fresh = _plain(analyze(_with_sea(doc, sea)))
     calls = _count_builds(monkeypatch)
     engine = build_engine(doc)
-    assert engine.systems == {}                  # the coupled systems are built per solve
+    assert engine.systems == {}  # the coupled systems are built per solve
     first = engine.solve(sea)
     engine.solve()
     assert calls["statics"] == 1

@@ -7,19 +7,25 @@ import math
 from pathlib import Path
 
 import pytest
-
 from references import BLIET_1984_GUY, TUAH_1982_EX2, TUAH_1982_EX5
-from stochcable.line.catenary import catenary_line
+
 from stochcable.errors import InputError
 from stochcable.examples import list_examples, load_example
+from stochcable.line.catenary import catenary_line
 from stochcable.line.mesh import mesh_line
 
 ROOT = Path(__file__).resolve().parents[1]
 PKG = ROOT / "stochcable" / "examples"
 
-EXPECTED = {"chain_catenary", "tuah_1982_suspended_cable", "taut_wire", "inclined_guy",
-            "tuah_1982_single_leg", "tuah_1982_disc_buoy_single_leg",
-            "tuah_1982_disc_buoy_three_legs"}
+EXPECTED = {
+    "chain_catenary",
+    "tuah_1982_suspended_cable",
+    "taut_wire",
+    "inclined_guy",
+    "tuah_1982_single_leg",
+    "tuah_1982_disc_buoy_single_leg",
+    "tuah_1982_disc_buoy_three_legs",
+}
 
 
 def test_list_and_load():
@@ -29,8 +35,11 @@ def test_list_and_load():
         scene = load_example(name)
         assert 0 < len(scene.title) <= 200
         assert load_example(f"{name}.json") == scene
-    with pytest.raises(InputError, match=r"example = 'nope': is not a known example; known: "
-                                         r"chain_catenary, inclined_guy"):
+    with pytest.raises(
+        InputError,
+        match=r"example = 'nope': is not a known example; known: "
+        r"chain_catenary, inclined_guy",
+    ):
         load_example("nope")
 
 
@@ -45,17 +54,31 @@ def test_chain_catenary_is_design_example():
     """The example is DESIGN.md's v1 scene (without the load-free attachment)."""
     doc = json.loads((PKG / "chain_catenary.json").read_text(encoding="utf-8"))
     line = doc["lines"][0]
-    assert doc["environment"] == {"depth": 200.0, "rho": 1025.0, "g": 9.80665,
-                                  "current": [{"z": 0.0, "speed": 0.5, "heading": 0.0}],
-                                  "seabed": {"stiffness": 3.0e6, "damping": 3.0e5}}
-    assert doc["sea"] == {"spectrum": {"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0},
-                          "heading": 0.0}
+    assert doc["environment"] == {
+        "depth": 200.0,
+        "rho": 1025.0,
+        "g": 9.80665,
+        "current": [{"z": 0.0, "speed": 0.5, "heading": 0.0}],
+        "seabed": {"stiffness": 3.0e6, "damping": 3.0e5},
+    }
+    assert doc["sea"] == {
+        "spectrum": {"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0},
+        "heading": 0.0,
+    }
     assert line["end_a"]["position"] == [-800.0, 0.0, -200.0]
-    assert line["end_b"]["motion"]["surge"] == {"type": "pierson_moskowitz", "hs": 2.0,
-                                                "tp": 10.0}
-    assert line["segments"] == [{"length": 850.0, "ea": 1.2326e9, "mass": 288.0,
-                                 "diameter": 0.216, "cd_normal": 1.333, "cd_axial": 0.2034,
-                                 "ca_normal": 1.0, "elements": 40}]
+    assert line["end_b"]["motion"]["surge"] == {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}
+    assert line["segments"] == [
+        {
+            "length": 850.0,
+            "ea": 1.2326e9,
+            "mass": 288.0,
+            "diameter": 0.216,
+            "cd_normal": 1.333,
+            "cd_axial": 0.2034,
+            "ca_normal": 1.0,
+            "elements": 40,
+        }
+    ]
 
 
 def test_tuah_suspended_cable_matches_seed_data():
@@ -107,7 +130,6 @@ def test_single_leg_wind_balance_and_sea():
     assert (sp.m0, sp.omega_p) == (TUAH_1982_EX5["m0"], TUAH_1982_EX5["omega_p"])
     om = s.analysis.omega
     assert om.count == TUAH_1982_EX5["n_frequencies"]
-    assert (om.max - om.min) / (om.count - 1) == pytest.approx(TUAH_1982_EX5["d_omega"],
-                                                              rel=1e-12)
+    assert (om.max - om.min) / (om.count - 1) == pytest.approx(TUAH_1982_EX5["d_omega"], rel=1e-12)
     ts = s.analysis.timeseries
     assert (ts.duration, ts.dt) == (TUAH_1982_EX5["record_length"], TUAH_1982_EX5["dt"])

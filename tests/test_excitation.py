@@ -9,7 +9,6 @@ import pytest
 
 from stochcable.dynamics import system as dsystem
 from stochcable.dynamics import variance as dvariance
-from stochcable.errors import InputError
 from stochcable.dynamics.loads import (
     drag_matrix,
     element_frames,
@@ -17,8 +16,9 @@ from stochcable.dynamics.loads import (
     line_channels,
     prescribed_motion,
 )
-from stochcable.sea.kinematics import wave_kinematics
+from stochcable.errors import InputError
 from stochcable.scene.model import load_scene
+from stochcable.sea.kinematics import wave_kinematics
 from stochcable.statics import solve_statics
 
 RHO = 1025.0
@@ -32,20 +32,34 @@ def straight_doc(*, sea=True, motion=None, heading=20.0, attachments=()):
         end_b["motion"] = motion
     doc = {
         "environment": {"depth": 100.0, "rho": RHO, "g": G},
-        "lines": [{
-            "name": "l",
-            "end_a": {"position": [0.0, 0.0, -80.0]},
-            "end_b": end_b,
-            "segments": [{"length": 89.0, "ea": 1.0e8, "mass": 20.0, "diameter": 0.2,
-                          "cd_normal": 1.2, "cd_axial": 0.3, "ca_normal": 0.8,
-                          "weight": 0.0, "elements": 9}],
-            "attachments": list(attachments),
-        }],
+        "lines": [
+            {
+                "name": "l",
+                "end_a": {"position": [0.0, 0.0, -80.0]},
+                "end_b": end_b,
+                "segments": [
+                    {
+                        "length": 89.0,
+                        "ea": 1.0e8,
+                        "mass": 20.0,
+                        "diameter": 0.2,
+                        "cd_normal": 1.2,
+                        "cd_axial": 0.3,
+                        "ca_normal": 0.8,
+                        "weight": 0.0,
+                        "elements": 9,
+                    }
+                ],
+                "attachments": list(attachments),
+            }
+        ],
         "analysis": {"omega": {"min": 0.2, "max": 1.5, "count": 7}},
     }
     if sea:
-        doc["sea"] = {"spectrum": {"type": "pierson_moskowitz", "hs": 3.0, "tp": 8.0},
-                      "heading": heading}
+        doc["sea"] = {
+            "spectrum": {"type": "pierson_moskowitz", "hs": 3.0, "tp": 8.0},
+            "heading": heading,
+        }
     return doc
 
 
@@ -114,8 +128,10 @@ def test_element_frames_are_orthonormal_and_n2_out_of_plane():
 
 
 def test_channels_order_kinematics_and_prescribed_motion():
-    motion = {"surge": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 9.0},
-              "heave": {"type": "jonswap", "hs": 0.5, "tp": 7.0}}
+    motion = {
+        "surge": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 9.0},
+        "heave": {"type": "jonswap", "hs": 0.5, "tp": 7.0},
+    }
     doc = straight_doc(motion=motion)
     scene, system = built(doc)
     w = scene.analysis.omega.values()
@@ -126,8 +142,9 @@ def test_channels_order_kinematics_and_prescribed_motion():
     np.testing.assert_array_equal(sea.velocity, np.transpose(kin.velocity, (2, 0, 1)))
     np.testing.assert_array_equal(sea.acceleration, np.transpose(kin.acceleration, (2, 0, 1)))
     np.testing.assert_allclose(sea.spectrum, scene.sea.spectrum.spectral_density(w, G))
-    np.testing.assert_allclose(chans[2].spectrum,
-                               scene.lines[0].end_b.motion.heave.spectral_density(w, G))
+    np.testing.assert_allclose(
+        chans[2].spectrum, scene.lines[0].end_b.motion.heave.spectral_density(w, G)
+    )
     ub = prescribed_motion(system.model, chans, w.size)  # (n_w, n_fixed=6, n_ch)
     assert np.all(ub[:, :, 0] == 0)
     np.testing.assert_array_equal(ub[:, :, 1], np.tile([0, 0, 0, 1, 0, 0], (w.size, 1)))
@@ -163,18 +180,19 @@ def test_sigma_of_line_at_rest_is_element_mean_of_fluid_velocity_sigma():
     pos = system.positions
     xg, wg = np.polynomial.legendre.leggauss(12)
     xi, wg = 0.5 * (xg + 1.0), 0.5 * wg
-    pts = (pos[:-1, None, :] + xi[None, :, None] * (pos[1:] - pos[:-1])[:, None, :])
+    pts = pos[:-1, None, :] + xi[None, :, None] * (pos[1:] - pos[:-1])[:, None, :]
     kin = wave_kinematics(w, pts.reshape(-1, 3), math.radians(20.0), 100.0, G).velocity
     kin = kin.reshape(n, xi.size, 3, w.size)
     s = scene.sea.spectrum.spectral_density(w, G)
     e = element_frames(pos)[0]
     total = np.trapezoid(np.einsum("epkw,p->ew", np.abs(kin) ** 2, wg) * s, w, axis=-1)
-    axial = np.trapezoid(np.einsum("epw,p->ew", np.abs(np.einsum("epkw,ek->epw", kin, e)) ** 2,
-                                   wg) * s, w, axis=-1)
+    axial = np.trapezoid(
+        np.einsum("epw,p->ew", np.abs(np.einsum("epkw,ek->epw", kin, e)) ** 2, wg) * s, w, axis=-1
+    )
     # 12-point Gauss on e^{2kz} over Δz = 6.7 m with 2k <= 0.46/m (kΔz <= 3): exact to
     # ~1e-15; the rest is round-off
-    np.testing.assert_allclose(sig[:n] ** 2 + sig[n:2 * n] ** 2, total, rtol=1e-12)
-    np.testing.assert_allclose(sig[n:2 * n] ** 2, axial, rtol=1e-12)
+    np.testing.assert_allclose(sig[:n] ** 2 + sig[n : 2 * n] ** 2, total, rtol=1e-12)
+    np.testing.assert_allclose(sig[n : 2 * n] ** 2, axial, rtol=1e-12)
 
 
 def test_fully_wet_exp_moments_are_the_general_formula():
@@ -203,8 +221,9 @@ def test_fully_wet_exp_moments_are_the_general_formula():
     p, q = np.zeros((25, 1)), np.ones((25, 1))
     for sign in (1.0, -1.0):
         e0 = _complex(np.multiply.outer(za, k), -np.multiply.outer(chi[:-1], k))
-        alpha = _complex(sign * np.multiply.outer(zb - za, k),
-                         -np.multiply.outer(chi[1:] - chi[:-1], k))
+        alpha = _complex(
+            sign * np.multiply.outer(zb - za, k), -np.multiply.outer(chi[1:] - chi[:-1], k)
+        )
         for got, ref in zip(_exp_moments(e0, alpha, p, q), general(e0, alpha, p, q)):
             np.testing.assert_array_equal(got, ref)
 
@@ -228,8 +247,9 @@ def test_sea_nodal_kinematics_are_computed_on_first_access_only():
         calls.append(1)
         return nodal()
 
-    lazy = Channel(name="sea", kind="sea", omega=w, spectrum=sea.spectrum,
-                   density=sea.density, nodal=counted)
+    lazy = Channel(
+        name="sea", kind="sea", omega=w, spectrum=sea.spectrum, density=sea.density, nodal=counted
+    )
     assert calls == []
     acc = lazy.acceleration
     vel = lazy.velocity
@@ -237,11 +257,17 @@ def test_sea_nodal_kinematics_are_computed_on_first_access_only():
     kin = wave_kinematics(w, system.positions, math.radians(20.0), 100.0, G)
     np.testing.assert_array_equal(vel, np.transpose(kin.velocity, (2, 0, 1)))
     np.testing.assert_array_equal(acc, np.transpose(kin.acceleration, (2, 0, 1)))
-    given = Channel(name="x", kind="sea", omega=w, spectrum=np.zeros_like(w),
-                    density=np.zeros_like, velocity=vel, nodal=counted)
+    given = Channel(
+        name="x",
+        kind="sea",
+        omega=w,
+        spectrum=np.zeros_like(w),
+        density=np.zeros_like,
+        velocity=vel,
+        nodal=counted,
+    )
     assert given.velocity is vel and given.acceleration is None and len(calls) == 1
-    plain = Channel(name="x", kind="sea", omega=w, spectrum=np.zeros_like(w),
-                    density=np.zeros_like)
+    plain = Channel(name="x", kind="sea", omega=w, spectrum=np.zeros_like(w), density=np.zeros_like)
     assert plain.velocity is None and plain.acceleration is None
     with pytest.raises(dataclasses.FrozenInstanceError):
         lazy.velocity = vel
@@ -256,9 +282,13 @@ def test_second_exponent_shares_phi_psi_by_conjugation():
     and the φ1 of ∫e^{−2k(z+2h)} as that of ∫e^{2kz} (issue 6 pass E6): the moments
     equal those of their own φ1, ψ to the bit, for rising, sinking and horizontal
     elements, at ω = 0, fully wet (the short path) and partly wet (the general one)."""
-    from stochcable.dynamics.element_kinematics import (_complex, _exp_integral,
-                                                        _exp_moments, _moment_argument,
-                                                        _phi1_psi)
+    from stochcable.dynamics.element_kinematics import (
+        _complex,
+        _exp_integral,
+        _exp_moments,
+        _moment_argument,
+        _phi1_psi,
+    )
     from stochcable.sea.kinematics import _wavenumber
 
     rng = np.random.default_rng(13)
@@ -266,10 +296,10 @@ def test_second_exponent_shares_phi_psi_by_conjugation():
     k = _wavenumber(np.r_[0.0, np.linspace(0.05, 3.0, 40)], h, 9.80665)
     za = rng.uniform(-h, -1.0, 30)
     zb = za + rng.uniform(-6.0, 6.0, 30)
-    zb[::5] = za[::5]                       # horizontal elements: dz = 0
+    zb[::5] = za[::5]  # horizontal elements: dz = 0
     zb = np.minimum(zb, -0.5)
     chi = rng.uniform(-500.0, 0.0, 31)
-    chi[3] = chi[2]                          # an element across the waves: dφ = 0
+    chi[3] = chi[2]  # an element across the waves: dφ = 0
     dz = np.multiply.outer(k, zb - za)
     dphase = -np.multiply.outer(k, chi[1:] - chi[:-1])
     phase0 = -np.multiply.outer(k, chi[:-1])
@@ -281,14 +311,14 @@ def test_second_exponent_shares_phi_psi_by_conjugation():
         f12_2 = tuple(np.where(dz != 0.0, f.conj(), f) for f in f12)
         alpha2 = _complex(-dz, dphase)
         e0 = _complex(e2a, phase0)
-        for got, want in zip(_exp_moments(e0, alpha2, p, q, f12_2),
-                             _exp_moments(e0, alpha2, p, q)):
+        for got, want in zip(_exp_moments(e0, alpha2, p, q, f12_2), _exp_moments(e0, alpha2, p, q)):
             np.testing.assert_array_equal(got, want)
         two_dz = 2.0 * dz
-        phi_k, _ = _phi1_psi(np.where(two_dz >= 0.0, -two_dz, two_dz) * (q - p),
-                             want_psi=False)
-        np.testing.assert_array_equal(_exp_integral(2.0 * e2a, -two_dz, p, q, phi_k),
-                                      _exp_integral(2.0 * e2a, -two_dz, p, q))
+        phi_k, _ = _phi1_psi(np.where(two_dz >= 0.0, -two_dz, two_dz) * (q - p), want_psi=False)
+        np.testing.assert_array_equal(
+            _exp_integral(2.0 * e2a, -two_dz, p, q, phi_k), _exp_integral(2.0 * e2a, -two_dz, p, q)
+        )
         np.testing.assert_array_equal(
             _exp_moments(_complex(np.multiply.outer(k, za), phase0), alpha1, p, q, f12),
-            _exp_moments(_complex(np.multiply.outer(k, za), phase0), alpha1, p, q))
+            _exp_moments(_complex(np.multiply.outer(k, za), phase0), alpha1, p, q),
+        )

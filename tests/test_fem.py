@@ -14,8 +14,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import scipy.sparse as sp
-
 from fem_cases import hanging_chain, shallow_parabola, taut_string, uniform_mesh
+
 from stochcable.errors import InputError
 from stochcable.line.fem import (
     SLACK_EA_RATIO,
@@ -114,7 +114,7 @@ def test_total_mass_is_conserved():
     mesh, pos, ten = taut_string(17, 50.0, 1e4, 3.0, 1e8)
     model = assemble(mesh, pos, ten, RHO, dim=3)
     ones = np.zeros(model.n_dof)
-    ones[model.dof(0, "x")::3] = 1.0  # rigid unit translation in x
+    ones[model.dof(0, "x") :: 3] = 1.0  # rigid unit translation in x
     assert ones @ (model.M @ ones) == pytest.approx(3.0 * 50.0, rel=1e-13)
 
 
@@ -172,8 +172,7 @@ def test_seabed_springs_and_damping_vertical_only():
     expected = np.zeros(33)
     expected[[2, 5, 8, 11]] = 3.0e6 * 0.2 * trib
     np.testing.assert_allclose(dk, np.diag(expected), rtol=1e-14, atol=1e-6)
-    np.testing.assert_allclose(with_bed.Cs.toarray(), np.diag(expected / 3.0e6 * 2.0e5),
-                               rtol=1e-14)
+    np.testing.assert_allclose(with_bed.Cs.toarray(), np.diag(expected / 3.0e6 * 2.0e5), rtol=1e-14)
     assert without.Cs.nnz == 0
 
 
@@ -187,10 +186,12 @@ def test_attachment_masses_lumped_on_nodes():
     pos = np.column_stack([np.arange(5.0), np.zeros(5), np.zeros(5)])
     model = assemble(mesh, pos, np.full(4, 10.0), RHO, dim=3)
     base = assemble(uniform_mesh(4, 1.0, 1e6, 1.0), pos, np.full(4, 10.0), RHO, dim=3)
-    np.testing.assert_allclose((model.M - base.M).toarray(),
-                               np.diag(np.r_[np.zeros(6), [50.0] * 3, np.zeros(6)]))
-    np.testing.assert_allclose((model.Ma - base.Ma).toarray(),
-                               np.diag(np.r_[np.zeros(6), [7.0] * 3, np.zeros(6)]))
+    np.testing.assert_allclose(
+        (model.M - base.M).toarray(), np.diag(np.r_[np.zeros(6), [50.0] * 3, np.zeros(6)])
+    )
+    np.testing.assert_allclose(
+        (model.Ma - base.Ma).toarray(), np.diag(np.r_[np.zeros(6), [7.0] * 3, np.zeros(6)])
+    )
 
 
 def test_partition_dof_and_banded_storage():
@@ -225,8 +226,9 @@ def test_build_fe_model_from_line_statics():
     model = build_fe_model(ls, env)
     assert model.dim == 2  # in the x–z plane
     assert build_fe_model(ls, env, dim=3).dim == 3
-    shifted = SimpleNamespace(mesh=mesh, positions=pos + [0, 5.0, 0], tension=ten,
-                              grounded=grounded)
+    shifted = SimpleNamespace(
+        mesh=mesh, positions=pos + [0, 5.0, 0], tension=ten, grounded=grounded
+    )
     assert build_fe_model(shifted, env).dim == 3
 
 
@@ -234,18 +236,35 @@ def test_build_fe_model_with_solved_statics():
     statics = pytest.importorskip("stochcable.statics")
     from stochcable.scene.model import load_scene
 
-    scene = load_scene({
-        "environment": {"depth": 200.0},
-        "lines": [{"name": "leg", "end_a": {"position": [-800.0, 0.0, -200.0]},
-                   "end_b": {"position": [0.0, 0.0, -20.0]},
-                   "segments": [{"length": 850.0, "ea": 1.2326e9, "mass": 288.0,
-                                 "diameter": 0.216, "elements": 40}]}],
-    })
+    scene = load_scene(
+        {
+            "environment": {"depth": 200.0},
+            "lines": [
+                {
+                    "name": "leg",
+                    "end_a": {"position": [-800.0, 0.0, -200.0]},
+                    "end_b": {"position": [0.0, 0.0, -20.0]},
+                    "segments": [
+                        {
+                            "length": 850.0,
+                            "ea": 1.2326e9,
+                            "mass": 288.0,
+                            "diameter": 0.216,
+                            "elements": 40,
+                        }
+                    ],
+                }
+            ],
+        }
+    )
     ls = statics.solve_statics(scene).lines["leg"]
     model = build_fe_model(ls, scene.environment, dim=3)
     assert model.grounded.sum() == ls.grounded.sum() > 0
     # seabed springs only on grounded nodes' z DOFs
-    kz = model.K.diagonal()[2::3] - assemble(ls.mesh, ls.positions, ls.tension, 1025.0).K.diagonal()[2::3]
+    kz = (
+        model.K.diagonal()[2::3]
+        - assemble(ls.mesh, ls.positions, ls.tension, 1025.0).K.diagonal()[2::3]
+    )
     assert (kz[ls.grounded] > 0).all() and (kz[~ls.grounded] == 0).all()
 
 
@@ -255,7 +274,9 @@ def test_assemble_error_paths():
         assemble(mesh, pos, ten, RHO, dim=2)
     with pytest.raises(InputError, match=r"dim = 4: must be 2 \(in-plane x–z\) or 3"):
         assemble(mesh, pos, ten, RHO, dim=4)
-    with pytest.raises(InputError, match=r"tension = \(3,\) \[N\]: must have one value per element \(4\)"):
+    with pytest.raises(
+        InputError, match=r"tension = \(3,\) \[N\]: must have one value per element \(4\)"
+    ):
         assemble(mesh, pos, ten[:3], RHO)
     with pytest.raises(InputError, match=r"fixed_nodes = 9: must be node indices in 0…4"):
         assemble(mesh, pos, ten, RHO, fixed_nodes=(0, 9))
@@ -310,8 +331,7 @@ def test_free_free_block_and_total_mass_match_partition():
             ref = model.partition(name)[0]
             assert sp.issparse(ff)
             np.testing.assert_array_equal(ff.toarray(), ref.toarray())
-        np.testing.assert_array_equal(model._mass_total.toarray(),
-                                      (model.M + model.Ma).toarray())
+        np.testing.assert_array_equal(model._mass_total.toarray(), (model.M + model.Ma).toarray())
         # "MT" by name stays a fresh matrix: changing it does not touch the cache
         mt = model._matrix("MT")
         mt.data[:] = 0.0

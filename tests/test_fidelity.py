@@ -23,9 +23,9 @@ from stochcable.fidelity import (
     points_per_bandwidth,
     spectrum_tail_frequency,
 )
-from stochcable.statics import solve_statics
 from stochcable.scene.model import load_scene
 from stochcable.sea.spectra import spectrum_pierson_moskowitz
+from stochcable.statics import solve_statics
 
 
 def _string_frequencies(n_el: int, length: float, c: float) -> np.ndarray:
@@ -99,14 +99,26 @@ def _taut_scene(wmax_note: str = "") -> dict:
     return {
         "title": "constructed taut string" + wmax_note,
         "environment": {"depth": 200.0},
-        "lines": [{"name": "s",
-                   "end_a": {"position": [-200.0, 0.0, -100.0]},
-                   "end_b": {"position": [0.0, 0.0, -100.0],
-                             "motion": {"heave": {"type": "pierson_moskowitz", "hs": 1.0,
-                                                  "tp": 4.0}}},
-                   "segments": [{"length": 199.5, "ea": 4e8, "mass": 20.0,
-                                 "diameter": 0.05, "cd_normal": 1.2,
-                                 "elements": 20}]}],
+        "lines": [
+            {
+                "name": "s",
+                "end_a": {"position": [-200.0, 0.0, -100.0]},
+                "end_b": {
+                    "position": [0.0, 0.0, -100.0],
+                    "motion": {"heave": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 4.0}},
+                },
+                "segments": [
+                    {
+                        "length": 199.5,
+                        "ea": 4e8,
+                        "mass": 20.0,
+                        "diameter": 0.05,
+                        "cd_normal": 1.2,
+                        "elements": 20,
+                    }
+                ],
+            }
+        ],
     }
 
 
@@ -119,9 +131,11 @@ def test_plan_elements_follow_the_wavelength_rule_on_a_taut_string():
     # ⟨1/c²⟩ over the (uniform-tension) string
     c = math.sqrt(float(np.mean(st.tension)) / m_t)
     eps_el = BUDGET["elements"] * 0.01  # no sea: the whole element share is the wave rule
-    expect = max(elements_wavelength(seg.length, plan.omega_response, c, eps_el),
-                 elements_wavelength(seg.length, plan.omega_max, c, CUTOFF_KH**2 / 24))
-    (i, length, n), = plan.segments["s"]
+    expect = max(
+        elements_wavelength(seg.length, plan.omega_response, c, eps_el),
+        elements_wavelength(seg.length, plan.omega_max, c, CUTOFF_KH**2 / 24),
+    )
+    ((i, length, n),) = plan.segments["s"]
     assert (i, length) == (0, seg.length)
     # tension varies by < 0.1 % along the string (sag): the count may differ by one
     assert abs(n - expect) <= 1
@@ -185,17 +199,20 @@ def test_choose_fidelity_rejects_a_bad_target():
 def _sigmas(result) -> np.ndarray:
     line = next(iter(result.lines.values()))
     s_star = line.s_nodes[-1] * 0.95
-    motion = np.sqrt(sum(np.interp(s_star, line.s_nodes, line.motion_std[:, k]) ** 2
-                         for k in range(3)))
+    motion = np.sqrt(
+        sum(np.interp(s_star, line.s_nodes, line.motion_std[:, k]) ** 2 for k in range(3))
+    )
     return np.array([line.end_b.std, line.end_a.std, motion])
 
 
-@pytest.mark.parametrize("name, target", [("taut_wire", 0.05), ("inclined_guy", 0.05),
-                                          ("tuah_1982_single_leg", 0.01)])
+@pytest.mark.parametrize(
+    "name, target", [("taut_wire", 0.05), ("inclined_guy", 0.05), ("tuah_1982_single_leg", 0.01)]
+)
 def test_chosen_settings_meet_the_target_against_a_finer_reference(name, target):
     scene = load_example(name)
-    scene = scene.model_copy(update={"analysis": scene.analysis.model_copy(
-        update={"timeseries": None})})
+    scene = scene.model_copy(
+        update={"analysis": scene.analysis.model_copy(update={"timeseries": None})}
+    )
     plan = choose_fidelity(scene, target, evaluate=analyze)
     assert isinstance(plan, FidelityPlan) and plan.tail_bounded
     got = _sigmas(analyze(apply_fidelity(scene, plan)))
@@ -205,11 +222,15 @@ def test_chosen_settings_meet_the_target_against_a_finer_reference(name, target)
     # whose plan puts a node at the touchdown, by 0.03 %)
     dw = (plan.omega_max - plan.omega_min) / (plan.omega_count - 1) / 2
     ref_plan = replace(
-        plan, segments={k: tuple((i, L, 2 * n) for i, L, n in v)
-                        for k, v in plan.segments.items()},
-        omega_min=plan.omega_min / 2, omega_max=2 * plan.omega_max,
+        plan,
+        segments={k: tuple((i, L, 2 * n) for i, L, n in v) for k, v in plan.segments.items()},
+        omega_min=plan.omega_min / 2,
+        omega_max=2 * plan.omega_max,
         omega_count=int((1.5 * plan.omega_max + 0.5 * plan.omega_min) / dw) + 1,
-        solver="direct", modes="auto", tolerance=1e-8)
+        solver="direct",
+        modes="auto",
+        tolerance=1e-8,
+    )
     ref = _sigmas(analyze(apply_fidelity(scene, ref_plan)))
     err = np.abs(got / ref - 1.0)
     assert err.max() < target, err  # the target

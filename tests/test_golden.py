@@ -14,11 +14,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-
 from _compare import assert_close_documents
 
 _SPEC = importlib.util.spec_from_file_location(
-    "golden_record", Path(__file__).parent / "golden" / "record.py")
+    "golden_record", Path(__file__).parent / "golden" / "record.py"
+)
 record = importlib.util.module_from_spec(_SPEC)
 _SPEC.loader.exec_module(record)
 

@@ -22,33 +22,50 @@ import pytest
 from stochcable.analysis import analyze
 from stochcable.dynamics.system import build_line_system
 from stochcable.dynamics.variance import drag_coefficients
-from stochcable.errors import (InputError, PhysicsWarning, ResolutionWarning,
-                              SolverError)
+from stochcable.errors import InputError, PhysicsWarning, ResolutionWarning, SolverError
 from stochcable.examples import load_example
 from stochcable.sea.kinematics import wavenumber
 
 PM = {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}
 
 
-def chain(*, depth: float = 100.0, span: float = 400.0, length: float = 450.0,
-          fairlead_z: float = -10.0, elements: int = 20, cd: float = 2.4,
-          solver: str = "foss", sea: dict | None = None, omega: dict | None = None,
-          seabed_damping: float = 1.0e3) -> dict:
+def chain(
+    *,
+    depth: float = 100.0,
+    span: float = 400.0,
+    length: float = 450.0,
+    fairlead_z: float = -10.0,
+    elements: int = 20,
+    cd: float = 2.4,
+    solver: str = "foss",
+    sea: dict | None = None,
+    omega: dict | None = None,
+    seabed_damping: float = 1.0e3,
+) -> dict:
     """A chain-like line from an anchor on the seabed to a fixed fairlead, in a sea."""
     return {
-        "environment": {"depth": depth,
-                        "seabed": {"stiffness": 3.0e5, "damping": seabed_damping}},
+        "environment": {"depth": depth, "seabed": {"stiffness": 3.0e5, "damping": seabed_damping}},
         "sea": {"spectrum": sea or PM, "heading": 0.0},
-        "lines": [{
-            "name": "l",
-            "end_a": {"position": [-span, 0.0, -depth]},
-            "end_b": {"position": [0.0, 0.0, fairlead_z]},
-            "segments": [{"length": length, "ea": 5.0e8, "mass": 100.0, "diameter": 0.1,
-                          "cd_normal": cd, "cd_axial": 0.5 * cd, "ca_normal": 1.0,
-                          "elements": elements}],
-        }],
-        "analysis": {"omega": omega or {"min": 0.1, "max": 2.0, "count": 60},
-                     "solver": solver},
+        "lines": [
+            {
+                "name": "l",
+                "end_a": {"position": [-span, 0.0, -depth]},
+                "end_b": {"position": [0.0, 0.0, fairlead_z]},
+                "segments": [
+                    {
+                        "length": length,
+                        "ea": 5.0e8,
+                        "mass": 100.0,
+                        "diameter": 0.1,
+                        "cd_normal": cd,
+                        "cd_axial": 0.5 * cd,
+                        "ca_normal": 1.0,
+                        "elements": elements,
+                    }
+                ],
+            }
+        ],
+        "analysis": {"omega": omega or {"min": 0.1, "max": 2.0, "count": 60}, "solver": solver},
     }
 
 
@@ -60,9 +77,16 @@ def assert_finite(res, name: str = "l") -> None:
         d = stats.as_dict()
         assert all(math.isfinite(v) for v in d.values()), d
         assert stats.std >= 0.0 and stats.mpm_3h >= stats.mean
-    for arr in (line.motion_transfer, line.tension_transfer, line.motion_std,
-                line.tension_std, line.tension_mean, line.modes_omega,
-                line.end_tension_transfer["end_a"], line.end_tension_transfer["end_b"]):
+    for arr in (
+        line.motion_transfer,
+        line.tension_transfer,
+        line.motion_std,
+        line.tension_std,
+        line.tension_mean,
+        line.modes_omega,
+        line.end_tension_transfer["end_a"],
+        line.end_tension_transfer["end_b"],
+    ):
         assert np.all(np.isfinite(arr))
     assert res.converged
 
@@ -137,8 +161,10 @@ def test_very_slack_line_mostly_on_the_seabed():
     # Foss with all 78 modes = direct to round-off of the QZ decomposition
     assert line.n_modes == line.model.free.size
     for end in ("end_a", "end_b"):
-        assert rel_diff(line.end_tension_transfer[end],
-                        res_d.lines["l"].end_tension_transfer[end]) < 1e-8
+        assert (
+            rel_diff(line.end_tension_transfer[end], res_d.lines["l"].end_tension_transfer[end])
+            < 1e-8
+        )
 
 
 def test_tension_to_zero_at_the_anchor_end_flags_snap():
@@ -170,8 +196,11 @@ def test_tension_to_zero_at_the_anchor_end_flags_snap():
     assert ind.snap_risk and "snap" in ind.flags and ind.snap_margin < 0.0
     # the element at the anchor has (numerically) zero mean tension: it is the one named
     assert line.tension_mean[0] - 3.0 * line.tension_std[0] < 0.0
-    snap = [str(w_.message) for w_ in caught if issubclass(w_.category, PhysicsWarning)
-            and "snap loads likely" in str(w_.message)]
+    snap = [
+        str(w_.message)
+        for w_ in caught
+        if issubclass(w_.category, PhysicsWarning) and "snap loads likely" in str(w_.message)
+    ]
     assert snap and "at element 1 (" in snap[0], [str(w_.message) for w_ in caught]
     # ... and not at the taut 480 m line
     assert "snap" not in taut.lines["l"].indicators.flags
@@ -184,14 +213,25 @@ def test_nearly_vertical_tether():
     doc = {
         "environment": {"depth": 200.0},
         "sea": {"spectrum": PM, "heading": 0.0},
-        "lines": [{
-            "name": "t",
-            "end_a": {"position": [-2.0, 0.0, -200.0]},
-            "end_b": {"position": [0.0, 0.0, -10.0]},
-            "segments": [{"length": 189.5, "ea": 1.0e9, "mass": 80.0, "diameter": 0.3,
-                          "cd_normal": 1.2, "cd_axial": 0.02, "ca_normal": 1.0,
-                          "elements": 30}],
-        }],
+        "lines": [
+            {
+                "name": "t",
+                "end_a": {"position": [-2.0, 0.0, -200.0]},
+                "end_b": {"position": [0.0, 0.0, -10.0]},
+                "segments": [
+                    {
+                        "length": 189.5,
+                        "ea": 1.0e9,
+                        "mass": 80.0,
+                        "diameter": 0.3,
+                        "cd_normal": 1.2,
+                        "cd_axial": 0.02,
+                        "ca_normal": 1.0,
+                        "elements": 30,
+                    }
+                ],
+            }
+        ],
         "analysis": {"omega": {"min": 0.1, "max": 2.0, "count": 60}},
     }
     res_f, res_d = foss_vs_direct(doc)
@@ -199,8 +239,9 @@ def test_nearly_vertical_tether():
     a, b = res_f.lines["t"], res_d.lines["t"]
     st = res_f.statics.lines["t"]
     # strain (190.01 − 189.5)/189.5 = 0.27 %: T ≈ EA·strain minus/plus the weight
-    assert st.tension_b == pytest.approx(1.0e9 * (math.dist((-2, 0, -200), (0, 0, -10))
-                                                  / 189.5 - 1.0), rel=0.05)
+    assert st.tension_b == pytest.approx(
+        1.0e9 * (math.dist((-2, 0, -200), (0, 0, -10)) / 189.5 - 1.0), rel=0.05
+    )
     for end in ("end_a", "end_b"):
         assert rel_diff(a.end_tension_transfer[end], b.end_tension_transfer[end]) < 1e-7
     # the tether surges (waves) much more than it heaves (axially stiff)
@@ -232,18 +273,29 @@ def _veer_doc(phi_deg: float, lam2: float) -> dict:
     za = -1500.0
     return {
         "environment": {"depth": 2000.0},
-        "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 10.0},
-                "heading": 0.0},
-        "lines": [{
-            "name": "c",
-            "end_a": {"position": [0.0, 0.0, za]},
-            "end_b": {"position": [VEER_CHORD * math.cos(phi), 0.0,
-                                   za + VEER_CHORD * math.sin(phi)]},
-            "segments": [{"length": arc / (1.0 + VEER_H_STAR / ea), "ea": ea,
-                          "mass": VEER_MASS, "diameter": 0.1, "cd_normal": 1.2,
-                          "cd_axial": 0.0, "ca_normal": 0.0, "weight": w,
-                          "elements": 40}],
-        }],
+        "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 10.0}, "heading": 0.0},
+        "lines": [
+            {
+                "name": "c",
+                "end_a": {"position": [0.0, 0.0, za]},
+                "end_b": {
+                    "position": [VEER_CHORD * math.cos(phi), 0.0, za + VEER_CHORD * math.sin(phi)]
+                },
+                "segments": [
+                    {
+                        "length": arc / (1.0 + VEER_H_STAR / ea),
+                        "ea": ea,
+                        "mass": VEER_MASS,
+                        "diameter": 0.1,
+                        "cd_normal": 1.2,
+                        "cd_axial": 0.0,
+                        "ca_normal": 0.0,
+                        "weight": w,
+                        "elements": 40,
+                    }
+                ],
+            }
+        ],
         "analysis": {"omega": {"min": 0.2, "max": 1.0, "count": 5}, "solver": "direct"},
     }
 
@@ -272,8 +324,10 @@ def _veer_sweep(phi_deg: float) -> np.ndarray:
         d = model.dim
         sym = []
         for j in range(2):
-            un = (-math.sin(phi) * shapes[model.dof(0, "x")::d, j]
-                  + math.cos(phi) * shapes[model.dof(0, "z")::d, j])
+            un = (
+                -math.sin(phi) * shapes[model.dof(0, "x") :: d, j]
+                + math.cos(phi) * shapes[model.dof(0, "z") :: d, j]
+            )
             sym.append(float(un @ un[::-1] / (un @ un)))
         rows.append((lam2_act, *(line.modes_omega[:2] / w_a), *sym))
     return np.array(rows)
@@ -316,7 +370,7 @@ def test_inclined_cable_modes_veer_without_crossing(veering):
     # the minimum gap is interior, at 4π² within the shallow-sag theory's O(8(d/L)²)
     k = int(np.argmin(gap))
     assert 0 < k < gap.size - 1
-    c2, c1, _ = np.polyfit(lam2[k - 1:k + 2], gap[k - 1:k + 2], 2)
+    c2, c1, _ = np.polyfit(lam2[k - 1 : k + 2], gap[k - 1 : k + 2], 2)
     lam2_min = -c1 / (2.0 * c2)
     assert lam2_min / (4.0 * math.pi**2) == pytest.approx(1.0, abs=0.04)
     # hybrid modes near the veering, and the curves exchange their character: mode 1
@@ -334,8 +388,15 @@ def test_inclined_cable_modes_veer_without_crossing(veering):
 def test_very_light_drag_resolves_or_refuses_never_nan():
     """Cd = 1e-6, no seabed damping: the peak is either resolved (finite answer) or
     the analysis says it is not (ResolutionWarning / SolverError), never inf/NaN."""
-    doc = chain(depth=300.0, span=400.0, length=480.0, fairlead_z=-10.0, cd=1e-6,
-                elements=16, seabed_damping=0.0)
+    doc = chain(
+        depth=300.0,
+        span=400.0,
+        length=480.0,
+        fairlead_z=-10.0,
+        cd=1e-6,
+        elements=16,
+        seabed_damping=0.0,
+    )
     doc["environment"]["depth"] = 300.0
     doc["lines"][0]["end_a"]["position"] = [-400.0, 0.0, -200.0]  # suspended, no contact
     with warnings.catch_warnings(record=True) as caught:
@@ -347,8 +408,10 @@ def test_very_light_drag_resolves_or_refuses_never_nan():
             return
     assert_finite(res)
     # the grid of 60 points cannot resolve a nearly undamped peak: it must say so
-    assert any(issubclass(w.category, ResolutionWarning) and "does not resolve" in str(w.message)
-               for w in caught)
+    assert any(
+        issubclass(w.category, ResolutionWarning) and "does not resolve" in str(w.message)
+        for w in caught
+    )
 
 
 def test_very_heavy_drag_overdamped_foss_equals_direct():
@@ -362,14 +425,12 @@ def test_very_heavy_drag_overdamped_foss_equals_direct():
     scene = res_f.scene
     system = build_line_system(scene, scene.lines[0], res_f.statics.lines["l"])
     rec = a.linearization
-    damp = drag_coefficients(system, np.concatenate([rec.sigma_normal, rec.sigma_axial]),
-                             "seed")
+    damp = drag_coefficients(system, np.concatenate([rec.sigma_normal, rec.sigma_axial]), "seed")
     free = system.model.free
     c = damp.matrix.tocsr()[free][:, free].toarray()
     m = (system.model.M + system.model.Ma).tocsr()[free][:, free].toarray()
     phi, wn = system.modes.shapes[free], system.modes.omega
-    zeta = np.einsum("ij,ij->j", phi, c @ phi) / (
-        2.0 * wn * np.einsum("ij,ij->j", phi, m @ phi))
+    zeta = np.einsum("ij,ij->j", phi, c @ phi) / (2.0 * wn * np.einsum("ij,ij->j", phi, m @ phi))
     assert np.all(zeta[:4] > 1.0)
     # QZ of an overdamped pencil (real eigenvalue pairs): same round-off as underdamped
     for end in ("end_a", "end_b"):
@@ -414,16 +475,22 @@ def test_very_shallow_water_10_m_small_kh():
     """10 m of water, swell Tp = 14 s: kh ≈ 0.47 at the peak (shallow-water limit
     k ≈ ω/√(gh)); horizontal velocity nearly uniform over depth."""
     sea = {"type": "pierson_moskowitz", "hs": 1.5, "tp": 14.0}
-    doc = chain(depth=10.0, span=100.0, length=105.0, fairlead_z=-2.0, elements=20,
-                sea=sea, omega={"min": 0.1, "max": 2.0, "count": 60})
+    doc = chain(
+        depth=10.0,
+        span=100.0,
+        length=105.0,
+        fairlead_z=-2.0,
+        elements=20,
+        sea=sea,
+        omega={"min": 0.1, "max": 2.0, "count": 60},
+    )
     res = analyze(doc)
     assert_finite(res)
     wp = 2.0 * math.pi / 14.0
     kh = float(wavenumber(np.array([wp]), 10.0)[0]) * 10.0
     assert kh < 0.5
     # shallow-water limit: k h = ω √(h/g) (1 + (kh)²/6 + …), (kh)²/6 = 3.7 %
-    assert kh == pytest.approx(wp * math.sqrt(10.0 / 9.80665) * (1.0 + kh**2 / 6.0),
-                               rel=3e-3)
+    assert kh == pytest.approx(wp * math.sqrt(10.0 / 9.80665) * (1.0 + kh**2 / 6.0), rel=3e-3)
     assert res.lines["l"].end_b.std > 0.0
 
 
@@ -433,8 +500,7 @@ def test_very_shallow_water_10_m_small_kh():
 def test_log_grid_from_1e_minus_4_to_1e2():
     """omega.spacing = "log", 1e-4 … 1e2 rad/s: the quasi-static end (k → 0 in 100 m,
     velocities ∝ ω → 0) and the high end (kinematics e^{kz}, kz ~ −1e5) stay finite."""
-    doc = chain(elements=16, omega={"min": 1e-4, "max": 1e2, "count": 120,
-                                    "spacing": "log"})
+    doc = chain(elements=16, omega={"min": 1e-4, "max": 1e2, "count": 120, "spacing": "log"})
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ResolutionWarning)
         res = analyze(doc)
@@ -461,8 +527,12 @@ def _long_record(n_t: int, method: str):
     the realization grid and the sea spectrum S there (zero at ω = 0 and Nyquist),
     after checking the record is finite and complete."""
     doc = chain(elements=10, omega={"min": 0.2, "max": 1.6, "count": 60})
-    doc["analysis"]["timeseries"] = {"method": method, "duration": n_t * 0.25, "dt": 0.25,
-                                     "seed": 5}
+    doc["analysis"]["timeseries"] = {
+        "method": method,
+        "duration": n_t * 0.25,
+        "dt": 0.25,
+        "seed": 5,
+    }
     res = analyze(doc)
     ts = res.timeseries
     assert ts.time.size == n_t
@@ -482,8 +552,7 @@ def test_long_record_2_pow_20_samples():
     res, ts, dyn, h, s = _long_record(2**20, "dsa")
     d_omega = ts.omega[1]
     # DSA: exact up to round-off of a 2^20 FFT
-    assert np.mean(dyn**2) == pytest.approx(float(np.sum(np.abs(h) ** 2 * s) * d_omega),
-                                            rel=1e-9)
+    assert np.mean(dyn**2) == pytest.approx(float(np.sum(np.abs(h) ** 2 * s) * d_omega), rel=1e-9)
     # the realization grid (Δω = 2.4e-5 rad/s) vs the 60-point analysis grid: the
     # trapezoid of a smooth, drag-damped spectrum (1 %)
     assert math.sqrt(np.mean(dyn**2)) == pytest.approx(res.lines["l"].end_b.std, rel=0.01)
@@ -506,8 +575,9 @@ def test_long_record_2_pow_22_samples_nsa_variance_within_sampling_error():
     assert np.mean(dyn**2) == pytest.approx(m0, rel=4.0 * sd)
     # ... and the analysis σ: the 60-point trapezoid (1 %, see the 2^20 test) plus the
     # sampling error of σ (half that of the variance)
-    assert math.sqrt(np.mean(dyn**2)) == pytest.approx(res.lines["l"].end_b.std,
-                                                       rel=0.01 + 2.0 * sd)
+    assert math.sqrt(np.mean(dyn**2)) == pytest.approx(
+        res.lines["l"].end_b.std, rel=0.01 + 2.0 * sd
+    )
 
 
 # ------------------------------------------------------------------------- big model
@@ -539,8 +609,7 @@ def test_800_element_line_converges_to_the_200_element_answer():
     tuah_1982_single_leg, see stochcable.fidelity.planner); the string dispersion (kh)²/24 is
     < 1e-4 here."""
     omega = {"min": 0.1, "max": 2.0, "count": 40}
-    res = {n: analyze(chain(elements=n, solver="direct", omega=omega))
-           for n in (200, 400, 800)}
+    res = {n: analyze(chain(elements=n, solver="direct", omega=omega)) for n in (200, 400, 800)}
     assert_finite(res[800])
     fine = res[800].lines["l"]
     assert fine.model.free.size == 2 * 799
@@ -563,8 +632,10 @@ def test_imperial_suspended_cable_with_buoy_in_a_sea():
     """Seed 001 §6.2 cable (ft, slug, lbf; g = 32.174) with its 900 lb buoy, excited by
     the seed's §6.5 sea (PM m0 = 28 ft², ωp = 0.5 rad/s) in deep water."""
     doc = load_example("tuah_1982_suspended_cable").model_dump()
-    doc["sea"] = {"spectrum": {"type": "pierson_moskowitz", "m0": 28.0, "omega_p": 0.5},
-                  "heading": 0.0}
+    doc["sea"] = {
+        "spectrum": {"type": "pierson_moskowitz", "m0": 28.0, "omega_p": 0.5},
+        "heading": 0.0,
+    }
     # raise the cable near the surface so the waves reach it
     for end in ("end_a", "end_b"):
         x, y, z = doc["lines"][0][end]["position"]
@@ -575,4 +646,3 @@ def test_imperial_suspended_cable_with_buoy_in_a_sea():
     assert line.end_b.std > 0.0
     # a stiff-ish response in lbf: σ well below the static tension of ~1000 lbf
     assert line.end_b.std < line.end_b.mean
-

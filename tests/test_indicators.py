@@ -17,10 +17,10 @@ from scipy import integrate
 from stochcable.analysis import analyze
 from stochcable.dynamics.fixedpoint import linearize
 from stochcable.dynamics.indicators import line_indicators
+from stochcable.dynamics.linearization import borgman_variance_ratio, drag_inertia_ratio
+from stochcable.dynamics.loads import line_channels
 from stochcable.dynamics.system import build_line_system
 from stochcable.errors import InputError, PhysicsWarning
-from stochcable.dynamics.loads import line_channels
-from stochcable.dynamics.linearization import borgman_variance_ratio, drag_inertia_ratio
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
@@ -57,8 +57,9 @@ def _moments_by_quadrature(mu: float) -> float:
     def e(f):
         lo, hi = mu - 12.0, mu + 12.0
         pts = [0.0] if lo < 0.0 < hi else None
-        return integrate.quad(lambda v: f(v) * pdf(v), lo, hi, points=pts,
-                              epsabs=0, epsrel=1e-13, limit=200)[0]
+        return integrate.quad(
+            lambda v: f(v) * pdf(v), lo, hi, points=pts, epsabs=0, epsrel=1e-13, limit=200
+        )[0]
 
     e_abs = e(abs)
     e_vv = e(lambda v: v * abs(v))
@@ -112,8 +113,7 @@ def test_drag_inertia_ratio_closed_form_and_thin_vs_thick_cylinder():
     for d in (0.05, 0.5, 2.0, 10.0):
         kc = sv * (2 * math.pi / w) / d
         expected = math.sqrt(8 / math.pi) / math.pi**2 * cd / cm * kc
-        assert drag_inertia_ratio(rho, cd, cm, d, sv, sa) == pytest.approx(expected,
-                                                                         rel=1e-13)
+        assert drag_inertia_ratio(rho, cd, cm, d, sv, sa) == pytest.approx(expected, rel=1e-13)
     thin = drag_inertia_ratio(rho, cd, cm, 0.05, sv, sa)
     thick = drag_inertia_ratio(rho, cd, cm, 10.0, sv, sa)
     # KC_σ 209 vs 1.05: drag-dominated (20.3) vs inertia-dominated (0.10), ratio ∝ 1/D
@@ -134,7 +134,7 @@ def test_drag_inertia_in_analysis_scales_like_sigma_squared_over_diameter():
     seg = thick["lines"][0]["segments"][0]
     d1 = seg["diameter"]
     seg["diameter"] = 4.0 * d1
-    seg["mass"] += doc["environment"]["rho"] * math.pi / 4.0 * (seg["diameter"]**2 - d1**2)
+    seg["mass"] += doc["environment"]["rho"] * math.pi / 4.0 * (seg["diameter"] ** 2 - d1**2)
     l1 = _analyze_quiet(doc).lines["wire"]
     l4 = _analyze_quiet(thick).lines["wire"]
     q1 = l1.indicators.drag_inertia_ratio / l1.linearization.sigma_normal**2
@@ -151,8 +151,11 @@ def test_drag_inertia_in_analysis_scales_like_sigma_squared_over_diameter():
 
 def test_tuah_6_5_sigma_exceeds_mean_tension_gives_snap_warning():
     doc = _doc("tuah_1982_single_leg")
-    with pytest.warns(PhysicsWarning, match=r"snap loads likely; the linear model is out "
-                                            r"of its depth \(threshold mean − 3σ >= 0\)"):
+    with pytest.warns(
+        PhysicsWarning,
+        match=r"snap loads likely; the linear model is out "
+        r"of its depth \(threshold mean − 3σ >= 0\)",
+    ):
         res = analyze(doc)
     line = next(iter(res.lines.values()))
     assert line.end_a.std > line.end_a.mean  # the seed's case σ_T > T_mean
@@ -174,9 +177,12 @@ def test_chain_has_no_snap_resonance_or_motion_flag():
 
 def test_near_undamped_resonance_flag_fires_and_is_cured_by_damping():
     doc = _doc("inclined_guy")
-    with pytest.warns(PhysicsWarning, match=r"mode 2 \(1\.193 rad/s\) lies in the "
-                                            r"excitation band with modal damping ratio"
-                                            r".*threshold 1%"):
+    with pytest.warns(
+        PhysicsWarning,
+        match=r"mode 2 \(1\.193 rad/s\) lies in the "
+        r"excitation band with modal damping ratio"
+        r".*threshold 1%",
+    ):
         res = analyze(doc)
     ind = res.lines["guy"].indicators
     assert "resonance" in ind.flags
@@ -232,9 +238,17 @@ def test_snap_flag_fires_at_an_element_and_not_below_threshold():
         std[k] = factor * t[k]  # 3σ = 1.02 T or 0.96 T
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            ind = line_indicators(system, chans, lin, std, np.zeros((t.size + 1, 3)),
-                                  {"end_a": dataclasses.replace(res.end_a, std=0.0),
-                                   "end_b": dataclasses.replace(res.end_b, std=0.0)})
+            ind = line_indicators(
+                system,
+                chans,
+                lin,
+                std,
+                np.zeros((t.size + 1, 3)),
+                {
+                    "end_a": dataclasses.replace(res.end_a, std=0.0),
+                    "end_b": dataclasses.replace(res.end_b, std=0.0),
+                },
+            )
         msgs = [str(w.message) for w in caught]
         assert ind.snap_risk is fires
         assert any(f"element {k + 1}" in m and "snap loads likely" in m for m in msgs) is fires

@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
-from stochcable.sea import realization as sea
 from stochcable.errors import InputError
+from stochcable.sea import realization as sea
 from stochcable.sea.kinematics import kinematics_timeseries, wave_kinematics, wavenumber
 from stochcable.sea.spectra import spectrum_pierson_moskowitz
 
@@ -70,7 +70,7 @@ def test_kh_range_no_overflow_or_warning():
 def test_dispersion_residual_property(omega, h):
     k = wavenumber(np.array([omega]), h)[0]
     res = G * k * math.tanh(k * h) / omega**2 - 1
-    assert abs(res) < 4e-16 * 4       # a few ulp of the products
+    assert abs(res) < 4e-16 * 4  # a few ulp of the products
 
 
 def test_wavenumber_errors():
@@ -95,8 +95,9 @@ def test_surface_vertical_velocity_is_deta_dt(depth):
     np.testing.assert_allclose(kin.acceleration, 1j * w * kin.velocity, rtol=1e-15, atol=0)
     np.testing.assert_allclose(kin.pressure, kin.elevation, rtol=1e-14)  # p/ρg = η at z = 0
     k = wavenumber(w, depth)
-    np.testing.assert_allclose(kin.elevation[1], np.exp(-1j * k * (12 * math.cos(0.7) - 4 * math.sin(0.7))),
-                               rtol=1e-13)
+    np.testing.assert_allclose(
+        kin.elevation[1], np.exp(-1j * k * (12 * math.cos(0.7) - 4 * math.sin(0.7))), rtol=1e-13
+    )
 
 
 def test_deep_water_decay_and_surface_speed():
@@ -106,9 +107,13 @@ def test_deep_water_decay_and_surface_speed():
     kin = wave_kinematics(w, pts, heading=0.0)
     k = w * w / G
     for i, zi in enumerate(z):
-        np.testing.assert_allclose(np.abs(kin.velocity[i, 0]), w * np.exp(k * zi), rtol=1e-14, atol=0)
-        np.testing.assert_allclose(np.abs(kin.velocity[i, 2]), w * np.exp(k * zi), rtol=1e-14, atol=0)
-    np.testing.assert_allclose(kin.velocity[0, 0], w * kin.elevation[0], rtol=1e-15)   # u = ω η
+        np.testing.assert_allclose(
+            np.abs(kin.velocity[i, 0]), w * np.exp(k * zi), rtol=1e-14, atol=0
+        )
+        np.testing.assert_allclose(
+            np.abs(kin.velocity[i, 2]), w * np.exp(k * zi), rtol=1e-14, atol=0
+        )
+    np.testing.assert_allclose(kin.velocity[0, 0], w * kin.elevation[0], rtol=1e-15)  # u = ω η
     np.testing.assert_array_equal(kin.velocity[:, 1], 0)
 
 
@@ -124,7 +129,9 @@ def test_finite_depth_against_seed_form():
         ww = G * k / w * np.sinh(k * (zi + h)) / np.cosh(k * h)
         np.testing.assert_allclose(kin.velocity[i, 0], u, rtol=1e-13)
         np.testing.assert_allclose(kin.velocity[i, 2], 1j * ww, rtol=1e-13, atol=1e-16)
-        np.testing.assert_allclose(kin.pressure[i], np.cosh(k * (zi + h)) / np.cosh(k * h), rtol=1e-13)
+        np.testing.assert_allclose(
+            kin.pressure[i], np.cosh(k * (zi + h)) / np.cosh(k * h), rtol=1e-13
+        )
     np.testing.assert_allclose(kin.velocity[2, 2], 0, atol=1e-16)  # no flow through the seabed
 
 
@@ -160,7 +167,9 @@ def test_points_above_water_zero_and_extremes():
 
 
 def test_kinematics_errors():
-    with pytest.raises(InputError, match=r"points .*z must be >= -depth = -10 \(point 0 has z = -11\)"):
+    with pytest.raises(
+        InputError, match=r"points .*z must be >= -depth = -10 \(point 0 has z = -11\)"
+    ):
         wave_kinematics([1.0], [0, 0, -11.0], depth=10.0)
     with pytest.raises(InputError, match=r"points .*shape \(3,\) or \(n_points, 3\)"):
         wave_kinematics([1.0], [0, 0])
@@ -184,8 +193,9 @@ def test_kinematics_timeseries_variance():
     for i, zi in enumerate((0.0, -8.0)):
         expect_u = float((w**2 * np.exp(2 * k * zi) * s).sum() * real.d_omega)
         assert np.mean(vel[i, 0] ** 2) == pytest.approx(expect_u, rel=1e-12)
-        assert np.mean(acc[i, 2] ** 2) == pytest.approx(float((w**4 * np.exp(2 * k * zi) * s).sum()
-                                                              * real.d_omega), rel=1e-12)
+        assert np.mean(acc[i, 2] ** 2) == pytest.approx(
+            float((w**4 * np.exp(2 * k * zi) * s).sum() * real.d_omega), rel=1e-12
+        )
     # w(t) at the surface is dη/dt: compare with the spectral derivative of η
     deta = np.fft.irfft(1j * real.omega * real.coefficients, real.n_samples)
     np.testing.assert_allclose(vel[0, 2], deta, atol=1e-13)

@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.errors import ConvergenceError, InputError
 from stochcable.dynamics.iteration import fixed_point
 from stochcable.dynamics.linearization import (
     drag_linear_current,
@@ -17,6 +16,7 @@ from stochcable.dynamics.linearization import (
     mean_drag_gaussian,
 )
 from stochcable.dynamics.solvers import solve_direct
+from stochcable.errors import ConvergenceError, InputError
 
 RHO, CD, DIAM = 1025.0, 1.2, 0.1
 KAPPA = 0.5 * RHO * CD * DIAM  # 1/2 rho Cd D [N s^2/m^3]
@@ -51,7 +51,8 @@ def test_current_form_limits():
     # U = 0: the seed form exactly (same closed form, round-off)
     np.testing.assert_allclose(
         drag_linear_current(RHO, CD, DIAM, sigma, 0.0),
-        drag_linear_seed(RHO, CD, DIAM, sigma), rtol=1e-14,
+        drag_linear_seed(RHO, CD, DIAM, sigma),
+        rtol=1e-14,
     )
     # sigma -> 0: rho Cd D |U|, exactly at sigma = 0, and within O(sigma^2 / U^2) near 0
     u = np.array([-2.0, -0.3, 0.4, 1.5])
@@ -155,12 +156,14 @@ def test_vector_form_isotropic_closed_form():
 
 def test_vector_quadrature_agrees_with_closed_form_at_zero_mean():
     # mean = 0 passed explicitly uses the graded quadrature; mean=None the elliptic form
-    covs = np.array([
-        [[1.0, 0.3], [0.3, 0.5]],
-        [[2.0, 0.0], [0.0, 2.0]],
-        [[1.0, 0.999], [0.999, 1.0]],  # nearly one-directional (ratio of std 0.02)
-        [[1e-12, 0.0], [0.0, 1.0]],
-    ])
+    covs = np.array(
+        [
+            [[1.0, 0.3], [0.3, 0.5]],
+            [[2.0, 0.0], [0.0, 2.0]],
+            [[1.0, 0.999], [0.999, 1.0]],  # nearly one-directional (ratio of std 0.02)
+            [[1e-12, 0.0], [0.0, 1.0]],
+        ]
+    )
     b_closed = drag_linear_vector(RHO, CD, DIAM, covs)
     b_quad = drag_linear_vector(RHO, CD, DIAM, covs, np.zeros((4, 2)))
     scale = np.abs(b_closed).max(axis=(1, 2))[:, None, None]
@@ -319,8 +322,7 @@ def test_fixed_point_anderson_mixing_parameter():
     exact = np.linalg.solve(np.eye(6) - a, b)
     runs = {}
     for mix in (None, 0.5, 1.0):
-        r = fixed_point(lambda x: a @ x + b, np.abs(b), tol=1e-10, relaxation=0.5,
-                        mixing=mix)
+        r = fixed_point(lambda x: a @ x + b, np.abs(b), tol=1e-10, relaxation=0.5, mixing=mix)
         np.testing.assert_allclose(r.x, exact, rtol=1e-8)  # tol 1e-10 on the change
         runs[mix] = r
     assert runs[None].history == runs[0.5].history
@@ -335,9 +337,9 @@ def test_current_form_without_current_is_the_seed_form_to_the_bit():
     sigma = np.r_[0.0, rng.uniform(0.0, 3.0, 200), 1e-300]
     got = drag_linear_current(1025.0, 1.2, 0.1, sigma, np.zeros_like(sigma))
     # the general expression's value: σ·√(2/π)·e⁰ + 0·erf(0)
-    expected = 1025.0 * 1.2 * 0.1 * np.where(sigma > 0, sigma * math.sqrt(2.0 / math.pi),
-                                              0.0)
+    expected = 1025.0 * 1.2 * 0.1 * np.where(sigma > 0, sigma * math.sqrt(2.0 / math.pi), 0.0)
     np.testing.assert_array_equal(got, expected)
-    np.testing.assert_allclose(got, drag_linear_seed(1025.0, 1.2, 0.1, sigma),
-                               rtol=4e-16)  # √(8/π)·½ against √(2/π): one rounding
+    np.testing.assert_allclose(
+        got, drag_linear_seed(1025.0, 1.2, 0.1, sigma), rtol=4e-16
+    )  # √(8/π)·½ against √(2/π): one rounding
     assert got[0] == 0.0

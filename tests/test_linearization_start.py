@@ -11,13 +11,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stochcable.dynamics import system as dsystem
 from stochcable.dynamics import blocks as dblocks
-from stochcable.dynamics import line_loads as dloads
-from stochcable.dynamics import solve as dsolve
-from stochcable.dynamics import variance as dvariance
 from stochcable.dynamics import fixedpoint as dfixedpoint
+from stochcable.dynamics import line_loads as dloads
 from stochcable.dynamics import outputs as doutputs
+from stochcable.dynamics import solve as dsolve
+from stochcable.dynamics import system as dsystem
+from stochcable.dynamics import variance as dvariance
 from stochcable.dynamics.loads import line_channels
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
@@ -87,8 +87,10 @@ def test_small_grid_has_no_coarse_stage(chain):
     sub = line_channels(scene, system.line, system.positions, w)
     lin = dfixedpoint.linearize(system, sub, scene.analysis)
     assert lin.coarse is None
-    assert lin.record.iterations == dfixedpoint.linearize(system, sub, scene.analysis,
-                                                 coarse=False).record.iterations
+    assert (
+        lin.record.iterations
+        == dfixedpoint.linearize(system, sub, scene.analysis, coarse=False).record.iterations
+    )
 
 
 def test_interpolatory_weights_integrate_cubics_as_the_full_grid():
@@ -142,5 +144,3 @@ def test_narrow_resonance_is_not_missed_by_the_coarse_subset():
     f = dfixedpoint.linearize(system, ch, scene.analysis, coarse=False)
     tol = scene.analysis.linearization.tolerance
     assert np.max(np.abs(_sigma(c) / _sigma(f) - 1)) < 4 * tol  # each within 2 tol
-
-

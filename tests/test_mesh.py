@@ -15,15 +15,35 @@ RHO, G = 1025.0, 9.80665
 
 def make_line(segments, attachments=()):
     total = sum(s.length for s in segments)
-    return Line(name="l", end_a=End(position=(-0.8 * total, 0.0, -100.0)),
-                end_b=End(position=(0.0, 0.0, -10.0)), segments=tuple(segments),
-                attachments=tuple(attachments))
+    return Line(
+        name="l",
+        end_a=End(position=(-0.8 * total, 0.0, -100.0)),
+        end_b=End(position=(0.0, 0.0, -10.0)),
+        segments=tuple(segments),
+        attachments=tuple(attachments),
+    )
 
 
-SEG_A = Segment(length=300.0, ea=1e9, mass=100.0, diameter=0.1, cd_normal=1.1,
-                cd_axial=0.1, ca_normal=0.9, elements=3)
-SEG_B = Segment(length=200.0, ea=2e8, mass=20.0, diameter=0.2, cd_normal=1.3,
-                cd_axial=0.2, ca_normal=1.1, elements=4)
+SEG_A = Segment(
+    length=300.0,
+    ea=1e9,
+    mass=100.0,
+    diameter=0.1,
+    cd_normal=1.1,
+    cd_axial=0.1,
+    ca_normal=0.9,
+    elements=3,
+)
+SEG_B = Segment(
+    length=200.0,
+    ea=2e8,
+    mass=20.0,
+    diameter=0.2,
+    cd_normal=1.3,
+    cd_axial=0.2,
+    ca_normal=1.1,
+    elements=4,
+)
 
 
 def test_node_arc_lengths_uniform_per_segment():
@@ -42,7 +62,8 @@ def test_segment_properties_per_element():
     m = mesh_line(make_line([SEG_A, SEG_B]), RHO, G)
     for attr in ("ea", "mass", "diameter", "cd_normal", "cd_axial", "ca_normal"):
         np.testing.assert_array_equal(
-            getattr(m, attr), [getattr(SEG_A, attr)] * 3 + [getattr(SEG_B, attr)] * 4)
+            getattr(m, attr), [getattr(SEG_A, attr)] * 3 + [getattr(SEG_B, attr)] * 4
+        )
 
 
 def test_weight_is_mass_minus_displaced_times_g():
@@ -56,8 +77,9 @@ def test_weight_is_mass_minus_displaced_times_g():
     assert np.all(mesh_line(make_line([seg]), RHO, G).weight == 123.0)
     # imperial units: seed 001 §6.2 cable, w = (3.35 - 2.0) A g lbf/ft
     a = 0.0218
-    imp = Segment(length=500.0, ea=8.12e6 * a, mass=3.35 * a,
-                  diameter=math.sqrt(4 * a / math.pi), elements=3)
+    imp = Segment(
+        length=500.0, ea=8.12e6 * a, mass=3.35 * a, diameter=math.sqrt(4 * a / math.pi), elements=3
+    )
     w = mesh_line(make_line([imp]), 2.0, 32.174).weight
     np.testing.assert_allclose(w, (3.35 - 2.0) * a * 32.174, rtol=1e-12)
 
@@ -71,15 +93,23 @@ def test_attachment_splits_element_and_sits_on_node():
     np.testing.assert_array_equal(m.segment, [0, 0, 0, 0, 1, 1, 1, 1])
     i = int(np.flatnonzero(m.node_mass)[0])
     assert m.s0[i] == 150.0
-    assert (m.node_mass[i], m.node_buoyancy[i], m.node_added_mass[i],
-            m.node_drag_area[i]) == (500.0, 2000.0, 50.0, 0.3)
+    assert (m.node_mass[i], m.node_buoyancy[i], m.node_added_mass[i], m.node_drag_area[i]) == (
+        500.0,
+        2000.0,
+        50.0,
+        0.3,
+    )
     assert m.node_mass.sum() == 500.0 and m.node_buoyancy.sum() == 2000.0
     assert m.l0.sum() == pytest.approx(500.0, rel=1e-15)
 
 
 def test_attachments_on_existing_nodes_and_ends_do_not_split():
-    atts = [Attachment(at=0.0, mass=1.0), Attachment(at=300.0, buoyancy=900.0),
-            Attachment(at=500.0, mass=2.0), Attachment(at=100.0 * (1 + 1e-9), mass=3.0)]
+    atts = [
+        Attachment(at=0.0, mass=1.0),
+        Attachment(at=300.0, buoyancy=900.0),
+        Attachment(at=500.0, mass=2.0),
+        Attachment(at=100.0 * (1 + 1e-9), mass=3.0),
+    ]
     m = mesh_line(make_line([SEG_A, SEG_B], atts), RHO, G)
     assert m.n_nodes == 8  # no sliver element (snap within 1e-6 of the element length)
     assert m.node_mass[0] == 1.0 and m.node_mass[-1] == 2.0 and m.node_mass[1] == 3.0
@@ -87,8 +117,11 @@ def test_attachments_on_existing_nodes_and_ends_do_not_split():
 
 
 def test_two_attachments_in_one_element_and_summed_on_one_node():
-    atts = [Attachment(at=120.0, mass=1.0), Attachment(at=180.0, mass=2.0),
-            Attachment(at=180.0, buoyancy=5.0)]
+    atts = [
+        Attachment(at=120.0, mass=1.0),
+        Attachment(at=180.0, mass=2.0),
+        Attachment(at=180.0, buoyancy=5.0),
+    ]
     m = mesh_line(make_line([SEG_A], atts), RHO, G)
     np.testing.assert_allclose(m.s0, [0, 100, 120, 180, 200, 300], atol=1e-12)
     assert m.node_mass[2] == 1.0 and m.node_mass[3] == 2.0 and m.node_buoyancy[3] == 5.0

@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from fem_cases import hanging_chain, shallow_parabola, taut_string, uniform_mesh
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, fsolve
 from scipy.special import jn_zeros
 
-from fem_cases import hanging_chain, shallow_parabola, taut_string, uniform_mesh
 from stochcable.errors import InputError
 from stochcable.line.fem import assemble
 from stochcable.line.modes import Modes, natural_modes
@@ -32,9 +32,17 @@ BLIET_1984_EQ_3_9 = (1.204, 2.760, 4.327, 5.896, 7.465)
 # Bliet 1984 §7.3 guy data and static results (Fig. 7-7).  The printed net weight
 # 494.98 N/m is a misprint: T_top − T_bot = w·depth (to 1e-5) and the printed static
 # angles and Δx are reproduced with w = 414.98 N/m (checked in test_guy_statics).
-BLIET_1984_GUY = {"t_top": 1.332e6, "t_bot": 1155096.0, "ea": 1.30e9, "length": 1036.32,
-                  "depth": 426.70, "mass": 48.7, "added_mass": 6.3, "weight": 414.98,
-                  "diameter": 0.0889}
+BLIET_1984_GUY = {
+    "t_top": 1.332e6,
+    "t_bot": 1155096.0,
+    "ea": 1.30e9,
+    "length": 1036.32,
+    "depth": 426.70,
+    "mass": 48.7,
+    "added_mass": 6.3,
+    "weight": 414.98,
+    "diameter": 0.0889,
+}
 BLIET_1984_GUY_STATICS = {"phi_top_deg": 33.056, "phi_bot_deg": 14.874, "dx": 940.68}
 # Bliet 1984 Table 7-II: in-plane eigenfrequencies of the guy [rad/s] and shapes.
 BLIET_1984_TABLE_7_II = (0.9011, 1.1949, 1.6086, 1.8228, 2.3115, 2.7527, 3.2335, 3.7059)
@@ -95,8 +103,9 @@ def test_string_in_plane_and_out_of_plane_modes_are_equal():
 
 def test_string_in_an_oblique_vertical_plane_is_classified():
     p = BLIET_1984_STRING
-    mesh, pos, ten = taut_string(40, p["length"], p["tension"], p["mass"], 1e12,
-                                 direction=(1.0, 0.7, 0.5))
+    mesh, pos, ten = taut_string(
+        40, p["length"], p["tension"], p["mass"], 1e12, direction=(1.0, 0.7, 0.5)
+    )
     m = natural_modes(assemble(mesh, pos, ten, RHO), count=6, added_mass=False)
     # the line's plane is rotated 35° about z: the pairs still split cleanly
     assert sorted(m.plane.tolist()) == ["in-plane"] * 3 + ["out-of-plane"] * 3
@@ -111,9 +120,9 @@ def test_string_axial_modes():
     mesh, pos, ten = taut_string(200, p["length"], p["tension"], p["mass"], ea)
     model = assemble(mesh, pos, ten, RHO, dim=2)
     m = natural_modes(model, count=80, added_mass=False)
-    axial_share = np.array([
-        np.sum(m.shapes[0::2, j] ** 2) / np.sum(m.shapes[:, j] ** 2) for j in range(m.count)
-    ])
+    axial_share = np.array(
+        [np.sum(m.shapes[0::2, j] ** 2) / np.sum(m.shapes[:, j] ** 2) for j in range(m.count)]
+    )
     axial = m.omega[axial_share > 0.999][:3]
     ref = np.arange(1, 4) * np.pi / p["length"] * np.sqrt(ea / p["mass"])
     # 200 elements: O((kh)²/24) <= 6e-5 for n <= 3
@@ -129,8 +138,9 @@ def test_large_ea_over_t_keeps_low_modes_accurate():
     # FE error (kh)²/24 at 200 elements <= 6e-5; any round-off loss would show above it
     np.testing.assert_allclose(m.omega, exact, rtol=1e-4)
     fe_error = (m.omega - exact) / exact
-    np.testing.assert_allclose(fe_error, (np.repeat(np.arange(1, 4), 2) * np.pi / 200) ** 2 / 24,
-                               rtol=0.01)
+    np.testing.assert_allclose(
+        fe_error, (np.repeat(np.arange(1, 4), 2) * np.pi / 200) ** 2 / 24, rtol=0.01
+    )
 
 
 # ----------------------------------------------------------------- hanging chain
@@ -164,24 +174,31 @@ def _irvine_symmetric(lam2: float, n: int) -> np.ndarray:
     """
     c = 4.0 / lam2
     eps = 1e-12
-    return np.array([
-        brentq(lambda x: np.tan(x) - x + c * x**3, (2 * j - 1) * np.pi / 2 + eps,
-               (2 * j + 1) * np.pi / 2 - eps, xtol=1e-14)
-        for j in range(1, n + 1)
-    ])
+    return np.array(
+        [
+            brentq(
+                lambda x: np.tan(x) - x + c * x**3,
+                (2 * j - 1) * np.pi / 2 + eps,
+                (2 * j + 1) * np.pi / 2 - eps,
+                xtol=1e-14,
+            )
+            for j in range(1, n + 1)
+        ]
+    )
 
 
 def _symmetry(model, shapes):
     """+1 for a symmetric vertical displacement about midspan, −1 antisymmetric."""
-    z = shapes[model.dof(0, "z")::model.dim]
+    z = shapes[model.dof(0, "z") :: model.dim]
     return np.sign(np.einsum("ij,ij->j", z, z[::-1]))
 
 
 SPAN, H_IRVINE, SAG = 100.0, 1.0e5, 0.01
 
 
-@pytest.mark.parametrize("lam2", [1.0, 4 * np.pi**2 - 1, 4 * np.pi**2, 4 * np.pi**2 + 1,
-                                  100.0, 1000.0])
+@pytest.mark.parametrize(
+    "lam2", [1.0, 4 * np.pi**2 - 1, 4 * np.pi**2, 4 * np.pi**2 + 1, 100.0, 1000.0]
+)
 def test_irvine_caughey_shallow_sag(lam2):
     n_el = 200
     w = 8 * H_IRVINE * SAG / SPAN  # parabola: d = w L²/(8H)
@@ -256,13 +273,19 @@ def _guy_shape(h, va, s):
 
 def test_guy_statics_reproduce_bliet_fig_7_7():
     p = BLIET_1984_GUY
+
     # w from three printed numbers (T_top, T_bot, depth) with H, V_a unknown
     def eqs(q):
         h, va, w = q
         v = va + w * p["length"]
-        z = (np.hypot(h, v) - np.hypot(h, va)) / w + (va * p["length"] + w * p["length"] ** 2 / 2) / p["ea"]
-        return [np.hypot(h, v) / p["t_top"] - 1, np.hypot(h, va) / p["t_bot"] - 1,
-                z / p["depth"] - 1]
+        z = (np.hypot(h, v) - np.hypot(h, va)) / w + (
+            va * p["length"] + w * p["length"] ** 2 / 2
+        ) / p["ea"]
+        return [
+            np.hypot(h, v) / p["t_top"] - 1,
+            np.hypot(h, va) / p["t_bot"] - 1,
+            z / p["depth"] - 1,
+        ]
 
     w = fsolve(eqs, [1.1e6, 2e5, 450.0], xtol=1e-13)[2]
     assert w == pytest.approx(p["weight"], abs=0.01)  # not the printed 494.98
@@ -299,29 +322,36 @@ def guy_shooting():
         t = f0 / tt
         out = np.empty(8)
         for j in (0, 4):
-            u, f = y[j:j + 2], y[j + 2:j + 4]
-            out[j:j + 2] = (1 / tt + 1 / ea) * f - (t @ f) * t / tt
-            out[j + 2:j + 4] = -om**2 * (m * u + ma * (u - (t @ u) * t))
+            u, f = y[j : j + 2], y[j + 2 : j + 4]
+            out[j : j + 2] = (1 / tt + 1 / ea) * f - (t @ f) * t / tt
+            out[j + 2 : j + 4] = -(om**2) * (m * u + ma * (u - (t @ u) * t))
         return out
 
     def det_in(om):
         y0 = np.array([0, 0, 1, 0, 0, 0, 0, 1.0])
-        y = solve_ivp(rhs_in, (0, length), y0, args=(om,), method="DOP853",
-                      rtol=1e-11, atol=1e-14).y[:, -1]
+        y = solve_ivp(
+            rhs_in, (0, length), y0, args=(om,), method="DOP853", rtol=1e-11, atol=1e-14
+        ).y[:, -1]
         return y[0] * y[5] - y[1] * y[4]
 
     def v_out(om):
         def rhs(s, y):
             tt = np.hypot(h, va + w * s)
-            return [(1 / tt + 1 / ea) * y[1], -om**2 * (m + ma) * y[0]]
-        return solve_ivp(rhs, (0, length), [0.0, 1.0], method="DOP853",
-                         rtol=1e-11, atol=1e-14).y[0, -1]
+            return [(1 / tt + 1 / ea) * y[1], -(om**2) * (m + ma) * y[0]]
+
+        return solve_ivp(rhs, (0, length), [0.0, 1.0], method="DOP853", rtol=1e-11, atol=1e-14).y[
+            0, -1
+        ]
 
     def roots(fun, grid):
         vals = [fun(o) for o in grid]
-        return np.array([brentq(fun, grid[i], grid[i + 1], xtol=1e-13)
-                         for i in range(grid.size - 1)
-                         if np.sign(vals[i]) != np.sign(vals[i + 1])])
+        return np.array(
+            [
+                brentq(fun, grid[i], grid[i + 1], xtol=1e-13)
+                for i in range(grid.size - 1)
+                if np.sign(vals[i]) != np.sign(vals[i + 1])
+            ]
+        )
 
     grid = np.arange(0.05, 3.85, 0.1)
     return {"in": roots(det_in, grid), "out": roots(v_out, grid), "h": h, "va": va}
@@ -334,8 +364,14 @@ def _guy_model(n_el, h, va, dim=3):
     mid = 0.5 * (s[1:] + s[:-1])
     tension = np.hypot(h, va + p["weight"] * mid)
     area = np.pi * p["diameter"] ** 2 / 4
-    mesh = uniform_mesh(n_el, np.diff(s), p["ea"], p["mass"], diameter=p["diameter"],
-                        ca_normal=p["added_mass"] / (RHO * area))
+    mesh = uniform_mesh(
+        n_el,
+        np.diff(s),
+        p["ea"],
+        p["mass"],
+        diameter=p["diameter"],
+        ca_normal=p["added_mass"] / (RHO * area),
+    )
     pos = np.column_stack([x, np.zeros_like(x), z])
     return assemble(mesh, pos, tension, RHO, dim=dim)
 
@@ -389,9 +425,13 @@ def test_sparse_and_banded_paths_equal_dense_at_400_elements():
         # 400 elements), ARPACK's is smaller: agreement to 1e-8, far below FE error
         np.testing.assert_allclose(other.omega, dense.omega, rtol=1e-8)
         # same shapes up to round-off (non-degenerate modes, deterministic sign)
-        np.testing.assert_allclose(np.abs(other.shapes.T @ model.M @ dense.shapes +
-                                          other.shapes.T @ model.Ma @ dense.shapes),
-                                   np.eye(30), atol=1e-6)
+        np.testing.assert_allclose(
+            np.abs(
+                other.shapes.T @ model.M @ dense.shapes + other.shapes.T @ model.Ma @ dense.shapes
+            ),
+            np.eye(30),
+            atol=1e-6,
+        )
         assert (other.plane == dense.plane).all()
 
 
@@ -406,7 +446,7 @@ def test_degenerate_pairs_kept_on_lanczos_path():
         np.testing.assert_allclose(m.omega, dense.omega, rtol=1e-6)
         # each double frequency: one in-plane and one out-of-plane mode
         for j in range(0, 20, 2):
-            assert sorted(m.plane[j:j + 2]) == ["in-plane", "out-of-plane"]
+            assert sorted(m.plane[j : j + 2]) == ["in-plane", "out-of-plane"]
 
 
 def test_mass_normalization_and_fixed_dofs_zero():
@@ -427,8 +467,9 @@ def test_added_mass_lowers_frequencies_by_mass_ratio():
     wet = natural_modes(model, count=4, added_mass=True)
     ma = RHO * np.pi * 0.0889**2 / 4
     # transverse modes only (axial ones are far above): exact √(m/(m+ma)) scaling
-    np.testing.assert_allclose(wet.omega / dry.omega, np.sqrt(p["mass"] / (p["mass"] + ma)),
-                               rtol=1e-12)
+    np.testing.assert_allclose(
+        wet.omega / dry.omega, np.sqrt(p["mass"] / (p["mass"] + ma)), rtol=1e-12
+    )
 
 
 def test_document_and_period():
@@ -464,10 +505,24 @@ def test_error_paths():
 # with the mass per stretched length, m·L0/L).
 TAUT_SCENE = {
     "environment": {"depth": 500.0, "rho": 1025.0},
-    "lines": [{"name": "taut", "end_a": {"position": [0.0, 0.0, -300.0]},
-               "end_b": {"position": [400.0, 0.0, -300.0]},
-               "segments": [{"length": 399.6, "ea": 1.0e9, "mass": 50.0, "diameter": 0.1,
-                             "weight": 0.0, "ca_normal": 1.0, "elements": 100}]}],
+    "lines": [
+        {
+            "name": "taut",
+            "end_a": {"position": [0.0, 0.0, -300.0]},
+            "end_b": {"position": [400.0, 0.0, -300.0]},
+            "segments": [
+                {
+                    "length": 399.6,
+                    "ea": 1.0e9,
+                    "mass": 50.0,
+                    "diameter": 0.1,
+                    "weight": 0.0,
+                    "ca_normal": 1.0,
+                    "elements": 100,
+                }
+            ],
+        }
+    ],
 }
 
 
@@ -501,8 +556,9 @@ def test_dense_blocks_and_sparse_blocks_give_the_same_modes(dim, rotate):
     component grouping of dense and sparse matrices is the same."""
     from stochcable.line.modes import _component_groups
 
-    mesh, pos, ten = shallow_parabola(12, SPAN, SAG, H_IRVINE, 8.0 * H_IRVINE * SAG / SPAN / G,
-                                      G, ea=1e7)
+    mesh, pos, ten = shallow_parabola(
+        12, SPAN, SAG, H_IRVINE, 8.0 * H_IRVINE * SAG / SPAN / G, G, ea=1e7
+    )
     if rotate:
         c, s = np.cos(0.7), np.sin(0.7)
         pos = pos @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
@@ -518,17 +574,30 @@ def test_dense_blocks_and_sparse_blocks_give_the_same_modes(dim, rotate):
         from scipy.linalg import eigh
 
         groups = _component_groups(dim, a, b)
-        lam = np.sort(np.concatenate([eigh(
-            model.partition("K")[0].toarray()[np.ix_(sel, sel)],
-            model.partition("MT")[0].toarray()[np.ix_(sel, sel)], eigvals_only=True)
-            for sel in (np.flatnonzero(np.isin(np.arange(a.shape[0]) % dim, g))
-                        for g in groups)]))
+        lam = np.sort(
+            np.concatenate(
+                [
+                    eigh(
+                        model.partition("K")[0].toarray()[np.ix_(sel, sel)],
+                        model.partition("MT")[0].toarray()[np.ix_(sel, sel)],
+                        eigvals_only=True,
+                    )
+                    for sel in (
+                        np.flatnonzero(np.isin(np.arange(a.shape[0]) % dim, g)) for g in groups
+                    )
+                ]
+            )
+        )
         np.testing.assert_allclose(dense.omega, np.sqrt(lam[:8]), rtol=1e-13)
     if dim == 3 and not rotate:
         assert _component_groups(3, a, b) == [[0, 2], [1]]  # in-plane and out-of-plane
     if rotate:  # the planar line's modes, rotated: the same frequencies (round-off)
-        flat = natural_modes(assemble(mesh, pos @ np.array(
-            [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), ten, RHO, dim=3), 8)
+        flat = natural_modes(
+            assemble(
+                mesh, pos @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), ten, RHO, dim=3
+            ),
+            8,
+        )
         np.testing.assert_allclose(dense.omega, flat.omega, rtol=1e-10)
 
 
@@ -544,8 +613,9 @@ def test_dense_rotation_path_is_the_sparse_path_to_the_bit(shape, monkeypatch):
 
     import stochcable.line.modes as md
 
-    mesh, pos, ten = shallow_parabola(12, SPAN, SAG, H_IRVINE, 8.0 * H_IRVINE * SAG / SPAN / G,
-                                      G, ea=1e7)
+    mesh, pos, ten = shallow_parabola(
+        12, SPAN, SAG, H_IRVINE, 8.0 * H_IRVINE * SAG / SPAN / G, G, ea=1e7
+    )
     c, s = np.cos(2.1), np.sin(2.1)
     pos = pos @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
     if shape == "non-planar":  # bow the interior nodes out of the chord's plane
@@ -556,8 +626,9 @@ def test_dense_rotation_path_is_the_sparse_path_to_the_bit(shape, monkeypatch):
     # the sparse path with the dense eigensolver: what "auto" ran before the pass
     solve_block = md._solve_block
     monkeypatch.setattr(md, "DENSE_MAX_DOF", -1)
-    monkeypatch.setattr(md, "_solve_block",
-                        lambda a, b, k, method, u: solve_block(a, b, k, "dense", u))
+    monkeypatch.setattr(
+        md, "_solve_block", lambda a, b, k, method, u: solve_block(a, b, k, "dense", u)
+    )
     ref = natural_modes(model, 8)
     monkeypatch.undo()
     assert fast.method == ref.method == "dense"
@@ -566,12 +637,16 @@ def test_dense_rotation_path_is_the_sparse_path_to_the_bit(shape, monkeypatch):
     np.testing.assert_array_equal(fast.out_of_plane, ref.out_of_plane)
     assert list(fast.plane) == list(ref.plane)
     # and the kernels themselves against the sparse products
-    r = np.array([[fast.normal[1], fast.normal[0], 0.0],
-                  [-fast.normal[0], fast.normal[1], 0.0], [0.0, 0.0, 1.0]])
+    r = np.array(
+        [
+            [fast.normal[1], fast.normal[0], 0.0],
+            [-fast.normal[0], fast.normal[1], 0.0],
+            [0.0, 0.0, 1.0],
+        ]
+    )
     a = model._free_free(model.K)
     rot = sp.csr_array(sp.kron(sp.eye_array(a.shape[0] // 3), r, format="csr"))
-    np.testing.assert_array_equal(md._rotate_dense(a.toarray(), r),
-                                  (rot.T @ a @ rot).toarray())
+    np.testing.assert_array_equal(md._rotate_dense(a.toarray(), r), (rot.T @ a @ rot).toarray())
     x = np.random.default_rng(3).standard_normal((a.shape[0], 5))
     np.testing.assert_array_equal(md._unrotate_dense(x, r), rot @ x)
 

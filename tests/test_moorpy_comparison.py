@@ -33,10 +33,20 @@ def _moorpy_line():
     ms = mp.System(depth=DEPTH, rho=RHO, g=G)
     ms.addPoint(1, np.array([-800.0, 0.0, -200.0]))
     ms.addPoint(1, np.array([0.0, 0.0, -20.0]))
-    line_type = dict(name="chain", m=MASS, d_vol=DIAMETER, EA=EA,
-                     w=(MASS - math.pi / 4 * DIAMETER**2 * RHO) * G, Cd=CDN,
-                     CdAx=CDT * math.pi, Ca=CAN, CaAx=0.0, MBL=0.0, cost=0.0,
-                     material="chain")
+    line_type = dict(
+        name="chain",
+        m=MASS,
+        d_vol=DIAMETER,
+        EA=EA,
+        w=(MASS - math.pi / 4 * DIAMETER**2 * RHO) * G,
+        Cd=CDN,
+        CdAx=CDT * math.pi,
+        Ca=CAN,
+        CaAx=0.0,
+        MBL=0.0,
+        cost=0.0,
+        material="chain",
+    )
     line = ms.addLine(LENGTH, line_type, nSegs=N_EL, pointA=1, pointB=2)
     ms.initialize()
     return line
@@ -78,8 +88,9 @@ def test_dynamic_tension_sigma_matches_moorpy_within_discretization():
     rao_b = np.zeros((omega.size, 3))
     rao_b[:, 0] = 1.0
     ds = LENGTH / N_EL
-    out = line.dynamicSolve(omega, s_surge, rao_a, rao_b, DEPTH, K_BED * DIAMETER * ds,
-                            C_BED * DIAMETER * ds, tol=1e-4)
+    out = line.dynamicSolve(
+        omega, s_surge, rao_a, rao_b, DEPTH, K_BED * DIAMETER * ds, C_BED * DIAMETER * ds, tol=1e-4
+    )
     t_std = out[2]
     assert res.end_a.std == pytest.approx(float(t_std[0]), rel=0.03)
     assert res.end_b.std == pytest.approx(float(t_std[-1]), rel=0.03)

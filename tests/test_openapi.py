@@ -39,8 +39,9 @@ def test_check_mode_detects_drift(tmp_path, capsys):
 
 def test_operation_ids_are_stable():
     doc = openapi_document()
-    found = {(m, p): op["operationId"] for p, item in doc["paths"].items()
-             for m, op in item.items()}
+    found = {
+        (m, p): op["operationId"] for p, item in doc["paths"].items() for m, op in item.items()
+    }
     for key, op_id in OPERATIONS.items():
         assert found.get(key) == op_id, key
 
@@ -61,9 +62,16 @@ def test_every_numeric_field_states_its_unit():
                 missing.append(f"{name}.{field}")
     # integer identifiers without a physical unit, error locations, and the scene's
     # ComplexTable whose unit depends on where it is used (stochcable/scene.py)
-    allowed = {"TimeSeriesSettings.seed", "RealizationRequest.seed", "AnalysisSettings.modes",
-               "TimeSeriesDocument.seed",
-               "ErrorItem.loc", "ValidationError.loc", "ComplexTable.re", "ComplexTable.im"}
+    allowed = {
+        "TimeSeriesSettings.seed",
+        "RealizationRequest.seed",
+        "AnalysisSettings.modes",
+        "TimeSeriesDocument.seed",
+        "ErrorItem.loc",
+        "ValidationError.loc",
+        "ComplexTable.re",
+        "ComplexTable.im",
+    }
     assert sorted(set(missing) - allowed) == []
 
 
@@ -86,10 +94,17 @@ def test_analyses_are_documented_with_the_scene_and_the_result_models():
     assert ok["content"]["application/json"]["schema"]["$ref"].endswith("AnalysisResponse")
     assert "X-Stochcable-Warnings" in ok["headers"]
     for code in ("413", "422", "504"):
-        assert post["responses"][code]["content"]["application/json"]["schema"][
-            "$ref"].endswith("ErrorResponse")
+        assert post["responses"][code]["content"]["application/json"]["schema"]["$ref"].endswith(
+            "ErrorResponse"
+        )
     params = {p["name"]: p for p in post["parameters"]}
     assert params["timeseries"]["schema"]["enum"] == ["window", "full", "none"]
     result = doc["components"]["schemas"]["AnalysisResponse"]
-    assert set(result["required"]) == {"statics", "modes", "linearization", "lines",
-                                       "timing", "warnings"}
+    assert set(result["required"]) == {
+        "statics",
+        "modes",
+        "linearization",
+        "lines",
+        "timing",
+        "warnings",
+    }

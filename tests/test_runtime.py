@@ -19,8 +19,8 @@ import pytest
 
 from stochcable import runtime
 from stochcable import runtime as _parallel
-from stochcable.runtime import single_blas_thread
 from stochcable.errors import PhysicsWarning, SolverError, collect_warnings, warn
+from stochcable.runtime import single_blas_thread
 
 
 def _eig_item(seed: int) -> tuple[np.ndarray, str]:
@@ -49,7 +49,7 @@ def test_same_bits_and_order_as_the_loop(monkeypatch):
     serial = [_eig_item(s)[0] for s in range(5)]
     with single_blas_thread():
         out = _parallel.line_map(_eig_item, range(5))
-    assert used == [1]   # the calling thread and one pool worker
+    assert used == [1]  # the calling thread and one pool worker
     assert [np.array_equal(a, b) for (a, _), b in zip(out, serial)] == [True] * 5
 
 
@@ -86,8 +86,12 @@ def test_no_nesting_warnings_forwarded_and_first_exception(monkeypatch):
         assert len(names) == 1
         return _parallel.line_map(inner, range(2))
 
-    with single_blas_thread(), collect_warnings() as outer_caught, \
-            collect_warnings() as caught, pytest.warns(PhysicsWarning):
+    with (
+        single_blas_thread(),
+        collect_warnings() as outer_caught,
+        collect_warnings() as caught,
+        pytest.warns(PhysicsWarning),
+    ):
         out = _parallel.line_map(outer, range(3))
     assert out == [[True, True]] * 3
     # forwarded to every collector of the calling thread, once each, in item order
@@ -118,8 +122,9 @@ def test_single_blas_thread_applies_in_worker_threads():
     threadpoolctl = pytest.importorskip("threadpoolctl")
 
     def blas_threads() -> list[int]:
-        return [d["num_threads"] for d in threadpoolctl.threadpool_info()
-                if d["user_api"] == "blas"]
+        return [
+            d["num_threads"] for d in threadpoolctl.threadpool_info() if d["user_api"] == "blas"
+        ]
 
     before = blas_threads()
     seen: dict[str, list[int]] = {}
@@ -173,17 +178,21 @@ def test_library_changes_no_process_setting_until_configured():
     # runtime.configure() then gives the small model one BLAS thread during the
     # analysis, restored afterwards, and sets the passive OpenMP policy
     pytest.importorskip("threadpoolctl")
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("OMP_WAIT_POLICY", "MALLOC_TOP_PAD_", "STOCHCABLE_MALLOC_TUNING")}
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("OMP_WAIT_POLICY", "MALLOC_TOP_PAD_", "STOCHCABLE_MALLOC_TUNING")
+    }
     env.update(OPENBLAS_NUM_THREADS="2", OMP_NUM_THREADS="2")
-    out = subprocess.run([sys.executable, "-c", _PLAIN_IMPORT], capture_output=True,
-                         text=True, env=env, timeout=120)
+    out = subprocess.run(
+        [sys.executable, "-c", _PLAIN_IMPORT], capture_output=True, text=True, env=env, timeout=120
+    )
     assert out.returncode == 0, out.stderr
     got = json.loads(out.stdout)
     assert got["before"] is None and got["after"] is None
     if not got["during"]:
         pytest.skip("no BLAS library visible to threadpoolctl")
-    assert max(got["during"]) == 2          # the process's own setting, untouched
+    assert max(got["during"]) == 2  # the process's own setting, untouched
     assert got["configured"] == [1] * len(got["configured"])
     assert max(got["restored"]) == 2
     assert got["omp"] == "PASSIVE"
@@ -196,7 +205,7 @@ def test_configure_switches_and_env_policy_respected(monkeypatch):
     try:
         runtime.configure(small_model_blas=False, allocator=False)
         assert runtime.configured() == {"configured": True, "small_model_blas": False}
-        assert os.environ["OMP_WAIT_POLICY"] == "ACTIVE"   # the user's choice stays
+        assert os.environ["OMP_WAIT_POLICY"] == "ACTIVE"  # the user's choice stays
         runtime.configure()
         assert runtime.configured()["small_model_blas"] is True
     finally:
@@ -205,12 +214,13 @@ def test_configure_switches_and_env_policy_respected(monkeypatch):
 
 def test_cli_and_service_configure_the_process():
     # the command line and the service apply the settings at start
-    code = ("import sys; from stochcable import runtime; from stochcable.cli import main;"
-            "main(['spectrum', 'pm', '--hs', '2', '--tp', '8', '--format', 'json', '-o',"
-            " '/dev/null']); a = runtime.configured()['configured'];"
-            "runtime._settings['configured'] = False;"
-            "import service.app; print(a, runtime.configured()['configured'])")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=120)
+    code = (
+        "import sys; from stochcable import runtime; from stochcable.cli import main;"
+        "main(['spectrum', 'pm', '--hs', '2', '--tp', '8', '--format', 'json', '-o',"
+        " '/dev/null']); a = runtime.configured()['configured'];"
+        "runtime._settings['configured'] = False;"
+        "import service.app; print(a, runtime.configured()['configured'])"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["True", "True"]

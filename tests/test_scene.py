@@ -56,42 +56,85 @@ def _seg(d):
 @pytest.mark.parametrize(
     "mutate, pattern",
     [
-        (lambda d: _seg(d).__setitem__("ea", -1.0),
-         r"^lines\[0\]\.segments\[0\]\.ea = -1\.0 \[N\]: Input should be greater than 0"),
-        (lambda d: _seg(d).__setitem__("ea", 0.0),
-         r"^lines\[0\]\.segments\[0\]\.ea = 0\.0 \[N\]: Input should be greater than 0"),
-        (lambda d: _seg(d).__setitem__("elements", 0),
-         r"^lines\[0\]\.segments\[0\]\.elements = 0: Input should be greater than or equal to 1"),
-        (lambda d: _seg(d).__setitem__("mass", float("nan")),
-         r"^lines\[0\]\.segments\[0\]\.mass = nan \[kg/m\]: Input should be a finite number"),
-        (lambda d: d["environment"].__setitem__("depth", math.inf),
-         r"^environment\.depth = inf \[m\]: Input should be a finite number"),
-        (lambda d: _seg(d).__setitem__("length", 500.0),
-         r"^lines\[0\]: the line \(500 m unstretched\) is shorter than its span \(820 m\): "
-         r"it would have to stretch 64\.0% \(> 10 %\)"),
-        (lambda d: d["lines"][0]["end_a"].__setitem__("position", [-800.0, 0.0, 5.0]),
-         r"lines\[0\]\.end_a\.position z = 5\.0 m: the anchor end \(end_a\) is above the "
-         r"still-water surface"),
-        (lambda d: d["lines"][0]["end_b"].__setitem__("position", [0.0, 0.0, -250.0]),
-         r"lines\[0\]\.end_b\.position z = -250\.0 m is below the seabed \(depth 200\.0 m\)"),
-        (lambda d: d["lines"].append(copy.deepcopy(d["lines"][0])),
-         r"line names must be unique; repeated: \['leg1'\]"),
-        (lambda d: d["sea"]["spectrum"].update({"m0": 2.0, "omega_p": 0.6}),
-         r"^sea\.spectrum: give exactly one of \(hs, tp\), \(m0, omega_p\) or wind_speed"),
-        (lambda d: d["sea"].__setitem__(
-            "spectrum", {"type": "table", "omega": [0.1, 0.3, 0.2], "density": [1, 2, 3]}),
-         r"^sea\.spectrum: omega must be >= 0 and strictly increasing"),
-        (lambda d: _seg(d).__setitem__("colour", "red"),
-         r"^lines\[0\]\.segments\[0\]\.colour = 'red': Extra inputs are not permitted"),
+        (
+            lambda d: _seg(d).__setitem__("ea", -1.0),
+            r"^lines\[0\]\.segments\[0\]\.ea = -1\.0 \[N\]: Input should be greater than 0",
+        ),
+        (
+            lambda d: _seg(d).__setitem__("ea", 0.0),
+            r"^lines\[0\]\.segments\[0\]\.ea = 0\.0 \[N\]: Input should be greater than 0",
+        ),
+        (
+            lambda d: _seg(d).__setitem__("elements", 0),
+            r"^lines\[0\]\.segments\[0\]\.elements = 0: Input should be greater than or equal to 1",
+        ),
+        (
+            lambda d: _seg(d).__setitem__("mass", float("nan")),
+            r"^lines\[0\]\.segments\[0\]\.mass = nan \[kg/m\]: Input should be a finite number",
+        ),
+        (
+            lambda d: d["environment"].__setitem__("depth", math.inf),
+            r"^environment\.depth = inf \[m\]: Input should be a finite number",
+        ),
+        (
+            lambda d: _seg(d).__setitem__("length", 500.0),
+            r"^lines\[0\]: the line \(500 m unstretched\) is shorter than its span \(820 m\): "
+            r"it would have to stretch 64\.0% \(> 10 %\)",
+        ),
+        (
+            lambda d: d["lines"][0]["end_a"].__setitem__("position", [-800.0, 0.0, 5.0]),
+            r"lines\[0\]\.end_a\.position z = 5\.0 m: the anchor end \(end_a\) is above the "
+            r"still-water surface",
+        ),
+        (
+            lambda d: d["lines"][0]["end_b"].__setitem__("position", [0.0, 0.0, -250.0]),
+            r"lines\[0\]\.end_b\.position z = -250\.0 m is below the seabed \(depth 200\.0 m\)",
+        ),
+        (
+            lambda d: d["lines"].append(copy.deepcopy(d["lines"][0])),
+            r"line names must be unique; repeated: \['leg1'\]",
+        ),
+        (
+            lambda d: d["sea"]["spectrum"].update({"m0": 2.0, "omega_p": 0.6}),
+            r"^sea\.spectrum: give exactly one of \(hs, tp\), \(m0, omega_p\) or wind_speed",
+        ),
+        (
+            lambda d: d["sea"].__setitem__(
+                "spectrum", {"type": "table", "omega": [0.1, 0.3, 0.2], "density": [1, 2, 3]}
+            ),
+            r"^sea\.spectrum: omega must be >= 0 and strictly increasing",
+        ),
+        (
+            lambda d: _seg(d).__setitem__("colour", "red"),
+            r"^lines\[0\]\.segments\[0\]\.colour = 'red': Extra inputs are not permitted",
+        ),
         (lambda d: d.__setitem__("foo", 1), r"^foo = 1: Extra inputs are not permitted"),
-        (lambda d: d["lines"][0].__setitem__("attachments", [{"at": 900.0}]),
-         r"attachments\[0\]\.at = 900\.0 m is beyond the line length 850\.0 m"),
-        (lambda d: d["analysis"]["omega"].update({"min": 2.0, "max": 1.0}),
-         r"^analysis\.omega: max \(1\.0 rad/s\) must exceed min \(2\.0 rad/s\)"),
+        (
+            lambda d: d["lines"][0].__setitem__("attachments", [{"at": 900.0}]),
+            r"attachments\[0\]\.at = 900\.0 m is beyond the line length 850\.0 m",
+        ),
+        (
+            lambda d: d["analysis"]["omega"].update({"min": 2.0, "max": 1.0}),
+            r"^analysis\.omega: max \(1\.0 rad/s\) must exceed min \(2\.0 rad/s\)",
+        ),
     ],
-    ids=["ea<0", "ea=0", "elements<1", "nan", "inf", "too-short", "anchor-above-surface",
-         "end-below-seabed", "duplicate-names", "pm-both-forms", "table-omega",
-         "extra-field", "extra-top", "attachment-beyond", "omega-order"],
+    ids=[
+        "ea<0",
+        "ea=0",
+        "elements<1",
+        "nan",
+        "inf",
+        "too-short",
+        "anchor-above-surface",
+        "end-below-seabed",
+        "duplicate-names",
+        "pm-both-forms",
+        "table-omega",
+        "extra-field",
+        "extra-top",
+        "attachment-beyond",
+        "omega-order",
+    ],
 )
 def test_validation_errors_name_path_unit_constraint(chain_doc, mutate, pattern):
     with pytest.raises(InputError, match=pattern):
@@ -110,25 +153,33 @@ def test_nested_spectrum_error_has_unit(chain_doc):
     bad = _mutated(chain_doc, lambda d: d["sea"]["spectrum"].__setitem__("hs", -2.0))
     with pytest.raises(InputError, match=r"^sea\.spectrum\.hs = -2\.0 \[m\]: Input should be"):
         load_scene(bad)
-    bad = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"]["motion"]["surge"].__setitem__("tp", -2.0))
+    bad = _mutated(
+        chain_doc, lambda d: d["lines"][0]["end_b"]["motion"]["surge"].__setitem__("tp", -2.0)
+    )
     with pytest.raises(InputError, match=r"motion\.surge\.tp = -2\.0 \[s\]: Input should be"):
         load_scene(bad)
 
 
 def test_is_planar(chain_doc):
     assert load_scene(chain_doc).is_planar
-    moved = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"].__setitem__(
-        "position", [0.0, 5.0, -20.0]))
+    moved = _mutated(
+        chain_doc, lambda d: d["lines"][0]["end_b"].__setitem__("position", [0.0, 5.0, -20.0])
+    )
     assert not load_scene(moved).is_planar
     oblique = _mutated(chain_doc, lambda d: d["sea"].__setitem__("heading", 30.0))
     assert not load_scene(oblique).is_planar
     head_sea = _mutated(chain_doc, lambda d: d["sea"].__setitem__("heading", 180.0))
     assert load_scene(head_sea).is_planar
-    cross_current = _mutated(chain_doc, lambda d: d["environment"]["current"][0].__setitem__(
-        "heading", 90.0))
+    cross_current = _mutated(
+        chain_doc, lambda d: d["environment"]["current"][0].__setitem__("heading", 90.0)
+    )
     assert not load_scene(cross_current).is_planar
-    sway = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"]["motion"].__setitem__(
-        "sway", {"type": "pierson_moskowitz", "hs": 1.0, "tp": 8.0}))
+    sway = _mutated(
+        chain_doc,
+        lambda d: d["lines"][0]["end_b"]["motion"].__setitem__(
+            "sway", {"type": "pierson_moskowitz", "hs": 1.0, "tp": 8.0}
+        ),
+    )
     assert not load_scene(sway).is_planar
 
 
@@ -157,17 +208,23 @@ def test_schema_content_and_writer(tmp_path):
 
 @pytest.fixture()
 def disc_doc() -> dict:
-    return load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json",
-                                                                      exclude_none=True)
+    return load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json", exclude_none=True)
 
 
 def test_body_end_validation(disc_doc):
     neither = _mutated(disc_doc, lambda d: d["lines"][0].__setitem__("end_b", {}))
-    with pytest.raises(InputError, match=r"lines\[0\]\.end_b: give the end's position or "
-                                         r"attach it to a body"):
+    with pytest.raises(
+        InputError,
+        match=r"lines\[0\]\.end_b: give the end's position or "
+        r"attach it to a body",
+    ):
         load_scene(neither)
-    moving = _mutated(disc_doc, lambda d: d["lines"][0]["end_b"].__setitem__(
-        "motion", {"heave": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 8.0}}))
+    moving = _mutated(
+        disc_doc,
+        lambda d: d["lines"][0]["end_b"].__setitem__(
+            "motion", {"heave": {"type": "pierson_moskowitz", "hs": 1.0, "tp": 8.0}}
+        ),
+    )
     with pytest.raises(InputError, match=r"an end attached to a body cannot have a motion"):
         load_scene(moving)
     dup = _mutated(disc_doc, lambda d: d["bodies"].append(copy.deepcopy(d["bodies"][0])))
@@ -176,13 +233,21 @@ def test_body_end_validation(disc_doc):
     # the span check uses the body position for attached ends
     far = _mutated(disc_doc, lambda d: d["bodies"][0].__setitem__("position", [200.0, 0, 0]))
     # the disc scene is in feet (g = 32.174 ft/s²): the message quotes its lengths in ft
-    with pytest.raises(InputError, match=r"lines\[0\]: the line \(339 ft unstretched\) is "
-                                         r"shorter than its span"):
+    with pytest.raises(
+        InputError,
+        match=r"lines\[0\]: the line \(339 ft unstretched\) is "
+        r"shorter than its span",
+    ):
         load_scene(far)
-    bad_table = _mutated(disc_doc, lambda d: d["bodies"][0]["hydrodynamics"][
-        "radiation_damping"][0][0].__setitem__(0, -5.0))
-    with pytest.raises(InputError, match=r"bodies\[0\]\.hydrodynamics: radiation_damping .*"
-                                         r"must be >= 0"):
+    bad_table = _mutated(
+        disc_doc,
+        lambda d: d["bodies"][0]["hydrodynamics"]["radiation_damping"][0][0].__setitem__(0, -5.0),
+    )
+    with pytest.raises(
+        InputError,
+        match=r"bodies\[0\]\.hydrodynamics: radiation_damping .*"
+        r"must be >= 0",
+    ):
         load_scene(bad_table)
 
 
@@ -197,9 +262,11 @@ def test_body_scene_geometry_and_planarity(disc_doc):
     assert line.end_b.position == (0.0, 0.0, -2.5) and line.end_b.attach is None
     # a vessel sway RAO, a body off the plane, an attachment off the plane: not planar
     vessel = {"omega": [0.1, 2.0], "sway": {"re": [0.1, 0.1], "im": [0.0, 0.0]}}
-    for fn in (lambda d: d["bodies"][0].__setitem__("prescribed", vessel),
-               lambda d: d["bodies"][0].__setitem__("wind_force", [0.0, 5.0, 0.0]),
-               lambda d: d["lines"][0]["end_b"]["attach"].__setitem__("point", [0, 1.0, -2.5])):
+    for fn in (
+        lambda d: d["bodies"][0].__setitem__("prescribed", vessel),
+        lambda d: d["bodies"][0].__setitem__("wind_force", [0.0, 5.0, 0.0]),
+        lambda d: d["lines"][0]["end_b"]["attach"].__setitem__("point", [0, 1.0, -2.5]),
+    ):
         d = _mutated(disc_doc, fn)
         d["bodies"][0] = _six_dof(d["bodies"][0])
         assert not load_scene(d).is_planar
@@ -220,8 +287,11 @@ def _six_dof(body: dict) -> dict:
 def test_vessel_motion_transfer():
     from stochcable.scene.model import VesselMotion
 
-    v = VesselMotion(omega=(0.5, 1.0), heave={"re": [1.0, 0.5], "im": [0.0, 1.0]},
-                     pitch={"re": [0.0, 0.2], "im": [0.0, 0.0]})
+    v = VesselMotion(
+        omega=(0.5, 1.0),
+        heave={"re": [1.0, 0.5], "im": [0.0, 1.0]},
+        pitch={"re": [0.0, 0.2], "im": [0.0, 0.0]},
+    )
     t = v.transfer(np.array([0.1, 0.75, 1.0, 2.0]))
     assert t.shape == (6, 4)
     np.testing.assert_allclose(t[2], [0.0, 0.75 + 0.5j, 0.5 + 1j, 0.0])  # zero outside

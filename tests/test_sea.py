@@ -17,10 +17,14 @@ import numpy as np
 import pytest
 
 import stochcable
+from stochcable.errors import InputError, ResolutionWarning
 from stochcable.sea import fft as _fft
 from stochcable.sea import realization as sea
-from stochcable.errors import InputError, ResolutionWarning
-from stochcable.sea.spectra import spectrum_jonswap, spectrum_pierson_moskowitz, spectrum_pierson_moskowitz_m0
+from stochcable.sea.spectra import (
+    spectrum_jonswap,
+    spectrum_pierson_moskowitz,
+    spectrum_pierson_moskowitz_m0,
+)
 
 # Seed 001 §6.5 (Tuah 1982): PM with m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla),
 # 256 s at Δt = 0.25 s = 1024 points, Δω = 0.0245 rad/s; imperial units, g = 32.174 ft/s².
@@ -44,19 +48,22 @@ def riemann_m0(real, density):
 def test_frequency_grid():
     w, dw = sea.frequency_grid(256.0, 0.25)
     assert w.shape == (513,) and dw == pytest.approx(2 * math.pi / 256)
-    assert w[0] == 0.0 and w[-1] == pytest.approx(math.pi / 0.25)   # Nyquist
+    assert w[0] == 0.0 and w[-1] == pytest.approx(math.pi / 0.25)  # Nyquist
 
 
-@pytest.mark.parametrize("duration,dt,match", [
-    (255.75, 0.25, r"duration .*1023 samples must be an even integer"),
-    (1e-12, 1.0, r"duration .*0 samples must be an even integer >= 2"),
-    (0.1, 0.25, r"duration .*duration/dt = 0.4 must be an even integer"),
-    (100.1, 0.25, r"duration .*must be an even integer number of samples"),
-    (0.0, 0.25, r"duration = 0.0 \[s\]: must be > 0"),
-    (256.0, -1.0, r"dt = -1.0 \[s\]: must be > 0"),
-    (float("nan"), 0.25, r"duration = nan \[s\]: must be finite"),
-    (256.0, float("inf"), r"dt = inf \[s\]: must be finite"),
-])
+@pytest.mark.parametrize(
+    "duration,dt,match",
+    [
+        (255.75, 0.25, r"duration .*1023 samples must be an even integer"),
+        (1e-12, 1.0, r"duration .*0 samples must be an even integer >= 2"),
+        (0.1, 0.25, r"duration .*duration/dt = 0.4 must be an even integer"),
+        (100.1, 0.25, r"duration .*must be an even integer number of samples"),
+        (0.0, 0.25, r"duration = 0.0 \[s\]: must be > 0"),
+        (256.0, -1.0, r"dt = -1.0 \[s\]: must be > 0"),
+        (float("nan"), 0.25, r"duration = nan \[s\]: must be finite"),
+        (256.0, float("inf"), r"dt = inf \[s\]: must be finite"),
+    ],
+)
 def test_frequency_grid_errors(duration, dt, match):
     with pytest.raises(InputError, match=match):
         sea.frequency_grid(duration, dt)
@@ -70,7 +77,7 @@ def test_dsa_variance_is_riemann_sum(seed):
     m0g = riemann_m0(real, pm)
     # Parseval: mean(η²) = Σ a²/2 = Σ S Δω; only FFT round-off (~1e-15) remains
     assert np.mean(real.elevation**2) == pytest.approx(m0g, rel=1e-12)
-    assert abs(real.elevation.mean()) < 1e-13 * math.sqrt(m0g)   # X_0 = 0
+    assert abs(real.elevation.mean()) < 1e-13 * math.sqrt(m0g)  # X_0 = 0
     assert real.variance_grid == pytest.approx(m0g, rel=1e-13)
     # the returned target m0 is the same Riemann sum (same S values, same summation)
     assert real.m0 == pytest.approx(m0g, rel=1e-15)
@@ -120,12 +127,12 @@ def test_nsa_periodogram_and_variance_scatter():
     var = np.empty(k)
     for i in range(k):
         r = sea.simulate_sea(pm, duration, dt, "nsa", rng=1000 + i)
-        per[i] = r.amplitudes[1:-1] ** 2 / 2        # a²/2 ~ S Δω · Exp(1)  (χ²₂/2)
+        per[i] = r.amplitudes[1:-1] ** 2 / 2  # a²/2 ~ S Δω · Exp(1)  (χ²₂/2)
         var[i] = np.mean(r.elevation**2)
     ok = sdw > 1e-6 * sdw.max()
     # mean periodogram: each ratio is a mean of k Exp(1) → mean 1, std 1/√k
     z = (per[:, ok].mean(0) / sdw[ok] - 1) * math.sqrt(k)
-    assert np.abs(z).max() < 5.5          # ~100 frequencies: P(any |z| > 5.5) ~ 1e-6
+    assert np.abs(z).max() < 5.5  # ~100 frequencies: P(any |z| > 5.5) ~ 1e-6
     assert abs(z.mean()) < 5.5 / math.sqrt(ok.sum())
     # variance = Σ SΔω E_m: mean m0_grid, variance Σ (SΔω)²
     m0g, sd = sdw.sum(), math.sqrt((sdw**2).sum())
@@ -134,7 +141,9 @@ def test_nsa_periodogram_and_variance_scatter():
     # 5σ band widened to 0.4 for the excess kurtosis of the exponential mixture
     assert abs(var.var(ddof=1) / sd**2 - 1) < 0.4
     # DSA does not scatter
-    dvar = [np.mean(sea.simulate_sea(pm, duration, dt, "dsa", rng=i).elevation ** 2) for i in range(5)]
+    dvar = [
+        np.mean(sea.simulate_sea(pm, duration, dt, "dsa", rng=i).elevation ** 2) for i in range(5)
+    ]
     assert np.ptp(dvar) < 1e-12 * m0g
 
 
@@ -143,7 +152,7 @@ def test_tuah_1982_case_in_feet():
         return spectrum_pierson_moskowitz_m0(w, TUAH_1982_M0_FT2, TUAH_1982_OMEGA_P)
 
     with warnings.catch_warnings():
-        warnings.simplefilter("error")                 # Nyquist 4π rad/s: no warning
+        warnings.simplefilter("error")  # Nyquist 4π rad/s: no warning
         real = sea.simulate_sea(dens, TUAH_1982_DURATION, TUAH_1982_DT, rng=1)
     assert real.n_samples == TUAH_1982_N_POINTS
     assert real.d_omega == pytest.approx(TUAH_1982_D_OMEGA, abs=5e-5)  # seed rounds to 3 digits
@@ -156,7 +165,7 @@ def test_tuah_1982_case_in_feet():
 
 
 def test_nyquist_warning_fraction_and_fix():
-    hs, tp, dt = 6.0, 10.0, 1.5
+    _hs, tp, dt = 6.0, 10.0, 1.5
     with pytest.warns(ResolutionWarning) as rec:
         sea.simulate_sea(pm, 300.0, dt, rng=1)
     msg = str(rec[0].message)
@@ -164,7 +173,7 @@ def test_nyquist_warning_fraction_and_fix():
     wn, wp = math.pi / dt, 2 * math.pi / tp
     frac = 1 - math.exp(-1.25 * (wp / wn) ** 4)
     got = float(re.search(r"([\d.]+)% of the spectrum's m0", msg).group(1)) / 100
-    assert got == pytest.approx(frac, rel=0.02)    # printed to 3 digits; grid m0 vs exact
+    assert got == pytest.approx(frac, rel=0.02)  # printed to 3 digits; grid m0 vs exact
     assert "pi/dt = 2.094 rad/s" in msg
     dt_ok = float(re.search(r"use dt <= ([\d.]+) s", msg).group(1))
     # closed form: tail fraction 1e-3 at ω = ωp (1.25/−ln(1−1e-3))^(1/4)
@@ -186,7 +195,7 @@ def test_synthesize_variance_and_shapes():
     s = pm(w)
     for i in range(3):
         expect = float((np.abs(h[i, 1:-1]) ** 2 * s[1:-1]).sum() * real.d_omega)
-        assert np.mean(y[i] ** 2) == pytest.approx(expect, rel=1e-12)   # Parseval, DSA
+        assert np.mean(y[i] ** 2) == pytest.approx(expect, rel=1e-12)  # Parseval, DSA
     # H = iω is d/dt: compare with a centred spectral derivative check via np.gradient order
     dy = np.gradient(real.elevation, real.dt)
     assert np.corrcoef(dy, y[1])[0, 1] > 0.99
@@ -194,11 +203,14 @@ def test_synthesize_variance_and_shapes():
     assert y4.shape == (2, 3, real.n_samples)
 
 
-@pytest.mark.parametrize("transfer,match", [
-    (np.ones(5), r"transfer .*must have shape \(\.\.\., 257\)"),
-    (np.full(257, np.nan), r"transfer .*must be finite"),
-    (1.0, r"transfer .*must have shape"),
-])
+@pytest.mark.parametrize(
+    "transfer,match",
+    [
+        (np.ones(5), r"transfer .*must have shape \(\.\.\., 257\)"),
+        (np.full(257, np.nan), r"transfer .*must be finite"),
+        (1.0, r"transfer .*must have shape"),
+    ],
+)
 def test_synthesize_errors(transfer, match):
     real = sea.simulate_sea(pm, 256.0, 0.5, rng=5)
     with pytest.raises(InputError, match=match):
@@ -207,16 +219,19 @@ def test_synthesize_errors(transfer, match):
         sea.synthesize("nope", np.ones(257))
 
 
-@pytest.mark.parametrize("density,kw,match", [
-    (lambda w: -pm(w), {}, r"density .*must return finite values >= 0"),
-    (lambda w: pm(w) * np.nan, {}, r"density .*must return finite values >= 0"),
-    (lambda w: pm(w)[:-1], {}, r"density .*must return an array of shape"),
-    (lambda w: 0 * w, {}, r"density .*zero at every grid frequency"),
-    (3.0, {}, r"density .*must be a callable"),
-    (pm, {"method": "xyz"}, r"method = 'xyz': must be 'dsa' or 'nsa'"),
-    (pm, {"rng": -1}, r"rng = -1: must be a numpy Generator"),
-    (pm, {"rng": 1.5}, r"rng = 1.5: must be a numpy Generator"),
-])
+@pytest.mark.parametrize(
+    "density,kw,match",
+    [
+        (lambda w: -pm(w), {}, r"density .*must return finite values >= 0"),
+        (lambda w: pm(w) * np.nan, {}, r"density .*must return finite values >= 0"),
+        (lambda w: pm(w)[:-1], {}, r"density .*must return an array of shape"),
+        (lambda w: 0 * w, {}, r"density .*zero at every grid frequency"),
+        (3.0, {}, r"density .*must be a callable"),
+        (pm, {"method": "xyz"}, r"method = 'xyz': must be 'dsa' or 'nsa'"),
+        (pm, {"rng": -1}, r"rng = -1: must be a numpy Generator"),
+        (pm, {"rng": 1.5}, r"rng = 1.5: must be a numpy Generator"),
+    ],
+)
 def test_simulate_errors(density, kw, match):
     with pytest.raises(InputError, match=match):
         sea.simulate_sea(density, 64.0, 0.5, **{"rng": 1, **kw})
@@ -242,6 +257,7 @@ def test_welch_spectrum_integrates_to_variance():
 
 # --- _fft -----------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("n", [8, 1024, 2**16])
 def test_fft_matches_numpy(n):
     rng = np.random.default_rng(n)
@@ -253,7 +269,7 @@ def test_fft_matches_numpy(n):
     np.testing.assert_allclose(_fft.irfft(_fft.rfft(x), n), x, atol=1e-14)
     X0 = X.copy()
     _fft.irfft(X, n)
-    np.testing.assert_array_equal(X, X0)               # input preserved
+    np.testing.assert_array_equal(X, X0)  # input preserved
 
 
 def test_fft_numpy_fallback_agrees(monkeypatch):
@@ -262,7 +278,9 @@ def test_fft_numpy_fallback_agrees(monkeypatch):
     monkeypatch.setattr(_fft, "_pyfftw", None)
     assert _fft.backend() == "numpy"
     b = sea.simulate_sea(pm, 512.0, 0.25, rng=21)
-    np.testing.assert_allclose(a.elevation, b.elevation, rtol=0, atol=1e-14 * np.abs(b.elevation).max())
+    np.testing.assert_allclose(
+        a.elevation, b.elevation, rtol=0, atol=1e-14 * np.abs(b.elevation).max()
+    )
 
 
 def test_fft_thread_safe():
@@ -336,45 +354,75 @@ def _rational_density(w):
 
 PINNED_REALIZATIONS = {
     # (density, duration, dt, method, seed): ({m: X_m}, {n: eta_n})
-    "dsa": ((_rational_density, 2**18 * 0.1, 0.1, "dsa", 2024),
-            {1: 129.03954889986068 + 256.55857165234784j,
-             2: -63.88400224481865 - 280.19830145331446j,
-             4095: 484.00132175613186 + 385.32499864669893j,
-             65537: 0.5022350125020892 - 0.024021442751745833j,
-             131071: 0.10868521943061805 + 0.05290292617847559j},
-            {0: 0.3586032398176005, 1: 0.35737028004511867, 99999: 0.21413946814707613,
-             262143: 0.3548551579141106}),
-    "nsa": ((_rational_density, 2**18 * 0.1, 0.1, "nsa", 2024),
-            {1: 50.6160349705762 + 100.63564035576334j,
-             2: -82.17961505619681 - 360.44373777006365j,
-             4095: 377.66661272811047 + 300.66940005524657j,
-             65537: 0.2220349236684626 - 0.010619727966034713j,
-             131071: 0.018389439715516296 + 0.008951126720174975j},
-            {0: 0.2347583604810836, 1: 0.2160820433105238, 99999: 0.08014221122498172,
-             262143: 0.24850132598633112}),
-    "pm": ((lambda w: spectrum_pierson_moskowitz(w, 2.0, 8.0), 600.0, 0.5, "dsa", 1),
-           {100: 6.770147453717849 + 43.26199640417681j,
+    "dsa": (
+        (_rational_density, 2**18 * 0.1, 0.1, "dsa", 2024),
+        {
+            1: 129.03954889986068 + 256.55857165234784j,
+            2: -63.88400224481865 - 280.19830145331446j,
+            4095: 484.00132175613186 + 385.32499864669893j,
+            65537: 0.5022350125020892 - 0.024021442751745833j,
+            131071: 0.10868521943061805 + 0.05290292617847559j,
+        },
+        {
+            0: 0.3586032398176005,
+            1: 0.35737028004511867,
+            99999: 0.21413946814707613,
+            262143: 0.3548551579141106,
+        },
+    ),
+    "nsa": (
+        (_rational_density, 2**18 * 0.1, 0.1, "nsa", 2024),
+        {
+            1: 50.6160349705762 + 100.63564035576334j,
+            2: -82.17961505619681 - 360.44373777006365j,
+            4095: 377.66661272811047 + 300.66940005524657j,
+            65537: 0.2220349236684626 - 0.010619727966034713j,
+            131071: 0.018389439715516296 + 0.008951126720174975j,
+        },
+        {
+            0: 0.2347583604810836,
+            1: 0.2160820433105238,
+            99999: 0.08014221122498172,
+            262143: 0.24850132598633112,
+        },
+    ),
+    "pm": (
+        (lambda w: spectrum_pierson_moskowitz(w, 2.0, 8.0), 600.0, 0.5, "dsa", 1),
+        {
+            100: 6.770147453717849 + 43.26199640417681j,
             300: -1.7160276886092998 - 2.952442714809495j,
-            599: 0.3613286079402964 - 0.48847335546932646j},
-           {0: -0.0054378744903556125, 1: 0.05521784773983332, 100: -0.24977981314472641,
-            1199: -0.16683778816619355}),
+            599: 0.3613286079402964 - 0.48847335546932646j,
+        },
+        {
+            0: -0.0054378744903556125,
+            1: 0.05521784773983332,
+            100: -0.24977981314472641,
+            1199: -0.16683778816619355,
+        },
+    ),
 }
 
 PINNED_47A3978 = {
     # the coefficient pins of git 47a3978 (2048-entry table kernel), same cases
-    "dsa": {1: 129.0395488998607 + 256.55857165234784j,
-            2: -63.884002244818596 - 280.1983014533145j,
-            4095: 484.0013217561319 + 385.32499864669893j,
-            65537: 0.5022350125020892 - 0.02402144275174565j,
-            131071: 0.10868521943061807 + 0.05290292617847558j},
-    "nsa": {1: 50.6160349705762 + 100.63564035576334j,
-            2: -82.17961505619674 - 360.4437377700637j,
-            4095: 377.6666127281104 + 300.6694000552465j,
-            65537: 0.22203492366846264 - 0.010619727966034631j,
-            131071: 0.018389439715516296 + 0.008951126720174974j},
-    "pm": {100: 6.770147453717832 + 43.26199640417681j,
-           300: -1.7160276886093002 - 2.952442714809495j,
-           599: 0.36132860794029653 - 0.48847335546932635j},
+    "dsa": {
+        1: 129.0395488998607 + 256.55857165234784j,
+        2: -63.884002244818596 - 280.1983014533145j,
+        4095: 484.0013217561319 + 385.32499864669893j,
+        65537: 0.5022350125020892 - 0.02402144275174565j,
+        131071: 0.10868521943061807 + 0.05290292617847558j,
+    },
+    "nsa": {
+        1: 50.6160349705762 + 100.63564035576334j,
+        2: -82.17961505619674 - 360.4437377700637j,
+        4095: 377.6666127281104 + 300.6694000552465j,
+        65537: 0.22203492366846264 - 0.010619727966034631j,
+        131071: 0.018389439715516296 + 0.008951126720174974j,
+    },
+    "pm": {
+        100: 6.770147453717832 + 43.26199640417681j,
+        300: -1.7160276886093002 - 2.952442714809495j,
+        599: 0.36132860794029653 - 0.48847335546932635j,
+    },
 }
 
 
@@ -385,9 +433,9 @@ def test_seeded_realization_is_pinned(case):
     got_c = np.array([real.coefficients[m] for m in coeffs])
     want_c = np.array(list(coeffs.values()))
     if case == "pm":
-        np.testing.assert_allclose(got_c, want_c, rtol=1e-13)   # np.exp may differ by an ulp
+        np.testing.assert_allclose(got_c, want_c, rtol=1e-13)  # np.exp may differ by an ulp
     else:
-        np.testing.assert_array_equal(got_c, want_c)           # IEEE-exact arithmetic only
+        np.testing.assert_array_equal(got_c, want_c)  # IEEE-exact arithmetic only
     # the same realization as the first implementation: both kernels are within a few
     # ulp of the exact phasor (≤ 4e-16 measured; 1e-15 allows ~4 ulp)
     np.testing.assert_allclose(got_c, list(PINNED_47A3978[case].values()), rtol=1e-15)
@@ -420,7 +468,8 @@ def test_generator_argument_advanced_by_the_draws_only(method, draws):
     assert gen.bit_generator.state == ref.bit_generator.state
     assert real.seed is None
     np.testing.assert_array_equal(
-        real.coefficients, sea.simulate_sea(_rational_density, duration, dt, method, 5).coefficients)
+        real.coefficients, sea.simulate_sea(_rational_density, duration, dt, method, 5).coefficients
+    )
 
 
 def test_generator_untouched_when_the_density_is_rejected():
@@ -437,8 +486,7 @@ def test_concurrent_realizations_equal_sequential_ones():
     # lock): every realization must equal its sequential twin bit for bit
     density, duration, dt = _rational_density, 2**17 * 0.1, 0.1
     seeds = list(range(6))
-    ref = {s: sea.simulate_sea(density, duration, dt, "nsa" if s % 2 else "dsa", s)
-           for s in seeds}
+    ref = {s: sea.simulate_sea(density, duration, dt, "nsa" if s % 2 else "dsa", s) for s in seeds}
     got = {}
 
     def work(s):
@@ -460,6 +508,7 @@ def test_concurrent_realizations_equal_sequential_ones():
 
 
 # --- spectrum evaluated on grid pieces by two threads (issue 2) -------------------------
+
 
 def _jonswap_density(w):
     return spectrum_jonswap(w, 6.0, 10.0, 3.3)
@@ -494,10 +543,11 @@ def test_spectrum_pieces_fall_back_to_one_call():
     a = sea.simulate_sea(cached, duration, dt, "dsa", 4)
     b = sea.simulate_sea(_rational_density, duration, dt, "dsa", 4)
     np.testing.assert_array_equal(a.coefficients, b.coefficients)
-    assert omega.size in calls                       # the whole-grid call happened
+    assert omega.size in calls  # the whole-grid call happened
     # a wrong shape is reported for the whole grid, as without pieces
-    with pytest.raises(InputError,
-                       match=rf"must return an array of shape \({omega.size},\), got \(3,\)"):
+    with pytest.raises(
+        InputError, match=rf"must return an array of shape \({omega.size},\), got \(3,\)"
+    ):
         sea.simulate_sea(lambda w: np.ones(3), duration, dt, rng=4)
 
 
@@ -525,21 +575,37 @@ def test_spectrum_pieces_use_the_callers_floating_point_modes():
     omega = sea._grid(2**17, 0.01)
 
     def dens(w):
-        return 1.0 / w        # 1/0 at ω = 0
+        return 1.0 / w  # 1/0 at ω = 0
 
     with np.errstate(divide="raise"):
-        job = sea._Synthesis(np.random.default_rng(0), 2**17 - 1, False,
-                             np.empty(2**17 - 1, complex), np.empty(2**17 - 1, complex), 1.0,
-                             dens, omega, 4)
-    with np.errstate(divide="ignore"):      # this thread's modes must not matter
+        job = sea._Synthesis(
+            np.random.default_rng(0),
+            2**17 - 1,
+            False,
+            np.empty(2**17 - 1, complex),
+            np.empty(2**17 - 1, complex),
+            1.0,
+            dens,
+            omega,
+            4,
+        )
+    with np.errstate(divide="ignore"):  # this thread's modes must not matter
         t = threading.Thread(target=job.spectrum)
         t.start()
         t.join()
     assert job.s_ready.is_set() and job.piece_failed
     with np.errstate(divide="ignore"):
-        job = sea._Synthesis(np.random.default_rng(0), 2**17 - 1, False,
-                             np.empty(2**17 - 1, complex), np.empty(2**17 - 1, complex), 1.0,
-                             dens, omega, 4)
+        job = sea._Synthesis(
+            np.random.default_rng(0),
+            2**17 - 1,
+            False,
+            np.empty(2**17 - 1, complex),
+            np.empty(2**17 - 1, complex),
+            1.0,
+            dens,
+            omega,
+            4,
+        )
     with np.errstate(divide="raise"):
         t = threading.Thread(target=job.spectrum)
         t.start()
@@ -561,6 +627,7 @@ def test_grid_is_shared_read_only_and_exact():
 
 # --- FFTW wisdom (_fft.tune, wisdom_path) ------------------------------------------------
 
+
 @pytest.fixture
 def fresh_fft_state(monkeypatch, tmp_path):
     """Plans and wisdom of this test only (file under tmp_path, nothing in ~/.cache)."""
@@ -576,7 +643,7 @@ def test_wisdom_path_from_environment(monkeypatch, tmp_path):
     monkeypatch.setenv("STOCHCABLE_FFTW_WISDOM", str(tmp_path / "w.txt"))
     assert _fft.wisdom_path() == str(tmp_path / "w.txt")
     monkeypatch.setenv("STOCHCABLE_FFTW_WISDOM", "")
-    assert _fft.wisdom_path() is None                      # switched off
+    assert _fft.wisdom_path() is None  # switched off
     monkeypatch.delenv("STOCHCABLE_FFTW_WISDOM")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     assert _fft.wisdom_path() == str(tmp_path / "stochcable" / "fftw_wisdom.txt")
@@ -587,7 +654,7 @@ def test_tune_writes_wisdom_and_measured_plans_agree(fresh_fft_state):
     rng = np.random.default_rng(3)
     x = rng.standard_normal(n)
     X = np.fft.rfft(x)
-    est = _fft.irfft(X, n)                                  # FFTW_ESTIMATE plan
+    est = _fft.irfft(X, n)  # FFTW_ESTIMATE plan
     assert _fft.tune(n) == str(fresh_fft_state)
     text = fresh_fft_state.read_text()
     assert text.startswith("(fftw-3") and "fftw_wisdom" in text
@@ -610,12 +677,17 @@ def test_unreadable_wisdom_file_is_ignored(fresh_fft_state):
     np.testing.assert_allclose(_fft.irfft(X, 64), np.arange(64.0), atol=1e-12)
 
 
-@pytest.mark.parametrize("kw,match", [
-    ({"n_samples": 1}, r"n_samples = 1: must be an integer >= 2"),
-    ({"n_samples": [64, 2.5]}, r"n_samples = 2.5: must be an integer"),
-    ({"n_samples": 64, "effort": "FFTW_ESTIMATE"},
-     r"effort = 'FFTW_ESTIMATE': must be 'FFTW_MEASURE'"),
-])
+@pytest.mark.parametrize(
+    "kw,match",
+    [
+        ({"n_samples": 1}, r"n_samples = 1: must be an integer >= 2"),
+        ({"n_samples": [64, 2.5]}, r"n_samples = 2.5: must be an integer"),
+        (
+            {"n_samples": 64, "effort": "FFTW_ESTIMATE"},
+            r"effort = 'FFTW_ESTIMATE': must be 'FFTW_MEASURE'",
+        ),
+    ],
+)
 def test_tune_errors(kw, match):
     with pytest.raises(InputError, match=match):
         _fft.tune(**kw)
@@ -646,10 +718,13 @@ def test_work_arrays_follow_the_fft_backend(monkeypatch):
     np.testing.assert_array_equal(a.coefficients, b.coefficients)
     np.testing.assert_array_equal(a.elevation, c.elevation)
     # irfft of 2^17 points, numpy vs FFTW: ~1e-16 of max |η| per sample, 1e-14 with margin
-    np.testing.assert_allclose(b.elevation, a.elevation, rtol=0, atol=1e-14 * np.abs(a.elevation).max())
+    np.testing.assert_allclose(
+        b.elevation, a.elevation, rtol=0, atol=1e-14 * np.abs(a.elevation).max()
+    )
 
 
 # --- compiled (numba) coefficient kernel (issue 2, third pass) -------------------------
+
 
 def _numpy_complex_product_is_fused() -> bool:
     """Whether numpy's complex multiply rounds like fma(a_r, b_r, −a_i b_i) (FMA3/NEON).
@@ -662,8 +737,10 @@ def _numpy_complex_product_is_fused() -> bool:
     r = np.random.default_rng(0).standard_normal((4, 256))
     a, b = r[0] + 1j * r[1], r[2] + 1j * r[3]
     p = a * b
-    fused = [float(Fraction(x.real) * Fraction(y.real) - Fraction(float(x.imag * y.imag)))
-             for x, y in zip(a, b)]
+    fused = [
+        float(Fraction(x.real) * Fraction(y.real) - Fraction(float(x.imag * y.imag)))
+        for x, y in zip(a, b)
+    ]
     return bool(np.array_equal(p.real, fused))
 
 
@@ -671,7 +748,7 @@ def _kernel_inputs(n: int = 70_001):
     rng = np.random.default_rng(17)
     u = rng.random(n)
     u[:6] = [0.0, 1.0 - 2.0**-53, 0.5, 2.0**-40, 0.25, (8191.0 + 0.5) / 8192.0]  # table ends
-    s = spectrum_pierson_moskowitz(np.linspace(0.0, 12.0, n), 6.0, 10.0)   # 0 … 1e-300 … max
+    s = spectrum_pierson_moskowitz(np.linspace(0.0, 12.0, n), 6.0, 10.0)  # 0 … 1e-300 … max
     s[10:20] = 0.0
     return u, s, rng.standard_normal(n), rng.standard_normal(n)
 
@@ -693,12 +770,29 @@ def test_compiled_kernel_equals_numpy_kernel():
         gain = np.hypot(alpha, beta) if nsa else None
         for a in range(0, n, sea._CHUNK):
             b = min(a + sea._CHUNK, n)
-            sea._phasor_chunk(u[a:b], s[a:b], c2, ref_out[a:b],
-                              None if gain is None else gain[a:b], ref_in[a:b], scale)
+            sea._phasor_chunk(
+                u[a:b],
+                s[a:b],
+                c2,
+                ref_out[a:b],
+                None if gain is None else gain[a:b],
+                ref_in[a:b],
+                scale,
+            )
         out, fin = np.empty(n, complex), np.empty(n, complex)
         jbuf = np.empty(n)
-        kernels.phasor_chunk(u, s, c2, alpha if nsa else empty, beta if nsa else empty,
-                             sea._TABLE, out, fin, scale, jbuf)
+        kernels.phasor_chunk(
+            u,
+            s,
+            c2,
+            alpha if nsa else empty,
+            beta if nsa else empty,
+            sea._TABLE,
+            out,
+            fin,
+            scale,
+            jbuf,
+        )
         assert np.count_nonzero(ref_out == 0) == np.count_nonzero(s[:n] == 0)
         np.testing.assert_allclose(out, ref_out, rtol=1e-15, atol=0)
         np.testing.assert_allclose(fin, ref_in, rtol=1e-15, atol=0)
@@ -722,8 +816,9 @@ def test_realization_with_and_without_numba(monkeypatch, method):
     b = sea.simulate_sea(pm, duration, dt, method, 40)
     np.testing.assert_allclose(a.coefficients, b.coefficients, rtol=1e-15, atol=0)
     # same FFT plan: the elevation follows the coefficients (≲ 1e-16 of max |η| if not equal)
-    np.testing.assert_allclose(a.elevation, b.elevation, rtol=0,
-                               atol=1e-15 * np.abs(b.elevation).max())
+    np.testing.assert_allclose(
+        a.elevation, b.elevation, rtol=0, atol=1e-15 * np.abs(b.elevation).max()
+    )
     assert a.m0 == b.m0
     if _numpy_complex_product_is_fused():
         np.testing.assert_array_equal(a.coefficients, b.coefficients)
@@ -731,13 +826,13 @@ def test_realization_with_and_without_numba(monkeypatch, method):
 
 
 def test_numba_missing_or_failing_falls_back(monkeypatch):
-    duration, dt = 2**18 * 0.1, 0.1             # 2^17 − 1 lines: the compiled kernel's range
+    duration, dt = 2**18 * 0.1, 0.1  # 2^17 − 1 lines: the compiled kernel's range
     monkeypatch.delenv("STOCHCABLE_NUMBA", raising=False)
     ref = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
     # numba not installed: silently the NumPy kernel
     monkeypatch.setattr(sea, "_compiled_state", [])
     monkeypatch.delattr(stochcable.sea, "kernels", raising=False)
-    monkeypatch.setitem(sys.modules, "stochcable.sea.kernels", None)     # import -> ImportError
+    monkeypatch.setitem(sys.modules, "stochcable.sea.kernels", None)  # import -> ImportError
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         a = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
@@ -745,11 +840,14 @@ def test_numba_missing_or_failing_falls_back(monkeypatch):
     np.testing.assert_array_equal(a.coefficients, ref.coefficients)
     # numba present but the kernel unusable (e.g. an LLVM error): one warning, NumPy kernel
     monkeypatch.setattr(sea, "_compiled_state", [])
-    broken = types.ModuleType("stochcable.sea.kernels")                   # no phasor_chunk
+    broken = types.ModuleType("stochcable.sea.kernels")  # no phasor_chunk
     monkeypatch.setitem(sys.modules, "stochcable.sea.kernels", broken)
     monkeypatch.setattr(stochcable.sea, "kernels", broken, raising=False)
-    with pytest.warns(UserWarning, match=r"compiled sea kernel is unavailable .*"
-                                         r"using the NumPy kernel .*STOCHCABLE_NUMBA=0"):
+    with pytest.warns(
+        UserWarning,
+        match=r"compiled sea kernel is unavailable .*"
+        r"using the NumPy kernel .*STOCHCABLE_NUMBA=0",
+    ):
         b = sea.simulate_sea(_rational_density, duration, dt, "dsa", 9)
     np.testing.assert_array_equal(b.coefficients, ref.coefficients)
 
@@ -804,14 +902,27 @@ def test_numba_imported_only_by_large_realizations():
     # 2^16 lines must not pay numba's import (~0.2 s) and kernel load (~0.4 s)
     try:
         import numba  # noqa: F401
+
         numba_present = True
     except ImportError:
         numba_present = False
     env = {k: v for k, v in os.environ.items() if k != "STOCHCABLE_NUMBA"}
-    out = subprocess.run([sys.executable, "-c", _LAZY_SCRIPT], capture_output=True, text=True,
-                         cwd=str(pathlib.Path(sea.__file__).parents[2]), env=env, timeout=120)
+    out = subprocess.run(
+        [sys.executable, "-c", _LAZY_SCRIPT],
+        capture_output=True,
+        text=True,
+        cwd=str(pathlib.Path(sea.__file__).parents[2]),
+        env=env,
+        timeout=120,
+    )
     assert out.returncode == 0, out.stderr
-    assert out.stdout.split() == ["before", "False", "after", str(numba_present), str(numba_present)]
+    assert out.stdout.split() == [
+        "before",
+        "False",
+        "after",
+        str(numba_present),
+        str(numba_present),
+    ]
 
 
 def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
@@ -820,18 +931,32 @@ def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
     # unusable: one UserWarning, the kernel compiled in memory, the same realization
     pytest.importorskip("numba")
     pkg = tmp_path / "stochcable"
-    shutil.copytree(pathlib.Path(sea.__file__).parents[1], pkg,
-                    ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(
+        pathlib.Path(sea.__file__).parents[1], pkg, ignore=shutil.ignore_patterns("__pycache__")
+    )
     (pkg / "sea" / "__pycache__").write_text("")
-    env = dict(os.environ, PYTHONPATH=str(tmp_path), PYTHONDONTWRITEBYTECODE="1",
-               NUMBA_CACHE_DIR="/dev/null/numba", XDG_CACHE_HOME="/dev/null/xdg",
-               HOME="/dev/null")
+    env = dict(
+        os.environ,
+        PYTHONPATH=str(tmp_path),
+        PYTHONDONTWRITEBYTECODE="1",
+        NUMBA_CACHE_DIR="/dev/null/numba",
+        XDG_CACHE_HOME="/dev/null/xdg",
+        HOME="/dev/null",
+    )
     env.pop("STOCHCABLE_NUMBA", None)
-    script = ("import warnings, numpy as np, stochcable.sea.realization as sea, stochcable.sea.kernels as k\n"
-              "r = sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**18 * 0.1, 0.1, 'dsa', 3)\n"
-              "print(sea.__file__, k.CACHED, repr(complex(r.coefficients[12345])))\n")
-    out = subprocess.run([sys.executable, "-W", "always", "-c", script], env=env,
-                         capture_output=True, text=True, cwd=str(tmp_path), timeout=180)
+    script = (
+        "import warnings, numpy as np, stochcable.sea.realization as sea, stochcable.sea.kernels as k\n"
+        "r = sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**18 * 0.1, 0.1, 'dsa', 3)\n"
+        "print(sea.__file__, k.CACHED, repr(complex(r.coefficients[12345])))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-W", "always", "-c", script],
+        env=env,
+        capture_output=True,
+        text=True,
+        cwd=str(tmp_path),
+        timeout=180,
+    )
     assert out.returncode == 0, out.stderr
     path, cached, value = out.stdout.split(maxsplit=2)
     assert path == str(pkg / "sea" / "realization.py") and cached == "False"
@@ -841,6 +966,7 @@ def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
 
 
 # --- fourth issue-2 pass: S checked piece by piece, lazy seeding, cached cpu count --------
+
 
 @pytest.mark.parametrize("bad_at", [0, 5, 40_000, 2**17 - 1, 2**17])
 @pytest.mark.parametrize("bad", [np.nan, -1e-300, -np.inf])
@@ -876,14 +1002,32 @@ def test_piece_minimum_keeps_a_nan():
         s[w == 0.0] = np.nan
         return s
 
-    job = sea._Synthesis(0, 2**17 - 1, False, np.empty(2**17 - 1, complex),
-                         np.empty(2**17 - 1, complex), 1.0, dens, omega, 4)
+    job = sea._Synthesis(
+        0,
+        2**17 - 1,
+        False,
+        np.empty(2**17 - 1, complex),
+        np.empty(2**17 - 1, complex),
+        1.0,
+        dens,
+        omega,
+        4,
+    )
     job.spectrum()
     assert math.isnan(job.piece_min)
-    job = sea._Synthesis(0, 2**17 - 1, False, np.empty(2**17 - 1, complex),
-                         np.empty(2**17 - 1, complex), 1.0, lambda w: 1.0 - w, omega, 4)
+    job = sea._Synthesis(
+        0,
+        2**17 - 1,
+        False,
+        np.empty(2**17 - 1, complex),
+        np.empty(2**17 - 1, complex),
+        1.0,
+        lambda w: 1.0 - w,
+        omega,
+        4,
+    )
     job.spectrum()
-    assert job.piece_min == 0.0            # exact: 1 − 1
+    assert job.piece_min == 0.0  # exact: 1 − 1
 
 
 def test_int_seed_generator_built_lazily_by_the_draws():
@@ -893,8 +1037,10 @@ def test_int_seed_generator_built_lazily_by_the_draws():
     job.draw()
     ref = np.random.default_rng(11)
     np.testing.assert_array_equal(job.u, ref.random(5))
-    np.testing.assert_array_equal(job.gain, np.hypot(ref.standard_normal(5), ref.standard_normal(5)))
-    job.cancel()                           # a private generator: nothing to restore
+    np.testing.assert_array_equal(
+        job.gain, np.hypot(ref.standard_normal(5), ref.standard_normal(5))
+    )
+    job.cancel()  # a private generator: nothing to restore
 
 
 def test_cpu_count_is_asked_again_when_replaced(monkeypatch):

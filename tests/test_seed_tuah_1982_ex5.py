@@ -125,8 +125,7 @@ def test_seed_dsa_realization_has_the_expected_spectrum(result):
     expected = np.zeros_like(ts.omega)
     expected[1:-1] = spec.spectral_density(ts.omega[1:-1], res.scene.environment.g)
     # FFT round-off
-    np.testing.assert_allclose(sample[1:-1], expected[1:-1], rtol=1e-9,
-                               atol=1e-12 * expected.max())
+    np.testing.assert_allclose(sample[1:-1], expected[1:-1], rtol=1e-9, atol=1e-12 * expected.max())
     # m0 = 28 ft²: the grid 0.0245 … 63 rad/s misses < 1e-4 of the PM spectrum
     assert np.var(ts.elevation) == pytest.approx(TUAH_1982_EX5["m0"], rel=1e-4)
 
@@ -244,21 +243,26 @@ def test_same_scene_in_si_gives_the_same_results(doc, result):
         assert sb.mpm_3h / LBF == pytest.approx(sa.mpm_3h, rel=rel)
     np.testing.assert_allclose(b.tension_mean / LBF, a.tension_mean, rtol=rel)
     np.testing.assert_allclose(b.tension_std / LBF, a.tension_std, rtol=rel)
-    np.testing.assert_allclose(b.motion_std / FT, a.motion_std, rtol=rel,
-                               atol=rel * a.motion_std.max())
-    np.testing.assert_allclose(b.positions / FT, a.positions, rtol=0,
-                               atol=rel * np.abs(a.positions).max())
+    np.testing.assert_allclose(
+        b.motion_std / FT, a.motion_std, rtol=rel, atol=rel * a.motion_std.max()
+    )
+    np.testing.assert_allclose(
+        b.positions / FT, a.positions, rtol=0, atol=rel * np.abs(a.positions).max()
+    )
     # linearized drag per unit length: N·s/m² -> lbf·s/ft²
-    np.testing.assert_allclose(b.linearization.b_normal / (LBF / FT**2),
-                               a.linearization.b_normal, rtol=rel)
+    np.testing.assert_allclose(
+        b.linearization.b_normal / (LBF / FT**2), a.linearization.b_normal, rtol=rel
+    )
     # time series: same realization (ω, seed), tension in N vs lbf, η in m vs ft
     ta, tb = imp.timeseries, si.timeseries
-    np.testing.assert_allclose(tb.elevation / FT, ta.elevation, rtol=0,
-                               atol=rel * np.abs(ta.elevation).max())
+    np.testing.assert_allclose(
+        tb.elevation / FT, ta.elevation, rtol=0, atol=rel * np.abs(ta.elevation).max()
+    )
     for end in ("end_a", "end_b"):
         xa = ta.end_tension["leg"][end]
-        np.testing.assert_allclose(tb.end_tension["leg"][end] / LBF, xa, rtol=0,
-                                   atol=rel * np.abs(xa).max())
+        np.testing.assert_allclose(
+            tb.end_tension["leg"][end] / LBF, xa, rtol=0, atol=rel * np.abs(xa).max()
+        )
 
 
 def test_standard_gravity_instead_of_the_exact_conversion_is_visible(doc, result):

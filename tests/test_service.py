@@ -19,8 +19,8 @@ from service.app import create_app
 from service.schemas import default_omega
 from service.settings import Settings
 from stochcable.errors import ConvergenceError, SolverError
-from stochcable.sea.kinematics import kinematics_timeseries
 from stochcable.scene.model import PiersonMoskowitz, Spectrum
+from stochcable.sea.kinematics import kinematics_timeseries
 from stochcable.sea.realization import simulate_sea
 from stochcable.sea.spectra import spectrum_statistics
 
@@ -32,8 +32,15 @@ SPECTRA = [
     {"type": "jonswap", "hs": 4.0, "tp": 8.0, "gamma": 3.3},
     {"type": "bretschneider", "hs": 3.0, "tp": 9.0},
     {"type": "issc", "hs": 5.0, "t1": 8.0},
-    {"type": "ochi_hubble", "hs1": 2.0, "tp1": 14.0, "lambda1": 3.0,
-     "hs2": 3.0, "tp2": 7.0, "lambda2": 1.5},
+    {
+        "type": "ochi_hubble",
+        "hs1": 2.0,
+        "tp1": 14.0,
+        "lambda1": 3.0,
+        "hs2": 3.0,
+        "tp2": 7.0,
+        "lambda2": 1.5,
+    },
     {"type": "table", "omega": [0.2, 0.5, 0.8, 1.5], "density": [0.0, 2.0, 1.0, 0.0]},
 ]
 
@@ -91,8 +98,10 @@ def test_spectrum_equals_the_core(client, doc):
     # JSON carries float64 by repr, which round-trips exactly: equality, not closeness
     assert data["omega"] == omega.tolist()
     assert data["density"] == density.tolist()
-    expected = {k: (None if math.isinf(v) else v)
-                for k, v in spectrum_statistics(omega, density).as_dict().items()}
+    expected = {
+        k: (None if math.isinf(v) else v)
+        for k, v in spectrum_statistics(omega, density).as_dict().items()
+    }
     assert data["stats"] == expected
 
 
@@ -129,14 +138,18 @@ def test_spectrum_npy_and_csv_equal_json(client):
 
 
 def test_unsupported_accept_is_406(client):
-    err = _only_error(client.post("/v1/spectra", json={"spectrum": PM},
-                                  headers={"Accept": "image/png"}), 406)
+    err = _only_error(
+        client.post("/v1/spectra", json={"spectrum": PM}, headers={"Accept": "image/png"}), 406
+    )
     assert "application/x-npy" in err["msg"]
 
 
 def test_accept_quality_values_pick_the_best(client):
-    resp = client.post("/v1/spectra", json={"spectrum": PM},
-                       headers={"Accept": "application/json;q=0.5, text/csv;q=0.9"})
+    resp = client.post(
+        "/v1/spectra",
+        json={"spectrum": PM},
+        headers={"Accept": "application/json;q=0.5, text/csv;q=0.9"},
+    )
     assert resp.headers["content-type"].startswith("text/csv")
 
 
@@ -146,13 +159,26 @@ def test_accept_quality_values_pick_the_best(client):
 @pytest.mark.parametrize(
     ("spectrum", "type_", "parameter", "unit"),
     [
-        ({"type": "pierson_moskowitz", "hs": -6.0, "tp": 10.0}, "greater_than_equal", "spectrum.hs", "m"),
+        (
+            {"type": "pierson_moskowitz", "hs": -6.0, "tp": 10.0},
+            "greater_than_equal",
+            "spectrum.hs",
+            "m",
+        ),
         ({"type": "jonswap", "hs": 6.0}, "missing", "spectrum.tp", "s"),
         ({"type": "jonswap", "hs": "big", "tp": 10.0}, "float_parsing", "spectrum.hs", "m"),
-        ({"type": "jonswap", "hs": 6.0, "tp": 10.0, "gamma": 30}, "less_than_equal",
-         "spectrum.gamma", "-"),
-        ({"type": "bretschneider", "hs": 1.0, "tp": 5.0, "colour": "blue"}, "extra_forbidden",
-         "spectrum.colour", None),
+        (
+            {"type": "jonswap", "hs": 6.0, "tp": 10.0, "gamma": 30},
+            "less_than_equal",
+            "spectrum.gamma",
+            "-",
+        ),
+        (
+            {"type": "bretschneider", "hs": 1.0, "tp": 5.0, "colour": "blue"},
+            "extra_forbidden",
+            "spectrum.colour",
+            None,
+        ),
         ({"type": "nope", "hs": 1.0}, "union_tag_invalid", "spectrum", None),
     ],
 )
@@ -166,22 +192,27 @@ def test_validation_errors_name_path_and_unit(client, spectrum, type_, parameter
 
 def test_nan_is_rejected_with_the_field_path(client):
     body = b'{"spectrum": {"type": "pierson_moskowitz", "hs": NaN, "tp": 10}}'
-    err = _only_error(client.post("/v1/spectra", content=body,
-                                  headers={"Content-Type": "application/json"}))
+    err = _only_error(
+        client.post("/v1/spectra", content=body, headers={"Content-Type": "application/json"})
+    )
     assert err["type"] == "finite_number"
     assert err["parameter"] == "spectrum.hs" and err["unit"] == "m"
     assert "input" not in err  # NaN is not echoed (it is not valid JSON)
 
 
 def test_malformed_json_is_422(client):
-    err = _only_error(client.post("/v1/spectra", content=b'{"spectrum": ',
-                                  headers={"Content-Type": "application/json"}))
+    err = _only_error(
+        client.post(
+            "/v1/spectra", content=b'{"spectrum": ', headers={"Content-Type": "application/json"}
+        )
+    )
     assert err["type"] == "json_invalid" and err["loc"][0] == "body"
 
 
 def test_pydantic_model_validator_message_is_kept(client):
-    err = _only_error(client.post("/v1/spectra", json={
-        "spectrum": {"type": "pierson_moskowitz", "hs": 6.0}}))
+    err = _only_error(
+        client.post("/v1/spectra", json={"spectrum": {"type": "pierson_moskowitz", "hs": 6.0}})
+    )
     assert "hs and tp must be given together" in err["msg"]
 
 
@@ -210,8 +241,11 @@ def test_solver_errors_map_to_422_with_the_reason():
         assert err["solver"] == "drag linearization" and err["iterations"] == 100
         assert "did not converge" in err["msg"] and "raise max_iterations" in err["msg"]
         err = _only_error(c.get("/solve"))
-        assert err == {"loc": ["body"], "msg": "singular stiffness: line end_b is free",
-                       "type": "solver_error"}
+        assert err == {
+            "loc": ["body"],
+            "msg": "singular stiffness: line end_b is free",
+            "type": "solver_error",
+        }
 
 
 # ------------------------------------------------------------------------------ sea
@@ -225,8 +259,13 @@ def _realization_body(**kw):
 
 def _local(body):
     spec = _spectrum_model(body["spectrum"])
-    return simulate_sea(lambda w: spec.spectral_density(w), body["duration"], body["dt"],
-                        method=body.get("method", "dsa"), rng=body["seed"])
+    return simulate_sea(
+        lambda w: spec.spectral_density(w),
+        body["duration"],
+        body["dt"],
+        method=body.get("method", "dsa"),
+        rng=body["seed"],
+    )
 
 
 @pytest.mark.parametrize("method", ["dsa", "nsa"])
@@ -252,18 +291,15 @@ def test_dsa_variance_equals_the_target_m0(client):
 
 def test_single_column_npy_is_the_elevation(client):
     body = _realization_body(method="nsa")
-    resp = client.post("/v1/sea/realizations", json=body,
-                       headers={"Accept": "application/x-npy"})
+    resp = client.post("/v1/sea/realizations", json=body, headers={"Accept": "application/x-npy"})
     rec = np.load(io.BytesIO(resp.content), allow_pickle=False)
     sea = _local(body)
-    assert rec.dtype.names == ("elevation",) and np.array_equal(rec["elevation"],
-                                                                 sea.elevation)
+    assert rec.dtype.names == ("elevation",) and np.array_equal(rec["elevation"], sea.elevation)
     # m0 is the Riemann sum of S over the simulated lines m = 1 … N-1 (independent
     # evaluation here; the service reuses the simulation's own S values)
     spec = _spectrum_model(PM)
     m0 = spec.spectral_density(sea.omega[1:-1]).sum() * sea.d_omega
-    assert json.loads(resp.headers["x-stochcable-stats"])["m0"] == pytest.approx(m0,
-                                                                                 rel=1e-15)
+    assert json.loads(resp.headers["x-stochcable-stats"])["m0"] == pytest.approx(m0, rel=1e-15)
 
 
 def test_realization_kinematics_equal_the_core(client):
@@ -284,8 +320,9 @@ def test_realization_npy_and_csv_layouts(client):
     js = client.post("/v1/sea/realizations", json=body).json()
     resp = client.post("/v1/sea/realizations", json=body, headers={"Accept": "application/x-npy"})
     rec = np.load(io.BytesIO(resp.content), allow_pickle=False)
-    names = ["elevation"] + [f"{q}_{p}_{a}" for q in ("velocity", "acceleration")
-                             for p in range(2) for a in "xyz"]
+    names = ["elevation"] + [
+        f"{q}_{p}_{a}" for q in ("velocity", "acceleration") for p in range(2) for a in "xyz"
+    ]
     assert list(rec.dtype.names) == names  # NPY: no time column, t_n = n·dt
     assert (np.arange(rec.size) * body["dt"]).tolist() == js["time"]
     assert rec["elevation"].tolist() == js["elevation"]
@@ -298,8 +335,7 @@ def test_realization_npy_and_csv_layouts(client):
 
 
 def test_odd_sample_count_is_an_input_error(client):
-    err = _only_error(client.post("/v1/sea/realizations",
-                                  json=_realization_body(duration=100.5)))
+    err = _only_error(client.post("/v1/sea/realizations", json=_realization_body(duration=100.5)))
     assert err["type"] == "input_error" and err["parameter"] == "duration"
     assert "even integer" in err["msg"] and err["unit"] == "s"
 
@@ -307,8 +343,9 @@ def test_odd_sample_count_is_an_input_error(client):
 def test_realization_request_bounds(client):
     err = _only_error(client.post("/v1/sea/realizations", json=_realization_body(method="x")))
     assert err["parameter"] == "method"
-    err = _only_error(client.post("/v1/sea/realizations",
-                                  json=_realization_body(points=[[0.0, 0.0]])))
+    err = _only_error(
+        client.post("/v1/sea/realizations", json=_realization_body(points=[[0.0, 0.0]]))
+    )
     assert err["parameter"].startswith("points[0]")
     err = _only_error(client.post("/v1/sea/realizations", json=_realization_body(depth=-1)))
     assert err["parameter"] == "depth" and err["unit"] == "m"
@@ -316,12 +353,14 @@ def test_realization_request_bounds(client):
 
 def test_large_json_is_gzipped_but_npy_is_not(client):
     body = _realization_body(duration=4096.0)
-    resp = client.post("/v1/sea/realizations", json=body,
-                       headers={"Accept-Encoding": "gzip"})
+    resp = client.post("/v1/sea/realizations", json=body, headers={"Accept-Encoding": "gzip"})
     assert resp.headers.get("content-encoding") == "gzip"
     assert len(resp.json()["elevation"]) == 8192  # httpx decoded it
-    resp = client.post("/v1/sea/realizations", json=body,
-                       headers={"Accept-Encoding": "gzip", "Accept": "application/x-npy"})
+    resp = client.post(
+        "/v1/sea/realizations",
+        json=body,
+        headers={"Accept-Encoding": "gzip", "Accept": "application/x-npy"},
+    )
     assert "content-encoding" not in resp.headers
     # sanity of the fixture: gzip really is what the header says
     assert gzip.decompress(gzip.compress(b"x")) == b"x"
@@ -389,10 +428,12 @@ def test_dumps_refuses_non_finite_anywhere_in_a_document(bad, where):
     from service.encoding import dumps
     from service.errors import NumericalError
 
-    docs = {"scalar": {"a": {"b": bad}},
-            "list": {"a": [1.0, 2.0, bad]},
-            "nested": {"a": [[1.0, 2.0], [3.0, bad]]},
-            "mixed": {"a": [None, "x", 1, bad]}}
+    docs = {
+        "scalar": {"a": {"b": bad}},
+        "list": {"a": [1.0, 2.0, bad]},
+        "nested": {"a": [[1.0, 2.0], [3.0, bad]]},
+        "mixed": {"a": [None, "x", 1, bad]},
+    }
     with pytest.raises(NumericalError, match="non-finite"):
         dumps(docs[where])
 

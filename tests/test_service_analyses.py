@@ -12,6 +12,7 @@ import time
 import warnings
 
 import pytest
+from _compare import assert_close_documents
 from fastapi.testclient import TestClient
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -21,7 +22,6 @@ from service.app import create_app
 from service.routers.analyses import WARNINGS_HEADER
 from service.schemas import AnalysisResponse
 from service.settings import Settings
-from _compare import assert_close_documents
 from stochcable.analysis import analyze
 from stochcable.cli import main as cli_main
 from stochcable.examples import list_examples, load_example
@@ -54,8 +54,7 @@ def client() -> TestClient:
 
 @pytest.fixture(scope="module")
 def small() -> TestClient:
-    limits = Settings(max_elements=3, max_frequencies=200, max_samples=1024,
-                      max_body_bytes=4096)
+    limits = Settings(max_elements=3, max_frequencies=200, max_samples=1024, max_body_bytes=4096)
     with TestClient(create_app(limits)) as c:
         yield c
 
@@ -98,8 +97,15 @@ def test_document_conforms_to_the_response_model(chain_answer):
     # the v1 contract keys (DESIGN.md "Scene and result documents")
     assert model.lines["leg1"].end_b.tension.std > 0
     assert model.statics.lines["leg1"]["end_b"]["tension"] > 0
-    assert set(doc) >= {"statics", "modes", "linearization", "lines", "timing", "warnings",
-                        "timeseries"}
+    assert set(doc) >= {
+        "statics",
+        "modes",
+        "linearization",
+        "lines",
+        "timing",
+        "warnings",
+        "timeseries",
+    }
 
 
 def test_warnings_are_listed_and_counted_in_a_header(chain_answer, client):
@@ -150,8 +156,10 @@ def test_frequency_limit_names_the_bound(small):
     scene = _doc(SMALL)
     scene["analysis"]["omega"]["count"] = 201
     err = _err(small.post("/v1/analyses", json=scene))
-    assert err["msg"] == ("analysis.omega.count = 201 frequencies exceeds the limit of 200 "
-                          "(STOCHCABLE_MAX_FREQUENCIES)")
+    assert err["msg"] == (
+        "analysis.omega.count = 201 frequencies exceeds the limit of 200 "
+        "(STOCHCABLE_MAX_FREQUENCIES)"
+    )
     assert err["loc"] == ["body", "analysis", "omega", "count"] and err["limit"] == 200
 
 
@@ -159,15 +167,16 @@ def test_sample_limit_names_the_bound(small):
     scene = _doc(SMALL)
     scene["analysis"]["timeseries"]["duration"] = 512.0  # 2048 samples at 0.25 s
     err = _err(small.post("/v1/analyses", json=scene))
-    assert err["msg"] == ("analysis.timeseries duration/dt = 2048 samples exceeds the limit "
-                          "of 1024 (STOCHCABLE_MAX_SAMPLES)")
+    assert err["msg"] == (
+        "analysis.timeseries duration/dt = 2048 samples exceeds the limit "
+        "of 1024 (STOCHCABLE_MAX_SAMPLES)"
+    )
     assert err["loc"] == ["body", "analysis", "timeseries", "duration"]
 
 
 def test_body_limit_is_413(small):
     body = json.dumps(_doc(SMALL)) + " " * 4096
-    resp = small.post("/v1/analyses", content=body,
-                      headers={"Content-Type": "application/json"})
+    resp = small.post("/v1/analyses", content=body, headers={"Content-Type": "application/json"})
     err = _err(resp, 413)
     assert "exceeds the limit of 4096 bytes (STOCHCABLE_MAX_BODY_BYTES)" in err["msg"]
 
@@ -206,7 +215,7 @@ def test_validation_error_names_the_field_path_and_unit(small):
     err = _err(small.post("/v1/analyses", json=scene))
     assert err["parameter"] == "lines[0].segments[0].ea" and err["unit"] == "lbf"
     assert err["msg"] == "Input should be greater than 0"
-    scene = _doc(CHAIN)   # SI
+    scene = _doc(CHAIN)  # SI
     scene["lines"][0]["segments"][0]["ea"] = -1.0
     err = _err(small.post("/v1/analyses", json=scene))
     assert err["parameter"] == "lines[0].segments[0].ea" and err["unit"] == "N"
@@ -261,8 +270,7 @@ def test_queued_analyses_do_not_hold_the_slots_of_other_endpoints(monkeypatch):
             t.start()
         time.sleep(0.3)  # one analysis runs (1 of 2 slots), two wait for their turn
         t0 = time.perf_counter()
-        resp = c.post("/v1/spectra", json={"spectrum": {"type": "jonswap", "hs": 2.0,
-                                                        "tp": 8.0}})
+        resp = c.post("/v1/spectra", json={"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 8.0}})
         assert resp.status_code == 200 and time.perf_counter() - t0 < 2.0
         release.set()
         for t in threads:
@@ -275,8 +283,7 @@ def test_concurrent_analyses_keep_their_own_warnings(client):
     # the service runs one analysis at a time so overlapping requests neither swap
     # their warnings nor leave the process's warning filters altered
     filters = list(warnings.filters)
-    names = ["tuah_1982_suspended_cable", "taut_wire", "tuah_1982_suspended_cable",
-             "taut_wire"]
+    names = ["tuah_1982_suspended_cable", "taut_wire", "tuah_1982_suspended_cable", "taut_wire"]
     out: dict[int, object] = {}
 
     def post(i: int) -> None:
@@ -314,15 +321,21 @@ def _perturbed_scenes(draw):
     seg["elements"] = draw(st.integers(1, 30))
     seg["cd_normal"] = draw(st.floats(0.0, 3.0))
     line["end_b"]["position"][1] = draw(st.sampled_from([0.0, 15.0]))
-    doc["environment"]["current"] = [{"z": 0.0, "speed": draw(st.floats(0.0, 2.0)),
-                                      "heading": draw(st.floats(-180.0, 180.0))}]
+    doc["environment"]["current"] = [
+        {"z": 0.0, "speed": draw(st.floats(0.0, 2.0)), "heading": draw(st.floats(-180.0, 180.0))}
+    ]
     hs = draw(st.floats(0.1, 15.0))
-    doc["sea"] = {"spectrum": {"type": "jonswap", "hs": hs, "tp": draw(st.floats(3.0, 20.0))},
-                  "heading": draw(st.floats(-180.0, 180.0))}
+    doc["sea"] = {
+        "spectrum": {"type": "jonswap", "hs": hs, "tp": draw(st.floats(3.0, 20.0))},
+        "heading": draw(st.floats(-180.0, 180.0)),
+    }
     a = doc["analysis"]
-    a["omega"] = {"min": draw(st.floats(0.01, 0.5)), "max": draw(st.floats(0.6, 6.0)),
-                  "count": draw(st.integers(2, 120)),
-                  "spacing": draw(st.sampled_from(["linear", "log"]))}
+    a["omega"] = {
+        "min": draw(st.floats(0.01, 0.5)),
+        "max": draw(st.floats(0.6, 6.0)),
+        "count": draw(st.integers(2, 120)),
+        "spacing": draw(st.sampled_from(["linear", "log"])),
+    }
     a["solver"] = draw(st.sampled_from(["foss", "direct"]))
     a["modes"] = draw(st.sampled_from(["auto", 1, 5]))
     a["linearization"]["method"] = draw(st.sampled_from(["seed", "vector"]))
@@ -333,8 +346,13 @@ def _perturbed_scenes(draw):
 _GENERATED_APP = create_app(Settings(max_run_seconds=10.0))
 
 
-@settings(max_examples=12, deadline=None, derandomize=True, database=None,
-          suppress_health_check=list(HealthCheck))
+@settings(
+    max_examples=12,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    suppress_health_check=list(HealthCheck),
+)
 @given(scene=_perturbed_scenes())
 def test_generated_scenes_answer_a_document_or_a_reason(scene):
     with TestClient(_GENERATED_APP, raise_server_exceptions=False) as c:
@@ -344,4 +362,8 @@ def test_generated_scenes_answer_a_document_or_a_reason(scene):
         AnalysisResponse.model_validate(resp.json())
     else:
         assert resp.json()["detail"][0]["type"] in (
-            "input_error", "convergence_error", "solver_error", "value_error")
+            "input_error",
+            "convergence_error",
+            "solver_error",
+            "value_error",
+        )

@@ -10,9 +10,9 @@ import warnings
 
 import numpy as np
 import pytest
+from _compare import assert_close_documents
 from fastapi.testclient import TestClient
 
-from _compare import assert_close_documents
 from service.app import create_app
 from service.settings import Settings
 from stochcable.analysis import analyze
@@ -61,8 +61,7 @@ def test_bodies_scene_with_timeseries_document_carries_body_series(client):
     coupled leg's tensions and the body's motion series (timeseries.bodies.<name>.motion
     per DOF), equal to the core's."""
     doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
-    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 128.0, "dt": 0.5,
-                                     "seed": 4}
+    doc["analysis"]["timeseries"] = {"method": "dsa", "duration": 128.0, "dt": 0.5, "seed": 4}
     r = client.post("/v1/analyses", json=doc)
     assert r.status_code == 200, r.text
     got = _plain(r.json())

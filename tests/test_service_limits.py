@@ -25,8 +25,7 @@ def _err(resp, status):
 
 @pytest.fixture(scope="module")
 def small() -> TestClient:
-    settings = Settings(max_samples=4096, max_frequencies=1000, max_points=4,
-                        max_body_bytes=4096)
+    settings = Settings(max_samples=4096, max_frequencies=1000, max_points=4, max_body_bytes=4096)
     with TestClient(create_app(settings)) as c:
         yield c
 
@@ -35,8 +34,9 @@ def test_sample_limit_names_the_bound(small):
     body = {"spectrum": PM, "duration": 8192.0, "dt": 1.0}
     err = _err(small.post("/v1/sea/realizations", json=body), 422)
     assert err["type"] == "limit_exceeded"
-    assert err["msg"] == ("duration/dt = 8192 samples exceeds the limit of 4096 "
-                          "(STOCHCABLE_MAX_SAMPLES)")
+    assert err["msg"] == (
+        "duration/dt = 8192 samples exceeds the limit of 4096 (STOCHCABLE_MAX_SAMPLES)"
+    )
     assert err["setting"] == "STOCHCABLE_MAX_SAMPLES" and err["limit"] == 4096
     assert err["parameter"] == "duration"
     # at the bound it is accepted
@@ -45,8 +45,12 @@ def test_sample_limit_names_the_bound(small):
 
 
 def test_sample_limit_counts_kinematics_points(small):
-    body = {"spectrum": PM, "duration": 2048.0, "dt": 1.0,
-            "points": [[0.0, 0.0, -1.0], [0.0, 0.0, -2.0], [0.0, 0.0, -3.0]]}
+    body = {
+        "spectrum": PM,
+        "duration": 2048.0,
+        "dt": 1.0,
+        "points": [[0.0, 0.0, -1.0], [0.0, 0.0, -2.0], [0.0, 0.0, -3.0]],
+    }
     err = _err(small.post("/v1/sea/realizations", json=body), 422)
     assert "2048 × 3 = 6144 kinematics samples exceeds the limit of 4096" in err["msg"]
     assert err["parameter"] == "points"
@@ -61,21 +65,24 @@ def test_point_limit(small):
 def test_frequency_limit(small):
     body = {"spectrum": PM, "omega": {"min": 0.1, "max": 2.0, "count": 1001}}
     err = _err(small.post("/v1/spectra", json=body), 422)
-    assert err["msg"] == ("omega.count = 1001 frequencies exceeds the limit of 1000 "
-                          "(STOCHCABLE_MAX_FREQUENCIES)")
+    assert err["msg"] == (
+        "omega.count = 1001 frequencies exceeds the limit of 1000 (STOCHCABLE_MAX_FREQUENCIES)"
+    )
     assert err["loc"] == ["body", "omega", "count"]
 
 
 def test_element_limit_helper():
     check_elements(10, Settings(max_elements=10))
-    with pytest.raises(LimitExceeded, match=r"11 finite elements exceeds the limit of 10 "
-                                            r"\(STOCHCABLE_MAX_ELEMENTS\)"):
+    with pytest.raises(
+        LimitExceeded,
+        match=r"11 finite elements exceeds the limit of 10 "
+        r"\(STOCHCABLE_MAX_ELEMENTS\)",
+    ):
         check_elements(11, Settings(max_elements=10))
 
 
 def test_body_over_content_length_is_413(small):
-    table = {"type": "table", "omega": [0.1 * i for i in range(1, 400)],
-             "density": [1.0] * 399}
+    table = {"type": "table", "omega": [0.1 * i for i in range(1, 400)], "density": [1.0] * 399}
     err = _err(small.post("/v1/spectra", json={"spectrum": table}), 413)
     assert err["type"] == "body_too_large"
     assert "exceeds the limit of 4096 bytes (STOCHCABLE_MAX_BODY_BYTES)" in err["msg"]
@@ -89,11 +96,11 @@ def test_streamed_body_over_the_limit_is_413(small):
             yield b" " * 100
         yield b"}"
 
-    resp = small.post("/v1/spectra", content=chunks(),
-                      headers={"Content-Type": "application/json"})
+    resp = small.post("/v1/spectra", content=chunks(), headers={"Content-Type": "application/json"})
     err = _err(resp, 413)
-    assert err["msg"] == ("the request body exceeds the limit of 4096 bytes "
-                          "(STOCHCABLE_MAX_BODY_BYTES)")
+    assert err["msg"] == (
+        "the request body exceeds the limit of 4096 bytes (STOCHCABLE_MAX_BODY_BYTES)"
+    )
 
 
 def _slow_app(**kw):
@@ -151,8 +158,10 @@ def test_settings_from_the_environment(monkeypatch):
     assert s.max_samples == 1024 and s.max_run_seconds == 2.5
     assert Settings.env_name("max_samples") == "STOCHCABLE_MAX_SAMPLES"
     with TestClient(create_app()) as c:
-        err = _err(c.post("/v1/sea/realizations",
-                          json={"spectrum": PM, "duration": 2048.0, "dt": 1.0}), 422)
+        err = _err(
+            c.post("/v1/sea/realizations", json={"spectrum": PM, "duration": 2048.0, "dt": 1.0}),
+            422,
+        )
         assert "limit of 1024 (STOCHCABLE_MAX_SAMPLES)" in err["msg"]
 
 

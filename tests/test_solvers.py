@@ -9,11 +9,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from stochcable.errors import InputError, SolverError
 from stochcable.dynamics.linearization import drag_linear_seed
 from stochcable.dynamics.modal_solvers import (
-    auto_mode_count,
     DefectivePencilWarning,
+    auto_mode_count,
     foss_decomposition,
     foss_transfer,
     modal_basis,
@@ -25,10 +24,12 @@ from stochcable.dynamics.solvers import (
     solve_direct,
     tridiagonal_blocks,
 )
-
+from stochcable.errors import InputError, SolverError
 
 # Foss must really be used (no silent fallback) except where a test expects the warning
-pytestmark = pytest.mark.filterwarnings("error::stochcable.dynamics.modal_solvers.DefectivePencilWarning")
+pytestmark = pytest.mark.filterwarnings(
+    "error::stochcable.dynamics.modal_solvers.DefectivePencilWarning"
+)
 
 
 def _rel(a, b):
@@ -83,8 +84,9 @@ def test_modal_basis_chain_closed_form_and_normalization():
     K, M = _chain(n, k, m)
     wn, phi = modal_basis(K, M, n_modes=6)
     j = np.arange(1, 7)
-    np.testing.assert_allclose(wn, 2 * math.sqrt(k / m) * np.sin(j * math.pi / (2 * (n + 1))),
-                               rtol=1e-12)  # LAPACK eigh, well separated: round-off
+    np.testing.assert_allclose(
+        wn, 2 * math.sqrt(k / m) * np.sin(j * math.pi / (2 * (n + 1))), rtol=1e-12
+    )  # LAPACK eigh, well separated: round-off
     np.testing.assert_allclose(phi.T @ M @ phi, np.eye(6), atol=1e-12)
     assert np.all(phi[np.argmax(np.abs(phi), axis=0), np.arange(6)] > 0)  # sign convention
     wn_s, phi_s = modal_basis(sp.csr_matrix(K), sp.csr_matrix(M), n_modes=6)
@@ -241,13 +243,12 @@ def test_foss_decomposition_distinct_eigenvalues_a_j_formula():
     a = 2 * lam * np.einsum("ij,ik,kj->j", chi, Mh, chi) + np.einsum("ij,ik,kj->j", chi, Ch, chi)
     np.testing.assert_allclose(fm.a, a, rtol=1e-12)
     # quadratic eigenproblem residual (lambda^2 M + lambda C + K) chi = 0
-    res = (lam**2 * (Mh @ chi) + lam * (Ch @ chi) + Kh @ chi)
+    res = lam**2 * (Mh @ chi) + lam * (Ch @ chi) + Kh @ chi
     assert np.abs(res).max() < 1e-12
     # DESIGN's per-mode formula equals foss_transfer when the eigenvalues are distinct
     w = np.linspace(0.0, 3.0, 7)
     fh = rng.standard_normal((w.size, n)) + 0j
-    per_mode = np.einsum("nj,wj->wn", chi,
-                         (fh @ chi) / (fm.a * (1j * w[:, None] - lam)))
+    per_mode = np.einsum("nj,wj->wn", chi, (fh @ chi) / (fm.a * (1j * w[:, None] - lam)))
     np.testing.assert_allclose(foss_transfer(fm, fh, w), per_mode, rtol=1e-10, atol=1e-14)
 
 
@@ -266,8 +267,9 @@ def test_truncation_error_decreases_monotonically_with_static_correction():
     err_sc, err_plain = [], []
     for nm in range(1, n + 1):
         err_sc.append(_rel(solve_modal(K, M, C, F, w, n_modes=nm, basis=basis), ref))
-        err_plain.append(_rel(solve_modal(K, M, C, F, w, n_modes=nm, basis=basis,
-                                          static_correction=False), ref))
+        err_plain.append(
+            _rel(solve_modal(K, M, C, F, w, n_modes=nm, basis=basis, static_correction=False), ref)
+        )
     err_sc = np.array(err_sc)
     assert np.all(np.diff(err_sc) <= 0)  # monotone convergence curve
     assert err_sc[-1] < 1e-8  # all modes: equals direct
@@ -334,14 +336,16 @@ def _block_line(n_nodes, b, rng, *, slack=(), ea=1e9, tension=1e5, m=100.0, damp
                 if 0 <= a < n_nodes and 0 <= c < n_nodes:
                     blk = sa * sc * k[j]
                     mb = (m * l / 3.0 if a == c else m * l / 6.0) * np.eye(b)
-                    K[a * b:(a + 1) * b, c * b:(c + 1) * b] += blk
-                    M[a * b:(a + 1) * b, c * b:(c + 1) * b] += mb
-                    C[a * b:(a + 1) * b, c * b:(c + 1) * b] += damping * mb / m
+                    K[a * b : (a + 1) * b, c * b : (c + 1) * b] += blk
+                    M[a * b : (a + 1) * b, c * b : (c + 1) * b] += mb
+                    C[a * b : (a + 1) * b, c * b : (c + 1) * b] += damping * mb / m
     return K, M, C
 
 
-@pytest.mark.parametrize("b, n_nodes, slack", [(2, 39, ()), (3, 39, ()), (3, 40, (0, 7, 8, 20)),
-                                               (2, 30, tuple(range(5, 25)))])
+@pytest.mark.parametrize(
+    "b, n_nodes, slack",
+    [(2, 39, ()), (3, 39, ()), (3, 40, (0, 7, 8, 20)), (2, 30, tuple(range(5, 25)))],
+)
 def test_block_tridiagonal_equals_dense_direct(b, n_nodes, slack):
     """Chain-like lines in 2-D and 3-D, also with slack elements (1e-6 EA, T = 0:
     tiny stiffness, nearly singular K), across resonances with light damping."""

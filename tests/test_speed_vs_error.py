@@ -69,12 +69,15 @@ def test_errors_decrease_towards_reference(study):
     # chance (the default's motion error is 1e-4 while ×2's is 7e-4: a sign change of
     # an error that shrinks as O(h²) overall)
     for q in ("T_anchor", "motion"):
-        errs = [abs(_row(study, lab).err_ref[q])
-                for lab in ("elements ×0.25", "elements ×0.5", "elements ×2")]
+        errs = [
+            abs(_row(study, lab).err_ref[q])
+            for lab in ("elements ×0.25", "elements ×0.5", "elements ×2")
+        ]
         assert all(a > b for a, b in zip(errs, errs[1:])), (q, errs)
     # a finer grid on the wide band: 50 -> 400 frequencies
-    assert (abs(_row(study, "50 ω to 2·ω_max").err_ref["T_fairlead"])
-            > abs(_row(study, "400 ω to 2·ω_max").err_ref["T_fairlead"]))
+    assert abs(_row(study, "50 ω to 2·ω_max").err_ref["T_fairlead"]) > abs(
+        _row(study, "400 ω to 2·ω_max").err_ref["T_fairlead"]
+    )
     # the combination closest to the reference beats the default on every quantity
     best = _row(study, "×2 el, 400 ω to 2·ω_max")
     default = _row(study, "default")
@@ -114,9 +117,19 @@ def test_report(study, tmp_path):
 def test_scene_document_does_not_mutate():
     base = sve.base_document("taut_wire")
     before = repr(base)
-    doc = sve.scene_document(base, sve.Setting("x", "elements", elements=0.25, modes="all",
-                                                count=50, omega_max_factor=2.0,
-                                                tolerance=1e-6, solver="direct"))
+    doc = sve.scene_document(
+        base,
+        sve.Setting(
+            "x",
+            "elements",
+            elements=0.25,
+            modes="all",
+            count=50,
+            omega_max_factor=2.0,
+            tolerance=1e-6,
+            solver="direct",
+        ),
+    )
     assert repr(base) == before
     assert doc["lines"][0]["segments"][0]["elements"] == 5
     assert doc["analysis"]["omega"]["count"] == 50
@@ -133,8 +146,9 @@ def test_reference_ladder_puts_a_node_at_the_touchdown():
     base = sve.base_document("tuah_1982_single_leg")
     before = copy.deepcopy(base)
     s_td = static_touchdowns(load_scene(base))["leg"]
-    doc = sve.split_at_touchdown(sve.scene_document(
-        base, sve.Setting("x", "reference", elements=4.0)), s_td)
+    doc = sve.split_at_touchdown(
+        sve.scene_document(base, sve.Setting("x", "reference", elements=4.0)), s_td
+    )
     assert base == before  # not mutated
     segs = doc["lines"][0]["segments"]
     assert [s["length"] for s in segs] == pytest.approx([s_td, 339.0 - s_td], rel=1e-12)

@@ -8,26 +8,56 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.line.multisegment import catenary_multisegment
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.mesh import mesh_line
-from stochcable.scene.model import load_scene
+from stochcable.line.multisegment import catenary_multisegment
 from stochcable.line.statics import solve_fe, solve_line_statics
+from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
 # DESIGN.md "Scene and result documents": the chain leg of the example scene.
-CHAIN = dict(length=850.0, ea=1.2326e9, mass=288.0, diameter=0.216, cd_normal=1.333,
-             cd_axial=0.2034, elements=100)
+CHAIN = dict(
+    length=850.0,
+    ea=1.2326e9,
+    mass=288.0,
+    diameter=0.216,
+    cd_normal=1.333,
+    cd_axial=0.2034,
+    elements=100,
+)
 
 
-def make(end_a, end_b, segments, depth=200.0, current=(), attachments=(), stiffness=3e6,
-         rho=1025.0, g=9.80665):
-    scene = load_scene({
-        "environment": {"depth": depth, "rho": rho, "g": g, "current": list(current),
-                        "seabed": {"stiffness": stiffness}},
-        "lines": [{"name": "l", "end_a": {"position": list(end_a)},
-                   "end_b": {"position": list(end_b)}, "segments": list(segments),
-                   "attachments": list(attachments)}]})
+def make(
+    end_a,
+    end_b,
+    segments,
+    depth=200.0,
+    current=(),
+    attachments=(),
+    stiffness=3e6,
+    rho=1025.0,
+    g=9.80665,
+):
+    scene = load_scene(
+        {
+            "environment": {
+                "depth": depth,
+                "rho": rho,
+                "g": g,
+                "current": list(current),
+                "seabed": {"stiffness": stiffness},
+            },
+            "lines": [
+                {
+                    "name": "l",
+                    "end_a": {"position": list(end_a)},
+                    "end_b": {"position": list(end_b)},
+                    "segments": list(segments),
+                    "attachments": list(attachments),
+                }
+            ],
+        }
+    )
     env = scene.environment
     return mesh_line(scene.lines[0], env.rho, env.g), env, scene
 
@@ -47,10 +77,13 @@ def richardson(seg, end_a, end_b, n, **kw):
     return (4 * t2 - t1) / 3, (4 * p2 - p1) / 3, (t1, t2)
 
 
-@pytest.mark.parametrize("case,length,end_a,end_b", [
-    ("slack", 500.0, (-400.0, 0.0, -100.0), (0.0, 0.0, -20.0)),
-    ("taut", 407.0, (-400.0, 0.0, -100.0), (0.0, 0.0, -20.0)),
-])
+@pytest.mark.parametrize(
+    "case,length,end_a,end_b",
+    [
+        ("slack", 500.0, (-400.0, 0.0, -100.0), (0.0, 0.0, -20.0)),
+        ("taut", 407.0, (-400.0, 0.0, -100.0), (0.0, 0.0, -20.0)),
+    ],
+)
 def test_fe_converges_to_catenary(case, length, end_a, end_b):
     # A chain of straight bars with the weight lumped at the nodes is not the
     # continuous catenary: its chords are shorter than the arcs by O(l0³ κ²) each,
@@ -101,8 +134,12 @@ def test_fe_seabed_touchdown_matches_catenary():
 def test_auto_uses_catenary_and_fe_otherwise():
     m, env, scene = make((-400, 0, -100), (0, 0, -20), [dict(CHAIN, length=500.0)])
     assert solve_line_statics(m, env).method == "catenary"
-    m2, env2, _ = make((-400, 0, -100), (0, 0, -20), [dict(CHAIN, length=500.0)],
-                       current=[{"z": 0.0, "speed": 0.5}])
+    m2, env2, _ = make(
+        (-400, 0, -100),
+        (0, 0, -20),
+        [dict(CHAIN, length=500.0)],
+        current=[{"z": 0.0, "speed": 0.5}],
+    )
     assert solve_line_statics(m2, env2).method == "fe"
     with pytest.raises(InputError, match="there is a current"):
         solve_line_statics(m2, env2, method="catenary")
@@ -125,8 +162,9 @@ def test_equilibrium_end_forces_balance_loads():
 
 
 def test_symmetric_u_shape():
-    m, env, _ = make((-200, 0, -50), (200, 0, -50), [dict(CHAIN, length=500.0, elements=50)],
-                     depth=500.0)
+    m, env, _ = make(
+        (-200, 0, -50), (200, 0, -50), [dict(CHAIN, length=500.0, elements=50)], depth=500.0
+    )
     r = fe(m, env)
     p = r.positions
     # mirror x -> -x reverses the node order; round-off of a 1e-10 relative residual
@@ -139,8 +177,15 @@ def test_symmetric_u_shape():
 # Seed 001 §6.2 (Tuah 1982): two segments, 500 ft and 1000 ft, from (0, 0) to
 # (1200, 500) ft, A0 = 0.0218 ft², E = 8.12e6 psf, cable 3.35 slug/ft³, water
 # 2.0 slug/ft³, a 900 lb buoy at the junction (imperial units, g = 32.174 ft/s²).
-TUAH_1982_6_2 = dict(area=0.0218, E=8.12e6, rho_c=3.35, rho_f=2.0, buoy=900.0,
-                     lengths=(500.0, 1000.0), end_b=(1200.0, 500.0))
+TUAH_1982_6_2 = dict(
+    area=0.0218,
+    E=8.12e6,
+    rho_c=3.35,
+    rho_f=2.0,
+    buoy=900.0,
+    lengths=(500.0, 1000.0),
+    end_b=(1200.0, 500.0),
+)
 
 
 def test_seed_001_example_6_2_two_segments_with_buoy():
@@ -148,16 +193,31 @@ def test_seed_001_example_6_2_two_segments_with_buoy():
     g = 32.174
     diam = math.sqrt(4 * d["area"] / math.pi)
     seg = dict(ea=d["E"] * d["area"], mass=d["rho_c"] * d["area"], diameter=diam)
-    segs = [dict(seg, length=d["lengths"][0], elements=40),
-            dict(seg, length=d["lengths"][1], elements=80)]
+    segs = [
+        dict(seg, length=d["lengths"][0], elements=40),
+        dict(seg, length=d["lengths"][1], elements=80),
+    ]
     end_a = (0.0, 0.0, -600.0)
     end_b = (d["end_b"][0], 0.0, -600.0 + d["end_b"][1])
-    m, env, _ = make(end_a, end_b, segs, depth=2000.0, rho=d["rho_f"], g=g,
-                     attachments=[{"at": 500.0, "buoyancy": d["buoy"]}])
+    m, env, _ = make(
+        end_a,
+        end_b,
+        segs,
+        depth=2000.0,
+        rho=d["rho_f"],
+        g=g,
+        attachments=[{"at": 500.0, "buoyancy": d["buoy"]}],
+    )
     r = fe(m, env)
     w = (d["rho_c"] - d["rho_f"]) * d["area"] * g
-    ref = catenary_multisegment(d["end_b"][0], d["end_b"][1], d["lengths"], [w, w],
-                                [seg["ea"]] * 2, junction_loads=[-d["buoy"]])
+    ref = catenary_multisegment(
+        d["end_b"][0],
+        d["end_b"][1],
+        d["lengths"],
+        [w, w],
+        [seg["ea"]] * 2,
+        junction_loads=[-d["buoy"]],
+    )
     # O(1/n²) discretization with 120 elements: 1e-4 relative (measured below 3e-5)
     assert r.tension_a == pytest.approx(ref.tension_a, rel=1e-4)
     assert r.tension_b == pytest.approx(ref.tension_b, rel=1e-4)
@@ -168,8 +228,7 @@ def test_seed_001_example_6_2_two_segments_with_buoy():
 
 def test_3d_line_equals_rotated_planar_one():
     th = math.radians(37.0)
-    rot = np.array([[math.cos(th), -math.sin(th), 0], [math.sin(th), math.cos(th), 0],
-                    [0, 0, 1]])
+    rot = np.array([[math.cos(th), -math.sin(th), 0], [math.sin(th), math.cos(th), 0], [0, 0, 1]])
     a, b = np.array([-800.0, 0, -200]), np.array([0.0, 0, -20])
     m2, env, _ = make(a, b, [CHAIN])
     m3, env3, _ = make(rot @ a, rot @ b, [CHAIN])
@@ -180,17 +239,42 @@ def test_3d_line_equals_rotated_planar_one():
     assert np.allclose(r3.force_b, rot @ r2.force_b, atol=1e-9 * r2.tension_b)
 
 
-@pytest.mark.parametrize("name,end_a,end_b,seg,depth", [
-    ("nearly taut", (-400, 0, -100), (0, 0, -100), dict(CHAIN, length=400.0 * (1 + 1e-8) ), 200.0),
-    ("very slack, mostly grounded", (-800, 0, -200), (0, 0, -20), dict(CHAIN, length=960.0), 200.0),
-    ("nearly vertical", (-5, 0, -200), (0, 0, -20), dict(CHAIN, length=180.1), 300.0),
-    ("EA/T 1e6", (-400, 0, -100), (0, 0, -20), dict(CHAIN, length=500.0, ea=1e12), 200.0),
-    ("400 elements", (-800, 0, -200), (0, 0, -20), dict(CHAIN, elements=400), 200.0),
-    ("very slack, 400 elements", (-800, 0, -200), (0, 0, -20),
-     dict(CHAIN, length=960.0, elements=400), 200.0),
-    ("very slack, 800 elements", (-800, 0, -200), (0, 0, -20),
-     dict(CHAIN, length=960.0, elements=800), 200.0),
-])
+@pytest.mark.parametrize(
+    "name,end_a,end_b,seg,depth",
+    [
+        (
+            "nearly taut",
+            (-400, 0, -100),
+            (0, 0, -100),
+            dict(CHAIN, length=400.0 * (1 + 1e-8)),
+            200.0,
+        ),
+        (
+            "very slack, mostly grounded",
+            (-800, 0, -200),
+            (0, 0, -20),
+            dict(CHAIN, length=960.0),
+            200.0,
+        ),
+        ("nearly vertical", (-5, 0, -200), (0, 0, -20), dict(CHAIN, length=180.1), 300.0),
+        ("EA/T 1e6", (-400, 0, -100), (0, 0, -20), dict(CHAIN, length=500.0, ea=1e12), 200.0),
+        ("400 elements", (-800, 0, -200), (0, 0, -20), dict(CHAIN, elements=400), 200.0),
+        (
+            "very slack, 400 elements",
+            (-800, 0, -200),
+            (0, 0, -20),
+            dict(CHAIN, length=960.0, elements=400),
+            200.0,
+        ),
+        (
+            "very slack, 800 elements",
+            (-800, 0, -200),
+            (0, 0, -20),
+            dict(CHAIN, length=960.0, elements=800),
+            200.0,
+        ),
+    ],
+)
 def test_hard_cases_match_catenary(name, end_a, end_b, seg, depth):
     m, env, _ = make(end_a, end_b, [seg], depth=depth)
     cat = solve_line_statics(m, env, method="catenary")
@@ -212,10 +296,16 @@ def test_current_deflects_downstream_taut_string():
     # drag load q = ½ρ Cd D U² per length deflects it downstream (+y), and the small-
     # deflection string gives the midspan sag q L²/(8 T).  Weightless line
     # (weight = 0) so the deflection is purely horizontal.
-    seg = dict(length=100.0, ea=1e7, mass=10.0, diameter=0.1, cd_normal=1.2, weight=0.0,
-               elements=50)
-    m, env, _ = make((-100.5, 0, -50), (0.5, 0, -50), [seg], depth=100.0,
-                     current=[{"z": 0.0, "speed": 1.0, "heading": 90.0}])
+    seg = dict(
+        length=100.0, ea=1e7, mass=10.0, diameter=0.1, cd_normal=1.2, weight=0.0, elements=50
+    )
+    m, env, _ = make(
+        (-100.5, 0, -50),
+        (0.5, 0, -50),
+        [seg],
+        depth=100.0,
+        current=[{"z": 0.0, "speed": 1.0, "heading": 90.0}],
+    )
     r = fe(m, env)
     q = 0.5 * 1025.0 * 1.2 * 0.1 * 1.0**2
     T = float(np.mean(r.tension))
@@ -251,8 +341,11 @@ def test_slack_grounded_line_longer_than_span_plus_depth_is_input_error():
     # undetermined.  Raised up front, before any iteration, for fe and auto alike.
     m, env, _ = make((-800, 0, -200), (0, 0, -20), [dict(CHAIN, length=985.0)])
     for method in ("fe", "auto"):
-        with pytest.raises(InputError, match=r"lines\['l'\]\.length = 985.*800 m \+ 179\.968"
-                           r".*without seabed friction.*undetermined.*shorten"):
+        with pytest.raises(
+            InputError,
+            match=r"lines\['l'\]\.length = 985.*800 m \+ 179\.968"
+            r".*without seabed friction.*undetermined.*shorten",
+        ):
             solve_line_statics(m, env, method=method)
     # just below the threshold the line is determined and solves
     m2, env2, _ = make((-800, 0, -200), (0, 0, -20), [dict(CHAIN, length=975.0)])
@@ -274,15 +367,19 @@ def test_clump_weight_two_segments_matches_multisegment_catenary():
     # (deep water).  Reference: piecewise elastic catenary, V jumps by the clump
     # weight at the junction (catenary_multisegment).  O(1/n²) discretization at 2 x 100
     # elements: 1e-4 relative on the end tensions, 0.05 m on the junction.
-    segs = [dict(CHAIN, length=400.0, elements=100),
-            dict(length=300.0, ea=5e8, mass=60.0, diameter=0.1, elements=100)]
+    segs = [
+        dict(CHAIN, length=400.0, elements=100),
+        dict(length=300.0, ea=5e8, mass=60.0, diameter=0.1, elements=100),
+    ]
     clump = 2e4
-    m, env, _ = make((-300, 0, -500), (0, 0, -20), segs, depth=1000.0,
-                     attachments=[{"at": 400.0, "mass": clump}])
+    m, env, _ = make(
+        (-300, 0, -500), (0, 0, -20), segs, depth=1000.0, attachments=[{"at": 400.0, "mass": clump}]
+    )
     r = fe(m, env)
     ws = [float(m.weight[0]), float(m.weight[-1])]
-    ref = catenary_multisegment(300.0, 480.0, [400.0, 300.0], ws, [1.2326e9, 5e8],
-                                junction_loads=[clump * env.g])
+    ref = catenary_multisegment(
+        300.0, 480.0, [400.0, 300.0], ws, [1.2326e9, 5e8], junction_loads=[clump * env.g]
+    )
     assert r.tension_a == pytest.approx(ref.tension_a, rel=1e-4)
     assert r.tension_b == pytest.approx(ref.tension_b, rel=1e-4)
     j = int(np.argmin(np.abs(m.s0 - 400.0)))
@@ -340,18 +437,22 @@ def _drag_on_line(r, m, env, u_of_z):
     return np.sum(l[:, None] * f, axis=0)
 
 
-@pytest.mark.parametrize("current", [
-    [{"z": 0.0, "speed": 1.5, "heading": 0.0}],
-    [{"z": 0.0, "speed": 1.5, "heading": 90.0}],
-    # sheared profile: the tangent leaves out dU/dz (linear convergence in the
-    # asymptotic phase), still converged to 1e-10 within the budget
-    [{"z": 0.0, "speed": 2.0, "heading": 30.0}, {"z": -300.0, "speed": 0.2, "heading": 0.0}],
-])
+@pytest.mark.parametrize(
+    "current",
+    [
+        [{"z": 0.0, "speed": 1.5, "heading": 0.0}],
+        [{"z": 0.0, "speed": 1.5, "heading": 90.0}],
+        # sheared profile: the tangent leaves out dU/dz (linear convergence in the
+        # asymptotic phase), still converged to 1e-10 within the budget
+        [{"z": 0.0, "speed": 2.0, "heading": 30.0}, {"z": -300.0, "speed": 0.2, "heading": 0.0}],
+    ],
+)
 def test_current_drag_balance_heavy_line(current):
     # Conservation: the supports carry weight + integrated drag, so the horizontal end
     # forces sum to the total drag, recomputed here from the converged positions.
-    m, env, _ = make((-400, 0, -150), (0, 0, -20), [dict(CHAIN, length=500.0)],
-                     current=current, depth=1000.0)
+    m, env, _ = make(
+        (-400, 0, -150), (0, 0, -20), [dict(CHAIN, length=500.0)], current=current, depth=1000.0
+    )
     r = fe(m, env)
 
     def u_of_z(z):
@@ -375,8 +476,9 @@ def test_load_stepping_rescues_drag_dominated_line():
     from stochcable.line.equilibrium import LocalFrame, StaticsModel, StaticsSolver
 
     seg = dict(length=600.0, ea=1e8, mass=20.0, diameter=0.15, elements=60)
-    m, env, _ = make((-400, 0, -100), (0, 0, -20), [seg],
-                     current=[{"z": 0.0, "speed": 2.0, "heading": 0.0}])
+    m, env, _ = make(
+        (-400, 0, -100), (0, 0, -20), [seg], current=[{"z": 0.0, "speed": 2.0, "heading": 0.0}]
+    )
     frame = LocalFrame(m, env)
     model = StaticsModel(m, env, frame)
     solver = StaticsSolver(model, 1e-10, 500)
@@ -394,8 +496,12 @@ def _chain_in_current():
     from stochcable.line.chain import initial_guess
     from stochcable.line.equilibrium import LocalFrame, StaticsModel
 
-    m, env, _ = make((-800, 0, -200), (0, 0, -20), [dict(CHAIN, elements=20)],
-                     current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}])
+    m, env, _ = make(
+        (-800, 0, -200),
+        (0, 0, -20),
+        [dict(CHAIN, elements=20)],
+        current=[{"z": 0.0, "speed": 0.5, "heading": 0.0}],
+    )
     frame = LocalFrame(m, env)
     model = StaticsModel(m, env, frame)
     return m, env, frame, model, initial_guess(m, env, frame, model)
@@ -414,8 +520,8 @@ def test_repeated_residual_reuses_the_same_numbers():
     for beta in (1.0, 0.5):
         b.beta = beta
         for X in (x, x2):
-            b.forces(X, tangent=False)           # remembered without the tangent ...
-            got = b.forces(X.copy())             # ... then asked again with it
+            b.forces(X, tangent=False)  # remembered without the tangent ...
+            got = b.forces(X.copy())  # ... then asked again with it
             drag_nodes = b.drag_nodes.copy()
             ref = StaticsModel(m, env, LocalFrame(m, env))  # fresh: no memory
             ref.beta = beta
@@ -455,13 +561,11 @@ def test_chain_shots_batched_end_equals_single_shots() -> None:
     rng = np.random.default_rng(11)
     H = np.exp(rng.uniform(np.log(1e-3 * total), np.log(10.0 * total), 60))
     # V0 from all lifted (> 0) through lifting part-way to never lifting (< -total)
-    V0 = np.r_[rng.uniform(-1.5 * total, 0.5 * total, 57), 0.2 * total, -0.5 * total,
-               -2.0 * total]
+    V0 = np.r_[rng.uniform(-1.5 * total, 0.5 * total, 57), 0.2 * total, -0.5 * total, -2.0 * total]
     for on_bed in (True, False):
         shoot, shoot_ends = chain_shots(mesh, model, a, zi, on_bed, kb)
         ends = shoot_ends(H, V0, P)
-        single = np.array([[shoot(h, v, P)[0][-1], shoot(h, v, P)[1][-1]]
-                           for h, v in zip(H, V0)])
+        single = np.array([[shoot(h, v, P)[0][-1], shoot(h, v, P)[1][-1]] for h, v in zip(H, V0)])
         assert np.array_equal(ends, single)  # bit-equal: the same float operations
 
 

@@ -167,12 +167,27 @@ def test_single_spectrum_equals_the_batched_form_to_the_bit(duration):
     (m0 = 0, m2 = 0 through a spectrum only at ω = 0, N < 1)."""
     rng = np.random.default_rng(7)
     w = np.r_[0.0, np.sort(rng.uniform(0.01, 4.0, 150))]
-    cases = [rng.uniform(0.0, 2.0, w.size) ** 3, np.zeros(w.size),
-             np.r_[1.0, np.zeros(w.size - 1)], np.exp(-((w - 1.0) / 0.05) ** 2)]
+    cases = [
+        rng.uniform(0.0, 2.0, w.size) ** 3,
+        np.zeros(w.size),
+        np.r_[1.0, np.zeros(w.size - 1)],
+        np.exp(-(((w - 1.0) / 0.05) ** 2)),
+    ]
     for s in cases:
         one = response_statistics(w, s, duration)
         row = response_statistics(w, s[None, :], duration)
-        for f in ("m0", "m1", "m2", "m4", "std", "tz", "significant", "bandwidth", "mpm",
-                  "expected_max", "n_cycles"):
+        for f in (
+            "m0",
+            "m1",
+            "m2",
+            "m4",
+            "std",
+            "tz",
+            "significant",
+            "bandwidth",
+            "mpm",
+            "expected_max",
+            "n_cycles",
+        ):
             assert isinstance(getattr(one, f), float)
             assert getattr(one, f) == float(getattr(row, f)[0]), f

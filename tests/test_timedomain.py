@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.errors import ConvergenceError, InputError
 from stochcable.dynamics.iteration import fixed_point
 from stochcable.dynamics.linearization import drag_linear_seed
 from stochcable.dynamics.solvers import solve_direct
+from stochcable.errors import ConvergenceError, InputError
 from stochcable.results.statistics import response_statistics
 from stochcable.sea.timeseries import LinearSystem, NonlinearSystem, newmark
 
@@ -48,7 +48,8 @@ def test_second_order_convergence_damped_forced():
 
     def exact(t):
         return (hss * np.exp(1j * big_w * t)).real + np.exp(-zeta * wn * t) * (
-            a_ * np.cos(wd * t) + b_ * np.sin(wd * t))
+            a_ * np.cos(wd * t) + b_ * np.sin(wd * t)
+        )
 
     errs = []
     for h in (0.02, 0.01, 0.005):
@@ -199,7 +200,7 @@ def test_drag_sdof_monte_carlo_against_statistical_linearization():
     np.testing.assert_allclose(flow.var(axis=1), np.sum(amp**2) / 2, rtol=1e-10)
     t = np.arange(n_t) * dt
     th = newmark(_DragOscillators(flow, dt), np.zeros(n_seeds), np.zeros(n_seeds), t, tol=1e-9)
-    sig_seeds = th.u[int(spin_up / dt):].std(axis=0)
+    sig_seeds = th.u[int(spin_up / dt) :].std(axis=0)
     sig_mc = sig_seeds.mean()
     se = sig_seeds.std(ddof=1) / math.sqrt(n_seeds)  # ~1 % of sigma with these settings
     sig_lin = _linearized_sigma_x()

@@ -40,14 +40,26 @@ def test_examples_in_feet_are_labelled_in_feet() -> None:
     assert unit_labels(metric.environment.g).length == "m"
 
 
-@pytest.mark.parametrize(("si", "feet"), [
-    ("m", "ft"), ("kg/m", "slug/ft"), ("N/m, N, N·m/rad", "lbf/ft, lbf, lbf·ft/rad"),
-    ("m/s²", "ft/s²"), ("kg/m³", "slug/ft³"), ("Pa·s/m", "(lbf/ft²)·s/ft"),
-    ("kg, kg·m, kg·m²", "slug, slug·ft, slug·ft²"),
-    # symbols that are not SI base symbols stay
-    ("rad/s", "rad/s"), ("s", "s"), ("deg", "deg"), ("-", "-"), ("1/s", "1/s"),
-    ("unit²·s/rad", "unit²·s/rad"), ("", ""),
-])
+@pytest.mark.parametrize(
+    ("si", "feet"),
+    [
+        ("m", "ft"),
+        ("kg/m", "slug/ft"),
+        ("N/m, N, N·m/rad", "lbf/ft, lbf, lbf·ft/rad"),
+        ("m/s²", "ft/s²"),
+        ("kg/m³", "slug/ft³"),
+        ("Pa·s/m", "(lbf/ft²)·s/ft"),
+        ("kg, kg·m, kg·m²", "slug, slug·ft, slug·ft²"),
+        # symbols that are not SI base symbols stay
+        ("rad/s", "rad/s"),
+        ("s", "s"),
+        ("deg", "deg"),
+        ("-", "-"),
+        ("1/s", "1/s"),
+        ("unit²·s/rad", "unit²·s/rad"),
+        ("", ""),
+    ],
+)
 def test_si_labels_converted_symbol_by_symbol(si: str, feet: str) -> None:
     assert FOOT_SLUG_SECOND.convert(si) == feet
     assert SI.convert(si) == si
@@ -57,18 +69,21 @@ def test_generic_labels_convert_to_words() -> None:
     assert unit_labels(1.0).convert("N·m") == "force unit·length unit"
 
 
-@pytest.mark.parametrize(("doc", "system"), [
-    ({"environment": {"g": 32.174}}, "foot-slug-second"),
-    ({"environment": {"g": 9.81}}, "SI"),
-    ({"environment": {}}, "SI"),                  # the scene's default g
-    ({"environment": {"g": "x"}}, "SI"),          # invalid g: the default's labels
-    ({"environment": {"g": -32.174}}, "SI"),
-    ({"environment": {"g": float("nan")}}, "SI"),
-    ({"environment": {"g": True}}, "SI"),
-    ({"environment": [1, 2]}, "SI"),
-    ([], "SI"),
-    (None, "SI"),
-])
+@pytest.mark.parametrize(
+    ("doc", "system"),
+    [
+        ({"environment": {"g": 32.174}}, "foot-slug-second"),
+        ({"environment": {"g": 9.81}}, "SI"),
+        ({"environment": {}}, "SI"),  # the scene's default g
+        ({"environment": {"g": "x"}}, "SI"),  # invalid g: the default's labels
+        ({"environment": {"g": -32.174}}, "SI"),
+        ({"environment": {"g": float("nan")}}, "SI"),
+        ({"environment": {"g": True}}, "SI"),
+        ({"environment": [1, 2]}, "SI"),
+        ([], "SI"),
+        (None, "SI"),
+    ],
+)
 def test_labels_of_a_document_that_may_be_invalid(doc, system: str) -> None:
     from stochcable.scene.units import labels_of_document
 
@@ -110,6 +125,9 @@ def test_validator_messages_quote_values_in_the_scene_units() -> None:
         doc = load_example(name).model_dump(mode="json", exclude_none=True)
         depth = doc["environment"]["depth"]
         doc["environment"]["current"] = [{"z": -2.0 * depth, "speed": 0.1}]
-        with pytest.raises(InputError, match=rf"z = {-2.0 * depth} {unit} is below the "
-                                             rf"seabed \(depth {depth} {unit}\)"):
+        with pytest.raises(
+            InputError,
+            match=rf"z = {-2.0 * depth} {unit} is below the "
+            rf"seabed \(depth {depth} {unit}\)",
+        ):
             load_scene(doc)

@@ -12,11 +12,9 @@ import pytest
 from scipy.integrate import quad_vec
 
 from stochcable import analysis
-from stochcable.dynamics import system as dsystem
 from stochcable.dynamics import blocks as dblocks
+from stochcable.dynamics import system as dsystem
 from stochcable.dynamics import variance as dvariance
-from stochcable.errors import InputError, ResolutionWarning
-from stochcable.examples import load_example
 from stochcable.dynamics.element_kinematics import element_wave_kinematics
 from stochcable.dynamics.loads import (
     Channel,
@@ -27,8 +25,10 @@ from stochcable.dynamics.loads import (
     line_channels,
     wave_loads,
 )
-from stochcable.sea.kinematics import wave_kinematics, wavenumber
+from stochcable.errors import InputError, ResolutionWarning
+from stochcable.examples import load_example
 from stochcable.scene.model import load_scene
+from stochcable.sea.kinematics import wave_kinematics, wavenumber
 from stochcable.statics import solve_statics
 
 G = 9.80665
@@ -37,17 +37,21 @@ RHO = 1025.0
 # (label, omega, node a, node b, heading, depth)
 ELEMENTS = [
     ("deep, short inclined", [0.3, 2.0], [0, 0, -30.0], [3, 1, -28.0], 0.3, math.inf),
-    ("deep, long inclined to the surface", [1.0, 4.0], [-20, 0, -14.0], [0, 0, 0.0], 0.0,
-     math.inf),
+    ("deep, long inclined to the surface", [1.0, 4.0], [-20, 0, -14.0], [0, 0, 0.0], 0.0, math.inf),
     ("deep, piercing the surface", [4.0], [-20, 0, -14.0], [0, 0, 5.0], 0.0, math.inf),
     ("deep, dry", [1.0], [0, 0, 1.0], [5, 0, 2.0], 0.0, math.inf),
-    ("deep, horizontal, many wavelengths", [3.0], [0, 0, -2.0], [40, 10, -2.0], 0.2,
-     math.inf),
+    ("deep, horizontal, many wavelengths", [3.0], [0, 0, -2.0], [40, 10, -2.0], 0.2, math.inf),
     ("finite, vertical full depth", [0.2, 1.5], [5, 0, -100.0], [5, 0, 0.0], 0.0, 100.0),
     ("finite, vertical tiny", [1.0], [0, 0, -50.0], [0, 0, -50.0 + 1e-6], 0.0, 60.0),
     ("shallow, horizontal", [0.5], [0, 0, -10.0], [40, 0, -10.0], 0.7, 10.0),
-    ("shallow, from the seabed through the surface", [0.3, 0.05], [0, 0, -10.0],
-     [3, 1, 3.0], 0.0, 10.0),
+    (
+        "shallow, from the seabed through the surface",
+        [0.3, 0.05],
+        [0, 0, -10.0],
+        [3, 1, 3.0],
+        0.0,
+        10.0,
+    ),
 ]
 
 
@@ -77,8 +81,9 @@ def quadrature(w, ra, rb, heading, depth):
     return mom, res[12:].reshape(3, 3), np.array(ends)
 
 
-@pytest.mark.parametrize("label, omega, ra, rb, heading, depth", ELEMENTS,
-                         ids=[e[0] for e in ELEMENTS])
+@pytest.mark.parametrize(
+    "label, omega, ra, rb, heading, depth", ELEMENTS, ids=[e[0] for e in ELEMENTS]
+)
 def test_closed_form_element_integrals_equal_quadrature(label, omega, ra, rb, heading, depth):
     el = element_wave_kinematics(omega, np.array([ra, rb]), heading, depth, G)
     for i, w in enumerate(omega):
@@ -87,11 +92,13 @@ def test_closed_form_element_integrals_equal_quadrature(label, omega, ra, rb, he
         # quad_vec to 1e-13 relative (1e-15 absolute); the closed forms are exact to
         # round-off (~1e-16 of the largest |v| on the element, times the phase k·χ ~ 100)
         assert np.abs(el.velocity[i, 0] - mom).max() <= 1e-11 * max(scale, w), label
-        assert np.abs(el.velocity_square[i, 0] - sq).max() <= 1e-11 * max(np.abs(sq).max(),
-                                                                           w * w), label
+        assert np.abs(el.velocity_square[i, 0] - sq).max() <= 1e-11 * max(
+            np.abs(sq).max(), w * w
+        ), label
         np.testing.assert_allclose(el.end_square[i, 0], ends, rtol=1e-12, atol=1e-300)
-    np.testing.assert_allclose(el.acceleration, el.velocity * (1j * np.asarray(omega))[:, None,
-                                                                                        None, None])
+    np.testing.assert_allclose(
+        el.acceleration, el.velocity * (1j * np.asarray(omega))[:, None, None, None]
+    )
 
 
 def test_no_overflow_and_closed_forms_for_extreme_elements():
@@ -111,12 +118,13 @@ def test_no_overflow_and_closed_forms_for_extreme_elements():
     exact = w[0] * math.exp(k * z0) * (1 - np.exp(-1j * k * length)) / (1j * k * length)
     assert abs(total - exact) <= 1e-12 * w[0] * math.exp(k * z0)  # phase round-off k·L·eps
     tiny = 1e-12 / k
-    el = element_wave_kinematics(w, np.array([[0, 0, -1.0], [0, 0, -1.0 + tiny]]), 0.0,
-                                 math.inf, G)
+    el = element_wave_kinematics(w, np.array([[0, 0, -1.0], [0, 0, -1.0 + tiny]]), 0.0, math.inf, G)
     # ∫(1 − ξ)e^{αξ} = 1/2 + α/6 + O(α²), ∫ξ e^{αξ} = 1/2 + α/3 + O(α²), α = 1e-12
-    np.testing.assert_allclose(el.velocity[0, 0, :, 0],
-                               w[0] * math.exp(-k) * np.array([0.5 + 1e-12 / 6, 0.5 + 1e-12 / 3]),
-                               rtol=1e-15)
+    np.testing.assert_allclose(
+        el.velocity[0, 0, :, 0],
+        w[0] * math.exp(-k) * np.array([0.5 + 1e-12 / 6, 0.5 + 1e-12 / 3]),
+        rtol=1e-15,
+    )
 
 
 def test_invalid_positions_are_rejected():
@@ -136,11 +144,26 @@ def vertical_doc(top: float, depth: float | None, elements: int) -> dict:
     length = (top - bottom) * (1.0 - 1e-6)
     return {
         "environment": {"depth": 1e4 if depth is None else depth, "rho": RHO, "g": G},
-        "lines": [{"name": "l", "end_a": {"position": [0.0, 0.0, bottom]},
-                   "end_b": {"position": [0.0, 0.0, top]},
-                   "segments": [{"length": length, "ea": 1e9, "mass": 200.0,
-                                 "diameter": 0.5, "cd_normal": 1.0, "cd_axial": 0.0,
-                                 "ca_normal": 1.0, "weight": 0.0, "elements": elements}]}],
+        "lines": [
+            {
+                "name": "l",
+                "end_a": {"position": [0.0, 0.0, bottom]},
+                "end_b": {"position": [0.0, 0.0, top]},
+                "segments": [
+                    {
+                        "length": length,
+                        "ea": 1e9,
+                        "mass": 200.0,
+                        "diameter": 0.5,
+                        "cd_normal": 1.0,
+                        "cd_axial": 0.0,
+                        "ca_normal": 1.0,
+                        "weight": 0.0,
+                        "elements": elements,
+                    }
+                ],
+            }
+        ],
         "sea": {"spectrum": {"type": "pierson_moskowitz", "hs": 3.0, "tp": 8.0}},
         "analysis": {"omega": {"min": 0.2, "max": 4.0, "count": 5}},
     }
@@ -170,16 +193,24 @@ def test_total_inertia_force_on_surface_piercing_cylinder(top, depth):
     coef = RHO * math.pi * 0.5**2 / 4 * 2.0
     z = model.positions[:, 2]
     np.testing.assert_allclose(model.positions[:, :2], 0.0, atol=1e-12)  # vertical
-    scale = model.l0 / model.length   # per element (the dry top element is more strained)
+    scale = model.l0 / model.length  # per element (the dry top element is more strained)
     if depth is None:
         # Σ_j (l0/l)_j ∫_{z_j}^{min(z_j+1, 0)} iω² e^{kz} dz; with uniform l0/l it is
         # iω²(1 − e^{−kL})/k
         k = w**2 / G
         z_wet = np.minimum(z[1:], 0.0)
-        expected = coef * 1j * w**2 * np.sum(
-            scale[:, None] * (np.exp(np.outer(z_wet, k)) - np.exp(np.outer(z[:-1], k))), axis=0) / k
-        np.testing.assert_allclose(expected, coef * 1j * w**2 * (1 - np.exp(-80 * k)) / k
-                                   * scale[0], rtol=1e-4)  # strain differences only
+        expected = (
+            coef
+            * 1j
+            * w**2
+            * np.sum(
+                scale[:, None] * (np.exp(np.outer(z_wet, k)) - np.exp(np.outer(z[:-1], k))), axis=0
+            )
+            / k
+        )
+        np.testing.assert_allclose(
+            expected, coef * 1j * w**2 * (1 - np.exp(-80 * k)) / k * scale[0], rtol=1e-4
+        )  # strain differences only
     else:
         assert np.ptp(scale) < 1e-15
         expected = coef * scale[0] * 1j * G * np.tanh(wavenumber(w, depth, G) * depth)
@@ -220,18 +251,22 @@ def test_wave_loads_equal_gauss_quadrature_on_inclined_line_with_drag():
             cuts = [0.0, za / (za - zb), 1.0]
         for lo, hi in zip(cuts[:-1], cuts[1:]):
             sub = np.linspace(lo, hi, 41)
-            xi = (0.5 * (sub[1:, None] + sub[:-1, None])
-                  + 0.5 * np.diff(sub)[:, None] * xg[None]).ravel()
+            xi = (
+                0.5 * (sub[1:, None] + sub[:-1, None]) + 0.5 * np.diff(sub)[:, None] * xg[None]
+            ).ravel()
             wx = (0.5 * np.diff(sub)[:, None] * wg[None]).ravel()
-            v = wave_kinematics(w, pos[j] + xi[:, None] * (pos[j + 1] - pos[j]),
-                                scene.sea.heading_rad, math.inf, G).velocity  # (P, 3, W)
-            load = (np.einsum("ik,pkw->pwi", blk, v)
-                    + ci * (1j * w)[None, :, None] * np.einsum("ik,pkw->pwi", np.eye(3) - ee, v))
+            v = wave_kinematics(
+                w, pos[j] + xi[:, None] * (pos[j + 1] - pos[j]), scene.sea.heading_rad, math.inf, G
+            ).velocity  # (P, 3, W)
+            load = np.einsum("ik,pkw->pwi", blk, v) + ci * (1j * w)[None, :, None] * np.einsum(
+                "ik,pkw->pwi", np.eye(3) - ee, v
+            )
             ref[:, j] += model.l0[j] * np.einsum("p,pwi->wi", wx * (1 - xi), load)
             ref[:, j + 1] += model.l0[j] * np.einsum("p,pwi->wi", wx * xi, load)
     # composite Gauss: exact to ~1e-15 for these smooth integrands (k·l <= 10 per panel)
-    np.testing.assert_allclose(f.reshape(w.size, -1, 3), ref, rtol=0,
-                               atol=1e-11 * np.abs(ref).max())
+    np.testing.assert_allclose(
+        f.reshape(w.size, -1, 3), ref, rtol=0, atol=1e-11 * np.abs(ref).max()
+    )
 
 
 @pytest.mark.parametrize("mass_matrix", ["consistent", "lumped"])
@@ -246,8 +281,15 @@ def test_uniform_field_loads_equal_the_matrix_products(mass_matrix):
     n_el = model.n_elements
     w = np.array([0.5, 1.0])
     v = np.broadcast_to(np.array([0.3, -0.1j, 0.2]), (w.size, model.n_nodes, 3))
-    ch = Channel("u", "sea", w, np.ones(2), lambda x: x, velocity=np.array(v),
-                 acceleration=np.array(v) * (1j * w)[:, None, None])
+    ch = Channel(
+        "u",
+        "sea",
+        w,
+        np.ones(2),
+        lambda x: x,
+        velocity=np.array(v),
+        acceleration=np.array(v) * (1j * w)[:, None, None],
+    )
     bn, bt = np.full(n_el, 30.0), np.full(n_el, 2.0)
     f = wave_loads(model, (ch,), bn, bt, g=G)
     ref = channel_loads(model, (ch,), drag_matrix(model, bn, bt), inertia_matrix(model, G))
@@ -255,8 +297,9 @@ def test_uniform_field_loads_equal_the_matrix_products(mass_matrix):
     # exact element data of a uniform field: the same loads
     mom = np.broadcast_to(0.5 * np.array(v)[:, :1, None, :], (w.size, n_el, 2, 3))
     ch2 = dataclasses.replace(ch, element_velocity=np.array(mom))
-    np.testing.assert_allclose(wave_loads(model, (ch2,), bn, bt, g=G), ref, rtol=1e-13,
-                               atol=1e-13 * np.abs(ref).max())
+    np.testing.assert_allclose(
+        wave_loads(model, (ch2,), bn, bt, g=G), ref, rtol=1e-13, atol=1e-13 * np.abs(ref).max()
+    )
 
 
 # ------------------------------------------------------- element-mean σ of v − U̇
@@ -293,14 +336,19 @@ def test_element_mean_sigma_with_moving_structure_equals_quadrature():
         for lo, hi in zip(cuts[:-1], cuts[1:]):
             xi = lo + (hi - lo) * 0.5 * (xg + 1)
             wx = (hi - lo) * 0.5 * wg
-            v = wave_kinematics(w, pos[j] + xi[:, None] * (pos[j + 1] - pos[j]),
-                                scene.sea.heading_rad, math.inf, G).velocity  # (P, 3, W)
-            us = (1 - xi)[:, None, None] * un[:, j].T[None] + xi[:, None, None] * un[:, j + 1].T[None]
+            v = wave_kinematics(
+                w, pos[j] + xi[:, None] * (pos[j + 1] - pos[j]), scene.sea.heading_rad, math.inf, G
+            ).velocity  # (P, 3, W)
+            us = (1 - xi)[:, None, None] * un[:, j].T[None] + xi[:, None, None] * un[:, j + 1].T[
+                None
+            ]
             vr = v - 1j * w[None, None, :] * us
-            var[j] += np.einsum("p,rpw,w->r", wx, np.abs(np.einsum("rk,pkw->rpw", rows[j], vr)) ** 2,
-                                qweights)
-    got = np.column_stack([sig[:n] ** 2, sig[n:2 * n] ** 2, sig[2 * n:3 * n] ** 2,
-                           sig[3 * n:4 * n] ** 2])
+            var[j] += np.einsum(
+                "p,rpw,w->r", wx, np.abs(np.einsum("rk,pkw->rpw", rows[j], vr)) ** 2, qweights
+            )
+    got = np.column_stack(
+        [sig[:n] ** 2, sig[n : 2 * n] ** 2, sig[2 * n : 3 * n] ** 2, sig[3 * n : 4 * n] ** 2]
+    )
     ref = var[:, [1, 2, 3, 0]]  # layout: s1, s2, s3, then axial
     # the Gauss rule is exact for the polynomial structural part and to ~1e-14 for the
     # exponential fluid part over k·Δz <= 8; the expanded square cancels to round-off
@@ -330,8 +378,13 @@ def test_inclined_guy_converges_and_warns_only_when_coarse():
             warnings.simplefilter("always")
             res = analysis.analyze(guy_doc(n))
         sig.append(res.lines["guy"].end_b.std)
-        warned.append(any(issubclass(r.category, ResolutionWarning)
-                          and "wave-velocity σ varies" in str(r.message) for r in rec))
+        warned.append(
+            any(
+                issubclass(r.category, ResolutionWarning)
+                and "wave-velocity σ varies" in str(r.message)
+                for r in rec
+            )
+        )
     assert all(a > b for a, b in zip(sig, sig[1:])), sig  # monotone
     rel = [s / sig[-1] - 1 for s in sig]
     assert 0 < rel[0] < 0.10 and rel[1] < 0.035 and rel[2] < 0.01, rel
@@ -340,9 +393,12 @@ def test_inclined_guy_converges_and_warns_only_when_coarse():
 
 @pytest.mark.filterwarnings("ignore::stochcable.errors.PhysicsWarning")
 def test_surface_warning_message_names_threshold_and_fix():
-    with pytest.warns(ResolutionWarning, match=r"line 'guy': the wave-velocity σ varies by a "
-                      r"factor 2\.\d+ along element 40 .*threshold 2\).*use at least \d+ "
-                      r"elements on segment 0 \(now 40\)"):
+    with pytest.warns(
+        ResolutionWarning,
+        match=r"line 'guy': the wave-velocity σ varies by a "
+        r"factor 2\.\d+ along element 40 .*threshold 2\).*use at least \d+ "
+        r"elements on segment 0 \(now 40\)",
+    ):
         analysis.analyze(guy_doc(40))
 
 

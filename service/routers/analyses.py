@@ -10,13 +10,12 @@ from typing import Annotated, Any, Literal
 from fastapi import APIRouter, Body, Query
 from starlette.responses import Response
 
+from service.dependencies import RunnerDep, SettingsDep
+from service.encoding import JSON, dumps, error_responses
+from service.errors import RunTimeExceeded
+from service.limits import check_scene
+from service.schemas import AnalysisResponse
 from stochcable.scene.model import Scene, load_scene
-
-from ..dependencies import RunnerDep, SettingsDep
-from ..encoding import JSON, dumps, error_responses
-from ..errors import RunTimeExceeded
-from ..limits import check_scene
-from ..schemas import AnalysisResponse
 
 __all__ = ["router", "WARNINGS_HEADER"]
 
@@ -44,26 +43,42 @@ def _body_examples() -> dict[str, dict[str, Any]]:
     out = {}
     for name in list_examples():
         scene = load_example(name)
-        out[name] = {"summary": name, "description": scene.title,
-                     "value": scene.model_dump(mode="json", exclude_defaults=True)}
+        out[name] = {
+            "summary": name,
+            "description": scene.title,
+            "value": scene.model_dump(mode="json", exclude_defaults=True),
+        }
     return out
 
 
 @router.post(
-    "/analyses", operation_id="run_analysis", response_model=AnalysisResponse,
-    responses={200: {"headers": {WARNINGS_HEADER: {
-        "description": "Number of warnings in the document's warnings list",
-        "schema": {"type": "integer", "minimum": 0}}}},
-        **error_responses(413, 422, 504)},
+    "/analyses",
+    operation_id="run_analysis",
+    response_model=AnalysisResponse,
+    responses={
+        200: {
+            "headers": {
+                WARNINGS_HEADER: {
+                    "description": "Number of warnings in the document's warnings list",
+                    "schema": {"type": "integer", "minimum": 0},
+                }
+            }
+        },
+        **error_responses(413, 422, 504),
+    },
     summary="Analyse a scene: statics, drag linearization, response statistics",
 )
 async def run_analysis(
     scene: Annotated[Scene, Body(openapi_examples=_body_examples())],
     settings: SettingsDep,
     runner: RunnerDep,
-    timeseries: Annotated[Timeseries, Query(
-        description="Time series in the document: the first 2048 samples (window), "
-        "all of them (full) or none; only when the scene has analysis.timeseries")] = "window",
+    timeseries: Annotated[
+        Timeseries,
+        Query(
+            description="Time series in the document: the first 2048 samples (window), "
+            "all of them (full) or none; only when the scene has analysis.timeseries"
+        ),
+    ] = "window",
 ) -> Response:
     """The v1 result document of :func:`stochcable.analysis.analyze` (seed 001 ch. 5):
     identical to ``stochcable analyze SCENE.json`` and ``analyze(scene).to_document()``
@@ -86,9 +101,15 @@ async def run_analysis(
     load_scene(scene, allow_files=False)
     check_scene(scene, settings)
     deadline = time.monotonic() + settings.max_run_seconds
-    body, n_warnings = await runner.run(_analysis, scene, timeseries, deadline,
-                                        settings.max_run_seconds, strict_fp=False,
-                                        exclusive="analysis")
+    body, n_warnings = await runner.run(
+        _analysis,
+        scene,
+        timeseries,
+        deadline,
+        settings.max_run_seconds,
+        strict_fp=False,
+        exclusive="analysis",
+    )
     return Response(body, media_type=JSON, headers={WARNINGS_HEADER: str(n_warnings)})
 
 
@@ -96,8 +117,7 @@ class _Abandoned(Exception):
     """Raised inside an analysis whose request already answered 504: stops the work."""
 
 
-def _analysis(scene: Scene, timeseries: str, deadline: float,
-              limit: float) -> tuple[bytes, int]:
+def _analysis(scene: Scene, timeseries: str, deadline: float, limit: float) -> tuple[bytes, int]:
     """Run the analysis (one at a time) and encode the result document.
 
     Past ``deadline`` (``limit`` seconds after the request arrived) the work stops

@@ -7,11 +7,10 @@ from typing import Annotated
 
 from fastapi import APIRouter, Path
 
+from service.encoding import error_responses
+from service.errors import NotFound
+from service.schemas import ExampleSummary
 from stochcable.scene.model import Scene
-
-from ..encoding import error_responses
-from ..errors import NotFound
-from ..schemas import ExampleSummary
 
 router = APIRouter(prefix="/v1", tags=["examples"])
 
@@ -23,21 +22,31 @@ def _catalog() -> dict[str, Scene]:
     return {name: load_example(name) for name in list_examples()}
 
 
-@router.get("/examples", operation_id="list_examples", response_model=list[ExampleSummary],
-            summary="List the example scenes")
+@router.get(
+    "/examples",
+    operation_id="list_examples",
+    response_model=list[ExampleSummary],
+    summary="List the example scenes",
+)
 def list_examples() -> list[ExampleSummary]:
     """Names and titles of the scenes shipped with stochcable."""
     return [ExampleSummary(name=n, title=s.title) for n, s in _catalog().items()]
 
 
-@router.get("/examples/{name}", operation_id="get_example", response_model=Scene,
-            responses=error_responses(404, 422), summary="Get an example scene document")
+@router.get(
+    "/examples/{name}",
+    operation_id="get_example",
+    response_model=Scene,
+    responses=error_responses(404, 422),
+    summary="Get an example scene document",
+)
 def get_example(
     name: Annotated[str, Path(max_length=64, description="Example name from GET /v1/examples")],
 ) -> Scene:
     """The scene document, ready for ``POST /v1/analyses`` or ``stochcable analyze``."""
     catalog = _catalog()
     if name not in catalog:
-        raise NotFound(["path", "name"],
-                       f"unknown example {name!r}; known examples: {', '.join(catalog)}")
+        raise NotFound(
+            ["path", "name"], f"unknown example {name!r}; known examples: {', '.join(catalog)}"
+        )
     return catalog[name]

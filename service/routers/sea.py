@@ -8,13 +8,12 @@ import numpy as np
 from fastapi import APIRouter
 from starlette.responses import Response
 
+from service.dependencies import MediaTypeDep, RunnerDep, SettingsDep
+from service.encoding import JSON, NPY, array_responses, columns_response, json_response
+from service.limits import check_points, check_samples
+from service.schemas import RealizationRequest, RealizationResponse
 from stochcable.sea.kinematics import kinematics_timeseries
 from stochcable.sea.realization import simulate_sea
-
-from ..dependencies import MediaTypeDep, RunnerDep, SettingsDep
-from ..encoding import JSON, NPY, array_responses, columns_response, json_response
-from ..limits import check_points, check_samples
-from ..schemas import RealizationRequest, RealizationResponse
 
 router = APIRouter(prefix="/v1", tags=["sea"])
 
@@ -27,12 +26,16 @@ _LAYOUT = (
 )
 
 
-@router.post("/sea/realizations", operation_id="simulate_sea",
-             response_model=RealizationResponse,
-             responses=array_responses(RealizationResponse, _LAYOUT, 413, 422, 504),
-             summary="Simulate a random sea realization and its wave kinematics")
-async def simulate_sea_realization(body: RealizationRequest, settings: SettingsDep,
-                                   runner: RunnerDep, media: MediaTypeDep) -> Response:
+@router.post(
+    "/sea/realizations",
+    operation_id="simulate_sea",
+    response_model=RealizationResponse,
+    responses=array_responses(RealizationResponse, _LAYOUT, 413, 422, 504),
+    summary="Simulate a random sea realization and its wave kinematics",
+)
+async def simulate_sea_realization(
+    body: RealizationRequest, settings: SettingsDep, runner: RunnerDep, media: MediaTypeDep
+) -> Response:
     """η(t) by :func:`stochcable.sea.realization.simulate_sea` (seed 001 §5.1; duration/dt must be an
     even number of samples) and, at ``points``, the velocity and acceleration by
     :func:`stochcable.sea.kinematics.kinematics_timeseries` from the same amplitudes.
@@ -53,8 +56,8 @@ def _mean_square(x: np.ndarray) -> float:
     buf = np.empty(min(_SQUARE_CHUNK, x.size))
     total = 0.0
     for a in range(0, x.size, _SQUARE_CHUNK):
-        seg = x[a:a + _SQUARE_CHUNK]
-        sq = buf[:seg.size]
+        seg = x[a : a + _SQUARE_CHUNK]
+        sq = buf[: seg.size]
         np.multiply(seg, seg, out=sq)
         total += float(np.add.reduce(sq))
     return total / x.size
@@ -73,16 +76,24 @@ def _realization(body: RealizationRequest, media: str) -> Response:
     stats = {"variance": variance, "m0": sea.m0}
     kin = None
     if body.points:
-        kin = kinematics_timeseries(sea, np.asarray(body.points, dtype=float),
-                                    math.radians(body.heading), body.depth_or_inf(), g)
+        kin = kinematics_timeseries(
+            sea,
+            np.asarray(body.points, dtype=float),
+            math.radians(body.heading),
+            body.depth_or_inf(),
+            g,
+        )
     if media == JSON:
         payload = {"time": sea.time, "elevation": sea.elevation, "stats": stats}
         if kin is not None:
             payload["kinematics"] = {"velocity": kin[0], "acceleration": kin[1]}
         return json_response(payload)
     # NPY: no time column (t_n = n·dt): it would double the answer for one known column
-    columns = {"elevation": sea.elevation} if media == NPY else {
-        "time": sea.time, "elevation": sea.elevation}
+    columns = (
+        {"elevation": sea.elevation}
+        if media == NPY
+        else {"time": sea.time, "elevation": sea.elevation}
+    )
     if kin is not None:
         for name, arr in (("velocity", kin[0]), ("acceleration", kin[1])):
             for p in range(arr.shape[0]):
@@ -90,5 +101,6 @@ def _realization(body: RealizationRequest, media: str) -> Response:
                     columns[f"{name}_{p}_{axis}"] = arr[p, c]
     # a finite sum of squares means every elevation sample is finite (the check the
     # encoder would otherwise repeat over the 8 MiB); kinematics columns are still checked
-    return columns_response(columns, media, stats,
-                            finite=("elevation",) if math.isfinite(variance) else ())
+    return columns_response(
+        columns, media, stats, finite=("elevation",) if math.isfinite(variance) else ()
+    )

@@ -182,8 +182,8 @@ class CoupledSystem:
         k = 0
         for body in self.bodies:
             d = body.n_dof
-            a[:, k:k + d, k:k + d] = body.added_mass_at(w)
-            b[:, k:k + d, k:k + d] = body.radiation_damping_at(w)
+            a[:, k : k + d, k : k + d] = body.added_mass_at(w)
+            b[:, k : k + d, k : k + d] = body.radiation_damping_at(w)
             k += d
         return a, b
 
@@ -277,21 +277,43 @@ def couple(
     def total(getter: Any, body_part: Any) -> tuple[sp.csr_array, sp.csr_array]:
         return _sum_links(getter, body_part, lines, bodies, maps, pres, body_dofs, n, n_p)
 
-    K, K_p = total(lambda ln: ln.model.K,
-                   lambda b: b.hydrostatic_stiffness + b.extra_stiffness + geo[b.name])
+    K, K_p = total(
+        lambda ln: ln.model.K, lambda b: b.hydrostatic_stiffness + b.extra_stiffness + geo[b.name]
+    )
     M, M_p = total(lambda ln: (ln.model.M + ln.model.Ma).tocsr(), lambda b: b.mass_matrix())
-    C, C_p = total(_line_damping, lambda b: b.extra_damping + (
-        square_matrix(f"body_damping[{b.name}]", bd[b.name], b.n_dof, "N·s/m") if b.name in bd
-        else 0.0))
+    C, C_p = total(
+        _line_damping,
+        lambda b: (
+            b.extra_damping
+            + (
+                square_matrix(f"body_damping[{b.name}]", bd[b.name], b.n_dof, "N·s/m")
+                if b.name in bd
+                else 0.0
+            )
+        ),
+    )
     for a in (K, M, C, K_p, M_p, C_p):
         a.eliminate_zeros()
-    return CoupledSystem(K=K, M=M, C=C, K_p=K_p, M_p=M_p, C_p=C_p, bodies=bodies,
-                         lines=lines, line_dofs=line_dofs, body_dofs=body_dofs,
-                         prescribed_dofs=pres, link_maps=maps, geometric=geo)
+    return CoupledSystem(
+        K=K,
+        M=M,
+        C=C,
+        K_p=K_p,
+        M_p=M_p,
+        C_p=C_p,
+        bodies=bodies,
+        lines=lines,
+        line_dofs=line_dofs,
+        body_dofs=body_dofs,
+        prescribed_dofs=pres,
+        link_maps=maps,
+        geometric=geo,
+    )
 
 
-def _dof_layout(lines: tuple[LineLink, ...], bodies: tuple[RigidBody, ...]
-                ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], int]:
+def _dof_layout(
+    lines: tuple[LineLink, ...], bodies: tuple[RigidBody, ...]
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray], int]:
     """Indices in x of each line's free DOFs and each body's DOFs (lines first), and
     the number n of coupled DOFs."""
     n_free = sum(int(ln.model.free.size) for ln in lines)
@@ -308,17 +330,20 @@ def _dof_layout(lines: tuple[LineLink, ...], bodies: tuple[RigidBody, ...]
     return line_dofs, body_dofs, n
 
 
-def _attachments(ln: LineLink, by_name: dict[str, RigidBody], g: float | None,
-                 geometric_stiffness: bool
-                 ) -> tuple[dict[int, tuple[RigidBody, np.ndarray]],
-                            list[tuple[str, np.ndarray]]]:
+def _attachments(
+    ln: LineLink, by_name: dict[str, RigidBody], g: float | None, geometric_stiffness: bool
+) -> tuple[dict[int, tuple[RigidBody, np.ndarray]], list[tuple[str, np.ndarray]]]:
     """The checked body attachments of a line: end node -> (body, arm r), and, with
     ``geometric_stiffness``, per attached end the body's attachment geometric stiffness
     of the static end force (:func:`stochcable.bodies.rigid.attachment_geometric_stiffness`)."""
     model = ln.model
     if not isinstance(model, FEModel):
-        raise InputError(f"lines[{ln.name}].model", type(model).__name__, "-",
-                         "must be a stochcable.line.fem.FEModel")
+        raise InputError(
+            f"lines[{ln.name}].model",
+            type(model).__name__,
+            "-",
+            "must be a stochcable.line.fem.FEModel",
+        )
     names = list(by_name)
     fixed_nodes = set((model.fixed // model.dim).tolist())
     attached: dict[int, tuple[RigidBody, np.ndarray]] = {}
@@ -328,36 +353,56 @@ def _attachments(ln: LineLink, by_name: dict[str, RigidBody], g: float | None,
         if bname is None:
             continue
         if bname not in by_name:
-            raise InputError(f"lines[{ln.name}].{end}", bname, "-",
-                             f"is not a body; bodies: {names}")
+            raise InputError(
+                f"lines[{ln.name}].{end}", bname, "-", f"is not a body; bodies: {names}"
+            )
         body = by_name[bname]
         if node not in fixed_nodes:
-            raise InputError(f"lines[{ln.name}].{end}", bname, "-",
-                             "the end node is free in the model: build it with the end "
-                             "prescribed (fixed_nodes)")
+            raise InputError(
+                f"lines[{ln.name}].{end}",
+                bname,
+                "-",
+                "the end node is free in the model: build it with the end prescribed (fixed_nodes)",
+            )
         if (model.dim == 2) != body.planar:
-            raise InputError(f"lines[{ln.name}].{end}", bname, "-",
-                             f"a {model.dim}-D line model needs a "
-                             f"{'planar' if model.dim == 2 else '6-DOF'} body")
+            raise InputError(
+                f"lines[{ln.name}].{end}",
+                bname,
+                "-",
+                f"a {model.dim}-D line model needs a "
+                f"{'planar' if model.dim == 2 else '6-DOF'} body",
+            )
         r = model.positions[node] - body.position
         if body.planar and abs(r[1]) > _SYM_TOL * max(1.0, float(np.abs(r).max())):
-            raise InputError(f"lines[{ln.name}].{end}", r.tolist(), "m",
-                             "a planar body's attachment must lie in its x–z plane")
+            raise InputError(
+                f"lines[{ln.name}].{end}",
+                r.tolist(),
+                "m",
+                "a planar body's attachment must lie in its x–z plane",
+            )
         fgiven = getattr(ln, "force_a" if end == "end_a" else "force_b")
-        f = (_model_end_force(model, end, g) if fgiven is None
-             else float_array(f"lines[{ln.name}].force_{end[-1]}", fgiven, "N"))
+        f = (
+            _model_end_force(model, end, g)
+            if fgiven is None
+            else float_array(f"lines[{ln.name}].force_{end[-1]}", fgiven, "N")
+        )
         if f.shape != (3,):
-            raise InputError(f"lines[{ln.name}].force_{end[-1]}", f.shape, "N",
-                             "must have 3 components")
+            raise InputError(
+                f"lines[{ln.name}].force_{end[-1]}", f.shape, "N", "must have 3 components"
+            )
         if geometric_stiffness:
             geometric.append((bname, attachment_geometric_stiffness(f, r, body.planar)))
         attached[node] = (body, r)
     return attached, geometric
 
 
-def _link_maps(model: FEModel, attached: dict[int, tuple[RigidBody, np.ndarray]],
-               free_dofs: np.ndarray, body_dofs: dict[str, np.ndarray], n: int
-               ) -> tuple[sp.csr_array, sp.csr_array]:
+def _link_maps(
+    model: FEModel,
+    attached: dict[int, tuple[RigidBody, np.ndarray]],
+    free_dofs: np.ndarray,
+    body_dofs: dict[str, np.ndarray],
+    n: int,
+) -> tuple[sp.csr_array, sp.csr_array]:
     """The sparse maps u_line = L x + P p of a line: identity from its free DOFs,
     T(r) from the body DOFs on an attached end node (seed 001 eqs. 3.3.6–3.3.7), P on
     its still-prescribed DOFs (model order)."""
@@ -379,19 +424,28 @@ def _link_maps(model: FEModel, attached: dict[int, tuple[RigidBody, np.ndarray]]
         rows.append(d * node + ii)
         cols.append(body_dofs[body.name][jj])
         vals.append(t[ii, jj])
-    L = sp.csr_array((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                     shape=(model.n_dof, n))
+    L = sp.csr_array(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(model.n_dof, n)
+    )
     still_arr = np.asarray(still, dtype=int)
-    P = sp.csr_array((np.ones(still_arr.size), (still_arr, np.arange(still_arr.size))),
-                     shape=(model.n_dof, still_arr.size))
+    P = sp.csr_array(
+        (np.ones(still_arr.size), (still_arr, np.arange(still_arr.size))),
+        shape=(model.n_dof, still_arr.size),
+    )
     return L, P
 
 
-def _sum_links(getter: Any, body_part: Any, lines: tuple[LineLink, ...],
-               bodies: tuple[RigidBody, ...],
-               maps: dict[str, tuple[sp.csr_array, sp.csr_array]],
-               pres: dict[str, np.ndarray], body_dofs: dict[str, np.ndarray], n: int,
-               n_p: int) -> tuple[sp.csr_array, sp.csr_array]:
+def _sum_links(
+    getter: Any,
+    body_part: Any,
+    lines: tuple[LineLink, ...],
+    bodies: tuple[RigidBody, ...],
+    maps: dict[str, tuple[sp.csr_array, sp.csr_array]],
+    pres: dict[str, np.ndarray],
+    body_dofs: dict[str, np.ndarray],
+    n: int,
+    n_p: int,
+) -> tuple[sp.csr_array, sp.csr_array]:
     """Σ L_ℓᵀ A_ℓ L_ℓ + the body blocks, and Σ L_ℓᵀ A_ℓ P_ℓ (seed 001 eq. 3.3.10),
     A_ℓ = ``getter(line)``, the body blocks ``body_part(body)``."""
     acc = sp.csr_array((n, n))
@@ -420,8 +474,12 @@ def _line_damping(ln: LineLink) -> Any:
         return ln.model.Cs
     c = ln.damping
     if c.shape != (ln.model.n_dof, ln.model.n_dof):
-        raise InputError(f"lines[{ln.name}].damping", c.shape, "N·s/m",
-                         f"must be ({ln.model.n_dof}, {ln.model.n_dof})")
+        raise InputError(
+            f"lines[{ln.name}].damping",
+            c.shape,
+            "N·s/m",
+            f"must be ({ln.model.n_dof}, {ln.model.n_dof})",
+        )
     return sp.csr_array(ln.model.Cs + sp.csr_array(c))
 
 
@@ -477,8 +535,9 @@ def coupled_load(
         f = np.asarray(f, dtype=complex)
         L, _ = system.link_maps[name]
         if f.shape[:2] != (n_w, L.shape[0]):
-            raise InputError(f"line_loads[{name}]", f.shape, "N",
-                             f"must start with ({n_w}, {L.shape[0]})")
+            raise InputError(
+                f"line_loads[{name}]", f.shape, "N", f"must start with ({n_w}, {L.shape[0]})"
+            )
         out = add(out, _rows_apply(L.T.tocsr(), f))
     for name, f in (body_loads or {}).items():
         if name not in system.body_dofs:
@@ -486,8 +545,9 @@ def coupled_load(
         f = np.asarray(f, dtype=complex)
         idx = system.body_dofs[name]
         if f.shape[:2] != (n_w, idx.size):
-            raise InputError(f"body_loads[{name}]", f.shape, "N",
-                             f"must start with ({n_w}, {idx.size})")
+            raise InputError(
+                f"body_loads[{name}]", f.shape, "N", f"must start with ({n_w}, {idx.size})"
+            )
         v = np.zeros((n_w, n) + f.shape[2:], dtype=complex)
         v[:, idx] = f
         out = add(out, v)
@@ -499,16 +559,20 @@ def coupled_load(
             u = np.asarray(u, dtype=complex)
             _, P = system.link_maps[name]
             if u.shape[:2] != (n_w, P.shape[0]):
-                raise InputError(f"line_motions[{name}]", u.shape, "m",
-                                 f"must start with ({n_w}, {P.shape[0]})")
+                raise InputError(
+                    f"line_motions[{name}]", u.shape, "m", f"must start with ({n_w}, {P.shape[0]})"
+                )
             if p is None:
                 p = np.zeros((n_w, system.n_prescribed) + u.shape[2:], dtype=complex)
             p[:, system.prescribed_dofs[name]] = _rows_apply(P.T.tocsr(), u)
         if p is not None:
             extra = (1,) * (p.ndim - 2)
             ww = w.reshape((n_w, 1) + extra)
-            z = (_rows_apply(system.K_p, p) - ww**2 * _rows_apply(system.M_p, p)
-                 + 1j * ww * _rows_apply(system.C_p, p))
+            z = (
+                _rows_apply(system.K_p, p)
+                - ww**2 * _rows_apply(system.M_p, p)
+                + 1j * ww * _rows_apply(system.C_p, p)
+            )
             out = add(out, -z)
     if out is None:
         return np.zeros((n_w, n), dtype=complex)
@@ -547,8 +611,9 @@ def expand_line(system: CoupledSystem, name: str, x: Any, p: Any | None = None) 
 # ------------------------------------------------------------------------- solve
 
 
-def constant_matrices(system: CoupledSystem, omega_ref: float
-                      ) -> tuple[sp.csr_array, sp.csr_array, sp.csr_array]:
+def constant_matrices(
+    system: CoupledSystem, omega_ref: float
+) -> tuple[sp.csr_array, sp.csr_array, sp.csr_array]:
     """K, M + A(ω_ref) and C + B(ω_ref): constant matrices for modes and Foss.
 
     Parameters

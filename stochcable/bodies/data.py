@@ -27,11 +27,11 @@ from typing import Any, Literal
 
 import numpy as np
 
-from stochcable.validation import nonnegative
 from stochcable.bodies.rigid import SPATIAL_DOFS, RigidBody
 from stochcable.bodies.tables import ExcitationTable, FrequencyTable
 from stochcable.errors import InputError
 from stochcable.scene.tables import SYMMETRY_TOLERANCE, checked_table, parse_table
+from stochcable.validation import nonnegative
 
 __all__ = [
     "Hydrodynamics",
@@ -95,25 +95,30 @@ class Hydrodynamics:
         """The added mass as a :class:`~stochcable.bodies.tables.FrequencyTable`."""
         return FrequencyTable(self.omega, self.added_mass, extrapolation)
 
-    def radiation_damping_table(self, extrapolation: Literal["error", "hold"] = "error"
-                                ) -> FrequencyTable:
+    def radiation_damping_table(
+        self, extrapolation: Literal["error", "hold"] = "error"
+    ) -> FrequencyTable:
         """The radiation damping as a :class:`~stochcable.bodies.tables.FrequencyTable`."""
         return FrequencyTable(self.omega, self.radiation_damping, extrapolation)
 
-    def excitation_table(self, extrapolation: Literal["error", "hold"] = "error"
-                         ) -> ExcitationTable | None:
+    def excitation_table(
+        self, extrapolation: Literal["error", "hold"] = "error"
+    ) -> ExcitationTable | None:
         """The excitation as an :class:`~stochcable.bodies.tables.ExcitationTable` (None if absent)."""
         if self.excitation is None:
             return None
         return ExcitationTable(self.omega, self.heading, self.excitation, extrapolation)
+
 
 # ---------------------------------------------------------------------- checks
 
 
 def _build(dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source, tol) -> Hydrodynamics:
     """The checked record (:func:`stochcable.scene.tables.checked_table`)."""
-    return Hydrodynamics(**checked_table(dofs, omega, am, bd, heading, exc, hs, ref,
-                                         exc_point, source, tol))
+    return Hydrodynamics(
+        **checked_table(dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source, tol)
+    )
+
 
 # ------------------------------------------------------------------- Capytaine
 
@@ -122,9 +127,12 @@ def _require_xarray():
     try:
         import xarray as xr
     except ImportError:  # pragma: no cover - exercised only without the extra
-        raise InputError("source", "Capytaine dataset", "-",
-                         "reading NetCDF needs xarray and netCDF4: pip install "
-                         "'stochcable[bodies]'") from None
+        raise InputError(
+            "source",
+            "Capytaine dataset",
+            "-",
+            "reading NetCDF needs xarray and netCDF4: pip install 'stochcable[bodies]'",
+        ) from None
     return xr
 
 
@@ -186,14 +194,22 @@ def read_capytaine(
         ds = ds.drop_vars("complex", errors="ignore")
     for req in ("added_mass", "radiation_damping"):
         if req not in ds:
-            raise InputError("source", name, "-", f"has no '{req}' variable (a Capytaine "
-                             "radiation dataset is needed)")
+            raise InputError(
+                "source",
+                name,
+                "-",
+                f"has no '{req}' variable (a Capytaine radiation dataset is needed)",
+            )
     if "omega" not in ds.coords:
         raise InputError("source", name, "-", "has no 'omega' coordinate")
     freq_dim = ds["omega"].dims[0] if ds["omega"].dims else None
     if freq_dim is None:
-        raise InputError("source", name, "-", "has a single scalar omega: at least one "
-                         "frequency dimension is needed")
+        raise InputError(
+            "source",
+            name,
+            "-",
+            "has a single scalar omega: at least one frequency dimension is needed",
+        )
     if "forward_speed" in ds.coords:
         fs = np.atleast_1d(ds["forward_speed"].values)
         if np.any(fs != 0):
@@ -206,23 +222,38 @@ def read_capytaine(
     def matrices(var):
         da = _squeeze_extra(ds[var], (freq_dim, "influenced_dof", "radiating_dof"), name)
         da = da.sel(influenced_dof=sel_i, radiating_dof=sel)
-        return np.asarray(da.transpose(freq_dim, "influenced_dof", "radiating_dof").values,
-                          dtype=float)[order]
+        return np.asarray(
+            da.transpose(freq_dim, "influenced_dof", "radiating_dof").values, dtype=float
+        )[order]
 
     am = matrices("added_mass")
     bd = matrices("radiation_damping")
     heading, exc = _capytaine_excitation(ds, name, freq_dim, sel_i, order)
     hs = None
     if "hydrostatic_stiffness" in ds:
-        da = _squeeze_extra(ds["hydrostatic_stiffness"], ("influenced_dof", "radiating_dof"),
-                            name)
-        hs = np.asarray(da.sel(influenced_dof=sel_i, radiating_dof=sel)
-                        .transpose("influenced_dof", "radiating_dof").values, dtype=float)
+        da = _squeeze_extra(ds["hydrostatic_stiffness"], ("influenced_dof", "radiating_dof"), name)
+        hs = np.asarray(
+            da.sel(influenced_dof=sel_i, radiating_dof=sel)
+            .transpose("influenced_dof", "radiating_dof")
+            .values,
+            dtype=float,
+        )
     ref = np.zeros(3)
     if "rotation_center" in ds:
         ref = np.asarray(ds["rotation_center"].values, dtype=float).reshape(3)
-    return _build(tuple(SPATIAL_DOFS), w, am, bd, heading, exc, hs, ref, -ref[:2],
-                  f"capytaine:{name}", nonnegative("symmetry_tolerance", symmetry_tolerance, "-"))
+    return _build(
+        tuple(SPATIAL_DOFS),
+        w,
+        am,
+        bd,
+        heading,
+        exc,
+        hs,
+        ref,
+        -ref[:2],
+        f"capytaine:{name}",
+        nonnegative("symmetry_tolerance", symmetry_tolerance, "-"),
+    )
 
 
 def _open_dataset(source: Any) -> tuple[Any, str]:
@@ -250,9 +281,13 @@ def _squeeze_extra(da: Any, keep: tuple[str, ...], name: str) -> Any:
         if dim in keep:
             continue
         if da.sizes[dim] != 1:
-            raise InputError("source", name, "-",
-                             f"variable '{da.name}' varies over '{dim}' "
-                             f"({da.sizes[dim]} values): select one before reading")
+            raise InputError(
+                "source",
+                name,
+                "-",
+                f"variable '{da.name}' varies over '{dim}' "
+                f"({da.sizes[dim]} values): select one before reading",
+            )
         da = da.isel({dim: 0})
     return da
 
@@ -264,18 +299,24 @@ def _capytaine_dofs(ds: Any) -> tuple[list[str], list[str]]:
     lower = {v.lower(): v for v in dofs_present}
     missing = [d for d in _CAPYTAINE_DOFS if d.lower() not in lower]
     if missing:
-        raise InputError("radiating_dof", dofs_present, "-",
-                         f"must include the six rigid-body DOFs; missing {missing}")
+        raise InputError(
+            "radiating_dof",
+            dofs_present,
+            "-",
+            f"must include the six rigid-body DOFs; missing {missing}",
+        )
     sel = [lower[d.lower()] for d in _CAPYTAINE_DOFS]
     infl = {str(v).lower(): str(v) for v in ds["influenced_dof"].values}
     if any(d.lower() not in infl for d in _CAPYTAINE_DOFS):
-        raise InputError("influenced_dof", list(infl.values()), "-",
-                         "must include the six rigid-body DOFs")
+        raise InputError(
+            "influenced_dof", list(infl.values()), "-", "must include the six rigid-body DOFs"
+        )
     return sel, [infl[d.lower()] for d in _CAPYTAINE_DOFS]
 
 
-def _capytaine_excitation(ds: Any, name: str, freq_dim: str, sel_i: list[str],
-                          order: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+def _capytaine_excitation(
+    ds: Any, name: str, freq_dim: str, sel_i: list[str], order: np.ndarray
+) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Headings [rad] (one turn from the first, increasing) and the excitation
     (n_h, 6, n_w), conjugated to e^{+iωt} (read_capytaine's Notes); None, None without
     an excitation (or diffraction + Froude–Krylov) force."""
@@ -289,8 +330,11 @@ def _capytaine_excitation(ds: Any, name: str, freq_dim: str, sel_i: list[str],
     fx = _squeeze_extra(fx, (freq_dim, "wave_direction", "influenced_dof"), name)
     if "wave_direction" not in fx.dims:
         fx = fx.expand_dims("wave_direction")
-        hvals = np.atleast_1d(ds["wave_direction"].values) if "wave_direction" in ds.coords \
+        hvals = (
+            np.atleast_1d(ds["wave_direction"].values)
+            if "wave_direction" in ds.coords
             else np.zeros(1)
+        )
     else:
         hvals = np.asarray(fx["wave_direction"].values, dtype=float)
     fx = fx.sel(influenced_dof=sel_i).transpose("wave_direction", "influenced_dof", freq_dim)
@@ -384,10 +428,16 @@ def body_from_hydrodynamics(
         raise InputError("planar", planar, "-", "a (surge, heave, pitch) table needs planar=True")
     hs = kw.pop("hydrostatic_stiffness", hydro.hydrostatic_stiffness)
     return RigidBody(
-        name=name, position=position, mass=mass, inertia=inertia, cog=cog,
+        name=name,
+        position=position,
+        mass=mass,
+        inertia=inertia,
+        cog=cog,
         added_mass=hydro.added_mass_table(extrapolation),
         radiation_damping=hydro.radiation_damping_table(extrapolation),
         hydrostatic_stiffness=hs,
         excitation=hydro.excitation_table(extrapolation),
-        excitation_point=hydro.excitation_point, planar=planar, **kw,
+        excitation_point=hydro.excitation_point,
+        planar=planar,
+        **kw,
     )

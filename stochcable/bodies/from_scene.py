@@ -12,16 +12,17 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from stochcable.bodies.rigid import RigidBody
 from stochcable.bodies.data import body_from_hydrodynamics, load_hydrodynamics, read_table
+from stochcable.bodies.rigid import RigidBody
 from stochcable.errors import InputError
 from stochcable.scene.model import Body, BodyHydrodynamicsFile, Environment, Scene
 
 __all__ = ["rigid_body_from_scene", "scene_rigid_bodies"]
 
 
-def rigid_body_from_scene(body: Body, *, planar: bool, environment: Environment,
-                          base_path: str | Path | None = None) -> RigidBody:
+def rigid_body_from_scene(
+    body: Body, *, planar: bool, environment: Environment, base_path: str | Path | None = None
+) -> RigidBody:
     """The :class:`~stochcable.bodies.rigid.RigidBody` of a scene body.
 
     Parameters
@@ -67,8 +68,9 @@ def rigid_body_from_scene(body: Body, *, planar: bool, environment: Environment,
     where = f"bodies[{body.name}]"
     try:
         if h is None:
-            return RigidBody(name=body.name, position=body.position, mass=body.mass,
-                             planar=planar, **kw)
+            return RigidBody(
+                name=body.name, position=body.position, mass=body.mass, planar=planar, **kw
+            )
         if isinstance(h, BodyHydrodynamicsFile):
             p = Path(h.file)
             if not p.is_absolute() and base_path is not None:
@@ -77,23 +79,43 @@ def rigid_body_from_scene(body: Body, *, planar: bool, environment: Environment,
         else:
             hydro = read_table(h.table())
         override = {k: kw.pop(k) for k in ("added_mass", "radiation_damping") if k in kw}
-        rb = body_from_hydrodynamics(hydro, body.name, body.position, body.mass,
-                                     planar=planar, extrapolation=body.extrapolation, **kw)
+        rb = body_from_hydrodynamics(
+            hydro,
+            body.name,
+            body.position,
+            body.mass,
+            planar=planar,
+            extrapolation=body.extrapolation,
+            **kw,
+        )
         if override:
             rb = RigidBody(**{**{f: getattr(rb, f) for f in _FIELDS}, **override})
         return rb
     except InputError as exc:
-        raise InputError(f"{where}.{exc.parameter}", exc.value, exc.unit,
-                         exc.constraint) from None
+        raise InputError(f"{where}.{exc.parameter}", exc.value, exc.unit, exc.constraint) from None
 
 
-_FIELDS = ("name", "position", "mass", "inertia", "cog", "added_mass", "radiation_damping",
-           "hydrostatic_stiffness", "excitation", "excitation_point", "drag_area",
-           "drag_point", "extra_stiffness", "extra_damping", "planar", "fixed_dofs")
+_FIELDS = (
+    "name",
+    "position",
+    "mass",
+    "inertia",
+    "cog",
+    "added_mass",
+    "radiation_damping",
+    "hydrostatic_stiffness",
+    "excitation",
+    "excitation_point",
+    "drag_area",
+    "drag_point",
+    "extra_stiffness",
+    "extra_damping",
+    "planar",
+    "fixed_dofs",
+)
 
 
-def scene_rigid_bodies(scene: Scene, base_path: str | Path | None = None
-                       ) -> dict[str, RigidBody]:
+def scene_rigid_bodies(scene: Scene, base_path: str | Path | None = None) -> dict[str, RigidBody]:
     """Every body of a scene as a RigidBody, by name (:func:`rigid_body_from_scene`).
 
     Parameters
@@ -108,5 +130,9 @@ def scene_rigid_bodies(scene: Scene, base_path: str | Path | None = None
         In scene order; planar (3 DOF) when ``scene.is_planar``.
     """
     planar = scene.is_planar
-    return {b.name: rigid_body_from_scene(b, planar=planar, environment=scene.environment,
-                                          base_path=base_path) for b in scene.bodies}
+    return {
+        b.name: rigid_body_from_scene(
+            b, planar=planar, environment=scene.environment, base_path=base_path
+        )
+        for b in scene.bodies
+    }

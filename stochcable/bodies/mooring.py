@@ -26,9 +26,15 @@ from stochcable.scene.model import Scene
 __all__ = ["mooring_stiffness", "mooring_stiffness_and_maps", "end_condensation", "pose_map"]
 
 
-def mooring_stiffness(scene: Scene, lines: dict[str, Any], poses: dict[str, np.ndarray],
-                      bodies: list[str], planar: bool, method: str = "auto",
-                      tolerance: float = 1e-10) -> np.ndarray:
+def mooring_stiffness(
+    scene: Scene,
+    lines: dict[str, Any],
+    poses: dict[str, np.ndarray],
+    bodies: list[str],
+    planar: bool,
+    method: str = "auto",
+    tolerance: float = 1e-10,
+) -> np.ndarray:
     """Quasi-static stiffness of the lines on the free bodies' DOFs.
 
     Parameters
@@ -57,15 +63,19 @@ def mooring_stiffness(scene: Scene, lines: dict[str, Any], poses: dict[str, np.n
         that the stiffness is that of the statics actually solved). [N/m, N, N·m/rad]
     """
     method, tolerance, _ = check_statics_options(method, tolerance, 500)
-    return mooring_stiffness_and_maps(scene, lines, poses, bodies, planar, method,
-                                      tolerance)[0]
+    return mooring_stiffness_and_maps(scene, lines, poses, bodies, planar, method, tolerance)[0]
 
 
-def mooring_stiffness_and_maps(scene: Scene, lines: dict[str, Any],
-                               poses: dict[str, np.ndarray], bodies: list[str],
-                               planar: bool, method: str, tolerance: float,
-                               end_position: Any = None
-                               ) -> tuple[np.ndarray, dict[str, tuple[list[str], np.ndarray]]]:
+def mooring_stiffness_and_maps(
+    scene: Scene,
+    lines: dict[str, Any],
+    poses: dict[str, np.ndarray],
+    bodies: list[str],
+    planar: bool,
+    method: str,
+    tolerance: float,
+    end_position: Any = None,
+) -> tuple[np.ndarray, dict[str, tuple[list[str], np.ndarray]]]:
     """:func:`mooring_stiffness` and, by line name, the ends on the bodies and the
     interior map S of :func:`end_condensation` (FE-solved lines only); ``method`` and
     ``tolerance`` checked (:func:`stochcable.line.statics.check_statics_options`).
@@ -78,9 +88,11 @@ def mooring_stiffness_and_maps(scene: Scene, lines: dict[str, Any],
     block = {nm: i * d for i, nm in enumerate(bodies)}
     pm = pose_map(poses)
     for ln in scene.lines:
-        ends = [(end, getattr(ln, end).attach.body) for end in ("end_a", "end_b")
-                if getattr(ln, end).attach is not None
-                and getattr(ln, end).attach.body in block]
+        ends = [
+            (end, getattr(ln, end).attach.body)
+            for end in ("end_a", "end_b")
+            if getattr(ln, end).attach is not None and getattr(ln, end).attach.body in block
+        ]
         if not ends:
             continue
         ls = lines[ln.name]
@@ -92,24 +104,27 @@ def mooring_stiffness_and_maps(scene: Scene, lines: dict[str, Any],
         comps = [0, 2] if planar else [0, 1, 2]
         tmat = []
         for end, bname in ends:
-            r = (scene.end_position(ln, end, pm) if end_position is None
-                 else end_position(ln, end, poses)) - poses[bname][:3]
+            r = (
+                scene.end_position(ln, end, pm)
+                if end_position is None
+                else end_position(ln, end, poses)
+            ) - poses[bname][:3]
             t = link_matrix(r, planar)
             tmat.append(t[comps] if t.shape[0] == 3 and planar else t)
             f = ls.force_a if end == "end_a" else ls.force_b
             i = block[bname]
-            K[i:i + d, i:i + d] += geometric_stiffness(f, r, planar)
+            K[i : i + d, i : i + d] += geometric_stiffness(f, r, planar)
         for p_, (_, bp) in enumerate(ends):
             for q_, (_, bq) in enumerate(ends):
-                kpq = ke[p_ * c:(p_ + 1) * c, q_ * c:(q_ + 1) * c]
+                kpq = ke[p_ * c : (p_ + 1) * c, q_ * c : (q_ + 1) * c]
                 i, j = block[bp], block[bq]
-                K[i:i + d, j:j + d] += tmat[p_].T @ kpq @ tmat[q_]
+                K[i : i + d, j : j + d] += tmat[p_].T @ kpq @ tmat[q_]
     return K, maps
 
 
-def end_condensation(scene: Scene, line: Any, ls: Any, ends: list[str], planar: bool,
-                     method: str, tolerance: float
-                     ) -> tuple[np.ndarray, np.ndarray | None]:
+def end_condensation(
+    scene: Scene, line: Any, ls: Any, ends: list[str], planar: bool, method: str, tolerance: float
+) -> tuple[np.ndarray, np.ndarray | None]:
     """Condensed end stiffness K_e = −dF/dx of the given ends of a line (2 or 3
     components each, the other end held) and, for an FE-solved line, the interior map S.
 
@@ -139,14 +154,18 @@ def end_condensation(scene: Scene, line: Any, ls: Any, ends: list[str], planar: 
                 pos[comp] += sgn * h
                 m2 = dataclasses.replace(mesh, **{e: pos})
                 l2 = line_statics(m2, env, method, None, tolerance, 500)
-                fs.append(np.concatenate([(l2.force_a if p == "end_a" else l2.force_b)[comps]
-                                          for p in ends]))
+                fs.append(
+                    np.concatenate(
+                        [(l2.force_a if p == "end_a" else l2.force_b)[comps] for p in ends]
+                    )
+                )
             out[:, q_ * c + k] = -(fs[0] - fs[1]) / (2.0 * h)
     return out, None
 
 
-def _fe_condensation(ls: Any, env: Any, ends: list[str], comps: list[int]
-                     ) -> tuple[np.ndarray, np.ndarray]:
+def _fe_condensation(
+    ls: Any, env: Any, ends: list[str], comps: list[int]
+) -> tuple[np.ndarray, np.ndarray]:
     """K_e and S of :func:`end_condensation` for an FE-solved line."""
     c = len(comps)
     mesh = ls.mesh
@@ -154,8 +173,9 @@ def _fe_condensation(ls: Any, env: Any, ends: list[str], comps: list[int]
     pos = np.asarray(ls.positions, dtype=float)[:, comps]
     dd = pos[1:] - pos[:-1]
     ll = np.sqrt(np.einsum("ij,ij->i", dd, dd))
-    k = stiffness_blocks(dd / ll[:, None], ll, mesh.l0, mesh.ea,
-                         np.asarray(ls.tension, dtype=float))  # (n_el, c, c)
+    k = stiffness_blocks(
+        dd / ll[:, None], ll, mesh.l0, mesh.ea, np.asarray(ls.tension, dtype=float)
+    )  # (n_el, c, c)
     diag = np.zeros((n, c, c))
     diag[:-1] += k
     diag[1:] += k
@@ -169,7 +189,7 @@ def _fe_condensation(ls: Any, env: Any, ends: list[str], comps: list[int]
     ne = len(ends)
     kbb = np.zeros((ne * c, ne * c))
     for p_, e in enumerate(ends):
-        kbb[p_ * c:(p_ + 1) * c, p_ * c:(p_ + 1) * c] = diag[node[e]]
+        kbb[p_ * c : (p_ + 1) * c, p_ * c : (p_ + 1) * c] = diag[node[e]]
     nf = n - 2
     if nf == 0:
         if ne == 2:
@@ -180,15 +200,16 @@ def _fe_condensation(ls: Any, env: Any, ends: list[str], comps: list[int]
     kfb = np.zeros((nf * c, ne * c))
     for p_, e in enumerate(ends):
         if e == "end_a":
-            kfb[:c, p_ * c:(p_ + 1) * c] = -k[0]
+            kfb[:c, p_ * c : (p_ + 1) * c] = -k[0]
         else:
-            kfb[(nf - 1) * c:, p_ * c:(p_ + 1) * c] = -k[-1]
+            kfb[(nf - 1) * c :, p_ * c : (p_ + 1) * c] = -k[-1]
     bw = 2 * c - 1
     rows, cols = block_band_indices(nf, c)
     ab = np.zeros((3 * bw + 1, nf * c), order="F")  # gbsv's layout (banded_solve)
     # diagonal blocks of the interior nodes, then the couplings −k_i (i = 1 … n−3)
-    ab[rows + bw, cols] = np.concatenate([diag[1:-1].ravel(), (-k[1:-1]).ravel(),
-                                          (-k[1:-1]).ravel()])
+    ab[rows + bw, cols] = np.concatenate(
+        [diag[1:-1].ravel(), (-k[1:-1]).ravel(), (-k[1:-1]).ravel()]
+    )
     S = banded_solve(ab, kfb, bw)
     return kbb - kfb.T @ S, S
 

@@ -38,9 +38,9 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.validation import float_array, nonnegative
-from stochcable.errors import InputError
 from stochcable.bodies.tables import ExcitationTable, FrequencyTable
+from stochcable.errors import InputError
+from stochcable.validation import float_array, nonnegative
 
 __all__ = [
     "SPATIAL_DOFS",
@@ -76,8 +76,9 @@ def skew(r: Any) -> np.ndarray:
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
-def rigid_body_mass_matrix(mass: float, inertia: Any, cog: Any = (0.0, 0.0, 0.0),
-                           planar: bool = False) -> np.ndarray:
+def rigid_body_mass_matrix(
+    mass: float, inertia: Any, cog: Any = (0.0, 0.0, 0.0), planar: bool = False
+) -> np.ndarray:
     """Rigid-body mass matrix about the reference point.
 
     Parameters
@@ -130,10 +131,13 @@ def square_matrix(name: str, value: Any, n: int, unit: str) -> np.ndarray:
 def _table_or_square(name: str, value: Any, n: int, unit: str) -> np.ndarray | FrequencyTable:
     if isinstance(value, FrequencyTable):
         if value.size == 6 and n == 3:
-            return FrequencyTable(value.omega, value.values[:, PLANAR_INDEX][:, :, PLANAR_INDEX],
-                                  value.extrapolation)
+            return FrequencyTable(
+                value.omega, value.values[:, PLANAR_INDEX][:, :, PLANAR_INDEX], value.extrapolation
+            )
         if value.size != n:
-            raise InputError(name, value.size, unit, f"table must hold ({n}, {n}) or (6, 6) matrices")
+            raise InputError(
+                name, value.size, unit, f"table must hold ({n}, {n}) or (6, 6) matrices"
+            )
         return value
     return square_matrix(name, value, n, unit)
 
@@ -229,35 +233,56 @@ class RigidBody:
         put(self, "planar", bool(self.planar))
         put(self, "position", _vec3("position", self.position, "m"))
         put(self, "mass", nonnegative("mass", self.mass, "kg"))
-        inertia = np.zeros((3, 3)) if self.inertia is None else float_array(
-            "inertia", self.inertia, "kg·m²", ndim=2)
+        inertia = (
+            np.zeros((3, 3))
+            if self.inertia is None
+            else float_array("inertia", self.inertia, "kg·m²", ndim=2)
+        )
         if inertia.shape != (3, 3):
             raise InputError("inertia", inertia.shape, "kg·m²", "must be a (3, 3) tensor")
-        if not np.allclose(inertia, inertia.T, rtol=1e-9, atol=1e-12 * max(1.0, np.abs(inertia).max())):
+        if not np.allclose(
+            inertia, inertia.T, rtol=1e-9, atol=1e-12 * max(1.0, np.abs(inertia).max())
+        ):
             raise InputError("inertia", inertia, "kg·m²", "must be symmetric")
         if np.linalg.eigvalsh(inertia).min() < -1e-9 * max(1.0, np.abs(inertia).max()):
             raise InputError("inertia", inertia, "kg·m²", "must be positive semi-definite")
         put(self, "inertia", inertia.copy())
         put(self, "cog", _vec3("cog", self.cog, "m"))
         put(self, "added_mass", _table_or_square("added_mass", self.added_mass, n, "kg"))
-        put(self, "radiation_damping",
-            _table_or_square("radiation_damping", self.radiation_damping, n, "N·s/m"))
-        put(self, "hydrostatic_stiffness",
-            square_matrix("hydrostatic_stiffness", self.hydrostatic_stiffness, n, "N/m"))
-        put(self, "extra_stiffness", square_matrix("extra_stiffness", self.extra_stiffness, n, "N/m"))
+        put(
+            self,
+            "radiation_damping",
+            _table_or_square("radiation_damping", self.radiation_damping, n, "N·s/m"),
+        )
+        put(
+            self,
+            "hydrostatic_stiffness",
+            square_matrix("hydrostatic_stiffness", self.hydrostatic_stiffness, n, "N/m"),
+        )
+        put(
+            self,
+            "extra_stiffness",
+            square_matrix("extra_stiffness", self.extra_stiffness, n, "N/m"),
+        )
         put(self, "extra_damping", square_matrix("extra_damping", self.extra_damping, n, "N·s/m"))
         exc = self.excitation
         if exc is not None:
             if not isinstance(exc, ExcitationTable):
-                raise InputError("excitation", type(exc).__name__, "-", "must be an ExcitationTable")
+                raise InputError(
+                    "excitation", type(exc).__name__, "-", "must be an ExcitationTable"
+                )
             if exc.size == 6 and n == 3:
-                exc = ExcitationTable(exc.omega, exc.heading, exc.values[:, PLANAR_INDEX, :],
-                                      exc.extrapolation)
+                exc = ExcitationTable(
+                    exc.omega, exc.heading, exc.values[:, PLANAR_INDEX, :], exc.extrapolation
+                )
             elif exc.size != n:
                 raise InputError("excitation", exc.size, "-", f"must have {n} or 6 DOFs")
             put(self, "excitation", exc)
-        ep = np.zeros(2) if self.excitation_point is None else float_array(
-            "excitation_point", self.excitation_point, "m")
+        ep = (
+            np.zeros(2)
+            if self.excitation_point is None
+            else float_array("excitation_point", self.excitation_point, "m")
+        )
         if ep.shape != (2,):
             raise InputError("excitation_point", ep.shape, "m", "must be (x, y)")
         put(self, "excitation_point", ep.copy())
@@ -273,8 +298,12 @@ class RigidBody:
         names = PLANAR_DOFS if self.planar else SPATIAL_DOFS
         bad = [f for f in fixed if f not in names]
         if bad:
-            raise InputError("fixed_dofs", list(fixed), "-",
-                             f"must name DOFs of the body among {list(names)}; unknown {bad}")
+            raise InputError(
+                "fixed_dofs",
+                list(fixed),
+                "-",
+                f"must name DOFs of the body among {list(names)}; unknown {bad}",
+            )
         if len(set(fixed)) != len(fixed):
             raise InputError("fixed_dofs", list(fixed), "-", "must not repeat a DOF")
         put(self, "fixed_dofs", fixed)
@@ -283,8 +312,7 @@ class RigidBody:
     def free_index(self) -> np.ndarray:
         """Indices (in ``dof_names`` order) of the DOFs not in ``fixed_dofs``."""
         names = self.dof_names
-        return np.array([i for i, n in enumerate(names) if n not in self.fixed_dofs],
-                        dtype=int)
+        return np.array([i for i, n in enumerate(names) if n not in self.fixed_dofs], dtype=int)
 
     @property
     def n_dof(self) -> int:
@@ -312,7 +340,8 @@ class RigidBody:
     def frequency_dependent(self) -> bool:
         """True when the added mass or the radiation damping is tabulated over ω."""
         return isinstance(self.added_mass, FrequencyTable) or isinstance(
-            self.radiation_damping, FrequencyTable)
+            self.radiation_damping, FrequencyTable
+        )
 
 
 def _matrix_at(a: np.ndarray | FrequencyTable, omega: Any) -> np.ndarray:
@@ -322,8 +351,9 @@ def _matrix_at(a: np.ndarray | FrequencyTable, omega: Any) -> np.ndarray:
     return np.broadcast_to(a, (w.size,) + a.shape).copy()
 
 
-def body_excitation(body: RigidBody, omega: Any, heading: float,
-                    wavenumber: Any | None = None) -> np.ndarray:
+def body_excitation(
+    body: RigidBody, omega: Any, heading: float, wavenumber: Any | None = None
+) -> np.ndarray:
     """Wave excitation force on a body per unit wave amplitude.
 
     Parameters
@@ -352,7 +382,9 @@ def body_excitation(body: RigidBody, omega: Any, heading: float,
     if wavenumber is not None:
         k = float_array("wavenumber", wavenumber, "rad/m", nonnegative=True)
         if k.shape != w.shape:
-            raise InputError("wavenumber", k.shape, "rad/m", f"must have one value per omega ({w.size})")
+            raise InputError(
+                "wavenumber", k.shape, "rad/m", f"must have one value per omega ({w.size})"
+            )
         x = body.position[0] + body.excitation_point[0]
         y = body.position[1] + body.excitation_point[1]
         f = f * np.exp(-1j * k * (x * math.cos(heading) + y * math.sin(heading)))[:, None]

@@ -52,14 +52,13 @@ from stochcable.bodies.rigid import (
     RigidBody,
     geometric_stiffness,
 )
-from stochcable.validation import positive, positive_int
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.mesh import mesh_line
 from stochcable.line.statics import check_statics_options, line_statics
 from stochcable.scene.model import Scene, rotate
+from stochcable.validation import positive, positive_int
 
-__all__ = ["BodyStatics", "solve_body_statics", "body_static_load",
-           "mooring_stiffness"]
+__all__ = ["BodyStatics", "solve_body_statics", "body_static_load", "mooring_stiffness"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,8 +133,9 @@ def _reduce(v6: np.ndarray, planar: bool) -> np.ndarray:
     return v6[list(PLANAR_INDEX)] if planar else v6
 
 
-def body_static_load(scene: Scene, name: str, pose: Any, rigid: RigidBody | None = None
-                     ) -> tuple[np.ndarray, np.ndarray]:
+def body_static_load(
+    scene: Scene, name: str, pose: Any, rigid: RigidBody | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Generalized static force on a body from everything but its lines.
 
     Parameters
@@ -219,10 +219,15 @@ def _geo6(force: np.ndarray, arm: np.ndarray) -> np.ndarray:
 # ---------------------------------------------------------------------- the solver
 
 
-def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float = 1e-10,
-                       max_iterations: int = 500, body_tolerance: float = 1e-8,
-                       max_body_iterations: int = 60
-                       ) -> tuple[dict[str, Any], dict[str, BodyStatics]]:
+def solve_body_statics(
+    scene: Scene,
+    method: str = "auto",
+    *,
+    tolerance: float = 1e-10,
+    max_iterations: int = 500,
+    body_tolerance: float = 1e-8,
+    max_body_iterations: int = 60,
+) -> tuple[dict[str, Any], dict[str, BodyStatics]]:
     """Static equilibrium of a scene with bodies: Newton on the free body poses.
 
     Parameters
@@ -260,16 +265,15 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
     """
     body_tolerance = positive("body_tolerance", body_tolerance, "-")
     max_body_iterations = positive_int("max_body_iterations", max_body_iterations)
-    method, tolerance, max_iterations = check_statics_options(method, tolerance,
-                                                              max_iterations)
+    method, tolerance, max_iterations = check_statics_options(method, tolerance, max_iterations)
     pb = _BodyPoses(scene, method, tolerance, max_iterations)
-    poses = {b.name: np.concatenate([np.asarray(b.position, float), np.zeros(3)])
-             for b in scene.bodies}
+    poses = {
+        b.name: np.concatenate([np.asarray(b.position, float), np.zeros(3)]) for b in scene.bodies
+    }
     fixed = pb.fixed_lines(poses)
     state = pb.first_state(poses, fixed)
     if pb.free and pb.sel.size:
-        _check_determined(state.K, pb.sel, pb.active, pb.free, pb.d, pb.planar, pb.lref,
-                          pb.dofs)
+        _check_determined(state.K, pb.sel, pb.active, pb.free, pb.d, pb.planar, pb.lref, pb.dofs)
     it = 0
     while state.r > body_tolerance and it < max_body_iterations and pb.sel.size:
         it += 1
@@ -279,12 +283,17 @@ def solve_body_statics(scene: Scene, method: str = "auto", *, tolerance: float =
         state = trial
     if state.r > body_tolerance:
         raise ConvergenceError(
-            "body statics Newton", it, state.r, body_tolerance,
-            hint=("check that the lines can hold the bodies (weight, buoyancy, wind): "
-                  "a body held only by lines slack on the frictionless seabed has an "
-                  "undetermined position; give initial positions near equilibrium, "
-                  "raise max_body_iterations or give fixed_dofs for DOFs without "
-                  "restoring"),
+            "body statics Newton",
+            it,
+            state.r,
+            body_tolerance,
+            hint=(
+                "check that the lines can hold the bodies (weight, buoyancy, wind): "
+                "a body held only by lines slack on the frictionless seabed has an "
+                "undetermined position; give initial positions near equilibrium, "
+                "raise max_body_iterations or give fixed_dofs for DOFs without "
+                "restoring"
+            ),
             partial={nm: state.poses[nm].copy() for nm in pb.free},
         )
     lines = {**fixed, **state.lines}
@@ -314,8 +323,7 @@ class _BodyPoses:
     a free body, re-solved at every trial pose; the other lines are solved once.
     """
 
-    def __init__(self, scene: Scene, method: str, tolerance: float,
-                 max_iterations: int) -> None:
+    def __init__(self, scene: Scene, method: str, tolerance: float, max_iterations: int) -> None:
         self.scene = scene
         self.method, self.tolerance, self.max_iterations = method, tolerance, max_iterations
         self.env = env = scene.environment
@@ -324,14 +332,20 @@ class _BodyPoses:
         self.dofs = PLANAR_DOFS if planar else SPATIAL_DOFS
         self.rigid = scene_rigid_bodies(scene)
         self.free = free = [b.name for b in scene.bodies if b.prescribed is None]
-        self.attached = {ln.name: {end: getattr(ln, end).attach.body
-                                   for end in ("end_a", "end_b")
-                                   if getattr(ln, end).attach is not None}
-                         for ln in scene.lines}
-        self.moving = [ln for ln in scene.lines
-                       if any(b in free for b in self.attached[ln.name].values())]
-        self.meshes = {ln.name: mesh_line(scene.resolved_line(ln), env.rho, env.g)
-                       for ln in self.moving}
+        self.attached = {
+            ln.name: {
+                end: getattr(ln, end).attach.body
+                for end in ("end_a", "end_b")
+                if getattr(ln, end).attach is not None
+            }
+            for ln in scene.lines
+        }
+        self.moving = [
+            ln for ln in scene.lines if any(b in free for b in self.attached[ln.name].values())
+        ]
+        self.meshes = {
+            ln.name: mesh_line(scene.resolved_line(ln), env.rho, env.g) for ln in self.moving
+        }
         self.comps = [0, 2] if planar else [0, 1, 2]
         self.c = len(self.comps)
         self._end_memo: dict[tuple, np.ndarray] = {}
@@ -343,8 +357,7 @@ class _BodyPoses:
                 if dn not in fixed:
                     self.active.append((nm, k))
         self.pos_in_block = {nm: i for i, nm in enumerate(free)}
-        self.sel = np.array([self.pos_in_block[nm] * d + k for nm, k in self.active],
-                            dtype=int)
+        self.sel = np.array([self.pos_in_block[nm] * d + k for nm, k in self.active], dtype=int)
         self.fref, self.lref = self._scales()
 
     def _scales(self) -> tuple[float, float]:
@@ -354,8 +367,12 @@ class _BodyPoses:
         fref = 0.0
         lref = 0.0
         for b in self.scene.bodies:
-            fref = max(fref, b.mass * env.g, env.rho * env.g * (b.displaced_volume or 0.0),
-                       float(np.linalg.norm(b.wind_force)))
+            fref = max(
+                fref,
+                b.mass * env.g,
+                env.rho * env.g * (b.displaced_volume or 0.0),
+                float(np.linalg.norm(b.wind_force)),
+            )
             for v in (b.cog, b.centre_of_buoyancy, b.drag_point):
                 lref = max(lref, float(np.linalg.norm(v)))
         for ln in self.scene.lines:
@@ -366,39 +383,49 @@ class _BodyPoses:
         return fref, (lref if lref > 0.0 else 1.0)
 
     def _line(self, mesh: Any, initial: np.ndarray | None = None) -> Any:
-        return line_statics(mesh, self.env, self.method, initial, self.tolerance,
-                            self.max_iterations)
+        return line_statics(
+            mesh, self.env, self.method, initial, self.tolerance, self.max_iterations
+        )
 
     def fixed_lines(self, poses: dict[str, np.ndarray]) -> dict[str, Any]:
         """The statics of the lines no free body moves, solved once."""
         env = self.env
-        return {ln.name: self._line(mesh_line(self.scene.resolved_line(ln, pose_map(poses)),
-                                              env.rho, env.g))
-                for ln in self.scene.lines if ln not in self.moving}
+        return {
+            ln.name: self._line(
+                mesh_line(self.scene.resolved_line(ln, pose_map(poses)), env.rho, env.g)
+            )
+            for ln in self.scene.lines
+            if ln not in self.moving
+        }
 
     def end_pos(self, ln: Any, end: str, pz: dict[str, np.ndarray]) -> np.ndarray:
         """``scene.end_position(ln, end, pose_map(pz))``, memoized on the attached
         body's pose (the lines' solve, the forces and the stiffness ask for the same
         ends at the same trial pose)."""
         a = getattr(ln, end).attach
-        key = (ln.name, end, None if a is None or a.body not in pz
-               else pz[a.body].tobytes())
+        key = (ln.name, end, None if a is None or a.body not in pz else pz[a.body].tobytes())
         hit = self._end_memo.get(key)
         if hit is None:
             hit = self._end_memo[key] = self.scene.end_position(ln, end, pose_map(pz))
         return hit.copy()
 
-    def solve_lines(self, pz: dict[str, np.ndarray], base: dict[str, Any] | None = None,
-                    maps: dict[str, tuple[list[str], np.ndarray]] | None = None
-                    ) -> dict[str, Any]:
+    def solve_lines(
+        self,
+        pz: dict[str, np.ndarray],
+        base: dict[str, Any] | None = None,
+        maps: dict[str, tuple[list[str], np.ndarray]] | None = None,
+    ) -> dict[str, Any]:
         """The moving lines at the poses pz, each FE line warm-started from its shape
         in ``base`` plus the first-order interior motion −S δx_ends (``maps``, the
         static condensation of its tangent); a cold start if that fails."""
         comps, c = self.comps, self.c
         out = {}
         for ln in self.moving:
-            mesh = replace(self.meshes[ln.name], end_a=self.end_pos(ln, "end_a", pz),
-                           end_b=self.end_pos(ln, "end_b", pz))
+            mesh = replace(
+                self.meshes[ln.name],
+                end_a=self.end_pos(ln, "end_a", pz),
+                end_b=self.end_pos(ln, "end_b", pz),
+            )
             prev = None if base is None else base.get(ln.name)
             init = None
             if prev is not None and prev.method == "fe":
@@ -406,9 +433,13 @@ class _BodyPoses:
                 m = None if maps is None else maps.get(ln.name)
                 if m is not None and m[1].size:
                     ends, smap = m
-                    dxb = np.concatenate([
-                        (mesh.end_a if e == "end_a" else mesh.end_b)[comps]
-                        - prev.positions[0 if e == "end_a" else -1, comps] for e in ends])
+                    dxb = np.concatenate(
+                        [
+                            (mesh.end_a if e == "end_a" else mesh.end_b)[comps]
+                            - prev.positions[0 if e == "end_a" else -1, comps]
+                            for e in ends
+                        ]
+                    )
                     init[1:-1, comps] -= (smap @ dxb).reshape(-1, c)
                 init[0], init[-1] = mesh.end_a, mesh.end_b
             try:
@@ -426,30 +457,37 @@ class _BodyPoses:
         try:
             ls = self.solve_lines(poses)
         except InputError as exc:
-            where = ", ".join(f"{nm} at {np.round(poses[nm][:3], 6).tolist()}"
-                              for nm in self.free)
-            raise InputError(exc.parameter, exc.value, exc.unit,
-                             f"{exc.constraint} (at the initial body positions: {where}; "
-                             "give positions near equilibrium with the lines neither slack "
-                             "on the seabed nor over-stretched)") from None
+            where = ", ".join(f"{nm} at {np.round(poses[nm][:3], 6).tolist()}" for nm in self.free)
+            raise InputError(
+                exc.parameter,
+                exc.value,
+                exc.unit,
+                f"{exc.constraint} (at the initial body positions: {where}; "
+                "give positions near equilibrium with the lines neither slack "
+                "on the seabed nor over-stretched)",
+            ) from None
         fref = self.fref
         for ln in self.moving:
             s = ls[ln.name]
-            fref = max(fref, float(s.tension.max(initial=0.0)), float(s.tension_a),
-                       float(s.tension_b))
+            fref = max(
+                fref, float(s.tension.max(initial=0.0)), float(s.tension_a), float(s.tension_b)
+            )
         self.fref = fref if fref > 0.0 else 1.0
         return self.state(poses, ls, fixed)
 
-    def state(self, pz: dict[str, np.ndarray], ls: dict[str, Any],
-              fixed: dict[str, Any]) -> _State:
+    def state(self, pz: dict[str, np.ndarray], ls: dict[str, Any], fixed: dict[str, Any]) -> _State:
         """The iterate at the poses pz with the moving lines ``ls`` solved there."""
         Q, K, lf, maps = self.forces(pz, ls, fixed)
-        return _State(poses=pz, lines=ls, Q=Q, K=K, line_forces=lf, maps=maps,
-                      r=self.scaled(Q))
+        return _State(poses=pz, lines=ls, Q=Q, K=K, line_forces=lf, maps=maps, r=self.scaled(Q))
 
-    def forces(self, pz: dict[str, np.ndarray], ls: dict[str, Any], fixed: dict[str, Any]
-               ) -> tuple[np.ndarray, np.ndarray, dict[str, dict[str, np.ndarray]],
-                          dict[str, tuple[list[str], np.ndarray]]]:
+    def forces(
+        self, pz: dict[str, np.ndarray], ls: dict[str, Any], fixed: dict[str, Any]
+    ) -> tuple[
+        np.ndarray,
+        np.ndarray,
+        dict[str, dict[str, np.ndarray]],
+        dict[str, tuple[list[str], np.ndarray]],
+    ]:
         """Generalized forces (n_free·d,), stiffness (n_free·d)², line forces, and the
         lines' interior maps (:func:`stochcable.bodies.mooring.mooring_stiffness_and_maps`)."""
         scene, planar, d = self.scene, self.planar, self.d
@@ -462,30 +500,43 @@ class _BodyPoses:
             attached = self.attached[ln.name]
             for end, bname in attached.items():
                 f = np.asarray(getattr(allls[ln.name], "force_" + end[-1]), dtype=float)
-                key = ln.name if len(attached) == 1 or \
-                    len(set(attached.values())) == 2 else f"{ln.name}.{end}"
+                key = (
+                    ln.name
+                    if len(attached) == 1 or len(set(attached.values())) == 2
+                    else f"{ln.name}.{end}"
+                )
                 lf[bname][key] = f
                 if bname not in pos_in_block:
                     continue
                 p = pz[bname]
                 arm = self.end_pos(ln, end, pz) - p[:3]
                 i = pos_in_block[bname] * d
-                Q[i:i + d] += _reduce(np.concatenate([f, _cross3(arm, f)]), planar)
+                Q[i : i + d] += _reduce(np.concatenate([f, _cross3(arm, f)]), planar)
         for nm in free:
             i = pos_in_block[nm] * d
             load, st = body_static_load(scene, nm, pz[nm], rigid[nm])
-            Q[i:i + d] += _reduce(load, planar)
-            K[i:i + d, i:i + d] += st[np.ix_(PLANAR_INDEX, PLANAR_INDEX)] if planar else st
-            K[i:i + d, i:i + d] += np.asarray(rigid[nm].extra_stiffness, float)
-            Q[i:i + d] -= np.asarray(rigid[nm].extra_stiffness, float) @ (
-                _reduce(pz[nm], planar) - _reduce(
-                    np.concatenate([np.asarray(scene.body(nm).position, float),
-                                    np.zeros(3)]), planar))
+            Q[i : i + d] += _reduce(load, planar)
+            K[i : i + d, i : i + d] += st[np.ix_(PLANAR_INDEX, PLANAR_INDEX)] if planar else st
+            K[i : i + d, i : i + d] += np.asarray(rigid[nm].extra_stiffness, float)
+            Q[i : i + d] -= np.asarray(rigid[nm].extra_stiffness, float) @ (
+                _reduce(pz[nm], planar)
+                - _reduce(
+                    np.concatenate([np.asarray(scene.body(nm).position, float), np.zeros(3)]),
+                    planar,
+                )
+            )
         maps: dict[str, tuple[list[str], np.ndarray]] = {}
         if free:
-            km, maps = mooring_stiffness_and_maps(scene, allls, pz, free, planar,
-                                                  self.method, self.tolerance,
-                                                  end_position=self.end_pos)
+            km, maps = mooring_stiffness_and_maps(
+                scene,
+                allls,
+                pz,
+                free,
+                planar,
+                self.method,
+                self.tolerance,
+                end_position=self.end_pos,
+            )
             K += km
         return Q, K, lf, maps
 
@@ -509,14 +560,21 @@ class _BodyPoses:
             p = state.poses[b.name]
             if b.name in self.pos_in_block:
                 i = self.pos_in_block[b.name] * d
-                st = state.K[i:i + d, i:i + d].copy()
+                st = state.K[i : i + d, i : i + d].copy()
                 res, iters = state.r, iterations
             else:
                 st, res, iters = np.zeros((d, d)), 0.0, 0
             out[b.name] = BodyStatics(
-                name=b.name, position=p[:3].copy(), rotation=p[3:].copy(),
-                line_forces=state.line_forces[b.name], iterations=iters, residual=res,
-                stiffness=st, dofs=self.dofs, prescribed=b.prescribed is not None)
+                name=b.name,
+                position=p[:3].copy(),
+                rotation=p[3:].copy(),
+                line_forces=state.line_forces[b.name],
+                iterations=iters,
+                residual=res,
+                stiffness=st,
+                dofs=self.dofs,
+                prescribed=b.prescribed is not None,
+            )
         return out
 
 
@@ -538,7 +596,7 @@ def _newton_step(pb: _BodyPoses, fixed: dict[str, Any], state: _State) -> _State
         trial = {nm: p.copy() for nm, p in state.poses.items()}
         for nm in pb.free:
             i = pb.pos_in_block[nm] * d
-            trial[nm] = trial[nm] + _full(step * dq[i:i + d], pb.planar)
+            trial[nm] = trial[nm] + _full(step * dq[i : i + d], pb.planar)
         try:
             ls_t = pb.solve_lines(trial, state.lines, state.maps)
             new = pb.state(trial, ls_t, fixed)
@@ -552,9 +610,16 @@ def _newton_step(pb: _BodyPoses, fixed: dict[str, Any], state: _State) -> _State
     return None
 
 
-def _check_determined(K: np.ndarray, sel: np.ndarray, active: list[tuple[str, int]],
-                      free: list[str], d: int, planar: bool, lref: float,
-                      dofs: tuple[str, ...]) -> None:
+def _check_determined(
+    K: np.ndarray,
+    sel: np.ndarray,
+    active: list[tuple[str, int]],
+    free: list[str],
+    d: int,
+    planar: bool,
+    lref: float,
+    dofs: tuple[str, ...],
+) -> None:
     """InputError naming a body DOF without restoring (singular K on the unknowns)."""
     scale = np.ones(len(free) * d)
     rot = [2] if planar else [3, 4, 5]
@@ -564,14 +629,23 @@ def _check_determined(K: np.ndarray, sel: np.ndarray, active: list[tuple[str, in
     big = float(np.abs(Ks).max(initial=0.0))
     if big == 0.0:
         nm, k = active[0]
-        raise InputError(f"bodies[{nm}].{dofs[k]}", 0.0, "N/m", "has no restoring force "
-                         "(no line, hydrostatic or extra stiffness): the static pose is "
-                         "undetermined; hold the DOF with fixed_dofs or add a stiffness")
+        raise InputError(
+            f"bodies[{nm}].{dofs[k]}",
+            0.0,
+            "N/m",
+            "has no restoring force "
+            "(no line, hydrostatic or extra stiffness): the static pose is "
+            "undetermined; hold the DOF with fixed_dofs or add a stiffness",
+        )
     u, s, vt = np.linalg.svd(Ks)
     if s[-1] <= 1e-10 * s[0]:
         j = int(np.argmax(np.abs(vt[-1])))
         nm, k = active[j]
-        raise InputError(f"bodies[{nm}].{dofs[k]}", float(s[-1] / s[0]), "-",
-                         "has no restoring force (the stiffness matrix is singular in "
-                         "this DOF): the static pose is undetermined; hold the DOF with "
-                         "fixed_dofs or add a hydrostatic or extra stiffness")
+        raise InputError(
+            f"bodies[{nm}].{dofs[k]}",
+            float(s[-1] / s[0]),
+            "-",
+            "has no restoring force (the stiffness matrix is singular in "
+            "this DOF): the static pose is undetermined; hold the DOF with "
+            "fixed_dofs or add a hydrostatic or extra stiffness",
+        )

@@ -16,8 +16,9 @@ from stochcable.validation import finite_scalar, float_array
 __all__ = ["FrequencyTable", "ExcitationTable"]
 
 
-def _interp_weights(table: np.ndarray, x: np.ndarray, name: str, unit: str,
-                    extrapolation: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _interp_weights(
+    table: np.ndarray, x: np.ndarray, name: str, unit: str, extrapolation: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Indices i, i+1 and weight t of the linear interpolation of x in a sorted table."""
     n = table.size
     if n == 1:
@@ -29,9 +30,13 @@ def _interp_weights(table: np.ndarray, x: np.ndarray, name: str, unit: str,
         out = (x < lo - slack) | (x > hi + slack)
         if out.any():
             bad = float(x[np.flatnonzero(out)[0]])
-            raise InputError(name, bad, unit,
-                             f"is outside the table [{lo:g}, {hi:g}]: extend the table or "
-                             "use extrapolation='hold'")
+            raise InputError(
+                name,
+                bad,
+                unit,
+                f"is outside the table [{lo:g}, {hi:g}]: extend the table or "
+                "use extrapolation='hold'",
+            )
     xc = np.clip(x, lo, hi)
     i = np.clip(np.searchsorted(table, xc, side="right") - 1, 0, n - 2)
     t = (xc - table[i]) / (table[i + 1] - table[i])
@@ -62,8 +67,12 @@ class FrequencyTable:
         w = float_array("omega", self.omega, "rad/s", nonnegative=True, increasing=True)
         v = float_array("values", self.values, "-", ndim=3)
         if v.shape[0] != w.size or v.shape[1] != v.shape[2]:
-            raise InputError("values", v.shape, "-",
-                             f"must have shape ({w.size}, d, d): one square matrix per omega")
+            raise InputError(
+                "values",
+                v.shape,
+                "-",
+                f"must have shape ({w.size}, d, d): one square matrix per omega",
+            )
         if self.extrapolation not in ("error", "hold"):
             raise InputError("extrapolation", self.extrapolation, "-", "must be 'error' or 'hold'")
         object.__setattr__(self, "omega", w.copy())
@@ -90,9 +99,13 @@ def _heading_weights(table: np.ndarray, beta: float) -> tuple[int, int, float]:
     if n == 1:
         if min(abs(b - table[0]), two_pi - abs(b - table[0])) <= tol:
             return 0, 0, 0.0
-        raise InputError("heading", math.degrees(beta), "deg",
-                         f"is not in the excitation table (one heading, "
-                         f"{math.degrees(table[0]):g} deg): add headings to the table")
+        raise InputError(
+            "heading",
+            math.degrees(beta),
+            "deg",
+            f"is not in the excitation table (one heading, "
+            f"{math.degrees(table[0]):g} deg): add headings to the table",
+        )
     if b <= table[-1] + tol:
         i = int(np.clip(np.searchsorted(table, b, side="right") - 1, 0, n - 2))
         t = float(np.clip((b - table[i]) / (table[i + 1] - table[i]), 0.0, 1.0))
@@ -102,9 +115,13 @@ def _heading_weights(table: np.ndarray, beta: float) -> tuple[int, int, float]:
         return 0, 0, 0.0
     if gap <= np.diff(table).max() * (1 + 1e-9):  # a full-circle table: wrap around
         return n - 1, 0, float((b - table[-1]) / gap)
-    raise InputError("heading", math.degrees(beta), "deg",
-                     f"is outside the excitation table's headings "
-                     f"[{math.degrees(table[0]):g}, {math.degrees(table[-1]):g}] deg")
+    raise InputError(
+        "heading",
+        math.degrees(beta),
+        "deg",
+        f"is outside the excitation table's headings "
+        f"[{math.degrees(table[0]):g}, {math.degrees(table[-1]):g}] deg",
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,8 +161,9 @@ class ExcitationTable:
             raise InputError("heading", h, "rad", "must span less than 2π")
         v = np.asarray(self.values, dtype=complex)
         if v.ndim != 3 or v.shape[0] != h.size or v.shape[2] != w.size:
-            raise InputError("values", v.shape, "-",
-                             f"must have shape (n_heading={h.size}, d, n_omega={w.size})")
+            raise InputError(
+                "values", v.shape, "-", f"must have shape (n_heading={h.size}, d, n_omega={w.size})"
+            )
         if not np.isfinite(v).all():
             raise InputError("values", "non-finite", "N/m", "must be finite")
         if self.extrapolation not in ("error", "hold"):

@@ -86,7 +86,9 @@ def require_matplotlib():
         import matplotlib.pyplot as plt
     except ImportError:
         raise InputError(
-            "--plot", "requested", "-",
+            "--plot",
+            "requested",
+            "-",
             "needs matplotlib: pip install 'stochcable[plot]'",
         ) from None
     return plt
@@ -101,4 +103,6 @@ def read_json_file(name: str, path: str) -> Any:
     try:
         return json.loads(text)
     except json.JSONDecodeError as exc:
-        raise InputError(name, path, "-", f"is not valid JSON ({exc.msg} at line {exc.lineno})") from None
+        raise InputError(
+            name, path, "-", f"is not valid JSON ({exc.msg} at line {exc.lineno})"
+        ) from None

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as v
-from stochcable.sea import spectra
 from stochcable.errors import InputError
+from stochcable.sea import spectra
 
 __all__ = ["SPECTRUM_TYPES", "add_spectrum_arguments", "SpectrumChoice", "spectrum_from_args"]
 
@@ -26,30 +26,51 @@ SPECTRUM_TYPES = ("pm", "jonswap", "bretschneider", "issc", "ochi-hubble", "tabl
 
 def add_spectrum_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the spectrum type and its parameters to ``parser``."""
-    parser.add_argument("type", choices=SPECTRUM_TYPES,
-                        help="spectrum: pm (Pierson-Moskowitz), jonswap, bretschneider, "
-                             "issc (ITTC, Hs and T1), ochi-hubble (two peaks), table (CSV)")
+    parser.add_argument(
+        "type",
+        choices=SPECTRUM_TYPES,
+        help="spectrum: pm (Pierson-Moskowitz), jonswap, bretschneider, "
+        "issc (ITTC, Hs and T1), ochi-hubble (two peaks), table (CSV)",
+    )
     grp = parser.add_argument_group("spectrum parameters (SI; periods in s, --fp in Hz)")
     grp.add_argument("--hs", type=float, help="significant wave height 4*sqrt(m0) [m]")
     grp.add_argument("--tp", type=float, help="peak period [s]")
     grp.add_argument("--fp", type=float, help="peak frequency [Hz] (instead of --tp)")
-    grp.add_argument("--omega-p", type=float, help="peak angular frequency [rad/s] (instead of --tp)")
-    grp.add_argument("--m0", type=float, help="pm: zeroth moment m0 = Hs^2/16 [m^2] (instead of --hs)")
-    grp.add_argument("--wind-speed", type=float,
-                     help="pm: wind speed at 19.5 m [m/s] (instead of --hs/--tp)")
-    grp.add_argument("--g", type=float, default=spectra.G_STANDARD,
-                     help="gravity for --wind-speed [m/s^2] (default 9.80665)")
-    grp.add_argument("--gamma", type=float, default=3.3, help="jonswap: peak enhancement [-] (default 3.3)")
-    grp.add_argument("--sigma-a", type=float, default=0.07, help="jonswap: width below peak [-] (default 0.07)")
-    grp.add_argument("--sigma-b", type=float, default=0.09, help="jonswap: width above peak [-] (default 0.09)")
+    grp.add_argument(
+        "--omega-p", type=float, help="peak angular frequency [rad/s] (instead of --tp)"
+    )
+    grp.add_argument(
+        "--m0", type=float, help="pm: zeroth moment m0 = Hs^2/16 [m^2] (instead of --hs)"
+    )
+    grp.add_argument(
+        "--wind-speed", type=float, help="pm: wind speed at 19.5 m [m/s] (instead of --hs/--tp)"
+    )
+    grp.add_argument(
+        "--g",
+        type=float,
+        default=spectra.G_STANDARD,
+        help="gravity for --wind-speed [m/s^2] (default 9.80665)",
+    )
+    grp.add_argument(
+        "--gamma", type=float, default=3.3, help="jonswap: peak enhancement [-] (default 3.3)"
+    )
+    grp.add_argument(
+        "--sigma-a", type=float, default=0.07, help="jonswap: width below peak [-] (default 0.07)"
+    )
+    grp.add_argument(
+        "--sigma-b", type=float, default=0.09, help="jonswap: width above peak [-] (default 0.09)"
+    )
     grp.add_argument("--t1", type=float, help="issc: mean period T1 = Tm01 [s]")
     for j, what in ((1, "swell (low-frequency)"), (2, "wind sea (high-frequency)")):
         grp.add_argument(f"--hs{j}", type=float, help=f"ochi-hubble: {what} Hs [m]")
         grp.add_argument(f"--tp{j}", type=float, help=f"ochi-hubble: {what} peak period [s]")
         grp.add_argument(f"--lambda{j}", type=float, help=f"ochi-hubble: {what} shape [-]")
-    grp.add_argument("--table", metavar="CSV",
-                     help="table: CSV file with columns omega [rad/s], density [m^2 s/rad] "
-                          "(optional header line)")
+    grp.add_argument(
+        "--table",
+        metavar="CSV",
+        help="table: CSV file with columns omega [rad/s], density [m^2 s/rad] "
+        "(optional header line)",
+    )
 
 
 @dataclass(frozen=True)
@@ -70,14 +91,23 @@ def _need(args: argparse.Namespace, attr: str, flag: str, kind: str) -> Any:
 
 
 def _peak_omega(args: argparse.Namespace, kind: str, required: bool = True) -> float | None:
-    given = [(f, x) for f, x in (("--tp", args.tp), ("--fp", args.fp), ("--omega-p", args.omega_p))
-             if x is not None]
+    given = [
+        (f, x)
+        for f, x in (("--tp", args.tp), ("--fp", args.fp), ("--omega-p", args.omega_p))
+        if x is not None
+    ]
     if len(given) > 1:
-        raise InputError(given[1][0], given[1][1], "-",
-                         f"give only one of --tp, --fp, --omega-p (also got {given[0][0]})")
+        raise InputError(
+            given[1][0],
+            given[1][1],
+            "-",
+            f"give only one of --tp, --fp, --omega-p (also got {given[0][0]})",
+        )
     if not given:
         if required:
-            raise InputError("--tp", None, "s", f"is required for the {kind} spectrum (or --fp / --omega-p)")
+            raise InputError(
+                "--tp", None, "s", f"is required for the {kind} spectrum (or --fp / --omega-p)"
+            )
         return None
     flag, x = given[0]
     if flag == "--tp":
@@ -105,7 +135,9 @@ def _read_table(path: str) -> tuple[np.ndarray, np.ndarray]:
             if not rows and not header_seen:
                 header_seen = True
                 continue  # header line
-            raise InputError("--table", path, "-", f"line {i} is not two numbers: {line!r}") from None
+            raise InputError(
+                "--table", path, "-", f"line {i} is not two numbers: {line!r}"
+            ) from None
         if len(vals) != 2:
             raise InputError("--table", path, "-", f"line {i} must have 2 columns (omega,density)")
         rows.append(vals)
@@ -125,9 +157,12 @@ def spectrum_from_args(args: argparse.Namespace) -> SpectrumChoice:
             u = v.positive("--wind-speed", args.wind_speed, "m/s")
             g = v.positive("--g", args.g, "m/s²")
             m0 = 0.0081 * u**4 / (4.0 * 0.74 * g * g)
-            return SpectrumChoice("pierson_moskowitz_wind",
-                                  lambda w: spectra.spectrum_pierson_moskowitz_wind(w, u, g),
-                                  m0, {"wind_speed": u, "g": g})
+            return SpectrumChoice(
+                "pierson_moskowitz_wind",
+                lambda w: spectra.spectrum_pierson_moskowitz_wind(w, u, g),
+                m0,
+                {"wind_speed": u, "g": g},
+            )
         wp = _peak_omega(args, kind)
         if kind == "pm" and args.m0 is not None:
             if args.hs is not None:
@@ -136,38 +171,55 @@ def spectrum_from_args(args: argparse.Namespace) -> SpectrumChoice:
         else:
             m0 = v.positive("--hs", _need(args, "hs", "--hs", kind), "m") ** 2 / 16.0
         name = "pierson_moskowitz" if kind == "pm" else "bretschneider"
-        return SpectrumChoice(name, lambda w: spectra.spectrum_pierson_moskowitz_m0(w, m0, wp),
-                              m0, {"m0": m0, "hs": 4.0 * math.sqrt(m0), "omega_p": wp,
-                                   "tp": 2.0 * math.pi / wp})
+        return SpectrumChoice(
+            name,
+            lambda w: spectra.spectrum_pierson_moskowitz_m0(w, m0, wp),
+            m0,
+            {"m0": m0, "hs": 4.0 * math.sqrt(m0), "omega_p": wp, "tp": 2.0 * math.pi / wp},
+        )
     if kind == "jonswap":
         hs = v.positive("--hs", _need(args, "hs", "--hs", kind), "m")
         tp = 2.0 * math.pi / _peak_omega(args, kind)
         gamma = v.in_range("--gamma", args.gamma, "-", lo=1.0)
         sa = v.positive("--sigma-a", args.sigma_a, "-")
         sb = v.positive("--sigma-b", args.sigma_b, "-")
-        return SpectrumChoice("jonswap", lambda w: spectra.spectrum_jonswap(w, hs, tp, gamma, sa, sb),
-                              hs * hs / 16.0, {"hs": hs, "tp": tp, "gamma": gamma,
-                                               "sigma_a": sa, "sigma_b": sb})
+        return SpectrumChoice(
+            "jonswap",
+            lambda w: spectra.spectrum_jonswap(w, hs, tp, gamma, sa, sb),
+            hs * hs / 16.0,
+            {"hs": hs, "tp": tp, "gamma": gamma, "sigma_a": sa, "sigma_b": sb},
+        )
     if kind == "issc":
         hs = v.positive("--hs", _need(args, "hs", "--hs", kind), "m")
         t1 = v.positive("--t1", _need(args, "t1", "--t1", kind), "s")
-        return SpectrumChoice("issc", lambda w: spectra.spectrum_issc(w, hs, t1),
-                              hs * hs / 16.0, {"hs": hs, "t1": t1})
+        return SpectrumChoice(
+            "issc", lambda w: spectra.spectrum_issc(w, hs, t1), hs * hs / 16.0, {"hs": hs, "t1": t1}
+        )
     if kind == "ochi-hubble":
         p = {}
         for j in (1, 2):
             p[f"hs{j}"] = v.nonnegative(f"--hs{j}", _need(args, f"hs{j}", f"--hs{j}", kind), "m")
             p[f"tp{j}"] = v.positive(f"--tp{j}", _need(args, f"tp{j}", f"--tp{j}", kind), "s")
-            p[f"lambda{j}"] = v.positive(f"--lambda{j}", _need(args, f"lambda{j}", f"--lambda{j}", kind), "-")
+            p[f"lambda{j}"] = v.positive(
+                f"--lambda{j}", _need(args, f"lambda{j}", f"--lambda{j}", kind), "-"
+            )
         if p["hs1"] == 0.0 and p["hs2"] == 0.0:
             raise InputError("--hs1", 0.0, "m", "--hs1 and --hs2 must not both be 0")
-        return SpectrumChoice("ochi_hubble", lambda w: spectra.spectrum_ochi_hubble(w, **p),
-                              (p["hs1"] ** 2 + p["hs2"] ** 2) / 16.0, p)
+        return SpectrumChoice(
+            "ochi_hubble",
+            lambda w: spectra.spectrum_ochi_hubble(w, **p),
+            (p["hs1"] ** 2 + p["hs2"] ** 2) / 16.0,
+            p,
+        )
     # table
     path = _need(args, "table", "--table", kind)
     wt, st = _read_table(path)
     m0 = float(np.trapezoid(st, wt))
     if m0 <= 0.0:
         raise InputError("--table", path, "-", "density is zero everywhere")
-    return SpectrumChoice("table", lambda w: spectra.spectrum_table(w, wt, st), m0,
-                          {"file": str(path), "rows": int(wt.size)})
+    return SpectrumChoice(
+        "table",
+        lambda w: spectra.spectrum_table(w, wt, st),
+        m0,
+        {"file": str(path), "rows": int(wt.size)},
+    )

@@ -33,17 +33,28 @@ def register(subparsers: Any) -> None:
         "a scene document and print the v1 result document.",
     )
     p.add_argument("scene", help="scene document (JSON file)")
-    p.add_argument("--format", choices=["json"], default="json",
-                   help="output format (default json)")
+    p.add_argument(
+        "--format", choices=["json"], default="json", help="output format (default json)"
+    )
     p.add_argument("-o", "--output", default=None, help="output file (default stdout)")
-    p.add_argument("--plot", metavar="DIR", default=None,
-                   help="write PNG figures (end-tension spectra, tension σ along the "
-                   "line, time-series window) into DIR")
-    p.add_argument("--timeseries", choices=["window", "full", "none"], default="window",
-                   help="time series in the document: first 2048 samples (default), "
-                   "all, or none")
-    p.add_argument("--progress", action="store_true",
-                   help="report stages on stderr even when it is not a terminal")
+    p.add_argument(
+        "--plot",
+        metavar="DIR",
+        default=None,
+        help="write PNG figures (end-tension spectra, tension σ along the "
+        "line, time-series window) into DIR",
+    )
+    p.add_argument(
+        "--timeseries",
+        choices=["window", "full", "none"],
+        default="window",
+        help="time series in the document: first 2048 samples (default), all, or none",
+    )
+    p.add_argument(
+        "--progress",
+        action="store_true",
+        help="report stages on stderr even when it is not a terminal",
+    )
     p.set_defaults(func=run)
 
 
@@ -56,8 +67,10 @@ class _StderrProgress:
     def __call__(self, stage: str, info: Any) -> None:
         line = info.get("line") if hasattr(info, "get") else None
         if stage == "linearization" and info.get("iteration"):
-            msg = (f"  linearization '{line}': iteration {info['iteration']}, "
-                   f"change {info.get('change', float('nan')):.2e}")
+            msg = (
+                f"  linearization '{line}': iteration {info['iteration']}, "
+                f"change {info.get('change', float('nan')):.2e}"
+            )
         elif stage == "done":
             msg = f"done in {info.get('total_s', 0.0):.2f} s"
         else:

@@ -42,22 +42,31 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("scene", metavar="SCENE.json", help="scene document")
     p.add_argument("--count", type=int, default=10, help="modes per line (default 10)")
-    p.add_argument("--dim", type=int, choices=(2, 3), default=3,
-                   help="3: all modes, classified in-/out-of-plane (default); "
-                   "2: in-plane only (lines in the x–z plane)")
+    p.add_argument(
+        "--dim",
+        type=int,
+        choices=(2, 3),
+        default=3,
+        help="3: all modes, classified in-/out-of-plane (default); "
+        "2: in-plane only (lines in the x–z plane)",
+    )
     p.add_argument("--in-air", action="store_true", help="without added mass")
     p.add_argument("--format", choices=("json",), default="json", help="output format")
     p.add_argument("-o", "--output", default=None, help="output file (default stdout)")
-    p.add_argument("--plot", metavar="FILE.png", default=None,
-                   help="draw the first mode shapes over the static shape")
+    p.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        default=None,
+        help="draw the first mode shapes over the static shape",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``stochcable modes``; returns the exit code."""
-    from stochcable.validation import positive_int
-    from stochcable.statics import scene_fe_models
     from stochcable.line.modes import natural_modes
+    from stochcable.statics import scene_fe_models
+    from stochcable.validation import positive_int
 
     count = positive_int("--count", args.count)
     plt = require_matplotlib() if args.plot else None
@@ -66,13 +75,17 @@ def run(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     if scene.bodies:
-        warn("the scene has bodies: these are the modes of each line with its ends held "
-             "at their static positions; the coupled modes of lines and bodies are in "
-             "the result of 'stochcable analyze' under bodies.<name>.modes",
-             PhysicsWarning)
+        warn(
+            "the scene has bodies: these are the modes of each line with its ends held "
+            "at their static positions; the coupled modes of lines and bodies are in "
+            "the result of 'stochcable analyze' under bodies.<name>.modes",
+            PhysicsWarning,
+        )
     models = scene_fe_models(scene, dim=args.dim)
-    modes = {name: natural_modes(model, count=count, added_mass=not args.in_air)
-             for name, model in models.items()}
+    modes = {
+        name: natural_modes(model, count=count, added_mass=not args.in_air)
+        for name, model in models.items()
+    }
     lines = {name: m.to_document() for name, m in modes.items()}
     first = next(iter(lines.values()))
     write_json({"modes": {"omega": first["omega"], "lines": lines}}, args.output)

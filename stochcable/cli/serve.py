@@ -17,15 +17,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "STOCHCABLE_* environment variables (STOCHCABLE_MAX_SAMPLES, "
         "STOCHCABLE_MAX_BODY_BYTES, STOCHCABLE_MAX_RUN_SECONDS, ...).",
     )
-    p.add_argument("--host", default=None,
-                   help="interface to bind (default STOCHCABLE_HOST or 127.0.0.1)")
-    p.add_argument("--port", type=int, default=None,
-                   help="TCP port (default STOCHCABLE_PORT or 8000)")
-    p.add_argument("--workers", type=int, default=None,
-                   help="worker processes (default STOCHCABLE_WORKERS or 1)")
-    p.add_argument("--log-level", default="info",
-                   choices=["critical", "error", "warning", "info", "debug"],
-                   help="uvicorn log level (default info)")
+    p.add_argument(
+        "--host", default=None, help="interface to bind (default STOCHCABLE_HOST or 127.0.0.1)"
+    )
+    p.add_argument(
+        "--port", type=int, default=None, help="TCP port (default STOCHCABLE_PORT or 8000)"
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="worker processes (default STOCHCABLE_WORKERS or 1)",
+    )
+    p.add_argument(
+        "--log-level",
+        default="info",
+        choices=["critical", "error", "warning", "info", "debug"],
+        help="uvicorn log level (default info)",
+    )
     p.set_defaults(func=run)
 
 
@@ -41,9 +50,11 @@ def banner(host: str, port: int) -> str:
     # a wildcard bind address is not a destination: the example goes to loopback
     local = {"0.0.0.0": "127.0.0.1", "": "127.0.0.1", "::": "[::1]"}.get(host, shown)
     url = f"http://{local}:{port}"
-    return (f"stochcable service on {base} — docs at {base}/docs\n"
-            f"try: curl -s {url}/v1/examples/{EXAMPLE} | curl -s -X POST "
-            f"{url}/v1/analyses -H 'Content-Type: application/json' -d @-\n")
+    return (
+        f"stochcable service on {base} — docs at {base}/docs\n"
+        f"try: curl -s {url}/v1/examples/{EXAMPLE} | curl -s -X POST "
+        f"{url}/v1/analyses -H 'Content-Type: application/json' -d @-\n"
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -51,7 +62,6 @@ def run(args: argparse.Namespace) -> int:
     import uvicorn
 
     from service.settings import Settings
-
     from stochcable.errors import InputError
 
     settings = Settings()
@@ -65,6 +75,5 @@ def run(args: argparse.Namespace) -> int:
     # each worker process imports service.app:app and reads the STOCHCABLE_* variables
     sys.stderr.write(banner(host, port))
     sys.stderr.flush()
-    uvicorn.run("service.app:app", host=host, port=port, workers=workers,
-                log_level=args.log_level)
+    uvicorn.run("service.app:app", host=host, port=port, workers=workers, log_level=args.log_level)
     return 0

@@ -7,13 +7,24 @@ import argparse
 import numpy as np
 
 from stochcable import validation as v
-from stochcable.sea.spectra import spectrum_statistics
 from stochcable.cli._output import require_matplotlib, write_columns, write_json
 from stochcable.cli._spectrum_args import add_spectrum_arguments, spectrum_from_args
+from stochcable.sea.spectra import spectrum_statistics
 
-UNITS = {"omega": "rad/s", "density": "m^2*s/rad", "m0": "m^2", "m1": "m^2*rad/s",
-         "m2": "m^2*(rad/s)^2", "m3": "m^2*(rad/s)^3", "m4": "m^2*(rad/s)^4",
-         "hs": "m", "tz": "s", "tm01": "s", "tp": "s", "bandwidth": "-"}
+UNITS = {
+    "omega": "rad/s",
+    "density": "m^2*s/rad",
+    "m0": "m^2",
+    "m1": "m^2*rad/s",
+    "m2": "m^2*(rad/s)^2",
+    "m3": "m^2*(rad/s)^3",
+    "m4": "m^2*(rad/s)^4",
+    "hs": "m",
+    "tz": "s",
+    "tm01": "s",
+    "tp": "s",
+    "bandwidth": "-",
+}
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -22,13 +33,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "spectrum",
         help="evaluate a wave spectrum S(omega) and its statistics",
         description="Evaluate a one-sided wave spectrum S(omega) [m^2 s/rad] on the grid "
-                    "omega_i = i*omega_max/count, i = 1..count (0 excluded), and its moments "
-                    "(trapezoid on that grid), Hs, Tz, Tm01, Tp and bandwidth.",
+        "omega_i = i*omega_max/count, i = 1..count (0 excluded), and its moments "
+        "(trapezoid on that grid), Hs, Tz, Tm01, Tp and bandwidth.",
     )
     add_spectrum_arguments(p)
-    p.add_argument("--omega-max", type=float, default=3.0,
-                   help="largest grid frequency [rad/s] (default 3.0)")
-    p.add_argument("--count", type=int, default=200, help="number of grid frequencies (default 200)")
+    p.add_argument(
+        "--omega-max", type=float, default=3.0, help="largest grid frequency [rad/s] (default 3.0)"
+    )
+    p.add_argument(
+        "--count", type=int, default=200, help="number of grid frequencies (default 200)"
+    )
     p.add_argument("--format", choices=("json", "csv"), default="json", help="output format")
     p.add_argument("-o", "--output", help="output file (default stdout)")
     p.add_argument("--plot", metavar="FILE.png", help="also plot S(omega) to this image")
@@ -56,7 +70,15 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "csv":
         write_columns({"omega": omega, "density": density}, "csv", args.output)
     else:
-        write_json({"spectrum": choice.name, "parameters": choice.parameters,
-                    "omega": omega, "density": density, "stats": stats.as_dict(),
-                    "units": UNITS}, args.output)
+        write_json(
+            {
+                "spectrum": choice.name,
+                "parameters": choice.parameters,
+                "omega": omega,
+                "density": density,
+                "stats": stats.as_dict(),
+                "units": UNITS,
+            },
+            args.output,
+        )
     return 0

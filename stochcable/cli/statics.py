@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 
+from stochcable.cli._output import require_matplotlib, write_json
 from stochcable.scene.model import load_scene
 from stochcable.statics import StaticsResult, solve_statics
-from stochcable.cli._output import require_matplotlib, write_json
 
 __all__ = ["register", "run"]
 
@@ -23,10 +23,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("scene", help="scene document (JSON file)")
     p.add_argument("--format", choices=["json"], default="json", help="output format")
     p.add_argument("-o", "--output", default=None, help="output file (default stdout)")
-    p.add_argument("--method", choices=["auto", "fe", "catenary"], default="auto",
-                   help="auto: closed-form catenary where it applies, FE otherwise")
-    p.add_argument("--plot", default=None, metavar="FILE.png",
-                   help="draw each line's static shape (x-z, and plan view if 3-D)")
+    p.add_argument(
+        "--method",
+        choices=["auto", "fe", "catenary"],
+        default="auto",
+        help="auto: closed-form catenary where it applies, FE otherwise",
+    )
+    p.add_argument(
+        "--plot",
+        default=None,
+        metavar="FILE.png",
+        help="draw each line's static shape (x-z, and plan view if 3-D)",
+    )
     p.set_defaults(func=run)
 
 
@@ -53,8 +61,9 @@ def _plot(plt, scene, result: StaticsResult, path: str) -> None:  # noqa: ANN001
     lo, hi = float(xs.min()), float(xs.max())
     pad = 0.05 * max(hi - lo, 1.0)
     ax.axhline(0.0, color="tab:blue", lw=0.8, label="surface")
-    ax.fill_between([lo - pad, hi + pad], -depth, -depth - 0.03 * depth, color="tan",
-                    label="seabed")
+    ax.fill_between(
+        [lo - pad, hi + pad], -depth, -depth - 0.03 * depth, color="tan", label="seabed"
+    )
     for name, ls in result.lines.items():
         ax.plot(ls.positions[:, 0], ls.positions[:, 2], ".-", ms=2, label=name)
         if three_d:

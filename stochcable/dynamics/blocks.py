@@ -65,11 +65,19 @@ def node_blocks(a: Any, d: int) -> NodeBlocks:
     reference chain); anything else, or entries outside the pattern, goes through
     that function (same values, its error messages)."""
     stash = getattr(a, "_node_blocks", None)  # assembled from node blocks (fem)
-    if (stash is not None and stash[1].shape[1:] == (d, d) and stash[0].shape == a.data.shape
-            and np.array_equal(stash[0], a.data)):
+    if (
+        stash is not None
+        and stash[1].shape[1:] == (d, d)
+        and stash[0].shape == a.data.shape
+        and np.array_equal(stash[0], a.data)
+    ):
         return stash[1].copy(), stash[2].copy()
-    if (isinstance(a, (sp.csr_array, sp.csr_matrix)) and a.has_canonical_format
-            and a.shape[0] == a.shape[1] and a.shape[0] % d == 0):
+    if (
+        isinstance(a, (sp.csr_array, sp.csr_matrix))
+        and a.has_canonical_format
+        and a.shape[0] == a.shape[1]
+        and a.shape[0] % d == 0
+    ):
         n = a.shape[0]
         rows = np.repeat(np.arange(n), np.diff(a.indptr))
         cols = a.indices
@@ -111,8 +119,9 @@ def element_load(b: np.ndarray, mom: np.ndarray) -> np.ndarray:
     return out.view(complex).reshape((n_el + 1, d) + mom.shape[3:])
 
 
-def blocks_of_elements(model: FEModel, blocks3: np.ndarray,
-                        node_diag: np.ndarray | None) -> NodeBlocks:
+def blocks_of_elements(
+    model: FEModel, blocks3: np.ndarray, node_diag: np.ndarray | None
+) -> NodeBlocks:
     """Node blocks of per-unit-length element matrices (n_el, 3, 3) distributed like the
     model's mass (as :func:`stochcable.dynamics.loads.drag_matrix` assembles them)."""
     return distribute(model, element_blocks(model, blocks3), node_diag)
@@ -121,8 +130,11 @@ def blocks_of_elements(model: FEModel, blocks3: np.ndarray,
 def distribute(model: FEModel, b: np.ndarray, node_diag: np.ndarray | None) -> NodeBlocks:
     """:func:`blocks_of_elements` of the element blocks b (n_el, d, d) (l0
     included, :func:`element_blocks`)."""
-    pat = (np.array([[0.5, 0.0], [0.0, 0.5]]) if model.mass_matrix == "lumped" else
-           np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]]))
+    pat = (
+        np.array([[0.5, 0.0], [0.0, 0.5]])
+        if model.mass_matrix == "lumped"
+        else np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
+    )
     D = np.zeros((model.n_nodes, model.dim, model.dim))
     D[:-1] += pat[0, 0] * b
     D[1:] += pat[1, 1] * b
@@ -210,9 +222,12 @@ class LinePrep:
         n = model.n_nodes
         fixed_ok = np.array_equal(model.fixed, np.r_[np.arange(d), (n - 1) * d + np.arange(d)])
         if not fixed_ok or n < 3:
-            raise InputError("model.fixed", model.fixed, "-",
-                             "the line solve needs both end nodes prescribed and at least "
-                             "one free node")
+            raise InputError(
+                "model.fixed",
+                model.fixed,
+                "-",
+                "the line solve needs both end nodes prescribed and at least one free node",
+            )
         alpha, beta = system.structural_damping
         self.d, self.n = d, n
         self._system = system
@@ -265,13 +280,14 @@ class LinePrep:
             try:
                 self._chol = sla.cholesky_banded(upper, lower=False, check_finite=False)
             except np.linalg.LinAlgError:
-                raise SolverError("static correction: K_ff is not positive definite "
-                                  "(check the static tensions)") from None
+                raise SolverError(
+                    "static correction: K_ff is not positive definite (check the static tensions)"
+                ) from None
         c = (self._chol, False)
         if np.iscomplexobj(rhs):
-            return (sla.cho_solve_banded(c, np.ascontiguousarray(rhs.real), check_finite=False)
-                    + 1j * sla.cho_solve_banded(c, np.ascontiguousarray(rhs.imag),
-                                                check_finite=False))
+            return sla.cho_solve_banded(
+                c, np.ascontiguousarray(rhs.real), check_finite=False
+            ) + 1j * sla.cho_solve_banded(c, np.ascontiguousarray(rhs.imag), check_finite=False)
         return sla.cho_solve_banded(c, rhs, check_finite=False)
 
     def residual(self, system: LineSystem, rhs: np.ndarray) -> np.ndarray:
@@ -317,9 +333,12 @@ class LinePrep:
             if not direct:
                 g[1:-1] = self.follower().reshape(n - 2, d, 2 * d)
             flat = (n * d, 2 * d)
-            self.cache[key] = (g.reshape(flat), block_matvec(self.MT, g).reshape(flat),
-                                block_matvec(self.S, g).reshape(flat),
-                                block_matvec(self.K, g).reshape(flat) if direct else None)
+            self.cache[key] = (
+                g.reshape(flat),
+                block_matvec(self.MT, g).reshape(flat),
+                block_matvec(self.S, g).reshape(flat),
+                block_matvec(self.K, g).reshape(flat) if direct else None,
+            )
         return self.cache[key]
 
     def modal(self, system: LineSystem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -343,7 +362,6 @@ class LinePrep:
     def free_rows(self, y: np.ndarray) -> np.ndarray:
         """Node vectors (n_nodes, d, ...) -> free rows (n_free_dof, ...)."""
         return y[1:-1].reshape(((self.n - 2) * self.d,) + y.shape[2:])
-
 
 
 def line_prep(system: LineSystem) -> LinePrep:

@@ -40,8 +40,8 @@ from stochcable.dynamics.coupled.inputs import (
     scene_line_channels,
     vessel_rao,
 )
-from stochcable.dynamics.solve import end_tension_from_support
 from stochcable.dynamics.loads import Channel, spectrum_callable
+from stochcable.dynamics.solve import end_tension_from_support
 
 __all__ = [
     "CHUNK_BYTES",
@@ -95,8 +95,7 @@ class GroupTransfer:
     body_motion: dict[str, np.ndarray]
 
 
-def frequency_chunks(n_omega: int, entry_bytes: int, budget: int = CHUNK_BYTES
-                     ) -> Iterator[slice]:
+def frequency_chunks(n_omega: int, entry_bytes: int, budget: int = CHUNK_BYTES) -> Iterator[slice]:
     """Consecutive slices of ``range(n_omega)`` whose node arrays fit ``budget``.
 
     Parameters
@@ -121,41 +120,60 @@ def frequency_chunks(n_omega: int, entry_bytes: int, budget: int = CHUNK_BYTES
 def vessel_raos(scene: Any, omega: np.ndarray) -> dict[str, np.ndarray]:
     """6-DOF RAO (n_omega, 6) of every prescribed body (vessel) of the scene on
     ``omega`` (zero outside its table). [m/m, rad/m]"""
-    return {b.name: vessel_rao(b.prescribed, omega)
-            for b in (getattr(scene, "bodies", ()) or ())
-            if getattr(b, "prescribed", None) is not None}
+    return {
+        b.name: vessel_rao(b.prescribed, omega)
+        for b in (getattr(scene, "bodies", ()) or ())
+        if getattr(b, "prescribed", None) is not None
+    }
 
 
 def _scene_line(scene: Any, name: str) -> Any:
     return next(ln for ln in scene.lines if ln.name == name)
 
 
-def _group_on(scene: Any, group: CoupledGroup, omega: np.ndarray
-              ) -> tuple[GroupSystem, tuple[str, ...], tuple[tuple[str, str] | None, ...]]:
+def _group_on(
+    scene: Any, group: CoupledGroup, omega: np.ndarray
+) -> tuple[GroupSystem, tuple[str, ...], tuple[tuple[str, str] | None, ...]]:
     """The group's solve data on ``omega``: channels of every line (vessel ends in the
     sea channel), aligned on the group list as the analysis does, and body loads."""
     env = scene.environment
     vessel = vessel_raos(scene, omega)
     chans: dict[str, tuple[Channel, ...]] = {}
     for n in group.lines:
-        chans[n], _ = scene_line_channels(scene, _scene_line(scene, n), group.systems[n],
-                                           omega, vessel)
+        chans[n], _ = scene_line_channels(
+            scene, _scene_line(scene, n), group.systems[n], omega, vessel
+        )
     if group.lines:
         gch = group_channels(group.lines, chans, omega)
-        cls = [CoupledLine(group.systems[n], gch[n], end_a=group.attach[n].get("end_a"),
-                           end_b=group.attach[n].get("end_b")) for n in group.lines]
+        cls = [
+            CoupledLine(
+                group.systems[n],
+                gch[n],
+                end_a=group.attach[n].get("end_a"),
+                end_b=group.attach[n].get("end_b"),
+            )
+            for n in group.lines
+        ]
         channels = cls[0].channels
     else:  # a free-floating body: the sea alone (analyze_coupled)
         dens = spectrum_callable(scene.sea.spectrum, env.g)
-        channels = (Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega),
-                            density=dens),)
+        channels = (
+            Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega), density=dens),
+        )
         cls = []
-    own = {f"{n}.{c.name}": (n, c.name) for n in group.lines for c in chans[n]
-           if c.kind == "end_motion"}
+    own = {
+        f"{n}.{c.name}": (n, c.name)
+        for n in group.lines
+        for c in chans[n]
+        if c.kind == "end_motion"
+    }
     sources = tuple(own.get(c.name) if c.kind == "end_motion" else None for c in channels)
     loads = {b.name: body_loads(b, channels, omega, scene.sea, env) for b in group.bodies}
-    return (GroupSystem(cls, group.bodies, loads, env.rho, channels),
-            tuple(c.kind for c in channels), sources)
+    return (
+        GroupSystem(cls, group.bodies, loads, env.rho, channels),
+        tuple(c.kind for c in channels),
+        sources,
+    )
 
 
 def line_entry_bytes(model: Any, n_columns: int) -> int:
@@ -179,17 +197,29 @@ def line_entry_bytes(model: Any, n_columns: int) -> int:
 
 def _entry_bytes(group: CoupledGroup, scene: Any) -> int:
     """Bytes of the group's node arrays per frequency (the chunk budget's unit)."""
-    n_ch = 1 + sum(3 for n in group.lines for e in ("end_a", "end_b")
-                   if getattr(getattr(_scene_line(scene, n), e), "motion", None) is not None)
-    total = sum(line_entry_bytes(group.systems[n].model,
-                                 n_ch + group.systems[n].model.dim * len(group.attach[n]))
-                for n in group.lines)
+    n_ch = 1 + sum(
+        3
+        for n in group.lines
+        for e in ("end_a", "end_b")
+        if getattr(getattr(_scene_line(scene, n), e), "motion", None) is not None
+    )
+    total = sum(
+        line_entry_bytes(
+            group.systems[n].model, n_ch + group.systems[n].model.dim * len(group.attach[n])
+        )
+        for n in group.lines
+    )
     return max(total, 1)
 
 
-def coupled_group_transfer(scene: Any, group: CoupledGroup, omega: Any, *,
-                           budget: int = CHUNK_BYTES,
-                           timing: dict[str, float] | None = None) -> GroupTransfer:
+def coupled_group_transfer(
+    scene: Any,
+    group: CoupledGroup,
+    omega: Any,
+    *,
+    budget: int = CHUNK_BYTES,
+    timing: dict[str, float] | None = None,
+) -> GroupTransfer:
     """End-tension and body-motion transfer functions of a coupled group on ``omega``.
 
     Parameters
@@ -197,7 +227,8 @@ def coupled_group_transfer(scene: Any, group: CoupledGroup, omega: Any, *,
     scene : Scene
         The scene the group belongs to (environment, sea, line end motions, vessels).
     group : CoupledGroup
-        The group's converged state (:attr:`stochcable.dynamics.coupled.analysis.CoupledAnalysis.groups`).
+        The group's converged state
+        (:attr:`stochcable.dynamics.coupled.analysis.CoupledAnalysis.groups`).
     omega : array_like, shape (n_omega,)
         Frequencies, > 0 (the realization band). [rad/s]
     budget : int, optional
@@ -236,10 +267,11 @@ def coupled_group_transfer(scene: Any, group: CoupledGroup, omega: Any, *,
         g, kinds, sources = _group_on(scene, group, w[sl])
         if not names:
             names = tuple(c.name for c in g.channels)
-            end_t = {n: {e: np.zeros((g.n_ch, n_w), dtype=complex)
-                         for e in ("end_a", "end_b")} for n in group.lines}
-            motion = {b.name: np.zeros((g.n_ch, b.n_dof, n_w), dtype=complex)
-                      for b in group.bodies}
+            end_t = {
+                n: {e: np.zeros((g.n_ch, n_w), dtype=complex) for e in ("end_a", "end_b")}
+                for n in group.lines
+            }
+            motion = {b.name: np.zeros((g.n_ch, b.n_dof, n_w), dtype=complex) for b in group.bodies}
         body_c = np.zeros((g.nb, g.nb))
         body_b: dict[str, np.ndarray] = {}
         for b in g.drag:
@@ -258,5 +290,11 @@ def coupled_group_transfer(scene: Any, group: CoupledGroup, omega: Any, *,
             s = slice(g.off[b.name], g.off[b.name] + b.n_dof)
             motion[b.name][:, :, sl] = np.transpose(xi[:, s, :], (2, 1, 0))
         del sol, xi, g
-    return GroupTransfer(omega=w.copy(), channels=names, kinds=kinds, sources=sources,
-                         end_tension=end_t, body_motion=motion)
+    return GroupTransfer(
+        omega=w.copy(),
+        channels=names,
+        kinds=kinds,
+        sources=sources,
+        end_tension=end_t,
+        body_motion=motion,
+    )

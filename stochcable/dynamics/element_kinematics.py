@@ -81,7 +81,7 @@ def _phi1_psi(x: np.ndarray, want_psi: bool = True) -> tuple[np.ndarray, np.ndar
         if want_psi:
             psi = em1 * (x - 1.0)
             psi += x
-            psi /= x * x                                   # ((x − 1)e^x + 1)/x²
+            psi /= x * x  # ((x − 1)e^x + 1)/x²
     if small.any():
         xs = x[small]
         phi[small] = _series(xs, _PHI1_COEF)
@@ -98,9 +98,13 @@ def _moment_argument(alpha: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndar
     return s * alpha * (q - p)
 
 
-def _exp_moments(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray,
-                 phi_psi: tuple[np.ndarray, np.ndarray] | None = None
-                 ) -> tuple[np.ndarray, np.ndarray]:
+def _exp_moments(
+    e0: np.ndarray,
+    alpha: np.ndarray,
+    p: np.ndarray,
+    q: np.ndarray,
+    phi_psi: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """∫_p^q (1 − ξ) e^{e0 + αξ} dξ and ∫_p^q ξ e^{e0 + αξ} dξ, elementwise.
 
     The exponential is factored at the endpoint c where Re(e0 + αξ) is largest (q when
@@ -128,8 +132,9 @@ def _exp_moments(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray
     return ref * ((1.0 - c) * t1 - t2), ref * (c * t1 + t2)
 
 
-def _exp_integral(e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray,
-                  phi: np.ndarray | None = None) -> np.ndarray:
+def _exp_integral(
+    e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray, phi: np.ndarray | None = None
+) -> np.ndarray:
     """∫_p^q e^{e0 + αξ} dξ for real e0, α (as :func:`_exp_moments`, factored at the
     larger endpoint).  ``phi``: φ1 of the argument −|α|(q − p) when the caller has it
     (the same for α and −α)."""
@@ -249,8 +254,9 @@ def element_wave_kinematics(
     z = pts[:, 2]
     if not math.isinf(h) and (z < -h).any():
         i = int(np.flatnonzero(z < -h)[0])
-        raise InputError("positions", positions, "m",
-                         f"z must be >= -depth = {-h:g} (node {i} has z = {z[i]:g})")
+        raise InputError(
+            "positions", positions, "m", f"z must be >= -depth = {-h:g} (node {i} has z = {z[i]:g})"
+        )
     return _element_kinematics(w, k, pts, beta, h, g)
 
 
@@ -262,8 +268,9 @@ def _complex(re: np.ndarray, im: np.ndarray) -> np.ndarray:
     return out
 
 
-def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float,
-                        h: float, g: float) -> ElementKinematics:
+def _element_kinematics(
+    w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float, h: float, g: float
+) -> ElementKinematics:
     """:func:`element_wave_kinematics` without validation."""
     cb, sb = math.cos(beta), math.sin(beta)
     za, zb = pts[:-1, 2], pts[1:, 2]
@@ -279,7 +286,7 @@ def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: flo
     p, q = np.clip(p, 0.0, 1.0)[None, :], np.clip(q, 0.0, 1.0)[None, :]
     length = q - p
     dz = np.multiply.outer(k, zb - za)
-    phase0 = -np.multiply.outer(k, chi[:-1])   # imaginary parts of the exponents
+    phase0 = -np.multiply.outer(k, chi[:-1])  # imaginary parts of the exponents
     dphase = -np.multiply.outer(k, chi[1:] - chi[:-1])
     kza = np.multiply.outer(k, za)
     alpha1 = _complex(dz, dphase)
@@ -287,11 +294,11 @@ def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: flo
     ma1, mb1 = _exp_moments(_complex(kza, phase0), alpha1, p, q, f12)
     two_dz = 2.0 * dz
     phi_k, _ = _phi1_psi(np.where(two_dz >= 0.0, -two_dz, two_dz) * length, want_psi=False)
-    k1 = _exp_integral(2.0 * kza, two_dz, p, q, phi_k)      # ∫ e^{2kz} dξ
+    k1 = _exp_integral(2.0 * kza, two_dz, p, q, phi_k)  # ∫ e^{2kz} dξ
     zero_w = w == 0.0
-    z_ends = (za[:, None] + (zb - za)[:, None] * np.hstack([p.T, q.T]))   # (n_el, 2)
+    z_ends = za[:, None] + (zb - za)[:, None] * np.hstack([p.T, q.T])  # (n_el, 2)
     z_ends = np.minimum(z_ends, 0.0)
-    e1_ends = np.exp(2.0 * np.multiply.outer(k, z_ends))             # (n_w, n_el, 2)
+    e1_ends = np.exp(2.0 * np.multiply.outer(k, z_ends))  # (n_w, n_el, 2)
     if math.isinf(h):
         coef = w.astype(complex)[:, None]
         mh = (ma1 * coef, mb1 * coef)
@@ -318,7 +325,7 @@ def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: flo
             ch2 = (k1 + k2 + cross2) * c2
             sh2 = np.clip(k1 + k2 - cross2, 0.0, None) * c2
         e2_ends = np.exp(-2.0 * np.multiply.outer(k, z_ends + 2.0 * h))
-        ends = 2.0 * (e1_ends + e2_ends) * c2[:, :, None]        # ω²(ch² + sh²)
+        ends = 2.0 * (e1_ends + e2_ends) * c2[:, :, None]  # ω²(ch² + sh²)
         mh = ((ma1 + ma2) * c[:, None], (mb1 + mb2) * c[:, None])
         ic = (1j * c)[:, None]
         mz = ((ma1 - ma2) * ic, (mb1 - mb2) * ic)
@@ -344,8 +351,14 @@ def _element_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: flo
     ends = np.where((length > 0.0)[:, :, None], ends, 0.0)
     for a in (w, k, pts, wet, vel, sq, ends):
         a.setflags(write=False)
-    return ElementKinematics(omega=w, wavenumber=k, positions=pts, heading=beta, depth=h,
-                             wet_fraction=wet, velocity=vel, velocity_square=sq,
-                             end_square=ends)
-
-
+    return ElementKinematics(
+        omega=w,
+        wavenumber=k,
+        positions=pts,
+        heading=beta,
+        depth=h,
+        wet_fraction=wet,
+        velocity=vel,
+        velocity_square=sq,
+        end_square=ends,
+    )

@@ -49,9 +49,9 @@ from stochcable.dynamics.system import (
 )
 from stochcable.dynamics.timeseries import simulate_timeseries
 from stochcable.errors import InputError, PhysicsWarning, collect_warnings, warn
-from stochcable.statics import StaticsResult, solve_statics
 from stochcable.results.documents import LineResult, Result
 from stochcable.scene.model import Scene, Sea, input_error_from_validation, load_scene
+from stochcable.statics import StaticsResult, solve_statics
 
 __all__ = ["Engine", "build_engine"]
 
@@ -90,8 +90,9 @@ class Engine:
     timing: Mapping[str, float]
     warnings: tuple[str, ...]
 
-    def solve(self, sea: Sea | Mapping[str, Any] | None = None, *,
-              progress: Progress | None = None) -> Result:
+    def solve(
+        self, sea: Sea | Mapping[str, Any] | None = None, *, progress: Progress | None = None
+    ) -> Result:
         """Stochastic response of the scene to one sea state.
 
         Parameters
@@ -127,8 +128,7 @@ class Engine:
                 # lines attached to bodies are solved together with them (issue 6)
                 from stochcable.dynamics.coupled import analyze_coupled
 
-                coupled = analyze_coupled(scene, self.statics, scene.analysis, progress,
-                                          timing)
+                coupled = analyze_coupled(scene, self.statics, scene.analysis, progress, timing)
                 lines, bodies, systems, dampings = coupled
                 groups = coupled.groups
             else:
@@ -138,14 +138,27 @@ class Engine:
             if scene.analysis.timeseries is not None:
                 progress("timeseries", {})
                 t0 = time.perf_counter()
-                ts = simulate_timeseries(scene, systems, dampings, scene.analysis.timeseries,
-                                         coupled=groups, timing=timing)
+                ts = simulate_timeseries(
+                    scene,
+                    systems,
+                    dampings,
+                    scene.analysis.timeseries,
+                    coupled=groups,
+                    timing=timing,
+                )
                 timing["timeseries_s"] = time.perf_counter() - t0
         messages = _messages(self.warnings, caught)
         timing["total_s"] = timing.pop("build_s") + time.perf_counter() - t_start
         progress("done", {"total_s": timing["total_s"]})
-        return Result(scene=scene, statics=self.statics, lines=lines, timeseries=ts,
-                      timing=timing, warnings=tuple(messages), bodies=bodies)
+        return Result(
+            scene=scene,
+            statics=self.statics,
+            lines=lines,
+            timeseries=ts,
+            timing=timing,
+            warnings=tuple(messages),
+            bodies=bodies,
+        )
 
 
 def build_engine(
@@ -182,10 +195,15 @@ def build_engine(
     progress = noop_progress if progress is None else progress
     settings = scene.analysis
     if settings.linearization.method == "harmonic" and any(
-            p.speed > 0 for p in scene.environment.current):
-        raise InputError("analysis.linearization.method", "harmonic", "-",
-                         "the harmonic (regular-wave) form has no current term: use "
-                         "'seed' or 'vector' with a current")
+        p.speed > 0 for p in scene.environment.current
+    ):
+        raise InputError(
+            "analysis.linearization.method",
+            "harmonic",
+            "-",
+            "the harmonic (regular-wave) form has no current term: use "
+            "'seed' or 'vector' with a current",
+        )
     timing = {"statics_s": 0.0, "model_s": 0.0}
     systems: dict[str, LineSystem] = {}
     with collect_warnings() as caught, runtime.analysis_blas(is_small(scene)):
@@ -196,17 +214,21 @@ def build_engine(
             # linearized about it, so it must be an equilibrium of the same FE model
             statics = solve_statics(scene, method="fe")
         timing["statics_s"] = time.perf_counter() - t0
-        for line in (() if scene.bodies else scene.lines):
+        for line in () if scene.bodies else scene.lines:
             progress("model", {"line": line.name})
             t0 = time.perf_counter()
-            system = build_line_system(scene, line, statics.lines[line.name],
-                                       settings=settings)
+            system = build_line_system(scene, line, statics.lines[line.name], settings=settings)
             line_prep(system)  # node blocks and band storage of K, M_T, C_s
             systems[line.name] = system
             timing["model_s"] += time.perf_counter() - t0
     timing["build_s"] = time.perf_counter() - t_start  # (in each result's total_s)
-    return Engine(scene=scene, statics=statics, systems=systems, timing=timing,
-                  warnings=tuple(_messages((), caught)))
+    return Engine(
+        scene=scene,
+        statics=statics,
+        systems=systems,
+        timing=timing,
+        warnings=tuple(_messages((), caught)),
+    )
 
 
 def _with_sea(scene: Scene, sea: Sea | Mapping[str, Any] | None) -> Scene:
@@ -221,20 +243,22 @@ def _with_sea(scene: Scene, sea: Sea | Mapping[str, Any] | None) -> Scene:
     return scene.model_copy(update={"sea": sea})
 
 
-def _solve_lines(scene: Scene, systems: Mapping[str, LineSystem], progress: Progress,
-                 timing: dict[str, float]
-                 ) -> tuple[dict[str, LineResult], dict[str, Damping]]:
+def _solve_lines(
+    scene: Scene, systems: Mapping[str, LineSystem], progress: Progress, timing: dict[str, float]
+) -> tuple[dict[str, LineResult], dict[str, Damping]]:
     """Channels, drag fixed point and outputs of every independent line."""
     lines: dict[str, LineResult] = {}
     dampings: dict[str, Damping] = {}
     for line in scene.lines:
         lines[line.name], dampings[line.name] = _solve_line(
-            scene, line, systems[line.name], progress, timing)
+            scene, line, systems[line.name], progress, timing
+        )
     return lines, dampings
 
 
-def _solve_line(scene: Scene, line: Any, system: LineSystem, progress: Progress,
-                timing: dict[str, float]) -> tuple[LineResult, Damping]:
+def _solve_line(
+    scene: Scene, line: Any, system: LineSystem, progress: Progress, timing: dict[str, float]
+) -> tuple[LineResult, Damping]:
     """One independent line: its channels (the sea-dependent loads, timed with the
     model), the drag linearization and the outputs."""
     settings = scene.analysis
@@ -246,7 +270,8 @@ def _solve_line(scene: Scene, line: Any, system: LineSystem, progress: Progress,
         warn(
             f"line '{line.name}' has no excitation (no sea and no end motion): its "
             "dynamic response is zero; add a 'sea' or an end 'motion'",
-            PhysicsWarning, stacklevel=3,
+            PhysicsWarning,
+            stacklevel=3,
         )
         channels = silent_channel(omega)
     progress("linearization", {"line": line.name, "iteration": 0})

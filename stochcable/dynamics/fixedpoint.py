@@ -18,7 +18,8 @@ chain the subset σ are within 1e-5 of the full-grid ones at the same drag, agai
 the full-grid iteration, which runs (first step unmixed) until the usual test passes
 on the full grid: the answer is the full-grid fixed point, and the record's iterations
 and history count full-grid evaluations only (the coarse stage is
-:attr:`~stochcable.dynamics.system.Linearization.coarse`).  The subset solves the same modal equations per
+:attr:`~stochcable.dynamics.system.Linearization.coarse`).  The subset solves the same modal
+equations per
 frequency instead of by the Foss eigenproblem
 (:func:`~stochcable.dynamics.solve.solve_free` with ``modal_direct``).  On the chain: 6
 coarse evaluations on 51 frequencies and one full-grid evaluation (change 1.1e-5)
@@ -142,12 +143,10 @@ def interpolatory_weights(omega: np.ndarray, idx: np.ndarray) -> np.ndarray:
     basis = r[:, :, 0].copy()
     for b in range(1, order):
         basis *= r[:, :, b]
-    return np.bincount(nodes.ravel(), weights=(q[:, None] * basis).ravel(),
-                       minlength=n_sub)
+    return np.bincount(nodes.ravel(), weights=(q[:, None] * basis).ravel(), minlength=n_sub)
 
 
-def _coarse_subset(system: LineSystem, inp: LineInputs, damping: Damping
-                   ) -> np.ndarray | None:
+def _coarse_subset(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndarray | None:
     """Indices of the coarse-start frequencies (module docstring "Coarse start"), or
     None when the grid is too small or the subset would not be much smaller.
 
@@ -174,7 +173,7 @@ def _coarse_subset(system: LineSystem, inp: LineInputs, damping: Damping
         if s_i[k] <= 0:
             continue
         low = s_i < 0.5 * s_i[k]
-        lo = k - int(np.argmax(low[k::-1])) if np.any(low[:k + 1]) else 0
+        lo = k - int(np.argmax(low[k::-1])) if np.any(low[: k + 1]) else 0
         hi = k + int(np.argmax(low[k:])) if np.any(low[k:]) else n - 1
         if w[hi] - w[lo] < 2.0 * coarse_spacing[k]:
             centers.append(np.array([k]))
@@ -196,8 +195,9 @@ def _coarse_subset(system: LineSystem, inp: LineInputs, damping: Damping
     return idx if idx.size <= COARSE_MAX_FRACTION * n else None
 
 
-def subset_inputs(system: LineSystem, channels: tuple[Channel, ...], inp: LineInputs,
-                   idx: np.ndarray) -> LineInputs:
+def subset_inputs(
+    system: LineSystem, channels: tuple[Channel, ...], inp: LineInputs, idx: np.ndarray
+) -> LineInputs:
     """The inputs on the frequencies ``inp.omega[idx]``, weighted by
     :func:`interpolatory_weights` (the same layout as :func:`line_inputs`)."""
     comps = list(system.model.components)
@@ -215,10 +215,18 @@ def subset_inputs(system: LineSystem, channels: tuple[Channel, ...], inp: LineIn
     def take(a: np.ndarray | None, axis: int) -> np.ndarray | None:
         return None if a is None else np.take(a, idx, axis=axis)
 
-    sub = LineInputs(inp.omega[idx], take(inp.velocity, 2), take(inp.inertia_load, 2),
-                  take(inp.ub, 2), weights, take(inp.moments, 3), square)
+    sub = LineInputs(
+        inp.omega[idx],
+        take(inp.velocity, 2),
+        take(inp.inertia_load, 2),
+        take(inp.ub, 2),
+        weights,
+        take(inp.moments, 3),
+        square,
+    )
     # The drag-independent, per-frequency arrays the full grid has already computed
-    # (:func:`base_motion`, :func:`drag_inputs`, :func:`end_motion_projections`, the projected moments of
+    # (:func:`base_motion`, :func:`drag_inputs`, :func:`end_motion_projections`, the projected
+    # moments of
     # :func:`fluid_terms`) are the same numbers at the subset's frequencies: sliced,
     # not recomputed (0.3 ms of the chain's coarse start).
     n_w, n_ch = inp.weights.shape
@@ -228,8 +236,9 @@ def subset_inputs(system: LineSystem, channels: tuple[Channel, ...], inp: LineIn
         if a is None:
             return None
         lead = a.shape[:-1]
-        return np.ascontiguousarray(np.take(a.reshape(lead + (n_w, 2 * n_ch)), idx,
-                                            axis=len(lead))).reshape(lead + (-1,))
+        return np.ascontiguousarray(
+            np.take(a.reshape(lead + (n_w, 2 * n_ch)), idx, axis=len(lead))
+        ).reshape(lead + (-1,))
 
     for key, val in inp.cache.items():
         if key in ("foss", "direct"):
@@ -241,8 +250,11 @@ def subset_inputs(system: LineSystem, channels: tuple[Channel, ...], inp: LineIn
             sub.cache[key] = take_view(val)
         elif key[0] == "qproj":
             q_p, wcol, y = val
-            sub.cache[key] = (take_view(q_p), np.ascontiguousarray(
-                wcol.reshape(n_w, n_ch)[idx]).ravel(), take(y, 2))
+            sub.cache[key] = (
+                take_view(q_p),
+                np.ascontiguousarray(wcol.reshape(n_w, n_ch)[idx]).ravel(),
+                take(y, 2),
+            )
     return sub
 
 
@@ -297,9 +309,15 @@ def _coarse_start(
     return fp.x, CoarseStage(int(idx.size), fp.iterations, fp.history, fp.converged)
 
 
-def _coarse_fixed_point(system: LineSystem, sub: LineInputs, first: Damping,
-                        x_rest: np.ndarray, lin: Any, progress: Progress,
-                        timing: dict[str, float] | None) -> FixedPointResult | None:
+def _coarse_fixed_point(
+    system: LineSystem,
+    sub: LineInputs,
+    first: Damping,
+    x_rest: np.ndarray,
+    lin: Any,
+    progress: Progress,
+    timing: dict[str, float] | None,
+) -> FixedPointResult | None:
     """The fixed point on the subset inputs ``sub`` from the at-rest σ ``x_rest`` (whose
     drag is ``first``) to ``COARSE_TOLERANCE_RATIO`` times the tolerance, unconverged
     allowed; None when it breaks down (non-finite σ, a singular subset solve)."""
@@ -314,9 +332,15 @@ def _coarse_fixed_point(system: LineSystem, sub: LineInputs, first: Damping,
         new = sigmas_from_free(system, sub, u_f, method)
         count[0] += 1
         if progress is not noop_progress:  # (the change is for the callback only)
-            progress("linearization", {"line": system.name, "iteration": 0,
-                                       "coarse_iteration": count[0],
-                                       "change": relative_change(new, x)})
+            progress(
+                "linearization",
+                {
+                    "line": system.name,
+                    "iteration": 0,
+                    "coarse_iteration": count[0],
+                    "change": relative_change(new, x),
+                },
+            )
         return new
 
     tol = COARSE_TOLERANCE_RATIO * lin.tolerance
@@ -328,16 +352,21 @@ def _coarse_fixed_point(system: LineSystem, sub: LineInputs, first: Damping,
         if change0 <= tol:
             return FixedPointResult(x0, 1, change0, True, (change0,))
         fp = fixed_point(
-            update, x0, tol=tol, max_iterations=lin.max_iterations,
+            update,
+            x0,
+            tol=tol,
+            max_iterations=lin.max_iterations,
             relaxation=lin.relaxation,
             method="anderson" if lin.acceleration == "anderson" else "relaxed",
-            mixing=ANDERSON_MIXING, allow_unconverged=True,
+            mixing=ANDERSON_MIXING,
+            allow_unconverged=True,
             name=f"coarse start of the drag linearization of line '{system.name}'",
         )
     except (ConvergenceError, SolverError, np.linalg.LinAlgError):
         return None  # non-finite σ or a singular subset solve
-    return FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
-                            (change0,) + fp.history)
+    return FixedPointResult(
+        fp.x, fp.iterations + 1, fp.relative_change, fp.converged, (change0,) + fp.history
+    )
 
 
 def linearize(
@@ -404,9 +433,13 @@ def linearize(
     method = lin.method
     progress = noop_progress if progress is None else progress
     if method == "harmonic" and (np.any(system.current_el) or np.any(system.current_node)):
-        raise InputError("analysis.linearization.method", "harmonic", "-",
-                         "the harmonic (regular-wave) form has no current term: use "
-                         "'seed' or 'vector' with a current")
+        raise InputError(
+            "analysis.linearization.method",
+            "harmonic",
+            "-",
+            "the harmonic (regular-wave) form has no current term: use "
+            "'seed' or 'vector' with a current",
+        )
     inp = line_inputs(system, channels)
     step = _Step(system, inp, method, progress, timing)
     name = f"drag linearization of line '{system.name}'"
@@ -414,8 +447,9 @@ def linearize(
     # starts the iteration unmixed (one iteration fewer than relaxing toward the guess
     # on the chain, taut wire and 3-D benchmarks; same fixed point).  The coarse stage
     # replaces the guess by the subset's fixed point (same first full-grid step).
-    x_start, stage = (_coarse_start(system, channels, inp, settings, progress, timing)
-                      if coarse else (None, None))
+    x_start, stage = (
+        _coarse_start(system, channels, inp, settings, progress, timing) if coarse else (None, None)
+    )
     if x_start is None:
         x_start = rest_sigmas(system, inp, method)
     fp = _full_grid_fixed_point(step, step(x_start), lin, name)
@@ -424,16 +458,15 @@ def linearize(
             f"{name} did not converge: relative change {fp.relative_change:.3e} after "
             f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "
             "flagged unconverged (increase analysis.linearization.max_iterations)",
-            PhysicsWarning, stacklevel=2,
+            PhysicsWarning,
+            stacklevel=2,
         )
     t0 = time.perf_counter()
     # transfer functions of the recorded drag: the last step solved with it
     u_f, c = step.solved
-    resp = line_response(system, inp, step.damping,
-                         (total_displacement(system, inp, u_f), c))
+    resp = line_response(system, inp, step.damping, (total_displacement(system, inp, u_f), c))
     _add_time(timing, t0)
-    record = linearization_record(system, step.sigma, step.damping, fp, lin.tolerance,
-                                  method)
+    record = linearization_record(system, step.sigma, step.damping, fp, lin.tolerance, method)
     return Linearization(damping=step.damping, record=record, response=resp, coarse=stage)
 
 
@@ -447,8 +480,14 @@ class _Step:
     """One full-grid step of the drag fixed point, σ -> drag -> response -> new σ,
     keeping the last drag, σ and solve (the outputs reuse them: no extra solve)."""
 
-    def __init__(self, system: LineSystem, inp: LineInputs, method: str,
-                 progress: Progress, timing: dict[str, float] | None) -> None:
+    def __init__(
+        self,
+        system: LineSystem,
+        inp: LineInputs,
+        method: str,
+        progress: Progress,
+        timing: dict[str, float] | None,
+    ) -> None:
         self.system, self.inp, self.method = system, inp, method
         self.progress, self.timing = progress, timing
         self.iterations = 0
@@ -466,22 +505,26 @@ class _Step:
         new = sigmas_from_free(system, self.inp, u_f, self.method)
         self.iterations += 1
         self.change = relative_change(new, x)
-        self.progress("linearization", {"line": system.name, "iteration": self.iterations,
-                                        "change": self.change})
+        self.progress(
+            "linearization",
+            {"line": system.name, "iteration": self.iterations, "change": self.change},
+        )
         self.damping, self.sigma, self.solved = damping, new, (u_f, c)
         return new
 
 
-def _full_grid_fixed_point(step: _Step, x0: np.ndarray, lin: Any, name: str
-                           ) -> FixedPointResult:
+def _full_grid_fixed_point(step: _Step, x0: np.ndarray, lin: Any, name: str) -> FixedPointResult:
     """The fixed point from the first step's σ ``x0`` (its change in ``step.change``),
     the first step counted in the iterations and the history."""
     change0 = step.change
-    hint = ("increase analysis.linearization.max_iterations, lower relaxation, or set "
-            "allow_unconverged to get a flagged result")
+    hint = (
+        "increase analysis.linearization.max_iterations, lower relaxation, or set "
+        "allow_unconverged to get a flagged result"
+    )
     if not np.all(np.isfinite(x0)):
-        raise ConvergenceError(name, 1, float("nan"), lin.tolerance,
-                               hint="the first response gave non-finite σ")
+        raise ConvergenceError(
+            name, 1, float("nan"), lin.tolerance, hint="the first response gave non-finite σ"
+        )
     if change0 <= lin.tolerance or lin.max_iterations == 1:
         fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance, (change0,))
         if not fp.converged and not lin.allow_unconverged:
@@ -489,26 +532,37 @@ def _full_grid_fixed_point(step: _Step, x0: np.ndarray, lin: Any, name: str
         return fp
     try:
         fp = fixed_point(
-            step, x0, tol=lin.tolerance, max_iterations=lin.max_iterations - 1,
+            step,
+            x0,
+            tol=lin.tolerance,
+            max_iterations=lin.max_iterations - 1,
             relaxation=lin.relaxation,
             method="anderson" if lin.acceleration == "anderson" else "relaxed",
-            mixing=ANDERSON_MIXING, allow_unconverged=lin.allow_unconverged,
+            mixing=ANDERSON_MIXING,
+            allow_unconverged=lin.allow_unconverged,
             name=name,
         )
     except ConvergenceError as exc:
         partial = exc.partial
         if isinstance(partial, FixedPointResult):
-            partial = FixedPointResult(partial.x, partial.iterations + 1,
-                                       partial.relative_change, False,
-                                       (change0,) + partial.history)
-        raise ConvergenceError(name, exc.iterations + 1, exc.residual, exc.tolerance,
-                               hint=hint, partial=partial) from None
-    return FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
-                            (change0,) + fp.history)
+            partial = FixedPointResult(
+                partial.x,
+                partial.iterations + 1,
+                partial.relative_change,
+                False,
+                (change0,) + partial.history,
+            )
+        raise ConvergenceError(
+            name, exc.iterations + 1, exc.residual, exc.tolerance, hint=hint, partial=partial
+        ) from None
+    return FixedPointResult(
+        fp.x, fp.iterations + 1, fp.relative_change, fp.converged, (change0,) + fp.history
+    )
 
 
-def linearization_record(system: LineSystem, sigma: np.ndarray, damping: Damping, fp: Any,
-                         tolerance: float, method: str) -> LinearizationRecord:
+def linearization_record(
+    system: LineSystem, sigma: np.ndarray, damping: Damping, fp: Any, tolerance: float, method: str
+) -> LinearizationRecord:
     """The record of a converged (or flagged) drag fixed point of one line: the
     iteration history of ``fp`` (a FixedPointResult), the final σ (the
     :func:`drag_coefficients` layout) split into normal and axial, and the linear
@@ -520,8 +574,14 @@ def linearization_record(system: LineSystem, sigma: np.ndarray, damping: Damping
     else:
         sig_n, b_n = parts["normal"][0], damping.b_normal
     return LinearizationRecord(
-        method=method, converged=fp.converged, iterations=fp.iterations,
-        relative_change=fp.relative_change, history=fp.history, tolerance=tolerance,
-        sigma_normal=sig_n, sigma_axial=parts["axial"], b_normal=b_n,
+        method=method,
+        converged=fp.converged,
+        iterations=fp.iterations,
+        relative_change=fp.relative_change,
+        history=fp.history,
+        tolerance=tolerance,
+        sigma_normal=sig_n,
+        sigma_axial=parts["axial"],
+        b_normal=b_n,
         b_axial=damping.b_axial,
     )

@@ -54,7 +54,8 @@ def modal_bandwidths(system: LineSystem, damping: Damping) -> np.ndarray:
         c = add_blocks(prep.S, drag_blocks(system, damping))
         phi = np.ascontiguousarray(system.modes.shapes[system.model.free])
         damping._cache["modal_band"] = np.einsum(
-            "ij,ij->j", phi, prep.free_rows(block_matvec(c, prep.nodes(phi))))
+            "ij,ij->j", phi, prep.free_rows(block_matvec(c, prep.nodes(phi)))
+        )
     return damping._cache["modal_band"]
 
 
@@ -92,17 +93,20 @@ def resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) ->
     j, wj, b, dw = bad[0]
     width = omega[-1] - omega[0]
     need = int(math.ceil(width / max(b, 1e-12 * wj))) + 1 if b > 0 else None
-    fix = (f"use analysis.omega.count >= {need} (or refine the grid around {wj:.4g} rad/s)"
-           if need is not None and need < 10**7 else
-           "the mode has no damping: add drag or seabed damping (no analysis.omega grid "
-           "resolves an undamped peak)")
+    fix = (
+        f"use analysis.omega.count >= {need} (or refine the grid around {wj:.4g} rad/s)"
+        if need is not None and need < 10**7
+        else "the mode has no damping: add drag or seabed damping (no analysis.omega grid "
+        "resolves an undamped peak)"
+    )
     more = f" and {len(bad) - 1} more mode(s)" if len(bad) > 1 else ""
     warn(
         f"line '{system.name}': the frequency grid (spacing {dw:.3g} rad/s near "
         f"{wj:.4g} rad/s) does not resolve mode {j + 1} at {wj:.4g} rad/s, whose "
         f"half-power bandwidth is {b:.3g} rad/s{more}; the resonance peak may be missed: "
         f"{fix}",
-        ResolutionWarning, stacklevel=3,
+        ResolutionWarning,
+        stacklevel=3,
     )
 
 
@@ -121,8 +125,12 @@ SURFACE_TARGET_RATIO = 1.5
 SURFACE_MATTERS_FRACTION = 0.25
 
 
-def surface_resolution_check(system: LineSystem, channels: tuple[Channel, ...],
-                              omega: np.ndarray, q: np.ndarray | None = None) -> None:
+def surface_resolution_check(
+    system: LineSystem,
+    channels: tuple[Channel, ...],
+    omega: np.ndarray,
+    q: np.ndarray | None = None,
+) -> None:
     """ResolutionWarning when the wave-velocity σ varies by more than
     ``SURFACE_SIGMA_RATIO`` along an element that matters (larger end σ at least
     ``SURFACE_MATTERS_FRACTION`` of the line's largest): one drag coefficient per element
@@ -158,8 +166,11 @@ def surface_resolution_check(system: LineSystem, channels: tuple[Channel, ...],
     za, zb = float(min(pos[j, 2], 0.0)), float(min(pos[j + 1, 2], 0.0))
     dz = abs(zb - za)
     shrink = math.log(SURFACE_TARGET_RATIO) / math.log(r) if math.isfinite(r) else 0.0
-    need = (f"at least {int(math.ceil(n_seg / shrink))} elements on segment {seg} "
-            f"(now {n_seg})" if shrink > 0 else "more elements")
+    need = (
+        f"at least {int(math.ceil(n_seg / shrink))} elements on segment {seg} (now {n_seg})"
+        if shrink > 0
+        else "more elements"
+    )
     more = int(np.count_nonzero(bad)) - 1
     others = f" ({more} more element(s) likewise)" if more > 0 else ""
     warn(
@@ -170,7 +181,8 @@ def surface_resolution_check(system: LineSystem, channels: tuple[Channel, ...],
         "decay depth of the wave kinematics and the response there carries an error of "
         f"several %; use {need}, or elements spanning at most {dz * shrink:.3g} "
         f"{units.length} of depth near the surface",
-        ResolutionWarning, stacklevel=3,
+        ResolutionWarning,
+        stacklevel=3,
     )
 
 
@@ -191,7 +203,8 @@ def tail_check(line: str, end: str, w: np.ndarray, dens: np.ndarray, m0: float) 
             f"(threshold {TAIL_FRACTION:g}): the grid cuts the response and σ is "
             "underestimated; raise analysis.omega.max (end motion spectra with an ω⁻⁵ "
             "tail drive inertia loads whose spectrum decays only like ω⁻¹)",
-            ResolutionWarning, stacklevel=3,
+            ResolutionWarning,
+            stacklevel=3,
         )
 
 
@@ -207,8 +220,9 @@ BAND_FRACTION = 0.01
 MOTION_SAG_FRACTION = 0.1
 
 
-def _normal_acceleration_sigma(system: LineSystem, channels: tuple[Channel, ...],
-                               omega: np.ndarray) -> np.ndarray:
+def _normal_acceleration_sigma(
+    system: LineSystem, channels: tuple[Channel, ...], omega: np.ndarray
+) -> np.ndarray:
     """σ of the fluid acceleration normal to each element, element mean square
     ω²(tr S − eᵀSe), S = ∫₀¹ Re(v vᴴ) dξ (:func:`element_mean_square`). [m/s²]"""
     e = system.frames[0]
@@ -294,17 +308,28 @@ def line_indicators(
     snap_margin, snap = _snap(system, tension_std, end_stats)
     resonances = _resonances(system, channels, linearization.damping, w)
     m_max, sag, to_sag, to_d = _large_motion(system, motion_std)
-    flags = (["snap"] if snap else []) + (["resonance"] if resonances else []) + (
-        ["large_motion"] if to_sag > MOTION_SAG_FRACTION else [])
+    flags = (
+        (["snap"] if snap else [])
+        + (["resonance"] if resonances else [])
+        + (["large_motion"] if to_sag > MOTION_SAG_FRACTION else [])
+    )
     return LineIndicators(
-        borgman_ratio=borgman, drag_inertia_ratio=d_i, snap_margin=snap_margin,
-        snap_risk=snap, resonances=tuple(resonances), motion_std_max=m_max, sag=sag,
-        motion_to_sag=float(to_sag), motion_to_diameter=to_d, flags=tuple(flags),
+        borgman_ratio=borgman,
+        drag_inertia_ratio=d_i,
+        snap_margin=snap_margin,
+        snap_risk=snap,
+        resonances=tuple(resonances),
+        motion_std_max=m_max,
+        sag=sag,
+        motion_to_sag=float(to_sag),
+        motion_to_diameter=to_d,
+        flags=tuple(flags),
     )
 
 
-def _drag_ratios(system: LineSystem, channels: tuple[Channel, ...], rec: Any,
-                 w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _drag_ratios(
+    system: LineSystem, channels: tuple[Channel, ...], rec: Any, w: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Borgman variance ratio and drag/inertia ratio per element (:func:`line_indicators`
     Notes). [-]"""
     model = system.model
@@ -313,17 +338,19 @@ def _drag_ratios(system: LineSystem, channels: tuple[Channel, ...], rec: Any,
     borgman = np.atleast_1d(borgman_variance_ratio(rec.sigma_normal, u_n))
     s_an = _normal_acceleration_sigma(system, channels, w)
     drag_sigma = rec.b_normal * rec.sigma_normal
-    inertia_sigma = (model.rho * (1.0 + mesh.ca_normal) * math.pi * mesh.diameter**2 / 4.0
-                     * s_an)
+    inertia_sigma = model.rho * (1.0 + mesh.ca_normal) * math.pi * mesh.diameter**2 / 4.0 * s_an
     with np.errstate(divide="ignore", invalid="ignore"):
-        d_i = np.where(inertia_sigma > 0, drag_sigma / np.where(inertia_sigma > 0,
-                                                                 inertia_sigma, 1.0),
-                       np.where(drag_sigma > 0, np.inf, 0.0))
+        d_i = np.where(
+            inertia_sigma > 0,
+            drag_sigma / np.where(inertia_sigma > 0, inertia_sigma, 1.0),
+            np.where(drag_sigma > 0, np.inf, 0.0),
+        )
     return borgman, d_i
 
 
-def _snap(system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, Any]
-          ) -> tuple[float, bool]:
+def _snap(
+    system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, Any]
+) -> tuple[float, bool]:
     """Snap margin min (mean − 3σ)/|mean| over the elements and ends, and whether some
     mean − 3σ < 0 (PhysicsWarning naming the worst place)."""
     mesh = system.model.mesh
@@ -332,15 +359,22 @@ def _snap(system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, A
     sigmas = np.concatenate([tension_std, [end_stats["end_a"].std, end_stats["end_b"].std]])
     low = means - SNAP_SIGMAS * sigmas
     with np.errstate(divide="ignore", invalid="ignore"):
-        margins = np.where(np.abs(means) > 0, low / np.abs(np.where(means != 0, means, 1.0)),
-                           np.where(low < 0, -np.inf, 0.0))
+        margins = np.where(
+            np.abs(means) > 0,
+            low / np.abs(np.where(means != 0, means, 1.0)),
+            np.where(low < 0, -np.inf, 0.0),
+        )
     k = int(np.argmin(margins))
     snap = bool(np.any(low < 0))
     if snap:
         units = unit_labels(system.environment.g)
-        where = ("end_a" if k == t_mean.size else "end_b" if k == t_mean.size + 1
-                 else f"element {k + 1} (s = {0.5 * (mesh.s0[k] + mesh.s0[k + 1]):.4g} "
-                      f"{units.length})")
+        where = (
+            "end_a"
+            if k == t_mean.size
+            else "end_b"
+            if k == t_mean.size + 1
+            else f"element {k + 1} (s = {0.5 * (mesh.s0[k] + mesh.s0[k + 1]):.4g} {units.length})"
+        )
         warn(
             f"line '{system.name}': the dynamic tension σ ({sigmas[k]:.4g} {units.force} "
             f"at {where}) exceeds 1/{SNAP_SIGMAS:g} of the mean tension ({means[k]:.4g} "
@@ -348,13 +382,15 @@ def _snap(system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, A
             "model is out of its depth (threshold mean − 3σ >= 0): use a nonlinear "
             "time-domain analysis "
             "(stochcable.reference.cable) or increase the pretension",
-            PhysicsWarning, stacklevel=4,
+            PhysicsWarning,
+            stacklevel=4,
         )
     return float(margins[k]), snap
 
 
-def _resonances(system: LineSystem, channels: tuple[Channel, ...], damping: Damping,
-                w: np.ndarray) -> list[dict[str, Any]]:
+def _resonances(
+    system: LineSystem, channels: tuple[Channel, ...], damping: Damping, w: np.ndarray
+) -> list[dict[str, Any]]:
     """Modes inside the excitation band with a modal damping ratio below
     ``RESONANCE_DAMPING_RATIO`` (PhysicsWarning naming the first)."""
     resonances: list[dict[str, Any]] = []
@@ -367,8 +403,9 @@ def _resonances(system: LineSystem, channels: tuple[Channel, ...], damping: Damp
             inside |= in_band
         zeta = _modal_damping_ratios(system, damping)
         for j in np.flatnonzero(inside & (zeta < RESONANCE_DAMPING_RATIO)):
-            resonances.append({"mode": int(j + 1), "omega": float(wn[j]),
-                               "damping_ratio": float(zeta[j])})
+            resonances.append(
+                {"mode": int(j + 1), "omega": float(wn[j]), "damping_ratio": float(zeta[j])}
+            )
     if resonances:
         r0 = resonances[0]
         more = f" and {len(resonances) - 1} more" if len(resonances) > 1 else ""
@@ -379,13 +416,13 @@ def _resonances(system: LineSystem, channels: tuple[Channel, ...], damping: Damp
             "response is set by damping the model may not represent; check the drag "
             "coefficients and add structural damping (analysis.structural_damping) or "
             "seabed damping where physical",
-            PhysicsWarning, stacklevel=4,
+            PhysicsWarning,
+            stacklevel=4,
         )
     return resonances
 
 
-def _large_motion(system: LineSystem, motion_std: np.ndarray
-                  ) -> tuple[float, float, float, float]:
+def _large_motion(system: LineSystem, motion_std: np.ndarray) -> tuple[float, float, float, float]:
     """Largest node motion σ [m], the sag of the static shape [m] (largest distance
     from the chord, once per line), and their ratio and the ratio to the diameter
     (PhysicsWarning above ``MOTION_SAG_FRACTION`` of the sag)."""
@@ -412,6 +449,7 @@ def _large_motion(system: LineSystem, motion_std: np.ndarray
             f"{units.length}), above the threshold {MOTION_SAG_FRACTION:g}: the "
             "linearization about the static shape is doubtful; check with a nonlinear "
             "time-domain analysis (stochcable.reference.cable)",
-            PhysicsWarning, stacklevel=4,
+            PhysicsWarning,
+            stacklevel=4,
         )
     return m_max, sag, to_sag, to_d

@@ -129,8 +129,7 @@ def fixed_point(
     if method not in ("relaxed", "anderson"):
         raise InputError("method", method, "-", "must be 'relaxed' or 'anderson'")
     floor_ = None if floor is None else _v.positive("floor", floor, "unit of x")
-    mix = beta if mixing is None else _v.in_range("mixing", mixing, "-", 0.0, 1.0,
-                                                  lo_open=True)
+    mix = beta if mixing is None else _v.in_range("mixing", mixing, "-", 0.0, 1.0, lo_open=True)
     x = _v.float_array("x0", x0, "unit of x", ndim=None, nonnegative=True).copy()
     shape = x.shape
     x = x.ravel()
@@ -152,7 +151,10 @@ def fixed_point(
         g = np.asarray(update(x.reshape(shape)), dtype=float).ravel()
         if g.shape != x.shape or not np.all(np.isfinite(g)):
             raise ConvergenceError(
-                name, it, float("nan"), tol_,
+                name,
+                it,
+                float("nan"),
+                tol_,
                 hint="update(x) returned a non-finite value or a wrong shape",
             )
         f = g - x
@@ -187,7 +189,10 @@ def fixed_point(
     if allow_unconverged:
         return result
     raise ConvergenceError(
-        name, max_it, change, tol_,
+        name,
+        max_it,
+        change,
+        tol_,
         hint="increase max_iterations, lower the relaxation or try method='anderson'",
         partial=result,
     )

@@ -99,8 +99,9 @@ def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs
             # exact along the elements: l0·C_I(I − eeᵀ)·iω∫N_i v dξ, plus attachments
             inertia[..., i] = element_load(b_in, mom[..., i] * (1j * w))
             if np.any(node_mass) and ch.acceleration is not None:
-                inertia[..., i] += (node_mass[:, None, None]
-                                    * np.transpose(ch.acceleration[..., comps], (1, 2, 0)))
+                inertia[..., i] += node_mass[:, None, None] * np.transpose(
+                    ch.acceleration[..., comps], (1, 2, 0)
+                )
         elif ch.acceleration is not None:  # hand-built channel: nodal interpolation
             acc = np.transpose(ch.acceleration[..., comps], (1, 2, 0))[..., None]
             inertia[..., i] = block_matvec(prep.BI, acc)[..., 0]
@@ -129,8 +130,11 @@ def drag_blocks(system: LineSystem, damping: Damping) -> NodeBlocks:
                 comps = list(model.components)
                 e = system.frames[0][:, comps]
                 eet = e[:, :, None] * e[:, None, :]
-                system._cache["eet"] = (eet, np.eye(len(comps))[None] - eet,
-                                        model.l0[:, None, None])
+                system._cache["eet"] = (
+                    eet,
+                    np.eye(len(comps))[None] - eet,
+                    model.l0[:, None, None],
+                )
             eet, ieet, l0 = system._cache["eet"]
             el = bn[:, None, None] * ieet
             el += damping.b_axial[:, None, None] * eet
@@ -178,8 +182,12 @@ def end_loads(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndarr
     if inp.moments is not None:
         drag_blocks(system, damping)
         b = damping._cache["elements"]
-        f = np.stack([np.einsum("ij,jwc->iwc", b[0], inp.moments[0, 0]),
-                      np.einsum("ij,jwc->iwc", b[-1], inp.moments[-1, 1])])
+        f = np.stack(
+            [
+                np.einsum("ij,jwc->iwc", b[0], inp.moments[0, 0]),
+                np.einsum("ij,jwc->iwc", b[-1], inp.moments[-1, 1]),
+            ]
+        )
     if inp.velocity is not None and np.any(damping.b_node):
         fn = damping.b_node[[0, -1], None, None, None] * inp.velocity[[0, -1]]
         f = fn if f is None else f + fn
@@ -254,8 +262,9 @@ def _moving_channels(inp: LineInputs) -> np.ndarray | None:
     return None if moving.all() else np.flatnonzero(moving)
 
 
-def drag_inputs(system: LineSystem, prep: LinePrep, inp: LineInputs
-                 ) -> tuple[np.ndarray | None, np.ndarray | None]:
+def drag_inputs(
+    system: LineSystem, prep: LinePrep, inp: LineInputs
+) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Drag-independent parts of the drag load on the free rows, F_d(V) + C_d Q of
     :func:`base_motion`, cached per inputs and solver: the element moments
     W_s = ∫N_s v dξ + Σ_t P_st Q_t (P the mass pattern of the drag,
@@ -267,9 +276,11 @@ def drag_inputs(system: LineSystem, prep: LinePrep, inp: LineInputs
         _, _, q = base_motion(system, prep, inp)
         wm = None
         if q is not None:
-            pat = (np.array([[0.5, 0.0], [0.0, 0.5]])
-                   if system.model.mass_matrix == "lumped" else
-                   np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]]))
+            pat = (
+                np.array([[0.5, 0.0], [0.0, 0.5]])
+                if system.model.mass_matrix == "lumped"
+                else np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
+            )
             act = _moving_channels(inp)  # Q = 0 for the others: W = the moments
             qa = q if act is None else q[..., act]
             w_q = np.empty((prep.n - 1, 2) + qa.shape[1:], dtype=complex)
@@ -281,8 +292,11 @@ def drag_inputs(system: LineSystem, prep: LinePrep, inp: LineInputs
             if act is None:
                 wm = w_q
             else:
-                wm = (inp.moments.copy() if inp.moments is not None else
-                      np.zeros((prep.n - 1, 2) + q.shape[1:], dtype=complex))
+                wm = (
+                    inp.moments.copy()
+                    if inp.moments is not None
+                    else np.zeros((prep.n - 1, 2) + q.shape[1:], dtype=complex)
+                )
                 wm[..., act] = w_q
         elif inp.moments is not None:
             wm = inp.moments
@@ -293,8 +307,7 @@ def drag_inputs(system: LineSystem, prep: LinePrep, inp: LineInputs
     return inp.cache[key]
 
 
-def free_load(system: LineSystem, prep: LinePrep, inp: LineInputs, damping: Damping
-               ) -> np.ndarray:
+def free_load(system: LineSystem, prep: LinePrep, inp: LineInputs, damping: Damping) -> np.ndarray:
     """The load of :func:`solve_free`, F0 + F_d(V) + C_d Q (:func:`base_motion`), on all
     nodes (n_nodes, d, n_w, n_ch), a fresh array."""
     _, f0, _ = base_motion(system, prep, inp)
@@ -312,8 +325,8 @@ def free_load(system: LineSystem, prep: LinePrep, inp: LineInputs, damping: Damp
 
 def silent_channel(omega: np.ndarray) -> tuple[Channel, ...]:
     """A zero-spectrum channel so a line without excitation still gets (zero) outputs."""
+
     def zero(w: np.ndarray) -> np.ndarray:
         return np.zeros_like(np.asarray(w, dtype=float))
 
-    return (Channel(name="none", kind="none", omega=omega, spectrum=zero(omega),
-                    density=zero),)
+    return (Channel(name="none", kind="none", omega=omega, spectrum=zero(omega), density=zero),)

@@ -544,6 +544,7 @@ def drag_inertia_ratio(
     drag = rho_ * cd_ * d_ * mean_abs_gaussian(sv, u_) * sv
     inertia = rho_ * cm_ * math.pi * d_**2 / 4.0 * sa
     with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(inertia > 0, drag / np.where(inertia > 0, inertia, 1.0),
-                         np.where(drag > 0, np.inf, 0.0))
+        ratio = np.where(
+            inertia > 0, drag / np.where(inertia > 0, inertia, 1.0), np.where(drag > 0, np.inf, 0.0)
+        )
     return _out(ratio)

@@ -164,13 +164,13 @@ class Channel:
     element_velocity: np.ndarray | None = None
     element_velocity_square: np.ndarray | None = None
     element_end_square: np.ndarray | None = None
-    nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(
-        default=None, repr=False)
+    nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
 
 
 def spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
     """ω -> S(ω) of a scene spectrum ``spec`` (one-sided, zero at ω <= 0), ω in
     [rad/s], S in [m²·s/rad]; ``g`` [m/s²] for the spectra that need it."""
+
     def density(w: np.ndarray) -> np.ndarray:
         w = np.asarray(w, dtype=float)
         out = np.zeros_like(w)
@@ -224,7 +224,9 @@ def line_channels(
         if m is not None and m.rao is not None:
             if scene.sea is None:
                 raise InputError(
-                    f"lines[{line.name}].{end}.motion.rao", "RAO table", "-",
+                    f"lines[{line.name}].{end}.motion.rao",
+                    "RAO table",
+                    "-",
                     "an RAO is relative to the sea: the scene needs a 'sea' (or give the "
                     "end motion as spectra per DOF)",
                 )
@@ -236,12 +238,21 @@ def line_channels(
         pts = np.array(positions, dtype=float)
         pts[:, 2] = np.maximum(pts[:, 2], -env.depth)
         el = element_wave_kinematics(w, pts, scene.sea.heading_rad, env.depth, env.g)
-        channels.append(Channel(
-            name="sea", kind="sea", omega=w, spectrum=density(w), density=density,
-            motion_a=raos.get("end_a"), motion_b=raos.get("end_b"),
-            element_velocity=el.velocity, element_velocity_square=el.velocity_square,
-            element_end_square=el.end_square, nodal=_sea_nodal(el, env.g),
-        ))
+        channels.append(
+            Channel(
+                name="sea",
+                kind="sea",
+                omega=w,
+                spectrum=density(w),
+                density=density,
+                motion_a=raos.get("end_a"),
+                motion_b=raos.get("end_b"),
+                element_velocity=el.velocity,
+                element_velocity_square=el.velocity_square,
+                element_end_square=el.end_square,
+                nodal=_sea_nodal(el, env.g),
+            )
+        )
     for end in ("end_a", "end_b"):
         m = getattr(line, end).motion
         if m is None or m.rao is not None:
@@ -253,26 +264,34 @@ def line_channels(
             density = spectrum_callable(spec, env.g)
             unit = np.zeros((w.size, 3), dtype=complex)
             unit[:, axis] = 1.0
-            channels.append(Channel(
-                name=f"{end}.{dof}", kind="end_motion", omega=w, spectrum=density(w),
-                density=density,
-                motion_a=unit if end == "end_a" else None,
-                motion_b=unit if end == "end_b" else None,
-            ))
+            channels.append(
+                Channel(
+                    name=f"{end}.{dof}",
+                    kind="end_motion",
+                    omega=w,
+                    spectrum=density(w),
+                    density=density,
+                    motion_a=unit if end == "end_a" else None,
+                    motion_b=unit if end == "end_b" else None,
+                )
+            )
     return tuple(channels)
 
 
-def _sea_nodal(el: ElementKinematics, g: float
-               ) -> Callable[[], tuple[np.ndarray, np.ndarray]]:
+def _sea_nodal(el: ElementKinematics, g: float) -> Callable[[], tuple[np.ndarray, np.ndarray]]:
     """The sea channel's nodal velocity and acceleration (n_omega, n_nodes, 3), on
     demand: :func:`stochcable.sea.kinematics.wave_kinematics` from the validated
     frequencies, points and wavenumbers of the element kinematics (no second
     validation, wavenumber solve or pressure)."""
+
     def nodal() -> tuple[np.ndarray, np.ndarray]:
-        _, _, _, vel, acc = _nodal_kinematics(el.omega, el.wavenumber, el.positions,
-                                              el.heading, el.depth, g)
-        return (np.ascontiguousarray(np.transpose(vel, (2, 0, 1))),
-                np.ascontiguousarray(np.transpose(acc, (2, 0, 1))))
+        _, _, _, vel, acc = _nodal_kinematics(
+            el.omega, el.wavenumber, el.positions, el.heading, el.depth, g
+        )
+        return (
+            np.ascontiguousarray(np.transpose(vel, (2, 0, 1))),
+            np.ascontiguousarray(np.transpose(acc, (2, 0, 1))),
+        )
 
     return nodal
 
@@ -300,8 +319,7 @@ def element_moments(model: Any, channel: Channel) -> np.ndarray | None:
         return None
     pat = _LUMPED if getattr(model, "mass_matrix", "consistent") == "lumped" else _CONSISTENT
     va, vb = channel.velocity[:, :-1], channel.velocity[:, 1:]
-    return np.stack([pat[0, 0] * va + pat[0, 1] * vb, pat[1, 0] * va + pat[1, 1] * vb],
-                    axis=2)
+    return np.stack([pat[0, 0] * va + pat[0, 1] * vb, pat[1, 0] * va + pat[1, 1] * vb], axis=2)
 
 
 def element_mean_square(channel: Channel) -> np.ndarray | None:
@@ -353,7 +371,9 @@ def element_frames(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     n2 = _cross(e, np.array([0.0, 0.0, 1.0]))
     nn = np.linalg.norm(n2, axis=1)
     vertical = nn < 1e-12
-    n2 = np.where(vertical[:, None], np.array([0.0, 1.0, 0.0]), n2 / np.where(vertical, 1.0, nn)[:, None])
+    n2 = np.where(
+        vertical[:, None], np.array([0.0, 1.0, 0.0]), n2 / np.where(vertical, 1.0, nn)[:, None]
+    )
     n1 = _cross(n2, e)
     return e, n1, n2
 
@@ -395,7 +415,7 @@ def _assemble(model: Any, blocks3: np.ndarray, node_diag: np.ndarray | None) -> 
     el = np.empty((n_el, 2 * d, 2 * d))
     for a in range(2):
         for c in range(2):
-            el[:, a * d:(a + 1) * d, c * d:(c + 1) * d] = pattern[a, c] * b
+            el[:, a * d : (a + 1) * d, c * d : (c + 1) * d] = pattern[a, c] * b
     from stochcable.line.fem import chain_csr
 
     diag = np.repeat(node_diag, d) if node_diag is not None and np.any(node_diag) else None
@@ -460,8 +480,9 @@ def drag_matrix(
     return _assemble(model, _drag_blocks3(model, b_normal, b_axial), b_node)
 
 
-def inertia_blocks(model: Any, g: float, e: np.ndarray | None = None
-                    ) -> tuple[np.ndarray, np.ndarray]:
+def inertia_blocks(
+    model: Any, g: float, e: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Morison inertia per unit length (n_el, 3, 3) and per attachment node (n_nodes,);
     ``e`` the element tangents when already at hand (:func:`element_frames`)."""
     mesh = model.mesh
@@ -536,7 +557,7 @@ def wave_loads(
             continue
         w = ch.omega
         blk = (l0 * drag)[None] + (1j * w)[:, None, None, None] * (l0 * inertia)[None]
-        el = np.einsum("weij,wesj->wesi", blk, mom)   # (n_w, n_el, 2, 3)
+        el = np.einsum("weij,wesj->wesi", blk, mom)  # (n_w, n_el, 2, 3)
         nodes = np.zeros((w.size, model.n_nodes, 3), dtype=complex)
         nodes[:, :-1] += el[:, :, 0]
         nodes[:, 1:] += el[:, :, 1]

@@ -61,9 +61,7 @@ class DefectivePencilWarning(PhysicsWarning):
 # ---------------------------------------------------------------------------------
 
 
-def modal_basis(
-    K: Matrix, M: Matrix, n_modes: int | None = None
-) -> tuple[np.ndarray, np.ndarray]:
+def modal_basis(K: Matrix, M: Matrix, n_modes: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     r"""Lowest natural frequencies and mass-normalized mode shapes of ``(K, M)``.
 
     Parameters
@@ -102,15 +100,16 @@ def modal_basis(
     if m > n:
         raise InputError("n_modes", n_modes, "-", f"must be <= n_dof = {n}")
     if sp.issparse(K_) and n > 2000 and 2 * m < n:
-        lam, phi = spla.eigsh(sp.csc_matrix(K_), k=m, M=sp.csc_matrix(M_), sigma=0.0,
-                              which="LM")
+        lam, phi = spla.eigsh(sp.csc_matrix(K_), k=m, M=sp.csc_matrix(M_), sigma=0.0, which="LM")
         order = np.argsort(lam)
         lam, phi = lam[order], phi[:, order]
         mm = np.einsum("ij,ij->j", phi, M_ @ phi)
         phi = phi / np.sqrt(mm)
     else:
         try:
-            lam, phi = sla.eigh(dense_matrix(K_, n), dense_matrix(M_, n), subset_by_index=[0, m - 1])
+            lam, phi = sla.eigh(
+                dense_matrix(K_, n), dense_matrix(M_, n), subset_by_index=[0, m - 1]
+            )
         except np.linalg.LinAlgError as exc:
             raise SolverError(
                 f"modal analysis failed: M is not positive definite ({exc})"
@@ -186,9 +185,7 @@ class FossModes:
     condition: float
 
 
-def foss_decomposition(
-    Mhat: np.ndarray, Chat: np.ndarray, Khat: np.ndarray
-) -> FossModes:
+def foss_decomposition(Mhat: np.ndarray, Chat: np.ndarray, Khat: np.ndarray) -> FossModes:
     r"""Foss state-space decoupling of ``Mhat z'' + Chat z' + Khat z = Fhat``.
 
     Parameters
@@ -286,11 +283,10 @@ def foss_modes(Mh: np.ndarray, Ch: np.ndarray, Kh: np.ndarray) -> FossModes:
     chi = theta[n:]
     # A^{-1} [0; I] = [M^{-1}; 0] (A = [[0, M], [M, C]])
     rhs = np.zeros((2 * n, n), dtype=complex)
-    rhs[:n] = minv[:, 2 * n:]
+    rhs[:n] = minv[:, 2 * n :]
     weights = sla.lu_solve((lu, piv), rhs, check_finite=False)
     # a_j = theta_j^T A theta_j = 2 lambda_j chi_j^T M chi_j + chi_j^T C chi_j
-    a = (2.0 * lam * np.einsum("ij,ij->j", chi, Mh @ chi)
-         + np.einsum("ij,ij->j", chi, Ch @ chi))
+    a = 2.0 * lam * np.einsum("ij,ij->j", chi, Mh @ chi) + np.einsum("ij,ij->j", chi, Ch @ chi)
     return FossModes(lam, chi, a, weights, float(cond))
 
 
@@ -375,7 +371,8 @@ def _residual_flexibility_times(
         lu = spla.splu(sp.csc_matrix(K))
         rhs = np.moveaxis(f, 0, 1).reshape(n, -1)
         full = lu.solve(np.ascontiguousarray(rhs.real)) + 1j * lu.solve(
-            np.ascontiguousarray(rhs.imag))
+            np.ascontiguousarray(rhs.imag)
+        )
         return np.moveaxis(full.reshape(n, f.shape[0], -1), 1, 0) - modal @ f
     try:
         cf = sla.cho_factor(dense_matrix(K, n))
@@ -470,7 +467,8 @@ def solve_modal(
         except SolverError as exc:
             warn(
                 f"{exc}; falling back to the direct solve in modal coordinates",
-                DefectivePencilWarning, stacklevel=2,
+                DefectivePencilWarning,
+                stacklevel=2,
             )
         else:
             z = foss_transfer(foss, fh, w)
@@ -483,4 +481,3 @@ def solve_modal(
     if not np.all(np.isfinite(u)):  # pragma: no cover - guarded above
         raise SolverError("modal solve produced non-finite values")
     return u[:, :, 0] if squeeze else u
-

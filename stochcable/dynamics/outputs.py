@@ -118,9 +118,11 @@ def line_result(
     if np.any(spectra > 0):  # nothing to resolve without excitation
         resolution_check(system, linearization.damping, w)
         surface_resolution_check(system, channels, w, q)
-    indicators = (None if linearization.record is None else
-                  line_indicators(system, channels, linearization, tension_std, motion_std,
-                                  stats))
+    indicators = (
+        None
+        if linearization.record is None
+        else line_indicators(system, channels, linearization, tension_std, motion_std, stats)
+    )
     end_force = _end_force_transfer(model, resp, n_ch)
     return LineResult(
         name=system.name,
@@ -156,8 +158,9 @@ def _motion_transfer(model: Any, resp: Response, n_ch: int) -> np.ndarray:
     w = resp.omega
     # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the frequency-major
     # layout and transposing made every later pass strided)
-    u_h = np.transpose(resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch),
-                       (3, 1, 2, 0))
+    u_h = np.transpose(
+        resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch), (3, 1, 2, 0)
+    )
     if tuple(model.components) == (0, 1, 2):  # 3-D: no zero components to embed
         return np.ascontiguousarray(u_h)
     motion_h = np.zeros((n_ch, model.n_nodes, 3, w.size), dtype=resp.displacement.dtype)
@@ -173,6 +176,6 @@ def _end_force_transfer(model: Any, resp: Response, n_ch: int) -> dict[str, np.n
     end_force = {}
     for k, end in enumerate(("end_a", "end_b")):
         f = np.zeros((n_ch, 3, w.size), dtype=complex)
-        f[:, comps, :] = np.transpose(resp.support_force[:, k * d:(k + 1) * d, :], (2, 1, 0))
+        f[:, comps, :] = np.transpose(resp.support_force[:, k * d : (k + 1) * d, :], (2, 1, 0))
         end_force[end] = f
     return end_force

@@ -63,11 +63,12 @@ from stochcable.errors import (
 
 def _dynamic(prep: LinePrep, c: NodeBlocks, w: np.ndarray, x: np.ndarray) -> np.ndarray:
     """(−ω²M_T + iωC) x for node vectors x (n_nodes, d, n_w, k)."""
-    return (-(w * w)[:, None] * block_matvec(prep.MT, x) + (1j * w)[:, None] * block_matvec(c, x))
+    return -(w * w)[:, None] * block_matvec(prep.MT, x) + (1j * w)[:, None] * block_matvec(c, x)
 
 
-def solve_free(system: LineSystem, inp: LineInputs, damping: Damping, *,
-                modal_direct: bool = False) -> tuple[np.ndarray, NodeBlocks]:
+def solve_free(
+    system: LineSystem, inp: LineInputs, damping: Damping, *, modal_direct: bool = False
+) -> tuple[np.ndarray, NodeBlocks]:
     """Dynamic part on the free nodes, (n_nodes − 2, d, n_w, n_ch), and C = C_s + C_d.
 
     The total displacement is U = U_p + [0; u_f; 0] with U_p of :func:`base_motion`.
@@ -82,8 +83,9 @@ def solve_free(system: LineSystem, inp: LineInputs, damping: Damping, *,
     if system.solver == "direct":
         rhs_f = to_freq(rhs[1:-1])
         bC = prep.bS + free_band(cd)
-        u_f = solve_band_stacked(prep.bK, prep.bM, bC, rhs_f, w, 2 * d - 1, 2 * d - 1,
-                                  (system.model.K, system.model.M))
+        u_f = solve_band_stacked(
+            prep.bK, prep.bM, bC, rhs_f, w, 2 * d - 1, 2 * d - 1, (system.model.K, system.model.M)
+        )
         _check_line_conditioning(system, prep, bC, w, rhs_f, u_f)
         return np.ascontiguousarray(from_freq(u_f, d)), c
     u_f = _foss_free(system, prep, c, prep.free_rows(rhs), w, modal_direct=modal_direct)
@@ -98,8 +100,9 @@ def total_displacement(system: LineSystem, inp: LineInputs, u_free: np.ndarray) 
     return u
 
 
-def _solve_nodes(system: LineSystem, inp: LineInputs, damping: Damping
-                 ) -> tuple[np.ndarray, NodeBlocks]:
+def _solve_nodes(
+    system: LineSystem, inp: LineInputs, damping: Damping
+) -> tuple[np.ndarray, NodeBlocks]:
     """Total displacement (n_nodes, d, n_w, n_ch) and C = C_s + C_d."""
     u_f, c = solve_free(system, inp, damping)
     return total_displacement(system, inp, u_f), c
@@ -114,8 +117,9 @@ def _check_line_conditioning(system, prep, bC, w, f, u) -> None:
     nf = np.linalg.norm(f.reshape(w.size, -1), axis=1)
     nu = np.linalg.norm(u.reshape(w.size, -1), axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
-        est = np.where(np.isfinite(nu), nz * np.where(nf > 0, nu / np.where(nf > 0, nf, 1.0),
-                                                      0.0), np.inf)
+        est = np.where(
+            np.isfinite(nu), nz * np.where(nf > 0, nu / np.where(nf > 0, nf, 1.0), 0.0), np.inf
+        )
     bad = np.flatnonzero(est > SINGULAR_CONDITION)
     if bad.size:
         k = int(bad[np.argmax(est[bad])])
@@ -123,8 +127,14 @@ def _check_line_conditioning(system, prep, bC, w, f, u) -> None:
         raise singular_error(K, M, float(w[k]), float(est[k]))
 
 
-def _foss_free(system: LineSystem, prep: LinePrep, c: NodeBlocks, rhs: np.ndarray,
-               w: np.ndarray, modal_direct: bool = False) -> np.ndarray:
+def _foss_free(
+    system: LineSystem,
+    prep: LinePrep,
+    c: NodeBlocks,
+    rhs: np.ndarray,
+    w: np.ndarray,
+    modal_direct: bool = False,
+) -> np.ndarray:
     """Foss modal solve on the free DOFs, rhs (n_free_dof, n_w, n_ch), with the static
     correction of the truncated modes (seed 001 §5.3;
     :func:`stochcable.dynamics.modal_solvers.foss_decomposition`).
@@ -146,8 +156,11 @@ def _foss_free(system: LineSystem, prep: LinePrep, c: NodeBlocks, rhs: np.ndarra
         try:
             foss = foss_modes(mh, ch, kh)
         except SolverError as exc:
-            warn(f"{exc}; falling back to the direct solve in modal coordinates",
-                 DefectivePencilWarning, stacklevel=3)
+            warn(
+                f"{exc}; falling back to the direct solve in modal coordinates",
+                DefectivePencilWarning,
+                stacklevel=3,
+            )
         else:
             z = foss_transfer_modal(foss, fh, w, n_ch)
     if z is None and modal_direct:
@@ -174,8 +187,14 @@ def _foss_free(system: LineSystem, prep: LinePrep, c: NodeBlocks, rhs: np.ndarra
     return u.reshape(nf, n_w, n_ch)
 
 
-def reactions(system: LineSystem, prep: LinePrep, c: NodeBlocks, u: np.ndarray,
-               f_all: np.ndarray, w: np.ndarray) -> np.ndarray:
+def reactions(
+    system: LineSystem,
+    prep: LinePrep,
+    c: NodeBlocks,
+    u: np.ndarray,
+    f_all: np.ndarray,
+    w: np.ndarray,
+) -> np.ndarray:
     """Dynamic force of the line on the supports, (n_w, 2d, n_ch):
     −[(K − ω²M_T + iωC)U − F]_end rows, u and f_all in the node layout."""
     d = u.shape[1]
@@ -200,16 +219,24 @@ def reactions(system: LineSystem, prep: LinePrep, c: NodeBlocks, u: np.ndarray,
     return -np.concatenate(out, axis=1)
 
 
-def line_response(system: LineSystem, inp: LineInputs, damping: Damping,
-              solved: tuple[np.ndarray, NodeBlocks] | None = None) -> Response:
+def line_response(
+    system: LineSystem,
+    inp: LineInputs,
+    damping: Damping,
+    solved: tuple[np.ndarray, NodeBlocks] | None = None,
+) -> Response:
     """Response with reactions and end tensions; ``solved`` = (u, C) of a solve already
     done with this ``damping`` (:func:`_solve_nodes`) skips the solve."""
     prep = line_prep(system)
     u, c = _solve_nodes(system, inp, damping) if solved is None else solved
     support = reactions(system, prep, c, u, end_loads(system, inp, damping), inp.omega)
     disp = to_freq(u)
-    return Response(omega=inp.omega, displacement=disp, support_force=support,
-                    end_tension=end_tension_from_support(system, support))
+    return Response(
+        omega=inp.omega,
+        displacement=disp,
+        support_force=support,
+        end_tension=end_tension_from_support(system, support),
+    )
 
 
 # --------------------------------------------------------------------------- solve
@@ -288,6 +315,6 @@ def end_tension_from_support(system: LineSystem, support: np.ndarray) -> dict[st
     out = {}
     for k, end in enumerate(("end_a", "end_b")):
         u = _end_direction(system, end)[comps]
-        df = support[:, k * d:(k + 1) * d, :]  # fixed DOFs: node 0 then node n-1
+        df = support[:, k * d : (k + 1) * d, :]  # fixed DOFs: node 0 then node n-1
         out[end] = np.einsum("c,wcr->rw", u, df)
     return out

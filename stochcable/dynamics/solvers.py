@@ -92,8 +92,10 @@ def load_array(F: Any, n: int, n_omega: int) -> tuple[np.ndarray, bool]:
     f = f.astype(complex)
     if f.ndim not in (2, 3) or f.shape[0] != n_omega or f.shape[1] != n:
         raise InputError(
-            "F", f, "N", f"must have shape (n_omega={n_omega}, n_dof={n}[, n_rhs]) "
-            f"(got {f.shape})",
+            "F",
+            f,
+            "N",
+            f"must have shape (n_omega={n_omega}, n_dof={n}[, n_rhs]) (got {f.shape})",
         )
     if not np.all(np.isfinite(f)):
         raise InputError("F", f, "N", "must be finite (not NaN or inf)")
@@ -143,7 +145,7 @@ def _band(a: Matrix | None, n: int, lo: int, up: int) -> np.ndarray:
         return ab
     for d in range(-lo, up + 1):
         diag = a.diagonal(d) if sp.issparse(a) else np.diagonal(a, d)
-        ab[up - d, max(0, d): n + min(0, d)] = diag
+        ab[up - d, max(0, d) : n + min(0, d)] = diag
     return ab
 
 
@@ -162,8 +164,9 @@ def _nearest_mode_text(K: Matrix, M: Matrix, w: float) -> str:
         if n <= 2000:
             lam = sla.eigh(dense_matrix(K, n), dense_matrix(M, n), eigvals_only=True)
         else:  # pragma: no cover - large models
-            lam = spla.eigsh(sp.csc_matrix(K), k=6, M=sp.csc_matrix(M), sigma=w * w,
-                             return_eigenvectors=False)
+            lam = spla.eigsh(
+                sp.csc_matrix(K), k=6, M=sp.csc_matrix(M), sigma=w * w, return_eigenvectors=False
+            )
             lam = np.sort(lam)
         wn = np.sqrt(np.clip(lam, 0.0, None))
         j = int(np.argmin(np.abs(wn - w)))
@@ -209,10 +212,10 @@ def solve_dense_batched(K, M, C, F, omega):
     out = np.empty_like(F)
     chunk = max(1, _CHUNK_BYTES // (16 * n * n))
     for lo in range(0, omega.size, chunk):
-        w = omega[lo: lo + chunk, None, None]
+        w = omega[lo : lo + chunk, None, None]
         Z = Kd - w**2 * Md + (0j if Cd is None else 1j * w * Cd)
         try:
-            out[lo: lo + chunk] = np.linalg.solve(Z, F[lo: lo + chunk])
+            out[lo : lo + chunk] = np.linalg.solve(Z, F[lo : lo + chunk])
         except np.linalg.LinAlgError:
             for k in range(Z.shape[0]):  # error path only: find the singular frequency
                 try:
@@ -375,8 +378,12 @@ def tridiagonal_blocks(A: Matrix, block_size: int) -> Blocks:
     off = bi - bj
     if np.any(np.abs(off) > 1):
         k = int(np.flatnonzero(np.abs(off) > 1)[0])
-        raise InputError("A", f"entry ({rows[k]}, {cols[k]})", "-",
-                         f"must be block-tridiagonal with {b}x{b} blocks")
+        raise InputError(
+            "A",
+            f"entry ({rows[k]}, {cols[k]})",
+            "-",
+            f"must be block-tridiagonal with {b}x{b} blocks",
+        )
     out = []
     for sel in (off == 0, off == 1, off == -1):
         blk = np.zeros((nb, b, b), dtype=dtype)
@@ -394,8 +401,8 @@ def band_from_blocks(blocks: Blocks) -> np.ndarray:
     p, q = np.meshgrid(np.arange(b), np.arange(b), indexing="ij")
     i = np.arange(nb)[:, None, None]
     for blk, shift in ((diag, 0), (lower, -1), (upper, 1)):
-        rows = (i * b + p)
-        cols = ((i + shift) * b + q)
+        rows = i * b + p
+        cols = (i + shift) * b + q
         ok = np.broadcast_to((cols >= 0) & (cols < nb * b), blk.shape)
         ab[(u + rows - cols)[ok], cols[ok]] = blk[ok]
     return ab
@@ -406,14 +413,25 @@ def _blocks_sparse(blocks: Blocks) -> sp.csr_array:
     ab = band_from_blocks(blocks)
     u = (ab.shape[0] - 1) // 2
     n = ab.shape[1]
-    return sp.csr_array(sp.diags_array([ab[u - d, max(0, d): n + min(0, d)]
-                                        for d in range(-u, u + 1)],
-                                       offsets=list(range(-u, u + 1)), shape=(n, n)))
+    return sp.csr_array(
+        sp.diags_array(
+            [ab[u - d, max(0, d) : n + min(0, d)] for d in range(-u, u + 1)],
+            offsets=list(range(-u, u + 1)),
+            shape=(n, n),
+        )
+    )
 
 
-def solve_band_stacked(bK: np.ndarray, bM: np.ndarray, bC: np.ndarray | None,
-                        f: np.ndarray, omega: np.ndarray, lo_bw: int, up_bw: int,
-                        mats: tuple | None = None) -> np.ndarray:
+def solve_band_stacked(
+    bK: np.ndarray,
+    bM: np.ndarray,
+    bC: np.ndarray | None,
+    f: np.ndarray,
+    omega: np.ndarray,
+    lo_bw: int,
+    up_bw: int,
+    mats: tuple | None = None,
+) -> np.ndarray:
     """All frequencies in one LAPACK ``gbsv`` call per chunk (no validation).
 
     bK, bM, bC: band storage ``ab[up + i - j, j]`` (lo + up + 1, n) of K, M, C; f of
@@ -429,7 +447,7 @@ def solve_band_stacked(bK: np.ndarray, bM: np.ndarray, bC: np.ndarray | None,
     chunk = max(1, _CHUNK_BYTES // (16 * n * (rows + lo_bw + r)))
     gbsv = sla.get_lapack_funcs("gbsv", dtype=complex)
     for lo in range(0, n_w, chunk):
-        w = omega[lo: lo + chunk]
+        w = omega[lo : lo + chunk]
         m = w.size
         # Fortran-ordered band storage of the stack (no copy in the LAPACK wrapper):
         # column j of frequency k is column k·n + j
@@ -439,7 +457,7 @@ def solve_band_stacked(bK: np.ndarray, bM: np.ndarray, bC: np.ndarray | None,
         z -= bM[:, :, None] * (w * w)
         if bC is not None:
             z += bC[:, :, None] * (1j * w)
-        rhs = np.array(f[lo: lo + chunk].reshape(m * n, r), order="F")  # a copy
+        rhs = np.array(f[lo : lo + chunk].reshape(m * n, r), order="F")  # a copy
         _, _, x, info = gbsv(lo_bw, up_bw, ab, rhs, overwrite_ab=True, overwrite_b=True)
         if info > 0:
             k = lo + (info - 1) // n
@@ -447,20 +465,28 @@ def solve_band_stacked(bK: np.ndarray, bM: np.ndarray, bC: np.ndarray | None,
             raise singular_error(K, M, float(omega[k]), None)
         if info < 0:  # pragma: no cover - argument error
             raise SolverError(f"LAPACK gbsv argument {-info} is invalid")
-        out[lo: lo + chunk] = x.reshape(m, n, r)
+        out[lo : lo + chunk] = x.reshape(m, n, r)
     return out
 
 
 def _as_blocks(name: str, a: Any, b: int, n: int | None) -> Blocks:
     if isinstance(a, tuple):
         if len(a) != 3:
-            raise InputError(name, f"tuple of {len(a)}", "-",
-                             "must be a matrix or the (diag, lower, upper) blocks")
+            raise InputError(
+                name,
+                f"tuple of {len(a)}",
+                "-",
+                "must be a matrix or the (diag, lower, upper) blocks",
+            )
         arrs = [_v.float_array(f"{name}[{k}]", x, "-", ndim=3) for k, x in enumerate(a)]
         shape = arrs[0].shape
         if shape[1:] != (b, b) or any(x.shape != shape for x in arrs):
-            raise InputError(name, [x.shape for x in arrs], "-",
-                             f"blocks must all have shape (n_blocks, {b}, {b})")
+            raise InputError(
+                name,
+                [x.shape for x in arrs],
+                "-",
+                f"blocks must all have shape (n_blocks, {b}, {b})",
+            )
         blocks = (arrs[0], arrs[1], arrs[2])
     else:
         m = as_matrix(name, a)
@@ -538,13 +564,17 @@ def solve_block_tridiagonal(
     else:
         mats = list(system_matrices(K, M, C))
         if mats[0].shape[0] % b:
-            raise InputError("K", mats[0].shape, "-",
-                             f"size must be a multiple of block_size = {b}")
+            raise InputError(
+                "K", mats[0].shape, "-", f"size must be a multiple of block_size = {b}"
+            )
         lo_bw, up_bw = matrix_bandwidth(*mats)
         if max(lo_bw, up_bw) > bw:
-            raise InputError("K, M, C", f"bandwidth ({lo_bw}, {up_bw})", "-",
-                             f"must be block-tridiagonal with {b}x{b} blocks "
-                             f"(bandwidth <= {bw})")
+            raise InputError(
+                "K, M, C",
+                f"bandwidth ({lo_bw}, {up_bw})",
+                "-",
+                f"must be block-tridiagonal with {b}x{b} blocks (bandwidth <= {bw})",
+            )
     n = mats[0].shape[0]
     f, squeeze = load_array(F, n, w.size)
     bands = [None if x is None else _band(x, n, bw, bw) for x in mats]

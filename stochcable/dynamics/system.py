@@ -180,8 +180,9 @@ class Damping:
         """Drag damping matrix C_d on all DOFs (without the seabed damping), assembled
         on first access (:func:`stochcable.dynamics.loads.drag_matrix`). [N·s/m]"""
         if "matrix" not in self._cache:
-            self._cache["matrix"] = drag_matrix(self.model, self.b_normal, self.b_axial,
-                                                self.b_node)
+            self._cache["matrix"] = drag_matrix(
+                self.model, self.b_normal, self.b_axial, self.b_node
+            )
         return self._cache["matrix"]
 
 
@@ -209,7 +210,8 @@ class Response:
 
 @dataclass(frozen=True)
 class CoarseStage:
-    """The coarse start of a drag linearization (:mod:`stochcable.dynamics.fixedpoint`, "Coarse start").
+    """The coarse start of a drag linearization (:mod:`stochcable.dynamics.fixedpoint`,
+    "Coarse start").
 
     Attributes
     ----------
@@ -310,6 +312,8 @@ def build_line_system(
         current_node=current_at_nodes(env, model.positions),
         drag_nodes=np.flatnonzero(mesh.node_drag_area > 0),
         environment=env,
-        structural_damping=(float(settings.structural_damping.alpha),
-                            float(settings.structural_damping.beta)),
+        structural_damping=(
+            float(settings.structural_damping.alpha),
+            float(settings.structural_damping.beta),
+        ),
     )

@@ -92,8 +92,10 @@ def simulate_timeseries(
     scene_order = [ln.name for ln in scene.lines if ln.name in all_systems]
     names = scene_order + [n for n in all_systems if n not in scene_order]
     # channel names and densities of every line (scene order) from one frequency
-    probe = {n: _channels_on(scene, all_systems[n], syn.w_band[:1]) if syn.band.size
-             else () for n in names}
+    probe = {
+        n: _channels_on(scene, all_systems[n], syn.w_band[:1]) if syn.band.size else ()
+        for n in names
+    }
     syn.realize_end_motions(probe)
     out = _Series()
     _independent_lines(scene, systems, dampings, probe, syn, out, timing)
@@ -101,20 +103,29 @@ def simulate_timeseries(
     for b in getattr(scene, "bodies", ()) or ():
         if getattr(b, "prescribed", None) is None or syn.sea is None:
             continue  # vessels: their RAO times the sea
-        h = syn.full(vessel_raos(scene, syn.w_band)[b.name].T)[None]      # (1, 6, N+1)
+        h = syn.full(vessel_raos(scene, syn.w_band)[b.name].T)[None]  # (1, 6, N+1)
         mean = np.concatenate([np.asarray(b.position, dtype=float), np.zeros(3)])
-        out.add_body(b.name, mean, ("surge", "sway", "heave", "roll", "pitch", "yaw"),
-                     h, syn.synthesized(h, ("sea",), (None,)), ("sea",))
+        out.add_body(
+            b.name,
+            mean,
+            ("surge", "sway", "heave", "roll", "pitch", "yaw"),
+            h,
+            syn.synthesized(h, ("sea",), (None,)),
+            ("sea",),
+        )
     order = [n for n in names if n in out.end_tension]
-    body_order = [b.name for b in (getattr(scene, "bodies", ()) or ())
-                  if b.name in out.body_motion]
+    body_order = [b.name for b in (getattr(scene, "bodies", ()) or ()) if b.name in out.body_motion]
     return TimeSeries(
-        time=syn.time_axis(), method=settings.method, seed=syn.seed,
+        time=syn.time_axis(),
+        method=settings.method,
+        seed=syn.seed,
         elevation=None if syn.sea is None else np.asarray(syn.sea.elevation),
-        end_motion={f"{name}.{cname}": np.asarray(r.elevation)
-                    for (name, cname), r in syn.reals.items()},
+        end_motion={
+            f"{name}.{cname}": np.asarray(r.elevation) for (name, cname), r in syn.reals.items()
+        },
         end_tension={n: out.end_tension[n] for n in order},
-        omega=syn.omega, channels={n: out.channels[n] for n in order},
+        omega=syn.omega,
+        channels={n: out.channels[n] for n in order},
         end_tension_transfer={n: out.transfer[n] for n in order},
         body_motion={n: out.body_motion[n] for n in body_order},
         body_channels={n: out.body_channels[n] for n in body_order},
@@ -145,22 +156,24 @@ class _Synthesis:
                 out[w > 0] = spec.spectral_density(w[w > 0], g)
                 return out
 
-            self.sea = simulate_sea(sea_density, settings.duration, settings.dt,
-                                    settings.method, rng=self.seed)
+            self.sea = simulate_sea(
+                sea_density, settings.duration, settings.dt, settings.method, rng=self.seed
+            )
         self.reals: dict[tuple[str, str], Any] = {}
 
     def realize_end_motions(self, probe: Mapping[str, tuple[Channel, ...]]) -> None:
         """One realization per end-motion channel, in the order of ``probe`` (lines)
         and of their channels, from independent children of the seed."""
         st = self.settings
-        keys = [(name, ch.name) for name, chs in probe.items() for ch in chs
-                if ch.kind == "end_motion"]
+        keys = [
+            (name, ch.name) for name, chs in probe.items() for ch in chs if ch.kind == "end_motion"
+        ]
         children = np.random.SeedSequence(self.seed).spawn(len(keys)) if keys else []
         for (name, cname), child in zip(keys, children):
             ch = next(c for c in probe[name] if c.name == cname)
-            self.reals[(name, cname)] = simulate_sea(ch.density, st.duration, st.dt,
-                                                     st.method,
-                                                     rng=np.random.default_rng(child))
+            self.reals[(name, cname)] = simulate_sea(
+                ch.density, st.duration, st.dt, st.method, rng=np.random.default_rng(child)
+            )
 
     def full(self, h: np.ndarray) -> np.ndarray:
         """Band values (..., n_band) -> the realization grid (..., N+1), zero outside."""
@@ -168,8 +181,9 @@ class _Synthesis:
         out[..., self.band] = h
         return out
 
-    def synthesized(self, h: np.ndarray, kinds: tuple[str, ...],
-                    sources: tuple[tuple[str, str] | None, ...]) -> np.ndarray:
+    def synthesized(
+        self, h: np.ndarray, kinds: tuple[str, ...], sources: tuple[tuple[str, str] | None, ...]
+    ) -> np.ndarray:
         """Σ over channels of synthesize(realization, H), H (n_ch, ..., N+1)."""
         y = np.zeros(h.shape[1:-1] + (self.n_t,))
         for i, (kind, src) in enumerate(zip(kinds, sources)):
@@ -195,19 +209,35 @@ class _Series:
         self.body_transfer: dict[str, np.ndarray] = {}
         self.body_channels: dict[str, tuple[str, ...]] = {}
 
-    def add_line(self, name: str, statics: Any, tr: dict[str, np.ndarray], syn: _Synthesis,
-                 kinds: tuple[str, ...], sources: tuple[Any, ...],
-                 channels: tuple[str, ...]) -> None:
+    def add_line(
+        self,
+        name: str,
+        statics: Any,
+        tr: dict[str, np.ndarray],
+        syn: _Synthesis,
+        kinds: tuple[str, ...],
+        sources: tuple[Any, ...],
+        channels: tuple[str, ...],
+    ) -> None:
         """End tensions: the static tension plus the synthesis of the transfer ``tr``."""
         self.end_tension[name] = {
-            e: float(t) + (syn.synthesized(tr[e], kinds, sources) if tr else 0.0)
+            e: float(t)
+            + (syn.synthesized(tr[e], kinds, sources) if tr else 0.0)
             + np.zeros(syn.n_t)
-            for e, t in (("end_a", statics.tension_a), ("end_b", statics.tension_b))}
+            for e, t in (("end_a", statics.tension_a), ("end_b", statics.tension_b))
+        }
         self.transfer[name] = tr
         self.channels[name] = channels
 
-    def add_body(self, name: str, mean: np.ndarray, dofs: tuple[str, ...], h: np.ndarray,
-                 y: np.ndarray, channels: tuple[str, ...]) -> None:
+    def add_body(
+        self,
+        name: str,
+        mean: np.ndarray,
+        dofs: tuple[str, ...],
+        h: np.ndarray,
+        y: np.ndarray,
+        channels: tuple[str, ...],
+    ) -> None:
         self.body_motion[name] = {k: float(mean[i]) + y[i] for i, k in enumerate(dofs)}
         self.body_transfer[name] = h
         self.body_channels[name] = channels
@@ -222,10 +252,15 @@ def _channels_on(scene: Scene, system: LineSystem, w: np.ndarray) -> tuple[Chann
     return ch
 
 
-def _independent_lines(scene: Scene, systems: Mapping[str, LineSystem],
-                       dampings: Mapping[str, Damping],
-                       probe: Mapping[str, tuple[Channel, ...]], syn: _Synthesis,
-                       out: _Series, timing: dict[str, float] | None) -> None:
+def _independent_lines(
+    scene: Scene,
+    systems: Mapping[str, LineSystem],
+    dampings: Mapping[str, Damping],
+    probe: Mapping[str, tuple[Channel, ...]],
+    syn: _Synthesis,
+    out: _Series,
+    timing: dict[str, float] | None,
+) -> None:
     """Independent lines: :func:`solve` with their converged drag on the band, in
     chunks of frequencies (only the end tensions of the whole band are held)."""
     from stochcable.dynamics.coupled_timeseries import (
@@ -238,38 +273,64 @@ def _independent_lines(scene: Scene, systems: Mapping[str, LineSystem],
         chs = probe.get(name, ())
         tr = {}
         if chs:
-            h = {e: np.zeros((len(chs), syn.band.size), dtype=complex)
-                 for e in ("end_a", "end_b")}
+            h = {e: np.zeros((len(chs), syn.band.size), dtype=complex) for e in ("end_a", "end_b")}
             entry = line_entry_bytes(system.model, len(chs))
             for sl in frequency_chunks(syn.band.size, entry, CHUNK_BYTES):
-                resp = solve(system, _channels_on(scene, system, syn.w_band[sl]),
-                             dampings[name], timing)
+                resp = solve(
+                    system, _channels_on(scene, system, syn.w_band[sl]), dampings[name], timing
+                )
                 for e, he in h.items():
                     he[:, sl] = resp.end_tension[e]
             tr = {e: syn.full(v) for e, v in h.items()}
-        out.add_line(name, system.statics, tr, syn, tuple(c.kind for c in chs),
-                     tuple((name, c.name) for c in chs), tuple(c.name for c in chs))
+        out.add_line(
+            name,
+            system.statics,
+            tr,
+            syn,
+            tuple(c.kind for c in chs),
+            tuple((name, c.name) for c in chs),
+            tuple(c.name for c in chs),
+        )
 
 
-def _coupled_groups(scene: Scene, groups: tuple[Any, ...], syn: _Synthesis, out: _Series,
-                    timing: dict[str, float] | None) -> None:
+def _coupled_groups(
+    scene: Scene,
+    groups: tuple[Any, ...],
+    syn: _Synthesis,
+    out: _Series,
+    timing: dict[str, float] | None,
+) -> None:
     """Coupled groups: the group's linear system at its converged drag solved on the
     band (:func:`stochcable.dynamics.coupled_timeseries.coupled_group_transfer`): the
     end tensions of its lines and the motions of its free bodies."""
     from stochcable.dynamics.coupled_timeseries import coupled_group_transfer
 
     for grp in groups:
-        gt = (coupled_group_transfer(scene, grp, syn.w_band, timing=timing)
-              if syn.band.size else None)
+        gt = (
+            coupled_group_transfer(scene, grp, syn.w_band, timing=timing) if syn.band.size else None
+        )
         for name in grp.lines:
             tr = {} if gt is None else {e: syn.full(v) for e, v in gt.end_tension[name].items()}
-            out.add_line(name, grp.systems[name].statics, tr, syn,
-                         () if gt is None else gt.kinds, () if gt is None else gt.sources,
-                         () if gt is None else gt.channels)
+            out.add_line(
+                name,
+                grp.systems[name].statics,
+                tr,
+                syn,
+                () if gt is None else gt.kinds,
+                () if gt is None else gt.sources,
+                () if gt is None else gt.channels,
+            )
         for b in grp.bodies:
-            h = (np.zeros((0, b.n_dof, syn.omega.size), dtype=complex) if gt is None
-                 else syn.full(gt.body_motion[b.name]))
-            y = (syn.synthesized(h, gt.kinds, gt.sources) if gt is not None
-                 else np.zeros((b.n_dof, syn.n_t)))
-            out.add_body(b.name, grp.pose[b.name], b.dof_names, h, y,
-                         () if gt is None else gt.channels)
+            h = (
+                np.zeros((0, b.n_dof, syn.omega.size), dtype=complex)
+                if gt is None
+                else syn.full(gt.body_motion[b.name])
+            )
+            y = (
+                syn.synthesized(h, gt.kinds, gt.sources)
+                if gt is not None
+                else np.zeros((b.n_dof, syn.n_t))
+            )
+            out.add_body(
+                b.name, grp.pose[b.name], b.dof_names, h, y, () if gt is None else gt.channels
+            )

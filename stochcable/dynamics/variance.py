@@ -50,13 +50,17 @@ def split_sigma(system: LineSystem, x: np.ndarray, method: str) -> dict[str, np.
     "axial" (n_el,) and "node" (n_drag_nodes,) views, k = 3 for "vector" else 1. [m/s]"""
     n = system.model.n_elements
     k = 3 if method == "vector" else 1
-    parts = {"normal": x[: k * n].reshape(k, n), "axial": x[k * n:(k + 1) * n],
-             "node": x[(k + 1) * n:]}
+    parts = {
+        "normal": x[: k * n].reshape(k, n),
+        "axial": x[k * n : (k + 1) * n],
+        "node": x[(k + 1) * n :],
+    }
     return parts
 
 
-def _drag_current(rho: float, cd: Any, diameter: Any, sigma: np.ndarray,
-                  mean: np.ndarray) -> np.ndarray:
+def _drag_current(
+    rho: float, cd: Any, diameter: Any, sigma: np.ndarray, mean: np.ndarray
+) -> np.ndarray:
     """:func:`stochcable.dynamics.linearization.drag_linear_current` without validation (finite
     σ >= 0): the same operations in the same order."""
     return rho * np.asarray(cd, dtype=float) * diameter * mean_abs_gaussian(sigma, mean)
@@ -118,14 +122,14 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
         cov[:, 0, 1] = cov[:, 1, 0] = c12
         mean = None
         if np.any(u_n > 0):
-            mean = np.column_stack([np.einsum("ij,ij->i", u_nvec, n1),
-                                    np.einsum("ij,ij->i", u_nvec, n2)])
+            mean = np.column_stack(
+                [np.einsum("ij,ij->i", u_nvec, n1), np.einsum("ij,ij->i", u_nvec, n2)]
+            )
         b_n = drag_linear_vector(rho, mesh.cd_normal, d, cov, mean)
         b_t = drag_linear_current(rho, mesh.cd_axial, math.pi * d, parts["axial"], u_t)
     elif method == "harmonic":
         b_n = drag_linear_harmonic(rho, mesh.cd_normal, d, math.sqrt(2.0) * parts["normal"][0])
-        b_t = drag_linear_harmonic(rho, mesh.cd_axial, math.pi * d,
-                                   math.sqrt(2.0) * parts["axial"])
+        b_t = drag_linear_harmonic(rho, mesh.cd_axial, math.pi * d, math.sqrt(2.0) * parts["axial"])
     else:
         # the iteration's σ are finite and >= 0: skip the public validation (a third
         # of this function's time, called at every iteration); anything else goes
@@ -144,15 +148,20 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
         u_node = np.linalg.norm(system.current_node[idx], axis=1)
         sig = parts["node"]
         if method == "harmonic":
-            b_node[idx] = drag_linear_harmonic(rho, mesh.node_drag_area[idx], 1.0,
-                                               math.sqrt(2.0) * sig)
+            b_node[idx] = drag_linear_harmonic(
+                rho, mesh.node_drag_area[idx], 1.0, math.sqrt(2.0) * sig
+            )
         else:
             b_node[idx] = drag_linear_current(rho, mesh.node_drag_area[idx], 1.0, sig, u_node)
     b_n = np.atleast_1d(np.asarray(b_n, dtype=float))
     b_t = np.atleast_1d(np.asarray(b_t, dtype=float))
     return Damping(
-        method=method, sigma=np.asarray(sigma, dtype=float).copy(), b_normal=b_n,
-        b_axial=b_t, b_node=b_node, model=model,
+        method=method,
+        sigma=np.asarray(sigma, dtype=float).copy(),
+        b_normal=b_n,
+        b_axial=b_t,
+        b_node=b_node,
+        model=model,
     )
 
 
@@ -235,8 +244,9 @@ def _project_ends(pr: np.ndarray, x: np.ndarray) -> np.ndarray:
     return out
 
 
-def fluid_terms(system: LineSystem, inp: LineInputs, method: str
-                 ) -> tuple[np.ndarray, np.ndarray | None]:
+def fluid_terms(
+    system: LineSystem, inp: LineInputs, method: str
+) -> tuple[np.ndarray, np.ndarray | None]:
     """Drag-independent terms of the element mean square, cached per inputs and method:
     c0 = Σ weight ∫₀¹ |r·v|² dξ (n_el, k) and the weighted projected consistent moments
     weight·(r·∫N_a v dξ, r·∫N_b v dξ) as a real (n_el, k, 2, 2·n_w·n_ch) view (None
@@ -264,8 +274,9 @@ def fluid_terms(system: LineSystem, inp: LineInputs, method: str
 _GRAM = np.array([[1.0, 0.5], [0.5, 1.0]]) / 3.0  # ∫N_i N_j dξ
 
 
-def _element_variance(system: LineSystem, inp: LineInputs, method: str,
-                      q: np.ndarray | None) -> np.ndarray:
+def _element_variance(
+    system: LineSystem, inp: LineInputs, method: str, q: np.ndarray | None
+) -> np.ndarray:
     """Σ weight ∫₀¹ |r·(v(ξ) + N_a q_a + N_b q_b)|² dξ per element and row, (n_el, k).
 
     q = −iωU is minus the structural velocity at the element's two nodes, projected
@@ -286,8 +297,9 @@ def _element_variance(system: LineSystem, inp: LineInputs, method: str,
     var = c0 + (t @ _w2(inp)) * _GRAM[0, 0]
     if mw is not None:
         n_el, k = q.shape[:2]
-        var += 2.0 * np.einsum("ekn,ekn->ek", mw.reshape(n_el, k, -1),
-                               q.reshape(n_el, k, -1))  # Σ w (m_a q_a + m_b q_b)
+        var += 2.0 * np.einsum(
+            "ekn,ekn->ek", mw.reshape(n_el, k, -1), q.reshape(n_el, k, -1)
+        )  # Σ w (m_a q_a + m_b q_b)
     return var
 
 
@@ -298,8 +310,9 @@ def _w2(inp: LineInputs) -> np.ndarray:
     return inp.cache["w2"]
 
 
-def _sigma_vector(system: LineSystem, var: np.ndarray, s_node: np.ndarray,
-                  method: str) -> np.ndarray:
+def _sigma_vector(
+    system: LineSystem, var: np.ndarray, s_node: np.ndarray, method: str
+) -> np.ndarray:
     """The σ vector (layout of :func:`drag_coefficients`) from the element-mean variances
     of the projected relative velocity, var (n_el, k) for the rows of
     :func:`_proj_rows`."""
@@ -333,19 +346,23 @@ def _node_sigmas(system: LineSystem, inp: LineInputs, vr_nodes: np.ndarray) -> n
     return np.sqrt(_weighted_var(flat, inp).reshape(n, d).sum(axis=1))
 
 
-def sigmas_from_nodes(system: LineSystem, inp: LineInputs, u: np.ndarray | None, method: str) -> np.ndarray:
+def sigmas_from_nodes(
+    system: LineSystem, inp: LineInputs, u: np.ndarray | None, method: str
+) -> np.ndarray:
     """σ vector from node displacements u (n_nodes, d, n_w, n_ch) (None: at rest)."""
     model = system.model
     n_w, n_ch = inp.weights.shape
     idx = system.drag_nodes
     if u is None:
         var = _element_variance(system, inp, method, None)
-        vr = (np.zeros((idx.size, model.dim, n_w, n_ch), dtype=complex)
-              if inp.velocity is None else inp.velocity[idx])
+        vr = (
+            np.zeros((idx.size, model.dim, n_w, n_ch), dtype=complex)
+            if inp.velocity is None
+            else inp.velocity[idx]
+        )
     else:
         q = (-1j * inp.omega)[:, None] * u
-        var = _element_variance(system, inp, method,
-                                _project_ends(_proj_rows(system, method), q))
+        var = _element_variance(system, inp, method, _project_ends(_proj_rows(system, method), q))
         vr = q[idx] if inp.velocity is None else q[idx] + inp.velocity[idx]
     return _sigma_vector(system, var, _node_sigmas(system, inp, vr), method)
 
@@ -372,8 +389,9 @@ def end_motion_projections(system: LineSystem, inp: LineInputs, method: str) -> 
     return inp.cache[key]
 
 
-def sigmas_from_free(system: LineSystem, inp: LineInputs, u_free: np.ndarray,
-                 method: str) -> np.ndarray:
+def sigmas_from_free(
+    system: LineSystem, inp: LineInputs, u_free: np.ndarray, method: str
+) -> np.ndarray:
     """σ vector from the free-node dynamic part of :func:`solve_free`.
 
     The structure's velocity is that of U_p (:func:`base_motion`, cached projections) plus
@@ -406,14 +424,16 @@ def sigmas_from_free(system: LineSystem, inp: LineInputs, u_free: np.ndarray,
 
 def rest_sigmas(system: LineSystem, inp: LineInputs, method: str) -> np.ndarray:
     """The σ of the start (step 5): the fluid velocity relative to the line following
-    its ends quasi-statically, :func:`sigmas_from_nodes` of :func:`quasi_static_motion`.  For Foss
-    that motion is U_p of :func:`base_motion`, whose projections :func:`end_motion_projections` has cached
+    its ends quasi-statically, :func:`sigmas_from_nodes` of :func:`quasi_static_motion`.  For
+    Foss that motion is U_p of :func:`base_motion`, whose projections
+    :func:`end_motion_projections` has cached
     (the same numbers)."""
     if system.solver == "direct":
         return sigmas_from_nodes(system, inp, quasi_static_motion(system, inp), method)
     q_p, _, y = end_motion_projections(system, inp, method)
-    return _sigma_vector(system, _element_variance(system, inp, method, q_p),
-                         _node_sigmas(system, inp, y), method)
+    return _sigma_vector(
+        system, _element_variance(system, inp, method, q_p), _node_sigmas(system, inp, y), method
+    )
 
 
 def quasi_static_motion(system: LineSystem, inp: LineInputs) -> np.ndarray | None:

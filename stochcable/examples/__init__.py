@@ -69,9 +69,7 @@ def _files():
 
 def list_examples() -> list[str]:
     """Names of the example scenes (without the ``.json`` suffix), sorted."""
-    return sorted(
-        p.name[: -len(".json")] for p in _files().iterdir() if p.name.endswith(".json")
-    )
+    return sorted(p.name[: -len(".json")] for p in _files().iterdir() if p.name.endswith(".json"))
 
 
 def load_example(name: str) -> Scene:

@@ -13,8 +13,8 @@ import numpy as np
 
 from stochcable.fidelity.plan import Choice
 from stochcable.fidelity.rules import CUTOFF_KH
-from stochcable.statics import solve_statics
 from stochcable.scene.model import Scene, load_scene
+from stochcable.statics import solve_statics
 
 __all__ = [
     "TOUCHDOWN_ELEMENTS",
@@ -42,9 +42,9 @@ class LineGeometry:
     z_nodes: np.ndarray
 
 
-def segment_geometry(scene: Scene, statics: Any,
-                      touchdown: dict[str, float | None] | None = None
-                      ) -> dict[str, LineGeometry]:
+def segment_geometry(
+    scene: Scene, statics: Any, touchdown: dict[str, float | None] | None = None
+) -> dict[str, LineGeometry]:
     """Per line and segment: length, ⟨1/c²⟩ over the suspended part, suspended length,
     arc-length interval, node z (for the wave-load rule) and the static touchdown
     (``touchdown`` overrides the statics' own, e.g. from a finer model)."""
@@ -71,11 +71,18 @@ def segment_geometry(scene: Scene, statics: Any,
                 inv_c2 = float(np.sum(l0f * m_t / tf) / np.sum(l0f))
             else:
                 inv_c2 = 0.0
-            segs.append({"length": seg.length, "inv_c2": inv_c2,
-                         "suspended": float(np.sum(l0f)), "line_suspended": susp_line,
-                         "s0": s_start, "s1": s_start + seg.length,
-                         "grounded_any": bool(np.any(grounded_el[sel])),
-                         "touchdown": s_td})
+            segs.append(
+                {
+                    "length": seg.length,
+                    "inv_c2": inv_c2,
+                    "suspended": float(np.sum(l0f)),
+                    "line_suspended": susp_line,
+                    "s0": s_start,
+                    "s1": s_start + seg.length,
+                    "grounded_any": bool(np.any(grounded_el[sel])),
+                    "touchdown": s_td,
+                }
+            )
             s_start += seg.length
         out[line.name] = LineGeometry(segs, np.asarray(mesh.s0), st.positions[:, 2].copy())
     return out
@@ -115,7 +122,8 @@ def static_touchdowns(scene: Scene | Any) -> dict[str, float | None]:
             f = TOUCHDOWN_ELEMENTS / n
             refine[line.name] = tuple(
                 (i, seg.length, max(1, int(math.ceil(seg.elements * f))))
-                for i, seg in enumerate(line.segments))
+                for i, seg in enumerate(line.segments)
+            )
     if refine:
         fine = solve_statics(segments_scene(scene, refine, {}), method="fe")
         for name in refine:
@@ -131,15 +139,21 @@ Segments = dict[str, tuple[tuple[int, float, int], ...]]
 class _LoadRule:
     """The wave-load element rule: off (``k`` None) or h ≤ ``dz`` above ``depth``."""
 
-    k: float | None      # load wavenumber [rad/m]
-    depth: float         # depth where e^{kz} < eps_el [m]
-    dz: float            # element length above it [m]
-    eps_el: float        # element share of the error [-]
+    k: float | None  # load wavenumber [rad/m]
+    depth: float  # depth where e^{kz} < eps_el [m]
+    dz: float  # element length above it [m]
+    eps_el: float  # element share of the error [-]
 
 
-def mesh_rules(scene: Scene, geo: dict[str, LineGeometry], w2: float, wmax: float,
-               eps_el: float, k_load: float | None, exact: bool
-               ) -> tuple[Segments, list[Choice], float]:
+def mesh_rules(
+    scene: Scene,
+    geo: dict[str, LineGeometry],
+    w2: float,
+    wmax: float,
+    eps_el: float,
+    k_load: float | None,
+    exact: bool,
+) -> tuple[Segments, list[Choice], float]:
     """Segments (source, length, elements) per line by the element rules.
 
     Parameters
@@ -172,7 +186,8 @@ def mesh_rules(scene: Scene, geo: dict[str, LineGeometry], w2: float, wmax: floa
         k=k_load if (k_load and not exact) else None,
         depth=(math.log(1.0 / eps_el) / k_load) if k_load else 0.0,
         dz=math.sqrt(12.0 * eps_el / 2.0) / k_load if k_load else math.inf,
-        eps_el=eps_el)
+        eps_el=eps_el,
+    )
     for line in scene.lines:
         lg = geo[line.name]
         new: list[tuple[int, float, int]] = []
@@ -180,8 +195,11 @@ def mesh_rules(scene: Scene, geo: dict[str, LineGeometry], w2: float, wmax: floa
             path = f"lines[{line.name}].segments[{i}].elements"
             h, n, rule = _wavelength_rules(g, w2, wmax, eps_el, eps_w)
             kh_eff = (h * w2 * math.sqrt(g["inv_c2"])) if g["inv_c2"] > 0 else 0.0
-            e_seg = kh_eff**2 / 24.0 + (min(h, load.dz) * k_load) ** 2 / 12.0 \
-                if load.k else kh_eff**2 / 24.0
+            e_seg = (
+                kh_eff**2 / 24.0 + (min(h, load.dz) * k_load) ** 2 / 12.0
+                if load.k
+                else kh_eff**2 / 24.0
+            )
             wet_part = None  # (a, b) arc-length interval of the finely meshed top part
             if load.k:
                 h, n, rule, wet_part = _wave_load_rule(g, lg, load, h, n, rule)
@@ -192,33 +210,45 @@ def mesh_rules(scene: Scene, geo: dict[str, LineGeometry], w2: float, wmax: floa
             # at 56, 112, 224, 448 uniform elements, +0.09 %, +0.03 % at 56, 112 with a
             # node at the touchdown (then the √ε rule above bounds it).
             s_td = g.get("touchdown")
-            cut_td = (s_td is not None and g["s0"] + 1e-6 * g["length"] < s_td
-                      < g["s1"] - 1e-6 * g["length"])
+            cut_td = (
+                s_td is not None
+                and g["s0"] + 1e-6 * g["length"] < s_td < g["s1"] - 1e-6 * g["length"]
+            )
             err = max(err, e_seg)
             if wet_part is None and not cut_td:
                 new.append((i, g["length"], n))
-                choices.append(Choice(path, n, rule + f"; h = {g['length'] / n:.3g} m",
-                                      e_seg))
+                choices.append(Choice(path, n, rule + f"; h = {g['length'] / n:.3g} m", e_seg))
                 continue
             parts = _split_segment(i, g, h, load.dz, wet_part, s_td if cut_td else None)
             new.extend(parts)
             why = []
             if wet_part is not None:
-                why.append(f"wave-load depth {load.depth:.3g} m (e^(kz) < {eps_el:.2g}, "
-                           f"k = {k_load:.3g} rad/m): the part above it with h ≤ "
-                           f"√(12·{eps_el / 2:.2g})/k = {load.dz:.3g} m")
+                why.append(
+                    f"wave-load depth {load.depth:.3g} m (e^(kz) < {eps_el:.2g}, "
+                    f"k = {k_load:.3g} rad/m): the part above it with h ≤ "
+                    f"√(12·{eps_el / 2:.2g})/k = {load.dz:.3g} m"
+                )
             if cut_td:
                 why.append(f"a node at the static touchdown s = {float(s_td):.4g} m")
-            choices.append(Choice(
-                path, [m for _, _, m in parts],
-                "split at " + " and ".join(why) + f"; elsewhere {rule} (lengths "
-                + ", ".join(f"{L:.4g}" for _, L, _ in parts) + " m)", e_seg))
+            choices.append(
+                Choice(
+                    path,
+                    [m for _, _, m in parts],
+                    "split at "
+                    + " and ".join(why)
+                    + f"; elsewhere {rule} (lengths "
+                    + ", ".join(f"{L:.4g}" for _, L, _ in parts)
+                    + " m)",
+                    e_seg,
+                )
+            )
         out[line.name] = tuple(new)
     return out, choices, err
 
 
-def _wavelength_rules(g: dict[str, Any], w2: float, wmax: float, eps_el: float,
-                      eps_w: float) -> tuple[float, int, str]:
+def _wavelength_rules(
+    g: dict[str, Any], w2: float, wmax: float, eps_el: float, eps_w: float
+) -> tuple[float, int, str]:
     """Element length, count and reason of a segment by the string-wave, cut-off and
     touchdown-length rules (the smallest h binds)."""
     if g["inv_c2"] > 0:
@@ -227,21 +257,22 @@ def _wavelength_rules(g: dict[str, Any], w2: float, wmax: float, eps_el: float,
         h_cut = CUTOFF_KH / (wmax * sq)
     else:
         h_w2 = h_cut = math.inf
-    h_td = (g["line_suspended"] * math.sqrt(eps_el) if g["grounded_any"]
-            else math.inf)
+    h_td = g["line_suspended"] * math.sqrt(eps_el) if g["grounded_any"] else math.inf
     h = min(h_w2, h_cut, h_td, g["length"])
     n = max(1, int(math.ceil(g["length"] / h - 1e-9)))
-    rule = {h_w2: f"string wave at the response's ω₂ = {w2:.3g} rad/s: h ≤ "
-                  f"√(24·{eps_w:.2g})·c/ω₂ = {h_w2:.3g} m",
-            h_cut: f"cut-off at ω_max = {wmax:.3g} rad/s: kh ≤ {CUTOFF_KH:g}, "
-                   f"h ≤ {h_cut:.3g} m",
-            h_td: f"touchdown: h ≤ √{eps_el:.2g} × suspended length = {h_td:.3g} m",
-            g["length"]: "one element (no rule binds)"}[h]
+    rule = {
+        h_w2: f"string wave at the response's ω₂ = {w2:.3g} rad/s: h ≤ "
+        f"√(24·{eps_w:.2g})·c/ω₂ = {h_w2:.3g} m",
+        h_cut: f"cut-off at ω_max = {wmax:.3g} rad/s: kh ≤ {CUTOFF_KH:g}, h ≤ {h_cut:.3g} m",
+        h_td: f"touchdown: h ≤ √{eps_el:.2g} × suspended length = {h_td:.3g} m",
+        g["length"]: "one element (no rule binds)",
+    }[h]
     return h, n, rule
 
 
-def _wave_load_rule(g: dict[str, Any], lg: LineGeometry, load: _LoadRule, h: float, n: int,
-                    rule: str) -> tuple[float, int, str, tuple[float, float] | None]:
+def _wave_load_rule(
+    g: dict[str, Any], lg: LineGeometry, load: _LoadRule, h: float, n: int, rule: str
+) -> tuple[float, int, str, tuple[float, float] | None]:
     """The wave-load rule on one segment: the part above ``load.depth`` gets h ≤
     ``load.dz`` — the whole segment (new h, n, reason) or a top part to split off
     (its arc-length interval)."""
@@ -252,9 +283,11 @@ def _wave_load_rule(g: dict[str, Any], lg: LineGeometry, load: _LoadRule, h: flo
         if load.dz < h:
             h = load.dz
             n = max(1, int(math.ceil(g["length"] / h - 1e-9)))
-            rule = (f"wave loads (nodal kinematics e^(kz-ikx)): h ≤ "
-                    f"√(12·{load.eps_el / 2:.2g})/k = {load.dz:.3g} m, k = {load.k:.3g} "
-                    "rad/m")
+            rule = (
+                f"wave loads (nodal kinematics e^(kz-ikx)): h ≤ "
+                f"√(12·{load.eps_el / 2:.2g})/k = {load.dz:.3g} m, k = {load.k:.3g} "
+                "rad/m"
+            )
         return h, n, rule, None
     if not (wet[-1] or wet[0]):
         return h, n, rule, None
@@ -266,25 +299,30 @@ def _wave_load_rule(g: dict[str, Any], lg: LineGeometry, load: _LoadRule, h: flo
         j = int(np.flatnonzero(~wet)[0])
         l_top = ss[j] - g["s0"]
     if load.dz < h and 0.0 < l_top < g["length"]:
-        return h, n, rule, ((g["s1"] - l_top, g["s1"]) if top_end
-                            else (g["s0"], g["s0"] + l_top))
+        return h, n, rule, ((g["s1"] - l_top, g["s1"]) if top_end else (g["s0"], g["s0"] + l_top))
     return h, n, rule, None
 
 
-def _split_segment(i: int, g: dict[str, Any], h: float, dz_load: float,
-                   wet_part: tuple[float, float] | None, s_td: float | None
-                   ) -> list[tuple[int, float, int]]:
+def _split_segment(
+    i: int,
+    g: dict[str, Any],
+    h: float,
+    dz_load: float,
+    wet_part: tuple[float, float] | None,
+    s_td: float | None,
+) -> list[tuple[int, float, int]]:
     """Segment ``i`` cut at the wet part's ends and the touchdown ``s_td``: (i, length,
     elements) per part, h ≤ ``dz_load`` in the wet part."""
-    cuts = sorted({g["s0"], g["s1"]}
-                  | ({wet_part[0], wet_part[1]} if wet_part else set())
-                  | ({float(s_td)} if s_td is not None else set()))
+    cuts = sorted(
+        {g["s0"], g["s1"]}
+        | ({wet_part[0], wet_part[1]} if wet_part else set())
+        | ({float(s_td)} if s_td is not None else set())
+    )
     parts = []
     for a, b in zip(cuts[:-1], cuts[1:]):
         if b - a <= 1e-9 * g["length"]:
             continue
-        in_wet = wet_part is not None and wet_part[0] - 1e-9 <= a and \
-            b <= wet_part[1] + 1e-9
+        in_wet = wet_part is not None and wet_part[0] - 1e-9 <= a and b <= wet_part[1] + 1e-9
         hp = min(h, dz_load) if in_wet else h
         m = max(1, int(math.ceil((b - a) / hp - 1e-9)))
         parts.append((i, float(b - a), m))
@@ -300,9 +338,10 @@ def segments_scene(scene: Scene, segments: Segments, update: dict[str, Any]) -> 
         if spec is None:
             lines.append(line)
             continue
-        segs = tuple(line.segments[i].model_copy(update={"length": float(L),
-                                                         "elements": int(n)})
-                     for i, L, n in spec)
+        segs = tuple(
+            line.segments[i].model_copy(update={"length": float(L), "elements": int(n)})
+            for i, L, n in spec
+        )
         lines.append(line.model_copy(update={"segments": segs}))
     analysis = scene.analysis.model_copy(update=update)
     new = scene.model_copy(update={"lines": tuple(lines), "analysis": analysis})

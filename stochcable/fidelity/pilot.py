@@ -91,8 +91,12 @@ def input_densities(scene: Scene) -> list[tuple[str, Callable[[np.ndarray], np.n
             for dof in ("surge", "sway", "heave"):
                 spec = getattr(m, dof)
                 if spec is not None:
-                    out.append((f"{line.name}.{end}.{dof}",
-                                lambda w, spec=spec: spec.spectral_density(w, g)))
+                    out.append(
+                        (
+                            f"{line.name}.{end}.{dof}",
+                            lambda w, spec=spec: spec.spectral_density(w, g),
+                        )
+                    )
     return out
 
 
@@ -183,9 +187,11 @@ def response_spectra(line_result: Any) -> dict[str, np.ndarray]:
     out = {}
     for end in ("end_a", "end_b"):
         out[f"{line_result.name}.{end}.tension"] = np.einsum(
-            "cw,cw->w", np.abs(line_result.end_tension_transfer[end]) ** 2, spectra)
+            "cw,cw->w", np.abs(line_result.end_tension_transfer[end]) ** 2, spectra
+        )
     out[f"{line_result.name}.motion"] = np.einsum(
-        "cnkw,cw->w", np.abs(line_result.motion_transfer) ** 2, spectra)
+        "cnkw,cw->w", np.abs(line_result.motion_transfer) ** 2, spectra
+    )
     return out
 
 
@@ -204,9 +210,15 @@ def modal_bandwidths(line_result: Any, scene: Scene) -> tuple[np.ndarray, np.nda
     return wn, np.maximum(band, 0.0)
 
 
-def pilot_analysis(scene: Scene, geo: dict[str, LineGeometry], w_lo: float, w_top: float,
-                   k_load: float | None, exact: bool, evaluate: Evaluate
-                   ) -> tuple[Any, dict, float]:
+def pilot_analysis(
+    scene: Scene,
+    geo: dict[str, LineGeometry],
+    w_lo: float,
+    w_top: float,
+    k_load: float | None,
+    exact: bool,
+    evaluate: Evaluate,
+) -> tuple[Any, dict, float]:
     """One pilot: ``evaluate`` on the scene meshed with kh = :data:`PILOT_KH` at
     ``w_top`` (at most :data:`PILOT_MAX_ELEMENTS` per line), a log grid of
     :data:`PILOT_COUNT` points on [w_lo, w_top], direct solve, tolerance 1e-3, no time
@@ -219,21 +231,29 @@ def pilot_analysis(scene: Scene, geo: dict[str, LineGeometry], w_lo: float, w_to
         if n > PILOT_MAX_ELEMENTS:
             f = PILOT_MAX_ELEMENTS / n
             segs[name] = tuple((i, L, max(1, int(round(m * f)))) for i, L, m in segs[name])
-    update = {"omega": scene.analysis.omega.model_copy(
-                  update={"min": w_lo, "max": w_top, "count": PILOT_COUNT,
-                          "spacing": "log"}),
-              "solver": "direct", "modes": "auto", "timeseries": None,
-              "linearization": scene.analysis.linearization.model_copy(
-                  update={"tolerance": 1e-3})}
+    update = {
+        "omega": scene.analysis.omega.model_copy(
+            update={"min": w_lo, "max": w_top, "count": PILOT_COUNT, "spacing": "log"}
+        ),
+        "solver": "direct",
+        "modes": "auto",
+        "timeseries": None,
+        "linearization": scene.analysis.linearization.model_copy(update={"tolerance": 1e-3}),
+    }
     pscene = segments_scene(scene, segs, update)
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = evaluate(pscene)
     wall = time.perf_counter() - t0
-    info = {"elements": {k: sum(n for _, _, n in v) for k, v in segs.items()},
-            "omega_min": w_lo, "omega_max": w_top, "count": PILOT_COUNT,
-            "spacing": "log", "wall_s": wall}
+    info = {
+        "elements": {k: sum(n for _, _, n in v) for k, v in segs.items()},
+        "omega_min": w_lo,
+        "omega_max": w_top,
+        "count": PILOT_COUNT,
+        "spacing": "log",
+        "wall_s": wall,
+    }
     return res, info, wall
 
 
@@ -249,16 +269,23 @@ class Pilot:
     info: dict[str, Any]
 
 
-def run_pilot(scene: Scene, geo: dict[str, LineGeometry], inputs: InputBand,
-              band_share: float, exact: bool, evaluate: Evaluate) -> Pilot:
+def run_pilot(
+    scene: Scene,
+    geo: dict[str, LineGeometry],
+    inputs: InputBand,
+    band_share: float,
+    exact: bool,
+    evaluate: Evaluate,
+) -> Pilot:
     """Pilots from the input band, the top doubled up to :data:`PILOT_EXTENSIONS` times
     while a response tail beyond it holds more than ``band_share`` of the variance
     or the pilot does not cover twice the ω_max it gives."""
     w_top = inputs.omega_hi
     pilot_wall = 0.0
     for ext in range(PILOT_EXTENSIONS + 1):
-        res, info, wall = pilot_analysis(scene, geo, inputs.omega_lo, w_top, inputs.k_load,
-                                         exact, evaluate)
+        res, info, wall = pilot_analysis(
+            scene, geo, inputs.omega_lo, w_top, inputs.k_load, exact, evaluate
+        )
         pilot_wall += wall
         pilot_info = {**info, "extensions": ext, "wall_s": pilot_wall}
         spectra: dict[str, np.ndarray] = {}
@@ -284,15 +311,19 @@ def _tails_bounded(w: np.ndarray, spectra: dict[str, np.ndarray], band_share: fl
             continue
         ab = tail_above(w, s, tail_exponent(w, s))
         m0 = ab[0] + tail_below(w, s)[0]
-        frac = (s[-1] * w[-1] / (tail_exponent(w, s) - 1.0) / m0
-                if tail_exponent(w, s) > 1 + MIN_TAIL_EXCESS else math.inf)
+        frac = (
+            s[-1] * w[-1] / (tail_exponent(w, s) - 1.0) / m0
+            if tail_exponent(w, s) > 1 + MIN_TAIL_EXCESS
+            else math.inf
+        )
         if not np.isfinite(ab[0]) or frac > band_share:
             bounded = False
     return bounded
 
 
-def _covers_twice_omega_max(w: np.ndarray, spectra: dict[str, np.ndarray],
-                            band_share: float) -> bool:
+def _covers_twice_omega_max(
+    w: np.ndarray, spectra: dict[str, np.ndarray], band_share: float
+) -> bool:
     """Whether the pilot's top reaches twice the ω_max of every response spectrum."""
     lim = 2.0 * band_share * 0.8
     covered = True

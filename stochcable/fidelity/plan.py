@@ -34,8 +34,12 @@ class Choice:
     error: float = 0.0
 
     def to_document(self) -> dict[str, Any]:
-        return {"setting": self.setting, "value": _plain(self.value), "reason": self.reason,
-                "error": float(self.error)}
+        return {
+            "setting": self.setting,
+            "value": _plain(self.value),
+            "reason": self.reason,
+            "error": float(self.error),
+        }
 
 
 @dataclass(frozen=True)
@@ -98,13 +102,21 @@ class FidelityPlan:
         """Plain JSON-ready form (for the result document's "fidelity")."""
         return {
             "target_error": self.target_error,
-            "omega": {"min": self.omega_min, "max": self.omega_max,
-                      "count": self.omega_count, "values_count": len(self.omega_values)},
+            "omega": {
+                "min": self.omega_min,
+                "max": self.omega_max,
+                "count": self.omega_count,
+                "values_count": len(self.omega_values),
+            },
             "segments": {k: [list(s) for s in v] for k, v in self.segments.items()},
-            "solver": self.solver, "modes": self.modes, "tolerance": self.tolerance,
+            "solver": self.solver,
+            "modes": self.modes,
+            "tolerance": self.tolerance,
             "choices": [c.to_document() for c in self.choices],
-            "error_estimate": dict(self.error_estimate), "cost": dict(self.cost),
-            "tail_bounded": self.tail_bounded, "omega_response": self.omega_response,
+            "error_estimate": dict(self.error_estimate),
+            "cost": dict(self.cost),
+            "tail_bounded": self.tail_bounded,
+            "omega_response": self.omega_response,
             "pilot": _plain(self.pilot),
         }
 

@@ -55,8 +55,8 @@ from stochcable.fidelity.rules import (
     tail_exponent,
     union_grid,
 )
-from stochcable.statics import solve_statics
 from stochcable.scene.model import OmegaGrid, Scene, load_scene
+from stochcable.statics import solve_statics
 
 __all__ = [
     "BUDGET",
@@ -69,10 +69,14 @@ __all__ = [
 ]
 
 
-def choose_fidelity(scene: Scene | Any, target_error: float = 0.01, *,
-                    evaluate: Evaluate,
-                    exact_wave_integration: bool = False,
-                    allow_grid_values: bool | None = None) -> FidelityPlan:
+def choose_fidelity(
+    scene: Scene | Any,
+    target_error: float = 0.01,
+    *,
+    evaluate: Evaluate,
+    exact_wave_integration: bool = False,
+    allow_grid_values: bool | None = None,
+) -> FidelityPlan:
     """Settings that meet a target error of the response σ at the least cost.
 
     Parameters
@@ -116,29 +120,56 @@ def choose_fidelity(scene: Scene | Any, target_error: float = 0.01, *,
     inputs = input_summary(scene)
     pilot = run_pilot(scene, geo, inputs, share["band"], exact_wave_integration, evaluate)
     band = _choose_band(pilot, inputs, share["band"])
-    segs, el_choices, el_err = mesh_rules(scene, geo, band.omega2, band.omega_max,
-                                          share["elements"], inputs.k_load,
-                                          exact_wave_integration)
+    segs, el_choices, el_err = mesh_rules(
+        scene,
+        geo,
+        band.omega2,
+        band.omega_max,
+        share["elements"],
+        inputs.k_load,
+        exact_wave_integration,
+    )
     grid = _choose_grid(scene, pilot, band, share["grid"], bool(allow_grid_values))
-    solver, modes, mode_err, mode_choices = _choose_modes(pilot, segs, band.omega_max,
-                                                          share["modes"])
+    solver, modes, mode_err, mode_choices = _choose_modes(
+        pilot, segs, band.omega_max, share["modes"]
+    )
     tol = share["linearization"]
-    tol_choice = Choice("analysis.linearization.tolerance", tol,
-                        "fraction of the target: the fixed point's remaining error ≈ "
-                        "the last relative change of the σ", tol)
-    parts = {"band": band.error, "grid": grid.error, "elements": el_err, "modes": mode_err,
-             "linearization": tol}
+    tol_choice = Choice(
+        "analysis.linearization.tolerance",
+        tol,
+        "fraction of the target: the fixed point's remaining error ≈ "
+        "the last relative change of the σ",
+        tol,
+    )
+    parts = {
+        "band": band.error,
+        "grid": grid.error,
+        "elements": el_err,
+        "modes": mode_err,
+        "linearization": tol,
+    }
     parts["total"] = float(sum(parts.values()))
     n_el = sum(sum(n for _, _, n in v) for v in segs.values())
-    cost = {"elements": float(n_el), "frequencies": float(grid.n_freq),
-            "elements_x_frequencies": float(n_el * grid.n_freq)}
+    cost = {
+        "elements": float(n_el),
+        "frequencies": float(grid.n_freq),
+        "elements_x_frequencies": float(n_el * grid.n_freq),
+    }
     return FidelityPlan(
-        target_error=eps, omega_min=float(band.omega_min), omega_max=float(band.omega_max),
-        omega_count=grid.count_linear, omega_values=tuple(float(x) for x in grid.values),
-        segments=segs, solver=solver, modes=modes, tolerance=float(tol),
+        target_error=eps,
+        omega_min=float(band.omega_min),
+        omega_max=float(band.omega_max),
+        omega_count=grid.count_linear,
+        omega_values=tuple(float(x) for x in grid.values),
+        segments=segs,
+        solver=solver,
+        modes=modes,
+        tolerance=float(tol),
         choices=(*band.choices, *el_choices, grid.choice, *mode_choices, tol_choice),
-        error_estimate=parts, cost=cost,
-        tail_bounded=bool(pilot.bounded), omega_response=float(band.omega2),
+        error_estimate=parts,
+        cost=cost,
+        tail_bounded=bool(pilot.bounded),
+        omega_response=float(band.omega2),
         pilot=pilot.info,
     )
 
@@ -150,8 +181,8 @@ def choose_fidelity(scene: Scene | Any, target_error: float = 0.01, *,
 class _Band:
     omega_min: float
     omega_max: float
-    omega2: float   # ω₂ = √(m₂/m₀) of the response spectra (largest) [rad/s]
-    error: float    # σ error the band leaves [-]
+    omega2: float  # ω₂ = √(m₂/m₀) of the response spectra (largest) [rad/s]
+    error: float  # σ error the band leaves [-]
     choices: tuple[Choice, ...]
 
 
@@ -183,24 +214,33 @@ def _choose_band(pilot: Pilot, inputs: InputBand, band_share: float) -> _Band:
         w_min, w_max, w2 = inputs.omega_lo, inputs.omega_hi, inputs.omega2
     w_max = min(max(w_max, 1.05 * w_min), float(w[-1]))
     band_err = _band_error(w, spectra, w_min, w_max)
-    tail_note = ("" if pilot.bounded else
-                 "; a response tail is NOT bounded at the pilot top "
-                 f"{w[-1]:.3g} rad/s (decays slower than ω^-{1 + MIN_TAIL_EXCESS:g}, e.g. "
-                 "an ω⁻⁵ end-motion spectrum driving inertia loads): σ depends on the band "
-                 "and the band error is a lower bound")
+    tail_note = (
+        ""
+        if pilot.bounded
+        else "; a response tail is NOT bounded at the pilot top "
+        f"{w[-1]:.3g} rad/s (decays slower than ω^-{1 + MIN_TAIL_EXCESS:g}, e.g. "
+        "an ω⁻⁵ end-motion spectrum driving inertia loads): σ depends on the band "
+        "and the band error is a lower bound"
+    )
     choices = (
-        Choice("analysis.omega.max", w_max,
-               f"response variance above ≤ {lim_hi:.2g} m0 (pilot to "
-               f"{w[-1]:.3g} rad/s + power-law tail); " + "; ".join(detail)
-               + tail_note, band_err),
-        Choice("analysis.omega.min", w_min,
-               f"response variance below ≤ {lim_lo:.2g} m0 (pilot from "
-               f"{w[0]:.3g} rad/s)", 0.0))
+        Choice(
+            "analysis.omega.max",
+            w_max,
+            f"response variance above ≤ {lim_hi:.2g} m0 (pilot to "
+            f"{w[-1]:.3g} rad/s + power-law tail); " + "; ".join(detail) + tail_note,
+            band_err,
+        ),
+        Choice(
+            "analysis.omega.min",
+            w_min,
+            f"response variance below ≤ {lim_lo:.2g} m0 (pilot from {w[0]:.3g} rad/s)",
+            0.0,
+        ),
+    )
     return _Band(w_min, w_max, w2, band_err, choices)
 
 
-def _band_error(w: np.ndarray, spectra: dict[str, np.ndarray], w_min: float,
-                w_max: float) -> float:
+def _band_error(w: np.ndarray, spectra: dict[str, np.ndarray], w_min: float, w_max: float) -> float:
     """σ error left by the band: the largest variance fraction outside it, halved."""
     band_err = 0.0
     for s in spectra.values():
@@ -210,8 +250,7 @@ def _band_error(w: np.ndarray, spectra: dict[str, np.ndarray], w_min: float,
         above = tail_above(w, s, p)
         below = tail_below(w, s)
         m0 = below[-1] + (above[-1] if np.isfinite(above[-1]) else 0.0)
-        fa = np.interp(math.log(w_max), np.log(w), np.where(np.isfinite(above), above, np.nan)
-                       ) / m0
+        fa = np.interp(math.log(w_max), np.log(w), np.where(np.isfinite(above), above, np.nan)) / m0
         fb = np.interp(math.log(w_min), np.log(w), below) / m0
         band_err = max(band_err, 0.5 * ((fa if np.isfinite(fa) else 1.0) + fb))
     return band_err
@@ -222,15 +261,16 @@ def _band_error(w: np.ndarray, spectra: dict[str, np.ndarray], w_min: float,
 
 @dataclass(frozen=True, eq=False)
 class _Grid:
-    count_linear: int    # points of the linear grid at the finest spacing
-    values: np.ndarray   # the non-uniform union grid [rad/s]
-    n_freq: int          # points of the grid applied
+    count_linear: int  # points of the linear grid at the finest spacing
+    values: np.ndarray  # the non-uniform union grid [rad/s]
+    n_freq: int  # points of the grid applied
     error: float
     choice: Choice
 
 
-def _choose_grid(scene: Scene, pilot: Pilot, band: _Band, grid_share: float,
-                 allow_values: bool) -> _Grid:
+def _choose_grid(
+    scene: Scene, pilot: Pilot, band: _Band, grid_share: float, allow_values: bool
+) -> _Grid:
     """The base linear spacing from the input spectra, refined around the pilot's
     lightly damped modes in the band (half of the grid share each)."""
     w_min, w_max = band.omega_min, band.omega_max
@@ -251,18 +291,26 @@ def _choose_grid(scene: Scene, pilot: Pilot, band: _Band, grid_share: float,
         f"ω⁴S of the inputs within {grid_share / 2:.2g}); {len(peaks)} lightly damped "
         f"mode(s) in the band need {n_bw:.2g} points per half-power bandwidth "
         f"(2e^(-πN) ≤ {grid_share / 2:.2g})"
-        + (f", narrowest {min(b for _, b in peaks):.3g} rad/s at "
-           f"{min(peaks, key=lambda p: p[1])[0]:.3g} rad/s" if peaks else "")
-        + ("; non-uniform union grid" if use_values else
-           f"; linear grid at the finest spacing {dw_fine:.3g} rad/s"
-           + (f" (a non-uniform grid would need {len(values)})" if len(values) < count_lin
-              else "")),
-        grid_err)
+        + (
+            f", narrowest {min(b for _, b in peaks):.3g} rad/s at "
+            f"{min(peaks, key=lambda p: p[1])[0]:.3g} rad/s"
+            if peaks
+            else ""
+        )
+        + (
+            "; non-uniform union grid"
+            if use_values
+            else f"; linear grid at the finest spacing {dw_fine:.3g} rad/s"
+            + (f" (a non-uniform grid would need {len(values)})" if len(values) < count_lin else "")
+        ),
+        grid_err,
+    )
     return _Grid(count_lin, values, n_freq, grid_err, choice)
 
 
-def _narrow_peaks(scene: Scene, pilot: Pilot, w_min: float, w_max: float,
-                  dw_base: float) -> list[tuple[float, float]]:
+def _narrow_peaks(
+    scene: Scene, pilot: Pilot, w_min: float, w_max: float, dw_base: float
+) -> list[tuple[float, float]]:
     """(ω_j, bandwidth) of the pilot's modes in the band narrower than
     :data:`~stochcable.fidelity.rules.PEAK_RESOLVED` base spacings (undamped: 1e-6·ω_j)."""
     peaks = []
@@ -279,8 +327,9 @@ def _narrow_peaks(scene: Scene, pilot: Pilot, w_min: float, w_max: float,
 # ------------------------------------------------------------------------ modes
 
 
-def _choose_modes(pilot: Pilot, segs: Segments, w_max: float, mode_share: float
-                  ) -> tuple[str, Any, float, tuple[Choice, Choice]]:
+def _choose_modes(
+    pilot: Pilot, segs: Segments, w_max: float, mode_share: float
+) -> tuple[str, Any, float, tuple[Choice, Choice]]:
     """Solver and kept modes: Foss "auto" when its factor suffices, else the pilot's
     modes up to F·ω_max, or the direct solve when they are many."""
     f_need = math.sqrt(MODE_ERROR_CONSTANT / mode_share)
@@ -288,22 +337,32 @@ def _choose_modes(pilot: Pilot, segs: Segments, w_max: float, mode_share: float
     if f_need <= AUTO_FACTOR:
         solver, modes = "foss", "auto"
         mode_err = MODE_ERROR_CONSTANT / AUTO_FACTOR**2
-        why = (f"Foss 'auto' keeps the modes up to {AUTO_FACTOR:g}·ω_max ≥ F·ω_max, F = "
-               f"√({MODE_ERROR_CONSTANT:g}/{mode_share:.2g}) = {f_need:.3g}")
+        why = (
+            f"Foss 'auto' keeps the modes up to {AUTO_FACTOR:g}·ω_max ≥ F·ω_max, F = "
+            f"√({MODE_ERROR_CONSTANT:g}/{mode_share:.2g}) = {f_need:.3g}"
+        )
     else:
-        wn_all = np.concatenate([np.asarray(lr.modes_omega)
-                                 for lr in pilot.result.lines.values()])
+        wn_all = np.concatenate([np.asarray(lr.modes_omega) for lr in pilot.result.lines.values()])
         n_keep = int(np.count_nonzero(wn_all <= f_need * w_max))
         if n_keep > DIRECT_MODES or n_keep >= n_el_total:
             solver, modes, mode_err = "direct", "auto", 0.0
-            why = (f"{n_keep} modes up to F·ω_max (F = {f_need:.3g}) > {DIRECT_MODES}: the "
-                   "direct solve is exact and cheaper")
+            why = (
+                f"{n_keep} modes up to F·ω_max (F = {f_need:.3g}) > {DIRECT_MODES}: the "
+                "direct solve is exact and cheaper"
+            )
         else:
             solver, modes = "foss", max(1, n_keep)
             mode_err = MODE_ERROR_CONSTANT / f_need**2
             why = f"modes up to F·ω_max, F = √(C/ε_modes) = {f_need:.3g} (pilot modes)"
-    return solver, modes, mode_err, (Choice("analysis.solver", solver, why, 0.0),
-                                     Choice("analysis.modes", modes, why, mode_err))
+    return (
+        solver,
+        modes,
+        mode_err,
+        (
+            Choice("analysis.solver", solver, why, 0.0),
+            Choice("analysis.modes", modes, why, mode_err),
+        ),
+    )
 
 
 # ------------------------------------------------------------------------ apply
@@ -333,15 +392,28 @@ def apply_fidelity(scene: Scene | Any, plan: FidelityPlan) -> Scene:
     scene = load_scene(scene)
     if not isinstance(plan, FidelityPlan):
         raise _v.InputError("plan", type(plan).__name__, "-", "must be a FidelityPlan")
-    use_values = any(c.setting == "analysis.omega.values" for c in plan.choices) and \
-        grid_values_supported()
-    om: dict[str, Any] = {"min": plan.omega_min, "max": plan.omega_max,
-                          "count": plan.omega_count, "spacing": "linear"}
+    use_values = (
+        any(c.setting == "analysis.omega.values" for c in plan.choices) and grid_values_supported()
+    )
+    om: dict[str, Any] = {
+        "min": plan.omega_min,
+        "max": plan.omega_max,
+        "count": plan.omega_count,
+        "spacing": "linear",
+    }
     if use_values:  # pragma: no cover - needs the proposed OmegaGrid.values
-        om = {"min": plan.omega_min, "max": plan.omega_max,
-              "count": len(plan.omega_values), "values": list(plan.omega_values)}
-    update = {"omega": scene.analysis.omega.model_copy(update=om),
-              "solver": plan.solver, "modes": plan.modes,
-              "linearization": scene.analysis.linearization.model_copy(
-                  update={"tolerance": plan.tolerance})}
+        om = {
+            "min": plan.omega_min,
+            "max": plan.omega_max,
+            "count": len(plan.omega_values),
+            "values": list(plan.omega_values),
+        }
+    update = {
+        "omega": scene.analysis.omega.model_copy(update=om),
+        "solver": plan.solver,
+        "modes": plan.modes,
+        "linearization": scene.analysis.linearization.model_copy(
+            update={"tolerance": plan.tolerance}
+        ),
+    }
     return segments_scene(scene, plan.segments, update)

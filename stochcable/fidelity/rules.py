@@ -109,8 +109,13 @@ __all__ = [
 ]
 
 #: Shares of the target error given to each part (sum 1). [-]
-BUDGET: dict[str, float] = {"band": 0.3, "grid": 0.15, "elements": 0.35, "modes": 0.1,
-                            "linearization": 0.1}
+BUDGET: dict[str, float] = {
+    "band": 0.3,
+    "grid": 0.15,
+    "elements": 0.35,
+    "modes": 0.1,
+    "linearization": 0.1,
+}
 #: A power-law tail S ∝ ω^-p counts as bounded for p > 1 + MIN_TAIL_EXCESS. [-]
 MIN_TAIL_EXCESS = 0.25
 #: Largest kh at ω_max (consistent-mass cut-off is kh = √12 ≈ 3.5). [-]
@@ -216,20 +221,25 @@ def spectrum_tail_frequency(omega: Any, density: Any, fraction: float) -> tuple[
     s = _v.float_array("density", density, "unit²·s/rad", nonnegative=True)
     frac = _v.in_range("fraction", fraction, "-", 0.0, 0.5, lo_open=True, hi_open=True)
     if s.shape != w.shape:
-        raise _v.InputError("density", f"shape {s.shape}", "unit²·s/rad",
-                            f"must have the shape of omega {w.shape}")
+        raise _v.InputError(
+            "density", f"shape {s.shape}", "unit²·s/rad", f"must have the shape of omega {w.shape}"
+        )
     above = tail_above(w, s, tail_exponent(w, s))
     below = tail_below(w, s)
     m0 = below[-1] + above[-1]
     if not np.isfinite(m0) or m0 <= 0.0:
-        raise _v.InputError("density", "spectrum", "unit²·s/rad",
-                            "must have a positive, finite variance (tail decaying faster "
-                            "than 1/ω)")
+        raise _v.InputError(
+            "density",
+            "spectrum",
+            "unit²·s/rad",
+            "must have a positive, finite variance (tail decaying faster than 1/ω)",
+        )
     return crossing_down(w, below / m0, frac), crossing_up(w, above / m0, frac)
 
 
-def elements_wavelength(length: float, omega: float, celerity: float,
-                        frequency_error: float) -> int:
+def elements_wavelength(
+    length: float, omega: float, celerity: float, frequency_error: float
+) -> int:
     """Linear elements with consistent mass for a string-wave frequency error.
 
     Parameters
@@ -285,8 +295,9 @@ def points_per_bandwidth(error: float) -> float:
     return max(1.0, math.log(2.0 / e) / math.pi)
 
 
-def union_grid(w_min: float, w_max: float, base: int,
-               peaks: list[tuple[float, float]], n_bw: float) -> np.ndarray:
+def union_grid(
+    w_min: float, w_max: float, base: int, peaks: list[tuple[float, float]], n_bw: float
+) -> np.ndarray:
     """The base linear grid of ``base`` points on [w_min, w_max] united with, around
     every (ω_j, b_j) of ``peaks``, ± :data:`PEAK_HALF_WIDTHS` bandwidths sampled at
     b_j/n_bw (points closer than 1e-9·w_max merged). [rad/s]"""

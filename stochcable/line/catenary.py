@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Union
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -116,9 +116,21 @@ class CatenarySolution:
     residual: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("H", "V_a", "V_b", "tension_a", "tension_b", "grounded_length",
-                     "touchdown", "horizontal_span", "vertical_span", "length", "weight",
-                     "ea", "residual"):
+        for name in (
+            "H",
+            "V_a",
+            "V_b",
+            "tension_a",
+            "tension_b",
+            "grounded_length",
+            "touchdown",
+            "horizontal_span",
+            "vertical_span",
+            "length",
+            "weight",
+            "ea",
+            "residual",
+        ):
             object.__setattr__(self, name, float(getattr(self, name)))
         object.__setattr__(self, "iterations", int(self.iterations))
         object.__setattr__(self, "seabed", bool(self.seabed))
@@ -193,13 +205,17 @@ def check_reach(L, chord, ea):
     if math.isinf(ea):
         if chord >= L:
             raise InputError(
-                "length", L, "m",
+                "length",
+                L,
+                "m",
                 f"an inextensible line must be longer than the distance between its ends "
                 f"({chord:.6g} m)",
             )
     elif chord > L * (1.0 + MAX_STRAIN):
         raise InputError(
-            "length", L, "m",
+            "length",
+            L,
+            "m",
             f"is shorter than the distance between the ends ({chord:.6g} m): the line "
             f"would have to stretch {chord / L - 1.0:.1%} (> {MAX_STRAIN:.0%})",
         )
@@ -278,7 +294,10 @@ def _newton(H, Va, X, Z, L, w, c, seabed, scale):
     if nr <= tol:
         return H, Va, it, nr
     raise ConvergenceError(
-        "elastic catenary Newton", it, nr, tol,
+        "elastic catenary Newton",
+        it,
+        nr,
+        tol,
         hint="check that the line length, weight and EA are consistent with the spans",
         partial=(H, Va),
     )
@@ -307,7 +326,9 @@ def _vertical_solve(Z, L, w, c, seabed):
     Va = 0.5 * (lo + hi)
     if seabed and Va < 0.0:
         raise InputError(
-            "horizontal_span", 0.0, "m",
+            "horizontal_span",
+            0.0,
+            "m",
             "a vertical slack line on the seabed would pile up at end_a; no catenary "
             "equilibrium (give a horizontal span or a shorter line)",
         )
@@ -372,8 +393,9 @@ def catenary_solve(
     return elastic_catenary(X, Z, L, w, ea, bool(seabed))
 
 
-def elastic_catenary(X: float, Z: float, L: float, w: float, ea: float,
-                     seabed: bool) -> CatenarySolution:
+def elastic_catenary(
+    X: float, Z: float, L: float, w: float, ea: float, seabed: bool
+) -> CatenarySolution:
     """:func:`catenary_solve` for inputs already checked: floats, X >= 0 and Z, w
     finite, L > 0, EA > 0 (``math.inf`` inextensible) [m, m, m, N/m, N].  For the inner
     loops (the lumped-chain start of the FE statics, the line statics at every body
@@ -383,20 +405,29 @@ def elastic_catenary(X: float, Z: float, L: float, w: float, ea: float,
     c = 0.0 if math.isinf(ea) else 1.0 / ea
     chord = math.hypot(X, Z)
     if chord == 0.0:
-        raise InputError("horizontal_span", X, "m",
-                         "end_a and end_b coincide (horizontal and vertical span are 0)")
+        raise InputError(
+            "horizontal_span",
+            X,
+            "m",
+            "end_a and end_b coincide (horizontal and vertical span are 0)",
+        )
     check_reach(L, chord, ea)
     seabed = bool(seabed)
     if seabed and w <= 0.0:
         seabed = False  # a weightless or buoyant line does not rest on the seabed
     if seabed and Z <= 0.0:
-        raise InputError("vertical_span", Z, "m",
-                         "must be > 0 with seabed contact (end_b above the seabed)")
+        raise InputError(
+            "vertical_span", Z, "m", "must be > 0 with seabed contact (end_b above the seabed)"
+        )
     if w == 0.0:
         if chord <= L:
-            raise InputError("weight", w, "N/m",
-                             "a weightless line must be taut (length < distance between "
-                             "the ends); its slack shape is undetermined")
+            raise InputError(
+                "weight",
+                w,
+                "N/m",
+                "a weightless line must be taut (length < distance between "
+                "the ends); its slack shape is undetermined",
+            )
         T = (chord / L - 1.0) / c
         H, Va = T * X / chord, T * Z / chord
         return CatenarySolution(H, Va, Va, T, T, 0.0, 0.0, 0, X, Z, L, w, ea, seabed, 0.0)
@@ -405,25 +436,44 @@ def elastic_catenary(X: float, Z: float, L: float, w: float, ea: float,
         ls_min = 2.0 * Z / (1.0 + math.sqrt(1.0 + 2.0 * c * w * Z))
         if ls_min < L and X <= L - ls_min:
             raise InputError(
-                "horizontal_span", X, "m",
+                "horizontal_span",
+                X,
+                "m",
                 f"must be > {L - ls_min:.6g} m: with seabed contact a line this slack "
                 "would pile up on the seabed (frictionless catenary has no solution)",
             )
     if X == 0.0:
         Va, it, res = _vertical_solve(Z, L, w, c, seabed)
         Vb = Va + w * L
-        return CatenarySolution(0.0, Va, Vb, abs(Va), abs(Vb), 0.0, 0.0, it, X, Z, L, w,
-                                ea, seabed, res)
+        return CatenarySolution(
+            0.0, Va, Vb, abs(Va), abs(Vb), 0.0, 0.0, it, X, Z, L, w, ea, seabed, res
+        )
     H0, Va0 = newton_start(X, Z, L, w, c)
     scale = max(L, chord)
     H, Va, it, res = _newton(H0, Va0, X, Z, L, w, c, seabed, scale)
     Vb = Va + w * L
     if seabed and Va < 0.0:
         lb = min(-Va / w, L)
-        return CatenarySolution(H, 0.0, Vb, H, math.hypot(H, Vb), lb * (1.0 + H * c), lb,
-                                it, X, Z, L, w, ea, seabed, res)
-    return CatenarySolution(H, Va, Vb, math.hypot(H, Va), math.hypot(H, Vb), 0.0, 0.0,
-                            it, X, Z, L, w, ea, seabed, res)
+        return CatenarySolution(
+            H,
+            0.0,
+            Vb,
+            H,
+            math.hypot(H, Vb),
+            lb * (1.0 + H * c),
+            lb,
+            it,
+            X,
+            Z,
+            L,
+            w,
+            ea,
+            seabed,
+            res,
+        )
+    return CatenarySolution(
+        H, Va, Vb, math.hypot(H, Va), math.hypot(H, Vb), 0.0, 0.0, it, X, Z, L, w, ea, seabed, res
+    )
 
 
 def catenary_from_top_tension(
@@ -486,9 +536,13 @@ def catenary_from_top_tension(
     lo, hi = Tb * 1e-9, Tb * (1.0 - 1e-12)
     flo, fhi = spans(lo)[1] - Z, spans(hi)[1] - Z
     if flo * fhi > 0.0:
-        raise InputError("tension_b", Tb, "N",
-                         f"no horizontal span gives this end_b tension for a vertical span "
-                         f"of {Z:g} m (the line is too heavy or too long for it)")
+        raise InputError(
+            "tension_b",
+            Tb,
+            "N",
+            f"no horizontal span gives this end_b tension for a vertical span "
+            f"of {Z:g} m (the line is too heavy or too long for it)",
+        )
     H = brentq(lambda h: spans(h)[1] - Z, lo, hi, xtol=1e-14 * Tb, rtol=1e-15, maxiter=500)
     X = spans(H)[0]
     return elastic_catenary(X, Z, L, w, ea, bool(seabed))
@@ -519,9 +573,7 @@ class CatenaryLine:
     node_tension: np.ndarray
 
 
-def catenary_line(
-    mesh_or_line: Union["LineMesh", "Line"], environment: "Environment"
-) -> CatenaryLine:
+def catenary_line(mesh_or_line: LineMesh | Line, environment: Environment) -> CatenaryLine:
     """Closed-form statics of a one-segment line without attachments, in 3-D.
 
     Parameters
@@ -548,15 +600,23 @@ def catenary_line(
     else:
         mesh = mesh_line(mesh_or_line, environment.rho, environment.g)
     if np.unique(mesh.segment).size != 1:
-        raise InputError(f"line {mesh.name!r}.segments", int(np.unique(mesh.segment).size),
-                         "-", "the closed-form catenary needs exactly one segment")
-    if (np.any(mesh.node_mass != 0.0) or np.any(mesh.node_buoyancy != 0.0)):
-        raise InputError(f"line {mesh.name!r}.attachments", "mass/buoyancy", "-",
-                         "the closed-form catenary needs a line without loaded attachments")
+        raise InputError(
+            f"line {mesh.name!r}.segments",
+            int(np.unique(mesh.segment).size),
+            "-",
+            "the closed-form catenary needs exactly one segment",
+        )
+    if np.any(mesh.node_mass != 0.0) or np.any(mesh.node_buoyancy != 0.0):
+        raise InputError(
+            f"line {mesh.name!r}.attachments",
+            "mass/buoyancy",
+            "-",
+            "the closed-form catenary needs a line without loaded attachments",
+        )
     return catenary_on_mesh(mesh, environment)
 
 
-def catenary_on_mesh(mesh: "LineMesh", environment: "Environment") -> CatenaryLine:
+def catenary_on_mesh(mesh: LineMesh, environment: Environment) -> CatenaryLine:
     """:func:`catenary_line` of a mesh already known to have one segment and no loaded
     attachment (the line statics checks that before it takes the closed form)."""
     a, b = mesh.end_a, mesh.end_b
@@ -566,8 +626,9 @@ def catenary_on_mesh(mesh: "LineMesh", environment: "Environment") -> CatenaryLi
     e_h = np.array([d[0], d[1], 0.0]) / X if X > 0.0 else np.array([1.0, 0.0, 0.0])
     depth = environment.depth
     on_seabed = abs(a[2] + depth) <= 1e-9 * depth
-    sol = elastic_catenary(X, Z, float(mesh.length), float(mesh.weight[0]),
-                           float(mesh.ea[0]), bool(on_seabed))
+    sol = elastic_catenary(
+        X, Z, float(mesh.length), float(mesh.weight[0]), float(mesh.ea[0]), bool(on_seabed)
+    )
     x, z, t = sol.profile(mesh.s0)
     pos = a[None, :] + x[:, None] * e_h[None, :] + z[:, None] * np.array([0.0, 0.0, 1.0])
     mid = 0.5 * (mesh.s0[1:] + mesh.s0[:-1])

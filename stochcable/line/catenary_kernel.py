@@ -16,8 +16,16 @@ import math
 
 import numpy as np
 
-__all__ = ["CLOSURE_TOL", "MAX_NEWTON", "asinhc", "kernel", "kernel_scalar", "kernel_spans",
-           "closure", "vertical_profile"]
+__all__ = [
+    "CLOSURE_TOL",
+    "MAX_NEWTON",
+    "asinhc",
+    "kernel",
+    "kernel_scalar",
+    "kernel_spans",
+    "closure",
+    "vertical_profile",
+]
 
 CLOSURE_TOL = 1e-12  # closure tolerance, relative to max(length, chord)
 MAX_NEWTON = 200  # Newton iterations of the closure
@@ -110,8 +118,10 @@ def closure(H, Va, L, w, c, seabed):
     if seabed and Va < 0.0:
         lb = -Va / w  # may exceed L inside the iteration: the closure stays smooth
         x, z, a, b, cc, d = stretch(H, 0.0, w, L - lb, c)
-        return float(x + lb * (1.0 + H * c)), float(z), np.array(
-            [[a + lb * c, b], [cc, d]], dtype=float
+        return (
+            float(x + lb * (1.0 + H * c)),
+            float(z),
+            np.array([[a + lb * c, b], [cc, d]], dtype=float),
         )
     x, z, a, b, cc, d = stretch(H, Va, w, L, c)
     return float(x), float(z), np.array([[a, b], [cc, d]], dtype=float)

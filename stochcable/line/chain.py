@@ -28,8 +28,9 @@ def straight(a: np.ndarray, b: np.ndarray, frac: np.ndarray) -> np.ndarray:
     return a + frac[:, None] * (b - a)
 
 
-def initial_guess(mesh: LineMesh, env: Environment, frame: LocalFrame,
-                   model: StaticsModel) -> np.ndarray:
+def initial_guess(
+    mesh: LineMesh, env: Environment, frame: LocalFrame, model: StaticsModel
+) -> np.ndarray:
     """A hanging (parabolic) or straight initial shape in the local frame, (n, dim)."""
     a = frame.to_local(mesh.end_a[None, :])[0]
     b = frame.to_local(mesh.end_b[None, :])[0]
@@ -72,8 +73,9 @@ def initial_guess(mesh: LineMesh, env: Environment, frame: LocalFrame,
     return X
 
 
-def chain_shots(mesh: LineMesh, model: StaticsModel, a: np.ndarray, zi: int, on_bed: bool,
-                 kb: np.ndarray) -> tuple[Any, Any]:
+def chain_shots(
+    mesh: LineMesh, model: StaticsModel, a: np.ndarray, zi: int, on_bed: bool, kb: np.ndarray
+) -> tuple[Any, Any]:
     """The shots of :func:`chain_guess`: ``shoot(H, V0, P) -> (x, z)`` the node
     coordinates of the lumped chain from end ``a`` with horizontal force H, first
     element vertical force V0 and node loads P; ``shoot_ends(H, V0, P)`` the end node
@@ -105,9 +107,9 @@ def chain_shots(mesh: LineMesh, model: StaticsModel, a: np.ndarray, zi: int, on_
         dz = c * Ve / T
         z = np.empty(mesh.n_nodes)
         z[0] = a[zi]
-        z[1:k_star + 1] = zbed - pen[1:k_star + 1]
+        z[1 : k_star + 1] = zbed - pen[1 : k_star + 1]
         if k_star < V.size:
-            z[k_star + 1:] = z[k_star] + np.cumsum(dz[k_star:])
+            z[k_star + 1 :] = z[k_star] + np.cumsum(dz[k_star:])
         return x, z
 
     def shoot_ends(H: np.ndarray, V0: np.ndarray, P: np.ndarray) -> np.ndarray:
@@ -145,8 +147,14 @@ def chain_shots(mesh: LineMesh, model: StaticsModel, a: np.ndarray, zi: int, on_
     return shoot, shoot_ends
 
 
-def chain_guess(mesh: LineMesh, env: Environment, frame: LocalFrame, model: StaticsModel,
-                 a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+def chain_guess(
+    mesh: LineMesh,
+    env: Environment,
+    frame: LocalFrame,
+    model: StaticsModel,
+    a: np.ndarray,
+    b: np.ndarray,
+) -> np.ndarray | None:
     """Exact equilibrium of the lumped chain without drag: a two-unknown shooting.
 
     With the loads lumped at the nodes and no current, the element forces of the FE
@@ -180,7 +188,7 @@ def chain_guess(mesh: LineMesh, env: Environment, frame: LocalFrame, model: Stat
     if X <= 1e-6 * L:
         return None
     zbed = model.zbed
-    on_bed = (a[zi] <= zbed * (1.0 - 1e-9) and Z > 0.0 and env.seabed.stiffness > 0.0)
+    on_bed = a[zi] <= zbed * (1.0 - 1e-9) and Z > 0.0 and env.seabed.stiffness > 0.0
     l0, ea = mesh.l0, mesh.ea
     kb = np.where(model.kb > 0.0, model.kb, np.inf)
 
@@ -196,8 +204,9 @@ def chain_guess(mesh: LineMesh, env: Environment, frame: LocalFrame, model: Stat
     P = loads(W)
     scale = max(L, 1.0)
     for _pass in range(3):
-        HV = chain_newton(shoot, P, float(b[0]), float(b[zi]), X, Z, L, l0, ea,
-                           on_bed, scale, shoot_ends)
+        HV = chain_newton(
+            shoot, P, float(b[0]), float(b[zi]), X, Z, L, l0, ea, on_bed, scale, shoot_ends
+        )
         if HV is None:
             HV = chain_closure(shoot, P, float(b[0]), float(b[zi]), scale)
         if HV is None:
@@ -219,16 +228,28 @@ def chain_guess(mesh: LineMesh, env: Environment, frame: LocalFrame, model: Stat
     Xg[:, zi] = z
     if not np.all(np.isfinite(Xg)):
         return None
-    if float(np.min(z[1:-1], initial=0.0)) < zbed - 10.0 * float(np.max(
-            np.abs(P) / kb, initial=0.0)) - 1e-9 * max(env.depth, 1.0):
+    if float(np.min(z[1:-1], initial=0.0)) < zbed - 10.0 * float(
+        np.max(np.abs(P) / kb, initial=0.0)
+    ) - 1e-9 * max(env.depth, 1.0):
         return None  # passes through the seabed away from end_a
     Xg[0], Xg[-1] = a, b
     return Xg
 
 
-def chain_newton(shoot, P: np.ndarray, xb: float, zb: float, X: float, Z: float,
-                  L: float, l0: np.ndarray, ea: np.ndarray, on_bed: bool,
-                  scale: float, shoot_ends: Any = None) -> tuple[float, float] | None:
+def chain_newton(
+    shoot,
+    P: np.ndarray,
+    xb: float,
+    zb: float,
+    X: float,
+    Z: float,
+    L: float,
+    l0: np.ndarray,
+    ea: np.ndarray,
+    on_bed: bool,
+    scale: float,
+    shoot_ends: Any = None,
+) -> tuple[float, float] | None:
     """(H, V_0) of the lumped chain by damped Newton on the end closure, started from
     the continuous catenary of the mean weight; None when it fails (kinks where an
     element lifts off the bed can stall it; :func:`chain_closure` then brackets).
@@ -236,8 +257,9 @@ def chain_newton(shoot, P: np.ndarray, xb: float, zb: float, X: float, Z: float,
     of the central-difference Jacobian in one call, the same numbers)."""
     w_mean = float(np.sum(P)) / L
     try:
-        sol = elastic_catenary(X, Z, float(L), w_mean, L / float(np.sum(l0 / ea)),
-                               bool(on_bed and w_mean > 0.0))
+        sol = elastic_catenary(
+            X, Z, float(L), w_mean, L / float(np.sum(l0 / ea)), bool(on_bed and w_mean > 0.0)
+        )
     except (InputError, ConvergenceError, ValueError):
         return None
     fscale = max(abs(w_mean) * L, sol.H, 1.0)
@@ -262,8 +284,9 @@ def chain_newton(shoot, P: np.ndarray, xb: float, zb: float, X: float, Z: float,
                 du = np.zeros(2)
                 du[j] = hstep
                 pts += [u + du, u - du]
-            ends = shoot_ends(np.array([math.exp(p[0]) for p in pts]),
-                              np.array([p[1] for p in pts]), P)
+            ends = shoot_ends(
+                np.array([math.exp(p[0]) for p in pts]), np.array([p[1] for p in pts]), P
+            )
             ends -= np.array([xb, zb])
             for j, hstep in enumerate(steps):
                 J[:, j] = (ends[2 * j] - ends[2 * j + 1]) / (2.0 * hstep)
@@ -290,8 +313,9 @@ def chain_newton(shoot, P: np.ndarray, xb: float, zb: float, X: float, Z: float,
     return None
 
 
-def chain_closure(shoot, P: np.ndarray, xb: float, zb: float,
-                   scale: float) -> tuple[float, float] | None:
+def chain_closure(
+    shoot, P: np.ndarray, xb: float, zb: float, scale: float
+) -> tuple[float, float] | None:
     """(H, V_0) of the lumped chain reaching (xb, zb): nested monotone root finding.
 
     For fixed H the end elevation increases monotonically with V_0 (every element
@@ -316,8 +340,14 @@ def chain_closure(shoot, P: np.ndarray, xb: float, zb: float,
             fhi = shoot(H, hi, P)[1][-1] - zb
         if not (flo <= 0.0 <= fhi):
             return None
-        return brentq(lambda v: shoot(H, v, P)[1][-1] - zb, lo, hi, xtol=1e-15 * load,
-                      rtol=4 * _EPS, maxiter=200)
+        return brentq(
+            lambda v: shoot(H, v, P)[1][-1] - zb,
+            lo,
+            hi,
+            xtol=1e-15 * load,
+            rtol=4 * _EPS,
+            maxiter=200,
+        )
 
     def gx(logh: float) -> float:
         H = math.exp(logh)

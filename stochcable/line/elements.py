@@ -16,9 +16,19 @@ import numpy as np
 from stochcable.errors import InputError
 from stochcable.validation import float_array, positive
 
-__all__ = ["SLACK_EA_RATIO", "STIFFNESS_PATTERN", "CONSISTENT_PATTERN", "LUMPED_PATTERN",
-           "element_stiffness", "element_mass", "element_added_mass", "stiffness_blocks",
-           "expand_blocks", "added_mass_elements", "check_dim"]
+__all__ = [
+    "SLACK_EA_RATIO",
+    "STIFFNESS_PATTERN",
+    "CONSISTENT_PATTERN",
+    "LUMPED_PATTERN",
+    "element_stiffness",
+    "element_mass",
+    "element_added_mass",
+    "stiffness_blocks",
+    "expand_blocks",
+    "added_mass_elements",
+    "check_dim",
+]
 
 #: Slack elements (T <= 0) keep this fraction of their EA and no geometric stiffness,
 #: so K stays positive semi-definite and a slack stretch only loses its stiffness
@@ -26,8 +36,9 @@ __all__ = ["SLACK_EA_RATIO", "STIFFNESS_PATTERN", "CONSISTENT_PATTERN", "LUMPED_
 SLACK_EA_RATIO = 1.0e-6
 
 
-def stiffness_blocks(e: np.ndarray, l: np.ndarray, l0: np.ndarray, ea: np.ndarray,
-                     tension: np.ndarray) -> np.ndarray:
+def stiffness_blocks(
+    e: np.ndarray, l: np.ndarray, l0: np.ndarray, ea: np.ndarray, tension: np.ndarray
+) -> np.ndarray:
     """Node-block k (n_el, d, d) of K_e = k ⊗ [[1, -1], [-1, 1]] (no validation)."""
     slack = tension <= 0.0
     t_eff = np.where(slack, 0.0, tension)
@@ -44,7 +55,7 @@ def expand_blocks(block: np.ndarray, pattern: np.ndarray) -> np.ndarray:
     out = np.empty((n, 2 * d, 2 * d))
     for a in range(2):
         for b in range(2):
-            out[:, a * d:(a + 1) * d, b * d:(b + 1) * d] = pattern[a, b] * block
+            out[:, a * d : (a + 1) * d, b * d : (b + 1) * d] = pattern[a, b] * block
     return out
 
 
@@ -94,8 +105,12 @@ def element_stiffness(
     pa = float_array("positions_a", positions_a, "m", ndim=2)
     pb = float_array("positions_b", positions_b, "m", ndim=2)
     if pa.shape != pb.shape or pa.shape[1] not in (2, 3):
-        raise InputError("positions_b", pb.shape, "-",
-                         f"must have the shape of positions_a {pa.shape}, with 2 or 3 columns")
+        raise InputError(
+            "positions_b",
+            pb.shape,
+            "-",
+            f"must have the shape of positions_a {pa.shape}, with 2 or 3 columns",
+        )
     n = pa.shape[0]
     l0 = float_array("l0", l0, "m", positive=True)
     ea = float_array("ea", ea, "N", positive=True)
@@ -107,8 +122,9 @@ def element_stiffness(
     l = np.linalg.norm(d, axis=1)
     if (l <= 0.0).any():
         i = int(np.flatnonzero(l <= 0.0)[0])
-        raise InputError("positions_b", pb[i], "m",
-                         f"element {i} has zero length (its nodes coincide)")
+        raise InputError(
+            "positions_b", pb[i], "m", f"element {i} has zero length (its nodes coincide)"
+        )
     e = d / l[:, None]
     return expand_blocks(stiffness_blocks(e, l, l0, ea, tension), STIFFNESS_PATTERN)
 

@@ -39,8 +39,11 @@ class LocalFrame:
         a, b = mesh.end_a, mesh.end_b
         h = b[:2] - a[:2]
         hn = math.hypot(*h)
-        cur = [(p.speed * math.cos(p.heading_rad), p.speed * math.sin(p.heading_rad))
-               for p in env.current if p.speed > 0.0]
+        cur = [
+            (p.speed * math.cos(p.heading_rad), p.speed * math.sin(p.heading_rad))
+            for p in env.current
+            if p.speed > 0.0
+        ]
         if hn > 1e-12 * max(1.0, mesh.length):
             ux = h / hn
         elif cur:
@@ -51,8 +54,9 @@ class LocalFrame:
             ux = np.array([1.0, 0.0])
         self.Q = np.array([[ux[0], ux[1], 0.0], [-ux[1], ux[0], 0.0], [0.0, 0.0, 1.0]])
         self.origin = np.array([a[0], a[1], 0.0])
-        out_of_plane = any(abs(-ux[1] * cx + ux[0] * cy) > 1e-12 * math.hypot(cx, cy)
-                           for cx, cy in cur)
+        out_of_plane = any(
+            abs(-ux[1] * cx + ux[0] * cy) > 1e-12 * math.hypot(cx, cy) for cx, cy in cur
+        )
         self.dim = 3 if (force_3d or out_of_plane) else 2
         self.cols = [0, 1, 2] if self.dim == 3 else [0, 2]
 
@@ -96,16 +100,22 @@ class StaticsModel:
         self.has_current = any(p.speed > 0 for p in pts)
         if self.has_current:
             self.cz = np.array([p.z for p in pts])
-            uv = np.array([[p.speed * math.cos(p.heading_rad),
-                            p.speed * math.sin(p.heading_rad), 0.0] for p in pts])
+            uv = np.array(
+                [
+                    [p.speed * math.cos(p.heading_rad), p.speed * math.sin(p.heading_rad), 0.0]
+                    for p in pts
+                ]
+            )
             loc = uv @ frame.Q.T
             self.cu = loc[:, frame.cols]  # (n_pts, dim)
         self.c_n = 0.5 * env.rho * mesh.cd_normal * mesh.diameter
         self.c_t = 0.5 * env.rho * mesh.cd_axial * math.pi * mesh.diameter
         self.c_node = 0.5 * env.rho * mesh.node_drag_area
         self.has_drag = self.has_current and (
-            bool(np.any(self.c_n > 0)) or bool(np.any(self.c_t > 0))
-            or bool(np.any(self.c_node > 0)))
+            bool(np.any(self.c_n > 0))
+            or bool(np.any(self.c_t > 0))
+            or bool(np.any(self.c_node > 0))
+        )
         # load-stepping factor of the drag (1 = full current)
         self.beta = 1.0
         self._band_index()
@@ -117,8 +127,7 @@ class StaticsModel:
         ws = self.__dict__.get("_weight_scale")
         if ws is None:
             w = np.maximum(np.abs(self.w_sub), np.abs(self.w_dry))
-            ws = self._weight_scale = float(np.sum(w * self.l0)
-                                            + np.sum(np.abs(self.node_fz)))
+            ws = self._weight_scale = float(np.sum(w * self.l0) + np.sum(np.abs(self.node_fz)))
         return ws
 
     def energy(self, X: np.ndarray) -> float:
@@ -133,8 +142,12 @@ class StaticsModel:
         wet = (za <= 0.0) & (zb <= 0.0)
         W = l0 * np.where(wet, self.w_sub, self.w_dry)
         pen = np.maximum(self.zbed - z, 0.0)
-        return float(0.5 * np.sum(eae * l0 * strain**2) + np.sum(W * 0.5 * (za + zb))
-                     - np.sum(self.node_fz * z) + 0.5 * np.sum(self.kb * pen**2))
+        return float(
+            0.5 * np.sum(eae * l0 * strain**2)
+            + np.sum(W * 0.5 * (za + zb))
+            - np.sum(self.node_fz * z)
+            + 0.5 * np.sum(self.kb * pen**2)
+        )
 
     def current(self, z: np.ndarray) -> np.ndarray:
         u = np.empty(z.shape + (self.dim,))
@@ -161,8 +174,12 @@ class StaticsModel:
         adds the tangent (the same numbers, ≈ 0.4 ms of the reference chain's
         statics)."""
         memo = self._memo
-        if (memo is not None and memo["beta"] == self.beta and memo["X"].shape == X.shape
-                and np.array_equal(memo["X"], X)):
+        if (
+            memo is not None
+            and memo["beta"] == self.beta
+            and memo["X"].shape == X.shape
+            and np.array_equal(memo["X"], X)
+        ):
             if self.has_drag:
                 self.drag_nodes = memo["drag_nodes"].copy()
             R = memo["R"].copy()
@@ -214,25 +231,37 @@ class StaticsModel:
             ua = np.einsum("ij,ij->i", u, e)
             un = u - ua[:, None] * e
             unn = np.sqrt(np.einsum("ij,ij->i", un, un))
-            g = ((self.c_n * unn)[:, None] * un
-                 + (self.c_t * np.abs(ua) * ua)[:, None] * e)
+            g = (self.c_n * unn)[:, None] * un + (self.c_t * np.abs(ua) * ua)[:, None] * e
             Fd = beta * l[:, None] * g
             R[:-1] += 0.5 * Fd
             R[1:] += 0.5 * Fd
             un_node = self.current(z)
-            Fn = beta * (self.c_node * np.sqrt(np.einsum("ij,ij->i", un_node, un_node)))[:, None] * un_node
+            Fn = (
+                beta
+                * (self.c_node * np.sqrt(np.einsum("ij,ij->i", un_node, un_node)))[:, None]
+                * un_node
+            )
             R += Fn
             self.drag_nodes = np.zeros_like(X)
             self.drag_nodes[:-1] += 0.5 * Fd
             self.drag_nodes[1:] += 0.5 * Fd
             self.drag_nodes += Fn
-            drag = float(np.sum(np.sqrt(np.einsum("ij,ij->i", Fd, Fd)))
-                         + np.sum(np.abs(Fn)))
+            drag = float(np.sum(np.sqrt(np.einsum("ij,ij->i", Fd, Fd))) + np.sum(np.abs(Fn)))
         pen = self.zbed - z
         contact = pen > 0.0
         R[:, zi] += np.where(contact, self.kb * pen, 0.0)
-        st = {"X": X.copy(), "beta": beta, "R": R, "T": T, "drag": drag, "e": e, "l": l,
-              "eae": eae, "mixed": mixed, "pen": pen}
+        st = {
+            "X": X.copy(),
+            "beta": beta,
+            "R": R,
+            "T": T,
+            "drag": drag,
+            "e": e,
+            "l": l,
+            "eae": eae,
+            "mixed": mixed,
+            "pen": pen,
+        }
         if mixed.any():
             st["dfa"], st["dfb"] = dfa, dfb
         if self.has_drag:
@@ -261,13 +290,16 @@ class StaticsModel:
         if self.has_drag:
             # D = dF/dd = g eᵀ + (dg/de)(I - e eᵀ)
             safe = np.where(unn > 0.0, unn, 1.0)
-            A = (unn[:, None, None] * I
-                 + np.where(unn > 0.0, 1.0 / safe, 0.0)[:, None, None]
-                 * un[:, :, None] * un[:, None, :])
+            A = (
+                unn[:, None, None] * I
+                + np.where(unn > 0.0, 1.0 / safe, 0.0)[:, None, None]
+                * un[:, :, None]
+                * un[:, None, :]
+            )
             B = e[:, :, None] * u[:, None, :] + ua[:, None, None] * I
-            dg = (-self.c_n[:, None, None] * (A @ B)
-                  + (self.c_t * np.abs(ua))[:, None, None]
-                  * (2.0 * e[:, :, None] * u[:, None, :] + ua[:, None, None] * I))
+            dg = -self.c_n[:, None, None] * (A @ B) + (self.c_t * np.abs(ua))[:, None, None] * (
+                2.0 * e[:, :, None] * u[:, None, :] + ua[:, None, None] * I
+            )
             D = beta * (g[:, :, None] * e[:, None, :] + dg @ (I - ee))
             Kd[:-1] += 0.5 * D
             Kd[1:] -= 0.5 * D
@@ -317,8 +349,9 @@ class StaticsSolver:
         scale = float(np.max(model.ea / model.l0))
         self._floor_k = 8.0 * _EPS * scale
 
-    def status(self, X: np.ndarray, tangent: bool = True
-               ) -> tuple[float, float, np.ndarray, tuple | None]:
+    def status(
+        self, X: np.ndarray, tangent: bool = True
+    ) -> tuple[float, float, np.ndarray, tuple | None]:
         """Relative residual, tolerance (raised to the round-off floor), nodal
         residual and, with ``tangent``, the tangent blocks (else None: a converged
         point needs no tangent; ``m.forces(X)`` adds it later from the memo)."""

@@ -31,7 +31,6 @@ from typing import Any, Literal
 import numpy as np
 import scipy.sparse as sp
 
-from stochcable.validation import float_array, positive
 from stochcable.errors import InputError
 from stochcable.line.elements import (
     CONSISTENT_PATTERN,
@@ -48,6 +47,7 @@ from stochcable.line.elements import (
 )
 from stochcable.line.mesh import LineMesh
 from stochcable.scene.model import Environment, Seabed
+from stochcable.validation import float_array, positive
 
 __all__ = [
     "SLACK_EA_RATIO",
@@ -166,9 +166,13 @@ class FEModel:
         if isinstance(component, str):
             axis = _AXES.get(component)
             if axis is None or axis not in self.components:
-                raise InputError("component", component, "-",
-                                 f"must be one of the model axes "
-                                 f"{[k for k, v in _AXES.items() if v in self.components]}")
+                raise InputError(
+                    "component",
+                    component,
+                    "-",
+                    f"must be one of the model axes "
+                    f"{[k for k, v in _AXES.items() if v in self.components]}",
+                )
             c = self.components.index(axis)
         else:
             c = int(component)
@@ -186,11 +190,16 @@ class FEModel:
         Assembled matrices share one pattern: the sum entry by entry on it (the same
         numbers as scipy's sum, which also drops the entries that cancel to 0; 0.1 ms)."""
         m, ma = self.M, self.Ma
-        if (isinstance(m, sp.csr_array) and isinstance(ma, sp.csr_array)
-                and m.shape == ma.shape and np.array_equal(m.indptr, ma.indptr)
-                and np.array_equal(m.indices, ma.indices)):
-            return sp.csr_array((m.data + ma.data, m.indices.copy(), m.indptr.copy()),
-                                shape=m.shape)
+        if (
+            isinstance(m, sp.csr_array)
+            and isinstance(ma, sp.csr_array)
+            and m.shape == ma.shape
+            and np.array_equal(m.indptr, ma.indptr)
+            and np.array_equal(m.indices, ma.indices)
+        ):
+            return sp.csr_array(
+                (m.data + ma.data, m.indices.copy(), m.indptr.copy()), shape=m.shape
+            )
         return (m + ma).tocsr()
 
     def _matrix(self, matrix: str | Any) -> Any:
@@ -207,8 +216,7 @@ class FEModel:
         the free DOFs are one contiguous range (both ends prescribed), ≈ 3x faster
         than the fancy indexing."""
         free = self.free
-        if (sp.issparse(matrix) and free.size
-                and int(free[-1]) - int(free[0]) + 1 == free.size):
+        if sp.issparse(matrix) and free.size and int(free[-1]) - int(free[0]) + 1 == free.size:
             lo, hi = int(free[0]), int(free[-1]) + 1
             return matrix.tocsr()[lo:hi][:, lo:hi].tocsr()
         return self.partition(matrix)[0]
@@ -265,8 +273,9 @@ def _element_dofs(n_el: int, dim: int) -> np.ndarray:
     return np.hstack([base, base + dim])
 
 
-def _assemble_sparse(blocks: np.ndarray, dofs: np.ndarray, n_dof: int,
-                     node_diag: np.ndarray | None = None) -> sp.csr_array:
+def _assemble_sparse(
+    blocks: np.ndarray, dofs: np.ndarray, n_dof: int, node_diag: np.ndarray | None = None
+) -> sp.csr_array:
     """Sum element matrices (n_el, 2d, 2d) into a CSR matrix, plus a diagonal."""
     k = dofs.shape[1]
     rows = np.broadcast_to(dofs[:, :, None], (dofs.shape[0], k, k)).ravel()
@@ -302,8 +311,9 @@ def _chain_pattern(n: int, d: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return out
 
 
-def chain_csr(blocks: np.ndarray, n_nodes: int, dim: int,
-               diag: np.ndarray | None = None) -> sp.csr_array:
+def chain_csr(
+    blocks: np.ndarray, n_nodes: int, dim: int, diag: np.ndarray | None = None
+) -> sp.csr_array:
     """Canonical CSR of element matrices (n_el, 2d, 2d) on consecutive nodes (element j
     joins nodes j and j + 1, node-major DOFs), plus a diagonal (n_dof,).
 
@@ -314,8 +324,8 @@ def chain_csr(blocks: np.ndarray, n_nodes: int, dim: int,
     d = dim
     n = n_nodes
     diag_b = np.zeros((n, d, d))
-    diag_b[:-1] += blocks[:, :d, :d]   # node a of element j: node j
-    diag_b[1:] += blocks[:, d:, d:]    # node b of element j: node j + 1
+    diag_b[:-1] += blocks[:, :d, :d]  # node a of element j: node j
+    diag_b[1:] += blocks[:, d:, d:]  # node b of element j: node j + 1
     if diag is not None:
         diag_b[:, np.arange(d), np.arange(d)] += diag.reshape(n, d)
     # rows of node i: [lower (node i-1) | diagonal (node i) | upper (node i+1)]
@@ -324,8 +334,7 @@ def chain_csr(blocks: np.ndarray, n_nodes: int, dim: int,
     data[:, :, 1] = diag_b
     data[:-1, :, 2] = blocks[:, :d, d:]
     sel, indices, indptr = _chain_pattern(n, d)
-    a = sp.csr_array((data.reshape(-1)[sel], indices.copy(), indptr.copy()),
-                     shape=(n * d, n * d))
+    a = sp.csr_array((data.reshape(-1)[sel], indices.copy(), indptr.copy()), shape=(n * d, n * d))
     # the node blocks (diagonal, O[j] = A[j+1, j]) for the analysis' block solves, with
     # a copy of the entries to detect a later in-place change (then they are re-read)
     a._node_blocks = (a.data.copy(), diag_b, np.ascontiguousarray(blocks[:, d:, :d]))
@@ -389,8 +398,12 @@ def assemble(
     if pos.shape == (n_nodes, 2) and dim == 2:
         pos = np.column_stack([pos[:, 0], np.zeros(n_nodes), pos[:, 1]])
     if pos.shape != (n_nodes, 3):
-        raise InputError("positions", pos.shape, "m",
-                         f"must have shape ({n_nodes}, 3), one (x, y, z) row per node")
+        raise InputError(
+            "positions",
+            pos.shape,
+            "m",
+            f"must have shape ({n_nodes}, 3), one (x, y, z) row per node",
+        )
     ten = float_array("tension", tension, "N")
     if ten.shape != (n_el,):
         raise InputError("tension", ten.shape, "N", f"must have one value per element ({n_el})")
@@ -399,9 +412,13 @@ def assemble(
         scale = max(float(np.ptp(pos, axis=0).max()), 1.0)
         dy = float(np.ptp(pos[:, 1]))
         if dy > _PLANE_TOL * scale:
-            raise InputError("dim", 2, "-",
-                             f"needs a line in the x–z plane; line '{mesh.name}' spans "
-                             f"{dy:.3g} m in y: use dim=3")
+            raise InputError(
+                "dim",
+                2,
+                "-",
+                f"needs a line in the x–z plane; line '{mesh.name}' spans "
+                f"{dy:.3g} m in y: use dim=3",
+            )
     if grounded is None:
         gr = np.zeros(n_nodes, dtype=bool)
     else:
@@ -410,7 +427,11 @@ def assemble(
             raise InputError("grounded", gr.shape, "-", f"must have one flag per node ({n_nodes})")
     fixed_set = set()
     for f in fixed_nodes:
-        if isinstance(f, bool) or not isinstance(f, (int, np.integer)) or not -n_nodes <= f < n_nodes:
+        if (
+            isinstance(f, bool)
+            or not isinstance(f, (int, np.integer))
+            or not -n_nodes <= f < n_nodes
+        ):
             raise InputError("fixed_nodes", f, "-", f"must be node indices in 0…{n_nodes - 1}")
         fixed_set.add(int(f) % n_nodes)
     seabed = Seabed() if seabed is None else seabed
@@ -420,15 +441,21 @@ def assemble(
     l = np.linalg.norm(d, axis=1)
     if (l <= 0.0).any():
         i = int(np.flatnonzero(l <= 0.0)[0])
-        raise InputError("positions", pos[i], "m",
-                         f"element {i} has zero length (nodes {i} and {i + 1} coincide)")
+        raise InputError(
+            "positions",
+            pos[i],
+            "m",
+            f"element {i} has zero length (nodes {i} and {i + 1} coincide)",
+        )
     e = d / l[:, None]
     lumped = mass_matrix == "lumped"
     n_dof = dim * n_nodes
 
     k_el = expand_blocks(stiffness_blocks(e, l, mesh.l0, mesh.ea, ten), STIFFNESS_PATTERN)
-    m_el = expand_blocks((mesh.l0 * mesh.mass)[:, None, None] * np.eye(dim)[None],
-                   LUMPED_PATTERN if lumped else CONSISTENT_PATTERN)
+    m_el = expand_blocks(
+        (mesh.l0 * mesh.mass)[:, None, None] * np.eye(dim)[None],
+        LUMPED_PATTERN if lumped else CONSISTENT_PATTERN,
+    )
     ma_el = added_mass_elements(e, mesh.l0, mesh.ca_normal, mesh.diameter, rho, lumped)
 
     # Seabed: vertical springs/dashpots on grounded nodes, tributary D·l0/2 per element.
@@ -450,8 +477,14 @@ def assemble(
     Ma = chain_csr(ma_el, n_nodes, dim, ma_diag)
     if c_diag.any():  # the nonzero diagonal entries only (as sp.diags_array gave)
         nz = c_diag != 0.0
-        Cs = sp.csr_array((c_diag[nz], np.flatnonzero(nz).astype(np.int32),
-                           np.r_[0, np.cumsum(nz)].astype(np.int32)), shape=(n_dof, n_dof))
+        Cs = sp.csr_array(
+            (
+                c_diag[nz],
+                np.flatnonzero(nz).astype(np.int32),
+                np.r_[0, np.cumsum(nz)].astype(np.int32),
+            ),
+            shape=(n_dof, n_dof),
+        )
     else:
         Cs = sp.csr_array((n_dof, n_dof))
 

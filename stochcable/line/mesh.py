@@ -173,4 +173,3 @@ def mesh_line(line: Line, rho: float, g: float) -> LineMesh:
         end_a=np.asarray(line.end_a.position, dtype=float),
         end_b=np.asarray(line.end_b.position, dtype=float),
     )
-

@@ -34,9 +34,9 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from stochcable.validation import positive_int
 from stochcable.errors import InputError, SolverError
 from stochcable.line.fem import FEModel
+from stochcable.validation import positive_int
 
 __all__ = ["DENSE_MAX_DOF", "Modes", "natural_modes", "plane_normal"]
 
@@ -90,8 +90,9 @@ class Modes:
     def period(self) -> np.ndarray:
         """Natural periods 2π/ω (inf for a zero frequency). [s]"""
         with np.errstate(divide="ignore"):
-            return np.where(self.omega > 0, 2.0 * np.pi / np.where(self.omega > 0,
-                                                                    self.omega, 1.0), np.inf)
+            return np.where(
+                self.omega > 0, 2.0 * np.pi / np.where(self.omega > 0, self.omega, 1.0), np.inf
+            )
 
     def to_document(self) -> dict[str, list]:
         """{"omega": [rad/s], "period": [s] (null for a zero frequency), "plane": [...]}."""
@@ -160,8 +161,13 @@ def _component_groups(d: int, a: sp.csr_array, b: sp.csr_array) -> list[list[int
             # dense: the largest magnitude of each component pair (i, j) in one
             # reduction (np.nonzero of the matrix was 40 µs)
             nb = mat.shape[0] // d
-            big = np.abs(mat).reshape(nb, d, nb, d).transpose(1, 3, 0, 2).reshape(
-                d, d, -1).max(axis=-1)  # (a reduction over two strided axes is 10x slower)
+            big = (
+                np.abs(mat)
+                .reshape(nb, d, nb, d)
+                .transpose(1, 3, 0, 2)
+                .reshape(d, d, -1)
+                .max(axis=-1)
+            )  # (a reduction over two strided axes is 10x slower)
             strong = big > _COUPLING_TOL * big.max(initial=0.0)
             for i, j in zip(*np.nonzero(strong)):
                 ri, rj = find(int(i)), find(int(j))
@@ -177,8 +183,7 @@ def _component_groups(d: int, a: sp.csr_array, b: sp.csr_array) -> list[list[int
         nz = np.abs(data) > _COUPLING_TOL * np.abs(data).max(initial=0.0)
         # the distinct component pairs (i, j) as flat indices i·d + j (a 1-D count is
         # ~10x faster than np.unique(axis=1) on the stacked pairs)
-        flat = np.flatnonzero(np.bincount((ci[nz] * d + cj[nz]).astype(np.intp),
-                                          minlength=d * d))
+        flat = np.flatnonzero(np.bincount((ci[nz] * d + cj[nz]).astype(np.intp), minlength=d * d))
         for i, j in zip(*np.divmod(flat, d)):
             ri, rj = find(int(i)), find(int(j))
             if ri != rj:
@@ -214,7 +219,8 @@ def _solve_dense(a: Any, b: Any, k: int) -> tuple[np.ndarray, np.ndarray]:
     if info != 0:
         raise np.linalg.LinAlgError(
             f"dsygvd failed (info = {info}): the mass matrix is not positive definite "
-            "or the eigenvalue iteration did not converge")
+            "or the eigenvalue iteration did not converge"
+        )
     return lam[:k], vec[:, :k]
 
 
@@ -235,13 +241,16 @@ def _banded_opinv(a: sp.csr_array, b: sp.csr_array, sigma: float, u: int) -> Any
     ab = _to_upper_banded((a - sigma * b).tocsr(), u)
     c = sla.cholesky_banded(ab, lower=False, check_finite=False)
     n = a.shape[0]
-    return spla.LinearOperator((n, n), dtype=float,
-                               matvec=lambda x: sla.cho_solve_banded((c, False), x,
-                                                                     check_finite=False))
+    return spla.LinearOperator(
+        (n, n),
+        dtype=float,
+        matvec=lambda x: sla.cho_solve_banded((c, False), x, check_finite=False),
+    )
 
 
-def _solve_lanczos(a: sp.csr_array, b: sp.csr_array, k: int, method: str,
-                   u: int) -> tuple[np.ndarray, np.ndarray]:
+def _solve_lanczos(
+    a: sp.csr_array, b: sp.csr_array, k: int, method: str, u: int
+) -> tuple[np.ndarray, np.ndarray]:
     n = a.shape[0]
     sigma = _shift(a, b)
     kk = min(k + 2, n - 1)  # two beyond the request: a gap for the Sturm check
@@ -254,8 +263,9 @@ def _solve_lanczos(a: sp.csr_array, b: sp.csr_array, k: int, method: str,
         opinv = None
     v0 = np.ones(n) / np.sqrt(n)  # deterministic start vector
     ncv = min(n, max(2 * kk + 1, kk + 20))
-    lam, vec = spla.eigsh(a, k=kk, M=b, sigma=sigma, which="LM", OPinv=opinv, v0=v0,
-                          ncv=ncv, tol=1e-13, mode="normal")
+    lam, vec = spla.eigsh(
+        a, k=kk, M=b, sigma=sigma, which="LM", OPinv=opinv, v0=v0, ncv=ncv, tol=1e-13, mode="normal"
+    )
     order = np.argsort(lam)
     lam, vec = lam[order], vec[:, order]
     # Sturm check: exactly k eigenvalues below the gap after the k-th.
@@ -272,10 +282,11 @@ class _SturmMismatch(Exception):
 def _count_below(a: sp.csr_array, b: sp.csr_array, theta: float) -> int:
     """Number of eigenvalues of (A, B) below theta: negative pivots of LDLᵀ(A − θB)."""
     s = (a - theta * b).tocsc()
-    lu = spla.splu(s, permc_spec="NATURAL", diag_pivot_thresh=0.0,
-                   options={"SymmetricMode": True})
-    if not (np.array_equal(lu.perm_r, np.arange(s.shape[0]))
-            and np.array_equal(lu.perm_c, np.arange(s.shape[0]))):
+    lu = spla.splu(s, permc_spec="NATURAL", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+    if not (
+        np.array_equal(lu.perm_r, np.arange(s.shape[0]))
+        and np.array_equal(lu.perm_c, np.arange(s.shape[0]))
+    ):
         return int((sla.eigvalsh(s.toarray(), b.toarray()) < theta).sum())
     return int((lu.U.diagonal() < 0).sum())
 
@@ -320,8 +331,9 @@ def _rotate_dense(a: np.ndarray, r: np.ndarray) -> np.ndarray:
         t[:, i] = r[0, i] * a4[:, 0] + r[1, i] * a4[:, 1] + r[2, i] * a4[:, 2]
     out = np.empty_like(a4)
     for j in range(3):  # (T R)[·, i, ·, j] = Σ_l T[·, i, ·, l] r[l, j]
-        out[:, :, :, j] = (t[:, :, :, 0] * r[0, j] + t[:, :, :, 1] * r[1, j]
-                           + t[:, :, :, 2] * r[2, j])
+        out[:, :, :, j] = (
+            t[:, :, :, 0] * r[0, j] + t[:, :, :, 1] * r[1, j] + t[:, :, :, 2] * r[2, j]
+        )
     return out.reshape(a.shape)
 
 
@@ -384,9 +396,11 @@ def natural_modes(
     # atol=1e-15) written out: |ny − 1|, |nx| <= 1e-15)
     planar_frame = d == 2 or (abs(normal[1] - 1.0) <= 1e-15 and abs(normal[0]) <= 1e-15)
     dense = method == "dense" or (method == "auto" and n_free <= DENSE_MAX_DOF)
-    rz = np.array([[normal[1], normal[0], 0.0],
-                   [-normal[0], normal[1], 0.0],
-                   [0.0, 0.0, 1.0]]) if d == 3 else None  # columns: local x, y (= normal), z
+    rz = (
+        np.array([[normal[1], normal[0], 0.0], [-normal[0], normal[1], 0.0], [0.0, 0.0, 1.0]])
+        if d == 3
+        else None
+    )  # columns: local x, y (= normal), z
     rotate = d == 3 and not planar_frame
     a, b, rot, method = _free_matrices(model, mt, dense, method, rz if rotate else None)
     lams, vecs, idxs, used = _solve_groups(a, b, d, k_req, method)
@@ -415,8 +429,9 @@ def natural_modes(
     shapes = shapes * np.sign(shapes[big, np.arange(k)])
 
     frac = _out_of_plane_fraction(model, mt, shapes, normal)
-    plane = np.where(frac <= PLANE_TOL, "in-plane",
-                     np.where(frac >= 1.0 - PLANE_TOL, "out-of-plane", "mixed"))
+    plane = np.where(
+        frac <= PLANE_TOL, "in-plane", np.where(frac >= 1.0 - PLANE_TOL, "out-of-plane", "mixed")
+    )
     return Modes(
         omega=omega,
         shapes=shapes,
@@ -428,8 +443,9 @@ def natural_modes(
     )
 
 
-def _free_matrices(model: FEModel, mt: Any, dense: bool, method: str, rz: Any
-                   ) -> tuple[Any, Any, Any, str]:
+def _free_matrices(
+    model: FEModel, mt: Any, dense: bool, method: str, rz: Any
+) -> tuple[Any, Any, Any, str]:
     """K_ff and M_T,ff, dense or sparse, rotated about z by ``rz`` (3-D lines off the
     x–z plane; None: not rotated) so that the line's vertical plane is the local x–z
     plane: a planar line's out-of-plane DOFs then decouple exactly from the in-plane
@@ -456,8 +472,7 @@ def _free_matrices(model: FEModel, mt: Any, dense: bool, method: str, rz: Any
     return a, b, rot, method
 
 
-def _solve_groups(a: Any, b: Any, d: int, k_req: int, method: str
-                  ) -> tuple[list, list, list, list]:
+def _solve_groups(a: Any, b: Any, d: int, k_req: int, method: str) -> tuple[list, list, list, list]:
     """The lowest ``k_req`` eigenpairs of every group of coupled components
     (:func:`_component_groups`): eigenvalues, vectors, their free-DOF indices and the
     solver used, per group."""
@@ -485,8 +500,9 @@ def _solve_groups(a: Any, b: Any, d: int, k_req: int, method: str
     return lams, vecs, idxs, used
 
 
-def _group_columns(vecs: list, idxs: list, lam_all: np.ndarray, order: np.ndarray,
-                   n_free: int) -> np.ndarray:
+def _group_columns(
+    vecs: list, idxs: list, lam_all: np.ndarray, order: np.ndarray, n_free: int
+) -> np.ndarray:
     """The kept group eigenvectors as columns (n_free, k) in the order ``order`` of
     the concatenated eigenvalues: one block copy per group (not per column)."""
     k = order.size
@@ -495,14 +511,15 @@ def _group_columns(vecs: list, idxs: list, lam_all: np.ndarray, order: np.ndarra
     rank = np.full(lam_all.size, -1)
     rank[order] = np.arange(k)  # output column of each group eigenvector (-1: dropped)
     for g, vec in enumerate(vecs):
-        r = rank[starts[g]:starts[g + 1]]
+        r = rank[starts[g] : starts[g + 1]]
         kept = np.flatnonzero(r >= 0)
         local[np.ix_(idxs[g], r[kept])] = vec[:, kept]
     return local
 
 
-def _out_of_plane_fraction(model: FEModel, mt: Any, shapes: np.ndarray,
-                           normal: np.ndarray) -> np.ndarray:
+def _out_of_plane_fraction(
+    model: FEModel, mt: Any, shapes: np.ndarray, normal: np.ndarray
+) -> np.ndarray:
     if model.dim == 2:
         return np.zeros(shapes.shape[1])
     d = model.dim

@@ -135,8 +135,9 @@ def catenary_multisegment(
     else:
         P = v.float_array("junction_loads", junction_loads, "N", min_size=0)
     if P.size != n - 1:
-        raise InputError("junction_loads", junction_loads, "N",
-                         f"must have {n - 1} entries (one per junction)")
+        raise InputError(
+            "junction_loads", junction_loads, "N", f"must have {n - 1} entries (one per junction)"
+        )
     cs = np.where(np.isinf(eas_a), 0.0, 1.0 / eas_a)
     L = float(Ls.sum())
     chord = math.hypot(X, Z)
@@ -185,8 +186,7 @@ def catenary_multisegment(
             break
         H, Va, r, J, nr = H + t * d[0], Va + t * d[1], rn, Jn, nrn
     if nr > tol:
-        raise ConvergenceError("multi-segment catenary Newton", it, nr, tol,
-                               partial=(H, Va))
+        raise ConvergenceError("multi-segment catenary Newton", it, nr, tol, partial=(H, Va))
     V_start = Va + offsets
     V_end = V_start + ws * Ls
     junctions = np.zeros((n - 1, 2))
@@ -197,7 +197,15 @@ def catenary_multisegment(
         pz += float(z)
         junctions[j] = (px, pz)
     return MultiSegmentSolution(
-        H=H, V_start=V_start, V_end=V_end, tension_a=math.hypot(H, V_start[0]),
-        tension_b=math.hypot(H, V_end[-1]), junctions=junctions, iterations=it,
-        lengths=Ls, weights=ws, eas=eas_a, residual=nr,
+        H=H,
+        V_start=V_start,
+        V_end=V_end,
+        tension_a=math.hypot(H, V_start[0]),
+        tension_b=math.hypot(H, V_end[-1]),
+        junctions=junctions,
+        iterations=it,
+        lengths=Ls,
+        weights=ws,
+        eas=eas_a,
+        residual=nr,
     )

@@ -30,8 +30,14 @@ from stochcable.line.equilibrium import LocalFrame, StaticsModel, StaticsSolver
 from stochcable.line.mesh import LineMesh
 from stochcable.scene.model import Environment
 
-__all__ = ["Method", "LineStatics", "solve_line_statics", "line_statics",
-           "check_statics_options", "solve_fe"]
+__all__ = [
+    "Method",
+    "LineStatics",
+    "solve_line_statics",
+    "line_statics",
+    "check_statics_options",
+    "solve_fe",
+]
 
 Method = Literal["auto", "fe", "catenary"]
 
@@ -90,10 +96,8 @@ class LineStatics:
     def to_document(self) -> dict[str, Any]:
         """The line's entry of the result document's ``statics`` (DESIGN.md v1)."""
         return {
-            "end_a": {"tension": float(self.tension_a),
-                      "force": [float(v) for v in self.force_a]},
-            "end_b": {"tension": float(self.tension_b),
-                      "force": [float(v) for v in self.force_b]},
+            "end_a": {"tension": float(self.tension_a), "force": [float(v) for v in self.force_a]},
+            "end_b": {"tension": float(self.tension_b), "force": [float(v) for v in self.force_b]},
             "touchdown": None if self.touchdown is None else float(self.touchdown),
             "nodes": self.positions.tolist(),
             "s": self.mesh.s0.tolist(),
@@ -107,8 +111,9 @@ class LineStatics:
 # ------------------------------------------------------------------------ public API
 
 
-def check_statics_options(method: Any, tolerance: Any, max_iterations: Any
-                          ) -> tuple[Method, float, int]:
+def check_statics_options(
+    method: Any, tolerance: Any, max_iterations: Any
+) -> tuple[Method, float, int]:
     """The checked options of the line statics, once per call of an entry point
     (:func:`solve_line_statics`, :func:`stochcable.statics.solve_statics`,
     :func:`stochcable.bodies.statics.solve_body_statics`).
@@ -233,19 +238,24 @@ def solve_line_statics(
     8·eps·max(EA/l0)·max|x| relative to the reference force; ``tolerance`` is raised
     to that floor when it is larger (nearly inextensible, finely meshed lines).
     """
-    method, tolerance, max_iterations = check_statics_options(method, tolerance,
-                                                              max_iterations)
+    method, tolerance, max_iterations = check_statics_options(method, tolerance, max_iterations)
     if initial is not None:
         initial = np.asarray(initial, dtype=float)
         if initial.shape != (mesh.n_nodes, 3) or not np.isfinite(initial).all():
-            raise InputError("initial", initial, "m",
-                             f"must be finite with shape ({mesh.n_nodes}, 3)")
+            raise InputError(
+                "initial", initial, "m", f"must be finite with shape ({mesh.n_nodes}, 3)"
+            )
     return line_statics(mesh, environment, method, initial, tolerance, max_iterations)
 
 
-def line_statics(mesh: LineMesh, environment: Environment, method: Method,
-                 initial: np.ndarray | None, tolerance: float,
-                 max_iterations: int) -> LineStatics:
+def line_statics(
+    mesh: LineMesh,
+    environment: Environment,
+    method: Method,
+    initial: np.ndarray | None,
+    tolerance: float,
+    max_iterations: int,
+) -> LineStatics:
     """:func:`solve_line_statics` with its options already checked
     (:func:`check_statics_options`): for the callers that solve many lines or the same
     line many times (the scene statics, the body statics at every trial pose).
@@ -264,8 +274,12 @@ def line_statics(mesh: LineMesh, environment: Environment, method: Method,
                 return out
             why = out
         if method == "catenary":
-            raise InputError("method", "catenary", "-",
-                             f"does not apply to line {mesh.name!r}: {why}; use 'fe' or 'auto'")
+            raise InputError(
+                "method",
+                "catenary",
+                "-",
+                f"does not apply to line {mesh.name!r}: {why}; use 'fe' or 'auto'",
+            )
     return solve_fe(mesh, environment, initial, tolerance, max_iterations)
 
 
@@ -292,12 +306,14 @@ def _check_determined(mesh: LineMesh, env: Environment) -> None:
     X = math.hypot(d[0], d[1])
     Z = float(d[2])
     chord = math.hypot(X, Z)
-    if (np.all(mesh.weight == 0.0) and np.all(mesh.node_mass == 0.0)
-            and L > chord * (1.0 + 1e-12)):
+    if np.all(mesh.weight == 0.0) and np.all(mesh.node_mass == 0.0) and L > chord * (1.0 + 1e-12):
         raise InputError(
-            f"lines[{mesh.name!r}].length", L, "m",
+            f"lines[{mesh.name!r}].length",
+            L,
+            "m",
             f"a weightless line longer than the distance between its ends ({chord:.6g} m) "
-            "has an undetermined slack shape; shorten it or give it a weight")
+            "has an undetermined slack shape; shorten it or give it a weight",
+        )
     on_bed = mesh.end_a[2] <= -env.depth * (1.0 - 1e-9)
     if not on_bed or Z < 0.0 or not np.any(mesh.weight > 0.0):
         return
@@ -305,17 +321,26 @@ def _check_determined(mesh: LineMesh, env: Environment) -> None:
     lv = 2.0 * Z / (1.0 + math.sqrt(1.0 + 2.0 * w * Z / ea))
     if L >= X + lv:
         raise InputError(
-            f"lines[{mesh.name!r}].length", L, "m",
+            f"lines[{mesh.name!r}].length",
+            L,
+            "m",
             f"the line is longer than its horizontal span plus its vertical hanging length "
             f"({X:.6g} m + {lv:.6g} m = {X + lv:.6g} m) with end_a on the seabed: the "
             "surplus lies slack on the seabed with zero horizontal tension, and without "
             "seabed friction (not modelled) the horizontal position of a fully slack "
             f"grounded line is undetermined; shorten the line below {X + lv:.6g} m or move "
-            "the ends apart")
+            "the ends apart",
+        )
 
 
-def solve_fe(mesh: LineMesh, env: Environment, initial: np.ndarray | None,
-              tol: float, budget: int, force_3d: bool = False) -> LineStatics:
+def solve_fe(
+    mesh: LineMesh,
+    env: Environment,
+    initial: np.ndarray | None,
+    tol: float,
+    budget: int,
+    force_3d: bool = False,
+) -> LineStatics:
     frame = LocalFrame(mesh, env, force_3d=force_3d)
     model = StaticsModel(mesh, env, frame)
     if initial is not None:
@@ -333,20 +358,28 @@ def solve_fe(mesh: LineMesh, env: Environment, initial: np.ndarray | None,
     if not ok:
         note = ""
         if model.has_drag and bool(np.any(X[1:-1, frame.dim - 1] < model.zbed)):
-            note = ("; part of the line lies on the seabed, where no friction is modelled: "
-                    "drag on a grounded slack part may have no horizontal restoring force")
+            note = (
+                "; part of the line lies on the seabed, where no friction is modelled: "
+                "drag on a grounded slack part may have no horizontal restoring force"
+            )
         raise ConvergenceError(
-            "statics Newton", solver.used, r, tol,
-            hint=(f"line {mesh.name!r}: check that the line can reach its ends and that "
-                  "the loads are physical, give a better initial shape, raise "
-                  f"max_iterations or refine the mesh{note}"),
+            "statics Newton",
+            solver.used,
+            r,
+            tol,
+            hint=(
+                f"line {mesh.name!r}: check that the line can reach its ends and that "
+                "the loads are physical, give a better initial shape, raise "
+                f"max_iterations or refine the mesh{note}"
+            ),
             partial=frame.to_global(X),
         )
     return _fe_result(mesh, env, frame, model, X, solver.used, r)
 
 
-def _drag_stepping(solver: "StaticsSolver", model: StaticsModel, X0: np.ndarray,
-                   budget: int) -> tuple[np.ndarray, float, bool]:
+def _drag_stepping(
+    solver: StaticsSolver, model: StaticsModel, X0: np.ndarray, budget: int
+) -> tuple[np.ndarray, float, bool]:
     """Load stepping of the current (seed 001 §4.1, eq. 4.1.2 applied per increment).
 
     The drag is scaled by a factor beta (model.beta) raised from 0 (the equilibrium
@@ -372,8 +405,15 @@ def _drag_stepping(solver: "StaticsSolver", model: StaticsModel, X0: np.ndarray,
     return X_ok, r, bool(ok and beta_ok >= 1.0)
 
 
-def _fe_result(mesh: LineMesh, env: Environment, frame: LocalFrame, model: StaticsModel,
-               X: np.ndarray, iterations: int, r: float) -> LineStatics:
+def _fe_result(
+    mesh: LineMesh,
+    env: Environment,
+    frame: LocalFrame,
+    model: StaticsModel,
+    X: np.ndarray,
+    iterations: int,
+    r: float,
+) -> LineStatics:
     R, T, _, _ = model.forces(X, tangent=False)
     zi = frame.dim - 1
     z = X[:, zi]
@@ -398,14 +438,25 @@ def _fe_result(mesh: LineMesh, env: Environment, frame: LocalFrame, model: Stati
     pos = frame.to_global(X)
     pos[0], pos[-1] = mesh.end_a, mesh.end_b
     return LineStatics(
-        mesh=mesh, positions=pos, tension=tension, node_tension=node_t,
-        force_a=fa, force_b=fb, tension_a=ta, tension_b=tb, grounded=grounded,
-        touchdown=touchdown, iterations=iterations, residual=r, method="fe",
+        mesh=mesh,
+        positions=pos,
+        tension=tension,
+        node_tension=node_t,
+        force_a=fa,
+        force_b=fb,
+        tension_a=ta,
+        tension_b=tb,
+        grounded=grounded,
+        touchdown=touchdown,
+        iterations=iterations,
+        residual=r,
+        method="fe",
     )
 
 
-def _touchdown(mesh: LineMesh, X: np.ndarray, T: np.ndarray, zi: int,
-               grounded: np.ndarray) -> float | None:
+def _touchdown(
+    mesh: LineMesh, X: np.ndarray, T: np.ndarray, zi: int, grounded: np.ndarray
+) -> float | None:
     """Arc length where the line leaves the seabed toward end_b.
 
     Interpolated from the vertical tension component of the first suspended element k:
@@ -472,10 +523,16 @@ def _solve_catenary(mesh: LineMesh, env: Environment) -> LineStatics | str:
     node_t = np.asarray(cl.node_tension, dtype=float).copy()
     node_t[0], node_t[-1] = sol.tension_a, sol.tension_b
     return LineStatics(
-        mesh=mesh, positions=np.asarray(pos, dtype=float),
-        tension=np.asarray(cl.element_tension, dtype=float), node_tension=node_t,
-        force_a=fa, force_b=fb, tension_a=float(sol.tension_a),
-        tension_b=float(sol.tension_b), grounded=grounded, touchdown=touchdown,
+        mesh=mesh,
+        positions=np.asarray(pos, dtype=float),
+        tension=np.asarray(cl.element_tension, dtype=float),
+        node_tension=node_t,
+        force_a=fa,
+        force_b=fb,
+        tension_a=float(sol.tension_a),
+        tension_b=float(sol.tension_b),
+        grounded=grounded,
+        touchdown=touchdown,
         iterations=sol.iterations,
         residual=float(sol.residual) / max(mesh.length, float(np.linalg.norm(d))),
         method="catenary",

@@ -28,8 +28,9 @@ __all__ = ["solve_coupled_direct", "body_drag_damping"]
 _DENSE_MAX = 3000
 
 
-def body_drag_damping(body: RigidBody, rho: float, sigma: Any,
-                      mean: Any | None = None) -> np.ndarray:
+def body_drag_damping(
+    body: RigidBody, rho: float, sigma: Any, mean: Any | None = None
+) -> np.ndarray:
     """Linearized quadratic drag of a body as a damping matrix about its reference point.
 
     Parameters
@@ -143,10 +144,16 @@ def _free_body(system: CoupledSystem) -> tuple[np.ndarray, np.ndarray]:
     """Global indices of the free body DOFs and, among ``body_index``, their positions
     (the bodies' ``fixed_dofs`` removed)."""
     J = system.body_index
-    pos = np.concatenate([system.body_dofs[b.name][b.free_index] for b in system.bodies]
-                         ) if system.bodies else np.zeros(0, dtype=int)
-    where = np.searchsorted(J, pos) if np.all(np.diff(J) > 0) else np.array(
-        [int(np.flatnonzero(J == p)[0]) for p in pos], dtype=int)
+    pos = (
+        np.concatenate([system.body_dofs[b.name][b.free_index] for b in system.bodies])
+        if system.bodies
+        else np.zeros(0, dtype=int)
+    )
+    where = (
+        np.searchsorted(J, pos)
+        if np.all(np.diff(J) > 0)
+        else np.array([int(np.flatnonzero(J == p)[0]) for p in pos], dtype=int)
+    )
     return pos.astype(int), where.astype(int)
 
 
@@ -179,17 +186,23 @@ def _solve_small(z: np.ndarray, g: np.ndarray, w: np.ndarray, what: str) -> np.n
     bad = ~(est <= 1e12)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise SolverError(f"{what}: dynamic matrix singular to working precision at omega = "
-                          f"{float(w[k]):.6g} rad/s (condition estimate {float(est[k]):.2e}; "
-                          "undamped resonance); add damping or move the frequency")
+        raise SolverError(
+            f"{what}: dynamic matrix singular to working precision at omega = "
+            f"{float(w[k]):.6g} rad/s (condition estimate {float(est[k]):.2e}; "
+            "undamped resonance); add damping or move the frequency"
+        )
     return x
 
 
 def _solve_dense(system: CoupledSystem, f: np.ndarray, w: np.ndarray) -> np.ndarray:
     n = system.n_dof
     if n > _DENSE_MAX:
-        raise InputError("method", "dense", "-",
-                         f"the dense solve is limited to {_DENSE_MAX} DOFs (system has {n})")
+        raise InputError(
+            "method",
+            "dense",
+            "-",
+            f"the dense solve is limited to {_DENSE_MAX} DOFs (system has {n})",
+        )
     J = system.body_index
     a, b = system.body_hydrodynamics(w)
     k, m, c = system.K.toarray(), system.M.toarray(), system.C.toarray()
@@ -199,12 +212,11 @@ def _solve_dense(system: CoupledSystem, f: np.ndarray, w: np.ndarray) -> np.ndar
     if J.size:
         z[np.ix_(np.arange(w.size), J, J)] += -w2 * a + iw * b
     free, _ = _free_body(system)
-    keep = np.setdiff1d(np.arange(n), np.setdiff1d(J, free))   # fixed body DOFs out
+    keep = np.setdiff1d(np.arange(n), np.setdiff1d(J, free))  # fixed body DOFs out
     if keep.size == n:
         return _solve_small(z, f, w, "coupled direct solve")
     x = np.zeros_like(f)
-    x[:, keep, :] = _solve_small(z[:, keep][:, :, keep], f[:, keep, :], w,
-                                 "coupled direct solve")
+    x[:, keep, :] = _solve_small(z[:, keep][:, :, keep], f[:, keep, :], w, "coupled direct solve")
     return x
 
 
@@ -218,9 +230,11 @@ def _solve_schur(system: CoupledSystem, f: np.ndarray, w: np.ndarray) -> np.ndar
     iw = (1j * w)[:, None, None]
 
     def z_of(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        return (_block(system.K, rows, cols).toarray()[None]
-                - w2 * _block(system.M, rows, cols).toarray()[None]
-                + iw * _block(system.C, rows, cols).toarray()[None])
+        return (
+            _block(system.K, rows, cols).toarray()[None]
+            - w2 * _block(system.M, rows, cols).toarray()[None]
+            + iw * _block(system.C, rows, cols).toarray()[None]
+        )
 
     if nb:
         s = _body_z(system, w)[:, where][:, :, where]

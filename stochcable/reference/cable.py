@@ -173,8 +173,12 @@ class CableTimeHistory:
         if end not in ("a", "b"):
             raise InputError("end", end, "-", "must be 'a' or 'b'")
         x = (self.tension_a if end == "a" else self.tension_b)[self.steady(start)]
-        return {"mean": float(x.mean()), "std": float(x.std()),
-                "min": float(x.min()), "max": float(x.max())}
+        return {
+            "mean": float(x.mean()),
+            "std": float(x.std()),
+            "min": float(x.min()),
+            "max": float(x.max()),
+        }
 
     def stationarity_ratio(self, windows: int | None = None) -> tuple[float, float, float]:
         """Largest over smallest σ of the end tensions over windows after the ramp.
@@ -214,12 +218,12 @@ class CableTimeHistory:
             return 1.0, float(t[0]), 0.0
         worst = (1.0, float(t[0]), 0.0)
         for x in (self.tension_a[keep], self.tension_b[keep]):
-            sig = np.array([x[j * size:(j + 1) * size].std() for j in range(n_w)])
+            sig = np.array([x[j * size : (j + 1) * size].std() for j in range(n_w)])
             lo = float(sig.min())
             ratio = float(sig.max()) / lo if lo > 0 else (math.inf if sig.max() > 0 else 1.0)
             if ratio > worst[0]:
                 j = int(np.argmax(sig))
-                seg = x[j * size:(j + 1) * size]
+                seg = x[j * size : (j + 1) * size]
                 spec = np.abs(np.fft.rfft(seg - seg.mean())) ** 2
                 w = 2.0 * math.pi * np.fft.rfftfreq(seg.size, self.dt)
                 worst = (ratio, float(t[j * size]), float(w[int(np.argmax(spec))]))
@@ -347,8 +351,12 @@ def simulate_line_timedomain(
     ends = end_coefficients(scene, line, grid, seed, method, end_realizations)
     ends, X_sea = band_limited(grid, ends, band)
     if grid.realization is None and not ends:
-        raise InputError("scene", "no sea and no end motion", "-",
-                         "needs a sea or a prescribed end motion to excite the line")
+        raise InputError(
+            "scene",
+            "no sea and no end motion",
+            "-",
+            "needs a sea or a prescribed end motion to excite the line",
+        )
     wmax, w_peak, k_up, h = _time_step(grid, X_sea, ends, dt)
     n_steps = int(round(grid.duration / h))
     t = h * np.arange(n_steps + 1)
@@ -356,8 +364,9 @@ def simulate_line_timedomain(
         ramp = 3.0 * 2.0 * math.pi / w_peak if w_peak > 0 else 0.0
     ramp = _v.nonnegative("ramp", ramp, "s")
     if ramp >= grid.duration:
-        raise InputError("ramp", ramp, "s",
-                         f"must be shorter than the duration {grid.duration:g} s")
+        raise InputError(
+            "ramp", ramp, "s", f"must be shorter than the duration {grid.duration:g} s"
+        )
 
     # ---- model, static start, excitation on the steps, integration
     mesh = mesh_line(line, scene.environment.rho, scene.environment.g)
@@ -368,25 +377,64 @@ def simulate_line_timedomain(
     sl = np.arange(n_steps + 1) % (k_up * grid.n_samples)  # periodic in T_L
     u_wave = u_wave_g = f_in = None
     if grid.realization is not None:
-        u_wave, u_wave_g, f_in = wave_series(model, xs @ ax.T, grid.omega, X_sea,
-                                             scene.sea.heading_rad, scene.environment, ax,
-                                             grid.n_samples, k_up, sl, r[0])
+        u_wave, u_wave_g, f_in = wave_series(
+            model,
+            xs @ ax.T,
+            grid.omega,
+            X_sea,
+            scene.sea.heading_rad,
+            scene.environment,
+            ax,
+            grid.n_samples,
+            k_up,
+            sl,
+            r[0],
+        )
     end_disp = end_series(ends, grid.omega, mesh.n_nodes, ax, grid.n_samples, k_up, sl, r)
-    pos, ten_el, iters, maxres = integrate(model, xs, u_cur, u_cur_g, u_wave, u_wave_g,
-                                           f_in, end_disp, t, h, tol_abs, max_iterations,
-                                           element_every)
+    pos, ten_el, iters, maxres = integrate(
+        model,
+        xs,
+        u_cur,
+        u_cur_g,
+        u_wave,
+        u_wave_g,
+        f_in,
+        end_disp,
+        t,
+        h,
+        tol_abs,
+        max_iterations,
+        element_every,
+    )
 
     # ---- the record, in 3-D coordinates
     y_off = 0.0 if dim == 3 else np.array([0.0, 1.0, 0.0]) * x3[0, 1]
     _, _, Ts, _ = model.elements(xs)
     out = CableTimeHistory(
-        line=line.name, t=t, positions=pos @ ax.T + y_off, static_positions=xs @ ax.T + y_off,
-        tension_a=ten_el[0], tension_b=ten_el[1],
-        element_tension=ten_el[2], element_time=t[::element_every],
-        static_tension=Ts, iterations=iters, max_residual=maxres, tolerance=tol_abs,
-        dt=h, ramp=ramp, s0=mesh.s0,
-        _meta={"omega_max": wmax, "omega_peak": w_peak, "upsample": k_up, "dim": dim,
-               "realization": grid.realization, "ends": ends, "model": model},
+        line=line.name,
+        t=t,
+        positions=pos @ ax.T + y_off,
+        static_positions=xs @ ax.T + y_off,
+        tension_a=ten_el[0],
+        tension_b=ten_el[1],
+        element_tension=ten_el[2],
+        element_time=t[::element_every],
+        static_tension=Ts,
+        iterations=iters,
+        max_residual=maxres,
+        tolerance=tol_abs,
+        dt=h,
+        ramp=ramp,
+        s0=mesh.s0,
+        _meta={
+            "omega_max": wmax,
+            "omega_peak": w_peak,
+            "upsample": k_up,
+            "dim": dim,
+            "realization": grid.realization,
+            "ends": ends,
+            "model": model,
+        },
     )
     _check_stationary(out, h)
     return out
@@ -401,8 +449,9 @@ def _select_line(scene: Scene, line_name: str | None) -> Line:
     return scene.lines[names.index(line_name)]
 
 
-def _time_step(grid: ExcitationGrid, X_sea: np.ndarray | None, ends: dict[str, np.ndarray],
-               dt: float | None) -> tuple[float, float, int, float]:
+def _time_step(
+    grid: ExcitationGrid, X_sea: np.ndarray | None, ends: dict[str, np.ndarray], dt: float | None
+) -> tuple[float, float, int, float]:
     """The highest excitation frequency (:data:`_ENERGY_QUANTILE` of every channel's
     variance below it), the peak frequency, the upsampling k of the realization's step
     and the step Δt_sea/k: ``dt`` or the largest with (ωΔt)²/12 <= 0.5 % (a
@@ -432,27 +481,31 @@ def _time_step(grid: ExcitationGrid, X_sea: np.ndarray | None, ends: dict[str, n
             f"time step {h:.4g} s gives a Newmark period error (omega dt)^2/12 = {err:.2%} "
             f"at the highest excitation frequency {wmax:.4g} rad/s (> "
             f"{PERIOD_ERROR_TOLERANCE:.0%}); use dt <= {dt_ok:.4g} s",
-            ResolutionWarning, stacklevel=3)
+            ResolutionWarning,
+            stacklevel=3,
+        )
     return wmax, w_peak, k_up, h
 
 
-def _static_start(scene: Scene, mesh: Any, x3: np.ndarray, dim: int, tolerance: float
-                  ) -> tuple[LineModel, np.ndarray, np.ndarray, np.ndarray, float]:
+def _static_start(
+    scene: Scene, mesh: Any, x3: np.ndarray, dim: int, tolerance: float
+) -> tuple[LineModel, np.ndarray, np.ndarray, np.ndarray, float]:
     """The model about its own static equilibrium (re-solved from the statics' shape
     ``x3``), the current at the nodes and the drag points, and the absolute Newton
     tolerance (``tolerance`` × the largest static force)."""
     env = scene.environment
     ax = axes(dim)
     model0 = LineModel(mesh, env, x3 @ ax, dim)
-    u_cur = env.current_velocity(x3[:, 2]) @ ax                     # (n, d)
+    u_cur = env.current_velocity(x3[:, 2]) @ ax  # (n, d)
     # current at the drag quadrature points (of the statics shape; the profile is
     # interpolated in z, the points move millimetres in the re-solve)
-    u_cur_g = env.current_velocity(model0.gauss_points(x3)[..., 2]) @ ax   # (ne, ng, d)
+    u_cur_g = env.current_velocity(model0.gauss_points(x3)[..., 2]) @ ax  # (ne, ng, d)
     e0, _, T0, _ = model0.elements(x3 @ ax)
     f_ref = max(float(np.abs(T0).max()), float(np.abs(model0.f_gravity).max()), 1e-12)
     tol_abs = tolerance * f_ref
-    xs, _ = static_equilibrium(model0, x3 @ ax, u_cur, u_cur_g, f_ref,
-                               max(1e-3 * tol_abs, 1e-11 * f_ref))
+    xs, _ = static_equilibrium(
+        model0, x3 @ ax, u_cur, u_cur_g, f_ref, max(1e-3 * tol_abs, 1e-11 * f_ref)
+    )
     model = LineModel(mesh, env, xs, dim)  # added mass about the re-solved tangents
     return model, xs, u_cur, u_cur_g, tol_abs
 
@@ -471,4 +524,6 @@ def _check_stationary(out: CableTimeHistory, h: float) -> None:
             "under-resolved oscillation pumped by the time stepping (typically at "
             f"slack–taut snaps), not the response; rerun with dt <= {dt_ok:.3g} s or at "
             "least a quarter of the present step",
-            ResolutionWarning, stacklevel=3)
+            ResolutionWarning,
+            stacklevel=3,
+        )

@@ -67,8 +67,9 @@ class ExcitationGrid:
     duration: float
 
 
-def realization_grid(scene: Scene, realization: Any, duration: float | None,
-                     dt: float | None, seed: int, method: str) -> ExcitationGrid:
+def realization_grid(
+    scene: Scene, realization: Any, duration: float | None, dt: float | None, seed: int, method: str
+) -> ExcitationGrid:
     """The given realization's grid, or a new realization of the scene's sea on the grid
     of ``duration`` (default: the scene's time series, else 600 s) and the scene's
     time-series step (else ``dt``, else 0.25 s)."""
@@ -76,30 +77,42 @@ def realization_grid(scene: Scene, realization: Any, duration: float | None,
     ts = scene.analysis.timeseries
     if realization is not None:
         if not isinstance(realization, _sea.SeaRealization):
-            raise InputError("realization", type(realization).__name__, "-",
-                             "must be a SeaRealization")
+            raise InputError(
+                "realization", type(realization).__name__, "-", "must be a SeaRealization"
+            )
         t_l, dt_sea, n_t = realization.duration, realization.dt, realization.n_samples
         omega = np.asarray(realization.omega)
     else:
-        t_l = _v.positive("duration", duration, "s") if duration is not None else \
-            (ts.duration if ts is not None else 600.0)
+        t_l = (
+            _v.positive("duration", duration, "s")
+            if duration is not None
+            else (ts.duration if ts is not None else 600.0)
+        )
         dt_sea = ts.dt if ts is not None else (dt if dt is not None else 0.25)
         dt_sea = _v.positive("dt", dt_sea, "s")
         n_t = 2 * max(1, int(math.ceil(t_l / dt_sea / 2.0 - 1e-9)))
         t_l = n_t * dt_sea
         omega = 2.0 * math.pi / t_l * np.arange(n_t // 2 + 1)
         if scene.sea is not None:
-            realization = _sea.simulate_sea(spectrum_density(scene.sea.spectrum, env.g),
-                                            t_l, dt_sea, method, rng=int(seed))
+            realization = _sea.simulate_sea(
+                spectrum_density(scene.sea.spectrum, env.g), t_l, dt_sea, method, rng=int(seed)
+            )
     sim_len = t_l if duration is None else _v.positive("duration", duration, "s")
     if sim_len > t_l * (1 + 1e-9):
-        raise InputError("duration", duration, "s",
-                         f"must be <= the realization's length {t_l:g} s")
+        raise InputError(
+            "duration", duration, "s", f"must be <= the realization's length {t_l:g} s"
+        )
     return ExcitationGrid(realization, t_l, dt_sea, n_t, omega, sim_len)
 
 
-def end_coefficients(scene: Scene, line: Line, grid: ExcitationGrid, seed: int,
-                     method: str, end_realizations: dict | None) -> dict[str, np.ndarray]:
+def end_coefficients(
+    scene: Scene,
+    line: Line,
+    grid: ExcitationGrid,
+    seed: int,
+    method: str,
+    end_realizations: dict | None,
+) -> dict[str, np.ndarray]:
     """End-motion coefficients ``{"a"|"b": (3, N+1) complex}`` on the grid: the given
     ones, else the scene's end-motion spectra realized with the channel seeds of
     :func:`end_motion_generators`, or RAO × the sea's coefficients. [m]"""
@@ -109,9 +122,13 @@ def end_coefficients(scene: Scene, line: Line, grid: ExcitationGrid, seed: int,
         for k_, v_ in end_realizations.items():
             arr = np.asarray(v_, dtype=complex)
             if k_ not in ("a", "b") or arr.shape != (3, omega.size):
-                raise InputError(f"end_realizations[{k_!r}]", f"shape {arr.shape}", "m",
-                                 f"keys must be 'a' or 'b' and values of shape (3, "
-                                 f"{omega.size}) on the realization's grid")
+                raise InputError(
+                    f"end_realizations[{k_!r}]",
+                    f"shape {arr.shape}",
+                    "m",
+                    f"keys must be 'a' or 'b' and values of shape (3, "
+                    f"{omega.size}) on the realization's grid",
+                )
             ends[k_] = arr
         return ends
     env = scene.environment
@@ -123,22 +140,27 @@ def end_coefficients(scene: Scene, line: Line, grid: ExcitationGrid, seed: int,
             gen = gens.get((line.name, key, dof))
             if gen is None:
                 continue
-            r = _sea.simulate_sea(spectrum_density(getattr(m, dof), env.g), grid.length,
-                                  grid.dt, method, rng=gen)
+            r = _sea.simulate_sea(
+                spectrum_density(getattr(m, dof), env.g), grid.length, grid.dt, method, rng=gen
+            )
             c[k_] = r.coefficients
         if m is not None and m.rao is not None:
             if grid.realization is None:
-                raise InputError(f"{line.name}.{'end_' + key}.motion.rao", "rao", "-",
-                                 "needs a sea (the RAO multiplies the sea's amplitudes)")
+                raise InputError(
+                    f"{line.name}.{'end_' + key}.motion.rao",
+                    "rao",
+                    "-",
+                    "needs a sea (the RAO multiplies the sea's amplitudes)",
+                )
             c = m.rao.transfer(omega) * np.asarray(grid.realization.coefficients)[None]
         if np.any(c):
             ends[key] = c
     return ends
 
 
-def band_limited(grid: ExcitationGrid, ends: dict[str, np.ndarray],
-                 band: tuple[float, float] | None
-                 ) -> tuple[dict[str, np.ndarray], np.ndarray | None]:
+def band_limited(
+    grid: ExcitationGrid, ends: dict[str, np.ndarray], band: tuple[float, float] | None
+) -> tuple[dict[str, np.ndarray], np.ndarray | None]:
     """The end coefficients and the sea's (None without a sea) with the components
     outside ``band`` = (low, high) zeroed (all kept when ``band`` is None)."""
     omega = grid.omega
@@ -150,13 +172,13 @@ def band_limited(grid: ExcitationGrid, ends: dict[str, np.ndarray],
             raise InputError("band", band, "rad/s", "must be (low, high) with high > low")
         keep = ((omega >= lo) & (omega <= hi)).astype(float)
         ends = {k_: c * keep for k_, c in ends.items()}
-    x_sea = None if grid.realization is None else \
-        np.asarray(grid.realization.coefficients) * keep
+    x_sea = None if grid.realization is None else np.asarray(grid.realization.coefficients) * keep
     return ends, x_sea
 
 
 def spectrum_density(spec: Any, g: float):
     """ω -> S(ω) with S(0) = 0 (as :mod:`stochcable.dynamics` samples it)."""
+
     def density(w: np.ndarray) -> np.ndarray:
         w = np.asarray(w, dtype=float)
         out = np.zeros_like(w)
@@ -180,8 +202,11 @@ def end_motion_generators(scene: Scene, seed: int) -> dict[tuple[str, str, str],
             m = getattr(ln, "end_" + end).motion
             if m is None or m.rao is not None:
                 continue
-            keys += [(ln.name, end, dof) for dof in ("surge", "sway", "heave")
-                     if getattr(m, dof) is not None]
+            keys += [
+                (ln.name, end, dof)
+                for dof in ("surge", "sway", "heave")
+                if getattr(m, dof) is not None
+            ]
     children = np.random.SeedSequence(int(seed)).spawn(len(keys)) if keys else []
     return {k: np.random.default_rng(c) for k, c in zip(keys, children)}
 
@@ -189,8 +214,9 @@ def end_motion_generators(scene: Scene, seed: int) -> dict[tuple[str, str, str],
 # ------------------------------------------------------------------- time series
 
 
-def upsample(coeff: np.ndarray, n_t: int, k: int,
-             dtype_factor: np.ndarray | None = None) -> np.ndarray:
+def upsample(
+    coeff: np.ndarray, n_t: int, k: int, dtype_factor: np.ndarray | None = None
+) -> np.ndarray:
     """irfft of coefficients (..., N+1) on a grid k times finer: shape (..., k·n_t)."""
     n_fine = k * n_t
     shape = coeff.shape[:-1] + (n_fine // 2 + 1,)
@@ -200,9 +226,19 @@ def upsample(coeff: np.ndarray, n_t: int, k: int,
     return _fft.irfft(big * k, n_fine)
 
 
-def wave_series(model: LineModel, x_static: np.ndarray, omega: np.ndarray, X: np.ndarray,
-                 heading: float, env: Environment, ax: np.ndarray, n_t: int, k_up: int,
-                 sl: np.ndarray, r: np.ndarray):
+def wave_series(
+    model: LineModel,
+    x_static: np.ndarray,
+    omega: np.ndarray,
+    X: np.ndarray,
+    heading: float,
+    env: Environment,
+    ax: np.ndarray,
+    n_t: int,
+    k_up: int,
+    sl: np.ndarray,
+    r: np.ndarray,
+):
     """Wave excitation on the simulation steps, ramped by ``r``.
 
     Returns the fluid velocity at the nodes (n_steps+1, n, d) (attachment drag), at
@@ -217,28 +253,35 @@ def wave_series(model: LineModel, x_static: np.ndarray, omega: np.ndarray, X: np
     pts[:, 2] = np.maximum(pts[:, 2], -env.depth)  # nodes pressed into the seabed
     gp = model.gauss_points(pts).reshape(-1, 3)
     kin = wave_kinematics(omega, np.vstack([pts, gp]), heading, env.depth, env.g)
-    vel = np.einsum("pcw,cd->pdw", kin.velocity, ax)           # (n + ne·ng, d, n_w)
+    vel = np.einsum("pcw,cd->pdw", kin.velocity, ax)  # (n + ne·ng, d, n_w)
     acc_n = np.einsum("ncw,cd->ndw", kin.acceleration[: model.n], ax)
     el = element_wave_kinematics(omega, pts, heading, env.depth, env.g)
-    mom = el.acceleration @ ax                                  # (n_w, ne, 2, d)
+    mom = el.acceleration @ ax  # (n_w, ne, 2, d)
     f_el = np.einsum("eij,wesj->wesi", model.inertia_el, mom)  # (n_w, ne, 2, d)
     f_nodes = np.zeros((omega.size, model.n, model.dim), dtype=complex)
     f_nodes[:, :-1] += f_el[:, :, 0]
     f_nodes[:, 1:] += f_el[:, :, 1]
     f_nodes += model.node_mw[None, :, None] * np.moveaxis(acc_n, 2, 0)
     coeff = np.concatenate([vel, np.moveaxis(f_nodes, 0, 2)], axis=0) * X  # (p, d, n_w)
-    series = upsample(coeff, n_t, k_up)[..., sl] * r             # (p, d, n_steps+1)
-    series = np.moveaxis(series, 2, 0)                             # (n_steps+1, p, d)
+    series = upsample(coeff, n_t, k_up)[..., sl] * r  # (p, d, n_steps+1)
+    series = np.moveaxis(series, 2, 0)  # (n_steps+1, p, d)
     n, ne = model.n, model.ne
     u_nodes = series[:, :n]
-    u_gauss = series[:, n:n + gp.shape[0]].reshape(-1, ne, model.gauss_xi.size, model.dim)
-    f_in = np.ascontiguousarray(series[:, n + gp.shape[0]:]).reshape(-1, model.N)
+    u_gauss = series[:, n : n + gp.shape[0]].reshape(-1, ne, model.gauss_xi.size, model.dim)
+    f_in = np.ascontiguousarray(series[:, n + gp.shape[0] :]).reshape(-1, model.N)
     return u_nodes, u_gauss, f_in
 
 
-def end_series(ends: dict[str, np.ndarray], omega: np.ndarray, n_nodes: int, ax: np.ndarray,
-               n_t: int, k_up: int, sl: np.ndarray, ramp: tuple[np.ndarray, ...]
-               ) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+def end_series(
+    ends: dict[str, np.ndarray],
+    omega: np.ndarray,
+    n_nodes: int,
+    ax: np.ndarray,
+    n_t: int,
+    k_up: int,
+    sl: np.ndarray,
+    ramp: tuple[np.ndarray, ...],
+) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Prescribed end motion on the steps, per end node: the ramped displacement r·x,
     velocity and acceleration with the ramp's exact derivatives, each (n_steps+1, d)."""
     r, r1, r2 = ramp

@@ -65,8 +65,8 @@ from scipy import sparse
 
 from stochcable.errors import ConvergenceError
 from stochcable.line.mesh import LineMesh
-from stochcable.statics import solve_statics
 from stochcable.scene.model import Environment, Line, Scene
+from stochcable.statics import solve_statics
 
 __all__ = [
     "SLACK_STIFFNESS_RATIO",
@@ -117,17 +117,17 @@ class LineModel:
         self.g = env.g
         self.depth = env.depth
         area = math.pi * mesh.diameter**2 / 4.0
-        self.cn = 0.5 * env.rho * mesh.cd_normal * mesh.diameter        # [kg/m²]
+        self.cn = 0.5 * env.rho * mesh.cd_normal * mesh.diameter  # [kg/m²]
         self.ct = 0.5 * env.rho * mesh.cd_axial * math.pi * mesh.diameter
-        self.node_cda = 0.5 * env.rho * mesh.node_drag_area               # [kg/m]
+        self.node_cda = 0.5 * env.rho * mesh.node_drag_area  # [kg/m]
         trib = np.zeros(n)
         trib[:-1] += 0.5 * mesh.l0
         trib[1:] += 0.5 * mesh.l0
         trib_d = np.zeros(n)
         trib_d[:-1] += 0.5 * mesh.l0 * mesh.diameter
         trib_d[1:] += 0.5 * mesh.l0 * mesh.diameter
-        self.k_bed = env.seabed.stiffness * trib_d   # [N/m] per node
-        self.c_bed = env.seabed.damping * trib_d     # [N·s/m] per node
+        self.k_bed = env.seabed.stiffness * trib_d  # [N/m] per node
+        self.c_bed = env.seabed.damping * trib_d  # [N·s/m] per node
         # static penetration of a grounded node under its weight: w·L / (k·D·L)
         w_node = np.zeros(n)
         w_node[:-1] += 0.5 * np.abs(mesh.weight) * mesh.l0
@@ -158,7 +158,7 @@ class LineModel:
         self.P0 = P0
         # wave inertia: per element l0·ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ) (acts on the exact
         # element moments ∫N_i a dξ), per attachment (buoyancy/g + added mass) (on a_node)
-        self.inertia_el = mw                                              # (ne, d, d)
+        self.inertia_el = mw  # (ne, d, d)
         self.node_mw = mesh.node_buoyancy / env.g + mesh.node_added_mass  # (n,)
         # drag quadrature: Gauss–Legendre points ξ_g on [0, 1], weights w_g (Σ = 1),
         # shape functions N_a = 1 − ξ, N_b = ξ at the points
@@ -170,15 +170,15 @@ class LineModel:
         self._gauss_wNN = np.einsum("g,ga,gc->gac", self.gauss_w, self.gauss_N, self.gauss_N)
 
         # banded/sparse index maps -------------------------------------------------
-        self.u = u = 2 * d - 1                       # half bandwidth
+        self.u = u = 2 * d - 1  # half bandwidth
         loc = np.arange(2 * d)
-        gi = (np.arange(ne)[:, None] * d + loc[None, :])          # (ne, 2d)
+        gi = np.arange(ne)[:, None] * d + loc[None, :]  # (ne, 2d)
         rows = np.broadcast_to(gi[:, :, None], (ne, 2 * d, 2 * d))
         cols = np.broadcast_to(gi[:, None, :], (ne, 2 * d, 2 * d))
         self._el_rows = rows.ravel()
         self._el_cols = cols.ravel()
         self._el_band = ((u + rows - cols) * self.N + cols).ravel()
-        nd = np.arange(n)[:, None] * d + np.arange(d)[None, :]    # (n, d)
+        nd = np.arange(n)[:, None] * d + np.arange(d)[None, :]  # (n, d)
         nrows = np.broadcast_to(nd[:, :, None], (n, d, d))
         ncols = np.broadcast_to(nd[:, None, :], (n, d, d))
         self._nd_band = ((u + nrows - ncols) * self.N + ncols).ravel()
@@ -239,8 +239,9 @@ class LineModel:
         out[1:] += f
         return out
 
-    def stiffness_blocks(self, e: np.ndarray, l: np.ndarray, T: np.ndarray,
-                         ea: np.ndarray) -> np.ndarray:
+    def stiffness_blocks(
+        self, e: np.ndarray, l: np.ndarray, T: np.ndarray, ea: np.ndarray
+    ) -> np.ndarray:
         d = self.dim
         ee = e[:, :, None] * e[:, None, :]
         k = (ea / self.l0)[:, None, None] * ee + (T / l)[:, None, None] * (np.eye(d)[None] - ee)
@@ -257,8 +258,15 @@ class LineModel:
         N = self.gauss_N
         return N[None, :, 0, None] * X[:-1, None, :] + N[None, :, 1, None] * X[1:, None, :]
 
-    def drag(self, X: np.ndarray, V: np.ndarray, e: np.ndarray, u_fluid: np.ndarray,
-             u_gauss: np.ndarray, jacobian: bool):
+    def drag(
+        self,
+        X: np.ndarray,
+        V: np.ndarray,
+        e: np.ndarray,
+        u_fluid: np.ndarray,
+        u_gauss: np.ndarray,
+        jacobian: bool,
+    ):
         """Drag nodal forces (n, d) and the element/node blocks of −∂F/∂u̇.
 
         ``u_fluid`` (n, d): fluid velocity at the nodes (attachment drag);
@@ -273,34 +281,42 @@ class LineModel:
         if np.any(self.cn) or np.any(self.ct):
             # relative velocity at the quadrature points: (ne, ng, d)
             w = u_gauss - self.gauss_points(V)
-            s = np.einsum("egd,ed->eg", w, e)              # axial component
+            s = np.einsum("egd,ed->eg", w, e)  # axial component
             wn = w - s[:, :, None] * e[:, None, :]
             mag = np.sqrt(np.einsum("egd,egd->eg", wn, wn) + DRAG_EPS**2)
-            f = (self.cn[:, None] * mag)[:, :, None] * wn + \
-                (self.ct[:, None] * np.abs(s) * s)[:, :, None] * e[:, None, :]
+            f = (self.cn[:, None] * mag)[:, :, None] * wn + (self.ct[:, None] * np.abs(s) * s)[
+                :, :, None
+            ] * e[:, None, :]
             nodal = self.l0[:, None, None] * np.einsum(
-                "g,ga,egd->ead", self.gauss_w, self.gauss_N, f)
+                "g,ga,egd->ead", self.gauss_w, self.gauss_N, f
+            )
             F[:-1] += nodal[:, 0]
             F[1:] += nodal[:, 1]
             if jacobian:
                 P = np.eye(d)[None, None] - e[:, None, :, None] * e[:, None, None, :]
-                J = (self.cn[:, None] * mag)[:, :, None, None] * P + \
-                    (self.cn[:, None, None, None] * wn[:, :, :, None] * wn[:, :, None, :]
-                     / mag[:, :, None, None]) + \
-                    (2.0 * self.ct[:, None] * np.abs(s))[:, :, None, None] * \
-                    (e[:, None, :, None] * e[:, None, None, :])      # (ne, ng, d, d)
+                J = (
+                    (self.cn[:, None] * mag)[:, :, None, None] * P
+                    + (
+                        self.cn[:, None, None, None]
+                        * wn[:, :, :, None]
+                        * wn[:, :, None, :]
+                        / mag[:, :, None, None]
+                    )
+                    + (2.0 * self.ct[:, None] * np.abs(s))[:, :, None, None]
+                    * (e[:, None, :, None] * e[:, None, None, :])
+                )  # (ne, ng, d, d)
                 # block (a, c) = l0 Σ_g w_g N_a N_c J_g
                 blk = np.einsum("gac,egij->eaicj", self._gauss_wNN, J)
-                c_el = (self.l0[:, None, None] * blk.reshape(self.ne, 2 * d, 2 * d))
+                c_el = self.l0[:, None, None] * blk.reshape(self.ne, 2 * d, 2 * d)
         c_nd = np.zeros((self.n, d, d)) if jacobian else None
         if np.any(self.node_cda):
             vr = u_fluid - V
             mag = np.sqrt(np.einsum("nd,nd->n", vr, vr) + DRAG_EPS**2)
             F += (self.node_cda * mag)[:, None] * vr
             if jacobian:
-                c_nd += (self.node_cda * mag)[:, None, None] * np.eye(d)[None] + \
-                    self.node_cda[:, None, None] * vr[:, :, None] * vr[:, None, :] \
-                    / mag[:, None, None]
+                c_nd += (self.node_cda * mag)[:, None, None] * np.eye(d)[None] + self.node_cda[
+                    :, None, None
+                ] * vr[:, :, None] * vr[:, None, :] / mag[:, None, None]
         return F, c_el, c_nd
 
     def contact_blend(self, X: np.ndarray) -> np.ndarray:
@@ -328,10 +344,11 @@ class LineModel:
         on = pen > 0.0
         full = pen >= p0
         x = np.clip(pen / p0, 0.0, 1.0)
-        s = x * x * (3.0 - 2.0 * x)                      # smoothstep blend, C1
-        spring = np.where(full, self.k_bed * (pen - 0.5 * p0),
-                          self.k_bed * p0 * x**3 * (1.0 - 0.5 * x))   # k ∫₀ᵖ s
-        kz = self.k_bed * s                              # ∂spring/∂p
+        s = x * x * (3.0 - 2.0 * x)  # smoothstep blend, C1
+        spring = np.where(
+            full, self.k_bed * (pen - 0.5 * p0), self.k_bed * p0 * x**3 * (1.0 - 0.5 * x)
+        )  # k ∫₀ᵖ s
+        kz = self.k_bed * s  # ∂spring/∂p
         vz = V[:, -1]
         F = np.zeros_like(X)
         if s_damp is not None:
@@ -349,9 +366,15 @@ class LineModel:
 # --------------------------------------------------------------------------- statics
 
 
-def static_equilibrium(model: LineModel, X: np.ndarray, u_current: np.ndarray,
-                        u_current_gauss: np.ndarray, f_ref: float, tol: float,
-                        max_iter: int = 200) -> tuple[np.ndarray, float]:
+def static_equilibrium(
+    model: LineModel,
+    X: np.ndarray,
+    u_current: np.ndarray,
+    u_current_gauss: np.ndarray,
+    f_ref: float,
+    tol: float,
+    max_iter: int = 200,
+) -> tuple[np.ndarray, float]:
     """Newton (with backtracking) on the static residual of this model, from ``X``.
 
     The start is the statics module's solution; this re-solve removes the small
@@ -397,9 +420,14 @@ def static_equilibrium(model: LineModel, X: np.ndarray, u_current: np.ndarray,
             lam *= 0.5
         X, r, rn, st = Xn, r_new, rn_new, st_new
     if rn > tol:
-        raise ConvergenceError("time-domain static start (Newton)", max_iter, rn, tol,
-                               hint="the statics solution is far from this model's "
-                                    "equilibrium; check the seabed stiffness and current")
+        raise ConvergenceError(
+            "time-domain static start (Newton)",
+            max_iter,
+            rn,
+            tol,
+            hint="the statics solution is far from this model's "
+            "equilibrium; check the seabed stiffness and current",
+        )
     return X, rn
 
 

@@ -42,9 +42,21 @@ def newmark_period_error(omega: float | np.ndarray, dt: float) -> float | np.nda
     return float(r) if r.ndim == 0 else r
 
 
-def integrate(model: LineModel, xs: np.ndarray, u_cur: np.ndarray, u_cur_g: np.ndarray,
-              u_wave, u_wave_g, f_in, end_disp: dict, t: np.ndarray, h: float, tol: float,
-              max_it: int, every: int):
+def integrate(
+    model: LineModel,
+    xs: np.ndarray,
+    u_cur: np.ndarray,
+    u_cur_g: np.ndarray,
+    u_wave,
+    u_wave_g,
+    f_in,
+    end_disp: dict,
+    t: np.ndarray,
+    h: float,
+    tol: float,
+    max_it: int,
+    every: int,
+):
     """Newmark average acceleration with Newton iterations (seed 001 eqs. 4.2.7–4.2.11).
 
     Parameters
@@ -100,7 +112,7 @@ def integrate(model: LineModel, xs: np.ndarray, u_cur: np.ndarray, u_cur_g: np.n
     carry_a = fgr[0] if xs[0, -1] <= -model.depth + zbed_tol else np.zeros(d)
     carry_b = fgr[-1] if xs[-1, -1] <= -model.depth + zbed_tol else np.zeros(d)
     ten_a[0] = np.linalg.norm(R0[:d] + carry_a)
-    ten_b[0] = np.linalg.norm(R0[N - d:] + carry_b)
+    ten_b[0] = np.linalg.norm(R0[N - d :] + carry_b)
     ten_el[0] = T
     M_band_f = model.M_band[:, fr]
     c1, c2 = 4.0 / h**2, 2.0 / h
@@ -119,27 +131,42 @@ def integrate(model: LineModel, xs: np.ndarray, u_cur: np.ndarray, u_cur_g: np.n
             Xn[sl] += xe[k]
             Vn[sl] = ve[k]
             An[sl] = ae[k]
-        step = _Step(model, c1, c2, (Xp, Vp, Ap), (Xn, Vn, An),
-                     u_cur if u_wave is None else u_cur + u_wave[k],
-                     u_cur_g if u_wave_g is None else u_cur_g + u_wave_g[k],
-                     None if f_in is None else f_in[k], model.contact_blend(X))
+        step = _Step(
+            model,
+            c1,
+            c2,
+            (Xp, Vp, Ap),
+            (Xn, Vn, An),
+            u_cur if u_wave is None else u_cur + u_wave[k],
+            u_cur_g if u_wave_g is None else u_cur_g + u_wave_g[k],
+            None if f_in is None else f_in[k],
+            model.contact_blend(X),
+        )
         # predictor (constant acceleration) for the free DOFs
         du = h * Vp[fr] + 0.25 * h * h * Ap[fr]
         rn, R, T, res_hist = _newton(step, du, M_band_f, tol, max_it)
         it = len(res_hist) - 1
         if rn > tol:
             raise ConvergenceError(
-                f"time-domain Newton at step {k} (t = {t[k]:.6g} s)", it, rn, tol,
+                f"time-domain Newton at step {k} (t = {t[k]:.6g} s)",
+                it,
+                rn,
+                tol,
                 hint=f"reduce dt (now {h:.4g} s) or check the excitation amplitude",
-                partial={"t": t[:k], "positions": pos[:k], "residuals": res_hist,
-                         "worst_dof": int(np.argmax(np.abs(R[fr]))) + d})
+                partial={
+                    "t": t[:k],
+                    "positions": pos[:k],
+                    "residuals": res_hist,
+                    "worst_dof": int(np.argmax(np.abs(R[fr]))) + d,
+                },
+            )
         maxres = max(maxres, rn)
         iters[k] = it
         X, V, A = Xn.reshape(n, d).copy(), Vn.reshape(n, d).copy(), An.reshape(n, d).copy()
         pos[k] = X
         # support reactions: the residual rows of the prescribed end nodes
         ten_a[k] = np.linalg.norm(R[:d] + carry_a)
-        ten_b[k] = np.linalg.norm(R[N - d:] + carry_b)
+        ten_b[k] = np.linalg.norm(R[N - d :] + carry_b)
         if k % every == 0:
             ten_el[k // every] = T
     return pos, (ten_a, ten_b, ten_el), iters, maxres
@@ -150,10 +177,18 @@ class _Step:
     DOFs of (X, V, A) are set at t_k, the free ones from the increment ``du`` by
     :meth:`residual` (eqs. 4.2.7a,b), so (X, V, A) hold the last state evaluated."""
 
-    def __init__(self, model: LineModel, c1: float, c2: float,
-                 previous: tuple[np.ndarray, np.ndarray, np.ndarray],
-                 state: tuple[np.ndarray, np.ndarray, np.ndarray], uf: np.ndarray,
-                 ug: np.ndarray, fi: np.ndarray | None, s_bed: np.ndarray) -> None:
+    def __init__(
+        self,
+        model: LineModel,
+        c1: float,
+        c2: float,
+        previous: tuple[np.ndarray, np.ndarray, np.ndarray],
+        state: tuple[np.ndarray, np.ndarray, np.ndarray],
+        uf: np.ndarray,
+        ug: np.ndarray,
+        fi: np.ndarray | None,
+        s_bed: np.ndarray,
+    ) -> None:
         self.model, self.c1, self.c2 = model, c1, c2
         self.Xp, self.Vp, self.Ap = previous
         self.X, self.V, self.A = state
@@ -173,16 +208,18 @@ class _Step:
         e, l, T, ea = model.elements(Xm)
         fd, c_el, c_nd = model.drag(Xm, Vm, e, self.uf, self.ug, jacobian=jac)
         fb, kb, cb = model.seabed(Xm, Vm, self.s_bed)
-        R = (model.M_sparse @ An) + (model.internal_force(Xm, e, T) - model.f_gravity - fd
-                                     - fb).reshape(-1)
+        R = (model.M_sparse @ An) + (
+            model.internal_force(Xm, e, T) - model.f_gravity - fd - fb
+        ).reshape(-1)
         if self.fi is not None:
             R -= self.fi
         rn = float(np.abs(R[fr]).max()) if model.N - 2 * d else 0.0
         return rn, R, T, (e, l, ea, c_el, c_nd, kb, cb)
 
 
-def _newton(step: _Step, du: np.ndarray, M_band_f: np.ndarray, tol: float, max_it: int
-            ) -> tuple[float, np.ndarray, np.ndarray, list[float]]:
+def _newton(
+    step: _Step, du: np.ndarray, M_band_f: np.ndarray, tol: float, max_it: int
+) -> tuple[float, np.ndarray, np.ndarray, list[float]]:
     """Newton iterations on the step from the predictor ``du`` with a backtracking line
     search, at most ``max_it``.  Returns the final max |R_free| (above ``tol``: not
     converged), R, the element tensions and the max |R_free| of every iterate."""

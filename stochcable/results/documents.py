@@ -85,9 +85,23 @@ class ResponseStats:
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict of the fields."""
-        return {k: float(getattr(self, k)) for k in
-                ("mean", "std", "tz", "mpm_3h", "significant", "m0", "m1", "m2", "m4",
-                 "bandwidth", "mpm", "expected_max")}
+        return {
+            k: float(getattr(self, k))
+            for k in (
+                "mean",
+                "std",
+                "tz",
+                "mpm_3h",
+                "significant",
+                "m0",
+                "m1",
+                "m2",
+                "m4",
+                "bandwidth",
+                "mpm",
+                "expected_max",
+            )
+        }
 
 
 def stats_from_spectrum(
@@ -122,8 +136,9 @@ def stats_from_spectrum(
     return _response_stats(st, sd, mean)
 
 
-def stats_from_validated(omega: np.ndarray, density: np.ndarray, mean: float,
-                         duration: float) -> ResponseStats:
+def stats_from_validated(
+    omega: np.ndarray, density: np.ndarray, mean: float, duration: float
+) -> ResponseStats:
     """:func:`stats_from_spectrum` of a validated grid and spectrum (the analysis grid,
     validated once at the boundary; a 1-D float density >= 0 of its size, duration
     > 0): no second validation per call."""
@@ -138,10 +153,18 @@ def _response_stats(st: Any, sd: Any, mean: float) -> ResponseStats:
     """ResponseStats from the statistics over three hours (st) and the duration (sd)."""
     mean = float(mean)
     return ResponseStats(
-        mean=mean, std=float(st.std), m0=float(st.m0), m1=float(st.m1), m2=float(st.m2),
-        m4=float(st.m4), tz=float(st.tz), significant=float(st.significant),
-        bandwidth=float(st.bandwidth), mpm_3h=mean + float(st.mpm),
-        mpm=mean + float(sd.mpm), expected_max=mean + float(sd.expected_max),
+        mean=mean,
+        std=float(st.std),
+        m0=float(st.m0),
+        m1=float(st.m1),
+        m2=float(st.m2),
+        m4=float(st.m4),
+        tz=float(st.tz),
+        significant=float(st.significant),
+        bandwidth=float(st.bandwidth),
+        mpm_3h=mean + float(st.mpm),
+        mpm=mean + float(sd.mpm),
+        expected_max=mean + float(sd.expected_max),
     )
 
 
@@ -190,7 +213,6 @@ class LinearizationRecord:
             "tolerance": float(self.tolerance),
             "history": [float(h) for h in self.history],
         }
-
 
 
 def _finite_or_none(x: float) -> float | None:
@@ -248,19 +270,24 @@ class LineIndicators:
         """JSON-ready dict (non-finite numbers as None)."""
         br, di = self.borgman_ratio, self.drag_inertia_ratio
         return {
-            "borgman_ratio": {"min": _finite_or_none(br.min()) if br.size else None,
-                              "max": _finite_or_none(br.max()) if br.size else None,
-                              "elements": [_finite_or_none(x) for x in br]},
+            "borgman_ratio": {
+                "min": _finite_or_none(br.min()) if br.size else None,
+                "max": _finite_or_none(br.max()) if br.size else None,
+                "elements": [_finite_or_none(x) for x in br],
+            },
             "drag_inertia_ratio": {
                 "min": _finite_or_none(di.min()) if di.size else None,
                 "max": _finite_or_none(di.max()) if di.size else None,
-                "elements": [_finite_or_none(x) for x in di]},
-            "snap": {"risk": bool(self.snap_risk),
-                     "margin": _finite_or_none(self.snap_margin)},
+                "elements": [_finite_or_none(x) for x in di],
+            },
+            "snap": {"risk": bool(self.snap_risk), "margin": _finite_or_none(self.snap_margin)},
             "resonances": [dict(r) for r in self.resonances],
-            "motion": {"std_max": float(self.motion_std_max), "sag": float(self.sag),
-                       "to_sag": _finite_or_none(self.motion_to_sag),
-                       "to_diameter": _finite_or_none(self.motion_to_diameter)},
+            "motion": {
+                "std_max": float(self.motion_std_max),
+                "sag": float(self.sag),
+                "to_sag": _finite_or_none(self.motion_to_sag),
+                "to_diameter": _finite_or_none(self.motion_to_diameter),
+            },
             "flags": list(self.flags),
         }
 
@@ -350,8 +377,9 @@ class LineResult:
     # ---------------------------------------------------------------- spectra
     def _spectrum(self, transfer: np.ndarray) -> np.ndarray:
         """Σ_i |H_i|² S_i over the channel axis (axis 0)."""
-        s = self.input_spectra.reshape((self.input_spectra.shape[0],)
-                                       + (1,) * (transfer.ndim - 2) + (-1,))
+        s = self.input_spectra.reshape(
+            (self.input_spectra.shape[0],) + (1,) * (transfer.ndim - 2) + (-1,)
+        )
         return np.sum(np.abs(transfer) ** 2 * s, axis=0)
 
     def end_force_std(self, end: str) -> np.ndarray:
@@ -376,10 +404,14 @@ class LineResult:
     def to_document(self) -> dict[str, Any]:
         """The line's part of the result document."""
         return {
-            "end_a": {"tension": self.end_a.as_dict(),
-                      "force_std": self.end_force_std("end_a").tolist()},
-            "end_b": {"tension": self.end_b.as_dict(),
-                      "force_std": self.end_force_std("end_b").tolist()},
+            "end_a": {
+                "tension": self.end_a.as_dict(),
+                "force_std": self.end_force_std("end_a").tolist(),
+            },
+            "end_b": {
+                "tension": self.end_b.as_dict(),
+                "force_std": self.end_force_std("end_b").tolist(),
+            },
             "tension": {
                 "s": self.s_elements.tolist(),
                 "std": self.tension_std.tolist(),
@@ -396,7 +428,6 @@ class LineResult:
             "modes": {"omega": self.listed_modes.tolist(), "kept": self.n_modes},
             "indicators": None if self.indicators is None else self.indicators.as_dict(),
         }
-
 
 
 @dataclass(frozen=True, eq=False)
@@ -466,13 +497,19 @@ class BodyResult:
             "prescribed": bool(self.prescribed),
             "dofs": list(self.dofs),
             "motion": motion,
-            "spectra": {"omega": self.omega.tolist(),
-                        **{k: s.tolist() for k, s in zip(self.dofs, self.motion_spectrum)}},
+            "spectra": {
+                "omega": self.omega.tolist(),
+                **{k: s.tolist() for k, s in zip(self.dofs, self.motion_spectrum)},
+            },
             "channels": list(self.channels),
-            "drag": None if self.drag_sigma is None else {
+            "drag": None
+            if self.drag_sigma is None
+            else {
                 "sigma": self.drag_sigma.tolist(),
-                "coefficient": (None if self.drag_coefficient is None
-                                else self.drag_coefficient.tolist())},
+                "coefficient": (
+                    None if self.drag_coefficient is None else self.drag_coefficient.tolist()
+                ),
+            },
             "modes": None if self.modes is None else self.modes.as_dict(),
         }
 
@@ -556,8 +593,10 @@ class TimeSeries:
         if self.body_motion:
             # {body: {"motion": {dof: [...]}}} (rad for rotations), as the result's
             # "bodies" part
-            doc["bodies"] = {name: {"motion": {k: s[:n].tolist() for k, s in dofs.items()}}
-                             for name, dofs in self.body_motion.items()}
+            doc["bodies"] = {
+                name: {"motion": {k: s[:n].tolist() for k, s in dofs.items()}}
+                for name, dofs in self.body_motion.items()
+            }
         return doc
 
 

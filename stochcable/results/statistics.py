@@ -52,8 +52,9 @@ def response_spectrum(transfer: np.ndarray, input_spectrum: np.ndarray) -> np.nd
     DESIGN.md "Outputs": ``S_x = |H_x|^2 S_eta``.
     """
     h = np.asarray(transfer)
-    s = _v.float_array("input_spectrum", input_spectrum, "unit^2*s/rad", ndim=None,
-                       nonnegative=True)
+    s = _v.float_array(
+        "input_spectrum", input_spectrum, "unit^2*s/rad", ndim=None, nonnegative=True
+    )
     return np.abs(h) ** 2 * s
 
 
@@ -79,8 +80,9 @@ def cross_spectrum(
     -----
     ``S_{a+b} = S_aa + S_bb + 2 Re S_ab``; prefer forming ``H_a + H_b`` directly.
     """
-    s = _v.float_array("input_spectrum", input_spectrum, "unit^2*s/rad", ndim=None,
-                       nonnegative=True)
+    s = _v.float_array(
+        "input_spectrum", input_spectrum, "unit^2*s/rad", ndim=None, nonnegative=True
+    )
     return np.asarray(transfer_a) * np.conj(np.asarray(transfer_b)) * s
 
 
@@ -173,8 +175,9 @@ def response_statistics(
     s = _v.float_array("density", density, "unit^2*s/rad", ndim=None, nonnegative=True)
     dur = _v.positive("duration", duration, "s")
     if s.ndim == 0 or s.shape[-1] != w.size:
-        raise InputError("density", s, "unit^2*s/rad",
-                         f"must have the frequency axis last with {w.size} entries")
+        raise InputError(
+            "density", s, "unit^2*s/rad", f"must have the frequency axis last with {w.size} entries"
+        )
     return _statistics(w, s, dur)
 
 
@@ -190,8 +193,9 @@ def _statistics(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
     m4 = np.trapezoid(s * w**4, w, axis=-1)
     std = np.sqrt(m0)
     ok = (m0 > 0) & (m2 > 0)
-    tz = np.where(ok, 2.0 * math.pi * np.sqrt(np.divide(m0, m2, out=np.ones_like(m0),
-                                                       where=ok)), 0.0)
+    tz = np.where(
+        ok, 2.0 * math.pi * np.sqrt(np.divide(m0, m2, out=np.ones_like(m0), where=ok)), 0.0
+    )
     n_cyc = np.where(ok, dur / np.where(ok, tz, 1.0), 0.0)
     ln_n = np.log(np.maximum(n_cyc, 1.0))
     root = np.sqrt(2.0 * ln_n)
@@ -207,9 +211,18 @@ def _statistics(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
         return float(x) if np.ndim(x) == 0 else x
 
     return ResponseStatistics(
-        m0=out(m0), m1=out(m1), m2=out(m2), m4=out(m4), std=out(std), tz=out(tz),
-        significant=out(2.0 * std), bandwidth=out(bandwidth), mpm=out(mpm),
-        expected_max=out(expected), n_cycles=out(n_cyc), duration=dur,
+        m0=out(m0),
+        m1=out(m1),
+        m2=out(m2),
+        m4=out(m4),
+        std=out(std),
+        tz=out(tz),
+        significant=out(2.0 * std),
+        bandwidth=out(bandwidth),
+        mpm=out(mpm),
+        expected_max=out(expected),
+        n_cycles=out(n_cyc),
+        duration=dur,
     )
 
 
@@ -235,7 +248,16 @@ def _statistics_1d(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatisti
     den = m0 * m4
     bandwidth = math.sqrt(min(max(1.0 - m2 * m2 / den, 0.0), 1.0)) if den > 0 else 0.0
     return ResponseStatistics(
-        m0=m0, m1=m1, m2=m2, m4=m4, std=std, tz=tz, significant=2.0 * std,
-        bandwidth=bandwidth, mpm=std * root, expected_max=expected, n_cycles=n_cyc,
+        m0=m0,
+        m1=m1,
+        m2=m2,
+        m4=m4,
+        std=std,
+        tz=tz,
+        significant=2.0 * std,
+        bandwidth=bandwidth,
+        mpm=std * root,
+        expected_max=expected,
+        n_cycles=n_cyc,
         duration=dur,
     )

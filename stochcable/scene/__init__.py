@@ -5,4 +5,4 @@ settings) is validated and resolved here, once; the layers below trust what they
 """
 
 from stochcable.scene.model import *  # noqa: F403  (the scene's public models)
-from stochcable.scene.model import __all__
+from stochcable.scene.model import __all__ as __all__

@@ -10,8 +10,14 @@ from pydantic import Field, model_validator
 
 from stochcable.scene.base import _Doc, _f
 
-__all__ = ["OmegaGrid", "LinearizationSettings", "TimeSeriesSettings", "StructuralDamping",
-           "FidelitySettings", "AnalysisSettings"]
+__all__ = [
+    "OmegaGrid",
+    "LinearizationSettings",
+    "TimeSeriesSettings",
+    "StructuralDamping",
+    "FidelitySettings",
+    "AnalysisSettings",
+]
 
 
 class OmegaGrid(_Doc):
@@ -20,11 +26,10 @@ class OmegaGrid(_Doc):
     min: float = _f("Lowest frequency", "rad/s", gt=0, default=0.05)
     max: float = _f("Highest frequency", "rad/s", gt=0, default=2.0)
     count: int = _f("Number of frequencies", "-", ge=2, le=100_000, default=200)
-    spacing: Literal["linear", "log"] = Field(default="linear",
-                                              description="Grid spacing")
+    spacing: Literal["linear", "log"] = Field(default="linear", description="Grid spacing")
 
     @model_validator(mode="after")
-    def _order(self) -> "OmegaGrid":
+    def _order(self) -> OmegaGrid:
         if self.max <= self.min:
             raise ValueError(f"max ({self.max} rad/s) must exceed min ({self.min} rad/s)")
         return self
@@ -44,13 +49,16 @@ class LinearizationSettings(_Doc):
         description="seed: scalar sqrt(8/pi) form (eq. 5.2.2); vector: exact normal-plane "
         "Gaussian form; harmonic: 8/(3 pi) regular-wave form",
     )
-    tolerance: float = _f("Relative change of every sigma at convergence", "-", gt=0, lt=1,
-                          default=1e-4)
+    tolerance: float = _f(
+        "Relative change of every sigma at convergence", "-", gt=0, lt=1, default=1e-4
+    )
     max_iterations: int = _f("Iteration limit", "-", ge=1, le=10_000, default=100)
-    relaxation: float = _f("Under-relaxation factor of the plain iteration", "-", gt=0, le=1,
-                           default=0.5)
-    acceleration: Literal["anderson", "none"] = Field(default="anderson",
-                                                      description="Fixed-point accelerator")
+    relaxation: float = _f(
+        "Under-relaxation factor of the plain iteration", "-", gt=0, le=1, default=0.5
+    )
+    acceleration: Literal["anderson", "none"] = Field(
+        default="anderson", description="Fixed-point accelerator"
+    )
     allow_unconverged: bool = Field(
         default=False,
         description="Return a flagged partial result instead of an error when the "
@@ -78,7 +86,10 @@ class FidelitySettings(_Doc):
     """Adaptive fidelity: the engine chooses elements, frequencies, modes and tolerance."""
 
     target_error: float = _f(
-        "Target relative error of the response standard deviations", "-", gt=0, le=0.5,
+        "Target relative error of the response standard deviations",
+        "-",
+        gt=0,
+        le=0.5,
         default=0.01,
     )
 
@@ -87,8 +98,9 @@ class AnalysisSettings(_Doc):
     """How to solve: frequencies, solver, modes, linearization, time series."""
 
     omega: OmegaGrid = Field(default_factory=OmegaGrid)
-    solver: Literal["foss", "direct"] = Field(default="foss",
-                                              description="Modal Foss or direct solve")
+    solver: Literal["foss", "direct"] = Field(
+        default="foss", description="Modal Foss or direct solve"
+    )
     modes: Literal["auto"] | Annotated[int, Field(ge=1)] = Field(
         default="auto", description="Number of modes kept, or auto from the frequency content"
     )
@@ -101,5 +113,4 @@ class AnalysisSettings(_Doc):
         "choices and their error estimates are reported under 'fidelity'",
     )
     timeseries: TimeSeriesSettings | None = None
-    duration: float = _f("Storm duration for extreme-value statistics", "s", gt=0,
-                         default=10800.0)
+    duration: float = _f("Storm duration for extreme-value statistics", "s", gt=0, default=10800.0)

@@ -4,7 +4,7 @@ hydrodynamic coefficients (inline table or file) and prescribed motions."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Discriminator, Field, Tag, model_validator
@@ -14,8 +14,15 @@ from stochcable.scene.base import _Doc, _f
 from stochcable.scene.lines import ComplexTable
 from stochcable.scene.tables import BODY_DOFS, PLANAR_BODY_DOFS, parse_table
 
-__all__ = ["BODY_DOFS", "PLANAR_BODY_DOFS", "BodyExcitation", "BodyHydrodynamics",
-           "BodyHydrodynamicsFile", "VesselMotion", "Body"]
+__all__ = [
+    "BODY_DOFS",
+    "PLANAR_BODY_DOFS",
+    "BodyExcitation",
+    "BodyHydrodynamics",
+    "BodyHydrodynamicsFile",
+    "VesselMotion",
+    "Body",
+]
 
 
 Matrix = tuple[tuple[float, ...], ...]
@@ -25,10 +32,12 @@ Vec3 = tuple[float, float, float]
 class BodyExcitation(_Doc):
     """Wave excitation table of a body (docs/BODIES.md JSON table format)."""
 
-    heading: tuple[float, ...] = _f("Wave headings, increasing, spanning < 360", "deg",
-                                    min_length=1)
-    re: tuple[Matrix, ...] = _f("Real part, (n_heading, n_dof, n_omega), per unit wave "
-                                "amplitude, e^{+iωt}", "N/m, N·m/m")
+    heading: tuple[float, ...] = _f(
+        "Wave headings, increasing, spanning < 360", "deg", min_length=1
+    )
+    re: tuple[Matrix, ...] = _f(
+        "Real part, (n_heading, n_dof, n_omega), per unit wave amplitude, e^{+iωt}", "N/m, N·m/m"
+    )
     im: tuple[Matrix, ...] = _f("Imaginary part, shape as re", "N/m, N·m/m")
 
 
@@ -40,21 +49,25 @@ class BodyHydrodynamics(_Doc):
     """
 
     dofs: tuple[str, ...] | None = Field(
-        default=None, description="DOF order: the six (default) or surge, heave, pitch")
-    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s",
-                                  min_length=1)
-    added_mass: tuple[Matrix, ...] = _f("Added mass (n_omega, d, d) about the reference "
-                                        "point", "kg, kg·m, kg·m²")
-    radiation_damping: tuple[Matrix, ...] = _f("Radiation damping (n_omega, d, d)",
-                                               "N·s/m, N·s, N·m·s")
+        default=None, description="DOF order: the six (default) or surge, heave, pitch"
+    )
+    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s", min_length=1)
+    added_mass: tuple[Matrix, ...] = _f(
+        "Added mass (n_omega, d, d) about the reference point", "kg, kg·m, kg·m²"
+    )
+    radiation_damping: tuple[Matrix, ...] = _f(
+        "Radiation damping (n_omega, d, d)", "N·s/m, N·s, N·m·s"
+    )
     excitation: BodyExcitation | None = None
-    hydrostatic_stiffness: Matrix | None = _f("Hydrostatic restoring (d, d), weight terms "
-                                              "included", "N/m, N, N·m/rad", default=None)
-    reference_point: Vec3 | None = _f("Reference point of the table (informative)", "m",
-                                      default=None)
+    hydrostatic_stiffness: Matrix | None = _f(
+        "Hydrostatic restoring (d, d), weight terms included", "N/m, N, N·m/rad", default=None
+    )
+    reference_point: Vec3 | None = _f(
+        "Reference point of the table (informative)", "m", default=None
+    )
 
     @model_validator(mode="after")
-    def _check_table(self) -> "BodyHydrodynamics":
+    def _check_table(self) -> BodyHydrodynamics:
         try:
             parse_table(self.table())
         except InputError as exc:
@@ -78,8 +91,9 @@ class BodyHydrodynamicsFile(_Doc):
     absolute); the HTTP service refuses files (``load_scene(..., allow_files=False)``).
     """
 
-    file: str = Field(min_length=1, max_length=4096,
-                      description="Path of a Capytaine .nc or JSON table file")
+    file: str = Field(
+        min_length=1, max_length=4096, description="Path of a Capytaine .nc or JSON table file"
+    )
 
 
 class VesselMotion(_Doc):
@@ -91,8 +105,7 @@ class VesselMotion(_Doc):
     eqs. 3.3.6–3.3.7), nothing couples back.
     """
 
-    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s",
-                                  min_length=2)
+    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s", min_length=2)
     surge: ComplexTable | None = None
     sway: ComplexTable | None = None
     heave: ComplexTable | None = None
@@ -101,7 +114,7 @@ class VesselMotion(_Doc):
     yaw: ComplexTable | None = None
 
     @model_validator(mode="after")
-    def _check(self) -> "VesselMotion":
+    def _check(self) -> VesselMotion:
         w = np.asarray(self.omega)
         if w[0] < 0 or (np.diff(w) <= 0).any():
             raise ValueError("omega must be >= 0 and strictly increasing")
@@ -110,8 +123,7 @@ class VesselMotion(_Doc):
             raise ValueError(f"give at least one of {', '.join(BODY_DOFS)}")
         for k, v in given.items():
             if v is not None and len(v.re) != len(self.omega):
-                raise ValueError(f"{k} has {len(v.re)} values but omega has "
-                                 f"{len(self.omega)}")
+                raise ValueError(f"{k} has {len(v.re)} values but omega has {len(self.omega)}")
         return self
 
     def transfer(self, omega: np.ndarray) -> np.ndarray:
@@ -126,14 +138,17 @@ class VesselMotion(_Doc):
                 continue
             v = t.values()
             out[i] = np.interp(omega, w, v.real, 0.0, 0.0) + 1j * np.interp(
-                omega, w, v.imag, 0.0, 0.0)
+                omega, w, v.imag, 0.0, 0.0
+            )
         return out
 
     @property
     def out_of_plane(self) -> bool:
         """True when a sway, roll or yaw RAO is non-zero."""
-        return any(getattr(self, k) is not None and np.any(getattr(self, k).values() != 0)
-                   for k in ("sway", "roll", "yaw"))
+        return any(
+            getattr(self, k) is not None and np.any(getattr(self, k).values() != 0)
+            for k in ("sway", "roll", "yaw")
+        )
 
 
 def _hydro_kind(v: Any) -> str:
@@ -159,64 +174,98 @@ class Body(_Doc):
     by ``hydrostatic_stiffness`` only.
     """
 
-    name: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.\-]+$",
-                      description="Unique body name (letters, digits, _ . -)")
-    position: Vec3 = _f("Reference point at the static pose (initial guess of the "
-                        "statics for a free body)", "m")
+    name: str = Field(
+        min_length=1,
+        max_length=64,
+        pattern=r"^[A-Za-z0-9_.\-]+$",
+        description="Unique body name (letters, digits, _ . -)",
+    )
+    position: Vec3 = _f(
+        "Reference point at the static pose (initial guess of the statics for a free body)", "m"
+    )
     mass: float = _f("Mass", "kg", gt=0)
-    inertia: Matrix | None = _f("Inertia tensor about the centre of gravity, global axes, "
-                                "3×3", "kg·m²", default=None)
-    cog: Vec3 = _f("Centre of gravity relative to the reference point", "m",
-                   default=(0.0, 0.0, 0.0))
+    inertia: Matrix | None = _f(
+        "Inertia tensor about the centre of gravity, global axes, 3×3", "kg·m²", default=None
+    )
+    cog: Vec3 = _f(
+        "Centre of gravity relative to the reference point", "m", default=(0.0, 0.0, 0.0)
+    )
     added_mass: Matrix | None = _f("Constant added mass", "kg, kg·m, kg·m²", default=None)
-    radiation_damping: Matrix | None = _f("Constant radiation damping",
-                                          "N·s/m, N·s, N·m·s", default=None)
+    radiation_damping: Matrix | None = _f(
+        "Constant radiation damping", "N·s/m, N·s, N·m·s", default=None
+    )
     hydrostatic_stiffness: Matrix | None = _f(
         "Hydrostatic restoring about the reference point, weight terms included",
-        "N/m, N, N·m/rad", default=None)
-    extra_stiffness: Matrix | None = _f("Additional linear stiffness", "N/m, N, N·m/rad",
-                                        default=None)
-    extra_damping: Matrix | None = _f("Additional linear damping", "N·s/m, N·s, N·m·s",
-                                      default=None)
-    hydrodynamics: Annotated[
-        Union[Annotated[BodyHydrodynamicsFile, Tag("file")],
-              Annotated[BodyHydrodynamics, Tag("table")]],
-        Discriminator(_hydro_kind)] | None = Field(
-        default=None, description="Frequency-dependent coefficients: inline table or file")
-    displaced_volume: float | None = _f("Displaced volume for the static buoyancy", "m³",
-                                        ge=0, default=None)
-    centre_of_buoyancy: Vec3 = _f("Centre of buoyancy relative to the reference point",
-                                  "m", default=(0.0, 0.0, 0.0))
-    drag_area: Vec3 = _f("Drag coefficient times area, Cd·A, for flow along x, y, z",
-                         "m²", default=(0.0, 0.0, 0.0))
-    drag_point: Vec3 = _f("Point of application of the drag relative to the reference "
-                          "point", "m", default=(0.0, 0.0, 0.0))
-    wind_force: Vec3 = _f("Static wind force at the reference point (seed 001 §6.5)", "N",
-                          default=(0.0, 0.0, 0.0))
-    wind_moment: Vec3 = _f("Static wind moment about the reference point", "N·m",
-                           default=(0.0, 0.0, 0.0))
+        "N/m, N, N·m/rad",
+        default=None,
+    )
+    extra_stiffness: Matrix | None = _f(
+        "Additional linear stiffness", "N/m, N, N·m/rad", default=None
+    )
+    extra_damping: Matrix | None = _f(
+        "Additional linear damping", "N·s/m, N·s, N·m·s", default=None
+    )
+    hydrodynamics: (
+        Annotated[
+            Annotated[BodyHydrodynamicsFile, Tag("file")]
+            | Annotated[BodyHydrodynamics, Tag("table")],
+            Discriminator(_hydro_kind),
+        ]
+        | None
+    ) = Field(default=None, description="Frequency-dependent coefficients: inline table or file")
+    displaced_volume: float | None = _f(
+        "Displaced volume for the static buoyancy", "m³", ge=0, default=None
+    )
+    centre_of_buoyancy: Vec3 = _f(
+        "Centre of buoyancy relative to the reference point", "m", default=(0.0, 0.0, 0.0)
+    )
+    drag_area: Vec3 = _f(
+        "Drag coefficient times area, Cd·A, for flow along x, y, z", "m²", default=(0.0, 0.0, 0.0)
+    )
+    drag_point: Vec3 = _f(
+        "Point of application of the drag relative to the reference point",
+        "m",
+        default=(0.0, 0.0, 0.0),
+    )
+    wind_force: Vec3 = _f(
+        "Static wind force at the reference point (seed 001 §6.5)", "N", default=(0.0, 0.0, 0.0)
+    )
+    wind_moment: Vec3 = _f(
+        "Static wind moment about the reference point", "N·m", default=(0.0, 0.0, 0.0)
+    )
     extrapolation: Literal["error", "hold"] = Field(
-        default="error", description="Outside the frequencies of the hydrodynamic table: "
-        "refuse, or hold the end values")
+        default="error",
+        description="Outside the frequencies of the hydrodynamic table: "
+        "refuse, or hold the end values",
+    )
     prescribed: VesselMotion | None = Field(
-        default=None, description="Prescribed motion (a vessel): the body is not solved "
-        "for; its static pose is position, no rotation")
-    fixed_dofs: tuple[Literal["surge", "sway", "heave", "roll", "pitch", "yaw"], ...] = \
-        Field(default=(), description="DOFs held fixed (statics and dynamics), e.g. yaw "
-              "of a buoy on one line")
+        default=None,
+        description="Prescribed motion (a vessel): the body is not solved "
+        "for; its static pose is position, no rotation",
+    )
+    fixed_dofs: tuple[Literal["surge", "sway", "heave", "roll", "pitch", "yaw"], ...] = Field(
+        default=(),
+        description="DOFs held fixed (statics and dynamics), e.g. yaw of a buoy on one line",
+    )
 
     @model_validator(mode="after")
-    def _check_body(self) -> "Body":
-        for k in ("added_mass", "radiation_damping", "hydrostatic_stiffness",
-                  "extra_stiffness", "extra_damping"):
+    def _check_body(self) -> Body:
+        for k in (
+            "added_mass",
+            "radiation_damping",
+            "hydrostatic_stiffness",
+            "extra_stiffness",
+            "extra_damping",
+        ):
             m = getattr(self, k)
             if m is None:
                 continue
             n = len(m)
             if n not in (3, 6) or any(len(row) != n for row in m):
                 raise ValueError(f"{k} must be a 6×6 or (planar) 3×3 matrix")
-        if self.inertia is not None and (len(self.inertia) != 3
-                                         or any(len(r) != 3 for r in self.inertia)):
+        if self.inertia is not None and (
+            len(self.inertia) != 3 or any(len(r) != 3 for r in self.inertia)
+        ):
             raise ValueError("inertia must be a 3×3 tensor")
         if any(v < 0 for v in self.drag_area):
             raise ValueError(f"drag_area = {list(self.drag_area)} m²: must be >= 0")
@@ -227,9 +276,16 @@ class Body(_Doc):
     @property
     def planar_data(self) -> bool:
         """True when a matrix or the table is 3×3 (surge, heave, pitch)."""
-        mats = [getattr(self, k) for k in ("added_mass", "radiation_damping",
-                                           "hydrostatic_stiffness", "extra_stiffness",
-                                           "extra_damping")]
+        mats = [
+            getattr(self, k)
+            for k in (
+                "added_mass",
+                "radiation_damping",
+                "hydrostatic_stiffness",
+                "extra_stiffness",
+                "extra_damping",
+            )
+        ]
         if any(m is not None and len(m) == 3 for m in mats):
             return True
         h = self.hydrodynamics
@@ -240,9 +296,15 @@ class Body(_Doc):
         """True when the body leaves the x–z plane: y of its points, sway forces,
         roll/yaw moments, out-of-plane vessel RAOs."""
         tol = 1e-9
-        ys = [self.position[1], self.cog[1], self.centre_of_buoyancy[1],
-              self.drag_point[1], self.wind_force[1], self.wind_moment[0],
-              self.wind_moment[2]]
+        ys = [
+            self.position[1],
+            self.cog[1],
+            self.centre_of_buoyancy[1],
+            self.drag_point[1],
+            self.wind_force[1],
+            self.wind_moment[0],
+            self.wind_moment[2],
+        ]
         if any(abs(v) > tol for v in ys):
             return True
         return self.prescribed is not None and self.prescribed.out_of_plane

@@ -19,8 +19,7 @@ class CurrentPoint(_Doc):
 
     z: float = _f("Elevation, z up from the still-water level", "m", le=0)
     speed: float = _f("Current speed", "m/s", ge=0)
-    heading: float = _f("Direction the current flows toward, from +x toward +y", "deg",
-                        default=0.0)
+    heading: float = _f("Direction the current flows toward, from +x toward +y", "deg", default=0.0)
 
     @property
     def heading_rad(self) -> float:
@@ -47,7 +46,7 @@ class Environment(_Doc):
     seabed: Seabed = Field(default_factory=Seabed, description="Seabed contact model")
 
     @model_validator(mode="after")
-    def _current_in_water(self) -> "Environment":
+    def _current_in_water(self) -> Environment:
         for i, p in enumerate(self.current):
             if p.z < -self.depth:
                 raise ValueError(
@@ -80,8 +79,7 @@ class Sea(_Doc):
     """Long-crested random sea: a spectrum and a heading."""
 
     spectrum: Spectrum
-    heading: float = _f("Direction the waves travel toward, from +x toward +y", "deg",
-                        default=0.0)
+    heading: float = _f("Direction the waves travel toward, from +x toward +y", "deg", default=0.0)
 
     @property
     def heading_rad(self) -> float:

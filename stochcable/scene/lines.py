@@ -12,8 +12,17 @@ from pydantic import Field, model_validator
 from stochcable.scene.base import _Doc, _f
 from stochcable.scene.spectra import Spectrum
 
-__all__ = ["ComplexTable", "MotionRao", "EndMotion", "BodyAttachment", "End", "Segment",
-           "Attachment", "Line", "check_span"]
+__all__ = [
+    "ComplexTable",
+    "MotionRao",
+    "EndMotion",
+    "BodyAttachment",
+    "End",
+    "Segment",
+    "Attachment",
+    "Line",
+    "check_span",
+]
 
 
 class ComplexTable(_Doc):
@@ -23,7 +32,7 @@ class ComplexTable(_Doc):
     im: tuple[float, ...]
 
     @model_validator(mode="after")
-    def _same_length(self) -> "ComplexTable":
+    def _same_length(self) -> ComplexTable:
         if len(self.re) != len(self.im):
             raise ValueError(f"re ({len(self.re)}) and im ({len(self.im)}) differ in length")
         return self
@@ -36,14 +45,13 @@ class ComplexTable(_Doc):
 class MotionRao(_Doc):
     """End motion RAOs relative to the sea: metres of motion per metre of wave amplitude."""
 
-    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s",
-                                  min_length=2)
+    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s", min_length=2)
     surge: ComplexTable | None = None
     sway: ComplexTable | None = None
     heave: ComplexTable | None = None
 
     @model_validator(mode="after")
-    def _check(self) -> "MotionRao":
+    def _check(self) -> MotionRao:
         w = np.asarray(self.omega)
         if w[0] < 0 or (np.diff(w) <= 0).any():
             raise ValueError("omega must be >= 0 and strictly increasing")
@@ -52,9 +60,7 @@ class MotionRao(_Doc):
             raise ValueError("give at least one of surge, sway, heave")
         for k, v in given.items():
             if v is not None and len(v.re) != len(self.omega):
-                raise ValueError(
-                    f"{k} has {len(v.re)} values but omega has {len(self.omega)}"
-                )
+                raise ValueError(f"{k} has {len(v.re)} values but omega has {len(self.omega)}")
         return self
 
     def transfer(self, omega: np.ndarray) -> np.ndarray:
@@ -87,7 +93,7 @@ class EndMotion(_Doc):
     rao: MotionRao | None = None
 
     @model_validator(mode="after")
-    def _one_kind(self) -> "EndMotion":
+    def _one_kind(self) -> EndMotion:
         spectra_given = any(getattr(self, k) is not None for k in ("surge", "sway", "heave"))
         if spectra_given and self.rao is not None:
             raise ValueError("give motion spectra (surge/sway/heave) or rao, not both")
@@ -101,29 +107,34 @@ class BodyAttachment(_Doc):
 
     body: str = Field(min_length=1, max_length=64, description="Name of the body")
     point: tuple[float, float, float] = _f(
-        "Attachment point relative to the body reference point, global axes, at the "
-        "static pose", "m", default=(0.0, 0.0, 0.0))
+        "Attachment point relative to the body reference point, global axes, at the static pose",
+        "m",
+        default=(0.0, 0.0, 0.0),
+    )
 
 
 class End(_Doc):
     """A line end: fixed at ``position`` unless a ``motion`` is prescribed about it, or
     attached to a body (``attach``), which then carries it (seed 001 eqs. 3.3.6–3.3.7)."""
 
-    position: tuple[float, float, float] | None = _f("Position (x, y, z), z up", "m",
-                                                     default=None)
+    position: tuple[float, float, float] | None = _f("Position (x, y, z), z up", "m", default=None)
     motion: EndMotion | None = None
     attach: BodyAttachment | None = None
 
     @model_validator(mode="after")
-    def _position_or_attach(self) -> "End":
+    def _position_or_attach(self) -> End:
         if self.attach is None and self.position is None:
             raise ValueError("give the end's position or attach it to a body")
         if self.attach is not None and self.position is not None:
-            raise ValueError("give position or attach, not both (an attached end's "
-                             "position is the body position plus attach.point)")
+            raise ValueError(
+                "give position or attach, not both (an attached end's "
+                "position is the body position plus attach.point)"
+            )
         if self.attach is not None and self.motion is not None:
-            raise ValueError("an end attached to a body cannot have a motion: the body "
-                             "moves it (give the body a 'prescribed' motion instead)")
+            raise ValueError(
+                "an end attached to a body cannot have a motion: the body "
+                "moves it (give the body a 'prescribed' motion instead)"
+            )
         return self
 
 
@@ -135,12 +146,15 @@ class Segment(_Doc):
     mass: float = _f("Mass per unit length in air", "kg/m", gt=0)
     diameter: float = _f("Hydrodynamic (volume-equivalent) diameter", "m", gt=0)
     cd_normal: float = _f("Normal drag coefficient, on the diameter", "-", ge=0, default=1.2)
-    cd_axial: float = _f("Axial drag coefficient, on pi·diameter (as MoorDyn's CdAx)", "-",
-                         ge=0, default=0.0)
+    cd_axial: float = _f(
+        "Axial drag coefficient, on pi·diameter (as MoorDyn's CdAx)", "-", ge=0, default=0.0
+    )
     ca_normal: float = _f("Normal added-mass coefficient", "-", ge=0, default=1.0)
     weight: float | None = _f(
         "Net submerged weight per unit length, overriding (mass - rho·pi·D²/4)·g; "
-        "negative for buoyant line", "N/m", default=None,
+        "negative for buoyant line",
+        "N/m",
+        default=None,
     )
     elements: int = _f("Number of finite elements", "-", ge=1, le=100_000, default=20)
 
@@ -156,18 +170,22 @@ class Attachment(_Doc):
 
     at: float = _f("Unstretched arc length from end_a", "m", ge=0)
     mass: float = _f("Mass in air", "kg", ge=0, default=0.0)
-    buoyancy: float = _f("Upward buoyancy force (weight of displaced water)", "N", ge=0,
-                         default=0.0)
+    buoyancy: float = _f(
+        "Upward buoyancy force (weight of displaced water)", "N", ge=0, default=0.0
+    )
     added_mass: float = _f("Added mass, all directions", "kg", ge=0, default=0.0)
-    drag_area: float = _f("Drag coefficient times projected area, Cd·A", "m²", ge=0,
-                          default=0.0)
+    drag_area: float = _f("Drag coefficient times projected area, Cd·A", "m²", ge=0, default=0.0)
 
 
 class Line(_Doc):
     """A line from end_a (the anchor or lower end) to end_b, of one or more segments."""
 
-    name: str = Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.\-]+$",
-                      description="Unique line name (letters, digits, _ . -)")
+    name: str = Field(
+        min_length=1,
+        max_length=64,
+        pattern=r"^[A-Za-z0-9_.\-]+$",
+        description="Unique line name (letters, digits, _ . -)",
+    )
     end_a: End
     end_b: End
     segments: tuple[Segment, ...] = Field(min_length=1, max_length=1000)
@@ -184,7 +202,7 @@ class Line(_Doc):
         return int(sum(s.elements for s in self.segments))
 
     @model_validator(mode="after")
-    def _check_line(self) -> "Line":
+    def _check_line(self) -> Line:
         total = self.length
         for i, a in enumerate(self.attachments):
             if a.at > total * (1 + 1e-12):

@@ -116,6 +116,7 @@ __all__ = [
     "field_path_and_unit",
 ]
 
+
 class Scene(_Doc):
     """A complete analysis: environment, sea, lines and settings (DESIGN.md v1)."""
 
@@ -123,12 +124,13 @@ class Scene(_Doc):
     environment: Environment
     sea: Sea | None = None
     lines: tuple[Line, ...] = Field(min_length=1, max_length=100)
-    bodies: tuple[Body, ...] = Field(default=(), max_length=100,
-                                     description="Large rigid bodies the lines attach to")
+    bodies: tuple[Body, ...] = Field(
+        default=(), max_length=100, description="Large rigid bodies the lines attach to"
+    )
     analysis: AnalysisSettings = Field(default_factory=AnalysisSettings)
 
     @model_validator(mode="after")
-    def _check_scene(self) -> "Scene":
+    def _check_scene(self) -> Scene:
         names = [ln.name for ln in self.lines]
         dup = {n for n in names if names.count(n) > 1}
         if dup:
@@ -146,13 +148,13 @@ class Scene(_Doc):
                     if e.attach.body not in bodies:
                         raise ValueError(
                             f"lines[{i}].{end}.attach.body = {e.attach.body!r}: no body of "
-                            f"that name; bodies: {bnames}")
+                            f"that name; bodies: {bnames}"
+                        )
                     continue
                 z = e.position[2]
                 if z < -depth * (1 + 1e-9):
                     raise ValueError(
-                        f"lines[{i}].{end}.position z = {z} m is below the seabed "
-                        f"(depth {depth} m)"
+                        f"lines[{i}].{end}.position z = {z} m is below the seabed (depth {depth} m)"
                     )
             if ln.end_a.attach is None:
                 za = ln.end_a.position[2]
@@ -163,8 +165,9 @@ class Scene(_Doc):
                     )
             if ln.end_a.attach is not None or ln.end_b.attach is not None:
                 try:
-                    check_span(self.end_position(ln, "end_a"), self.end_position(ln, "end_b"),
-                                ln.length)
+                    check_span(
+                        self.end_position(ln, "end_a"), self.end_position(ln, "end_b"), ln.length
+                    )
                 except ValueError as exc:
                     raise ValueError(f"lines[{i}]: {exc}") from None
         if self.bodies:
@@ -174,13 +177,15 @@ class Scene(_Doc):
                     raise ValueError(
                         f"bodies[{j}] ({b.name!r}) has 3×3 (surge, heave, pitch) data but "
                         "the scene is not planar (a line, body, sea or current leaves the "
-                        "x–z plane): give 6×6 matrices and a 6-DOF table")
+                        "x–z plane): give 6×6 matrices and a 6-DOF table"
+                    )
                 if planar:
                     bad = [d for d in b.fixed_dofs if d not in PLANAR_BODY_DOFS]
                     if bad:
                         raise ValueError(
                             f"bodies[{j}].fixed_dofs {bad}: the scene is planar, its bodies "
-                            f"have only {list(PLANAR_BODY_DOFS)}")
+                            f"have only {list(PLANAR_BODY_DOFS)}"
+                        )
         return self
 
     @property
@@ -188,16 +193,21 @@ class Scene(_Doc):
         """True when a body's hydrodynamics refers to a file (refused by the service)."""
         return any(isinstance(b.hydrodynamics, BodyHydrodynamicsFile) for b in self.bodies)
 
-    def body(self, name: str) -> "Body":
+    def body(self, name: str) -> Body:
         """The body called ``name``."""
         for b in self.bodies:
             if b.name == name:
                 return b
-        raise InputError("body", name, "-", f"no body of that name; bodies: "
-                         f"{[b.name for b in self.bodies]}")
+        raise InputError(
+            "body", name, "-", f"no body of that name; bodies: {[b.name for b in self.bodies]}"
+        )
 
-    def end_position(self, line: "Line | str", end: Literal["end_a", "end_b"],
-                     poses: Mapping[str, Any] | None = None) -> np.ndarray:
+    def end_position(
+        self,
+        line: Line | str,
+        end: Literal["end_a", "end_b"],
+        poses: Mapping[str, Any] | None = None,
+    ) -> np.ndarray:
         """Position of a line end, shape (3,). [m]
 
         Parameters
@@ -236,7 +246,7 @@ class Scene(_Doc):
             x, rot = pose
         return np.asarray(x, dtype=float) + rotate(np.asarray(rot, dtype=float), r)
 
-    def resolved_line(self, line: "Line", poses: Mapping[str, Any] | None = None) -> "Line":
+    def resolved_line(self, line: Line, poses: Mapping[str, Any] | None = None) -> Line:
         """The line with its attached ends replaced by fixed positions at ``poses``
         (:meth:`end_position`), for the code that needs ``end.position``."""
         upd = {}
@@ -262,7 +272,9 @@ class Scene(_Doc):
                     return False
             for end in (ln.end_a, ln.end_b):
                 m = end.motion
-                if m is not None and (m.sway is not None or (m.rao is not None and m.rao.sway is not None)):
+                if m is not None and (
+                    m.sway is not None or (m.rao is not None and m.rao.sway is not None)
+                ):
                     return False
         if self.sea is not None and abs(math.sin(self.sea.heading_rad)) > tol:
             return False
@@ -303,7 +315,8 @@ def field_path_and_unit(model: type[BaseModel] | None, loc: Sequence[Any]) -> tu
             out += f"[{part}]"
             continue
         tagged = [
-            c for c in candidates
+            c
+            for c in candidates
             if "type" in c.model_fields and c.model_fields["type"].default == part
         ]
         if tagged:
@@ -311,10 +324,13 @@ def field_path_and_unit(model: type[BaseModel] | None, loc: Sequence[Any]) -> tu
             continue
         if isinstance(part, str) and part.startswith("function-"):
             continue
-        if part in ("file", "table") and any(
-                c in (BodyHydrodynamicsFile, BodyHydrodynamics) for c in candidates) \
-                and not any(part in c.model_fields for c in candidates
-                            if c is not BodyHydrodynamicsFile):
+        if (
+            part in ("file", "table")
+            and any(c in (BodyHydrodynamicsFile, BodyHydrodynamics) for c in candidates)
+            and not any(
+                part in c.model_fields for c in candidates if c is not BodyHydrodynamicsFile
+            )
+        ):
             if part == "table":
                 candidates = [BodyHydrodynamics]
                 continue
@@ -346,7 +362,9 @@ _QUOTED_UNIT = re.compile(r"([\d\]] )((?:kg|m|N)(?:[²³]|/m|/s)?)(?![\w/·])")
 
 
 def input_error_from_validation(
-    exc: ValidationError, model: type[BaseModel], prefix: str = "",
+    exc: ValidationError,
+    model: type[BaseModel],
+    prefix: str = "",
     labels: UnitLabels | None = None,
 ) -> InputError:
     """Convert the first error of a pydantic ValidationError into an InputError.
@@ -359,8 +377,7 @@ def input_error_from_validation(
     # pydantic repeats a nested failure at every enclosing tuple ("should have at least
     # 1 item"): keep only errors whose location is not a prefix of another's.
     leaves = [
-        e for e, lc in zip(errors, locs)
-        if not any(o != lc and o[: len(lc)] == lc for o in locs)
+        e for e, lc in zip(errors, locs) if not any(o != lc and o[: len(lc)] == lc for o in locs)
     ] or errors
     err = leaves[0]
     path, unit = field_path_and_unit(model, tuple(err.get("loc", ())))
@@ -371,7 +388,7 @@ def input_error_from_validation(
         path = f"{prefix}.{path}" if path != "scene" else prefix
     msg = str(err.get("msg", "invalid"))
     if msg.startswith("Value error, "):
-        msg = msg[len("Value error, "):]
+        msg = msg[len("Value error, ") :]
     if labels is not None and labels.system != "SI":
         # the validators' own messages quote values with SI symbols ("z = -120 m")
         msg = _QUOTED_UNIT.sub(lambda mt: mt.group(1) + labels.convert(mt.group(2)), msg)
@@ -392,12 +409,14 @@ def rotate(rotation: np.ndarray, r: np.ndarray) -> np.ndarray:
     if th == 0.0:
         return np.array(r, dtype=float)
     k = rotation / th
-    return (r * math.cos(th) + np.cross(k, r) * math.sin(th)
-            + k * float(k @ r) * (1.0 - math.cos(th)))
+    return (
+        r * math.cos(th) + np.cross(k, r) * math.sin(th) + k * float(k @ r) * (1.0 - math.cos(th))
+    )
 
 
-def load_scene(source: Scene | Mapping[str, Any] | str | Path, *,
-               allow_files: bool = True) -> Scene:
+def load_scene(
+    source: Scene | Mapping[str, Any] | str | Path, *, allow_files: bool = True
+) -> Scene:
     """Validate a scene given as a model, a mapping, a JSON string or a path to a file.
 
     Parameters
@@ -429,20 +448,24 @@ def load_scene(source: Scene | Mapping[str, Any] | str | Path, *,
                 text = Path(source).read_text(encoding="utf-8")
                 base = Path(source).resolve().parent
             except OSError as exc:
-                raise InputError("scene", str(source), "-",
-                                 f"cannot be read ({exc.strerror})") from None
+                raise InputError(
+                    "scene", str(source), "-", f"cannot be read ({exc.strerror})"
+                ) from None
         try:
             data = json.loads(text)
         except json.JSONDecodeError as exc:
-            raise InputError("scene", str(source)[:80], "-",
-                             f"is not valid JSON ({exc.msg} at line {exc.lineno})") from None
+            raise InputError(
+                "scene",
+                str(source)[:80],
+                "-",
+                f"is not valid JSON ({exc.msg} at line {exc.lineno})",
+            ) from None
     else:
         data = source
     try:
         scene = Scene.model_validate(data)
     except ValidationError as exc:
-        raise input_error_from_validation(exc, Scene,
-                                          labels=labels_of_document(data)) from None
+        raise input_error_from_validation(exc, Scene, labels=labels_of_document(data)) from None
     return _check_files(scene, allow_files, base)
 
 
@@ -457,8 +480,13 @@ def _check_files(scene: Scene, allow_files: bool, base: Path | None = None) -> S
             continue
         where = f"bodies[{i}].hydrodynamics.file"
         if not allow_files:
-            raise InputError(where, h.file, "-", "files are not accepted here: give the "
-                             "coefficient table inline (docs/BODIES.md JSON table)")
+            raise InputError(
+                where,
+                h.file,
+                "-",
+                "files are not accepted here: give the "
+                "coefficient table inline (docs/BODIES.md JSON table)",
+            )
         p = Path(h.file)
         if not p.is_absolute():
             p = (base if base is not None else Path.cwd()) / p

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -43,21 +43,23 @@ class PiersonMoskowitz(_SpectrumBase):
     type: Literal["pierson_moskowitz"] = "pierson_moskowitz"
     hs: float | None = _f("Significant wave height", "m", ge=1e-6, le=1e4, default=None)
     tp: float | None = _f("Peak period", "s", ge=1e-3, le=1e5, default=None)
-    m0: float | None = _f("Zeroth spectral moment (variance)", "m²", ge=6.25e-14, le=6.25e6, default=None)
-    omega_p: float | None = _f("Peak angular frequency", "rad/s", ge=2 * math.pi * 1e-5, le=2 * math.pi * 1e3, default=None)
+    m0: float | None = _f(
+        "Zeroth spectral moment (variance)", "m²", ge=6.25e-14, le=6.25e6, default=None
+    )
+    omega_p: float | None = _f(
+        "Peak angular frequency", "rad/s", ge=2 * math.pi * 1e-5, le=2 * math.pi * 1e3, default=None
+    )
     wind_speed: float | None = _f("Wind speed at 19.5 m", "m/s", ge=1e-3, le=1e3, default=None)
 
     @model_validator(mode="after")
-    def _one_form(self) -> "PiersonMoskowitz":
+    def _one_form(self) -> PiersonMoskowitz:
         forms = [
             self.hs is not None or self.tp is not None,
             self.m0 is not None or self.omega_p is not None,
             self.wind_speed is not None,
         ]
         if sum(forms) != 1:
-            raise ValueError(
-                "give exactly one of (hs, tp), (m0, omega_p) or wind_speed"
-            )
+            raise ValueError("give exactly one of (hs, tp), (m0, omega_p) or wind_speed")
         if forms[0] and (self.hs is None or self.tp is None):
             raise ValueError("hs and tp must be given together")
         if forms[1] and (self.m0 is None or self.omega_p is None):
@@ -141,13 +143,13 @@ class TableSpectrum(_SpectrumBase):
     """A user table (omega, density), linearly interpolated, zero outside."""
 
     type: Literal["table"] = "table"
-    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing, >= 0", "rad/s",
-                                  min_length=2)
-    density: tuple[float, ...] = _f("Spectral density at omega, >= 0", "unit²·s/rad",
-                                    min_length=2)
+    omega: tuple[float, ...] = _f(
+        "Angular frequencies, strictly increasing, >= 0", "rad/s", min_length=2
+    )
+    density: tuple[float, ...] = _f("Spectral density at omega, >= 0", "unit²·s/rad", min_length=2)
 
     @model_validator(mode="after")
-    def _check_table(self) -> "TableSpectrum":
+    def _check_table(self) -> TableSpectrum:
         if len(self.omega) != len(self.density):
             raise ValueError(
                 f"omega ({len(self.omega)} values) and density ({len(self.density)} values)"
@@ -167,6 +169,6 @@ class TableSpectrum(_SpectrumBase):
 
 
 Spectrum = Annotated[
-    Union[PiersonMoskowitz, Jonswap, Bretschneider, Issc, OchiHubble, TableSpectrum],
+    PiersonMoskowitz | Jonswap | Bretschneider | Issc | OchiHubble | TableSpectrum,
     Field(discriminator="type"),
 ]

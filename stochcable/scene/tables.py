@@ -33,9 +33,16 @@ import numpy as np
 from stochcable.errors import InputError
 from stochcable.validation import float_array, nonnegative
 
-__all__ = ["BODY_DOFS", "PLANAR_BODY_DOFS", "SYMMETRY_TOLERANCE",
-           "NEGATIVE_DAMPING_TOLERANCE", "parse_table", "checked_table", "check_matrices",
-           "array3"]
+__all__ = [
+    "BODY_DOFS",
+    "PLANAR_BODY_DOFS",
+    "SYMMETRY_TOLERANCE",
+    "NEGATIVE_DAMPING_TOLERANCE",
+    "parse_table",
+    "checked_table",
+    "check_matrices",
+    "array3",
+]
 
 #: Rigid-body DOF names (global axes, rotations about the reference point), as
 #: :data:`stochcable.bodies.rigid.SPATIAL_DOFS`; planar scenes use the x–z subset.
@@ -49,8 +56,9 @@ SYMMETRY_TOLERANCE = 2.0e-2
 NEGATIVE_DAMPING_TOLERANCE = 1.0e-6
 
 
-def check_matrices(name: str, a: np.ndarray, omega: np.ndarray, unit: str,
-                    damping: bool, tol: float) -> np.ndarray:
+def check_matrices(
+    name: str, a: np.ndarray, omega: np.ndarray, unit: str, damping: bool, tol: float
+) -> np.ndarray:
     """Symmetry (and non-negative diagonal) per frequency; returns the symmetrized copy."""
     if not np.isfinite(a).all():
         k = int(np.flatnonzero(~np.isfinite(a).reshape(a.shape[0], -1).all(axis=1))[0])
@@ -61,24 +69,32 @@ def check_matrices(name: str, a: np.ndarray, omega: np.ndarray, unit: str,
         rel = np.where(top > 0, asym / np.where(top > 0, top, 1.0), 0.0)
     if (rel > tol).any():
         k = int(np.argmax(rel))
-        raise InputError(name, f"max|A − Aᵀ|/max|A| = {rel[k]:.3g} at omega = {omega[k]:g} rad/s",
-                         unit, f"must be symmetric within {tol:g} of the largest entry")
+        raise InputError(
+            name,
+            f"max|A − Aᵀ|/max|A| = {rel[k]:.3g} at omega = {omega[k]:g} rad/s",
+            unit,
+            f"must be symmetric within {tol:g} of the largest entry",
+        )
     out = 0.5 * (a + np.swapaxes(a, 1, 2))
     if damping:
         diag = np.einsum("wii->wi", out)
         neg = diag < -NEGATIVE_DAMPING_TOLERANCE * np.maximum(top, 1e-300)[:, None]
         if neg.any():
             k, i = (int(v[0]) for v in np.nonzero(neg))
-            raise InputError(name, f"diagonal entry {i} = {diag[k, i]:.6g} at omega = "
-                             f"{omega[k]:g} rad/s", unit,
-                             "must be >= 0 (radiation damping dissipates energy)")
+            raise InputError(
+                name,
+                f"diagonal entry {i} = {diag[k, i]:.6g} at omega = {omega[k]:g} rad/s",
+                unit,
+                "must be >= 0 (radiation damping dissipates energy)",
+            )
         idx = np.arange(out.shape[1])
         out[:, idx, idx] = np.maximum(diag, 0.0)
     return out
 
 
-def checked_table(dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source,
-                  tol) -> dict[str, Any]:
+def checked_table(
+    dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source, tol
+) -> dict[str, Any]:
     """The checked coefficient arrays of a table (shapes, symmetry within ``tol``,
     non-negative damping diagonal, matrices symmetrized), as the fields of
     :class:`stochcable.bodies.data.Hydrodynamics` by name."""
@@ -90,9 +106,13 @@ def checked_table(dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source,
         if a.ndim != 3 or a.shape[1:] != (d, d):
             raise InputError(name, a.shape, unit, f"must have shape (n_omega, {d}, {d})")
         if a.shape[0] != w.size:
-            raise InputError(name, a.shape, unit,
-                             f"has {a.shape[0]} frequencies but omega has {w.size}: give one "
-                             "matrix per frequency")
+            raise InputError(
+                name,
+                a.shape,
+                unit,
+                f"has {a.shape[0]} frequencies but omega has {w.size}: give one "
+                "matrix per frequency",
+            )
     am = check_matrices("added_mass", am, w, "kg", False, tol)
     bd = check_matrices("radiation_damping", bd, w, "N·s/m", True, tol)
     h = None
@@ -102,8 +122,12 @@ def checked_table(dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source,
         h = float_array("excitation.heading", heading, "rad", increasing=True)
         exc = np.asarray(exc, dtype=complex)
         if exc.shape != (h.size, d, w.size):
-            raise InputError("excitation", exc.shape, "N/m",
-                             f"must have shape (n_heading={h.size}, {d}, n_omega={w.size})")
+            raise InputError(
+                "excitation",
+                exc.shape,
+                "N/m",
+                f"must have shape (n_heading={h.size}, {d}, n_omega={w.size})",
+            )
         if not np.isfinite(exc).all():
             raise InputError("excitation", "non-finite", "N/m", "must be finite")
     if hs is not None:
@@ -113,11 +137,18 @@ def checked_table(dofs, omega, am, bd, heading, exc, hs, ref, exc_point, source,
     ref = np.zeros(3) if ref is None else float_array("reference_point", ref, "m")
     if ref.shape != (3,):
         raise InputError("reference_point", ref.shape, "m", "must be (x, y, z)")
-    return {"dofs": tuple(dofs), "omega": w.copy(), "added_mass": am,
-            "radiation_damping": bd, "heading": h, "excitation": exc,
-            "hydrostatic_stiffness": hs, "reference_point": ref.copy(),
-            "excitation_point": np.asarray(exc_point, dtype=float).copy(),
-            "source": source}
+    return {
+        "dofs": tuple(dofs),
+        "omega": w.copy(),
+        "added_mass": am,
+        "radiation_damping": bd,
+        "heading": h,
+        "excitation": exc,
+        "hydrostatic_stiffness": hs,
+        "reference_point": ref.copy(),
+        "excitation_point": np.asarray(exc_point, dtype=float).copy(),
+        "source": source,
+    }
 
 
 def parse_table(
@@ -162,19 +193,29 @@ def parse_table(
         try:
             doc = json.loads(text)
         except json.JSONDecodeError as exc:
-            raise InputError("source", name, "-", f"is not valid JSON ({exc.msg} at line "
-                             f"{exc.lineno})") from None
+            raise InputError(
+                "source", name, "-", f"is not valid JSON ({exc.msg} at line {exc.lineno})"
+            ) from None
     if not isinstance(doc, Mapping):
         raise InputError("source", type(doc).__name__, "-", "must be a JSON object")
-    known = {"dofs", "omega", "added_mass", "radiation_damping", "excitation",
-             "hydrostatic_stiffness", "reference_point", "title"}
+    known = {
+        "dofs",
+        "omega",
+        "added_mass",
+        "radiation_damping",
+        "excitation",
+        "hydrostatic_stiffness",
+        "reference_point",
+        "title",
+    }
     extra = sorted(set(doc) - known)
     if extra:
         raise InputError("source", extra, "-", f"unknown keys; allowed: {sorted(known)}")
     dofs = tuple(str(d).lower() for d in doc.get("dofs", BODY_DOFS))
     if dofs not in (tuple(BODY_DOFS), tuple(PLANAR_BODY_DOFS)):
-        raise InputError("dofs", list(dofs), "-",
-                         f"must be {list(BODY_DOFS)} or {list(PLANAR_BODY_DOFS)}")
+        raise InputError(
+            "dofs", list(dofs), "-", f"must be {list(BODY_DOFS)} or {list(PLANAR_BODY_DOFS)}"
+        )
     for req in ("omega", "added_mass", "radiation_damping"):
         if req not in doc:
             raise InputError(req, None, "-", "is missing from the table")
@@ -183,14 +224,20 @@ def parse_table(
     bd = array3("radiation_damping", doc["radiation_damping"], "N·s/m")
     for nm, a in (("added_mass", am), ("radiation_damping", bd)):
         if a.shape[0] != w.size:
-            raise InputError(nm, a.shape, "-", f"has {a.shape[0]} frequencies but omega has "
-                             f"{w.size}: give one matrix per frequency")
+            raise InputError(
+                nm,
+                a.shape,
+                "-",
+                f"has {a.shape[0]} frequencies but omega has "
+                f"{w.size}: give one matrix per frequency",
+            )
     heading = exc = None
     if doc.get("excitation") is not None:
         e = doc["excitation"]
         if not isinstance(e, Mapping):
-            raise InputError("excitation", type(e).__name__, "-",
-                             "must be an object with heading, re, im")
+            raise InputError(
+                "excitation", type(e).__name__, "-", "must be an object with heading, re, im"
+            )
         for req in ("heading", "re", "im"):
             if req not in e:
                 raise InputError(f"excitation.{req}", None, "-", "is missing from the table")
@@ -201,19 +248,37 @@ def parse_table(
         re = array3("excitation.re", e["re"], "N/m")
         im = array3("excitation.im", e["im"], "N/m")
         if re.shape != im.shape:
-            raise InputError("excitation.im", im.shape, "N/m",
-                             f"must have the shape of excitation.re {re.shape}")
+            raise InputError(
+                "excitation.im", im.shape, "N/m", f"must have the shape of excitation.re {re.shape}"
+            )
         if re.shape[0] != heading.size:
-            raise InputError("excitation.re", re.shape, "N/m",
-                             f"has {re.shape[0]} headings but excitation.heading has "
-                             f"{heading.size}")
+            raise InputError(
+                "excitation.re",
+                re.shape,
+                "N/m",
+                f"has {re.shape[0]} headings but excitation.heading has {heading.size}",
+            )
         if re.shape[2] != w.size:
-            raise InputError("excitation.re", re.shape, "N/m",
-                             f"has {re.shape[2]} frequencies but omega has {w.size}")
+            raise InputError(
+                "excitation.re",
+                re.shape,
+                "N/m",
+                f"has {re.shape[2]} frequencies but omega has {w.size}",
+            )
         exc = re + 1j * im
-    return checked_table(dofs, w, am, bd, heading, exc, doc.get("hydrostatic_stiffness"),
-                  doc.get("reference_point"), np.zeros(2), f"table:{name}",
-                  nonnegative("symmetry_tolerance", symmetry_tolerance, "-"))
+    return checked_table(
+        dofs,
+        w,
+        am,
+        bd,
+        heading,
+        exc,
+        doc.get("hydrostatic_stiffness"),
+        doc.get("reference_point"),
+        np.zeros(2),
+        f"table:{name}",
+        nonnegative("symmetry_tolerance", symmetry_tolerance, "-"),
+    )
 
 
 def array3(name: str, value: Any, unit: str) -> np.ndarray:
@@ -221,8 +286,9 @@ def array3(name: str, value: Any, unit: str) -> np.ndarray:
     try:
         a = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise InputError(name, "ragged or non-numeric", unit,
-                         "must be a regular 3-D array of numbers") from None
+        raise InputError(
+            name, "ragged or non-numeric", unit, "must be a regular 3-D array of numbers"
+        ) from None
     if a.ndim != 3:
         raise InputError(name, a.shape, unit, f"must be a 3-D array (got {a.ndim}-D)")
     return a

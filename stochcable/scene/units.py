@@ -80,14 +80,23 @@ class UnitLabels:
         """
         if self.system == "SI" or not unit:
             return unit
-        table = {"m": self.length, "kg": self.mass, "N": self.force,
-                 "Pa": f"({self.force}/{self.length}²)"}
+        table = {
+            "m": self.length,
+            "kg": self.mass,
+            "N": self.force,
+            "Pa": f"({self.force}/{self.length}²)",
+        }
         return _SI_SYMBOL.sub(lambda mt: table[mt.group(0)], unit)
 
     def as_dict(self) -> dict[str, str]:
         """The labels as a JSON-ready mapping."""
-        return {"system": self.system, "length": self.length, "mass": self.mass,
-                "force": self.force, "time": self.time}
+        return {
+            "system": self.system,
+            "length": self.length,
+            "mass": self.mass,
+            "force": self.force,
+            "time": self.time,
+        }
 
 
 #: Whole SI symbols in a unit label (not the "m" of "mm" or of a word).

@@ -37,8 +37,16 @@ try:  # pragma: no cover - exercised through monkeypatching in tests
 except ImportError:  # pragma: no cover
     _pyfftw = None
 
-__all__ = ["rfft", "irfft", "irfft_input", "irfft_overwrite", "backend", "clear_cache",
-           "wisdom_path", "tune"]
+__all__ = [
+    "rfft",
+    "irfft",
+    "irfft_input",
+    "irfft_overwrite",
+    "backend",
+    "clear_cache",
+    "wisdom_path",
+    "tune",
+]
 
 _MAX_PLANS = 16
 _THREAD_MIN_SIZE = 2**15
@@ -47,7 +55,7 @@ _EFFORT = os.environ.get("STOCHCABLE_FFTW_EFFORT", "FFTW_ESTIMATE")
 _WISDOM_ENV = "STOCHCABLE_FFTW_WISDOM"
 _wisdom_loaded = False
 
-_cache: OrderedDict[tuple, "_Plan"] = OrderedDict()
+_cache: OrderedDict[tuple, _Plan] = OrderedDict()
 _cache_lock = threading.Lock()
 
 
@@ -80,7 +88,7 @@ def _load_wisdom() -> None:
     except OSError:
         return
     if data:
-        _pyfftw.import_wisdom((data, b"", b""))   # FFTW ignores what it cannot parse
+        _pyfftw.import_wisdom((data, b"", b""))  # FFTW ignores what it cannot parse
 
 
 def _save_wisdom() -> str | None:
@@ -92,7 +100,7 @@ def _save_wisdom() -> str | None:
     tmp = f"{path}.{os.getpid()}.{threading.get_ident()}.tmp"
     with open(tmp, "wb") as f:
         f.write(_pyfftw.export_wisdom()[0])
-    os.replace(tmp, path)                          # readers never see a partial file
+    os.replace(tmp, path)  # readers never see a partial file
     return path
 
 
@@ -112,8 +120,9 @@ class _Plan:
 
     __slots__ = ("fftw", "inp", "out_shape", "out_dtype", "lock", "scale")
 
-    def __init__(self, in_shape: tuple[int, ...], n: int, inverse: bool,
-                 effort: str | None = None) -> None:
+    def __init__(
+        self, in_shape: tuple[int, ...], n: int, inverse: bool, effort: str | None = None
+    ) -> None:
         if inverse:
             in_dtype, out_dtype = "complex128", "float64"
             out_shape = in_shape[:-1] + (n,)
@@ -167,8 +176,8 @@ def _plan(in_shape: tuple[int, ...], n: int, inverse: bool) -> _Plan:
         plan = _Plan(in_shape, n, inverse)
         if _EFFORT != "FFTW_ESTIMATE":
             try:
-                _save_wisdom()                     # a measured plan: keep it for next time
-            except OSError:                        # no writable cache: the plan still works
+                _save_wisdom()  # a measured plan: keep it for next time
+            except OSError:  # no writable cache: the plan still works
                 pass
         _cache[key] = plan
         while len(_cache) > _MAX_PLANS:
@@ -199,8 +208,9 @@ def tune(n_samples: int | list[int], effort: str = "FFTW_MEASURE") -> str | None
         n_samples = [n_samples]
     sizes = [v.positive_int("n_samples", n, minimum=2) for n in n_samples]
     if effort not in ("FFTW_MEASURE", "FFTW_PATIENT", "FFTW_EXHAUSTIVE"):
-        raise InputError("effort", effort, "-",
-                         "must be 'FFTW_MEASURE', 'FFTW_PATIENT' or 'FFTW_EXHAUSTIVE'")
+        raise InputError(
+            "effort", effort, "-", "must be 'FFTW_MEASURE', 'FFTW_PATIENT' or 'FFTW_EXHAUSTIVE'"
+        )
     if _pyfftw is None:
         return None
     with _cache_lock:

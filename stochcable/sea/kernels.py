@@ -31,8 +31,8 @@ from numba.extending import intrinsic
 
 __all__ = ["phasor_chunk", "CACHED"]
 
-_TABLE_SIZE = 8192.0                    # = sea._TABLE_SIZE (2^13 entries)
-_DELTA = 2.0 * math.pi / 8192           # the same constant as sea._phasor_chunk's
+_TABLE_SIZE = 8192.0  # = sea._TABLE_SIZE (2^13 entries)
+_DELTA = 2.0 * math.pi / 8192  # the same constant as sea._phasor_chunk's
 _COS4 = 1.0 / 24.0
 _SIN3 = -1.0 / 6.0
 
@@ -60,9 +60,14 @@ def _phasor_chunk(u, s, c2, alpha, beta, table, out, fft_in, scale, jbuf):  # no
     second (scalar: the table gather does not vectorize) forms T[j]·(amp·e^{iδ}).
     """
     n = u.shape[0]
-    if (jbuf.shape[0] < n or s.shape[0] != n or out.shape[0] != n or fft_in.shape[0] != n
-            or (alpha.shape[0] != 0 and (alpha.shape[0] != n or beta.shape[0] != n))):
-        raise ValueError("phasor_chunk: inconsistent array sizes")   # no bounds checks below
+    if (
+        jbuf.shape[0] < n
+        or s.shape[0] != n
+        or out.shape[0] != n
+        or fft_in.shape[0] != n
+        or (alpha.shape[0] != 0 and (alpha.shape[0] != n or beta.shape[0] != n))
+    ):
+        raise ValueError("phasor_chunk: inconsistent array sizes")  # no bounds checks below
     if alpha.shape[0] == 0:
         for i in range(n):
             x = u[i] * _TABLE_SIZE
@@ -71,8 +76,7 @@ def _phasor_chunk(u, s, c2, alpha, beta, table, out, fft_in, scale, jbuf):  # no
             x = (x - w) * _DELTA
             d2 = x * x
             amp = math.sqrt(s[i] * c2)
-            out[i] = complex(((d2 * _COS4 - 0.5) * d2 + 1.0) * amp,
-                             ((d2 * _SIN3 + 1.0) * x) * amp)
+            out[i] = complex(((d2 * _COS4 - 0.5) * d2 + 1.0) * amp, ((d2 * _SIN3 + 1.0) * x) * amp)
     else:
         for i in range(n):
             x = u[i] * _TABLE_SIZE
@@ -81,8 +85,7 @@ def _phasor_chunk(u, s, c2, alpha, beta, table, out, fft_in, scale, jbuf):  # no
             x = (x - w) * _DELTA
             d2 = x * x
             amp = math.sqrt(s[i] * c2) * np.hypot(alpha[i], beta[i])
-            out[i] = complex(((d2 * _COS4 - 0.5) * d2 + 1.0) * amp,
-                             ((d2 * _SIN3 + 1.0) * x) * amp)
+            out[i] = complex(((d2 * _COS4 - 0.5) * d2 + 1.0) * amp, ((d2 * _SIN3 + 1.0) * x) * amp)
     for i in range(n):
         t = table[int(jbuf[i])]
         e = out[i]
@@ -92,7 +95,7 @@ def _phasor_chunk(u, s, c2, alpha, beta, table, out, fft_in, scale, jbuf):  # no
         fft_in[i] = complex(re * scale, im * scale)
 
 
-_RO = types.Array(types.float64, 1, "C", readonly=True)       # accepts writable arrays too
+_RO = types.Array(types.float64, 1, "C", readonly=True)  # accepts writable arrays too
 _RW = types.Array(types.float64, 1, "C")
 _TAB = types.Array(types.complex128, 1, "C", readonly=True)
 _OUT = types.Array(types.complex128, 1, "C")
@@ -107,10 +110,13 @@ def _compile():  # noqa: ANN202
     except RuntimeError as exc:  # "cannot cache function ...: no locator available ..."
         if "cache" not in str(exc):
             raise
-        warnings.warn(f"stochcable: no writable numba cache directory ({exc}); the sea "
-                      "kernel is compiled in memory in each process (~1 s at its first "
-                      "use); set NUMBA_CACHE_DIR to a writable directory to keep it",
-                      UserWarning, stacklevel=3)
+        warnings.warn(
+            f"stochcable: no writable numba cache directory ({exc}); the sea "
+            "kernel is compiled in memory in each process (~1 s at its first "
+            "use); set NUMBA_CACHE_DIR to a writable directory to keep it",
+            UserWarning,
+            stacklevel=3,
+        )
         return numba.njit(_SIGNATURE, nogil=True)(_phasor_chunk), False
 
 

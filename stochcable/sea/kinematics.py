@@ -61,7 +61,7 @@ def _solve_kh(x: np.ndarray) -> np.ndarray:
         np.subtract(1.0, fp, out=fp)
         fp *= y
         fp += t
-        np.divide(f, fp, out=f)       # Newton step
+        np.divide(f, fp, out=f)  # Newton step
         y -= f
         np.divide(f, y, out=f)
         if np.abs(f).max() < _NEWTON_TOL:
@@ -113,7 +113,7 @@ def _wavenumber(w: np.ndarray, h: float, g: float) -> np.ndarray:
     k /= g
     if math.isinf(h):
         return k
-    x = k * h                                  # ω² h / g
+    x = k * h  # ω² h / g
     pos = x > 0.0
     if pos.all():
         return _solve_kh(x) / h
@@ -159,18 +159,20 @@ class WaveKinematics:
     pressure: np.ndarray
 
 
-def _depth_ratios(k: np.ndarray, z: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _depth_ratios(
+    k: np.ndarray, z: np.ndarray, h: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """cosh k(z+h)/sinh kh, sinh k(z+h)/sinh kh, cosh k(z+h)/cosh kh for z <= 0.
 
     Exponential forms (never overflow): with E = e^{kz}, a = e^{−2k(z+h)}, b = e^{−2kh},
     ch = E(1 + a)/(1 − b), sh = E(1 − a)/(1 − b), cc = E(1 + a)/(1 + b), with
     1 − a and 1 − b by expm1 (shallow water).  Shapes (n_points, n_omega).
     """
-    kz = np.multiply.outer(z, k)               # (P, W), kz <= 0
+    kz = np.multiply.outer(z, k)  # (P, W), kz <= 0
     e = np.exp(kz)
     if math.isinf(h):
         return e, e.copy(), e.copy()
-    kzh = np.multiply.outer(z + h, k)          # k(z+h) >= 0
+    kzh = np.multiply.outer(z + h, k)  # k(z+h) >= 0
     a = np.exp(-2.0 * kzh)
     one_minus_a = -np.expm1(-2.0 * kzh)
     one_minus_b = -np.expm1(-2.0 * k * h)
@@ -182,15 +184,16 @@ def _depth_ratios(k: np.ndarray, z: np.ndarray, h: float) -> tuple[np.ndarray, n
     return ch, sh, cc
 
 
-def _nodal_kinematics(w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float,
-                      h: float, g: float) -> tuple[np.ndarray, ...]:
+def _nodal_kinematics(
+    w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float, h: float, g: float
+) -> tuple[np.ndarray, ...]:
     """:func:`wave_kinematics` without validation or pressure (validated frequencies,
     their wavenumbers k, points): the elevation phase (P, W), cosh k(z+h)/cosh kh
     (P, W), the dry points (P,), the velocity and the acceleration (P, 3, W)."""
     cb, sb = math.cos(beta), math.sin(beta)
     z = pts[:, 2]
     xi = pts[:, 0] * cb + pts[:, 1] * sb
-    phase = np.exp(-1j * np.multiply.outer(xi, k))          # (P, W)
+    phase = np.exp(-1j * np.multiply.outer(xi, k))  # (P, W)
     wet = z <= 0.0
     zc = np.minimum(z, 0.0)
     ch, sh, cc = _depth_ratios(k, zc, h)
@@ -263,8 +266,9 @@ def wave_kinematics(
     z = pts[:, 2]
     if not math.isinf(h) and (z < -h).any():
         i = int(np.flatnonzero(z < -h)[0])
-        raise InputError("points", points, "m",
-                         f"z must be >= -depth = {-h:g} (point {i} has z = {z[i]:g})")
+        raise InputError(
+            "points", points, "m", f"z must be >= -depth = {-h:g} (point {i} has z = {z[i]:g})"
+        )
 
     k = _wavenumber(w, h, g)
     phase, cc, dry, vel, acc = _nodal_kinematics(w, k, pts, beta, h, g)
@@ -273,8 +277,15 @@ def wave_kinematics(
     for a in (w, k, pts, phase, vel, acc, pressure):
         a.setflags(write=False)
     return WaveKinematics(
-        omega=w, wavenumber=k, points=pts, heading=beta, depth=h,
-        elevation=phase, velocity=vel, acceleration=acc, pressure=pressure,
+        omega=w,
+        wavenumber=k,
+        points=pts,
+        heading=beta,
+        depth=h,
+        elevation=phase,
+        velocity=vel,
+        acceleration=acc,
+        pressure=pressure,
     )
 
 

@@ -34,9 +34,9 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike
 
-from stochcable.sea import fft as _fft
 from stochcable import validation as v
 from stochcable.errors import InputError, ResolutionWarning, warn
+from stochcable.sea import fft as _fft
 
 __all__ = [
     "frequency_grid",
@@ -52,16 +52,16 @@ NYQUIST_LOSS_TOLERANCE = 1e-3
 
 _TABLE_BITS = 13
 _TABLE_SIZE = 1 << _TABLE_BITS
-_TABLE = -np.exp(2j * np.pi * np.arange(_TABLE_SIZE) / _TABLE_SIZE)   # −e^{2πij/2^13}
+_TABLE = -np.exp(2j * np.pi * np.arange(_TABLE_SIZE) / _TABLE_SIZE)  # −e^{2πij/2^13}
 _CHUNK = 32768
 _PARALLEL_MIN = 2**16
 _SPECTRUM_PIECES = 8
 _GRID_CACHE_SIZE = 4
-_COMPILED_MIN = 2**16                    # lines from which the numba kernel is used
+_COMPILED_MIN = 2**16  # lines from which the numba kernel is used
 _NUMBA_ENV = "STOCHCABLE_NUMBA"
 _pool = None
 _pool_lock = threading.Lock()
-_compiled_state: list = []               # [kernel or None] once the import was tried
+_compiled_state: list = []  # [kernel or None] once the import was tried
 _compiled_lock = threading.Lock()
 
 
@@ -74,12 +74,13 @@ def _executor():
         if _pool is None:
             from concurrent.futures import ThreadPoolExecutor
 
-            _pool = ThreadPoolExecutor(max_workers=os.cpu_count() or 1,
-                                       thread_name_prefix="stochcable-sea")
+            _pool = ThreadPoolExecutor(
+                max_workers=os.cpu_count() or 1, thread_name_prefix="stochcable-sea"
+            )
         return _pool
 
 
-_cpus: list = [None, 1]                  # [os.cpu_count as last called, its value]
+_cpus: list = [None, 1]  # [os.cpu_count as last called, its value]
 
 
 def _cpu_count() -> int:
@@ -112,15 +113,19 @@ def _compiled_kernel() -> Callable | None:
             try:
                 from stochcable.sea import kernels as _kernels
 
-                kernel = _kernels.phasor_chunk     # compiled (or loaded) at import
-            except ImportError:          # numba not installed (or not for this numpy)
+                kernel = _kernels.phasor_chunk  # compiled (or loaded) at import
+            except ImportError:  # numba not installed (or not for this numpy)
                 kernel = None
             except Exception as exc:  # noqa: BLE001 - any numba/LLVM failure: fall back
                 import warnings
 
-                warnings.warn(f"stochcable: the compiled sea kernel is unavailable ({exc!r}); "
-                              f"using the NumPy kernel (same results, slower; set "
-                              f"{_NUMBA_ENV}=0 to skip numba)", UserWarning, stacklevel=3)
+                warnings.warn(
+                    f"stochcable: the compiled sea kernel is unavailable ({exc!r}); "
+                    f"using the NumPy kernel (same results, slower; set "
+                    f"{_NUMBA_ENV}=0 to skip numba)",
+                    UserWarning,
+                    stacklevel=3,
+                )
                 kernel = None
             _compiled_state.append(kernel)
     return _compiled_state[0]
@@ -154,11 +159,19 @@ def _sample_count(duration: float, dt: float) -> int:
     ratio = duration / dt
     n_t = round(ratio)
     if abs(ratio - n_t) > 1e-9 * max(ratio, 1.0):
-        raise InputError("duration", duration, "s",
-                         f"duration/dt = {ratio:.10g} must be an even integer number of samples (dt = {dt:g} s)")
+        raise InputError(
+            "duration",
+            duration,
+            "s",
+            f"duration/dt = {ratio:.10g} must be an even integer number of samples (dt = {dt:g} s)",
+        )
     if n_t < 2 or n_t % 2:
-        raise InputError("duration", duration, "s",
-                         f"duration/dt = {n_t} samples must be an even integer >= 2 (dt = {dt:g} s)")
+        raise InputError(
+            "duration",
+            duration,
+            "s",
+            f"duration/dt = {n_t} samples must be an even integer >= 2 (dt = {dt:g} s)",
+        )
     return int(n_t)
 
 
@@ -274,7 +287,7 @@ def _work_arrays(n_t: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     page-fault 16 MiB of fresh memory in, call after call.  A call owns its set until
     it gives it back; concurrent calls get different sets.
     """
-    key = (n_t, _fft.backend())          # the FFT input must suit the backend's alignment
+    key = (n_t, _fft.backend())  # the FFT input must suit the backend's alignment
     with _work_lock:
         for i in range(len(_work_pool) - 1, -1, -1):
             if _work_pool[i][0] == key:
@@ -287,8 +300,10 @@ def _give_back(n_t: int, arrays: tuple[np.ndarray, np.ndarray, np.ndarray]) -> N
     """Keep a call's work arrays for reuse (the 8 most recent sets, ≤ 64 MiB in all)."""
     with _work_lock:
         _work_pool.append(((n_t, _fft.backend()), arrays))
-        while (len(_work_pool) > 8
-               or sum(a.nbytes for _, arrs in _work_pool for a in arrs) > _WORK_POOL_BYTES):
+        while (
+            len(_work_pool) > 8
+            or sum(a.nbytes for _, arrs in _work_pool for a in arrs) > _WORK_POOL_BYTES
+        ):
             _work_pool.pop(0)
 
 
@@ -296,14 +311,24 @@ def _buffers(size: int) -> list[np.ndarray]:
     """Per-thread scratch arrays of the coefficient kernel (kept between calls)."""
     bufs = getattr(_scratch, "bufs", None)
     if bufs is None or bufs[0].shape[0] < size:
-        bufs = ([np.empty(size) for _ in range(5)] + [np.empty(size, dtype=np.intp)]
-                + [np.empty(size, dtype=np.complex128) for _ in range(2)])
+        bufs = (
+            [np.empty(size) for _ in range(5)]
+            + [np.empty(size, dtype=np.intp)]
+            + [np.empty(size, dtype=np.complex128) for _ in range(2)]
+        )
         _scratch.bufs = bufs
     return bufs
 
 
-def _phasor_chunk(u: np.ndarray, s: np.ndarray, c2: float, out: np.ndarray,
-                  gain: np.ndarray | None, fft_in: np.ndarray, scale: float) -> None:
+def _phasor_chunk(
+    u: np.ndarray,
+    s: np.ndarray,
+    c2: float,
+    out: np.ndarray,
+    gain: np.ndarray | None,
+    fft_in: np.ndarray,
+    scale: float,
+) -> None:
     """out = a·e^{−iθ}, a = √(c2·S) (× gain), θ = π − 2πu, without calling cos/sin;
     fft_in = out·scale (the FFT's work array, filled while the chunk is in cache).
 
@@ -320,8 +345,8 @@ def _phasor_chunk(u: np.ndarray, s: np.ndarray, c2: float, out: np.ndarray,
     np.floor(x_, out=w_)
     np.copyto(j_, w_, casting="unsafe")
     np.subtract(x_, w_, out=x_)
-    x_ *= 2.0 * math.pi / _TABLE_SIZE     # δ
-    np.multiply(x_, x_, out=d2_)          # δ²
+    x_ *= 2.0 * math.pi / _TABLE_SIZE  # δ
+    np.multiply(x_, x_, out=d2_)  # δ²
     np.multiply(s, c2, out=amp)
     np.sqrt(amp, out=amp)
     if gain is not None:
@@ -336,7 +361,7 @@ def _phasor_chunk(u: np.ndarray, s: np.ndarray, c2: float, out: np.ndarray,
     c_ += 1.0
     c_ *= x_
     np.multiply(c_, amp, out=ev[1::2])
-    np.take(_TABLE, j_, out=t, mode="wrap")   # 0 <= j < 8192: no wrap; "wrap" skips the checks
+    np.take(_TABLE, j_, out=t, mode="wrap")  # 0 <= j < 8192: no wrap; "wrap" skips the checks
     np.multiply(t, e, out=out)
     np.multiply(out.view(np.float64), scale, out=fft_in.view(np.float64))
 
@@ -363,24 +388,34 @@ class _Synthesis:
     the end of the kernel work, and the caller validates S while the helper finishes.
     """
 
-    def __init__(self, gen: np.random.Generator | int, lines: int, nsa: bool,
-                 coeff: np.ndarray, fft_in: np.ndarray, scale: float,
-                 density: Callable | None = None, omega: np.ndarray | None = None,
-                 pieces: int = 1, u: np.ndarray | None = None,
-                 s_grid: np.ndarray | None = None, kernel: Callable | None = None,
-                 c2: float = 0.0) -> None:
+    def __init__(
+        self,
+        gen: np.random.Generator | int,
+        lines: int,
+        nsa: bool,
+        coeff: np.ndarray,
+        fft_in: np.ndarray,
+        scale: float,
+        density: Callable | None = None,
+        omega: np.ndarray | None = None,
+        pieces: int = 1,
+        u: np.ndarray | None = None,
+        s_grid: np.ndarray | None = None,
+        kernel: Callable | None = None,
+        c2: float = 0.0,
+    ) -> None:
         self.gen, self.lines, self.nsa = gen, lines, nsa
-        self.kernel = kernel                     # compiled kernel, or None for NumPy's
+        self.kernel = kernel  # compiled kernel, or None for NumPy's
         # pipelined: S piece -> kernel on its lines, same thread (compiled kernel only)
         self.pipelined = kernel is not None and density is not None and omega is not None
-        self.drawn = threading.Event()           # set once every draw is made
-        self._deferred: list[tuple[int, int]] = []   # line ranges waiting for the draws
+        self.drawn = threading.Event()  # set once every draw is made
+        self._deferred: list[tuple[int, int]] = []  # line ranges waiting for the draws
         self.coeff, self.fft_in, self.scale = coeff, fft_in, scale
         self.u = np.empty(lines) if u is None else u
-        self.gain: np.ndarray | None = None      # NSA: √(α² + β²) (NumPy kernel)
-        self.alpha = self.beta = np.empty(0)     # NSA: α, β (compiled kernel: fused hypot)
-        self.s: np.ndarray | None = None         # S(ω_m), m = 1 … N−1
-        self.c2 = c2                             # a_m N_t/2 = √(c2 S(ω_m))
+        self.gain: np.ndarray | None = None  # NSA: √(α² + β²) (NumPy kernel)
+        self.alpha = self.beta = np.empty(0)  # NSA: α, β (compiled kernel: fused hypot)
+        self.s: np.ndarray | None = None  # S(ω_m), m = 1 … N−1
+        self.c2 = c2  # a_m N_t/2 = √(c2 S(ω_m))
         self.edges = list(range(0, lines, _CHUNK)) + [lines]
         self._next = itertools.count()
         self._draw_lock = threading.Lock()
@@ -389,7 +424,7 @@ class _Synthesis:
         # caller's set-up; seeding costs 0.05–0.2 ms with cold caches) and is private
         self._state = gen.bit_generator.state if isinstance(gen, np.random.Generator) else None
         self.cancelled = False
-        self.ready = threading.Event()           # set once s and c2 are final
+        self.ready = threading.Event()  # set once s and c2 are final
         # S(ω) on the whole grid, evaluated piece by piece (see spectrum())
         self.density, self.omega = density, omega
         size = 0 if density is None or omega is None else omega.shape[0]
@@ -398,10 +433,10 @@ class _Synthesis:
         self._next_piece = itertools.count()
         self._pieces_done = 0
         self.piece_failed = False
-        self.piece_min = math.inf                # min over the pieces (NaN if one has a NaN)
-        self.s_ready = threading.Event()         # set once every piece is done
+        self.piece_min = math.inf  # min over the pieces (NaN if one has a NaN)
+        self.s_ready = threading.Event()  # set once every piece is done
         self._piece_lock = threading.Lock()
-        self.errstate = np.geterr()              # the caller's floating-point error modes
+        self.errstate = np.geterr()  # the caller's floating-point error modes
 
     def spectrum(self) -> None:
         """Evaluate S on grid pieces from a shared counter until none is left.
@@ -423,7 +458,7 @@ class _Synthesis:
                         if si.shape == (b - a,):
                             self.s_grid[a:b] = si
                             lo = float(si.min()) if b > a else math.inf
-                            with self._piece_lock:        # NaN wins (fails every check)
+                            with self._piece_lock:  # NaN wins (fails every check)
                                 if not (math.isnan(self.piece_min) or lo >= self.piece_min):
                                     self.piece_min = lo
                         else:
@@ -445,8 +480,9 @@ class _Synthesis:
                             # queued chunk by chunk: the two threads then finish
                             # the kernel within one chunk (≈ 0.15 ms) of each other
                             with self._piece_lock:
-                                self._deferred.extend((c, min(c + _CHUNK, lb))
-                                                      for c in range(la, lb, _CHUNK))
+                                self._deferred.extend(
+                                    (c, min(c + _CHUNK, lb)) for c in range(la, lb, _CHUNK)
+                                )
 
     def _kernel_lines(self, a: int, b: int) -> None:
         """Compiled kernel on lines [a, b) with S from ``s_grid``, in _CHUNK sub-chunks."""
@@ -456,9 +492,18 @@ class _Synthesis:
         jbuf = _buffers(_CHUNK)[0]
         for c in range(a, b, _CHUNK):
             d = min(c + _CHUNK, b)
-            kernel(u[c:d], s[c + 1:d + 1], c2, alpha[c:d] if nsa else alpha,
-                   beta[c:d] if nsa else beta, _TABLE, coeff[c:d], fft_in[c:d],
-                   self.scale, jbuf)
+            kernel(
+                u[c:d],
+                s[c + 1 : d + 1],
+                c2,
+                alpha[c:d] if nsa else alpha,
+                beta[c:d] if nsa else beta,
+                _TABLE,
+                coeff[c:d],
+                fft_in[c:d],
+                self.scale,
+                jbuf,
+            )
 
     def drain(self) -> None:
         """Run the kernel on the queued pieces (the draws must be done)."""
@@ -524,8 +569,18 @@ class _Synthesis:
                 if i >= last:
                     return
                 a, b = edges[i], edges[i + 1]
-                kernel(u[a:b], s[a:b], c2, alpha[a:b] if nsa else alpha,
-                       beta[a:b] if nsa else beta, _TABLE, coeff[a:b], fft_in[a:b], scale, jbuf)
+                kernel(
+                    u[a:b],
+                    s[a:b],
+                    c2,
+                    alpha[a:b] if nsa else alpha,
+                    beta[a:b] if nsa else beta,
+                    _TABLE,
+                    coeff[a:b],
+                    fft_in[a:b],
+                    scale,
+                    jbuf,
+                )
             return
         # the caller's thread validates S while a helper may already run the kernel:
         # on invalid S (discarded, then rejected) √ of a negative must stay silent
@@ -535,8 +590,15 @@ class _Synthesis:
                 if i >= last:
                     return
                 a, b = edges[i], edges[i + 1]
-                _phasor_chunk(u[a:b], s[a:b], c2, coeff[a:b],
-                              None if gain is None else gain[a:b], fft_in[a:b], scale)
+                _phasor_chunk(
+                    u[a:b],
+                    s[a:b],
+                    c2,
+                    coeff[a:b],
+                    None if gain is None else gain[a:b],
+                    fft_in[a:b],
+                    scale,
+                )
 
 
 @functools.lru_cache(maxsize=_GRID_CACHE_SIZE)
@@ -571,9 +633,11 @@ def _nyquist_check(density: Callable, omega_nyq: float, d_omega: float, m0_grid:
         dt_ok = math.pi / w[ok[0]]
         fix = f"use dt <= {dt_ok:.4g} s to keep the loss below {NYQUIST_LOSS_TOLERANCE:.1%}"
     else:
-        fix = (f"the spectrum still holds more than {NYQUIST_LOSS_TOLERANCE:.1%} of m0 above "
-               f"{100 * omega_nyq:.4g} rad/s; use dt <= {math.pi / (100 * omega_nyq):.4g} s "
-               "or a spectrum with a decaying tail")
+        fix = (
+            f"the spectrum still holds more than {NYQUIST_LOSS_TOLERANCE:.1%} of m0 above "
+            f"{100 * omega_nyq:.4g} rad/s; use dt <= {math.pi / (100 * omega_nyq):.4g} s "
+            "or a spectrum with a decaying tail"
+        )
     warn(
         f"{frac:.2%} of the spectrum's m0 lies above the Nyquist frequency "
         f"pi/dt = {omega_nyq:.4g} rad/s and is not simulated; {fix}",
@@ -643,7 +707,7 @@ def simulate_sea(
     if method_l not in ("dsa", "nsa"):
         raise InputError("method", method, "-", "must be 'dsa' or 'nsa'")
     if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and rng >= 0:
-        gen = seed = int(rng)                # default_rng(seed) is built by the draws
+        gen = seed = int(rng)  # default_rng(seed) is built by the draws
     else:
         gen, seed = _resolve_rng(rng)
     n = n_t // 2
@@ -652,7 +716,7 @@ def simulate_sea(
     nsa = method_l == "nsa"
     coeff = np.empty(n + 1, dtype=np.complex128)
     work = _work_arrays(n_t)
-    u, s_work, fft_in = work                 # fft_in: the FFT's work array (destroyed by it)
+    u, s_work, fft_in = work  # fft_in: the FFT's work array (destroyed by it)
     coeff[0] = coeff[n] = fft_in[0] = fft_in[n] = 0.0
     # X_m/N_t goes into the FFT input (exact for N_t = 2^k), so the FFT output is η
     omega = _grid(n, d_omega)
@@ -661,16 +725,28 @@ def simulate_sea(
     # a_m N_t/2 = √(c2 S_m), c2 = (2 or 1)·Δω·(N_t/2)², computed chunk by chunk in
     # the kernel (the callable's array is only read)
     c2 = (1.0 if nsa else 2.0) * d_omega * (0.5 * n_t) ** 2
-    job = _Synthesis(gen, n - 1, nsa, coeff[1:n], fft_in[1:n], 1.0 / n_t,
-                     density if parallel else None, omega, _SPECTRUM_PIECES, u, s_work,
-                     kernel, c2)
+    job = _Synthesis(
+        gen,
+        n - 1,
+        nsa,
+        coeff[1:n],
+        fft_in[1:n],
+        1.0 / n_t,
+        density if parallel else None,
+        omega,
+        _SPECTRUM_PIECES,
+        u,
+        s_work,
+        kernel,
+        c2,
+    )
     helper = None
     if parallel:
         # the draws meanwhile, then pieces of S, then kernel chunks
         helper = _executor().submit(job.work)
     try:
         s = None
-        s_min = math.nan                     # min of S from its pieces, if known
+        s_min = math.nan  # min of S from its pieces, if known
         if parallel:
             job.spectrum()
             job.s_ready.wait()
@@ -686,23 +762,37 @@ def simulate_sea(
         if s is None:
             s = np.asarray(density(omega), dtype=float)
         if s.shape != omega.shape:
-            raise InputError("density", density, "m²·s/rad",
-                             f"must return an array of shape {omega.shape}, got {s.shape}")
+            raise InputError(
+                "density",
+                density,
+                "m²·s/rad",
+                f"must return an array of shape {omega.shape}, got {s.shape}",
+            )
         # The helper may start on the kernel now (pipelined: it already has); this
         # thread validates S meanwhile and discards the work if S is invalid.
         job.start(s[1:n], c2)
         m0_grid = float(s[1:n].sum()) * d_omega
-        if not (math.isfinite(m0_grid) and math.isfinite(s[0]) and math.isfinite(s[n])
-                and (s_min if s_min == s_min else s.min()) >= 0.0):
+        if not (
+            math.isfinite(m0_grid)
+            and math.isfinite(s[0])
+            and math.isfinite(s[n])
+            and (s_min if s_min == s_min else s.min()) >= 0.0
+        ):
             bad = np.flatnonzero(~(np.isfinite(s) & (s >= 0)))
             if bad.size:
-                raise InputError("density", density, "m²·s/rad",
-                                 f"must return finite values >= 0 "
-                                 f"(S({omega[bad[0]]:.6g} rad/s) = {s[bad[0]]})")
+                raise InputError(
+                    "density",
+                    density,
+                    "m²·s/rad",
+                    f"must return finite values >= 0 (S({omega[bad[0]]:.6g} rad/s) = {s[bad[0]]})",
+                )
         if m0_grid <= 0.0:
-            raise InputError("density", density, "m²·s/rad",
-                             f"is zero at every grid frequency {d_omega:.4g} … "
-                             f"{n * d_omega:.4g} rad/s")
+            raise InputError(
+                "density",
+                density,
+                "m²·s/rad",
+                f"is zero at every grid frequency {d_omega:.4g} … {n * d_omega:.4g} rad/s",
+            )
         _nyquist_check(density, n * d_omega, d_omega, m0_grid)
     except BaseException:
         job.cancel()
@@ -753,8 +843,12 @@ def synthesize(realization: SeaRealization, transfer: ArrayLike) -> np.ndarray:
     h = np.asarray(transfer)
     n1 = realization.coefficients.shape[0]
     if h.ndim == 0 or h.shape[-1] != n1:
-        raise InputError("transfer", h if h.size <= 6 else f"shape {h.shape}", "-",
-                         f"must have shape (..., {n1}) (one value per realization.omega)")
+        raise InputError(
+            "transfer",
+            h if h.size <= 6 else f"shape {h.shape}",
+            "-",
+            f"must have shape (..., {n1}) (one value per realization.omega)",
+        )
     if not np.isfinite(h).all():
         raise InputError("transfer", f"shape {h.shape}", "-", "must be finite (not NaN or inf)")
     return _fft.irfft(h * realization.coefficients, realization.n_samples)

@@ -94,12 +94,12 @@ def _pm_shape(w: np.ndarray, omega_p: float, scale: float) -> np.ndarray:
     w = w.reshape(-1)
     x_min = _PM_X_MIN * omega_p
     out = np.maximum(w, x_min)
-    np.divide(omega_p, out, out=out)           # r = ωp/ω
+    np.divide(omega_p, out, out=out)  # r = ωp/ω
     tmp = np.multiply(out, out)
-    tmp *= tmp                                 # r⁴
-    out *= tmp                                 # r⁵
+    tmp *= tmp  # r⁴
+    out *= tmp  # r⁵
     tmp *= -1.25
-    np.exp(tmp, out=tmp)                       # exp(−1.25 r⁴), 0.0 below x = 0.2
+    np.exp(tmp, out=tmp)  # exp(−1.25 r⁴), 0.0 below x = 0.2
     out *= tmp
     out *= scale
     if out.size and w.min() < x_min:
@@ -221,7 +221,9 @@ def _jonswap_integral(gamma: float, sigma_a: float, sigma_b: float) -> float:
             continue
         x = 0.5 * (hi - lo) * _GL_X + 0.5 * (hi + lo)
         pm = 5.0 / 16.0 * x**-5 * np.exp(-1.25 * x**-4)
-        f = pm * np.expm1(math.log(gamma) * np.exp(-0.5 * ((x - 1.0) / np.where(x <= 1.0, sigma_a, sigma_b)) ** 2))
+        f = pm * np.expm1(
+            math.log(gamma) * np.exp(-0.5 * ((x - 1.0) / np.where(x <= 1.0, sigma_a, sigma_b)) ** 2)
+        )
         total += 0.5 * (hi - lo) * float(_GL_W @ f)
     return total
 
@@ -399,13 +401,17 @@ def spectrum_ochi_hubble(
 
 
 def _table(omega_table: ArrayLike, density_table: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-    wt = v.float_array("omega_table", omega_table, "rad/s", nonnegative=True,
-                       increasing=True, min_size=2)
-    st = v.float_array("density_table", density_table, "m²·s/rad", nonnegative=True,
-                       min_size=2)
+    wt = v.float_array(
+        "omega_table", omega_table, "rad/s", nonnegative=True, increasing=True, min_size=2
+    )
+    st = v.float_array("density_table", density_table, "m²·s/rad", nonnegative=True, min_size=2)
     if st.shape != wt.shape:
-        raise InputError("density_table", density_table, "m²·s/rad",
-                         f"must have the same length as omega_table ({wt.size}), got {st.size}")
+        raise InputError(
+            "density_table",
+            density_table,
+            "m²·s/rad",
+            f"must have the same length as omega_table ({wt.size}), got {st.size}",
+        )
     return wt, st
 
 
@@ -463,13 +469,19 @@ def spectral_moments(
     w = v.float_array("omega", omega, "rad/s", nonnegative=True, increasing=True, min_size=2)
     s = v.float_array("density", density, "unit²·s/rad", nonnegative=True, min_size=2)
     if s.shape != w.shape:
-        raise InputError("density", density, "unit²·s/rad",
-                         f"must have the same length as omega ({w.size}), got {s.size}")
+        raise InputError(
+            "density",
+            density,
+            "unit²·s/rad",
+            f"must have the same length as omega ({w.size}), got {s.size}",
+        )
     orders = tuple(int(n) for n in orders)
     return np.array([np.trapezoid(w**n * s, w) for n in orders])
 
 
-def moments_pierson_moskowitz(hs: float, tp: float, orders: tuple[int, ...] = (0, 1, 2, 3)) -> np.ndarray:
+def moments_pierson_moskowitz(
+    hs: float, tp: float, orders: tuple[int, ...] = (0, 1, 2, 3)
+) -> np.ndarray:
     """Closed-form moments of the Pierson–Moskowitz spectrum (orders < 4).
 
     Parameters
@@ -563,8 +575,15 @@ def spectrum_statistics(omega: ArrayLike, density: ArrayLike) -> SpectrumStatist
     tm01 = 2.0 * math.pi * m0 / m1 if m1 > 0 else math.inf
     eps2 = 1.0 - m2 * m2 / (m0 * m4) if m4 > 0 else 0.0
     return SpectrumStatistics(
-        m0=m0, m1=m1, m2=m2, m3=m3, m4=m4,
-        hs=4.0 * math.sqrt(m0), tz=tz, tm01=tm01, tp=tp,
+        m0=m0,
+        m1=m1,
+        m2=m2,
+        m3=m3,
+        m4=m4,
+        hs=4.0 * math.sqrt(m0),
+        tz=tz,
+        tm01=tm01,
+        tp=tp,
         bandwidth=math.sqrt(max(eps2, 0.0)),
     )
 

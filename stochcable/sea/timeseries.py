@@ -197,9 +197,14 @@ def newmark(
             inertia = M @ a_new
             r = inertia + f_int - f_ext
             # scale: the largest term summed (round-off of a_new is relative to 4 du/h^2)
-            scale = max(np.abs(M @ (4.0 * du / (h * h))).max(), np.abs(M @ an).max(),
-                        np.abs(inertia).max(), np.abs(f_int).max(), np.abs(f_ext).max(),
-                        np.finfo(float).tiny)
+            scale = max(
+                np.abs(M @ (4.0 * du / (h * h))).max(),
+                np.abs(M @ an).max(),
+                np.abs(inertia).max(),
+                np.abs(f_int).max(),
+                np.abs(f_ext).max(),
+                np.finfo(float).tiny,
+            )
             res_rel = float(np.abs(r).max() / scale)
             if res_rel <= tol_ or (small_step and res_rel <= 1e3 * tol_):
                 # (a negligible correction with a residual at round-off level is accepted)
@@ -218,10 +223,14 @@ def newmark(
             step = tol_ * np.abs(u_new - un).max() + 8 * np.finfo(float).eps * np.abs(u_new).max()
             small_step = bool(np.abs(delta).max() <= step)
         if not converged:
-            partial = TimeHistory(tt[: k + 1], U[: k + 1], V[: k + 1], A[: k + 1],
-                                  iters[:k], max_res)
+            partial = TimeHistory(
+                tt[: k + 1], U[: k + 1], V[: k + 1], A[: k + 1], iters[:k], max_res
+            )
             raise ConvergenceError(
-                f"Newmark Newton (step {k + 1}, t = {tk:.6g} s)", max_it, res_rel, tol_,
+                f"Newmark Newton (step {k + 1}, t = {tk:.6g} s)",
+                max_it,
+                res_rel,
+                tol_,
                 hint="reduce the time step or provide external_force_jacobian_v",
                 partial=partial,
             )

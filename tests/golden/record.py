@@ -37,8 +37,10 @@ def _variant(name: str, **analysis: object) -> dict:
 
 def _chain_current() -> dict:
     doc = _example("chain_catenary")
-    doc["environment"]["current"] = [{"z": 0.0, "speed": 1.0, "heading": 30.0},
-                                     {"z": -200.0, "speed": 0.3, "heading": 30.0}]
+    doc["environment"]["current"] = [
+        {"z": 0.0, "speed": 1.0, "heading": 30.0},
+        {"z": -200.0, "speed": 0.3, "heading": 30.0},
+    ]
     doc["analysis"].pop("timeseries", None)
     return doc
 
@@ -51,10 +53,11 @@ def cases() -> dict[str, dict]:
     out["taut_wire_fidelity"] = _variant("taut_wire", fidelity={"target_error": 0.02})
     ts = {"method": "dsa", "duration": 256.0, "dt": 0.25, "seed": 3}
     out["disc_buoy_single_leg_timeseries"] = _variant(
-        "tuah_1982_disc_buoy_single_leg", timeseries=ts)
+        "tuah_1982_disc_buoy_single_leg", timeseries=ts
+    )
     out["disc_buoy_three_legs_foss"] = _variant(
-        "tuah_1982_disc_buoy_three_legs", solver="foss",
-        timeseries={**ts, "method": "nsa"})
+        "tuah_1982_disc_buoy_three_legs", solver="foss", timeseries={**ts, "method": "nsa"}
+    )
     return out
 
 

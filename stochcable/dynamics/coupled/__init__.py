@@ -65,4 +65,5 @@ __all__ = [
     "fairlead_motion",
     "linearize_coupled",
     "solve_coupled",
+    "scene_line_channels",
 ]

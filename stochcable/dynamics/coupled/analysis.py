@@ -37,8 +37,8 @@ from stochcable.dynamics.coupled.inputs import (
 from stochcable.dynamics.coupled.model import CoupledModel, ModelGroup, build_coupled
 from stochcable.dynamics.coupled.modes import coupled_modes
 from stochcable.dynamics.coupled.results import body_result, coupled_results
-from stochcable.dynamics.system import Damping, LineSystem, Progress, noop_progress
 from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.system import Damping, LineSystem, Progress, noop_progress
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.results.documents import BodyResult, LineResult
 
@@ -111,12 +111,15 @@ class CoupledAnalysis:
         return iter((self.lines, self.bodies, self.systems, self.dampings))
 
 
-
-def analyze_coupled(scene: Any, statics: Any, settings: Any,
-                    progress: Progress | None = None,
-                    timing: dict[str, float] | None = None, *,
-                    rigid_bodies: Mapping[str, RigidBody] | None = None
-                    ) -> CoupledAnalysis:
+def analyze_coupled(
+    scene: Any,
+    statics: Any,
+    settings: Any,
+    progress: Progress | None = None,
+    timing: dict[str, float] | None = None,
+    *,
+    rigid_bodies: Mapping[str, RigidBody] | None = None,
+) -> CoupledAnalysis:
     """Frequency-domain analysis of a scene with bodies (the ``analyze`` branch).
 
     Parameters
@@ -157,9 +160,13 @@ def analyze_coupled(scene: Any, statics: Any, settings: Any,
     return solve_coupled(model, None, settings, progress, timing)
 
 
-def solve_coupled(model: CoupledModel, sea: Any = None, settings: Any = None,
-                  progress: Progress | None = None,
-                  timing: dict[str, float] | None = None) -> CoupledAnalysis:
+def solve_coupled(
+    model: CoupledModel,
+    sea: Any = None,
+    settings: Any = None,
+    progress: Progress | None = None,
+    timing: dict[str, float] | None = None,
+) -> CoupledAnalysis:
     """Solve a built scene with bodies for one sea state.
 
     Parameters
@@ -192,8 +199,9 @@ def solve_coupled(model: CoupledModel, sea: Any = None, settings: Any = None,
     """
     settings = model.settings if settings is None else settings
     if not np.array_equal(settings.omega.values(), model.omega):
-        raise InputError("settings.omega", settings.omega, "rad/s",
-                         "must be the grid the model was built on")
+        raise InputError(
+            "settings.omega", settings.omega, "rad/s", "must be the grid the model was built on"
+        )
     scene = _with_sea(model.scene, sea)
     progress = noop_progress if progress is None else progress
     timing = {} if timing is None else timing
@@ -202,15 +210,17 @@ def solve_coupled(model: CoupledModel, sea: Any = None, settings: Any = None,
     t0 = time.perf_counter()
     chans: dict[str, tuple[Channel, ...]] = {}
     for line in scene.lines:
-        chans[line.name], _ = scene_line_channels(scene, line, model.systems[line.name],
-                                                  model.omega, model.vessel_rao)
+        chans[line.name], _ = scene_line_channels(
+            scene, line, model.systems[line.name], model.omega, model.vessel_rao
+        )
     timing["model_s"] += time.perf_counter() - t0
     lines_out: dict[str, LineResult] = {}
     bodies_out: dict[str, BodyResult] = {}
     dampings: dict[str, Damping] = {}
     for name in model.independent:
-        lines_out[name], dampings[name] = _solve_line(model, name, chans[name], settings,
-                                                      progress, timing)
+        lines_out[name], dampings[name] = _solve_line(
+            model, name, chans[name], settings, progress, timing
+        )
     states: list[CoupledGroup] = []
     for group in model.groups:
         lo, bo, state = _solve_group(model, scene, group, chans, settings, progress, timing)
@@ -234,28 +244,36 @@ def _with_sea(scene: Any, sea: Any) -> Any:
     """The model's scene with the sea state ``sea`` (a Sea, a Scene or None)."""
     if sea is None:
         return scene
-    if hasattr(sea, "lines"):   # a Scene: its sea
+    if hasattr(sea, "lines"):  # a Scene: its sea
         sea = sea.sea
-    if hasattr(scene, "model_copy"):   # the frozen pydantic Scene
+    if hasattr(scene, "model_copy"):  # the frozen pydantic Scene
         return scene.model_copy(update={"sea": sea})
-    out = copy.copy(scene)             # a stand-in scene object
+    out = copy.copy(scene)  # a stand-in scene object
     out.sea = sea
     return out
 
 
-def _solve_line(model: CoupledModel, name: str, ch: tuple[Channel, ...], settings: Any,
-                progress: Progress, timing: dict[str, float]
-                ) -> tuple[LineResult, Damping]:
+def _solve_line(
+    model: CoupledModel,
+    name: str,
+    ch: tuple[Channel, ...],
+    settings: Any,
+    progress: Progress,
+    timing: dict[str, float],
+) -> tuple[LineResult, Damping]:
     """A line attached to no free body: the independent path."""
+    from stochcable.dynamics.fixedpoint import linearize
     from stochcable.dynamics.line_loads import silent_channel
     from stochcable.dynamics.outputs import line_result
-    from stochcable.dynamics.fixedpoint import linearize
 
     system = model.systems[name]
     if not ch:
-        warn(f"line '{name}' has no excitation (no sea and no end motion): its "
-             "dynamic response is zero; add a 'sea' or an end 'motion'",
-             PhysicsWarning, stacklevel=4)
+        warn(
+            f"line '{name}' has no excitation (no sea and no end motion): its "
+            "dynamic response is zero; add a 'sea' or an end 'motion'",
+            PhysicsWarning,
+            stacklevel=4,
+        )
         ch = silent_channel(model.omega)
     t1 = time.perf_counter()
     lin = linearize(system, ch, settings, progress=progress, timing=timing)
@@ -266,82 +284,114 @@ def _solve_line(model: CoupledModel, name: str, ch: tuple[Channel, ...], setting
     return out, lin.damping
 
 
-def _solve_group(model: CoupledModel, scene: Any, group: ModelGroup,
-                 chans: Mapping[str, tuple[Channel, ...]], settings: Any,
-                 progress: Progress, timing: dict[str, float]
-                 ) -> tuple[dict[str, LineResult], dict[str, BodyResult], CoupledGroup]:
+def _solve_group(
+    model: CoupledModel,
+    scene: Any,
+    group: ModelGroup,
+    chans: Mapping[str, tuple[Channel, ...]],
+    settings: Any,
+    progress: Progress,
+    timing: dict[str, float],
+) -> tuple[dict[str, LineResult], dict[str, BodyResult], CoupledGroup]:
     """A coupled group: its fixed point, modes and results."""
     omega, env = model.omega, scene.environment
     lnames, attach = group.lines, model.attach
     gbodies = [model.free[n] for n in group.bodies]
     group_ch = group_channels(lnames, chans, omega)
-    cls = [CoupledLine(model.systems[n], group_ch[n], end_a=attach[n].get("end_a"),
-                       end_b=attach[n].get("end_b")) for n in lnames]
+    cls = [
+        CoupledLine(
+            model.systems[n],
+            group_ch[n],
+            end_a=attach[n].get("end_a"),
+            end_b=attach[n].get("end_b"),
+        )
+        for n in lnames
+    ]
     first = cls[0].channels
     loads = {b.name: body_loads(b, first, omega, scene.sea, env) for b in gbodies}
     t1 = time.perf_counter()
-    clin = linearize_coupled(cls, gbodies, settings, rho=env.rho, loads=loads,
-                             progress=progress, timing=timing)
+    clin = linearize_coupled(
+        cls, gbodies, settings, rho=env.rho, loads=loads, progress=progress, timing=timing
+    )
     timing["linearization_s"] += time.perf_counter() - t1
     t1 = time.perf_counter()
     w_ref = reference_omega(first, omega)
     if group.modes is None:
         modes = coupled_modes(cls, gbodies, w_ref, float(omega[-1]))
-    else:   # sea-independent (constant added mass): the model's, at this sea's ω_ref
+    else:  # sea-independent (constant added mass): the model's, at this sea's ω_ref
         modes = dataclasses.replace(group.modes, omega_ref=float(w_ref))
-    lo, bo = coupled_results(cls, gbodies, clin, settings, static_pose=model.pose,
-                             modes=modes)
+    lo, bo = coupled_results(cls, gbodies, clin, settings, static_pose=model.pose, modes=modes)
     timing["outputs_s"] += time.perf_counter() - t1
     return lo, bo, _group_state(lnames, model, gbodies, clin)
 
 
-def _solve_lonely(model: CoupledModel, scene: Any, name: str, settings: Any,
-                  progress: Progress, timing: dict[str, float]
-                  ) -> tuple[BodyResult, CoupledGroup] | None:
+def _solve_lonely(
+    model: CoupledModel,
+    scene: Any,
+    name: str,
+    settings: Any,
+    progress: Progress,
+    timing: dict[str, float],
+) -> tuple[BodyResult, CoupledGroup] | None:
     """A free-floating body without lines: the body alone in the sea (None without
     a sea)."""
     from stochcable.dynamics.loads import spectrum_callable
 
     if scene.sea is None:
-        warn(f"body '{name}' has no lines and there is no sea: its motion is zero",
-             PhysicsWarning, stacklevel=4)
+        warn(
+            f"body '{name}' has no lines and there is no sea: its motion is zero",
+            PhysicsWarning,
+            stacklevel=4,
+        )
         return None
     omega, env = model.omega, scene.environment
     dens = spectrum_callable(scene.sea.spectrum, env.g)
-    sea_ch = (Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega),
-                      density=dens),)
+    sea_ch = (Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega), density=dens),)
     b = model.free[name]
     t1 = time.perf_counter()
-    clin = linearize_coupled([], [b], settings, rho=env.rho, channels=sea_ch,
-                             loads={name: body_loads(b, sea_ch, omega, scene.sea, env)},
-                             progress=progress, timing=timing)
+    clin = linearize_coupled(
+        [],
+        [b],
+        settings,
+        rho=env.rho,
+        channels=sea_ch,
+        loads={name: body_loads(b, sea_ch, omega, scene.sea, env)},
+        progress=progress,
+        timing=timing,
+    )
     timing["linearization_s"] += time.perf_counter() - t1
-    _, bo = coupled_results([], [b], clin, settings, static_pose=model.pose,
-                            channels=sea_ch)
+    _, bo = coupled_results([], [b], clin, settings, static_pose=model.pose, channels=sea_ch)
     return bo[name], _group_state([], model, [b], clin)
 
 
-def _vessel_results(model: CoupledModel, scene: Any, settings: Any
-                    ) -> dict[str, BodyResult]:
+def _vessel_results(model: CoupledModel, scene: Any, settings: Any) -> dict[str, BodyResult]:
     """The prescribed bodies' motion statistics from their RAOs in the sea."""
     omega, env = model.omega, scene.environment
     body_docs = {b.name: b for b in scene.bodies}
     out = {}
     for n in model.prescribed:
-        h = model.vessel_rao[n].T[None]   # (1, 6, n_w)
+        h = model.vessel_rao[n].T[None]  # (1, 6, n_w)
         sea = np.atleast_2d(scene.sea.spectrum.spectral_density(omega, env.g))
         dofs = ("surge", "sway", "heave", "roll", "pitch", "yaw")
         mean = np.concatenate([np.asarray(body_docs[n].position, float), np.zeros(3)])
-        out[n] = body_result(n, dofs, omega, ("sea",), sea, h, mean, settings.duration,
-                             prescribed=True)
+        out[n] = body_result(
+            n, dofs, omega, ("sea",), sea, h, mean, settings.duration, prescribed=True
+        )
     return out
 
 
-def _group_state(lnames: Sequence[str], model: CoupledModel, bodies: Sequence[RigidBody],
-                 clin: CoupledLinearization) -> CoupledGroup:
+def _group_state(
+    lnames: Sequence[str],
+    model: CoupledModel,
+    bodies: Sequence[RigidBody],
+    clin: CoupledLinearization,
+) -> CoupledGroup:
     return CoupledGroup(
-        lines=tuple(lnames), systems={n: model.systems[n] for n in lnames},
-        attach={n: dict(model.attach[n]) for n in lnames}, bodies=tuple(bodies),
+        lines=tuple(lnames),
+        systems={n: model.systems[n] for n in lnames},
+        attach={n: dict(model.attach[n]) for n in lnames},
+        bodies=tuple(bodies),
         pose={b.name: np.asarray(model.pose[b.name], dtype=float).copy() for b in bodies},
         dampings={n: clin.lines[n].damping for n in lnames},
-        body_drag={k: np.asarray(v, dtype=float).copy() for k, v in clin.body_drag.items()})
+        body_drag={k: np.asarray(v, dtype=float).copy() for k, v in clin.body_drag.items()},
+    )

@@ -43,10 +43,10 @@ import numpy as np
 
 from stochcable.dynamics.coupled.group import GroupSystem, relative_change, sigma_update
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine
-from stochcable.dynamics.system import Progress
 from stochcable.dynamics.fixedpoint import interpolatory_weights, subset_inputs
 from stochcable.dynamics.iteration import fixed_point
 from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.system import Progress
 from stochcable.errors import ConvergenceError, SolverError
 
 __all__ = [
@@ -113,8 +113,7 @@ _WARM_ROUNDS = True
 _WARM_MEMORY = 3
 
 
-def _warm_step(pairs: Sequence[tuple[np.ndarray, np.ndarray]], ratio: np.ndarray
-               ) -> np.ndarray:
+def _warm_step(pairs: Sequence[tuple[np.ndarray, np.ndarray]], ratio: np.ndarray) -> np.ndarray:
     """Anderson step (type II, unmixed) of the corrected coarse map y -> r·G(y) from
     its secant pairs: the coarse evaluations (x_j, G(x_j)), the last at the current
     full-grid point. [m/s]"""
@@ -134,13 +133,15 @@ def _coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
     trapezoid rule on the subset's cubic interpolant
     (:func:`stochcable.dynamics.fixedpoint.interpolatory_weights`), the lines' inputs sliced
     from the full grid's (:func:`stochcable.dynamics.fixedpoint.subset_inputs`), Foss lines
-    solved per frequency in modal coordinates (:class:`~stochcable.dynamics.coupled.lineparts.ModalLine`); the frequencies
-    of negligible σ weight (``COARSE_NEGLIGIBLE``) left out after the weights are
-    formed."""
+    solved per frequency in modal coordinates
+    (:class:`~stochcable.dynamics.coupled.lineparts.ModalLine`); the frequencies of negligible
+    σ weight (``COARSE_NEGLIGIBLE``) left out after the weights are formed."""
     spectra = np.stack([c.spectrum for c in g.channels], axis=1)[idx]
     weights = interpolatory_weights(g.omega, idx)[:, None] * spectra
-    inp = {cl.name: subset_inputs(cl.system, tuple(cl.channels), g.inp_phys[cl.name], idx)
-           for cl in g.lines}
+    inp = {
+        cl.name: subset_inputs(cl.system, tuple(cl.channels), g.inp_phys[cl.name], idx)
+        for cl in g.lines
+    }
     # frequencies whose σ weight is negligible in every channel (the spectrum's empty
     # tail) are dropped after the weights are formed: the other weights, the mean
     # squares and the inputs stay those of the interpolant on ``idx``
@@ -150,20 +151,31 @@ def _coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
         for cl in g.lines:
             sub = inp[cl.name]
             rows = subset_inputs(cl.system, _sliced_line(cl, idx).channels, sub, keep)
-            inp[cl.name] = dataclasses.replace(rows, weights=sub.weights[keep],
-                                               square=sub.square)
+            inp[cl.name] = dataclasses.replace(rows, weights=sub.weights[keep], square=sub.square)
         idx, weights = idx[keep], weights[keep]
-    gc = GroupSystem([_sliced_line(cl, idx) for cl in g.lines], g.bodies,
-                {k: _sliced_loads(v, idx) for k, v in g.loads.items()}, g.rho,
-                [_sliced_channel(c, idx) for c in g.channels], inp_phys=inp,
-                weights=weights)
+    gc = GroupSystem(
+        [_sliced_line(cl, idx) for cl in g.lines],
+        g.bodies,
+        {k: _sliced_loads(v, idx) for k, v in g.loads.items()},
+        g.rho,
+        [_sliced_channel(c, idx) for c in g.channels],
+        inp_phys=inp,
+        weights=weights,
+    )
     gc.sizes = g.sizes
     gc.modal_direct = True
     return gc
 
 
-_CHANNEL_ARRAYS = ("velocity", "acceleration", "motion_a", "motion_b", "element_velocity",
-                   "element_velocity_square", "element_end_square")
+_CHANNEL_ARRAYS = (
+    "velocity",
+    "acceleration",
+    "motion_a",
+    "motion_b",
+    "element_velocity",
+    "element_velocity_square",
+    "element_end_square",
+)
 _NODAL_ARRAYS = ("velocity", "acceleration")
 
 
@@ -176,9 +188,13 @@ def _sliced_channel(c: Channel, idx: np.ndarray) -> Channel:
     never reads them; slicing them eagerly computed them on the full grid, ≈ 0.4 ms
     per line, docs/BENCHMARKS.md pass E5c)."""
     lazy = c.nodal is not None
-    kw: dict[str, Any] = {k: getattr(c, k)[idx] for k in _CHANNEL_ARRAYS
-                          if not (lazy and k in _NODAL_ARRAYS) and getattr(c, k) is not None}
+    kw: dict[str, Any] = {
+        k: getattr(c, k)[idx]
+        for k in _CHANNEL_ARRAYS
+        if not (lazy and k in _NODAL_ARRAYS) and getattr(c, k) is not None
+    }
     if lazy:
+
         def nodal() -> tuple[Any, Any]:
             v, a = c.velocity, c.acceleration
             return (None if v is None else v[idx], None if a is None else a[idx])
@@ -188,13 +204,11 @@ def _sliced_channel(c: Channel, idx: np.ndarray) -> Channel:
 
 
 def _sliced_line(cl: CoupledLine, idx: np.ndarray) -> CoupledLine:
-    return dataclasses.replace(cl, channels=tuple(_sliced_channel(c, idx)
-                                                  for c in cl.channels))
+    return dataclasses.replace(cl, channels=tuple(_sliced_channel(c, idx) for c in cl.channels))
 
 
 def _sliced_loads(ld: BodyLoads, idx: np.ndarray) -> BodyLoads:
     return BodyLoads(force=ld.force[idx], velocity=ld.velocity[idx], current=ld.current)
-
 
 
 class CoarseStart:
@@ -231,11 +245,22 @@ class CoarseStart:
         evaluations made inside the rounds, in order.
     """
 
-    def __init__(self, g: GroupSystem, idx: np.ndarray, method: str, rho: float,
-                 state: dict[str, Any], progress: Progress, names: str, lin: Any,
-                 fixed: dict[str, Any], gname: str) -> None:
-        self.raw = sigma_update(_coarse_group(g, idx), method, rho, state, {}, progress,
-                                names, None)
+    def __init__(
+        self,
+        g: GroupSystem,
+        idx: np.ndarray,
+        method: str,
+        rho: float,
+        state: dict[str, Any],
+        progress: Progress,
+        names: str,
+        lin: Any,
+        fixed: dict[str, Any],
+        gname: str,
+    ) -> None:
+        self.raw = sigma_update(
+            _coarse_group(g, idx), method, rho, state, {}, progress, names, None
+        )
         self.lin, self.fixed, self.gname = lin, fixed, gname
         # the coarse model is only good to its defect: no tighter than 1e-6 (round-off
         # noise of the σ stalls tighter coarse iterations; the full grid finishes)
@@ -260,9 +285,15 @@ class CoarseStart:
             xc = self(x_rest)
             hc: tuple[float, ...] = (self.raw.state["change"],)
             if np.all(np.isfinite(xc)) and hc[0] > self.tol:
-                fc = fixed_point(self, xc, tol=self.tol, max_iterations=lin.max_iterations,
-                                 allow_unconverged=True,
-                                 name=self.gname + " (coarse start)", **self.fixed)
+                fc = fixed_point(
+                    self,
+                    xc,
+                    tol=self.tol,
+                    max_iterations=lin.max_iterations,
+                    allow_unconverged=True,
+                    name=self.gname + " (coarse start)",
+                    **self.fixed,
+                )
                 hc = hc + tuple(fc.history)
             ok = bool(np.all(np.isfinite(self.last["g"])))
         except _COARSE_FAILURES:
@@ -272,8 +303,13 @@ class CoarseStart:
         self.history = hc
         return self.last["x"]
 
-    def correct(self, update: Callable[[np.ndarray], np.ndarray], state: dict[str, Any],
-                x0: np.ndarray, change0: float) -> tuple[np.ndarray, float, int]:
+    def correct(
+        self,
+        update: Callable[[np.ndarray], np.ndarray],
+        state: dict[str, Any],
+        x0: np.ndarray,
+        change0: float,
+    ) -> tuple[np.ndarray, float, int]:
         """The defect-correction rounds after the first full-grid evaluation.
 
         Parameters
@@ -295,8 +331,12 @@ class CoarseStart:
         lin = self.lin
         x_full = self.last["x"]
         rounds = 0
-        while (rounds < COARSE_CORRECTIONS and np.all(np.isfinite(x0))
-               and change0 > lin.tolerance and rounds + 2 < lin.max_iterations):
+        while (
+            rounds < COARSE_CORRECTIONS
+            and np.all(np.isfinite(x0))
+            and change0 > lin.tolerance
+            and rounds + 2 < lin.max_iterations
+        ):
             try:
                 x_next, hist = self._round(x_full, x0, change0)
             except _COARSE_FAILURES:
@@ -308,12 +348,13 @@ class CoarseStart:
             x_full = x_next
             x0 = update(x_full)
             prev, change0 = change0, state["change"]
-            if change0 > 0.3 * prev:   # not contracting: the plain full-grid iteration
+            if change0 > 0.3 * prev:  # not contracting: the plain full-grid iteration
                 break
         return x0, change0, rounds
 
-    def _round(self, x_full: np.ndarray, x0: np.ndarray, change0: float
-               ) -> tuple[np.ndarray, tuple[float, ...]]:
+    def _round(
+        self, x_full: np.ndarray, x0: np.ndarray, change0: float
+    ) -> tuple[np.ndarray, tuple[float, ...]]:
         """One round: the coarse map scaled by the full/coarse ratio at the last
         full-grid point ``x_full`` (output ``x0``) has that point's full-grid
         response; its fixed point (coarse evaluations) is the next full-grid point.
@@ -325,8 +366,7 @@ class CoarseStart:
             self.history = self.history + (self.raw.state["change"],)
             last["x"] = x_full
         g_in = last["g"]
-        ratio = np.clip(np.divide(x0, g_in, out=np.ones_like(x0), where=g_in > 0),
-                        0.1, 10.0)
+        ratio = np.clip(np.divide(x0, g_in, out=np.ones_like(x0), where=g_in > 0), 0.1, 10.0)
         tol_r = max(self.tol, 0.005 * change0)
         hist: tuple[float, ...] = ()
         start = x0
@@ -341,7 +381,13 @@ class CoarseStart:
             start = h
         if hist and hist[0] <= max(tol_r, 0.1 * change0):
             return h, hist
-        fc = fixed_point(lambda y, r=ratio: r * self(y), start, tol=tol_r,
-                         max_iterations=self.lin.max_iterations, allow_unconverged=True,
-                         name=self.gname + " (coarse correction)", **self.fixed)
+        fc = fixed_point(
+            lambda y, r=ratio: r * self(y),
+            start,
+            tol=tol_r,
+            max_iterations=self.lin.max_iterations,
+            allow_unconverged=True,
+            name=self.gname + " (coarse correction)",
+            **self.fixed,
+        )
         return last["x"], hist + fc.history

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.bodies.rigid import RigidBody
+from stochcable.dynamics.blocks import to_freq
 from stochcable.dynamics.coupled.coarse import (
     COARSE_MIN_TOLERANCE,
     CoarseStart,
@@ -31,18 +32,19 @@ from stochcable.dynamics.coupled.coarse import (
 from stochcable.dynamics.coupled.group import GroupSystem, body_sigma, sigma_update
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine
 from stochcable.dynamics.fixedpoint import ANDERSON_MIXING, linearization_record
-from stochcable.dynamics.system import Linearization, Progress, Response, noop_progress
-from stochcable.dynamics.solve import end_tension_from_support
-from stochcable.dynamics.variance import quasi_static_motion, sigmas_from_nodes
-from stochcable.dynamics.blocks import to_freq
 from stochcable.dynamics.iteration import FixedPointResult, fixed_point
 from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.solve import end_tension_from_support
+from stochcable.dynamics.system import Linearization, Progress, Response, noop_progress
+from stochcable.dynamics.variance import quasi_static_motion, sigmas_from_nodes
 from stochcable.errors import ConvergenceError, InputError, PhysicsWarning, warn
 
 __all__ = ["CoupledLinearization", "linearize_coupled"]
 
-_HINT = ("increase analysis.linearization.max_iterations, lower relaxation, or set "
-         "allow_unconverged to get a flagged result")
+_HINT = (
+    "increase analysis.linearization.max_iterations, lower relaxation, or set "
+    "allow_unconverged to get a flagged result"
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -139,21 +141,24 @@ def linearize_coupled(
     progress = noop_progress if progress is None else progress
     if channels is None:
         if not lines:
-            raise InputError("channels", None, "-",
-                             "a group without lines needs its channels")
+            raise InputError("channels", None, "-", "a group without lines needs its channels")
         channels = lines[0].channels
     if not lines and not bodies:
         raise InputError("lines", 0, "-", "a coupled group needs a line or a body")
     g = GroupSystem(lines, bodies, loads or {}, rho, channels)
     names = ", ".join(cl.name for cl in g.lines)
-    gname = f"coupled drag linearization of lines {names} and bodies " \
-            f"{', '.join(b.name for b in g.bodies)}"
+    gname = (
+        f"coupled drag linearization of lines {names} and bodies "
+        f"{', '.join(b.name for b in g.bodies)}"
+    )
     x_rest = _rest_start(g, method)
     state: dict[str, Any] = {"it": 0}
     cache: dict[str, Any] = {}
-    fixed = {"relaxation": lin.relaxation,
-             "method": "anderson" if lin.acceleration == "anderson" else "relaxed",
-             "mixing": ANDERSON_MIXING}
+    fixed = {
+        "relaxation": lin.relaxation,
+        "method": "anderson" if lin.acceleration == "anderson" else "relaxed",
+        "mixing": ANDERSON_MIXING,
+    }
     # coarse stage (stochcable.dynamics.coupled.coarse): the fixed point of a frequency
     # subset supplies the start of the full-grid iteration; its history is kept
     if coarse is None:
@@ -175,58 +180,91 @@ def linearize_coupled(
         x0, change0, rounds = stage.correct(update, state, x0, change0)
     coarse_hist = () if stage is None else stage.history
     fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), lin, gname, fixed)
-    fp = FixedPointResult(fp.x, len(coarse_hist) + fp.iterations, fp.relative_change,
-                          fp.converged, coarse_hist + fp.history)
+    fp = FixedPointResult(
+        fp.x,
+        len(coarse_hist) + fp.iterations,
+        fp.relative_change,
+        fp.converged,
+        coarse_hist + fp.history,
+    )
     if not fp.converged:
-        warn(f"{gname} did not converge: relative change {fp.relative_change:.3e} after "
-             f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "
-             "flagged unconverged (increase analysis.linearization.max_iterations)",
-             PhysicsWarning, stacklevel=2)
+        warn(
+            f"{gname} did not converge: relative change {fp.relative_change:.3e} after "
+            f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "
+            "flagged unconverged (increase analysis.linearization.max_iterations)",
+            PhysicsWarning,
+            stacklevel=2,
+        )
     return _outcome(g, cache, fp, lin.tolerance, method)
 
 
 def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
     """σ of lines at rest (quasi-static on their moving ends) and bodies at rest;
     sets ``g.sizes``. [m/s]"""
-    parts = [sigmas_from_nodes(cl.system, g.inp_phys[cl.name],
-                     quasi_static_motion(cl.system, g.inp_phys[cl.name]), method)
-             for cl in g.lines]
+    parts = [
+        sigmas_from_nodes(
+            cl.system,
+            g.inp_phys[cl.name],
+            quasi_static_motion(cl.system, g.inp_phys[cl.name]),
+            method,
+        )
+        for cl in g.lines
+    ]
     g.sizes = {cl.name: p.size for cl, p in zip(g.lines, parts)}
     for b in g.drag:
         parts.append(body_sigma(g, b, None))
     return np.concatenate(parts) if parts else np.zeros(0)
 
 
-def _full_grid(update: Any, x0: np.ndarray, change0: float, rounds: int, n_c: int,
-               lin: Any, gname: str, fixed: dict[str, Any]) -> FixedPointResult:
+def _full_grid(
+    update: Any,
+    x0: np.ndarray,
+    change0: float,
+    rounds: int,
+    n_c: int,
+    lin: Any,
+    gname: str,
+    fixed: dict[str, Any],
+) -> FixedPointResult:
     """The full-grid iteration from the output ``x0`` (relative change ``change0``) of
     its first evaluation after ``rounds`` correction rounds and ``n_c`` coarse-stage
     entries: its record (first evaluation included, coarse stage not)."""
     if not np.all(np.isfinite(x0)):
-        raise ConvergenceError(gname, n_c + 1, float("nan"), lin.tolerance,
-                               hint="the first response gave non-finite σ")
+        raise ConvergenceError(
+            gname, n_c + 1, float("nan"), lin.tolerance, hint="the first response gave non-finite σ"
+        )
     if change0 <= lin.tolerance or lin.max_iterations == 1 or x0.size == 0:
-        fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance or x0.size == 0,
-                              (change0,))
+        fp = FixedPointResult(x0, 1, change0, change0 <= lin.tolerance or x0.size == 0, (change0,))
         if not fp.converged and not lin.allow_unconverged:
-            raise ConvergenceError(gname, n_c + 1, change0, lin.tolerance, hint=_HINT,
-                                   partial=fp)
+            raise ConvergenceError(gname, n_c + 1, change0, lin.tolerance, hint=_HINT, partial=fp)
         return fp
     try:
         fp = fixed_point(
-            update, x0, tol=lin.tolerance,
+            update,
+            x0,
+            tol=lin.tolerance,
             max_iterations=lin.max_iterations - 1 - rounds,
-            allow_unconverged=lin.allow_unconverged, name=gname, **fixed,
+            allow_unconverged=lin.allow_unconverged,
+            name=gname,
+            **fixed,
         )
     except ConvergenceError as exc:
-        raise ConvergenceError(gname, n_c + exc.iterations + 1, exc.residual,
-                               exc.tolerance, hint=_HINT, partial=exc.partial) from None
-    return FixedPointResult(fp.x, fp.iterations + 1, fp.relative_change, fp.converged,
-                            (change0,) + fp.history)
+        raise ConvergenceError(
+            gname,
+            n_c + exc.iterations + 1,
+            exc.residual,
+            exc.tolerance,
+            hint=_HINT,
+            partial=exc.partial,
+        ) from None
+    return FixedPointResult(
+        fp.x, fp.iterations + 1, fp.relative_change, fp.converged, (change0,) + fp.history
+    )
 
 
-def _outcome(g: GroupSystem, cache: Mapping[str, Any], fp: FixedPointResult,
-             tolerance: float, method: str) -> CoupledLinearization:
+def _outcome(
+    g: GroupSystem, cache: Mapping[str, Any], fp: FixedPointResult, tolerance: float, method: str
+) -> CoupledLinearization:
     """The record of the converged group from its last evaluation ``cache``."""
     ls, bs = g.split(cache["sigma"])
     out = {}
@@ -234,16 +272,24 @@ def _outcome(g: GroupSystem, cache: Mapping[str, Any], fp: FixedPointResult,
         system = cl.system
         damping = cache["damping"][cl.name]
         uc, sc = cache["sol"][cl.name]
-        resp = Response(omega=g.omega, displacement=to_freq(uc), support_force=sc,
-                        end_tension=end_tension_from_support(system, sc))
+        resp = Response(
+            omega=g.omega,
+            displacement=to_freq(uc),
+            support_force=sc,
+            end_tension=end_tension_from_support(system, sc),
+        )
         record = linearization_record(system, ls[cl.name], damping, fp, tolerance, method)
         out[cl.name] = Linearization(damping=damping, record=record, response=resp)
     xi = cache["xi"]
-    motion = {b.name: xi[:, g.off[b.name]:g.off[b.name] + b.n_dof, :].copy()
-              for b in g.bodies}
+    motion = {b.name: xi[:, g.off[b.name] : g.off[b.name] + b.n_dof, :].copy() for b in g.bodies}
     return CoupledLinearization(
-        lines=out, body_motion=motion,
+        lines=out,
+        body_motion=motion,
         body_sigma={b.name: bs[b.name].copy() for b in g.drag},
         body_drag={k: v.copy() for k, v in cache["body_b"].items()},
-        converged=fp.converged, iterations=fp.iterations,
-        relative_change=fp.relative_change, history=fp.history, tolerance=tolerance)
+        converged=fp.converged,
+        iterations=fp.iterations,
+        relative_change=fp.relative_change,
+        history=fp.history,
+        tolerance=tolerance,
+    )

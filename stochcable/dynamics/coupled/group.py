@@ -48,14 +48,14 @@ from stochcable.bodies.rigid import (
     attachment_geometric_stiffness,
     rigid_link_matrix,
 )
+from stochcable.dynamics.blocks import trapezoid_weights
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine, unit_channels
 from stochcable.dynamics.coupled.lineparts import FossLine, ModalLine, line_parts
-from stochcable.dynamics.system import Damping, Progress
 from stochcable.dynamics.line_loads import line_inputs
-from stochcable.dynamics.variance import sigmas_from_nodes, drag_coefficients
-from stochcable.dynamics.blocks import trapezoid_weights
 from stochcable.dynamics.linearization import drag_linear_current, drag_linear_harmonic
 from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.system import Damping, Progress
+from stochcable.dynamics.variance import drag_coefficients, sigmas_from_nodes
 from stochcable.errors import InputError, SolverError
 
 __all__ = [
@@ -133,11 +133,16 @@ class GroupSystem:
         (filled on the first evaluation).
     """
 
-    def __init__(self, lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
-                 loads: Mapping[str, BodyLoads], rho: float,
-                 channels: Sequence[Channel],
-                 inp_phys: Mapping[str, Any] | None = None,
-                 weights: np.ndarray | None = None) -> None:
+    def __init__(
+        self,
+        lines: Sequence[CoupledLine],
+        bodies: Sequence[RigidBody],
+        loads: Mapping[str, BodyLoads],
+        rho: float,
+        channels: Sequence[Channel],
+        inp_phys: Mapping[str, Any] | None = None,
+        weights: np.ndarray | None = None,
+    ) -> None:
         self.lines = tuple(lines)
         # the coarse stage's group (fixedpoint._coarse_group): Foss lines solve their
         # modal equations per frequency (ModalLine), no Foss eigenproblem
@@ -159,14 +164,18 @@ class GroupSystem:
         self.off = off
         self.nb = k
         # body DOFs not held by ``RigidBody.fixed_dofs`` (the fixed ones are ξ ≡ 0)
-        self.body_free = np.array([off[b.name] + i for b in bodies for i in b.free_index],
-                                  dtype=int)
+        self.body_free = np.array(
+            [off[b.name] + i for b in bodies for i in b.free_index], dtype=int
+        )
         self.channels = tuple(channels)
         self.n_ch = len(channels)
         self.omega = channels[0].omega
-        self.weights = (trapezoid_weights(self.omega)[:, None]
-                        * np.stack([c.spectrum for c in channels], axis=1)
-                        if weights is None else weights)
+        self.weights = (
+            trapezoid_weights(self.omega)[:, None]
+            * np.stack([c.spectrum for c in channels], axis=1)
+            if weights is None
+            else weights
+        )
         self.sizes: dict[str, int] = {}
         # per line: augmented inputs (built on first use: only the node-level paths
         # need them), link matrix T_l (d·n_att, nb), attached rows
@@ -174,8 +183,11 @@ class GroupSystem:
         self.inp_phys, self.tmat, self.rows = {}, {}, {}
         self.geometric = self._link_lines(names)
         # the physical channels alone, for the σ (the unit channels weigh zero)
-        self.inp_phys = ({cl.name: line_inputs(cl.system, tuple(cl.channels))
-                          for cl in self.lines} if inp_phys is None else dict(inp_phys))
+        self.inp_phys = (
+            {cl.name: line_inputs(cl.system, tuple(cl.channels)) for cl in self.lines}
+            if inp_phys is None
+            else dict(inp_phys)
+        )
         self._body_matrices()
         # body loads (n_w, nb, n_ch), drag-point maps
         w = self.omega
@@ -187,7 +199,7 @@ class GroupSystem:
             if ld is not None:
                 s = slice(off[b.name], off[b.name] + b.n_dof)
                 self.f_body[:, s, :] = ld.force
-        self.emb = {}   # (6, d) embedding of a body's DOFs among the six
+        self.emb = {}  # (6, d) embedding of a body's DOFs among the six
         for b in bodies:
             e = np.eye(6)
             self.emb[b.name] = e[:, list(PLANAR_INDEX)] if b.planar else e
@@ -198,8 +210,12 @@ class GroupSystem:
         geo = {b.name: np.zeros((b.n_dof, b.n_dof)) for b in self.bodies}
         for cl in self.lines:
             if [c.name for c in cl.channels] != [c.name for c in self.channels]:
-                raise InputError(f"lines[{cl.name}].channels", [c.name for c in cl.channels],
-                                 "-", "every line of a group needs the group's channels")
+                raise InputError(
+                    f"lines[{cl.name}].channels",
+                    [c.name for c in cl.channels],
+                    "-",
+                    "every line of a group needs the group's channels",
+                )
             model = cl.system.model
             d = model.dim
             att = cl.attached()
@@ -207,18 +223,25 @@ class GroupSystem:
             rows = []
             for i, (k, bname) in enumerate(att):
                 if bname not in self.by_name:
-                    raise InputError(f"lines[{cl.name}].{('end_a', 'end_b')[k]}", bname, "-",
-                                     f"is not a body; bodies: {names}")
+                    raise InputError(
+                        f"lines[{cl.name}].{('end_a', 'end_b')[k]}",
+                        bname,
+                        "-",
+                        f"is not a body; bodies: {names}",
+                    )
                 body = self.by_name[bname]
                 if (d == 2) != body.planar:
-                    raise InputError(f"lines[{cl.name}]", bname, "-",
-                                     f"a {d}-D line model needs a "
-                                     f"{'planar' if d == 2 else '6-DOF'} body")
+                    raise InputError(
+                        f"lines[{cl.name}]",
+                        bname,
+                        "-",
+                        f"a {d}-D line model needs a {'planar' if d == 2 else '6-DOF'} body",
+                    )
                 node = 0 if k == 0 else model.n_nodes - 1
                 r = model.positions[node] - body.position
                 tl = rigid_link_matrix(r, planar=body.planar)
                 o = self.off[bname]
-                t[i * d:(i + 1) * d, o:o + body.n_dof] = tl
+                t[i * d : (i + 1) * d, o : o + body.n_dof] = tl
                 st = cl.system.statics
                 f = np.asarray(st.force_a if k == 0 else st.force_b, dtype=float)
                 geo[bname] += attachment_geometric_stiffness(f, r, body.planar)
@@ -255,11 +278,11 @@ class GroupSystem:
         out, k = {}, 0
         for cl in self.lines:
             n = self.sizes[cl.name]
-            out[cl.name] = x[k:k + n]
+            out[cl.name] = x[k : k + n]
             k += n
         body = {}
         for b in self.drag:
-            body[b.name] = x[k:k + 3]
+            body[b.name] = x[k : k + 3]
             k += 3
         return out, body
 
@@ -286,8 +309,9 @@ def body_drag_matrix(body: RigidBody, b: np.ndarray) -> np.ndarray:
     return c
 
 
-def linear_body_drag(body: RigidBody, rho: float, sigma: np.ndarray, mean: np.ndarray,
-                     method: str) -> tuple[np.ndarray, np.ndarray]:
+def linear_body_drag(
+    body: RigidBody, rho: float, sigma: np.ndarray, mean: np.ndarray, method: str
+) -> tuple[np.ndarray, np.ndarray]:
     """Statistically linearized drag of a body at its drag point.
 
     Parameters
@@ -311,8 +335,9 @@ def linear_body_drag(body: RigidBody, rho: float, sigma: np.ndarray, mean: np.nd
         :func:`body_drag_matrix` of ``b``.
     """
     if method == "harmonic":
-        b = np.asarray(drag_linear_harmonic(rho, body.drag_area, 1.0, math.sqrt(2.0) * sigma),
-                       dtype=float)
+        b = np.asarray(
+            drag_linear_harmonic(rho, body.drag_area, 1.0, math.sqrt(2.0) * sigma), dtype=float
+        )
     else:
         b = np.asarray(drag_linear_current(rho, body.drag_area, 1.0, sigma, mean), dtype=float)
     return np.broadcast_to(b, (3,)).copy(), body_drag_matrix(body, b)
@@ -334,8 +359,11 @@ def body_sigma(g: GroupSystem, body: RigidBody, xi: np.ndarray | None) -> np.nda
     ndarray, shape (3,)
         σ along x, y, z of fluid minus body velocity, over ``g.weights``. [m/s]
     """
-    v = g.loads[body.name].velocity if body.name in g.loads else np.zeros(
-        (g.omega.size, 3, g.n_ch), dtype=complex)
+    v = (
+        g.loads[body.name].velocity
+        if body.name in g.loads
+        else np.zeros((g.omega.size, 3, g.n_ch), dtype=complex)
+    )
     if xi is not None:
         s = slice(g.off[body.name], g.off[body.name] + body.n_dof)
         t = rigid_link_matrix(body.drag_point) @ g.emb[body.name]  # (3, d)
@@ -344,10 +372,13 @@ def body_sigma(g: GroupSystem, body: RigidBody, xi: np.ndarray | None) -> np.nda
     return np.sqrt(np.clip(var, 0.0, None))
 
 
-def solve_group(g: GroupSystem, line_damping: Mapping[str, Damping],
-                body_c: np.ndarray, body_b: Mapping[str, np.ndarray],
-                timing: dict[str, float] | None
-                ) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], np.ndarray]:
+def solve_group(
+    g: GroupSystem,
+    line_damping: Mapping[str, Damping],
+    body_c: np.ndarray,
+    body_b: Mapping[str, np.ndarray],
+    timing: dict[str, float] | None,
+) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], np.ndarray]:
     """One coupled solve of a group for given linear drag (module docstring).
 
     Parameters
@@ -386,15 +417,15 @@ def solve_group(g: GroupSystem, line_damping: Mapping[str, Damping],
         rhs = rhs + t.T[None] @ r0
         parts[cl.name] = part
     xi = _solve_free_dofs(g, s, rhs)
-    out = {cl.name: _combine(g, parts[cl.name], g.tmat[cl.name][None] @ xi)
-           for cl in g.lines}
+    out = {cl.name: _combine(g, parts[cl.name], g.tmat[cl.name][None] @ xi) for cl in g.lines}
     if timing is not None:
         timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
     return out, xi
 
 
-def _body_equation(g: GroupSystem, body_c: np.ndarray, body_b: Mapping[str, np.ndarray]
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def _body_equation(
+    g: GroupSystem, body_c: np.ndarray, body_b: Mapping[str, np.ndarray]
+) -> tuple[np.ndarray, np.ndarray]:
     """The body impedance with the drag damping and the body loads with the drag
     loads Tdᵀ diag(b) v, before the lines are condensed."""
     iw = (1j * g.omega)[:, None, None]
@@ -403,7 +434,7 @@ def _body_equation(g: GroupSystem, body_c: np.ndarray, body_b: Mapping[str, np.n
     for b in g.drag:
         bb = body_b[b.name]
         t = rigid_link_matrix(b.drag_point)
-        gen = g.emb[b.name].T @ (t.T * bb[None, :])     # (d, 3)
+        gen = g.emb[b.name].T @ (t.T * bb[None, :])  # (d, 3)
         sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
         rhs[:, sl, :] += np.einsum("ij,wjc->wic", gen, g.loads[b.name].velocity)
     return s, rhs
@@ -439,10 +470,12 @@ def _solve_body(s: np.ndarray, g: np.ndarray) -> np.ndarray:
     except np.linalg.LinAlgError:
         x = None
     if x is None or not np.all(np.isfinite(x)):
-        raise SolverError("coupled body solve: the body impedance (with the condensed "
-                          "lines) is singular at some frequency (an undamped body "
-                          "resonance or a DOF without restoring); add damping or "
-                          "stiffness to the body")
+        raise SolverError(
+            "coupled body solve: the body impedance (with the condensed "
+            "lines) is singular at some frequency (an undamped body "
+            "resonance or a DOF without restoring); add damping or "
+            "stiffness to the body"
+        )
     return x
 
 
@@ -462,14 +495,20 @@ def relative_change(new: np.ndarray, x: np.ndarray) -> float:
     float
         max |new − x| / max(|new|, 1e-6·max|new|). [-]
     """
-    den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)),
-                                             1e-300))
+    den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)), 1e-300))
     return float(np.max(np.abs(new - x) / den, initial=0.0))
 
 
-def sigma_update(g: GroupSystem, method: str, rho: float, state: dict[str, Any],
-                 cache: dict[str, Any], progress: Progress, names: str,
-                 timing: dict[str, float] | None) -> Any:
+def sigma_update(
+    g: GroupSystem,
+    method: str,
+    rho: float,
+    state: dict[str, Any],
+    cache: dict[str, Any],
+    progress: Progress,
+    names: str,
+    timing: dict[str, float] | None,
+) -> Any:
     """The fixed-point map σ → σ(response to the drag of σ) of a group.
 
     Parameters
@@ -507,8 +546,13 @@ def sigma_update(g: GroupSystem, method: str, rho: float, state: dict[str, Any],
         body_c = np.zeros((g.nb, g.nb))
         body_b = {}
         for b in g.drag:
-            bb, c = linear_body_drag(b, rho, bs[b.name], g.loads[b.name].current
-                                     if b.name in g.loads else np.zeros(3), method)
+            bb, c = linear_body_drag(
+                b,
+                rho,
+                bs[b.name],
+                g.loads[b.name].current if b.name in g.loads else np.zeros(3),
+                method,
+            )
             sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
             body_c[sl, sl] += c
             body_b[b.name] = bb
@@ -522,8 +566,7 @@ def sigma_update(g: GroupSystem, method: str, rho: float, state: dict[str, Any],
         state["it"] += 1
         change = relative_change(new, x)
         state["change"] = change
-        progress("linearization", {"group": names, "iteration": state["it"],
-                                   "change": change})
+        progress("linearization", {"group": names, "iteration": state["it"], "change": change})
         cache.update(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
         return new
 

@@ -29,8 +29,8 @@ from stochcable.bodies.rigid import (
     attachment_geometric_stiffness,
     rigid_link_matrix,
 )
-from stochcable.dynamics.system import LineSystem
 from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.system import LineSystem
 from stochcable.errors import InputError
 
 __all__ = [
@@ -122,8 +122,9 @@ def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
     return a @ t.T
 
 
-def body_loads(body: RigidBody, channels: Sequence[Channel], omega: np.ndarray,
-               sea: Any, environment: Any) -> BodyLoads:
+def body_loads(
+    body: RigidBody, channels: Sequence[Channel], omega: np.ndarray, sea: Any, environment: Any
+) -> BodyLoads:
     """Excitation force and drag-point fluid velocity of a body per channel.
 
     Parameters
@@ -165,13 +166,13 @@ def body_loads(body: RigidBody, channels: Sequence[Channel], omega: np.ndarray,
             p[2] = max(p[2], -environment.depth)
             kin = wave_kinematics(w, p, beta, environment.depth, environment.g)
             vel[:, :, i] = kin.velocity[0].T
-    cur = np.asarray(environment.current_velocity(np.array([min(point[2], 0.0)]))[0],
-                     dtype=float)
+    cur = np.asarray(environment.current_velocity(np.array([min(point[2], 0.0)]))[0], dtype=float)
     return BodyLoads(force=force, velocity=vel, current=cur)
 
 
-def body_gravity_stiffness(body: RigidBody, displaced_volume: float,
-                           centre_of_buoyancy: Any, rho: float, g: float) -> np.ndarray:
+def body_gravity_stiffness(
+    body: RigidBody, displaced_volume: float, centre_of_buoyancy: Any, rho: float, g: float
+) -> np.ndarray:
     """Restoring of the weight and the buoyancy of a body when it rotates.
 
     Parameters
@@ -201,8 +202,9 @@ def body_gravity_stiffness(body: RigidBody, displaced_volume: float,
     w = np.array([0.0, 0.0, -body.mass * g])
     b = np.array([0.0, 0.0, rho * g * float(displaced_volume)])
     cob = np.asarray(centre_of_buoyancy, dtype=float)
-    return (attachment_geometric_stiffness(w, body.cog, body.planar)
-            + attachment_geometric_stiffness(b, cob, body.planar))
+    return attachment_geometric_stiffness(
+        w, body.cog, body.planar
+    ) + attachment_geometric_stiffness(b, cob, body.planar)
 
 
 def _zero_density(w: np.ndarray) -> np.ndarray:
@@ -232,10 +234,17 @@ def unit_channels(cl: CoupledLine) -> tuple[Channel, ...]:
         for j, c in enumerate(comps):
             m = np.zeros((w.size, 3), dtype=complex)
             m[:, c] = 1.0
-            out.append(Channel(name=f"unit.{k}.{j}", kind="end_motion", omega=w,
-                               spectrum=np.zeros(w.size), density=_zero_density,
-                               motion_a=m if k == 0 else None,
-                               motion_b=m if k == 1 else None))
+            out.append(
+                Channel(
+                    name=f"unit.{k}.{j}",
+                    kind="end_motion",
+                    omega=w,
+                    spectrum=np.zeros(w.size),
+                    density=_zero_density,
+                    motion_a=m if k == 0 else None,
+                    motion_b=m if k == 1 else None,
+                )
+            )
     return tuple(out)
 
 
@@ -264,8 +273,9 @@ def reference_omega(channels: Sequence[Channel], omega: np.ndarray) -> float:
     return float(omega[omega.size // 2])
 
 
-def group_channels(lnames: Sequence[str], chans: Mapping[str, tuple[Channel, ...]],
-                   omega: np.ndarray) -> dict[str, tuple[Channel, ...]]:
+def group_channels(
+    lnames: Sequence[str], chans: Mapping[str, tuple[Channel, ...]], omega: np.ndarray
+) -> dict[str, tuple[Channel, ...]]:
     """Align the lines' channels on the group's channel list.
 
     Parameters
@@ -296,19 +306,44 @@ def group_channels(lnames: Sequence[str], chans: Mapping[str, tuple[Channel, ...
         own = {c.name: c for c in chans[n]}
         lst = []
         if sea is not None:
-            lst.append(own.get("sea", dataclasses.replace(
-                sea, velocity=None, acceleration=None, motion_a=None, motion_b=None,
-                element_velocity=None, element_velocity_square=None,
-                element_end_square=None)))
+            lst.append(
+                own.get(
+                    "sea",
+                    dataclasses.replace(
+                        sea,
+                        velocity=None,
+                        acceleration=None,
+                        motion_a=None,
+                        motion_b=None,
+                        element_velocity=None,
+                        element_velocity_square=None,
+                        element_end_square=None,
+                    ),
+                )
+            )
         for owner, full, c in order:
             if owner == n:
                 lst.append(dataclasses.replace(c, name=full))
             else:
-                lst.append(Channel(name=full, kind="end_motion", omega=c.omega,
-                                   spectrum=c.spectrum, density=c.density))
+                lst.append(
+                    Channel(
+                        name=full,
+                        kind="end_motion",
+                        omega=c.omega,
+                        spectrum=c.spectrum,
+                        density=c.density,
+                    )
+                )
         if not lst:
-            lst = [Channel(name="none", kind="none", omega=omega,
-                           spectrum=np.zeros(omega.size), density=_zero_density)]
+            lst = [
+                Channel(
+                    name="none",
+                    kind="none",
+                    omega=omega,
+                    spectrum=np.zeros(omega.size),
+                    density=_zero_density,
+                )
+            ]
         out[n] = tuple(lst)
     return out
 
@@ -338,14 +373,19 @@ def vessel_rao(motion: Any, omega: np.ndarray) -> np.ndarray:
         if tab is None:
             continue
         v = tab.values()
-        out[:, i] = (np.interp(omega, w, v.real, 0.0, 0.0)
-                     + 1j * np.interp(omega, w, v.imag, 0.0, 0.0))
+        out[:, i] = np.interp(omega, w, v.real, 0.0, 0.0) + 1j * np.interp(
+            omega, w, v.imag, 0.0, 0.0
+        )
     return out
 
 
-def scene_line_channels(scene: Any, line: Any, system: LineSystem, omega: np.ndarray,
-                        vessel_rao: Mapping[str, np.ndarray]
-                        ) -> tuple[tuple[Channel, ...], dict[str, str]]:
+def scene_line_channels(
+    scene: Any,
+    line: Any,
+    system: LineSystem,
+    omega: np.ndarray,
+    vessel_rao: Mapping[str, np.ndarray],
+) -> tuple[tuple[Channel, ...], dict[str, str]]:
     """A scene line's input channels on ``omega`` and its ends on free bodies.
 
     Parameters
@@ -382,13 +422,17 @@ def scene_line_channels(scene: Any, line: Any, system: LineSystem, omega: np.nda
             att[end] = a.body
             continue
         if scene.sea is None:
-            raise InputError(f"bodies[{a.body}].prescribed", "RAO table", "-",
-                             "a vessel motion RAO is relative to the sea: the scene "
-                             "needs a 'sea'")
+            raise InputError(
+                f"bodies[{a.body}].prescribed",
+                "RAO table",
+                "-",
+                "a vessel motion RAO is relative to the sea: the scene needs a 'sea'",
+            )
         node = 0 if k == 0 else system.model.n_nodes - 1
         r = system.positions[node] - np.asarray(body_docs[a.body].position, float)
         mot = fairlead_motion(vessel_rao[a.body], r)
-        ch = tuple(dataclasses.replace(c, **{f"motion_{end[-1]}": mot})
-                   if c.kind == "sea" else c for c in ch)
+        ch = tuple(
+            dataclasses.replace(c, **{f"motion_{end[-1]}": mot}) if c.kind == "sea" else c
+            for c in ch
+        )
     return ch, att
-

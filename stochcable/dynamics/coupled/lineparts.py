@@ -32,19 +32,20 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.system import Damping, LineSystem
 from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep, real_gemm
 from stochcable.dynamics.line_loads import base_motion, drag_blocks, end_loads, free_load
-from stochcable.dynamics.solve import reactions, solve_free, total_displacement
 from stochcable.dynamics.modal_solvers import FossModes, foss_modes, foss_transfer_modal
+from stochcable.dynamics.solve import reactions, solve_free, total_displacement
+from stochcable.dynamics.system import Damping, LineSystem
 from stochcable.errors import SolverError
 from stochcable.runtime import line_map
 
 __all__ = ["FossLine", "ModalLine", "foss_state", "foss_unit_split", "line_parts"]
 
 
-def line_parts(g: Any, line_damping: Mapping[str, Damping]
-               ) -> list[tuple[Any, np.ndarray, np.ndarray]]:
+def line_parts(
+    g: Any, line_damping: Mapping[str, Damping]
+) -> list[tuple[Any, np.ndarray, np.ndarray]]:
     """Every line of a group before the body solve.
 
     Parameters
@@ -70,33 +71,47 @@ def line_parts(g: Any, line_damping: Mapping[str, Damping]
     GIL: pooled they cost more CPU than they overlap, docs/BENCHMARKS.md pass E4);
     the same bits with or without the pool.
     """
-    modal = [cl for cl in g.lines
-             if cl.system.solver != "direct" and _MODAL_FOSS and not g.modal_direct]
-    states = dict(zip([cl.name for cl in modal], line_map(
-        lambda cl: foss_state(cl.system, line_damping[cl.name]), modal)))
-    return [_line_part(g, cl, line_damping[cl.name], states.get(cl.name))
-            for cl in g.lines]
+    modal = [
+        cl for cl in g.lines if cl.system.solver != "direct" and _MODAL_FOSS and not g.modal_direct
+    ]
+    states = dict(
+        zip(
+            [cl.name for cl in modal],
+            line_map(lambda cl: foss_state(cl.system, line_damping[cl.name]), modal),
+        )
+    )
+    return [_line_part(g, cl, line_damping[cl.name], states.get(cl.name)) for cl in g.lines]
 
 
-def _line_part(g: Any, cl: Any, damping: Damping, state: Any = None
-               ) -> tuple[Any, np.ndarray, np.ndarray]:
+def _line_part(
+    g: Any, cl: Any, damping: Damping, state: Any = None
+) -> tuple[Any, np.ndarray, np.ndarray]:
     """One line of :func:`line_parts`; ``state``: the line's :func:`foss_state` when
     already computed."""
     system = cl.system
     rows = g.rows[cl.name]
     n_ch = g.n_ch
     if system.solver != "direct" and g.modal_direct:
-        part = ModalLine(system, g.inp_phys[cl.name], damping,
-                          tuple(k for k, _ in cl.attached()),
-                          g.modal_cache.setdefault(cl.name, {}))
+        part = ModalLine(
+            system,
+            g.inp_phys[cl.name],
+            damping,
+            tuple(k for k, _ in cl.attached()),
+            g.modal_cache.setdefault(cl.name, {}),
+        )
         r0, re = part.reactions(rows)
         return part, r0, re
     if system.solver != "direct" and _MODAL_FOSS:
         try:
-            part = FossLine(system, g.inp_phys[cl.name], damping,
-                             tuple(k for k, _ in cl.attached()), state,
-                             g.foss_cache.setdefault(cl.name, {}))
-        except SolverError:   # defective pencil: the plain solve's fallback
+            part = FossLine(
+                system,
+                g.inp_phys[cl.name],
+                damping,
+                tuple(k for k, _ in cl.attached()),
+                state,
+                g.foss_cache.setdefault(cl.name, {}),
+            )
+        except SolverError:  # defective pencil: the plain solve's fallback
             pass
         else:
             r0, re = part.reactions(rows)
@@ -111,8 +126,9 @@ def _line_part(g: Any, cl: Any, damping: Damping, state: Any = None
     return (u, sup), sup[:, rows, :n_ch], sup[:, rows, n_ch:]
 
 
-def foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Damping
-                    ) -> tuple[np.ndarray, Any] | None:
+def foss_unit_split(
+    system: LineSystem, inp_phys: Any, inp: Any, damping: Damping
+) -> tuple[np.ndarray, Any] | None:
     """:func:`stochcable.dynamics.solve.solve_free` (Foss) of the physical channels plus the
     unit end-motion channels, the unit columns in closed form.
 
@@ -153,8 +169,9 @@ def foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Dampin
     # physical channels: the free-row load of solve_free
     rhs = free_load(system, prep, inp_phys, damping)
     flat = np.ascontiguousarray(prep.free_rows(rhs)).reshape(nf, n_w * n_ch)
-    u_p = real_gemm(phi, np.ascontiguousarray(
-        foss_transfer_modal(foss, real_gemm(phi.T, flat), w, n_ch)))
+    u_p = real_gemm(
+        phi, np.ascontiguousarray(foss_transfer_modal(foss, real_gemm(phi.T, flat), w, n_ch))
+    )
     # unit channels: U_p,j constant (node vectors (n, d, n_e))
     key = ("unit_up", n_ch)
     if key not in inp.cache:
@@ -162,17 +179,20 @@ def foss_unit_split(system: LineSystem, inp_phys: Any, inp: Any, damping: Dampin
         inp.cache[key] = (up, prep.free_rows(block_matvec(prep.MT, up)))
     up, a = inp.cache[key]
     b = prep.free_rows(block_matvec(c, up))
-    ah, bh = phi.T @ a, phi.T @ b                              # (m, n_e)
-    fe = ((w * w)[None, :, None] * ah[:, None, :]
-          - (1j * w)[None, :, None] * bh[:, None, :])          # (m, n_w, n_e)
-    u_e = real_gemm(phi, np.ascontiguousarray(
-        foss_transfer_modal(foss, fe.reshape(m, n_w * n_e), w, n_e)))
+    ah, bh = phi.T @ a, phi.T @ b  # (m, n_e)
+    fe = (w * w)[None, :, None] * ah[:, None, :] - (1j * w)[None, :, None] * bh[
+        :, None, :
+    ]  # (m, n_w, n_e)
+    u_e = real_gemm(
+        phi, np.ascontiguousarray(foss_transfer_modal(foss, fe.reshape(m, n_w * n_e), w, n_e))
+    )
     u_e = u_e.reshape(nf, n_w, n_e)
     if m < nf:
         u_p += prep.residual(system, flat)
         st = prep.residual(system, np.concatenate([a, b], axis=1).astype(complex))
-        u_e += ((w * w)[None, :, None] * st[:, None, :n_e]
-                - (1j * w)[None, :, None] * st[:, None, n_e:])
+        u_e += (w * w)[None, :, None] * st[:, None, :n_e] - (1j * w)[None, :, None] * st[
+            :, None, n_e:
+        ]
     u = np.concatenate([u_p.reshape(nf, n_w, n_ch), u_e], axis=2)
     return u.reshape(prep.n - 2, prep.d, n_w, n_ch + n_e), c
 
@@ -209,8 +229,9 @@ def foss_state(system: LineSystem, damping: Damping) -> tuple[Any, Any, FossMode
     return cd, c, foss
 
 
-def _unit_follow(system: LineSystem, inp: Any, ends: tuple[int, ...]
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+def _unit_follow(
+    system: LineSystem, inp: Any, ends: tuple[int, ...]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """The unit end motions of the attached ends ``ends`` of a Foss line: their
     constant static following U_p (n_nodes, d, n_e), the modal mass load
     âh = Φᵀ[M_T U_p]_f (m, n_e) and its static correction (None with all modes kept),
@@ -224,7 +245,7 @@ def _unit_follow(system: LineSystem, inp: Any, ends: tuple[int, ...]
         n_e = d * len(ends)
         ub = np.zeros((2 * d, n_e))
         for i, k in enumerate(ends):
-            ub[k * d:(k + 1) * d, i * d:(i + 1) * d] = np.eye(d)
+            ub[k * d : (k + 1) * d, i * d : (i + 1) * d] = np.eye(d)
         up = np.zeros((n, d, n_e))
         up[0], up[-1] = ub[:d], ub[d:]
         up[1:-1] = (prep.follower() @ ub).reshape(n - 2, d, n_e)
@@ -252,16 +273,23 @@ class FossLine:
     Φχ); after the body solve, :meth:`combine` forms P_0 + P_e u_e and reconstructs
     the one combined response on all nodes (σ, support forces).  Raises SolverError
     when the Foss pencil is defective (the caller falls back to the plain solve).
-    ``cache`` (a dict per line of the group, :attr:`~stochcable.dynamics.coupled.group.GroupSystem.foss_cache`) keeps the
+    ``cache`` (a dict per line of the group,
+    :attr:`~stochcable.dynamics.coupled.group.GroupSystem.foss_cache`) keeps the
     drag-independent arrays (end-node rows of Φ, of the base response and of the
     static following, ω²·[static correction of âh] at those rows) from the first
     evaluation for the next ones: the same arrays, not recomputed (docs/BENCHMARKS.md
     pass E8).
     """
 
-    def __init__(self, system: LineSystem, inp: Any, damping: Damping,
-                 ends: tuple[int, ...], state: Any = None,
-                 cache: dict[str, Any] | None = None) -> None:
+    def __init__(
+        self,
+        system: LineSystem,
+        inp: Any,
+        damping: Damping,
+        ends: tuple[int, ...],
+        state: Any = None,
+        cache: dict[str, Any] | None = None,
+    ) -> None:
         prep = line_prep(system)
         w = inp.omega
         n_w, n_ch = inp.weights.shape
@@ -272,9 +300,9 @@ class FossLine:
         phi, _, _ = prep.modal(system)
         m, nf = phi.shape[1], phi.shape[0]
         lam = foss.lambdas
-        den = 1j * w[None, :] - lam[:, None]                      # (2m, n_w)
+        den = 1j * w[None, :] - lam[:, None]  # (2m, n_w)
         bad = np.abs(den) <= 1e-12 * np.maximum(np.abs(lam)[:, None], w[None, :])
-        if bad.any():   # the message of solvers._foss_transfer_modal
+        if bad.any():  # the message of solvers._foss_transfer_modal
             foss_transfer_modal(foss, np.zeros((m, n_w), dtype=complex), w, 1)
         w2, iw = w * w, 1j * w
         cache = _foss_cache(system, prep, inp, ends, phi, cache)
@@ -297,8 +325,8 @@ class FossLine:
         if m < nf:
             self.res0 = prep.residual(system, flat).reshape(nf, n_w, n_ch)
             st_b = prep.residual(system, b.astype(complex)).real
-            self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))   # (nf, 2 n_e)
-        y_adj = cache["pa"] @ foss.chi                               # (2d, 2m)
+            self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))  # (nf, 2 n_e)
+        y_adj = cache["pa"] @ foss.chi  # (2d, 2m)
         u4 = cache["u4"].copy()
         v = (y_adj @ p0.reshape(2 * m, -1)).reshape(2, d, n_w, n_ch)
         if self.res0 is not None:
@@ -308,16 +336,17 @@ class FossLine:
         # the unit columns' P_e = (ω² W âh − iω W b̂h)/(iω − λ) seen through y_adj, the
         # âh and b̂h rows stacked in one product with 1/(iω − λ) (rows as the separate
         # products', tested to the bit)
-        y2 = (y_adj[None, :, None, :] * wab.T.reshape(2, 1, n_e, 2 * m)
-              ).reshape(2 * 2 * d * n_e, 2 * m) @ rden
-        ya, yb = y2[:2 * d * n_e], y2[2 * d * n_e:]
+        y2 = (y_adj[None, :, None, :] * wab.T.reshape(2, 1, n_e, 2 * m)).reshape(
+            2 * 2 * d * n_e, 2 * m
+        ) @ rden
+        ya, yb = y2[: 2 * d * n_e], y2[2 * d * n_e :]
         ve = (w2 * ya - iw * yb).reshape(2, d, n_e, n_w)
         if self.st is not None:
-            sb = st_b[adj]                                           # (2d, n_e)
+            sb = st_b[adj]  # (2d, n_e)
             ve += (cache["w2sa"] - iw[None, None] * sb[:, :, None]).reshape(2, d, n_e, n_w)
         u4e[1:3] += ve.transpose(0, 1, 3, 2)
         f_end = end_loads(system, inp, damping)
-        self.sup0 = reactions(system, prep, c, u4, f_end, w)       # (n_w, 2d, n_ch)
+        self.sup0 = reactions(system, prep, c, u4, f_end, w)  # (n_w, 2d, n_ch)
         self.supe = reactions(system, prep, c, u4e, cache["zero_e"], w)
         self.inp, self.phi, self.chi, self.rden = inp, phi, foss.chi, rden
         self.p0, self.wab, self.up, self.u_p = p0, wab, up, u_p
@@ -332,11 +361,10 @@ class FossLine:
         n_ch) of the line whose attached ends move by ``ue`` (n_w, n_e, n_ch)."""
         m2, n_w, n_ch = self.p0.shape
         n_e = self.up.shape[2]
-        uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))       # (n_e, n_w, n_ch)
+        uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))  # (n_e, n_w, n_ch)
         flat_e = uet.reshape(n_e, n_w * n_ch)
         # W âh u_e and W b̂h u_e: the row blocks of one product (tested to the bit)
-        gab = (self.wab.reshape(m2, 2, n_e).transpose(1, 0, 2).reshape(2 * m2, n_e)
-               @ flat_e)
+        gab = self.wab.reshape(m2, 2, n_e).transpose(1, 0, 2).reshape(2 * m2, n_e) @ flat_e
         ga = gab[:m2].reshape(m2, n_w, n_ch)
         gb = gab[m2:].reshape(m2, n_w, n_ch)
         # p0 + (ω² ga − iω gb)/(iω − λ) in place (the sum commutes exactly)
@@ -349,7 +377,8 @@ class FossLine:
 
 
 class ModalLine:
-    """A Foss line of the coarse stage's group (:mod:`stochcable.dynamics.coupled.fixedpoint`): the modal equations of its kept modes
+    """A Foss line of the coarse stage's group (:mod:`stochcable.dynamics.coupled.fixedpoint`):
+    the modal equations of its kept modes
     (K̂ − ω²M̂ + iωĈ) z = Φᵀf solved per frequency (one batched dense LU for the
     physical channels and the unit end motions), no Foss eigenproblem.
 
@@ -361,14 +390,21 @@ class ModalLine:
     z_0 (n_w, m, n_ch), the unit end motions' z_e (n_w, m, n_e) (loads
     ω²âh − iωb̂h, :func:`foss_unit_split`); after the body solve z_0 + z_e u_e is
     reconstructed on the nodes with the static correction of the truncated modes.
-    ``cache`` (a dict per line of the coarse group, :attr:`~stochcable.dynamics.coupled.group.GroupSystem.modal_cache`) keeps
+    ``cache`` (a dict per line of the coarse group,
+    :attr:`~stochcable.dynamics.coupled.group.GroupSystem.modal_cache`) keeps
     the drag-independent arrays (static following, unit-motion mass loads, K̂ − ω²M̂,
     end-node rows) from the first coarse evaluation for the next ones: the same
     arrays, not recomputed (docs/BENCHMARKS.md pass E5c).
     """
 
-    def __init__(self, system: LineSystem, inp: Any, damping: Damping,
-                 ends: tuple[int, ...], cache: dict[str, Any] | None = None) -> None:
+    def __init__(
+        self,
+        system: LineSystem,
+        inp: Any,
+        damping: Damping,
+        ends: tuple[int, ...],
+        cache: dict[str, Any] | None = None,
+    ) -> None:
         prep = line_prep(system)
         w = inp.omega
         n_w, n_ch = inp.weights.shape
@@ -405,8 +441,8 @@ class ModalLine:
         if m < nf:
             self.res0 = prep.residual(system, flat).reshape(nf, n_w, n_ch)
             st_b = prep.residual(system, b.astype(complex)).real
-            self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))   # (nf, 2 n_e)
-        adj, pa = cache["adj"], cache["pa"]                            # (2d,), (2d, m)
+            self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))  # (nf, 2 n_e)
+        adj, pa = cache["adj"], cache["pa"]  # (2d,), (2d, m)
         u4 = cache["u4"].copy()
         v = np.transpose(pa @ z0, (1, 0, 2)).reshape(2, d, n_w, n_ch)
         if self.res0 is not None:
@@ -416,9 +452,8 @@ class ModalLine:
         u4e[...] = cache["up4"]
         ve = np.transpose(pa @ ze, (1, 0, 2)).reshape(2, d, n_w, n_e)
         if self.st is not None:
-            sb = st_b[adj]                                             # (2d, n_e)
-            ve += (cache["w2sa"] - iw[None, :, None] * sb[:, None, :]
-                   ).reshape(2, d, n_w, n_e)
+            sb = st_b[adj]  # (2d, n_e)
+            ve += (cache["w2sa"] - iw[None, :, None] * sb[:, None, :]).reshape(2, d, n_w, n_e)
         u4e[1:3] += ve
         f_end = end_loads(system, inp, damping)
         self.sup0 = reactions(system, prep, c, u4, f_end, w)
@@ -432,15 +467,21 @@ class ModalLine:
     def combine(self, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """As :meth:`FossLine.combine`."""
         n_w, m, n_ch = self.z0.shape
-        z = self.z0 + self.ze @ ue                                      # (n_w, m, n_ch)
+        z = self.z0 + self.ze @ ue  # (n_w, m, n_ch)
         zf = np.ascontiguousarray(np.transpose(z, (1, 0, 2))).reshape(m, n_w * n_ch)
         uf = real_gemm(self.phi, zf)
-        uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))       # (n_e, n_w, n_ch)
+        uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))  # (n_e, n_w, n_ch)
         return _assemble_line(self, uf, ue, uet)
 
 
-def _foss_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
-                phi: np.ndarray, cache: dict[str, Any] | None) -> dict[str, Any]:
+def _foss_cache(
+    system: LineSystem,
+    prep: Any,
+    inp: Any,
+    ends: tuple[int, ...],
+    phi: np.ndarray,
+    cache: dict[str, Any] | None,
+) -> dict[str, Any]:
     """The drag-independent arrays of a :class:`FossLine`, filled into ``cache`` (one
     per line of the group) on the first evaluation and kept for the later ones: the
     base response, the static following of the attached ends, the rows of the end
@@ -464,14 +505,16 @@ def _foss_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
     up4 = np.empty((4, d, n_w, n_e), dtype=complex)
     up4[...] = up[[0, 1, -2, -1]][:, :, None, :]
     cache["up4"] = up4
-    cache["w2sa"] = (None if st_a is None
-                     else w2[None, None] * st_a[adj][:, :, None])  # (2d, n_e, n_w)
-    cache["zero_e"] = np.zeros((2, d, n_w, n_e), complex)     # read only
+    cache["w2sa"] = (
+        None if st_a is None else w2[None, None] * st_a[adj][:, :, None]
+    )  # (2d, n_e, n_w)
+    cache["zero_e"] = np.zeros((2, d, n_w, n_e), complex)  # read only
     return cache
 
 
-def _modal_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
-                 cache: dict[str, Any] | None) -> dict[str, Any]:
+def _modal_cache(
+    system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...], cache: dict[str, Any] | None
+) -> dict[str, Any]:
     """The drag-independent arrays of a :class:`ModalLine`, filled into ``cache`` (one
     per line of the coarse group) on the first coarse evaluation and kept for the
     later ones: the base response, the static following and its mass loads, K̂ − ω²M̂,
@@ -491,8 +534,7 @@ def _modal_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
     cache["pa"] = phi[adj]
     cache["u4"] = cache["u_p"][[0, 1, -2, -1]]
     cache["up4"] = up[[0, 1, -2, -1]][:, :, None, :]
-    cache["w2sa"] = (None if st_a is None
-                     else w2[None, :, None] * st_a[adj][:, None, :])
+    cache["w2sa"] = None if st_a is None else w2[None, :, None] * st_a[adj][:, None, :]
     key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂, as analysis._foss_free
     if key not in prep.cache:
         prep.cache[key] = kh - (w2[:, None, None]) * mh
@@ -500,8 +542,9 @@ def _modal_cache(system: LineSystem, prep: Any, inp: Any, ends: tuple[int, ...],
     return cache
 
 
-def _assemble_line(part: Any, uf: np.ndarray, ue: np.ndarray, uet: np.ndarray
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def _assemble_line(
+    part: Any, uf: np.ndarray, ue: np.ndarray, uet: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The tail of :meth:`FossLine.combine` and :meth:`ModalLine.combine`: the free
     rows' modal displacement ``uf`` (nf, n_w·n_ch) plus the truncated modes' static
     correction (physical and unit channels), the static following of the end motions

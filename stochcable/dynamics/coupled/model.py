@@ -111,9 +111,14 @@ class CoupledModel:
     lonely: tuple[str, ...]
 
 
-def build_coupled(scene: Any, statics: Any, settings: Any, *,
-                  rigid_bodies: Mapping[str, RigidBody] | None = None,
-                  timing: dict[str, float] | None = None) -> CoupledModel:
+def build_coupled(
+    scene: Any,
+    statics: Any,
+    settings: Any,
+    *,
+    rigid_bodies: Mapping[str, RigidBody] | None = None,
+    timing: dict[str, float] | None = None,
+) -> CoupledModel:
     """Build the sea-independent part of the analysis of a scene with bodies.
 
     Parameters
@@ -151,34 +156,61 @@ def build_coupled(scene: Any, statics: Any, settings: Any, *,
     t0 = time.perf_counter()
     omega = settings.omega.values()
     body_docs = {b.name: b for b in scene.bodies}
-    prescribed = tuple(n for n, b in body_docs.items()
-                       if getattr(b, "prescribed", None) is not None)
+    prescribed = tuple(
+        n for n, b in body_docs.items() if getattr(b, "prescribed", None) is not None
+    )
     free, pose = _free_bodies(scene, statics, prescribed, rigid_bodies)
     raos = {n: vessel_rao(body_docs[n].prescribed, omega) for n in prescribed}
     systems: dict[str, LineSystem] = {}
     attach: dict[str, dict[str, str]] = {}
     for line in scene.lines:
-        systems[line.name] = build_line_system(scene, line, statics.lines[line.name],
-                                               settings=settings)
+        systems[line.name] = build_line_system(
+            scene, line, statics.lines[line.name], settings=settings
+        )
         attach[line.name] = _free_ends(line, prescribed)
     groups = _connected_groups(scene, free, attach)
     in_group = {b for lnames, bnames in groups for b in bnames}
-    mgroups = tuple(ModelGroup(lnames, bnames, _static_modes(
-        [CoupledLine(systems[n], (), end_a=attach[n].get("end_a"),
-                     end_b=attach[n].get("end_b")) for n in lnames],
-        [free[b] for b in bnames], omega)) for lnames, bnames in groups)
+    mgroups = tuple(
+        ModelGroup(
+            lnames,
+            bnames,
+            _static_modes(
+                [
+                    CoupledLine(
+                        systems[n], (), end_a=attach[n].get("end_a"), end_b=attach[n].get("end_b")
+                    )
+                    for n in lnames
+                ],
+                [free[b] for b in bnames],
+                omega,
+            ),
+        )
+        for lnames, bnames in groups
+    )
     if timing is not None:
         timing["model_s"] = timing.get("model_s", 0.0) + time.perf_counter() - t0
     return CoupledModel(
-        scene=scene, settings=settings, omega=omega, systems=systems, attach=attach,
-        free=free, pose=pose, prescribed=prescribed, vessel_rao=raos, groups=mgroups,
+        scene=scene,
+        settings=settings,
+        omega=omega,
+        systems=systems,
+        attach=attach,
+        free=free,
+        pose=pose,
+        prescribed=prescribed,
+        vessel_rao=raos,
+        groups=mgroups,
         independent=tuple(ln.name for ln in scene.lines if not attach[ln.name]),
-        lonely=tuple(n for n in free if n not in in_group))
+        lonely=tuple(n for n in free if n not in in_group),
+    )
 
 
-def _free_bodies(scene: Any, statics: Any, prescribed: tuple[str, ...],
-                 rigid_bodies: Mapping[str, RigidBody] | None
-                 ) -> tuple[dict[str, RigidBody], dict[str, np.ndarray]]:
+def _free_bodies(
+    scene: Any,
+    statics: Any,
+    prescribed: tuple[str, ...],
+    rigid_bodies: Mapping[str, RigidBody] | None,
+) -> tuple[dict[str, RigidBody], dict[str, np.ndarray]]:
     """The free bodies at their static pose with their gravity restoring, and the
     pose of each DOF."""
     env = scene.environment
@@ -215,7 +247,8 @@ def _free_bodies(scene: Any, statics: Any, prescribed: tuple[str, ...],
             vol = getattr(doc, "displaced_volume", None) or 0.0
             cob = getattr(doc, "centre_of_buoyancy", None)
             extra = extra + body_gravity_stiffness(
-                body, vol, np.zeros(3) if cob is None else cob, env.rho, env.g)
+                body, vol, np.zeros(3) if cob is None else cob, env.rho, env.g
+            )
         free[name] = dataclasses.replace(body, position=pos, extra_stiffness=extra)
     return free, pose
 
@@ -224,14 +257,17 @@ def _static_rotation_check(name: str, rotation: np.ndarray) -> None:
     """PhysicsWarning when a body's static rotation exceeds STATIC_ROTATION_LIMIT."""
     angle = float(np.linalg.norm(rotation))
     if angle > STATIC_ROTATION_LIMIT:
-        warn(f"body '{name}': its static rotation is {math.degrees(angle):.3g}° "
-             f"(rotation vector {np.round(np.degrees(rotation), 3).tolist()} deg), above "
-             f"{math.degrees(STATIC_ROTATION_LIMIT):g}°: the dynamics use its mass, inertia, "
-             "added mass, damping, hydrostatic stiffness, excitation and drag point at the "
-             "input orientation (only the line attachment arms follow the rotation), so "
-             "they are off by about the sine of that angle; give the body's data at its "
-             "static orientation (rotate them and the attachment points) and re-run",
-             PhysicsWarning, stacklevel=4)
+        warn(
+            f"body '{name}': its static rotation is {math.degrees(angle):.3g}° "
+            f"(rotation vector {np.round(np.degrees(rotation), 3).tolist()} deg), above "
+            f"{math.degrees(STATIC_ROTATION_LIMIT):g}°: the dynamics use its mass, inertia, "
+            "added mass, damping, hydrostatic stiffness, excitation and drag point at the "
+            "input orientation (only the line attachment arms follow the rotation), so "
+            "they are off by about the sine of that angle; give the body's data at its "
+            "static orientation (rotate them and the attachment points) and re-run",
+            PhysicsWarning,
+            stacklevel=4,
+        )
 
 
 def _free_ends(line: Any, prescribed: tuple[str, ...]) -> dict[str, str]:
@@ -245,9 +281,9 @@ def _free_ends(line: Any, prescribed: tuple[str, ...]) -> dict[str, str]:
     return att
 
 
-def _connected_groups(scene: Any, free: Mapping[str, RigidBody],
-                      attach: Mapping[str, Mapping[str, str]]
-                      ) -> list[tuple[tuple[str, ...], tuple[str, ...]]]:
+def _connected_groups(
+    scene: Any, free: Mapping[str, RigidBody], attach: Mapping[str, Mapping[str, str]]
+) -> list[tuple[tuple[str, ...], tuple[str, ...]]]:
     """Each connected component of free bodies and their lines (union–find over the
     lines' attached ends): (lines in scene order, bodies in scene order), in the scene
     order of the first line."""
@@ -266,12 +302,12 @@ def _connected_groups(scene: Any, free: Mapping[str, RigidBody],
     for line in scene.lines:
         if attach[line.name]:
             groups.setdefault(root(next(iter(attach[line.name].values()))), []).append(line.name)
-    return [(tuple(lnames), tuple(n for n in free if root(n) == r))
-            for r, lnames in groups.items()]
+    return [(tuple(lnames), tuple(n for n in free if root(n) == r)) for r, lnames in groups.items()]
 
 
-def _static_modes(lines: list[CoupledLine], bodies: list[RigidBody], omega: np.ndarray
-                  ) -> CoupledModes | None:
+def _static_modes(
+    lines: list[CoupledLine], bodies: list[RigidBody], omega: np.ndarray
+) -> CoupledModes | None:
     """The group's coupled modes when no body's added mass is tabulated over ω (then
     A(ω_ref) is the same array for every ω_ref: the same modes to the bit; ``omega_ref``
     is set by the solve); else None."""

@@ -22,9 +22,9 @@ import scipy.linalg as sla
 
 from stochcable.bodies.coupling import LineLink, constant_matrices, couple
 from stochcable.bodies.rigid import RigidBody, attachment_geometric_stiffness, rigid_link_matrix
+from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep
 from stochcable.dynamics.coupled.group import body_drag_matrix
 from stochcable.dynamics.coupled.inputs import CoupledLine
-from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep
 from stochcable.dynamics.line_loads import drag_blocks
 from stochcable.errors import InputError
 
@@ -46,8 +46,6 @@ _DENSE_MODES = 1500
 # Dense eigenproblems up to this size are solved whole (LAPACK divide and conquer)
 # and the listed modes kept; larger ones by the subset driver (``_listed_eigh``).
 _ALL_EIGH_MAX = 256
-
-
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,13 +79,22 @@ class CoupledModes:
     line_shapes: dict[str, np.ndarray] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
-        return {"omega": self.omega.tolist(), "body_fraction": self.body_fraction.tolist(),
-                "omega_ref": float(self.omega_ref), "asymmetry": float(self.asymmetry)}
+        return {
+            "omega": self.omega.tolist(),
+            "body_fraction": self.body_fraction.tolist(),
+            "omega_ref": float(self.omega_ref),
+            "asymmetry": float(self.asymmetry),
+        }
 
 
-def coupled_modes(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
-                  omega_ref: float, omega_top: float, *,
-                  method: str = "auto") -> CoupledModes:
+def coupled_modes(
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    omega_ref: float,
+    omega_top: float,
+    *,
+    method: str = "auto",
+) -> CoupledModes:
     """Natural modes of lines and bodies coupled by rigid links.
 
     Parameters
@@ -129,10 +136,12 @@ def coupled_modes(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
     top = (LISTED_MODE_FACTOR * omega_top) ** 2
     if method == "auto":
         ok = bool(lines) and all(
-            cl.system.modes is not None and cl.system.modes.count
+            cl.system.modes is not None
+            and cl.system.modes.count
             and float(np.max(cl.system.modes.omega)) >= _CB_MIN_RATIO * math.sqrt(top)
-            and cl.system.model.free.size == (cl.system.model.n_nodes - 2)
-            * cl.system.model.dim for cl in lines)
+            and cl.system.model.free.size == (cl.system.model.n_nodes - 2) * cl.system.model.dim
+            for cl in lines
+        )
         method = "reduced" if ok else "full"
     if method == "reduced":
         return _coupled_modes_reduced(lines, bodies, omega_ref, top)
@@ -144,16 +153,17 @@ def coupled_modes(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
 _CB_MIN_RATIO = 1.5
 
 
-def _fixed_body_rows(bodies: Sequence[RigidBody], body_dofs: Mapping[str, np.ndarray]
-                     ) -> np.ndarray:
+def _fixed_body_rows(
+    bodies: Sequence[RigidBody], body_dofs: Mapping[str, np.ndarray]
+) -> np.ndarray:
     """Coupled indices of the fixed body DOFs."""
-    out = [body_dofs[b.name][i] for b in bodies
-           for i, n in enumerate(b.dof_names) if n in b.fixed_dofs]
+    out = [
+        body_dofs[b.name][i] for b in bodies for i, n in enumerate(b.dof_names) if n in b.fixed_dofs
+    ]
     return np.asarray(out, dtype=int)
 
 
-def _listed_eigh(kd: np.ndarray, md: np.ndarray, top: float
-                 ) -> tuple[np.ndarray, np.ndarray]:
+def _listed_eigh(kd: np.ndarray, md: np.ndarray, top: float) -> tuple[np.ndarray, np.ndarray]:
     n = kd.shape[0]
     if n == 0:
         return np.zeros(0), np.zeros((0, 0))
@@ -170,13 +180,21 @@ def _listed_eigh(kd: np.ndarray, md: np.ndarray, top: float
     return lam, phi
 
 
-def _coupled_modes_full(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
-                        omega_ref: float, top: float) -> CoupledModes:
+def _coupled_modes_full(
+    lines: Sequence[CoupledLine], bodies: Sequence[RigidBody], omega_ref: float, top: float
+) -> CoupledModes:
     """:func:`coupled_modes` on the assembled system (the reference)."""
-    links = [LineLink(cl.name, cl.system.model, end_a=cl.end_a, end_b=cl.end_b,
-                      force_a=cl.system.statics.force_a if cl.end_a else None,
-                      force_b=cl.system.statics.force_b if cl.end_b else None)
-             for cl in lines]
+    links = [
+        LineLink(
+            cl.name,
+            cl.system.model,
+            end_a=cl.end_a,
+            end_b=cl.end_b,
+            force_a=cl.system.statics.force_a if cl.end_a else None,
+            force_b=cl.system.statics.force_b if cl.end_b else None,
+        )
+        for cl in lines
+    ]
     system = couple(links, bodies)
     K, M, _ = constant_matrices(system, omega_ref)
     asym = system.asymmetry()
@@ -204,15 +222,25 @@ def _coupled_modes_full(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody
     J = system.body_index
     frac = np.einsum("jn,jn->n", full[J], mfull[J]) if J.size else np.zeros(lam.size)
     shapes = {b.name: full[system.body_dofs[b.name]].copy() for b in bodies}
-    lshapes = {cl.name: np.asarray(system.link_maps[cl.name][0] @ full).reshape(
-        cl.system.model.n_nodes, cl.system.model.dim, lam.size) for cl in lines}
-    return CoupledModes(omega=np.sqrt(np.clip(lam, 0.0, None)),
-                        body_fraction=np.clip(frac, 0.0, 1.0), body_shapes=shapes,
-                        omega_ref=float(omega_ref), asymmetry=asym, line_shapes=lshapes)
+    lshapes = {
+        cl.name: np.asarray(system.link_maps[cl.name][0] @ full).reshape(
+            cl.system.model.n_nodes, cl.system.model.dim, lam.size
+        )
+        for cl in lines
+    }
+    return CoupledModes(
+        omega=np.sqrt(np.clip(lam, 0.0, None)),
+        body_fraction=np.clip(frac, 0.0, 1.0),
+        body_shapes=shapes,
+        omega_ref=float(omega_ref),
+        asymmetry=asym,
+        line_shapes=lshapes,
+    )
 
 
-def _coupled_modes_reduced(lines: Sequence[CoupledLine], bodies: Sequence[RigidBody],
-                           omega_ref: float, top: float) -> CoupledModes:
+def _coupled_modes_reduced(
+    lines: Sequence[CoupledLine], bodies: Sequence[RigidBody], omega_ref: float, top: float
+) -> CoupledModes:
     """:func:`coupled_modes` by the Craig–Bampton reduction (its Notes)."""
     by_name = {b.name: b for b in bodies}
     off, nb = {}, 0
@@ -224,7 +252,7 @@ def _coupled_modes_reduced(lines: Sequence[CoupledLine], bodies: Sequence[RigidB
         sl = slice(off[b.name], off[b.name] + b.n_dof)
         kb[sl, sl] = b.hydrostatic_stiffness + b.extra_stiffness
         mb[sl, sl] = b.mass_matrix() + b.added_mass_at(np.array([omega_ref]))[0]
-    parts = []          # per line: (L (n_dof, m + nb), K, M, end rows, T, offset, m)
+    parts = []  # per line: (L (n_dof, m + nb), K, M, end rows, T, offset, m)
     top_k = 0.0
     kb_lines = np.zeros((nb, nb))
     m_tot = 0
@@ -245,8 +273,9 @@ def _coupled_modes_reduced(lines: Sequence[CoupledLine], bodies: Sequence[RigidB
         mr[np.ix_(idx, idx)] += ell.T @ md_ @ ell
     kr[m_tot:, m_tot:] += kb
     mr[m_tot:, m_tot:] += mb
-    fixed = m_tot + _fixed_body_rows(bodies, {b.name: np.arange(off[b.name], off[b.name]
-                                                                 + b.n_dof) for b in bodies})
+    fixed = m_tot + _fixed_body_rows(
+        bodies, {b.name: np.arange(off[b.name], off[b.name] + b.n_dof) for b in bodies}
+    )
     keep = np.setdiff1d(np.arange(n), fixed)
     ks = 0.5 * (kr + kr.T)[np.ix_(keep, keep)]
     ms = 0.5 * (mr + mr.T)[np.ix_(keep, keep)]
@@ -258,19 +287,29 @@ def _coupled_modes_reduced(lines: Sequence[CoupledLine], bodies: Sequence[RigidB
     mxi = mb @ xi
     lshapes = {}
     for cl, (ell, _, md_, ends, t, o, m) in zip(lines, parts):
-        u = ell @ np.r_[zf[o:o + m], xi]
+        u = ell @ np.r_[zf[o : o + m], xi]
         mxi += t.T @ (md_[ends] @ u)
         lshapes[cl.name] = u.reshape(cl.system.model.n_nodes, cl.system.model.dim, lam.size)
     frac = np.einsum("jn,jn->n", xi, mxi) if nb else np.zeros(lam.size)
-    shapes = {b.name: xi[off[b.name]:off[b.name] + b.n_dof].copy() for b in bodies}
-    return CoupledModes(omega=np.sqrt(np.clip(lam, 0.0, None)),
-                        body_fraction=np.clip(frac, 0.0, 1.0), body_shapes=shapes,
-                        omega_ref=float(omega_ref), asymmetry=asym, line_shapes=lshapes)
+    shapes = {b.name: xi[off[b.name] : off[b.name] + b.n_dof].copy() for b in bodies}
+    return CoupledModes(
+        omega=np.sqrt(np.clip(lam, 0.0, None)),
+        body_fraction=np.clip(frac, 0.0, 1.0),
+        body_shapes=shapes,
+        omega_ref=float(omega_ref),
+        asymmetry=asym,
+        line_shapes=lshapes,
+    )
 
 
-def _reduced_line(cl: CoupledLine, by_name: Mapping[str, RigidBody],
-                  off: Mapping[str, int], nb: int, kb: np.ndarray, offset: int
-                  ) -> tuple[tuple[Any, ...], float, np.ndarray]:
+def _reduced_line(
+    cl: CoupledLine,
+    by_name: Mapping[str, RigidBody],
+    off: Mapping[str, int],
+    nb: int,
+    kb: np.ndarray,
+    offset: int,
+) -> tuple[tuple[Any, ...], float, np.ndarray]:
     """One line of the Craig–Bampton reduction: its part (L (n_dof, m + nb) = [Φ, G T]
     on the free rows and T on the end rows, K, M + M_a, end rows, T, ``offset`` of its
     modal coordinates, m), the largest entry of its free rows' assembled stiffness and
@@ -285,8 +324,9 @@ def _reduced_line(cl: CoupledLine, by_name: Mapping[str, RigidBody],
         body = by_name[bname]
         node = 0 if k == 0 else nn - 1
         r = model.positions[node] - body.position
-        t[k * d:(k + 1) * d, off[bname]:off[bname] + body.n_dof] = rigid_link_matrix(
-            r, planar=body.planar)
+        t[k * d : (k + 1) * d, off[bname] : off[bname] + body.n_dof] = rigid_link_matrix(
+            r, planar=body.planar
+        )
         st = cl.system.statics
         f = np.asarray(st.force_a if k == 0 else st.force_b, dtype=float)
         sl = slice(off[bname], off[bname] + body.n_dof)
@@ -299,7 +339,7 @@ def _reduced_line(cl: CoupledLine, by_name: Mapping[str, RigidBody],
     # block Tᵀ K_ends T (the selection rows of Lᵀ taken by indexing)
     lp = np.zeros((model.n_dof, model.free.size + nb))
     lp[model.free, np.arange(model.free.size)] = 1.0
-    lp[ends, model.free.size:] = t
+    lp[ends, model.free.size :] = t
     k_top = float(np.abs(kd_[model.free] @ lp).max(initial=0.0))
     k_ends = t.T @ kd_[np.ix_(ends, ends)] @ t
     ell = np.zeros((model.n_dof, m + nb))
@@ -312,10 +352,13 @@ def _reduced_line(cl: CoupledLine, by_name: Mapping[str, RigidBody],
 # ------------------------------------------------- modal damping of the coupled modes
 
 
-def coupled_modal_bandwidths(modes: CoupledModes, lines: Sequence[CoupledLine],
-                             bodies: Sequence[RigidBody], line_damping: Mapping[str, Any],
-                             body_drag: Mapping[str, np.ndarray] | None = None
-                             ) -> np.ndarray:
+def coupled_modal_bandwidths(
+    modes: CoupledModes,
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    line_damping: Mapping[str, Any],
+    body_drag: Mapping[str, np.ndarray] | None = None,
+) -> np.ndarray:
     """Half-power bandwidths 2ζ_nω_n of the coupled modes: the diagonal of the modal
     damping.
 
@@ -362,8 +405,7 @@ def coupled_modal_bandwidths(modes: CoupledModes, lines: Sequence[CoupledLine],
     return band
 
 
-def line_mode_shares(modes: CoupledModes, lines: Sequence[CoupledLine]
-                     ) -> dict[str, np.ndarray]:
+def line_mode_shares(modes: CoupledModes, lines: Sequence[CoupledLine]) -> dict[str, np.ndarray]:
     """Share of each coupled mode's kinetic energy in each line.
 
     Parameters

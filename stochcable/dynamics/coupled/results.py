@@ -12,8 +12,8 @@ from stochcable.bodies.rigid import PLANAR_INDEX, RigidBody
 from stochcable.dynamics.coupled.fixedpoint import CoupledLinearization
 from stochcable.dynamics.coupled.inputs import CoupledLine
 from stochcable.dynamics.coupled.modes import CoupledModes
-from stochcable.dynamics.outputs import line_result
 from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.outputs import line_result
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 
 __all__ = ["body_result", "coupled_results"]
@@ -52,8 +52,9 @@ def coupled_results(
     """
     out_lines = {}
     for cl in lines:
-        out_lines[cl.name] = line_result(cl.system, cl.channels,
-                                         linearization.lines[cl.name], settings)
+        out_lines[cl.name] = line_result(
+            cl.system, cl.channels, linearization.lines[cl.name], settings
+        )
     ch = tuple(lines[0].channels if channels is None else channels)
     spectra = np.stack([c.spectrum for c in ch])
     w = ch[0].omega
@@ -65,25 +66,54 @@ def coupled_results(
         else:
             full = np.concatenate([b.position, np.zeros(3)])
             mean = full[list(PLANAR_INDEX)] if b.planar else full
-        out_bodies[b.name] = body_result(b.name, b.dof_names, w, tuple(c.name for c in ch),
-                                         spectra, h, mean, settings.duration,
-                                         sigma=linearization.body_sigma.get(b.name),
-                                         drag=linearization.body_drag.get(b.name),
-                                         modes=modes, prescribed=False)
+        out_bodies[b.name] = body_result(
+            b.name,
+            b.dof_names,
+            w,
+            tuple(c.name for c in ch),
+            spectra,
+            h,
+            mean,
+            settings.duration,
+            sigma=linearization.body_sigma.get(b.name),
+            drag=linearization.body_drag.get(b.name),
+            modes=modes,
+            prescribed=False,
+        )
     return out_lines, out_bodies
 
 
-def body_result(name: str, dofs: Sequence[str], omega: np.ndarray,
-                channels: tuple[str, ...], spectra: np.ndarray, transfer: np.ndarray,
-                mean: np.ndarray, duration: float, *, sigma: Any = None, drag: Any = None,
-                modes: CoupledModes | None = None, prescribed: bool = False) -> BodyResult:
+def body_result(
+    name: str,
+    dofs: Sequence[str],
+    omega: np.ndarray,
+    channels: tuple[str, ...],
+    spectra: np.ndarray,
+    transfer: np.ndarray,
+    mean: np.ndarray,
+    duration: float,
+    *,
+    sigma: Any = None,
+    drag: Any = None,
+    modes: CoupledModes | None = None,
+    prescribed: bool = False,
+) -> BodyResult:
     """Statistics of a body's motion from its transfer functions (see BodyResult)."""
     dens = np.einsum("cdw,cw->dw", np.abs(transfer) ** 2, spectra)
-    stats = {dof: stats_from_spectrum(omega, dens[i], float(mean[i]), duration)
-             for i, dof in enumerate(dofs)}
-    return BodyResult(name=name, dofs=tuple(dofs), omega=np.asarray(omega).copy(),
-                      channels=tuple(channels), input_spectra=np.asarray(spectra).copy(),
-                      motion_transfer=transfer, motion=stats, prescribed=prescribed,
-                      drag_sigma=None if sigma is None else np.asarray(sigma).copy(),
-                      drag_coefficient=None if drag is None else np.asarray(drag).copy(),
-                      modes=modes)
+    stats = {
+        dof: stats_from_spectrum(omega, dens[i], float(mean[i]), duration)
+        for i, dof in enumerate(dofs)
+    }
+    return BodyResult(
+        name=name,
+        dofs=tuple(dofs),
+        omega=np.asarray(omega).copy(),
+        channels=tuple(channels),
+        input_spectra=np.asarray(spectra).copy(),
+        motion_transfer=transfer,
+        motion=stats,
+        prescribed=prescribed,
+        drag_sigma=None if sigma is None else np.asarray(sigma).copy(),
+        drag_coefficient=None if drag is None else np.asarray(drag).copy(),
+        modes=modes,
+    )
