@@ -31,8 +31,9 @@ def test_readme_python_block_runs(index, monkeypatch):
         warnings.simplefilter("ignore")
         exec(compile(BLOCKS[index], f"README.md python block {index}", "exec"), namespace)
     if "engine" in namespace:
-        import stochcable
         from _compare import assert_close_documents
+
+        import stochcable
 
         scene = namespace["scene"]
         doc = scene.model_dump(mode="json")
