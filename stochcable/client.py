@@ -161,7 +161,8 @@ def _response_stats(doc: Mapping[str, Any]) -> ResponseStats:
 
 @dataclass(frozen=True, eq=False)
 class LineDocument:
-    """One line of an analysis result, named as on :class:`~stochcable.results.documents.LineResult`.
+    """One line of an analysis result, named as on
+    :class:`~stochcable.results.documents.LineResult`.
 
     Attributes
     ----------

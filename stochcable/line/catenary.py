@@ -315,7 +315,7 @@ def _vertical_solve(Z, L, w, c, seabed):
         hi = 2.0 * hi + Tsc
     while zend(lo) > Z:
         lo = 2.0 * lo - Tsc
-    for it in range(1, 400):
+    for it in range(1, 400):  # noqa: B007 - the bisection count is returned
         mid = 0.5 * (lo + hi)
         if zend(mid) < Z:
             lo = mid
@@ -380,8 +380,9 @@ def catenary_solve(
     Notes
     -----
     Closure equations of the elastic catenary (Irvine 1981, ch. 2; seed 000 eqs.
-    (2.5)–(2.6) integrated with T = H/cos φ, eq. (3.28)) with the seabed extension of the grounded length
-    L_B = L − V_b/w carrying the constant tension H.  Solved by Newton on (H, V_a) with
+    (2.5)–(2.6) integrated with T = H/cos φ, eq. (3.28)) with the seabed extension of
+    the grounded length L_B = L − V_b/w carrying the constant tension H.  Solved by
+    Newton on (H, V_a) with
     an analytic, symmetric Jacobian, a backtracking line search and H kept positive.
     The start is the inextensible estimate of Peyrot & Goulois (1979) (λ from
     (L² − Z²)/X² = 1 + λ²/3) for slack lines and a parabolic elastic estimate for taut

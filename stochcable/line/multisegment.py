@@ -169,7 +169,7 @@ def catenary_multisegment(
     r, J = closure(H, Va)
     nr = float(np.max(np.abs(r)))
     it = 0
-    for it in range(1, MAX_NEWTON + 1):
+    for it in range(1, MAX_NEWTON + 1):  # noqa: B007 - the count goes into the error
         if nr <= tol:
             break
         d = np.linalg.solve(J, -r)

@@ -54,7 +54,7 @@ def _solve_kh(x: np.ndarray) -> np.ndarray:
         return x.copy()
     t = np.tanh(x**0.75)
     y = x / t ** (2.0 / 3.0)
-    for it in range(1, _NEWTON_MAX + 1):
+    for _ in range(_NEWTON_MAX):
         t = np.tanh(y)
         f = y * t
         f -= x
