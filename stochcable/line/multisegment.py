@@ -13,8 +13,9 @@ from numpy.typing import ArrayLike
 
 from stochcable import validation as v
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.line.catenary import check_reach, elastic_catenary, newton_start
+from stochcable.line.catenary import elastic_catenary
 from stochcable.line.catenary_kernel import CLOSURE_TOL, MAX_NEWTON, kernel
+from stochcable.line.catenary_start import check_reach, newton_start
 
 __all__ = ["MultiSegmentSolution", "catenary_multisegment"]
 
