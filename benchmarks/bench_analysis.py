@@ -25,7 +25,7 @@ import time
 import warnings
 from pathlib import Path
 
-from _host import host_line
+from host_probe import host_line
 
 from stochcable.analysis import analyze
 from stochcable.scene.model import load_scene

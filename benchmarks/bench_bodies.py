@@ -37,7 +37,7 @@ import warnings
 from typing import Any
 
 import numpy as np
-from _host import host_line
+from host_probe import host_line
 
 import stochcable.dynamics.coupled as coupled_analysis
 from stochcable.analysis import analyze

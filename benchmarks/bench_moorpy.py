@@ -261,7 +261,8 @@ def main() -> None:
     for (method, n), r in sc.items():
         td = float("nan") if r["touchdown"] is None else r["touchdown"]
         print(
-            f"  stochcable {method:8s} {n:3d} el  T_a {r['TA'] / 1e3:9.3f}  T_b {r['TB'] / 1e3:9.3f}"
+            f"  stochcable {method:8s} {n:3d} el"
+            f"  T_a {r['TA'] / 1e3:9.3f}  T_b {r['TB'] / 1e3:9.3f}"
             f"  touchdown {td:7.2f}  {1e3 * r['t']:7.3f} / {1e3 * r['t_min']:.3f} ms"
         )
     if have_moorpy:
@@ -297,7 +298,8 @@ def main() -> None:
         f"σx on the grid {sigma_x:.4f} m (trapezoid)"
     )
     print(
-        f"  stochcable analyze, 40 el: end σ_a {st['std_a'] / 1e3:.3f}, σ_b {st['std_b'] / 1e3:.3f}; "
+        f"  stochcable analyze, 40 el: "
+        f"end σ_a {st['std_a'] / 1e3:.3f}, σ_b {st['std_b'] / 1e3:.3f}; "
         f"end elements σ_a {st['el_std_a'] / 1e3:.3f}, σ_b {st['el_std_b'] / 1e3:.3f}; "
         f"{st['iterations']} iterations; {1e3 * st['t']:.1f} / {1e3 * st['t_min']:.1f} ms; "
         f"warnings {st['warnings']}"
@@ -360,10 +362,12 @@ def main() -> None:
         ref = st if seg == 40 else st160
         print(
             f"  {name}: σ_a {r['std_a'] / 1e3:.3f}, σ_b {r['std_b'] / 1e3:.3f}; "
-            f"{r['solves']} linear solves (= iterations); {1e3 * r['t']:.0f} / {1e3 * r['t_min']:.0f} ms"
+            f"{r['solves']} linear solves (= iterations); "
+            f"{1e3 * r['t']:.0f} / {1e3 * r['t_min']:.0f} ms"
         )
         print(
-            f"      MoorPy / stochcable − 1: vs end elements σ_a {r['std_a'] / ref['el_std_a'] - 1:+.3f}, "
+            "      MoorPy / stochcable − 1: "
+            f"vs end elements σ_a {r['std_a'] / ref['el_std_a'] - 1:+.3f}, "
             f"σ_b {r['std_b'] / ref['el_std_b'] - 1:+.3f}; vs end reactions "
             f"σ_a {r['std_a'] / ref['std_a'] - 1:+.3f}, σ_b {r['std_b'] / ref['std_b'] - 1:+.3f}"
         )

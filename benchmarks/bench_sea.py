@@ -26,7 +26,7 @@ import sys
 import time
 
 import numpy as np
-from _host import host_line
+from host_probe import host_line
 
 from stochcable.sea import fft as _fft
 from stochcable.sea import realization as sea

@@ -69,9 +69,9 @@ def _start_server(port: int) -> subprocess.Popen:
         try:
             httpx.get(f"http://127.0.0.1:{port}/health", timeout=1.0)
             return proc
-        except httpx.TransportError:
+        except httpx.TransportError as err:
             if proc.poll() is not None:
-                raise SystemExit("uvicorn exited during start-up")
+                raise SystemExit("uvicorn exited during start-up") from err
             time.sleep(0.1)
     proc.kill()
     raise SystemExit("uvicorn did not start within 30 s")

@@ -741,7 +741,7 @@ def pareto_front(times: Sequence[float], errors: Sequence[float]) -> list[int]:
     ]
     pts.sort(key=lambda p: (p[0], p[1]))
     front, best = [], math.inf
-    for t, e, i in pts:
+    for _t, e, i in pts:
         if e < best:
             front.append(i)
             best = e
@@ -1046,7 +1046,9 @@ def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
     L.append("## Summary")
     L.append("")
     L.append(
-        "| scene | default time | same with solver direct | default error (fairlead / anchor / motion) | cheapest ≤ 1 % fairlead | its time | FD/TD fairlead (95 % CI) |"
+        "| scene | default time | same with solver direct "
+        "| default error (fairlead / anchor / motion) | cheapest ≤ 1 % fairlead | its time "
+        "| FD/TD fairlead (95 % CI) |"
     )
     L.append("|---|---|---|---|---|---|---|")
     for sc in study.scenes:
@@ -1132,7 +1134,8 @@ def _scene_section(sc: SceneStudy, plot_dir_rel: str) -> list[str]:
             )
             L.append("")
             L.append(
-                "| quantity | σ_TD mean | 95 % CI | FD same mesh | FD/TD (95 % CI) | FD reference / TD |"
+                "| quantity | σ_TD mean | 95 % CI | FD same mesh | FD/TD (95 % CI) "
+                "| FD reference / TD |"
             )
             L.append("|---|---|---|---|---|---|")
             for q in QUANTITIES:
@@ -1226,7 +1229,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--td-scenes",
         nargs="*",
         default=None,
-        help="scenes with the time-domain reference (default: all; quick: taut_wire chain_catenary)",
+        help="time-domain reference scenes (default: all; quick: taut_wire chain_catenary)",
     )
     ap.add_argument("--td-seeds", type=int, default=None)
     ap.add_argument("--td-duration", type=float, default=None)

@@ -61,7 +61,7 @@ def negotiate(request: Request) -> str:
     if not accept.strip():
         return JSON
     best, best_q = None, 0.0
-    for order, part in enumerate(accept.split(",")):
+    for part in accept.split(","):
         fields = [f.strip() for f in part.split(";")]
         media = fields[0].lower()
         q = 1.0

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import threading
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from typing import Any
 
@@ -23,6 +23,8 @@ __all__ = [
     "ResolutionWarning",
     "warn",
     "collect_warnings",
+    "forward_warnings",
+    "isolated_warnings",
 ]
 
 
@@ -175,3 +177,40 @@ def collect_warnings() -> Iterator[list[Warning]]:
         yield sink
     finally:
         sinks.remove(sink)
+
+
+def forward_warnings(caught: Iterable[Warning]) -> None:
+    """Record warnings in this thread's open :func:`collect_warnings` blocks.
+
+    For warnings :func:`warn` issued (and collected) in another thread on this
+    thread's behalf, e.g. by the workers of :func:`stochcable.runtime.line_map`: they
+    reach every collector open here, as if issued here, but are not issued again
+    through :mod:`warnings` (that happened where they arose).
+
+    Parameters
+    ----------
+    caught : iterable of Warning
+        The warnings, in the order to record them.
+    """
+    sinks = getattr(_local, "sinks", None)
+    if not sinks:
+        return
+    caught = list(caught)
+    for sink in sinks:
+        sink.extend(caught)
+
+
+@contextmanager
+def isolated_warnings() -> Iterator[None]:
+    """Hide this thread's open :func:`collect_warnings` blocks inside the block.
+
+    :func:`warn` inside reaches only the collectors opened inside; the outer ones are
+    restored on exit.  For code that collects per item and forwards the items'
+    warnings later, once and in order (:func:`forward_warnings`).
+    """
+    saved = getattr(_local, "sinks", None)
+    _local.sinks = []
+    try:
+        yield
+    finally:
+        _local.sinks = saved

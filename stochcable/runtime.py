@@ -354,23 +354,21 @@ def _drain(
     _worker.active = True
     # the caller's own collectors get every item's warnings once, in item order, after
     # the map: hide them while the caller runs items here
-    sinks = getattr(_errors._local, "sinks", None)
-    _errors._local.sinks = []
     try:
-        while True:
-            with lock:
-                i = state["next"]
-                state["next"] = i + 1
-            if i >= len(items):
-                return
-            with _errors.collect_warnings() as caught:
-                try:
-                    out[i] = (fn(items[i]), None, caught)
-                except Exception as exc:  # noqa: BLE001 - re-raised by the caller
-                    out[i] = (None, exc, caught)
+        with _errors.isolated_warnings():
+            while True:
+                with lock:
+                    i = state["next"]
+                    state["next"] = i + 1
+                if i >= len(items):
+                    return
+                with _errors.collect_warnings() as caught:
+                    try:
+                        out[i] = (fn(items[i]), None, caught)
+                    except Exception as exc:  # noqa: BLE001 - re-raised by the caller
+                        out[i] = (None, exc, caught)
     finally:
         _worker.active = was
-        _errors._local.sinks = sinks
 
 
 def line_map(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
@@ -392,10 +390,8 @@ def line_map(fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
     _drain(fn, items, out, state, lock)
     for f in futures:
         f.result()
-    sinks = getattr(_errors._local, "sinks", None) or ()
     for _, _, caught in out:
-        for sink in sinks:
-            sink.extend(caught)
+        _errors.forward_warnings(caught)
     for _, exc, _ in out:
         if exc is not None:
             raise exc

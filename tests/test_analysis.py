@@ -1,4 +1,5 @@
-"""Tests of the analysis pipeline (stochcable.analysis, stochcable.dynamics.*, stochcable.results.documents)."""
+"""Tests of the analysis pipeline (stochcable.analysis, stochcable.dynamics.*,
+stochcable.results.documents)."""
 
 from __future__ import annotations
 

@@ -488,7 +488,8 @@ def test_sliced_channel_keeps_nodal_kinematics_lazy():
 def test_listed_eigh_whole_driver_equals_subset_driver(top):
     """``_listed_eigh`` below ``_ALL_EIGH_MAX`` (every eigenpair by ``gvd``, then the
     listed ones) against the subset driver ``gvx`` on a random SPD pencil (n = 60,
-    eigenvalues 0.047–167; 5 below 0.5, 38 below 40, none within 1 % of a top): the same listed count, the
+    eigenvalues 0.047–167; 5 below 0.5, 38 below 40, none within 1 % of a top): the same
+    listed count, the
     eigenvalues to 1e-10 relative (round-off of two LAPACK drivers), M-orthonormal
     vectors; below 10 listed, the lowest 10 (top 0.5)."""
     import scipy.linalg as sla

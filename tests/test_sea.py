@@ -1,4 +1,5 @@
-"""Tests of stochcable.sea.realization (DSA/NSA simulation, seed 001 §5.1) and stochcable.sea.fft."""
+"""Tests of stochcable.sea.realization (DSA/NSA simulation, seed 001 §5.1) and
+stochcable.sea.fft."""
 
 from __future__ import annotations
 
@@ -945,7 +946,8 @@ def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
     )
     env.pop("STOCHCABLE_NUMBA", None)
     script = (
-        "import warnings, numpy as np, stochcable.sea.realization as sea, stochcable.sea.kernels as k\n"
+        "import warnings, numpy as np, stochcable.sea.realization as sea, "
+        "stochcable.sea.kernels as k\n"
         "r = sea.simulate_sea(lambda w: 1.0 / (1.0 + w**4), 2**18 * 0.1, 0.1, 'dsa', 3)\n"
         "print(sea.__file__, k.CACHED, repr(complex(r.coefficients[12345])))\n"
     )

@@ -39,7 +39,7 @@ async def simulate_sea_realization(
     """η(t) by :func:`stochcable.sea.realization.simulate_sea` (seed 001 §5.1; duration/dt must be an
     even number of samples) and, at ``points``, the velocity and acceleration by
     :func:`stochcable.sea.kinematics.kinematics_timeseries` from the same amplitudes.
-    Use ``Accept: application/x-npy`` for long records."""
+    Use ``Accept: application/x-npy`` for long records."""  # noqa: E501 - the OpenAPI description, kept verbatim
     n_points = len(body.points) if body.points else 0
     check_points(n_points, settings)
     check_samples(body.duration, body.dt, n_points, settings)

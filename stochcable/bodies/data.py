@@ -104,7 +104,8 @@ class Hydrodynamics:
     def excitation_table(
         self, extrapolation: Literal["error", "hold"] = "error"
     ) -> ExcitationTable | None:
-        """The excitation as an :class:`~stochcable.bodies.tables.ExcitationTable` (None if absent)."""
+        """The excitation as an :class:`~stochcable.bodies.tables.ExcitationTable`
+        (None if absent)."""
         if self.excitation is None:
             return None
         return ExcitationTable(self.omega, self.heading, self.excitation, extrapolation)

@@ -325,7 +325,8 @@ class RigidBody:
         return PLANAR_DOFS if self.planar else SPATIAL_DOFS
 
     def mass_matrix(self) -> np.ndarray:
-        """Rigid-body mass matrix about the reference point, (d, d) (:func:`rigid_body_mass_matrix`)."""
+        """Rigid-body mass matrix about the reference point, (d, d)
+        (:func:`rigid_body_mass_matrix`)."""
         return rigid_body_mass_matrix(self.mass, self.inertia, self.cog, self.planar)
 
     def added_mass_at(self, omega: Any) -> np.ndarray:

@@ -64,7 +64,7 @@ from stochcable.dynamics.element_kinematics import (
 )
 from stochcable.errors import InputError
 from stochcable.scene.model import Environment, Line, Scene
-from stochcable.sea.kinematics import G_STANDARD, _nodal_kinematics
+from stochcable.sea.kinematics import G_STANDARD, nodal_kinematics
 
 __all__ = [
     "Channel",
@@ -285,7 +285,7 @@ def _sea_nodal(el: ElementKinematics, g: float) -> Callable[[], tuple[np.ndarray
     validation, wavenumber solve or pressure)."""
 
     def nodal() -> tuple[np.ndarray, np.ndarray]:
-        _, _, _, vel, acc = _nodal_kinematics(
+        _, _, _, vel, acc = nodal_kinematics(
             el.omega, el.wavenumber, el.positions, el.heading, el.depth, g
         )
         return (

@@ -13,8 +13,9 @@ from numpy.typing import ArrayLike
 
 from stochcable import validation as v
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.line.catenary import check_reach, elastic_catenary, newton_start
+from stochcable.line.catenary import elastic_catenary
 from stochcable.line.catenary_kernel import CLOSURE_TOL, MAX_NEWTON, kernel
+from stochcable.line.catenary_start import check_reach, newton_start
 
 __all__ = ["MultiSegmentSolution", "catenary_multisegment"]
 
@@ -169,7 +170,7 @@ def catenary_multisegment(
     r, J = closure(H, Va)
     nr = float(np.max(np.abs(r)))
     it = 0
-    for it in range(1, MAX_NEWTON + 1):
+    for it in range(1, MAX_NEWTON + 1):  # noqa: B007 - the count goes into the error
         if nr <= tol:
             break
         d = np.linalg.solve(J, -r)

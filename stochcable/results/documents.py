@@ -4,7 +4,9 @@ Everything is a frozen dataclass holding numpy arrays; :meth:`Result.to_document
 returns the JSON-ready result document of DESIGN.md ("Scene and result documents",
 v1 contract) plus extra keys.  Transfer functions and response spectra live on the
 Python objects (:class:`LineResult`); the document carries statistics, the end-tension
-spectra and a window of the time series.
+spectra and a window of the time series.  The records they carry (:class:`ResponseStats`,
+:class:`LinearizationRecord`, :class:`LineIndicators`, :func:`stats_from_spectrum`)
+live in :mod:`stochcable.results.records` and are re-exported here.
 
 Conventions (DESIGN.md): SI, ω in rad/s, one-sided spectra S(ω) [unit²·s/rad],
 harmonic quantities Re{X e^{iωt}}, transfer functions per unit input of each channel
@@ -21,6 +23,14 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.results.records import (
+    THREE_HOURS,
+    LinearizationRecord,
+    LineIndicators,
+    ResponseStats,
+    stats_from_spectrum,
+    stats_from_validated,
+)
 from stochcable.scene.units import unit_labels
 
 __all__ = [
@@ -36,260 +46,8 @@ __all__ = [
     "stats_from_validated",
 ]
 
-THREE_HOURS = 10800.0
-"""Storm duration of the ``mpm_3h`` statistic. [s]"""
-
 # Number of time samples of the time-series window put in the result document.
 DOCUMENT_WINDOW = 2048
-
-
-@dataclass(frozen=True)
-class ResponseStats:
-    """Statistics of one Gaussian response: static mean + zero-mean dynamic part.
-
-    Attributes
-    ----------
-    mean : float
-        Static (mean) value. [unit]
-    std : float
-        Standard deviation of the dynamic part, √m0. [unit]
-    m0, m1, m2, m4 : float
-        Spectral moments ∫ωⁿ S dω (trapezoid on the analysis grid). [unit²·(rad/s)ⁿ]
-    tz : float
-        Mean zero-upcrossing period 2π√(m0/m2) (0 for a zero process). [s]
-    significant : float
-        Significant value 2σ (DESIGN.md "Outputs"). [unit]
-    bandwidth : float
-        Spectral bandwidth √(1 − m2²/(m0 m4)). [-]
-    mpm_3h : float
-        mean + Rayleigh most probable maximum of the dynamic part over three hours,
-        σ√(2 ln(10800/Tz)). [unit]
-    mpm : float
-        mean + the same over the scene's ``analysis.duration``. [unit]
-    expected_max : float
-        mean + expected maximum over ``analysis.duration``. [unit]
-    """
-
-    mean: float
-    std: float
-    m0: float
-    m1: float
-    m2: float
-    m4: float
-    tz: float
-    significant: float
-    bandwidth: float
-    mpm_3h: float
-    mpm: float
-    expected_max: float
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready dict of the fields."""
-        return {
-            k: float(getattr(self, k))
-            for k in (
-                "mean",
-                "std",
-                "tz",
-                "mpm_3h",
-                "significant",
-                "m0",
-                "m1",
-                "m2",
-                "m4",
-                "bandwidth",
-                "mpm",
-                "expected_max",
-            )
-        }
-
-
-def stats_from_spectrum(
-    omega: np.ndarray, density: np.ndarray, mean: float, duration: float
-) -> ResponseStats:
-    """Statistics of a response from its one-sided spectrum on the analysis grid.
-
-    Parameters
-    ----------
-    omega : ndarray, shape (n,)
-        Frequency grid. [rad/s]
-    density : ndarray, shape (n,)
-        One-sided spectrum of the dynamic part. [unit²·s/rad]
-    mean : float
-        Static value of the response. [unit]
-    duration : float
-        Storm duration for ``mpm`` and ``expected_max``. [s]
-
-    Returns
-    -------
-    ResponseStats
-
-    Notes
-    -----
-    :func:`stochcable.results.statistics.response_statistics` (trapezoid moments, Rayleigh
-    maxima); mpm_3h = mean + σ√(2 ln(10800/Tz)) (DESIGN.md "Outputs").
-    """
-    from stochcable.results.statistics import response_statistics
-
-    st = response_statistics(omega, density, THREE_HOURS)
-    sd = st if duration == THREE_HOURS else response_statistics(omega, density, duration)
-    return _response_stats(st, sd, mean)
-
-
-def stats_from_validated(
-    omega: np.ndarray, density: np.ndarray, mean: float, duration: float
-) -> ResponseStats:
-    """:func:`stats_from_spectrum` of a validated grid and spectrum (the analysis grid,
-    validated once at the boundary; a 1-D float density >= 0 of its size, duration
-    > 0): no second validation per call."""
-    from stochcable.results.statistics import _statistics
-
-    st = _statistics(omega, density, THREE_HOURS)
-    sd = st if duration == THREE_HOURS else _statistics(omega, density, float(duration))
-    return _response_stats(st, sd, mean)
-
-
-def _response_stats(st: Any, sd: Any, mean: float) -> ResponseStats:
-    """ResponseStats from the statistics over three hours (st) and the duration (sd)."""
-    mean = float(mean)
-    return ResponseStats(
-        mean=mean,
-        std=float(st.std),
-        m0=float(st.m0),
-        m1=float(st.m1),
-        m2=float(st.m2),
-        m4=float(st.m4),
-        tz=float(st.tz),
-        significant=float(st.significant),
-        bandwidth=float(st.bandwidth),
-        mpm_3h=mean + float(st.mpm),
-        mpm=mean + float(sd.mpm),
-        expected_max=mean + float(sd.expected_max),
-    )
-
-
-@dataclass(frozen=True, eq=False)
-class LinearizationRecord:
-    """The drag-linearization fixed point of one line (seed 001 §5.3 steps 5–13).
-
-    Attributes
-    ----------
-    method : str
-        ``"seed"``, ``"vector"`` or ``"harmonic"``.
-    converged : bool
-        Whether the relative change of every σ fell below the tolerance.
-    iterations : int
-        Number of response evaluations. [-]
-    relative_change : float
-        Final max relative change of the σ. [-]
-    history : tuple of float
-        Relative change after each iteration. [-]
-    tolerance : float
-        Tolerance asked for. [-]
-    sigma_normal, sigma_axial : ndarray, shape (n_el,)
-        Final σ of the normal and axial relative velocity at element midpoints. [m/s]
-    b_normal, b_axial : ndarray, shape (n_el,)
-        Final linear drag coefficients per unit length (normal: the trace/2 of the
-        normal-plane matrix for the vector form). [N·s/m²]
-    """
-
-    method: str
-    converged: bool
-    iterations: int
-    relative_change: float
-    history: tuple[float, ...]
-    tolerance: float
-    sigma_normal: np.ndarray
-    sigma_axial: np.ndarray
-    b_normal: np.ndarray
-    b_axial: np.ndarray
-
-    def as_dict(self) -> dict[str, Any]:
-        return {
-            "method": self.method,
-            "converged": bool(self.converged),
-            "iterations": int(self.iterations),
-            "relative_change": float(self.relative_change),
-            "tolerance": float(self.tolerance),
-            "history": [float(h) for h in self.history],
-        }
-
-
-def _finite_or_none(x: float) -> float | None:
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
-@dataclass(frozen=True, eq=False)
-class LineIndicators:
-    """Quality indicators of the linear model of one line (GitHub issue 7).
-
-    Attributes
-    ----------
-    borgman_ratio : ndarray, shape (n_el,)
-        Var(B v)/Var(½ρCdD|v|v) of the normal drag per element for the Gaussian
-        normal relative velocity with the element's normal current
-        (:func:`stochcable.dynamics.linearization.borgman_variance_ratio`; 0.849 without
-        current). [-]
-    drag_inertia_ratio : ndarray, shape (n_el,)
-        σ of the linearized normal drag force over σ of the Morison inertia force
-        ρ C_M (πD²/4) a_n of the sea per element (inf without fluid acceleration;
-        :func:`stochcable.dynamics.linearization.drag_inertia_ratio`). [-]
-    snap_margin : float
-        min over elements and ends of (T_mean − 3σ_T)/|T_mean|; below 0 the linear
-        model predicts slack (snap loads likely). [-]
-    snap_risk : bool
-        ``snap_margin < 0``.
-    resonances : tuple of dict
-        Modes inside the excitation band with modal damping ratio below 1 %:
-        ``{"mode": j (1-based), "omega": ω_j [rad/s], "damping_ratio": ζ_j [-]}``.
-    motion_std_max : float
-        Largest node motion σ (magnitude of the x, y, z σ). [m]
-    sag : float
-        Largest distance of the static shape from the chord of the ends. [m]
-    motion_to_sag : float
-        motion_std_max / sag (inf for a straight line). [-]
-    motion_to_diameter : float
-        motion_std_max / largest diameter. [-]
-    flags : tuple of str
-        Raised flags: ``"snap"``, ``"resonance"``, ``"large_motion"``.
-    """
-
-    borgman_ratio: np.ndarray
-    drag_inertia_ratio: np.ndarray
-    snap_margin: float
-    snap_risk: bool
-    resonances: tuple[dict[str, Any], ...]
-    motion_std_max: float
-    sag: float
-    motion_to_sag: float
-    motion_to_diameter: float
-    flags: tuple[str, ...]
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready dict (non-finite numbers as None)."""
-        br, di = self.borgman_ratio, self.drag_inertia_ratio
-        return {
-            "borgman_ratio": {
-                "min": _finite_or_none(br.min()) if br.size else None,
-                "max": _finite_or_none(br.max()) if br.size else None,
-                "elements": [_finite_or_none(x) for x in br],
-            },
-            "drag_inertia_ratio": {
-                "min": _finite_or_none(di.min()) if di.size else None,
-                "max": _finite_or_none(di.max()) if di.size else None,
-                "elements": [_finite_or_none(x) for x in di],
-            },
-            "snap": {"risk": bool(self.snap_risk), "margin": _finite_or_none(self.snap_margin)},
-            "resonances": [dict(r) for r in self.resonances],
-            "motion": {
-                "std_max": float(self.motion_std_max),
-                "sag": float(self.sag),
-                "to_sag": _finite_or_none(self.motion_to_sag),
-                "to_diameter": _finite_or_none(self.motion_to_diameter),
-            },
-            "flags": list(self.flags),
-        }
 
 
 @dataclass(frozen=True, eq=False)

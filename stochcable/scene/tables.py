@@ -170,8 +170,8 @@ def parse_table(
     -------
     dict
         The fields of :class:`stochcable.bodies.data.Hydrodynamics` by name
-        (:func:`checked_table`); excitation headings converted from degrees to radians; phases referred to the
-        reference point (``excitation_point`` = 0).
+        (:func:`checked_table`); excitation headings converted from degrees to
+        radians; phases referred to the reference point (``excitation_point`` = 0).
 
     Raises
     ------

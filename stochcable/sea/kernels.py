@@ -3,7 +3,7 @@
 Imported lazily by :mod:`stochcable.sea.realization` only when a realization of ≥ 2^16 lines runs
 (importing numba costs ~0.2 s); ``import stochcable``, the CLI and the service start do
 not import it.  The kernel performs exactly the floating-point operations of the NumPy
-kernel ``sea._phasor_chunk``, in the same order, without fast-math and without FMA
+kernel ``coefficients._phasor_chunk``, in the same order, without fast-math and without FMA
 contraction except for the complex product T·e, which is written with explicit fused
 multiply-adds in the form NumPy's SIMD complex multiply uses on x86-64 with FMA3
 (re = fma(T_r, e_r, −T_i e_i), im = fma(T_r, e_i, T_i e_r); checked against exact
@@ -32,7 +32,7 @@ from numba.extending import intrinsic
 __all__ = ["phasor_chunk", "CACHED"]
 
 _TABLE_SIZE = 8192.0  # = sea._TABLE_SIZE (2^13 entries)
-_DELTA = 2.0 * math.pi / 8192  # the same constant as sea._phasor_chunk's
+_DELTA = 2.0 * math.pi / 8192  # the same constant as coefficients._phasor_chunk's
 _COS4 = 1.0 / 24.0
 _SIN3 = -1.0 / 6.0
 
@@ -53,7 +53,7 @@ def _fma(typingctx, x, y, z):  # noqa: ANN001, ARG001 - numba intrinsic protocol
 def _phasor_chunk(u, s, c2, alpha, beta, table, out, fft_in, scale, jbuf):  # noqa: ANN001
     """out = a·e^{−iθ}, fft_in = out·scale; a = √(c2·S) (× √(α²+β²) when α is given).
 
-    Same operations as ``sea._phasor_chunk`` (see there for the table and series);
+    Same operations as ``coefficients._phasor_chunk`` (see there for the table and series);
     ``alpha``/``beta`` of size 0 select DSA, else NSA with the gain √(α²+β²) computed
     here (``np.hypot``, as NumPy's).  Two passes over the chunk: the first (vectorized
     by LLVM) writes amp·e^{iδ} into ``out`` and the table index j into ``jbuf``; the

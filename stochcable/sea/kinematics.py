@@ -21,6 +21,7 @@ __all__ = [
     "wavenumber",
     "WaveKinematics",
     "wave_kinematics",
+    "nodal_kinematics",
     "kinematics_timeseries",
 ]
 
@@ -53,7 +54,7 @@ def _solve_kh(x: np.ndarray) -> np.ndarray:
         return x.copy()
     t = np.tanh(x**0.75)
     y = x / t ** (2.0 / 3.0)
-    for it in range(1, _NEWTON_MAX + 1):
+    for _ in range(_NEWTON_MAX):
         t = np.tanh(y)
         f = y * t
         f -= x
@@ -184,12 +185,48 @@ def _depth_ratios(
     return ch, sh, cc
 
 
-def _nodal_kinematics(
+def nodal_kinematics(
     w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float, h: float, g: float
-) -> tuple[np.ndarray, ...]:
-    """:func:`wave_kinematics` without validation or pressure (validated frequencies,
-    their wavenumbers k, points): the elevation phase (P, W), cosh k(z+h)/cosh kh
-    (P, W), the dry points (P,), the velocity and the acceleration (P, 3, W)."""
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`wave_kinematics` on inputs already validated, without the pressure.
+
+    The inner kernel for callers that validated their frequencies and points once
+    and already hold the wavenumbers (the engine's sea channel, on every element
+    node): no checks, no dispersion solve.  Same conventions as
+    :func:`wave_kinematics` (per unit wave amplitude; points above z = 0 are dry).
+
+    Parameters
+    ----------
+    w : numpy.ndarray
+        Angular frequencies, >= 0, shape (n_omega,). [rad/s]
+    k : numpy.ndarray
+        Their wavenumbers k(ω) (:func:`wavenumber` at this depth and g), shape
+        (n_omega,). [rad/m]
+    pts : numpy.ndarray
+        Points (x, y, z), float, shape (n_points, 3), with z >= −h. [m]
+    beta : float
+        Wave heading β, from +x toward +y. [rad]
+    h : float
+        Water depth, > 0 or inf. [m]
+    g : float
+        Acceleration of gravity, > 0. [m/s²]
+
+    Returns
+    -------
+    phase : numpy.ndarray
+        Elevation phase P = e^{−ik(x cos β + y sin β)}, complex, shape
+        (n_points, n_omega). [m/m]
+    cc : numpy.ndarray
+        cosh k(z+h)/cosh kh (z clipped to 0), shape (n_points, n_omega). [-]
+    dry : numpy.ndarray
+        True where the point is above the still water level, shape (n_points,). [-]
+    vel : numpy.ndarray
+        Fluid velocity (u_x, u_y, u_z), complex, shape (n_points, 3, n_omega).
+        [(m/s)/m]
+    acc : numpy.ndarray
+        Fluid acceleration iω × velocity, complex, shape (n_points, 3, n_omega).
+        [(m/s²)/m]
+    """
     cb, sb = math.cos(beta), math.sin(beta)
     z = pts[:, 2]
     xi = pts[:, 0] * cb + pts[:, 1] * sb
@@ -271,7 +308,7 @@ def wave_kinematics(
         )
 
     k = _wavenumber(w, h, g)
-    phase, cc, dry, vel, acc = _nodal_kinematics(w, k, pts, beta, h, g)
+    phase, cc, dry, vel, acc = nodal_kinematics(w, k, pts, beta, h, g)
     pressure = cc * phase
     pressure[dry] = 0.0
     for a in (w, k, pts, phase, vel, acc, pressure):
