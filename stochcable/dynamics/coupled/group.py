@@ -262,6 +262,10 @@ class GroupSystem:
     def _body_matrices(self) -> None:
         """K_B, M_B, C_B and the body impedance ``z_body`` on the grid."""
         nb, off, geo = self.nb, self.off, self.geometric
+        if not nb:  # no bodies: empty matrices
+            self.kb = self.mb = self.cb = np.zeros((0, 0))
+            self.z_body = np.zeros((self.omega.size, 0, 0), dtype=complex)
+            return
         self.kb = np.zeros((nb, nb))
         self.mb = np.zeros((nb, nb))
         self.cb = np.zeros((nb, nb))

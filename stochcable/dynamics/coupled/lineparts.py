@@ -78,11 +78,15 @@ def line_parts(
         for cl in g.lines
         if cl.system.solver != "direct" and _MODAL_FOSS and not g.modal_direct and cl.attached()
     ]
-    states = dict(
-        zip(
-            [cl.name for cl in modal],
-            line_map(lambda cl: foss_state(cl.system, line_damping[cl.name]), modal),
+    states = (
+        dict(
+            zip(
+                [cl.name for cl in modal],
+                line_map(lambda cl: foss_state(cl.system, line_damping[cl.name]), modal),
+            )
         )
+        if modal
+        else {}
     )
     return [_line_part(g, cl, line_damping[cl.name], states.get(cl.name)) for cl in g.lines]
 
