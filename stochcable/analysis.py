@@ -13,10 +13,12 @@ inspect or replace::
     resp    = solve(system, chans, lin.damping)           # dynamics.solve
     out     = line_result(system, chans, lin, scene.analysis)       # dynamics.outputs
 
-Lines not attached to a free body are independent: each is linearized and solved on
-its own; lines on bodies are solved together with them
-(:mod:`stochcable.dynamics.coupled`).  The sea channel of all lines shares one
-realization in the time series (:mod:`stochcable.dynamics.timeseries`).
+One engine solves every scene (:mod:`stochcable.dynamics.coupled`): free bodies with
+the lines attached to them form coupled groups, and a line attached to no free body
+is the degenerate group of one line and no bodies; every group goes through the same
+drag fixed point, the same substructured solve and the same time-series transfer.
+The sea channel of all lines shares one realization in the time series
+(:mod:`stochcable.dynamics.timeseries`).
 
 Choices (see the functions for details)
 ---------------------------------------
@@ -31,8 +33,9 @@ Choices (see the functions for details)
 - ``modes="auto"`` (Foss): all modes up to ``AUTO_ALL_MODES`` free DOFs, else those up
   to ``AUTO_MODE_FACTOR``·ω_max (:mod:`stochcable.dynamics.system`); moving ends use
   the quasi-static split (:func:`stochcable.dynamics.solve.solve`).
-- Drag linearization: a coarse start on a frequency subset, then the full grid
-  (:mod:`stochcable.dynamics.fixedpoint`).
+- Drag linearization: a coarse start on a frequency subset with a defect
+  correction, then the full grid (:mod:`stochcable.dynamics.coupled.coarse`,
+  :mod:`stochcable.dynamics.coupled.fixedpoint`).
 - Time series: the first 2048 samples go in the document (``to_document(timeseries=
   "full")`` for all); the full series are on
   :class:`~stochcable.results.documents.TimeSeries`.

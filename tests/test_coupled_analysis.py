@@ -811,9 +811,9 @@ def _count_full_evaluations(monkeypatch, n_omega):
     count = [0]
     solve = cg.solve_group
 
-    def counted(g, *args):
+    def counted(g, *args, **kw):
         count[0] += g.omega.size == n_omega
-        return solve(g, *args)
+        return solve(g, *args, **kw)
 
     monkeypatch.setattr(cg, "solve_group", counted)
     return count

@@ -378,7 +378,7 @@ def test_modal_direct_equal_foss_planar_two_bodies():
 def _coarse_update(g, idx, x=None):
     """The coarse group of ``g`` on ``idx`` and its map evaluated at ``x`` (default
     the rest σ scaled up, so the drag is not tiny)."""
-    gc = cc._coarse_group(g, idx)
+    gc = cc.coarse_group(g, idx)
     rest = [
         sigmas_from_nodes(
             cl.system,

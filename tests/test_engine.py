@@ -111,10 +111,11 @@ def test_scene_with_bodies(monkeypatch):
     fresh = _plain(analyze(_with_sea(doc, sea)))
     calls = _count_builds(monkeypatch)
     engine = build_engine(doc)
-    assert engine.systems == {}  # the coupled systems are built per solve
+    # the line systems and the groups are built once, with the statics
+    assert set(engine.systems) == {"leg"} and engine.model.groups
     first = engine.solve(sea)
     engine.solve()
-    assert calls["statics"] == 1
+    assert calls["statics"] == 1 and calls["model"] == 1
     assert_close_documents(_plain(first), fresh, rtol=1e-12)
 
 

@@ -253,3 +253,76 @@ def test_snap_flag_fires_at_an_element_and_not_below_threshold():
         assert ind.snap_risk is fires
         assert any(f"element {k + 1}" in m and "snap loads likely" in m for m in msgs) is fires
         assert ind.snap_margin == pytest.approx(1.0 - 3.0 * factor, rel=1e-12)
+
+
+# ------------------------------------------- lines on bodies: the coupled modes
+
+
+def _line_modes_of(monkeypatch, factor: float):
+    """The disc buoy's leg analysed with the buoy's mass and inertia scaled by
+    ``factor`` (same statics): the coupled modes that count for the leg
+    (:func:`stochcable.dynamics.coupled.results.line_modes`), the leg's system and its
+    converged drag."""
+    from stochcable.bodies.from_scene import scene_rigid_bodies
+    from stochcable.dynamics.coupled import analyze_coupled
+    from stochcable.dynamics.coupled import results as cresults
+
+    scene = load_scene(_doc("tuah_1982_disc_buoy_single_leg"))
+    statics = solve_statics(scene, method="fe")
+    scaled = {
+        n: dataclasses.replace(
+            b,
+            mass=b.mass * factor,
+            inertia=None if b.inertia is None else np.asarray(b.inertia) * factor,
+        )
+        for n, b in scene_rigid_bodies(scene).items()
+    }
+    captured: dict = {}
+    line_modes = cresults.line_modes
+
+    def spy(*args):
+        captured.update(line_modes(*args))
+        return captured
+
+    monkeypatch.setattr(cresults, "line_modes", spy)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = analyze_coupled(scene, statics, scene.analysis, rigid_bodies=scaled)
+    (group,) = out.groups
+    return captured["leg"], group.systems["leg"], group.dampings["leg"], out
+
+
+def _fixed_end(system, damping, top: float):
+    from stochcable.dynamics.indicators import modal_bandwidths
+
+    wn = np.asarray(system.modes.omega)
+    keep = wn <= top
+    return wn[keep], modal_bandwidths(system, damping)[keep]
+
+
+def test_heavy_body_gives_the_fixed_end_modes(monkeypatch):
+    """A body 10^6 times heavier barely moves in the leg's modes: the coupled modes
+    that count for the leg (share >= LINE_MODE_SHARE) are its fixed-end modes, with
+    their frequencies and bandwidths, and the body modes do not count."""
+    modes, system, damping, out = _line_modes_of(monkeypatch, 1e6)
+    top = float(modes.omega.max())
+    wn, band = _fixed_end(system, damping, top * (1 + 1e-6))
+    assert modes.omega.size == wn.size >= 3
+    np.testing.assert_allclose(modes.omega, wn, rtol=1e-4)
+    np.testing.assert_allclose(modes.bandwidth, band, rtol=1e-3)
+    # the leg's indicator lists the same resonances as its fixed-end modes would
+    for r in out.lines["leg"].indicators.resonances:
+        assert np.min(np.abs(wn / r["omega"] - 1)) < 1e-4
+
+
+def test_light_body_changes_the_line_modes(monkeypatch):
+    """With the buoy's own mass the leg's end moves in its modes: the coupled modes
+    that count for the leg are not its fixed-end modes (other frequencies and
+    bandwidths: the body's motion, radiation and drag damp them too)."""
+    modes, system, damping, _ = _line_modes_of(monkeypatch, 1.0)
+    wn, band = _fixed_end(system, damping, float(modes.omega.max()) * (1 + 1e-3))
+    assert modes.omega.size == wn.size >= 3
+    # measured: the first mode 5.66 against 5.59 rad/s, its bandwidth 7.24 against
+    # 7.50 rad/s (the same converged drag); the heavy body gives both to 1e-4
+    assert np.max(np.abs(modes.omega / wn - 1)) > 5e-3
+    assert np.max(np.abs(modes.bandwidth / band - 1)) > 2e-2

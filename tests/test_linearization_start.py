@@ -1,7 +1,9 @@
-"""The coarse start of the drag linearization (stochcable.dynamics.fixedpoint, "Coarse start"):
-the frequency-subset fixed point only supplies the start, the answer is the full-grid
-fixed point; narrow resonances are kept at full resolution; the subset quadrature; the
-single-BLAS-thread limit in worker threads."""
+"""The coarse start of the drag linearization of a single line (the one fixed point,
+stochcable.dynamics.coupled.fixedpoint, applied to a line alone through
+stochcable.dynamics.fixedpoint.linearize; its coarse start stochcable.dynamics.coupled.
+coarse): the frequency-subset fixed point only supplies the start, the answer is the
+full-grid fixed point; narrow resonances are kept at full resolution; the subset
+quadrature; the single-BLAS-thread limit in worker threads."""
 
 from __future__ import annotations
 
@@ -12,7 +14,12 @@ import numpy as np
 import pytest
 
 from stochcable.dynamics import blocks as dblocks
+from stochcable.dynamics import coarse_grid as dgrid
 from stochcable.dynamics import fixedpoint as dfixedpoint
+from stochcable.dynamics.coupled import coarse as dcoarse
+from stochcable.dynamics.coupled import freeline as dfreeline
+from stochcable.dynamics.coupled.group import GroupSystem
+from stochcable.dynamics.coupled.inputs import CoupledLine
 from stochcable.dynamics import line_loads as dloads
 from stochcable.dynamics import outputs as doutputs
 from stochcable.dynamics import solve as dsolve
@@ -51,22 +58,41 @@ def _tight(scene):
     return scene.analysis.model_copy(update={"linearization": lin})
 
 
+def _counted(monkeypatch) -> list[tuple[bool, int]]:
+    """Record (coarse?, number of frequencies) of every response evaluation of a line
+    alone (its FreeLine solves: the coarse stage solves per frequency in modal
+    coordinates, ``modal_direct``)."""
+    calls: list[tuple[bool, int]] = []
+    solve_free = dfreeline.solve_free
+
+    def counted(system, inp, damping, *, modal_direct=False):
+        calls.append((modal_direct, inp.omega.size))
+        return solve_free(system, inp, damping, modal_direct=modal_direct)
+
+    monkeypatch.setattr(dfreeline, "solve_free", counted)
+    return calls
+
+
 @pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning")  # the cut tail
-def test_coarse_start_converges_to_the_full_grid_fixed_point(chain):
+def test_coarse_start_converges_to_the_full_grid_fixed_point(chain, monkeypatch):
     scene, system, ch = chain
+    calls = _counted(monkeypatch)
     coarse = dfixedpoint.linearize(system, ch, scene.analysis)
+    stage, calls[:] = list(calls), []
     full = dfixedpoint.linearize(system, ch, scene.analysis, coarse=False)
+    assert not any(c for c, _ in calls)  # coarse=False: the full grid only
     ref = dfixedpoint.linearize(system, ch, _tight(scene), coarse=False)
     tol = scene.analysis.linearization.tolerance
-    # the coarse stage ran on a real subset and is recorded apart from the record
-    assert coarse.coarse is not None and full.coarse is None
-    assert coarse.coarse.frequencies <= dfixedpoint.COARSE_MAX_FRACTION * ch[0].omega.size
-    assert coarse.coarse.converged and coarse.coarse.iterations == len(coarse.coarse.history)
-    # the record: full-grid evaluations only, the usual test passed on the full grid
+    n = ch[0].omega.size
+    # the coarse stage ran on a real subset; the record lists every evaluation in
+    # order, coarse and full-grid (the one fixed point's record)
+    sub = [k for c, k in stage if c]
+    assert sub and max(sub) <= dcoarse.COARSE_MAX_FRACTION * n
     rec = coarse.record
-    assert rec.converged and rec.iterations == len(rec.history) >= 1
+    assert rec.converged and rec.iterations == len(rec.history) == len(stage)
     assert rec.history[-1] == rec.relative_change <= tol
-    assert rec.iterations < full.record.iterations  # the point of the coarse start
+    # the point of the coarse start: fewer full-grid evaluations
+    assert sum(1 for c, _ in stage if not c) < full.record.iterations
     # same fixed point: both within the tolerance of the tight one (the map
     # contracts by <= 0.5 per step here, so the distance is <= 2 tol; round-off aside)
     s_ref = _sigma(ref)
@@ -80,13 +106,14 @@ def test_coarse_start_converges_to_the_full_grid_fixed_point(chain):
         assert abs(a / b - 1) < 1e-4
 
 
-def test_small_grid_has_no_coarse_stage(chain):
+def test_small_grid_has_no_coarse_stage(chain, monkeypatch):
     scene, system, ch = chain
     w = ch[0].omega[::4]  # 50 frequencies < COARSE_MIN_FREQUENCIES
-    assert w.size < dfixedpoint.COARSE_MIN_FREQUENCIES
+    assert w.size < dcoarse.COARSE_MIN_FREQUENCIES
     sub = line_channels(scene, system.line, system.positions, w)
+    calls = _counted(monkeypatch)
     lin = dfixedpoint.linearize(system, sub, scene.analysis)
-    assert lin.coarse is None
+    assert not any(c for c, _ in calls)  # no coarse evaluation
     assert (
         lin.record.iterations
         == dfixedpoint.linearize(system, sub, scene.analysis, coarse=False).record.iterations
@@ -100,7 +127,7 @@ def test_interpolatory_weights_integrate_cubics_as_the_full_grid():
     w = np.geomspace(0.05, 3.0, 157)
     idx = np.unique(np.r_[np.arange(0, 157, 4), 156, np.arange(60, 75)])
     q = dblocks.trapezoid_weights(w)
-    wts = dfixedpoint.interpolatory_weights(w, idx)
+    wts = dgrid.interpolatory_weights(w, idx)
     for f in (np.ones_like, lambda x: x, lambda x: 2 - x**2, lambda x: x**3 - x):
         assert wts @ f(w[idx]) == pytest.approx(q @ f(w), rel=1e-12, abs=1e-12)
     quartic = (w - 1.0) ** 4
@@ -120,24 +147,27 @@ def test_narrow_resonance_is_not_missed_by_the_coarse_subset():
     weak = dvariance.drag_coefficients(system, 0.03 * lin.damping.sigma, "seed")
     inp = dloads.line_inputs(system, ch)
     w = inp.omega
-    idx = dfixedpoint._coarse_subset(system, inp, weak)
+    # the coarse subset of the line alone (a group without bodies) at that drag
+    g = GroupSystem([CoupledLine(system, ch)], [], {}, system.environment.rho, ch)
+    g.sizes = {system.name: weak.sigma.size}
+    idx = dcoarse.coarse_subset(g, weak.sigma, "seed")
     assert idx is not None
     wn = system.modes.omega
     for wj in wn[(wn > w[0]) & (wn < w[-1])]:
         k = int(np.argmin(np.abs(w - wj)))
-        window = np.arange(k - dfixedpoint.COARSE_STEP, k + dfixedpoint.COARSE_STEP + 1)
+        window = np.arange(k - dcoarse.COARSE_STRIDE, k + dcoarse.COARSE_STRIDE + 1)
         assert np.isin(window, idx).all()  # full resolution around the resonance
     u, _ = dsolve.solve_free(system, inp, weak)
     full = dvariance.sigmas_from_free(system, inp, u, "seed")
 
     def err(sel: np.ndarray) -> float:
-        sub = dfixedpoint.subset_inputs(system, ch, inp, sel)
+        sub = dgrid.subset_inputs(system, ch, inp, sel)
         s = dvariance.sigmas_from_free(system, sub, np.ascontiguousarray(u[:, :, sel]), "seed")
         return float(np.max(np.abs(s - full)) / np.max(full))
 
     # the uniform subset misses the peaks (tens of %), the windowed one does not
     # (measured 0.6 %: the tails between the coarse points remain)
-    assert err(dfixedpoint._uniform_subset(w.size)) > 0.1
+    assert err(np.unique(np.r_[np.arange(0, w.size, dcoarse.COARSE_STRIDE), w.size - 1])) > 0.1
     assert err(idx) < 0.02
     # and the linearization of that line still ends at the full-grid fixed point
     c = dfixedpoint.linearize(system, ch, scene.analysis)

@@ -1,5 +1,6 @@
-"""Lines coupled to bodies on the realization grid: the transfer functions of the time
-series (seed 001 §5.1, eq. 5.3.29 and step 14).
+"""Groups on the realization grid: the transfer functions of the time series (seed 001
+§5.1, eq. 5.3.29 and step 14), for lines coupled to bodies and for lines alone (the
+groups without bodies) by the same solve.
 
 The time series of :func:`stochcable.dynamics.timeseries.simulate_timeseries` are the synthesis
 (:func:`stochcable.sea.realization.synthesize`) of transfer functions solved on the realization
@@ -135,13 +136,24 @@ def _group_on(
     scene: Any, group: CoupledGroup, omega: np.ndarray
 ) -> tuple[GroupSystem, tuple[str, ...], tuple[tuple[str, str] | None, ...]]:
     """The group's solve data on ``omega``: channels of every line (vessel ends in the
-    sea channel), aligned on the group list as the analysis does, and body loads."""
+    sea channel), aligned on the group list as the analysis does (a line alone keeps
+    its own channels), and body loads."""
     env = scene.environment
     vessel = vessel_raos(scene, omega)
     chans: dict[str, tuple[Channel, ...]] = {}
     for n in group.lines:
         chans[n], _ = scene_line_channels(
             scene, _scene_line(scene, n), group.systems[n], omega, vessel
+        )
+    if group.lines and not group.bodies:  # a line alone: its own channels
+        (n,) = group.lines
+        cls = [CoupledLine(group.systems[n], chans[n])]
+        channels = chans[n]
+        sources = tuple((n, c.name) if c.kind == "end_motion" else None for c in channels)
+        return (
+            GroupSystem(cls, (), {}, env.rho, channels),
+            tuple(c.kind for c in channels),
+            sources,
         )
     if group.lines:
         gch = group_channels(group.lines, chans, omega)

@@ -2,16 +2,20 @@
 scene and its response to one sea state (seed 001 ch. 5).
 
 :func:`build_engine` does everything that does not depend on the sea: the static
-equilibrium (all nonlinearities), the finite-element model of every independent line
-about it, its natural modes and the drag-independent arrays of the block-banded solves
+equilibrium (all nonlinearities), the finite-element model of every line about it,
+its natural modes and the drag-independent arrays of the block-banded solves
 (:class:`~stochcable.dynamics.blocks.LinePrep`; the banded Cholesky of K_ff and the
 modal matrices are computed on first use and then kept on the line's
-:class:`~stochcable.dynamics.system.LineSystem`).  :meth:`Engine.solve` does the rest
-for one sea state: the input channels (Morison loads, end motions), the drag fixed
-point (:func:`~stochcable.dynamics.fixedpoint.linearize`), the response
-(:func:`~stochcable.dynamics.solve.solve`), the outputs and the time series::
+:class:`~stochcable.dynamics.system.LineSystem`), and the scene as groups
+(:func:`~stochcable.dynamics.coupled.model.build_coupled`): free bodies with the lines
+attached to them, and every other line as a group of its own without bodies, with the
+vessels' RAOs and the sea-independent coupled modes.  :meth:`Engine.solve` does the
+rest for one sea state (:func:`~stochcable.dynamics.coupled.analysis.solve_coupled`):
+the input channels (Morison loads, end motions), the one drag fixed point of every
+group (:func:`~stochcable.dynamics.coupled.fixedpoint.linearize_coupled`) with its
+substructured response, the outputs and the time series::
 
-    engine = build_engine(scene)            # statics, FE models, modes
+    engine = build_engine(scene)            # statics, FE models, modes, groups
     for sea in sea_states:                  # Sea documents (or None: the scene's own)
         result = engine.solve(sea)
 
@@ -19,10 +23,6 @@ A sea state is a :class:`~stochcable.scene.model.Sea` document (spectrum and hea
 the current, the end motions and the settings are the scene's.  ``solve`` mutates no
 state that changes its answer: solving the same sea twice gives identical results, and
 ``engine.solve(sea)`` gives the result of ``analyze`` on the scene with that sea.
-
-Scenes with bodies: the statics are built once; the coupled systems (lines and bodies
-solved together, :func:`stochcable.dynamics.coupled.analyze_coupled`) are built at
-every solve for now.
 """
 
 from __future__ import annotations
@@ -36,20 +36,17 @@ from pydantic import ValidationError
 
 from stochcable import runtime
 from stochcable.dynamics.blocks import line_prep
-from stochcable.dynamics.fixedpoint import linearize
-from stochcable.dynamics.line_loads import silent_channel
-from stochcable.dynamics.loads import line_channels
-from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.coupled.analysis import solve_coupled
+from stochcable.dynamics.coupled.model import CoupledModel, build_coupled
 from stochcable.dynamics.system import (
-    Damping,
     LineSystem,
     Progress,
     build_line_system,
     noop_progress,
 )
 from stochcable.dynamics.timeseries import simulate_timeseries
-from stochcable.errors import InputError, PhysicsWarning, collect_warnings, warn
-from stochcable.results.documents import LineResult, Result
+from stochcable.errors import InputError, collect_warnings
+from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, Sea, input_error_from_validation, load_scene
 from stochcable.statics import StaticsResult, solve_statics
 
@@ -76,8 +73,11 @@ class Engine:
     statics : StaticsResult
         Static equilibrium of every line (and body).
     systems : mapping of LineSystem by line name
-        The independent lines' linear models (empty for a scene with bodies: the
-        coupled systems are built per solve).
+        Every line's linear model (both end nodes prescribed), in scene order.
+    model : CoupledModel
+        The scene as groups (:func:`stochcable.dynamics.coupled.model.build_coupled`):
+        each line attached to no free body is a group of its own without bodies;
+        free bodies with their lines; vessels' RAOs; sea-independent coupled modes.
     timing : mapping of float
         ``statics_s``, ``model_s`` and ``build_s`` (the whole build) of the build. [s]
     warnings : tuple of str
@@ -87,6 +87,7 @@ class Engine:
     scene: Scene
     statics: StaticsResult
     systems: Mapping[str, LineSystem]
+    model: CoupledModel
     timing: Mapping[str, float]
     warnings: tuple[str, ...]
 
@@ -124,26 +125,15 @@ class Engine:
         timing = {k: 0.0 for k in _STAGES}
         timing.update(self.timing)
         with collect_warnings() as caught, runtime.analysis_blas(is_small(scene)):
-            if scene.bodies:
-                # lines attached to bodies are solved together with them (issue 6)
-                from stochcable.dynamics.coupled import analyze_coupled
-
-                coupled = analyze_coupled(scene, self.statics, scene.analysis, progress, timing)
-                lines, bodies, systems, dampings = coupled
-                groups = coupled.groups
-            else:
-                systems, groups, bodies = dict(self.systems), (), {}
-                lines, dampings = _solve_lines(scene, systems, progress, timing)
+            solved = solve_coupled(self.model, scene, scene.analysis, progress, timing)
             ts = None
             if scene.analysis.timeseries is not None:
                 progress("timeseries", {})
                 t0 = time.perf_counter()
                 ts = simulate_timeseries(
                     scene,
-                    systems,
-                    dampings,
                     scene.analysis.timeseries,
-                    coupled=groups,
+                    solved.alone + solved.groups,
                     timing=timing,
                 )
                 timing["timeseries_s"] = time.perf_counter() - t0
@@ -153,11 +143,11 @@ class Engine:
         return Result(
             scene=scene,
             statics=self.statics,
-            lines=lines,
+            lines=solved.lines,
             timeseries=ts,
             timing=timing,
             warnings=tuple(messages),
-            bodies=bodies,
+            bodies=solved.bodies,
         )
 
 
@@ -214,18 +204,21 @@ def build_engine(
             # linearized about it, so it must be an equilibrium of the same FE model
             statics = solve_statics(scene, method="fe")
         timing["statics_s"] = time.perf_counter() - t0
-        for line in () if scene.bodies else scene.lines:
+        for line in scene.lines:
             progress("model", {"line": line.name})
             t0 = time.perf_counter()
             system = build_line_system(scene, line, statics.lines[line.name], settings=settings)
             line_prep(system)  # node blocks and band storage of K, M_T, C_s
             systems[line.name] = system
             timing["model_s"] += time.perf_counter() - t0
+        # bodies, vessels' RAOs, groups and their coupled modes (sea-independent)
+        model = build_coupled(scene, statics, settings, systems=systems, timing=timing)
     timing["build_s"] = time.perf_counter() - t_start  # (in each result's total_s)
     return Engine(
         scene=scene,
         statics=statics,
         systems=systems,
+        model=model,
         timing=timing,
         warnings=tuple(_messages((), caught)),
     )
@@ -241,48 +234,6 @@ def _with_sea(scene: Scene, sea: Sea | Mapping[str, Any] | None) -> Scene:
         except ValidationError as exc:
             raise input_error_from_validation(exc, Sea, prefix="sea") from None
     return scene.model_copy(update={"sea": sea})
-
-
-def _solve_lines(
-    scene: Scene, systems: Mapping[str, LineSystem], progress: Progress, timing: dict[str, float]
-) -> tuple[dict[str, LineResult], dict[str, Damping]]:
-    """Channels, drag fixed point and outputs of every independent line."""
-    lines: dict[str, LineResult] = {}
-    dampings: dict[str, Damping] = {}
-    for line in scene.lines:
-        lines[line.name], dampings[line.name] = _solve_line(
-            scene, line, systems[line.name], progress, timing
-        )
-    return lines, dampings
-
-
-def _solve_line(
-    scene: Scene, line: Any, system: LineSystem, progress: Progress, timing: dict[str, float]
-) -> tuple[LineResult, Damping]:
-    """One independent line: its channels (the sea-dependent loads, timed with the
-    model), the drag linearization and the outputs."""
-    settings = scene.analysis
-    omega = settings.omega.values()
-    t0 = time.perf_counter()
-    channels = line_channels(scene, line, system.positions, omega)
-    timing["model_s"] += time.perf_counter() - t0
-    if not channels:
-        warn(
-            f"line '{line.name}' has no excitation (no sea and no end motion): its "
-            "dynamic response is zero; add a 'sea' or an end 'motion'",
-            PhysicsWarning,
-            stacklevel=3,
-        )
-        channels = silent_channel(omega)
-    progress("linearization", {"line": line.name, "iteration": 0})
-    t0 = time.perf_counter()
-    lin = linearize(system, channels, settings, progress=progress, timing=timing)
-    timing["linearization_s"] += time.perf_counter() - t0
-    progress("outputs", {"line": line.name})
-    t0 = time.perf_counter()
-    result = line_result(system, channels, lin, settings)
-    timing["outputs_s"] += time.perf_counter() - t0
-    return result, lin.damping
 
 
 def _messages(first: tuple[str, ...], caught: list[Warning]) -> list[str]:

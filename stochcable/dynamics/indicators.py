@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -45,6 +46,38 @@ from stochcable.results.documents import (
 from stochcable.scene.units import unit_labels
 
 
+@dataclass(frozen=True, eq=False)
+class LineModes:
+    """The natural modes that count for a line's indicators, when they are not its
+    own fixed-end modes (a line on bodies: the coupled modes with a share of the
+    line, :func:`stochcable.dynamics.coupled.results.line_modes`).
+
+    Attributes
+    ----------
+    numbers : ndarray of int, shape (n,)
+        1-based numbers of the modes in their list (the messages name them).
+    omega : ndarray, shape (n,)
+        Natural frequencies. [rad/s]
+    bandwidth : ndarray, shape (n,)
+        Half-power bandwidths 2ζω = φᵀCφ (mass-normalized φ). [rad/s]
+    label : str
+        How the messages call them ("coupled mode").
+    """
+
+    numbers: np.ndarray
+    omega: np.ndarray
+    bandwidth: np.ndarray
+    label: str = "coupled mode"
+
+
+def _own_modes(system: LineSystem, damping: Damping, modes: LineModes | None) -> LineModes:
+    """``modes``, or the line's own fixed-end modes with their bandwidths."""
+    if modes is not None:
+        return modes
+    wn = np.asarray(system.modes.omega)
+    return LineModes(np.arange(1, wn.size + 1), wn, modal_bandwidths(system, damping), "mode")
+
+
 def modal_bandwidths(system: LineSystem, damping: Damping) -> np.ndarray:
     """φ_jᵀCφ_j of every computed mode (mass-normalized φ; C = structural damping +
     ``damping``): the half-power bandwidth 2ζ_jω_j, (n_modes,), cached on the damping
@@ -75,19 +108,26 @@ def _nearest_spacing(omega: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.n
     return np.minimum(d_lo, d_hi), spacing
 
 
-def resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) -> None:
+def resolution_check(
+    system: LineSystem, damping: Damping, omega: np.ndarray, modes: LineModes | None = None
+) -> None:
     """ResolutionWarning for natural frequencies inside the grid that the grid cannot
     resolve: nearest grid point farther than the local spacing, or a half-power
-    bandwidth (2ζω_j ≈ φ_jᵀCφ_j for mass-normalized φ) narrower than the local spacing."""
-    modes = system.modes
+    bandwidth (2ζω_j ≈ φ_jᵀCφ_j for mass-normalized φ) narrower than the local spacing.
+    ``modes``: the modes that count for the line (default its fixed-end modes)."""
+    modes = _own_modes(system, damping, modes)
     wn = np.asarray(modes.omega)
     inside = np.flatnonzero((wn >= omega[0]) & (wn <= omega[-1]))
     if inside.size == 0 or omega.size < 2:
         return
-    band = modal_bandwidths(system, damping)[inside]
+    band = np.asarray(modes.bandwidth)[inside]
     dist, spacing = _nearest_spacing(omega, wn[inside])
     flagged = (dist > spacing) | (spacing > band)
-    bad = [(j, wn[j], b, dw) for j, b, dw, f in zip(inside, band, spacing, flagged) if f]
+    bad = [
+        (modes.numbers[j] - 1, wn[j], b, dw)
+        for j, b, dw, f in zip(inside, band, spacing, flagged)
+        if f
+    ]
     if not bad:
         return
     j, wj, b, dw = bad[0]
@@ -102,7 +142,7 @@ def resolution_check(system: LineSystem, damping: Damping, omega: np.ndarray) ->
     more = f" and {len(bad) - 1} more mode(s)" if len(bad) > 1 else ""
     warn(
         f"line '{system.name}': the frequency grid (spacing {dw:.3g} rad/s near "
-        f"{wj:.4g} rad/s) does not resolve mode {j + 1} at {wj:.4g} rad/s, whose "
+        f"{wj:.4g} rad/s) does not resolve {modes.label} {j + 1} at {wj:.4g} rad/s, whose "
         f"half-power bandwidth is {b:.3g} rad/s{more}; the resonance peak may be missed: "
         f"{fix}",
         ResolutionWarning,
@@ -241,10 +281,10 @@ def _normal_acceleration_sigma(
     return np.sqrt(var)
 
 
-def _modal_damping_ratios(system: LineSystem, damping: Damping) -> np.ndarray:
-    """ζ_j = φ_jᵀCφ_j/(2ω_j) of the computed modes (mass-normalized φ). [-]"""
-    band = modal_bandwidths(system, damping)
-    wn = np.asarray(system.modes.omega)
+def _modal_damping_ratios(modes: LineModes) -> np.ndarray:
+    """ζ_j = φ_jᵀCφ_j/(2ω_j) of the modes (mass-normalized φ). [-]"""
+    band = np.asarray(modes.bandwidth)
+    wn = np.asarray(modes.omega)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(wn > 0, band / (2.0 * np.where(wn > 0, wn, 1.0)), np.inf)
 
@@ -256,6 +296,7 @@ def line_indicators(
     tension_std: np.ndarray,
     motion_std: np.ndarray,
     end_stats: Mapping[str, Any],
+    modes: LineModes | None = None,
 ) -> LineIndicators:
     """Quality indicators of the linear model of one line, with PhysicsWarnings.
 
@@ -272,6 +313,9 @@ def line_indicators(
         σ of the node motions. [m]
     end_stats : mapping {"end_a", "end_b"} of ResponseStats
         End-tension statistics (mean and std). [N]
+    modes : LineModes, optional
+        The modes of the resonance indicator (default the line's fixed-end modes; a
+        line on bodies: the coupled modes that count for it).
 
     Returns
     -------
@@ -306,7 +350,7 @@ def line_indicators(
     w = linearization.response.omega
     borgman, d_i = _drag_ratios(system, channels, linearization.record, w)
     snap_margin, snap = _snap(system, tension_std, end_stats)
-    resonances = _resonances(system, channels, linearization.damping, w)
+    resonances = _resonances(system, channels, linearization.damping, w, modes)
     m_max, sag, to_sag, to_d = _large_motion(system, motion_std)
     flags = (
         (["snap"] if snap else [])
@@ -389,33 +433,42 @@ def _snap(
 
 
 def _resonances(
-    system: LineSystem, channels: tuple[Channel, ...], damping: Damping, w: np.ndarray
+    system: LineSystem,
+    channels: tuple[Channel, ...],
+    damping: Damping,
+    w: np.ndarray,
+    modes: LineModes | None = None,
 ) -> list[dict[str, Any]]:
     """Modes inside the excitation band with a modal damping ratio below
     ``RESONANCE_DAMPING_RATIO`` (PhysicsWarning naming the first)."""
     resonances: list[dict[str, Any]] = []
-    wn = np.asarray(system.modes.omega)
+    modes = _own_modes(system, damping, modes)
+    wn = np.asarray(modes.omega)
     spectra = [c.spectrum for c in channels if np.any(c.spectrum > 0)]
     if spectra and wn.size:
         inside = np.zeros(wn.size, dtype=bool)
         for spec in spectra:
             in_band = np.interp(wn, w, spec, left=0.0, right=0.0) >= BAND_FRACTION * spec.max()
             inside |= in_band
-        zeta = _modal_damping_ratios(system, damping)
+        zeta = _modal_damping_ratios(modes)
         for j in np.flatnonzero(inside & (zeta < RESONANCE_DAMPING_RATIO)):
             resonances.append(
-                {"mode": int(j + 1), "omega": float(wn[j]), "damping_ratio": float(zeta[j])}
+                {
+                    "mode": int(modes.numbers[j]),
+                    "omega": float(wn[j]),
+                    "damping_ratio": float(zeta[j]),
+                }
             )
     if resonances:
         r0 = resonances[0]
         more = f" and {len(resonances) - 1} more" if len(resonances) > 1 else ""
         warn(
-            f"line '{system.name}': mode {r0['mode']} ({r0['omega']:.4g} rad/s){more} lies "
-            f"in the excitation band with modal damping ratio {r0['damping_ratio']:.2%} "
-            f"(threshold {RESONANCE_DAMPING_RATIO:.0%}): a near-undamped resonance whose "
-            "response is set by damping the model may not represent; check the drag "
-            "coefficients and add structural damping (analysis.structural_damping) or "
-            "seabed damping where physical",
+            f"line '{system.name}': {modes.label} {r0['mode']} ({r0['omega']:.4g} rad/s)"
+            f"{more} lies in the excitation band with modal damping ratio "
+            f"{r0['damping_ratio']:.2%} (threshold {RESONANCE_DAMPING_RATIO:.0%}): a "
+            "near-undamped resonance whose response is set by damping the model may not "
+            "represent; check the drag coefficients and add structural damping "
+            "(analysis.structural_damping) or seabed damping where physical",
             PhysicsWarning,
             stacklevel=4,
         )

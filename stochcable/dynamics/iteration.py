@@ -14,7 +14,29 @@ import numpy as np
 from stochcable import validation as _v
 from stochcable.errors import ConvergenceError, InputError
 
-__all__ = ["FixedPointResult", "fixed_point"]
+__all__ = ["ANDERSON_MIXING", "FixedPointResult", "fixed_point", "relative_change"]
+
+#: Mixing of the Anderson-accelerated steps of the drag fixed point (the plain steps use
+#: analysis.linearization.relaxation): undamped Anderson saves one iteration on the
+#: chain, the taut wire, the guy and a 3-D chain (docs/BENCHMARKS.md "Response analysis").
+ANDERSON_MIXING = 1.0
+
+
+def relative_change(new: np.ndarray, x: np.ndarray) -> float:
+    """The convergence measure of :func:`fixed_point`.
+
+    Parameters
+    ----------
+    new, x : ndarray
+        The map's output and input.
+
+    Returns
+    -------
+    float
+        max_i |new_i − x_i| / max(|new_i|, 1e-6·max|new|). [-]
+    """
+    den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)), 1e-300))
+    return float(np.max(np.abs(new - x) / den, initial=0.0))
 
 
 @dataclass(frozen=True, eq=False)

@@ -60,6 +60,7 @@ import scipy.sparse as sp
 
 from stochcable.dynamics.element_kinematics import (
     ElementKinematics,
+    element_frames,
     element_wave_kinematics,
 )
 from stochcable.errors import InputError
@@ -349,45 +350,6 @@ def element_mean_square(channel: Channel) -> np.ndarray | None:
 
 
 # ------------------------------------------------------------------ element geometry
-
-
-def element_frames(positions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Unit tangent and two unit normals of every element, global frame.
-
-    Parameters
-    ----------
-    positions : ndarray, shape (n_nodes, 3)
-        Static node positions. [m]
-
-    Returns
-    -------
-    e, n1, n2 : ndarray, shape (n_el, 3)
-        Tangent (node j to j+1); n2 the horizontal normal e × ẑ normalized (ŷ for a
-        vertical element), out of the plane for a line in a vertical plane; n1 = n2 × e,
-        the normal in the element's vertical plane. [-]
-    """
-    d = np.diff(positions, axis=0)
-    e = d / np.linalg.norm(d, axis=1)[:, None]
-    n2 = _cross(e, np.array([0.0, 0.0, 1.0]))
-    nn = np.linalg.norm(n2, axis=1)
-    vertical = nn < 1e-12
-    n2 = np.where(
-        vertical[:, None], np.array([0.0, 1.0, 0.0]), n2 / np.where(vertical, 1.0, nn)[:, None]
-    )
-    n1 = _cross(n2, e)
-    return e, n1, n2
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise a × b of 3-vectors: np.cross's products and differences in its order
-    (the same numbers), without its generic axis handling (≈ 20 µs a call)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    out[..., 0] = a1 * b2 - a2 * b1
-    out[..., 1] = a2 * b0 - a0 * b2
-    out[..., 2] = a0 * b1 - a1 * b0
-    return out
 
 
 def embed(model: Any, values: np.ndarray) -> np.ndarray:

@@ -21,6 +21,7 @@ from stochcable.dynamics.blocks import (
     trapezoid_weights,
 )
 from stochcable.dynamics.indicators import (
+    LineModes,
     line_indicators,
     resolution_check,
     surface_resolution_check,
@@ -78,6 +79,7 @@ def line_result(
     channels: tuple[Channel, ...],
     linearization: Linearization,
     settings: AnalysisSettings,
+    modes: LineModes | None = None,
 ) -> LineResult:
     """Transfer functions, spectra and statistics of one line.
 
@@ -89,6 +91,10 @@ def line_result(
         Its ``response`` is used.
     settings : AnalysisSettings
         ``duration`` for the maxima.
+    modes : LineModes, optional
+        The natural modes of the resolution check and the resonance indicator
+        (default the line's fixed-end modes; a line on bodies: the coupled modes that
+        count for it, :func:`stochcable.dynamics.coupled.results.line_modes`).
 
     Returns
     -------
@@ -116,12 +122,12 @@ def line_result(
         stats[end] = stats_from_validated(w, dens, float(mean), settings.duration)
         tail_check(system.name, end, w, dens, stats[end].m0)
     if np.any(spectra > 0):  # nothing to resolve without excitation
-        resolution_check(system, linearization.damping, w)
+        resolution_check(system, linearization.damping, w, modes)
         surface_resolution_check(system, channels, w, q)
     indicators = (
         None
         if linearization.record is None
-        else line_indicators(system, channels, linearization, tension_std, motion_std, stats)
+        else line_indicators(system, channels, linearization, tension_std, motion_std, stats, modes)
     )
     end_force = _end_force_transfer(model, resp, n_ch)
     return LineResult(

@@ -2,7 +2,7 @@
 frequency-independent model (:class:`LineSystem`, :func:`build_line_system`), the choice
 of the modes the Foss solve keeps, and the objects the later stages exchange: the
 linearized drag (:class:`Damping`), the harmonic response (:class:`Response`) and the
-outcome of the drag fixed point (:class:`Linearization`, :class:`CoarseStage`).
+outcome of the drag fixed point (:class:`Linearization`).
 
 Pipeline position: statics -> **system** -> loads (:mod:`~stochcable.dynamics.line_loads`)
 -> drag fixed point (:mod:`~stochcable.dynamics.fixedpoint`) -> solve
@@ -208,42 +208,26 @@ class Response:
     end_tension: dict[str, np.ndarray]
 
 
-@dataclass(frozen=True)
-class CoarseStage:
-    """The coarse start of a drag linearization (:mod:`stochcable.dynamics.fixedpoint`,
-    "Coarse start").
+@dataclass(frozen=True, eq=False)
+class Linearization:
+    """Outcome of the drag fixed point of one line
+    (:func:`stochcable.dynamics.fixedpoint.linearize`, or its share of a group's,
+    :func:`stochcable.dynamics.coupled.fixedpoint.linearize_coupled`).
 
     Attributes
     ----------
-    frequencies : int
-        Size of the frequency subset. [-]
-    iterations : int
-        Response evaluations on the subset. [-]
-    history : tuple of float
-        Relative change of the σ after each of them (on the subset). [-]
-    converged : bool
-        Whether the subset iteration reached its tolerance (``COARSE_TOLERANCE_RATIO``
-        times the linearization tolerance); either way its last σ only start the
-        full-grid iteration.
+    damping : Damping
+        The drag of the last response evaluation.
+    record : LinearizationRecord
+        The iteration record: every response evaluation in order (coarse and
+        full-grid), the final σ and B.
+    response : Response
+        The response solved with ``damping`` (no extra solve).
     """
-
-    frequencies: int
-    iterations: int
-    history: tuple[float, ...]
-    converged: bool
-
-
-@dataclass(frozen=True, eq=False)
-class Linearization:
-    """Outcome of :func:`linearize`: the drag, its record and the last response.
-
-    ``record`` counts the full-grid evaluations only; ``coarse`` is the coarse start
-    (None when the full grid was iterated from the start)."""
 
     damping: Damping
     record: LinearizationRecord
     response: Response
-    coarse: CoarseStage | None = None
 
 
 def _choose_modes(model: FEModel, settings: AnalysisSettings) -> tuple[Modes, int]:

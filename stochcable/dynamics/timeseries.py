@@ -1,7 +1,7 @@
 """Time series of one realization (seed 001 §5.1, eq. 5.3.29 and step 14): the sea,
 the end motions, the end tensions of every line and the motions of the bodies, all
-synthesized from transfer functions solved on the realization grid.  Lines on bodies
-go through :mod:`stochcable.dynamics.coupled_timeseries`.
+synthesized from transfer functions solved on the realization grid: every group (a
+line alone, lines on bodies) by :mod:`stochcable.dynamics.coupled_timeseries`.
 """
 
 from __future__ import annotations
@@ -14,13 +14,7 @@ import numpy as np
 from stochcable.dynamics.loads import (
     Channel,
 )
-from stochcable.dynamics.solve import (
-    solve,
-)
-from stochcable.dynamics.system import (
-    Damping,
-    LineSystem,
-)
+from stochcable.dynamics.system import LineSystem
 from stochcable.results.documents import (
     TimeSeries,
 )
@@ -32,11 +26,9 @@ from stochcable.sea.realization import frequency_grid, simulate_sea, synthesize
 
 def simulate_timeseries(
     scene: Scene,
-    systems: Mapping[str, LineSystem],
-    dampings: Mapping[str, Damping],
     settings: TimeSeriesSettings,
+    groups: tuple[Any, ...],
     *,
-    coupled: tuple[Any, ...] = (),
     timing: dict[str, float] | None = None,
 ) -> TimeSeries:
     """One realization of every input channel and the end-tension and body-motion
@@ -45,16 +37,13 @@ def simulate_timeseries(
     Parameters
     ----------
     scene : Scene
-    systems : mapping of LineSystem by line name
-        The independent lines (not attached to a free body).
-    dampings : mapping of Damping by line name
-        The converged linear drag of each of them.
     settings : TimeSeriesSettings
         method (dsa/nsa), duration, dt, seed.
-    coupled : tuple of CoupledGroup, optional
-        The converged coupled groups of a scene with bodies
-        (:attr:`stochcable.dynamics.coupled.CoupledAnalysis.groups`): their lines' end
-        tensions and their free bodies' motions are synthesized too.
+    groups : tuple of CoupledGroup
+        The converged groups of the scene
+        (:class:`stochcable.dynamics.coupled.analysis.CoupledGroup`): every line alone
+        (a group without bodies), every coupled group and every free-floating body;
+        their lines' end tensions and their free bodies' motions are synthesized.
     timing : dict, optional
         Accumulates ``solve_s``.
 
@@ -66,27 +55,26 @@ def simulate_timeseries(
     -----
     The sea: :func:`stochcable.sea.realization.simulate_sea` with ``rng=seed`` (so η is the
     realization a stand-alone simulation with that seed gives).  End-motion spectrum
-    channels, in the order of the scene's lines (independent and coupled alike) ×
+    channels, in the order of the scene's lines (alone and coupled alike) ×
     (end_a, end_b) × (surge, sway, heave), use the independent generators
     ``np.random.default_rng(c)`` for ``c in np.random.SeedSequence(seed).spawn(n)``.
     Responses are :func:`stochcable.sea.realization.synthesize` of the transfer functions solved
     on the realization grid ω_m = mΔω, restricted to the analysis band
     [omega.min, omega.max] (zero outside, as the response spectra are), so η, end
     motions, tensions and body motions of one realization are mutually consistent
-    (seed 001 §5.1, eq. 5.3.29 and step 14).  Independent lines: :func:`solve` with
-    their converged drag; an end on a vessel moves with the vessel RAO in the sea
-    channel.  Coupled groups: the group's linear system at its converged drag
-    (lines' Damping, bodies' drag σ) solved on the band
-    (:func:`stochcable.dynamics.coupled_timeseries.coupled_group_transfer`).  Vessels: their
-    RAO times the sea.  The band is solved in chunks of frequencies, so only the
-    end tensions and body motions of the whole band are held
+    (seed 001 §5.1, eq. 5.3.29 and step 14).  Every group: its linear system at its
+    converged drag (lines' Damping, bodies' drag σ) solved on the band
+    (:func:`stochcable.dynamics.coupled_timeseries.coupled_group_transfer`; an end on a
+    vessel moves with the vessel RAO in the sea channel).  Vessels: their RAO times
+    the sea.  The band is solved in chunks of frequencies, so only the end tensions
+    and body motions of the whole band are held
     (:mod:`stochcable.dynamics.coupled_timeseries`, "Memory").
     """
     from stochcable.dynamics.coupled_timeseries import vessel_raos
 
     syn = _Synthesis(scene, settings)
-    groups = tuple(coupled)
-    all_systems = dict(systems)
+    groups = tuple(groups)
+    all_systems: dict[str, LineSystem] = {}
     for grp in groups:
         all_systems.update(grp.systems)
     scene_order = [ln.name for ln in scene.lines if ln.name in all_systems]
@@ -98,8 +86,7 @@ def simulate_timeseries(
     }
     syn.realize_end_motions(probe)
     out = _Series()
-    _independent_lines(scene, systems, dampings, probe, syn, out, timing)
-    _coupled_groups(scene, groups, syn, out, timing)
+    _groups(scene, groups, probe, syn, out, timing)
     for b in getattr(scene, "bodies", ()) or ():
         if getattr(b, "prescribed", None) is None or syn.sea is None:
             continue  # vessels: their RAO times the sea
@@ -252,62 +239,26 @@ def _channels_on(scene: Scene, system: LineSystem, w: np.ndarray) -> tuple[Chann
     return ch
 
 
-def _independent_lines(
+def _groups(
     scene: Scene,
-    systems: Mapping[str, LineSystem],
-    dampings: Mapping[str, Damping],
+    groups: tuple[Any, ...],
     probe: Mapping[str, tuple[Channel, ...]],
     syn: _Synthesis,
     out: _Series,
     timing: dict[str, float] | None,
 ) -> None:
-    """Independent lines: :func:`solve` with their converged drag on the band, in
-    chunks of frequencies (only the end tensions of the whole band are held)."""
-    from stochcable.dynamics.coupled_timeseries import (
-        CHUNK_BYTES,
-        frequency_chunks,
-        line_entry_bytes,
-    )
-
-    for name, system in systems.items():
-        chs = probe.get(name, ())
-        tr = {}
-        if chs:
-            h = {e: np.zeros((len(chs), syn.band.size), dtype=complex) for e in ("end_a", "end_b")}
-            entry = line_entry_bytes(system.model, len(chs))
-            for sl in frequency_chunks(syn.band.size, entry, CHUNK_BYTES):
-                resp = solve(
-                    system, _channels_on(scene, system, syn.w_band[sl]), dampings[name], timing
-                )
-                for e, he in h.items():
-                    he[:, sl] = resp.end_tension[e]
-            tr = {e: syn.full(v) for e, v in h.items()}
-        out.add_line(
-            name,
-            system.statics,
-            tr,
-            syn,
-            tuple(c.kind for c in chs),
-            tuple((name, c.name) for c in chs),
-            tuple(c.name for c in chs),
-        )
-
-
-def _coupled_groups(
-    scene: Scene,
-    groups: tuple[Any, ...],
-    syn: _Synthesis,
-    out: _Series,
-    timing: dict[str, float] | None,
-) -> None:
-    """Coupled groups: the group's linear system at its converged drag solved on the
-    band (:func:`stochcable.dynamics.coupled_timeseries.coupled_group_transfer`): the
-    end tensions of its lines and the motions of its free bodies."""
+    """Every group: its linear system at its converged drag solved on the band
+    (:func:`stochcable.dynamics.coupled_timeseries.coupled_group_transfer`): the end
+    tensions of its lines and the motions of its free bodies (a line alone without
+    any channel: its static tension)."""
     from stochcable.dynamics.coupled_timeseries import coupled_group_transfer
 
     for grp in groups:
+        silent = not grp.bodies and not any(probe.get(n) for n in grp.lines)
         gt = (
-            coupled_group_transfer(scene, grp, syn.w_band, timing=timing) if syn.band.size else None
+            coupled_group_transfer(scene, grp, syn.w_band, timing=timing)
+            if syn.band.size and not silent
+            else None
         )
         for name in grp.lines:
             tr = {} if gt is None else {e: syn.full(v) for e, v in gt.end_tension[name].items()}

@@ -41,6 +41,7 @@ from stochcable.dynamics.system import (
     LineSystem,
     Response,
 )
+from stochcable.results.documents import LinearizationRecord
 
 # ------------------------------------------------------------------------- damping
 
@@ -446,3 +447,30 @@ def quasi_static_motion(system: LineSystem, inp: LineInputs) -> np.ndarray | Non
     ub = np.ascontiguousarray(inp.ub.reshape(2 * prep.d, -1))
     u[1:-1] = real_gemm(prep.follower(), ub).reshape(u[1:-1].shape)
     return u
+
+
+def linearization_record(
+    system: LineSystem, sigma: np.ndarray, damping: Damping, fp: Any, tolerance: float, method: str
+) -> LinearizationRecord:
+    """The record of a converged (or flagged) drag fixed point of one line: the
+    iteration history of ``fp`` (a FixedPointResult), the final σ (the
+    :func:`drag_coefficients` layout) split into normal and axial, and the linear
+    drag (the vector form reports σ_n = |σ| and b_n = trace/2 of its 2×2 blocks)."""
+    parts = split_sigma(system, sigma, method)
+    if method == "vector":
+        sig_n = np.sqrt(parts["normal"][0] ** 2 + parts["normal"][1] ** 2)
+        b_n = 0.5 * np.trace(damping.b_normal, axis1=1, axis2=2)
+    else:
+        sig_n, b_n = parts["normal"][0], damping.b_normal
+    return LinearizationRecord(
+        method=method,
+        converged=fp.converged,
+        iterations=fp.iterations,
+        relative_change=fp.relative_change,
+        history=fp.history,
+        tolerance=tolerance,
+        sigma_normal=sig_n,
+        sigma_axial=parts["axial"],
+        b_normal=b_n,
+        b_axial=damping.b_axial,
+    )

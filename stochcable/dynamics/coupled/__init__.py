@@ -1,11 +1,18 @@
-"""Coupled dynamics of lines and large rigid bodies (seed 001 §3.2.c, §3.3, ch. 5).
+"""The engine's groups: lines and large rigid bodies solved together (seed 001
+§3.2.c, §3.3, ch. 5), a line alone being the group of one line and no bodies.
 
 Lines attached to a freely moving body are solved together with it: one drag
 linearization loop over every attached line and body, the response at every frequency
 by substructuring, the outputs of each line as :func:`stochcable.dynamics.outputs.line_result`
 gives them and the body motions as :class:`stochcable.results.documents.BodyResult`.
+A line attached to no free body goes through the same fixed point and solve, its
+line part being its own response
+(:class:`~stochcable.dynamics.coupled.freeline.FreeLine`).
 
 Modules, lowest first (each imports only the ones above it):
+
+- :mod:`~stochcable.dynamics.coupled.bodydrag`: the linearized drag of a body;
+- :mod:`~stochcable.dynamics.coupled.freeline`: the line part of a line alone;
 
 - :mod:`~stochcable.dynamics.coupled.inputs`: a group's lines (:class:`CoupledLine`),
   body loads, vessel-driven ends and the group's channels;

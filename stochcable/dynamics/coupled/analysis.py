@@ -1,11 +1,12 @@
-"""Frequency-domain analysis of a scene with bodies: a built model
+"""Frequency-domain analysis of a scene: a built model
 (:mod:`stochcable.dynamics.coupled.model`) solved for a sea state.
 
 :func:`analyze_coupled` is :func:`~stochcable.dynamics.coupled.model.build_coupled`
-then :func:`solve_coupled`.  Lines attached to no free body take the independent path
-of :mod:`stochcable.dynamics` (linearize, line_result), an end on a prescribed
-body moving with :func:`~stochcable.dynamics.coupled.inputs.fairlead_motion` in the sea
-channel.  Each connected component of free bodies and their lines is one coupled group
+then :func:`solve_coupled`.  A line attached to no free body is a group of its own
+without bodies (the same fixed point, :func:`linearize_coupled`, then
+:func:`~stochcable.dynamics.outputs.line_result`), an end on a prescribed body moving
+with :func:`~stochcable.dynamics.coupled.inputs.fairlead_motion` in the sea channel.
+Each connected component of free bodies and their lines is one coupled group
 (:func:`~stochcable.dynamics.coupled.fixedpoint.linearize_coupled`,
 :func:`~stochcable.dynamics.coupled.modes.coupled_modes`,
 :func:`~stochcable.dynamics.coupled.results.coupled_results`).
@@ -37,7 +38,9 @@ from stochcable.dynamics.coupled.inputs import (
 from stochcable.dynamics.coupled.model import CoupledModel, ModelGroup, build_coupled
 from stochcable.dynamics.coupled.modes import coupled_modes
 from stochcable.dynamics.coupled.results import body_result, coupled_results
+from stochcable.dynamics.line_loads import silent_channel
 from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.outputs import line_result
 from stochcable.dynamics.system import Damping, LineSystem, Progress, noop_progress
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.results.documents import BodyResult, LineResult
@@ -99,6 +102,8 @@ class CoupledAnalysis:
         Their converged drag.
     groups : tuple of CoupledGroup
         Each coupled group, then each free-floating body without lines.
+    alone : tuple of CoupledGroup
+        Each line attached to no free body as a group without bodies, in scene order.
     """
 
     lines: dict[str, LineResult]
@@ -106,6 +111,7 @@ class CoupledAnalysis:
     systems: dict[str, LineSystem]
     dampings: dict[str, Damping]
     groups: tuple[CoupledGroup, ...] = ()
+    alone: tuple[CoupledGroup, ...] = ()
 
     def __iter__(self) -> Any:
         return iter((self.lines, self.bodies, self.systems, self.dampings))
@@ -217,10 +223,11 @@ def solve_coupled(
     lines_out: dict[str, LineResult] = {}
     bodies_out: dict[str, BodyResult] = {}
     dampings: dict[str, Damping] = {}
+    alone: list[CoupledGroup] = []
     for name in model.independent:
-        lines_out[name], dampings[name] = _solve_line(
-            model, name, chans[name], settings, progress, timing
-        )
+        lines_out[name], state = _solve_line(model, name, chans[name], settings, progress, timing)
+        dampings[name] = state.dampings[name]
+        alone.append(state)
     states: list[CoupledGroup] = []
     for group in model.groups:
         lo, bo, state = _solve_group(model, scene, group, chans, settings, progress, timing)
@@ -237,7 +244,7 @@ def solve_coupled(
     ordered = {line.name: lines_out[line.name] for line in scene.lines}
     ordered_b = {b.name: bodies_out[b.name] for b in scene.bodies if b.name in bodies_out}
     systems = {n: model.systems[n] for n in model.independent}
-    return CoupledAnalysis(ordered, ordered_b, systems, dampings, tuple(states))
+    return CoupledAnalysis(ordered, ordered_b, systems, dampings, tuple(states), tuple(alone))
 
 
 def _with_sea(scene: Any, sea: Any) -> Any:
@@ -260,13 +267,9 @@ def _solve_line(
     settings: Any,
     progress: Progress,
     timing: dict[str, float],
-) -> tuple[LineResult, Damping]:
-    """A line attached to no free body: the independent path."""
-    from stochcable.dynamics.fixedpoint import linearize
-    from stochcable.dynamics.line_loads import silent_channel
-    from stochcable.dynamics.outputs import line_result
-
-    system = model.systems[name]
+) -> tuple[LineResult, CoupledGroup]:
+    """A line attached to no free body: the group of this line alone (no bodies),
+    its own channels (a silent one without excitation, with a PhysicsWarning)."""
     if not ch:
         warn(
             f"line '{name}' has no excitation (no sea and no end motion): its "
@@ -275,13 +278,18 @@ def _solve_line(
             stacklevel=4,
         )
         ch = silent_channel(model.omega)
+    cl = CoupledLine(model.systems[name], ch)
+    progress("linearization", {"line": name, "iteration": 0})
     t1 = time.perf_counter()
-    lin = linearize(system, ch, settings, progress=progress, timing=timing)
+    clin = linearize_coupled(
+        [cl], [], settings, rho=model.scene.environment.rho, progress=progress, timing=timing
+    )
     timing["linearization_s"] += time.perf_counter() - t1
+    progress("outputs", {"line": name})
     t1 = time.perf_counter()
-    out = line_result(system, ch, lin, settings)
+    out = line_result(cl.system, ch, clin.lines[name], settings)
     timing["outputs_s"] += time.perf_counter() - t1
-    return out, lin.damping
+    return out, _group_state([name], model, [], clin)
 
 
 def _solve_group(

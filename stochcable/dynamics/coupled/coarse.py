@@ -5,7 +5,7 @@ On a grid of at least ``COARSE_MIN_FREQUENCIES`` points the iteration first runs
 a frequency subset G (every ``COARSE_STRIDE``-th frequency and the last) to
 ``COARSE_TOLERANCE_FACTOR`` times the tolerance.  The σ integrals on the subset are
 the full grid's trapezoid rule on the cubic interpolant of the integrand
-(:func:`stochcable.dynamics.fixedpoint.interpolatory_weights`, as the single-line coarse start
+(:func:`stochcable.dynamics.coarse_grid.interpolatory_weights`, as the single-line coarse start
 of :mod:`stochcable.dynamics`); subset frequencies whose σ weight is at most
 ``COARSE_NEGLIGIBLE`` (1e-12) of the largest in every channel (the spectrum's empty
 tail) are then left out (their σ contributions are below round-off).  A Foss line
@@ -41,23 +41,31 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.coupled.group import GroupSystem, relative_change, sigma_update
+from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep
+from stochcable.dynamics.coarse_grid import interpolatory_weights, subset_inputs
+from stochcable.dynamics.coupled.group import GroupSystem, sigma_update
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine
-from stochcable.dynamics.fixedpoint import interpolatory_weights, subset_inputs
-from stochcable.dynamics.iteration import fixed_point
+from stochcable.dynamics.iteration import fixed_point, relative_change
+from stochcable.dynamics.line_loads import drag_blocks, drag_inputs
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.system import Progress
+from stochcable.dynamics.variance import drag_coefficients, end_motion_projections, fluid_terms
 from stochcable.errors import ConvergenceError, SolverError
 
 __all__ = [
     "COARSE_CORRECTIONS",
+    "COARSE_MAX_FRACTION",
     "COARSE_MIN_FREQUENCIES",
     "COARSE_MIN_TOLERANCE",
     "COARSE_NEGLIGIBLE",
     "COARSE_STRIDE",
     "COARSE_TOLERANCE_FACTOR",
     "CoarseStart",
+    "coarse_group",
     "coarse_subset",
+    "full_grid_arrays",
+    "narrow_features",
+    "uniform_subset",
 ]
 
 #: Errors of a coarse model that hand over to the full grid alone (its checks).
@@ -82,19 +90,42 @@ COARSE_CORRECTIONS = 3
 COARSE_NEGLIGIBLE = 1e-12
 
 
-def coarse_subset(g: GroupSystem) -> np.ndarray | None:
+#: A group without bodies: the coarse stage is skipped when its subset, refined around
+#: the narrow features (:func:`coarse_subset`), holds more than this fraction of the
+#: grid (many narrow resonances: the full grid alone is cheaper; the inclined guy).
+COARSE_MAX_FRACTION = 0.35
+
+
+def coarse_subset(
+    g: GroupSystem, x_rest: np.ndarray | None = None, method: str = "seed"
+) -> np.ndarray | None:
     """Indices of the coarse-start grid.
 
     Parameters
     ----------
     g : GroupSystem
+        Its ``sizes`` set when ``x_rest`` is given.
+    x_rest : ndarray, optional
+        The at-rest σ of the fixed point (the starting drag of the narrow-feature
+        test of a group without bodies). [m/s]
+    method : str, optional
+        Drag linearization method (of ``x_rest``).
 
     Returns
     -------
     ndarray of int or None
         Every ``COARSE_STRIDE``-th frequency and the last; None when the grid has
         fewer than ``COARSE_MIN_FREQUENCIES`` points or the subset is not below 3/4
-        of it.
+        of it.  A group without bodies (a line alone) also keeps ± ``COARSE_STRIDE``
+        points around its narrow features (:func:`narrow_features`) and is None
+        above ``COARSE_MAX_FRACTION`` of the grid.
+
+    Notes
+    -----
+    The narrow-feature refinement needs the group's modes and their damping: for a
+    group without bodies they are the line's fixed-end modes (``system.modes``); a
+    group with bodies keeps the uniform subset and relies on the defect correction
+    (its coupled modes would be the ones to test).
     """
     n = g.omega.size
     if n < COARSE_MIN_FREQUENCIES:
@@ -102,8 +133,73 @@ def coarse_subset(g: GroupSystem) -> np.ndarray | None:
     keep = np.zeros(n, dtype=bool)
     keep[::COARSE_STRIDE] = True
     keep[-1] = True
+    if g.bodies or x_rest is None:
+        idx = np.flatnonzero(keep)
+        return idx if idx.size < 0.75 * n else None
+    centers = narrow_features(g, x_rest, method)
+    if centers.size:
+        span = centers[:, None] + np.arange(-COARSE_STRIDE, COARSE_STRIDE + 1)
+        keep[np.clip(span, 0, n - 1).ravel()] = True
     idx = np.flatnonzero(keep)
-    return idx if idx.size < 0.75 * n else None
+    return idx if idx.size <= COARSE_MAX_FRACTION * n else None
+
+
+def narrow_features(g: GroupSystem, x_rest: np.ndarray, method: str) -> np.ndarray:
+    """Grid indices of the features of a group without bodies that the stride-
+    ``COARSE_STRIDE`` subset cannot resolve: half-power band narrower than two coarse
+    spacings.
+
+    Parameters
+    ----------
+    g : GroupSystem
+        Without bodies; ``sizes`` set.
+    x_rest : ndarray
+        The at-rest σ (the starting drag). [m/s]
+    method : str
+        Drag linearization method.
+
+    Returns
+    -------
+    ndarray of int
+        The peak of each channel spectrum whose band S_i >= S_i,max/2 is narrow, and
+        the grid point nearest each natural frequency inside the grid whose
+        bandwidth 2ζ_jω_j = φ_jᵀCφ_j (mass-normalized φ_j, C the structural damping
+        plus the starting drag, :func:`stochcable.dynamics.indicators.
+        modal_bandwidths` of the modes inside) is narrow.
+    """
+    w = g.omega
+    n = w.size
+    spacing = COARSE_STRIDE * np.gradient(w)
+    centers = []
+    spectra = np.stack([c.spectrum for c in g.channels], axis=1)
+    for s_i in spectra.T:  # channels: is the half-power band of the peak narrow?
+        k = int(np.argmax(s_i))
+        if s_i[k] <= 0:
+            continue
+        low = s_i < 0.5 * s_i[k]
+        lo = k - int(np.argmax(low[k::-1])) if np.any(low[: k + 1]) else 0
+        hi = k + int(np.argmax(low[k:])) if np.any(low[k:]) else n - 1
+        if w[hi] - w[lo] < 2.0 * spacing[k]:
+            centers.append(np.array([k]))
+    sigmas, _ = g.split(x_rest)
+    drag = {}
+    g.start_drag = (x_rest, drag)  # the first evaluation at x_rest reuses them
+    for cl in g.lines:
+        wn = np.asarray(cl.system.modes.omega)
+        inside = np.flatnonzero((wn > w[0]) & (wn < w[-1]))
+        system = cl.system
+        if not inside.size:
+            drag[cl.name] = drag_coefficients(system, sigmas[cl.name], method)
+            continue
+        damping = drag[cl.name] = drag_coefficients(system, sigmas[cl.name], method)
+        prep = line_prep(system)
+        c = add_blocks(prep.S, drag_blocks(system, damping))
+        phi = system.modes.shapes[system.model.free][:, inside]
+        band = np.einsum("ij,ij->j", phi, prep.free_rows(block_matvec(c, prep.nodes(phi))))
+        near = np.clip(np.searchsorted(w, wn[inside]), 1, n - 1)
+        near -= (wn[inside] - w[near - 1]) < (w[near] - wn[inside])  # nearest point
+        centers.append(near[band < 2.0 * spacing[near]])
+    return np.concatenate(centers) if centers else np.zeros(0, dtype=int)
 
 
 #: Defect-correction rounds start with the warm step (:func:`_warm_step`) over the
@@ -128,41 +224,62 @@ def _warm_step(pairs: Sequence[tuple[np.ndarray, np.ndarray]], ratio: np.ndarray
     return np.maximum(step, 0.0)
 
 
-def _coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
+def uniform_subset(n: int) -> np.ndarray:
+    """Every ``COARSE_STRIDE``-th index of ``range(n)`` and the last."""
+    return np.unique(np.r_[np.arange(0, n, COARSE_STRIDE), n - 1])
+
+
+def full_grid_arrays(g: GroupSystem, method: str) -> None:
+    """The full grid's drag-independent arrays of the σ map of each line without
+    attached ends (end-motion projections, drag inputs, fluid terms: its full-grid
+    evaluations need them anyway), computed before a coarse group slices them
+    (:func:`~stochcable.dynamics.coarse_grid.subset_inputs`) instead of computing
+    its own."""
+    for cl in g.lines:
+        if not cl.attached():
+            inp = g.inp_phys[cl.name]
+            end_motion_projections(cl.system, inp, method)
+            drag_inputs(cl.system, line_prep(cl.system), inp)
+            fluid_terms(cl.system, inp, method)
+
+
+def coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
     """The group on the frequencies ``g.omega[idx]``: σ integrals by the full grid's
     trapezoid rule on the subset's cubic interpolant
-    (:func:`stochcable.dynamics.fixedpoint.interpolatory_weights`), the lines' inputs sliced
-    from the full grid's (:func:`stochcable.dynamics.fixedpoint.subset_inputs`), Foss lines
+    (:func:`stochcable.dynamics.coarse_grid.interpolatory_weights`), the lines' inputs sliced
+    from the full grid's (:func:`stochcable.dynamics.coarse_grid.subset_inputs`), Foss lines
     solved per frequency in modal coordinates
     (:class:`~stochcable.dynamics.coupled.lineparts.ModalLine`); the frequencies of negligible
     σ weight (``COARSE_NEGLIGIBLE``) left out after the weights are formed."""
     spectra = np.stack([c.spectrum for c in g.channels], axis=1)[idx]
-    weights = interpolatory_weights(g.omega, idx)[:, None] * spectra
-    inp = {
-        cl.name: subset_inputs(cl.system, tuple(cl.channels), g.inp_phys[cl.name], idx)
-        for cl in g.lines
-    }
+    quadrature = interpolatory_weights(g.omega, idx)
+    weights = quadrature[:, None] * spectra
     # frequencies whose σ weight is negligible in every channel (the spectrum's empty
     # tail) are dropped after the weights are formed: the other weights, the mean
     # squares and the inputs stay those of the interpolant on ``idx``
     ref = np.max(np.abs(weights), axis=0, initial=0.0)
     keep = np.flatnonzero(np.any(np.abs(weights) > COARSE_NEGLIGIBLE * ref, axis=1))
-    if 4 <= keep.size < idx.size:
-        for cl in g.lines:
-            sub = inp[cl.name]
-            rows = subset_inputs(cl.system, _sliced_line(cl, idx).channels, sub, keep)
-            inp[cl.name] = dataclasses.replace(rows, weights=sub.weights[keep], square=sub.square)
+    if not 4 <= keep.size < idx.size:
+        keep = None
+    inp = {
+        cl.name: subset_inputs(
+            cl.system, tuple(cl.channels), g.inp_phys[cl.name], idx, keep, quadrature
+        )
+        for cl in g.lines
+    }
+    if keep is not None:
         idx, weights = idx[keep], weights[keep]
     gc = GroupSystem(
         [_sliced_line(cl, idx) for cl in g.lines],
         g.bodies,
         {k: _sliced_loads(v, idx) for k, v in g.loads.items()},
         g.rho,
-        [_sliced_channel(c, idx) for c in g.channels],
+        [_sliced_channel(c, idx, light=True) for c in g.channels],
         inp_phys=inp,
         weights=weights,
     )
     gc.sizes = g.sizes
+    gc.start_drag = g.start_drag
     gc.modal_direct = True
     return gc
 
@@ -179,14 +296,24 @@ _CHANNEL_ARRAYS = (
 _NODAL_ARRAYS = ("velocity", "acceleration")
 
 
-def _sliced_channel(c: Channel, idx: np.ndarray) -> Channel:
-    """The channel on the frequencies ``omega[idx]`` (every array's first axis).
+def _sliced_channel(c: Channel, idx: np.ndarray, light: bool = False) -> Channel:
+    """The channel on the frequencies ``omega[idx]`` (every array's first axis);
+    ``light``: its name, grid and spectrum alone (the group's channel list and a line
+    without attached ends, whose coarse solve reads its sliced inputs only).
 
     Nodal kinematics computed on first use (a channel with ``nodal``, the sea
     channel of :func:`stochcable.dynamics.loads.line_channels`) stay lazy: the sliced
     channel's ``nodal`` slices the full channel's on first access (the coarse stage
     never reads them; slicing them eagerly computed them on the full grid, ≈ 0.4 ms
     per line, docs/BENCHMARKS.md pass E5c)."""
+    if light:
+        return Channel(
+            name=c.name,
+            kind=c.kind,
+            omega=c.omega[idx],
+            spectrum=c.spectrum[idx],
+            density=c.density,
+        )
     lazy = c.nodal is not None
     kw: dict[str, Any] = {
         k: getattr(c, k)[idx]
@@ -204,7 +331,10 @@ def _sliced_channel(c: Channel, idx: np.ndarray) -> Channel:
 
 
 def _sliced_line(cl: CoupledLine, idx: np.ndarray) -> CoupledLine:
-    return dataclasses.replace(cl, channels=tuple(_sliced_channel(c, idx) for c in cl.channels))
+    light = not cl.attached()  # no unit channels to build from its channels
+    return dataclasses.replace(
+        cl, channels=tuple(_sliced_channel(c, idx, light) for c in cl.channels)
+    )
 
 
 def _sliced_loads(ld: BodyLoads, idx: np.ndarray) -> BodyLoads:
@@ -237,6 +367,8 @@ class CoarseStart:
         (relaxation, method, mixing).
     gname : str
         The iteration's name in messages.
+    group : GroupSystem, optional
+        The coarse group on ``idx`` when already built (:func:`coarse_group`).
 
     Attributes
     ----------
@@ -257,10 +389,11 @@ class CoarseStart:
         lin: Any,
         fixed: dict[str, Any],
         gname: str,
+        group: GroupSystem | None = None,
     ) -> None:
-        self.raw = sigma_update(
-            _coarse_group(g, idx), method, rho, state, {}, progress, names, None
-        )
+        full_grid_arrays(g, method)
+        gc = coarse_group(g, idx) if group is None else group
+        self.raw = sigma_update(gc, method, rho, state, {}, progress, names, None)
         self.lin, self.fixed, self.gname = lin, fixed, gname
         # the coarse model is only good to its defect: no tighter than 1e-6 (round-off
         # noise of the σ stalls tighter coarse iterations; the full grid finishes)

@@ -25,18 +25,27 @@ import numpy as np
 from stochcable.bodies.rigid import RigidBody
 from stochcable.dynamics.blocks import to_freq
 from stochcable.dynamics.coupled.coarse import (
+    COARSE_MIN_FREQUENCIES,
     COARSE_MIN_TOLERANCE,
     CoarseStart,
+    coarse_group,
     coarse_subset,
+    full_grid_arrays,
+    uniform_subset,
 )
+from stochcable.dynamics.coupled.freeline import FreeLine
 from stochcable.dynamics.coupled.group import GroupSystem, body_sigma, sigma_update
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine
-from stochcable.dynamics.fixedpoint import ANDERSON_MIXING, linearization_record
-from stochcable.dynamics.iteration import FixedPointResult, fixed_point
+from stochcable.dynamics.iteration import ANDERSON_MIXING, FixedPointResult, fixed_point
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.solve import end_tension_from_support
 from stochcable.dynamics.system import Linearization, Progress, Response, noop_progress
-from stochcable.dynamics.variance import quasi_static_motion, sigmas_from_nodes
+from stochcable.dynamics.variance import (
+    linearization_record,
+    quasi_static_motion,
+    rest_sigmas,
+    sigmas_from_nodes,
+)
 from stochcable.errors import ConvergenceError, InputError, PhysicsWarning, warn
 
 __all__ = ["CoupledLinearization", "linearize_coupled"]
@@ -90,7 +99,9 @@ def linearize_coupled(
     timing: dict[str, float] | None = None,
     coarse: bool | None = None,
 ) -> CoupledLinearization:
-    """Drag linearization and response of lines coupled through rigid bodies.
+    """Drag linearization and response of lines coupled through rigid bodies: the
+    one drag fixed point of the engine (a single line is the group of one line and no
+    bodies, :func:`stochcable.dynamics.fixedpoint.linearize`).
 
     Parameters
     ----------
@@ -109,15 +120,17 @@ def linearize_coupled(
         The group's channels (names, spectra, grid); default those of the first
         line; required for bodies without lines (a body on springs).
     progress : callable, optional
-        ``progress("linearization", {"group", "iteration", "change"})``.
+        ``progress("linearization", {"group", "iteration", "change"})`` (and
+        ``"line"`` for a line without bodies).
     timing : dict, optional
         Accumulates ``solve_s``. [s]
     coarse : bool, optional
         Start the full-grid iteration from the fixed point of a frequency subset and
         correct it by the full/coarse defect (:mod:`stochcable.dynamics.coupled.coarse`);
         False iterates on the full grid only.  Default: when the tolerance is at
-        least ``COARSE_MIN_TOLERANCE`` (1e-6), under both solvers; skipped on grids
-        below ``COARSE_MIN_FREQUENCIES``.
+        least ``COARSE_MIN_TOLERANCE`` (1e-6), more than one evaluation is allowed
+        and no line has the vector form with a current, under both solvers; skipped
+        on grids below ``COARSE_MIN_FREQUENCIES``.
 
     Returns
     -------
@@ -148,10 +161,11 @@ def linearize_coupled(
     g = GroupSystem(lines, bodies, loads or {}, rho, channels)
     names = ", ".join(cl.name for cl in g.lines)
     gname = (
-        f"coupled drag linearization of lines {names} and bodies "
+        f"drag linearization of line '{names}'"
+        if len(g.lines) == 1 and not g.bodies
+        else f"coupled drag linearization of lines {names} and bodies "
         f"{', '.join(b.name for b in g.bodies)}"
     )
-    x_rest = _rest_start(g, method)
     state: dict[str, Any] = {"it": 0}
     cache: dict[str, Any] = {}
     fixed = {
@@ -162,11 +176,13 @@ def linearize_coupled(
     # coarse stage (stochcable.dynamics.coupled.coarse): the fixed point of a frequency
     # subset supplies the start of the full-grid iteration; its history is kept
     if coarse is None:
-        coarse = lin.tolerance >= COARSE_MIN_TOLERANCE
-    idx = coarse_subset(g) if coarse and x_rest.size else None
+        coarse = _coarse_pays(g, lin)
+    x_rest, idx, gc = _start(g, method, coarse)
     stage = None
     if idx is not None:
-        stage = CoarseStart(g, idx, method, rho, state, progress, names, lin, fixed, gname)
+        stage = CoarseStart(
+            g, idx, method, rho, state, progress, names, lin, fixed, gname, group=gc
+        )
         x_coarse = stage.start(x_rest)
         if x_coarse is None:
             stage = None
@@ -198,11 +214,55 @@ def linearize_coupled(
     return _outcome(g, cache, fp, lin.tolerance, method)
 
 
+def _coarse_pays(g: GroupSystem, lin: Any) -> bool:
+    """The default of the coarse start: tolerances of at least
+    ``COARSE_MIN_TOLERANCE``, more than one evaluation allowed, and not the vector
+    form with a current (its drag is a quadrature per element, ≈ 15 ms on the chain,
+    not frequency work: a subset saves nothing)."""
+    if lin.tolerance < COARSE_MIN_TOLERANCE or lin.max_iterations == 1:
+        return False
+    return not (
+        lin.method == "vector"
+        and any(np.any(cl.system.current_el) or np.any(cl.system.current_node) for cl in g.lines)
+    )
+
+
+def _start(
+    g: GroupSystem, method: str, coarse: bool
+) -> tuple[np.ndarray, np.ndarray | None, GroupSystem | None]:
+    """The at-rest σ of the fixed point (:func:`_rest_start`), the coarse subset
+    (:func:`~stochcable.dynamics.coupled.coarse.coarse_subset`; None: no coarse stage)
+    and the coarse group on it when already built.
+
+    A group without bodies whose coarse stage may run takes its at-rest σ on the
+    uniform subset (the coarse start only needs a start and the starting drag of the
+    narrow-feature test): the coarse group of the uniform subset is built first and
+    kept when the narrow features add no frequency; a group with bodies, on the full
+    grid."""
+    if coarse and not g.bodies and g.omega.size >= COARSE_MIN_FREQUENCIES:
+        full_grid_arrays(g, method)
+        base = uniform_subset(g.omega.size)
+        gc = coarse_group(g, base)
+        x_rest = _rest_start(gc, method)
+        g.sizes = gc.sizes
+        idx = coarse_subset(g, x_rest, method) if x_rest.size else None
+        if idx is not None:
+            gc.start_drag = g.start_drag
+            return x_rest, idx, gc if np.array_equal(idx, base) else None
+        return _rest_start(g, method), None, None
+    x_rest = _rest_start(g, method)
+    return x_rest, (coarse_subset(g, x_rest, method) if coarse and x_rest.size else None), None
+
+
 def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
     """σ of lines at rest (quasi-static on their moving ends) and bodies at rest;
     sets ``g.sizes``. [m/s]"""
     parts = [
-        sigmas_from_nodes(
+        # a line alone: by the cached end-motion projections of its σ map (the same
+        # numbers, :func:`~stochcable.dynamics.variance.rest_sigmas`)
+        rest_sigmas(cl.system, g.inp_phys[cl.name], method)
+        if not cl.attached()
+        else sigmas_from_nodes(
             cl.system,
             g.inp_phys[cl.name],
             quasi_static_motion(cl.system, g.inp_phys[cl.name]),
@@ -271,7 +331,8 @@ def _outcome(
     for cl in g.lines:
         system = cl.system
         damping = cache["damping"][cl.name]
-        uc, sc = cache["sol"][cl.name]
+        sol = cache["sol"][cl.name]
+        uc, sc = sol.combine(None) if isinstance(sol, FreeLine) else sol
         resp = Response(
             omega=g.omega,
             displacement=to_freq(uc),

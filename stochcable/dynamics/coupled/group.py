@@ -35,7 +35,6 @@ when all modes are kept).
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -49,10 +48,12 @@ from stochcable.bodies.rigid import (
     rigid_link_matrix,
 )
 from stochcable.dynamics.blocks import trapezoid_weights
+from stochcable.dynamics.coupled.bodydrag import body_drag_matrix, linear_body_drag
+from stochcable.dynamics.coupled.freeline import FreeLine
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine, unit_channels
 from stochcable.dynamics.coupled.lineparts import FossLine, ModalLine, line_parts
+from stochcable.dynamics.iteration import relative_change
 from stochcable.dynamics.line_loads import line_inputs
-from stochcable.dynamics.linearization import drag_linear_current, drag_linear_harmonic
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.system import Damping, Progress
 from stochcable.dynamics.variance import drag_coefficients, sigmas_from_nodes
@@ -63,7 +64,6 @@ __all__ = [
     "body_drag_matrix",
     "body_sigma",
     "linear_body_drag",
-    "relative_change",
     "sigma_update",
     "solve_group",
 ]
@@ -73,13 +73,16 @@ class _LazyInputs(dict):
     """Line name -> inputs of its channels plus its unit end-motion channels, built
     on first access."""
 
-    def __init__(self, lines: Sequence[CoupledLine]) -> None:
+    def __init__(self, lines: Sequence[CoupledLine], phys: Mapping[str, Any]) -> None:
         super().__init__()
         self._lines = {cl.name: cl for cl in lines}
+        self._phys = phys
 
     def __missing__(self, name: str) -> Any:
         cl = self._lines[name]
-        value = line_inputs(cl.system, tuple(cl.channels) + unit_channels(cl))
+        units = unit_channels(cl)
+        # a line without attached ends has no unit channels: its physical inputs
+        value = line_inputs(cl.system, tuple(cl.channels) + units) if units else self._phys[name]
         self[name] = value
         return value
 
@@ -126,6 +129,9 @@ class GroupSystem:
         The bodies with a drag area.
     sizes : dict of str to int
         Per line the size of its σ vector (set by the fixed point).
+    start_drag : (ndarray, dict of str to Damping) or None
+        The start σ of the fixed point and its drag per line, when already computed
+        (reused by the evaluation at that very σ).
     modal_direct : bool
         The coarse stage's group: Foss lines as :class:`ModalLine`.
     modal_cache, foss_cache : dict of str to dict
@@ -144,7 +150,7 @@ class GroupSystem:
         weights: np.ndarray | None = None,
     ) -> None:
         self.lines = tuple(lines)
-        # the coarse stage's group (fixedpoint._coarse_group): Foss lines solve their
+        # the coarse stage's group (coarse.coarse_group): Foss lines solve their
         # modal equations per frequency (ModalLine), no Foss eigenproblem
         self.modal_direct = False
         # per line: the drag-independent arrays of ModalLine
@@ -177,10 +183,12 @@ class GroupSystem:
             else weights
         )
         self.sizes: dict[str, int] = {}
+        # (x, drag per line) of the fixed point's start when already computed (the
+        # coarse subset's narrow-feature test): its first evaluation reuses them
+        self.start_drag: tuple[np.ndarray, dict[str, Damping]] | None = None
         # per line: augmented inputs (built on first use: only the node-level paths
         # need them), link matrix T_l (d·n_att, nb), attached rows
-        self.inp: dict[str, Any] = _LazyInputs(self.lines)
-        self.inp_phys, self.tmat, self.rows = {}, {}, {}
+        self.tmat, self.rows = {}, {}
         self.geometric = self._link_lines(names)
         # the physical channels alone, for the σ (the unit channels weigh zero)
         self.inp_phys = (
@@ -188,6 +196,7 @@ class GroupSystem:
             if inp_phys is None
             else dict(inp_phys)
         )
+        self.inp: dict[str, Any] = _LazyInputs(self.lines, self.inp_phys)
         self._body_matrices()
         # body loads (n_w, nb, n_ch), drag-point maps
         w = self.omega
@@ -253,6 +262,10 @@ class GroupSystem:
     def _body_matrices(self) -> None:
         """K_B, M_B, C_B and the body impedance ``z_body`` on the grid."""
         nb, off, geo = self.nb, self.off, self.geometric
+        if not nb:  # no bodies: empty matrices
+            self.kb = self.mb = self.cb = np.zeros((0, 0))
+            self.z_body = np.zeros((self.omega.size, 0, 0), dtype=complex)
+            return
         self.kb = np.zeros((nb, nb))
         self.mb = np.zeros((nb, nb))
         self.cb = np.zeros((nb, nb))
@@ -285,62 +298,6 @@ class GroupSystem:
             body[b.name] = x[k : k + 3]
             k += 3
         return out, body
-
-
-def body_drag_matrix(body: RigidBody, b: np.ndarray) -> np.ndarray:
-    """Linear drag at the drag point as a damping on the body DOFs.
-
-    Parameters
-    ----------
-    body : RigidBody
-        Its ``drag_point`` and ``planar``.
-    b : ndarray, shape (3,)
-        Linear drag coefficient per direction x, y, z. [N·s/m]
-
-    Returns
-    -------
-    ndarray, shape (d, d)
-        Tᵀ diag(b) T, T the rigid link of the drag point (seed 001 eq. 3.3.6). [N·s/m, …]
-    """
-    t = rigid_link_matrix(body.drag_point)
-    c = t.T @ (b[:, None] * t)
-    if body.planar:
-        c = c[np.ix_(PLANAR_INDEX, PLANAR_INDEX)]
-    return c
-
-
-def linear_body_drag(
-    body: RigidBody, rho: float, sigma: np.ndarray, mean: np.ndarray, method: str
-) -> tuple[np.ndarray, np.ndarray]:
-    """Statistically linearized drag of a body at its drag point.
-
-    Parameters
-    ----------
-    body : RigidBody
-        ``drag_area`` (per direction) and ``drag_point``.
-    rho : float
-        Water density. [kg/m³]
-    sigma : ndarray, shape (3,)
-        σ of the relative velocity per direction. [m/s]
-    mean : ndarray, shape (3,)
-        Mean relative velocity (the current at the drag point). [m/s]
-    method : str
-        ``"harmonic"`` (amplitude √2·σ) or the current-aware stochastic form.
-
-    Returns
-    -------
-    b : ndarray, shape (3,)
-        Linear drag per direction (seed 001 eq. 5.2.2 form). [N·s/m]
-    c : ndarray, shape (d, d)
-        :func:`body_drag_matrix` of ``b``.
-    """
-    if method == "harmonic":
-        b = np.asarray(
-            drag_linear_harmonic(rho, body.drag_area, 1.0, math.sqrt(2.0) * sigma), dtype=float
-        )
-    else:
-        b = np.asarray(drag_linear_current(rho, body.drag_area, 1.0, sigma, mean), dtype=float)
-    return np.broadcast_to(b, (3,)).copy(), body_drag_matrix(body, b)
 
 
 def body_sigma(g: GroupSystem, body: RigidBody, xi: np.ndarray | None) -> np.ndarray:
@@ -378,7 +335,9 @@ def solve_group(
     body_c: np.ndarray,
     body_b: Mapping[str, np.ndarray],
     timing: dict[str, float] | None,
-) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], np.ndarray]:
+    *,
+    lazy: bool = False,
+) -> tuple[dict[str, Any], np.ndarray]:
     """One coupled solve of a group for given linear drag (module docstring).
 
     Parameters
@@ -392,12 +351,18 @@ def solve_group(
         Linear drag per direction of each drag body (the fluid-velocity load). [N·s/m]
     timing : dict, optional
         Accumulates ``solve_s``. [s]
+    lazy : bool, optional
+        A line without attached ends is returned as its
+        :class:`~stochcable.dynamics.coupled.freeline.FreeLine` (σ from the free
+        nodes; node displacements and support forces formed on demand) instead of
+        the pair (the drag fixed point).
 
     Returns
     -------
     lines : dict of str to (u, support)
         Per line the node displacements (n_nodes, d, n_w, n_ch) [m/unit] and support
-        forces (n_w, 2d, n_ch) [N/unit] with its attached ends moving with the bodies.
+        forces (n_w, 2d, n_ch) [N/unit] with its attached ends moving with the bodies
+        (``lazy``: a FreeLine for a line without attached ends).
     xi : ndarray, complex, shape (n_w, nb, n_ch)
         Body motion per unit input. [m/unit, rad/unit]
 
@@ -407,8 +372,17 @@ def solve_group(
         A singular body impedance at some frequency.
     """
     t0 = time.perf_counter()
+    if not g.nb:  # no bodies (a line alone): nothing to condense or solve for
+        xi = np.zeros((g.omega.size, 0, g.n_ch), dtype=complex)
+        parts = {cl.name: p for cl, (p, _, _) in zip(g.lines, line_parts(g, line_damping))}
+        out = {
+            n: p if lazy and isinstance(p, FreeLine) else _combine(g, p, xi)
+            for n, p in parts.items()
+        }
+        _add_time(timing, t0)
+        return out, xi
     s, rhs = _body_equation(g, body_c, body_b)
-    parts: dict[str, Any] = {}
+    parts = {}
     for cl, (part, r0, re) in zip(g.lines, line_parts(g, line_damping)):
         # the condensed line (summed in line order: the same bits with or without
         # the thread pool)
@@ -417,10 +391,20 @@ def solve_group(
         rhs = rhs + t.T[None] @ r0
         parts[cl.name] = part
     xi = _solve_free_dofs(g, s, rhs)
-    out = {cl.name: _combine(g, parts[cl.name], g.tmat[cl.name][None] @ xi) for cl in g.lines}
+    out = {
+        cl.name: parts[cl.name]
+        if lazy and isinstance(parts[cl.name], FreeLine)
+        else _combine(g, parts[cl.name], g.tmat[cl.name][None] @ xi)
+        for cl in g.lines
+    }
+    _add_time(timing, t0)
+    return out, xi
+
+
+def _add_time(timing: dict[str, float] | None, t0: float) -> None:
+    """Add the time since ``t0`` to ``timing["solve_s"]`` (when timing is kept)."""
     if timing is not None:
         timing["solve_s"] = timing.get("solve_s", 0.0) + time.perf_counter() - t0
-    return out, xi
 
 
 def _body_equation(
@@ -455,7 +439,7 @@ def _solve_free_dofs(g: GroupSystem, s: np.ndarray, rhs: np.ndarray) -> np.ndarr
 
 def _combine(g: GroupSystem, part: Any, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A line's response with its attached ends moving by ``ue`` (n_w, d·n_att, n_ch)."""
-    if isinstance(part, (FossLine, ModalLine)):
+    if isinstance(part, (FossLine, ModalLine, FreeLine)):
         return part.combine(ue)
     n_ch = g.n_ch
     u, sup = part
@@ -480,23 +464,6 @@ def _solve_body(s: np.ndarray, g: np.ndarray) -> np.ndarray:
 
 
 # ------------------------------------------------------------ the σ map of a group
-
-
-def relative_change(new: np.ndarray, x: np.ndarray) -> float:
-    """The convergence measure of :func:`stochcable.dynamics.iteration.fixed_point`.
-
-    Parameters
-    ----------
-    new, x : ndarray
-        The map's output and input.
-
-    Returns
-    -------
-    float
-        max |new − x| / max(|new|, 1e-6·max|new|). [-]
-    """
-    den = np.maximum(np.abs(new), 1e-6 * max(float(np.max(np.abs(new), initial=0.0)), 1e-300))
-    return float(np.max(np.abs(new - x) / den, initial=0.0))
 
 
 def sigma_update(
@@ -539,10 +506,14 @@ def sigma_update(
         ``.state`` is ``state``.
     """
     state.setdefault("it", 0)
+    alone = len(g.lines) == 1 and not g.bodies
 
     def update(x: np.ndarray) -> np.ndarray:
         ls, bs = g.split(x)
-        damp = {cl.name: drag_coefficients(cl.system, ls[cl.name], method) for cl in g.lines}
+        if g.start_drag is not None and x is g.start_drag[0]:  # the start's drag, known
+            damp = dict(g.start_drag[1])
+        else:
+            damp = {cl.name: drag_coefficients(cl.system, ls[cl.name], method) for cl in g.lines}
         body_c = np.zeros((g.nb, g.nb))
         body_b = {}
         for b in g.drag:
@@ -556,17 +527,24 @@ def sigma_update(
             sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
             body_c[sl, sl] += c
             body_b[b.name] = bb
-        sol, xi = solve_group(g, damp, body_c, body_b, timing)
+        sol, xi = solve_group(g, damp, body_c, body_b, timing, lazy=True)
         new = []
         for cl in g.lines:
-            new.append(sigmas_from_nodes(cl.system, g.inp_phys[cl.name], sol[cl.name][0], method))
+            part = sol[cl.name]
+            if isinstance(part, FreeLine):  # a line alone: σ from its free nodes
+                new.append(part.sigmas(method))
+            else:
+                new.append(sigmas_from_nodes(cl.system, g.inp_phys[cl.name], part[0], method))
         for b in g.drag:
             new.append(body_sigma(g, b, xi))
         new = np.concatenate(new) if new else np.zeros(0)
         state["it"] += 1
         change = relative_change(new, x)
         state["change"] = change
-        progress("linearization", {"group": names, "iteration": state["it"], "change": change})
+        info = {"group": names, "iteration": state["it"], "change": change}
+        if alone:  # one line without bodies: named as a line
+            info["line"] = names
+        progress("linearization", info)
         cache.update(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
         return new
 

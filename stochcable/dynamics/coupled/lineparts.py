@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep, real_gemm
+from stochcable.dynamics.coupled.freeline import FreeLine
 from stochcable.dynamics.line_loads import base_motion, drag_blocks, end_loads, free_load
 from stochcable.dynamics.modal_solvers import FossModes, foss_modes, foss_transfer_modal
 from stochcable.dynamics.solve import reactions, solve_free, total_displacement
@@ -58,10 +59,11 @@ def line_parts(
     Returns
     -------
     list of (part, R_0, R_e)
-        In line order: the line part (a :class:`FossLine`, a :class:`ModalLine`, or
-        the node-level ``(u, support)`` with the unit columns) and its end reactions
-        R_0 (n_w, |rows|, n_ch) [N/unit], R_e (n_w, |rows|, n_e) [N/m] on the
-        attached rows.
+        In line order: the line part (a :class:`FossLine`, a :class:`ModalLine`, a
+        :class:`~stochcable.dynamics.coupled.freeline.FreeLine` for a line without
+        attached ends, or the node-level ``(u, support)`` with the unit columns) and
+        its end reactions R_0 (n_w, |rows|, n_ch) [N/unit], R_e (n_w, |rows|, n_e)
+        [N/m] on the attached rows.
 
     Notes
     -----
@@ -72,13 +74,19 @@ def line_parts(
     the same bits with or without the pool.
     """
     modal = [
-        cl for cl in g.lines if cl.system.solver != "direct" and _MODAL_FOSS and not g.modal_direct
+        cl
+        for cl in g.lines
+        if cl.system.solver != "direct" and _MODAL_FOSS and not g.modal_direct and cl.attached()
     ]
-    states = dict(
-        zip(
-            [cl.name for cl in modal],
-            line_map(lambda cl: foss_state(cl.system, line_damping[cl.name]), modal),
+    states = (
+        dict(
+            zip(
+                [cl.name for cl in modal],
+                line_map(lambda cl: foss_state(cl.system, line_damping[cl.name]), modal),
+            )
         )
+        if modal
+        else {}
     )
     return [_line_part(g, cl, line_damping[cl.name], states.get(cl.name)) for cl in g.lines]
 
@@ -91,6 +99,9 @@ def _line_part(
     system = cl.system
     rows = g.rows[cl.name]
     n_ch = g.n_ch
+    if not cl.attached():  # a line alone: its own response (no end motion to combine)
+        part = FreeLine(system, g.inp_phys[cl.name], damping, g.modal_direct)
+        return (part, *part.reactions(rows))
     if system.solver != "direct" and g.modal_direct:
         part = ModalLine(
             system,
@@ -552,6 +563,12 @@ def _assemble_line(
     node displacements (n_nodes, d, n_w, n_ch) and support forces (n_w, 2d, n_ch)."""
     n, d, n_e = part.up.shape
     n_w, n_ch = ue.shape[0], ue.shape[2]
+    if n_e == 0:  # no attached end (a line alone): the line's own response
+        if part.res0 is not None:
+            uf += part.res0.reshape(uf.shape[0], -1)
+        uc = part.u_p.copy()
+        uc[1:-1] += uf.reshape(n - 2, d, n_w, n_ch)
+        return uc, part.sup0
     flat_e = uet.reshape(n_e, n_w * n_ch)
     if part.res0 is not None:
         w = part.inp.omega

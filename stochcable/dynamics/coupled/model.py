@@ -1,4 +1,4 @@
-"""A scene with bodies built for the frequency-domain analysis, independent of the sea
+"""A scene built for the frequency-domain analysis, independent of the sea
 state: the build half of :func:`stochcable.dynamics.coupled.analysis.analyze_coupled`.
 
 :func:`build_coupled` makes everything that does not depend on the sea (its spectrum
@@ -118,6 +118,7 @@ def build_coupled(
     *,
     rigid_bodies: Mapping[str, RigidBody] | None = None,
     timing: dict[str, float] | None = None,
+    systems: Mapping[str, LineSystem] | None = None,
 ) -> CoupledModel:
     """Build the sea-independent part of the analysis of a scene with bodies.
 
@@ -136,6 +137,9 @@ def build_coupled(
         replaced by the static pose of ``statics.bodies`` when present.
     timing : dict, optional
         Accumulates ``model_s``. [s]
+    systems : mapping of str to LineSystem, optional
+        The lines' systems already built (:func:`stochcable.dynamics.system.
+        build_line_system` about ``statics``); default built here.
 
     Returns
     -------
@@ -161,10 +165,11 @@ def build_coupled(
     )
     free, pose = _free_bodies(scene, statics, prescribed, rigid_bodies)
     raos = {n: vessel_rao(body_docs[n].prescribed, omega) for n in prescribed}
-    systems: dict[str, LineSystem] = {}
+    given = {} if systems is None else systems
+    systems = {}
     attach: dict[str, dict[str, str]] = {}
     for line in scene.lines:
-        systems[line.name] = build_line_system(
+        systems[line.name] = given.get(line.name) or build_line_system(
             scene, line, statics.lines[line.name], settings=settings
         )
         attach[line.name] = _free_ends(line, prescribed)

@@ -11,12 +11,26 @@ import numpy as np
 from stochcable.bodies.rigid import PLANAR_INDEX, RigidBody
 from stochcable.dynamics.coupled.fixedpoint import CoupledLinearization
 from stochcable.dynamics.coupled.inputs import CoupledLine
-from stochcable.dynamics.coupled.modes import CoupledModes
+from stochcable.dynamics.coupled.modes import (
+    CoupledModes,
+    coupled_modal_bandwidths,
+    line_mode_shares,
+)
+from stochcable.dynamics.indicators import LineModes
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.outputs import line_result
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 
-__all__ = ["body_result", "coupled_results"]
+__all__ = ["LINE_MODE_SHARE", "body_result", "coupled_results", "line_modes"]
+
+#: A coupled mode counts for a line's resolution check and resonance indicator when at
+#: least this share of its kinetic energy is in the line (u_lᵀ(M + M_a)_l u_l of the
+#: mass-normalized mode).  A mode the line hardly takes part in (a body mode, a mode
+#: of another line) gives the line little response at its frequency: its resonance is
+#: not the line's.  Below 5 % the line's own motion in it is under ≈ 22 % of the
+#: mode's amplitude scale (√0.05); each line's fixed-end-like modes carry most of
+#: their energy in the line and pass by far.
+LINE_MODE_SHARE = 0.05
 
 
 def coupled_results(
@@ -42,7 +56,8 @@ def coupled_results(
         Static value of each body DOF (position and rotation components), the
         statistics' mean (default: the body position, zero rotation). [m, rad]
     modes : CoupledModes, optional
-        Listed on every body result.
+        Listed on every body result; the modes of the lines' resolution check and
+        resonance indicator (:func:`line_modes`; default each line's fixed-end modes).
     channels : sequence of Channel, optional
         The group's channels (default those of the first line).
 
@@ -50,10 +65,15 @@ def coupled_results(
     -------
     (lines, bodies) : dict of LineResult, dict of BodyResult
     """
+    counted = {} if modes is None else line_modes(modes, lines, bodies, linearization)
     out_lines = {}
     for cl in lines:
         out_lines[cl.name] = line_result(
-            cl.system, cl.channels, linearization.lines[cl.name], settings
+            cl.system,
+            cl.channels,
+            linearization.lines[cl.name],
+            settings,
+            counted.get(cl.name),
         )
     ch = tuple(lines[0].channels if channels is None else channels)
     spectra = np.stack([c.spectrum for c in ch])
@@ -81,6 +101,43 @@ def coupled_results(
             prescribed=False,
         )
     return out_lines, out_bodies
+
+
+def line_modes(
+    modes: CoupledModes,
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    linearization: CoupledLinearization,
+) -> dict[str, LineModes]:
+    """The coupled modes that count for each line of a group, with their bandwidths.
+
+    Parameters
+    ----------
+    modes : CoupledModes
+        The group's coupled modes (with ``line_shapes``).
+    lines : sequence of CoupledLine
+    bodies : sequence of RigidBody
+    linearization : CoupledLinearization
+        The converged drag of the lines and the bodies.
+
+    Returns
+    -------
+    dict of str to LineModes
+        Per line the modes with at least ``LINE_MODE_SHARE`` of their kinetic energy
+        in it (:func:`~stochcable.dynamics.coupled.modes.line_mode_shares`) and their
+        half-power bandwidths over the group at the converged drag
+        (:func:`~stochcable.dynamics.coupled.modes.coupled_modal_bandwidths`), the
+        modes numbered in the group's list.  Empty when the modes have no line shapes.
+    """
+    if not lines or any(cl.name not in modes.line_shapes for cl in lines):
+        return {}
+    damping = {cl.name: linearization.lines[cl.name].damping for cl in lines}
+    band = coupled_modal_bandwidths(modes, lines, bodies, damping, linearization.body_drag)
+    out = {}
+    for name, share in line_mode_shares(modes, lines).items():
+        j = np.flatnonzero(share >= LINE_MODE_SHARE)
+        out[name] = LineModes(j + 1, modes.omega[j], band[j])
+    return out
 
 
 def body_result(
