@@ -16,15 +16,15 @@ import pytest
 from stochcable.dynamics import blocks as dblocks
 from stochcable.dynamics import coarse_grid as dgrid
 from stochcable.dynamics import fixedpoint as dfixedpoint
-from stochcable.dynamics.coupled import coarse as dcoarse
-from stochcable.dynamics.coupled import freeline as dfreeline
-from stochcable.dynamics.coupled.group import GroupSystem
-from stochcable.dynamics.coupled.inputs import CoupledLine
 from stochcable.dynamics import line_loads as dloads
 from stochcable.dynamics import outputs as doutputs
 from stochcable.dynamics import solve as dsolve
 from stochcable.dynamics import system as dsystem
 from stochcable.dynamics import variance as dvariance
+from stochcable.dynamics.coupled import coarse as dcoarse
+from stochcable.dynamics.coupled import freeline as dfreeline
+from stochcable.dynamics.coupled.group import GroupSystem
+from stochcable.dynamics.coupled.inputs import CoupledLine
 from stochcable.dynamics.loads import line_channels
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
