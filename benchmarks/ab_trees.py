@@ -40,6 +40,7 @@ from pathlib import Path
 chain = json.loads(Path({example!r}).read_text())
 chain["analysis"].pop("timeseries", None)
 cases = {{"chain": chain, "bodies_foss": scene_doc("foss"), "bodies_direct": scene_doc("direct")}}
+cases = {{k: v for k, v in cases.items() if k in {cases_wanted!r}}}
 out = {{}}
 for name, doc in cases.items():
     scene = load_scene(doc)
@@ -53,9 +54,9 @@ print(json.dumps(out))
 """
 
 
-def _run(tree: Path, calls: int, bench: Path, example: Path) -> dict[str, float]:
+def _run(tree: Path, calls: int, bench: Path, example: Path, cases: list[str]) -> dict[str, float]:
     env = dict(os.environ, PYTHONPATH=str(tree))
-    code = _SNIPPET.format(bench=str(bench), example=str(example), calls=calls)
+    code = _SNIPPET.format(bench=str(bench), example=str(example), calls=calls, cases_wanted=cases)
     out = subprocess.run(
         [sys.executable, "-c", code],
         capture_output=True,
@@ -73,13 +74,21 @@ def main() -> int:
     ap.add_argument("new", type=Path)
     ap.add_argument("--rounds", type=int, default=6)
     ap.add_argument("--calls", type=int, default=15)
+    ap.add_argument(
+        "--cases",
+        nargs="+",
+        default=["chain", "bodies_foss", "bodies_direct"],
+        help="cases to time (chain, bodies_foss, bodies_direct)",
+    )
     args = ap.parse_args()
     here = Path(__file__).resolve().parent
     example = here.parent / "stochcable" / "examples" / "chain_catenary.json"
     res: dict[str, dict[str, list[float]]] = {"A": {}, "B": {}}
     for r in range(args.rounds):
         for side, tree in (("A", args.old), ("B", args.new)):
-            got = _run(tree.resolve(), args.calls, tree.resolve() / "benchmarks", example)
+            got = _run(
+                tree.resolve(), args.calls, tree.resolve() / "benchmarks", example, args.cases
+            )
             for k, v in got.items():
                 res[side].setdefault(k, []).append(v)
             print(
@@ -90,7 +99,12 @@ def main() -> int:
     for k in res["A"]:
         a = statistics.median(res["A"][k])
         b = statistics.median(res["B"][k])
-        print(f"{k}: A {1e3 * a:.1f} ms, B {1e3 * b:.1f} ms, B/A {b / a:.3f}")
+        a_min, b_min = min(res["A"][k]), min(res["B"][k])
+        print(
+            f"{k}: median of rounds A {1e3 * a:.1f} ms, B {1e3 * b:.1f} ms, B/A {b / a:.3f}; "
+            f"fastest round A {1e3 * a_min:.1f} ms, B {1e3 * b_min:.1f} ms, "
+            f"B/A {b_min / a_min:.3f}"
+        )
     return 0
 
 

@@ -39,7 +39,9 @@ from typing import Any
 import numpy as np
 from host_probe import host_line
 
-import stochcable.dynamics.coupled as coupled_analysis
+import stochcable.dynamics.coupled.coarse as coupled_coarse
+import stochcable.dynamics.coupled.lineparts as coupled_lineparts
+import stochcable.dynamics.coupled.modes as coupled_modes
 from stochcable.analysis import analyze
 from stochcable.dynamics.coupled import analyze_coupled
 from stochcable.dynamics.fixedpoint import linearize
@@ -132,21 +134,21 @@ def key_results(lines, bodies):
 
 def without_coarse_start(scene, statics, repeat):
     """Dynamics median time and results with the coarse start switched off."""
-    saved = coupled_analysis.COARSE_MIN_FREQUENCIES
-    coupled_analysis.COARSE_MIN_FREQUENCIES = 10**9
+    saved = coupled_coarse.COARSE_MIN_FREQUENCIES
+    coupled_coarse.COARSE_MIN_FREQUENCIES = 10**9
     try:
         (lines, bodies, _, _), _ = run_coupled(scene, statics)
         med, _ = median_time(lambda: run_coupled(scene, statics), repeat)
     finally:
-        coupled_analysis.COARSE_MIN_FREQUENCIES = saved
+        coupled_coarse.COARSE_MIN_FREQUENCIES = saved
     return med, lines, bodies
 
 
 def reference_paths(on: bool) -> None:
     """Switch the issue-6 pass E3 fast paths off (the reference: node-level Foss lines,
     the full coupled-mode eigenproblem) or on."""
-    coupled_analysis._MODAL_FOSS = not on
-    coupled_analysis._CB_MIN_RATIO = 1e9 if on else 1.5
+    coupled_lineparts._MODAL_FOSS = not on
+    coupled_modes._CB_MIN_RATIO = 1e9 if on else 1.5
 
 
 def interleaved_ab(
@@ -236,10 +238,10 @@ def threads_ab(repeat: int) -> None:
 def coarse_ab(repeat: int) -> None:
     """The coarse start of the drag linearization off (``COARSE_MIN_FREQUENCIES``
     raised) and on, with the evaluations of each."""
-    saved = coupled_analysis.COARSE_MIN_FREQUENCIES
+    saved = coupled_coarse.COARSE_MIN_FREQUENCIES
 
     def coarse(on: bool) -> Any:
-        return lambda: setattr(coupled_analysis, "COARSE_MIN_FREQUENCIES", saved if on else 10**9)
+        return lambda: setattr(coupled_coarse, "COARSE_MIN_FREQUENCIES", saved if on else 10**9)
 
     try:
         interleaved_ab(
@@ -249,7 +251,7 @@ def coarse_ab(repeat: int) -> None:
             history=True,
         )
     finally:
-        coupled_analysis.COARSE_MIN_FREQUENCIES = saved
+        coupled_coarse.COARSE_MIN_FREQUENCIES = saved
 
 
 def median_time(fn, repeat: int) -> tuple[float, float]:
