@@ -23,7 +23,7 @@ _LAZY = {
     "build_engine": ("dynamics.engine", "build_engine"),
     "load_scene": ("scene.model", "load_scene"),
     "Scene": ("scene.model", "Scene"),
-    "solve_statics": ("line.statics", "solve_statics"),
+    "solve_statics": ("statics", "solve_statics"),
     "natural_modes": ("line.modes", "natural_modes"),
     "simulate_sea": ("sea.realization", "simulate_sea"),
     "load_example": ("examples", "load_example"),

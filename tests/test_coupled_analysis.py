@@ -3,7 +3,7 @@
 Independent checks: a body on springs against its transfer function written out by
 hand (and its drag fixed point against the seed's linearized-drag formula); the
 infinite-mass limit against the independent line analysis with the equivalent
-prescribed end motion (stochcable.dynamics.line); the substructured solve against the
+prescribed end motion (stochcable.dynamics.solve); the substructured solve against the
 assembled coupled system of stochcable.bodies.rigid (couple + solve_coupled_direct); Foss
 with all modes against direct; the 120° symmetry of a three-leg mooring; the vessel
 fairlead motion against finite rotations.
@@ -246,7 +246,7 @@ def _single_leg_doc(motion=None):
 def test_infinite_body_mass_equals_line_with_moving_end():
     """A planar body of mass 1e15 kg excited by F = −ω²M ξ moves with ξ; its line
     must equal the independent analysis of the line whose end moves with the RAO
-    T(r)ξ (stochcable.dynamics.line, the existing moving-end path)."""
+    T(r)ξ (stochcable.dynamics.solve, the moving-end path)."""
     scene = load_scene(_single_leg_doc())
     w = scene.analysis.omega.values()
     xi = np.stack([0.6 * np.exp(0.7j * w), 0.9 + 0.1j * w, 0.02j * np.ones_like(w)])
@@ -1053,7 +1053,7 @@ def test_fixed_dofs_direct_equals_foss_all_modes():
 @pytest.mark.parametrize("method", ["full", "reduced"])
 def test_fixed_dofs_modes_are_the_constrained_eigenproblem(mooring_direct, method):
     """Coupled modes with heave and yaw fixed: the frequencies of the dense constrained
-    eigenproblem (the assembled K, M of stochcable.bodies.rigid.couple without the fixed
+    eigenproblem (the assembled K, M of stochcable.bodies.coupling.couple without the fixed
     rows and columns); the fixed DOFs are zero in the shapes."""
     import scipy.linalg as sla
 

@@ -7,7 +7,7 @@ frequency-domain σ of the Result (a separate solve on the analysis grid); the s
 against the direct O(N²) circular convolution of η and of the end-motion realization
 with the impulse responses of the Result's transfer functions (seed 001 §5.1: one
 realization drives everything); the infinitely heavy (fixed) body against the line
-with a fixed fairlead (stochcable.dynamics.line, the independent path); NSA variances
+with a fixed fairlead (a line alone, the group without bodies); NSA variances
 against their exact sampling distribution; the chunked solve against the one-piece
 solve; the vessel (prescribed body) and its riser against the RAO.
 

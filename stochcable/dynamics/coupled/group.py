@@ -14,8 +14,8 @@ The rigid link u_e = T(r) ξ (seed 001 eqs. 3.3.6–3.3.7,
 
 a dense (n_b × n_b) solve (Td, b, v: the drag point's rigid link, linear drag and
 fluid velocity); then U follows.  This is the Schur complement of the coupled system
-of :func:`stochcable.bodies.rigid.couple` on the body DOFs (tested equal to
-:func:`stochcable.bodies.rigid.solve_coupled_direct`), with the line interiors solved
+of :func:`stochcable.bodies.coupling.couple` on the body DOFs (tested equal to
+:func:`stochcable.reference.bodies.solve_coupled_direct`), with the line interiors solved
 by the line machinery: banded direct solve (``solver="direct"``) or Foss modal
 superposition with the static correction of the truncated modes (``solver="foss"``,
 seed 001 §5.3).

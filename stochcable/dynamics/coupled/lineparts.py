@@ -276,8 +276,8 @@ class FossLine:
     """A Foss line of a group in the coordinates of its Foss (state) modes (seed 001
     §5.3).
 
-    The same linear system as :func:`foss_unit_split` + :func:`stochcable.dynamics.line.
-    reactions`, reordered: the physical channels' state-modal response P_0 (2m, n_w,
+    The same linear system as :func:`foss_unit_split` + :func:`stochcable.dynamics.solve.reactions`,
+    reordered: the physical channels' state-modal response P_0 (2m, n_w,
     n_ch) and the unit end motions' P_e (2m, n_w, n_e) are kept (the latter in closed
     form, ``(ω²·W âh − iω·W b̂h)/(iω − λ)``, W the Foss weights); the end reactions
     need the displacement of the end nodes and their neighbours only (two rows of

@@ -2,11 +2,11 @@
 matrices; seed 001 §3.3, eqs. 3.3.8–3.3.10).
 
 The coupled modes need constant matrices: K and M + A(ω_ref) of
-:func:`stochcable.bodies.rigid.constant_matrices`, ω_ref the peak of the sea spectrum
+:func:`stochcable.bodies.coupling.constant_matrices`, ω_ref the peak of the sea spectrum
 (:func:`stochcable.dynamics.coupled.inputs.reference_omega`; documented on
 :class:`CoupledModes`).  ``RigidBody.fixed_dofs`` are constraints: the modes are those
 of the constrained system.  Two ways, the same listed frequencies to 1e-4 on the
-three-leg benchmark: the assembled system (:func:`stochcable.bodies.rigid.couple`) and
+three-leg benchmark: the assembled system (:func:`stochcable.bodies.coupling.couple`) and
 the Craig–Bampton reduction on each line's fixed-end modes and static following.
 """
 
@@ -120,7 +120,8 @@ def coupled_modes(
     Notes
     -----
     K φ = ω²(M + A(ω_ref)) φ on the assembled system of
-    :func:`stochcable.bodies.rigid.couple` (:func:`~stochcable.bodies.rigid.constant_matrices`),
+    :func:`stochcable.bodies.coupling.couple`
+    (:func:`~stochcable.bodies.coupling.constant_matrices`),
     the symmetric part of K (the attachment geometric stiffness is antisymmetric by
     ½[Σ r × F]× when the static moments on a body are not balanced by the model's own
     terms; :attr:`CoupledModes.asymmetry`).  Full: dense LAPACK up to 1500 DOFs, else

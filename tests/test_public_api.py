@@ -1,0 +1,60 @@
+"""The public entry points of ``stochcable`` resolve, lazily, to the pipeline's stages.
+
+``import stochcable`` stays light (the entry points are imported on first use); each name
+of ``stochcable.__all__`` must resolve, and the stage functions must be the ones the
+layered modules define (``stochcable.solve_statics`` is the scene-level statics of
+``stochcable.statics``, not one line's).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+import stochcable
+
+EXPECTED = {
+    "analyze": "stochcable.analysis",
+    "build_engine": "stochcable.dynamics.engine",
+    "load_scene": "stochcable.scene.model",
+    "Scene": "stochcable.scene.model",
+    "solve_statics": "stochcable.statics",
+    "natural_modes": "stochcable.line.modes",
+    "simulate_sea": "stochcable.sea.realization",
+    "load_example": "stochcable.examples",
+}
+
+
+@pytest.mark.parametrize("name", sorted(stochcable.__all__))
+def test_every_public_name_resolves(name):
+    assert getattr(stochcable, name) is not None
+
+
+@pytest.mark.parametrize("name, module", sorted(EXPECTED.items()))
+def test_entry_points_come_from_their_stage(name, module):
+    assert getattr(stochcable, name).__module__ == module
+
+
+def test_entry_points_run_on_an_example():
+    scene = stochcable.load_example("taut_wire")
+    statics = stochcable.solve_statics(scene)
+    assert set(statics.lines) == {line.name for line in scene.lines}
+
+
+def test_unknown_name_is_an_attribute_error():
+    with pytest.raises(AttributeError, match="no attribute 'nope'"):
+        stochcable.nope  # noqa: B018
+
+
+def test_import_is_light():
+    # the entry points are imported on first use: a bare import loads no engine
+    code = (
+        "import sys, stochcable; "
+        "print(any(m.startswith(('stochcable.dynamics', 'stochcable.line')) "
+        "for m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "False"
