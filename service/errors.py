@@ -36,7 +36,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import JSONResponse
 
 from stochcable.errors import ConvergenceError, InputError, SolverError, StochcableError
-from stochcable.scene.model import field_path_and_unit
+from stochcable.scene.model import error_location, field_path_and_unit
 from stochcable.scene.units import labels_of_document
 
 from .settings import Settings
@@ -167,7 +167,7 @@ async def _validation_handler(request: Request, exc: RequestValidationError) -> 
     labels = labels_of_document(_scene_of(getattr(exc, "body", None)))
     items = []
     for err in exc.errors():
-        loc = list(err.get("loc", ()))
+        loc = list(error_location(err))  # a scene-level check may name its field
         item: dict[str, Any] = {
             "loc": loc,
             "msg": str(err.get("msg", "invalid")),
