@@ -11,6 +11,8 @@ exception                                status  ``type``
 =======================================  ======  ==============================
 RequestValidationError (bad JSON,        422     pydantic's type (``json_invalid``,
 wrong type, NaN, out of bounds)                  ``greater_than``, ...)
+a body that is not UTF-8 or is nested    422     ``json_invalid`` (parameter ``body``)
+too deep to decode (FastAPI's 400)
 :class:`~stochcable.errors.InputError`   422     ``input_error``
 :class:`LimitExceeded`                   422     ``limit_exceeded``
 ConvergenceError                         422     ``convergence_error``
@@ -256,7 +258,32 @@ async def _run_time_handler(request: Request, exc: RunTimeExceeded) -> JSONRespo
     return error_response(504, [], str(exc), "run_time_exceeded", limit=exc.limit, setting=exc.env)
 
 
+def _undecodable_body(exc: StarletteHTTPException) -> str | None:
+    """Why a request body could not be decoded, when ``exc`` is FastAPI's 400 "There
+    was an error parsing the body" (raised from the decoding error), else None."""
+    cause = exc.__cause__
+    if exc.status_code != 400 or cause is None:
+        return None
+    if isinstance(cause, UnicodeDecodeError):
+        return (
+            f"the request body is not UTF-8 JSON: byte {cause.object[cause.start]:#04x} at "
+            f"offset {cause.start} cannot be decoded ({cause.reason}); send the JSON "
+            "document encoded as UTF-8"
+        )
+    if isinstance(cause, RecursionError):
+        return (
+            "the request body is JSON nested too deeply to decode (arrays or objects "
+            "nested beyond the JSON parser's recursion limit); the documents of this API "
+            "are nested a few levels deep"
+        )
+    return f"the request body could not be decoded as JSON ({type(cause).__name__}: {cause})"
+
+
 async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+    why = _undecodable_body(exc)
+    if why is not None:
+        # an undecodable body is invalid input like malformed JSON: 422 json_invalid
+        return error_response(422, ["body"], why, "json_invalid", parameter="body")
     loc = getattr(exc, "loc", [])
     type_ = "not_found" if exc.status_code == 404 else "http_error"
     detail = exc.detail if isinstance(exc.detail, str) else json.dumps(exc.detail)

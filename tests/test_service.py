@@ -209,6 +209,28 @@ def test_malformed_json_is_422(client):
     assert err["type"] == "json_invalid" and err["loc"][0] == "body"
 
 
+@pytest.mark.parametrize("path", ["/v1/spectra", "/v1/analyses"])
+def test_undecodable_body_is_422_naming_the_body(client, path):
+    # issue 19: FastAPI answered an undocumented 400 without a parameter
+    json_type = {"Content-Type": "application/json"}
+    not_utf8 = b'{"spectrum": {"type": "pierson_moskowitz", "hs": 6, "tp": 10, "x": "\xff"}}'
+    err = _only_error(client.post(path, content=not_utf8, headers=json_type))
+    assert err == {
+        "loc": ["body"],
+        "msg": f"the request body is not UTF-8 JSON: byte 0xff at offset {not_utf8.index(0xFF)} "
+        "cannot be decoded (invalid start byte); send the JSON document encoded as UTF-8",
+        "type": "json_invalid",
+        "parameter": "body",
+    }
+    for deep in (b"[" * 10_000 + b"]" * 10_000, b'{"a":' * 10_000 + b"1" + b"}" * 10_000):
+        err = _only_error(client.post(path, content=deep, headers=json_type))
+        assert err["type"] == "json_invalid" and err["parameter"] == "body"
+        assert err["loc"] == ["body"]
+        assert err["msg"].startswith("the request body is JSON nested too deeply to decode")
+    # the server is fine afterwards
+    assert client.get("/health").status_code == 200
+
+
 def test_pydantic_model_validator_message_is_kept(client):
     err = _only_error(
         client.post("/v1/spectra", json={"spectrum": {"type": "pierson_moskowitz", "hs": 6.0}})
