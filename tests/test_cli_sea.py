@@ -275,6 +275,18 @@ def test_simulate_sample_bound_is_an_option(capsys):
     )
 
 
+def test_arithmetic_error_in_the_core_is_one_line_exit_2(capsys):
+    # a grid far below the ISSC peak (omega_p = 4849 rad/s): m0·m4 underflows, 0/0
+    code, out, err = run(
+        capsys, "spectrum", "issc", "--hs", "1e4", "--t1", "1e-3", "--omega-max", "1000"
+    )
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith(
+        "stochcable spectrum: error: numerical failure (ZeroDivisionError: float division "
+        "by zero): an input is outside the range the model handles numerically"
+    )
+
+
 def test_memory_error_anywhere_is_one_line_exit_2(capsys, monkeypatch):
     import stochcable.cli.simulate as sim
 

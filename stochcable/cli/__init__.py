@@ -61,6 +61,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (OSError, ValueError) as exc:  # unreadable file, malformed JSON
         sys.stderr.write(f"stochcable {args.command}: error: {exc}\n")
         return 2
+    except ArithmeticError as exc:  # overflow or 0/0 in the core from extreme input
+        sys.stderr.write(
+            f"stochcable {args.command}: error: numerical failure ({type(exc).__name__}: "
+            f"{exc}): an input is outside the range the model handles numerically (check "
+            "magnitudes and units: periods, heights, frequencies, depth)\n"
+        )
+        return 2
     except MemoryError as exc:  # numpy's "Unable to allocate ..." or a bare MemoryError
         what = str(exc).splitlines()[0] if str(exc) else "a MemoryError"
         sys.stderr.write(
