@@ -258,11 +258,14 @@ async def _run_time_handler(request: Request, exc: RunTimeExceeded) -> JSONRespo
     return error_response(504, [], str(exc), "run_time_exceeded", limit=exc.limit, setting=exc.env)
 
 
+_FASTAPI_BODY_ERROR = "There was an error parsing the body"
+
+
 def _undecodable_body(exc: StarletteHTTPException) -> str | None:
     """Why a request body could not be decoded, when ``exc`` is FastAPI's 400 "There
     was an error parsing the body" (raised from the decoding error), else None."""
     cause = exc.__cause__
-    if exc.status_code != 400 or cause is None:
+    if exc.status_code != 400 or cause is None or exc.detail != _FASTAPI_BODY_ERROR:
         return None
     if isinstance(cause, UnicodeDecodeError):
         return (

@@ -84,13 +84,7 @@ def _seg(d):
         (
             lambda d: d["lines"][0]["end_a"].__setitem__("position", [-800.0, 0.0, 5.0]),
             r"^lines\[0\]\.end_a\.position = \[-800\.0, 0\.0, 5\.0\] \[m\]: z = 5\.0 is above "
-            r"the still-water level; z must be <= 0",
-        ),
-        (
-            lambda d: d["lines"][0]["end_b"].__setitem__("position", [0.0, 0.0, 30.0]),
-            r"^lines\[0\]\.end_b\.position = \[0\.0, 0\.0, 30\.0\] \[m\]: z = 30\.0 is above "
-            r"the still-water level; z must be <= 0 \(a fairlead at the surface has z = 0\): a "
-            r"line's part in air is not modelled in the dynamics",
+            r"the still-water level: the anchor end \(end_a\) must have z <= 0",
         ),
         (
             lambda d: d["lines"][0]["end_b"].__setitem__("position", [0.0, 0.0, -250.0]),
@@ -132,7 +126,6 @@ def _seg(d):
         "inf",
         "too-short",
         "anchor-above-surface",
-        "fairlead-above-surface",
         "end-below-seabed",
         "duplicate-names",
         "pm-both-forms",
@@ -148,18 +141,24 @@ def test_validation_errors_name_path_unit_constraint(chain_doc, mutate, pattern)
         load_scene(_mutated(chain_doc, mutate))
 
 
-def test_line_end_above_the_surface_names_the_field(chain_doc):
-    # issue 19: a line end above the still-water level was accepted silently
-    doc = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"].__setitem__("position", [0, 0, 30]))
+def test_anchor_above_the_surface_names_the_field(chain_doc):
+    # issue 19: the scene-level check named no field (parameter "scene")
+    doc = _mutated(
+        chain_doc, lambda d: d["lines"][0]["end_a"].__setitem__("position", [-800, 0, 5])
+    )
     with pytest.raises(InputError) as info:
         load_scene(doc)
     err = info.value
-    assert err.parameter == "lines[0].end_b.position" and err.unit == "m"
-    assert err.value == [0.0, 0.0, 30.0]
-    assert "z must be <= 0" in err.constraint and "not modelled" in err.constraint
-    # a fairlead at the still-water level exactly stays valid
-    doc = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"].__setitem__("position", [0, 0, 0]))
-    assert load_scene(doc).lines[0].end_b.position == (0.0, 0.0, 0.0)
+    assert err.parameter == "lines[0].end_a.position" and err.unit == "m"
+    assert err.value == [-800.0, 0.0, 5.0]
+    assert err.constraint.startswith("z = 5.0 is above the still-water level: the anchor end")
+    # end_b above the water is modelled (weight in air, no buoyancy, no wave or current
+    # load: test_statics.py, test_wave_loads.py); at the still-water level exactly too
+    for z in (30.0, 0.0):
+        doc = _mutated(
+            chain_doc, lambda d, z=z: d["lines"][0]["end_b"].__setitem__("position", [0, 0, z])
+        )
+        assert load_scene(doc).lines[0].end_b.position == (0.0, 0.0, z)
 
 
 def test_input_error_attributes(chain_doc):

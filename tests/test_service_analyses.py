@@ -223,16 +223,18 @@ def test_validation_error_names_the_field_path_and_unit(small):
     assert err["parameter"] == "lines[0].segments[0].ea" and err["unit"] == "N"
 
 
-def test_line_end_above_the_water_is_422_naming_the_field(small):
-    # issue 19: was accepted silently; the part in air is not modelled in the dynamics
+def test_anchor_above_the_water_is_422_naming_the_field(small):
+    # issue 19: a scene-level check named no field
     for name, unit in ((SMALL, "ft"), (CHAIN, "m")):
         scene = _doc(name)
-        scene["lines"][0]["end_b"]["position"] = [0.0, 0.0, 30.0]
+        scene["lines"][0]["end_a"]["position"][2] = 30.0
         err = _err(small.post("/v1/analyses", json=scene))
-        assert err["loc"] == ["body", "lines", 0, "end_b", "position"]
-        assert err["parameter"] == "lines[0].end_b.position" and err["unit"] == unit
-        assert "z = 30.0 is above the still-water level; z must be <= 0" in err["msg"]
-        assert "not modelled in the dynamics" in err["msg"]
+        assert err["loc"] == ["body", "lines", 0, "end_a", "position"]
+        assert err["parameter"] == "lines[0].end_a.position" and err["unit"] == unit
+        assert (
+            "z = 30.0 is above the still-water level: the anchor end (end_a) must have "
+            in (err["msg"])
+        )
 
 
 # -------------------------------------------------------- run time, concurrency

@@ -399,20 +399,8 @@ def test_fairlead_above_water_dry_weight_force_balance():
     # forces must balance exactly that weight (conservation; residual 1e-10 of the
     # reference force summed over the nodes), and differ from the all-wet weight by
     # the buoyancy of the dry length (so the check can fail).
-    # A scene refuses a line end above the water (the dynamics does not model the part
-    # in air, test_scene.py); the line statics below it does, from a Line and an
-    # Environment built without a scene.
-    from stochcable.scene.model import Environment, Line
-
     seg = dict(CHAIN, length=700.0, elements=100)
-    env = Environment(depth=1000.0, seabed={"stiffness": 3e6})  # no bed contact
-    line = Line(
-        name="l",
-        end_a={"position": [-600.0, 0.0, -150.0]},
-        end_b={"position": [0.0, 0.0, 15.0]},
-        segments=[seg],
-    )
-    m = mesh_line(line, env.rho, env.g)
+    m, env, _ = make((-600, 0, -150), (0, 0, 15), [seg], depth=1000.0)  # no bed contact
     r = fe(m, env)
     z = r.positions[:, 2]
     za, zb = z[:-1], z[1:]

@@ -118,8 +118,8 @@ class End(_Doc):
     attached to a body (``attach``), which then carries it (seed 001 eqs. 3.3.6–3.3.7)."""
 
     position: tuple[float, float, float] | None = _f(
-        "Position (x, y, z), z up from the still-water level; z <= 0 (a line end in air is "
-        "refused: the dynamics does not model a line's part in air)",
+        "Position (x, y, z), z up from the still-water level; end_a: z <= 0 (the part of "
+        "a line above z = 0 has its weight in air, no buoyancy, no wave or current load)",
         "m",
         default=None,
     )

@@ -157,15 +157,14 @@ class Scene(_Doc):
                     raise ValueError(
                         f"lines[{i}].{end}.position z = {z} m is below the seabed (depth {depth} m)"
                     )
-                if z > 0.0:
+                if end == "end_a" and z > 0.0:
                     raise LocatedValueError(
                         ("lines", i, end, "position"),
                         list(e.position),
-                        f"z = {z} is above the still-water level; z must be <= 0 (a "
-                        "fairlead at the surface has z = 0): a line's part in air is not "
-                        "modelled in the dynamics (it would get the added mass and drag "
-                        "damping of water; only the statics gives it its weight in air, no "
-                        "buoyancy and no current)",
+                        f"z = {z} is above the still-water level: the anchor end (end_a) "
+                        "must have z <= 0 (end_b may be above the water: the part of a line "
+                        "in air has its weight in air, no buoyancy and no wave or current "
+                        "load)",
                     )
             if ln.end_a.attach is not None or ln.end_b.attach is not None:
                 try:
