@@ -421,6 +421,43 @@ def test_fairlead_above_water_dry_weight_force_balance():
     assert abs(m.l0[k] * (w_dry - m.weight[k]) * (1 - f[k])) > 1e3 * 1e-8 * scale
 
 
+def test_fairlead_above_water_against_two_weight_catenary():
+    # issue 19: the part of a line above the still-water level is modelled (weight in
+    # air, no buoyancy).  Reference: an elastic catenary of two segments, the submerged
+    # weight below the waterline and the weight in air above it, the junction's arc
+    # length s* chosen so that it lies at z = 0 (catenary_multisegment; the effective
+    # tension below equals the true tension at z = 0, so H and V are continuous there).
+    # The FE converges to it as O(1/n²), its waterline crossing included.
+    from scipy.optimize import brentq
+
+    errs = []
+    for n in (100, 200):
+        m, env, _ = make(
+            (-600, 0, -150), (0, 0, 15), [dict(CHAIN, length=700.0, elements=n)], depth=1000.0
+        )
+        r = fe(m, env)
+        ws = [float(m.weight[0]), 288.0 * env.g]  # submerged, in air [N/m]
+
+        def ref_of(s, ws=ws):
+            return catenary_multisegment(600.0, 165.0, [s, 700.0 - s], ws, [1.2326e9] * 2)
+
+        s_star = brentq(lambda s: ref_of(s).junctions[0, 1] - 150.0, 500.0, 699.0, xtol=1e-12)
+        ref = ref_of(s_star)
+        z = r.positions[:, 2]
+        k = int(np.flatnonzero((z[:-1] <= 0.0) & (z[1:] > 0.0))[0])
+        s_fe = m.s0[k] + (m.s0[k + 1] - m.s0[k]) * -z[k] / (z[k + 1] - z[k])
+        errs.append(
+            (r.tension_a / ref.tension_a - 1.0, r.tension_b / ref.tension_b - 1.0, s_fe - s_star)
+        )
+    e100, e200 = np.array(errs[0]), np.array(errs[1])
+    # measured: 1.6e-5, 1.5e-5 and -4.1e-3 m at 100 elements; 4x smaller at 200
+    assert np.all(np.abs(e200[:2]) < 1e-5) and abs(e200[2]) < 2e-3
+    assert np.all((e100 / e200 > 3.5) & (e100 / e200 < 4.5))  # second order
+    # all wet (the buoyancy of the dry 19 m counted) would be far off
+    wet = catenary_multisegment(600.0, 165.0, [700.0], [ws[0]], [1.2326e9])
+    assert abs(wet.tension_b / ref.tension_b - 1.0) > 100 * abs(e100[1])
+
+
 # ------------------------------------------------------------------------- current
 
 
