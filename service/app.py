@@ -40,8 +40,9 @@ Conventions: SI units, angular frequency ω in rad/s, one-sided spectra
 still-water level.  Every field states its unit in brackets.
 
 Errors answer `{"detail": [{"loc": [...], "msg": ..., "type": ..., "parameter": ...,
-"unit": ...}]}`: 422 for invalid input, exceeded size limits (`limit_exceeded`,
-naming the `STOCHCABLE_*` setting) and solver failures; 413 for bodies over
+"unit": ...}]}`: 422 for invalid input (a body that is not UTF-8 JSON or is nested too
+deep to decode: `json_invalid`, parameter `body`), exceeded size limits
+(`limit_exceeded`, naming the `STOCHCABLE_*` setting) and solver failures; 413 for bodies over
 `STOCHCABLE_MAX_BODY_BYTES`; 504 when queueing plus computation exceed
 `STOCHCABLE_MAX_RUN_SECONDS`.
 

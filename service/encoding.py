@@ -219,9 +219,10 @@ _ERRORS: dict[int, dict[str, Any]] = {
     413: {"model": ErrorResponse, "description": "Request body over STOCHCABLE_MAX_BODY_BYTES"},
     422: {
         "model": ErrorResponse,
-        "description": "Invalid input (field path, value, unit, constraint), a size bound "
-        "exceeded (type limit_exceeded, naming the STOCHCABLE_* setting) or a solver "
-        "failure",
+        "description": "Invalid input (field path, value, unit, constraint; a body that "
+        "is not UTF-8 JSON or is nested too deep to decode: type json_invalid, parameter "
+        "body), a size bound exceeded (type limit_exceeded, naming the STOCHCABLE_* "
+        "setting) or a solver failure",
     },
     504: {
         "model": ErrorResponse,

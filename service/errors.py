@@ -11,6 +11,8 @@ exception                                status  ``type``
 =======================================  ======  ==============================
 RequestValidationError (bad JSON,        422     pydantic's type (``json_invalid``,
 wrong type, NaN, out of bounds)                  ``greater_than``, ...)
+a body that is not UTF-8 or is nested    422     ``json_invalid`` (parameter ``body``)
+too deep to decode (FastAPI's 400)
 :class:`~stochcable.errors.InputError`   422     ``input_error``
 :class:`LimitExceeded`                   422     ``limit_exceeded``
 ConvergenceError                         422     ``convergence_error``
@@ -36,7 +38,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import JSONResponse
 
 from stochcable.errors import ConvergenceError, InputError, SolverError, StochcableError
-from stochcable.scene.model import field_path_and_unit
+from stochcable.scene.model import error_location, field_path_and_unit
 from stochcable.scene.units import labels_of_document
 
 from .settings import Settings
@@ -167,7 +169,7 @@ async def _validation_handler(request: Request, exc: RequestValidationError) -> 
     labels = labels_of_document(_scene_of(getattr(exc, "body", None)))
     items = []
     for err in exc.errors():
-        loc = list(err.get("loc", ()))
+        loc = list(error_location(err))  # a scene-level check may name its field
         item: dict[str, Any] = {
             "loc": loc,
             "msg": str(err.get("msg", "invalid")),
@@ -256,7 +258,35 @@ async def _run_time_handler(request: Request, exc: RunTimeExceeded) -> JSONRespo
     return error_response(504, [], str(exc), "run_time_exceeded", limit=exc.limit, setting=exc.env)
 
 
+_FASTAPI_BODY_ERROR = "There was an error parsing the body"
+
+
+def _undecodable_body(exc: StarletteHTTPException) -> str | None:
+    """Why a request body could not be decoded, when ``exc`` is FastAPI's 400 "There
+    was an error parsing the body" (raised from the decoding error), else None."""
+    cause = exc.__cause__
+    if exc.status_code != 400 or cause is None or exc.detail != _FASTAPI_BODY_ERROR:
+        return None
+    if isinstance(cause, UnicodeDecodeError):
+        return (
+            f"the request body is not UTF-8 JSON: byte {cause.object[cause.start]:#04x} at "
+            f"offset {cause.start} cannot be decoded ({cause.reason}); send the JSON "
+            "document encoded as UTF-8"
+        )
+    if isinstance(cause, RecursionError):
+        return (
+            "the request body is JSON nested too deeply to decode (arrays or objects "
+            "nested beyond the JSON parser's recursion limit); the documents of this API "
+            "are nested a few levels deep"
+        )
+    return f"the request body could not be decoded as JSON ({type(cause).__name__}: {cause})"
+
+
 async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+    why = _undecodable_body(exc)
+    if why is not None:
+        # an undecodable body is invalid input like malformed JSON: 422 json_invalid
+        return error_response(422, ["body"], why, "json_invalid", parameter="body")
     loc = getattr(exc, "loc", [])
     type_ = "not_found" if exc.status_code == 404 else "http_error"
     detail = exc.detail if isinstance(exc.detail, str) else json.dumps(exc.detail)

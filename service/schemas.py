@@ -20,6 +20,7 @@ from stochcable.scene import model as sc
 from stochcable.scene.model import G_STANDARD, OmegaGrid, Spectrum, TimeSeriesSettings
 
 __all__ = [
+    "peak_period",
     "ErrorItem",
     "ErrorResponse",
     "HealthResponse",
@@ -142,8 +143,8 @@ class SpectrumRequest(_Request):
         return self.omega.count if self.omega is not None else DEFAULT_OMEGA_COUNT
 
 
-def _peak_period(spectrum: Any, g: float) -> float:
-    """Shortest peak period of a spectrum document. [s]"""
+def peak_period(spectrum: Any, g: float) -> float:
+    """Shortest peak period of a spectrum document (a table: its largest density). [s]"""
     from stochcable.sea import spectra
 
     if isinstance(spectrum, sc.PiersonMoskowitz):
@@ -157,6 +158,9 @@ def _peak_period(spectrum: Any, g: float) -> float:
         return spectrum.t1 / spectra.PM_TM01_OVER_TP  # ISSC has the PM shape
     if isinstance(spectrum, sc.OchiHubble):
         return min(spectrum.tp1, spectrum.tp2)
+    if isinstance(spectrum, sc.TableSpectrum):
+        w = spectrum.omega[int(np.argmax(spectrum.density))]
+        return 2.0 * math.pi / w if w > 0 else math.inf
     return float(spectrum.tp)
 
 
@@ -167,7 +171,7 @@ def default_omega(spectrum: Any, g: float = G_STANDARD) -> np.ndarray:
 
     if isinstance(spectrum, sc.TableSpectrum):
         return np.linspace(spectrum.omega[0], spectrum.omega[-1], DEFAULT_OMEGA_COUNT)
-    return spectra.omega_grid(_peak_period(spectrum, g), DEFAULT_OMEGA_COUNT)
+    return spectra.omega_grid(peak_period(spectrum, g), DEFAULT_OMEGA_COUNT)
 
 
 _INF_NOTE = "; null when infinite (a moment is zero on the grid)"

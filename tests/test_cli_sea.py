@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -241,6 +243,72 @@ def test_bad_input_exit_2_one_line(capsys, argv, flag):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in err
     assert flag in lines[0]
+
+
+def test_simulate_too_many_samples_is_one_sentence_before_any_allocation():
+    # issue 19: --duration 1e12 once ended in "Unable to allocate 74.5 GiB"; the
+    # bound is checked before any work (a subprocess: the real exit code and stderr)
+    argv = ["simulate", "pm", "--hs", "6", "--tp", "10", "--duration", "1e12", "--dt", "0.25"]
+    p = subprocess.run(
+        [sys.executable, "-m", "stochcable", *argv], capture_output=True, text=True, timeout=60
+    )
+    assert p.returncode == 2 and p.stdout == "" and "Traceback" not in p.stderr
+    assert p.stderr.splitlines() == [
+        "stochcable simulate: error: --duration = 1000000000000.0 [s]: --duration/--dt = "
+        "4e+12 samples exceeds the limit of 4194304 (--max-samples; default 2^22, the "
+        "service's STOCHCABLE_MAX_SAMPLES): shorten --duration, raise --dt or raise "
+        "--max-samples"
+    ]
+
+
+def test_simulate_sample_bound_is_an_option(capsys):
+    base = ["simulate", "pm", "--hs", "6", "--tp", "10", "--dt", "0.25", "--seed", "1"]
+    code, _, err = run(capsys, *base, "--duration", "1e308", "--dt", "1e-300")
+    assert code == 2 and "--duration/--dt = inf samples exceeds the limit" in err
+    code, _, err = run(capsys, *base, "--duration", "512", "--max-samples", "1024")
+    assert code == 2 and "2048 samples exceeds the limit of 1024 (--max-samples" in err
+    code, out, _ = run(capsys, *base, "--duration", "512", "--max-samples", "2048")
+    assert code == 0 and len(json.loads(out)["elevation"]) == 2048
+    code, _, err = run(capsys, *base, "--max-samples", "1")
+    assert code == 2 and err.strip() == (
+        "stochcable simulate: error: --max-samples = 1: must be >= 2"
+    )
+
+
+def test_arithmetic_error_in_the_core_is_one_line_exit_2(capsys):
+    # a grid far below the ISSC peak (omega_p = 4849 rad/s): m0·m4 underflows, 0/0
+    code, out, err = run(
+        capsys, "spectrum", "issc", "--hs", "1e4", "--t1", "1e-3", "--omega-max", "1000"
+    )
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith(
+        "stochcable spectrum: error: numerical failure (ZeroDivisionError: float division "
+        "by zero): an input is outside the range the model handles numerically"
+    )
+
+
+def test_memory_error_anywhere_is_one_line_exit_2(capsys, monkeypatch):
+    import stochcable.cli.simulate as sim
+
+    def out_of_memory(*_a, **_k):
+        # what numpy's _ArrayMemoryError (a MemoryError) says
+        raise MemoryError(
+            "Unable to allocate 74.5 GiB for an array with shape (5000000000000,) and "
+            "data type float64"
+        )
+
+    monkeypatch.setattr(sim, "simulate_sea", out_of_memory)
+    code, out, err = run(capsys, "simulate", "pm", "--hs", "6", "--tp", "10")
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith("stochcable simulate: error: out of memory (Unable to allocate ")
+    assert "reduce the size of the problem" in err
+
+    def bare(*_a, **_k):
+        raise MemoryError
+
+    monkeypatch.setattr(sim, "simulate_sea", bare)
+    code, _, err = run(capsys, "simulate", "pm", "--hs", "6", "--tp", "10")
+    assert code == 2 and err.startswith("stochcable simulate: error: out of memory (a MemoryError)")
 
 
 @pytest.mark.parametrize(

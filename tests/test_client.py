@@ -250,6 +250,8 @@ def test_analyze_bodies_scene_returns_body_motion_series(client):
 
 
 def test_analyze_unconverged_raises_client_error_with_the_reason(client):
+    # CPU-independent by a wide margin: the first iteration's relative change is 0.81
+    # (measured), 80 times the example's tolerance 1e-2
     doc = load_example("tuah_1982_single_leg").model_dump(mode="json")
     doc["analysis"]["linearization"]["max_iterations"] = 1
     with pytest.raises(

@@ -83,8 +83,8 @@ def _seg(d):
         ),
         (
             lambda d: d["lines"][0]["end_a"].__setitem__("position", [-800.0, 0.0, 5.0]),
-            r"lines\[0\]\.end_a\.position z = 5\.0 m: the anchor end \(end_a\) is above the "
-            r"still-water surface",
+            r"^lines\[0\]\.end_a\.position = \[-800\.0, 0\.0, 5\.0\] \[m\]: z = 5\.0 is above "
+            r"the still-water level: the anchor end \(end_a\) must have z <= 0",
         ),
         (
             lambda d: d["lines"][0]["end_b"].__setitem__("position", [0.0, 0.0, -250.0]),
@@ -139,6 +139,26 @@ def _seg(d):
 def test_validation_errors_name_path_unit_constraint(chain_doc, mutate, pattern):
     with pytest.raises(InputError, match=pattern):
         load_scene(_mutated(chain_doc, mutate))
+
+
+def test_anchor_above_the_surface_names_the_field(chain_doc):
+    # issue 19: the scene-level check named no field (parameter "scene")
+    doc = _mutated(
+        chain_doc, lambda d: d["lines"][0]["end_a"].__setitem__("position", [-800, 0, 5])
+    )
+    with pytest.raises(InputError) as info:
+        load_scene(doc)
+    err = info.value
+    assert err.parameter == "lines[0].end_a.position" and err.unit == "m"
+    assert err.value == [-800.0, 0.0, 5.0]
+    assert err.constraint.startswith("z = 5.0 is above the still-water level: the anchor end")
+    # end_b above the water is modelled (weight in air, no buoyancy, no wave or current
+    # load: test_statics.py, test_wave_loads.py); at the still-water level exactly too
+    for z in (30.0, 0.0):
+        doc = _mutated(
+            chain_doc, lambda d, z=z: d["lines"][0]["end_b"].__setitem__("position", [0, 0, z])
+        )
+        assert load_scene(doc).lines[0].end_b.position == (0.0, 0.0, z)
 
 
 def test_input_error_attributes(chain_doc):

@@ -209,6 +209,57 @@ def test_malformed_json_is_422(client):
     assert err["type"] == "json_invalid" and err["loc"][0] == "body"
 
 
+@pytest.mark.parametrize("path", ["/v1/spectra", "/v1/analyses"])
+def test_undecodable_body_is_422_naming_the_body(client, path):
+    # issue 19: FastAPI answered an undocumented 400 without a parameter
+    json_type = {"Content-Type": "application/json"}
+    not_utf8 = b'{"spectrum": {"type": "pierson_moskowitz", "hs": 6, "tp": 10, "x": "\xff"}}'
+    err = _only_error(client.post(path, content=not_utf8, headers=json_type))
+    assert err == {
+        "loc": ["body"],
+        "msg": f"the request body is not UTF-8 JSON: byte 0xff at offset {not_utf8.index(0xFF)} "
+        "cannot be decoded (invalid start byte); send the JSON document encoded as UTF-8",
+        "type": "json_invalid",
+        "parameter": "body",
+    }
+    for deep in (b"[" * 10_000 + b"]" * 10_000, b'{"a":' * 10_000 + b"1" + b"}" * 10_000):
+        err = _only_error(client.post(path, content=deep, headers=json_type))
+        assert err["type"] == "json_invalid" and err["parameter"] == "body"
+        assert err["loc"] == ["body"]
+        assert err["msg"].startswith("the request body is JSON nested too deeply to decode")
+    # the server is fine afterwards
+    assert client.get("/health").status_code == 200
+
+
+def test_spectrum_out_of_double_precision_names_the_parameter(client):
+    # issue 19: these answered 422 numerical_error with loc ["body"] and no parameter
+    def post(spectrum, omega=None):
+        body = {"spectrum": spectrum} if omega is None else {"spectrum": spectrum, "omega": omega}
+        return _only_error(client.post("/v1/spectra", json=body))
+
+    # the JONSWAP peak shape overflowed for a tiny width: refused by its bound
+    err = post({"type": "jonswap", "hs": 6.0, "tp": 10.0, "sigma_a": 1e-300})
+    assert err["parameter"] == "spectrum.sigma_a" and err["type"] == "greater_than_equal"
+    assert err["ctx"] == {"ge": 0.001}
+    # a grid far below the peak (omega_p = 4849 rad/s): m0·m4 underflows, 0/0
+    err = post({"type": "issc", "hs": 1e4, "t1": 1e-3}, {"min": 1e-3, "max": 1e3, "count": 100})
+    assert err["type"] == "input_error" and err["parameter"] == "omega"
+    assert err["loc"] == ["body", "omega"] and err["unit"] == "rad/s"
+    assert err["msg"].startswith(
+        "omega = [0.001, 1000.0] [rad/s]: the spectrum sampled on this grid (min, max; 100 "
+        "frequencies) has moments m0…m4 outside double precision (ZeroDivisionError: "
+    )
+    assert "omega_p = 4849.18 rad/s" in err["msg"] and "omit omega" in err["msg"]
+    # a grid far above it: ω⁴·S overflows
+    err = post({"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0}, {"min": 1e-3, "max": 1e300})
+    assert err["parameter"] == "omega" and "omega_p = 0.628319 rad/s" in err["msg"]
+    # a table density too large for its moments
+    err = post({"type": "table", "omega": [0.0, 1.0, 2.0], "density": [1e308] * 3})
+    assert err["parameter"] == "spectrum.density" and err["input"] == 1e308
+    assert err["loc"] == ["body", "spectrum", "density"]
+    assert "overflow double precision" in err["msg"] and "smaller unit" in err["msg"]
+
+
 def test_pydantic_model_validator_message_is_kept(client):
     err = _only_error(
         client.post("/v1/spectra", json={"spectrum": {"type": "pierson_moskowitz", "hs": 6.0}})

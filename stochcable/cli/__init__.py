@@ -3,8 +3,8 @@
 Each sub-command lives in its own module in this package and exposes
 ``register(subparsers)``, which adds its parser and sets ``func`` to a callable taking
 the parsed namespace and returning an exit code.  Modules are discovered, so adding a
-command is adding a file.  Errors a user causes are printed as one line on stderr with
-exit code 2; no traceback.
+command is adding a file.  Errors a user causes, and running out of memory, are printed
+as one line on stderr with exit code 2; no traceback.
 """
 
 from __future__ import annotations
@@ -60,6 +60,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     except (OSError, ValueError) as exc:  # unreadable file, malformed JSON
         sys.stderr.write(f"stochcable {args.command}: error: {exc}\n")
+        return 2
+    except ArithmeticError as exc:  # overflow or 0/0 in the core from extreme input
+        sys.stderr.write(
+            f"stochcable {args.command}: error: numerical failure ({type(exc).__name__}: "
+            f"{exc}): an input is outside the range the model handles numerically (check "
+            "magnitudes and units: periods, heights, frequencies, depth)\n"
+        )
+        return 2
+    except MemoryError as exc:  # numpy's "Unable to allocate ..." or a bare MemoryError
+        what = str(exc).splitlines()[0] if str(exc) else "a MemoryError"
+        sys.stderr.write(
+            f"stochcable {args.command}: error: out of memory ({what}); reduce the size "
+            "of the problem (elements, frequencies, time-series samples)\n"
+        )
         return 2
 
 

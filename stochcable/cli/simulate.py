@@ -10,6 +10,9 @@ from stochcable.cli._spectrum_args import add_spectrum_arguments, spectrum_from_
 from stochcable.errors import InputError
 from stochcable.sea.realization import simulate_sea
 
+# the default bound on duration/dt: the service's default STOCHCABLE_MAX_SAMPLES
+MAX_SAMPLES = 2**22
+
 UNITS = {
     "time": "s",
     "elevation": "m",
@@ -33,6 +36,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_spectrum_arguments(p)
     p.add_argument("--duration", type=float, default=256.0, help="record length [s] (default 256)")
     p.add_argument("--dt", type=float, default=0.25, help="time step [s] (default 0.25)")
+    p.add_argument(
+        "--max-samples",
+        type=int,
+        default=MAX_SAMPLES,
+        help="refuse a record of more than this many samples duration/dt (default 2^22 = "
+        "4194304, the service's STOCHCABLE_MAX_SAMPLES; 16 bytes of memory or more each)",
+    )
     p.add_argument(
         "--method",
         choices=("dsa", "nsa"),
@@ -59,6 +69,17 @@ def run(args: argparse.Namespace) -> int:
     if args.seed is not None and args.seed < 0:
         raise InputError("--seed", args.seed, "-", "must be >= 0")
     ratio = duration / dt
+    if args.max_samples < 2:
+        raise InputError("--max-samples", args.max_samples, "-", "must be >= 2")
+    if not ratio <= args.max_samples:  # also an infinite ratio
+        raise InputError(
+            "--duration",
+            duration,
+            "s",
+            f"--duration/--dt = {ratio:.6g} samples exceeds the limit of {args.max_samples} "
+            "(--max-samples; default 2^22, the service's STOCHCABLE_MAX_SAMPLES): shorten "
+            "--duration, raise --dt or raise --max-samples",
+        )
     n_t = round(ratio)
     if abs(ratio - n_t) > 1e-9 * max(ratio, 1.0) or n_t < 2 or n_t % 2:
         raise InputError(

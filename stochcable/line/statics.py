@@ -340,7 +340,18 @@ def solve_fe(
     tol: float,
     budget: int,
     force_3d: bool = False,
+    full_load_iterations: int | None = None,
 ) -> LineStatics:
+    """The FE statics of :func:`solve_line_statics` (options already checked).
+
+    ``initial`` None or finite node positions of shape (n_nodes, 3) [m], ``tol`` the
+    relative residual [-], ``budget`` the total number of iterations [-];
+    ``force_3d`` solves a planar line in 3-D.  With current, the first attempt at full
+    drag gets ``full_load_iterations`` of the budget (default a quarter) before the
+    drag is load-stepped from the current-free equilibrium; 0 goes straight to the
+    load stepping (a test of the stepping that does not rely on the full-load Newton
+    failing).  Raises ConvergenceError as :func:`solve_line_statics`.
+    """
     frame = LocalFrame(mesh, env, force_3d=force_3d)
     model = StaticsModel(mesh, env, frame)
     if initial is not None:
@@ -352,7 +363,10 @@ def solve_fe(
     solver = StaticsSolver(model, tol, budget)
     # with current, a first attempt at full load gets a quarter of the budget; the
     # rest goes to load stepping of the drag from the equilibrium without current
-    ok, X, r = solver.solve(X0, budget // 4 if model.has_drag else budget)
+    first = budget
+    if model.has_drag:
+        first = budget // 4 if full_load_iterations is None else int(full_load_iterations)
+    ok, X, r = solver.solve(X0, first)
     if not ok and model.has_drag and solver.used < budget:
         X, r, ok = _drag_stepping(solver, model, X0, budget)
     if not ok:

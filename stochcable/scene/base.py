@@ -18,3 +18,16 @@ def _f(description: str, unit: str, **kw: Any) -> Any:
 
 class _Doc(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+
+class LocatedValueError(ValueError):
+    """A ValueError of a check across fields (a model validator) that names the one field
+    it is about: ``loc``, its location relative to the validated model
+    (``("lines", 0, "end_b", "position")``), and ``value``, the field's value.  The
+    converters of validation errors (:func:`stochcable.scene.model.error_location`)
+    report that field instead of the enclosing model."""
+
+    def __init__(self, loc: tuple[str | int, ...], value: Any, message: str) -> None:
+        super().__init__(message)
+        self.loc = tuple(loc)
+        self.value = value

@@ -117,7 +117,12 @@ class End(_Doc):
     """A line end: fixed at ``position`` unless a ``motion`` is prescribed about it, or
     attached to a body (``attach``), which then carries it (seed 001 eqs. 3.3.6–3.3.7)."""
 
-    position: tuple[float, float, float] | None = _f("Position (x, y, z), z up", "m", default=None)
+    position: tuple[float, float, float] | None = _f(
+        "Position (x, y, z), z up from the still-water level; end_a: z <= 0 (the part of "
+        "a line above z = 0 has its weight in air, no buoyancy, no wave or current load)",
+        "m",
+        default=None,
+    )
     motion: EndMotion | None = None
     attach: BodyAttachment | None = None
 

@@ -42,7 +42,7 @@ from stochcable.scene.analysis_settings import (
     StructuralDamping,
     TimeSeriesSettings,
 )
-from stochcable.scene.base import G_STANDARD, RHO_SEAWATER, _Doc
+from stochcable.scene.base import G_STANDARD, RHO_SEAWATER, LocatedValueError, _Doc
 from stochcable.scene.bodies import (
     BODY_DOFS,
     PLANAR_BODY_DOFS,
@@ -114,6 +114,7 @@ __all__ = [
     "load_scene",
     "scene_json_schema",
     "field_path_and_unit",
+    "error_location",
 ]
 
 
@@ -156,12 +157,14 @@ class Scene(_Doc):
                     raise ValueError(
                         f"lines[{i}].{end}.position z = {z} m is below the seabed (depth {depth} m)"
                     )
-            if ln.end_a.attach is None:
-                za = ln.end_a.position[2]
-                if za > 0.0:
-                    raise ValueError(
-                        f"lines[{i}].end_a.position z = {za} m: the anchor end (end_a) is "
-                        "above the still-water surface (z must be <= 0)"
+                if end == "end_a" and z > 0.0:
+                    raise LocatedValueError(
+                        ("lines", i, end, "position"),
+                        list(e.position),
+                        f"z = {z} is above the still-water level: the anchor end (end_a) "
+                        "must have z <= 0 (end_b may be above the water: the part of a line "
+                        "in air has its weight in air, no buoyancy and no wave or current "
+                        "load)",
                     )
             if ln.end_a.attach is not None or ln.end_b.attach is not None:
                 try:
@@ -361,6 +364,16 @@ def field_path_and_unit(model: type[BaseModel] | None, loc: Sequence[Any]) -> tu
 _QUOTED_UNIT = re.compile(r"([\d\]] )((?:kg|m|N)(?:[²³]|/m|/s)?)(?![\w/·])")
 
 
+def error_location(err: Mapping[str, Any]) -> tuple[str | int, ...]:
+    """The location of one pydantic error (an item of ``ValidationError.errors()``),
+    extended by the field a :class:`~stochcable.scene.base.LocatedValueError` names."""
+    loc = tuple(err.get("loc", ()))
+    located = (err.get("ctx") or {}).get("error")
+    if isinstance(located, LocatedValueError):
+        loc += located.loc
+    return loc
+
+
 def input_error_from_validation(
     exc: ValidationError,
     model: type[BaseModel],
@@ -380,7 +393,7 @@ def input_error_from_validation(
         e for e, lc in zip(errors, locs) if not any(o != lc and o[: len(lc)] == lc for o in locs)
     ] or errors
     err = leaves[0]
-    path, unit = field_path_and_unit(model, tuple(err.get("loc", ())))
+    path, unit = field_path_and_unit(model, error_location(err))
     if labels is not None:
         unit = labels.convert(unit)
     path = path or "scene"
@@ -396,6 +409,9 @@ def input_error_from_validation(
     if more:
         msg += f" (and {more} more error{'s' if more > 1 else ''})"
     value = err.get("input")
+    located = (err.get("ctx") or {}).get("error")
+    if isinstance(located, LocatedValueError):
+        value = located.value
     if isinstance(value, Mapping):
         value = InputError._NO_VALUE
     elif isinstance(value, (list, tuple)) and len(value) > 6:

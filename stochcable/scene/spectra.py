@@ -83,8 +83,22 @@ class Jonswap(_SpectrumBase):
     hs: float = _f("Significant wave height", "m", ge=1e-6, le=1e4)
     tp: float = _f("Peak period", "s", ge=1e-3, le=1e5)
     gamma: float = _f("Peak enhancement factor", "-", ge=1, le=20, default=3.3)
-    sigma_a: float = _f("Peak width below the peak", "-", gt=0, le=1, default=0.07)
-    sigma_b: float = _f("Peak width above the peak", "-", gt=0, le=1, default=0.09)
+    # σ >= 1e-3: a narrower peak is resolved by no frequency grid of the service's size,
+    # and σ below ~1e-150 overflows ((ω/ωp − 1)/σ)² in the peak shape
+    sigma_a: float = _f(
+        "Peak width below the peak (>= 0.001: a narrower peak is resolved by no grid)",
+        "-",
+        ge=1e-3,
+        le=1,
+        default=0.07,
+    )
+    sigma_b: float = _f(
+        "Peak width above the peak (>= 0.001: a narrower peak is resolved by no grid)",
+        "-",
+        ge=1e-3,
+        le=1,
+        default=0.09,
+    )
 
     def spectral_density(self, omega: np.ndarray, g: float = G_STANDARD) -> np.ndarray:
         from stochcable.sea import spectra
