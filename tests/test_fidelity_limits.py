@@ -90,6 +90,21 @@ def test_an_inadmissible_plan_is_an_input_error_naming_the_request(plan_03):
     assert "analysis.omega.count" in err.constraint and "no admissible plan" in err.constraint
 
 
+def test_elements_are_clipped_to_the_model_with_a_larger_estimate(monkeypatch):
+    import stochcable.fidelity.planner as planner
+
+    scene = load_example("taut_wire")
+    free = choose_fidelity(scene, 0.05, evaluate=analyze)
+    n_max = max(n for v in free.segments.values() for _, _, n in v)
+    monkeypatch.setattr(planner, "elements_limit", lambda: n_max // 2)
+    plan = choose_fidelity(scene, 0.05, evaluate=analyze)
+    assert max(n for v in plan.segments.values() for _, _, n in v) == n_max // 2
+    assert plan.error_estimate["elements"] >= 4 * free.error_estimate["elements"] * 0.99
+    (text,) = plan.limits
+    assert f"limit of {n_max // 2} elements per segment" in text
+    apply_fidelity(scene, plan)  # admissible
+
+
 def test_unbounded_tail_warning_names_the_cause_and_the_fix(plan_03):
     (text, _) = fidelity_warnings(replace(plan_03, tail_bounded=False))
     assert "could not bound the response tail" in text

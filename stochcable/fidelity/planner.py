@@ -146,7 +146,8 @@ def _plan(
         inputs.k_load,
         exact_wave_integration,
     )
-    segs, el_limit = _clip_elements(segs)
+    segs, el_limit, el_factor = _clip_elements(segs)
+    el_err *= el_factor  # the element error grows like h²
     solver, modes, mode_err, mode_choices = _choose_modes(
         pilot, segs, band.omega_max, share["modes"]
     )
@@ -198,21 +199,26 @@ def _plan(
     )
 
 
-def _clip_elements(segs: Segments) -> tuple[Segments, str]:
+def _clip_elements(segs: Segments) -> tuple[Segments, str, float]:
     """The segments with every element count within the scene model's limit on
-    ``lines[*].segments[*].elements``, and a note when one was clipped."""
+    ``lines[*].segments[*].elements``, a note when one was clipped, and the factor
+    (n/limit)² of the element error estimate (it grows like h²; 1 when none was)."""
     limit = elements_limit()
     out: Segments = {}
     clipped = []
+    factor = 1.0
     for name, parts in segs.items():
         out[name] = tuple((i, L, min(n, limit)) for i, L, n in parts)
         clipped += [f"lines[{name}].segments[{i}]" for i, _, n in parts if n > limit]
+        factor = max([factor] + [(n / limit) ** 2 for _, _, n in parts])
     if not clipped:
-        return segs, ""
-    return out, (
+        return segs, "", 1.0
+    return (
+        out,
         f"{', '.join(clipped)}: the element rules ask for more than the scene model's "
-        f"limit of {limit} elements per segment; clipped to it (the element error "
-        "estimate then exceeds its share)"
+        f"limit of {limit} elements per segment; clipped to it (element error estimate "
+        f"× {factor:.3g})",
+        factor,
     )
 
 
