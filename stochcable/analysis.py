@@ -132,17 +132,47 @@ def _plan_fidelity(scene: Scene, progress: Progress) -> tuple[Scene, Any]:
 
 def _with_plan(result: Result, plan: Any, total_s: float) -> Result:
     """The result with its fidelity plan, the planning time in ``total_s``, and the
-    warning of an unbounded response tail first."""
+    warnings of what the plan could not bound first."""
     messages = list(result.warnings)
-    if not plan.tail_bounded:
-        text = (
-            "adaptive fidelity could not bound the response tail above "
-            f"{plan.omega_max:.3g} rad/s: the target error is not guaranteed (an input "
-            "spectrum with a slowly decaying tail, e.g. an end-motion spectrum without "
-            "a vessel RAO, drives tension up to high frequency)"
-        )
+    for text in reversed(fidelity_warnings(plan)):
         warn(text, PhysicsWarning)
         messages.insert(0, text)
     timing = dict(result.timing)
     timing["total_s"] = total_s
     return dataclasses.replace(result, warnings=tuple(messages), fidelity=plan, timing=timing)
+
+
+def fidelity_warnings(plan: Any) -> list[str]:
+    """The warnings of a fidelity plan that does not meet its target: an unbounded
+    response tail (what is unbounded and the fix) and every limit of the scene model
+    the plan hit (what it leaves unresolved), each with the plan's error estimate."""
+    out = []
+    est = plan.error_estimate
+    if not plan.tail_bounded:
+        out.append(
+            "adaptive fidelity could not bound the response tail: the response "
+            f"variance above the pilot's top {plan.pilot.get('omega_max', plan.omega_max):.3g}"
+            f" rad/s is not bounded within the target error {plan.target_error:g} "
+            f"(band ω_max {plan.omega_max:.3g} rad/s, band error ≥ {est['band']:.2g}, a "
+            "lower bound).  Typical cause: an end-motion spectrum with an ω⁻⁵ tail "
+            "drives inertia loads whose tension spectrum decays like ω⁻¹, so the "
+            "tension σ grows like log ω_max; band-limit the motion spectrum or give the "
+            "end motion as a vessel RAO"
+        )
+    if plan.limits:
+        met = est["total"] <= plan.target_error
+        out.append(
+            "adaptive fidelity reached the scene model's limits for the target error "
+            f"{plan.target_error:g}: best plan within them, estimated σ error "
+            f"{est['total']:.2g} ("
+            + (
+                "within the target, but part of it is an estimate, not a bound"
+                if met
+                else "the target is NOT met"
+            )
+            + "): "
+            + "; ".join(plan.limits)
+            + ".  Use a larger "
+            "analysis.fidelity.target_error, or add damping to the lightly damped modes"
+        )
+    return out

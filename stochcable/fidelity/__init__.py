@@ -3,6 +3,7 @@ target.
 
 Modules, lowest first: :mod:`~stochcable.fidelity.rules` (the error → resolution
 rules and constants), :mod:`~stochcable.fidelity.plan` (:class:`FidelityPlan`),
+:mod:`~stochcable.fidelity.limits` (the scene model's limits a plan respects),
 :mod:`~stochcable.fidelity.meshing` (the element rules on a scene),
 :mod:`~stochcable.fidelity.pilot` (input band and pilot analysis) and
 :mod:`~stochcable.fidelity.planner` (:func:`choose_fidelity`, :func:`apply_fidelity`).

@@ -80,6 +80,13 @@ class FidelityPlan:
         top: σ then depends on the band and the band estimate is a lower bound.
     pilot : dict
         The pilot analysis: elements, band, count, wall time [s].
+    grid_resolved : bool
+        False when a limit of the scene model (``analysis.omega.count``) kept the grid
+        from resolving some lightly damped modes of the band; their estimated share is
+        ``error_estimate["grid_unresolved"]``.
+    limits : tuple of str
+        Every limit of the scene model the plan hit, with what it leaves unmet (empty
+        when the target was met within them).
     """
 
     target_error: float
@@ -97,10 +104,12 @@ class FidelityPlan:
     tail_bounded: bool = True
     omega_response: float = 0.0
     pilot: dict[str, Any] = field(default_factory=dict)
+    grid_resolved: bool = True
+    limits: tuple[str, ...] = ()
 
     def to_document(self) -> dict[str, Any]:
         """Plain JSON-ready form (for the result document's "fidelity")."""
-        return {
+        doc = {
             "target_error": self.target_error,
             "omega": {
                 "min": self.omega_min,
@@ -119,6 +128,12 @@ class FidelityPlan:
             "omega_response": self.omega_response,
             "pilot": _plain(self.pilot),
         }
+        if self.limits:  # only when a limit was hit (documents of met targets unchanged)
+            doc["grid_resolved"] = self.grid_resolved
+            doc["limits"] = list(self.limits)
+        # plain Python numbers throughout (numpy scalars are not JSON for every encoder:
+        # the service's answered 500 on the band error's numpy float)
+        return _plain(doc)
 
 
 def _plain(x: Any) -> Any:
@@ -126,6 +141,8 @@ def _plain(x: Any) -> Any:
         return {k: _plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [_plain(v) for v in x]
-    if isinstance(x, (np.floating, np.integer)):
+    if isinstance(x, (np.floating, np.integer, np.bool_)):
         return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
     return x

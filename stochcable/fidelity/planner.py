@@ -21,8 +21,10 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from pydantic import ValidationError
 
 from stochcable import validation as _v
+from stochcable.fidelity.limits import elements_limit, omega_count_limit, planned_scene_error
 from stochcable.fidelity.meshing import (
     Segments,
     mesh_rules,
@@ -35,6 +37,7 @@ from stochcable.fidelity.pilot import (
     InputBand,
     Pilot,
     base_count,
+    base_error,
     input_summary,
     modal_bandwidths,
     run_pilot,
@@ -112,9 +115,23 @@ def choose_fidelity(
     """
     scene = load_scene(scene)
     eps = _v.in_range("target_error", target_error, "-", 0.0, 0.5, lo_open=True)
-    share = {k: v * eps for k, v in BUDGET.items()}
     if allow_grid_values is None:
         allow_grid_values = grid_values_supported()
+    try:
+        return _plan(scene, eps, evaluate, exact_wave_integration, bool(allow_grid_values))
+    except ValidationError as exc:  # a pilot or planned scene the model rejects
+        raise planned_scene_error(exc, eps) from None
+
+
+def _plan(
+    scene: Scene,
+    eps: float,
+    evaluate: Evaluate,
+    exact_wave_integration: bool,
+    allow_grid_values: bool,
+) -> FidelityPlan:
+    """:func:`choose_fidelity` on a loaded scene and a checked target."""
+    share = {k: v * eps for k, v in BUDGET.items()}
     statics = solve_statics(scene, method="fe")
     geo = segment_geometry(scene, statics, static_touchdowns(scene))
     inputs = input_summary(scene)
@@ -129,11 +146,15 @@ def choose_fidelity(
         inputs.k_load,
         exact_wave_integration,
     )
-    grid = _choose_grid(scene, pilot, band, share["grid"], bool(allow_grid_values))
+    segs, el_limit, el_factor = _clip_elements(segs)
+    el_err *= el_factor  # the element error grows like h²
     solver, modes, mode_err, mode_choices = _choose_modes(
         pilot, segs, band.omega_max, share["modes"]
     )
     tol = share["linearization"]
+    # what the other parts leave of the target (used only when the grid hits its limit)
+    slack = eps - (band.error + el_err + mode_err + tol + share["grid"] / 2.0)
+    grid = _choose_grid(scene, pilot, band, share["grid"], bool(allow_grid_values), slack)
     tol_choice = Choice(
         "analysis.linearization.tolerance",
         tol,
@@ -148,6 +169,8 @@ def choose_fidelity(
         "modes": mode_err,
         "linearization": tol,
     }
+    if grid.unresolved or grid.base_clipped:
+        parts["grid_unresolved"] = grid.unresolved_error
     parts["total"] = float(sum(parts.values()))
     n_el = sum(sum(n for _, _, n in v) for v in segs.values())
     cost = {
@@ -171,7 +194,54 @@ def choose_fidelity(
         tail_bounded=bool(pilot.bounded),
         omega_response=float(band.omega2),
         pilot=pilot.info,
+        grid_resolved=not (grid.unresolved or grid.base_clipped),
+        limits=_limits_hit(grid, el_limit, band.omega_max),
     )
+
+
+def _clip_elements(segs: Segments) -> tuple[Segments, str, float]:
+    """The segments with every element count within the scene model's limit on
+    ``lines[*].segments[*].elements``, a note when one was clipped, and the factor
+    (n/limit)² of the element error estimate (it grows like h²; 1 when none was)."""
+    limit = elements_limit()
+    out: Segments = {}
+    clipped = []
+    factor = 1.0
+    for name, parts in segs.items():
+        out[name] = tuple((i, L, min(n, limit)) for i, L, n in parts)
+        clipped += [f"lines[{name}].segments[{i}]" for i, _, n in parts if n > limit]
+        factor = max([factor] + [(n / limit) ** 2 for _, _, n in parts])
+    if not clipped:
+        return segs, "", 1.0
+    return (
+        out,
+        f"{', '.join(clipped)}: the element rules ask for more than the scene model's "
+        f"limit of {limit} elements per segment; clipped to it (element error estimate "
+        f"× {factor:.3g})",
+        factor,
+    )
+
+
+def _limits_hit(grid: _Grid, el_limit: str, omega_max: float) -> tuple[str, ...]:
+    """One sentence per limit of the scene model the plan hit."""
+    out = [el_limit] if el_limit else []
+    if grid.base_clipped:
+        out.append(
+            "analysis.omega.count: the input spectra alone need a finer linear grid "
+            f"on [ω_min, {omega_max:.3g}] rad/s than the scene model's limit of "
+            f"{omega_count_limit()} frequencies; grid at the limit (estimated σ error "
+            f"{grid.unresolved_error:.2g})"
+        )
+    if grid.unresolved:
+        w_n, b_n = min(grid.unresolved, key=lambda p: p[1])
+        out.append(
+            f"analysis.omega.count: resolving every lightly damped mode in the band up "
+            f"to {omega_max:.3g} rad/s needs more than the scene model's limit of "
+            f"{omega_count_limit()} frequencies; {len(grid.unresolved)} mode(s) "
+            f"(narrowest half-power bandwidth {b_n:.3g} rad/s at {w_n:.3g} rad/s) are "
+            f"left unresolved (estimated σ error {grid.unresolved_error:.2g})"
+        )
+    return tuple(out)
 
 
 # ------------------------------------------------------------------------- band
@@ -266,24 +336,40 @@ class _Grid:
     n_freq: int  # points of the grid applied
     error: float
     choice: Choice
+    unresolved: tuple[tuple[float, float], ...] = ()  # (ω_j, b_j) beyond the count limit
+    unresolved_error: float = 0.0  # estimated σ error they leave [-]
+    base_clipped: bool = False  # the inputs' own spacing is finer than the limit allows
 
 
 def _choose_grid(
-    scene: Scene, pilot: Pilot, band: _Band, grid_share: float, allow_values: bool
+    scene: Scene,
+    pilot: Pilot,
+    band: _Band,
+    grid_share: float,
+    allow_values: bool,
+    slack: float = 0.0,
 ) -> _Grid:
     """The base linear spacing from the input spectra, refined around the pilot's
-    lightly damped modes in the band (half of the grid share each)."""
+    lightly damped modes in the band (half of the grid share each), within the scene
+    model's limit on ``analysis.omega.count`` (see :func:`_within_limit`)."""
     w_min, w_max = band.omega_min, band.omega_max
+    limit = omega_count_limit()
     n_bw = points_per_bandwidth(grid_share / 2.0)
     base = base_count(scene, w_min, w_max, grid_share)
+    # the inputs' own spacing beyond the limit: its error measured at the limit
+    base_clip = base_error(scene, w_min, w_max, limit) if base > limit else 0.0
+    base = min(base, limit)
     dw_base = (w_max - w_min) / (base - 1)
     peaks = _narrow_peaks(scene, pilot, w_min, w_max, dw_base)
+    n_all = int(math.ceil((w_max - w_min) / min([dw_base] + [b / n_bw for _, b in peaks]))) + 1
+    peaks, unresolved = _within_limit(pilot, peaks, w_min, w_max, base, n_bw, allow_values, slack)
     dw_fine = min([dw_base] + [b / n_bw for _, b in peaks])
-    count_lin = int(math.ceil((w_max - w_min) / dw_fine)) + 1
+    count_lin = min(int(math.ceil((w_max - w_min) / dw_fine)) + 1, limit)
     values = union_grid(w_min, w_max, base, peaks, n_bw)
     grid_err = 2.0 * math.exp(-math.pi * n_bw) + grid_share / 2.0
     use_values = allow_values and len(values) < count_lin
     n_freq = len(values) if use_values else count_lin
+    un_err = _unresolved_error(pilot, unresolved) + base_clip
     choice = Choice(
         "analysis.omega.count" if not use_values else "analysis.omega.values",
         n_freq,
@@ -302,10 +388,91 @@ def _choose_grid(
             if use_values
             else f"; linear grid at the finest spacing {dw_fine:.3g} rad/s"
             + (f" (a non-uniform grid would need {len(values)})" if len(values) < count_lin else "")
+        )
+        + (_unresolved_note(unresolved, n_all, limit, un_err) if unresolved else "")
+        + (
+            f"; the inputs alone need {base_count(scene, w_min, w_max, grid_share)} "
+            f"points, above the scene model's limit analysis.omega.count ≤ {limit}: "
+            f"trapezoid error at the limit {base_clip:.2g}"
+            if base_clip
+            else ""
         ),
-        grid_err,
+        grid_err + un_err,
     )
-    return _Grid(count_lin, values, n_freq, grid_err, choice)
+    return _Grid(
+        count_lin, values, n_freq, grid_err, choice, tuple(unresolved), un_err, base_clip > 0
+    )
+
+
+def _within_limit(
+    pilot: Pilot,
+    peaks: list[tuple[float, float]],
+    w_min: float,
+    w_max: float,
+    base: int,
+    n_bw: float,
+    allow_values: bool,
+    slack: float,
+) -> tuple[list[tuple[float, float]], list[tuple[float, float]]]:
+    """The peaks to resolve and those left unresolved.  All are resolved when the grid
+    that does fits the scene model's limit on ``analysis.omega.count`` (the plan is
+    then the one of the rules alone).  Otherwise the modes whose spacing the limit
+    cannot give are left unresolved, and, narrowest (costliest) first, more of them as
+    long as the estimated σ error of all left (:func:`_unresolved_error`) stays within
+    ``slack`` (what the other parts leave of the target): the best grid within the
+    limit at the least cost."""
+    limit = omega_count_limit()
+
+    def count(pk: list[tuple[float, float]]) -> int:
+        if allow_values:
+            return min(len(union_grid(w_min, w_max, base, pk, n_bw)), _linear_count(pk))
+        return _linear_count(pk)
+
+    def _linear_count(pk: list[tuple[float, float]]) -> int:
+        dw = min([(w_max - w_min) / (base - 1)] + [b / n_bw for _, b in pk])
+        return int(math.ceil((w_max - w_min) / dw)) + 1
+
+    if count(peaks) <= limit:
+        return peaks, []
+    order = sorted(peaks, key=lambda p: p[1])  # narrowest first
+    k = next(i for i in range(len(order) + 1) if count(order[i:]) <= limit)
+    while k < len(order) and _unresolved_error(pilot, order[: k + 1]) <= slack:
+        k += 1
+    return order[k:], order[:k]
+
+
+def _unresolved_note(
+    unresolved: list[tuple[float, float]], n_all: int, limit: int, err: float
+) -> str:
+    """The grid reason's part on the modes the count limit leaves unresolved."""
+    w_n, b_n = min(unresolved, key=lambda p: p[1])
+    return (
+        f"; NOT resolved: resolving every mode needs {n_all} frequencies, above the "
+        f"scene model's limit analysis.omega.count ≤ {limit}; {len(unresolved)} "
+        f"lightly damped mode(s) (narrowest {b_n:.3g} rad/s at {w_n:.3g} rad/s) are left "
+        "unresolved — those the limit cannot reach and, narrowest first, those whose "
+        f"estimated σ error fits the target: ≈ {err:.2g} (half the variance fraction the "
+        "pilot puts in their pilot bins: an estimate, not a bound)"
+    )
+
+
+def _unresolved_error(pilot: Pilot, unresolved: list[tuple[float, float]]) -> float:
+    """Estimated σ error of modes the grid leaves unresolved: half the largest variance
+    fraction (over the response spectra) the pilot puts in the pilot intervals that
+    hold them (the pilot's log grid does not resolve them either: an estimate)."""
+    if not unresolved:
+        return 0.0
+    w = pilot.omega
+    idx = {int(np.clip(np.searchsorted(w, wj) - 1, 0, w.size - 2)) for wj, _ in unresolved}
+    sel = np.array(sorted(idx))
+    worst = 0.0
+    for s in pilot.spectra.values():
+        m0 = float(np.trapezoid(s, w))
+        if m0 <= 0:
+            continue
+        part = 0.5 * (s[sel] + s[sel + 1]) * (w[sel + 1] - w[sel])
+        worst = max(worst, float(np.sum(part)) / m0)
+    return 0.5 * worst
 
 
 def _narrow_peaks(
@@ -416,4 +583,7 @@ def apply_fidelity(scene: Scene | Any, plan: FidelityPlan) -> Scene:
             update={"tolerance": plan.tolerance}
         ),
     }
-    return segments_scene(scene, plan.segments, update)
+    try:
+        return segments_scene(scene, plan.segments, update)
+    except ValidationError as exc:  # never reaches a user as a pydantic error
+        raise planned_scene_error(exc, plan.target_error) from None
