@@ -24,11 +24,9 @@ from stochcable.examples import load_example
 from stochcable.fidelity import apply_fidelity, choose_fidelity
 from stochcable.fidelity.limits import (
     elements_limit,
-    field_bound,
     omega_count_limit,
-    segments_limit,
 )
-from stochcable.scene.model import Line, OmegaGrid, Segment
+from stochcable.scene.model import OmegaGrid, Segment
 
 
 def _chain(target: float | None = None) -> dict:
@@ -54,7 +52,6 @@ def test_limits_are_read_from_the_scene_model():
     assert omega_count_limit() == le[0]
     le = [m.le for m in Segment.model_fields["elements"].metadata if hasattr(m, "le")]
     assert elements_limit() == le[0]
-    assert segments_limit() == field_bound(Line, "segments", "max_length")
 
 
 def test_plan_at_0_3_percent_stays_within_the_limits_and_says_what_it_leaves(plan_03):

@@ -16,13 +16,12 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from stochcable.errors import InputError
-from stochcable.scene.model import Line, OmegaGrid, Scene, Segment, input_error_from_validation
+from stochcable.scene.model import OmegaGrid, Scene, Segment, input_error_from_validation
 
 __all__ = [
     "field_bound",
     "omega_count_limit",
     "elements_limit",
-    "segments_limit",
     "planned_scene_error",
     "clip",
 ]
@@ -48,11 +47,6 @@ def elements_limit() -> int:
     """Largest ``lines[*].segments[*].elements`` the scene model accepts."""
     le, lt = field_bound(Segment, "elements", "le"), field_bound(Segment, "elements", "lt")
     return int(min(le, lt - 1))
-
-
-def segments_limit() -> int:
-    """Most segments a line may have in the scene model."""
-    return int(field_bound(Line, "segments", "max_length"))
 
 
 def planned_scene_error(exc: ValidationError, target_error: float) -> InputError:
