@@ -16,6 +16,7 @@ the maxima of N years exceed once on average.
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -54,7 +55,9 @@ def _bandwidth(bandwidth: ArrayLike | None) -> np.ndarray | None:
     return eps
 
 
-def _q_maxima(x, mean, std, eps):  # noqa: ANN001, ANN202
+def _q_maxima(
+    x: np.ndarray, mean: np.ndarray, std: np.ndarray, eps: np.ndarray | None
+) -> np.ndarray:
     """P(a maximum > x) for arrays that broadcast; std = 0 gives 0 above the mean."""
     pos = std > 0.0
     u = (x - mean) / np.where(pos, std, 1.0)
@@ -197,17 +200,27 @@ def mpm_short_term(
 class _Diagram:
     """Validated scatter-diagram arrays: states on axis 0, response locations after."""
 
-    def __init__(self, probabilities, mean, std, tz, bandwidth, state_duration, formulation):  # noqa: ANN001
+    def __init__(
+        self,
+        probabilities: ArrayLike,
+        mean: ArrayLike,
+        std: ArrayLike,
+        tz: ArrayLike,
+        bandwidth: ArrayLike | None,
+        state_duration: float,
+        formulation: str,
+    ) -> None:
         p = v.float_array("probabilities", probabilities, "-", nonnegative=True)
         total = float(p.sum())
         if not total > 0.0:
             raise InputError("probabilities", probabilities, "-", "must not all be zero")
+        checked = (
+            _array("mean", mean, "unit"),
+            _array("std", std, "unit", nonnegative=True),
+            _array("tz", tz, "s", nonnegative=True),
+        )
         try:
-            mu, sd, t = np.broadcast_arrays(
-                _array("mean", mean, "unit"),
-                _array("std", std, "unit", nonnegative=True),
-                _array("tz", tz, "s", nonnegative=True),
-            )
+            mu, sd, t = np.broadcast_arrays(*checked)
         except ValueError:
             raise InputError(
                 "mean", np.shape(mean), "-", "mean, std and tz must broadcast together"
@@ -243,8 +256,7 @@ class _Diagram:
 
     def at(self, idx: tuple) -> _Diagram:
         """The diagram of one response location (trailing index idx)."""
-        sub = object.__new__(_Diagram)
-        sub.__dict__.update(self.__dict__)
+        sub = copy.copy(self)
         sel = (slice(None),) + idx
         sub.mean, sub.std, sub.rate = self.mean[sel], self.std[sel], self.rate[sel]
         sub.eps = None if self.eps is None else self.eps[sel]

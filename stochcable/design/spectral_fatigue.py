@@ -17,6 +17,7 @@ Each function is vectorized over the leading axes of ``density`` (shape
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -86,7 +87,7 @@ def _safe(x: np.ndarray, ok: np.ndarray) -> np.ndarray:
     return np.where(ok, x, 1.0)
 
 
-def _rayleigh_part(scale: np.ndarray, m: float, lo: float, hi: float, log10_a: float):
+def _rayleigh_part(scale: np.ndarray, m: float, lo: float, hi: float, log10_a: float) -> np.ndarray:
     """∫_lo^hi S^m p(S) dS / a for Rayleigh ranges p = S/σ² exp(−S²/2σ²), σ = scale > 0.
 
     = (2σ²)^{m/2} Γ(1 + m/2) [Q(1 + m/2, lo²/2σ²) − Q(1 + m/2, hi²/2σ²)] / a, Q the
@@ -100,7 +101,9 @@ def _rayleigh_part(scale: np.ndarray, m: float, lo: float, hi: float, log10_a: f
     return np.exp(log_pre) * (lower - upper)
 
 
-def _exponential_part(scale: np.ndarray, m: float, lo: float, hi: float, log10_a: float):
+def _exponential_part(
+    scale: np.ndarray, m: float, lo: float, hi: float, log10_a: float
+) -> np.ndarray:
     """∫_lo^hi S^m p(S) dS / a for exponential ranges p = exp(−S/θ)/θ, θ = scale > 0.
 
     = θ^m Γ(1 + m) [Q(1 + m, lo/θ) − Q(1 + m, hi/θ)] / a.
@@ -112,7 +115,11 @@ def _exponential_part(scale: np.ndarray, m: float, lo: float, hi: float, log10_a
     return np.exp(log_pre) * (lower - upper)
 
 
-def _mixture_damage(curve: FatigueCurve, parts, factor=None) -> np.ndarray:  # noqa: ANN001
+def _mixture_damage(
+    curve: FatigueCurve,
+    parts: list[tuple[str, np.ndarray, np.ndarray]],
+    factor: Callable[[float], np.ndarray] | None = None,
+) -> np.ndarray:
     """Σ_segments Σ_parts rate·weight·E[S^m; segment]/a (× factor(m) per segment)."""
     total = 0.0
     for seg in curve.segments():
@@ -180,7 +187,7 @@ def damage_rate_narrow_band(
     return p.finish(_mixture_damage(c, [("rayleigh", p.nu0, 2.0 * p.sigma)]))
 
 
-def _wirsching_light_factor(alpha2: np.ndarray):  # noqa: ANN202
+def _wirsching_light_factor(alpha2: np.ndarray) -> Callable[[float], np.ndarray]:
     eps = np.sqrt(np.clip(1.0 - alpha2 * alpha2, 0.0, 1.0))
 
     def factor(m: float) -> np.ndarray:
