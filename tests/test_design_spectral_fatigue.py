@@ -52,7 +52,8 @@ def test_moments_equal_sea_moments():
     for i in range(2):
         ref = spectral_moments(W, dens[i], orders=(0, 1, 2, 4))
         got = [mom[k][i] for k in ("m0", "m1", "m2", "m4")]
-        np.testing.assert_allclose(got, ref, rtol=1e-14)
+        # the same trapezoid rule summed in another order: round-off
+        np.testing.assert_allclose(got, ref, rtol=1e-13)
 
 
 @pytest.mark.parametrize("name", ["dnv-studless", "dnv-spiral-strand"])
