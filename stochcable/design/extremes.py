@@ -150,8 +150,9 @@ def maxima_exceedance_short_term(
     Notes
     -----
     The maxima are taken as a Poisson stream (independent, rare at high levels), so
-    P(X_max <= x) = exp(−N Q(x)) (e.g. Naess & Moan 2013, *Stochastic Dynamics of
-    Marine Structures*, §9.3).  At the most probable maximum of
+    P(X_max <= x) = exp(−N Q(x)) (the upcrossing/Poisson approximation, e.g. Naess &
+    Moan 2013, *Stochastic Dynamics of Marine Structures*, Cambridge University
+    Press).  At the most probable maximum of
     :func:`mpm_short_term` (narrow band) N Q = 1 and P = 1 − 1/e.
     """
     xx = _array("x", x, "unit")
@@ -323,10 +324,12 @@ def long_term_exceedance(
     Notes
     -----
     The all-maxima (individual maxima) long-term distribution of a linear response,
-    DNV-RP-C205 (2010/2014) §3.5.11 "long-term response" and Naess & Moan (2013),
-    *Stochastic Dynamics of Marine Structures*, §9.6: every maximum of every state is
-    a sample, so states weigh by p_i ν_i.  The storm-maximum form is the long-term
-    distribution of short-term extremes (Naess & Moan §9.7).
+    the "all short-term maxima" approach of DNV-RP-C205 (long-term response of a
+    linear system) and of Naess & Moan (2013), *Stochastic Dynamics of Marine
+    Structures*, chapter on long-term response: every maximum of every state is a
+    sample, so states weigh by p_i ν_i.  The storm-maximum form is the long-term
+    distribution of the short-term extremes, as in the same references.  (Section
+    numbers are not given: they could not be checked against the texts here.)
     """
     d = _Diagram(probabilities, mean, std, tz, bandwidth, state_duration, formulation)
     xx = _array("x", x, "unit")
