@@ -23,7 +23,7 @@ DNV_TABLE = {
     "dnv-six-strand": (3.4e14, 4.0),
     "dnv-spiral-strand": (1.7e17, 4.8),
 }
-# API RP 2SK 3rd ed. (2005) §7.4.2: N R^M = K
+# API RP 2SK 3rd ed. (2005), fatigue T-N curves: N R^M = K
 API_CHAIN = {"api-studlink": (1000.0, 3.0), "api-studless": (316.0, 3.0)}
 API_ROPE = {"api-six-strand": (3.20, 2.79, 4.09), "api-spiral-strand": (3.25, 3.43, 5.05)}
 

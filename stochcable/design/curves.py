@@ -31,7 +31,7 @@ __all__ = [
 _QUANTITIES = {"stress": "Pa", "tension_ratio": "-"}
 
 # DNV-OS-E301 (October 2010, Ch.2 Sec.2 Table D1 "S-N fatigue curve parameters"; the
-# same values in DNVGL-OS-E301, July 2015 and later, Ch.2 Sec.2 [4.3]):
+# same values in DNVGL-OS-E301, July 2015 and later,):
 # N = a_D·S^(−m), S the nominal stress range in MPa.
 _DNV = {
     "dnv-studlink": ("stud chain", 1.2e11, 3.0),
@@ -39,7 +39,7 @@ _DNV = {
     "dnv-six-strand": ("stranded (six-strand) rope", 3.4e14, 4.0),
     "dnv-spiral-strand": ("spiral rope", 1.7e17, 4.8),
 }
-# API RP 2SK 3rd ed. (October 2005) §7.4.2, T-N curves N·R^M = K, R = tension range/MBS.
+# API RP 2SK 3rd ed. (October 2005) fatigue section, T-N curves N·R^M = K, R = tension range/MBS.
 # Chain: K independent of the mean load.  Wire ropes: log10 K = a − b·Lm, Lm the ratio
 # of the mean load to the MBS.
 _API_CHAIN = {
@@ -52,11 +52,11 @@ _API_ROPE = {
 }
 _DNV_SOURCE = (
     "DNV-OS-E301 Position Mooring (Oct. 2010) Ch.2 Sec.2 D, Table D1 "
-    "(= DNVGL-OS-E301 (2015) Ch.2 Sec.2 [4.3]): {what}, a_D = {a:.3g} MPa^m, m = {m:g}; "
+    "(= DNVGL-OS-E301 (2015)): {what}, a_D = {a:.3g} MPa^m, m = {m:g}; "
     "stress range on the nominal area, converted to Pa"
 )
 _API_SOURCE = (
-    "API RP 2SK 3rd ed. (2005) §7.4.2, T-N curve N·R^M = K: {what}, {k}, M = {m:g}; "
+    "API RP 2SK 3rd ed. (2005), fatigue T-N curve N·R^M = K: {what}, {k}, M = {m:g}; "
     "R = tension range / MBS"
 )
 
@@ -307,16 +307,18 @@ def fatigue_curve(name: str, *, mean_load_ratio: float | None = None) -> Fatigue
 
     Notes
     -----
-    DNV-OS-E301 (2010) Ch.2 Sec.2 Table D1 / DNVGL-OS-E301 (2015) Ch.2 Sec.2 [4.3],
+    DNV-OS-E301 (2010) Ch.2 Sec.2 Table D1 / DNVGL-OS-E301 (2015),
     N = a_D S^(−m), S in MPa: stud chain a_D = 1.2·10¹¹, m = 3.0; studless chain
     6.0·10¹⁰, 3.0; stranded rope 3.4·10¹⁴, 4.0; spiral rope 1.7·10¹⁷, 4.8.  Stored in
-    Pa: log10 a = log10 a_D + 6 m.  The chain values were confirmed against two
+    Pa: log10 a = log10 a_D + 6 m.  The table and section numbers in the ``source``
+    strings are as recalled and were not checked against the standards' texts.  The
+    chain values were confirmed against two
     independent secondary sources (a DNV-GL ``qats`` example and a mooring-fatigue
     calculator page quoting OS-E301); the rope values are from the standard as recalled
     and could not be confirmed from a second source here — check them against your
     edition before design use.
 
-    API RP 2SK 3rd ed. (2005) §7.4.2, N R^M = K, R = tension range / MBS: common
+    API RP 2SK 3rd ed. (2005), fatigue section, N R^M = K, R = tension range / MBS: common
     studlink chain M = 3.0, K = 1000; common studless chain M = 3.0, K = 316;
     six/multi-strand rope M = 4.09, log10 K = 3.20 − 2.79 Lm; spiral strand rope
     M = 5.05, log10 K = 3.25 − 3.43 Lm.  Not confirmed from a second source here
