@@ -31,7 +31,7 @@ __all__ = [
 _QUANTITIES = {"stress": "Pa", "tension_ratio": "-"}
 
 # DNV-OS-E301 (October 2010, Ch.2 Sec.2 Table D1 "S-N fatigue curve parameters"; the
-# same values in DNVGL-OS-E301, July 2015 and later,):
+# same values in DNVGL-OS-E301, July 2015 and later):
 # N = a_D·S^(−m), S the nominal stress range in MPa.
 _DNV = {
     "dnv-studlink": ("stud chain", 1.2e11, 3.0),
