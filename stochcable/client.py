@@ -18,7 +18,8 @@ are defined in :mod:`stochcable.results.views` and re-exported here)::
     >>> with Client() as c:                                    # doctest: +SKIP
     ...     res = c.analyze(c.example("chain_catenary"))
     ...     res.lines["leg1"].end_b.std, res.lines["leg1"].tension_std.max()
-  An HTTP failure raises
+
+An HTTP failure raises
 :class:`ClientError` (4xx: the request was refused; the message names the field,
 value, unit and constraint) or :class:`ServiceError` (5xx, or the service cannot be
 reached), both :class:`~stochcable.errors.StochcableError`.

@@ -1,0 +1,310 @@
+"""The warnings page of the manual: every warning stochcable raises, with its threshold,
+what it means and what to do.
+
+:data:`WARNINGS` describes each warning and names the functions that raise it
+(``module:function``) and the constants that set its threshold (``module:NAME``, read
+at build time, so the page shows the values in force).  :func:`warning_sites` finds
+every ``warn(...)`` / ``warnings.warn(...)`` call in the source; the build and
+``tests/test_docs.py`` fail when a call site is described by no entry.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from scene_reference import escape_bars
+
+__all__ = ["WarningEntry", "WARNINGS", "warning_sites", "undocumented_sites", "warnings_reference_rst"]
+
+
+@dataclass(frozen=True)
+class WarningEntry:
+    """One warning: where it is raised, its threshold, its meaning and the remedy."""
+
+    title: str
+    category: str
+    sites: tuple[str, ...]
+    threshold: str
+    meaning: str
+    action: str
+    constants: tuple[str, ...] = ()
+
+
+WARNINGS: tuple[WarningEntry, ...] = (
+    WarningEntry(
+        "Response spectrum cut by the top of the grid",
+        "ResolutionWarning",
+        ("stochcable.dynamics.indicators:tail_check",),
+        "S(ω_max)·ω_max > TAIL_FRACTION · m0 of an end-tension spectrum",
+        "The end-tension spectrum is still large at ``analysis.omega.max``: the variance "
+        "beyond the grid is lost, so σ and every maximum are underestimated. Typical "
+        "cause: an end-motion spectrum with an ω⁻⁵ tail, whose inertia loads give a "
+        "tension spectrum that decays only like ω⁻¹.",
+        "Raise ``analysis.omega.max`` until the warning goes; give a fairlead motion as a "
+        "vessel RAO over the sea (``motion.rao``) or as a band-limited spectrum instead "
+        "of an unbounded one.",
+        ("stochcable.dynamics.indicators:TAIL_FRACTION",),
+    ),
+    WarningEntry(
+        "Natural frequency not resolved by the grid",
+        "ResolutionWarning",
+        ("stochcable.dynamics.indicators:resolution_check",),
+        "a mode inside the grid whose nearest grid point is farther than the local "
+        "spacing, or whose half-power bandwidth 2ζω is narrower than the spacing",
+        "A resonance peak may fall between frequencies: the response near it, and σ, "
+        "can be badly wrong.",
+        "Use the ``analysis.omega.count`` the message gives (or refine the grid around "
+        "the mode); a mode without damping is resolved by no grid: add drag, seabed or "
+        "structural damping.",
+    ),
+    WarningEntry(
+        "Elements too long for the wave kinematics near the surface",
+        "ResolutionWarning",
+        ("stochcable.dynamics.indicators:surface_resolution_check",),
+        "σ of the wave velocity varies by more than SURFACE_SIGMA_RATIO along an "
+        "element whose larger end σ is at least SURFACE_MATTERS_FRACTION of the line's "
+        "largest",
+        "The drag linearization takes one drag coefficient per element (seed 001 eq. "
+        "5.2.2) while the wave kinematics decay like e^{kz}; on such an element the "
+        "response carries an error of several per cent.",
+        "Use the number of elements the message gives on that segment (the fix aims at a "
+        "ratio SURFACE_TARGET_RATIO), or let ``analysis.fidelity`` choose the mesh.",
+        (
+            "stochcable.dynamics.indicators:SURFACE_SIGMA_RATIO",
+            "stochcable.dynamics.indicators:SURFACE_MATTERS_FRACTION",
+            "stochcable.dynamics.indicators:SURFACE_TARGET_RATIO",
+        ),
+    ),
+    WarningEntry(
+        "Snap loads likely (indicator ``snap``)",
+        "PhysicsWarning",
+        ("stochcable.dynamics.indicators:_snap",),
+        "mean − SNAP_SIGMAS·σ of the tension below zero at an element or end",
+        "The linear model predicts that the line goes slack: snap loads, which a "
+        "frequency-domain model cannot represent, are likely. The result's "
+        "``indicators.snap`` holds the margin.",
+        "Run the nonlinear time-domain reference (:mod:`stochcable.reference.cable`) or "
+        "increase the pretension.",
+        ("stochcable.dynamics.indicators:SNAP_SIGMAS",),
+    ),
+    WarningEntry(
+        "Lightly damped resonance in the excitation band (indicator ``resonance``)",
+        "PhysicsWarning",
+        ("stochcable.dynamics.indicators:_resonances",),
+        "a mode where some input spectrum exceeds BAND_FRACTION of its peak, with modal "
+        "damping ratio below RESONANCE_DAMPING_RATIO",
+        "The response at that mode is set by damping the model may not represent "
+        "(listed in ``indicators.resonances``).",
+        "Check the drag coefficients; add structural damping "
+        "(``analysis.structural_damping``) or seabed damping where physical.",
+        (
+            "stochcable.dynamics.indicators:BAND_FRACTION",
+            "stochcable.dynamics.indicators:RESONANCE_DAMPING_RATIO",
+        ),
+    ),
+    WarningEntry(
+        "Motion large against the sag (indicator ``large_motion``)",
+        "PhysicsWarning",
+        ("stochcable.dynamics.indicators:_large_motion",),
+        "a node motion σ above MOTION_SAG_FRACTION of the line's sag",
+        "The model is linear about the static shape; the geometric stiffness of a "
+        "sagging line depends on its sag at first order, so such motions change it by "
+        "more than a linear model tolerates.",
+        "Check with the nonlinear time-domain reference (:mod:`stochcable.reference.cable`).",
+        ("stochcable.dynamics.indicators:MOTION_SAG_FRACTION",),
+    ),
+    WarningEntry(
+        "Drag linearization did not converge",
+        "PhysicsWarning",
+        ("stochcable.dynamics.coupled.fixedpoint:linearize_coupled",),
+        "relative change of the drag σ above ``analysis.linearization.tolerance`` after "
+        "``max_iterations``",
+        "The result is flagged unconverged (``linearization.converged`` false); its "
+        "numbers are those of the last iteration.",
+        "Increase ``analysis.linearization.max_iterations``, or lower "
+        "``relaxation`` for an oscillating iteration.",
+    ),
+    WarningEntry(
+        "Line without excitation",
+        "PhysicsWarning",
+        ("stochcable.dynamics.coupled.analysis:_solve_line",),
+        "no sea and no end motion on a line not attached to a free body",
+        "The line's dynamic response is zero.",
+        "Add a ``sea`` or an end ``motion``.",
+    ),
+    WarningEntry(
+        "Body without lines or sea",
+        "PhysicsWarning",
+        ("stochcable.dynamics.coupled.analysis:_solve_lonely",),
+        "a free body with no line and no sea",
+        "Its motion is zero.",
+        "Add a ``sea`` or attach lines.",
+    ),
+    WarningEntry(
+        "Large static rotation of a body",
+        "PhysicsWarning",
+        ("stochcable.dynamics.coupled.model:_static_rotation_check",),
+        "static rotation above STATIC_ROTATION_LIMIT",
+        "The dynamics use the body's mass, inertia, hydrodynamic coefficients, "
+        "hydrostatics, excitation and drag point at the input orientation (only the line "
+        "attachment arms follow the rotation): they are off by about the sine of the "
+        "angle.",
+        "Give the body's data at its static orientation (rotate them and the attachment "
+        "points) and re-run.",
+        ("stochcable.dynamics.coupled.model:STATIC_ROTATION_LIMIT",),
+    ),
+    WarningEntry(
+        "Foss decomposition failed: direct modal solve instead",
+        "DefectivePencilWarning (a PhysicsWarning)",
+        ("stochcable.dynamics.solve:_foss_free", "stochcable.dynamics.modal_solvers:solve_modal"),
+        "the state-space pencil is defective (repeated eigenvalues without a full set "
+        "of eigenvectors)",
+        "The Foss decoupling does not exist for these matrices; the answer is computed "
+        "by the direct solve in modal coordinates and is still right, only slower.",
+        "Nothing, or ``analysis.solver = \"direct\"`` to skip the attempt.",
+    ),
+    WarningEntry(
+        "Adaptive fidelity could not meet its target",
+        "PhysicsWarning",
+        ("stochcable.analysis:_with_plan",),
+        "the response tail above the pilot's band is unbounded, or the plan reached a "
+        "limit of the scene model before ``analysis.fidelity.target_error``",
+        "The settings chosen are the best within the limits; the message gives the "
+        "estimated σ error and whether the target is met.",
+        "Band-limit an end-motion spectrum (or give it as a vessel RAO), use a larger "
+        "``target_error``, or add damping to lightly damped modes.",
+    ),
+    WarningEntry(
+        "Sea spectrum above the Nyquist frequency",
+        "ResolutionWarning",
+        ("stochcable.sea.realization:_nyquist_check",),
+        "more than NYQUIST_LOSS_TOLERANCE of m0 above π/Δt",
+        "A time-series realization with step Δt does not simulate that part of the "
+        "spectrum: its variance is too small.",
+        "Use the time step the message gives, or a spectrum with a decaying tail.",
+        ("stochcable.sea.realization:NYQUIST_LOSS_TOLERANCE",),
+    ),
+    WarningEntry(
+        "Time step of the nonlinear reference too coarse",
+        "ResolutionWarning",
+        ("stochcable.reference.cable:_time_step",),
+        "Newmark period error (ωΔt)²/12 above PERIOD_ERROR_TOLERANCE at the highest "
+        "excitation frequency",
+        "The time-domain reference misrepresents the highest frequencies it is driven at.",
+        "Use the ``dt`` the message gives.",
+        ("stochcable.reference.cable:PERIOD_ERROR_TOLERANCE",),
+    ),
+    WarningEntry(
+        "Nonlinear reference not stationary",
+        "ResolutionWarning",
+        ("stochcable.reference.cable:_check_stationary",),
+        "the end-tension σ over windows after the ramp varies by more than "
+        "NONSTATIONARY_RATIO",
+        "An under-resolved oscillation pumped by the time stepping (typically at "
+        "slack–taut snaps), not the response.",
+        "Re-run with the ``dt`` the message gives, or a quarter of the present step.",
+        ("stochcable.reference.cable:NONSTATIONARY_RATIO",),
+    ),
+    WarningEntry(
+        "Line modes of a scene with bodies (``stochcable modes``)",
+        "PhysicsWarning",
+        ("stochcable.cli.modes:run",),
+        "the scene has bodies",
+        "``stochcable modes`` lists each line's modes with its ends held at their static "
+        "positions, not the coupled modes of lines and bodies.",
+        "Read the coupled modes from ``stochcable analyze`` under ``bodies.<name>.modes``.",
+    ),
+    WarningEntry(
+        "Compiled sea kernel unavailable or not cached",
+        "UserWarning",
+        ("stochcable.sea.kernels:_compile", "stochcable.sea.realization:_compiled_kernel"),
+        "numba cannot compile or cache the sea coefficient kernel",
+        "Results are the same; the NumPy kernel is slower, or the kernel is compiled "
+        "again in each process (about 1 s at its first use).",
+        "Set ``NUMBA_CACHE_DIR`` to a writable directory, or ``STOCHCABLE_NUMBA=0`` to "
+        "skip numba.",
+    ),
+)
+
+
+def _module_name(root: Path, path: Path) -> str:
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _is_warn(call: ast.Call) -> bool:
+    f = call.func
+    if isinstance(f, ast.Name):
+        return f.id == "warn"
+    return (
+        isinstance(f, ast.Attribute)
+        and f.attr == "warn"
+        and isinstance(f.value, ast.Name)
+        and f.value.id == "warnings"
+    )
+
+
+def warning_sites(root: Path, packages: Iterable[str] = ("stochcable", "service")) -> set[str]:
+    """``module:function`` of every ``warn(...)`` / ``warnings.warn(...)`` call in the
+    packages under ``root`` (the helper ``stochcable.errors:warn`` itself excluded)."""
+    sites: set[str] = set()
+
+    def visit(node: ast.AST, module: str, function: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            name = function
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                name = child.name
+            if isinstance(child, ast.Call) and _is_warn(child):
+                sites.add(f"{module}:{function}")
+            visit(child, module, name)
+
+    for package in packages:
+        for path in sorted((root / package).rglob("*.py")):
+            module = _module_name(root, path)
+            visit(ast.parse(path.read_text(encoding="utf-8")), module, "<module>")
+    sites.discard("stochcable.errors:warn")
+    return sites
+
+
+def undocumented_sites(sites: Iterable[str]) -> list[str]:
+    """The call sites no entry of :data:`WARNINGS` names."""
+    known = {s for w in WARNINGS for s in w.sites}
+    return sorted(set(sites) - known)
+
+
+def _value(ref: str) -> str:
+    module, name = ref.split(":")
+    value = getattr(importlib.import_module(module), name)
+    if name == "STATIC_ROTATION_LIMIT":
+        return f"{math.degrees(value):g}°"
+    return f"{value:g}"
+
+
+def warnings_reference_rst() -> str:
+    """The reStructuredText of the warnings: one section per entry."""
+    out: list[str] = []
+    for w in WARNINGS:
+        threshold = w.threshold
+        values = []
+        for ref in w.constants:
+            name = ref.split(":")[1]
+            values.append(f"``{name}`` = {_value(ref)}")
+        out += [w.title, "-" * len(w.title), ""]
+        out += [
+            f":Category: ``{w.category}``",
+            f":Threshold: {threshold}" + (f" ({'; '.join(values)})" if values else ""),
+            ":Raised by: " + ", ".join(f"``{s.replace(':', '.')}``" for s in w.sites),
+            "",
+            f"**What it means.** {escape_bars(w.meaning)}",
+            "",
+            f"**What to do.** {escape_bars(w.action)}",
+            "",
+        ]
+    return "\n".join(out)
