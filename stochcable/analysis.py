@@ -125,7 +125,7 @@ def _plan_fidelity(scene: Scene, progress: Progress) -> tuple[Scene, Any]:
     )
     # exact_wave_integration stays False: its element rule alone can leave a short
     # line with a single element (no free node); the surface rule is conservative
-    # with the exact loads (see the closing note of issue 7)
+    # with the exact element integration of the wave loads
     plan = choose_fidelity(base, target, evaluate=analyze)
     return apply_fidelity(base, plan), plan
 

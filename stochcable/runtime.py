@@ -35,7 +35,7 @@ thread count changes summation orders at ≈ 1e-13 relative), possibly slower.
 
 Thread pool for per-line work
 -----------------------------
-Per-line work of a coupled group on a small thread pool (issue 6, bodies speed).
+Per-line work of a coupled group on a small thread pool (the speed of scenes with bodies).
 
 The lines of a coupled group are independent inside one drag-linearization
 evaluation until the body solve.  :func:`line_map` can run such per-line work on a

@@ -1,4 +1,4 @@
-"""Scene bodies to :class:`stochcable.bodies.rigid.RigidBody` (issue 6, docs/BODIES.md).
+"""Scene bodies to :class:`stochcable.bodies.rigid.RigidBody` (docs/BODIES.md).
 
 The scene document's :class:`stochcable.scene.model.Body` carries the data as given; the
 numerical code works on :class:`~stochcable.bodies.rigid.RigidBody` (seed 001 eq. 3.2.c.20

@@ -1,4 +1,4 @@
-"""Static equilibrium of bodies and their lines (issue 6; docs/BODIES.md §Statics).
+"""Static equilibrium of bodies and their lines (docs/BODIES.md, "Statics").
 
 The unknowns are the poses q = (X, θ) of the free bodies (6 DOF; planar scenes 3:
 surge, heave, pitch), X the reference point [m] and θ a rotation vector [rad].  The

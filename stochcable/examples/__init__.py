@@ -25,11 +25,11 @@ Each ``<name>.json`` is a scene document (DESIGN.md "Scene and result documents"
   0.25 s, drag linearization tolerance 0.01 (all as the seed).  The cable and depth are
   in the seed's Figure 6.5-1 only, not in its text: assumed the §6.2 cable, 100 ft
   depth, anchor 300 ft from the buoy, and L = 339 ft so that the horizontal tension
-  balances the seed's 100 lb wind load.  The disc buoy is not modelled (issue 6): it is
+  balances the seed's 100 lb wind load.  The disc buoy is not a body here: it is
   end_b, at its assumed 2.5 ft draft, heaving with the sea surface (heave RAO 1, which
   the seed reports for the disc).
 - ``tuah_1982_disc_buoy_single_leg``: seed 001 §6.5 Example 5 with the disc buoy as a
-  body (issue 6), planar (surge, heave, pitch), ft-slug-lbf, sea and frequencies as
+  body, planar (surge, heave, pitch), ft-slug-lbf, sea and frequencies as
   ``tuah_1982_single_leg``, the seed's static wind load of 100 lb along +x.  The
   figures' numbers are not in the seed text; assumed: depth 100 ft, the §6.2 cable
   (EA 177 016 lbf, 0.07303 slug/ft, D 0.1666 ft), L 339 ft, 3 elements, anchor at

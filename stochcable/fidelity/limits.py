@@ -1,4 +1,4 @@
-"""The limits of the scene model that a fidelity plan must respect (issue 16, item 2).
+"""The limits of the scene model that a fidelity plan must respect.
 
 The planner never builds a scene the model would reject: the bounds are read from the
 pydantic models' own constraints (``OmegaGrid.count``, ``Segment.elements``,

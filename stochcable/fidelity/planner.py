@@ -1,4 +1,4 @@
-"""Adaptive fidelity: model only what a scene needs (issue 7, item 2).
+"""Adaptive fidelity: model only what a scene needs.
 
 :func:`choose_fidelity` picks the frequency grid, the elements per segment, the kept
 modes and the linearization tolerance of a scene for a target relative error of the

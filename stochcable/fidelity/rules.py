@@ -1,4 +1,4 @@
-"""The error → resolution rules of the adaptive fidelity planner (issue 7, item 2).
+"""The error → resolution rules of the adaptive fidelity planner.
 
 Closed forms that turn a share of the target error into a resolution — the band of a
 spectrum (:func:`spectrum_tail_frequency`), elements per wavelength

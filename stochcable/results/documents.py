@@ -190,7 +190,7 @@ class LineResult:
 
 @dataclass(frozen=True, eq=False)
 class BodyResult:
-    """Frequency-domain motion of one rigid body (GitHub issue 6).
+    """Frequency-domain motion of one rigid body (docs/BODIES.md).
 
     Attributes
     ----------

@@ -208,7 +208,7 @@ def _finite_or_none(x: float) -> float | None:
 
 @dataclass(frozen=True, eq=False)
 class LineIndicators:
-    """Quality indicators of the linear model of one line (GitHub issue 7).
+    """Quality indicators of the linear model of one line.
 
     Attributes
     ----------
