@@ -1,10 +1,11 @@
 """Sphinx directives of the manual's generated pages.
 
-``.. scene-reference::``, ``.. results-reference::``, ``.. warnings-reference::`` and
-``.. openapi-reference::``, ``.. service-settings::`` insert the reStructuredText the generators of this folder
-build from the code (the scene models, result documents of the bundled examples, the
-warning call sites, the committed OpenAPI document).  A generator that finds something
-undocumented logs a Sphinx warning, which ``sphinx-build -W`` turns into an error.
+``.. scene-reference::``, ``.. results-reference::``, ``.. warnings-reference::``,
+``.. openapi-reference::`` and ``.. service-settings::`` insert the reStructuredText
+the generators of this folder build from the code (the scene models, result documents
+of the bundled examples, the warning call sites, the committed OpenAPI document).  A
+generator that finds something undocumented logs a Sphinx warning, which
+``sphinx-build -W`` turns into an error.
 """
 
 from __future__ import annotations
@@ -12,18 +13,17 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from docutils import nodes
-from docutils.statemachine import StringList
-from sphinx.directives.other import TocTree
-from sphinx.util import logging
-from sphinx.util.matching import patfilter
-from sphinx.util.docutils import SphinxDirective
-from sphinx.util.nodes import nested_parse_with_titles
-
 import openapi_reference
 import results_reference
 import scene_reference
 import warnings_reference
+from docutils import nodes
+from docutils.statemachine import StringList
+from sphinx.directives.other import TocTree
+from sphinx.util import logging
+from sphinx.util.docutils import SphinxDirective
+from sphinx.util.matching import patfilter
+from sphinx.util.nodes import nested_parse_with_titles
 
 ROOT = Path(__file__).resolve().parents[2]
 logger = logging.getLogger(__name__)

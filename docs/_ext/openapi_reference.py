@@ -94,7 +94,8 @@ def _operation(path: str, method: str, op: Mapping[str, Any], anchor) -> list[st
     if body:
         for media, content in body.get("content", {}).items():
             out += [
-                f"**Request body** (``{media}``): {_schema_text(content.get('schema', {}), anchor)}",
+                f"**Request body** (``{media}``): "
+                + _schema_text(content.get("schema", {}), anchor),
                 "",
             ]
             for name, example in content.get("examples", {}).items():

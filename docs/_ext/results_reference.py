@@ -38,102 +38,236 @@ STATS: dict[str, tuple[str, str]] = {
     "mean": ("{U}", "Static (mean) value."),
     "std": ("{U}", "Standard deviation σ = √m0 of the dynamic part."),
     "tz": ("s", "Mean zero-upcrossing period 2π√(m0/m2) (0 for a zero process)."),
-    "mpm_3h": ("{U}", "mean + most probable maximum of the dynamic part in 3 hours, σ√(2 ln(10800/Tz))."),
+    "mpm_3h": (
+        "{U}",
+        "mean + most probable maximum of the dynamic part in 3 hours, σ√(2 ln(10800/Tz)).",
+    ),
     "significant": ("{U}", "Significant value 2σ."),
     "m0": ("{U}²", "Spectral moment ∫S dω (trapezoid on the analysis grid)."),
     "m1": ("{U}²·rad/s", "Spectral moment ∫ωS dω."),
     "m2": ("{U}²·(rad/s)²", "Spectral moment ∫ω²S dω."),
     "m4": ("{U}²·(rad/s)⁴", "Spectral moment ∫ω⁴S dω."),
     "bandwidth": ("-", "Spectral bandwidth √(1 − m2²/(m0·m4))."),
-    "mpm": ("{U}", "mean + most probable maximum over the scene's ``analysis.timeseries.duration``."),
+    "mpm": (
+        "{U}",
+        "mean + most probable maximum over the scene's ``analysis.timeseries.duration``.",
+    ),
     "expected_max": ("{U}", "mean + expected maximum over the same duration."),
 }
 
 _STATIC_LINE = {
     "statics": ("", "Static equilibrium of every line (and body)."),
-    "statics.lines.<line>.<end>.tension": ("{F}", "Static end tension: magnitude of the force on the support."),
-    "statics.lines.<line>.<end>.force": ("{F}", "Force (x, y, z) the line exerts on the support, global frame."),
-    "statics.lines.<line>.touchdown": ("{L}", "Unstretched arc length from end_a where the line leaves the seabed; null without seabed contact."),
+    "statics.lines.<line>.<end>.tension": (
+        "{F}",
+        "Static end tension: magnitude of the force on the support.",
+    ),
+    "statics.lines.<line>.<end>.force": (
+        "{F}",
+        "Force (x, y, z) the line exerts on the support, global frame.",
+    ),
+    "statics.lines.<line>.touchdown": (
+        "{L}",
+        "Unstretched arc length from end_a where the line leaves the seabed; null without seabed "
+        "contact.",
+    ),
     "statics.lines.<line>.nodes": ("{L}", "Static node positions (x, y, z), shape (n_nodes, 3)."),
     "statics.lines.<line>.s": ("{L}", "Unstretched arc length of the nodes from end_a."),
     "statics.lines.<line>.tension": ("{F}", "Static effective tension per element."),
-    "statics.lines.<line>.iterations": ("-", "Newton or relaxation iterations (0 for the closed-form catenary)."),
-    "statics.lines.<line>.residual": ("-", "Final largest nodal residual force over the reference force."),
-    "statics.lines.<line>.method": ("", "``\"fe\"`` (finite elements) or ``\"catenary\"`` (closed form)."),
+    "statics.lines.<line>.iterations": (
+        "-",
+        "Newton or relaxation iterations (0 for the closed-form catenary).",
+    ),
+    "statics.lines.<line>.residual": (
+        "-",
+        "Final largest nodal residual force over the reference force.",
+    ),
+    "statics.lines.<line>.method": (
+        "",
+        '``"fe"`` (finite elements) or ``"catenary"`` (closed form).',
+    ),
     "statics.bodies.<body>.position": ("{L}", "Reference point of the body at equilibrium."),
-    "statics.bodies.<body>.rotation": ("rad", "Rotation vector from the input orientation (planar: only θ_y)."),
-    "statics.bodies.<body>.line_forces.<line>": ("{F}", "Force each attached line exerts on the body (``\"<line>.<end>\"`` when both ends are on it)."),
-    "statics.bodies.<body>.iterations": ("-", "Newton iterations of the body equilibrium (0 for a prescribed body)."),
-    "statics.bodies.<body>.residual": ("-", "Final largest generalized force over the reference force."),
-    "statics.bodies.<body>.dofs": ("", "DOF names of ``stiffness``: the six, or surge, heave, pitch when planar."),
-    "statics.bodies.<body>.stiffness": ("{F}/{L}, {F}, {F}·{L}/rad", "Quasi-static stiffness −dQ/dq at equilibrium over ``dofs``, shape (d, d)."),
+    "statics.bodies.<body>.rotation": (
+        "rad",
+        "Rotation vector from the input orientation (planar: only θ_y).",
+    ),
+    "statics.bodies.<body>.line_forces.<line>": (
+        "{F}",
+        'Force each attached line exerts on the body (``"<line>.<end>"`` when both ends are on '
+        "it).",
+    ),
+    "statics.bodies.<body>.iterations": (
+        "-",
+        "Newton iterations of the body equilibrium (0 for a prescribed body).",
+    ),
+    "statics.bodies.<body>.residual": (
+        "-",
+        "Final largest generalized force over the reference force.",
+    ),
+    "statics.bodies.<body>.dofs": (
+        "",
+        "DOF names of ``stiffness``: the six, or surge, heave, pitch when planar.",
+    ),
+    "statics.bodies.<body>.stiffness": (
+        "{F}/{L}, {F}, {F}·{L}/rad",
+        "Quasi-static stiffness −dQ/dq at equilibrium over ``dofs``, shape (d, d).",
+    ),
     "statics.bodies.<body>.prescribed": ("", "True for a vessel (pose imposed, not solved)."),
 }
 
 _MODES_LIN = {
     "modes.omega": ("rad/s", "Natural frequencies of the first line (with added mass)."),
-    "modes.lines.<line>": ("rad/s", "Natural frequencies of each line about its static shape, those up to 2.5·ω_max and at least 10."),
+    "modes.lines.<line>": (
+        "rad/s",
+        "Natural frequencies of each line about its static shape, those up to 2.5·ω_max and at "
+        "least 10.",
+    ),
     "linearization.converged": ("", "Whether the drag linearization converged on every line."),
     "linearization.iterations": ("-", "Largest number of iterations over the lines."),
-    "linearization.relative_change": ("-", "Largest relative change of the drag coefficients at the last iteration."),
-    "linearization.lines.<line>.method": ("", "Iteration used (``\"seed\"``: the fixed point of seed 001 §5.2, or an accelerated variant)."),
-    "linearization.lines.<line>.converged": ("", "Whether the line's drag linearization converged."),
+    "linearization.relative_change": (
+        "-",
+        "Largest relative change of the drag coefficients at the last iteration.",
+    ),
+    "linearization.lines.<line>.method": (
+        "",
+        'Iteration used (``"seed"``: the fixed point of seed 001 §5.2, or an accelerated variant).',
+    ),
+    "linearization.lines.<line>.converged": (
+        "",
+        "Whether the line's drag linearization converged.",
+    ),
     "linearization.lines.<line>.iterations": ("-", "Iterations used."),
-    "linearization.lines.<line>.relative_change": ("-", "Relative change of the drag coefficients at the last iteration."),
-    "linearization.lines.<line>.tolerance": ("-", "Tolerance asked (``analysis.linearization.tolerance``)."),
+    "linearization.lines.<line>.relative_change": (
+        "-",
+        "Relative change of the drag coefficients at the last iteration.",
+    ),
+    "linearization.lines.<line>.tolerance": (
+        "-",
+        "Tolerance asked (``analysis.linearization.tolerance``).",
+    ),
     "linearization.lines.<line>.history": ("-", "Relative change at each iteration."),
 }
 
 _LINES = {
-    "lines.<line>.<end>.tension": ("", "Statistics of the end tension (table of statistics below; U = force)."),
+    "lines.<line>.<end>.tension": (
+        "",
+        "Statistics of the end tension (table of statistics below; U = force).",
+    ),
     "lines.<line>.<end>.force_std": ("{F}", "σ of the x, y, z force on the support."),
-    "lines.<line>.tension.s": ("{L}", "Unstretched arc length of the element midpoints from end_a."),
+    "lines.<line>.tension.s": (
+        "{L}",
+        "Unstretched arc length of the element midpoints from end_a.",
+    ),
     "lines.<line>.tension.std": ("{F}", "σ of the dynamic effective tension per element."),
     "lines.<line>.tension.mean": ("{F}", "Static effective tension per element."),
     "lines.<line>.motion.s": ("{L}", "Unstretched arc length of the nodes from end_a."),
     "lines.<line>.motion.std": ("{L}", "σ of the x, y, z node displacements, shape (n_nodes, 3)."),
     "lines.<line>.spectra.omega": ("rad/s", "Analysis frequencies."),
     "lines.<line>.spectra.<end>.tension": ("{F}²·s/rad", "One-sided spectrum of the end tension."),
-    "lines.<line>.channels": ("", "Independent input channels: ``\"sea\"``, ``\"end_b.surge\"``, ``\"<line>.<end>.<dof>\"``…"),
-    "lines.<line>.linearization": ("", "The line's drag-linearization record (as ``linearization.lines.<line>``)."),
+    "lines.<line>.channels": (
+        "",
+        'Independent input channels: ``"sea"``, ``"end_b.surge"``, ``"<line>.<end>.<dof>"``…',
+    ),
+    "lines.<line>.linearization": (
+        "",
+        "The line's drag-linearization record (as ``linearization.lines.<line>``).",
+    ),
     "lines.<line>.modes.omega": ("rad/s", "Natural frequencies listed for the line."),
     "lines.<line>.modes.kept": ("-", "Modes kept by the Foss solve; null for the direct solve."),
-    "lines.<line>.indicators": ("", "Quality indicators of the linear model (null when not computed); see :doc:`warnings`."),
-    "lines.<line>.indicators.borgman_ratio.min": ("-", "Smallest Borgman variance ratio Var(B v)/Var(½ρC_dD|v|v) over the elements (0.849 without current)."),
-    "lines.<line>.indicators.borgman_ratio.max": ("-", "Largest Borgman variance ratio over the elements."),
+    "lines.<line>.indicators": (
+        "",
+        "Quality indicators of the linear model (null when not computed); see :doc:`warnings`.",
+    ),
+    "lines.<line>.indicators.borgman_ratio.min": (
+        "-",
+        "Smallest Borgman variance ratio Var(B v)/Var(½ρC_dD|v|v) over the elements (0.849 "
+        "without current).",
+    ),
+    "lines.<line>.indicators.borgman_ratio.max": (
+        "-",
+        "Largest Borgman variance ratio over the elements.",
+    ),
     "lines.<line>.indicators.borgman_ratio.elements": ("-", "Borgman variance ratio per element."),
-    "lines.<line>.indicators.drag_inertia_ratio.min": ("-", "Smallest ratio of σ of the linearized drag to σ of the Morison inertia force."),
-    "lines.<line>.indicators.drag_inertia_ratio.max": ("-", "Largest such ratio (null when infinite: no fluid acceleration)."),
+    "lines.<line>.indicators.drag_inertia_ratio.min": (
+        "-",
+        "Smallest ratio of σ of the linearized drag to σ of the Morison inertia force.",
+    ),
+    "lines.<line>.indicators.drag_inertia_ratio.max": (
+        "-",
+        "Largest such ratio (null when infinite: no fluid acceleration).",
+    ),
     "lines.<line>.indicators.drag_inertia_ratio.elements": ("-", "Drag/inertia ratio per element."),
-    "lines.<line>.indicators.snap.risk": ("", "True when mean − 3σ of the tension is below zero somewhere."),
-    "lines.<line>.indicators.snap.margin": ("-", "Smallest (T_mean − 3σ_T)/|T_mean| over elements and ends."),
-    "lines.<line>.indicators.resonances": ("", "Modes in the excitation band with modal damping ratio below 1 %."),
+    "lines.<line>.indicators.snap.risk": (
+        "",
+        "True when mean − 3σ of the tension is below zero somewhere.",
+    ),
+    "lines.<line>.indicators.snap.margin": (
+        "-",
+        "Smallest (T_mean − 3σ_T)/|T_mean| over elements and ends.",
+    ),
+    "lines.<line>.indicators.resonances": (
+        "",
+        "Modes in the excitation band with modal damping ratio below 1 %.",
+    ),
     "lines.<line>.indicators.resonances[].mode": ("-", "Mode number (1-based)."),
     "lines.<line>.indicators.resonances[].omega": ("rad/s", "Its natural frequency."),
     "lines.<line>.indicators.resonances[].damping_ratio": ("-", "Its modal damping ratio ζ."),
-    "lines.<line>.indicators.motion.std_max": ("{L}", "Largest node motion σ (magnitude of the x, y, z σ)."),
-    "lines.<line>.indicators.motion.sag": ("{L}", "Largest distance of the static shape from the chord of the ends."),
+    "lines.<line>.indicators.motion.std_max": (
+        "{L}",
+        "Largest node motion σ (magnitude of the x, y, z σ).",
+    ),
+    "lines.<line>.indicators.motion.sag": (
+        "{L}",
+        "Largest distance of the static shape from the chord of the ends.",
+    ),
     "lines.<line>.indicators.motion.to_sag": ("-", "``std_max / sag``."),
     "lines.<line>.indicators.motion.to_diameter": ("-", "``std_max`` over the largest diameter."),
-    "lines.<line>.indicators.flags": ("", "Raised flags: ``\"snap\"``, ``\"resonance\"``, ``\"large_motion\"``."),
+    "lines.<line>.indicators.flags": (
+        "",
+        'Raised flags: ``"snap"``, ``"resonance"``, ``"large_motion"``.',
+    ),
 }
 
 _BODIES = {
     "bodies.<body>.prescribed": ("", "True for a vessel whose motion is its RAO (not solved for)."),
     "bodies.<body>.dofs": ("", "DOF names in order."),
-    "bodies.<body>.motion.<dof>": ("", "Statistics of each DOF (table of statistics below; U = length or rad); the mean is the static pose."),
+    "bodies.<body>.motion.<dof>": (
+        "",
+        "Statistics of each DOF (table of statistics below; U = length or rad); the mean is the "
+        "static pose.",
+    ),
     "bodies.<body>.motion.<dof>.std_deg": ("deg", "σ of a rotation in degrees."),
     "bodies.<body>.spectra.omega": ("rad/s", "Analysis frequencies."),
-    "bodies.<body>.spectra.<dof>": ("{L}²·s/rad or rad²·s/rad", "One-sided motion spectrum of each DOF."),
+    "bodies.<body>.spectra.<dof>": (
+        "{L}²·s/rad or rad²·s/rad",
+        "One-sided motion spectrum of each DOF.",
+    ),
     "bodies.<body>.channels": ("", "Input channels of the body's coupled group."),
     "bodies.<body>.drag": ("", "Linearized drag at the drag point (null without one)."),
-    "bodies.<body>.drag.sigma": ("{L}/s", "σ of the relative velocity at the drag point along x, y, z."),
+    "bodies.<body>.drag.sigma": (
+        "{L}/s",
+        "σ of the relative velocity at the drag point along x, y, z.",
+    ),
     "bodies.<body>.drag.coefficient": ("{F}·s/{L}", "Linear drag coefficient per direction."),
-    "bodies.<body>.modes": ("", "Natural modes of the coupled group the body belongs to (null for a vessel)."),
-    "bodies.<body>.modes.omega": ("rad/s", "Natural frequencies of the coupled group, lowest first."),
-    "bodies.<body>.modes.body_fraction": ("-", "Share of each mode's kinetic energy in the body DOFs."),
-    "bodies.<body>.modes.omega_ref": ("rad/s", "Frequency at which the added mass was frozen for the modes."),
-    "bodies.<body>.modes.asymmetry": ("-", "max|K − Kᵀ|/max|K| of the coupled stiffness (its symmetric part is used)."),
+    "bodies.<body>.modes": (
+        "",
+        "Natural modes of the coupled group the body belongs to (null for a vessel).",
+    ),
+    "bodies.<body>.modes.omega": (
+        "rad/s",
+        "Natural frequencies of the coupled group, lowest first.",
+    ),
+    "bodies.<body>.modes.body_fraction": (
+        "-",
+        "Share of each mode's kinetic energy in the body DOFs.",
+    ),
+    "bodies.<body>.modes.omega_ref": (
+        "rad/s",
+        "Frequency at which the added mass was frozen for the modes.",
+    ),
+    "bodies.<body>.modes.asymmetry": (
+        "-",
+        "max|K − Kᵀ|/max|K| of the coupled stiffness (its symmetric part is used).",
+    ),
 }
 
 _REST = {
@@ -147,42 +281,74 @@ _REST = {
     "timing.timeseries_s": ("s", "Time-series synthesis."),
     "timing.total_s": ("s", "The whole analysis."),
     "warnings": ("", "Messages of the warnings raised during the analysis (see :doc:`warnings`)."),
-    "units.system": ("", "``\"SI\"``, ``\"foot-slug-second\"`` or ``\"consistent\"``: the unit system, read off ``environment.g``."),
+    "units.system": (
+        "",
+        '``"SI"``, ``"foot-slug-second"`` or ``"consistent"``: the unit system, read off '
+        "``environment.g``.",
+    ),
     "units.length": ("", "Length label of every number of the document."),
     "units.mass": ("", "Mass label."),
     "units.force": ("", "Force label."),
     "units.time": ("", "Time label."),
-    "timeseries.method": ("", "``\"dsa\"`` or ``\"nsa\"``: how the sea realization was drawn."),
+    "timeseries.method": ("", '``"dsa"`` or ``"nsa"``: how the sea realization was drawn.'),
     "timeseries.seed": ("-", "Root random seed."),
     "timeseries.dt": ("s", "Time step."),
     "timeseries.samples": ("-", "Length of the whole realization."),
-    "timeseries.window": ("-", "Samples in the document (the first 2048, or all with ``timeseries=\"full\"``)."),
+    "timeseries.window": (
+        "-",
+        'Samples in the document (the first 2048, or all with ``timeseries="full"``).',
+    ),
     "timeseries.time": ("s", "Sample times."),
     "timeseries.elevation": ("{L}", "Wave elevation at the origin (null without a sea)."),
     "timeseries.end_motion.<channel>": ("{L}", "Prescribed end motion of each end-motion channel."),
     "timeseries.lines.<line>.<end>.tension": ("{F}", "Total end tension, mean + dynamic."),
-    "timeseries.bodies.<body>.motion.<dof>": ("{L} or rad", "Body motion, static pose + dynamic part."),
-    "fidelity": ("", "Present when ``analysis.fidelity`` is set: the settings adaptive fidelity chose."),
+    "timeseries.bodies.<body>.motion.<dof>": (
+        "{L} or rad",
+        "Body motion, static pose + dynamic part.",
+    ),
+    "fidelity": (
+        "",
+        "Present when ``analysis.fidelity`` is set: the settings adaptive fidelity chose.",
+    ),
     "fidelity.target_error": ("-", "Target relative error of the response σ."),
     "fidelity.omega.min": ("rad/s", "Lowest frequency chosen."),
     "fidelity.omega.max": ("rad/s", "Highest frequency chosen."),
     "fidelity.omega.count": ("-", "Points of the base linear grid."),
-    "fidelity.omega.values_count": ("-", "Points of the grid applied (base grid plus refinements at lightly damped modes)."),
-    "fidelity.segments.<line>": ("-, {L}, -", "Per line, the new segments as (source segment index, length, elements)."),
+    "fidelity.omega.values_count": (
+        "-",
+        "Points of the grid applied (base grid plus refinements at lightly damped modes).",
+    ),
+    "fidelity.segments.<line>": (
+        "-, {L}, -",
+        "Per line, the new segments as (source segment index, length, elements).",
+    ),
     "fidelity.solver": ("", "Solver chosen."),
-    "fidelity.modes": ("", "Modes kept (``\"auto\"`` or a number)."),
+    "fidelity.modes": ("", 'Modes kept (``"auto"`` or a number).'),
     "fidelity.tolerance": ("-", "Linearization tolerance chosen."),
     "fidelity.choices[].setting": ("", "The setting chosen (a path in the scene)."),
     "fidelity.choices[].value": ("", "Its value."),
     "fidelity.choices[].reason": ("", "Why."),
     "fidelity.choices[].error": ("-", "Estimated relative error of σ the choice leaves."),
-    "fidelity.error_estimate": ("-", "Estimated relative error per part (band, grid, elements, modes, linearization) and ``total``."),
+    "fidelity.error_estimate": (
+        "-",
+        "Estimated relative error per part (band, grid, elements, modes, linearization) and "
+        "``total``.",
+    ),
     "fidelity.cost": ("-", "Elements, frequencies and their product of the plan applied."),
     "fidelity.tail_bounded": ("", "Whether the response variance above the band could be bounded."),
-    "fidelity.omega_response": ("rad/s", "ω₂ = √(m2/m0) of the pilot analysis' response spectra (largest)."),
+    "fidelity.omega_response": (
+        "rad/s",
+        "ω₂ = √(m2/m0) of the pilot analysis' response spectra (largest).",
+    ),
     "fidelity.pilot": ("", "The pilot analysis the plan is built on (grid and sizes)."),
-    "fidelity.grid_resolved": ("", "Present when a limit was hit: whether the grid resolves every lightly damped mode."),
-    "fidelity.limits": ("", "Present when a limit was hit: the scene model's limits the plan reached."),
+    "fidelity.grid_resolved": (
+        "",
+        "Present when a limit was hit: whether the grid resolves every lightly damped mode.",
+    ),
+    "fidelity.limits": (
+        "",
+        "Present when a limit was hit: the scene model's limits the plan reached.",
+    ),
 }
 
 #: Every key path of the result document: (unit template, meaning).
@@ -319,9 +485,7 @@ def results_reference_rst(paths: Iterable[str]) -> str:
     for key, (unit, meaning) in KEYS.items():
         under_seen = any(key.startswith(o + ".") and o in seen for o in OPAQUE)
         note = "" if key in seen or under_seen else " (not in the example documents)"
-        rows.append(
-            (key, _unit(unit, _SI), _unit(unit, _FSS), meaning + note)
-        )
+        rows.append((key, _unit(unit, _SI), _unit(unit, _FSS), meaning + note))
     stats = [
         (
             f"….{key}",

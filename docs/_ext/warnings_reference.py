@@ -19,7 +19,13 @@ from pathlib import Path
 
 from scene_reference import escape_bars
 
-__all__ = ["WarningEntry", "WARNINGS", "warning_sites", "undocumented_sites", "warnings_reference_rst"]
+__all__ = [
+    "WarningEntry",
+    "WARNINGS",
+    "warning_sites",
+    "undocumented_sites",
+    "warnings_reference_rst",
+]
 
 
 @dataclass(frozen=True)
@@ -166,7 +172,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "of eigenvectors)",
         "The Foss decoupling does not exist for these matrices; the answer is computed "
         "by the direct solve in modal coordinates and is still right, only slower.",
-        "Nothing, or ``analysis.solver = \"direct\"`` to skip the attempt.",
+        'Nothing, or ``analysis.solver = "direct"`` to skip the attempt.',
     ),
     WarningEntry(
         "Adaptive fidelity could not meet its target",
@@ -203,8 +209,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Nonlinear reference not stationary",
         "ResolutionWarning",
         ("stochcable.reference.cable:_check_stationary",),
-        "the end-tension σ over windows after the ramp varies by more than "
-        "NONSTATIONARY_RATIO",
+        "the end-tension σ over windows after the ramp varies by more than NONSTATIONARY_RATIO",
         "An under-resolved oscillation pumped by the time stepping (typically at "
         "slack–taut snaps), not the response.",
         "Re-run with the ``dt`` the message gives, or a quarter of the present step.",
@@ -226,8 +231,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "numba cannot compile or cache the sea coefficient kernel",
         "Results are the same; the NumPy kernel is slower, or the kernel is compiled "
         "again in each process (about 1 s at its first use).",
-        "Set ``NUMBA_CACHE_DIR`` to a writable directory, or ``STOCHCABLE_NUMBA=0`` to "
-        "skip numba.",
+        "Set ``NUMBA_CACHE_DIR`` to a writable directory, or ``STOCHCABLE_NUMBA=0`` to skip numba.",
     ),
 )
 
