@@ -154,8 +154,10 @@ def field_rows(
             default = "required"
         elif "default" in node:
             default = f"``{json.dumps(node['default'], ensure_ascii=False)}``"
+        elif "$ref" in node:
+            default = "its fields' defaults"
         else:
-            default = "(the model's defaults)"
+            default = "optional"
         rows.append(
             {
                 "field": f"``{name}``",
