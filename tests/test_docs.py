@@ -49,9 +49,10 @@ def test_scene_reference_has_every_model_and_field(schema):
             row = re.search(rf"   \* - ``{re.escape(name)}``\n((?:     - .*\n)+)", part)
             assert row, f"{model}.{name} has no row in the scene reference"
             cells = [c[len("     - ") :] for c in row.group(1).splitlines()]
-            _, unit, default, _, meaning = cells[:5]
+            _, unit, unit_fss, default, _, meaning = cells[:6]
             if "unit" in node:
                 assert unit == node["unit"], f"{model}.{name}: unit {unit!r}"
+                assert unit_fss == scene_reference.foot_slug_second(node["unit"])
             if name in spec.get("required", ()):
                 assert default == "required"
             elif "default" in node:
@@ -68,6 +69,16 @@ def test_scene_reference_constraints_are_the_schema_s(schema):
     assert f"≤ {node['maximum']}" in gamma["constraints"]
     # the trailing "[unit]" of the description is moved to the unit column
     assert not gamma["meaning"].endswith("[-]")
+
+
+def test_foot_slug_second_labels():
+    f = scene_reference.foot_slug_second
+    assert f("kg/m³") == "slug/ft³"
+    assert f("N·m/rad") == "lbf·ft/rad"
+    assert f("Pa·s/m") == "lbf·s/ft³"
+    assert f("m/s²") == "ft/s²"
+    assert f("rad/s") == "rad/s"
+    assert f("deg") == "deg"
 
 
 def test_escape_bars_leaves_literals_and_roles():

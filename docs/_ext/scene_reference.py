@@ -13,7 +13,14 @@ import re
 from collections.abc import Callable, Iterator, Mapping
 from typing import Any
 
-__all__ = ["escape_bars", "model_order", "field_rows", "model_section", "scene_reference_rst"]
+__all__ = [
+    "escape_bars",
+    "foot_slug_second",
+    "model_order",
+    "field_rows",
+    "model_section",
+    "scene_reference_rst",
+]
 
 # JSON Schema keywords shown as constraints, with how they read.
 _CONSTRAINTS = (
@@ -39,6 +46,28 @@ def escape_bars(text: str) -> str:
     them as substitutions."""
     parts = _LITERAL.split(text)
     return "".join(p if p.startswith("`") else p.replace("|", "\\|") for p in parts)
+
+
+# SI unit labels and their foot–slug–second counterparts (a scene in consistent units:
+# environment.g in ft/s² makes every length ft, mass slug, force lbf).
+_FSS = tuple(
+    (re.compile(rf"(?<![A-Za-z]){re.escape(si)}(?![A-Za-z])"), fss)
+    for si, fss in (
+        ("Pa·s/m", "N·s/m³"),
+        ("Pa/m", "N/m³"),
+        ("Pa", "N/m²"),
+        ("kg", "slug"),
+        ("N", "lbf"),
+        ("m", "ft"),
+    )
+)
+
+
+def foot_slug_second(unit: str) -> str:
+    """The foot–slug–second label of an SI unit label (``"kg/m³"`` → ``"slug/ft³"``)."""
+    for pattern, replacement in _FSS:
+        unit = pattern.sub(replacement, unit)
+    return unit
 
 
 def _ref_name(ref: str) -> str:
@@ -163,6 +192,7 @@ def field_rows(
                 "field": f"``{name}``",
                 "type": _type_text(node, anchor),
                 "unit": unit or "",
+                "unit_fss": foot_slug_second(unit) if unit else "",
                 "default": default,
                 "constraints": _constraints(node),
                 "meaning": _description(node, unit, defs),
@@ -193,17 +223,19 @@ def model_section(
     out += [
         ".. list-table::",
         "   :header-rows: 1",
-        "   :widths: 14 22 8 12 14 30",
+        "   :widths: 13 20 8 8 11 13 27",
         "",
         "   * - Field",
         "     - Type",
-        "     - Unit",
+        "     - Unit (SI)",
+        "     - Unit (ft–slug–s)",
         "     - Default",
         "     - Constraints",
         "     - Meaning",
     ]
     for row in rows:
-        cells = [row[k] for k in ("field", "type", "unit", "default", "constraints", "meaning")]
+        keys = ("field", "type", "unit", "unit_fss", "default", "constraints", "meaning")
+        cells = [row[k] for k in keys]
         out.append(f"   * - {_cell(cells[0])}")
         out += [f"     - {_cell(c)}" for c in cells[1:]]
     return out + [""]
