@@ -223,7 +223,30 @@ _LINES = {
     "lines.<line>.indicators.motion.to_diameter": ("-", "``std_max`` over the largest diameter."),
     "lines.<line>.indicators.flags": (
         "",
-        'Raised flags: ``"snap"``, ``"resonance"``, ``"large_motion"``.',
+        'Raised flags: ``"snap"``, ``"resonance"``, ``"large_motion"``, ``"second_order"``.',
+    ),
+    "lines.<line>.indicators.second_order": (
+        "",
+        "Second-order stretching tension T₂ = κ·½∫(∂u⊥/∂s)² ds of the linear response, "
+        "a Gaussian quadratic form (:mod:`stochcable.dynamics.second_order`).",
+    ),
+    "lines.<line>.indicators.second_order.mean": ("N", "Mean of T₂: a shift of the mean tension."),
+    "lines.<line>.indicators.second_order.std": (
+        "N",
+        "σ of T₂ (uncorrelated with the linear tension).",
+    ),
+    "lines.<line>.indicators.second_order.ratio": (
+        "-",
+        "σ of T₂ over the largest linear element tension σ (null: no linear tension σ).",
+    ),
+    "lines.<line>.indicators.second_order.lambda2": (
+        "-",
+        "Irvine's λ*² of the static shape (seed 000 eq. 4.3); the sag relieves T₂ by "
+        "1/(1 + λ*²/12) (null: no positive tension).",
+    ),
+    "lines.<line>.indicators.second_order.std_factor": (
+        "-",
+        "√(1 + ratio²): σ of linear + second-order tension over the linear σ.",
     ),
 }
 

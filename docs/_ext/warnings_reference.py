@@ -125,6 +125,21 @@ WARNINGS: tuple[WarningEntry, ...] = (
         ("stochcable.dynamics.indicators:MOTION_SAG_FRACTION",),
     ),
     WarningEntry(
+        "Second-order stretching tension large (indicator ``second_order``)",
+        "PhysicsWarning",
+        ("stochcable.dynamics.second_order:with_second_order",),
+        "σ of the second-order stretching tension above SECOND_ORDER_WARN_RATIO of the "
+        "line's largest linear tension σ",
+        "Transverse motion lengthens a line to second order, ½∫(∂u⊥/∂s)² ds; a taut line "
+        "takes it up as tension that the linear model drops, so the linear tension σ is "
+        "low by ``indicators.second_order.std_factor`` and the mean by "
+        "``indicators.second_order.mean``.",
+        "Use the corrected moments in ``indicators.second_order`` as an estimate; for a "
+        "design value check with the nonlinear time-domain reference "
+        "(:mod:`stochcable.reference.cable`).",
+        ("stochcable.dynamics.second_order:SECOND_ORDER_WARN_RATIO",),
+    ),
+    WarningEntry(
         "Drag linearization did not converge",
         "PhysicsWarning",
         ("stochcable.dynamics.coupled.fixedpoint:linearize_coupled",),

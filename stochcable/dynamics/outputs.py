@@ -30,6 +30,7 @@ from stochcable.dynamics.indicators import (
 from stochcable.dynamics.loads import (
     Channel,
 )
+from stochcable.dynamics.second_order import second_order_tension, with_second_order
 from stochcable.dynamics.system import (
     Linearization,
     LineSystem,
@@ -129,6 +130,11 @@ def line_result(
         if linearization.record is None
         else line_indicators(system, channels, linearization, tension_std, motion_std, stats, modes)
     )
+    if indicators is not None:
+        so = second_order_tension(
+            motion_h, spectra, q, model.positions, model.mesh, st.tension, tension_std
+        )
+        indicators = with_second_order(system.name, indicators, so)
     end_force = _end_force_transfer(model, resp, n_ch)
     return LineResult(
         name=system.name,

@@ -238,7 +238,11 @@ class LineIndicators:
     motion_to_diameter : float
         motion_std_max / largest diameter. [-]
     flags : tuple of str
-        Raised flags: ``"snap"``, ``"resonance"``, ``"large_motion"``.
+        Raised flags: ``"snap"``, ``"resonance"``, ``"large_motion"``,
+        ``"second_order"``.
+    second_order : object or None
+        Moments of the second-order stretching tension
+        (:class:`stochcable.dynamics.second_order.SecondOrderTension`; its ``as_dict``).
     """
 
     borgman_ratio: np.ndarray
@@ -251,6 +255,7 @@ class LineIndicators:
     motion_to_sag: float
     motion_to_diameter: float
     flags: tuple[str, ...]
+    second_order: Any = None
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite numbers as None)."""
@@ -275,4 +280,5 @@ class LineIndicators:
                 "to_diameter": _finite_or_none(self.motion_to_diameter),
             },
             "flags": list(self.flags),
+            "second_order": None if self.second_order is None else self.second_order.as_dict(),
         }

@@ -1,0 +1,201 @@
+"""Second-order (stretching) tension of a line from its linear response: the indicator
+of when linear tension is not enough.
+
+A transverse displacement u⊥ of a cable lengthens it to second order by ½∫(∂u⊥/∂s)² ds
+(the quadratic part of the Green strain), which the linear model drops.  With the axial
+response quasi-static (axial waves much faster than the excitation) the line takes up
+that lengthening as a uniform tension increment, reduced by the sag's flexibility::
+
+    T₂ = κ · ½ Σ_e |Δu⊥_e|² / l_e,    κ = 1 / (Σ_e l_e/EA_e · (1 + λ*²/12))
+
+(Irvine 1981, *Cable Structures*, §2.4 and §3.3: the chord stiffness of a shallow
+elastic cable; λ*² = (w₀L/H*)²·(EA/H*)·cos²φ_a for an inclined cable, seed 000 eq. 4.3).
+For a taut, near-straight line λ*² ≪ 1 and T₂ is the full stretching term; for a
+catenary (λ*² ≫ 1, a grounded length) the sag absorbs the lengthening and T₂ vanishes.
+
+The linear response x = (Δu⊥_e) is zero-mean Gaussian, so T₂ = xᵀAx is a Gaussian
+quadratic form with closed-form moments (Mathai & Provost 1992, *Quadratic Forms in
+Random Variables*, Thm 3.2b.2): E[T₂] = tr(AΣ), Var[T₂] = 2 tr((AΣ)²), and T₂ is
+uncorrelated with the linear tension (odd moments of x vanish), so the σ of
+linear + second-order tension is √(σ_lin² + Var T₂).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from stochcable.errors import PhysicsWarning, warn
+
+__all__ = [
+    "SecondOrderTension",
+    "second_order_tension",
+    "irvine_lambda2",
+    "quadratic_form_moments",
+    "SECOND_ORDER_WARN_RATIO",
+    "with_second_order",
+]
+
+#: σ(T₂)/σ_lin above which a warning is raised: the linear tension σ is then
+#: underestimated by more than 2 % (√(1 + 0.2²) = 1.020). [-]
+SECOND_ORDER_WARN_RATIO = 0.2
+
+
+@dataclass(frozen=True)
+class SecondOrderTension:
+    """Moments of the second-order stretching tension of one line.
+
+    Attributes
+    ----------
+    mean : float
+        Mean tension increment E[T₂] (a shift of the mean tension). [N]
+    std : float
+        σ of T₂. [N]
+    ratio : float
+        std / the largest linear element tension σ of the line (0 without response, inf
+        where only the second-order tension varies). [-]
+    lambda2 : float
+        Irvine's λ*² of the line's static shape (inf with a grounded length). [-]
+    std_factor : float
+        √(1 + ratio²): σ of linear + second-order tension over the linear σ. [-]
+    """
+
+    mean: float
+    std: float
+    ratio: float
+    lambda2: float
+    std_factor: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (non-finite λ*² as None)."""
+        return {
+            "mean": self.mean,
+            "std": self.std,
+            "ratio": _finite(self.ratio),
+            "lambda2": _finite(self.lambda2),
+            "std_factor": _finite(self.std_factor),
+        }
+
+
+def _finite(x: float) -> float | None:
+    return x if math.isfinite(x) else None
+
+
+def irvine_lambda2(
+    positions: np.ndarray, l0: np.ndarray, ea: np.ndarray, weight: np.ndarray, tension: np.ndarray
+) -> float:
+    """Irvine's λ*² of a line's static shape (seed 000 eq. 4.3). [-]
+
+    Parameters
+    ----------
+    positions : ndarray, shape (n_nodes, 3)
+        Static node positions. [m]
+    l0, ea, weight, tension : ndarray, shape (n_el,)
+        Element lengths [m], axial stiffness [N], submerged weight per length [N/m]
+        and static effective tension [N].
+
+    Returns
+    -------
+    float
+        (w₀L/H*)²·(EA/H*)·cos²φ_a with L the length, w₀ and EA length-weighted means,
+        H* the mean tension and φ_a the chord's angle to the horizontal; inf where the
+        mean tension is not positive. [-]
+    """
+    length = float(np.sum(l0))
+    h = float(np.sum(tension * l0) / length)
+    if h <= 0.0:
+        return math.inf
+    w0 = float(np.sum(np.abs(weight) * l0) / length)
+    ea_m = length / float(np.sum(l0 / ea))
+    chord = positions[-1] - positions[0]
+    cos_phi = math.hypot(chord[0], chord[1]) / max(float(np.linalg.norm(chord)), 1e-300)
+    return (w0 * length / h) ** 2 * (ea_m / h) * cos_phi**2
+
+
+def quadratic_form_moments(b: np.ndarray) -> tuple[float, float]:
+    """Mean and σ of xᵀx for the real Gaussian vector x = Re(B·a) of the spectral
+    representation (a complex unit amplitudes, columns of B the weighted components).
+
+    Parameters
+    ----------
+    b : ndarray, complex, shape (n_x, n_components)
+        √A·H·√(S dω): each column one frequency and input channel. [unit]
+
+    Returns
+    -------
+    (float, float)
+        tr Σ and √(2·‖Σ‖_F²) with Σ = Re(B Bᴴ) the covariance of x. [unit²]
+    """
+    c = np.concatenate([b.real, b.imag], axis=1)
+    mean = float(np.sum(c * c))
+    g = c @ c.T if c.shape[0] <= c.shape[1] else c.T @ c  # same Frobenius norm
+    return mean, math.sqrt(2.0 * float(np.sum(g * g)))
+
+
+def second_order_tension(
+    motion_transfer: np.ndarray,
+    input_spectra: np.ndarray,
+    weights: np.ndarray,
+    positions: np.ndarray,
+    mesh: Any,
+    tension_mean: np.ndarray,
+    tension_std: np.ndarray,
+) -> SecondOrderTension:
+    """The second-order stretching tension of one line (module docstring).
+
+    Parameters
+    ----------
+    motion_transfer : ndarray, complex, shape (n_ch, n_nodes, 3, n_omega)
+        Node displacement per unit input. [m/unit]
+    input_spectra : ndarray, shape (n_ch, n_omega)
+        Input spectra. [unit²·s/rad]
+    weights : ndarray, shape (n_omega,)
+        Trapezoid weights of the frequency grid. [rad/s]
+    positions : ndarray, shape (n_nodes, 3)
+        Static node positions. [m]
+    mesh : LineMesh
+        ``l0``, ``ea``, ``weight`` per element.
+    tension_mean, tension_std : ndarray, shape (n_el,)
+        Static tension and linear tension σ per element. [N]
+
+    Returns
+    -------
+    SecondOrderTension
+    """
+    d = positions[1:] - positions[:-1]
+    t = d / np.linalg.norm(d, axis=1)[:, None]
+    du = motion_transfer[:, 1:] - motion_transfer[:, :-1]  # (n_ch, n_el, 3, n_w)
+    du = du - np.einsum("cekw,ek->cew", du, t)[:, :, None, :] * t[None, :, :, None]
+    lam2 = irvine_lambda2(positions, mesh.l0, mesh.ea, mesh.weight, tension_mean)
+    kappa = 1.0 / (float(np.sum(mesh.l0 / mesh.ea)) * (1.0 + lam2 / 12.0))
+    a = 0.5 * kappa / mesh.l0  # T₂ = Σ_e a_e |Δu⊥_e|²
+    amp = np.sqrt(np.clip(input_spectra, 0.0, None) * weights)  # (n_ch, n_w)
+    b = du * np.sqrt(a)[None, :, None, None] * amp[:, None, None, :]
+    b = np.transpose(b, (1, 2, 0, 3)).reshape(du.shape[1] * 3, -1)
+    mean, std = quadratic_form_moments(b) if math.isfinite(lam2) else (0.0, 0.0)
+    sig = float(np.max(tension_std)) if tension_std.size else 0.0
+    ratio = std / sig if sig > 0 else (math.inf if std > 0 else 0.0)
+    return SecondOrderTension(mean, std, ratio, lam2, math.sqrt(1.0 + ratio * ratio))
+
+
+def with_second_order(line: str, indicators: Any, second_order: SecondOrderTension) -> Any:
+    """``indicators`` (a LineIndicators) carrying ``second_order``, flagged and warned
+    about when its σ ratio exceeds :data:`SECOND_ORDER_WARN_RATIO`."""
+    flags = indicators.flags
+    if second_order.ratio > SECOND_ORDER_WARN_RATIO:
+        flags = (*flags, "second_order")
+        warn(
+            f"line {line!r}: the second-order stretching tension has σ = "
+            f"{second_order.std:.4g} N and mean {second_order.mean:.4g} N, "
+            f"{second_order.ratio:.0%} of the linear tension σ (threshold "
+            f"{SECOND_ORDER_WARN_RATIO:.0%}): the linear tension σ is low by a factor "
+            f"{second_order.std_factor:.3f}; the result's indicators carry the corrected "
+            "moments — check against a nonlinear time-domain analysis "
+            "(stochcable.reference) for a design value",
+            PhysicsWarning,
+        )
+    return dataclasses.replace(indicators, second_order=second_order, flags=flags)
