@@ -168,14 +168,18 @@ def second_order_tension(
     """
     d = positions[1:] - positions[:-1]
     t = d / np.linalg.norm(d, axis=1)[:, None]
-    du = motion_transfer[:, 1:] - motion_transfer[:, :-1]  # (n_ch, n_el, 3, n_w)
-    du = du - np.einsum("cekw,ek->cew", du, t)[:, :, None, :] * t[None, :, :, None]
+    # two unit normals of every element: Δu⊥ in that basis, 2 components, not 3
+    ref = np.where(np.abs(t[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+    n1 = np.cross(t, ref)
+    n1 /= np.linalg.norm(n1, axis=1)[:, None]
+    normals = np.stack([n1, np.cross(t, n1)], axis=1)  # (n_el, 2, 3)
     lam2 = irvine_lambda2(positions, mesh.l0, mesh.ea, mesh.weight, tension_mean)
     kappa = 1.0 / (float(np.sum(mesh.l0 / mesh.ea)) * (1.0 + lam2 / 12.0))
-    a = 0.5 * kappa / mesh.l0  # T₂ = Σ_e a_e |Δu⊥_e|²
+    normals = normals * np.sqrt(0.5 * kappa / mesh.l0)[:, None, None]  # T₂ = Σ_e a_e|Δu⊥_e|²
     amp = np.sqrt(np.clip(input_spectra, 0.0, None) * weights)  # (n_ch, n_w)
-    b = du * np.sqrt(a)[None, :, None, None] * amp[:, None, None, :]
-    b = np.transpose(b, (1, 2, 0, 3)).reshape(du.shape[1] * 3, -1)
+    du = motion_transfer[:, 1:] - motion_transfer[:, :-1]  # (n_ch, n_el, 3, n_w)
+    b = np.einsum("ejk,cekw->ejcw", normals, du) * amp[None, None]
+    b = b.reshape(2 * du.shape[1], -1)
     mean, std = quadratic_form_moments(b) if math.isfinite(lam2) else (0.0, 0.0)
     sig = float(np.max(tension_std)) if tension_std.size else 0.0
     ratio = std / sig if sig > 0 else (math.inf if std > 0 else 0.0)
