@@ -14,6 +14,7 @@ from .curves import (
     tension_to_curve_quantity,
 )
 from .extremes import (
+    SECONDS_PER_YEAR,
     long_term_exceedance,
     maxima_exceedance_short_term,
     maximum_exceedance_rayleigh,
@@ -31,6 +32,7 @@ from .spectral_fatigue import (
 )
 
 __all__ = [
+    "SECONDS_PER_YEAR",
     "CurveSegment",
     "FatigueCurve",
     "curve_names",

@@ -1,0 +1,101 @@
+"""Fatigue settings of a load-case set: which curve, area or breaking strength, method and
+design fatigue factor each line is checked with."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from stochcable.design import FatigueCurve, fatigue_curve, tension_to_curve_quantity
+from stochcable.errors import InputError
+from stochcable.scene.units import unit_labels
+
+__all__ = ["LineFatigue", "curve_factor"]
+
+_METHODS = ("narrow_band", "wirsching_light", "dirlik", "benasciutti_tovo")
+
+
+@dataclass(frozen=True)
+class LineFatigue:
+    """How one line's fatigue is assessed.
+
+    Attributes
+    ----------
+    curve : str or FatigueCurve
+        A catalogue name (:func:`stochcable.design.curve_names`) or a curve.
+    nominal_diameter : float or None
+        Nominal bar diameter of a chain (area 2·πd²/4). [m]
+    nominal_area : float or None
+        Nominal area of the stress (a rope's metallic area). [m²]
+    mbs : float or None
+        Minimum breaking strength, for tension-ratio (API) curves. [force unit]
+    mean_load_ratio : float or None
+        Mean tension / MBS of the API wire-rope curves. [-]
+    method : {"narrow_band", "wirsching_light", "dirlik", "benasciutti_tovo"}
+        Spectral method.
+    design_factor : float
+        Design fatigue factor (DFF): the life is divided by it. [-]
+    """
+
+    curve: str | FatigueCurve = "dnv-studless"
+    nominal_diameter: float | None = None
+    nominal_area: float | None = None
+    mbs: float | None = None
+    mean_load_ratio: float | None = None
+    method: str = "dirlik"
+    design_factor: float = 1.0
+
+    @classmethod
+    def from_mapping(cls, doc: Mapping[str, Any], where: str = "fatigue") -> LineFatigue:
+        """From a JSON mapping with the attribute names as keys."""
+        known = {f for f in cls.__dataclass_fields__}
+        extra = sorted(set(doc) - known)
+        if extra:
+            raise InputError(f"{where}.{extra[0]}", doc[extra[0]], "-", "unknown setting")
+        out = cls(**dict(doc))
+        out.check(where)
+        return out
+
+    def check(self, where: str = "fatigue") -> None:
+        """Validate the settings (InputError naming ``where.<field>``)."""
+        if self.method not in _METHODS:
+            raise InputError(f"{where}.method", self.method, "-", f"must be one of {_METHODS}")
+        if not (math.isfinite(self.design_factor) and self.design_factor >= 1.0):
+            raise InputError(f"{where}.design_factor", self.design_factor, "-", "must be >= 1")
+
+
+def curve_factor(settings: LineFatigue, g: float, where: str) -> tuple[FatigueCurve, float]:
+    """The curve and the factor from the scene's force unit to the curve's quantity.
+
+    Stress curves take pascals, so they need an SI scene; tension-ratio curves work in
+    any consistent unit system (the MBS is in the scene's force unit).
+    """
+    curve = settings.curve
+    if isinstance(curve, str):
+        try:
+            curve = fatigue_curve(curve, mean_load_ratio=settings.mean_load_ratio)
+        except InputError as exc:
+            raise InputError(
+                f"{where}.{exc.parameter}", exc.value, exc.unit, exc.constraint
+            ) from None
+    labels = unit_labels(g)
+    if curve.quantity == "stress" and labels.system != "SI":
+        raise InputError(
+            f"{where}.curve",
+            curve.name,
+            "-",
+            f"takes stress in Pa, but the scene is in {labels.system} units: use a "
+            "tension-ratio curve (api-*) with mbs in the scene's force unit",
+        )
+    try:
+        k = tension_to_curve_quantity(
+            curve,
+            nominal_diameter=settings.nominal_diameter,
+            nominal_area=settings.nominal_area,
+            mbs=settings.mbs,
+        )
+    except InputError as exc:
+        raise InputError(f"{where}.{exc.parameter}", exc.value, exc.unit, exc.constraint) from None
+    return curve, k
