@@ -77,9 +77,8 @@ def curve_factor(settings: LineFatigue, g: float, where: str) -> tuple[FatigueCu
         try:
             curve = fatigue_curve(curve, mean_load_ratio=settings.mean_load_ratio)
         except InputError as exc:
-            raise InputError(
-                f"{where}.{exc.parameter}", exc.value, exc.unit, exc.constraint
-            ) from None
+            field = "curve" if exc.parameter == "name" else exc.parameter
+            raise InputError(f"{where}.{field}", exc.value, exc.unit, exc.constraint) from None
     labels = unit_labels(g)
     if curve.quantity == "stress" and labels.system != "SI":
         raise InputError(

@@ -152,6 +152,20 @@ def _fatigue_settings(
     return dict(fatigue)
 
 
+def _template(scene: Scene, scatter: ScatterDiagram) -> Scene:
+    """The scene the engine is built from: no time series, and the sea of an
+    out-of-plane state when the diagram has one (the models are then 3-D, and in-plane
+    states are solved by them exactly as by 2-D models)."""
+    upd: dict[str, Any] = {
+        "analysis": scene.analysis.model_copy(update={"timeseries": None}),
+    }
+    for state in scatter.states:
+        if abs(math.sin(math.radians(state.heading))) > 1e-9:
+            upd["sea"] = Sea(spectrum=state.spectrum(scatter.family), heading=state.heading)
+            break
+    return scene.model_copy(update=upd)
+
+
 class _DamageBuffer:
     """Spectra of the cases of one line, turned into damage rates in batches."""
 
@@ -242,9 +256,7 @@ def run_cases(
     for name, s in settings.items():
         s.check(f"fatigue[{name}]")
     if engine is None:
-        template = scene.model_copy(update={"analysis": scene.analysis.model_copy(
-            update={"timeseries": None})})  # fmt: skip
-        engine = build_engine(template)
+        engine = build_engine(_template(scene, scatter))
     n = len(scatter.states)
     names = tuple(ln.name for ln in scene.lines)
     n_el = {ln.name: sum(seg.elements for seg in ln.segments) for ln in scene.lines}

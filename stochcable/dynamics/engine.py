@@ -121,6 +121,17 @@ class Engine:
         """
         t_start = time.perf_counter()
         scene = _with_sea(self.scene, sea)
+        if self.scene.is_planar and not scene.is_planar:
+            # the models were built 2-D (in the plane of the lines): out-of-plane waves
+            # would be projected onto it without a word
+            raise InputError(
+                "sea.heading",
+                scene.sea.heading,
+                "deg",
+                "sends the waves out of the plane of a scene whose engine was built with "
+                "in-plane (2-D) models; build the engine from the scene with a sea of an "
+                "out-of-plane heading (3-D models) to solve every heading",
+            )
         progress = noop_progress if progress is None else progress
         timing = {k: 0.0 for k in _STAGES}
         timing.update(self.timing)
