@@ -12,57 +12,25 @@ set.
 from __future__ import annotations
 
 import math
-import traceback
 from collections.abc import Callable, Mapping
+from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, engine_template, solve_chunk
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import ScatterDiagram
-from stochcable.design import SECONDS_PER_YEAR, damage_rate, return_level
+from stochcable.design import SECONDS_PER_YEAR, return_level
 from stochcable.dynamics.engine import Engine, build_engine
-from stochcable.errors import InputError, StochcableError, collect_warnings
-from stochcable.scene.model import Scene, Sea, load_scene
+from stochcable.errors import InputError
+from stochcable.scene.model import Scene, load_scene
 
 __all__ = ["CaseRow", "LineTotals", "CaseSetResult", "run_cases", "ENDS"]
 
-ENDS = ("end_a", "end_b")
-#: Spectra kept at once before their damage is computed (memory bound of a set). [bytes]
-_DAMAGE_BUFFER_BYTES = 64 * 2**20
 
 Progress = Callable[[int, int], None]
-
-
-@dataclass(frozen=True)
-class CaseRow:
-    """One sea state of the set and its outcome.
-
-    Attributes
-    ----------
-    index : int
-        Position in the scatter diagram.
-    status : {"ok", "flagged", "not_converged", "failed"}
-        ``flagged``: an indicator of a line raised a flag (listed in ``flags``).
-    reason : str
-        Why the case is not ``ok`` ("" otherwise).
-    flags : tuple of str
-        ``"<line>:<flag>"`` of every raised indicator flag.
-    warnings : tuple of str
-        Messages of the warnings of this case's solve.
-    """
-
-    index: int
-    status: str
-    reason: str = ""
-    flags: tuple[str, ...] = ()
-    warnings: tuple[str, ...] = ()
-
-    @property
-    def has_numbers(self) -> bool:
-        """Whether the case produced a response (every status but ``failed``)."""
-        return self.status != "failed"
 
 
 @dataclass(frozen=True)
@@ -152,67 +120,8 @@ def _fatigue_settings(
     return dict(fatigue)
 
 
-def _template(scene: Scene, scatter: ScatterDiagram) -> Scene:
-    """The scene the engine is built from: no time series, and the sea of an
-    out-of-plane state when the diagram has one (the models are then 3-D, and in-plane
-    states are solved by them exactly as by 2-D models)."""
-    upd: dict[str, Any] = {
-        "analysis": scene.analysis.model_copy(update={"timeseries": None}),
-    }
-    for state in scatter.states:
-        if abs(math.sin(math.radians(state.heading))) > 1e-9:
-            upd["sea"] = Sea(spectrum=state.spectrum(scatter.family), heading=state.heading)
-            break
-    return scene.model_copy(update=upd)
-
-
-class _DamageBuffer:
-    """Spectra of the cases of one line, turned into damage rates in batches."""
-
-    def __init__(self, omega: np.ndarray, curve: Any, k: float, method: str, out: np.ndarray):
-        self.omega, self.curve, self.k2, self.method, self.out = omega, curve, k * k, method, out
-        self.idx: list[int] = []
-        self.spectra: list[np.ndarray] = []
-
-    def add(self, case: int, spectra: np.ndarray) -> None:
-        self.idx.append(case)
-        self.spectra.append(spectra)
-        if len(self.spectra) * spectra.nbytes >= _DAMAGE_BUFFER_BYTES:
-            self.flush()
-
-    def flush(self) -> None:
-        if self.spectra:
-            dens = np.stack(self.spectra) * self.k2
-            self.out[self.idx] = damage_rate(self.omega, dens, self.curve, method=self.method)
-            self.idx, self.spectra = [], []
-
-
-def _solve_case(engine: Engine, sea: Sea, index: int) -> tuple[CaseRow, Any]:
-    with collect_warnings() as caught:
-        try:
-            res = engine.solve(sea)
-        except StochcableError as exc:
-            return CaseRow(index, "failed", f"{type(exc).__name__}: {exc}"), None
-        except Exception as exc:  # a defect must cost its case only, with its trace
-            tb = traceback.format_exception_only(type(exc), exc)[-1].strip()
-            return CaseRow(index, "failed", f"internal error: {tb}"), None
-    msgs = tuple(dict.fromkeys(str(w) for w in caught))
-    flags = tuple(
-        f"{name}:{f}"
-        for name, lr in res.lines.items()
-        if lr.indicators is not None
-        for f in lr.indicators.flags
-    )
-    if not res.converged:
-        lin = res.linearization
-        reason = (
-            f"drag linearization not converged after {lin['iterations']} iterations "
-            f"(relative change {lin['relative_change']:.3g})"
-        )
-        return CaseRow(index, "not_converged", reason, flags, msgs), res
-    if flags:
-        return CaseRow(index, "flagged", "indicator flags: " + ", ".join(flags), flags, msgs), res
-    return CaseRow(index, "ok", "", (), msgs), res
+def _chunks(n: int, size: int) -> list[range]:
+    return [range(i, min(i + size, n)) for i in range(0, n, size)]
 
 
 def run_cases(
@@ -223,6 +132,8 @@ def run_cases(
     years: float = 100.0,
     progress: Progress | None = None,
     engine: Engine | None = None,
+    executor: Any = None,
+    chunk_size: int | None = None,
 ) -> CaseSetResult:
     """Solve every sea state of a scatter diagram on one scene.
 
@@ -237,61 +148,102 @@ def run_cases(
     years : float
         Return period of the long-term extremes. [years]
     progress : callable, optional
-        ``progress(done, total)`` after every case.
+        ``progress(done, total)`` as cases finish (after every chunk).
     engine : Engine, optional
-        A built engine of the same scene (reused as is).
+        A built engine of the same scene, used by the in-process executor.
+    executor : concurrent.futures.Executor or dask.distributed.Client, optional
+        Where the chunks run (None: in this process, one after the other).  With a
+        Dask client the scene template is scattered to every worker once; a worker
+        builds its engine once and keeps it for the next chunks.
+    chunk_size : int, optional
+        Cases per chunk (default: all in one chunk in this process; with an executor,
+        enough chunks for four per worker, at most 64 cases each).
 
     Returns
     -------
     CaseSetResult
+        The same numbers, bit for bit, whichever executor and chunking ran the set.
     """
     scene = load_scene(scene)
     if not (isinstance(years, (int, float)) and math.isfinite(years) and years > 0):
         raise InputError("years", years, "years", "must be finite and > 0")
     settings = _fatigue_settings(scene, fatigue)
-    factors = {
-        name: curve_factor(s, scene.environment.g, f"fatigue[{name}]")
-        for name, s in settings.items()
-    }
     for name, s in settings.items():
         s.check(f"fatigue[{name}]")
-    if engine is None:
-        engine = build_engine(_template(scene, scatter))
+        curve_factor(s, scene.environment.g, f"fatigue[{name}]")  # refused before work
+    n = len(scatter.states)
+    template = engine_template(scene, scatter.states, scatter.family)
+    size = _chunk_size(n, executor, chunk_size)
+    parts = [tuple((i, scatter.states[i]) for i in r) for r in _chunks(n, size)]
+    done = 0
+    results: list[ChunkResult] = []
+    for res in _run_chunks(template, scatter.family, parts, settings, engine, executor):
+        results.append(res)
+        done += len(res.rows)
+        if progress is not None:
+            progress(done, n)
+    return _assemble(scene, scatter, results, settings, float(years))
+
+
+def _chunk_size(n: int, executor: Any, chunk_size: int | None) -> int:
+    if chunk_size is not None:
+        if not isinstance(chunk_size, int) or isinstance(chunk_size, bool) or chunk_size < 1:
+            raise InputError("chunk_size", chunk_size, "-", "must be an integer >= 1")
+        return chunk_size
+    if executor is None:
+        return max(n, 1)
+    workers = _worker_count(executor)
+    return max(1, min(64, math.ceil(n / (4 * workers))))
+
+
+def _worker_count(executor: Any) -> int:
+    info = getattr(executor, "scheduler_info", None)
+    if callable(info):  # dask.distributed.Client
+        return max(1, len(info().get("workers", {})))
+    return max(1, int(getattr(executor, "_max_workers", 1) or 1))
+
+
+def _run_chunks(template, family, parts, settings, engine, executor):
+    """Yield the chunks' results as they finish."""
+    if executor is None:
+        if engine is None:
+            engine = build_engine(template)
+        for part in parts:
+            yield solve_chunk(template, family, part, settings, engine)
+        return
+    if hasattr(executor, "scatter") and hasattr(executor, "gather"):  # dask client
+        from distributed import as_completed as dask_completed
+
+        shared = executor.scatter(template, broadcast=True)
+        futures = [executor.submit(solve_chunk, shared, family, part, settings, pure=False)
+                   for part in parts]  # fmt: skip
+        for fut in dask_completed(futures):
+            yield fut.result()
+        return
+    futures = [executor.submit(solve_chunk, template, family, part, settings) for part in parts]
+    for fut in as_completed(futures):
+        yield fut.result()
+
+
+def _assemble(scene, scatter, results, settings, years) -> CaseSetResult:
     n = len(scatter.states)
     names = tuple(ln.name for ln in scene.lines)
     n_el = {ln.name: sum(seg.elements for seg in ln.segments) for ln in scene.lines}
     stats = {ln: {e: np.full((n, 4), np.nan) for e in ENDS} for ln in names}
-    d_ends = {ln: np.full((n, 2), np.nan) for ln in names}
-    d_along = {ln: np.full((n, n_el[ln]), np.nan) for ln in names}
+    damage = {ln: np.full((n, 2 + n_el[ln]), np.nan) for ln in names}
+    rows: list[CaseRow | None] = [None] * n
     s_el: dict[str, np.ndarray] = {}
-    buffers: dict[str, _DamageBuffer] = {}
-    rows: list[CaseRow] = []
-    for i, state in enumerate(scatter.states):
-        sea = Sea(spectrum=state.spectrum(scatter.family), heading=state.heading)
-        row, res = _solve_case(engine, sea, i)
-        rows.append(row)
-        if res is not None:
-            for name, lr in res.lines.items():
-                s_el.setdefault(name, lr.s_elements)
-                for e in ENDS:
-                    st = getattr(lr, e)
-                    stats[name][e][i] = (st.mean, st.std, st.tz, st.mpm_3h)
-                if name in factors:
-                    if name not in buffers:
-                        curve, k = factors[name]
-                        out = np.full((n, n_el[name] + 2), np.nan)
-                        buffers[name] = _DamageBuffer(
-                            lr.omega, curve, k, settings[name].method, out
-                        )
-                    spectra = np.concatenate(
-                        [np.stack([lr.end_tension_spectrum(e) for e in ENDS]), lr.tension_spectrum]
-                    )
-                    buffers[name].add(i, spectra)
-        if progress is not None:
-            progress(i + 1, n)
-    for name, buf in buffers.items():
-        buf.flush()
-        d_ends[name], d_along[name] = buf.out[:, :2], buf.out[:, 2:]
+    for res in results:
+        for j, i in enumerate(res.indices):
+            rows[i] = res.rows[j]
+        for ln in names:
+            for e in ENDS:
+                stats[ln][e][res.indices] = res.stats[ln][e]
+            damage[ln][res.indices] = res.damage[ln]
+        for ln, s in res.s_elements.items():
+            s_el.setdefault(ln, s)
+    d_ends = {ln: damage[ln][:, :2] for ln in names}
+    d_along = {ln: damage[ln][:, 2:] for ln in names}
     p = np.array([s.probability for s in scatter.states])
     has = np.array([r.has_numbers for r in rows])
     ok = np.array([r.status == "ok" for r in rows])
@@ -301,14 +253,12 @@ def run_cases(
         "failed": float(p[~has].sum()),
     }
     totals = {
-        name: _line_totals(
-            p, has, stats[name], d_ends[name], d_along[name], settings.get(name), years
-        )  # fmt: skip
-        for name in names
+        ln: _line_totals(p, has, stats[ln], d_ends[ln], d_along[ln], settings.get(ln), years)
+        for ln in names
     }
     return CaseSetResult(
         scatter, tuple(rows), names, s_el, stats, d_ends, d_along, totals, coverage,
-        float(years), settings,
+        years, settings,
     )  # fmt: skip
 
 

@@ -1,0 +1,206 @@
+"""One chunk of a load-case set: the cases that share one engine, solved where the
+executor runs them (this process, a worker process, a Dask worker).
+
+A chunk builds its scene's engine once — and a worker keeps the engine of the last
+scenes it saw, so chunks of the same set on one worker reuse it — solves its sea states,
+and turns the tension spectra into damage rates in one batched call per line.  Each
+case's numbers depend only on its sea state and the engine, and the engine is the
+same wherever it is built (one BLAS thread per chunk), so a set gives the same bits
+whichever executor ran it and however it was chunked.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import traceback
+from collections import OrderedDict
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
+from stochcable.cases.scatter import Family, SeaState
+from stochcable.design import damage_rate
+from stochcable.dynamics.engine import Engine, build_engine
+from stochcable.errors import StochcableError, collect_warnings
+from stochcable.scene.model import Scene, Sea
+
+__all__ = ["CaseRow", "ChunkResult", "solve_chunk", "engine_template", "ENDS"]
+
+ENDS = ("end_a", "end_b")
+#: Engines a worker keeps, most recent first (a set's scene, and the one before). [-]
+_ENGINE_CACHE_SIZE = 2
+_ENGINES: OrderedDict[str, Engine] = OrderedDict()
+
+
+@dataclass(frozen=True)
+class CaseRow:
+    """One sea state of the set and its outcome.
+
+    Attributes
+    ----------
+    index : int
+        Position in the scatter diagram.
+    status : {"ok", "flagged", "not_converged", "failed"}
+        ``flagged``: an indicator of a line raised a flag (listed in ``flags``).
+    reason : str
+        Why the case is not ``ok`` ("" otherwise).
+    flags : tuple of str
+        ``"<line>:<flag>"`` of every raised indicator flag.
+    warnings : tuple of str
+        Messages of the warnings of this case's solve.
+    """
+
+    index: int
+    status: str
+    reason: str = ""
+    flags: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def has_numbers(self) -> bool:
+        """Whether the case produced a response (every status but ``failed``)."""
+        return self.status != "failed"
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    """The numbers of the cases of one chunk (rows in the order of ``indices``).
+
+    Attributes
+    ----------
+    indices : ndarray of int
+        Positions of the cases in the scatter diagram.
+    rows : tuple of CaseRow
+    stats : dict
+        ``stats[line][end]`` shape (k, 4): mean, σ, Tz, 3-h MPM of the end tension.
+    damage : dict of ndarray
+        ``[line]`` shape (k, 2 + n_el): damage rate at end_a, end_b and every element
+        (NaN: failed case or no fatigue settings). [1/s]
+    s_elements : dict of ndarray
+        Element midpoint arc length per line. [m]
+    """
+
+    indices: np.ndarray
+    rows: tuple[CaseRow, ...]
+    stats: dict[str, dict[str, np.ndarray]]
+    damage: dict[str, np.ndarray]
+    s_elements: dict[str, np.ndarray]
+
+
+def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) -> Scene:
+    """The scene a set's engine is built from: no time series, and the sea of an
+    out-of-plane state when there is one (the models are then 3-D, and in-plane states
+    are solved by them exactly as by 2-D models)."""
+    upd: dict[str, Any] = {"analysis": scene.analysis.model_copy(update={"timeseries": None})}
+    for state in states:
+        if abs(math.sin(math.radians(state.heading))) > 1e-9:
+            upd["sea"] = Sea(spectrum=state.spectrum(family), heading=state.heading)
+            break
+    return scene.model_copy(update=upd)
+
+
+def _engine(template: Scene) -> Engine:
+    key = hashlib.sha256(template.model_dump_json().encode()).hexdigest()
+    if key in _ENGINES:
+        _ENGINES.move_to_end(key, last=False)
+        return _ENGINES[key]
+    engine = build_engine(template)
+    _ENGINES[key] = engine
+    _ENGINES.move_to_end(key, last=False)
+    while len(_ENGINES) > _ENGINE_CACHE_SIZE:
+        _ENGINES.popitem()
+    return engine
+
+
+def _solve_case(engine: Any, sea: Sea, index: int) -> tuple[CaseRow, Any]:
+    with collect_warnings() as caught:
+        try:
+            res = engine.solve(sea)
+        except StochcableError as exc:
+            return CaseRow(index, "failed", f"{type(exc).__name__}: {exc}"), None
+        except Exception as exc:  # a defect must cost its case only, with its trace
+            tb = traceback.format_exception_only(type(exc), exc)[-1].strip()
+            return CaseRow(index, "failed", f"internal error: {tb}"), None
+    msgs = tuple(dict.fromkeys(str(w) for w in caught))
+    flags = tuple(
+        f"{name}:{f}"
+        for name, lr in res.lines.items()
+        if lr.indicators is not None
+        for f in lr.indicators.flags
+    )
+    if not res.converged:
+        lin = res.linearization
+        reason = (
+            f"drag linearization not converged after {lin['iterations']} iterations "
+            f"(relative change {lin['relative_change']:.3g})"
+        )
+        return CaseRow(index, "not_converged", reason, flags, msgs), res
+    if flags:
+        return CaseRow(index, "flagged", "indicator flags: " + ", ".join(flags), flags, msgs), res
+    return CaseRow(index, "ok", "", (), msgs), res
+
+
+def solve_chunk(
+    template: Scene,
+    family: Family,
+    cases: tuple[tuple[int, SeaState], ...],
+    fatigue: dict[str, LineFatigue],
+    engine: Any = None,
+) -> ChunkResult:
+    """Solve the cases of one chunk on the engine of ``template``.
+
+    Parameters
+    ----------
+    template : Scene
+        :func:`engine_template` of the set's scene (its engine is built once per
+        worker and kept).
+    family : {"pierson_moskowitz", "jonswap"}
+    cases : tuple of (int, SeaState)
+        The cases and their positions in the diagram.
+    fatigue : dict of LineFatigue
+        Settings per line with a fatigue check (validated).
+    engine : Engine, optional
+        Use this engine instead (the in-process executor's).
+
+    Returns
+    -------
+    ChunkResult
+    """
+    with threadpool_limits(limits=1):
+        engine = _engine(template) if engine is None else engine
+        lines = {ln.name: sum(s.elements for s in ln.segments) for ln in template.lines}
+        k = len(cases)
+        stats = {ln: {e: np.full((k, 4), np.nan) for e in ENDS} for ln in lines}
+        damage = {ln: np.full((k, 2 + n), np.nan) for ln, n in lines.items()}
+        spectra: dict[str, list[np.ndarray]] = {ln: [] for ln in fatigue}
+        have: dict[str, list[int]] = {ln: [] for ln in fatigue}
+        s_el: dict[str, np.ndarray] = {}
+        omega = None
+        rows = []
+        for j, (i, state) in enumerate(cases):
+            sea = Sea(spectrum=state.spectrum(family), heading=state.heading)
+            row, res = _solve_case(engine, sea, i)
+            rows.append(row)
+            if res is None:
+                continue
+            for name, lr in res.lines.items():
+                s_el.setdefault(name, lr.s_elements)
+                omega = lr.omega
+                for e in ENDS:
+                    st = getattr(lr, e)
+                    stats[name][e][j] = (st.mean, st.std, st.tz, st.mpm_3h)
+                if name in fatigue:
+                    ends = np.stack([lr.end_tension_spectrum(e) for e in ENDS])
+                    spectra[name].append(np.concatenate([ends, lr.tension_spectrum]))
+                    have[name].append(j)
+        for name, settings in fatigue.items():
+            if have[name]:
+                curve, factor = curve_factor(settings, template.environment.g, name)
+                dens = np.stack(spectra[name]) * factor**2
+                damage[name][have[name]] = damage_rate(omega, dens, curve, settings.method)
+    idx = np.array([i for i, _ in cases], dtype=int)
+    return ChunkResult(idx, tuple(rows), stats, damage, s_el)

@@ -1,0 +1,82 @@
+"""The execution seam of load-case sets: the same bits whichever executor runs the
+chunks — this process, a process pool, a real Dask LocalCluster of two worker
+processes — and however the set is chunked."""
+
+from __future__ import annotations
+
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pytest
+
+from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
+from stochcable.errors import InputError
+from stochcable.examples import load_example
+
+FATIGUE = LineFatigue("dnv-studless", nominal_diameter=0.084)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_example("chain_catenary")
+
+
+@pytest.fixture(scope="module")
+def scatter():
+    rows = [
+        {"hs": hs, "tp": tp, "heading": hd, "probability": 1 / 12}
+        for hs in (1.5, 4.0)
+        for tp in (7.0, 10.0, 13.0)
+        for hd in (0.0, 180.0)
+    ]
+    return scatter_from_rows(rows)
+
+
+@pytest.fixture(scope="module")
+def serial(scene, scatter):
+    return run_cases(scene, scatter, fatigue=FATIGUE)
+
+
+def _assert_same_bits(a, b):
+    assert [r.status for r in a.rows] == [r.status for r in b.rows]
+    for ln in a.lines:
+        for e in ("end_a", "end_b"):
+            np.testing.assert_array_equal(a.stats[ln][e], b.stats[ln][e])
+        np.testing.assert_array_equal(a.damage_rate_ends[ln], b.damage_rate_ends[ln])
+        np.testing.assert_array_equal(a.damage_rate_along[ln], b.damage_rate_along[ln])
+        assert a.totals[ln].return_level == b.totals[ln].return_level
+        assert a.totals[ln].annual_damage["end_b"] == b.totals[ln].annual_damage["end_b"]
+
+
+def test_chunking_does_not_change_a_bit(scene, scatter, serial):
+    done = []
+    again = run_cases(
+        scene, scatter, fatigue=FATIGUE, chunk_size=5, progress=lambda d, n: done.append((d, n))
+    )
+    _assert_same_bits(serial, again)
+    assert done == [(5, 12), (10, 12), (12, 12)]
+
+
+def test_process_pool_gives_the_same_bits(scene, scatter, serial):
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as pool:
+        pooled = run_cases(scene, scatter, fatigue=FATIGUE, executor=pool)
+    _assert_same_bits(serial, pooled)
+
+
+def test_dask_local_cluster_gives_the_same_bits(scene, scatter, serial):
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        on_dask = run_cases(scene, scatter, fatigue=FATIGUE, executor=client, chunk_size=3)
+    _assert_same_bits(serial, on_dask)
+
+
+def test_chunk_size_is_validated(scene, scatter):
+    with pytest.raises(InputError, match="chunk_size"):
+        run_cases(scene, scatter, chunk_size=0)
