@@ -74,3 +74,13 @@ def test_errors_are_one_line(scatter, capsys, extra, message):
     err = capsys.readouterr().err
     assert err.startswith("stochcable cases: error:") and message in err
     assert err.count("\n") == 1
+
+
+def test_local_cluster_from_the_command_line(scatter, tmp_path):
+    pytest.importorskip("distributed")
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    common = ["cases", WIRE, "--scatter", scatter, "--curve", "dnv-six-strand",
+              "--nominal-area", "1.2e-3"]  # fmt: skip
+    assert main([*common, "-o", str(a)]) == 0
+    assert main([*common, "--workers", "2", "-o", str(b)]) == 0
+    assert json.loads(a.read_text()) == json.loads(b.read_text())

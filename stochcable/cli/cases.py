@@ -5,16 +5,19 @@ sea state, spectral fatigue damage and life, long-term extremes.
                      [--spectrum jonswap|pierson_moskowitz] [--curve dnv-studless]
                      [--nominal-diameter D | --nominal-area A | --mbs F]
                      [--method dirlik] [--dff 3] [--years 100] [-o out.nc|csv|json]
+                     [--workers N | --scheduler tcp://HOST:PORT]
 
 With ``--headings`` every row of the diagram is repeated for each heading with equal
 probability (the headings of the file are then ignored).  A progress bar is shown on a
 terminal (stderr), not when output is piped.  Without ``-o`` the JSON document goes to
-stdout.
+stdout.  ``--workers N`` runs the set on a local Dask cluster of N worker processes,
+``--scheduler`` on an existing one (the results are the same, bit for bit).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 from dataclasses import replace
@@ -58,6 +61,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--dff", type=float, default=1.0, help="design fatigue factor (default 1)")
     p.add_argument("--years", type=float, default=100.0, help="return period [years]")
     p.add_argument("-o", "--output", default=None, help="out.nc, out.csv or out.json")
+    p.add_argument(
+        "--workers", type=int, default=None,
+        help="run on a local Dask cluster of this many worker processes",
+    )  # fmt: skip
+    p.add_argument("--scheduler", default=None, help="an existing Dask scheduler (tcp://HOST:PORT)")
     p.set_defaults(func=run)
 
 
@@ -74,6 +82,36 @@ def _with_headings(scatter: ScatterDiagram, text: str) -> ScatterDiagram:
         for h in heads
     )
     return replace(scatter, states=states)
+
+
+@contextlib.contextmanager
+def _executor(args: argparse.Namespace):
+    """None (this process), a LocalCluster's client (``--workers``) or a client of an
+    existing scheduler (``--scheduler``)."""
+    if args.workers is None and args.scheduler is None:
+        yield None
+        return
+    if args.workers is not None and args.workers < 1:
+        raise InputError("--workers", args.workers, "-", "must be >= 1")
+    try:
+        import distributed
+    except ImportError:
+        raise InputError(
+            "--workers" if args.scheduler is None else "--scheduler",
+            args.workers if args.scheduler is None else args.scheduler,
+            "-",
+            "needs Dask: pip install 'stochcable[dask]'",
+        ) from None
+    if args.scheduler is not None:
+        with distributed.Client(args.scheduler, timeout=30) as client:
+            yield client
+        return
+    with (
+        distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1,
+                                 dashboard_address=None) as cluster,
+        distributed.Client(cluster) as client,
+    ):  # fmt: skip
+        yield client
 
 
 def run(args: argparse.Namespace) -> int:
@@ -103,7 +141,11 @@ def run(args: argparse.Namespace) -> int:
             bar.update(done - bar.n)
 
     try:
-        result = run_cases(scene, scatter, fatigue=fatigue, years=args.years, progress=progress)
+        with _executor(args) as executor:
+            result = run_cases(
+                scene, scatter, fatigue=fatigue, years=args.years, progress=progress,
+                executor=executor,
+            )  # fmt: skip
     finally:
         if bar is not None:
             bar.close()
