@@ -80,3 +80,33 @@ def test_dask_local_cluster_gives_the_same_bits(scene, scatter, serial):
 def test_chunk_size_is_validated(scene, scatter):
     with pytest.raises(InputError, match="chunk_size"):
         run_cases(scene, scatter, chunk_size=0)
+
+
+def test_a_killed_dask_worker_costs_nothing(scene, scatter, serial):
+    # One worker process is killed (SIGKILL) after the first chunks finish: its nanny
+    # restarts it, the scheduler reruns the chunks it held, and the set completes with
+    # every case, bit for bit the serial answer.
+    distributed = pytest.importorskip("distributed")
+    import os
+    import signal
+
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        killed = []
+
+        def kill_one(done: int, total: int) -> None:
+            if done >= 2 and not killed:
+                victim = sorted(client.scheduler_info()["workers"])[0]
+                pid = client.run(os.getpid, workers=[victim])[victim]
+                os.kill(pid, signal.SIGKILL)
+                killed.append(victim)
+
+        result = run_cases(
+            scene, scatter, fatigue=FATIGUE, executor=client, chunk_size=1, progress=kill_one
+        )
+    assert killed
+    _assert_same_bits(serial, result)
