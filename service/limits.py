@@ -7,13 +7,18 @@ Policy (documented in the README "Service" section):
 * a well-formed request whose work exceeds a size bound (``max_samples``,
   ``max_frequencies``, ``max_points``, ``max_elements``) answers **422** with
   ``type: "limit_exceeded"``, naming the bound and its environment variable;
-* computations run in worker threads, at most ``max_concurrency`` at once per process
-  (the rest queue); a request whose queueing plus computation exceeds
-  ``max_run_seconds`` answers **504** ``type: "run_time_exceeded"``.  Python cannot stop
-  a thread: the computation finishes in the background but keeps its concurrency slot
-  until then, so an overloaded server sheds load instead of piling up work.  An
-  analysis (``POST /v1/analyses``) stops earlier: its progress callback raises at the
-  next stage or drag-linearization iteration after the deadline.
+* an analysis whose estimated peak memory (:func:`stochcable.estimate_cost`) exceeds
+  ``max_memory_bytes`` answers **422** ``limit_exceeded`` before any work starts, naming
+  the estimate and the inputs to reduce;
+* analyses run in worker processes (:mod:`service.workers`): at their run limit the
+  worker is killed and replaced (**504**), a full queue answers **503**;
+* the light computations (spectra, realizations) run in threads, at most
+  ``max_concurrency`` at once per process (the rest queue); a request whose queueing
+  plus computation exceeds ``max_run_seconds`` answers **504** ``type:
+  "run_time_exceeded"``.  Python cannot stop a thread: the computation finishes in the
+  background but keeps its concurrency slot until then, so an overloaded server sheds
+  load instead of piling up work (these are bounded by ``max_samples`` and
+  ``max_frequencies`` to well under a second).
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ import anyio
 import numpy as np
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from stochcable.cost import estimate_cost
 from stochcable.errors import StochcableError
 
 from .errors import BodyTooLarge, LimitExceeded, NumericalError, RunTimeExceeded, error_response
@@ -43,6 +49,7 @@ __all__ = [
     "check_points",
     "check_elements",
     "check_scene",
+    "check_memory",
     "sample_count",
     "Runner",
 ]
@@ -112,11 +119,12 @@ def check_scene(scene: Any, settings: Settings) -> None:
 
     Checked before solving, in this order: total finite elements of all lines
     (``max_elements``), the analysis frequency count ``analysis.omega.count``
-    (``max_frequencies``) and the time-series length ``analysis.timeseries.duration /
-    dt`` (``max_samples``).
+    (``max_frequencies``), the estimated peak memory (``max_memory_bytes``) and the
+    time-series length ``analysis.timeseries.duration / dt`` (``max_samples``).
     """
     check_elements(sum(line.elements for line in scene.lines), settings)
     check_frequencies(scene.analysis.omega.count, settings, "analysis.omega.count")
+    check_memory(scene, settings)
     ts = scene.analysis.timeseries
     if ts is not None:
         n = sample_count(ts.duration, ts.dt)
@@ -128,6 +136,25 @@ def check_scene(scene: Any, settings: Settings) -> None:
                 "max_samples",
                 f"analysis.timeseries duration/dt = {n} samples",
             )
+
+
+def check_memory(scene: Any, settings: Settings) -> None:
+    """Raise LimitExceeded when the scene's estimated peak memory exceeds the budget.
+
+    The budget is ``max_memory_bytes`` (:attr:`Settings.memory_budget`); the estimate
+    is :func:`stochcable.estimate_cost` (sizes only, nothing allocated).
+    """
+    estimate = estimate_cost(scene)
+    budget = settings.memory_budget
+    if estimate.memory_bytes > budget:
+        raise LimitExceeded(
+            estimate.parameter,
+            None,
+            budget,
+            "max_memory_bytes",
+            f"the analysis's {estimate.describe()} = {estimate.memory_bytes} bytes",
+            hint=estimate.reduce_hint(),
+        )
 
 
 # ------------------------------------------------------------------ body size

@@ -1,0 +1,54 @@
+"""The computations the worker processes run (:mod:`service.workers`).
+
+Module-level functions, pickled by reference: the HTTP process sends the function and
+its arguments (the scene document as the validated model, never arrays) and gets back
+what it returns (the encoded result document).
+"""
+
+from __future__ import annotations
+
+from stochcable.scene.model import Scene
+
+from .encoding import dumps
+from .errors import memory_error
+from .limits import _checked
+
+__all__ = ["analysis_job"]
+
+
+def analysis_job(scene: Scene, timeseries: str) -> tuple[bytes, int]:
+    """Analyse a scene and encode its result document (in a worker process).
+
+    Parameters
+    ----------
+    scene : Scene
+        The validated scene document.
+    timeseries : {"window", "full", "none"}
+        Time series in the document.
+
+    Returns
+    -------
+    body : bytes
+        The v1 result document as compact JSON.
+    n_warnings : int
+        Entries of its ``warnings`` list.
+
+    Raises
+    ------
+    LimitExceeded
+        On MemoryError (the worker's address-space limit), naming what to reduce.
+    NumericalError
+        For non-finite results or arithmetic failures of the core on accepted input.
+    """
+    from stochcable.analysis import analyze
+    from stochcable.cost import estimate_cost
+
+    try:
+        # the core's own floating-point policy (the result equals analyze()'s);
+        # arithmetic failures escaping it become NumericalError (422)
+        result = _checked(False, analyze, scene)
+        doc = result.to_document(timeseries=timeseries)
+        return dumps(doc), len(doc.get("warnings", ()))
+    except MemoryError as exc:
+        hint = estimate_cost(scene).reduce_hint()
+        raise memory_error(exc, hint) from None
