@@ -35,7 +35,9 @@ def _body_examples() -> dict[str, dict[str, Any]]:
         out[name] = {
             "summary": name,
             "description": scene.title,
-            "value": scene.model_dump(mode="json", exclude_defaults=True),
+            # the fields the example file sets (exclude_defaults would drop the
+            # spectra's discriminator ``type``, whose value is also its default)
+            "value": scene.model_dump(mode="json", exclude_unset=True),
         }
     return out
 
