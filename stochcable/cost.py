@@ -75,6 +75,7 @@ __all__ = [
     "CostEstimate",
     "estimate_cost",
     "check_memory",
+    "available_memory",
     "BYTES_PER_NODE_FREQUENCY_CHANNEL",
     "BYTES_PER_SAMPLE_CHANNEL",
     "BASE_BYTES",
@@ -296,6 +297,13 @@ def check_memory(estimate: CostEstimate, limit_bytes: int, limit_name: str) -> N
         f"the analysis needs an {estimate.describe()}, more than {limit_name} "
         f"({_fmt_bytes(limit_bytes)}); {estimate.reduce_hint()}",
     )
+
+
+def available_memory() -> int:
+    """Memory the machine can give a new computation now (psutil ``available``). [B]"""
+    import psutil
+
+    return int(psutil.virtual_memory().available)
 
 
 def _value_of(estimate: CostEstimate) -> int:
