@@ -11,7 +11,7 @@ from stochcable.scene.model import Scene
 
 from .encoding import dumps
 from .errors import memory_error
-from .limits import _checked
+from .limits import checked_call
 
 __all__ = ["analysis_job"]
 
@@ -46,7 +46,7 @@ def analysis_job(scene: Scene, timeseries: str) -> tuple[bytes, int]:
     try:
         # the core's own floating-point policy (the result equals analyze()'s);
         # arithmetic failures escaping it become NumericalError (422)
-        result = _checked(False, analyze, scene)
+        result = checked_call(False, analyze, scene)
         doc = result.to_document(timeseries=timeseries)
         return dumps(doc), len(doc.get("warnings", ()))
     except MemoryError as exc:

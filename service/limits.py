@@ -52,6 +52,7 @@ __all__ = [
     "check_memory",
     "sample_count",
     "Runner",
+    "checked_call",
 ]
 
 T = TypeVar("T")
@@ -307,7 +308,7 @@ class Runner:
         ``exclusive``: computations of the same name run one at a time (see the class).
 
         ``strict_fp`` (default) makes floating-point overflow, invalid operations and
-        division by zero raise (see :func:`_checked`); with False the computation runs
+        division by zero raise (see :func:`checked_call`); with False the computation runs
         under numpy's default error state, exactly as the library runs it locally (the
         analyses: their results must equal ``analyze()``'s, and the core handles its
         own non-finite intermediates).
@@ -321,7 +322,7 @@ class Runner:
                 if time.monotonic() >= deadline:  # timed out while queued: skip
                     return None
                 return await anyio.to_thread.run_sync(
-                    _checked, strict_fp, func, *args, limiter=threads
+                    checked_call, strict_fp, func, *args, limiter=threads
                 )
 
         task = asyncio.ensure_future(job())
@@ -338,8 +339,8 @@ class Runner:
             task.exception()  # retrieved: an abandoned failure is not "never retrieved"
 
 
-def _checked(strict_fp: bool, func: Callable[..., T], *args: Any) -> T:
-    """Call ``func`` in the numerical policy of the service.
+def checked_call(strict_fp: bool, func: Callable[..., T], *args: Any) -> T:
+    """Call ``func`` in the numerical policy of the service (threads and workers alike).
 
     With ``strict_fp``, floating-point overflow, invalid operations and division by
     zero raise instead of producing inf/NaN silently (underflow to zero stays allowed);

@@ -6,9 +6,9 @@ schema-valid ones accepted, allowed methods.
 Two expectations are widened, each for a reason the schema cannot carry: a body of
 either kind may be refused as too large (413, before it is parsed), an unknown example
 name is a 404, and a schema-valid body may be refused with 422 and its reason, for the
-constraints between fields (``exactly one of (hs, tp), (m0, omega_p) or wind_speed``), the physics checks
-(an anchor above the water) and the configured size limits (``limit_exceeded``), which
-JSON Schema does not express.
+constraints between fields (``exactly one of (hs, tp), (m0, omega_p) or wind_speed``),
+the physics checks (an anchor above the water) and the configured size limits
+(``limit_exceeded``), which JSON Schema does not express.
 
 Bounded: 25 examples per operation (10 for ``POST /v1/analyses``, whose generated
 scenes are the costliest), small service limits so generated durations, grids and
