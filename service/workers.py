@@ -187,6 +187,28 @@ class _Worker:
         self.conn.close()
 
 
+_FIRST_START = threading.Lock()
+_FORKSERVER_STARTED = False
+
+
+def _first_worker(ctx: Any, address_space_extra: int, recycle_bytes: int) -> _Worker:
+    """The first worker of the process: it starts the fork server, which inherits the
+    environment then; with one BLAS thread it holds no OpenBLAS threads when it forks."""
+    global _FORKSERVER_STARTED
+    saved = {k: os.environ.get(k) for k in _ONE_THREAD}
+    os.environ.update(_ONE_THREAD)
+    try:
+        worker = _Worker(ctx, address_space_extra, recycle_bytes)
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+    _FORKSERVER_STARTED = True
+    return worker
+
+
 class WorkerPool:
     """Worker processes running one computation each, replaced one at a time.
 
@@ -240,16 +262,11 @@ class WorkerPool:
     def _spawn(self) -> _Worker:
         """A new worker (the first one starts the fork server, with one BLAS thread)."""
         ctx = self._context()
-        saved = {k: os.environ.get(k) for k in _ONE_THREAD}
-        os.environ.update(_ONE_THREAD)  # inherited by the fork server when it starts
-        try:
-            worker = _Worker(ctx, self.address_space_extra, self.recycle_bytes)
-        finally:
-            for k, v in saved.items():
-                if v is None:
-                    os.environ.pop(k, None)
-                else:
-                    os.environ[k] = v
+        with _FIRST_START:
+            if _FORKSERVER_STARTED:
+                worker = _Worker(ctx, self.address_space_extra, self.recycle_bytes)
+            else:
+                worker = _first_worker(ctx, self.address_space_extra, self.recycle_bytes)
         with self._lock:
             self._workers.append(worker)
         return worker
@@ -318,12 +335,15 @@ class WorkerPool:
             await anyio.to_thread.run_sync(lambda: self._release(self._spawn()))
         try:
             return await asyncio.wait_for(fut, max(deadline - time.monotonic(), 0.0))
-        except asyncio.TimeoutError:
-            raise RunTimeExceeded(limit) from None
-        finally:
+        except BaseException as exc:  # timed out, or the request was cancelled
             with self._lock:
                 if fut in self._waiters:
                     self._waiters.remove(fut)
+            if fut.done() and not fut.cancelled() and fut.exception() is None:
+                self._release(fut.result())  # handed over as the wait ended: pass it on
+            if isinstance(exc, asyncio.TimeoutError):
+                raise RunTimeExceeded(limit) from None
+            raise
 
     # ------------------------------------------------------------ running
 

@@ -149,3 +149,34 @@ def test_memory_error_under_the_address_space_limit_is_a_422():
         assert pool.replaced == 1
     finally:
         pool.close()
+
+
+def test_full_queue_is_503_with_retry_after_over_http():
+    import copy
+    import threading
+
+    from fastapi.testclient import TestClient
+
+    from service.app import create_app
+    from service.settings import Settings
+    from stochcable.examples import load_example
+
+    chain = load_example("chain_catenary").model_dump(mode="json", exclude_unset=True)
+    long = copy.deepcopy(chain)
+    long["lines"][0]["segments"][0]["elements"] = 100
+    long["analysis"]["omega"]["count"] = 2000  # ≈ 1.5 s in the one worker
+    app = create_app(Settings(analysis_workers=1, max_queue=0))
+    with TestClient(app) as c:
+        out = {}
+        t = threading.Thread(target=lambda: out.setdefault("r", c.post("/v1/analyses", json=long)))
+        t.start()
+        time.sleep(0.3)
+        resp = c.post("/v1/analyses", json=chain)
+        # the light endpoints do not queue behind the analysis
+        light = c.post("/v1/spectra", json={"spectrum": {"type": "jonswap", "hs": 2, "tp": 8}})
+        t.join(60.0)
+    assert out["r"].status_code == 200
+    assert light.status_code == 200
+    assert resp.status_code == 503 and int(resp.headers["retry-after"]) >= 1
+    err = resp.json()["detail"][0]
+    assert err["type"] == "queue_full" and err["setting"] == "STOCHCABLE_MAX_QUEUE"

@@ -168,7 +168,7 @@ def test_killed_worker_costs_only_its_request(one_worker):
     out: dict[str, httpx.Response] = {}
     thread = threading.Thread(target=lambda: out.setdefault("r", one_worker.post(LONG, 30.0)))
     thread.start()
-    deadline = time.monotonic() + 10.0
+    deadline = time.monotonic() + 1.0  # well inside the 2 s run limit
     while worker.cpu_percent(0.1) < 50.0 and time.monotonic() < deadline:
         pass  # until the worker computes
     os.kill(worker.pid, signal.SIGKILL)
