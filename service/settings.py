@@ -77,8 +77,9 @@ class Settings(BaseSettings):
         ge=2**20,
         description="Largest estimated peak memory of one analysis (stochcable.estimate_cost); "
         "over it the request answers 422 limit_exceeded.  Default: 80 % of the machine's "
-        "memory divided by analysis_workers.  Each worker runs under an address-space "
-        "limit of its imported size plus twice this budget [bytes]",
+        "memory divided by the analyses that can run at once (analysis_workers × "
+        "workers).  Each worker runs under an address-space limit of its imported size "
+        "plus twice this budget [bytes]",
     )
     worker_recycle_bytes: int = Field(
         default=1024 * 2**20,
@@ -93,7 +94,8 @@ class Settings(BaseSettings):
         """``max_memory_bytes``, or its default from the machine's memory. [bytes]"""
         if self.max_memory_bytes is not None:
             return self.max_memory_bytes
-        return int(0.8 * psutil.virtual_memory().total / self.analysis_workers)
+        running = self.analysis_workers * self.workers  # each uvicorn process has a pool
+        return int(0.8 * psutil.virtual_memory().total / running)
 
     @staticmethod
     def env_name(field: str) -> str:
