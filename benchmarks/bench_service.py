@@ -194,17 +194,25 @@ def _health_while(base: str, n: int, heavy_clients: int, post) -> dict:
     for t in threads:
         t.start()
     time.sleep(0.5)
-    lat = []
+    lat, server = [], []
     with httpx.Client(base_url=base, timeout=30.0) as c:
         for _ in range(n):
             t0 = time.perf_counter()
-            c.get("/health").raise_for_status()
+            resp = c.get("/health")
+            resp.raise_for_status()
             lat.append(time.perf_counter() - t0)
+            server.append(_server_s(resp))
             time.sleep(0.01)
     stop.set()
     for t in threads:
         t.join(120.0)
-    return {"p50": _pct(lat, 50), "p99": _pct(lat, 99), "max": max(lat), "heavy": heavy_done[0]}
+    return {
+        "p50": _pct(lat, 50),
+        "p99": _pct(lat, 99),
+        "max": max(lat),
+        "server_p99": _pct(server, 99),
+        "heavy": heavy_done[0],
+    }
 
 
 def bench_health_under_load(base: str, n: int, heavy_clients: int) -> dict:
@@ -430,13 +438,15 @@ def main(argv: list[str] | None = None) -> int:
         report(
             f"GET /health under analyses p50 {_fmt_ms(h['p50'])}  p99 {_fmt_ms(h['p99'])}  "
             f"max {_fmt_ms(h['max'])}  ({h['heavy']} analyses meanwhile)   goal p99 <= 10 ms: "
-            f"{'ok' if h['p99'] <= 10e-3 else 'MISSED'}"
+            f"{'ok' if h['p99'] <= 10e-3 else 'MISSED'}; server-side p99 "
+            f"{_fmt_ms(h['server_p99'])}"
         )
         h = bench_health_during_heavy(base, 100 if args.quick else 300)
         report(
             f"GET /health during a heavy analysis p50 {_fmt_ms(h['p50'])}  p99 "
             f"{_fmt_ms(h['p99'])}  max {_fmt_ms(h['max'])}   goal max <= 50 ms: "
-            f"{'ok' if h['max'] <= 50e-3 else 'MISSED'}"
+            f"{'ok' if h['max'] <= 50e-3 else 'MISSED'}; server-side p99 "
+            f"{_fmt_ms(h['server_p99'])}"
         )
     finally:
         proc.terminate()

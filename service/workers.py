@@ -58,7 +58,7 @@ import anyio
 
 from .errors import JobFailed, QueueFull, RunTimeExceeded, WorkerLost, error_answer
 
-__all__ = ["WorkerPool"]
+__all__ = ["WorkerPool", "WORKER_NICENESS"]
 
 _log = logging.getLogger("stochcable.service")
 
@@ -76,12 +76,21 @@ _PRELOAD = [
 ]
 """Modules the fork server imports once, so that every worker starts with them."""
 
+WORKER_NICENESS = 5
+"""CPU priority step of the workers below the HTTP process (``os.nice``): on a machine
+whose cores the workers fill, the event loop answering /health and small requests is
+scheduled first."""
+
 _ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
 
 
-def _worker_main(conn: Connection, address_space_extra: int, recycle_bytes: int) -> None:
+def _worker_main(
+    conn: Connection, address_space_extra: int, recycle_bytes: int, niceness: int
+) -> None:
     """The loop of one worker process: receive ``(func, args)``, answer, repeat."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the server ends its workers itself
+    if niceness > 0:
+        os.nice(niceness)  # the HTTP process (light requests, answers) goes first
     import psutil
     import threadpoolctl
 
@@ -147,7 +156,7 @@ class _Worker:
         self.conn, child = ctx.Pipe(duplex=True)
         self.process = ctx.Process(
             target=_worker_main,
-            args=(child, address_space_extra, recycle_bytes),
+            args=(child, address_space_extra, recycle_bytes, WORKER_NICENESS),
             name="stochcable-worker",
             daemon=True,
         )
