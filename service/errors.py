@@ -172,7 +172,15 @@ class JobFailed(Exception):
 
 
 class NumericalError(Exception):
-    """A computation produced non-finite numbers from accepted input (HTTP 422)."""
+    """A computation produced non-finite numbers from accepted input (HTTP 422).
+
+    ``parameter``: the input part whose results are non-finite, when known
+    (``lines[2]``, ``bodies[0]``).
+    """
+
+    def __init__(self, message: str, parameter: str | None = None) -> None:
+        self.parameter = parameter
+        super().__init__(message)
 
 
 class NotFound(StarletteHTTPException):
@@ -302,7 +310,10 @@ def error_answer(exc: BaseException) -> tuple[int, dict[str, Any], dict[str, str
     if isinstance(exc, StochcableError):
         return 422, _item(["body"], str(exc), "solver_error"), {}
     if isinstance(exc, (NumericalError, FloatingPointError)):
-        return 422, _item(["body"], f"{exc}: {_NUMERICAL_HINT}", "numerical_error"), {}
+        parameter = getattr(exc, "parameter", None)
+        loc = ["body", *_loc_from_parameter(parameter)] if parameter else ["body"]
+        msg = f"{exc}: {_NUMERICAL_HINT}"
+        return 422, _item(loc, msg, "numerical_error", parameter=parameter), {}
     if isinstance(exc, RunTimeExceeded):
         return 504, _item([], str(exc), "run_time_exceeded", limit=exc.limit, setting=exc.env), {}
     if isinstance(exc, QueueFull):

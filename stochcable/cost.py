@@ -59,7 +59,13 @@ memory model is what the budgets use.
 
 The constants are in one place (the ``*_BYTES_*`` and ``*_SECONDS_*`` module
 constants) so that a change of the engine's array layout (frequency-blocked solves)
-updates them here only.
+updates them here only: rerun ``benchmarks/bench_cost.py`` and take the largest
+bytes-per-node·frequency·channel ratio, rounded up.
+
+Not yet covered: the adaptive-fidelity planner (``analysis.fidelity``) chooses its own
+elements and frequencies and does not consult this budget; the estimate is that of the
+document as given, and the service's workers' address-space limit is what bounds a
+planned analysis that grows beyond it.
 """
 
 from __future__ import annotations

@@ -180,3 +180,18 @@ def test_full_queue_is_503_with_retry_after_over_http():
     assert resp.status_code == 503 and int(resp.headers["retry-after"]) >= 1
     err = resp.json()["detail"][0]
     assert err["type"] == "queue_full" and err["setting"] == "STOCHCABLE_MAX_QUEUE"
+
+
+def test_non_finite_results_name_the_line():
+    from service.errors import error_answer
+    from service.jobs import non_finite_error
+    from stochcable.analysis import analyze
+    from stochcable.examples import load_example
+
+    scene = load_example("tuah_1982_disc_buoy_three_legs")
+    doc = analyze(scene).to_document()
+    doc["lines"]["leg2"]["end_a"]["tension"]["std"] = float("nan")  # as a core overflow would
+    status, item, _ = error_answer(non_finite_error(scene, doc))
+    assert status == 422 and item["type"] == "numerical_error"
+    assert item["parameter"] == "lines[1]" and item["loc"] == ["body", "lines", 1]
+    assert "line 'leg2'" in item["msg"]
