@@ -1,7 +1,9 @@
-"""POST /v1/analyses in-process (FastAPI TestClient): the result document equals the
-core's analyze(scene).to_document() and the CLI's output, the limits answer 413/422
-naming the bound, solver failures answer 422 with the reason, the run-time bound stops
-an abandoned analysis, and concurrent analyses keep their own warnings."""
+"""POST /v1/analyses through the app (FastAPI TestClient; the analyses run in the app's
+worker processes): the result document equals the core's analyze(scene).to_document()
+and the CLI's output, every published OpenAPI example answers 200, the limits answer
+413/422 naming the bound, solver failures answer 422 with the reason, and concurrent
+analyses keep their own warnings.  The run limit and worker failures:
+tests/test_service_workers.py and tests/service/."""
 
 from __future__ import annotations
 
@@ -240,8 +242,8 @@ def test_anchor_above_the_water_is_422_naming_the_field(small):
 
 def test_concurrent_analyses_keep_their_own_warnings(client):
     # analyze() records warnings with warnings.catch_warnings (process-global state):
-    # the service runs one analysis at a time so overlapping requests neither swap
-    # their warnings nor leave the process's warning filters altered
+    # each analysis runs alone in its worker process, so overlapping requests neither
+    # swap their warnings nor alter the HTTP process's warning filters
     filters = list(warnings.filters)
     names = ["tuah_1982_suspended_cable", "taut_wire", "tuah_1982_suspended_cable", "taut_wire"]
     out: dict[int, object] = {}
