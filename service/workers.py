@@ -312,6 +312,9 @@ class WorkerPool:
     def _release(self, worker: _Worker) -> None:
         """Give a free worker to the first waiting request, or mark it idle."""
         with self._lock:
+            if worker not in self._workers:  # of a closed pool: end it, hand nothing over
+                threading.Thread(target=worker.stop, daemon=True).start()
+                return
             while self._waiters:
                 fut = self._waiters.popleft()
                 if not fut.done():
@@ -322,11 +325,12 @@ class WorkerPool:
     def _retire(self, worker: _Worker, kill: bool) -> None:
         """Stop a worker and start its replacement (in a thread: process start blocks)."""
         with self._lock:
-            if worker in self._workers:
+            current = worker in self._workers  # not if the pool was closed meanwhile
+            if current:
                 self._workers.remove(worker)
             self.replaced += 1
         worker.stop(kill=kill)
-        if not self._closed:
+        if current and not self._closed:
             self._release(self._spawn())
 
     async def _acquire(self, deadline: float, limit: float) -> _Worker:
