@@ -281,13 +281,13 @@ class WorkerPool:
         return worker
 
     def start(self) -> None:
-        """Start every worker now (blocking; else they start on first demand)."""
-        while True:
-            with self._lock:
-                if self._closed or len(self._workers) >= self.size:
-                    return
-            worker = self._spawn()
-            worker.wait_ready(60.0)
+        """Start every worker now and wait until they are warm (else they start on
+        first demand); the workers warm up in parallel."""
+        with self._lock:
+            missing = 0 if self._closed else self.size - len(self._workers)
+        started = [self._spawn() for _ in range(missing)]
+        for worker in started:
+            worker.wait_ready(120.0)
             self._release(worker)
 
     def close(self) -> None:
