@@ -139,11 +139,18 @@ def check_scene(scene: Any, settings: Settings) -> None:
             )
 
 
-def check_memory(scene: Any, settings: Settings) -> None:
-    """Raise LimitExceeded when the scene's estimated peak memory exceeds the budget.
+RUN_TIME_MARGIN = 10.0
+"""An analysis whose estimated run time exceeds this many times ``max_run_seconds`` is
+refused before it starts (the estimate is of the calibration machine; the margin covers
+slower machines and the estimate's spread, so only hopeless requests are refused). [-]"""
 
-    The budget is ``max_memory_bytes`` (:attr:`Settings.memory_budget`); the estimate
-    is :func:`stochcable.estimate_cost` (sizes only, nothing allocated).
+
+def check_memory(scene: Any, settings: Settings) -> None:
+    """Raise LimitExceeded when the scene's estimated cost exceeds the budgets.
+
+    The estimate is :func:`stochcable.estimate_cost` (sizes only, nothing allocated):
+    its peak memory against ``max_memory_bytes`` (:attr:`Settings.memory_budget`), then
+    its run time against :data:`RUN_TIME_MARGIN` × ``max_run_seconds``.
     """
     estimate = estimate_cost(scene)
     budget = settings.memory_budget
@@ -155,6 +162,18 @@ def check_memory(scene: Any, settings: Settings) -> None:
             "max_memory_bytes",
             f"the analysis's {estimate.describe()} = {estimate.memory_bytes} bytes",
             hint=estimate.reduce_hint(),
+        )
+    limit = settings.max_run_seconds
+    if estimate.seconds > RUN_TIME_MARGIN * limit:
+        raise LimitExceeded(
+            estimate.parameter,
+            None,
+            limit,
+            "max_run_seconds",
+            "",
+            message=f"the analysis's estimated run time {estimate.seconds:.3g} s is more "
+            f"than {RUN_TIME_MARGIN:g} times the run limit of {limit:g} s "
+            f"({Settings.env_name('max_run_seconds')}); {estimate.reduce_hint()}",
         )
 
 
