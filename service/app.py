@@ -10,7 +10,10 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
 
+import anyio
 from fastapi import FastAPI
 from starlette.middleware.gzip import DEFAULT_EXCLUDED_CONTENT_TYPES, GZipMiddleware
 
@@ -21,6 +24,7 @@ from .encoding import NPY
 from .errors import install_error_handlers
 from .limits import BodySizeLimitMiddleware, Runner, ServerTimingMiddleware
 from .settings import Settings
+from .workers import WorkerPool
 
 __all__ = ["create_app", "app", "GZIP_MINIMUM_BYTES", "GZIP_LEVEL"]
 
@@ -82,7 +86,23 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """
     settings = settings if settings is not None else Settings()
     runtime.configure()  # the service's process settings (stochcable.runtime)
+    pool = WorkerPool(
+        settings.analysis_workers,
+        settings.max_queue,
+        settings.memory_budget,
+        settings.worker_recycle_bytes,
+    )
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        await anyio.to_thread.run_sync(pool.start)  # warm workers before the first request
+        try:
+            yield
+        finally:
+            await anyio.to_thread.run_sync(pool.close)
+
     app = FastAPI(
+        lifespan=lifespan,
         title="stochcable",
         version=__version__,
         summary="Stochastic response of marine cables in random seas",
@@ -91,6 +111,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     app.state.runner = Runner(settings)
+    app.state.pool = pool  # analyses (started by the lifespan, or on first demand)
     install_error_handlers(app)
     for router in _routers():
         app.include_router(router)

@@ -9,8 +9,17 @@ from fastapi import Depends, Request
 from .encoding import negotiate
 from .limits import Runner
 from .settings import Settings
+from .workers import WorkerPool
 
-__all__ = ["SettingsDep", "RunnerDep", "MediaTypeDep", "get_settings", "get_runner"]
+__all__ = [
+    "SettingsDep",
+    "RunnerDep",
+    "PoolDep",
+    "MediaTypeDep",
+    "get_settings",
+    "get_runner",
+    "get_pool",
+]
 
 
 def get_settings(request: Request) -> Settings:
@@ -23,6 +32,12 @@ def get_runner(request: Request) -> Runner:
     return request.app.state.runner
 
 
+def get_pool(request: Request) -> WorkerPool:
+    """The application's analysis worker processes."""
+    return request.app.state.pool
+
+
 SettingsDep = Annotated[Settings, Depends(get_settings)]
 RunnerDep = Annotated[Runner, Depends(get_runner)]
+PoolDep = Annotated[WorkerPool, Depends(get_pool)]
 MediaTypeDep = Annotated[str, Depends(negotiate)]

@@ -224,6 +224,18 @@ _ERRORS: dict[int, dict[str, Any]] = {
         "body), a size bound exceeded (type limit_exceeded, naming the STOCHCABLE_* "
         "setting) or a solver failure",
     },
+    503: {
+        "model": ErrorResponse,
+        "description": "Every analysis worker busy and STOCHCABLE_MAX_QUEUE requests "
+        "waiting (type queue_full), or the worker process running the analysis ended by "
+        "the system, e.g. out of memory (type worker_lost); retry after Retry-After seconds",
+        "headers": {
+            "Retry-After": {
+                "description": "Seconds to wait before retrying",
+                "schema": {"type": "integer", "minimum": 0},
+            }
+        },
+    },
     504: {
         "model": ErrorResponse,
         "description": "Queueing plus computation over STOCHCABLE_MAX_RUN_SECONDS",

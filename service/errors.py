@@ -18,10 +18,19 @@ too deep to decode (FastAPI's 400)
 ConvergenceError                         422     ``convergence_error``
 SolverError, other StochcableError       422     ``solver_error``
 FloatingPointError, non-finite result    422     ``numerical_error``
+MemoryError (the process or a worker's   422     ``limit_exceeded`` (setting
+address-space limit)                             ``STOCHCABLE_MAX_MEMORY_BYTES``)
 :class:`BodyTooLarge`                    413     ``body_too_large``
+:class:`QueueFull`                       503     ``queue_full`` (Retry-After)
+:class:`WorkerLost` (killed, OOM)        503     ``worker_lost`` (Retry-After)
 :class:`RunTimeExceeded`                 504     ``run_time_exceeded``
 HTTPException (404, 405, 406, ...)       as is   ``http_error`` / ``not_found``
+any other exception (a bug)              500     ``internal_error`` (JSON)
 =======================================  ======  ==============================
+
+An analysis runs in a worker process (:mod:`service.workers`): its failure is mapped
+there by :func:`error_answer` (the same mapping) and travels back as a
+:class:`JobFailed` carrying the answer.
 """
 
 from __future__ import annotations
@@ -51,6 +60,11 @@ __all__ = [
     "LimitExceeded",
     "RunTimeExceeded",
     "BodyTooLarge",
+    "QueueFull",
+    "WorkerLost",
+    "JobFailed",
+    "error_answer",
+    "memory_error",
 ]
 
 
@@ -60,13 +74,25 @@ __all__ = [
 class LimitExceeded(Exception):
     """A request asks for more work than a configured bound allows (HTTP 422)."""
 
-    def __init__(self, parameter: str, value: Any, limit: Any, setting: str, what: str) -> None:
+    def __init__(
+        self,
+        parameter: str,
+        value: Any,
+        limit: Any,
+        setting: str,
+        what: str,
+        hint: str = "",
+        message: str | None = None,
+    ) -> None:
         self.parameter = parameter
         self.value = value
         self.limit = limit
         self.setting = setting
         self.env = Settings.env_name(setting)
-        super().__init__(f"{what} exceeds the limit of {limit} ({self.env})")
+        if message is None:
+            message = f"{what} exceeds the limit of {limit} ({self.env})"
+            message += f"; {hint}" if hint else ""
+        super().__init__(message)
 
 
 class RunTimeExceeded(Exception):
@@ -98,8 +124,63 @@ class BodyTooLarge(StarletteHTTPException):
         return str(self.detail)
 
 
+class QueueFull(Exception):
+    """Every analysis worker is busy and ``max_queue`` analyses already wait (HTTP 503)."""
+
+    def __init__(self, limit: int, retry_after: int) -> None:
+        self.limit = limit
+        self.retry_after = retry_after
+        self.env = Settings.env_name("max_queue")
+        super().__init__(
+            f"every analysis worker is busy and {limit} analyses are already waiting "
+            f"(the limit, {self.env}); retry after {retry_after} s"
+        )
+
+
+class WorkerLost(Exception):
+    """The worker process running an analysis ended without an answer (HTTP 503)."""
+
+    def __init__(self, exitcode: int | None) -> None:
+        self.exitcode = exitcode
+        if exitcode is not None and exitcode < 0:
+            import signal
+
+            try:
+                name = signal.Signals(-exitcode).name
+            except ValueError:
+                name = f"signal {-exitcode}"
+            how = f"was killed by {name}"
+            if -exitcode == signal.SIGKILL:
+                how += " (the kernel's out-of-memory killer or an operator)"
+        else:
+            how = f"exited with code {exitcode}"
+        super().__init__(
+            f"the worker process running this analysis {how} before answering; the server "
+            "has replaced it and other requests are unaffected; retry, and reduce the "
+            "analysis (frequencies, elements, time series) if it happens again"
+        )
+
+
+class JobFailed(Exception):
+    """The error answer of a computation that failed in a worker process."""
+
+    def __init__(self, status: int, item: dict[str, Any], headers: dict[str, str]) -> None:
+        self.status = status
+        self.item = item
+        self.headers = headers
+        super().__init__(item.get("msg", ""))
+
+
 class NumericalError(Exception):
-    """A computation produced non-finite numbers from accepted input (HTTP 422)."""
+    """A computation produced non-finite numbers from accepted input (HTTP 422).
+
+    ``parameter``: the input part whose results are non-finite, when known
+    (``lines[2]``, ``bodies[0]``).
+    """
+
+    def __init__(self, message: str, parameter: str | None = None) -> None:
+        self.parameter = parameter
+        super().__init__(message)
 
 
 class NotFound(StarletteHTTPException):
@@ -154,6 +235,111 @@ def _body_model(request: Request) -> type[BaseModel] | None:
     return None
 
 
+# ------------------------------------------------------------- the mapping
+
+_MEMORY_ENV = Settings.env_name("max_memory_bytes")
+
+
+def memory_error(exc: MemoryError, hint: str = "") -> LimitExceeded:
+    """A MemoryError as the limit it hit (``STOCHCABLE_MAX_MEMORY_BYTES``)."""
+    what = str(exc).splitlines()[0] if str(exc) else "MemoryError"
+    extra = f"; {hint}" if hint else ""
+    return LimitExceeded(
+        "body",
+        None,
+        None,
+        "max_memory_bytes",
+        "",
+        message=f"the computation ran out of memory ({what}) under the memory limit "
+        f"({_MEMORY_ENV}){extra}",
+    )
+
+
+def error_answer(exc: BaseException) -> tuple[int, dict[str, Any], dict[str, str]]:
+    """The status, error item and headers of an exception (the handlers' mapping).
+
+    Used by the handlers below and by the worker processes, which cannot send the
+    exception itself back (custom exception types do not all pickle).
+    """
+    if isinstance(exc, MemoryError):
+        exc = memory_error(exc)
+    if isinstance(exc, InputError):
+        value = exc.value if _json_safe(exc.value) else None
+        return (
+            422,
+            _item(
+                ["body", *_loc_from_parameter(exc.parameter)],
+                str(exc),
+                "input_error",
+                parameter=exc.parameter,
+                unit=exc.unit or None,
+                input=value,
+            ),
+            {},
+        )
+    if isinstance(exc, LimitExceeded):
+        value = exc.value if _json_safe(exc.value) else None
+        return (
+            422,
+            _item(
+                ["body", *_loc_from_parameter(exc.parameter)],
+                str(exc),
+                "limit_exceeded",
+                parameter=exc.parameter,
+                input=value,
+                limit=exc.limit,
+                setting=exc.env,
+            ),
+            {},
+        )
+    if isinstance(exc, ConvergenceError):
+        residual = exc.residual if _json_safe(float(exc.residual)) else None
+        return (
+            422,
+            _item(
+                ["body"],
+                str(exc),
+                "convergence_error",
+                solver=exc.solver,
+                iterations=exc.iterations,
+                residual=residual,
+                tolerance=exc.tolerance,
+            ),
+            {},
+        )
+    if isinstance(exc, StochcableError):
+        return 422, _item(["body"], str(exc), "solver_error"), {}
+    if isinstance(exc, (NumericalError, FloatingPointError)):
+        parameter = getattr(exc, "parameter", None)
+        loc = ["body", *_loc_from_parameter(parameter)] if parameter else ["body"]
+        msg = f"{exc}: {_NUMERICAL_HINT}"
+        return 422, _item(loc, msg, "numerical_error", parameter=parameter), {}
+    if isinstance(exc, RunTimeExceeded):
+        return 504, _item([], str(exc), "run_time_exceeded", limit=exc.limit, setting=exc.env), {}
+    if isinstance(exc, QueueFull):
+        return (
+            503,
+            _item([], str(exc), "queue_full", limit=exc.limit, setting=exc.env),
+            {"Retry-After": str(exc.retry_after)},
+        )
+    if isinstance(exc, WorkerLost):
+        return 503, _item([], str(exc), "worker_lost", exitcode=exc.exitcode), {"Retry-After": "1"}
+    if isinstance(exc, JobFailed):
+        return exc.status, exc.item, exc.headers
+    return 500, _item([], f"internal error ({type(exc).__name__}: {exc})", "internal_error"), {}
+
+
+def _item(loc: list[str | int], msg: str, type_: str, **extra: Any) -> dict[str, Any]:
+    item: dict[str, Any] = {"loc": loc, "msg": msg, "type": type_}
+    item.update({k: v for k, v in extra.items() if v is not None})
+    return item
+
+
+async def _mapped_handler(request: Request, exc: Exception) -> JSONResponse:
+    status, item, headers = error_answer(exc)
+    return JSONResponse({"detail": [item]}, status_code=status, headers=headers or None)
+
+
 # ------------------------------------------------------------------ handlers
 
 
@@ -193,69 +379,16 @@ async def _validation_handler(request: Request, exc: RequestValidationError) -> 
     return JSONResponse({"detail": items}, status_code=422)
 
 
-async def _input_error_handler(request: Request, exc: InputError) -> JSONResponse:
-    value = exc.value if _json_safe(exc.value) else None
-    return error_response(
-        422,
-        ["body", *_loc_from_parameter(exc.parameter)],
-        str(exc),
-        "input_error",
-        parameter=exc.parameter,
-        unit=exc.unit or None,
-        input=value,
-    )
-
-
-async def _limit_handler(request: Request, exc: LimitExceeded) -> JSONResponse:
-    value = exc.value if _json_safe(exc.value) else None
-    return error_response(
-        422,
-        ["body", *_loc_from_parameter(exc.parameter)],
-        str(exc),
-        "limit_exceeded",
-        parameter=exc.parameter,
-        input=value,
-        limit=exc.limit,
-        setting=exc.env,
-    )
-
-
-async def _convergence_handler(request: Request, exc: ConvergenceError) -> JSONResponse:
-    residual = exc.residual if _json_safe(float(exc.residual)) else None
-    return error_response(
-        422,
-        ["body"],
-        str(exc),
-        "convergence_error",
-        solver=exc.solver,
-        iterations=exc.iterations,
-        residual=residual,
-        tolerance=exc.tolerance,
-    )
-
-
-async def _solver_handler(request: Request, exc: StochcableError) -> JSONResponse:
-    return error_response(422, ["body"], str(exc), "solver_error")
-
-
 _NUMERICAL_HINT = (
     "an input is outside the range the model handles numerically (check "
     "magnitudes and units: periods, heights, frequencies, depth)"
 )
 
 
-async def _numerical_handler(request: Request, exc: Exception) -> JSONResponse:
-    return error_response(422, ["body"], f"{exc}: {_NUMERICAL_HINT}", "numerical_error")
-
-
 async def _body_too_large_handler(request: Request, exc: BodyTooLarge) -> JSONResponse:
     return error_response(
         413, ["body"], str(exc), "body_too_large", limit=exc.limit, setting=exc.env
     )
-
-
-async def _run_time_handler(request: Request, exc: RunTimeExceeded) -> JSONResponse:
-    return error_response(504, [], str(exc), "run_time_exceeded", limit=exc.limit, setting=exc.env)
 
 
 _FASTAPI_BODY_ERROR = "There was an error parsing the body"
@@ -298,13 +431,22 @@ async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONRe
 def install_error_handlers(app: FastAPI) -> None:
     """Register the handlers on ``app`` (the most specific exception classes win)."""
     app.add_exception_handler(RequestValidationError, _validation_handler)
-    app.add_exception_handler(InputError, _input_error_handler)
-    app.add_exception_handler(LimitExceeded, _limit_handler)
-    app.add_exception_handler(ConvergenceError, _convergence_handler)
-    app.add_exception_handler(SolverError, _solver_handler)
-    app.add_exception_handler(StochcableError, _solver_handler)
-    app.add_exception_handler(NumericalError, _numerical_handler)
-    app.add_exception_handler(FloatingPointError, _numerical_handler)
+    for exc_type in (
+        InputError,
+        LimitExceeded,
+        ConvergenceError,
+        SolverError,
+        StochcableError,
+        NumericalError,
+        FloatingPointError,
+        MemoryError,
+        RunTimeExceeded,
+        QueueFull,
+        WorkerLost,
+        JobFailed,
+    ):
+        app.add_exception_handler(exc_type, _mapped_handler)
     app.add_exception_handler(BodyTooLarge, _body_too_large_handler)
-    app.add_exception_handler(RunTimeExceeded, _run_time_handler)
     app.add_exception_handler(StarletteHTTPException, _http_handler)
+    # a bug answers JSON too (Starlette's ServerErrorMiddleware calls it, then logs)
+    app.add_exception_handler(Exception, _mapped_handler)

@@ -7,13 +7,18 @@ Policy (documented in the README "Service" section):
 * a well-formed request whose work exceeds a size bound (``max_samples``,
   ``max_frequencies``, ``max_points``, ``max_elements``) answers **422** with
   ``type: "limit_exceeded"``, naming the bound and its environment variable;
-* computations run in worker threads, at most ``max_concurrency`` at once per process
-  (the rest queue); a request whose queueing plus computation exceeds
-  ``max_run_seconds`` answers **504** ``type: "run_time_exceeded"``.  Python cannot stop
-  a thread: the computation finishes in the background but keeps its concurrency slot
-  until then, so an overloaded server sheds load instead of piling up work.  An
-  analysis (``POST /v1/analyses``) stops earlier: its progress callback raises at the
-  next stage or drag-linearization iteration after the deadline.
+* an analysis whose estimated peak memory (:func:`stochcable.estimate_cost`) exceeds
+  ``max_memory_bytes`` answers **422** ``limit_exceeded`` before any work starts, naming
+  the estimate and the inputs to reduce;
+* analyses run in worker processes (:mod:`service.workers`): at their run limit the
+  worker is killed and replaced (**504**), a full queue answers **503**;
+* the light computations (spectra, realizations) run in threads, at most
+  ``max_concurrency`` at once per process (the rest queue); a request whose queueing
+  plus computation exceeds ``max_run_seconds`` answers **504** ``type:
+  "run_time_exceeded"``.  Python cannot stop a thread: the computation finishes in the
+  background but keeps its concurrency slot until then, so an overloaded server sheds
+  load instead of piling up work (these are bounded by ``max_samples`` and
+  ``max_frequencies`` to well under a second).
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ import anyio
 import numpy as np
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from stochcable.cost import estimate_cost
 from stochcable.errors import StochcableError
 
 from .errors import BodyTooLarge, LimitExceeded, NumericalError, RunTimeExceeded, error_response
@@ -43,8 +49,10 @@ __all__ = [
     "check_points",
     "check_elements",
     "check_scene",
+    "check_memory",
     "sample_count",
     "Runner",
+    "checked_call",
 ]
 
 T = TypeVar("T")
@@ -112,11 +120,12 @@ def check_scene(scene: Any, settings: Settings) -> None:
 
     Checked before solving, in this order: total finite elements of all lines
     (``max_elements``), the analysis frequency count ``analysis.omega.count``
-    (``max_frequencies``) and the time-series length ``analysis.timeseries.duration /
-    dt`` (``max_samples``).
+    (``max_frequencies``), the estimated peak memory (``max_memory_bytes``) and the
+    time-series length ``analysis.timeseries.duration / dt`` (``max_samples``).
     """
     check_elements(sum(line.elements for line in scene.lines), settings)
     check_frequencies(scene.analysis.omega.count, settings, "analysis.omega.count")
+    check_memory(scene, settings)
     ts = scene.analysis.timeseries
     if ts is not None:
         n = sample_count(ts.duration, ts.dt)
@@ -128,6 +137,44 @@ def check_scene(scene: Any, settings: Settings) -> None:
                 "max_samples",
                 f"analysis.timeseries duration/dt = {n} samples",
             )
+
+
+RUN_TIME_MARGIN = 10.0
+"""An analysis whose estimated run time exceeds this many times ``max_run_seconds`` is
+refused before it starts (the estimate is of the calibration machine; the margin covers
+slower machines and the estimate's spread, so only hopeless requests are refused). [-]"""
+
+
+def check_memory(scene: Any, settings: Settings) -> None:
+    """Raise LimitExceeded when the scene's estimated cost exceeds the budgets.
+
+    The estimate is :func:`stochcable.estimate_cost` (sizes only, nothing allocated):
+    its peak memory against ``max_memory_bytes`` (:attr:`Settings.memory_budget`), then
+    its run time against :data:`RUN_TIME_MARGIN` × ``max_run_seconds``.
+    """
+    estimate = estimate_cost(scene)
+    budget = settings.memory_budget
+    if estimate.memory_bytes > budget:
+        raise LimitExceeded(
+            estimate.parameter,
+            None,
+            budget,
+            "max_memory_bytes",
+            f"the analysis's {estimate.describe()} = {estimate.memory_bytes} bytes",
+            hint=estimate.reduce_hint(),
+        )
+    limit = settings.max_run_seconds
+    if estimate.seconds > RUN_TIME_MARGIN * limit:
+        raise LimitExceeded(
+            estimate.parameter,
+            None,
+            limit,
+            "max_run_seconds",
+            "",
+            message=f"the analysis's estimated run time {estimate.seconds:.3g} s is more "
+            f"than {RUN_TIME_MARGIN:g} times the run limit of {limit:g} s "
+            f"({Settings.env_name('max_run_seconds')}); {estimate.reduce_hint()}",
+        )
 
 
 # ------------------------------------------------------------------ body size
@@ -280,7 +327,7 @@ class Runner:
         ``exclusive``: computations of the same name run one at a time (see the class).
 
         ``strict_fp`` (default) makes floating-point overflow, invalid operations and
-        division by zero raise (see :func:`_checked`); with False the computation runs
+        division by zero raise (see :func:`checked_call`); with False the computation runs
         under numpy's default error state, exactly as the library runs it locally (the
         analyses: their results must equal ``analyze()``'s, and the core handles its
         own non-finite intermediates).
@@ -294,7 +341,7 @@ class Runner:
                 if time.monotonic() >= deadline:  # timed out while queued: skip
                     return None
                 return await anyio.to_thread.run_sync(
-                    _checked, strict_fp, func, *args, limiter=threads
+                    checked_call, strict_fp, func, *args, limiter=threads
                 )
 
         task = asyncio.ensure_future(job())
@@ -311,8 +358,8 @@ class Runner:
             task.exception()  # retrieved: an abandoned failure is not "never retrieved"
 
 
-def _checked(strict_fp: bool, func: Callable[..., T], *args: Any) -> T:
-    """Call ``func`` in the numerical policy of the service.
+def checked_call(strict_fp: bool, func: Callable[..., T], *args: Any) -> T:
+    """Call ``func`` in the numerical policy of the service (threads and workers alike).
 
     With ``strict_fp``, floating-point overflow, invalid operations and division by
     zero raise instead of producing inf/NaN silently (underflow to zero stays allowed);

@@ -80,8 +80,9 @@ class ErrorItem(BaseModel):
     msg: str = Field(description="What is wrong and what the constraint is")
     type: str = Field(
         description="Error kind: a pydantic error type, or input_error, "
-        "limit_exceeded, body_too_large, run_time_exceeded, "
-        "convergence_error, solver_error, not_found, http_error"
+        "limit_exceeded, body_too_large, run_time_exceeded, queue_full, worker_lost, "
+        "convergence_error, solver_error, numerical_error, not_found, http_error, "
+        "internal_error"
     )
     parameter: str | None = Field(
         default=None, description="Dotted field path (or core parameter name)"

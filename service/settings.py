@@ -6,6 +6,9 @@ the setting (``STOCHCABLE_MAX_SAMPLES``) so an operator knows what to raise.
 
 from __future__ import annotations
 
+import os
+
+import psutil
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
@@ -54,6 +57,45 @@ class Settings(BaseSettings):
         le=1024,
         description="Computations running at once per worker process; the rest queue [-]",
     )
+
+    analysis_workers: int = Field(
+        default_factory=lambda: os.cpu_count() or 1,
+        ge=1,
+        le=256,
+        description="Worker processes running analyses (POST /v1/analyses), each one "
+        "analysis at a time; default the number of cores [-]",
+    )
+    max_queue: int = Field(
+        default=64,
+        ge=0,
+        le=100_000,
+        description="Analyses waiting for a worker process; beyond it the request answers "
+        "503 with Retry-After [-]",
+    )
+    max_memory_bytes: int | None = Field(
+        default=None,
+        ge=2**20,
+        description="Largest estimated peak memory of one analysis (stochcable.estimate_cost); "
+        "over it the request answers 422 limit_exceeded.  Default: 80 % of the machine's "
+        "memory divided by the analyses that can run at once (analysis_workers × "
+        "workers).  Each worker runs under an address-space limit of its imported size "
+        "plus twice this budget [bytes]",
+    )
+    worker_recycle_bytes: int = Field(
+        default=1024 * 2**20,
+        ge=2**20,
+        description="A worker whose resident memory stays above this after an analysis "
+        "is replaced by a fresh one, so a heavy analysis's memory returns to the system "
+        "[bytes]",
+    )
+
+    @property
+    def memory_budget(self) -> int:
+        """``max_memory_bytes``, or its default from the machine's memory. [bytes]"""
+        if self.max_memory_bytes is not None:
+            return self.max_memory_bytes
+        running = self.analysis_workers * self.workers  # each uvicorn process has a pool
+        return int(0.8 * psutil.virtual_memory().total / running)
 
     @staticmethod
     def env_name(field: str) -> str:

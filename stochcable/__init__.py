@@ -27,6 +27,7 @@ _LAZY = {
     "natural_modes": ("line.modes", "natural_modes"),
     "simulate_sea": ("sea.realization", "simulate_sea"),
     "load_example": ("examples", "load_example"),
+    "estimate_cost": ("cost", "estimate_cost"),
 }
 
 

@@ -504,3 +504,25 @@ def test_dumps_equals_the_standard_encoder_after_parsing():
         doc = analyze(load_example("chain_catenary")).to_document(timeseries="window")
     assert json.loads(dumps(doc)) == json.loads(json.dumps(doc, allow_nan=False))
     assert json.loads(dumps({"x": [1e308, 1e308]})) == {"x": [1e308, 1e308]}
+
+
+def test_realization_of_a_vanishing_spectrum_names_the_spectrum(client):
+    # JONSWAP with Tp = 1 ms: S underflows to 0 on every frequency of the record's grid
+    body = {"spectrum": {"type": "jonswap", "hs": 1.0, "tp": 1e-3}, "duration": 64, "dt": 0.25}
+    err = _only_error(client.post("/v1/sea/realizations", json=body))
+    assert err["type"] == "input_error" and err["parameter"] == "spectrum"
+    assert err["loc"] == ["body", "spectrum"] and "is zero at every grid frequency" in err["msg"]
+
+
+def test_a_bug_answers_json_500():
+    app = create_app(Settings())
+
+    @app.get("/bug")
+    def bug() -> dict:
+        raise KeyError("a programming error")
+
+    with TestClient(app, raise_server_exceptions=False) as c:
+        resp = c.get("/bug")
+    assert resp.status_code == 500 and resp.headers["content-type"] == "application/json"
+    err = resp.json()["detail"][0]
+    assert err["type"] == "internal_error" and "KeyError" in err["msg"]

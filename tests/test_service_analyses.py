@@ -1,14 +1,15 @@
-"""POST /v1/analyses in-process (FastAPI TestClient): the result document equals the
-core's analyze(scene).to_document() and the CLI's output, the limits answer 413/422
-naming the bound, solver failures answer 422 with the reason, the run-time bound stops
-an abandoned analysis, and concurrent analyses keep their own warnings."""
+"""POST /v1/analyses through the app (FastAPI TestClient; the analyses run in the app's
+worker processes): the result document equals the core's analyze(scene).to_document()
+and the CLI's output, every published OpenAPI example answers 200, the limits answer
+413/422 naming the bound, solver failures answer 422 with the reason, and concurrent
+analyses keep their own warnings.  The run limit and worker failures:
+tests/test_service_workers.py and tests/service/."""
 
 from __future__ import annotations
 
 import copy
 import json
 import threading
-import time
 import warnings
 
 import pytest
@@ -17,7 +18,6 @@ from fastapi.testclient import TestClient
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import stochcable.analysis
 from service.app import create_app
 from service.routers.analyses import WARNINGS_HEADER
 from service.schemas import AnalysisResponse
@@ -240,64 +240,10 @@ def test_anchor_above_the_water_is_422_naming_the_field(small):
 # -------------------------------------------------------- run time, concurrency
 
 
-def test_abandoned_analysis_stops_at_its_next_progress_call(monkeypatch):
-    calls = {"n": 0, "stopped": threading.Event()}
-
-    def endless(scene, *, statics=None, progress=None):  # an analysis that never ends
-        try:
-            while True:
-                calls["n"] += 1
-                progress("linearization", {"iteration": calls["n"]})
-                time.sleep(0.01)
-        finally:
-            calls["stopped"].set()
-
-    monkeypatch.setattr(stochcable.analysis, "analyze", endless)
-    with TestClient(create_app(Settings(max_run_seconds=0.3, max_concurrency=1))) as c:
-        t0 = time.perf_counter()
-        err = _err(c.post("/v1/analyses", json=_doc(SMALL)), 504)
-        assert err["setting"] == "STOCHCABLE_MAX_RUN_SECONDS"
-        assert time.perf_counter() - t0 < 3.0  # 0.3 s bound + TestClient overhead
-        # the worker stops instead of holding the only slot forever
-        assert calls["stopped"].wait(3.0)
-        monkeypatch.undo()
-        resp = c.post("/v1/analyses", json=_doc("tuah_1982_suspended_cable"))
-        assert resp.status_code == 200, resp.text
-
-
-def test_queued_analyses_do_not_hold_the_slots_of_other_endpoints(monkeypatch):
-    release = threading.Event()
-
-    def blocked(scene, *, statics=None, progress=None):  # an analysis that waits
-        while not release.wait(0.01):
-            progress("linearization", {})
-        return analyze(scene)
-
-    monkeypatch.setattr(stochcable.analysis, "analyze", blocked)
-    app = create_app(Settings(max_concurrency=2, max_run_seconds=10.0))
-    with TestClient(app) as c:
-        out: dict[int, object] = {}
-
-        def post(i: int) -> None:
-            out[i] = c.post("/v1/analyses", json=_doc("tuah_1982_suspended_cable"))
-
-        threads = [threading.Thread(target=post, args=(i,)) for i in range(3)]
-        for t in threads:
-            t.start()
-        time.sleep(0.3)  # one analysis runs (1 of 2 slots), two wait for their turn
-        t0 = time.perf_counter()
-        resp = c.post("/v1/spectra", json={"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 8.0}})
-        assert resp.status_code == 200 and time.perf_counter() - t0 < 2.0
-        release.set()
-        for t in threads:
-            t.join(30.0)
-    assert [out[i].status_code for i in range(3)] == [200, 200, 200]
-
-
 def test_concurrent_analyses_keep_their_own_warnings(client):
     # analyze() records warnings with warnings.catch_warnings (process-global state):
-    # the service runs one analysis at a time so overlapping requests neither swap
-    # their warnings nor leave the process's warning filters altered
+    # each analysis runs alone in its worker process, so overlapping requests neither
+    # swap their warnings nor alter the HTTP process's warning filters
     filters = list(warnings.filters)
     names = ["tuah_1982_suspended_cable", "taut_wire", "tuah_1982_suspended_cable", "taut_wire"]
     out: dict[int, object] = {}
@@ -317,6 +263,25 @@ def test_concurrent_analyses_keep_their_own_warnings(client):
         else:
             assert len(got) == 1 and "has no excitation" in got[0]
     assert warnings.filters == filters
+
+
+def test_every_published_openapi_example_answers_200(client):
+    # the "Try it out" examples of POST /v1/analyses in the served OpenAPI document
+    doc = client.get("/openapi.json").json()
+    body = doc["paths"]["/v1/analyses"]["post"]["requestBody"]["content"]["application/json"]
+    examples = body["examples"]
+    assert set(examples) == set(list_examples())
+    for name, example in examples.items():
+        resp = client.post("/v1/analyses?timeseries=none", json=example["value"])
+        assert resp.status_code == 200, (name, resp.text)
+
+
+def test_spectrum_type_is_required_in_the_schema(client):
+    # the union of spectra is discriminated by type: a document without it is refused,
+    # so the schema says so
+    schemas = client.get("/openapi.json").json()["components"]["schemas"]
+    for name in ("PiersonMoskowitz", "Jonswap", "TableSpectrum"):
+        assert "type" in schemas[name]["required"], name
 
 
 # ----------------------------------------------- generated scenes never fail 5xx

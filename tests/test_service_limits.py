@@ -167,3 +167,38 @@ def test_settings_from_the_environment(monkeypatch):
 
 def test_default_sample_limit_is_2_to_the_22():
     assert Settings().max_samples == 2**22
+
+
+def _chain(elements: int, count: int) -> dict:
+    from stochcable.examples import load_example
+
+    doc = load_example("chain_catenary").model_dump(mode="json", exclude_unset=True)
+    doc["lines"][0]["segments"][0]["elements"] = elements
+    doc["analysis"]["omega"]["count"] = count
+    return doc
+
+
+def test_memory_budget_refuses_before_any_work():
+    from stochcable import estimate_cost
+
+    doc = _chain(400, 4000)  # ≈ 2.9 GB estimated
+    need = estimate_cost(doc).memory_bytes
+    with TestClient(create_app(Settings(max_memory_bytes=need - 1))) as c:
+        err = _err(c.post("/v1/analyses", json=doc), 422)
+    assert err["type"] == "limit_exceeded" and err["setting"] == "STOCHCABLE_MAX_MEMORY_BYTES"
+    assert err["limit"] == need - 1 and f"= {need} bytes exceeds the limit" in err["msg"]
+    assert err["parameter"] == "analysis.omega.count"
+    assert "reduce analysis.omega.count (4000) or the elements of the lines" in err["msg"]
+
+
+def test_hopeless_run_time_refuses_before_any_work():
+    from service.limits import RUN_TIME_MARGIN
+    from stochcable import estimate_cost
+
+    doc = _chain(400, 4000)
+    seconds = estimate_cost(doc).seconds
+    limit = 0.9 * seconds / RUN_TIME_MARGIN
+    with TestClient(create_app(Settings(max_run_seconds=limit))) as c:
+        err = _err(c.post("/v1/analyses", json=doc), 422)
+    assert err["type"] == "limit_exceeded" and err["setting"] == "STOCHCABLE_MAX_RUN_SECONDS"
+    assert "estimated run time" in err["msg"] and "reduce analysis.omega.count" in err["msg"]

@@ -12,6 +12,7 @@ from service.dependencies import MediaTypeDep, RunnerDep, SettingsDep
 from service.encoding import JSON, NPY, array_responses, columns_response, json_response
 from service.limits import check_points, check_samples
 from service.schemas import RealizationRequest, RealizationResponse
+from stochcable.errors import InputError
 from stochcable.sea.kinematics import kinematics_timeseries
 from stochcable.sea.realization import simulate_sea
 
@@ -69,7 +70,15 @@ def _realization(body: RealizationRequest, media: str) -> Response:
     def density(w: np.ndarray) -> np.ndarray:
         return spectrum.spectral_density(w, g)
 
-    sea = simulate_sea(density, body.duration, body.dt, method=body.method, rng=body.seed)
+    try:
+        sea = simulate_sea(density, body.duration, body.dt, method=body.method, rng=body.seed)
+    except InputError as exc:
+        if exc.parameter != "density":
+            raise
+        # the core names its callable argument; the request's input is the spectrum
+        raise InputError(
+            "spectrum", spectrum.type, "-", f"{exc.constraint} (sampled on the record's grid)"
+        ) from None
     # target variance: the Riemann sum over the simulated lines m = 1 … N-1 (X_0 = X_N = 0),
     # as simulate_sea computed it from the S it evaluated (no second evaluation of S)
     variance = _mean_square(sea.elevation)

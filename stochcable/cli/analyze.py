@@ -82,9 +82,12 @@ class _StderrProgress:
 def run(args: argparse.Namespace) -> int:
     """Run the analysis and write the result document (and figures)."""
     from stochcable.analysis import analyze
+    from stochcable.cost import available_memory, check_memory, estimate_cost
     from stochcable.scene.model import load_scene
 
     scene = load_scene(Path(args.scene))
+    # a scene too large for this machine: one sentence naming what to reduce, at once
+    check_memory(estimate_cost(scene), available_memory(), "the memory available now")
     show = args.progress or (hasattr(sys.stderr, "isatty") and sys.stderr.isatty())
     result = analyze(scene, progress=_StderrProgress() if show else None)
     doc = result.to_document(timeseries=args.timeseries)

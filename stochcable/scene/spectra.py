@@ -4,10 +4,10 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import ConfigDict, Field, model_validator
 
 from stochcable.scene.base import G_STANDARD, _Doc, _f
 
@@ -22,7 +22,18 @@ __all__ = [
 ]
 
 
+def _type_required(schema: dict[str, Any]) -> None:
+    """``type`` selects the member of the discriminated union :data:`Spectrum`, so a
+    document must give it: required in the JSON Schema (Python code constructing one
+    class directly may omit it)."""
+    required = schema.setdefault("required", [])
+    if "type" not in required:
+        required.insert(0, "type")
+
+
 class _SpectrumBase(_Doc):
+    model_config = ConfigDict(json_schema_extra=_type_required)
+
     def spectral_density(self, omega: np.ndarray, g: float = G_STANDARD) -> np.ndarray:
         """Spectral density S(omega), one-sided in omega. [unit²·s/rad]"""
         raise NotImplementedError  # pragma: no cover - every subclass overrides

@@ -1,0 +1,321 @@
+"""The cost of an analysis before it runs: peak memory and time from the scene's sizes.
+
+:func:`estimate_cost` reads only the sizes of a scene document (finite elements,
+frequencies, input channels, bodies, time-series samples) and returns a
+:class:`CostEstimate`; nothing is allocated.  The HTTP service refuses a document whose
+estimate exceeds its memory budget before any work starts, and the command line
+refuses one that would not fit in the machine's available memory
+(:func:`check_memory`), so a scene too large for the machine answers one sentence
+naming the inputs to reduce instead of running out of memory halfway.
+
+The model
+---------
+The engine's large arrays are frequency-domain arrays with one axis over the
+frequencies (``analysis.omega.count`` = n_ω), one over the nodes of a line
+(n_nodes = elements + 1, three DOFs each) and one over the line's input channels
+(:class:`stochcable.dynamics.loads.Channel`: the sea, one per end-motion spectrum DOF,
+and the three translations of an end attached to a body).  Per node, frequency and
+channel they hold: the fluid velocity and acceleration at the nodes (2 × 3 complex,
+96 B), the element moments of the velocity (6 complex, 96 B), the element velocity
+square (9 real, 72 B) and end squares, the load vectors (3 complex, 48 B), the
+displacement and motion transfer functions (2 × 3 complex, 96 B), the tension transfer
+functions and the temporaries of the products that form them.  The peak resident
+memory is therefore
+
+    M ≈ M_0 + c_M · n_ω · Σ_lines n_nodes · n_ch  +  c_T · N_t · (1 + Σ_lines n_ch),
+
+with N_t = duration/dt the time-series samples (the realization, the transfer
+functions interpolated onto the N_t/2 FFT frequencies and the synthesized records), and
+the time
+
+    t ≈ k_M · n_ω · Σ_lines n_nodes · n_ch · (1 + 0.5 n_bodies)  +  k_T · N_t · (1 + Σ n_ch).
+
+The modes (at most the line's DOFs, dense only up to a few hundred DOFs per block) and
+the Foss state space (2 n_modes per line) are smaller than the nodal arrays and are in
+M_0.
+
+Constants (fitted on peak RSS above the imported baseline, ``ru_maxrss`` of a fresh
+subprocess, one BLAS thread; ``benchmarks/bench_cost.py``, x86-64, numpy 2, 2 cores):
+
+=====================================  =====  ======  =========  ======  ======
+scene                                  n_el   n_ω     channels   ΔRSS    B/(node·ω·ch)
+=====================================  =====  ======  =========  ======  ======
+taut_wire (sea only)                   200    1000    1          156 MB  775
+taut_wire                              400    1000    1          300 MB  748
+chain_catenary (sea + fairlead surge)  200    1000    2          352 MB  875
+chain_catenary                         400    1000    2          686 MB  856
+chain_catenary                         200    3000    2          1025 MB 850
+disc buoy, three legs (free body)      3×100  1000    4 per leg  966 MB  797
+disc buoy, three legs                  3×200  1000    4 per leg  1846 MB 766
+=====================================  =====  ======  =========  ======  ======
+
+so c_M = 900 B (the largest ratio, rounded up: the estimate should not be below the
+peak); c_T = 110 B per sample and channel (chain_catenary, 2^20 and 2^22 samples with
+the whole record in the result document: 320 B per sample); M_0 = 16 MB.  Time on the
+same machine: 3.5 µs per node·frequency·channel for single lines, 5.6 µs with a free
+body (k_M = 3.5 µs, the body factor 1 + 0.5 n_bodies), k_T = 1.7 µs per sample and
+channel.  Times are indicative (they scale with the CPU and the drag iterations); the
+memory model is what the budgets use.
+
+The constants are in one place (the ``*_BYTES_*`` and ``*_SECONDS_*`` module
+constants) so that a change of the engine's array layout (frequency-blocked solves)
+updates them here only: rerun ``benchmarks/bench_cost.py`` and take the largest
+bytes-per-node·frequency·channel ratio, rounded up.
+
+Not yet covered: the adaptive-fidelity planner (``analysis.fidelity``) chooses its own
+elements and frequencies and does not consult this budget; the estimate is that of the
+document as given, and the service's workers' address-space limit is what bounds a
+planned analysis that grows beyond it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from stochcable.errors import InputError
+from stochcable.scene.model import Scene, load_scene
+
+__all__ = [
+    "CostEstimate",
+    "estimate_cost",
+    "check_memory",
+    "available_memory",
+    "BYTES_PER_NODE_FREQUENCY_CHANNEL",
+    "BYTES_PER_SAMPLE_CHANNEL",
+    "BASE_BYTES",
+    "SECONDS_PER_NODE_FREQUENCY_CHANNEL",
+    "SECONDS_PER_SAMPLE_CHANNEL",
+]
+
+BYTES_PER_NODE_FREQUENCY_CHANNEL = 900
+"""Peak bytes per node, frequency and input channel of a line (c_M). [B]"""
+
+BYTES_PER_SAMPLE_CHANNEL = 110
+"""Peak bytes per time-series sample and channel, plus one for the sea (c_T). [B]"""
+
+BASE_BYTES = 16 * 2**20
+"""Peak bytes of an analysis independent of its size (M_0: modes, statics, small arrays). [B]"""
+
+SECONDS_PER_NODE_FREQUENCY_CHANNEL = 3.5e-6
+"""Wall time per node, frequency and channel on the calibration machine (k_M). [s]"""
+
+SECONDS_PER_SAMPLE_CHANNEL = 1.7e-6
+"""Wall time per time-series sample and channel on the calibration machine (k_T). [s]"""
+
+_BODY_TIME_FACTOR = 0.5  # extra time per free body (coupled solves): 5.6 µs vs 3.5 µs
+
+
+@dataclass(frozen=True)
+class CostEstimate:
+    """Estimated peak memory and time of one analysis.
+
+    Attributes
+    ----------
+    memory_bytes : int
+        Peak resident memory above the imported process. [B]
+    seconds : float
+        Wall time on the calibration machine (indicative). [s]
+    operations : float
+        Node·frequency·channel products of the frequency-domain arrays plus
+        sample·channel products of the time series. [-]
+    frequencies : int
+        ``analysis.omega.count``. [-]
+    nodes : int
+        Finite-element nodes of all lines. [-]
+    channels : int
+        Input channels summed over the lines. [-]
+    samples : int
+        Time-series samples duration/dt (0 without time series). [-]
+    bodies : int
+        Bodies of the scene. [-]
+    spectral_bytes : int
+        Part of ``memory_bytes`` in the frequency-domain arrays. [B]
+    timeseries_bytes : int
+        Part of ``memory_bytes`` in the time series. [B]
+    largest_line : str
+        Field path of the segment with the most elements (``lines[i].segments[j].elements``).
+    largest_elements : int
+        Its number of elements. [-]
+    """
+
+    memory_bytes: int
+    seconds: float
+    operations: float
+    frequencies: int
+    nodes: int
+    channels: int
+    samples: int
+    bodies: int
+    spectral_bytes: int
+    timeseries_bytes: int
+    largest_line: str
+    largest_elements: int
+
+    @property
+    def parameter(self) -> str:
+        """The input whose reduction lowers the memory most (a field path)."""
+        if self.timeseries_bytes > self.spectral_bytes:
+            return "analysis.timeseries.duration"
+        if self.frequencies >= self.nodes:
+            return "analysis.omega.count"
+        return self.largest_line
+
+    def reduce_hint(self) -> str:
+        """Which inputs to reduce, largest share first (one sentence)."""
+        spectral = (
+            f"analysis.omega.count ({self.frequencies}) or the elements of the lines "
+            f"({self.nodes} nodes; most in {self.largest_line}), memory ∝ frequencies × "
+            f"nodes × channels ({self.channels})"
+        )
+        series = (
+            f"analysis.timeseries duration/dt ({self.samples} samples) or drop analysis.timeseries"
+        )
+        if not self.samples:
+            parts = [spectral]
+        elif self.spectral_bytes >= self.timeseries_bytes:
+            parts = [spectral, series]
+        else:
+            parts = [series, spectral]
+        return "reduce " + "; then ".join(parts)
+
+    def describe(self) -> str:
+        """``estimated peak memory 3.4 TB (n_ω × nodes × channels = …)``."""
+        return (
+            f"estimated peak memory {_fmt_bytes(self.memory_bytes)} "
+            f"({self.frequencies} frequencies × {self.nodes} nodes × channels "
+            f"{self.channels}"
+            + (f"; {self.samples} time-series samples" if self.samples else "")
+            + ")"
+        )
+
+
+def _fmt_bytes(n: float) -> str:
+    for unit in ("B", "kB", "MB", "GB", "TB"):
+        if abs(n) < 1000.0 or unit == "TB":
+            return f"{n:.3g} {unit}"
+        n /= 1000.0
+    return f"{n:.3g} TB"  # pragma: no cover
+
+
+def _end_channels(end: Any) -> int:
+    """Input channels an end adds: one per end-motion spectrum DOF, three if attached."""
+    n = 0
+    motion = getattr(end, "motion", None)
+    if motion is not None:
+        n += sum(getattr(motion, dof) is not None for dof in ("surge", "sway", "heave"))
+    if getattr(end, "attach", None) is not None:
+        n += 3
+    return n
+
+
+def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
+    """Peak memory and time of ``analyze(scene)`` from the scene's sizes alone.
+
+    Parameters
+    ----------
+    scene : Scene or mapping
+        The scene document (validated with :func:`stochcable.load_scene` when a mapping).
+
+    Returns
+    -------
+    CostEstimate
+        Memory [B] and time [s] estimates and the sizes they were computed from.
+
+    Notes
+    -----
+    M ≈ M_0 + c_M n_ω Σ n_nodes n_ch + c_T N_t (1 + Σ n_ch), with the constants and
+    their calibration in the module docstring.  An analysis with
+    ``analysis.fidelity`` runs pilot analyses of its own choosing; the estimate is that
+    of the document as given.
+    """
+    if not isinstance(scene, Scene):
+        scene = load_scene(scene, allow_files=True)
+    n_w = int(scene.analysis.omega.count)
+    node_channels = 0
+    nodes = 0
+    channels = 0
+    largest, largest_path = -1, "lines[0].segments[0].elements"
+    for i, line in enumerate(scene.lines):
+        n_nodes = sum(int(s.elements) for s in line.segments) + 1
+        n_ch = 1 + _end_channels(line.end_a) + _end_channels(line.end_b)
+        nodes += n_nodes
+        channels += n_ch
+        node_channels += n_nodes * n_ch
+        for j, s in enumerate(line.segments):
+            if s.elements > largest:
+                largest, largest_path = int(s.elements), f"lines[{i}].segments[{j}].elements"
+    ts = scene.analysis.timeseries
+    samples = 0
+    if ts is not None:
+        ratio = ts.duration / ts.dt
+        samples = int(round(ratio)) if ratio < 2**62 else 2**62
+    spectral = BYTES_PER_NODE_FREQUENCY_CHANNEL * n_w * node_channels
+    series = BYTES_PER_SAMPLE_CHANNEL * samples * (1 + channels)
+    n_bodies = len(scene.bodies)
+    ops_spectral = float(n_w) * node_channels
+    ops_series = float(samples) * (1 + channels)
+    seconds = (
+        SECONDS_PER_NODE_FREQUENCY_CHANNEL * ops_spectral * (1.0 + _BODY_TIME_FACTOR * n_bodies)
+        + SECONDS_PER_SAMPLE_CHANNEL * ops_series
+    )
+    return CostEstimate(
+        memory_bytes=int(BASE_BYTES + spectral + series),
+        seconds=seconds,
+        operations=ops_spectral + ops_series,
+        frequencies=n_w,
+        nodes=nodes,
+        channels=channels,
+        samples=samples,
+        bodies=n_bodies,
+        spectral_bytes=int(spectral),
+        timeseries_bytes=int(series),
+        largest_line=largest_path,
+        largest_elements=max(largest, 0),
+    )
+
+
+def check_memory(estimate: CostEstimate, limit_bytes: int, limit_name: str) -> None:
+    """Raise InputError when the estimated peak memory exceeds ``limit_bytes``.
+
+    Parameters
+    ----------
+    estimate : CostEstimate
+        From :func:`estimate_cost`.
+    limit_bytes : int
+        The budget. [B]
+    limit_name : str
+        What the budget is, for the message (``"the available memory"``).
+
+    Raises
+    ------
+    InputError
+        Naming the input to reduce first (:attr:`CostEstimate.parameter`), the estimate,
+        the budget and what to reduce.
+    """
+    if estimate.memory_bytes <= limit_bytes:
+        return
+    raise InputError(
+        estimate.parameter,
+        _value_of(estimate),
+        "-",
+        f"the analysis needs an {estimate.describe()}, more than {limit_name} "
+        f"({_fmt_bytes(limit_bytes)}); {estimate.reduce_hint()}",
+    )
+
+
+def available_memory() -> int:
+    """Memory the machine can give a new computation now (psutil ``available``). [B]"""
+    import psutil
+
+    return int(psutil.virtual_memory().available)
+
+
+def _value_of(estimate: CostEstimate) -> int:
+    p = estimate.parameter
+    if p == "analysis.timeseries.duration":
+        return estimate.samples
+    if p == "analysis.omega.count":
+        return estimate.frequencies
+    return estimate.largest_elements

@@ -1,0 +1,110 @@
+"""stochcable.cost: the estimate against measured peak memory of real analyses, its
+counting of channels and sizes, the refusal it gives, and the CLI's use of it."""
+
+from __future__ import annotations
+
+import copy
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from stochcable import InputError, estimate_cost
+from stochcable.cli import main as cli_main
+from stochcable.cost import BYTES_PER_NODE_FREQUENCY_CHANNEL, check_memory
+from stochcable.examples import load_example
+
+ROOT = Path(__file__).resolve().parents[1]
+
+_MEASURE = """
+import json, resource, sys
+import psutil
+from stochcable.analysis import analyze
+from stochcable.examples import load_example
+doc = json.loads(sys.argv[1])
+base = psutil.Process().memory_info().rss
+analyze(doc)
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+print(peak - base)
+"""
+
+
+def _doc(name: str, elements: int | None = None, count: int | None = None) -> dict:
+    doc = load_example(name).model_dump(mode="json", exclude_unset=True)
+    if elements is not None:
+        for line in doc["lines"]:
+            for seg in line["segments"]:
+                seg["elements"] = elements
+    if count is not None:
+        doc["analysis"]["omega"]["count"] = count
+    return doc
+
+
+def _measured_peak(doc: dict) -> int:
+    """Peak RSS above the imported process of one analysis, in a fresh subprocess."""
+    out = subprocess.run(
+        [sys.executable, "-W", "ignore", "-c", _MEASURE, json.dumps(doc)],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+        env={"PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"},
+        timeout=300,
+    )
+    return int(out.stdout.split()[-1])
+
+
+@pytest.mark.parametrize(
+    ("name", "elements", "count"),
+    [("taut_wire", 200, 600), ("chain_catenary", 150, 600)],
+)
+def test_estimate_bounds_the_measured_peak(name, elements, count):
+    doc = _doc(name, elements, count)
+    doc["analysis"].pop("timeseries", None)
+    estimate = estimate_cost(doc)
+    measured = _measured_peak(doc)
+    # the constant is the largest calibration ratio rounded up, so the estimate is an
+    # upper bound; 10 % slack for allocator and library-version differences in the
+    # measurement, and it is not more than 2x too pessimistic (the arrays it counts
+    # are the arrays the engine holds)
+    assert measured <= 1.1 * estimate.memory_bytes, (measured, estimate)
+    assert measured >= 0.5 * estimate.memory_bytes, (measured, estimate)
+
+
+def test_channels_and_sizes_are_counted():
+    chain = estimate_cost(_doc("chain_catenary"))
+    assert chain.channels == 2  # the sea and the fairlead's surge spectrum
+    assert chain.nodes == 41 and chain.frequencies == 200 and chain.samples == 2400
+    three = estimate_cost(_doc("tuah_1982_disc_buoy_three_legs"))
+    assert three.channels == 3 * 4  # each leg: the sea and the buoy's three translations
+    assert three.bodies == 1 and three.samples == 0
+    # memory of the frequency-domain arrays is linear in the frequencies
+    doubled = estimate_cost(_doc("chain_catenary", count=400))
+    assert doubled.spectral_bytes == 2 * chain.spectral_bytes
+    assert chain.spectral_bytes == BYTES_PER_NODE_FREQUENCY_CHANNEL * 200 * 41 * 2
+
+
+def test_refusal_names_the_input_to_reduce():
+    heavy = estimate_cost(_doc("chain_catenary", 20000, 100000))
+    assert heavy.memory_bytes > 1e12
+    with pytest.raises(InputError) as info:
+        check_memory(heavy, 8 * 10**9, "the budget")
+    assert info.value.parameter == "analysis.omega.count" and info.value.value == 100000
+    assert "reduce analysis.omega.count" in str(info.value) and "8 GB" in str(info.value)
+    many_nodes = estimate_cost(_doc("chain_catenary", 20000, 2000))
+    assert many_nodes.parameter == "lines[0].segments[0].elements"
+    long_series = copy.deepcopy(_doc("chain_catenary"))
+    long_series["analysis"]["timeseries"]["duration"] = 1e7
+    assert estimate_cost(long_series).parameter == "analysis.timeseries.duration"
+    check_memory(estimate_cost(_doc("chain_catenary")), 8 * 10**9, "the budget")  # fits
+
+
+def test_cli_refuses_a_scene_too_large_in_one_sentence(tmp_path, capsys):
+    path = tmp_path / "huge.json"
+    path.write_text(json.dumps(_doc("chain_catenary", 20000, 100000)), encoding="utf-8")
+    assert cli_main(["analyze", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert "estimated peak memory" in err and "reduce analysis.omega.count" in err
