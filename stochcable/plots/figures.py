@@ -23,6 +23,8 @@ __all__ = [
 
 #: Ratio of the largest to the smallest positive value above which an axis is logarithmic.
 LOG_SPAN = 1.0e3
+#: Ratio of the largest to the smallest frequency above which the ω axis is logarithmic.
+OMEGA_LOG_SPAN = 20.0
 #: Length of the time-series window plotted by default. [s]
 WINDOW = 600.0
 _ENDS = ("end_a", "end_b")
@@ -58,7 +60,7 @@ def _line(result: Any, line: str | None) -> Any:
 def _spans_decades(values: np.ndarray) -> bool:
     v = np.asarray(values, dtype=float)
     pos = v[v > 0]
-    return pos.size > 1 and float(pos.max() / pos.min()) > LOG_SPAN
+    return pos.size > 1 and float(pos.max()) > LOG_SPAN * float(pos.min())
 
 
 def _horizontal(result: Any) -> tuple[bool, dict[str, np.ndarray]]:
@@ -138,7 +140,8 @@ def plot_end_tension_spectra(result: Any, line: str | None = None) -> Any:
         top = max(float(s.max()) for s in spectra.values())
         if top > 0:
             ax.set_ylim(top * 1e-8, top * 3)
-    if _spans_decades(lr.omega) or lr.omega.max() / max(lr.omega.min(), 1e-300) > 20:
+    w = np.asarray(lr.omega)
+    if w.size > 1 and w.min() > 0 and w.max() > OMEGA_LOG_SPAN * w.min():
         ax.set_xscale("log")
     ax.set_xlabel("ω [rad/s]")
     ax.set_ylabel(f"S_T(ω) [{u.force}²·s/rad]")
