@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from stochcable.analysis import analyze
-from stochcable.results.datasets import dataset_from_document
+from stochcable.results.datasets import dataset_from_document, netcdf_bytes
 from stochcable.scene.model import load_scene
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "stochcable" / "examples"
@@ -99,5 +99,16 @@ def test_spectra_along_the_line_integrate_to_the_documented_sigma(three_legs):
 def test_netcdf_round_trip(three_legs, tmp_path):
     path = three_legs.to_netcdf(tmp_path / "result.nc")
     ds = three_legs.to_xarray()
+    with xr.open_dataset(path) as back:
+        xr.testing.assert_identical(back.load(), ds)
+
+
+def test_netcdf_bytes_of_a_document_read_back(three_legs, tmp_path):
+    doc = json.loads(json.dumps(three_legs.to_document()))
+    ds = dataset_from_document(doc)
+    data = netcdf_bytes(ds)
+    assert data[:4] == b"\x89HDF"  # NetCDF-4 is an HDF5 file
+    path = tmp_path / "answer.nc"
+    path.write_bytes(data)
     with xr.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), ds)

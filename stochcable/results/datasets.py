@@ -23,7 +23,12 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["dataset_from_document", "dataset_from_result", "write_netcdf"]
+__all__ = [
+    "dataset_from_document",
+    "dataset_from_result",
+    "write_netcdf",
+    "netcdf_bytes",
+]
 
 ENDS = ("end_a", "end_b")
 AXES = ("x", "y", "z")
@@ -205,7 +210,7 @@ def _body_parts(doc: Mapping[str, Any], u: dict[str, str]) -> tuple[dict, dict]:
                     data[i, j] = stats[key]
         unit = "s" if key == "tz" else "see dof_units"
         out[f"body_motion_{key}"] = _var(("body", "dof"), data, unit, f"body motion: {long}")
-    spec = np.full((len(names), len(dofs), len(doc_omega(doc))), np.nan)
+    spec = np.full((len(names), len(dofs), len(_doc_omega(doc))), np.nan)
     for i, n in enumerate(names):
         for j, d in enumerate(dofs):
             s = bodies[n]["spectra"].get(d)
@@ -220,7 +225,7 @@ def _body_parts(doc: Mapping[str, Any], u: dict[str, str]) -> tuple[dict, dict]:
     return coords, out
 
 
-def doc_omega(doc: Mapping[str, Any]) -> np.ndarray:
+def _doc_omega(doc: Mapping[str, Any]) -> np.ndarray:
     """The analysis grid of a result document. [rad/s]"""
     return _omega(doc["lines"])
 
@@ -297,8 +302,9 @@ def dataset_from_result(result: Any):
     -------
     xarray.Dataset
     """
-    ds = dataset_from_document(result.to_document(timeseries="full"))
-    u = _units(result.to_document(timeseries="none"))
+    doc = result.to_document(timeseries="full")
+    ds = dataset_from_document(doc)
+    u = _units(doc)
     lines = list(result.lines.values())
     n_el, n_nd, n_w = ds.sizes["element"], ds.sizes["node"], ds.sizes["omega"]
     ts = np.full((len(lines), n_el, n_w), np.nan)
@@ -326,3 +332,23 @@ def write_netcdf(dataset: Any, path: str | Path) -> Path:
     path = Path(path)
     dataset.to_netcdf(path, engine="netcdf4")
     return path
+
+
+def netcdf_bytes(dataset: Any) -> bytes:
+    """A Dataset as the bytes of a NetCDF-4 file (an HTTP answer's body).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        For example :func:`dataset_from_document` of a result document.
+
+    Returns
+    -------
+    bytes
+        The file's content (HDF5-based NetCDF-4).
+    """
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = write_netcdf(dataset, Path(tmp) / "result.nc")
+        return path.read_bytes()
