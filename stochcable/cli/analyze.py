@@ -49,8 +49,8 @@ def register(subparsers: Any) -> None:
         "--format",
         choices=["summary", "json", "netcdf"],
         default=None,
-        help="output format (default: netcdf for -o *.nc, json for other -o files and "
-        "when stdout is not a terminal, else summary)",
+        help="output format (default: netcdf for an -o file ending in .nc, json for "
+        "other -o files and when stdout is not a terminal, else summary)",
     )
     p.add_argument("-o", "--output", default=None, help="output file (default stdout)")
     p.add_argument(
