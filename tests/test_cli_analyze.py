@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -82,7 +87,13 @@ def test_analyze_writes_the_v1_result_document_and_plots(scene_file, tmp_path, c
     assert {"total_s", "statics_s", "solve_s"} <= set(doc["timing"])
     assert doc["timeseries"]["samples"] == 200
     names = sorted(p.name for p in figs.iterdir())
-    assert names == ["leg1_end_tension_spectra.png", "leg1_tension_std.png", "timeseries.png"]
+    assert names == [
+        "leg1_end_tension_spectra.png",
+        "leg1_modes.png",
+        "leg1_tension_std.png",
+        "statics.png",
+        "timeseries.png",
+    ]
     assert all((figs / n).stat().st_size > 1000 for n in names)
 
 
@@ -113,3 +124,81 @@ def test_analyze_missing_file(tmp_path, capsys):
     rc = main(["analyze", str(tmp_path / "nope.json")])
     assert rc == 2
     assert "cannot be read" in capsys.readouterr().err
+
+
+ROOT = Path(__file__).resolve().parents[1]
+ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
+
+
+def _run_on_a_terminal(args: list[str]) -> tuple[str, str]:
+    """Run ``python -m stochcable ARGS`` with stdout on a pseudo-terminal; returns the
+    terminal's text (escape codes removed) and stderr."""
+    import pty
+
+    master, slave = pty.openpty()
+    env = dict(os.environ, PYTHONPATH=str(ROOT), COLUMNS="400", LINES="50")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "stochcable", *args],
+        stdout=slave,
+        stderr=subprocess.PIPE,
+        env=env,
+        cwd=ROOT,
+    )
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 65536)
+        except OSError:  # the pty closes when the child exits
+            break
+        if not data:
+            break
+        chunks.append(data)
+    err = proc.stderr.read().decode()
+    proc.wait(timeout=120)
+    os.close(master)
+    assert proc.returncode == 0, err
+    return ANSI.sub("", b"".join(chunks).decode()), err
+
+
+def test_analyze_on_a_terminal_prints_a_summary(scene_file, capsys):
+    text, err = _run_on_a_terminal(["analyze", str(scene_file), "--timeseries", "none"])
+    assert main(["analyze", str(scene_file), "--timeseries", "none"]) == 0
+    doc = json.loads(capsys.readouterr().out)  # piped: the JSON document
+    assert not text.lstrip().startswith("{")
+    assert "end tension [N]" in text and "drag linearization: converged" in text
+    t = doc["lines"]["leg1"]["end_b"]["tension"]
+    row = next(ln for ln in text.splitlines() if "leg1" in ln and "end_b" in ln)
+    for key in ("mean", "std", "tz", "mpm_3h"):
+        assert f"{t[key]:.4g}" in row, (key, row)
+    # the end-motion spectrum's ω⁻⁵ tail warns; each warning is shown once, in the
+    # summary, not again on stderr
+    assert doc["warnings"]
+    for msg in doc["warnings"]:
+        assert (text + err).count(msg[:60]) == 1, msg
+
+
+def test_analyze_summary_of_a_foot_slug_second_scene_is_in_ft_and_lbf():
+    scene = ROOT / "stochcable" / "examples" / "tuah_1982_disc_buoy_three_legs.json"
+    text, _ = _run_on_a_terminal(["analyze", str(scene)])
+    assert "end tension [lbf]" in text and "[ft]" in text
+    assert "foot-slug-second" in text and "disc" in text
+
+
+def test_analyze_writes_netcdf_for_a_nc_output(scene_file, tmp_path, capsys):
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("netCDF4")
+    nc = tmp_path / "result.nc"
+    assert main(["analyze", str(scene_file), "-o", str(nc)]) == 0
+    assert main(["analyze", str(scene_file), "--format", "json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    with xr.open_dataset(nc) as ds:
+        for end in ("end_a", "end_b"):
+            got = ds["end_tension_std"].sel(line="leg1", end=end).item()
+            assert got == doc["lines"]["leg1"][end]["tension"]["std"]
+        assert ds["end_tension_std"].attrs["units"] == "N"
+
+
+def test_analyze_netcdf_format_needs_an_output_file(scene_file, capsys):
+    assert main(["analyze", str(scene_file), "--format", "netcdf"]) == 2
+    assert "--output" in capsys.readouterr().err

@@ -173,9 +173,8 @@ def test_nested_spectrum_error_has_unit(chain_doc):
     bad = _mutated(chain_doc, lambda d: d["sea"]["spectrum"].__setitem__("hs", -2.0))
     with pytest.raises(InputError, match=r"^sea\.spectrum\.hs = -2\.0 \[m\]: Input should be"):
         load_scene(bad)
-    bad = _mutated(
-        chain_doc, lambda d: d["lines"][0]["end_b"]["motion"]["surge"].__setitem__("tp", -2.0)
-    )
+    pm = {"type": "pierson_moskowitz", "hs": 2.0, "tp": -2.0}
+    bad = _mutated(chain_doc, lambda d: d["lines"][0]["end_b"]["motion"].__setitem__("surge", pm))
     with pytest.raises(InputError, match=r"motion\.surge\.tp = -2\.0 \[s\]: Input should be"):
         load_scene(bad)
 

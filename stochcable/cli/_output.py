@@ -1,4 +1,5 @@
-"""Shared output helpers for CLI sub-commands: JSON, CSV and NPY writers, plot import."""
+"""Shared output helpers for CLI sub-commands: JSON, CSV, NPY and NetCDF writers, the
+result summary a person reads (rich), the choice of output format, plot import."""
 
 from __future__ import annotations
 
@@ -13,7 +14,16 @@ import numpy as np
 
 from stochcable.errors import InputError
 
-__all__ = ["to_jsonable", "write_json", "write_columns", "require_matplotlib", "read_json_file"]
+__all__ = [
+    "to_jsonable",
+    "write_json",
+    "write_columns",
+    "require_matplotlib",
+    "read_json_file",
+    "output_format",
+    "write_summary",
+    "write_netcdf_document",
+]
 
 
 def to_jsonable(obj: Any) -> Any:
@@ -106,3 +116,109 @@ def read_json_file(name: str, path: str) -> Any:
         raise InputError(
             name, path, "-", f"is not valid JSON ({exc.msg} at line {exc.lineno})"
         ) from None
+
+
+def output_format(fmt: str | None, output: str | None) -> str:
+    """The output format of ``analyze``: the one asked for, else ``netcdf`` for an
+    ``-o`` file ending in ``.nc``, ``json`` for another ``-o`` file or when stdout is
+    not a terminal (piped), else ``summary``."""
+    if fmt is not None:
+        if fmt == "netcdf" and output in (None, "-"):
+            raise InputError("--output", output, "-", "is required with --format netcdf")
+        return fmt
+    if output not in (None, "-"):
+        return "netcdf" if str(output).lower().endswith(".nc") else "json"
+    return "summary" if sys.stdout.isatty() else "json"
+
+
+def write_netcdf_document(result: Any, output: str) -> None:
+    """Write a result as NetCDF (:meth:`Result.to_netcdf`)."""
+    try:
+        result.to_netcdf(Path(output))
+    except ImportError as exc:
+        raise InputError(
+            "--output",
+            output,
+            "-",
+            f"NetCDF needs xarray and netCDF4 ({exc}): pip install 'stochcable[bodies]'",
+        ) from None
+
+
+def _g(x: Any) -> str:
+    return "-" if x is None else f"{float(x):.4g}"
+
+
+def write_summary(
+    doc: Mapping[str, Any], output: str | None, title: str = "", plots: Any = ()
+) -> None:
+    """Print the summary of a result document a person reads (rich tables).
+
+    Per line and end the tension statistics (mean, σ, Tz, 3-hour most probable
+    maximum), the largest motion σ along each line, the bodies' motion, the drag
+    linearization, the warnings (each once) and the figures written.
+    """
+    from rich.console import Console
+    from rich.markup import escape
+    from rich.table import Table
+
+    fh = _open_out(output)
+    console = Console(file=fh, highlight=False, force_terminal=None if fh is sys.stdout else False)
+    u = doc.get("units") or {"system": "SI", "length": "m", "force": "N"}
+    f, ln = u["force"], u["length"]
+    try:
+        console.print(f"[bold]stochcable analyze[/bold] {escape(title)}  (units: {u['system']})")
+        lin = doc["linearization"]
+        state = "[green]converged[/green]" if lin["converged"] else "[red]NOT converged[/red]"
+        console.print(
+            f"drag linearization: {state} in {lin['iterations']} iterations "
+            f"(last relative change {lin['relative_change']:.2e})"
+        )
+        table = Table(title=escape(f"end tension [{f}]; Tz [s]"))
+        for col in ("line", "end", "mean", "σ", "Tz", "MPM 3 h"):
+            table.add_column(col, justify="left" if col in ("line", "end") else "right")
+        for name, line in doc["lines"].items():
+            for end in ("end_a", "end_b"):
+                t = line[end]["tension"]
+                table.add_row(name, end, _g(t["mean"]), _g(t["std"]), _g(t["tz"]), _g(t["mpm_3h"]))
+        console.print(table)
+        table = Table(title=escape(f"largest motion σ along each line [{ln}]"))
+        for col in ("line", "σx", "σy", "σz", "iterations", "converged"):
+            table.add_column(col, justify="left" if col == "line" else "right")
+        for name, line in doc["lines"].items():
+            std = np.asarray(line["motion"]["std"], dtype=float).reshape(-1, 3)
+            rec = line["linearization"]
+            table.add_row(
+                escape(name),
+                *(_g(v) for v in std.max(axis=0)),
+                str(rec["iterations"]),
+                "yes" if rec["converged"] else "[red]no[/red]",
+            )
+        console.print(table)
+        bodies = doc.get("bodies") or {}
+        if bodies:
+            table = Table(title=escape(f"body motion (translations [{ln}], rotations [deg])"))
+            for col in ("body", "dof", "mean", "σ", "Tz [s]"):
+                table.add_column(col, justify="left" if col in ("body", "dof") else "right")
+            for name, body in bodies.items():
+                for dof, m in body["motion"].items():
+                    rot = dof in ("roll", "pitch", "yaw")
+                    k = 57.29577951308232 if rot else 1.0  # rad -> deg for rotations
+                    table.add_row(
+                        escape(name), dof, _g(m["mean"] * k), _g(m["std"] * k), _g(m["tz"])
+                    )
+            console.print(table)
+        messages = list(dict.fromkeys(doc.get("warnings") or []))
+        if messages:
+            console.print(f"[bold yellow]{len(messages)} warning(s):[/bold yellow]")
+            for k, msg in enumerate(messages, start=1):
+                console.print(f"  {k}. {escape(msg)}")
+        else:
+            console.print("no warnings")
+        for p in plots:
+            console.print(f"figure: {escape(str(p))}")
+        total = (doc.get("timing") or {}).get("total_s")
+        if total is not None:
+            console.print(f"analysed in {total:.2f} s")
+    finally:
+        if fh is not sys.stdout:
+            fh.close()

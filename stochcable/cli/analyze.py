@@ -1,9 +1,15 @@
-"""``stochcable analyze SCENE.json``: run the analysis pipeline, print the result document.
+"""``stochcable analyze SCENE.json``: run the analysis pipeline, report the result.
+
+On a terminal the command prints a summary (tensions, motions, linearization,
+warnings); piped, or with ``--format json``, it writes the result document as JSON;
+``-o result.nc`` writes the result as NetCDF (:mod:`stochcable.results.datasets`).
 
 Examples::
 
-    stochcable analyze scene.json                       # result document on stdout
+    stochcable analyze scene.json                       # summary on a terminal
+    stochcable analyze scene.json > result.json         # result document (piped)
     stochcable analyze scene.json -o result.json --plot figs/
+    stochcable analyze scene.json -o result.nc          # NetCDF (xarray Dataset)
     stochcable analyze scene.json --timeseries full     # whole time series in the JSON
 
 Progress (stage names and drag-linearization iterations) goes to stderr when stderr is
@@ -14,12 +20,17 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from stochcable.cli._output import require_matplotlib, write_json
+from stochcable.cli._output import (
+    output_format,
+    require_matplotlib,
+    write_json,
+    write_netcdf_document,
+    write_summary,
+)
 
 __all__ = ["register", "run"]
 
@@ -28,21 +39,26 @@ def register(subparsers: Any) -> None:
     """Add the ``analyze`` sub-command."""
     p = subparsers.add_parser(
         "analyze",
-        help="stochastic response of the lines of a scene (result document as JSON)",
+        help="stochastic response of the lines of a scene (summary, JSON or NetCDF)",
         description="Run statics, drag linearization and the frequency-domain solve of "
-        "a scene document and print the v1 result document.",
+        "a scene document; print a summary on a terminal, else the v1 result document "
+        "as JSON.",
     )
     p.add_argument("scene", help="scene document (JSON file)")
     p.add_argument(
-        "--format", choices=["json"], default="json", help="output format (default json)"
+        "--format",
+        choices=["summary", "json", "netcdf"],
+        default=None,
+        help="output format (default: netcdf for an -o file ending in .nc, json for "
+        "other -o files and when stdout is not a terminal, else summary)",
     )
     p.add_argument("-o", "--output", default=None, help="output file (default stdout)")
     p.add_argument(
         "--plot",
         metavar="DIR",
         default=None,
-        help="write PNG figures (end-tension spectra, tension σ along the "
-        "line, time-series window) into DIR",
+        help="write PNG figures (static shape, end-tension spectra, tension along the "
+        "line with mean ± 3σ, mode shapes, time-series window) into DIR",
     )
     p.add_argument(
         "--timeseries",
@@ -68,7 +84,7 @@ class _StderrProgress:
         line = info.get("line") if hasattr(info, "get") else None
         if stage == "linearization" and info.get("iteration"):
             msg = (
-                f"  linearization '{line}': iteration {info['iteration']}, "
+                f"  linearization{f' {line!r}' if line else ''}: iteration {info['iteration']}, "
                 f"change {info.get('change', float('nan')):.2e}"
             )
         elif stage == "done":
@@ -80,81 +96,34 @@ class _StderrProgress:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the analysis and write the result document (and figures)."""
+    """Run the analysis and write the summary, the result document or NetCDF (and figures)."""
     from stochcable.analysis import analyze
     from stochcable.cost import available_memory, check_memory, estimate_cost
     from stochcable.scene.model import load_scene
 
+    fmt = output_format(args.format, args.output)
     scene = load_scene(Path(args.scene))
     # a scene too large for this machine: one sentence naming what to reduce, at once
     check_memory(estimate_cost(scene), available_memory(), "the memory available now")
+    plt = require_matplotlib() if args.plot is not None else None
     show = args.progress or (hasattr(sys.stderr, "isatty") and sys.stderr.isatty())
-    result = analyze(scene, progress=_StderrProgress() if show else None)
+    with warnings.catch_warnings():
+        if fmt == "summary":
+            # the summary lists the run's warnings once (result.warnings); they are
+            # not echoed on stderr as well
+            warnings.simplefilter("ignore")
+        result = analyze(scene, progress=_StderrProgress() if show else None)
     doc = result.to_document(timeseries=args.timeseries)
-    if args.plot is not None:
-        doc["plots"] = [str(p) for p in plot_result(result, Path(args.plot))]
-    write_json(doc, args.output)
+    plots: list[str] = []
+    if plt is not None:
+        from stochcable.plots import plot_result
+
+        plots = [str(p) for p in plot_result(result, Path(args.plot))]
+        doc["plots"] = plots
+    if fmt == "netcdf":
+        write_netcdf_document(result, args.output)
+    elif fmt == "summary":
+        write_summary(doc, args.output, title=str(args.scene), plots=plots)
+    else:
+        write_json(doc, args.output)
     return 0
-
-
-def plot_result(result: Any, directory: Path) -> list[Path]:
-    """Write the standard figures of a result as PNG files; returns their paths.
-
-    - ``<line>_end_tension_spectra.png``: one-sided spectra of the end tensions;
-    - ``<line>_tension_std.png``: σ of the dynamic effective tension along the line;
-    - ``timeseries.png``: the first 600 s of η and of the end tensions.
-    """
-    plt = require_matplotlib()
-    directory.mkdir(parents=True, exist_ok=True)
-    paths: list[Path] = []
-    for name, lr in result.lines.items():
-        fig, ax = plt.subplots(figsize=(7, 4))
-        for end in ("end_a", "end_b"):
-            ax.plot(lr.omega, lr.end_tension_spectrum(end), label=end)
-        ax.set_xlabel("ω [rad/s]")
-        ax.set_ylabel("S_T(ω) [N²·s/rad]")
-        ax.set_title(f"line {name}: end tension spectra")
-        ax.legend()
-        fig.tight_layout()
-        p = directory / f"{name}_end_tension_spectra.png"
-        fig.savefig(p, dpi=100)
-        plt.close(fig)
-        paths.append(p)
-
-        fig, ax = plt.subplots(figsize=(7, 4))
-        ax.plot(lr.s_elements, lr.tension_std)
-        ax.set_xlabel("arc length from end_a s [m]")
-        ax.set_ylabel("σ of dynamic tension [N]")
-        ax.set_title(f"line {name}: dynamic tension σ")
-        fig.tight_layout()
-        p = directory / f"{name}_tension_std.png"
-        fig.savefig(p, dpi=100)
-        plt.close(fig)
-        paths.append(p)
-    ts = result.timeseries
-    if ts is not None:
-        n = int(np.searchsorted(ts.time, ts.time[0] + 600.0))
-        n = max(n, 2)
-        rows = 1 + len(ts.end_tension)
-        fig, axes = plt.subplots(rows, 1, figsize=(8, 2.2 * rows), sharex=True, squeeze=False)
-        ax0 = axes[0, 0]
-        if ts.elevation is not None:
-            ax0.plot(ts.time[:n], ts.elevation[:n], lw=0.8)
-            ax0.set_ylabel("η [m]")
-        for key, series in ts.end_motion.items():
-            ax0.plot(ts.time[:n], series[:n], lw=0.8, label=key)
-        if ts.end_motion:
-            ax0.legend(fontsize=7)
-        for k, (name, ends) in enumerate(ts.end_tension.items(), start=1):
-            ax = axes[k, 0]
-            for end, series in ends.items():
-                ax.plot(ts.time[:n], series[:n], lw=0.8, label=end)
-            ax.set_ylabel(f"{name} T [N]")
-            ax.legend(fontsize=7)
-        axes[-1, 0].set_xlabel("t [s]")
-        fig.tight_layout()
-        p = directory / "timeseries.png"
-        fig.savefig(p, dpi=100)
-        plt.close(fig)
-        paths.append(p)
-    return paths

@@ -3,10 +3,15 @@
 Each ``<name>.json`` is a scene document (DESIGN.md "Scene and result documents") whose
 ``title`` states its source and assumptions in short; the details:
 
-- ``chain_catenary``: the v1 contract example of DESIGN.md verbatim, without the
-  (load-free) attachment: 120 mm studless chain, 288 kg/m, hydrodynamic diameter 0.216 m
+- ``chain_catenary``: the v1 contract example of DESIGN.md, without the (load-free)
+  attachment: 120 mm studless chain, 288 kg/m, hydrodynamic diameter 0.216 m
   (1.8 x nominal), EA 1.2326e9 N, 850 m from an anchor at (-800, 0, -200) m to a
-  fairlead at (0, 0, -20) m moving in surge.
+  fairlead at (0, 0, -20) m moving in surge.  The fairlead surge is a vessel's motion
+  spectrum, band-limited as a vessel's is (its surge RAO falls off above the wave
+  frequencies it follows): DESIGN.md's Pierson–Moskowitz spectrum Hs 2 m, Tp 10 s
+  times a cos² taper from 1 at 0.9 rad/s to 0 at 1.5 rad/s, tabulated every 0.05
+  rad/s (σ 0.47 m).  DESIGN.md's untapered spectrum has an ω⁻⁵ tail whose inertia
+  loads keep the tension spectrum large at the top of any grid (a ResolutionWarning).
 - ``tuah_1982_suspended_cable``: seed 001 (Tuah 1982) §6.2 Example 2 in ft, slug, s,
   lbf (g = 32.174 ft/s², fluid 2.0 slug/ft³ as the seed).  Cable A0 = 0.0218 ft²
   (D = sqrt(4 A0/π) = 0.1666 ft), E = 8.12e6 psf (EA = 177 016 lbf), density
@@ -60,7 +65,40 @@ from importlib import resources
 from stochcable.errors import InputError
 from stochcable.scene.model import Scene, load_scene
 
-__all__ = ["list_examples", "load_example"]
+__all__ = ["list_examples", "load_example", "DOCUMENTED_WARNINGS"]
+
+#: The warnings an example raises on purpose, by example name: a phrase the warning's
+#: message contains, and why the example keeps it.  Every other example analyses
+#: without a warning (tests/test_examples.py checks both).
+DOCUMENTED_WARNINGS: dict[str, dict[str, str]] = {
+    "tuah_1982_suspended_cable": {
+        "has no excitation": "a statics example (seed 001 §6.2 Example 2): no sea, no "
+        "end motion, so the dynamic response is zero by design",
+    },
+    "inclined_guy": {
+        "wave-velocity σ varies": "the thesis's (seed 000 §7.3) 40 elements are kept so "
+        "the example matches its source; the warning says what a finer mesh near the "
+        "surface would change",
+        "near-undamped resonance": "the guy's second mode lies in the sea's band with "
+        "drag damping only: the warning is the physics of a taut guy in waves",
+    },
+    "tuah_1982_single_leg": {
+        "wave-velocity σ varies": "the seed's 3 elements (seed 001 §6.5 Example 5) are "
+        "kept so the example reproduces the seed's model",
+        "snap loads likely": "the seed's slack 100 lb leg in a 28 ft² sea: σ exceeds a "
+        "third of the mean tension; the example shows where the linear model stops",
+    },
+    "tuah_1982_disc_buoy_single_leg": {
+        "wave-velocity σ varies": "the seed's 3 elements are kept (seed 001 §6.5)",
+        "snap loads likely": "the seed's slack leg: σ exceeds a third of the mean tension",
+        "of the line's sag": "the buoy's motion is large against the slack leg's sag",
+    },
+    "tuah_1982_disc_buoy_three_legs": {
+        "wave-velocity σ varies": "the seed's 3 elements are kept (seed 001 §6.7)",
+        "snap loads likely": "the seed's slack legs: σ exceeds a third of the mean tension",
+        "of the line's sag": "the buoy's motion is large against the legs' sag",
+    },
+}
 
 
 def _files():

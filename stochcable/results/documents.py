@@ -409,6 +409,18 @@ class Result:
             "relative_change": max((r.relative_change for r in recs), default=0.0),
         }
 
+    def to_xarray(self) -> Any:
+        """The result as an :class:`xarray.Dataset` (:mod:`stochcable.results.datasets`)."""
+        from stochcable.results.datasets import dataset_from_result
+
+        return dataset_from_result(self)
+
+    def to_netcdf(self, path: Any) -> Any:
+        """Write :meth:`to_xarray` as a NetCDF-4 file; returns its path."""
+        from stochcable.results.datasets import write_netcdf
+
+        return write_netcdf(self.to_xarray(), path)
+
     def to_document(self, timeseries: str = "window") -> dict[str, Any]:
         """The v1 result document (DESIGN.md), JSON-ready.
 

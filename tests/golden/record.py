@@ -1,7 +1,8 @@
 """Golden result documents: the numbers the restructure must not change.
 
 ``python tests/golden/record.py`` writes ``tests/golden/<case>.json.gz`` for every case
-of :data:`CASES`: each bundled example, and variants that reach the other paths (the
+of :data:`CASES`: each bundled example, DESIGN.md's chain verbatim (``chain_design``: the
+example with its untapered fairlead surge), and variants that reach the other paths (the
 direct and Foss solvers for single lines and lines on bodies, time series of lines on
 bodies, statics with current, the adaptive-fidelity plan).  Each case stores the CLI's
 documents — ``statics``, ``modes`` (10 per line) and ``analyze`` (time-series window) —
@@ -35,8 +36,18 @@ def _variant(name: str, **analysis: object) -> dict:
     return doc
 
 
-def _chain_current() -> dict:
+def _design_chain() -> dict:
+    """DESIGN.md's v1 chain verbatim: the bundled example with its fairlead surge the
+    untapered Pierson–Moskowitz spectrum (the example band-limits it)."""
     doc = _example("chain_catenary")
+    doc["lines"][0]["end_b"]["motion"] = {
+        "surge": {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}
+    }
+    return doc
+
+
+def _chain_current() -> dict:
+    doc = _design_chain()
     doc["environment"]["current"] = [
         {"z": 0.0, "speed": 1.0, "heading": 30.0},
         {"z": -200.0, "speed": 0.3, "heading": 30.0},
@@ -48,7 +59,9 @@ def _chain_current() -> dict:
 def cases() -> dict[str, dict]:
     """The scene documents of every golden case, by case name."""
     out = {p.stem: _example(p.stem) for p in sorted(EXAMPLES.glob("*.json"))}
-    out["chain_direct"] = _variant("chain_catenary", solver="direct")
+    out["chain_design"] = _design_chain()
+    out["chain_direct"] = _design_chain()
+    out["chain_direct"]["analysis"]["solver"] = "direct"
     out["chain_current"] = _chain_current()
     out["taut_wire_fidelity"] = _variant("taut_wire", fidelity={"target_error": 0.02})
     ts = {"method": "dsa", "duration": 256.0, "dt": 0.25, "seed": 3}
