@@ -37,17 +37,17 @@ M_0.
 Constants (fitted on peak RSS above the imported baseline, ``ru_maxrss`` of a fresh
 subprocess, one BLAS thread; ``benchmarks/bench_cost.py``, x86-64, numpy 2, 2 cores):
 
-=====================================  =====  ======  =========  ======  ======
-scene                                  n_el   n_ω     channels   ΔRSS    B/(node·ω·ch)
-=====================================  =====  ======  =========  ======  ======
-taut_wire (sea only)                   200    1000    1          156 MB  775
-taut_wire                              400    1000    1          300 MB  748
-chain_catenary (sea + fairlead surge)  200    1000    2          352 MB  875
-chain_catenary                         400    1000    2          686 MB  856
-chain_catenary                         200    3000    2          1025 MB 850
-disc buoy, three legs (free body)      3×100  1000    4 per leg  966 MB  797
-disc buoy, three legs                  3×200  1000    4 per leg  1846 MB 766
-=====================================  =====  ======  =========  ======  ======
+=====================================  =====  ======  =========  =======  =============
+scene                                  n_el   n_ω     channels   ΔRSS     B/(node·ω·ch)
+=====================================  =====  ======  =========  =======  =============
+taut_wire (sea only)                   200    1000    1          156 MB   775
+taut_wire                              400    1000    1          300 MB   748
+chain_catenary (sea + fairlead surge)  200    1000    2          352 MB   875
+chain_catenary                         400    1000    2          686 MB   856
+chain_catenary                         200    3000    2          1025 MB  850
+disc buoy, three legs (free body)      3×100  1000    4 per leg  966 MB   797
+disc buoy, three legs                  3×200  1000    4 per leg  1846 MB  766
+=====================================  =====  ======  =========  =======  =============
 
 so c_M = 900 B (the largest ratio, rounded up: the estimate should not be below the
 peak); c_T = 110 B per sample and channel (chain_catenary, 2^20 and 2^22 samples with

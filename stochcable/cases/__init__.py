@@ -1,5 +1,5 @@
 """Load-case sets: a scene template over a wave scatter diagram, with spectral fatigue
-damage and long-term extremes (the design checks of :mod:`stochcable.design`).
+damage and long-term extremes (the design checks of :mod:`stochcable.design`)::
 
     scatter = read_scatter("scatter.csv")               # sea states and probabilities
     result = run_cases(scene, scatter, fatigue=LineFatigue("dnv-studless",
