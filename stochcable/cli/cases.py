@@ -5,7 +5,7 @@ sea state, spectral fatigue damage and life, long-term extremes.
                      [--spectrum jonswap|pierson_moskowitz] [--curve dnv-studless]
                      [--nominal-diameter D | --nominal-area A | --mbs F]
                      [--method dirlik] [--dff 3] [--years 100] [-o out.nc|csv|json]
-                     [--workers N | --scheduler tcp://HOST:PORT]
+                     [--workers N | --scheduler tcp://HOST:PORT] [--plot DIR]
 
 With ``--headings`` every row of the diagram is repeated for each heading with equal
 probability (the headings of the file are then ignored).  A progress bar is shown on a
@@ -66,6 +66,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="run on a local Dask cluster of this many worker processes",
     )  # fmt: skip
     p.add_argument("--scheduler", default=None, help="an existing Dask scheduler (tcp://HOST:PORT)")
+    p.add_argument("--plot", metavar="DIR", default=None, help="damage heat maps and lines (PNG)")
     p.set_defaults(func=run)
 
 
@@ -155,6 +156,11 @@ def run(args: argparse.Namespace) -> int:
             f"stochcable cases: {len(failed)} of {len(result.rows)} cases not ok "
             f"(probability covered by ok cases: {result.coverage['ok']:.4g})\n"
         )
+    if args.plot is not None:
+        from stochcable.plots import plot_cases
+
+        for path in plot_cases(result, args.plot):
+            sys.stderr.write(f"stochcable cases: wrote {path}\n")
     if suffix == ".nc":
         case_dataset(result).to_netcdf(out)
     elif suffix == ".csv":
