@@ -91,6 +91,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         settings.max_queue,
         settings.memory_budget,
         settings.worker_recycle_bytes,
+        start_method=settings.worker_start_method,
     )
 
     @asynccontextmanager

@@ -7,6 +7,7 @@ the setting (``STOCHCABLE_MAX_SAMPLES``) so an operator knows what to raise.
 from __future__ import annotations
 
 import os
+from typing import Literal
 
 import psutil
 from pydantic import Field
@@ -64,6 +65,11 @@ class Settings(BaseSettings):
         le=256,
         description="Worker processes running analyses (POST /v1/analyses), each one "
         "analysis at a time; default the number of cores [-]",
+    )
+    worker_start_method: Literal["forkserver", "fork"] = Field(
+        default="forkserver",
+        description="How analysis workers start: forkserver (warm, clean imports) or fork "
+        "(a copy of the HTTP process, for tests that patch the library) [-]",
     )
     max_queue: int = Field(
         default=64,

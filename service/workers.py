@@ -234,6 +234,9 @@ class WorkerPool:
         A worker keeping more than this resident after a computation is replaced. [bytes]
     retry_after : int
         ``Retry-After`` of a 503 for a full queue. [s]
+    start_method : {"forkserver", "fork"}
+        How workers start: from the warm fork server (clean imports), or forked from
+        this process (they inherit its state: tests that patch the library).
     """
 
     def __init__(
@@ -243,7 +246,9 @@ class WorkerPool:
         memory_budget: int,
         recycle_bytes: int,
         retry_after: int = 1,
+        start_method: str = "forkserver",
     ) -> None:
+        self.start_method = start_method
         self.size = size
         self.max_queue = max_queue
         self.address_space_extra = 2 * memory_budget
@@ -263,8 +268,9 @@ class WorkerPool:
 
     def _context(self) -> Any:
         if self._ctx is None:
-            ctx = multiprocessing.get_context("forkserver")
-            ctx.set_forkserver_preload(_PRELOAD)
+            ctx = multiprocessing.get_context(self.start_method)
+            if self.start_method == "forkserver":
+                ctx.set_forkserver_preload(_PRELOAD)
             self._ctx = ctx
         return self._ctx
 
@@ -272,7 +278,7 @@ class WorkerPool:
         """A new worker (the first one starts the fork server, with one BLAS thread)."""
         ctx = self._context()
         with _FIRST_START:
-            if _FORKSERVER_STARTED:
+            if _FORKSERVER_STARTED or self.start_method != "forkserver":
                 worker = _Worker(ctx, self.address_space_extra, self.recycle_bytes)
             else:
                 worker = _first_worker(ctx, self.address_space_extra, self.recycle_bytes)

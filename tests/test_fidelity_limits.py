@@ -189,6 +189,17 @@ def test_http_entrance_meets_the_target(target, client):
     assert _fidelity_texts(doc["warnings"]) == [] and "limits" not in doc["fidelity"]
 
 
+def _patched_client():
+    """A service whose analysis workers are forked from this process after the
+    planner was patched (forkserver workers would not see the patch)."""
+    from fastapi.testclient import TestClient
+
+    from service.app import create_app
+    from service.settings import Settings
+
+    return TestClient(create_app(Settings(analysis_workers=1, worker_start_method="fork")))
+
+
 @pytest.fixture
 def low_limit(monkeypatch):
     """The scene model's frequency limit as the planner reads it, lowered to 200 (the
@@ -205,7 +216,7 @@ def _check_limit_warning(texts: list[str]) -> None:
     assert "estimated σ error" in text and "analysis.fidelity.target_error" in text
 
 
-def test_entrances_at_the_limit_answer_with_the_warning(low_limit, tmp_path, capsys, client):
+def test_entrances_at_the_limit_answer_with_the_warning(low_limit, tmp_path, capsys):
     res = analyze(_chain(0.05))
     assert res.fidelity.omega_count == 200 and not res.fidelity.grid_resolved
     _check_limit_warning(_fidelity_texts(res.warnings))
@@ -213,7 +224,8 @@ def test_entrances_at_the_limit_answer_with_the_warning(low_limit, tmp_path, cap
     assert rc == 0, err
     _check_limit_warning([line.removeprefix("stochcable: warning: ") for line in err.splitlines()])
     assert out["fidelity"]["limits"] and out["fidelity"]["omega"]["count"] == 200
-    resp = client.post("/v1/analyses", json=_chain(0.05))
+    with _patched_client() as client:
+        resp = client.post("/v1/analyses", json=_chain(0.05))
     assert resp.status_code == 200, resp.text
     _check_limit_warning(resp.json()["warnings"])
 
@@ -227,7 +239,7 @@ def no_limit(monkeypatch):
     monkeypatch.setattr(planner, "omega_count_limit", lambda: 10**9)
 
 
-def test_entrances_refuse_an_inadmissible_plan(no_limit, tmp_path, capsys, client):
+def test_entrances_refuse_an_inadmissible_plan(no_limit, tmp_path, capsys):
     with pytest.raises(InputError) as info:
         analyze(_chain(0.003))
     assert info.value.parameter == "analysis.fidelity.target_error"
@@ -236,7 +248,8 @@ def test_entrances_refuse_an_inadmissible_plan(no_limit, tmp_path, capsys, clien
     (line,) = err.strip().splitlines()
     assert line.startswith("stochcable analyze: error: analysis.fidelity.target_error = 0.003")
     assert "analysis.omega.count" in line
-    resp = client.post("/v1/analyses", json=_chain(0.003))
+    with _patched_client() as client:
+        resp = client.post("/v1/analyses", json=_chain(0.003))
     assert resp.status_code == 422, resp.text
     detail = resp.json()["detail"][0]
     assert "analysis.fidelity.target_error" in json.dumps(detail)
