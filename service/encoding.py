@@ -7,7 +7,9 @@ Content negotiation on ``Accept``:
   float64 columns (``numpy.load(io.BytesIO(body))``; field names as the CSV header,
   except that a uniform time column is left out: t_n = n·dt);
 * ``text/csv``: a header row with the column names, then one row per sample
-  (``%.17g``, round-trips float64).
+  (``%.17g``, round-trips float64);
+* ``application/x-netcdf`` (analyses only): the result as a NetCDF-4 file, the Dataset
+  of :func:`stochcable.results.datasets.dataset_from_result`.
 
 The column layouts are documented on each endpoint.  Scalars that do not fit in
 columns (the statistics) travel in the ``X-Stochcable-Stats`` header as compact JSON
@@ -35,6 +37,7 @@ __all__ = [
     "JSON",
     "NPY",
     "CSV",
+    "NETCDF",
     "STATS_HEADER",
     "negotiate",
     "json_response",
@@ -48,12 +51,14 @@ __all__ = [
 JSON = "application/json"
 NPY = "application/x-npy"
 CSV = "text/csv"
+NETCDF = "application/x-netcdf"
 STATS_HEADER = "X-Stochcable-Stats"
 _SUPPORTED = (JSON, NPY, CSV)
 
 
-def negotiate(request: Request) -> str:
-    """The media type to answer with, from the request's ``Accept`` header.
+def negotiate(request: Request, supported: tuple[str, ...] = _SUPPORTED) -> str:
+    """The media type to answer with, from the request's ``Accept`` header, among
+    ``supported`` (JSON first).
 
     Raises a 406 HTTPException when ``Accept`` names only unsupported types.
     """
@@ -75,11 +80,11 @@ def negotiate(request: Request) -> str:
             media = JSON
         elif media == "text/*":
             media = CSV
-        if media in _SUPPORTED and q > best_q:
+        if media in supported and q > best_q:
             best, best_q = media, q
     if best is None:
         raise HTTPException(
-            406, f"cannot answer with {accept!r}; supported: {', '.join(_SUPPORTED)}"
+            406, f"cannot answer with {accept!r}; supported: {', '.join(supported)}"
         )
     return best
 

@@ -16,7 +16,7 @@ from .limits import checked_call
 __all__ = ["analysis_job", "non_finite_error"]
 
 
-def analysis_job(scene: Scene, timeseries: str) -> tuple[bytes, int]:
+def analysis_job(scene: Scene, timeseries: str, netcdf: bool = False) -> tuple[bytes, int]:
     """Analyse a scene and encode its result document (in a worker process).
 
     Parameters
@@ -25,11 +25,13 @@ def analysis_job(scene: Scene, timeseries: str) -> tuple[bytes, int]:
         The validated scene document.
     timeseries : {"window", "full", "none"}
         Time series in the document.
+    netcdf : bool
+        Answer the result as a NetCDF-4 file (its Dataset) instead of JSON.
 
     Returns
     -------
     body : bytes
-        The v1 result document as compact JSON.
+        The v1 result document as compact JSON, or the NetCDF file.
     n_warnings : int
         Entries of its ``warnings`` list.
 
@@ -50,6 +52,10 @@ def analysis_job(scene: Scene, timeseries: str) -> tuple[bytes, int]:
         doc = result.to_document(timeseries=timeseries)
         if not all_finite(doc):
             raise non_finite_error(scene, doc)
+        if netcdf:
+            from stochcable.results.datasets import dataset_from_result, netcdf_bytes
+
+            return netcdf_bytes(dataset_from_result(result)), len(doc.get("warnings", ()))
         return dumps(doc), len(doc.get("warnings", ()))
     except MemoryError as exc:
         hint = estimate_cost(scene).reduce_hint()

@@ -5,11 +5,11 @@ from __future__ import annotations
 import time
 from typing import Annotated, Any, Literal
 
-from fastapi import APIRouter, Body, Query
+from fastapi import APIRouter, Body, Query, Request
 from starlette.responses import Response
 
 from service.dependencies import PoolDep, SettingsDep
-from service.encoding import JSON, error_responses
+from service.encoding import JSON, NETCDF, error_responses, negotiate
 from service.jobs import analysis_job
 from service.limits import check_scene
 from service.schemas import AnalysisResponse
@@ -48,18 +48,23 @@ def _body_examples() -> dict[str, dict[str, Any]]:
     response_model=AnalysisResponse,
     responses={
         200: {
+            "description": "The v1 result document (JSON); with `Accept: "
+            "application/x-netcdf` the result as a NetCDF-4 file (save it as `result.nc`; "
+            '`xarray.load_dataset("result.nc")`)',
+            "content": {NETCDF: {"schema": {"type": "string", "format": "binary"}}},
             "headers": {
                 WARNINGS_HEADER: {
                     "description": "Number of warnings in the document's warnings list",
                     "schema": {"type": "integer", "minimum": 0},
                 }
-            }
+            },
         },
-        **error_responses(413, 422, 503, 504),
+        **error_responses(406, 413, 422, 503, 504),
     },
     summary="Analyse a scene: statics, drag linearization, response statistics",
 )
 async def run_analysis(
+    request: Request,
     scene: Annotated[Scene, Body(openapi_examples=_body_examples())],
     settings: SettingsDep,
     pool: PoolDep,
@@ -94,10 +99,16 @@ async def run_analysis(
     localhost:8000/v1/analyses -H 'Content-Type: application/json' -d @-``
     """
     # coefficient files would be read from the server's file system: inline tables only
+    media = negotiate(request, (JSON, NETCDF))
     load_scene(scene, allow_files=False)
     check_scene(scene, settings)
     limit = settings.max_run_seconds
     body, n_warnings = await pool.run(
-        analysis_job, scene, timeseries, deadline=time.monotonic() + limit, limit=limit
+        analysis_job,
+        scene,
+        timeseries,
+        media == NETCDF,
+        deadline=time.monotonic() + limit,
+        limit=limit,
     )
-    return Response(body, media_type=JSON, headers={WARNINGS_HEADER: str(n_warnings)})
+    return Response(body, media_type=media, headers={WARNINGS_HEADER: str(n_warnings)})
