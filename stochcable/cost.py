@@ -62,10 +62,11 @@ constants) so that a change of the engine's array layout (frequency-blocked solv
 updates them here only: rerun ``benchmarks/bench_cost.py`` and take the largest
 bytes-per-node·frequency·channel ratio, rounded up.
 
-Not yet covered: the adaptive-fidelity planner (``analysis.fidelity``) chooses its own
-elements and frequencies and does not consult this budget; the estimate is that of the
-document as given, and the service's workers' address-space limit is what bounds a
-planned analysis that grows beyond it.
+The adaptive-fidelity planner (``analysis.fidelity``) chooses its own elements and
+frequencies: the scene it plans is refused when its estimate exceeds the memory
+available (:func:`stochcable.fidelity.limits.check_plan_memory`); the service's check
+of the document as given does not see the plan, and the workers' address-space limit
+bounds a planned analysis beyond the service's budget.
 """
 
 from __future__ import annotations

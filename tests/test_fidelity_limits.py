@@ -254,3 +254,15 @@ def test_entrances_refuse_an_inadmissible_plan(no_limit, tmp_path, capsys):
     detail = resp.json()["detail"][0]
     assert "analysis.fidelity.target_error" in json.dumps(detail)
     assert "analysis.omega.count" in json.dumps(detail)
+
+
+def test_a_plan_beyond_the_memory_available_is_refused(monkeypatch):
+    # a machine with 1 MiB free: the 5 % plan of the chain (≈ 10² MB by the cost
+    # model) is refused before any work, naming the target and the estimate
+    import stochcable.cost as cost
+
+    monkeypatch.setattr(cost, "available_memory", lambda: 2**20)
+    with pytest.raises(InputError, match="memory available now") as info:
+        analyze(_chain(0.05))
+    assert info.value.parameter == "analysis.fidelity.target_error"
+    assert "estimated peak memory" in str(info.value)

@@ -19,6 +19,7 @@ from stochcable.errors import InputError
 from stochcable.scene.model import OmegaGrid, Scene, Segment, input_error_from_validation
 
 __all__ = [
+    "check_plan_memory",
     "field_bound",
     "omega_count_limit",
     "elements_limit",
@@ -67,3 +68,20 @@ def clip(value: Any, limit: int) -> tuple[int, bool]:
     """``min(value, limit)`` and whether it was clipped."""
     v = int(value)
     return (limit, True) if v > limit else (v, False)
+
+
+def check_plan_memory(planned: Scene, target_error: float) -> None:
+    """Refuse a planned scene whose estimated peak memory
+    (:func:`stochcable.cost.estimate_cost`) exceeds the memory available now: an
+    InputError naming ``analysis.fidelity.target_error``, the estimate and the fix."""
+    from stochcable.cost import available_memory, estimate_cost
+
+    estimate, free = estimate_cost(planned), available_memory()
+    if estimate.memory_bytes > free:
+        raise InputError(
+            "analysis.fidelity.target_error",
+            target_error,
+            "-",
+            f"the plan for this target needs an {estimate.describe()}, more than the "
+            f"memory available now ({free / 2**30:.3g} GiB): ask for a larger target error",
+        )

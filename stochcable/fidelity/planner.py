@@ -24,7 +24,12 @@ import numpy as np
 from pydantic import ValidationError
 
 from stochcable import validation as _v
-from stochcable.fidelity.limits import elements_limit, omega_count_limit, planned_scene_error
+from stochcable.fidelity.limits import (
+    check_plan_memory,
+    elements_limit,
+    omega_count_limit,
+    planned_scene_error,
+)
 from stochcable.fidelity.meshing import (
     Segments,
     mesh_rules,
@@ -584,6 +589,8 @@ def apply_fidelity(scene: Scene | Any, plan: FidelityPlan) -> Scene:
         ),
     }
     try:
-        return segments_scene(scene, plan.segments, update)
+        planned = segments_scene(scene, plan.segments, update)
     except ValidationError as exc:  # never reaches a user as a pydantic error
         raise planned_scene_error(exc, plan.target_error) from None
+    check_plan_memory(planned, plan.target_error)  # the budget of every analysis
+    return planned
