@@ -40,6 +40,7 @@ __all__ = [
     "NETCDF",
     "STATS_HEADER",
     "negotiate",
+    "negotiate_among",
     "json_response",
     "columns_response",
     "array_responses",
@@ -56,12 +57,18 @@ STATS_HEADER = "X-Stochcable-Stats"
 _SUPPORTED = (JSON, NPY, CSV)
 
 
-def negotiate(request: Request, supported: tuple[str, ...] = _SUPPORTED) -> str:
-    """The media type to answer with, from the request's ``Accept`` header, among
-    ``supported`` (JSON first).
+def negotiate(request: Request) -> str:
+    """The media type to answer with (JSON, NPY or CSV), from the request's ``Accept``
+    header (a FastAPI dependency).
 
     Raises a 406 HTTPException when ``Accept`` names only unsupported types.
     """
+    return negotiate_among(request, _SUPPORTED)
+
+
+def negotiate_among(request: Request, supported: tuple[str, ...]) -> str:
+    """The media type to answer with among ``supported`` (JSON first), from the
+    request's ``Accept`` header; a 406 HTTPException when it names only others."""
     accept = request.headers.get("accept", "")
     if not accept.strip():
         return JSON

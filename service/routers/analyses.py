@@ -9,7 +9,7 @@ from fastapi import APIRouter, Body, Query, Request
 from starlette.responses import Response
 
 from service.dependencies import PoolDep, SettingsDep
-from service.encoding import JSON, NETCDF, error_responses, negotiate
+from service.encoding import JSON, NETCDF, error_responses, negotiate_among
 from service.jobs import analysis_job
 from service.limits import check_scene
 from service.schemas import AnalysisResponse
@@ -99,7 +99,7 @@ async def run_analysis(
     localhost:8000/v1/analyses -H 'Content-Type: application/json' -d @-``
     """
     # coefficient files would be read from the server's file system: inline tables only
-    media = negotiate(request, (JSON, NETCDF))
+    media = negotiate_among(request, (JSON, NETCDF))
     load_scene(scene, allow_files=False)
     check_scene(scene, settings)
     limit = settings.max_run_seconds
