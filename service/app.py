@@ -14,16 +14,18 @@ from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 
 import anyio
-from fastapi import FastAPI
+from fastapi import Depends, FastAPI
 from starlette.middleware.gzip import DEFAULT_EXCLUDED_CONTENT_TYPES, GZipMiddleware
 
 from stochcable import __version__, runtime
 
 from . import routers
+from .batches import BatchService
+from .dependencies import get_caller
 from .encoding import NPY
 from .errors import install_error_handlers
 from .limits import BodySizeLimitMiddleware, Runner, ServerTimingMiddleware
-from .settings import Settings
+from .settings import Settings, insecure_bind_message
 from .workers import WorkerPool
 
 __all__ = ["create_app", "app", "GZIP_MINIMUM_BYTES", "GZIP_LEVEL"]
@@ -85,6 +87,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         The application (settings in ``app.state.settings``).
     """
     settings = settings if settings is not None else Settings()
+    why = insecure_bind_message(settings.host, settings)
+    if why is not None:
+        raise ValueError(why)
     runtime.configure()  # the service's process settings (stochcable.runtime)
     pool = WorkerPool(
         settings.analysis_workers,
@@ -97,9 +102,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         await anyio.to_thread.run_sync(pool.start)  # warm workers before the first request
+        batches.start()  # jobs left unfinished by a former process resume
         try:
             yield
         finally:
+            await anyio.to_thread.run_sync(batches.close)
             await anyio.to_thread.run_sync(pool.close)
 
     app = FastAPI(
@@ -113,9 +120,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.settings = settings
     app.state.runner = Runner(settings)
     app.state.pool = pool  # analyses (started by the lifespan, or on first demand)
+    batches = BatchService(settings)
+    app.state.batches = batches
     install_error_handlers(app)
     for router in _routers():
-        app.include_router(router)
+        # /v1 needs an API key when STOCHCABLE_API_KEYS is set; /health and /version never
+        keyed = router.prefix.startswith("/v1")
+        app.include_router(router, dependencies=[Depends(get_caller)] if keyed else None)
     app.add_middleware(
         GZipMiddleware,
         minimum_size=GZIP_MINIMUM_BYTES,

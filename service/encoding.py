@@ -226,6 +226,16 @@ def columns_response(
 
 
 _ERRORS: dict[int, dict[str, Any]] = {
+    401: {
+        "model": ErrorResponse,
+        "description": "No or an unknown API key (when STOCHCABLE_API_KEYS is set): send "
+        "Authorization: Bearer KEY",
+        "headers": {"WWW-Authenticate": {"description": "Bearer", "schema": {"type": "string"}}},
+    },
+    409: {
+        "model": ErrorResponse,
+        "description": "The batch has not finished (type conflict): poll its status",
+    },
     404: {"model": ErrorResponse, "description": "Unknown resource"},
     406: {"model": ErrorResponse, "description": "Accept names no supported media type"},
     413: {"model": ErrorResponse, "description": "Request body over STOCHCABLE_MAX_BODY_BYTES"},

@@ -56,6 +56,8 @@ __all__ = [
     "install_error_handlers",
     "error_response",
     "NotFound",
+    "Conflict",
+    "Unauthorized",
     "NumericalError",
     "LimitExceeded",
     "RunTimeExceeded",
@@ -189,6 +191,26 @@ class NotFound(StarletteHTTPException):
     def __init__(self, loc: list[str | int], message: str) -> None:
         self.loc = loc
         super().__init__(404, message)
+
+
+class Conflict(StarletteHTTPException):
+    """The resource is not in a state that allows the request (HTTP 409): the results
+    of a batch that has not finished."""
+
+    def __init__(self, loc: list[str | int], message: str) -> None:
+        self.loc = loc
+        super().__init__(409, message)
+
+
+class Unauthorized(StarletteHTTPException):
+    """No or an unknown API key (HTTP 401, ``WWW-Authenticate: Bearer``)."""
+
+    def __init__(self, message: str) -> None:
+        self.loc = ["header", "authorization"]
+        super().__init__(401, message, headers={"WWW-Authenticate": "Bearer"})
+
+
+_HTTP_TYPES = {401: "unauthorized", 404: "not_found", 409: "conflict"}
 
 
 def _json_safe(value: Any) -> bool:
@@ -421,7 +443,7 @@ async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONRe
         # an undecodable body is invalid input like malformed JSON: 422 json_invalid
         return error_response(422, ["body"], why, "json_invalid", parameter="body")
     loc = getattr(exc, "loc", [])
-    type_ = "not_found" if exc.status_code == 404 else "http_error"
+    type_ = _HTTP_TYPES.get(exc.status_code, "http_error")
     detail = exc.detail if isinstance(exc.detail, str) else json.dumps(exc.detail)
     return error_response(
         exc.status_code, loc, detail, type_, headers=dict(exc.headers) if exc.headers else None

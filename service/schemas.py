@@ -81,7 +81,8 @@ class ErrorItem(BaseModel):
     type: str = Field(
         description="Error kind: a pydantic error type, or input_error, "
         "limit_exceeded, body_too_large, run_time_exceeded, queue_full, worker_lost, "
-        "convergence_error, solver_error, numerical_error, not_found, http_error, "
+        "convergence_error, solver_error, numerical_error, not_found, unauthorized, "
+        "conflict, http_error, "
         "internal_error"
     )
     parameter: str | None = Field(

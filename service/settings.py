@@ -6,6 +6,7 @@ the setting (``STOCHCABLE_MAX_SAMPLES``) so an operator knows what to raise.
 
 from __future__ import annotations
 
+import ipaddress
 import os
 from typing import Literal
 
@@ -13,7 +14,7 @@ import psutil
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-__all__ = ["Settings", "ENV_PREFIX"]
+__all__ = ["Settings", "ENV_PREFIX", "is_loopback", "insecure_bind_message"]
 
 ENV_PREFIX = "STOCHCABLE_"
 
@@ -95,6 +96,68 @@ class Settings(BaseSettings):
         "[bytes]",
     )
 
+    jobs_database: str = Field(
+        default="stochcable-jobs.sqlite",
+        description="Where batch jobs and their results are kept: a SQLite file path "
+        "(created on first start, WAL mode; relative to the working directory) or any "
+        "SQLAlchemy URL such as postgresql+psycopg://user@host/db [-]",
+    )
+    dask_scheduler: str | None = Field(
+        default=None,
+        description="Run batch jobs on this Dask scheduler (tcp://HOST:PORT) instead of "
+        "the service's own batch worker processes [-]",
+    )
+    batch_workers: int = Field(
+        default_factory=lambda: os.cpu_count() or 1,
+        ge=1,
+        le=256,
+        description="Worker processes running the chunks of batch jobs (below the "
+        "analyses' CPU priority); default the number of cores [-]",
+    )
+    max_batch_cases: int = Field(
+        default=100_000, ge=1, description="Largest number of cases of one batch [-]"
+    )
+    max_queued_batches: int = Field(
+        default=64,
+        ge=1,
+        description="Batches queued or running at once (of all callers); beyond it a "
+        "submission answers 422 [-]",
+    )
+    max_result_bytes: int = Field(
+        default=512 * 2**20,
+        ge=2**10,
+        description="Largest estimated size of one batch's result table [bytes]",
+    )
+    batch_retention_hours: float = Field(
+        default=168.0,
+        gt=0,
+        description="Finished batches (done, failed, cancelled) and their results are "
+        "deleted this long after they finished [h]",
+    )
+    batch_lease_seconds: float = Field(
+        default=30.0,
+        ge=1.0,
+        description="A running batch whose service process has not reported for this "
+        "long (ended, killed) is taken over and resumed by another or a restarted one [s]",
+    )
+    api_keys: str | None = Field(
+        default=None,
+        description="Comma-separated API keys; when set, every /v1 request needs "
+        "'Authorization: Bearer KEY' and a batch is visible only to the key that "
+        "submitted it [-]",
+    )
+    insecure: bool = Field(
+        default=False,
+        description="Allow serving on a non-loopback address without API keys [-]",
+    )
+
+    @property
+    def keys(self) -> tuple[str, ...]:
+        """The configured API keys (empty: access control off)."""
+        if not self.api_keys:
+            return ()
+        return tuple(k.strip() for k in self.api_keys.split(",") if k.strip())
+
     @property
     def memory_budget(self) -> int:
         """``max_memory_bytes``, or its default from the machine's memory. [bytes]"""
@@ -107,3 +170,27 @@ class Settings(BaseSettings):
     def env_name(field: str) -> str:
         """Environment variable of a setting, e.g. ``STOCHCABLE_MAX_SAMPLES``."""
         return ENV_PREFIX + field.upper()
+
+
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` is a loopback interface (127.0.0.0/8, ::1, localhost)."""
+    if host.strip().lower() == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host.strip("[]")).is_loopback
+    except ValueError:
+        return False
+
+
+def insecure_bind_message(host: str, settings: Settings) -> str | None:
+    """Why the service must not start on ``host`` (None when it may): a non-loopback
+    address needs API keys (``STOCHCABLE_API_KEYS``) or an explicit ``--insecure``
+    (``STOCHCABLE_INSECURE=1``)."""
+    if is_loopback(host) or settings.keys or settings.insecure:
+        return None
+    return (
+        f"{host} is not a loopback address and no API keys are set: anyone who reaches it "
+        f"could run and read batches; set {Settings.env_name('api_keys')} (comma-separated "
+        f"keys, sent as 'Authorization: Bearer KEY') or pass --insecure "
+        f"({Settings.env_name('insecure')}=1) to serve without access control"
+    )

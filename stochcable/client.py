@@ -39,6 +39,7 @@ from typing import Any
 import httpx
 import numpy as np
 
+from stochcable.client_batches import BatchJob, BatchMethods
 from stochcable.errors import StochcableError
 from stochcable.results.views import AnalysisDocument, LineDocument, TimeSeriesWindow
 from stochcable.scene.model import G_STANDARD, OmegaGrid, Scene
@@ -46,6 +47,7 @@ from stochcable.sea.spectra import SpectrumStatistics
 
 __all__ = [
     "Client",
+    "BatchJob",
     "ServiceError",
     "ClientError",
     "SpectrumResult",
@@ -223,7 +225,7 @@ def _message(detail: Any, fallback: str) -> tuple[str, list[dict[str, Any]]]:
     return fallback, []
 
 
-class Client:
+class Client(BatchMethods):
     """Synchronous client of the stochcable service.
 
     Parameters
@@ -236,6 +238,8 @@ class Client:
         Extra headers sent with every request.
     transport : httpx.BaseTransport, optional
         Custom transport (tests, proxies).
+    api_key : str, optional
+        Sent as ``Authorization: Bearer`` (a service with ``STOCHCABLE_API_KEYS``).
     """
 
     def __init__(
@@ -245,12 +249,16 @@ class Client:
         *,
         headers: Mapping[str, str] | None = None,
         transport: httpx.BaseTransport | None = None,
+        api_key: str | None = None,
     ) -> None:
         self.base_url = base_url.rstrip("/")
+        sent = dict(headers or {})
+        if api_key is not None:
+            sent["Authorization"] = f"Bearer {api_key}"
         self._http = httpx.Client(
             base_url=self.base_url,
             timeout=timeout,
-            headers=dict(headers or {}),
+            headers=sent,
             transport=transport,
         )
 

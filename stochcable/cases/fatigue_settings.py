@@ -12,7 +12,7 @@ from stochcable.design import FatigueCurve, fatigue_curve, tension_to_curve_quan
 from stochcable.errors import InputError
 from stochcable.scene.units import unit_labels
 
-__all__ = ["LineFatigue", "curve_factor"]
+__all__ = ["LineFatigue", "curve_factor", "fatigue_from_document"]
 
 _METHODS = ("narrow_band", "wirsching_light", "dirlik", "benasciutti_tovo")
 
@@ -54,6 +54,17 @@ class LineFatigue:
         extra = sorted(set(doc) - known)
         if extra:
             raise InputError(f"{where}.{extra[0]}", doc[extra[0]], "-", "unknown setting")
+        units = {"nominal_diameter": "m", "nominal_area": "m²", "mbs": "force unit",
+                 "mean_load_ratio": "-", "design_factor": "-"}  # fmt: skip
+        for key, unit in units.items():
+            v = doc.get(key)
+            if key in doc and not (v is None and key != "design_factor"):
+                ok = isinstance(v, (int, float)) and not isinstance(v, bool)
+                if not (ok and math.isfinite(v) and v > 0):
+                    raise InputError(f"{where}.{key}", v, unit, "must be a finite number > 0")
+        for key in ("curve", "method"):
+            if key in doc and not isinstance(doc[key], str):
+                raise InputError(f"{where}.{key}", doc[key], "-", "must be a name (string)")
         out = cls(**dict(doc))
         out.check(where)
         return out
@@ -98,3 +109,45 @@ def curve_factor(settings: LineFatigue, g: float, where: str) -> tuple[FatigueCu
     except InputError as exc:
         raise InputError(f"{where}.{exc.parameter}", exc.value, exc.unit, exc.constraint) from None
     return curve, k
+
+
+def fatigue_from_document(
+    doc: Mapping[str, Any] | None, lines: tuple[str, ...], where: str = "fatigue"
+) -> dict[str, LineFatigue]:
+    """Fatigue settings from a JSON document: one mapping of :class:`LineFatigue`'s
+    attributes for every line, or a mapping of line name to such a mapping.
+
+    Parameters
+    ----------
+    doc : mapping or None
+        ``{"curve": "dnv-studless", "nominal_diameter": 0.076}`` or
+        ``{"<line>": {...}, ...}``; None: no fatigue check.
+    lines : tuple of str
+        The scene's line names.
+    where : str
+        Name of the document in error messages.
+
+    Returns
+    -------
+    dict of LineFatigue
+        Validated settings per line name.
+    """
+    if doc is None:
+        return {}
+    if not isinstance(doc, Mapping):
+        raise InputError(where, type(doc).__name__, "-", "must be a mapping")
+    fields = set(LineFatigue.__dataclass_fields__)
+    if set(doc) <= fields:
+        one = LineFatigue.from_mapping(doc, where)
+        return dict.fromkeys(lines, one)
+    out = {}
+    for name, sub in doc.items():
+        if name not in lines:
+            raise InputError(
+                f"{where}.{name}", name, "-", f"names no line of the scene ({list(lines)}) "
+                f"and is not a setting ({sorted(fields)})"
+            )  # fmt: skip
+        if not isinstance(sub, Mapping):
+            raise InputError(f"{where}.{name}", type(sub).__name__, "-", "must be a mapping")
+        out[name] = LineFatigue.from_mapping(sub, f"{where}.{name}")
+    return out

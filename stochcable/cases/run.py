@@ -12,22 +12,22 @@ set.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, engine_template, solve_chunk
-from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
+from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, solve_chunk
+from stochcable.cases.fatigue_settings import LineFatigue
+from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
 from stochcable.cases.scatter import ScatterDiagram
 from stochcable.design import SECONDS_PER_YEAR, return_level
 from stochcable.dynamics.engine import Engine, build_engine
-from stochcable.errors import InputError
-from stochcable.scene.model import Scene, load_scene
+from stochcable.scene.model import Scene
 
-__all__ = ["CaseRow", "LineTotals", "CaseSetResult", "run_cases", "ENDS"]
+__all__ = ["CaseRow", "LineTotals", "CaseSetResult", "run_cases", "assemble_cases", "ENDS"]
 
 
 Progress = Callable[[int, int], None]
@@ -106,24 +106,6 @@ class CaseSetResult:
         return np.array([s.probability for s in self.scatter.states])
 
 
-def _fatigue_settings(
-    scene: Scene, fatigue: LineFatigue | Mapping[str, LineFatigue] | None
-) -> dict[str, LineFatigue]:
-    names = [ln.name for ln in scene.lines]
-    if fatigue is None:
-        return {}
-    if isinstance(fatigue, LineFatigue):
-        return dict.fromkeys(names, fatigue)
-    unknown = sorted(set(fatigue) - set(names))
-    if unknown:
-        raise InputError("fatigue", unknown[0], "-", f"names no line of the scene ({names})")
-    return dict(fatigue)
-
-
-def _chunks(n: int, size: int) -> list[range]:
-    return [range(i, min(i + size, n)) for i in range(0, n, size)]
-
-
 def run_cases(
     scene: Scene | Mapping[str, Any] | str,
     scatter: ScatterDiagram,
@@ -157,43 +139,25 @@ def run_cases(
         builds its engine once and keeps it for the next chunks.
     chunk_size : int, optional
         Cases per chunk (default: all in one chunk in this process; with an executor,
-        enough chunks for four per worker, at most 64 cases each).
+        :func:`~stochcable.cases.plan.default_chunk_size` of its workers).
 
     Returns
     -------
     CaseSetResult
         The same numbers, bit for bit, whichever executor and chunking ran the set.
     """
-    scene = load_scene(scene)
-    if not (isinstance(years, (int, float)) and math.isfinite(years) and years > 0):
-        raise InputError("years", years, "years", "must be finite and > 0")
-    settings = _fatigue_settings(scene, fatigue)
-    for name, s in settings.items():
-        s.check(f"fatigue[{name}]")
-        curve_factor(s, scene.environment.g, f"fatigue[{name}]")  # refused before work
+    if chunk_size is None and executor is not None:
+        chunk_size = default_chunk_size(len(scatter.states), _worker_count(executor))
+    plan = plan_cases(scene, scatter, fatigue=fatigue, years=years, chunk_size=chunk_size)
     n = len(scatter.states)
-    template = engine_template(scene, scatter.states, scatter.family)
-    size = _chunk_size(n, executor, chunk_size)
-    parts = [tuple((i, scatter.states[i]) for i in r) for r in _chunks(n, size)]
     done = 0
     results: list[ChunkResult] = []
-    for res in _run_chunks(template, scatter.family, parts, settings, engine, executor):
+    for res in _run_chunks(plan, engine, executor):
         results.append(res)
         done += len(res.rows)
         if progress is not None:
             progress(done, n)
-    return _assemble(scene, scatter, results, settings, float(years))
-
-
-def _chunk_size(n: int, executor: Any, chunk_size: int | None) -> int:
-    if chunk_size is not None:
-        if not isinstance(chunk_size, int) or isinstance(chunk_size, bool) or chunk_size < 1:
-            raise InputError("chunk_size", chunk_size, "-", "must be an integer >= 1")
-        return chunk_size
-    if executor is None:
-        return max(n, 1)
-    workers = _worker_count(executor)
-    return max(1, min(64, math.ceil(n / (4 * workers))))
+    return assemble_cases(plan, results)
 
 
 def _worker_count(executor: Any) -> int:
@@ -203,29 +167,45 @@ def _worker_count(executor: Any) -> int:
     return max(1, int(getattr(executor, "_max_workers", 1) or 1))
 
 
-def _run_chunks(template, family, parts, settings, engine, executor):
+def _run_chunks(plan: CasePlan, engine: Engine | None, executor: Any):
     """Yield the chunks' results as they finish."""
+    family, settings = plan.scatter.family, plan.fatigue
     if executor is None:
         if engine is None:
-            engine = build_engine(template)
-        for part in parts:
-            yield solve_chunk(template, family, part, settings, engine)
+            engine = build_engine(plan.template)
+        for k in range(len(plan.chunks)):
+            yield plan.solve(k, engine)
         return
     if hasattr(executor, "scatter") and hasattr(executor, "gather"):  # dask client
         from distributed import as_completed as dask_completed
 
-        shared = executor.scatter(template, broadcast=True)
+        shared = executor.scatter(plan.template, broadcast=True)
         futures = [executor.submit(solve_chunk, shared, family, part, settings, pure=False)
-                   for part in parts]  # fmt: skip
+                   for part in plan.chunks]  # fmt: skip
         for fut in dask_completed(futures):
             yield fut.result()
         return
-    futures = [executor.submit(solve_chunk, template, family, part, settings) for part in parts]
+    futures = [
+        executor.submit(solve_chunk, plan.template, family, part, settings) for part in plan.chunks
+    ]
     for fut in as_completed(futures):
         yield fut.result()
 
 
-def _assemble(scene, scatter, results, settings, years) -> CaseSetResult:
+def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetResult:
+    """The set's results from the results of its chunks (in any order).
+
+    Parameters
+    ----------
+    plan : CasePlan
+    results : iterable of ChunkResult
+        Every chunk of ``plan`` once.
+
+    Returns
+    -------
+    CaseSetResult
+    """
+    scene, scatter, settings, years = plan.scene, plan.scatter, plan.fatigue, plan.years
     n = len(scatter.states)
     names = tuple(ln.name for ln in scene.lines)
     n_el = {ln.name: sum(seg.elements for seg in ln.segments) for ln in scene.lines}

@@ -110,6 +110,44 @@ class ScatterDiagram:
     def __len__(self) -> int:
         return len(self.states)
 
+    def to_document(self) -> dict[str, Any]:
+        """The diagram as a JSON document :func:`read_scatter` reads back (rows with
+        Hs, Tp, γ, heading and probability)."""
+        rows = [
+            {"hs": s.hs, "tp": s.tp, "gamma": s.gamma, "heading": s.heading,
+             "probability": s.probability}
+            for s in self.states
+        ]  # fmt: skip
+        return {"rows": rows, "spectrum": self.family, "source": self.source}
+
+    def with_headings(
+        self, headings: Sequence[float], parameter: str = "headings"
+    ) -> ScatterDiagram:
+        """Every state repeated for each heading with equal probability (the states'
+        own headings are replaced).
+
+        Parameters
+        ----------
+        headings : sequence of float
+            Wave headings, at least one. [deg]
+        parameter : str
+            Name of the argument in error messages.
+        """
+        try:
+            heads = [float(h) for h in headings]
+        except (TypeError, ValueError):
+            raise InputError(parameter, headings, "deg", "must be numbers") from None
+        if not heads:
+            raise InputError(parameter, headings, "deg", "must name at least one heading")
+        for i, h in enumerate(heads):
+            if not math.isfinite(h):
+                raise InputError(f"{parameter}[{i}]", h, "deg", "must be finite")
+        w = 1.0 / len(heads)
+        states = tuple(
+            SeaState(s.hs, s.tp, s.gamma, h, s.probability * w) for s in self.states for h in heads
+        )
+        return ScatterDiagram(states, self.family, self.source)
+
 
 def _number(row: Mapping[str, Any], key: str, i: int, unit: str, *, positive: bool) -> float:
     raw = row.get(key)
@@ -206,6 +244,9 @@ def scatter_from_rows(
         raise InputError("spectrum", family, "-", f"must be one of {', '.join(_FAMILIES)}")
     if len(rows) == 0:
         raise InputError("scatter", rows, "-", "must have at least one sea state")
+    for i, r in enumerate(rows):
+        if not isinstance(r, Mapping):
+            raise InputError(f"scatter[{i}]", type(r).__name__, "-", "must be a mapping (a row)")
     parsed = [_state(r, i, family) for i, r in enumerate(rows)]
     kinds = {k for _, k in parsed}
     if len(kinds) > 1:

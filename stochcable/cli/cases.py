@@ -20,7 +20,6 @@ import argparse
 import contextlib
 import json
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 from stochcable.cases import LineFatigue, ScatterDiagram, read_scatter, run_cases
@@ -75,14 +74,7 @@ def _with_headings(scatter: ScatterDiagram, text: str) -> ScatterDiagram:
         heads = [float(h) for h in text.split(",") if h.strip()]
     except ValueError:
         raise InputError("--headings", text, "deg", "must be comma-separated numbers") from None
-    if not heads:
-        raise InputError("--headings", text, "deg", "must name at least one heading")
-    states = tuple(
-        replace(s, heading=h, probability=s.probability / len(heads))
-        for s in scatter.states
-        for h in heads
-    )
-    return replace(scatter, states=states)
+    return scatter.with_headings(heads, "--headings")
 
 
 @contextlib.contextmanager

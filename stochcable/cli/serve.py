@@ -30,6 +30,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="worker processes (default STOCHCABLE_WORKERS or 1)",
     )
     p.add_argument(
+        "--insecure",
+        action="store_true",
+        help="serve on a non-loopback address without API keys (STOCHCABLE_API_KEYS)",
+    )
+    p.add_argument(
         "--log-level",
         default="info",
         choices=["critical", "error", "warning", "info", "debug"],
@@ -59,9 +64,11 @@ def banner(host: str, port: int) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Start uvicorn; returns when the server stops."""
+    import os
+
     import uvicorn
 
-    from service.settings import Settings
+    from service.settings import Settings, insecure_bind_message
     from stochcable.errors import InputError
 
     settings = Settings()
@@ -72,7 +79,13 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--port", port, "-", "must be in 0 … 65535")
     if workers < 1:
         raise InputError("--workers", workers, "-", "must be >= 1")
+    if args.insecure:
+        os.environ[Settings.env_name("insecure")] = "1"
+    why = insecure_bind_message(host, Settings())
+    if why is not None:
+        raise InputError("--host", host, "-", why)
     # each worker process imports service.app:app and reads the STOCHCABLE_* variables
+    os.environ[Settings.env_name("host")] = host
     sys.stderr.write(banner(host, port))
     sys.stderr.flush()
     uvicorn.run("service.app:app", host=host, port=port, workers=workers, log_level=args.log_level)

@@ -1,0 +1,245 @@
+"""/v1/batches in one process (FastAPI's TestClient with the app's lifespan: a real SQLite
+file, real batch worker processes): submission and validation, status and progress,
+results equal to :func:`stochcable.cases.run_cases` bit for bit in JSON, CSV and NetCDF,
+cancellation, limits, API keys, and the Python client."""
+
+from __future__ import annotations
+
+import copy
+import time
+
+import numpy as np
+import pytest
+import xarray as xr
+from fastapi.testclient import TestClient
+
+from service.app import create_app
+from service.settings import Settings
+from stochcable.cases import LineFatigue, case_document, case_summary_csv, read_scatter, run_cases
+from stochcable.client import Client, ClientError
+from stochcable.examples import load_example
+
+CHAIN = load_example("chain_catenary").model_dump(mode="json", exclude_unset=True)
+ROWS = [
+    {"hs": hs, "tp": tp, "probability": p}
+    for hs, tp, p in ((1.0, 7.0, 0.3), (2.0, 9.0, 0.4), (4.0, 11.0, 0.2), (6.0, 13.0, 0.1))
+]
+FATIGUE = {"curve": "dnv-studless", "nominal_diameter": 0.076}
+REQUEST = {"scene": CHAIN, "scatter": ROWS, "headings": [0, 30], "fatigue": FATIGUE}
+
+
+def _settings(tmp_path, **kw) -> Settings:
+    base = {"jobs_database": str(tmp_path / "jobs.sqlite"), "batch_workers": 2,
+            "analysis_workers": 1}  # fmt: skip
+    return Settings(**{**base, **kw})
+
+
+def _wait(client, job_id: str, timeout: float = 120.0, headers=None) -> dict:
+    deadline = time.monotonic() + timeout
+    while True:
+        doc = client.get(f"/v1/batches/{job_id}", headers=headers).json()
+        if doc["status"] not in ("queued", "running"):
+            return doc
+        assert time.monotonic() < deadline, f"batch still {doc['status']} after {timeout} s"
+        time.sleep(0.1)
+
+
+@pytest.fixture(scope="module")
+def service(tmp_path_factory):
+    app = create_app(_settings(tmp_path_factory.mktemp("batches")))
+    with TestClient(app) as client:
+        yield client
+
+
+@pytest.fixture(scope="module")
+def reference():
+    """The same set run by the library in this process, in the service's chunking."""
+    scatter = read_scatter(ROWS).with_headings([0, 30])
+    return run_cases(
+        CHAIN, scatter, fatigue=LineFatigue("dnv-studless", nominal_diameter=0.076), chunk_size=1
+    )
+
+
+@pytest.fixture(scope="module")
+def finished(service):
+    resp = service.post("/v1/batches", json={**REQUEST, "chunk_size": 1})
+    assert resp.status_code == 202, resp.text
+    assert resp.headers["location"] == f"/v1/batches/{resp.json()['id']}"
+    return _wait(service, resp.json()["id"])
+
+
+def test_a_batch_runs_to_done_with_progress(finished):
+    assert finished["status"] == "done", finished
+    p = finished["progress"]
+    assert (p["total"], p["done"], p["failed"], p["fraction"]) == (8, 8, 0, 1.0)
+    assert finished["finished"] >= finished["started"] >= finished["created"]
+
+
+def test_results_equal_the_library_bit_for_bit(service, finished, reference, tmp_path):
+    url = f"/v1/batches/{finished['id']}/results"
+    doc = service.get(url).json()
+    # the JSON floats round-trip exactly: the same numbers as run_cases in this process
+    assert {k: v for k, v in doc.items() if k != "id"} == case_document(reference)
+    csv = service.get(url, headers={"Accept": "text/csv"})
+    assert csv.headers["content-type"].startswith("text/csv")
+    assert csv.text == case_summary_csv(reference)
+    nc = service.get(url, headers={"Accept": "application/x-netcdf"})
+    assert nc.headers["content-type"] == "application/x-netcdf"
+    path = tmp_path / "results.nc"
+    path.write_bytes(nc.content)
+    ds = xr.load_dataset(path)
+    np.testing.assert_array_equal(ds["hs"].values, [s.hs for s in reference.scatter.states])
+    np.testing.assert_array_equal(
+        ds["tension_std"].sel(line="leg1", end="end_a").values,
+        reference.stats["leg1"]["end_a"][:, 1],
+    )
+
+
+def test_results_before_done_answer_409(tmp_path):
+    app = create_app(_settings(tmp_path, batch_workers=1))
+    with TestClient(app) as client:
+        rows = [{"hs": 1.0 + 0.01 * i, "tp": 9.0, "hours": 1.0} for i in range(400)]
+        job = client.post("/v1/batches", json={"scene": CHAIN, "scatter": rows,
+                                              "chunk_size": 2}).json()  # fmt: skip
+        resp = client.get(f"/v1/batches/{job['id']}/results")
+        assert resp.status_code == 409
+        assert resp.json()["detail"][0]["type"] == "conflict"
+        assert "results are available when it is done" in resp.json()["detail"][0]["msg"]
+        # cancel stops the work: after it, at most the chunks in flight (two per
+        # worker) finish, and the batch never completes
+        deadline = time.monotonic() + 60
+        while client.get(f"/v1/batches/{job['id']}").json()["progress"]["done"] < 4:
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        cancelled = client.delete(f"/v1/batches/{job['id']}")
+        assert cancelled.status_code == 200 and cancelled.json()["status"] == "cancelled"
+        at_cancel = cancelled.json()["progress"]["done"]
+        time.sleep(1.5)
+        later = client.get(f"/v1/batches/{job['id']}").json()
+        assert later["status"] == "cancelled"
+        assert later["progress"]["done"] <= at_cancel + 2 * 2  # two 2-case chunks in flight
+        # a finished batch is deleted with its results
+        assert client.delete(f"/v1/batches/{job['id']}").status_code == 204
+        assert client.get(f"/v1/batches/{job['id']}").status_code == 404
+
+
+@pytest.mark.parametrize(
+    ("change", "loc", "text"),
+    [
+        ({"scatter": [{"hs": -1.0, "tp": 9.0, "probability": 1.0}]},
+         ["body", "scatter", "rows", 0, "hs"], "greater than 0"),
+        ({"scatter": [{"hs": 1.0, "tp": 9.0, "probability": 0.5}]},
+         ["body", "scatter", "probability"], "must sum to 1"),
+        ({"scatter": {"rows": [{"hs": 1.0, "probability": 1.0}]}},
+         ["body", "scatter", 0, "tp"], "give exactly one of tp and tz"),
+        ({"fatigue": {"curve": "no-such-curve"}},
+         ["body", "fatigue", "leg1", "curve"], "no-such-curve"),
+        ({"fatigue": {"leg9": FATIGUE}}, ["body", "fatigue", "leg9"], "names no line"),
+        ({"headings": []}, ["body", "headings"], "at least 1"),
+        ({"years": 0}, ["body", "years"], "greater than 0"),
+    ],
+)  # fmt: skip
+def test_bad_requests_name_the_field(service, change, loc, text):
+    resp = service.post("/v1/batches", json={**REQUEST, **change})
+    assert resp.status_code == 422, resp.text
+    err = resp.json()["detail"][0]
+    assert err["loc"] == loc and text in err["msg"], err
+
+
+def test_scene_limits_apply_to_the_batch_scene(service):
+    scene = copy.deepcopy(CHAIN)
+    scene["lines"][0]["segments"][0]["elements"] = 30000
+    resp = service.post("/v1/batches", json={**REQUEST, "scene": scene})
+    err = resp.json()["detail"][0]
+    assert resp.status_code == 422 and err["setting"] == "STOCHCABLE_MAX_ELEMENTS"
+    assert err["parameter"] == "scene.lines"
+
+
+@pytest.mark.parametrize(
+    ("setting", "value", "env"),
+    [
+        ("max_batch_cases", 7, "STOCHCABLE_MAX_BATCH_CASES"),
+        ("max_result_bytes", 1024, "STOCHCABLE_MAX_RESULT_BYTES"),
+    ],
+)
+def test_batch_limits_answer_422_naming_the_setting(tmp_path, setting, value, env):
+    with TestClient(create_app(_settings(tmp_path, **{setting: value}))) as client:
+        resp = client.post("/v1/batches", json=REQUEST)  # 8 cases
+        assert resp.status_code == 422
+        err = resp.json()["detail"][0]
+        assert err["type"] == "limit_exceeded" and err["setting"] == env, err
+
+
+def test_queued_batches_limit(tmp_path):
+    with TestClient(create_app(_settings(tmp_path, max_queued_batches=1, batch_workers=1))) as c:
+        rows = [{"hs": 1.0 + 0.01 * i, "tp": 9.0, "hours": 1.0} for i in range(200)]
+        first = c.post("/v1/batches", json={"scene": CHAIN, "scatter": rows, "chunk_size": 4})
+        second = c.post("/v1/batches", json=REQUEST)
+        assert second.status_code == 422
+        assert second.json()["detail"][0]["setting"] == "STOCHCABLE_MAX_QUEUED_BATCHES"
+        c.delete(f"/v1/batches/{first.json()['id']}")
+        assert c.post("/v1/batches", json=REQUEST).status_code == 202
+
+
+def test_failing_cases_are_rows_not_a_lost_batch(service):
+    # one drag-linearization iteration cannot meet a 1e-9 tolerance: every case fails
+    # numerically with its reason, and the batch is still done with its result table
+    scene = copy.deepcopy(CHAIN)
+    scene["analysis"]["linearization"] = {"max_iterations": 1, "tolerance": 1e-9}
+    job = service.post("/v1/batches", json={"scene": scene, "scatter": ROWS}).json()
+    doc = _wait(service, job["id"])
+    assert doc["status"] == "done" and doc["progress"]["done"] == doc["progress"]["failed"] == 4
+    assert [p["index"] for p in doc["problems"]] == [0, 1, 2, 3]
+    assert all("did not converge" in p["reason"] for p in doc["problems"])
+    res = service.get(f"/v1/batches/{job['id']}/results").json()
+    assert res["coverage"]["failed"] == pytest.approx(1.0, rel=1e-12)  # a sum of 4 floats
+    assert [c["status"] for c in res["cases"]] == ["failed"] * 4
+
+
+def test_api_keys(tmp_path):
+    with TestClient(create_app(_settings(tmp_path, api_keys="alpha,beta"))) as client:
+        assert client.get("/health").status_code == 200  # liveness never needs a key
+        none = client.post("/v1/batches", json=REQUEST)
+        assert none.status_code == 401 and none.headers["www-authenticate"] == "Bearer"
+        assert none.json()["detail"][0]["type"] == "unauthorized"
+        wrong = client.get("/v1/examples", headers={"Authorization": "Bearer gamma"})
+        assert wrong.status_code == 401 and "unknown API key" in wrong.json()["detail"][0]["msg"]
+        alpha = {"Authorization": "Bearer alpha"}
+        beta = {"Authorization": "Bearer beta"}
+        job = client.post("/v1/batches", json=REQUEST, headers=alpha).json()
+        assert client.get(f"/v1/batches/{job['id']}", headers=alpha).status_code == 200
+        # another key does not see it, cannot cancel it or read its results
+        assert client.get(f"/v1/batches/{job['id']}", headers=beta).status_code == 404
+        assert client.delete(f"/v1/batches/{job['id']}", headers=beta).status_code == 404
+        assert client.get("/v1/batches", headers=beta).json()["batches"] == []
+        listed = client.get("/v1/batches", headers=alpha).json()["batches"]
+        assert [b["id"] for b in listed] == [job["id"]]
+        _wait(client, job["id"], headers=alpha)
+
+
+def test_non_loopback_without_keys_refuses_to_start(tmp_path):
+    with pytest.raises(ValueError, match="STOCHCABLE_API_KEYS.*--insecure"):
+        create_app(_settings(tmp_path, host="0.0.0.0"))
+    create_app(_settings(tmp_path, host="0.0.0.0", insecure=True))
+    create_app(_settings(tmp_path, host="0.0.0.0", api_keys="k"))
+
+
+def test_python_client_submit_wait_results(service, reference):
+    client = Client("http://testserver")
+    client._http = service  # the TestClient is an httpx.Client on the app
+    scatter = read_scatter(ROWS)
+    job = client.submit_batch(
+        CHAIN, scatter, headings=[0, 30],
+        fatigue=LineFatigue("dnv-studless", nominal_diameter=0.076), chunk_size=3,
+    )  # fmt: skip
+    assert job.status in ("queued", "running", "done")
+    done = client.wait(job, timeout=120)
+    assert done.status == "done" and done.progress["done"] == 8
+    ds = client.results(done)  # chunked by 3 here, by 1 in the reference: the same bits
+    np.testing.assert_array_equal(
+        ds["tension_std"].sel(line="leg1", end="end_b").values,
+        reference.stats["leg1"]["end_b"][:, 1],
+    )
+    assert client.results(done, "json")["totals"] == case_document(reference)["totals"]
+    with pytest.raises(ClientError, match="scatter.probability"):
+        client.submit_batch(CHAIN, [{"hs": 1.0, "tp": 9.0, "probability": 0.5}])
