@@ -343,7 +343,7 @@ class BatchService:
             while queue and len(pending) < window:
                 k = queue.pop()
                 pending[self._submit(plan, k, shared)] = k
-            done, _ = cf.wait(list(pending), timeout=lease / 3, return_when=cf.FIRST_COMPLETED)
+            done = self._wait_first(list(pending), lease / 3)
             for fut in done:
                 k = pending.pop(fut)
                 try:
@@ -379,6 +379,18 @@ class BatchService:
                 self._abandon(pending)
                 return
         self.store.finish(job.id, self.holder, "done")
+
+    def _wait_first(self, futures: list[Any], timeout: float) -> set[Any]:
+        """The futures done after at most ``timeout`` seconds (at least one if any
+        finishes in time)."""
+        if not futures or isinstance(futures[0], cf.Future):
+            return cf.wait(futures, timeout=timeout, return_when=cf.FIRST_COMPLETED)[0]
+        import distributed
+
+        try:
+            return distributed.wait(futures, timeout=timeout, return_when="FIRST_COMPLETED").done
+        except TimeoutError:
+            return set()
 
     def _abandon(self, pending: dict[Any, int]) -> None:
         for fut in pending:

@@ -243,3 +243,16 @@ def test_python_client_submit_wait_results(service, reference):
     assert client.results(done, "json")["totals"] == case_document(reference)["totals"]
     with pytest.raises(ClientError, match="scatter.probability"):
         client.submit_batch(CHAIN, [{"hs": 1.0, "tp": 9.0, "probability": 0.5}])
+
+
+def test_batches_on_a_dask_scheduler(tmp_path, reference):
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                 dashboard_address=None) as cluster,
+        TestClient(create_app(_settings(tmp_path, dask_scheduler=cluster.scheduler_address))) as c,
+    ):  # fmt: skip
+        job = c.post("/v1/batches", json={**REQUEST, "chunk_size": 2}).json()
+        assert _wait(c, job["id"])["status"] == "done"
+        doc = c.get(f"/v1/batches/{job['id']}/results").json()
+    assert {k: v for k, v in doc.items() if k != "id"} == case_document(reference)
