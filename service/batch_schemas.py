@@ -38,7 +38,7 @@ def _f(description: str, unit: str, **kw: Any) -> Any:
 
 
 class _Doc(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False, strict=True)
 
 
 class ScatterRow(_Doc):

@@ -445,9 +445,17 @@ async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONRe
     loc = getattr(exc, "loc", [])
     type_ = _HTTP_TYPES.get(exc.status_code, "http_error")
     detail = exc.detail if isinstance(exc.detail, str) else json.dumps(exc.detail)
-    return error_response(
-        exc.status_code, loc, detail, type_, headers=dict(exc.headers) if exc.headers else None
-    )
+    headers = dict(exc.headers) if exc.headers else None
+    if exc.status_code == 405:  # every method of the path, not only the first route's
+        path = request.url.path
+        methods = {
+            m
+            for r in request.app.routes
+            if getattr(r, "methods", None) and r.path_regex.match(path)
+            for m in r.methods
+        }
+        headers = {**(headers or {}), "Allow": ", ".join(sorted(methods))}
+    return error_response(exc.status_code, loc, detail, type_, headers=headers)
 
 
 def install_error_handlers(app: FastAPI) -> None:

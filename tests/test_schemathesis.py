@@ -10,8 +10,8 @@ constraints between fields (``exactly one of (hs, tp), (m0, omega_p) or wind_spe
 the physics checks (an anchor above the water) and the configured size limits
 (``limit_exceeded``), which JSON Schema does not express.
 
-Bounded: 25 examples per operation (10 for ``POST /v1/analyses``, whose generated
-scenes are the costliest), small service limits so generated durations, grids and
+Bounded: 25 examples per operation (10 for ``POST /v1/analyses`` and 5 for ``POST
+/v1/batches``, whose generated scenes are the costliest to make), small service limits so generated durations, grids and
 meshes stay cheap (max_elements 200, max_frequencies 400, a 5 s run-time bound that
 also stops an abandoned analysis at its next iteration); runs in well under a minute.
 """
@@ -50,7 +50,10 @@ load_all_checks()
 CHECKS = REGISTRY.get_all()
 
 
-@schema.exclude(operation_id="run_analysis").parametrize()
+HEAVY = "^(run_analysis|submit_batch)$"  # bodies holding a generated scene (slow to make)
+
+
+@schema.exclude(operation_id_regex=HEAVY).parametrize()
 @settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 def test_api(case):
     case.call_and_validate(checks=CHECKS)
@@ -59,4 +62,10 @@ def test_api(case):
 @schema.include(operation_id="run_analysis").parametrize()
 @settings(max_examples=10, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 def test_analyses(case):
+    case.call_and_validate(checks=CHECKS)
+
+
+@schema.include(operation_id="submit_batch").parametrize()
+@settings(max_examples=5, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
+def test_batches(case):
     case.call_and_validate(checks=CHECKS)

@@ -385,8 +385,19 @@ def read_scatter(
         fam = family or doc.get("spectrum", "jonswap")
         src = str(doc.get("source", src))
         if "occurrence" in doc:
-            per = "tp" if "tp" in doc else "tz"
-            heads = {float(k): float(v) for k, v in (doc.get("headings") or {"0": 1}).items()}
+            pers = [k for k in ("tp", "tz") if doc.get(k) is not None]
+            if len(pers) != 1:
+                raise InputError("scatter.tp", doc.get("tp"), "s", "give exactly one of tp and tz")
+            per = pers[0]
+            heads = {}
+            for k, v in (doc.get("headings") or {"0": 1}).items():
+                try:
+                    heads[float(k)] = float(v)
+                except (TypeError, ValueError):
+                    raise InputError(
+                        f"scatter.headings[{k}]", v, "deg", "keys are headings, values "
+                        "probabilities: both numbers"
+                    ) from None  # fmt: skip
             return scatter_from_matrix(
                 doc["hs"], doc[per], doc["occurrence"], period=per, headings=heads,
                 family=fam, source=src,

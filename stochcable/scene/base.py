@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import typing
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 G_STANDARD = 9.80665  # standard gravity [m/s²]
 RHO_SEAWATER = 1025.0  # sea water density [kg/m³]
@@ -16,8 +17,47 @@ def _f(description: str, unit: str, **kw: Any) -> Any:
     return Field(description=f"{description} [{unit}]", json_schema_extra=extra, **kw)
 
 
+def _admits_bool(annotation: Any) -> bool:
+    if annotation is bool or annotation is Any:
+        return True
+    return any(_admits_bool(a) for a in typing.get_args(annotation))
+
+
+def _bool_at(value: Any) -> tuple[int, ...] | None:
+    """Where a bool sits in a value or its (nested) lists; None if nowhere."""
+    if isinstance(value, bool):
+        return ()
+    if isinstance(value, (list, tuple)):
+        for i, item in enumerate(value):
+            at = _bool_at(item)
+            if at is not None:
+                return (i, *at)
+    return None
+
+
 class _Doc(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _numbers_are_not_bools(cls, data: Any) -> Any:
+        # pydantic's lax mode reads true/false as 1/0 where a number is expected, and
+        # 0/1 or "yes" where a bool is; either is a mistake in a document
+        if isinstance(data, dict):
+            for name, field in cls.model_fields.items():
+                key = field.alias or name
+                if key not in data:
+                    continue
+                value = data[key]
+                if field.annotation is bool and not isinstance(value, bool):
+                    raise LocatedValueError((key,), value, f"{key} must be true or false")
+                if not _admits_bool(field.annotation):
+                    at = _bool_at(value)
+                    if at is not None:
+                        raise LocatedValueError(
+                            (key, *at), value, f"{key} must be a number, not true/false"
+                        )
+        return data
 
 
 class LocatedValueError(ValueError):
