@@ -11,9 +11,10 @@ the physics checks (an anchor above the water) and the configured size limits
 (``limit_exceeded``), which JSON Schema does not express.
 
 Bounded: 25 examples per operation (10 for ``POST /v1/analyses`` and 5 for ``POST
-/v1/batches``, whose generated scenes are the costliest to make), small service limits so generated durations, grids and
-meshes stay cheap (max_elements 200, max_frequencies 400, a 5 s run-time bound that
-also stops an abandoned analysis at its next iteration); runs in well under a minute.
+/v1/batches``, whose generated scenes are the costliest to make: ≈ 30 s each), small
+service limits so generated durations, grids and meshes stay cheap (max_elements 200,
+max_frequencies 400, a 5 s run-time bound that also stops an abandoned analysis at its
+next iteration); ≈ 1.5 min in all.
 """
 
 from __future__ import annotations
