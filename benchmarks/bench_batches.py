@@ -1,0 +1,178 @@
+"""Many cases, many processes: a 1,000-case load-case set of the chain example run
+serially, on a Dask LocalCluster, and as a batch job of a real ``stochcable serve``.
+
+    python3 benchmarks/bench_batches.py [--quick] [--write]
+
+Reports the throughput of ``run_cases`` serial against a LocalCluster of 2 worker
+processes (goal ≥ 1.8×), the executor's overhead per case (LocalCluster of 1 worker
+against serial, amortized; goal ≤ 1 ms), and, for a batch of the same set submitted to
+``POST /v1/batches``, its wall time and the latency of ``GET /health`` polled while it
+runs (p50, p99, max).  ``--write`` writes docs/benchmarks/batches.md; ``--quick`` runs
+100 cases and never writes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import httpx
+import numpy as np
+
+from stochcable import runtime
+from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
+from stochcable.examples import load_example
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "benchmarks" / "batches.md"
+FATIGUE = LineFatigue("dnv-studless", nominal_diameter=0.076)
+
+
+def _rows(n: int) -> list[dict]:
+    n_tp = 50 if n >= 500 else 10
+    n_hs = n // n_tp
+    return [
+        {"hs": hs, "tp": tp, "heading": 0.0, "hours": 1.0}
+        for hs in np.linspace(0.5, 10.0, n_hs)
+        for tp in np.linspace(5.0, 17.0, n_tp)
+    ]
+
+
+def _timed(fn) -> float:
+    t0 = time.perf_counter()
+    fn()
+    return time.perf_counter() - t0
+
+
+def library(scene, rows) -> dict[str, float]:
+    """Serial and LocalCluster wall times of run_cases [s]."""
+    import distributed
+
+    sd = scatter_from_rows(rows)
+    run_cases(scene, scatter_from_rows(rows[:4]), fatigue=FATIGUE)  # warm-up
+    out = {"serial": _timed(lambda: run_cases(scene, sd, fatigue=FATIGUE))}
+    for workers in (1, 2):
+        with (
+            distributed.LocalCluster(n_workers=workers, threads_per_worker=1,
+                                     dashboard_address=None) as cluster,
+            distributed.Client(cluster) as client,
+        ):  # fmt: skip
+            run_cases(scene, scatter_from_rows(rows[:4]), fatigue=FATIGUE, executor=client)
+            out[f"cluster{workers}"] = _timed(
+                lambda c=client: run_cases(scene, sd, fatigue=FATIGUE, executor=c)
+            )
+    return out
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def service(scene, rows) -> dict[str, float]:
+    """A batch of the set on a real server: wall time, /health latency while it runs."""
+    port = _free_port()
+    url = f"http://127.0.0.1:{port}"
+    with tempfile.TemporaryDirectory() as tmp:
+        env = {**os.environ, "PYTHONPATH": str(ROOT),
+               "STOCHCABLE_JOBS_DATABASE": str(Path(tmp) / "jobs.sqlite")}  # fmt: skip
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "stochcable", "serve", "--port", str(port),
+             "--log-level", "warning"],
+            env=env, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )  # fmt: skip
+        try:
+            with httpx.Client(base_url=url, timeout=30) as http:
+                for _ in range(600):
+                    try:
+                        if http.get("/health").status_code == 200:
+                            break
+                    except httpx.HTTPError:
+                        time.sleep(0.2)
+                body = {"scene": scene.model_dump(mode="json", exclude_unset=True),
+                        "scatter": rows, "fatigue": {"curve": "dnv-studless",
+                                                     "nominal_diameter": 0.076}}  # fmt: skip
+                t0 = time.perf_counter()
+                job = http.post("/v1/batches", json=body).json()
+                lat = []
+                status = job
+                polls = 0
+                while status["status"] in ("queued", "running"):
+                    t1 = time.perf_counter()
+                    http.get("/health")
+                    lat.append(time.perf_counter() - t1)
+                    polls += 1
+                    if polls % 20 == 0:
+                        status = http.get(f"/v1/batches/{job['id']}").json()
+                    time.sleep(0.005)
+                wall = time.perf_counter() - t0
+                t2 = time.perf_counter()
+                http.get(f"/v1/batches/{job['id']}/results")
+                fetch = time.perf_counter() - t2
+        finally:
+            proc.terminate()
+            proc.wait(30)
+    ms = 1e3 * np.asarray(lat)
+    return {"wall": wall, "status": status["status"], "fetch": fetch,
+            "p50": float(np.percentile(ms, 50)), "p99": float(np.percentile(ms, 99)),
+            "max": float(ms.max()), "polls": len(ms)}  # fmt: skip
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--write", action="store_true")
+    args = ap.parse_args()
+    runtime.configure()
+    warnings.simplefilter("ignore")
+    scene = load_example("chain_catenary")
+    rows = _rows(100 if args.quick else 1000)
+    n = len(rows)
+    lib = library(scene, rows)
+    svc = service(scene, rows)
+    speedup = lib["serial"] / lib["cluster2"]
+    overhead = (lib["cluster1"] - lib["serial"]) / n * 1e3
+    lines = [
+        f"cases {n} (chain example, Hs x Tp, JONSWAP, Dirlik fatigue)",
+        f"run_cases serial            {lib['serial']:7.2f} s  "
+        f"{1e3 * lib['serial'] / n:6.2f} ms/case",
+        f"LocalCluster 1 worker       {lib['cluster1']:7.2f} s  executor overhead "
+        f"{overhead:+.2f} ms/case   goal <= 1 ms: {'ok' if overhead <= 1 else 'MISSED'}",
+        f"LocalCluster 2 workers      {lib['cluster2']:7.2f} s  speed-up {speedup:.2f}x   "
+        f"goal >= 1.8x: {'ok' if speedup >= 1.8 else 'MISSED'}",
+        f"service batch (2 workers)   {svc['wall']:7.2f} s  {n / svc['wall']:6.1f} cases/s  "
+        f"status {svc['status']}; results fetched in {1e3 * svc['fetch']:.0f} ms",
+        f"GET /health during it       p50 {svc['p50']:6.2f} ms  p99 {svc['p99']:6.2f} ms  "
+        f"max {svc['max']:6.2f} ms  ({svc['polls']} polls)",
+    ]
+    text = "\n".join(lines)
+    print(text)
+    if args.write and not args.quick:
+        DOC.write_text(
+            "# Batch throughput\n\nFigures of `benchmarks/bench_batches.py`: a "
+            f"{n}-case load-case set of the chain example run by `run_cases` serially "
+            "and on Dask LocalClusters (worker processes, one thread each), and as a "
+            "batch job of a real `stochcable serve` (default settings: one batch worker "
+            "process per core) while `GET /health` is polled.  Timings are noisy when "
+            "the machine is shared.\n\n"
+            f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python "
+            f"{platform.python_version()}.\n\nRegenerate with:\n\n"
+            "    python benchmarks/bench_batches.py --write\n\n```\n" + text + "\n```\n",
+            encoding="utf-8",
+        )
+
+
+if __name__ == "__main__":
+    main()
