@@ -1,9 +1,16 @@
-"""The batch-job store on a real SQLite file: leases (a job is run by one holder; a lease
-that runs out lets another take it over), a chunk counted once, cancellation seen by the
-holder, the queue limit and retention."""
+"""The batch-job store on a real SQLite file and, where a PostgreSQL server can be
+started here (Debian's postgresql binaries and psycopg), on a throw-away PostgreSQL
+cluster: leases (a job is run by one holder; a lease that runs out lets another take it
+over), a chunk counted once, cancellation seen by the holder, the queue limit and
+retention."""
 
 from __future__ import annotations
 
+import os
+import shutil
+import socket
+import subprocess
+import tempfile
 import time
 
 import pytest
@@ -11,10 +18,53 @@ import pytest
 from service.store import JobStore
 
 
-@pytest.fixture
-def store(tmp_path):
-    s = JobStore(str(tmp_path / "sub" / "jobs.sqlite"))  # the folder is created too
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def postgres_url():
+    """A PostgreSQL cluster in a temporary folder on 127.0.0.1 (skipped with the reason
+    where none can be started)."""
+    initdb, pg_ctl = shutil.which("initdb"), shutil.which("pg_ctl")
+    if initdb is None or pg_ctl is None:
+        pytest.skip("no PostgreSQL server binaries (initdb, pg_ctl) on PATH")
+    pytest.importorskip("psycopg", reason="the psycopg driver is not installed")
+    folder = tempfile.mkdtemp(prefix="stochcable-pg-")
+    as_user: list[str] = []
+    if os.geteuid() == 0:  # the server refuses to run as root
+        if shutil.which("runuser") is None:
+            pytest.skip("running as root without runuser to start PostgreSQL as another user")
+        shutil.chown(folder, "postgres")
+        as_user = ["runuser", "-u", "postgres", "--"]
+    data, port = os.path.join(folder, "data"), _free_port()
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    try:
+        subprocess.run([*as_user, initdb, "-D", data, "-A", "trust", "-U", "stochcable"],
+                       check=True, timeout=120, **quiet)  # fmt: skip
+        opts = f"-p {port} -k {folder} -c listen_addresses=127.0.0.1"
+        subprocess.run([*as_user, pg_ctl, "-D", data, "-o", opts, "-w", "-t", "60", "start"],
+                       check=True, timeout=90, **quiet)  # fmt: skip
+    except (subprocess.CalledProcessError, subprocess.TimeoutExpired) as exc:
+        shutil.rmtree(folder, ignore_errors=True)
+        pytest.skip(f"PostgreSQL could not be started here ({exc})")
+    yield f"postgresql+psycopg://stochcable@127.0.0.1:{port}/postgres"
+    subprocess.run([*as_user, pg_ctl, "-D", data, "-m", "immediate", "stop"], timeout=60, **quiet)
+    shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def store(request, tmp_path):
+    if request.param == "sqlite":
+        s = JobStore(str(tmp_path / "sub" / "jobs.sqlite"))  # the folder is created too
+    else:
+        s = JobStore(request.getfixturevalue("postgres_url"))
     yield s
+    with s.engine.begin() as conn:  # a clean database for the next test
+        conn.exec_driver_sql("DELETE FROM stochcable_batch_chunks")
+        conn.exec_driver_sql("DELETE FROM stochcable_batches")
     s.close()
 
 
@@ -25,8 +75,9 @@ def _job(store, max_active=10):
 
 def test_wal_mode_and_round_trip(store):
     job = _job(store)
-    with store.engine.connect() as conn:
-        assert conn.exec_driver_sql("PRAGMA journal_mode").scalar() == "wal"
+    if store.url.startswith("sqlite"):
+        with store.engine.connect() as conn:
+            assert conn.exec_driver_sql("PRAGMA journal_mode").scalar() == "wal"
     assert store.get(job.id).request == {"x": 1}
     assert store.get(job.id, owner="someone else") is None
 
