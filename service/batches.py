@@ -40,7 +40,14 @@ from stochcable.cases.run import assemble_cases
 from stochcable.errors import InputError
 from stochcable.scene.model import load_scene
 
-from .batch_schemas import BatchProgress, BatchRequest, BatchStatus, CaseProblem
+from .batch_schemas import (
+    BatchProgress,
+    BatchRequest,
+    BatchStatus,
+    CaseProblem,
+    ScatterMatrix,
+    ScatterTable,
+)
 from .encoding import CSV, JSON, NETCDF, dumps
 from .errors import Conflict, LimitExceeded, NotFound
 from .limits import check_scene
@@ -97,6 +104,8 @@ def plan_request(doc: dict[str, Any], settings: Settings | None = None) -> CaseP
             exc.parameter = f"scene.{exc.parameter}"
             raise
     scatter_doc: Any = req.model_dump(mode="json", exclude_none=True)["scatter"]
+    if settings is not None:  # before the diagram is expanded into its sea states
+        _check_case_count(req, settings)
     scatter = read_scatter(scatter_doc, family=req.spectrum)
     if req.headings is not None:
         scatter = scatter.with_headings(req.headings)
@@ -117,6 +126,18 @@ def plan_request(doc: dict[str, Any], settings: Settings | None = None) -> CaseP
                 hint="split the scatter diagram into several batches",
             )  # fmt: skip
     return plan
+
+
+def _check_case_count(req: BatchRequest, settings: Settings) -> None:
+    sc = req.scatter
+    if isinstance(sc, ScatterMatrix):
+        cells = sum(1 for row in sc.occurrence for x in row if x != 0)
+        n = cells * max(1, sum(1 for p in (sc.headings or {"0": 1}).values() if p > 0))
+    else:
+        n = len(sc.rows if isinstance(sc, ScatterTable) else sc)
+    n *= len(req.headings) if req.headings else 1
+    if n > settings.max_batch_cases:
+        raise LimitExceeded("scatter", n, settings.max_batch_cases, "max_batch_cases", f"{n} cases")
 
 
 def _worker_init(niceness: int) -> None:

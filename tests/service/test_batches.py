@@ -256,3 +256,19 @@ def test_batches_on_a_dask_scheduler(tmp_path, reference):
         assert _wait(c, job["id"])["status"] == "done"
         doc = c.get(f"/v1/batches/{job['id']}/results").json()
     assert {k: v for k, v in doc.items() if k != "id"} == case_document(reference)
+
+
+def test_a_huge_matrix_is_refused_before_it_is_expanded(tmp_path):
+    # 400 × 400 non-zero cells at 300 headings = 48 million sea states: refused on the
+    # count, before any is made (the client's timeout is the bound)
+    matrix = {
+        "hs": [1.0 + 0.01 * i for i in range(400)],
+        "tz": [4.0 + 0.01 * j for j in range(400)],
+        "occurrence": [[1.0] * 400] * 400,
+        "headings": {str(h): 1.0 for h in range(300)},
+    }
+    with TestClient(create_app(_settings(tmp_path))) as client:
+        resp = client.post("/v1/batches", json={"scene": CHAIN, "scatter": matrix})
+    assert resp.status_code == 422
+    assert resp.json()["detail"][0]["setting"] == "STOCHCABLE_MAX_BATCH_CASES"
+    assert "48000000 cases" in resp.json()["detail"][0]["msg"]
