@@ -124,7 +124,7 @@ class Settings(BaseSettings):
         "submission answers 422 [-]",
     )
     max_result_bytes: int = Field(
-        default=512 * 2**20,
+        default=128 * 2**20,
         ge=2**10,
         description="Largest estimated size of one batch's result table [bytes]",
     )

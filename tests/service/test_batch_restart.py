@@ -46,6 +46,11 @@ def test_killed_and_stopped_service_resume_the_batch(tmp_path):
                           json={"scene": CHAIN, "scatter": ROWS, "chunk_size": CHUNK})  # fmt: skip
         assert resp.status_code == 202, resp.text
         job_id = resp.json()["id"]
+        # the synchronous API keeps answering while the batch runs (the batch workers
+        # run below the analyses' CPU priority)
+        _until(first, job_id, lambda d: d["status"] == "running")
+        analysis = httpx.post(f"{first.url}/v1/analyses?timeseries=none", json=CHAIN, timeout=60)
+        assert analysis.status_code == 200 and "leg1" in analysis.json()["lines"]
         at_kill = _until(first, job_id, lambda d: d["progress"]["done"] >= 8 * CHUNK)
     finally:
         first.kill()  # SIGKILL: no lease released, chunks in flight lost
