@@ -44,6 +44,15 @@ def _run_banner_pipeline(line: str) -> httpx.Response:
     return httpx.post(post[4], content=scene.content, headers={name: value}, timeout=60.0)
 
 
+def test_non_loopback_without_keys_is_refused(capsys, monkeypatch):
+    monkeypatch.delenv("STOCHCABLE_API_KEYS", raising=False)
+    monkeypatch.delenv("STOCHCABLE_INSECURE", raising=False)
+    assert main(["serve", "--host", "0.0.0.0", "--port", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("stochcable serve: error: --host = '0.0.0.0': 0.0.0.0 is not a loopback")
+    assert "STOCHCABLE_API_KEYS" in err and "--insecure" in err
+
+
 def test_bad_port_is_a_one_line_error(capsys):
     assert main(["serve", "--port", "70000"]) == 2
     err = capsys.readouterr().err
