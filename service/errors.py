@@ -45,6 +45,7 @@ from fastapi.exceptions import RequestValidationError
 from pydantic import BaseModel
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import JSONResponse
+from starlette.routing import Match
 
 from stochcable.errors import ConvergenceError, InputError, SolverError, StochcableError
 from stochcable.scene.model import error_location, field_path_and_unit
@@ -437,6 +438,16 @@ def _undecodable_body(exc: StarletteHTTPException) -> str | None:
     return f"the request body could not be decoded as JSON ({type(cause).__name__}: {cause})"
 
 
+def _allowed_methods(request: Request) -> list[str]:
+    """The methods some route of the application answers at the request's path."""
+    found = []
+    for method in ("GET", "POST", "PUT", "PATCH", "DELETE"):
+        scope = {**request.scope, "method": method}
+        if any(r.matches(scope)[0] == Match.FULL for r in request.app.router.routes):
+            found.append(method)
+    return found
+
+
 async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONResponse:
     why = _undecodable_body(exc)
     if why is not None:
@@ -447,14 +458,7 @@ async def _http_handler(request: Request, exc: StarletteHTTPException) -> JSONRe
     detail = exc.detail if isinstance(exc.detail, str) else json.dumps(exc.detail)
     headers = dict(exc.headers) if exc.headers else None
     if exc.status_code == 405:  # every method of the path, not only the first route's
-        path = request.url.path
-        methods = {
-            m
-            for r in request.app.routes
-            if getattr(r, "methods", None) and r.path_regex.match(path)
-            for m in r.methods
-        }
-        headers = {**(headers or {}), "Allow": ", ".join(sorted(methods))}
+        headers = {**(headers or {}), "Allow": ", ".join(_allowed_methods(request))}
     return error_response(exc.status_code, loc, detail, type_, headers=headers)
 
 
