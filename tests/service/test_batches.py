@@ -272,3 +272,25 @@ def test_a_huge_matrix_is_refused_before_it_is_expanded(tmp_path):
     assert resp.status_code == 422
     assert resp.json()["detail"][0]["setting"] == "STOCHCABLE_MAX_BATCH_CASES"
     assert "48000000 cases" in resp.json()["detail"][0]["msg"]
+
+
+def test_a_killed_batch_worker_costs_only_its_chunks(tmp_path):
+    import os
+    import signal
+
+    with TestClient(create_app(_settings(tmp_path))) as client:
+        batches = client.app.state.batches
+        rows = [{"hs": 1.0 + 0.01 * i, "tp": 9.0, "hours": 1.0} for i in range(60)]
+        job = client.post("/v1/batches", json={"scene": CHAIN, "scatter": rows,
+                                              "chunk_size": 2}).json()  # fmt: skip
+        deadline = time.monotonic() + 60
+        while client.get(f"/v1/batches/{job['id']}").json()["progress"]["done"] < 6:
+            assert time.monotonic() < deadline
+            time.sleep(0.02)
+        victim = next(iter(batches._executor._processes))  # a worker process's pid
+        os.kill(victim, signal.SIGKILL)
+        doc = _wait(client, job["id"])
+        assert doc["status"] == "done" and doc["progress"]["done"] == 60, doc
+        got = client.get(f"/v1/batches/{job['id']}/results").json()
+    expected = case_document(run_cases(CHAIN, read_scatter(rows), chunk_size=2))
+    assert {k: v for k, v in got.items() if k != "id"} == expected
