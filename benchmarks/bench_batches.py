@@ -68,6 +68,7 @@ def library(scene, rows) -> dict[str, float]:
                                      dashboard_address=None) as cluster,
             distributed.Client(cluster) as client,
         ):  # fmt: skip
+            client.run(runtime.configure)  # as the CLI and the service do
             run_cases(scene, scatter_from_rows(rows[:4]), fatigue=FATIGUE, executor=client)
             out[f"cluster{workers}"] = _timed(
                 lambda c=client: run_cases(scene, sd, fatigue=FATIGUE, executor=c)

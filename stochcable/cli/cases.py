@@ -22,6 +22,7 @@ import json
 import sys
 from pathlib import Path
 
+from stochcable import runtime
 from stochcable.cases import LineFatigue, ScatterDiagram, read_scatter, run_cases
 from stochcable.cases.results import case_dataset, case_document, case_summary_csv
 from stochcable.design import curve_names
@@ -97,6 +98,7 @@ def _executor(args: argparse.Namespace):
         ) from None
     if args.scheduler is not None:
         with distributed.Client(args.scheduler, timeout=30) as client:
+            client.run(runtime.configure)  # the CLI's process settings on every worker
             yield client
         return
     with (
@@ -104,6 +106,7 @@ def _executor(args: argparse.Namespace):
                                  dashboard_address=None) as cluster,
         distributed.Client(cluster) as client,
     ):  # fmt: skip
+        client.run(runtime.configure)  # the CLI's process settings on every worker
         yield client
 
 
