@@ -206,7 +206,10 @@ class BatchService:
         doc["scene"] = request.scene.model_dump(mode="json", exclude_unset=True)
         if doc.get("chunk_size") is None:
             plan = plan_request(doc, self.settings)
-            doc["chunk_size"] = default_chunk_size(len(plan.scatter.states), self._workers())
+            # from the settings alone: a submission never waits for a Dask scheduler
+            doc["chunk_size"] = default_chunk_size(
+                len(plan.scatter.states), self.settings.batch_workers
+            )
         plan = plan_request(doc, self.settings)
         n = len(plan.scatter.states)
         job = self.store.create(
@@ -355,7 +358,13 @@ class BatchService:
             self.store.finish(job.id, self.holder, "failed", f"cannot plan the batch: {exc}")
             return
         todo = [k for k in range(len(plan.chunks)) if k not in self.store.done_chunks(job.id)]
-        ex = self._get_executor()
+        try:
+            ex = self._get_executor()
+        except (OSError, TimeoutError) as exc:  # the Dask scheduler away: try again later
+            log.warning("batch executor unavailable (%s); job %s waits", exc, job.id)
+            self.store.renew(job.id, self.holder, -lease)  # released: claimed again later
+            self._stop.wait(min(10.0, lease))
+            return
         shared: Any = plan.template
         if not isinstance(ex, cf.ProcessPoolExecutor):
             shared = ex.scatter(plan.template, broadcast=True)
