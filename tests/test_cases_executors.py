@@ -73,7 +73,7 @@ def test_dask_local_cluster_gives_the_same_bits(scene, scatter, serial):
         ) as cluster,
         distributed.Client(cluster) as client,
     ):
-        on_dask = run_cases(scene, scatter, fatigue=FATIGUE, executor=client, chunk_size=3)
+        on_dask = run_cases(scene, scatter, fatigue=FATIGUE, client=client, chunk_size=3)
     _assert_same_bits(serial, on_dask)
 
 

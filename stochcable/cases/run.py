@@ -25,6 +25,7 @@ from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
 from stochcable.cases.scatter import ScatterDiagram
 from stochcable.design import SECONDS_PER_YEAR, return_level
 from stochcable.dynamics.engine import Engine, build_engine
+from stochcable.errors import InputError
 from stochcable.scene.model import Scene
 
 __all__ = ["CaseRow", "LineTotals", "CaseSetResult", "run_cases", "assemble_cases", "ENDS"]
@@ -116,6 +117,7 @@ def run_cases(
     engine: Engine | None = None,
     executor: Any = None,
     chunk_size: int | None = None,
+    client: Any = None,
 ) -> CaseSetResult:
     """Solve every sea state of a scatter diagram on one scene.
 
@@ -143,12 +145,18 @@ def run_cases(
     chunk_size : int, optional
         Cases per chunk (default: all in one chunk in this process; with an executor,
         :func:`~stochcable.cases.plan.default_chunk_size` of its workers).
+    client : dask.distributed.Client, optional
+        The same as ``executor=client`` (give one of the two).
 
     Returns
     -------
     CaseSetResult
         The same numbers, bit for bit, whichever executor and chunking ran the set.
     """
+    if client is not None:
+        if executor is not None:
+            raise InputError("client", client, "-", "give executor or client, not both")
+        executor = client
     if chunk_size is None and executor is not None:
         chunk_size = default_chunk_size(len(scatter.states), _worker_count(executor))
     plan = plan_cases(scene, scatter, fatigue=fatigue, years=years, chunk_size=chunk_size)
