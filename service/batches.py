@@ -25,6 +25,8 @@ from datetime import datetime, timezone
 from functools import cached_property
 from typing import Any
 
+from sqlalchemy.exc import SQLAlchemyError
+
 from stochcable import runtime
 from stochcable.cases import read_scatter
 from stochcable.cases.chunk import solve_chunk
@@ -50,7 +52,7 @@ from .batch_schemas import (
     ScatterTable,
 )
 from .encoding import CSV, JSON, NETCDF, dumps
-from .errors import Conflict, LimitExceeded, NotFound
+from .errors import Conflict, LimitExceeded, NotFound, StoreUnavailable
 from .limits import check_scene
 from .settings import Settings
 from .store import ACTIVE, JobRecord, JobStore
@@ -68,6 +70,12 @@ _CHUNK_ATTEMPTS = 3
 
 #: Bytes per stored number of the result table, with the JSON answer's text. [bytes]
 _BYTES_PER_VALUE = 24
+
+
+def _reason(exc: BaseException) -> str:
+    """The first line of an exception's message (SQLAlchemy's carry a long tail)."""
+    text = str(getattr(exc, "orig", None) or exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0] if text else ''}"
 
 
 def _iso(t: float | None) -> str | None:
@@ -178,8 +186,13 @@ class BatchService:
 
     @cached_property
     def store(self) -> JobStore:
-        """The job store (opened, and created if new, on first use)."""
-        return JobStore(self.settings.jobs_database)
+        """The job store (opened, and created if new, on first use).
+
+        Raises StoreUnavailable (503) when the database cannot be opened."""
+        try:
+            return JobStore(self.settings.jobs_database)
+        except (OSError, SQLAlchemyError) as exc:
+            raise StoreUnavailable(self.settings.jobs_database, _reason(exc)) from None
 
     def start(self) -> None:
         """Start the runner thread (jobs left running by a former process resume)."""
@@ -323,9 +336,10 @@ class BatchService:
             try:
                 self._expire()
                 job = self.store.claim(self.holder, lease)
-            except Exception:  # the database away for a moment: try again
-                log.exception("batch store unavailable")
-                job = None
+            except Exception as exc:  # the database away for a moment: try again later
+                log.warning("batch store unavailable: %s", _reason(exc))
+                self._stop.wait(10.0)
+                continue
             if job is None:
                 self._wake.wait(timeout=min(1.0, lease / 3))
                 self._wake.clear()

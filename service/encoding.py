@@ -249,8 +249,9 @@ _ERRORS: dict[int, dict[str, Any]] = {
     503: {
         "model": ErrorResponse,
         "description": "Every analysis worker busy and STOCHCABLE_MAX_QUEUE requests "
-        "waiting (type queue_full), or the worker process running the analysis ended by "
-        "the system, e.g. out of memory (type worker_lost); retry after Retry-After seconds",
+        "waiting (type queue_full), the worker process running the analysis ended by "
+        "the system, e.g. out of memory (type worker_lost), or the batch-job database "
+        "not available (type store_unavailable); retry after Retry-After seconds",
         "headers": {
             "Retry-After": {
                 "description": "Seconds to wait before retrying",

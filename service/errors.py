@@ -43,6 +43,7 @@ from typing import Any
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from pydantic import BaseModel
+from sqlalchemy.exc import OperationalError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import JSONResponse
 from starlette.routing import Match
@@ -66,6 +67,7 @@ __all__ = [
     "QueueFull",
     "WorkerLost",
     "JobFailed",
+    "StoreUnavailable",
     "error_answer",
     "memory_error",
 ]
@@ -161,6 +163,17 @@ class WorkerLost(Exception):
             f"the worker process running this analysis {how} before answering; the server "
             "has replaced it and other requests are unaffected; retry, and reduce the "
             "analysis (frequencies, elements, time series) if it happens again"
+        )
+
+
+class StoreUnavailable(Exception):
+    """The batch-job database cannot be opened or answered an error (HTTP 503)."""
+
+    def __init__(self, url: str, reason: str) -> None:
+        self.env = Settings.env_name("jobs_database")
+        super().__init__(
+            f"the batch-job store {url} ({self.env}) is not available: {reason}; batch "
+            "requests wait for it (retry later); analyses are unaffected"
         )
 
 
@@ -347,6 +360,10 @@ def error_answer(exc: BaseException) -> tuple[int, dict[str, Any], dict[str, str
         )
     if isinstance(exc, WorkerLost):
         return 503, _item([], str(exc), "worker_lost", exitcode=exc.exitcode), {"Retry-After": "1"}
+    if isinstance(exc, OperationalError):  # the job database went away mid-request
+        exc = StoreUnavailable("database", str(exc.orig or exc).splitlines()[0])
+    if isinstance(exc, StoreUnavailable):
+        return 503, _item([], str(exc), "store_unavailable", setting=exc.env), {"Retry-After": "5"}
     if isinstance(exc, JobFailed):
         return exc.status, exc.item, exc.headers
     return 500, _item([], f"internal error ({type(exc).__name__}: {exc})", "internal_error"), {}
@@ -478,6 +495,8 @@ def install_error_handlers(app: FastAPI) -> None:
         QueueFull,
         WorkerLost,
         JobFailed,
+        StoreUnavailable,
+        OperationalError,
     ):
         app.add_exception_handler(exc_type, _mapped_handler)
     app.add_exception_handler(BodyTooLarge, _body_too_large_handler)

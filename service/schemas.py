@@ -82,6 +82,7 @@ class ErrorItem(BaseModel):
         description="Error kind: a pydantic error type, or input_error, "
         "limit_exceeded, body_too_large, run_time_exceeded, queue_full, worker_lost, "
         "convergence_error, solver_error, numerical_error, not_found, unauthorized, "
+        "store_unavailable, "
         "conflict, http_error, "
         "internal_error"
     )

@@ -47,7 +47,7 @@ def _example() -> dict[str, Any]:
     response_model=BatchStatus,
     responses={
         202: {"headers": {"Location": {"description": "The batch", "schema": {"type": "string"}}}},
-        **error_responses(401, 413, 422),
+        **error_responses(401, 413, 422, 503),
     },
     summary="Submit a load-case set as a batch job",
 )
@@ -73,7 +73,7 @@ def submit_batch(
     "/batches",
     operation_id="list_batches",
     response_model=BatchList,
-    responses=error_responses(401),
+    responses=error_responses(401, 503),
     summary="The caller's batches, newest first",
 )
 def list_batches(batches: BatchesDep, caller: CallerDep) -> BatchList:
@@ -86,7 +86,7 @@ def list_batches(batches: BatchesDep, caller: CallerDep) -> BatchList:
     "/batches/{job_id}",
     operation_id="get_batch",
     response_model=BatchStatus,
-    responses=error_responses(401, 404),
+    responses=error_responses(401, 404, 503),
     summary="Status and progress of a batch",
 )
 def get_batch(job_id: JobId, batches: BatchesDep, caller: CallerDep) -> BatchStatus:
@@ -109,7 +109,7 @@ def get_batch(job_id: JobId, batches: BatchesDep, caller: CallerDep) -> BatchSta
                 NETCDF: {"schema": {"type": "string", "format": "binary"}},
             },
         },
-        **error_responses(401, 404, 406, 409),
+        **error_responses(401, 404, 406, 409, 503),
     },
     summary="Results of a finished batch",
 )
@@ -126,7 +126,10 @@ def get_batch_results(
     "/batches/{job_id}",
     operation_id="cancel_batch",
     status_code=200,
-    responses={204: {"description": "A finished batch was deleted"}, **error_responses(401, 404)},
+    responses={
+        204: {"description": "A finished batch was deleted"},
+        **error_responses(401, 404, 503),
+    },
     response_model=BatchStatus,
     summary="Cancel a batch (or delete a finished one)",
 )

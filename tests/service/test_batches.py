@@ -294,3 +294,18 @@ def test_a_killed_batch_worker_costs_only_its_chunks(tmp_path):
         got = client.get(f"/v1/batches/{job['id']}/results").json()
     expected = case_document(run_cases(CHAIN, read_scatter(rows), chunk_size=2))
     assert {k: v for k, v in got.items() if k != "id"} == expected
+
+
+def test_an_unusable_job_store_answers_503_and_analyses_go_on(tmp_path):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    settings = _settings(tmp_path, jobs_database=str(blocker / "jobs.sqlite"))
+    with TestClient(create_app(settings)) as client:
+        resp = client.post("/v1/batches", json=REQUEST)
+        assert resp.status_code == 503 and resp.headers["retry-after"] == "5"
+        err = resp.json()["detail"][0]
+        assert err["type"] == "store_unavailable"
+        assert err["setting"] == "STOCHCABLE_JOBS_DATABASE" and "a-file" in err["msg"]
+        assert client.get("/health").status_code == 200
+        ok = client.post("/v1/analyses?timeseries=none", json=CHAIN)
+        assert ok.status_code == 200
