@@ -84,3 +84,16 @@ def test_local_cluster_from_the_command_line(scatter, tmp_path):
     assert main([*common, "-o", str(a)]) == 0
     assert main([*common, "--workers", "2", "-o", str(b)]) == 0
     assert json.loads(a.read_text()) == json.loads(b.read_text())
+
+
+def test_case_warnings_are_summarized_once(tmp_path, capsys):
+    # the chain example in short seas warns of its surface element (ResolutionWarning)
+    chain = str(resources.files("stochcable.examples") / "chain_catenary.json")
+    path = tmp_path / "s.csv"
+    path.write_text("hs,tp,probability\n2,5,0.5\n3,6,0.5\n")
+    assert main(["cases", chain, "--scatter", str(path), "-o", str(tmp_path / "r.json")]) == 0
+    err = capsys.readouterr().err
+    assert "stochcable: warning:" not in err
+    assert err.count("cases have warnings") == 1 and "e.g. case 0:" in err
+    doc = json.loads((tmp_path / "r.json").read_text())
+    assert all(c["warnings"] for c in doc["cases"])

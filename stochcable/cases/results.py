@@ -169,6 +169,7 @@ def case_document(result: CaseSetResult) -> dict[str, Any]:
                 "status": r.status,
                 "reason": r.reason,
                 "flags": list(r.flags),
+                "warnings": list(r.warnings),
                 "lines": lines,
             }
         )

@@ -20,6 +20,7 @@ import argparse
 import contextlib
 import json
 import sys
+import warnings
 from pathlib import Path
 
 from stochcable import runtime
@@ -137,7 +138,10 @@ def run(args: argparse.Namespace) -> int:
             bar.update(done - bar.n)
 
     try:
-        with _executor(args) as executor:
+        # a case's warnings are in its row (and the output): summarized below, not
+        # streamed once per case and message
+        with _executor(args) as executor, warnings.catch_warnings():
+            warnings.simplefilter("ignore")
             result = run_cases(
                 scene, scatter, fatigue=fatigue, years=args.years, progress=progress,
                 executor=executor,
@@ -145,6 +149,13 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if bar is not None:
             bar.close()
+    warned = [r for r in result.rows if r.warnings]
+    if warned:
+        first = warned[0]
+        sys.stderr.write(
+            f"stochcable cases: {len(warned)} of {len(result.rows)} cases have warnings "
+            f"(listed per case in the output), e.g. case {first.index}: {first.warnings[0]}\n"
+        )
     failed = [r for r in result.rows if r.status != "ok"]
     if failed:
         sys.stderr.write(
