@@ -32,6 +32,7 @@ import numpy as np
 
 from stochcable import runtime
 from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
+from stochcable.cases.chunk import prepare_worker
 from stochcable.examples import load_example
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -68,7 +69,7 @@ def library(scene, rows) -> dict[str, float]:
                                      dashboard_address=None) as cluster,
             distributed.Client(cluster) as client,
         ):  # fmt: skip
-            client.run(runtime.configure)  # as the CLI and the service do
+            client.run(prepare_worker)  # as the CLI and the service do
             run_cases(scene, scatter_from_rows(rows[:4]), fatigue=FATIGUE, executor=client)
             out[f"cluster{workers}"] = _timed(
                 lambda c=client: run_cases(scene, sd, fatigue=FATIGUE, executor=c)

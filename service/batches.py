@@ -29,7 +29,7 @@ from sqlalchemy.exc import SQLAlchemyError
 
 from stochcable import runtime
 from stochcable.cases import read_scatter
-from stochcable.cases.chunk import solve_chunk
+from stochcable.cases.chunk import prepare_worker, solve_chunk
 from stochcable.cases.fatigue_settings import fatigue_from_document
 from stochcable.cases.plan import (
     CasePlan,
@@ -157,8 +157,6 @@ def _worker_init(niceness: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the service ends its workers itself
     os.nice(niceness)
     import threadpoolctl
-
-    from stochcable import runtime
 
     runtime.configure()
     threadpoolctl.threadpool_limits(1)
@@ -309,7 +307,7 @@ class BatchService:
                 import distributed
 
                 client = distributed.Client(self.settings.dask_scheduler, timeout=30)
-                client.run(runtime.configure)  # the service's process settings (≈ 30 % faster)
+                client.run(prepare_worker)  # the service's process settings (≈ 30 % faster)
                 self._executor = client
             else:
                 ctx = multiprocessing.get_context(self.settings.worker_start_method)

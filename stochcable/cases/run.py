@@ -140,8 +140,8 @@ def run_cases(
         Dask client the scene template is scattered to every worker once; a worker
         builds its engine once and keeps it for the next chunks.  Workers run
         ≈ 30 % faster with the process settings of the CLI and the service:
-        ``client.run(stochcable.runtime.configure)`` (not done here: the library
-        changes no process by itself).
+        ``client.run(stochcable.cases.chunk.prepare_worker)`` (not done here: the
+        library changes no process by itself).
     chunk_size : int, optional
         Cases per chunk (default: all in one chunk in this process; with an executor,
         :func:`~stochcable.cases.plan.default_chunk_size` of its workers).

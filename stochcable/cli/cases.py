@@ -23,8 +23,8 @@ import sys
 import warnings
 from pathlib import Path
 
-from stochcable import runtime
 from stochcable.cases import LineFatigue, ScatterDiagram, read_scatter, run_cases
+from stochcable.cases.chunk import prepare_worker
 from stochcable.cases.results import case_dataset, case_document, case_summary_csv
 from stochcable.design import curve_names
 from stochcable.errors import InputError
@@ -99,7 +99,7 @@ def _executor(args: argparse.Namespace):
         ) from None
     if args.scheduler is not None:
         with distributed.Client(args.scheduler, timeout=30) as client:
-            client.run(runtime.configure)  # the CLI's process settings on every worker
+            client.run(prepare_worker)  # the CLI's process settings on every worker
             yield client
         return
     with (
@@ -107,7 +107,7 @@ def _executor(args: argparse.Namespace):
                                  dashboard_address=None) as cluster,
         distributed.Client(cluster) as client,
     ):  # fmt: skip
-        client.run(runtime.configure)  # the CLI's process settings on every worker
+        client.run(prepare_worker)  # the CLI's process settings on every worker
         yield client
 
 
