@@ -1,4 +1,4 @@
-"""Speed versus error of every fidelity setting of analyze() (issue 7, item 1).
+"""Speed versus error of every fidelity setting of analyze().
 
 For reference scenes of :mod:`stochcable.examples` — ``taut_wire``, ``chain_catenary``
 (seabed, moving fairlead), ``inclined_guy`` and a buoy mooring (``tuah_1982_single_leg``:
@@ -24,11 +24,10 @@ fairlead-adjacent node (linearly interpolated for other meshes) — against
     element ladder ×1, ×2, ×4, ×8 with Richardson extrapolation when the last three
     steps converge monotonically (else the finest level); on a grounded line every
     ladder mesh has a node at the static touchdown
-    (:func:`stochcable.fidelity.planner.static_touchdowns`): the linear model's contact state
-    is the static one, and a touchdown inside an element makes the ladder oscillate at
-    first order (tuah_1982_single_leg: 24 uniform elements are 8 % off); its
-    convergence is shown (element steps, a half-count grid on the finest mesh and a
-    4·ω_max grid);
+    (:func:`stochcable.fidelity.planner.static_touchdowns`), a discretization
+    independent of the split touchdown element of the swept settings
+    (:func:`stochcable.line.seabed.bed_contact`); its convergence is shown (element
+    steps, a half-count grid on the finest mesh and a 4·ω_max grid);
 (b) the nonlinear time-domain reference (:func:`stochcable.reference.cable.
     simulate_line_timedomain`, Newmark average acceleration, same mesh family) over
     several seeds of 600 s, excitation band [ω_min, 2·ω_max]: mean σ_TD with its 95 %
@@ -36,7 +35,8 @@ fairlead-adjacent node (linearly interpolated for other meshes) — against
 
 Writes a Markdown report (``docs/ACCURACY.md`` with ``--write``) and PNG plots of error versus
 time (log–log, each setting a point, Pareto front drawn, default marked) under
-``docs/accuracy/``.
+``docs/accuracy/``; the report ends with the adaptive-fidelity section of
+``benchmarks/adaptive_fidelity.py`` (left out with ``--no-fidelity`` and ``--quick``).
 
 Run:  python benchmarks/speed_vs_error.py [--quick] [--write | --out FILE.md]
 (without --write or --out the report goes to stdout; --quick never writes the docs)
@@ -698,6 +698,7 @@ class Study:
     wall_s: float
     load_before: tuple[float, float, float]
     load_after: tuple[float, float, float]
+    fidelity: tuple[Any, ...] = ()  # adaptive_fidelity.FidelityRow per plan
 
 
 def run_study(
@@ -707,9 +708,12 @@ def run_study(
     td_scenes: Sequence[str] | None = None,
     td_seeds: int | None = None,
     td_duration: float | None = None,
+    fidelity: bool = False,
     progress: Progress = _silent,
 ) -> Study:
-    """Run :func:`study_scene` for every scene (the TD reference for ``td_scenes``)."""
+    """Run :func:`study_scene` for every scene (the TD reference for ``td_scenes``) and,
+    with ``fidelity``, the adaptive-fidelity plans of ``benchmarks/adaptive_fidelity.py``
+    (its section of the report)."""
     if td_scenes is None:
         td_scenes = ("taut_wire", "chain_catenary") if quick else TD_DEFAULT_SCENES
     td_seeds = td_seeds if td_seeds is not None else (2 if quick else 8)
@@ -727,7 +731,13 @@ def run_study(
         )
         for n in scenes
     ]
-    return Study(tuple(out), quick, time.perf_counter() - t0, load0, os.getloadavg())
+    rows: tuple[Any, ...] = ()
+    if fidelity:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from adaptive_fidelity import study_fidelity
+
+        rows = tuple(study_fidelity(scenes, progress))
+    return Study(tuple(out), quick, time.perf_counter() - t0, load0, os.getloadavg(), rows)
 
 
 # ----------------------------------------------------------------------- report
@@ -870,12 +880,13 @@ SCENE_NOTES = {
         "this is the likely cause of FD/TD < 1 on the tension (not on the motion)."
     ),
     "chain_catenary": (
-        "The prescribed fairlead surge is a Pierson–Moskowitz spectrum with an ω⁻⁵ tail; "
-        "the inertia tension it drives has a spectrum decaying only like ω⁻¹, so the "
-        "tension σ keeps growing with ω_max (the ResolutionWarning of analyze() says so). "
-        "A real vessel's motion is cut by its RAO; here the reference is defined for the "
-        "band [ω_min, 2·ω_max] and the TD is driven by the same band. Seabed contact is "
-        "nodal, so the touchdown point jumps between nodes as the mesh changes."
+        "The fairlead surge is a Pierson–Moskowitz spectrum (Hs 2 m, Tp 10 s) tapered to "
+        "0.35–1.5 rad/s, as a vessel's RAO would cut it (an untapered ω⁻⁵ tail drives "
+        "inertia tension whose spectrum decays like ω⁻¹ only). The element that contains "
+        "the static touchdown is split there and condensed "
+        "(stochcable.line.seabed.bed_contact), so the suspended span ends at the touchdown "
+        "whatever the mesh and the element ladder converges monotonically; the reference "
+        "ladder also puts a node at the touchdown (a second discretization)."
     ),
     "inclined_guy": (
         "end_b is at the still-water level (z = 0). Wave kinematics are evaluated at the "
@@ -898,8 +909,7 @@ SCENE_NOTES = {
         "rad/s, ωΔt = 2.4) in some seeds: the record jumps to a persistent tension σ ≈ "
         "1e4 lbf; such records are detected (window σ ratio above "
         "stochcable.reference.cable.NONSTATIONARY_RATIO) and rerun at Δt/4 (listed "
-        "below). Averaging three such seeds in gave FD/TD = 0.103 in an earlier version "
-        "of this report."
+        "below)."
     ),
 }
 
@@ -1075,6 +1085,11 @@ def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
     L.append("")
     for sc in study.scenes:
         L += _scene_section(sc, plot_dir_rel)
+    if study.fidelity:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from adaptive_fidelity import render_section
+
+        L += render_section(list(study.fidelity))
     return "\n".join(L) + "\n"
 
 
@@ -1237,6 +1252,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         default=None,
         help="time-domain reference scenes (default: all; quick: taut_wire chain_catenary)",
     )
+    ap.add_argument(
+        "--no-fidelity",
+        action="store_true",
+        help="leave out the adaptive-fidelity section (benchmarks/adaptive_fidelity.py; "
+        "run by default except with --quick)",
+    )
     ap.add_argument("--td-seeds", type=int, default=None)
     ap.add_argument("--td-duration", type=float, default=None)
     args = ap.parse_args(argv)
@@ -1251,6 +1272,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         td_scenes=args.td_scenes,
         td_seeds=args.td_seeds,
         td_duration=args.td_duration,
+        fidelity=not (args.quick or args.no_fidelity),
         progress=progress,
     )
     out = args.out

@@ -125,9 +125,10 @@ def test_truncated_foss_converges_to_direct():
         sysn = dataclasses.replace(with_all_modes(system, "foss"), n_modes=n)
         h = dsolve.solve(sysn, chans, lin.damping).end_tension["end_b"]
         errors.append(np.max(np.abs(h - ref)) / np.max(np.abs(ref)))
-    # more modes never worse; with the quasi-static split of the end motion and the
-    # static correction, 24 of 30 modes is within 1e-3
-    assert errors[0] >= errors[1] >= errors[2]
+    # with the quasi-static split of the end motion and the static correction, 24 of 30
+    # modes is within 1e-3; 4 and 12 modes err alike (measured 1.6 % and 1.8 %: the
+    # modes between 2.7 and 20 rad/s add drag coupling the static correction ignores)
+    assert errors[2] < 0.1 * min(errors[:2])
     assert errors[2] < 1e-3
     # the count dsystem.AUTO_MODE_FACTOR x omega_max (used by "auto" for large models)
     # keeps the end-tension σ within 5 %: truncation is slow for drag-dominated lines
@@ -414,14 +415,30 @@ def test_quasi_static_fairlead_tension_matches_catenary_stiffness():
     assert abs(h.imag) < 1e-3 * abs(h.real)
 
 
-def test_quasi_static_fairlead_tension_matches_fe_statics_with_seabed():
-    """Grounded chain about its FE equilibrium: the linear model is the tangent of the FE
-    statics, so H_T(ω→0) equals the finite difference of the FE statics."""
-    doc = chain_doc(grounded=True, sea=False, elements=30)
+def test_quasi_static_fairlead_tension_matches_fe_statics():
+    """Suspended chain about its FE equilibrium: the linear model is the tangent of the
+    FE statics, so H_T(ω→0) equals the finite difference of the FE statics."""
+    doc = chain_doc(grounded=False, sea=False, elements=30)
     h = _low_frequency_transfer(doc, "fe")
     ref = _fd_end_tension(doc, "fe")
-    # central difference O(δ²) and ω = 1e-3 rad/s inertia: 1e-4
+    # central difference O(δ²) and ω = 1e-3 rad/s inertia: 1e-4 (measured 1.1e-5)
     assert h.real == pytest.approx(ref, rel=1e-4)
+
+
+def test_quasi_static_fairlead_tension_with_seabed_matches_catenary_stiffness():
+    """Grounded chain on a stiff bed: H_T(ω→0) tends to dT_b/dx of the closed-form
+    elastic catenary on a rigid frictionless bed.  The linear model's suspended span
+    ends at the static touchdown whatever the mesh (the touchdown element is split
+    there, stochcable.line.seabed), not at the last grounded node as the FE statics'
+    own tangent does (whose finite difference jumps by 20 % between meshes here)."""
+    doc = chain_doc(grounded=True, sea=False, elements=120)
+    doc["environment"]["seabed"]["stiffness"] = 3.0e7
+    h = _low_frequency_transfer(doc, "fe")
+    ref = _fd_end_tension(doc, "catenary")
+    # the bed's compliance moves the support √(T/k') ≈ 0.4 m behind the touchdown
+    # (1e-3 of the stiffness here; 1.4 % at 3e6 Pa/m, 4.6 % at 3e5) plus the
+    # discretization (0.1 % between 120 and 240 elements): measured −0.13 %
+    assert h.real == pytest.approx(ref, rel=5e-3)
 
 
 def test_end_reaction_tends_to_end_element_tension():
@@ -825,11 +842,23 @@ def test_reactions_and_tension_transfer_equal_their_direct_formulas(chain_parts)
     resp = dsolve.line_response(system, inp, damping, (u, c))
     model = system.model
     uu = resp.displacement.reshape(w.size, model.n_nodes, model.dim, -1)
-    ref_t = (model.mesh.ea / model.l0)[None, :, None] * np.einsum(
-        "wedc,ed->cew", uu[:, 1:] - uu[:, :-1], model.tangents
+    rows = model.tension_rows  # (EA/l0)(−e, e); the split touchdown element its own
+    np.testing.assert_allclose(
+        np.delete(rows[:, 1], int(np.flatnonzero(model.grounded)[-1]), axis=0),
+        np.delete(
+            (model.mesh.ea / model.l0)[:, None] * model.tangents,
+            int(np.flatnonzero(model.grounded)[-1]),
+            axis=0,
+        ),
+        rtol=1e-14,
+    )
+    ref_t = np.einsum("wedc,ed->cew", uu[:, :-1], rows[:, 0]) + np.einsum(
+        "wedc,ed->cew", uu[:, 1:], rows[:, 1]
     )
     got_t = doutputs.element_tension_transfer(system, resp)
-    np.testing.assert_allclose(got_t, ref_t, rtol=0, atol=1e-14 * np.abs(ref_t).max())
+    # 1e-12: the split touchdown element's two rows are large (EA over its suspended
+    # part's length) and nearly opposite, so the sums cancel to ~1e-13 of the largest
+    np.testing.assert_allclose(got_t, ref_t, rtol=0, atol=1e-12 * np.abs(ref_t).max())
 
 
 def test_attachment_drag_sigma_is_the_total_relative_velocity_sigma():

@@ -259,13 +259,18 @@ def test_build_fe_model_with_solved_statics():
     )
     ls = statics.solve_statics(scene).lines["leg"]
     model = build_fe_model(ls, scene.environment, dim=3)
-    assert model.grounded.sum() == ls.grounded.sum() > 0
-    # seabed springs only on grounded nodes' z DOFs
+    # contact nodes: those before the static touchdown
+    np.testing.assert_array_equal(model.grounded, ls.mesh.s0 <= ls.touchdown)
+    assert model.grounded.sum() > 0
+    # seabed springs only on the grounded nodes' z DOFs, and the touchdown element's
+    # node b, which the condensed split element supports at the touchdown
     kz = (
         model.K.diagonal()[2::3]
         - assemble(ls.mesh, ls.positions, ls.tension, 1025.0).K.diagonal()[2::3]
     )
-    assert (kz[ls.grounded] > 0).all() and (kz[~ls.grounded] == 0).all()
+    b = int(np.flatnonzero(model.grounded)[-1]) + 1
+    assert (kz[model.grounded] > 0).all() and kz[b] > 0
+    assert (kz[~model.grounded][1:] == 0).all()
 
 
 def test_assemble_error_paths():

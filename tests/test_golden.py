@@ -94,14 +94,20 @@ def _numbers_close(a: Any, b: Any, rtol: float, path: str) -> None:
 def test_single_lines_agree_with_the_pre_unification_record(case: str) -> None:
     """The re-recorded single-line documents: statics and modes unchanged (1e-10),
     the analysis within PRE_UNIFICATION_K × tolerance of the documents recorded by the
-    single-line fixed point (its own coarse start, no defect correction)."""
+    single-line fixed point (its own coarse start, no defect correction); for lines
+    with a touchdown, whose seabed model changed since, the statics only."""
     import gzip
     import json
 
     with gzip.open(PRE_UNIFICATION / f"{case}.json.gz", "rt") as f:
         old = _without_clock(json.load(f))
     new = _without_clock(record.load(case))
-    for stage in ("statics", "modes"):
-        assert_close_documents(new[stage], old[stage])
+    assert_close_documents(new["statics"], old["statics"])
+    if any(ln.get("touchdown") is not None for ln in new["statics"]["statics"]["lines"].values()):
+        # the linear model of a line with a touchdown changed after this record: the
+        # touchdown element is split at the static touchdown (stochcable.line.seabed)
+        # instead of springing the grounded nodes only; its statics did not change
+        return
+    assert_close_documents(new["modes"], old["modes"])
     tol = max(ln["linearization"]["tolerance"] for ln in old["analyze"]["lines"].values())
     _numbers_close(new["analyze"], old["analyze"], PRE_UNIFICATION_K * tol, f"{case}.analyze")

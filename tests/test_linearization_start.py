@@ -32,9 +32,11 @@ from stochcable.statics import solve_statics
 EXAMPLE = Path(dsystem.__file__).resolve().parents[1] / "examples" / "chain_catenary.json"
 
 
-def _chain(**env) -> tuple:
+def _chain(omega_count: int | None = None, **env) -> tuple:
     doc = json.loads(EXAMPLE.read_text())
     doc["analysis"].pop("timeseries", None)
+    if omega_count is not None:
+        doc["analysis"]["omega"]["count"] = omega_count
     doc["environment"].update(env)
     scene = load_scene(doc)
     line = scene.lines[0]
@@ -140,9 +142,13 @@ def test_interpolatory_weights_integrate_cubics_as_the_full_grid():
 
 def test_narrow_resonance_is_not_missed_by_the_coarse_subset():
     # no current and no seabed dashpots: with 3 % of the converged drag the in-band
-    # modes (0.84, 1.23, 1.74 rad/s) have half-power bandwidths of ~0.013 rad/s, below
-    # two coarse spacings (0.078 rad/s)
-    scene, system, ch = _chain(current=[], seabed={"stiffness": 3e6, "damping": 0.0})
+    # modes (0.85, 1.25, 1.77 rad/s) have half-power bandwidths of ~0.013 rad/s, below
+    # two coarse spacings (0.065 rad/s on 240 frequencies; on the example's 200 the three
+    # windows and the stride points fill 70 or 71 points of the 70 the coarse subset
+    # may have, depending on where the modes fall between the grid points)
+    scene, system, ch = _chain(
+        omega_count=240, current=[], seabed={"stiffness": 3e6, "damping": 0.0}
+    )
     lin = dfixedpoint.linearize(system, ch, scene.analysis, coarse=False)
     weak = dvariance.drag_coefficients(system, 0.03 * lin.damping.sigma, "seed")
     inp = dloads.line_inputs(system, ch)

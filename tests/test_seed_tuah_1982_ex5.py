@@ -184,9 +184,12 @@ def test_seed_more_elements_give_larger_response_then_converge(doc, result):
     here the fairlead tension σ is 35 % larger: the 3-element model's lowest natural
     frequency is 5.0 rad/s, above the grid, while 4 or more elements give ~1 rad/s).
     Beyond 8 elements the σ settles: with the wave loads integrated exactly along each
-    element, 682 / 658 / 652 lbf at 8 / 16 / 32 elements — 8 -> 16 within 5 % (the
-    8-element mesh still under-resolves the surface decay at the buoy, see the
-    analysis' surface-resolution warning), 16 -> 32 within 2 %."""
+    element and the suspended span ending at the static touchdown whatever the mesh
+    (stochcable.line.seabed), 647 / 598 / 591 lbf at 8 / 16 / 32 elements (601 at 64;
+    meshes with a node at the touchdown give 664 / 615 / 604 / 603, the same 7 % step
+    from 8 to 16) — 8 -> 16 within 10 % (the 8-element mesh under-resolves the surface
+    decay at the buoy, see the analysis' surface-resolution warning, and the leg's
+    curvature), 16 -> 32 within 2 %."""
     sigma = {3: result.lines["leg"].end_b.std}
     low = {3: result.lines["leg"].modes_omega[0]}
     for n in (8, 16, 32):
@@ -194,7 +197,7 @@ def test_seed_more_elements_give_larger_response_then_converge(doc, result):
         sigma[n], low[n] = line.end_b.std, line.modes_omega[0]
     assert sigma[8] > sigma[3]
     assert low[3] > 4.0 and low[8] < 1.5
-    assert sigma[16] == pytest.approx(sigma[8], rel=0.05)
+    assert sigma[16] == pytest.approx(sigma[8], rel=0.1)
     assert sigma[32] == pytest.approx(sigma[16], rel=0.02)
 
 

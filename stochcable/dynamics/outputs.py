@@ -49,22 +49,25 @@ from stochcable.scene.model import AnalysisSettings
 def element_tension_transfer(system: LineSystem, response: Response) -> np.ndarray:
     """Dynamic effective tension per element, (n_ch, n_el, n_omega). [N/unit]
 
-    δT = (EA/l0)·e·(u_{j+1} − u_j) (module docstring), EA reduced for slack elements.
+    δT = (EA/l0)·e·(u_{j+1} − u_j) (module docstring), EA reduced for slack elements;
+    the rows of :attr:`stochcable.line.fem.FEModel.tension_rows` (the touchdown element
+    split at the static touchdown has its suspended part's).
     """
 
     model = system.model
-    mesh = model.mesh
     n_w = response.omega.size
     u = response.displacement.reshape(n_w, model.n_nodes, model.dim, -1)
-    # e·(u_b − u_a) one component at a time, frequencies last (long inner loops; the
+    # rows·(u_a, u_b) one component at a time, frequencies last (long inner loops; the
     # complex einsum was 0.4 ms on the chain, the frequency-major layout 0.25)
     u = np.ascontiguousarray(np.transpose(u, (3, 1, 2, 0)))  # (n_ch, n_nodes, dim, n_w)
-    t = model.tangents
-    out = t[None, :, 0, None] * (u[:, 1:, 0] - u[:, :-1, 0])  # (n_ch, n_el, n_w)
+    rows = model.tension_rows
+    if rows is None:
+        ea = np.where(model.slack, SLACK_EA_RATIO * model.mesh.ea, model.mesh.ea)
+        t = model.tangents * (ea / model.l0)[:, None]
+        rows = np.stack([-t, t], axis=1)
+    out = rows[None, :, 0, 0, None] * u[:, :-1, 0] + rows[None, :, 1, 0, None] * u[:, 1:, 0]
     for k in range(1, model.dim):
-        out += t[None, :, k, None] * (u[:, 1:, k] - u[:, :-1, k])
-    ea = np.where(model.slack, SLACK_EA_RATIO * mesh.ea, mesh.ea)
-    out *= (ea / model.l0)[None, :, None]
+        out += rows[None, :, 0, k, None] * u[:, :-1, k] + rows[None, :, 1, k, None] * u[:, 1:, k]
     return out
 
 

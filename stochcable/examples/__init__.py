@@ -87,6 +87,8 @@ DOCUMENTED_WARNINGS: dict[str, dict[str, str]] = {
         "kept so the example reproduces the seed's model",
         "snap loads likely": "the seed's slack 100 lb leg in a 28 ft² sea: σ exceeds a "
         "third of the mean tension; the example shows where the linear model stops",
+        "of the line's sag": "the heaving end moves as much as a tenth of the slack leg's "
+        "sag: the linearization about the static shape is at its limit",
     },
     "tuah_1982_disc_buoy_single_leg": {
         "wave-velocity σ varies": "the seed's 3 elements are kept (seed 001 §6.5)",

@@ -5,6 +5,7 @@ natural modes (seed 001 ch. 4; seed 000 for the modes).
 integrals in ``catenary_kernel``, the multi-segment chain in ``multisegment``) ·
 ``statics`` (one line's static equilibrium: ``equilibrium`` the FE residual, tangent
 and Newton solver, ``chain`` its start, ``banded`` the banded solves) · ``elements``
-and ``fem`` (the finite-element model about the static shape) · ``modes``.  The
+and ``fem`` (the finite-element model about the static shape; ``seabed`` its bed contact,
+the touchdown element split at the static touchdown) · ``modes``.  The
 scene-level statics, with bodies, is :mod:`stochcable.statics`.
 """

@@ -46,6 +46,7 @@ from stochcable.line.elements import (
     stiffness_blocks,
 )
 from stochcable.line.mesh import LineMesh
+from stochcable.line.seabed import bed_contact, split_touchdown_element, tension_rows
 from stochcable.scene.model import Environment, Seabed
 from stochcable.validation import float_array, positive
 
@@ -93,7 +94,7 @@ class FEModel:
     slack : ndarray of bool, shape (n_el,)
         Elements treated as slack (T <= 0: T -> 0, EA -> SLACK_EA_RATIO·EA).
     grounded : ndarray of bool, shape (n_nodes,)
-        Nodes in seabed contact.
+        Nodes in seabed contact (next to the touchdown: the nodes before it).
     K : scipy.sparse.csr_array, shape (n_dof, n_dof)
         Tangent stiffness: elastic + geometric + vertical seabed springs. [N/m]
     M : scipy.sparse.csr_array
@@ -112,13 +113,21 @@ class FEModel:
         Water density. [kg/m³]
     mass_matrix : str
         "consistent" or "lumped".
+    tension_rows : ndarray, shape (n_el, 2, dim) or None
+        The dynamic effective tension of each element, δT_j = rows[j, 0]·u_j +
+        rows[j, 1]·u_j+1: (EA/l0)(−e, e), EA reduced for slack elements, and for the
+        touchdown element split at the touchdown its suspended part's
+        (:attr:`stochcable.line.seabed.BedContact.tension_row`). [N/m]
 
     Notes
     -----
     Seabed contact (DESIGN.md "Scene"): a grounded node gets a vertical spring
     stiffness·D·(tributary length) and a vertical dashpot damping·D·(tributary length),
     the tributary length being half the unstretched length of each adjacent element and
-    D the diameter of that element.  Horizontal seabed friction is ignored (no
+    D the diameter of that element; the element that contains the static touchdown
+    point is split there by a condensed node carrying the bed of its grounded part
+    (:func:`stochcable.line.seabed.bed_contact`), so the suspended span ends at the
+    touchdown whatever the mesh.  Horizontal seabed friction is ignored (no
     horizontal stiffness or damping from the seabed).
     """
 
@@ -141,6 +150,7 @@ class FEModel:
     mesh: LineMesh
     rho: float
     mass_matrix: str = "consistent"
+    tension_rows: np.ndarray | None = None
 
     @property
     def n_dof(self) -> int:
@@ -351,6 +361,7 @@ def assemble(
     seabed: Seabed | None = None,
     fixed_nodes: Sequence[int] = (0, -1),
     mass_matrix: Literal["consistent", "lumped"] = "consistent",
+    touchdown: float | None = None,
 ) -> FEModel:
     """Assemble the linear finite-element model of a line about a static shape.
 
@@ -376,6 +387,11 @@ def assemble(
         end.  ``(0, -1)`` both ends, ``(0,)`` a free lower end, ``()`` free–free.
     mass_matrix : {"consistent", "lumped"}
         Distribution of the line's mass and added mass over the element's nodes.
+    touchdown : float, optional
+        Static touchdown point, unstretched arc length from end_a where the line
+        leaves the seabed toward end_b; the element that contains it is split there
+        (:func:`stochcable.line.seabed.bed_contact`).  None: contact at the grounded
+        nodes only. [m]
 
     Returns
     -------
@@ -387,7 +403,8 @@ def assemble(
     Element stiffness: :func:`element_stiffness` (seed 001 eqs. 3.1.8–3.1.11);
     structural mass: :func:`element_mass` (eq. 3.1.12); normal added mass:
     :func:`element_added_mass`; attachment masses and added masses (isotropic) are
-    lumped on their nodes.  Seabed: see :class:`FEModel`.
+    lumped on their nodes.  Seabed: see :class:`FEModel` and
+    :func:`stochcable.line.seabed.bed_contact`.
     """
     dim = check_dim(dim)
     if mass_matrix not in ("consistent", "lumped"):
@@ -458,24 +475,35 @@ def assemble(
     )
     ma_el = added_mass_elements(e, mesh.l0, mesh.ca_normal, mesh.diameter, rho, lumped)
 
-    # Seabed: vertical springs/dashpots on grounded nodes, tributary D·l0/2 per element.
-    trib = np.zeros(n_nodes)
-    dl = mesh.diameter * mesh.l0 / 2.0
-    trib[:-1] += dl
-    trib[1:] += dl
-    trib = np.where(gr, trib, 0.0)
-    zc = comps.index(2)
-    k_diag = np.zeros(n_dof)
-    c_diag = np.zeros(n_dof)
-    k_diag[zc::dim] = seabed.stiffness * trib
-    c_diag[zc::dim] = seabed.damping * trib
+    # Seabed: vertical springs/dashpots of the contact length, the touchdown element
+    # split at the static touchdown (stochcable.line.seabed)
+    bed = bed_contact(
+        mesh.s0,
+        mesh.l0,
+        mesh.diameter,
+        e,
+        l,
+        mesh.ea,
+        ten,
+        gr,
+        touchdown,
+        seabed.stiffness,
+        seabed.damping,
+        comps.index(2),
+    )
+    k_el, m_el, ma_el = split_touchdown_element(bed, k_el, m_el, ma_el, mesh, rho, lumped)
     m_diag = np.repeat(mesh.node_mass, dim)
     ma_diag = np.repeat(mesh.node_added_mass, dim)
 
-    K = chain_csr(k_el, n_nodes, dim, k_diag)
+    K = chain_csr(k_el, n_nodes, dim, bed.k_diag)
     M = chain_csr(m_el, n_nodes, dim, m_diag)
     Ma = chain_csr(ma_el, n_nodes, dim, ma_diag)
-    if c_diag.any():  # the nonzero diagonal entries only (as sp.diags_array gave)
+    c_diag = bed.c_diag
+    if bed.c_block is not None and bed.c_block.any():
+        c_el = np.zeros((n_el, 2 * dim, 2 * dim))
+        c_el[bed.element] = bed.c_block
+        Cs = chain_csr(c_el, n_nodes, dim, c_diag)
+    elif c_diag.any():  # the nonzero diagonal entries only (as sp.diags_array gave)
         nz = c_diag != 0.0
         Cs = sp.csr_array(
             (
@@ -501,7 +529,7 @@ def assemble(
         l0=mesh.l0.copy(),
         tension=ten.copy(),
         slack=ten <= 0.0,
-        grounded=gr.copy(),
+        grounded=bed.grounded,
         K=K,
         M=M,
         Ma=Ma,
@@ -511,6 +539,7 @@ def assemble(
         mesh=mesh,
         rho=rho,
         mass_matrix=mass_matrix,
+        tension_rows=tension_rows(e, mesh.l0, mesh.ea, ten, bed),
     )
 
 
@@ -549,6 +578,7 @@ def build_fe_model(
     grounded = getattr(line_statics, "grounded", None)
     if grounded is None:
         grounded = pos[:, 2] <= -environment.depth * (1.0 - 1e-9)
+    touchdown = getattr(line_statics, "touchdown", None)
     return assemble(
         line_statics.mesh,
         pos,
@@ -559,4 +589,5 @@ def build_fe_model(
         seabed=environment.seabed,
         fixed_nodes=(0, -1),
         mass_matrix=mass_matrix,
+        touchdown=touchdown,
     )
