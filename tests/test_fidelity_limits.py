@@ -14,6 +14,7 @@ ValidationError inside ``apply_fidelity`` and ``POST /v1/analyses`` answered 500
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import replace
 
 import pytest
@@ -71,7 +72,11 @@ def test_plan_at_0_3_percent_stays_within_the_limits_and_says_what_it_leaves(pla
     (limit,) = plan.limits
     assert "analysis.omega.count" in limit and str(omega_count_limit()) in limit
     grid = next(c for c in plan.choices if c.setting == "analysis.omega.count")
-    assert "NOT resolved" in grid.reason and "4188420 frequencies" in grid.reason
+    assert "NOT resolved" in grid.reason
+    # what resolving every mode would need (the count follows the modes' damping, e.g.
+    # the seabed's): above the limit, said in the reason
+    needed = re.search(r"needs (\d+) frequencies", grid.reason)
+    assert needed is not None and int(needed.group(1)) > omega_count_limit(), grid.reason
     # the plan is admissible: applying it builds a valid scene
     scene = apply_fidelity(_chain(), plan)
     assert scene.analysis.omega.count == plan.omega_count
