@@ -418,8 +418,11 @@ def test_body_newton_converges_quadratically():
 
 
 def _dense_end_stiffness(ls, env, ends, planar):
-    """K_bb − K_bf K_ff⁻¹ K_fb of build_fe_model's sparse K, dense (second method)."""
-    model = build_fe_model(ls, env, dim=2 if planar else 3)
+    """K_bb − K_bf K_ff⁻¹ K_fb of build_fe_model's sparse K, dense (second method).
+
+    The statics tangent has the bed at the grounded nodes: without the dynamic
+    model's split of the touchdown element (stochcable.line.seabed)."""
+    model = build_fe_model(dataclasses.replace(ls, touchdown=None), env, dim=2 if planar else 3)
     k = model.K.toarray()
     c = model.dim
     n = ls.mesh.n_nodes

@@ -403,10 +403,13 @@ def test_surface_warning_message_names_threshold_and_fix():
 
 
 def test_chain_changes_less_than_its_discretization_error():
-    """The chain example (top at z = −20 m, 40 elements): exact element loads change the
-    fairlead tension σ by +0.04 % (118434 -> 118478 N) while its element discretization
-    error is −1.6 % (320 elements: 120357 N).  DESIGN.md's untapered PM fairlead surge,
-    as when these numbers were measured (the bundled example band-limits it)."""
+    """The chain example (top at z = −20 m, 40 elements): exact element loads changed
+    the fairlead tension σ by +0.04 % when measured (118434 -> 118478 N, nodal bed
+    contact); with the touchdown element split at the static touchdown
+    (stochcable.line.seabed) the 40-element σ is 120196 N and its element
+    discretization error −0.13 % (320 elements: 120357 N), still larger than the
+    loads' change.  DESIGN.md's untapered PM fairlead surge (the bundled example
+    band-limits it)."""
     doc = load_example("chain_catenary").model_dump(mode="json")
     doc["lines"][0]["end_b"]["motion"] = {
         "surge": {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}
@@ -416,6 +419,7 @@ def test_chain_changes_less_than_its_discretization_error():
         warnings.simplefilter("ignore", ResolutionWarning)
         res = analysis.analyze(copy.deepcopy(doc))
     std = next(iter(res.lines.values())).end_b.std
-    # the numbers of the docstring, to 0.1 % (Foss auto, same grid)
-    assert abs(std / 118478.0 - 1) < 1e-3
-    assert abs(std / 118434.0 - 1) < 0.1 * abs(118434.0 / 120357.0 - 1)
+    # the number of the docstring, to 0.1 % (Foss auto, same grid)
+    assert abs(std / 120196.0 - 1) < 1e-3
+    # the loads' change (+0.04 %) is below the discretization error that remains
+    assert 0.0004 < abs(std / 120357.0 - 1) < 0.005
