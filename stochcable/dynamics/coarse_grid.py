@@ -108,10 +108,9 @@ def subset_inputs(
         square,
     )
     # The drag-independent, per-frequency arrays the full grid has already computed
-    # (:func:`base_motion`, :func:`drag_inputs`, :func:`end_motion_projections`, the projected
-    # moments of
-    # :func:`fluid_terms`) are the same numbers at the subset's frequencies: sliced,
-    # not recomputed (0.3 ms of the chain's coarse start).
+    # (:func:`base_motion`, the attachments' velocity of :func:`drag_inputs`,
+    # :func:`end_motion_projections`, the projected moments of :func:`fluid_terms`)
+    # are the same numbers at the subset's frequencies: sliced, not recomputed.
     n_w, n_ch = inp.weights.shape
 
     def take_view(a: np.ndarray | None) -> np.ndarray | None:
@@ -125,16 +124,16 @@ def subset_inputs(
 
     for key, val in inp.cache.items():
         if key in ("foss", "direct"):
-            u, f0, q = val
-            sub.cache[key] = (take(u, 2), take(f0, 2), take(q, 2))
-        elif key[0] == "drag_inputs":
-            sub.cache[key] = (take(val[0], 3), take(val[1], 2))
+            u, f0, moving = val
+            sub.cache[key] = (take(u, 2), take(f0, 2), moving)
+        elif key[0] == "attached_velocity":
+            sub.cache[key] = take(val, 2)
         elif key[0] == "fluid_m":
             sub.cache[key] = take_view(val)
         elif key[0] == "qproj":
-            q_p, wcol, y = val
+            u_p, wcol, y = val
             sub.cache[key] = (
-                take_view(q_p),
+                take(u_p, 2),
                 np.ascontiguousarray(wcol.reshape(n_w, n_ch)[idx]).ravel(),
                 take(y, 2),
             )

@@ -216,13 +216,14 @@ def base_motion(system: LineSystem, prep: LinePrep, inp: LineInputs) -> tuple[np
                 F0 = F_I − (K − ω²M_T + iωC_s) U_p;
         Foss:   U_p = the end motion with the exact static following inside,
                 F0 = F_I − (−ω²M_T + iωC_s) U_p   (K U_p = 0 on the free rows),
-    F_I the Morison inertia load; returns (U_p, F0, Q) (Q None without end motion)."""
+    F_I the Morison inertia load; returns (U_p, F0, moving): ``moving`` False without
+    end motion (Q is formed where it is used, block by block: :func:`drag_inputs`)."""
     key = system.solver
     if key not in inp.cache:
         w = inp.omega
         if inp.ub is None:
             u = end_nodes(inp, prep.n, prep.d)
-            f0, q = inp.inertia_load, None
+            f0, moving = inp.inertia_load, False
         else:
             # U_p = G u_b with G (n_nodes, d, 2d) the unit end displacements (and their
             # static following): M_T U_p, C_s U_p, K U_p are (M_T G) u_b, … — small
@@ -245,14 +246,13 @@ def base_motion(system: LineSystem, prep: LinePrep, inp: LineInputs) -> tuple[np
             f0 = inertia - (-(w * w)[:, None] * times(mg) + (1j * w)[:, None] * times(sg))
             if direct:
                 f0 = f0 - times(kg)
-            q = (-1j * w)[:, None] * u
+            moving = True
             if act is not None:  # back to all channels
-                full = (prep.n, prep.d) + inp.ub.shape[2:]
-                u_all, q_all = np.zeros(full, dtype=complex), np.zeros(full, dtype=complex)
+                u_all = np.zeros((prep.n, prep.d) + inp.ub.shape[2:], dtype=complex)
                 f0_all = inp.inertia_load.copy()
-                u_all[..., act], q_all[..., act], f0_all[..., act] = u, q, f0
-                u, q, f0 = u_all, q_all, f0_all
-        inp.cache[key] = (u, f0, q)
+                u_all[..., act], f0_all[..., act] = u, f0
+                u, f0 = u_all, f0_all
+        inp.cache[key] = (u, f0, moving)
     return inp.cache[key]
 
 
@@ -263,61 +263,81 @@ def _moving_channels(inp: LineInputs) -> np.ndarray | None:
 
 
 def drag_inputs(
-    system: LineSystem, prep: LinePrep, inp: LineInputs
+    system: LineSystem, prep: LinePrep, inp: LineInputs, freq: slice = slice(None)
 ) -> tuple[np.ndarray | None, np.ndarray | None]:
     """Drag-independent parts of the drag load on the free rows, F_d(V) + C_d Q of
-    :func:`base_motion`, cached per inputs and solver: the element moments
+    :func:`base_motion`, on the frequencies ``freq``: the element moments
     W_s = ∫N_s v dξ + Σ_t P_st Q_t (P the mass pattern of the drag,
     :func:`blocks_of_elements`), so that both terms are ONE element load
-    Σ_el l0·B·W (:func:`element_load`), and the attachment velocity V + Q at the
-    nodes (n_nodes, d, n_w, n_ch); None where absent."""
-    key = ("drag_inputs", system.solver)
-    if key not in inp.cache:
-        _, _, q = base_motion(system, prep, inp)
-        wm = None
-        if q is not None:
-            pat = (
-                np.array([[0.5, 0.0], [0.0, 0.5]])
-                if system.model.mass_matrix == "lumped"
-                else np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
+    Σ_el l0·B·W (:func:`element_load`), formed per block (not kept: one complex
+    number per element end, component, frequency and channel), and the attachment
+    velocity V + Q at the nodes (n_nodes, d, n_w, n_ch) (:func:`attached_velocity`);
+    None where absent."""
+    u, _, moving = base_motion(system, prep, inp)
+    moments = None if inp.moments is None else inp.moments[..., freq, :]
+    wm = moments
+    if moving:
+        pat = (
+            np.array([[0.5, 0.0], [0.0, 0.5]])
+            if system.model.mass_matrix == "lumped"
+            else np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
+        )
+        act = _moving_channels(inp)  # Q = 0 for the others: W = the moments
+        qa = u[:, :, freq] if act is None else u[:, :, freq][..., act]
+        qa = qa * (-1j * inp.omega[freq])[:, None]  # Q = −iω U_p
+        w_q = np.empty((prep.n - 1, 2) + qa.shape[1:], dtype=complex)
+        for side in range(2):
+            np.multiply(pat[side, 0], qa[:-1], out=w_q[:, side])
+            w_q[:, side] += pat[side, 1] * qa[1:]
+        if moments is not None:
+            w_q += moments if act is None else moments[..., act]
+        if act is None:
+            wm = w_q
+        else:
+            wm = (
+                moments.copy()
+                if moments is not None
+                else np.zeros((prep.n - 1, 2) + u[:, :, freq].shape[1:], dtype=complex)
             )
-            act = _moving_channels(inp)  # Q = 0 for the others: W = the moments
-            qa = q if act is None else q[..., act]
-            w_q = np.empty((prep.n - 1, 2) + qa.shape[1:], dtype=complex)
-            for side in range(2):
-                w_q[:, side] = pat[side, 0] * qa[:-1]
-                w_q[:, side] += pat[side, 1] * qa[1:]
-            if inp.moments is not None:
-                w_q += inp.moments if act is None else inp.moments[..., act]
-            if act is None:
-                wm = w_q
-            else:
-                wm = (
-                    inp.moments.copy()
-                    if inp.moments is not None
-                    else np.zeros((prep.n - 1, 2) + q.shape[1:], dtype=complex)
-                )
-                wm[..., act] = w_q
-        elif inp.moments is not None:
-            wm = inp.moments
+            wm[..., act] = w_q
+    vq = attached_velocity(system, prep, inp)
+    return wm, None if vq is None else vq[:, :, freq]
+
+
+def attached_velocity(system: LineSystem, prep: LinePrep, inp: LineInputs) -> np.ndarray | None:
+    """The fluid velocity plus Q = −iω U_p at the nodes (n_nodes, d, n_w, n_ch), what
+    the attachments' drag loads (None without fluid velocity and end motion), cached
+    per inputs and solver (formed only for a line with attachment drag areas when it
+    moves)."""
+    key = ("attached_velocity", system.solver)
+    if key not in inp.cache:
+        u, _, moving = base_motion(system, prep, inp)
         vq = inp.velocity
-        if q is not None and system.drag_nodes.size:  # V + Q: attachments only
+        if moving and system.drag_nodes.size:  # V + Q: attachments only
+            q = (-1j * inp.omega)[:, None] * u
             vq = q if vq is None else vq + q
-        inp.cache[key] = (wm, vq)
+        inp.cache[key] = vq
     return inp.cache[key]
 
 
-def free_load(system: LineSystem, prep: LinePrep, inp: LineInputs, damping: Damping) -> np.ndarray:
+def free_load(
+    system: LineSystem,
+    prep: LinePrep,
+    inp: LineInputs,
+    damping: Damping,
+    freq: slice = slice(None),
+) -> np.ndarray:
     """The load of :func:`solve_free`, F0 + F_d(V) + C_d Q (:func:`base_motion`), on all
-    nodes (n_nodes, d, n_w, n_ch), a fresh array."""
+    nodes (n_nodes, d, n_w, n_ch), a fresh array; ``freq`` selects a block of the
+    frequencies (:mod:`stochcable.dynamics.freqblocks`)."""
     _, f0, _ = base_motion(system, prep, inp)
-    wm, vq = drag_inputs(system, prep, inp)
+    wm, vq = drag_inputs(system, prep, inp, freq)
     if wm is None:
-        rhs = f0.copy()
+        rhs = f0[:, :, freq].copy()
     else:
         drag_blocks(system, damping)
         rhs = element_load(damping._cache["elements"], wm)
-        rhs += f0
+        rhs += f0[:, :, freq]
     if vq is not None and np.any(damping.b_node):
         rhs += damping.b_node[:, None, None, None] * vq
     return rhs

@@ -14,6 +14,7 @@ solve and the time series use them too).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -28,6 +29,7 @@ from stochcable.dynamics.blocks import (
     real_gemm,
     to_freq,
 )
+from stochcable.dynamics.freqblocks import frequency_slices
 from stochcable.dynamics.line_loads import (
     LineInputs,
     base_motion,
@@ -73,23 +75,46 @@ def solve_free(
 
     The total displacement is U = U_p + [0; u_f; 0] with U_p of :func:`base_motion`.
     ``modal_direct`` (Foss systems): solve the same modal equations per frequency
-    instead of by the Foss eigenproblem (:func:`_foss_free`)."""
+    instead of by the Foss eigenproblem (:func:`_foss_free`).  The load assembly and
+    the solve run over blocks of frequencies
+    (:func:`~stochcable.dynamics.freqblocks.frequency_slices`; the Foss
+    decomposition once for all blocks)."""
     prep = line_prep(system)
     d = prep.d
     w = inp.omega
+    n_w, n_ch = inp.weights.shape
     cd = drag_blocks(system, damping)
     c = add_blocks(prep.S, cd)
-    rhs = free_load(system, prep, inp, damping)
+    u_f = np.empty((prep.n - 2, d, n_w, n_ch), dtype=complex)
+    # a frequency's temporaries: the load on all nodes, its element moments and the
+    # solve's copies (≈ 8 node vectors per channel)
+    slices = frequency_slices(n_w, 8 * 16 * prep.n * d * max(n_ch, 1))
     if system.solver == "direct":
-        rhs_f = to_freq(rhs[1:-1])
         bC = prep.bS + free_band(cd)
-        u_f = solve_band_stacked(
-            prep.bK, prep.bM, bC, rhs_f, w, 2 * d - 1, 2 * d - 1, (system.model.K, system.model.M)
-        )
-        _check_line_conditioning(system, prep, bC, w, rhs_f, u_f)
-        return np.ascontiguousarray(from_freq(u_f, d)), c
-    u_f = _foss_free(system, prep, c, prep.free_rows(rhs), w, modal_direct=modal_direct)
-    return u_f.reshape(prep.n - 2, d, *u_f.shape[1:]), c
+        for sl in slices:
+            rhs_f = to_freq(free_load(system, prep, inp, damping, sl)[1:-1])
+            u = solve_band_stacked(
+                prep.bK,
+                prep.bM,
+                bC,
+                rhs_f,
+                w[sl],
+                2 * d - 1,
+                2 * d - 1,
+                (system.model.K, system.model.M),
+            )
+            _check_line_conditioning(system, prep, bC, w[sl], rhs_f, u)
+            u_f[:, :, sl] = from_freq(u, d)
+        return u_f, c
+    if modal_direct or len(slices) == 1:
+        rhs = prep.free_rows(free_load(system, prep, inp, damping))
+        u = _foss_free(system, prep, c, rhs, w, modal_direct=modal_direct)
+        return u.reshape(u_f.shape), c
+    solver = _foss_solver(system, prep, c)
+    for sl in slices:
+        rhs = prep.free_rows(free_load(system, prep, inp, damping, sl))
+        u_f[:, :, sl] = solver(rhs, w[sl]).reshape(u_f[:, :, sl].shape)
+    return u_f, c
 
 
 def total_displacement(system: LineSystem, inp: LineInputs, u_free: np.ndarray) -> np.ndarray:
@@ -137,7 +162,17 @@ def _foss_free(
 ) -> np.ndarray:
     """Foss modal solve on the free DOFs, rhs (n_free_dof, n_w, n_ch), with the static
     correction of the truncated modes (seed 001 §5.3;
-    :func:`stochcable.dynamics.modal_solvers.foss_decomposition`).
+    :func:`stochcable.dynamics.modal_solvers.foss_decomposition`): :func:`_foss_solver`
+    applied to ``rhs``."""
+    return _foss_solver(system, prep, c, modal_direct)(rhs, w)
+
+
+def _foss_solver(
+    system: LineSystem, prep: LinePrep, c: NodeBlocks, modal_direct: bool = False
+) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """The Foss modal solve with the damping ``c``: the decomposition once, then
+    ``solve(rhs, w)`` for loads rhs (n_free_dof, n_w, n_ch) on frequencies w (any block
+    of the grid).
 
     ``modal_direct``: the modal equations (K̂ − ω²M̂ + iωĈ)z = Φᵀf solved per frequency
     (batched dense LU) instead of by the Foss eigenproblem: the same response to
@@ -146,12 +181,9 @@ def _foss_free(
     frequency-independent); also the fallback of a defective Foss pencil."""
     phi, mh, kh = prep.modal(system)
     m = phi.shape[1]
-    nf, n_w, n_ch = rhs.shape
     ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
     ch = 0.5 * (ch + ch.T)
-    flat = np.ascontiguousarray(rhs).reshape(nf, n_w * n_ch)
-    fh = real_gemm(phi.T, flat)  # (m, n_w·n_ch), mode-major
-    z = None
+    foss = None
     if not modal_direct:
         try:
             foss = foss_modes(mh, ch, kh)
@@ -161,30 +193,38 @@ def _foss_free(
                 DefectivePencilWarning,
                 stacklevel=3,
             )
-        else:
+
+    def solve(rhs: np.ndarray, w: np.ndarray) -> np.ndarray:
+        nf, n_w, n_ch = rhs.shape
+        flat = np.ascontiguousarray(rhs).reshape(nf, n_w * n_ch)
+        fh = real_gemm(phi.T, flat)  # (m, n_w·n_ch), mode-major
+        if foss is not None:
             z = foss_transfer_modal(foss, fh, w, n_ch)
-    if z is None and modal_direct:
-        # batched LU without the conditioning estimate of solve_direct: a singular
-        # frequency raises LinAlgError or gives non-finite σ (the coarse start then
-        # falls back on the full grid, which has the checks)
-        fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
-        wz = w[:, None, None]
-        key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂: drag-independent, per grid
-        if key not in prep.cache:
-            prep.cache[key] = kh - wz * wz * mh
-        # the matrices are symmetric to the bit (K̂, M̂, Ĉ symmetrized): passed as
-        # their transposes, whose memory is the column-major layout LAPACK takes, so
-        # numpy's copy into it is contiguous (the same matrices and bits, ≈ 10 % faster)
-        z3 = np.linalg.solve((prep.cache[key] + 1j * wz * ch).transpose(0, 2, 1), fh3)
-        z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
-    elif z is None:
-        fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
-        z3 = solve_direct(kh, mh, ch, fh3, w, method="dense")
-        z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
-    u = real_gemm(phi, np.ascontiguousarray(z))
-    if m < nf:
-        u += prep.residual(system, flat)
-    return u.reshape(nf, n_w, n_ch)
+        elif modal_direct:
+            # batched LU without the conditioning estimate of solve_direct: a singular
+            # frequency raises LinAlgError or gives non-finite σ (the coarse start then
+            # falls back on the full grid, which has the checks)
+            fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
+            wz = w[:, None, None]
+            key = ("stiff_mass", m, w.tobytes())  # K̂ − ω²M̂: drag-independent, per grid
+            if key not in prep.cache:
+                prep.cache[key] = kh - wz * wz * mh
+            # the matrices are symmetric to the bit (K̂, M̂, Ĉ symmetrized): passed as
+            # their transposes, whose memory is the column-major layout LAPACK takes, so
+            # numpy's copy into it is contiguous (the same matrices and bits, ≈ 10 %
+            # faster)
+            z3 = np.linalg.solve((prep.cache[key] + 1j * wz * ch).transpose(0, 2, 1), fh3)
+            z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
+        else:
+            fh3 = np.moveaxis(fh.reshape(m, n_w, n_ch), 1, 0)
+            z3 = solve_direct(kh, mh, ch, fh3, w, method="dense")
+            z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
+        u = real_gemm(phi, np.ascontiguousarray(z))
+        if m < nf:
+            u += prep.residual(system, flat)
+        return u.reshape(nf, n_w, n_ch)
+
+    return solve
 
 
 def reactions(

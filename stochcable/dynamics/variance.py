@@ -21,6 +21,7 @@ from stochcable.dynamics.blocks import (
     line_prep,
     real_gemm,
 )
+from stochcable.dynamics.freqblocks import frequency_slices
 from stochcable.dynamics.line_loads import (
     LineInputs,
     base_motion,
@@ -249,9 +250,10 @@ def fluid_terms(
     system: LineSystem, inp: LineInputs, method: str
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Drag-independent terms of the element mean square, cached per inputs and method:
-    c0 = Σ weight ∫₀¹ |r·v|² dξ (n_el, k) and the weighted projected consistent moments
-    weight·(r·∫N_a v dξ, r·∫N_b v dξ) as a real (n_el, k, 2, 2·n_w·n_ch) view (None
-    without fluid velocity), r the rows of :func:`_proj_rows`."""
+    c0 = Σ weight ∫₀¹ |r·v|² dξ (n_el, k) and the projected consistent moments
+    (r·∫N_a v dξ, r·∫N_b v dξ) as a real (n_el, 2, k, 2·n_w·n_ch) view (None without
+    fluid velocity; weighted block by block in :func:`_structural_variance`), r the
+    rows of :func:`_proj_rows`."""
     key = ("fluid", method)
     if key not in inp.cache:
         pr = _proj_rows(system, method)
@@ -259,16 +261,12 @@ def fluid_terms(
             inp.cache[key] = (np.zeros(pr.shape[:2]), None)
         else:
             c0 = np.sum((pr @ inp.square) * pr, axis=2)  # r·S·r (5x the einsum's speed)
-            n_el = inp.moments.shape[0]
             mkey = ("fluid_m", method)
             if mkey not in inp.cache:  # (a subset's are sliced from its full grid's)
-                d = inp.moments.shape[2]
+                n_el, _, d = inp.moments.shape[:3]
                 mf = np.ascontiguousarray(inp.moments).reshape(n_el, 2, d, -1).view(float)
                 inp.cache[mkey] = pr[:, None] @ mf  # (n_el, side, k, 2N): one product
-            m = inp.cache[mkey]
-            mw = np.empty((n_el, pr.shape[1], 2, m.shape[-1]))
-            np.multiply(np.swapaxes(m, 1, 2), _w2(inp), out=mw)
-            inp.cache[key] = (c0, mw)
+            inp.cache[key] = (c0, inp.cache[mkey])
     return inp.cache[key]
 
 
@@ -276,18 +274,50 @@ _GRAM = np.array([[1.0, 0.5], [0.5, 1.0]]) / 3.0  # ∫N_i N_j dξ
 
 
 def _element_variance(
-    system: LineSystem, inp: LineInputs, method: str, q: np.ndarray | None
+    system: LineSystem,
+    inp: LineInputs,
+    method: str,
+    u_nodes: np.ndarray | None = None,
+    u_free: np.ndarray | None = None,
 ) -> np.ndarray:
     """Σ weight ∫₀¹ |r·(v(ξ) + N_a q_a + N_b q_b)|² dξ per element and row, (n_el, k).
 
-    q = −iωU is minus the structural velocity at the element's two nodes, projected
-    (real view (n_el, k, 2, 2N) of :func:`_project_ends`; None: the structure at rest).
-    With m_i = r·∫N_i v and ∫N_a² = ∫N_b² = 1/3, ∫N_a N_b = 1/6 the integral is
-    ∫|r·v|² + 2Re(m̄_a q_a + m̄_b q_b) + (|q_a|² + |q_b|² + Re(q̄_a q_b))/3: two batched
-    (2 × 2N)(2N × 2) products per element and row."""
-    c0, mw = fluid_terms(system, inp, method)
-    if q is None:
+    q = −iωU is minus the structural velocity at the element's two nodes, U the node
+    displacement ``u_nodes`` (n_nodes, d, n_w, n_ch) plus the free-node part ``u_free``
+    (n_nodes − 2, d, n_w, n_ch) on the interior nodes (None: nothing; both None: the
+    structure at rest).  With m_i = r·∫N_i v and ∫N_a² = ∫N_b² = 1/3, ∫N_a N_b = 1/6
+    the integral is ∫|r·v|² + 2Re(m̄_a q_a + m̄_b q_b) + (|q_a|² + |q_b|² +
+    Re(q̄_a q_b))/3, summed over blocks of frequencies
+    (:func:`~stochcable.dynamics.freqblocks.frequency_slices`): the projections of one
+    block only are formed, two stacked real products per block."""
+    c0, m = fluid_terms(system, inp, method)
+    if u_nodes is None and u_free is None:
         return c0
+    pr = _proj_rows(system, method)
+    w2 = _w2(inp)
+    n_el, k, d = pr.shape
+    n_w, n_ch = inp.weights.shape
+    var = c0.copy()
+    wq = (-1j * inp.omega)[:, None]
+    for sl in frequency_slices(n_w, n_ch * 16 * (3 * (n_el + 1) * d + 5 * n_el * k)):
+        cols = slice(2 * n_ch * sl.start, 2 * n_ch * sl.stop)  # the real (re, im) columns
+        if u_nodes is not None:
+            qx = _project_ends(pr, u_nodes[:, :, sl] * wq[sl])
+        else:
+            qx = np.zeros((n_el, k, 2, cols.stop - cols.start))
+        if u_free is not None:
+            n_f = u_free.shape[0]
+            qf = (u_free[:, :, sl] * wq[sl]).reshape(n_f, d, -1).view(float)
+            qx[1:, :, 0] += pr[1:] @ qf
+            qx[:-1, :, 1] += pr[:-1] @ qf
+        var += _structural_variance(qx, w2[cols], None if m is None else m[..., cols])
+    return var
+
+
+def _structural_variance(q: np.ndarray, w2: np.ndarray, m: np.ndarray | None) -> np.ndarray:
+    """The q-terms of :func:`_element_variance` on the real columns of q (n_el, k, 2,
+    2N), of the weights w2 (2N,) and of the projected moments m (n_el, 2, k, 2N) (a
+    block of columns gives its part of the sums), (n_el, k)."""
     # (|q_a|² + |q_b|² + Re(q̄_a q_b))/3 = ((q_a + q_b)·q_a + q_b·q_b)/3 on the real
     # views: one elementwise pass and one matrix-vector product with the weights
     # (the stacked (2 × 2N)(2N × 2) products of the Gram matrix were 2-3x slower)
@@ -295,12 +325,10 @@ def _element_variance(
     t = qa + qb
     t *= qa
     t += qb * qb
-    var = c0 + (t @ _w2(inp)) * _GRAM[0, 0]
-    if mw is not None:
-        n_el, k = q.shape[:2]
-        var += 2.0 * np.einsum(
-            "ekn,ekn->ek", mw.reshape(n_el, k, -1), q.reshape(n_el, k, -1)
-        )  # Σ w (m_a q_a + m_b q_b)
+    var = (t @ w2) * _GRAM[0, 0]
+    if m is not None:
+        mw = np.swapaxes(m, 1, 2) * w2
+        var += 2.0 * np.einsum("eksn,eksn->ek", mw, q)  # Σ w (m_a q_a + m_b q_b)
     return var
 
 
@@ -355,63 +383,50 @@ def sigmas_from_nodes(
     n_w, n_ch = inp.weights.shape
     idx = system.drag_nodes
     if u is None:
-        var = _element_variance(system, inp, method, None)
+        var = _element_variance(system, inp, method)
         vr = (
             np.zeros((idx.size, model.dim, n_w, n_ch), dtype=complex)
             if inp.velocity is None
             else inp.velocity[idx]
         )
     else:
-        q = (-1j * inp.omega)[:, None] * u
-        var = _element_variance(system, inp, method, _project_ends(_proj_rows(system, method), q))
-        vr = q[idx] if inp.velocity is None else q[idx] + inp.velocity[idx]
+        var = _element_variance(system, inp, method, u)
+        q = (-1j * inp.omega)[:, None] * u[idx]
+        vr = q if inp.velocity is None else q + inp.velocity[idx]
     return _sigma_vector(system, var, _node_sigmas(system, inp, vr), method)
 
 
 def end_motion_projections(system: LineSystem, inp: LineInputs, method: str) -> tuple:
-    """Drag-independent parts of :func:`sigmas_from_free`, cached per inputs, solver and
-    method: the projections of Q = −iω U_p at the element ends (the real view of
-    :func:`_project_ends`, None without end motion), the factors −iω per column
-    (n_w·n_ch,) and the attachments' V + Q (n_drag_nodes, d, n_w, n_ch)."""
-    key = ("qproj", system.solver, method)
+    """Drag-independent parts of :func:`sigmas_from_free`, cached per inputs and solver:
+    the node displacement U_p of :func:`base_motion` (None without end motion; its
+    projections are formed block by block), the factors −iω per column (n_w·n_ch,)
+    and the attachments' V + Q (n_drag_nodes, d, n_w, n_ch)."""
+    key = ("qproj", system.solver)
     if key not in inp.cache:
         prep = line_prep(system)
-        _, _, q = base_motion(system, prep, inp)
+        u, _, moving = base_motion(system, prep, inp)
         wcol = np.repeat(-1j * inp.omega, inp.weights.shape[1])
         idx = system.drag_nodes
         y = np.zeros((idx.size, prep.d) + inp.weights.shape, dtype=complex)
         if inp.velocity is not None:
             y += inp.velocity[idx]
-        if q is None:
+        if not moving:
             inp.cache[key] = (None, wcol, y)
         else:
-            y += q[idx]
-            inp.cache[key] = (_project_ends(_proj_rows(system, method), q), wcol, y)
+            y += (-1j * inp.omega)[:, None] * u[idx]
+            inp.cache[key] = (u, wcol, y)
     return inp.cache[key]
 
 
 def sigmas_from_free(
     system: LineSystem, inp: LineInputs, u_free: np.ndarray, method: str
 ) -> np.ndarray:
-    """σ vector from the free-node dynamic part of :func:`solve_free`.
-
-    The structure's velocity is that of U_p (:func:`base_motion`, cached projections) plus
-    iω u_f: two stacked real products per iteration."""
+    """σ vector from the free-node dynamic part of :func:`solve_free`: the structure's
+    velocity is that of U_p (:func:`base_motion`) plus iω u_f
+    (:func:`_element_variance`, over blocks of frequencies)."""
     prep = line_prep(system)
-    pr = _proj_rows(system, method)
-    q_p, wcol, y = end_motion_projections(system, inp, method)
-    n_f, d = u_free.shape[:2]
-    qf = np.ascontiguousarray(u_free).reshape(n_f, d, -1) * wcol
-    qff = qf.view(float)
-    n_el = pr.shape[0]
-    qx = np.empty((n_el, pr.shape[1], 2, qff.shape[-1]))
-    qx[0, :, 0] = 0.0
-    qx[-1, :, 1] = 0.0
-    np.matmul(pr[1:], qff, out=qx[1:, :, 0])
-    np.matmul(pr[:-1], qff, out=qx[:-1, :, 1])
-    if q_p is not None:
-        qx += q_p
-    var = _element_variance(system, inp, method, qx)
+    u_p, wcol, y = end_motion_projections(system, inp, method)
+    var = _element_variance(system, inp, method, u_p, u_free)
     idx = system.drag_nodes
     s_node = np.zeros(0)
     if idx.size:
@@ -426,14 +441,15 @@ def sigmas_from_free(
 def rest_sigmas(system: LineSystem, inp: LineInputs, method: str) -> np.ndarray:
     """The σ of the start (step 5): the fluid velocity relative to the line following
     its ends quasi-statically, :func:`sigmas_from_nodes` of :func:`quasi_static_motion`.  For
-    Foss that motion is U_p of :func:`base_motion`, whose projections
-    :func:`end_motion_projections` has cached
-    (the same numbers)."""
+    Foss that motion is U_p of :func:`base_motion` (the same numbers)."""
     if system.solver == "direct":
         return sigmas_from_nodes(system, inp, quasi_static_motion(system, inp), method)
-    q_p, _, y = end_motion_projections(system, inp, method)
+    u_p, _, y = end_motion_projections(system, inp, method)
     return _sigma_vector(
-        system, _element_variance(system, inp, method, q_p), _node_sigmas(system, inp, y), method
+        system,
+        _element_variance(system, inp, method, u_p),
+        _node_sigmas(system, inp, y),
+        method,
     )
 
 

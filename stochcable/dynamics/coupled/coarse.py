@@ -46,7 +46,7 @@ from stochcable.dynamics.coarse_grid import interpolatory_weights, subset_inputs
 from stochcable.dynamics.coupled.group import GroupSystem, sigma_update
 from stochcable.dynamics.coupled.inputs import BodyLoads, CoupledLine
 from stochcable.dynamics.iteration import fixed_point, relative_change
-from stochcable.dynamics.line_loads import drag_blocks, drag_inputs
+from stochcable.dynamics.line_loads import attached_velocity, drag_blocks
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.system import Progress
 from stochcable.dynamics.variance import drag_coefficients, end_motion_projections, fluid_terms
@@ -231,7 +231,7 @@ def uniform_subset(n: int) -> np.ndarray:
 
 def full_grid_arrays(g: GroupSystem, method: str) -> None:
     """The full grid's drag-independent arrays of the σ map of each line without
-    attached ends (end-motion projections, drag inputs, fluid terms: its full-grid
+    attached ends (end-motion projections, attachment velocities, fluid terms: its full-grid
     evaluations need them anyway), computed before a coarse group slices them
     (:func:`~stochcable.dynamics.coarse_grid.subset_inputs`) instead of computing
     its own."""
@@ -239,7 +239,7 @@ def full_grid_arrays(g: GroupSystem, method: str) -> None:
         if not cl.attached():
             inp = g.inp_phys[cl.name]
             end_motion_projections(cl.system, inp, method)
-            drag_inputs(cl.system, line_prep(cl.system), inp)
+            attached_velocity(cl.system, line_prep(cl.system), inp)
             fluid_terms(cl.system, inp, method)
 
 
@@ -483,6 +483,9 @@ class CoarseStart:
             prev, change0 = change0, state["change"]
             if change0 > 0.3 * prev:  # not contracting: the plain full-grid iteration
                 break
+        # the full grid finishes: the coarse group and its arrays are not needed again
+        self.raw = None
+        self.pairs.clear()
         return x0, change0, rounds
 
     def _round(
