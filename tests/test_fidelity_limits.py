@@ -271,3 +271,15 @@ def test_a_plan_beyond_the_memory_available_is_refused(monkeypatch):
         analyze(_chain(0.05))
     assert info.value.parameter == "analysis.fidelity.target_error"
     assert "estimated peak memory" in str(info.value)
+
+
+def test_base_grid_spacing_gives_its_own_point_count():
+    """span/(span/(n − 1)) is n − 1 + round-off for many spans (0.313/(0.313/999) =
+    999.0000000000001): the point count of the base grid at the limit is n, not n + 1
+    (the planner raised StopIteration at the frequency limit)."""
+    from stochcable.fidelity.planner import _points
+
+    spans = [0.1 * i + 0.013 for i in range(1, 200)]
+    for n in (200, 1000, 4000):
+        assert all(_points(a, a / (n - 1)) == n for a in spans)
+        assert all(_points(a, a / (n - 1) * 0.999) == n + 1 for a in spans)

@@ -182,7 +182,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Foss decomposition failed: direct modal solve instead",
         "DefectivePencilWarning (a PhysicsWarning)",
-        ("stochcable.dynamics.solve:_foss_free", "stochcable.dynamics.modal_solvers:solve_modal"),
+        ("stochcable.dynamics.solve:_foss_solver", "stochcable.dynamics.modal_solvers:solve_modal"),
         "the state-space pencil is defective (repeated eigenvalues without a full set "
         "of eigenvectors)",
         "The Foss decoupling does not exist for these matrices; the answer is computed "

@@ -285,9 +285,11 @@ class LinePrep:
                 ) from None
         c = (self._chol, False)
         if np.iscomplexobj(rhs):
-            return sla.cho_solve_banded(
-                c, np.ascontiguousarray(rhs.real), check_finite=False
-            ) + 1j * sla.cho_solve_banded(c, np.ascontiguousarray(rhs.imag), check_finite=False)
+            # real K: the (re, im) columns of the interleaved real view in one solve
+            n, k = rhs.shape
+            x = np.ascontiguousarray(rhs, dtype=complex).view(float).reshape(n, 2 * k)
+            y = sla.cho_solve_banded(c, x, check_finite=False)
+            return np.ascontiguousarray(y).view(complex)
         return sla.cho_solve_banded(c, rhs, check_finite=False)
 
     def residual(self, system: LineSystem, rhs: np.ndarray) -> np.ndarray:

@@ -109,18 +109,9 @@ def subset_inputs(
     )
     # The drag-independent, per-frequency arrays the full grid has already computed
     # (:func:`base_motion`, the attachments' velocity of :func:`drag_inputs`,
-    # :func:`end_motion_projections`, the projected moments of :func:`fluid_terms`)
-    # are the same numbers at the subset's frequencies: sliced, not recomputed.
+    # :func:`end_motion_projections`) are the same numbers at the subset's
+    # frequencies: sliced, not recomputed.
     n_w, n_ch = inp.weights.shape
-
-    def take_view(a: np.ndarray | None) -> np.ndarray | None:
-        """Slice the interleaved (n_w·n_ch·2) last axis of a real view."""
-        if a is None:
-            return None
-        lead = a.shape[:-1]
-        return np.ascontiguousarray(
-            np.take(a.reshape(lead + (n_w, 2 * n_ch)), idx, axis=len(lead))
-        ).reshape(lead + (-1,))
 
     for key, val in inp.cache.items():
         if key in ("foss", "direct"):
@@ -128,8 +119,6 @@ def subset_inputs(
             sub.cache[key] = (take(u, 2), take(f0, 2), moving)
         elif key[0] == "attached_velocity":
             sub.cache[key] = take(val, 2)
-        elif key[0] == "fluid_m":
-            sub.cache[key] = take_view(val)
         elif key[0] == "qproj":
             u_p, wcol, y = val
             sub.cache[key] = (

@@ -12,6 +12,7 @@ assemble the drag-dependent loads at every iteration of the drag fixed point.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -75,7 +76,6 @@ def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs
     weights = trapezoid_weights(w)[:, None] * np.stack([c.spectrum for c in channels], axis=1)
     vel = None
     mom = None
-    square = None
     inertia = np.zeros(shape, dtype=complex)
     b_in, node_mass = _inertia_elements(system)
     # the nodal fluid velocity only drives the attachments' drag (b_node): without
@@ -91,10 +91,6 @@ def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs
             if mom is None:
                 mom = np.zeros((model.n_elements, 2, model.dim, n_w, n_ch), dtype=complex)
             mom[..., i] = np.transpose(m[..., comps], (1, 2, 3, 0))
-            # the d × d part in one gather (two chained ones were 0.1-0.4 ms)
-            sq = element_mean_square(ch)[:, :, np.array(comps)[:, None], comps]
-            sq = np.einsum("weij,w->eij", sq, weights[:, i])
-            square = sq if square is None else square + sq
         if ch.element_velocity is not None:
             # exact along the elements: l0·C_I(I − eeᵀ)·iω∫N_i v dξ, plus attachments
             inertia[..., i] = element_load(b_in, mom[..., i] * (1j * w))
@@ -112,7 +108,54 @@ def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs
                 if ub is None:
                     ub = np.zeros((2, model.dim, n_w, n_ch), dtype=complex)
                 ub[k, :, :, i] = m[:, comps].T
-    return LineInputs(w, vel, inertia, ub, weights, mom, square)
+    return LineInputs(w, vel, inertia, ub, weights, mom, _weighted_square(model, channels, weights))
+
+
+def _weighted_square(
+    model: Any, channels: tuple[Channel, ...], weights: np.ndarray
+) -> np.ndarray | None:
+    """Σ_i weight_i·∫Re(v vᴴ)dξ over the channels with a fluid velocity, on the model
+    components, (n_el, d, d) (None without fluid velocity)."""
+    comps = np.array(model.components)
+    square = None
+    for i, ch in enumerate(channels):
+        if ch.element_velocity is None and ch.velocity is None:
+            continue
+        # the d × d part in one gather (two chained ones were 0.1-0.4 ms)
+        sq = element_mean_square(ch)[:, :, comps[:, None], comps]
+        sq = np.einsum("weij,w->eij", sq, weights[:, i])
+        square = sq if square is None else square + sq
+    return square
+
+
+#: Caches of :class:`LineInputs` that do not depend on the channels' spectra (kept by
+#: :func:`with_spectra`): the base motion per solver, the end-motion projections and
+#: the attachments' velocity.  Every other cache is formed again.
+def _spectrum_free(key: Any) -> bool:
+    return key in ("foss", "direct") or (
+        isinstance(key, tuple) and key[0] in ("qproj", "attached_velocity")
+    )
+
+
+def with_spectra(system: LineSystem, inp: LineInputs, channels: tuple[Channel, ...]) -> LineInputs:
+    """The inputs of ``channels`` when ``inp`` are those of channels with the same
+    transfer functions (kinematics, end motions, grid) under other spectra: the arrays
+    and the spectrum-independent caches shared, the weights and the weighted mean
+    square formed for the new spectra.  The same numbers as :func:`line_inputs` of
+    ``channels``."""
+    w = channels[0].omega
+    weights = trapezoid_weights(w)[:, None] * np.stack([c.spectrum for c in channels], axis=1)
+    out = LineInputs(
+        inp.omega,
+        inp.velocity,
+        inp.inertia_load,
+        inp.ub,
+        weights,
+        inp.moments,
+        _weighted_square(system.model, channels, weights),
+    )
+    out.cache.update({k: v for k, v in inp.cache.items() if _spectrum_free(k)})
+    return out
 
 
 def drag_blocks(system: LineSystem, damping: Damping) -> NodeBlocks:

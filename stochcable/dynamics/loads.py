@@ -50,6 +50,7 @@ mean square ∫ Re(v vᴴ) dξ integrated exactly along the elements
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -166,6 +167,15 @@ class Channel:
     element_velocity_square: np.ndarray | None = None
     element_end_square: np.ndarray | None = None
     nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
+
+
+def with_spectrum(channel: Channel, density: Callable[[np.ndarray], np.ndarray]) -> Channel:
+    """``channel`` with the spectrum ``density`` (sampled on its grid) instead of its
+    own; its transfer functions shared (the lazy nodal kinematics not computed)."""
+    out = copy.copy(channel)
+    object.__setattr__(out, "density", density)
+    object.__setattr__(out, "spectrum", density(channel.omega))
+    return out
 
 
 def spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:

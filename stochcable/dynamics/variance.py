@@ -246,28 +246,28 @@ def _project_ends(pr: np.ndarray, x: np.ndarray) -> np.ndarray:
     return out
 
 
-def fluid_terms(
-    system: LineSystem, inp: LineInputs, method: str
-) -> tuple[np.ndarray, np.ndarray | None]:
-    """Drag-independent terms of the element mean square, cached per inputs and method:
-    c0 = Σ weight ∫₀¹ |r·v|² dξ (n_el, k) and the projected consistent moments
-    (r·∫N_a v dξ, r·∫N_b v dξ) as a real (n_el, 2, k, 2·n_w·n_ch) view (None without
-    fluid velocity; weighted block by block in :func:`_structural_variance`), r the
-    rows of :func:`_proj_rows`."""
+def fluid_terms(system: LineSystem, inp: LineInputs, method: str) -> tuple[np.ndarray, bool]:
+    """Drag-independent term of the element mean square, cached per inputs and method:
+    c0 = Σ weight ∫₀¹ |r·v|² dξ (n_el, k), r the rows of :func:`_proj_rows`, and
+    whether there is a fluid velocity (its consistent moments are projected block by
+    block: :func:`_projected_moments`)."""
     key = ("fluid", method)
     if key not in inp.cache:
         pr = _proj_rows(system, method)
         if inp.moments is None:
-            inp.cache[key] = (np.zeros(pr.shape[:2]), None)
+            inp.cache[key] = (np.zeros(pr.shape[:2]), False)
         else:
             c0 = np.sum((pr @ inp.square) * pr, axis=2)  # r·S·r (5x the einsum's speed)
-            mkey = ("fluid_m", method)
-            if mkey not in inp.cache:  # (a subset's are sliced from its full grid's)
-                n_el, _, d = inp.moments.shape[:3]
-                mf = np.ascontiguousarray(inp.moments).reshape(n_el, 2, d, -1).view(float)
-                inp.cache[mkey] = pr[:, None] @ mf  # (n_el, side, k, 2N): one product
-            inp.cache[key] = (c0, inp.cache[mkey])
+            inp.cache[key] = (c0, True)
     return inp.cache[key]
+
+
+def _projected_moments(pr: np.ndarray, moments: np.ndarray) -> np.ndarray:
+    """(r·∫N_a v dξ, r·∫N_b v dξ) of consistent moments (n_el, 2, d, n_w, n_ch) as a real
+    (n_el, 2, k, 2·n_w·n_ch) view: one stacked product."""
+    n_el, _, d = moments.shape[:3]
+    mf = np.ascontiguousarray(moments).reshape(n_el, 2, d, -1).view(float)
+    return pr[:, None] @ mf
 
 
 _GRAM = np.array([[1.0, 0.5], [0.5, 1.0]]) / 3.0  # ∫N_i N_j dξ
@@ -290,7 +290,7 @@ def _element_variance(
     Re(q̄_a q_b))/3, summed over blocks of frequencies
     (:func:`~stochcable.dynamics.freqblocks.frequency_slices`): the projections of one
     block only are formed, two stacked real products per block."""
-    c0, m = fluid_terms(system, inp, method)
+    c0, fluid = fluid_terms(system, inp, method)
     if u_nodes is None and u_free is None:
         return c0
     pr = _proj_rows(system, method)
@@ -310,7 +310,8 @@ def _element_variance(
             qf = (u_free[:, :, sl] * wq[sl]).reshape(n_f, d, -1).view(float)
             qx[1:, :, 0] += pr[1:] @ qf
             qx[:-1, :, 1] += pr[:-1] @ qf
-        var += _structural_variance(qx, w2[cols], None if m is None else m[..., cols])
+        m = _projected_moments(pr, inp.moments[..., sl, :]) if fluid else None
+        var += _structural_variance(qx, w2[cols], m)
     return var
 
 

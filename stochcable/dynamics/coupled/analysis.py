@@ -38,7 +38,8 @@ from stochcable.dynamics.coupled.inputs import (
 from stochcable.dynamics.coupled.model import CoupledModel, ModelGroup, build_coupled
 from stochcable.dynamics.coupled.modes import coupled_modes
 from stochcable.dynamics.coupled.results import body_result, coupled_results
-from stochcable.dynamics.line_loads import silent_channel
+from stochcable.dynamics.coupled.seainputs import heading_inputs
+from stochcable.dynamics.line_loads import LineInputs, silent_channel
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.outputs import line_result
 from stochcable.dynamics.system import Damping, LineSystem, Progress, noop_progress
@@ -215,17 +216,24 @@ def solve_coupled(
         timing.setdefault(key, 0.0)
     t0 = time.perf_counter()
     chans: dict[str, tuple[Channel, ...]] = {}
+    inputs: dict[str, LineInputs] = {}
+    alone = set(model.independent)
     for line in scene.lines:
-        chans[line.name], _ = scene_line_channels(
-            scene, line, model.systems[line.name], model.omega, model.vessel_rao
-        )
+        if line.name in alone:
+            chans[line.name], inputs[line.name] = heading_inputs(model, scene, line)
+        else:
+            chans[line.name], _ = scene_line_channels(
+                scene, line, model.systems[line.name], model.omega, model.vessel_rao
+            )
     timing["model_s"] += time.perf_counter() - t0
     lines_out: dict[str, LineResult] = {}
     bodies_out: dict[str, BodyResult] = {}
     dampings: dict[str, Damping] = {}
     alone: list[CoupledGroup] = []
     for name in model.independent:
-        lines_out[name], state = _solve_line(model, name, chans[name], settings, progress, timing)
+        lines_out[name], state = _solve_line(
+            model, name, chans[name], settings, progress, timing, inputs.get(name)
+        )
         dampings[name] = state.dampings[name]
         alone.append(state)
     states: list[CoupledGroup] = []
@@ -267,9 +275,11 @@ def _solve_line(
     settings: Any,
     progress: Progress,
     timing: dict[str, float],
+    inputs: LineInputs | None = None,
 ) -> tuple[LineResult, CoupledGroup]:
     """A line attached to no free body: the group of this line alone (no bodies),
-    its own channels (a silent one without excitation, with a PhysicsWarning)."""
+    its own channels (a silent one without excitation, with a PhysicsWarning) and
+    their ``inputs`` when already formed (:func:`heading_inputs`)."""
     if not ch:
         warn(
             f"line '{name}' has no excitation (no sea and no end motion): its "
@@ -282,7 +292,13 @@ def _solve_line(
     progress("linearization", {"line": name, "iteration": 0})
     t1 = time.perf_counter()
     clin = linearize_coupled(
-        [cl], [], settings, rho=model.scene.environment.rho, progress=progress, timing=timing
+        [cl],
+        [],
+        settings,
+        rho=model.scene.environment.rho,
+        progress=progress,
+        timing=timing,
+        inputs=None if inputs is None or not ch else {name: inputs},
     )
     timing["linearization_s"] += time.perf_counter() - t1
     progress("outputs", {"line": name})

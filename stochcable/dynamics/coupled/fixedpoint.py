@@ -98,6 +98,7 @@ def linearize_coupled(
     progress: Progress | None = None,
     timing: dict[str, float] | None = None,
     coarse: bool | None = None,
+    inputs: Mapping[str, Any] | None = None,
 ) -> CoupledLinearization:
     """Drag linearization and response of lines coupled through rigid bodies: the
     one drag fixed point of the engine (a single line is the group of one line and no
@@ -131,6 +132,9 @@ def linearize_coupled(
         least ``COARSE_MIN_TOLERANCE`` (1e-6), more than one evaluation is allowed
         and no line has the vector form with a current, under both solvers; skipped
         on grids below ``COARSE_MIN_FREQUENCIES``.
+    inputs : mapping of str to LineInputs, optional
+        The lines' inputs of their channels when already formed
+        (:func:`~stochcable.dynamics.line_loads.with_spectra`); default formed here.
 
     Returns
     -------
@@ -158,7 +162,7 @@ def linearize_coupled(
         channels = lines[0].channels
     if not lines and not bodies:
         raise InputError("lines", 0, "-", "a coupled group needs a line or a body")
-    g = GroupSystem(lines, bodies, loads or {}, rho, channels)
+    g = GroupSystem(lines, bodies, loads or {}, rho, channels, inp_phys=inputs)
     names = ", ".join(cl.name for cl in g.lines)
     gname = (
         f"drag linearization of line '{names}'"

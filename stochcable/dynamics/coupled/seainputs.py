@@ -1,0 +1,85 @@
+"""The inputs of a line alone for one sea state, reused across sea states of the same
+heading (the engine's load-case sets, seed 001 ch. 5 per sea state).
+
+The channels' transfer functions — the wave kinematics integrated along the elements,
+the Morison inertia loads, the end motions and vessel RAOs per unit wave amplitude —
+depend on the sea's heading and the frequency grid, not on its spectrum; only the
+σ weights (trapezoid × spectrum) and the weighted mean square of the fluid velocity
+do.  :func:`heading_inputs` keeps a line's channels and inputs of the last headings on
+its :class:`~stochcable.dynamics.system.LineSystem` (the engine's sea-independent
+state) and gives the next sea state of a known heading its spectra on them
+(:func:`~stochcable.dynamics.loads.with_spectrum`,
+:func:`~stochcable.dynamics.line_loads.with_spectra`): the same numbers as forming
+them again (tested), without the kinematics.  Lines whose inputs exceed
+:data:`INPUT_CACHE_BYTES` are not kept (the memory bound of large models).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from stochcable.dynamics.coupled.inputs import scene_line_channels
+from stochcable.dynamics.line_loads import LineInputs, line_inputs, with_spectra
+from stochcable.dynamics.loads import Channel, spectrum_callable, with_spectrum
+
+__all__ = ["INPUT_CACHE_BYTES", "heading_inputs"]
+
+#: Largest inputs (arrays and their drag-independent caches) of one line kept for the
+#: next sea state, summed over the kept headings. [bytes]
+INPUT_CACHE_BYTES = 64 * 2**20
+
+_KEY = "heading_inputs"
+
+
+def heading_inputs(model: Any, scene: Any, line: Any) -> tuple[tuple[Channel, ...], LineInputs]:
+    """The channels and inputs of a line attached to no free body for the sea state of
+    ``scene`` (its spectrum and heading), reusing those of an earlier sea state of the
+    same heading.
+
+    Parameters
+    ----------
+    model : CoupledModel
+        The engine's model (systems, grid, vessels' RAOs).
+    scene : Scene
+        The scene with the sea state.
+    line : Line
+        The scene line.
+
+    Returns
+    -------
+    channels : tuple of Channel
+        As :func:`~stochcable.dynamics.coupled.inputs.scene_line_channels`.
+    inputs : LineInputs or None
+        Their inputs (None when the line has no channel).
+    """
+    system = model.systems[line.name]
+    sea = scene.sea
+    heading = None if sea is None else float(sea.heading)
+    kept: dict[Any, tuple[tuple[Channel, ...], LineInputs]] = system._cache.setdefault(_KEY, {})
+    if heading in kept:
+        ch0, inp0 = kept[heading]
+        if sea is None:
+            return ch0, inp0
+        density = spectrum_callable(sea.spectrum, scene.environment.g)
+        ch = tuple(with_spectrum(c, density) if c.kind == "sea" else c for c in ch0)
+        return ch, with_spectra(system, inp0, ch)
+    ch, _ = scene_line_channels(scene, line, system, model.omega, model.vessel_rao)
+    if not ch:
+        return ch, None
+    inp = line_inputs(system, ch)
+    size = _nbytes(ch, inp)
+    if 2 * size <= INPUT_CACHE_BYTES:  # (its caches of the solve: about as much again)
+        while kept and 2 * size * (len(kept) + 1) > INPUT_CACHE_BYTES:
+            kept.pop(next(iter(kept)))  # the oldest heading
+        kept[heading] = (ch, inp)
+    return ch, inp
+
+
+def _nbytes(channels: tuple[Channel, ...], inp: LineInputs) -> int:
+    """Bytes of the channels' element kinematics and of the inputs' arrays."""
+    arrays = [inp.velocity, inp.inertia_load, inp.ub, inp.moments]
+    for c in channels:
+        arrays += [c.element_velocity, c.element_velocity_square, c.element_end_square]
+    return int(sum(a.nbytes for a in arrays if isinstance(a, np.ndarray)))

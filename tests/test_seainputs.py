@@ -1,0 +1,71 @@
+"""Inputs reused across sea states of one heading
+(stochcable.dynamics.coupled.seainputs): an engine solving sea states of known and new
+headings in any order gives the documents of fresh analyses, keeps the inputs of the
+headings it has seen (within its memory bound) and none of a large line."""
+
+from __future__ import annotations
+
+from _compare import assert_close_documents
+
+from stochcable.analysis import analyze
+from stochcable.dynamics.coupled import seainputs
+from stochcable.dynamics.engine import build_engine
+from stochcable.examples import load_example
+
+
+def _doc(heading: float) -> dict:
+    doc = load_example("chain_catenary").model_dump(mode="json", exclude_none=True)
+    doc["analysis"].pop("timeseries", None)
+    doc["analysis"]["omega"]["count"] = 80  # (a small grid: the test is on the reuse)
+    doc["lines"][0]["segments"][0]["elements"] = 20
+    doc["sea"]["heading"] = heading
+    return doc
+
+
+def _sea(kind: str, heading: float) -> dict:
+    spec = (
+        {"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0}
+        if kind == "pm"
+        else {"type": "jonswap", "hs": 3.0, "tp": 8.0, "gamma": 3.3}
+    )
+    return {"spectrum": spec, "heading": heading}
+
+
+def _plain(result) -> dict:
+    doc = result.to_document()
+    doc.pop("timing")
+    return doc
+
+
+def test_sea_states_of_known_headings_equal_fresh_analyses() -> None:
+    # an out-of-plane heading: the engine's models are 3-D, every heading solvable
+    engine = build_engine(_doc(30.0))
+    order = [("pm", 30.0), ("js", 30.0), ("pm", 60.0), ("js", 60.0), ("pm", 30.0)]
+    for kind, heading in order:
+        got = _plain(engine.solve(_sea(kind, heading)))
+        ref = _plain(analyze({**_doc(30.0), "sea": _sea(kind, heading)}))
+        # the same arrays and caches: round-off only (the contracting fixed point
+        # carries 1e-16 regroupings to ~1e-13)
+        assert_close_documents(got, ref, rtol=1e-12)
+    kept = engine.systems["leg1"]._cache[seainputs._KEY]
+    assert sorted(kept) == [30.0, 60.0]
+
+
+def test_large_inputs_are_not_kept(monkeypatch) -> None:
+    monkeypatch.setattr(seainputs, "INPUT_CACHE_BYTES", 1024)
+    engine = build_engine(_doc(0.0))
+    got = _plain(engine.solve(_sea("js", 0.0)))
+    assert not engine.systems["leg1"]._cache[seainputs._KEY]
+    ref = _plain(analyze({**_doc(0.0), "sea": _sea("js", 0.0)}))
+    assert_close_documents(got, ref, rtol=1e-12)
+
+
+def test_oldest_heading_gives_way(monkeypatch) -> None:
+    engine = build_engine(_doc(30.0))
+    engine.solve(_sea("pm", 30.0))
+    size = seainputs._nbytes(*engine.systems["leg1"]._cache[seainputs._KEY][30.0])
+    # room for two headings' inputs (twice their arrays each): the third evicts the first
+    monkeypatch.setattr(seainputs, "INPUT_CACHE_BYTES", 4 * size + 1)
+    for h in (45.0, 60.0):
+        engine.solve(_sea("pm", h))
+    assert sorted(engine.systems["leg1"]._cache[seainputs._KEY]) == [45.0, 60.0]
