@@ -282,4 +282,4 @@ def test_base_grid_spacing_gives_its_own_point_count():
     spans = [0.1 * i + 0.013 for i in range(1, 200)]
     for n in (200, 1000, 4000):
         assert all(_points(a, a / (n - 1)) == n for a in spans)
-        assert all(_points(a, a / (n - 1) * 0.999) == n + 1 for a in spans)
+        assert all(_points(a, a / (n - 1) * 0.999) > n for a in spans)  # finer: more
