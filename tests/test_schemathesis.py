@@ -61,12 +61,12 @@ def test_api(case):
 
 
 @schema.include(operation_id="run_analysis").parametrize()
-@settings(max_examples=10, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
+@settings(max_examples=6, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 def test_analyses(case):
     case.call_and_validate(checks=CHECKS)
 
 
 @schema.include(operation_id="submit_batch").parametrize()
-@settings(max_examples=5, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
+@settings(max_examples=3, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 def test_batches(case):
     case.call_and_validate(checks=CHECKS)

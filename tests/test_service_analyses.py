@@ -330,7 +330,7 @@ _GENERATED_APP = create_app(Settings(max_run_seconds=10.0))
 
 
 @settings(
-    max_examples=12,
+    max_examples=8,
     deadline=None,
     derandomize=True,
     database=None,

@@ -16,7 +16,7 @@ from stochcable.cases import case_document, read_scatter, run_cases
 from stochcable.examples import load_example
 
 CHAIN = load_example("chain_catenary").model_dump(mode="json", exclude_unset=True)
-N, CHUNK = 160, 4
+N, CHUNK = 96, 4  # enough that the kill (>= 32 done) and the stop (+16) fall mid-batch
 ROWS = [{"hs": 1.0 + 0.02 * i, "tp": 8.0 + 0.01 * i, "hours": 1.0} for i in range(N)]
 LEASE = 2.0  # s: a killed server's batch is taken over this long after its last report
 
