@@ -1,0 +1,483 @@
+"""Strumming (vortex-induced vibration) of a line in a steady current, in the
+frequency domain (seed 001 §3.2.b).
+
+A steady normal flow U_n past an element of diameter D sheds vortices at
+ω_s = 2π·St·U_n/D (seed 001 eq. 3.2.b.4).  A natural mode ω_n is a lock-in candidate
+when its reduced velocity V_R = 2π U_n/(ω_n D) lies in the cross-flow band
+3 ≤ V_R ≤ 16 of DNV-RP-C205 (2010) ch. 9 (:data:`CROSS_FLOW_BAND`); the nearest
+candidates are balanced with the Skop–Griffin wake oscillator
+(:mod:`stochcable.line.strumming_balance`).  A mode with a first-harmonic solution is
+*locked in* and vibrates at its steady amplitude; one without is an *unlocked* mode
+driven by the free wakes (C_L = C_L0 at ω_s), whose response is bounded by twice the
+forced amplitude (the beat from rest, seed 001 Example 6).  The vibration of a
+locked-in mode magnifies the in-line drag: C_d/C_d0 = 1 + 1.043 (2 Y_rms/D)^0.65 (Vandiver 1983,
+:func:`drag_amplification_vandiver`).
+
+:func:`strumming_screen` is the one entry point: one line's static shape, sections,
+current and natural modes in, a :class:`StrummingTable` out.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from stochcable.errors import InputError
+from stochcable.line.strumming_balance import lock_in_balance, wake_parameters
+from stochcable.validation import finite_scalar
+
+__all__ = [
+    "CROSS_FLOW_BAND",
+    "STROUHAL_DEFAULT",
+    "LIFT_DEFAULT",
+    "shedding_frequency",
+    "reduced_velocity",
+    "hydrodynamic_damping_ratio",
+    "reduced_damping",
+    "drag_amplification_vandiver",
+    "StrummingInput",
+    "StrummingMode",
+    "StrummingTable",
+    "strumming_screen",
+]
+
+#: Cross-flow lock-in band of the reduced velocity V_R = U/(f_n D), DNV-RP-C205
+#: (2010) ch. 9 "Vortex induced oscillations" (cross-flow VIV for 3 ≤ V_R ≤ 16). [-]
+CROSS_FLOW_BAND = (3.0, 16.0)
+#: Strouhal number of a circular cylinder, subcritical 300 < Re < 2·10⁵ (Blevins 1990
+#: Fig. 3-5; DNV-RP-C205 Fig. 9-2). [-]
+STROUHAL_DEFAULT = 0.2
+#: Lift-coefficient amplitude of the fixed cylinder (seed 001 Example 6). [-]
+LIFT_DEFAULT = 0.2
+#: Candidate modes balanced per line (nearest to the shedding frequency, seed 001
+#: §3.2.b: "the natural frequency having a value closest to the shedding frequency"). [-]
+_CANDIDATES = 3
+
+
+def shedding_frequency(speed, diameter, strouhal=STROUHAL_DEFAULT):
+    """Vortex-shedding frequency ω_s = 2π St U_n/D.
+
+    Parameters
+    ----------
+    speed : float or array_like
+        Normal flow speed U_n (>= 0). [m/s]
+    diameter : float or array_like
+        Diameter (> 0). [m]
+    strouhal : float or array_like, optional
+        Strouhal number St (> 0). [-]
+
+    Returns
+    -------
+    float or ndarray
+        ω_s. [rad/s]
+
+    Notes
+    -----
+    Seed 001 eq. 3.2.b.4.
+    """
+    u = np.asarray(speed, dtype=float)
+    d = np.asarray(diameter, dtype=float)
+    st = np.asarray(strouhal, dtype=float)
+    _check_positive("strouhal", st, "-")
+    _check_positive("diameter", d, "m")
+    if np.any(~np.isfinite(u)) or np.any(u < 0):
+        raise InputError("speed", speed, "m/s", "must be finite and >= 0")
+    out = 2.0 * math.pi * st * u / d
+    return float(out) if out.ndim == 0 else out
+
+
+def reduced_velocity(speed, omega_n, diameter):
+    """Reduced velocity V_R = U_n/(f_n D) = 2π U_n/(ω_n D).
+
+    Parameters
+    ----------
+    speed : float or array_like
+        Normal flow speed. [m/s]
+    omega_n : float or array_like
+        Natural frequency (> 0). [rad/s]
+    diameter : float or array_like
+        Diameter (> 0). [m]
+
+    Returns
+    -------
+    float or ndarray
+        V_R. [-]
+    """
+    _check_positive("omega_n", np.asarray(omega_n, dtype=float), "rad/s")
+    _check_positive("diameter", np.asarray(diameter, dtype=float), "m")
+    out = 2.0 * math.pi * np.asarray(speed, dtype=float) / (np.asarray(omega_n) * diameter)
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def hydrodynamic_damping_ratio(rho, diameter, mass, viscosity, omega_n):
+    """Still-water viscous damping ratio of a cylinder vibrating at ω_n.
+
+    Parameters
+    ----------
+    rho : float
+        Water density (> 0). [kg/m³]
+    diameter : float
+        Diameter (> 0). [m]
+    mass : float
+        Mass per length, structural + added (> 0). [kg/m]
+    viscosity : float
+        Kinematic viscosity ν (> 0). [m²/s]
+    omega_n : float
+        Natural frequency (> 0). [rad/s]
+
+    Returns
+    -------
+    float
+        ξ = (12 ρ D/(π m)) √(ν/ω_n). [-]
+
+    Notes
+    -----
+    Seed 001 eq. 3.2.b.8.
+    """
+    for name, v, unit in (
+        ("rho", rho, "kg/m³"),
+        ("diameter", diameter, "m"),
+        ("mass", mass, "kg/m"),
+        ("viscosity", viscosity, "m²/s"),
+        ("omega_n", omega_n, "rad/s"),
+    ):
+        if not finite_scalar(name, v, unit) > 0:
+            raise InputError(name, v, unit, "must be > 0")
+    return 12.0 * rho * diameter / (math.pi * mass) * math.sqrt(viscosity / omega_n)
+
+
+def reduced_damping(mass, damping_ratio, rho, diameter, strouhal=STROUHAL_DEFAULT):
+    """Skop–Griffin reduced damping S_G = 2π St² k_s, k_s = 4π m ξ/(ρ D²).
+
+    Parameters
+    ----------
+    mass : float
+        Mass per length, structural + added. [kg/m]
+    damping_ratio : float
+        ξ of the mode (structural + hydrodynamic, > 0). [-]
+    rho : float
+        Water density. [kg/m³]
+    diameter : float
+        Diameter. [m]
+    strouhal : float, optional
+        St. [-]
+
+    Returns
+    -------
+    float
+        S_G. [-]
+
+    Notes
+    -----
+    Seed 001 eq. 3.2.b.6 (Griffin, Skop & Ramberg 1975).
+    """
+    if not finite_scalar("damping_ratio", damping_ratio, "-") > 0:
+        raise InputError("damping_ratio", damping_ratio, "-", "must be > 0")
+    ks = 4.0 * math.pi * mass * damping_ratio / (rho * diameter**2)
+    return 2.0 * math.pi * strouhal**2 * ks
+
+
+def drag_amplification_vandiver(y_rms_over_d):
+    """In-line drag amplification of a vibrating cable, C_d/C_d0.
+
+    Parameters
+    ----------
+    y_rms_over_d : float or array_like
+        RMS cross-flow displacement over the diameter (>= 0). [-]
+
+    Returns
+    -------
+    float or ndarray
+        1 + 1.043 (2 Y_rms/D)^0.65. [-]
+
+    Notes
+    -----
+    Vandiver, J. K. (1983), "Drag coefficients of long flexible cylinders", OTC 4490,
+    fitted to field data of strumming cables; the magnification the seed names (Skop,
+    Griffin and Ramberg 1977) and leaves for future study (seed 001 ch. 7).
+    """
+    y = np.asarray(y_rms_over_d, dtype=float)
+    if np.any(~np.isfinite(y)) or np.any(y < 0):
+        raise InputError("y_rms_over_d", y_rms_over_d, "-", "must be finite and >= 0")
+    out = 1.0 + 1.043 * (2.0 * y) ** 0.65
+    return float(out) if out.ndim == 0 else out
+
+
+def _check_positive(name: str, value: np.ndarray, unit: str) -> None:
+    if np.any(~np.isfinite(value)) or np.any(value <= 0):
+        bad = value if value.ndim == 0 else value[~(np.isfinite(value) & (value > 0))][0]
+        raise InputError(name, float(bad), unit, "must be finite and > 0")
+
+
+@dataclass(frozen=True, eq=False)
+class StrummingInput:
+    """One line's data for the screening (per element unless stated).
+
+    Attributes
+    ----------
+    positions : ndarray, shape (n_nodes, 3)
+        Static node positions. [m]
+    current : ndarray, shape (n_el, 3)
+        Steady current at the element midpoints. [m/s]
+    diameter, cd_normal, mass, ca_normal, ea, l0 : ndarray, shape (n_el,)
+        Diameter [m], normal drag coefficient [-], mass per length in air [kg/m],
+        normal added-mass coefficient [-], axial stiffness [N], unstretched length [m].
+    strouhal, lift : ndarray, shape (n_el,)
+        St [-] and C_L0 [-] (lift 0 where strumming is suppressed).
+    rho : float
+        Water density. [kg/m³]
+    viscosity : float
+        Kinematic viscosity. [m²/s]
+    structural_damping : ndarray, shape (n_el,)
+        Structural damping ratio (ψ²-weighted into each mode's). [-]
+    """
+
+    positions: np.ndarray
+    current: np.ndarray
+    diameter: np.ndarray
+    cd_normal: np.ndarray
+    mass: np.ndarray
+    ca_normal: np.ndarray
+    ea: np.ndarray
+    l0: np.ndarray
+    strouhal: np.ndarray
+    lift: np.ndarray
+    rho: float
+    viscosity: float
+    structural_damping: np.ndarray | float = 0.0
+
+    def __post_init__(self) -> None:
+        n_el = np.asarray(self.l0).size
+        for name, unit in (("strouhal", "-"), ("diameter", "m"), ("viscosity", "m²/s")):
+            _check_positive(name, np.asarray(getattr(self, name), dtype=float), unit)
+        lift = np.asarray(self.lift, dtype=float)
+        if np.any(~np.isfinite(lift)) or np.any(lift < 0):
+            raise InputError("lift_coefficient", float(lift.min()), "-", "C_L0 must be >= 0")
+        zeta = np.asarray(self.structural_damping, dtype=float)
+        if np.any(~np.isfinite(zeta)) or np.any(zeta < 0) or np.any(zeta >= 1):
+            raise InputError("damping_ratio", self.structural_damping, "-", "must be in [0, 1)")
+        for name in ("current", "diameter", "cd_normal", "mass", "ca_normal", "ea"):
+            if np.asarray(getattr(self, name)).shape[0] != n_el:
+                raise InputError(name, np.shape(getattr(self, name)), "-", f"needs {n_el} rows")
+
+
+@dataclass(frozen=True, eq=False)
+class StrummingMode:
+    """One screened mode of a :class:`StrummingTable`.
+
+    Attributes
+    ----------
+    index : int
+        Mode index in the line's modes (0 = lowest). [-]
+    omega_n : float
+        Natural frequency. [rad/s]
+    omega_s : float
+        Shedding frequency where the mode is excited (ψ²-weighted mean). [rad/s]
+    omega : float
+        Response frequency (the lock-in frequency, or ω_s when unlocked). [rad/s]
+    reduced_velocity : float
+        V_R = 2π U_n/(ω_n D), ψ²-weighted. [-]
+    locked : bool
+        Whether the wake oscillator locks in (a harmonic-balance solution exists).
+    amplitude_over_d : float
+        Largest cross-flow amplitude over the diameter: steady lock-in amplitude, or
+        for an unlocked mode the beat bound (twice the forced amplitude). [-]
+    damping_ratio, reduced_damping : float
+        ξ (structural + hydrodynamic) and S_G of the mode. [-]
+    displacement : ndarray, shape (n_nodes, 3)
+        Steady amplitude of the node displacements (forced amplitude when unlocked). [m]
+    tension_range : ndarray, shape (n_el,)
+        Peak-to-peak dynamic effective tension of the strumming mode. [N]
+    cycle_rate : float
+        Stress cycles per second, ω/(2π) (an extra narrow-band component). [1/s]
+    """
+
+    index: int
+    omega_n: float
+    omega_s: float
+    omega: float
+    reduced_velocity: float
+    locked: bool
+    amplitude_over_d: float
+    damping_ratio: float
+    reduced_damping: float
+    displacement: np.ndarray
+    tension_range: np.ndarray
+    cycle_rate: float
+
+    def as_dict(self) -> dict:
+        """JSON-ready dict (SI: rad/s, m, N, 1/s)."""
+        return {
+            "mode": self.index,
+            "omega_n": self.omega_n,
+            "omega_s": self.omega_s,
+            "omega": self.omega,
+            "reduced_velocity": self.reduced_velocity,
+            "locked": self.locked,
+            "amplitude_over_d": self.amplitude_over_d,
+            "damping_ratio": self.damping_ratio,
+            "reduced_damping": self.reduced_damping,
+            "tension_range": self.tension_range.tolist(),
+            "cycle_rate": self.cycle_rate,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class StrummingTable:
+    """Strumming screening of one line (:func:`strumming_screen`).
+
+    Attributes
+    ----------
+    modes : tuple of StrummingMode
+        The screened candidate modes (in the lock-in band, nearest to ω_s first).
+    omega_s : ndarray, shape (n_el,)
+        Shedding frequency of every element (0 without flow or where suppressed). [rad/s]
+    cd_normal : ndarray, shape (n_el,)
+        Normal drag coefficient amplified by the governing mode's vibration. [-]
+    governing : int or None
+        Position in ``modes`` of the mode whose amplitude amplifies the drag: the
+        locked-in mode of largest amplitude (None when no mode locks in: an unlocked
+        mode's wakes drift in phase along the line and its response stays small and
+        incoherent, tests/test_strumming.py, so the drag is not amplified).
+    """
+
+    modes: tuple[StrummingMode, ...]
+    omega_s: np.ndarray
+    cd_normal: np.ndarray
+    governing: int | None
+
+    @property
+    def locked(self) -> tuple[StrummingMode, ...]:
+        """The locked-in modes."""
+        return tuple(m for m in self.modes if m.locked)
+
+    def as_dict(self) -> dict:
+        """JSON-ready dict for the result document."""
+        return {
+            "modes": [m.as_dict() for m in self.modes],
+            "governing": self.governing,
+            "cd_normal": self.cd_normal.tolist(),
+            "omega_s": self.omega_s.tolist(),
+        }
+
+
+def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
+    """Screen one line in a steady current for strumming.
+
+    Parameters
+    ----------
+    line : StrummingInput
+        Static shape, sections, current and strumming settings.
+    omega_n : array_like, shape (count,)
+        Natural frequencies (with added mass). [rad/s]
+    shapes : array_like, shape (n_nodes, 3, count)
+        Mode shapes, global x, y, z per node, normalized φᵀ M_T φ = 1. [kg^-1/2]
+
+    Returns
+    -------
+    StrummingTable
+
+    Notes
+    -----
+    Per element: tangent t, normal flow U_n = U − (U·t)t, lift direction
+    l = t × U_n/|U_n|, ω_s = 2π St |U_n|/D.  Per mode: ψ_e = ½(φ_a + φ_b)·l_e, the
+    ψ²-weighted U_n, D, m_T = m + C_a ρπD²/4 and ω_s; V_R (:func:`reduced_velocity`)
+    in :data:`CROSS_FLOW_BAND`; ξ = structural + :func:`hydrodynamic_damping_ratio`;
+    S_G (:func:`reduced_damping`); the balance
+    (:func:`~stochcable.line.strumming_balance.lock_in_balance`).  Unlocked: free wakes
+    C_L0 at ω_s, A_f = |Σ q ψ C_L0|/|ω_n² − ω_s² + 2iξω_nω_s|, reported 2A_f.  The
+    tension amplitude of element e is (EA/l0)·t·(φ_b − φ_a)·A (linear), its range twice
+    that.  The drag of element e is amplified with Y_rms = A|ψ_e|/√2 of the governing
+    (locked-in) mode.
+    """
+    pos = np.asarray(line.positions, dtype=float)
+    w_n = np.asarray(omega_n, dtype=float)
+    phi = np.asarray(shapes, dtype=float)
+    n_el = pos.shape[0] - 1
+    seg = np.diff(pos, axis=0)
+    length = np.linalg.norm(seg, axis=1)
+    t = seg / length[:, None]
+    u = np.asarray(line.current, dtype=float)
+    u_n = u - np.einsum("ij,ij->i", u, t)[:, None] * t
+    speed = np.linalg.norm(u_n, axis=1)
+    lift_on = (speed > 0) & (np.asarray(line.lift) > 0)
+    ldir = np.zeros((n_el, 3))
+    ldir[lift_on] = np.cross(t[lift_on], u_n[lift_on]) / speed[lift_on, None]
+    d = np.asarray(line.diameter, dtype=float)
+    omega_s = np.where(lift_on, shedding_frequency(speed, d, line.strouhal), 0.0)
+    q = np.where(lift_on, 0.5 * line.rho * d * speed**2 * length, 0.0)
+    m_t = np.asarray(line.mass) + np.asarray(line.ca_normal) * line.rho * math.pi * d**2 / 4
+    cd0 = np.asarray(line.cd_normal, dtype=float)
+    if not np.any(lift_on) or w_n.size == 0:
+        return StrummingTable((), omega_s, cd0.copy(), None)
+    mid = 0.5 * (phi[:-1] + phi[1:])  # (n_el, 3, count)
+    psi = np.einsum("ek,ekm->em", ldir, mid)  # (n_el, count)
+    weight = psi**2 * length[:, None] * lift_on[:, None]
+    total = weight.sum(axis=0)
+    cand = []
+    for k in np.flatnonzero((total > 0) & (w_n > 0)):
+        wk = weight[:, k] / total[k]
+        vr = reduced_velocity(wk @ speed, w_n[k], wk @ d)
+        if CROSS_FLOW_BAND[0] <= vr <= CROSS_FLOW_BAND[1]:
+            cand.append((abs(math.log(w_n[k] / (wk @ omega_s))), int(k), vr, wk))
+    cand.sort()
+    stiff = np.asarray(line.ea) / np.asarray(line.l0)
+    modes = []
+    for _, k, vr, wk in cand[:_CANDIDATES]:
+        modes.append(
+            _screen_mode(
+                line, k, w_n[k], vr, wk, psi[:, k], phi[:, :, k], q, d, m_t, omega_s, t, stiff
+            )
+        )
+    governing = None
+    locked = [i for i, m in enumerate(modes) if m.locked]
+    if locked:
+        governing = max(locked, key=lambda i: modes[i].amplitude_over_d)
+    cd = cd0.copy()
+    if governing is not None:
+        g = modes[governing]
+        y_rms = np.abs(
+            np.einsum("ek,ek->e", 0.5 * (g.displacement[:-1] + g.displacement[1:]), ldir)
+        ) / math.sqrt(2.0)
+        cd = np.where(lift_on, cd0 * drag_amplification_vandiver(y_rms / d), cd0)
+    return StrummingTable(tuple(modes), omega_s, cd, governing)
+
+
+def _screen_mode(line, k, w_n, vr, wk, psi, shape, q, d, m_t, omega_s, t, stiff):
+    """The :class:`StrummingMode` of mode k (see :func:`strumming_screen`)."""
+    zeta = np.broadcast_to(np.asarray(line.structural_damping, dtype=float), wk.shape)
+    xi = float(wk @ zeta) + hydrodynamic_damping_ratio(
+        line.rho, wk @ d, wk @ m_t, line.viscosity, w_n
+    )
+    st = float(wk @ np.asarray(line.strouhal))
+    sg = reduced_damping(wk @ m_t, xi, line.rho, wk @ d, st)
+    params = wake_parameters(sg, xi)
+    lift0 = np.asarray(line.lift, dtype=float)
+    res = lock_in_balance(w_n, xi, psi, q, d, omega_s, lift0, params)
+    ws_mode = float(wk @ omega_s)
+    if res.locked:
+        amp, omega, bound = res.amplitude, res.omega, 1.0
+    else:
+        f = abs(np.sum(q * psi * lift0))
+        amp = f / abs(w_n**2 - ws_mode**2 + 2j * xi * w_n * ws_mode)
+        omega, bound = ws_mode, 2.0
+    disp = amp * shape
+    live = q > 0
+    a_over_d = bound * float(np.max(np.abs(amp * psi[live]) / d[live]))
+    tension = stiff * np.abs(np.einsum("ek,ek->e", t, shape[1:] - shape[:-1])) * amp
+    return StrummingMode(
+        index=k,
+        omega_n=float(w_n),
+        omega_s=ws_mode,
+        omega=float(omega),
+        reduced_velocity=float(vr),
+        locked=bool(res.locked),
+        amplitude_over_d=a_over_d,
+        damping_ratio=float(xi),
+        reduced_damping=float(sg),
+        displacement=disp,
+        tension_range=2.0 * tension,
+        cycle_rate=float(omega) / (2.0 * math.pi),
+    )
