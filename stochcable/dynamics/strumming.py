@@ -27,43 +27,32 @@ from stochcable.line.strumming import (
 from stochcable.line.strumming_modes import modes_by_node, out_of_plane_modes
 from stochcable.scene.model import Scene
 
-__all__ = ["with_strumming"]
+__all__ = ["strumming_inputs", "with_strumming"]
 
 
-def with_strumming(scene: Scene, system: LineSystem) -> tuple[LineSystem, StrummingTable | None]:
-    """Screen ``system`` for strumming; the system with the amplified drag.
+def strumming_inputs(
+    scene: Scene, system: LineSystem
+) -> tuple[StrummingInput, np.ndarray, np.ndarray] | None:
+    """What :func:`with_strumming` screens: the line's data and its modes.
 
     Parameters
     ----------
     scene : Scene
-        The scene (environment: density, viscosity, current).
     system : LineSystem
-        The line's linear model about its static shape (modes with added mass).
 
     Returns
     -------
-    system : LineSystem
-        ``system`` with ``model.mesh.cd_normal`` amplified where the line strums (the
-        same object when nothing strums).
-    table : StrummingTable or None
-        The screening; None without current or with every segment suppressed.
-
-    Notes
-    -----
-    Modes: the system's (global x, y, z per node), computed further up when they stop
-    below the highest frequency a lock-in band can reach (V_R = 3: ω_n = 2π U/(3D));
-    a 2-D model adds its out-of-plane modes
-    (:func:`~stochcable.line.strumming_modes.out_of_plane_modes`).  A physics warning
-    names every locked-in mode, the band and the fix.
+    (StrummingInput, omega [rad/s], shapes (n_nodes, 3, count) [kg^-1/2]) or None
+        None without current or with every segment suppressed.
     """
     env = scene.environment
     if not any(p.speed > 0 for p in env.current):
-        return system, None
+        return None
     model, mesh, line = system.model, system.model.mesh, system.line
     settings = [sg.strumming for sg in line.segments]
     on = np.array([s is None or s.suppression == "none" for s in settings])[mesh.segment]
     if not on.any():
-        return system, None
+        return None
     pick = np.asarray(mesh.segment)
 
     def per_el(attr: str, default: float) -> np.ndarray:
@@ -96,6 +85,40 @@ def with_strumming(scene: Scene, system: LineSystem) -> tuple[LineSystem, Strumm
         viscosity=env.viscosity,
         structural_damping=per_el("damping_ratio", 0.0),
     )
+    return inp, omega, shapes
+
+
+def with_strumming(scene: Scene, system: LineSystem) -> tuple[LineSystem, StrummingTable | None]:
+    """Screen ``system`` for strumming; the system with the amplified drag.
+
+    Parameters
+    ----------
+    scene : Scene
+        The scene (environment: density, viscosity, current).
+    system : LineSystem
+        The line's linear model about its static shape (modes with added mass).
+
+    Returns
+    -------
+    system : LineSystem
+        ``system`` with ``model.mesh.cd_normal`` amplified where the line strums (the
+        same object when nothing strums).
+    table : StrummingTable or None
+        The screening; None without current or with every segment suppressed.
+
+    Notes
+    -----
+    Modes: the system's (global x, y, z per node), computed further up when they stop
+    below the highest frequency a lock-in band can reach (V_R = 3: ω_n = 2π U/(3D));
+    a 2-D model adds its out-of-plane modes
+    (:func:`~stochcable.line.strumming_modes.out_of_plane_modes`).  A physics warning
+    names every locked-in mode, the band and the fix.
+    """
+    got = strumming_inputs(scene, system)
+    if got is None:
+        return system, None
+    inp, omega, shapes = got
+    mesh, line = system.model.mesh, system.line
     table = strumming_screen(inp, omega, shapes)
     cd0 = np.asarray(mesh.cd_normal, dtype=float)
     gain = float(np.max(np.divide(table.cd_normal, cd0, out=np.ones_like(cd0), where=cd0 > 0)))
@@ -111,5 +134,5 @@ def with_strumming(scene: Scene, system: LineSystem) -> tuple[LineSystem, Strumm
         )
     if table.governing is None or np.array_equal(table.cd_normal, mesh.cd_normal):
         return system, table
-    new_model = replace(model, mesh=replace(mesh, cd_normal=table.cd_normal))
+    new_model = replace(system.model, mesh=replace(mesh, cd_normal=table.cd_normal))
     return replace(system, model=new_model), table

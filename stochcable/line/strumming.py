@@ -38,6 +38,8 @@ __all__ = [
     "reduced_damping",
     "drag_amplification_vandiver",
     "StrummingInput",
+    "ElementFlow",
+    "element_flow",
     "StrummingMode",
     "StrummingTable",
     "strumming_screen",
@@ -363,6 +365,67 @@ class StrummingTable:
         }
 
 
+@dataclass(frozen=True, eq=False)
+class ElementFlow:
+    """The steady flow past every element (:func:`element_flow`).
+
+    Attributes
+    ----------
+    tangent, lift_direction : ndarray, shape (n_el, 3)
+        Unit tangent t and lift direction l = t × U_n/|U_n| (zero without flow). [-]
+    speed : ndarray, shape (n_el,)
+        Normal flow speed |U_n|. [m/s]
+    length : ndarray, shape (n_el,)
+        Static (stretched) element length. [m]
+    lift_on : ndarray of bool, shape (n_el,)
+        Elements that shed vortices (flow and C_L0 > 0).
+    omega_s : ndarray, shape (n_el,)
+        Shedding frequency (0 where the lift is off). [rad/s]
+    q : ndarray, shape (n_el,)
+        ½ρ D U_n² L, the lift force per unit C_L (0 where the lift is off). [N]
+    """
+
+    tangent: np.ndarray
+    lift_direction: np.ndarray
+    speed: np.ndarray
+    length: np.ndarray
+    lift_on: np.ndarray
+    omega_s: np.ndarray
+    q: np.ndarray
+
+    def along_lift(self, shape: np.ndarray) -> np.ndarray:
+        """ψ_e = ½(φ_a + φ_b)·l_e of one node field ``shape`` (n_nodes, 3). [same unit]"""
+        mid = 0.5 * (np.asarray(shape)[:-1] + np.asarray(shape)[1:])
+        return np.einsum("ek,ek->e", self.lift_direction, mid)
+
+
+def element_flow(line: StrummingInput) -> ElementFlow:
+    """Normal flow, lift direction, shedding frequency and lift load of every element.
+
+    Parameters
+    ----------
+    line : StrummingInput
+
+    Returns
+    -------
+    ElementFlow
+    """
+    pos = np.asarray(line.positions, dtype=float)
+    seg = np.diff(pos, axis=0)
+    length = np.linalg.norm(seg, axis=1)
+    t = seg / length[:, None]
+    u = np.asarray(line.current, dtype=float)
+    u_n = u - np.einsum("ij,ij->i", u, t)[:, None] * t
+    speed = np.linalg.norm(u_n, axis=1)
+    lift_on = (speed > 0) & (np.asarray(line.lift) > 0)
+    ldir = np.zeros_like(t)
+    ldir[lift_on] = np.cross(t[lift_on], u_n[lift_on]) / speed[lift_on, None]
+    d = np.asarray(line.diameter, dtype=float)
+    omega_s = np.where(lift_on, shedding_frequency(speed, d, line.strouhal), 0.0)
+    q = np.where(lift_on, 0.5 * line.rho * d * speed**2 * length, 0.0)
+    return ElementFlow(t, ldir, speed, length, lift_on, omega_s, q)
+
+
 def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
     """Screen one line in a steady current for strumming.
 
@@ -392,22 +455,12 @@ def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
     that.  The drag of element e is amplified with Y_rms = A|ψ_e|/√2 of the governing
     (locked-in) mode.
     """
-    pos = np.asarray(line.positions, dtype=float)
+    flow = element_flow(line)
     w_n = np.asarray(omega_n, dtype=float)
     phi = np.asarray(shapes, dtype=float)
-    n_el = pos.shape[0] - 1
-    seg = np.diff(pos, axis=0)
-    length = np.linalg.norm(seg, axis=1)
-    t = seg / length[:, None]
-    u = np.asarray(line.current, dtype=float)
-    u_n = u - np.einsum("ij,ij->i", u, t)[:, None] * t
-    speed = np.linalg.norm(u_n, axis=1)
-    lift_on = (speed > 0) & (np.asarray(line.lift) > 0)
-    ldir = np.zeros((n_el, 3))
-    ldir[lift_on] = np.cross(t[lift_on], u_n[lift_on]) / speed[lift_on, None]
+    t, ldir, speed = flow.tangent, flow.lift_direction, flow.speed
+    lift_on, omega_s, q, length = flow.lift_on, flow.omega_s, flow.q, flow.length
     d = np.asarray(line.diameter, dtype=float)
-    omega_s = np.where(lift_on, shedding_frequency(speed, d, line.strouhal), 0.0)
-    q = np.where(lift_on, 0.5 * line.rho * d * speed**2 * length, 0.0)
     m_t = np.asarray(line.mass) + np.asarray(line.ca_normal) * line.rho * math.pi * d**2 / 4
     cd0 = np.asarray(line.cd_normal, dtype=float)
     if not np.any(lift_on) or w_n.size == 0:

@@ -38,8 +38,10 @@ __all__ = ["WakeParameters", "wake_parameters", "wake_response", "LockIn", "lock
 #: reaches ~1e-12 on a true root, a local minimum that is not a root stays above ~1e-3).
 _ROOT_TOL = 1.0e-7
 #: Largest relative residual of a grid point refined by least squares (a root's
-#: neighbours on the 16 x 29 grid stay below ~0.05). [-]
+#: neighbours on the 20 x 29 grid stay below ~0.05). [-]
 _START_TOL = 0.5
+#: Most local minima of the grid refined. [-]
+_STARTS = 4
 
 
 @dataclass(frozen=True)
@@ -226,14 +228,15 @@ def lock_in_balance(
     -------
     LockIn
         ``locked`` False (amplitude 0) when no first-harmonic solution exists within
-        ω/ω_n ∈ [0.65, 1.35] and A·max|ψ|/D ∈ [1e-4, 5].
+        ω/ω_n ∈ [0.65, 1.35] and A·max|ψ|/D ∈ [1e-3, 3].
 
     Notes
     -----
     Unknowns A (real, the phase reference) and ω; the complex modal balance
     (ω_n² − ω² + 2iξω_nω) A = Σ_e q_e ψ_e c_e(A ψ_e iω/D_e, ω) (the wakes by
-    :func:`wake_response`) is solved by least squares in (ln A, ω) from the best
-    points of a coarse grid, on the scale-free residual |ZA − L|/(|ZA| + |L|).
+    :func:`wake_response`) is solved by least squares in (ln A, ω) from the local
+    minima of a coarse grid, on the scale-free residual |ZA − L|/(|ZA| + |L|); of
+    several roots the largest amplitude is taken.
     """
     psi = np.asarray(psi, dtype=float)
     q = np.asarray(q, dtype=float)
@@ -253,7 +256,7 @@ def lock_in_balance(
         z = (left - right) / (abs(left) + abs(right))
         return np.array([z.real, z.imag])
 
-    ln_a = np.log(np.geomspace(1e-4, 5.0, 16) / y_scale)
+    ln_a = np.log(np.geomspace(1e-3, 3.0, 20) / y_scale)
     ratio = np.linspace(0.65, 1.35, 29)
     aa, rr = np.meshgrid(np.exp(ln_a), ratio * omega_n, indexing="ij")
     a_, w_ = aa.reshape(-1, 1), rr.reshape(-1, 1)
@@ -262,10 +265,27 @@ def lock_in_balance(
     right = c @ (qs * ps)
     z = (left - right) / (np.abs(left) + np.abs(right))
     grid = np.abs(z).reshape(aa.shape)
+    # starts: the grid's local minima below _START_TOL (a grid point farther than that
+    # from a root is not refined: the balance is smooth on the grid's scale except at
+    # branch switches, where a root has |z| << 1 nearby), best first
+    pad = np.pad(grid, 1, constant_values=np.inf)
+    neigh = np.min(
+        [
+            pad[1 + di : 1 + di + grid.shape[0], 1 + dj : 1 + dj + grid.shape[1]]
+            for di in (-1, 0, 1)
+            for dj in (-1, 0, 1)
+            if di or dj
+        ],
+        axis=0,
+    )
+    minima = np.flatnonzero(((grid <= neigh) & (grid < _START_TOL)).ravel())
+    starts = list(minima[np.argsort(grid.ravel()[minima])][:_STARTS])
+    # and the best points overall (a root at a branch switch of the wakes sits on a
+    # slope of the grid, not in a local minimum of it)
+    starts += [f for f in np.argsort(grid, axis=None)[:3] if grid.flat[f] < _START_TOL]
+    starts = list(dict.fromkeys(int(f) for f in starts))
     best = (np.array([ln_a[0], 1.0]), math.inf)
-    # a grid point farther than this from a root is not refined: the balance is smooth
-    # on the grid's scale except at branch switches, where a root has |z| << 1 nearby
-    starts = [f for f in np.argsort(grid, axis=None)[:3] if grid.flat[f] < _START_TOL]
+    roots = []
     for flat in starts:
         i, j = np.unravel_index(flat, grid.shape)
         sol = least_squares(
@@ -275,13 +295,17 @@ def lock_in_balance(
             xtol=1e-13,
             ftol=1e-13,
             gtol=1e-13,
-            max_nfev=40,  # a true root converges in < 20 evaluations
+            max_nfev=100,  # a true root converges in < 60 evaluations
         )
         res = float(np.hypot(*sol.fun))
         if res < best[1]:
             best = (sol.x, res)
         if res < _ROOT_TOL:
-            break
+            roots.append((sol.x, res))
+    if roots:
+        # several branches: the largest amplitude is the one a run from rest reaches
+        # (the wakes are self-excited; tests/test_strumming.py)
+        best = max(roots, key=lambda r: r[0][0])
     x, res = best
     if res >= _ROOT_TOL:
         return LockIn(False, 0.0, float(omega_n), np.zeros(psi.size, complex), res)
