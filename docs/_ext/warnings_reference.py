@@ -240,6 +240,22 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Read the coupled modes from ``stochcable analyze`` under ``bodies.<name>.modes``.",
     ),
     WarningEntry(
+        "Strumming lock-in predicted",
+        "PhysicsWarning",
+        ("stochcable.dynamics.strumming:with_strumming",),
+        "a mode whose reduced velocity V_R = 2πU_n/(ω_n D) is inside the cross-flow band "
+        "3 ≤ V_R ≤ 16 (DNV-RP-C205 ch. 9) and for which the wake-oscillator harmonic "
+        "balance has a locked-in solution",
+        "The line vibrates across the current at the mode's frequency with the amplitude "
+        "A/D the message gives (the result's ``lines.<line>.strumming`` table); the "
+        "normal drag coefficient is amplified (Vandiver 1983) in the drag linearization "
+        "of every sea state, and the mode's tension range and cycle rate add a "
+        "high-frequency fatigue component. See :doc:`../strumming`.",
+        "Fit strakes or fairings on the segments concerned "
+        "(``segments[i].strumming.suppression``), or move the mode out of the band "
+        "(pretension, diameter); check the amplitude with a time-domain VIV analysis.",
+    ),
+    WarningEntry(
         "Compiled sea kernel unavailable or not cached",
         "UserWarning",
         ("stochcable.sea.kernels:_compile", "stochcable.sea.realization:_compiled_kernel"),
