@@ -203,8 +203,7 @@ _LINES = {
     "lines.<line>.strumming.modes[].reduced_damping": ("-", "Skop–Griffin S_G = 2π St² k_s."),
     "lines.<line>.strumming.modes[].tension_range": (
         "{F}",
-        "Peak-to-peak dynamic tension of the mode per element (a narrow-band fatigue "
-        "component).",
+        "Peak-to-peak dynamic tension of the mode per element (a narrow-band fatigue component).",
     ),
     "lines.<line>.strumming.modes[].cycle_rate": ("1/s", "Its cycles per second ω/2π."),
     "lines.<line>.strumming.governing": (
