@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from stochcable.design.curves import FatigueCurve
 from stochcable.dynamics.engine import build_engine
 from stochcable.dynamics.strumming import strumming_inputs
 from stochcable.dynamics.system import build_line_system
@@ -261,6 +262,12 @@ def test_locked_in_string_amplifies_drag_warns_and_reports():
     row = doc["modes"][table.governing]
     assert row["locked"] and row["cycle_rate"] == pytest.approx(mode.omega / (2 * math.pi))
     assert len(row["tension_range"]) == 4 and max(row["tension_range"]) > 0
+    # the narrow-band fatigue component: ν (ΔT/A)^m / a of a one-slope curve
+    curve = FatigueCurve("test", "one slope", "stress", (3.0,), (12.0 + 18.0,))
+    area = math.pi * 0.01524**2 / 4
+    rate = mode.damage_rate(curve, 1.0 / area)
+    expected = mode.cycle_rate * (mode.tension_range / area) ** 3 / 10.0**30
+    assert np.allclose(rate, expected, rtol=1e-12)
 
 
 def test_suppression_turns_strumming_off():

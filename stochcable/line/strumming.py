@@ -10,7 +10,8 @@ candidates are balanced with the Skop–Griffin wake oscillator
 *locked in* and vibrates at its steady amplitude; one without is an *unlocked* mode
 driven by the free wakes (C_L = C_L0 at ω_s), whose response is bounded by twice the
 forced amplitude (the beat from rest, seed 001 Example 6).  The vibration of a
-locked-in mode magnifies the in-line drag: C_d/C_d0 = 1 + 1.043 (2 Y_rms/D)^0.65 (Vandiver 1983,
+locked-in mode magnifies the in-line drag: C_d/C_d0 = 1 + 1.043 (2 Y_rms/D)^0.65
+(Vandiver 1983,
 :func:`drag_amplification_vandiver`).
 
 :func:`strumming_screen` is the one entry point: one line's static shape, sections,
@@ -24,8 +25,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stochcable.design.curves import FatigueCurve
 from stochcable.errors import InputError
-from stochcable.line.strumming_balance import lock_in_balance, wake_parameters
+from stochcable.line.strumming_balance import (
+    CROSS_FLOW_BAND,
+    LIFT_DEFAULT,
+    STROUHAL_DEFAULT,
+    _check_positive,
+    drag_amplification_vandiver,
+    hydrodynamic_damping_ratio,
+    lock_in_balance,
+    reduced_damping,
+    reduced_velocity,
+    shedding_frequency,
+    wake_parameters,
+)
 from stochcable.validation import finite_scalar
 
 __all__ = [
@@ -45,172 +59,9 @@ __all__ = [
     "strumming_screen",
 ]
 
-#: Cross-flow lock-in band of the reduced velocity V_R = U/(f_n D), DNV-RP-C205
-#: (2010) ch. 9 "Vortex induced oscillations" (cross-flow VIV for 3 ≤ V_R ≤ 16). [-]
-CROSS_FLOW_BAND = (3.0, 16.0)
-#: Strouhal number of a circular cylinder, subcritical 300 < Re < 2·10⁵ (Blevins 1990
-#: Fig. 3-5; DNV-RP-C205 Fig. 9-2). [-]
-STROUHAL_DEFAULT = 0.2
-#: Lift-coefficient amplitude of the fixed cylinder (seed 001 Example 6). [-]
-LIFT_DEFAULT = 0.2
 #: Candidate modes balanced per line (nearest to the shedding frequency, seed 001
 #: §3.2.b: "the natural frequency having a value closest to the shedding frequency"). [-]
 _CANDIDATES = 3
-
-
-def shedding_frequency(speed, diameter, strouhal=STROUHAL_DEFAULT):
-    """Vortex-shedding frequency ω_s = 2π St U_n/D.
-
-    Parameters
-    ----------
-    speed : float or array_like
-        Normal flow speed U_n (>= 0). [m/s]
-    diameter : float or array_like
-        Diameter (> 0). [m]
-    strouhal : float or array_like, optional
-        Strouhal number St (> 0). [-]
-
-    Returns
-    -------
-    float or ndarray
-        ω_s. [rad/s]
-
-    Notes
-    -----
-    Seed 001 eq. 3.2.b.4.
-    """
-    u = np.asarray(speed, dtype=float)
-    d = np.asarray(diameter, dtype=float)
-    st = np.asarray(strouhal, dtype=float)
-    _check_positive("strouhal", st, "-")
-    _check_positive("diameter", d, "m")
-    if np.any(~np.isfinite(u)) or np.any(u < 0):
-        raise InputError("speed", speed, "m/s", "must be finite and >= 0")
-    out = 2.0 * math.pi * st * u / d
-    return float(out) if out.ndim == 0 else out
-
-
-def reduced_velocity(speed, omega_n, diameter):
-    """Reduced velocity V_R = U_n/(f_n D) = 2π U_n/(ω_n D).
-
-    Parameters
-    ----------
-    speed : float or array_like
-        Normal flow speed. [m/s]
-    omega_n : float or array_like
-        Natural frequency (> 0). [rad/s]
-    diameter : float or array_like
-        Diameter (> 0). [m]
-
-    Returns
-    -------
-    float or ndarray
-        V_R. [-]
-    """
-    _check_positive("omega_n", np.asarray(omega_n, dtype=float), "rad/s")
-    _check_positive("diameter", np.asarray(diameter, dtype=float), "m")
-    out = 2.0 * math.pi * np.asarray(speed, dtype=float) / (np.asarray(omega_n) * diameter)
-    return float(out) if np.ndim(out) == 0 else out
-
-
-def hydrodynamic_damping_ratio(rho, diameter, mass, viscosity, omega_n):
-    """Still-water viscous damping ratio of a cylinder vibrating at ω_n.
-
-    Parameters
-    ----------
-    rho : float
-        Water density (> 0). [kg/m³]
-    diameter : float
-        Diameter (> 0). [m]
-    mass : float
-        Mass per length, structural + added (> 0). [kg/m]
-    viscosity : float
-        Kinematic viscosity ν (> 0). [m²/s]
-    omega_n : float
-        Natural frequency (> 0). [rad/s]
-
-    Returns
-    -------
-    float
-        ξ = (12 ρ D/(π m)) √(ν/ω_n). [-]
-
-    Notes
-    -----
-    Seed 001 eq. 3.2.b.8.
-    """
-    for name, v, unit in (
-        ("rho", rho, "kg/m³"),
-        ("diameter", diameter, "m"),
-        ("mass", mass, "kg/m"),
-        ("viscosity", viscosity, "m²/s"),
-        ("omega_n", omega_n, "rad/s"),
-    ):
-        if not finite_scalar(name, v, unit) > 0:
-            raise InputError(name, v, unit, "must be > 0")
-    return 12.0 * rho * diameter / (math.pi * mass) * math.sqrt(viscosity / omega_n)
-
-
-def reduced_damping(mass, damping_ratio, rho, diameter, strouhal=STROUHAL_DEFAULT):
-    """Skop–Griffin reduced damping S_G = 2π St² k_s, k_s = 4π m ξ/(ρ D²).
-
-    Parameters
-    ----------
-    mass : float
-        Mass per length, structural + added. [kg/m]
-    damping_ratio : float
-        ξ of the mode (structural + hydrodynamic, > 0). [-]
-    rho : float
-        Water density. [kg/m³]
-    diameter : float
-        Diameter. [m]
-    strouhal : float, optional
-        St. [-]
-
-    Returns
-    -------
-    float
-        S_G. [-]
-
-    Notes
-    -----
-    Seed 001 eq. 3.2.b.6 (Griffin, Skop & Ramberg 1975).
-    """
-    if not finite_scalar("damping_ratio", damping_ratio, "-") > 0:
-        raise InputError("damping_ratio", damping_ratio, "-", "must be > 0")
-    ks = 4.0 * math.pi * mass * damping_ratio / (rho * diameter**2)
-    return 2.0 * math.pi * strouhal**2 * ks
-
-
-def drag_amplification_vandiver(y_rms_over_d):
-    """In-line drag amplification of a vibrating cable, C_d/C_d0.
-
-    Parameters
-    ----------
-    y_rms_over_d : float or array_like
-        RMS cross-flow displacement over the diameter (>= 0). [-]
-
-    Returns
-    -------
-    float or ndarray
-        1 + 1.043 (2 Y_rms/D)^0.65. [-]
-
-    Notes
-    -----
-    Vandiver, J. K. (1983), "Drag coefficients of long flexible cylinders", OTC 4490,
-    fitted to field data of strumming cables; the magnification the seed names (Skop,
-    Griffin and Ramberg 1977) and leaves for future study (seed 001 ch. 7).
-    """
-    y = np.asarray(y_rms_over_d, dtype=float)
-    if np.any(~np.isfinite(y)) or np.any(y < 0):
-        raise InputError("y_rms_over_d", y_rms_over_d, "-", "must be finite and >= 0")
-    out = 1.0 + 1.043 * (2.0 * y) ** 0.65
-    return float(out) if out.ndim == 0 else out
-
-
-def _check_positive(name: str, value: np.ndarray, unit: str) -> None:
-    if np.any(~np.isfinite(value)) or np.any(value <= 0):
-        bad = value if value.ndim == 0 else value[~(np.isfinite(value) & (value > 0))][0]
-        raise InputError(name, float(bad), unit, "must be finite and > 0")
 
 
 @dataclass(frozen=True, eq=False)
@@ -308,6 +159,28 @@ class StrummingMode:
     displacement: np.ndarray
     tension_range: np.ndarray
     cycle_rate: float
+
+    def damage_rate(self, curve: FatigueCurve, to_quantity: float) -> np.ndarray:
+        """Miner damage per second of the strumming cycles, per element.
+
+        Parameters
+        ----------
+        curve : FatigueCurve
+            The fatigue curve (:func:`stochcable.design.curves.fatigue_curve`).
+        to_quantity : float
+            Factor from tension to the curve's quantity
+            (:func:`stochcable.design.curves.tension_to_curve_quantity`). [1/m² or 1/N]
+
+        Returns
+        -------
+        ndarray, shape (n_el,)
+            ν / N(S), S = ``to_quantity`` · tension range: the constant-amplitude
+            narrow-band component to add to the wave-frequency damage rate. [1/s]
+        """
+        if not isinstance(curve, FatigueCurve):
+            raise InputError("curve", type(curve).__name__, "-", "must be a FatigueCurve")
+        ranges = finite_scalar("to_quantity", to_quantity, "-") * self.tension_range
+        return self.cycle_rate / curve.cycles_to_failure(ranges)
 
     def as_dict(self) -> dict:
         """JSON-ready dict (SI: rad/s, m, N, 1/s)."""

@@ -1,4 +1,6 @@
-"""The Skop–Griffin wake oscillator of seed 001 §3.2.b and its harmonic balance.
+"""The closed forms of strumming (shedding, reduced velocity, damping, drag
+amplification) and the Skop–Griffin wake oscillator of seed 001 §3.2.b with its
+harmonic balance.
 
 The lift coefficient C_L(s, t) of every element obeys the wake oscillator of
 Griffin, Skop & Ramberg (1975) (seed 001 eq. 3.2.b.3)::
@@ -31,7 +33,24 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-__all__ = ["WakeParameters", "wake_parameters", "wake_response", "LockIn", "lock_in_balance"]
+from stochcable.errors import InputError
+from stochcable.validation import finite_scalar
+
+__all__ = [
+    "CROSS_FLOW_BAND",
+    "STROUHAL_DEFAULT",
+    "LIFT_DEFAULT",
+    "shedding_frequency",
+    "reduced_velocity",
+    "hydrodynamic_damping_ratio",
+    "reduced_damping",
+    "drag_amplification_vandiver",
+    "WakeParameters",
+    "wake_parameters",
+    "wake_response",
+    "LockIn",
+    "lock_in_balance",
+]
 
 #: Relative residual below which a harmonic-balance root is accepted (the modal
 #: balance |Z A − L|/(|Z A| + |L|), structure term Z A and lift term L; least_squares
@@ -42,6 +61,171 @@ _ROOT_TOL = 1.0e-7
 _START_TOL = 0.5
 #: Most local minima of the grid refined. [-]
 _STARTS = 4
+
+
+#: Cross-flow lock-in band of the reduced velocity V_R = U/(f_n D), DNV-RP-C205
+#: (2010) ch. 9 "Vortex induced oscillations" (cross-flow VIV for 3 ≤ V_R ≤ 16). [-]
+CROSS_FLOW_BAND = (3.0, 16.0)
+#: Strouhal number of a circular cylinder, subcritical 300 < Re < 2·10⁵ (Blevins 1990
+#: Fig. 3-5; DNV-RP-C205 Fig. 9-2). [-]
+STROUHAL_DEFAULT = 0.2
+#: Lift-coefficient amplitude of the fixed cylinder (seed 001 Example 6). [-]
+LIFT_DEFAULT = 0.2
+
+
+def shedding_frequency(speed, diameter, strouhal=STROUHAL_DEFAULT):
+    """Vortex-shedding frequency ω_s = 2π St U_n/D.
+
+    Parameters
+    ----------
+    speed : float or array_like
+        Normal flow speed U_n (>= 0). [m/s]
+    diameter : float or array_like
+        Diameter (> 0). [m]
+    strouhal : float or array_like, optional
+        Strouhal number St (> 0). [-]
+
+    Returns
+    -------
+    float or ndarray
+        ω_s. [rad/s]
+
+    Notes
+    -----
+    Seed 001 eq. 3.2.b.4.
+    """
+    u = np.asarray(speed, dtype=float)
+    d = np.asarray(diameter, dtype=float)
+    st = np.asarray(strouhal, dtype=float)
+    _check_positive("strouhal", st, "-")
+    _check_positive("diameter", d, "m")
+    if np.any(~np.isfinite(u)) or np.any(u < 0):
+        raise InputError("speed", speed, "m/s", "must be finite and >= 0")
+    out = 2.0 * math.pi * st * u / d
+    return float(out) if out.ndim == 0 else out
+
+
+def reduced_velocity(speed, omega_n, diameter):
+    """Reduced velocity V_R = U_n/(f_n D) = 2π U_n/(ω_n D).
+
+    Parameters
+    ----------
+    speed : float or array_like
+        Normal flow speed. [m/s]
+    omega_n : float or array_like
+        Natural frequency (> 0). [rad/s]
+    diameter : float or array_like
+        Diameter (> 0). [m]
+
+    Returns
+    -------
+    float or ndarray
+        V_R. [-]
+    """
+    _check_positive("omega_n", np.asarray(omega_n, dtype=float), "rad/s")
+    _check_positive("diameter", np.asarray(diameter, dtype=float), "m")
+    out = 2.0 * math.pi * np.asarray(speed, dtype=float) / (np.asarray(omega_n) * diameter)
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def hydrodynamic_damping_ratio(rho, diameter, mass, viscosity, omega_n):
+    """Still-water viscous damping ratio of a cylinder vibrating at ω_n.
+
+    Parameters
+    ----------
+    rho : float
+        Water density (> 0). [kg/m³]
+    diameter : float
+        Diameter (> 0). [m]
+    mass : float
+        Mass per length, structural + added (> 0). [kg/m]
+    viscosity : float
+        Kinematic viscosity ν (> 0). [m²/s]
+    omega_n : float
+        Natural frequency (> 0). [rad/s]
+
+    Returns
+    -------
+    float
+        ξ = (12 ρ D/(π m)) √(ν/ω_n). [-]
+
+    Notes
+    -----
+    Seed 001 eq. 3.2.b.8.
+    """
+    for name, v, unit in (
+        ("rho", rho, "kg/m³"),
+        ("diameter", diameter, "m"),
+        ("mass", mass, "kg/m"),
+        ("viscosity", viscosity, "m²/s"),
+        ("omega_n", omega_n, "rad/s"),
+    ):
+        if not finite_scalar(name, v, unit) > 0:
+            raise InputError(name, v, unit, "must be > 0")
+    return 12.0 * rho * diameter / (math.pi * mass) * math.sqrt(viscosity / omega_n)
+
+
+def reduced_damping(mass, damping_ratio, rho, diameter, strouhal=STROUHAL_DEFAULT):
+    """Skop–Griffin reduced damping S_G = 2π St² k_s, k_s = 4π m ξ/(ρ D²).
+
+    Parameters
+    ----------
+    mass : float
+        Mass per length, structural + added. [kg/m]
+    damping_ratio : float
+        ξ of the mode (structural + hydrodynamic, > 0). [-]
+    rho : float
+        Water density. [kg/m³]
+    diameter : float
+        Diameter. [m]
+    strouhal : float, optional
+        St. [-]
+
+    Returns
+    -------
+    float
+        S_G. [-]
+
+    Notes
+    -----
+    Seed 001 eq. 3.2.b.6 (Griffin, Skop & Ramberg 1975).
+    """
+    if not finite_scalar("damping_ratio", damping_ratio, "-") > 0:
+        raise InputError("damping_ratio", damping_ratio, "-", "must be > 0")
+    ks = 4.0 * math.pi * mass * damping_ratio / (rho * diameter**2)
+    return 2.0 * math.pi * strouhal**2 * ks
+
+
+def drag_amplification_vandiver(y_rms_over_d):
+    """In-line drag amplification of a vibrating cable, C_d/C_d0.
+
+    Parameters
+    ----------
+    y_rms_over_d : float or array_like
+        RMS cross-flow displacement over the diameter (>= 0). [-]
+
+    Returns
+    -------
+    float or ndarray
+        1 + 1.043 (2 Y_rms/D)^0.65. [-]
+
+    Notes
+    -----
+    Vandiver, J. K. (1983), "Drag coefficients of long flexible cylinders", OTC 4490,
+    fitted to field data of strumming cables; the magnification the seed names (Skop,
+    Griffin and Ramberg 1977) and leaves for future study (seed 001 ch. 7).
+    """
+    y = np.asarray(y_rms_over_d, dtype=float)
+    if np.any(~np.isfinite(y)) or np.any(y < 0):
+        raise InputError("y_rms_over_d", y_rms_over_d, "-", "must be finite and >= 0")
+    out = 1.0 + 1.043 * (2.0 * y) ** 0.65
+    return float(out) if out.ndim == 0 else out
+
+
+def _check_positive(name: str, value: np.ndarray, unit: str) -> None:
+    if np.any(~np.isfinite(value)) or np.any(value <= 0):
+        bad = value if value.ndim == 0 else value[~(np.isfinite(value) & (value > 0))][0]
+        raise InputError(name, float(bad), unit, "must be finite and > 0")
 
 
 @dataclass(frozen=True)
