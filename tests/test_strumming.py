@@ -320,6 +320,23 @@ def test_out_of_plane_modes_of_a_2d_model_match_the_3d_model():
     assert float(v @ (mt @ v)) == pytest.approx(1.0, rel=1e-9)
 
 
+def test_out_of_plane_modes_sparse_path_matches_dense(monkeypatch):
+    import stochcable.line.strumming_modes as sm
+
+    scene = load_example("chain_catenary")
+    statics = solve_statics(scene, method="fe")
+    model = build_line_system(scene, scene.lines[0], statics.lines["leg1"]).model
+    w_dense, s_dense = out_of_plane_modes(model, 3.0)
+    monkeypatch.setattr(sm, "_DENSE_MAX", 0)
+    w_sparse, s_sparse = out_of_plane_modes(model, 3.0)
+    # 1e-9: shift-invert Lanczos to its default tolerance, the same matrices
+    assert np.allclose(w_sparse, w_dense, rtol=1e-9)
+    # shapes up to sign
+    dots = np.einsum("nm,nm->m", s_sparse[:, 1], s_dense[:, 1])
+    norms = np.linalg.norm(s_sparse[:, 1], axis=0) * np.linalg.norm(s_dense[:, 1], axis=0)
+    assert np.allclose(np.abs(dots) / norms, 1.0, atol=1e-8)
+
+
 def test_strumming_input_checks():
     base = dict(
         positions=np.array([[0.0, 0, 0], [1.0, 0, 0]]),

@@ -11,8 +11,7 @@ candidates are balanced with the Skop–Griffin wake oscillator
 driven by the free wakes (C_L = C_L0 at ω_s), whose response is bounded by twice the
 forced amplitude (the beat from rest, seed 001 Example 6).  The vibration of a
 locked-in mode magnifies the in-line drag: C_d/C_d0 = 1 + 1.043 (2 Y_rms/D)^0.65
-(Vandiver 1983,
-:func:`drag_amplification_vandiver`).
+(Vandiver 1983, :func:`drag_amplification_vandiver`).
 
 :func:`strumming_screen` is the one entry point: one line's static shape, sections,
 current and natural modes in, a :class:`StrummingTable` out.

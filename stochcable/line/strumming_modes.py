@@ -17,11 +17,17 @@ import math
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from stochcable.line.fem import FEModel
 from stochcable.line.modes import Modes
 
 __all__ = ["modes_by_node", "out_of_plane_modes"]
+
+#: Free nodes up to which the out-of-plane problem is solved densely (above: sparse
+#: shift-invert Lanczos, the matrices being tridiagonal). [-]
+_DENSE_MAX = 600
 
 
 def modes_by_node(model: FEModel, modes: Modes) -> np.ndarray:
@@ -71,18 +77,33 @@ def out_of_plane_modes(model: FEModel, omega_max: float) -> tuple[np.ndarray, np
     m_el = mesh.mass * mesh.l0
     ma_el = mesh.ca_normal * model.rho * math.pi * mesh.diameter**2 / 4.0 * mesh.l0
     mt = m_el + ma_el
-    k = np.zeros((n, n))
-    m = np.zeros((n, n))
     i = np.arange(n - 1)
-    for a, b, s in ((i, i, 1.0), (i + 1, i + 1, 1.0), (i, i + 1, -1.0), (i + 1, i, -1.0)):
-        np.add.at(k, (a, b), s * kel)
-        np.add.at(m, (a, b), (mt / 3.0) if s > 0 else (mt / 6.0))
-    m[np.arange(n), np.arange(n)] += mesh.node_mass + mesh.node_added_mass
+    rows = np.concatenate([i, i + 1, i, i + 1])
+    cols = np.concatenate([i, i + 1, i + 1, i])
+    k = sp.csr_array((np.concatenate([kel, kel, -kel, -kel]), (rows, cols)), shape=(n, n))
+    m = sp.csr_array(
+        (np.concatenate([mt / 3.0, mt / 3.0, mt / 6.0, mt / 6.0]), (rows, cols)), shape=(n, n)
+    )
+    m = m + sp.diags_array(mesh.node_mass + mesh.node_added_mass)
     free_nodes = np.unique(np.asarray(model.free) // model.dim)
-    kf = k[np.ix_(free_nodes, free_nodes)]
-    mf = m[np.ix_(free_nodes, free_nodes)]
-    lam, vec = sla.eigh(kf, mf, subset_by_value=(-np.inf, float(omega_max) ** 2))
+    kf = k[free_nodes][:, free_nodes]
+    mf = m[free_nodes][:, free_nodes]
+    top = float(omega_max) ** 2
+    if free_nodes.size <= _DENSE_MAX:
+        lam, vec = sla.eigh(kf.toarray(), mf.toarray(), subset_by_value=(-np.inf, top))
+    else:
+        count = 16
+        while True:
+            count = min(count, free_nodes.size - 1)
+            lam, vec = spla.eigsh(kf.tocsc(), count, mf.tocsc(), sigma=-1e-6 * top, which="LM")
+            order = np.argsort(lam)
+            lam, vec = lam[order], vec[:, order]
+            if lam[-1] > top or count >= free_nodes.size - 1:
+                keep = lam <= top
+                lam, vec = lam[keep], vec[:, keep]
+                break
+            count *= 2
     omega = np.sqrt(np.maximum(lam, 0.0))
     shapes = np.zeros((n, 3, omega.size))
-    shapes[free_nodes, 1, :] = vec  # eigh normalizes vᵀ M v = 1
+    shapes[free_nodes, 1, :] = vec / np.sqrt(np.einsum("im,im->m", vec, mf @ vec))
     return omega, shapes
