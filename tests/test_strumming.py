@@ -15,7 +15,7 @@ from stochcable.design.curves import FatigueCurve
 from stochcable.dynamics.engine import build_engine
 from stochcable.dynamics.strumming import strumming_inputs
 from stochcable.dynamics.system import build_line_system
-from stochcable.errors import InputError
+from stochcable.errors import InputError, ResolutionWarning
 from stochcable.examples import load_example
 from stochcable.line.fem import build_fe_model
 from stochcable.line.modes import natural_modes
@@ -361,3 +361,19 @@ def test_strumming_input_checks():
         StrummingInput(**{**base, "viscosity": -1.0})
     with pytest.raises(InputError, match="damping_ratio"):
         StrummingInput(**{**base, "structural_damping": 1.5})
+
+
+def test_screening_that_stops_below_the_lock_in_range_warns(monkeypatch):
+    import stochcable.dynamics.strumming as ds
+
+    doc = load_example(EXAMPLE).model_dump(exclude_none=True)
+    doc["analysis"]["modes"] = 2  # the system keeps 2 modes (14.1 rad/s at most)
+    monkeypatch.setattr(ds, "MAX_MODES", 2)
+    with pytest.warns(ResolutionWarning, match=r"stops at mode 2 .* below 29.11 rad/s"):
+        build_engine(doc)
+    monkeypatch.setattr(ds, "MAX_MODES", 512)  # computed further up: no warning
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        engine = build_engine(doc)
+    assert not any("stops at mode" in str(w.message) for w in caught)
+    assert engine.strumming["string"].modes[0].index == 1

@@ -256,6 +256,17 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "(pretension, diameter); check the amplitude with a time-domain VIV analysis.",
     ),
     WarningEntry(
+        "Strumming screening stops below the lock-in range",
+        "ResolutionWarning",
+        ("stochcable.dynamics.strumming:strumming_inputs",),
+        "the 3-D model's modes, computed up to MAX_MODES, stay below 2πU/(3D), the "
+        "highest natural frequency the current can lock in (reduced velocity 3)",
+        "Modes above the last one computed are not screened for strumming: a lock-in of "
+        "a high mode of a thin, fast-flowed line may be missed.",
+        "Screen the line alone with fewer elements, or check its high modes separately.",
+        ("stochcable.dynamics.strumming:MAX_MODES",),
+    ),
+    WarningEntry(
         "Compiled sea kernel unavailable or not cached",
         "UserWarning",
         ("stochcable.sea.kernels:_compile", "stochcable.sea.realization:_compiled_kernel"),

@@ -15,7 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from stochcable.dynamics.system import LineSystem
-from stochcable.errors import warn
+from stochcable.errors import ResolutionWarning, warn
 from stochcable.line.modes import natural_modes
 from stochcable.line.strumming import (
     LIFT_DEFAULT,
@@ -27,7 +27,10 @@ from stochcable.line.strumming import (
 from stochcable.line.strumming_modes import modes_by_node, out_of_plane_modes
 from stochcable.scene.model import Scene
 
-__all__ = ["strumming_inputs", "with_strumming"]
+__all__ = ["MAX_MODES", "strumming_inputs", "with_strumming"]
+
+#: Most natural modes of a 3-D model computed for the screening. [-]
+MAX_MODES = 512
 
 
 def strumming_inputs(
@@ -62,8 +65,17 @@ def strumming_inputs(
     w_top = 2.0 * math.pi * u_max / (3.0 * float(np.min(mesh.diameter)))
     modes = system.modes
     n_free = int(model.free.size)
-    while modes.omega.size < n_free and modes.omega[-1] < w_top:
-        modes = natural_modes(model, min(n_free, 2 * modes.omega.size))
+    while modes.omega.size < min(n_free, MAX_MODES) and modes.omega[-1] < w_top:
+        modes = natural_modes(model, min(n_free, MAX_MODES, 2 * modes.omega.size))
+    if modes.omega.size < n_free and modes.omega[-1] < w_top:
+        warn(
+            f"line {line.name!r}: the strumming screening stops at mode {modes.omega.size} "
+            f"({modes.omega[-1]:.4g} rad/s, MAX_MODES = {MAX_MODES}) below "
+            f"{w_top:.4g} rad/s, the highest natural frequency the current can lock in "
+            "(reduced velocity 3): modes above it are not screened; screen the line "
+            "alone with fewer elements or check its high modes separately",
+            ResolutionWarning,
+        )
     omega, shapes = modes.omega, modes_by_node(model, modes)
     if model.dim == 2:
         w_out, s_out = out_of_plane_modes(model, w_top)
