@@ -83,6 +83,8 @@ class Engine:
         ``statics_s``, ``model_s`` and ``build_s`` (the whole build) of the build. [s]
     warnings : tuple of str
         Messages of the warnings raised by the build (repeated in every result).
+    strumming : mapping of StrummingTable or None by line name
+        The strumming screening of every line (:mod:`stochcable.dynamics.strumming`).
     """
 
     scene: Scene
