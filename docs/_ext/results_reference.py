@@ -191,10 +191,15 @@ _LINES = {
     ),
     "lines.<line>.strumming.modes[].reduced_velocity": ("-", "V_R = 2π U_n/(ω_n D)."),
     "lines.<line>.strumming.modes[].locked": ("-", "Whether the wake oscillator locks in."),
+    "lines.<line>.strumming.modes[].resonant": (
+        "-",
+        "Unlocked but ω_s inside the mode's half-power band: the free wakes drive a resonance.",
+    ),
     "lines.<line>.strumming.modes[].amplitude_over_d": (
         "-",
-        "Cross-flow amplitude over D: steady lock-in amplitude, or twice the forced "
-        "amplitude of an unlocked mode (the beat bound).",
+        "Cross-flow amplitude over D: steady lock-in amplitude; resonant: the forced "
+        "amplitude capped by Griffin et al. (1975); otherwise twice the forced amplitude "
+        "(the beat bound).",
     ),
     "lines.<line>.strumming.modes[].damping_ratio": (
         "-",
@@ -208,7 +213,7 @@ _LINES = {
     "lines.<line>.strumming.modes[].cycle_rate": ("1/s", "Its cycles per second ω/2π."),
     "lines.<line>.strumming.governing": (
         "-",
-        "Index in ``modes`` of the locked-in mode that amplifies the drag (null: none).",
+        "Index in ``modes`` of the strumming mode that amplifies the drag (null: none).",
     ),
     "lines.<line>.strumming.cd_normal": (
         "-",

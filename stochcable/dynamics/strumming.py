@@ -136,7 +136,9 @@ def with_strumming(scene: Scene, system: LineSystem) -> tuple[LineSystem, Strumm
     gain = float(np.max(np.divide(table.cd_normal, cd0, out=np.ones_like(cd0), where=cd0 > 0)))
     for m in table.locked:
         warn(
-            f"line {line.name!r}: strumming lock-in predicted for mode {m.index} "
+            f"line {line.name!r}: strumming "
+            f"{'lock-in' if m.locked else 'resonance with the free wakes'} predicted for "
+            f"mode {m.index} "
             f"(ω_n = {m.omega_n:.4g} rad/s, shedding ω_s = {m.omega_s:.4g} rad/s, reduced "
             f"velocity V_R = {m.reduced_velocity:.3g} inside the cross-flow band 3-16 of "
             f"DNV-RP-C205): cross-flow amplitude A/D = {m.amplitude_over_d:.3g}, normal "

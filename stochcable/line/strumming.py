@@ -50,6 +50,7 @@ __all__ = [
     "hydrodynamic_damping_ratio",
     "reduced_damping",
     "drag_amplification_vandiver",
+    "amplitude_griffin",
     "StrummingInput",
     "ElementFlow",
     "element_flow",
@@ -61,6 +62,9 @@ __all__ = [
 #: Candidate modes balanced per line (nearest to the shedding frequency, seed 001
 #: §3.2.b: "the natural frequency having a value closest to the shedding frequency"). [-]
 _CANDIDATES = 3
+#: Least share of a mode's modal mass that moves across the flow on shedding elements
+#: for it to be a candidate (an in-line or axial mode is not excited by the lift). [-]
+_MIN_SHARE = 0.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -133,9 +137,14 @@ class StrummingMode:
         V_R = 2π U_n/(ω_n D), ψ²-weighted. [-]
     locked : bool
         Whether the wake oscillator locks in (a harmonic-balance solution exists).
+    resonant : bool
+        Unlocked, but ω_s within the mode's half-power band |ω_s − ω_n| ≤ 2ξω_n: the
+        free wakes drive a steady resonance (amplitude capped by
+        :func:`amplitude_griffin`).
     amplitude_over_d : float
-        Largest cross-flow amplitude over the diameter: steady lock-in amplitude, or
-        for an unlocked mode the beat bound (twice the forced amplitude). [-]
+        Largest cross-flow amplitude over the diameter: steady lock-in amplitude; for a
+        resonant mode the forced amplitude capped by :func:`amplitude_griffin`; for
+        another unlocked mode the beat bound (twice the forced amplitude). [-]
     damping_ratio, reduced_damping : float
         ξ (structural + hydrodynamic) and S_G of the mode. [-]
     displacement : ndarray, shape (n_nodes, 3)
@@ -152,6 +161,7 @@ class StrummingMode:
     omega: float
     reduced_velocity: float
     locked: bool
+    resonant: bool
     amplitude_over_d: float
     damping_ratio: float
     reduced_damping: float
@@ -190,6 +200,7 @@ class StrummingMode:
             "omega": self.omega,
             "reduced_velocity": self.reduced_velocity,
             "locked": self.locked,
+            "resonant": self.resonant,
             "amplitude_over_d": self.amplitude_over_d,
             "damping_ratio": self.damping_ratio,
             "reduced_damping": self.reduced_damping,
@@ -212,9 +223,10 @@ class StrummingTable:
         Normal drag coefficient amplified by the governing mode's vibration. [-]
     governing : int or None
         Position in ``modes`` of the mode whose amplitude amplifies the drag: the
-        locked-in mode of largest amplitude (None when no mode locks in: an unlocked
-        mode's wakes drift in phase along the line and its response stays small and
-        incoherent, tests/test_strumming.py, so the drag is not amplified).
+        strumming (locked-in or resonant) mode of largest amplitude.  None when no mode
+        strums: an unlocked, non-resonant mode's wakes drift in phase along the line
+        and its response decays (seed 001 Example 6, tests/test_strumming.py), so the
+        drag is not amplified.
     """
 
     modes: tuple[StrummingMode, ...]
@@ -224,8 +236,8 @@ class StrummingTable:
 
     @property
     def locked(self) -> tuple[StrummingMode, ...]:
-        """The locked-in modes."""
-        return tuple(m for m in self.modes if m.locked)
+        """The modes that strum: locked in, or resonant with the free wakes."""
+        return tuple(m for m in self.modes if m.locked or m.resonant)
 
     def as_dict(self) -> dict:
         """JSON-ready dict for the result document."""
@@ -318,7 +330,8 @@ def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
     -----
     Per element: tangent t, normal flow U_n = U − (U·t)t, lift direction
     l = t × U_n/|U_n|, ω_s = 2π St |U_n|/D.  Per mode: ψ_e = ½(φ_a + φ_b)·l_e, the
-    ψ²-weighted U_n, D, m_T = m + C_a ρπD²/4 and ω_s; V_R (:func:`reduced_velocity`)
+    ψ²-weighted U_n, D, m_T = m + C_a ρπD²/4 and ω_s; a candidate moves at least 5 %
+    of its modal mass Σ m_T L ψ² across the flow and has V_R (:func:`reduced_velocity`)
     in :data:`CROSS_FLOW_BAND`; ξ = structural + :func:`hydrodynamic_damping_ratio`;
     S_G (:func:`reduced_damping`); the balance
     (:func:`~stochcable.line.strumming_balance.lock_in_balance`).  Unlocked: free wakes
@@ -341,8 +354,10 @@ def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
     psi = np.einsum("ek,ekm->em", ldir, mid)  # (n_el, count)
     weight = psi**2 * length[:, None] * lift_on[:, None]
     total = weight.sum(axis=0)
+    # share of the (unit) modal mass moving along the lift directions
+    share = np.einsum("e,em->m", m_t * length * lift_on, psi**2)
     cand = []
-    for k in np.flatnonzero((total > 0) & (w_n > 0)):
+    for k in np.flatnonzero((total > 0) & (w_n > 0) & (share >= _MIN_SHARE)):
         wk = weight[:, k] / total[k]
         vr = reduced_velocity(wk @ speed, w_n[k], wk @ d)
         if CROSS_FLOW_BAND[0] <= vr <= CROSS_FLOW_BAND[1]:
@@ -357,7 +372,7 @@ def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
             )
         )
     governing = None
-    locked = [i for i, m in enumerate(modes) if m.locked]
+    locked = [i for i, m in enumerate(modes) if m.locked or m.resonant]
     if locked:
         governing = max(locked, key=lambda i: modes[i].amplitude_over_d)
     cd = cd0.copy()
@@ -382,15 +397,23 @@ def _screen_mode(line, k, w_n, vr, wk, psi, shape, q, d, m_t, omega_s, t, stiff)
     lift0 = np.asarray(line.lift, dtype=float)
     res = lock_in_balance(w_n, xi, psi, q, d, omega_s, lift0, params)
     ws_mode = float(wk @ omega_s)
+    live = q > 0
+    y_per_a = float(np.max(np.abs(psi[live]) / d[live]))  # Y_max/D per unit A
+    resonant = False
     if res.locked:
         amp, omega, bound = res.amplitude, res.omega, 1.0
     else:
         f = abs(np.sum(q * psi * lift0))
         amp = f / abs(w_n**2 - ws_mode**2 + 2j * xi * w_n * ws_mode)
         omega, bound = ws_mode, 2.0
+        if abs(ws_mode - w_n) <= 2.0 * xi * w_n:
+            # the free wakes drive the mode inside its half-power band: a steady
+            # resonance, capped by the Griffin–Skop–Ramberg response
+            resonant, bound = True, 1.0
+            y_cap = amplitude_griffin(sg, _mode_shape_factor(psi, wk))
+            amp = min(amp, y_cap / y_per_a)
     disp = amp * shape
-    live = q > 0
-    a_over_d = bound * float(np.max(np.abs(amp * psi[live]) / d[live]))
+    a_over_d = float(bound * amp * y_per_a)
     tension = stiff * np.abs(np.einsum("ek,ek->e", t, shape[1:] - shape[:-1])) * amp
     return StrummingMode(
         index=k,
@@ -399,6 +422,7 @@ def _screen_mode(line, k, w_n, vr, wk, psi, shape, q, d, m_t, omega_s, t, stiff)
         omega=float(omega),
         reduced_velocity=float(vr),
         locked=bool(res.locked),
+        resonant=resonant,
         amplitude_over_d=a_over_d,
         damping_ratio=float(xi),
         reduced_damping=float(sg),
@@ -406,3 +430,39 @@ def _screen_mode(line, k, w_n, vr, wk, psi, shape, q, d, m_t, omega_s, t, stiff)
         tension_range=2.0 * tension,
         cycle_rate=float(omega) / (2.0 * math.pi),
     )
+
+
+def _mode_shape_factor(psi: np.ndarray, wk: np.ndarray) -> float:
+    """γ = max|ψ| (Σ w ψ² / Σ w ψ⁴)^½ over the shedding elements (w ∝ ψ²L: use L)."""
+    live = wk > 0
+    length = wk[live] / psi[live] ** 2  # wk = ψ² L / Σ ψ² L, so this is ∝ L
+    p = psi[live]
+    return float(np.max(np.abs(p)) * math.sqrt(np.sum(length * p**2) / np.sum(length * p**4)))
+
+
+def amplitude_griffin(reduced_damping_sg: float, shape_factor: float = 1.0) -> float:
+    """Largest cross-flow amplitude of a locked-in mode over the diameter.
+
+    Parameters
+    ----------
+    reduced_damping_sg : float
+        S_G (>= 0). [-]
+    shape_factor : float, optional
+        Mode-shape factor γ = max|ψ| (∫ψ² / ∫ψ⁴)^½ (1 for a rigid cylinder, √(4/3)
+        for a sine). [-]
+
+    Returns
+    -------
+    float
+        Y/D = 1.29 γ / (1 + 0.43 S_G)^3.35. [-]
+
+    Notes
+    -----
+    Griffin, Skop & Ramberg (1975), OTC 2319 (seed 001 ref. 20): the fit of measured
+    resonant amplitudes of cylinders and cables against S_G that the wake oscillator's
+    parameters (seed 001 eq. 3.2.b.5) were calibrated to.
+    """
+    sg = finite_scalar("reduced_damping", reduced_damping_sg, "-")
+    if sg < 0:
+        raise InputError("reduced_damping", reduced_damping_sg, "-", "must be >= 0")
+    return 1.29 * float(shape_factor) / (1.0 + 0.43 * sg) ** 3.35
