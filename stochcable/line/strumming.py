@@ -139,12 +139,11 @@ class StrummingMode:
         Whether the wake oscillator locks in (a harmonic-balance solution exists).
     resonant : bool
         Unlocked, but ω_s within the mode's half-power band |ω_s − ω_n| ≤ 2ξω_n: the
-        free wakes drive a steady resonance (amplitude capped by
-        :func:`amplitude_griffin`).
+        free wakes drive a steady resonance (amplitude :func:`amplitude_griffin`).
     amplitude_over_d : float
         Largest cross-flow amplitude over the diameter: steady lock-in amplitude; for a
-        resonant mode the forced amplitude capped by :func:`amplitude_griffin`; for
-        another unlocked mode the beat bound (twice the forced amplitude). [-]
+        resonant mode :func:`amplitude_griffin`; for another unlocked mode the beat
+        bound (twice the forced amplitude). [-]
     damping_ratio, reduced_damping : float
         ξ (structural + hydrodynamic) and S_G of the mode. [-]
     displacement : ndarray, shape (n_nodes, 3)
@@ -408,10 +407,10 @@ def _screen_mode(line, k, w_n, vr, wk, psi, shape, q, d, m_t, omega_s, t, stiff)
         omega, bound = ws_mode, 2.0
         if abs(ws_mode - w_n) <= 2.0 * xi * w_n:
             # the free wakes drive the mode inside its half-power band: a steady
-            # resonance, capped by the Griffin–Skop–Ramberg response
+            # resonance at the Griffin–Skop–Ramberg amplitude (the wakes grow beyond
+            # C_L0 there: the forced amplitude with C_L0 is below the time integration)
             resonant, bound = True, 1.0
-            y_cap = amplitude_griffin(sg, _mode_shape_factor(psi, wk))
-            amp = min(amp, y_cap / y_per_a)
+            amp = amplitude_griffin(sg, _mode_shape_factor(psi, wk)) / y_per_a
     disp = amp * shape
     a_over_d = float(bound * amp * y_per_a)
     tension = stiff * np.abs(np.einsum("ek,ek->e", t, shape[1:] - shape[:-1])) * amp
