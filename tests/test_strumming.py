@@ -28,6 +28,7 @@ from stochcable.line.strumming import (
     reduced_damping,
     reduced_velocity,
     shedding_frequency,
+    strouhal_roshko,
     strumming_screen,
 )
 from stochcable.line.strumming_balance import lock_in_balance, wake_parameters, wake_response
@@ -454,3 +455,22 @@ def test_resonant_unlocked_mode_is_capped_and_conservative():
     # detuned by 5 % (outside the half-power band 2ξ = 1.3 %): the balance locks in
     detuned = strumming_screen(inp, *_uniform_string(1.05)[1:])
     assert detuned.modes[0].locked and not detuned.modes[0].resonant
+
+
+def test_strouhal_from_reynolds():
+    # Roshko (1954): F = 0.212 Re − 4.5 (stable range), − 2.7 (irregular range)
+    assert strouhal_roshko(100.0) == pytest.approx(0.212 - 4.5 / 100, rel=1e-15)
+    assert strouhal_roshko(1000.0) == pytest.approx(0.212 - 2.7 / 1000, rel=1e-15)
+    assert strouhal_roshko(1e4) == 0.2 and strouhal_roshko(30.0) == 0.0
+    with pytest.raises(InputError, match="reynolds"):
+        strouhal_roshko(-1.0)
+    # the example with St from Re: Re = U D/ν = 3075, so St = 0.2
+    doc = load_example(EXAMPLE).model_dump(exclude_none=True)
+    doc["lines"][0]["segments"][0]["strumming"]["strouhal"] = "reynolds"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        engine = build_engine(doc)
+    u, d = 0.695 * FT, 0.05 * FT
+    assert u * d / doc["environment"]["viscosity"] == pytest.approx(3075, rel=1e-3)
+    table = engine.strumming["string"]
+    assert np.allclose(table.omega_s, 2 * math.pi * 0.2 * u / d, rtol=1e-5)

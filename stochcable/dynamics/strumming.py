@@ -59,7 +59,8 @@ def strumming_inputs(
     pick = np.asarray(mesh.segment)
 
     def per_el(attr: str, default: float) -> np.ndarray:
-        return np.array([default if s is None else getattr(s, attr) for s in settings])[pick]
+        vals = [default if s is None else getattr(s, attr) for s in settings]
+        return np.array([math.nan if v == "reynolds" else v for v in vals], dtype=float)[pick]
 
     u_max = float(np.max(np.linalg.norm(system.current_el, axis=1)))
     w_top = 2.0 * math.pi * u_max / (3.0 * float(np.min(mesh.diameter)))
@@ -91,7 +92,7 @@ def strumming_inputs(
         ca_normal=mesh.ca_normal,
         ea=mesh.ea,
         l0=mesh.l0,
-        strouhal=per_el("strouhal", STROUHAL_DEFAULT),
+        strouhal=per_el("strouhal", STROUHAL_DEFAULT),  # NaN: from Re
         lift=np.where(on, per_el("lift_coefficient", LIFT_DEFAULT), 0.0),
         rho=env.rho,
         viscosity=env.viscosity,

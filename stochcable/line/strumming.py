@@ -37,6 +37,7 @@ from stochcable.line.strumming_balance import (
     reduced_damping,
     reduced_velocity,
     shedding_frequency,
+    strouhal_roshko,
     wake_parameters,
 )
 from stochcable.validation import finite_scalar
@@ -46,6 +47,7 @@ __all__ = [
     "STROUHAL_DEFAULT",
     "LIFT_DEFAULT",
     "shedding_frequency",
+    "strouhal_roshko",
     "reduced_velocity",
     "hydrodynamic_damping_ratio",
     "reduced_damping",
@@ -81,7 +83,8 @@ class StrummingInput:
         Diameter [m], normal drag coefficient [-], mass per length in air [kg/m],
         normal added-mass coefficient [-], axial stiffness [N], unstretched length [m].
     strouhal, lift : ndarray, shape (n_el,)
-        St [-] and C_L0 [-] (lift 0 where strumming is suppressed).
+        St [-] (NaN: from the Reynolds number, :func:`strouhal_roshko`) and C_L0 [-]
+        (lift 0 where strumming is suppressed).
     rho : float
         Water density. [kg/m³]
     viscosity : float
@@ -106,8 +109,10 @@ class StrummingInput:
 
     def __post_init__(self) -> None:
         n_el = np.asarray(self.l0).size
-        for name, unit in (("strouhal", "-"), ("diameter", "m"), ("viscosity", "m²/s")):
+        for name, unit in (("diameter", "m"), ("viscosity", "m²/s")):
             _check_positive(name, np.asarray(getattr(self, name), dtype=float), unit)
+        st = np.asarray(self.strouhal, dtype=float)
+        _check_positive("strouhal", st[~np.isnan(st)], "-")
         lift = np.asarray(self.lift, dtype=float)
         if np.any(~np.isfinite(lift)) or np.any(lift < 0):
             raise InputError("lift_coefficient", float(lift.min()), "-", "C_L0 must be >= 0")
@@ -266,6 +271,8 @@ class ElementFlow:
         Shedding frequency (0 where the lift is off). [rad/s]
     q : ndarray, shape (n_el,)
         ½ρ D U_n² L, the lift force per unit C_L (0 where the lift is off). [N]
+    strouhal : ndarray, shape (n_el,)
+        The Strouhal number used (the given one, or from the Reynolds number). [-]
     """
 
     tangent: np.ndarray
@@ -275,6 +282,7 @@ class ElementFlow:
     lift_on: np.ndarray
     omega_s: np.ndarray
     q: np.ndarray
+    strouhal: np.ndarray
 
     def along_lift(self, shape: np.ndarray) -> np.ndarray:
         """ψ_e = ½(φ_a + φ_b)·l_e of one node field ``shape`` (n_nodes, 3). [same unit]"""
@@ -304,9 +312,13 @@ def element_flow(line: StrummingInput) -> ElementFlow:
     ldir = np.zeros_like(t)
     ldir[lift_on] = np.cross(t[lift_on], u_n[lift_on]) / speed[lift_on, None]
     d = np.asarray(line.diameter, dtype=float)
-    omega_s = np.where(lift_on, shedding_frequency(speed, d, line.strouhal), 0.0)
+    st = np.asarray(line.strouhal, dtype=float)
+    st = np.where(np.isnan(st), strouhal_roshko(speed * d / line.viscosity), st)
+    lift_on &= st > 0
+    ldir[~lift_on] = 0.0
+    omega_s = np.where(lift_on, 2.0 * math.pi * st * speed / d, 0.0)
     q = np.where(lift_on, 0.5 * line.rho * d * speed**2 * length, 0.0)
-    return ElementFlow(t, ldir, speed, length, lift_on, omega_s, q)
+    return ElementFlow(t, ldir, speed, length, lift_on, omega_s, q, st)
 
 
 def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
@@ -367,7 +379,20 @@ def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
     for _, k, vr, wk in cand[:_CANDIDATES]:
         modes.append(
             _screen_mode(
-                line, k, w_n[k], vr, wk, psi[:, k], phi[:, :, k], q, d, m_t, omega_s, t, stiff
+                line,
+                k,
+                w_n[k],
+                vr,
+                wk,
+                psi[:, k],
+                phi[:, :, k],
+                q,
+                d,
+                m_t,
+                omega_s,
+                t,
+                stiff,
+                flow.strouhal,
             )
         )
     governing = None
@@ -384,13 +409,13 @@ def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
     return StrummingTable(tuple(modes), omega_s, cd, governing)
 
 
-def _screen_mode(line, k, w_n, vr, wk, psi, shape, q, d, m_t, omega_s, t, stiff):
+def _screen_mode(line, k, w_n, vr, wk, psi, shape, q, d, m_t, omega_s, t, stiff, st_el):
     """The :class:`StrummingMode` of mode k (see :func:`strumming_screen`)."""
     zeta = np.broadcast_to(np.asarray(line.structural_damping, dtype=float), wk.shape)
     xi = float(wk @ zeta) + hydrodynamic_damping_ratio(
         line.rho, wk @ d, wk @ m_t, line.viscosity, w_n
     )
-    st = float(wk @ np.asarray(line.strouhal))
+    st = float(wk @ st_el)
     sg = reduced_damping(wk @ m_t, xi, line.rho, wk @ d, st)
     params = wake_parameters(sg, xi)
     lift0 = np.asarray(line.lift, dtype=float)

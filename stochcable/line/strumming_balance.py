@@ -41,6 +41,7 @@ __all__ = [
     "STROUHAL_DEFAULT",
     "LIFT_DEFAULT",
     "shedding_frequency",
+    "strouhal_roshko",
     "reduced_velocity",
     "hydrodynamic_damping_ratio",
     "reduced_damping",
@@ -102,6 +103,36 @@ def shedding_frequency(speed, diameter, strouhal=STROUHAL_DEFAULT):
     if np.any(~np.isfinite(u)) or np.any(u < 0):
         raise InputError("speed", speed, "m/s", "must be finite and >= 0")
     out = 2.0 * math.pi * st * u / d
+    return float(out) if out.ndim == 0 else out
+
+
+def strouhal_roshko(reynolds):
+    """Strouhal number of a smooth circular cylinder from its Reynolds number.
+
+    Parameters
+    ----------
+    reynolds : float or array_like
+        Re = U_n D/ν (>= 0). [-]
+
+    Returns
+    -------
+    float or ndarray
+        St: 0 below Re = 40 (a steady wake, no shedding); 0.212 − 4.5/Re for
+        40 ≤ Re < 300 and 0.212 − 2.7/Re for 300 ≤ Re < 2000 (Roshko 1954, NACA
+        Report 1191: F = 0.212 Re − 4.5 in the stable and − 2.7 in the irregular
+        range); 0.2 above, the subcritical plateau up to Re ≈ 2·10⁵ (Blevins 1990;
+        DNV-RP-C205 Fig. 9-2), kept beyond it (the critical and supercritical values
+        scatter from 0.2 to 0.45: give St per segment there). [-]
+    """
+    re = np.asarray(reynolds, dtype=float)
+    if np.any(~np.isfinite(re)) or np.any(re < 0):
+        raise InputError("reynolds", reynolds, "-", "must be finite and >= 0")
+    safe = np.maximum(re, 1.0)
+    out = np.where(
+        re < 40.0,
+        0.0,
+        np.where(re < 300.0, 0.212 - 4.5 / safe, np.where(re < 2000.0, 0.212 - 2.7 / safe, 0.2)),
+    )
     return float(out) if out.ndim == 0 else out
 
 

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from typing import Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from stochcable.scene.base import _Doc, _f
 from stochcable.scene.spectra import Spectrum
@@ -152,8 +152,11 @@ class SegmentStrumming(_Doc):
     "fairings" turns the vortex shedding of the segment off.
     """
 
-    strouhal: float = _f(
-        "Strouhal number St of the shedding frequency 2π·St·U_n/D", "-", gt=0, le=1, default=0.2
+    strouhal: float | Literal["reynolds"] = _f(
+        "Strouhal number St of the shedding frequency 2π·St·U_n/D, or 'reynolds': from "
+        "the Reynolds number (Roshko 1954 below Re 2000, 0.2 above)",
+        "-",
+        default=0.2,
     )
     lift_coefficient: float = _f(
         "Lift-coefficient amplitude C_L0 of the fixed cylinder (wake oscillator)",
@@ -173,6 +176,13 @@ class SegmentStrumming(_Doc):
         default="none",
         description="VIV suppression fitted: strakes or fairings turn strumming off",
     )
+
+    @field_validator("strouhal")
+    @classmethod
+    def _strouhal_range(cls, v: float | str) -> float | str:
+        if not isinstance(v, str) and not 0.0 < v <= 1.0:
+            raise ValueError(f"St = {v} must be > 0 and <= 1")
+        return v
 
 
 class Segment(_Doc):
