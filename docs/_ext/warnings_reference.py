@@ -246,7 +246,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "a mode whose reduced velocity V_R = 2πU_n/(ω_n D) is inside the cross-flow band "
         "3 ≤ V_R ≤ 16 (DNV-RP-C205 ch. 9) and for which the wake-oscillator harmonic "
         "balance has a locked-in solution, or whose shedding frequency is inside its "
-        "half-power band |ω_s − ω_n| ≤ 2ξω_n (resonance with the free wakes)",
+        "half-power band, ω_s within 2ξω_n of ω_n (resonance with the free wakes)",
         "The line vibrates across the current at the mode's frequency with the amplitude "
         "A/D the message gives (the result's ``lines.<line>.strumming`` table); the "
         "normal drag coefficient is amplified (Vandiver 1983) in the drag linearization "
