@@ -27,6 +27,7 @@ EXPECTED = {
     "tuah_1982_single_leg",
     "tuah_1982_disc_buoy_single_leg",
     "tuah_1982_disc_buoy_three_legs",
+    "tuah_1982_strumming_string",
 }
 
 

@@ -173,6 +173,53 @@ _LINES = {
     ),
     "lines.<line>.modes.omega": ("rad/s", "Natural frequencies listed for the line."),
     "lines.<line>.modes.kept": ("-", "Modes kept by the Foss solve; null for the direct solve."),
+    "lines.<line>.strumming": (
+        "",
+        "Strumming screening of the line in the current (present only with a current "
+        "and unsuppressed segments); see :doc:`../strumming`.",
+    ),
+    "lines.<line>.strumming.modes": (
+        "",
+        "Screened modes: in the cross-flow band 3 ≤ V_R ≤ 16, nearest the shedding frequency.",
+    ),
+    "lines.<line>.strumming.modes[].mode": ("-", "Mode index (0 = lowest)."),
+    "lines.<line>.strumming.modes[].omega_n": ("rad/s", "Natural frequency."),
+    "lines.<line>.strumming.modes[].omega_s": ("rad/s", "Shedding frequency 2π·St·U_n/D."),
+    "lines.<line>.strumming.modes[].omega": (
+        "rad/s",
+        "Response frequency: lock-in frequency, or ω_s when unlocked.",
+    ),
+    "lines.<line>.strumming.modes[].reduced_velocity": ("-", "V_R = 2π U_n/(ω_n D)."),
+    "lines.<line>.strumming.modes[].locked": ("-", "Whether the wake oscillator locks in."),
+    "lines.<line>.strumming.modes[].resonant": (
+        "-",
+        "Unlocked but ω_s inside the mode's half-power band: the free wakes drive a resonance.",
+    ),
+    "lines.<line>.strumming.modes[].amplitude_over_d": (
+        "-",
+        "Cross-flow amplitude over D: steady lock-in amplitude; resonant: the forced "
+        "amplitude capped by Griffin et al. (1975); otherwise twice the forced amplitude "
+        "(the beat bound).",
+    ),
+    "lines.<line>.strumming.modes[].damping_ratio": (
+        "-",
+        "Modal damping ratio ξ: structural + viscous (seed 001 eq. 3.2.b.8).",
+    ),
+    "lines.<line>.strumming.modes[].reduced_damping": ("-", "Skop–Griffin S_G = 2π St² k_s."),
+    "lines.<line>.strumming.modes[].tension_range": (
+        "{F}",
+        "Peak-to-peak dynamic tension of the mode per element (a narrow-band fatigue component).",
+    ),
+    "lines.<line>.strumming.modes[].cycle_rate": ("1/s", "Its cycles per second ω/2π."),
+    "lines.<line>.strumming.governing": (
+        "-",
+        "Index in ``modes`` of the strumming mode that amplifies the drag (null: none).",
+    ),
+    "lines.<line>.strumming.cd_normal": (
+        "-",
+        "Normal drag coefficient per element, amplified where the line strums.",
+    ),
+    "lines.<line>.strumming.omega_s": ("rad/s", "Shedding frequency per element."),
     "lines.<line>.indicators": (
         "",
         "Quality indicators of the linear model (null when not computed); see :doc:`warnings`.",

@@ -240,6 +240,34 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Read the coupled modes from ``stochcable analyze`` under ``bodies.<name>.modes``.",
     ),
     WarningEntry(
+        "Strumming lock-in (or resonance) predicted",
+        "PhysicsWarning",
+        ("stochcable.dynamics.strumming:with_strumming",),
+        "a mode whose reduced velocity V_R = 2πU_n/(ω_n D) is inside the cross-flow band "
+        "3 ≤ V_R ≤ 16 (DNV-RP-C205 ch. 9) and for which the wake-oscillator harmonic "
+        "balance has a locked-in solution, or whose shedding frequency is inside its "
+        "half-power band, ω_s within 2ξω_n of ω_n (resonance with the free wakes)",
+        "The line vibrates across the current at the mode's frequency with the amplitude "
+        "A/D the message gives (the result's ``lines.<line>.strumming`` table); the "
+        "normal drag coefficient is amplified (Vandiver 1983) in the drag linearization "
+        "of every sea state, and the mode's tension range and cycle rate add a "
+        "high-frequency fatigue component. See :doc:`../strumming`.",
+        "Fit strakes or fairings on the segments concerned "
+        "(``segments[i].strumming.suppression``), or move the mode out of the band "
+        "(pretension, diameter); check the amplitude with a time-domain VIV analysis.",
+    ),
+    WarningEntry(
+        "Strumming screening stops below the lock-in range",
+        "ResolutionWarning",
+        ("stochcable.dynamics.strumming:strumming_inputs",),
+        "the 3-D model's modes, computed up to MAX_MODES, stay below 2πU/(3D), the "
+        "highest natural frequency the current can lock in (reduced velocity 3)",
+        "Modes above the last one computed are not screened for strumming: a lock-in of "
+        "a high mode of a thin, fast-flowed line may be missed.",
+        "Screen the line alone with fewer elements, or check its high modes separately.",
+        ("stochcable.dynamics.strumming:MAX_MODES",),
+    ),
+    WarningEntry(
         "Compiled sea kernel unavailable or not cached",
         "UserWarning",
         ("stochcable.sea.kernels:_compile", "stochcable.sea.realization:_compiled_kernel"),

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from pydantic import ValidationError
@@ -38,6 +38,7 @@ from stochcable import runtime
 from stochcable.dynamics.blocks import line_prep
 from stochcable.dynamics.coupled.analysis import solve_coupled
 from stochcable.dynamics.coupled.model import CoupledModel, build_coupled
+from stochcable.dynamics.strumming import with_strumming
 from stochcable.dynamics.system import (
     LineSystem,
     Progress,
@@ -82,6 +83,8 @@ class Engine:
         ``statics_s``, ``model_s`` and ``build_s`` (the whole build) of the build. [s]
     warnings : tuple of str
         Messages of the warnings raised by the build (repeated in every result).
+    strumming : mapping of StrummingTable or None by line name
+        The strumming screening of every line (:mod:`stochcable.dynamics.strumming`).
     """
 
     scene: Scene
@@ -90,6 +93,7 @@ class Engine:
     model: CoupledModel
     timing: Mapping[str, float]
     warnings: tuple[str, ...]
+    strumming: Mapping[str, Any] = field(default_factory=dict)  # StrummingTable by line
 
     def solve(
         self, sea: Sea | Mapping[str, Any] | None = None, *, progress: Progress | None = None
@@ -154,7 +158,7 @@ class Engine:
         return Result(
             scene=scene,
             statics=self.statics,
-            lines=solved.lines,
+            lines={k: replace(v, strumming=self.strumming.get(k)) for k, v in solved.lines.items()},
             timeseries=ts,
             timing=timing,
             warnings=tuple(messages),
@@ -207,6 +211,7 @@ def build_engine(
         )
     timing = {"statics_s": 0.0, "model_s": 0.0}
     systems: dict[str, LineSystem] = {}
+    strumming: dict[str, Any] = {}
     with collect_warnings() as caught, runtime.analysis_blas(is_small(scene)):
         progress("statics", {})
         t0 = time.perf_counter()
@@ -219,6 +224,7 @@ def build_engine(
             progress("model", {"line": line.name})
             t0 = time.perf_counter()
             system = build_line_system(scene, line, statics.lines[line.name], settings=settings)
+            system, strumming[line.name] = with_strumming(scene, system)  # docs/strumming.md
             line_prep(system)  # node blocks and band storage of K, M_T, C_s
             systems[line.name] = system
             timing["model_s"] += time.perf_counter() - t0
@@ -232,6 +238,7 @@ def build_engine(
         model=model,
         timing=timing,
         warnings=tuple(_messages((), caught)),
+        strumming=strumming,
     )
 
 

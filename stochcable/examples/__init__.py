@@ -56,6 +56,17 @@ Each ``<name>.json`` is a scene document (DESIGN.md "Scene and result documents"
   each leg attached at the disc rim (5 ft out, 2.5 ft down) facing its anchor (rim
   attachments give the yaw restoring), mass (ρ g ∇ - 450 lbf)/g, wind 100 lb along +x
   kept from Example 5.
+- ``tuah_1982_strumming_string``: seed 001 §6.6 Example 6, the strumming experiment of
+  Ramberg et al. (1980), converted to SI (ft 0.3048 m, slug 14.5939 kg, lbf
+  4.44822 N): D 0.05 ft = 0.01524 m, span 14.37 ft = 4.379976 m, density
+  7.78 slug/ft³ = 4009.65 kg/m³ (mass 0.731419 kg/m), E 8 113 100 psf = 3.88457e8 Pa
+  (EA 70 860.3 N), initial stress 33 100 psf = 1.58484 MPa (T0 289.10 N: unstretched
+  length span/(1 + σ0/E) = 4.362179 m), flow 0.695 ft/s = 0.211836 m/s across the
+  string (heading 90°, the string along x), water 2.0 slug/ft³ = 1030.76 kg/m³,
+  ν 1.13e-5 ft²/s = 1.04980e-6 m²/s, C_L0 0.2, 4 elements (the seed's).  Assumed:
+  St 0.18 (the seed's ω_s = 15.73 rad/s back-computed: 2π·0.18·0.695/0.05 = 15.72),
+  C_a 1, C_d 1.2, the string 0.5 m deep in 1 m of water.  No sea: the example is the
+  strumming screening (docs/strumming.md).
 """
 
 from __future__ import annotations
@@ -94,6 +105,10 @@ DOCUMENTED_WARNINGS: dict[str, dict[str, str]] = {
         "wave-velocity σ varies": "the seed's 3 elements are kept (seed 001 §6.5)",
         "snap loads likely": "the seed's slack leg: σ exceeds a third of the mean tension",
         "of the line's sag": "the buoy's motion is large against the slack leg's sag",
+    },
+    "tuah_1982_strumming_string": {
+        "has no excitation": "a strumming example (seed 001 §6.6 Example 6): no sea, no "
+        "end motion; its result is the strumming table of the line in the current",
     },
     "tuah_1982_disc_buoy_three_legs": {
         "wave-velocity σ varies": "the seed's 3 elements are kept (seed 001 §6.7)",

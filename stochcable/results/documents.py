@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.line.strumming import StrummingTable
 from stochcable.results.records import (
     THREE_HOURS,
     LinearizationRecord,
@@ -100,6 +101,9 @@ class LineResult:
         inspection and re-use).
     indicators : LineIndicators or None
         Quality indicators of the linear model (None when not computed).
+    strumming : StrummingTable or None
+        Strumming screening of the line in the current (None without current;
+        docs/strumming.md).
     """
 
     name: str
@@ -126,6 +130,7 @@ class LineResult:
     model: Any = None
     modes: Any = None
     indicators: LineIndicators | None = None
+    strumming: StrummingTable | None = None
 
     @property
     def listed_modes(self) -> np.ndarray:
@@ -185,6 +190,7 @@ class LineResult:
             "linearization": self.linearization.as_dict(),
             "modes": {"omega": self.listed_modes.tolist(), "kept": self.n_modes},
             "indicators": None if self.indicators is None else self.indicators.as_dict(),
+            **({} if self.strumming is None else {"strumming": self.strumming.as_dict()}),
         }
 
 

@@ -44,6 +44,13 @@ class Environment(_Doc):
         default=(), description="Current profile points, any order; empty for no current"
     )
     seabed: Seabed = Field(default_factory=Seabed, description="Seabed contact model")
+    viscosity: float = _f(
+        "Kinematic viscosity of the water (strumming: viscous damping); sea water at "
+        "15 °C (ITTC 2011)",
+        "m²/s",
+        gt=0,
+        default=1.19e-6,
+    )
 
     @model_validator(mode="after")
     def _current_in_water(self) -> Environment:

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from stochcable.scene.base import _Doc, _f
 from stochcable.scene.spectra import Spectrum
@@ -18,6 +19,7 @@ __all__ = [
     "EndMotion",
     "BodyAttachment",
     "End",
+    "SegmentStrumming",
     "Segment",
     "Attachment",
     "Line",
@@ -143,6 +145,46 @@ class End(_Doc):
         return self
 
 
+class SegmentStrumming(_Doc):
+    """Strumming (vortex-induced vibration) settings of a segment (docs/strumming.md).
+
+    The screening runs only where a current flows; ``suppression`` "strakes" or
+    "fairings" turns the vortex shedding of the segment off.
+    """
+
+    strouhal: float | Literal["reynolds"] = _f(
+        "Strouhal number St of the shedding frequency 2π·St·U_n/D, or 'reynolds': from "
+        "the Reynolds number (Roshko 1954 below Re 2000, 0.2 above)",
+        "-",
+        default=0.2,
+    )
+    lift_coefficient: float = _f(
+        "Lift-coefficient amplitude C_L0 of the fixed cylinder (wake oscillator)",
+        "-",
+        ge=0,
+        le=5,
+        default=0.2,
+    )
+    damping_ratio: float = _f(
+        "Structural damping ratio of the modes (added to the viscous damping)",
+        "-",
+        ge=0,
+        lt=1,
+        default=0.0,
+    )
+    suppression: Literal["none", "strakes", "fairings"] = Field(
+        default="none",
+        description="VIV suppression fitted: strakes or fairings turn strumming off",
+    )
+
+    @field_validator("strouhal")
+    @classmethod
+    def _strouhal_range(cls, v: float | str) -> float | str:
+        if not isinstance(v, str) and not 0.0 < v <= 1.0:
+            raise ValueError(f"St = {v} must be > 0 and <= 1")
+        return v
+
+
 class Segment(_Doc):
     """A homogeneous stretch of line."""
 
@@ -162,6 +204,10 @@ class Segment(_Doc):
         default=None,
     )
     elements: int = _f("Number of finite elements", "-", ge=1, le=100_000, default=20)
+    strumming: SegmentStrumming | None = Field(
+        default=None,
+        description="Strumming settings (default: St 0.2, C_L0 0.2, no suppression)",
+    )
 
     def submerged_weight(self, rho: float, g: float) -> float:
         """Net weight per unit length in water. [N/m]"""

@@ -62,6 +62,7 @@ from stochcable.scene.lines import (
     Line,
     MotionRao,
     Segment,
+    SegmentStrumming,
     check_span,
 )
 from stochcable.scene.spectra import (
@@ -95,6 +96,7 @@ __all__ = [
     "BodyAttachment",
     "End",
     "Segment",
+    "SegmentStrumming",
     "Attachment",
     "Line",
     "BodyExcitation",
