@@ -100,7 +100,9 @@ def main() -> None:
         f"| largest fairlead σ difference from `analyze()` of the same sea | {worst:.1e} |",
         "",
         "The statics, the finite-element model, the modes and the factorizations are built",
-        "once per set; a case costs the sea's loads, the drag fixed point and the outputs.",
+        "once per set, and a line's wave kinematics and loads per unit wave once per",
+        "heading (kept within 64 MiB a line); a case costs its spectrum's weights, the",
+        "drag fixed point and the outputs.",
         "Timings are of one run on the machine of docs/BENCHMARKS.md; they move with its",
         "fast and slow states.",
     ]

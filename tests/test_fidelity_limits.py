@@ -277,9 +277,9 @@ def test_base_grid_spacing_gives_its_own_point_count():
     """span/(span/(n − 1)) is n − 1 + round-off for many spans (0.313/(0.313/999) =
     999.0000000000001): the point count of the base grid at the limit is n, not n + 1
     (the planner raised StopIteration at the frequency limit)."""
-    from stochcable.fidelity.planner import _points
+    from stochcable.fidelity.rules import grid_points
 
     spans = [0.1 * i + 0.013 for i in range(1, 200)]
     for n in (200, 1000, 4000):
-        assert all(_points(a, a / (n - 1)) == n for a in spans)
-        assert all(_points(a, a / (n - 1) * 0.999) > n for a in spans)  # finer: more
+        assert all(grid_points(a, a / (n - 1)) == n for a in spans)
+        assert all(grid_points(a, a / (n - 1) * 0.999) > n for a in spans)  # finer: more

@@ -57,6 +57,7 @@ from stochcable.fidelity.rules import (
     PEAK_RESOLVED,
     crossing_down,
     crossing_up,
+    grid_points,
     points_per_bandwidth,
     tail_above,
     tail_below,
@@ -366,10 +367,10 @@ def _choose_grid(
     base = min(base, limit)
     dw_base = (w_max - w_min) / (base - 1)
     peaks = _narrow_peaks(scene, pilot, w_min, w_max, dw_base)
-    n_all = _points(w_max - w_min, min([dw_base] + [b / n_bw for _, b in peaks]))
+    n_all = grid_points(w_max - w_min, min([dw_base] + [b / n_bw for _, b in peaks]))
     peaks, unresolved = _within_limit(pilot, peaks, w_min, w_max, base, n_bw, allow_values, slack)
     dw_fine = min([dw_base] + [b / n_bw for _, b in peaks])
-    count_lin = min(_points(w_max - w_min, dw_fine), limit)
+    count_lin = min(grid_points(w_max - w_min, dw_fine), limit)
     values = union_grid(w_min, w_max, base, peaks, n_bw)
     grid_err = 2.0 * math.exp(-math.pi * n_bw) + grid_share / 2.0
     use_values = allow_values and len(values) < count_lin
@@ -409,13 +410,6 @@ def _choose_grid(
     )
 
 
-def _points(span: float, dw: float) -> int:
-    """Points of a linear grid over ``span`` with spacing at most ``dw``: the base
-    grid's own spacing span/(n − 1) gives n again (its quotient's round-off above
-    n − 1, 199.00000000000003, asked for one point more than the limit)."""
-    return int(math.ceil(span / dw * (1.0 - 1e-12))) + 1
-
-
 def _within_limit(
     pilot: Pilot,
     peaks: list[tuple[float, float]],
@@ -442,12 +436,11 @@ def _within_limit(
 
     def _linear_count(pk: list[tuple[float, float]]) -> int:
         dw = min([(w_max - w_min) / (base - 1)] + [b / n_bw for _, b in pk])
-        return _points(w_max - w_min, dw)
+        return grid_points(w_max - w_min, dw)
 
     if count(peaks) <= limit:
         return peaks, []
     order = sorted(peaks, key=lambda p: p[1])  # narrowest first
-    # (every peak left unresolved is the base grid, within the limit: the default)
     k = next((i for i in range(len(order) + 1) if count(order[i:]) <= limit), len(order))
     while k < len(order) and _unresolved_error(pilot, order[: k + 1]) <= slack:
         k += 1

@@ -99,6 +99,7 @@ __all__ = [
     "PEAK_RESOLVED",
     "spectrum_tail_frequency",
     "elements_wavelength",
+    "grid_points",
     "points_per_bandwidth",
     "tail_exponent",
     "tail_above",
@@ -270,6 +271,13 @@ def elements_wavelength(
     e = _v.in_range("frequency_error", frequency_error, "-", 0.0, 0.5, lo_open=True)
     kh = math.sqrt(24.0 * e)
     return max(1, int(math.ceil(L * (w / c) / kh - 1e-9)))
+
+
+def grid_points(span: float, dw: float) -> int:
+    """Points of a linear grid over ``span`` [rad/s] with spacing at most ``dw``
+    [rad/s]: a base grid's own spacing span/(n − 1) gives n again (the quotient's
+    round-off above n − 1, 199.00000000000003, asked for one point more than a limit)."""
+    return int(math.ceil(span / dw * (1.0 - 1e-12))) + 1
 
 
 def points_per_bandwidth(error: float) -> float:
