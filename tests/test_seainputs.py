@@ -51,7 +51,7 @@ def test_sea_states_of_known_headings_equal_fresh_analyses() -> None:
         # carries 1e-16 regroupings to ~1e-13)
         assert_close_documents(got, ref, rtol=1e-12)
     kept = engine.systems["leg1"]._cache[seainputs._KEY]
-    assert sorted(kept) == [30.0, 60.0]
+    assert sorted(h for h, _ in kept) == [30.0, 60.0]
 
 
 def test_large_inputs_are_not_kept(monkeypatch) -> None:
@@ -66,9 +66,9 @@ def test_large_inputs_are_not_kept(monkeypatch) -> None:
 def test_oldest_heading_gives_way(monkeypatch) -> None:
     engine = build_engine(_doc(30.0))
     engine.solve(_sea("pm", 30.0))
-    size = seainputs._nbytes(*engine.systems["leg1"]._cache[seainputs._KEY][30.0])
+    size = seainputs._nbytes(*engine.systems["leg1"]._cache[seainputs._KEY][(30.0, None)])
     # room for two headings' inputs (twice their arrays each): the third evicts the first
     monkeypatch.setattr(seainputs, "INPUT_CACHE_BYTES", 4 * size + 1)
     for h in (45.0, 60.0):
         engine.solve(_sea("pm", h))
-    assert sorted(engine.systems["leg1"]._cache[seainputs._KEY]) == [45.0, 60.0]
+    assert sorted(h for h, _ in engine.systems["leg1"]._cache[seainputs._KEY]) == [45.0, 60.0]

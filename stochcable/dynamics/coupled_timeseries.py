@@ -149,7 +149,10 @@ def _group_on(
         (n,) = group.lines
         cls = [CoupledLine(group.systems[n], chans[n])]
         channels = chans[n]
-        sources = tuple((n, c.name) if c.kind == "end_motion" else None for c in channels)
+        sources = tuple(
+            (n, c.name) if c.kind == "end_motion" else ("sea", c.name) if c.kind == "sea" else None
+            for c in channels
+        )
         return (
             GroupSystem(cls, (), {}, env.rho, channels),
             tuple(c.kind for c in channels),
@@ -179,7 +182,10 @@ def _group_on(
         for c in chans[n]
         if c.kind == "end_motion"
     }
-    sources = tuple(own.get(c.name) if c.kind == "end_motion" else None for c in channels)
+    sources = tuple(
+        own.get(c.name) if c.kind == "end_motion" else ("sea", c.name) if c.kind == "sea" else None
+        for c in channels
+    )
     loads = {b.name: body_loads(b, channels, omega, scene.sea, env) for b in group.bodies}
     return (
         GroupSystem(cls, group.bodies, loads, env.rho, channels),

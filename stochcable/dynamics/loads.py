@@ -178,6 +178,29 @@ def with_spectrum(channel: Channel, density: Callable[[np.ndarray], np.ndarray])
     return out
 
 
+def sea_channel_densities(
+    sea: Any, g: float
+) -> list[tuple[str, float, Callable[[np.ndarray], np.ndarray]]]:
+    """The sea's input channels: (name, heading [rad], ω -> spectrum).  A long-crested
+    sea is one channel "sea"; a short-crested one a channel "sea@<heading in deg>" per
+    discrete direction k (:meth:`stochcable.scene.environment.Sea.direction_set`) with
+    the share w_k S(ω) of the spectrum: independent inputs whose variances add (the
+    directional spectrum S(ω)D(θ), seed 001 §5.1 per direction)."""
+    density = spectrum_callable(sea.spectrum, g)
+    ds = sea.direction_set()
+    if ds is None:
+        return [("sea", sea.heading_rad, density)]
+    return [
+        (direction_channel(b), float(b), lambda w, f=float(wk): f * density(w))
+        for b, wk in zip(ds.heading, ds.weight)
+    ]
+
+
+def direction_channel(heading: float) -> str:
+    """The name of the sea channel of direction ``heading`` [rad]: "sea@<deg>"."""
+    return f"sea@{math.degrees(heading):.6g}"
+
+
 def spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
     """ω -> S(ω) of a scene spectrum ``spec`` (one-sided, zero at ω <= 0), ω in
     [rad/s], S in [m²·s/rad]; ``g`` [m/s²] for the spectra that need it."""
@@ -243,27 +266,27 @@ def line_channels(
                 )
             raos[end] = np.ascontiguousarray(m.rao.transfer(w).T)  # (n_omega, 3)
     if scene.sea is not None:
-        density = spectrum_callable(scene.sea.spectrum, env.g)
         # nodes resting on a penalty seabed sit slightly below z = -depth: evaluate
         # the kinematics on the seabed there
         pts = np.array(positions, dtype=float)
         pts[:, 2] = np.maximum(pts[:, 2], -env.depth)
-        el = element_wave_kinematics(w, pts, scene.sea.heading_rad, env.depth, env.g)
-        channels.append(
-            Channel(
-                name="sea",
-                kind="sea",
-                omega=w,
-                spectrum=density(w),
-                density=density,
-                motion_a=raos.get("end_a"),
-                motion_b=raos.get("end_b"),
-                element_velocity=el.velocity,
-                element_velocity_square=el.velocity_square,
-                element_end_square=el.end_square,
-                nodal=_sea_nodal(el, env.g),
+        for name, heading, density in sea_channel_densities(scene.sea, env.g):
+            el = element_wave_kinematics(w, pts, heading, env.depth, env.g)
+            channels.append(
+                Channel(
+                    name=name,
+                    kind="sea",
+                    omega=w,
+                    spectrum=density(w),
+                    density=density,
+                    motion_a=raos.get("end_a"),
+                    motion_b=raos.get("end_b"),
+                    element_velocity=el.velocity,
+                    element_velocity_square=el.velocity_square,
+                    element_end_square=el.end_square,
+                    nodal=_sea_nodal(el, env.g),
+                )
             )
-        )
     for end in ("end_a", "end_b"):
         m = getattr(line, end).motion
         if m is None or m.rao is not None:

@@ -13,6 +13,7 @@ import numpy as np
 
 from stochcable.dynamics.loads import (
     Channel,
+    direction_channel,
 )
 from stochcable.dynamics.system import LineSystem
 from stochcable.results.documents import (
@@ -20,6 +21,7 @@ from stochcable.results.documents import (
 )
 from stochcable.scene.model import Scene, TimeSeriesSettings
 from stochcable.sea.realization import frequency_grid, simulate_sea, synthesize
+from stochcable.sea.spreading import simulate_sea_directional
 
 # ---------------------------------------------------------------------- time series
 
@@ -106,7 +108,9 @@ def simulate_timeseries(
         time=syn.time_axis(),
         method=settings.method,
         seed=syn.seed,
-        elevation=None if syn.sea is None else np.asarray(syn.sea.elevation),
+        elevation=None
+        if syn.sea is None
+        else np.asarray(syn.sea.elevation if syn.elevation is None else syn.elevation),
         end_motion={
             f"{name}.{cname}": np.asarray(r.elevation) for (name, cname), r in syn.reals.items()
         },
@@ -134,6 +138,8 @@ class _Synthesis:
         self.w_band = w[self.band]
         self.n_t = int(round(settings.duration / settings.dt))
         self.sea = None
+        self.elevation = None  # (the sea's η; a short-crested sea's sums its directions)
+        self.directions: dict[str, Any] = {}  # sea channel name -> its realization
         if scene.sea is not None:
             spec, g = scene.sea.spectrum, scene.environment.g
 
@@ -143,9 +149,18 @@ class _Synthesis:
                 out[w > 0] = spec.spectral_density(w[w > 0], g)
                 return out
 
-            self.sea = simulate_sea(
-                sea_density, settings.duration, settings.dt, settings.method, rng=self.seed
-            )
+            ds = scene.sea.direction_set()
+            if ds is None or ds.count == 1:  # (one direction: the long-crested realization)
+                self.sea = simulate_sea(
+                    sea_density, settings.duration, settings.dt, settings.method, rng=self.seed
+                )
+            else:  # a short-crested sea: an independent realization per direction
+                reals = simulate_sea_directional(
+                    sea_density, ds, settings.duration, settings.dt, settings.method, self.seed
+                )
+                self.directions = {direction_channel(b): r for b, r in zip(ds.heading, reals)}
+                self.sea = reals[0]
+                self.elevation = np.sum([r.elevation for r in reals], axis=0)
         self.reals: dict[tuple[str, str], Any] = {}
 
     def realize_end_motions(self, probe: Mapping[str, tuple[Channel, ...]]) -> None:
@@ -174,7 +189,11 @@ class _Synthesis:
         """Σ over channels of synthesize(realization, H), H (n_ch, ..., N+1)."""
         y = np.zeros(h.shape[1:-1] + (self.n_t,))
         for i, (kind, src) in enumerate(zip(kinds, sources)):
-            real = self.sea if kind == "sea" else self.reals.get(src) if src else None
+            if kind == "sea":
+                real = self.directions.get(src[1]) if (self.directions and src) else None
+                real = self.sea if real is None else real
+            else:
+                real = self.reals.get(src) if src else None
             if real is not None:
                 y += synthesize(real, h[i])
         return y

@@ -10,6 +10,7 @@ from pydantic import Field, model_validator
 
 from stochcable.scene.base import G_STANDARD, RHO_SEAWATER, _Doc, _f
 from stochcable.scene.spectra import Spectrum
+from stochcable.scene.spreading import Spreading
 
 __all__ = ["CurrentPoint", "Seabed", "Environment", "Sea"]
 
@@ -83,10 +84,21 @@ class Environment(_Doc):
 
 
 class Sea(_Doc):
-    """Long-crested random sea: a spectrum and a heading."""
+    """Random sea: a spectrum, a (mean) heading and, for a short-crested sea, its
+    directional spreading (long-crested without)."""
 
     spectrum: Spectrum
     heading: float = _f("Direction the waves travel toward, from +x toward +y", "deg", default=0.0)
+    spreading: Spreading | None = Field(
+        default=None,
+        description="Directional spreading about the heading (a short-crested sea); "
+        "none: long-crested",
+    )
+
+    def direction_set(self):
+        """The discrete directions (:class:`stochcable.sea.spreading.DirectionSet`,
+        headings in rad) of the spreading; None for a long-crested sea."""
+        return None if self.spreading is None else self.spreading.direction_set(self.heading)
 
     @property
     def heading_rad(self) -> float:

@@ -175,7 +175,8 @@ class Scene(_Doc):
                     )
                 except ValueError as exc:
                     raise ValueError(f"lines[{i}]: {exc}") from None
-        if self.bodies:
+        # (a spread sea with bodies is refused by the engine, naming sea.spreading)
+        if self.bodies and (self.sea is None or self.sea.spreading is None):
             planar = self.is_planar
             for j, b in enumerate(self.bodies):
                 if b.planar_data and not planar:
@@ -281,7 +282,9 @@ class Scene(_Doc):
                     m.sway is not None or (m.rao is not None and m.rao.sway is not None)
                 ):
                     return False
-        if self.sea is not None and abs(math.sin(self.sea.heading_rad)) > tol:
+        if self.sea is not None and (
+            abs(math.sin(self.sea.heading_rad)) > tol or self.sea.spreading is not None
+        ):
             return False
         for p in self.environment.current:
             if p.speed > 0 and abs(math.sin(p.heading_rad)) > tol:

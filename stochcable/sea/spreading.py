@@ -186,7 +186,7 @@ def _binned(
     """``count`` equal bins on [lo, hi] (relative to the mean): weight = ∫_bin D from the
     closed-form distribution function ``cdf`` (exact however narrow D is), heading =
     ∫_bin θD/∫_bin D by Gauss–Legendre (where D is too narrow for the rule to see it
-    in a bin: the bin's point nearest the mean)."""
+    in a bin: the bin's point nearest the mean); bins of zero weight are left out."""
     x, gw = np.polynomial.legendre.leggauss(_GAUSS)
     edges = np.linspace(lo, hi, count + 1)
     half = 0.5 * np.diff(edges)
@@ -197,7 +197,8 @@ def _binned(
     nearest = np.clip(0.0, edges[:-1], edges[1:])
     centroid = np.divide((d * th * gw).sum(axis=1), w0, out=nearest, where=w0 > 0)
     w = np.maximum(np.diff(cdf(edges)), 0.0)
-    return DirectionSet(heading=centroid, weight=w / w.sum())
+    keep = w > 0  # (bins a very narrow spreading leaves empty carry nothing)
+    return DirectionSet(heading=centroid[keep], weight=w[keep] / w.sum())
 
 
 def _count(count: int) -> int:

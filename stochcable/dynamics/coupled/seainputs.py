@@ -22,7 +22,7 @@ import numpy as np
 
 from stochcable.dynamics.coupled.inputs import scene_line_channels
 from stochcable.dynamics.line_loads import LineInputs, line_inputs, with_spectra
-from stochcable.dynamics.loads import Channel, spectrum_callable, with_spectrum
+from stochcable.dynamics.loads import Channel, sea_channel_densities, with_spectrum
 
 __all__ = ["INPUT_CACHE_BYTES", "heading_inputs"]
 
@@ -56,14 +56,22 @@ def heading_inputs(model: Any, scene: Any, line: Any) -> tuple[tuple[Channel, ..
     """
     system = model.systems[line.name]
     sea = scene.sea
-    heading = None if sea is None else float(sea.heading)
+    # the directions: the heading, and the spreading's (a short-crested sea)
+    heading = (
+        None
+        if sea is None
+        else (
+            float(sea.heading),
+            None if sea.spreading is None else sea.spreading.model_dump_json(),
+        )
+    )
     kept: dict[Any, tuple[tuple[Channel, ...], LineInputs]] = system._cache.setdefault(_KEY, {})
     if heading in kept:
         ch0, inp0 = kept[heading]
         if sea is None:
             return ch0, inp0
-        density = spectrum_callable(sea.spectrum, scene.environment.g)
-        ch = tuple(with_spectrum(c, density) if c.kind == "sea" else c for c in ch0)
+        dens = {name: d for name, _, d in sea_channel_densities(sea, scene.environment.g)}
+        ch = tuple(with_spectrum(c, dens[c.name]) if c.kind == "sea" else c for c in ch0)
         return ch, with_spectra(system, inp0, ch)
     ch, _ = scene_line_channels(scene, line, system, model.omega, model.vessel_rao)
     if not ch:

@@ -1,0 +1,136 @@
+"""Short-crested seas through the engine (``sea.spreading``): a spreading that narrows
+to zero width is the long-crested analysis, mirrored spreadings give mirrored
+responses on a line symmetric about the mean heading, sea states of one spreading
+reuse their inputs, the time series realize every direction independently, and bad
+documents are refused naming the parameter."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stochcable.analysis import analyze
+from stochcable.dynamics.engine import build_engine
+from stochcable.errors import InputError
+from stochcable.examples import load_example
+from stochcable.scene.model import load_scene
+
+
+def _chain(heading: float = 0.0, spreading: dict | None = None, timeseries: bool = False) -> dict:
+    doc = load_example("chain_catenary").model_dump(mode="json", exclude_none=True)
+    if not timeseries:
+        doc["analysis"].pop("timeseries", None)
+    doc["analysis"]["omega"]["count"] = 120  # (the physics is the test's, not the grid's)
+    doc["sea"]["heading"] = heading
+    if spreading is not None:
+        doc["sea"]["spreading"] = spreading
+    return doc
+
+
+def _stats(result) -> dict:
+    line = result.lines["leg1"]
+    return {
+        "end_a": line.end_a.std,
+        "end_b": line.end_b.std,
+        "tension": line.tension_std,
+        "motion": line.motion_std,
+    }
+
+
+def test_zero_width_spreading_is_the_long_crested_sea():
+    """cos-2s with s = 10⁶ in 15 bins: the side bins carry < 1e-30 and are left out,
+    so the one direction left is the mean heading: the same channels' numbers (a
+    different channel name) and, with one direction, the same realization."""
+    ref = analyze(_chain(30.0, timeseries=True))
+    got = analyze(_chain(30.0, {"type": "cos2s", "s": 1e6, "directions": 15}, timeseries=True))
+    assert got.lines["leg1"].channels[0] == "sea@30"
+    a, b = _stats(got), _stats(ref)
+    for key in a:
+        np.testing.assert_allclose(a[key], b[key], rtol=1e-10, atol=0)
+    for end in ("end_a", "end_b"):
+        np.testing.assert_allclose(
+            got.timeseries.end_tension["leg1"][end],
+            ref.timeseries.end_tension["leg1"][end],
+            rtol=1e-10,
+        )
+    np.testing.assert_array_equal(got.timeseries.elevation, ref.timeseries.elevation)
+
+
+def test_mirrored_spreadings_give_mirrored_responses():
+    """The chain lies in the x–z plane and the mean heading is 0: the spreading
+    mirrored about it (offsets negated) mirrors the response in y, so the tensions and
+    the x, y, z motion σ are the same (round-off: the same sums in another order)."""
+    table = {"type": "table", "offset": [-35.0, -5.0, 20.0], "weight": [0.2, 0.5, 0.3]}
+    mirror = {**table, "offset": [-x for x in table["offset"]]}
+    a = _stats(analyze(_chain(0.0, table)))
+    b = _stats(analyze(_chain(0.0, mirror)))
+    for key in a:
+        np.testing.assert_allclose(a[key], b[key], rtol=1e-9, atol=1e-12 * np.max(a[key]))
+    # and the spreading matters: out-of-plane motion that a long-crested head sea lacks
+    assert np.max(a["motion"][:, 1]) > 1e-3 * np.max(a["motion"][:, 0])
+
+
+def test_sea_states_of_one_spreading_reuse_their_inputs():
+    spread = {"type": "cosn", "n": 4.0, "directions": 9}
+    engine = build_engine(_chain(20.0, spread))
+    sea = {
+        "spectrum": {"type": "jonswap", "hs": 3.0, "tp": 8.0},
+        "heading": 20.0,
+        "spreading": spread,
+    }
+    engine.solve()
+    got = _stats(engine.solve(sea))
+    ref = _stats(analyze({**_chain(20.0, spread), "sea": sea}))
+    for key in got:
+        np.testing.assert_allclose(got[key], ref[key], rtol=1e-11)
+    assert len(engine.systems["leg1"]._cache["heading_inputs"]) == 1  # one spreading kept
+
+
+def test_time_series_realize_the_directions_independently():
+    """DSA over the record: each direction has its own phases, so the end-tension
+    series variance scatters about the frequency-domain σ² by the cross terms of
+    directions sharing a frequency; four seeds: their mean within 4 standard errors."""
+    spread = {"type": "cos2s", "s": 2.0, "directions": 8}
+    doc = _chain(45.0, spread, timeseries=True)
+    doc["analysis"]["timeseries"]["duration"] = 400.0
+    sig, fd = [], None
+    for seed in range(4):
+        doc["analysis"]["timeseries"]["seed"] = seed
+        res = analyze(doc)
+        fd = res.lines["leg1"].end_a.std
+        sig.append(float(np.std(res.timeseries.end_tension["leg1"]["end_a"])))
+        # the elevation is the sum of the directions' realizations: its variance is the
+        # spectrum's on the record's lines up to the same cross terms
+        assert res.timeseries.elevation.std() > 0
+    sig = np.array(sig)
+    se = sig.std(ddof=1) / math.sqrt(sig.size)
+    # the record's band-limited synthesis resolves the analysis band on its own grid:
+    # 3 % of grid difference allowed on top (the long-crested tests' allowance)
+    assert abs(sig.mean() - fd) <= 4 * se + 0.03 * fd, (sig, fd)
+
+
+def test_bodies_with_a_spread_sea_are_refused():
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json", exclude_none=True)
+    doc["sea"]["spreading"] = {"type": "cos2s", "s": 3.0}
+    with pytest.raises(InputError) as info:
+        analyze(doc)
+    assert info.value.parameter == "sea.spreading"
+
+
+@pytest.mark.parametrize(
+    ("spreading", "parameter"),
+    [
+        ({"type": "cos2s", "s": 0.0}, "sea.spreading.s"),
+        ({"type": "cosn", "n": -1.0}, "sea.spreading.n"),
+        ({"type": "cos2s", "s": 2.0, "directions": 0}, "sea.spreading.directions"),
+        ({"type": "cos2s", "s": 2.0, "directions": 65}, "sea.spreading.directions"),
+        ({"type": "table", "offset": [0.0, 10.0], "weight": [0.0, 0.0]}, "sea.spreading"),
+        ({"type": "table", "offset": [0.0, 0.0], "weight": [1.0, 1.0]}, "sea.spreading"),
+    ],
+)
+def test_bad_spreading_names_the_parameter(spreading, parameter):
+    with pytest.raises(InputError) as info:
+        load_scene(_chain(0.0, spreading))
+    assert info.value.parameter == parameter
