@@ -41,7 +41,8 @@ from stochcable.dynamics.coupled.inputs import (
     scene_line_channels,
     vessel_rao,
 )
-from stochcable.dynamics.loads import Channel, spectrum_callable
+from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.sea_channels import spectrum_callable
 from stochcable.dynamics.solve import end_tension_from_support
 
 __all__ = [

@@ -11,10 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.loads import (
-    Channel,
-    direction_channel,
-)
+from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.sea_channels import direction_channel
 from stochcable.dynamics.system import LineSystem
 from stochcable.results.documents import (
     TimeSeries,

@@ -359,7 +359,7 @@ def _solve_lonely(
 ) -> tuple[BodyResult, CoupledGroup] | None:
     """A free-floating body without lines: the body alone in the sea (None without
     a sea)."""
-    from stochcable.dynamics.loads import spectrum_callable
+    from stochcable.dynamics.sea_channels import spectrum_callable
 
     if scene.sea is None:
         warn(

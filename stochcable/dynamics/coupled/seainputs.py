@@ -22,7 +22,8 @@ import numpy as np
 
 from stochcable.dynamics.coupled.inputs import scene_line_channels
 from stochcable.dynamics.line_loads import LineInputs, line_inputs, with_spectra
-from stochcable.dynamics.loads import Channel, sea_channel_densities, with_spectrum
+from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.sea_channels import sea_channel_densities, with_spectrum
 
 __all__ = ["INPUT_CACHE_BYTES", "heading_inputs"]
 
