@@ -259,6 +259,7 @@ def simulate_line_timedomain(
     element_every: int = 1,
     end_realizations: dict | None = None,
     band: tuple[float, float] | None = None,
+    internal_damping: float = 0.0,
 ) -> CableTimeHistory:
     """Nonlinear time-domain response of one line to the scene's sea and end motions.
 
@@ -303,6 +304,11 @@ def simulate_line_timedomain(
         frequency-domain analysis synthesizes its series on its ``omega`` range, so
         ``band=(omega.min, omega.max)`` reproduces its excitation exactly.  Default:
         every component of the realization. [rad/s]
+    internal_damping : float, default 0
+        Axial internal damping BA of every element: the axial force gains
+        T_d = BA·(dl/dt)/l0, l0 the element's unstretched length (MoorDyn's line-type
+        ``BA`` in N·s, :mod:`stochcable.reference.moordyn`); included in
+        ``element_tension`` and the end tensions.  0 (the default): none. [N·s]
 
     Returns
     -------
@@ -372,7 +378,10 @@ def simulate_line_timedomain(
     mesh = mesh_line(line, scene.environment.rho, scene.environment.g)
     ax = axes(dim)
     x3 = statics_guess(scene, line, mesh, statics)
-    model, xs, u_cur, u_cur_g, tol_abs = _static_start(scene, mesh, x3, dim, tolerance)
+    internal_damping = _v.nonnegative("internal_damping", internal_damping, "N·s")
+    model, xs, u_cur, u_cur_g, tol_abs = _static_start(
+        scene, mesh, x3, dim, tolerance, internal_damping
+    )
     r = half_cosine(t, ramp)
     sl = np.arange(n_steps + 1) % (k_up * grid.n_samples)  # periodic in T_L
     u_wave = u_wave_g = f_in = None
@@ -488,7 +497,7 @@ def _time_step(
 
 
 def _static_start(
-    scene: Scene, mesh: Any, x3: np.ndarray, dim: int, tolerance: float
+    scene: Scene, mesh: Any, x3: np.ndarray, dim: int, tolerance: float, ba: float = 0.0
 ) -> tuple[LineModel, np.ndarray, np.ndarray, np.ndarray, float]:
     """The model about its own static equilibrium (re-solved from the statics' shape
     ``x3``), the current at the nodes and the drag points, and the absolute Newton
@@ -506,7 +515,7 @@ def _static_start(
     xs, _ = static_equilibrium(
         model0, x3 @ ax, u_cur, u_cur_g, f_ref, max(1e-3 * tol_abs, 1e-11 * f_ref)
     )
-    model = LineModel(mesh, env, xs, dim)  # added mass about the re-solved tangents
+    model = LineModel(mesh, env, xs, dim, ba)  # added mass about the re-solved tangents
     return model, xs, u_cur, u_cur_g, tol_abs
 
 

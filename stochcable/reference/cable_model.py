@@ -105,7 +105,14 @@ class LineModel:
     Arrays: X, V, A of shape (n_nodes, dim); the DOF of node i, coordinate c is i·dim + c.
     """
 
-    def __init__(self, mesh: LineMesh, env: Environment, x_static: np.ndarray, dim: int):
+    def __init__(
+        self,
+        mesh: LineMesh,
+        env: Environment,
+        x_static: np.ndarray,
+        dim: int,
+        internal_damping: float = 0.0,
+    ):
         self.mesh = mesh
         self.dim = d = dim
         self.n = n = mesh.n_nodes
@@ -113,6 +120,8 @@ class LineModel:
         self.N = n * d
         self.l0 = mesh.l0
         self.ea = mesh.ea
+        # axial internal damping BA [N·s] per element: T_d = BA·(dl/dt)/l0 (MoorDyn's)
+        self.ba = np.full(ne, float(internal_damping))
         self.rho = env.rho
         self.g = env.g
         self.depth = env.depth
@@ -238,6 +247,22 @@ class LineModel:
         out[:-1] -= f
         out[1:] += f
         return out
+
+    def damping_tension(self, V: np.ndarray, e: np.ndarray) -> np.ndarray | None:
+        """Internal (axial) damping tension T_d = BA·e·(v_b − v_a)/l0 of every element,
+        None without internal damping. [N]"""
+        if not np.any(self.ba):
+            return None
+        dv = V[1:] - V[:-1]
+        return self.ba / self.l0 * np.einsum("ij,ij->i", e, dv)
+
+    def damping_blocks(self, e: np.ndarray) -> np.ndarray | None:
+        """Element blocks of ∂(T_d forces)/∂u̇: (BA/l0) e eᵀ ⊗ [[1, −1], [−1, 1]] (the
+        rotation of e left out, as for the drag), None without internal damping."""
+        if not np.any(self.ba):
+            return None
+        zero = np.zeros_like(self.ba)
+        return self.stiffness_blocks(e, np.ones_like(self.ba), zero, self.ba)
 
     def stiffness_blocks(
         self, e: np.ndarray, l: np.ndarray, T: np.ndarray, ea: np.ndarray
