@@ -37,6 +37,7 @@ __all__ = [
     "student_interval",
     "simulate_line_reference",
     "compare_line",
+    "window_std",
     "QUANTITIES",
 ]
 
@@ -199,7 +200,9 @@ class LineComparison:
         )
 
 
-def _window_std(h: EndTensionHistory, t0: float, t1: float) -> tuple[dict[str, float], float]:
+def window_std(h: EndTensionHistory, t0: float, t1: float) -> tuple[dict[str, float], float]:
+    """σ of every quantity of :data:`QUANTITIES` [N] and of the applied motion [m] over
+    t0 <= t < t1 (one whole period: the motion's σ is exact)."""
     w = h.window(t0, t1)
     out = {
         "a": float(h.tension_a[w].std()),
@@ -292,8 +295,8 @@ def compare_line(
             dt=moordyn_dt,
             internal_damping=moordyn_internal_damping,
         )
-        s_ref, x_ref = _window_std(ref, period, duration)
-        s_md, _ = _window_std(md, period, duration)
+        s_ref, x_ref = window_std(ref, period, duration)
+        s_md, _ = window_std(md, period, duration)
         results.append(SeedResult(int(seed), x_ref, s_ref, s_md))
         static = {
             "reference": (ref.static_a, ref.static_b),
