@@ -159,3 +159,44 @@ def test_reference_agrees_with_moordyn_on_a_short_chain_record(moordyn, chain):
     # the same phases in both: the σ themselves are of the chain's size (DESIGN.md
     # chain, FD fairlead σ ≈ 120 kN for this motion)
     assert 1.0e5 < c.sigma("moordyn", "b")[0] < 1.4e5
+
+
+# ------------------------------------------------------------------ the benchmark page
+
+
+def _load_benchmark():
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "moordyn_check.py"
+    spec = importlib.util.spec_from_file_location("moordyn_check", path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_benchmark_page_reports_the_paired_ratio(moordyn):
+    """The page of benchmarks/moordyn_check.py from a synthetic cache in which every
+    reference σ is 1 % above MoorDyn's: every paired ratio reads +1.000 ± 0.000 %."""
+    bench = _load_benchmark()
+    cache = {}
+    for run in bench._runs():
+        sig = {q: 1e5 * (1.0 + 0.1 * i) for i, q in enumerate(("a", "b", "reaction_b"))}
+        # seed-to-seed scatter, the same for both simulators of a pair
+        k_md = 1.0 + 0.01 * run["seed"]
+        fac = 1.01 if run["sim"] == "reference" else 1.0
+        cache[bench.run_key(run)] = {
+            **{q: v * k_md * fac for q, v in sig.items()},
+            "motion_std": 0.5,
+            "motion_exact": 0.5,
+            "static_a": 1e6,
+            "static_b": 1.5e6,
+            "ba_ns": 0.0,
+            "wall": 1.0,
+        }
+    page = bench.write_page(cache)
+    table = [r for r in page.splitlines() if r.startswith("| chain |")][0]
+    assert table.count("+1.000 ± 0.000 %") == 3  # ratio a, ratio b, ratio reaction b
+    assert "| 20 elements" in page and "| deep |" in page
