@@ -113,6 +113,64 @@ def test_comparison_scene_refuses_what_moordyn_line_types_cannot_hold(chain):
         comparison_scene(chain, "nope")
 
 
+# ------------------------------------------------------------------ reference options
+
+
+def _model(chain, **kw):
+    from stochcable.line.mesh import mesh_line
+    from stochcable.reference.cable_model import LineModel
+
+    sc = comparison_scene(chain, elements=6)
+    env = sc.environment
+    mesh = mesh_line(sc.lines[0], env.rho, env.g)
+    ls = solve_statics(sc).lines[sc.lines[0].name]
+    X = np.asarray(ls.positions)[:, [0, 2]]
+    return LineModel(mesh, env, X, 2, **kw), X
+
+
+def test_internal_damping_is_ba_times_the_strain_rate(chain):
+    ba = 2.5e6  # [N·s]
+    model, X = _model(chain, internal_damping=ba)
+    rng = np.random.default_rng(11)
+    V = rng.normal(size=X.shape)
+    e, l, _, _ = model.elements(X)
+    # strain rate by central differences of the element lengths along X + V·τ
+    h = 1e-6
+    lp = model.elements(X + h * V)[1]
+    lm = model.elements(X - h * V)[1]
+    rate = (lp - lm) / (2 * h) / model.l0
+    np.testing.assert_allclose(model.damping_tension(V, e), ba * rate, rtol=1e-6)
+    # its velocity Jacobian (fixed tangents): linear in V, so central differences are
+    # exact to rounding
+    blocks = model.damping_blocks(e)
+    j = 2
+    Vj = V.copy()
+    dv = np.zeros_like(V)
+    dv[j + 1, 0] = 1.0  # node b of element j, x
+    td1 = model.damping_tension(Vj + dv, e)[j]
+    td0 = model.damping_tension(Vj, e)[j]
+    force_b = (td1 - td0) * e[j]  # change of T_d·e on node b (sign of the residual)
+    np.testing.assert_allclose(blocks[j][2:, 2], force_b, rtol=1e-9)
+    # none by default (the reference's results unchanged)
+    plain, _ = _model(chain)
+    assert plain.damping_tension(V, e) is None and plain.damping_blocks(e) is None
+
+
+def test_lumped_mass_keeps_the_total_and_is_diagonal(chain):
+    lumped, _ = _model(chain, lumped_mass=True)
+    consistent, _ = _model(chain)
+    Ml = lumped.M_sparse.toarray()
+    Mc = consistent.M_sparse.toarray()
+    # every element's mass split half-half: the row sums of the two matrices agree
+    # (a rigid translation has the same inertia)
+    np.testing.assert_allclose(Ml.sum(axis=1), Mc.sum(axis=1), rtol=1e-12)
+    # the structural mass is diagonal (added mass couples x, z of a node only)
+    off_node = Ml.copy()
+    for i in range(lumped.n):
+        off_node[2 * i : 2 * i + 2, 2 * i : 2 * i + 2] = 0.0
+    assert np.abs(off_node).max() == 0.0
+
+
 # ------------------------------------------------------------------ MoorDyn
 
 

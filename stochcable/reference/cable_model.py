@@ -72,6 +72,7 @@ __all__ = [
     "SLACK_STIFFNESS_RATIO",
     "GAUSS_POINTS",
     "CONSISTENT",
+    "LUMPED",
     "DRAG_EPS",
     "axes",
     "LineModel",
@@ -87,6 +88,9 @@ GAUSS_POINTS = 3
 
 CONSISTENT = np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
 """Consistent-mass weights of a linear element, ∫N_a N_c dξ. [-]"""
+
+LUMPED = np.array([[0.5, 0.0], [0.0, 0.5]])
+"""Lumped-mass weights (half of the element on each node, as MoorDyn's nodes). [-]"""
 
 DRAG_EPS = 1e-9
 """Regularization of |v| in the drag and its Jacobian. [m/s]"""
@@ -112,6 +116,7 @@ class LineModel:
         x_static: np.ndarray,
         dim: int,
         internal_damping: float = 0.0,
+        lumped_mass: bool = False,
     ):
         self.mesh = mesh
         self.dim = d = dim
@@ -197,7 +202,8 @@ class LineModel:
 
         def el_matrix(blocks3: np.ndarray) -> np.ndarray:
             """Element (ne, d, d) densities ⊗ consistent weights -> (ne, 2d, 2d)."""
-            return np.einsum("ab,eij->eaibj", CONSISTENT, blocks3).reshape(ne, 2 * d, 2 * d)
+            weights = LUMPED if lumped_mass else CONSISTENT
+            return np.einsum("ab,eij->eaibj", weights, blocks3).reshape(ne, 2 * d, 2 * d)
 
         node_m = (mesh.node_mass + mesh.node_added_mass)[:, None, None] * I  # (n, d, d)
         mel = el_matrix(m_struct + m_add)
