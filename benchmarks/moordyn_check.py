@@ -123,7 +123,12 @@ def _runs() -> list[dict]:
     both("chain", two, elements=40)
     both("chain", two, cbot=0.0)
     for s in two:
-        runs.append({"line": "chain", "sim": "reference", "seed": s, **BASE, "dt": 0.025})
+        runs.append(
+            {"line": "chain", "sim": "reference", "seed": s, **BASE, "cbot": 0.0, "dt": 0.0125}
+        )
+    for s in two:
+        for dt in (0.025, 0.1, 0.125, 0.2):
+            runs.append({"line": "chain", "sim": "reference", "seed": s, **BASE, "dt": dt})
         runs.append({"line": "chain", "sim": "moordyn", "seed": s, **BASE, "coupling": 1e-3})
         runs.append({"line": "chain", "sim": "moordyn", "seed": s, **BASE, "ba": -1.0})
         runs.append(
@@ -135,6 +140,9 @@ def _runs() -> list[dict]:
                 {"line": "chain", "sim": "reference", "seed": s, **BASE, "elements": n,
                  "mass": "lumped"}
             )  # fmt: skip
+    for s in two:
+        runs.append({"line": "deep", "sim": "reference", "seed": s, **BASE, "dt": 0.025})
+        runs.append({"line": "deep", "sim": "reference", "seed": s, **BASE, "mass": "lumped"})
     for line in ("chain", "taut", "deep"):
         for s in (1, 2, 3):
             runs.append(
@@ -297,7 +305,7 @@ def write_page(cache: dict) -> str:
         )
     lines += _experiments(cache)
     lines += _partial_window()
-    lines += FINDINGS
+    lines += _findings(cache)
     return "\n".join(lines) + "\n"
 
 
@@ -327,7 +335,110 @@ def _partial_window() -> list[str]:
     return out
 
 
-FINDINGS: list[str] = []
+def _mean_pct(new: list[dict], base: list[dict], q: str) -> float:
+    return 100.0 * float(np.mean(_shift(new, base, q)))
+
+
+def _findings(cache: dict) -> list[str]:
+    """The conclusions, with their numbers read from the runs above."""
+    two, three = (1, 2), (1, 2, 3)
+    g = lambda line, sim, seeds=two, **o: _get(cache, line, sim, seeds, **o)  # noqa: E731
+    worst = max(
+        abs(x) * 100.0
+        for line in ("chain", "taut", "deep")
+        for q in ("a", "b")
+        for x in _ratio(g(line, "reference", SEEDS), g(line, "moordyn", SEEDS), q)
+    )
+    ref0 = g("chain", "reference")
+    dts = {dt: _mean_pct(g("chain", "reference", dt=dt), ref0, "b") for dt in (0.025, 0.125, 0.2)}
+    n20 = 100 * np.mean(
+        _ratio(g("chain", "reference", elements=20), g("chain", "moordyn", elements=20), "b")
+    )
+    n20l = 100 * np.mean(
+        _ratio(
+            g("chain", "reference", elements=20, mass="lumped"),
+            g("chain", "moordyn", elements=20),
+            "b",
+        )
+    )
+    ba = {
+        line: (
+            100
+            * np.mean(
+                _ratio(
+                    g(line, "reference", three),
+                    g(line, "moordyn", three, ba=-1.0, scheme="RK2"),
+                    "b",
+                )
+            ),
+            100
+            * np.mean(
+                _ratio(
+                    g(line, "reference", three, ba=-1.0),
+                    g(line, "moordyn", three, ba=-1.0, scheme="RK2"),
+                    "b",
+                )
+            ),
+        )
+        for line in ("chain", "taut", "deep")
+    }
+    deep_l = 100 * np.mean(_ratio(g("deep", "reference", mass="lumped"), g("deep", "moordyn"), "b"))
+    deep_c = 100 * np.mean(_ratio(g("deep", "reference"), g("deep", "moordyn"), "b"))
+    cb = 100 * np.mean(
+        _ratio(g("chain", "reference", cbot=0.0), g("chain", "moordyn", cbot=0.0), "b")
+    )
+    cb_fine = 100 * np.mean(
+        _ratio(g("chain", "reference", cbot=0.0, dt=0.0125), g("chain", "moordyn", cbot=0.0), "b")
+    )
+    react = 100 * np.mean([r["reaction_b"] / r["b"] - 1.0 for r in ref0])
+    return [
+        "",
+        "## Findings",
+        "",
+        f"1. **Agreement.**  With the same physics (no internal damping) and 80 elements the "
+        f"reference and MoorDyn agree on the end tension σ within {worst:.2f} % on every "
+        "seed of the three lines, at both ends, and on the static end tensions within "
+        "0.01 %.  The goal (0.5 %) is met without changing the reference's physics; the "
+        "differences below are the modelling and numerical choices that move it.",
+        f"2. **Reference time step** (Newmark period error, numerical): the fairlead σ "
+        f"moves by {dts[0.025]:+.2f} % at Δt 0.025 s, {dts[0.125]:+.2f} % at 0.125 s and "
+        f"{dts[0.2]:+.2f} % at 0.2 s against Δt 0.05 s.  0.125 s is the step the reference "
+        "picks by itself for this motion on the example's 0.25 s grid ((ωΔt)²/12 ≤ 0.5 % "
+        "at the 99 % frequency, 1.72 rad/s): its default records read high by that row.  "
+        "Pass `dt` ≤ 0.05 s (what this page does) for a 0.2 %-level yardstick.",
+        "3. **Internal damping** (physical: MoorDyn's `BA`).  MoorDyn as commonly run "
+        "(BA = −1, i.e. ζ = 1 of each segment's axial mode, RK2; RK2 needs it: without "
+        "damping its axial modes grow) against the undamped reference: ratio b "
+        + ", ".join(f"{k} {v[0]:+.2f} %" for k, v in ba.items())
+        + "; with the same BA in the reference (`simulate_line_timedomain(..., "
+        "internal_damping=BA)`, N·s, from `internal_damping_coefficient`): "
+        + ", ".join(f"{k} {v[1]:+.2f} %" for k, v in ba.items())
+        + ".  ζ-per-segment damping depends on the segment count; it is a model choice of "
+        "MoorDyn's, not a property of the line.",
+        f"4. **Lumped vs consistent mass** (discretization).  At 20 elements the reference "
+        f"reads {n20:+.2f} % against MoorDyn at the fairlead; with MoorDyn's lumped mass "
+        f"(`mass_matrix='lumped'`) {n20l:+.2f} % — the mass matrix is most of the "
+        "difference, the rest is MoorDyn's nodal drag and node-tangent added mass.  Both "
+        "converge to the same σ as the elements grow (the 40- and 80-element rows).  The "
+        f"deep line's {deep_c:+.2f} % at 80 elements (27.5 m elements) is the same term: "
+        f"{deep_l:+.2f} % with the lumped mass.",
+        f"5. **Seabed damping.**  With cBot = 0 the reference reads {cb:+.0f} % against "
+        "MoorDyn (which moves by < 0.3 %): the grounded nodes ring on the contact spring "
+        "(k·D·l ≈ 6.9e6 N/m per node against ≈ 3.4 t of node mass, ≈ 45 rad/s; ωΔt ≈ 2.3 "
+        "at Δt 0.05 s) and the one-sided contact pumps that unresolved oscillation; no "
+        "ResolutionWarning says so.  At Δt 0.0125 s the reference reads "
+        f"{cb_fine:+.2f} %.  With the example's cBot = 3e5 Pa·s/m the contact mode is "
+        "overdamped and Δt 0.05 s is fine.",
+        "6. **Conventions that do not matter here**: MoorDyn's `CdAx` is on π·d like ours "
+        "(passed unchanged; a factor π in the axial drag moves the chain's fairlead σ by "
+        "≈ 1.7 % at 40 elements, which the test would see); MoorDyn coupling calls "
+        "every 1 ms instead of 5 ms move σ by < 0.05 %; RK2 vs RK4 with BA by ≈ 0.05 %.",
+        f"7. **Which tension.**  MoorDyn's `FairTen`/`AnchTen` are end-*segment* tensions; "
+        f"the support reaction (the frequency-domain end tension's definition) has a σ "
+        f"{react:+.2f} % above it at the chain's fairlead with 80 elements (O(1/N): the "
+        "inertia of the half element on the end node), identical in both simulators.  "
+        "A comparison of the frequency domain with MoorDyn must use the same one.",
+    ]
 
 
 def _experiments(cache: dict) -> list[str]:
@@ -372,11 +483,13 @@ def _experiments(cache: dict) -> list[str]:
             _get(cache, "chain", "reference", two, elements=n, mass="lumped"),
             md_n,
         )
-    row(
-        "reference Δt 0.025 s (Newmark period error)",
-        _get(cache, "chain", "reference", two, dt=0.025),
-        md0,
-    )
+    for dt in (0.025, 0.1, 0.125, 0.2):
+        row(
+            f"reference Δt {dt:g} s (Newmark period error (ωΔt)²/12 = "
+            f"{(2.0 * dt) ** 2 / 12:.2%} at 2 rad/s, {(0.63 * dt) ** 2 / 12:.3%} at the peak)",
+            _get(cache, "chain", "reference", two, dt=dt),
+            md0,
+        )
     row(
         "MoorDyn coupling calls every 1 ms",
         ref0,
@@ -387,6 +500,11 @@ def _experiments(cache: dict) -> list[str]:
         _get(cache, "chain", "reference", two, cbot=0.0),
         _get(cache, "chain", "moordyn", two, cbot=0.0),
     )
+    row(
+        "… and the reference at Δt 0.0125 s",
+        _get(cache, "chain", "reference", two, cbot=0.0, dt=0.0125),
+        _get(cache, "chain", "moordyn", two, cbot=0.0),
+    )
     md_ba4 = _get(cache, "chain", "moordyn", two, ba=-1.0)
     row("MoorDyn BA = −1 (ζ 1 per segment), RK4; reference undamped", ref0, md_ba4)
     row(
@@ -394,6 +512,22 @@ def _experiments(cache: dict) -> list[str]:
         _get(cache, "chain", "reference", two, ba=-1.0, dt=0.025),
         md_ba4,
     )
+    ref_d = _get(cache, "deep", "reference", two)
+    md_d = _get(cache, "deep", "moordyn", two)
+    out += [
+        "",
+        "Deep-water catenary, seeds 1–2:",
+        "",
+        "| change | ratio a | ratio b |",
+        "|---|---|---|",
+        f"| baseline | {_pct(_ratio(ref_d, md_d, 'a'))} | {_pct(_ratio(ref_d, md_d, 'b'))} |",
+    ]
+    for label, opt in (
+        ("reference Δt 0.025 s", {"dt": 0.025}),
+        ("reference lumped mass", {"mass": "lumped"}),
+    ):
+        r = _get(cache, "deep", "reference", two, **opt)
+        out.append(f"| {label} | {_pct(_ratio(r, md_d, 'a'))} | {_pct(_ratio(r, md_d, 'b'))} |")
     out += [
         "",
         "## Internal damping: MoorDyn as commonly run (BA = −1, RK2) — seeds 1–3",
