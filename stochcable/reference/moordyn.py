@@ -47,6 +47,12 @@ internal damping (option)      ``BA`` [N·s]: T_d = BA·(dl/dt)/l0 per segment;
 - Masses: MoorDyn lumps mass, added mass, weight and drag on the nodes (node tangent =
   the mean of the adjacent segments'), ours uses consistent mass and Gauss quadrature
   on the elements; with the same element count the two converge to the same continuum.
+  ``simulate_line_timedomain(..., mass_matrix="lumped")`` takes MoorDyn's lumped mass
+  (most of the difference on coarse meshes: docs/benchmarks/moordyn.md).
+- Time integration: MoorDyn's RK2 needs internal damping (see :func:`moordyn_input_file`),
+  so the harness runs RK4 with BA = 0 to match the undamped reference; to compare with
+  MoorDyn as commonly run (BA = −1, RK2) give the reference the same BA in N·s
+  (:func:`internal_damping_coefficient`).
 - Tensions compared: the **end-segment tension** (MoorDyn ``GetLineFairTen`` = |T_N−1
   + T_d|, ``GetLineNodeTen(line, 0)`` at the anchor; ours ``element_tension`` of the
   first and last element), a like-for-like quantity.  The support reaction (ours
@@ -68,7 +74,7 @@ import math
 import os
 import sys
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -76,8 +82,9 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as _v
-from stochcable.errors import InputError
+from stochcable.errors import InputError, SolverError
 from stochcable.reference.cable_excitation import half_cosine
+from stochcable.reference.periodic_motion import SurgeMotion, periodic_dsa_surge
 from stochcable.scene.model import Line, Scene, load_scene
 
 __all__ = [
@@ -110,111 +117,6 @@ def import_moordyn() -> Any:
     except ImportError as exc:  # pragma: no cover - exercised only without moordyn
         raise ImportError(_EXTRA_HINT) from exc
     return moordyn
-
-
-# --------------------------------------------------------------------------- motion
-
-
-@dataclass(frozen=True, eq=False)
-class SurgeMotion:
-    """A periodic surge x(t) = Σ_j a_j cos(ω_j t − θ_j), ω_j = 2πj/T.
-
-    Attributes
-    ----------
-    omega : ndarray, shape (n,)
-        Component frequencies, multiples of 2π/period. [rad/s]
-    amplitude : ndarray, shape (n,)
-        Amplitudes a_j. [m]
-    phase : ndarray, shape (n,)
-        Phases θ_j. [rad]
-    period : float
-        The period T. [s]
-    harmonic : ndarray of int, shape (n,)
-        j = ω_j·T/2π. [-]
-    """
-
-    omega: np.ndarray
-    amplitude: np.ndarray
-    phase: np.ndarray
-    period: float
-    harmonic: np.ndarray
-
-    @property
-    def std(self) -> float:
-        """Standard deviation over one whole period, √(Σ a_j²/2). [m]"""
-        return float(math.sqrt(0.5 * float(np.sum(self.amplitude**2))))
-
-    def displacement(self, t: np.ndarray) -> np.ndarray:
-        """x(t). [m]"""
-        arg = np.multiply.outer(np.asarray(t, float), self.omega) - self.phase
-        return np.cos(arg) @ self.amplitude
-
-    def velocity(self, t: np.ndarray) -> np.ndarray:
-        """ẋ(t). [m/s]"""
-        arg = np.multiply.outer(np.asarray(t, float), self.omega) - self.phase
-        return -np.sin(arg) @ (self.amplitude * self.omega)
-
-    def acceleration(self, t: np.ndarray) -> np.ndarray:
-        """ẍ(t). [m/s²]"""
-        arg = np.multiply.outer(np.asarray(t, float), self.omega) - self.phase
-        return -np.cos(arg) @ (self.amplitude * self.omega**2)
-
-    def coefficients(self, n_periods: int, n_samples: int) -> np.ndarray:
-        """FFT coefficients X_m (m = 0 … n_samples/2) of x on a record of ``n_periods``
-        periods sampled ``n_samples`` times, with x(t_n) = irfft(X)[n]: X_m =
-        (n_samples/2)·a_j·e^{−iθ_j} at m = n_periods·j (DESIGN.md "FFT"). [m]"""
-        m = n_periods * self.harmonic
-        if m.size and int(m.max()) >= n_samples // 2:
-            raise InputError(
-                "n_samples", n_samples, "-", f"must exceed 2·{int(m.max())} (the top harmonic)"
-            )
-        out = np.zeros(n_samples // 2 + 1, dtype=complex)
-        out[m] = 0.5 * n_samples * self.amplitude * np.exp(-1j * self.phase)
-        return out
-
-
-def periodic_dsa_surge(
-    density: Callable[[np.ndarray], np.ndarray],
-    period: float,
-    band: tuple[float, float],
-    rng: np.random.Generator | int,
-) -> SurgeMotion:
-    """A periodic DSA realization of a motion spectrum over a band.
-
-    Parameters
-    ----------
-    density : callable
-        One-sided motion spectrum S(ω). [m²·s/rad]
-    period : float
-        Period T of the realization; Δω = 2π/T. [s]
-    band : (float, float)
-        Components with band[0] <= ω_j <= band[1] are kept. [rad/s]
-    rng : Generator or int
-        Source of the phases θ_j, uniform on (−π, π]. [-]
-
-    Returns
-    -------
-    SurgeMotion
-
-    Notes
-    -----
-    DSA (seed 001 eq. 5.1.1 with DESIGN.md's correction): a_j = √(2 S(ω_j) Δω), so the
-    variance over a whole period is Σ S(ω_j)Δω exactly, for every seed.
-    """
-    period = _v.positive("period", period, "s")
-    lo = _v.nonnegative("band[0]", band[0], "rad/s")
-    hi = _v.positive("band[1]", band[1], "rad/s")
-    if hi <= lo:
-        raise InputError("band", band, "rad/s", "must be (low, high) with high > low")
-    dw = 2.0 * math.pi / period
-    j = np.arange(max(1, int(math.ceil(lo / dw - 1e-9))), int(math.floor(hi / dw + 1e-9)) + 1)
-    if j.size == 0:
-        raise InputError("period", period, "s", f"gives no component in the band {band} rad/s")
-    w = j * dw
-    a = np.sqrt(2.0 * np.asarray(density(w), float) * dw)
-    gen = np.random.default_rng(rng)
-    theta = gen.uniform(-math.pi, math.pi, size=j.size)
-    return SurgeMotion(w, a, theta, period, j)
 
 
 # --------------------------------------------------------------------------- scenes
@@ -535,5 +437,10 @@ def simulate_line_moordyn(
         finally:
             with _quiet():
                 md.Close(system)
+    if not (np.all(np.isfinite(ta)) and np.all(np.isfinite(tb))):
+        raise SolverError(
+            f"MoorDyn's end tensions are not finite (dtM {dt} s, tScheme {scheme}, BA "
+            f"{internal_damping}): reduce dt, or use RK4 or internal damping"
+        )
     ts = tc[::every]
     return EndTensionHistory(ts, ta, tb, rb, static_a, static_b, xs[::every], "moordyn")
