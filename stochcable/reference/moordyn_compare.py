@@ -25,6 +25,7 @@ from stochcable.reference.moordyn import (
     EndTensionHistory,
     SurgeMotion,
     comparison_scene,
+    internal_damping_coefficient,
     periodic_dsa_surge,
     simulate_line_moordyn,
 )
@@ -227,6 +228,8 @@ def compare_line(
     moordyn_dt: float = 1e-3,
     coupling_dt: float = 5e-3,
     moordyn_internal_damping: float = 0.0,
+    moordyn_scheme: str = "RK4",
+    match_internal_damping: bool = False,
     reference_options: dict | None = None,
 ) -> LineComparison:
     """Tension σ of the reference simulator and MoorDyn on one line and several seeds.
@@ -256,6 +259,11 @@ def compare_line(
         MoorDyn's dtM and the interval of its coupling calls. [s]
     moordyn_internal_damping : float, default 0
         MoorDyn's BA (N·s, or minus a damping ratio). [N·s]
+    moordyn_scheme : str, default "RK4"
+        MoorDyn's tScheme (RK2 needs internal damping). [-]
+    match_internal_damping : bool, default False
+        Give the reference MoorDyn's BA too (in N·s for this element count,
+        :func:`~stochcable.reference.moordyn.internal_damping_coefficient`). [-]
     reference_options : dict, optional
         Extra keywords of :func:`~stochcable.reference.cable.simulate_line_timedomain`.
 
@@ -272,6 +280,8 @@ def compare_line(
         raise InputError("seeds", seeds, "-", "needs at least one seed")
     duration = 2.0 * period
     opts = dict(reference_options or {})
+    if match_internal_damping:
+        opts["internal_damping"] = internal_damping_coefficient(sc, moordyn_internal_damping)
 
     def density(w: np.ndarray) -> np.ndarray:
         return spectrum_pierson_moskowitz(w, hs, tp)
@@ -294,6 +304,7 @@ def compare_line(
             coupling_dt=coupling_dt,
             dt=moordyn_dt,
             internal_damping=moordyn_internal_damping,
+            scheme=moordyn_scheme,
         )
         s_ref, x_ref = window_std(ref, period, duration)
         s_md, _ = window_std(md, period, duration)
@@ -312,6 +323,7 @@ def compare_line(
         "moordyn_dt": moordyn_dt,
         "coupling_dt": coupling_dt,
         "moordyn_internal_damping": moordyn_internal_damping,
+        "moordyn_scheme": moordyn_scheme,
         "reference_options": opts,
     }
     return LineComparison(sc.lines[0].name, tuple(results), std0, static, settings)
