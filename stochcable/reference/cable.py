@@ -259,6 +259,8 @@ def simulate_line_timedomain(
     element_every: int = 1,
     end_realizations: dict | None = None,
     band: tuple[float, float] | None = None,
+    internal_damping: float = 0.0,
+    mass_matrix: str = "consistent",
 ) -> CableTimeHistory:
     """Nonlinear time-domain response of one line to the scene's sea and end motions.
 
@@ -303,6 +305,14 @@ def simulate_line_timedomain(
         frequency-domain analysis synthesizes its series on its ``omega`` range, so
         ``band=(omega.min, omega.max)`` reproduces its excitation exactly.  Default:
         every component of the realization. [rad/s]
+    internal_damping : float, default 0
+        Axial internal damping BA of every element: the axial force gains
+        T_d = BA·(dl/dt)/l0, l0 the element's unstretched length (MoorDyn's line-type
+        ``BA`` in N·s, :mod:`stochcable.reference.moordyn`); included in
+        ``element_tension`` and the end tensions.  0 (the default): none. [N·s]
+    mass_matrix : {"consistent", "lumped"}, default "consistent"
+        Element mass and added mass: consistent (m l0 [[1/3, 1/6], [1/6, 1/3]], the
+        frequency-domain model's) or lumped (half on each node, MoorDyn's). [-]
 
     Returns
     -------
@@ -372,7 +382,12 @@ def simulate_line_timedomain(
     mesh = mesh_line(line, scene.environment.rho, scene.environment.g)
     ax = axes(dim)
     x3 = statics_guess(scene, line, mesh, statics)
-    model, xs, u_cur, u_cur_g, tol_abs = _static_start(scene, mesh, x3, dim, tolerance)
+    internal_damping = _v.nonnegative("internal_damping", internal_damping, "N·s")
+    if mass_matrix not in ("consistent", "lumped"):
+        raise InputError("mass_matrix", mass_matrix, "-", "must be 'consistent' or 'lumped'")
+    model, xs, u_cur, u_cur_g, tol_abs = _static_start(
+        scene, mesh, x3, dim, tolerance, internal_damping, mass_matrix == "lumped"
+    )
     r = half_cosine(t, ramp)
     sl = np.arange(n_steps + 1) % (k_up * grid.n_samples)  # periodic in T_L
     u_wave = u_wave_g = f_in = None
@@ -488,7 +503,13 @@ def _time_step(
 
 
 def _static_start(
-    scene: Scene, mesh: Any, x3: np.ndarray, dim: int, tolerance: float
+    scene: Scene,
+    mesh: Any,
+    x3: np.ndarray,
+    dim: int,
+    tolerance: float,
+    ba: float = 0.0,
+    lumped: bool = False,
 ) -> tuple[LineModel, np.ndarray, np.ndarray, np.ndarray, float]:
     """The model about its own static equilibrium (re-solved from the statics' shape
     ``x3``), the current at the nodes and the drag points, and the absolute Newton
@@ -506,7 +527,7 @@ def _static_start(
     xs, _ = static_equilibrium(
         model0, x3 @ ax, u_cur, u_cur_g, f_ref, max(1e-3 * tol_abs, 1e-11 * f_ref)
     )
-    model = LineModel(mesh, env, xs, dim)  # added mass about the re-solved tangents
+    model = LineModel(mesh, env, xs, dim, ba, lumped)  # added mass about the re-solved tangents
     return model, xs, u_cur, u_cur_g, tol_abs
 
 

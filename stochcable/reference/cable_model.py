@@ -72,6 +72,7 @@ __all__ = [
     "SLACK_STIFFNESS_RATIO",
     "GAUSS_POINTS",
     "CONSISTENT",
+    "LUMPED",
     "DRAG_EPS",
     "axes",
     "LineModel",
@@ -87,6 +88,9 @@ GAUSS_POINTS = 3
 
 CONSISTENT = np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
 """Consistent-mass weights of a linear element, ∫N_a N_c dξ. [-]"""
+
+LUMPED = np.array([[0.5, 0.0], [0.0, 0.5]])
+"""Lumped-mass weights (half of the element on each node, as MoorDyn's nodes). [-]"""
 
 DRAG_EPS = 1e-9
 """Regularization of |v| in the drag and its Jacobian. [m/s]"""
@@ -105,7 +109,15 @@ class LineModel:
     Arrays: X, V, A of shape (n_nodes, dim); the DOF of node i, coordinate c is i·dim + c.
     """
 
-    def __init__(self, mesh: LineMesh, env: Environment, x_static: np.ndarray, dim: int):
+    def __init__(
+        self,
+        mesh: LineMesh,
+        env: Environment,
+        x_static: np.ndarray,
+        dim: int,
+        internal_damping: float = 0.0,
+        lumped_mass: bool = False,
+    ):
         self.mesh = mesh
         self.dim = d = dim
         self.n = n = mesh.n_nodes
@@ -113,6 +125,8 @@ class LineModel:
         self.N = n * d
         self.l0 = mesh.l0
         self.ea = mesh.ea
+        # axial internal damping BA [N·s] per element: T_d = BA·(dl/dt)/l0 (MoorDyn's)
+        self.ba = np.full(ne, float(internal_damping))
         self.rho = env.rho
         self.g = env.g
         self.depth = env.depth
@@ -188,7 +202,8 @@ class LineModel:
 
         def el_matrix(blocks3: np.ndarray) -> np.ndarray:
             """Element (ne, d, d) densities ⊗ consistent weights -> (ne, 2d, 2d)."""
-            return np.einsum("ab,eij->eaibj", CONSISTENT, blocks3).reshape(ne, 2 * d, 2 * d)
+            weights = LUMPED if lumped_mass else CONSISTENT
+            return np.einsum("ab,eij->eaibj", weights, blocks3).reshape(ne, 2 * d, 2 * d)
 
         node_m = (mesh.node_mass + mesh.node_added_mass)[:, None, None] * I  # (n, d, d)
         mel = el_matrix(m_struct + m_add)
@@ -238,6 +253,22 @@ class LineModel:
         out[:-1] -= f
         out[1:] += f
         return out
+
+    def damping_tension(self, V: np.ndarray, e: np.ndarray) -> np.ndarray | None:
+        """Internal (axial) damping tension T_d = BA·e·(v_b − v_a)/l0 of every element,
+        None without internal damping. [N]"""
+        if not np.any(self.ba):
+            return None
+        dv = V[1:] - V[:-1]
+        return self.ba / self.l0 * np.einsum("ij,ij->i", e, dv)
+
+    def damping_blocks(self, e: np.ndarray) -> np.ndarray | None:
+        """Element blocks of ∂(T_d forces)/∂u̇: (BA/l0) e eᵀ ⊗ [[1, −1], [−1, 1]] (the
+        rotation of e left out, as for the drag), None without internal damping."""
+        if not np.any(self.ba):
+            return None
+        zero = np.zeros_like(self.ba)
+        return self.stiffness_blocks(e, np.ones_like(self.ba), zero, self.ba)
 
     def stiffness_blocks(
         self, e: np.ndarray, l: np.ndarray, T: np.ndarray, ea: np.ndarray

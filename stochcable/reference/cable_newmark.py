@@ -206,6 +206,9 @@ class _Step:
         Xm = Xn.reshape(n, d)
         Vm = Vn.reshape(n, d)
         e, l, T, ea = model.elements(Xm)
+        td = model.damping_tension(Vm, e)
+        if td is not None:
+            T = T + td  # the element's total axial force (as MoorDyn's T + T_d)
         fd, c_el, c_nd = model.drag(Xm, Vm, e, self.uf, self.ug, jacobian=jac)
         fb, kb, cb = model.seabed(Xm, Vm, self.s_bed)
         R = (model.M_sparse @ An) + (
@@ -237,6 +240,9 @@ def _newton(
         kel = model.stiffness_blocks(e, l, T, ea)
         if c_el is not None:
             kel = kel + c2 * c_el
+        c_int = model.damping_blocks(e)
+        if c_int is not None:
+            kel = kel + c2 * c_int
         c_nd[:, -1, -1] += c2 * cb + kb
         ab = model.band_matrix(kel, c_nd)[:, fr] + c1 * M_band_f
         ddu = sla.solve_banded((u_b, u_b), ab, -R[fr], check_finite=False)
