@@ -14,6 +14,7 @@ import numpy as np
 
 from stochcable import validation as _v
 from stochcable.dynamics.loads import element_wave_kinematics
+from stochcable.dynamics.sea_channels import spectrum_callable
 from stochcable.errors import InputError
 from stochcable.reference.cable_model import LineModel
 from stochcable.scene.model import Environment, Line, Scene
@@ -177,16 +178,9 @@ def band_limited(
 
 
 def spectrum_density(spec: Any, g: float):
-    """ω -> S(ω) with S(0) = 0 (as :mod:`stochcable.dynamics` samples it)."""
-
-    def density(w: np.ndarray) -> np.ndarray:
-        w = np.asarray(w, dtype=float)
-        out = np.zeros_like(w)
-        pos = w > 0
-        out[pos] = spec.spectral_density(w[pos], g)
-        return out
-
-    return density
+    """ω -> S(ω) with S(0) = 0, as :mod:`stochcable.dynamics` samples it
+    (:func:`stochcable.dynamics.sea_channels.spectrum_callable`)."""
+    return spectrum_callable(spec, g)
 
 
 def end_motion_generators(scene: Scene, seed: int) -> dict[tuple[str, str, str], Any]:

@@ -83,9 +83,10 @@ import numpy as np
 
 from stochcable import validation as _v
 from stochcable.errors import InputError, SolverError
+from stochcable.reference.cable import _select_line
 from stochcable.reference.cable_excitation import half_cosine
 from stochcable.reference.periodic_motion import SurgeMotion, periodic_dsa_surge
-from stochcable.scene.model import Line, Scene, load_scene
+from stochcable.scene.model import Scene, load_scene
 
 __all__ = [
     "SurgeMotion",
@@ -165,15 +166,6 @@ def comparison_scene(
     doc["analysis"].pop("timeseries", None)
     doc["analysis"].pop("fidelity", None)
     return load_scene(doc)
-
-
-def _select_line(scene: Scene, line_name: str | None) -> Line:
-    if line_name is None:
-        return scene.lines[0]
-    names = [ln.name for ln in scene.lines]
-    if line_name not in names:
-        raise InputError("line_name", line_name, "-", f"must be one of {names}")
-    return scene.lines[names.index(line_name)]
 
 
 def moordyn_input_file(
