@@ -99,10 +99,10 @@ def test_forced_block_must_be_a_positive_integer(size) -> None:
 
 
 #: Peak RSS bound of the 400-element, 2,000-frequency chain analysis in a fresh
-#: process. [MiB]  Measured 0.89–0.95 GB (Python, NumPy, SciPy and the library ≈
-#: 0.15 GB of it); the bound leaves 15 % for allocator and BLAS differences between
-#: machines.  Before the frequency blocks it was 1.44 GB.
-PEAK_400x2000_MB = 1100
+#: process. [MiB]  Measured 0.79 GB (Python, NumPy, SciPy and the library ≈ 0.16 GB
+#: of it); the bound leaves 15 % for allocator and BLAS differences between machines.
+#: Before the frequency blocks it was 1.44 GB.
+PEAK_400x2000_MB = 920
 
 _PEAK_CHILD = """
 import json, resource, sys

@@ -232,7 +232,7 @@ def solve_coupled(
     alone: list[CoupledGroup] = []
     for name in model.independent:
         lines_out[name], state = _solve_line(
-            model, name, chans[name], settings, progress, timing, inputs.get(name)
+            model, name, chans[name], settings, progress, timing, inputs.pop(name, None)
         )
         dampings[name] = state.dampings[name]
         alone.append(state)
@@ -300,6 +300,7 @@ def _solve_line(
         timing=timing,
         inputs=None if inputs is None or not ch else {name: inputs},
     )
+    inputs = None  # (not held through the outputs: the heading cache keeps small ones)
     timing["linearization_s"] += time.perf_counter() - t1
     progress("outputs", {"line": name})
     t1 = time.perf_counter()
