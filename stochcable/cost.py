@@ -40,22 +40,24 @@ subprocess, one BLAS thread; ``benchmarks/bench_cost.py``, x86-64, numpy 2, 2 co
 =====================================  =====  ======  =========  =======  =============
 scene                                  n_el   n_ω     channels   ΔRSS     B/(node·ω·ch)
 =====================================  =====  ======  =========  =======  =============
-taut_wire (sea only)                   200    1000    1          156 MB   775
-taut_wire                              400    1000    1          300 MB   748
-chain_catenary (sea + fairlead surge)  200    1000    2          352 MB   875
-chain_catenary                         400    1000    2          686 MB   856
-chain_catenary                         200    3000    2          1025 MB  850
-disc buoy, three legs (free body)      3×100  1000    4 per leg  966 MB   797
-disc buoy, three legs                  3×200  1000    4 per leg  1846 MB  766
+taut_wire (sea only)                   200    1000    1          140 MB   697
+taut_wire                              400    1000    1          223 MB   556
+chain_catenary (sea + fairlead surge)  200    1000    2          217 MB   540
+chain_catenary                         400    1000    2          359 MB   447
+chain_catenary                         200    3000    2          488 MB   405
+disc buoy, three legs (free body)      3×100  1000    4 per leg  622 MB   513
+disc buoy, three legs                  3×200  1000    4 per leg  1186 MB  492
 =====================================  =====  ======  =========  =======  =============
 
-so c_M = 900 B (the largest ratio, rounded up: the estimate should not be below the
-peak); c_T = 110 B per sample and channel (chain_catenary, 2^20 and 2^22 samples with
-the whole record in the result document: 320 B per sample); M_0 = 16 MB.  Time on the
-same machine: 3.5 µs per node·frequency·channel for single lines, 5.6 µs with a free
-body (k_M = 3.5 µs, the body factor 1 + 0.5 n_bodies), k_T = 1.7 µs per sample and
-channel.  Times are indicative (they scale with the CPU and the drag iterations); the
-memory model is what the budgets use.
+so c_M = 700 B (the largest ratio, rounded up: the estimate should not be below the
+peak; the drag fixed point's temporaries run over frequency blocks,
+:mod:`stochcable.dynamics.freqblocks`, so the ratio falls with the model's size);
+c_T = 110 B per sample and channel (chain_catenary, 2^20 and 2^22 samples with the
+whole record in the result document: 320 B per sample); M_0 = 16 MB.  Time on the
+same machine: 1.6–2.1 µs per node·frequency·channel for single lines, 3.8 µs with a
+free body (k_M = 2.2 µs, the body factor 1 + 0.8 n_bodies), k_T = 1.7 µs per sample
+and channel.  Times are indicative (they scale with the CPU and the drag iterations);
+the memory model is what the budgets use.
 
 The constants are in one place (the ``*_BYTES_*`` and ``*_SECONDS_*`` module
 constants) so that a change of the engine's array layout (frequency-blocked solves)
@@ -90,7 +92,7 @@ __all__ = [
     "SECONDS_PER_SAMPLE_CHANNEL",
 ]
 
-BYTES_PER_NODE_FREQUENCY_CHANNEL = 900
+BYTES_PER_NODE_FREQUENCY_CHANNEL = 700
 """Peak bytes per node, frequency and input channel of a line (c_M). [B]"""
 
 BYTES_PER_SAMPLE_CHANNEL = 110
@@ -99,13 +101,13 @@ BYTES_PER_SAMPLE_CHANNEL = 110
 BASE_BYTES = 16 * 2**20
 """Peak bytes of an analysis independent of its size (M_0: modes, statics, small arrays). [B]"""
 
-SECONDS_PER_NODE_FREQUENCY_CHANNEL = 3.5e-6
+SECONDS_PER_NODE_FREQUENCY_CHANNEL = 2.2e-6
 """Wall time per node, frequency and channel on the calibration machine (k_M). [s]"""
 
 SECONDS_PER_SAMPLE_CHANNEL = 1.7e-6
 """Wall time per time-series sample and channel on the calibration machine (k_T). [s]"""
 
-_BODY_TIME_FACTOR = 0.5  # extra time per free body (coupled solves): 5.6 µs vs 3.5 µs
+_BODY_TIME_FACTOR = 0.8  # extra time per free body (coupled solves): 3.8 µs vs 2.1 µs
 
 
 @dataclass(frozen=True)
