@@ -518,3 +518,23 @@ def test_nonstationary_record_warning_is_wired(monkeypatch):
         ResolutionWarning, match=r"not stationary.*\d rad/s \(omega dt = .*rerun with dt <="
     ):
         simulate_line_timedomain(scene, duration=600.0, seed=1, band=(0.0245, 9.8))
+
+
+def test_undamped_seabed_contact_under_resolved_is_a_warning():
+    """The chain's grounded nodes on a seabed without contact damping ring at ≈ 45
+    rad/s: at the reference's own step ((ωΔt)²/12 ≫ 1 %) a ResolutionWarning says so
+    (the record was silently 1.5–2.8× too energetic); with the example's damping, none."""
+    from stochcable.examples import load_example
+
+    doc = load_example("chain_catenary").model_dump(mode="json", exclude_none=True)
+    doc["lines"][0]["segments"][0]["elements"] = 20
+    doc["environment"]["seabed"]["damping"] = 0.0
+    with pytest.warns(ResolutionWarning, match="undamped seabed"):
+        simulate_line_timedomain(load_scene(doc), duration=40.0)
+    doc["environment"]["seabed"]["damping"] = 3.0e5
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ResolutionWarning)
+        try:
+            simulate_line_timedomain(load_scene(doc), duration=40.0)
+        except ResolutionWarning as exc:
+            assert "undamped seabed" not in str(exc)

@@ -43,6 +43,7 @@ import numpy as np
 from stochcable import validation as _v
 from stochcable.errors import InputError, ResolutionWarning, warn
 from stochcable.line.mesh import mesh_line
+from stochcable.reference.cable_checks import check_seabed_contact
 from stochcable.reference.cable_excitation import (
     ExcitationGrid,
     band_limited,
@@ -388,6 +389,7 @@ def simulate_line_timedomain(
     model, xs, u_cur, u_cur_g, tol_abs = _static_start(
         scene, mesh, x3, dim, tolerance, internal_damping, mass_matrix == "lumped"
     )
+    check_seabed_contact(scene, mesh, model, xs, h, PERIOD_ERROR_TOLERANCE)
     r = half_cosine(t, ramp)
     sl = np.arange(n_steps + 1) % (k_up * grid.n_samples)  # periodic in T_L
     u_wave = u_wave_g = f_in = None
