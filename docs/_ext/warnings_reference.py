@@ -219,8 +219,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "The time-domain reference's average-acceleration scheme does not dissipate the "
         "ringing, which can dominate the tension record (1.5–2.8× the σ on the chain "
         "example at Δt 0.05 s).",
-        "Give ``environment.seabed.damping`` (MoorDyn's cBot) or the ``dt`` the message "
-        "gives.",
+        "Give ``environment.seabed.damping`` (MoorDyn's cBot) or the ``dt`` the message gives.",
         ("stochcable.reference.cable:PERIOD_ERROR_TOLERANCE",),
     ),
     WarningEntry(
