@@ -115,7 +115,7 @@ def main() -> None:
         "",
         "The statics, the finite-element model, the modes and the factorizations are built",
         "once per set, and a line's wave kinematics and loads per unit wave once per",
-        "heading (kept within 64 MiB a line); a case costs its spectrum's weights, the",
+        "heading (kept within 128 MiB a line); a case costs its spectrum's weights, the",
         "drag fixed point and the outputs.",
         "Timings are of one run on the machine of docs/BENCHMARKS.md; they move with its",
         "fast and slow states.",

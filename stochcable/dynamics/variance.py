@@ -21,7 +21,7 @@ from stochcable.dynamics.blocks import (
     line_prep,
     real_gemm,
 )
-from stochcable.dynamics.freqblocks import frequency_slices
+from stochcable.dynamics.freqblocks import frequency_slices, working_memory_bytes
 from stochcable.dynamics.line_loads import (
     LineInputs,
     base_motion,
@@ -299,26 +299,50 @@ def _element_variance(
     n_w, n_ch = inp.weights.shape
     var = c0.copy()
     wq = (-1j * inp.omega)[:, None]
+    mw_all = _weighted_moments(system, inp, method) if fluid else None
     for sl in frequency_slices(n_w, n_ch * 16 * (3 * (n_el + 1) * d + 5 * n_el * k)):
         cols = slice(2 * n_ch * sl.start, 2 * n_ch * sl.stop)  # the real (re, im) columns
+        # U on the block's frequencies (the free part on the interior nodes), times −iω,
+        # projected at both ends of every element in one pass
         if u_nodes is not None:
-            qx = _project_ends(pr, u_nodes[:, :, sl] * wq[sl])
+            x = u_nodes[:, :, sl] * wq[sl]
+            if u_free is not None:
+                x[1:-1] += u_free[:, :, sl] * wq[sl]
         else:
-            qx = np.zeros((n_el, k, 2, cols.stop - cols.start))
-        if u_free is not None:
-            n_f = u_free.shape[0]
-            qf = (u_free[:, :, sl] * wq[sl]).reshape(n_f, d, -1).view(float)
-            qx[1:, :, 0] += pr[1:] @ qf
-            qx[:-1, :, 1] += pr[:-1] @ qf
-        m = _projected_moments(pr, inp.moments[..., sl, :]) if fluid else None
-        var += _structural_variance(qx, w2[cols], m)
+            x = np.zeros((n_el + 1, d) + u_free[:, :, sl].shape[2:], dtype=complex)
+            np.multiply(u_free[:, :, sl], wq[sl], out=x[1:-1])
+        qx = _project_ends(pr, x)
+        mw = None
+        if mw_all is not None:
+            mw = mw_all[..., cols]
+        elif fluid:
+            mw = np.swapaxes(_projected_moments(pr, inp.moments[..., sl, :]), 1, 2) * w2[cols]
+        var += _structural_variance(qx, w2[cols], mw)
     return var
 
 
-def _structural_variance(q: np.ndarray, w2: np.ndarray, m: np.ndarray | None) -> np.ndarray:
+def _weighted_moments(system: LineSystem, inp: LineInputs, method: str) -> np.ndarray | None:
+    """weight·(r·∫N_a v dξ, r·∫N_b v dξ) of all frequencies as a real (n_el, k, 2,
+    2·n_w·n_ch) view, cached per inputs and method when it fits in the working-memory
+    target (a small model then projects and weighs its moments once, not at every
+    evaluation); None when it does not (formed block by block)."""
+    key = ("fluid_mw", method)
+    if key not in inp.cache:
+        pr = _proj_rows(system, method)
+        n_el, k = pr.shape[:2]
+        n_cols = 2 * inp.weights.size
+        if 16 * n_el * k * n_cols > working_memory_bytes():  # (the product and the copy)
+            inp.cache[key] = None
+        else:
+            m = _projected_moments(pr, inp.moments)
+            inp.cache[key] = np.swapaxes(m, 1, 2) * _w2(inp)
+    return inp.cache[key]
+
+
+def _structural_variance(q: np.ndarray, w2: np.ndarray, mw: np.ndarray | None) -> np.ndarray:
     """The q-terms of :func:`_element_variance` on the real columns of q (n_el, k, 2,
-    2N), of the weights w2 (2N,) and of the projected moments m (n_el, 2, k, 2N) (a
-    block of columns gives its part of the sums), (n_el, k)."""
+    2N), of the weights w2 (2N,) and of the weighted projected moments mw (n_el, k, 2,
+    2N) (a block of columns gives its part of the sums), (n_el, k)."""
     # (|q_a|² + |q_b|² + Re(q̄_a q_b))/3 = ((q_a + q_b)·q_a + q_b·q_b)/3 on the real
     # views: one elementwise pass and one matrix-vector product with the weights
     # (the stacked (2 × 2N)(2N × 2) products of the Gram matrix were 2-3x slower)
@@ -327,8 +351,7 @@ def _structural_variance(q: np.ndarray, w2: np.ndarray, m: np.ndarray | None) ->
     t *= qa
     t += qb * qb
     var = (t @ w2) * _GRAM[0, 0]
-    if m is not None:
-        mw = np.swapaxes(m, 1, 2) * w2
+    if mw is not None:
         var += 2.0 * np.einsum("eksn,eksn->ek", mw, q)  # Σ w (m_a q_a + m_b q_b)
     return var
 

@@ -29,7 +29,7 @@ __all__ = ["INPUT_CACHE_BYTES", "heading_inputs"]
 
 #: Largest inputs (arrays and their drag-independent caches) of one line kept for the
 #: next sea state, summed over the kept headings. [bytes]
-INPUT_CACHE_BYTES = 64 * 2**20
+INPUT_CACHE_BYTES = 128 * 2**20
 
 _KEY = "heading_inputs"
 
