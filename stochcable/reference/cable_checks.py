@@ -28,10 +28,11 @@ def check_seabed_contact(
     env = scene.environment
     if env.seabed.stiffness <= 0 or env.seabed.damping > 0 or not math.isfinite(env.depth):
         return
+    n = xs.shape[0]
     grounded = np.flatnonzero(xs[:, -1] <= -env.depth + 1e-9)
+    grounded = grounded[(grounded > 0) & (grounded < n - 1)]  # (the ends are prescribed)
     if grounded.size == 0:
         return
-    n = xs.shape[0]
     m_node = np.asarray(mesh.node_mass + mesh.node_added_mass, dtype=float).copy()
     per_length = (
         np.asarray(mesh.mass, dtype=float)
