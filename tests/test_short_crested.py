@@ -89,26 +89,30 @@ def test_sea_states_of_one_spreading_reuse_their_inputs():
 
 
 def test_time_series_realize_the_directions_independently():
-    """DSA over the record: each direction has its own phases, so the end-tension
-    series variance scatters about the frequency-domain σ² by the cross terms of
-    directions sharing a frequency; four seeds: their mean within 4 standard errors."""
+    """Each direction has its own phases: the elevation variance over the record
+    scatters about the spectrum's sum Σ S(ω_m)Δω (its expectation: the directions'
+    cross terms at one frequency average out), four seeds within 4 standard errors of
+    it.  Directions sharing one realization would give (Σ_k √w_k)² times that (≈ 5.6
+    here), far outside."""
+    from stochcable.sea.realization import frequency_grid
+    from stochcable.sea.spectra import spectrum_pierson_moskowitz
+
     spread = {"type": "cos2s", "s": 2.0, "directions": 8}
     doc = _chain(45.0, spread, timeseries=True)
-    doc["analysis"]["timeseries"]["duration"] = 400.0
-    sig, fd = [], None
+    ts = doc["analysis"]["timeseries"]
+    ts["duration"] = 400.0
+    w, dw = frequency_grid(ts["duration"], ts["dt"])
+    m0 = float(np.sum(spectrum_pierson_moskowitz(w[1:-1], 6.0, 10.0)) * dw)  # the sea's
+    var = []
     for seed in range(4):
-        doc["analysis"]["timeseries"]["seed"] = seed
-        res = analyze(doc)
-        fd = res.lines["leg1"].end_a.std
-        sig.append(float(np.std(res.timeseries.end_tension["leg1"]["end_a"])))
-        # the elevation is the sum of the directions' realizations: its variance is the
-        # spectrum's on the record's lines up to the same cross terms
-        assert res.timeseries.elevation.std() > 0
-    sig = np.array(sig)
-    se = sig.std(ddof=1) / math.sqrt(sig.size)
-    # the record's band-limited synthesis resolves the analysis band on its own grid:
-    # 3 % of grid difference allowed on top (the long-crested tests' allowance)
-    assert abs(sig.mean() - fd) <= 4 * se + 0.03 * fd, (sig, fd)
+        ts["seed"] = seed
+        var.append(float(np.var(analyze(doc).timeseries.elevation)))
+    var = np.array(var)
+    se = var.std(ddof=1) / math.sqrt(var.size)
+    assert abs(var.mean() - m0) <= 4 * se, (var, m0)
+    ds = load_scene(doc).sea.direction_set()
+    coherent = float(np.sum(np.sqrt(ds.weight)) ** 2)
+    assert abs(var.mean() - coherent * m0) > 20 * se, (coherent, var, m0)
 
 
 def test_bodies_with_a_spread_sea_are_refused():

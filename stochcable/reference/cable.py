@@ -62,7 +62,11 @@ from stochcable.reference.cable_model import (
     static_equilibrium,
     statics_guess,
 )
-from stochcable.reference.cable_newmark import integrate, newmark_period_error
+from stochcable.reference.cable_newmark import (
+    integrate,
+    newmark_period_error,
+    newmark_step_for,
+)
 from stochcable.scene.model import Line, Scene, load_scene
 
 __all__ = [
@@ -493,7 +497,7 @@ def _time_step(
     h = dt_sea / k_up
     err = newmark_period_error(wmax, h)
     if err > PERIOD_ERROR_TOLERANCE:
-        dt_ok = 2.0 * math.sqrt(3.0 * PERIOD_ERROR_TOLERANCE) / wmax
+        dt_ok = newmark_step_for(wmax, PERIOD_ERROR_TOLERANCE)
         warn(
             f"time step {h:.4g} s gives a Newmark period error (omega dt)^2/12 = {err:.2%} "
             f"at the highest excitation frequency {wmax:.4g} rad/s (> "
@@ -538,7 +542,7 @@ def _check_stationary(out: CableTimeHistory, h: float) -> None:
     (:data:`NONSTATIONARY_RATIO`)."""
     ratio, t_jump, w_dom = out.stationarity_ratio()
     if ratio > NONSTATIONARY_RATIO:
-        dt_ok = 2.0 * math.sqrt(3.0 * PERIOD_ERROR_TOLERANCE) / max(w_dom, 1e-12)
+        dt_ok = newmark_step_for(w_dom, PERIOD_ERROR_TOLERANCE)
         warn(
             f"the end tension is not stationary: its σ over windows after the ramp varies "
             f"by a factor {ratio:.3g} (threshold {NONSTATIONARY_RATIO:g}), largest in the "

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.errors import ResolutionWarning, warn
-from stochcable.reference.cable_newmark import newmark_period_error
+from stochcable.reference.cable_newmark import newmark_period_error, newmark_step_for
 from stochcable.scene.model import Scene
 
 __all__ = ["check_seabed_contact"]
@@ -51,7 +51,7 @@ def check_seabed_contact(
     w_c = float(np.max(np.sqrt(k / np.maximum(m_node[grounded], 1e-300))))
     err = newmark_period_error(w_c, h)
     if err > tolerance:
-        dt_ok = 2.0 * math.sqrt(3.0 * tolerance) / w_c
+        dt_ok = newmark_step_for(w_c, tolerance)
         warn(
             f"{grounded.size} node(s) rest on an undamped seabed (environment.seabed."
             f"damping = 0) and ring on the contact spring at {w_c:.4g} rad/s, which the "

@@ -5,13 +5,15 @@ LAPACK solves; the end tensions are the support reactions."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy import linalg as sla
 
 from stochcable.errors import ConvergenceError
 from stochcable.reference.cable_model import LineModel
 
-__all__ = ["newmark_period_error", "integrate"]
+__all__ = ["newmark_period_error", "newmark_step_for", "integrate"]
 
 _BACKTRACK = 12  # largest number of step halvings in a Newton line search
 
@@ -40,6 +42,12 @@ def newmark_period_error(omega: float | np.ndarray, dt: float) -> float | np.nda
     with np.errstate(invalid="ignore", divide="ignore"):
         r = np.where(x > 0, x / (2.0 * np.arctan(0.5 * np.where(x > 0, x, 1.0))) - 1.0, 0.0)
     return float(r) if r.ndim == 0 else r
+
+
+def newmark_step_for(omega: float, tolerance: float) -> float:
+    """The largest step with the period error (ωΔt)²/12 of :func:`newmark_period_error`
+    at most ``tolerance`` at ``omega`` [rad/s]: Δt = 2√(3·tolerance)/ω. [s]"""
+    return 2.0 * math.sqrt(3.0 * tolerance) / max(float(omega), 1e-12)
 
 
 def integrate(
