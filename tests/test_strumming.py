@@ -142,6 +142,35 @@ def test_lock_in_balance_matches_the_time_domain_oscillator(ratio, xi):
     assert fd.amplitude <= 1.005 * td
 
 
+@pytest.mark.parametrize("xi", [0.02, 0.2])
+def test_compiled_start_grid_equals_the_wake_closed_form(xi):
+    """The compiled start grid of lock_in_balance (one cube root per wake, coefficients
+    per frequency) against the modal residual formed from wake_response (NumPy, both
+    Cardano roots) at every grid point: the same closed form, round-off apart (1e-9: the
+    residual is a ratio of sums of ~40 terms; any wrong coefficient moves it by O(1))."""
+    from stochcable.line.strumming_kernels import balance_grid
+
+    psi, q, d, ws, mstar, st = _string_mode()  # a mode that locks in (test above)
+    rng = np.random.default_rng(7)  # and wakes that differ element by element
+    ws = ws * rng.uniform(0.98, 1.02, ws.size)
+    lift0 = rng.uniform(0.18, 0.22, ws.size)
+    wn = float(np.mean(ws))
+    params = wake_parameters(reduced_damping(mstar, xi, 1.0, 1.0, st), xi)
+    amps = np.geomspace(1e-3, 3.0, 20) / np.max(np.abs(psi) / d)
+    omegas = np.linspace(0.65, 1.35, 29) * wn
+    grid = balance_grid(
+        amps, omegas, wn, xi, psi, q, d, ws, lift0, params.g, params.big_h, params.f
+    )
+    a_, w_ = np.meshgrid(amps, omegas, indexing="ij")
+    a_, w_ = a_.reshape(-1, 1), w_.reshape(-1, 1)
+    c = wake_response(1j * w_ * a_ * psi / d, w_, ws, lift0, params)
+    left = (wn**2 - w_[:, 0] ** 2 + 2j * xi * wn * w_[:, 0]) * a_[:, 0]
+    right = c @ (q * psi)
+    ref = (np.abs(left - right) / (np.abs(left) + np.abs(right))).reshape(grid.shape)
+    np.testing.assert_allclose(grid, ref, rtol=0, atol=1e-9)
+    assert ref.min() < 0.15 < 0.5 < ref.max()  # near a root and far from one
+
+
 # ------------------------------------------------------------------ Example 6
 
 

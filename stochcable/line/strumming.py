@@ -367,12 +367,15 @@ def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
     total = weight.sum(axis=0)
     # share of the (unit) modal mass moving along the lift directions
     share = np.einsum("e,em->m", m_t * length * lift_on, psi**2)
-    cand = []
-    for k in np.flatnonzero((total > 0) & (w_n > 0) & (share >= _MIN_SHARE)):
-        wk = weight[:, k] / total[k]
-        vr = reduced_velocity(wk @ speed, w_n[k], wk @ d)
-        if CROSS_FLOW_BAND[0] <= vr <= CROSS_FLOW_BAND[1]:
-            cand.append((abs(math.log(w_n[k] / (wk @ omega_s))), int(k), vr, wk))
+    pick = np.flatnonzero((total > 0) & (w_n > 0) & (share >= _MIN_SHARE))
+    wk_all = weight[:, pick] / total[pick]  # (n_el, picked): the ψ²L weights
+    vr_all = reduced_velocity(speed @ wk_all, w_n[pick], d @ wk_all) if pick.size else pick
+    in_band = (CROSS_FLOW_BAND[0] <= vr_all) & (vr_all <= CROSS_FLOW_BAND[1])
+    cand = [
+        (abs(math.log(w_n[k] / (wk_all[:, c] @ omega_s))), int(k), float(vr_all[c]), wk_all[:, c])
+        for c, k in enumerate(pick)
+        if in_band[c]
+    ]
     cand.sort()
     stiff = np.asarray(line.ea) / np.asarray(line.l0)
     modes = []

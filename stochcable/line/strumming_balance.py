@@ -473,13 +473,12 @@ def lock_in_balance(
 
     ln_a = np.log(np.geomspace(1e-3, 3.0, 20) / y_scale)
     ratio = np.linspace(0.65, 1.35, 29)
-    aa, rr = np.meshgrid(np.exp(ln_a), ratio * omega_n, indexing="ij")
-    a_, w_ = aa.reshape(-1, 1), rr.reshape(-1, 1)
-    c = wake_response(1j * w_ * a_ * ps / ds, w_, ws, c0, params)
-    left = (omega_n**2 - w_[:, 0] ** 2 + 2j * damping_ratio * omega_n * w_[:, 0]) * a_[:, 0]
-    right = c @ (qs * ps)
-    z = (left - right) / (np.abs(left) + np.abs(right))
-    grid = np.abs(z).reshape(aa.shape)
+    from stochcable.line.strumming_kernels import balance_grid  # numba: lazily
+
+    grid = balance_grid(
+        np.exp(ln_a), ratio * omega_n, omega_n, damping_ratio, ps, qs, ds, ws, c0,
+        params.g, params.big_h, params.f,
+    )  # fmt: skip
     # starts: the grid's local minima below _START_TOL (a grid point farther than that
     # from a root is not refined: the balance is smooth on the grid's scale except at
     # branch switches, where a root has |z| << 1 nearby), best first

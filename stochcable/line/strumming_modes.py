@@ -77,21 +77,25 @@ def out_of_plane_modes(model: FEModel, omega_max: float) -> tuple[np.ndarray, np
     m_el = mesh.mass * mesh.l0
     ma_el = mesh.ca_normal * model.rho * math.pi * mesh.diameter**2 / 4.0 * mesh.l0
     mt = m_el + ma_el
-    i = np.arange(n - 1)
-    rows = np.concatenate([i, i + 1, i, i + 1])
-    cols = np.concatenate([i, i + 1, i + 1, i])
-    k = sp.csr_array((np.concatenate([kel, kel, -kel, -kel]), (rows, cols)), shape=(n, n))
-    m = sp.csr_array(
-        (np.concatenate([mt / 3.0, mt / 3.0, mt / 6.0, mt / 6.0]), (rows, cols)), shape=(n, n)
-    )
-    m = m + sp.diags_array(mesh.node_mass + mesh.node_added_mass)
     free_nodes = np.unique(np.asarray(model.free) // model.dim)
-    kf = k[free_nodes][:, free_nodes]
-    mf = m[free_nodes][:, free_nodes]
     top = float(omega_max) ** 2
     if free_nodes.size <= _DENSE_MAX:
-        lam, vec = sla.eigh(kf.toarray(), mf.toarray(), subset_by_value=(-np.inf, top))
+        k, m = _tridiagonal(kel, kel, n), _tridiagonal(mt / 3.0, -mt / 6.0, n)
+        m[np.diag_indices(n)] += mesh.node_mass + mesh.node_added_mass
+        sub = np.ix_(free_nodes, free_nodes)
+        mf = m[sub]
+        lam, vec = sla.eigh(k[sub], mf, subset_by_value=(-np.inf, top))
     else:
+        i = np.arange(n - 1)
+        rows = np.concatenate([i, i + 1, i, i + 1])
+        cols = np.concatenate([i, i + 1, i + 1, i])
+        ks = sp.csr_array((np.concatenate([kel, kel, -kel, -kel]), (rows, cols)), shape=(n, n))
+        ms = sp.csr_array(
+            (np.concatenate([mt / 3.0, mt / 3.0, mt / 6.0, mt / 6.0]), (rows, cols)),
+            shape=(n, n),
+        )
+        ms = ms + sp.diags_array(mesh.node_mass + mesh.node_added_mass)
+        kf, mf = ks[free_nodes][:, free_nodes], ms[free_nodes][:, free_nodes]
         count = 16
         while True:
             count = min(count, free_nodes.size - 1)
@@ -107,3 +111,15 @@ def out_of_plane_modes(model: FEModel, omega_max: float) -> tuple[np.ndarray, np
     shapes = np.zeros((n, 3, omega.size))
     shapes[free_nodes, 1, :] = vec / np.sqrt(np.einsum("im,im->m", vec, mf @ vec))
     return omega, shapes
+
+
+def _tridiagonal(diag_el: np.ndarray, off_el: np.ndarray, n: int) -> np.ndarray:
+    """Dense n × n assembly of the two-node element matrices [[d, −o], [−o, d]] of a
+    chain of n nodes."""
+    out = np.zeros((n, n))
+    idx = np.arange(n - 1)
+    out[idx, idx] += diag_el  # each index once per statement: no np.add.at needed
+    out[idx + 1, idx + 1] += diag_el
+    out[idx, idx + 1] -= off_el
+    out[idx + 1, idx] -= off_el
+    return out

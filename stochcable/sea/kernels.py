@@ -21,13 +21,13 @@ compiled in memory in each process, with a UserWarning).
 from __future__ import annotations
 
 import math
-import warnings
 
-import numba
 import numpy as np
 from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
+
+from stochcable.compiled import jit_cached
 
 __all__ = ["phasor_chunk", "CACHED"]
 
@@ -104,20 +104,4 @@ _SIGNATURE = types.void(_RO, _RO, types.float64, _RO, _RO, _TAB, _OUT, _OUT, typ
 read-only S, e.g. a density's cached array, then needs no second compilation)."""
 
 
-def _compile():  # noqa: ANN202
-    try:
-        return numba.njit(_SIGNATURE, nogil=True, cache=True)(_phasor_chunk), True
-    except RuntimeError as exc:  # "cannot cache function ...: no locator available ..."
-        if "cache" not in str(exc):
-            raise
-        warnings.warn(
-            f"stochcable: no writable numba cache directory ({exc}); the sea "
-            "kernel is compiled in memory in each process (~1 s at its first "
-            "use); set NUMBA_CACHE_DIR to a writable directory to keep it",
-            UserWarning,
-            stacklevel=3,
-        )
-        return numba.njit(_SIGNATURE, nogil=True)(_phasor_chunk), False
-
-
-phasor_chunk, CACHED = _compile()
+phasor_chunk, CACHED = jit_cached(_phasor_chunk, _SIGNATURE, "sea")

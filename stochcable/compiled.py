@@ -1,0 +1,56 @@
+"""Numba kernels compiled once per machine: :func:`jit_cached`.
+
+Kernels are compiled for one explicit signature with ``nogil=True`` and ``cache=True``:
+the machine code is stored in ``__pycache__`` next to the kernel's module, in numba's
+user cache directory or in ``$NUMBA_CACHE_DIR``, and later processes load it.  Where
+none is writable the kernel is compiled in memory in each process (about a second at
+its first use) and a :class:`UserWarning` says how to keep it.  Numba is imported here
+only, by the modules that hold kernels; those are imported lazily (importing numba
+costs ~0.2 s), so ``import stochcable``, the CLI and the service start do not load it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+__all__ = ["jit_cached"]
+
+
+def jit_cached(
+    function: Callable[..., Any], signature: Any, what: str
+) -> tuple[Callable[..., Any], bool]:
+    """``function`` compiled by numba for ``signature``, cached on disk where possible.
+
+    Parameters
+    ----------
+    function : callable
+        A numba-compilable Python function.
+    signature : numba signature
+        The one signature compiled (arrays declared read-only accept writable ones).
+    what : str
+        What the kernel computes, for the warning without a cache directory.
+
+    Returns
+    -------
+    kernel : callable
+        The compiled dispatcher.
+    cached : bool
+        Whether its machine code is kept on disk.
+    """
+    import numba
+
+    try:
+        return numba.njit(signature, nogil=True, cache=True)(function), True
+    except RuntimeError as exc:  # "cannot cache function ...: no locator available ..."
+        if "cache" not in str(exc):
+            raise
+        warnings.warn(
+            f"stochcable: no writable numba cache directory ({exc}); the {what} kernel "
+            "is compiled in memory in each process (~1 s at its first use); set "
+            "NUMBA_CACHE_DIR to a writable directory to keep it",
+            UserWarning,
+            stacklevel=3,
+        )
+        return numba.njit(signature, nogil=True)(function), False
