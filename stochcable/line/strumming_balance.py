@@ -479,6 +479,8 @@ def lock_in_balance(
         np.exp(ln_a), ratio * omega_n, omega_n, damping_ratio, ps, qs, ds, ws, c0,
         params.g, params.big_h, params.f,
     )  # fmt: skip
+    if not grid.min() < _START_TOL:  # no start: no root is refined (the common case)
+        return none
     # starts: the grid's local minima below _START_TOL (a grid point farther than that
     # from a root is not refined: the balance is smooth on the grid's scale except at
     # branch switches, where a root has |z| << 1 nearby), best first

@@ -12,6 +12,16 @@ version formed them for every grid point and element, with a dozen temporaries o
 that size — 4 ms of the 5 ms a mode's screening took.  The grid only chooses where
 least squares starts, so round-off differences from the NumPy form change no root.
 
+Most grid points are far from a root, and a bound proves it without a root: with
+α = ωω_sḠC_L0² and β = ωω_sḠ(1 + 3r²)/4 (Im a0 = −α, Im a1 = β), Im(a0 + a1x) ≥ βx/2 for
+x ≥ 2α/β, so |c| = √x ≤ √(2α/β) + (4|rhs|²/β²)^(1/6); and |c| ≤ |rhs|/m with m the
+distance from 0 to the ray a0 + a1x, x ≥ 0.  Summed over the elements (|rhs| ∝ A),
+|L| ≤ min(S₁ + S₂A^(1/3), S_lin A) per frequency; where that is at most |Z A|/3 the
+residual is at least 0.5, above the start threshold of
+:func:`~stochcable.line.strumming_balance.lock_in_balance`, and the point holds 1.0
+(no start, and no local minimum beside it changes).  On the chain example every point
+of its three candidate modes is proven so (no lock-in: no cube root at all).
+
 Compiled with ``cache=True`` (the machine code is kept in ``__pycache__`` next to this
 file, in numba's user cache directory or in ``$NUMBA_CACHE_DIR``; without a writable
 one, in memory in each process, with a warning: :func:`stochcable.compiled.jit_cached`).
@@ -49,6 +59,10 @@ def _balance_grid(
         w = omegas[j]
         zr = omega_n * omega_n - w * w
         zi = 2.0 * zeta * omega_n * w
+        z_abs = math.hypot(zr, zi)
+        s1 = 0.0
+        s2 = 0.0
+        s_lin = 0.0
         for e in range(n):
             ws = omega_s[e]
             r2 = (w / ws) ** 2
@@ -67,8 +81,24 @@ def _balance_grid(
             # |rhs|² per unit amplitude²: rhs = ω_s F̄ · iωAψ/D
             rhs_unit[e] = ws * f * w * psi[e] / diameter[e]
             k2_unit[e] = rhs_unit[e] ** 2
+            # the bound |c| <= sqrt(2α/β) + (4/β²)^(1/6) |rhs|^(1/3) (module notes)
+            alpha = w * ws * g * lift0sq[e]
+            beta = a1i[e]
+            weight = abs(q[e] * psi[e])
+            s1 += weight * math.sqrt(2.0 * alpha / beta)
+            s2 += weight * (4.0 / (beta * beta)) ** (1.0 / 6.0) * abs(rhs_unit[e]) ** (1.0 / 3.0)
+            # and |c| <= |rhs|/m, m = min over x >= 0 of |a0 + a1 x|
+            dot = a0r[e] * a1r[e] + a0i[e] * a1i[e]
+            if dot >= 0.0:
+                dist = math.hypot(a0r[e], a0i[e])
+            else:
+                dist = abs(a0r[e] * a1i[e] - a0i[e] * a1r[e]) * math.sqrt(inv_c3[e])
+            s_lin += weight * abs(rhs_unit[e]) / dist if dist > 0.0 else math.inf
         for i in range(amps.size):
             a = amps[i]
+            if min(s1 + s2 * a ** (1.0 / 3.0), s_lin * a) <= z_abs * a / 3.0:
+                out[i, j] = 1.0  # |L| >= 3|R| proves the residual is at least 0.5
+                continue
             right_r = 0.0
             right_i = 0.0
             for e in range(n):
@@ -166,7 +196,7 @@ def balance_grid(
     Returns
     -------
     ndarray, shape (n_a, n_w)
-        |Z A − L|/(|Z A| + |L|). [-]
+        |Z A − L|/(|Z A| + |L|), or 1.0 where a bound proves it is at least 0.5. [-]
     """
     out = np.empty((amps.size, omegas.size))
     as_f = np.ascontiguousarray
