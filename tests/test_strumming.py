@@ -515,3 +515,31 @@ def test_strouhal_from_reynolds():
     assert u * d / doc["environment"]["viscosity"] == pytest.approx(3075, rel=1e-3)
     table = engine.strumming["string"]
     assert np.allclose(table.omega_s, 2 * math.pi * 0.2 * u / d, rtol=1e-5)
+
+
+def test_load_case_set_adds_the_strumming_damage_to_every_sea_state():
+    """A strumming line's load-case set: every case's damage rate is its wave damage
+    (the spectral method on that sea state's tension spectra) plus the locked-in mode's
+    constant-amplitude damage f·(S/MBS)^m/a (closed form of a single-slope curve), and
+    each row says so."""
+    from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
+    from stochcable.design import damage_rate, fatigue_curve_user
+    from stochcable.scene.model import Sea
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = load_scene(_locked_scene())
+        engine = build_engine(scene)
+        m, log10_a, mbs = 3.0, 3.0, 50.0  # N = 10³ (S/MBS)^-3 [S in N]
+        curve = fatigue_curve_user("t", quantity="tension_ratio", slope=m, log10_a=log10_a)
+        rows = [{"hs": hs, "tp": 0.5, "heading": 90.0, "probability": 0.5} for hs in (0.03, 0.06)]
+        fat = LineFatigue(curve=curve, mbs=mbs, method="narrow_band")
+        res = run_cases(scene, scatter_from_rows(rows), fatigue=fat, engine=engine)
+        mode = engine.strumming["string"].modes[engine.strumming["string"].governing]
+        strum = mode.cycle_rate * (mode.tension_range / mbs) ** m / 10.0**log10_a
+        assert strum.max() > 0
+        for i, state in enumerate(res.scatter.states):
+            lr = engine.solve(Sea(spectrum=state.spectrum("jonswap"), heading=90.0)).lines["string"]
+            wave = damage_rate(lr.omega, lr.tension_spectrum / mbs**2, curve, "narrow_band")
+            np.testing.assert_allclose(res.damage_rate_along["string"][i], wave + strum, rtol=1e-9)
+            assert any("strumming of mode 1" in w for w in res.rows[i].warnings)

@@ -15,7 +15,7 @@ import hashlib
 import math
 import traceback
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -157,6 +157,28 @@ def _solve_case(engine: Any, sea: Sea, index: int) -> tuple[CaseRow, Any]:
     return CaseRow(index, "ok", "", (), msgs), res
 
 
+def _strumming_damage(
+    engine: Any, name: str, curve: Any, factor: float
+) -> tuple[np.ndarray, str] | None:
+    """The damage rate of line ``name``'s strumming mode at the two ends and every
+    element (the end elements' ranges at the ends), and what the rows say of it; None
+    when the line does not strum (docs/strumming.md).  The current is the scene's, the
+    same in every sea state, so the same rate is added to every case's wave damage (the
+    two summed, as DNV-RP-F204 sums wave and VIV fatigue damage)."""
+    table = getattr(engine, "strumming", {}).get(name)
+    if table is None or table.governing is None:
+        return None
+    mode = table.modes[table.governing]
+    el = mode.damage_rate(curve, factor)
+    rate = np.concatenate([el[[0, -1]], el])
+    msg = (
+        f"line {name!r}: strumming of mode {mode.index} ({mode.cycle_rate:.4g} Hz, "
+        f"A/D {mode.amplitude_over_d:.3g}) adds a damage rate of {rate[1]:.3g}/s at end_b "
+        f"and up to {el.max():.3g}/s along the line to every sea state's damage"
+    )
+    return rate, msg
+
+
 def solve_chunk(
     template: Scene,
     family: Family,
@@ -215,5 +237,10 @@ def solve_chunk(
                 curve, factor = curve_factor(settings, template.environment.g, name)
                 dens = np.stack(spectra[name]) * factor**2
                 damage[name][have[name]] = damage_rate(omega, dens, curve, settings.method)
+                strum = _strumming_damage(engine, name, curve, factor)
+                if strum is not None:
+                    damage[name][have[name]] += strum[0]
+                    for j in have[name]:
+                        rows[j] = replace(rows[j], warnings=(*rows[j].warnings, strum[1]))
     idx = np.array([i for i, _ in cases], dtype=int)
     return ChunkResult(idx, tuple(rows), stats, damage, s_el)
