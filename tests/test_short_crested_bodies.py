@@ -260,6 +260,7 @@ def test_zero_width_time_series_with_bodies_are_the_long_crested_ones():
         for dof in DOFS:
             a, b = got.body_motion[body][dof], ref.body_motion[body][dof]
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-10 * scale, err_msg=(body, dof))
+    assert set(got.end_tension) == set(ref.end_tension) == {"leg1", "leg2", "leg3", "riser"}
     for line in ref.end_tension:
         for end in ("end_a", "end_b"):
             np.testing.assert_allclose(
