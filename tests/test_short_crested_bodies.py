@@ -219,15 +219,21 @@ def test_vessel_rao_applies_to_every_direction():
     assert got.lines["riser"].end_a.std != pytest.approx(ref.lines["riser"].end_a.std, rel=1e-3)
 
 
-def test_engine_solves_a_spread_sea_as_analyze():
-    """An engine built for the long-crested scene (3-D models) solves a spread sea
-    state as ``analyze`` of the scene with it: the same numbers (1e-11: round-off)."""
+def test_engine_solves_spread_sea_states_as_analyze():
+    """An engine built for the long-crested scene (3-D models) solves spread sea
+    states as ``analyze`` of the scene with each: the same numbers (1e-11: round-off).
+    The second sea state of the spreading reuses the grouped legs' kinematics of the
+    first (one entry per directions kept) with its own spectra."""
     from stochcable.dynamics.engine import build_engine
 
     spread = {"type": "cosn", "n": 4.0, "directions": 7}
     engine = build_engine(_buoy(30.0, full_circle=True, vessel=True))
+    engine.solve()  # the long-crested sea of the scene
+    engine.solve({"spectrum": {"type": "jonswap", "hs": 8.0, "tp": 9.0}, "heading": 30.0,
+                  "spreading": spread})  # fmt: skip
     sea = {"spectrum": {"type": "jonswap", "hs": 12.0, "tp": 11.0}, "heading": 30.0}
     got = engine.solve({**sea, "spreading": spread})
+    assert len(engine.systems["leg1"]._cache["group_channels"]) == 2
     ref = analyze(
         {**_buoy(30.0, spread, full_circle=True, vessel=True), "sea": {**sea, "spreading": spread}}
     )

@@ -33,13 +33,12 @@ from stochcable.dynamics.coupled.inputs import (
     body_loads,
     group_channels,
     reference_omega,
-    scene_line_channels,
     sea_only_channels,
 )
 from stochcable.dynamics.coupled.model import CoupledModel, ModelGroup, build_coupled
 from stochcable.dynamics.coupled.modes import coupled_modes
 from stochcable.dynamics.coupled.results import body_result, coupled_results
-from stochcable.dynamics.coupled.seainputs import heading_inputs
+from stochcable.dynamics.coupled.seainputs import group_line_channels, heading_inputs
 from stochcable.dynamics.line_loads import LineInputs, silent_channel
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.outputs import line_result
@@ -224,9 +223,7 @@ def solve_coupled(
         if line.name in alone:
             chans[line.name], inputs[line.name] = heading_inputs(model, scene, line)
         else:
-            chans[line.name], _ = scene_line_channels(
-                scene, line, model.systems[line.name], model.omega, model.vessel_rao
-            )
+            chans[line.name], _ = group_line_channels(model, scene, line)
     timing["model_s"] += time.perf_counter() - t0
     lines_out: dict[str, LineResult] = {}
     bodies_out: dict[str, BodyResult] = {}

@@ -169,11 +169,13 @@ def body_loads(
     vel = np.zeros((w.size, 3, n_ch), dtype=complex)
     point = body.position + body.drag_point
     headings = {} if sea is None else sea_channel_headings(sea)
+    k = None
     for i, ch in enumerate(channels):
         if ch.kind != "sea" or sea is None:
             continue
         beta = headings[ch.name]
-        k = wavenumber(w, environment.depth, environment.g)
+        if k is None:  # (the same for every direction)
+            k = wavenumber(w, environment.depth, environment.g)
         force[:, :, i] = _excitation(body, w, beta, k, ch.name, sea)
         if np.any(body.drag_area > 0):
             p = point.copy()
