@@ -2,7 +2,8 @@
 to zero width is the long-crested analysis, mirrored spreadings give mirrored
 responses on a line symmetric about the mean heading, sea states of one spreading
 reuse their inputs, the time series realize every direction independently, and bad
-documents are refused naming the parameter."""
+documents are refused naming the parameter.  Scenes with bodies and vessels:
+tests/test_short_crested_bodies.py."""
 
 from __future__ import annotations
 
@@ -113,14 +114,6 @@ def test_time_series_realize_the_directions_independently():
     ds = load_scene(doc).sea.direction_set()
     coherent = float(np.sum(np.sqrt(ds.weight)) ** 2)
     assert abs(var.mean() - coherent * m0) > 20 * se, (coherent, var, m0)
-
-
-def test_bodies_with_a_spread_sea_are_refused():
-    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json", exclude_none=True)
-    doc["sea"]["spreading"] = {"type": "cos2s", "s": 3.0}
-    with pytest.raises(InputError) as info:
-        analyze(doc)
-    assert info.value.parameter == "sea.spreading"
 
 
 @pytest.mark.parametrize(

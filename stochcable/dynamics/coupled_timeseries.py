@@ -39,10 +39,10 @@ from stochcable.dynamics.coupled.inputs import (
     body_loads,
     group_channels,
     scene_line_channels,
+    sea_only_channels,
     vessel_rao,
 )
 from stochcable.dynamics.loads import Channel
-from stochcable.dynamics.sea_channels import spectrum_callable
 from stochcable.dynamics.solve import end_tension_from_support
 
 __all__ = [
@@ -172,10 +172,7 @@ def _group_on(
         ]
         channels = cls[0].channels
     else:  # a free-floating body: the sea alone (analyze_coupled)
-        dens = spectrum_callable(scene.sea.spectrum, env.g)
-        channels = (
-            Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega), density=dens),
-        )
+        channels = sea_only_channels(scene.sea, omega, env.g)
         cls = []
     own = {
         f"{n}.{c.name}": (n, c.name)
@@ -216,7 +213,8 @@ def line_entry_bytes(model: Any, n_columns: int) -> int:
 
 def _entry_bytes(group: CoupledGroup, scene: Any) -> int:
     """Bytes of the group's node arrays per frequency (the chunk budget's unit)."""
-    n_ch = 1 + sum(
+    ds = None if scene.sea is None else scene.sea.direction_set()
+    n_ch = (1 if ds is None else ds.count) + sum(
         3
         for n in group.lines
         for e in ("end_a", "end_b")

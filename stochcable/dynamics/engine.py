@@ -125,7 +125,6 @@ class Engine:
         """
         t_start = time.perf_counter()
         scene = _with_sea(self.scene, sea)
-        _check_spreading(scene)
         if self.scene.is_planar and not scene.is_planar:
             # the models were built 2-D (in the plane of the lines): out-of-plane waves
             # would be projected onto it without a word
@@ -198,7 +197,6 @@ def build_engine(
     """
     t_start = time.perf_counter()
     scene = load_scene(scene)
-    _check_spreading(scene)
     progress = noop_progress if progress is None else progress
     settings = scene.analysis
     if settings.linearization.method == "harmonic" and any(
@@ -242,20 +240,6 @@ def build_engine(
         warnings=tuple(_messages((), caught)),
         strumming=strumming,
     )
-
-
-def _check_spreading(scene: Scene) -> None:
-    """A short-crested sea drives lines alone: the bodies' wave excitation and the
-    vessels' RAOs are not yet spread over directions (InputError)."""
-    if scene.sea is not None and scene.sea.spreading is not None and scene.bodies:
-        raise InputError(
-            "sea.spreading",
-            scene.sea.spreading.type,
-            "-",
-            "a short-crested sea is supported for scenes without bodies (the bodies' "
-            "wave excitation and vessel RAOs are not yet spread over directions): "
-            "remove the spreading (long-crested) or the bodies",
-        )
 
 
 def _with_sea(scene: Scene, sea: Sea | Mapping[str, Any] | None) -> Scene:

@@ -12,7 +12,13 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["direction_channel", "sea_channel_densities", "spectrum_callable", "with_spectrum"]
+__all__ = [
+    "direction_channel",
+    "sea_channel_densities",
+    "sea_channel_headings",
+    "spectrum_callable",
+    "with_spectrum",
+]
 
 
 def with_spectrum(channel: Any, density: Callable[[np.ndarray], np.ndarray]) -> Any:
@@ -43,9 +49,22 @@ def sea_channel_densities(
     ]
 
 
+def sea_channel_headings(sea: Any) -> dict[str, float]:
+    """The heading [rad] of each of the sea's input channels by name
+    (:func:`sea_channel_densities`: ``{"sea": β}`` for a long-crested sea, one
+    ``"sea@<deg>"`` per direction θ_k of a short-crested one)."""
+    ds = sea.direction_set()
+    if ds is None:
+        return {"sea": sea.heading_rad}
+    return {direction_channel(b): float(b) for b in ds.heading}
+
+
 def direction_channel(heading: float) -> str:
-    """The name of the sea channel of direction ``heading`` [rad]: "sea@<deg>"."""
-    return f"sea@{math.degrees(heading):.6g}"
+    """The name of the sea channel of direction ``heading`` [rad]: "sea@<deg>" (six
+    significant digits; the round-off of a centroid on the mean, |θ| < 1e-9 deg, as
+    0: "sea@0", not "sea@-1.27092e-14")."""
+    deg = math.degrees(heading)
+    return f"sea@{0.0 if abs(deg) < 1e-9 else deg:.6g}"
 
 
 def spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.loads import Channel
-from stochcable.dynamics.sea_channels import direction_channel
+from stochcable.dynamics.sea_channels import direction_channel, sea_channel_headings
 from stochcable.dynamics.system import LineSystem
 from stochcable.results.documents import (
     TimeSeries,
@@ -90,15 +90,19 @@ def simulate_timeseries(
     for b in getattr(scene, "bodies", ()) or ():
         if getattr(b, "prescribed", None) is None or syn.sea is None:
             continue  # vessels: their RAO times the sea
+        # one channel per direction of a short-crested sea, each with the same RAO
+        # (no heading dimension) and its own realization
+        sea_names = tuple(sea_channel_headings(scene.sea))
         h = syn.full(vessel_raos(scene, syn.w_band)[b.name].T)[None]  # (1, 6, N+1)
+        h = np.broadcast_to(h, (len(sea_names),) + h.shape[1:]).copy()
         mean = np.concatenate([np.asarray(b.position, dtype=float), np.zeros(3)])
         out.add_body(
             b.name,
             mean,
             ("surge", "sway", "heave", "roll", "pitch", "yaw"),
             h,
-            syn.synthesized(h, ("sea",), (None,)),
-            ("sea",),
+            syn.synthesized(h, ("sea",) * len(sea_names), tuple(("sea", n) for n in sea_names)),
+            sea_names,
         )
     order = [n for n in names if n in out.end_tension]
     body_order = [b.name for b in (getattr(scene, "bodies", ()) or ()) if b.name in out.body_motion]

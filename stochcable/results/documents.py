@@ -208,7 +208,8 @@ class BodyResult:
     omega : ndarray, shape (n_omega,)
         Analysis frequencies. [rad/s]
     channels : tuple of str
-        Input channels (the coupled group's: ``"sea"``, ``"<line>.<end>.<dof>"``).
+        Input channels (the coupled group's: ``"sea"`` — a short-crested sea's
+        ``"sea@<deg>"`` per direction —, ``"<line>.<end>.<dof>"``).
     input_spectra : ndarray, shape (n_ch, n_omega)
         One-sided input spectrum of each channel. [m²·s/rad]
     motion_transfer : ndarray, complex, shape (n_ch, d, n_omega)
@@ -318,7 +319,8 @@ class TimeSeries:
         coupled solve, prescribed bodies (vessels) from their RAO.
     body_channels : dict
         ``{body: (channel names)}``, the order of the body transfer arrays (the
-        coupled group's channels; ``("sea",)`` for a vessel).
+        coupled group's channels; the sea's for a vessel: ``("sea",)``, or one
+        ``"sea@<deg>"`` per direction of a short-crested sea).
     body_motion_transfer : dict
         ``{body: H}``, H of shape (n_ch, d, N+1) on ``omega`` (zero outside the
         analysis band), the transfer functions synthesized. [m/unit, rad/unit]

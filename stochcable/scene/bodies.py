@@ -100,9 +100,10 @@ class VesselMotion(_Doc):
     """A prescribed (vessel) body motion: 6-DOF RAOs per unit wave amplitude.
 
     Translations in m/m, rotations in rad/m, about the body reference point, for the
-    scene's sea heading (v1: no heading dimension); zero outside the table.  The
-    body is not solved for: lines attached to it see the end motion T(r)·ξ (seed 001
-    eqs. 3.3.6–3.3.7), nothing couples back.
+    scene's sea heading (v1: no heading dimension: in a short-crested sea the same RAO
+    applies to every direction); zero outside the table.  The body is not solved
+    for: lines attached to it see the end motion T(r)·ξ (seed 001 eqs. 3.3.6–3.3.7),
+    nothing couples back.
     """
 
     omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s", min_length=2)

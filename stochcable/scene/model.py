@@ -175,15 +175,16 @@ class Scene(_Doc):
                     )
                 except ValueError as exc:
                     raise ValueError(f"lines[{i}]: {exc}") from None
-        # (a spread sea with bodies is refused by the engine, naming sea.spreading)
-        if self.bodies and (self.sea is None or self.sea.spreading is None):
+        if self.bodies:
             planar = self.is_planar
             for j, b in enumerate(self.bodies):
                 if b.planar_data and not planar:
-                    raise ValueError(
+                    raise LocatedValueError(
+                        ("bodies", j),
+                        b.name,
                         f"bodies[{j}] ({b.name!r}) has 3×3 (surge, heave, pitch) data but "
                         "the scene is not planar (a line, body, sea or current leaves the "
-                        "x–z plane): give 6×6 matrices and a 6-DOF table"
+                        "x–z plane; a spread sea does): give 6×6 matrices and a 6-DOF table",
                     )
                 if planar:
                     bad = [d for d in b.fixed_dofs if d not in PLANAR_BODY_DOFS]

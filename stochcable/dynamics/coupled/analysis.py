@@ -33,15 +33,16 @@ from stochcable.dynamics.coupled.inputs import (
     body_loads,
     group_channels,
     reference_omega,
-    scene_line_channels,
+    sea_only_channels,
 )
 from stochcable.dynamics.coupled.model import CoupledModel, ModelGroup, build_coupled
 from stochcable.dynamics.coupled.modes import coupled_modes
 from stochcable.dynamics.coupled.results import body_result, coupled_results
-from stochcable.dynamics.coupled.seainputs import heading_inputs
+from stochcable.dynamics.coupled.seainputs import group_line_channels, heading_inputs
 from stochcable.dynamics.line_loads import LineInputs, silent_channel
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.sea_channels import sea_channel_densities
 from stochcable.dynamics.system import Damping, LineSystem, Progress, noop_progress
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.results.documents import BodyResult, LineResult
@@ -222,9 +223,7 @@ def solve_coupled(
         if line.name in alone:
             chans[line.name], inputs[line.name] = heading_inputs(model, scene, line)
         else:
-            chans[line.name], _ = scene_line_channels(
-                scene, line, model.systems[line.name], model.omega, model.vessel_rao
-            )
+            chans[line.name], _ = group_line_channels(model, scene, line)
     timing["model_s"] += time.perf_counter() - t0
     lines_out: dict[str, LineResult] = {}
     bodies_out: dict[str, BodyResult] = {}
@@ -360,8 +359,6 @@ def _solve_lonely(
 ) -> tuple[BodyResult, CoupledGroup] | None:
     """A free-floating body without lines: the body alone in the sea (None without
     a sea)."""
-    from stochcable.dynamics.sea_channels import spectrum_callable
-
     if scene.sea is None:
         warn(
             f"body '{name}' has no lines and there is no sea: its motion is zero",
@@ -370,8 +367,7 @@ def _solve_lonely(
         )
         return None
     omega, env = model.omega, scene.environment
-    dens = spectrum_callable(scene.sea.spectrum, env.g)
-    sea_ch = (Channel(name="sea", kind="sea", omega=omega, spectrum=dens(omega), density=dens),)
+    sea_ch = sea_only_channels(scene.sea, omega, env.g)
     b = model.free[name]
     t1 = time.perf_counter()
     clin = linearize_coupled(
@@ -390,17 +386,25 @@ def _solve_lonely(
 
 
 def _vessel_results(model: CoupledModel, scene: Any, settings: Any) -> dict[str, BodyResult]:
-    """The prescribed bodies' motion statistics from their RAOs in the sea."""
+    """The prescribed bodies' motion statistics from their RAOs in the sea: one channel
+    per sea channel (every direction of a short-crested sea with the same RAO, the
+    tables having no heading dimension), the spectra summed over them."""
     omega, env = model.omega, scene.environment
     body_docs = {b.name: b for b in scene.bodies}
+    if scene.sea.spreading is None:
+        names: tuple[str, ...] = ("sea",)
+        sea = np.atleast_2d(scene.sea.spectrum.spectral_density(omega, env.g))
+    else:
+        dens = sea_channel_densities(scene.sea, env.g)
+        names = tuple(n for n, _, _ in dens)
+        sea = np.stack([d(omega) for _, _, d in dens])
     out = {}
     for n in model.prescribed:
-        h = model.vessel_rao[n].T[None]  # (1, 6, n_w)
-        sea = np.atleast_2d(scene.sea.spectrum.spectral_density(omega, env.g))
+        h = np.broadcast_to(model.vessel_rao[n].T[None], (len(names), 6, omega.size)).copy()
         dofs = ("surge", "sway", "heave", "roll", "pitch", "yaw")
         mean = np.concatenate([np.asarray(body_docs[n].position, float), np.zeros(3)])
         out[n] = body_result(
-            n, dofs, omega, ("sea",), sea, h, mean, settings.duration, prescribed=True
+            n, dofs, omega, names, sea, h, mean, settings.duration, prescribed=True
         )
     return out
 

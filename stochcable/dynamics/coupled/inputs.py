@@ -2,8 +2,10 @@
 group's channels (seed 001 §3.2.c, §3.3).
 
 A coupled group (:mod:`stochcable.dynamics.coupled`) is solved on one list of input
-channels: ``"sea"`` first, then ``"<line>.<end>.<dof>"`` for the end-motion spectra of
-the lines' unattached ends (:func:`group_channels`).  Each line sees every channel of
+channels: the sea's first (``"sea"``; a short-crested sea's ``"sea@<heading in deg>"``,
+one per direction, :mod:`stochcable.dynamics.sea_channels`), then
+``"<line>.<end>.<dof>"`` for the end-motion spectra of the lines' unattached ends
+(:func:`group_channels`).  Each line sees every channel of
 the group (the ones that do not concern it carry only their spectrum).
 
 Vessel-driven ends
@@ -12,7 +14,9 @@ An end attached to a *prescribed* body (a vessel with a motion RAO ξ_RAO) moves
 the RAO u = T(r)·ξ_RAO (three translations; the rotations move it through the arm r)
 coherently with the sea: it is the sea channel's end motion of an otherwise
 independent line (:func:`fairlead_motion`, :func:`scene_line_channels`), no coupling
-back.
+back.  The scene's vessel RAO tables have no heading dimension (they are given for
+the sea's heading): in a short-crested sea every direction channel carries the same
+RAO end motion, so the fairlead's motion spectrum is |RAO|² Σ_k w_k S = |RAO|² S.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ from stochcable.bodies.rigid import (
     rigid_link_matrix,
 )
 from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.sea_channels import sea_channel_densities, sea_channel_headings
 from stochcable.dynamics.system import LineSystem
 from stochcable.errors import InputError
 
@@ -42,6 +47,7 @@ __all__ = [
     "group_channels",
     "reference_omega",
     "scene_line_channels",
+    "sea_only_channels",
     "unit_channels",
     "vessel_rao",
 ]
@@ -135,18 +141,25 @@ def body_loads(
     omega : ndarray, shape (n_omega,)
         [rad/s]
     sea : Sea or None
-        The scene's sea (heading).
+        The scene's sea (heading and spreading).
     environment : Environment
         depth, g, current.
 
     Returns
     -------
     BodyLoads
-        The sea channel: ``body_excitation(body, ω, β, k)`` (phase moved to the global
-        wave phase) and the linear wave velocity at the drag point
+        Each sea channel at its heading β (the sea's heading; a direction of a
+        short-crested sea, :func:`~stochcable.dynamics.sea_channels.sea_channel_headings`):
+        ``body_excitation(body, ω, β, k)`` (phase moved to the global wave phase) and
+        the linear wave velocity at the drag point
         (:func:`stochcable.sea.kinematics.wave_kinematics`, zero above z = 0).
+
+    Raises
+    ------
+    InputError
+        ``heading``: a direction outside the body's excitation table (for a
+        short-crested sea the message names the direction and its channel).
     """
-    from stochcable.bodies.rigid import body_excitation
     from stochcable.sea.kinematics import wave_kinematics, wavenumber
 
     w = np.asarray(omega, dtype=float)
@@ -155,12 +168,15 @@ def body_loads(
     force = np.zeros((w.size, d, n_ch), dtype=complex)
     vel = np.zeros((w.size, 3, n_ch), dtype=complex)
     point = body.position + body.drag_point
+    headings = {} if sea is None else sea_channel_headings(sea)
+    k = None
     for i, ch in enumerate(channels):
         if ch.kind != "sea" or sea is None:
             continue
-        beta = sea.heading_rad
-        k = wavenumber(w, environment.depth, environment.g)
-        force[:, :, i] = body_excitation(body, w, beta, wavenumber=k)
+        beta = headings[ch.name]
+        if k is None:  # (the same for every direction)
+            k = wavenumber(w, environment.depth, environment.g)
+        force[:, :, i] = _excitation(body, w, beta, k, ch.name, sea)
         if np.any(body.drag_area > 0):
             p = point.copy()
             p[2] = max(p[2], -environment.depth)
@@ -168,6 +184,32 @@ def body_loads(
             vel[:, :, i] = kin.velocity[0].T
     cur = np.asarray(environment.current_velocity(np.array([min(point[2], 0.0)]))[0], dtype=float)
     return BodyLoads(force=force, velocity=vel, current=cur)
+
+
+def _excitation(
+    body: RigidBody, w: np.ndarray, beta: float, k: np.ndarray, channel: str, sea: Any
+) -> np.ndarray:
+    """:func:`~stochcable.bodies.rigid.body_excitation` at heading ``beta`` [rad]; a
+    heading outside the table of a short-crested sea's direction names the direction."""
+    from stochcable.bodies.rigid import body_excitation
+
+    try:
+        return body_excitation(body, w, beta, wavenumber=k)
+    except InputError as exc:
+        if exc.parameter != "heading" or sea.spreading is None:
+            raise
+        ds = sea.direction_set()
+        j = int(np.argmin(np.abs(ds.heading - beta)))
+        raise InputError(
+            "heading",
+            exc.value,
+            exc.unit,
+            f"{exc.constraint} of body '{body.name}' — direction {j + 1} of {ds.count} "
+            f"(channel '{channel}', weight {ds.weight[j]:.3g}) of sea.spreading "
+            f"({sea.spreading.type}) about sea.heading = {sea.heading:g} deg: give the "
+            "body's excitation at every direction of the spreading (a table over the "
+            "whole circle) or narrow the spreading",
+        ) from None
 
 
 def body_gravity_stiffness(
@@ -209,6 +251,17 @@ def body_gravity_stiffness(
 
 def _zero_density(w: np.ndarray) -> np.ndarray:
     return np.zeros_like(np.asarray(w, dtype=float))
+
+
+def sea_only_channels(sea: Any, omega: np.ndarray, g: float) -> tuple[Channel, ...]:
+    """The sea's channels on ``omega`` [rad/s] without line kinematics, the inputs of
+    a free-floating body: "sea", or one "sea@<deg>" per direction of a short-crested
+    sea with its share of the spectrum
+    (:func:`~stochcable.dynamics.sea_channels.sea_channel_densities`); ``g`` [m/s²]."""
+    return tuple(
+        Channel(name=name, kind="sea", omega=omega, spectrum=d(omega), density=d)
+        for name, _, d in sea_channel_densities(sea, g)
+    )
 
 
 def unit_channels(cl: CoupledLine) -> tuple[Channel, ...]:
@@ -290,37 +343,37 @@ def group_channels(
     Returns
     -------
     dict of str to tuple of Channel
-        Per line the group's list: ``"sea"``, then ``"<line>.<end>.<dof>"`` of every
+        Per line the group's list: the sea's channels (``"sea"`` or one
+        ``"sea@<deg>"`` per direction), then ``"<line>.<end>.<dof>"`` of every
         line's end motions; channels of another line carry only their spectrum.
     """
     order: list[tuple[str, str, Channel]] = []
-    sea = None
+    seas: dict[str, Channel] = {}  # the sea's channels (one per direction), in order
     for n in lnames:
         for c in chans[n]:
             if c.kind == "sea":
-                sea = c
+                seas[c.name] = c
             else:
                 order.append((n, f"{n}.{c.name}", c))
     out = {}
     for n in lnames:
         own = {c.name: c for c in chans[n]}
-        lst = []
-        if sea is not None:
-            lst.append(
-                own.get(
-                    "sea",
-                    dataclasses.replace(
-                        sea,
-                        velocity=None,
-                        acceleration=None,
-                        motion_a=None,
-                        motion_b=None,
-                        element_velocity=None,
-                        element_velocity_square=None,
-                        element_end_square=None,
-                    ),
-                )
+        lst = [
+            own.get(
+                name,
+                dataclasses.replace(
+                    sea,
+                    velocity=None,
+                    acceleration=None,
+                    motion_a=None,
+                    motion_b=None,
+                    element_velocity=None,
+                    element_velocity_square=None,
+                    element_end_square=None,
+                ),
             )
+            for name, sea in seas.items()
+        ]
         for owner, full, c in order:
             if owner == n:
                 lst.append(dataclasses.replace(c, name=full))
@@ -405,7 +458,8 @@ def scene_line_channels(
     -------
     channels : tuple of Channel
         As :func:`stochcable.dynamics.loads.line_channels`, each end attached to a
-        prescribed body moving with :func:`fairlead_motion` inside the sea channel.
+        prescribed body moving with :func:`fairlead_motion` inside every sea channel
+        (the vessel RAO has no heading dimension: the same in every direction).
     attach : dict of str to str
         ``{end: body}`` of the ends attached to free bodies (solved with the body).
     """
