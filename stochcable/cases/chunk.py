@@ -111,7 +111,11 @@ def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) 
     upd: dict[str, Any] = {"analysis": scene.analysis.model_copy(update={"timeseries": None})}
     for state in states:
         if abs(math.sin(math.radians(state.heading))) > 1e-9:
-            upd["sea"] = Sea(spectrum=state.spectrum(family), heading=state.heading)
+            upd["sea"] = Sea(
+                spectrum=state.spectrum(family),
+                heading=state.heading,
+                spreading=scene.sea.spreading,
+            )
             break
     return scene.model_copy(update=upd)
 
@@ -217,7 +221,12 @@ def solve_chunk(
         omega = None
         rows = []
         for j, (i, state) in enumerate(cases):
-            sea = Sea(spectrum=state.spectrum(family), heading=state.heading)
+            # the scene's directional spreading about every state's heading
+            sea = Sea(
+                spectrum=state.spectrum(family),
+                heading=state.heading,
+                spreading=template.sea.spreading,
+            )
             row, res = _solve_case(engine, sea, i)
             rows.append(row)
             if res is None:
