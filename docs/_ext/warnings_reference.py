@@ -280,11 +280,12 @@ WARNINGS: tuple[WarningEntry, ...] = (
         ("stochcable.dynamics.strumming:MAX_MODES",),
     ),
     WarningEntry(
-        "Compiled sea kernel unavailable or not cached",
+        "Compiled kernel unavailable or not cached",
         "UserWarning",
-        ("stochcable.sea.kernels:_compile", "stochcable.sea.realization:_compiled_kernel"),
-        "numba cannot compile or cache the sea coefficient kernel",
-        "Results are the same; the NumPy kernel is slower, or the kernel is compiled "
+        ("stochcable.compiled:jit_cached", "stochcable.sea.realization:_compiled_kernel"),
+        "numba cannot compile or cache a kernel (the sea coefficients, the strumming "
+        "lock-in start grid)",
+        "Results are the same; the NumPy sea kernel is slower, or the kernel is compiled "
         "again in each process (about 1 s at its first use).",
         "Set ``NUMBA_CACHE_DIR`` to a writable directory, or ``STOCHCABLE_NUMBA=0`` to skip numba.",
     ),
