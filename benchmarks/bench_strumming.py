@@ -83,5 +83,6 @@ def main() -> None:
         f"| {share:+.1%} ({ratios[0]:+.1%} … {ratios[-1]:+.1%}) |"
     )
 
+
 if __name__ == "__main__":
     main()

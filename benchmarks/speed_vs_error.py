@@ -390,7 +390,7 @@ def converged_reference(
     progress: Progress = _silent,
 ) -> Reference:
     """The converged FD reference of an example (see the module docstring)."""
-    from stochcable.fidelity.planner import static_touchdowns
+    from stochcable.fidelity import static_touchdowns
     from stochcable.scene.model import load_scene
 
     c0 = int(base["analysis"]["omega"]["count"])

@@ -144,8 +144,9 @@ def _with_plan(result: Result, plan: Any, total_s: float) -> Result:
 
 def fidelity_warnings(plan: Any) -> list[str]:
     """The warnings of a fidelity plan that does not meet its target: an unbounded
-    response tail (what is unbounded and the fix) and every limit of the scene model
-    the plan hit (what it leaves unresolved), each with the plan's error estimate."""
+    response tail (what is unbounded and the fix), a linear model whose own error
+    exceeds the target, and every limit of the scene model the plan hit (what it leaves
+    unresolved), each with the plan's error estimate."""
     out = []
     est = plan.error_estimate
     if not plan.tail_bounded:
@@ -159,12 +160,23 @@ def fidelity_warnings(plan: Any) -> list[str]:
             "tension σ grows like log ω_max; band-limit the motion spectrum or give the "
             "end motion as a vessel RAO"
         )
+    model = est.get("linearization_model", 0.0)
+    if model > plan.target_error:
+        out.append(
+            f"adaptive fidelity cannot meet the target error {plan.target_error:g}: the "
+            f"linear model's own σ error against the nonlinear time domain is estimated "
+            f"at {model:.2g} ({plan.model_error_basis}); the plan resolves the "
+            f"discretization to {est.get('discretization', est['total']):.2g}, the "
+            f"answer carries both (total {est['total']:.2g}).  Check a design value "
+            "against a nonlinear time-domain analysis (stochcable.reference) or use a "
+            "target_error of at least the model error"
+        )
     if plan.limits:
-        met = est["total"] <= plan.target_error
+        met = est.get("discretization", est["total"]) <= plan.target_error
         out.append(
             "adaptive fidelity reached the scene model's limits for the target error "
-            f"{plan.target_error:g}: best plan within them, estimated σ error "
-            f"{est['total']:.2g} ("
+            f"{plan.target_error:g}: best plan within them, estimated discretization "
+            f"error {est.get('discretization', est['total']):.2g} ("
             + (
                 "within the target, but part of it is an estimate, not a bound"
                 if met

@@ -140,7 +140,7 @@ def test_reference_ladder_puts_a_node_at_the_touchdown():
     # tuah_1982_single_leg lies on the seabed from the anchor to s = 165.7 ft (closed-form
     # catenary): the ladder meshes are split there so that the element ladder converges
     # (uniform meshes oscillate at first order, see stochcable.fidelity.planner)
-    from stochcable.fidelity.planner import static_touchdowns
+    from stochcable.fidelity import static_touchdowns
     from stochcable.scene.model import load_scene
 
     base = sve.base_document("tuah_1982_single_leg")

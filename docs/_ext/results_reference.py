@@ -401,8 +401,14 @@ _REST = {
     "fidelity.choices[].error": ("-", "Estimated relative error of σ the choice leaves."),
     "fidelity.error_estimate": (
         "-",
-        "Estimated relative error per part (band, grid, elements, modes, linearization) and "
-        "``total``.",
+        "Estimated relative error per part of the discretization (band, grid, elements, "
+        "modes, linearization: the fixed point's tolerance), their sum ``discretization``, "
+        "``linearization_model`` (the linear model's own error against the nonlinear time "
+        "domain, calibrated: ``stochcable.fidelity.model_error``) and ``total``.",
+    ),
+    "fidelity.model_error_basis": (
+        "",
+        "Which line and term give ``linearization_model``, and the source of its calibration.",
     ),
     "fidelity.cost": ("-", "Elements, frequencies and their product of the plan applied."),
     "fidelity.tail_bounded": ("", "Whether the response variance above the band could be bounded."),

@@ -193,12 +193,15 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Adaptive fidelity could not meet its target",
         "PhysicsWarning",
         ("stochcable.analysis:_with_plan",),
-        "the response tail above the pilot's band is unbounded, or the plan reached a "
-        "limit of the scene model before ``analysis.fidelity.target_error``",
+        "the response tail above the pilot's band is unbounded, the linear model's own "
+        "error against the nonlinear time domain (calibrated, "
+        "``stochcable.fidelity.model_error``) exceeds ``analysis.fidelity.target_error``, "
+        "or the plan reached a limit of the scene model before the target",
         "The settings chosen are the best within the limits; the message gives the "
-        "estimated σ error and whether the target is met.",
+        "estimated σ error (discretization and model) and whether the target is met.",
         "Band-limit an end-motion spectrum (or give it as a vessel RAO), use a larger "
-        "``target_error``, or add damping to lightly damped modes.",
+        "``target_error``, add damping to lightly damped modes, or check the design "
+        "value against a nonlinear time-domain analysis.",
     ),
     WarningEntry(
         "Sea spectrum above the Nyquist frequency",

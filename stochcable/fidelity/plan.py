@@ -68,8 +68,11 @@ class FidelityPlan:
     choices : tuple of Choice
         Every choice with its reason and error estimate.
     error_estimate : dict of str to float
-        Estimate per part ("band", "grid", "elements", "modes", "linearization") and
-        "total" (their sum). [-]
+        Estimate per part of the discretization ("band", "grid", "elements", "modes",
+        "linearization": the fixed point's tolerance), "discretization" (their sum),
+        "linearization_model" (the linear model's own error against the nonlinear time
+        domain, which no fidelity removes: :mod:`stochcable.fidelity.model_error`) and
+        "total" (discretization + model). [-]
     cost : dict of str to float
         "elements", "frequencies" (of the grid applied) and "elements_x_frequencies".
     omega_response : float
@@ -87,6 +90,9 @@ class FidelityPlan:
     limits : tuple of str
         Every limit of the scene model the plan hit, with what it leaves unmet (empty
         when the target was met within them).
+    model_error_basis : str
+        Which line and term give ``error_estimate["linearization_model"]``, and the
+        source of its calibration.
     """
 
     target_error: float
@@ -106,6 +112,7 @@ class FidelityPlan:
     pilot: dict[str, Any] = field(default_factory=dict)
     grid_resolved: bool = True
     limits: tuple[str, ...] = ()
+    model_error_basis: str = ""
 
     def to_document(self) -> dict[str, Any]:
         """Plain JSON-ready form (for the result document's "fidelity")."""
@@ -123,6 +130,7 @@ class FidelityPlan:
             "tolerance": self.tolerance,
             "choices": [c.to_document() for c in self.choices],
             "error_estimate": dict(self.error_estimate),
+            "model_error_basis": self.model_error_basis,
             "cost": dict(self.cost),
             "tail_bounded": self.tail_bounded,
             "omega_response": self.omega_response,

@@ -6,12 +6,11 @@ response standard deviations, and records every choice with its reason and its e
 estimate in a :class:`~stochcable.fidelity.plan.FidelityPlan`; :func:`apply_fidelity`
 returns a new scene with the plan's settings (the input scene is never modified).
 
-The steps of :func:`choose_fidelity`: the static geometry of every segment
-(:mod:`stochcable.fidelity.meshing`), the input spectra's band and a pilot analysis
-whose response spectra are bounded (:mod:`stochcable.fidelity.pilot`; the pilot
-analysis is the ``evaluate`` callable the orchestrator passes), then the band, the
-elements, the grid, the modes and the linearization tolerance by the rules of
-:mod:`stochcable.fidelity.rules`, where the rules and the error budget are described.
+The steps: the static geometry of every segment (:mod:`stochcable.fidelity.meshing`),
+the input band and a pilot analysis whose response spectra are bounded
+(:mod:`stochcable.fidelity.pilot`; ``evaluate`` runs it), then the band, elements,
+grid, modes and linearization tolerance by the rules and error budget of
+:mod:`stochcable.fidelity.rules`.
 """
 
 from __future__ import annotations
@@ -37,6 +36,7 @@ from stochcable.fidelity.meshing import (
     segments_scene,
     static_touchdowns,
 )
+from stochcable.fidelity.model_error import linearization_model_error
 from stochcable.fidelity.pilot import (
     Evaluate,
     InputBand,
@@ -73,7 +73,6 @@ __all__ = [
     "FidelityPlan",
     "choose_fidelity",
     "apply_fidelity",
-    "static_touchdowns",
     "grid_values_supported",
 ]
 
@@ -113,18 +112,18 @@ def choose_fidelity(
 
     Notes
     -----
-    See :mod:`stochcable.fidelity.rules` for the rules.  Cost: one static solve and one
-    pilot analysis (log grid of :data:`~stochcable.fidelity.pilot.PILOT_COUNT` points,
-    mesh with kh = 1 at its top; doubled up to
-    :data:`~stochcable.fidelity.pilot.PILOT_EXTENSIONS` times while the response tail
-    is unbounded or the pilot's top is below 2·ω_max).
+    See :mod:`stochcable.fidelity.rules` for the rules; the discretization's share of
+    the target is what the linear model's own error
+    (:mod:`stochcable.fidelity.model_error`) leaves of it.  Cost: one static solve and
+    one pilot analysis (log grid of :data:`~stochcable.fidelity.pilot.PILOT_COUNT`
+    points, kh = 1 at its top, doubled up to ``PILOT_EXTENSIONS`` times while the
+    response tail is unbounded or the pilot's top is below 2·ω_max).
     """
     scene = load_scene(scene)
     eps = _v.in_range("target_error", target_error, "-", 0.0, 0.5, lo_open=True)
-    if allow_grid_values is None:
-        allow_grid_values = grid_values_supported()
+    grid_values = grid_values_supported() if allow_grid_values is None else allow_grid_values
     try:
-        return _plan(scene, eps, evaluate, exact_wave_integration, bool(allow_grid_values))
+        return _plan(scene, eps, evaluate, exact_wave_integration, bool(grid_values))
     except ValidationError as exc:  # a pilot or planned scene the model rejects
         raise planned_scene_error(exc, eps) from None
 
@@ -137,11 +136,12 @@ def _plan(
     allow_grid_values: bool,
 ) -> FidelityPlan:
     """:func:`choose_fidelity` on a loaded scene and a checked target."""
-    share = {k: v * eps for k, v in BUDGET.items()}
     statics = solve_statics(scene, method="fe")
-    geo = segment_geometry(scene, statics, static_touchdowns(scene))
+    geo = segment_geometry(scene, statics, tds := static_touchdowns(scene))
     inputs = input_summary(scene)
-    pilot = run_pilot(scene, geo, inputs, share["band"], exact_wave_integration, evaluate)
+    pilot = run_pilot(scene, geo, inputs, BUDGET["band"] * eps, exact_wave_integration, evaluate)
+    model, basis = linearization_model_error(pilot.result.lines, tds)
+    share = {k: v * (eps - model if model < eps else eps) for k, v in BUDGET.items()}
     band = _choose_band(pilot, inputs, share["band"])
     segs, el_choices, el_err = mesh_rules(
         scene,
@@ -159,7 +159,7 @@ def _plan(
     )
     tol = share["linearization"]
     # what the other parts leave of the target (used only when the grid hits its limit)
-    slack = eps - (band.error + el_err + mode_err + tol + share["grid"] / 2.0)
+    slack = sum(share.values()) - (band.error + el_err + mode_err + tol + share["grid"] / 2.0)
     grid = _choose_grid(scene, pilot, band, share["grid"], bool(allow_grid_values), slack)
     tol_choice = Choice(
         "analysis.linearization.tolerance",
@@ -177,7 +177,9 @@ def _plan(
     }
     if grid.unresolved or grid.base_clipped:
         parts["grid_unresolved"] = grid.unresolved_error
-    parts["total"] = float(sum(parts.values()))
+    parts["discretization"] = float(sum(parts.values()))
+    parts["linearization_model"] = model
+    parts["total"] = parts["discretization"] + model
     n_el = sum(sum(n for _, _, n in v) for v in segs.values())
     cost = {
         "elements": float(n_el),
@@ -198,6 +200,7 @@ def _plan(
         error_estimate=parts,
         cost=cost,
         tail_bounded=bool(pilot.bounded),
+        model_error_basis=basis,
         omega_response=float(band.omega2),
         pilot=pilot.info,
         grid_resolved=not (grid.unresolved or grid.base_clipped),
