@@ -266,6 +266,9 @@ def simulate_line_timedomain(
     band: tuple[float, float] | None = None,
     internal_damping: float = 0.0,
     mass_matrix: str = "consistent",
+    drag: str = "quadratic",
+    linear_drag: tuple[Any, Any] | None = None,
+    seabed: str = "one_sided",
 ) -> CableTimeHistory:
     """Nonlinear time-domain response of one line to the scene's sea and end motions.
 
@@ -318,6 +321,16 @@ def simulate_line_timedomain(
     mass_matrix : {"consistent", "lumped"}, default "consistent"
         Element mass and added mass: consistent (m l0 [[1/3, 1/6], [1/6, 1/3]], the
         frequency-domain model's) or lumped (half on each node, MoorDyn's). [-]
+    drag : {"quadratic", "static_tangent", "linear"}, default "quadratic"
+        Morison drag with the instantaneous element tangent (the default), with the
+        static tangent (the frequency-domain model's normal/axial split), or linear
+        with ``linear_drag`` (controlled experiments, docs/benchmarks/fd_budget.md). [-]
+    linear_drag : (array_like, array_like), optional
+        (B_n, B_t) per element for ``drag="linear"``, e.g. a frequency-domain
+        analysis' converged ``linearization.b_normal`` and ``b_axial``; no current. [N·s/m²]
+    seabed : {"one_sided", "linear"}, default "one_sided"
+        The one-sided penalty bed, or its tangent at the static start (bilateral
+        spring and dashpot, the frequency-domain model's kind of bed). [-]
 
     Returns
     -------
@@ -393,6 +406,7 @@ def simulate_line_timedomain(
     model, xs, u_cur, u_cur_g, tol_abs = _static_start(
         scene, mesh, x3, dim, tolerance, internal_damping, mass_matrix == "lumped"
     )
+    model.set_variant(**_variant(scene, mesh, drag, linear_drag, seabed))
     check_seabed_contact(scene, mesh, model, xs, h, PERIOD_ERROR_TOLERANCE)
     r = half_cosine(t, ramp)
     sl = np.arange(n_steps + 1) % (k_up * grid.n_samples)  # periodic in T_L
@@ -459,6 +473,28 @@ def simulate_line_timedomain(
     )
     _check_stationary(out, h)
     return out
+
+
+def _variant(scene: Scene, mesh: Any, drag: str, linear_drag: Any, seabed: str) -> dict[str, Any]:
+    """The checked model variant of :func:`simulate_line_timedomain`."""
+    if drag not in ("quadratic", "static_tangent", "linear"):
+        raise InputError("drag", drag, "-", "must be 'quadratic', 'static_tangent' or 'linear'")
+    if seabed not in ("one_sided", "linear"):
+        raise InputError("seabed", seabed, "-", "must be 'one_sided' or 'linear'")
+    pair = None
+    if drag == "linear":
+        if linear_drag is None or len(linear_drag) != 2:
+            raise InputError(
+                "linear_drag", linear_drag, "N·s/m²", "must be (B_n, B_t) with drag='linear'"
+            )
+        pair = tuple(np.broadcast_to(np.asarray(b, float), (mesh.n_elements,)) for b in linear_drag)
+        if not all(np.all(np.isfinite(b)) and np.all(b >= 0) for b in pair):
+            raise InputError("linear_drag", "negative or non-finite", "N·s/m²", "must be >= 0")
+        if scene.environment.current:
+            raise InputError(
+                "linear_drag", "with a current", "N·s/m²", "is linear about zero mean flow"
+            )
+    return {"drag": drag, "linear_drag": pair, "seabed": seabed}
 
 
 def _select_line(scene: Scene, line_name: str | None) -> Line:

@@ -210,6 +210,40 @@ class LineModel:
         self.M_band = self.band_matrix(mel, node_m)
         self.M_sparse = self.sparse_matrix(mel, node_m)
         self.free = slice(d, self.N - d)
+        # controlled-experiment variants (set_variant); defaults: the nonlinear model
+        self.drag_tangent = "instantaneous"
+        self.linear_drag: tuple[np.ndarray, np.ndarray] | None = None
+        self.bed_linear: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+
+    def set_variant(
+        self,
+        drag: str = "quadratic",
+        linear_drag: tuple[np.ndarray, np.ndarray] | None = None,
+        seabed: str = "one_sided",
+    ) -> None:
+        """Switch terms of the model to their linear (frequency-domain) form.
+
+        Parameters
+        ----------
+        drag : {"quadratic", "static_tangent", "linear"}
+            Morison drag with the instantaneous element tangent (the default), with the
+            static tangent e₀ (the frequency-domain model's normal/axial split), or
+            linear: f = B_n (I − e₀e₀ᵀ) v_r + B_t e₀e₀ᵀ v_r with ``linear_drag``. [-]
+        linear_drag : (ndarray, ndarray), optional
+            (B_n, B_t) per element for ``drag="linear"`` (e.g. the frequency-domain
+            analysis' converged ``linearization.b_normal``/``b_axial``). [N·s/m²]
+        seabed : {"one_sided", "linear"}
+            The one-sided penalty bed (default) or its tangent at the static start,
+            bilateral (spring and dashpot frozen at the static contact). [-]
+        """
+        self.drag_tangent = "static" if drag in ("static_tangent", "linear") else "instantaneous"
+        if drag == "linear":
+            b_n, b_t = (np.asarray(b, dtype=float) for b in linear_drag)
+            self.linear_drag = (b_n, b_t)
+        if seabed == "linear":
+            zeros = np.zeros_like(self.x_static)
+            f0, k0, c0 = self.seabed(self.x_static, zeros)
+            self.bed_linear = (f0[:, -1].copy(), k0.copy(), c0.copy(), self.x_static[:, -1].copy())
 
     # ---- assembly helpers
     def band_matrix(self, el: np.ndarray | None, nd: np.ndarray | None) -> np.ndarray:
@@ -309,7 +343,12 @@ class LineModel:
         d = self.dim
         F = np.zeros_like(X)
         c_el = None
-        if np.any(self.cn) or np.any(self.ct):
+        if self.drag_tangent == "static":
+            dx0 = np.diff(self.x_static, axis=0)
+            e = dx0 / np.linalg.norm(dx0, axis=1)[:, None]
+        if self.linear_drag is not None:
+            F, c_el = self._linear_drag(V, e, u_gauss, jacobian)
+        elif np.any(self.cn) or np.any(self.ct):
             # relative velocity at the quadrature points: (ne, ng, d)
             w = u_gauss - self.gauss_points(V)
             s = np.einsum("egd,ed->eg", w, e)  # axial component
@@ -350,6 +389,27 @@ class LineModel:
                 ] * vr[:, :, None] * vr[:, None, :] / mag[:, None, None]
         return F, c_el, c_nd
 
+    def _linear_drag(self, V: np.ndarray, e: np.ndarray, u_gauss: np.ndarray, jacobian: bool):
+        """Linear drag B_n (I − e₀e₀ᵀ) v_r + B_t e₀e₀ᵀ v_r at the quadrature points:
+        nodal forces (n, d) and the constant element blocks l0 B ⊗ [[1/3, 1/6], ...]."""
+        d = self.dim
+        b_n, b_t = self.linear_drag
+        w = u_gauss - self.gauss_points(V)
+        s = np.einsum("egd,ed->eg", w, e)
+        wn = w - s[:, :, None] * e[:, None, :]
+        f = b_n[:, None, None] * wn + (b_t[:, None] * s)[:, :, None] * e[:, None, :]
+        nodal = self.l0[:, None, None] * np.einsum("g,ga,egd->ead", self.gauss_w, self.gauss_N, f)
+        F = np.zeros_like(V)
+        F[:-1] += nodal[:, 0]
+        F[1:] += nodal[:, 1]
+        c_el = None
+        if jacobian:
+            ee = e[:, :, None] * e[:, None, :]
+            J = b_n[:, None, None] * (np.eye(d)[None] - ee) + b_t[:, None, None] * ee
+            blk = np.einsum("ac,eij->eaicj", CONSISTENT, J)
+            c_el = self.l0[:, None, None] * blk.reshape(self.ne, 2 * d, 2 * d)
+        return F, c_el
+
     def contact_blend(self, X: np.ndarray) -> np.ndarray:
         """Blend factor s(p/p₀) of every node (0 off the bed, 1 in full contact)."""
         x = np.clip((-self.depth - X[:, -1]) / self.pen0, 0.0, 1.0)
@@ -370,6 +430,11 @@ class LineModel:
         (p = 1.5 p₀) have the full k and c, as the frequency-domain model's grounded
         nodes; the blend only shifts the resting depth by p₀/2 (millimetres).
         """
+        if self.bed_linear is not None:
+            f0, k0, c0, z0 = self.bed_linear
+            F = np.zeros_like(X)
+            F[:, -1] = f0 - k0 * (X[:, -1] - z0) - c0 * V[:, -1]
+            return F, k0, c0
         pen = -self.depth - X[:, -1]
         p0 = self.pen0
         on = pen > 0.0
