@@ -131,11 +131,11 @@ def test_met_targets_have_no_limits_and_unchanged_documents():
     assert plan.grid_resolved and plan.limits == () and plan.tail_bounded
     assert "grid_unresolved" not in plan.error_estimate
     assert {"limits", "grid_resolved"}.isdisjoint(plan.to_document())
-    # only the linear model's own error is said (5.1 % on this seabed line, > 5 %)
+    # only the linear model's own error is said (7.7 % on this seabed line, > 5 %)
     (text,) = fidelity_warnings(plan)
     assert text.startswith("adaptive fidelity cannot meet the target error 0.05")
-    loose = choose_fidelity(_chain(), 0.08, evaluate=analyze)  # the model leaves 2.9 %
-    assert loose.error_estimate["total"] <= 0.08 and fidelity_warnings(loose) == []
+    loose = choose_fidelity(_chain(), 0.11, evaluate=analyze)  # the model leaves 3.3 %
+    assert loose.error_estimate["total"] <= 0.11 and fidelity_warnings(loose) == []
 
 
 # ------------------------------------------------------------- the entrances
@@ -155,12 +155,12 @@ def _fidelity_texts(warnings) -> list[str]:
 
 
 def _model_error_said(texts: list[str], target: float) -> None:
-    """The chain touches the seabed: its calibrated linear-model error (5.1 %, anchor)
+    """The chain touches the seabed: its calibrated linear-model error (7.7 %, anchor)
     exceeds both targets, so the one fidelity warning says the target cannot be met and
     why (never claimed), while the discretization meets it."""
     (text,) = texts
     assert text.startswith(f"adaptive fidelity cannot meet the target error {target:g}")
-    assert "0.051" in text and "touchdown" in text and "moordyn" in text
+    assert "0.077" in text and "touchdown" in text and "fd_budget" in text
 
 
 @pytest.mark.parametrize("target", TARGETS)
