@@ -164,7 +164,7 @@ def table(res: dict, elements: int, seeds: tuple[int, ...]) -> str:
         fdv = r["fd"]
         var = r["var"]  # (variant, seed, end, [in, out])
         sig = np.sqrt(var.sum(-1))  # (variant, seed, end)
-        rows.append(f"\n### Motion ×{scale:g} (FD σ {fdv[0] / 1e3:.2f} / {fdv[1] / 1e3:.2f} kN)\n")
+        rows.append(f"\n## Motion ×{scale:g} (FD σ {fdv[0] / 1e3:.2f} / {fdv[1] / 1e3:.2f} kN)\n")
         rows.append(
             "| step | fairlead σ/FD − 1 [%] | shift [%] | in-band σ/FD − 1 [%] "
             "| off-band var. [%] | anchor σ/FD − 1 [%] | shift [%] | in-band σ/FD − 1 [%] "
