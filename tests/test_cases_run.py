@@ -226,3 +226,19 @@ def test_fatigue_setting_errors():
         run_cases(fss, sd, fatigue=LineFatigue("dnv-studless", nominal_diameter=0.08))
     res = run_cases(fss, sd, fatigue=LineFatigue("api-studless", mbs=2.0e5))
     assert math.isfinite(res.totals[fss.lines[0].name].annual_damage["end_b"])
+
+
+def test_a_template_without_a_sea_takes_every_state_long_crested():
+    """A scene with no sea of its own (sea: null) still gives its states their seas,
+    in and out of the plane (found by schemathesis: the spreading of a missing sea)."""
+    doc = load_example("chain_catenary").model_dump(mode="json", exclude_none=True)
+    doc["analysis"].pop("timeseries", None)
+    doc["sea"] = None
+    rows = [{"hs": 2.0, "tp": 8.0, "heading": h, "probability": 0.5} for h in (0.0, 30.0)]
+    res = run_cases(load_scene(doc), scatter_from_rows(rows))
+    assert [r.status for r in res.rows] == ["ok", "ok"]
+    for i, h in enumerate((0.0, 30.0)):
+        sea = {"spectrum": res.scatter.states[i].spectrum("jonswap").model_dump(), "heading": h}
+        ref = analyze({**doc, "sea": sea}).lines["leg1"].end_b.std
+        # 1e-5: fixed points started elsewhere, both within the tolerance 1e-4
+        assert res.stats["leg1"]["end_b"][i, 1] == pytest.approx(ref, rel=1e-5)

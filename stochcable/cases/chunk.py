@@ -114,7 +114,7 @@ def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) 
             upd["sea"] = Sea(
                 spectrum=state.spectrum(family),
                 heading=state.heading,
-                spreading=scene.sea.spreading,
+                spreading=None if scene.sea is None else scene.sea.spreading,
             )
             break
     return scene.model_copy(update=upd)
@@ -225,7 +225,7 @@ def solve_chunk(
             sea = Sea(
                 spectrum=state.spectrum(family),
                 heading=state.heading,
-                spreading=template.sea.spreading,
+                spreading=None if template.sea is None else template.sea.spreading,
             )
             row, res = _solve_case(engine, sea, i)
             rows.append(row)
