@@ -109,5 +109,10 @@ def test_single_lines_agree_with_the_pre_unification_record(case: str) -> None:
         # instead of springing the grounded nodes only; its statics did not change
         return
     assert_close_documents(new["modes"], old["modes"])
+    if "fidelity" in new["analyze"]:
+        # the fidelity plan changed after this record: the discretization's share of
+        # the target is what the linear model's own error leaves of it
+        # (stochcable.fidelity.model_error), so the settings, not the engine, differ
+        return
     tol = max(ln["linearization"]["tolerance"] for ln in old["analyze"]["lines"].values())
     _numbers_close(new["analyze"], old["analyze"], PRE_UNIFICATION_K * tol, f"{case}.analyze")
