@@ -28,7 +28,15 @@ from stochcable.dynamics.engine import Engine, build_engine
 from stochcable.errors import StochcableError, collect_warnings
 from stochcable.scene.model import Scene, Sea
 
-__all__ = ["CaseRow", "ChunkResult", "solve_chunk", "engine_template", "prepare_worker", "ENDS"]
+__all__ = [
+    "CaseRow",
+    "ChunkResult",
+    "solve_chunk",
+    "case_sea",
+    "engine_template",
+    "prepare_worker",
+    "ENDS",
+]
 
 ENDS = ("end_a", "end_b")
 #: Engines a worker keeps, most recent first (a set's scene, and the one before). [-]
@@ -104,6 +112,13 @@ def prepare_worker() -> None:
     warnings.simplefilter("ignore")
 
 
+def case_sea(scene: Scene, state: SeaState, family: Family) -> Sea:
+    """The sea of one state of the set: its spectrum and heading, and the scene's
+    directional spreading (if any) about that heading."""
+    spreading = None if scene.sea is None else scene.sea.spreading
+    return Sea(spectrum=state.spectrum(family), heading=state.heading, spreading=spreading)
+
+
 def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) -> Scene:
     """The scene a set's engine is built from: no time series, and the sea of an
     out-of-plane state when there is one (the models are then 3-D, and in-plane states
@@ -111,11 +126,7 @@ def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) 
     upd: dict[str, Any] = {"analysis": scene.analysis.model_copy(update={"timeseries": None})}
     for state in states:
         if abs(math.sin(math.radians(state.heading))) > 1e-9:
-            upd["sea"] = Sea(
-                spectrum=state.spectrum(family),
-                heading=state.heading,
-                spreading=None if scene.sea is None else scene.sea.spreading,
-            )
+            upd["sea"] = case_sea(scene, state, family)
             break
     return scene.model_copy(update=upd)
 
@@ -169,7 +180,7 @@ def _strumming_damage(
     when the line does not strum (docs/strumming.md).  The current is the scene's, the
     same in every sea state, so the same rate is added to every case's wave damage (the
     two summed, as DNV-RP-F204 sums wave and VIV fatigue damage)."""
-    table = getattr(engine, "strumming", {}).get(name)
+    table = engine.strumming.get(name)
     if table is None or table.governing is None:
         return None
     mode = table.modes[table.governing]
@@ -221,13 +232,7 @@ def solve_chunk(
         omega = None
         rows = []
         for j, (i, state) in enumerate(cases):
-            # the scene's directional spreading about every state's heading
-            sea = Sea(
-                spectrum=state.spectrum(family),
-                heading=state.heading,
-                spreading=None if template.sea is None else template.sea.spreading,
-            )
-            row, res = _solve_case(engine, sea, i)
+            row, res = _solve_case(engine, case_sea(template, state, family), i)
             rows.append(row)
             if res is None:
                 continue

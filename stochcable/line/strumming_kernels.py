@@ -52,7 +52,6 @@ def _balance_grid(
     p1 = np.empty(n)
     big_p = np.empty(n)
     q_base = np.empty(n)
-    k2_unit = np.empty(n)
     inv_c3 = np.empty(n)
     rhs_unit = np.empty(n)
     for j in range(omegas.size):
@@ -80,7 +79,6 @@ def _balance_grid(
             q_base[e] = 2.0 * p2[e] ** 3 / 27.0 - p2[e] * p1[e] / 3.0
             # |rhs|² per unit amplitude²: rhs = ω_s F̄ · iωAψ/D
             rhs_unit[e] = ws * f * w * psi[e] / diameter[e]
-            k2_unit[e] = rhs_unit[e] ** 2
             # the bound |c| <= sqrt(2α/β) + (4/β²)^(1/6) |rhs|^(1/3) (module notes)
             alpha = w * ws * g * lift0sq[e]
             beta = a1i[e]
@@ -102,7 +100,9 @@ def _balance_grid(
             right_r = 0.0
             right_i = 0.0
             for e in range(n):
-                k2 = k2_unit[e] * a * a
+                # c = rhs/(a0 + a1 x), rhs = i ω_s F̄ ω A ψ/D (purely imaginary)
+                rhs_i = rhs_unit[e] * a
+                k2 = rhs_i * rhs_i
                 if k2 <= 0.0:
                     continue
                 p0 = -k2 * inv_c3[e]
@@ -125,8 +125,6 @@ def _balance_grid(
                     if dfx != 0.0:
                         x = x - fx / dfx
                 x = max(x, 0.0)
-                # c = rhs/(a0 + a1 x), rhs = i ω_s F̄ ω A ψ/D (purely imaginary)
-                rhs_i = rhs_unit[e] * a
                 dr = a0r[e] + a1r[e] * x
                 di = a0i[e] + a1i[e] * x
                 scale = rhs_i / (dr * dr + di * di)
