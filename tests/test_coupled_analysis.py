@@ -537,12 +537,13 @@ def _attached_scene(scene, attach, bodies):
 
 
 class _Vessel:
-    """A VesselMotion stand-in: transfer(omega) -> (6, n_omega) per unit amplitude."""
+    """A VesselMotion stand-in: transfer(omega, heading) -> (6, n_omega) per unit
+    amplitude, the same for every heading."""
 
     def __init__(self, rao):
         self.rao = rao
 
-    def transfer(self, omega):
+    def transfer(self, omega, heading=None):
         return np.stack([f(np.asarray(omega)) for f in self.rao])
 
 

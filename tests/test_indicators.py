@@ -16,7 +16,7 @@ from scipy import integrate
 
 from stochcable.analysis import analyze
 from stochcable.dynamics.fixedpoint import linearize
-from stochcable.dynamics.indicators import line_indicators
+from stochcable.dynamics.indicators import AT_REST_FRACTION, at_rest_zeroed, line_indicators
 from stochcable.dynamics.linearization import borgman_variance_ratio, drag_inertia_ratio
 from stochcable.dynamics.loads import line_channels
 from stochcable.dynamics.system import build_line_system
@@ -104,6 +104,36 @@ def test_borgman_ratio_limits_and_range():
 
 
 # ------------------------------------------------------------ drag / inertia
+
+
+def test_elements_at_rest_take_the_limits():
+    """Grounded chain barely moves (σ falls by ~100 per element away from the
+    touchdown, to round-off): σ and current below 1e-6 of the line's largest are zero
+    for the indicators, so the Borgman ratio takes its σ → 0 limits (1 with a normal
+    current, 8/(3π) without) and the drag/inertia ratio 0, the same on every machine;
+    the moving part keeps its values."""
+    s, u = at_rest_zeroed(np.array([1.0, 2e-7, 5e-13, 0.5]), np.array([0.3, 0.2, 1e-15, 0.0]))
+    np.testing.assert_array_equal(s, [1.0, 0.0, 0.0, 0.5])
+    np.testing.assert_array_equal(u, [0.3, 0.2, 0.0, 0.0])
+    assert borgman_variance_ratio(s, u)[1] == 1.0
+    assert borgman_variance_ratio(s, u)[2] == pytest.approx(8.0 / (3.0 * math.pi), rel=1e-14)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = analyze(load_scene(EXAMPLES / "chain_catenary.json"))
+    ind = res.lines["leg1"].indicators
+    # grounded elements lie flat on the bed and slide along it (x): the normal
+    # motion is y and z; both nodes moving less than 1e-7 m normally bound the
+    # element's normal velocity σ by ω_max·1e-7 m = 2e-7 m/s, under 1e-6 of the
+    # line's largest (0.73 m/s)
+    node = res.lines["leg1"].motion_std[:, 1:].max(axis=1)
+    grounded = np.maximum(node[:-1], node[1:]) < AT_REST_FRACTION * 0.1
+    assert grounded.sum() >= 10
+    limits = np.isclose(ind.borgman_ratio, 8.0 / (3.0 * math.pi), rtol=1e-14) | (
+        ind.borgman_ratio == 1.0
+    )
+    assert np.all(limits[grounded])
+    assert np.all(ind.drag_inertia_ratio[grounded] == 0.0)
+    assert ind.borgman_ratio[-5:].min() > 0.0 and ind.drag_inertia_ratio[-5:].min() > 0.0
 
 
 def test_drag_inertia_ratio_closed_form_and_thin_vs_thick_cylinder():

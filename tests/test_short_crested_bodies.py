@@ -1,7 +1,8 @@
 """Short-crested seas with bodies and vessels (``sea.spreading``, issue 20): each
 direction channel drives the bodies' wave excitation at its own heading and the
-vessel's fairleads with the vessel RAO (no heading dimension: the same in every
-direction), and the drag linearization stays one fixed point over all directions.
+vessel's fairleads with the vessel RAO (a table without headings: the same in every
+direction; tables over heading: tests/test_vessels.py), and the drag linearization
+stays one fixed point over all directions.
 
 Independent checks: a spreading that narrows to zero width is the long-crested
 analysis; with the drag off (nothing couples the directions) the spread response
@@ -11,101 +12,18 @@ response; an excitation table without a direction's heading names it."""
 
 from __future__ import annotations
 
-import copy
 import math
 
 import numpy as np
 import pytest
+from _scenes import buoy_with_vessel as _buoy
 
 from stochcable.analysis import analyze
 from stochcable.errors import InputError
 from stochcable.examples import load_example
 from stochcable.scene.model import load_scene
 
-THREE_LEGS = "tuah_1982_disc_buoy_three_legs"
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
-
-
-def _full_circle(doc: dict, step: float = 15.0) -> None:
-    """The disc's excitation table (heading 0 only) over the whole circle: the disc is
-    axisymmetric about z through its reference point, so the excitation of heading β
-    is that of heading 0 with its force and moment vectors turned by β about z."""
-    exc = doc["bodies"][0]["hydrodynamics"]["excitation"]
-    f0 = np.asarray(exc["re"], float)[0] + 1j * np.asarray(exc["im"], float)[0]  # (6, n_w)
-    heads = np.arange(0.0, 360.0, step)
-    out = []
-    for b in np.radians(heads):
-        c, s = math.cos(b), math.sin(b)
-        rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        out.append(np.concatenate([rot @ f0[:3], rot @ f0[3:]]))
-    out = np.array(out)
-    exc.update(heading=heads.tolist(), re=out.real.tolist(), im=out.imag.tolist())
-
-
-def _vessel(doc: dict) -> None:
-    """A prescribed vessel (6-DOF RAO table, no heading dimension) and a riser from it,
-    beside the buoy (ft-slug-lbf, as the example)."""
-    w = np.linspace(0.01, 5.0, 60)
-    rao = {
-        "surge": 0.8 * np.exp(-0.3j * w) / (1 + w**2),
-        "sway": 0.3j / (1 + w**2),
-        "heave": 1.0 / (1 + (w / 0.9) ** 4) + 0j,
-        "roll": 0.01 * w * np.exp(-w) + 0j,
-        "pitch": 0.02j * w * np.exp(-w),
-    }
-    doc["bodies"].append(
-        {
-            "name": "ship",
-            "position": [600.0, 0.0, 0.0],
-            "mass": 1e6,
-            "prescribed": {
-                "omega": w.tolist(),
-                **{k: {"re": v.real.tolist(), "im": v.imag.tolist()} for k, v in rao.items()},
-            },
-        }
-    )
-    doc["lines"].append(
-        {
-            "name": "riser",
-            "end_a": {"position": [800.0, 30.0, -100.0]},
-            "end_b": {"attach": {"body": "ship", "point": [10.0, 0.0, -5.0]}},
-            "segments": [
-                {
-                    "length": 265.0,
-                    "ea": 1.0e6,
-                    "mass": 0.5,
-                    "diameter": 0.2,
-                    "cd_normal": 1.2,
-                    "elements": 8,
-                }
-            ],
-        }
-    )
-
-
-def _buoy(
-    heading: float = 0.0,
-    spreading: dict | None = None,
-    *,
-    full_circle: bool = False,
-    vessel: bool = False,
-    drag: bool = True,
-) -> dict:
-    doc = copy.deepcopy(load_example(THREE_LEGS).model_dump(mode="json", exclude_none=True))
-    doc["analysis"].pop("timeseries", None)
-    if full_circle:
-        _full_circle(doc)
-    if vessel:
-        _vessel(doc)
-    if not drag:  # nothing couples the directions: the response is linear in the sea
-        for line in doc["lines"]:
-            for seg in line["segments"]:
-                seg.update(cd_normal=0.0, cd_axial=0.0)
-        doc["bodies"][0]["drag_area"] = [0.0, 0.0, 0.0]
-    doc["sea"]["heading"] = heading
-    if spreading is not None:
-        doc["sea"]["spreading"] = spreading
-    return doc
 
 
 def _body_std(result, name: str = "disc") -> np.ndarray:
@@ -303,7 +221,7 @@ def test_time_series_drive_each_direction_with_its_own_realization():
     grid = scene.analysis.omega
     band = (w >= grid.min) & (w <= grid.max) & (w > 0)
     rao = np.zeros((6, w.size), dtype=complex)
-    rao[:, band] = vessel_raos(scene, w[band])["ship"].T
+    rao[:, band] = vessel_raos(scene, w[band]).at("ship", scene.sea.heading_rad).T
     surge = sum(synthesize(r, rao[0]) for r in reals)
     scale = np.max(np.abs(surge))
     np.testing.assert_allclose(ts.body_motion["ship"]["surge"] - 600.0, surge, atol=1e-10 * scale)

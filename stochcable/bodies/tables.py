@@ -11,6 +11,7 @@ from typing import Any, Literal
 import numpy as np
 
 from stochcable.errors import InputError
+from stochcable.scene.tables import heading_weights
 from stochcable.validation import finite_scalar, float_array
 
 __all__ = ["FrequencyTable", "ExcitationTable"]
@@ -90,40 +91,6 @@ class FrequencyTable:
         return (1.0 - t)[:, None, None] * self.values[i] + t[:, None, None] * self.values[j]
 
 
-def _heading_weights(table: np.ndarray, beta: float) -> tuple[int, int, float]:
-    """Two table indices and a weight for heading beta [rad] (periodic tables)."""
-    n = table.size
-    two_pi = 2.0 * math.pi
-    b = table[0] + (beta - table[0]) % two_pi
-    tol = 1e-9
-    if n == 1:
-        if min(abs(b - table[0]), two_pi - abs(b - table[0])) <= tol:
-            return 0, 0, 0.0
-        raise InputError(
-            "heading",
-            math.degrees(beta),
-            "deg",
-            f"is not in the excitation table (one heading, "
-            f"{math.degrees(table[0]):g} deg): add headings to the table",
-        )
-    if b <= table[-1] + tol:
-        i = int(np.clip(np.searchsorted(table, b, side="right") - 1, 0, n - 2))
-        t = float(np.clip((b - table[i]) / (table[i + 1] - table[i]), 0.0, 1.0))
-        return i, i + 1, t
-    gap = table[0] + two_pi - table[-1]
-    if b >= table[0] + two_pi - tol:
-        return 0, 0, 0.0
-    if gap <= np.diff(table).max() * (1 + 1e-9):  # a full-circle table: wrap around
-        return n - 1, 0, float((b - table[-1]) / gap)
-    raise InputError(
-        "heading",
-        math.degrees(beta),
-        "deg",
-        f"is outside the excitation table's headings "
-        f"[{math.degrees(table[0]):g}, {math.degrees(table[-1]):g}] deg",
-    )
-
-
 @dataclass(frozen=True, eq=False)
 class ExcitationTable:
     """Wave excitation force RAOs over frequency and heading.
@@ -181,7 +148,7 @@ class ExcitationTable:
         """Excitation at ``omega`` (n_w,) and one ``heading`` [rad], shape (d, n_w)."""
         x = np.atleast_1d(np.asarray(omega, dtype=float))
         beta = finite_scalar("heading", heading, "rad")
-        a, b, s = _heading_weights(self.heading, beta)
+        a, b, s = heading_weights(self.heading, beta, "excitation table")
         v = (1.0 - s) * self.values[a] + s * self.values[b]  # (d, n_w_table)
         i, j, t = _interp_weights(self.omega, x, "omega", "rad/s", self.extrapolation)
         return (1.0 - t)[None, :] * v[:, i] + t[None, :] * v[:, j]

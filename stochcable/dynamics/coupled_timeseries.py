@@ -40,8 +40,8 @@ from stochcable.dynamics.coupled.inputs import (
     group_channels,
     scene_line_channels,
     sea_only_channels,
-    vessel_rao,
 )
+from stochcable.dynamics.coupled.vessels import VesselRaos
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.solve import end_tension_from_support
 
@@ -119,14 +119,17 @@ def frequency_chunks(n_omega: int, entry_bytes: int, budget: int = CHUNK_BYTES) 
         yield slice(start, min(start + size, int(n_omega)))
 
 
-def vessel_raos(scene: Any, omega: np.ndarray) -> dict[str, np.ndarray]:
-    """6-DOF RAO (n_omega, 6) of every prescribed body (vessel) of the scene on
-    ``omega`` (zero outside its table). [m/m, rad/m]"""
-    return {
-        b.name: vessel_rao(b.prescribed, omega)
-        for b in (getattr(scene, "bodies", ()) or ())
-        if getattr(b, "prescribed", None) is not None
-    }
+def vessel_raos(scene: Any, omega: np.ndarray) -> VesselRaos:
+    """The 6-DOF RAOs of every prescribed body (vessel) of the scene on ``omega``, per
+    wave heading (zero outside the frequency table). [m/m, rad/m]"""
+    return VesselRaos(
+        np.asarray(omega, dtype=float),
+        {
+            b.name: b.prescribed
+            for b in (getattr(scene, "bodies", ()) or ())
+            if getattr(b, "prescribed", None) is not None
+        },
+    )
 
 
 def _scene_line(scene: Any, name: str) -> Any:

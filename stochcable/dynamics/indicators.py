@@ -333,7 +333,8 @@ def line_indicators(
     Notes
     -----
     Borgman ratio per element: :func:`stochcable.dynamics.linearization.borgman_variance_ratio`
-    of the normal relative velocity (σ_n of the record, mean = the normal current).
+    of the normal relative velocity (σ_n of the record, mean = the normal current;
+    elements at rest, :func:`at_rest_zeroed`, take its σ → 0 limit).
     Drag/inertia: :func:`stochcable.dynamics.linearization.drag_inertia_ratio` in the form
     B_n σ_n / (ρ C_M (πD²/4) σ_an), B_n the record's normal coefficient, σ_an the σ
     of the fluid acceleration normal to the element (the sea channel).
@@ -371,6 +372,29 @@ def line_indicators(
     )
 
 
+#: An element's normal relative-velocity σ (and normal current) at most this fraction
+#: of the line's largest is "at rest" for the indicators (:func:`at_rest_zeroed`).
+AT_REST_FRACTION = 1.0e-6
+
+
+def at_rest_zeroed(sigma: np.ndarray, current: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The elements' normal relative-velocity σ and normal current [m/s] with those at
+    rest set to zero: σ ≤ :data:`AT_REST_FRACTION` × the largest σ of the line, and
+    |U_n| ≤ the same fraction of max(largest |U_n|, largest σ).
+
+    The grounded elements of a line on a penalty seabed move ever less away from the
+    touchdown (σ falls by ~100 per element, to 1e-16 of the line's largest: round-off);
+    the ratios of such σ and currents are round-off too, and would differ between
+    machines.  At rest the indicators take their limits (Borgman ratio 1 with a
+    current, 8/(3π) without; no drag force)."""
+    s = np.asarray(sigma, dtype=float)
+    u = np.asarray(current, dtype=float)
+    top = float(s.max()) if s.size else 0.0
+    s = np.where(s <= AT_REST_FRACTION * top, 0.0, s)
+    u_top = max(float(np.abs(u).max()) if u.size else 0.0, top)
+    return s, np.where(np.abs(u) <= AT_REST_FRACTION * u_top, 0.0, u)
+
+
 def _drag_ratios(
     system: LineSystem, channels: tuple[Channel, ...], rec: Any, w: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -378,10 +402,10 @@ def _drag_ratios(
     Notes). [-]"""
     model = system.model
     mesh = model.mesh
-    u_n = current_split(system)[2]
-    borgman = np.atleast_1d(borgman_variance_ratio(rec.sigma_normal, u_n))
+    sigma, u_n = at_rest_zeroed(rec.sigma_normal, current_split(system)[2])
+    borgman = np.atleast_1d(borgman_variance_ratio(sigma, u_n))
     s_an = _normal_acceleration_sigma(system, channels, w)
-    drag_sigma = rec.b_normal * rec.sigma_normal
+    drag_sigma = rec.b_normal * sigma
     inertia_sigma = model.rho * (1.0 + mesh.ca_normal) * math.pi * mesh.diameter**2 / 4.0 * s_an
     with np.errstate(divide="ignore", invalid="ignore"):
         d_i = np.where(

@@ -218,7 +218,7 @@ def line_channels(
                     "an RAO is relative to the sea: the scene needs a 'sea' (or give the "
                     "end motion as spectra per DOF)",
                 )
-            raos[end] = np.ascontiguousarray(m.rao.transfer(w).T)  # (n_omega, 3)
+            raos[end] = m.rao
     if scene.sea is not None:
         # nodes resting on a penalty seabed sit slightly below z = -depth: evaluate
         # the kinematics on the seabed there
@@ -233,8 +233,8 @@ def line_channels(
                     omega=w,
                     spectrum=density(w),
                     density=density,
-                    motion_a=raos.get("end_a"),
-                    motion_b=raos.get("end_b"),
+                    motion_a=_end_rao(raos.get("end_a"), w, heading),
+                    motion_b=_end_rao(raos.get("end_b"), w, heading),
                     element_velocity=el.velocity,
                     element_velocity_square=el.velocity_square,
                     element_end_square=el.end_square,
@@ -264,6 +264,11 @@ def line_channels(
                 )
             )
     return tuple(channels)
+
+
+def _end_rao(rao: Any, omega: np.ndarray, heading: float) -> np.ndarray | None:
+    """An end's motion RAO (n_omega, 3) for waves toward ``heading`` [rad], or None."""
+    return None if rao is None else np.ascontiguousarray(rao.transfer(omega, heading).T)
 
 
 def _sea_nodal(el: ElementKinematics, g: float) -> Callable[[], tuple[np.ndarray, np.ndarray]]:

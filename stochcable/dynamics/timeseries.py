@@ -90,11 +90,12 @@ def simulate_timeseries(
     for b in getattr(scene, "bodies", ()) or ():
         if getattr(b, "prescribed", None) is None or syn.sea is None:
             continue  # vessels: their RAO times the sea
-        # one channel per direction of a short-crested sea, each with the same RAO
-        # (no heading dimension) and its own realization
-        sea_names = tuple(sea_channel_headings(scene.sea))
-        h = syn.full(vessel_raos(scene, syn.w_band)[b.name].T)[None]  # (1, 6, N+1)
-        h = np.broadcast_to(h, (len(sea_names),) + h.shape[1:]).copy()
+        # one channel per direction of a short-crested sea, each with the RAO of its
+        # heading and its own realization
+        headings = sea_channel_headings(scene.sea)
+        sea_names = tuple(headings)
+        raos = vessel_raos(scene, syn.w_band)
+        h = np.stack([syn.full(raos.at(b.name, headings[n]).T) for n in sea_names])
         mean = np.concatenate([np.asarray(b.position, dtype=float), np.zeros(3)])
         out.add_body(
             b.name,

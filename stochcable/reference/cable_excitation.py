@@ -153,7 +153,8 @@ def end_coefficients(
                     "-",
                     "needs a sea (the RAO multiplies the sea's amplitudes)",
                 )
-            c = m.rao.transfer(omega) * np.asarray(grid.realization.coefficients)[None]
+            rao = m.rao.transfer(omega, scene.sea.heading_rad)
+            c = rao * np.asarray(grid.realization.coefficients)[None]
         if np.any(c):
             ends[key] = c
     return ends

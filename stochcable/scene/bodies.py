@@ -6,12 +6,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Annotated, Any, Literal
 
-import numpy as np
 from pydantic import Discriminator, Field, Tag, model_validator
 
 from stochcable.errors import InputError
 from stochcable.scene.base import _Doc, _f
-from stochcable.scene.lines import ComplexTable
+from stochcable.scene.raos import VesselMotion
 from stochcable.scene.tables import BODY_DOFS, PLANAR_BODY_DOFS, parse_table
 
 __all__ = [
@@ -20,7 +19,6 @@ __all__ = [
     "BodyExcitation",
     "BodyHydrodynamics",
     "BodyHydrodynamicsFile",
-    "VesselMotion",
     "Body",
 ]
 
@@ -94,62 +92,6 @@ class BodyHydrodynamicsFile(_Doc):
     file: str = Field(
         min_length=1, max_length=4096, description="Path of a Capytaine .nc or JSON table file"
     )
-
-
-class VesselMotion(_Doc):
-    """A prescribed (vessel) body motion: 6-DOF RAOs per unit wave amplitude.
-
-    Translations in m/m, rotations in rad/m, about the body reference point, for the
-    scene's sea heading (v1: no heading dimension: in a short-crested sea the same RAO
-    applies to every direction); zero outside the table.  The body is not solved
-    for: lines attached to it see the end motion T(r)·ξ (seed 001 eqs. 3.3.6–3.3.7),
-    nothing couples back.
-    """
-
-    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s", min_length=2)
-    surge: ComplexTable | None = None
-    sway: ComplexTable | None = None
-    heave: ComplexTable | None = None
-    roll: ComplexTable | None = None
-    pitch: ComplexTable | None = None
-    yaw: ComplexTable | None = None
-
-    @model_validator(mode="after")
-    def _check(self) -> VesselMotion:
-        w = np.asarray(self.omega)
-        if w[0] < 0 or (np.diff(w) <= 0).any():
-            raise ValueError("omega must be >= 0 and strictly increasing")
-        given = {k: getattr(self, k) for k in BODY_DOFS}
-        if all(v is None for v in given.values()):
-            raise ValueError(f"give at least one of {', '.join(BODY_DOFS)}")
-        for k, v in given.items():
-            if v is not None and len(v.re) != len(self.omega):
-                raise ValueError(f"{k} has {len(v.re)} values but omega has {len(self.omega)}")
-        return self
-
-    def transfer(self, omega: np.ndarray) -> np.ndarray:
-        """RAO per unit wave amplitude at ``omega``, shape (6, n), zero outside the
-        table. [m/m, rad/m]"""
-        omega = np.asarray(omega, dtype=float)
-        out = np.zeros((6, omega.size), dtype=complex)
-        w = np.asarray(self.omega)
-        for i, k in enumerate(BODY_DOFS):
-            t = getattr(self, k)
-            if t is None:
-                continue
-            v = t.values()
-            out[i] = np.interp(omega, w, v.real, 0.0, 0.0) + 1j * np.interp(
-                omega, w, v.imag, 0.0, 0.0
-            )
-        return out
-
-    @property
-    def out_of_plane(self) -> bool:
-        """True when a sway, roll or yaw RAO is non-zero."""
-        return any(
-            getattr(self, k) is not None and np.any(getattr(self, k).values() != 0)
-            for k in ("sway", "roll", "yaw")
-        )
 
 
 def _hydro_kind(v: Any) -> str:

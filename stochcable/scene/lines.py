@@ -7,15 +7,13 @@ import math
 from collections.abc import Sequence
 from typing import Literal
 
-import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from stochcable.scene.base import _Doc, _f
+from stochcable.scene.raos import MotionRao
 from stochcable.scene.spectra import Spectrum
 
 __all__ = [
-    "ComplexTable",
-    "MotionRao",
     "EndMotion",
     "BodyAttachment",
     "End",
@@ -25,60 +23,6 @@ __all__ = [
     "Line",
     "check_span",
 ]
-
-
-class ComplexTable(_Doc):
-    """Complex values as separate real and imaginary parts."""
-
-    re: tuple[float, ...]
-    im: tuple[float, ...]
-
-    @model_validator(mode="after")
-    def _same_length(self) -> ComplexTable:
-        if len(self.re) != len(self.im):
-            raise ValueError(f"re ({len(self.re)}) and im ({len(self.im)}) differ in length")
-        return self
-
-    def values(self) -> np.ndarray:
-        """The complex values."""
-        return np.asarray(self.re) + 1j * np.asarray(self.im)
-
-
-class MotionRao(_Doc):
-    """End motion RAOs relative to the sea: metres of motion per metre of wave amplitude."""
-
-    omega: tuple[float, ...] = _f("Angular frequencies, strictly increasing", "rad/s", min_length=2)
-    surge: ComplexTable | None = None
-    sway: ComplexTable | None = None
-    heave: ComplexTable | None = None
-
-    @model_validator(mode="after")
-    def _check(self) -> MotionRao:
-        w = np.asarray(self.omega)
-        if w[0] < 0 or (np.diff(w) <= 0).any():
-            raise ValueError("omega must be >= 0 and strictly increasing")
-        given = {k: getattr(self, k) for k in ("surge", "sway", "heave")}
-        if all(v is None for v in given.values()):
-            raise ValueError("give at least one of surge, sway, heave")
-        for k, v in given.items():
-            if v is not None and len(v.re) != len(self.omega):
-                raise ValueError(f"{k} has {len(v.re)} values but omega has {len(self.omega)}")
-        return self
-
-    def transfer(self, omega: np.ndarray) -> np.ndarray:
-        """Motion per unit wave amplitude at ``omega``, shape (3, n), zero outside the table."""
-        omega = np.asarray(omega, dtype=float)
-        out = np.zeros((3, omega.size), dtype=complex)
-        w = np.asarray(self.omega)
-        for i, k in enumerate(("surge", "sway", "heave")):
-            t = getattr(self, k)
-            if t is None:
-                continue
-            v = t.values()
-            out[i] = np.interp(omega, w, v.real, 0.0, 0.0) + 1j * np.interp(
-                omega, w, v.imag, 0.0, 0.0
-            )
-        return out
 
 
 class EndMotion(_Doc):

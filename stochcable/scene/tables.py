@@ -24,6 +24,7 @@ A matrix entry A[i][j] is the force in DOF i due to a unit motion of DOF j.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,7 @@ __all__ = [
     "checked_table",
     "check_matrices",
     "array3",
+    "heading_weights",
 ]
 
 #: Rigid-body DOF names (global axes, rotations about the reference point), as
@@ -292,3 +294,40 @@ def array3(name: str, value: Any, unit: str) -> np.ndarray:
     if a.ndim != 3:
         raise InputError(name, a.shape, unit, f"must be a 3-D array (got {a.ndim}-D)")
     return a
+
+
+def heading_weights(table: np.ndarray, beta: float, what: str) -> tuple[int, int, float]:
+    """Two indices into a sorted heading ``table`` [rad] and the weight t of heading
+    ``beta`` [rad] for linear interpolation (1 − t)·v[i] + t·v[j]: periodic in 2π, a
+    table covering the full circle (its closing gap no larger than its largest step)
+    wraps around; otherwise a heading outside it is an InputError naming ``what``."""
+    n = table.size
+    two_pi = 2.0 * math.pi
+    b = table[0] + (beta - table[0]) % two_pi
+    tol = 1e-9
+    if n == 1:
+        if min(abs(b - table[0]), two_pi - abs(b - table[0])) <= tol:
+            return 0, 0, 0.0
+        raise InputError(
+            "heading",
+            math.degrees(beta),
+            "deg",
+            f"is not in the {what} (one heading, "
+            f"{math.degrees(table[0]):g} deg): add headings to the table",
+        )
+    if b <= table[-1] + tol:
+        i = int(np.clip(np.searchsorted(table, b, side="right") - 1, 0, n - 2))
+        t = float(np.clip((b - table[i]) / (table[i + 1] - table[i]), 0.0, 1.0))
+        return i, i + 1, t
+    gap = table[0] + two_pi - table[-1]
+    if b >= table[0] + two_pi - tol:
+        return 0, 0, 0.0
+    if gap <= np.diff(table).max() * (1 + 1e-9):  # a full-circle table: wrap around
+        return n - 1, 0, float((b - table[-1]) / gap)
+    raise InputError(
+        "heading",
+        math.degrees(beta),
+        "deg",
+        f"is outside the {what}'s headings "
+        f"[{math.degrees(table[0]):g}, {math.degrees(table[-1]):g}] deg",
+    )

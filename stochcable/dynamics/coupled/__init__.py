@@ -47,12 +47,12 @@ from stochcable.dynamics.coupled.inputs import (
     CoupledLine,
     body_gravity_stiffness,
     body_loads,
-    fairlead_motion,
     scene_line_channels,
 )
 from stochcable.dynamics.coupled.model import CoupledModel, build_coupled
 from stochcable.dynamics.coupled.modes import CoupledModes, coupled_modes
 from stochcable.dynamics.coupled.results import body_result, coupled_results
+from stochcable.dynamics.coupled.vessels import fairlead_motion
 
 __all__ = [
     "BodyLoads",

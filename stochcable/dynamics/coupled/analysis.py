@@ -5,7 +5,7 @@
 then :func:`solve_coupled`.  A line attached to no free body is a group of its own
 without bodies (the same fixed point, :func:`linearize_coupled`, then
 :func:`~stochcable.dynamics.outputs.line_result`), an end on a prescribed body moving
-with :func:`~stochcable.dynamics.coupled.inputs.fairlead_motion` in the sea channel.
+with :func:`~stochcable.dynamics.coupled.vessels.fairlead_motion` in the sea channel.
 Each connected component of free bodies and their lines is one coupled group
 (:func:`~stochcable.dynamics.coupled.fixedpoint.linearize_coupled`,
 :func:`~stochcable.dynamics.coupled.modes.coupled_modes`,
@@ -387,20 +387,20 @@ def _solve_lonely(
 
 def _vessel_results(model: CoupledModel, scene: Any, settings: Any) -> dict[str, BodyResult]:
     """The prescribed bodies' motion statistics from their RAOs in the sea: one channel
-    per sea channel (every direction of a short-crested sea with the same RAO, the
-    tables having no heading dimension), the spectra summed over them."""
+    per sea channel (each direction of a short-crested sea with the RAO of its
+    heading), the spectra summed over them."""
     omega, env = model.omega, scene.environment
     body_docs = {b.name: b for b in scene.bodies}
     if scene.sea.spreading is None:
-        names: tuple[str, ...] = ("sea",)
+        dens = [("sea", scene.sea.heading_rad, None)]
         sea = np.atleast_2d(scene.sea.spectrum.spectral_density(omega, env.g))
     else:
         dens = sea_channel_densities(scene.sea, env.g)
-        names = tuple(n for n, _, _ in dens)
         sea = np.stack([d(omega) for _, _, d in dens])
+    names = tuple(n for n, _, _ in dens)
     out = {}
     for n in model.prescribed:
-        h = np.broadcast_to(model.vessel_rao[n].T[None], (len(names), 6, omega.size)).copy()
+        h = np.stack([model.vessel_rao.at(n, beta).T for _, beta, _ in dens])
         dofs = ("surge", "sway", "heave", "roll", "pitch", "yaw")
         mean = np.concatenate([np.asarray(body_docs[n].position, float), np.zeros(3)])
         out[n] = body_result(

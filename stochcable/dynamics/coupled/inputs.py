@@ -14,9 +14,9 @@ An end attached to a *prescribed* body (a vessel with a motion RAO ξ_RAO) moves
 the RAO u = T(r)·ξ_RAO (three translations; the rotations move it through the arm r)
 coherently with the sea: it is the sea channel's end motion of an otherwise
 independent line (:func:`fairlead_motion`, :func:`scene_line_channels`), no coupling
-back.  The scene's vessel RAO tables have no heading dimension (they are given for
-the sea's heading): in a short-crested sea every direction channel carries the same
-RAO end motion, so the fairlead's motion spectrum is |RAO|² Σ_k w_k S = |RAO|² S.
+back.  In a short-crested sea each direction channel θ_k carries the RAO of its
+direction (:class:`VesselRaos`; a table without headings the same in every direction,
+so the fairlead's motion spectrum is |RAO|² Σ_k w_k S = |RAO|² S).
 """
 
 from __future__ import annotations
@@ -31,8 +31,8 @@ import numpy as np
 from stochcable.bodies.rigid import (
     RigidBody,
     attachment_geometric_stiffness,
-    rigid_link_matrix,
 )
+from stochcable.dynamics.coupled.vessels import VesselRaos, fairlead_motion
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.sea_channels import sea_channel_densities, sea_channel_headings
 from stochcable.dynamics.system import LineSystem
@@ -43,13 +43,11 @@ __all__ = [
     "CoupledLine",
     "body_gravity_stiffness",
     "body_loads",
-    "fairlead_motion",
     "group_channels",
     "reference_omega",
     "scene_line_channels",
     "sea_only_channels",
     "unit_channels",
-    "vessel_rao",
 ]
 
 
@@ -103,29 +101,6 @@ class BodyLoads:
     force: np.ndarray
     velocity: np.ndarray
     current: np.ndarray
-
-
-def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
-    """Motion of a point of a prescribed (vessel) body from its 6-DOF RAO.
-
-    Parameters
-    ----------
-    rao : array_like, complex, shape (n_omega, 6)
-        Vessel motion per unit wave amplitude (surge, sway, heave [m/m], roll, pitch,
-        yaw [rad/m]) about its reference point, global axes.
-    r : array_like, shape (3,)
-        The point relative to the reference point at the static pose. [m]
-
-    Returns
-    -------
-    ndarray, complex, shape (n_omega, 3)
-        u = T(r)·ξ = ξ_t + θ × r (seed 001 eqs. 3.3.6–3.3.7). [m/m]
-    """
-    a = np.asarray(rao, dtype=complex)
-    if a.ndim != 2 or a.shape[1] != 6:
-        raise InputError("rao", a.shape, "m/m", "must have shape (n_omega, 6)")
-    t = rigid_link_matrix(r)
-    return a @ t.T
 
 
 def body_loads(
@@ -401,43 +376,12 @@ def group_channels(
     return out
 
 
-def vessel_rao(motion: Any, omega: np.ndarray) -> np.ndarray:
-    """A vessel's 6-DOF motion RAO on the grid.
-
-    Parameters
-    ----------
-    motion : VesselMotion
-        The scene's prescribed body motion (a table, or an object with ``transfer``).
-    omega : ndarray, shape (n_omega,)
-        [rad/s]
-
-    Returns
-    -------
-    ndarray, complex, shape (n_omega, 6)
-        Surge, sway, heave [m/m], roll, pitch, yaw [rad/m]; zero outside the table
-        (as end-motion RAOs).
-    """
-    if hasattr(motion, "transfer"):  # (6, n_omega), as MotionRao.transfer's (3, n)
-        return np.asarray(motion.transfer(omega), dtype=complex).T
-    out = np.zeros((omega.size, 6), dtype=complex)
-    w = np.asarray(motion.omega, dtype=float)
-    for i, k in enumerate(("surge", "sway", "heave", "roll", "pitch", "yaw")):
-        tab = getattr(motion, k, None)
-        if tab is None:
-            continue
-        v = tab.values()
-        out[:, i] = np.interp(omega, w, v.real, 0.0, 0.0) + 1j * np.interp(
-            omega, w, v.imag, 0.0, 0.0
-        )
-    return out
-
-
 def scene_line_channels(
     scene: Any,
     line: Any,
     system: LineSystem,
     omega: np.ndarray,
-    vessel_rao: Mapping[str, np.ndarray],
+    vessels: VesselRaos,
 ) -> tuple[tuple[Channel, ...], dict[str, str]]:
     """A scene line's input channels on ``omega`` and its ends on free bodies.
 
@@ -451,15 +395,15 @@ def scene_line_channels(
         Its system (static node positions).
     omega : ndarray, shape (n_omega,)
         [rad/s]
-    vessel_rao : mapping of str to ndarray, complex, shape (n_omega, 6)
-        The prescribed bodies' RAOs on ``omega`` (:func:`vessel_rao`).
+    vessels : VesselRaos
+        The prescribed bodies' RAOs on ``omega``.
 
     Returns
     -------
     channels : tuple of Channel
         As :func:`stochcable.dynamics.loads.line_channels`, each end attached to a
-        prescribed body moving with :func:`fairlead_motion` inside every sea channel
-        (the vessel RAO has no heading dimension: the same in every direction).
+        prescribed body moving with :func:`fairlead_motion` inside every sea channel,
+        with the vessel's RAO of that channel's direction.
     attach : dict of str to str
         ``{end: body}`` of the ends attached to free bodies (solved with the body).
     """
@@ -472,7 +416,7 @@ def scene_line_channels(
         a = getattr(getattr(line, end), "attach", None)
         if a is None:
             continue
-        if a.body not in vessel_rao:
+        if a.body not in vessels:
             att[end] = a.body
             continue
         if scene.sea is None:
@@ -482,11 +426,15 @@ def scene_line_channels(
                 "-",
                 "a vessel motion RAO is relative to the sea: the scene needs a 'sea'",
             )
+        headings = sea_channel_headings(scene.sea)
         node = 0 if k == 0 else system.model.n_nodes - 1
         r = system.positions[node] - np.asarray(body_docs[a.body].position, float)
-        mot = fairlead_motion(vessel_rao[a.body], r)
         ch = tuple(
-            dataclasses.replace(c, **{f"motion_{end[-1]}": mot}) if c.kind == "sea" else c
+            dataclasses.replace(
+                c, **{f"motion_{end[-1]}": fairlead_motion(vessels.at(a.body, headings[c.name]), r)}
+            )
+            if c.kind == "sea"
+            else c
             for c in ch
         )
     return ch, att

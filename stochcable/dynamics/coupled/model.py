@@ -23,12 +23,9 @@ from typing import Any
 import numpy as np
 
 from stochcable.bodies.rigid import PLANAR_INDEX, FrequencyTable, RigidBody
-from stochcable.dynamics.coupled.inputs import (
-    CoupledLine,
-    body_gravity_stiffness,
-    vessel_rao,
-)
+from stochcable.dynamics.coupled.inputs import CoupledLine, body_gravity_stiffness
 from stochcable.dynamics.coupled.modes import CoupledModes, coupled_modes
+from stochcable.dynamics.coupled.vessels import VesselRaos
 from stochcable.dynamics.system import LineSystem
 from stochcable.errors import InputError, PhysicsWarning, warn
 
@@ -87,8 +84,8 @@ class CoupledModel:
         Static value of each free body DOF (position and rotation). [m, rad]
     prescribed : tuple of str
         The prescribed bodies (vessels).
-    vessel_rao : dict of str to ndarray, complex, shape (n_omega, 6)
-        Their motion RAOs on the grid. [m/m, rad/m]
+    vessel_rao : VesselRaos
+        Their motion RAOs on the grid, per wave heading. [m/m, rad/m]
     groups : tuple of ModelGroup
         The coupled groups, in the scene order of their first line.
     independent : tuple of str
@@ -105,7 +102,7 @@ class CoupledModel:
     free: dict[str, RigidBody]
     pose: dict[str, np.ndarray]
     prescribed: tuple[str, ...]
-    vessel_rao: dict[str, np.ndarray]
+    vessel_rao: VesselRaos
     groups: tuple[ModelGroup, ...]
     independent: tuple[str, ...]
     lonely: tuple[str, ...]
@@ -164,7 +161,7 @@ def build_coupled(
         n for n, b in body_docs.items() if getattr(b, "prescribed", None) is not None
     )
     free, pose = _free_bodies(scene, statics, prescribed, rigid_bodies)
-    raos = {n: vessel_rao(body_docs[n].prescribed, omega) for n in prescribed}
+    raos = VesselRaos(omega, {n: body_docs[n].prescribed for n in prescribed})
     given = {} if systems is None else systems
     systems = {}
     attach: dict[str, dict[str, str]] = {}
