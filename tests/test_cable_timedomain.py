@@ -364,6 +364,12 @@ def test_unknown_line_and_bad_inputs():
     no_excitation = _taut(hs=0.0, ts={"duration": 64.0, "dt": 0.25})
     with pytest.raises(InputError, match="needs a sea or a prescribed end motion"):
         simulate_line_timedomain(no_excitation)
+    spread = scene.model_copy(
+        update={"sea": scene.sea.model_copy(update={"spreading": {"type": "cosn", "n": 2.0}})}
+    )
+    spread = load_scene(spread.model_dump(mode="json"))
+    with pytest.raises(InputError, match=r"sea.spreading = 'cosn'.*long-crested sea only"):
+        simulate_line_timedomain(spread)
 
 
 def test_newton_failure_reports_step_and_residual():

@@ -76,6 +76,14 @@ def realization_grid(
     time-series step (else ``dt``, else 0.25 s)."""
     env = scene.environment
     ts = scene.analysis.timeseries
+    if scene.sea is not None and scene.sea.spreading is not None:
+        raise InputError(
+            "sea.spreading",
+            scene.sea.spreading.type,
+            "-",
+            "the time-domain reference simulates a long-crested sea only: remove the "
+            "spreading (or compare direction by direction, the linear responses add)",
+        )
     if realization is not None:
         if not isinstance(realization, _sea.SeaRealization):
             raise InputError(
