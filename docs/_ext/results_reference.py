@@ -173,6 +173,36 @@ _LINES = {
     ),
     "lines.<line>.modes.omega": ("rad/s", "Natural frequencies listed for the line."),
     "lines.<line>.modes.kept": ("-", "Modes kept by the Foss solve; null for the direct solve."),
+    "lines.<line>.drag_residual": (
+        "",
+        "The end-tension variance the statistical drag linearization drops, in closed "
+        "form (the Hermite residual of the quadratic drag; present with "
+        "``analysis.linearization.drag_residual``); see :doc:`../benchmarks/drag_residual`.",
+    ),
+    "lines.<line>.drag_residual.computed": (
+        "-",
+        "False where the line is outside the closed form's scope (3-D lines, the vector "
+        "or harmonic linearization, lines on free bodies).",
+    ),
+    "lines.<line>.drag_residual.reason": ("-", "Why not computed; empty when computed."),
+    "lines.<line>.drag_residual.order": ("-", "Highest Hermite order kept."),
+    "lines.<line>.drag_residual.panels": ("-", "Element groups the residual was evaluated on."),
+    "lines.<line>.drag_residual.<end>": ("", "The residual at the end."),
+    "lines.<line>.drag_residual.<end>.variance": (
+        "{F}²",
+        "Variance the residual adds to the end tension (in band, superharmonics and "
+        "difference frequencies).",
+    ),
+    "lines.<line>.drag_residual.<end>.in_band": (
+        "{F}²",
+        "Its part on the analysis band [ω_min, ω_max].",
+    ),
+    "lines.<line>.drag_residual.<end>.std_linear": ("{F}", "σ of the linear model."),
+    "lines.<line>.drag_residual.<end>.std": (
+        "{F}",
+        "√(σ_linear² + variance): the end-tension σ with the residual.",
+    ),
+    "lines.<line>.drag_residual.<end>.ratio": ("-", "std / std_linear."),
     "lines.<line>.strumming": (
         "",
         "Strumming screening of the line in the current (present only with a current "
@@ -519,6 +549,7 @@ def example_documents() -> dict[str, dict[str, Any]]:
             docs[name] = stochcable.analyze(stochcable.load_example(name)).to_document()
         scene = stochcable.load_example("taut_wire").model_dump()
         scene["analysis"]["fidelity"] = {"target_error": 0.05}
+        scene["analysis"]["linearization"]["drag_residual"] = True
         result = stochcable.analyze(stochcable.Scene.model_validate(scene))
         docs["taut_wire with analysis.fidelity"] = result.to_document()
     return docs

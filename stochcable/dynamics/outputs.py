@@ -20,6 +20,7 @@ import numpy as np
 from stochcable.dynamics.blocks import (
     trapezoid_weights,
 )
+from stochcable.dynamics.drag_residual import drag_residual
 from stochcable.dynamics.indicators import (
     LineModes,
     line_indicators,
@@ -41,6 +42,7 @@ from stochcable.results.documents import (
     LineResult,
     stats_from_validated,
 )
+from stochcable.results.records import DragResidual
 from stochcable.scene.model import AnalysisSettings
 
 # ------------------------------------------------------------------------- outputs
@@ -84,6 +86,8 @@ def line_result(
     linearization: Linearization,
     settings: AnalysisSettings,
     modes: LineModes | None = None,
+    *,
+    alone: bool = True,
 ) -> LineResult:
     """Transfer functions, spectra and statistics of one line.
 
@@ -99,6 +103,9 @@ def line_result(
         The natural modes of the resolution check and the resonance indicator
         (default the line's fixed-end modes; a line on bodies: the coupled modes that
         count for it, :func:`stochcable.dynamics.coupled.results.line_modes`).
+    alone : bool
+        False for a line of a coupled group (on free bodies): its drag residual
+        (``settings.linearization.drag_residual``) is not computed.
 
     Returns
     -------
@@ -139,6 +146,14 @@ def line_result(
         )
         indicators = with_second_order(system.name, indicators, so)
     end_force = _end_force_transfer(model, resp, n_ch)
+    residual = None
+    if settings.linearization.drag_residual and linearization.record is not None:
+        std = {e: stats[e].std for e in stats}
+        residual = (
+            drag_residual(system, channels, linearization, std)
+            if alone
+            else DragResidual.not_computed("a line on free bodies is not covered", std)
+        )
     return LineResult(
         name=system.name,
         omega=w,
@@ -164,6 +179,7 @@ def line_result(
         model=model,
         modes=system.modes,
         indicators=indicators,
+        drag_residual=residual,
     )
 
 

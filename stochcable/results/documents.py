@@ -26,6 +26,7 @@ import numpy as np
 from stochcable.line.strumming import StrummingTable
 from stochcable.results.records import (
     THREE_HOURS,
+    DragResidual,
     LinearizationRecord,
     LineIndicators,
     ResponseStats,
@@ -104,6 +105,9 @@ class LineResult:
     strumming : StrummingTable or None
         Strumming screening of the line in the current (None without current;
         docs/strumming.md).
+    drag_residual : DragResidual or None
+        The end-tension variance the drag linearization drops
+        (``analysis.linearization.drag_residual``; None when not asked for).
     """
 
     name: str
@@ -131,6 +135,7 @@ class LineResult:
     modes: Any = None
     indicators: LineIndicators | None = None
     strumming: StrummingTable | None = None
+    drag_residual: DragResidual | None = None
 
     @property
     def listed_modes(self) -> np.ndarray:
@@ -191,6 +196,11 @@ class LineResult:
             "modes": {"omega": self.listed_modes.tolist(), "kept": self.n_modes},
             "indicators": None if self.indicators is None else self.indicators.as_dict(),
             **({} if self.strumming is None else {"strumming": self.strumming.as_dict()}),
+            **(
+                {}
+                if self.drag_residual is None
+                else {"drag_residual": self.drag_residual.as_dict()}
+            ),
         }
 
 

@@ -21,6 +21,7 @@ __all__ = [
     "ResponseStats",
     "LinearizationRecord",
     "LineIndicators",
+    "DragResidual",
     "stats_from_spectrum",
     "stats_from_validated",
 ]
@@ -283,4 +284,86 @@ class LineIndicators:
             },
             "flags": list(self.flags),
             "second_order": None if self.second_order is None else self.second_order.as_dict(),
+        }
+
+
+@dataclass(frozen=True)
+class DragResidual:
+    """The end-tension variance the drag linearization drops, and σ with it
+    (:func:`stochcable.dynamics.drag_residual.drag_residual`).
+
+    Attributes
+    ----------
+    computed : bool
+        False where the line is outside the closed form's scope (``reason`` says why).
+    reason : str
+        Why not computed ("" when computed).
+    variance : dict {"end_a", "end_b"} of float
+        Variance the Hermite residual of the drag adds to the end tension. [N²]
+    in_band : dict {"end_a", "end_b"} of float
+        Its part on the analysis band (the rest: superharmonics above ω_max, and
+        difference frequencies below ω_min). [N²]
+    std_linear : dict {"end_a", "end_b"} of float
+        σ of the linear model (the result's end statistics). [N]
+    std : dict {"end_a", "end_b"} of float
+        √(σ_linear² + variance): the end-tension σ with the residual. [N]
+    order : int
+        Highest Hermite order kept. [-]
+    panels : int
+        Element groups the residual was evaluated on. [-]
+    """
+
+    computed: bool
+    reason: str
+    variance: dict[str, float]
+    in_band: dict[str, float]
+    std_linear: dict[str, float]
+    std: dict[str, float]
+    order: int = 0
+    panels: int = 0
+
+    @classmethod
+    def not_computed(cls, reason: str, std: dict[str, float]) -> DragResidual:
+        """A record that says why the residual was not computed."""
+        zero = {e: 0.0 for e in std}
+        return cls(False, reason, zero, dict(zero), dict(std), dict(std))
+
+    @classmethod
+    def from_variances(
+        cls,
+        variance: dict[str, float],
+        in_band: dict[str, float],
+        std: dict[str, float],
+        order: int,
+        panels: int,
+    ) -> DragResidual:
+        """The record of computed residual variances (negative round-off clipped)."""
+        var = {e: max(0.0, float(v)) for e, v in variance.items()}
+        band = {e: max(0.0, float(v)) for e, v in in_band.items()}
+        total = {e: math.sqrt(float(std[e]) ** 2 + var[e]) for e in var}
+        return cls(True, "", var, band, dict(std), total, order, panels)
+
+    def ratio(self, end: str) -> float:
+        """σ with the residual over the linear σ at ``end`` (1 when not computed). [-]"""
+        lin = self.std_linear[end]
+        return self.std[end] / lin if lin > 0 else 1.0
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        ends = {
+            e: {
+                "variance": self.variance[e],
+                "in_band": self.in_band[e],
+                "std_linear": self.std_linear[e],
+                "std": self.std[e],
+                "ratio": self.ratio(e),
+            }
+            for e in ("end_a", "end_b")
+        }
+        return {
+            "computed": self.computed,
+            "reason": self.reason,
+            "order": self.order,
+            "panels": self.panels,
+            **ends,
         }

@@ -64,6 +64,12 @@ class LinearizationSettings(_Doc):
         description="Return a flagged partial result instead of an error when the "
         "iteration does not converge",
     )
+    drag_residual: bool = Field(
+        default=False,
+        description="Also compute the end-tension variance the linearization drops: the "
+        "closed-form Hermite residual of the quadratic drag (lines.<name>.drag_residual; "
+        "planar lines, seed method, lines not on free bodies)",
+    )
 
 
 class TimeSeriesSettings(_Doc):

@@ -74,6 +74,7 @@ def coupled_results(
             linearization.lines[cl.name],
             settings,
             counted.get(cl.name),
+            alone=False,
         )
     ch = tuple(lines[0].channels if channels is None else channels)
     spectra = np.stack([c.spectrum for c in ch])
