@@ -287,6 +287,35 @@ def test_linear_limit_same_realization_equals_analysis_series():
         assert a.std() == pytest.approx(b.std(), rel=0.01)
 
 
+def test_linear_limit_short_crested_sea_equals_analysis_series():
+    # A spread sea (cos-2s, s = 4, 8 directions about 30°: the tether in 3-D): each
+    # direction realized with the analysis' rule (simulate_sea_directional, same seed)
+    # and its wave loads at its own heading; the TD end tension against the analysis'
+    # synthesized series, in the linear limit of the test above (current-dominated
+    # drag, tiny waves: the same 1 % allowance).
+    from stochcable.analysis import analyze
+
+    base = _taut(hs=0.1, cd=1.2, current=1.0, ts={"duration": 256.0, "dt": 0.25, "seed": 7})
+    doc = base.model_dump(mode="json")
+    doc["sea"].update(heading=30.0, spreading={"type": "cos2s", "s": 4.0, "directions": 8})
+    scene = load_scene(doc)
+    ts = analyze(scene).timeseries
+    hist = simulate_line_timedomain(scene, band=(0.05, 3.0))
+    assert hist.positions.shape[-1] == 3  # the spread sea leaves the x–z plane
+    np.testing.assert_allclose(hist._meta["realization"].elevation, ts.elevation, atol=1e-12)
+    k = round(0.25 / hist.dt)
+    sel = ts.time >= hist.ramp
+    for end in ("a", "b"):
+        fd = np.asarray(ts.end_tension["tether"][f"end_{end}"])[sel]
+        td = (hist.tension_a if end == "a" else hist.tension_b)[::k][: ts.time.size][sel]
+        a, b = td - td.mean(), fd - fd.mean()
+        assert (a - b).std() <= 0.01 * b.std()
+    # and the directions matter: the long-crested sea's series differ
+    lc = analyze(base.model_copy(update={"sea": base.sea.model_copy(update={"heading": 30.0})}))
+    other = np.asarray(lc.timeseries.end_tension["tether"]["end_b"])[sel]
+    assert (other - other.mean() - b).std() > 0.1 * b.std()
+
+
 # ------------------------------------------------- statistics: linearization error
 
 
@@ -364,12 +393,10 @@ def test_unknown_line_and_bad_inputs():
     no_excitation = _taut(hs=0.0, ts={"duration": 64.0, "dt": 0.25})
     with pytest.raises(InputError, match="needs a sea or a prescribed end motion"):
         simulate_line_timedomain(no_excitation)
-    spread = scene.model_copy(
-        update={"sea": scene.sea.model_copy(update={"spreading": {"type": "cosn", "n": 2.0}})}
-    )
-    spread = load_scene(spread.model_dump(mode="json"))
-    with pytest.raises(InputError, match=r"sea.spreading = 'cosn'.*long-crested sea only"):
-        simulate_line_timedomain(spread)
+    doc = scene.model_dump(mode="json")
+    doc["sea"]["spreading"] = {"type": "cosn", "n": 2.0}
+    with pytest.raises(InputError, match=r"realization = 'a SeaRealization'.*short-crested"):
+        simulate_line_timedomain(load_scene(doc), realization=real)
 
 
 def test_newton_failure_reports_step_and_residual():

@@ -281,7 +281,11 @@ def simulate_line_timedomain(
     realization : SeaRealization, optional
         The sea realization to use (the same one the frequency-domain analysis
         synthesizes from).  Default: ``simulate_sea`` of the scene's spectrum with
-        ``duration``, the scene's time-series ``dt`` and ``seed``. [-]
+        ``duration``, the scene's time-series ``dt`` and ``seed``; a short-crested sea
+        (``sea.spreading``) is realized direction by direction with the analysis'
+        rule (:func:`stochcable.sea.spreading.simulate_sea_directional`) and each
+        direction's waves load the line at its heading (a given realization is then
+        refused). [-]
     duration : float, optional
         Simulated length, at most the realization's length (default: the
         realization's length, or the scene's time-series duration, else 600 s). [s]
@@ -377,7 +381,7 @@ def simulate_line_timedomain(
     # ---- the excitation in the frequency domain and the step
     grid = realization_grid(scene, realization, duration, dt, seed, method)
     ends = end_coefficients(scene, line, grid, seed, method, end_realizations)
-    ends, X_sea = band_limited(grid, ends, band)
+    ends, seas = band_limited(grid, ends, band)
     if grid.realization is None and not ends:
         raise InputError(
             "scene",
@@ -385,7 +389,7 @@ def simulate_line_timedomain(
             "-",
             "needs a sea or a prescribed end motion to excite the line",
         )
-    wmax, w_peak, k_up, h = _time_step(grid, X_sea, ends, dt)
+    wmax, w_peak, k_up, h = _time_step(grid, seas, ends, dt)
     n_steps = int(round(grid.duration / h))
     t = h * np.arange(n_steps + 1)
     if ramp is None:
@@ -411,20 +415,15 @@ def simulate_line_timedomain(
     r = half_cosine(t, ramp)
     sl = np.arange(n_steps + 1) % (k_up * grid.n_samples)  # periodic in T_L
     u_wave = u_wave_g = f_in = None
-    if grid.realization is not None:
-        u_wave, u_wave_g, f_in = wave_series(
-            model,
-            xs @ ax.T,
-            grid.omega,
-            X_sea,
-            scene.sea.heading_rad,
-            scene.environment,
-            ax,
-            grid.n_samples,
-            k_up,
-            sl,
-            r[0],
-        )
+    for heading, x_sea in seas:  # the directions' excitations add
+        part = wave_series(
+            model, xs @ ax.T, grid.omega, x_sea, heading, scene.environment, ax,
+            grid.n_samples, k_up, sl, r[0],
+        )  # fmt: skip
+        if u_wave is None:
+            u_wave, u_wave_g, f_in = part
+        else:
+            u_wave, u_wave_g, f_in = (a + b for a, b in zip((u_wave, u_wave_g, f_in), part))
     end_disp = end_series(ends, grid.omega, mesh.n_nodes, ax, grid.n_samples, k_up, sl, r)
     pos, ten_el, iters, maxres = integrate(
         model,
@@ -507,7 +506,10 @@ def _select_line(scene: Scene, line_name: str | None) -> Line:
 
 
 def _time_step(
-    grid: ExcitationGrid, X_sea: np.ndarray | None, ends: dict[str, np.ndarray], dt: float | None
+    grid: ExcitationGrid,
+    seas: tuple[tuple[float, np.ndarray], ...],
+    ends: dict[str, np.ndarray],
+    dt: float | None,
 ) -> tuple[float, float, int, float]:
     """The highest excitation frequency (:data:`_ENERGY_QUANTILE` of every channel's
     variance below it), the peak frequency, the upsampling k of the realization's step
@@ -516,7 +518,7 @@ def _time_step(
     omega, dt_sea = grid.omega, grid.dt
     power = np.zeros(omega.size)
     wmax = 0.0
-    chans = [X_sea] if X_sea is not None else []
+    chans = [x for _, x in seas]
     chans += [c for v_ in ends.values() for c in v_]
     for c in chans:
         p = np.abs(c) ** 2

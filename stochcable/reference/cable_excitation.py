@@ -6,6 +6,7 @@ ramped end motions)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -21,6 +22,7 @@ from stochcable.scene.model import Environment, Line, Scene
 from stochcable.sea import fft as _fft
 from stochcable.sea import realization as _sea
 from stochcable.sea.kinematics import wave_kinematics
+from stochcable.sea.spreading import simulate_sea_directional
 
 __all__ = [
     "ExcitationGrid",
@@ -58,6 +60,11 @@ class ExcitationGrid:
         Its frequencies 2πm/T_L, m = 0 … n_samples/2. [rad/s]
     duration : float
         Simulated length (at most ``length``). [s]
+    directions : tuple of (float, SeaRealization)
+        The sea's directions [rad] and their realizations: one (the sea's heading, the
+        realization) for a long-crested sea, one per direction of a short-crested one
+        (:func:`stochcable.sea.spreading.simulate_sea_directional`, whose elevations add
+        up to ``realization``'s); empty without a sea.
     """
 
     realization: Any
@@ -66,6 +73,7 @@ class ExcitationGrid:
     n_samples: int
     omega: np.ndarray
     duration: float
+    directions: tuple = ()
 
 
 def realization_grid(
@@ -76,14 +84,17 @@ def realization_grid(
     time-series step (else ``dt``, else 0.25 s)."""
     env = scene.environment
     ts = scene.analysis.timeseries
-    if scene.sea is not None and scene.sea.spreading is not None:
+    ds = None if scene.sea is None else scene.sea.direction_set()
+    spread = ds is not None and ds.count > 1
+    if spread and realization is not None:
         raise InputError(
-            "sea.spreading",
-            scene.sea.spreading.type,
+            "realization",
+            "a SeaRealization",
             "-",
-            "the time-domain reference simulates a long-crested sea only: remove the "
-            "spreading (or compare direction by direction, the linear responses add)",
+            "is long-crested but the scene's sea is short-crested (sea.spreading): leave "
+            "it out, the sea is then realized direction by direction",
         )
+    directions: tuple = ()
     if realization is not None:
         if not isinstance(realization, _sea.SeaRealization):
             raise InputError(
@@ -102,7 +113,17 @@ def realization_grid(
         n_t = 2 * max(1, int(math.ceil(t_l / dt_sea / 2.0 - 1e-9)))
         t_l = n_t * dt_sea
         omega = 2.0 * math.pi / t_l * np.arange(n_t // 2 + 1)
-        if scene.sea is not None:
+        if spread:  # the rule of the analysis' time series: a realization per direction
+            reals = simulate_sea_directional(
+                spectrum_density(scene.sea.spectrum, env.g), ds, t_l, dt_sea, method, int(seed)
+            )
+            directions = tuple((float(b), r) for b, r in zip(ds.heading, reals))
+            realization = dataclasses.replace(
+                reals[0],
+                elevation=np.sum([r.elevation for r in reals], axis=0),
+                coefficients=np.sum([r.coefficients for r in reals], axis=0),
+            )
+        elif scene.sea is not None:
             realization = _sea.simulate_sea(
                 spectrum_density(scene.sea.spectrum, env.g), t_l, dt_sea, method, rng=int(seed)
             )
@@ -111,7 +132,9 @@ def realization_grid(
         raise InputError(
             "duration", duration, "s", f"must be <= the realization's length {t_l:g} s"
         )
-    return ExcitationGrid(realization, t_l, dt_sea, n_t, omega, sim_len)
+    if realization is not None and not directions:
+        directions = ((scene.sea.heading_rad, realization),)
+    return ExcitationGrid(realization, t_l, dt_sea, n_t, omega, sim_len, directions)
 
 
 def end_coefficients(
@@ -161,8 +184,10 @@ def end_coefficients(
                     "-",
                     "needs a sea (the RAO multiplies the sea's amplitudes)",
                 )
-            rao = m.rao.transfer(omega, scene.sea.heading_rad)
-            c = rao * np.asarray(grid.realization.coefficients)[None]
+            c = sum(
+                m.rao.transfer(omega, b) * np.asarray(r.coefficients)[None]
+                for b, r in grid.directions
+            )
         if np.any(c):
             ends[key] = c
     return ends
@@ -170,9 +195,10 @@ def end_coefficients(
 
 def band_limited(
     grid: ExcitationGrid, ends: dict[str, np.ndarray], band: tuple[float, float] | None
-) -> tuple[dict[str, np.ndarray], np.ndarray | None]:
-    """The end coefficients and the sea's (None without a sea) with the components
-    outside ``band`` = (low, high) zeroed (all kept when ``band`` is None)."""
+) -> tuple[dict[str, np.ndarray], tuple[tuple[float, np.ndarray], ...]]:
+    """The end coefficients and the sea's per direction, ((heading [rad], coefficients),
+    ...) (empty without a sea), with the components outside ``band`` = (low, high)
+    zeroed (all kept when ``band`` is None)."""
     omega = grid.omega
     keep = np.ones(omega.size)
     if band is not None:
@@ -182,8 +208,8 @@ def band_limited(
             raise InputError("band", band, "rad/s", "must be (low, high) with high > low")
         keep = ((omega >= lo) & (omega <= hi)).astype(float)
         ends = {k_: c * keep for k_, c in ends.items()}
-    x_sea = None if grid.realization is None else np.asarray(grid.realization.coefficients) * keep
-    return ends, x_sea
+    seas = tuple((b, np.asarray(r.coefficients) * keep) for b, r in grid.directions)
+    return ends, seas
 
 
 def spectrum_density(spec: Any, g: float):
