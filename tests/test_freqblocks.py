@@ -12,9 +12,6 @@ Intel Xeon (AVX-512) and 1.01e-12 on an AMD EPYC (AVX2, other BLAS kernels), so 
 is compared to 3e-12.
 """
 
-#: Relative tolerance per case (module notes).
-RTOL = {"guy": 3e-12}
-
 from __future__ import annotations
 
 import json
@@ -33,6 +30,9 @@ from stochcable.dynamics.freqblocks import (
 )
 from stochcable.errors import InputError
 from stochcable.examples import load_example
+
+#: Relative tolerance per case (module notes).
+RTOL = {"guy": 3e-12}
 
 #: A buoy with a drag area on the chain: the attachment's nodal σ sums over blocks too.
 BUOY = {"at": 300.0, "mass": 500.0, "buoyancy": 2.0e4, "drag_area": 2.0, "added_mass": 300.0}
