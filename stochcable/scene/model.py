@@ -62,7 +62,7 @@ from stochcable.scene.lines import (
     SegmentStrumming,
     check_span,
 )
-from stochcable.scene.raos import ComplexTable, MotionRao, VesselMotion, uncovered_heading
+from stochcable.scene.raos import ComplexTable, MotionRao, VesselMotion, check_rao_headings
 from stochcable.scene.spectra import (
     Bretschneider,
     Issc,
@@ -173,7 +173,7 @@ class Scene(_Doc):
                     )
                 except ValueError as exc:
                     raise ValueError(f"lines[{i}]: {exc}") from None
-        self._check_rao_headings()
+        check_rao_headings(self.sea, self.bodies, self.lines)
         if self.bodies:
             planar = self.is_planar
             for j, b in enumerate(self.bodies):
@@ -193,27 +193,6 @@ class Scene(_Doc):
                             f"have only {list(PLANAR_BODY_DOFS)}"
                         )
         return self
-
-    def _check_rao_headings(self) -> None:
-        """Every RAO table with headings covers every direction of the sea."""
-        if self.sea is None:
-            return
-        ds = self.sea.direction_set()
-        dirs = np.array([self.sea.heading_rad]) if ds is None else ds.heading
-        tables = [(("bodies", j, "prescribed"), b.prescribed) for j, b in enumerate(self.bodies)]
-        for i, ln in enumerate(self.lines):
-            for end in ("end_a", "end_b"):
-                m = getattr(ln, end).motion
-                tables.append((("lines", i, end, "motion", "rao"), m and m.rao))
-        for loc, table in tables:
-            why = None if table is None else uncovered_heading(table, dirs)
-            if why is not None:
-                raise LocatedValueError(
-                    (*loc, "heading"),
-                    list(table.heading),
-                    f"{why}: extend the RAO table's headings to every direction of the "
-                    "sea (its heading and spreading)",
-                )
 
     @property
     def uses_files(self) -> bool:

@@ -14,15 +14,16 @@ sea, moves the vessel as its RAOs say for each direction.
 from __future__ import annotations
 
 import math
-from typing import ClassVar
+from collections.abc import Sequence
+from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import model_validator
 
-from stochcable.scene.base import _Doc, _f
+from stochcable.scene.base import LocatedValueError, _Doc, _f
 from stochcable.scene.tables import BODY_DOFS, heading_weights
 
-__all__ = ["ComplexTable", "MotionRao", "VesselMotion", "uncovered_heading"]
+__all__ = ["ComplexTable", "MotionRao", "VesselMotion", "check_rao_headings", "uncovered_heading"]
 
 
 class ComplexTable(_Doc):
@@ -110,6 +111,30 @@ class _RaoTable(_Doc):
                 omega, w, v.imag, 0.0, 0.0
             )
         return out
+
+
+def check_rao_headings(sea: Any, bodies: Sequence[Any], lines: Sequence[Any]) -> None:
+    """Every RAO table with headings (the vessels' ``prescribed``, the line ends'
+    ``motion.rao``) covers every direction of ``sea`` (its heading and spreading);
+    else a LocatedValueError at the table's ``heading``."""
+    if sea is None:
+        return
+    ds = sea.direction_set()
+    dirs = np.array([sea.heading_rad]) if ds is None else ds.heading
+    tables = [(("bodies", j, "prescribed"), b.prescribed) for j, b in enumerate(bodies)]
+    for i, ln in enumerate(lines):
+        for end in ("end_a", "end_b"):
+            m = getattr(ln, end).motion
+            tables.append((("lines", i, end, "motion", "rao"), m and m.rao))
+    for loc, table in tables:
+        why = None if table is None else uncovered_heading(table, dirs)
+        if why is not None:
+            raise LocatedValueError(
+                (*loc, "heading"),
+                list(table.heading),
+                f"{why}: extend the RAO table's headings to every direction of the sea "
+                "(its heading and spreading)",
+            )
 
 
 def uncovered_heading(table: _RaoTable, headings_rad: np.ndarray) -> str | None:
