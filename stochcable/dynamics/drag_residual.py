@@ -226,9 +226,12 @@ def drag_residual(
     variance = {"end_a": 0.0, "end_b": 0.0}
     in_band = {"end_a": 0.0, "end_b": 0.0}
     keep = (w_out >= w[0] * (1 - 1e-9)) & (w_out <= w[-1] * (1 + 1e-9))
-    for name, (c_el, mean_el) in parts.items():
-        if not np.any(c_el > 0):
-            continue
+    live = [name for name, (c_el, _) in parts.items() if np.any(c_el > 0)]
+    if not live:  # no drag: nothing dropped
+        return DragResidual.from_variances(variance, in_band, std, order, len(groups))
+    h_all = _unit_load_transfer(system, damping, groups, [dirs[n] for n in live], w_out)
+    for i_part, name in enumerate(live):
+        c_el, mean_el = parts[name]
         scale = np.array([float(np.sum(c_el[g] * mesh.l0[g])) for g in groups])
         length = np.array([float(np.sum(mesh.l0[g])) for g in groups])
         mean = np.array([float(np.sum(mean_el[g] * mesh.l0[g])) for g in groups]) / length
@@ -236,7 +239,7 @@ def drag_residual(
         sig = np.sqrt(np.sum(np.abs(v) ** 2, axis=(0, 2)))
         mu = np.where(sig > 0, mean / np.where(sig > 0, sig, 1.0), 0.0)
         coeffs = hermite_coefficients(np.clip(mu, -10.0, 10.0), order)
-        h = _unit_load_transfer(system, damping, groups, dirs[name], w_out)
+        h = h_all[:, i_part * len(groups) : (i_part + 1) * len(groups)]
         lines_t = residual_output_lines(v, scale, coeffs, h, n_fft)
         for i, end in enumerate(("end_a", "end_b")):
             variance[end] += float(lines_t[i].sum())
@@ -300,11 +303,16 @@ def _panel_lines(
 
 
 def _unit_load_transfer(
-    system: Any, damping: Any, groups: list[np.ndarray], direction: np.ndarray, w: np.ndarray
+    system: Any,
+    damping: Any,
+    groups: list[np.ndarray],
+    directions: list[np.ndarray],
+    w: np.ndarray,
 ) -> np.ndarray:
     """End tensions (end_a, end_b) per unit force spread uniformly over each panel
-    along ``direction`` (consistent linear-element loads, half an element's share on
-    each of its nodes), ends prescribed, on ``w``: shape (2, n_panels, n_w). [N/N]"""
+    along each of ``directions`` (n_el, 3) (consistent linear-element loads, half an
+    element's share on each of its nodes), ends prescribed, on ``w``, one solve for
+    all: shape (2, n_directions · n_panels, n_w), direction-major. [N/N]"""
     model = system.model
     prep = line_prep(system)
     d = model.dim
@@ -312,14 +320,16 @@ def _unit_load_transfer(
     cd = drag_blocks(system, damping)
     c = add_blocks(prep.S, cd)
     b_c = prep.bS + free_band(cd)
-    n_p = len(groups)
+    n_p = len(groups) * len(directions)
     unit = np.zeros((model.n_nodes, d, n_p))
     l0 = model.mesh.l0
-    for p, g in enumerate(groups):
-        share = l0[g] / l0[g].sum()
-        for e, s in zip(g, share):
-            unit[e, :, p] += 0.5 * s * direction[e, comps]
-            unit[e + 1, :, p] += 0.5 * s * direction[e, comps]
+    for k, direction in enumerate(directions):
+        for q, g in enumerate(groups):
+            p = k * len(groups) + q
+            share = l0[g] / l0[g].sum()
+            for e, s in zip(g, share):
+                unit[e, :, p] += 0.5 * s * direction[e, comps]
+                unit[e + 1, :, p] += 0.5 * s * direction[e, comps]
     out = np.zeros((2, n_p, w.size), dtype=complex)
     for sl in frequency_slices(w.size, 8 * 16 * model.n_nodes * d * n_p):
         load = np.ascontiguousarray(
