@@ -230,20 +230,30 @@ def drag_residual(
     if not live:  # no drag: nothing dropped
         return DragResidual.from_variances(variance, in_band, std, order, len(groups))
     h_all = _unit_load_transfer(system, damping, groups, [dirs[n] for n in live], w_out)
-    for i_part, name in enumerate(live):
+    # the normal and axial residuals of every panel are one set of components: they are
+    # functions of jointly Gaussian velocities, so their cross terms count too (where
+    # the linear tensions of the two cancel, so do the residuals' in part)
+    length = np.array([float(np.sum(mesh.l0[g])) for g in groups])
+    scales, coeffs, lines = [], [], []
+    for name in live:
         c_el, mean_el = parts[name]
-        scale = np.array([float(np.sum(c_el[g] * mesh.l0[g])) for g in groups])
-        length = np.array([float(np.sum(mesh.l0[g])) for g in groups])
+        scales.append([float(np.sum(c_el[g] * mesh.l0[g])) for g in groups])
         mean = np.array([float(np.sum(mean_el[g] * mesh.l0[g])) for g in groups]) / length
         v = lines_v[name]
         sig = np.sqrt(np.sum(np.abs(v) ** 2, axis=(0, 2)))
         mu = np.where(sig > 0, mean / np.where(sig > 0, sig, 1.0), 0.0)
-        coeffs = hermite_coefficients(np.clip(mu, -10.0, 10.0), order)
-        h = h_all[:, i_part * len(groups) : (i_part + 1) * len(groups)]
-        lines_t = residual_output_lines(v, scale, coeffs, h, n_fft)
-        for i, end in enumerate(("end_a", "end_b")):
-            variance[end] += float(lines_t[i].sum())
-            in_band[end] += float(lines_t[i][keep].sum())
+        coeffs.append(hermite_coefficients(np.clip(mu, -10.0, 10.0), order))
+        lines.append(v)
+    lines_t = residual_output_lines(
+        np.concatenate(lines, axis=1),
+        np.concatenate(scales),
+        np.concatenate(coeffs),
+        h_all,
+        n_fft,
+    )
+    for i, end in enumerate(("end_a", "end_b")):
+        variance[end] = float(lines_t[i].sum())
+        in_band[end] = float(lines_t[i][keep].sum())
     return DragResidual.from_variances(variance, in_band, std, order, len(groups))
 
 
