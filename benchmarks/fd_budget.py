@@ -24,6 +24,7 @@ Run:  OPENBLAS_NUM_THREADS=1 nice -n 19 python3 benchmarks/fd_budget.py [--write
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
 import time
@@ -43,12 +44,16 @@ BAND = (0.05, 2.0)  # [rad/s]
 SMALL = 1e-3  # motion scale of the "linear" TD variant
 
 
-def chain_doc(elements: int, **analysis) -> dict:
-    """The bundled chain's line alone: fairlead surge only (sea and current off)."""
-    doc = load_example("chain_catenary").model_dump(mode="json")
+def chain_doc(elements: int, base: dict | None = None, **analysis) -> dict:
+    """The bundled chain's line alone (or the one line of ``base``, a scene document
+    with an end_b surge spectrum): fairlead surge only (sea and current off)."""
+    if base is None:
+        doc = load_example("chain_catenary").model_dump(mode="json")
+    else:
+        doc = json.loads(json.dumps(base))
     doc["sea"] = None
     doc["environment"]["current"] = []
-    doc["analysis"].pop("timeseries", None)
+    doc.setdefault("analysis", {}).pop("timeseries", None)
     doc["analysis"].update(analysis)
     doc["lines"][0]["segments"][0]["elements"] = elements
     return doc
@@ -61,12 +66,13 @@ def td_lines(period: float = PERIOD) -> tuple[np.ndarray, dict]:
     return dw * np.arange(k0, k1 + 1), {"min": k0 * dw, "max": k1 * dw, "count": k1 - k0 + 1}
 
 
-def fd(elements: int, scale: float = 1.0, **analysis) -> dict:
+def fd(elements: int, scale: float = 1.0, base: dict | None = None, **analysis) -> dict:
     """FD end σ (fairlead, anchor) on the TD's lines and its converged drag; ``scale``
-    multiplies the motion amplitude."""
+    multiplies the motion amplitude (a table spectrum); ``base`` as :func:`chain_doc`."""
     _, omega = td_lines()
     doc = chain_doc(
         elements,
+        base,
         solver="direct",
         omega=omega,
         linearization={"tolerance": 1e-8, "max_iterations": 200},
@@ -74,12 +80,28 @@ def fd(elements: int, scale: float = 1.0, **analysis) -> dict:
     )
     surge = doc["lines"][0]["end_b"]["motion"]["surge"]
     surge["density"] = [scale**2 * v for v in surge["density"]]
-    line = analyze(doc).lines["leg1"]
+    line = analyze(doc).lines[doc["lines"][0]["name"]]
     rec = line.linearization
     return {
-        "std": np.array([line.end_b.std, line.end_a.std]),
+        "std": line_sum_std(line),
         "b": (np.asarray(rec.b_normal), np.asarray(rec.b_axial)),
     }
+
+
+def line_sum_std(line) -> np.ndarray:
+    """End σ (fairlead, anchor) [N] of an FD line result on the TD's lines as the DSA
+    sums them, Σ_j S(ω_j)Δω: every line with its full weight (the FD's own σ, a
+    trapezoid, halves the first and the last line; that matters when the spectrum is
+    not zero at the band's ends)."""
+    dw = float(line.omega[1] - line.omega[0])
+    return np.array(
+        [
+            math.sqrt(
+                float(np.sum(np.abs(line.end_tension_transfer[e]) ** 2 * line.input_spectra)) * dw
+            )
+            for e in ("end_b", "end_a")
+        ]
+    )
 
 
 def periodic_surge(scene, seed: int, n_t: int, period: float = PERIOD) -> np.ndarray:
@@ -107,9 +129,11 @@ def split_variance(x: np.ndarray, period: float = PERIOD) -> tuple[float, float]
     return float(p[inb].sum()), float(p[~inb].sum())
 
 
-def td(elements: int, seed: int, scale: float = 1.0, **variant) -> np.ndarray:
+def td(
+    elements: int, seed: int, scale: float = 1.0, base: dict | None = None, **variant
+) -> np.ndarray:
     """TD end σ split: [[fairlead in, out], [anchor in, out]] variances / scale²."""
-    scene = load_scene(chain_doc(elements))
+    scene = load_scene(chain_doc(elements, base))
     n_t = int(round(2 * PERIOD / DT))
     c = periodic_surge(scene, seed, n_t) * scale
     h = simulate_line_timedomain(
@@ -131,21 +155,33 @@ VARIANTS = (
 ENDS = ("fairlead", "anchor")
 
 
-def run(elements: int, seeds: tuple[int, ...], scales: tuple[float, ...]) -> dict:
+def variant_options(name: str, fd_result: dict) -> tuple[dict, float]:
+    """The ``simulate_line_timedomain`` options of a variant and its motion scale
+    relative to the FD's (``fd_result`` from :func:`fd`: its drag for the linear ones)."""
+    kw = dict(next(v[2] for v in VARIANTS if v[0] == name))
+    if name in ("lin", "lin_amp"):
+        kw.update(drag="linear", linear_drag=fd_result["b"])
+    return kw, (SMALL if name == "lin" else 1.0)
+
+
+def run(
+    elements: int,
+    seeds: tuple[int, ...],
+    scales: tuple[float, ...],
+    base: dict | None = None,
+) -> dict:
     """FD and the TD variants for every seed and motion scale: variances (variant,
     seed, end, [in, out]) / scale²."""
     out = {}
     for scale in scales:
-        f = fd(elements, scale)
+        f = fd(elements, scale, base)
         var = np.empty((len(VARIANTS), len(seeds), 2, 2))
-        for i, (name, _, kw) in enumerate(VARIANTS):
-            kw = dict(kw)
-            if name in ("lin", "lin_amp"):
-                kw.update(drag="linear", linear_drag=f["b"])
-            s = SMALL if name == "lin" else scale
+        for i, (name, _, _) in enumerate(VARIANTS):
+            kw, rel = variant_options(name, f)
+            s = rel * scale
             for j, seed in enumerate(seeds):
                 t0 = time.time()
-                var[i, j] = td(elements, seed, s, **kw) * scale**2
+                var[i, j] = td(elements, seed, s, base, **kw) * scale**2
                 print(f"scale {scale:g} {name} seed {seed}: {time.time() - t0:.1f} s", flush=True)
         out[scale] = {"fd": f["std"], "var": var}
     return out

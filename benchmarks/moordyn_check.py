@@ -32,8 +32,10 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import tempfile
 import time
+from collections.abc import Callable
 from importlib import metadata
 from pathlib import Path
 
@@ -58,6 +60,7 @@ PAGE = ROOT / "docs" / "benchmarks" / "moordyn.md"
 PERIOD, RAMP, BAND, HS, TP = 200.0, 30.0, (0.05, 2.0), 2.0, 10.0
 SEEDS = (1, 2, 3, 4, 5)
 SEABED = {"stiffness": 3.0e6, "damping": 3.0e5}
+CACHE = Path(tempfile.gettempdir()) / "stochcable_moordyn_check" / "runs.json"
 
 TAUT = {
     "environment": {"depth": 200.0, "rho": 1025.0, "g": 9.80665, "seabed": SEABED},
@@ -202,18 +205,32 @@ def load_cache(path: Path) -> dict:
     return json.loads(path.read_text()) if path.exists() else {}
 
 
-def run_missing(cache_path: Path, budget: float) -> int:
-    """Run missing simulations until ``budget`` seconds are spent; the number left."""
+def run_missing(
+    cache_path: Path,
+    budget: float,
+    runs: list[dict] | None = None,
+    execute_run: Callable[[dict], dict] | None = None,
+) -> int:
+    """Run missing simulations until ``budget`` seconds are spent; the number left.
+
+    ``runs`` (default this page's) are executed by ``execute_run`` (default
+    :func:`execute`); benchmarks/accuracy_lines.py shares the cache and its runs."""
     cache = load_cache(cache_path)
     t_start = time.perf_counter()
-    todo = [r for r in _runs() if run_key(r) not in cache]
+    todo = [r for r in (_runs() if runs is None else runs) if run_key(r) not in cache]
     for i, run in enumerate(todo):
         if time.perf_counter() - t_start > budget:
             return len(todo) - i
+        if run_key(run) in load_cache(cache_path):  # done by another process
+            continue
         print(f"run {run_key(run)}", flush=True)
-        cache[run_key(run)] = execute(run)
+        result = (execute_run or execute)(run)
+        cache = load_cache(cache_path)  # another process may have added runs meanwhile
+        cache[run_key(run)] = result
         cache_path.parent.mkdir(parents=True, exist_ok=True)
-        cache_path.write_text(json.dumps(cache, indent=1))
+        tmp = cache_path.with_name(f"{cache_path.name}.{os.getpid()}")
+        tmp.write_text(json.dumps(cache, indent=1))
+        os.replace(tmp, cache_path)  # atomic: a reader never sees half a file
         print(f"  {cache[run_key(run)]['wall']:.1f} s", flush=True)
     return 0
 
@@ -560,11 +577,7 @@ def _experiments(cache: dict) -> list[str]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--budget", type=float, default=170.0, help="seconds per call")
-    ap.add_argument(
-        "--cache",
-        type=Path,
-        default=Path(tempfile.gettempdir()) / "stochcable_moordyn_check" / "runs.json",
-    )
+    ap.add_argument("--cache", type=Path, default=CACHE)
     ap.add_argument("--write", action="store_true", help=f"write {PAGE.relative_to(ROOT)}")
     args = ap.parse_args()
     if args.write:

@@ -62,6 +62,12 @@ import numpy as np
 
 SCENES: tuple[str, ...] = ("taut_wire", "chain_catenary", "inclined_guy", "tuah_1982_single_leg")
 QUANTITIES: tuple[str, ...] = ("T_fairlead", "T_anchor", "motion")
+LINES_LINK = (
+    "Per line against the nonlinear time-domain reference and MoorDyn — the FD at a "
+    "user's settings and with adaptive fidelity, confidence intervals over seeds, and "
+    "the error budget of FD − TD by term: [Accuracy per line](accuracy/lines.md) "
+    "(`benchmarks/accuracy_lines.py`)."
+)
 QUANTITY_TEXT = {
     "T_fairlead": "fairlead (end_b) tension σ",
     "T_anchor": "anchor (end_a) tension σ",
@@ -1005,6 +1011,8 @@ def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
         + "`. Do not edit by "
         "hand: re-run the script."
     )
+    L.append("")
+    L.append(LINES_LINK)
     L.append("")
     L.append(
         f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python "

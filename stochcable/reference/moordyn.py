@@ -296,6 +296,10 @@ class EndTensionHistory:
         The surge applied at end_b (ramped). [m]
     simulator : str
         ``"moordyn"`` or ``"reference"``.
+    reaction_a : ndarray, shape (n_t,), optional
+        Support reaction at end_a (the fixed anchor: the end segment's force plus the
+        loads lumped on the end node, seabed contact included; what the frequency
+        domain's ``end_a`` tension is). [N]
     """
 
     t: np.ndarray
@@ -306,6 +310,7 @@ class EndTensionHistory:
     static_b: float
     motion: np.ndarray
     simulator: str
+    reaction_a: np.ndarray | None = None
 
     def window(self, start: float, stop: float) -> np.ndarray:
         """Mask of the samples with start <= t < stop (a whole period: exact σ)."""
@@ -395,7 +400,7 @@ def simulate_line_moordyn(
         sc, dt=dt, internal_damping=internal_damping, ic_threshold=ic_threshold, scheme=scheme
     )
     n_s = n_steps // every + 1
-    ta, tb, rb = np.empty(n_s), np.empty(n_s), np.empty(n_s)
+    ta, tb, rb, ra = np.empty(n_s), np.empty(n_s), np.empty(n_s), np.empty(n_s)
     a_ramped = (
         r * motion.acceleration(tc) + 2.0 * r1 * motion.velocity(tc) + r2 * motion.displacement(tc)
     )
@@ -421,6 +426,8 @@ def simulate_line_moordyn(
                     f_end = np.asarray(md.GetLineNodeForce(line, n_node))
                     m_end = np.asarray(md.GetLineNodeM(line, n_node))
                     rb[j] = np.linalg.norm(m_end[:, 0] * a_ramped[k] - f_end)
+                    # the anchor node does not move: its reaction is its net force
+                    ra[j] = np.linalg.norm(md.GetLineNodeForce(line, 0))
                 if k == n_steps:
                     break
                 x = p0 + np.array([xs[k], 0.0, 0.0])
@@ -435,4 +442,6 @@ def simulate_line_moordyn(
             f"{internal_damping}): reduce dt, or use RK4 or internal damping"
         )
     ts = tc[::every]
-    return EndTensionHistory(ts, ta, tb, rb, static_a, static_b, xs[::every], "moordyn")
+    return EndTensionHistory(
+        ts, ta, tb, rb, static_a, static_b, xs[::every], "moordyn", reaction_a=ra
+    )

@@ -42,8 +42,9 @@ __all__ = [
     "QUANTITIES",
 ]
 
-QUANTITIES = ("a", "b", "reaction_b")
-"""The σ compared: end-segment tension at end_a and end_b, support reaction at end_b."""
+QUANTITIES = ("a", "b", "reaction_a", "reaction_b")
+"""The σ compared: end-segment tension at end_a and end_b, support reaction at end_a and
+end_b (the reactions are what the frequency domain's end tensions are)."""
 
 
 def student_interval(x: np.ndarray, level: float = 0.95) -> tuple[float, float]:
@@ -102,7 +103,7 @@ def simulate_line_reference(
     -------
     EndTensionHistory
         End-element tensions (``element_tension`` of the first and last element) and
-        the support reaction ``tension_b`` at end_b.
+        the support reactions ``tension_a``, ``tension_b`` at both ends.
     """
     sc = load_scene(scene)
     n_per = duration / motion.period
@@ -132,6 +133,7 @@ def simulate_line_reference(
         tension_a=h.element_tension[:, 0],
         tension_b=h.element_tension[:, -1],
         reaction_b=h.tension_b,
+        reaction_a=h.tension_a,
         static_a=float(h.static_tension[0]),
         static_b=float(h.static_tension[-1]),
         motion=x,
@@ -203,13 +205,16 @@ class LineComparison:
 
 def window_std(h: EndTensionHistory, t0: float, t1: float) -> tuple[dict[str, float], float]:
     """σ of every quantity of :data:`QUANTITIES` [N] and of the applied motion [m] over
-    t0 <= t < t1 (one whole period: the motion's σ is exact)."""
+    t0 <= t < t1 (one whole period: the motion's σ is exact); ``reaction_a`` only when
+    the history has it."""
     w = h.window(t0, t1)
     out = {
         "a": float(h.tension_a[w].std()),
         "b": float(h.tension_b[w].std()),
         "reaction_b": float(h.reaction_b[w].std()),
     }
+    if h.reaction_a is not None:
+        out["reaction_a"] = float(h.reaction_a[w].std())
     return out, float(h.motion[w].std())
 
 
