@@ -1,6 +1,6 @@
 """Error budget of the frequency-domain (FD) end tension σ against the nonlinear time
-domain (TD), one term at a time, on the bundled chain's line (fairlead surge, band-limited
-PM Hs 2 m Tp 10 s, 0.05–2 rad/s, sea and current off).
+domain (TD), one term at a time, on the bundled chain's line (the example's fairlead surge
+table, non-zero on 0.35–1.45 rad/s, on the band 0.05–2 rad/s; sea and current off).
 
 Every TD run is driven by a periodic DSA fairlead surge of period P (lines 2πj/P in the
 band, uniform phases per seed) over two periods, measured over the second: the input
