@@ -125,6 +125,18 @@ WARNINGS: tuple[WarningEntry, ...] = (
         ("stochcable.dynamics.indicators:MOTION_SAG_FRACTION",),
     ),
     WarningEntry(
+        "Drag residual large (``analysis.linearization.drag_residual``)",
+        "PhysicsWarning",
+        ("stochcable.dynamics.drag_residual:_warn_large",),
+        "the end-tension σ with the drag residual above RESIDUAL_WARN_RATIO times the linear σ",
+        "The quadratic drag is far from its Gaussian linear fit: the linear σ is low, and "
+        "the first-order residual correction, exact for small corrections, overestimates "
+        "large ones (the inclined guy: +38 % predicted, +19 % in the time domain).",
+        "Check with the nonlinear time-domain reference (:mod:`stochcable.reference.cable`); "
+        "read the corrected σ as an upper estimate.",
+        ("stochcable.dynamics.drag_residual:RESIDUAL_WARN_RATIO",),
+    ),
+    WarningEntry(
         "Second-order stretching tension large (indicator ``second_order``)",
         "PhysicsWarning",
         ("stochcable.dynamics.second_order:with_second_order",),
