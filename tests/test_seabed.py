@@ -259,8 +259,8 @@ def test_td_window_has_the_exact_input_variance(chain_td):
     "linearization's relative error does not shrink with it), geometric nonlinearity "
     "+0.9 / +1.5 % (off band), the one-sided bed +0.3 / +0.45 %, the instantaneous "
     "tangent 0.  The closed-form drag residual (analysis.linearization.drag_residual, "
-    "docs/benchmarks/drag_residual.md) predicts the quadratic-drag term (+3.9 / +6.9 %) "
-    "and leaves +1.2 ± 1.9 / +1.4 ± 2.7 % at full motion; it is reported beside the "
+    "docs/benchmarks/drag_residual.md) predicts the quadratic-drag term (+4.0 / +6.9 %) "
+    "and leaves +1.1 ± 1.9 / +1.4 ± 2.7 % at full motion; it is reported beside the "
     "linear σ, not in it, and this test's coarse TD (80 elements: bed ±2 %) cannot "
     "resolve the rest",
 )
