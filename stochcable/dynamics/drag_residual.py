@@ -43,18 +43,13 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.blocks import (
-    add_blocks,
-    free_band,
-    from_freq,
-    line_prep,
-    to_freq,
-    trapezoid_weights,
+from stochcable.dynamics.residual_lines import (
+    UniformGrid,
+    covariance_lines,
+    cross_covariance,
+    load_transfer,
+    uniform_grid,
 )
-from stochcable.dynamics.freqblocks import frequency_slices
-from stochcable.dynamics.line_loads import drag_blocks
-from stochcable.dynamics.solve import end_tension_from_support, reactions
-from stochcable.dynamics.solvers import solve_band_stacked
 from stochcable.dynamics.variance import current_split
 from stochcable.errors import PhysicsWarning, warn
 from stochcable.results.records import DragResidual
@@ -78,9 +73,6 @@ MAX_PANELS = 64
 #: on the inclined guy, +18 % against +16 ± 3 % on the taut wire
 #: (docs/benchmarks/drag_residual.md). [-]
 RESIDUAL_WARN_RATIO = 1.2
-#: Most lines of the uniform grid the velocities are placed on (its step is the
-#: analysis grid's smallest spacing, or ω_max/MAX_LINES if that is finer). [-]
-MAX_LINES = 2048
 
 
 def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
@@ -152,7 +144,6 @@ def residual_output_lines(
         The outputs' variance lines at ω_j, j = 1 … n_o (their sum is the variance the
         residual adds). [N²]
     """
-    n_p = lines.shape[1]
     order = coeffs.shape[1] - 1
     sig = np.sqrt(np.einsum("cpj,cpj->p", lines.real, lines.real) + np.einsum(
         "cpj,cpj->p", lines.imag, lines.imag
@@ -161,20 +152,16 @@ def residual_output_lines(
     force = np.where(live, scale * sig**2, 0.0)  # cσ²L
     inv = np.where(live, 1.0 / np.where(live, sig, 1.0), 0.0)
     n_o = transfer.shape[2]
-    half = n_fft // 2 + 1
     out = np.zeros((transfer.shape[0], n_o))
     for e in np.flatnonzero(live):
-        cross = np.zeros((n_p, half), dtype=complex)
-        cross[:, : lines.shape[2]] = np.einsum("cj,cpj->pj", np.conj(lines[:, e]), lines)
-        cross[:, 0] *= 2.0  # (irfft halves the zero-frequency line)
-        rho = np.fft.irfft(cross, n=n_fft, axis=1) * (0.5 * n_fft) * (inv[e] * inv[:, None])
+        rho = cross_covariance(lines[:, e], lines, n_fft) * (inv[e] * inv[:, None])
         rr = np.zeros_like(rho)
         power = rho.copy()
         for k in range(2, order + 1):
             power *= rho
             rr += (math.factorial(k) * coeffs[e, k]) * coeffs[:, k, None] * power
         rr *= force[e] * force[:, None]
-        cr = (2.0 / n_fft) * np.fft.rfft(rr, axis=1)[:, 1 : n_o + 1]  # (n_p, n_o)
+        cr = covariance_lines(rr, n_o)  # (n_p, n_o)
         out += np.real(np.conj(transfer[:, e]) * np.einsum("opj,pj->oj", transfer, cr))
     return out
 
@@ -218,7 +205,9 @@ def drag_residual(
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
     groups = _panels(model.n_elements)
-    lines_v, grid_step, n_j, dirs = _panel_lines(system, channels, resp, groups)
+    grid = uniform_grid(w)
+    lines_v, dirs = _panel_lines(system, channels, resp, groups, grid)
+    grid_step, n_j = grid.step, grid.n_j
     mesh = model.mesh
     rho = model.rho
     u_t, u_nvec, _ = current_split(system)
@@ -236,7 +225,9 @@ def drag_residual(
     live = [name for name, (c_el, _) in parts.items() if np.any(c_el > 0)]
     if not live:  # no drag: nothing dropped
         return DragResidual.from_variances(variance, in_band, std, order, len(groups))
-    h_all = _unit_load_transfer(system, damping, groups, [dirs[n] for n in live], w_out)
+    h_all = load_transfer(
+        system, damping, _panel_loads(model, groups, [dirs[n] for n in live]), w_out
+    )
     # the normal and axial residuals of every panel are one set of components: they are
     # functions of jointly Gaussian velocities, so their cross terms count too (where
     # the linear tensions of the two cancel, so do the residuals' in part)
@@ -289,12 +280,10 @@ def _panels(n_el: int) -> list[np.ndarray]:
 
 
 def _panel_lines(
-    system: Any, channels: Any, resp: Any, groups: list[np.ndarray]
-) -> tuple[dict[str, np.ndarray], float, int, dict[str, np.ndarray]]:
-    """Normal and axial relative-velocity amplitudes of the panels per channel on a
-    uniform grid (each analysis frequency moved to its nearest multiple of the step,
-    its trapezoid weight kept), the step, the number of grid lines and the element
-    directions (3-D unit vectors)."""
+    system: Any, channels: Any, resp: Any, groups: list[np.ndarray], grid: UniformGrid
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Normal and axial relative-velocity lines of the panels per channel on ``grid``
+    (:meth:`UniformGrid.lines`) and the element directions (3-D unit vectors)."""
     model = system.model
     w = np.asarray(resp.omega, dtype=float)
     n_ch = len(channels)
@@ -310,73 +299,38 @@ def _panel_lines(
         elif ch.kind == "sea" and ch.velocity is not None:
             vel[..., c] += 0.5 * (ch.velocity[:, :-1] + ch.velocity[:, 1:])
     tang = system.frames[0]
-    plane = np.zeros(3)
-    plane[[i for i in range(3) if i not in comps][0]] = 1.0  # the out-of-plane axis
-    normal = np.cross(plane, tang)
-    normal /= np.linalg.norm(normal, axis=1)[:, None]
-    dirs = {"normal": normal, "axial": tang}
-    steps = np.diff(w)
-    step = max(float(steps.min()) if steps.size else float(w[0]), float(w[-1]) / MAX_LINES)
-    n_j = int(np.rint(w[-1] / step)) + 1
-    j = np.clip(np.rint(w / step).astype(int), 0, n_j - 1)
-    # frequencies sharing a grid point (a grid finer than the step) add their
-    # cross-spectra, not their amplitudes: each one of a point is its own channel
-    rank = np.zeros(w.size, dtype=int)
-    for i in range(1, w.size):
-        rank[i] = rank[i - 1] + 1 if j[i] == j[i - 1] else 0
-    n_r = int(rank.max()) + 1
-    amp = np.sqrt(np.stack([ch.spectrum for ch in channels]) * trapezoid_weights(w)[None])
-    out = {}
+    dirs = {"normal": in_plane_normal(tang, comps), "axial": tang}
+    spectra = np.stack([ch.spectrum for ch in channels])
     l0 = model.mesh.l0
+    out = {}
     for name, vec in dirs.items():
         comp = np.einsum("wedc,ed->cew", vel, vec)  # (n_ch, n_el, n_w)
         pan = np.stack([(comp[:, g] * l0[g, None]).sum(axis=1) / l0[g].sum() for g in groups], 1)
-        lines = np.zeros((n_ch, n_r, len(groups), n_j), dtype=complex)
-        lines[:, rank, :, j] = np.moveaxis(pan * amp[:, None, :], 2, 0)  # (n_w, n_ch, n_p)
-        out[name] = lines.reshape(n_ch * n_r, len(groups), n_j)
-    return out, step, n_j, dirs
+        out[name] = grid.lines(pan, spectra)
+    return out, dirs
 
 
-def _unit_load_transfer(
-    system: Any,
-    damping: Any,
-    groups: list[np.ndarray],
-    directions: list[np.ndarray],
-    w: np.ndarray,
-) -> np.ndarray:
-    """End tensions (end_a, end_b) per unit force spread uniformly over each panel
-    along each of ``directions`` (n_el, 3) (consistent linear-element loads, half an
-    element's share on each of its nodes), ends prescribed, on ``w``, one solve for
-    all: shape (2, n_directions · n_panels, n_w), direction-major. [N/N]"""
-    model = system.model
-    prep = line_prep(system)
-    d = model.dim
+def in_plane_normal(tangent: np.ndarray, comps: list[int]) -> np.ndarray:
+    """The unit normal (n_el, 3) of each element in the plane of a planar model's
+    components ``comps`` (tangent × the out-of-plane axis)."""
+    plane = np.zeros(3)
+    plane[[i for i in range(3) if i not in comps][0]] = 1.0
+    normal = np.cross(plane, tangent)
+    return normal / np.linalg.norm(normal, axis=1)[:, None]
+
+
+def _panel_loads(model: Any, groups: list[np.ndarray], directions: list[np.ndarray]) -> np.ndarray:
+    """Unit forces spread uniformly over each panel along each of ``directions`` (n_el,
+    3) (consistent linear-element loads, half an element's share on each node): shape
+    (n_nodes, d, n_directions · n_panels), direction-major."""
     comps = list(model.components)
-    cd = drag_blocks(system, damping)
-    c = add_blocks(prep.S, cd)
-    b_c = prep.bS + free_band(cd)
-    n_p = len(groups) * len(directions)
-    unit = np.zeros((model.n_nodes, d, n_p))
+    unit = np.zeros((model.n_nodes, model.dim, len(groups) * len(directions)))
     l0 = model.mesh.l0
     for k, direction in enumerate(directions):
         for q, g in enumerate(groups):
             p = k * len(groups) + q
             share = l0[g] / l0[g].sum()
-            for e, s in zip(g, share):
-                unit[e, :, p] += 0.5 * s * direction[e, comps]
-                unit[e + 1, :, p] += 0.5 * s * direction[e, comps]
-    out = np.zeros((2, n_p, w.size), dtype=complex)
-    for sl in frequency_slices(w.size, 8 * 16 * model.n_nodes * d * n_p):
-        load = np.ascontiguousarray(
-            np.broadcast_to(unit[:, :, None, :], (model.n_nodes, d, w[sl].size, n_p)),
-            dtype=complex,
-        )
-        u_free = solve_band_stacked(
-            prep.bK, prep.bM, b_c, to_freq(np.ascontiguousarray(load[1:-1])), w[sl],
-            2 * d - 1, 2 * d - 1, (model.K, model.M),
-        )  # fmt: skip
-        u = np.zeros_like(load)
-        u[1:-1] = from_freq(u_free, d)
-        tension = end_tension_from_support(system, reactions(system, prep, c, u, load, w[sl]))
-        out[0, :, sl], out[1, :, sl] = tension["end_a"], tension["end_b"]
-    return out
+            for e, s_ in zip(g, share):
+                unit[e, :, p] += 0.5 * s_ * direction[e, comps]
+                unit[e + 1, :, p] += 0.5 * s_ * direction[e, comps]
+    return unit
