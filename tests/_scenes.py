@@ -8,6 +8,8 @@ import math
 import numpy as np
 
 from stochcable.examples import load_example
+from stochcable.reference.cable import simulate_line_timedomain
+from stochcable.scene.model import load_scene
 
 
 def three_chain_legs(n_el: int, attach: str | None = None) -> list[dict]:
@@ -136,3 +138,62 @@ def buoy_with_vessel(
     if spreading is not None:
         doc["sea"]["spreading"] = spreading
     return doc
+
+
+# ------------------------------------------------- the chain's line, fairlead surge
+
+CHAIN_BAND = (0.05, 2.0)
+CHAIN_PERIOD = 200.0
+
+
+def chain_surge_doc(elements: int, residual: bool = True, scale: float = 1.0) -> dict:
+    """The chain example's line alone, fairlead surge only (sea and current off; its
+    spectrum × scale²), FD on the lines 2πj/P of the band (the TD's), direct solve,
+    drag to 1e-8, the drag and geometric residuals asked for when ``residual``."""
+    doc = copy.deepcopy(load_example("chain_catenary").model_dump(mode="json"))
+    doc["sea"] = None
+    doc["environment"]["current"] = []
+    doc["analysis"].pop("timeseries", None)
+    dw = 2 * math.pi / CHAIN_PERIOD
+    k0, k1 = math.ceil(CHAIN_BAND[0] / dw), math.floor(CHAIN_BAND[1] / dw)
+    doc["analysis"].update(
+        solver="direct",
+        omega={"min": k0 * dw, "max": k1 * dw, "count": k1 - k0 + 1},
+        linearization={
+            "tolerance": 1e-8,
+            "max_iterations": 200,
+            "drag_residual": residual,
+            "geometric_residual": residual,
+        },
+    )
+    surge = doc["lines"][0]["end_b"]["motion"]["surge"]
+    surge["density"] = [scale**2 * v for v in surge["density"]]
+    doc["lines"][0]["segments"][0]["elements"] = elements
+    return doc
+
+
+def td_end_sigma(doc: dict, seed: int, scale: float = 1.0, **variant) -> np.ndarray:
+    """TD end σ (fairlead, anchor) over the second of two periods of a periodic DSA
+    fairlead surge on the FD's lines (the input variance exact), the motion × ``scale``
+    and the σ divided by it (a small scale: the linear limit)."""
+    scene = load_scene(doc)
+    dt = 0.05
+    n_t = int(round(2 * CHAIN_PERIOD / dt))
+    dw = 2 * math.pi / CHAIN_PERIOD
+    w = scene.analysis.omega.values()
+    s = scene.lines[0].end_b.motion.surge.spectral_density(w, scene.environment.g)
+    phase = np.random.default_rng(seed).uniform(-np.pi, np.pi, w.size)
+    c = np.zeros((3, n_t // 2 + 1), dtype=complex)
+    c[0, 2 * np.rint(w / dw).astype(int)] = (
+        0.5 * n_t * scale * np.sqrt(2 * s * dw) * np.exp(-1j * phase)
+    )
+    h = simulate_line_timedomain(
+        scene,
+        duration=2 * CHAIN_PERIOD,
+        end_realizations={"b": c},
+        band=CHAIN_BAND,
+        dt=dt,
+        **variant,
+    )
+    keep = (h.t >= CHAIN_PERIOD - 1e-9) & (h.t < 2 * CHAIN_PERIOD - 1e-9)
+    return np.array([h.tension_b[keep].std(), h.tension_a[keep].std()]) / scale

@@ -9,20 +9,18 @@ chain; the panel grouping against the element-by-element evaluation."""
 
 from __future__ import annotations
 
-import copy
 import math
 import warnings
 
 import numpy as np
 import pytest
+from _scenes import chain_surge_doc, td_end_sigma
 from scipy import stats
 
 import stochcable.dynamics.drag_residual as dr
 from stochcable import analyze, load_example
 from stochcable.dynamics.drag_residual import hermite_coefficients, residual_output_lines
 from stochcable.dynamics.linearization import mean_abs_gaussian
-from stochcable.reference.cable import simulate_line_timedomain
-from stochcable.scene.model import load_scene
 
 
 def test_hermite_coefficients_closed_forms():
@@ -91,46 +89,6 @@ def test_residual_lines_equal_monte_carlo_gaussian_realizations():
 
 # ---------------------------------------------------------------------- the chain
 
-_BAND = (0.05, 2.0)
-_PERIOD = 200.0
-
-
-def _chain(elements: int, residual: bool = True) -> dict:
-    """The chain example's line alone, fairlead surge only (sea and current off), FD
-    on the lines 2πj/P of the band (the TD's), direct solve, drag to 1e-8."""
-    doc = copy.deepcopy(load_example("chain_catenary").model_dump(mode="json"))
-    doc["sea"] = None
-    doc["environment"]["current"] = []
-    doc["analysis"].pop("timeseries", None)
-    dw = 2 * math.pi / _PERIOD
-    k0, k1 = math.ceil(_BAND[0] / dw), math.floor(_BAND[1] / dw)
-    doc["analysis"].update(
-        solver="direct",
-        omega={"min": k0 * dw, "max": k1 * dw, "count": k1 - k0 + 1},
-        linearization={"tolerance": 1e-8, "max_iterations": 200, "drag_residual": residual},
-    )
-    doc["lines"][0]["segments"][0]["elements"] = elements
-    return doc
-
-
-def _td_sigma(doc: dict, seed: int, **variant) -> np.ndarray:
-    """TD end σ (fairlead, anchor) over the second of two periods of a periodic DSA
-    fairlead surge on the FD's lines (the input variance exact)."""
-    scene = load_scene(doc)
-    dt = 0.05
-    n_t = int(round(2 * _PERIOD / dt))
-    dw = 2 * math.pi / _PERIOD
-    w = scene.analysis.omega.values()
-    s = scene.lines[0].end_b.motion.surge.spectral_density(w, scene.environment.g)
-    phase = np.random.default_rng(seed).uniform(-np.pi, np.pi, w.size)
-    c = np.zeros((3, n_t // 2 + 1), dtype=complex)
-    c[0, 2 * np.rint(w / dw).astype(int)] = 0.5 * n_t * np.sqrt(2 * s * dw) * np.exp(-1j * phase)
-    h = simulate_line_timedomain(
-        scene, duration=2 * _PERIOD, end_realizations={"b": c}, band=_BAND, dt=dt, **variant
-    )
-    keep = (h.t >= _PERIOD - 1e-9) & (h.t < 2 * _PERIOD - 1e-9)
-    return np.array([h.tension_b[keep].std(), h.tension_a[keep].std()])
-
 
 @pytest.mark.slow
 def test_chain_correction_matches_the_time_domain_quadratic_drag_shift():
@@ -141,17 +99,17 @@ def test_chain_correction_matches_the_time_domain_quadratic_drag_shift():
     shift (Student t over the seeds: ±2–3 %; a factor-2 error is 4–7 % off)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        line = analyze(_chain(40)).lines["leg1"]
+        line = analyze(chain_surge_doc(40)).lines["leg1"]
     res = line.drag_residual
     assert res.computed and res.order == dr.HERMITE_ORDER
     pred = np.array([res.ratio("end_b"), res.ratio("end_a")]) - 1.0
     fd = np.array([line.end_b.std, line.end_a.std])
     b = (np.asarray(line.linearization.b_normal), np.asarray(line.linearization.b_axial))
-    doc = _chain(40, residual=False)
+    doc = chain_surge_doc(40, residual=False)
     shifts = []
     for seed in (1, 2, 3, 4):
-        lin = _td_sigma(doc, seed, drag="linear", linear_drag=b, seabed="linear")
-        quad = _td_sigma(doc, seed, drag="static_tangent", seabed="linear")
+        lin = td_end_sigma(doc, seed, drag="linear", linear_drag=b, seabed="linear")
+        quad = td_end_sigma(doc, seed, drag="static_tangent", seabed="linear")
         shifts.append((quad - lin) / fd)
     shifts = np.array(shifts)
     half = stats.t.ppf(0.975, len(shifts) - 1) * shifts.std(axis=0, ddof=1) / 2.0
@@ -165,9 +123,9 @@ def test_panels_converge_to_the_element_by_element_residual(monkeypatch):
     line)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        grouped = analyze(_chain(160)).lines["leg1"].drag_residual
+        grouped = analyze(chain_surge_doc(160)).lines["leg1"].drag_residual
         monkeypatch.setattr(dr, "MAX_PANELS", 160)
-        full = analyze(_chain(160)).lines["leg1"].drag_residual
+        full = analyze(chain_surge_doc(160)).lines["leg1"].drag_residual
     assert grouped.panels == 54 and full.panels == 160
     for end in ("end_a", "end_b"):
         assert grouped.variance[end] == pytest.approx(full.variance[end], rel=0.02)
@@ -178,13 +136,13 @@ def test_only_when_asked_and_out_of_scope_says_why():
     vector linearization: not computed, with the reason."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        off = analyze(_chain(20, residual=False)).lines["leg1"]
+        off = analyze(chain_surge_doc(20, residual=False)).lines["leg1"]
         assert off.drag_residual is None and "drag_residual" not in off.to_document()
-        doc = _chain(20)
+        doc = chain_surge_doc(20)
         doc["lines"][0]["segments"][0].update(cd_normal=0.0, cd_axial=0.0)
         zero = analyze(doc).lines["leg1"].drag_residual
         assert zero.computed and zero.variance == {"end_a": 0.0, "end_b": 0.0}
-        doc = _chain(20)
+        doc = chain_surge_doc(20)
         doc["analysis"]["linearization"]["method"] = "vector"
         vec = analyze(doc).lines["leg1"].drag_residual
         assert not vec.computed and "'vector'" in vec.reason and vec.ratio("end_b") == 1.0
@@ -210,5 +168,5 @@ def test_large_correction_warns():
     assert res.ratio("end_b") > dr.RESIDUAL_WARN_RATIO
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        analyze(_chain(20))
+        analyze(chain_surge_doc(20))
     assert not any("drag residual" in str(w.message) for w in caught)

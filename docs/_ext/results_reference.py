@@ -203,6 +203,37 @@ _LINES = {
         "√(σ_linear² + variance): the end-tension σ with the residual.",
     ),
     "lines.<line>.drag_residual.<end>.ratio": ("-", "std / std_linear."),
+    "lines.<line>.geometric_residual": (
+        "",
+        "The end-tension variance of the second-order geometric forces of the linear "
+        "response (stretching and rotation of the tension; present with "
+        "``analysis.linearization.geometric_residual``); see "
+        ":doc:`../benchmarks/drag_residual`.",
+    ),
+    "lines.<line>.geometric_residual.computed": (
+        "-",
+        "False where the line is outside the closed form's scope (more than 400 "
+        "elements, lines on free bodies).",
+    ),
+    "lines.<line>.geometric_residual.reason": ("-", "Why not computed; empty when computed."),
+    "lines.<line>.geometric_residual.order": ("-", "2: the forces are quadratic in the response."),
+    "lines.<line>.geometric_residual.panels": ("-", "The elements the residual was evaluated on."),
+    "lines.<line>.geometric_residual.<end>": ("", "The residual at the end."),
+    "lines.<line>.geometric_residual.<end>.variance": (
+        "{F}²",
+        "Variance the residual adds to the end tension (in band, superharmonics and "
+        "difference frequencies).",
+    ),
+    "lines.<line>.geometric_residual.<end>.in_band": (
+        "{F}²",
+        "Its part on the analysis band [ω_min, ω_max].",
+    ),
+    "lines.<line>.geometric_residual.<end>.std_linear": ("{F}", "σ of the linear model."),
+    "lines.<line>.geometric_residual.<end>.std": (
+        "{F}",
+        "√(σ_linear² + variance): the end-tension σ with the residual.",
+    ),
+    "lines.<line>.geometric_residual.<end>.ratio": ("-", "std / std_linear."),
     "lines.<line>.strumming": (
         "",
         "Strumming screening of the line in the current (present only with a current "
@@ -550,6 +581,7 @@ def example_documents() -> dict[str, dict[str, Any]]:
         scene = stochcable.load_example("taut_wire").model_dump()
         scene["analysis"]["fidelity"] = {"target_error": 0.05}
         scene["analysis"]["linearization"]["drag_residual"] = True
+        scene["analysis"]["linearization"]["geometric_residual"] = True
         result = stochcable.analyze(stochcable.Scene.model_validate(scene))
         docs["taut_wire with analysis.fidelity"] = result.to_document()
     return docs

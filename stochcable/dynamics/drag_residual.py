@@ -52,7 +52,7 @@ from stochcable.dynamics.residual_lines import (
 )
 from stochcable.dynamics.variance import current_split
 from stochcable.errors import PhysicsWarning, warn
-from stochcable.results.records import DragResidual
+from stochcable.results.records import ResidualRecord
 
 __all__ = [
     "HERMITE_ORDER",
@@ -172,7 +172,7 @@ def drag_residual(
     linearization: Any,
     std: dict[str, float],
     order: int = HERMITE_ORDER,
-) -> DragResidual:
+) -> ResidualRecord:
     """The end-tension variance the drag linearization of one line drops (module notes).
 
     Parameters
@@ -190,7 +190,7 @@ def drag_residual(
 
     Returns
     -------
-    DragResidual
+    ResidualRecord
         ``computed`` False with the reason where the scope (module notes) excludes the line.
     """
     model = system.model
@@ -201,7 +201,7 @@ def drag_residual(
     elif damping.method != "seed":
         why = f"linearization method {damping.method!r}: only 'seed' is covered"
     if why is not None:
-        return DragResidual.not_computed(why, std)
+        return ResidualRecord.not_computed(why, std)
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
     groups = _panels(model.n_elements)
@@ -224,7 +224,7 @@ def drag_residual(
     keep = (w_out >= w[0] * (1 - 1e-9)) & (w_out <= w[-1] * (1 + 1e-9))
     live = [name for name, (c_el, _) in parts.items() if np.any(c_el > 0)]
     if not live:  # no drag: nothing dropped
-        return DragResidual.from_variances(variance, in_band, std, order, len(groups))
+        return ResidualRecord.from_variances(variance, in_band, std, order, len(groups))
     h_all = load_transfer(
         system, damping, _panel_loads(model, groups, [dirs[n] for n in live]), w_out
     )
@@ -252,12 +252,12 @@ def drag_residual(
     for i, end in enumerate(("end_a", "end_b")):
         variance[end] = float(lines_t[i].sum())
         in_band[end] = float(lines_t[i][keep].sum())
-    out = DragResidual.from_variances(variance, in_band, std, order, len(groups))
+    out = ResidualRecord.from_variances(variance, in_band, std, order, len(groups))
     _warn_large(system.name, out)
     return out
 
 
-def _warn_large(name: str, res: DragResidual) -> None:
+def _warn_large(name: str, res: ResidualRecord) -> None:
     """PhysicsWarning where the residual raises an end's σ by more than
     :data:`RESIDUAL_WARN_RATIO`."""
     end = max(("end_a", "end_b"), key=res.ratio)

@@ -21,6 +21,7 @@ from stochcable.dynamics.blocks import (
     trapezoid_weights,
 )
 from stochcable.dynamics.drag_residual import drag_residual
+from stochcable.dynamics.geometric_residual import geometric_residual
 from stochcable.dynamics.indicators import (
     LineModes,
     line_indicators,
@@ -42,7 +43,7 @@ from stochcable.results.documents import (
     LineResult,
     stats_from_validated,
 )
-from stochcable.results.records import DragResidual
+from stochcable.results.records import ResidualRecord
 from stochcable.scene.model import AnalysisSettings
 
 # ------------------------------------------------------------------------- outputs
@@ -104,8 +105,9 @@ def line_result(
         (default the line's fixed-end modes; a line on bodies: the coupled modes that
         count for it, :func:`stochcable.dynamics.coupled.results.line_modes`).
     alone : bool
-        False for a line of a coupled group (on free bodies): its drag residual
-        (``settings.linearization.drag_residual``) is not computed.
+        False for a line of a coupled group (on free bodies): its residuals
+        (``settings.linearization.drag_residual`` and ``.geometric_residual``) are not
+        computed.
 
     Returns
     -------
@@ -146,14 +148,15 @@ def line_result(
         )
         indicators = with_second_order(system.name, indicators, so)
     end_force = _end_force_transfer(model, resp, n_ch)
-    residual = None
-    if settings.linearization.drag_residual and linearization.record is not None:
-        std = {e: stats[e].std for e in stats}
-        residual = (
-            drag_residual(system, channels, linearization, std)
-            if alone
-            else DragResidual.not_computed("a line on free bodies is not covered", std)
-        )
+    residual = {}
+    std = {e: stats[e].std for e in stats}
+    for key, fn in (("drag_residual", drag_residual), ("geometric_residual", geometric_residual)):
+        if getattr(settings.linearization, key) and linearization.record is not None:
+            residual[key] = (
+                fn(system, channels, linearization, std)
+                if alone
+                else ResidualRecord.not_computed("a line on free bodies is not covered", std)
+            )
     return LineResult(
         name=system.name,
         omega=w,
@@ -179,7 +182,7 @@ def line_result(
         model=model,
         modes=system.modes,
         indicators=indicators,
-        drag_residual=residual,
+        **residual,
     )
 
 

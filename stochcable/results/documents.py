@@ -26,9 +26,9 @@ import numpy as np
 from stochcable.line.strumming import StrummingTable
 from stochcable.results.records import (
     THREE_HOURS,
-    DragResidual,
     LinearizationRecord,
     LineIndicators,
+    ResidualRecord,
     ResponseStats,
     stats_from_spectrum,
     stats_from_validated,
@@ -105,9 +105,13 @@ class LineResult:
     strumming : StrummingTable or None
         Strumming screening of the line in the current (None without current;
         docs/strumming.md).
-    drag_residual : DragResidual or None
+    drag_residual : ResidualRecord or None
         The end-tension variance the drag linearization drops
         (``analysis.linearization.drag_residual``; None when not asked for).
+    geometric_residual : ResidualRecord or None
+        The end-tension variance of the second-order geometric forces
+        (``analysis.linearization.geometric_residual``; None when not asked for).  With
+        a zero-mean flow the residuals are uncorrelated: their variances add.
     """
 
     name: str
@@ -135,7 +139,8 @@ class LineResult:
     modes: Any = None
     indicators: LineIndicators | None = None
     strumming: StrummingTable | None = None
-    drag_residual: DragResidual | None = None
+    drag_residual: ResidualRecord | None = None
+    geometric_residual: ResidualRecord | None = None
 
     @property
     def listed_modes(self) -> np.ndarray:
@@ -196,11 +201,14 @@ class LineResult:
             "modes": {"omega": self.listed_modes.tolist(), "kept": self.n_modes},
             "indicators": None if self.indicators is None else self.indicators.as_dict(),
             **({} if self.strumming is None else {"strumming": self.strumming.as_dict()}),
-            **(
-                {}
-                if self.drag_residual is None
-                else {"drag_residual": self.drag_residual.as_dict()}
-            ),
+            **{
+                k: r.as_dict()
+                for k, r in (
+                    ("drag_residual", self.drag_residual),
+                    ("geometric_residual", self.geometric_residual),
+                )
+                if r is not None
+            },
         }
 
 

@@ -21,7 +21,7 @@ __all__ = [
     "ResponseStats",
     "LinearizationRecord",
     "LineIndicators",
-    "DragResidual",
+    "ResidualRecord",
     "stats_from_spectrum",
     "stats_from_validated",
 ]
@@ -288,9 +288,11 @@ class LineIndicators:
 
 
 @dataclass(frozen=True)
-class DragResidual:
-    """The end-tension variance the drag linearization drops, and σ with it
-    (:func:`stochcable.dynamics.drag_residual.drag_residual`).
+class ResidualRecord:
+    """The end-tension variance a closed-form residual of the linear model adds, and σ
+    with it: the drag the linearization drops
+    (:func:`stochcable.dynamics.drag_residual.drag_residual`) or the second-order
+    geometric forces (:func:`stochcable.dynamics.geometric_residual.geometric_residual`).
 
     Attributes
     ----------
@@ -299,7 +301,7 @@ class DragResidual:
     reason : str
         Why not computed ("" when computed).
     variance : dict {"end_a", "end_b"} of float
-        Variance the Hermite residual of the drag adds to the end tension. [N²]
+        Variance the residual adds to the end tension. [N²]
     in_band : dict {"end_a", "end_b"} of float
         Its part on the analysis band (the rest: superharmonics above ω_max, and
         difference frequencies below ω_min). [N²]
@@ -308,9 +310,11 @@ class DragResidual:
     std : dict {"end_a", "end_b"} of float
         √(σ_linear² + variance): the end-tension σ with the residual. [N]
     order : int
-        Highest Hermite order kept. [-]
+        Highest order kept (Hermite order of the drag; 2 for the quadratic geometric
+        forces). [-]
     panels : int
-        Element groups the residual was evaluated on. [-]
+        Element groups the residual was evaluated on (the elements for the geometric
+        forces). [-]
     """
 
     computed: bool
@@ -323,7 +327,7 @@ class DragResidual:
     panels: int = 0
 
     @classmethod
-    def not_computed(cls, reason: str, std: dict[str, float]) -> DragResidual:
+    def not_computed(cls, reason: str, std: dict[str, float]) -> ResidualRecord:
         """A record that says why the residual was not computed."""
         zero = {e: 0.0 for e in std}
         return cls(False, reason, zero, dict(zero), dict(std), dict(std))
@@ -336,7 +340,7 @@ class DragResidual:
         std: dict[str, float],
         order: int,
         panels: int,
-    ) -> DragResidual:
+    ) -> ResidualRecord:
         """The record of computed residual variances (negative round-off clipped)."""
         var = {e: max(0.0, float(v)) for e, v in variance.items()}
         band = {e: max(0.0, float(v)) for e, v in in_band.items()}

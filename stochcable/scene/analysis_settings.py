@@ -70,6 +70,12 @@ class LinearizationSettings(_Doc):
         "closed-form Hermite residual of the quadratic drag (lines.<name>.drag_residual; "
         "planar lines, seed method, lines not on free bodies)",
     )
+    geometric_residual: bool = Field(
+        default=False,
+        description="Also compute the end-tension variance of the second-order geometric "
+        "forces of the linear response (stretching and rotation of the tension; "
+        "lines.<name>.geometric_residual; lines not on free bodies, at most 400 elements)",
+    )
 
 
 class TimeSeriesSettings(_Doc):

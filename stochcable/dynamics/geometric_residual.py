@@ -1,0 +1,174 @@
+"""The end-tension variance the linear (small-displacement) model drops: the second-order
+geometric forces of the linear response, in closed form.
+
+A straight bar element of static length l, tangent t and effective tension T₀ carries
+the force T·ℓ̂ on its end b, with ℓ = l·t + Δu (Δu = u_b − u_a) and T = T₀ + EA(|ℓ| −
+l)/L₀ (L₀ the unstretched length).  To second order in Δu = a·t + b (a = t·Δu, b ⊥ t),
+
+    T·ℓ̂ = T₀t + [(EA/L₀)·a·t + (T₀/l)·b] + κ·[½|b|²·t + a·b],   κ = (EA/L₀ − T₀/l)/l,
+
+the bracket being the model's linear (elastic and geometric) stiffness (seed 001 §3.1)
+and the last term the quadratic force it drops: Green–Lagrange stretching ½|b|²/l under
+the axial stiffness and the rotation of the axial force by the transverse motion.  With
+the linear response Gaussian, every component of κ[½|b|²·t + a·b] is a Gaussian
+quadratic form whose cross-covariances between elements are sums of products of two
+linear cross-covariances (Isserlis: Cov(x₁y₁, x₂y₂) = R_{x₁x₂}R_{y₁y₂} +
+R_{x₁y₂}R_{y₁x₂}); they are uncorrelated with the linear response (odd moments vanish),
+so the response to them adds to the linear variance:
+Var(ΔT) = Σ_ij ∫ H_T,i*(ω) G_ij(ω) H_T,j(ω) dω, H_T,i the end tension per unit force
+pair of component i (+ on node b, − on node a), through the same linear system — the
+second-order (Volterra) term of the response (Roberts and Spanos, "Random Vibration and
+Statistical Linearization", §5; the quadratic forms of
+:mod:`stochcable.dynamics.second_order` are its stretching part alone, without the line's
+response to them).  It acts at the sum and difference frequencies of the response.
+
+Validation: the chain's line (fairlead surge) against the nonlinear time domain with the
+frequency domain's linear drag, i.e. geometric nonlinearity alone
+(docs/benchmarks/drag_residual.md).  Scope: lines not on free bodies, at most
+:data:`MAX_ELEMENTS` elements (the cost is O(elements² · n_fft log n_fft)).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from stochcable.dynamics.residual_lines import (
+    covariance_lines,
+    cross_covariance,
+    load_transfer,
+    uniform_grid,
+)
+from stochcable.results.records import ResidualRecord
+
+__all__ = ["MAX_ELEMENTS", "geometric_residual", "quadratic_output_lines"]
+
+#: Most elements the residual is computed for. [-]
+MAX_ELEMENTS = 400
+
+
+def geometric_residual(system: Any, channels: Any, linearization: Any, std: dict[str, float]):
+    """The end-tension variance of the second-order geometric forces of one line's
+    linear response (module notes).
+
+    Parameters
+    ----------
+    system : LineSystem
+        The line alone (ends prescribed).
+    channels : tuple of Channel
+        Its inputs on the analysis grid.
+    linearization : Linearization
+        The converged fixed point (its ``response`` and ``damping``).
+    std : dict {"end_a", "end_b"} of float
+        The linear end-tension σ. [N]
+
+    Returns
+    -------
+    ResidualRecord
+        The record (``order`` 2: quadratic forces; ``panels``: the elements);
+        ``computed`` False above :data:`MAX_ELEMENTS` elements.
+    """
+    model = system.model
+    n_el = model.n_elements
+    if n_el > MAX_ELEMENTS:
+        return ResidualRecord.not_computed(
+            f"{n_el} elements: above {MAX_ELEMENTS} (the cost grows with their square)", std
+        )
+    resp = linearization.response
+    w = np.asarray(resp.omega, dtype=float)
+    grid = uniform_grid(w)
+    comps = list(model.components)
+    d = model.dim
+    n_ch = len(channels)
+    pos = np.asarray(system.positions, dtype=float)
+    chord = np.diff(pos, axis=0)
+    length = np.linalg.norm(chord, axis=1)
+    frames = _frames(system, comps)
+    u = np.zeros((w.size, model.n_nodes, 3, n_ch), dtype=complex)
+    u[:, :, comps] = resp.displacement.reshape(w.size, model.n_nodes, d, n_ch)
+    du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, 3, n_ch)
+    spectra = np.stack([ch.spectrum for ch in channels])
+    # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
+    proc = [grid.lines(np.einsum("wedc,ed->cew", du, f), spectra) for f in frames]
+    mesh = model.mesh
+    kappa = (mesh.ea / mesh.l0 - np.asarray(system.statics.tension) / length) / length
+    # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms
+    comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [
+        [(1.0, 0, k)] for k in range(1, len(frames))
+    ]
+    unit = np.zeros((model.n_nodes, d, len(comp_terms) * n_el))
+    for i, f in enumerate(frames):
+        for e in range(n_el):
+            unit[e + 1, :, i * n_el + e] += kappa[e] * f[e, comps]
+            unit[e, :, i * n_el + e] -= kappa[e] * f[e, comps]
+    n_o = 2 * (grid.n_j - 1)
+    w_out = grid.step * np.arange(1, n_o + 1)
+    h = load_transfer(system, linearization.damping, unit, w_out)  # (2, n_comp·n_el, n_o)
+    n_fft = int(2 ** math.ceil(math.log2(4 * grid.n_j + 2)))
+    lines = quadratic_output_lines(proc, comp_terms, h, n_fft)
+    keep = (w_out >= w[0] * (1 - 1e-9)) & (w_out <= w[-1] * (1 + 1e-9))
+    variance = {end: float(lines[k].sum()) for k, end in enumerate(("end_a", "end_b"))}
+    in_band = {end: float(lines[k][keep].sum()) for k, end in enumerate(("end_a", "end_b"))}
+    return ResidualRecord.from_variances(variance, in_band, std, 2, n_el)
+
+
+def quadratic_output_lines(
+    processes: list[np.ndarray],
+    terms: list[list[tuple[float, int, int]]],
+    transfer: np.ndarray,
+    n_fft: int,
+) -> np.ndarray:
+    """Spectral lines of outputs driven by Gaussian quadratic forms of each element.
+
+    Parameters
+    ----------
+    processes : list of ndarray, complex, each (n_ch, n_el, n_j)
+        Zero-mean jointly Gaussian processes per element as lines on a uniform grid
+        (:meth:`~stochcable.dynamics.residual_lines.UniformGrid.lines`).
+    terms : list of list of (float, int, int)
+        Each force component of an element as Σ coef·x·y of its processes (by index).
+    transfer : ndarray, complex, shape (n_out, n_comp · n_el, n_o)
+        Outputs per unit of each component of each element (component-major) at ω_j,
+        j = 1 … n_o.
+    n_fft : int
+        Samples of the lag grid, ≥ 4·n_j.
+
+    Returns
+    -------
+    ndarray, shape (n_out, n_o)
+        Variance lines of the outputs (Isserlis: Cov(x₁y₁, x₂y₂) = R_{x₁x₂}R_{y₁y₂} +
+        R_{x₁y₂}R_{y₁x₂}; the means of the forms, a static shift, left out).
+    """
+    n_p = len(processes)
+    n_el = processes[0].shape[1]
+    n_o = transfer.shape[2]
+    out = np.zeros((transfer.shape[0], n_o))
+    for e in range(n_el):
+        r = [[cross_covariance(processes[x][:, e], processes[y], n_fft) for y in range(n_p)]
+             for x in range(n_p)]  # fmt: skip
+        for i, terms_i in enumerate(terms):
+            h_i = np.conj(transfer[:, i * n_el + e])
+            for j, terms_j in enumerate(terms):
+                cov = sum(
+                    ci * cj * (r[x1][x2] * r[y1][y2] + r[x1][y2] * r[y1][x2])
+                    for ci, x1, y1 in terms_i
+                    for cj, x2, y2 in terms_j
+                )
+                cl = covariance_lines(cov, n_o)  # element e's component i, every f's j
+                h_j = transfer[:, j * n_el : (j + 1) * n_el]
+                out += np.real(h_i * np.einsum("opj,pj->oj", h_j, cl))
+    return out
+
+
+def _frames(system: Any, comps: list[int]) -> list[np.ndarray]:
+    """The element tangent and the normals the model moves along: (t, n) in the plane
+    of a planar model, (t, n₁, n₂) in 3-D; each (n_el, 3)."""
+    t, n1, n2 = system.frames
+    if len(comps) == 3:
+        return [t, n1, n2]
+    plane = np.zeros(3)
+    plane[[i for i in range(3) if i not in comps][0]] = 1.0
+    normal = np.cross(plane, t)
+    return [t, normal / np.linalg.norm(normal, axis=1)[:, None]]
