@@ -52,7 +52,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "docs" / "accuracy" / "lines.md"
 LINES = ("chain", "taut", "deep")
 FINE = 160  # elements of the converged TD and of the budget
-FD_VARIANTS = ("default", "adaptive", "residual", "lines80", "lines160", "lines320", "fine320")
+FD_VARIANTS = ("default", "adaptive", "residuals", "lines80", "lines160", "lines320", "fine320")
 FINE_GRID = 2000  # frequencies of the converged continuous-spectrum FD on the band
 TARGET = 0.01  # analysis.fidelity.target_error of the adaptive FD
 
@@ -74,8 +74,10 @@ def fd_document(line: str, variant: str = "default") -> dict:
     doc["lines"][0]["end_b"]["motion"] = {"surge": surge_table()}
     if variant == "adaptive":
         doc["analysis"]["fidelity"] = {"target_error": TARGET}
-    elif variant == "residual":  # the default settings with the closed-form drag residual
-        doc["analysis"].setdefault("linearization", {})["drag_residual"] = True
+    elif variant == "residuals":  # the default settings with the closed-form residuals
+        doc["analysis"].setdefault("linearization", {}).update(
+            drag_residual=True, geometric_residual=True
+        )
     elif variant.startswith(("lines", "fine")):
         _, omega = fd_budget.td_lines(mc.PERIOD)
         if variant.startswith("fine"):
@@ -114,9 +116,11 @@ def run_fd(line: str, variant: str) -> dict:
         "tolerance": an.linearization.tolerance,
         "warnings": list(res.warnings),
     }
-    if lr.drag_residual is not None and lr.drag_residual.computed:
-        out["residual_b"] = float(lr.drag_residual.std["end_b"])
-        out["residual_a"] = float(lr.drag_residual.std["end_a"])
+    parts = [r for r in (lr.drag_residual, lr.geometric_residual) if r is not None]
+    if parts and all(r.computed for r in parts):  # (uncorrelated: the variances add)
+        for end, key in (("end_b", "residual_b"), ("end_a", "residual_a")):
+            extra = sum(r.variance[end] for r in parts)
+            out[key] = math.sqrt(getattr(lr, end).std ** 2 + extra)
     if res.fidelity is not None:
         plan = res.fidelity.to_document()
         out["plan"] = {
@@ -332,14 +336,14 @@ def _sigma_tables(cache: dict) -> list[str]:
         "",
         "## Ratios",
         "",
-        "| line | end | FD default / TD − 1 | FD adaptive / TD − 1 | FD default + drag "
-        "residual / TD − 1 | FD default / MoorDyn − 1 | FD adaptive / MoorDyn − 1 "
+        "| line | end | FD default / TD − 1 | FD adaptive / TD − 1 | FD default + "
+        "residuals / TD − 1 | FD default / MoorDyn − 1 | FD adaptive / MoorDyn − 1 "
         "| TD / MoorDyn − 1 (paired) |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for line in LINES:
         fd0, fda = _fd(cache, line, "default"), _fd(cache, line, "adaptive")
-        fdr = _fd(cache, line, "residual")
+        fdr = _fd(cache, line, "residuals")
         td, md = _seeds(cache, line, "reference"), _seeds(cache, line, "moordyn")
         for q, end in ENDS:
             rq = q.replace("reaction", "residual")
@@ -351,9 +355,10 @@ def _sigma_tables(cache: dict) -> list[str]:
             )
     out += [
         "",
-        "'FD default + drag residual': σ with the end-tension variance the drag "
-        "linearization drops (`analysis.linearization.drag_residual`, "
-        "[its benchmark](../benchmarks/drag_residual.md)); the linear σ is unchanged.",
+        "'FD default + residuals': σ with the end-tension variances the linear model "
+        "drops — the drag residual and the second-order geometric forces "
+        "(`analysis.linearization.drag_residual`, `.geometric_residual`, "
+        "[their benchmark](../benchmarks/drag_residual.md)); the linear σ is unchanged.",
     ]
     return out + [""]
 
