@@ -65,14 +65,19 @@ def test_set_equals_one_at_a_time_analyses():
 
 
 def test_in_plane_set_equals_analyses_to_round_off():
-    # every heading in the plane: the engine is 2-D like analyze(), the same numbers
+    # every heading in the plane: the engine is 2-D like analyze(), the same model.  The
+    # first case of a warm-start run starts at rest as analyze() does: the same numbers;
+    # the next starts from its predecessor's σ (stochcable.cases.chunk): the same fixed
+    # point within the linearization tolerance tol (σ to a few tol, 10·tol allowed)
     scene = load_scene(_wire())
+    tol = scene.analysis.linearization.tolerance
     rows = [{"hs": h, "tp": 9.0, "heading": 0, "probability": 0.5} for h in (2.0, 3.5)]
     res = run_cases(scene, scatter_from_rows(rows), fatigue=WIRE)
     for i, r in enumerate(res.scatter.states):
         sea = Sea(spectrum=r.spectrum("jonswap"), heading=0.0)
         one = analyze(scene.model_copy(update={"sea": sea})).lines["wire"]
-        assert res.stats["wire"]["end_b"][i, 1] == pytest.approx(one.end_b.std, rel=1e-12)
+        rel = 1e-12 if i == 0 else 10 * tol
+        assert res.stats["wire"]["end_b"][i, 1] == pytest.approx(one.end_b.std, rel=rel)
 
 
 def test_engine_refuses_an_out_of_plane_sea_when_built_2d():
