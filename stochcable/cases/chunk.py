@@ -9,7 +9,7 @@ The cases of a set form runs of ``WARM_RUN`` consecutive positions of the diagra
 (0–7, 8–15, …): the first case of a run, and a case whose heading differs from the
 case before it, starts its drag fixed point at rest, each other from the converged σ
 of the cases before it (:func:`stochcable.dynamics.coupled.fixedpoint.warm_starts`;
-neighbouring sea states of a diagram have neighbouring σ: ≈ 5.2 evaluations a case
+neighbouring sea states of a diagram have neighbouring σ: ≈ 4.9 evaluations a case
 instead of 7.6 on the chain example's 200 cases).  A chunk that starts inside a run
 solves that run's earlier cases first (its ``lead``, discarded).  So each case's
 numbers depend only on its run and the engine, and the engine is the same wherever it

@@ -55,8 +55,10 @@ __all__ = ["CoupledLinearization", "linearize_coupled", "warm_starts"]
 #: The store of :func:`warm_starts` open in this context (None: every fixed point
 #: starts at rest).
 _WARM: ContextVar[dict[str, np.ndarray] | None] = ContextVar("warm_starts", default=None)
-#: Key suffix of the converged σ before the last in a :func:`warm_starts` store.
-_BEFORE = " (before)"
+#: Converged σ a :func:`warm_starts` store keeps per group, and the weights of the
+#: polynomial extrapolation of 1, 2 and 3 of them (newest first). [-]
+_WARM_ORDER = 3
+_EXTRAPOLATION = (np.array([1.0]), np.array([2.0, -1.0]), np.array([3.0, -3.0, 1.0]))
 
 _HINT = (
     "increase analysis.linearization.max_iterations, lower relaxation, or set "
@@ -99,8 +101,8 @@ class CoupledLinearization:
 def warm_starts(store: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]:
     """Warm starts of the drag fixed points solved inside the block: each group's
     iteration starts from the σ its last converged fixed points left in ``store``
-    (keyed by the group's lines and bodies: the last, linearly extrapolated from the
-    one before) instead of the rest start, and leaves its own there — sea states
+    (keyed by the group's lines and bodies: extrapolated from the last three) instead
+    of the rest start, and leaves its own there — sea states
     solved in order, each from its predecessors' answers
     (:func:`stochcable.cases.chunk.solve_chunk`).
 
@@ -112,7 +114,8 @@ def warm_starts(store: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]
     Parameters
     ----------
     store : dict of str to ndarray
-        The σ vectors per group, filled and read here. [m/s]
+        The last converged σ vectors per group (newest first), filled and read
+        here. [m/s]
 
     Yields
     ------
@@ -231,10 +234,10 @@ def linearize_coupled(
             fp = None
     if fp is None or not fp.converged:
         fp, cache = _iterate(g, x_rest, idx, gc, run)
-    if store is not None and fp.converged:
-        if gname in store:
-            store[gname + _BEFORE] = store[gname]
-        store[gname] = fp.x.copy()
+    if store is not None and fp.converged:  # the newest first
+        hist = store.get(gname)
+        keep = () if hist is None or hist.shape[1] != fp.x.size else tuple(hist)
+        store[gname] = np.array((fp.x, *keep[: _WARM_ORDER - 1]))
     if not fp.converged:
         warn(
             f"{gname} did not converge: relative change {fp.relative_change:.3e} after "
@@ -247,15 +250,15 @@ def linearize_coupled(
 
 
 def _warm_start(store: dict[str, np.ndarray], gname: str) -> np.ndarray | None:
-    """The warm start of group ``gname`` from ``store``: the last converged σ, linearly
-    extrapolated from the one before when there is one (neighbouring sea states in
-    order: on the chain example's diagram 5.2 evaluations a case instead of 5.8 from
-    the last σ alone and 7.6 from rest), never negative. [m/s]"""
-    last = store.get(gname)
-    before = store.get(gname + _BEFORE)
-    if last is None or before is None or before.shape != last.shape:
-        return last
-    return np.maximum(2.0 * last - before, 0.0)
+    """The warm start of group ``gname`` from ``store``: the polynomial extrapolation
+    of its last (up to ``_WARM_ORDER``) converged σ, never negative (neighbouring sea
+    states in order: on the chain example's diagram 4.9 evaluations a case against
+    5.2 with 2, 5.8 with the last σ alone and 7.6 from rest). [m/s]"""
+    hist = store.get(gname)
+    if hist is None:
+        return None
+    coef = _EXTRAPOLATION[hist.shape[0] - 1]
+    return np.maximum(coef @ hist, 0.0)
 
 
 def _iterate(
