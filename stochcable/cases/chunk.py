@@ -6,10 +6,10 @@ scenes it saw, so chunks of the same set on one worker reuse it — solves its s
 and turns the tension spectra into damage rates in one batched call per line.
 
 The cases of a set form runs of ``WARM_RUN`` consecutive positions of the diagram
-(0–7, 8–15, …): the first case of a run, and a case whose heading differs from the
+(0–15, 16–31, …): the first case of a run, and a case whose heading differs from the
 case before it, starts its drag fixed point at rest, each other from the converged σ
 of the cases before it (:func:`stochcable.dynamics.coupled.fixedpoint.warm_starts`;
-neighbouring sea states of a diagram have neighbouring σ: ≈ 4.9 evaluations a case
+neighbouring sea states of a diagram have neighbouring σ: ≈ 4.7 evaluations a case
 instead of 7.6 on the chain example's 200 cases).  A chunk that starts inside a run
 solves that run's earlier cases first (its ``lead``, discarded).  So each case's
 numbers depend only on its run and the engine, and the engine is the same wherever it
@@ -53,7 +53,7 @@ __all__ = [
 ENDS = ("end_a", "end_b")
 #: Cases of a warm-start run (module docstring): a chunk size that is a multiple of it
 #: never solves a case twice. [-]
-WARM_RUN = 8
+WARM_RUN = 16
 #: Engines a worker keeps, most recent first (a set's scene, and the one before). [-]
 _ENGINE_CACHE_SIZE = 2
 _ENGINES: OrderedDict[str, Engine] = OrderedDict()

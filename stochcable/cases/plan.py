@@ -99,11 +99,13 @@ def _fatigue_settings(
 
 
 def default_chunk_size(n_cases: int, workers: int) -> int:
-    """Cases per chunk: four chunks per worker, at most :data:`MAX_CHUNK_CASES`, and
-    from ``WARM_RUN`` cases on the nearest multiple of it (chunks then start at a
-    warm-start run's start and solve no case twice). [-]"""
+    """Cases per chunk: about four chunks per worker, at most :data:`MAX_CHUNK_CASES`,
+    a multiple of ``WARM_RUN`` (the whole set when smaller): every chunk then starts
+    at a warm-start run's start and solves no case twice
+    (:mod:`stochcable.cases.chunk`; a chunk inside a run first solves the run's earlier
+    cases). [-]"""
     size = max(1, min(MAX_CHUNK_CASES, math.ceil(n_cases / (4 * max(workers, 1)))))
-    return WARM_RUN * round(size / WARM_RUN) if size >= WARM_RUN else size
+    return max(1, min(n_cases, WARM_RUN * max(1, round(size / WARM_RUN))))
 
 
 def plan_cases(

@@ -222,17 +222,23 @@ def linearize_coupled(
     # subset supplies the start of the full-grid iteration; its history is kept
     if coarse is None:
         coarse = _coarse_pays(g, lin)
-    x_rest, idx, gc = _start(g, method, coarse)
     run = (method, rho, progress, names, lin, fixed, gname, timing)
     store = _WARM.get()
     warm = None if store is None or lin.max_iterations == 1 else _warm_start(store, gname)
-    fp = None
-    if warm is not None and warm.shape == x_rest.shape and x_rest.size:
-        try:  # a start that does not converge: the rest start, as without one
-            fp, cache = _iterate(g, warm, idx, gc, run)
-        except (ConvergenceError, SolverError):
-            fp = None
+    x_rest, fp = None, None
+    if warm is not None:
+        idx = _warm_subset(g, method, coarse, warm)
+        gc = None
+        if idx is None:  # the subset from the rest start's drag, as without a warm start
+            x_rest, idx, gc = _start(g, method, coarse)
+        if x_rest is None or (warm.shape == x_rest.shape and x_rest.size):
+            try:  # a start that does not converge: the rest start, as without one
+                fp, cache = _iterate(g, warm, idx, gc, run)
+            except (ConvergenceError, SolverError):
+                fp = None
     if fp is None or not fp.converged:
+        if x_rest is None:
+            x_rest, idx, gc = _start(g, method, coarse)
         fp, cache = _iterate(g, x_rest, idx, gc, run)
     if store is not None and fp.converged:  # the newest first
         hist = store.get(gname)
@@ -252,8 +258,9 @@ def linearize_coupled(
 def _warm_start(store: dict[str, np.ndarray], gname: str) -> np.ndarray | None:
     """The warm start of group ``gname`` from ``store``: the polynomial extrapolation
     of its last (up to ``_WARM_ORDER``) converged σ, never negative (neighbouring sea
-    states in order: on the chain example's diagram 4.9 evaluations a case against
-    5.2 with 2, 5.8 with the last σ alone and 7.6 from rest). [m/s]"""
+    states in order: on the chain example's diagram in runs of 8 cases, 4.9
+    evaluations a case against 5.2 with 2, 5.8 with the last σ alone and 7.6 from
+    rest). [m/s]"""
     hist = store.get(gname)
     if hist is None:
         return None
@@ -336,6 +343,20 @@ def _start(
         return _rest_start(g, method), None, None
     x_rest = _rest_start(g, method)
     return x_rest, (coarse_subset(g, x_rest, method) if coarse and x_rest.size else None), None
+
+
+def _warm_subset(g: GroupSystem, method: str, coarse: bool, warm: np.ndarray) -> np.ndarray | None:
+    """The coarse subset of a warm start of a line alone: the narrow features of the
+    warm start's drag (:func:`~stochcable.dynamics.coupled.coarse.coarse_subset`; the
+    at-rest σ are then not needed); None where :func:`_start` decides (bodies, no
+    coarse stage, or none on this drag)."""
+    if not (coarse and not g.bodies and len(g.lines) == 1 and warm.size):
+        return None
+    if g.omega.size < COARSE_MIN_FREQUENCIES:
+        return None
+    full_grid_arrays(g, method)
+    g.sizes = {g.lines[0].name: warm.size}
+    return coarse_subset(g, warm, method)
 
 
 def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
