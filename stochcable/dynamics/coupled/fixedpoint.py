@@ -226,7 +226,7 @@ def linearize_coupled(
     store = _WARM.get()
     warm = None if store is None or lin.max_iterations == 1 else _warm_start(store, gname)
     x_rest, fp = None, None
-    if warm is not None:
+    if warm is not None and np.all(np.isfinite(warm)):
         idx = _warm_subset(g, method, coarse, warm)
         gc = None
         if idx is None:  # the subset from the rest start's drag, as without a warm start
