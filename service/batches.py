@@ -356,7 +356,7 @@ class BatchService:
 
     def _submit(self, plan: CasePlan, k: int, shared: Any) -> Any:
         ex = self._get_executor()
-        args = (shared, plan.scatter.family, plan.chunks[k], plan.fatigue)
+        args = (shared, plan.scatter.family, plan.chunks[k], plan.fatigue, None, plan.leads[k])
         if isinstance(ex, cf.ProcessPoolExecutor):
             return ex.submit(solve_chunk, *args)
         return ex.submit(solve_chunk, *args, pure=False, retries=_CHUNK_ATTEMPTS - 1)

@@ -62,5 +62,6 @@ def test_plan_refuses_bad_settings(kw, parameter):
 
 def test_default_chunk_size():
     assert default_chunk_size(1000, 2) == 64  # capped: progress and small losses
-    assert default_chunk_size(40, 2) == 5  # four chunks per worker
+    assert default_chunk_size(200, 2) == 32  # about four chunks per worker (25) ...
+    assert default_chunk_size(40, 2) == 16  # ... whole warm-start runs (16 cases)
     assert default_chunk_size(1, 8) == 1

@@ -17,7 +17,14 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.cases.chunk import CaseRow, ChunkResult, engine_template, solve_chunk
+from stochcable.cases.chunk import (
+    WARM_RUN,
+    CaseRow,
+    ChunkResult,
+    engine_template,
+    run_lead,
+    solve_chunk,
+)
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import ScatterDiagram, SeaState
 from stochcable.errors import InputError
@@ -54,6 +61,10 @@ class CasePlan:
         Return period of the long-term extremes. [years]
     chunks : tuple of tuple of (int, SeaState)
         The cases of every chunk with their positions in the diagram.
+    leads : tuple of tuple of (int, SeaState)
+        Per chunk, the cases solved before its own and discarded
+        (:func:`~stochcable.cases.chunk.run_lead`: the earlier cases of the warm-start
+        run its first case is in); executors pass ``leads[k]`` with ``chunks[k]``.
     """
 
     scene: Scene
@@ -62,11 +73,15 @@ class CasePlan:
     fatigue: dict[str, LineFatigue]
     years: float
     chunks: tuple[tuple[tuple[int, SeaState], ...], ...]
+    leads: tuple[tuple[tuple[int, SeaState], ...], ...] = ()
 
     def solve(self, k: int, engine: Any = None) -> ChunkResult:
         """Solve chunk ``k`` (here; executors call :func:`solve_chunk` with the same
         arguments)."""
-        return solve_chunk(self.template, self.scatter.family, self.chunks[k], self.fatigue, engine)
+        lead = self.leads[k] if self.leads else ()
+        return solve_chunk(
+            self.template, self.scatter.family, self.chunks[k], self.fatigue, engine, lead
+        )
 
 
 def _fatigue_settings(
@@ -84,8 +99,13 @@ def _fatigue_settings(
 
 
 def default_chunk_size(n_cases: int, workers: int) -> int:
-    """Cases per chunk: four chunks per worker, at most :data:`MAX_CHUNK_CASES`. [-]"""
-    return max(1, min(MAX_CHUNK_CASES, math.ceil(n_cases / (4 * max(workers, 1)))))
+    """Cases per chunk: about four chunks per worker, at most :data:`MAX_CHUNK_CASES`,
+    a multiple of ``WARM_RUN`` (the whole set when smaller): every chunk then starts
+    at a warm-start run's start and solves no case twice
+    (:mod:`stochcable.cases.chunk`; a chunk inside a run first solves the run's earlier
+    cases). [-]"""
+    size = max(1, min(MAX_CHUNK_CASES, math.ceil(n_cases / (4 * max(workers, 1)))))
+    return max(1, min(n_cases, WARM_RUN * max(1, round(size / WARM_RUN))))
 
 
 def plan_cases(
@@ -137,7 +157,8 @@ def plan_cases(
         tuple((i, scatter.states[i]) for i in range(a, min(a + chunk_size, n)))
         for a in range(0, n, chunk_size)
     )
-    return CasePlan(scene, scatter, template, settings, float(years), chunks)
+    leads = tuple(run_lead(scatter.states, part[0][0]) for part in chunks)
+    return CasePlan(scene, scatter, template, settings, float(years), chunks, leads)
 
 
 def chunk_to_bytes(result: ChunkResult) -> bytes:

@@ -191,13 +191,15 @@ def _run_chunks(plan: CasePlan, engine: Engine | None, executor: Any):
         from distributed import as_completed as dask_completed
 
         shared = executor.scatter(plan.template, broadcast=True)
-        futures = [executor.submit(solve_chunk, shared, family, part, settings, pure=False)
-                   for part in plan.chunks]  # fmt: skip
+        futures = [executor.submit(solve_chunk, shared, family, part, settings, None, lead,
+                                   pure=False)
+                   for part, lead in zip(plan.chunks, plan.leads)]  # fmt: skip
         for fut in dask_completed(futures):
             yield fut.result()
         return
     futures = [
-        executor.submit(solve_chunk, plan.template, family, part, settings) for part in plan.chunks
+        executor.submit(solve_chunk, plan.template, family, part, settings, None, lead)
+        for part, lead in zip(plan.chunks, plan.leads)
     ]
     for fut in as_completed(futures):
         yield fut.result()

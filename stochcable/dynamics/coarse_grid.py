@@ -119,6 +119,8 @@ def subset_inputs(
             sub.cache[key] = (take(u, 2), take(f0, 2), moving)
         elif key[0] == "attached_velocity":
             sub.cache[key] = take(val, 2)
+        elif key[0] == "drag_moments":
+            sub.cache[key] = take(val, 3)
         elif key[0] == "qproj":
             u_p, wcol, y = val
             sub.cache[key] = (

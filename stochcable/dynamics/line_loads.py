@@ -27,6 +27,7 @@ from stochcable.dynamics.blocks import (
     real_gemm,
     trapezoid_weights,
 )
+from stochcable.dynamics.freqblocks import working_memory_bytes
 from stochcable.dynamics.loads import (
     Channel,
     element_mean_square,
@@ -133,7 +134,7 @@ def _weighted_square(
 #: the attachments' velocity.  Every other cache is formed again.
 def _spectrum_free(key: Any) -> bool:
     return key in ("foss", "direct") or (
-        isinstance(key, tuple) and key[0] in ("qproj", "attached_velocity")
+        isinstance(key, tuple) and key[0] in ("qproj", "attached_velocity", "drag_moments")
     )
 
 
@@ -319,7 +320,11 @@ def drag_inputs(
     u, _, moving = base_motion(system, prep, inp)
     moments = None if inp.moments is None else inp.moments[..., freq, :]
     wm = moments
-    if moving:
+    key = ("drag_moments", system.solver)
+    whole = freq == slice(None)
+    if moving and whole and key in inp.cache:
+        wm = inp.cache[key]
+    elif moving:
         pat = (
             np.array([[0.5, 0.0], [0.0, 0.5]])
             if system.model.mass_matrix == "lumped"
@@ -343,6 +348,10 @@ def drag_inputs(
                 else np.zeros((prep.n - 1, 2) + u[:, :, freq].shape[1:], dtype=complex)
             )
             wm[..., act] = w_q
+        if whole and wm.nbytes <= working_memory_bytes() // 4:
+            # drag-independent: kept for the next evaluations (and the next sea
+            # states of the heading, :func:`with_spectra`) when small
+            inp.cache[key] = wm
     vq = attached_velocity(system, prep, inp)
     return wm, None if vq is None else vq[:, :, freq]
 

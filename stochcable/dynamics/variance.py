@@ -12,6 +12,7 @@ structural velocity linear along the element.
 from __future__ import annotations
 
 import math
+import os
 from typing import Any
 
 import numpy as np
@@ -294,6 +295,11 @@ def _element_variance(
     if u_nodes is None and u_free is None:
         return c0
     pr = _proj_rows(system, method)
+    kernel = _compiled_terms()
+    if kernel is not None:  # the same sums in one compiled pass (variance_kernels)
+        var = c0.copy()
+        kernel(pr, u_nodes, u_free, inp.omega, inp.weights, inp.moments if fluid else None, var)
+        return var
     w2 = _w2(inp)
     n_el, k, d = pr.shape
     n_w, n_ch = inp.weights.shape
@@ -319,6 +325,23 @@ def _element_variance(
             mw = np.swapaxes(_projected_moments(pr, inp.moments[..., sl, :]), 1, 2) * w2[cols]
         var += _structural_variance(qx, w2[cols], mw)
     return var
+
+
+def _compiled_terms() -> Any:
+    """:func:`stochcable.dynamics.variance_kernels.element_variance_terms`, or None
+    without numba or with ``STOCHCABLE_NUMBA=0`` (the NumPy blocks then)."""
+    if os.environ.get("STOCHCABLE_NUMBA", "").strip() == "0":
+        return None
+    if not _KERNEL:
+        try:  # numba: imported on first use
+            from stochcable.dynamics.variance_kernels import element_variance_terms
+        except ImportError:
+            element_variance_terms = None
+        _KERNEL.append(element_variance_terms)
+    return _KERNEL[0]
+
+
+_KERNEL: list[Any] = []
 
 
 def _weighted_moments(system: LineSystem, inp: LineInputs, method: str) -> np.ndarray | None:

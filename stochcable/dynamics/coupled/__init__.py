@@ -41,6 +41,7 @@ from stochcable.dynamics.coupled.analysis import (
 from stochcable.dynamics.coupled.fixedpoint import (
     CoupledLinearization,
     linearize_coupled,
+    warm_starts,
 )
 from stochcable.dynamics.coupled.inputs import (
     BodyLoads,
@@ -71,6 +72,7 @@ __all__ = [
     "coupled_results",
     "fairlead_motion",
     "linearize_coupled",
+    "warm_starts",
     "solve_coupled",
     "scene_line_channels",
 ]

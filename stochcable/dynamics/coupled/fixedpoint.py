@@ -16,7 +16,9 @@ fixed point of a frequency subset, corrected by the full/coarse defect
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from typing import Any
 
@@ -46,9 +48,17 @@ from stochcable.dynamics.variance import (
     rest_sigmas,
     sigmas_from_nodes,
 )
-from stochcable.errors import ConvergenceError, InputError, PhysicsWarning, warn
+from stochcable.errors import ConvergenceError, InputError, PhysicsWarning, SolverError, warn
 
-__all__ = ["CoupledLinearization", "linearize_coupled"]
+__all__ = ["CoupledLinearization", "linearize_coupled", "warm_starts"]
+
+#: The store of :func:`warm_starts` open in this context (None: every fixed point
+#: starts at rest).
+_WARM: ContextVar[dict[str, np.ndarray] | None] = ContextVar("warm_starts", default=None)
+#: Converged σ a :func:`warm_starts` store keeps per group, and the weights of the
+#: polynomial extrapolation of 1, 2 and 3 of them (newest first). [-]
+_WARM_ORDER = 3
+_EXTRAPOLATION = (np.array([1.0]), np.array([2.0, -1.0]), np.array([3.0, -3.0, 1.0]))
 
 _HINT = (
     "increase analysis.linearization.max_iterations, lower relaxation, or set "
@@ -85,6 +95,38 @@ class CoupledLinearization:
     relative_change: float
     history: tuple[float, ...]
     tolerance: float
+
+
+@contextmanager
+def warm_starts(store: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]:
+    """Warm starts of the drag fixed points solved inside the block: each group's
+    iteration starts from the σ its last converged fixed points left in ``store``
+    (keyed by the group's lines and bodies: extrapolated from the last three) instead
+    of the rest start, and leaves its own there — sea states
+    solved in order, each from its predecessors' answers
+    (:func:`stochcable.cases.chunk.solve_chunk`).
+
+    The fixed point found is the same within the linearization tolerance (the usual
+    convergence test ends it; not to the bit: the iterates differ).  A warm start
+    that does not converge is dropped for the rest start; a single evaluation
+    (``max_iterations`` 1) always starts at rest.
+
+    Parameters
+    ----------
+    store : dict of str to ndarray
+        The last converged σ vectors per group (newest first), filled and read
+        here. [m/s]
+
+    Yields
+    ------
+    dict
+        ``store``.
+    """
+    token = _WARM.set(store)
+    try:
+        yield store
+    finally:
+        _WARM.reset(token)
 
 
 def linearize_coupled(
@@ -151,7 +193,8 @@ def linearize_coupled(
     -----
     Module docstrings: the substructured solve
     (:mod:`stochcable.dynamics.coupled.group`), the fixed point (seed 001 §5.3 steps
-    5–13 over all lines and bodies).
+    5–13 over all lines and bodies).  Inside :func:`warm_starts` the iteration
+    starts from the group's last converged σ.
     """
     lin = settings.linearization
     method = lin.method
@@ -170,8 +213,6 @@ def linearize_coupled(
         else f"coupled drag linearization of lines {names} and bodies "
         f"{', '.join(b.name for b in g.bodies)}"
     )
-    state: dict[str, Any] = {"it": 0}
-    cache: dict[str, Any] = {}
     fixed = {
         "relaxation": lin.relaxation,
         "method": "anderson" if lin.acceleration == "anderson" else "relaxed",
@@ -181,19 +222,73 @@ def linearize_coupled(
     # subset supplies the start of the full-grid iteration; its history is kept
     if coarse is None:
         coarse = _coarse_pays(g, lin)
-    x_rest, idx, gc = _start(g, method, coarse)
+    run = (method, rho, progress, names, lin, fixed, gname, timing)
+    store = _WARM.get()
+    warm = None if store is None or lin.max_iterations == 1 else _warm_start(store, gname)
+    x_rest, fp = None, None
+    if warm is not None and np.all(np.isfinite(warm)):
+        idx = _warm_subset(g, method, coarse, warm)
+        gc = None
+        if idx is None:  # the subset from the rest start's drag, as without a warm start
+            x_rest, idx, gc = _start(g, method, coarse)
+        if x_rest is None or (warm.shape == x_rest.shape and x_rest.size):
+            try:  # a start that does not converge: the rest start, as without one
+                fp, cache = _iterate(g, warm, idx, gc, run)
+            except (ConvergenceError, SolverError):
+                fp = None
+    if fp is None or not fp.converged:
+        if x_rest is None:
+            x_rest, idx, gc = _start(g, method, coarse)
+        fp, cache = _iterate(g, x_rest, idx, gc, run)
+    if store is not None and fp.converged:  # the newest first
+        hist = store.get(gname)
+        keep = () if hist is None or hist.shape[1] != fp.x.size else tuple(hist)
+        store[gname] = np.array((fp.x, *keep[: _WARM_ORDER - 1]))
+    if not fp.converged:
+        warn(
+            f"{gname} did not converge: relative change {fp.relative_change:.3e} after "
+            f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "
+            "flagged unconverged (increase analysis.linearization.max_iterations)",
+            PhysicsWarning,
+            stacklevel=2,
+        )
+    return _outcome(g, cache, fp, lin.tolerance, method)
+
+
+def _warm_start(store: dict[str, np.ndarray], gname: str) -> np.ndarray | None:
+    """The warm start of group ``gname`` from ``store``: the polynomial extrapolation
+    of its last (up to ``_WARM_ORDER``) converged σ, never negative (neighbouring sea
+    states in order: on the chain example's diagram in runs of 8 cases, 4.9
+    evaluations a case against 5.2 with 2, 5.8 with the last σ alone and 7.6 from
+    rest). [m/s]"""
+    hist = store.get(gname)
+    if hist is None:
+        return None
+    coef = _EXTRAPOLATION[hist.shape[0] - 1]
+    return np.maximum(coef @ hist, 0.0)
+
+
+def _iterate(
+    g: GroupSystem, x_start: np.ndarray, idx: np.ndarray | None, gc: Any, run: tuple
+) -> tuple[FixedPointResult, dict[str, Any]]:
+    """The fixed point from ``x_start`` (the coarse stage on ``idx`` first when not
+    None, on the coarse group ``gc`` when built) and the cache of its last evaluation;
+    ``run`` = (method, rho, progress, names, lin, fixed, gname, timing)."""
+    method, rho, progress, names, lin, fixed, gname, timing = run
+    state: dict[str, Any] = {"it": 0}
+    cache: dict[str, Any] = {}
     stage = None
     if idx is not None:
         stage = CoarseStart(
             g, idx, method, rho, state, progress, names, lin, fixed, gname, group=gc
         )
-        x_coarse = stage.start(x_rest)
+        x_coarse = stage.start(x_start)
         if x_coarse is None:
             stage = None
         else:
-            x_rest = x_coarse
+            x_start = x_coarse
     update = sigma_update(g, method, rho, state, cache, progress, names, timing)
-    x0 = update(x_rest)
+    x0 = update(x_start)
     change0 = state["change"]
     rounds = 0
     if stage is not None:
@@ -207,15 +302,7 @@ def linearize_coupled(
         fp.converged,
         coarse_hist + fp.history,
     )
-    if not fp.converged:
-        warn(
-            f"{gname} did not converge: relative change {fp.relative_change:.3e} after "
-            f"{fp.iterations} iterations (tolerance {lin.tolerance:.1e}); the result is "
-            "flagged unconverged (increase analysis.linearization.max_iterations)",
-            PhysicsWarning,
-            stacklevel=2,
-        )
-    return _outcome(g, cache, fp, lin.tolerance, method)
+    return fp, cache
 
 
 def _coarse_pays(g: GroupSystem, lin: Any) -> bool:
@@ -256,6 +343,20 @@ def _start(
         return _rest_start(g, method), None, None
     x_rest = _rest_start(g, method)
     return x_rest, (coarse_subset(g, x_rest, method) if coarse and x_rest.size else None), None
+
+
+def _warm_subset(g: GroupSystem, method: str, coarse: bool, warm: np.ndarray) -> np.ndarray | None:
+    """The coarse subset of a warm start of a line alone: the narrow features of the
+    warm start's drag (:func:`~stochcable.dynamics.coupled.coarse.coarse_subset`; the
+    at-rest σ are then not needed); None where :func:`_start` decides (bodies, no
+    coarse stage, or none on this drag)."""
+    if not (coarse and not g.bodies and len(g.lines) == 1 and warm.size):
+        return None
+    if g.omega.size < COARSE_MIN_FREQUENCIES:
+        return None
+    full_grid_arrays(g, method)
+    g.sizes = {g.lines[0].name: warm.size}
+    return coarse_subset(g, warm, method)
 
 
 def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
