@@ -20,6 +20,7 @@ the linearization tolerance.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 import traceback
@@ -116,15 +117,21 @@ class ChunkResult:
 
 def prepare_worker() -> None:
     """Settings of a process that runs chunks for the CLI or the service (a Dask
-    worker: ``client.run(prepare_worker)``): :func:`stochcable.runtime.configure`, and
+    worker: ``client.run(prepare_worker)``): :func:`stochcable.runtime.configure`,
     warnings not shown — every case's warnings are recorded in its row, and showing
-    them costs ≈ 7 % of a chunk."""
+    them costs ≈ 7 % of a chunk — and the compiled kernels the cases run loaded (numba
+    and their cached machine code, ≈ 0.5 s once per process, before the first chunk
+    instead of inside it)."""
     import warnings
 
     from stochcable import runtime
+    from stochcable.dynamics.variance import element_variance_kernel
 
     runtime.configure()
     warnings.simplefilter("ignore")
+    element_variance_kernel()
+    with contextlib.suppress(ImportError):  # (no numba: the NumPy paths)
+        import stochcable.line.strumming_kernels  # noqa: F401
 
 
 def case_sea(scene: Scene, state: SeaState, family: Family) -> Sea:

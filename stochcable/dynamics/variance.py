@@ -295,7 +295,7 @@ def _element_variance(
     if u_nodes is None and u_free is None:
         return c0
     pr = _proj_rows(system, method)
-    kernel = _compiled_terms()
+    kernel = element_variance_kernel()
     if kernel is not None:  # the same sums in one compiled pass (variance_kernels)
         var = c0.copy()
         kernel(pr, u_nodes, u_free, inp.omega, inp.weights, inp.moments if fluid else None, var)
@@ -327,7 +327,7 @@ def _element_variance(
     return var
 
 
-def _compiled_terms() -> Any:
+def element_variance_kernel() -> Any:
     """:func:`stochcable.dynamics.variance_kernels.element_variance_terms`, or None
     without numba or with ``STOCHCABLE_NUMBA=0`` (the NumPy blocks then)."""
     if os.environ.get("STOCHCABLE_NUMBA", "").strip() == "0":
