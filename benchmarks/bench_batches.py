@@ -70,7 +70,9 @@ def library(scene, rows) -> dict[str, float]:
             distributed.Client(cluster) as client,
         ):  # fmt: skip
             client.run(prepare_worker)  # as the CLI and the service do
-            run_cases(scene, scatter_from_rows(rows[:4]), fatigue=FATIGUE, executor=client)
+            # warm every worker (its engine, as the serial run's warm-up builds one)
+            warm = scatter_from_rows(rows[: 4 * workers])
+            run_cases(scene, warm, fatigue=FATIGUE, executor=client, chunk_size=1)
             out[f"cluster{workers}"] = _timed(
                 lambda c=client: run_cases(scene, sd, fatigue=FATIGUE, executor=c)
             )
