@@ -47,6 +47,8 @@ __all__ = ["MAX_ELEMENTS", "geometric_residual", "quadratic_output_lines"]
 
 #: Most elements the residual is computed for. [-]
 MAX_ELEMENTS = 400
+#: Memory of the covariance functions held at a time (a block of element pairs). [bytes]
+_BLOCK_BYTES = 64 * 2**20
 
 
 def geometric_residual(system: Any, channels: Any, linearization: Any, std: dict[str, float]):
@@ -145,20 +147,24 @@ def quadratic_output_lines(
     n_el = processes[0].shape[1]
     n_o = transfer.shape[2]
     out = np.zeros((transfer.shape[0], n_o))
+    # the elements f paired with e in blocks: n_p² covariance functions of a block at a time
+    size = max(1, int(_BLOCK_BYTES // (8 * n_fft * (n_p * n_p + 2))))
     for e in range(n_el):
-        r = [[cross_covariance(processes[x][:, e], processes[y], n_fft) for y in range(n_p)]
-             for x in range(n_p)]  # fmt: skip
-        for i, terms_i in enumerate(terms):
-            h_i = np.conj(transfer[:, i * n_el + e])
-            for j, terms_j in enumerate(terms):
-                cov = sum(
-                    ci * cj * (r[x1][x2] * r[y1][y2] + r[x1][y2] * r[y1][x2])
-                    for ci, x1, y1 in terms_i
-                    for cj, x2, y2 in terms_j
-                )
-                cl = covariance_lines(cov, n_o)  # element e's component i, every f's j
-                h_j = transfer[:, j * n_el : (j + 1) * n_el]
-                out += np.real(h_i * np.einsum("opj,pj->oj", h_j, cl))
+        for start in range(0, n_el, size):
+            blk = slice(start, min(start + size, n_el))
+            r = [[cross_covariance(processes[x][:, e], processes[y][:, blk], n_fft)
+                  for y in range(n_p)] for x in range(n_p)]  # fmt: skip
+            for i, terms_i in enumerate(terms):
+                h_i = np.conj(transfer[:, i * n_el + e])
+                for j, terms_j in enumerate(terms):
+                    cov = sum(
+                        ci * cj * (r[x1][x2] * r[y1][y2] + r[x1][y2] * r[y1][x2])
+                        for ci, x1, y1 in terms_i
+                        for cj, x2, y2 in terms_j
+                    )
+                    cl = covariance_lines(cov, n_o)  # e's component i, the block's j
+                    h_j = transfer[:, j * n_el : (j + 1) * n_el][:, blk]
+                    out += np.real(h_i * np.einsum("opj,pj->oj", h_j, cl))
     return out
 
 

@@ -41,7 +41,7 @@ __all__ = [
 
 #: Most lines of the uniform grid the linear quantities are placed on (its step is the
 #: analysis grid's smallest spacing, or ω_max/MAX_LINES if that is finer). [-]
-MAX_LINES = 2048
+MAX_LINES = 1024
 
 
 class UniformGrid:
