@@ -73,6 +73,7 @@ bounds a planned analysis beyond the service's budget.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -108,6 +109,38 @@ SECONDS_PER_SAMPLE_CHANNEL = 1.7e-6
 """Wall time per time-series sample and channel on the calibration machine (k_T). [s]"""
 
 _BODY_TIME_FACTOR = 0.8  # extra time per free body (coupled solves): 3.8 µs vs 2.1 µs
+
+#: The residuals of the linear model (``analysis.linearization.drag_residual`` and
+#: ``.geometric_residual``): their peak memory (bounded by their blocks: the drag's
+#: ≤ 128 components on ≤ 1024 lines, the geometric covariance blocks of 64 MiB and its
+#: transfer functions) and their time per component pair and FFT sample·log₂ — an
+#: analysis of the chain, the inclined guy and the taut wire with both measured 0.53,
+#: 0.65 and 0.16 s against 0.72, 0.79 and 0.18 s estimated (the chain at 160 elements:
+#: 0.90 against 0.80 s); the caps are those of :mod:`stochcable.dynamics.residual_lines`
+#: and the two residual modules.
+_RESIDUAL_BYTES = 256 * 2**20
+_RESIDUAL_LINES, _DRAG_PANELS, _GEOMETRIC_ELEMENTS = 1024, 64, 400
+_DRAG_SECONDS, _GEOMETRIC_SECONDS = 2.0e-9, 3.0e-10
+
+
+def _residual_seconds(scene: Scene) -> float:
+    """Estimated time of the residuals the scene asks for. [s]"""
+    lin = scene.analysis.linearization
+    if not (lin.drag_residual or lin.geometric_residual):
+        return 0.0
+    w = scene.analysis.omega.values()
+    step = float(min(w[1:] - w[:-1])) if w.size > 1 else float(w[0])
+    n_j = min(_RESIDUAL_LINES, max(2, int(w[-1] / max(step, 1e-12)) + 1))
+    out = 0.0
+    for line in scene.lines:
+        n_el = sum(int(s.elements) for s in line.segments)
+        if lin.drag_residual:
+            fft = 2 ** math.ceil(math.log2(10 * n_j + 2))
+            out += _DRAG_SECONDS * (2 * min(n_el, _DRAG_PANELS)) ** 2 * fft * math.log2(fft)
+        if lin.geometric_residual and n_el <= _GEOMETRIC_ELEMENTS:
+            fft = 2 ** math.ceil(math.log2(4 * n_j + 2))
+            out += _GEOMETRIC_SECONDS * 12 * n_el**2 * fft * math.log2(fft)
+    return out
 
 
 @dataclass(frozen=True)
@@ -262,9 +295,12 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
     seconds = (
         SECONDS_PER_NODE_FREQUENCY_CHANNEL * ops_spectral * (1.0 + _BODY_TIME_FACTOR * n_bodies)
         + SECONDS_PER_SAMPLE_CHANNEL * ops_series
+        + _residual_seconds(scene)
     )
+    lin = scene.analysis.linearization
+    residual_bytes = _RESIDUAL_BYTES if lin.drag_residual or lin.geometric_residual else 0
     return CostEstimate(
-        memory_bytes=int(BASE_BYTES + spectral + series),
+        memory_bytes=int(BASE_BYTES + spectral + series + residual_bytes),
         seconds=seconds,
         operations=ops_spectral + ops_series,
         frequencies=n_w,

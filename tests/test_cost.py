@@ -122,3 +122,24 @@ def test_cli_refuses_a_scene_too_large_in_one_sentence(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
     assert "estimated peak memory" in err and "reduce analysis.omega.count" in err
+
+
+def test_residuals_are_in_the_estimate_and_bound_their_peak():
+    """The residuals of the linear model add their time and a bounded memory
+    (≤ 256 MiB: blocked covariance functions) to the estimate, which bounds the measured
+    peak of an analysis with both on the inclined guy at 200 elements (the geometric
+    residual's pairs: 200² elements); the geometric one is not counted above its cap."""
+    doc = _doc("inclined_guy", 200)
+    doc["analysis"].pop("timeseries", None)
+    plain = estimate_cost(doc)
+    doc["analysis"].setdefault("linearization", {}).update(
+        drag_residual=True, geometric_residual=True
+    )
+    est = estimate_cost(doc)
+    assert est.seconds > plain.seconds and est.memory_bytes == plain.memory_bytes + 256 * 2**20
+    assert _measured_peak(doc) <= 1.1 * est.memory_bytes
+    big = _doc("inclined_guy", 1000)
+    big["analysis"].setdefault("linearization", {})["drag_residual"] = True
+    drag_only = estimate_cost(big).seconds
+    big["analysis"]["linearization"]["geometric_residual"] = True
+    assert estimate_cost(big).seconds == drag_only
