@@ -108,6 +108,26 @@ def test_document_conforms_to_the_response_model(chain_answer):
     }
 
 
+def test_residuals_of_the_linear_model_through_http(client):
+    """The chain example with both residuals asked for: the service answers the core's
+    residual records (the closed forms are deterministic: round-off only) and the
+    response model accepts them."""
+    doc = _doc(CHAIN)
+    doc["analysis"].pop("timeseries", None)
+    doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
+    resp = client.post("/v1/analyses", json=doc)
+    assert resp.status_code == 200, resp.text
+    got = resp.json()["lines"]["leg1"]
+    AnalysisResponse.model_validate(resp.json())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        want = analyze(doc).lines["leg1"].to_document()
+    for key in ("drag_residual", "geometric_residual"):
+        assert got[key]["computed"] is True
+        assert_close_documents(got[key], want[key])
+        assert got[key]["end_b"]["ratio"] > 1.0
+
+
 def test_warnings_are_listed_and_counted_in_a_header(chain_answer, client):
     # the seed's slack leg warns of snap loads (and of its coarse mesh)
     loud = client.post("/v1/analyses", json=_doc("tuah_1982_single_leg"))
