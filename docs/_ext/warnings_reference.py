@@ -117,12 +117,17 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Motion large against the sag (indicator ``large_motion``)",
         "PhysicsWarning",
         ("stochcable.dynamics.indicators:_large_motion",),
-        "a node motion σ above MOTION_SAG_FRACTION of the line's sag",
+        "a node motion σ above MOTION_SAG_FRACTION of the line's sag, on a line whose sag "
+        "governs its stiffness (Irvine's λ² of at least MOTION_SAG_LAMBDA2)",
         "The model is linear about the static shape; the geometric stiffness of a "
         "sagging line depends on its sag at first order, so such motions change it by "
-        "more than a linear model tolerates.",
+        "more than a linear model tolerates.  A taut line (small λ²: its stiffness is "
+        "elastic) does not warn, however far its fairlead carries it.",
         "Check with the nonlinear time-domain reference (:mod:`stochcable.reference.cable`).",
-        ("stochcable.dynamics.indicators:MOTION_SAG_FRACTION",),
+        (
+            "stochcable.dynamics.indicators:MOTION_SAG_FRACTION",
+            "stochcable.dynamics.indicators:MOTION_SAG_LAMBDA2",
+        ),
     ),
     WarningEntry(
         "Drag residual large (``analysis.linearization.drag_residual``)",

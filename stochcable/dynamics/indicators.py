@@ -29,6 +29,7 @@ from stochcable.dynamics.loads import (
     Channel,
     element_mean_square,
 )
+from stochcable.dynamics.second_order import irvine_lambda2
 from stochcable.dynamics.system import (
     Damping,
     Linearization,
@@ -258,6 +259,12 @@ RESONANCE_DAMPING_RATIO = 0.01
 BAND_FRACTION = 0.01
 #: Large-motion flag: node motion σ above this fraction of the line's sag.
 MOTION_SAG_FRACTION = 0.1
+#: ... on a line whose sag governs its stiffness: Irvine's λ² at least this.  The
+#: elastic catenary's stiffness is (EA/L)/(1 + λ²/12) (Irvine 1981; seed 000 eq. 4.3):
+#: below λ² = 1 the sag takes less than 8 % of it, so even a 30 % change of sag moves the
+#: stiffness by a few % and a taut line carried by its fairlead stays linear (the taut
+#: rope of docs/accuracy/lines.md: λ² = 0.05, motion 0.47 of its sag, FD = TD to 0.02 %).
+MOTION_SAG_LAMBDA2 = 1.0
 
 
 def _normal_acceleration_sigma(
@@ -345,19 +352,18 @@ def line_indicators(
     (T ≈ wL²/8·1/sag for a shallow catenary), so a motion σ of 10 % of the sag (a
     3σ excursion of 30 %) changes the stiffness by about as much as a linear model
     can tolerate; the sag is the largest distance of the static shape from the
-    chord.  The diameter ratio is reported, not flagged (large motion over D means
-    drag-dominated loading, the domain of the drag linearization).
+    chord.  Only where the sag governs the stiffness: Irvine's λ² ≥ 1
+    (:data:`MOTION_SAG_LAMBDA2`).  The diameter ratio is reported, not flagged (large
+    motion over D means drag-dominated loading, the domain of the drag linearization).
     """
     w = linearization.response.omega
     borgman, d_i = _drag_ratios(system, channels, linearization.record, w)
     snap_margin, snap = _snap(system, tension_std, end_stats)
     resonances = _resonances(system, channels, linearization.damping, w, modes)
     m_max, sag, to_sag, to_d = _large_motion(system, motion_std)
-    flags = (
-        (["snap"] if snap else [])
-        + (["resonance"] if resonances else [])
-        + (["large_motion"] if to_sag > MOTION_SAG_FRACTION else [])
-    )
+    large = to_sag > MOTION_SAG_FRACTION and _sag_governs(system)
+    flags = (["snap"] if snap else []) + (["resonance"] if resonances else [])
+    flags += ["large_motion"] if large else []
     return LineIndicators(
         borgman_ratio=borgman,
         drag_inertia_ratio=d_i,
@@ -499,6 +505,18 @@ def _resonances(
     return resonances
 
 
+def _sag_governs(system: LineSystem) -> bool:
+    """Whether the line's sag governs its stiffness: Irvine's λ² of the static shape at
+    least :data:`MOTION_SAG_LAMBDA2` (once per line)."""
+    if "sag_governs" not in system._cache:
+        mesh = system.model.mesh
+        lam2 = irvine_lambda2(
+            system.model.positions, mesh.l0, mesh.ea, mesh.weight, system.statics.tension
+        )
+        system._cache["sag_governs"] = lam2 >= MOTION_SAG_LAMBDA2
+    return system._cache["sag_governs"]
+
+
 def _large_motion(system: LineSystem, motion_std: np.ndarray) -> tuple[float, float, float, float]:
     """Largest node motion σ [m], the sag of the static shape [m] (largest distance
     from the chord, once per line), and their ratio and the ratio to the diameter
@@ -517,7 +535,7 @@ def _large_motion(system: LineSystem, motion_std: np.ndarray) -> tuple[float, fl
     m_max = float(m_std.max()) if m_std.size else 0.0
     to_sag = m_max / sag if sag > 0 else (np.inf if m_max > 0 else 0.0)
     to_d = m_max / float(np.max(model.mesh.diameter))
-    if to_sag > MOTION_SAG_FRACTION:
+    if to_sag > MOTION_SAG_FRACTION and _sag_governs(system):
         units = unit_labels(system.environment.g)
         j = int(np.argmax(m_std))
         warn(
