@@ -143,3 +143,14 @@ def test_residuals_are_in_the_estimate_and_bound_their_peak():
     drag_only = estimate_cost(big).seconds
     big["analysis"]["linearization"]["geometric_residual"] = True
     assert estimate_cost(big).seconds == drag_only
+
+
+def test_residual_caps_are_the_modules():
+    """The cost model's copies of the residuals' caps (it sits below the dynamics layer)
+    are the caps the residual modules apply."""
+    from stochcable import cost
+    from stochcable.dynamics import drag_residual, geometric_residual, residual_lines
+
+    assert cost._RESIDUAL_LINES == residual_lines.MAX_LINES
+    assert cost._DRAG_PANELS == drag_residual.MAX_PANELS
+    assert cost._GEOMETRIC_ELEMENTS == geometric_residual.MAX_ELEMENTS

@@ -38,7 +38,9 @@ import numpy as np
 from stochcable.dynamics.residual_lines import (
     covariance_lines,
     cross_covariance,
+    element_directions,
     load_transfer,
+    residual_record,
     uniform_grid,
 )
 from stochcable.results.records import ResidualRecord
@@ -51,7 +53,9 @@ MAX_ELEMENTS = 400
 _BLOCK_BYTES = 64 * 2**20
 
 
-def geometric_residual(system: Any, channels: Any, linearization: Any, std: dict[str, float]):
+def geometric_residual(
+    system: Any, channels: Any, linearization: Any, std: dict[str, float]
+) -> ResidualRecord:
     """The end-tension variance of the second-order geometric forces of one line's
     linear response (module notes).
 
@@ -87,7 +91,7 @@ def geometric_residual(system: Any, channels: Any, linearization: Any, std: dict
     pos = np.asarray(system.positions, dtype=float)
     chord = np.diff(pos, axis=0)
     length = np.linalg.norm(chord, axis=1)
-    frames = _frames(system, comps)
+    frames = element_directions(system)
     u = np.zeros((w.size, model.n_nodes, 3, n_ch), dtype=complex)
     u[:, :, comps] = resp.displacement.reshape(w.size, model.n_nodes, d, n_ch)
     du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, 3, n_ch)
@@ -110,10 +114,7 @@ def geometric_residual(system: Any, channels: Any, linearization: Any, std: dict
     h = load_transfer(system, linearization.damping, unit, w_out)  # (2, n_comp·n_el, n_o)
     n_fft = int(2 ** math.ceil(math.log2(4 * grid.n_j + 2)))
     lines = quadratic_output_lines(proc, comp_terms, h, n_fft)
-    keep = (w_out >= w[0] * (1 - 1e-9)) & (w_out <= w[-1] * (1 + 1e-9))
-    variance = {end: float(lines[k].sum()) for k, end in enumerate(("end_a", "end_b"))}
-    in_band = {end: float(lines[k][keep].sum()) for k, end in enumerate(("end_a", "end_b"))}
-    return ResidualRecord.from_variances(variance, in_band, std, 2, n_el)
+    return residual_record(lines, w_out, w, std, 2, n_el)
 
 
 def quadratic_output_lines(
@@ -166,15 +167,3 @@ def quadratic_output_lines(
                     h_j = transfer[:, j * n_el : (j + 1) * n_el][:, blk]
                     out += np.real(h_i * np.einsum("opj,pj->oj", h_j, cl))
     return out
-
-
-def _frames(system: Any, comps: list[int]) -> list[np.ndarray]:
-    """The element tangent and the normals the model moves along: (t, n) in the plane
-    of a planar model, (t, n₁, n₂) in 3-D; each (n_el, 3)."""
-    t, n1, n2 = system.frames
-    if len(comps) == 3:
-        return [t, n1, n2]
-    plane = np.zeros(3)
-    plane[[i for i in range(3) if i not in comps][0]] = 1.0
-    normal = np.cross(plane, t)
-    return [t, normal / np.linalg.norm(normal, axis=1)[:, None]]

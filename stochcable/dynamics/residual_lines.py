@@ -29,13 +29,16 @@ from stochcable.dynamics.freqblocks import frequency_slices
 from stochcable.dynamics.line_loads import drag_blocks
 from stochcable.dynamics.solve import end_tension_from_support, reactions
 from stochcable.dynamics.solvers import solve_band_stacked
+from stochcable.results.records import ResidualRecord
 
 __all__ = [
     "MAX_LINES",
     "UniformGrid",
     "covariance_lines",
     "cross_covariance",
+    "element_directions",
     "load_transfer",
+    "residual_record",
     "uniform_grid",
 ]
 
@@ -124,3 +127,34 @@ def load_transfer(system: Any, damping: Any, unit: np.ndarray, w: np.ndarray) ->
         tension = end_tension_from_support(system, reactions(system, prep, c, u, load, w[sl]))
         out[0, :, sl], out[1, :, sl] = tension["end_a"], tension["end_b"]
     return out
+
+
+def element_directions(system: Any) -> list[np.ndarray]:
+    """The element tangent and the normals the line's model moves along, each (n_el, 3):
+    (t, n) with n the normal in the plane of a planar model (t × the out-of-plane
+    axis), (t, n₁, n₂) in 3-D."""
+    t, n1, n2 = system.frames
+    comps = list(system.model.components)
+    if len(comps) == 3:
+        return [t, n1, n2]
+    plane = np.zeros(3)
+    plane[[i for i in range(3) if i not in comps][0]] = 1.0
+    normal = np.cross(plane, t)
+    return [t, normal / np.linalg.norm(normal, axis=1)[:, None]]
+
+
+def residual_record(
+    lines: np.ndarray,
+    w_out: np.ndarray,
+    w: np.ndarray,
+    std: dict[str, float],
+    order: int,
+    panels: int,
+) -> ResidualRecord:
+    """The record of the end tensions' variance lines ``lines`` (end_a, end_b) at
+    ``w_out``: their sums, and the sums over the analysis band [w[0], w[-1]]."""
+    keep = (w_out >= w[0] * (1 - 1e-9)) & (w_out <= w[-1] * (1 + 1e-9))
+    ends = ("end_a", "end_b")
+    variance = {end: float(lines[k].sum()) for k, end in enumerate(ends)}
+    in_band = {end: float(lines[k][keep].sum()) for k, end in enumerate(ends)}
+    return ResidualRecord.from_variances(variance, in_band, std, order, panels)
