@@ -379,7 +379,7 @@ class BatchService:
             return
         shared: Any = plan.template
         if not isinstance(ex, cf.ProcessPoolExecutor):
-            shared = ex.scatter(plan.template, broadcast=True)
+            shared = ex.scatter(plan.template, broadcast=True, hash=False)
         window = 2 * self._workers()
         pending: dict[Any, int] = {}
         attempts: dict[int, int] = {}

@@ -190,7 +190,7 @@ def _run_chunks(plan: CasePlan, engine: Engine | None, executor: Any):
     if hasattr(executor, "scatter") and hasattr(executor, "gather"):  # dask client
         from distributed import as_completed as dask_completed
 
-        shared = executor.scatter(plan.template, broadcast=True)
+        shared = executor.scatter(plan.template, broadcast=True, hash=False)
         futures = [executor.submit(solve_chunk, shared, family, part, settings, None, lead,
                                    pure=False)
                    for part, lead in zip(plan.chunks, plan.leads)]  # fmt: skip
