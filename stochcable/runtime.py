@@ -17,11 +17,13 @@ What :func:`configure` does (each switch can be turned off):
   linear algebra is small (eigenproblems, LU and products of at most a few hundred
   rows, per line); multi-threaded OpenBLAS makes such calls slower even on a quiet
   machine and 5–10× slower when the cores are busy (docs/BENCHMARKS.md).
-- ``allocator``: glibc's heap top pad (``mallopt(M_TOP_PAD)``) is set to
-  :data:`MALLOC_TOP_PAD` so that the freed temporaries of one drag iteration stay mapped
-  for the next instead of being zero-filled again by the kernel (page faults were a
-  third of the chain analysis).  Linux/glibc only; ``STOCHCABLE_MALLOC_TUNING=0`` or an
-  explicit ``MALLOC_TOP_PAD_`` leave the allocator alone.
+- ``allocator``: glibc's heap top pad and mmap threshold (``mallopt``) are set to
+  :data:`MALLOC_TOP_PAD` and :data:`MALLOC_MMAP_THRESHOLD` so that the freed temporaries
+  of one drag iteration stay mapped for the next instead of being zero-filled again by
+  the kernel (page faults were a third of the chain analysis; in a Dask worker, whose
+  nanny sets ``MALLOC_TRIM_THRESHOLD_``, ≈ 400 faults a case and 10–30 % of its time).
+  Linux/glibc only; ``STOCHCABLE_MALLOC_TUNING=0`` leaves the allocator alone, an
+  explicit ``MALLOC_TOP_PAD_`` or ``MALLOC_MMAP_THRESHOLD_`` that setting.
 - ``omp_wait_policy``: ``OMP_WAIT_POLICY=PASSIVE`` unless the environment chose one.
   pyfftw's FFTW threads run through OpenMP (libgomp); with the default policy the worker
   thread spins after every parallel transform and takes the second core from the
@@ -105,6 +107,7 @@ __all__ = [
     "thread_count",
     "SMALL_MODEL_DOF",
     "MALLOC_TOP_PAD",
+    "MALLOC_MMAP_THRESHOLD",
 ]
 
 _settings = {"small_model_blas": False, "configured": False}
@@ -120,7 +123,8 @@ def configure(
     small_model_blas : bool
         Run analyses of small models (:data:`SMALL_MODEL_DOF`) with one BLAS thread.
     allocator : bool
-        Keep :data:`MALLOC_TOP_PAD` bytes of freed heap mapped (glibc only).
+        Keep freed temporaries mapped: :data:`MALLOC_TOP_PAD` and
+        :data:`MALLOC_MMAP_THRESHOLD` (glibc only).
     omp_wait_policy : bool
         Set ``OMP_WAIT_POLICY=PASSIVE`` unless the environment has a policy.
 
@@ -268,10 +272,22 @@ def single_blas_thread(active: bool = True) -> Iterator[None]:
 # ``MALLOC_TOP_PAD`` keeps that much freed memory mapped instead (process-wide, set once
 # by :func:`configure`; glibc only; the environment variable ``STOCHCABLE_MALLOC_TUNING=0``
 # or an explicit ``MALLOC_TOP_PAD_`` leaves the allocator alone).
+#
+# Blocks above the mmap threshold bypass the heap: mapped on allocation, unmapped on
+# free, faulted in again every time.  glibc raises the threshold as such blocks are
+# freed — unless any malloc parameter was set, by ``mallopt`` (the top pad above) or by
+# the environment (a Dask nanny starts its workers with ``MALLOC_TRIM_THRESHOLD_``):
+# then it stays wherever it was, 128 KiB in a fresh worker, and a chain case cost ≈ 400
+# page faults and 10–30 % more time in a Dask worker than in the main process.  So it is
+# set explicitly, to glibc's own ceiling of the dynamic threshold on 64-bit systems.
 
 #: Heap top pad set by :func:`_tune_allocator`. [bytes]
 MALLOC_TOP_PAD = 32 * 1024 * 1024
-_M_TOP_PAD = -2  # mallopt parameter number (glibc malloc.h)
+#: mmap threshold set by :func:`_tune_allocator` (glibc's DEFAULT_MMAP_THRESHOLD_MAX on
+#: 64-bit systems, the largest value ``mallopt`` accepts). [bytes]
+MALLOC_MMAP_THRESHOLD = 32 * 1024 * 1024
+_M_TOP_PAD = -2  # mallopt parameter numbers (glibc malloc.h)
+_M_MMAP_THRESHOLD = -3
 _allocator_state = {"done": False}
 
 
@@ -282,17 +298,18 @@ def _tune_allocator() -> None:
     _allocator_state["done"] = True
     import sys
 
-    if (
-        not sys.platform.startswith("linux")
-        or os.environ.get("STOCHCABLE_MALLOC_TUNING", "1") == "0"
-        or "MALLOC_TOP_PAD_" in os.environ
-    ):
+    if not sys.platform.startswith("linux") or os.environ.get("STOCHCABLE_MALLOC_TUNING") == "0":
         return
     try:
         import ctypes
 
         libc = ctypes.CDLL("libc.so.6")
-        libc.mallopt(ctypes.c_int(_M_TOP_PAD), ctypes.c_int(MALLOC_TOP_PAD))
+        for env, param, value in (
+            ("MALLOC_TOP_PAD_", _M_TOP_PAD, MALLOC_TOP_PAD),
+            ("MALLOC_MMAP_THRESHOLD_", _M_MMAP_THRESHOLD, MALLOC_MMAP_THRESHOLD),
+        ):
+            if env not in os.environ:
+                libc.mallopt(ctypes.c_int(param), ctypes.c_int(value))
     except (OSError, AttributeError):  # not glibc (musl, ...): leave malloc alone
         pass
 
