@@ -259,3 +259,26 @@ def test_configured_worker_keeps_its_temporaries_mapped_under_a_dask_nanny():
     )  # fmt: skip
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout) < 35
+
+
+_SPECTRA_ONLY = """
+import json, sys, warnings
+warnings.simplefilter("ignore")
+import stochcable
+from stochcable.examples import load_example
+d = load_example("chain_catenary").model_dump(mode="json", exclude_none=True)
+d["analysis"].pop("timeseries", None)
+stochcable.analyze(d)
+print(json.dumps([m for m in ("pyfftw", "dask.array", "xarray") if m in sys.modules]))
+"""
+
+
+def test_an_analysis_without_records_loads_no_fft_library():
+    # pyfftw imports dask.array, xarray and pandas whenever dask is installed (≈ 0.7 s
+    # of every command's and batch worker's start); an analysis that synthesizes no
+    # record needs none of them (stochcable.sea.fft imports pyfftw on first use)
+    out = subprocess.run(
+        [sys.executable, "-c", _SPECTRA_ONLY], capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout) == []

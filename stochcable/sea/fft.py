@@ -23,19 +23,32 @@ from __future__ import annotations
 import os
 import threading
 from collections import OrderedDict
+from typing import Any
 
 import numpy as np
 
 from stochcable import validation as v
 from stochcable.errors import InputError
 
-# pyfftw's FFTW runs its threads through OpenMP (libgomp): its wait policy is set by
-# stochcable.runtime.configure() (the CLI and the service), not on import.
+# pyfftw is imported on first use, not with this module: it imports dask.array (and
+# with it xarray and pandas) whenever dask is installed, ≈ 0.7 s of every command's and
+# worker's start that an analysis without time series never needs.  Its FFTW threads run
+# through OpenMP (libgomp), whose wait policy stochcable.runtime.configure() sets.
+_UNLOADED: Any = object()
+_pyfftw: Any = _UNLOADED  # the module, None without pyfftw (tests patch None in)
 
-try:  # pragma: no cover - exercised through monkeypatching in tests
-    import pyfftw as _pyfftw
-except ImportError:  # pragma: no cover
-    _pyfftw = None
+
+def _lib() -> Any:
+    """pyfftw, imported on the first call (None when it is not installed)."""
+    global _pyfftw
+    if _pyfftw is _UNLOADED:
+        try:
+            import pyfftw
+        except ImportError:  # pragma: no cover
+            pyfftw = None
+        _pyfftw = pyfftw
+    return _pyfftw
+
 
 __all__ = [
     "rfft",
@@ -88,7 +101,7 @@ def _load_wisdom() -> None:
     except OSError:
         return
     if data:
-        _pyfftw.import_wisdom((data, b"", b""))  # FFTW ignores what it cannot parse
+        _lib().import_wisdom((data, b"", b""))  # FFTW ignores what it cannot parse
 
 
 def _save_wisdom() -> str | None:
@@ -99,14 +112,14 @@ def _save_wisdom() -> str | None:
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     tmp = f"{path}.{os.getpid()}.{threading.get_ident()}.tmp"
     with open(tmp, "wb") as f:
-        f.write(_pyfftw.export_wisdom()[0])
+        f.write(_lib().export_wisdom()[0])
     os.replace(tmp, path)  # readers never see a partial file
     return path
 
 
 def backend() -> str:
     """Name of the FFT backend in use: ``"pyfftw"`` or ``"numpy"``."""
-    return "numpy" if _pyfftw is None else "pyfftw"
+    return "numpy" if _lib() is None else "pyfftw"
 
 
 def clear_cache() -> None:
@@ -129,10 +142,10 @@ class _Plan:
         else:
             in_dtype, out_dtype = "float64", "complex128"
             out_shape = in_shape[:-1] + (n // 2 + 1,)
-        self.inp = _pyfftw.empty_aligned(in_shape, dtype=in_dtype)
-        out = _pyfftw.empty_aligned(out_shape, dtype=out_dtype)
+        self.inp = _lib().empty_aligned(in_shape, dtype=in_dtype)
+        out = _lib().empty_aligned(out_shape, dtype=out_dtype)
         threads = (os.cpu_count() or 1) if n >= _THREAD_MIN_SIZE else 1
-        self.fftw = _pyfftw.FFTW(
+        self.fftw = _lib().FFTW(
             self.inp,
             out,
             axes=(len(in_shape) - 1,),
@@ -147,14 +160,14 @@ class _Plan:
 
     def run(self, inp: np.ndarray) -> np.ndarray:
         """Transform a caller-owned aligned input (destroyed) into a new output array."""
-        out = _pyfftw.empty_aligned(self.out_shape, dtype=self.out_dtype)
+        out = _lib().empty_aligned(self.out_shape, dtype=self.out_dtype)
         with self.lock:
             self.fftw.update_arrays(inp, out)
             self.fftw.execute()
         return out
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
-        out = _pyfftw.empty_aligned(self.out_shape, dtype=self.out_dtype)
+        out = _lib().empty_aligned(self.out_shape, dtype=self.out_dtype)
         with self.lock:
             np.copyto(self.inp, x, casting="unsafe")
             self.fftw.update_arrays(self.inp, out)
@@ -211,7 +224,7 @@ def tune(n_samples: int | list[int], effort: str = "FFTW_MEASURE") -> str | None
         raise InputError(
             "effort", effort, "-", "must be 'FFTW_MEASURE', 'FFTW_PATIENT' or 'FFTW_EXHAUSTIVE'"
         )
-    if _pyfftw is None:
+    if _lib() is None:
         return None
     with _cache_lock:
         _load_wisdom()
@@ -242,7 +255,7 @@ def irfft(x: np.ndarray, n: int, axis: int = -1) -> np.ndarray:
         float64 array, ``x[k]`` → ``(1/n) Σ_k X_k e^{2πi k j/n}`` (numpy convention). [unit]
     """
     x = np.asarray(x)
-    if _pyfftw is None:
+    if _lib() is None:
         return np.fft.irfft(x, n, axis=axis)
     if x.shape[axis] != n // 2 + 1:
         return np.fft.irfft(x, n, axis=axis)  # padding/truncation: rare, let numpy do it
@@ -256,9 +269,9 @@ def irfft_input(n: int) -> np.ndarray:
 
     SIMD-aligned as the FFTW plans require (a plain array with the numpy backend).
     """
-    if _pyfftw is None:
+    if _lib() is None:
         return np.empty(n // 2 + 1, dtype=np.complex128)
-    return _pyfftw.empty_aligned(n // 2 + 1, dtype="complex128")
+    return _lib().empty_aligned(n // 2 + 1, dtype="complex128")
 
 
 def irfft_overwrite(x: np.ndarray, n: int) -> np.ndarray:
@@ -285,7 +298,7 @@ def irfft_overwrite(x: np.ndarray, n: int) -> np.ndarray:
     on the caller's array was tried: 1–3 ms slower for 2^20 points than this
     input-destroying plan plus the fused copy.
     """
-    if _pyfftw is None:
+    if _lib() is None:
         return np.fft.irfft(x, n, norm="forward")
     return _plan(x.shape, int(n), True).run(x)
 
@@ -306,7 +319,7 @@ def rfft(x: np.ndarray, axis: int = -1) -> np.ndarray:
         complex128 half-spectrum with ``n // 2 + 1`` entries along ``axis``. [unit]
     """
     x = np.asarray(x)
-    if _pyfftw is None or np.iscomplexobj(x):
+    if _lib() is None or np.iscomplexobj(x):
         return np.fft.rfft(x, axis=axis)
     xm = np.moveaxis(x, axis, -1)
     out = _plan(xm.shape, xm.shape[-1], False)(xm)
