@@ -71,7 +71,8 @@ CALIBRATION: dict[str, Calibration] = {
         source="docs/benchmarks/fd_budget.md: the nonlinear TD σ +5.1 ± 2.0 % / "
         "+8.3 ± 2.8 % above the FD (fairlead / anchor; 160 elements in both, 5 seeds, "
         "whole DSA periods; mostly the quadratic drag the Borgman linearization drops); "
-        "docs/benchmarks/moordyn.md: the deep catenary −3.6 % / −4.3 % at 80 elements",
+        "docs/accuracy/lines.md: the deep catenary −2.4 ± 1.1 % / −3.3 ± 0.9 % (FD and TD "
+        "on the same 160-element line)",
     ),
     "suspended": Calibration(
         fairlead=0.0002,
