@@ -65,3 +65,26 @@ def test_default_chunk_size():
     assert default_chunk_size(200, 2) == 32  # about four chunks per worker (25) ...
     assert default_chunk_size(40, 2) == 16  # ... whole warm-start runs (16 cases)
     assert default_chunk_size(1, 8) == 1
+
+
+def test_a_set_drops_the_residuals_and_says_so():
+    # the set's statistics and damage are the linear model's: a scene that asks for the
+    # closed-form residuals gets the same numbers, bit for bit, as one that does not,
+    # without their cost in every case, and a PhysicsWarning naming the settings
+    from stochcable.errors import PhysicsWarning
+
+    doc = SCENE.model_dump(mode="json", exclude_unset=True)
+    doc["analysis"].setdefault("linearization", {}).update(
+        drag_residual=True, geometric_residual=True
+    )
+    rows = [{"hs": 2, "tp": 8, "probability": 0.5}, {"hs": 3, "tp": 9, "probability": 0.5}]
+    small = scatter_from_rows(rows)
+    named = r"drag_residual, analysis\.linearization\.geometric_residual is not applied"
+    with pytest.warns(PhysicsWarning, match=named):
+        plan = plan_cases(doc, small)
+        asked = run_cases(doc, small)
+    lin = plan.template.analysis.linearization
+    assert not lin.drag_residual and not lin.geometric_residual
+    plain = run_cases(SCENE, small)
+    for e in ("end_a", "end_b"):
+        np.testing.assert_array_equal(asked.stats["leg1"][e], plain.stats["leg1"][e])

@@ -142,6 +142,19 @@ WARNINGS: tuple[WarningEntry, ...] = (
         ("stochcable.dynamics.drag_residual:RESIDUAL_WARN_RATIO",),
     ),
     WarningEntry(
+        "Residuals not applied to a load-case set",
+        "PhysicsWarning",
+        ("stochcable.cases.plan:plan_cases",),
+        "the set's scene sets ``analysis.linearization.drag_residual`` or ``geometric_residual``",
+        "A load-case set's statistics, extremes and damage come from the linear model's "
+        "response spectra; the closed-form residuals are variances beside them, not "
+        "spectra, and would cost 10–100 cases' time in every case, so the set does not "
+        "compute them.",
+        "Run ``analyze()`` with the residuals on the governing cases of the set (its "
+        "``governing_mpm_case``) and carry the σ ratio they report as a margin on the "
+        "set's extremes.",
+    ),
+    WarningEntry(
         "Second-order stretching tension large (indicator ``second_order``)",
         "PhysicsWarning",
         ("stochcable.dynamics.second_order:with_second_order",),

@@ -49,6 +49,7 @@ __all__ = [
     "ENDS",
     "WARM_RUN",
     "run_lead",
+    "SET_DROPS_RESIDUALS",
 ]
 
 ENDS = ("end_a", "end_b")
@@ -141,11 +142,21 @@ def case_sea(scene: Scene, state: SeaState, family: Family) -> Sea:
     return Sea(spectrum=state.spectrum(family), heading=state.heading, spreading=spreading)
 
 
+#: Settings of a scene's analysis that a load-case set does not apply (the set's
+#: statistics and damage are the linear model's). [-]
+SET_DROPS_RESIDUALS = ("drag_residual", "geometric_residual")
+
+
 def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) -> Scene:
-    """The scene a set's engine is built from: no time series, and the sea of an
-    out-of-plane state when there is one (the models are then 3-D, and in-plane states
-    are solved by them exactly as by 2-D models)."""
-    upd: dict[str, Any] = {"analysis": scene.analysis.model_copy(update={"timeseries": None})}
+    """The scene a set's engine is built from: no time series, no closed-form residuals
+    (:data:`SET_DROPS_RESIDUALS`: a set's statistics and damage come from the linear
+    response spectra, and a residual costs 10–100 cases' time in every case), and the
+    sea of an out-of-plane state when there is one (the models are then 3-D, and in-plane
+    states are solved by them exactly as by 2-D models)."""
+    lin = scene.analysis.linearization.model_copy(update=dict.fromkeys(SET_DROPS_RESIDUALS, False))
+    upd: dict[str, Any] = {
+        "analysis": scene.analysis.model_copy(update={"timeseries": None, "linearization": lin})
+    }
     for state in states:
         if abs(math.sin(math.radians(state.heading))) > 1e-9:
             upd["sea"] = case_sea(scene, state, family)
