@@ -67,6 +67,10 @@ _CANDIDATES = 3
 #: Least share of a mode's modal mass that moves across the flow on shedding elements
 #: for it to be a candidate (an in-line or axial mode is not excited by the lift). [-]
 _MIN_SHARE = 0.05
+#: A mode's modal lift below this fraction of the sum of its magnitudes is zero by
+#: symmetry (what is left is round-off: 1e-16 of the terms, whose digits differ
+#: between BLAS paths). [-]
+_CANCELLATION = 1e-12
 
 
 @dataclass(frozen=True, eq=False)
@@ -430,7 +434,10 @@ def _screen_mode(line, k, w_n, vr, wk, psi, shape, q, d, m_t, omega_s, t, stiff,
     if res.locked:
         amp, omega, bound = res.amplitude, res.omega, 1.0
     else:
-        f = abs(np.sum(q * psi * lift0))
+        terms = q * psi * lift0
+        f = abs(np.sum(terms))
+        if f <= _CANCELLATION * np.sum(np.abs(terms)):
+            f = 0.0  # zero by symmetry (an antisymmetric mode in a uniform lift)
         amp = f / abs(w_n**2 - ws_mode**2 + 2j * xi * w_n * ws_mode)
         omega, bound = ws_mode, 2.0
         if abs(ws_mode - w_n) <= 2.0 * xi * w_n:
