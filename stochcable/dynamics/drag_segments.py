@@ -69,6 +69,10 @@ class Segments:
         Its unstretched length. [m]
     fine : ndarray of bool, shape (n_s,)
         Part of a split element (evaluated alone, never grouped into a panel).
+    ends : ndarray, shape (n_s, 2), optional
+        Wave-velocity variance at the ends of its element's wet part, where it matters
+        for the grouping (drag scale above :data:`WEIGHT_FLOOR` of the line's largest;
+        NaN elsewhere and without wave kinematics). [m²/s²]
     """
 
     element: np.ndarray
@@ -76,6 +80,7 @@ class Segments:
     hi: np.ndarray
     length: np.ndarray
     fine: np.ndarray
+    ends: np.ndarray | None = None
 
     @property
     def xi(self) -> np.ndarray:
@@ -120,6 +125,7 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
     n_el = system.model.n_elements
     parts = np.ones(n_el, dtype=int)
     kin = _kinematic_channels(channels)
+    ends_el = np.full((n_el, 2), np.nan)
     if kin:
         ends = np.zeros((n_el, 2))
         for ch in kin:
@@ -132,6 +138,7 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
             ratio = np.where(lo > 0, hi / np.where(lo > 0, lo, 1.0), np.inf)
         want = np.ceil(np.log(np.minimum(ratio, 1e300)) / math.log(SUB_RATIO))
         parts = np.where(live, np.clip(want, 1, MAX_SUB), 1).astype(int)
+        ends_el[live] = ends[live]
         budget = max_panels // 2
         while parts[parts > 1].sum() > budget:
             parts[int(np.argmax(parts))] -= 1
@@ -144,13 +151,21 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
         hi=(k + 1) / m,
         length=mesh.l0[element] / m,
         fine=parts[element] > 1,
+        ends=ends_el[element],
     )
 
 
+#: Variance ratios a group of whole elements may span, tried in turn (the finest whose
+#: panels fit in the budget wins): the reason to split an element holds for a group. [-]
+GROUP_RATIOS = (1.05, 1.1, 1.25, 1.5, 2.0, 4.0, 16.0, math.inf)
+
+
 def panel_groups(seg: Segments, max_panels: int) -> list[np.ndarray]:
-    """Pieces grouped into panels: every split element's pieces alone, the runs of
-    whole elements between them in consecutive groups of equal size (⌈n/max_panels⌉
-    for a line without splits)."""
+    """Pieces grouped into panels: every split element's pieces alone; the runs of
+    whole elements between them in consecutive groups, closed where the group's
+    wave-velocity variance would vary by more than a ratio of :data:`GROUP_RATIOS` (the
+    finest that fits in ``max_panels``) or where it reaches a length (the least that
+    fits; ⌈n/max_panels⌉ for a line without wave kinematics, as equal groups)."""
     runs: list[np.ndarray] = []
     start = None
     for i in range(seg.size + 1):
@@ -163,11 +178,45 @@ def panel_groups(seg: Segments, max_panels: int) -> list[np.ndarray]:
     n_fine = int(seg.fine.sum())
     n_coarse = seg.size - n_fine
     room = max(1, max_panels - n_fine - (len(runs) - 1 if runs else 0))
+    ends = np.full((seg.size, 2), np.nan) if seg.ends is None else seg.ends
+    fine = [np.array([i]) for i in np.flatnonzero(seg.fine)]
+    budget = max_panels - n_fine
     size = max(1, math.ceil(n_coarse / room))
-    groups = [np.array([i]) for i in np.flatnonzero(seg.fine)]
-    for run in runs:
-        groups += [run[i : i + size] for i in range(0, run.size, size)]
-    return sorted(groups, key=lambda g: int(g[0]))
+    for ratio in GROUP_RATIOS:
+        if ratio < math.inf and len(_grouped_all(runs, max(n_coarse, 1), ends, ratio)) > budget:
+            continue  # the ratio alone needs more panels than there are
+        lo, hi = size, max(size, n_coarse)  # the count falls as the length grows: bisect
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if len(_grouped_all(runs, mid, ends, ratio)) <= budget:
+                hi = mid
+            else:
+                lo = mid + 1
+        return sorted(fine + _grouped_all(runs, lo, ends, ratio), key=lambda g: int(g[0]))
+    raise AssertionError("unreachable: GROUP_RATIOS ends with inf")
+
+
+def _grouped_all(runs: list[np.ndarray], size: int, ends: np.ndarray, ratio: float) -> list:
+    """The groups of every run (:func:`_grouped`)."""
+    return [g for run in runs for g in _grouped(run, size, ends, ratio)]
+
+
+def _grouped(run: np.ndarray, size: int, ends: np.ndarray, ratio: float) -> list[np.ndarray]:
+    """Consecutive groups of ``run`` of at most ``size``, closed where the variance
+    ``ends`` (NaN: no matter) would span more than ``ratio``."""
+    out, cur, lo, hi = [], [], math.inf, 0.0
+    for i in run:
+        v = ends[i][np.isfinite(ends[i])]
+        lo_i, hi_i = (min(lo, float(v.min())), max(hi, float(v.max()))) if v.size else (lo, hi)
+        if cur and (len(cur) == size or (hi_i > 0 and hi_i > ratio * lo_i)):
+            out.append(np.array(cur))
+            cur, lo, hi = [], math.inf, 0.0
+            lo_i, hi_i = (float(v.min()), float(v.max())) if v.size else (lo, hi)
+        cur.append(int(i))
+        lo, hi = lo_i, hi_i
+    if cur:
+        out.append(np.array(cur))
+    return out
 
 
 def segment_velocity(
