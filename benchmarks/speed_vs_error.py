@@ -904,6 +904,9 @@ SCENE_NOTES = {
         "tension variance above 2 rad/s falls from 2.2e4 to 2.5e3 to 77 N² at 40/80/160 "
         "elements and the 1–2 rad/s band changes by ×5. Elements in the splash zone should "
         "be shorter than about g/ω_max²; the example's 40 elements are far too coarse."
+        " With the closed-form drag residual (analysis.linearization.drag_residual, which "
+        "splits the top elements) (FD + residuals) / TD is 0.994 ± 0.037 at the fairlead "
+        "on the example's mesh (docs/benchmarks/drag_residual.md)."
     ),
     "tuah_1982_single_leg": (
         "The buoy is not modelled (no bodies yet): end_b heaves with the sea surface (RAO "

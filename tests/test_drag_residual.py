@@ -154,18 +154,23 @@ def test_only_when_asked_and_out_of_scope_says_why():
     assert leg.to_document()["drag_residual"]["computed"] is False
 
 
-def test_large_correction_warns():
-    """The inclined guy in its sea: the residual raises the fairlead σ by ≈ 38 %, above
-    RESIDUAL_WARN_RATIO, and a PhysicsWarning says the correction overestimates there
-    (the time domain reads +19 %, docs/benchmarks/drag_residual.md); the chain's
-    +4 / +7 % does not warn."""
+def test_large_correction_warns(monkeypatch):
+    """A PhysicsWarning where the correction is beyond RESIDUAL_WARN_RATIO, the largest
+    checked against the time domain: the inclined guy's +18 % does not warn at the
+    default ×1.25 and does with the threshold lowered to ×1.1; the chain's +4 / +7 %
+    does not."""
     from stochcable.errors import PhysicsWarning
 
     doc = load_example("inclined_guy").model_dump(mode="json")
     doc["analysis"]["linearization"]["drag_residual"] = True
-    with pytest.warns(PhysicsWarning, match=r"drag residual raises the end_b tension σ by 3\d%"):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         res = analyze(doc).lines["guy"].drag_residual
-    assert res.ratio("end_b") > dr.RESIDUAL_WARN_RATIO
+    assert 1.1 < res.ratio("end_b") < dr.RESIDUAL_WARN_RATIO
+    assert not any("drag residual" in str(w.message) for w in caught)
+    monkeypatch.setattr(dr, "RESIDUAL_WARN_RATIO", 1.1)
+    with pytest.warns(PhysicsWarning, match=r"drag residual changes the end_b tension σ by \+1\d%"):
+        analyze(doc)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         analyze(chain_surge_doc(20))

@@ -152,6 +152,10 @@ class Channel:
         ``nodal() -> (velocity, acceleration)``: computes the nodal kinematics on first
         access of ``velocity`` or ``acceleration`` when both were left None (the sea
         channel of :func:`line_channels`); None: the fields are as given.
+    heading : float or None
+        Wave heading β of a sea channel with element kinematics (the drag residual
+        integrates them over parts of elements,
+        :mod:`stochcable.dynamics.drag_segments`); None otherwise. [rad]
     """
 
     name: str
@@ -167,6 +171,7 @@ class Channel:
     element_velocity_square: np.ndarray | None = None
     element_end_square: np.ndarray | None = None
     nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
+    heading: float | None = None
 
 
 def line_channels(
@@ -239,6 +244,7 @@ def line_channels(
                     element_velocity_square=el.velocity_square,
                     element_end_square=el.end_square,
                     nodal=_sea_nodal(el, env.g),
+                    heading=float(heading),
                 )
             )
     for end in ("end_a", "end_b"):

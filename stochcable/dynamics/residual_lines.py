@@ -150,11 +150,15 @@ def residual_record(
     std: dict[str, float],
     order: int,
     panels: int,
+    linear: dict[str, float] | None = None,
 ) -> ResidualRecord:
     """The record of the end tensions' variance lines ``lines`` (end_a, end_b) at
-    ``w_out``: their sums, and the sums over the analysis band [w[0], w[-1]]."""
+    ``w_out``: their sums, and the sums over the analysis band [w[0], w[-1]]; plus
+    ``linear`` (a variance change on the analysis grid itself, e.g. of a load
+    correlated with the linear response; it may be negative). [N²]"""
     keep = (w_out >= w[0] * (1 - 1e-9)) & (w_out <= w[-1] * (1 + 1e-9))
     ends = ("end_a", "end_b")
-    variance = {end: float(lines[k].sum()) for k, end in enumerate(ends)}
-    in_band = {end: float(lines[k][keep].sum()) for k, end in enumerate(ends)}
+    extra = linear or {}
+    variance = {end: float(lines[k].sum()) + extra.get(end, 0.0) for k, end in enumerate(ends)}
+    in_band = {end: float(lines[k][keep].sum()) + extra.get(end, 0.0) for k, end in enumerate(ends)}
     return ResidualRecord.from_variances(variance, in_band, std, order, panels)

@@ -301,7 +301,8 @@ class ResidualRecord:
     reason : str
         Why not computed ("" when computed).
     variance : dict {"end_a", "end_b"} of float
-        Variance the residual adds to the end tension. [N²]
+        Variance the residual adds to the end tension (negative where it lowers it:
+        the drag residual's linear part, :mod:`stochcable.dynamics.drag_segments`). [N²]
     in_band : dict {"end_a", "end_b"} of float
         Its part on the analysis band (the rest: superharmonics above ω_max, and
         difference frequencies below ω_min). [N²]
@@ -341,10 +342,11 @@ class ResidualRecord:
         order: int,
         panels: int,
     ) -> ResidualRecord:
-        """The record of computed residual variances (negative round-off clipped)."""
-        var = {e: max(0.0, float(v)) for e, v in variance.items()}
-        band = {e: max(0.0, float(v)) for e, v in in_band.items()}
-        total = {e: math.sqrt(float(std[e]) ** 2 + var[e]) for e in var}
+        """The record of computed residual variances (a variance change may be
+        negative: it is clipped at −σ_linear², σ with it at 0)."""
+        var = {e: max(-(float(std[e]) ** 2), float(v)) for e, v in variance.items()}
+        band = {e: max(-(float(std[e]) ** 2), float(v)) for e, v in in_band.items()}
+        total = {e: math.sqrt(max(0.0, float(std[e]) ** 2 + var[e])) for e in var}
         return cls(True, "", var, band, dict(std), total, order, panels)
 
     def ratio(self, end: str) -> float:
