@@ -277,6 +277,25 @@ def quantities_fd(result: Any, s_star: float) -> dict[str, float]:
     }
 
 
+def fd_with_residuals(doc: dict[str, Any]) -> dict[str, float]:
+    """End-tension σ of ``doc``'s analysis with the closed-form drag and geometric
+    residuals (σ² + both variances; NaN at an end where a residual is not computed). [N]"""
+    import stochcable
+
+    d = copy.deepcopy(doc)
+    d["analysis"].setdefault("linearization", {}).update(
+        drag_residual=True, geometric_residual=True
+    )
+    line = next(iter(stochcable.analyze(d).lines.values()))
+    out = {}
+    for q, e in (("T_fairlead", "end_b"), ("T_anchor", "end_a")):
+        var = getattr(line, e).std ** 2
+        for rec in (line.drag_residual, line.geometric_residual):
+            var = var + (rec.variance[e] if rec is not None and rec.computed else math.nan)
+        out[q] = math.sqrt(var) if var >= 0 else math.nan
+    return out
+
+
 def quantities_td(history: Any, s_star: float) -> dict[str, float]:
     """The same three quantities from a time-domain history (after its ramp)."""
     ms = history.motion_std()
@@ -369,6 +388,9 @@ class TDReference:
     wall_s: float  # per seed, median
     failures: tuple[str, ...] = ()
     refined: tuple[str, ...] = ()  # seeds rerun at Δt/4 after a non-stationary record
+    # the same FD's end-tension σ with the closed-form drag and geometric residuals
+    # (analysis.linearization.drag_residual / geometric_residual; NaN where not computed)
+    fd_residuals: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -505,6 +527,7 @@ def td_reference(
     band = (float(om["min"]), float(om["max"]))
     fd, _, _ = timed_analysis(doc, 1, 0.0)
     fd_q = quantities_fd(fd, s_star)
+    fd_r = fd_with_residuals(doc)
     per: dict[str, list[float]] = {q: [] for q in QUANTITIES}
     walls: list[float] = []
     failures: list[str] = []
@@ -569,6 +592,7 @@ def td_reference(
         mean=mean,
         halfwidth=hw,
         fd_same_mesh=fd_q,
+        fd_residuals=fd_r,
         wall_s=statistics.median(walls) if walls else float("nan"),
         failures=tuple(failures),
         refined=tuple(refined),
@@ -1000,6 +1024,16 @@ def _ratio_ci(td: TDReference, q: str) -> str:
     return f"{int(CI_LEVEL * 100)} % CI {fd / (m + hw):.3f}–{fd / (m - hw):.3f}"
 
 
+def _residual_ratio(td: TDReference, q: str) -> str:
+    """(FD + residuals)/TD with its interval, or why there is none."""
+    fd, m, hw = td.fd_residuals.get(q, math.nan), td.mean[q], td.halfwidth[q]
+    if not math.isfinite(fd):
+        return "not computed"
+    if not np.isfinite(hw) or hw >= m:
+        return f"{fd / m:.3f} (CI —)"
+    return f"{fd / m:.3f} ({int(CI_LEVEL * 100)} % CI {fd / (m + hw):.3f}–{fd / (m - hw):.3f})"
+
+
 def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
     """The report text (Markdown)."""
     import numpy as _np
@@ -1064,6 +1098,10 @@ def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
   confidence interval from the seed-to-seed scatter; "FD/TD" uses the FD answer
   (direct, reference grid) on the **same mesh** as the TD, so it isolates the
   linearization (drag and geometry) error; its interval is FD/(σ̄_TD ± half-width).
+  "(FD + residuals)/TD" is the same FD with the closed-form drag and geometric
+  residuals of the linear model added to its variance
+  (`analysis.linearization.drag_residual`, `geometric_residual`;
+  docs/benchmarks/drag_residual.md).
 - Errors are signed relative errors σ/σ_ref − 1; the plots show their magnitude
   (values below 1e-7 are drawn at 1e-7).""")
     L.append("")
@@ -1072,28 +1110,29 @@ def render_markdown(study: Study, plot_dir_rel: str = "accuracy") -> str:
     L.append(
         "| scene | default time | same with solver direct "
         "| default error (fairlead / anchor / motion) | cheapest ≤ 1 % fairlead | its time "
-        "| FD/TD fairlead (95 % CI) |"
+        "| FD/TD fairlead (95 % CI) | (FD + residuals)/TD fairlead (95 % CI) |"
     )
-    L.append("|---|---|---|---|---|---|---|")
+    L.append("|---|---|---|---|---|---|---|---|")
     for sc in study.scenes:
         rows = [r for r in sc.rows if r.failure is None]
         d = next(r for r in rows if r.setting.group == "default")
         c = cheapest(rows, ("T_fairlead",), 0.01)
-        td = "not run"
+        td = td_res = "not run"
         if sc.td is not None and sc.td.seeds:
             td = (
                 f"{sc.td.fd_same_mesh['T_fairlead'] / sc.td.mean['T_fairlead']:.3f} "
                 f"({_ratio_ci(sc.td, 'T_fairlead')})"
             )
+            td_res = _residual_ratio(sc.td, "T_fairlead")
         elif sc.td is not None:
-            td = "TD failed"
+            td = td_res = "TD failed"
         dr = next((r for r in rows if r.setting.label == "direct"), None)
         L.append(
             f"| {sc.name} | {1e3 * d.time_s:.0f} ms | "
             f"{f'{1e3 * dr.time_s:.0f} ms' if dr else '—'} | {_pct(d.err_ref['T_fairlead'])} / "
             f"{_pct(d.err_ref['T_anchor'])} / {_pct(d.err_ref['motion'])} | "
             f"{c.setting.label if c else 'none swept'} | "
-            f"{f'{1e3 * c.time_s:.0f} ms' if c else '—'} | {td} |"
+            f"{f'{1e3 * c.time_s:.0f} ms' if c else '—'} | {td} | {td_res} |"
         )
     L.append("")
     for sc in study.scenes:
