@@ -944,7 +944,10 @@ SCENE_NOTES = {
         "rad/s, ωΔt = 2.4) in some seeds: the record jumps to a persistent tension σ ≈ "
         "1e4 lbf; such records are detected (window σ ratio above "
         "stochcable.reference.cable.NONSTATIONARY_RATIO) and rerun at Δt/4 (listed "
-        "below)."
+        "below). The closed-form residuals assume a line that stays taut (a Gaussian "
+        "response about the static state); here they add to the overestimate "
+        "((FD + residuals)/TD 1.68 in the summary): a line that goes slack needs the time "
+        "domain, and the analysis's snap indicator says so."
     ),
 }
 
