@@ -98,30 +98,23 @@ def subset_inputs(
     def take(a: np.ndarray | None, axis: int) -> np.ndarray | None:
         return None if a is None else np.take(a, idx, axis=axis)
 
-    sub = LineInputs(
-        inp.omega[idx],
-        take(inp.velocity, 2),
-        take(inp.inertia_load, 2),
-        take(inp.ub, 2),
-        weights,
-        take(inp.moments, 3),
-        square,
-    )
+    sub = inp.subset(idx, weights, square)
     # The drag-independent, per-frequency arrays the full grid has already computed
-    # (:func:`base_motion`, the attachments' velocity of :func:`drag_inputs`,
-    # :func:`end_motion_projections`) are the same numbers at the subset's
-    # frequencies: sliced, not recomputed.
+    # (:func:`end_following`, :func:`base_load`, the attachments' velocity of
+    # :func:`drag_inputs`, :func:`end_motion_projections`, the kept moments and
+    # inertia load) are the same numbers at the subset's frequencies: sliced, not
+    # recomputed.
     n_w, n_ch = inp.weights.shape
 
     for key, val in inp.cache.items():
-        if key in ("foss", "direct"):
-            u, f0, moving = val
-            sub.cache[key] = (take(u, 2), take(f0, 2), moving)
-        elif key[0] == "attached_velocity":
-            sub.cache[key] = take(val, 2)
-        elif key[0] == "drag_moments":
+        name = key if isinstance(key, str) else key[0]
+        if name in ("moments", "drag_moments"):
             sub.cache[key] = take(val, 3)
-        elif key[0] == "qproj":
+        elif name in ("inertia", "base_load", "attached_velocity"):
+            sub.cache[key] = take(val, 2)
+        elif name == "following":
+            sub.cache[key] = (take(val[0], 2), val[1])
+        elif name == "qproj":
             u_p, wcol, y = val
             sub.cache[key] = (
                 take(u_p, 2),

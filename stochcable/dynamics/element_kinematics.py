@@ -48,6 +48,9 @@ _SERIES_RADIUS = 0.5
 _SERIES_TERMS = 15
 _PHI1_COEF = np.array([1.0 / math.factorial(n + 1) for n in range(_SERIES_TERMS)])
 _PSI_COEF = np.array([1.0 / (math.factorial(n) * (n + 2)) for n in range(_SERIES_TERMS)])
+# Elements × frequencies per block of :func:`_element_kinematics` (its temporaries,
+# ≈ 30 arrays of this many entries, stay in the cache).
+_BLOCK_ENTRIES = 2**14
 
 
 def _series(x: np.ndarray, coef: np.ndarray) -> np.ndarray:
@@ -281,9 +284,49 @@ def _element_kinematics(
     wet_a, wet_b = za <= 0.0, zb <= 0.0
     p = np.where(wet_a, 0.0, np.where(wet_b, cross, 0.0))
     q = np.where(wet_b, 1.0, np.where(wet_a, cross, 0.0))
-    # frequency-major (n_w, n_el) arrays throughout: the outputs' layout, so they are
-    # written without transposes (the same products, operands swapped)
     p, q = np.clip(p, 0.0, 1.0)[None, :], np.clip(q, 0.0, 1.0)[None, :]
+    n_w, n_el = w.size, za.size
+    vel = np.empty((n_w, n_el, 2, 3), dtype=complex)
+    sq = np.zeros((n_w, n_el, 3, 3))
+    ends = np.empty((n_w, n_el, 2))
+    geo = (za, zb, chi, p, q, cb, sb, h, g)
+    # blocks of frequencies: every operation is elementwise in ω, so the numbers are
+    # those of the whole grid at once, with temporaries of one block (kept in cache:
+    # ≈ 2x faster than whole-grid passes on 400 elements × 2,000 ω)
+    step = max(1, _BLOCK_ENTRIES // max(n_el, 1))
+    for i in range(0, n_w, step):
+        sl = slice(i, min(i + step, n_w))
+        _kinematics_block(w[sl], k[sl], geo, vel[sl], sq[sl], ends[sl])
+    wet = (q - p)[0]
+    for a in (w, k, pts, wet, vel, sq, ends):
+        a.setflags(write=False)
+    return ElementKinematics(
+        omega=w,
+        wavenumber=k,
+        positions=pts,
+        heading=beta,
+        depth=h,
+        wet_fraction=wet,
+        velocity=vel,
+        velocity_square=sq,
+        end_square=ends,
+    )
+
+
+def _kinematics_block(
+    w: np.ndarray,
+    k: np.ndarray,
+    geo: tuple,
+    vel: np.ndarray,
+    sq: np.ndarray,
+    ends_out: np.ndarray,
+) -> None:
+    """The element kinematics of the frequencies ``w`` (wavenumbers ``k``) written into
+    ``vel``, ``sq`` (zeroed) and ``ends_out``: the body of :func:`_element_kinematics`
+    on one block; ``geo`` = (z_a, z_b, χ, p, q, cos β, sin β, h, g).  Frequency-major
+    (n_w, n_el) arrays throughout: the outputs' layout, so they are written without
+    transposes."""
+    za, zb, chi, p, q, cb, sb, h, g = geo
     length = q - p
     dz = np.multiply.outer(k, zb - za)
     phase0 = -np.multiply.outer(k, chi[:-1])  # imaginary parts of the exponents
@@ -336,32 +379,15 @@ def _element_kinematics(
             mh[1][zero_w, :] = u0 * side_b
             ch2[zero_w, :] = u0 * u0 * length
             ends[zero_w] = u0 * u0
-    n_w, n_el = ma1.shape
-    vel = np.empty((n_w, n_el, 2, 3), dtype=complex)
     for side in range(2):
         vel[:, :, side, 0] = mh[side] * cb
         vel[:, :, side, 1] = mh[side] * sb
         vel[:, :, side, 2] = mz[side]
-    sq = np.zeros((n_w, n_el, 3, 3))
     sq[:, :, 0, 0] = ch2 * (cb * cb)
     sq[:, :, 1, 1] = ch2 * (sb * sb)
     sq[:, :, 0, 1] = sq[:, :, 1, 0] = ch2 * (cb * sb)
     sq[:, :, 2, 2] = sh2
-    wet = length[0]
-    ends = np.where((length > 0.0)[:, :, None], ends, 0.0)
-    for a in (w, k, pts, wet, vel, sq, ends):
-        a.setflags(write=False)
-    return ElementKinematics(
-        omega=w,
-        wavenumber=k,
-        positions=pts,
-        heading=beta,
-        depth=h,
-        wet_fraction=wet,
-        velocity=vel,
-        velocity_square=sq,
-        end_square=ends,
-    )
+    ends_out[...] = np.where((length > 0.0)[:, :, None], ends, 0.0)
 
 
 # ------------------------------------------------------------------ element geometry

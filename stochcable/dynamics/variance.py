@@ -25,7 +25,7 @@ from stochcable.dynamics.blocks import (
 from stochcable.dynamics.freqblocks import frequency_slices, working_memory_bytes
 from stochcable.dynamics.line_loads import (
     LineInputs,
-    base_motion,
+    end_following,
     end_nodes,
     line_inputs,
 )
@@ -255,7 +255,7 @@ def fluid_terms(system: LineSystem, inp: LineInputs, method: str) -> tuple[np.nd
     key = ("fluid", method)
     if key not in inp.cache:
         pr = _proj_rows(system, method)
-        if inp.moments is None:
+        if not inp.has_fluid:
             inp.cache[key] = (np.zeros(pr.shape[:2]), False)
         else:
             c0 = np.sum((pr @ inp.square) * pr, axis=2)  # r·S·r (5x the einsum's speed)
@@ -296,13 +296,24 @@ def _element_variance(
         return c0
     pr = _proj_rows(system, method)
     kernel = element_variance_kernel()
-    if kernel is not None:  # the same sums in one compiled pass (variance_kernels)
-        var = c0.copy()
-        kernel(pr, u_nodes, u_free, inp.omega, inp.weights, inp.moments if fluid else None, var)
-        return var
-    w2 = _w2(inp)
     n_el, k, d = pr.shape
     n_w, n_ch = inp.weights.shape
+    if kernel is not None:  # the same sums in one compiled pass (variance_kernels)
+        var = c0.copy()
+        # over blocks of frequencies: the block's moments (gathered from the channels)
+        # and the kernel's contiguous copies of the block's displacements
+        for sl in frequency_slices(n_w, n_ch * 16 * (2 * (n_el + 1) * d + 2 * n_el * d)):
+            kernel(
+                pr,
+                None if u_nodes is None else u_nodes[:, :, sl],
+                None if u_free is None else u_free[:, :, sl],
+                inp.omega[sl],
+                inp.weights[sl],
+                inp.moments_at(sl) if fluid else None,
+                var,
+            )
+        return var
+    w2 = _w2(inp)
     var = c0.copy()
     wq = (-1j * inp.omega)[:, None]
     mw_all = _weighted_moments(system, inp, method) if fluid else None
@@ -322,7 +333,7 @@ def _element_variance(
         if mw_all is not None:
             mw = mw_all[..., cols]
         elif fluid:
-            mw = np.swapaxes(_projected_moments(pr, inp.moments[..., sl, :]), 1, 2) * w2[cols]
+            mw = np.swapaxes(_projected_moments(pr, inp.moments_at(sl)), 1, 2) * w2[cols]
         var += _structural_variance(qx, w2[cols], mw)
     return var
 
@@ -357,7 +368,7 @@ def _weighted_moments(system: LineSystem, inp: LineInputs, method: str) -> np.nd
         if 16 * n_el * k * n_cols > working_memory_bytes():  # (the product and the copy)
             inp.cache[key] = None
         else:
-            m = _projected_moments(pr, inp.moments)
+            m = _projected_moments(pr, inp.moments_at())
             inp.cache[key] = np.swapaxes(m, 1, 2) * _w2(inp)
     return inp.cache[key]
 
@@ -445,13 +456,13 @@ def sigmas_from_nodes(
 
 def end_motion_projections(system: LineSystem, inp: LineInputs, method: str) -> tuple:
     """Drag-independent parts of :func:`sigmas_from_free`, cached per inputs and solver:
-    the node displacement U_p of :func:`base_motion` (None without end motion; its
+    the node displacement U_p of :func:`end_following` (None without end motion; its
     projections are formed block by block), the factors −iω per column (n_w·n_ch,)
     and the attachments' V + Q (n_drag_nodes, d, n_w, n_ch)."""
     key = ("qproj", system.solver)
     if key not in inp.cache:
         prep = line_prep(system)
-        u, _, moving = base_motion(system, prep, inp)
+        u, moving = end_following(system, prep, inp)
         wcol = np.repeat(-1j * inp.omega, inp.weights.shape[1])
         idx = system.drag_nodes
         y = np.zeros((idx.size, prep.d) + inp.weights.shape, dtype=complex)
@@ -469,7 +480,7 @@ def sigmas_from_free(
     system: LineSystem, inp: LineInputs, u_free: np.ndarray, method: str
 ) -> np.ndarray:
     """σ vector from the free-node dynamic part of :func:`solve_free`: the structure's
-    velocity is that of U_p (:func:`base_motion`) plus iω u_f
+    velocity is that of U_p (:func:`end_following`) plus iω u_f
     (:func:`_element_variance`, over blocks of frequencies)."""
     prep = line_prep(system)
     u_p, wcol, y = end_motion_projections(system, inp, method)
@@ -488,7 +499,7 @@ def sigmas_from_free(
 def rest_sigmas(system: LineSystem, inp: LineInputs, method: str) -> np.ndarray:
     """The σ of the start (step 5): the fluid velocity relative to the line following
     its ends quasi-statically, :func:`sigmas_from_nodes` of :func:`quasi_static_motion`.  For
-    Foss that motion is U_p of :func:`base_motion` (the same numbers)."""
+    Foss that motion is U_p of :func:`end_following` (the same numbers)."""
     if system.solver == "direct":
         return sigmas_from_nodes(system, inp, quasi_static_motion(system, inp), method)
     u_p, _, y = end_motion_projections(system, inp, method)

@@ -135,7 +135,7 @@ def _channel_bytes(channels: tuple[Channel, ...]) -> int:
 
 def _nbytes(channels: tuple[Channel, ...], inp: LineInputs) -> int:
     """Bytes of the channels' element kinematics and of the inputs' arrays."""
-    arrays = [inp.velocity, inp.inertia_load, inp.ub, inp.moments]
+    arrays = [inp.velocity, inp.ub, inp.inertia_extra]
     for c in channels:
         arrays += [c.element_velocity, c.element_velocity_square, c.element_end_square]
     return int(sum(a.nbytes for a in arrays if isinstance(a, np.ndarray)))
