@@ -100,25 +100,14 @@ def subset_inputs(
 
     sub = inp.subset(idx, weights, square)
     # The drag-independent, per-frequency arrays the full grid has already computed
-    # (:func:`end_following`, :func:`base_load`, the attachments' velocity of
-    # :func:`drag_inputs`, :func:`end_motion_projections`, the kept moments and
-    # inertia load) are the same numbers at the subset's frequencies: sliced, not
-    # recomputed.
-    n_w, n_ch = inp.weights.shape
+    # (:func:`end_following_at`, :func:`base_load`, the attachments' velocity of
+    # :func:`drag_inputs`, the kept moments and inertia load, where kept) are the same
+    # numbers at the subset's frequencies: sliced, not recomputed.
 
     for key, val in inp.cache.items():
         name = key if isinstance(key, str) else key[0]
         if name in ("moments", "drag_moments"):
             sub.cache[key] = take(val, 3)
-        elif name in ("inertia", "base_load", "attached_velocity"):
+        elif name in ("inertia", "base_load", "attached_velocity", "following"):
             sub.cache[key] = take(val, 2)
-        elif name == "following":
-            sub.cache[key] = (take(val[0], 2), val[1])
-        elif name == "qproj":
-            u_p, wcol, y = val
-            sub.cache[key] = (
-                take(u_p, 2),
-                np.ascontiguousarray(wcol.reshape(n_w, n_ch)[idx]).ravel(),
-                take(y, 2),
-            )
     return sub

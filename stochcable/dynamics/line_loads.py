@@ -38,6 +38,7 @@ __all__ = [
     "drag_blocks",
     "drag_inputs",
     "end_following",
+    "end_following_at",
     "end_loads",
     "end_nodes",
     "fluid_loads",
@@ -141,30 +142,53 @@ def end_nodes(inp: LineInputs, n: int, d: int) -> np.ndarray:
 
 
 def end_following(system: LineSystem, prep: LinePrep, inp: LineInputs) -> tuple[np.ndarray, bool]:
-    """The prescribed motion U_p of :func:`base_load` on all nodes, (n_nodes, d, n_w,
-    n_ch), and whether an end moves; cached per inputs and solver.
+    """The prescribed motion U_p of :func:`base_load` on all nodes and frequencies,
+    (n_nodes, d, n_w, n_ch), and whether an end moves (:func:`end_following_at`; zero
+    without end motion)."""
+    if inp.ub is None:
+        return end_nodes(inp, prep.n, prep.d), False
+    return end_following_at(system, prep, inp), True
+
+
+def end_following_at(
+    system: LineSystem,
+    prep: LinePrep,
+    inp: LineInputs,
+    freq: slice = slice(None),
+    nodes: np.ndarray | None = None,
+) -> np.ndarray | None:
+    """The prescribed motion U_p on the frequencies ``freq``, (n_nodes, d, n_f, n_ch)
+    (``nodes``: those nodes only), None without end motion:
 
         direct: U_p = the end motion (zero inside);
-        Foss:   U_p = the end motion with the exact static following inside.
-    """
+        Foss:   U_p = the end motion with the exact static following inside,
+
+    U_p = G u_b with G (n_nodes·d, 2d) the unit end displacements (and their static
+    following) of :meth:`~stochcable.dynamics.blocks.LinePrep.end_basis`, formed for
+    the channels that move an end (the others are zero); the whole grid kept when it
+    fits a quarter of the working-memory target. [m/unit]"""
+    if inp.ub is None:
+        return None
     key = ("following", system.solver)
-    if key not in inp.cache:
-        if inp.ub is None:
-            inp.cache[key] = (end_nodes(inp, prep.n, prep.d), False)
-        else:
-            # U_p = G u_b with G (n_nodes, d, 2d) the unit end displacements (and their
-            # static following), only for the channels that move an end
-            g = prep.end_basis(system.solver == "direct")[0]
-            act = _moving_channels(inp)
-            ub = inp.ub if act is None else inp.ub[..., act]
-            u = real_gemm(g, np.ascontiguousarray(ub.reshape(2 * prep.d, -1)))
-            u = u.reshape((prep.n, prep.d) + ub.shape[2:])
-            if act is not None:  # back to all channels
-                u_all = np.zeros((prep.n, prep.d) + inp.ub.shape[2:], dtype=complex)
-                u_all[..., act] = u
-                u = u_all
-            inp.cache[key] = (u, True)
-    return inp.cache[key]
+    if key in inp.cache:
+        u = inp.cache[key]
+        return (u if nodes is None else u[nodes])[:, :, freq]
+    g = prep.end_basis(system.solver == "direct")[0]
+    n = prep.n
+    if nodes is not None:
+        g = g.reshape(n, prep.d, -1)[nodes].reshape(-1, 2 * prep.d)
+        n = g.shape[0] // prep.d
+    act = _moving_channels(inp)
+    ub = inp.ub[:, :, freq] if act is None else inp.ub[:, :, freq][..., act]
+    u = real_gemm(g, np.ascontiguousarray(ub.reshape(2 * prep.d, -1)))
+    u = u.reshape((n, prep.d) + ub.shape[2:])
+    if act is not None:  # back to all channels
+        u_all = np.zeros((n, prep.d) + ub.shape[2:-1] + inp.ub.shape[-1:], dtype=complex)
+        u_all[..., act] = u
+        u = u_all
+    if nodes is None and freq == slice(None) and u.nbytes <= working_memory_bytes() // 4:
+        inp.cache[key] = u
+    return u
 
 
 def base_load(
@@ -237,7 +261,7 @@ def drag_inputs(
     number per element end, component, frequency and channel), and the attachment
     velocity V + Q at the nodes (n_nodes, d, n_w, n_ch) (:func:`attached_velocity`);
     None where absent."""
-    u, moving = end_following(system, prep, inp)
+    moving = inp.ub is not None
     moments = inp.moments_at(freq)
     wm = moments
     key = ("drag_moments", system.solver)
@@ -251,7 +275,8 @@ def drag_inputs(
             else np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
         )
         act = _moving_channels(inp)  # Q = 0 for the others: W = the moments
-        qa = u[:, :, freq] if act is None else u[:, :, freq][..., act]
+        u = end_following_at(system, prep, inp, freq)
+        qa = u if act is None else u[..., act]
         qa = qa * (-1j * inp.omega[freq])[:, None]  # Q = −iω U_p
         w_q = np.empty((prep.n - 1, 2) + qa.shape[1:], dtype=complex)
         for side in range(2):
@@ -265,7 +290,7 @@ def drag_inputs(
             wm = (
                 moments.copy()
                 if moments is not None
-                else np.zeros((prep.n - 1, 2) + u[:, :, freq].shape[1:], dtype=complex)
+                else np.zeros((prep.n - 1, 2) + u.shape[1:], dtype=complex)
             )
             wm[..., act] = w_q
         if whole and wm.nbytes <= working_memory_bytes() // 4:
@@ -283,10 +308,9 @@ def attached_velocity(system: LineSystem, prep: LinePrep, inp: LineInputs) -> np
     moves)."""
     key = ("attached_velocity", system.solver)
     if key not in inp.cache:
-        u, moving = end_following(system, prep, inp)
         vq = inp.velocity
-        if moving and system.drag_nodes.size:  # V + Q: attachments only
-            q = (-1j * inp.omega)[:, None] * u
+        if inp.ub is not None and system.drag_nodes.size:  # V + Q: attachments only
+            q = (-1j * inp.omega)[:, None] * end_following(system, prep, inp)[0]
             vq = q if vq is None else vq + q
         inp.cache[key] = vq
     return inp.cache[key]

@@ -49,28 +49,38 @@ from stochcable.scene.model import AnalysisSettings
 # ------------------------------------------------------------------------- outputs
 
 
-def element_tension_transfer(system: LineSystem, response: Response) -> np.ndarray:
+def element_tension_transfer(
+    system: LineSystem, response: Response, motion: np.ndarray | None = None
+) -> np.ndarray:
     """Dynamic effective tension per element, (n_ch, n_el, n_omega). [N/unit]
 
     δT = (EA/l0)·e·(u_{j+1} − u_j) (module docstring), EA reduced for slack elements;
     the rows of :attr:`stochcable.line.fem.FEModel.tension_rows` (the touchdown element
-    split at the static touchdown has its suspended part's).
+    split at the static touchdown has its suspended part's).  ``motion``: the node
+    motion transfer (n_ch, n_nodes, 3, n_omega) of ``response`` when already formed
+    (read in place: the same numbers without a transposed copy of the response).
     """
 
     model = system.model
     n_w = response.omega.size
-    u = response.displacement.reshape(n_w, model.n_nodes, model.dim, -1)
-    # rows·(u_a, u_b) one component at a time, frequencies last (long inner loops; the
-    # complex einsum was 0.4 ms on the chain, the frequency-major layout 0.25)
-    u = np.ascontiguousarray(np.transpose(u, (3, 1, 2, 0)))  # (n_ch, n_nodes, dim, n_w)
+    comps = list(range(model.dim))
+    if motion is not None:  # (n_ch, n_nodes, 3, n_w): the model's components in place
+        u, comps = motion, list(model.components)
+    else:
+        u = response.displacement.reshape(n_w, model.n_nodes, model.dim, -1)
+        # rows·(u_a, u_b) one component at a time, frequencies last (long inner loops;
+        # the complex einsum was 0.4 ms on the chain, the frequency-major layout 0.25)
+        u = np.ascontiguousarray(np.transpose(u, (3, 1, 2, 0)))
     rows = model.tension_rows
     if rows is None:
         ea = np.where(model.slack, SLACK_EA_RATIO * model.mesh.ea, model.mesh.ea)
         t = model.tangents * (ea / model.l0)[:, None]
         rows = np.stack([-t, t], axis=1)
-    out = rows[None, :, 0, 0, None] * u[:, :-1, 0] + rows[None, :, 1, 0, None] * u[:, 1:, 0]
+    c = comps[0]
+    out = rows[None, :, 0, 0, None] * u[:, :-1, c] + rows[None, :, 1, 0, None] * u[:, 1:, c]
     for k in range(1, model.dim):
-        out += rows[None, :, 0, k, None] * u[:, :-1, k] + rows[None, :, 1, k, None] * u[:, 1:, k]
+        c = comps[k]
+        out += rows[None, :, 0, k, None] * u[:, :-1, c] + rows[None, :, 1, k, None] * u[:, 1:, c]
     return out
 
 
@@ -119,7 +129,7 @@ def line_result(
     n_ch = len(channels)
     spectra = np.stack([c.spectrum for c in channels]) if n_ch else np.zeros((0, w.size))
     motion_h = _motion_transfer(model, resp, n_ch)
-    tension_h = element_tension_transfer(system, resp)
+    tension_h = element_tension_transfer(system, resp, motion_h)
     # σ² = Σ_c ∫|H_c|² S_c dω as one weighted reduction with the trapezoid weights q
     # (the response spectra are not kept; the same trapezoid rule as np.trapezoid up
     # to round-off, ≈ 0.1 ms a line less than the spectra and two trapezoids)

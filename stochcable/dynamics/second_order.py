@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.dynamics.freqblocks import working_memory_bytes
 from stochcable.errors import PhysicsWarning, warn
 
 __all__ = [
@@ -182,20 +183,51 @@ def second_order_tension(
     kappa = 1.0 / (float(np.sum(mesh.l0 / mesh.ea)) * (1.0 + lam2 / 12.0))
     normals = normals * np.sqrt(0.5 * kappa / mesh.l0)[:, None, None]  # T₂ = Σ_e a_e|Δu⊥_e|²
     amp = np.sqrt(np.clip(input_spectra, 0.0, None) * weights)  # (n_ch, n_w)
-    n_ch, n_nodes, _, n_w = motion_transfer.shape
-    # Δu·amp per element, component, channel and frequency, then its normal components
-    # as one stacked real product on the interleaved (re, im) view: the rows of B,
-    # each column's real and imaginary parts side by side (the complex einsum and the
-    # [Re B, Im B] copy were 2/3 of this function)
-    du = np.empty((n_nodes - 1, 3, n_ch, n_w), dtype=complex)
-    mt = motion_transfer.transpose(1, 2, 0, 3)
-    np.subtract(mt[1:], mt[:-1], out=du)
-    du *= amp
-    c = (normals @ du.view(float).reshape(n_nodes - 1, 3, -1)).reshape(2 * (n_nodes - 1), -1)
-    mean, std = _real_form_moments(c) if math.isfinite(lam2) else (0.0, 0.0)
+    mean, std = _moments(motion_transfer, amp, normals) if math.isfinite(lam2) else (0.0, 0.0)
     sig = float(np.max(tension_std)) if tension_std.size else 0.0
     ratio = std / sig if sig > 0 else (math.inf if std > 0 else 0.0)
     return SecondOrderTension(mean, std, ratio, lam2, math.sqrt(1.0 + ratio * ratio))
+
+
+def _moments(
+    motion_transfer: np.ndarray, amp: np.ndarray, normals: np.ndarray
+) -> tuple[float, float]:
+    """:func:`_real_form_moments` of the rows B = normals·Δu·amp (two per element; one
+    column per channel and frequency, real and imaginary parts side by side), over
+    blocks: of frequencies when there are fewer rows than columns (the rows' Gram
+    matrix summed block by block), else of elements (the columns' Gram matrix), each
+    block's Δu and B within the working-memory target (the whole B of 400 elements ×
+    2,000 ω × 2 channels was 51 MB and its Δu 77 MB)."""
+    n_ch, n_nodes, _, n_w = motion_transfer.shape
+    n_rows, n_cols = 2 * (n_nodes - 1), 2 * n_ch * n_w
+    mt = motion_transfer.transpose(1, 2, 0, 3)
+
+    def rows(el: slice, fr: slice) -> np.ndarray:
+        # Δu·amp per element, component, channel and frequency, then its normal
+        # components as one stacked real product on the interleaved (re, im) view
+        a, b = mt[el.start + 1 : el.stop + 1, :, :, fr], mt[el, :, :, fr]
+        du = np.empty(a.shape, dtype=complex)
+        np.subtract(a, b, out=du)
+        du *= amp[:, fr]
+        c = normals[el] @ du.view(float).reshape(du.shape[0], 3, -1)
+        return c.reshape(2 * du.shape[0], -1)
+
+    # a block's Δu, B and copies: ≈ 200 bytes per element, channel and frequency
+    per = 200.0 * n_ch
+    mean, gram = 0.0, None
+    if n_rows <= n_cols:
+        step = max(1, int(working_memory_bytes() // (per * (n_nodes - 1))))
+        for i in range(0, n_w, step):
+            c = rows(slice(0, n_nodes - 1), slice(i, min(i + step, n_w)))
+            mean += float(np.sum(c * c))
+            gram = c @ c.T if gram is None else gram + c @ c.T
+    else:
+        step = max(1, int(working_memory_bytes() // (per * n_w)))
+        for i in range(0, n_nodes - 1, step):
+            c = rows(slice(i, min(i + step, n_nodes - 1)), slice(0, n_w))
+            mean += float(np.sum(c * c))
+            gram = c.T @ c if gram is None else gram + c.T @ c
+    return mean, math.sqrt(2.0 * float(np.sum(gram * gram)))
 
 
 def with_second_order(line: str, indicators: Any, second_order: SecondOrderTension) -> Any:

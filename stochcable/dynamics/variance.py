@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -25,7 +26,7 @@ from stochcable.dynamics.blocks import (
 from stochcable.dynamics.freqblocks import frequency_slices, working_memory_bytes
 from stochcable.dynamics.line_loads import (
     LineInputs,
-    end_following,
+    end_following_at,
     end_nodes,
     line_inputs,
 )
@@ -278,13 +279,14 @@ def _element_variance(
     system: LineSystem,
     inp: LineInputs,
     method: str,
-    u_nodes: np.ndarray | None = None,
+    u_nodes: np.ndarray | Callable[[slice], np.ndarray] | None = None,
     u_free: np.ndarray | None = None,
 ) -> np.ndarray:
     """Σ weight ∫₀¹ |r·(v(ξ) + N_a q_a + N_b q_b)|² dξ per element and row, (n_el, k).
 
     q = −iωU is minus the structural velocity at the element's two nodes, U the node
-    displacement ``u_nodes`` (n_nodes, d, n_w, n_ch) plus the free-node part ``u_free``
+    displacement ``u_nodes`` (n_nodes, d, n_w, n_ch), or a callable giving it on a
+    slice of the frequencies, plus the free-node part ``u_free``
     (n_nodes − 2, d, n_w, n_ch) on the interior nodes (None: nothing; both None: the
     structure at rest).  With m_i = r·∫N_i v and ∫N_a² = ∫N_b² = 1/3, ∫N_a N_b = 1/6
     the integral is ∫|r·v|² + 2Re(m̄_a q_a + m̄_b q_b) + (|q_a|² + |q_b|² +
@@ -305,7 +307,7 @@ def _element_variance(
         for sl in frequency_slices(n_w, n_ch * 16 * (2 * (n_el + 1) * d + 2 * n_el * d)):
             kernel(
                 pr,
-                None if u_nodes is None else u_nodes[:, :, sl],
+                _block(u_nodes, sl),
                 None if u_free is None else u_free[:, :, sl],
                 inp.omega[sl],
                 inp.weights[sl],
@@ -322,7 +324,7 @@ def _element_variance(
         # U on the block's frequencies (the free part on the interior nodes), times −iω,
         # projected at both ends of every element in one pass
         if u_nodes is not None:
-            x = u_nodes[:, :, sl] * wq[sl]
+            x = _block(u_nodes, sl) * wq[sl]
             if u_free is not None:
                 x[1:-1] += u_free[:, :, sl] * wq[sl]
         else:
@@ -336,6 +338,13 @@ def _element_variance(
             mw = np.swapaxes(_projected_moments(pr, inp.moments_at(sl)), 1, 2) * w2[cols]
         var += _structural_variance(qx, w2[cols], mw)
     return var
+
+
+def _block(u: Any, sl: slice) -> np.ndarray | None:
+    """The frequencies ``sl`` of node vectors given as an array or a callable."""
+    if u is None:
+        return None
+    return u(sl) if callable(u) else u[:, :, sl]
 
 
 def element_variance_kernel() -> Any:
@@ -456,24 +465,27 @@ def sigmas_from_nodes(
 
 def end_motion_projections(system: LineSystem, inp: LineInputs, method: str) -> tuple:
     """Drag-independent parts of :func:`sigmas_from_free`, cached per inputs and solver:
-    the node displacement U_p of :func:`end_following` (None without end motion; its
-    projections are formed block by block), the factors −iω per column (n_w·n_ch,)
-    and the attachments' V + Q (n_drag_nodes, d, n_w, n_ch)."""
+    the node displacement U_p of :func:`end_following_at` as a callable on a slice of
+    the frequencies (None without end motion: formed block by block), the factors −iω
+    per column (n_w·n_ch,) and the attachments' V + Q (n_drag_nodes, d, n_w, n_ch)."""
     key = ("qproj", system.solver)
+    prep = line_prep(system)
     if key not in inp.cache:
-        prep = line_prep(system)
-        u, moving = end_following(system, prep, inp)
         wcol = np.repeat(-1j * inp.omega, inp.weights.shape[1])
         idx = system.drag_nodes
         y = np.zeros((idx.size, prep.d) + inp.weights.shape, dtype=complex)
         if inp.velocity is not None:
             y += inp.velocity[idx]
-        if not moving:
-            inp.cache[key] = (None, wcol, y)
-        else:
-            y += (-1j * inp.omega)[:, None] * u[idx]
-            inp.cache[key] = (u, wcol, y)
-    return inp.cache[key]
+        if inp.ub is not None and idx.size:
+            y += (-1j * inp.omega)[:, None] * end_following_at(system, prep, inp, nodes=idx)
+        inp.cache[key] = (wcol, y)
+    if inp.ub is None:
+        return (None, *inp.cache[key])
+
+    def u_p(sl: slice) -> np.ndarray:  # (not kept in the cache: no reference cycle)
+        return end_following_at(system, prep, inp, sl)
+
+    return (u_p, *inp.cache[key])
 
 
 def sigmas_from_free(

@@ -20,8 +20,9 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.blocks import line_prep
-from stochcable.dynamics.line_loads import end_loads
+from stochcable.dynamics.blocks import line_prep, to_freq
+from stochcable.dynamics.freqblocks import frequency_slices
+from stochcable.dynamics.line_loads import end_following_at, end_loads
 from stochcable.dynamics.solve import reactions, solve_free, total_displacement
 from stochcable.dynamics.system import Damping, LineSystem
 from stochcable.dynamics.variance import sigmas_from_free
@@ -89,6 +90,32 @@ class FreeLine:
                 self.inp.omega,
             )
         return self._support
+
+    def response_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """The node displacements in the frequency-major layout (n_w, n_nodes·d, n_ch)
+        [m/unit] and the support forces (n_w, 2d, n_ch) [N/unit], formed over blocks of
+        frequencies without the node-major total displacement (the reactions read the
+        two nodes at each end only); the free-node part is released."""
+        system, inp = self.system, self.inp
+        prep = line_prep(system)
+        n, d = prep.n, prep.d
+        n_w, n_ch = inp.weights.shape
+        ends = np.array([0, 1, n - 2, n - 1])
+        u_end = np.zeros((4, d, n_w, n_ch), dtype=complex)
+        disp = np.empty((n_w, n * d, n_ch), dtype=complex)
+        for sl in frequency_slices(n_w, 3 * 16 * n * d * max(n_ch, 1)):
+            u = np.zeros((n, d, sl.stop - sl.start, n_ch), dtype=complex)
+            up = end_following_at(system, prep, inp, sl)
+            if up is not None:
+                u += up
+            u[1:-1] += self.u_free[:, :, sl]
+            disp[sl] = to_freq(u)
+            u_end[:, :, sl] = u[ends]
+        self.u_free = None  # (the response is formed)
+        support = reactions(
+            system, prep, self.c, u_end, end_loads(system, inp, self.damping), inp.omega
+        )
+        return disp, support
 
     def combine(self, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Node displacements and support forces; ``ue`` has no columns (no attached
