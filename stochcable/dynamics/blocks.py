@@ -292,14 +292,22 @@ class LinePrep:
             return np.ascontiguousarray(y).view(complex)
         return sla.cho_solve_banded(c, rhs, check_finite=False)
 
-    def residual(self, system: LineSystem, rhs: np.ndarray) -> np.ndarray:
+    def residual(
+        self, system: LineSystem, rhs: np.ndarray, modal: np.ndarray | None = None
+    ) -> np.ndarray:
         """Static correction of the truncated modes, (K_ff⁻¹ − Φ K̂⁻¹ Φᵀ) rhs, rhs of
-        shape (n_free_dof, k) complex: an explicit dense residual flexibility (one
-        matrix product) up to ``_DENSE_FLEX`` free DOFs, else the banded Cholesky."""
+        shape (n_free_dof, k) complex (C-contiguous): an explicit dense residual
+        flexibility (one matrix product) up to ``_DENSE_FLEX`` free DOFs, else the
+        banded Cholesky with the modal part as real products (``modal``: Φᵀ rhs, (m,
+        k), when the caller has it)."""
         phi, _, kh = self.modal(system)
         nf = phi.shape[0]
         if nf > _DENSE_FLEX:
-            return self.k_solve(rhs) - phi @ np.linalg.solve(kh, phi.T @ rhs)
+            fh = real_gemm(phi.T, rhs) if modal is None else modal
+            zh = np.linalg.solve(kh, fh.view(float))
+            out = self.k_solve(rhs)
+            out -= real_gemm(phi, np.ascontiguousarray(zh).view(complex))
+            return out
         key = ("flex", phi.shape[1])
         if key not in self.cache:
             flex = self.k_solve(np.eye(nf)) - phi @ np.linalg.solve(kh, phi.T)

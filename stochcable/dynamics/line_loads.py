@@ -17,6 +17,7 @@ import numpy as np
 from stochcable.dynamics.blocks import (
     LinePrep,
     NodeBlocks,
+    block_matvec,
     distribute,
     element_blocks,
     element_load,
@@ -323,19 +324,42 @@ def free_load(
     damping: Damping,
     freq: slice = slice(None),
 ) -> np.ndarray:
-    """The load of :func:`solve_free`, F0 + F_d(V) + C_d Q (:func:`base_motion`), on all
+    """The load of :func:`solve_free`, F0 + F_d(V) + C_d Q (:func:`base_load`), on all
     nodes (n_nodes, d, n_w, n_ch), a fresh array; ``freq`` selects a block of the
-    frequencies (:mod:`stochcable.dynamics.freqblocks`)."""
-    f0 = base_load(system, prep, inp, freq)
-    wm, vq = drag_inputs(system, prep, inp, freq)
-    if wm is None:
-        rhs = f0.copy()
-    else:
-        drag_blocks(system, damping)
-        rhs = element_load(damping._cache["elements"], wm)
-        rhs += f0
+    frequencies (:mod:`stochcable.dynamics.freqblocks`).
+
+    F_d(V) = Σ_el l0·B·∫N_i v dξ is formed per channel with a fluid velocity from its
+    moments (:meth:`LineInputs.fluid_block`), the elements' part of C_d Q as
+    (C_d G)(−iω u_b) with U_p = G u_b (:func:`end_following_at`; C_d G a small
+    (n_nodes·d, 2d) matrix per drag) and the attachments' b·(V + Q) at their nodes:
+    the same sums as one element load of the moments W = ∫N v dξ + P Q
+    (:func:`drag_inputs`) to round-off, without forming W."""
+    rhs = base_load(system, prep, inp, freq)
+    if ("base_load", system.solver) in inp.cache or (inp.ub is None and "inertia" in inp.cache):
+        rhs = rhs.copy()  # (a view of a kept array)
+    drag_blocks(system, damping)
+    el = damping._cache["elements"]
+    for i, f in enumerate(inp.fluid):
+        if f is not None:
+            rhs[..., i] += element_load(el, inp.fluid_block(i, freq))
+    if inp.ub is not None:
+        act = _moving_channels(inp)
+        ub = inp.ub[:, :, freq] if act is None else inp.ub[:, :, freq][..., act]
+        w = inp.omega[freq]
+        key = ("drag_end_basis", system.solver)
+        if key not in damping._cache:  # C_d G, the elements' part (attachments below)
+            g = prep.end_basis(system.solver == "direct")[0].reshape(prep.n, prep.d, -1)
+            dg = block_matvec(distribute(system.model, el, None), g)
+            damping._cache[key] = dg.reshape(prep.n * prep.d, -1)
+        q = real_gemm(damping._cache[key], np.ascontiguousarray(ub.reshape(2 * prep.d, -1)))
+        q = q.reshape((prep.n, prep.d) + ub.shape[2:]) * (-1j * w)[:, None]
+        if act is None:
+            rhs += q
+        else:
+            rhs[..., act] += q
+    vq = attached_velocity(system, prep, inp)
     if vq is not None and np.any(damping.b_node):
-        rhs += damping.b_node[:, None, None, None] * vq
+        rhs += damping.b_node[:, None, None, None] * vq[:, :, freq]
     return rhs
 
 

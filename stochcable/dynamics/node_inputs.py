@@ -109,19 +109,37 @@ class LineInputs:
         last = self.cache.get("last_block")
         if tag is not None and last is not None and last[0] == tag:
             return last[1]
-        comps = list(self.comps)
         out = None
         for i, src in enumerate(self.fluid):
             if src is None:
                 continue
-            m = src[freq][..., comps]
+            el = np.moveaxis(src, 0, -1)  # (n_el, 2, 3, n_w): the sea's storage order
             if out is None:
-                out = np.zeros(m.shape[1:] + (m.shape[0], len(self.fluid)), dtype=complex)
-            out[..., i] = np.transpose(m, (1, 2, 3, 0))
+                nf = el[0, 0, 0, freq].size
+                shape = el.shape[:2] + (len(self.comps), nf, len(self.fluid))
+                out = np.zeros(shape, dtype=complex)
+            for j, c in enumerate(self.comps):
+                out[:, :, j, :, i] = el[:, :, c, freq]
         if _whole(freq) and out.nbytes <= working_memory_bytes() // 4:
             self.cache["moments"] = out
         elif tag is not None:
             self.cache["last_block"] = (tag, out)
+        return out
+
+    def fluid_block(self, i: int, freq: Freq = slice(None)) -> np.ndarray:
+        """The moments of channel ``i`` (one with a fluid velocity) on the frequencies
+        ``freq``, (n_el, 2, d, n_f), contiguous (one run per element end and
+        component from the sea's element-major storage). [(m/s)/unit]"""
+        if "moments" in self.cache:
+            return np.ascontiguousarray(self.cache["moments"][..., freq, i])
+        tag = (i, freq.start, freq.stop) if isinstance(freq, slice) else None
+        last = self.cache.get("last_fluid")
+        if tag is not None and last is not None and last[0] == tag:
+            return last[1]
+        el = np.moveaxis(self.fluid[i], 0, -1)  # (n_el, 2, 3, n_w)
+        out = np.ascontiguousarray(el[:, :, list(self.comps), freq])
+        if tag is not None:  # read twice per block (inertia and drag loads)
+            self.cache["last_fluid"] = (tag, out)
         return out
 
     def inertia_at(self, freq: Freq = slice(None)) -> np.ndarray:
@@ -136,11 +154,9 @@ class LineInputs:
             out = self.inertia_extra[:, :, freq].copy()
         else:
             out = np.zeros((n_el + 1, d, w.size, len(self.fluid)), dtype=complex)
-        if any(self.moment_inertia):
-            mom = self.moments_at(freq)
-            for i, use in enumerate(self.moment_inertia):
-                if use:  # exact along the elements: l0·C_I(I − eeᵀ)·iω∫N_i v dξ
-                    out[..., i] += element_load(self.inertia_el, mom[..., i] * (1j * w))
+        for i, use in enumerate(self.moment_inertia):
+            if use:  # exact along the elements: l0·C_I(I − eeᵀ)·iω∫N_i v dξ
+                out[..., i] += element_load(self.inertia_el, self.fluid_block(i, freq) * (1j * w))
         if _whole(freq) and out.nbytes <= working_memory_bytes() // 4:
             self.cache["inertia"] = out
         return out

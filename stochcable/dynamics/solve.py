@@ -221,7 +221,7 @@ def _foss_solver(
             z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
         u = real_gemm(phi, np.ascontiguousarray(z))
         if m < nf:
-            u += prep.residual(system, flat)
+            u += prep.residual(system, flat, fh)
         return u.reshape(nf, n_w, n_ch)
 
     return solve
