@@ -10,7 +10,7 @@ import numpy as np
 
 from stochcable.dynamics.blocks import trapezoid_weights
 from stochcable.dynamics.line_loads import LineInputs
-from stochcable.dynamics.loads import Channel, element_mean_square
+from stochcable.dynamics.loads import Channel, weighted_mean_square
 from stochcable.dynamics.system import LineSystem
 
 __all__ = ["interpolatory_weights", "subset_inputs"]
@@ -88,9 +88,7 @@ def subset_inputs(
     for i, ch in enumerate(channels):
         if ch.element_velocity is None and ch.velocity is None:
             continue  # as line_inputs: the mean square goes with the element moments
-        sq = element_mean_square(ch)[idx]
-        sq = sq[:, :, np.array(comps)[:, None], comps]  # one gather of the d × d part
-        sq = np.einsum("weij,w->eij", sq, weights[:, i])
+        sq = weighted_mean_square(ch, weights[:, i], comps, idx)
         square = sq if square is None else square + sq
     if keep is not None:
         idx, weights = idx[keep], weights[keep]

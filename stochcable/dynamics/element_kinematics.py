@@ -38,7 +38,7 @@ from stochcable import validation as v
 from stochcable.errors import InputError
 from stochcable.sea.kinematics import G_STANDARD, wavenumber
 
-__all__ = ["ElementKinematics", "element_frames", "element_wave_kinematics"]
+__all__ = ["ElementKinematics", "SquareParts", "element_frames", "element_wave_kinematics"]
 
 
 # |x| below which φ1 and ψ are summed as series (full relative precision; above it the
@@ -150,6 +150,67 @@ def _exp_integral(
 
 
 @dataclass(frozen=True, eq=False)
+class SquareParts:
+    """The element mean square ∫₀¹ Re(v vᴴ) dξ of the sea's kinematics in its two
+    parts, S = h·b bᵀ + v·ẑ ẑᵀ with b = (cos β, sin β, 0) the wave direction (the
+    horizontal and vertical velocities are in quadrature): two numbers per element and
+    frequency instead of the nine of S.
+
+    Attributes
+    ----------
+    horizontal, vertical : ndarray, shape (n_omega, n_el)
+        h = ∫|u_h|² dξ and v = ∫|u_z|² dξ. [(m/s)²/m²]
+    heading : float
+        β. [rad]
+    """
+
+    horizontal: np.ndarray
+    vertical: np.ndarray
+    heading: float
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes of the two arrays. [B]"""
+        return int(self.horizontal.nbytes + self.vertical.nbytes)
+
+    def _pattern(self) -> tuple[np.ndarray, np.ndarray]:
+        cb, sb = math.cos(self.heading), math.sin(self.heading)
+        p = np.array([[cb * cb, cb * sb, 0.0], [cb * sb, sb * sb, 0.0], [0.0, 0.0, 0.0]])
+        z = np.zeros((3, 3))
+        z[2, 2] = 1.0
+        return p, z
+
+    def full(self) -> np.ndarray:
+        """S, shape (n_omega, n_el, 3, 3) (a fresh array). [(m/s)²/m²]"""
+        cb, sb = math.cos(self.heading), math.sin(self.heading)
+        h = self.horizontal
+        sq = np.zeros(h.shape + (3, 3))
+        sq[:, :, 0, 0] = h * (cb * cb)
+        sq[:, :, 1, 1] = h * (sb * sb)
+        sq[:, :, 0, 1] = sq[:, :, 1, 0] = h * (cb * sb)
+        sq[:, :, 2, 2] = self.vertical
+        return sq
+
+    def __getitem__(self, idx: Any) -> SquareParts:
+        """The parts on the frequencies ``idx``."""
+        return SquareParts(self.horizontal[idx], self.vertical[idx], self.heading)
+
+    def weighted(self, weights: np.ndarray, comps: Any) -> np.ndarray:
+        """Σ_ω weight·S on the components ``comps``, (n_el, d, d). [(m/s)²·…]"""
+        p, z = self._pattern()
+        c = np.asarray(comps)
+        hw, vw = self.horizontal.T @ weights, self.vertical.T @ weights
+        return hw[:, None, None] * p[c[:, None], c][None] + vw[:, None, None] * z[c[:, None], c]
+
+    def projected(self, proj: np.ndarray) -> np.ndarray:
+        """Σ_ij S_ij P_ij for per-element matrices P (n_el, 3, 3), (n_omega, n_el)."""
+        p, z = self._pattern()
+        ph = np.einsum("eij,ij->e", proj, p)
+        pz = np.einsum("eij,ij->e", proj, z)
+        return self.horizontal * ph + self.vertical * pz
+
+
+@dataclass(frozen=True, eq=False)
 class ElementKinematics:
     """Linear wave kinematics integrated along straight elements, per unit amplitude.
 
@@ -170,8 +231,9 @@ class ElementKinematics:
     velocity : ndarray, complex, shape (n_omega, n_el, 2, 3)
         ∫₀¹ N_a v dξ and ∫₀¹ N_b v dξ (N_a = 1 − ξ, N_b = ξ, ξ = s/l), v = 0 above
         z = 0 (a view of element-major storage: frequencies contiguous). [(m/s)/m]
-    velocity_square : ndarray, real, shape (n_omega, n_el, 3, 3)
-        ∫₀¹ Re(v vᴴ) dξ, the element mean of the velocity's second moment. [(m/s)²/m²]
+    square : SquareParts
+        ∫₀¹ Re(v vᴴ) dξ, the element mean of the velocity's second moment, in its
+        horizontal and vertical parts (:attr:`velocity_square` forms it). [(m/s)²/m²]
     end_square : ndarray, real, shape (n_omega, n_el, 2)
         |v|² at the two ends of each element's wet part (the lower-ξ end first; the
         waterline point for an element crossing it; 0 for a dry element). [(m/s)²/m²]
@@ -184,8 +246,13 @@ class ElementKinematics:
     depth: float
     wet_fraction: np.ndarray
     velocity: np.ndarray
-    velocity_square: np.ndarray
+    square: SquareParts
     end_square: np.ndarray
+
+    @property
+    def velocity_square(self) -> np.ndarray:
+        """∫₀¹ Re(v vᴴ) dξ, shape (n_omega, n_el, 3, 3) (formed on access). [(m/s)²/m²]"""
+        return self.square.full()
 
     @property
     def acceleration(self) -> np.ndarray:
@@ -291,7 +358,7 @@ def _element_kinematics(
     # run (the frequency-major storage made that gather a transpose, 0.4 s of a
     # 400-element, 2,000-frequency analysis)
     vel = np.empty((n_el, 2, 3, n_w), dtype=complex).transpose(3, 0, 1, 2)
-    sq = np.zeros((n_w, n_el, 3, 3))
+    sq = np.empty((2, n_w, n_el))  # ∫|u_h|², ∫|u_z|² (SquareParts)
     ends = np.empty((n_w, n_el, 2))
     geo = (za, zb, chi, p, q, cb, sb, h, g)
     # blocks of frequencies: every operation is elementwise in ω, so the numbers are
@@ -300,10 +367,11 @@ def _element_kinematics(
     step = max(1, _BLOCK_ENTRIES // max(n_el, 1))
     for i in range(0, n_w, step):
         sl = slice(i, min(i + step, n_w))
-        _kinematics_block(w[sl], k[sl], geo, vel[sl], sq[sl], ends[sl])
+        _kinematics_block(w[sl], k[sl], geo, vel[sl], sq[:, sl], ends[sl])
     wet = (q - p)[0]
     for a in (w, k, pts, wet, vel, sq, ends):
         a.setflags(write=False)
+    square = SquareParts(sq[0], sq[1], beta)
     return ElementKinematics(
         omega=w,
         wavenumber=k,
@@ -312,7 +380,7 @@ def _element_kinematics(
         depth=h,
         wet_fraction=wet,
         velocity=vel,
-        velocity_square=sq,
+        square=square,
         end_square=ends,
     )
 
@@ -326,10 +394,9 @@ def _kinematics_block(
     ends_out: np.ndarray,
 ) -> None:
     """The element kinematics of the frequencies ``w`` (wavenumbers ``k``) written into
-    ``vel``, ``sq`` (zeroed) and ``ends_out``: the body of :func:`_element_kinematics`
-    on one block; ``geo`` = (z_a, z_b, χ, p, q, cos β, sin β, h, g).  Frequency-major
-    (n_w, n_el) arrays throughout: the outputs' layout, so they are written without
-    transposes."""
+    ``vel``, ``sq`` (h and v of :class:`SquareParts`) and ``ends_out``: the body of
+    :func:`_element_kinematics` on one block; ``geo`` = (z_a, z_b, χ, p, q, cos β,
+    sin β, h, g).  Frequency-major (n_w, n_el) arrays throughout."""
     za, zb, chi, p, q, cb, sb, h, g = geo
     length = q - p
     dz = np.multiply.outer(k, zb - za)
@@ -387,10 +454,8 @@ def _kinematics_block(
         vel[:, :, side, 0] = mh[side] * cb
         vel[:, :, side, 1] = mh[side] * sb
         vel[:, :, side, 2] = mz[side]
-    sq[:, :, 0, 0] = ch2 * (cb * cb)
-    sq[:, :, 1, 1] = ch2 * (sb * sb)
-    sq[:, :, 0, 1] = sq[:, :, 1, 0] = ch2 * (cb * sb)
-    sq[:, :, 2, 2] = sh2
+    sq[0] = ch2
+    sq[1] = sh2
     ends_out[...] = np.where((length > 0.0)[:, :, None], ends, 0.0)
 
 

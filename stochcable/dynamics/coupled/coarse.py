@@ -291,6 +291,7 @@ _CHANNEL_ARRAYS = (
     "motion_b",
     "element_velocity",
     "element_velocity_square",
+    "element_square",
     "element_end_square",
 )
 _NODAL_ARRAYS = ("velocity", "acceleration")

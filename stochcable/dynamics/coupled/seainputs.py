@@ -21,8 +21,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from stochcable.dynamics.coupled.inputs import scene_line_channels
 from stochcable.dynamics.line_loads import LineInputs, line_inputs, with_spectra
 from stochcable.dynamics.loads import Channel
@@ -130,7 +128,8 @@ def _channel_bytes(channels: tuple[Channel, ...]) -> int:
     arrays = []
     for c in channels:
         arrays += [c.element_velocity, c.element_velocity_square, c.element_end_square]
-    return int(sum(a.nbytes for a in arrays if isinstance(a, np.ndarray)))
+        arrays.append(c.element_square)
+    return int(sum(getattr(a, "nbytes", 0) for a in arrays if a is not None))
 
 
 def _nbytes(channels: tuple[Channel, ...], inp: LineInputs) -> int:
@@ -138,4 +137,5 @@ def _nbytes(channels: tuple[Channel, ...], inp: LineInputs) -> int:
     arrays = [inp.velocity, inp.ub, inp.inertia_extra]
     for c in channels:
         arrays += [c.element_velocity, c.element_velocity_square, c.element_end_square]
-    return int(sum(a.nbytes for a in arrays if isinstance(a, np.ndarray)))
+        arrays.append(c.element_square)
+    return int(sum(getattr(a, "nbytes", 0) for a in arrays if a is not None))
