@@ -103,12 +103,6 @@ class LineInputs:
             return None
         if "moments" in self.cache:
             return self.cache["moments"][..., freq, :]
-        # the last block gathered is kept (read-only for every caller): the load
-        # assembly reads a block's moments twice (inertia and drag)
-        tag = (freq.start, freq.stop) if isinstance(freq, slice) else None
-        last = self.cache.get("last_block")
-        if tag is not None and last is not None and last[0] == tag:
-            return last[1]
         out = None
         for i, src in enumerate(self.fluid):
             if src is None:
@@ -122,8 +116,6 @@ class LineInputs:
                 out[:, :, j, :, i] = el[:, :, c, freq]
         if _whole(freq) and out.nbytes <= working_memory_bytes() // 4:
             self.cache["moments"] = out
-        elif tag is not None:
-            self.cache["last_block"] = (tag, out)
         return out
 
     def fluid_block(self, i: int, freq: Freq = slice(None)) -> np.ndarray:

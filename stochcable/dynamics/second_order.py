@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -143,7 +144,7 @@ def _real_form_moments(c: np.ndarray) -> tuple[float, float]:
 
 
 def second_order_tension(
-    motion_transfer: np.ndarray,
+    motion_transfer: np.ndarray | Callable[[slice], np.ndarray],
     input_spectra: np.ndarray,
     weights: np.ndarray,
     positions: np.ndarray,
@@ -155,8 +156,9 @@ def second_order_tension(
 
     Parameters
     ----------
-    motion_transfer : ndarray, complex, shape (n_ch, n_nodes, 3, n_omega)
-        Node displacement per unit input. [m/unit]
+    motion_transfer : ndarray, complex, shape (n_ch, n_nodes, 3, n_omega), or callable
+        Node displacement per unit input, or a callable giving it on a slice of the
+        frequencies (read block by block). [m/unit]
     input_spectra : ndarray, shape (n_ch, n_omega)
         Input spectra. [unit²·s/rad]
     weights : ndarray, shape (n_omega,)
@@ -190,22 +192,31 @@ def second_order_tension(
 
 
 def _moments(
-    motion_transfer: np.ndarray, amp: np.ndarray, normals: np.ndarray
+    motion_transfer: np.ndarray | Callable[[slice], np.ndarray],
+    amp: np.ndarray,
+    normals: np.ndarray,
 ) -> tuple[float, float]:
     """:func:`_real_form_moments` of the rows B = normals·Δu·amp (two per element; one
     column per channel and frequency, real and imaginary parts side by side), over
     blocks: of frequencies when there are fewer rows than columns (the rows' Gram
     matrix summed block by block), else of elements (the columns' Gram matrix), each
     block's Δu and B within the working-memory target (the whole B of 400 elements ×
-    2,000 ω × 2 channels was 51 MB and its Δu 77 MB)."""
-    n_ch, n_nodes, _, n_w = motion_transfer.shape
+    2,000 ω × 2 channels was 51 MB and its Δu 77 MB).  A callable ``motion_transfer``
+    is read by frequency blocks (formed whole for the elements' blocks)."""
+    n_ch, n_w = amp.shape
+    n_nodes = normals.shape[0] + 1
     n_rows, n_cols = 2 * (n_nodes - 1), 2 * n_ch * n_w
-    mt = motion_transfer.transpose(1, 2, 0, 3)
+    if callable(motion_transfer) and n_rows > n_cols:
+        motion_transfer = motion_transfer(slice(None))
 
     def rows(el: slice, fr: slice) -> np.ndarray:
         # Δu·amp per element, component, channel and frequency, then its normal
         # components as one stacked real product on the interleaved (re, im) view
-        a, b = mt[el.start + 1 : el.stop + 1, :, :, fr], mt[el, :, :, fr]
+        if callable(motion_transfer):  # this block of frequencies, all elements
+            mt, fm = motion_transfer(fr).transpose(1, 2, 0, 3), slice(None)
+        else:
+            mt, fm = motion_transfer.transpose(1, 2, 0, 3), fr
+        a, b = mt[el.start + 1 : el.stop + 1, :, :, fm], mt[el, :, :, fm]
         du = np.empty(a.shape, dtype=complex)
         np.subtract(a, b, out=du)
         du *= amp[:, fr]
