@@ -23,7 +23,7 @@ from stochcable.dynamics.blocks import (
     element_load,
     real_gemm,
 )
-from stochcable.dynamics.freqblocks import working_memory_bytes
+from stochcable.dynamics.freqblocks import whole_grid, working_memory_bytes
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.node_inputs import LineInputs, line_inputs, with_spectra
 from stochcable.dynamics.system import (
@@ -187,7 +187,8 @@ def end_following_at(
         u_all = np.zeros((n, prep.d) + ub.shape[2:-1] + inp.ub.shape[-1:], dtype=complex)
         u_all[..., act] = u
         u = u_all
-    if nodes is None and freq == slice(None) and u.nbytes <= working_memory_bytes() // 4:
+    whole = whole_grid(freq, inp.omega.size)
+    if nodes is None and whole and u.nbytes <= working_memory_bytes() // 4:
         inp.cache[key] = u
     return u
 
@@ -232,7 +233,7 @@ def base_load(
             f0 -= dyn
         else:
             f0[..., act] -= dyn
-    if freq == slice(None) and f0.nbytes <= working_memory_bytes() // 4:
+    if whole_grid(freq, inp.omega.size) and f0.nbytes <= working_memory_bytes() // 4:
         inp.cache[key] = f0
     return f0
 
@@ -266,7 +267,7 @@ def drag_inputs(
     moments = inp.moments_at(freq)
     wm = moments
     key = ("drag_moments", system.solver)
-    whole = freq == slice(None)
+    whole = whole_grid(freq, inp.omega.size)
     if moving and whole and key in inp.cache:
         wm = inp.cache[key]
     elif moving:

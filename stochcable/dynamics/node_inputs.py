@@ -30,7 +30,7 @@ from stochcable.dynamics.blocks import (
     line_prep,
     trapezoid_weights,
 )
-from stochcable.dynamics.freqblocks import working_memory_bytes
+from stochcable.dynamics.freqblocks import whole_grid, working_memory_bytes
 from stochcable.dynamics.loads import (
     Channel,
     element_moments,
@@ -114,7 +114,7 @@ class LineInputs:
                 out = np.zeros(shape, dtype=complex)
             for j, c in enumerate(self.comps):
                 out[:, :, j, :, i] = el[:, :, c, freq]
-        if _whole(freq) and out.nbytes <= working_memory_bytes() // 4:
+        if whole_grid(freq, self.omega.size) and out.nbytes <= working_memory_bytes() // 4:
             self.cache["moments"] = out
         return out
 
@@ -149,7 +149,7 @@ class LineInputs:
         for i, use in enumerate(self.moment_inertia):
             if use:  # exact along the elements: l0·C_I(I − eeᵀ)·iω∫N_i v dξ
                 out[..., i] += element_load(self.inertia_el, self.fluid_block(i, freq) * (1j * w))
-        if _whole(freq) and out.nbytes <= working_memory_bytes() // 4:
+        if whole_grid(freq, self.omega.size) and out.nbytes <= working_memory_bytes() // 4:
             self.cache["inertia"] = out
         return out
 
@@ -224,10 +224,6 @@ class LineInputs:
             self.moment_inertia,
             take(self.inertia_extra, 2),
         )
-
-
-def _whole(freq: Freq) -> bool:
-    return isinstance(freq, slice) and freq == slice(None)
 
 
 def _inertia_elements(system: LineSystem) -> tuple[np.ndarray, np.ndarray]:
