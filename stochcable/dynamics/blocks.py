@@ -15,6 +15,7 @@ need that depends neither on the sea nor on the drag.
 from __future__ import annotations
 
 import functools
+import os
 from typing import Any
 
 import numpy as np
@@ -30,6 +31,23 @@ from stochcable.errors import (
     SolverError,
 )
 from stochcable.line.fem import FEModel
+
+_BAND: list[Any] = []
+
+
+def _band_kernel() -> Any:
+    """:func:`stochcable.dynamics.band_kernels.cholesky_band_solve`, or None without
+    numba or with ``STOCHCABLE_NUMBA=0`` (SciPy's ``cho_solve_banded`` then)."""
+    if os.environ.get("STOCHCABLE_NUMBA", "").strip() == "0":
+        return None
+    if not _BAND:
+        try:  # numba: imported on first use
+            from stochcable.dynamics.band_kernels import cholesky_band_solve
+        except ImportError:
+            cholesky_band_solve = None
+        _BAND.append(cholesky_band_solve)
+    return _BAND[0]
+
 
 # -------------------------------------------------------------------- linearization
 
@@ -283,6 +301,9 @@ class LinePrep:
                 raise SolverError(
                     "static correction: K_ff is not positive definite (check the static tensions)"
                 ) from None
+        kernel = _band_kernel()
+        if kernel is not None and rhs.ndim == 2:  # row sweeps, no transposes (band_kernels)
+            return kernel(self._chol, rhs)
         c = (self._chol, False)
         if np.iscomplexobj(rhs):
             # real K: the (re, im) columns of the interleaved real view in one solve

@@ -111,7 +111,10 @@ class LineInputs:
             if out is None:
                 nf = el[0, 0, 0, freq].size
                 shape = el.shape[:2] + (len(self.comps), nf, len(self.fluid))
-                out = np.zeros(shape, dtype=complex)
+                out = np.empty(shape, dtype=complex)
+                for k, f in enumerate(self.fluid):
+                    if f is None:  # (no fluid velocity: zero moments)
+                        out[..., k] = 0.0
             for j, c in enumerate(self.comps):
                 out[:, :, j, :, i] = el[:, :, c, freq]
         if whole_grid(freq, self.omega.size) and out.nbytes <= working_memory_bytes() // 4:
