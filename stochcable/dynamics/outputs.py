@@ -159,7 +159,14 @@ def line_result(
     )
     if indicators is not None:
         so = second_order_tension(
-            motion, spectra, q, model.positions, model.mesh, st.tension, tension_std
+            motion,
+            spectra,
+            q,
+            model.positions,
+            model.mesh,
+            st.tension,
+            tension_std,
+            tuple(model.components),
         )
         indicators = with_second_order(system.name, indicators, so)
     end_force = _end_force_transfer(model, resp, n_ch)

@@ -151,6 +151,7 @@ def second_order_tension(
     mesh: Any,
     tension_mean: np.ndarray,
     tension_std: np.ndarray,
+    components: tuple[int, ...] = (0, 1, 2),
 ) -> SecondOrderTension:
     """The second-order stretching tension of one line (module docstring).
 
@@ -169,6 +170,10 @@ def second_order_tension(
         ``l0``, ``ea``, ``weight`` per element.
     tension_mean, tension_std : ndarray, shape (n_el,)
         Static tension and linear tension σ per element. [N]
+    components : tuple of int, optional
+        The components the motion can have (a 2-D model's: its plane): the normals
+        with no part on them give rows of B that are zero, left out of its Gram
+        matrix (a line in a vertical plane: half the rows, a quarter of the work).
 
     Returns
     -------
@@ -185,7 +190,8 @@ def second_order_tension(
     kappa = 1.0 / (float(np.sum(mesh.l0 / mesh.ea)) * (1.0 + lam2 / 12.0))
     normals = normals * np.sqrt(0.5 * kappa / mesh.l0)[:, None, None]  # T₂ = Σ_e a_e|Δu⊥_e|²
     amp = np.sqrt(np.clip(input_spectra, 0.0, None) * weights)  # (n_ch, n_w)
-    mean, std = _moments(motion_transfer, amp, normals) if math.isfinite(lam2) else (0.0, 0.0)
+    keep = np.any(normals[:, :, list(components)] != 0.0, axis=2).ravel()  # (2·n_el,)
+    mean, std = _moments(motion_transfer, amp, normals, keep) if math.isfinite(lam2) else (0.0, 0.0)
     sig = float(np.max(tension_std)) if tension_std.size else 0.0
     ratio = std / sig if sig > 0 else (math.inf if std > 0 else 0.0)
     return SecondOrderTension(mean, std, ratio, lam2, math.sqrt(1.0 + ratio * ratio))
@@ -195,6 +201,7 @@ def _moments(
     motion_transfer: np.ndarray | Callable[[slice], np.ndarray],
     amp: np.ndarray,
     normals: np.ndarray,
+    keep: np.ndarray | None = None,
 ) -> tuple[float, float]:
     """:func:`_real_form_moments` of the rows B = normals·Δu·amp (two per element; one
     column per channel and frequency, real and imaginary parts side by side), over
@@ -202,10 +209,12 @@ def _moments(
     matrix summed block by block), else of elements (the columns' Gram matrix), each
     block's Δu and B within the working-memory target (the whole B of 400 elements ×
     2,000 ω × 2 channels was 51 MB and its Δu 77 MB).  A callable ``motion_transfer``
-    is read by frequency blocks (formed whole for the elements' blocks)."""
+    is read by frequency blocks (formed whole for the elements' blocks).  ``keep``: the
+    rows (two per element) that can be nonzero (default all)."""
     n_ch, n_w = amp.shape
     n_nodes = normals.shape[0] + 1
-    n_rows, n_cols = 2 * (n_nodes - 1), 2 * n_ch * n_w
+    keep = np.ones(2 * (n_nodes - 1), dtype=bool) if keep is None else keep
+    n_rows, n_cols = int(np.count_nonzero(keep)), 2 * n_ch * n_w
     if callable(motion_transfer) and n_rows > n_cols:
         motion_transfer = motion_transfer(slice(None))
 
@@ -221,7 +230,9 @@ def _moments(
         np.subtract(a, b, out=du)
         du *= amp[:, fr]
         c = normals[el] @ du.view(float).reshape(du.shape[0], 3, -1)
-        return c.reshape(2 * du.shape[0], -1)
+        c = c.reshape(2 * du.shape[0], -1)
+        rows_kept = keep[2 * el.start : 2 * el.stop]
+        return c if rows_kept.all() else c[rows_kept]
 
     # a block's Δu, B and copies: ≈ 200 bytes per element, channel and frequency
     per = 200.0 * n_ch
