@@ -335,9 +335,13 @@ def free_load(
     (n_nodes·d, 2d) matrix per drag) and the attachments' b·(V + Q) at their nodes:
     the same sums as one element load of the moments W = ∫N v dξ + P Q
     (:func:`drag_inputs`) to round-off, without forming W."""
-    rhs = base_load(system, prep, inp, freq)
-    if ("base_load", system.solver) in inp.cache or (inp.ub is None and "inertia" in inp.cache):
-        rhs = rhs.copy()  # (a view of a kept array)
+    kept = ("base_load", system.solver) in inp.cache
+    if kept:  # (a view of the kept F0)
+        rhs = base_load(system, prep, inp, freq).copy()
+    else:  # F_I, the end motion's part of F0 below with C_d Q
+        rhs = inp.inertia_at(freq)
+        if "inertia" in inp.cache:
+            rhs = rhs.copy()  # (a view of the kept inertia load)
     drag_blocks(system, damping)
     el = damping._cache["elements"]
     for i, f in enumerate(inp.fluid):
@@ -346,14 +350,16 @@ def free_load(
     if inp.ub is not None:
         act = _moving_channels(inp)
         ub = inp.ub[:, :, freq] if act is None else inp.ub[:, :, freq][..., act]
-        w = inp.omega[freq]
-        key = ("drag_end_basis", system.solver)
-        if key not in damping._cache:  # C_d G, the elements' part (attachments below)
-            g = prep.end_basis(system.solver == "direct")[0].reshape(prep.n, prep.d, -1)
-            dg = block_matvec(distribute(system.model, el, None), g)
-            damping._cache[key] = dg.reshape(prep.n * prep.d, -1)
-        q = real_gemm(damping._cache[key], np.ascontiguousarray(ub.reshape(2 * prep.d, -1)))
-        q = q.reshape((prep.n, prep.d) + ub.shape[2:]) * (-1j * w)[:, None]
+        w = inp.omega[freq][:, None]
+        # the end motion's loads as ONE product of a (n_nodes·d, ·) basis per drag:
+        # M_T G (ω² u_b) + (C_s + C_d) G (−iω u_b) − K G u_b (the last for the direct
+        # solve), or C_d G (−iω u_b) alone beside a kept F0
+        h = _end_load_basis(system, prep, damping, el, kept)
+        parts = [-1j * w * ub] if kept else [w * w * ub, -1j * w * ub]
+        if h.shape[1] > 2 * prep.d * len(parts):  # (direct: − K G u_b)
+            parts.append(-ub)
+        x = np.ascontiguousarray(np.concatenate(parts, axis=0).reshape(h.shape[1], -1))
+        q = real_gemm(h, x).reshape((prep.n, prep.d) + ub.shape[2:])
         if act is None:
             rhs += q
         else:
@@ -362,6 +368,24 @@ def free_load(
     if vq is not None and np.any(damping.b_node):
         rhs += damping.b_node[:, None, None, None] * vq[:, :, freq]
     return rhs
+
+
+def _end_load_basis(
+    system: LineSystem, prep: LinePrep, damping: Damping, el: np.ndarray, kept: bool
+) -> np.ndarray:
+    """[M_T G, (C_s + C_d) G (, K G)] (n_nodes·d, 4d or 6d), or C_d G alone (``kept``):
+    the end motion's loads of :func:`free_load` per unit (ω² u_b, −iω u_b (, −u_b)),
+    cached on ``damping`` (C_d G: the elements' drag, the attachments' in
+    :func:`attached_velocity`)."""
+    direct = system.solver == "direct"
+    key = ("end_load_basis", system.solver, kept)
+    if key not in damping._cache:
+        g, mg, sg, kg = prep.end_basis(direct)
+        dg = block_matvec(distribute(system.model, el, None), g.reshape(prep.n, prep.d, -1))
+        dg = dg.reshape(prep.n * prep.d, -1)
+        parts = [dg] if kept else [mg, sg + dg] + ([kg] if direct else [])
+        damping._cache[key] = np.ascontiguousarray(np.concatenate(parts, axis=1))
+    return damping._cache[key]
 
 
 def silent_channel(omega: np.ndarray) -> tuple[Channel, ...]:
