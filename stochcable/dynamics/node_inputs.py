@@ -121,6 +121,19 @@ class LineInputs:
             self.cache["moments"] = out
         return out
 
+    def fluid_views(self, freq: slice) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The moments of the channels with a fluid velocity on the frequencies
+        ``freq`` as views of their element-major storage, (n_fc, n_el, 2, 3, n_f), with
+        the model's components and those channels' indices (the variance kernel's
+        form; stacked, a copy, only with several fluid channels); None without
+        fluid velocity. [(m/s)/unit]"""
+        idx = [i for i, f in enumerate(self.fluid) if f is not None]
+        if not idx:
+            return None
+        views = [np.moveaxis(self.fluid[i], 0, -1)[..., freq] for i in idx]
+        stacked = views[0][None] if len(views) == 1 else np.stack(views)
+        return stacked, np.asarray(self.comps, dtype=np.int64), np.asarray(idx, dtype=np.int64)
+
     def fluid_block(self, i: int, freq: Freq = slice(None)) -> np.ndarray:
         """The moments of channel ``i`` (one with a fluid velocity) on the frequencies
         ``freq``, (n_el, 2, d, n_f), contiguous (one run per element end and

@@ -311,7 +311,7 @@ def _element_variance(
                 None if u_free is None else u_free[:, :, sl],
                 inp.omega[sl],
                 inp.weights[sl],
-                inp.moments_at(sl) if fluid else None,
+                _kernel_moments(inp, sl) if fluid else None,
                 var,
             )
         return var
@@ -338,6 +338,14 @@ def _element_variance(
             mw = np.swapaxes(_projected_moments(pr, inp.moments_at(sl)), 1, 2) * w2[cols]
         var += _structural_variance(qx, w2[cols], mw)
     return var
+
+
+def _kernel_moments(inp: LineInputs, sl: slice) -> Any:
+    """The moments of a block as the variance kernel reads them: the kept whole grid,
+    or the channels' element-major storage in place (no gather)."""
+    if "moments" in inp.cache:
+        return inp.cache["moments"][..., sl, :]
+    return inp.fluid_views(sl)
 
 
 def _block(u: Any, sl: slice) -> np.ndarray | None:
