@@ -231,14 +231,19 @@ def _motion_transfer(
 ) -> np.ndarray:
     """Node motion transfer functions on x, y, z on the frequencies ``freq``, (n_ch,
     n_nodes, 3, n_f) (zero on the components a 2-D model lacks). [m/unit]"""
-    disp = resp.displacement[freq]
-    n_f = disp.shape[0]
-    # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the frequency-major
-    # layout and transposing made every later pass strided)
-    u_h = np.transpose(disp.reshape(n_f, model.n_nodes, model.dim, n_ch), (3, 1, 2, 0))
+    if resp.nodes is not None:  # the node layout (n_nodes, d, n_f, n_ch) of a block
+        u_h = np.transpose(resp.nodes(freq), (3, 0, 1, 2))
+    else:
+        disp = resp.displacement[freq]
+        # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the
+        # frequency-major layout and transposing made every later pass strided)
+        u_h = np.transpose(
+            disp.reshape(disp.shape[0], model.n_nodes, model.dim, n_ch), (3, 1, 2, 0)
+        )
+    n_f = u_h.shape[-1]
     if tuple(model.components) == (0, 1, 2):  # 3-D: no zero components to embed
         return np.ascontiguousarray(u_h)
-    motion_h = np.zeros((n_ch, model.n_nodes, 3, n_f), dtype=disp.dtype)
+    motion_h = np.zeros((n_ch, model.n_nodes, 3, n_f), dtype=complex)
     motion_h[:, :, list(model.components)] = u_h
     return motion_h
 

@@ -36,6 +36,7 @@ from stochcable.results.records import (
 from stochcable.scene.units import unit_labels
 
 __all__ = [
+    "FormedOnAccess",
     "THREE_HOURS",
     "ResponseStats",
     "LinearizationRecord",
@@ -52,7 +53,7 @@ __all__ = [
 DOCUMENT_WINDOW = 2048
 
 
-class _FormedOnAccess:
+class FormedOnAccess:
     """A dataclass field (no default) holding an array, or a zero-argument callable
     that forms it: called on the first access, its array then kept (the node motion
     transfer of :class:`LineResult`, formed only when read)."""
@@ -144,7 +145,7 @@ class LineResult:
     s_nodes: np.ndarray
     s_elements: np.ndarray
     positions: np.ndarray
-    motion_transfer: np.ndarray = _FormedOnAccess()  # type: ignore[assignment]
+    motion_transfer: np.ndarray = FormedOnAccess()  # type: ignore[assignment]
     tension_transfer: np.ndarray
     end_tension_transfer: dict[str, np.ndarray]
     end_force_transfer: dict[str, np.ndarray]

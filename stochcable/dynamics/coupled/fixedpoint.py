@@ -443,13 +443,15 @@ def _outcome(
         system = cl.system
         damping = cache["damping"][cl.name]
         sol = cache["sol"][cl.name]
-        if isinstance(sol, FreeLine):  # frequency-major, block by block
-            disp, sc = sol.response_arrays()
+        nodes = None
+        if isinstance(sol, FreeLine):  # read block by block, formed only if asked for
+            nodes, disp, sc = sol.response()
         else:
             disp, sc = to_freq(sol[0]), sol[1]
         resp = Response(
             omega=g.omega,
             displacement=disp,
+            nodes=nodes,
             support_force=sc,
             end_tension=end_tension_from_support(system, sc),
         )

@@ -16,6 +16,7 @@ own solve costs.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -91,31 +92,51 @@ class FreeLine:
             )
         return self._support
 
-    def response_arrays(self) -> tuple[np.ndarray, np.ndarray]:
-        """The node displacements in the frequency-major layout (n_w, n_nodes·d, n_ch)
-        [m/unit] and the support forces (n_w, 2d, n_ch) [N/unit], formed over blocks of
-        frequencies without the node-major total displacement (the reactions read the
-        two nodes at each end only); the free-node part is released."""
+    def response(self) -> tuple[Any, Any, np.ndarray]:
+        """The converged response without the whole grid's frequency-major copy:
+        ``nodes(freq)``, the total node displacement (n_nodes, d, n_f, n_ch) on a
+        slice of the frequencies (:attr:`~stochcable.dynamics.system.Response.nodes`);
+        a zero-argument callable forming the frequency-major displacement (n_w,
+        n_nodes·d, n_ch) when it is read; and the support forces (n_w, 2d, n_ch),
+        formed here from the two nodes at each end.  They keep the free-node part and
+        the end motions only (not the inputs' fluid arrays). [m/unit, N/unit]"""
         system, inp = self.system, self.inp
         prep = line_prep(system)
         n, d = prep.n, prep.d
         n_w, n_ch = inp.weights.shape
-        ends = np.array([0, 1, n - 2, n - 1])
-        u_end = np.zeros((4, d, n_w, n_ch), dtype=complex)
-        disp = np.empty((n_w, n * d, n_ch), dtype=complex)
-        for sl in frequency_slices(n_w, 3 * 16 * n * d * max(n_ch, 1)):
-            u = np.zeros((n, d, sl.stop - sl.start, n_ch), dtype=complex)
-            up = end_following_at(system, prep, inp, sl)
+        light = replace(
+            inp,
+            velocity=None,
+            square=None,
+            fluid=tuple(None for _ in inp.fluid),
+            inertia_extra=None,
+            cache={k: v for k, v in inp.cache.items() if k == ("following", system.solver)},
+        )
+        u_free, omega = self.u_free, inp.omega  # (the closures hold no fluid arrays)
+
+        def nodes(freq: slice = slice(None)) -> np.ndarray:
+            n_f = omega[freq].size
+            u = np.zeros((n, d, n_f, n_ch), dtype=complex)
+            up = end_following_at(system, prep, light, freq)
             if up is not None:
                 u += up
-            u[1:-1] += self.u_free[:, :, sl]
-            disp[sl] = to_freq(u)
-            u_end[:, :, sl] = u[ends]
-        self.u_free = None  # (the response is formed)
+            u[1:-1] += u_free[:, :, freq]
+            return u
+
+        def displacement() -> np.ndarray:
+            disp = np.empty((n_w, n * d, n_ch), dtype=complex)
+            for sl in frequency_slices(n_w, 3 * 16 * n * d * max(n_ch, 1)):
+                disp[sl] = to_freq(nodes(sl))
+            return disp
+
+        ends = np.array([0, 1, n - 2, n - 1])
+        u_end = np.zeros((4, d, n_w, n_ch), dtype=complex)
+        for sl in frequency_slices(n_w, 2 * 16 * n * d * max(n_ch, 1)):
+            u_end[:, :, sl] = nodes(sl)[ends]
         support = reactions(
             system, prep, self.c, u_end, end_loads(system, inp, self.damping), inp.omega
         )
-        return disp, support
+        return nodes, displacement, support
 
     def combine(self, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Node displacements and support forces; ``ue`` has no columns (no attached
