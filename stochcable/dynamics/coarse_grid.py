@@ -10,7 +10,8 @@ import numpy as np
 
 from stochcable.dynamics.blocks import trapezoid_weights
 from stochcable.dynamics.line_loads import LineInputs
-from stochcable.dynamics.loads import Channel, weighted_mean_square
+from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.node_inputs import weighted_mean_square
 from stochcable.dynamics.system import LineSystem
 
 __all__ = ["interpolatory_weights", "subset_inputs"]
@@ -86,7 +87,11 @@ def subset_inputs(
     weights = quadrature[:, None] * spectra
     square = None
     for i, ch in enumerate(channels):
-        if ch.element_velocity is None and ch.velocity is None:
+        if (
+            ch.element_velocity is None
+            and ch.element_velocity_parts is None
+            and ch.velocity is None
+        ):
             continue  # as line_inputs: the mean square goes with the element moments
         sq = weighted_mean_square(ch, weights[:, i], comps, idx)
         square = sq if square is None else square + sq

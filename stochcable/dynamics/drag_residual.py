@@ -294,6 +294,8 @@ def _panel_lines(
     vel[:, :, comps] = -1j * w[:, None, None, None] * 0.5 * (u[:, :-1] + u[:, 1:])
     for c, ch in enumerate(channels):
         fluid = ch.element_velocity
+        if fluid is None and ch.element_velocity_parts is not None:  # (the sea's parts)
+            fluid = ch.element_velocity_parts.full()
         if fluid is not None:
             vel[..., c] += fluid.sum(axis=2)
         elif ch.kind == "sea" and ch.velocity is not None:

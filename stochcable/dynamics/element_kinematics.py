@@ -35,10 +35,17 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as v
+from stochcable.dynamics.element_parts import MomentParts, SquareParts
 from stochcable.errors import InputError
 from stochcable.sea.kinematics import G_STANDARD, wavenumber
 
-__all__ = ["ElementKinematics", "SquareParts", "element_frames", "element_wave_kinematics"]
+__all__ = [
+    "ElementKinematics",
+    "MomentParts",
+    "SquareParts",
+    "element_frames",
+    "element_wave_kinematics",
+]
 
 
 # |x| below which φ1 and ψ are summed as series (full relative precision; above it the
@@ -150,67 +157,6 @@ def _exp_integral(
 
 
 @dataclass(frozen=True, eq=False)
-class SquareParts:
-    """The element mean square ∫₀¹ Re(v vᴴ) dξ of the sea's kinematics in its two
-    parts, S = h·b bᵀ + v·ẑ ẑᵀ with b = (cos β, sin β, 0) the wave direction (the
-    horizontal and vertical velocities are in quadrature): two numbers per element and
-    frequency instead of the nine of S.
-
-    Attributes
-    ----------
-    horizontal, vertical : ndarray, shape (n_omega, n_el)
-        h = ∫|u_h|² dξ and v = ∫|u_z|² dξ. [(m/s)²/m²]
-    heading : float
-        β. [rad]
-    """
-
-    horizontal: np.ndarray
-    vertical: np.ndarray
-    heading: float
-
-    @property
-    def nbytes(self) -> int:
-        """Bytes of the two arrays. [B]"""
-        return int(self.horizontal.nbytes + self.vertical.nbytes)
-
-    def _pattern(self) -> tuple[np.ndarray, np.ndarray]:
-        cb, sb = math.cos(self.heading), math.sin(self.heading)
-        p = np.array([[cb * cb, cb * sb, 0.0], [cb * sb, sb * sb, 0.0], [0.0, 0.0, 0.0]])
-        z = np.zeros((3, 3))
-        z[2, 2] = 1.0
-        return p, z
-
-    def full(self) -> np.ndarray:
-        """S, shape (n_omega, n_el, 3, 3) (a fresh array). [(m/s)²/m²]"""
-        cb, sb = math.cos(self.heading), math.sin(self.heading)
-        h = self.horizontal
-        sq = np.zeros(h.shape + (3, 3))
-        sq[:, :, 0, 0] = h * (cb * cb)
-        sq[:, :, 1, 1] = h * (sb * sb)
-        sq[:, :, 0, 1] = sq[:, :, 1, 0] = h * (cb * sb)
-        sq[:, :, 2, 2] = self.vertical
-        return sq
-
-    def __getitem__(self, idx: Any) -> SquareParts:
-        """The parts on the frequencies ``idx``."""
-        return SquareParts(self.horizontal[idx], self.vertical[idx], self.heading)
-
-    def weighted(self, weights: np.ndarray, comps: Any) -> np.ndarray:
-        """Σ_ω weight·S on the components ``comps``, (n_el, d, d). [(m/s)²·…]"""
-        p, z = self._pattern()
-        c = np.asarray(comps)
-        hw, vw = self.horizontal.T @ weights, self.vertical.T @ weights
-        return hw[:, None, None] * p[c[:, None], c][None] + vw[:, None, None] * z[c[:, None], c]
-
-    def projected(self, proj: np.ndarray) -> np.ndarray:
-        """Σ_ij S_ij P_ij for per-element matrices P (n_el, 3, 3), (n_omega, n_el)."""
-        p, z = self._pattern()
-        ph = np.einsum("eij,ij->e", proj, p)
-        pz = np.einsum("eij,ij->e", proj, z)
-        return self.horizontal * ph + self.vertical * pz
-
-
-@dataclass(frozen=True, eq=False)
 class ElementKinematics:
     """Linear wave kinematics integrated along straight elements, per unit amplitude.
 
@@ -228,9 +174,10 @@ class ElementKinematics:
         [m]
     wet_fraction : ndarray, shape (n_el,)
         Fraction of each element below z = 0 (only that part is loaded). [-]
-    velocity : ndarray, complex, shape (n_omega, n_el, 2, 3)
+    moments : MomentParts
         ∫₀¹ N_a v dξ and ∫₀¹ N_b v dξ (N_a = 1 − ξ, N_b = ξ, ξ = s/l), v = 0 above
-        z = 0 (a view of element-major storage: frequencies contiguous). [(m/s)/m]
+        z = 0, in their horizontal and vertical parts (:attr:`velocity` forms them on
+        x, y, z). [(m/s)/m]
     square : SquareParts
         ∫₀¹ Re(v vᴴ) dξ, the element mean of the velocity's second moment, in its
         horizontal and vertical parts (:attr:`velocity_square` forms it). [(m/s)²/m²]
@@ -245,9 +192,15 @@ class ElementKinematics:
     heading: float
     depth: float
     wet_fraction: np.ndarray
-    velocity: np.ndarray
+    moments: MomentParts
     square: SquareParts
     end_square: np.ndarray
+
+    @property
+    def velocity(self) -> np.ndarray:
+        """∫₀¹ N_i v dξ on x, y, z, shape (n_omega, n_el, 2, 3) (formed on access).
+        [(m/s)/m]"""
+        return self.moments.full()
 
     @property
     def velocity_square(self) -> np.ndarray:
@@ -353,11 +306,10 @@ def _element_kinematics(
     q = np.where(wet_b, 1.0, np.where(wet_a, cross, 0.0))
     p, q = np.clip(p, 0.0, 1.0)[None, :], np.clip(q, 0.0, 1.0)[None, :]
     n_w, n_el = w.size, za.size
-    # the moments stored element-major (n_el, 2, 3, n_w), seen frequency-major: the
-    # loads gather a block of frequencies per element and component as one contiguous
-    # run (the frequency-major storage made that gather a transpose, 0.4 s of a
-    # 400-element, 2,000-frequency analysis)
-    vel = np.empty((n_el, 2, 3, n_w), dtype=complex).transpose(3, 0, 1, 2)
+    # the moments' horizontal and vertical parts stored element-major (n_el, 2, 2,
+    # n_w): the loads read a block of frequencies per element end and part as one
+    # contiguous run (MomentParts)
+    parts = np.empty((n_el, 2, 2, n_w), dtype=complex)
     sq = np.empty((2, n_w, n_el))  # ∫|u_h|², ∫|u_z|² (SquareParts)
     ends = np.empty((n_w, n_el, 2))
     geo = (za, zb, chi, p, q, cb, sb, h, g)
@@ -367,9 +319,9 @@ def _element_kinematics(
     step = max(1, _BLOCK_ENTRIES // max(n_el, 1))
     for i in range(0, n_w, step):
         sl = slice(i, min(i + step, n_w))
-        _kinematics_block(w[sl], k[sl], geo, vel[sl], sq[:, sl], ends[sl])
+        _kinematics_block(w[sl], k[sl], geo, parts[..., sl], sq[:, sl], ends[sl])
     wet = (q - p)[0]
-    for a in (w, k, pts, wet, vel, sq, ends):
+    for a in (w, k, pts, wet, parts, sq, ends):
         a.setflags(write=False)
     square = SquareParts(sq[0], sq[1], beta)
     return ElementKinematics(
@@ -379,7 +331,7 @@ def _element_kinematics(
         heading=beta,
         depth=h,
         wet_fraction=wet,
-        velocity=vel,
+        moments=MomentParts(parts, beta),
         square=square,
         end_square=ends,
     )
@@ -394,7 +346,8 @@ def _kinematics_block(
     ends_out: np.ndarray,
 ) -> None:
     """The element kinematics of the frequencies ``w`` (wavenumbers ``k``) written into
-    ``vel``, ``sq`` (h and v of :class:`SquareParts`) and ``ends_out``: the body of
+    ``vel`` (the parts of :class:`MomentParts`, (n_el, 2, 2, n_w)), ``sq`` (h and v of
+    :class:`SquareParts`) and ``ends_out``: the body of
     :func:`_element_kinematics` on one block; ``geo`` = (z_a, z_b, χ, p, q, cos β,
     sin β, h, g).  Frequency-major (n_w, n_el) arrays throughout."""
     za, zb, chi, p, q, cb, sb, h, g = geo
@@ -450,10 +403,9 @@ def _kinematics_block(
             mh[1][zero_w, :] = u0 * side_b
             ch2[zero_w, :] = u0 * u0 * length
             ends[zero_w] = u0 * u0
-    for side in range(2):
-        vel[:, :, side, 0] = mh[side] * cb
-        vel[:, :, side, 1] = mh[side] * sb
-        vel[:, :, side, 2] = mz[side]
+    for side in range(2):  # (n_el, n_w) each: the transposed block
+        vel[:, side, 0] = mh[side].T
+        vel[:, side, 1] = mz[side].T
     sq[0] = ch2
     sq[1] = sh2
     ends_out[...] = np.where((length > 0.0)[:, :, None], ends, 0.0)

@@ -76,7 +76,6 @@ __all__ = [
     "drag_matrix",
     "element_frames",
     "element_mean_square",
-    "weighted_mean_square",
     "element_moments",
     "embed",
     "inertia_matrix",
@@ -146,10 +145,11 @@ class Channel:
         times these (linear kinematics).  None: interpolate the nodal values. [(m/s)/m]
     element_velocity_square : ndarray or None, real, shape (n_omega, n_el, 3, 3)
         Element mean ∫₀¹ Re(v vᴴ) dξ of the fluid velocity. [(m/s)²/m²]
-    element_square : SquareParts or None
-        The sea's element mean square in its horizontal and vertical parts
-        (:class:`~stochcable.dynamics.element_kinematics.SquareParts`), what
-        :func:`element_mean_square` forms when ``element_velocity_square`` is None.
+    element_velocity_parts, element_square : MomentParts, SquareParts or None
+        The sea's element moments and mean square in their horizontal and vertical
+        parts (:mod:`stochcable.dynamics.element_parts`), what :func:`element_moments`
+        and :func:`element_mean_square` form when ``element_velocity`` and
+        ``element_velocity_square`` are None.
     element_end_square : ndarray or None, real, shape (n_omega, n_el, 2)
         |v|² at the ends of each element's wet part
         (:attr:`ElementKinematics.end_square`). [(m/s)²/m²]
@@ -172,6 +172,7 @@ class Channel:
     element_velocity_square: np.ndarray | None = None
     element_end_square: np.ndarray | None = None
     element_square: Any = None  # SquareParts
+    element_velocity_parts: Any = None  # MomentParts
     nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
 
 
@@ -241,7 +242,7 @@ def line_channels(
                     density=density,
                     motion_a=_end_rao(raos.get("end_a"), w, heading),
                     motion_b=_end_rao(raos.get("end_b"), w, heading),
-                    element_velocity=el.velocity,
+                    element_velocity_parts=el.moments,
                     element_square=el.square,
                     element_end_square=el.end_square,
                     nodal=_sea_nodal(el, env.g),
@@ -314,6 +315,8 @@ def element_moments(model: Any, channel: Channel) -> np.ndarray | None:
     """
     if channel.element_velocity is not None:
         return channel.element_velocity
+    if channel.element_velocity_parts is not None:
+        return channel.element_velocity_parts.full()
     if channel.velocity is None:
         return None
     pat = _LUMPED if getattr(model, "mass_matrix", "consistent") == "lumped" else _CONSISTENT
@@ -347,24 +350,6 @@ def element_mean_square(channel: Channel) -> np.ndarray | None:
     bb = np.einsum("wei,wej->weij", vb, vb.conj()).real
     ab = np.einsum("wei,wej->weij", va, vb.conj()).real
     return (aa + bb) / 3.0 + (ab + np.swapaxes(ab, 2, 3)) / 6.0
-
-
-def weighted_mean_square(
-    channel: Channel, weights: np.ndarray, comps: Any, idx: Any = slice(None)
-) -> np.ndarray | None:
-    """Σ_ω weight·∫₀¹ Re(v vᴴ) dξ of a channel on the frequencies ``idx``, on the
-    components ``comps``, (n_el, d, d) (None without fluid velocity): from the sea's
-    two parts (:class:`~stochcable.dynamics.element_kinematics.SquareParts`) without
-    forming the 3 × 3 matrices where it has them. [(m/s)²·weight]"""
-    comps = np.asarray(comps)
-    if channel.element_velocity_square is None and channel.element_square is not None:
-        return channel.element_square[idx].weighted(weights, comps)
-    sq = element_mean_square(channel)
-    if sq is None:
-        return None
-    # the d × d part in one gather (two chained ones were 0.1-0.4 ms)
-    sq = sq[idx][:, :, comps[:, None], comps]
-    return np.einsum("weij,w->eij", sq, weights)
 
 
 # ------------------------------------------------------------------ element geometry

@@ -30,16 +30,17 @@ from stochcable.dynamics.blocks import (
     line_prep,
     trapezoid_weights,
 )
+from stochcable.dynamics.element_parts import ArrayMoments
 from stochcable.dynamics.freqblocks import whole_grid, working_memory_bytes
 from stochcable.dynamics.loads import (
     Channel,
+    element_mean_square,
     element_moments,
     inertia_blocks,
-    weighted_mean_square,
 )
 from stochcable.dynamics.system import LineSystem
 
-__all__ = ["LineInputs", "line_inputs", "with_spectra"]
+__all__ = ["LineInputs", "line_inputs", "weighted_mean_square", "with_spectra"]
 
 #: Frequency selections: a slice of the grid or an index array (the coarse subset).
 Freq = slice | np.ndarray
@@ -62,9 +63,10 @@ class LineInputs:
         Trapezoid weight × spectrum. [unit²]
     square : ndarray or None, shape (n_el, d, d)
         Σ weight·∫Re(v vᴴ)dξ of the fluid velocity. [(m/s)²]
-    fluid : tuple of (ndarray or None)
-        Per channel its consistent element moments ∫N_i v dξ, shape (n_w, n_el, 2, 3)
-        (the channel's own array; None without fluid velocity). [(m/s)/unit]
+    fluid : tuple of (MomentParts, ArrayMoments or None)
+        Per channel its consistent element moments ∫N_i v dξ
+        (:mod:`stochcable.dynamics.element_parts`: the sea's parts, the channel's own
+        arrays; None without fluid velocity). [(m/s)/unit]
     comps : tuple of int
         The model's components among x, y, z.
     inertia_el : ndarray, shape (n_el, d, d)
@@ -83,7 +85,7 @@ class LineInputs:
     ub: np.ndarray | None
     weights: np.ndarray
     square: np.ndarray | None
-    fluid: tuple[np.ndarray | None, ...]
+    fluid: tuple[Any, ...]
     comps: tuple[int, ...]
     inertia_el: np.ndarray
     moment_inertia: tuple[bool, ...]
@@ -107,32 +109,35 @@ class LineInputs:
         for i, src in enumerate(self.fluid):
             if src is None:
                 continue
-            el = np.moveaxis(src, 0, -1)  # (n_el, 2, 3, n_w): the sea's storage order
+            m = src.block(self.comps, freq)  # (n_el, 2, d, n_f)
             if out is None:
-                nf = el[0, 0, 0, freq].size
-                shape = el.shape[:2] + (len(self.comps), nf, len(self.fluid))
-                out = np.empty(shape, dtype=complex)
+                out = np.empty(m.shape + (len(self.fluid),), dtype=complex)
                 for k, f in enumerate(self.fluid):
                     if f is None:  # (no fluid velocity: zero moments)
                         out[..., k] = 0.0
-            for j, c in enumerate(self.comps):
-                out[:, :, j, :, i] = el[:, :, c, freq]
+            out[..., i] = m
         if whole_grid(freq, self.omega.size) and out.nbytes <= working_memory_bytes() // 4:
             self.cache["moments"] = out
         return out
 
     def fluid_views(self, freq: slice) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """The moments of the channels with a fluid velocity on the frequencies
-        ``freq`` as views of their element-major storage, (n_fc, n_el, 2, 3, n_f), with
-        the model's components and those channels' indices (the variance kernel's
-        form; stacked, a copy, only with several fluid channels); None without
-        fluid velocity. [(m/s)/unit]"""
+        ``freq`` as views of their element-major parts, (n_fc, n_el, 2, P, n_f), the
+        model's components as combinations of the parts (n_fc, d, P) and those
+        channels' indices (the variance kernel's form; stacked, a copy, only with
+        several fluid channels); None without fluid velocity. [(m/s)/unit]"""
         idx = [i for i, f in enumerate(self.fluid) if f is not None]
         if not idx:
             return None
-        views = [np.moveaxis(self.fluid[i], 0, -1)[..., freq] for i in idx]
+        srcs = [self.fluid[i] for i in idx]
+        if len({s.stacked(slice(0, 0)).shape[2] for s in srcs}) > 1:  # mixed kinds
+            views = [np.moveaxis(s.full(), 0, -1)[..., freq] for s in srcs]
+            mix = np.stack([np.eye(3)[list(self.comps)]] * len(srcs))
+        else:
+            views = [s.stacked(freq) for s in srcs]
+            mix = np.stack([s.mix(self.comps) for s in srcs])
         stacked = views[0][None] if len(views) == 1 else np.stack(views)
-        return stacked, np.asarray(self.comps, dtype=np.int64), np.asarray(idx, dtype=np.int64)
+        return stacked, mix, np.asarray(idx, dtype=np.int64)
 
     def fluid_block(self, i: int, freq: Freq = slice(None)) -> np.ndarray:
         """The moments of channel ``i`` (one with a fluid velocity) on the frequencies
@@ -144,8 +149,7 @@ class LineInputs:
         last = self.cache.get("last_fluid")
         if tag is not None and last is not None and last[0] == tag:
             return last[1]
-        el = np.moveaxis(self.fluid[i], 0, -1)  # (n_el, 2, 3, n_w)
-        out = np.ascontiguousarray(el[:, :, list(self.comps), freq])
+        out = self.fluid[i].block(self.comps, freq)
         if tag is not None:  # read twice per block (inertia and drag loads)
             self.cache["last_fluid"] = (tag, out)
         return out
@@ -197,12 +201,10 @@ class LineInputs:
         if "moments" in self.cache:
             mom = self.cache["moments"]
             return mom[0, 0], mom[-1, 1]
-        comps = list(self.comps)
-        out = np.zeros((2, len(comps)) + self.weights.shape, dtype=complex)
+        out = np.zeros((2, len(self.comps)) + self.weights.shape, dtype=complex)
         for i, src in enumerate(self.fluid):
             if src is not None:
-                out[0, :, :, i] = src[:, 0, 0, comps].T
-                out[1, :, :, i] = src[:, -1, 1, comps].T
+                out[0, :, :, i], out[1, :, :, i] = src.ends(self.comps)
         return out[0], out[1]
 
     @property
@@ -275,9 +277,10 @@ def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs
             if vel is None:
                 vel = np.zeros(shape, dtype=complex)
             vel[..., i] = np.transpose(ch.velocity[..., comps], (1, 2, 0))
-        fluid.append(element_moments(model, ch))
-        by_moments.append(ch.element_velocity is not None)
-        if ch.element_velocity is not None:
+        src = _moment_source(model, ch)
+        fluid.append(src)
+        by_moments.append(_has_element_moments(ch))
+        if _has_element_moments(ch):
             if np.any(node_mass) and ch.acceleration is not None:
                 if extra is None:
                     extra = np.zeros(shape, dtype=complex)
@@ -317,11 +320,44 @@ def _weighted_square(
     components, (n_el, d, d) (None without fluid velocity)."""
     square = None
     for i, ch in enumerate(channels):
-        if ch.element_velocity is None and ch.velocity is None:
+        if not _has_element_moments(ch) and ch.velocity is None:
             continue
         sq = weighted_mean_square(ch, weights[:, i], model.components)
         square = sq if square is None else square + sq
     return square
+
+
+def _has_element_moments(ch: Channel) -> bool:
+    """Whether a channel carries moments integrated along the elements (the sea's
+    parts or a given array; else its nodal kinematics are interpolated)."""
+    return ch.element_velocity is not None or ch.element_velocity_parts is not None
+
+
+def _moment_source(model: Any, ch: Channel) -> Any:
+    """A channel's element moments as :class:`MomentParts` or :class:`ArrayMoments`
+    (None without fluid velocity)."""
+    if ch.element_velocity is None and ch.element_velocity_parts is not None:
+        return ch.element_velocity_parts
+    m = element_moments(model, ch)
+    return None if m is None else ArrayMoments(m)
+
+
+def weighted_mean_square(
+    channel: Channel, weights: np.ndarray, comps: Any, idx: Any = slice(None)
+) -> np.ndarray | None:
+    """Σ_ω weight·∫₀¹ Re(v vᴴ) dξ of a channel on the frequencies ``idx``, on the
+    components ``comps``, (n_el, d, d) (None without fluid velocity): from the sea's
+    two parts (:class:`~stochcable.dynamics.element_parts.SquareParts`) without
+    forming the 3 × 3 matrices where it has them. [(m/s)²·weight]"""
+    comps = np.asarray(comps)
+    if channel.element_velocity_square is None and channel.element_square is not None:
+        return channel.element_square[idx].weighted(weights, comps)
+    sq = element_mean_square(channel)
+    if sq is None:
+        return None
+    # the d × d part in one gather (two chained ones were 0.1-0.4 ms)
+    sq = sq[idx][:, :, comps[:, None], comps]
+    return np.einsum("weij,w->eij", sq, weights)
 
 
 def _spectrum_free(key: Any) -> bool:

@@ -30,15 +30,16 @@ from stochcable.compiled import jit_cached
 __all__ = ["element_variance_terms"]
 
 
-def _terms(pr, a, f, omega, wt, mom, comps, fch, n_ch, var):  # noqa: ANN001 - numba kernel
+def _terms(pr, a, f, omega, wt, mom, mix, fch, n_ch, var):  # noqa: ANN001 - numba kernel
     """var[e, r] += the sums of the module docstring (a, f, mom empty: absent), with
     q = −iω·x: |q|² terms times ω², Re(m̄q) = ω·Im(m̄x); column n is frequency
-    n // n_ch and channel n % n_ch, mom[i] the moments (n_el, 2, 3, n_w) of channel
-    fch[i] on the model components ``comps``."""
+    n // n_ch and channel n % n_ch, mom[i] the moments (n_el, 2, P, n_w) of channel
+    fch[i] in P parts, mix[i] (d, P) the model components as their combinations."""
     n_el, k, d = pr.shape
     n_cols = omega.size
     has_a = a.shape[0] > 0
     n_fc = mom.shape[0]
+    n_p = mom.shape[3]
     n_free = f.shape[0]
     xa = np.empty(d, dtype=np.complex128)
     xb = np.empty(d, dtype=np.complex128)
@@ -79,8 +80,13 @@ def _terms(pr, a, f, omega, wt, mom, comps, fch, n_ch, var):  # noqa: ANN001 - n
                     ma = 0j
                     mb = 0j
                     for j in range(d):
-                        ma += pr[e, r, j] * mom[fm, e, 0, comps[j], iw]
-                        mb += pr[e, r, j] * mom[fm, e, 1, comps[j], iw]
+                        va = 0j
+                        vb = 0j
+                        for p in range(n_p):
+                            va += mix[fm, j, p] * mom[fm, e, 0, p, iw]
+                            vb += mix[fm, j, p] * mom[fm, e, 1, p, iw]
+                        ma += pr[e, r, j] * va
+                        mb += pr[e, r, j] * vb
                     acc_m[r] += w1 * (ma.real * ai - ma.imag * ar + mb.real * bi - mb.imag * br)
         for r in range(k):
             var[e, r] += acc_t[r] / 3.0 + 2.0 * acc_m[r]
@@ -94,13 +100,14 @@ _SIGNATURE = types.void(
     types.Array(types.float64, 1, "C", readonly=True),
     types.Array(types.float64, 1, "C", readonly=True),
     types.Array(types.complex128, 5, "A", readonly=True),
-    types.Array(types.int64, 1, "C", readonly=True),
+    types.Array(types.float64, 3, "C", readonly=True),
     types.Array(types.int64, 1, "C", readonly=True),
     types.int64,
     types.Array(types.float64, 2, "C"),
 )
 """(rows, U_p, u_f, ω per column, weight per column, moments per fluid channel
-(n_fc, n_el, 2, 3, n_w), the model components, the fluid channels, n_ch, var)."""
+(n_fc, n_el, 2, P, n_w), their mixing to the model components (n_fc, d, P), the fluid
+channels, n_ch, var)."""
 
 _kernel, _ = jit_cached(_terms, _SIGNATURE, "element variance")
 
@@ -133,10 +140,11 @@ def element_variance_terms(
         σ² weights (quadrature × spectrum). [unit²·rad/s·s/rad]
     moments : ndarray, tuple or None
         Consistent moments ∫N_{a,b} v dξ of the fluid velocity: an array (n_el, 2, d,
-        n_w, n_ch), or ``(views, comps, channels)`` with ``views`` (n_fc, n_el, 2, 3,
-        n_w) the moments of the channels ``channels`` on x, y, z in any memory layout
-        (the sea's element-major storage, read in place) and ``comps`` the model's
-        components; None: no fluid velocity. [m/s/unit]
+        n_w, n_ch), or ``(views, mix, channels)`` with ``views`` (n_fc, n_el, 2, P,
+        n_w) the moments of the channels ``channels`` in P parts in any memory layout
+        (the sea's element-major parts, read in place) and ``mix`` (n_fc, d, P) the
+        model's components as combinations of them; None: no fluid velocity.
+        [m/s/unit]
     var : ndarray, shape (n_el, k)
         Accumulated in place. [m²/s²]
     """
@@ -149,12 +157,13 @@ def element_variance_terms(
         return np.ascontiguousarray(x, dtype=complex).reshape(*x.shape[: x.ndim - 2], n)
 
     if moments is None:
-        views, comps, chans = _NONE5, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        views, mix, chans = _NONE5, np.zeros((0, 0, 0)), np.zeros(0, dtype=np.int64)
     elif isinstance(moments, tuple):
-        views, comps, chans = moments
+        views, mix, chans = moments
     else:  # (n_el, 2, d, n_w, n_ch): every channel, the model's components in order
         views = np.moveaxis(moments, 4, 0)
-        comps, chans = np.arange(moments.shape[2]), np.arange(n_ch)
+        mix = np.broadcast_to(np.eye(moments.shape[2]), (n_ch,) + (moments.shape[2],) * 2)
+        chans = np.arange(n_ch)
     _kernel(
         np.ascontiguousarray(rows, dtype=float),
         flat(u_nodes, _NONE3),
@@ -162,7 +171,7 @@ def element_variance_terms(
         np.repeat(np.asarray(omega, dtype=float), n_ch),
         np.ascontiguousarray(weights, dtype=float).ravel(),
         views,
-        np.asarray(comps, dtype=np.int64),
+        np.ascontiguousarray(mix, dtype=float),
         np.asarray(chans, dtype=np.int64),
         n_ch,
         var,

@@ -292,6 +292,7 @@ _CHANNEL_ARRAYS = (
     "element_velocity",
     "element_velocity_square",
     "element_square",
+    "element_velocity_parts",
     "element_end_square",
 )
 _NODAL_ARRAYS = ("velocity", "acceleration")

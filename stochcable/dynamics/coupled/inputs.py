@@ -345,6 +345,7 @@ def group_channels(
                     element_velocity=None,
                     element_velocity_square=None,
                     element_square=None,
+                    element_velocity_parts=None,
                     element_end_square=None,
                 ),
             )
