@@ -181,9 +181,14 @@ def surface_resolution_check(
         q = trapezoid_weights(omega)
     var = None
     for ch in channels:
-        if ch.element_end_square is None or not np.any(ch.spectrum > 0):
+        if not np.any(ch.spectrum > 0):
             continue
-        v_ = np.einsum("wes,w->es", ch.element_end_square, q * ch.spectrum)
+        if ch.element_end_square is not None:
+            v_ = np.einsum("wes,w->es", ch.element_end_square, q * ch.spectrum)
+        elif ch.element_ends is not None:  # (the sea's, formed block by block)
+            v_ = ch.element_ends.weighted(q * ch.spectrum)
+        else:
+            continue
         var = v_ if var is None else var + v_
     if var is None:
         return

@@ -150,6 +150,10 @@ class Channel:
         parts (:mod:`stochcable.dynamics.element_parts`), what :func:`element_moments`
         and :func:`element_mean_square` form when ``element_velocity`` and
         ``element_velocity_square`` are None.
+    element_ends : EndSquare or None
+        The sea's |v|² at the element ends, formed on demand
+        (:class:`~stochcable.dynamics.element_kinematics.EndSquare`; read where
+        ``element_end_square`` is None).
     element_end_square : ndarray or None, real, shape (n_omega, n_el, 2)
         |v|² at the ends of each element's wet part
         (:attr:`ElementKinematics.end_square`). [(m/s)²/m²]
@@ -173,6 +177,7 @@ class Channel:
     element_end_square: np.ndarray | None = None
     element_square: Any = None  # SquareParts
     element_velocity_parts: Any = None  # MomentParts
+    element_ends: Any = None  # EndSquare
     nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
 
 
@@ -244,7 +249,7 @@ def line_channels(
                     motion_b=_end_rao(raos.get("end_b"), w, heading),
                     element_velocity_parts=el.moments,
                     element_square=el.square,
-                    element_end_square=el.end_square,
+                    element_ends=el.ends,
                     nodal=_sea_nodal(el, env.g),
                 )
             )

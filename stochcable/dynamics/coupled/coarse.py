@@ -293,6 +293,7 @@ _CHANNEL_ARRAYS = (
     "element_velocity_square",
     "element_square",
     "element_velocity_parts",
+    "element_ends",
     "element_end_square",
 )
 _NODAL_ARRAYS = ("velocity", "acceleration")

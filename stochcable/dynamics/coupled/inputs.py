@@ -346,6 +346,7 @@ def group_channels(
                     element_velocity_square=None,
                     element_square=None,
                     element_velocity_parts=None,
+                    element_ends=None,
                     element_end_square=None,
                 ),
             )

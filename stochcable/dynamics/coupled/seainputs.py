@@ -128,7 +128,7 @@ def _channel_bytes(channels: tuple[Channel, ...]) -> int:
     arrays = []
     for c in channels:
         arrays += [c.element_velocity, c.element_velocity_square, c.element_end_square]
-        arrays += [c.element_square, c.element_velocity_parts]
+        arrays += [c.element_square, c.element_velocity_parts, c.element_ends]
     return int(sum(getattr(a, "nbytes", 0) for a in arrays if a is not None))
 
 
@@ -137,5 +137,5 @@ def _nbytes(channels: tuple[Channel, ...], inp: LineInputs) -> int:
     arrays = [inp.velocity, inp.ub, inp.inertia_extra]
     for c in channels:
         arrays += [c.element_velocity, c.element_velocity_square, c.element_end_square]
-        arrays += [c.element_square, c.element_velocity_parts]
+        arrays += [c.element_square, c.element_velocity_parts, c.element_ends]
     return int(sum(getattr(a, "nbytes", 0) for a in arrays if a is not None))
