@@ -15,10 +15,10 @@ frequencies (``analysis.omega.count`` = n_ω), one over the nodes of a line
 (n_nodes = elements + 1, three DOFs each) and one over the line's input channels
 (:class:`stochcable.dynamics.loads.Channel`: the sea, one per end-motion spectrum DOF,
 and the three translations of an end attached to a body).  Held for the whole grid
-are the sea's element kinematics (the consistent moments of the velocity, 6 complex
-per element, and its mean square and end squares, 4 real), the converged response
-(the free nodes' part during the fixed point, then the displacement: d complex per
-node and channel) and the element tension transfer functions; everything else — the
+are the sea's element kinematics (the horizontal and vertical parts of the consistent
+moments of the velocity, 4 complex per element, and of its mean square, 2 real), the
+converged response (its free nodes' part: d complex per node and channel) and the
+element tension transfer functions; everything else — the
 loads, the solves, the variance sums, the node motion transfer of the outputs — runs
 over blocks of frequencies whose temporaries stay within the working-memory target
 (``STOCHCABLE_WORKING_MEMORY_MB``, 48 MiB by default,
@@ -43,22 +43,22 @@ kernels; ``benchmarks/bench_cost.py``, x86-64, numpy 2, 2 cores):
 =====================================  =====  ======  =========  =======  =============
 scene                                  n_el   n_ω     channels   ΔRSS     B/(node·ω·ch)
 =====================================  =====  ======  =========  =======  =============
-taut_wire (sea only)                   200    1000    1          90 MB    114
-taut_wire                              400    1000    1          138 MB   177
-chain_catenary (sea + fairlead surge)  200    1000    2          118 MB   127
-chain_catenary                         400    1000    2          167 MB   125
-chain_catenary                         200    3000    2          233 MB   138
-disc buoy, three legs (free body)      3×100  1000    4 per leg  213 MB   120
-disc buoy, three legs                  3×200  1000    4 per leg  374 MB   127
+taut_wire (sea only)                   200    1000    1          69 MB    12
+taut_wire                              400    1000    1          114 MB   116
+chain_catenary (sea + fairlead surge)  200    1000    2          77 MB    25
+chain_catenary                         400    1000    2          140 MB   90
+chain_catenary                         200    3000    2          172 MB   87
+disc buoy, three legs (free body)      3×100  1000    4 per leg  206 MB   115
+disc buoy, three legs                  3×200  1000    4 per leg  346 MB   116
 =====================================  =====  ======  =========  =======  =============
 
-(the ratio is (ΔRSS − M_0)/(n_ω Σ n_nodes n_ch)) so c_M = 180 B (the largest ratio,
+(the ratio is (ΔRSS − M_0)/(n_ω Σ n_nodes n_ch)) so c_M = 120 B (the largest ratio,
 rounded up: the estimate should not be below the peak; a line with the sea alone
 holds its kinematics for one channel, the most per channel), M_0 = 64 MiB (the
 working-memory target's temporaries and the small arrays); c_T = 110 B per sample and
 channel (chain_catenary, 2^20 and 2^22 samples with the whole record in the result
-document: 320 B per sample).  Time on the same machine: 0.9–1.3 µs per
-node·frequency·channel for single lines, 2.5–2.7 µs with a free body (k_M = 1.3 µs,
+document: 320 B per sample).  Time on the same machine: 0.9–1.2 µs per
+node·frequency·channel for single lines, 2.1–2.4 µs with a free body (k_M = 1.3 µs,
 the body factor 1 + n_bodies), k_T = 1.7 µs per sample and channel.  Times are
 indicative (they scale with the CPU and the drag iterations); the memory model is
 what the budgets use.
@@ -97,7 +97,7 @@ __all__ = [
     "SECONDS_PER_SAMPLE_CHANNEL",
 ]
 
-BYTES_PER_NODE_FREQUENCY_CHANNEL = 180
+BYTES_PER_NODE_FREQUENCY_CHANNEL = 120
 """Peak bytes per node, frequency and input channel of a line (c_M). [B]"""
 
 BYTES_PER_SAMPLE_CHANNEL = 110
