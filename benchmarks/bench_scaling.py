@@ -149,9 +149,9 @@ def write(rows: list[dict], f: dict) -> None:
         "channel) and the element tensions' transfer functions, which the result",
         "keeps; `LineResult.motion_transfer` (every node's motion transfer functions)",
         "is formed from the kept response only when it is read.  Drag-independent",
-        "arrays of the whole grid are kept between",
-        "the iterations only where they fit a quarter of the memory target (a small",
-        "model forms them once).  The results do not depend on the block size",
+        "arrays of the whole grid are kept between the iterations only where they",
+        "fit a quarter of the memory target (a small model forms them once).  The",
+        "results do not depend on the block size",
         "(tested to 1e-12 for blocks of 1, 7 and all frequencies).",
         "",
     ]

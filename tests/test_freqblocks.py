@@ -111,8 +111,8 @@ def test_forced_block_must_be_a_positive_integer(size) -> None:
 #: process. [MiB]  The goal of issue 21 ("400 × 2,000 under 400 MB": the frequency
 #: blocks keep the temporaries within STOCHCABLE_WORKING_MEMORY_MB, 48 MiB by
 #: default, and the whole-grid arrays to the sea's element kinematics, the response
-#: and the element tensions, ≈ 170 bytes per DOF·ω); measured 0.27 GB (1.6e6 DOF·ω),
-#: 0.63 GB before the inputs were blocked.
+#: and the element tensions, ≈ 130 bytes per DOF·ω with the chain's two channels);
+#: measured 0.21 GB (1.6e6 DOF·ω; 0.63 GB before the inputs and outputs were blocked).
 PEAK_400x2000_MB = 400
 
 _PEAK_CHILD = """
