@@ -14,50 +14,54 @@ The engine's large arrays are frequency-domain arrays with one axis over the
 frequencies (``analysis.omega.count`` = n_ω), one over the nodes of a line
 (n_nodes = elements + 1, three DOFs each) and one over the line's input channels
 (:class:`stochcable.dynamics.loads.Channel`: the sea, one per end-motion spectrum DOF,
-and the three translations of an end attached to a body).  Per node, frequency and
-channel they hold: the fluid velocity and acceleration at the nodes (2 × 3 complex,
-96 B), the element moments of the velocity (6 complex, 96 B), the element velocity
-square (9 real, 72 B) and end squares, the load vectors (3 complex, 48 B), the
-displacement and motion transfer functions (2 × 3 complex, 96 B), the tension transfer
-functions and the temporaries of the products that form them.  The peak resident
-memory is therefore
+and the three translations of an end attached to a body).  Held for the whole grid
+are the sea's element kinematics (the horizontal and vertical parts of the consistent
+moments of the velocity, 4 complex per element, and of its mean square, 2 real), the
+converged response (its free nodes' part: d complex per node and channel) and the
+element tension transfer functions; everything else — the
+loads, the solves, the variance sums, the node motion transfer of the outputs — runs
+over blocks of frequencies whose temporaries stay within the working-memory target
+(``STOCHCABLE_WORKING_MEMORY_MB``, 48 MiB by default,
+:mod:`stochcable.dynamics.freqblocks`).  The peak resident memory is therefore
 
     M ≈ M_0 + c_M · n_ω · Σ_lines n_nodes · n_ch  +  c_T · N_t · (1 + Σ_lines n_ch),
 
-with N_t = duration/dt the time-series samples (the realization, the transfer
-functions interpolated onto the N_t/2 FFT frequencies and the synthesized records), and
-the time
+with M_0 the blocks' temporaries and the small arrays, N_t = duration/dt the
+time-series samples (the realization, the transfer functions interpolated onto the
+N_t/2 FFT frequencies and the synthesized records), and the time
 
-    t ≈ k_M · n_ω · Σ_lines n_nodes · n_ch · (1 + 0.5 n_bodies)  +  k_T · N_t · (1 + Σ n_ch).
+    t ≈ k_M · n_ω · Σ_lines n_nodes · n_ch · (1 + n_bodies)  +  k_T · N_t · (1 + Σ n_ch).
 
 The modes (at most the line's DOFs, dense only up to a few hundred DOFs per block) and
 the Foss state space (2 n_modes per line) are smaller than the nodal arrays and are in
 M_0.
 
-Constants (fitted on peak RSS above the imported baseline, ``ru_maxrss`` of a fresh
-subprocess, one BLAS thread; ``benchmarks/bench_cost.py``, x86-64, numpy 2, 2 cores):
+Constants (fitted on the peak RSS above the warmed-up process: a fresh subprocess,
+one BLAS thread, the VmHWM reset after two small analyses that load the compiled
+kernels; ``benchmarks/bench_cost.py``, x86-64, numpy 2, 2 cores):
 
 =====================================  =====  ======  =========  =======  =============
 scene                                  n_el   n_ω     channels   ΔRSS     B/(node·ω·ch)
 =====================================  =====  ======  =========  =======  =============
-taut_wire (sea only)                   200    1000    1          140 MB   697
-taut_wire                              400    1000    1          223 MB   556
-chain_catenary (sea + fairlead surge)  200    1000    2          217 MB   540
-chain_catenary                         400    1000    2          359 MB   447
-chain_catenary                         200    3000    2          488 MB   405
-disc buoy, three legs (free body)      3×100  1000    4 per leg  622 MB   513
-disc buoy, three legs                  3×200  1000    4 per leg  1186 MB  492
+taut_wire (sea only)                   200    1000    1          69 MB    12
+taut_wire                              400    1000    1          114 MB   116
+chain_catenary (sea + fairlead surge)  200    1000    2          77 MB    25
+chain_catenary                         400    1000    2          140 MB   90
+chain_catenary                         200    3000    2          172 MB   87
+disc buoy, three legs (free body)      3×100  1000    4 per leg  206 MB   115
+disc buoy, three legs                  3×200  1000    4 per leg  346 MB   116
 =====================================  =====  ======  =========  =======  =============
 
-so c_M = 700 B (the largest ratio, rounded up: the estimate should not be below the
-peak; the drag fixed point's temporaries run over frequency blocks,
-:mod:`stochcable.dynamics.freqblocks`, so the ratio falls with the model's size);
-c_T = 110 B per sample and channel (chain_catenary, 2^20 and 2^22 samples with the
-whole record in the result document: 320 B per sample); M_0 = 16 MB.  Time on the
-same machine: 1.6–2.1 µs per node·frequency·channel for single lines, 3.8 µs with a
-free body (k_M = 2.2 µs, the body factor 1 + 0.8 n_bodies), k_T = 1.7 µs per sample
-and channel.  Times are indicative (they scale with the CPU and the drag iterations);
-the memory model is what the budgets use.
+(the ratio is (ΔRSS − M_0)/(n_ω Σ n_nodes n_ch)) so c_M = 120 B (the largest ratio,
+rounded up: the estimate should not be below the peak; a line with the sea alone
+holds its kinematics for one channel, the most per channel), M_0 = 64 MiB (the
+working-memory target's temporaries and the small arrays); c_T = 110 B per sample and
+channel (chain_catenary, 2^20 and 2^22 samples with the whole record in the result
+document: 320 B per sample).  Time on the same machine: 0.9–1.2 µs per
+node·frequency·channel for single lines, 2.1–2.4 µs with a free body (k_M = 1.3 µs,
+the body factor 1 + n_bodies), k_T = 1.7 µs per sample and channel.  Times are
+indicative (they scale with the CPU and the drag iterations); the memory model is
+what the budgets use.
 
 The constants are in one place (the ``*_BYTES_*`` and ``*_SECONDS_*`` module
 constants) so that a change of the engine's array layout (frequency-blocked solves)
@@ -93,22 +97,23 @@ __all__ = [
     "SECONDS_PER_SAMPLE_CHANNEL",
 ]
 
-BYTES_PER_NODE_FREQUENCY_CHANNEL = 700
+BYTES_PER_NODE_FREQUENCY_CHANNEL = 120
 """Peak bytes per node, frequency and input channel of a line (c_M). [B]"""
 
 BYTES_PER_SAMPLE_CHANNEL = 110
 """Peak bytes per time-series sample and channel, plus one for the sea (c_T). [B]"""
 
-BASE_BYTES = 16 * 2**20
-"""Peak bytes of an analysis independent of its size (M_0: modes, statics, small arrays). [B]"""
+BASE_BYTES = 64 * 2**20
+"""Peak bytes of an analysis independent of its size (M_0: the frequency blocks'
+temporaries, modes, statics, small arrays). [B]"""
 
-SECONDS_PER_NODE_FREQUENCY_CHANNEL = 2.2e-6
+SECONDS_PER_NODE_FREQUENCY_CHANNEL = 1.3e-6
 """Wall time per node, frequency and channel on the calibration machine (k_M). [s]"""
 
 SECONDS_PER_SAMPLE_CHANNEL = 1.7e-6
 """Wall time per time-series sample and channel on the calibration machine (k_T). [s]"""
 
-_BODY_TIME_FACTOR = 0.8  # extra time per free body (coupled solves): 3.8 µs vs 2.1 µs
+_BODY_TIME_FACTOR = 1.0  # extra time per free body (coupled solves): 2.6 µs vs 1.2 µs
 
 #: The residuals of the linear model (``analysis.linearization.drag_residual`` and
 #: ``.geometric_residual``): their peak memory (bounded by their blocks: the drag's

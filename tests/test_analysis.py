@@ -796,9 +796,11 @@ def test_subset_caches_are_the_subset_computation(chain_parts):
     idx = np.unique(np.r_[np.arange(0, inp.omega.size, 4), inp.omega.size - 1])  # stride 4
     sliced = dgrid.subset_inputs(system, chans, inp, idx)
     fresh = dgrid.subset_inputs(system, chans, dloads.line_inputs(system, chans), idx)
-    assert ("qproj", "foss") in sliced.cache and not fresh.cache
+    assert ("following", "foss") in sliced.cache and not fresh.cache
 
     def close(a, b):
+        if callable(a):  # U_p of end_motion_projections, on a slice of the frequencies
+            a, b = a(slice(None)), b(slice(None))
         if a is None or b is None:
             assert a is None and b is None
         else:

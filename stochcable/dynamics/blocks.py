@@ -15,6 +15,7 @@ need that depends neither on the sea nor on the drag.
 from __future__ import annotations
 
 import functools
+import os
 from typing import Any
 
 import numpy as np
@@ -30,6 +31,23 @@ from stochcable.errors import (
     SolverError,
 )
 from stochcable.line.fem import FEModel
+
+_BAND: list[Any] = []
+
+
+def _band_kernel() -> Any:
+    """:func:`stochcable.dynamics.band_kernels.cholesky_band_solve`, or None without
+    numba or with ``STOCHCABLE_NUMBA=0`` (SciPy's ``cho_solve_banded`` then)."""
+    if os.environ.get("STOCHCABLE_NUMBA", "").strip() == "0":
+        return None
+    if not _BAND:
+        try:  # numba: imported on first use
+            from stochcable.dynamics.band_kernels import cholesky_band_solve
+        except ImportError:
+            cholesky_band_solve = None
+        _BAND.append(cholesky_band_solve)
+    return _BAND[0]
+
 
 # -------------------------------------------------------------------- linearization
 
@@ -283,6 +301,9 @@ class LinePrep:
                 raise SolverError(
                     "static correction: K_ff is not positive definite (check the static tensions)"
                 ) from None
+        kernel = _band_kernel()
+        if kernel is not None and rhs.ndim == 2:  # row sweeps, no transposes (band_kernels)
+            return kernel(self._chol, rhs)
         c = (self._chol, False)
         if np.iscomplexobj(rhs):
             # real K: the (re, im) columns of the interleaved real view in one solve
@@ -292,14 +313,22 @@ class LinePrep:
             return np.ascontiguousarray(y).view(complex)
         return sla.cho_solve_banded(c, rhs, check_finite=False)
 
-    def residual(self, system: LineSystem, rhs: np.ndarray) -> np.ndarray:
+    def residual(
+        self, system: LineSystem, rhs: np.ndarray, modal: np.ndarray | None = None
+    ) -> np.ndarray:
         """Static correction of the truncated modes, (K_ff⁻¹ − Φ K̂⁻¹ Φᵀ) rhs, rhs of
-        shape (n_free_dof, k) complex: an explicit dense residual flexibility (one
-        matrix product) up to ``_DENSE_FLEX`` free DOFs, else the banded Cholesky."""
+        shape (n_free_dof, k) complex (C-contiguous): an explicit dense residual
+        flexibility (one matrix product) up to ``_DENSE_FLEX`` free DOFs, else the
+        banded Cholesky with the modal part as real products (``modal``: Φᵀ rhs, (m,
+        k), when the caller has it)."""
         phi, _, kh = self.modal(system)
         nf = phi.shape[0]
         if nf > _DENSE_FLEX:
-            return self.k_solve(rhs) - phi @ np.linalg.solve(kh, phi.T @ rhs)
+            fh = real_gemm(phi.T, rhs) if modal is None else modal
+            zh = np.linalg.solve(kh, fh.view(float))
+            out = self.k_solve(rhs)
+            out -= real_gemm(phi, np.ascontiguousarray(zh).view(complex))
+            return out
         key = ("flex", phi.shape[1])
         if key not in self.cache:
             flex = self.k_solve(np.eye(nf)) - phi @ np.linalg.solve(kh, phi.T)

@@ -10,7 +10,8 @@ import numpy as np
 
 from stochcable.dynamics.blocks import trapezoid_weights
 from stochcable.dynamics.line_loads import LineInputs
-from stochcable.dynamics.loads import Channel, element_mean_square
+from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.node_inputs import weighted_mean_square
 from stochcable.dynamics.system import LineSystem
 
 __all__ = ["interpolatory_weights", "subset_inputs"]
@@ -86,11 +87,13 @@ def subset_inputs(
     weights = quadrature[:, None] * spectra
     square = None
     for i, ch in enumerate(channels):
-        if ch.element_velocity is None and ch.velocity is None:
+        if (
+            ch.element_velocity is None
+            and ch.element_velocity_parts is None
+            and ch.velocity is None
+        ):
             continue  # as line_inputs: the mean square goes with the element moments
-        sq = element_mean_square(ch)[idx]
-        sq = sq[:, :, np.array(comps)[:, None], comps]  # one gather of the d × d part
-        sq = np.einsum("weij,w->eij", sq, weights[:, i])
+        sq = weighted_mean_square(ch, weights[:, i], comps, idx)
         square = sq if square is None else square + sq
     if keep is not None:
         idx, weights = idx[keep], weights[keep]
@@ -98,34 +101,16 @@ def subset_inputs(
     def take(a: np.ndarray | None, axis: int) -> np.ndarray | None:
         return None if a is None else np.take(a, idx, axis=axis)
 
-    sub = LineInputs(
-        inp.omega[idx],
-        take(inp.velocity, 2),
-        take(inp.inertia_load, 2),
-        take(inp.ub, 2),
-        weights,
-        take(inp.moments, 3),
-        square,
-    )
+    sub = inp.subset(idx, weights, square)
     # The drag-independent, per-frequency arrays the full grid has already computed
-    # (:func:`base_motion`, the attachments' velocity of :func:`drag_inputs`,
-    # :func:`end_motion_projections`) are the same numbers at the subset's
-    # frequencies: sliced, not recomputed.
-    n_w, n_ch = inp.weights.shape
+    # (:func:`end_following_at`, :func:`base_load`, the attachments' velocity of
+    # :func:`drag_inputs`, the kept moments and inertia load, where kept) are the same
+    # numbers at the subset's frequencies: sliced, not recomputed.
 
     for key, val in inp.cache.items():
-        if key in ("foss", "direct"):
-            u, f0, moving = val
-            sub.cache[key] = (take(u, 2), take(f0, 2), moving)
-        elif key[0] == "attached_velocity":
-            sub.cache[key] = take(val, 2)
-        elif key[0] == "drag_moments":
+        name = key if isinstance(key, str) else key[0]
+        if name in ("moments", "drag_moments"):
             sub.cache[key] = take(val, 3)
-        elif key[0] == "qproj":
-            u_p, wcol, y = val
-            sub.cache[key] = (
-                take(u_p, 2),
-                np.ascontiguousarray(wcol.reshape(n_w, n_ch)[idx]).ravel(),
-                take(y, 2),
-            )
+        elif name in ("inertia", "base_load", "attached_velocity", "following"):
+            sub.cache[key] = take(val, 2)
     return sub

@@ -101,7 +101,9 @@ def _kinematic_channels(channels: Any) -> list[Any]:
     return [
         ch
         for ch in channels
-        if ch.kind == "sea" and ch.heading is not None and ch.element_end_square is not None
+        if ch.kind == "sea"
+        and ch.heading is not None
+        and (ch.element_end_square is not None or ch.element_ends is not None)
     ]
 
 
@@ -133,7 +135,10 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
         ends = np.zeros((n_el, 2))
         for ch in kin:
             q = trapezoid_weights(np.asarray(ch.omega, dtype=float)) * ch.spectrum
-            ends += np.einsum("w,wea->ea", q, ch.element_end_square)
+            if ch.element_end_square is not None:
+                ends += np.einsum("w,wea->ea", q, ch.element_end_square)
+            else:  # (the sea's, formed block by block)
+                ends += ch.element_ends.weighted(q)
         hi, lo = ends.max(axis=1), ends.min(axis=1)
         weight = drag_scale * mesh.l0 * hi
         live = (hi > 0) & (weight >= WEIGHT_FLOOR * weight.max(initial=0.0))
@@ -245,14 +250,18 @@ def segment_velocity(
     )
     sub = None
     for c, ch in enumerate(channels):
-        if ch.kind == "sea" and ch.heading is not None and ch.element_velocity is not None:
+        moments = ch.element_velocity
+        if moments is None and ch.element_velocity_parts is not None:  # (the sea's parts)
+            moments = ch.element_velocity_parts
+        if ch.kind == "sea" and ch.heading is not None and moments is not None:
             if sub is None:
                 sub = _subdivided_points(system, seg)
             env = system.environment
             kin = element_wave_kinematics(np.asarray(ch.omega), sub, ch.heading, env.depth, env.g)
             vel[..., c] += kin.velocity.sum(axis=2)
-        elif ch.element_velocity is not None:
-            vel[..., c] += ch.element_velocity.sum(axis=2)[:, e]
+        elif moments is not None:
+            full = moments if isinstance(moments, np.ndarray) else moments.full()
+            vel[..., c] += full.sum(axis=2)[:, e]
         elif ch.kind == "sea" and ch.velocity is not None:
             vel[..., c] += (1.0 - xi)[None, :, None] * ch.velocity[:, e] + xi[
                 None, :, None

@@ -35,10 +35,18 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as v
+from stochcable.dynamics.element_parts import MomentParts, SquareParts
 from stochcable.errors import InputError
 from stochcable.sea.kinematics import G_STANDARD, wavenumber
 
-__all__ = ["ElementKinematics", "element_frames", "element_wave_kinematics"]
+__all__ = [
+    "ElementKinematics",
+    "EndSquare",
+    "MomentParts",
+    "SquareParts",
+    "element_frames",
+    "element_wave_kinematics",
+]
 
 
 # |x| below which φ1 and ψ are summed as series (full relative precision; above it the
@@ -48,6 +56,9 @@ _SERIES_RADIUS = 0.5
 _SERIES_TERMS = 15
 _PHI1_COEF = np.array([1.0 / math.factorial(n + 1) for n in range(_SERIES_TERMS)])
 _PSI_COEF = np.array([1.0 / (math.factorial(n) * (n + 2)) for n in range(_SERIES_TERMS)])
+# Elements × frequencies per block of :func:`_element_kinematics` (its temporaries,
+# ≈ 30 arrays of this many entries, stay in the cache).
+_BLOCK_ENTRIES = 2**14
 
 
 def _series(x: np.ndarray, coef: np.ndarray) -> np.ndarray:
@@ -147,6 +158,76 @@ def _exp_integral(
 
 
 @dataclass(frozen=True, eq=False)
+class EndSquare:
+    """|v|² at the two ends of each element's wet part, formed on demand from the
+    wavenumbers and the ends' depths (two exponentials per element end and frequency:
+    ω²(ch² + sh²) of the kinematics; in deep water 2ω²e^{2kz}).
+
+    Attributes
+    ----------
+    omega, wavenumber : ndarray, shape (n_omega,)
+        [rad/s], [rad/m]
+    z_ends : ndarray, shape (n_el, 2)
+        Depth of the ends of each element's wet part (≤ 0). [m]
+    wet : ndarray of bool, shape (n_el,)
+        Elements with a wet part.
+    depth, g : float
+        [m], [m/s²]
+    """
+
+    omega: np.ndarray
+    wavenumber: np.ndarray
+    z_ends: np.ndarray
+    wet: np.ndarray
+    depth: float
+    g: float
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes kept (no per-frequency array of the elements). [B]"""
+        return int(self.omega.nbytes + self.wavenumber.nbytes + self.z_ends.nbytes)
+
+    def block(self, freq: Any = slice(None)) -> np.ndarray:
+        """|v|² on the frequencies ``freq``, (n_f, n_el, 2). [(m/s)²/m²]"""
+        w, k, h, z = self.omega[freq], self.wavenumber[freq], self.depth, self.z_ends
+        e1 = np.exp(2.0 * np.multiply.outer(k, z))  # (n_f, n_el, 2)
+        if math.isinf(h):
+            ends = 2.0 * e1 * (w * w)[:, None, None]
+        else:
+            zero_w = w == 0.0
+            den = -np.expm1(-2.0 * k * h)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                c = np.where(zero_w, 0.0, w / np.where(zero_w, 1.0, den))
+            c2 = (c * c)[:, None]
+            e2 = np.exp(-2.0 * np.multiply.outer(k, z + 2.0 * h))
+            ends = 2.0 * (e1 + e2) * c2[:, :, None]  # ω²(ch² + sh²)
+            if zero_w.any():  # long-wave limit: u_h = √(g/h) uniform, u_z = 0
+                u0 = math.sqrt(self.g / h)
+                ends[zero_w] = u0 * u0
+        return np.where(self.wet[None, :, None], ends, 0.0)
+
+    def full(self) -> np.ndarray:
+        """|v|², shape (n_omega, n_el, 2). [(m/s)²/m²]"""
+        return self.block()
+
+    def weighted(self, weights: np.ndarray) -> np.ndarray:
+        """Σ_ω weight·|v|² per element end, (n_el, 2), over blocks of frequencies."""
+        out = np.zeros(self.z_ends.shape)
+        n_w = self.omega.size
+        step = max(1, _BLOCK_ENTRIES // max(self.z_ends.shape[0], 1))
+        for i in range(0, n_w, step):
+            sl = slice(i, min(i + step, n_w))
+            out += np.einsum("wes,w->es", self.block(sl), weights[sl])
+        return out
+
+    def __getitem__(self, idx: Any) -> EndSquare:
+        """On the frequencies ``idx``."""
+        return EndSquare(
+            self.omega[idx], self.wavenumber[idx], self.z_ends, self.wet, self.depth, self.g
+        )
+
+
+@dataclass(frozen=True, eq=False)
 class ElementKinematics:
     """Linear wave kinematics integrated along straight elements, per unit amplitude.
 
@@ -164,14 +245,17 @@ class ElementKinematics:
         [m]
     wet_fraction : ndarray, shape (n_el,)
         Fraction of each element below z = 0 (only that part is loaded). [-]
-    velocity : ndarray, complex, shape (n_omega, n_el, 2, 3)
+    moments : MomentParts
         ∫₀¹ N_a v dξ and ∫₀¹ N_b v dξ (N_a = 1 − ξ, N_b = ξ, ξ = s/l), v = 0 above
-        z = 0. [(m/s)/m]
-    velocity_square : ndarray, real, shape (n_omega, n_el, 3, 3)
-        ∫₀¹ Re(v vᴴ) dξ, the element mean of the velocity's second moment. [(m/s)²/m²]
-    end_square : ndarray, real, shape (n_omega, n_el, 2)
+        z = 0, in their horizontal and vertical parts (:attr:`velocity` forms them on
+        x, y, z). [(m/s)/m]
+    square : SquareParts
+        ∫₀¹ Re(v vᴴ) dξ, the element mean of the velocity's second moment, in its
+        horizontal and vertical parts (:attr:`velocity_square` forms it). [(m/s)²/m²]
+    ends : EndSquare
         |v|² at the two ends of each element's wet part (the lower-ξ end first; the
-        waterline point for an element crossing it; 0 for a dry element). [(m/s)²/m²]
+        waterline point for an element crossing it; 0 for a dry element), formed on
+        demand (:attr:`end_square`). [(m/s)²/m²]
     """
 
     omega: np.ndarray
@@ -180,9 +264,26 @@ class ElementKinematics:
     heading: float
     depth: float
     wet_fraction: np.ndarray
-    velocity: np.ndarray
-    velocity_square: np.ndarray
-    end_square: np.ndarray
+    moments: MomentParts
+    square: SquareParts
+    ends: EndSquare
+
+    @property
+    def end_square(self) -> np.ndarray:
+        """|v|² at the ends of the wet parts, shape (n_omega, n_el, 2) (formed on
+        access). [(m/s)²/m²]"""
+        return self.ends.full()
+
+    @property
+    def velocity(self) -> np.ndarray:
+        """∫₀¹ N_i v dξ on x, y, z, shape (n_omega, n_el, 2, 3) (formed on access).
+        [(m/s)/m]"""
+        return self.moments.full()
+
+    @property
+    def velocity_square(self) -> np.ndarray:
+        """∫₀¹ Re(v vᴴ) dξ, shape (n_omega, n_el, 3, 3) (formed on access). [(m/s)²/m²]"""
+        return self.square.full()
 
     @property
     def acceleration(self) -> np.ndarray:
@@ -281,9 +382,53 @@ def _element_kinematics(
     wet_a, wet_b = za <= 0.0, zb <= 0.0
     p = np.where(wet_a, 0.0, np.where(wet_b, cross, 0.0))
     q = np.where(wet_b, 1.0, np.where(wet_a, cross, 0.0))
-    # frequency-major (n_w, n_el) arrays throughout: the outputs' layout, so they are
-    # written without transposes (the same products, operands swapped)
     p, q = np.clip(p, 0.0, 1.0)[None, :], np.clip(q, 0.0, 1.0)[None, :]
+    n_w, n_el = w.size, za.size
+    # the moments' horizontal and vertical parts stored element-major (n_el, 2, 2,
+    # n_w): the loads read a block of frequencies per element end and part as one
+    # contiguous run (MomentParts)
+    parts = np.empty((n_el, 2, 2, n_w), dtype=complex)
+    sq = np.empty((2, n_w, n_el))  # ∫|u_h|², ∫|u_z|² (SquareParts)
+    geo = (za, zb, chi, p, q, cb, sb, h, g)
+    # blocks of frequencies: every operation is elementwise in ω, so the numbers are
+    # those of the whole grid at once, with temporaries of one block (kept in cache:
+    # ≈ 2x faster than whole-grid passes on 400 elements × 2,000 ω)
+    step = max(1, _BLOCK_ENTRIES // max(n_el, 1))
+    for i in range(0, n_w, step):
+        sl = slice(i, min(i + step, n_w))
+        _kinematics_block(w[sl], k[sl], geo, parts[..., sl], sq[:, sl])
+    wet = (q - p)[0]
+    z_ends = za[:, None] + (zb - za)[:, None] * np.hstack([p.T, q.T])  # (n_el, 2)
+    z_ends = np.minimum(z_ends, 0.0)
+    for a in (w, k, pts, wet, parts, sq, z_ends):
+        a.setflags(write=False)
+    square = SquareParts(sq[0], sq[1], beta)
+    return ElementKinematics(
+        omega=w,
+        wavenumber=k,
+        positions=pts,
+        heading=beta,
+        depth=h,
+        wet_fraction=wet,
+        moments=MomentParts(parts, beta),
+        square=square,
+        ends=EndSquare(w, k, z_ends, wet > 0.0, h, g),
+    )
+
+
+def _kinematics_block(
+    w: np.ndarray,
+    k: np.ndarray,
+    geo: tuple,
+    vel: np.ndarray,
+    sq: np.ndarray,
+) -> None:
+    """The element kinematics of the frequencies ``w`` (wavenumbers ``k``) written into
+    ``vel`` (the parts of :class:`MomentParts`, (n_el, 2, 2, n_w)), ``sq`` (h and v of
+    :class:`SquareParts`): the body of
+    :func:`_element_kinematics` on one block; ``geo`` = (z_a, z_b, χ, p, q, cos β,
+    sin β, h, g).  Frequency-major (n_w, n_el) arrays throughout."""
+    za, zb, chi, p, q, cb, sb, h, g = geo
     length = q - p
     dz = np.multiply.outer(k, zb - za)
     phase0 = -np.multiply.outer(k, chi[:-1])  # imaginary parts of the exponents
@@ -296,15 +441,11 @@ def _element_kinematics(
     phi_k, _ = _phi1_psi(np.where(two_dz >= 0.0, -two_dz, two_dz) * length, want_psi=False)
     k1 = _exp_integral(2.0 * kza, two_dz, p, q, phi_k)  # ∫ e^{2kz} dξ
     zero_w = w == 0.0
-    z_ends = za[:, None] + (zb - za)[:, None] * np.hstack([p.T, q.T])  # (n_el, 2)
-    z_ends = np.minimum(z_ends, 0.0)
-    e1_ends = np.exp(2.0 * np.multiply.outer(k, z_ends))  # (n_w, n_el, 2)
     if math.isinf(h):
         coef = w.astype(complex)[:, None]
         mh = (ma1 * coef, mb1 * coef)
         mz = (ma1 * (1j * w)[:, None], mb1 * (1j * w)[:, None])
         ch2 = sh2 = k1 * (w * w)[:, None]
-        ends = 2.0 * e1_ends * (w * w)[:, None, None]
     else:
         e2a = -np.multiply.outer(k, za + 2.0 * h)
         # the second exponent's slope −dz + i·dphase: where dz ≠ 0 the sign s of
@@ -324,8 +465,6 @@ def _element_kinematics(
             c2 = (c * c)[:, None]
             ch2 = (k1 + k2 + cross2) * c2
             sh2 = np.clip(k1 + k2 - cross2, 0.0, None) * c2
-        e2_ends = np.exp(-2.0 * np.multiply.outer(k, z_ends + 2.0 * h))
-        ends = 2.0 * (e1_ends + e2_ends) * c2[:, :, None]  # ω²(ch² + sh²)
         mh = ((ma1 + ma2) * c[:, None], (mb1 + mb2) * c[:, None])
         ic = (1j * c)[:, None]
         mz = ((ma1 - ma2) * ic, (mb1 - mb2) * ic)
@@ -335,33 +474,11 @@ def _element_kinematics(
             mh[0][zero_w, :] = u0 * (length - side_b)
             mh[1][zero_w, :] = u0 * side_b
             ch2[zero_w, :] = u0 * u0 * length
-            ends[zero_w] = u0 * u0
-    n_w, n_el = ma1.shape
-    vel = np.empty((n_w, n_el, 2, 3), dtype=complex)
-    for side in range(2):
-        vel[:, :, side, 0] = mh[side] * cb
-        vel[:, :, side, 1] = mh[side] * sb
-        vel[:, :, side, 2] = mz[side]
-    sq = np.zeros((n_w, n_el, 3, 3))
-    sq[:, :, 0, 0] = ch2 * (cb * cb)
-    sq[:, :, 1, 1] = ch2 * (sb * sb)
-    sq[:, :, 0, 1] = sq[:, :, 1, 0] = ch2 * (cb * sb)
-    sq[:, :, 2, 2] = sh2
-    wet = length[0]
-    ends = np.where((length > 0.0)[:, :, None], ends, 0.0)
-    for a in (w, k, pts, wet, vel, sq, ends):
-        a.setflags(write=False)
-    return ElementKinematics(
-        omega=w,
-        wavenumber=k,
-        positions=pts,
-        heading=beta,
-        depth=h,
-        wet_fraction=wet,
-        velocity=vel,
-        velocity_square=sq,
-        end_square=ends,
-    )
+    for side in range(2):  # (n_el, n_w) each: the transposed block
+        vel[:, side, 0] = mh[side].T
+        vel[:, side, 1] = mz[side].T
+    sq[0] = ch2
+    sq[1] = sh2
 
 
 # ------------------------------------------------------------------ element geometry

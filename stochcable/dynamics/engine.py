@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 from pydantic import ValidationError
@@ -158,7 +158,7 @@ class Engine:
         return Result(
             scene=scene,
             statics=self.statics,
-            lines={k: replace(v, strumming=self.strumming.get(k)) for k, v in solved.lines.items()},
+            lines={k: v.with_strumming(self.strumming.get(k)) for k, v in solved.lines.items()},
             timeseries=ts,
             timing=timing,
             warnings=tuple(messages),

@@ -24,7 +24,13 @@ from collections.abc import Iterator
 
 from stochcable.errors import InputError
 
-__all__ = ["WORKING_MEMORY_MB", "frequency_block", "frequency_slices", "working_memory_bytes"]
+__all__ = [
+    "WORKING_MEMORY_MB",
+    "frequency_block",
+    "frequency_slices",
+    "whole_grid",
+    "working_memory_bytes",
+]
 
 #: Default target of one frequency block's temporaries. [MiB]
 WORKING_MEMORY_MB = 48
@@ -76,6 +82,14 @@ def frequency_block(size: int | None) -> Iterator[None]:
         yield
     finally:
         _FORCED.reset(token)
+
+
+def whole_grid(freq: slice | object, n_omega: int) -> bool:
+    """Whether ``freq`` (a slice, or an index array: never) selects all ``n_omega``
+    frequencies in order (``slice(None)`` or the one block of :func:`frequency_slices`)."""
+    if not isinstance(freq, slice):
+        return False
+    return freq.indices(n_omega) == (0, n_omega, 1)
 
 
 def frequency_slices(n_omega: int, bytes_per_frequency: float) -> list[slice]:

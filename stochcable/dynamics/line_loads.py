@@ -1,18 +1,16 @@
-"""The inputs of one line in the node layout and its load assembly (the right-hand
-side of seed 001 eq. 5.2.6 with prescribed ends).
+"""The load assembly of one line (the right-hand side of seed 001 eq. 5.2.6 with
+prescribed ends) from its inputs (:class:`~stochcable.dynamics.node_inputs.LineInputs`,
+re-exported here with :func:`line_inputs` and :func:`with_spectra`).
 
-:func:`line_inputs` turns the channels (:class:`~stochcable.dynamics.loads.Channel`:
-sea, end motions) into node-layout arrays (:class:`LineInputs`: fluid velocity, exact
-Morison inertia load, end displacements, consistent element moments of the wave
-velocity); :func:`base_motion` and :func:`drag_inputs` cache their drag-independent
-parts per solver; :func:`drag_blocks`, :func:`free_load` and :func:`end_loads`
-assemble the drag-dependent loads at every iteration of the drag fixed point.
+:func:`end_following` keeps the drag-independent motion of the ends (and its static
+following) per solver; :func:`base_load` and :func:`drag_inputs` form the
+drag-independent loads on any block of frequencies (kept for the whole grid only where
+they fit the working-memory target); :func:`drag_blocks`, :func:`free_load` and
+:func:`end_loads` assemble the drag-dependent loads at every iteration of the drag
+fixed point.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -23,140 +21,33 @@ from stochcable.dynamics.blocks import (
     distribute,
     element_blocks,
     element_load,
-    line_prep,
     real_gemm,
-    trapezoid_weights,
 )
-from stochcable.dynamics.freqblocks import working_memory_bytes
-from stochcable.dynamics.loads import (
-    Channel,
-    element_mean_square,
-    element_moments,
-    inertia_blocks,
-)
+from stochcable.dynamics.freqblocks import whole_grid, working_memory_bytes
+from stochcable.dynamics.loads import Channel
+from stochcable.dynamics.node_inputs import LineInputs, line_inputs, with_spectra
 from stochcable.dynamics.system import (
     Damping,
     LineSystem,
 )
 
-
-@dataclass(frozen=True, eq=False)
-class LineInputs:
-    """Channel data in the node layout (n_nodes, d, n_w, n_ch)."""
-
-    omega: np.ndarray
-    velocity: np.ndarray | None  # fluid velocity at the nodes (attachments)
-    inertia_load: np.ndarray  # Morison inertia load, exact along the elements
-    ub: np.ndarray | None  # prescribed end displacement, (2, d, n_w, n_ch)
-    weights: np.ndarray  # trapezoid weight x spectrum, (n_w, n_ch)
-    moments: np.ndarray | None = None  # ∫N_i v dξ, (n_el, 2, d, n_w, n_ch)
-    square: np.ndarray | None = None  # Σ weight·∫Re(v vᴴ)dξ, (n_el, d, d)
-    cache: dict = field(default_factory=dict)  # drag-independent loads per solver
-
-
-def _inertia_elements(system: LineSystem) -> tuple[np.ndarray, np.ndarray]:
-    """Morison inertia l0·ρ(πD²/4)(1 + Can)(I − eeᵀ) per element on the model
-    components (n_el, d, d) and the attachments' (buoyancy/g + added mass) (n_nodes,)."""
-    if "inertia_el" not in system._cache:
-        blocks, node = inertia_blocks(system.model, system.environment.g, system.frames[0])
-        system._cache["inertia_el"] = (element_blocks(system.model, blocks), node)
-    return system._cache["inertia_el"]
-
-
-def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs:
-    """The channels of a line in the node layout (:class:`LineInputs`), sampled on the
-    channels' common grid: fluid velocity at the attachment nodes, Morison inertia load
-    (exact along the elements, seed 001 eq. 5.2.6), end displacements, trapezoid ×
-    spectrum weights and the consistent element moments of the fluid velocity."""
-    model = system.model
-    prep = line_prep(system)
-    comps = list(model.components)
-    w = channels[0].omega
-    n_w, n_ch = w.size, len(channels)
-    shape = (model.n_nodes, model.dim, n_w, n_ch)
-    weights = trapezoid_weights(w)[:, None] * np.stack([c.spectrum for c in channels], axis=1)
-    vel = None
-    mom = None
-    inertia = np.zeros(shape, dtype=complex)
-    b_in, node_mass = _inertia_elements(system)
-    # the nodal fluid velocity only drives the attachments' drag (b_node): without
-    # attachment drag areas it is never used (and not built)
-    attached = system.drag_nodes.size > 0
-    for i, ch in enumerate(channels):
-        if attached and ch.velocity is not None:  # (the sea's is computed on access)
-            if vel is None:
-                vel = np.zeros(shape, dtype=complex)
-            vel[..., i] = np.transpose(ch.velocity[..., comps], (1, 2, 0))
-        m = element_moments(model, ch)
-        if m is not None:
-            if mom is None:
-                mom = np.zeros((model.n_elements, 2, model.dim, n_w, n_ch), dtype=complex)
-            mom[..., i] = np.transpose(m[..., comps], (1, 2, 3, 0))
-        if ch.element_velocity is not None:
-            # exact along the elements: l0·C_I(I − eeᵀ)·iω∫N_i v dξ, plus attachments
-            inertia[..., i] = element_load(b_in, mom[..., i] * (1j * w))
-            if np.any(node_mass) and ch.acceleration is not None:
-                inertia[..., i] += node_mass[:, None, None] * np.transpose(
-                    ch.acceleration[..., comps], (1, 2, 0)
-                )
-        elif ch.acceleration is not None:  # hand-built channel: nodal interpolation
-            acc = np.transpose(ch.acceleration[..., comps], (1, 2, 0))[..., None]
-            inertia[..., i] = block_matvec(prep.BI, acc)[..., 0]
-    ub = None
-    for i, ch in enumerate(channels):
-        for k, m in enumerate((ch.motion_a, ch.motion_b)):
-            if m is not None and np.any(m):
-                if ub is None:
-                    ub = np.zeros((2, model.dim, n_w, n_ch), dtype=complex)
-                ub[k, :, :, i] = m[:, comps].T
-    return LineInputs(w, vel, inertia, ub, weights, mom, _weighted_square(model, channels, weights))
-
-
-def _weighted_square(
-    model: Any, channels: tuple[Channel, ...], weights: np.ndarray
-) -> np.ndarray | None:
-    """Σ_i weight_i·∫Re(v vᴴ)dξ over the channels with a fluid velocity, on the model
-    components, (n_el, d, d) (None without fluid velocity)."""
-    comps = np.array(model.components)
-    square = None
-    for i, ch in enumerate(channels):
-        if ch.element_velocity is None and ch.velocity is None:
-            continue
-        # the d × d part in one gather (two chained ones were 0.1-0.4 ms)
-        sq = element_mean_square(ch)[:, :, comps[:, None], comps]
-        sq = np.einsum("weij,w->eij", sq, weights[:, i])
-        square = sq if square is None else square + sq
-    return square
-
-
-#: Caches of :class:`LineInputs` that do not depend on the channels' spectra (kept by
-#: :func:`with_spectra`): the base motion per solver, the end-motion projections and
-#: the attachments' velocity.  Every other cache is formed again.
-def _spectrum_free(key: Any) -> bool:
-    return key in ("foss", "direct") or (
-        isinstance(key, tuple) and key[0] in ("qproj", "attached_velocity", "drag_moments")
-    )
-
-
-def with_spectra(system: LineSystem, inp: LineInputs, channels: tuple[Channel, ...]) -> LineInputs:
-    """The inputs of ``channels`` when ``inp`` are those of channels with the same
-    transfer functions (kinematics, end motions, grid) under other spectra: the arrays
-    and the spectrum-independent caches shared, the weights and the weighted mean
-    square formed for the new spectra.  The same numbers as :func:`line_inputs` of
-    ``channels``."""
-    w = channels[0].omega
-    weights = trapezoid_weights(w)[:, None] * np.stack([c.spectrum for c in channels], axis=1)
-    out = LineInputs(
-        inp.omega,
-        inp.velocity,
-        inp.inertia_load,
-        inp.ub,
-        weights,
-        inp.moments,
-        _weighted_square(system.model, channels, weights),
-    )
-    out.cache.update({k: v for k, v in inp.cache.items() if _spectrum_free(k)})
-    return out
+__all__ = [
+    "LineInputs",
+    "attached_velocity",
+    "base_load",
+    "base_motion",
+    "drag_blocks",
+    "drag_inputs",
+    "end_following",
+    "end_following_at",
+    "end_loads",
+    "end_nodes",
+    "fluid_loads",
+    "free_load",
+    "line_inputs",
+    "silent_channel",
+    "with_spectra",
+]
 
 
 def drag_blocks(system: LineSystem, damping: Damping) -> NodeBlocks:
@@ -199,10 +90,10 @@ def drag_blocks(system: LineSystem, damping: Damping) -> NodeBlocks:
 def _drag_load(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndarray | None:
     """Linearized drag load of the fluid velocity, Σ_el l0·B·∫N_i v dξ + b_node·V_node,
     node vectors (n_nodes, d, n_w, n_ch); None without fluid velocity."""
-    if inp.velocity is None and inp.moments is None:
+    if inp.velocity is None and not inp.has_fluid:
         return None
     drag_blocks(system, damping)
-    if inp.moments is not None:
+    if inp.has_fluid:
         f = element_load(damping._cache["elements"], inp.moments)
     else:
         f = np.zeros(inp.velocity.shape, dtype=complex)
@@ -223,19 +114,20 @@ def end_loads(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndarr
     reactions (:func:`reactions`) read of it — element 0's share on node 0, the last
     element's on the last node (the whole-line load was 0.2 ms of the chain)."""
     f = None
-    if inp.moments is not None:
+    ends = inp.moment_ends()
+    if ends is not None:
         drag_blocks(system, damping)
         b = damping._cache["elements"]
         f = np.stack(
             [
-                np.einsum("ij,jwc->iwc", b[0], inp.moments[0, 0]),
-                np.einsum("ij,jwc->iwc", b[-1], inp.moments[-1, 1]),
+                np.einsum("ij,jwc->iwc", b[0], ends[0]),
+                np.einsum("ij,jwc->iwc", b[-1], ends[1]),
             ]
         )
     if inp.velocity is not None and np.any(damping.b_node):
         fn = damping.b_node[[0, -1], None, None, None] * inp.velocity[[0, -1]]
         f = fn if f is None else f + fn
-    ends = inp.inertia_load[[0, -1]]
+    ends = inp.inertia_ends()
     return ends if f is None else ends + f
 
 
@@ -250,54 +142,108 @@ def end_nodes(inp: LineInputs, n: int, d: int) -> np.ndarray:
     return x
 
 
-def base_motion(system: LineSystem, prep: LinePrep, inp: LineInputs) -> tuple[np.ndarray, ...]:
-    """Drag-independent parts of the free-row load, cached per inputs and solver.
+def end_following(system: LineSystem, prep: LinePrep, inp: LineInputs) -> tuple[np.ndarray, bool]:
+    """The prescribed motion U_p of :func:`base_load` on all nodes and frequencies,
+    (n_nodes, d, n_w, n_ch), and whether an end moves (:func:`end_following_at`; zero
+    without end motion)."""
+    if inp.ub is None:
+        return end_nodes(inp, prep.n, prep.d), False
+    return end_following_at(system, prep, inp), True
 
-    The load on the free rows is  F0 + F_d(V) + C_d Q  with  Q = −iω U_p, F_d(V) the
-    drag load of the fluid velocity integrated along the elements (:func:`_drag_load`)
-    and
-        direct: U_p = the end motion (zero inside),
-                F0 = F_I − (K − ω²M_T + iωC_s) U_p;
+
+def end_following_at(
+    system: LineSystem,
+    prep: LinePrep,
+    inp: LineInputs,
+    freq: slice = slice(None),
+    nodes: np.ndarray | None = None,
+) -> np.ndarray | None:
+    """The prescribed motion U_p on the frequencies ``freq``, (n_nodes, d, n_f, n_ch)
+    (``nodes``: those nodes only), None without end motion:
+
+        direct: U_p = the end motion (zero inside);
         Foss:   U_p = the end motion with the exact static following inside,
-                F0 = F_I − (−ω²M_T + iωC_s) U_p   (K U_p = 0 on the free rows),
-    F_I the Morison inertia load; returns (U_p, F0, moving): ``moving`` False without
-    end motion (Q is formed where it is used, block by block: :func:`drag_inputs`)."""
-    key = system.solver
-    if key not in inp.cache:
-        w = inp.omega
-        if inp.ub is None:
-            u = end_nodes(inp, prep.n, prep.d)
-            f0, moving = inp.inertia_load, False
+
+    U_p = G u_b with G (n_nodes·d, 2d) the unit end displacements (and their static
+    following) of :meth:`~stochcable.dynamics.blocks.LinePrep.end_basis`, formed for
+    the channels that move an end (the others are zero); the whole grid kept when it
+    fits a quarter of the working-memory target. [m/unit]"""
+    if inp.ub is None:
+        return None
+    key = ("following", system.solver)
+    if key in inp.cache:
+        u = inp.cache[key]
+        return (u if nodes is None else u[nodes])[:, :, freq]
+    g = prep.end_basis(system.solver == "direct")[0]
+    n = prep.n
+    if nodes is not None:
+        g = g.reshape(n, prep.d, -1)[nodes].reshape(-1, 2 * prep.d)
+        n = g.shape[0] // prep.d
+    act = _moving_channels(inp)
+    ub = inp.ub[:, :, freq] if act is None else inp.ub[:, :, freq][..., act]
+    u = real_gemm(g, np.ascontiguousarray(ub.reshape(2 * prep.d, -1)))
+    u = u.reshape((n, prep.d) + ub.shape[2:])
+    if act is not None:  # back to all channels
+        u_all = np.zeros((n, prep.d) + ub.shape[2:-1] + inp.ub.shape[-1:], dtype=complex)
+        u_all[..., act] = u
+        u = u_all
+    whole = whole_grid(freq, inp.omega.size)
+    if nodes is None and whole and u.nbytes <= working_memory_bytes() // 4:
+        inp.cache[key] = u
+    return u
+
+
+def base_load(
+    system: LineSystem, prep: LinePrep, inp: LineInputs, freq: slice = slice(None)
+) -> np.ndarray:
+    """The drag-independent part F0 of the free-row load on the frequencies ``freq``,
+    on all nodes (n_nodes, d, n_f, n_ch): a fresh array, or a view of the whole grid
+    kept when it fits a quarter of the working-memory target.
+
+    The load on the free rows is  F0 + F_d(V) + C_d Q  with  Q = −iω U_p
+    (:func:`end_following`), F_d(V) the drag load of the fluid velocity integrated
+    along the elements (:func:`_drag_load`) and
+        direct: F0 = F_I − (K − ω²M_T + iωC_s) U_p,
+        Foss:   F0 = F_I − (−ω²M_T + iωC_s) U_p   (K U_p = 0 on the free rows),
+    F_I the Morison inertia load (:meth:`LineInputs.inertia_at`)."""
+    key = ("base_load", system.solver)
+    if key in inp.cache:
+        return inp.cache[key][:, :, freq]
+    f0 = inp.inertia_at(freq)
+    if inp.ub is not None:
+        if "inertia" in inp.cache:  # a view of the kept inertia load: not changed
+            f0 = f0.copy()
+        # M_T U_p, C_s U_p, K U_p as (M_T G) u_b, … — small products with the cached
+        # M_T G, C_s G, K G instead of block products of the node vectors
+        direct = system.solver == "direct"
+        _, mg, sg, kg = prep.end_basis(direct)
+        w = inp.omega[freq]
+        act = _moving_channels(inp)
+        ub = inp.ub[:, :, freq] if act is None else inp.ub[:, :, freq][..., act]
+        ubf = np.ascontiguousarray(ub.reshape(2 * prep.d, -1))
+        shape = (prep.n, prep.d) + ub.shape[2:]
+
+        def times(b: np.ndarray) -> np.ndarray:
+            return real_gemm(b, ubf).reshape(shape)
+
+        dyn = -(w * w)[:, None] * times(mg) + (1j * w)[:, None] * times(sg)
+        if direct:
+            dyn = dyn + times(kg)
+        if act is None:
+            f0 -= dyn
         else:
-            # U_p = G u_b with G (n_nodes, d, 2d) the unit end displacements (and their
-            # static following): M_T U_p, C_s U_p, K U_p are (M_T G) u_b, … — small
-            # products with the cached M_T G, C_s G, K G instead of block products of
-            # the (n_nodes, d, n_w·n_ch) vectors (0.3 ms per grid on the chain)
-            direct = system.solver == "direct"
-            g, mg, sg, kg = prep.end_basis(direct)
-            # only the channels that move an end (the sea without RAOs does not): the
-            # others have U_p = 0, F0 = F_I
-            act = _moving_channels(inp)
-            ub = inp.ub if act is None else inp.ub[..., act]
-            ubf = np.ascontiguousarray(ub.reshape(2 * prep.d, -1))
-            shape = (prep.n, prep.d) + ub.shape[2:]
+            f0[..., act] -= dyn
+    if whole_grid(freq, inp.omega.size) and f0.nbytes <= working_memory_bytes() // 4:
+        inp.cache[key] = f0
+    return f0
 
-            def times(b: np.ndarray) -> np.ndarray:
-                return real_gemm(b, ubf).reshape(shape)
 
-            inertia = inp.inertia_load if act is None else inp.inertia_load[..., act]
-            u = times(g)
-            f0 = inertia - (-(w * w)[:, None] * times(mg) + (1j * w)[:, None] * times(sg))
-            if direct:
-                f0 = f0 - times(kg)
-            moving = True
-            if act is not None:  # back to all channels
-                u_all = np.zeros((prep.n, prep.d) + inp.ub.shape[2:], dtype=complex)
-                f0_all = inp.inertia_load.copy()
-                u_all[..., act], f0_all[..., act] = u, f0
-                u, f0 = u_all, f0_all
-        inp.cache[key] = (u, f0, moving)
-    return inp.cache[key]
+def base_motion(system: LineSystem, prep: LinePrep, inp: LineInputs) -> tuple[np.ndarray, ...]:
+    """(U_p, F0, moving) of :func:`end_following` and :func:`base_load` on the whole
+    grid (F0 formed for all frequencies: the solves run over blocks of
+    :func:`base_load`)."""
+    u, moving = end_following(system, prep, inp)
+    return u, base_load(system, prep, inp), moving
 
 
 def _moving_channels(inp: LineInputs) -> np.ndarray | None:
@@ -317,11 +263,11 @@ def drag_inputs(
     number per element end, component, frequency and channel), and the attachment
     velocity V + Q at the nodes (n_nodes, d, n_w, n_ch) (:func:`attached_velocity`);
     None where absent."""
-    u, _, moving = base_motion(system, prep, inp)
-    moments = None if inp.moments is None else inp.moments[..., freq, :]
+    moving = inp.ub is not None
+    moments = inp.moments_at(freq)
     wm = moments
     key = ("drag_moments", system.solver)
-    whole = freq == slice(None)
+    whole = whole_grid(freq, inp.omega.size)
     if moving and whole and key in inp.cache:
         wm = inp.cache[key]
     elif moving:
@@ -331,7 +277,8 @@ def drag_inputs(
             else np.array([[1.0 / 3.0, 1.0 / 6.0], [1.0 / 6.0, 1.0 / 3.0]])
         )
         act = _moving_channels(inp)  # Q = 0 for the others: W = the moments
-        qa = u[:, :, freq] if act is None else u[:, :, freq][..., act]
+        u = end_following_at(system, prep, inp, freq)
+        qa = u if act is None else u[..., act]
         qa = qa * (-1j * inp.omega[freq])[:, None]  # Q = −iω U_p
         w_q = np.empty((prep.n - 1, 2) + qa.shape[1:], dtype=complex)
         for side in range(2):
@@ -345,7 +292,7 @@ def drag_inputs(
             wm = (
                 moments.copy()
                 if moments is not None
-                else np.zeros((prep.n - 1, 2) + u[:, :, freq].shape[1:], dtype=complex)
+                else np.zeros((prep.n - 1, 2) + u.shape[1:], dtype=complex)
             )
             wm[..., act] = w_q
         if whole and wm.nbytes <= working_memory_bytes() // 4:
@@ -363,10 +310,9 @@ def attached_velocity(system: LineSystem, prep: LinePrep, inp: LineInputs) -> np
     moves)."""
     key = ("attached_velocity", system.solver)
     if key not in inp.cache:
-        u, _, moving = base_motion(system, prep, inp)
         vq = inp.velocity
-        if moving and system.drag_nodes.size:  # V + Q: attachments only
-            q = (-1j * inp.omega)[:, None] * u
+        if inp.ub is not None and system.drag_nodes.size:  # V + Q: attachments only
+            q = (-1j * inp.omega)[:, None] * end_following(system, prep, inp)[0]
             vq = q if vq is None else vq + q
         inp.cache[key] = vq
     return inp.cache[key]
@@ -379,20 +325,67 @@ def free_load(
     damping: Damping,
     freq: slice = slice(None),
 ) -> np.ndarray:
-    """The load of :func:`solve_free`, F0 + F_d(V) + C_d Q (:func:`base_motion`), on all
+    """The load of :func:`solve_free`, F0 + F_d(V) + C_d Q (:func:`base_load`), on all
     nodes (n_nodes, d, n_w, n_ch), a fresh array; ``freq`` selects a block of the
-    frequencies (:mod:`stochcable.dynamics.freqblocks`)."""
-    _, f0, _ = base_motion(system, prep, inp)
-    wm, vq = drag_inputs(system, prep, inp, freq)
-    if wm is None:
-        rhs = f0[:, :, freq].copy()
-    else:
-        drag_blocks(system, damping)
-        rhs = element_load(damping._cache["elements"], wm)
-        rhs += f0[:, :, freq]
+    frequencies (:mod:`stochcable.dynamics.freqblocks`).
+
+    F_d(V) = Σ_el l0·B·∫N_i v dξ is formed per channel with a fluid velocity from its
+    moments (:meth:`LineInputs.fluid_block`), the elements' part of C_d Q as
+    (C_d G)(−iω u_b) with U_p = G u_b (:func:`end_following_at`; C_d G a small
+    (n_nodes·d, 2d) matrix per drag) and the attachments' b·(V + Q) at their nodes:
+    the same sums as one element load of the moments W = ∫N v dξ + P Q
+    (:func:`drag_inputs`) to round-off, without forming W."""
+    kept = ("base_load", system.solver) in inp.cache
+    if kept:  # (a view of the kept F0)
+        rhs = base_load(system, prep, inp, freq).copy()
+    else:  # F_I, the end motion's part of F0 below with C_d Q
+        rhs = inp.inertia_at(freq)
+        if "inertia" in inp.cache:
+            rhs = rhs.copy()  # (a view of the kept inertia load)
+    drag_blocks(system, damping)
+    el = damping._cache["elements"]
+    for i, f in enumerate(inp.fluid):
+        if f is not None:
+            rhs[..., i] += element_load(el, inp.fluid_block(i, freq))
+    if inp.ub is not None:
+        act = _moving_channels(inp)
+        ub = inp.ub[:, :, freq] if act is None else inp.ub[:, :, freq][..., act]
+        w = inp.omega[freq][:, None]
+        # the end motion's loads as ONE product of a (n_nodes·d, ·) basis per drag:
+        # M_T G (ω² u_b) + (C_s + C_d) G (−iω u_b) − K G u_b (the last for the direct
+        # solve), or C_d G (−iω u_b) alone beside a kept F0
+        h = _end_load_basis(system, prep, damping, el, kept)
+        parts = [-1j * w * ub] if kept else [w * w * ub, -1j * w * ub]
+        if h.shape[1] > 2 * prep.d * len(parts):  # (direct: − K G u_b)
+            parts.append(-ub)
+        x = np.ascontiguousarray(np.concatenate(parts, axis=0).reshape(h.shape[1], -1))
+        q = real_gemm(h, x).reshape((prep.n, prep.d) + ub.shape[2:])
+        if act is None:
+            rhs += q
+        else:
+            rhs[..., act] += q
+    vq = attached_velocity(system, prep, inp)
     if vq is not None and np.any(damping.b_node):
-        rhs += damping.b_node[:, None, None, None] * vq
+        rhs += damping.b_node[:, None, None, None] * vq[:, :, freq]
     return rhs
+
+
+def _end_load_basis(
+    system: LineSystem, prep: LinePrep, damping: Damping, el: np.ndarray, kept: bool
+) -> np.ndarray:
+    """[M_T G, (C_s + C_d) G (, K G)] (n_nodes·d, 4d or 6d), or C_d G alone (``kept``):
+    the end motion's loads of :func:`free_load` per unit (ω² u_b, −iω u_b (, −u_b)),
+    cached on ``damping`` (C_d G: the elements' drag, the attachments' in
+    :func:`attached_velocity`)."""
+    direct = system.solver == "direct"
+    key = ("end_load_basis", system.solver, kept)
+    if key not in damping._cache:
+        g, mg, sg, kg = prep.end_basis(direct)
+        dg = block_matvec(distribute(system.model, el, None), g.reshape(prep.n, prep.d, -1))
+        dg = dg.reshape(prep.n * prep.d, -1)
+        parts = [dg] if kept else [mg, sg + dg] + ([kg] if direct else [])
+        damping._cache[key] = np.ascontiguousarray(np.concatenate(parts, axis=1))
+    return damping._cache[key]
 
 
 def silent_channel(omega: np.ndarray) -> tuple[Channel, ...]:

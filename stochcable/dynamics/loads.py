@@ -145,6 +145,15 @@ class Channel:
         times these (linear kinematics).  None: interpolate the nodal values. [(m/s)/m]
     element_velocity_square : ndarray or None, real, shape (n_omega, n_el, 3, 3)
         Element mean ∫₀¹ Re(v vᴴ) dξ of the fluid velocity. [(m/s)²/m²]
+    element_velocity_parts, element_square : MomentParts, SquareParts or None
+        The sea's element moments and mean square in their horizontal and vertical
+        parts (:mod:`stochcable.dynamics.element_parts`), what :func:`element_moments`
+        and :func:`element_mean_square` form when ``element_velocity`` and
+        ``element_velocity_square`` are None.
+    element_ends : EndSquare or None
+        The sea's |v|² at the element ends, formed on demand
+        (:class:`~stochcable.dynamics.element_kinematics.EndSquare`; read where
+        ``element_end_square`` is None).
     element_end_square : ndarray or None, real, shape (n_omega, n_el, 2)
         |v|² at the ends of each element's wet part
         (:attr:`ElementKinematics.end_square`). [(m/s)²/m²]
@@ -170,6 +179,9 @@ class Channel:
     element_velocity: np.ndarray | None = None
     element_velocity_square: np.ndarray | None = None
     element_end_square: np.ndarray | None = None
+    element_square: Any = None  # SquareParts
+    element_velocity_parts: Any = None  # MomentParts
+    element_ends: Any = None  # EndSquare
     nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
     heading: float | None = None
 
@@ -240,9 +252,9 @@ def line_channels(
                     density=density,
                     motion_a=_end_rao(raos.get("end_a"), w, heading),
                     motion_b=_end_rao(raos.get("end_b"), w, heading),
-                    element_velocity=el.velocity,
-                    element_velocity_square=el.velocity_square,
-                    element_end_square=el.end_square,
+                    element_velocity_parts=el.moments,
+                    element_square=el.square,
+                    element_ends=el.ends,
                     nodal=_sea_nodal(el, env.g),
                     heading=float(heading),
                 )
@@ -314,6 +326,8 @@ def element_moments(model: Any, channel: Channel) -> np.ndarray | None:
     """
     if channel.element_velocity is not None:
         return channel.element_velocity
+    if channel.element_velocity_parts is not None:
+        return channel.element_velocity_parts.full()
     if channel.velocity is None:
         return None
     pat = _LUMPED if getattr(model, "mass_matrix", "consistent") == "lumped" else _CONSISTENT
@@ -338,6 +352,8 @@ def element_mean_square(channel: Channel) -> np.ndarray | None:
     """
     if channel.element_velocity_square is not None:
         return channel.element_velocity_square
+    if channel.element_square is not None:
+        return channel.element_square.full()
     if channel.velocity is None:
         return None
     va, vb = channel.velocity[:, :-1], channel.velocity[:, 1:]

@@ -21,6 +21,7 @@ from stochcable.dynamics.blocks import (
     trapezoid_weights,
 )
 from stochcable.dynamics.drag_residual import drag_residual
+from stochcable.dynamics.freqblocks import frequency_slices
 from stochcable.dynamics.geometric_residual import geometric_residual
 from stochcable.dynamics.indicators import (
     LineModes,
@@ -49,28 +50,38 @@ from stochcable.scene.model import AnalysisSettings
 # ------------------------------------------------------------------------- outputs
 
 
-def element_tension_transfer(system: LineSystem, response: Response) -> np.ndarray:
+def element_tension_transfer(
+    system: LineSystem, response: Response, motion: np.ndarray | None = None
+) -> np.ndarray:
     """Dynamic effective tension per element, (n_ch, n_el, n_omega). [N/unit]
 
     δT = (EA/l0)·e·(u_{j+1} − u_j) (module docstring), EA reduced for slack elements;
     the rows of :attr:`stochcable.line.fem.FEModel.tension_rows` (the touchdown element
-    split at the static touchdown has its suspended part's).
+    split at the static touchdown has its suspended part's).  ``motion``: the node
+    motion transfer (n_ch, n_nodes, 3, n_omega) of ``response`` when already formed
+    (read in place: the same numbers without a transposed copy of the response).
     """
 
     model = system.model
     n_w = response.omega.size
-    u = response.displacement.reshape(n_w, model.n_nodes, model.dim, -1)
-    # rows·(u_a, u_b) one component at a time, frequencies last (long inner loops; the
-    # complex einsum was 0.4 ms on the chain, the frequency-major layout 0.25)
-    u = np.ascontiguousarray(np.transpose(u, (3, 1, 2, 0)))  # (n_ch, n_nodes, dim, n_w)
+    comps = list(range(model.dim))
+    if motion is not None:  # (n_ch, n_nodes, 3, n_w): the model's components in place
+        u, comps = motion, list(model.components)
+    else:
+        u = response.displacement.reshape(n_w, model.n_nodes, model.dim, -1)
+        # rows·(u_a, u_b) one component at a time, frequencies last (long inner loops;
+        # the complex einsum was 0.4 ms on the chain, the frequency-major layout 0.25)
+        u = np.ascontiguousarray(np.transpose(u, (3, 1, 2, 0)))
     rows = model.tension_rows
     if rows is None:
         ea = np.where(model.slack, SLACK_EA_RATIO * model.mesh.ea, model.mesh.ea)
         t = model.tangents * (ea / model.l0)[:, None]
         rows = np.stack([-t, t], axis=1)
-    out = rows[None, :, 0, 0, None] * u[:, :-1, 0] + rows[None, :, 1, 0, None] * u[:, 1:, 0]
+    c = comps[0]
+    out = rows[None, :, 0, 0, None] * u[:, :-1, c] + rows[None, :, 1, 0, None] * u[:, 1:, c]
     for k in range(1, model.dim):
-        out += rows[None, :, 0, k, None] * u[:, :-1, k] + rows[None, :, 1, k, None] * u[:, 1:, k]
+        c = comps[k]
+        out += rows[None, :, 0, k, None] * u[:, :-1, c] + rows[None, :, 1, k, None] * u[:, 1:, c]
     return out
 
 
@@ -118,15 +129,19 @@ def line_result(
     w = resp.omega
     n_ch = len(channels)
     spectra = np.stack([c.spectrum for c in channels]) if n_ch else np.zeros((0, w.size))
-    motion_h = _motion_transfer(model, resp, n_ch)
-    tension_h = element_tension_transfer(system, resp)
-    # σ² = Σ_c ∫|H_c|² S_c dω as one weighted reduction with the trapezoid weights q
-    # (the response spectra are not kept; the same trapezoid rule as np.trapezoid up
-    # to round-off, ≈ 0.1 ms a line less than the spectra and two trapezoids)
+    # σ² = Σ_c ∫|H_c|² S_c dω as weighted reductions with the trapezoid weights q
+    # (the response spectra are not kept), the node motion and the element tensions
+    # over blocks of frequencies: the node motion transfer is formed only when read
+    # (LineResult.motion_transfer)
     q = trapezoid_weights(w)
     sq = spectra * q
+    tension_h, motion_var = _blocked_transfers(system, resp, n_ch, sq)
     tension_std = np.sqrt(np.einsum("cew,cw->e", np.abs(tension_h) ** 2, sq))
-    motion_std = np.sqrt(np.einsum("cnkw,cw->nk", np.abs(motion_h) ** 2, sq))
+    motion_std = np.sqrt(motion_var)
+
+    def motion(freq: slice = slice(None)) -> np.ndarray:
+        return _motion_transfer(model, resp, n_ch, freq)
+
     st = system.statics
     s0 = model.mesh.s0
     stats = {}
@@ -144,7 +159,14 @@ def line_result(
     )
     if indicators is not None:
         so = second_order_tension(
-            motion_h, spectra, q, model.positions, model.mesh, st.tension, tension_std
+            motion,
+            spectra,
+            q,
+            model.positions,
+            model.mesh,
+            st.tension,
+            tension_std,
+            tuple(model.components),
         )
         indicators = with_second_order(system.name, indicators, so)
     end_force = _end_force_transfer(model, resp, n_ch)
@@ -165,7 +187,7 @@ def line_result(
         s_nodes=s0.copy(),
         s_elements=0.5 * (s0[1:] + s0[:-1]),
         positions=model.positions.copy(),
-        motion_transfer=motion_h,
+        motion_transfer=motion,  # formed when read
         tension_transfer=tension_h,
         end_tension_transfer=dict(resp.end_tension),
         end_force_transfer=end_force,
@@ -186,18 +208,42 @@ def line_result(
     )
 
 
-def _motion_transfer(model: Any, resp: Response, n_ch: int) -> np.ndarray:
-    """Node motion transfer functions on x, y, z, (n_ch, n_nodes, 3, n_omega) (zero on
-    the components a 2-D model lacks). [m/unit]"""
-    w = resp.omega
-    # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the frequency-major
-    # layout and transposing made every later pass strided)
-    u_h = np.transpose(
-        resp.displacement.reshape(w.size, model.n_nodes, model.dim, n_ch), (3, 1, 2, 0)
-    )
+def _blocked_transfers(
+    system: LineSystem, resp: Response, n_ch: int, sq: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The element tension transfer (n_ch, n_el, n_omega) and the node motion
+    variances (n_nodes, 3) over the σ weights ``sq`` (n_ch, n_omega), from the motion
+    transfer of blocks of frequencies (never formed for the whole grid)."""
+    model = system.model
+    n_w = resp.omega.size
+    tension = np.empty((n_ch, model.n_elements, n_w), dtype=complex)
+    var = np.zeros((model.n_nodes, 3))
+    # a block's motion transfer, its squares and the tension temporaries
+    for sl in frequency_slices(n_w, 16 * n_ch * model.n_nodes * 8):
+        m = _motion_transfer(model, resp, n_ch, sl)
+        tension[:, :, sl] = element_tension_transfer(system, resp, m)
+        var += np.einsum("cnkw,cw->nk", np.abs(m) ** 2, sq[:, sl])
+    return tension, var
+
+
+def _motion_transfer(
+    model: Any, resp: Response, n_ch: int, freq: slice = slice(None)
+) -> np.ndarray:
+    """Node motion transfer functions on x, y, z on the frequencies ``freq``, (n_ch,
+    n_nodes, 3, n_f) (zero on the components a 2-D model lacks). [m/unit]"""
+    if resp.nodes is not None:  # the node layout (n_nodes, d, n_f, n_ch) of a block
+        u_h = np.transpose(resp.nodes(freq), (3, 0, 1, 2))
+    else:
+        disp = resp.displacement[freq]
+        # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the
+        # frequency-major layout and transposing made every later pass strided)
+        u_h = np.transpose(
+            disp.reshape(disp.shape[0], model.n_nodes, model.dim, n_ch), (3, 1, 2, 0)
+        )
+    n_f = u_h.shape[-1]
     if tuple(model.components) == (0, 1, 2):  # 3-D: no zero components to embed
         return np.ascontiguousarray(u_h)
-    motion_h = np.zeros((n_ch, model.n_nodes, 3, w.size), dtype=resp.displacement.dtype)
+    motion_h = np.zeros((n_ch, model.n_nodes, 3, n_f), dtype=complex)
     motion_h[:, :, list(model.components)] = u_h
     return motion_h
 

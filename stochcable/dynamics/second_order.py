@@ -24,11 +24,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from stochcable.dynamics.freqblocks import working_memory_bytes
 from stochcable.errors import PhysicsWarning, warn
 
 __all__ = [
@@ -142,20 +144,22 @@ def _real_form_moments(c: np.ndarray) -> tuple[float, float]:
 
 
 def second_order_tension(
-    motion_transfer: np.ndarray,
+    motion_transfer: np.ndarray | Callable[[slice], np.ndarray],
     input_spectra: np.ndarray,
     weights: np.ndarray,
     positions: np.ndarray,
     mesh: Any,
     tension_mean: np.ndarray,
     tension_std: np.ndarray,
+    components: tuple[int, ...] = (0, 1, 2),
 ) -> SecondOrderTension:
     """The second-order stretching tension of one line (module docstring).
 
     Parameters
     ----------
-    motion_transfer : ndarray, complex, shape (n_ch, n_nodes, 3, n_omega)
-        Node displacement per unit input. [m/unit]
+    motion_transfer : ndarray, complex, shape (n_ch, n_nodes, 3, n_omega), or callable
+        Node displacement per unit input, or a callable giving it on a slice of the
+        frequencies (read block by block). [m/unit]
     input_spectra : ndarray, shape (n_ch, n_omega)
         Input spectra. [unit²·s/rad]
     weights : ndarray, shape (n_omega,)
@@ -166,6 +170,10 @@ def second_order_tension(
         ``l0``, ``ea``, ``weight`` per element.
     tension_mean, tension_std : ndarray, shape (n_el,)
         Static tension and linear tension σ per element. [N]
+    components : tuple of int, optional
+        The components the motion can have (a 2-D model's: its plane): the normals
+        with no part on them give rows of B that are zero, left out of its Gram
+        matrix (a line in a vertical plane: half the rows, a quarter of the work).
 
     Returns
     -------
@@ -182,20 +190,66 @@ def second_order_tension(
     kappa = 1.0 / (float(np.sum(mesh.l0 / mesh.ea)) * (1.0 + lam2 / 12.0))
     normals = normals * np.sqrt(0.5 * kappa / mesh.l0)[:, None, None]  # T₂ = Σ_e a_e|Δu⊥_e|²
     amp = np.sqrt(np.clip(input_spectra, 0.0, None) * weights)  # (n_ch, n_w)
-    n_ch, n_nodes, _, n_w = motion_transfer.shape
-    # Δu·amp per element, component, channel and frequency, then its normal components
-    # as one stacked real product on the interleaved (re, im) view: the rows of B,
-    # each column's real and imaginary parts side by side (the complex einsum and the
-    # [Re B, Im B] copy were 2/3 of this function)
-    du = np.empty((n_nodes - 1, 3, n_ch, n_w), dtype=complex)
-    mt = motion_transfer.transpose(1, 2, 0, 3)
-    np.subtract(mt[1:], mt[:-1], out=du)
-    du *= amp
-    c = (normals @ du.view(float).reshape(n_nodes - 1, 3, -1)).reshape(2 * (n_nodes - 1), -1)
-    mean, std = _real_form_moments(c) if math.isfinite(lam2) else (0.0, 0.0)
+    keep = np.any(normals[:, :, list(components)] != 0.0, axis=2).ravel()  # (2·n_el,)
+    mean, std = _moments(motion_transfer, amp, normals, keep) if math.isfinite(lam2) else (0.0, 0.0)
     sig = float(np.max(tension_std)) if tension_std.size else 0.0
     ratio = std / sig if sig > 0 else (math.inf if std > 0 else 0.0)
     return SecondOrderTension(mean, std, ratio, lam2, math.sqrt(1.0 + ratio * ratio))
+
+
+def _moments(
+    motion_transfer: np.ndarray | Callable[[slice], np.ndarray],
+    amp: np.ndarray,
+    normals: np.ndarray,
+    keep: np.ndarray | None = None,
+) -> tuple[float, float]:
+    """:func:`_real_form_moments` of the rows B = normals·Δu·amp (two per element; one
+    column per channel and frequency, real and imaginary parts side by side), over
+    blocks: of frequencies when there are fewer rows than columns (the rows' Gram
+    matrix summed block by block), else of elements (the columns' Gram matrix), each
+    block's Δu and B within the working-memory target (the whole B of 400 elements ×
+    2,000 ω × 2 channels was 51 MB and its Δu 77 MB).  A callable ``motion_transfer``
+    is read by frequency blocks (formed whole for the elements' blocks).  ``keep``: the
+    rows (two per element) that can be nonzero (default all)."""
+    n_ch, n_w = amp.shape
+    n_nodes = normals.shape[0] + 1
+    keep = np.ones(2 * (n_nodes - 1), dtype=bool) if keep is None else keep
+    n_rows, n_cols = int(np.count_nonzero(keep)), 2 * n_ch * n_w
+    if callable(motion_transfer) and n_rows > n_cols:
+        motion_transfer = motion_transfer(slice(None))
+
+    def rows(el: slice, fr: slice) -> np.ndarray:
+        # Δu·amp per element, component, channel and frequency, then its normal
+        # components as one stacked real product on the interleaved (re, im) view
+        if callable(motion_transfer):  # this block of frequencies, all elements
+            mt, fm = motion_transfer(fr).transpose(1, 2, 0, 3), slice(None)
+        else:
+            mt, fm = motion_transfer.transpose(1, 2, 0, 3), fr
+        a, b = mt[el.start + 1 : el.stop + 1, :, :, fm], mt[el, :, :, fm]
+        du = np.empty(a.shape, dtype=complex)
+        np.subtract(a, b, out=du)
+        du *= amp[:, fr]
+        c = normals[el] @ du.view(float).reshape(du.shape[0], 3, -1)
+        c = c.reshape(2 * du.shape[0], -1)
+        rows_kept = keep[2 * el.start : 2 * el.stop]
+        return c if rows_kept.all() else c[rows_kept]
+
+    # a block's Δu, B and copies: ≈ 200 bytes per element, channel and frequency
+    per = 200.0 * n_ch
+    mean, gram = 0.0, None
+    if n_rows <= n_cols:
+        step = max(1, int(working_memory_bytes() // (per * (n_nodes - 1))))
+        for i in range(0, n_w, step):
+            c = rows(slice(0, n_nodes - 1), slice(i, min(i + step, n_w)))
+            mean += float(np.sum(c * c))
+            gram = c @ c.T if gram is None else gram + c @ c.T
+    else:
+        step = max(1, int(working_memory_bytes() // (per * n_w)))
+        for i in range(0, n_nodes - 1, step):
+            c = rows(slice(i, min(i + step, n_nodes - 1)), slice(0, n_w))
+            mean += float(np.sum(c * c))
+            gram = c.T @ c if gram is None else gram + c.T @ c
+    return mean, math.sqrt(2.0 * float(np.sum(gram * gram)))
 
 
 def with_second_order(line: str, indicators: Any, second_order: SecondOrderTension) -> Any:

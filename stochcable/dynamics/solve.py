@@ -32,8 +32,8 @@ from stochcable.dynamics.blocks import (
 from stochcable.dynamics.freqblocks import frequency_slices
 from stochcable.dynamics.line_loads import (
     LineInputs,
-    base_motion,
     drag_blocks,
+    end_following,
     end_loads,
     free_load,
     line_inputs,
@@ -120,7 +120,7 @@ def solve_free(
 def total_displacement(system: LineSystem, inp: LineInputs, u_free: np.ndarray) -> np.ndarray:
     """Total displacement (n_nodes, d, n_w, n_ch) from the free-node dynamic part."""
     prep = line_prep(system)
-    u = base_motion(system, prep, inp)[0].copy()
+    u = end_following(system, prep, inp)[0].copy()
     u[1:-1] += u_free
     return u
 
@@ -221,7 +221,7 @@ def _foss_solver(
             z = np.ascontiguousarray(np.moveaxis(z3, 0, 1)).reshape(m, n_w * n_ch)
         u = real_gemm(phi, np.ascontiguousarray(z))
         if m < nf:
-            u += prep.residual(system, flat)
+            u += prep.residual(system, flat, fh)
         return u.reshape(nf, n_w, n_ch)
 
     return solve

@@ -30,6 +30,7 @@ from stochcable.line.fem import FEModel, build_fe_model
 from stochcable.line.modes import Modes, natural_modes
 from stochcable.line.statics import LineStatics
 from stochcable.results.documents import (
+    FormedOnAccess,
     LinearizationRecord,
 )
 from stochcable.scene.model import AnalysisSettings, Line, Scene
@@ -195,17 +196,23 @@ class Response:
     omega : ndarray, shape (n_omega,)
         [rad/s]
     displacement : ndarray, complex, shape (n_omega, n_dof, n_ch)
-        Total displacement on all model DOFs (prescribed ends included). [m/unit]
+        Total displacement on all model DOFs (prescribed ends included); may be given
+        as a zero-argument callable, then formed on first access. [m/unit]
     support_force : ndarray, complex, shape (n_omega, n_fixed, n_ch)
         Dynamic force of the line on the supports at the fixed DOFs. [N/unit]
     end_tension : dict {"end_a", "end_b"} of ndarray (n_ch, n_omega)
         δ|F| at each support. [N/unit]
+    nodes : callable or None
+        ``nodes(freq)``: the total displacement in the node layout (n_nodes, d, n_f,
+        n_ch) on a slice of the frequencies, what the outputs read block by block
+        without forming ``displacement`` (None: read ``displacement``). [m/unit]
     """
 
     omega: np.ndarray
-    displacement: np.ndarray
+    displacement: np.ndarray = FormedOnAccess()  # type: ignore[assignment]
     support_force: np.ndarray
     end_tension: dict[str, np.ndarray]
+    nodes: Callable[[slice], np.ndarray] | None = None
 
 
 @dataclass(frozen=True, eq=False)

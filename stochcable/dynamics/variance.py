@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -25,7 +26,7 @@ from stochcable.dynamics.blocks import (
 from stochcable.dynamics.freqblocks import frequency_slices, working_memory_bytes
 from stochcable.dynamics.line_loads import (
     LineInputs,
-    base_motion,
+    end_following_at,
     end_nodes,
     line_inputs,
 )
@@ -255,7 +256,7 @@ def fluid_terms(system: LineSystem, inp: LineInputs, method: str) -> tuple[np.nd
     key = ("fluid", method)
     if key not in inp.cache:
         pr = _proj_rows(system, method)
-        if inp.moments is None:
+        if not inp.has_fluid:
             inp.cache[key] = (np.zeros(pr.shape[:2]), False)
         else:
             c0 = np.sum((pr @ inp.square) * pr, axis=2)  # r·S·r (5x the einsum's speed)
@@ -278,13 +279,14 @@ def _element_variance(
     system: LineSystem,
     inp: LineInputs,
     method: str,
-    u_nodes: np.ndarray | None = None,
+    u_nodes: np.ndarray | Callable[[slice], np.ndarray] | None = None,
     u_free: np.ndarray | None = None,
 ) -> np.ndarray:
     """Σ weight ∫₀¹ |r·(v(ξ) + N_a q_a + N_b q_b)|² dξ per element and row, (n_el, k).
 
     q = −iωU is minus the structural velocity at the element's two nodes, U the node
-    displacement ``u_nodes`` (n_nodes, d, n_w, n_ch) plus the free-node part ``u_free``
+    displacement ``u_nodes`` (n_nodes, d, n_w, n_ch), or a callable giving it on a
+    slice of the frequencies, plus the free-node part ``u_free``
     (n_nodes − 2, d, n_w, n_ch) on the interior nodes (None: nothing; both None: the
     structure at rest).  With m_i = r·∫N_i v and ∫N_a² = ∫N_b² = 1/3, ∫N_a N_b = 1/6
     the integral is ∫|r·v|² + 2Re(m̄_a q_a + m̄_b q_b) + (|q_a|² + |q_b|² +
@@ -296,13 +298,24 @@ def _element_variance(
         return c0
     pr = _proj_rows(system, method)
     kernel = element_variance_kernel()
-    if kernel is not None:  # the same sums in one compiled pass (variance_kernels)
-        var = c0.copy()
-        kernel(pr, u_nodes, u_free, inp.omega, inp.weights, inp.moments if fluid else None, var)
-        return var
-    w2 = _w2(inp)
     n_el, k, d = pr.shape
     n_w, n_ch = inp.weights.shape
+    if kernel is not None:  # the same sums in one compiled pass (variance_kernels)
+        var = c0.copy()
+        # over blocks of frequencies: the block's moments (gathered from the channels)
+        # and the kernel's contiguous copies of the block's displacements
+        for sl in frequency_slices(n_w, n_ch * 16 * (2 * (n_el + 1) * d + 2 * n_el * d)):
+            kernel(
+                pr,
+                _block(u_nodes, sl),
+                None if u_free is None else u_free[:, :, sl],
+                inp.omega[sl],
+                inp.weights[sl],
+                _kernel_moments(inp, sl) if fluid else None,
+                var,
+            )
+        return var
+    w2 = _w2(inp)
     var = c0.copy()
     wq = (-1j * inp.omega)[:, None]
     mw_all = _weighted_moments(system, inp, method) if fluid else None
@@ -311,7 +324,7 @@ def _element_variance(
         # U on the block's frequencies (the free part on the interior nodes), times −iω,
         # projected at both ends of every element in one pass
         if u_nodes is not None:
-            x = u_nodes[:, :, sl] * wq[sl]
+            x = _block(u_nodes, sl) * wq[sl]
             if u_free is not None:
                 x[1:-1] += u_free[:, :, sl] * wq[sl]
         else:
@@ -322,9 +335,24 @@ def _element_variance(
         if mw_all is not None:
             mw = mw_all[..., cols]
         elif fluid:
-            mw = np.swapaxes(_projected_moments(pr, inp.moments[..., sl, :]), 1, 2) * w2[cols]
+            mw = np.swapaxes(_projected_moments(pr, inp.moments_at(sl)), 1, 2) * w2[cols]
         var += _structural_variance(qx, w2[cols], mw)
     return var
+
+
+def _kernel_moments(inp: LineInputs, sl: slice) -> Any:
+    """The moments of a block as the variance kernel reads them: the kept whole grid,
+    or the channels' element-major storage in place (no gather)."""
+    if "moments" in inp.cache:
+        return inp.cache["moments"][..., sl, :]
+    return inp.fluid_views(sl)
+
+
+def _block(u: Any, sl: slice) -> np.ndarray | None:
+    """The frequencies ``sl`` of node vectors given as an array or a callable."""
+    if u is None:
+        return None
+    return u(sl) if callable(u) else u[:, :, sl]
 
 
 def element_variance_kernel() -> Any:
@@ -357,7 +385,7 @@ def _weighted_moments(system: LineSystem, inp: LineInputs, method: str) -> np.nd
         if 16 * n_el * k * n_cols > working_memory_bytes():  # (the product and the copy)
             inp.cache[key] = None
         else:
-            m = _projected_moments(pr, inp.moments)
+            m = _projected_moments(pr, inp.moments_at())
             inp.cache[key] = np.swapaxes(m, 1, 2) * _w2(inp)
     return inp.cache[key]
 
@@ -445,31 +473,34 @@ def sigmas_from_nodes(
 
 def end_motion_projections(system: LineSystem, inp: LineInputs, method: str) -> tuple:
     """Drag-independent parts of :func:`sigmas_from_free`, cached per inputs and solver:
-    the node displacement U_p of :func:`base_motion` (None without end motion; its
-    projections are formed block by block), the factors −iω per column (n_w·n_ch,)
-    and the attachments' V + Q (n_drag_nodes, d, n_w, n_ch)."""
+    the node displacement U_p of :func:`end_following_at` as a callable on a slice of
+    the frequencies (None without end motion: formed block by block), the factors −iω
+    per column (n_w·n_ch,) and the attachments' V + Q (n_drag_nodes, d, n_w, n_ch)."""
     key = ("qproj", system.solver)
+    prep = line_prep(system)
     if key not in inp.cache:
-        prep = line_prep(system)
-        u, _, moving = base_motion(system, prep, inp)
         wcol = np.repeat(-1j * inp.omega, inp.weights.shape[1])
         idx = system.drag_nodes
         y = np.zeros((idx.size, prep.d) + inp.weights.shape, dtype=complex)
         if inp.velocity is not None:
             y += inp.velocity[idx]
-        if not moving:
-            inp.cache[key] = (None, wcol, y)
-        else:
-            y += (-1j * inp.omega)[:, None] * u[idx]
-            inp.cache[key] = (u, wcol, y)
-    return inp.cache[key]
+        if inp.ub is not None and idx.size:
+            y += (-1j * inp.omega)[:, None] * end_following_at(system, prep, inp, nodes=idx)
+        inp.cache[key] = (wcol, y)
+    if inp.ub is None:
+        return (None, *inp.cache[key])
+
+    def u_p(sl: slice) -> np.ndarray:  # (not kept in the cache: no reference cycle)
+        return end_following_at(system, prep, inp, sl)
+
+    return (u_p, *inp.cache[key])
 
 
 def sigmas_from_free(
     system: LineSystem, inp: LineInputs, u_free: np.ndarray, method: str
 ) -> np.ndarray:
     """σ vector from the free-node dynamic part of :func:`solve_free`: the structure's
-    velocity is that of U_p (:func:`base_motion`) plus iω u_f
+    velocity is that of U_p (:func:`end_following`) plus iω u_f
     (:func:`_element_variance`, over blocks of frequencies)."""
     prep = line_prep(system)
     u_p, wcol, y = end_motion_projections(system, inp, method)
@@ -488,7 +519,7 @@ def sigmas_from_free(
 def rest_sigmas(system: LineSystem, inp: LineInputs, method: str) -> np.ndarray:
     """The σ of the start (step 5): the fluid velocity relative to the line following
     its ends quasi-statically, :func:`sigmas_from_nodes` of :func:`quasi_static_motion`.  For
-    Foss that motion is U_p of :func:`base_motion` (the same numbers)."""
+    Foss that motion is U_p of :func:`end_following` (the same numbers)."""
     if system.solver == "direct":
         return sigmas_from_nodes(system, inp, quasi_static_motion(system, inp), method)
     u_p, _, y = end_motion_projections(system, inp, method)

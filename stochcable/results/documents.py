@@ -36,6 +36,7 @@ from stochcable.results.records import (
 from stochcable.scene.units import unit_labels
 
 __all__ = [
+    "FormedOnAccess",
     "THREE_HOURS",
     "ResponseStats",
     "LinearizationRecord",
@@ -50,6 +51,27 @@ __all__ = [
 
 # Number of time samples of the time-series window put in the result document.
 DOCUMENT_WINDOW = 2048
+
+
+class FormedOnAccess:
+    """A dataclass field (no default) holding an array, or a zero-argument callable
+    that forms it: called on the first access, its array then kept (the node motion
+    transfer of :class:`LineResult`, formed only when read)."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._key = "_" + name
+
+    def __get__(self, obj: Any, objtype: Any = None) -> Any:
+        if obj is None:
+            raise AttributeError(self._key[1:])  # (the dataclass field has no default)
+        val = obj.__dict__[self._key]
+        if callable(val):
+            val = val()
+            obj.__dict__[self._key] = val
+        return val
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        obj.__dict__[self._key] = value
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,7 +95,9 @@ class LineResult:
     positions : ndarray, shape (n_nodes, 3)
         Static node positions. [m]
     motion_transfer : ndarray, complex, shape (n_ch, n_nodes, 3, n_omega)
-        Total node displacement (prescribed end motion + response) per unit input. [m/m]
+        Total node displacement (prescribed end motion + response) per unit input,
+        formed from the kept response on first access (the analysis itself reads it
+        block by block; a zero-argument callable may be given for it). [m/m]
     tension_transfer : ndarray, complex, shape (n_ch, n_el, n_omega)
         Dynamic effective tension of each element per unit input. [N/m]
     end_tension_transfer : dict {"end_a", "end_b"} of ndarray (n_ch, n_omega)
@@ -121,7 +145,7 @@ class LineResult:
     s_nodes: np.ndarray
     s_elements: np.ndarray
     positions: np.ndarray
-    motion_transfer: np.ndarray
+    motion_transfer: np.ndarray = FormedOnAccess()  # type: ignore[assignment]
     tension_transfer: np.ndarray
     end_tension_transfer: dict[str, np.ndarray]
     end_force_transfer: dict[str, np.ndarray]
@@ -141,6 +165,19 @@ class LineResult:
     strumming: StrummingTable | None = None
     drag_residual: ResidualRecord | None = None
     geometric_residual: ResidualRecord | None = None
+
+    def with_strumming(self, strumming: StrummingTable | None) -> LineResult:
+        """This result with ``strumming`` (a shallow copy: the motion transfer stays
+        unformed until read)."""
+        out = object.__new__(LineResult)
+        out.__dict__.update(self.__dict__)
+        object.__setattr__(out, "strumming", strumming)
+        return out
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled with the motion transfer formed (no callable)."""
+        _ = self.motion_transfer
+        return dict(self.__dict__)
 
     @property
     def listed_modes(self) -> np.ndarray:

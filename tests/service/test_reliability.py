@@ -39,7 +39,7 @@ def _chain(elements: int, count: int, timeseries: bool = True) -> dict:
 
 
 HEAVY_INADMISSIBLE = _chain(20000, 100000)  # at STOCHCABLE_MAX_ELEMENTS/_FREQUENCIES
-LONG = _chain(300, 3000, timeseries=False)  # ≈ 6 s and ≈ 1.6 GB on the 2-core machine
+LONG = _chain(600, 6000, timeseries=False)  # ≈ 6 s and ≈ 0.7 GB on the 2-core machine
 
 
 @pytest.fixture(scope="module")

@@ -291,6 +291,9 @@ _CHANNEL_ARRAYS = (
     "motion_b",
     "element_velocity",
     "element_velocity_square",
+    "element_square",
+    "element_velocity_parts",
+    "element_ends",
     "element_end_square",
 )
 _NODAL_ARRAYS = ("velocity", "acceleration")

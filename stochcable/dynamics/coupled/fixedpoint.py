@@ -233,13 +233,15 @@ def linearize_coupled(
             x_rest, idx, gc = _start(g, method, coarse)
         if x_rest is None or (warm.shape == x_rest.shape and x_rest.size):
             try:  # a start that does not converge: the rest start, as without one
-                fp, cache = _iterate(g, warm, idx, gc, run)
+                fp, cache = _iterate(g, warm, idx, [gc], run)
             except (ConvergenceError, SolverError):
                 fp = None
     if fp is None or not fp.converged:
         if x_rest is None:
             x_rest, idx, gc = _start(g, method, coarse)
-        fp, cache = _iterate(g, x_rest, idx, gc, run)
+        # (the coarse group in a box: released by _iterate when its stage is over)
+        box, gc = [gc], None
+        fp, cache = _iterate(g, x_rest, idx, box, run)
     if store is not None and fp.converged:  # the newest first
         hist = store.get(gname)
         keep = () if hist is None or hist.shape[1] != fp.x.size else tuple(hist)
@@ -269,12 +271,14 @@ def _warm_start(store: dict[str, np.ndarray], gname: str) -> np.ndarray | None:
 
 
 def _iterate(
-    g: GroupSystem, x_start: np.ndarray, idx: np.ndarray | None, gc: Any, run: tuple
+    g: GroupSystem, x_start: np.ndarray, idx: np.ndarray | None, box: list, run: tuple
 ) -> tuple[FixedPointResult, dict[str, Any]]:
     """The fixed point from ``x_start`` (the coarse stage on ``idx`` first when not
-    None, on the coarse group ``gc`` when built) and the cache of its last evaluation;
+    None, on the coarse group ``box[0]`` when built: emptied, so the coarse group's
+    inputs are released once its stage is over) and the cache of its last evaluation;
     ``run`` = (method, rho, progress, names, lin, fixed, gname, timing)."""
     method, rho, progress, names, lin, fixed, gname, timing = run
+    gc = box.pop() if box else None
     state: dict[str, Any] = {"it": 0}
     cache: dict[str, Any] = {}
     stage = None
@@ -282,6 +286,7 @@ def _iterate(
         stage = CoarseStart(
             g, idx, method, rho, state, progress, names, lin, fixed, gname, group=gc
         )
+        gc = None
         x_coarse = stage.start(x_start)
         if x_coarse is None:
             stage = None
@@ -294,6 +299,7 @@ def _iterate(
     if stage is not None:
         x0, change0, rounds = stage.correct(update, state, x0, change0)
     coarse_hist = () if stage is None else stage.history
+    stage = None  # (its coarse group and inputs released before the full-grid iteration)
     fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), lin, gname, fixed)
     fp = FixedPointResult(
         fp.x,
@@ -437,10 +443,15 @@ def _outcome(
         system = cl.system
         damping = cache["damping"][cl.name]
         sol = cache["sol"][cl.name]
-        uc, sc = sol.combine(None) if isinstance(sol, FreeLine) else sol
+        nodes = None
+        if isinstance(sol, FreeLine):  # read block by block, formed only if asked for
+            nodes, disp, sc = sol.response()
+        else:
+            disp, sc = to_freq(sol[0]), sol[1]
         resp = Response(
             omega=g.omega,
-            displacement=to_freq(uc),
+            displacement=disp,
+            nodes=nodes,
             support_force=sc,
             end_tension=end_tension_from_support(system, sc),
         )

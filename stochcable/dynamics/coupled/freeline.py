@@ -16,12 +16,14 @@ own solve costs.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.blocks import line_prep
-from stochcable.dynamics.line_loads import end_loads
+from stochcable.dynamics.blocks import line_prep, to_freq
+from stochcable.dynamics.freqblocks import frequency_slices
+from stochcable.dynamics.line_loads import end_following_at, end_loads
 from stochcable.dynamics.solve import reactions, solve_free, total_displacement
 from stochcable.dynamics.system import Damping, LineSystem
 from stochcable.dynamics.variance import sigmas_from_free
@@ -89,6 +91,52 @@ class FreeLine:
                 self.inp.omega,
             )
         return self._support
+
+    def response(self) -> tuple[Any, Any, np.ndarray]:
+        """The converged response without the whole grid's frequency-major copy:
+        ``nodes(freq)``, the total node displacement (n_nodes, d, n_f, n_ch) on a
+        slice of the frequencies (:attr:`~stochcable.dynamics.system.Response.nodes`);
+        a zero-argument callable forming the frequency-major displacement (n_w,
+        n_nodes·d, n_ch) when it is read; and the support forces (n_w, 2d, n_ch),
+        formed here from the two nodes at each end.  They keep the free-node part and
+        the end motions only (not the inputs' fluid arrays). [m/unit, N/unit]"""
+        system, inp = self.system, self.inp
+        prep = line_prep(system)
+        n, d = prep.n, prep.d
+        n_w, n_ch = inp.weights.shape
+        light = replace(
+            inp,
+            velocity=None,
+            square=None,
+            fluid=tuple(None for _ in inp.fluid),
+            inertia_extra=None,
+            cache={k: v for k, v in inp.cache.items() if k == ("following", system.solver)},
+        )
+        u_free, omega = self.u_free, inp.omega  # (the closures hold no fluid arrays)
+
+        def nodes(freq: slice = slice(None)) -> np.ndarray:
+            n_f = omega[freq].size
+            u = np.zeros((n, d, n_f, n_ch), dtype=complex)
+            up = end_following_at(system, prep, light, freq)
+            if up is not None:
+                u += up
+            u[1:-1] += u_free[:, :, freq]
+            return u
+
+        def displacement() -> np.ndarray:
+            disp = np.empty((n_w, n * d, n_ch), dtype=complex)
+            for sl in frequency_slices(n_w, 3 * 16 * n * d * max(n_ch, 1)):
+                disp[sl] = to_freq(nodes(sl))
+            return disp
+
+        ends = np.array([0, 1, n - 2, n - 1])
+        u_end = np.zeros((4, d, n_w, n_ch), dtype=complex)
+        for sl in frequency_slices(n_w, 2 * 16 * n * d * max(n_ch, 1)):
+            u_end[:, :, sl] = nodes(sl)[ends]
+        support = reactions(
+            system, prep, self.c, u_end, end_loads(system, inp, self.damping), inp.omega
+        )
+        return nodes, displacement, support
 
     def combine(self, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Node displacements and support forces; ``ue`` has no columns (no attached

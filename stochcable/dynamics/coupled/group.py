@@ -509,6 +509,9 @@ def sigma_update(
     alone = len(g.lines) == 1 and not g.bodies
 
     def update(x: np.ndarray) -> np.ndarray:
+        # the last evaluation's response is released before this one is solved (the
+        # outcome reads the cache of the last evaluation only)
+        cache.pop("sol", None)
         ls, bs = g.split(x)
         if g.start_drag is not None and x is g.start_drag[0]:  # the start's drag, known
             damp = dict(g.start_drag[1])

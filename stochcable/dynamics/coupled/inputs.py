@@ -344,6 +344,9 @@ def group_channels(
                     motion_b=None,
                     element_velocity=None,
                     element_velocity_square=None,
+                    element_square=None,
+                    element_velocity_parts=None,
+                    element_ends=None,
                     element_end_square=None,
                 ),
             )

@@ -34,7 +34,7 @@ import numpy as np
 
 from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep, real_gemm
 from stochcable.dynamics.coupled.freeline import FreeLine
-from stochcable.dynamics.line_loads import base_motion, drag_blocks, end_loads, free_load
+from stochcable.dynamics.line_loads import drag_blocks, end_following, end_loads, free_load
 from stochcable.dynamics.modal_solvers import FossModes, foss_modes, foss_transfer_modal
 from stochcable.dynamics.solve import reactions, solve_free, total_displacement
 from stochcable.dynamics.system import Damping, LineSystem
@@ -186,7 +186,7 @@ def foss_unit_split(
     # unit channels: U_p,j constant (node vectors (n, d, n_e))
     key = ("unit_up", n_ch)
     if key not in inp.cache:
-        up = np.ascontiguousarray(base_motion(system, prep, inp)[0][:, :, 0, n_ch:].real)
+        up = np.ascontiguousarray(end_following(system, prep, inp)[0][:, :, 0, n_ch:].real)
         inp.cache[key] = (up, prep.free_rows(block_matvec(prep.MT, up)))
     up, a = inp.cache[key]
     b = prep.free_rows(block_matvec(c, up))
@@ -506,7 +506,7 @@ def _foss_cache(
     d = prep.d
     nf = phi.shape[0]
     w2 = w * w
-    cache["u_p"] = u_p = base_motion(system, prep, inp)[0]
+    cache["u_p"] = u_p = end_following(system, prep, inp)[0]
     up, _, st_a = cache["follow"] = _unit_follow(system, inp, ends)
     n_e = up.shape[2]
     # end nodes and their neighbours: nodes 0, 1, n-2, n-1
@@ -538,7 +538,7 @@ def _modal_cache(
     phi, mh, kh = prep.modal(system)
     m, nf = phi.shape[1], phi.shape[0]
     w2 = w * w
-    cache["u_p"] = base_motion(system, prep, inp)[0]
+    cache["u_p"] = end_following(system, prep, inp)[0]
     up, ah, st_a = cache["follow"] = _unit_follow(system, inp, ends)
     cache["w2ah"] = w2[:, None, None] * ah[None]
     cache["adj"] = adj = np.r_[np.arange(d), np.arange(nf - d, nf)]

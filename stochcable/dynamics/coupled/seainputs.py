@@ -21,8 +21,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from stochcable.dynamics.coupled.inputs import scene_line_channels
 from stochcable.dynamics.line_loads import LineInputs, line_inputs, with_spectra
 from stochcable.dynamics.loads import Channel
@@ -130,12 +128,14 @@ def _channel_bytes(channels: tuple[Channel, ...]) -> int:
     arrays = []
     for c in channels:
         arrays += [c.element_velocity, c.element_velocity_square, c.element_end_square]
-    return int(sum(a.nbytes for a in arrays if isinstance(a, np.ndarray)))
+        arrays += [c.element_square, c.element_velocity_parts, c.element_ends]
+    return int(sum(getattr(a, "nbytes", 0) for a in arrays if a is not None))
 
 
 def _nbytes(channels: tuple[Channel, ...], inp: LineInputs) -> int:
     """Bytes of the channels' element kinematics and of the inputs' arrays."""
-    arrays = [inp.velocity, inp.inertia_load, inp.ub, inp.moments]
+    arrays = [inp.velocity, inp.ub, inp.inertia_extra]
     for c in channels:
         arrays += [c.element_velocity, c.element_velocity_square, c.element_end_square]
-    return int(sum(a.nbytes for a in arrays if isinstance(a, np.ndarray)))
+        arrays += [c.element_square, c.element_velocity_parts, c.element_ends]
+    return int(sum(getattr(a, "nbytes", 0) for a in arrays if a is not None))
