@@ -15,7 +15,29 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["jit_cached"]
+__all__ = ["jit_cached", "optional_kernel"]
+
+_KERNELS: dict[tuple[str, str], Any] = {}
+
+
+def optional_kernel(module: str, name: str) -> Any:
+    """The kernel ``name`` of ``module``, imported on first use (importing numba costs
+    ~0.2 s); None without numba or with ``STOCHCABLE_NUMBA=0`` (the caller's NumPy or
+    SciPy path then).  The environment variable is read at every call, the import once.
+    """
+    import os
+
+    if os.environ.get("STOCHCABLE_NUMBA", "").strip() == "0":
+        return None
+    key = (module, name)
+    if key not in _KERNELS:
+        import importlib
+
+        try:
+            _KERNELS[key] = getattr(importlib.import_module(module), name)
+        except ImportError:
+            _KERNELS[key] = None
+    return _KERNELS[key]
 
 
 def jit_cached(

@@ -15,13 +15,13 @@ need that depends neither on the sea nor on the drag.
 from __future__ import annotations
 
 import functools
-import os
 from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from stochcable.compiled import optional_kernel
 from stochcable.dynamics.solvers import band_from_blocks, tridiagonal_blocks
 from stochcable.dynamics.system import (
     LineSystem,
@@ -32,21 +32,11 @@ from stochcable.errors import (
 )
 from stochcable.line.fem import FEModel
 
-_BAND: list[Any] = []
-
 
 def _band_kernel() -> Any:
     """:func:`stochcable.dynamics.band_kernels.cholesky_band_solve`, or None without
     numba or with ``STOCHCABLE_NUMBA=0`` (SciPy's ``cho_solve_banded`` then)."""
-    if os.environ.get("STOCHCABLE_NUMBA", "").strip() == "0":
-        return None
-    if not _BAND:
-        try:  # numba: imported on first use
-            from stochcable.dynamics.band_kernels import cholesky_band_solve
-        except ImportError:
-            cholesky_band_solve = None
-        _BAND.append(cholesky_band_solve)
-    return _BAND[0]
+    return optional_kernel("stochcable.dynamics.band_kernels", "cholesky_band_solve")
 
 
 # -------------------------------------------------------------------- linearization

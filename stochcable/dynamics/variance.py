@@ -12,12 +12,12 @@ structural velocity linear along the element.
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from stochcable.compiled import optional_kernel
 from stochcable.dynamics.blocks import (
     from_freq,
     line_prep,
@@ -358,18 +358,7 @@ def _block(u: Any, sl: slice) -> np.ndarray | None:
 def element_variance_kernel() -> Any:
     """:func:`stochcable.dynamics.variance_kernels.element_variance_terms`, or None
     without numba or with ``STOCHCABLE_NUMBA=0`` (the NumPy blocks then)."""
-    if os.environ.get("STOCHCABLE_NUMBA", "").strip() == "0":
-        return None
-    if not _KERNEL:
-        try:  # numba: imported on first use
-            from stochcable.dynamics.variance_kernels import element_variance_terms
-        except ImportError:
-            element_variance_terms = None
-        _KERNEL.append(element_variance_terms)
-    return _KERNEL[0]
-
-
-_KERNEL: list[Any] = []
+    return optional_kernel("stochcable.dynamics.variance_kernels", "element_variance_terms")
 
 
 def _weighted_moments(system: LineSystem, inp: LineInputs, method: str) -> np.ndarray | None:
