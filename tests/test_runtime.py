@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import platform
 import subprocess
 import sys
 import threading
@@ -243,7 +244,10 @@ print(json.dumps((resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0) / 20)
 """
 
 
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc only")
+@pytest.mark.skipif(
+    not sys.platform.startswith("linux") or platform.libc_ver()[0] != "glibc",
+    reason="glibc's malloc only",
+)
 def test_configured_worker_keeps_its_temporaries_mapped_under_a_dask_nanny():
     # A Dask nanny starts its workers with MALLOC_TRIM_THRESHOLD_=65536, which freezes
     # glibc's mmap threshold at 128 KiB: every larger temporary of a solve was mapped
