@@ -159,3 +159,27 @@ def test_peak_memory_of_a_large_analysis_stays_bounded() -> None:
     got = json.loads(out.stdout.strip().splitlines()[-1])
     assert got["sigma"] > 0
     assert got["extra_mb"] < PEAK_400x2000_MB, got
+
+
+def test_transfer_functions_are_formed_when_read():
+    # the analysis keeps the response, not the node motion and element tension
+    # transfers: they are formed on first read (and before pickling), and the σ the
+    # analysis summed block by block are those of the formed transfers
+    import pickle
+
+    from stochcable.dynamics.blocks import trapezoid_weights
+
+    lr = analyze(load_example("chain_catenary")).lines["leg1"]
+    for key in ("_motion_transfer", "_tension_transfer"):
+        assert callable(lr.__dict__[key])
+    h = lr.tension_transfer
+    assert h.shape == (len(lr.channels), lr.s_elements.size, lr.omega.size)
+    assert not callable(lr.__dict__["_tension_transfer"])
+    sq = lr.input_spectra * trapezoid_weights(lr.omega)
+    var = np.einsum("cew,cw->e", np.abs(h) ** 2, sq)
+    np.testing.assert_allclose(lr.tension_std, np.sqrt(var), rtol=1e-12)
+    m = lr.motion_transfer
+    var = np.einsum("cnkw,cw->nk", np.abs(m) ** 2, sq)
+    np.testing.assert_allclose(lr.motion_std, np.sqrt(var), rtol=1e-12, atol=1e-15)
+    again = pickle.loads(pickle.dumps(analyze(load_example("chain_catenary")).lines["leg1"]))
+    np.testing.assert_array_equal(again.tension_transfer, h)

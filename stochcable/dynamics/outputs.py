@@ -131,16 +131,19 @@ def line_result(
     spectra = np.stack([c.spectrum for c in channels]) if n_ch else np.zeros((0, w.size))
     # σ² = Σ_c ∫|H_c|² S_c dω as weighted reductions with the trapezoid weights q
     # (the response spectra are not kept), the node motion and the element tensions
-    # over blocks of frequencies: the node motion transfer is formed only when read
-    # (LineResult.motion_transfer)
+    # over blocks of frequencies: their transfer functions are formed only when read
+    # (LineResult.motion_transfer, .tension_transfer)
     q = trapezoid_weights(w)
     sq = spectra * q
-    tension_h, motion_var = _blocked_transfers(system, resp, n_ch, sq)
-    tension_std = np.sqrt(np.einsum("cew,cw->e", np.abs(tension_h) ** 2, sq))
+    tension_var, motion_var = _blocked_variances(system, resp, n_ch, sq)
+    tension_std = np.sqrt(tension_var)
     motion_std = np.sqrt(motion_var)
 
     def motion(freq: slice = slice(None)) -> np.ndarray:
         return _motion_transfer(model, resp, n_ch, freq)
+
+    def tension() -> np.ndarray:
+        return _tension_transfer(system, resp, n_ch)
 
     st = system.statics
     s0 = model.mesh.s0
@@ -188,7 +191,7 @@ def line_result(
         s_elements=0.5 * (s0[1:] + s0[:-1]),
         positions=model.positions.copy(),
         motion_transfer=motion,  # formed when read
-        tension_transfer=tension_h,
+        tension_transfer=tension,  # formed when read
         end_tension_transfer=dict(resp.end_tension),
         end_force_transfer=end_force,
         tension_mean=np.asarray(st.tension, dtype=float).copy(),
@@ -208,22 +211,36 @@ def line_result(
     )
 
 
-def _blocked_transfers(
+def _blocked_variances(
     system: LineSystem, resp: Response, n_ch: int, sq: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The element tension transfer (n_ch, n_el, n_omega) and the node motion
-    variances (n_nodes, 3) over the σ weights ``sq`` (n_ch, n_omega), from the motion
-    transfer of blocks of frequencies (never formed for the whole grid)."""
+    """The element tension variances (n_el,) and the node motion variances (n_nodes,
+    3) over the σ weights ``sq`` (n_ch, n_omega), from the motion transfer of blocks
+    of frequencies (no transfer function formed for the whole grid)."""
     model = system.model
     n_w = resp.omega.size
-    tension = np.empty((n_ch, model.n_elements, n_w), dtype=complex)
+    t_var = np.zeros(model.n_elements)
     var = np.zeros((model.n_nodes, 3))
     # a block's motion transfer, its squares and the tension temporaries
     for sl in frequency_slices(n_w, 16 * n_ch * model.n_nodes * 8):
         m = _motion_transfer(model, resp, n_ch, sl)
-        tension[:, :, sl] = element_tension_transfer(system, resp, m)
+        t = element_tension_transfer(system, resp, m)
+        t_var += np.einsum("cew,cw->e", np.abs(t) ** 2, sq[:, sl])
         var += np.einsum("cnkw,cw->nk", np.abs(m) ** 2, sq[:, sl])
-    return tension, var
+    return t_var, var
+
+
+def _tension_transfer(system: LineSystem, resp: Response, n_ch: int) -> np.ndarray:
+    """The element tension transfer (n_ch, n_el, n_omega), formed over blocks of
+    frequencies (the node motion transfer of a block at a time). [N/unit]"""
+    model = system.model
+    n_w = resp.omega.size
+    tension = np.empty((n_ch, model.n_elements, n_w), dtype=complex)
+    for sl in frequency_slices(n_w, 16 * n_ch * model.n_nodes * 8):
+        tension[:, :, sl] = element_tension_transfer(
+            system, resp, _motion_transfer(model, resp, n_ch, sl)
+        )
+    return tension
 
 
 def _motion_transfer(

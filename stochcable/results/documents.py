@@ -56,7 +56,7 @@ DOCUMENT_WINDOW = 2048
 class FormedOnAccess:
     """A dataclass field (no default) holding an array, or a zero-argument callable
     that forms it: called on the first access, its array then kept (the node motion
-    transfer of :class:`LineResult`, formed only when read)."""
+    and element tension transfers of :class:`LineResult`, formed only when read)."""
 
     def __set_name__(self, owner: type, name: str) -> None:
         self._key = "_" + name
@@ -99,7 +99,8 @@ class LineResult:
         formed from the kept response on first access (the analysis itself reads it
         block by block; a zero-argument callable may be given for it). [m/m]
     tension_transfer : ndarray, complex, shape (n_ch, n_el, n_omega)
-        Dynamic effective tension of each element per unit input. [N/m]
+        Dynamic effective tension of each element per unit input, formed from the kept
+        response on first access (as ``motion_transfer``). [N/m]
     end_tension_transfer : dict {"end_a", "end_b"} of ndarray (n_ch, n_omega)
         Dynamic change of the magnitude of the force on each support per unit input
         (from the reaction rows of the finite-element equations). [N/m]
@@ -146,7 +147,7 @@ class LineResult:
     s_elements: np.ndarray
     positions: np.ndarray
     motion_transfer: np.ndarray = FormedOnAccess()  # type: ignore[assignment]
-    tension_transfer: np.ndarray
+    tension_transfer: np.ndarray = FormedOnAccess()  # type: ignore[assignment]
     end_tension_transfer: dict[str, np.ndarray]
     end_force_transfer: dict[str, np.ndarray]
     tension_mean: np.ndarray
@@ -167,7 +168,7 @@ class LineResult:
     geometric_residual: ResidualRecord | None = None
 
     def with_strumming(self, strumming: StrummingTable | None) -> LineResult:
-        """This result with ``strumming`` (a shallow copy: the motion transfer stays
+        """This result with ``strumming`` (a shallow copy: the transfer functions stay
         unformed until read)."""
         out = object.__new__(LineResult)
         out.__dict__.update(self.__dict__)
@@ -175,8 +176,8 @@ class LineResult:
         return out
 
     def __getstate__(self) -> dict[str, Any]:
-        """Pickled with the motion transfer formed (no callable)."""
-        _ = self.motion_transfer
+        """Pickled with the transfer functions formed (no callable)."""
+        _ = self.motion_transfer, self.tension_transfer
         return dict(self.__dict__)
 
     @property
