@@ -222,6 +222,22 @@ def test_schema_content_and_writer(tmp_path):
     assert json.loads(out.read_text(encoding="utf-8")) == schema
 
 
+def test_schema_command_line(tmp_path, monkeypatch, capsys):
+    # `python -m stochcable.scene.schema [path]`: --help is help, not a file named
+    # "--help"; a path is written
+    from stochcable.scene.schema import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0 and "output file" in capsys.readouterr().out
+    assert list(tmp_path.iterdir()) == []
+    assert main(["s.json"]) == 0
+    assert json.loads((tmp_path / "s.json").read_text(encoding="utf-8")) == json.loads(
+        scene_schema_text()
+    )
+
+
 # ------------------------------------------------------------------ bodies (issue 6)
 
 

@@ -42,6 +42,18 @@ def write_scene_schema(path: str | Path = DEFAULT_SCHEMA_PATH) -> Path:
     return out
 
 
-if __name__ == "__main__":  # pragma: no cover - exercised by hand / CI
-    target = write_scene_schema(sys.argv[1] if len(sys.argv) > 1 else DEFAULT_SCHEMA_PATH)
+def main(argv: list[str] | None = None) -> int:
+    """``python -m stochcable.scene.schema [path]``: write the schema, say where."""
+    import argparse
+
+    ap = argparse.ArgumentParser(
+        prog="python -m stochcable.scene.schema", description=__doc__.splitlines()[0]
+    )
+    ap.add_argument("path", nargs="?", default=str(DEFAULT_SCHEMA_PATH), help="output file")
+    target = write_scene_schema(ap.parse_args(argv).path)
     sys.stdout.write(f"wrote {target}\n")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover - exercised by hand / CI
+    raise SystemExit(main())
