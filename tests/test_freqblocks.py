@@ -75,6 +75,18 @@ def test_blocked_equals_unblocked(case: str) -> None:
         assert_close_documents(got, ref, rtol=RTOL.get(case, 1e-12))
 
 
+@pytest.mark.parametrize("case", ["chain_foss", "chain_direct", "chain_buoy_direct", "guy"])
+def test_kinematics_formed_when_read_equal_the_kept(case: str, monkeypatch) -> None:
+    # a memory target whose quarter (12.8 kB) no example's kinematics fit: the loads,
+    # the variance sums and the outputs form the blocks they read
+    # (element_kinematics.KinematicsBlocks), with blocks of a few frequencies
+    name, analysis = CASES[case]
+    ref = _plain(_doc(name, **analysis))
+    monkeypatch.setenv("STOCHCABLE_WORKING_MEMORY_MB", "0.05")
+    got = _plain(_doc(name, **analysis))
+    assert_close_documents(got, ref, rtol=RTOL.get(case, 1e-12))
+
+
 def test_frequency_slices_cover_the_grid_in_order() -> None:
     for n, size in ((1, 1), (10, 1), (10, 3), (10, 10), (10, 64)):
         with frequency_block(size):

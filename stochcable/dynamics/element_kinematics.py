@@ -35,13 +35,20 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as v
-from stochcable.dynamics.element_parts import MomentParts, SquareParts
+from stochcable.dynamics.element_parts import (
+    KINEMATICS_BYTES,
+    EndSquare,
+    MomentParts,
+    SquareParts,
+)
+from stochcable.dynamics.freqblocks import working_memory_bytes
 from stochcable.errors import InputError
 from stochcable.sea.kinematics import G_STANDARD, wavenumber
 
 __all__ = [
     "ElementKinematics",
     "EndSquare",
+    "KinematicsBlocks",
     "MomentParts",
     "SquareParts",
     "element_frames",
@@ -155,76 +162,6 @@ def _exp_integral(
     if phi is None:
         phi, _ = _phi1_psi(np.where(grow, -alpha, alpha) * length, want_psi=False)
     return np.exp(e0 + alpha * c) * length * phi
-
-
-@dataclass(frozen=True, eq=False)
-class EndSquare:
-    """|v|² at the two ends of each element's wet part, formed on demand from the
-    wavenumbers and the ends' depths (two exponentials per element end and frequency:
-    ω²(ch² + sh²) of the kinematics; in deep water 2ω²e^{2kz}).
-
-    Attributes
-    ----------
-    omega, wavenumber : ndarray, shape (n_omega,)
-        [rad/s], [rad/m]
-    z_ends : ndarray, shape (n_el, 2)
-        Depth of the ends of each element's wet part (≤ 0). [m]
-    wet : ndarray of bool, shape (n_el,)
-        Elements with a wet part.
-    depth, g : float
-        [m], [m/s²]
-    """
-
-    omega: np.ndarray
-    wavenumber: np.ndarray
-    z_ends: np.ndarray
-    wet: np.ndarray
-    depth: float
-    g: float
-
-    @property
-    def nbytes(self) -> int:
-        """Bytes kept (no per-frequency array of the elements). [B]"""
-        return int(self.omega.nbytes + self.wavenumber.nbytes + self.z_ends.nbytes)
-
-    def block(self, freq: Any = slice(None)) -> np.ndarray:
-        """|v|² on the frequencies ``freq``, (n_f, n_el, 2). [(m/s)²/m²]"""
-        w, k, h, z = self.omega[freq], self.wavenumber[freq], self.depth, self.z_ends
-        e1 = np.exp(2.0 * np.multiply.outer(k, z))  # (n_f, n_el, 2)
-        if math.isinf(h):
-            ends = 2.0 * e1 * (w * w)[:, None, None]
-        else:
-            zero_w = w == 0.0
-            den = -np.expm1(-2.0 * k * h)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                c = np.where(zero_w, 0.0, w / np.where(zero_w, 1.0, den))
-            c2 = (c * c)[:, None]
-            e2 = np.exp(-2.0 * np.multiply.outer(k, z + 2.0 * h))
-            ends = 2.0 * (e1 + e2) * c2[:, :, None]  # ω²(ch² + sh²)
-            if zero_w.any():  # long-wave limit: u_h = √(g/h) uniform, u_z = 0
-                u0 = math.sqrt(self.g / h)
-                ends[zero_w] = u0 * u0
-        return np.where(self.wet[None, :, None], ends, 0.0)
-
-    def full(self) -> np.ndarray:
-        """|v|², shape (n_omega, n_el, 2). [(m/s)²/m²]"""
-        return self.block()
-
-    def weighted(self, weights: np.ndarray) -> np.ndarray:
-        """Σ_ω weight·|v|² per element end, (n_el, 2), over blocks of frequencies."""
-        out = np.zeros(self.z_ends.shape)
-        n_w = self.omega.size
-        step = max(1, _BLOCK_ENTRIES // max(self.z_ends.shape[0], 1))
-        for i in range(0, n_w, step):
-            sl = slice(i, min(i + step, n_w))
-            out += np.einsum("wes,w->es", self.block(sl), weights[sl])
-        return out
-
-    def __getitem__(self, idx: Any) -> EndSquare:
-        """On the frequencies ``idx``."""
-        return EndSquare(
-            self.omega[idx], self.wavenumber[idx], self.z_ends, self.wet, self.depth, self.g
-        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -383,26 +320,15 @@ def _element_kinematics(
     p = np.where(wet_a, 0.0, np.where(wet_b, cross, 0.0))
     q = np.where(wet_b, 1.0, np.where(wet_a, cross, 0.0))
     p, q = np.clip(p, 0.0, 1.0)[None, :], np.clip(q, 0.0, 1.0)[None, :]
-    n_w, n_el = w.size, za.size
-    # the moments' horizontal and vertical parts stored element-major (n_el, 2, 2,
-    # n_w): the loads read a block of frequencies per element end and part as one
-    # contiguous run (MomentParts)
-    parts = np.empty((n_el, 2, 2, n_w), dtype=complex)
-    sq = np.empty((2, n_w, n_el))  # ∫|u_h|², ∫|u_z|² (SquareParts)
-    geo = (za, zb, chi, p, q, cb, sb, h, g)
-    # blocks of frequencies: every operation is elementwise in ω, so the numbers are
-    # those of the whole grid at once, with temporaries of one block (kept in cache:
-    # ≈ 2x faster than whole-grid passes on 400 elements × 2,000 ω)
-    step = max(1, _BLOCK_ENTRIES // max(n_el, 1))
-    for i in range(0, n_w, step):
-        sl = slice(i, min(i + step, n_w))
-        _kinematics_block(w[sl], k[sl], geo, parts[..., sl], sq[:, sl])
+    for a in (w, k, pts):
+        a.setflags(write=False)
+    src = KinematicsBlocks(w, k, (za, zb, chi, p, q, cb, sb, h, g), beta)
+    moments, square = src.parts()
     wet = (q - p)[0]
     z_ends = za[:, None] + (zb - za)[:, None] * np.hstack([p.T, q.T])  # (n_el, 2)
     z_ends = np.minimum(z_ends, 0.0)
-    for a in (w, k, pts, wet, parts, sq, z_ends):
+    for a in (wet, z_ends):
         a.setflags(write=False)
-    square = SquareParts(sq[0], sq[1], beta)
     return ElementKinematics(
         omega=w,
         wavenumber=k,
@@ -410,10 +336,103 @@ def _element_kinematics(
         heading=beta,
         depth=h,
         wet_fraction=wet,
-        moments=MomentParts(parts, beta),
+        moments=moments,
         square=square,
         ends=EndSquare(w, k, z_ends, wet > 0.0, h, g),
     )
+
+
+@dataclass(frozen=True, eq=False)
+class KinematicsBlocks:
+    """The sea's element kinematics of a line formed for any frequencies: every
+    quantity is elementwise in ω, so a block of frequencies formed alone holds the
+    numbers of the whole grid formed at once (the same operations on the same inputs).
+
+    A grid whose kinematics (:data:`~stochcable.dynamics.element_parts.
+    KINEMATICS_BYTES` per element and frequency) fit a quarter of the working-memory
+    target (:func:`~stochcable.dynamics.freqblocks.working_memory_bytes`) keeps them
+    (:meth:`parts`); a larger one keeps only this source, and the loads, the variance
+    sums and the outputs form the block of frequencies they read (memory independent
+    of the number of frequencies; each read costs a formation of that block).
+
+    Attributes
+    ----------
+    omega, wavenumber : ndarray, shape (n_omega,)
+        [rad/s], [rad/m]
+    geometry : tuple
+        (z_a, z_b, χ, p, q, cos β, sin β, h, g) of :func:`_kinematics_block`.
+    heading : float
+        β. [rad]
+    """
+
+    omega: np.ndarray
+    wavenumber: np.ndarray
+    geometry: tuple
+    heading: float
+
+    @property
+    def n_omega(self) -> int:
+        """Number of frequencies. [-]"""
+        return int(self.omega.size)
+
+    @property
+    def n_elements(self) -> int:
+        """Number of elements. [-]"""
+        return int(self.geometry[0].size)
+
+    def fits(self) -> bool:
+        """Whether the whole grid's kinematics fit a quarter of the working-memory
+        target (as the other drag-independent arrays kept between evaluations)."""
+        need = KINEMATICS_BYTES * self.n_elements * self.n_omega
+        return need <= working_memory_bytes() // 4
+
+    def form(self, freq: Any = slice(None)) -> tuple[np.ndarray, np.ndarray]:
+        """The moments' parts (n_el, 2, 2, n_f) and the mean square's (2, n_f, n_el)
+        on the frequencies ``freq``. [(m/s)/m, (m/s)²/m²]"""
+        w, k = self.omega[freq], self.wavenumber[freq]
+        n_w, n_el = w.size, self.n_elements
+        # the moments' horizontal and vertical parts stored element-major: the loads
+        # read a block of frequencies per element end and part as one contiguous run
+        parts = np.empty((n_el, 2, 2, n_w), dtype=complex)
+        sq = np.empty((2, n_w, n_el))  # ∫|u_h|², ∫|u_z|²
+        # sub-blocks whose temporaries stay in cache (≈ 2x faster than whole-grid
+        # passes on 400 elements × 2,000 ω); elementwise in ω: the same numbers
+        step = max(1, _BLOCK_ENTRIES // max(n_el, 1))
+        for i in range(0, n_w, step):
+            sl = slice(i, min(i + step, n_w))
+            _kinematics_block(w[sl], k[sl], self.geometry, parts[..., sl], sq[:, sl])
+        return parts, sq
+
+    def moments(self, freq: Any = slice(None)) -> np.ndarray:
+        """The moments' parts on ``freq``, (n_el, 2, 2, n_f). [(m/s)/m]"""
+        return self.form(freq)[0]
+
+    def square(self, freq: Any = slice(None)) -> np.ndarray:
+        """The mean square's parts on ``freq``, (2, n_f, n_el). [(m/s)²/m²]"""
+        return self.form(freq)[1]
+
+    def parts(self) -> tuple[MomentParts, SquareParts]:
+        """The whole grid's parts: formed and kept where they fit the working-memory
+        target, else formed per block when read."""
+        if not self.fits():
+            return MomentParts(None, self.heading, self), SquareParts(
+                None, None, self.heading, self
+            )
+        parts, sq = self.form()
+        for a in (parts, sq):
+            a.setflags(write=False)
+        return MomentParts(parts, self.heading), SquareParts(sq[0], sq[1], self.heading)
+
+    def elements(self, sel: slice) -> KinematicsBlocks:
+        """The source of the elements ``sel`` (a slice with step 1)."""
+        za, zb, chi, p, q, *rest = self.geometry
+        start, stop, _ = sel.indices(za.size)
+        geo = (za[sel], zb[sel], chi[start : stop + 1], p[:, sel], q[:, sel], *rest)
+        return KinematicsBlocks(self.omega, self.wavenumber, geo, self.heading)
+
+    def __getitem__(self, idx: Any) -> KinematicsBlocks:
+        """The source on the frequencies ``idx``."""
+        return KinematicsBlocks(self.omega[idx], self.wavenumber[idx], self.geometry, self.heading)
 
 
 def _kinematics_block(

@@ -105,15 +105,17 @@ def solve_free(
             )
             _check_line_conditioning(system, prep, bC, w[sl], rhs_f, u)
             u_f[:, :, sl] = from_freq(u, d)
+        inp.cache.pop("last_fluid", None)
         return u_f, c
     if modal_direct or len(slices) == 1:
         rhs = prep.free_rows(free_load(system, prep, inp, damping))
-        u = _foss_free(system, prep, c, rhs, w, modal_direct=modal_direct)
-        return u.reshape(u_f.shape), c
-    solver = _foss_solver(system, prep, c)
-    for sl in slices:
-        rhs = prep.free_rows(free_load(system, prep, inp, damping, sl))
-        u_f[:, :, sl] = solver(rhs, w[sl]).reshape(u_f[:, :, sl].shape)
+        u_f = _foss_free(system, prep, c, rhs, w, modal_direct=modal_direct).reshape(u_f.shape)
+    else:
+        solver = _foss_solver(system, prep, c)
+        for sl in slices:
+            rhs = prep.free_rows(free_load(system, prep, inp, damping, sl))
+            u_f[:, :, sl] = solver(rhs, w[sl]).reshape(u_f[:, :, sl].shape)
+    inp.cache.pop("last_fluid", None)  # (the last block's moments: not read again)
     return u_f, c
 
 

@@ -396,7 +396,10 @@ class CoarseStart:
     ) -> None:
         full_grid_arrays(g, method)
         gc = coarse_group(g, idx) if group is None else group
-        self.raw = sigma_update(gc, method, rho, state, {}, progress, names, None)
+        # the coarse map's cache (its last response) emptied after every evaluation:
+        # the stage reads its σ only, and the full grid's evaluations run beside it
+        self._cache: dict[str, Any] = {}
+        self.raw = sigma_update(gc, method, rho, state, self._cache, progress, names, None)
         self.lin, self.fixed, self.gname = lin, fixed, gname
         # the coarse model is only good to its defect: no tighter than 1e-6 (round-off
         # noise of the σ stalls tighter coarse iterations; the full grid finishes)
@@ -408,6 +411,7 @@ class CoarseStart:
     def __call__(self, y: np.ndarray) -> np.ndarray:
         """The coarse map, remembering its inputs and outputs."""
         out = self.raw(y)
+        self._cache.clear()
         self.last["x"], self.last["g"] = np.array(y, dtype=float), out
         self.pairs.append((self.last["x"], out))
         return out

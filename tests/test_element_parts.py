@@ -1,0 +1,91 @@
+"""The sea's element kinematics formed per block when read
+(stochcable.dynamics.element_parts, element_kinematics.KinematicsBlocks): a grid whose
+kinematics do not fit a quarter of the working-memory target keeps none, and every
+read (a block of frequencies, the end elements, a frequency subset, the weighted and
+projected sums) gives the numbers of the kinematics formed and kept.
+
+Every quantity is elementwise in ω, so a block formed alone holds the same operations
+on the same inputs as the whole grid; the comparison allows 1e-14 of the array's
+largest value, the few-ulp differences SIMD and scalar tails of the vectorized
+exponentials may leave (NumPy path), and the sums over frequency regrouped by blocks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stochcable.dynamics.element_kinematics import element_wave_kinematics
+
+#: Tolerance relative to the array's largest |value| (module notes). [-]
+RTOL = 1e-14
+
+
+def _line(n_el: int = 30) -> np.ndarray:
+    """A catenary-like line from the seabed (z = −60 m) through the surface to z = +4 m
+    (elements crossing the waterline and dry ones), heading off the x axis."""
+    s = np.linspace(0.0, 1.0, n_el + 1)
+    return np.column_stack([300.0 * s, 40.0 * s, -60.0 + 64.0 * s**2])
+
+
+def _close(got: np.ndarray, ref: np.ndarray) -> None:
+    scale = float(np.max(np.abs(ref), initial=0.0))
+    np.testing.assert_allclose(got, ref, rtol=0.0, atol=RTOL * scale + 1e-300)
+
+
+@pytest.fixture(params=[60.0, np.inf], ids=["depth60", "deep"])
+def pair(request, monkeypatch):
+    """(kept, formed when read) kinematics of the same line and grid, ω = 0 included."""
+    w = np.linspace(0.0, 4.0, 301)
+    kw = {"heading": 0.4, "depth": request.param}
+    kept = element_wave_kinematics(w, _line(), **kw)
+    monkeypatch.setenv("STOCHCABLE_WORKING_MEMORY_MB", "0.01")  # quarter: 2.6 kB
+    lazy = element_wave_kinematics(w, _line(), **kw)
+    return kept, lazy
+
+
+def test_a_large_grid_keeps_no_kinematics(pair) -> None:
+    kept, lazy = pair
+    assert kept.moments.parts is not None and kept.square.horizontal is not None
+    assert lazy.moments.parts is None and lazy.square.horizontal is None
+    assert lazy.moments.nbytes == 0 and lazy.square.nbytes == 0
+    assert kept.moments.nbytes == 30 * 301 * 64 and kept.square.nbytes == 30 * 301 * 16
+
+
+def test_blocks_and_subsets_formed_when_read_equal_the_kept(pair) -> None:
+    kept, lazy = pair
+    for freq in (slice(None), slice(7, 8), slice(100, 251), np.array([0, 5, 300, 17])):
+        _close(lazy.moments.block((0, 1, 2), freq), kept.moments.block((0, 1, 2), freq))
+        _close(lazy.moments.stacked(freq), kept.moments.stacked(freq))
+    for got, ref in zip(lazy.moments.ends((0, 2)), kept.moments.ends((0, 2))):
+        _close(got, ref)
+    _close(lazy.velocity, kept.velocity)
+    _close(lazy.velocity_square, kept.velocity_square)
+    idx = np.arange(0, 301, 3)
+    sub_l, sub_k = lazy.moments[idx], kept.moments[idx]
+    assert sub_l.parts is None  # (still above the target: formed when read)
+    _close(sub_l.block((0, 2)), sub_k.block((0, 2)))
+    _close(lazy.square[idx].full(), kept.square[idx].full())
+
+
+def test_sums_over_frequency_formed_by_blocks_equal_the_kept(pair) -> None:
+    kept, lazy = pair
+    rng = np.random.default_rng(21)
+    wts = rng.uniform(0.0, 1.0, kept.omega.size)
+    _close(lazy.square.weighted(wts, (0, 1, 2)), kept.square.weighted(wts, (0, 1, 2)))
+    e = np.diff(_line(), axis=0)
+    e /= np.linalg.norm(e, axis=1)[:, None]
+    proj = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
+    ref = np.clip(np.einsum("weij,eij->we", kept.velocity_square, proj), 0.0, None).T @ wts
+    _close(lazy.square.projected_sum(proj, wts), ref)
+    _close(kept.square.projected_sum(proj, wts), ref)
+
+
+def test_a_small_subset_of_a_large_grid_is_kept(monkeypatch) -> None:
+    w = np.linspace(0.05, 3.0, 400)
+    monkeypatch.setenv("STOCHCABLE_WORKING_MEMORY_MB", "0.5")  # quarter: 131 kB
+    lazy = element_wave_kinematics(w, _line(), depth=80.0)  # 30 × 400 × 80 B = 960 kB
+    assert lazy.moments.parts is None
+    sub = lazy.moments[np.arange(0, 400, 8)]  # 50 frequencies: 120 kB, kept
+    assert sub.parts is not None
+    _close(sub.parts, lazy.moments.stacked(np.arange(0, 400, 8)))
