@@ -264,6 +264,19 @@ class WorkerPool:
         self.replaced = 0
         """Workers replaced so far (died, killed at the run limit or recycled)."""
 
+    @property
+    def busy(self) -> int:
+        """Workers not idle: running a computation, or starting (on first demand, for
+        a request then counted in :attr:`waiting` until it is handed over). [-]"""
+        with self._lock:
+            return len(self._workers) - len(self._idle)
+
+    @property
+    def waiting(self) -> int:
+        """Requests queued for a worker. [-]"""
+        with self._lock:
+            return len(self._waiters)
+
     # ------------------------------------------------------------ processes
 
     def _context(self) -> Any:

@@ -119,9 +119,13 @@ def test_full_queue_answers_at_once():
         async def go():
             deadline = time.monotonic() + 30.0
             running = asyncio.ensure_future(pool.run(_sleep, 1.0, deadline=deadline, limit=30.0))
-            await asyncio.sleep(0.3)
+            # waited for, not slept on: the worker starts on first demand, slower on a
+            # loaded machine
+            while (pool.busy < 1 or pool.waiting) and time.monotonic() < deadline:
+                await asyncio.sleep(0.01)
             waiting = asyncio.ensure_future(pool.run(_add, 1, 2, deadline=deadline, limit=30.0))
-            await asyncio.sleep(0.1)
+            while pool.waiting < 1 and time.monotonic() < deadline:
+                await asyncio.sleep(0.01)
             with pytest.raises(QueueFull) as info:
                 await pool.run(_add, 2, 2, deadline=deadline, limit=30.0)
             return info.value, await running, await waiting
@@ -170,7 +174,11 @@ def test_full_queue_is_503_with_retry_after_over_http():
         out = {}
         t = threading.Thread(target=lambda: out.setdefault("r", c.post("/v1/analyses", json=long)))
         t.start()
-        time.sleep(0.3)
+        # the long analysis holds the one worker (the lifespan started it idle): waited
+        # for, not slept on (a loaded machine takes longer to hand the request over)
+        end = time.monotonic() + 30.0
+        while (app.state.pool.busy < 1 or app.state.pool.waiting) and time.monotonic() < end:
+            time.sleep(0.01)
         resp = c.post("/v1/analyses", json=chain)
         # the light endpoints do not queue behind the analysis
         light = c.post("/v1/spectra", json={"spectrum": {"type": "jonswap", "hs": 2, "tp": 8}})
