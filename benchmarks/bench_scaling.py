@@ -44,6 +44,7 @@ def doc(n_el, n_w):
     d["analysis"]["omega"]["count"] = n_w
     return d
 stochcable.analyze(doc(10, 50))
+import stochcable.dynamics.kinematics_kernels  # (large grids' compiled kinematics)
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 n_el, n_w = int(sys.argv[1]), int(sys.argv[2])
 d = doc(n_el, n_w)
@@ -111,7 +112,7 @@ def write(rows: list[dict], f: dict) -> None:
         "The bundled chain example with its sea (`analyze`, no time series), the element",
         "count and the frequency count varied, each case in a fresh process with one BLAS",
         "thread; memory is the peak RSS minus the baseline of the same process after the",
-        "imports and a small warm-up analysis.  Reproduce with",
+        "imports, the compiled kernels and a small warm-up analysis.  Reproduce with",
         "`python3 benchmarks/bench_scaling.py --write` (a quiet machine: the times are",
         "wall clock).",
         "",

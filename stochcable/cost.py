@@ -14,21 +14,23 @@ The engine's large arrays are frequency-domain arrays with one axis over the
 frequencies (``analysis.omega.count`` = n_ω), one over the nodes of a line
 (n_nodes = elements + 1, three DOFs each) and one over the line's input channels
 (:class:`stochcable.dynamics.loads.Channel`: the sea, one per end-motion spectrum DOF,
-and the three translations of an end attached to a body).  Held for the whole grid
-are the sea's element kinematics (the horizontal and vertical parts of the consistent
-moments of the velocity, 4 complex per element, and of its mean square, 2 real), the
-converged response (its free nodes' part: d complex per node and channel) and the
-element tension transfer functions; everything else — the
-loads, the solves, the variance sums, the node motion transfer of the outputs — runs
-over blocks of frequencies whose temporaries stay within the working-memory target
+and the three translations of an end attached to a body).  A line without an end on
+a body holds for the whole grid only its converged response (its free nodes' part: d
+complex per node and channel, which the result keeps); everything else — the sea's
+element kinematics (formed per block when they do not fit a quarter of the working
+memory target), the loads, the solves, the variance sums, the outputs — runs over
+blocks of frequencies whose temporaries stay within the working-memory target
 (``STOCHCABLE_WORKING_MEMORY_MB``, 48 MiB by default,
-:mod:`stochcable.dynamics.freqblocks`).  The peak resident memory is therefore
+:mod:`stochcable.dynamics.freqblocks`).  A line on a body also holds its node response
+per channel and the coupling columns of the body's solve.  The peak resident memory is
+therefore
 
-    M ≈ M_0 + c_M · n_ω · Σ_lines n_nodes · n_ch  +  c_T · N_t · (1 + Σ_lines n_ch),
+    M ≈ M_0 + n_ω · Σ_lines c_M · n_nodes · n_ch  +  c_T · N_t · (1 + Σ_lines n_ch),
 
-with M_0 the blocks' temporaries and the small arrays, N_t = duration/dt the
-time-series samples (the realization, the transfer functions interpolated onto the
-N_t/2 FFT frequencies and the synthesized records), and the time
+with c_M the free lines' constant or the attached lines' one, M_0 the blocks'
+temporaries and the small arrays, N_t = duration/dt the time-series samples (the
+realization, the transfer functions interpolated onto the N_t/2 FFT frequencies and
+the synthesized records), and the time
 
     t ≈ k_M · n_ω · Σ_lines n_nodes · n_ch · (1 + n_bodies)  +  k_T · N_t · (1 + Σ n_ch).
 
@@ -43,19 +45,20 @@ kernels; ``benchmarks/bench_cost.py``, x86-64, numpy 2, 2 cores):
 =====================================  =====  ======  =========  =======  =============
 scene                                  n_el   n_ω     channels   ΔRSS     B/(node·ω·ch)
 =====================================  =====  ======  =========  =======  =============
-taut_wire (sea only)                   200    1000    1          69 MB    12
-taut_wire                              400    1000    1          114 MB   116
-chain_catenary (sea + fairlead surge)  200    1000    2          77 MB    25
-chain_catenary                         400    1000    2          140 MB   90
-chain_catenary                         200    3000    2          172 MB   87
-disc buoy, three legs (free body)      3×100  1000    4 per leg  206 MB   115
-disc buoy, three legs                  3×200  1000    4 per leg  346 MB   116
+taut_wire (sea only)                   200    1000    1          68 MB    3
+taut_wire                              400    1000    1          85 MB    43
+chain_catenary (sea + fairlead surge)  200    1000    2          79 MB    30
+chain_catenary                         400    1000    2          100 MB   40
+chain_catenary                         200    3000    2          119 MB   43
+disc buoy, three legs (free body)      3×100  1000    4 per leg  219 MB   125
+disc buoy, three legs                  3×200  1000    4 per leg  328 MB   108
 =====================================  =====  ======  =========  =======  =============
 
-(the ratio is (ΔRSS − M_0)/(n_ω Σ n_nodes n_ch)) so c_M = 120 B (the largest ratio,
-rounded up: the estimate should not be below the peak; a line with the sea alone
-holds its kinematics for one channel, the most per channel), M_0 = 64 MiB (the
-working-memory target's temporaries and the small arrays); c_T = 110 B per sample and
+(the ratio is (ΔRSS − M_0)/(n_ω Σ n_nodes n_ch)) so c_M = 56 B for free lines (the
+largest ratio, 43, with a third more: the estimate should not be below the peak, and
+the small cases' ratios carry the noise of M_0) and 140 B for lines on a body (125
+rounded up), M_0 = 64 MiB (the working-memory target's temporaries and the small
+arrays); c_T = 110 B per sample and
 channel (chain_catenary, 2^20 and 2^22 samples with the whole record in the result
 document: 320 B per sample).  Time on the same machine: 0.9–1.2 µs per
 node·frequency·channel for single lines, 2.1–2.4 µs with a free body (k_M = 1.3 µs,
@@ -64,9 +67,9 @@ indicative (they scale with the CPU and the drag iterations); the memory model i
 what the budgets use.
 
 The constants are in one place (the ``*_BYTES_*`` and ``*_SECONDS_*`` module
-constants) so that a change of the engine's array layout (frequency-blocked solves)
-updates them here only: rerun ``benchmarks/bench_cost.py`` and take the largest
-bytes-per-node·frequency·channel ratio, rounded up.
+constants) so that a change of the engine's array layout updates them here only:
+rerun ``benchmarks/bench_cost.py`` and take the largest bytes-per-node·frequency·channel
+ratio of each kind of line, rounded up.
 
 The adaptive-fidelity planner (``analysis.fidelity``) chooses its own elements and
 frequencies: the scene it plans is refused when its estimate exceeds the memory
@@ -91,14 +94,20 @@ __all__ = [
     "check_memory",
     "available_memory",
     "BYTES_PER_NODE_FREQUENCY_CHANNEL",
+    "BYTES_PER_NODE_FREQUENCY_CHANNEL_ATTACHED",
     "BYTES_PER_SAMPLE_CHANNEL",
     "BASE_BYTES",
     "SECONDS_PER_NODE_FREQUENCY_CHANNEL",
     "SECONDS_PER_SAMPLE_CHANNEL",
 ]
 
-BYTES_PER_NODE_FREQUENCY_CHANNEL = 120
-"""Peak bytes per node, frequency and input channel of a line (c_M). [B]"""
+BYTES_PER_NODE_FREQUENCY_CHANNEL = 56
+"""Peak bytes per node, frequency and input channel of a line without an end on a
+body (c_M). [B]"""
+
+BYTES_PER_NODE_FREQUENCY_CHANNEL_ATTACHED = 140
+"""Peak bytes per node, frequency and input channel of a line with an end on a body
+(c_M). [B]"""
 
 BYTES_PER_SAMPLE_CHANNEL = 110
 """Peak bytes per time-series sample and channel, plus one for the sea (c_T). [B]"""
@@ -272,7 +281,7 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
 
     Notes
     -----
-    M ≈ M_0 + c_M n_ω Σ n_nodes n_ch + c_T N_t (1 + Σ n_ch), with the constants and
+    M ≈ M_0 + n_ω Σ c_M n_nodes n_ch + c_T N_t (1 + Σ n_ch), with the constants and
     their calibration in the module docstring.  An analysis with
     ``analysis.fidelity`` runs pilot analyses of its own choosing; the estimate is that
     of the document as given.
@@ -281,6 +290,7 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
         scene = load_scene(scene, allow_files=True)
     n_w = int(scene.analysis.omega.count)
     node_channels = 0
+    node_bytes = 0  # Σ_lines c_M n_nodes n_ch
     nodes = 0
     channels = 0
     largest, largest_path = -1, "lines[0].segments[0].elements"
@@ -290,6 +300,13 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
         nodes += n_nodes
         channels += n_ch
         node_channels += n_nodes * n_ch
+        attached = any(getattr(e, "attach", None) is not None for e in (line.end_a, line.end_b))
+        c_m = (
+            BYTES_PER_NODE_FREQUENCY_CHANNEL_ATTACHED
+            if attached
+            else BYTES_PER_NODE_FREQUENCY_CHANNEL
+        )
+        node_bytes += c_m * n_nodes * n_ch
         for j, s in enumerate(line.segments):
             if s.elements > largest:
                 largest, largest_path = int(s.elements), f"lines[{i}].segments[{j}].elements"
@@ -298,7 +315,7 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
     if ts is not None:
         ratio = ts.duration / ts.dt
         samples = int(round(ratio)) if ratio < 2**62 else 2**62
-    spectral = BYTES_PER_NODE_FREQUENCY_CHANNEL * n_w * node_channels
+    spectral = n_w * node_bytes
     series = BYTES_PER_SAMPLE_CHANNEL * samples * (1 + channels)
     n_bodies = len(scene.bodies)
     ops_spectral = float(n_w) * node_channels

@@ -13,7 +13,11 @@ import pytest
 
 from stochcable import InputError, estimate_cost
 from stochcable.cli import main as cli_main
-from stochcable.cost import BYTES_PER_NODE_FREQUENCY_CHANNEL, check_memory
+from stochcable.cost import (
+    BYTES_PER_NODE_FREQUENCY_CHANNEL,
+    BYTES_PER_NODE_FREQUENCY_CHANNEL_ATTACHED,
+    check_memory,
+)
 from stochcable.examples import load_example
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -29,6 +33,7 @@ doc = json.loads(sys.argv[1])
 # is in current: its strumming screening loads numba's lock-in grid kernel)
 analyze(load_example("taut_wire"))
 analyze(load_example("chain_catenary"))
+import stochcable.dynamics.kinematics_kernels  # (large grids' compiled kinematics)
 try:  # reset the peak RSS (VmHWM) to the current RSS (Linux >= 4.0)
     with open("/proc/self/clear_refs", "w") as f:
         f.write("5")
@@ -72,7 +77,12 @@ def _measured_peak(doc: dict) -> int:
 
 @pytest.mark.parametrize(
     ("name", "elements", "count"),
-    [("taut_wire", 200, 600), ("chain_catenary", 150, 600)],
+    [
+        ("taut_wire", 200, 600),
+        ("chain_catenary", 150, 600),
+        ("chain_catenary", 400, 2000),
+        ("tuah_1982_disc_buoy_three_legs", 100, 600),
+    ],
 )
 def test_estimate_bounds_the_measured_peak(name, elements, count):
     doc = _doc(name, elements, count)
@@ -98,6 +108,9 @@ def test_channels_and_sizes_are_counted():
     doubled = estimate_cost(_doc("chain_catenary", count=400))
     assert doubled.spectral_bytes == 2 * chain.spectral_bytes
     assert chain.spectral_bytes == BYTES_PER_NODE_FREQUENCY_CHANNEL * 200 * 41 * 2
+    # the legs on the buoy: the attached lines' constant (their node response per channel)
+    legs = three.nodes * 4 * three.frequencies
+    assert three.spectral_bytes == BYTES_PER_NODE_FREQUENCY_CHANNEL_ATTACHED * legs
 
 
 def test_refusal_names_the_input_to_reduce():

@@ -145,6 +145,7 @@ def doc(n_el, n_w):
     d["analysis"]["omega"]["count"] = n_w
     return d
 stochcable.analyze(doc(10, 50))  # imports, compiled kernels, caches
+import stochcable.dynamics.kinematics_kernels  # (large grids' compiled kinematics)
 try:  # the high-water mark from here on: reset to the current RSS
     with open("/proc/self/clear_refs", "w") as f:
         f.write("5")

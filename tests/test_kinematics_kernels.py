@@ -67,9 +67,11 @@ def _long_line(n_el: int = 200, far: float = 0.0) -> np.ndarray:
 
 
 def _both(monkeypatch, *args):
+    """(compiled, NumPy) kinematics of ``args`` (the compiled loop on any grid size)."""
     monkeypatch.setenv("STOCHCABLE_NUMBA", "0")
     ref = element_wave_kinematics(*args)
     monkeypatch.delenv("STOCHCABLE_NUMBA", raising=False)
+    monkeypatch.setattr(ek, "KERNEL_MIN_ENTRIES", 0)  # the compiled loop on any grid
     got = element_wave_kinematics(*args)
     return got, ref
 
@@ -137,34 +139,38 @@ def test_dry_elements_are_zero_and_wet_ones_loaded(monkeypatch):
         assert np.all(part[:, dry] == 0.0)
 
 
+@pytest.mark.parametrize("depth", [200.0, math.inf])
+def test_elements_high_above_the_water_are_zero_on_both_paths(monkeypatch, depth):
+    # a guy's top element 100–150 m above the water at 6 rad/s: k·z ≈ 550, 2k·z > 709
+    # (e^{2kz} overflows; times the zero wet length it was NaN on the NumPy path)
+    pts = np.array([[0.0, 0.0, -50.0], [60.0, 0.0, -1.0], [90.0, 0.0, 100.0], [120, 0, 150.0]])
+    got, ref = _both(monkeypatch, np.linspace(0.0, 6.0, 13), pts, 0.0, depth, G)
+    for ek_ in (got, ref):
+        assert np.all(np.isfinite(ek_.moments.parts)) and np.all(np.isfinite(ek_.square.full()))
+        assert np.all(ek_.moments.parts[2:] == 0.0) and np.all(ek_.square.horizontal[:, 2:] == 0)
+    _compare(got, ref)
+
+
 def test_direct_call_writes_a_strided_block_only(monkeypatch):
-    """_kinematics_block on a block of frequencies writes that block of the (strided)
-    views only, the same numbers as the NumPy form."""
+    """The kernel on a block of frequencies writes that block of the (strided) views
+    only, the same numbers as the NumPy form (_kinematics_block)."""
+    from stochcable.dynamics.kinematics_kernels import kinematics_block
+
     pts = _line(200.0)
     w = np.linspace(0.0, 6.0, 40)
     k = wavenumber(w, 200.0, G)
-    captured = []
-    real = ek._kinematics_block
-
-    def record(wb, kb, geo, vel, sq):
-        captured.append(geo)
-        real(wb, kb, geo, vel, sq)
-
-    monkeypatch.setattr(ek, "_kinematics_block", record)
-    element_wave_kinematics(w, pts, 0.3, 200.0, G)
-    monkeypatch.setattr(ek, "_kinematics_block", real)
-    geo = captured[0]
+    monkeypatch.setenv("STOCHCABLE_WORKING_MEMORY_MB", "0.001")  # kept: none (a source)
+    geo = element_wave_kinematics(w, pts, 0.3, 200.0, G).moments.source.geometry
     n_el = pts.shape[0] - 1
     sl = slice(7, 29)
     out = {}
     for env in ("0", None):
-        if env is None:
-            monkeypatch.delenv("STOCHCABLE_NUMBA", raising=False)
-        else:
-            monkeypatch.setenv("STOCHCABLE_NUMBA", env)
         parts = np.full((n_el, 2, 2, w.size), np.nan + 0j)
         sq = np.full((2, w.size, n_el), np.nan)
-        ek._kinematics_block(w[sl], k[sl], geo, parts[..., sl], sq[:, sl])
+        if env is None:
+            kinematics_block(w[sl], k[sl], *geo, parts[..., sl], sq[:, sl])
+        else:
+            ek._kinematics_block(w[sl], k[sl], geo, parts[..., sl], sq[:, sl])
         assert np.all(np.isnan(parts[..., : sl.start])) and np.all(np.isnan(parts[..., sl.stop :]))
         assert np.all(np.isnan(sq[:, : sl.start])) and np.all(np.isnan(sq[:, sl.stop :]))
         out[env] = parts[..., sl], sq[:, sl]

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as v
+from stochcable.compiled import optional_kernel
 from stochcable.dynamics.element_parts import (
     KINEMATICS_BYTES,
     EndSquare,
@@ -63,6 +64,10 @@ _SERIES_RADIUS = 0.5
 _SERIES_TERMS = 15
 _PHI1_COEF = np.array([1.0 / math.factorial(n + 1) for n in range(_SERIES_TERMS)])
 _PSI_COEF = np.array([1.0 / (math.factorial(n) * (n + 2)) for n in range(_SERIES_TERMS)])
+#: Elements × frequencies from which a block is formed by the compiled loop
+#: (:mod:`stochcable.dynamics.kinematics_kernels`, ≈ 2–3x faster; loading it costs
+#: ≈ 0.3 s once per process, more than NumPy spends on the bundled examples' grids).
+KERNEL_MIN_ENTRIES = 2**16
 # Elements × frequencies per block of :func:`_element_kinematics` (its temporaries,
 # ≈ 30 arrays of this many entries, stay in the cache).
 _BLOCK_ENTRIES = 2**14
@@ -395,8 +400,15 @@ class KinematicsBlocks:
         # read a block of frequencies per element end and part as one contiguous run
         parts = np.empty((n_el, 2, 2, n_w), dtype=complex)
         sq = np.empty((2, n_w, n_el))  # ∫|u_h|², ∫|u_z|²
-        # sub-blocks whose temporaries stay in cache (≈ 2x faster than whole-grid
-        # passes on 400 elements × 2,000 ω); elementwise in ω: the same numbers
+        kern = None
+        if n_w * n_el >= KERNEL_MIN_ENTRIES:
+            kern = optional_kernel("stochcable.dynamics.kinematics_kernels", "kinematics_block")
+        if kern is not None:  # the compiled loop, in one call (it chunks its own work)
+            kern(w, k, *self.geometry, parts, sq)
+            return parts, sq
+        # NumPy: sub-blocks whose temporaries stay in cache (≈ 2x faster than
+        # whole-grid passes on 400 elements × 2,000 ω); elementwise in ω: the same
+        # numbers
         step = max(1, _BLOCK_ENTRIES // max(n_el, 1))
         for i in range(0, n_w, step):
             sl = slice(i, min(i + step, n_w))
@@ -446,17 +458,15 @@ def _kinematics_block(
     ``vel`` (the parts of :class:`MomentParts`, (n_el, 2, 2, n_w)), ``sq`` (h and v of
     :class:`SquareParts`): the body of
     :func:`_element_kinematics` on one block; ``geo`` = (z_a, z_b, χ, p, q, cos β,
-    sin β, h, g).  Frequency-major (n_w, n_el) arrays throughout.  The compiled loop
-    :func:`stochcable.dynamics.kinematics_kernels.kinematics_block` where numba is
-    available (not with ``STOCHCABLE_NUMBA=0``): the same formulas, ≈ 2x faster."""
-    from stochcable.compiled import optional_kernel
-
-    kern = optional_kernel("stochcable.dynamics.kinematics_kernels", "kinematics_block")
-    if kern is not None:
-        kern(w, k, *geo, vel, sq)
-        return
+    sin β, h, g).  Frequency-major (n_w, n_el) arrays throughout.  The NumPy form of
+    :func:`stochcable.dynamics.kinematics_kernels.kinematics_block`, the compiled loop
+    :meth:`KinematicsBlocks.form` calls where numba is available (not with
+    ``STOCHCABLE_NUMBA=0``): the same formulas, ≈ 2–3x faster."""
     za, zb, chi, p, q, cb, sb, h, g = geo
     length = q - p
+    dry = length[0] <= 0.0  # no wet part: computed at z = 0, then set to zero
+    if dry.any():
+        za, zb = np.where(dry, 0.0, za), np.where(dry, 0.0, zb)
     dz = np.multiply.outer(k, zb - za)
     phase0 = -np.multiply.outer(k, chi[:-1])  # imaginary parts of the exponents
     dphase = -np.multiply.outer(k, chi[1:] - chi[:-1])
@@ -506,6 +516,9 @@ def _kinematics_block(
         vel[:, side, 1] = mz[side].T
     sq[0] = ch2
     sq[1] = sh2
+    if dry.any():  # (zeros, not e^{kz}·0: NaN once kz > 709 high above the water)
+        vel[dry] = 0.0
+        sq[:, :, dry] = 0.0
 
 
 # ------------------------------------------------------------------ element geometry
