@@ -199,7 +199,7 @@ def test_fully_wet_exp_moments_are_the_general_formula():
     """_exp_moments drops the factors 1 and 0 when every element is wet over its whole
     length (the speed pass of issue 4); the general expressions give the same numbers
     to the bit (x·1 and 0 + x are exact), growing and decaying exponents alike."""
-    from stochcable.dynamics.element_kinematics import _complex, _exp_moments, _phi1_psi
+    from stochcable.dynamics.kinematics_closed_forms import _complex, _exp_moments, _phi1_psi
     from stochcable.sea.kinematics import _wavenumber
 
     def general(e0, alpha, p, q):  # the formula for any wet part [p, q]
@@ -282,7 +282,7 @@ def test_second_exponent_shares_phi_psi_by_conjugation():
     and the φ1 of ∫e^{−2k(z+2h)} as that of ∫e^{2kz} (issue 6 pass E6): the moments
     equal those of their own φ1, ψ to the bit, for rising, sinking and horizontal
     elements, at ω = 0, fully wet (the short path) and partly wet (the general one)."""
-    from stochcable.dynamics.element_kinematics import (
+    from stochcable.dynamics.kinematics_closed_forms import (
         _complex,
         _exp_integral,
         _exp_moments,

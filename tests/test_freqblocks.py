@@ -119,12 +119,14 @@ def test_forced_block_must_be_a_positive_integer(size) -> None:
 
 
 #: Bound of the peak RSS of the 400-element, 2,000-frequency chain analysis above the
-#: process's RSS before it (after the imports and a small warm-up analysis), in a fresh
-#: process. [MiB]  The goal of issue 21 ("400 × 2,000 under 400 MB": the frequency
-#: blocks keep the temporaries within STOCHCABLE_WORKING_MEMORY_MB, 48 MiB by
-#: default, and the whole-grid arrays to the sea's element kinematics, the response
-#: and the element tensions, ≈ 130 bytes per DOF·ω with the chain's two channels);
-#: measured 0.21 GB (1.6e6 DOF·ω; 0.63 GB before the inputs and outputs were blocked).
+#: process's RSS before it (after the imports, the compiled kernels and a small warm-up
+#: analysis), in a fresh process. [MiB]  The goal of issue 21 ("400 × 2,000 under
+#: 400 MB": the frequency blocks keep the temporaries within
+#: STOCHCABLE_WORKING_MEMORY_MB, 48 MiB by default, the sea's element kinematics are
+#: formed per block, and the whole-grid arrays are the response the result keeps, 32
+#: bytes per DOF·ω with the chain's two channels); measured 0.13 GB (1.6e6 DOF·ω;
+#: 0.63 GB before the inputs and outputs were blocked, 0.21 GB with the kinematics
+#: kept).
 PEAK_400x2000_MB = 400
 
 _PEAK_CHILD = """

@@ -1,5 +1,5 @@
 """The compiled element kinematics (stochcable.dynamics.kinematics_kernels) against the
-NumPy form of element_kinematics._kinematics_block (``STOCHCABLE_NUMBA=0``): the same
+NumPy form (kinematics_closed_forms.kinematics_block, ``STOCHCABLE_NUMBA=0``): the same
 formulas, so equal to a few ulps of each element's largest value.
 
 The closed forms themselves are checked against quadrature of the nodal kinematics
@@ -16,6 +16,7 @@ import pytest
 pytest.importorskip("numba")
 
 from stochcable.dynamics import element_kinematics as ek  # noqa: E402
+from stochcable.dynamics import kinematics_closed_forms as closed_forms  # noqa: E402
 from stochcable.dynamics.element_kinematics import element_wave_kinematics  # noqa: E402
 from stochcable.sea.kinematics import wavenumber  # noqa: E402
 
@@ -153,7 +154,7 @@ def test_elements_high_above_the_water_are_zero_on_both_paths(monkeypatch, depth
 
 def test_direct_call_writes_a_strided_block_only(monkeypatch):
     """The kernel on a block of frequencies writes that block of the (strided) views
-    only, the same numbers as the NumPy form (_kinematics_block)."""
+    only, the same numbers as the NumPy form."""
     from stochcable.dynamics.kinematics_kernels import kinematics_block
 
     pts = _line(200.0)
@@ -170,7 +171,7 @@ def test_direct_call_writes_a_strided_block_only(monkeypatch):
         if env is None:
             kinematics_block(w[sl], k[sl], *geo, parts[..., sl], sq[:, sl])
         else:
-            ek._kinematics_block(w[sl], k[sl], geo, parts[..., sl], sq[:, sl])
+            closed_forms.kinematics_block(w[sl], k[sl], geo, parts[..., sl], sq[:, sl])
         assert np.all(np.isnan(parts[..., : sl.start])) and np.all(np.isnan(parts[..., sl.stop :]))
         assert np.all(np.isnan(sq[:, : sl.start])) and np.all(np.isnan(sq[:, sl.stop :]))
         out[env] = parts[..., sl], sq[:, sl]

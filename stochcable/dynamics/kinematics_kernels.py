@@ -1,9 +1,9 @@
 """The element wave kinematics of a block of frequencies as one compiled loop
-(:func:`kinematics_block`): what :func:`stochcable.dynamics.element_kinematics.
-_kinematics_block` forms with NumPy.
+(:func:`kinematics_block`): what :func:`stochcable.dynamics.kinematics_closed_forms.
+kinematics_block` forms with NumPy.
 
 Per element (wet part ξ ∈ [p, q], L = q − p) and frequency it evaluates the closed
-forms of :mod:`~stochcable.dynamics.element_kinematics` for the kinematics of
+forms of :mod:`~stochcable.dynamics.kinematics_closed_forms` for the kinematics of
 seed 001 eqs. 5.2.8–5.2.11 (:func:`~stochcable.dynamics.element_kinematics.
 element_wave_kinematics`): with E₁ = k z − i k χ, E₂ = −k(z + 2h) − i k χ (linear in ξ
 along the element, slopes α₁ = k dz − i k dχ and α₂ = −k dz − i k dχ) and
@@ -33,9 +33,10 @@ cancels the same way, to exactly 0 on the seabed), the closed forms where |x| >=
 (x⁻¹ = x̄/|x|² once) and the combinations.  The factors of a frequency (D, e^{−2kh})
 are formed once per call.  :func:`~stochcable.dynamics.element_kinematics.
 element_wave_kinematics` on 1,000 elements × 2,000 frequencies: ≈ 220 → 110 ms at
-h = 200 m, 155 → 80 ms in deep water (≈ 110 → 55 and 80 → 40 ns an entry); its blocks
-of 16 frequencies scatter the writes of the element-major moments (≈ 15 ns an entry of
-those 55 and 40; 42 and 27 ns with the whole grid as one block).
+h = 200 m, 155 → 80 ms in deep water (≈ 110 → 55 and 80 → 40 ns an entry) in blocks of
+16 frequencies, whose scattered writes of the element-major moments cost ≈ 15 ns an
+entry: 42 and 27 ns with the whole grid as one block, as
+:meth:`~stochcable.dynamics.element_kinematics.KinematicsBlocks.form` calls it.
 
 The same formulas: equal to the NumPy form to a few ulps of each element's largest
 value (libm's exponential against NumPy's vectorized one, e^{2a} as (e^a)² in deep
@@ -59,7 +60,7 @@ import numpy as np
 from numba import types
 
 from stochcable.compiled import jit_cached
-from stochcable.dynamics.element_kinematics import (
+from stochcable.dynamics.kinematics_closed_forms import (
     _PHI1_COEF,
     _PSI_COEF,
     _SERIES_RADIUS,
@@ -203,7 +204,7 @@ def _passes(k, za, zb, chi, p, q, c_phi, c_psi, e0, e1, n_rows, sc):  # noqa: AN
 def _moments(r, f1, f2, full, grow, c, length):  # noqa: ANN001
     """∫_p^q (1 − ξ) e^{E} dξ and ∫_p^q ξ e^{E} dξ = r·(…) with r = e^{E(c)}, c the end
     where Re E is largest (c = q where ``grow``), from φ1 and ψ of x
-    (element_kinematics._exp_moments; ``full``: p = 0, q = 1, its shorter form)."""
+    (kinematics_closed_forms._exp_moments; ``full``: p = 0, q = 1, its shorter form)."""
     if full:
         d12 = f1 - f2
         if grow:
@@ -379,7 +380,7 @@ def kinematics_block(
 ) -> None:
     """The element kinematics of the frequencies ``w`` written into ``vel`` and ``sq``
     (module docstring; the arguments of
-    :func:`stochcable.dynamics.element_kinematics._kinematics_block`, ``geo`` spread).
+    :func:`stochcable.dynamics.kinematics_closed_forms.kinematics_block`, ``geo`` spread).
 
     Parameters
     ----------
