@@ -180,6 +180,11 @@ class BatchStatus(BaseModel):
     error: str | None = Field(description="Why the batch failed")
     chunk_size: int = Field(description="Cases per chunk [-]")
     results: str = Field(description="Where the results are (when done)")
+    warnings: list[str] = Field(
+        default_factory=list,
+        description="Physics warnings of the set as planned (e.g. a residual of the "
+        "scene that load-case sets do not apply; threshold and fix in each message)",
+    )
 
 
 class BatchList(BaseModel):

@@ -40,7 +40,7 @@ from stochcable.cases.plan import (
 )
 from stochcable.cases.results import case_dataset, case_document, case_summary_csv
 from stochcable.cases.run import assemble_cases
-from stochcable.errors import InputError
+from stochcable.errors import InputError, collect_warnings
 from stochcable.scene.model import load_scene
 
 from .batch_schemas import (
@@ -101,7 +101,8 @@ def plan_request(doc: dict[str, Any], settings: Settings | None = None) -> CaseP
     -------
     CasePlan
     """
-    req = BatchRequest.model_validate(doc)
+    # (a stored job's document also holds its planning warnings: not the request's)
+    req = BatchRequest.model_validate({k: v for k, v in doc.items() if k != "warnings"})
     try:
         scene = load_scene(req.scene, allow_files=False)
     except InputError as exc:
@@ -215,13 +216,16 @@ class BatchService:
         """Validate, plan and store a batch; the runner is woken."""
         doc = request.model_dump(mode="json", exclude_none=True)
         doc["scene"] = request.scene.model_dump(mode="json", exclude_unset=True)
-        if doc.get("chunk_size") is None:
+        with collect_warnings() as caught:  # (what the set does not apply, ...)
+            if doc.get("chunk_size") is None:
+                plan = plan_request(doc, self.settings)
+                # from the settings alone: a submission never waits for a Dask scheduler
+                doc["chunk_size"] = default_chunk_size(
+                    len(plan.scatter.states), self.settings.batch_workers
+                )
             plan = plan_request(doc, self.settings)
-            # from the settings alone: a submission never waits for a Dask scheduler
-            doc["chunk_size"] = default_chunk_size(
-                len(plan.scatter.states), self.settings.batch_workers
-            )
-        plan = plan_request(doc, self.settings)
+        # stored with the request: the status shows them as long as the job is kept
+        doc["warnings"] = list(dict.fromkeys(str(w) for w in caught))
         n = len(plan.scatter.states)
         job = self.store.create(
             owner, doc, n, len(plan.chunks), doc["chunk_size"], self.settings.max_queued_batches
@@ -266,7 +270,7 @@ class BatchService:
             id=job.id, status=job.status, created=_iso(job.created), started=_iso(job.started),
             finished=_iso(job.finished), progress=progress, problems=problems,
             problems_total=job.cases_not_ok, error=job.error, chunk_size=job.chunk_size,
-            results=f"/v1/batches/{job.id}/results",
+            results=f"/v1/batches/{job.id}/results", warnings=job.request.get("warnings", []),
         )  # fmt: skip
 
     def cancel(self, job: JobRecord) -> bool:

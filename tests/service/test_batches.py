@@ -196,6 +196,20 @@ def test_failing_cases_are_rows_not_a_lost_batch(service):
     assert [c["status"] for c in res["cases"]] == ["failed"] * 4
 
 
+def test_planning_warnings_are_in_the_status(service, finished):
+    # a residual the set does not apply is said in the 202 and in every later status
+    # (stored with the job); the plain set has none
+    scene = copy.deepcopy(CHAIN)
+    scene["analysis"]["linearization"] = {"drag_residual": True}
+    one = [{**ROWS[0], "probability": 1.0}]
+    resp = service.post("/v1/batches", json={"scene": scene, "scatter": one})
+    assert resp.status_code == 202, resp.text
+    (msg,) = resp.json()["warnings"]
+    assert "analysis.linearization.drag_residual is not applied" in msg
+    assert _wait(service, resp.json()["id"])["warnings"] == [msg]
+    assert finished["warnings"] == []
+
+
 def test_api_keys(tmp_path):
     with TestClient(create_app(_settings(tmp_path, api_keys="alpha,beta"))) as client:
         assert client.get("/health").status_code == 200  # liveness never needs a key
