@@ -16,13 +16,14 @@ from __future__ import annotations
 import dataclasses
 import sys
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from stochcable.cases import LineFatigue, ScatterDiagram, read_scatter
-from stochcable.errors import InputError, StochcableError
+from stochcable.errors import InputError, PhysicsWarning, StochcableError
 from stochcable.scene.model import Scene
 
 __all__ = ["BatchJob", "BatchMethods", "BatchTimeout"]
@@ -51,6 +52,8 @@ class BatchJob:
         Why the batch failed.
     document : dict
         The whole status document.
+    warnings : list of str
+        Physics warnings of the set as planned (what load-case sets do not apply).
     """
 
     id: str
@@ -59,6 +62,7 @@ class BatchJob:
     problems: list[dict[str, Any]] = field(default_factory=list)
     error: str | None = None
     document: dict[str, Any] = field(default_factory=dict, repr=False)
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def finished(self) -> bool:
@@ -71,6 +75,7 @@ class BatchJob:
         return cls(
             str(doc["id"]), str(doc["status"]), dict(doc.get("progress") or {}),
             list(doc.get("problems") or []), doc.get("error"), dict(doc),
+            [str(w) for w in doc.get("warnings") or []],
         )  # fmt: skip
 
 
@@ -135,7 +140,9 @@ class BatchMethods:
         Returns
         -------
         BatchJob
-            Its id and status (``queued``).
+            Its id and status (``queued``); its planning warnings are also issued
+            here as :class:`~stochcable.errors.PhysicsWarning` (as
+            :func:`stochcable.cases.run_cases` issues them).
 
         Raises
         ------
@@ -158,7 +165,10 @@ class BatchMethods:
             body["spectrum"] = spectrum
         if chunk_size is not None:
             body["chunk_size"] = chunk_size
-        return BatchJob.from_document(self._request("POST", "/v1/batches", json_body=body).json())
+        job = BatchJob.from_document(self._request("POST", "/v1/batches", json_body=body).json())
+        for message in job.warnings:
+            warnings.warn(message, PhysicsWarning, stacklevel=2)
+        return job
 
     def batch(self, job: BatchJob | str) -> BatchJob:
         """``GET /v1/batches/{id}``: the batch's status, progress and problem cases."""

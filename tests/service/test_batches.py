@@ -17,6 +17,7 @@ from service.app import create_app
 from service.settings import Settings
 from stochcable.cases import LineFatigue, case_document, case_summary_csv, read_scatter, run_cases
 from stochcable.client import Client, ClientError
+from stochcable.errors import PhysicsWarning
 from stochcable.examples import load_example
 
 CHAIN = load_example("chain_catenary").model_dump(mode="json", exclude_unset=True)
@@ -208,6 +209,12 @@ def test_planning_warnings_are_in_the_status(service, finished):
     assert "analysis.linearization.drag_residual is not applied" in msg
     assert _wait(service, resp.json()["id"])["warnings"] == [msg]
     assert finished["warnings"] == []
+    client = Client("http://testserver")
+    client._http = service  # the Python client issues them as the library does
+    with pytest.warns(PhysicsWarning, match="drag_residual is not applied"):
+        job = client.submit_batch(scene, one)
+    assert job.warnings == [msg]
+    client.wait(job, timeout=120)
 
 
 def test_api_keys(tmp_path):
