@@ -19,6 +19,7 @@ from stochcable.dynamics import fixedpoint as dfixedpoint
 from stochcable.dynamics import indicators as dindicators
 from stochcable.dynamics import line_loads as dloads
 from stochcable.dynamics import outputs as doutputs
+from stochcable.dynamics import resolution as dresolution
 from stochcable.dynamics import solve as dsolve
 from stochcable.dynamics import system as dsystem
 from stochcable.dynamics import variance as dvariance
@@ -963,7 +964,7 @@ def test_nearest_spacing_equals_argmin_and_gradient():
     omega = np.cumsum(rng.uniform(0.01, 0.1, 50)) + 0.1
     mids = 0.5 * (omega[1:] + omega[:-1])
     x = np.concatenate([omega[[0, 1, -2, -1]], mids[::7], rng.uniform(omega[0], omega[-1], 200)])
-    dist, spacing = dindicators._nearest_spacing(omega, x)
+    dist, spacing = dresolution._nearest_spacing(omega, x)
     near = np.argmin(np.abs(omega[None, :] - x[:, None]), axis=1)
     # exact equality: the same subtractions and divisions as np.argmin/np.gradient
     np.testing.assert_array_equal(dist, np.abs(omega[near] - x))

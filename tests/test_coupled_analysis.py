@@ -1362,10 +1362,10 @@ def test_coupled_bandwidths_tend_to_the_fixed_end_ones_under_a_heavy_body():
     """One leg on a body 10⁶ times heavier (its end all but held): the line-dominated
     coupled modes are the leg's fixed-end modes and their modal damping φᵀCφ
     (:func:`coupled_modal_bandwidths`) the fixed-end one of
-    :func:`stochcable.dynamics.indicators.modal_bandwidths` (1e-4; measured ≤ 8e-6 with
+    :func:`stochcable.dynamics.resolution.modal_bandwidths` (1e-4; measured ≤ 8e-6 with
     body energy fractions ≤ 1e-5 in those modes)."""
     from stochcable.dynamics.coupled.modes import coupled_modal_bandwidths
-    from stochcable.dynamics.indicators import modal_bandwidths
+    from stochcable.dynamics.resolution import modal_bandwidths
     from stochcable.dynamics.variance import drag_coefficients
 
     heavy = _buoy(

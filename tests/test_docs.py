@@ -109,10 +109,11 @@ def test_every_warning_is_described():
 
 
 def test_warning_thresholds_are_read_from_the_code():
-    from stochcable.dynamics import indicators
+    from stochcable.dynamics import indicators, resolution
 
     text = warnings_reference.warnings_reference_rst()
-    assert f"``TAIL_FRACTION`` = {indicators.TAIL_FRACTION:g}" in text
+    assert f"``TAIL_FRACTION`` = {resolution.TAIL_FRACTION:g}" in text
+    assert f"``RESONANCE_PEAK_ERROR`` = {resolution.RESONANCE_PEAK_ERROR:g}" in text
     assert f"``SNAP_SIGMAS`` = {indicators.SNAP_SIGMAS:g}" in text
 
 

@@ -65,6 +65,11 @@ _ITERATION_RECORD = {"iterations", "relative_change", "history"}
 _ADDED_SINCE = {"second_order"}
 
 
+#: Warnings the library gives since the pre-unification record (a phrase of each): the
+#: trapezoid rule's error on a resonant peak (stochcable.dynamics.resolution).
+_WARNINGS_ADDED_SINCE = ("the trapezoid rule is off by",)
+
+
 def _numbers_close(a: Any, b: Any, rtol: float, path: str) -> None:
     """Numbers within ``rtol`` of the largest magnitude of their array (or of
     themselves), the iteration record skipped, everything else equal."""
@@ -115,4 +120,7 @@ def test_single_lines_agree_with_the_pre_unification_record(case: str) -> None:
         # (stochcable.fidelity.model_error), so the settings, not the engine, differ
         return
     tol = max(ln["linearization"]["tolerance"] for ln in old["analyze"]["lines"].values())
+    new["analyze"]["warnings"] = [
+        w for w in new["analyze"]["warnings"] if not any(t in w for t in _WARNINGS_ADDED_SINCE)
+    ]
     _numbers_close(new["analyze"], old["analyze"], PRE_UNIFICATION_K * tol, f"{case}.analyze")

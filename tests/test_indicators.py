@@ -323,7 +323,7 @@ def _line_modes_of(monkeypatch, factor: float):
 
 
 def _fixed_end(system, damping, top: float):
-    from stochcable.dynamics.indicators import modal_bandwidths
+    from stochcable.dynamics.resolution import modal_bandwidths
 
     wn = np.asarray(system.modes.omega)
     keep = wn <= top

@@ -23,15 +23,15 @@ from stochcable.dynamics.blocks import (
 from stochcable.dynamics.drag_residual import drag_residual
 from stochcable.dynamics.freqblocks import frequency_slices
 from stochcable.dynamics.geometric_residual import geometric_residual
-from stochcable.dynamics.indicators import (
+from stochcable.dynamics.indicators import line_indicators
+from stochcable.dynamics.loads import (
+    Channel,
+)
+from stochcable.dynamics.resolution import (
     LineModes,
-    line_indicators,
     resolution_check,
     surface_resolution_check,
     tail_check,
-)
-from stochcable.dynamics.loads import (
-    Channel,
 )
 from stochcable.dynamics.second_order import second_order_tension, with_second_order
 from stochcable.dynamics.system import (

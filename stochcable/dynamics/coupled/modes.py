@@ -381,7 +381,7 @@ def coupled_modal_bandwidths(
     ndarray, shape (n,)
         φ_nᵀCφ_n over the group (mass-normalized φ): per line its structural, seabed
         and drag damping on all its nodes (the attached ends moving with the bodies,
-        as :func:`stochcable.dynamics.indicators.modal_bandwidths` does on the free nodes of
+        as :func:`stochcable.dynamics.resolution.modal_bandwidths` does on the free nodes of
         a line with fixed ends), per body C_B + B(ω_ref) + Tdᵀ diag(b) Td. [rad/s]
 
     Notes

@@ -16,9 +16,9 @@ from stochcable.dynamics.coupled.modes import (
     coupled_modal_bandwidths,
     line_mode_shares,
 )
-from stochcable.dynamics.indicators import LineModes
 from stochcable.dynamics.loads import Channel
 from stochcable.dynamics.outputs import line_result
+from stochcable.dynamics.resolution import LineModes
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 
 __all__ = ["LINE_MODE_SHARE", "body_result", "coupled_results", "line_modes"]
