@@ -786,9 +786,10 @@ def test_rest_sigmas_equal_quasi_static_sigmas(chain_parts):
     np.testing.assert_array_equal(dvariance.rest_sigmas(system, inp, "seed"), ref)
 
 
-def test_subset_caches_are_the_subset_computation(chain_parts):
+def test_subset_caches_are_the_subset_computation(chain_parts, monkeypatch):
     """The coarse subset slices the full grid's drag-independent arrays; computed on
     the subset directly they are the same (1e-15: products in other batch sizes)."""
+    monkeypatch.delenv("STOCHCABLE_WORKING_MEMORY_MB", raising=False)  # (caches kept)
     _, system, chans, inp, _ = chain_parts
     prep = dblocks.line_prep(system)
     dvariance.end_motion_projections(system, inp, "seed")

@@ -461,10 +461,11 @@ def test_coarse_group_leaves_out_negligible_weights(monkeypatch):
     np.testing.assert_allclose(upd(x), upd_all(x), rtol=1e-10)
 
 
-def test_sliced_channel_keeps_nodal_kinematics_lazy():
+def test_sliced_channel_keeps_nodal_kinematics_lazy(monkeypatch):
     """A channel whose nodal kinematics are computed on first use (``nodal``) is sliced
     without computing them; the sliced channel's velocity and acceleration, on first
     access, are the full channel's at the subset (bit-identical)."""
+    monkeypatch.delenv("STOCHCABLE_WORKING_MEMORY_MB", raising=False)  # (kept kinematics)
     body = _buoy()
     _, cls, _ = _group(_mooring_doc(count=40, solver="foss"), body)
     sea = cls[0].channels[0]

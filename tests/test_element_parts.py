@@ -38,6 +38,7 @@ def pair(request, monkeypatch):
     """(kept, formed when read) kinematics of the same line and grid, ω = 0 included."""
     w = np.linspace(0.0, 4.0, 301)
     kw = {"heading": 0.4, "depth": request.param}
+    monkeypatch.delenv("STOCHCABLE_WORKING_MEMORY_MB", raising=False)  # kept: the default
     kept = element_wave_kinematics(w, _line(), **kw)
     monkeypatch.setenv("STOCHCABLE_WORKING_MEMORY_MB", "0.01")  # quarter: 2.6 kB
     lazy = element_wave_kinematics(w, _line(), **kw)

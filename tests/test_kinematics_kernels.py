@@ -68,7 +68,9 @@ def _long_line(n_el: int = 200, far: float = 0.0) -> np.ndarray:
 
 
 def _both(monkeypatch, *args):
-    """(compiled, NumPy) kinematics of ``args`` (the compiled loop on any grid size)."""
+    """(compiled, NumPy) kinematics of ``args`` (the compiled loop on any grid size),
+    kept (the default working-memory target)."""
+    monkeypatch.delenv("STOCHCABLE_WORKING_MEMORY_MB", raising=False)
     monkeypatch.setenv("STOCHCABLE_NUMBA", "0")
     ref = element_wave_kinematics(*args)
     monkeypatch.delenv("STOCHCABLE_NUMBA", raising=False)
