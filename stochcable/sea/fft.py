@@ -21,6 +21,7 @@ may differ at round-off between machines and wisdom files.
 from __future__ import annotations
 
 import os
+import sys
 import threading
 from collections import OrderedDict
 from typing import Any
@@ -30,22 +31,32 @@ import numpy as np
 from stochcable import validation as v
 from stochcable.errors import InputError
 
-# pyfftw is imported on first use, not with this module: it imports dask.array (and
-# with it xarray and pandas) whenever dask is installed, ≈ 0.7 s of every command's and
-# worker's start that an analysis without time series never needs.  Its FFTW threads run
-# through OpenMP (libgomp), whose wait policy stochcable.runtime.configure() sets.
+# pyfftw is imported on first use, not with this module, and without its optional dask
+# interface: pyfftw.interfaces imports dask.array (and with it pandas) whenever dask is
+# installed, ≈ 0.5 s of the first time series of every command and worker, for an
+# interface stochcable does not use.  Its FFTW threads run through OpenMP (libgomp),
+# whose wait policy stochcable.runtime.configure() sets.
 _UNLOADED: Any = object()
 _pyfftw: Any = _UNLOADED  # the module, None without pyfftw (tests patch None in)
 
 
 def _lib() -> Any:
-    """pyfftw, imported on the first call (None when it is not installed)."""
+    """pyfftw, imported on the first call (None when it is not installed); dask.array,
+    when nothing has imported it yet, is hidden from pyfftw's import (its
+    ``from dask.array.fft import fft_wrap`` then fails and skips the dask interface, as
+    without dask)."""
     global _pyfftw
     if _pyfftw is _UNLOADED:
+        hide = "dask.array" not in sys.modules
+        if hide:
+            sys.modules["dask.array"] = None  # type: ignore[assignment]
         try:
             import pyfftw
         except ImportError:  # pragma: no cover
             pyfftw = None
+        finally:
+            if hide and sys.modules.get("dask.array", 0) is None:
+                del sys.modules["dask.array"]
         _pyfftw = pyfftw
     return _pyfftw
 
