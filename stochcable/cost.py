@@ -50,14 +50,17 @@ taut_wire                              400    1000    1          85 MB    43
 chain_catenary (sea + fairlead surge)  200    1000    2          79 MB    30
 chain_catenary                         400    1000    2          100 MB   40
 chain_catenary                         200    3000    2          119 MB   43
+taut_wire                              1000   4000    1          250 MB   46
+chain_catenary                         1000   4000    2          344 MB   35
 disc buoy, three legs (free body)      3×100  1000    4 per leg  219 MB   125
 disc buoy, three legs                  3×200  1000    4 per leg  328 MB   108
 =====================================  =====  ======  =========  =======  =============
 
-(the ratio is (ΔRSS − M_0)/(n_ω Σ n_nodes n_ch)) so c_M = 56 B for free lines (the
-largest ratio, 43, with a third more: the estimate should not be below the peak, and
-the small cases' ratios carry the noise of M_0) and 140 B for lines on a body (125
-rounded up), M_0 = 64 MiB (the working-memory target's temporaries and the small
+(the ratio is (ΔRSS − M_0)/(n_ω Σ n_nodes n_ch)) so c_M = 64 B for free lines (the
+ratio grows towards the kept response's 16 B per DOF, 48 B per node of a line in 3-D,
+as the grid grows: 46 on the taut wire at 1,000 × 4,000; a third above it, so the
+estimate is not below the peak) and 140 B for lines on a body (125 rounded up),
+M_0 = 64 MiB (the working-memory target's temporaries and the small
 arrays); c_T = 110 B per sample and
 channel (chain_catenary, 2^20 and 2^22 samples with the whole record in the result
 document: 320 B per sample).  Time on the same machine: 0.9–1.2 µs per
@@ -101,7 +104,7 @@ __all__ = [
     "SECONDS_PER_SAMPLE_CHANNEL",
 ]
 
-BYTES_PER_NODE_FREQUENCY_CHANNEL = 56
+BYTES_PER_NODE_FREQUENCY_CHANNEL = 64
 """Peak bytes per node, frequency and input channel of a line without an end on a
 body (c_M). [B]"""
 
