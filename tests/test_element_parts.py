@@ -90,3 +90,22 @@ def test_a_small_subset_of_a_large_grid_is_kept(monkeypatch) -> None:
     sub = lazy.moments[np.arange(0, 400, 8)]  # 50 frequencies: 120 kB, kept
     assert sub.parts is not None
     _close(sub.parts, lazy.moments.stacked(np.arange(0, 400, 8)))
+
+
+@pytest.mark.parametrize("depth", [60.0, 5.0, np.inf])
+def test_squares_alone_are_those_formed_with_the_moments(depth, monkeypatch):
+    # KinematicsBlocks.square forms the mean square without the moments (the sums that
+    # read no moments): the same NumPy operations, so the same bits — ω = 0 (the
+    # long-wave limit), dry elements (zeros) and shallow water (the clipped vertical
+    # part) included
+    monkeypatch.setenv("STOCHCABLE_NUMBA", "0")
+    line = _line()
+    if depth < 60.0:
+        line[:, 2] = np.where(line[:, 2] < 0.0, line[:, 2] * depth / 60.0, line[:, 2])
+    ek = element_wave_kinematics(np.linspace(0.0, 4.0, 301), line, heading=0.4, depth=depth)
+    monkeypatch.setenv("STOCHCABLE_WORKING_MEMORY_MB", "0.01")
+    src = element_wave_kinematics(ek.omega, line, heading=0.4, depth=depth).moments.source
+    both = src.form()[1]
+    np.testing.assert_array_equal(src.square(), both)
+    np.testing.assert_array_equal(src.square(slice(40, 77)), both[:, 40:77])
+    assert np.all(both[:, :, ek.wet_fraction == 0.0] == 0.0) and np.all(both >= 0.0)

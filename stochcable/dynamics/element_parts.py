@@ -24,13 +24,30 @@ import numpy as np
 
 from stochcable.dynamics.freqblocks import frequency_slices
 
-__all__ = ["KINEMATICS_BYTES", "ArrayMoments", "EndSquare", "MomentParts", "SquareParts"]
+__all__ = [
+    "KINEMATICS_BYTES",
+    "ArrayMoments",
+    "EndSquare",
+    "MomentParts",
+    "SquareParts",
+    "sub_blocks",
+]
 
 #: Bytes of the sea's element kinematics per element and frequency: the moments' two
 #: parts at both ends (4 complex numbers) and the mean square's two parts. [B]
 KINEMATICS_BYTES = 80
-#: Elements × frequencies per block of :meth:`EndSquare.weighted`.
+#: Elements × frequencies per sub-block of the NumPy forms of the kinematics
+#: (:func:`sub_blocks`; ≈ 30 temporaries of this many entries stay in the cache).
 _BLOCK_ENTRIES = 2**14
+
+
+def sub_blocks(n_w: int, n_el: int) -> list[slice]:
+    """Consecutive slices of ``range(n_w)`` of ``_BLOCK_ENTRIES`` // ``n_el``
+    frequencies: the NumPy forms' temporaries stay in cache (≈ 2x faster than
+    whole-grid passes on 400 elements × 2,000 ω); their quantities are elementwise in
+    ω, so the numbers do not depend on the slices."""
+    step = max(1, _BLOCK_ENTRIES // max(n_el, 1))
+    return [slice(i, min(i + step, n_w)) for i in range(0, n_w, step)]
 
 
 def _direction(heading: float) -> tuple[float, float]:
@@ -310,10 +327,7 @@ class EndSquare:
     def weighted(self, weights: np.ndarray) -> np.ndarray:
         """Σ_ω weight·|v|² per element end, (n_el, 2), over blocks of frequencies."""
         out = np.zeros(self.z_ends.shape)
-        n_w = self.omega.size
-        step = max(1, _BLOCK_ENTRIES // max(self.z_ends.shape[0], 1))
-        for i in range(0, n_w, step):
-            sl = slice(i, min(i + step, n_w))
+        for sl in sub_blocks(self.omega.size, self.z_ends.shape[0]):
             out += np.einsum("wes,w->es", self.block(sl), weights[sl])
         return out
 
