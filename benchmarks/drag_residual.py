@@ -220,7 +220,7 @@ evenly (as the old closed form).  The linear model has the same defect (one B pe
 element): its misfit (B(ξ) − B_e)·v is linear, correlated with the linear response, and
 lowers the fairlead σ² by 22 % here.  Now the elements whose wave-velocity variance
 varies by more than ×1.5 along them are split into pieces (up to half the panel
-budget, `stochcable.dynamics.drag_segments`), whole elements are grouped into panels
+budget, `stochcable.dynamics.residuals.drag_segments`), whole elements are grouped into panels
 only where the variance is uniform enough, the misfit enters with its cross term, and
 the guy's corrected σ lands within the TD's interval.  Splitting finer (×1.05, 186
 panels) moves it by 0.2 %; on 160 elements (linear σ −7.5 %) the corrected σ is 3 %

@@ -133,9 +133,9 @@ _BODY_TIME_FACTOR = 1.0  # extra time per free body (coupled solves): 2.6 µs vs
 #: transfer functions) and their time per component pair and FFT sample·log₂ — an
 #: analysis of the chain, the inclined guy and the taut wire with both measured 0.53,
 #: 0.65 and 0.16 s against 0.72, 0.79 and 0.18 s estimated (the chain at 160 elements:
-#: 0.90 against 0.80 s); the caps are those of :mod:`stochcable.dynamics.residual_lines`
+#: 0.90 against 0.80 s); the caps are those of :mod:`stochcable.dynamics.residuals.residual_lines`
 #: and the two residual modules.  In a sea the drag residual splits the elements near
-#: the surface (:mod:`stochcable.dynamics.drag_segments`; 40 elements: the chain 54
+#: the surface (:mod:`stochcable.dynamics.residuals.drag_segments`; 40 elements: the chain 54
 #: panels, the guy 53), counted as a quarter of the panel cap more in every sea (the
 #: chain and the guy: 1.12 and 1.43 s measured against 1.29 and 1.36 s estimated, on a
 #: loaded host; the taut wire, 10 m below the surface, splits none: 0.21 against 0.52 s,

@@ -1,4 +1,4 @@
-"""The drag residual (stochcable.dynamics.drag_residual): the end-tension variance the
+"""The drag residual (stochcable.dynamics.residuals.drag_residual): the end-tension variance the
 statistical linearization drops, in closed form.
 
 Independent checks: the Hermite coefficients against closed forms (a₁ = 2E|μ + x|,
@@ -17,10 +17,10 @@ import pytest
 from _scenes import chain_surge_doc, td_end_sigma
 from scipy import stats
 
-import stochcable.dynamics.drag_residual as dr
+import stochcable.dynamics.residuals.drag_residual as dr
 from stochcable import analyze, load_example
-from stochcable.dynamics.drag_residual import hermite_coefficients, residual_output_lines
 from stochcable.dynamics.linearization import mean_abs_gaussian
+from stochcable.dynamics.residuals.drag_residual import hermite_coefficients, residual_output_lines
 
 
 def test_hermite_coefficients_closed_forms():

@@ -1,4 +1,4 @@
-"""Where the drag residual is evaluated (stochcable.dynamics.drag_segments) and the
+"""Where the drag residual is evaluated (stochcable.dynamics.residuals.drag_segments) and the
 linear part it gains there: the pieces of split elements integrate to their element's
 kinematics, their loads to a unit force at their centroid; the decomposition of the
 pointwise dropped drag (the linear misfit of the element-constant B, correlated with
@@ -16,10 +16,11 @@ import numpy as np
 import pytest
 from scipy import stats
 
-import stochcable.dynamics.drag_residual as dr
+import stochcable.dynamics.residuals.drag_residual as dr
 from stochcable import analyze, load_example, load_scene
-from stochcable.dynamics.drag_residual import hermite_coefficients, residual_output_lines
-from stochcable.dynamics.drag_segments import (
+from stochcable.dynamics.loads import line_channels
+from stochcable.dynamics.residuals.drag_residual import hermite_coefficients, residual_output_lines
+from stochcable.dynamics.residuals.drag_segments import (
     MAX_SUB,
     Segments,
     panel_groups,
@@ -27,8 +28,7 @@ from stochcable.dynamics.drag_segments import (
     segment_velocity,
     segments,
 )
-from stochcable.dynamics.loads import line_channels
-from stochcable.dynamics.residual_lines import element_directions
+from stochcable.dynamics.residuals.residual_lines import element_directions
 from stochcable.dynamics.system import build_line_system
 from stochcable.reference.cable import simulate_line_timedomain
 from stochcable.statics import solve_statics

@@ -1,4 +1,4 @@
-"""The geometric residual (stochcable.dynamics.geometric_residual): the end-tension
+"""The geometric residual (stochcable.dynamics.residuals.geometric_residual): the end-tension
 variance of the second-order geometric forces of the linear response.
 
 Independent checks: the quadratic forms' output lines against Monte-Carlo Gaussian
@@ -18,9 +18,9 @@ import pytest
 from _scenes import chain_surge_doc, td_end_sigma
 from scipy import stats
 
-import stochcable.dynamics.geometric_residual as gr
+import stochcable.dynamics.residuals.geometric_residual as gr
 from stochcable import analyze
-from stochcable.dynamics.geometric_residual import quadratic_output_lines
+from stochcable.dynamics.residuals.geometric_residual import quadratic_output_lines
 
 #: planar components of an element: ½b² along t, a·b along n (a, b: processes 0, 1)
 TERMS = [[(0.5, 1, 1)], [(1.0, 0, 1)]]

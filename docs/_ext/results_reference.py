@@ -336,7 +336,7 @@ _LINES = {
     "lines.<line>.indicators.second_order": (
         "",
         "Second-order stretching tension T₂ = κ·½∫(∂u⊥/∂s)² ds of the linear response, "
-        "a Gaussian quadratic form (:mod:`stochcable.dynamics.second_order`).",
+        "a Gaussian quadratic form (:mod:`stochcable.dynamics.residuals.second_order`).",
     ),
     "lines.<line>.indicators.second_order.mean": ("N", "Mean of T₂: a shift of the mean tension."),
     "lines.<line>.indicators.second_order.std": (

@@ -22,8 +22,8 @@ from stochcable.dynamics.loads import (
     Channel,
     element_mean_square,
 )
+from stochcable.dynamics.residuals.second_order import irvine_lambda2
 from stochcable.dynamics.resolution import LineModes, own_modes
-from stochcable.dynamics.second_order import irvine_lambda2
 from stochcable.dynamics.system import (
     Damping,
     Linearization,

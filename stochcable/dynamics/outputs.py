@@ -20,20 +20,20 @@ import numpy as np
 from stochcable.dynamics.blocks import (
     trapezoid_weights,
 )
-from stochcable.dynamics.drag_residual import drag_residual
 from stochcable.dynamics.freqblocks import frequency_slices
-from stochcable.dynamics.geometric_residual import geometric_residual
 from stochcable.dynamics.indicators import line_indicators
 from stochcable.dynamics.loads import (
     Channel,
 )
+from stochcable.dynamics.residuals.drag_residual import drag_residual
+from stochcable.dynamics.residuals.geometric_residual import geometric_residual
+from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
 from stochcable.dynamics.resolution import (
     LineModes,
     resolution_check,
     surface_resolution_check,
     tail_check,
 )
-from stochcable.dynamics.second_order import second_order_tension, with_second_order
 from stochcable.dynamics.system import (
     Linearization,
     LineSystem,

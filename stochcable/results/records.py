@@ -245,7 +245,7 @@ class LineIndicators:
         ``"second_order"``.
     second_order : object or None
         Moments of the second-order stretching tension
-        (:class:`stochcable.dynamics.second_order.SecondOrderTension`; its ``as_dict``).
+        (:class:`stochcable.dynamics.residuals.second_order.SecondOrderTension`; its ``as_dict``).
     """
 
     borgman_ratio: np.ndarray
@@ -291,8 +291,8 @@ class LineIndicators:
 class ResidualRecord:
     """The end-tension variance a closed-form residual of the linear model adds, and σ
     with it: the drag the linearization drops
-    (:func:`stochcable.dynamics.drag_residual.drag_residual`) or the second-order
-    geometric forces (:func:`stochcable.dynamics.geometric_residual.geometric_residual`).
+    (:func:`stochcable.dynamics.residuals.drag_residual.drag_residual`) or the second-order
+    geometric forces (:func:`stochcable.dynamics.residuals.geometric_residual.geometric_residual`).
 
     Attributes
     ----------
@@ -302,7 +302,7 @@ class ResidualRecord:
         Why not computed ("" when computed).
     variance : dict {"end_a", "end_b"} of float
         Variance the residual adds to the end tension (negative where it lowers it:
-        the drag residual's linear part, :mod:`stochcable.dynamics.drag_segments`). [N²]
+        the drag residual's linear part, :mod:`stochcable.dynamics.residuals.drag_segments`). [N²]
     in_band : dict {"end_a", "end_b"} of float
         Its part on the analysis band (the rest: superharmonics above ω_max, and
         difference frequencies below ω_min). [N²]

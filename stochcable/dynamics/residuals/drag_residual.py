@@ -32,7 +32,7 @@ vary along an element (near the surface) the dropped drag has a linear part as w
 instead of 0): it is correlated with the linear response, so its end tension H_c
 enters with its cross term, Σ_c ∫ S_c (|H_L + H_c|² − |H_L|²) dω, and may lower σ.
 Such elements are split into pieces evaluated one by one, each loading its element's
-nodes where it lies (:mod:`stochcable.dynamics.drag_segments`); the orders k ≥ 2 stay
+nodes where it lies (:mod:`stochcable.dynamics.residuals.drag_segments`); the orders k ≥ 2 stay
 uncorrelated with both linear parts.  Without the split, the inclined guy's 26 m top
 element at z = 0 took the residual as one mean velocity spread evenly over its two
 nodes, and the correction read +38 % at the fairlead, mostly on the line's 0.7 %-damped
@@ -62,7 +62,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.blocks import trapezoid_weights
-from stochcable.dynamics.drag_segments import (
+from stochcable.dynamics.residuals.drag_segments import (
     Segments,
     panel_groups,
     panel_loads,
@@ -70,7 +70,7 @@ from stochcable.dynamics.drag_segments import (
     segment_velocity,
     segments,
 )
-from stochcable.dynamics.residual_lines import (
+from stochcable.dynamics.residuals.residual_lines import (
     covariance_lines,
     cross_covariance,
     element_directions,

@@ -19,7 +19,7 @@ Var(ΔT) = Σ_ij ∫ H_T,i*(ω) G_ij(ω) H_T,j(ω) dω, H_T,i the end tension pe
 pair of component i (+ on node b, − on node a), through the same linear system — the
 second-order (Volterra) term of the response (Roberts and Spanos, "Random Vibration and
 Statistical Linearization", §5; the quadratic forms of
-:mod:`stochcable.dynamics.second_order` are its stretching part alone, without the line's
+:mod:`stochcable.dynamics.residuals.second_order` are its stretching part alone, without the line's
 response to them).  It acts at the sum and difference frequencies of the response.
 
 Validation: the chain's line (fairlead surge) against the nonlinear time domain with the
@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.residual_lines import (
+from stochcable.dynamics.residuals.residual_lines import (
     covariance_lines,
     cross_covariance,
     element_directions,
@@ -129,7 +129,7 @@ def quadratic_output_lines(
     ----------
     processes : list of ndarray, complex, each (n_ch, n_el, n_j)
         Zero-mean jointly Gaussian processes per element as lines on a uniform grid
-        (:meth:`~stochcable.dynamics.residual_lines.UniformGrid.lines`).
+        (:meth:`~stochcable.dynamics.residuals.residual_lines.UniformGrid.lines`).
     terms : list of list of (float, int, int)
         Each force component of an element as Σ coef·x·y of its processes (by index).
     transfer : ndarray, complex, shape (n_out, n_comp · n_el, n_o)

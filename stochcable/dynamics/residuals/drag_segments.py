@@ -1,4 +1,4 @@
-"""Where the drag residual (:mod:`stochcable.dynamics.drag_residual`) is evaluated along
+"""Where the drag residual (:mod:`stochcable.dynamics.residuals.drag_residual`) is evaluated along
 a line: elements split where the wave kinematics vary along them, grouped into panels.
 
 The drag is a pointwise load, c|v(ξ)|v(ξ) along each element, while the linear model

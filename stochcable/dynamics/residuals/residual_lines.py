@@ -1,5 +1,5 @@
-"""Shared steps of the closed-form residuals of the linear model
-(:mod:`stochcable.dynamics.drag_residual`, :mod:`stochcable.dynamics.geometric_residual`):
+"""Shared steps of the closed-form residuals of the linear model (:mod:`.drag_residual`,
+:mod:`.geometric_residual`):
 linear response quantities as spectral lines on a uniform grid, their cross-covariance
 functions by FFT, covariance functions back to variance lines, and the end tensions per
 unit load on the line.
