@@ -78,7 +78,8 @@ def lines(guy: bool = False) -> dict[str, dict]:
 
 def residual_variances() -> dict:
     """The drag and geometric residuals' end-tension variances of every line (and the
-    guy), both switches on: line → {"drag"|"geometric": {end: variance [N²]}}."""
+    guy), both switches on: line → {"drag"|"geometric": {end: variance [N²]},
+    "std_linear": {end: σ [N]}}."""
     out = {}
     for name, doc in lines(guy=True).items():
         lr = next(iter(analyze(with_variant(doc, "both")).lines.values()))
@@ -86,6 +87,7 @@ def residual_variances() -> dict:
             key: {end: float(rec.variance[end]) for end in ("end_a", "end_b")}
             for key, rec in (("drag", lr.drag_residual), ("geometric", lr.geometric_residual))
         }
+        out[name]["std_linear"] = {end: float(getattr(lr, end).std) for end in ("end_a", "end_b")}
     return out
 
 

@@ -73,8 +73,8 @@ def test_pieces_integrate_to_their_elements_kinematics():
 def test_panel_loads_are_unit_forces_at_the_panels_centroids():
     """Every panel's nodal loads add up to the unit force along its direction, and their
     first moment puts it at the length-weighted centroid of its pieces; the pieces of a
-    split element are panels of their own, whole elements are grouped (three at a time
-    for 160 elements, as before the split)."""
+    split element are panels of their own, whole elements are grouped (⌈160/32⌉ = 5 at
+    a time for 160 elements)."""
     system, chans, scale = _line("inclined_guy")
     model = system.model
     seg = segments(system, chans, scale, dr.MAX_PANELS)
@@ -93,9 +93,11 @@ def test_panel_loads_are_unit_forces_at_the_panels_centroids():
         )
         at = x[e] + seg.xi[g, None] * (x[e + 1] - x[e])
         mag = np.linalg.norm(unit[:, :, q], axis=1)
-        np.testing.assert_allclose(mag @ x / mag.sum(), share @ at, rtol=1e-9)
+        # (the normals of a group's neighbouring elements differ slightly: a shared node's
+        # load magnitude is not quite the sum of its shares, 1e-9 on 5-element groups)
+        np.testing.assert_allclose(mag @ x / mag.sum(), share @ at, rtol=1e-8)
     whole = Segments(np.arange(160), np.zeros(160), np.ones(160), np.ones(160), np.zeros(160, bool))
-    assert len(panel_groups(whole, dr.MAX_PANELS)) == 54
+    assert len(panel_groups(whole, dr.MAX_PANELS)) == 32
 
 
 def test_corrected_sigma_holds_under_mesh_refinement():

@@ -20,14 +20,12 @@ import numpy as np
 from stochcable.dynamics.blocks import (
     add_blocks,
     free_band,
-    from_freq,
     line_prep,
-    to_freq,
     trapezoid_weights,
 )
 from stochcable.dynamics.freqblocks import frequency_slices
 from stochcable.dynamics.line_loads import drag_blocks
-from stochcable.dynamics.solve import end_tension_from_support, reactions
+from stochcable.dynamics.solve import end_tension_from_support
 from stochcable.dynamics.solvers import solve_band_stacked
 from stochcable.results.records import ResidualRecord
 
@@ -37,6 +35,7 @@ __all__ = [
     "covariance_lines",
     "cross_covariance",
     "element_directions",
+    "end_influence",
     "load_transfer",
     "residual_record",
     "uniform_grid",
@@ -44,7 +43,7 @@ __all__ = [
 
 #: Most lines of the uniform grid the linear quantities are placed on (its step is the
 #: analysis grid's smallest spacing, or ω_max/MAX_LINES if that is finer). [-]
-MAX_LINES = 1024
+MAX_LINES = 128
 
 
 class UniformGrid:
@@ -103,29 +102,56 @@ def covariance_lines(cov: np.ndarray, n_o: int) -> np.ndarray:
 def load_transfer(system: Any, damping: Any, unit: np.ndarray, w: np.ndarray) -> np.ndarray:
     """End tensions (end_a, end_b) per unit of each load case ``unit`` (n_nodes, d,
     n_load) (node forces on the model's components), ends prescribed, the line's
-    linear system with ``damping``, on ``w``; one banded solve per frequency block for
-    all load cases: shape (2, n_load, n_w). [N/unit]"""
+    linear system with ``damping``, on ``w``: the load cases contracted with the end
+    tensions' influence (:func:`end_influence`), shape (2, n_load, n_w). [N/unit]"""
+    g = end_influence(system, damping, w)
+    n = g.shape[1] * g.shape[2]
+    flat = np.moveaxis(g.reshape(2, n, w.size), 2, 1)  # (2, n_w, n_nodes·d)
+    return np.moveaxis(flat @ unit.reshape(n, -1).astype(complex), 2, 1)
+
+
+def end_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
+    """End tensions (end_a, end_b) per unit force on each node and component, ends
+    prescribed, the line's linear system with ``damping``: shape (2, n_nodes, d, n_w).
+    [N/N]
+
+    By the adjoint: with the ends held, T = ê·F_end − ê·Z_end,f u_f and u_f = A⁻¹F_f,
+    A = Z_ff = K − ω²M + iωC the free–free impedance; A is symmetric (not Hermitian),
+    so T = ê·F_end − (A⁻¹g)ᵀF_f, g = Z_f,end ê: two solves per frequency (one
+    factorization) whatever the number of load cases."""
     model = system.model
     prep = line_prep(system)
     d = model.dim
+    n = model.n_nodes
     cd = drag_blocks(system, damping)
     c = add_blocks(prep.S, cd)
     b_c = prep.bS + free_band(cd)
-    n_p = unit.shape[2]
-    out = np.zeros((2, n_p, w.size), dtype=complex)
-    for sl in frequency_slices(w.size, 8 * 16 * model.n_nodes * d * n_p):
-        load = np.ascontiguousarray(
-            np.broadcast_to(unit[:, :, None, :], (model.n_nodes, d, w[sl].size, n_p)),
-            dtype=complex,
-        )
-        u_free = solve_band_stacked(
-            prep.bK, prep.bM, b_c, to_freq(np.ascontiguousarray(load[1:-1])), w[sl],
-            2 * d - 1, 2 * d - 1, (model.K, model.M),
-        )  # fmt: skip
-        u = np.zeros_like(load)
-        u[1:-1] = from_freq(u_free, d)
-        tension = end_tension_from_support(system, reactions(system, prep, c, u, load, w[sl]))
-        out[0, :, sl], out[1, :, sl] = tension["end_a"], tension["end_b"]
+    # ê of each end: the end tension of a unit support force along each component
+    eye = np.eye(2 * d)[None].astype(complex)
+    ten = end_tension_from_support(system, eye)
+    e_hat = [np.real(ten[end][:, 0]) for end in ("end_a", "end_b")]  # (2d,) each
+    e_a, e_b = e_hat[0][:d], e_hat[1][d:]
+    out = np.zeros((2, n, d, w.size), dtype=complex)
+    out[0, 0] = e_a[:, None]
+    out[1, -1] = e_b[:, None]
+    for sl in frequency_slices(w.size, 8 * 16 * n * d * 2):
+        ws = w[sl]
+        # the end rows' coupling blocks Z(1, 0) and Z(n − 2, n − 1) at each frequency
+        o_first = [blk[1][0] for blk in (prep.K, prep.MT, c)]
+        o_last = [blk[1][-1] for blk in (prep.K, prep.MT, c)]
+        rhs = np.zeros((ws.size, (n - 2) * d, 2), dtype=complex)
+        for k, (o, vec, rows, tr) in enumerate(
+            ((o_first, e_a, slice(0, d), False), (o_last, e_b, slice((n - 3) * d, None), True))
+        ):
+            blocks = [b.T if tr else b for b in o]
+            g = [b @ vec for b in blocks]  # (d,) of K, M, C
+            rhs[:, rows, k] = (
+                g[0][None] - (ws * ws)[:, None] * g[1][None] + (1j * ws)[:, None] * g[2][None]
+            )
+        x = solve_band_stacked(
+            prep.bK, prep.bM, b_c, rhs, ws, 2 * d - 1, 2 * d - 1, (model.K, model.M)
+        )  # (n_w, n_f·d, 2)
+        out[:, 1:-1, :, sl] = -np.transpose(x.reshape(ws.size, n - 2, d, 2), (3, 1, 2, 0))
     return out
 
 
