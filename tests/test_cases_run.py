@@ -278,7 +278,7 @@ def test_warm_starts_meet_the_cold_fixed_point_and_a_bad_one_falls_back():
 
 def test_a_warm_start_that_does_not_converge_falls_back_to_rest(monkeypatch):
     from stochcable.dynamics.engine import build_engine
-    from stochcable.dynamics.groups import fixedpoint
+    from stochcable.dynamics.groups import group_fixed_point as fixedpoint
 
     scene = load_scene(_wire())
     engine = build_engine(scene)

@@ -8,7 +8,7 @@ depend on the sea's heading and the frequency grid, not on its spectrum; only th
 do.  :func:`heading_inputs` keeps a line's channels and inputs of the last headings on
 its :class:`~stochcable.dynamics.model.system.LineSystem` (the engine's sea-independent
 state) and gives the next sea state of a known heading its spectra on them
-(:func:`~stochcable.dynamics.loads.channels.with_spectrum`,
+(:func:`~stochcable.dynamics.loads.sea_channels.with_spectrum`,
 :func:`~stochcable.dynamics.solve.line_loads.with_spectra`): the same numbers as forming
 them again (tested), without the kinematics.  Lines whose inputs exceed
 :data:`INPUT_CACHE_BYTES` are not kept (the memory bound of large models).  The lines
@@ -85,7 +85,8 @@ def group_line_channels(
     """The channels of a line of a coupled group (attached to a free body) for the sea
     state of ``scene``: :func:`~stochcable.dynamics.groups.inputs.scene_line_channels`,
     reusing the kinematics of an earlier sea state of the same directions (heading and
-    spreading) with this sea's spectra (:func:`~stochcable.dynamics.loads.channels.with_spectrum`:
+    spreading) with this sea's spectra
+    (:func:`~stochcable.dynamics.loads.sea_channels.with_spectrum`:
     the same numbers); kept while they fit :data:`INPUT_CACHE_BYTES`.
 
     Returns
