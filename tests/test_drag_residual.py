@@ -23,7 +23,7 @@ from scipy import stats
 import stochcable.dynamics.residuals.drag_residual as dr
 import stochcable.dynamics.residuals.residual_lines as rl
 from stochcable import analyze, load_example
-from stochcable.dynamics.linearization import mean_abs_gaussian
+from stochcable.dynamics.linearization.formulas import mean_abs_gaussian
 from stochcable.dynamics.residuals.drag_residual import hermite_coefficients, residual_output_lines
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))

@@ -18,7 +18,8 @@ from scipy import stats
 
 import stochcable.dynamics.residuals.drag_residual as dr
 from stochcable import analyze, load_example, load_scene
-from stochcable.dynamics.loads import line_channels
+from stochcable.dynamics.loads.channels import line_channels
+from stochcable.dynamics.model.system import build_line_system
 from stochcable.dynamics.residuals.drag_residual import hermite_coefficients, residual_output_lines
 from stochcable.dynamics.residuals.drag_segments import (
     MAX_SUB,
@@ -29,7 +30,6 @@ from stochcable.dynamics.residuals.drag_segments import (
     segments,
 )
 from stochcable.dynamics.residuals.residual_lines import element_directions
-from stochcable.dynamics.system import build_line_system
 from stochcable.reference.cable import simulate_line_timedomain
 from stochcable.statics import solve_statics
 

@@ -62,7 +62,8 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.blocks import trapezoid_weights
+from stochcable.dynamics.linearization.variance import current_split
+from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.residuals.drag_segments import (
     Segments,
     panel_groups,
@@ -77,7 +78,6 @@ from stochcable.dynamics.residuals.residual_lines import (
     residual_record,
     uniform_grid,
 )
-from stochcable.dynamics.variance import current_split
 from stochcable.errors import PhysicsWarning, warn
 from stochcable.results.records import ResidualRecord
 

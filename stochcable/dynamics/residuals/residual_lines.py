@@ -17,16 +17,16 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.blocks import (
+from stochcable.dynamics.loads.freqblocks import frequency_slices
+from stochcable.dynamics.model.blocks import (
     add_blocks,
     free_band,
     line_prep,
     trapezoid_weights,
 )
-from stochcable.dynamics.freqblocks import frequency_slices
-from stochcable.dynamics.line_loads import drag_blocks
-from stochcable.dynamics.solve import end_tension_from_support
-from stochcable.dynamics.solvers import solve_band_stacked
+from stochcable.dynamics.model.solvers import solve_band_stacked
+from stochcable.dynamics.solve.line_loads import drag_blocks
+from stochcable.dynamics.solve.line_solve import end_tension_from_support
 from stochcable.results.records import ResidualRecord
 
 __all__ = [
