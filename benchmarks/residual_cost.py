@@ -30,6 +30,7 @@ import copy
 import cProfile
 import json
 import math
+import os
 import pstats
 import sys
 import time
@@ -156,7 +157,7 @@ def profile(name: str, variant: str = "both") -> str:
         def write(self, s):
             out.append(s)
 
-    pstats.Stats(prof, stream=_W()).sort_stats("cumulative").print_stats(45)
+    pstats.Stats(prof, stream=_W()).sort_stats(os.environ.get("SORT", "cumulative")).print_stats(45)
     return "".join(out)
 
 

@@ -196,7 +196,7 @@ def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     """The settings of the evaluation before issue 31."""
     monkeypatch.setattr(rl, "MAX_LINES", 1024)
     monkeypatch.setattr(dr, "MAX_PANELS", 64)
-    monkeypatch.setattr(dr.drag_residual, "__defaults__", (dr.HERMITE_ORDER, False))
+    monkeypatch.setattr(dr.drag_residual, "__defaults__", (dr.HERMITE_ORDER, False, None))
 
 
 @pytest.mark.slow

@@ -38,6 +38,7 @@ from stochcable.dynamics.outputs.resolution import (
 )
 from stochcable.dynamics.residuals.drag_residual import drag_residual
 from stochcable.dynamics.residuals.geometric_residual import geometric_residual
+from stochcable.dynamics.residuals.residual_lines import EndInfluence
 from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
 from stochcable.line.fem import SLACK_EA_RATIO
 from stochcable.results.documents import (
@@ -175,10 +176,11 @@ def line_result(
     end_force = _end_force_transfer(model, resp, n_ch)
     residual = {}
     std = {e: stats[e].std for e in stats}
+    shared = EndInfluence(system, linearization.damping)  # (one solve for both)
     for key, fn in (("drag_residual", drag_residual), ("geometric_residual", geometric_residual)):
         if getattr(settings.linearization, key) and linearization.record is not None:
             residual[key] = (
-                fn(system, channels, linearization, std)
+                fn(system, channels, linearization, std, influence=shared)
                 if alone
                 else ResidualRecord.not_computed("a line on free bodies is not covered", std)
             )

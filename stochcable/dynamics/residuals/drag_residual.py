@@ -73,7 +73,9 @@ from stochcable.dynamics.residuals.drag_segments import (
     segments,
 )
 from stochcable.dynamics.residuals.residual_lines import (
+    EndInfluence,
     element_directions,
+    fft_length,
     load_transfer,
     residual_record,
     uniform_grid,
@@ -265,6 +267,7 @@ def drag_residual(
     std: dict[str, float],
     order: int = LUMPED_ORDER,
     lumped: bool = True,
+    influence: EndInfluence | None = None,
 ) -> ResidualRecord:
     """The end-tension variance the drag linearization of one line drops (module notes).
 
@@ -284,6 +287,8 @@ def drag_residual(
         The two highest orders carry the variance of all higher ones of their parity
         (:func:`lumped_coefficients`); False: the orders above ``order`` dropped (the
         evaluation before issue 31, with ``order`` :data:`HERMITE_ORDER`).
+    influence : EndInfluence, optional
+        The line's end influence, shared with its other residual.
 
     Returns
     -------
@@ -324,10 +329,9 @@ def drag_residual(
     spectra = np.stack([ch.spectrum for ch in channels])
     n_o = order * (grid.n_j - 1)
     w_out = grid.step * np.arange(1, n_o + 1)
-    n_fft = int(2 ** math.ceil(math.log2(2 * order * grid.n_j + 2)))
-    h_all = load_transfer(
-        system, damping, panel_loads(model, seg, groups, [parts[n][2] for n in live]), w_out
-    )
+    n_fft = fft_length(2 * order * grid.n_j + 2)
+    unit = panel_loads(model, seg, groups, [parts[n][2] for n in live])
+    h_all = load_transfer(system, damping, unit, w_out, influence)
     # the normal and axial residuals of every panel are one set of components: they are
     # functions of jointly Gaussian velocities, so their cross terms count too (where
     # the linear tensions of the two cancel, so do the residuals' in part)

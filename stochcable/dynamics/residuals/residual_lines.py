@@ -16,6 +16,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import scipy.fft
 
 from stochcable.dynamics.loads.freqblocks import frequency_slices
 from stochcable.dynamics.model.blocks import (
@@ -35,6 +36,8 @@ __all__ = [
     "covariance_lines",
     "cross_covariance",
     "element_directions",
+    "fft_length",
+    "EndInfluence",
     "end_influence",
     "load_transfer",
     "residual_record",
@@ -91,6 +94,12 @@ def cross_covariance(x: np.ndarray, y: np.ndarray, n_fft: int) -> np.ndarray:
     return np.fft.irfft(cross, n=n_fft, axis=1) * (0.5 * n_fft)
 
 
+def fft_length(n: int) -> int:
+    """The shortest lag grid of at least ``n`` samples whose real FFT is fast (a
+    5-smooth length: 518 → 540 where a power of two is 1,024)."""
+    return int(scipy.fft.next_fast_len(int(n), real=True))
+
+
 def covariance_lines(cov: np.ndarray, n_o: int) -> np.ndarray:
     """Lines c_j, j = 1 … n_o, of covariance functions ``cov`` (n_k, n_fft) on the lag
     grid, cov(τ) = Σ_j Re(c_j e^{iω_jτ}) (the zero-frequency line, a random constant,
@@ -99,15 +108,43 @@ def covariance_lines(cov: np.ndarray, n_o: int) -> np.ndarray:
     return (2.0 / n_fft) * np.fft.rfft(cov, axis=1)[:, 1 : n_o + 1]
 
 
-def load_transfer(system: Any, damping: Any, unit: np.ndarray, w: np.ndarray) -> np.ndarray:
+def load_transfer(
+    system: Any,
+    damping: Any,
+    unit: np.ndarray,
+    w: np.ndarray,
+    influence: EndInfluence | None = None,
+) -> np.ndarray:
     """End tensions (end_a, end_b) per unit of each load case ``unit`` (n_nodes, d,
     n_load) (node forces on the model's components), ends prescribed, the line's
     linear system with ``damping``, on ``w``: the load cases contracted with the end
-    tensions' influence (:func:`end_influence`), shape (2, n_load, n_w). [N/unit]"""
-    g = end_influence(system, damping, w)
+    tensions' influence (:func:`end_influence`; from ``influence`` where given, shared
+    by the residuals of one line), shape (2, n_load, n_w). [N/unit]"""
+    g = end_influence(system, damping, w) if influence is None else influence.on(w)
     n = g.shape[1] * g.shape[2]
     flat = np.moveaxis(g.reshape(2, n, w.size), 2, 1)  # (2, n_w, n_nodes·d)
     return np.moveaxis(flat @ unit.reshape(n, -1).astype(complex), 2, 1)
+
+
+class EndInfluence:
+    """The end influence (:func:`end_influence`) of one line and drag, kept for the
+    last frequencies asked: a later request for a leading part of them (the geometric
+    residual's 2·n_j lines after the drag residual's 3·n_j) is a slice of it."""
+
+    def __init__(self, system: Any, damping: Any) -> None:
+        self.system = system
+        self.damping = damping
+        self._kept: tuple[np.ndarray, np.ndarray] | None = None
+
+    def on(self, w: np.ndarray) -> np.ndarray:
+        """The influence on ``w``, shape (2, n_nodes, d, n_w). [N/N]"""
+        w = np.asarray(w, dtype=float)
+        kept = self._kept
+        if kept is not None and w.size <= kept[0].size and np.array_equal(kept[0][: w.size], w):
+            return kept[1][..., : w.size]
+        g = end_influence(self.system, self.damping, w)
+        self._kept = (w.copy(), g)
+        return g
 
 
 def end_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
