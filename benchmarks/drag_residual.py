@@ -48,7 +48,7 @@ SEA_SKIP = 200.0
 def corrected(line, end: str) -> float:
     """σ with both residuals: their variances add (zero-mean flow: uncorrelated). [N]"""
     extra = sum(getattr(line, k).variance[end] for k in RESIDUALS)
-    return math.sqrt(getattr(line, end).std ** 2 + extra)
+    return math.sqrt(line.linear_end(end).std ** 2 + extra)
 
 
 def fd(elements: int, scale: float) -> dict:
@@ -158,7 +158,7 @@ says so beyond ×1.25.
             "|---|---|---|---|---|---|---|---|",
         ]
         for k, (end, label) in enumerate(ENDS):
-            s_fd = getattr(line, end).std
+            s_fd = line.linear_end(end).std
             quad = ci((sig["quad_st"][:, k] - sig["lin_amp"][:, k]) / s_fd)
             geo = ci((sig["lin_amp"][:, k] - sig["lin"][:, k]) / s_fd)
             rows.append(
@@ -189,7 +189,7 @@ def sea_table(res: dict, seeds: tuple[int, ...]) -> str:
         line = r["line"]
         for k, (end, label) in enumerate(ENDS):
             m, h = ci(r["td"][:, k])
-            fd_, cor = getattr(line, end).std, corrected(line, end)
+            fd_, cor = line.linear_end(end).std, corrected(line, end)
             quad = ci((r["td"][:, k] - r["td_lin"][:, k]) / fd_)
             rows.append(
                 f"| {name} | {label} | {fd_:.4g} | {_pct(line.drag_residual.ratio(end) - 1)} "

@@ -93,7 +93,7 @@ def residual_variances() -> dict:
             key: {end: float(rec.variance[end]) for end in ("end_a", "end_b")}
             for key, rec in (("drag", lr.drag_residual), ("geometric", lr.geometric_residual))
         }
-        out[name]["std_linear"] = {end: float(getattr(lr, end).std) for end in ("end_a", "end_b")}
+        out[name]["std_linear"] = {end: float(lr.linear_end(end).std) for end in ("end_a", "end_b")}
     return out
 
 
@@ -109,7 +109,7 @@ def _fairlead_ratio(res, variant: str) -> float:
     lr = next(iter(res.lines.values()))
     recs = [r for r in (lr.drag_residual, lr.geometric_residual) if r is not None and r.computed]
     extra = sum(r.variance["end_b"] for r in recs)
-    return math.sqrt(1.0 + extra / lr.end_b.std**2) if recs else 1.0
+    return math.sqrt(1.0 + extra / lr.linear_end("end_b").std ** 2) if recs else 1.0
 
 
 def measure(repeat: int) -> dict[str, dict[str, tuple[float, float]]]:

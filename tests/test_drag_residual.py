@@ -110,7 +110,7 @@ def test_chain_correction_matches_the_time_domain_quadratic_drag_shift():
     res = line.drag_residual
     assert res.computed and res.order == dr.LUMPED_ORDER
     pred = np.array([res.ratio("end_b"), res.ratio("end_a")]) - 1.0
-    fd = np.array([line.end_b.std, line.end_a.std])
+    fd = np.array([line.linear_end("end_b").std, line.linear_end("end_a").std])
     b = (np.asarray(line.linearization.b_normal), np.asarray(line.linearization.b_axial))
     doc = chain_surge_doc(40, residual=False)
     shifts = []
@@ -251,3 +251,33 @@ def test_lumped_coefficients_carry_the_tail() -> None:
         total = mu**4 + 6 * mu**2 + 3 - a[0] ** 2 - a[1] ** 2
         assert 2.0 * lump[2] ** 2 + 6.0 * lump[3] ** 2 == pytest.approx(total, rel=1e-10)
     assert 6.0 * dr.lumped_coefficients([0.0])[0, 3] ** 2 == pytest.approx(3 - 8 / math.pi)
+
+
+def test_end_statistics_carry_the_residuals_moments():
+    """With the residuals the end statistics are those of the linear spectrum plus the
+    residuals' lines: σ² = σ_linear² + Σ variances (1e-12: the same sums), Tz and the
+    bandwidth from the added moments m_n = m_n,lin + Σ ωⁿ·v (checked against the
+    lines summed here), the mean unchanged; the linear statistics kept beside them,
+    in the document's ``linear`` block; without residuals no such block."""
+    doc = load_example("chain_catenary").model_dump(mode="json")
+    doc["analysis"].pop("timeseries", None)
+    doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        line = analyze(doc).lines["leg1"]
+    recs = (line.drag_residual, line.geometric_residual)
+    for end in ("end_a", "end_b"):
+        lin, cor = line.linear[end], getattr(line, end)
+        var = lin.std**2 + sum(r.variance[end] for r in recs)
+        assert cor.std == pytest.approx(math.sqrt(var), rel=1e-12)
+        m2 = lin.m2 + sum(float(np.sum(w**2 * v[end])) for r in recs for w, v in r.lines)
+        assert cor.tz == pytest.approx(2 * math.pi * math.sqrt(var / m2), rel=1e-12)
+        assert cor.mean == lin.mean and cor.tz < lin.tz  # (the superharmonics)
+        assert cor.mpm_3h > lin.mpm_3h
+        assert line.to_document()["linear"][end]["tension"] == lin.as_dict()
+    doc["analysis"]["linearization"].update(drag_residual=False, geometric_residual=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = analyze(doc).lines["leg1"]
+    assert plain.linear is None and "linear" not in plain.to_document()
+    assert plain.end_b.std == line.linear["end_b"].std

@@ -110,7 +110,7 @@ def test_chain_correction_matches_the_time_domain_geometric_shift():
     res = line.geometric_residual
     assert res.computed and res.order == 2 and res.panels == 40
     pred = np.array([res.ratio("end_b"), res.ratio("end_a")]) - 1.0
-    fd = np.array([line.end_b.std, line.end_a.std])
+    fd = np.array([line.linear_end("end_b").std, line.linear_end("end_a").std])
     b = (np.asarray(line.linearization.b_normal), np.asarray(line.linearization.b_axial))
     doc = chain_surge_doc(40, residual=False)
     kw = {"drag": "linear", "linear_drag": b, "seabed": "linear"}

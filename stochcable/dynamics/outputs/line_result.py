@@ -36,6 +36,7 @@ from stochcable.dynamics.outputs.resolution import (
     surface_resolution_check,
     tail_check,
 )
+from stochcable.dynamics.residuals.corrected import corrected_stats
 from stochcable.dynamics.residuals.drag_residual import drag_residual
 from stochcable.dynamics.residuals.geometric_residual import geometric_residual
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
@@ -184,6 +185,10 @@ def line_result(
                 if alone
                 else ResidualRecord.not_computed("a line on free bodies is not covered", std)
             )
+    applied = [r for r in residual.values() if r.computed]
+    linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
+    if applied:  # the end statistics with the residuals (their spectra's moments added)
+        stats = {e: corrected_stats(stats[e], e, applied, settings.duration) for e in linear}
     return LineResult(
         name=system.name,
         omega=w,
@@ -201,6 +206,7 @@ def line_result(
         motion_std=motion_std,
         end_a=stats["end_a"],
         end_b=stats["end_b"],
+        linear=linear,
         linearization=linearization.record,
         modes_omega=np.asarray(system.modes.omega).copy(),
         modes_listed=_listed_modes(system.modes.omega, float(w[-1])),

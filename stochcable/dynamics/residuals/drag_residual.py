@@ -401,15 +401,16 @@ def _misfit_variance(
     live: list[str],
     parts: dict[str, Any],
     misfit: list[tuple[np.ndarray, np.ndarray]],
-) -> dict[str, float]:
-    """The end-tension variance the linear misfit of the element-constant drag changes:
-    its load δB·l·v on the pieces of split elements is linear in the response, so its
-    end tension H_c adds to the linear H_L (Σ_c ∫ S_c (|H_L + H_c|² − |H_L|²) dω on the
-    analysis grid, the trapezoid of the linear σ; it may be negative). [N²]"""
+) -> dict[str, np.ndarray]:
+    """The end-tension variance the linear misfit of the element-constant drag changes,
+    as lines on the analysis grid (empty without split elements): its load δB·l·v on
+    the pieces of split elements is linear in the response, so its end tension H_c
+    adds to the linear H_L (Σ_c S_c (|H_L + H_c|² − |H_L|²) times the trapezoid
+    weights of the linear σ; it may be negative). [N²]"""
     w = np.asarray(resp.omega, dtype=float)
     keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
     if not keep:
-        return {"end_a": 0.0, "end_b": 0.0}
+        return {}
     sel = [[groups[i] for i in idx] for _, idx in keep]
     unit = np.concatenate(
         [panel_loads(system.model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
@@ -424,7 +425,7 @@ def _misfit_variance(
     for o, end in enumerate(("end_a", "end_b")):
         h_l = np.asarray(resp.end_tension[end])
         h_c = np.einsum("pw,cpw->cw", h[o], load)
-        out[end] = float(np.sum(q * (np.abs(h_l + h_c) ** 2 - np.abs(h_l) ** 2)))
+        out[end] = np.sum(q * (np.abs(h_l + h_c) ** 2 - np.abs(h_l) ** 2), axis=0)
     return out
 
 

@@ -213,15 +213,19 @@ def residual_record(
     std: dict[str, float],
     order: int,
     panels: int,
-    linear: dict[str, float] | None = None,
+    linear: dict[str, np.ndarray] | None = None,
 ) -> ResidualRecord:
     """The record of the end tensions' variance lines ``lines`` (end_a, end_b) at
     ``w_out``: their sums, and the sums over the analysis band [w[0], w[-1]]; plus
-    ``linear`` (a variance change on the analysis grid itself, e.g. of a load
-    correlated with the linear response; it may be negative). [N²]"""
+    ``linear`` (variance-change lines on the analysis grid ``w`` itself, e.g. of a load
+    correlated with the linear response; they may be negative), the lines kept in the
+    record. [N²]"""
     keep = (w_out >= w[0] * (1 - 1e-9)) & (w_out <= w[-1] * (1 + 1e-9))
     ends = ("end_a", "end_b")
-    extra = linear or {}
+    extra = {e: float(np.sum(v)) for e, v in (linear or {}).items()}
     variance = {end: float(lines[k].sum()) + extra.get(end, 0.0) for k, end in enumerate(ends)}
     in_band = {end: float(lines[k][keep].sum()) + extra.get(end, 0.0) for k, end in enumerate(ends)}
-    return ResidualRecord.from_variances(variance, in_band, std, order, panels)
+    parts = [(np.asarray(w_out, dtype=float), {end: lines[k] for k, end in enumerate(ends)})]
+    if linear:
+        parts.append((np.asarray(w, dtype=float), {e: np.asarray(v) for e, v in linear.items()}))
+    return ResidualRecord.from_variances(variance, in_band, std, order, panels, tuple(parts))
