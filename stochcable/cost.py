@@ -142,7 +142,7 @@ _BODY_TIME_FACTOR = 1.0  # extra time per free body (coupled solves): 2.6 µs vs
 #: loaded host; the taut wire, 10 m below the surface, splits none: 0.21 against 0.52 s,
 #: on the safe side).
 _RESIDUAL_BYTES = 256 * 2**20
-_RESIDUAL_LINES, _DRAG_PANELS, _GEOMETRIC_ELEMENTS = 128, 32, 400
+_RESIDUAL_LINES, _DRAG_PANELS, _GEOMETRIC_ELEMENTS, _GEOMETRIC_LINES = 128, 32, 400, 64
 _DRAG_SECONDS, _GEOMETRIC_SECONDS = 2.0e-9, 3.0e-10
 
 
@@ -163,7 +163,7 @@ def _residual_seconds(scene: Scene) -> float:
             # (the pairs f ≥ e: half of them)
             out += _DRAG_SECONDS * 2 * panels**2 * fft * math.log2(fft)
         if lin.geometric_residual and n_el <= _GEOMETRIC_ELEMENTS:
-            fft = 2 ** math.ceil(math.log2(4 * n_j + 2))
+            fft = 2 ** math.ceil(math.log2(4 * min(n_j, _GEOMETRIC_LINES + 1) + 2))
             out += _GEOMETRIC_SECONDS * 12 * n_el**2 * fft * math.log2(fft)
     return out
 

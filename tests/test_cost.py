@@ -167,3 +167,4 @@ def test_residual_caps_are_the_modules():
     assert cost._RESIDUAL_LINES == residual_lines.MAX_LINES
     assert cost._DRAG_PANELS == drag_residual.MAX_PANELS
     assert cost._GEOMETRIC_ELEMENTS == geometric_residual.MAX_ELEMENTS
+    assert cost._GEOMETRIC_LINES == geometric_residual.MAX_LINES

@@ -48,6 +48,9 @@ from stochcable.results.records import ResidualRecord
 
 __all__ = ["MAX_ELEMENTS", "geometric_residual", "quadratic_output_lines"]
 
+#: Most lines of its uniform grid: its share of the corrected σ is small (≤ 0.6 % on the
+#: benchmark lines), so its own error matters less than the drag's. [-]
+MAX_LINES = 64
 #: Most elements the residual is computed for. [-]
 MAX_ELEMENTS = 400
 #: Memory of the covariance functions held at a time (a block of element pairs). [bytes]
@@ -91,7 +94,7 @@ def geometric_residual(
         )
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
-    grid = uniform_grid(w)
+    grid = uniform_grid(w, MAX_LINES)
     comps = list(model.components)
     d = model.dim
     n_ch = len(channels)

@@ -56,11 +56,12 @@ class UniformGrid:
     Frequencies sharing a line (a grid finer than the step) add their cross-spectra,
     not their amplitudes: each one of a line becomes its own channel (``ranks``)."""
 
-    def __init__(self, w: np.ndarray) -> None:
+    def __init__(self, w: np.ndarray, max_lines: int | None = None) -> None:
         w = np.asarray(w, dtype=float)
         steps = np.diff(w)
         self.omega = w
-        self.step = max(float(steps.min()) if steps.size else float(w[0]), float(w[-1]) / MAX_LINES)
+        top = MAX_LINES if max_lines is None else max_lines
+        self.step = max(float(steps.min()) if steps.size else float(w[0]), float(w[-1]) / top)
         self.n_j = int(np.rint(w[-1] / self.step)) + 1
         self.index = np.clip(np.rint(w / self.step).astype(int), 0, self.n_j - 1)
         rank = np.zeros(w.size, dtype=int)
@@ -80,9 +81,10 @@ class UniformGrid:
         return out.reshape(n_ch * self.ranks, n_x, self.n_j)
 
 
-def uniform_grid(w: Any) -> UniformGrid:
-    """The :class:`UniformGrid` of the analysis frequencies ``w``. [rad/s]"""
-    return UniformGrid(np.asarray(w, dtype=float))
+def uniform_grid(w: Any, max_lines: int | None = None) -> UniformGrid:
+    """The :class:`UniformGrid` of the analysis frequencies ``w`` [rad/s], of at most
+    ``max_lines`` lines (:data:`MAX_LINES` by default)."""
+    return UniformGrid(np.asarray(w, dtype=float), max_lines)
 
 
 def cross_covariance(x: np.ndarray, y: np.ndarray, n_fft: int) -> np.ndarray:
