@@ -108,6 +108,12 @@ RESIDUAL_WARN_RATIO = 1.25
 #: Orders of the default evaluation: 2 and 3, each carrying the variance of the higher
 #: orders of its parity (:func:`lumped_coefficients`). [-]
 LUMPED_ORDER = 3
+#: Points across a line's cell where the transfer functions of the residual loads are
+#: taken where the lines do not resolve them (:func:`cell_factor`). [-]
+SUB_SAMPLES = 5
+#: Bend of the log power between neighbouring lines (|Δ² ln P|) above which a cell's
+#: transfer functions are sub-sampled (:func:`cell_factor`). [-]
+CELL_BEND = 0.1
 #: Memory of the covariance functions held at a time (a block of panel pairs). [bytes]
 _BLOCK_BYTES = 32 * 2**20
 
@@ -212,7 +218,8 @@ def residual_output_lines(
     transfer : ndarray, complex, shape (n_out, n_p, n_o)
         Outputs per unit force on each panel at ω_j, j = 1 … n_o. [N/N]
     n_fft : int
-        Samples of the lag grid, ≥ 2·K·n_j (no aliasing of the k-fold convolutions).
+        Samples of the lag grid, ≥ 2·K·(n_j − 1) + 1 (no aliasing of the k-fold
+        convolutions, whose lines reach K·(n_j − 1)).
 
     Returns
     -------
@@ -255,8 +262,11 @@ def residual_output_lines(
         diag = np.arange(blk.stop - start)
         cr[diag, diag] *= 0.5
         cr[np.arange(cr.shape[0])[:, None] > np.arange(cr.shape[1])[None, :]] = 0.0
-        tf = np.einsum("efj,ofj->oej", cr, transfer[:, f_all])
-        out += np.real(np.einsum("oej,oej->oj", np.conj(transfer[:, blk]), tf))
+        # Σ_ef conj(T_e) G_ef T_f per line: G_j T_j as one matrix product per line
+        t_f = np.transpose(transfer[:, f_all], (2, 1, 0))  # (n_o, n_f, n_out)
+        tf = np.moveaxis(cr, 2, 0) @ t_f  # (n_o, n_b, n_out)
+        t_e = np.transpose(np.conj(transfer[:, blk]), (2, 1, 0))
+        out += np.einsum("jek,jek->kj", t_e, tf).real
     return out
 
 
@@ -329,7 +339,8 @@ def drag_residual(
     spectra = np.stack([ch.spectrum for ch in channels])
     n_o = order * (grid.n_j - 1)
     w_out = grid.step * np.arange(1, n_o + 1)
-    n_fft = fft_length(2 * order * grid.n_j + 2)
+    # (ρ^K reaches line K·(n_j − 1): a lag grid of 2·K·(n_j − 1) + 1 samples resolves it)
+    n_fft = fft_length(2 * order * (grid.n_j - 1) + 1)
     unit = panel_loads(model, seg, groups, [parts[n][2] for n in live])
     h_all = load_transfer(system, damping, unit, w_out, influence)
     # the normal and axial residuals of every panel are one set of components: they are
@@ -356,10 +367,43 @@ def drag_residual(
         np.concatenate(coeffs),
         h_all,
         n_fft,
-    )
+    ) * cell_factor(system, damping, unit, w_out, h_all)
     linear = _misfit_variance(system, damping, resp, spectra, seg, groups, live, parts, misfit)
     out = residual_record(lines_t, w_out, w, std, order, len(groups), linear)
     _warn_large(system.name, out)
+    return out
+
+
+def cell_factor(
+    system: Any, damping: Any, unit: np.ndarray, w_out: np.ndarray, h: np.ndarray
+) -> np.ndarray:
+    """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
+    panel force over its value at ω_j, where the lines do not resolve it: shape
+    (n_out, n_o).
+
+    Near a lightly damped mode every panel's transfer function is the mode's resonance
+    times its shape, T_e(ω) ≈ φ_e·R(ω): the cell mean of every product conj(T_e)·T_f is
+    then the line's times this one factor, and the residual's variance line is
+    integrated over the cell, not sampled (the inclined guy's 0.7 %-damped mode, half-
+    power width 0.016 rad/s, on lines 0.03 rad/s apart: its corrected σ moved ±2 % with
+    the line count, within 0.2 % with the factor).  The cells are those where the log
+    power (``h``'s, summed over the panels) bends by more than :data:`CELL_BEND`
+    between neighbours, and theirs; elsewhere the factor is 1 (no solve)."""
+    power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
+    out = np.ones_like(power)
+    logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
+    bend = np.zeros(power.shape[1], dtype=bool)
+    bend[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > CELL_BEND, 0)
+    cells = np.flatnonzero(bend | np.roll(bend, 1) | np.roll(bend, -1))
+    if cells.size == 0:
+        return out
+    step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
+    sub = step * ((np.arange(SUB_SAMPLES) + 0.5) / SUB_SAMPLES - 0.5)
+    w_sub = (w_out[cells, None] + sub[None]).ravel()
+    h_sub = load_transfer(system, damping, unit, w_sub)
+    p_sub = np.sum(np.abs(h_sub) ** 2, axis=1).reshape(power.shape[0], cells.size, -1)
+    at = power[:, cells]
+    out[:, cells] = np.where(at > 0, p_sub.mean(axis=2) / np.where(at > 0, at, 1.0), 1.0)
     return out
 
 

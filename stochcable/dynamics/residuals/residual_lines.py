@@ -46,7 +46,7 @@ __all__ = [
 
 #: Most lines of the uniform grid the linear quantities are placed on (its step is the
 #: analysis grid's smallest spacing, or ω_max/MAX_LINES if that is finer). [-]
-MAX_LINES = 128
+MAX_LINES = 63
 
 
 class UniformGrid:
@@ -98,7 +98,7 @@ def cross_covariance(x: np.ndarray, y: np.ndarray, n_fft: int) -> np.ndarray:
 
 def fft_length(n: int) -> int:
     """The shortest lag grid of at least ``n`` samples whose real FFT is fast (a
-    5-smooth length: 518 → 540 where a power of two is 1,024)."""
+    5-smooth length: 763 → 768, 769 → 800)."""
     return int(scipy.fft.next_fast_len(int(n), real=True))
 
 
