@@ -247,7 +247,9 @@ def residual_output_lines(
         blk = slice(start, min(start + size, n_p))
         f_all = slice(start, n_p)
         cross = np.zeros((blk.stop - start, n_p - start, n_fft // 2 + 1), dtype=complex)
-        cross[:, :, :n_j] = np.einsum("cej,cfj->efj", np.conj(z[:, blk]), z[:, f_all])
+        # Σ_c conj(z_ce)·z_cf per line: one matrix product per line
+        zz = np.conj(z[:, blk]).transpose(2, 1, 0) @ z[:, f_all].transpose(2, 0, 1)
+        cross[:, :, :n_j] = np.moveaxis(zz, 0, 2)
         cross[:, :, 0] *= 2.0  # (irfft halves the zero-frequency line)
         rho = np.fft.irfft(cross, n=n_fft, axis=2) * (0.5 * n_fft)
         # Σ_{k≥2} b_k^e b_k^f ρ^k by Horner's rule

@@ -91,7 +91,8 @@ def cross_covariance(x: np.ndarray, y: np.ndarray, n_fft: int) -> np.ndarray:
     """E[x(t) y_k(t + τ)] on the lag grid τ_m = 2πm/(n_fft·step), for one quantity's
     lines ``x`` (n_ch, n_j) and many ``y`` (n_ch, n_k, n_j): shape (n_k, n_fft)."""
     cross = np.zeros((y.shape[1], n_fft // 2 + 1), dtype=complex)
-    cross[:, : y.shape[2]] = np.einsum("cj,ckj->kj", np.conj(x), y)
+    # Σ_c x̄_c·y_ck per line: one matrix product per line
+    cross[:, : y.shape[2]] = (np.conj(x).T[:, None, :] @ y.transpose(2, 0, 1))[:, 0].T
     cross[:, 0] *= 2.0  # (irfft halves the zero-frequency line)
     return np.fft.irfft(cross, n=n_fft, axis=1) * (0.5 * n_fft)
 
