@@ -18,9 +18,12 @@ to the linear one, and the residual σ ratios (σ with / σ without) at the fair
     OPENBLAS_NUM_THREADS=1 python3 benchmarks/residual_cost.py [--repeat 3] [--profile LINE]
 
 Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
-analysis before issue 31 and 4.7–8.1× after (adjoint end tensions: exact; pairs f ≥ e:
-exact; Hermite orders 2 and 3 carrying the higher orders' variance, 32 panels, 128
-lines: corrected σ within −0.19…+0.33 % of before, −0.64 % on the inclined guy).
+analysis before issue 31 and 1.8–4.4× after (chain 4.4×, two-segment 3.2×, deep 2.5×,
+taut 1.8×; loaded host, ±1): exact steps (adjoint end tensions, pairs f ≥ e, the lag
+grid at the alias bound, one end influence) and approximate ones (Hermite orders 2
+and 3 carrying the higher orders' variance, 32 panels, 64 lines with resonant cells
+integrated, the geometric residual on 64 lines): corrected σ within −0.20…+0.33 % of
+before on the four lines and the inclined guy (tests/test_drag_residual.py).
 """
 
 from __future__ import annotations
