@@ -1,0 +1,216 @@
+"""Transport terms of a travelling line (stochcable.line.transport).
+
+References: Wickert & Mote (1990), "Classical vibration analysis of axially moving
+continua", J. Appl. Mech. 57, 738–744 (the travelling string's frequencies and mode
+shapes, eqs. 22 and 26).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from fem_cases import shallow_parabola, taut_string
+
+from stochcable.errors import InputError
+from stochcable.line.fem import assemble
+from stochcable.line.transport import check_axial_speed, critical_speed, transport_matrices
+from stochcable.line.transport_modes import (
+    complex_modes,
+    divergence_speed,
+    receptance_direct,
+    receptance_modal,
+    stability_transport,
+)
+
+L, T, M_STRING, EA = 10.0, 1000.0, 1.0, 1.0e9  # EA/T = 1e6: the stretch is negligible
+CW = np.sqrt(T / M_STRING)
+
+
+def _string(n_el: int):
+    mesh, pos, ten = taut_string(n_el, L, T, M_STRING, EA)
+    return assemble(mesh, pos, ten, rho=1025.0, dim=2)
+
+
+def _wickert_mote(n: np.ndarray, c: float) -> np.ndarray:
+    """ω_n = nπ(c_w² − c²)/(L c_w) (Wickert & Mote 1990, eq. 22). [rad/s]"""
+    return n * np.pi * (CW**2 - c**2) / (L * CW)
+
+
+def test_matrices_skew_and_centripetal():
+    model = _string(10)
+    tr = transport_matrices(model, 7.0)
+    g = tr.G.toarray()
+    # assembled on prescribed ends and a uniform line: G is skew-symmetric
+    assert np.abs(g + g.T).max() == 0.0
+    # K_c = −m c² (1/l) pattern: on the free DOFs, −c²/c_w² times the transverse
+    # geometric stiffness of the taut string (T/l pattern)
+    ff = model.free
+    kz = model.K.toarray()[np.ix_(ff[1::2], ff[1::2])]
+    kcz = tr.Kc.toarray()[np.ix_(ff[1::2], ff[1::2])]
+    np.testing.assert_allclose(kcz, -(7.0**2) / CW**2 * kz, rtol=1e-12)
+
+
+@pytest.mark.parametrize("ratio", [0.0, 0.3, 0.6, 0.9])
+def test_travelling_string_frequencies(ratio):
+    """Wickert & Mote within 0.5 % for n = 1…3, converged in the element count."""
+    c = ratio * CW
+    n = np.arange(1, 4)
+    exact = _wickert_mote(n, c)
+    errs = []
+    for n_el in (60, 120):
+        modes = complex_modes(_string(n_el), c, count=3, added_mass=False)
+        # conservative gyroscopic system: imaginary eigenvalues (QZ round-off ~1e-12)
+        assert np.abs(modes.growth).max() < 1e-8 * modes.omega.max()
+        errs.append(modes.omega / exact - 1.0)
+    # 0.5 %: the issue's tolerance; linear elements are O(h²): 120 elements give
+    # ≤ 0.17 % at c/c_w = 0.9, n = 3
+    assert np.abs(errs[1]).max() < 5e-3
+    # converged: halving the element length divides the error by ≈ 4 (O(h²))
+    np.testing.assert_allclose(errs[0] / errs[1], 4.0, rtol=0.02)
+
+
+def test_travelling_string_mode_phase_follows_travel():
+    """The mode's phase e^{iβs}, β = cω/(c_w² − c²), sign set by the travel direction
+    (Wickert & Mote 1990, eq. 26: φ = sin(nπs/L) e^{iβs} for u = Re φ e^{iωt})."""
+    model = _string(60)
+    for c in (0.5 * CW, -0.5 * CW):
+        modes = complex_modes(model, c, count=1, added_mass=False)
+        w = modes.omega[0]
+        phi = modes.right[1::2, 0]  # z components along the string
+        s = model.positions[:, 0]
+        beta = c * w / (CW**2 - c**2)
+        inner = slice(5, -5)
+        ref = np.sin(np.pi * s / L) * np.exp(1j * beta * s)
+        ratio = phi[inner] / ref[inner]
+        # one complex constant (the normalization): its phase is the same along s
+        # O(h²) phase error of 60 elements: a few 1e-3 rad, against βL ≈ 2 rad
+        np.testing.assert_allclose(np.angle(ratio / ratio[len(ratio) // 2]), 0.0, atol=1e-2)
+
+
+def test_modal_receptance_equals_direct_solve():
+    """Left/right normalization ψᵀ(2λM + D)φ = 1 gives the exact receptance."""
+    model = _string(12)
+    rng = np.random.default_rng(34)
+    n_free = model.free.size
+    c = np.diag(rng.uniform(0.0, 2.0, n_free))  # a damping on top of G
+    omega = np.array([0.0, 3.0, 17.5, 60.0])
+    modes = complex_modes(model, 0.7 * CW, damping=c, added_mass=False)
+    h_modal = receptance_modal(modes, omega, model.free)
+    h_direct = receptance_direct(model, 0.7 * CW, omega, added_mass=False, damping=c)
+    # the two agree to round-off of the QZ and of the inverse
+    np.testing.assert_allclose(h_modal, h_direct, rtol=0, atol=1e-9 * np.abs(h_direct).max())
+
+
+def test_critical_speed_refusal_names_speed():
+    model = _string(10)
+    crit = critical_speed(model)
+    assert crit.speed == pytest.approx(CW, rel=1e-12)
+    assert check_axial_speed(model, -0.99 * CW) == -0.99 * CW
+    for c in (CW, -1.2 * CW):
+        with pytest.raises(InputError) as err:
+            check_axial_speed(model, c, "lines[0].axial_speed")
+        msg = str(err.value)
+        assert "lines[0].axial_speed" in msg and f"{CW:.4g} m/s" in msg
+        assert "\n" not in msg
+
+
+def test_string_diverges_at_wave_speed():
+    """The taut string: stable below c_w, an eigenvalue through zero at c_w, a real
+    positive eigenvalue (divergence) above."""
+    model = _string(20)
+    assert divergence_speed(model) == pytest.approx(CW, rel=1e-9)
+    below = stability_transport(model, 0.95 * CW, added_mass=False)
+    assert below.stable and below.negative_stiffness == 0
+    above = stability_transport(model, 1.05 * CW, added_mass=False)
+    assert above.kind == "divergence"
+    assert above.eigenvalue.real > 0 and above.negative_stiffness % 2 == 1
+
+
+def test_sagged_cable_divergence_between_tension_bounds():
+    """A sagged cable (tension varying along it): the divergence speed of the symmetric
+    problem K φ = c² K₁ φ lies between √(T_min/m) and √(T_max/m), and the complex
+    eigenvalues of the gyroscopic system agree: stable 1 % below it, divergent 1 %
+    above."""
+    g, span, sag, h = 9.81, 100.0, 0.1, 2.0e4
+    w = 8.0 * h * sag * span / span**2
+    mesh, pos, ten = shallow_parabola(40, span, sag, h, w / g, g, 1.0e9)
+    model = assemble(mesh, pos, ten, rho=1025.0, dim=2)
+    m = w / g
+    cd = divergence_speed(model)
+    assert np.sqrt(ten.min() / m) <= cd <= np.sqrt(ten.max() / m)
+    assert critical_speed(model).speed <= cd
+    assert stability_transport(model, 0.99 * cd, added_mass=False).stable
+    above = stability_transport(model, 1.01 * cd, added_mass=False)
+    # the nearly uniform tension (T/H ≤ 1.08) softens many modes at once: the index
+    # is large, but any negative stiffness under a gyroscopic term alone diverges here
+    assert above.kind == "divergence" and above.negative_stiffness >= 1
+
+
+# ---------------------------------------------------------------- the scene field
+
+
+def _taut_scene(speed: float) -> dict:
+    """The weightless taut line of test_modes (T = EA(span/l0 − 1) ≈ 1.0 MN), travelling."""
+    from test_modes import TAUT_SCENE
+
+    doc = json.loads(json.dumps(TAUT_SCENE))
+    doc["lines"][0]["axial_speed"] = speed
+    return doc
+
+
+def _taut_scene_wave_speed() -> float:
+    """c_w = √(T/m) of the taut scene, m per current length. [m/s]"""
+    l0, span, ea, m0 = 399.6, 400.0, 1.0e9, 50.0
+    return float(np.sqrt(ea * (span / l0 - 1.0) / (m0 * l0 / span)))
+
+
+def test_scene_axial_speed_field():
+    from stochcable.scene.model import load_scene
+
+    assert load_scene(_taut_scene(0.0)).lines[0].axial_speed == 0.0
+    assert load_scene(_taut_scene(-3.0)).lines[0].axial_speed == -3.0  # end_b to end_a
+    doc = _taut_scene(2.0)
+    doc["lines"][0]["attachments"] = [{"at": 100.0, "mass": 10.0}]
+    with pytest.raises(InputError, match=r"lines\[0\].axial_speed.*attachments"):
+        load_scene(doc)
+
+
+def test_cli_modes_travelling_line(tmp_path):
+    """`stochcable modes` on a travelling taut line (in air, in-plane): Wickert & Mote."""
+    from stochcable.cli import main
+
+    cw = _taut_scene_wave_speed()
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(_taut_scene(0.5 * cw)))
+    out = tmp_path / "modes.json"
+    assert main(["modes", str(path), "--count", "3", "--dim", "2", "--in-air", "-o", str(out)]) == 0
+    line = json.loads(out.read_text())["modes"]["lines"]["taut"]
+    assert line["stability"] == "stable" and line["axial_speed"] == 0.5 * cw
+    assert line["critical_speed"] == pytest.approx(cw, rel=1e-9)
+    c, span = 0.5 * cw, 400.0
+    exact = np.arange(1, 4) * np.pi * (cw**2 - c**2) / (span * cw)
+    # 100 elements, effective wavenumbers up to 1.5·3π/L: O(h²) error ≤ 0.2 %
+    np.testing.assert_allclose(line["omega"], exact, rtol=2e-3)
+
+
+@pytest.mark.parametrize("command", ["modes", "analyze"])
+def test_cli_refuses_critical_speed_in_one_line(tmp_path, capsys, command):
+    from stochcable.cli import main
+
+    cw = _taut_scene_wave_speed()
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(_taut_scene(-1.01 * cw)))
+    assert main([command, str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "lines[0].axial_speed" in err and f"√(T/m) = {cw:.4g} m/s" in err
+    assert "\n" not in err
+
+
+def test_analyze_refuses_transport_below_critical():
+    """No silent response without the transport terms: the engine has none yet."""
+    from stochcable.analysis import analyze
+
+    with pytest.raises(InputError, match="not in the engine yet"):
+        analyze(_taut_scene(1.0))
