@@ -214,3 +214,20 @@ def test_analyze_refuses_transport_below_critical():
 
     with pytest.raises(InputError, match="not in the engine yet"):
         analyze(_taut_scene(1.0))
+
+
+def test_flutter_reported_not_solved():
+    """A negative damping −εM (a stand-in for a non-conservative fluid load) makes the
+    string's oscillating modes grow: complex pairs with Re λ > 0 are a flutter (at rest
+    Re λ = ε/2 exactly, the damping being proportional); +εM damps them (stable)."""
+    model = _string(12)
+    m_free = model.partition("M")[0].toarray()
+    eps = 0.4  # [1/s]
+    rest = stability_transport(model, 0.0, added_mass=False, damping=-eps * m_free)
+    # QZ round-off ~1e-10 of the largest |λ| (the axial modes, ~4e5 rad/s): 1e-4 abs
+    assert rest.kind == "flutter" and rest.eigenvalue.real == pytest.approx(eps / 2, abs=1e-4)
+    grows = stability_transport(model, 0.5 * CW, added_mass=False, damping=-eps * m_free)
+    assert grows.kind == "flutter" and not grows.stable and grows.eigenvalue.real > 0.1
+    assert grows.negative_stiffness == 0  # not a divergence: K + K_c stays positive
+    damped = stability_transport(model, 0.5 * CW, added_mass=False, damping=eps * m_free)
+    assert damped.stable
