@@ -231,3 +231,21 @@ def test_flutter_reported_not_solved():
     assert grows.negative_stiffness == 0  # not a divergence: K + K_c stays positive
     damped = stability_transport(model, 0.5 * CW, added_mass=False, damping=eps * m_free)
     assert damped.stable
+
+
+def test_service_answers_422_naming_the_critical_speed():
+    """The HTTP service: the same one-line error, a 422 with parameter and unit."""
+    pytest.importorskip("fastapi")
+    from fastapi.testclient import TestClient
+
+    from service.app import create_app
+    from service.settings import Settings
+
+    cw = _taut_scene_wave_speed()
+    # one forked analysis worker, as test_fidelity_limits (the default spawns several)
+    with TestClient(create_app(Settings(analysis_workers=1, worker_start_method="fork"))) as client:
+        resp = client.post("/v1/analyses", json=_taut_scene(1.5 * cw))
+    assert resp.status_code == 422, resp.text
+    err = resp.json()["detail"][0]
+    assert err["parameter"] == "lines[0].axial_speed" and err["unit"] == "m/s"
+    assert f"√(T/m) = {cw:.4g} m/s" in err["msg"]
