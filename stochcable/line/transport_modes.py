@@ -22,10 +22,12 @@ from stochcable.errors import InputError, SolverError
 from stochcable.line.fem import FEModel
 from stochcable.line.modes import PLANE_TOL, _out_of_plane_fraction, plane_normal
 from stochcable.line.transport import _check_model, critical_speed, transport_matrices
+from stochcable.line.transport_sparse import lowest_complex_modes
 from stochcable.validation import float_array, positive_int
 
 __all__ = [
     "DENSE_MAX_STATES",
+    "DENSE_AUTO_STATES",
     "ComplexModes",
     "Stability",
     "complex_modes",
@@ -38,6 +40,9 @@ __all__ = [
 
 #: Largest first-order state (2 × free DOFs) solved by the dense QZ with left vectors.
 DENSE_MAX_STATES = 4000
+#: Above this state size ``method="auto"`` takes the sparse Arnoldi (a dense QZ with
+#: left vectors of 1,200 states takes a few seconds on 2 cores).
+DENSE_AUTO_STATES = 1200
 # A real part below this fraction of |λ| (or of the largest |λ|) is round-off: the
 # conservative gyroscopic system has λ on the imaginary axis, and QZ returns it to
 # ~1e-12 relative on these well-scaled pencils; 1e-8 leaves four decades of margin.
@@ -114,7 +119,7 @@ def complex_modes(
     count: int | None = None,
     added_mass: bool = True,
     damping: Any = None,
-    method: Literal["dense"] = "dense",
+    method: Literal["auto", "dense", "sparse"] = "auto",
 ) -> ComplexModes:
     """Complex modes of a travelling line, with their left eigenvectors.
 
@@ -132,8 +137,11 @@ def complex_modes(
         Include the added mass in M (modes in water) or not (in air).
     damping : array_like or sparse, optional
         A symmetric or general damping matrix C, (n_dof, n_dof) or free–free. [N·s/m]
-    method : {"dense"}
-        QZ on the first-order pencil (up to ``DENSE_MAX_STATES`` states).
+    method : {"auto", "dense", "sparse"}
+        "dense": QZ on the first-order pencil (up to ``DENSE_MAX_STATES`` states);
+        "sparse": shift-invert Arnoldi for the lowest ``count``
+        (:mod:`stochcable.line.transport_sparse`); "auto": dense up to
+        ``DENSE_AUTO_STATES`` states or when ``count`` is None, sparse above.
 
     Returns
     -------
@@ -154,11 +162,15 @@ def complex_modes(
     eigenvalues are imaginary (Thomson–Tait–Chetaev), and ψ = φ̄ for λ = iω.
     """
     model = _check_model(model)
-    if method != "dense":
-        raise InputError("method", method, "-", "must be 'dense'")
+    if method not in ("auto", "dense", "sparse"):
+        raise InputError("method", method, "-", "must be 'auto', 'dense' or 'sparse'")
     n = model.free.size
     if n == 0:
         raise InputError("model", "no free DOFs", "-", "needs at least one free node")
+    if method == "sparse" or (method == "auto" and count is not None and 2 * n > DENSE_AUTO_STATES):
+        if count is None:
+            raise InputError("count", None, "-", "the sparse complex modes need a count")
+        return _sparse(model, speed, positive_int("count", count), added_mass, damping)
     if 2 * n > DENSE_MAX_STATES:
         raise InputError(
             "model",
@@ -209,6 +221,31 @@ def complex_modes(
         speed=float(speed),
         complete=complete,
     )
+
+
+def _sparse(
+    model: FEModel, speed: float, count: int, added_mass: bool, damping: Any
+) -> ComplexModes:
+    """The lowest complex modes by shift-invert Arnoldi on sparse matrices."""
+    tr = transport_matrices(model, speed)
+    m = model._free_free(model._mass_total if added_mass else model.M)
+    d = model._free_free(tr.G)
+    if damping is not None:
+        c = sp.csr_array(damping) if sp.issparse(damping) else np.asarray(damping, dtype=float)
+        if c.shape == (model.n_dof, model.n_dof):
+            c = model.partition(c)[0]
+        if c.shape != m.shape:
+            raise InputError(
+                "damping", c.shape, "N·s/m", f"must be ({model.n_dof}, {model.n_dof}) or free–free"
+            )
+        d = d + sp.csr_array(c)
+    k = model._free_free(tr.K)
+    lam, phi, psi = lowest_complex_modes(sp.csr_array(m), sp.csr_array(d), sp.csr_array(k), count)
+    right = np.zeros((model.n_dof, lam.size), dtype=complex)
+    left = np.zeros_like(right)
+    right[model.free] = phi
+    left[model.free] = psi
+    return ComplexModes(eigenvalues=lam, right=right, left=left, speed=float(speed), complete=False)
 
 
 def receptance_modal(modes: ComplexModes, omega: Any, free: np.ndarray) -> np.ndarray:
@@ -405,7 +442,13 @@ def modes_document(
         "flutter").
     """
     modes = complex_modes(model, speed, count=count, added_mass=added_mass)
-    stab = stability_transport(model, speed, added_mass=added_mass)
+    if 2 * model.free.size <= DENSE_AUTO_STATES:
+        kind = stability_transport(model, speed, added_mass=added_mass).kind
+    else:  # below the critical speed K + K_c is positive definite: the lowest modes
+        tol = _REAL_TOL * float(np.abs(modes.eigenvalues).max())
+        lead = modes.eigenvalues[int(np.argmax(modes.eigenvalues.real))]
+        grows = lead.real > tol
+        kind = "stable" if not grows else "divergence" if abs(lead.imag) <= tol else "flutter"
     mt = model._mass_total if added_mass else model.M
     normal = plane_normal(model.positions)
     shapes = np.hstack([modes.right.real, modes.right.imag])
@@ -428,5 +471,5 @@ def modes_document(
         "growth": [float(g) for g in modes.growth],
         "axial_speed": float(speed),
         "critical_speed": critical_speed(model).speed,
-        "stability": stab.kind,
+        "stability": kind,
     }
