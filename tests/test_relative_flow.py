@@ -77,3 +77,24 @@ def test_fe_reproduces_the_closed_form_where_the_reduction_holds():
         worst = max(worst, abs(shape.midspan_angle() - ref))
     assert np.degrees(worst) < 2.0
     assert shape.midspan_angle() > 3.0  # at the top by λ0 = 20
+
+
+def test_swing_up_speed_levels_the_midspan():
+    """At the swing-up speed of eq. (38) the FE mid-span stands level with the chord
+    (φ ≈ π/2, within 2°: the drag and slope terms), below it hangs, above it rises."""
+    from stochcable.reference.travelling_cable import swing_up_speed_hu_jin
+
+    d = 0.02
+    pos, l0, ea, w, _ = _cable(d)
+    vf = 0.1
+    c_up = swing_up_speed_hu_jin(w, RHO, DC, CF * CD, vf)
+    # the lift alone: ½ρC_L D(V_f² + c²) = w
+    assert 0.5 * RHO * CF * CD * DC * (vf**2 + c_up**2) == pytest.approx(w, rel=1e-12)
+    start, angles = pos, []
+    for c in (0.0, 0.5 * c_up, 0.9 * c_up, c_up, 1.1 * c_up):
+        load = lambda e, c=c: hu_jin_flow_force(e, c, vf, RHO, DC, CD, CF * CD)  # noqa: E731
+        shape = static_shape_in_flow(start, l0, ea, w, load, steps=4 if c == 0 else 2)
+        start = shape.positions
+        angles.append(shape.midspan_angle())
+    assert angles[3] == pytest.approx(np.pi / 2, abs=np.radians(2.0))
+    assert angles[2] < np.pi / 2 < angles[4]

@@ -40,6 +40,7 @@ __all__ = [
     "groups_hu_jin",
     "residual_hu_jin",
     "equilibrium_hu_jin",
+    "swing_up_speed_hu_jin",
 ]
 
 #: ω₀² = π⁴/2, the stretching stiffness of the reduced model (Hu & Jin 2001, eq. 18).
@@ -256,3 +257,53 @@ def equilibrium_hu_jin(
         kind=(kinds[0], kinds[1]),
         theta=float(theta),
     )
+
+
+def swing_up_speed_hu_jin(
+    weight: float, rho: float, diameter: float, cl: float, flow_speed: float
+) -> float:
+    """Axial speed at which the lift of the relative flow carries the weight.
+
+    Parameters
+    ----------
+    weight : float
+        Weight per unit length that the lift must carry (Hu & Jin use ρ_c A g; a
+        submerged line: its net submerged weight). [N/m]
+    rho : float
+        Fluid density. [kg/m³]
+    diameter : float
+        Hydrodynamic diameter. [m]
+    cl : float
+        Lift coefficient on |V_r|². [-]
+    flow_speed : float
+        Cross-flow speed V_f. [m/s]
+
+    Returns
+    -------
+    float
+        c with ½ρ C_L D (V_f² + c²) = weight (inf when C_L = 0 or V_f = 0, 0 when
+        the flow alone lifts it). [m/s]
+
+    Notes
+    -----
+    Eq. (38) of Hu & Jin (2001) with V_r² = V_f² + c²: the lift term m D_f v_f of eq. (39)
+    equals μ².  There the mid-span section of the cable stands level with the chord,
+    φ₀ = π/2 up to the drag and the slope terms (σ₂): the speed at which a sagged
+    cable in a cross-flow swings up from the bottom towards the top.  Below it the
+    cable hangs below the chord, above it rises above it.
+
+    References
+    ----------
+    Hu, H. Y. & Jin, D. P. (2001), Non-linear dynamics of a suspended travelling cable
+    subject to transverse fluid excitation, Journal of Sound and Vibration 239(3),
+    515–529, eq. 38.
+    """
+    w = positive("weight", weight, "N/m")
+    rho = positive("rho", rho, "kg/m³")
+    dia = positive("diameter", diameter, "m")
+    cl = nonnegative("cl", cl, "-")
+    vf = nonnegative("flow_speed", flow_speed, "m/s")
+    if cl == 0.0 or vf == 0.0:
+        return float("inf")
+    vr2 = w / (0.5 * rho * cl * dia)
+    return float(np.sqrt(max(vr2 - vf * vf, 0.0)))
