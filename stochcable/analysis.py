@@ -51,7 +51,7 @@ from typing import Any
 
 from stochcable.dynamics.engine import Engine, build_engine
 from stochcable.dynamics.model.system import Progress, noop_progress
-from stochcable.errors import InputError, PhysicsWarning, warn
+from stochcable.errors import PhysicsWarning, warn
 from stochcable.fidelity import apply_fidelity, choose_fidelity
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, load_scene
@@ -105,8 +105,6 @@ def analyze(
     """
     t_start = time.perf_counter()
     scene = load_scene(scene)
-    if any(line.axial_speed != 0.0 for line in scene.lines):
-        _refuse_transport(scene)
     progress = noop_progress if progress is None else progress
     plan = None
     if scene.analysis.fidelity is not None:
@@ -116,24 +114,6 @@ def analyze(
     if plan is None:
         return result
     return _with_plan(result, plan, time.perf_counter() - t_start)
-
-
-def _refuse_transport(scene: Scene) -> None:
-    """A travelling line: the speed checked against its critical speed (named), then
-    refused, as the response engine has no transport terms yet (docs/travelling.md)."""
-    from stochcable.line.transport import check_line_speeds
-    from stochcable.statics import scene_fe_models
-
-    check_line_speeds(scene.lines, scene_fe_models(scene))
-    i, line = next((i, ln) for i, ln in enumerate(scene.lines) if ln.axial_speed != 0.0)
-    raise InputError(
-        f"lines[{i}].axial_speed",
-        line.axial_speed,
-        "m/s",
-        "the stochastic response of a travelling line is not in the engine yet (its "
-        "complex modes and stability are: 'stochcable modes', docs/travelling.md); "
-        "set 0 for the line at rest",
-    )
 
 
 def _plan_fidelity(scene: Scene, progress: Progress) -> tuple[Scene, Any]:

@@ -234,9 +234,13 @@ def test_cli_refuses_critical_speed_in_one_line(tmp_path, capsys, command):
 def test_analyze_refuses_transport_below_critical():
     """No silent response without the transport terms: the engine has none yet."""
     from stochcable.analysis import analyze
+    from stochcable.dynamics.engine import build_engine
 
     with pytest.raises(InputError, match="not in the engine yet"):
         analyze(_taut_scene(1.0))
+    # the engine itself refuses, so load-case sets (which build it directly) do too
+    with pytest.raises(InputError, match=r"lines\[0\].axial_speed.*not in the engine yet"):
+        build_engine(_taut_scene(-1.0))
 
 
 def test_flutter_reported_not_solved():

@@ -47,6 +47,7 @@ __all__ = [
     "check_axial_speed",
     "transport_matrices",
     "check_line_speeds",
+    "refuse_travelling_lines",
 ]
 
 #: The 2×2 node pattern of the consistent skew-symmetric gyroscopic element.
@@ -247,3 +248,38 @@ def check_line_speeds(lines: Any, models: dict[str, FEModel]) -> dict[str, float
         if c != 0.0:
             out[line.name] = check_axial_speed(models[line.name], c, f"lines[{i}].axial_speed")
     return out
+
+
+def refuse_travelling_lines(scene: Any, statics: Any) -> None:
+    """Refuse the response of a scene with a travelling line (no transport in it yet).
+
+    Parameters
+    ----------
+    scene : Scene
+        The validated scene.
+    statics : StaticsResult
+        Its statics (``statics.lines[name]``).
+
+    Raises
+    ------
+    InputError
+        ``lines[i].axial_speed``: at or above the critical speed (named), or, below it,
+        because the response engine has no transport terms yet (docs/travelling.md).
+    """
+    from stochcable.line.fem import build_fe_model
+
+    moving = [(i, ln) for i, ln in enumerate(scene.lines) if ln.axial_speed != 0.0]
+    if not moving:
+        return
+    for i, line in moving:
+        model = build_fe_model(statics.lines[line.name], scene.environment, dim=3)
+        check_axial_speed(model, line.axial_speed, f"lines[{i}].axial_speed")
+    i, line = moving[0]
+    raise InputError(
+        f"lines[{i}].axial_speed",
+        line.axial_speed,
+        "m/s",
+        "the stochastic response of a travelling line is not in the engine yet (its "
+        "complex modes and stability are: 'stochcable modes', docs/travelling.md); "
+        "set 0 for the line at rest",
+    )
