@@ -339,3 +339,12 @@ def test_statics_axial_drag_on_the_relative_axial_velocity():
         change = (line.tension[-1] - line.tension[0]) - span
         # the solver's tolerance on the tensions (~1e-9 of 8e4 N) against 440 N
         assert change == pytest.approx(np.sign(c) * coef * c * c * between, rel=1e-6)
+
+
+def test_time_domain_reference_refuses_transport():
+    """The TD reference has no transport terms: a travelling line is refused, not
+    simulated at rest."""
+    from stochcable.reference.cable import simulate_line_timedomain
+
+    with pytest.raises(InputError, match="axial_speed"):
+        simulate_line_timedomain(_taut_scene(1.0), "taut")
