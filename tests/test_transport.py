@@ -348,3 +348,11 @@ def test_time_domain_reference_refuses_transport():
 
     with pytest.raises(InputError, match="axial_speed"):
         simulate_line_timedomain(_taut_scene(1.0), "taut")
+
+
+def test_real_modes_of_a_travelling_line_warn():
+    from stochcable.errors import PhysicsWarning
+    from stochcable.statics import modes_of_scene
+
+    with pytest.warns(PhysicsWarning, match="travels: these are its modes at rest"):
+        modes_of_scene(_taut_scene(1.0), count=2)

@@ -297,6 +297,16 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Read the coupled modes from ``stochcable analyze`` under ``bodies.<name>.modes``.",
     ),
     WarningEntry(
+        "Real modes of a travelling line",
+        "PhysicsWarning",
+        ("stochcable.line.modes:natural_modes",),
+        "the model's line has ``axial_speed`` ≠ 0 (``lines[i].axial_speed``)",
+        "The real modes K φ = ω² M φ leave out the transport terms (the gyroscopic "
+        "matrix and the centripetal stiffness): they are the line's modes at rest.",
+        "Use ``stochcable modes`` (which lists the complex modes of a travelling line) "
+        "or ``stochcable.line.transport_modes.complex_modes``. See :doc:`../travelling`.",
+    ),
+    WarningEntry(
         "Strumming lock-in (or resonance) predicted",
         "PhysicsWarning",
         ("stochcable.dynamics.model.strumming:with_strumming",),

@@ -13,7 +13,8 @@ Output document (JSON)::
 A travelling line (``axial_speed`` ≠ 0) lists its complex modes (docs/travelling.md): its
 entry adds ``growth`` (Re λ, [1/s]), ``axial_speed``, ``critical_speed`` (√(T/m) at the
 lowest-tension point, [m/s]) and ``stability`` ("stable", "divergence", "flutter"); a
-speed at or above the critical speed is refused, naming it.
+speed at or above the critical speed is refused, naming it.  ``--plot`` draws the lines
+at rest only.
 
 The top-level ``modes.omega`` repeats the first line's frequencies so that the document
 satisfies DESIGN.md's result contract (``"modes": {"omega": [...]}``) for the common
@@ -90,17 +91,17 @@ def run(args: argparse.Namespace) -> int:
         )
     models = scene_fe_models(scene, dim=args.dim)
     speeds = check_line_speeds(scene.lines, models)
-    modes = {
-        name: natural_modes(model, count=count, added_mass=not args.in_air)
-        for name, model in models.items()
-    }
-    lines = {name: m.to_document() for name, m in modes.items()}
-    for name, c in speeds.items():  # travelling lines: complex modes (docs/travelling.md)
-        lines[name] = modes_document(models[name], c, count, added_mass=not args.in_air)
+    lines, modes = {}, {}
+    for name, model in models.items():  # travelling lines: complex modes (docs/travelling.md)
+        if name in speeds:
+            lines[name] = modes_document(model, speeds[name], count, added_mass=not args.in_air)
+        else:
+            modes[name] = natural_modes(model, count=count, added_mass=not args.in_air)
+            lines[name] = modes[name].to_document()
     first = next(iter(lines.values()))
     write_json({"modes": {"omega": first["omega"], "lines": lines}}, args.output)
-    if plt is not None:
-        _plot(plt, models, modes, args.plot)
+    if plt is not None and modes:  # the lines at rest (--plot draws no complex modes)
+        _plot(plt, {name: models[name] for name in modes}, modes, args.plot)
     return 0
 
 
