@@ -356,3 +356,39 @@ def test_real_modes_of_a_travelling_line_warn():
 
     with pytest.warns(PhysicsWarning, match="travels: these are its modes at rest"):
         modes_of_scene(_taut_scene(1.0), count=2)
+
+
+def test_statics_of_a_travelling_line_with_axial_drag_is_the_fe():
+    """The closed-form catenary has no axial drag: a travelling line with one is
+    solved by the FE ("auto" = "fe"), not silently as at rest."""
+    from stochcable.scene.model import load_scene
+    from stochcable.statics import solve_statics
+
+    doc = {
+        "environment": {"depth": 100.0, "rho": 1025.0},
+        "lines": [
+            {
+                "name": "lay",
+                "end_a": {"position": [0.0, 0.0, -90.0]},
+                "end_b": {"position": [60.0, 0.0, -5.0]},
+                "axial_speed": -3.0,
+                "segments": [
+                    {
+                        "length": 110.0,
+                        "ea": 1e8,
+                        "mass": 20.0,
+                        "diameter": 0.05,
+                        "cd_axial": 0.05,
+                        "elements": 30,
+                    }
+                ],
+            }
+        ],
+    }
+    auto = solve_statics(load_scene(doc)).lines["lay"]
+    fe = solve_statics(load_scene(doc), method="fe").lines["lay"]
+    np.testing.assert_allclose(auto.tension, fe.tension, rtol=1e-9)
+    doc["lines"][0]["axial_speed"] = 0.0
+    rest = solve_statics(load_scene(doc), method="fe").lines["lay"]
+    # paid out downwards: the drag pulls the line up, the top tension drops
+    assert fe.tension[-1] < rest.tension[-1] - 1.0
