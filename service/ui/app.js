@@ -100,7 +100,7 @@ function facetPlot(node, series, xlabel, ylabel, extra) {
   const xr = (extra && extra.xrange) || pad(Math.min(...xs), Math.max(...xs));
   const yr = (extra && extra.yrange) || pad(Math.min(...ys), Math.max(...ys));
   const opts = {
-    mode: 2, width: 600, height: 320,
+    mode: 2, width: 560, height: 320,
     legend: { live: false, show: !(extra && extra.noLegend) }, cursor: { drag: { x: false, y: false } },
     scales: { x: { time: false, range: xr }, y: { range: yr } },
     axes: [{ label: xlabel, values: (u, vals) => vals.map(tick) },

@@ -256,15 +256,17 @@ def _tab_to(page, element_id: str, limit: int = 60) -> None:
 
 @pytest.mark.slow
 def test_keyboard_only(browser, server):
+    # the disc buoy: a body, warnings with their fixes, foot-slug-second units
+    example = "tuah_1982_disc_buoy_single_leg"
     page, errors = _page(browser, server.url + "/")
-    page.wait_for_selector(f"#example-select option[value={EXAMPLE}]", state="attached")
+    page.wait_for_selector(f"#example-select option[value={example}]", state="attached")
     _tab_to(page, "example-select")
     names = page.locator("#example-select option").evaluate_all("os => os.map(o => o.value)")
-    for _ in range(names.index(EXAMPLE)):
+    for _ in range(names.index(example)):
         page.keyboard.press("ArrowDown")  # a closed select changes on arrows
     _tab_to(page, "example-load")
     page.keyboard.press("Enter")
-    page.wait_for_function("document.getElementById('scene-text').value.includes('leg1')")
+    page.wait_for_function("document.getElementById('scene-text').value.includes('disc')")
     _tab_to(page, "run")
     page.keyboard.press("Enter")
     page.wait_for_selector("#result:not([hidden])")
@@ -275,17 +277,22 @@ def test_keyboard_only(browser, server):
     with page.expect_download() as dl:
         page.keyboard.press("Enter")
     doc = json.loads(Path(dl.value.path()).read_text())
-    assert doc["lines"]["leg1"]["end_b"]["tension"]["std"] > 0
+    assert doc["lines"]["leg"]["end_b"]["tension"]["std"] > 0
     page.keyboard.press("Tab")
     page.keyboard.press("Tab")
     assert page.evaluate("document.activeElement.id") == "dl-csv"
     with page.expect_download() as dl:
         page.keyboard.press("Enter")
     csv = Path(dl.value.path()).read_text().splitlines()
-    assert csv[0] == "line,end,mean [N],std [N],tz [s],mpm_3h [N]" and len(csv) == 3
+    assert csv[0] == "line,end,mean [lbf],std [lbf],tz [s],mpm_3h [lbf]" and len(csv) == 3
     # every control shows where the focus is
     outline = page.evaluate("getComputedStyle(document.activeElement).outlineStyle")
     assert outline == "solid"
+    # the body is drawn, and every warning is listed whole (with its fix)
+    assert "body disc" in page.locator("#profile-plot .u-legend").inner_text()
+    listed = page.locator("#warnings-list li").all_inner_texts()
+    assert listed == doc["warnings"] and len(listed) >= 1
+    _shot(page, "web_bodies", "#result")
     assert errors == []
     page.close()
 
