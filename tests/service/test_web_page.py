@@ -222,11 +222,20 @@ def test_batch_progress_heat_map_and_delete(browser, server):
     _load_example(page)
     page.fill("#scatter-text", SCATTER_CSV)
     page.fill("#batch-headings", "0, 30")
+    # every progress message the page shows, as it shows it
+    page.evaluate(
+        """() => { window.seen = [];
+        new MutationObserver(() => window.seen.push(
+            document.getElementById('job-progress-text').textContent))
+          .observe(document.getElementById('job-progress-text'), {childList: true}); }"""
+    )
     page.click("#batch-submit")
     page.wait_for_selector("#job:not([hidden])")
     page.wait_for_selector("#job-results:not([hidden])")
     assert page.locator("#job-progress").evaluate("e => e.value") == 1
     assert "done: 12 of 12 cases" in page.inner_text("#job-progress-text")
+    seen = page.evaluate("window.seen")
+    assert re.match(r"(queued|running): \d+ of 12 cases", seen[0]), seen  # live, before done
     assert page.locator("#heatmap-plot canvas").count() == 1
     assert page.locator("#cases-table tbody tr").count() == 12
     job_id = page.inner_text("#job-title").split()[-1]
@@ -237,11 +246,43 @@ def test_batch_progress_heat_map_and_delete(browser, server):
     cells = page.locator("#cases-table tbody tr td:last-child")
     shown = [float(v) for v in cells.evaluate_all("tds => tds.map(t => t.dataset.value)")]
     assert shown == [c["lines"]["leg1"]["end_b"]["damage_rate"] for c in res["cases"]]
+    # the heat map's colour scale spans the cells' annual damage: probability x damage
+    # rate, summed over the headings of each (Hs, Tp) cell
+    year = 365.25 * 86400.0
+    cells: dict = {}
+    for c in res["cases"]:
+        key = (c["hs"], c["tp"])
+        cells[key] = (
+            cells.get(key, 0.0)
+            + c["probability"] * c["lines"]["leg1"]["end_b"]["damage_rate"] * year
+        )
+    low, high = page.locator("#heatmap-legend span:not(.bar)").all_inner_texts()
+    assert float(high.split()[0].replace(",", "")) == pytest.approx(max(cells.values()), rel=5e-4)
+    assert float(low.split()[0].replace(",", "")) == pytest.approx(min(cells.values()), rel=5e-4)
     _shot(page, "web_batch", "#batches")
     # delete the finished batch from the page: gone from the API
     page.click("#job-cancel")
     page.wait_for_selector("#job", state="hidden")
     assert httpx.get(f"{server.url}/v1/batches/{job_id}").status_code == 404
+    assert errors == []
+    page.close()
+
+
+@pytest.mark.slow
+def test_fidelity_plan_is_shown(browser, server):
+    page, errors = _page(browser, server.url + "/")
+    _load_example(page, "taut_wire")
+    scene = json.loads(page.input_value("#scene-text"))
+    scene["analysis"]["fidelity"] = {"target_error": 0.05}
+    page.fill("#scene-text", json.dumps(scene))
+    page.click("#run")
+    page.wait_for_selector("#fidelity:not([hidden])")
+    plan = server.post(scene, timeout=180).json()["fidelity"]
+    rows = page.locator("#fidelity-table tbody tr")
+    assert rows.count() == len(plan["choices"]) > 0
+    first = rows.first.locator("td").all_inner_texts()
+    assert first[0] == plan["choices"][0]["setting"] and first[2] == plan["choices"][0]["reason"]
+    assert "Target error 0.05" in page.inner_text("#fidelity-meta")
     assert errors == []
     page.close()
 
