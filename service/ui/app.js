@@ -320,10 +320,16 @@ async function submitBatch() {
     state.batchForce = forceUnit((scene.environment && scene.environment.g) || 9.80665);
     const heads = $("batch-headings").value.trim();
     if (heads) body.headings = heads.split(",").map((h) => Number(h.trim()));
-    const fat = { curve: $("batch-curve").value.trim() || "dnv-studless" };
-    const d = Number($("batch-diameter").value);
-    if ($("batch-diameter").value && d > 0) fat.nominal_diameter = d;
-    body.fatigue = fat;
+    const curve = $("batch-curve").value.trim();
+    if (curve) {
+      const fat = { curve, method: $("batch-method").value };
+      const fields = { nominal_diameter: "batch-diameter", nominal_area: "batch-area", mbs: "batch-mbs",
+        mean_load_ratio: "batch-mlr", design_factor: "batch-dff" };
+      for (const [k, id] of Object.entries(fields)) {
+        if ($(id).value.trim() !== "") fat[k] = Number($(id).value);
+      }
+      body.fatigue = fat;
+    }
   } catch (e) { showError(box, e); return; }
   $("batch-submit").disabled = true;
   try {
@@ -446,15 +452,23 @@ function drawHeatmap(cases, ln, end) {
   const pts = [...cells].map(([k, v]) => { const [h, t] = k.split("|").map(Number); return { h, t, v }; });
   const pos = pts.filter((p) => p.v > 0).map((p) => Math.log10(p.v));
   const lo = pos.length ? Math.min(...pos) : 0, hi = pos.length ? Math.max(...pos) : 1;
-  const dt = step(pts.map((p) => p.t)), dh = step(pts.map((p) => p.h));
+  // cell sizes: the Hs class step, and the Tp step within each Hs row (a diagram in Tz
+  // classes has its Tp off any common grid: each row's Tp = Tz × a factor of its Hs)
+  const dh = step(pts.map((p) => p.h)), dtAll = step(pts.map((p) => p.t));
+  const rowStep = new Map();
+  for (const h of new Set(pts.map((p) => p.h))) {
+    const row = pts.filter((p) => p.h === h).map((p) => p.t);
+    rowStep.set(h, row.length > 1 ? step(row) : dtAll);
+  }
+  for (const p of pts) p.w = rowStep.get(p.h);
   const ts = pts.map((p) => p.t), hs = pts.map((p) => p.h);
-  const xr = [Math.min(...ts) - dt / 2, Math.max(...ts) + dt / 2];
+  const xr = [Math.min(...pts.map((p) => p.t - p.w / 2)), Math.max(...pts.map((p) => p.t + p.w / 2))];
   const yr = [Math.min(0, Math.min(...hs) - dh / 2), Math.max(...hs) + dh / 2];
   const drawCells = (u) => {
     const ctx = u.ctx;
     ctx.save();
     for (const p of pts) {
-      const x0 = u.valToPos(p.t - dt / 2, "x", true), x1 = u.valToPos(p.t + dt / 2, "x", true);
+      const x0 = u.valToPos(p.t - p.w / 2, "x", true), x1 = u.valToPos(p.t + p.w / 2, "x", true);
       const y0 = u.valToPos(p.h + dh / 2, "y", true), y1 = u.valToPos(p.h - dh / 2, "y", true);
       ctx.fillStyle = p.v > 0 ? viridis((Math.log10(p.v) - lo) / ((hi - lo) || 1)) : "#ddd";
       ctx.fillRect(x0, y0, x1 - x0, y1 - y0);

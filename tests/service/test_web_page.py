@@ -24,8 +24,10 @@ from fastapi.testclient import TestClient
 from service.app import create_app
 from service.routers.ui import ASSETS
 from service.settings import Settings
+from stochcable.cases import read_scatter
 
 UI = Path(__file__).resolve().parents[2] / "service" / "ui"
+EXAMPLES = UI.parents[1] / "stochcable" / "examples"
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = [
     "--headless",
@@ -267,6 +269,27 @@ def test_batch_progress_heat_map_and_delete(browser, server):
     page.click("#job-cancel")
     page.wait_for_selector("#job", state="hidden")
     assert httpx.get(f"{server.url}/v1/batches/{job_id}").status_code == 404
+    assert errors == []
+    page.close()
+
+
+@pytest.mark.slow
+def test_bundled_diagram_and_wire_rope_settings(browser, server):
+    # the bundled North Atlantic diagram (Tz classes: Tp off a common grid) on the taut
+    # wire with the DNV spiral-strand curve, which takes a nominal area
+    page, errors = _page(browser, server.url + "/")
+    _load_example(page, "taut_wire")
+    page.click("#scatter-example")
+    page.wait_for_function("document.getElementById('scatter-text').value.includes('hs,tz')")
+    page.fill("#batch-curve", "dnv-spiral-strand")
+    page.fill("#batch-diameter", "")
+    page.fill("#batch-area", "0.0015")
+    page.click("#batch-submit")
+    page.wait_for_selector("#job-results:not([hidden])")
+    n = len(read_scatter(EXAMPLES / "scatter_north_atlantic.csv").states)
+    assert page.locator("#cases-table tbody tr").count() == n
+    assert "wire end_a: annual damage" in page.inner_text("#job-totals")
+    _shot(page, "web_heatmap", "#job")
     assert errors == []
     page.close()
 
