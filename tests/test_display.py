@@ -90,7 +90,7 @@ def test_result_repr_names_units_bodies_and_warnings(disc):
     text = repr(disc)
     assert "end tension σ [lbf]" in text
     assert "bodies: disc" in text
-    assert f"warnings: {len(disc.warnings)} (result.warnings)" in text and disc.warnings
+    assert f"warnings: {len(disc.warnings)} (.warnings)" in text and disc.warnings
 
 
 def test_result_html_is_a_table_with_units_and_warnings(disc):
@@ -193,3 +193,16 @@ def test_batch_job_repr_and_html():
     assert "case 3: flagged" in body and "2026-01-01T00:00:00Z" in body
     failed = BatchJob.from_document(_status(status="failed", error="<boom>"))
     assert repr(failed).endswith("error: <boom>>") and "&lt;boom&gt;" in failed._repr_html_()
+
+
+def test_service_document_summary_matches_the_result(disc):
+    # the client's AnalysisDocument (the result document read back) shows what the
+    # Result shows, apart from the first line (the document carries no scene title)
+    from stochcable.results.views import AnalysisDocument
+
+    doc = AnalysisDocument(disc.to_document())
+    assert repr(doc).splitlines()[1:] == repr(disc).splitlines()[1:]
+    assert repr(doc).startswith("<stochcable AnalysisDocument: result of the service>")
+    page = doc._repr_html_()
+    body = "".join(_parse(page).text)
+    assert "σ [lbf]" in body and all(w in body for w in disc.warnings)

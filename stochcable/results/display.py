@@ -12,6 +12,7 @@ from __future__ import annotations
 import html
 import math
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from stochcable.scene.units import unit_labels
@@ -25,6 +26,8 @@ __all__ = [
     "html_block",
     "result_text",
     "result_html",
+    "document_text",
+    "document_html",
     "batch_status_text",
     "batch_status_html",
 ]
@@ -88,14 +91,24 @@ def _short(text: str) -> str:
     return text if len(text) <= TITLE_CHARS else text[: TITLE_CHARS - 1] + "…"
 
 
-def _units(result: Any) -> Any:
-    env = getattr(result.scene, "environment", None)
-    return unit_labels(env.g if env is not None else 9.80665)
+@dataclass(frozen=True)
+class _Summary:
+    """What both summaries show, from a Result or from a result document."""
+
+    kind: str
+    title: str
+    force: str
+    time: str
+    lines: list[tuple[str, bool, int, float]]  # name, converged, iterations, change
+    ends: list[tuple[str, str, float, float, float, float]]  # line, end, mean, σ, Tz, MPM
+    warnings: tuple[str, ...]
+    bodies: tuple[str, ...] = ()
+    target_error: float | None = None
 
 
-def _end_rows(result: Any) -> list[tuple[str, str, float, float, float, float]]:
+def _ends(lines: Any) -> list[tuple[str, str, float, float, float, float]]:
     rows = []
-    for name, line in result.lines.items():
+    for name, line in lines.items():
         for end in ENDS:
             st = getattr(line, end, None)
             if st is not None:
@@ -103,62 +116,105 @@ def _end_rows(result: Any) -> list[tuple[str, str, float, float, float, float]]:
     return rows
 
 
+def _of_result(result: Any) -> _Summary:
+    env = getattr(result.scene, "environment", None)
+    units = unit_labels(env.g if env is not None else 9.80665)
+    lin = [
+        (n, r.linearization.converged, r.linearization.iterations, r.linearization.relative_change)
+        for n, r in result.lines.items()
+    ]
+    fid = result.fidelity
+    return _Summary(
+        "Result",
+        getattr(result.scene, "title", "") or "(untitled scene)",
+        units.force,
+        units.time,
+        lin,
+        _ends(result.lines),
+        tuple(result.warnings),
+        tuple(result.bodies),
+        None if fid is None else float(fid.target_error),
+    )
+
+
+def _of_document(doc: Any) -> _Summary:
+    units = doc.get("units") or {}
+    lin = [
+        (n, bool(r.linearization["converged"]), int(r.linearization["iterations"]),
+         float(r.linearization["relative_change"]))
+        for n, r in doc.lines.items()
+    ]  # fmt: skip
+    fid = doc.get("fidelity")
+    return _Summary(
+        "AnalysisDocument",
+        "result of the service",
+        units.get("force", "N"),
+        units.get("time", "s"),
+        lin,
+        _ends(doc.lines),
+        tuple(doc.warnings),
+        tuple(doc.get("bodies") or ()),
+        None if fid is None else float(fid["target_error"]),
+    )
+
+
+def _text(s: _Summary) -> str:
+    lines = ", ".join(
+        f"{name} ({'converged' if ok else 'NOT converged'}, {it} it.)"
+        for name, ok, it, _ in s.lines
+    )
+    sigma = "; ".join(f"{name} {end} {format_value(std)}" for name, end, _, std, _, _ in s.ends)
+    n = len(s.warnings)
+    out = [f"<stochcable {s.kind}: {_short(s.title)}>", f"  lines: {lines}"]
+    if s.bodies:
+        out.append(f"  bodies: {', '.join(s.bodies)}")
+    out.append(f"  end tension σ [{s.force}]: {sigma}")
+    out.append(f"  warnings: {n}" + (" (.warnings)" if n else ""))
+    if s.target_error is not None:
+        out.append(f"  fidelity: target error {format_value(s.target_error)}")
+    return "\n".join(out)
+
+
+def _html(s: _Summary) -> str:
+    f, t = s.force, s.time
+    stats = html_table(
+        ["line", "end", f"mean [{f}]", f"σ [{f}]", f"Tz [{t}]", f"MPM 3 h [{f}]"],
+        s.ends,
+        caption="End-tension statistics",
+    )
+    lin = html_table(
+        ["line", "linearization", "iterations", "relative change [-]"],
+        [(n, "converged" if ok else "NOT converged", it, ch) for n, ok, it, ch in s.lines],
+    )
+    warn = (
+        f"<p>{len(s.warnings)} warning(s):</p>" + html_list(s.warnings)
+        if s.warnings
+        else "<p>No warnings.</p>"
+    )
+    return html_block(f"stochcable {s.kind}: {s.title}", [stats, lin, warn])
+
+
 def result_text(result: Any) -> str:
     """A few lines on a :class:`~stochcable.results.documents.Result`: title, lines with
-    their linearization, end-tension σ with units, the number of warnings."""
-    units = _units(result)
-    title = _short(getattr(result.scene, "title", "") or "(untitled scene)")
-    lines = ", ".join(
-        f"{name} ({'converged' if r.linearization.converged else 'NOT converged'}, "
-        f"{r.linearization.iterations} it.)"
-        for name, r in result.lines.items()
-    )
-    sigma = "; ".join(
-        f"{name} {end} {format_value(std)}" for name, end, _, std, _, _ in _end_rows(result)
-    )
-    n = len(result.warnings)
-    out = [
-        f"<stochcable Result: {title}>",
-        f"  lines: {lines}",
-        f"  end tension σ [{units.force}]: {sigma}",
-        f"  warnings: {n}" + (" (result.warnings)" if n else ""),
-    ]
-    if result.bodies:
-        out.insert(2, f"  bodies: {', '.join(result.bodies)}")
-    if result.fidelity is not None:
-        out.append(f"  fidelity: target error {format_value(result.fidelity.target_error)}")
-    return "\n".join(out)
+    their linearization, bodies, end-tension σ with units, the number of warnings."""
+    return _text(_of_result(result))
 
 
 def result_html(result: Any) -> str:
     """An HTML summary of a result: the end-tension statistics with units, the
     linearization per line and the warnings."""
-    units = _units(result)
-    f, t = units.force, units.time
-    stats = html_table(
-        ["line", "end", f"mean [{f}]", f"σ [{f}]", f"Tz [{t}]", f"MPM 3 h [{f}]"],
-        _end_rows(result),
-        caption="End-tension statistics",
-    )
-    lin = html_table(
-        ["line", "linearization", "iterations", "relative change [-]"],
-        [
-            (
-                name,
-                "converged" if r.linearization.converged else "NOT converged",
-                r.linearization.iterations,
-                r.linearization.relative_change,
-            )
-            for name, r in result.lines.items()
-        ],
-    )
-    warn = (
-        f"<p>{len(result.warnings)} warning(s):</p>" + html_list(result.warnings)
-        if result.warnings
-        else "<p>No warnings.</p>"
-    )
-    title = getattr(result.scene, "title", "") or "(untitled scene)"
-    return html_block(f"stochcable Result: {title}", [stats, lin, warn])
+    return _html(_of_result(result))
+
+
+def document_text(document: Any) -> str:
+    """:func:`result_text` of a result document read back from the service
+    (:class:`~stochcable.results.views.AnalysisDocument`)."""
+    return _text(_of_document(document))
+
+
+def document_html(document: Any) -> str:
+    """:func:`result_html` of a result document read back from the service."""
+    return _html(_of_document(document))
 
 
 def _progress(status: Any) -> str:
