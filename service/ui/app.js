@@ -130,30 +130,36 @@ function interp(s, values, at) {
   return values[values.length - 1];
 }
 
+const VIEWS = { xz: [0, 2], yz: [1, 2], xy: [0, 1] };  // node coordinates drawn
+
 function drawProfile(doc, scene, units) {
+  const view = $("profile-view").value || "xz";
+  const [i0, i1] = VIEWS[view];
   const series = [];
   let i = 0;
   for (const [name, st] of Object.entries(doc.statics.lines)) {
-    const x = st.nodes.map((n) => n[0]), z = st.nodes.map((n) => n[2]);
-    series.push({ label: name, x, y: z, color: COLORS[i++ % COLORS.length] });
+    const a = st.nodes.map((n) => n[i0]), b = st.nodes.map((n) => n[i1]);
+    series.push({ label: name, x: a, y: b, color: COLORS[i++ % COLORS.length] });
     if (st.touchdown != null && st.s) {
-      series.push({ label: `${name} touchdown`, x: [interp(st.s, x, st.touchdown)],
-        y: [interp(st.s, z, st.touchdown)], marker: true, color: "#a51b0b" });
+      series.push({ label: `${name} touchdown`, x: [interp(st.s, a, st.touchdown)],
+        y: [interp(st.s, b, st.touchdown)], marker: true, color: "#a51b0b" });
     }
   }
   const allx = series.flatMap((s) => s.x);
   const depth = scene && scene.environment && scene.environment.depth;
-  if (depth != null) {
-    series.unshift({ label: "seabed", x: [Math.min(...allx), Math.max(...allx)],
-      y: [-depth, -depth], color: "#8b6b3d" });
-    series.unshift({ label: "still water", x: [Math.min(...allx), Math.max(...allx)], y: [0, 0],
-      color: "#7fb3d5" });
+  if (depth != null && view !== "xy") {
+    const span = [Math.min(...allx), Math.max(...allx)];
+    series.unshift({ label: "seabed", x: span, y: [-depth, -depth], color: "#8b6b3d" });
+    series.unshift({ label: "still water", x: span, y: [0, 0], color: "#7fb3d5" });
   }
-  for (const [name, b] of Object.entries(doc.statics.bodies || {})) {
-    series.push({ label: `body ${name}`, x: [b.position[0]], y: [b.position[2]], marker: true,
+  for (const [name, body] of Object.entries(doc.statics.bodies || {})) {
+    series.push({ label: `body ${name}`, x: [body.position[i0]], y: [body.position[i1]], marker: true,
       color: "#333" });
   }
-  facetPlot($("profile-plot"), series, `x [${units.length}]`, `z [${units.length}]`);
+  const old = state.plots.indexOf(state.profile);
+  if (old >= 0) { state.profile.destroy(); state.plots.splice(old, 1); }
+  const L = units.length;
+  state.profile = facetPlot($("profile-plot"), series, `${"xyz"[i0]} [${L}]`, `${"xyz"[i1]} [${L}]`);
 }
 
 function drawSpectra(doc, units) {
@@ -212,6 +218,7 @@ async function runAnalysis() {
     state.doc = doc; state.sceneText = text;
     let scene = null;
     try { scene = JSON.parse(text); } catch (e) { /* the server accepted it */ }
+    state.scene = scene;
     showResult(doc, scene);
     $("run-status").textContent = `Done in ${((performance.now() - t0) / 1000).toFixed(1)} s.`;
     $("result-title").focus();
@@ -535,6 +542,9 @@ function bind() {
   $("dl-json").addEventListener("click", () => save(new Blob([JSON.stringify(state.doc)], { type: "application/json" }), "result.json"));
   $("dl-csv").addEventListener("click", () => save(new Blob([statsCsv(state.doc)], { type: "text/csv" }), "statistics.csv"));
   $("dl-netcdf").addEventListener("click", downloadNetcdf);
+  $("profile-view").addEventListener("change", () => {
+    if (state.doc) drawProfile(state.doc, state.scene, state.doc.units || { length: "m" });
+  });
   $("batch-submit").addEventListener("click", submitBatch);
   $("jobs-refresh").addEventListener("click", refreshJobs);
   for (const k of ["csv", "netcdf", "json"]) $(`job-${k}`).addEventListener("click", () => jobDownload(k));

@@ -175,6 +175,12 @@ def test_example_result_is_drawn_with_the_api_sigma(browser, server):
     assert page.locator("#spectra-plot canvas").count() == 1
     legend = page.locator("#profile-plot .u-legend").inner_text()
     assert "leg1" in legend and "seabed" in legend and "touchdown" in legend
+    # the plan view: no seabed or water line, the lines still drawn
+    page.select_option("#profile-view", "xy")
+    legend = page.locator("#profile-plot .u-legend").inner_text()
+    assert "seabed" not in legend and "leg1" in legend
+    assert page.locator("#profile-plot canvas").count() == 1
+    page.select_option("#profile-view", "xz")
     headers = page.locator("#stats-table thead").inner_text()
     assert "σ [N]" in headers and "Tz [s]" in headers and "MPM 3 h [N]" in headers
     shown = float(page.get_attribute("#stats-table td[data-name='leg1.end_b.std']", "data-value"))
