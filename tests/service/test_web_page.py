@@ -301,6 +301,27 @@ def test_bundled_diagram_and_wire_rope_settings(browser, server):
 
 
 @pytest.mark.slow
+def test_cancel_a_running_batch(browser, server):
+    page, errors = _page(browser, server.url + "/")
+    _load_example(page, "taut_wire")
+    page.click("#scatter-example")  # 111 cases: about 20 s on one batch worker
+    page.wait_for_function("document.getElementById('scatter-text').value.includes('hs,tz')")
+    page.fill("#batch-curve", "")  # extremes only
+    page.click("#batch-submit")
+    page.wait_for_selector("#job:not([hidden])")
+    assert page.inner_text("#job-cancel") == "Cancel"
+    page.click("#job-cancel")
+    page.wait_for_function(
+        "document.getElementById('job-progress-text').textContent.startsWith('cancelled')"
+    )
+    job_id = page.inner_text("#job-title").split()[-1]
+    assert httpx.get(f"{server.url}/v1/batches/{job_id}").json()["status"] == "cancelled"
+    assert page.inner_text("#job-cancel") == "Delete" and page.is_hidden("#job-results")
+    assert errors == []
+    page.close()
+
+
+@pytest.mark.slow
 def test_fidelity_plan_is_shown(browser, server):
     page, errors = _page(browser, server.url + "/")
     _load_example(page, "taut_wire")
