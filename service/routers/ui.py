@@ -61,4 +61,4 @@ def asset(name: Annotated[str, Path(max_length=64)]) -> Response:
     """A file of the page (only those of :data:`ASSETS`)."""
     if name not in ASSETS:
         raise NotFound(["path", "name"], f"no page asset {name!r}")
-    return Response(_read(name), media_type=ASSETS[name], headers={"Cache-Control": "max-age=3600"})
+    return Response(_read(name), media_type=ASSETS[name], headers={"Cache-Control": "no-cache"})
