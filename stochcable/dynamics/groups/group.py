@@ -47,6 +47,7 @@ from stochcable.bodies.rigid import (
     attachment_geometric_stiffness,
     rigid_link_matrix,
 )
+from stochcable.dynamics.groups.fixed_point_state import Evaluation, EvaluationCount
 from stochcable.dynamics.groups.freeline import FreeLine
 from stochcable.dynamics.groups.inputs import BodyLoads, CoupledLine, unit_channels
 from stochcable.dynamics.groups.lineparts import FossLine, ModalLine, line_parts
@@ -64,7 +65,7 @@ __all__ = [
     "body_drag_matrix",
     "body_sigma",
     "linear_body_drag",
-    "sigma_update",
+    "SigmaMap",
     "solve_group",
 ]
 
@@ -466,16 +467,7 @@ def _solve_body(s: np.ndarray, g: np.ndarray) -> np.ndarray:
 # ------------------------------------------------------------ the σ map of a group
 
 
-def sigma_update(
-    g: GroupSystem,
-    method: str,
-    rho: float,
-    state: dict[str, Any],
-    cache: dict[str, Any],
-    progress: Progress,
-    names: str,
-    timing: dict[str, float] | None,
-) -> Any:
+class SigmaMap:
     """The fixed-point map σ → σ(response to the drag of σ) of a group.
 
     Parameters
@@ -487,32 +479,48 @@ def sigma_update(
         (:func:`stochcable.dynamics.linearization.variance.drag_coefficients`).
     rho : float
         Water density. [kg/m³]
-    state : dict
-        Shared record: ``"it"`` the evaluation count, ``"change"`` the last
-        :func:`relative_change`.
-    cache : dict
-        Receives the last evaluation's ``damping``, ``sol``, ``xi``, ``sigma``,
-        ``body_b``.
+    count : EvaluationCount
+        Shared record: the evaluation count and the last :func:`relative_change`.
     progress : callable
         ``progress("linearization", {"group", "iteration", "change"})``.
     names : str
         The group's line names (progress).
     timing : dict, optional
         Accumulates ``solve_s``. [s]
+    keep_last : bool, optional
+        Keep the last evaluation as :attr:`last` (the full grid's, whose outcome is
+        the fixed point's); False: keep nothing (the coarse map reads its σ only).
 
-    Returns
-    -------
-    callable
-        x (lines' σ then bodies' σ, [m/s]) → the σ of the response to the drag of x;
-        ``.state`` is ``state``.
+    Attributes
+    ----------
+    last : Evaluation or None
+        The last evaluation (released when the next one starts).
     """
-    state.setdefault("it", 0)
-    alone = len(g.lines) == 1 and not g.bodies
 
-    def update(x: np.ndarray) -> np.ndarray:
+    def __init__(
+        self,
+        g: GroupSystem,
+        method: str,
+        rho: float,
+        count: EvaluationCount,
+        progress: Progress,
+        names: str,
+        timing: dict[str, float] | None,
+        *,
+        keep_last: bool = True,
+    ) -> None:
+        self.g, self.method, self.rho, self.count = g, method, rho, count
+        self.progress, self.names, self.timing = progress, names, timing
+        self.keep_last = keep_last
+        self.last: Evaluation | None = None
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """x (lines' σ then bodies' σ, [m/s]) → the σ of the response to the drag of
+        x. [m/s]"""
+        g, method = self.g, self.method
         # the last evaluation's response is released before this one is solved (the
-        # outcome reads the cache of the last evaluation only)
-        cache.pop("sol", None)
+        # outcome reads the last evaluation only)
+        self.last = None
         ls, bs = g.split(x)
         if g.start_drag is not None and x is g.start_drag[0]:  # the start's drag, known
             damp = dict(g.start_drag[1])
@@ -523,7 +531,7 @@ def sigma_update(
         for b in g.drag:
             bb, c = linear_body_drag(
                 b,
-                rho,
+                self.rho,
                 bs[b.name],
                 g.loads[b.name].current if b.name in g.loads else np.zeros(3),
                 method,
@@ -531,7 +539,7 @@ def sigma_update(
             sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
             body_c[sl, sl] += c
             body_b[b.name] = bb
-        sol, xi = solve_group(g, damp, body_c, body_b, timing, lazy=True)
+        sol, xi = solve_group(g, damp, body_c, body_b, self.timing, lazy=True)
         new = []
         for cl in g.lines:
             part = sol[cl.name]
@@ -542,15 +550,13 @@ def sigma_update(
         for b in g.drag:
             new.append(body_sigma(g, b, xi))
         new = np.concatenate(new) if new else np.zeros(0)
-        state["it"] += 1
+        self.count.iterations += 1
         change = relative_change(new, x)
-        state["change"] = change
-        info = {"group": names, "iteration": state["it"], "change": change}
-        if alone:  # one line without bodies: named as a line
-            info["line"] = names
-        progress("linearization", info)
-        cache.update(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
+        self.count.change = change
+        info = {"group": self.names, "iteration": self.count.iterations, "change": change}
+        if len(g.lines) == 1 and not g.bodies:  # one line without bodies: named as a line
+            info["line"] = self.names
+        self.progress("linearization", info)
+        if self.keep_last:
+            self.last = Evaluation(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
         return new
-
-    update.state = state  # type: ignore[attr-defined]
-    return update
