@@ -47,6 +47,7 @@ from stochcable.dynamics.model.system import (
 )
 from stochcable.dynamics.timeseries.synthesis import simulate_timeseries
 from stochcable.errors import InputError, collect_warnings
+from stochcable.line.strumming import StrummingTable
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, Sea, input_error_from_validation, load_scene
 from stochcable.statics import StaticsResult, solve_statics
@@ -93,7 +94,7 @@ class Engine:
     model: CoupledModel
     timing: Mapping[str, float]
     warnings: tuple[str, ...]
-    strumming: Mapping[str, Any] = field(default_factory=dict)  # StrummingTable by line
+    strumming: Mapping[str, StrummingTable | None] = field(default_factory=dict)
 
     def solve(
         self, sea: Sea | Mapping[str, Any] | None = None, *, progress: Progress | None = None
@@ -211,7 +212,7 @@ def build_engine(
         )
     timing = {"statics_s": 0.0, "model_s": 0.0}
     systems: dict[str, LineSystem] = {}
-    strumming: dict[str, Any] = {}
+    strumming: dict[str, StrummingTable | None] = {}
     with collect_warnings() as caught, runtime.analysis_blas(is_small(scene)):
         progress("statics", {})
         t0 = time.perf_counter()

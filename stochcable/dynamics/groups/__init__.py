@@ -13,9 +13,13 @@ line part being its own response
 Modules, lowest first (each imports only the ones above it):
 
 - :mod:`~stochcable.dynamics.groups.freeline`: the line part of a line alone;
+- :mod:`~stochcable.dynamics.groups.fixed_point_state`: the fixed point's typed state
+  (its run, one evaluation, the evaluation count);
 
 - :mod:`~stochcable.dynamics.groups.inputs`: a group's lines (:class:`CoupledLine`),
   body loads, vessel-driven ends and the group's channels;
+- :mod:`~stochcable.dynamics.groups.modal_parts`: a line's Foss state-modal and modal
+  parts;
 - :mod:`~stochcable.dynamics.groups.lineparts`: a line before the body solve (node
   level, Foss state-modal, modal per frequency), linear in its end motion;
 - :mod:`~stochcable.dynamics.groups.group`: the group on a grid

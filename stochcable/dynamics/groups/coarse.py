@@ -11,7 +11,7 @@ of :mod:`stochcable.dynamics`); subset frequencies whose σ weight is at most
 ``COARSE_NEGLIGIBLE`` (1e-12) of the largest in every channel (the spectrum's empty
 tail) are then left out (their σ contributions are below round-off).  A Foss line
 solves its modal equations per frequency there
-(:class:`~stochcable.dynamics.groups.lineparts.ModalLine`: the same modal system, no
+(:class:`~stochcable.dynamics.groups.modal_parts.ModalLine`: the same modal system, no
 Foss eigenproblem).  Then, at the coarse map's last input x, one full-grid evaluation
 F(x); while its relative change exceeds the tolerance, a defect correction: the
 coarse map scaled by the ratio r = F(x)/G(x) (per component, clipped to [0.1, 10])
@@ -256,7 +256,7 @@ def coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
     from the full grid's (:func:`stochcable.dynamics.linearization.coarse_grid.subset_inputs`), Foss
     lines
     solved per frequency in modal coordinates
-    (:class:`~stochcable.dynamics.groups.lineparts.ModalLine`); the frequencies of negligible
+    (:class:`~stochcable.dynamics.groups.modal_parts.ModalLine`); the frequencies of negligible
     σ weight (``COARSE_NEGLIGIBLE``) left out after the weights are formed."""
     spectra = np.stack([c.spectrum for c in g.channels], axis=1)[idx]
     quadrature = interpolatory_weights(g.omega, idx)

@@ -16,17 +16,18 @@ own solve costs.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 
 from stochcable.dynamics.linearization.variance import sigmas_from_free
-from stochcable.dynamics.loads.freqblocks import frequency_slices
+from stochcable.dynamics.loads.freqblocks import FrequencyIndex, frequency_slices
 from stochcable.dynamics.model.blocks import line_prep, to_freq
 from stochcable.dynamics.model.system import Damping, LineSystem
 from stochcable.dynamics.solve.line_loads import end_following_at, end_loads
 from stochcable.dynamics.solve.line_solve import reactions, solve_free, total_displacement
+from stochcable.dynamics.solve.node_inputs import LineInputs
 
 __all__ = ["FreeLine"]
 
@@ -55,7 +56,7 @@ class FreeLine:
     """
 
     def __init__(
-        self, system: LineSystem, inp: Any, damping: Damping, modal_direct: bool = False
+        self, system: LineSystem, inp: LineInputs, damping: Damping, modal_direct: bool = False
     ) -> None:
         self.system, self.inp, self.damping = system, inp, damping
         self.u_free, self.c = solve_free(system, inp, damping, modal_direct=modal_direct)
@@ -92,7 +93,9 @@ class FreeLine:
             )
         return self._support
 
-    def response(self) -> tuple[Any, Any, np.ndarray]:
+    def response(
+        self,
+    ) -> tuple[Callable[[FrequencyIndex], np.ndarray], Callable[[], np.ndarray], np.ndarray]:
         """The converged response without the whole grid's frequency-major copy:
         ``nodes(freq)``, the total node displacement (n_nodes, d, n_f, n_ch) on a
         slice of the frequencies (:attr:`~stochcable.dynamics.model.system.Response.nodes`);

@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
-from typing import Any
 
 import numpy as np
 
@@ -47,10 +46,11 @@ from stochcable.bodies.rigid import (
     attachment_geometric_stiffness,
     rigid_link_matrix,
 )
-from stochcable.dynamics.groups.fixed_point_state import Evaluation, EvaluationCount
+from stochcable.dynamics.groups.fixed_point_state import Evaluation, EvaluationCount, LineSolution
 from stochcable.dynamics.groups.freeline import FreeLine
 from stochcable.dynamics.groups.inputs import BodyLoads, CoupledLine, unit_channels
-from stochcable.dynamics.groups.lineparts import FossLine, ModalLine, line_parts
+from stochcable.dynamics.groups.lineparts import LinePart, line_parts
+from stochcable.dynamics.groups.modal_parts import FossLine, ModalLine, PartCache
 from stochcable.dynamics.linearization.bodydrag import body_drag_matrix, linear_body_drag
 from stochcable.dynamics.linearization.iteration import relative_change
 from stochcable.dynamics.linearization.variance import drag_coefficients, sigmas_from_nodes
@@ -58,6 +58,7 @@ from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.model.system import Damping, Progress
 from stochcable.dynamics.solve.line_loads import line_inputs
+from stochcable.dynamics.solve.node_inputs import LineInputs
 from stochcable.errors import InputError, SolverError
 
 __all__ = [
@@ -74,12 +75,12 @@ class _LazyInputs(dict):
     """Line name -> inputs of its channels plus its unit end-motion channels, built
     on first access."""
 
-    def __init__(self, lines: Sequence[CoupledLine], phys: Mapping[str, Any]) -> None:
+    def __init__(self, lines: Sequence[CoupledLine], phys: Mapping[str, LineInputs]) -> None:
         super().__init__()
         self._lines = {cl.name: cl for cl in lines}
         self._phys = phys
 
-    def __missing__(self, name: str) -> Any:
+    def __missing__(self, name: str) -> LineInputs:
         cl = self._lines[name]
         units = unit_channels(cl)
         # a line without attached ends has no unit channels: its physical inputs
@@ -147,7 +148,7 @@ class GroupSystem:
         loads: Mapping[str, BodyLoads],
         rho: float,
         channels: Sequence[Channel],
-        inp_phys: Mapping[str, Any] | None = None,
+        inp_phys: Mapping[str, LineInputs] | None = None,
         weights: np.ndarray | None = None,
     ) -> None:
         self.lines = tuple(lines)
@@ -155,9 +156,9 @@ class GroupSystem:
         # modal equations per frequency (ModalLine), no Foss eigenproblem
         self.modal_direct = False
         # per line: the drag-independent arrays of ModalLine
-        self.modal_cache: dict[str, dict[str, Any]] = {}
+        self.modal_cache: dict[str, PartCache] = {}
         # per line: the drag-independent arrays of FossLine (full grid)
-        self.foss_cache: dict[str, dict[str, Any]] = {}
+        self.foss_cache: dict[str, PartCache] = {}
         self.bodies = tuple(bodies)
         self.rho = rho
         names = [b.name for b in bodies]
@@ -197,7 +198,7 @@ class GroupSystem:
             if inp_phys is None
             else dict(inp_phys)
         )
-        self.inp: dict[str, Any] = _LazyInputs(self.lines, self.inp_phys)
+        self.inp: dict[str, LineInputs] = _LazyInputs(self.lines, self.inp_phys)
         self._body_matrices()
         # body loads (n_w, nb, n_ch), drag-point maps
         w = self.omega
@@ -338,7 +339,7 @@ def solve_group(
     timing: dict[str, float] | None,
     *,
     lazy: bool = False,
-) -> tuple[dict[str, Any], np.ndarray]:
+) -> tuple[dict[str, LineSolution], np.ndarray]:
     """One coupled solve of a group for given linear drag (module docstring).
 
     Parameters
@@ -438,7 +439,7 @@ def _solve_free_dofs(g: GroupSystem, s: np.ndarray, rhs: np.ndarray) -> np.ndarr
     return xi
 
 
-def _combine(g: GroupSystem, part: Any, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _combine(g: GroupSystem, part: LinePart, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A line's response with its attached ends moving by ``ue`` (n_w, d·n_att, n_ch)."""
     if isinstance(part, (FossLine, ModalLine, FreeLine)):
         return part.combine(ue)

@@ -24,9 +24,9 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stochcable.bodies.rigid import (
     RigidBody,
@@ -37,6 +37,7 @@ from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.loads.sea_channels import sea_channel_densities, sea_channel_headings
 from stochcable.dynamics.model.system import LineSystem
 from stochcable.errors import InputError
+from stochcable.scene.model import Environment, Line, Scene, Sea
 
 __all__ = [
     "BodyLoads",
@@ -104,7 +105,11 @@ class BodyLoads:
 
 
 def body_loads(
-    body: RigidBody, channels: Sequence[Channel], omega: np.ndarray, sea: Any, environment: Any
+    body: RigidBody,
+    channels: Sequence[Channel],
+    omega: np.ndarray,
+    sea: Sea | None,
+    environment: Environment,
 ) -> BodyLoads:
     """Excitation force and drag-point fluid velocity of a body per channel.
 
@@ -162,7 +167,7 @@ def body_loads(
 
 
 def _excitation(
-    body: RigidBody, w: np.ndarray, beta: float, k: np.ndarray, channel: str, sea: Any
+    body: RigidBody, w: np.ndarray, beta: float, k: np.ndarray, channel: str, sea: Sea | None
 ) -> np.ndarray:
     """:func:`~stochcable.bodies.rigid.body_excitation` at heading ``beta`` [rad]; a
     heading outside the table of a short-crested sea's direction names the direction."""
@@ -188,7 +193,7 @@ def _excitation(
 
 
 def body_gravity_stiffness(
-    body: RigidBody, displaced_volume: float, centre_of_buoyancy: Any, rho: float, g: float
+    body: RigidBody, displaced_volume: float, centre_of_buoyancy: ArrayLike, rho: float, g: float
 ) -> np.ndarray:
     """Restoring of the weight and the buoyancy of a body when it rotates.
 
@@ -228,7 +233,7 @@ def _zero_density(w: np.ndarray) -> np.ndarray:
     return np.zeros_like(np.asarray(w, dtype=float))
 
 
-def sea_only_channels(sea: Any, omega: np.ndarray, g: float) -> tuple[Channel, ...]:
+def sea_only_channels(sea: Sea, omega: np.ndarray, g: float) -> tuple[Channel, ...]:
     """The sea's channels on ``omega`` [rad/s] without line kinematics, the inputs of
     a free-floating body: "sea", or one "sea@<deg>" per direction of a short-crested
     sea with its share of the spectrum
@@ -380,8 +385,8 @@ def group_channels(
 
 
 def scene_line_channels(
-    scene: Any,
-    line: Any,
+    scene: Scene,
+    line: Line,
     system: LineSystem,
     omega: np.ndarray,
     vessels: VesselRaos,

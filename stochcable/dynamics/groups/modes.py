@@ -25,6 +25,7 @@ from stochcable.bodies.rigid import RigidBody, attachment_geometric_stiffness, r
 from stochcable.dynamics.groups.group import body_drag_matrix
 from stochcable.dynamics.groups.inputs import CoupledLine
 from stochcable.dynamics.model.blocks import add_blocks, block_matvec, line_prep
+from stochcable.dynamics.model.system import Damping
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.errors import InputError
 
@@ -357,7 +358,7 @@ def coupled_modal_bandwidths(
     modes: CoupledModes,
     lines: Sequence[CoupledLine],
     bodies: Sequence[RigidBody],
-    line_damping: Mapping[str, Any],
+    line_damping: Mapping[str, Damping],
     body_drag: Mapping[str, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Half-power bandwidths 2ζ_nω_n of the coupled modes: the diagonal of the modal

@@ -8,17 +8,18 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stochcable.bodies.rigid import rigid_link_matrix
 from stochcable.errors import InputError
+from stochcable.scene.model import VesselMotion
 
 __all__ = ["VesselRaos", "fairlead_motion", "vessel_rao"]
 
 
-def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
+def fairlead_motion(rao: ArrayLike, r: ArrayLike) -> np.ndarray:
     """Motion of a point of a prescribed (vessel) body from its 6-DOF RAO.
 
     Parameters
@@ -41,7 +42,7 @@ def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
     return a @ t.T
 
 
-def vessel_rao(motion: Any, omega: np.ndarray, heading: float | None = None) -> np.ndarray:
+def vessel_rao(motion: VesselMotion, omega: np.ndarray, heading: float | None = None) -> np.ndarray:
     """A vessel's 6-DOF motion RAO on the grid for waves travelling toward ``heading``.
 
     Parameters
@@ -75,7 +76,7 @@ class VesselRaos:
     """
 
     omega: np.ndarray
-    motions: Mapping[str, Any]
+    motions: Mapping[str, VesselMotion]
     _kept: dict[tuple[str, float], np.ndarray] = dataclasses.field(default_factory=dict, repr=False)
 
     def __contains__(self, name: object) -> bool:

@@ -14,9 +14,9 @@ All formulas are pure, vectorized over elements (broadcasting over leading axes)
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import special
 
 from stochcable import validation as _v
@@ -36,11 +36,11 @@ _SQRT_2_OVER_PI = math.sqrt(2.0 / math.pi)
 _SQRT_8_OVER_PI = math.sqrt(8.0 / math.pi)
 
 
-def _nonneg_array(name: str, value: Any, unit: str) -> np.ndarray:
+def _nonneg_array(name: str, value: ArrayLike, unit: str) -> np.ndarray:
     return _v.float_array(name, value, unit, ndim=None, nonnegative=True)
 
 
-def _finite_array(name: str, value: Any, unit: str) -> np.ndarray:
+def _finite_array(name: str, value: ArrayLike, unit: str) -> np.ndarray:
     return _v.float_array(name, value, unit, ndim=None)
 
 

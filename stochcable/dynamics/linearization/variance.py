@@ -24,6 +24,7 @@ from stochcable.dynamics.linearization.formulas import (
     drag_linear_vector,
     mean_abs_gaussian,
 )
+from stochcable.dynamics.linearization.iteration import FixedPointResult
 from stochcable.dynamics.loads.channels import (
     Channel,
 )
@@ -63,7 +64,11 @@ def split_sigma(system: LineSystem, x: np.ndarray, method: str) -> dict[str, np.
 
 
 def _drag_current(
-    rho: float, cd: Any, diameter: Any, sigma: np.ndarray, mean: np.ndarray
+    rho: float,
+    cd: np.ndarray | float,
+    diameter: np.ndarray | float,
+    sigma: np.ndarray,
+    mean: np.ndarray,
 ) -> np.ndarray:
     """:func:`stochcable.dynamics.linearization.formulas.drag_linear_current` without validation
     (finite
@@ -350,14 +355,14 @@ def _kernel_moments(inp: LineInputs, sl: slice) -> Any:
     return inp.fluid_views(sl)
 
 
-def _block(u: Any, sl: slice) -> np.ndarray | None:
+def _block(u: np.ndarray | Callable[[slice], np.ndarray] | None, sl: slice) -> np.ndarray | None:
     """The frequencies ``sl`` of node vectors given as an array or a callable."""
     if u is None:
         return None
     return u(sl) if callable(u) else u[:, :, sl]
 
 
-def element_variance_kernel() -> Any:
+def element_variance_kernel() -> Callable[..., None] | None:
     """:func:`stochcable.dynamics.linearization.variance_kernels.element_variance_terms`, or None
     without numba or with ``STOCHCABLE_NUMBA=0`` (the NumPy blocks then)."""
     return optional_kernel(
@@ -537,7 +542,12 @@ def quasi_static_motion(system: LineSystem, inp: LineInputs) -> np.ndarray | Non
 
 
 def linearization_record(
-    system: LineSystem, sigma: np.ndarray, damping: Damping, fp: Any, tolerance: float, method: str
+    system: LineSystem,
+    sigma: np.ndarray,
+    damping: Damping,
+    fp: FixedPointResult,
+    tolerance: float,
+    method: str,
 ) -> LinearizationRecord:
     """The record of a converged (or flagged) drag fixed point of one line: the
     iteration history of ``fp`` (a FixedPointResult), the final σ (the

@@ -53,7 +53,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 import scipy.sparse as sp
@@ -63,9 +63,11 @@ from stochcable.dynamics.loads.element_kinematics import (
     element_frames,
     element_wave_kinematics,
 )
+from stochcable.dynamics.loads.element_parts import EndSquare, MomentParts, SquareParts
 from stochcable.dynamics.loads.sea_channels import sea_channel_densities, spectrum_callable
 from stochcable.errors import InputError
-from stochcable.scene.model import Environment, Line, Scene
+from stochcable.line.fem import FEModel
+from stochcable.scene.model import Environment, Line, MotionRao, Scene
 from stochcable.sea.kinematics import G_STANDARD, nodal_kinematics
 
 __all__ = [
@@ -100,7 +102,7 @@ class _LazyNodal:
     def __set_name__(self, owner: type, name: str) -> None:
         self._key = "_" + name
 
-    def __get__(self, obj: Any, objtype: Any = None) -> Any:
+    def __get__(self, obj: Channel | None, objtype: type | None = None) -> np.ndarray | None:
         if obj is None:
             return None  # the dataclass default
         d = obj.__dict__
@@ -112,7 +114,7 @@ class _LazyNodal:
             val = d.get(self._key)
         return val
 
-    def __set__(self, obj: Any, value: Any) -> None:
+    def __set__(self, obj: Channel, value: np.ndarray | None) -> None:
         obj.__dict__[self._key] = value
 
 
@@ -179,9 +181,9 @@ class Channel:
     element_velocity: np.ndarray | None = None
     element_velocity_square: np.ndarray | None = None
     element_end_square: np.ndarray | None = None
-    element_square: Any = None  # SquareParts
-    element_velocity_parts: Any = None  # MomentParts
-    element_ends: Any = None  # EndSquare
+    element_square: SquareParts | None = None
+    element_velocity_parts: MomentParts | None = None
+    element_ends: EndSquare | None = None
     nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
     heading: float | None = None
 
@@ -284,7 +286,7 @@ def line_channels(
     return tuple(channels)
 
 
-def _end_rao(rao: Any, omega: np.ndarray, heading: float) -> np.ndarray | None:
+def _end_rao(rao: MotionRao | None, omega: np.ndarray, heading: float) -> np.ndarray | None:
     """An end's motion RAO (n_omega, 3) for waves toward ``heading`` [rad], or None."""
     return None if rao is None else np.ascontiguousarray(rao.transfer(omega, heading).T)
 
@@ -307,7 +309,7 @@ def _sea_nodal(el: ElementKinematics, g: float) -> Callable[[], tuple[np.ndarray
     return nodal
 
 
-def element_moments(model: Any, channel: Channel) -> np.ndarray | None:
+def element_moments(model: FEModel, channel: Channel) -> np.ndarray | None:
     """Consistent moments of a channel's fluid velocity along the model's elements.
 
     Parameters
@@ -366,7 +368,7 @@ def element_mean_square(channel: Channel) -> np.ndarray | None:
 # ------------------------------------------------------------------ element geometry
 
 
-def embed(model: Any, values: np.ndarray) -> np.ndarray:
+def embed(model: FEModel, values: np.ndarray) -> np.ndarray:
     """Model-DOF vectors (..., n_dof) -> node vectors (..., n_nodes, 3), zeros off-model."""
     lead = values.shape[:-1]
     out = np.zeros(lead + (model.n_nodes, 3), dtype=values.dtype)
@@ -374,13 +376,13 @@ def embed(model: Any, values: np.ndarray) -> np.ndarray:
     return out
 
 
-def _to_dofs(model: Any, node_vectors: np.ndarray) -> np.ndarray:
+def _to_dofs(model: FEModel, node_vectors: np.ndarray) -> np.ndarray:
     """Node vectors (..., n_nodes, 3) -> model-DOF vectors (..., n_dof)."""
     sub = node_vectors[..., list(model.components)]
     return sub.reshape(sub.shape[:-2] + (model.n_dof,))
 
 
-def _assemble(model: Any, blocks3: np.ndarray, node_diag: np.ndarray | None) -> sp.csr_array:
+def _assemble(model: FEModel, blocks3: np.ndarray, node_diag: np.ndarray | None) -> sp.csr_array:
     """Assemble per-unit-length 3×3 element matrices (n_el, 3, 3) times the mass
     distribution pattern·l0, plus an isotropic per-node diagonal, on the model DOFs."""
     comps = list(model.components)
@@ -398,7 +400,7 @@ def _assemble(model: Any, blocks3: np.ndarray, node_diag: np.ndarray | None) -> 
     return chain_csr(el, model.n_nodes, d, diag)
 
 
-def inertia_matrix(model: Any, g: float) -> sp.csr_array:
+def inertia_matrix(model: FEModel, g: float) -> sp.csr_array:
     """Morison inertia matrix B_I: load = B_I·A for nodal fluid accelerations A.
 
     Parameters
@@ -423,7 +425,7 @@ def inertia_matrix(model: Any, g: float) -> sp.csr_array:
 
 
 def drag_matrix(
-    model: Any,
+    model: FEModel,
     b_normal: np.ndarray,
     b_axial: np.ndarray,
     b_node: np.ndarray | None = None,
@@ -457,7 +459,7 @@ def drag_matrix(
 
 
 def inertia_blocks(
-    model: Any, g: float, e: np.ndarray | None = None
+    model: FEModel, g: float, e: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Morison inertia per unit length (n_el, 3, 3) and per attachment node (n_nodes,);
     ``e`` the element tangents when already at hand (:func:`element_frames`)."""
@@ -469,7 +471,7 @@ def inertia_blocks(
     return blocks, mesh.node_buoyancy / g + mesh.node_added_mass
 
 
-def _drag_blocks3(model: Any, b_normal: np.ndarray, b_axial: np.ndarray) -> np.ndarray:
+def _drag_blocks3(model: FEModel, b_normal: np.ndarray, b_axial: np.ndarray) -> np.ndarray:
     """Linear drag per unit length B_n(I − eeᵀ) + B_t eeᵀ (or N B Nᵀ + B_t eeᵀ), (n_el, 3, 3)."""
     e, n1, n2 = element_frames(model.positions)
     eet = e[:, :, None] * e[:, None, :]
@@ -483,7 +485,7 @@ def _drag_blocks3(model: Any, b_normal: np.ndarray, b_axial: np.ndarray) -> np.n
 
 
 def wave_loads(
-    model: Any,
+    model: FEModel,
     channels: tuple[Channel, ...],
     b_normal: np.ndarray,
     b_axial: np.ndarray,
@@ -544,7 +546,7 @@ def wave_loads(
     return out
 
 
-def prescribed_motion(model: Any, channels: tuple[Channel, ...], n_omega: int) -> np.ndarray:
+def prescribed_motion(model: FEModel, channels: tuple[Channel, ...], n_omega: int) -> np.ndarray:
     """Prescribed displacements of the fixed DOFs, shape (n_omega, n_fixed, n_ch). [m/unit]"""
     n_ch = len(channels)
     nodes = np.zeros((n_omega, n_ch, model.n_nodes, 3), dtype=complex)
@@ -558,7 +560,7 @@ def prescribed_motion(model: Any, channels: tuple[Channel, ...], n_omega: int) -
 
 
 def channel_loads(
-    model: Any,
+    model: FEModel,
     channels: tuple[Channel, ...],
     c_drag: sp.csr_array,
     b_inertia: sp.csr_array,

@@ -22,9 +22,16 @@ import contextvars
 import os
 from collections.abc import Iterator
 
+import numpy as np
+
 from stochcable.errors import InputError
 
+#: Frequencies of a grid: a slice or an index array (the last axis of per-frequency
+#: arrays).
+FrequencyIndex = slice | np.ndarray
+
 __all__ = [
+    "FrequencyIndex",
     "WORKING_MEMORY_MB",
     "frequency_block",
     "frequency_slices",

@@ -34,7 +34,7 @@ from stochcable.results.documents import (
     FormedOnAccess,
     LinearizationRecord,
 )
-from stochcable.scene.model import AnalysisSettings, Line, Scene
+from stochcable.scene.model import AnalysisSettings, Environment, Line, Scene
 
 Progress = Callable[[str, Mapping[str, Any]], None]
 """``progress(stage, info)``: called with the stage name ("statics", "model", "modes",
@@ -115,7 +115,7 @@ class LineSystem:
     current_el: np.ndarray
     current_node: np.ndarray
     drag_nodes: np.ndarray
-    environment: Any
+    environment: Environment
     structural_damping: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
@@ -172,7 +172,7 @@ class Damping:
     b_normal: np.ndarray
     b_axial: np.ndarray
     b_node: np.ndarray
-    model: Any = None
+    model: FEModel | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_cache", {})

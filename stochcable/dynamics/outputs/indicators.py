@@ -37,6 +37,7 @@ from stochcable.errors import (
 from stochcable.results.documents import (
     LineIndicators,
 )
+from stochcable.results.records import LinearizationRecord, ResponseStats
 from stochcable.scene.units import unit_labels
 
 # ------------------------------------------------------------------ quality indicators
@@ -95,7 +96,7 @@ def line_indicators(
     linearization: Linearization,
     tension_std: np.ndarray,
     motion_std: np.ndarray,
-    end_stats: Mapping[str, Any],
+    end_stats: Mapping[str, ResponseStats],
     modes: LineModes | None = None,
 ) -> LineIndicators:
     """Quality indicators of the linear model of one line, with PhysicsWarnings.
@@ -196,7 +197,7 @@ def at_rest_zeroed(sigma: np.ndarray, current: np.ndarray) -> tuple[np.ndarray, 
 
 
 def _drag_ratios(
-    system: LineSystem, channels: tuple[Channel, ...], rec: Any, w: np.ndarray
+    system: LineSystem, channels: tuple[Channel, ...], rec: LinearizationRecord, w: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Borgman variance ratio and drag/inertia ratio per element (:func:`line_indicators`
     Notes). [-]"""
@@ -217,7 +218,7 @@ def _drag_ratios(
 
 
 def _snap(
-    system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, Any]
+    system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, ResponseStats]
 ) -> tuple[float, bool]:
     """Snap margin min (mean − 3σ)/|mean| over the elements and ends, and whether some
     mean − 3σ < 0 (PhysicsWarning naming the worst place)."""

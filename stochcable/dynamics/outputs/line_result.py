@@ -13,8 +13,6 @@ tensions are computed with the response (:mod:`stochcable.dynamics.solve.line_so
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from stochcable.dynamics.drag_residual import drag_residual
@@ -39,7 +37,7 @@ from stochcable.dynamics.outputs.resolution import (
     tail_check,
 )
 from stochcable.dynamics.second_order import second_order_tension, with_second_order
-from stochcable.line.fem import SLACK_EA_RATIO
+from stochcable.line.fem import SLACK_EA_RATIO, FEModel
 from stochcable.results.documents import (
     LineResult,
     stats_from_validated,
@@ -244,7 +242,7 @@ def _tension_transfer(system: LineSystem, resp: Response, n_ch: int) -> np.ndarr
 
 
 def _motion_transfer(
-    model: Any, resp: Response, n_ch: int, freq: slice = slice(None)
+    model: FEModel, resp: Response, n_ch: int, freq: slice = slice(None)
 ) -> np.ndarray:
     """Node motion transfer functions on x, y, z on the frequencies ``freq``, (n_ch,
     n_nodes, 3, n_f) (zero on the components a 2-D model lacks). [m/unit]"""
@@ -265,7 +263,7 @@ def _motion_transfer(
     return motion_h
 
 
-def _end_force_transfer(model: Any, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
+def _end_force_transfer(model: FEModel, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
     """Support force transfer functions on x, y, z per end, (n_ch, 3, n_omega). [N/unit]"""
     comps = list(model.components)
     d = model.dim

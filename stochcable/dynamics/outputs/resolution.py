@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.model.blocks import add_blocks, block_matvec, line_prep, trapezoid_weights
@@ -93,7 +93,7 @@ def _nearest_spacing(omega: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.n
 RESONANCE_PEAK_ERROR = 0.01
 
 
-def peak_quadrature_error(bandwidth: Any, spacing: Any) -> np.ndarray:
+def peak_quadrature_error(bandwidth: ArrayLike, spacing: ArrayLike) -> np.ndarray:
     """Largest relative error of the trapezoid rule on a resonant peak.
 
     Parameters

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -47,6 +46,8 @@ from stochcable.dynamics.groups.inputs import (
 from stochcable.dynamics.groups.vessels import VesselRaos
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
+from stochcable.line.fem import FEModel
+from stochcable.scene.model import Line, Scene
 
 __all__ = [
     "CHUNK_BYTES",
@@ -122,7 +123,7 @@ def frequency_chunks(n_omega: int, entry_bytes: int, budget: int = CHUNK_BYTES) 
         yield slice(start, min(start + size, int(n_omega)))
 
 
-def vessel_raos(scene: Any, omega: np.ndarray) -> VesselRaos:
+def vessel_raos(scene: Scene, omega: np.ndarray) -> VesselRaos:
     """The 6-DOF RAOs of every prescribed body (vessel) of the scene on ``omega``, per
     wave heading (zero outside the frequency table). [m/m, rad/m]"""
     return VesselRaos(
@@ -135,12 +136,12 @@ def vessel_raos(scene: Any, omega: np.ndarray) -> VesselRaos:
     )
 
 
-def _scene_line(scene: Any, name: str) -> Any:
+def _scene_line(scene: Scene, name: str) -> Line:
     return next(ln for ln in scene.lines if ln.name == name)
 
 
 def _group_on(
-    scene: Any, group: CoupledGroup, omega: np.ndarray
+    scene: Scene, group: CoupledGroup, omega: np.ndarray
 ) -> tuple[GroupSystem, tuple[str, ...], tuple[tuple[str, str] | None, ...]]:
     """The group's solve data on ``omega``: channels of every line (vessel ends in the
     sea channel), aligned on the group list as the analysis does (a line alone keeps
@@ -198,7 +199,7 @@ def _group_on(
     )
 
 
-def line_entry_bytes(model: Any, n_columns: int) -> int:
+def line_entry_bytes(model: FEModel, n_columns: int) -> int:
     """Bytes of a line's node arrays per frequency, the unit of the chunk budget.
 
     Parameters
@@ -217,7 +218,7 @@ def line_entry_bytes(model: Any, n_columns: int) -> int:
     return int(model.n_nodes * model.dim * max(int(n_columns), 1) * 16 * _ARRAYS_PER_ENTRY)
 
 
-def _entry_bytes(group: CoupledGroup, scene: Any) -> int:
+def _entry_bytes(group: CoupledGroup, scene: Scene) -> int:
     """Bytes of the group's node arrays per frequency (the chunk budget's unit)."""
     ds = None if scene.sea is None else scene.sea.direction_set()
     n_ch = (1 if ds is None else ds.count) + sum(
@@ -236,9 +237,9 @@ def _entry_bytes(group: CoupledGroup, scene: Any) -> int:
 
 
 def coupled_group_transfer(
-    scene: Any,
+    scene: Scene,
     group: CoupledGroup,
-    omega: Any,
+    omega: np.ndarray,
     *,
     budget: int = CHUNK_BYTES,
     timing: dict[str, float] | None = None,

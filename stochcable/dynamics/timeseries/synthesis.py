@@ -7,18 +7,19 @@ line alone, lines on bodies) by :mod:`stochcable.dynamics.timeseries.group_trans
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
+from stochcable.dynamics.groups.analysis import CoupledGroup
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.loads.sea_channels import direction_channel, sea_channel_headings
 from stochcable.dynamics.model.system import LineSystem
+from stochcable.line.statics import LineStatics
 from stochcable.results.documents import (
     TimeSeries,
 )
 from stochcable.scene.model import Scene, TimeSeriesSettings
-from stochcable.sea.realization import frequency_grid, simulate_sea, synthesize
+from stochcable.sea.realization import SeaRealization, frequency_grid, simulate_sea, synthesize
 from stochcable.sea.spreading import simulate_sea_directional
 
 # ---------------------------------------------------------------------- time series
@@ -27,7 +28,7 @@ from stochcable.sea.spreading import simulate_sea_directional
 def simulate_timeseries(
     scene: Scene,
     settings: TimeSeriesSettings,
-    groups: tuple[Any, ...],
+    groups: tuple[CoupledGroup, ...],
     *,
     timing: dict[str, float] | None = None,
 ) -> TimeSeries:
@@ -142,7 +143,7 @@ class _Synthesis:
         self.n_t = int(round(settings.duration / settings.dt))
         self.sea = None
         self.elevation = None  # (the sea's η; a short-crested sea's sums its directions)
-        self.directions: dict[str, Any] = {}  # sea channel name -> its realization
+        self.directions: dict[str, SeaRealization] = {}  # sea channel name -> its realization
         if scene.sea is not None:
             spec, g = scene.sea.spectrum, scene.environment.g
 
@@ -164,7 +165,7 @@ class _Synthesis:
                 self.directions = {direction_channel(b): r for b, r in zip(ds.heading, reals)}
                 self.sea = reals[0]
                 self.elevation = np.sum([r.elevation for r in reals], axis=0)
-        self.reals: dict[tuple[str, str], Any] = {}
+        self.reals: dict[tuple[str, str], SeaRealization] = {}
 
     def realize_end_motions(self, probe: Mapping[str, tuple[Channel, ...]]) -> None:
         """One realization per end-motion channel, in the order of ``probe`` (lines)
@@ -221,11 +222,11 @@ class _Series:
     def add_line(
         self,
         name: str,
-        statics: Any,
+        statics: LineStatics,
         tr: dict[str, np.ndarray],
         syn: _Synthesis,
         kinds: tuple[str, ...],
-        sources: tuple[Any, ...],
+        sources: tuple[tuple[str, str] | None, ...],
         channels: tuple[str, ...],
     ) -> None:
         """End tensions: the static tension plus the synthesis of the transfer ``tr``."""
@@ -263,7 +264,7 @@ def _channels_on(scene: Scene, system: LineSystem, w: np.ndarray) -> tuple[Chann
 
 def _groups(
     scene: Scene,
-    groups: tuple[Any, ...],
+    groups: tuple[CoupledGroup, ...],
     probe: Mapping[str, tuple[Channel, ...]],
     syn: _Synthesis,
     out: _Series,
