@@ -1,5 +1,5 @@
 """Build once, solve per sea state: the seam between the sea-independent model of a
-scene and its response to one sea state (seed 001 ch. 5).
+scene and its response to one sea state (Tuah 1982, ch. 5).
 
 :func:`build_engine` does everything that does not depend on the sea: the static
 equilibrium (all nonlinearities), the finite-element model of every line about it,
@@ -23,6 +23,11 @@ A sea state is a :class:`~stochcable.scene.model.Sea` document (spectrum and hea
 the current, the end motions and the settings are the scene's.  ``solve`` mutates no
 state that changes its answer: solving the same sea twice gives identical results, and
 ``engine.solve(sea)`` gives the result of ``analyze`` on the scene with that sea.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

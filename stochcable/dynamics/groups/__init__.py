@@ -1,5 +1,5 @@
-"""The engine's groups: lines and large rigid bodies solved together (seed 001
-§3.2.c, §3.3, ch. 5), a line alone being the group of one line and no bodies.
+"""The engine's groups: lines and large rigid bodies solved together (Tuah
+1982, §3.2.c, §3.3, ch. 5), a line alone being the group of one line and no bodies.
 
 Lines attached to a freely moving body are solved together with it: one drag
 linearization loop over every attached line and body, the response at every frequency
@@ -39,6 +39,11 @@ Modules, lowest first (each imports only the ones above it):
   (:func:`linearize`, a convenience for users and tests).
 
 The linearized drag of a body is :mod:`stochcable.dynamics.linearization.bodydrag`.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from stochcable.dynamics.groups.analysis import (

@@ -6,8 +6,7 @@ a frequency subset G (every ``COARSE_STRIDE``-th frequency and the last) to
 ``COARSE_TOLERANCE_FACTOR`` times the tolerance.  The σ integrals on the subset are
 the full grid's trapezoid rule on the cubic interpolant of the integrand
 (:func:`stochcable.dynamics.linearization.coarse_grid.interpolatory_weights`, as the single-line
-coarse start
-of :mod:`stochcable.dynamics`); subset frequencies whose σ weight is at most
+coarse start of :mod:`stochcable.dynamics`); subset frequencies whose σ weight is at most
 ``COARSE_NEGLIGIBLE`` (1e-12) of the largest in every channel (the spectrum's empty
 tail) are then left out (their σ contributions are below round-off).  A Foss line
 solves its modal equations per frequency there
@@ -251,10 +250,9 @@ def full_grid_arrays(g: GroupSystem, method: str) -> None:
 def coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
     """The group on the frequencies ``g.omega[idx]``: σ integrals by the full grid's
     trapezoid rule on the subset's cubic interpolant
-    (:func:`stochcable.dynamics.linearization.coarse_grid.interpolatory_weights`), the lines' inputs
-    sliced
-    from the full grid's (:func:`stochcable.dynamics.linearization.coarse_grid.subset_inputs`), Foss
-    lines
+    (:func:`stochcable.dynamics.linearization.coarse_grid.interpolatory_weights`), the
+    lines' inputs sliced from the full grid's
+    (:func:`stochcable.dynamics.linearization.coarse_grid.subset_inputs`), Foss lines
     solved per frequency in modal coordinates
     (:class:`~stochcable.dynamics.groups.modal_parts.ModalLine`); the frequencies of negligible
     σ weight (``COARSE_NEGLIGIBLE``) left out after the weights are formed."""

@@ -1,4 +1,4 @@
-"""A line of a group with no end on a body: the degenerate line part (seed 001 eq.
+"""A line of a group with no end on a body: the degenerate line part (Tuah 1982, eq.
 5.2.6, §5.3).
 
 A line attached to no free body is a group of its own without bodies
@@ -12,6 +12,11 @@ the σ of the drag fixed point from the free-node part
 displacements and the support forces only when they are asked for (the outputs of
 the last evaluation): the fixed point of a single line costs per evaluation what its
 own solve costs.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

@@ -1,13 +1,13 @@
-"""A coupled group and its solve at every frequency for given linear drag (seed 001
-§3.2.c, §3.3, §5.3).
+"""A coupled group and its solve at every frequency for given linear drag (Tuah
+1982, §3.2.c, §3.3, §5.3).
 
 Substructuring (exact at every frequency)
 -----------------------------------------
 Each attached line's response is linear in the motion u_e of its attached end nodes,
 U = U_0 + G u_e, F_end = R_0 + R_e u_e (:mod:`stochcable.dynamics.groups.lineparts`).
-The rigid link u_e = T(r) ξ (seed 001 eqs. 3.3.6–3.3.7,
+The rigid link u_e = T(r) ξ (Tuah 1982, eqs. 3.3.6–3.3.7,
 :func:`stochcable.bodies.rigid.rigid_link_matrix`) and the transformed body equation
-(seed 001 eq. 3.2.c.20 with eqs. 3.3.8–3.3.10) give, per frequency,
+(Tuah 1982, eq. 3.2.c.20 with eqs. 3.3.8–3.3.10) give, per frequency,
 
     [K_B − ω²(M_B + A(ω)) + iω(B(ω) + C_B) − Σ Tᵀ R_e T] ξ
         = F_exc + Tdᵀ diag(b) v + Σ Tᵀ R_0,
@@ -18,7 +18,7 @@ of :func:`stochcable.bodies.coupling.couple` on the body DOFs (tested equal to
 :func:`stochcable.reference.bodies.solve_coupled_direct`), with the line interiors solved
 by the line machinery: banded direct solve (``solver="direct"``) or Foss modal
 superposition with the static correction of the truncated modes (``solver="foss"``,
-seed 001 §5.3).
+Tuah (1982), §5.3).
 
 Fixed body DOFs
 ---------------
@@ -31,6 +31,11 @@ Frequency-dependent added mass and radiation damping
 Because the body DOFs are always condensed exactly at every ω, the body's A(ω), B(ω)
 are exact under both solvers; "foss" only approximates the line interiors (exact
 when all modes are kept).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

@@ -1,19 +1,22 @@
 """The coupled drag linearization: one fixed point over every line and body of a
-group (seed 001 §5.3 steps 5–13, eq. 5.2.2).
+group (Tuah 1982, §5.3 steps 5–13, eq. 5.2.2).
 
 The fixed-point variable is the concatenation of every attached line's σ vector
 (:func:`stochcable.dynamics.linearization.variance.drag_coefficients` layout) and, per body with a
-drag
-area, the σ of the relative velocity (fluid − body) at its drag point along x, y, z
-(:func:`stochcable.dynamics.groups.group.linear_body_drag`: b = ρ·CdA·E|v|, seed 001
+drag area, the σ of the relative velocity (fluid − body) at its drag point along x, y, z
+(:func:`stochcable.dynamics.groups.group.linear_body_drag`: b = ρ·CdA·E|v|, Tuah (1982)
 eq. 5.2.2 form with the current).  The iteration mirrors
 :func:`stochcable.dynamics.groups.line_fixed_point.linearize`: the start is the fluid velocity
-relative to
-lines and bodies at rest (lines following their moving unattached ends
+relative to lines and bodies at rest (lines following their moving unattached ends
 quasi-statically), the first response starts the Anderson-accelerated iteration
 unmixed.  The record is one for the whole group.  On fine grids the start is the
 fixed point of a frequency subset, corrected by the full/coarse defect
 (:mod:`stochcable.dynamics.groups.coarse`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -200,7 +203,7 @@ def linearize_coupled(
     Notes
     -----
     Module docstrings: the substructured solve
-    (:mod:`stochcable.dynamics.groups.group`), the fixed point (seed 001 §5.3 steps
+    (:mod:`stochcable.dynamics.groups.group`), the fixed point (Tuah 1982, §5.3 steps
     5–13 over all lines and bodies).  Inside :func:`warm_starts` the iteration
     starts from the group's last converged σ.
     """

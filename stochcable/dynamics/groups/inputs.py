@@ -1,5 +1,5 @@
 """Inputs of a coupled group: its lines, the body loads, vessel-driven ends and the
-group's channels (seed 001 §3.2.c, §3.3).
+group's channels (Tuah 1982, §3.2.c, §3.3).
 
 A coupled group (:mod:`stochcable.dynamics.groups`) is solved on one list of input
 channels: the sea's first (``"sea"``; a short-crested sea's ``"sea@<heading in deg>"``,
@@ -17,6 +17,11 @@ independent line (:func:`fairlead_motion`, :func:`scene_line_channels`), no coup
 back.  In a short-crested sea each direction channel θ_k carries the RAO of its
 direction (:class:`VesselRaos`; a table without headings the same in every direction,
 so the fairlead's motion spectrum is |RAO|² Σ_k w_k S = |RAO|² S).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

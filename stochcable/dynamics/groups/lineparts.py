@@ -1,4 +1,4 @@
-"""The lines of a coupled group before the body solve (seed 001 §3.3, §5.3).
+"""The lines of a coupled group before the body solve (Tuah 1982, §3.3, §5.3).
 
 Each attached line keeps its own finite-element model with both end nodes prescribed
 (:func:`stochcable.dynamics.model.system.build_line_system`); its response is linear in the
@@ -23,6 +23,11 @@ Three forms, the same linear system to round-off (tests/test_coupled_reduction.p
 The lines' Foss decompositions of one evaluation (:func:`foss_state`) may run on a
 thread pool, opt-in with ``STOCHCABLE_THREADS`` (:mod:`stochcable.runtime`; the same
 bits as serially).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -157,8 +162,7 @@ def foss_unit_split(
     system: LineSystem, inp_phys: LineInputs, inp: LineInputs, damping: Damping
 ) -> tuple[np.ndarray, NodeBlocks] | None:
     """:func:`stochcable.dynamics.solve.line_solve.solve_free` (Foss) of the physical channels plus
-    the
-    unit end-motion channels, the unit columns in closed form.
+    the unit end-motion channels, the unit columns in closed form.
 
     Parameters
     ----------
@@ -179,8 +183,7 @@ def foss_unit_split(
     -----
     A unit end motion e_j moves the line by the constant U_p,j (the end and its exact
     static following, :func:`stochcable.dynamics.solve.line_loads.base_motion`), so its free-row
-    load is
-    ω²·[M_T U_p,j]_f − iω·[C U_p,j]_f: its modal load, its static correction and the
+    load is ω²·[M_T U_p,j]_f − iω·[C U_p,j]_f: its modal load, its static correction and the
     drag load need no per-frequency products over the nodes; one Foss decomposition
     serves both.  The same linear system as the plain call to round-off; None (use the
     plain call) when the pencil is defective (its fallback and warning).

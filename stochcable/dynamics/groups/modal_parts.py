@@ -1,9 +1,14 @@
 """The Foss and modal line parts of a group solve
 (:mod:`~stochcable.dynamics.groups.lineparts`): a line kept in the coordinates of its
-Foss (state) modes until the body solve (:class:`FossLine`, seed 001 §5.3), or its
+Foss (state) modes until the body solve (:class:`FossLine`, Tuah (1982), §5.3), or its
 modal equations solved per frequency in the coarse stage (:class:`ModalLine`); the
 drag-dependent start of a Foss line (:func:`foss_state`) and the drag-independent
 arrays each keeps across the evaluations of the fixed point (:data:`PartCache`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -51,7 +56,7 @@ def foss_state(system: LineSystem, damping: Damping) -> FossState:
     (C_d, C, foss)
         The drag blocks C_d, the damping C = S + C_d [N·s/m] and the Foss
         decomposition of the line's kept modes (None when the pencil is defective,
-        seed 001 §5.3).
+        Tuah (1982), §5.3).
 
     Notes
     -----
@@ -97,8 +102,8 @@ def _unit_follow(
 
 
 class FossLine:
-    """A Foss line of a group in the coordinates of its Foss (state) modes (seed 001
-    §5.3).
+    """A Foss line of a group in the coordinates of its Foss (state) modes (Tuah
+    1982, §5.3).
 
     The same linear system as :func:`foss_unit_split` +
     :func:`stochcable.dynamics.solve.line_solve.reactions`,

@@ -1,5 +1,5 @@
 """Natural modes of a coupled group: lines and rigid bodies (undamped, constant
-matrices; seed 001 §3.3, eqs. 3.3.8–3.3.10).
+matrices; Tuah (1982), §3.3, eqs. 3.3.8–3.3.10).
 
 The coupled modes need constant matrices: K and M + A(ω_ref) of
 :func:`stochcable.bodies.coupling.constant_matrices`, ω_ref the peak of the sea spectrum
@@ -8,6 +8,11 @@ The coupled modes need constant matrices: K and M + A(ω_ref) of
 of the constrained system.  Two ways, the same listed frequencies to 1e-4 on the
 three-leg benchmark: the assembled system (:func:`stochcable.bodies.coupling.couple`) and
 the Craig–Bampton reduction on each line's fixed-end modes and static following.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

@@ -1,5 +1,11 @@
 """Results of a coupled group: the lines' results and the bodies' motion statistics
-(seed 001 §5.1, spectral moments and maxima)."""
+(Tuah 1982, §5.1, spectral moments and maxima).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
+"""
 
 from __future__ import annotations
 

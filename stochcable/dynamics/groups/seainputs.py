@@ -1,5 +1,5 @@
 """The inputs of a line alone for one sea state, reused across sea states of the same
-heading (the engine's load-case sets, seed 001 ch. 5 per sea state).
+heading (the engine's load-case sets, Tuah (1982), ch. 5 per sea state).
 
 The channels' transfer functions — the wave kinematics integrated along the elements,
 the Morison inertia loads, the end motions and vessel RAOs per unit wave amplitude —
@@ -15,6 +15,11 @@ them again (tested), without the kinematics.  Lines whose inputs exceed
 of a coupled group keep their channels alone (:func:`group_line_channels`: the group
 forms its inputs in the group's channel order), with their kinematics per direction of
 a short-crested sea.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

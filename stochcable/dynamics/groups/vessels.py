@@ -1,7 +1,13 @@
-"""Vessels: prescribed bodies whose motion is an RAO table relative to the sea (seed 001
-eqs. 3.3.6–3.3.7): their RAOs on the analysis grid per wave heading, and the motion of a
+"""Vessels: prescribed bodies whose motion is an RAO table relative to the sea (Tuah
+1982, eqs. 3.3.6–3.3.7): their RAOs on the analysis grid per wave heading, and the motion of a
 point on them (a fairlead) that drives the lines attached to it.  Nothing couples back
-from the lines to a vessel."""
+from the lines to a vessel.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
+"""
 
 from __future__ import annotations
 
@@ -33,7 +39,7 @@ def fairlead_motion(rao: ArrayLike, r: ArrayLike) -> np.ndarray:
     Returns
     -------
     ndarray, complex, shape (n_omega, 3)
-        u = T(r)·ξ = ξ_t + θ × r (seed 001 eqs. 3.3.6–3.3.7). [m/m]
+        u = T(r)·ξ = ξ_t + θ × r (Tuah 1982, eqs. 3.3.6–3.3.7). [m/m]
     """
     a = np.asarray(rao, dtype=complex)
     if a.ndim != 2 or a.shape[1] != 6:

@@ -1,4 +1,4 @@
-"""σ of the relative velocities and the linear drag they give (seed 001 eqs.
+"""σ of the relative velocities and the linear drag they give (Tuah 1982, eqs.
 5.2.2–5.2.5): the two halves of one step of the drag fixed point.
 
 :func:`drag_coefficients` maps the σ vector to the linearized drag
@@ -7,6 +7,11 @@ the iteration's faster :func:`sigmas_from_free`) maps a response back to σ.  Th
 an element is its element mean square,
 σ² = Σ_i ∫ S_i ∫₀¹ |row·(v(ξ) − U̇(ξ))|² dξ dω, exact for the wave field and the
 structural velocity linear along the element.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -71,8 +76,7 @@ def _drag_current(
     mean: np.ndarray,
 ) -> np.ndarray:
     """:func:`stochcable.dynamics.linearization.formulas.drag_linear_current` without validation
-    (finite
-    σ >= 0): the same operations in the same order."""
+    (finite σ >= 0): the same operations in the same order."""
     return rho * np.asarray(cd, dtype=float) * diameter * mean_abs_gaussian(sigma, mean)
 
 
@@ -110,7 +114,7 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
     Notes
     -----
     seed: B_n = ρ Cdn D E|v_n| with v_n ~ N(|U_n|, σ_n²) (:func:`drag_linear_current`;
-    = √(8/π)·½ρCdnD·σ_n without current, seed 001 eq. 5.2.2.a); axial the same with
+    = √(8/π)·½ρCdnD·σ_n without current, Tuah (1982), eq. 5.2.2.a); axial the same with
     Cdt and πD (eq. 5.2.2.b) and the mean U·e.  vector: the exact 2×2 normal-plane
     form (:func:`drag_linear_vector`).  harmonic: (8/3π)·½ρCdD·|v̂| with |v̂| = √2 σ
     (the amplitude of a single harmonic of standard deviation σ).  Attachments:
@@ -209,8 +213,7 @@ def relative_velocity_sigmas(
     the element's e (axial) or normals n1, n2; the scalar form uses
     σ_n² = σ_n1² + σ_n2².  The fluid part is integrated exactly
     (:func:`stochcable.dynamics.loads.element_kinematics.element_wave_kinematics`: the wet part
-    only), the
-    structural displacement U(ξ) is the element's linear interpolation, so the
+    only), the structural displacement U(ξ) is the element's linear interpolation, so the
     ξ-integral is closed-form (:func:`_element_variance`).  The drag coefficient B is
     then constant over the element (eq. 5.2.2 with this σ).  Attachments: the nodal
     relative velocity.

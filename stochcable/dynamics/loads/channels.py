@@ -1,6 +1,6 @@
 """Excitation of a line: independent input channels and the hydrodynamic matrices.
 
-The linear system of a line about its static shape (seed 001 eqs. 5.1, 5.2.6) is
+The linear system of a line about its static shape (Tuah 1982, eqs. 5.1, 5.2.6) is
 
     M_T Ü + (C_d + C_s) U̇ + K U = C_d V + B_I A          (all DOFs, U total motion)
 
@@ -37,7 +37,7 @@ The drag damping and the inertia matrix (for nodal accelerations) are distribute
 each element like the model's mass (consistent [[1/3, 1/6], [1/6, 1/3]]·l0 by default,
 lumped [[1/2, 0], [0, 1/2]]·l0 when the model is lumped), with the element direction
 constant over the element, so the matrices are symmetric (the non-symmetry the seed
-avoids by lumping, seed 001 §3.2.a, comes from nodal direction cosines).  Lengths are
+avoids by lumping, Tuah (1982), §3.2.a, comes from nodal direction cosines).  Lengths are
 the unstretched lengths l0, as the added mass of :mod:`stochcable.line.fem`, so that a line
 moving with a uniform fluid (Ü = A) feels exactly the Froude–Krylov force
 ρ(πD²/4)(I − eeᵀ)A.  Attachments (buoys, clumps) get the isotropic inertia load
@@ -46,6 +46,11 @@ The sea channel carries the wave velocity's consistent moments ∫ N_i v dξ and
 mean square ∫ Re(v vᴴ) dξ integrated exactly along the elements
 (:mod:`stochcable.dynamics.loads.element_kinematics`), read by :func:`element_moments` and
 :func:`element_mean_square` (hand-built channels: the nodal kinematics interpolated).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -217,7 +222,7 @@ def line_channels(
 
     Notes
     -----
-    Kinematics: seed 001 eqs. 5.2.8–5.2.11 (:func:`stochcable.sea.kinematics.wave_kinematics`)
+    Kinematics: Tuah (1982), eqs. 5.2.8–5.2.11 (:func:`stochcable.sea.kinematics.wave_kinematics`)
     at the nodes, and integrated exactly along the straight elements between them
     (:func:`element_wave_kinematics`).  Nodes resting on a penalty seabed slightly below
     z = −depth are moved onto it.
@@ -417,7 +422,7 @@ def inertia_matrix(model: FEModel, g: float) -> sp.csr_array:
 
     Notes
     -----
-    Per unit length ρ(πD²/4)(1 + Can)(I − eeᵀ) (seed 001 eq. 5.2.1, the B_I C_M term,
+    Per unit length ρ(πD²/4)(1 + Can)(I − eeᵀ) (Tuah 1982, eq. 5.2.1, the B_I C_M term,
     C_M = 1 + Can); per attachment (buoyancy/g + added mass)·I.
     """
     blocks, node = inertia_blocks(model, g)
@@ -452,7 +457,7 @@ def drag_matrix(
 
     Notes
     -----
-    Per unit length B_n(I − eeᵀ) + B_t eeᵀ (seed 001 eq. 5.2.1 with B_DL, B_DT of
+    Per unit length B_n(I − eeᵀ) + B_t eeᵀ (Tuah 1982, eq. 5.2.1 with B_DL, B_DT of
     eq. 5.2.2), or N B Nᵀ + B_t eeᵀ with N = [n1 n2] for the vector form.
     """
     return _assemble(model, _drag_blocks3(model, b_normal, b_axial), b_node)
@@ -518,7 +523,7 @@ def wave_loads(
     Notes
     -----
     Node i of element j gets l0_j·[iω C_I(I − eeᵀ) + B_j]·∫₀¹ N_i v dξ with
-    C_I = ρ(πD²/4)(1 + Can) (seed 001 eq. 5.2.1, the B_I C_M and drag terms; B_j of
+    C_I = ρ(πD²/4)(1 + Can) (Tuah 1982, eq. 5.2.1, the B_I C_M and drag terms; B_j of
     eq. 5.2.2 constant over the element) and the moments of :func:`element_moments`
     (exact for the sea channel, :func:`element_wave_kinematics`); attachments get
     (buoyancy/g + added mass)·A + b_node·V at their node.

@@ -24,6 +24,11 @@ The moments are the exact consistent load for both mass-matrix options: for a un
 field they equal the lumped ½·l0 weights, so the Froude–Krylov balance above holds
 either way.  Channels without these element data (built by hand) fall back on the
 linear interpolation of their nodal kinematics with the model's mass pattern.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -164,7 +169,7 @@ def element_wave_kinematics(
 
     Notes
     -----
-    Kinematics of seed 001 eqs. 5.2.8–5.2.11 in the DESIGN.md convention
+    Kinematics of Tuah (1982), eqs. 5.2.8–5.2.11 in the DESIGN.md convention
     (:func:`stochcable.sea.kinematics.wave_kinematics`): with χ = x cos β + y sin β,
     E₁ = k z − i k χ, E₂ = −k(z + 2h) − i k χ and D = 1 − e^{−2kh},
 

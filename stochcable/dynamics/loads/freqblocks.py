@@ -2,7 +2,7 @@
 so that its temporaries stay within a working-memory target.
 
 The drag fixed point needs, per evaluation, only sums over frequency (the element
-variances of seed 001 eqs. 5.2.3–5.2.5), and every frequency is solved on its own
+variances of Tuah (1982), eqs. 5.2.3–5.2.5), and every frequency is solved on its own
 (eq. 5.2.6): the load assembly, the direct or Foss solve and the variance sums of one
 evaluation run over consecutive blocks of frequencies, each block's temporaries freed
 before the next.  The block length comes from the working-memory target
@@ -13,6 +13,11 @@ only regrouped; tested for blocks of 1, 7 and all frequencies).
 Settings: ``STOCHCABLE_WORKING_MEMORY_MB`` (environment variable, read at every call;
 default :data:`WORKING_MEMORY_MB`) is the target of one block's temporaries;
 :func:`frequency_block` fixes the block length instead (tests, benchmarks).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ kinematics_block` forms with NumPy.
 
 Per element (wet part ξ ∈ [p, q], L = q − p) and frequency it evaluates the closed
 forms of :mod:`~stochcable.dynamics.loads.kinematics_closed_forms` for the kinematics of
-seed 001 eqs. 5.2.8–5.2.11 (:func:`~stochcable.dynamics.loads.element_kinematics.
+Tuah (1982), eqs. 5.2.8–5.2.11 (:func:`~stochcable.dynamics.loads.element_kinematics.
 element_wave_kinematics`): with E₁ = k z − i k χ, E₂ = −k(z + 2h) − i k χ (linear in ξ
 along the element, slopes α₁ = k dz − i k dχ and α₂ = −k dz − i k dχ) and
 D = 1 − e^{−2kh},
@@ -49,6 +49,11 @@ multiplies e^{2kz} at its dry end by L = 0: NaN once 2kz > 709, 97 m above the w
 
 Imported lazily (numba costs ≈ 0.2 s to import); compiled with ``cache=True``
 (:func:`stochcable.compiled.jit_cached`).  Single-threaded (one thread per worker).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

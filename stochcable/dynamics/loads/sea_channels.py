@@ -1,7 +1,13 @@
 """The sea's input channels: its spectrum as a function, one channel per direction of a
 short-crested sea, and a channel's spectrum swapped for another sea state's (the
 engine's reuse of a line's inputs across sea states,
-:mod:`stochcable.dynamics.groups.seainputs`)."""
+:mod:`stochcable.dynamics.groups.seainputs`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
+"""
 
 from __future__ import annotations
 
@@ -44,7 +50,7 @@ def sea_channel_densities(
     sea is one channel "sea"; a short-crested one a channel "sea@<heading in deg>" per
     discrete direction k (:meth:`stochcable.scene.environment.Sea.direction_set`) with
     the share w_k S(ω) of the spectrum: independent inputs whose variances add (the
-    directional spectrum S(ω)D(θ), seed 001 §5.1 per direction)."""
+    directional spectrum S(ω)D(θ), Tuah (1982), §5.1 per direction)."""
     density = spectrum_callable(sea.spectrum, g)
     ds = sea.direction_set()
     if ds is None:

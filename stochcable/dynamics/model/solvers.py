@@ -1,4 +1,4 @@
-"""Frequency-domain solves of ``M_T U'' + C U' + K U = F`` (seed 001 §5.3; DESIGN.md
+"""Frequency-domain solves of ``M_T U'' + C U' + K U = F`` (Tuah 1982, §5.3; DESIGN.md
 "Solution: direct and Foss").
 
 Harmonic quantities are ``Re{X e^{i omega t}}``, so the dynamic matrix is
@@ -23,6 +23,11 @@ frequencies is a batch of linear systems); the response has the same layout as
 
 Singular dynamic matrices (undamped resonance) raise :class:`SolverError` naming the
 frequency and the mode; no function returns inf or NaN.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -309,8 +314,8 @@ def solve_direct(
 
     Notes
     -----
-    The reference solution of DESIGN.md "Solution: direct and Foss" (seed 001
-    eq. 5.2.6 in the frequency domain).
+    The reference solution of DESIGN.md "Solution: direct and Foss" (Tuah
+    1982, eq. 5.2.6 in the frequency domain).
     """
     K_, M_, C_ = system_matrices(K, M, C)
     n = K_.shape[0]

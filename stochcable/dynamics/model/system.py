@@ -1,4 +1,4 @@
-"""The assembled linear system of one line (seed 001 ch. 3 and §5.2): the
+"""The assembled linear system of one line (Tuah 1982, ch. 3 and §5.2): the
 frequency-independent model (:class:`LineSystem`, :func:`build_line_system`), the choice
 of the modes the Foss solve keeps, and the objects the later stages exchange: the
 linearized drag (:class:`Damping`), the harmonic response (:class:`Response`) and the
@@ -8,6 +8,11 @@ Pipeline position: statics -> **system** -> loads (:mod:`~stochcable.dynamics.so
 -> drag fixed point (:mod:`~stochcable.dynamics.groups.line_fixed_point`) -> solve
 (:mod:`~stochcable.dynamics.solve.line_solve`) -> outputs
 (:mod:`~stochcable.dynamics.outputs.line_result`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

@@ -4,11 +4,16 @@
 Dynamic effective tension
 -------------------------
 Per element δT = (EA/l0)·e·(u_b − u_a), the first-order change of T = EA(l/l0 − 1)
-(seed 001 eqs. 3.1.8–3.1.11: the K_NL part of the tangent stiffness).  The "geometric"
+(Tuah 1982, eqs. 3.1.8–3.1.11: the K_NL part of the tangent stiffness).  The "geometric"
 term (T/l)(I − eeᵀ)Δu of the tangent stiffness rotates the element force; it changes
 its direction, not its magnitude, and contributes to the tension only at second order,
 so it is not part of δT.  Slack elements (T <= 0) use the model's reduced EA.  The end
 tensions are computed with the response (:mod:`stochcable.dynamics.solve.line_solve`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations

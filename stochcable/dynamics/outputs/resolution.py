@@ -4,6 +4,11 @@ rule's error on a resonant peak: :func:`peak_quadrature_error`), of the wave kin
 by the mesh near the surface (:func:`surface_resolution_check`) and of the response
 tail by ω_max (:func:`tail_check`).  The quality indicators of the response are in
 :mod:`stochcable.dynamics.outputs.indicators`.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -170,7 +175,7 @@ def resolution_check(
 
 #: Largest ratio of the wave-velocity σ at the two ends of an element's wet part before
 #: :func:`surface_resolution_check` warns.  The drag linearization takes one B ∝ σ per
-#: element (seed 001 eq. 5.2.2) while σ decays like e^{k̄z} from the surface; on the
+#: element (Tuah 1982, eq. 5.2.2) while σ decays like e^{k̄z} from the surface; on the
 #: inclined guy (docs/ACCURACY.md) the ratio of its top element is 2.18 / 1.59 / 1.32 /
 #: 1.17 at 40 / 80 / 160 / 320 elements, and the fairlead tension σ is off its
 #: 320-element value by +8.6 / +2.9 / +0.46 % (with uniform B the 40-element value is
@@ -240,7 +245,7 @@ def surface_resolution_check(
         f"line '{system.name}': the wave-velocity σ varies by a factor {r:.3g} along "
         f"element {j + 1} (z from {za:.4g} to {zb:.4g} {units.length}; threshold "
         f"{SURFACE_SIGMA_RATIO:g}){others}, but the drag linearization takes one drag "
-        "coefficient per element (seed 001 eq. 5.2.2): the element is long against the "
+        "coefficient per element (Tuah 1982, eq. 5.2.2): the element is long against the "
         "decay depth of the wave kinematics and the response there carries an error of "
         f"several %; use {need}, or elements spanning at most {dz * shrink:.3g} "
         f"{units.length} of depth near the surface",

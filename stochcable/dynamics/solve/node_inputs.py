@@ -6,7 +6,7 @@ sea, end motions) into what the load assembly and the variance sums of one line 
 the σ weights (trapezoid × spectrum), the weighted mean square of the fluid velocity,
 the end displacements and, on any block of frequencies, the consistent element moments
 of the fluid velocity (:meth:`LineInputs.moments_at`) and the exact Morison inertia
-load (:meth:`LineInputs.inertia_at`, seed 001 eq. 5.2.6).  Those two are not kept for
+load (:meth:`LineInputs.inertia_at`, Tuah (1982), eq. 5.2.6).  Those two are not kept for
 the whole grid: they are gathered from the channels' element kinematics (which the
 channels hold once) for the block at hand, so the drag fixed point holds one block of
 them at a time (:mod:`stochcable.dynamics.loads.freqblocks`); where the whole grid fits a
@@ -14,6 +14,11 @@ quarter of the working-memory target they are kept after the first use (a small 
 forms them once).  :attr:`LineInputs.moments` and :attr:`LineInputs.inertia_load`
 give the whole grid (kept after the first access: the solves of the lines of a coupled
 group read them at once).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -259,7 +264,7 @@ def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs
     """The channels of a line in the node layout (:class:`LineInputs`), sampled on the
     channels' common grid: fluid velocity at the attachment nodes, the channels'
     element moments (the Morison inertia load formed from them, exact along the
-    elements, seed 001 eq. 5.2.6), end displacements, trapezoid × spectrum weights and
+    elements, Tuah (1982), eq. 5.2.6), end displacements, trapezoid × spectrum weights and
     the weighted mean square of the fluid velocity."""
     model = system.model
     comps = list(model.components)

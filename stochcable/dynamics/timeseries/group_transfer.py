@@ -1,16 +1,15 @@
-"""Groups on the realization grid: the transfer functions of the time series (seed 001
-§5.1, eq. 5.3.29 and step 14), for lines coupled to bodies and for lines alone (the
+"""Groups on the realization grid: the transfer functions of the time series (Tuah
+1982, §5.1, eq. 5.3.29 and step 14), for lines coupled to bodies and for lines alone (the
 groups without bodies) by the same solve.
 
 The time series of :func:`stochcable.dynamics.timeseries.synthesis.simulate_timeseries` are the
-synthesis
-(:func:`stochcable.sea.realization.synthesize`) of transfer functions solved on the realization
+synthesis (:func:`stochcable.sea.realization.synthesize`) of transfer functions solved on the
+realization
 grid ω_m = mΔω inside the analysis band, driven by the same complex amplitudes as η.
 For a coupled group (lines attached to free bodies, :mod:`stochcable.dynamics.groups`)
 the drag linearization is done once on the analysis grid; with its converged linear
 drag (the lines' :class:`~stochcable.dynamics.model.system.Damping`, the bodies' drag σ) the group
-is
-a linear system, solved here again on the realization band by the same substructured
+is a linear system, solved here again on the realization band by the same substructured
 solve (:func:`stochcable.dynamics.groups.group.solve_group`): the channels and the body
 loads are evaluated on the band, the lines' support forces give the end tensions
 (:func:`stochcable.dynamics.solve.line_solve.end_tension_from_support`) and the body equation the
@@ -24,6 +23,11 @@ n_nodes × d × n_w × n_ch each) exist one chunk of frequencies at a time; the 
 holds about :data:`CHUNK_BYTES` of them (:func:`frequency_chunks`).  The solve is
 independent per frequency, so the chunked transfer equals the one-piece solve to
 round-off.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -273,9 +277,9 @@ def coupled_group_transfer(
     Notes
     -----
     The group's linear system at the converged drag: lines' drag ``group.dampings``,
-    body drag ``group.body_drag`` (seed 001 eq. 5.2.2 form with the current at the
+    body drag ``group.body_drag`` (Tuah 1982, eq. 5.2.2 form with the current at the
     drag point, Tᵀ diag(b) T on the body DOFs), the body equation
-    (seed 001 eq. 3.2.c.20) with the condensed lines (eqs. 3.3.8–3.3.10) solved exactly
+    (Tuah 1982, eq. 3.2.c.20) with the condensed lines (eqs. 3.3.8–3.3.10) solved exactly
     at every frequency — the same system as the frequency-domain result, so on a common
     frequency the transfer functions agree to round-off.
     """

@@ -1,7 +1,12 @@
-"""Time series of one realization (seed 001 §5.1, eq. 5.3.29 and step 14): the sea,
+"""Time series of one realization (Tuah 1982, §5.1, eq. 5.3.29 and step 14): the sea,
 the end motions, the end tensions of every line and the motions of the bodies, all
 synthesized from transfer functions solved on the realization grid: every group (a
 line alone, lines on bodies) by :mod:`stochcable.dynamics.timeseries.group_transfer`.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University.
 """
 
 from __future__ import annotations
@@ -63,7 +68,7 @@ def simulate_timeseries(
     on the realization grid ω_m = mΔω, restricted to the analysis band
     [omega.min, omega.max] (zero outside, as the response spectra are), so η, end
     motions, tensions and body motions of one realization are mutually consistent
-    (seed 001 §5.1, eq. 5.3.29 and step 14).  Every group: its linear system at its
+    (Tuah 1982, §5.1, eq. 5.3.29 and step 14).  Every group: its linear system at its
     converged drag (lines' Damping, bodies' drag σ) solved on the band
     (:func:`stochcable.dynamics.timeseries.group_transfer.coupled_group_transfer`; an end on a
     vessel moves with the vessel RAO in the sea channel).  Vessels: their RAO times
