@@ -10,6 +10,5 @@ fixed point), :mod:`~stochcable.dynamics.timeseries` and, on top,
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """

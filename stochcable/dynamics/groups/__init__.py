@@ -42,8 +42,7 @@ The linearized drag of a body is :mod:`stochcable.dynamics.linearization.bodydra
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from stochcable.dynamics.groups.analysis import (

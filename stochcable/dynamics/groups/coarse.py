@@ -23,10 +23,8 @@ the full-grid change.  At most ``COARSE_CORRECTIONS`` rounds, a round that does 
 contract the full-grid change by 0.3 hands over to the plain full-grid iteration.
 The usual convergence test on the full grid ends the iteration, so the answer is
 the full-grid fixed point (tested equal within the tolerance to ``coarse=False``);
-the coarse model only moves the start.  On the three-leg benchmark (narrow, lightly
-damped line resonances that a stride-4 subset does not resolve: its σ are 0.7 % off
-at the same drag) the full grid needs 2 evaluations instead of 7 (6 + 1 coarse ones
-on 45 of 200 frequencies; docs/BENCHMARKS.md, "Bodies", passes E5, E5c).  The
+the coarse model only moves the start (what it saves: docs/benchmarks/dynamics.md,
+"Coarse start of the drag fixed point").  The
 record's ``iterations`` and ``history`` list every evaluation in order, coarse and
 full.  Used by default under both solvers when the tolerance is at least
 ``COARSE_MIN_TOLERANCE`` (tighter: the coarse stage's 1e-6 floor and slower rounds

@@ -15,8 +15,7 @@ fixed point of a frequency subset, corrected by the full/coarse defect
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

@@ -20,8 +20,7 @@ so the fairlead's motion spectrum is |RAO|² Σ_k w_k S = |RAO|² S).
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

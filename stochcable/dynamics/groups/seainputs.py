@@ -18,8 +18,7 @@ a short-crested sea.
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

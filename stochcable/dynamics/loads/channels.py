@@ -49,8 +49,7 @@ mean square ∫ Re(v vᴴ) dξ integrated exactly along the elements
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -100,9 +99,8 @@ class _LazyNodal:
     """A :class:`Channel` field (``velocity``/``acceleration``) that, when left None
     while the channel has a ``nodal`` callable, is computed from it on first access
     (both fields at once) and kept: the sea's nodal kinematics only drive the
-    attachments' drag and inertia, which most lines do not have (0.35 ms of the
-    chain).  A dataclass descriptor field: the default is None and ``__init__`` stores
-    the value through :meth:`__set__`."""
+    attachments' drag and inertia, which most lines do not have (docs/benchmarks/
+    dynamics.md).  A dataclass descriptor field: None by default, set by :meth:`__set__`."""
 
     def __set_name__(self, owner: type, name: str) -> None:
         self._key = "_" + name

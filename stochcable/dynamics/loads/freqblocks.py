@@ -16,8 +16,7 @@ default :data:`WORKING_MEMORY_MB`) is the target of one block's temporaries;
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

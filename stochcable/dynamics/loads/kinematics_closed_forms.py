@@ -12,8 +12,7 @@ element for large grids; this form is the reference and the path without numba.
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

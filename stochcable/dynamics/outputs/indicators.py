@@ -7,8 +7,7 @@ References
 ----------
 Bliet, A. (1984), Dynamic analysis of single span cables, PhD thesis, Massachusetts
 Institute of Technology.
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

@@ -12,8 +12,7 @@ tensions are computed with the response (:mod:`stochcable.dynamics.solve.line_so
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

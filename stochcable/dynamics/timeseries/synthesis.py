@@ -5,8 +5,7 @@ line alone, lines on bodies) by :mod:`stochcable.dynamics.timeseries.group_trans
 
 References
 ----------
-Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
-University.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
