@@ -104,7 +104,7 @@ def write_moordyn(
     beta = sc.analysis.structural_damping.beta
     if sc.analysis.structural_damping.alpha > 0:
         warn("structural_damping.alpha (mass-proportional) has no MoorDyn counterpart: not written")
-    positions = _static_positions(sc) if static_positions else {}
+    positions, poses = _static_positions(sc) if static_positions else ({}, {})
 
     # ---- line types
     types: dict[tuple, str] = {}
@@ -175,7 +175,8 @@ def write_moordyn(
         if vol == 0 and a > 0:
             warn(f"bodies[{i}] ({b.name!r}): added mass without volume is not written")
         mass = 0.0 if b.mass <= POINT_BODY_MASS * (1 + 1e-12) else b.mass
-        body_point[b.name] = add_point("Free", b.position, mass, vol, b.drag_area[0], ca)
+        where = poses.get(b.name, b.position)
+        body_point[b.name] = add_point("Free", where, mass, vol, b.drag_area[0], ca)
 
     # ---- lines
     line_rows: list[str] = []
@@ -263,7 +264,7 @@ def moordyn_lines(scene: Scene) -> list[tuple[str, int, int]]:
     out = []
     for ln in scene.lines:
         e0 = 0
-        for _, _, n in _pieces(ln):
+        for _, _, n in _pieces(ln)[0]:
             out.append((ln.name, e0, n))
             e0 += n
     return out
@@ -319,16 +320,20 @@ def _end_point(sc, ln, end, coupled, body_point, md_body, add_point) -> int:
     return add_point("Fixed", e.position)
 
 
-def _static_positions(sc: Scene) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Line name → (unstretched arc lengths, static node positions), or {} when the
-    statics do not solve (the free points then go on the straight line)."""
+def _static_positions(
+    sc: Scene,
+) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], dict[str, np.ndarray]]:
+    """Line name → (unstretched arc lengths, static node positions) and free body name
+    → static position, or ({}, {}) when the statics do not solve (the free points then
+    go on the straight line, the point bodies at their ``position``)."""
     from stochcable.statics import solve_statics
 
     try:
         st = solve_statics(sc)
     except (StochcableError, ArithmeticError, ValueError):
-        return {}
-    return {
+        return {}, {}
+    lines = {
         name: (np.asarray(ls.mesh.s0, float), np.asarray(ls.positions, float))
         for name, ls in st.lines.items()
     }
+    return lines, {name: np.asarray(b.position, float) for name, b in st.bodies.items()}
