@@ -23,6 +23,7 @@ READABLE = [
     "tripod_network.txt",
     "stochcable_clump_buoy.txt",
     "stochcable_buoy_network.txt",
+    "stochcable_openfast_v1_counts.txt",
 ]
 
 
@@ -78,6 +79,17 @@ def test_v1_and_v2_of_the_same_mooring_read_alike():
     assert (s2.cd_normal, s2.ca_normal, s2.cd_axial) == (1.6, 1.0, 0.1)
     # defaults where the option is absent: MoorDyn v1 g = 9.8, v2 9.80665
     assert v1.environment.g == 9.8 and v2.environment.g == 9.80665
+
+
+def test_moordyn_f_v1_count_rows_and_nine_column_types():
+    # MoorDyn-F 1.x: "3 NLines"-style count rows, CONNECTION PROPERTIES, and a LINE
+    # TYPES table in v1's order (Can Cat Cdn Cdt, no EI) under the v2 header
+    sc = _read("stochcable_openfast_v1_counts.txt")
+    sg = sc.lines[0].segments[0]
+    assert (sg.cd_normal, sg.ca_normal, sg.cd_axial) == (1.6, 1.0, 0.1)
+    assert (sg.length, sg.elements) == (902.2, 20)
+    assert sc.lines[1].end_a.position == (-426.935, 739.47, -320.0)
+    assert sc.lines[2].end_b.attach.point == (-2.6, -4.5, -70.0)
 
 
 def test_ba_becomes_stiffness_proportional_damping():

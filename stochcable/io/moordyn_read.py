@@ -103,6 +103,8 @@ def _type_columns(table: Table) -> dict[str, int]:
     v1 (LINE DICTIONARY) LineType Diam MassDenInAir EA BA/-zeta [EI] Can Cat Cdn Cdt.
     A v2 table whose names row gives v1's order (Can Cat Cdn Cdt) gets a warning."""
     low = [x.lower() for x in table.names]
+    if len(low) == 9:  # v1 without EI, also under MoorDyn-F 1.x's "LINE TYPES" header
+        return {"d": 1, "mass": 2, "ea": 3, "ba": 4, "can": 5, "cat": 6, "cdn": 7, "cdt": 8}
     if "DICTIONARY" in table.title.upper():
         if "ei" in low or len(low) >= 10:
             return {
