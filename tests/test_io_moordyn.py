@@ -278,3 +278,48 @@ def test_bad_numbers_and_nonlinear_ea():
     assert "Mass/m must be > 0" in str(err)
     err = _bad(GOOD.replace("2 Free -420", "3 Free -420"))
     assert "IDs must be 1, 2, 3" in str(err)
+
+
+def test_a_scene_check_names_the_file_row():
+    text = (DATA / "wd0050_chain.txt").read_text().replace("410       41", "300       41")
+    err = _bad(text)
+    assert (
+        err.line == 15 and "MoorDyn line(s) 1" in str(err) and "shorter than its span" in str(err)
+    )
+
+
+def test_mutated_files_give_input_errors_only():
+    """Never a traceback: 600 random edits of the shipped files (a line deleted,
+    truncated, a token replaced, a line inserted, text appended) read to a scene or
+    raise an InputError, nothing else."""
+    import random
+
+    from stochcable.errors import StochcableError
+
+    rng = random.Random(20261128)
+    files = sorted(DATA.glob("*.txt")) + [DATA / "bodies_and_rods.dat"]
+    texts = {f: f.read_text().splitlines() for f in files}
+    tokens = ["x", "-1", "0", "1e400", "nan", "R1A", "Body9", "P0", "|", "END"]
+    inserts = ["END", "--- POINTS ---", "garbage here", "1 2 3", "---"]
+    for _ in range(600):
+        lines = list(texts[rng.choice(files)])
+        k = rng.randrange(len(lines))
+        op = rng.randrange(5)
+        if op == 0:
+            del lines[k]
+        elif op == 1:
+            lines[k] = lines[k][: rng.randrange(len(lines[k]) + 1)]
+        elif op == 2 and lines[k].split():
+            t = lines[k].split()
+            t[rng.randrange(len(t))] = rng.choice(tokens)
+            lines[k] = " ".join(t)
+        elif op == 3:
+            lines.insert(k, rng.choice(inserts))
+        else:
+            lines[k] += " extra"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                read_moordyn("\n".join(lines) + "\n")
+            except StochcableError:
+                pass

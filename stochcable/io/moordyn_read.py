@@ -644,4 +644,17 @@ def read_moordyn(source: str | Path) -> Scene:
         "bodies": body_docs,
         "analysis": {"structural_damping": {"beta": beta}},
     }
-    return load_scene(doc)
+    try:
+        return load_scene(doc)
+    except InputError as exc:
+        # a check of the scene (a line shorter than its span, an anchor above the
+        # water): name the file's row of the line's first MoorDyn line
+        m = re.search(r"lines\[(\d+)\]", str(exc))
+        lines_table = tables.sections["lines"]
+        if m is None or int(m.group(1)) >= len(chains):
+            raise MoorDynInputError(lines_table.line, 1, lines_table.title, "-", str(exc)) from None
+        row = chains[int(m.group(1))][0][0].row
+        ids = ", ".join(str(ln.lid) for ln, _ in chains[int(m.group(1))])
+        raise MoorDynInputError(
+            row.line, 1, lines_table.title, row.tokens[0], f"MoorDyn line(s) {ids}: {exc}"
+        ) from None
