@@ -67,3 +67,18 @@ def test_bad_file_is_one_line_on_stderr(inputs, capsys):
     assert "\n" not in err and "line 15, column 3 (LINES)" in err and "unknown line type" in err
     assert main(["import", str(inputs / "sea.json")]) == 2
     assert "not a MoorDyn input file" in capsys.readouterr().err
+
+
+def test_cases_takes_the_moordyn_file(inputs, capsys):
+    scatter = inputs / "s.csv"
+    scatter.write_text("hs,tp,gamma,probability\n2,8,2,0.5\n3,10,3.3,0.5\n")
+    args = ["cases", str(DATA / "wd0050_chain.txt"), "--scatter", str(scatter)]
+    args += ["--vessel-rao", str(inputs / "rao.json")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(args) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert len(doc["cases"]) == 2
+    # the vessel's motion drives the line: the larger sea gives the larger σ
+    sig = [c["lines"]["line1"]["end_b"]["tension"]["std"] for c in doc["cases"]]
+    assert 0 < sig[0] < sig[1]
