@@ -82,3 +82,23 @@ def test_cases_takes_the_moordyn_file(inputs, capsys):
     # the vessel's motion drives the line: the larger sea gives the larger σ
     sig = [c["lines"]["line1"]["end_b"]["tension"]["std"] for c in doc["cases"]]
     assert 0 < sig[0] < sig[1]
+
+
+def test_fairlead_spectra_replace_the_vessel(inputs, capsys):
+    spectra = inputs / "fs.json"
+    spectra.write_text(json.dumps({"surge": {"type": "jonswap", "hs": 2.0, "tp": 60.0}}))
+    args = ["analyze", str(DATA / "oc3_hywind_v2.txt"), "--format", "json"]
+    args += ["--sea", str(inputs / "sea.json"), "--fairlead-spectra", str(spectra)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(args) == 0
+    doc = json.loads(capsys.readouterr().out)
+    sig = {n: doc["lines"][n]["end_b"]["tension"]["std"] for n in ("line1", "line2", "line3")}
+    # a surge along x: line1 lies along x, lines 2 and 3 at ±120°; to first order only
+    # the motion in a line's own plane changes its tension, cos 120° = −0.5 of it.
+    # ±0.01 (2 %): the drag linearization takes the whole (in- and out-of-plane) response
+    assert sig["line2"] / sig["line1"] == pytest.approx(0.5, abs=0.01)
+    assert sig["line3"] == pytest.approx(sig["line2"], rel=1e-9)
+    both = [*args[:2], "--vessel-rao", str(inputs / "rao.json"), "--fairlead-spectra", str(spectra)]
+    assert main(both) == 2
+    assert "not both" in capsys.readouterr().err
