@@ -29,7 +29,7 @@ from stochcable.dynamics.solve import line_solve as dsolve
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
-EXAMPLE = Path(dsystem.__file__).resolve().parents[1] / "examples" / "chain_catenary.json"
+EXAMPLE = Path(dsystem.__file__).resolve().parents[2] / "examples" / "chain_catenary.json"
 
 
 def _chain(omega_count: int | None = None, **env) -> tuple:

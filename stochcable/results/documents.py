@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.line.strumming import StrummingTable
+from stochcable.results.display import result_html, result_text
 from stochcable.results.records import (
     THREE_HOURS,
     LinearizationRecord,
@@ -473,6 +474,14 @@ class Result:
     warnings: tuple[str, ...] = field(default_factory=tuple)
     fidelity: Any = None
     bodies: dict[str, BodyResult] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        """A few lines: title, lines, end-tension σ with units, number of warnings."""
+        return result_text(self)
+
+    def _repr_html_(self) -> str:
+        """The summary table a notebook shows (:mod:`stochcable.results.display`)."""
+        return result_html(self)
 
     @property
     def converged(self) -> bool:

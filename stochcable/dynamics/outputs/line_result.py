@@ -4,16 +4,18 @@
 Dynamic effective tension
 -------------------------
 Per element δT = (EA/l0)·e·(u_b − u_a), the first-order change of T = EA(l/l0 − 1)
-(seed 001 eqs. 3.1.8–3.1.11: the K_NL part of the tangent stiffness).  The "geometric"
+(Tuah 1982, eqs. 3.1.8–3.1.11: the K_NL part of the tangent stiffness).  The "geometric"
 term (T/l)(I − eeᵀ)Δu of the tangent stiffness rotates the element force; it changes
 its direction, not its magnitude, and contributes to the tension only at second order,
 so it is not part of δT.  Slack elements (T <= 0) use the model's reduced EA.  The end
 tensions are computed with the response (:mod:`stochcable.dynamics.solve.line_solve`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
-
-from typing import Any
 
 import numpy as np
 
@@ -41,7 +43,7 @@ from stochcable.dynamics.residuals.drag_residual import drag_residual
 from stochcable.dynamics.residuals.geometric_residual import geometric_residual
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
 from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
-from stochcable.line.fem import SLACK_EA_RATIO
+from stochcable.line.fem import SLACK_EA_RATIO, FEModel
 from stochcable.results.documents import (
     LineResult,
     stats_from_validated,
@@ -252,7 +254,7 @@ def _tension_transfer(system: LineSystem, resp: Response, n_ch: int) -> np.ndarr
 
 
 def _motion_transfer(
-    model: Any, resp: Response, n_ch: int, freq: slice = slice(None)
+    model: FEModel, resp: Response, n_ch: int, freq: slice = slice(None)
 ) -> np.ndarray:
     """Node motion transfer functions on x, y, z on the frequencies ``freq``, (n_ch,
     n_nodes, 3, n_f) (zero on the components a 2-D model lacks). [m/unit]"""
@@ -273,7 +275,7 @@ def _motion_transfer(
     return motion_h
 
 
-def _end_force_transfer(model: Any, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
+def _end_force_transfer(model: FEModel, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
     """Support force transfer functions on x, y, z per end, (n_ch, 3, n_omega). [N/unit]"""
     comps = list(model.components)
     d = model.dim
