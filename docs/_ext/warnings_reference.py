@@ -349,7 +349,9 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "PhysicsWarning",
         (
             "stochcable.io.moordyn_read:read_moordyn",
-            "stochcable.io.moordyn_read:_type_columns",
+            "stochcable.io.moordyn_read:_structural_beta",
+            "stochcable.io.moordyn_read:_warn_ignored",
+            "stochcable.io.moordyn_parts:_type_columns",
         ),
         "a MoorDyn file (docs/manual/moordyn.md) with options other than WtrDpth, rho, "
         "g, kBot and cBot; non-zero EI, CaAx or Cl; lines whose BA/−ζ give different "
@@ -369,7 +371,9 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "PhysicsWarning",
         (
             "stochcable.io.moordyn_write:write_moordyn",
-            "stochcable.io.moordyn_write:_pieces",
+            "stochcable.io.moordyn_write:_body_rows",
+            "stochcable.io.moordyn_write:_joint_point",
+            "stochcable.io.moordyn_pieces:line_pieces",
         ),
         "a scene written with write_moordyn that has a prescribed motion, a current, "
         "mass-proportional structural damping, an attachment at a line end, or added "

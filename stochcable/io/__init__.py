@@ -13,8 +13,9 @@ from pathlib import Path
 from typing import Any
 
 from stochcable.io.moordyn_file import MoorDynInputError, is_moordyn_text
+from stochcable.io.moordyn_pieces import moordyn_lines
 from stochcable.io.moordyn_read import read_moordyn
-from stochcable.io.moordyn_write import moordyn_lines, write_moordyn
+from stochcable.io.moordyn_write import write_moordyn
 from stochcable.scene.model import Scene
 from stochcable.scene.model import load_scene as _load_json_scene
 

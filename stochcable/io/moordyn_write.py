@@ -17,30 +17,19 @@ from Mass/m and Diam) and free bodies that are not point bodies.
 from __future__ import annotations
 
 from collections.abc import Collection
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from stochcable import validation as _v
-from stochcable.errors import InputError, StochcableError, warn
-from stochcable.io.moordyn_read import POINT_BODY_MASS, VESSEL
-from stochcable.scene.model import Body, Line, Scene, load_scene
+from stochcable.errors import InputError, warn
+from stochcable.io.moordyn_parts import VESSEL
+from stochcable.io.moordyn_pieces import line_pieces, static_node_positions
+from stochcable.io.moordyn_scene import POINT_BODY_MASS, is_point_body
+from stochcable.scene.model import Line, Scene, load_scene
 
-__all__ = ["write_moordyn", "is_point_body", "moordyn_lines"]
-
-
-def is_point_body(body: Body) -> bool:
-    """True for a point body: free, rotations held, no inertia or hydrodynamic table
-    (what :func:`~stochcable.io.moordyn_read.read_moordyn` makes of a MoorDyn free point
-    joining one or three and more line ends)."""
-    rot = {"roll", "pitch", "yaw"}
-    return (
-        body.prescribed is None
-        and body.hydrodynamics is None
-        and body.inertia is None
-        and (rot <= set(body.fixed_dofs) or set(body.fixed_dofs) == {"pitch"})
-        and body.hydrostatic_stiffness is None
-    )
+__all__ = ["write_moordyn", "is_point_body"]
 
 
 def _f(v: float) -> str:
@@ -101,13 +90,47 @@ def write_moordyn(
     ic_threshold = _v.positive("ic_threshold", ic_threshold, "-")
     ic_tmax = _v.positive("ic_tmax", ic_tmax, "s")
     coupled = set(coupled_ends)
-    beta = sc.analysis.structural_damping.beta
     if sc.analysis.structural_damping.alpha > 0:
         warn("structural_damping.alpha (mass-proportional) has no MoorDyn counterpart: not written")
-    positions, poses = _static_positions(sc) if static_positions else ({}, {})
+    positions, poses = static_node_positions(sc) if static_positions else ({}, {})
+    types, type_rows = _line_type_rows(sc, internal_damping)
+    points = _PointRows()
+    body_rows, body_point, md_body = _body_rows(sc, poses, points)
+    ends = _Ends(sc, coupled, body_point, md_body, points)
+    line_rows = _line_rows(sc, types, positions, ends, points)
+    options = [
+        f"{_f(dt)} dtM",
+        f"{_f(env.seabed.stiffness)} kBot",
+        f"{_f(env.seabed.damping)} cBot",
+        f"{_f(env.depth)} WtrDpth",
+        f"{_f(env.rho)} rho",
+        f"{_f(env.g)} g",
+        "0 WaveKin",
+        "0 Currents",
+        f"{scheme} tScheme",
+        f"{_f(ic_threshold)} threshIC",
+        f"{_f(ic_tmax)} TmaxIC",
+        "0 writeLog",
+        "1 disableOutput",
+    ]
+    text = _file_text(sc.title, type_rows, body_rows, points.rows, line_rows, options)
+    if env.current:
+        warn("the scene's current is not written (MoorDyn reads currents from its own files)")
+    return text
 
-    # ---- line types
-    types: dict[tuple, str] = {}
+
+def _type_key(sg: Any) -> tuple[float, ...]:
+    """The properties that make a MoorDyn line type."""
+    return (sg.diameter, sg.mass, sg.ea, sg.cd_normal, sg.ca_normal, sg.cd_axial)
+
+
+def _line_type_rows(
+    sc: Scene, internal_damping: float | None
+) -> tuple[dict[tuple[float, ...], str], list[str]]:
+    """LINE TYPES: a type per distinct segment (``type1``, ``type2``, ...) and its rows;
+    BA = ``internal_damping``, else β·EA."""
+    beta = sc.analysis.structural_damping.beta
+    types: dict[tuple[float, ...], str] = {}
     type_rows = []
     for i, ln in enumerate(sc.lines):
         for j, sg in enumerate(ln.segments):
@@ -119,7 +142,7 @@ def write_moordyn(
                     "cannot be written to MoorDyn (it derives the weight from Mass/m and "
                     "Diam): remove it and give mass and diameter",
                 )
-            key = (sg.diameter, sg.mass, sg.ea, sg.cd_normal, sg.ca_normal, sg.cd_axial)
+            key = _type_key(sg)
             if key not in types:
                 name = f"type{len(types) + 1}"
                 types[key] = name
@@ -128,18 +151,61 @@ def write_moordyn(
                     f"{name} {_f(sg.diameter)} {_f(sg.mass)} {_f(sg.ea)} {_f(ba)} 0 "
                     f"{_f(sg.cd_normal)} {_f(sg.ca_normal)} {_f(sg.cd_axial)} 0"
                 )
+    return types, type_rows
 
-    # ---- bodies and their points
-    point_rows: list[str] = []
 
-    def add_point(kind: str, xyz: Any, mass=0.0, vol=0.0, cda=0.0, ca=0.0) -> int:
-        pid = len(point_rows) + 1
-        point_rows.append(
-            f"{pid} {kind} {_f(xyz[0])} {_f(xyz[1])} {_f(xyz[2])} {_f(mass)} {_f(vol)} "
-            f"{_f(cda)} {_f(ca)}"
-        )
+class _PointRows:
+    """The POINTS section: its rows, a point's ID its place in the list."""
+
+    def __init__(self) -> None:
+        self.rows: list[str] = []
+
+    def add(self, kind: str, xyz: Any, *props: float) -> int:
+        """Add a point at ``xyz`` [m], ``props`` its mass [kg], volume [m³], CdA [m²]
+        and Ca [-] (zero where not given); its ID."""
+        pid = len(self.rows) + 1
+        numbers = [xyz[0], xyz[1], xyz[2], *props, *[0.0] * (4 - len(props))]
+        self.rows.append(f"{pid} {kind} " + " ".join(_f(v) for v in numbers))
         return pid
 
+
+@dataclass(frozen=True)
+class _Ends:
+    """The points of the scene lines' ends: a point body's Free point; a Body<k> point
+    of a Coupled MoorDyn body; a Coupled point (on ``vessel``, with a prescribed motion
+    or listed in ``coupled``); else a Fixed point."""
+
+    sc: Scene
+    coupled: set[tuple[str, str]]
+    body_point: dict[str, int]
+    md_body: dict[str, int]
+    points: _PointRows
+
+    def point(self, ln: Line, end: str) -> int:
+        """The point ID of ``ln``'s ``end`` ("end_a" or "end_b"), added if new."""
+        e = getattr(ln, end)
+        if e.attach is not None:
+            name = e.attach.body
+            if name in self.body_point:
+                return self.body_point[name]
+            body = self.sc.body(name)
+            if name in self.md_body:
+                return self.points.add(f"Body{self.md_body[name]}", e.attach.point)
+            return self.points.add(
+                "Coupled", np.asarray(body.position) + np.asarray(e.attach.point)
+            )
+        if e.motion is not None or (ln.name, end) in self.coupled:
+            return self.points.add("Coupled", e.position)
+        return self.points.add("Fixed", e.position)
+
+
+def _body_rows(
+    sc: Scene, poses: dict[str, np.ndarray], points: _PointRows
+) -> tuple[list[str], dict[str, int], dict[str, int]]:
+    """BODIES (a Coupled body per prescribed body other than ``vessel``) and the point
+    bodies' Free points: the rows, point body name → point ID, prescribed body name →
+    MoorDyn body ID."""
+    env = sc.environment
     body_point: dict[str, int] = {}
     body_rows: list[str] = []
     md_body: dict[str, int] = {}
@@ -158,7 +224,8 @@ def write_moordyn(
             }:
                 warn(
                     f"bodies[{i}] ({b.name!r}): its prescribed motion is not written "
-                    "(MoorDyn takes the motion of Coupled points from its driver)"
+                    "(MoorDyn takes the motion of Coupled points from its driver)",
+                    stacklevel=3,
                 )
             continue
         if not is_point_body(b):
@@ -173,18 +240,28 @@ def write_moordyn(
         a = 0.0 if b.added_mass is None else b.added_mass[0][0]
         ca = a / (env.rho * vol) if vol > 0 else 0.0
         if vol == 0 and a > 0:
-            warn(f"bodies[{i}] ({b.name!r}): added mass without volume is not written")
+            warn(
+                f"bodies[{i}] ({b.name!r}): added mass without volume is not written", stacklevel=3
+            )
         mass = 0.0 if b.mass <= POINT_BODY_MASS * (1 + 1e-12) else b.mass
         where = poses.get(b.name, b.position)
-        body_point[b.name] = add_point("Free", where, mass, vol, b.drag_area[0], ca)
+        body_point[b.name] = points.add("Free", where, mass, vol, b.drag_area[0], ca)
+    return body_rows, body_point, md_body
 
-    # ---- lines
+
+def _line_rows(
+    sc: Scene,
+    types: dict[tuple[float, ...], str],
+    positions: dict[str, tuple[np.ndarray, np.ndarray]],
+    ends: _Ends,
+    points: _PointRows,
+) -> list[str]:
+    """LINES: per scene line, a MoorDyn line per piece from end_a through the Free
+    joint points (at the static positions, else on the straight line) to end_b."""
     line_rows: list[str] = []
     for ln in sc.lines:
-        pieces, joints = _pieces(ln)
-        pa = _end_point(sc, ln, "end_a", coupled, body_point, md_body, add_point)
-        prev = pa
-        total = ln.length
+        pieces, joints = line_pieces(ln)
+        prev = ends.point(ln, "end_a")
         xa, xb = sc.end_position(ln, "end_a"), sc.end_position(ln, "end_b")
         for k, (seg, length, elements) in enumerate(pieces):
             if k < len(pieces) - 1:
@@ -193,26 +270,45 @@ def write_moordyn(
                     s0, xyz = positions[ln.name]
                     pos = [float(np.interp(s, s0, xyz[:, c])) for c in range(3)]
                 else:
-                    pos = xa + (xb - xa) * (s / total)
-                mass = sum(a.mass for a in att)
-                vol = sum(a.buoyancy for a in att) / (env.rho * env.g)
-                added = sum(a.added_mass for a in att)
-                ca = added / (env.rho * vol) if vol > 0 else 0.0
-                if vol == 0 and added > 0:
-                    warn(f"line {ln.name!r}: attachment added mass without buoyancy is not written")
-                cda = sum(a.drag_area for a in att)
-                nxt = add_point("Free", pos, mass, vol, cda, ca)
+                    pos = xa + (xb - xa) * (s / ln.length)
+                nxt = _joint_point(sc.environment, ln, pos, att, points)
             else:
-                nxt = _end_point(sc, ln, "end_b", coupled, body_point, md_body, add_point)
-            key = (seg.diameter, seg.mass, seg.ea, seg.cd_normal, seg.ca_normal, seg.cd_axial)
+                nxt = ends.point(ln, "end_b")
             line_rows.append(
-                f"{len(line_rows) + 1} {types[key]} {prev} {nxt} {_f(length)} {elements} -"
+                f"{len(line_rows) + 1} {types[_type_key(seg)]} {prev} {nxt} {_f(length)} "
+                f"{elements} -"
             )
             prev = nxt
+    return line_rows
 
+
+def _joint_point(env: Any, ln: Line, pos: Any, att: list, points: _PointRows) -> int:
+    """The Free point joining two pieces of line ``ln`` at ``pos``, carrying the
+    attachments ``att`` there (volume = buoyancy/(ρ·g), Ca = added mass/(ρ·V))."""
+    mass = sum(a.mass for a in att)
+    vol = sum(a.buoyancy for a in att) / (env.rho * env.g)
+    added = sum(a.added_mass for a in att)
+    ca = added / (env.rho * vol) if vol > 0 else 0.0
+    if vol == 0 and added > 0:
+        warn(
+            f"line {ln.name!r}: attachment added mass without buoyancy is not written", stacklevel=4
+        )
+    cda = sum(a.drag_area for a in att)
+    return points.add("Free", pos, mass, vol, cda, ca)
+
+
+def _file_text(
+    title: str,
+    type_rows: list[str],
+    body_rows: list[str],
+    point_rows: list[str],
+    line_rows: list[str],
+    options: list[str],
+) -> str:
+    """The file: the sections' headers, names and units rows around their rows."""
     rows = [
         "--------------------- MoorDyn Input File ------------------------------------",
-        sc.title.replace("\n", " ").replace("---", "- - -"),
+        title.replace("\n", " ").replace("---", "- - -"),
         "---------------------- LINE TYPES -----------------------------------------",
         "TypeName Diam Mass/m EA BA/-zeta EI Cd Ca CdAx CaAx",
         "(name) (m) (kg/m) (N) (N-s/-) (N-m^2) (-) (-) (-) (-)",
@@ -235,105 +331,8 @@ def write_moordyn(
         "(#) (name) (#) (#) (m) (-) (-)",
         *line_rows,
         "---------------------- OPTIONS --------------------------------------------",
-        f"{_f(dt)} dtM",
-        f"{_f(env.seabed.stiffness)} kBot",
-        f"{_f(env.seabed.damping)} cBot",
-        f"{_f(env.depth)} WtrDpth",
-        f"{_f(env.rho)} rho",
-        f"{_f(env.g)} g",
-        "0 WaveKin",
-        "0 Currents",
-        f"{scheme} tScheme",
-        f"{_f(ic_threshold)} threshIC",
-        f"{_f(ic_tmax)} TmaxIC",
-        "0 writeLog",
-        "1 disableOutput",
+        *options,
         "------------------------- need this line ---------------------------------",
         "",
     ]
-    if env.current:
-        warn("the scene's current is not written (MoorDyn reads currents from its own files)")
     return "\n".join(rows)
-
-
-def moordyn_lines(scene: Scene) -> list[tuple[str, int, int]]:
-    """The MoorDyn lines :func:`write_moordyn` writes for ``scene``, in file order: (scene
-    line name, index of its first element in the scene line, element count).  The
-    indices are the scene mesh's when the attachments sit at segment boundaries (every
-    scene read from a MoorDyn file); an attachment inside a segment splits it."""
-    out = []
-    for ln in scene.lines:
-        e0 = 0
-        for _, _, n in _pieces(ln)[0]:
-            out.append((ln.name, e0, n))
-            e0 += n
-    return out
-
-
-def _pieces(ln: Line) -> tuple[list[tuple[Any, float, int]], list[tuple[float, list]]]:
-    """The MoorDyn lines of a scene line: (segment, length, elements) pieces and the
-    joints between them (arc length, attachments there)."""
-    total = ln.length
-    tol = 1e-9 * total
-    bounds = np.cumsum([0.0] + [s.length for s in ln.segments])
-    cuts = sorted({float(b) for b in bounds[1:-1]})
-    for i, a in enumerate(ln.attachments):
-        if a.at <= tol or a.at >= total - tol:
-            warn(
-                f"line {ln.name!r}: attachments[{i}] at an end (at = {a.at} m) is not "
-                "written (MoorDyn lumps it with the end point)"
-            )
-            continue
-        if all(abs(a.at - c) > tol for c in cuts):
-            cuts.append(float(a.at))
-    cuts.sort()
-    edges = [0.0, *cuts, total]
-    pieces, joints = [], []
-    for k in range(len(edges) - 1):
-        s0, s1 = edges[k], edges[k + 1]
-        j = int(np.searchsorted(bounds, 0.5 * (s0 + s1)) - 1)
-        seg = ln.segments[j]
-        frac = (s1 - s0) / seg.length
-        if frac > 1 - 1e-9:  # the whole segment: its own numbers, exactly
-            pieces.append((seg, seg.length, seg.elements))
-        else:
-            pieces.append((seg, s1 - s0, max(1, int(round(seg.elements * frac)))))
-        if k < len(edges) - 2:
-            att = [a for a in ln.attachments if abs(a.at - s1) <= tol]
-            joints.append((s1, att))
-    return pieces, joints
-
-
-def _end_point(sc, ln, end, coupled, body_point, md_body, add_point) -> int:
-    e = getattr(ln, end)
-    if e.attach is not None:
-        name = e.attach.body
-        if name in body_point:
-            return body_point[name]
-        body = sc.body(name)
-        if name in md_body:
-            r = e.attach.point
-            return add_point(f"Body{md_body[name]}", r)
-        return add_point("Coupled", np.asarray(body.position) + np.asarray(e.attach.point))
-    if e.motion is not None or (ln.name, end) in coupled:
-        return add_point("Coupled", e.position)
-    return add_point("Fixed", e.position)
-
-
-def _static_positions(
-    sc: Scene,
-) -> tuple[dict[str, tuple[np.ndarray, np.ndarray]], dict[str, np.ndarray]]:
-    """Line name → (unstretched arc lengths, static node positions) and free body name
-    → static position, or ({}, {}) when the statics do not solve (the free points then
-    go on the straight line, the point bodies at their ``position``)."""
-    from stochcable.statics import solve_statics
-
-    try:
-        st = solve_statics(sc)
-    except (StochcableError, ArithmeticError, ValueError):
-        return {}, {}
-    lines = {
-        name: (np.asarray(ls.mesh.s0, float), np.asarray(ls.positions, float))
-        for name, ls in st.lines.items()
-    }
-    return lines, {name: np.asarray(b.position, float) for name, b in st.bodies.items()}
