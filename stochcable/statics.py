@@ -6,17 +6,20 @@ body poses): a scene without bodies is its lines, each solved alone
 Newton on the free body poses with the lines attached
 (:func:`stochcable.bodies.statics.solve_body_statics`).  Then, about the static shape,
 the finite-element model and the natural modes of every line
-(:func:`scene_fe_models`, :func:`modes_of_scene`).
+(:func:`scene_fe_models`, :func:`natural_modes`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from stochcable.line.fem import FEModel, build_fe_model, check_dim
 from stochcable.line.mesh import mesh_line
-from stochcable.line.modes import Modes, natural_modes
+from stochcable.line.modes import Modes
+from stochcable.line.modes import natural_modes as line_modes
 from stochcable.line.statics import LineStatics, Method, check_statics_options, line_statics
 from stochcable.scene.model import Scene, load_scene
 from stochcable.validation import positive_int
@@ -24,7 +27,12 @@ from stochcable.validation import positive_int
 if TYPE_CHECKING:  # pragma: no cover
     from stochcable.bodies.statics import BodyStatics
 
-__all__ = ["StaticsResult", "solve_statics", "scene_fe_models", "modes_of_scene"]
+__all__ = [
+    "StaticsResult",
+    "solve_statics",
+    "scene_fe_models",
+    "natural_modes",
+]
 
 
 @dataclass(frozen=True)
@@ -45,14 +53,18 @@ class StaticsResult:
 
 
 def solve_statics(
-    scene: Scene, method: Method = "auto", *, tolerance: float = 1e-10, max_iterations: int = 500
+    scene: Scene | Mapping[str, Any] | str | Path,
+    method: Method = "auto",
+    *,
+    tolerance: float = 1e-10,
+    max_iterations: int = 500,
 ) -> StaticsResult:
     """Static equilibrium of every line of a scene.
 
     Parameters
     ----------
-    scene : Scene
-        The validated scene (see :func:`stochcable.scene.model.load_scene`).
+    scene : Scene, mapping, JSON string or path
+        The scene document (validated by :func:`stochcable.scene.model.load_scene`).
     method : {"auto", "fe", "catenary"}, optional
         Solution method, see :func:`stochcable.line.statics.solve_line_statics`.
     tolerance : float, optional
@@ -76,6 +88,7 @@ def solve_statics(
     ConvergenceError
         A line or the body poses did not converge.
     """
+    scene = load_scene(scene)
     method, tolerance, max_iterations = check_statics_options(method, tolerance, max_iterations)
     env = scene.environment
     if scene.bodies:
@@ -126,18 +139,20 @@ def scene_fe_models(
     }
 
 
-def modes_of_scene(
-    scene: Any,
+def natural_modes(
+    scene: Scene | Mapping[str, Any] | str | Path | FEModel,
     count: int | None = None,
     dim: int = 3,
     added_mass: bool = True,
-) -> dict[str, Modes]:
+) -> dict[str, Modes] | Modes:
     """Natural modes of every line of a scene about its static equilibrium.
 
     Parameters
     ----------
-    scene : Scene, mapping, JSON string or path
-        The scene document (:func:`stochcable.scene.model.load_scene`).
+    scene : Scene, mapping, JSON string, path or FEModel
+        The scene document (:func:`stochcable.scene.model.load_scene`); an
+        :class:`~stochcable.line.fem.FEModel` gives that one model's modes
+        (:func:`stochcable.line.modes.natural_modes`, ``dim`` unused).
     count : int, optional
         Modes per line; default all.
     dim : {2, 3}
@@ -149,12 +164,15 @@ def modes_of_scene(
     Returns
     -------
     dict of str to Modes
-        Per line name, in scene order.
+        Per line name, in scene order (a :class:`~stochcable.line.modes.Modes` for an
+        FEModel).
     """
     if count is not None:
         count = positive_int("count", count)
+    if isinstance(scene, FEModel):
+        return line_modes(scene, count=count, added_mass=added_mass)
     models = scene_fe_models(scene, dim=dim)
     return {
-        name: natural_modes(model, count=count, added_mass=added_mass)
+        name: line_modes(model, count=count, added_mass=added_mass)
         for name, model in models.items()
     }

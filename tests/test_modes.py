@@ -535,7 +535,7 @@ def taut_scene_reference(n: int = 3) -> np.ndarray:
 
 def test_modes_of_scene_weightless_string():
     pytest.importorskip("stochcable.statics")
-    from stochcable.statics import modes_of_scene
+    from stochcable.statics import natural_modes as modes_of_scene
 
     m = modes_of_scene(TAUT_SCENE, count=6)["taut"]
     ref = np.repeat(taut_scene_reference(3), 2)

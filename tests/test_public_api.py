@@ -21,7 +21,7 @@ EXPECTED = {
     "load_scene": "stochcable.scene.model",
     "Scene": "stochcable.scene.model",
     "solve_statics": "stochcable.statics",
-    "natural_modes": "stochcable.line.modes",
+    "natural_modes": "stochcable.statics",
     "simulate_sea": "stochcable.sea.realization",
     "load_example": "stochcable.examples",
 }

@@ -35,7 +35,9 @@ banded Jacobian assembly is specific to the line topology.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -248,7 +250,7 @@ class CableTimeHistory:
 
 
 def simulate_line_timedomain(
-    scene: Scene | dict | str,
+    scene: Scene | Mapping[str, Any] | str | Path,
     line_name: str | None = None,
     *,
     realization: Any = None,
@@ -274,8 +276,8 @@ def simulate_line_timedomain(
 
     Parameters
     ----------
-    scene : Scene, mapping or JSON
-        The scene document.
+    scene : Scene, mapping, JSON string or path
+        The scene document (validated by :func:`stochcable.scene.model.load_scene`).
     line_name : str, optional
         Which line (default: the first). [-]
     realization : SeaRealization, optional
