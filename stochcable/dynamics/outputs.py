@@ -29,6 +29,7 @@ from stochcable.dynamics.loads import (
 )
 from stochcable.dynamics.resolution import (
     LineModes,
+    excitation_end,
     resolution_check,
     surface_resolution_check,
     tail_check,
@@ -148,10 +149,11 @@ def line_result(
     st = system.statics
     s0 = model.mesh.s0
     stats = {}
+    input_end = excitation_end(channels, w)
     for end, mean in (("end_a", st.tension_a), ("end_b", st.tension_b)):
         dens = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
         stats[end] = stats_from_validated(w, dens, float(mean), settings.duration)
-        tail_check(system.name, end, w, dens, stats[end].m0)
+        tail_check(system.name, end, w, dens, stats[end].m0, input_end)
     if np.any(spectra > 0):  # nothing to resolve without excitation
         resolution_check(system, linearization.damping, w, modes)
         surface_resolution_check(system, channels, w, q)
