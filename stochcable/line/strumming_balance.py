@@ -31,9 +31,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from stochcable.errors import InputError
+from stochcable.line.strumming_bound import grid_is_proven
 from stochcable.validation import finite_scalar
 
 __all__ = [
@@ -473,6 +473,9 @@ def lock_in_balance(
 
     ln_a = np.log(np.geomspace(1e-3, 3.0, 20) / y_scale)
     ratio = np.linspace(0.65, 1.35, 29)
+    args = (np.exp(ln_a), ratio * omega_n, omega_n, damping_ratio, ps, qs, ds, ws, c0)
+    if grid_is_proven(*args, params.g, params.big_h, params.f):
+        return none  # every point proven: no start, and no compiled kernel needed
     from stochcable.line.strumming_kernels import balance_grid  # numba: lazily
 
     grid = balance_grid(
@@ -504,6 +507,8 @@ def lock_in_balance(
     roots = []
     for flat in starts:
         i, j = np.unravel_index(flat, grid.shape)
+        from scipy.optimize import least_squares  # (only where a start is refined)
+
         sol = least_squares(
             resid,
             np.array([ln_a[i], ratio[j]]),
