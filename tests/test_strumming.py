@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -194,25 +193,6 @@ def test_numpy_bound_proves_what_the_kernel_proves(xi, amp_scale):
     args = (amps, np.linspace(0.65, 1.35, 29) * wn, wn, xi, psi, q, d, ws, lift0)
     grid = balance_grid(*args, params.g, params.big_h, params.f)
     assert grid_is_proven(*args, params.g, params.big_h, params.f) == bool(np.all(grid == 1.0))
-
-
-def test_chain_is_screened_without_numba():
-    # the chain's candidate modes are all proven without a start by the NumPy bound:
-    # its first analysis imports no numba (a fresh process)
-    import subprocess
-    import sys
-
-    code = (
-        "import sys, warnings; warnings.simplefilter('ignore'); import stochcable; "
-        "r = stochcable.analyze('stochcable/examples/chain_catenary.json'); "
-        "print('numba' in sys.modules)"
-    )
-    root = Path(__file__).resolve().parents[1]
-    out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=root
-    )
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "False"
 
 
 # ------------------------------------------------------------------ Example 6
