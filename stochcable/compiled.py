@@ -11,11 +11,12 @@ costs ~0.2 s), so ``import stochcable``, the CLI and the service start do not lo
 
 from __future__ import annotations
 
+import time
 import warnings
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["KERNEL_MIN_ENTRIES", "jit_cached", "optional_kernel"]
+__all__ = ["KERNEL_MIN_ENTRIES", "compile_cpu_seconds", "jit_cached", "optional_kernel"]
 
 #: Problem size (array entries: elements × frequencies × inputs of the variance sums,
 #: right-hand-side entries of the banded solves) from which the dynamics use their
@@ -25,6 +26,7 @@ __all__ = ["KERNEL_MIN_ENTRIES", "jit_cached", "optional_kernel"]
 KERNEL_MIN_ENTRIES = 2**16
 
 _KERNELS: dict[tuple[str, str], Any] = {}
+_COMPILE_CPU_S = [0.0]  # (compile_cpu_seconds)
 
 
 def optional_kernel(module: str, name: str) -> Any:
@@ -68,6 +70,21 @@ def jit_cached(
     cached : bool
         Whether its machine code is kept on disk.
     """
+    start = time.process_time()
+    try:
+        return _jit(function, signature, what)
+    finally:
+        _COMPILE_CPU_S[0] += time.process_time() - start
+
+
+def compile_cpu_seconds() -> float:
+    """CPU time this process has spent in :func:`jit_cached`: compiling kernels, or
+    loading them from the cache (the test suite's fast-tier guard leaves it out of a
+    test's cost: it is the machine's first use, not the test's work). [s]"""
+    return _COMPILE_CPU_S[0]
+
+
+def _jit(function: Callable[..., Any], signature: Any, what: str) -> tuple[Any, bool]:
     import numba
 
     try:
@@ -80,6 +97,6 @@ def jit_cached(
             "is compiled in memory in each process (~1 s at its first use); set "
             "NUMBA_CACHE_DIR to a writable directory to keep it",
             UserWarning,
-            stacklevel=3,
+            stacklevel=4,
         )
         return numba.njit(signature, nogil=True)(function), False

@@ -32,7 +32,10 @@ from stochcable.statics import solve_statics
 # The fairlead surge spectra below have a PM ω⁻⁵ tail, so the tension spectra are cut by
 # the 2 rad/s grids (ResolutionWarning, tested in test_grid_cutting_the_response_warns);
 # the tests compare methods on the same grid, so the warning is silenced elsewhere.
-pytestmark = pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning")
+pytestmark = [
+    pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning"),
+    pytest.mark.xdist_group("test_analysis"),
+]
 
 PM_SEA = {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}
 PM_SURGE = {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}

@@ -29,6 +29,9 @@ from stochcable.fidelity.limits import (
 )
 from stochcable.scene.model import OmegaGrid, Segment
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_fidelity_limits")
+
 
 def _chain(target: float | None = None) -> dict:
     """The chain example with DESIGN.md's untapered PM fairlead surge (ω⁻⁵ tail; the
@@ -125,6 +128,7 @@ def test_unbounded_tail_warning_names_the_cause_and_the_fix(plan_03):
         assert part in text
 
 
+@pytest.mark.slow
 def test_met_targets_have_no_limits_and_unchanged_documents():
     # where the limits are not hit the plan is the one of the rules alone (no new keys)
     plan = choose_fidelity(_chain(), 0.05, evaluate=analyze)
@@ -163,6 +167,7 @@ def _model_error_said(texts: list[str], target: float) -> None:
     assert "0.077" in text and "touchdown" in text and "fd_budget" in text
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target", TARGETS)
 def test_library_entrance_meets_the_target(target):
     res = analyze(_chain(target))
@@ -185,6 +190,7 @@ def _cli(tmp_path, doc, capsys) -> tuple[int, str, dict | None]:
     return rc, err, (json.loads(out.read_text()) if rc == 0 else None)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target", TARGETS)
 def test_cli_entrance_meets_the_target(target, tmp_path, capsys):
     rc, err, out = _cli(tmp_path, _chain(target), capsys)
@@ -206,6 +212,7 @@ def client():
         yield c
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target", TARGETS)
 def test_http_entrance_meets_the_target(target, client):
     resp = client.post("/v1/analyses", json=_chain(target))
@@ -244,6 +251,7 @@ def _check_limit_warning(texts: list[str]) -> None:
     assert "estimated σ error" in text and "analysis.fidelity.target_error" in text
 
 
+@pytest.mark.slow
 def test_entrances_at_the_limit_answer_with_the_warning(low_limit, tmp_path, capsys):
     res = analyze(_chain(0.05))
     assert res.fidelity.omega_count == 200 and not res.fidelity.grid_resolved

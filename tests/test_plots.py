@@ -11,6 +11,9 @@ import pytest
 from stochcable.analysis import analyze
 from stochcable.examples import load_example
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_plots")
+
 matplotlib = pytest.importorskip("matplotlib")
 matplotlib.use("Agg")
 

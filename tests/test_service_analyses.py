@@ -26,6 +26,9 @@ from stochcable.analysis import analyze
 from stochcable.cli import main as cli_main
 from stochcable.examples import list_examples, load_example
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_service_analyses")
+
 CHAIN = "chain_catenary"  # the README / banner example: sea + end motion, time series
 SMALL = "tuah_1982_single_leg"  # 3 elements, time series, ~20 ms: for the limit tests
 

@@ -37,6 +37,9 @@ from stochcable.reference.wake_oscillator import simulate_wake_oscillator
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_strumming")
+
 FT = 0.3048
 EXAMPLE = "tuah_1982_strumming_string"
 #: seed 001 §6.6: Strouhal frequency, fundamental, maximum transverse displacement

@@ -74,6 +74,7 @@ def test_heavy_document_is_refused_before_any_work(two_workers):
     assert all(w.memory_info().rss < 1 * GB for w in two_workers.workers())
 
 
+@pytest.mark.slow
 def test_heavy_analysis_does_not_hold_up_the_others(two_workers):
     heavy: dict[str, httpx.Response] = {}
     thread = threading.Thread(
