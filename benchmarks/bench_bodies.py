@@ -4,7 +4,7 @@ A buoy (6 DOF, constant added mass and radiation damping, drag) on three chain l
 at 0/120/240 deg, 40 elements per leg (3-D), 200 frequencies on [0.1, 2] rad/s,
 JONSWAP Hs 3 m Tp 9 s.  Timed: the whole dynamic analysis of the group
 with the statics (lines and the buoy pose, stochcable.line.statics) and without them
-(:func:`stochcable.dynamics.coupled.analyze_coupled`: models, channels, coupled drag
+(:func:`stochcable.dynamics.groups.analyze_coupled`: models, channels, coupled drag
 linearization, coupled modes, line and body outputs), with one BLAS thread as
 ``analyze()`` runs small models, for the direct and the Foss ("auto") solvers, and
 the whole ``analyze()`` call (scene to result: statics, dynamics, warnings,
@@ -39,15 +39,15 @@ from typing import Any
 import numpy as np
 from host_probe import host_line
 
-import stochcable.dynamics.coupled.coarse as coupled_coarse
-import stochcable.dynamics.coupled.lineparts as coupled_lineparts
-import stochcable.dynamics.coupled.modes as coupled_modes
+import stochcable.dynamics.groups.coarse as coupled_coarse
+import stochcable.dynamics.groups.lineparts as coupled_lineparts
+import stochcable.dynamics.groups.modes as coupled_modes
 from stochcable.analysis import analyze
-from stochcable.dynamics.coupled import analyze_coupled
-from stochcable.dynamics.fixedpoint import linearize
-from stochcable.dynamics.loads import line_channels
-from stochcable.dynamics.outputs import line_result
-from stochcable.dynamics.system import build_line_system
+from stochcable.dynamics.groups import analyze_coupled
+from stochcable.dynamics.groups.line_fixed_point import linearize
+from stochcable.dynamics.loads.channels import line_channels
+from stochcable.dynamics.model.system import build_line_system
+from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.runtime import single_blas_thread
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics

@@ -35,7 +35,7 @@ doc = json.loads(sys.argv[1])
 # compiler's memory is not the analysis' arrays), as tests/test_cost.py measures
 analyze(load_example("taut_wire"))
 analyze(load_example("chain_catenary"))
-import stochcable.dynamics.kinematics_kernels  # (large grids' compiled kinematics)
+import stochcable.dynamics.loads.kinematics_kernels  # (large grids' compiled kinematics)
 try:  # reset the peak RSS (VmHWM) to the current RSS (Linux >= 4.0)
     with open("/proc/self/clear_refs", "w") as f:
         f.write("5")

@@ -315,7 +315,7 @@ def main() -> None:
         # wrapped; MoorPy lumps the mass, stochcable's default is consistent
         import functools
 
-        from stochcable.dynamics import system as analysis
+        from stochcable.dynamics.model import system as analysis
 
         original = analysis.build_fe_model
         analysis.build_fe_model = functools.partial(original, mass_matrix="lumped")

@@ -44,7 +44,7 @@ def doc(n_el, n_w):
     d["analysis"]["omega"]["count"] = n_w
     return d
 stochcable.analyze(doc(10, 50))
-import stochcable.dynamics.kinematics_kernels  # (large grids' compiled kinematics)
+import stochcable.dynamics.loads.kinematics_kernels  # (large grids' compiled kinematics)
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 n_el, n_w = int(sys.argv[1]), int(sys.argv[2])
 d = doc(n_el, n_w)

@@ -1,4 +1,4 @@
-"""Benchmark of the frequency-domain solvers (stochcable.dynamics.solvers).
+"""Benchmark of the frequency-domain solvers (stochcable.dynamics.model.solvers).
 
 A 40-element 3-D line (120 DOF: 40 free nodes x 3, end A pinned, end B on a stiff
 spring), consistent mass plus normal added mass, a lumped linearized drag damping
@@ -17,13 +17,13 @@ import time
 
 import numpy as np
 
-from stochcable.dynamics.modal_solvers import (
+from stochcable.dynamics.model.modal_solvers import (
     foss_decomposition,
     foss_transfer,
     modal_basis,
     solve_modal,
 )
-from stochcable.dynamics.solvers import matrix_bandwidth, solve_direct
+from stochcable.dynamics.model.solvers import matrix_bandwidth, solve_direct
 
 
 def line_model(

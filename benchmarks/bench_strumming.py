@@ -23,7 +23,7 @@ from host_probe import host_line
 
 from stochcable.analysis import analyze
 from stochcable.dynamics.engine import build_engine
-from stochcable.dynamics.strumming import with_strumming
+from stochcable.dynamics.model.strumming import with_strumming
 from stochcable.examples import load_example
 from stochcable.scene.model import load_scene
 

@@ -7,35 +7,36 @@ it for the scene's sea state.  Each stage is a public function that an engineer 
 inspect or replace::
 
     statics = solve_statics(scene, method="fe")           # stochcable.line.statics
-    system  = build_line_system(scene, line, statics.lines[line.name])  # dynamics.system
-    chans   = line_channels(scene, line, system.positions, omega)   # dynamics.loads
-    lin     = linearize(system, chans, scene.analysis)    # dynamics.fixedpoint
-    resp    = solve(system, chans, lin.damping)           # dynamics.solve
-    out     = line_result(system, chans, lin, scene.analysis)       # dynamics.outputs
+    system  = build_line_system(scene, line, statics.lines[line.name])  # dynamics.model.system
+    chans   = line_channels(scene, line, system.positions, omega)   # dynamics.loads.channels
+    lin     = linearize(system, chans, scene.analysis)    # dynamics.groups.line_fixed_point
+    resp    = solve(system, chans, lin.damping)           # dynamics.solve.line_solve
+    out     = line_result(system, chans, lin, scene.analysis)       # dynamics.outputs.line_result
 
-One engine solves every scene (:mod:`stochcable.dynamics.coupled`): free bodies with
+One engine solves every scene (:mod:`stochcable.dynamics.groups`): free bodies with
 the lines attached to them form coupled groups, and a line attached to no free body
 is the degenerate group of one line and no bodies; every group goes through the same
 drag fixed point, the same substructured solve and the same time-series transfer.
 The sea channel of all lines shares one realization in the time series
-(:mod:`stochcable.dynamics.timeseries`).
+(:mod:`stochcable.dynamics.timeseries.synthesis`).
 
 Choices (see the functions for details)
 ---------------------------------------
 - Model: 2-D (x–z) when ``scene.is_planar``, else 3-D; both ends prescribed.
 - Drag damping and added mass distributed like the model mass (consistent by default),
-  element direction constant per element (:mod:`stochcable.dynamics.loads`).
+  element direction constant per element (:mod:`stochcable.dynamics.loads.channels`).
 - Wave loads (Morison inertia and linearized drag) integrated exactly along each
-  element's wet part (:func:`stochcable.dynamics.element_kinematics.element_wave_kinematics`), B
+  element's wet part (:func:`stochcable.dynamics.loads.element_kinematics.element_wave_kinematics`),
+  B
   constant per element.
 - The σ of the relative velocity of an element is its element mean square
-  (:func:`stochcable.dynamics.variance.relative_velocity_sigmas`).
+  (:func:`stochcable.dynamics.linearization.variance.relative_velocity_sigmas`).
 - ``modes="auto"`` (Foss): all modes up to ``AUTO_ALL_MODES`` free DOFs, else those up
-  to ``AUTO_MODE_FACTOR``·ω_max (:mod:`stochcable.dynamics.system`); moving ends use
-  the quasi-static split (:func:`stochcable.dynamics.solve.solve`).
+  to ``AUTO_MODE_FACTOR``·ω_max (:mod:`stochcable.dynamics.model.system`); moving ends use
+  the quasi-static split (:func:`stochcable.dynamics.solve.line_solve.solve`).
 - Drag linearization: a coarse start on a frequency subset with a defect
-  correction, then the full grid (:mod:`stochcable.dynamics.coupled.coarse`,
-  :mod:`stochcable.dynamics.coupled.fixedpoint`).
+  correction, then the full grid (:mod:`stochcable.dynamics.groups.coarse`,
+  :mod:`stochcable.dynamics.groups.group_fixed_point`).
 - Time series: the first 2048 samples go in the document (``to_document(timeseries=
   "full")`` for all); the full series are on
   :class:`~stochcable.results.documents.TimeSeries`.
@@ -49,7 +50,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from stochcable.dynamics.engine import Engine, build_engine
-from stochcable.dynamics.system import Progress, noop_progress
+from stochcable.dynamics.model.system import Progress, noop_progress
 from stochcable.errors import PhysicsWarning, warn
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, load_scene
@@ -75,7 +76,7 @@ def analyze(
         :func:`stochcable.statics.solve_statics`; ignored under adaptive
         fidelity, which changes the mesh).
     progress : callable, optional
-        ``progress(stage, info)`` (see :data:`stochcable.dynamics.system.Progress`).
+        ``progress(stage, info)`` (see :data:`stochcable.dynamics.model.system.Progress`).
 
     Returns
     -------

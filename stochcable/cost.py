@@ -13,7 +13,7 @@ The model
 The engine's large arrays are frequency-domain arrays with one axis over the
 frequencies (``analysis.omega.count`` = n_ω), one over the nodes of a line
 (n_nodes = elements + 1, three DOFs each) and one over the line's input channels
-(:class:`stochcable.dynamics.loads.Channel`: the sea, one per end-motion spectrum DOF,
+(:class:`stochcable.dynamics.loads.channels.Channel`: the sea, one per end-motion spectrum DOF,
 and the three translations of an end attached to a body).  A line without an end on
 a body holds for the whole grid only its converged response (its free nodes' part: d
 complex per node and channel, which the result keeps); everything else — the sea's
@@ -21,7 +21,7 @@ element kinematics (formed per block when they do not fit a quarter of the worki
 memory target), the loads, the solves, the variance sums, the outputs — runs over
 blocks of frequencies whose temporaries stay within the working-memory target
 (``STOCHCABLE_WORKING_MEMORY_MB``, 48 MiB by default,
-:mod:`stochcable.dynamics.freqblocks`).  A line on a body also holds its node response
+:mod:`stochcable.dynamics.loads.freqblocks`).  A line on a body also holds its node response
 per channel and the coupling columns of the body's solve.  The peak resident memory is
 therefore
 

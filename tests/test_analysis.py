@@ -13,17 +13,17 @@ import numpy as np
 import pytest
 
 from stochcable import analysis
-from stochcable.dynamics import blocks as dblocks
-from stochcable.dynamics import coarse_grid as dgrid
-from stochcable.dynamics import fixedpoint as dfixedpoint
-from stochcable.dynamics import indicators as dindicators
-from stochcable.dynamics import line_loads as dloads
-from stochcable.dynamics import outputs as doutputs
-from stochcable.dynamics import resolution as dresolution
-from stochcable.dynamics import solve as dsolve
-from stochcable.dynamics import system as dsystem
-from stochcable.dynamics import variance as dvariance
-from stochcable.dynamics.loads import line_channels
+from stochcable.dynamics.groups import line_fixed_point as dfixedpoint
+from stochcable.dynamics.linearization import coarse_grid as dgrid
+from stochcable.dynamics.linearization import variance as dvariance
+from stochcable.dynamics.loads.channels import line_channels
+from stochcable.dynamics.model import blocks as dblocks
+from stochcable.dynamics.model import system as dsystem
+from stochcable.dynamics.outputs import indicators as dindicators
+from stochcable.dynamics.outputs import line_result as doutputs
+from stochcable.dynamics.outputs import resolution as dresolution
+from stochcable.dynamics.solve import line_loads as dloads
+from stochcable.dynamics.solve import line_solve as dsolve
 from stochcable.errors import ConvergenceError, InputError, ResolutionWarning, SolverError
 from stochcable.line.modes import natural_modes
 from stochcable.scene.model import load_scene
@@ -605,8 +605,8 @@ def test_strong_current_drag_tends_to_steady_drag_tangent():
 def test_rayleigh_damping_equals_independent_linear_solve():
     """Cd = 0, no current, no seabed contact: the transfer functions are the linear
     solve of (K − ω²M_T + iω(αM_T + βK))U = F, built here from the FE matrices and the
-    sparse load assembly of stochcable.dynamics.loads (independent of the block solver)."""
-    from stochcable.dynamics.loads import prescribed_motion, wave_loads
+    sparse load assembly of stochcable.dynamics.loads.channels (independent of the block solver)."""
+    from stochcable.dynamics.loads.channels import prescribed_motion, wave_loads
 
     doc = chain_doc(grounded=False, sea=True, surge=True, elements=12, omega_count=25)
     for seg in doc["lines"][0]["segments"]:
@@ -698,7 +698,7 @@ def test_damping_matrix_is_assembled_lazily_and_equals_drag_matrix():
     import json
     from pathlib import Path
 
-    from stochcable.dynamics.loads import drag_matrix
+    from stochcable.dynamics.loads.channels import drag_matrix
 
     path = Path(dsystem.__file__).parents[1] / "examples" / "chain_catenary.json"
     scene = load_scene(json.loads(path.read_text()))

@@ -564,7 +564,7 @@ def _normal_velocity_sigma_and_amplitude(res, name: str) -> tuple[np.ndarray, np
     a, b = pos[:-1], pos[1:]
     pts = a[:, None, :] + xi[None, :, None] * (b - a)[:, None, :]  # (n_el, q, 3)
     # grounded nodes rest a penalty penetration w/(kD) below z = -depth: the
-    # kinematics are evaluated at the seabed there, as stochcable.dynamics.loads does
+    # kinematics are evaluated at the seabed there, as stochcable.dynamics.loads.channels does
     flat = pts.reshape(-1, 3).copy()
     flat[:, 2] = np.maximum(flat[:, 2], -env.depth)
     kin = wave_kinematics(w, flat, scene.sea.heading_rad, env.depth, env.g)

@@ -319,7 +319,7 @@ def test_functions_are_at_most_the_line_limit():
     "source, importer, expected",
     [
         ("from stochcable.dynamics.line import _x", "stochcable.results.documents", 1),
-        ("from stochcable.dynamics.line import _x", "stochcable.dynamics.coupled", 0),
+        ("from stochcable.dynamics.line import _x", "stochcable.dynamics.groups", 0),
         ("def f():\n    from stochcable.errors import _local", "stochcable.runtime", 1),
         ("from stochcable.errors import __version__", "stochcable.runtime", 0),
         ("from stochcable.cli._output import write_json", "stochcable.cli.analyze", 0),

@@ -1,4 +1,4 @@
-"""The compiled banded Cholesky solve (stochcable.dynamics.band_kernels) against SciPy's
+"""The compiled banded Cholesky solve (stochcable.dynamics.model.band_kernels) against SciPy's
 ``cho_solve_banded`` on the same factor: the same substitutions in another order, so
 equal to round-off."""
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-band_kernels = pytest.importorskip("stochcable.dynamics.band_kernels")
+band_kernels = pytest.importorskip("stochcable.dynamics.model.band_kernels")
 
 
 @pytest.mark.parametrize("n, u, k", [(1, 0, 3), (7, 2, 1), (60, 5, 40), (200, 11, 9)])

@@ -2,7 +2,7 @@
 
 Every check compares the time-domain (TD) simulation with something independent: the
 statics module (static start), the frequency-domain finite-element matrices of
-:mod:`stochcable.line.fem` / :mod:`stochcable.dynamics.loads` solved directly (harmonic and
+:mod:`stochcable.line.fem` / :mod:`stochcable.dynamics.loads.channels` solved directly (harmonic and
 linear-limit tests), and :func:`stochcable.analysis.analyze` (statistics and the
 synthesized series of the same realization).
 """
@@ -201,7 +201,12 @@ def _fd_series_fem(scene, hist):
     synthesized with the realization's coefficients; F the Morison inertia and
     linearized drag loads integrated exactly along the elements
     (excitation.wave_loads with the element_wave_kinematics moments)."""
-    from stochcable.dynamics.loads import Channel, drag_matrix, element_wave_kinematics, wave_loads
+    from stochcable.dynamics.loads.channels import (
+        Channel,
+        drag_matrix,
+        element_wave_kinematics,
+        wave_loads,
+    )
     from stochcable.sea.kinematics import wave_kinematics
     from stochcable.sea.realization import synthesize
 

@@ -251,11 +251,11 @@ def test_a_template_without_a_sea_takes_every_state_long_crested():
 
 
 def test_warm_starts_meet_the_cold_fixed_point_and_a_bad_one_falls_back():
-    # stochcable.dynamics.coupled.fixedpoint.warm_starts: a fixed point started from a
+    # stochcable.dynamics.groups.group_fixed_point.warm_starts: a fixed point started from a
     # neighbouring sea state's σ stops within the tolerance of the one started at rest;
     # a start that is not finite is dropped for the rest start (same bits)
-    from stochcable.dynamics.coupled.fixedpoint import warm_starts
     from stochcable.dynamics.engine import build_engine
+    from stochcable.dynamics.groups.group_fixed_point import warm_starts
 
     scene = load_scene(_wire())
     tol = scene.analysis.linearization.tolerance
@@ -277,8 +277,8 @@ def test_warm_starts_meet_the_cold_fixed_point_and_a_bad_one_falls_back():
 
 
 def test_a_warm_start_that_does_not_converge_falls_back_to_rest(monkeypatch):
-    from stochcable.dynamics.coupled import fixedpoint
     from stochcable.dynamics.engine import build_engine
+    from stochcable.dynamics.groups import group_fixed_point as fixedpoint
 
     scene = load_scene(_wire())
     engine = build_engine(scene)

@@ -33,7 +33,7 @@ doc = json.loads(sys.argv[1])
 # is in current: its strumming screening loads numba's lock-in grid kernel)
 analyze(load_example("taut_wire"))
 analyze(load_example("chain_catenary"))
-import stochcable.dynamics.kinematics_kernels  # (large grids' compiled kinematics)
+import stochcable.dynamics.loads.kinematics_kernels  # (large grids' compiled kinematics)
 try:  # reset the peak RSS (VmHWM) to the current RSS (Linux >= 4.0)
     with open("/proc/self/clear_refs", "w") as f:
         f.write("5")

@@ -1,9 +1,9 @@
-"""Coupled lines–bodies dynamics (stochcable.dynamics.coupled).
+"""Coupled lines–bodies dynamics (stochcable.dynamics.groups).
 
 Independent checks: a body on springs against its transfer function written out by
 hand (and its drag fixed point against the seed's linearized-drag formula); the
 infinite-mass limit against the independent line analysis with the equivalent
-prescribed end motion (stochcable.dynamics.solve); the substructured solve against the
+prescribed end motion (stochcable.dynamics.solve.line_solve); the substructured solve against the
 assembled coupled system of stochcable.bodies.rigid (couple + solve_coupled_direct); Foss
 with all modes against direct; the 120° symmetry of a three-leg mooring; the vessel
 fairlead motion against finite rotations.
@@ -21,8 +21,7 @@ from scipy.spatial.transform import Rotation
 
 from stochcable.bodies.coupling import LineLink, couple, coupled_load, expand_line
 from stochcable.bodies.rigid import ExcitationTable, RigidBody
-from stochcable.dynamics.blocks import to_freq
-from stochcable.dynamics.coupled import (
+from stochcable.dynamics.groups import (
     BodyLoads,
     CoupledLine,
     body_loads,
@@ -31,11 +30,12 @@ from stochcable.dynamics.coupled import (
     fairlead_motion,
     linearize_coupled,
 )
-from stochcable.dynamics.fixedpoint import linearize
-from stochcable.dynamics.line_loads import fluid_loads, line_inputs
-from stochcable.dynamics.loads import Channel, line_channels
-from stochcable.dynamics.outputs import line_result
-from stochcable.dynamics.system import build_line_system
+from stochcable.dynamics.groups.line_fixed_point import linearize
+from stochcable.dynamics.loads.channels import Channel, line_channels
+from stochcable.dynamics.model.blocks import to_freq
+from stochcable.dynamics.model.system import build_line_system
+from stochcable.dynamics.outputs.line_result import line_result
+from stochcable.dynamics.solve.line_loads import fluid_loads, line_inputs
 from stochcable.errors import InputError
 from stochcable.reference.bodies import solve_coupled_direct
 from stochcable.scene.model import load_scene
@@ -249,7 +249,7 @@ def _single_leg_doc(motion=None):
 def test_infinite_body_mass_equals_line_with_moving_end():
     """A planar body of mass 1e15 kg excited by F = −ω²M ξ moves with ξ; its line
     must equal the independent analysis of the line whose end moves with the RAO
-    T(r)ξ (stochcable.dynamics.solve, the moving-end path)."""
+    T(r)ξ (stochcable.dynamics.solve.line_solve, the moving-end path)."""
     scene = load_scene(_single_leg_doc())
     w = scene.analysis.omega.values()
     xi = np.stack([0.6 * np.exp(0.7j * w), 0.9 + 0.1j * w, 0.02j * np.ones_like(w)])
@@ -316,7 +316,7 @@ def test_substructure_equals_assembled_coupled_system(mooring_direct):
         )
         inp = line_inputs(cl.system, cl.channels)
         line_loads[cl.name] = to_freq(fluid_loads(cl.system, inp, damp))
-    from stochcable.dynamics.coupled.group import linear_body_drag
+    from stochcable.dynamics.groups.group import linear_body_drag
 
     bb, cdrag = linear_body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
     system = couple(links, [body], body_damping={"buoy": cdrag})
@@ -503,7 +503,7 @@ def test_errors(mooring_direct):
 
 from types import SimpleNamespace  # noqa: E402
 
-from stochcable.dynamics.coupled import analyze_coupled  # noqa: E402
+from stochcable.dynamics.groups import analyze_coupled  # noqa: E402
 from stochcable.results.documents import Result  # noqa: E402
 
 
@@ -684,7 +684,7 @@ def test_free_floating_body_without_lines_closed_form():
 def test_body_gravity_stiffness_metacentric_terms():
     """Weight at the CoG and buoyancy at the CoB give roll/pitch restoring
     ρg∇z_B − m g z_G (hand formula), nothing on translations or yaw."""
-    from stochcable.dynamics.coupled import body_gravity_stiffness
+    from stochcable.dynamics.groups import body_gravity_stiffness
 
     m, zg, zb, vol, g = 3e4, -1.5, -0.4, 40.0, 9.81
     body = RigidBody("s", [0, 0, -10.0], m, cog=[0.0, 0.0, zg])
@@ -810,7 +810,7 @@ def test_scene_three_leg_example_mirror_symmetry():
 
 def _count_full_evaluations(monkeypatch, n_omega):
     """Count the group solves on the full grid of ``n_omega`` frequencies."""
-    import stochcable.dynamics.coupled.group as cg
+    import stochcable.dynamics.groups.group as cg
 
     count = [0]
     solve = cg.solve_group
@@ -830,8 +830,8 @@ def test_coarse_start_gives_the_full_grid_fixed_point(solver, monkeypatch):
     change below tol = 1e-8 with a contraction ≈ 0.1, so each is within ~tol of the
     fixed point: σ and the outputs agree to 1e-6 (100·tol, margin for the transfer
     functions' amplification of the σ error)."""
-    from stochcable.dynamics.coupled.coarse import coarse_subset
-    from stochcable.dynamics.coupled.group import GroupSystem
+    from stochcable.dynamics.groups.coarse import coarse_subset
+    from stochcable.dynamics.groups.group import GroupSystem
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver=solver, tol=1e-8), body)
@@ -880,7 +880,7 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
     mooring: the stride-4 subset's σ are ~4 % off, the corrected rounds gain ~30x
     each), with or without the rounds' warm step, and the answer is the full-grid
     fixed point within the tolerance."""
-    import stochcable.dynamics.coupled.coarse as cc
+    import stochcable.dynamics.groups.coarse as cc
 
     monkeypatch.setattr(cc, "_WARM_ROUNDS", warm)
     body = _buoy()
@@ -908,8 +908,8 @@ def test_coarse_start_saves_full_grid_evaluations(solver, warm, monkeypatch):
 
 def test_coarse_subset_skipped_on_small_grids(mooring_direct):
     """40 frequencies (< COARSE_MIN_FREQUENCIES): no coarse stage."""
-    from stochcable.dynamics.coupled.coarse import COARSE_MIN_FREQUENCIES, coarse_subset
-    from stochcable.dynamics.coupled.group import GroupSystem
+    from stochcable.dynamics.groups.coarse import COARSE_MIN_FREQUENCIES, coarse_subset
+    from stochcable.dynamics.groups.group import GroupSystem
 
     scene, cls, loads, body, lin = mooring_direct
     assert cls[0].channels[0].omega.size < COARSE_MIN_FREQUENCIES
@@ -919,7 +919,7 @@ def test_coarse_subset_skipped_on_small_grids(mooring_direct):
 def test_sliced_channel_inputs_equal_the_subset_of_the_full_inputs(mooring_direct):
     """A channel restricted to a frequency subset gives the full channel's loads at
     those frequencies (every array sliced along its frequency axis)."""
-    from stochcable.dynamics.coupled.coarse import _sliced_channel
+    from stochcable.dynamics.groups.coarse import _sliced_channel
 
     scene, cls, loads, body, lin = mooring_direct
     s = cls[0].system
@@ -938,10 +938,10 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
     is the plain analysis._solve_free of the augmented channels: the same linear
     system, so equal to round-off (1e-10 of the largest entry), truncated (8 of 27
     modes, static correction on) or not."""
-    from stochcable.dynamics.coupled.group import GroupSystem
-    from stochcable.dynamics.coupled.lineparts import foss_unit_split
-    from stochcable.dynamics.solve import solve_free
-    from stochcable.dynamics.variance import drag_coefficients
+    from stochcable.dynamics.groups.group import GroupSystem
+    from stochcable.dynamics.groups.lineparts import foss_unit_split
+    from stochcable.dynamics.linearization.variance import drag_coefficients
+    from stochcable.dynamics.solve.line_solve import solve_free
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(solver="foss", modes=modes), body)
@@ -963,7 +963,8 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
 
 def test_all_dofs_fixed_equals_lines_with_fixed_fairleads():
     """A buoy with all six DOFs in ``fixed_dofs`` holds its fairleads: each leg is the
-    independent analysis (stochcable.dynamics.fixedpoint.linearize) of the leg with its fairlead
+    independent analysis (stochcable.dynamics.groups.line_fixed_point.linearize) of the leg with its
+    fairlead
     fixed at the same static point; the body does not move."""
     body = _buoy(fixed_dofs=("surge", "sway", "heave", "roll", "pitch", "yaw"))
     scene, cls, loads = _group(_mooring_doc(), body)
@@ -1140,7 +1141,7 @@ def test_fixed_dofs_validation_and_scene():
 def test_coarse_start_falls_back_to_the_full_grid(monkeypatch):
     """A coarse model that fails (a singular modal impedance) is skipped: the full-grid
     iteration alone runs, the same evaluations as ``coarse=False``."""
-    import stochcable.dynamics.coupled.lineparts as cp
+    import stochcable.dynamics.groups.lineparts as cp
 
     body = _buoy()
     scene, cls, loads = _group(_mooring_doc(count=96, solver="foss", tol=1e-4), body)
@@ -1160,7 +1161,7 @@ def test_warm_step_is_the_fixed_point_of_an_affine_map():
     step over secant pairs: for an affine map y -> r·(A y + b) in n dimensions, n + 1
     affinely independent pairs give its fixed point exactly (closed form
     (I − diag(r) A)⁻¹ diag(r) b; tolerance: round-off of a 3×3 solve)."""
-    from stochcable.dynamics.coupled.coarse import _warm_step
+    from stochcable.dynamics.groups.coarse import _warm_step
 
     rng = np.random.default_rng(3)
     a = 0.3 * rng.standard_normal((3, 3))
@@ -1182,7 +1183,7 @@ def test_large_static_body_rotation_is_flagged():
     import warnings
 
     from stochcable.analysis import analyze
-    from stochcable.dynamics.coupled.model import STATIC_ROTATION_LIMIT
+    from stochcable.dynamics.groups.model import STATIC_ROTATION_LIMIT
     from stochcable.errors import PhysicsWarning
     from stochcable.examples import load_example
     from stochcable.scene.model import load_scene
@@ -1295,7 +1296,7 @@ def test_one_model_solved_for_two_seas_equals_two_fresh_analyses(name, table):
     the coupled modes (their ω_ref set per sea); tabulated over ω (``table``), each
     solve computes them at its sea's spectral peak."""
     from stochcable.bodies.from_scene import scene_rigid_bodies
-    from stochcable.dynamics.coupled import build_coupled, solve_coupled
+    from stochcable.dynamics.groups import build_coupled, solve_coupled
     from stochcable.examples import load_example
 
     scene = load_scene(load_example(name).model_dump(mode="json", exclude_none=True))
@@ -1324,7 +1325,7 @@ def test_one_model_solved_for_two_seas_equals_two_fresh_analyses(name, table):
 
 def test_solve_coupled_needs_the_model_grid():
     """Settings on another grid than the model's are refused."""
-    from stochcable.dynamics.coupled import build_coupled, solve_coupled
+    from stochcable.dynamics.groups import build_coupled, solve_coupled
     from stochcable.examples import load_example
 
     scene = load_scene(
@@ -1347,7 +1348,7 @@ def test_coupled_mode_line_shares_complete_the_mass_normalization(mooring_direct
     nodes, attached ends moving with the body): Σ_l u_lᵀ(M + M_a)_l u_l +
     ξᵀ(M_B + A(ω_ref))ξ = 1 for every mode (round-off of the eigen-solve), under both
     the assembled and the reduced eigenproblem; the ends not on the body are at rest."""
-    from stochcable.dynamics.coupled.modes import line_mode_shares
+    from stochcable.dynamics.groups.modes import line_mode_shares
 
     scene, cls, loads, body, _ = mooring_direct
     m = coupled_modes(cls, [body], 0.7, 2.0, method=method)
@@ -1365,11 +1366,11 @@ def test_coupled_bandwidths_tend_to_the_fixed_end_ones_under_a_heavy_body():
     """One leg on a body 10⁶ times heavier (its end all but held): the line-dominated
     coupled modes are the leg's fixed-end modes and their modal damping φᵀCφ
     (:func:`coupled_modal_bandwidths`) the fixed-end one of
-    :func:`stochcable.dynamics.resolution.modal_bandwidths` (1e-4; measured ≤ 8e-6 with
+    :func:`stochcable.dynamics.outputs.resolution.modal_bandwidths` (1e-4; measured ≤ 8e-6 with
     body energy fractions ≤ 1e-5 in those modes)."""
-    from stochcable.dynamics.coupled.modes import coupled_modal_bandwidths
-    from stochcable.dynamics.resolution import modal_bandwidths
-    from stochcable.dynamics.variance import drag_coefficients
+    from stochcable.dynamics.groups.modes import coupled_modal_bandwidths
+    from stochcable.dynamics.linearization.variance import drag_coefficients
+    from stochcable.dynamics.outputs.resolution import modal_bandwidths
 
     heavy = _buoy(
         mass=2.0e10,

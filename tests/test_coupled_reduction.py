@@ -1,8 +1,8 @@
-"""Fast paths of the coupled dynamics (stochcable.dynamics.coupled, issue 6 speed).
+"""Fast paths of the coupled dynamics (stochcable.dynamics.groups, issue 6 speed).
 
 Each fast path is the same linear system as a reference kept reachable:
 - Foss lines in modal coordinates (``FossLine``, ``lineparts._MODAL_FOSS``) against the node-level
-  path (:func:`stochcable.dynamics.coupled.lineparts.foss_unit_split` + reactions), at a given
+  path (:func:`stochcable.dynamics.groups.lineparts.foss_unit_split` + reactions), at a given
   drag and through the whole drag fixed point;
 - coupled modes by Craig–Bampton reduction (``coupled_modes(method="reduced")``)
   against the assembled system (``method="full"``): a Rayleigh–Ritz projection, exact
@@ -19,21 +19,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import stochcable.dynamics.coupled.coarse as cc
-import stochcable.dynamics.coupled.group as cg
-import stochcable.dynamics.coupled.lineparts as cp
-import stochcable.dynamics.coupled.modes as cm
+import stochcable.dynamics.groups.coarse as cc
+import stochcable.dynamics.groups.group as cg
+import stochcable.dynamics.groups.lineparts as cp
+import stochcable.dynamics.groups.modes as cm
 from stochcable.bodies.rigid import RigidBody
-from stochcable.dynamics.coupled import (
+from stochcable.dynamics.groups import (
     CoupledLine,
     body_loads,
     coupled_modes,
     linearize_coupled,
 )
-from stochcable.dynamics.coupled.group import GroupSystem, solve_group
-from stochcable.dynamics.loads import line_channels
-from stochcable.dynamics.system import build_line_system, noop_progress
-from stochcable.dynamics.variance import drag_coefficients, quasi_static_motion, sigmas_from_nodes
+from stochcable.dynamics.groups.group import GroupSystem, solve_group
+from stochcable.dynamics.linearization.variance import (
+    drag_coefficients,
+    quasi_static_motion,
+    sigmas_from_nodes,
+)
+from stochcable.dynamics.loads.channels import line_channels
+from stochcable.dynamics.model.system import build_line_system, noop_progress
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
@@ -158,7 +162,7 @@ def _planar_two_body_group():
     ch2 = line_channels(scene, tether, s2.positions, w)
     ch1 = line_channels(scene, link, s.positions, w)
     # the group's channels: the sea and the tether's end motion (silent for the link)
-    from stochcable.dynamics.loads import Channel
+    from stochcable.dynamics.loads.channels import Channel
 
     names = [c.name for c in ch2]
     ch1 = tuple(
@@ -305,9 +309,9 @@ def test_foss_decomposition_of_a_line_with_drag_solves_the_quadratic_eigenproble
     thread pool) on a line's kept modes with drag: every pair satisfies
     (λ²M̂ + λĈ + K̂)χ = 0 to 1e-10 of the terms' size (round-off of a 78×78 geev with
     condition ≈ the printed one), and the pairs come in complex conjugates."""
-    from stochcable.dynamics.blocks import add_blocks, block_matvec, line_prep
-    from stochcable.dynamics.line_loads import drag_blocks
-    from stochcable.dynamics.modal_solvers import foss_modes
+    from stochcable.dynamics.model.blocks import add_blocks, block_matvec, line_prep
+    from stochcable.dynamics.model.modal_solvers import foss_modes
+    from stochcable.dynamics.solve.line_loads import drag_blocks
 
     body = _buoy()
     _, cls, _ = _group(_mooring_doc(solver="foss", tol=1e-4), body)

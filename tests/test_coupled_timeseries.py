@@ -1,5 +1,6 @@
-"""Time series of lines coupled to bodies and of the bodies (stochcable.dynamics.coupled_timeseries,
-stochcable.dynamics.timeseries.simulate_timeseries with ``coupled=``; GitHub issue 6).
+"""Time series of lines coupled to bodies and of the bodies
+(stochcable.dynamics.timeseries.group_transfer,
+stochcable.dynamics.timeseries.synthesis.simulate_timeseries with ``coupled=``; GitHub issue 6).
 
 Independent checks: the DSA variance of every series against the band sum of the
 response spectrum of the transfer synthesized (Parseval, round-off) and against the
@@ -27,7 +28,7 @@ import pytest
 from scipy import stats
 
 from stochcable.analysis import analyze
-from stochcable.dynamics.coupled_timeseries import coupled_group_transfer, frequency_chunks
+from stochcable.dynamics.timeseries.group_transfer import coupled_group_transfer, frequency_chunks
 from stochcable.errors import InputError
 from stochcable.examples import load_example
 from stochcable.sea.realization import simulate_sea
@@ -477,7 +478,7 @@ def test_chunked_solve_equals_one_piece(dsa_result):
     """The band solved in chunks of 64 frequencies equals the one-piece solve (the
     solve is independent per frequency: round-off)."""
     res, _ = dsa_result
-    from stochcable.dynamics.coupled import analyze_coupled
+    from stochcable.dynamics.groups import analyze_coupled
 
     scene = res.scene
     out = analyze_coupled(scene, res.statics, scene.analysis)
@@ -499,7 +500,7 @@ def test_chunked_solve_equals_one_piece(dsa_result):
 
 def test_group_transfer_refuses_bad_frequencies(dsa_result):
     res, _ = dsa_result
-    from stochcable.dynamics.coupled import analyze_coupled
+    from stochcable.dynamics.groups import analyze_coupled
 
     (group,) = analyze_coupled(res.scene, res.statics, res.scene.analysis).groups
     with pytest.raises(InputError, match=r"omega.*rad/s"):

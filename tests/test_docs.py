@@ -109,7 +109,7 @@ def test_every_warning_is_described():
 
 
 def test_warning_thresholds_are_read_from_the_code():
-    from stochcable.dynamics import indicators, resolution
+    from stochcable.dynamics.outputs import indicators, resolution
 
     text = warnings_reference.warnings_reference_rst()
     assert f"``TAIL_FRACTION`` = {resolution.TAIL_FRACTION:g}" in text

@@ -20,7 +20,7 @@ from scipy import stats
 import stochcable.dynamics.drag_residual as dr
 from stochcable import analyze, load_example
 from stochcable.dynamics.drag_residual import hermite_coefficients, residual_output_lines
-from stochcable.dynamics.linearization import mean_abs_gaussian
+from stochcable.dynamics.linearization.formulas import mean_abs_gaussian
 
 
 def test_hermite_coefficients_closed_forms():

@@ -27,9 +27,9 @@ from stochcable.dynamics.drag_segments import (
     segment_velocity,
     segments,
 )
-from stochcable.dynamics.loads import line_channels
+from stochcable.dynamics.loads.channels import line_channels
+from stochcable.dynamics.model.system import build_line_system
 from stochcable.dynamics.residual_lines import element_directions
-from stochcable.dynamics.system import build_line_system
 from stochcable.reference.cable import simulate_line_timedomain
 from stochcable.statics import solve_statics
 

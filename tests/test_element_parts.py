@@ -1,5 +1,5 @@
 """The sea's element kinematics formed per block when read
-(stochcable.dynamics.element_parts, element_kinematics.KinematicsBlocks): a grid whose
+(stochcable.dynamics.loads.element_parts, element_kinematics.KinematicsBlocks): a grid whose
 kinematics do not fit a quarter of the working-memory target keeps none, and every
 read (a block of frequencies, the end elements, a frequency subset, the weighted and
 projected sums) gives the numbers of the kinematics formed and kept.
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stochcable.dynamics.element_kinematics import element_wave_kinematics
+from stochcable.dynamics.loads.element_kinematics import element_wave_kinematics
 
 #: Tolerance relative to the array's largest |value| (module notes). [-]
 RTOL = 1e-14

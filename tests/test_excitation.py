@@ -1,4 +1,4 @@
-"""Tests of stochcable.dynamics.loads: input channels and hydrodynamic matrices."""
+"""Tests of stochcable.dynamics.loads.channels: input channels and hydrodynamic matrices."""
 
 from __future__ import annotations
 
@@ -7,15 +7,15 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.dynamics import system as dsystem
-from stochcable.dynamics import variance as dvariance
-from stochcable.dynamics.loads import (
+from stochcable.dynamics.linearization import variance as dvariance
+from stochcable.dynamics.loads.channels import (
     drag_matrix,
     element_frames,
     inertia_matrix,
     line_channels,
     prescribed_motion,
 )
+from stochcable.dynamics.model import system as dsystem
 from stochcable.errors import InputError
 from stochcable.scene.model import load_scene
 from stochcable.sea.kinematics import wave_kinematics
@@ -199,7 +199,7 @@ def test_fully_wet_exp_moments_are_the_general_formula():
     """_exp_moments drops the factors 1 and 0 when every element is wet over its whole
     length (the speed pass of issue 4); the general expressions give the same numbers
     to the bit (x·1 and 0 + x are exact), growing and decaying exponents alike."""
-    from stochcable.dynamics.kinematics_closed_forms import _complex, _exp_moments, _phi1_psi
+    from stochcable.dynamics.loads.kinematics_closed_forms import _complex, _exp_moments, _phi1_psi
     from stochcable.sea.kinematics import _wavenumber
 
     def general(e0, alpha, p, q):  # the formula for any wet part [p, q]
@@ -234,7 +234,7 @@ def test_sea_nodal_kinematics_are_computed_on_first_access_only():
     stochcable.sea.kinematics.wave_kinematics; explicit fields are kept as given."""
     import dataclasses
 
-    from stochcable.dynamics.loads import Channel
+    from stochcable.dynamics.loads.channels import Channel
 
     scene, system = built(straight_doc())
     w = scene.analysis.omega.values()
@@ -282,7 +282,7 @@ def test_second_exponent_shares_phi_psi_by_conjugation():
     and the φ1 of ∫e^{−2k(z+2h)} as that of ∫e^{2kz} (issue 6 pass E6): the moments
     equal those of their own φ1, ψ to the bit, for rising, sinking and horizontal
     elements, at ω = 0, fully wet (the short path) and partly wet (the general one)."""
-    from stochcable.dynamics.kinematics_closed_forms import (
+    from stochcable.dynamics.loads.kinematics_closed_forms import (
         _complex,
         _exp_integral,
         _exp_moments,

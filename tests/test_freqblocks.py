@@ -1,4 +1,4 @@
-"""Frequency-blocked evaluation (stochcable.dynamics.freqblocks): the load assembly,
+"""Frequency-blocked evaluation (stochcable.dynamics.loads.freqblocks): the load assembly,
 the solves and the variance sums of the drag fixed point over blocks of frequencies
 give the answer of one block of all frequencies, and the temporaries of an analysis
 stay bounded.
@@ -24,7 +24,7 @@ import pytest
 from _compare import assert_close_documents
 
 from stochcable.analysis import analyze
-from stochcable.dynamics.freqblocks import (
+from stochcable.dynamics.loads.freqblocks import (
     frequency_block,
     frequency_slices,
     working_memory_bytes,
@@ -147,7 +147,7 @@ def doc(n_el, n_w):
     d["analysis"]["omega"]["count"] = n_w
     return d
 stochcable.analyze(doc(10, 50))  # imports, compiled kernels, caches
-import stochcable.dynamics.kinematics_kernels  # (large grids' compiled kinematics)
+import stochcable.dynamics.loads.kinematics_kernels  # (large grids' compiled kinematics)
 try:  # the high-water mark from here on: reset to the current RSS
     with open("/proc/self/clear_refs", "w") as f:
         f.write("5")
@@ -182,7 +182,7 @@ def test_transfer_functions_are_formed_when_read():
     # analysis summed block by block are those of the formed transfers
     import pickle
 
-    from stochcable.dynamics.blocks import trapezoid_weights
+    from stochcable.dynamics.model.blocks import trapezoid_weights
 
     lr = analyze(load_example("chain_catenary")).lines["leg1"]
     for key in ("_motion_transfer", "_tension_transfer"):

@@ -66,7 +66,7 @@ _ADDED_SINCE = {"second_order"}
 
 
 #: Warnings the library gives since the pre-unification record (a phrase of each): the
-#: trapezoid rule's error on a resonant peak (stochcable.dynamics.resolution).
+#: trapezoid rule's error on a resonant peak (stochcable.dynamics.outputs.resolution).
 _WARNINGS_ADDED_SINCE = ("the trapezoid rule is off by",)
 
 

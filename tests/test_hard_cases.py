@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 
 from stochcable.analysis import analyze
-from stochcable.dynamics.system import build_line_system
-from stochcable.dynamics.variance import drag_coefficients
+from stochcable.dynamics.linearization.variance import drag_coefficients
+from stochcable.dynamics.model.system import build_line_system
 from stochcable.errors import InputError, PhysicsWarning, ResolutionWarning, SolverError
 from stochcable.examples import load_example
 from stochcable.sea.kinematics import wavenumber
@@ -460,7 +460,7 @@ def test_deep_water_3000_m():
     # short waves do not reach the deep part: at the grid's top (2 rad/s, k = 0.41/m)
     # the fluid velocity below 1000 m is e^{kz} < 1e-100 (exponential form: no
     # overflow of cosh/sinh with kh ~ 1200)
-    from stochcable.dynamics.loads import line_channels
+    from stochcable.dynamics.loads.channels import line_channels
 
     sea = line_channels(res.scene, res.scene.lines[0], line.positions, line.omega)[0]
     z = line.positions[:, 2]

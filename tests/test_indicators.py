@@ -15,11 +15,11 @@ import pytest
 from scipy import integrate
 
 from stochcable.analysis import analyze
-from stochcable.dynamics.fixedpoint import linearize
-from stochcable.dynamics.indicators import AT_REST_FRACTION, at_rest_zeroed, line_indicators
-from stochcable.dynamics.linearization import borgman_variance_ratio, drag_inertia_ratio
-from stochcable.dynamics.loads import line_channels
-from stochcable.dynamics.system import build_line_system
+from stochcable.dynamics.groups.line_fixed_point import linearize
+from stochcable.dynamics.linearization.formulas import borgman_variance_ratio, drag_inertia_ratio
+from stochcable.dynamics.loads.channels import line_channels
+from stochcable.dynamics.model.system import build_line_system
+from stochcable.dynamics.outputs.indicators import AT_REST_FRACTION, at_rest_zeroed, line_indicators
 from stochcable.errors import InputError, PhysicsWarning
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
@@ -291,11 +291,11 @@ def test_snap_flag_fires_at_an_element_and_not_below_threshold():
 def _line_modes_of(monkeypatch, factor: float):
     """The disc buoy's leg analysed with the buoy's mass and inertia scaled by
     ``factor`` (same statics): the coupled modes that count for the leg
-    (:func:`stochcable.dynamics.coupled.results.line_modes`), the leg's system and its
+    (:func:`stochcable.dynamics.groups.results.line_modes`), the leg's system and its
     converged drag."""
     from stochcable.bodies.from_scene import scene_rigid_bodies
-    from stochcable.dynamics.coupled import analyze_coupled
-    from stochcable.dynamics.coupled import results as cresults
+    from stochcable.dynamics.groups import analyze_coupled
+    from stochcable.dynamics.groups import results as cresults
 
     scene = load_scene(_doc("tuah_1982_disc_buoy_single_leg"))
     statics = solve_statics(scene, method="fe")
@@ -323,7 +323,7 @@ def _line_modes_of(monkeypatch, factor: float):
 
 
 def _fixed_end(system, damping, top: float):
-    from stochcable.dynamics.resolution import modal_bandwidths
+    from stochcable.dynamics.outputs.resolution import modal_bandwidths
 
     wn = np.asarray(system.modes.omega)
     keep = wn <= top

@@ -1,4 +1,4 @@
-"""The compiled element kinematics (stochcable.dynamics.kinematics_kernels) against the
+"""The compiled element kinematics (stochcable.dynamics.loads.kinematics_kernels) against the
 NumPy form (kinematics_closed_forms.kinematics_block, ``STOCHCABLE_NUMBA=0``): the same
 formulas, so equal to a few ulps of each element's largest value.
 
@@ -15,9 +15,9 @@ import pytest
 
 pytest.importorskip("numba")
 
-from stochcable.dynamics import element_kinematics as ek  # noqa: E402
-from stochcable.dynamics import kinematics_closed_forms as closed_forms  # noqa: E402
-from stochcable.dynamics.element_kinematics import element_wave_kinematics  # noqa: E402
+from stochcable.dynamics.loads import element_kinematics as ek  # noqa: E402
+from stochcable.dynamics.loads import kinematics_closed_forms as closed_forms  # noqa: E402
+from stochcable.dynamics.loads.element_kinematics import element_wave_kinematics  # noqa: E402
 from stochcable.sea.kinematics import wavenumber  # noqa: E402
 
 G = 9.80665
@@ -157,7 +157,7 @@ def test_elements_high_above_the_water_are_zero_on_both_paths(monkeypatch, depth
 def test_direct_call_writes_a_strided_block_only(monkeypatch):
     """The kernel on a block of frequencies writes that block of the (strided) views
     only, the same numbers as the NumPy form."""
-    from stochcable.dynamics.kinematics_kernels import kinematics_block
+    from stochcable.dynamics.loads.kinematics_kernels import kinematics_block
 
     pts = _line(200.0)
     w = np.linspace(0.0, 6.0, 40)

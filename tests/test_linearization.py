@@ -1,4 +1,5 @@
-"""Tests of stochcable.dynamics.linearization: drag linearization formulas and the fixed point."""
+"""Tests of stochcable.dynamics.linearization.formulas: drag linearization formulas and the fixed
+point."""
 
 from __future__ import annotations
 
@@ -7,15 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.dynamics.iteration import fixed_point
-from stochcable.dynamics.linearization import (
+from stochcable.dynamics.linearization.formulas import (
     drag_linear_current,
     drag_linear_harmonic,
     drag_linear_seed,
     drag_linear_vector,
     mean_drag_gaussian,
 )
-from stochcable.dynamics.solvers import solve_direct
+from stochcable.dynamics.linearization.iteration import fixed_point
+from stochcable.dynamics.model.solvers import solve_direct
 from stochcable.errors import ConvergenceError, InputError
 
 RHO, CD, DIAM = 1025.0, 1.2, 0.1

@@ -1,6 +1,6 @@
 """The coarse start of the drag linearization of a single line (the one fixed point,
-stochcable.dynamics.coupled.fixedpoint, applied to a line alone through
-stochcable.dynamics.fixedpoint.linearize; its coarse start stochcable.dynamics.coupled.
+stochcable.dynamics.groups.group_fixed_point, applied to a line alone through
+stochcable.dynamics.groups.line_fixed_point.linearize; its coarse start stochcable.dynamics.groups.
 coarse): the frequency-subset fixed point only supplies the start, the answer is the
 full-grid fixed point; narrow resonances are kept at full resolution; the subset
 quadrature; the single-BLAS-thread limit in worker threads."""
@@ -13,19 +13,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stochcable.dynamics import blocks as dblocks
-from stochcable.dynamics import coarse_grid as dgrid
-from stochcable.dynamics import fixedpoint as dfixedpoint
-from stochcable.dynamics import line_loads as dloads
-from stochcable.dynamics import outputs as doutputs
-from stochcable.dynamics import solve as dsolve
-from stochcable.dynamics import system as dsystem
-from stochcable.dynamics import variance as dvariance
-from stochcable.dynamics.coupled import coarse as dcoarse
-from stochcable.dynamics.coupled import freeline as dfreeline
-from stochcable.dynamics.coupled.group import GroupSystem
-from stochcable.dynamics.coupled.inputs import CoupledLine
-from stochcable.dynamics.loads import line_channels
+from stochcable.dynamics.groups import coarse as dcoarse
+from stochcable.dynamics.groups import freeline as dfreeline
+from stochcable.dynamics.groups import line_fixed_point as dfixedpoint
+from stochcable.dynamics.groups.group import GroupSystem
+from stochcable.dynamics.groups.inputs import CoupledLine
+from stochcable.dynamics.linearization import coarse_grid as dgrid
+from stochcable.dynamics.linearization import variance as dvariance
+from stochcable.dynamics.loads.channels import line_channels
+from stochcable.dynamics.model import blocks as dblocks
+from stochcable.dynamics.model import system as dsystem
+from stochcable.dynamics.outputs import line_result as doutputs
+from stochcable.dynamics.solve import line_loads as dloads
+from stochcable.dynamics.solve import line_solve as dsolve
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 

@@ -1,4 +1,4 @@
-"""The frequency grid's resolution of a resonance (stochcable.dynamics.resolution):
+"""The frequency grid's resolution of a resonance (stochcable.dynamics.outputs.resolution):
 the trapezoid rule's error bound on a Lorentzian peak against the rule itself, and the
 warning on the inclined guy's lightly damped mode, cured by the count it names."""
 
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from stochcable.analysis import analyze
-from stochcable.dynamics.resolution import RESONANCE_PEAK_ERROR, peak_quadrature_error
+from stochcable.dynamics.outputs.resolution import RESONANCE_PEAK_ERROR, peak_quadrature_error
 from stochcable.errors import ResolutionWarning
 from stochcable.examples import load_example
 
@@ -114,8 +114,8 @@ def test_grid_top_warning_says_where_the_input_ends(sea_top, motion_top):
 
 
 def test_excitation_end_of_tables_and_of_an_analytic_spectrum():
-    from stochcable.dynamics.loads import Channel
-    from stochcable.dynamics.resolution import excitation_end
+    from stochcable.dynamics.loads.channels import Channel
+    from stochcable.dynamics.outputs.resolution import excitation_end
 
     omega = np.linspace(0.2, 3.0, 50)
 

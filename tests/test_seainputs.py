@@ -1,5 +1,5 @@
 """Inputs reused across sea states of one heading
-(stochcable.dynamics.coupled.seainputs): an engine solving sea states of known and new
+(stochcable.dynamics.groups.seainputs): an engine solving sea states of known and new
 headings in any order gives the documents of fresh analyses, keeps the inputs of the
 headings it has seen (within its memory bound) and none of a large line."""
 
@@ -8,8 +8,8 @@ from __future__ import annotations
 from _compare import assert_close_documents
 
 from stochcable.analysis import analyze
-from stochcable.dynamics.coupled import seainputs
 from stochcable.dynamics.engine import build_engine
+from stochcable.dynamics.groups import seainputs
 from stochcable.examples import load_example
 
 

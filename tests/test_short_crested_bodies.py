@@ -197,8 +197,8 @@ def test_time_series_drive_each_direction_with_its_own_realization():
     analysis' names), and the vessel's motion is Σ_k of its RAO driven by direction
     k's realization (:func:`stochcable.sea.spreading.simulate_sea_directional` with the
     scene's seed), not by one shared realization."""
-    from stochcable.dynamics.coupled_timeseries import vessel_raos
-    from stochcable.dynamics.sea_channels import spectrum_callable
+    from stochcable.dynamics.loads.sea_channels import spectrum_callable
+    from stochcable.dynamics.timeseries.group_transfer import vessel_raos
     from stochcable.sea.realization import synthesize
     from stochcable.sea.spreading import simulate_sea_directional
 

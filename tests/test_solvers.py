@@ -1,4 +1,4 @@
-"""Tests of stochcable.dynamics.solvers: direct, banded/sparse, modal, Foss."""
+"""Tests of stochcable.dynamics.model.solvers: direct, banded/sparse, modal, Foss."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from stochcable.dynamics.linearization import drag_linear_seed
-from stochcable.dynamics.modal_solvers import (
+from stochcable.dynamics.linearization.formulas import drag_linear_seed
+from stochcable.dynamics.model.modal_solvers import (
     DefectivePencilWarning,
     auto_mode_count,
     foss_decomposition,
@@ -18,7 +18,7 @@ from stochcable.dynamics.modal_solvers import (
     modal_basis,
     solve_modal,
 )
-from stochcable.dynamics.solvers import (
+from stochcable.dynamics.model.solvers import (
     matrix_bandwidth,
     solve_block_tridiagonal,
     solve_direct,
@@ -28,7 +28,7 @@ from stochcable.errors import InputError, SolverError
 
 # Foss must really be used (no silent fallback) except where a test expects the warning
 pytestmark = pytest.mark.filterwarnings(
-    "error::stochcable.dynamics.modal_solvers.DefectivePencilWarning"
+    "error::stochcable.dynamics.model.modal_solvers.DefectivePencilWarning"
 )
 
 

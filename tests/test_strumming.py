@@ -13,8 +13,8 @@ from scipy.integrate import solve_ivp
 
 from stochcable.design.curves import FatigueCurve
 from stochcable.dynamics.engine import build_engine
-from stochcable.dynamics.strumming import strumming_inputs
-from stochcable.dynamics.system import build_line_system
+from stochcable.dynamics.model.strumming import strumming_inputs
+from stochcable.dynamics.model.system import build_line_system
 from stochcable.errors import InputError, ResolutionWarning
 from stochcable.examples import load_example
 from stochcable.line.fem import build_fe_model
@@ -430,7 +430,7 @@ def test_strumming_input_checks():
 
 
 def test_screening_that_stops_below_the_lock_in_range_warns(monkeypatch):
-    import stochcable.dynamics.strumming as ds
+    import stochcable.dynamics.model.strumming as ds
 
     doc = load_example(EXAMPLE).model_dump(exclude_none=True)
     doc["analysis"]["modes"] = 2  # the system keeps 2 modes (14.1 rad/s at most)

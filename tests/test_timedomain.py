@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from stochcable.dynamics.iteration import fixed_point
-from stochcable.dynamics.linearization import drag_linear_seed
-from stochcable.dynamics.solvers import solve_direct
+from stochcable.dynamics.linearization.formulas import drag_linear_seed
+from stochcable.dynamics.linearization.iteration import fixed_point
+from stochcable.dynamics.model.solvers import solve_direct
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.results.statistics import response_statistics
 from stochcable.sea.timeseries import LinearSystem, NonlinearSystem, newmark

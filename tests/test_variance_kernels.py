@@ -1,4 +1,4 @@
-"""The compiled element variances (stochcable.dynamics.variance_kernels) against the
+"""The compiled element variances (stochcable.dynamics.linearization.variance_kernels) against the
 formula they sum, written out with NumPy, and the analysis with and without them."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import pytest
 pytest.importorskip("numba")
 
 from stochcable.analysis import analyze  # noqa: E402
-from stochcable.dynamics.variance_kernels import element_variance_terms  # noqa: E402
+from stochcable.dynamics.linearization.variance_kernels import element_variance_terms  # noqa: E402
 from stochcable.examples import load_example  # noqa: E402
 
 

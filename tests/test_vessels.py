@@ -1,6 +1,6 @@
 """Vessel and end-motion RAO tables over wave heading (issue 20, "vessel RAOs
 interpolated over heading"): :mod:`stochcable.scene.raos` and
-:mod:`stochcable.dynamics.coupled.vessels`.
+:mod:`stochcable.dynamics.groups.vessels`.
 
 Independent checks: a sea heading on a table row gives the analysis of the
 heading-free table holding that row; a heading between two rows gives that of the

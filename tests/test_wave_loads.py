@@ -1,4 +1,4 @@
-"""Wave loads integrated exactly along the elements (stochcable.dynamics.loads.
+"""Wave loads integrated exactly along the elements (stochcable.dynamics.loads.channels.
 element_wave_kinematics, wave_loads) and the element-mean σ of the drag linearization."""
 
 from __future__ import annotations
@@ -12,11 +12,8 @@ import pytest
 from scipy.integrate import quad_vec
 
 from stochcable import analysis
-from stochcable.dynamics import blocks as dblocks
-from stochcable.dynamics import system as dsystem
-from stochcable.dynamics import variance as dvariance
-from stochcable.dynamics.element_kinematics import element_wave_kinematics
-from stochcable.dynamics.loads import (
+from stochcable.dynamics.linearization import variance as dvariance
+from stochcable.dynamics.loads.channels import (
     Channel,
     channel_loads,
     drag_matrix,
@@ -25,6 +22,9 @@ from stochcable.dynamics.loads import (
     line_channels,
     wave_loads,
 )
+from stochcable.dynamics.loads.element_kinematics import element_wave_kinematics
+from stochcable.dynamics.model import blocks as dblocks
+from stochcable.dynamics.model import system as dsystem
 from stochcable.errors import InputError, ResolutionWarning
 from stochcable.examples import load_example
 from stochcable.scene.model import load_scene

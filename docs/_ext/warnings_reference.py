@@ -45,7 +45,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Response spectrum cut by the top of the grid",
         "ResolutionWarning",
-        ("stochcable.dynamics.resolution:tail_check",),
+        ("stochcable.dynamics.outputs.resolution:tail_check",),
         "S(ω_max)·ω_max > TAIL_FRACTION · m0 of an end-tension spectrum, and an input "
         "goes on above ω_max (quiet when every input, a band-limited motion or a "
         "spectrum table, ends at the grid's top: nothing excites the line above it)",
@@ -57,12 +57,12 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "or until the warning goes; give a fairlead motion as a "
         "vessel RAO over the sea (``motion.rao``) or as a band-limited spectrum instead "
         "of an unbounded one.",
-        ("stochcable.dynamics.resolution:TAIL_FRACTION",),
+        ("stochcable.dynamics.outputs.resolution:TAIL_FRACTION",),
     ),
     WarningEntry(
         "Natural frequency not resolved by the grid",
         "ResolutionWarning",
-        ("stochcable.dynamics.resolution:resolution_check",),
+        ("stochcable.dynamics.outputs.resolution:resolution_check",),
         "a mode inside the grid whose nearest grid point is farther than the local "
         "spacing, or whose half-power bandwidth b = 2ζω is so narrow against the "
         "spacing Δω that the trapezoid rule may be off by more than "
@@ -75,12 +75,12 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Use the ``analysis.omega.count`` the message gives (or refine the grid around "
         "the mode); a mode without damping is resolved by no grid: add drag, seabed or "
         "structural damping.",
-        ("stochcable.dynamics.resolution:RESONANCE_PEAK_ERROR",),
+        ("stochcable.dynamics.outputs.resolution:RESONANCE_PEAK_ERROR",),
     ),
     WarningEntry(
         "Elements too long for the wave kinematics near the surface",
         "ResolutionWarning",
-        ("stochcable.dynamics.resolution:surface_resolution_check",),
+        ("stochcable.dynamics.outputs.resolution:surface_resolution_check",),
         "σ of the wave velocity varies by more than SURFACE_SIGMA_RATIO along an "
         "element whose larger end σ is at least SURFACE_MATTERS_FRACTION of the line's "
         "largest",
@@ -90,27 +90,27 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Use the number of elements the message gives on that segment (the fix aims at a "
         "ratio SURFACE_TARGET_RATIO), or let ``analysis.fidelity`` choose the mesh.",
         (
-            "stochcable.dynamics.resolution:SURFACE_SIGMA_RATIO",
-            "stochcable.dynamics.resolution:SURFACE_MATTERS_FRACTION",
-            "stochcable.dynamics.resolution:SURFACE_TARGET_RATIO",
+            "stochcable.dynamics.outputs.resolution:SURFACE_SIGMA_RATIO",
+            "stochcable.dynamics.outputs.resolution:SURFACE_MATTERS_FRACTION",
+            "stochcable.dynamics.outputs.resolution:SURFACE_TARGET_RATIO",
         ),
     ),
     WarningEntry(
         "Snap loads likely (indicator ``snap``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.indicators:_snap",),
+        ("stochcable.dynamics.outputs.indicators:_snap",),
         "mean − SNAP_SIGMAS·σ of the tension below zero at an element or end",
         "The linear model predicts that the line goes slack: snap loads, which a "
         "frequency-domain model cannot represent, are likely. The result's "
         "``indicators.snap`` holds the margin.",
         "Run the nonlinear time-domain reference (:mod:`stochcable.reference.cable`) or "
         "increase the pretension.",
-        ("stochcable.dynamics.indicators:SNAP_SIGMAS",),
+        ("stochcable.dynamics.outputs.indicators:SNAP_SIGMAS",),
     ),
     WarningEntry(
         "Lightly damped resonance in the excitation band (indicator ``resonance``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.indicators:_resonances",),
+        ("stochcable.dynamics.outputs.indicators:_resonances",),
         "a mode where some input spectrum exceeds BAND_FRACTION of its peak, with modal "
         "damping ratio below RESONANCE_DAMPING_RATIO",
         "The response at that mode is set by damping the model may not represent "
@@ -118,14 +118,14 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Check the drag coefficients; add structural damping "
         "(``analysis.structural_damping``) or seabed damping where physical.",
         (
-            "stochcable.dynamics.indicators:BAND_FRACTION",
-            "stochcable.dynamics.indicators:RESONANCE_DAMPING_RATIO",
+            "stochcable.dynamics.outputs.indicators:BAND_FRACTION",
+            "stochcable.dynamics.outputs.indicators:RESONANCE_DAMPING_RATIO",
         ),
     ),
     WarningEntry(
         "Motion large against the sag (indicator ``large_motion``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.indicators:_large_motion",),
+        ("stochcable.dynamics.outputs.indicators:_large_motion",),
         "a node motion σ above MOTION_SAG_FRACTION of the line's sag, on a line whose sag "
         "governs its stiffness (Irvine's λ² of at least MOTION_SAG_LAMBDA2)",
         "The model is linear about the static shape; the geometric stiffness of a "
@@ -134,8 +134,8 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "elastic) does not warn, however far its fairlead carries it.",
         "Check with the nonlinear time-domain reference (:mod:`stochcable.reference.cable`).",
         (
-            "stochcable.dynamics.indicators:MOTION_SAG_FRACTION",
-            "stochcable.dynamics.indicators:MOTION_SAG_LAMBDA2",
+            "stochcable.dynamics.outputs.indicators:MOTION_SAG_FRACTION",
+            "stochcable.dynamics.outputs.indicators:MOTION_SAG_LAMBDA2",
         ),
     ),
     WarningEntry(
@@ -184,7 +184,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Drag linearization did not converge",
         "PhysicsWarning",
-        ("stochcable.dynamics.coupled.fixedpoint:linearize_coupled",),
+        ("stochcable.dynamics.groups.group_fixed_point:linearize_coupled",),
         "relative change of the drag σ above ``analysis.linearization.tolerance`` after "
         "``max_iterations``",
         "The result is flagged unconverged (``linearization.converged`` false); its "
@@ -195,7 +195,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Line without excitation",
         "PhysicsWarning",
-        ("stochcable.dynamics.coupled.analysis:_solve_line",),
+        ("stochcable.dynamics.groups.analysis:_solve_line",),
         "no sea and no end motion on a line not attached to a free body",
         "The line's dynamic response is zero.",
         "Add a ``sea`` or an end ``motion``.",
@@ -203,7 +203,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Body without lines or sea",
         "PhysicsWarning",
-        ("stochcable.dynamics.coupled.analysis:_solve_lonely",),
+        ("stochcable.dynamics.groups.analysis:_solve_lonely",),
         "a free body with no line and no sea",
         "Its motion is zero.",
         "Add a ``sea`` or attach lines.",
@@ -211,7 +211,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Large static rotation of a body",
         "PhysicsWarning",
-        ("stochcable.dynamics.coupled.model:_static_rotation_check",),
+        ("stochcable.dynamics.groups.model:_static_rotation_check",),
         "static rotation above STATIC_ROTATION_LIMIT",
         "The dynamics use the body's mass, inertia, hydrodynamic coefficients, "
         "hydrostatics, excitation and drag point at the input orientation (only the line "
@@ -219,12 +219,15 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "angle.",
         "Give the body's data at its static orientation (rotate them and the attachment "
         "points) and re-run.",
-        ("stochcable.dynamics.coupled.model:STATIC_ROTATION_LIMIT",),
+        ("stochcable.dynamics.groups.model:STATIC_ROTATION_LIMIT",),
     ),
     WarningEntry(
         "Foss decomposition failed: direct modal solve instead",
         "DefectivePencilWarning (a PhysicsWarning)",
-        ("stochcable.dynamics.solve:_foss_solver", "stochcable.dynamics.modal_solvers:solve_modal"),
+        (
+            "stochcable.dynamics.solve.line_solve:_foss_solver",
+            "stochcable.dynamics.model.modal_solvers:solve_modal",
+        ),
         "the state-space pencil is defective (repeated eigenvalues without a full set "
         "of eigenvectors)",
         "The Foss decoupling does not exist for these matrices; the answer is computed "
@@ -299,7 +302,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Strumming lock-in (or resonance) predicted",
         "PhysicsWarning",
-        ("stochcable.dynamics.strumming:with_strumming",),
+        ("stochcable.dynamics.model.strumming:with_strumming",),
         "a mode whose reduced velocity V_R = 2πU_n/(ω_n D) is inside the cross-flow band "
         "3 ≤ V_R ≤ 16 (DNV-RP-C205 ch. 9) and for which the wake-oscillator harmonic "
         "balance has a locked-in solution, or whose shedding frequency is inside its "
@@ -316,13 +319,13 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Strumming screening stops below the lock-in range",
         "ResolutionWarning",
-        ("stochcable.dynamics.strumming:strumming_inputs",),
+        ("stochcable.dynamics.model.strumming:strumming_inputs",),
         "the 3-D model's modes, computed up to MAX_MODES, stay below 2πU/(3D), the "
         "highest natural frequency the current can lock in (reduced velocity 3)",
         "Modes above the last one computed are not screened for strumming: a lock-in of "
         "a high mode of a thin, fast-flowed line may be missed.",
         "Screen the line alone with fewer elements, or check its high modes separately.",
-        ("stochcable.dynamics.strumming:MAX_MODES",),
+        ("stochcable.dynamics.model.strumming:MAX_MODES",),
     ),
     WarningEntry(
         "Compiled kernel unavailable or not cached",

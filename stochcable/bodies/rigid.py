@@ -187,7 +187,7 @@ class RigidBody:
         Quadratic drag Cd·A for relative velocities along x, y and z (a Morison
         element on the body), linearized as
         :func:`stochcable.reference.bodies.body_drag_damping` (the engine's drag
-        linearization, :mod:`stochcable.dynamics.coupled`). [m²]
+        linearization, :mod:`stochcable.dynamics.groups`). [m²]
     drag_point : array_like, shape (3,), optional
         Point of application of the drag, relative to the reference point. [m]
     extra_stiffness, extra_damping : array_like (d, d), optional
@@ -196,7 +196,7 @@ class RigidBody:
         Three DOFs (surge, heave, pitch) in the x–z plane instead of six.
     fixed_dofs : sequence of str, optional
         Names of DOFs held fixed (among ``dof_names``; default none): a constraint
-        ξ_j ≡ 0 in the coupled dynamics (:mod:`stochcable.dynamics.coupled`), as the
+        ξ_j ≡ 0 in the coupled dynamics (:mod:`stochcable.dynamics.groups`), as the
         body statics hold them.
 
     Notes

@@ -8,7 +8,7 @@ and turns the tension spectra into damage rates in one batched call per line.
 The cases of a set form runs of ``WARM_RUN`` consecutive positions of the diagram
 (0–15, 16–31, …): the first case of a run, and a case whose heading differs from the
 case before it, starts its drag fixed point at rest, each other from the converged σ
-of the cases before it (:func:`stochcable.dynamics.coupled.fixedpoint.warm_starts`;
+of the cases before it (:func:`stochcable.dynamics.groups.group_fixed_point.warm_starts`;
 neighbouring sea states of a diagram have neighbouring σ: ≈ 4.7 evaluations a case
 instead of 7.6 on the chain example's 200 cases).  A chunk that starts inside a run
 solves that run's earlier cases first (its ``lead``, discarded).  So each case's
@@ -34,8 +34,8 @@ from threadpoolctl import threadpool_limits
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import Family, SeaState
 from stochcable.design import damage_rate
-from stochcable.dynamics.coupled.fixedpoint import warm_starts
 from stochcable.dynamics.engine import Engine, build_engine
+from stochcable.dynamics.groups.group_fixed_point import warm_starts
 from stochcable.errors import StochcableError, collect_warnings
 from stochcable.scene.model import Scene, Sea
 
@@ -126,7 +126,7 @@ def prepare_worker() -> None:
     import warnings
 
     from stochcable import runtime
-    from stochcable.dynamics.variance import element_variance_kernel
+    from stochcable.dynamics.linearization.variance import element_variance_kernel
 
     runtime.configure()
     warnings.simplefilter("ignore")

@@ -1,3 +1,9 @@
-"""Dynamics about the static equilibrium: wave and end loads, statistical drag
-linearization, direct and Foss modal solves, coupled lines and bodies, time series
-(seed 001 ch. 5)."""
+"""Dynamics about the static equilibrium, one room per stage (seed 001 ch. 5):
+:mod:`~stochcable.dynamics.loads` (input channels, element kinematics),
+:mod:`~stochcable.dynamics.model` (one line's linear system and solvers),
+:mod:`~stochcable.dynamics.solve` (load assembly and the solve of one line),
+:mod:`~stochcable.dynamics.linearization` (statistical drag linearization),
+:mod:`~stochcable.dynamics.outputs` (spectra, statistics, indicators of a line),
+:mod:`~stochcable.dynamics.groups` (lines and bodies solved together: the one drag
+fixed point), :mod:`~stochcable.dynamics.timeseries` and, on top,
+:mod:`~stochcable.dynamics.engine` (build once, solve per sea state)."""

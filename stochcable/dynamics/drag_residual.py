@@ -61,7 +61,6 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.blocks import trapezoid_weights
 from stochcable.dynamics.drag_segments import (
     Segments,
     panel_groups,
@@ -70,6 +69,8 @@ from stochcable.dynamics.drag_segments import (
     segment_velocity,
     segments,
 )
+from stochcable.dynamics.linearization.variance import current_split
+from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.residual_lines import (
     covariance_lines,
     cross_covariance,
@@ -78,7 +79,6 @@ from stochcable.dynamics.residual_lines import (
     residual_record,
     uniform_grid,
 )
-from stochcable.dynamics.variance import current_split
 from stochcable.errors import PhysicsWarning, warn
 from stochcable.results.records import ResidualRecord
 

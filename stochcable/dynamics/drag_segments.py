@@ -31,8 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.blocks import trapezoid_weights
-from stochcable.dynamics.element_kinematics import element_wave_kinematics
+from stochcable.dynamics.loads.element_kinematics import element_wave_kinematics
+from stochcable.dynamics.model.blocks import trapezoid_weights
 
 __all__ = [
     "MAX_SUB",

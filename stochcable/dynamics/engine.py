@@ -4,15 +4,15 @@ scene and its response to one sea state (seed 001 ch. 5).
 :func:`build_engine` does everything that does not depend on the sea: the static
 equilibrium (all nonlinearities), the finite-element model of every line about it,
 its natural modes and the drag-independent arrays of the block-banded solves
-(:class:`~stochcable.dynamics.blocks.LinePrep`; the banded Cholesky of K_ff and the
+(:class:`~stochcable.dynamics.model.blocks.LinePrep`; the banded Cholesky of K_ff and the
 modal matrices are computed on first use and then kept on the line's
-:class:`~stochcable.dynamics.system.LineSystem`), and the scene as groups
-(:func:`~stochcable.dynamics.coupled.model.build_coupled`): free bodies with the lines
+:class:`~stochcable.dynamics.model.system.LineSystem`), and the scene as groups
+(:func:`~stochcable.dynamics.groups.model.build_coupled`): free bodies with the lines
 attached to them, and every other line as a group of its own without bodies, with the
 vessels' RAOs and the sea-independent coupled modes.  :meth:`Engine.solve` does the
-rest for one sea state (:func:`~stochcable.dynamics.coupled.analysis.solve_coupled`):
+rest for one sea state (:func:`~stochcable.dynamics.groups.analysis.solve_coupled`):
 the input channels (Morison loads, end motions), the one drag fixed point of every
-group (:func:`~stochcable.dynamics.coupled.fixedpoint.linearize_coupled`) with its
+group (:func:`~stochcable.dynamics.groups.group_fixed_point.linearize_coupled`) with its
 substructured response, the outputs and the time series::
 
     engine = build_engine(scene)            # statics, FE models, modes, groups
@@ -35,17 +35,17 @@ from typing import Any
 from pydantic import ValidationError
 
 from stochcable import runtime
-from stochcable.dynamics.blocks import line_prep
-from stochcable.dynamics.coupled.analysis import solve_coupled
-from stochcable.dynamics.coupled.model import CoupledModel, build_coupled
-from stochcable.dynamics.strumming import with_strumming
-from stochcable.dynamics.system import (
+from stochcable.dynamics.groups.analysis import solve_coupled
+from stochcable.dynamics.groups.model import CoupledModel, build_coupled
+from stochcable.dynamics.model.blocks import line_prep
+from stochcable.dynamics.model.strumming import with_strumming
+from stochcable.dynamics.model.system import (
     LineSystem,
     Progress,
     build_line_system,
     noop_progress,
 )
-from stochcable.dynamics.timeseries import simulate_timeseries
+from stochcable.dynamics.timeseries.synthesis import simulate_timeseries
 from stochcable.errors import InputError, collect_warnings
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, Sea, input_error_from_validation, load_scene
@@ -76,7 +76,7 @@ class Engine:
     systems : mapping of LineSystem by line name
         Every line's linear model (both end nodes prescribed), in scene order.
     model : CoupledModel
-        The scene as groups (:func:`stochcable.dynamics.coupled.model.build_coupled`):
+        The scene as groups (:func:`stochcable.dynamics.groups.model.build_coupled`):
         each line attached to no free body is a group of its own without bodies;
         free bodies with their lines; vessels' RAOs; sea-independent coupled modes.
     timing : mapping of float
@@ -84,7 +84,7 @@ class Engine:
     warnings : tuple of str
         Messages of the warnings raised by the build (repeated in every result).
     strumming : mapping of StrummingTable or None by line name
-        The strumming screening of every line (:mod:`stochcable.dynamics.strumming`).
+        The strumming screening of every line (:mod:`stochcable.dynamics.model.strumming`).
     """
 
     scene: Scene
@@ -106,7 +106,7 @@ class Engine:
             The sea state (a ``Sea`` document: spectrum and heading); None takes the
             scene's own sea.
         progress : callable, optional
-            ``progress(stage, info)`` (:data:`~stochcable.dynamics.system.Progress`):
+            ``progress(stage, info)`` (:data:`~stochcable.dynamics.model.system.Progress`):
             "linearization", "outputs", "timeseries", "done".
 
         Returns

@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.blocks import (
+from stochcable.dynamics.loads.freqblocks import frequency_slices
+from stochcable.dynamics.model.blocks import (
     add_blocks,
     free_band,
     from_freq,
@@ -25,10 +26,9 @@ from stochcable.dynamics.blocks import (
     to_freq,
     trapezoid_weights,
 )
-from stochcable.dynamics.freqblocks import frequency_slices
-from stochcable.dynamics.line_loads import drag_blocks
-from stochcable.dynamics.solve import end_tension_from_support, reactions
-from stochcable.dynamics.solvers import solve_band_stacked
+from stochcable.dynamics.model.solvers import solve_band_stacked
+from stochcable.dynamics.solve.line_loads import drag_blocks
+from stochcable.dynamics.solve.line_solve import end_tension_from_support, reactions
 from stochcable.results.records import ResidualRecord
 
 __all__ = [

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.freqblocks import working_memory_bytes
+from stochcable.dynamics.loads.freqblocks import working_memory_bytes
 from stochcable.errors import PhysicsWarning, warn
 
 __all__ = [

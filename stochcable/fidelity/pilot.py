@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.loads import drag_matrix
+from stochcable.dynamics.loads.channels import drag_matrix
 from stochcable.fidelity.meshing import LineGeometry, mesh_rules, segments_scene
 from stochcable.fidelity.rules import (
     MIN_TAIL_EXCESS,

@@ -67,7 +67,7 @@ Elements
     wire, whose loads vary along x, the observed anchor-tension error is 0.5× this
     estimate), realized by splitting the segment into a top
     sub-segment (same properties) — unless ``exact_wave_integration`` (element-exact
-    integration, being added in :mod:`stochcable.dynamics.loads`), which removes this rule.
+    integration, being added in :mod:`stochcable.dynamics.loads.channels`), which removes this rule.
 Modes
     With the static correction, a mode at ω_j contributes (ω/ω_j)² of its dynamic part
     beyond the quasi-static one; keeping the modes up to F·ω_max leaves ≈ C/F²
@@ -123,7 +123,7 @@ MIN_TAIL_EXCESS = 0.25
 CUTOFF_KH = 1.5
 #: Modal truncation error ≈ MODE_ERROR_CONSTANT/F² with the static correction. [-]
 MODE_ERROR_CONSTANT = 0.06
-#: Engine's "auto" factor (stochcable.dynamics.system.AUTO_MODE_FACTOR). [-]
+#: Engine's "auto" factor (stochcable.dynamics.model.system.AUTO_MODE_FACTOR). [-]
 AUTO_FACTOR = 5.0
 #: Above this many kept modes the direct solver is chosen. [-]
 DIRECT_MODES = 40

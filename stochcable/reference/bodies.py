@@ -1,6 +1,6 @@
 """Independent checks of the coupled lines–bodies dynamics (seed 001 §3.3).
 
-The engine (:mod:`stochcable.dynamics.coupled`) solves the coupled system by its own
+The engine (:mod:`stochcable.dynamics.groups`) solves the coupled system by its own
 paths (modal lines, Foss, the coarse-start drag fixed point); the solvers here take the
 assembled system of :func:`stochcable.bodies.coupling.couple` as it is and solve it
 directly at every frequency (dense, or line blocks banded with the bodies' Schur
@@ -17,8 +17,8 @@ import numpy as np
 
 from stochcable.bodies.coupling import CoupledSystem
 from stochcable.bodies.rigid import PLANAR_INDEX, RigidBody, rigid_link_matrix
-from stochcable.dynamics.linearization import drag_linear_current
-from stochcable.dynamics.solvers import solve_direct
+from stochcable.dynamics.linearization.formulas import drag_linear_current
+from stochcable.dynamics.model.solvers import solve_direct
 from stochcable.errors import InputError, SolverError
 from stochcable.validation import finite_scalar, float_array
 
@@ -53,7 +53,8 @@ def body_drag_damping(
     Notes
     -----
     Per direction b = ρ CdA E|v| for v ~ N(U, σ²) (DESIGN.md "Drag linearization",
-    :func:`stochcable.dynamics.linearization.drag_linear_current`); for U = 0 this is the seed
+    :func:`stochcable.dynamics.linearization.formulas.drag_linear_current`); for U = 0 this is the
+    seed
     form √(8/π)·½ρ CdA σ (seed 001 eq. 5.2.2).  The fluid load that goes with it is
     Tᵀ diag(b) v_fluid (wave velocity at the drag point).
     """
@@ -91,7 +92,7 @@ def solve_coupled_direct(
         Angular frequencies. [rad/s]
     method : {"auto", "schur", "dense"}
         ``"schur"``: each line's free block solved by
-        :func:`stochcable.dynamics.solvers.solve_direct` (banded, all frequencies at once),
+        :func:`stochcable.dynamics.model.solvers.solve_direct` (banded, all frequencies at once),
         the body DOFs from the Schur complement; ``"dense"``: one batched dense solve
         (small systems); ``"auto"``: schur, falling back to dense (up to 3000 DOFs)
         when a line block alone is singular (a fixed-end line resonance).
@@ -171,7 +172,7 @@ def _body_z(system: CoupledSystem, w: np.ndarray) -> np.ndarray:
 
 def _solve_small(z: np.ndarray, g: np.ndarray, w: np.ndarray, what: str) -> np.ndarray:
     """Batched dense solve; SolverError where ||Z||·||x||/||F|| > 1e12 (the estimate of
-    :func:`stochcable.dynamics.solvers.solve_direct`) or Z is exactly singular."""
+    :func:`stochcable.dynamics.model.solvers.solve_direct`) or Z is exactly singular."""
     try:
         x = np.linalg.solve(z, g)
     except np.linalg.LinAlgError:

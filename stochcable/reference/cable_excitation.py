@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from stochcable import validation as _v
-from stochcable.dynamics.loads import element_wave_kinematics
-from stochcable.dynamics.sea_channels import spectrum_callable
+from stochcable.dynamics.loads.channels import element_wave_kinematics
+from stochcable.dynamics.loads.sea_channels import spectrum_callable
 from stochcable.errors import InputError
 from stochcable.reference.cable_model import LineModel
 from stochcable.scene.model import Environment, Line, Scene
@@ -214,14 +214,15 @@ def band_limited(
 
 def spectrum_density(spec: Any, g: float):
     """ω -> S(ω) with S(0) = 0, as :mod:`stochcable.dynamics` samples it
-    (:func:`stochcable.dynamics.sea_channels.spectrum_callable`)."""
+    (:func:`stochcable.dynamics.loads.sea_channels.spectrum_callable`)."""
     return spectrum_callable(spec, g)
 
 
 def end_motion_generators(scene: Scene, seed: int) -> dict[tuple[str, str, str], Any]:
     """The generator of every end-motion spectrum channel, keyed (line, end, dof).
 
-    The rule of :func:`stochcable.dynamics.timeseries.simulate_timeseries`: channels in the order
+    The rule of :func:`stochcable.dynamics.timeseries.synthesis.simulate_timeseries`: channels in
+    the order
     lines × (end_a, end_b) × (surge, sway, heave), channel k drawing from
     ``default_rng(SeedSequence(seed).spawn(n)[k])``.
     """
@@ -273,8 +274,9 @@ def wave_series(
     Returns the fluid velocity at the nodes (n_steps+1, n, d) (attachment drag), at
     the drag quadrature points (n_steps+1, ne, ng, d), and the wave-inertia nodal load
     (n_steps+1, N): per element l0·ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ)·∫₀¹ N_i a dξ with the
-    exact element moments of :func:`stochcable.dynamics.element_kinematics.element_wave_kinematics`
-    (the load of :func:`stochcable.dynamics.loads.wave_loads`), plus the attachments'
+    exact element moments of
+    :func:`stochcable.dynamics.loads.element_kinematics.element_wave_kinematics`
+    (the load of :func:`stochcable.dynamics.loads.channels.wave_loads`), plus the attachments'
     (buoyancy/g + added mass)·a_node.  All are linear transfer functions per unit wave
     amplitude at the static positions, synthesized with the realization's coefficients.
     """

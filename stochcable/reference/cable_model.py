@@ -22,14 +22,15 @@ Model (the same finite-element discretization as the frequency-domain model):
   (:meth:`LineModel.seabed`), the dashpot's engagement lagged by one step: a kinked
   contact law makes Newton cycle when a node lands within a step.
 - Wave loads use the load model of the frequency-domain analysis
-  (:func:`stochcable.dynamics.loads.wave_loads`), the wave kinematics taken at the
+  (:func:`stochcable.dynamics.loads.channels.wave_loads`), the wave kinematics taken at the
   *static* positions (linear wave theory; the error is second order in the motion;
   zero above z = 0):
 
   * wave inertia (linear in the kinematics) — **exact** along each straight element:
     node i of element j gets l0_j ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ)·∫₀¹ N_i a dξ with the
     closed-form consistent moments of
-    :func:`stochcable.dynamics.element_kinematics.element_wave_kinematics` (split at the waterline),
+    :func:`stochcable.dynamics.loads.element_kinematics.element_wave_kinematics` (split at the
+    waterline),
     synthesized in time with the realization's coefficients like any transfer
     function; attachments get (buoyancy/g + added mass)·a at their node.
   * Morison drag with the relative velocity v_r = U_current + v_wave − u̇ (seed eqs.

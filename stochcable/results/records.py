@@ -216,14 +216,14 @@ class LineIndicators:
     borgman_ratio : ndarray, shape (n_el,)
         Var(B v)/Var(½ρCdD|v|v) of the normal drag per element for the Gaussian
         normal relative velocity with the element's normal current
-        (:func:`stochcable.dynamics.linearization.borgman_variance_ratio`; 0.849 without
+        (:func:`stochcable.dynamics.linearization.formulas.borgman_variance_ratio`; 0.849 without
         current; elements at rest — normal velocity σ below 1e-6 of the line's
         largest, such as grounded chain — take the σ → 0 limit: 1 with a normal
         current, 0.849 without). [-]
     drag_inertia_ratio : ndarray, shape (n_el,)
         σ of the linearized normal drag force over σ of the Morison inertia force
         ρ C_M (πD²/4) a_n of the sea per element (inf without fluid acceleration;
-        :func:`stochcable.dynamics.linearization.drag_inertia_ratio`; 0 at rest). [-]
+        :func:`stochcable.dynamics.linearization.formulas.drag_inertia_ratio`; 0 at rest). [-]
     snap_margin : float
         min over elements and ends of (T_mean − 3σ_T)/|T_mean|; below 0 the linear
         model predicts slack (snap loads likely). [-]

@@ -1,0 +1,177 @@
+"""Results of a coupled group: the lines' results and the bodies' motion statistics
+(seed 001 §5.1, spectral moments and maxima)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from stochcable.bodies.rigid import PLANAR_INDEX, RigidBody
+from stochcable.dynamics.groups.group_fixed_point import CoupledLinearization
+from stochcable.dynamics.groups.inputs import CoupledLine
+from stochcable.dynamics.groups.modes import (
+    CoupledModes,
+    coupled_modal_bandwidths,
+    line_mode_shares,
+)
+from stochcable.dynamics.loads.channels import Channel
+from stochcable.dynamics.outputs.line_result import line_result
+from stochcable.dynamics.outputs.resolution import LineModes
+from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
+
+__all__ = ["LINE_MODE_SHARE", "body_result", "coupled_results", "line_modes"]
+
+#: A coupled mode counts for a line's resolution check and resonance indicator when at
+#: least this share of its kinetic energy is in the line (u_lᵀ(M + M_a)_l u_l of the
+#: mass-normalized mode).  A mode the line hardly takes part in (a body mode, a mode
+#: of another line) gives the line little response at its frequency: its resonance is
+#: not the line's.  Below 5 % the line's own motion in it is under ≈ 22 % of the
+#: mode's amplitude scale (√0.05); each line's fixed-end-like modes carry most of
+#: their energy in the line and pass by far.
+LINE_MODE_SHARE = 0.05
+
+
+def coupled_results(
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    linearization: CoupledLinearization,
+    settings: Any,
+    *,
+    static_pose: Mapping[str, np.ndarray] | None = None,
+    modes: CoupledModes | None = None,
+    channels: Sequence[Channel] | None = None,
+) -> tuple[dict[str, LineResult], dict[str, BodyResult]]:
+    """Line and body results of a coupled group.
+
+    Parameters
+    ----------
+    lines : sequence of CoupledLine
+    bodies : sequence of RigidBody
+    linearization : CoupledLinearization
+    settings : AnalysisSettings
+        ``duration`` for the maxima.
+    static_pose : mapping of body name to ndarray (d,), optional
+        Static value of each body DOF (position and rotation components), the
+        statistics' mean (default: the body position, zero rotation). [m, rad]
+    modes : CoupledModes, optional
+        Listed on every body result; the modes of the lines' resolution check and
+        resonance indicator (:func:`line_modes`; default each line's fixed-end modes).
+    channels : sequence of Channel, optional
+        The group's channels (default those of the first line).
+
+    Returns
+    -------
+    (lines, bodies) : dict of LineResult, dict of BodyResult
+    """
+    counted = {} if modes is None else line_modes(modes, lines, bodies, linearization)
+    out_lines = {}
+    for cl in lines:
+        out_lines[cl.name] = line_result(
+            cl.system,
+            cl.channels,
+            linearization.lines[cl.name],
+            settings,
+            counted.get(cl.name),
+            alone=False,
+        )
+    ch = tuple(lines[0].channels if channels is None else channels)
+    spectra = np.stack([c.spectrum for c in ch])
+    w = ch[0].omega
+    out_bodies = {}
+    for b in bodies:
+        h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)
+        if static_pose is not None and b.name in static_pose:
+            mean = np.asarray(static_pose[b.name], dtype=float)
+        else:
+            full = np.concatenate([b.position, np.zeros(3)])
+            mean = full[list(PLANAR_INDEX)] if b.planar else full
+        out_bodies[b.name] = body_result(
+            b.name,
+            b.dof_names,
+            w,
+            tuple(c.name for c in ch),
+            spectra,
+            h,
+            mean,
+            settings.duration,
+            sigma=linearization.body_sigma.get(b.name),
+            drag=linearization.body_drag.get(b.name),
+            modes=modes,
+            prescribed=False,
+        )
+    return out_lines, out_bodies
+
+
+def line_modes(
+    modes: CoupledModes,
+    lines: Sequence[CoupledLine],
+    bodies: Sequence[RigidBody],
+    linearization: CoupledLinearization,
+) -> dict[str, LineModes]:
+    """The coupled modes that count for each line of a group, with their bandwidths.
+
+    Parameters
+    ----------
+    modes : CoupledModes
+        The group's coupled modes (with ``line_shapes``).
+    lines : sequence of CoupledLine
+    bodies : sequence of RigidBody
+    linearization : CoupledLinearization
+        The converged drag of the lines and the bodies.
+
+    Returns
+    -------
+    dict of str to LineModes
+        Per line the modes with at least ``LINE_MODE_SHARE`` of their kinetic energy
+        in it (:func:`~stochcable.dynamics.groups.modes.line_mode_shares`) and their
+        half-power bandwidths over the group at the converged drag
+        (:func:`~stochcable.dynamics.groups.modes.coupled_modal_bandwidths`), the
+        modes numbered in the group's list.  Empty when the modes have no line shapes.
+    """
+    if not lines or any(cl.name not in modes.line_shapes for cl in lines):
+        return {}
+    damping = {cl.name: linearization.lines[cl.name].damping for cl in lines}
+    band = coupled_modal_bandwidths(modes, lines, bodies, damping, linearization.body_drag)
+    out = {}
+    for name, share in line_mode_shares(modes, lines).items():
+        j = np.flatnonzero(share >= LINE_MODE_SHARE)
+        out[name] = LineModes(j + 1, modes.omega[j], band[j])
+    return out
+
+
+def body_result(
+    name: str,
+    dofs: Sequence[str],
+    omega: np.ndarray,
+    channels: tuple[str, ...],
+    spectra: np.ndarray,
+    transfer: np.ndarray,
+    mean: np.ndarray,
+    duration: float,
+    *,
+    sigma: Any = None,
+    drag: Any = None,
+    modes: CoupledModes | None = None,
+    prescribed: bool = False,
+) -> BodyResult:
+    """Statistics of a body's motion from its transfer functions (see BodyResult)."""
+    dens = np.einsum("cdw,cw->dw", np.abs(transfer) ** 2, spectra)
+    stats = {
+        dof: stats_from_spectrum(omega, dens[i], float(mean[i]), duration)
+        for i, dof in enumerate(dofs)
+    }
+    return BodyResult(
+        name=name,
+        dofs=tuple(dofs),
+        omega=np.asarray(omega).copy(),
+        channels=tuple(channels),
+        input_spectra=np.asarray(spectra).copy(),
+        motion_transfer=transfer,
+        motion=stats,
+        prescribed=prescribed,
+        drag_sigma=None if sigma is None else np.asarray(sigma).copy(),
+        drag_coefficient=None if drag is None else np.asarray(drag).copy(),
+        modes=modes,
+    )

@@ -1,0 +1,280 @@
+"""Outputs of one line: transfer functions, spectra and statistics
+(:func:`line_result`) and the dynamic effective tension per element.
+
+Dynamic effective tension
+-------------------------
+Per element δT = (EA/l0)·e·(u_b − u_a), the first-order change of T = EA(l/l0 − 1)
+(seed 001 eqs. 3.1.8–3.1.11: the K_NL part of the tangent stiffness).  The "geometric"
+term (T/l)(I − eeᵀ)Δu of the tangent stiffness rotates the element force; it changes
+its direction, not its magnitude, and contributes to the tension only at second order,
+so it is not part of δT.  Slack elements (T <= 0) use the model's reduced EA.  The end
+tensions are computed with the response (:mod:`stochcable.dynamics.solve.line_solve`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from stochcable.dynamics.drag_residual import drag_residual
+from stochcable.dynamics.geometric_residual import geometric_residual
+from stochcable.dynamics.loads.channels import (
+    Channel,
+)
+from stochcable.dynamics.loads.freqblocks import frequency_slices
+from stochcable.dynamics.model.blocks import (
+    trapezoid_weights,
+)
+from stochcable.dynamics.model.system import (
+    Linearization,
+    LineSystem,
+    Response,
+)
+from stochcable.dynamics.outputs.indicators import line_indicators
+from stochcable.dynamics.outputs.resolution import (
+    LineModes,
+    excitation_end,
+    resolution_check,
+    surface_resolution_check,
+    tail_check,
+)
+from stochcable.dynamics.second_order import second_order_tension, with_second_order
+from stochcable.line.fem import SLACK_EA_RATIO
+from stochcable.results.documents import (
+    LineResult,
+    stats_from_validated,
+)
+from stochcable.results.records import ResidualRecord
+from stochcable.scene.model import AnalysisSettings
+
+# ------------------------------------------------------------------------- outputs
+
+
+def element_tension_transfer(
+    system: LineSystem, response: Response, motion: np.ndarray | None = None
+) -> np.ndarray:
+    """Dynamic effective tension per element, (n_ch, n_el, n_omega). [N/unit]
+
+    δT = (EA/l0)·e·(u_{j+1} − u_j) (module docstring), EA reduced for slack elements;
+    the rows of :attr:`stochcable.line.fem.FEModel.tension_rows` (the touchdown element
+    split at the static touchdown has its suspended part's).  ``motion``: the node
+    motion transfer (n_ch, n_nodes, 3, n_omega) of ``response`` when already formed
+    (read in place: the same numbers without a transposed copy of the response).
+    """
+
+    model = system.model
+    n_w = response.omega.size
+    comps = list(range(model.dim))
+    if motion is not None:  # (n_ch, n_nodes, 3, n_w): the model's components in place
+        u, comps = motion, list(model.components)
+    else:
+        u = response.displacement.reshape(n_w, model.n_nodes, model.dim, -1)
+        # rows·(u_a, u_b) one component at a time, frequencies last (long inner loops;
+        # the complex einsum was 0.4 ms on the chain, the frequency-major layout 0.25)
+        u = np.ascontiguousarray(np.transpose(u, (3, 1, 2, 0)))
+    rows = model.tension_rows
+    if rows is None:
+        ea = np.where(model.slack, SLACK_EA_RATIO * model.mesh.ea, model.mesh.ea)
+        t = model.tangents * (ea / model.l0)[:, None]
+        rows = np.stack([-t, t], axis=1)
+    c = comps[0]
+    out = rows[None, :, 0, 0, None] * u[:, :-1, c] + rows[None, :, 1, 0, None] * u[:, 1:, c]
+    for k in range(1, model.dim):
+        c = comps[k]
+        out += rows[None, :, 0, k, None] * u[:, :-1, c] + rows[None, :, 1, k, None] * u[:, 1:, c]
+    return out
+
+
+def _listed_modes(omega_n: np.ndarray, w_top: float) -> int:
+    """How many natural frequencies the document lists: those up to
+    2.5·ω_max, at least min(10, available)."""
+    wn = np.asarray(omega_n)
+    return int(max(np.count_nonzero(wn <= 2.5 * w_top), min(10, wn.size)))
+
+
+def line_result(
+    system: LineSystem,
+    channels: tuple[Channel, ...],
+    linearization: Linearization,
+    settings: AnalysisSettings,
+    modes: LineModes | None = None,
+    *,
+    alone: bool = True,
+) -> LineResult:
+    """Transfer functions, spectra and statistics of one line.
+
+    Parameters
+    ----------
+    system : LineSystem
+    channels : tuple of Channel
+    linearization : Linearization
+        Its ``response`` is used.
+    settings : AnalysisSettings
+        ``duration`` for the maxima.
+    modes : LineModes, optional
+        The natural modes of the resolution check and the resonance indicator
+        (default the line's fixed-end modes; a line on bodies: the coupled modes that
+        count for it, :func:`stochcable.dynamics.groups.results.line_modes`).
+    alone : bool
+        False for a line of a coupled group (on free bodies): its residuals
+        (``settings.linearization.drag_residual`` and ``.geometric_residual``) are not
+        computed.
+
+    Returns
+    -------
+    LineResult
+    """
+    model = system.model
+    resp = linearization.response
+    w = resp.omega
+    n_ch = len(channels)
+    spectra = np.stack([c.spectrum for c in channels]) if n_ch else np.zeros((0, w.size))
+    # σ² = Σ_c ∫|H_c|² S_c dω as weighted reductions with the trapezoid weights q
+    # (the response spectra are not kept), the node motion and the element tensions
+    # over blocks of frequencies: their transfer functions are formed only when read
+    # (LineResult.motion_transfer, .tension_transfer)
+    q = trapezoid_weights(w)
+    sq = spectra * q
+    tension_var, motion_var = _blocked_variances(system, resp, n_ch, sq)
+    tension_std = np.sqrt(tension_var)
+    motion_std = np.sqrt(motion_var)
+
+    def motion(freq: slice = slice(None)) -> np.ndarray:
+        return _motion_transfer(model, resp, n_ch, freq)
+
+    def tension() -> np.ndarray:
+        return _tension_transfer(system, resp, n_ch)
+
+    st = system.statics
+    s0 = model.mesh.s0
+    stats = {}
+    input_end = excitation_end(channels, w)
+    for end, mean in (("end_a", st.tension_a), ("end_b", st.tension_b)):
+        dens = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
+        stats[end] = stats_from_validated(w, dens, float(mean), settings.duration)
+        tail_check(system.name, end, w, dens, stats[end].m0, input_end)
+    if np.any(spectra > 0):  # nothing to resolve without excitation
+        resolution_check(system, linearization.damping, w, modes)
+        surface_resolution_check(system, channels, w, q)
+    indicators = (
+        None
+        if linearization.record is None
+        else line_indicators(system, channels, linearization, tension_std, motion_std, stats, modes)
+    )
+    if indicators is not None:
+        so = second_order_tension(
+            motion,
+            spectra,
+            q,
+            model.positions,
+            model.mesh,
+            st.tension,
+            tension_std,
+            tuple(model.components),
+        )
+        indicators = with_second_order(system.name, indicators, so)
+    end_force = _end_force_transfer(model, resp, n_ch)
+    residual = {}
+    std = {e: stats[e].std for e in stats}
+    for key, fn in (("drag_residual", drag_residual), ("geometric_residual", geometric_residual)):
+        if getattr(settings.linearization, key) and linearization.record is not None:
+            residual[key] = (
+                fn(system, channels, linearization, std)
+                if alone
+                else ResidualRecord.not_computed("a line on free bodies is not covered", std)
+            )
+    return LineResult(
+        name=system.name,
+        omega=w,
+        channels=tuple(c.name for c in channels),
+        input_spectra=spectra,
+        s_nodes=s0.copy(),
+        s_elements=0.5 * (s0[1:] + s0[:-1]),
+        positions=model.positions.copy(),
+        motion_transfer=motion,  # formed when read
+        tension_transfer=tension,  # formed when read
+        end_tension_transfer=dict(resp.end_tension),
+        end_force_transfer=end_force,
+        tension_mean=np.asarray(st.tension, dtype=float).copy(),
+        tension_std=tension_std,
+        motion_std=motion_std,
+        end_a=stats["end_a"],
+        end_b=stats["end_b"],
+        linearization=linearization.record,
+        modes_omega=np.asarray(system.modes.omega).copy(),
+        modes_listed=_listed_modes(system.modes.omega, float(w[-1])),
+        n_modes=system.n_modes if system.solver == "foss" else None,
+        statics=st,
+        model=model,
+        modes=system.modes,
+        indicators=indicators,
+        **residual,
+    )
+
+
+def _blocked_variances(
+    system: LineSystem, resp: Response, n_ch: int, sq: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The element tension variances (n_el,) and the node motion variances (n_nodes,
+    3) over the σ weights ``sq`` (n_ch, n_omega), from the motion transfer of blocks
+    of frequencies (no transfer function formed for the whole grid)."""
+    model = system.model
+    n_w = resp.omega.size
+    t_var = np.zeros(model.n_elements)
+    var = np.zeros((model.n_nodes, 3))
+    # a block's motion transfer, its squares and the tension temporaries
+    for sl in frequency_slices(n_w, 16 * n_ch * model.n_nodes * 8):
+        m = _motion_transfer(model, resp, n_ch, sl)
+        t = element_tension_transfer(system, resp, m)
+        t_var += np.einsum("cew,cw->e", np.abs(t) ** 2, sq[:, sl])
+        var += np.einsum("cnkw,cw->nk", np.abs(m) ** 2, sq[:, sl])
+    return t_var, var
+
+
+def _tension_transfer(system: LineSystem, resp: Response, n_ch: int) -> np.ndarray:
+    """The element tension transfer (n_ch, n_el, n_omega), formed over blocks of
+    frequencies (the node motion transfer of a block at a time). [N/unit]"""
+    model = system.model
+    n_w = resp.omega.size
+    tension = np.empty((n_ch, model.n_elements, n_w), dtype=complex)
+    for sl in frequency_slices(n_w, 16 * n_ch * model.n_nodes * 8):
+        tension[:, :, sl] = element_tension_transfer(
+            system, resp, _motion_transfer(model, resp, n_ch, sl)
+        )
+    return tension
+
+
+def _motion_transfer(
+    model: Any, resp: Response, n_ch: int, freq: slice = slice(None)
+) -> np.ndarray:
+    """Node motion transfer functions on x, y, z on the frequencies ``freq``, (n_ch,
+    n_nodes, 3, n_f) (zero on the components a 2-D model lacks). [m/unit]"""
+    if resp.nodes is not None:  # the node layout (n_nodes, d, n_f, n_ch) of a block
+        u_h = np.transpose(resp.nodes(freq), (3, 0, 1, 2))
+    else:
+        disp = resp.displacement[freq]
+        # (n_ch, n_nodes, 3, n_w) built in its own layout (embedding in the
+        # frequency-major layout and transposing made every later pass strided)
+        u_h = np.transpose(
+            disp.reshape(disp.shape[0], model.n_nodes, model.dim, n_ch), (3, 1, 2, 0)
+        )
+    n_f = u_h.shape[-1]
+    if tuple(model.components) == (0, 1, 2):  # 3-D: no zero components to embed
+        return np.ascontiguousarray(u_h)
+    motion_h = np.zeros((n_ch, model.n_nodes, 3, n_f), dtype=complex)
+    motion_h[:, :, list(model.components)] = u_h
+    return motion_h
+
+
+def _end_force_transfer(model: Any, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
+    """Support force transfer functions on x, y, z per end, (n_ch, 3, n_omega). [N/unit]"""
+    comps = list(model.components)
+    d = model.dim
+    w = resp.omega
+    end_force = {}
+    for k, end in enumerate(("end_a", "end_b")):
+        f = np.zeros((n_ch, 3, w.size), dtype=complex)
+        f[:, comps, :] = np.transpose(resp.support_force[:, k * d : (k + 1) * d, :], (2, 1, 0))
+        end_force[end] = f
+    return end_force
