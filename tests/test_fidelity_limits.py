@@ -275,6 +275,7 @@ def no_limit(monkeypatch):
     monkeypatch.setattr(planner, "omega_count_limit", lambda: 10**9)
 
 
+@pytest.mark.slow
 def test_entrances_refuse_an_inadmissible_plan(no_limit, tmp_path, capsys):
     with pytest.raises(InputError) as info:
         analyze(_chain(0.003))
@@ -292,6 +293,7 @@ def test_entrances_refuse_an_inadmissible_plan(no_limit, tmp_path, capsys):
     assert "analysis.omega.count" in json.dumps(detail)
 
 
+@pytest.mark.slow
 def test_a_plan_beyond_the_memory_available_is_refused(monkeypatch):
     # a machine with 1 MiB free: the 5 % plan of the chain (≈ 10² MB by the cost
     # model) is refused before any work, naming the target and the estimate

@@ -104,6 +104,7 @@ def test_timeseries_window_labels(chain):
     plt.close("all")
 
 
+@pytest.mark.slow
 def test_plot_result_writes_every_figure(fss, tmp_path):
     paths = plots.plot_result(fss, tmp_path)
     names = sorted(p.name for p in paths)

@@ -898,6 +898,7 @@ print("after", "numba" in sys.modules, sea._compiled_state[0] is not None)
 """
 
 
+@pytest.mark.slow
 def test_numba_imported_only_by_large_realizations():
     # import stochcable, the CLI's `spectrum`, the service app and realizations below
     # 2^16 lines must not pay numba's import (~0.2 s) and kernel load (~0.4 s)
@@ -926,6 +927,7 @@ def test_numba_imported_only_by_large_realizations():
     ]
 
 
+@pytest.mark.slow
 def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
     # a read-only install: no writable __pycache__ next to _kernels.py (here a file of that
     # name, which even root cannot write into), NUMBA_CACHE_DIR and the user cache

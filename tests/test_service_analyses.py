@@ -111,6 +111,7 @@ def test_document_conforms_to_the_response_model(chain_answer):
     }
 
 
+@pytest.mark.slow
 def test_residuals_of_the_linear_model_through_http(client):
     """The chain example with both residuals asked for: the service answers the core's
     residual records (the closed forms are deterministic: round-off only) and the
@@ -352,6 +353,7 @@ def _perturbed_scenes(draw):
 _GENERATED_APP = create_app(Settings(max_run_seconds=10.0))
 
 
+@pytest.mark.slow
 @settings(
     max_examples=8,
     deadline=None,
