@@ -71,20 +71,6 @@ def jit_cached(
         Whether its machine code is kept on disk.
     """
     start = time.process_time()
-    try:
-        return _jit(function, signature, what)
-    finally:
-        _COMPILE_CPU_S[0] += time.process_time() - start
-
-
-def compile_cpu_seconds() -> float:
-    """CPU time this process has spent in :func:`jit_cached`: compiling kernels, or
-    loading them from the cache (the test suite's fast-tier guard leaves it out of a
-    test's cost: it is the machine's first use, not the test's work). [s]"""
-    return _COMPILE_CPU_S[0]
-
-
-def _jit(function: Callable[..., Any], signature: Any, what: str) -> tuple[Any, bool]:
     import numba
 
     try:
@@ -97,6 +83,16 @@ def _jit(function: Callable[..., Any], signature: Any, what: str) -> tuple[Any, 
             "is compiled in memory in each process (~1 s at its first use); set "
             "NUMBA_CACHE_DIR to a writable directory to keep it",
             UserWarning,
-            stacklevel=4,
+            stacklevel=3,
         )
         return numba.njit(signature, nogil=True)(function), False
+    finally:
+        _COMPILE_CPU_S[0] += time.process_time() - start
+
+
+def compile_cpu_seconds() -> float:
+    """CPU time this process has spent in :func:`jit_cached`: compiling kernels or
+    loading them from the cache (the test suite's fast-tier guard
+    leaves it out of a test's cost: it is the machine's first use, not the test's
+    work). [s]"""
+    return _COMPILE_CPU_S[0]
