@@ -63,6 +63,7 @@ def test_limits_are_read_from_the_scene_model():
     assert elements_limit() == le[0]
 
 
+@pytest.mark.slow
 def test_plan_at_0_3_percent_stays_within_the_limits_and_says_what_it_leaves(plan_03):
     plan = plan_03
     assert plan.omega_count <= omega_count_limit()
@@ -97,6 +98,7 @@ def test_plan_at_0_3_percent_stays_within_the_limits_and_says_what_it_leaves(pla
     assert "left unresolved" in text and "analysis.fidelity.target_error" in text
 
 
+@pytest.mark.slow
 def test_an_inadmissible_plan_is_an_input_error_naming_the_request(plan_03):
     bad = replace(plan_03, omega_count=omega_count_limit() + 1)
     with pytest.raises(InputError) as info:
@@ -121,6 +123,7 @@ def test_elements_are_clipped_to_the_model_with_a_larger_estimate(monkeypatch):
     apply_fidelity(scene, plan)  # admissible
 
 
+@pytest.mark.slow
 def test_unbounded_tail_warning_names_the_cause_and_the_fix(plan_03):
     (text, _, _) = fidelity_warnings(replace(plan_03, tail_bounded=False))
     assert "could not bound the response tail" in text

@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-# one worker runs the module: its module fixtures run once (--dist loadgroup)
-pytestmark = pytest.mark.xdist_group("test_speed_vs_error")
+# an accuracy study against the time domain (seconds of fixtures): the slow tier
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("test_speed_vs_error")]
 
 SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "speed_vs_error.py"
 

@@ -24,6 +24,10 @@ from _server import Server
 
 from stochcable.examples import load_example
 
+# reliability: servers killed and restarted, run limits (the slow tier; one worker: its
+# module servers start once)
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("test_reliability")]
+
 ROOT = Path(__file__).resolve().parents[2]
 CHAIN = load_example("chain_catenary").model_dump(mode="json", exclude_unset=True)
 GB = 1e9
