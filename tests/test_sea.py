@@ -631,9 +631,12 @@ def test_grid_is_shared_read_only_and_exact():
 
 @pytest.fixture
 def fresh_fft_state(monkeypatch, tmp_path):
-    """Plans and wisdom of this test only (file under tmp_path, nothing in ~/.cache)."""
+    """Plans and wisdom of this test only (file under tmp_path, nothing in ~/.cache);
+    FFTW runs every length (the small lengths of these tests go to numpy.fft otherwise:
+    PYFFTW_MIN_SIZE)."""
     path = tmp_path / "cache" / "fftw_wisdom.txt"
     monkeypatch.setenv("STOCHCABLE_FFTW_WISDOM", str(path))
+    monkeypatch.setattr(_fft, "PYFFTW_MIN_SIZE", 1)
     monkeypatch.setattr(_fft, "_wisdom_loaded", False)
     _fft.clear_cache()
     yield path
@@ -1052,3 +1055,18 @@ def test_cpu_count_is_asked_again_when_replaced(monkeypatch):
     assert sea._cpu_count() == 7
     monkeypatch.setattr(sea.os, "cpu_count", lambda: None)
     assert sea._cpu_count() == 1
+
+
+def test_short_transforms_go_to_numpy_and_long_ones_to_fftw():
+    # below PYFFTW_MIN_SIZE numpy.fft (no pyfftw import for a short record), from it
+    # FFTW: the same numbers to round-off either way
+    rng = np.random.default_rng(3)
+    for n in (_fft.PYFFTW_MIN_SIZE - 2, _fft.PYFFTW_MIN_SIZE):
+        x = rng.standard_normal(n)
+        X = _fft.rfft(x)
+        np.testing.assert_allclose(X, np.fft.rfft(x), rtol=0, atol=1e-10)
+        np.testing.assert_allclose(_fft.irfft(X, n), x, rtol=0, atol=1e-12)
+        work = _fft.irfft_input(n)
+        work[:] = X
+        np.testing.assert_allclose(_fft.irfft_overwrite(work, n), n * x, rtol=0, atol=1e-8)
+    assert _fft._lib_for(_fft.PYFFTW_MIN_SIZE - 1) is None
