@@ -24,6 +24,7 @@ from typing import Any
 
 from stochcable.cases import LineFatigue, ScatterDiagram, read_scatter
 from stochcable.errors import InputError, PhysicsWarning, StochcableError
+from stochcable.results.display import batch_status_html, batch_status_text
 from stochcable.scene.model import Scene, load_scene
 
 __all__ = ["BatchJob", "BatchMethods", "BatchTimeout"]
@@ -63,6 +64,14 @@ class BatchJob:
     error: str | None = None
     document: dict[str, Any] = field(default_factory=dict, repr=False)
     warnings: list[str] = field(default_factory=list)
+
+    def __repr__(self) -> str:
+        """One line: id, status, progress, cases not ok, warnings."""
+        return batch_status_text(self)
+
+    def _repr_html_(self) -> str:
+        """The status table a notebook shows."""
+        return batch_status_html(self)
 
     @property
     def finished(self) -> bool:

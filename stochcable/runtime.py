@@ -42,7 +42,7 @@ Per-line work of a coupled group on a small thread pool (the speed of scenes wit
 The lines of a coupled group are independent inside one drag-linearization
 evaluation until the body solve.  :func:`line_map` can run such per-line work on a
 module-level thread pool, created on first use.  It is used for the lines' Foss
-decompositions (:func:`stochcable.dynamics.groups.lineparts.foss_state`): LAPACK ``geev``
+decompositions (:func:`stochcable.dynamics.groups.modal_parts.foss_state`): LAPACK ``geev``
 through NumPy releases the GIL, so two cores overlap the lines' eigenproblems.
 
 Opt-in

@@ -700,7 +700,7 @@ def test_damping_matrix_is_assembled_lazily_and_equals_drag_matrix():
 
     from stochcable.dynamics.loads.channels import drag_matrix
 
-    path = Path(analysis.__file__).parent / "examples" / "chain_catenary.json"
+    path = Path(dsystem.__file__).parents[2] / "examples" / "chain_catenary.json"
     scene = load_scene(json.loads(path.read_text()))
     st = solve_statics(scene)
     line = scene.lines[0]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shlex
 import socket
 import subprocess
@@ -34,15 +35,39 @@ def test_banner_names_the_docs_and_an_example():
     assert "curl -s http://127.0.0.1:80/v1/examples" in banner("0.0.0.0", 80)
 
 
-def _run_banner_pipeline(line: str) -> httpx.Response:
+def _headers(args: list[str], env: dict[str, str]) -> dict[str, str]:
+    """The ``-H`` options of a curl command, with ``$NAME`` read from ``env`` as a shell
+    does inside double quotes."""
+    out = {}
+    for i, a in enumerate(args):
+        if a == "-H":
+            name, value = args[i + 1].split(": ")
+            out[name] = re.sub(r"\$(\w+)", lambda m: env[m.group(1)], value)
+    return out
+
+
+def _run_banner_pipeline(line: str, env: dict[str, str] | None = None) -> httpx.Response:
     """Execute the banner's ``curl A | curl -X POST B -H H -d @-`` with httpx."""
     get, post = (shlex.split(part) for part in line.split("try:", 1)[1].split("|"))
     assert get[:2] == ["curl", "-s"] and post[:4] == ["curl", "-s", "-X", "POST"]
-    scene = httpx.get(get[2], timeout=30.0)
+    env = env or {}
+    scene = httpx.get(get[-1], headers=_headers(get, env), timeout=30.0)
     assert scene.status_code == 200, scene.text
-    name, value = post[post.index("-H") + 1].split(": ")
     assert post[-2:] == ["-d", "@-"]
-    return httpx.post(post[4], content=scene.content, headers={name: value}, timeout=60.0)
+    return httpx.post(post[4], content=scene.content, headers=_headers(post, env), timeout=60.0)
+
+
+def test_banner_points_to_the_page():
+    assert "open http://127.0.0.1:8000/ in a browser" in banner("127.0.0.1", 8000)
+    assert "open http://127.0.0.1:80/ in a browser" in banner("0.0.0.0", 80)
+
+
+def test_banner_request_carries_the_key_when_keys_are_on():
+    text = banner("127.0.0.1", 8000, keys=True)
+    example = text.splitlines()[1]
+    assert example.count('-H "Authorization: Bearer $STOCHCABLE_KEY"') == 2  # both requests
+    assert "STOCHCABLE_KEY" in text.splitlines()[2]
+    assert "Authorization" not in banner("127.0.0.1", 8000)
 
 
 def test_non_loopback_without_keys_is_refused(capsys, monkeypatch):
@@ -107,6 +132,40 @@ def test_serve_starts_uvicorn_and_answers():
         resp = _run_banner_pipeline(example)
         assert resp.status_code == 200, resp.text
         assert resp.json()["lines"]["leg1"]["end_b"]["tension"]["std"] > 0
+    finally:
+        proc.terminate()
+        proc.wait(10.0)
+
+
+@pytest.mark.slow
+def test_keyed_banner_request_works_as_printed():
+    port = _free_port()
+    env = {**os.environ, "STOCHCABLE_API_KEYS": "k1,k2", "STOCHCABLE_ANALYSIS_WORKERS": "1"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "stochcable", "serve", "--port", str(port)]
+        + ["--log-level", "warning"],
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    try:
+        assert f"open http://127.0.0.1:{port}/ in a browser" in proc.stderr.readline()
+        example = proc.stderr.readline()
+        deadline = time.monotonic() + 30.0
+        while True:
+            try:
+                httpx.get(f"http://127.0.0.1:{port}/health", timeout=1.0)
+                break
+            except httpx.TransportError:
+                assert time.monotonic() < deadline, "server did not answer within 30 s"
+                time.sleep(0.1)
+        resp = _run_banner_pipeline(example, {"STOCHCABLE_KEY": "k2"})
+        assert resp.status_code == 200, resp.text
+        assert resp.json()["lines"]["leg1"]["end_b"]["tension"]["std"] > 0
+        # the key is what lets it through
+        get = shlex.split(example.split("try:", 1)[1].split("|")[0])
+        bad = httpx.get(get[-1], headers=_headers(get, {"STOCHCABLE_KEY": "nope"}))
+        assert bad.status_code == 401
     finally:
         proc.terminate()
         proc.wait(10.0)

@@ -964,8 +964,7 @@ def test_foss_unit_columns_in_closed_form_equal_the_plain_solve(modes):
 def test_all_dofs_fixed_equals_lines_with_fixed_fairleads():
     """A buoy with all six DOFs in ``fixed_dofs`` holds its fairleads: each leg is the
     independent analysis (stochcable.dynamics.groups.line_fixed_point.linearize) of the leg with its
-    fairlead
-    fixed at the same static point; the body does not move."""
+    fairlead fixed at the same static point; the body does not move."""
     body = _buoy(fixed_dofs=("surge", "sway", "heave", "roll", "pitch", "yaw"))
     scene, cls, loads = _group(_mooring_doc(), body)
     lin = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)

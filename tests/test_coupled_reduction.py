@@ -30,6 +30,7 @@ from stochcable.dynamics.groups import (
     coupled_modes,
     linearize_coupled,
 )
+from stochcable.dynamics.groups.fixed_point_state import EvaluationCount
 from stochcable.dynamics.groups.group import GroupSystem, solve_group
 from stochcable.dynamics.linearization.variance import (
     drag_coefficients,
@@ -398,7 +399,7 @@ def _coarse_update(g, idx, x=None):
     gc.sizes = {cl.name: p.size for cl, p in zip(g.lines, rest)}
     rest += [cg.body_sigma(g, b, None) for b in g.drag]
     x = 3.0 * np.concatenate(rest) if x is None else x
-    upd = cg.sigma_update(gc, "seed", RHO, {}, {}, noop_progress, "g", None)
+    upd = cg.SigmaMap(gc, "seed", RHO, EvaluationCount(), noop_progress, "g", None)
     return gc, upd, x
 
 

@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import stochcable
 from stochcable.dynamics.groups import coarse as dcoarse
 from stochcable.dynamics.groups import freeline as dfreeline
 from stochcable.dynamics.groups import line_fixed_point as dfixedpoint
@@ -33,7 +32,7 @@ from stochcable.statics import solve_statics
 # one worker runs the module: its module fixtures run once (--dist loadgroup)
 pytestmark = pytest.mark.xdist_group("test_linearization_start")
 
-EXAMPLE = Path(stochcable.__file__).resolve().parent / "examples" / "chain_catenary.json"
+EXAMPLE = Path(dsystem.__file__).resolve().parents[2] / "examples" / "chain_catenary.json"
 
 
 def _chain(omega_count: int | None = None, **env) -> tuple:

@@ -141,7 +141,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Drag residual large (``analysis.linearization.drag_residual``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.drag_residual:_warn_large",),
+        ("stochcable.dynamics.residuals.drag_residual:_warn_large",),
         "the end-tension σ with the drag residual beyond RESIDUAL_WARN_RATIO times the "
         "linear σ (or below its inverse)",
         "The quadratic drag is far from its Gaussian linear fit: the first-order residual "
@@ -149,7 +149,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "time domain (up to +18 %: the taut wire and the inclined guy, within the "
         "time domain's 95 % interval).",
         "Check with the nonlinear time-domain reference (:mod:`stochcable.reference.cable`).",
-        ("stochcable.dynamics.drag_residual:RESIDUAL_WARN_RATIO",),
+        ("stochcable.dynamics.residuals.drag_residual:RESIDUAL_WARN_RATIO",),
     ),
     WarningEntry(
         "Residuals not applied to a load-case set",
@@ -169,7 +169,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Second-order stretching tension large (indicator ``second_order``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.second_order:with_second_order",),
+        ("stochcable.dynamics.residuals.second_order:with_second_order",),
         "σ of the second-order stretching tension above SECOND_ORDER_WARN_RATIO of the "
         "line's largest linear tension σ",
         "Transverse motion lengthens a line to second order, ½∫(∂u⊥/∂s)² ds; a taut line "
@@ -179,7 +179,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Use the corrected moments in ``indicators.second_order`` as an estimate; for a "
         "design value check with the nonlinear time-domain reference "
         "(:mod:`stochcable.reference.cable`).",
-        ("stochcable.dynamics.second_order:SECOND_ORDER_WARN_RATIO",),
+        ("stochcable.dynamics.residuals.second_order:SECOND_ORDER_WARN_RATIO",),
     ),
     WarningEntry(
         "Drag linearization did not converge",
@@ -300,6 +300,16 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Read the coupled modes from ``stochcable analyze`` under ``bodies.<name>.modes``.",
     ),
     WarningEntry(
+        "Real modes of a travelling line",
+        "PhysicsWarning",
+        ("stochcable.line.modes:natural_modes",),
+        "the model's line has ``axial_speed`` ≠ 0 (``lines[i].axial_speed``)",
+        "The real modes K φ = ω² M φ leave out the transport terms (the gyroscopic "
+        "matrix and the centripetal stiffness): they are the line's modes at rest.",
+        "Use ``stochcable modes`` (which lists the complex modes of a travelling line) "
+        "or ``stochcable.line.transport_modes.complex_modes``. See :doc:`../travelling`.",
+    ),
+    WarningEntry(
         "Strumming lock-in (or resonance) predicted",
         "PhysicsWarning",
         ("stochcable.dynamics.model.strumming:with_strumming",),
@@ -336,6 +346,40 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Results are the same; the NumPy sea kernel is slower, or the kernel is compiled "
         "again in each process (about 1 s at its first use).",
         "Set ``NUMBA_CACHE_DIR`` to a writable directory, or ``STOCHCABLE_NUMBA=0`` to skip numba.",
+    ),
+    WarningEntry(
+        "MoorDyn file: parts read with a loss",
+        "PhysicsWarning",
+        (
+            "stochcable.io.moordyn_read:read_moordyn",
+            "stochcable.io.moordyn_read:_type_columns",
+        ),
+        "a MoorDyn file (docs/manual/moordyn.md) with options other than WtrDpth, rho, "
+        "g, kBot and cBot; non-zero EI, CaAx or Cl; lines whose BA/−ζ give different "
+        "β = BA/EA; sections other than line types, bodies, rods, points, lines, "
+        "options and outputs; a free point joined to no line; or LINE TYPES columns "
+        "named in v1's order",
+        "The scene holds what it can of the file: the options MoorDyn uses for its own "
+        "time stepping and initial conditions are dropped, bending stiffness, axial added "
+        "mass and VIV lift have no counterpart, and the scene's one stiffness-proportional "
+        "damping β takes the smallest of the lines'.",
+        "Nothing, when the options listed are numerics; for a bending-stiff line "
+        "(umbilical, riser) check that tension dominates; give "
+        "``analysis.structural_damping.beta`` yourself if the lines' damping differs.",
+    ),
+    WarningEntry(
+        "MoorDyn file written with a loss",
+        "PhysicsWarning",
+        (
+            "stochcable.io.moordyn_write:write_moordyn",
+            "stochcable.io.moordyn_write:_pieces",
+        ),
+        "a scene written with write_moordyn that has a prescribed motion, a current, "
+        "mass-proportional structural damping, an attachment at a line end, or added "
+        "mass without buoyancy",
+        "MoorDyn takes motions and currents from its driver and its own files; the file "
+        "holds the mooring only.",
+        "Drive the Coupled points from the program that runs MoorDyn.",
     ),
 )
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, solve_chunk
+from stochcable.cases.display import case_set_html, case_set_text
 from stochcable.cases.fatigue_settings import LineFatigue
 from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
 from stochcable.cases.scatter import ScatterDiagram
@@ -100,6 +101,14 @@ class CaseSetResult:
     coverage: dict[str, float]
     years: float
     fatigue: dict[str, LineFatigue] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        """A few lines: cases by status, per line end the governing MPM and damage."""
+        return case_set_text(self)
+
+    def _repr_html_(self) -> str:
+        """The summary table a notebook shows (:mod:`stochcable.cases.display`)."""
+        return case_set_html(self)
 
     @property
     def probabilities(self) -> np.ndarray:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-__all__ = ["register", "run", "banner", "EXAMPLE"]
+__all__ = ["register", "run", "banner", "EXAMPLE", "KEY_VARIABLE"]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -47,19 +47,29 @@ EXAMPLE = "chain_catenary"
 """Bundled example scene analysed by the request the start-up message shows."""
 
 
-def banner(host: str, port: int) -> str:
-    """The message printed on start: where the service and its interactive docs are,
-    and a copy-pasteable request analysing a bundled example scene."""
+KEY_VARIABLE = "STOCHCABLE_KEY"
+"""Shell variable the start-up message's example request reads the API key from (the
+message never prints a key)."""
+
+
+def banner(host: str, port: int, keys: bool = False) -> str:
+    """The message printed on start: the page to open in a browser, the interactive docs,
+    and a copy-pasteable request analysing a bundled example scene (carrying the
+    ``Authorization`` header, from ``$STOCHCABLE_KEY``, when API keys are on)."""
     shown = f"[{host}]" if ":" in host else host
     base = f"http://{shown}:{port}"
-    # a wildcard bind address is not a destination: the example goes to loopback
+    # a wildcard bind address is not a destination: the page and example go to loopback
     local = {"0.0.0.0": "127.0.0.1", "": "127.0.0.1", "::": "[::1]"}.get(host, shown)
     url = f"http://{local}:{port}"
-    return (
-        f"stochcable service on {base} — docs at {base}/docs\n"
-        f"try: curl -s {url}/v1/examples/{EXAMPLE} | curl -s -X POST "
-        f"{url}/v1/analyses -H 'Content-Type: application/json' -d @-\n"
+    auth = f' -H "Authorization: Bearer ${KEY_VARIABLE}"' if keys else ""
+    text = (
+        f"stochcable service on {base} — open {url}/ in a browser; docs at {base}/docs\n"
+        f"try: curl -s{auth} {url}/v1/examples/{EXAMPLE} | curl -s -X POST "
+        f"{url}/v1/analyses{auth} -H 'Content-Type: application/json' -d @-\n"
     )
+    if keys:
+        text += f"(API keys are on: set {KEY_VARIABLE} to one of STOCHCABLE_API_KEYS first)\n"
+    return text
 
 
 def run(args: argparse.Namespace) -> int:
@@ -86,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--host", host, "-", why)
     # each worker process imports service.app:app and reads the STOCHCABLE_* variables
     os.environ[Settings.env_name("host")] = host
-    sys.stderr.write(banner(host, port))
+    sys.stderr.write(banner(host, port, keys=bool(Settings().keys)))
     sys.stderr.flush()
     uvicorn.run("service.app:app", host=host, port=port, workers=workers, log_level=args.log_level)
     return 0

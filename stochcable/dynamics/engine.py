@@ -1,5 +1,5 @@
 """Build once, solve per sea state: the seam between the sea-independent model of a
-scene and its response to one sea state (seed 001 ch. 5).
+scene and its response to one sea state (Tuah 1982, ch. 5).
 
 :func:`build_engine` does everything that does not depend on the sea: the static
 equilibrium (all nonlinearities), the finite-element model of every line about it,
@@ -23,6 +23,10 @@ A sea state is a :class:`~stochcable.scene.model.Sea` document (spectrum and hea
 the current, the end motions and the settings are the scene's.  ``solve`` mutates no
 state that changes its answer: solving the same sea twice gives identical results, and
 ``engine.solve(sea)`` gives the result of ``analyze`` on the scene with that sea.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -47,6 +51,8 @@ from stochcable.dynamics.model.system import (
 )
 from stochcable.dynamics.timeseries.synthesis import simulate_timeseries
 from stochcable.errors import InputError, collect_warnings
+from stochcable.line.strumming import StrummingTable
+from stochcable.line.transport import refuse_travelling_lines
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, Sea, input_error_from_validation, load_scene
 from stochcable.statics import StaticsResult, solve_statics
@@ -93,7 +99,7 @@ class Engine:
     model: CoupledModel
     timing: Mapping[str, float]
     warnings: tuple[str, ...]
-    strumming: Mapping[str, Any] = field(default_factory=dict)  # StrummingTable by line
+    strumming: Mapping[str, StrummingTable | None] = field(default_factory=dict)
 
     def solve(
         self, sea: Sea | Mapping[str, Any] | None = None, *, progress: Progress | None = None
@@ -199,9 +205,8 @@ def build_engine(
     scene = load_scene(scene)
     progress = noop_progress if progress is None else progress
     settings = scene.analysis
-    if settings.linearization.method == "harmonic" and any(
-        p.speed > 0 for p in scene.environment.current
-    ):
+    current = any(p.speed > 0 for p in scene.environment.current)
+    if settings.linearization.method == "harmonic" and current:
         raise InputError(
             "analysis.linearization.method",
             "harmonic",
@@ -211,7 +216,7 @@ def build_engine(
         )
     timing = {"statics_s": 0.0, "model_s": 0.0}
     systems: dict[str, LineSystem] = {}
-    strumming: dict[str, Any] = {}
+    strumming: dict[str, StrummingTable | None] = {}
     with collect_warnings() as caught, runtime.analysis_blas(is_small(scene)):
         progress("statics", {})
         t0 = time.perf_counter()
@@ -220,6 +225,7 @@ def build_engine(
             # linearized about it, so it must be an equilibrium of the same FE model
             statics = solve_statics(scene, method="fe")
         timing["statics_s"] = time.perf_counter() - t0
+        refuse_travelling_lines(scene, statics)  # no transport in the response yet
         for line in scene.lines:
             progress("model", {"line": line.name})
             t0 = time.perf_counter()

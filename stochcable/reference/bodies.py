@@ -54,8 +54,7 @@ def body_drag_damping(
     -----
     Per direction b = ρ CdA E|v| for v ~ N(U, σ²) (DESIGN.md "Drag linearization",
     :func:`stochcable.dynamics.linearization.formulas.drag_linear_current`); for U = 0 this is the
-    seed
-    form √(8/π)·½ρ CdA σ (seed 001 eq. 5.2.2).  The fluid load that goes with it is
+    seed form √(8/π)·½ρ CdA σ (seed 001 eq. 5.2.2).  The fluid load that goes with it is
     Tᵀ diag(b) v_fluid (wave velocity at the drag point).
     """
     rho = finite_scalar("rho", rho, "kg/m³")

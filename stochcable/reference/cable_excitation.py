@@ -222,8 +222,7 @@ def end_motion_generators(scene: Scene, seed: int) -> dict[tuple[str, str, str],
     """The generator of every end-motion spectrum channel, keyed (line, end, dof).
 
     The rule of :func:`stochcable.dynamics.timeseries.synthesis.simulate_timeseries`: channels in
-    the order
-    lines × (end_a, end_b) × (surge, sway, heave), channel k drawing from
+    the order lines × (end_a, end_b) × (surge, sway, heave), channel k drawing from
     ``default_rng(SeedSequence(seed).spawn(n)[k])``.
     """
     keys = []

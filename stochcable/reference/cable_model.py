@@ -30,8 +30,7 @@ Model (the same finite-element discretization as the frequency-domain model):
     node i of element j gets l0_j ρ(πD²/4)(1 + Can)(I − e₀e₀ᵀ)·∫₀¹ N_i a dξ with the
     closed-form consistent moments of
     :func:`stochcable.dynamics.loads.element_kinematics.element_wave_kinematics` (split at the
-    waterline),
-    synthesized in time with the realization's coefficients like any transfer
+    waterline), synthesized in time with the realization's coefficients like any transfer
     function; attachments get (buoyancy/g + added mass)·a at their node.
   * Morison drag with the relative velocity v_r = U_current + v_wave − u̇ (seed eqs.
     3.2.a.2–3.2.a.5), normal ½ρ Cdn D |v_rn| v_rn and axial ½ρ Cdt πD |v_rt| v_rt with

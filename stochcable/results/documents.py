@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.line.strumming import StrummingTable
+from stochcable.results.display import result_html, result_text
 from stochcable.results.records import (
     THREE_HOURS,
     LinearizationRecord,
@@ -137,6 +138,11 @@ class LineResult:
         The end-tension variance of the second-order geometric forces
         (``analysis.linearization.geometric_residual``; None when not asked for).  With
         a zero-mean flow the residuals are uncorrelated: their variances add.
+    linear : dict {"end_a", "end_b"} of ResponseStats or None
+        Where a residual was computed, ``end_a`` and ``end_b`` are the statistics with
+        the residuals (their spectra's moments added:
+        :mod:`stochcable.dynamics.residuals.corrected`) and these the linear model's
+        alone; None otherwise (``end_a`` and ``end_b`` are the linear model's).
     """
 
     name: str
@@ -166,6 +172,12 @@ class LineResult:
     strumming: StrummingTable | None = None
     drag_residual: ResidualRecord | None = None
     geometric_residual: ResidualRecord | None = None
+    linear: dict[str, ResponseStats] | None = None
+
+    def linear_end(self, end: str) -> ResponseStats:
+        """The linear model's statistics of the tension at ``end`` ("end_a" or
+        "end_b"): the end's own without residuals, ``linear[end]`` with them."""
+        return getattr(self, end) if self.linear is None else self.linear[end]
 
     def with_strumming(self, strumming: StrummingTable | None) -> LineResult:
         """This result with ``strumming`` (a shallow copy: the transfer functions stay
@@ -247,6 +259,11 @@ class LineResult:
                 )
                 if r is not None
             },
+            **(
+                {}
+                if self.linear is None
+                else {"linear": {e: {"tension": s.as_dict()} for e, s in self.linear.items()}}
+            ),
         }
 
 
@@ -457,6 +474,14 @@ class Result:
     warnings: tuple[str, ...] = field(default_factory=tuple)
     fidelity: Any = None
     bodies: dict[str, BodyResult] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        """A few lines: title, lines, end-tension σ with units, number of warnings."""
+        return result_text(self)
+
+    def _repr_html_(self) -> str:
+        """The summary table a notebook shows (:mod:`stochcable.results.display`)."""
+        return result_html(self)
 
     @property
     def converged(self) -> bool:

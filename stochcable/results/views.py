@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.results.display import document_html, document_text
 from stochcable.results.records import ResponseStats
 
 __all__ = ["AnalysisDocument", "LineDocument", "TimeSeriesWindow"]
@@ -229,10 +230,12 @@ class AnalysisDocument(Mapping[str, Any]):
         return len(self._doc)
 
     def __repr__(self) -> str:
-        return (
-            f"AnalysisDocument(lines={list(self.lines)}, converged={self.converged}, "
-            f"warnings={len(self.warnings)})"
-        )
+        """A few lines: lines, end-tension σ with units, number of warnings."""
+        return document_text(self)
+
+    def _repr_html_(self) -> str:
+        """The summary table a notebook shows (:mod:`stochcable.results.display`)."""
+        return document_html(self)
 
     @property
     def document(self) -> dict[str, Any]:

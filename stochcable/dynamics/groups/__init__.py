@@ -1,5 +1,5 @@
-"""The engine's groups: lines and large rigid bodies solved together (seed 001
-§3.2.c, §3.3, ch. 5), a line alone being the group of one line and no bodies.
+"""The engine's groups: lines and large rigid bodies solved together (Tuah
+1982, §3.2.c, §3.3, ch. 5), a line alone being the group of one line and no bodies.
 
 Lines attached to a freely moving body are solved together with it: one drag
 linearization loop over every attached line and body, the response at every frequency
@@ -13,9 +13,13 @@ line part being its own response
 Modules, lowest first (each imports only the ones above it):
 
 - :mod:`~stochcable.dynamics.groups.freeline`: the line part of a line alone;
+- :mod:`~stochcable.dynamics.groups.fixed_point_state`: the fixed point's typed state
+  (its run, one evaluation, the evaluation count);
 
 - :mod:`~stochcable.dynamics.groups.inputs`: a group's lines (:class:`CoupledLine`),
   body loads, vessel-driven ends and the group's channels;
+- :mod:`~stochcable.dynamics.groups.modal_parts`: a line's Foss state-modal and modal
+  parts;
 - :mod:`~stochcable.dynamics.groups.lineparts`: a line before the body solve (node
   level, Foss state-modal, modal per frequency), linear in its end motion;
 - :mod:`~stochcable.dynamics.groups.group`: the group on a grid
@@ -35,6 +39,10 @@ Modules, lowest first (each imports only the ones above it):
   (:func:`linearize`, a convenience for users and tests).
 
 The linearized drag of a body is :mod:`stochcable.dynamics.linearization.bodydrag`.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from stochcable.dynamics.groups.analysis import (

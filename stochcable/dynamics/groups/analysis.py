@@ -17,9 +17,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -46,6 +45,8 @@ from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.solve.line_loads import LineInputs, silent_channel
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.results.documents import BodyResult, LineResult
+from stochcable.scene.model import AnalysisSettings, Scene, Sea
+from stochcable.statics import StaticsResult
 
 __all__ = ["CoupledAnalysis", "CoupledGroup", "analyze_coupled", "solve_coupled"]
 
@@ -115,14 +116,14 @@ class CoupledAnalysis:
     groups: tuple[CoupledGroup, ...] = ()
     alone: tuple[CoupledGroup, ...] = ()
 
-    def __iter__(self) -> Any:
+    def __iter__(self) -> Iterator[Mapping[str, object]]:
         return iter((self.lines, self.bodies, self.systems, self.dampings))
 
 
 def analyze_coupled(
-    scene: Any,
-    statics: Any,
-    settings: Any,
+    scene: Scene,
+    statics: StaticsResult,
+    settings: AnalysisSettings,
     progress: Progress | None = None,
     timing: dict[str, float] | None = None,
     *,
@@ -170,8 +171,8 @@ def analyze_coupled(
 
 def solve_coupled(
     model: CoupledModel,
-    sea: Any = None,
-    settings: Any = None,
+    sea: Sea | Scene | None = None,
+    settings: AnalysisSettings | None = None,
     progress: Progress | None = None,
     timing: dict[str, float] | None = None,
 ) -> CoupledAnalysis:
@@ -254,7 +255,7 @@ def solve_coupled(
     return CoupledAnalysis(ordered, ordered_b, systems, dampings, tuple(states), tuple(alone))
 
 
-def _with_sea(scene: Any, sea: Any) -> Any:
+def _with_sea(scene: Scene, sea: Sea | Scene | None) -> Scene:
     """The model's scene with the sea state ``sea`` (a Sea, a Scene or None)."""
     if sea is None:
         return scene
@@ -271,7 +272,7 @@ def _solve_line(
     model: CoupledModel,
     name: str,
     ch: tuple[Channel, ...],
-    settings: Any,
+    settings: AnalysisSettings,
     progress: Progress,
     timing: dict[str, float],
     inputs: LineInputs | None = None,
@@ -310,10 +311,10 @@ def _solve_line(
 
 def _solve_group(
     model: CoupledModel,
-    scene: Any,
+    scene: Scene,
     group: ModelGroup,
     chans: Mapping[str, tuple[Channel, ...]],
-    settings: Any,
+    settings: AnalysisSettings,
     progress: Progress,
     timing: dict[str, float],
 ) -> tuple[dict[str, LineResult], dict[str, BodyResult], CoupledGroup]:
@@ -351,9 +352,9 @@ def _solve_group(
 
 def _solve_lonely(
     model: CoupledModel,
-    scene: Any,
+    scene: Scene,
     name: str,
-    settings: Any,
+    settings: AnalysisSettings,
     progress: Progress,
     timing: dict[str, float],
 ) -> tuple[BodyResult, CoupledGroup] | None:
@@ -385,7 +386,9 @@ def _solve_lonely(
     return bo[name], _group_state([], model, [b], clin)
 
 
-def _vessel_results(model: CoupledModel, scene: Any, settings: Any) -> dict[str, BodyResult]:
+def _vessel_results(
+    model: CoupledModel, scene: Scene, settings: AnalysisSettings
+) -> dict[str, BodyResult]:
     """The prescribed bodies' motion statistics from their RAOs in the sea: one channel
     per sea channel (each direction of a short-crested sea with the RAO of its
     heading), the spectra summed over them."""

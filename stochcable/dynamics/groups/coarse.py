@@ -6,12 +6,11 @@ a frequency subset G (every ``COARSE_STRIDE``-th frequency and the last) to
 ``COARSE_TOLERANCE_FACTOR`` times the tolerance.  The σ integrals on the subset are
 the full grid's trapezoid rule on the cubic interpolant of the integrand
 (:func:`stochcable.dynamics.linearization.coarse_grid.interpolatory_weights`, as the single-line
-coarse start
-of :mod:`stochcable.dynamics`); subset frequencies whose σ weight is at most
+coarse start of :mod:`stochcable.dynamics`); subset frequencies whose σ weight is at most
 ``COARSE_NEGLIGIBLE`` (1e-12) of the largest in every channel (the spectrum's empty
 tail) are then left out (their σ contributions are below round-off).  A Foss line
 solves its modal equations per frequency there
-(:class:`~stochcable.dynamics.groups.lineparts.ModalLine`: the same modal system, no
+(:class:`~stochcable.dynamics.groups.modal_parts.ModalLine`: the same modal system, no
 Foss eigenproblem).  Then, at the coarse map's last input x, one full-grid evaluation
 F(x); while its relative change exceeds the tolerance, a defect correction: the
 coarse map scaled by the ratio r = F(x)/G(x) (per component, clipped to [0.1, 10])
@@ -24,10 +23,8 @@ the full-grid change.  At most ``COARSE_CORRECTIONS`` rounds, a round that does 
 contract the full-grid change by 0.3 hands over to the plain full-grid iteration.
 The usual convergence test on the full grid ends the iteration, so the answer is
 the full-grid fixed point (tested equal within the tolerance to ``coarse=False``);
-the coarse model only moves the start.  On the three-leg benchmark (narrow, lightly
-damped line resonances that a stride-4 subset does not resolve: its σ are 0.7 % off
-at the same drag) the full grid needs 2 evaluations instead of 7 (6 + 1 coarse ones
-on 45 of 200 frequencies; docs/BENCHMARKS.md, "Bodies", passes E5, E5c).  The
+the coarse model only moves the start (what it saves: docs/benchmarks/dynamics.md,
+"Coarse start of the drag fixed point").  The
 record's ``iterations`` and ``history`` list every evaluation in order, coarse and
 full.  Used by default under both solvers when the tolerance is at least
 ``COARSE_MIN_TOLERANCE`` (tighter: the coarse stage's 1e-6 floor and slower rounds
@@ -42,10 +39,11 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.groups.group import GroupSystem, sigma_update
+from stochcable.dynamics.groups.fixed_point_state import EvaluationCount, FixedPointRun
+from stochcable.dynamics.groups.group import GroupSystem, SigmaMap
 from stochcable.dynamics.groups.inputs import BodyLoads, CoupledLine
 from stochcable.dynamics.linearization.coarse_grid import interpolatory_weights, subset_inputs
-from stochcable.dynamics.linearization.iteration import fixed_point, relative_change
+from stochcable.dynamics.linearization.iteration import relative_change
 from stochcable.dynamics.linearization.variance import (
     drag_coefficients,
     end_motion_projections,
@@ -53,7 +51,6 @@ from stochcable.dynamics.linearization.variance import (
 )
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.model.blocks import add_blocks, block_matvec, line_prep
-from stochcable.dynamics.model.system import Progress
 from stochcable.dynamics.solve.line_loads import attached_velocity, drag_blocks
 from stochcable.errors import ConvergenceError, SolverError
 
@@ -251,12 +248,11 @@ def full_grid_arrays(g: GroupSystem, method: str) -> None:
 def coarse_group(g: GroupSystem, idx: np.ndarray) -> GroupSystem:
     """The group on the frequencies ``g.omega[idx]``: σ integrals by the full grid's
     trapezoid rule on the subset's cubic interpolant
-    (:func:`stochcable.dynamics.linearization.coarse_grid.interpolatory_weights`), the lines' inputs
-    sliced
-    from the full grid's (:func:`stochcable.dynamics.linearization.coarse_grid.subset_inputs`), Foss
-    lines
+    (:func:`stochcable.dynamics.linearization.coarse_grid.interpolatory_weights`), the
+    lines' inputs sliced from the full grid's
+    (:func:`stochcable.dynamics.linearization.coarse_grid.subset_inputs`), Foss lines
     solved per frequency in modal coordinates
-    (:class:`~stochcable.dynamics.groups.lineparts.ModalLine`); the frequencies of negligible
+    (:class:`~stochcable.dynamics.groups.modal_parts.ModalLine`); the frequencies of negligible
     σ weight (``COARSE_NEGLIGIBLE``) left out after the weights are formed."""
     spectra = np.stack([c.spectrum for c in g.channels], axis=1)[idx]
     quadrature = interpolatory_weights(g.omega, idx)
@@ -332,7 +328,7 @@ def _sliced_channel(c: Channel, idx: np.ndarray, light: bool = False) -> Channel
     }
     if lazy:
 
-        def nodal() -> tuple[Any, Any]:
+        def nodal() -> tuple[np.ndarray | None, np.ndarray | None]:
             v, a = c.velocity, c.acceleration
             return (None if v is None else v[idx], None if a is None else a[idx])
 
@@ -361,22 +357,10 @@ class CoarseStart:
         The full-grid group (``sizes`` set).
     idx : ndarray of int
         The coarse subset (:func:`coarse_subset`).
-    method : str
-        Drag linearization method.
-    rho : float
-        Water density. [kg/m³]
-    state : dict
+    run : FixedPointRun
+        The fixed point's method, density, progress, settings and name.
+    count : EvaluationCount
         The record shared with the full-grid map (evaluation count, last change).
-    progress : callable
-    names : str
-        The group's line names (progress).
-    lin : LinearizationSettings
-        ``tolerance``, ``max_iterations``.
-    fixed : dict
-        Keyword arguments of :func:`stochcable.dynamics.linearization.iteration.fixed_point`
-        (relaxation, method, mixing).
-    gname : str
-        The iteration's name in messages.
     group : GroupSystem, optional
         The coarse group on ``idx`` when already built (:func:`coarse_group`).
 
@@ -391,34 +375,31 @@ class CoarseStart:
         self,
         g: GroupSystem,
         idx: np.ndarray,
-        method: str,
-        rho: float,
-        state: dict[str, Any],
-        progress: Progress,
-        names: str,
-        lin: Any,
-        fixed: dict[str, Any],
-        gname: str,
+        run: FixedPointRun,
+        count: EvaluationCount,
         group: GroupSystem | None = None,
     ) -> None:
-        full_grid_arrays(g, method)
+        full_grid_arrays(g, run.method)
         gc = coarse_group(g, idx) if group is None else group
-        # the coarse map's cache (its last response) emptied after every evaluation:
-        # the stage reads its σ only, and the full grid's evaluations run beside it
-        self._cache: dict[str, Any] = {}
-        self.raw = sigma_update(gc, method, rho, state, self._cache, progress, names, None)
-        self.lin, self.fixed, self.gname = lin, fixed, gname
+        # the coarse map keeps no evaluation (its last response): the stage reads its
+        # σ only, and the full grid's evaluations run beside it
+        self.raw: SigmaMap | None = SigmaMap(
+            gc, run.method, run.rho, count, run.progress, run.names, None, keep_last=False
+        )
+        self.run, self.count = run, count
+        self.lin, self.gname = run.lin, run.gname
         # the coarse model is only good to its defect: no tighter than 1e-6 (round-off
         # noise of the σ stalls tighter coarse iterations; the full grid finishes)
-        self.tol = max(lin.tolerance * COARSE_TOLERANCE_FACTOR, 1e-6)
+        self.tol = max(run.lin.tolerance * COARSE_TOLERANCE_FACTOR, 1e-6)
         self.last: dict[str, np.ndarray] = {}
         self.pairs: list[tuple[np.ndarray, np.ndarray]] = []
         self.history: tuple[float, ...] = ()
 
     def __call__(self, y: np.ndarray) -> np.ndarray:
         """The coarse map, remembering its inputs and outputs."""
+        if self.raw is None:
+            raise RuntimeError("the coarse stage is over: its map is released")
         out = self.raw(y)
-        self._cache.clear()
         self.last["x"], self.last["g"] = np.array(y, dtype=float), out
         self.pairs.append((self.last["x"], out))
         return out
@@ -430,16 +411,15 @@ class CoarseStart:
         lin = self.lin
         try:
             xc = self(x_rest)
-            hc: tuple[float, ...] = (self.raw.state["change"],)
+            hc: tuple[float, ...] = (self.count.change,)
             if np.all(np.isfinite(xc)) and hc[0] > self.tol:
-                fc = fixed_point(
+                fc = self.run.iterate(
                     self,
                     xc,
                     tol=self.tol,
                     max_iterations=lin.max_iterations,
                     allow_unconverged=True,
                     name=self.gname + " (coarse start)",
-                    **self.fixed,
                 )
                 hc = hc + tuple(fc.history)
             ok = bool(np.all(np.isfinite(self.last["g"])))
@@ -453,7 +433,6 @@ class CoarseStart:
     def correct(
         self,
         update: Callable[[np.ndarray], np.ndarray],
-        state: dict[str, Any],
         x0: np.ndarray,
         change0: float,
     ) -> tuple[np.ndarray, float, int]:
@@ -462,9 +441,8 @@ class CoarseStart:
         Parameters
         ----------
         update : callable
-            The full-grid map (sharing ``state``).
-        state : dict
-            Its record (``"change"`` after each evaluation).
+            The full-grid map (sharing :attr:`count`: its ``change`` after each
+            evaluation).
         x0 : ndarray
             The full-grid map's output at the coarse start. [m/s]
         change0 : float
@@ -494,7 +472,7 @@ class CoarseStart:
             rounds += 1
             x_full = x_next
             x0 = update(x_full)
-            prev, change0 = change0, state["change"]
+            prev, change0 = change0, self.count.change
             if change0 > 0.3 * prev:  # not contracting: the plain full-grid iteration
                 break
         # the full grid finishes: the coarse group and its arrays are not needed again
@@ -513,7 +491,7 @@ class CoarseStart:
         if x_full is not last["x"]:
             # the coarse response at the last full-grid point (warm rounds)
             self(x_full)
-            self.history = self.history + (self.raw.state["change"],)
+            self.history = self.history + (self.count.change,)
             last["x"] = x_full
         g_in = last["g"]
         ratio = np.clip(np.divide(x0, g_in, out=np.ones_like(x0), where=g_in > 0), 0.1, 10.0)
@@ -531,13 +509,12 @@ class CoarseStart:
             start = h
         if hist and hist[0] <= max(tol_r, 0.1 * change0):
             return h, hist
-        fc = fixed_point(
+        fc = self.run.iterate(
             lambda y, r=ratio: r * self(y),
             start,
             tol=tol_r,
             max_iterations=self.lin.max_iterations,
             allow_unconverged=True,
             name=self.gname + " (coarse correction)",
-            **self.fixed,
         )
         return last["x"], hist + fc.history

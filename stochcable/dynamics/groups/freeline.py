@@ -1,4 +1,4 @@
-"""A line of a group with no end on a body: the degenerate line part (seed 001 eq.
+"""A line of a group with no end on a body: the degenerate line part (Tuah 1982, eq.
 5.2.6, §5.3).
 
 A line attached to no free body is a group of its own without bodies
@@ -12,21 +12,26 @@ the σ of the drag fixed point from the free-node part
 displacements and the support forces only when they are asked for (the outputs of
 the last evaluation): the fixed point of a single line costs per evaluation what its
 own solve costs.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 
 from stochcable.dynamics.linearization.variance import sigmas_from_free
-from stochcable.dynamics.loads.freqblocks import frequency_slices
+from stochcable.dynamics.loads.freqblocks import FrequencyIndex, frequency_slices
 from stochcable.dynamics.model.blocks import line_prep, to_freq
 from stochcable.dynamics.model.system import Damping, LineSystem
 from stochcable.dynamics.solve.line_loads import end_following_at, end_loads
 from stochcable.dynamics.solve.line_solve import reactions, solve_free, total_displacement
+from stochcable.dynamics.solve.node_inputs import LineInputs
 
 __all__ = ["FreeLine"]
 
@@ -55,7 +60,7 @@ class FreeLine:
     """
 
     def __init__(
-        self, system: LineSystem, inp: Any, damping: Damping, modal_direct: bool = False
+        self, system: LineSystem, inp: LineInputs, damping: Damping, modal_direct: bool = False
     ) -> None:
         self.system, self.inp, self.damping = system, inp, damping
         self.u_free, self.c = solve_free(system, inp, damping, modal_direct=modal_direct)
@@ -92,7 +97,9 @@ class FreeLine:
             )
         return self._support
 
-    def response(self) -> tuple[Any, Any, np.ndarray]:
+    def response(
+        self,
+    ) -> tuple[Callable[[FrequencyIndex], np.ndarray], Callable[[], np.ndarray], np.ndarray]:
         """The converged response without the whole grid's frequency-major copy:
         ``nodes(freq)``, the total node displacement (n_nodes, d, n_f, n_ch) on a
         slice of the frequencies (:attr:`~stochcable.dynamics.model.system.Response.nodes`);

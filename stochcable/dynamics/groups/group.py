@@ -1,13 +1,13 @@
-"""A coupled group and its solve at every frequency for given linear drag (seed 001
-§3.2.c, §3.3, §5.3).
+"""A coupled group and its solve at every frequency for given linear drag (Tuah
+1982, §3.2.c, §3.3, §5.3).
 
 Substructuring (exact at every frequency)
 -----------------------------------------
 Each attached line's response is linear in the motion u_e of its attached end nodes,
 U = U_0 + G u_e, F_end = R_0 + R_e u_e (:mod:`stochcable.dynamics.groups.lineparts`).
-The rigid link u_e = T(r) ξ (seed 001 eqs. 3.3.6–3.3.7,
+The rigid link u_e = T(r) ξ (Tuah 1982, eqs. 3.3.6–3.3.7,
 :func:`stochcable.bodies.rigid.rigid_link_matrix`) and the transformed body equation
-(seed 001 eq. 3.2.c.20 with eqs. 3.3.8–3.3.10) give, per frequency,
+(Tuah 1982, eq. 3.2.c.20 with eqs. 3.3.8–3.3.10) give, per frequency,
 
     [K_B − ω²(M_B + A(ω)) + iω(B(ω) + C_B) − Σ Tᵀ R_e T] ξ
         = F_exc + Tdᵀ diag(b) v + Σ Tᵀ R_0,
@@ -18,7 +18,7 @@ of :func:`stochcable.bodies.coupling.couple` on the body DOFs (tested equal to
 :func:`stochcable.reference.bodies.solve_coupled_direct`), with the line interiors solved
 by the line machinery: banded direct solve (``solver="direct"``) or Foss modal
 superposition with the static correction of the truncated modes (``solver="foss"``,
-seed 001 §5.3).
+Tuah (1982), §5.3).
 
 Fixed body DOFs
 ---------------
@@ -31,13 +31,16 @@ Frequency-dependent added mass and radiation damping
 Because the body DOFs are always condensed exactly at every ω, the body's A(ω), B(ω)
 are exact under both solvers; "foss" only approximates the line interiors (exact
 when all modes are kept).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
-from typing import Any
 
 import numpy as np
 
@@ -47,9 +50,11 @@ from stochcable.bodies.rigid import (
     attachment_geometric_stiffness,
     rigid_link_matrix,
 )
+from stochcable.dynamics.groups.fixed_point_state import Evaluation, EvaluationCount, LineSolution
 from stochcable.dynamics.groups.freeline import FreeLine
 from stochcable.dynamics.groups.inputs import BodyLoads, CoupledLine, unit_channels
-from stochcable.dynamics.groups.lineparts import FossLine, ModalLine, line_parts
+from stochcable.dynamics.groups.lineparts import LinePart, line_parts
+from stochcable.dynamics.groups.modal_parts import FossLine, ModalLine, PartCache
 from stochcable.dynamics.linearization.bodydrag import body_drag_matrix, linear_body_drag
 from stochcable.dynamics.linearization.iteration import relative_change
 from stochcable.dynamics.linearization.variance import drag_coefficients, sigmas_from_nodes
@@ -57,6 +62,7 @@ from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.model.system import Damping, Progress
 from stochcable.dynamics.solve.line_loads import line_inputs
+from stochcable.dynamics.solve.node_inputs import LineInputs
 from stochcable.errors import InputError, SolverError
 
 __all__ = [
@@ -64,7 +70,7 @@ __all__ = [
     "body_drag_matrix",
     "body_sigma",
     "linear_body_drag",
-    "sigma_update",
+    "SigmaMap",
     "solve_group",
 ]
 
@@ -73,12 +79,12 @@ class _LazyInputs(dict):
     """Line name -> inputs of its channels plus its unit end-motion channels, built
     on first access."""
 
-    def __init__(self, lines: Sequence[CoupledLine], phys: Mapping[str, Any]) -> None:
+    def __init__(self, lines: Sequence[CoupledLine], phys: Mapping[str, LineInputs]) -> None:
         super().__init__()
         self._lines = {cl.name: cl for cl in lines}
         self._phys = phys
 
-    def __missing__(self, name: str) -> Any:
+    def __missing__(self, name: str) -> LineInputs:
         cl = self._lines[name]
         units = unit_channels(cl)
         # a line without attached ends has no unit channels: its physical inputs
@@ -146,7 +152,7 @@ class GroupSystem:
         loads: Mapping[str, BodyLoads],
         rho: float,
         channels: Sequence[Channel],
-        inp_phys: Mapping[str, Any] | None = None,
+        inp_phys: Mapping[str, LineInputs] | None = None,
         weights: np.ndarray | None = None,
     ) -> None:
         self.lines = tuple(lines)
@@ -154,9 +160,9 @@ class GroupSystem:
         # modal equations per frequency (ModalLine), no Foss eigenproblem
         self.modal_direct = False
         # per line: the drag-independent arrays of ModalLine
-        self.modal_cache: dict[str, dict[str, Any]] = {}
+        self.modal_cache: dict[str, PartCache] = {}
         # per line: the drag-independent arrays of FossLine (full grid)
-        self.foss_cache: dict[str, dict[str, Any]] = {}
+        self.foss_cache: dict[str, PartCache] = {}
         self.bodies = tuple(bodies)
         self.rho = rho
         names = [b.name for b in bodies]
@@ -196,7 +202,7 @@ class GroupSystem:
             if inp_phys is None
             else dict(inp_phys)
         )
-        self.inp: dict[str, Any] = _LazyInputs(self.lines, self.inp_phys)
+        self.inp: dict[str, LineInputs] = _LazyInputs(self.lines, self.inp_phys)
         self._body_matrices()
         # body loads (n_w, nb, n_ch), drag-point maps
         w = self.omega
@@ -337,7 +343,7 @@ def solve_group(
     timing: dict[str, float] | None,
     *,
     lazy: bool = False,
-) -> tuple[dict[str, Any], np.ndarray]:
+) -> tuple[dict[str, LineSolution], np.ndarray]:
     """One coupled solve of a group for given linear drag (module docstring).
 
     Parameters
@@ -437,7 +443,7 @@ def _solve_free_dofs(g: GroupSystem, s: np.ndarray, rhs: np.ndarray) -> np.ndarr
     return xi
 
 
-def _combine(g: GroupSystem, part: Any, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _combine(g: GroupSystem, part: LinePart, ue: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A line's response with its attached ends moving by ``ue`` (n_w, d·n_att, n_ch)."""
     if isinstance(part, (FossLine, ModalLine, FreeLine)):
         return part.combine(ue)
@@ -466,16 +472,7 @@ def _solve_body(s: np.ndarray, g: np.ndarray) -> np.ndarray:
 # ------------------------------------------------------------ the σ map of a group
 
 
-def sigma_update(
-    g: GroupSystem,
-    method: str,
-    rho: float,
-    state: dict[str, Any],
-    cache: dict[str, Any],
-    progress: Progress,
-    names: str,
-    timing: dict[str, float] | None,
-) -> Any:
+class SigmaMap:
     """The fixed-point map σ → σ(response to the drag of σ) of a group.
 
     Parameters
@@ -487,32 +484,48 @@ def sigma_update(
         (:func:`stochcable.dynamics.linearization.variance.drag_coefficients`).
     rho : float
         Water density. [kg/m³]
-    state : dict
-        Shared record: ``"it"`` the evaluation count, ``"change"`` the last
-        :func:`relative_change`.
-    cache : dict
-        Receives the last evaluation's ``damping``, ``sol``, ``xi``, ``sigma``,
-        ``body_b``.
+    count : EvaluationCount
+        Shared record: the evaluation count and the last :func:`relative_change`.
     progress : callable
         ``progress("linearization", {"group", "iteration", "change"})``.
     names : str
         The group's line names (progress).
     timing : dict, optional
         Accumulates ``solve_s``. [s]
+    keep_last : bool, optional
+        Keep the last evaluation as :attr:`last` (the full grid's, whose outcome is
+        the fixed point's); False: keep nothing (the coarse map reads its σ only).
 
-    Returns
-    -------
-    callable
-        x (lines' σ then bodies' σ, [m/s]) → the σ of the response to the drag of x;
-        ``.state`` is ``state``.
+    Attributes
+    ----------
+    last : Evaluation or None
+        The last evaluation (released when the next one starts).
     """
-    state.setdefault("it", 0)
-    alone = len(g.lines) == 1 and not g.bodies
 
-    def update(x: np.ndarray) -> np.ndarray:
+    def __init__(
+        self,
+        g: GroupSystem,
+        method: str,
+        rho: float,
+        count: EvaluationCount,
+        progress: Progress,
+        names: str,
+        timing: dict[str, float] | None,
+        *,
+        keep_last: bool = True,
+    ) -> None:
+        self.g, self.method, self.rho, self.count = g, method, rho, count
+        self.progress, self.names, self.timing = progress, names, timing
+        self.keep_last = keep_last
+        self.last: Evaluation | None = None
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """x (lines' σ then bodies' σ, [m/s]) → the σ of the response to the drag of
+        x. [m/s]"""
+        g, method = self.g, self.method
         # the last evaluation's response is released before this one is solved (the
-        # outcome reads the cache of the last evaluation only)
-        cache.pop("sol", None)
+        # outcome reads the last evaluation only)
+        self.last = None
         ls, bs = g.split(x)
         if g.start_drag is not None and x is g.start_drag[0]:  # the start's drag, known
             damp = dict(g.start_drag[1])
@@ -523,7 +536,7 @@ def sigma_update(
         for b in g.drag:
             bb, c = linear_body_drag(
                 b,
-                rho,
+                self.rho,
                 bs[b.name],
                 g.loads[b.name].current if b.name in g.loads else np.zeros(3),
                 method,
@@ -531,7 +544,7 @@ def sigma_update(
             sl = slice(g.off[b.name], g.off[b.name] + b.n_dof)
             body_c[sl, sl] += c
             body_b[b.name] = bb
-        sol, xi = solve_group(g, damp, body_c, body_b, timing, lazy=True)
+        sol, xi = solve_group(g, damp, body_c, body_b, self.timing, lazy=True)
         new = []
         for cl in g.lines:
             part = sol[cl.name]
@@ -542,15 +555,13 @@ def sigma_update(
         for b in g.drag:
             new.append(body_sigma(g, b, xi))
         new = np.concatenate(new) if new else np.zeros(0)
-        state["it"] += 1
+        self.count.iterations += 1
         change = relative_change(new, x)
-        state["change"] = change
-        info = {"group": names, "iteration": state["it"], "change": change}
-        if alone:  # one line without bodies: named as a line
-            info["line"] = names
-        progress("linearization", info)
-        cache.update(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
+        self.count.change = change
+        info = {"group": self.names, "iteration": self.count.iterations, "change": change}
+        if len(g.lines) == 1 and not g.bodies:  # one line without bodies: named as a line
+            info["line"] = self.names
+        self.progress("linearization", info)
+        if self.keep_last:
+            self.last = Evaluation(damping=damp, sol=sol, xi=xi, sigma=new, body_b=body_b)
         return new
-
-    update.state = state  # type: ignore[attr-defined]
-    return update

@@ -1,19 +1,21 @@
 """The coupled drag linearization: one fixed point over every line and body of a
-group (seed 001 §5.3 steps 5–13, eq. 5.2.2).
+group (Tuah 1982, §5.3 steps 5–13, eq. 5.2.2).
 
 The fixed-point variable is the concatenation of every attached line's σ vector
 (:func:`stochcable.dynamics.linearization.variance.drag_coefficients` layout) and, per body with a
-drag
-area, the σ of the relative velocity (fluid − body) at its drag point along x, y, z
-(:func:`stochcable.dynamics.groups.group.linear_body_drag`: b = ρ·CdA·E|v|, seed 001
+drag area, the σ of the relative velocity (fluid − body) at its drag point along x, y, z
+(:func:`stochcable.dynamics.groups.group.linear_body_drag`: b = ρ·CdA·E|v|, Tuah (1982)
 eq. 5.2.2 form with the current).  The iteration mirrors
 :func:`stochcable.dynamics.groups.line_fixed_point.linearize`: the start is the fluid velocity
-relative to
-lines and bodies at rest (lines following their moving unattached ends
+relative to lines and bodies at rest (lines following their moving unattached ends
 quasi-statically), the first response starts the Anderson-accelerated iteration
 unmixed.  The record is one for the whole group.  On fine grids the start is the
 fixed point of a frequency subset, corrected by the full/coarse defect
 (:mod:`stochcable.dynamics.groups.coarse`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -22,7 +24,6 @@ from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -36,14 +37,15 @@ from stochcable.dynamics.groups.coarse import (
     full_grid_arrays,
     uniform_subset,
 )
-from stochcable.dynamics.groups.freeline import FreeLine
-from stochcable.dynamics.groups.group import GroupSystem, body_sigma, sigma_update
-from stochcable.dynamics.groups.inputs import BodyLoads, CoupledLine
-from stochcable.dynamics.linearization.iteration import (
-    ANDERSON_MIXING,
-    FixedPointResult,
-    fixed_point,
+from stochcable.dynamics.groups.fixed_point_state import (
+    Evaluation,
+    EvaluationCount,
+    FixedPointRun,
 )
+from stochcable.dynamics.groups.freeline import FreeLine
+from stochcable.dynamics.groups.group import GroupSystem, SigmaMap, body_sigma
+from stochcable.dynamics.groups.inputs import BodyLoads, CoupledLine
+from stochcable.dynamics.linearization.iteration import FixedPointResult
 from stochcable.dynamics.linearization.variance import (
     linearization_record,
     quasi_static_motion,
@@ -54,7 +56,9 @@ from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.model.blocks import to_freq
 from stochcable.dynamics.model.system import Linearization, Progress, Response, noop_progress
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
+from stochcable.dynamics.solve.node_inputs import LineInputs
 from stochcable.errors import ConvergenceError, InputError, PhysicsWarning, SolverError, warn
+from stochcable.scene.model import AnalysisSettings, LinearizationSettings
 
 __all__ = ["CoupledLinearization", "linearize_coupled", "warm_starts"]
 
@@ -138,7 +142,7 @@ def warm_starts(store: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]
 def linearize_coupled(
     lines: Sequence[CoupledLine],
     bodies: Sequence[RigidBody],
-    settings: Any,
+    settings: AnalysisSettings,
     *,
     rho: float,
     loads: Mapping[str, BodyLoads] | None = None,
@@ -146,7 +150,7 @@ def linearize_coupled(
     progress: Progress | None = None,
     timing: dict[str, float] | None = None,
     coarse: bool | None = None,
-    inputs: Mapping[str, Any] | None = None,
+    inputs: Mapping[str, LineInputs] | None = None,
 ) -> CoupledLinearization:
     """Drag linearization and response of lines coupled through rigid bodies: the
     one drag fixed point of the engine (a single line is the group of one line and no
@@ -198,7 +202,7 @@ def linearize_coupled(
     Notes
     -----
     Module docstrings: the substructured solve
-    (:mod:`stochcable.dynamics.groups.group`), the fixed point (seed 001 §5.3 steps
+    (:mod:`stochcable.dynamics.groups.group`), the fixed point (Tuah 1982, §5.3 steps
     5–13 over all lines and bodies).  Inside :func:`warm_starts` the iteration
     starts from the group's last converged σ.
     """
@@ -219,16 +223,11 @@ def linearize_coupled(
         else f"coupled drag linearization of lines {names} and bodies "
         f"{', '.join(b.name for b in g.bodies)}"
     )
-    fixed = {
-        "relaxation": lin.relaxation,
-        "method": "anderson" if lin.acceleration == "anderson" else "relaxed",
-        "mixing": ANDERSON_MIXING,
-    }
     # coarse stage (stochcable.dynamics.groups.coarse): the fixed point of a frequency
     # subset supplies the start of the full-grid iteration; its history is kept
     if coarse is None:
         coarse = _coarse_pays(g, lin)
-    run = (method, rho, progress, names, lin, fixed, gname, timing)
+    run = FixedPointRun(method, rho, progress, names, lin, gname, timing)
     store = _WARM.get()
     warm = None if store is None or lin.max_iterations == 1 else _warm_start(store, gname)
     x_rest, fp = None, None
@@ -239,15 +238,15 @@ def linearize_coupled(
             x_rest, idx, gc = _start(g, method, coarse)
         if x_rest is None or (warm.shape == x_rest.shape and x_rest.size):
             try:  # a start that does not converge: the rest start, as without one
-                fp, cache = _iterate(g, warm, idx, [gc], run)
+                fp, last = _iterate(g, warm, idx, _CoarseGroupSlot(gc), run)
             except (ConvergenceError, SolverError):
                 fp = None
     if fp is None or not fp.converged:
         if x_rest is None:
             x_rest, idx, gc = _start(g, method, coarse)
-        # (the coarse group in a box: released by _iterate when its stage is over)
-        box, gc = [gc], None
-        fp, cache = _iterate(g, x_rest, idx, box, run)
+        # (the coarse group in a slot: released by _iterate when its stage is over)
+        slot, gc = _CoarseGroupSlot(gc), None
+        fp, last = _iterate(g, x_rest, idx, slot, run)
     if store is not None and fp.converged:  # the newest first
         hist = store.get(gname)
         keep = () if hist is None or hist.shape[1] != fp.x.size else tuple(hist)
@@ -260,7 +259,7 @@ def linearize_coupled(
             PhysicsWarning,
             stacklevel=2,
         )
-    return _outcome(g, cache, fp, lin.tolerance, method)
+    return _outcome(g, last, fp, lin.tolerance, method)
 
 
 def _warm_start(store: dict[str, np.ndarray], gname: str) -> np.ndarray | None:
@@ -276,37 +275,49 @@ def _warm_start(store: dict[str, np.ndarray], gname: str) -> np.ndarray | None:
     return np.maximum(coef @ hist, 0.0)
 
 
+@dataclass(eq=False)
+class _CoarseGroupSlot:
+    """The coarse group built by the start (or None), handed to :func:`_iterate`,
+    which takes it out: the caller keeps no reference to it, so its inputs are
+    released once the coarse stage is over.  Not frozen: taking empties it."""
+
+    group: GroupSystem | None
+
+    def take(self) -> GroupSystem | None:
+        group, self.group = self.group, None
+        return group
+
+
 def _iterate(
-    g: GroupSystem, x_start: np.ndarray, idx: np.ndarray | None, box: list, run: tuple
-) -> tuple[FixedPointResult, dict[str, Any]]:
+    g: GroupSystem,
+    x_start: np.ndarray,
+    idx: np.ndarray | None,
+    slot: _CoarseGroupSlot,
+    run: FixedPointRun,
+) -> tuple[FixedPointResult, Evaluation]:
     """The fixed point from ``x_start`` (the coarse stage on ``idx`` first when not
-    None, on the coarse group ``box[0]`` when built: emptied, so the coarse group's
-    inputs are released once its stage is over) and the cache of its last evaluation;
-    ``run`` = (method, rho, progress, names, lin, fixed, gname, timing)."""
-    method, rho, progress, names, lin, fixed, gname, timing = run
-    gc = box.pop() if box else None
-    state: dict[str, Any] = {"it": 0}
-    cache: dict[str, Any] = {}
+    None, on the coarse group in ``slot`` when built: taken, so the coarse group's
+    inputs are released once its stage is over) and its last evaluation."""
+    gc = slot.take()
+    count = EvaluationCount()
     stage = None
     if idx is not None:
-        stage = CoarseStart(
-            g, idx, method, rho, state, progress, names, lin, fixed, gname, group=gc
-        )
+        stage = CoarseStart(g, idx, run, count, group=gc)
         gc = None
         x_coarse = stage.start(x_start)
         if x_coarse is None:
             stage = None
         else:
             x_start = x_coarse
-    update = sigma_update(g, method, rho, state, cache, progress, names, timing)
+    update = SigmaMap(g, run.method, run.rho, count, run.progress, run.names, run.timing)
     x0 = update(x_start)
-    change0 = state["change"]
+    change0 = count.change
     rounds = 0
     if stage is not None:
-        x0, change0, rounds = stage.correct(update, state, x0, change0)
+        x0, change0, rounds = stage.correct(update, x0, change0)
     coarse_hist = () if stage is None else stage.history
     stage = None  # (its coarse group and inputs released before the full-grid iteration)
-    fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), lin, gname, fixed)
+    fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), run)
     fp = FixedPointResult(
         fp.x,
         len(coarse_hist) + fp.iterations,
@@ -314,10 +325,12 @@ def _iterate(
         fp.converged,
         coarse_hist + fp.history,
     )
-    return fp, cache
+    if update.last is None:  # (every evaluation keeps its outcome: not reached)
+        raise RuntimeError(f"{run.gname}: no evaluation of the full grid")
+    return fp, update.last
 
 
-def _coarse_pays(g: GroupSystem, lin: Any) -> bool:
+def _coarse_pays(g: GroupSystem, lin: LinearizationSettings) -> bool:
     """The default of the coarse start: tolerances of at least
     ``COARSE_MIN_TOLERANCE``, more than one evaluation allowed, and not the vector
     form with a current (its drag is a quadrature per element, ≈ 15 ms on the chain,
@@ -394,18 +407,17 @@ def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
 
 
 def _full_grid(
-    update: Any,
+    update: SigmaMap,
     x0: np.ndarray,
     change0: float,
     rounds: int,
     n_c: int,
-    lin: Any,
-    gname: str,
-    fixed: dict[str, Any],
+    run: FixedPointRun,
 ) -> FixedPointResult:
     """The full-grid iteration from the output ``x0`` (relative change ``change0``) of
     its first evaluation after ``rounds`` correction rounds and ``n_c`` coarse-stage
     entries: its record (first evaluation included, coarse stage not)."""
+    lin, gname = run.lin, run.gname
     if not np.all(np.isfinite(x0)):
         raise ConvergenceError(
             gname, n_c + 1, float("nan"), lin.tolerance, hint="the first response gave non-finite σ"
@@ -416,14 +428,13 @@ def _full_grid(
             raise ConvergenceError(gname, n_c + 1, change0, lin.tolerance, hint=_HINT, partial=fp)
         return fp
     try:
-        fp = fixed_point(
+        fp = run.iterate(
             update,
             x0,
             tol=lin.tolerance,
             max_iterations=lin.max_iterations - 1 - rounds,
             allow_unconverged=lin.allow_unconverged,
             name=gname,
-            **fixed,
         )
     except ConvergenceError as exc:
         raise ConvergenceError(
@@ -440,15 +451,15 @@ def _full_grid(
 
 
 def _outcome(
-    g: GroupSystem, cache: Mapping[str, Any], fp: FixedPointResult, tolerance: float, method: str
+    g: GroupSystem, last: Evaluation, fp: FixedPointResult, tolerance: float, method: str
 ) -> CoupledLinearization:
-    """The record of the converged group from its last evaluation ``cache``."""
-    ls, bs = g.split(cache["sigma"])
+    """The record of the converged group from its last evaluation."""
+    ls, bs = g.split(last.sigma)
     out = {}
     for cl in g.lines:
         system = cl.system
-        damping = cache["damping"][cl.name]
-        sol = cache["sol"][cl.name]
+        damping = last.damping[cl.name]
+        sol = last.sol[cl.name]
         nodes = None
         if isinstance(sol, FreeLine):  # read block by block, formed only if asked for
             nodes, disp, sc = sol.response()
@@ -463,13 +474,13 @@ def _outcome(
         )
         record = linearization_record(system, ls[cl.name], damping, fp, tolerance, method)
         out[cl.name] = Linearization(damping=damping, record=record, response=resp)
-    xi = cache["xi"]
+    xi = last.xi
     motion = {b.name: xi[:, g.off[b.name] : g.off[b.name] + b.n_dof, :].copy() for b in g.bodies}
     return CoupledLinearization(
         lines=out,
         body_motion=motion,
         body_sigma={b.name: bs[b.name].copy() for b in g.drag},
-        body_drag={k: v.copy() for k, v in cache["body_b"].items()},
+        body_drag={k: v.copy() for k, v in last.body_b.items()},
         converged=fp.converged,
         iterations=fp.iterations,
         relative_change=fp.relative_change,

@@ -1,5 +1,5 @@
 """Inputs of a coupled group: its lines, the body loads, vessel-driven ends and the
-group's channels (seed 001 §3.2.c, §3.3).
+group's channels (Tuah 1982, §3.2.c, §3.3).
 
 A coupled group (:mod:`stochcable.dynamics.groups`) is solved on one list of input
 channels: the sea's first (``"sea"``; a short-crested sea's ``"sea@<heading in deg>"``,
@@ -17,6 +17,10 @@ independent line (:func:`fairlead_motion`, :func:`scene_line_channels`), no coup
 back.  In a short-crested sea each direction channel θ_k carries the RAO of its
 direction (:class:`VesselRaos`; a table without headings the same in every direction,
 so the fairlead's motion spectrum is |RAO|² Σ_k w_k S = |RAO|² S).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -24,9 +28,9 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stochcable.bodies.rigid import (
     RigidBody,
@@ -37,6 +41,7 @@ from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.loads.sea_channels import sea_channel_densities, sea_channel_headings
 from stochcable.dynamics.model.system import LineSystem
 from stochcable.errors import InputError
+from stochcable.scene.model import Environment, Line, Scene, Sea
 
 __all__ = [
     "BodyLoads",
@@ -104,7 +109,11 @@ class BodyLoads:
 
 
 def body_loads(
-    body: RigidBody, channels: Sequence[Channel], omega: np.ndarray, sea: Any, environment: Any
+    body: RigidBody,
+    channels: Sequence[Channel],
+    omega: np.ndarray,
+    sea: Sea | None,
+    environment: Environment,
 ) -> BodyLoads:
     """Excitation force and drag-point fluid velocity of a body per channel.
 
@@ -162,7 +171,7 @@ def body_loads(
 
 
 def _excitation(
-    body: RigidBody, w: np.ndarray, beta: float, k: np.ndarray, channel: str, sea: Any
+    body: RigidBody, w: np.ndarray, beta: float, k: np.ndarray, channel: str, sea: Sea | None
 ) -> np.ndarray:
     """:func:`~stochcable.bodies.rigid.body_excitation` at heading ``beta`` [rad]; a
     heading outside the table of a short-crested sea's direction names the direction."""
@@ -188,7 +197,7 @@ def _excitation(
 
 
 def body_gravity_stiffness(
-    body: RigidBody, displaced_volume: float, centre_of_buoyancy: Any, rho: float, g: float
+    body: RigidBody, displaced_volume: float, centre_of_buoyancy: ArrayLike, rho: float, g: float
 ) -> np.ndarray:
     """Restoring of the weight and the buoyancy of a body when it rotates.
 
@@ -228,7 +237,7 @@ def _zero_density(w: np.ndarray) -> np.ndarray:
     return np.zeros_like(np.asarray(w, dtype=float))
 
 
-def sea_only_channels(sea: Any, omega: np.ndarray, g: float) -> tuple[Channel, ...]:
+def sea_only_channels(sea: Sea, omega: np.ndarray, g: float) -> tuple[Channel, ...]:
     """The sea's channels on ``omega`` [rad/s] without line kinematics, the inputs of
     a free-floating body: "sea", or one "sea@<deg>" per direction of a short-crested
     sea with its share of the spectrum
@@ -380,8 +389,8 @@ def group_channels(
 
 
 def scene_line_channels(
-    scene: Any,
-    line: Any,
+    scene: Scene,
+    line: Line,
     system: LineSystem,
     omega: np.ndarray,
     vessels: VesselRaos,

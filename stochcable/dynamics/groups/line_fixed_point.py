@@ -1,4 +1,4 @@
-"""The drag linearization of one line on its own (seed 001 §5.3 steps 5–13): the one
+"""The drag linearization of one line on its own (Tuah 1982, §5.3 steps 5–13): the one
 drag fixed point of the engine (:func:`stochcable.dynamics.groups.group_fixed_point.
 linearize_coupled`) applied to the degenerate group of one line and no bodies.
 
@@ -9,6 +9,10 @@ interpolatory weights, defect correction, warm Anderson step;
 a user (or a test) who holds one :class:`~stochcable.dynamics.model.system.LineSystem` and
 its channels; the engine itself solves every line as a group
 (:func:`stochcable.dynamics.groups.analysis.solve_coupled`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -35,7 +39,7 @@ def linearize(
     coarse: bool = True,
 ) -> Linearization:
     """Drag linearization of one line: iterate the σ of the relative velocities to a
-    fixed point (seed 001 §5.3 steps 5–13).
+    fixed point (Tuah 1982, §5.3 steps 5–13).
 
     Parameters
     ----------

@@ -18,7 +18,6 @@ import math
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -28,6 +27,8 @@ from stochcable.dynamics.groups.modes import CoupledModes, coupled_modes
 from stochcable.dynamics.groups.vessels import VesselRaos
 from stochcable.dynamics.model.system import LineSystem
 from stochcable.errors import InputError, PhysicsWarning, warn
+from stochcable.scene.model import AnalysisSettings, Line, Scene
+from stochcable.statics import StaticsResult
 
 __all__ = ["STATIC_ROTATION_LIMIT", "CoupledModel", "ModelGroup", "build_coupled"]
 
@@ -94,8 +95,8 @@ class CoupledModel:
         The free bodies without lines (solved alone).
     """
 
-    scene: Any
-    settings: Any
+    scene: Scene
+    settings: AnalysisSettings
     omega: np.ndarray
     systems: dict[str, LineSystem]
     attach: dict[str, dict[str, str]]
@@ -109,9 +110,9 @@ class CoupledModel:
 
 
 def build_coupled(
-    scene: Any,
-    statics: Any,
-    settings: Any,
+    scene: Scene,
+    statics: StaticsResult,
+    settings: AnalysisSettings,
     *,
     rigid_bodies: Mapping[str, RigidBody] | None = None,
     timing: dict[str, float] | None = None,
@@ -208,8 +209,8 @@ def build_coupled(
 
 
 def _free_bodies(
-    scene: Any,
-    statics: Any,
+    scene: Scene,
+    statics: StaticsResult,
     prescribed: tuple[str, ...],
     rigid_bodies: Mapping[str, RigidBody] | None,
 ) -> tuple[dict[str, RigidBody], dict[str, np.ndarray]]:
@@ -272,7 +273,7 @@ def _static_rotation_check(name: str, rotation: np.ndarray) -> None:
         )
 
 
-def _free_ends(line: Any, prescribed: tuple[str, ...]) -> dict[str, str]:
+def _free_ends(line: Line, prescribed: tuple[str, ...]) -> dict[str, str]:
     """``{end: body}`` of a scene line's ends attached to free (not prescribed) bodies
     (as :func:`~stochcable.dynamics.groups.inputs.scene_line_channels`)."""
     att: dict[str, str] = {}
@@ -284,7 +285,7 @@ def _free_ends(line: Any, prescribed: tuple[str, ...]) -> dict[str, str]:
 
 
 def _connected_groups(
-    scene: Any, free: Mapping[str, RigidBody], attach: Mapping[str, Mapping[str, str]]
+    scene: Scene, free: Mapping[str, RigidBody], attach: Mapping[str, Mapping[str, str]]
 ) -> list[tuple[tuple[str, ...], tuple[str, ...]]]:
     """Each connected component of free bodies and their lines (union–find over the
     lines' attached ends): (lines in scene order, bodies in scene order), in the scene

@@ -1,5 +1,5 @@
 """Natural modes of a coupled group: lines and rigid bodies (undamped, constant
-matrices; seed 001 §3.3, eqs. 3.3.8–3.3.10).
+matrices; Tuah (1982), §3.3, eqs. 3.3.8–3.3.10).
 
 The coupled modes need constant matrices: K and M + A(ω_ref) of
 :func:`stochcable.bodies.coupling.constant_matrices`, ω_ref the peak of the sea spectrum
@@ -8,6 +8,10 @@ The coupled modes need constant matrices: K and M + A(ω_ref) of
 of the constrained system.  Two ways, the same listed frequencies to 1e-4 on the
 three-leg benchmark: the assembled system (:func:`stochcable.bodies.coupling.couple`) and
 the Craig–Bampton reduction on each line's fixed-end modes and static following.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from stochcable.bodies.rigid import RigidBody, attachment_geometric_stiffness, r
 from stochcable.dynamics.groups.group import body_drag_matrix
 from stochcable.dynamics.groups.inputs import CoupledLine
 from stochcable.dynamics.model.blocks import add_blocks, block_matvec, line_prep
+from stochcable.dynamics.model.system import Damping
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.errors import InputError
 
@@ -357,7 +362,7 @@ def coupled_modal_bandwidths(
     modes: CoupledModes,
     lines: Sequence[CoupledLine],
     bodies: Sequence[RigidBody],
-    line_damping: Mapping[str, Any],
+    line_damping: Mapping[str, Damping],
     body_drag: Mapping[str, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Half-power bandwidths 2ζ_nω_n of the coupled modes: the diagonal of the modal

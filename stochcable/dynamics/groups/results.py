@@ -1,10 +1,14 @@
 """Results of a coupled group: the lines' results and the bodies' motion statistics
-(seed 001 §5.1, spectral moments and maxima)."""
+(Tuah 1982, §5.1, spectral moments and maxima).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
 
 import numpy as np
 
@@ -20,6 +24,7 @@ from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.outputs.resolution import LineModes
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
+from stochcable.scene.model import AnalysisSettings
 
 __all__ = ["LINE_MODE_SHARE", "body_result", "coupled_results", "line_modes"]
 
@@ -37,7 +42,7 @@ def coupled_results(
     lines: Sequence[CoupledLine],
     bodies: Sequence[RigidBody],
     linearization: CoupledLinearization,
-    settings: Any,
+    settings: AnalysisSettings,
     *,
     static_pose: Mapping[str, np.ndarray] | None = None,
     modes: CoupledModes | None = None,
@@ -151,8 +156,8 @@ def body_result(
     mean: np.ndarray,
     duration: float,
     *,
-    sigma: Any = None,
-    drag: Any = None,
+    sigma: np.ndarray | None = None,
+    drag: np.ndarray | None = None,
     modes: CoupledModes | None = None,
     prescribed: bool = False,
 ) -> BodyResult:

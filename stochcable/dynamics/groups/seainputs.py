@@ -1,5 +1,5 @@
 """The inputs of a line alone for one sea state, reused across sea states of the same
-heading (the engine's load-case sets, seed 001 ch. 5 per sea state).
+heading (the engine's load-case sets, Tuah (1982), ch. 5 per sea state).
 
 The channels' transfer functions — the wave kinematics integrated along the elements,
 the Morison inertia loads, the end motions and vessel RAOs per unit wave amplitude —
@@ -15,16 +15,22 @@ them again (tested), without the kinematics.  Lines whose inputs exceed
 of a coupled group keep their channels alone (:func:`group_line_channels`: the group
 forms its inputs in the group's channel order), with their kinematics per direction of
 a short-crested sea.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Hashable
 
 from stochcable.dynamics.groups.inputs import scene_line_channels
+from stochcable.dynamics.groups.model import CoupledModel
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.loads.sea_channels import sea_channel_densities, with_spectrum
 from stochcable.dynamics.solve.line_loads import LineInputs, line_inputs, with_spectra
+from stochcable.scene.model import Line, Scene, Sea
 
 __all__ = ["INPUT_CACHE_BYTES", "group_line_channels", "heading_inputs"]
 
@@ -36,7 +42,9 @@ _KEY = "heading_inputs"
 _GROUP_KEY = "group_channels"
 
 
-def heading_inputs(model: Any, scene: Any, line: Any) -> tuple[tuple[Channel, ...], LineInputs]:
+def heading_inputs(
+    model: CoupledModel, scene: Scene, line: Line
+) -> tuple[tuple[Channel, ...], LineInputs]:
     """The channels and inputs of a line attached to no free body for the sea state of
     ``scene`` (its spectrum and heading), reusing those of an earlier sea state of the
     same heading.
@@ -60,7 +68,9 @@ def heading_inputs(model: Any, scene: Any, line: Any) -> tuple[tuple[Channel, ..
     system = model.systems[line.name]
     sea = scene.sea
     heading = _directions_key(sea)
-    kept: dict[Any, tuple[tuple[Channel, ...], LineInputs]] = system._cache.setdefault(_KEY, {})
+    kept: dict[Hashable, tuple[tuple[Channel, ...], LineInputs]] = system._cache.setdefault(
+        _KEY, {}
+    )
     if heading in kept:
         ch0, inp0 = kept[heading]
         if sea is None:
@@ -80,7 +90,7 @@ def heading_inputs(model: Any, scene: Any, line: Any) -> tuple[tuple[Channel, ..
 
 
 def group_line_channels(
-    model: Any, scene: Any, line: Any
+    model: CoupledModel, scene: Scene, line: Line
 ) -> tuple[tuple[Channel, ...], dict[str, str]]:
     """The channels of a line of a coupled group (attached to a free body) for the sea
     state of ``scene``: :func:`~stochcable.dynamics.groups.inputs.scene_line_channels`,
@@ -98,7 +108,9 @@ def group_line_channels(
     system = model.systems[line.name]
     sea = scene.sea
     key = _directions_key(sea)
-    kept: dict[Any, Any] = system._cache.setdefault(_GROUP_KEY, {})
+    kept: dict[Hashable, tuple[tuple[Channel, ...], dict[str, str]]] = system._cache.setdefault(
+        _GROUP_KEY, {}
+    )
     if key in kept:
         ch0, att = kept[key]
         return (ch0 if sea is None else _respectrum(ch0, sea, scene.environment.g)), dict(att)
@@ -111,14 +123,14 @@ def group_line_channels(
     return ch, att
 
 
-def _directions_key(sea: Any) -> Any:
+def _directions_key(sea: Sea | None) -> Hashable:
     """The directions of a sea state: its heading and spreading (None: no sea)."""
     if sea is None:
         return None
     return (float(sea.heading), None if sea.spreading is None else sea.spreading.model_dump_json())
 
 
-def _respectrum(channels: tuple[Channel, ...], sea: Any, g: float) -> tuple[Channel, ...]:
+def _respectrum(channels: tuple[Channel, ...], sea: Sea, g: float) -> tuple[Channel, ...]:
     """``channels`` with the sea channels' spectra of ``sea`` (by channel name)."""
     dens = {name: d for name, _, d in sea_channel_densities(sea, g)}
     return tuple(with_spectrum(c, dens[c.name]) if c.kind == "sea" else c for c in channels)

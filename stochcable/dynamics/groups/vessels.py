@@ -1,24 +1,30 @@
-"""Vessels: prescribed bodies whose motion is an RAO table relative to the sea (seed 001
-eqs. 3.3.6–3.3.7): their RAOs on the analysis grid per wave heading, and the motion of a
+"""Vessels: prescribed bodies whose motion is an RAO table relative to the sea (Tuah
+1982, eqs. 3.3.6–3.3.7): their RAOs on the analysis grid per wave heading, and the motion of a
 point on them (a fairlead) that drives the lines attached to it.  Nothing couples back
-from the lines to a vessel."""
+from the lines to a vessel.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stochcable.bodies.rigid import rigid_link_matrix
 from stochcable.errors import InputError
+from stochcable.scene.model import VesselMotion
 
 __all__ = ["VesselRaos", "fairlead_motion", "vessel_rao"]
 
 
-def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
+def fairlead_motion(rao: ArrayLike, r: ArrayLike) -> np.ndarray:
     """Motion of a point of a prescribed (vessel) body from its 6-DOF RAO.
 
     Parameters
@@ -32,7 +38,7 @@ def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
     Returns
     -------
     ndarray, complex, shape (n_omega, 3)
-        u = T(r)·ξ = ξ_t + θ × r (seed 001 eqs. 3.3.6–3.3.7). [m/m]
+        u = T(r)·ξ = ξ_t + θ × r (Tuah 1982, eqs. 3.3.6–3.3.7). [m/m]
     """
     a = np.asarray(rao, dtype=complex)
     if a.ndim != 2 or a.shape[1] != 6:
@@ -41,7 +47,7 @@ def fairlead_motion(rao: Any, r: Any) -> np.ndarray:
     return a @ t.T
 
 
-def vessel_rao(motion: Any, omega: np.ndarray, heading: float | None = None) -> np.ndarray:
+def vessel_rao(motion: VesselMotion, omega: np.ndarray, heading: float | None = None) -> np.ndarray:
     """A vessel's 6-DOF motion RAO on the grid for waves travelling toward ``heading``.
 
     Parameters
@@ -75,7 +81,7 @@ class VesselRaos:
     """
 
     omega: np.ndarray
-    motions: Mapping[str, Any]
+    motions: Mapping[str, VesselMotion]
     _kept: dict[tuple[str, float], np.ndarray] = dataclasses.field(default_factory=dict, repr=False)
 
     def __contains__(self, name: object) -> bool:

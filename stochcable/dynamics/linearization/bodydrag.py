@@ -1,6 +1,11 @@
-"""The statistically linearized drag of a rigid body at its drag point (seed 001 eq.
+"""The statistically linearized drag of a rigid body at its drag point (Tuah 1982, eq.
 5.2.2 form, with the current) and its damping on the body DOFs through the rigid link
-of the drag point (seed 001 eq. 3.3.6)."""
+of the drag point (Tuah 1982, eq. 3.3.6).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
@@ -27,7 +32,7 @@ def body_drag_matrix(body: RigidBody, b: np.ndarray) -> np.ndarray:
     Returns
     -------
     ndarray, shape (d, d)
-        Tᵀ diag(b) T, T the rigid link of the drag point (seed 001 eq. 3.3.6). [N·s/m, …]
+        Tᵀ diag(b) T, T the rigid link of the drag point (Tuah 1982, eq. 3.3.6). [N·s/m, …]
     """
     t = rigid_link_matrix(body.drag_point)
     c = t.T @ (b[:, None] * t)
@@ -57,7 +62,7 @@ def linear_body_drag(
     Returns
     -------
     b : ndarray, shape (3,)
-        Linear drag per direction (seed 001 eq. 5.2.2 form). [N·s/m]
+        Linear drag per direction (Tuah 1982, eq. 5.2.2 form). [N·s/m]
     c : ndarray, shape (d, d)
         :func:`body_drag_matrix` of ``b``.
     """

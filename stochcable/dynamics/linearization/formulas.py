@@ -1,22 +1,26 @@
 """Statistical (and harmonic) linearization of Morison drag.
 
 Per unit length the drag force on a cable element is ``f = 1/2 rho Cd D |v| v`` with
-``v`` the relative fluid velocity (seed 001 eq. 3.2.a.6, §5.2).  Statistical
+``v`` the relative fluid velocity (Tuah 1982, eq. 3.2.a.6, §5.2).  Statistical
 linearization (Borgman 1972) replaces it by ``f ~ B v`` with ``B = E[df/dv]`` for a
 Gaussian ``v`` (equivalently the least-squares fit ``E[(f - B v)^2] -> min``).
 ``B`` depends on the statistics of ``v``, which depend on the response: the
-standard deviations are iterated to a fixed point (seed 001 §5.3, steps 5-13) with
+standard deviations are iterated to a fixed point (Tuah 1982, §5.3, steps 5-13) with
 :func:`stochcable.dynamics.linearization.iteration.fixed_point`.
 
 All formulas are pure, vectorized over elements (broadcasting over leading axes).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import special
 
 from stochcable import validation as _v
@@ -36,11 +40,11 @@ _SQRT_2_OVER_PI = math.sqrt(2.0 / math.pi)
 _SQRT_8_OVER_PI = math.sqrt(8.0 / math.pi)
 
 
-def _nonneg_array(name: str, value: Any, unit: str) -> np.ndarray:
+def _nonneg_array(name: str, value: ArrayLike, unit: str) -> np.ndarray:
     return _v.float_array(name, value, unit, ndim=None, nonnegative=True)
 
 
-def _finite_array(name: str, value: Any, unit: str) -> np.ndarray:
+def _finite_array(name: str, value: ArrayLike, unit: str) -> np.ndarray:
     return _v.float_array(name, value, unit, ndim=None)
 
 
@@ -145,7 +149,7 @@ def drag_linear_current(
 
     ``B = rho Cd D [sigma sqrt(2/pi) exp(-U^2/(2 sigma^2)) + U erf(U/(sigma sqrt 2))]``
 
-    (DESIGN.md "Drag linearization").  For ``U = 0`` it is seed 001 eq. (5.2.2);
+    (DESIGN.md "Drag linearization").  For ``U = 0`` it is Tuah (1982), eq. (5.2.2);
     for ``sigma -> 0`` it tends to ``rho Cd D |U|`` (the tangent of the steady
     drag), which is returned exactly for ``sigma = 0``; ``sigma = U = 0`` gives 0.
     The mean force that goes with it is :func:`mean_drag_gaussian`.
@@ -383,7 +387,7 @@ def drag_linear_vector(
 
     With velocity in one direction only (``s2 = 0``, ``m = 1``):
     ``B11 = 1/2 rho Cd D * 2 sqrt(2/pi) s1 = sqrt(8/pi) 1/2 rho Cd D sigma``, the seed
-    form (seed 001 eq. 5.2.2.a), and ``B22 = B11 / 2``: the out-of-line
+    form (Tuah 1982, eq. 5.2.2.a), and ``B22 = B11 / 2``: the out-of-line
     fluctuation is damped at half the in-line rate.  For an isotropic velocity
     (``s1 = s2 = sigma``) ``B = (3/2) sqrt(pi/2) 1/2 rho Cd D sigma I``, 18 % more
     than the seed form applied to each component separately (the magnitude

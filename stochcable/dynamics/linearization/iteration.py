@@ -1,6 +1,10 @@
-"""The fixed-point iteration of the drag linearization (seed 001 §5.3, steps 5-13):
+"""The fixed-point iteration of the drag linearization (Tuah 1982, §5.3, steps 5-13):
 plain relaxed steps or Anderson acceleration, with the relative-change convergence
 test (:func:`fixed_point`, :class:`FixedPointResult`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -94,10 +98,10 @@ def fixed_point(
     update : callable
         ``update(x) -> x_new``; maps the vector of velocity standard deviations
         used to build the linear drag to the ones of the resulting response
-        (seed 001 §5.3 steps 6-12). [unit of x]
+        (Tuah 1982, §5.3 steps 6-12). [unit of x]
     x0 : array_like
         Starting point, e.g. the standard deviations of the fluid velocity alone
-        (cable at rest, seed 001 §5.3 step 5).  Must be >= 0. [unit of x]
+        (cable at rest, Tuah (1982), §5.3 step 5).  Must be >= 0. [unit of x]
     tol : float, optional
         Tolerance on the relative change of every component. [-]
     max_iterations : int, optional

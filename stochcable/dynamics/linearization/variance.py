@@ -1,4 +1,4 @@
-"""σ of the relative velocities and the linear drag they give (seed 001 eqs.
+"""σ of the relative velocities and the linear drag they give (Tuah 1982, eqs.
 5.2.2–5.2.5): the two halves of one step of the drag fixed point.
 
 :func:`drag_coefficients` maps the σ vector to the linearized drag
@@ -7,6 +7,10 @@ the iteration's faster :func:`sigmas_from_free`) maps a response back to σ.  Th
 an element is its element mean square,
 σ² = Σ_i ∫ S_i ∫₀¹ |row·(v(ξ) − U̇(ξ))|² dξ dω, exact for the wave field and the
 structural velocity linear along the element.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from stochcable.dynamics.linearization.formulas import (
     drag_linear_vector,
     mean_abs_gaussian,
 )
+from stochcable.dynamics.linearization.iteration import FixedPointResult
 from stochcable.dynamics.loads.channels import (
     Channel,
 )
@@ -63,11 +68,14 @@ def split_sigma(system: LineSystem, x: np.ndarray, method: str) -> dict[str, np.
 
 
 def _drag_current(
-    rho: float, cd: Any, diameter: Any, sigma: np.ndarray, mean: np.ndarray
+    rho: float,
+    cd: np.ndarray | float,
+    diameter: np.ndarray | float,
+    sigma: np.ndarray,
+    mean: np.ndarray,
 ) -> np.ndarray:
     """:func:`stochcable.dynamics.linearization.formulas.drag_linear_current` without validation
-    (finite
-    σ >= 0): the same operations in the same order."""
+    (finite σ >= 0): the same operations in the same order."""
     return rho * np.asarray(cd, dtype=float) * diameter * mean_abs_gaussian(sigma, mean)
 
 
@@ -105,7 +113,7 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
     Notes
     -----
     seed: B_n = ρ Cdn D E|v_n| with v_n ~ N(|U_n|, σ_n²) (:func:`drag_linear_current`;
-    = √(8/π)·½ρCdnD·σ_n without current, seed 001 eq. 5.2.2.a); axial the same with
+    = √(8/π)·½ρCdnD·σ_n without current, Tuah (1982), eq. 5.2.2.a); axial the same with
     Cdt and πD (eq. 5.2.2.b) and the mean U·e.  vector: the exact 2×2 normal-plane
     form (:func:`drag_linear_vector`).  harmonic: (8/3π)·½ρCdD·|v̂| with |v̂| = √2 σ
     (the amplitude of a single harmonic of standard deviation σ).  Attachments:
@@ -204,8 +212,7 @@ def relative_velocity_sigmas(
     the element's e (axial) or normals n1, n2; the scalar form uses
     σ_n² = σ_n1² + σ_n2².  The fluid part is integrated exactly
     (:func:`stochcable.dynamics.loads.element_kinematics.element_wave_kinematics`: the wet part
-    only), the
-    structural displacement U(ξ) is the element's linear interpolation, so the
+    only), the structural displacement U(ξ) is the element's linear interpolation, so the
     ξ-integral is closed-form (:func:`_element_variance`).  The drag coefficient B is
     then constant over the element (eq. 5.2.2 with this σ).  Attachments: the nodal
     relative velocity.
@@ -350,14 +357,14 @@ def _kernel_moments(inp: LineInputs, sl: slice) -> Any:
     return inp.fluid_views(sl)
 
 
-def _block(u: Any, sl: slice) -> np.ndarray | None:
+def _block(u: np.ndarray | Callable[[slice], np.ndarray] | None, sl: slice) -> np.ndarray | None:
     """The frequencies ``sl`` of node vectors given as an array or a callable."""
     if u is None:
         return None
     return u(sl) if callable(u) else u[:, :, sl]
 
 
-def element_variance_kernel() -> Any:
+def element_variance_kernel() -> Callable[..., None] | None:
     """:func:`stochcable.dynamics.linearization.variance_kernels.element_variance_terms`, or None
     without numba or with ``STOCHCABLE_NUMBA=0`` (the NumPy blocks then)."""
     return optional_kernel(
@@ -537,7 +544,12 @@ def quasi_static_motion(system: LineSystem, inp: LineInputs) -> np.ndarray | Non
 
 
 def linearization_record(
-    system: LineSystem, sigma: np.ndarray, damping: Damping, fp: Any, tolerance: float, method: str
+    system: LineSystem,
+    sigma: np.ndarray,
+    damping: Damping,
+    fp: FixedPointResult,
+    tolerance: float,
+    method: str,
 ) -> LinearizationRecord:
     """The record of a converged (or flagged) drag fixed point of one line: the
     iteration history of ``fp`` (a FixedPointResult), the final σ (the

@@ -10,11 +10,11 @@ velocity,
     w_n [(|q_a|² + |q_b|² + Re(q̄_a q_b))/3 + 2 Re(m̄_a q_a + m̄_b q_b)],
 
 in one pass over the response without temporaries (the NumPy form builds −iωU on all
-nodes, its projections at both ends and their products: ≈ 0.2 ms an evaluation on the
-chain example, 5 per sea state; this loop ≈ 0.05 ms).  The same sums in another
-order: equal to round-off.
+nodes, its projections at both ends and their products; measured in
+docs/benchmarks/dynamics.md, "Element variances").  The same sums in another order:
+equal to round-off.
 
-Imported lazily (numba costs ≈ 0.2 s to import); compiled with ``cache=True``
+Imported lazily (numba's import is slow); compiled with ``cache=True``
 (:func:`stochcable.compiled.jit_cached`).
 """
 

@@ -1,6 +1,6 @@
 """Excitation of a line: independent input channels and the hydrodynamic matrices.
 
-The linear system of a line about its static shape (seed 001 eqs. 5.1, 5.2.6) is
+The linear system of a line about its static shape (Tuah 1982, eqs. 5.1, 5.2.6) is
 
     M_T Ü + (C_d + C_s) U̇ + K U = C_d V + B_I A          (all DOFs, U total motion)
 
@@ -37,7 +37,7 @@ The drag damping and the inertia matrix (for nodal accelerations) are distribute
 each element like the model's mass (consistent [[1/3, 1/6], [1/6, 1/3]]·l0 by default,
 lumped [[1/2, 0], [0, 1/2]]·l0 when the model is lumped), with the element direction
 constant over the element, so the matrices are symmetric (the non-symmetry the seed
-avoids by lumping, seed 001 §3.2.a, comes from nodal direction cosines).  Lengths are
+avoids by lumping, Tuah (1982), §3.2.a, comes from nodal direction cosines).  Lengths are
 the unstretched lengths l0, as the added mass of :mod:`stochcable.line.fem`, so that a line
 moving with a uniform fluid (Ü = A) feels exactly the Froude–Krylov force
 ρ(πD²/4)(I − eeᵀ)A.  Attachments (buoys, clumps) get the isotropic inertia load
@@ -46,6 +46,10 @@ The sea channel carries the wave velocity's consistent moments ∫ N_i v dξ and
 mean square ∫ Re(v vᴴ) dξ integrated exactly along the elements
 (:mod:`stochcable.dynamics.loads.element_kinematics`), read by :func:`element_moments` and
 :func:`element_mean_square` (hand-built channels: the nodal kinematics interpolated).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -53,7 +57,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 import scipy.sparse as sp
@@ -63,9 +67,11 @@ from stochcable.dynamics.loads.element_kinematics import (
     element_frames,
     element_wave_kinematics,
 )
+from stochcable.dynamics.loads.element_parts import EndSquare, MomentParts, SquareParts
 from stochcable.dynamics.loads.sea_channels import sea_channel_densities, spectrum_callable
 from stochcable.errors import InputError
-from stochcable.scene.model import Environment, Line, Scene
+from stochcable.line.fem import FEModel
+from stochcable.scene.model import Environment, Line, MotionRao, Scene
 from stochcable.sea.kinematics import G_STANDARD, nodal_kinematics
 
 __all__ = [
@@ -93,14 +99,13 @@ class _LazyNodal:
     """A :class:`Channel` field (``velocity``/``acceleration``) that, when left None
     while the channel has a ``nodal`` callable, is computed from it on first access
     (both fields at once) and kept: the sea's nodal kinematics only drive the
-    attachments' drag and inertia, which most lines do not have (0.35 ms of the
-    chain).  A dataclass descriptor field: the default is None and ``__init__`` stores
-    the value through :meth:`__set__`."""
+    attachments' drag and inertia, which most lines do not have (docs/benchmarks/
+    dynamics.md).  A dataclass descriptor field: None by default, set by :meth:`__set__`."""
 
     def __set_name__(self, owner: type, name: str) -> None:
         self._key = "_" + name
 
-    def __get__(self, obj: Any, objtype: Any = None) -> Any:
+    def __get__(self, obj: Channel | None, objtype: type | None = None) -> np.ndarray | None:
         if obj is None:
             return None  # the dataclass default
         d = obj.__dict__
@@ -112,7 +117,7 @@ class _LazyNodal:
             val = d.get(self._key)
         return val
 
-    def __set__(self, obj: Any, value: Any) -> None:
+    def __set__(self, obj: Channel, value: np.ndarray | None) -> None:
         obj.__dict__[self._key] = value
 
 
@@ -164,7 +169,7 @@ class Channel:
     heading : float or None
         Wave heading β of a sea channel with element kinematics (the drag residual
         integrates them over parts of elements,
-        :mod:`stochcable.dynamics.drag_segments`); None otherwise. [rad]
+        :mod:`stochcable.dynamics.residuals.drag_segments`); None otherwise. [rad]
     """
 
     name: str
@@ -179,9 +184,9 @@ class Channel:
     element_velocity: np.ndarray | None = None
     element_velocity_square: np.ndarray | None = None
     element_end_square: np.ndarray | None = None
-    element_square: Any = None  # SquareParts
-    element_velocity_parts: Any = None  # MomentParts
-    element_ends: Any = None  # EndSquare
+    element_square: SquareParts | None = None
+    element_velocity_parts: MomentParts | None = None
+    element_ends: EndSquare | None = None
     nodal: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False)
     heading: float | None = None
 
@@ -215,7 +220,7 @@ def line_channels(
 
     Notes
     -----
-    Kinematics: seed 001 eqs. 5.2.8–5.2.11 (:func:`stochcable.sea.kinematics.wave_kinematics`)
+    Kinematics: Tuah (1982), eqs. 5.2.8–5.2.11 (:func:`stochcable.sea.kinematics.wave_kinematics`)
     at the nodes, and integrated exactly along the straight elements between them
     (:func:`element_wave_kinematics`).  Nodes resting on a penalty seabed slightly below
     z = −depth are moved onto it.
@@ -284,7 +289,7 @@ def line_channels(
     return tuple(channels)
 
 
-def _end_rao(rao: Any, omega: np.ndarray, heading: float) -> np.ndarray | None:
+def _end_rao(rao: MotionRao | None, omega: np.ndarray, heading: float) -> np.ndarray | None:
     """An end's motion RAO (n_omega, 3) for waves toward ``heading`` [rad], or None."""
     return None if rao is None else np.ascontiguousarray(rao.transfer(omega, heading).T)
 
@@ -307,7 +312,7 @@ def _sea_nodal(el: ElementKinematics, g: float) -> Callable[[], tuple[np.ndarray
     return nodal
 
 
-def element_moments(model: Any, channel: Channel) -> np.ndarray | None:
+def element_moments(model: FEModel, channel: Channel) -> np.ndarray | None:
     """Consistent moments of a channel's fluid velocity along the model's elements.
 
     Parameters
@@ -366,7 +371,7 @@ def element_mean_square(channel: Channel) -> np.ndarray | None:
 # ------------------------------------------------------------------ element geometry
 
 
-def embed(model: Any, values: np.ndarray) -> np.ndarray:
+def embed(model: FEModel, values: np.ndarray) -> np.ndarray:
     """Model-DOF vectors (..., n_dof) -> node vectors (..., n_nodes, 3), zeros off-model."""
     lead = values.shape[:-1]
     out = np.zeros(lead + (model.n_nodes, 3), dtype=values.dtype)
@@ -374,13 +379,13 @@ def embed(model: Any, values: np.ndarray) -> np.ndarray:
     return out
 
 
-def _to_dofs(model: Any, node_vectors: np.ndarray) -> np.ndarray:
+def _to_dofs(model: FEModel, node_vectors: np.ndarray) -> np.ndarray:
     """Node vectors (..., n_nodes, 3) -> model-DOF vectors (..., n_dof)."""
     sub = node_vectors[..., list(model.components)]
     return sub.reshape(sub.shape[:-2] + (model.n_dof,))
 
 
-def _assemble(model: Any, blocks3: np.ndarray, node_diag: np.ndarray | None) -> sp.csr_array:
+def _assemble(model: FEModel, blocks3: np.ndarray, node_diag: np.ndarray | None) -> sp.csr_array:
     """Assemble per-unit-length 3×3 element matrices (n_el, 3, 3) times the mass
     distribution pattern·l0, plus an isotropic per-node diagonal, on the model DOFs."""
     comps = list(model.components)
@@ -398,7 +403,7 @@ def _assemble(model: Any, blocks3: np.ndarray, node_diag: np.ndarray | None) -> 
     return chain_csr(el, model.n_nodes, d, diag)
 
 
-def inertia_matrix(model: Any, g: float) -> sp.csr_array:
+def inertia_matrix(model: FEModel, g: float) -> sp.csr_array:
     """Morison inertia matrix B_I: load = B_I·A for nodal fluid accelerations A.
 
     Parameters
@@ -415,7 +420,7 @@ def inertia_matrix(model: Any, g: float) -> sp.csr_array:
 
     Notes
     -----
-    Per unit length ρ(πD²/4)(1 + Can)(I − eeᵀ) (seed 001 eq. 5.2.1, the B_I C_M term,
+    Per unit length ρ(πD²/4)(1 + Can)(I − eeᵀ) (Tuah 1982, eq. 5.2.1, the B_I C_M term,
     C_M = 1 + Can); per attachment (buoyancy/g + added mass)·I.
     """
     blocks, node = inertia_blocks(model, g)
@@ -423,7 +428,7 @@ def inertia_matrix(model: Any, g: float) -> sp.csr_array:
 
 
 def drag_matrix(
-    model: Any,
+    model: FEModel,
     b_normal: np.ndarray,
     b_axial: np.ndarray,
     b_node: np.ndarray | None = None,
@@ -450,14 +455,14 @@ def drag_matrix(
 
     Notes
     -----
-    Per unit length B_n(I − eeᵀ) + B_t eeᵀ (seed 001 eq. 5.2.1 with B_DL, B_DT of
+    Per unit length B_n(I − eeᵀ) + B_t eeᵀ (Tuah 1982, eq. 5.2.1 with B_DL, B_DT of
     eq. 5.2.2), or N B Nᵀ + B_t eeᵀ with N = [n1 n2] for the vector form.
     """
     return _assemble(model, _drag_blocks3(model, b_normal, b_axial), b_node)
 
 
 def inertia_blocks(
-    model: Any, g: float, e: np.ndarray | None = None
+    model: FEModel, g: float, e: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Morison inertia per unit length (n_el, 3, 3) and per attachment node (n_nodes,);
     ``e`` the element tangents when already at hand (:func:`element_frames`)."""
@@ -469,7 +474,7 @@ def inertia_blocks(
     return blocks, mesh.node_buoyancy / g + mesh.node_added_mass
 
 
-def _drag_blocks3(model: Any, b_normal: np.ndarray, b_axial: np.ndarray) -> np.ndarray:
+def _drag_blocks3(model: FEModel, b_normal: np.ndarray, b_axial: np.ndarray) -> np.ndarray:
     """Linear drag per unit length B_n(I − eeᵀ) + B_t eeᵀ (or N B Nᵀ + B_t eeᵀ), (n_el, 3, 3)."""
     e, n1, n2 = element_frames(model.positions)
     eet = e[:, :, None] * e[:, None, :]
@@ -483,7 +488,7 @@ def _drag_blocks3(model: Any, b_normal: np.ndarray, b_axial: np.ndarray) -> np.n
 
 
 def wave_loads(
-    model: Any,
+    model: FEModel,
     channels: tuple[Channel, ...],
     b_normal: np.ndarray,
     b_axial: np.ndarray,
@@ -516,7 +521,7 @@ def wave_loads(
     Notes
     -----
     Node i of element j gets l0_j·[iω C_I(I − eeᵀ) + B_j]·∫₀¹ N_i v dξ with
-    C_I = ρ(πD²/4)(1 + Can) (seed 001 eq. 5.2.1, the B_I C_M and drag terms; B_j of
+    C_I = ρ(πD²/4)(1 + Can) (Tuah 1982, eq. 5.2.1, the B_I C_M and drag terms; B_j of
     eq. 5.2.2 constant over the element) and the moments of :func:`element_moments`
     (exact for the sea channel, :func:`element_wave_kinematics`); attachments get
     (buoyancy/g + added mass)·A + b_node·V at their node.
@@ -544,7 +549,7 @@ def wave_loads(
     return out
 
 
-def prescribed_motion(model: Any, channels: tuple[Channel, ...], n_omega: int) -> np.ndarray:
+def prescribed_motion(model: FEModel, channels: tuple[Channel, ...], n_omega: int) -> np.ndarray:
     """Prescribed displacements of the fixed DOFs, shape (n_omega, n_fixed, n_ch). [m/unit]"""
     n_ch = len(channels)
     nodes = np.zeros((n_omega, n_ch, model.n_nodes, 3), dtype=complex)
@@ -558,7 +563,7 @@ def prescribed_motion(model: Any, channels: tuple[Channel, ...], n_omega: int) -
 
 
 def channel_loads(
-    model: Any,
+    model: FEModel,
     channels: tuple[Channel, ...],
     c_drag: sp.csr_array,
     b_inertia: sp.csr_array,

@@ -24,15 +24,19 @@ The moments are the exact consistent load for both mass-matrix options: for a un
 field they equal the lumped ½·l0 weights, so the Froude–Krylov balance above holds
 either way.  Channels without these element data (built by hand) fall back on the
 linear interpolation of their nodal kinematics with the model's mass pattern.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stochcable import validation as v
 from stochcable.compiled import optional_kernel
@@ -43,7 +47,7 @@ from stochcable.dynamics.loads.element_parts import (
     SquareParts,
     sub_blocks,
 )
-from stochcable.dynamics.loads.freqblocks import working_memory_bytes
+from stochcable.dynamics.loads.freqblocks import FrequencyIndex, working_memory_bytes
 from stochcable.dynamics.loads.kinematics_closed_forms import kinematics_block, square_block
 from stochcable.errors import InputError
 from stochcable.sea.kinematics import G_STANDARD, wavenumber
@@ -130,8 +134,8 @@ class ElementKinematics:
 
 
 def element_wave_kinematics(
-    omega: Any,
-    positions: Any,
+    omega: ArrayLike,
+    positions: ArrayLike,
     heading: float = 0.0,
     depth: float = np.inf,
     g: float = G_STANDARD,
@@ -164,7 +168,7 @@ def element_wave_kinematics(
 
     Notes
     -----
-    Kinematics of seed 001 eqs. 5.2.8–5.2.11 in the DESIGN.md convention
+    Kinematics of Tuah (1982), eqs. 5.2.8–5.2.11 in the DESIGN.md convention
     (:func:`stochcable.sea.kinematics.wave_kinematics`): with χ = x cos β + y sin β,
     E₁ = k z − i k χ, E₂ = −k(z + 2h) − i k χ and D = 1 − e^{−2kh},
 
@@ -281,7 +285,7 @@ class KinematicsBlocks:
         need = KINEMATICS_BYTES * self.n_elements * self.n_omega
         return need <= working_memory_bytes() // 4
 
-    def form(self, freq: Any = slice(None)) -> tuple[np.ndarray, np.ndarray]:
+    def form(self, freq: FrequencyIndex = slice(None)) -> tuple[np.ndarray, np.ndarray]:
         """The moments' parts (n_el, 2, 2, n_f) and the mean square's (2, n_f, n_el)
         on the frequencies ``freq``. [(m/s)/m, (m/s)²/m²]"""
         w, k = self.omega[freq], self.wavenumber[freq]
@@ -302,11 +306,11 @@ class KinematicsBlocks:
             kinematics_block(w[sl], k[sl], self.geometry, parts[..., sl], sq[:, sl])
         return parts, sq
 
-    def moments(self, freq: Any = slice(None)) -> np.ndarray:
+    def moments(self, freq: FrequencyIndex = slice(None)) -> np.ndarray:
         """The moments' parts on ``freq``, (n_el, 2, 2, n_f). [(m/s)/m]"""
         return self.form(freq)[0]
 
-    def square(self, freq: Any = slice(None)) -> np.ndarray:
+    def square(self, freq: FrequencyIndex = slice(None)) -> np.ndarray:
         """The mean square's parts on ``freq``, (2, n_f, n_el), alone (NumPy,
         :func:`~stochcable.dynamics.loads.kinematics_closed_forms.square_block`: ≈ 17 ns per
         element and frequency against the compiled moments and squares' ≈ 42; the
@@ -336,7 +340,7 @@ class KinematicsBlocks:
         geo = (za[sel], zb[sel], chi[start : stop + 1], p[:, sel], q[:, sel], *rest)
         return KinematicsBlocks(self.omega, self.wavenumber, geo, self.heading)
 
-    def __getitem__(self, idx: Any) -> KinematicsBlocks:
+    def __getitem__(self, idx: FrequencyIndex) -> KinematicsBlocks:
         """The source on the frequencies ``idx``."""
         return KinematicsBlocks(self.omega[idx], self.wavenumber[idx], self.geometry, self.heading)
 

@@ -17,18 +17,39 @@ the same numbers.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Protocol
 
 import numpy as np
 
-from stochcable.dynamics.loads.freqblocks import frequency_slices
+from stochcable.dynamics.loads.freqblocks import FrequencyIndex, frequency_slices
+
+#: Components of x, y, z (indices 0, 1, 2).
+Components = Sequence[int] | np.ndarray
+
+
+class PartsSource(Protocol):
+    """What forms the parts of any frequencies when none are kept
+    (:class:`~stochcable.dynamics.loads.element_kinematics.KinematicsBlocks`)."""
+
+    @property
+    def n_elements(self) -> int: ...
+
+    def moments(self, freq: FrequencyIndex = ...) -> np.ndarray: ...
+
+    def square(self, freq: FrequencyIndex = ...) -> np.ndarray: ...
+
+    def elements(self, sel: slice) -> PartsSource: ...
+
 
 __all__ = [
     "KINEMATICS_BYTES",
     "ArrayMoments",
+    "Components",
     "EndSquare",
     "MomentParts",
+    "PartsSource",
     "SquareParts",
     "sub_blocks",
 ]
@@ -75,25 +96,25 @@ class MomentParts:
 
     parts: np.ndarray | None
     heading: float
-    source: Any = None
+    source: PartsSource | None = None
 
     @property
     def nbytes(self) -> int:
         """Bytes kept (none for parts formed when read). [B]"""
         return 0 if self.parts is None else int(self.parts.nbytes)
 
-    def stacked(self, freq: Any) -> np.ndarray:
+    def stacked(self, freq: FrequencyIndex) -> np.ndarray:
         """The parts on the frequencies ``freq``, (n_el, 2, 2, n_f): a view of the kept
         parts or formed."""
         return self.source.moments(freq) if self.parts is None else self.parts[..., freq]
 
-    def mix(self, comps: Any) -> np.ndarray:
+    def mix(self, comps: Components) -> np.ndarray:
         """The components ``comps`` of x, y, z as combinations of the parts, (d, 2)."""
         cb, sb = _direction(self.heading)
         rows = np.array([[cb, 0.0], [sb, 0.0], [0.0, 1.0]])
         return rows[np.asarray(comps, dtype=int)]
 
-    def block(self, comps: Any, freq: Any = slice(None)) -> np.ndarray:
+    def block(self, comps: Components, freq: FrequencyIndex = slice(None)) -> np.ndarray:
         """The moments on the components ``comps`` and frequencies ``freq``, (n_el, 2,
         d, n_f), a fresh contiguous array. [(m/s)/m]"""
         cb, sb = _direction(self.heading)
@@ -107,7 +128,7 @@ class MomentParts:
                 np.multiply(h, cb if c == 0 else sb, out=out[:, :, j])
         return out
 
-    def ends(self, comps: Any) -> tuple[np.ndarray, np.ndarray]:
+    def ends(self, comps: Components) -> tuple[np.ndarray, np.ndarray]:
         """∫N_a v dξ of the first element and ∫N_b v dξ of the last on ``comps``, each
         (d, n_omega). [(m/s)/m]"""
         if self.parts is None:  # the two elements alone
@@ -124,7 +145,7 @@ class MomentParts:
         of fresh element-major storage. [(m/s)/m]"""
         return np.moveaxis(self.block((0, 1, 2)), 3, 0)
 
-    def __getitem__(self, idx: Any) -> MomentParts:
+    def __getitem__(self, idx: FrequencyIndex) -> MomentParts:
         """The parts on the frequencies ``idx`` (a copy for an index array; formed, or
         formed when read where they do not fit the working-memory target)."""
         if self.parts is not None:
@@ -152,21 +173,21 @@ class ArrayMoments:
         """Bytes of the array. [B]"""
         return int(self.array.nbytes)
 
-    def mix(self, comps: Any) -> np.ndarray:
+    def mix(self, comps: Components) -> np.ndarray:
         """The selection of ``comps`` among x, y, z, (d, 3)."""
         return np.eye(3)[np.asarray(comps, dtype=int)]
 
-    def block(self, comps: Any, freq: Any = slice(None)) -> np.ndarray:
+    def block(self, comps: Components, freq: FrequencyIndex = slice(None)) -> np.ndarray:
         """(n_el, 2, d, n_f), a fresh contiguous array. [(m/s)/m]"""
         el = np.moveaxis(self.array, 0, -1)  # (n_el, 2, 3, n_w)
         return np.ascontiguousarray(el[:, :, list(comps), freq])
 
-    def ends(self, comps: Any) -> tuple[np.ndarray, np.ndarray]:
+    def ends(self, comps: Components) -> tuple[np.ndarray, np.ndarray]:
         """(d, n_omega) each: the first element's end a, the last element's end b."""
         c = list(comps)
         return self.array[:, 0, 0, c].T.copy(), self.array[:, -1, 1, c].T.copy()
 
-    def stacked(self, freq: Any) -> np.ndarray:
+    def stacked(self, freq: FrequencyIndex) -> np.ndarray:
         """(n_el, 2, 3, n_f), a view."""
         return np.moveaxis(self.array, 0, -1)[..., freq]
 
@@ -174,7 +195,7 @@ class ArrayMoments:
         """The array itself, (n_omega, n_el, 2, 3)."""
         return self.array
 
-    def __getitem__(self, idx: Any) -> ArrayMoments:
+    def __getitem__(self, idx: FrequencyIndex) -> ArrayMoments:
         return ArrayMoments(self.array[idx])
 
 
@@ -199,7 +220,7 @@ class SquareParts:
     horizontal: np.ndarray | None
     vertical: np.ndarray | None
     heading: float
-    source: Any = None
+    source: PartsSource | None = None
 
     @property
     def nbytes(self) -> int:
@@ -208,7 +229,7 @@ class SquareParts:
             return 0
         return int(self.horizontal.nbytes + self.vertical.nbytes)
 
-    def _blocks(self) -> Any:
+    def _blocks(self) -> Iterator[tuple[FrequencyIndex, np.ndarray, np.ndarray]]:
         """(frequencies, h, v) of the whole grid at once, or per block of the
         working-memory target when formed."""
         if self.horizontal is not None:
@@ -240,7 +261,7 @@ class SquareParts:
         sq[:, :, 2, 2] = self.vertical
         return sq
 
-    def __getitem__(self, idx: Any) -> SquareParts:
+    def __getitem__(self, idx: FrequencyIndex) -> SquareParts:
         """The parts on the frequencies ``idx`` (formed, or formed when read, as
         :meth:`MomentParts.__getitem__`)."""
         if self.horizontal is not None:
@@ -248,7 +269,7 @@ class SquareParts:
         sub = self.source[idx]
         return sub.parts()[1] if sub.fits() else SquareParts(None, None, self.heading, sub)
 
-    def weighted(self, weights: np.ndarray, comps: Any) -> np.ndarray:
+    def weighted(self, weights: np.ndarray, comps: Components) -> np.ndarray:
         """Σ_ω weight·S on the components ``comps``, (n_el, d, d). [(m/s)²·…]"""
         p, z = self._pattern()
         c = np.asarray(comps)
@@ -301,7 +322,7 @@ class EndSquare:
         """Bytes kept (no per-frequency array of the elements). [B]"""
         return int(self.omega.nbytes + self.wavenumber.nbytes + self.z_ends.nbytes)
 
-    def block(self, freq: Any = slice(None)) -> np.ndarray:
+    def block(self, freq: FrequencyIndex = slice(None)) -> np.ndarray:
         """|v|² on the frequencies ``freq``, (n_f, n_el, 2). [(m/s)²/m²]"""
         w, k, h, z = self.omega[freq], self.wavenumber[freq], self.depth, self.z_ends
         e1 = np.exp(2.0 * np.multiply.outer(k, z))  # (n_f, n_el, 2)
@@ -331,7 +352,7 @@ class EndSquare:
             out += np.einsum("wes,w->es", self.block(sl), weights[sl])
         return out
 
-    def __getitem__(self, idx: Any) -> EndSquare:
+    def __getitem__(self, idx: FrequencyIndex) -> EndSquare:
         """On the frequencies ``idx``."""
         return EndSquare(
             self.omega[idx], self.wavenumber[idx], self.z_ends, self.wet, self.depth, self.g

@@ -2,7 +2,7 @@
 so that its temporaries stay within a working-memory target.
 
 The drag fixed point needs, per evaluation, only sums over frequency (the element
-variances of seed 001 eqs. 5.2.3–5.2.5), and every frequency is solved on its own
+variances of Tuah (1982), eqs. 5.2.3–5.2.5), and every frequency is solved on its own
 (eq. 5.2.6): the load assembly, the direct or Foss solve and the variance sums of one
 evaluation run over consecutive blocks of frequencies, each block's temporaries freed
 before the next.  The block length comes from the working-memory target
@@ -13,6 +13,10 @@ only regrouped; tested for blocks of 1, 7 and all frequencies).
 Settings: ``STOCHCABLE_WORKING_MEMORY_MB`` (environment variable, read at every call;
 default :data:`WORKING_MEMORY_MB`) is the target of one block's temporaries;
 :func:`frequency_block` fixes the block length instead (tests, benchmarks).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -22,9 +26,16 @@ import contextvars
 import os
 from collections.abc import Iterator
 
+import numpy as np
+
 from stochcable.errors import InputError
 
+#: Frequencies of a grid: a slice or an index array (the last axis of per-frequency
+#: arrays).
+FrequencyIndex = slice | np.ndarray
+
 __all__ = [
+    "FrequencyIndex",
     "WORKING_MEMORY_MB",
     "frequency_block",
     "frequency_slices",

@@ -1,7 +1,7 @@
 """The element wave kinematics in closed form, NumPy: the consistent moments and the
 mean square of the wave velocity integrated exactly along straight elements
 (:func:`kinematics_block`; the model and its formulas in
-:mod:`stochcable.dynamics.loads.element_kinematics`, seed 001 eqs. 5.2.8–5.2.11).
+:mod:`stochcable.dynamics.loads.element_kinematics`, Tuah (1982), eqs. 5.2.8–5.2.11).
 
 The integrals are sums of exponentials e^{e0 + αξ} with e0, α linear in the element's
 geometry: ∫ N_i e^{…} dξ by φ1(x) = (e^x − 1)/x and ψ(x) = ((x − 1)e^x + 1)/x² of an
@@ -9,6 +9,10 @@ argument with Re x <= 0 (factored at the endpoint where the exponential is large
 overflow), as series near x = 0.  The compiled loop
 (:mod:`stochcable.dynamics.loads.kinematics_kernels`) evaluates the same formulas element by
 element for large grids; this form is the reference and the path without numba.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

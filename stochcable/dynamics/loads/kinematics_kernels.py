@@ -4,7 +4,7 @@ kinematics_block` forms with NumPy.
 
 Per element (wet part ξ ∈ [p, q], L = q − p) and frequency it evaluates the closed
 forms of :mod:`~stochcable.dynamics.loads.kinematics_closed_forms` for the kinematics of
-seed 001 eqs. 5.2.8–5.2.11 (:func:`~stochcable.dynamics.loads.element_kinematics.
+Tuah (1982), eqs. 5.2.8–5.2.11 (:func:`~stochcable.dynamics.loads.element_kinematics.
 element_wave_kinematics`): with E₁ = k z − i k χ, E₂ = −k(z + 2h) − i k χ (linear in ξ
 along the element, slopes α₁ = k dz − i k dχ and α₂ = −k dz − i k dχ) and
 D = 1 − e^{−2kh},
@@ -22,7 +22,7 @@ D = 1 − e^{−2kh},
 
 The NumPy form makes ≈ 30 passes over (frequency × element) temporaries, evaluating the
 series and the closed forms everywhere, with three complex exponentials per element and
-frequency (≈ 25 ns each: libm's cos and sin).  Here, per chunk of ≈ 512 elements ×
+frequency (libm's cos and sin).  Here, per chunk of ≈ 512 elements ×
 frequencies, vectorized passes form the phases (the same angles, rounded the same way),
 their cos and sin (in line: Cody–Waite reduction on π/2 and Taylor series, within an ulp
 or two of libm's; libm beyond |θ| = 1e6) and the series of φ1 and ψ on every entry; then
@@ -31,12 +31,8 @@ factoring ends and the two e^{2 Re E} of the mean squares (deep water: the squar
 e^{Re E}; in finite depth their own, as in the NumPy form, so that K₁ + K₂ − 2e^{−2kh}L
 cancels the same way, to exactly 0 on the seabed), the closed forms where |x| >= 0.5
 (x⁻¹ = x̄/|x|² once) and the combinations.  The factors of a frequency (D, e^{−2kh})
-are formed once per call.  :func:`~stochcable.dynamics.loads.element_kinematics.
-element_wave_kinematics` on 1,000 elements × 2,000 frequencies: ≈ 220 → 110 ms at
-h = 200 m, 155 → 80 ms in deep water (≈ 110 → 55 and 80 → 40 ns an entry) in blocks of
-16 frequencies, whose scattered writes of the element-major moments cost ≈ 15 ns an
-entry: 42 and 27 ns with the whole grid as one block, as
-:meth:`~stochcable.dynamics.loads.element_kinematics.KinematicsBlocks.form` calls it.
+are formed once per call: half the time of the NumPy form (measured in
+docs/benchmarks/dynamics.md, "Element wave kinematics").
 
 The same formulas: equal to the NumPy form to a few ulps of each element's largest
 value (libm's exponential against NumPy's vectorized one, e^{2a} as (e^a)² in deep
@@ -47,8 +43,12 @@ element_wave_kinematics`).  A wholly dry element gets exact zeros (the NumPy for
 multiplies e^{2kz} at its dry end by L = 0: NaN once 2kz > 709, 97 m above the water at
 6 rad/s).
 
-Imported lazily (numba costs ≈ 0.2 s to import); compiled with ``cache=True``
+Imported lazily (numba's import is slow); compiled with ``cache=True``
 (:func:`stochcable.compiled.jit_cached`).  Single-threaded (one thread per worker).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

@@ -1,16 +1,27 @@
 """The sea's input channels: its spectrum as a function, one channel per direction of a
 short-crested sea, and a channel's spectrum swapped for another sea state's (the
 engine's reuse of a line's inputs across sea states,
-:mod:`stochcable.dynamics.groups.seainputs`)."""
+:mod:`stochcable.dynamics.groups.seainputs`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
 import copy
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import TypeVar
 
 import numpy as np
+
+from stochcable.scene.model import Sea, Spectrum
+
+#: A channel (:class:`~stochcable.dynamics.loads.channels.Channel`, which imports this
+#: module): :func:`with_spectrum` returns the type it is given.
+ChannelT = TypeVar("ChannelT")
 
 __all__ = [
     "direction_channel",
@@ -21,7 +32,7 @@ __all__ = [
 ]
 
 
-def with_spectrum(channel: Any, density: Callable[[np.ndarray], np.ndarray]) -> Any:
+def with_spectrum(channel: ChannelT, density: Callable[[np.ndarray], np.ndarray]) -> ChannelT:
     """``channel`` (a :class:`~stochcable.dynamics.loads.channels.Channel`) with the spectrum
     ``density`` (sampled on its grid) instead of its own; its transfer functions shared
     (the lazy nodal kinematics not computed)."""
@@ -32,13 +43,13 @@ def with_spectrum(channel: Any, density: Callable[[np.ndarray], np.ndarray]) -> 
 
 
 def sea_channel_densities(
-    sea: Any, g: float
+    sea: Sea, g: float
 ) -> list[tuple[str, float, Callable[[np.ndarray], np.ndarray]]]:
     """The sea's input channels: (name, heading [rad], ω -> spectrum).  A long-crested
     sea is one channel "sea"; a short-crested one a channel "sea@<heading in deg>" per
     discrete direction k (:meth:`stochcable.scene.environment.Sea.direction_set`) with
     the share w_k S(ω) of the spectrum: independent inputs whose variances add (the
-    directional spectrum S(ω)D(θ), seed 001 §5.1 per direction)."""
+    directional spectrum S(ω)D(θ), Tuah (1982), §5.1 per direction)."""
     density = spectrum_callable(sea.spectrum, g)
     ds = sea.direction_set()
     if ds is None:
@@ -49,7 +60,7 @@ def sea_channel_densities(
     ]
 
 
-def sea_channel_headings(sea: Any) -> dict[str, float]:
+def sea_channel_headings(sea: Sea) -> dict[str, float]:
     """The heading [rad] of each of the sea's input channels by name
     (:func:`sea_channel_densities`: ``{"sea": β}`` for a long-crested sea, one
     ``"sea@<deg>"`` per direction θ_k of a short-crested one)."""
@@ -67,7 +78,7 @@ def direction_channel(heading: float) -> str:
     return f"sea@{0.0 if abs(deg) < 1e-9 else deg:.6g}"
 
 
-def spectrum_callable(spec: Any, g: float) -> Callable[[np.ndarray], np.ndarray]:
+def spectrum_callable(spec: Spectrum, g: float) -> Callable[[np.ndarray], np.ndarray]:
     """ω -> S(ω) of a scene spectrum ``spec`` (one-sided, zero at ω <= 0), ω in
     [rad/s], S in [m²·s/rad]; ``g`` [m/s²] for the spectra that need it."""
 

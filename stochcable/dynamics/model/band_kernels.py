@@ -4,13 +4,13 @@ sweep over the rows (:func:`cholesky_band_solve`).
 X is node-major (n_free_dof, k): one row per DOF, the frequencies and channels (real
 and imaginary parts side by side) along the row.  LAPACK's ``dpbtrs`` solves column by
 column and takes the columns contiguous, so SciPy transposed X in and out at every
-call (two strided copies of the whole block) around a level-2 solve: ≈ 30 ms for 800
-DOFs and 2,000 columns.  Here the forward (Uᵀy = x) and the backward (Ux = y)
-substitutions run row by row, each step a contiguous multiply-add over the whole row
-(≈ 1.5 ms, in place, no copy).  The same operations in another order: equal to
-round-off (≈ 1e-16 relative).
+call (two strided copies of the whole block) around a level-2 solve.  Here the forward
+(Uᵀy = x) and the backward (Ux = y) substitutions run row by row, each step a
+contiguous multiply-add over the whole row, in place, no copy (measured in
+docs/benchmarks/dynamics.md, "Banded Cholesky solve").  The same operations in another
+order: equal to round-off (≈ 1e-16 relative).
 
-Imported lazily (numba costs ≈ 0.2 s to import); compiled with ``cache=True``
+Imported lazily (numba's import is slow); compiled with ``cache=True``
 (:func:`stochcable.compiled.jit_cached`).
 """
 

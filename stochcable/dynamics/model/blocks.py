@@ -15,6 +15,7 @@ need that depends neither on the sea nor on the drag.
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -22,7 +23,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from stochcable.compiled import KERNEL_MIN_ENTRIES, optional_kernel
-from stochcable.dynamics.model.solvers import band_from_blocks, tridiagonal_blocks
+from stochcable.dynamics.model.solvers import MatrixLike, band_from_blocks, tridiagonal_blocks
 from stochcable.dynamics.model.system import (
     LineSystem,
 )
@@ -33,7 +34,7 @@ from stochcable.errors import (
 from stochcable.line.fem import FEModel
 
 
-def _band_kernel() -> Any:
+def _band_kernel() -> Callable[[np.ndarray, np.ndarray], np.ndarray] | None:
     """:func:`stochcable.dynamics.model.band_kernels.cholesky_band_solve`, or None without
     numba or with ``STOCHCABLE_NUMBA=0`` (SciPy's ``cho_solve_banded`` then)."""
     return optional_kernel("stochcable.dynamics.model.band_kernels", "cholesky_band_solve")
@@ -64,7 +65,7 @@ def trapezoid_weights(w: np.ndarray) -> np.ndarray:
 NodeBlocks = tuple[np.ndarray, np.ndarray]
 
 
-def node_blocks(a: Any, d: int) -> NodeBlocks:
+def node_blocks(a: MatrixLike, d: int) -> NodeBlocks:
     """Node blocks (D, O) of a symmetric block-tridiagonal model matrix.
 
     A canonical CSR matrix (sorted, no duplicates: the FE assembly's) is read from its
@@ -251,7 +252,7 @@ class LinePrep:
         #: frequency-independent arrays computed on first use (modal matrices, residual
         #: flexibility, end basis, …), keyed by what they depend on
         self.cache: dict[Any, Any] = {}
-        self._chol: Any = None
+        self._chol: np.ndarray | None = None
 
     # used by the direct solve, its conditioning check and hand-built channels only:
     # computed on first use (≈ 0.2 ms of every Foss analysis of the reference chain)

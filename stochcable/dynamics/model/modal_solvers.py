@@ -1,4 +1,4 @@
-"""Modal frequency-domain solves of ``M_T U'' + C U' + K U = F`` (seed 001 §5.3;
+"""Modal frequency-domain solves of ``M_T U'' + C U' + K U = F`` (Tuah 1982, §5.3;
 DESIGN.md "Solution: direct and Foss"), in the layout of
 :mod:`stochcable.dynamics.model.solvers` (frequency first, ``Z(omega) = K - omega^2 M +
 i omega C``).
@@ -11,6 +11,10 @@ i omega C``).
 - :func:`solve_modal` — truncated modal solve (Foss or direct in modal
   coordinates) with static correction for the truncated modes.
 - :func:`auto_mode_count` — how many modes a frequency range needs.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -320,7 +324,7 @@ def foss_transfer(foss: FossModes, F_hat: np.ndarray, omega: np.ndarray) -> np.n
     Notes
     -----
     ``z(omega) = sum_j chi_j (chi_j^T F_hat) / (a_j (i omega - lambda_j))`` (DESIGN.md;
-    seed 001 eqs. 5.3.27-5.3.29), evaluated as ``chi diag(1/(i w - lambda)) G^{-1}
+    Tuah (1982), eqs. 5.3.27-5.3.29), evaluated as ``chi diag(1/(i w - lambda)) G^{-1}
     chi^T F_hat`` (see :func:`foss_decomposition`): ``O(n^2)`` per frequency.
     """
     w = _v.float_array("omega", omega, "rad/s", nonnegative=True)

@@ -1,4 +1,4 @@
-"""Frequency-domain solves of ``M_T U'' + C U' + K U = F`` (seed 001 §5.3; DESIGN.md
+"""Frequency-domain solves of ``M_T U'' + C U' + K U = F`` (Tuah 1982, §5.3; DESIGN.md
 "Solution: direct and Foss").
 
 Harmonic quantities are ``Re{X e^{i omega t}}``, so the dynamic matrix is
@@ -23,16 +23,21 @@ frequencies is a batch of linear systems); the response has the same layout as
 
 Singular dynamic matrices (undamped resonance) raise :class:`SolverError` naming the
 frequency and the mode; no function returns inf or NaN.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from numpy.typing import ArrayLike
 
 from stochcable import validation as _v
 from stochcable.errors import InputError, SolverError
@@ -49,7 +54,10 @@ SINGULAR_CONDITION = 1e12
 _CHUNK_BYTES = 64 * 2**20
 
 
-Matrix = Any  # numpy.ndarray or scipy.sparse matrix
+#: A validated matrix: dense or CSR.
+Matrix = np.ndarray | sp.csr_matrix
+#: A matrix as given: array-like or any scipy.sparse matrix or array.
+MatrixLike = ArrayLike | sp.spmatrix | sp.sparray
 
 
 # ---------------------------------------------------------------------------------
@@ -57,7 +65,7 @@ Matrix = Any  # numpy.ndarray or scipy.sparse matrix
 # ---------------------------------------------------------------------------------
 
 
-def as_matrix(name: str, a: Any, n: int | None = None) -> Matrix:
+def as_matrix(name: str, a: MatrixLike, n: int | None = None) -> Matrix:
     """``a`` as a float matrix (CSR when sparse), square and of size ``n`` when given
     (InputError naming ``name`` otherwise)."""
     if sp.issparse(a):
@@ -75,7 +83,9 @@ def as_matrix(name: str, a: Any, n: int | None = None) -> Matrix:
     return a
 
 
-def system_matrices(K: Any, M: Any, C: Any) -> tuple[Matrix, Matrix, Matrix | None]:
+def system_matrices(
+    K: MatrixLike, M: MatrixLike, C: MatrixLike | None
+) -> tuple[Matrix, Matrix, Matrix | None]:
     """K, M and C (or None) validated by :func:`as_matrix`, all of K's size."""
     K_ = as_matrix("K", K)
     n = K_.shape[0]
@@ -84,7 +94,7 @@ def system_matrices(K: Any, M: Any, C: Any) -> tuple[Matrix, Matrix, Matrix | No
     return K_, M_, C_
 
 
-def load_array(F: Any, n: int, n_omega: int) -> tuple[np.ndarray, bool]:
+def load_array(F: ArrayLike, n: int, n_omega: int) -> tuple[np.ndarray, bool]:
     """The load as a complex (n_omega, n, n_rhs) array and whether it had no n_rhs axis."""
     f = np.asarray(F)
     if not np.iscomplexobj(f):
@@ -303,8 +313,8 @@ def solve_direct(
 
     Notes
     -----
-    The reference solution of DESIGN.md "Solution: direct and Foss" (seed 001
-    eq. 5.2.6 in the frequency domain).
+    The reference solution of DESIGN.md "Solution: direct and Foss" (Tuah
+    1982, eq. 5.2.6 in the frequency domain).
     """
     K_, M_, C_ = system_matrices(K, M, C)
     n = K_.shape[0]
@@ -469,7 +479,7 @@ def solve_band_stacked(
     return out
 
 
-def _as_blocks(name: str, a: Any, b: int, n: int | None) -> Blocks:
+def _as_blocks(name: str, a: Blocks | MatrixLike, b: int, n: int | None) -> Blocks:
     if isinstance(a, tuple):
         if len(a) != 3:
             raise InputError(

@@ -1,4 +1,4 @@
-"""The assembled linear system of one line (seed 001 ch. 3 and §5.2): the
+"""The assembled linear system of one line (Tuah 1982, ch. 3 and §5.2): the
 frequency-independent model (:class:`LineSystem`, :func:`build_line_system`), the choice
 of the modes the Foss solve keeps, and the objects the later stages exchange: the
 linearized drag (:class:`Damping`), the harmonic response (:class:`Response`) and the
@@ -8,6 +8,10 @@ Pipeline position: statics -> **system** -> loads (:mod:`~stochcable.dynamics.so
 -> drag fixed point (:mod:`~stochcable.dynamics.groups.line_fixed_point`) -> solve
 (:mod:`~stochcable.dynamics.solve.line_solve`) -> outputs
 (:mod:`~stochcable.dynamics.outputs.line_result`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -34,7 +38,7 @@ from stochcable.results.documents import (
     FormedOnAccess,
     LinearizationRecord,
 )
-from stochcable.scene.model import AnalysisSettings, Line, Scene
+from stochcable.scene.model import AnalysisSettings, Environment, Line, Scene
 
 Progress = Callable[[str, Mapping[str, Any]], None]
 """``progress(stage, info)``: called with the stage name ("statics", "model", "modes",
@@ -115,7 +119,7 @@ class LineSystem:
     current_el: np.ndarray
     current_node: np.ndarray
     drag_nodes: np.ndarray
-    environment: Any
+    environment: Environment
     structural_damping: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
@@ -172,7 +176,7 @@ class Damping:
     b_normal: np.ndarray
     b_axial: np.ndarray
     b_node: np.ndarray
-    model: Any = None
+    model: FEModel | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_cache", {})

@@ -2,6 +2,12 @@
 large-motion indicators and the drag ratios (:func:`line_indicators`), each with its
 warning.  The checks of the grid's and the mesh's resolution are in
 :mod:`stochcable.dynamics.outputs.resolution`.
+
+References
+----------
+Bliet, A. (1984), Dynamic analysis of single span cables, PhD thesis, Massachusetts
+Institute of Technology.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -29,7 +35,7 @@ from stochcable.dynamics.model.system import (
     LineSystem,
 )
 from stochcable.dynamics.outputs.resolution import LineModes, own_modes
-from stochcable.dynamics.second_order import irvine_lambda2
+from stochcable.dynamics.residuals.second_order import irvine_lambda2
 from stochcable.errors import (
     PhysicsWarning,
     warn,
@@ -37,6 +43,7 @@ from stochcable.errors import (
 from stochcable.results.documents import (
     LineIndicators,
 )
+from stochcable.results.records import LinearizationRecord, ResponseStats
 from stochcable.scene.units import unit_labels
 
 # ------------------------------------------------------------------ quality indicators
@@ -50,7 +57,7 @@ BAND_FRACTION = 0.01
 #: Large-motion flag: node motion σ above this fraction of the line's sag.
 MOTION_SAG_FRACTION = 0.1
 #: ... on a line whose sag governs its stiffness: Irvine's λ² at least this.  The
-#: elastic catenary's stiffness is (EA/L)/(1 + λ²/12) (Irvine 1981; seed 000 eq. 4.3):
+#: elastic catenary's stiffness is (EA/L)/(1 + λ²/12) (Irvine 1981; Bliet (1984), eq. 4.3):
 #: below λ² = 1 the sag takes less than 8 % of it, so even a 30 % change of sag moves the
 #: stiffness by a few % and a taut line carried by its fairlead stays linear (the taut
 #: rope of docs/accuracy/lines.md: λ² = 0.05, motion 0.47 of its sag, FD = TD to 0.02 %).
@@ -95,7 +102,7 @@ def line_indicators(
     linearization: Linearization,
     tension_std: np.ndarray,
     motion_std: np.ndarray,
-    end_stats: Mapping[str, Any],
+    end_stats: Mapping[str, ResponseStats],
     modes: LineModes | None = None,
 ) -> LineIndicators:
     """Quality indicators of the linear model of one line, with PhysicsWarnings.
@@ -141,7 +148,7 @@ def line_indicators(
     of the fluid acceleration normal to the element (the sea channel).
     Modal damping ζ_j = φ_jᵀCφ_j/(2ω_j) with C = drag + seabed + structural damping
     (the diagonal of the modal damping; the coupling terms are ignored).
-    Large motion: the tangent model (seed 001 §3) is linear about the static shape;
+    Large motion: the tangent model (Tuah 1982, §3) is linear about the static shape;
     the geometric stiffness of a sagging line depends on its sag at first order
     (T ≈ wL²/8·1/sag for a shallow catenary), so a motion σ of 10 % of the sag (a
     3σ excursion of 30 %) changes the stiffness by about as much as a linear model
@@ -196,7 +203,7 @@ def at_rest_zeroed(sigma: np.ndarray, current: np.ndarray) -> tuple[np.ndarray, 
 
 
 def _drag_ratios(
-    system: LineSystem, channels: tuple[Channel, ...], rec: Any, w: np.ndarray
+    system: LineSystem, channels: tuple[Channel, ...], rec: LinearizationRecord, w: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Borgman variance ratio and drag/inertia ratio per element (:func:`line_indicators`
     Notes). [-]"""
@@ -217,7 +224,7 @@ def _drag_ratios(
 
 
 def _snap(
-    system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, Any]
+    system: LineSystem, tension_std: np.ndarray, end_stats: Mapping[str, ResponseStats]
 ) -> tuple[float, bool]:
     """Snap margin min (mean − 3σ)/|mean| over the elements and ends, and whether some
     mean − 3σ < 0 (PhysicsWarning naming the worst place)."""

@@ -4,21 +4,21 @@
 Dynamic effective tension
 -------------------------
 Per element δT = (EA/l0)·e·(u_b − u_a), the first-order change of T = EA(l/l0 − 1)
-(seed 001 eqs. 3.1.8–3.1.11: the K_NL part of the tangent stiffness).  The "geometric"
+(Tuah 1982, eqs. 3.1.8–3.1.11: the K_NL part of the tangent stiffness).  The "geometric"
 term (T/l)(I − eeᵀ)Δu of the tangent stiffness rotates the element force; it changes
 its direction, not its magnitude, and contributes to the tension only at second order,
 so it is not part of δT.  Slack elements (T <= 0) use the model's reduced EA.  The end
 tensions are computed with the response (:mod:`stochcable.dynamics.solve.line_solve`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
-from stochcable.dynamics.drag_residual import drag_residual
-from stochcable.dynamics.geometric_residual import geometric_residual
 from stochcable.dynamics.loads.channels import (
     Channel,
 )
@@ -39,8 +39,12 @@ from stochcable.dynamics.outputs.resolution import (
     surface_resolution_check,
     tail_check,
 )
-from stochcable.dynamics.second_order import second_order_tension, with_second_order
-from stochcable.line.fem import SLACK_EA_RATIO
+from stochcable.dynamics.residuals.corrected import corrected_stats
+from stochcable.dynamics.residuals.drag_residual import drag_residual
+from stochcable.dynamics.residuals.geometric_residual import geometric_residual
+from stochcable.dynamics.residuals.residual_lines import EndInfluence
+from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
+from stochcable.line.fem import SLACK_EA_RATIO, FEModel
 from stochcable.results.documents import (
     LineResult,
     stats_from_validated,
@@ -177,13 +181,18 @@ def line_result(
     end_force = _end_force_transfer(model, resp, n_ch)
     residual = {}
     std = {e: stats[e].std for e in stats}
+    shared = EndInfluence(system, linearization.damping)  # (one solve for both)
     for key, fn in (("drag_residual", drag_residual), ("geometric_residual", geometric_residual)):
         if getattr(settings.linearization, key) and linearization.record is not None:
             residual[key] = (
-                fn(system, channels, linearization, std)
+                fn(system, channels, linearization, std, influence=shared)
                 if alone
                 else ResidualRecord.not_computed("a line on free bodies is not covered", std)
             )
+    applied = [r for r in residual.values() if r.computed]
+    linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
+    if applied:  # the end statistics with the residuals (their spectra's moments added)
+        stats = {e: corrected_stats(stats[e], e, applied, settings.duration) for e in linear}
     return LineResult(
         name=system.name,
         omega=w,
@@ -201,6 +210,7 @@ def line_result(
         motion_std=motion_std,
         end_a=stats["end_a"],
         end_b=stats["end_b"],
+        linear=linear,
         linearization=linearization.record,
         modes_omega=np.asarray(system.modes.omega).copy(),
         modes_listed=_listed_modes(system.modes.omega, float(w[-1])),
@@ -246,7 +256,7 @@ def _tension_transfer(system: LineSystem, resp: Response, n_ch: int) -> np.ndarr
 
 
 def _motion_transfer(
-    model: Any, resp: Response, n_ch: int, freq: slice = slice(None)
+    model: FEModel, resp: Response, n_ch: int, freq: slice = slice(None)
 ) -> np.ndarray:
     """Node motion transfer functions on x, y, z on the frequencies ``freq``, (n_ch,
     n_nodes, 3, n_f) (zero on the components a 2-D model lacks). [m/unit]"""
@@ -267,7 +277,7 @@ def _motion_transfer(
     return motion_h
 
 
-def _end_force_transfer(model: Any, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
+def _end_force_transfer(model: FEModel, resp: Response, n_ch: int) -> dict[str, np.ndarray]:
     """Support force transfer functions on x, y, z per end, (n_ch, 3, n_omega). [N/unit]"""
     comps = list(model.components)
     d = model.dim

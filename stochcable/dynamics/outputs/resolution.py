@@ -5,15 +5,19 @@ by the mesh near the surface (:func:`surface_resolution_check`) and of the respo
 tail by ω_max where the excitation goes on above it (:func:`tail_check`,
 :func:`excitation_end`).  The quality indicators of the response are in
 :mod:`stochcable.dynamics.outputs.indicators`.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.model.blocks import add_blocks, block_matvec, line_prep, trapezoid_weights
@@ -94,7 +98,7 @@ def _nearest_spacing(omega: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.n
 RESONANCE_PEAK_ERROR = 0.01
 
 
-def peak_quadrature_error(bandwidth: Any, spacing: Any) -> np.ndarray:
+def peak_quadrature_error(bandwidth: ArrayLike, spacing: ArrayLike) -> np.ndarray:
     """Largest relative error of the trapezoid rule on a resonant peak.
 
     Parameters
@@ -171,7 +175,7 @@ def resolution_check(
 
 #: Largest ratio of the wave-velocity σ at the two ends of an element's wet part before
 #: :func:`surface_resolution_check` warns.  The drag linearization takes one B ∝ σ per
-#: element (seed 001 eq. 5.2.2) while σ decays like e^{k̄z} from the surface; on the
+#: element (Tuah 1982, eq. 5.2.2) while σ decays like e^{k̄z} from the surface; on the
 #: inclined guy (docs/ACCURACY.md) the ratio of its top element is 2.18 / 1.59 / 1.32 /
 #: 1.17 at 40 / 80 / 160 / 320 elements, and the fairlead tension σ is off its
 #: 320-element value by +8.6 / +2.9 / +0.46 % (with uniform B the 40-element value is

@@ -1,4 +1,4 @@
-"""The load assembly of one line (the right-hand side of seed 001 eq. 5.2.6 with
+"""The load assembly of one line (the right-hand side of Tuah (1982), eq. 5.2.6 with
 prescribed ends) from its inputs (:class:`~stochcable.dynamics.solve.node_inputs.LineInputs`,
 re-exported here with :func:`line_inputs` and :func:`with_spectra`).
 
@@ -8,6 +8,10 @@ drag-independent loads on any block of frequencies (kept for the whole grid only
 they fit the working-memory target); :func:`drag_blocks`, :func:`free_load` and
 :func:`end_loads` assemble the drag-dependent loads at every iteration of the drag
 fixed point.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

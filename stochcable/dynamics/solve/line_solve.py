@@ -1,4 +1,4 @@
-"""The direct and the Foss modal solve of one line (seed 001 eq. 5.2.6, §5.3), the
+"""The direct and the Foss modal solve of one line (Tuah 1982, eq. 5.2.6, §5.3), the
 support reactions and the end tensions.
 
 End tensions are the change of the magnitude of the force on each support,
@@ -9,6 +9,10 @@ element's δT (:func:`stochcable.dynamics.outputs.line_result.element_tension_tr
 are small (tested).  They live here, not in :mod:`~stochcable.dynamics.outputs.line_result`,
 because every :class:`~stochcable.dynamics.model.system.Response` carries them (the coupled
 solve and the time series use them too).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -163,7 +167,7 @@ def _foss_free(
     modal_direct: bool = False,
 ) -> np.ndarray:
     """Foss modal solve on the free DOFs, rhs (n_free_dof, n_w, n_ch), with the static
-    correction of the truncated modes (seed 001 §5.3;
+    correction of the truncated modes (Tuah 1982, §5.3;
     :func:`stochcable.dynamics.model.modal_solvers.foss_decomposition`): :func:`_foss_solver`
     applied to ``rhs``."""
     return _foss_solver(system, prep, c, modal_direct)(rhs, w)
@@ -314,9 +318,9 @@ def solve(
 
     Notes
     -----
-    Free rows (seed 001 eq. 5.2.6 with prescribed ends):
+    Free rows (Tuah 1982, eq. 5.2.6 with prescribed ends):
     (K_ff − ω²M_T,ff + iωC_ff)U_f = [C_d V + B_I A]_f − (K_fb − ω²M_T,fb + iωC_fb)u_b,
-    solved directly or by Foss modal superposition (seed 001 §5.3) with the static
+    solved directly or by Foss modal superposition (Tuah 1982, §5.3) with the static
     correction of the truncated modes.  For Foss, a moving end is split into the exact
     quasi-static following U_qs = −K_ff⁻¹K_fb u_b and a dynamic part loaded by the
     inertia and damping forces of u_b and U_qs (the classical support-excitation

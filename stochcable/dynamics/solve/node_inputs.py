@@ -6,7 +6,7 @@ sea, end motions) into what the load assembly and the variance sums of one line 
 the σ weights (trapezoid × spectrum), the weighted mean square of the fluid velocity,
 the end displacements and, on any block of frequencies, the consistent element moments
 of the fluid velocity (:meth:`LineInputs.moments_at`) and the exact Morison inertia
-load (:meth:`LineInputs.inertia_at`, seed 001 eq. 5.2.6).  Those two are not kept for
+load (:meth:`LineInputs.inertia_at`, Tuah (1982), eq. 5.2.6).  Those two are not kept for
 the whole grid: they are gathered from the channels' element kinematics (which the
 channels hold once) for the block at hand, so the drag fixed point holds one block of
 them at a time (:mod:`stochcable.dynamics.loads.freqblocks`); where the whole grid fits a
@@ -14,12 +14,16 @@ quarter of the working-memory target they are kept after the first use (a small 
 forms them once).  :attr:`LineInputs.moments` and :attr:`LineInputs.inertia_load`
 give the whole grid (kept after the first access: the solves of the lines of a coupled
 group read them at once).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
+from collections.abc import Hashable
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -29,8 +33,8 @@ from stochcable.dynamics.loads.channels import (
     element_moments,
     inertia_blocks,
 )
-from stochcable.dynamics.loads.element_parts import ArrayMoments
-from stochcable.dynamics.loads.freqblocks import whole_grid, working_memory_bytes
+from stochcable.dynamics.loads.element_parts import ArrayMoments, Components, MomentParts
+from stochcable.dynamics.loads.freqblocks import FrequencyIndex, whole_grid, working_memory_bytes
 from stochcable.dynamics.model.blocks import (
     block_matvec,
     element_blocks,
@@ -39,6 +43,7 @@ from stochcable.dynamics.model.blocks import (
     trapezoid_weights,
 )
 from stochcable.dynamics.model.system import LineSystem
+from stochcable.line.fem import FEModel
 
 __all__ = ["LineInputs", "line_inputs", "weighted_mean_square", "with_spectra"]
 
@@ -85,7 +90,7 @@ class LineInputs:
     ub: np.ndarray | None
     weights: np.ndarray
     square: np.ndarray | None
-    fluid: tuple[Any, ...]
+    fluid: tuple[MomentParts | ArrayMoments | None, ...]
     comps: tuple[int, ...]
     inertia_el: np.ndarray
     moment_inertia: tuple[bool, ...]
@@ -223,7 +228,7 @@ class LineInputs:
             self.cache["inertia"] = self.inertia_at()
         return self.cache["inertia"]
 
-    def subset(self, idx: np.ndarray, weights: np.ndarray, square: np.ndarray | None) -> Any:
+    def subset(self, idx: np.ndarray, weights: np.ndarray, square: np.ndarray | None) -> LineInputs:
         """These inputs on the frequencies ``omega[idx]`` with the σ ``weights`` and
         mean ``square`` given
         (:func:`stochcable.dynamics.linearization.coarse_grid.subset_inputs`)."""
@@ -258,7 +263,7 @@ def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs
     """The channels of a line in the node layout (:class:`LineInputs`), sampled on the
     channels' common grid: fluid velocity at the attachment nodes, the channels'
     element moments (the Morison inertia load formed from them, exact along the
-    elements, seed 001 eq. 5.2.6), end displacements, trapezoid × spectrum weights and
+    elements, Tuah (1982), eq. 5.2.6), end displacements, trapezoid × spectrum weights and
     the weighted mean square of the fluid velocity."""
     model = system.model
     comps = list(model.components)
@@ -315,7 +320,7 @@ def line_inputs(system: LineSystem, channels: tuple[Channel, ...]) -> LineInputs
 
 
 def _weighted_square(
-    model: Any, channels: tuple[Channel, ...], weights: np.ndarray
+    model: FEModel, channels: tuple[Channel, ...], weights: np.ndarray
 ) -> np.ndarray | None:
     """Σ_i weight_i·∫Re(v vᴴ)dξ over the channels with a fluid velocity, on the model
     components, (n_el, d, d) (None without fluid velocity)."""
@@ -334,7 +339,7 @@ def _has_element_moments(ch: Channel) -> bool:
     return ch.element_velocity is not None or ch.element_velocity_parts is not None
 
 
-def _moment_source(model: Any, ch: Channel) -> Any:
+def _moment_source(model: FEModel, ch: Channel) -> MomentParts | ArrayMoments | None:
     """A channel's element moments as :class:`MomentParts` or :class:`ArrayMoments`
     (None without fluid velocity)."""
     if ch.element_velocity is None and ch.element_velocity_parts is not None:
@@ -344,7 +349,7 @@ def _moment_source(model: Any, ch: Channel) -> Any:
 
 
 def weighted_mean_square(
-    channel: Channel, weights: np.ndarray, comps: Any, idx: Any = slice(None)
+    channel: Channel, weights: np.ndarray, comps: Components, idx: FrequencyIndex = slice(None)
 ) -> np.ndarray | None:
     """Σ_ω weight·∫₀¹ Re(v vᴴ) dξ of a channel on the frequencies ``idx``, on the
     components ``comps``, (n_el, d, d) (None without fluid velocity): from the sea's
@@ -361,7 +366,7 @@ def weighted_mean_square(
     return np.einsum("weij,w->eij", sq, weights)
 
 
-def _spectrum_free(key: Any) -> bool:
+def _spectrum_free(key: Hashable) -> bool:
     """Caches of :class:`LineInputs` that do not depend on the channels' spectra (kept by
     :func:`with_spectra`): the base motion and load per solver, the end-motion
     projections, the attachments' velocity, the kept moments and inertia load.  Every

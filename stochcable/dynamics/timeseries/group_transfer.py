@@ -1,16 +1,15 @@
-"""Groups on the realization grid: the transfer functions of the time series (seed 001
-§5.1, eq. 5.3.29 and step 14), for lines coupled to bodies and for lines alone (the
+"""Groups on the realization grid: the transfer functions of the time series (Tuah
+1982, §5.1, eq. 5.3.29 and step 14), for lines coupled to bodies and for lines alone (the
 groups without bodies) by the same solve.
 
 The time series of :func:`stochcable.dynamics.timeseries.synthesis.simulate_timeseries` are the
-synthesis
-(:func:`stochcable.sea.realization.synthesize`) of transfer functions solved on the realization
+synthesis (:func:`stochcable.sea.realization.synthesize`) of transfer functions solved on the
+realization
 grid ω_m = mΔω inside the analysis band, driven by the same complex amplitudes as η.
 For a coupled group (lines attached to free bodies, :mod:`stochcable.dynamics.groups`)
 the drag linearization is done once on the analysis grid; with its converged linear
 drag (the lines' :class:`~stochcable.dynamics.model.system.Damping`, the bodies' drag σ) the group
-is
-a linear system, solved here again on the realization band by the same substructured
+is a linear system, solved here again on the realization band by the same substructured
 solve (:func:`stochcable.dynamics.groups.group.solve_group`): the channels and the body
 loads are evaluated on the band, the lines' support forces give the end tensions
 (:func:`stochcable.dynamics.solve.line_solve.end_tension_from_support`) and the body equation the
@@ -24,13 +23,16 @@ n_nodes × d × n_w × n_ch each) exist one chunk of frequencies at a time; the 
 holds about :data:`CHUNK_BYTES` of them (:func:`frequency_chunks`).  The solve is
 independent per frequency, so the chunked transfer equals the one-piece solve to
 round-off.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -47,6 +49,8 @@ from stochcable.dynamics.groups.inputs import (
 from stochcable.dynamics.groups.vessels import VesselRaos
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
+from stochcable.line.fem import FEModel
+from stochcable.scene.model import Line, Scene
 
 __all__ = [
     "CHUNK_BYTES",
@@ -122,7 +126,7 @@ def frequency_chunks(n_omega: int, entry_bytes: int, budget: int = CHUNK_BYTES) 
         yield slice(start, min(start + size, int(n_omega)))
 
 
-def vessel_raos(scene: Any, omega: np.ndarray) -> VesselRaos:
+def vessel_raos(scene: Scene, omega: np.ndarray) -> VesselRaos:
     """The 6-DOF RAOs of every prescribed body (vessel) of the scene on ``omega``, per
     wave heading (zero outside the frequency table). [m/m, rad/m]"""
     return VesselRaos(
@@ -135,12 +139,12 @@ def vessel_raos(scene: Any, omega: np.ndarray) -> VesselRaos:
     )
 
 
-def _scene_line(scene: Any, name: str) -> Any:
+def _scene_line(scene: Scene, name: str) -> Line:
     return next(ln for ln in scene.lines if ln.name == name)
 
 
 def _group_on(
-    scene: Any, group: CoupledGroup, omega: np.ndarray
+    scene: Scene, group: CoupledGroup, omega: np.ndarray
 ) -> tuple[GroupSystem, tuple[str, ...], tuple[tuple[str, str] | None, ...]]:
     """The group's solve data on ``omega``: channels of every line (vessel ends in the
     sea channel), aligned on the group list as the analysis does (a line alone keeps
@@ -198,7 +202,7 @@ def _group_on(
     )
 
 
-def line_entry_bytes(model: Any, n_columns: int) -> int:
+def line_entry_bytes(model: FEModel, n_columns: int) -> int:
     """Bytes of a line's node arrays per frequency, the unit of the chunk budget.
 
     Parameters
@@ -217,7 +221,7 @@ def line_entry_bytes(model: Any, n_columns: int) -> int:
     return int(model.n_nodes * model.dim * max(int(n_columns), 1) * 16 * _ARRAYS_PER_ENTRY)
 
 
-def _entry_bytes(group: CoupledGroup, scene: Any) -> int:
+def _entry_bytes(group: CoupledGroup, scene: Scene) -> int:
     """Bytes of the group's node arrays per frequency (the chunk budget's unit)."""
     ds = None if scene.sea is None else scene.sea.direction_set()
     n_ch = (1 if ds is None else ds.count) + sum(
@@ -236,9 +240,9 @@ def _entry_bytes(group: CoupledGroup, scene: Any) -> int:
 
 
 def coupled_group_transfer(
-    scene: Any,
+    scene: Scene,
     group: CoupledGroup,
-    omega: Any,
+    omega: np.ndarray,
     *,
     budget: int = CHUNK_BYTES,
     timing: dict[str, float] | None = None,
@@ -272,9 +276,9 @@ def coupled_group_transfer(
     Notes
     -----
     The group's linear system at the converged drag: lines' drag ``group.dampings``,
-    body drag ``group.body_drag`` (seed 001 eq. 5.2.2 form with the current at the
+    body drag ``group.body_drag`` (Tuah 1982, eq. 5.2.2 form with the current at the
     drag point, Tᵀ diag(b) T on the body DOFs), the body equation
-    (seed 001 eq. 3.2.c.20) with the condensed lines (eqs. 3.3.8–3.3.10) solved exactly
+    (Tuah 1982, eq. 3.2.c.20) with the condensed lines (eqs. 3.3.8–3.3.10) solved exactly
     at every frequency — the same system as the frequency-domain result, so on a common
     frequency the transfer functions agree to round-off.
     """

@@ -1,24 +1,29 @@
-"""Time series of one realization (seed 001 §5.1, eq. 5.3.29 and step 14): the sea,
+"""Time series of one realization (Tuah 1982, §5.1, eq. 5.3.29 and step 14): the sea,
 the end motions, the end tensions of every line and the motions of the bodies, all
 synthesized from transfer functions solved on the realization grid: every group (a
 line alone, lines on bodies) by :mod:`stochcable.dynamics.timeseries.group_transfer`.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
+from stochcable.dynamics.groups.analysis import CoupledGroup
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.loads.sea_channels import direction_channel, sea_channel_headings
 from stochcable.dynamics.model.system import LineSystem
+from stochcable.line.statics import LineStatics
 from stochcable.results.documents import (
     TimeSeries,
 )
 from stochcable.scene.model import Scene, TimeSeriesSettings
-from stochcable.sea.realization import frequency_grid, simulate_sea, synthesize
+from stochcable.sea.realization import SeaRealization, frequency_grid, simulate_sea, synthesize
 from stochcable.sea.spreading import simulate_sea_directional
 
 # ---------------------------------------------------------------------- time series
@@ -27,7 +32,7 @@ from stochcable.sea.spreading import simulate_sea_directional
 def simulate_timeseries(
     scene: Scene,
     settings: TimeSeriesSettings,
-    groups: tuple[Any, ...],
+    groups: tuple[CoupledGroup, ...],
     *,
     timing: dict[str, float] | None = None,
 ) -> TimeSeries:
@@ -62,7 +67,7 @@ def simulate_timeseries(
     on the realization grid ω_m = mΔω, restricted to the analysis band
     [omega.min, omega.max] (zero outside, as the response spectra are), so η, end
     motions, tensions and body motions of one realization are mutually consistent
-    (seed 001 §5.1, eq. 5.3.29 and step 14).  Every group: its linear system at its
+    (Tuah 1982, §5.1, eq. 5.3.29 and step 14).  Every group: its linear system at its
     converged drag (lines' Damping, bodies' drag σ) solved on the band
     (:func:`stochcable.dynamics.timeseries.group_transfer.coupled_group_transfer`; an end on a
     vessel moves with the vessel RAO in the sea channel).  Vessels: their RAO times
@@ -142,7 +147,7 @@ class _Synthesis:
         self.n_t = int(round(settings.duration / settings.dt))
         self.sea = None
         self.elevation = None  # (the sea's η; a short-crested sea's sums its directions)
-        self.directions: dict[str, Any] = {}  # sea channel name -> its realization
+        self.directions: dict[str, SeaRealization] = {}  # sea channel name -> its realization
         if scene.sea is not None:
             spec, g = scene.sea.spectrum, scene.environment.g
 
@@ -164,7 +169,7 @@ class _Synthesis:
                 self.directions = {direction_channel(b): r for b, r in zip(ds.heading, reals)}
                 self.sea = reals[0]
                 self.elevation = np.sum([r.elevation for r in reals], axis=0)
-        self.reals: dict[tuple[str, str], Any] = {}
+        self.reals: dict[tuple[str, str], SeaRealization] = {}
 
     def realize_end_motions(self, probe: Mapping[str, tuple[Channel, ...]]) -> None:
         """One realization per end-motion channel, in the order of ``probe`` (lines)
@@ -221,11 +226,11 @@ class _Series:
     def add_line(
         self,
         name: str,
-        statics: Any,
+        statics: LineStatics,
         tr: dict[str, np.ndarray],
         syn: _Synthesis,
         kinds: tuple[str, ...],
-        sources: tuple[Any, ...],
+        sources: tuple[tuple[str, str] | None, ...],
         channels: tuple[str, ...],
     ) -> None:
         """End tensions: the static tension plus the synthesis of the transfer ``tr``."""
@@ -263,7 +268,7 @@ def _channels_on(scene: Scene, system: LineSystem, w: np.ndarray) -> tuple[Chann
 
 def _groups(
     scene: Scene,
-    groups: tuple[Any, ...],
+    groups: tuple[CoupledGroup, ...],
     probe: Mapping[str, tuple[Channel, ...]],
     syn: _Synthesis,
     out: _Series,
