@@ -32,6 +32,7 @@ __all__ = [
     "solve_statics",
     "scene_fe_models",
     "natural_modes",
+    "modes_of_scene",
 ]
 
 
@@ -176,3 +177,7 @@ def natural_modes(
         name: line_modes(model, count=count, added_mass=added_mass)
         for name, model in models.items()
     }
+
+
+#: The former name of :func:`natural_modes` on a scene (kept for the callers of it).
+modes_of_scene = natural_modes
