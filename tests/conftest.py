@@ -68,6 +68,17 @@ def _queued_s() -> float:
         return 0.0
 
 
+def fast_tier_wait_limit(load_per_core: float) -> float:
+    """The waiting limit [s]: FAST_TIER_WAIT_S times the load per core when above 1."""
+    return FAST_TIER_WAIT_S * max(1.0, load_per_core)
+
+
+def too_slow_for_the_fast_tier(cpu: float, own_wall: float, wait_limit: float) -> bool:
+    """The guard's rule: CPU [s] over FAST_TIER_CPU_S, or wall time out of the run queue
+    [s] over ``wait_limit``."""
+    return cpu > FAST_TIER_CPU_S or own_wall > wait_limit
+
+
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_call(item):
     cpu0, queued0, wall0 = _cpu_s(), _queued_s(), time.perf_counter()
@@ -89,8 +100,8 @@ def pytest_runtest_makereport(item, call):
         with open(log, "a", encoding="utf-8") as f:
             row = {"id": item.nodeid, "cpu": cpu, "own_wall": own_wall, "wall": wall}
             f.write(json.dumps({**row, "slow": slow}) + "\n")
-    wait_limit = FAST_TIER_WAIT_S * max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
-    if report.passed and not slow and (cpu > FAST_TIER_CPU_S or own_wall > wait_limit):
+    wait_limit = fast_tier_wait_limit(os.getloadavg()[0] / (os.cpu_count() or 1))
+    if report.passed and not slow and too_slow_for_the_fast_tier(cpu, own_wall, wait_limit):
         report.outcome = "failed"
         report.longrepr = (
             f"{item.nodeid}: too slow for the fast tier: {cpu:.1f} s of CPU, "
