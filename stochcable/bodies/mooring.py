@@ -20,7 +20,7 @@ import numpy as np
 from stochcable.bodies.rigid import geometric_stiffness, link_matrix
 from stochcable.line.banded import banded_solve, block_band_indices
 from stochcable.line.elements import stiffness_blocks
-from stochcable.line.statics import check_statics_options, line_statics
+from stochcable.line.statics import check_statics_options, solve_line_statics_unchecked
 from stochcable.scene.model import Scene
 
 __all__ = ["mooring_stiffness", "mooring_stiffness_and_maps", "end_condensation", "pose_map"]
@@ -153,7 +153,7 @@ def end_condensation(
                 pos = getattr(mesh, e).copy()
                 pos[comp] += sgn * h
                 m2 = dataclasses.replace(mesh, **{e: pos})
-                l2 = line_statics(m2, env, method, None, tolerance, 500)
+                l2 = solve_line_statics_unchecked(m2, env, method, None, tolerance, 500)
                 fs.append(
                     np.concatenate(
                         [(l2.force_a if p == "end_a" else l2.force_b)[comps] for p in ends]

@@ -43,7 +43,7 @@ from stochcable.bodies.rigid import (
 from stochcable.bodies.static_loads import _cross3, _full, _reduce, body_static_load
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.mesh import mesh_line
-from stochcable.line.statics import check_statics_options, line_statics
+from stochcable.line.statics import check_statics_options, solve_line_statics_unchecked
 from stochcable.scene.model import Scene
 from stochcable.validation import positive, positive_int
 
@@ -273,7 +273,7 @@ class _BodyPoses:
         return fref, (lref if lref > 0.0 else 1.0)
 
     def _line(self, mesh: Any, initial: np.ndarray | None = None) -> Any:
-        return line_statics(
+        return solve_line_statics_unchecked(
             mesh, self.env, self.method, initial, self.tolerance, self.max_iterations
         )
 

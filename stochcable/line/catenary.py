@@ -59,9 +59,9 @@ __all__ = [
     "CatenarySolution",
     "CatenaryLine",
     "catenary_solve",
+    "catenary_solve_unchecked",
     "catenary_from_top_tension",
     "catenary_line",
-    "elastic_catenary",
     "catenary_on_mesh",
     "check_reach",
     "newton_start",
@@ -292,10 +292,10 @@ def catenary_solve(
     A horizontal span of exactly 0 gives H = 0 (vertical, possibly folded line).
     """
     X, Z, L, w, ea = _check_common(horizontal_span, vertical_span, length, weight, ea)
-    return elastic_catenary(X, Z, L, w, ea, bool(seabed))
+    return catenary_solve_unchecked(X, Z, L, w, ea, bool(seabed))
 
 
-def elastic_catenary(
+def catenary_solve_unchecked(
     X: float, Z: float, L: float, w: float, ea: float, seabed: bool
 ) -> CatenarySolution:
     """:func:`catenary_solve` for inputs already checked: floats, X >= 0 and Z, w
@@ -447,7 +447,7 @@ def catenary_from_top_tension(
         )
     H = brentq(lambda h: spans(h)[1] - Z, lo, hi, xtol=1e-14 * Tb, rtol=1e-15, maxiter=500)
     X = spans(H)[0]
-    return elastic_catenary(X, Z, L, w, ea, bool(seabed))
+    return catenary_solve_unchecked(X, Z, L, w, ea, bool(seabed))
 
 
 # ------------------------------------------------------------------------------ 3-D
@@ -528,7 +528,7 @@ def catenary_on_mesh(mesh: LineMesh, environment: Environment) -> CatenaryLine:
     e_h = np.array([d[0], d[1], 0.0]) / X if X > 0.0 else np.array([1.0, 0.0, 0.0])
     depth = environment.depth
     on_seabed = abs(a[2] + depth) <= 1e-9 * depth
-    sol = elastic_catenary(
+    sol = catenary_solve_unchecked(
         X, Z, float(mesh.length), float(mesh.weight[0]), float(mesh.ea[0]), bool(on_seabed)
     )
     x, z, t = sol.profile(mesh.s0)
@@ -536,3 +536,7 @@ def catenary_on_mesh(mesh: LineMesh, environment: Environment) -> CatenaryLine:
     mid = 0.5 * (mesh.s0[1:] + mesh.s0[:-1])
     _, _, t_mid = sol.profile(mid)
     return CatenaryLine(solution=sol, positions=pos, element_tension=t_mid, node_tension=t)
+
+
+# Former name of catenary_solve_unchecked (ARCHITECTURE.md "Conventions"), kept importable.
+elastic_catenary = catenary_solve_unchecked

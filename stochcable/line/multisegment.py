@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from stochcable import validation as v
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.line.catenary import elastic_catenary
+from stochcable.line.catenary import catenary_solve_unchecked
 from stochcable.line.catenary_kernel import CLOSURE_TOL, MAX_NEWTON, kernel
 from stochcable.line.catenary_start import check_reach, newton_start
 
@@ -161,7 +161,7 @@ def catenary_multisegment(
     if abs(w_avg) <= 1e-6 * float(np.max(np.abs(ws), initial=0.0)):
         w_avg = float(np.mean(np.abs(ws))) or 1.0  # a start only
     try:
-        s0 = elastic_catenary(X, Z, L, w_avg, ea_eq, False)
+        s0 = catenary_solve_unchecked(X, Z, L, w_avg, ea_eq, False)
         H, Va = s0.H, s0.V_a
     except (InputError, ConvergenceError):
         H, Va = newton_start(X, Z, L, w_avg if w_avg != 0 else 1.0, 1.0 / ea_eq)

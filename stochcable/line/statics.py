@@ -34,7 +34,7 @@ __all__ = [
     "Method",
     "LineStatics",
     "solve_line_statics",
-    "line_statics",
+    "solve_line_statics_unchecked",
     "check_statics_options",
     "solve_fe",
 ]
@@ -245,10 +245,12 @@ def solve_line_statics(
             raise InputError(
                 "initial", initial, "m", f"must be finite with shape ({mesh.n_nodes}, 3)"
             )
-    return line_statics(mesh, environment, method, initial, tolerance, max_iterations)
+    return solve_line_statics_unchecked(
+        mesh, environment, method, initial, tolerance, max_iterations
+    )
 
 
-def line_statics(
+def solve_line_statics_unchecked(
     mesh: LineMesh,
     environment: Environment,
     method: Method,
@@ -551,3 +553,7 @@ def _solve_catenary(mesh: LineMesh, env: Environment) -> LineStatics | str:
         residual=float(sol.residual) / max(mesh.length, float(np.linalg.norm(d))),
         method="catenary",
     )
+
+
+# Former name of solve_line_statics_unchecked (ARCHITECTURE.md "Conventions"), kept importable.
+line_statics = solve_line_statics_unchecked

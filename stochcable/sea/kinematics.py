@@ -21,7 +21,7 @@ __all__ = [
     "wavenumber",
     "WaveKinematics",
     "wave_kinematics",
-    "nodal_kinematics",
+    "wave_kinematics_unchecked",
     "kinematics_timeseries",
 ]
 
@@ -185,7 +185,7 @@ def _depth_ratios(
     return ch, sh, cc
 
 
-def nodal_kinematics(
+def wave_kinematics_unchecked(
     w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float, h: float, g: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """:func:`wave_kinematics` on inputs already validated, without the pressure.
@@ -308,7 +308,7 @@ def wave_kinematics(
         )
 
     k = _wavenumber(w, h, g)
-    phase, cc, dry, vel, acc = nodal_kinematics(w, k, pts, beta, h, g)
+    phase, cc, dry, vel, acc = wave_kinematics_unchecked(w, k, pts, beta, h, g)
     pressure = cc * phase
     pressure[dry] = 0.0
     for a in (w, k, pts, phase, vel, acc, pressure):
@@ -361,3 +361,7 @@ def kinematics_timeseries(
     """
     kin = wave_kinematics(realization.omega, points, heading, depth, g)
     return synthesize(realization, kin.velocity), synthesize(realization, kin.acceleration)
+
+
+# Former name of wave_kinematics_unchecked (ARCHITECTURE.md "Conventions"), kept importable.
+nodal_kinematics = wave_kinematics_unchecked
