@@ -21,7 +21,9 @@ from stochcable.errors import (
 _LAZY = {
     "analyze": ("analysis", "analyze"),
     "build_engine": ("dynamics.engine", "build_engine"),
-    "load_scene": ("scene.model", "load_scene"),
+    "load_scene": ("io", "load_scene"),
+    "read_moordyn": ("io", "read_moordyn"),
+    "write_moordyn": ("io", "write_moordyn"),
     "Scene": ("scene.model", "Scene"),
     "solve_statics": ("statics", "solve_statics"),
     "natural_modes": ("line.modes", "natural_modes"),

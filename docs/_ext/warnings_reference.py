@@ -297,6 +297,16 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Read the coupled modes from ``stochcable analyze`` under ``bodies.<name>.modes``.",
     ),
     WarningEntry(
+        "Real modes of a travelling line",
+        "PhysicsWarning",
+        ("stochcable.line.modes:natural_modes",),
+        "the model's line has ``axial_speed`` ≠ 0 (``lines[i].axial_speed``)",
+        "The real modes K φ = ω² M φ leave out the transport terms (the gyroscopic "
+        "matrix and the centripetal stiffness): they are the line's modes at rest.",
+        "Use ``stochcable modes`` (which lists the complex modes of a travelling line) "
+        "or ``stochcable.line.transport_modes.complex_modes``. See :doc:`../travelling`.",
+    ),
+    WarningEntry(
         "Strumming lock-in (or resonance) predicted",
         "PhysicsWarning",
         ("stochcable.dynamics.model.strumming:with_strumming",),
@@ -333,6 +343,40 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Results are the same; the NumPy sea kernel is slower, or the kernel is compiled "
         "again in each process (about 1 s at its first use).",
         "Set ``NUMBA_CACHE_DIR`` to a writable directory, or ``STOCHCABLE_NUMBA=0`` to skip numba.",
+    ),
+    WarningEntry(
+        "MoorDyn file: parts read with a loss",
+        "PhysicsWarning",
+        (
+            "stochcable.io.moordyn_read:read_moordyn",
+            "stochcable.io.moordyn_read:_type_columns",
+        ),
+        "a MoorDyn file (docs/manual/moordyn.md) with options other than WtrDpth, rho, "
+        "g, kBot and cBot; non-zero EI, CaAx or Cl; lines whose BA/−ζ give different "
+        "β = BA/EA; sections other than line types, bodies, rods, points, lines, "
+        "options and outputs; a free point joined to no line; or LINE TYPES columns "
+        "named in v1's order",
+        "The scene holds what it can of the file: the options MoorDyn uses for its own "
+        "time stepping and initial conditions are dropped, bending stiffness, axial added "
+        "mass and VIV lift have no counterpart, and the scene's one stiffness-proportional "
+        "damping β takes the smallest of the lines'.",
+        "Nothing, when the options listed are numerics; for a bending-stiff line "
+        "(umbilical, riser) check that tension dominates; give "
+        "``analysis.structural_damping.beta`` yourself if the lines' damping differs.",
+    ),
+    WarningEntry(
+        "MoorDyn file written with a loss",
+        "PhysicsWarning",
+        (
+            "stochcable.io.moordyn_write:write_moordyn",
+            "stochcable.io.moordyn_write:_pieces",
+        ),
+        "a scene written with write_moordyn that has a prescribed motion, a current, "
+        "mass-proportional structural damping, an attachment at a line end, or added "
+        "mass without buoyancy",
+        "MoorDyn takes motions and currents from its driver and its own files; the file "
+        "holds the mooring only.",
+        "Drive the Coupled points from the program that runs MoorDyn.",
     ),
 )
 

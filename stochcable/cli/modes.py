@@ -10,6 +10,12 @@ Output document (JSON)::
                "lines": {name: {"omega": [rad/s], "period": [s],
                                 "plane": ["in-plane" | "out-of-plane" | "mixed"]}}}}
 
+A travelling line (``axial_speed`` ≠ 0) lists its complex modes (docs/travelling.md): its
+entry adds ``growth`` (Re λ, [1/s]), ``axial_speed``, ``critical_speed`` (√(T/m) at the
+lowest-tension point, [m/s]) and ``stability`` ("stable", "divergence", "flutter"); a
+speed at or above the critical speed is refused, naming it.  ``--plot`` draws the lines
+at rest only.
+
 The top-level ``modes.omega`` repeats the first line's frequencies so that the document
 satisfies DESIGN.md's result contract (``"modes": {"omega": [...]}``) for the common
 one-line scene; ``modes.lines`` is complete.  Periods of zero-frequency modes are null.
@@ -65,6 +71,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``stochcable modes``; returns the exit code."""
     from stochcable.line.modes import natural_modes
+    from stochcable.line.transport import check_line_speeds
+    from stochcable.line.transport_modes import modes_document
     from stochcable.statics import scene_fe_models
     from stochcable.validation import positive_int
 
@@ -82,15 +90,18 @@ def run(args: argparse.Namespace) -> int:
             PhysicsWarning,
         )
     models = scene_fe_models(scene, dim=args.dim)
-    modes = {
-        name: natural_modes(model, count=count, added_mass=not args.in_air)
-        for name, model in models.items()
-    }
-    lines = {name: m.to_document() for name, m in modes.items()}
+    speeds = check_line_speeds(scene.lines, models)
+    lines, modes = {}, {}
+    for name, model in models.items():  # travelling lines: complex modes (docs/travelling.md)
+        if name in speeds:
+            lines[name] = modes_document(model, speeds[name], count, added_mass=not args.in_air)
+        else:
+            modes[name] = natural_modes(model, count=count, added_mass=not args.in_air)
+            lines[name] = modes[name].to_document()
     first = next(iter(lines.values()))
     write_json({"modes": {"omega": first["omega"], "lines": lines}}, args.output)
-    if plt is not None:
-        _plot(plt, models, modes, args.plot)
+    if plt is not None and modes:  # the lines at rest (--plot draws no complex modes)
+        _plot(plt, {name: models[name] for name in modes}, modes, args.plot)
     return 0
 
 

@@ -111,11 +111,10 @@ class StaticsModel:
         self.c_n = 0.5 * env.rho * mesh.cd_normal * mesh.diameter
         self.c_t = 0.5 * env.rho * mesh.cd_axial * math.pi * mesh.diameter
         self.c_node = 0.5 * env.rho * mesh.node_drag_area
-        self.has_drag = self.has_current and (
-            bool(np.any(self.c_n > 0))
-            or bool(np.any(self.c_t > 0))
-            or bool(np.any(self.c_node > 0))
-        )
+        # a travelling line: its axial drag acts on the relative axial velocity u_t − c
+        self.speed = float(mesh.axial_speed)
+        coefs = np.concatenate([self.c_n, self.c_t, self.c_node])
+        self.has_drag = (self.has_current or self.speed != 0.0) and bool((coefs > 0).any())
         # load-stepping factor of the drag (1 = full current)
         self.beta = 1.0
         self._band_index()
@@ -150,6 +149,8 @@ class StaticsModel:
         )
 
     def current(self, z: np.ndarray) -> np.ndarray:
+        if not self.has_current:
+            return np.zeros(z.shape + (self.dim,))
         u = np.empty(z.shape + (self.dim,))
         for k in range(self.dim):
             u[:, k] = np.interp(z, self.cz, self.cu[:, k])
@@ -231,16 +232,15 @@ class StaticsModel:
             ua = np.einsum("ij,ij->i", u, e)
             un = u - ua[:, None] * e
             unn = np.sqrt(np.einsum("ij,ij->i", un, un))
-            g = (self.c_n * unn)[:, None] * un + (self.c_t * np.abs(ua) * ua)[:, None] * e
+            # relative axial velocity of the water past the travelling line (wet part)
+            rel = ua - self.speed * (0.5 * (za + zb) <= 0.0)
+            g = (self.c_n * unn)[:, None] * un + (self.c_t * np.abs(rel) * rel)[:, None] * e
             Fd = beta * l[:, None] * g
             R[:-1] += 0.5 * Fd
             R[1:] += 0.5 * Fd
             un_node = self.current(z)
-            Fn = (
-                beta
-                * (self.c_node * np.sqrt(np.einsum("ij,ij->i", un_node, un_node)))[:, None]
-                * un_node
-            )
+            speed_node = np.sqrt(np.einsum("ij,ij->i", un_node, un_node))
+            Fn = beta * (self.c_node * speed_node)[:, None] * un_node
             R += Fn
             self.drag_nodes = np.zeros_like(X)
             self.drag_nodes[:-1] += 0.5 * Fd
@@ -265,7 +265,7 @@ class StaticsModel:
         if mixed.any():
             st["dfa"], st["dfb"] = dfa, dfb
         if self.has_drag:
-            st.update(u=u, ua=ua, un=un, unn=unn, g=g, drag_nodes=self.drag_nodes.copy())
+            st.update(u=u, ua=ua, rel=rel, un=un, unn=unn, g=g, drag_nodes=self.drag_nodes.copy())
         return st
 
     def _tangent(self, st: dict) -> tuple:
@@ -276,7 +276,7 @@ class StaticsModel:
         e, l, eae, T, mixed, pen = (st[k] for k in ("e", "l", "eae", "T", "mixed", "pen"))
         w_sub, w_dry = self.w_sub, self.w_dry
         if self.has_drag:
-            u, ua, un, unn, g = (st[k] for k in ("u", "ua", "un", "unn", "g"))
+            u, ua, rel, un, unn, g = (st[k] for k in ("u", "ua", "rel", "un", "unn", "g"))
         if mixed.any():
             dfa, dfb = st["dfa"], st["dfb"]
         I = np.eye(dim)
@@ -297,8 +297,8 @@ class StaticsModel:
                 * un[:, None, :]
             )
             B = e[:, :, None] * u[:, None, :] + ua[:, None, None] * I
-            dg = -self.c_n[:, None, None] * (A @ B) + (self.c_t * np.abs(ua))[:, None, None] * (
-                2.0 * e[:, :, None] * u[:, None, :] + ua[:, None, None] * I
+            dg = -self.c_n[:, None, None] * (A @ B) + (self.c_t * np.abs(rel))[:, None, None] * (
+                2.0 * e[:, :, None] * u[:, None, :] + rel[:, None, None] * I
             )
             D = beta * (g[:, :, None] * e[:, None, :] + dg @ (I - ee))
             Kd[:-1] += 0.5 * D

@@ -56,6 +56,8 @@ class LineMesh:
         Lumped attachment Cd·A. [m²]
     end_a, end_b : ndarray, shape (3,)
         End positions. [m]
+    axial_speed : float
+        Transport speed of the line's material, end_a → end_b (docs/travelling.md). [m/s]
     """
 
     name: str
@@ -75,6 +77,7 @@ class LineMesh:
     node_drag_area: np.ndarray
     end_a: np.ndarray
     end_b: np.ndarray
+    axial_speed: float = 0.0
 
     @property
     def n_nodes(self) -> int:
@@ -172,4 +175,5 @@ def mesh_line(line: Line, rho: float, g: float) -> LineMesh:
         node_drag_area=node_cda,
         end_a=np.asarray(line.end_a.position, dtype=float),
         end_b=np.asarray(line.end_b.position, dtype=float),
+        axial_speed=float(line.axial_speed),
     )

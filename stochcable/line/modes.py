@@ -34,7 +34,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from stochcable.errors import InputError, SolverError
+from stochcable.errors import InputError, PhysicsWarning, SolverError, warn
 from stochcable.line.fem import FEModel
 from stochcable.validation import positive_int
 
@@ -383,6 +383,8 @@ def natural_modes(
     """
     if not isinstance(model, FEModel):
         raise InputError("model", type(model).__name__, "-", "must be an FEModel")
+    if model.mesh.axial_speed != 0.0:  # docs/travelling.md
+        warn(f"line '{model.mesh.name}' travels: these are its modes at rest", PhysicsWarning)
     if method not in ("auto", "dense", "banded", "sparse"):
         raise InputError("method", method, "-", "must be auto, dense, banded or sparse")
     n_free = model.free.size

@@ -506,6 +506,8 @@ def _catenary_inapplicable(mesh: LineMesh, env: Environment) -> str | None:
         return "it has attachments"
     if any(p.speed > 0.0 for p in env.current):
         return "there is a current"
+    if mesh.axial_speed != 0.0 and np.any(mesh.cd_axial > 0.0):
+        return "it travels with an axial drag"  # docs/travelling.md
     if not (float(mesh.weight[0]) > 0.0):
         return "its net submerged weight is not positive"
     if max(mesh.end_a[2], mesh.end_b[2]) > 0.0:

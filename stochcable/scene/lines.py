@@ -9,7 +9,7 @@ from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from stochcable.scene.base import _Doc, _f
+from stochcable.scene.base import LocatedValueError, _Doc, _f
 from stochcable.scene.raos import MotionRao
 from stochcable.scene.spectra import Spectrum
 
@@ -185,6 +185,15 @@ class Line(_Doc):
     end_b: End
     segments: tuple[Segment, ...] = Field(min_length=1, max_length=1000)
     attachments: tuple[Attachment, ...] = Field(default=(), max_length=10_000)
+    axial_speed: float = _f(
+        "Transport speed of the line's material along itself (laying, payout, hauling), "
+        "positive from end_a to end_b, negative from end_b to end_a; |c| must stay "
+        "below the critical speed √(T/m) of the static line (docs/travelling.md)",
+        "m/s",
+        ge=-1000.0,
+        le=1000.0,
+        default=0.0,
+    )
 
     @property
     def length(self) -> float:
@@ -199,6 +208,13 @@ class Line(_Doc):
     @model_validator(mode="after")
     def _check_line(self) -> Line:
         total = self.length
+        if self.axial_speed != 0.0 and self.attachments:
+            raise LocatedValueError(
+                ("axial_speed",),
+                self.axial_speed,
+                "a travelling line cannot have "
+                "attachments (they would travel with it: no steady state)",
+            )
         for i, a in enumerate(self.attachments):
             if a.at > total * (1 + 1e-12):
                 raise ValueError(
