@@ -1,4 +1,4 @@
-"""The statics stage of the pipeline: static equilibrium of a scene (seed 001 §4.1).
+"""The statics stage of the pipeline: static equilibrium of a scene (Tuah (1982), §4.1).
 
 Above :mod:`stochcable.line` (one line's statics) and :mod:`stochcable.bodies` (the
 body poses): a scene without bodies is its lines, each solved alone
@@ -7,6 +7,10 @@ Newton on the free body poses with the lines attached
 (:func:`stochcable.bodies.statics.solve_body_statics`).  Then, about the static shape,
 the finite-element model and the natural modes of every line
 (:func:`scene_fe_models`, :func:`modes_of_scene`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

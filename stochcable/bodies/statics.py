@@ -11,7 +11,7 @@ F_ℓ the static force a line exerts on its end at X + R(θ)·r_ℓ (each line s
 method solves Q = 0 with the tangent stiffness K = −dQ/dq: the condensed end stiffness
 of every line (Schur complement K_bb − K_bf K_ff⁻¹ K_fb of its FE tangent, the matrix
 of :func:`stochcable.line.fem.build_fe_model`, over the interior DOFs: one banded solve)
-including the attachment geometric term −[F]×[r]× (seed 001 eqs. 3.3.8–3.3.10
+including the attachment geometric term −[F]×[r]× (Tuah (1982), eqs. 3.3.8–3.3.10
 linearized about the static state), the hydrostatic matrix, and the geometric terms
 of the point forces whose moment arm rotates (weight, buoyancy, drag).  K is exact, so
 the iteration converges quadratically.  K at the solution is reported as the
@@ -24,6 +24,10 @@ Body loads: :mod:`stochcable.bodies.static_loads` (weight, buoyancy, hydrostatic
 restoring, wind and current drag; :func:`body_static_load`).
 
 Prescribed bodies (vessels) are not solved for: their pose is ``position``, no rotation.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -150,7 +154,7 @@ def solve_body_statics(
 
     Notes
     -----
-    Module docstring; docs/BODIES.md §Statics.  Seed 001 §4.1 (static configuration
+    Module docstring; docs/BODIES.md §Statics.  Tuah (1982), §4.1 (static configuration
     as the starting state), eq. 3.2.c.20 (static force F̄), eqs. 3.3.6–3.3.10.
     """
     body_tolerance = positive("body_tolerance", body_tolerance, "-")

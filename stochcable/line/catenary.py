@@ -7,7 +7,7 @@ end_a toward end_b, z up.  Unstretched arc length s runs from end_a (s = 0) to e
 vertical component V(s) = V_a + w s, w the net submerged weight per unit length
 (positive downward).  The tension is T(s) = sqrt(H² + V(s)²) (effective tension).
 
-Closure: seed 000 (Bliet 1984) eqs. (2.5)–(2.6), the 2-D static equations without
+Closure: Bliet (1984), eqs. (2.5)–(2.6), the 2-D static equations without
 current, integrated in closed form as in Irvine (1981), *Cable Structures*, ch. 2::
 
     x(s) = H s / EA + ∫₀ˢ H / T ds'   = H s/EA + (H/w)[asinh(V(s)/H) − asinh(V_a/H)]
@@ -22,6 +22,12 @@ iteration on (H, V_a) covers both regimes.
 The integrals are evaluated as divided differences (no 1/w cancellation), so the
 weightless limit w → 0, the vertical limit H → 0 and taut lines (EA/T up to 1e6 and
 more) are all accurate to round-off.
+
+References
+----------
+Bliet, A. (1984), Dynamic analysis of single span cables, PhD thesis, Massachusetts
+Institute of Technology.
+Irvine, H. M. (1981), Cable structures, MIT Press, Cambridge, MA.
 """
 
 from __future__ import annotations
@@ -280,7 +286,7 @@ def catenary_solve(
 
     Notes
     -----
-    Closure equations of the elastic catenary (Irvine 1981, ch. 2; seed 000 eqs.
+    Closure equations of the elastic catenary (Irvine 1981, ch. 2; Bliet (1984), eqs.
     (2.5)–(2.6) integrated with T = H/cos φ, eq. (3.28)) with the seabed extension of
     the grounded length L_B = L − V_b/w carrying the constant tension H.  Solved by
     Newton on (H, V_a) with

@@ -1,6 +1,11 @@
 """A chain of elastic catenary segments with point loads at the junctions (Irvine 1981,
-ch. 2; seed 001 §6.2's buoy), no seabed contact: the reference of the FE statics of
+ch. 2; Tuah's (1982) §6.2 buoy), no seabed contact: the reference of the FE statics of
 multi-segment lines.
+
+References
+----------
+Irvine, H. M. (1981), Cable structures, MIT Press, Cambridge, MA.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -116,7 +121,7 @@ def catenary_multisegment(
     Notes
     -----
     The vertical tension component jumps by the junction load across each junction
-    (node equilibrium, seed 001 §6.2 buoy of 900 lb); H is constant.  The spans are
+    (node equilibrium, Tuah (1982), §6.2 buoy of 900 lb); H is constant.  The spans are
     the sums of the segments' closures (Irvine 1981, ch. 2) and the Jacobian the
     sum of theirs; damped Newton on (H, V_a) as in :func:`catenary_solve`, started from
     the single-segment solution with the average weight.  No seabed contact.

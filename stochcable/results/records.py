@@ -6,6 +6,10 @@ into the result document by their ``as_dict`` (:mod:`stochcable.results.document
 holds the result objects that carry them).  :func:`stats_from_spectrum` turns a
 one-sided response spectrum on the analysis grid into :class:`ResponseStats`
 (DESIGN.md "Outputs").
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -160,7 +164,7 @@ def _response_stats(st: Any, sd: Any, mean: float) -> ResponseStats:
 
 @dataclass(frozen=True, eq=False)
 class LinearizationRecord:
-    """The drag-linearization fixed point of one line (seed 001 §5.3 steps 5–13).
+    """The drag-linearization fixed point of one line (Tuah (1982), §5.3 steps 5–13).
 
     Attributes
     ----------

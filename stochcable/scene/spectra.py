@@ -1,5 +1,10 @@
 """Spectrum documents of the scene: a sea state or an end motion as a spectrum
-(the formulas are :mod:`stochcable.sea.spectra`'s; ``type`` is the discriminator)."""
+(the formulas are :mod:`stochcable.sea.spectra`'s; ``type`` is the discriminator).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
@@ -63,7 +68,7 @@ class _SpectrumBase(_Doc):
 class PiersonMoskowitz(_SpectrumBase):
     """Pierson–Moskowitz spectrum, given by (hs, tp), (m0, omega_p) or wind_speed.
 
-    The (m0, omega_p) form is seed 001's example (m0 = 28 ft², omega_p = 0.5 rad/s).
+    The (m0, omega_p) form is Tuah's (1982) example (m0 = 28 ft², omega_p = 0.5 rad/s).
     """
 
     type: Literal["pierson_moskowitz"] = "pierson_moskowitz"

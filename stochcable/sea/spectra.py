@@ -10,9 +10,12 @@ and re-exported here; the accepted ranges of the parameters in :mod:`stochcable.
 
 References
 ----------
-Tuah, H. (1982), seed 001, §5.1 and §6.5 (Pierson–Moskowitz, m0 = 28 ft², ωp = 0.5 rad/s).
-Pierson, W. J. and Moskowitz, L. (1964), J. Geophys. Res. 69(24).
-Hasselmann, K. et al. (1973), JONSWAP, Dtsch. Hydrogr. Z. A8(12).
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University, §5.1 and §6.5 (Pierson–Moskowitz, m0 = 28 ft², ωp = 0.5 rad/s).
+Pierson, W. J. and Moskowitz, L. (1964), A proposed spectral form for fully developed
+wind seas based on the similarity theory of S. A. Kitaigorodskii, J. Geophys. Res. 69(24).
+Hasselmann, K. et al. (1973), Measurements of wind-wave growth and swell decay during
+the Joint North Sea Wave Project (JONSWAP), Dtsch. Hydrogr. Z. A8(12).
 Ochi, M. K. and Hubble, E. N. (1976), Six-parameter wave spectra, Proc. 15th ICCE.
 ITTC (1978), 15th ITTC Seakeeping Committee (ISSC / ITTC two-parameter spectrum).
 """
@@ -126,7 +129,7 @@ def spectrum_pierson_moskowitz(omega: ArrayLike, hs: float, tp: float) -> np.nda
     Notes
     -----
     S(ω) = (5/16) Hs² ωp⁴ ω⁻⁵ exp[−(5/4)(ωp/ω)⁴], ωp = 2π/Tp (DESIGN.md; the
-    two-parameter form of Pierson & Moskowitz 1964 used by seed 001 §6.5).
+    two-parameter form of Pierson & Moskowitz 1964 used by Tuah (1982), §6.5).
     Closed forms: m0 = Hs²/16, m_n = (Hs²/64) ωpⁿ (5/4)^(n/4) Γ(1 − n/4) for n < 4
     (:func:`moments_pierson_moskowitz`), Tz = (5π/4)^(−1/4) Tp = 0.7104 Tp, peak at ωp.
     """
@@ -138,7 +141,7 @@ def spectrum_pierson_moskowitz(omega: ArrayLike, hs: float, tp: float) -> np.nda
 
 
 def spectrum_pierson_moskowitz_m0(omega: ArrayLike, m0: float, omega_p: float) -> np.ndarray:
-    """Pierson–Moskowitz spectrum in zeroth moment and peak frequency (seed 001 form).
+    """Pierson–Moskowitz spectrum in zeroth moment and peak frequency (Tuah's (1982) form).
 
     Parameters
     ----------
@@ -156,8 +159,8 @@ def spectrum_pierson_moskowitz_m0(omega: ArrayLike, m0: float, omega_p: float) -
 
     Notes
     -----
-    S(ω) = 5 m0 ωp⁴ ω⁻⁵ exp[−(5/4)(ωp/ω)⁴], the PM shape with Hs = 4√m0; seed 001
-    §6.5 (Fig. 6.5-6) uses m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla record).
+    S(ω) = 5 m0 ωp⁴ ω⁻⁵ exp[−(5/4)(ωp/ω)⁴], the PM shape with Hs = 4√m0; Tuah
+    (1982), §6.5 (Fig. 6.5-6) uses m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla record).
     """
     m0 = v.in_range("m0", m0, "m²", *M0_RANGE)
     wp = v.in_range("omega_p", omega_p, "rad/s", *OMEGA_P_RANGE)

@@ -11,10 +11,14 @@ D-weighted centroid of its bin, so that direction sums of smooth functions
 err by O(Δθ²) and a spreading that narrows to zero width puts all its weight at the
 mean heading: the long-crested sea), the directional moments, and the realization of a
 short-crested sea as independent long-crested components, one per direction, each
-with the spectrum w_k S(ω) (the "double sum" of DSA/NSA, seed 001 §5.1 per direction).
+with the spectrum w_k S(ω) (the "double sum" of DSA/NSA, Tuah (1982), §5.1 per direction).
 
 Angles are in radians here; headings follow DESIGN.md (from +x toward +y, the
 direction the waves travel).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -321,7 +325,7 @@ def velocity_timeseries_directional(
     g: float = G_STANDARD,
 ) -> np.ndarray:
     """Fluid velocity at points in a short-crested sea: the sum over directions of
-    each direction's linear kinematics (seed 001 eqs. 5.2.8–5.2.9) driven by its
+    each direction's linear kinematics (Tuah (1982), eqs. 5.2.8–5.2.9) driven by its
     realization, shape (n_points, 3, N_t). [m/s]"""
     if len(realizations) != directions.count:
         raise InputError(
