@@ -24,6 +24,7 @@ from stochcable.errors import InputError
 
 __all__ = [
     "THREE_HOURS",
+    "stats_from_moments",
     "ResponseStats",
     "LinearizationRecord",
     "LineIndicators",
@@ -143,6 +144,17 @@ def stats_from_spectrum_unchecked(
     return _response_stats(st, sd, mean)
 
 
+def stats_from_moments(moments: Any, mean: float, duration: float) -> ResponseStats:
+    """Statistics of a Gaussian response from its spectral moments (m0, m1, m2, m4)
+    [unit²·(rad/s)ⁿ], e.g. of a spectrum in parts on different grids whose moments
+    add; ``mean`` and ``duration`` as in :func:`stats_from_spectrum`."""
+    from stochcable.results.statistics import statistics_from_moments
+
+    st = statistics_from_moments(*moments, THREE_HOURS)
+    sd = st if duration == THREE_HOURS else statistics_from_moments(*moments, float(duration))
+    return _response_stats(st, sd, mean)
+
+
 def _response_stats(st: Any, sd: Any, mean: float) -> ResponseStats:
     """ResponseStats from the statistics over three hours (st) and the duration (sd)."""
     mean = float(mean)
@@ -252,7 +264,7 @@ class LineIndicators:
         ``"second_order"``.
     second_order : object or None
         Moments of the second-order stretching tension
-        (:class:`stochcable.dynamics.second_order.SecondOrderTension`; its ``as_dict``).
+        (:class:`stochcable.dynamics.residuals.second_order.SecondOrderTension`; its ``as_dict``).
     """
 
     borgman_ratio: np.ndarray
@@ -298,8 +310,8 @@ class LineIndicators:
 class ResidualRecord:
     """The end-tension variance a closed-form residual of the linear model adds, and σ
     with it: the drag the linearization drops
-    (:func:`stochcable.dynamics.drag_residual.drag_residual`) or the second-order
-    geometric forces (:func:`stochcable.dynamics.geometric_residual.geometric_residual`).
+    (:func:`stochcable.dynamics.residuals.drag_residual.drag_residual`) or the second-order
+    geometric forces (:func:`stochcable.dynamics.residuals.geometric_residual.geometric_residual`).
 
     Attributes
     ----------
@@ -309,7 +321,7 @@ class ResidualRecord:
         Why not computed ("" when computed).
     variance : dict {"end_a", "end_b"} of float
         Variance the residual adds to the end tension (negative where it lowers it:
-        the drag residual's linear part, :mod:`stochcable.dynamics.drag_segments`). [N²]
+        the drag residual's linear part, :mod:`stochcable.dynamics.residuals.drag_segments`). [N²]
     in_band : dict {"end_a", "end_b"} of float
         Its part on the analysis band (the rest: superharmonics above ω_max, and
         difference frequencies below ω_min). [N²]
@@ -323,6 +335,11 @@ class ResidualRecord:
     panels : int
         Element groups the residual was evaluated on (the elements for the geometric
         forces). [-]
+    lines : tuple of (ndarray, dict {"end_a", "end_b"} of ndarray)
+        The variance as spectral lines: parts (ω [rad/s], the end tensions' variance at
+        each ω [N²]) whose sums are ``variance`` (the residual's uniform lines up to
+        its highest order times ω_max; the drag's linear misfit on the analysis grid).
+        Empty when not computed.
     """
 
     computed: bool
@@ -333,6 +350,7 @@ class ResidualRecord:
     std: dict[str, float]
     order: int = 0
     panels: int = 0
+    lines: tuple = ()
 
     @classmethod
     def not_computed(cls, reason: str, std: dict[str, float]) -> ResidualRecord:
@@ -348,13 +366,14 @@ class ResidualRecord:
         std: dict[str, float],
         order: int,
         panels: int,
+        lines: tuple = (),
     ) -> ResidualRecord:
         """The record of computed residual variances (a variance change may be
-        negative: it is clipped at −σ_linear², σ with it at 0)."""
+        negative: it is clipped at −σ_linear², σ with it at 0) and their ``lines``."""
         var = {e: max(-(float(std[e]) ** 2), float(v)) for e, v in variance.items()}
         band = {e: max(-(float(std[e]) ** 2), float(v)) for e, v in in_band.items()}
         total = {e: math.sqrt(max(0.0, float(std[e]) ** 2 + var[e])) for e in var}
-        return cls(True, "", var, band, dict(std), total, order, panels)
+        return cls(True, "", var, band, dict(std), total, order, panels, tuple(lines))
 
     def ratio(self, end: str) -> float:
         """σ with the residual over the linear σ at ``end`` (1 when not computed). [-]"""

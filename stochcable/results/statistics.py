@@ -27,6 +27,7 @@ __all__ = [
     "ResponseStatistics",
     "response_statistics_unchecked",
     "response_statistics",
+    "statistics_from_moments",
 ]
 
 _EULER_GAMMA = 0.5772156649015329
@@ -247,7 +248,18 @@ def _statistics_1d(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatisti
     np.multiply(s, w**2, out=y[2])
     np.multiply(s, w**4, out=y[3])
     m0, m1, m2, m4 = (float(m) for m in (d * (y[:, 1:] + y[:, :-1]) / 2.0).sum(axis=-1))
-    std = math.sqrt(m0)
+    return statistics_from_moments(m0, m1, m2, m4, dur)
+
+
+def statistics_from_moments(
+    m0: float, m1: float, m2: float, m4: float, dur: float
+) -> ResponseStatistics:
+    """The statistics of a Gaussian response with spectral moments ``m0`` … ``m4``
+    [unit²·(rad/s)ⁿ] over a storm of ``dur`` [s] (the formulas of
+    :func:`response_statistics`), e.g. of a spectrum in parts on different grids whose
+    moments add."""
+    m0, m1, m2, m4 = (float(m) for m in (m0, m1, m2, m4))
+    std = math.sqrt(max(m0, 0.0))
     ok = m0 > 0 and m2 > 0
     tz = 2.0 * math.pi * math.sqrt(m0 / m2) if ok else 0.0
     n_cyc = dur / tz if ok else 0.0

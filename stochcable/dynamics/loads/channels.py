@@ -169,7 +169,7 @@ class Channel:
     heading : float or None
         Wave heading β of a sea channel with element kinematics (the drag residual
         integrates them over parts of elements,
-        :mod:`stochcable.dynamics.drag_segments`); None otherwise. [rad]
+        :mod:`stochcable.dynamics.residuals.drag_segments`); None otherwise. [rad]
     """
 
     name: str
