@@ -18,7 +18,7 @@ import stochcable
 EXPECTED = {
     "analyze": "stochcable.analysis",
     "build_engine": "stochcable.dynamics.engine",
-    "load_scene": "stochcable.scene.model",
+    "load_scene": "stochcable.io",  # (also reads MoorDyn input files)
     "Scene": "stochcable.scene.model",
     "solve_statics": "stochcable.statics",
     "natural_modes": "stochcable.statics",
