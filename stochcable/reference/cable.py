@@ -38,7 +38,6 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -253,7 +252,7 @@ class CableTimeHistory:
 
 
 def simulate_line_timedomain(
-    scene: Scene | Mapping[str, Any] | str | Path,
+    scene: Scene | dict[str, Any] | str | Path,
     line_name: str | None = None,
     *,
     realization: Any = None,
