@@ -26,7 +26,7 @@ _LAZY = {
     "write_moordyn": ("io", "write_moordyn"),
     "Scene": ("scene.model", "Scene"),
     "solve_statics": ("statics", "solve_statics"),
-    "natural_modes": ("line.modes", "natural_modes"),
+    "natural_modes": ("statics", "natural_modes"),
     "simulate_sea": ("sea.realization", "simulate_sea"),
     "load_example": ("examples", "load_example"),
     "estimate_cost": ("cost", "estimate_cost"),

@@ -125,6 +125,7 @@ def test_chain_correction_matches_the_time_domain_quadratic_drag_shift():
     np.testing.assert_array_less(np.abs(pred - shifts.mean(axis=0)), half)
 
 
+@pytest.mark.slow
 def test_panels_converge_to_the_element_by_element_residual(monkeypatch):
     """160 elements grouped into 32 panels (the default cap) give the element-by-element
     residual variance within 2 % (measured 1 % with 54 panels: the residual is smooth
@@ -162,6 +163,7 @@ def test_only_when_asked_and_out_of_scope_says_why():
     assert leg.to_document()["drag_residual"]["computed"] is False
 
 
+@pytest.mark.slow
 def test_large_correction_warns(monkeypatch):
     """A PhysicsWarning where the correction is beyond RESIDUAL_WARN_RATIO, the largest
     checked against the time domain: the inclined guy's +18 % does not warn at the

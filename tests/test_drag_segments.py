@@ -100,6 +100,7 @@ def test_panel_loads_are_unit_forces_at_the_panels_centroids():
     assert len(panel_groups(whole, dr.MAX_PANELS)) == 32
 
 
+@pytest.mark.slow
 def test_corrected_sigma_holds_under_mesh_refinement():
     """The inclined guy's FD σ with the drag residual on 40 and 160 elements: the linear
     σ falls by 7.5 % (one B per element on the 14 m deep top element), the corrected

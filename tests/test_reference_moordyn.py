@@ -23,6 +23,9 @@ from stochcable.reference.moordyn_compare import compare_line, student_interval
 from stochcable.sea.spectra import spectrum_pierson_moskowitz
 from stochcable.statics import solve_statics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_reference_moordyn")
+
 
 def _pm(w: np.ndarray) -> np.ndarray:
     return spectrum_pierson_moskowitz(w, 2.0, 10.0)

@@ -15,6 +15,9 @@ from stochcable.line.fem import assemble
 from stochcable.line.seabed import TOUCHDOWN_SNAP, touchdown_element
 from stochcable.scene.model import Seabed
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_seabed")
+
 # ------------------------------------------------------------------ touchdown element
 
 

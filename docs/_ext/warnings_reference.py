@@ -46,12 +46,15 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Response spectrum cut by the top of the grid",
         "ResolutionWarning",
         ("stochcable.dynamics.outputs.resolution:tail_check",),
-        "S(ω_max)·ω_max > TAIL_FRACTION · m0 of an end-tension spectrum",
+        "S(ω_max)·ω_max > TAIL_FRACTION · m0 of an end-tension spectrum, and an input "
+        "goes on above ω_max (quiet when every input, a band-limited motion or a "
+        "spectrum table, ends at the grid's top: nothing excites the line above it)",
         "The end-tension spectrum is still large at ``analysis.omega.max``: the variance "
         "beyond the grid is lost, so σ and every maximum are underestimated. Typical "
         "cause: an end-motion spectrum with an ω⁻⁵ tail, whose inertia loads give a "
         "tension spectrum that decays only like ω⁻¹.",
-        "Raise ``analysis.omega.max`` until the warning goes; give a fairlead motion as a "
+        "The message says where the input ends. Raise ``analysis.omega.max`` to there, "
+        "or until the warning goes; give a fairlead motion as a "
         "vessel RAO over the sea (``motion.rao``) or as a band-limited spectrum instead "
         "of an unbounded one.",
         ("stochcable.dynamics.outputs.resolution:TAIL_FRACTION",),

@@ -34,6 +34,7 @@ from stochcable.dynamics.model.system import (
 from stochcable.dynamics.outputs.indicators import line_indicators
 from stochcable.dynamics.outputs.resolution import (
     LineModes,
+    excitation_end,
     resolution_check,
     surface_resolution_check,
     tail_check,
@@ -46,7 +47,7 @@ from stochcable.dynamics.residuals.second_order import second_order_tension, wit
 from stochcable.line.fem import SLACK_EA_RATIO, FEModel
 from stochcable.results.documents import (
     LineResult,
-    stats_from_validated,
+    stats_from_spectrum_unchecked,
 )
 from stochcable.results.records import ResidualRecord
 from stochcable.scene.model import AnalysisSettings
@@ -152,10 +153,11 @@ def line_result(
     st = system.statics
     s0 = model.mesh.s0
     stats = {}
+    input_end = excitation_end(channels, w)
     for end, mean in (("end_a", st.tension_a), ("end_b", st.tension_b)):
         dens = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
-        stats[end] = stats_from_validated(w, dens, float(mean), settings.duration)
-        tail_check(system.name, end, w, dens, stats[end].m0)
+        stats[end] = stats_from_spectrum_unchecked(w, dens, float(mean), settings.duration)
+        tail_check(system.name, end, w, dens, stats[end].m0, input_end)
     if np.any(spectra > 0):  # nothing to resolve without excitation
         resolution_check(system, linearization.damping, w, modes)
         surface_resolution_check(system, channels, w, q)
