@@ -52,8 +52,10 @@ def test_area_is_the_corrected_variance(chain):
         assert om[-1] > 2.9 * line.omega[-1] and np.all(np.diff(om) > 0)
         assert np.all(np.isin(line.omega, om)) and np.all(dens >= 0)
         assert abs(line.corrected_spectra[end].scale - 1.0) < 0.02
-        # the linear density is kept on the analysis grid where no residual reaches
         assert st.std > line.linear[end].std
+        part = line.to_document()["corrected_spectra"][end]
+        np.testing.assert_array_equal(part["omega"], om)
+        np.testing.assert_array_equal(part["tension"], dens)
 
 
 def test_exact_parts_of_a_synthetic_record():
@@ -103,4 +105,5 @@ def test_fatigue_damage_of_the_corrected_spectrum(chain, method):
         om0, dens0 = plain.end_tension_density(end)
         assert om0 is plain.omega and plain.corrected_spectra is None
         np.testing.assert_array_equal(dens0, plain.end_tension_spectrum(end))
+    assert "corrected_spectra" not in plain.to_document()
     assert math.isclose(plain.end_b.std, line.linear["end_b"].std)

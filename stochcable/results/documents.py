@@ -281,6 +281,16 @@ class LineResult:
                 if self.linear is None
                 else {"linear": {e: {"tension": s.as_dict()} for e, s in self.linear.items()}}
             ),
+            **(
+                {}
+                if self.corrected_spectra is None
+                else {
+                    "corrected_spectra": {
+                        e: {"omega": c.omega.tolist(), "tension": c.density.tolist()}
+                        for e, c in self.corrected_spectra.items()
+                    }
+                }
+            ),
         }
 
 
