@@ -32,7 +32,8 @@ from stochcable.results.records import (
     ResidualRecord,
     ResponseStats,
     stats_from_spectrum,
-    stats_from_validated,
+    stats_from_spectrum_unchecked,
+    stats_from_validated,  # noqa: F401  (former name, kept importable)
 )
 from stochcable.scene.units import unit_labels
 
@@ -47,7 +48,7 @@ __all__ = [
     "TimeSeries",
     "Result",
     "stats_from_spectrum",
-    "stats_from_validated",
+    "stats_from_spectrum_unchecked",
 ]
 
 # Number of time samples of the time-series window put in the result document.

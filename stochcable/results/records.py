@@ -6,6 +6,10 @@ into the result document by their ``as_dict`` (:mod:`stochcable.results.document
 holds the result objects that carry them).  :func:`stats_from_spectrum` turns a
 one-sided response spectrum on the analysis grid into :class:`ResponseStats`
 (DESIGN.md "Outputs").
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -16,6 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.errors import InputError
+
 __all__ = [
     "THREE_HOURS",
     "stats_from_moments",
@@ -24,7 +30,7 @@ __all__ = [
     "LineIndicators",
     "ResidualRecord",
     "stats_from_spectrum",
-    "stats_from_validated",
+    "stats_from_spectrum_unchecked",
 ]
 
 THREE_HOURS = 10800.0
@@ -117,23 +123,24 @@ def stats_from_spectrum(
     :func:`stochcable.results.statistics.response_statistics` (trapezoid moments, Rayleigh
     maxima); mpm_3h = mean + σ√(2 ln(10800/Tz)) (DESIGN.md "Outputs").
     """
-    from stochcable.results.statistics import response_statistics
+    from stochcable.results.statistics import check_response_spectrum
 
-    st = response_statistics(omega, density, THREE_HOURS)
-    sd = st if duration == THREE_HOURS else response_statistics(omega, density, duration)
-    return _response_stats(st, sd, mean)
+    w, s, dur = check_response_spectrum(omega, density, duration)
+    if s.ndim != 1:
+        raise InputError("density", density, "unit^2*s/rad", f"must be 1-D of {w.size} entries")
+    return stats_from_spectrum_unchecked(w, s, mean, dur)
 
 
-def stats_from_validated(
+def stats_from_spectrum_unchecked(
     omega: np.ndarray, density: np.ndarray, mean: float, duration: float
 ) -> ResponseStats:
     """:func:`stats_from_spectrum` of a validated grid and spectrum (the analysis grid,
     validated once at the boundary; a 1-D float density >= 0 of its size, duration
     > 0): no second validation per call."""
-    from stochcable.results.statistics import _statistics
+    from stochcable.results.statistics import response_statistics_unchecked as stats
 
-    st = _statistics(omega, density, THREE_HOURS)
-    sd = st if duration == THREE_HOURS else _statistics(omega, density, float(duration))
+    st = stats(omega, density, THREE_HOURS)
+    sd = st if duration == THREE_HOURS else stats(omega, density, float(duration))
     return _response_stats(st, sd, mean)
 
 
@@ -169,7 +176,7 @@ def _response_stats(st: Any, sd: Any, mean: float) -> ResponseStats:
 
 @dataclass(frozen=True, eq=False)
 class LinearizationRecord:
-    """The drag-linearization fixed point of one line (seed 001 §5.3 steps 5–13).
+    """The drag-linearization fixed point of one line (Tuah (1982), §5.3 steps 5–13).
 
     Attributes
     ----------
@@ -392,3 +399,7 @@ class ResidualRecord:
             "panels": self.panels,
             **ends,
         }
+
+
+# Former name of stats_from_spectrum_unchecked (ARCHITECTURE.md "Conventions"), kept importable.
+stats_from_validated = stats_from_spectrum_unchecked

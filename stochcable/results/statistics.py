@@ -25,6 +25,7 @@ __all__ = [
     "response_spectrum",
     "cross_spectrum",
     "ResponseStatistics",
+    "response_statistics_unchecked",
     "response_statistics",
     "statistics_from_moments",
 ]
@@ -172,6 +173,14 @@ def response_statistics(
     ``N < 1`` the most probable maximum is 0; the asymptotic expected maximum is
     held at its value at ``2 ln N = 1`` (``1.577 std``) for ``N < e^{1/2}``.
     """
+    return response_statistics_unchecked(*check_response_spectrum(omega, density, duration))
+
+
+def check_response_spectrum(
+    omega: np.ndarray, density: np.ndarray, duration: float
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """The checks of :func:`response_statistics` (its parameters, same units): float
+    arrays and the duration, or an InputError naming the parameter."""
     w = _v.float_array("omega", omega, "rad/s", nonnegative=True, increasing=True, min_size=2)
     s = _v.float_array("density", density, "unit^2*s/rad", ndim=None, nonnegative=True)
     dur = _v.positive("duration", duration, "s")
@@ -179,10 +188,10 @@ def response_statistics(
         raise InputError(
             "density", s, "unit^2*s/rad", f"must have the frequency axis last with {w.size} entries"
         )
-    return _statistics(w, s, dur)
+    return w, s, dur
 
 
-def _statistics(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
+def response_statistics_unchecked(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
     """:func:`response_statistics` of validated float arrays (w increasing, s >= 0 with
     the frequency axis last of w's size, dur > 0): the pipeline's grids are validated
     once at the boundary."""
@@ -228,7 +237,7 @@ def _statistics(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
 
 
 def _statistics_1d(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
-    """:func:`_statistics` of one spectrum (s of shape (n,)): the four trapezoid
+    """:func:`response_statistics_unchecked` of one spectrum (s of shape (n,)): the four trapezoid
     moments as ONE row-wise reduction of the same products and sums as
     ``np.trapezoid`` (the same bits), and the scalar formulas on floats (numpy's
     0-d array operations were most of the time of a call)."""

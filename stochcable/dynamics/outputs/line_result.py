@@ -47,7 +47,7 @@ from stochcable.dynamics.residuals.second_order import second_order_tension, wit
 from stochcable.line.fem import SLACK_EA_RATIO, FEModel
 from stochcable.results.documents import (
     LineResult,
-    stats_from_validated,
+    stats_from_spectrum_unchecked,
 )
 from stochcable.results.records import ResidualRecord
 from stochcable.scene.model import AnalysisSettings
@@ -155,7 +155,7 @@ def line_result(
     stats, dens = {}, {}
     for end, mean in (("end_a", st.tension_a), ("end_b", st.tension_b)):
         dens[end] = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
-        stats[end] = stats_from_validated(w, dens[end], float(mean), settings.duration)
+        stats[end] = stats_from_spectrum_unchecked(w, dens[end], float(mean), settings.duration)
         tail_check(system.name, end, w, dens[end], stats[end].m0)
     if np.any(spectra > 0):  # nothing to resolve without excitation
         resolution_check(system, linearization.damping, w, modes)
