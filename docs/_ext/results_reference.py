@@ -154,7 +154,9 @@ _LINES = {
         "``analysis.linearization.drag_residual`` or ``geometric_residual``: with the "
         "residuals, their spectra's moments added to the linear spectrum's (the "
         "superharmonics above the band included), the linear model's alone in "
-        "``lines.<line>.linear``; the spectra below stay the linear model's.",
+        "``lines.<line>.linear``; their spectral density in "
+        "``lines.<line>.corrected_spectra`` (``lines.<line>.spectra`` stays the linear "
+        "model's).",
     ),
     "lines.<line>.linear": (
         "",
@@ -165,6 +167,25 @@ _LINES = {
     "lines.<line>.linear.<end>.tension": (
         "",
         "Statistics of the linear model's end tension (table of statistics below).",
+    ),
+    "lines.<line>.corrected_spectra": (
+        "",
+        "Only where a residual of the linear model was computed: the end tensions' "
+        "spectral density with the residuals' spectra "
+        "(:mod:`stochcable.dynamics.residuals.corrected_spectrum`; "
+        "``LineResult.end_tension_density``), whose area is the corrected σ² of "
+        "``lines.<line>.<end>.tension`` (to round-off); spectral fatigue and the "
+        "load-case sets' end statistics and end damage read it.",
+    ),
+    "lines.<line>.corrected_spectra.<end>": ("", "The end."),
+    "lines.<line>.corrected_spectra.<end>.omega": (
+        "rad/s",
+        "The analysis frequencies and the residual lines outside them (the "
+        "superharmonics up to the drag residual's highest order times ω_max).",
+    ),
+    "lines.<line>.corrected_spectra.<end>.tension": (
+        "{F}²·s/rad",
+        "One-sided spectral density of the end tension with the residuals.",
     ),
     "lines.<line>.<end>.force_std": ("{F}", "σ of the x, y, z force on the support."),
     "lines.<line>.tension.s": (

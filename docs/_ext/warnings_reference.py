@@ -152,19 +152,20 @@ WARNINGS: tuple[WarningEntry, ...] = (
         ("stochcable.dynamics.residuals.drag_residual:RESIDUAL_WARN_RATIO",),
     ),
     WarningEntry(
-        "Residuals not applied to a load-case set",
+        "Residuals applied to a load-case set's end tensions only",
         "PhysicsWarning",
         ("stochcable.cases.plan:plan_cases", "stochcable.client_batches:submit_batch"),
         "the set's scene sets ``analysis.linearization.drag_residual`` or "
         "``geometric_residual`` (over HTTP: the batch status's ``warnings``, which the "
         "Python client's ``submit_batch`` issues)",
-        "A load-case set's statistics, extremes and damage come from the linear model's "
-        "response spectra; the closed-form residuals are variances beside them, not "
-        "spectra, and would cost 10–100 cases' time in every case, so the set does not "
-        "compute them.",
-        "Run ``analyze()`` with the residuals on the governing cases of the set (its "
-        "``governing_mpm_case``) and carry the σ ratio they report as a margin on the "
-        "set's extremes.",
+        "Every case's end statistics and end damage are those of the corrected spectrum "
+        "(the linear spectrum plus the residuals', "
+        ":mod:`stochcable.dynamics.residuals.corrected_spectrum`); the along-line "
+        "damage comes from the linear model's element tension spectra, and lines on "
+        "free bodies carry no residual.",
+        "Read the along-line damage as the linear model's; where it governs, run "
+        "``analyze()`` on the governing cases and scale it by the end's σ ratio "
+        "(``linear`` block) to the power of the curve's slope.",
     ),
     WarningEntry(
         "Second-order stretching tension large (indicator ``second_order``)",

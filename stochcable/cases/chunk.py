@@ -49,7 +49,6 @@ __all__ = [
     "ENDS",
     "WARM_RUN",
     "run_lead",
-    "SET_DROPS_RESIDUALS",
 ]
 
 ENDS = ("end_a", "end_b")
@@ -142,21 +141,14 @@ def case_sea(scene: Scene, state: SeaState, family: Family) -> Sea:
     return Sea(spectrum=state.spectrum(family), heading=state.heading, spreading=spreading)
 
 
-#: Settings of a scene's analysis that a load-case set does not apply (the set's
-#: statistics and damage are the linear model's). [-]
-SET_DROPS_RESIDUALS = ("drag_residual", "geometric_residual")
-
-
 def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) -> Scene:
-    """The scene a set's engine is built from: no time series, no closed-form residuals
-    (:data:`SET_DROPS_RESIDUALS`: a set's statistics and damage come from the linear
-    response spectra, and a residual costs 10–100 cases' time in every case), and the
-    sea of an out-of-plane state when there is one (the models are then 3-D, and in-plane
-    states are solved by them exactly as by 2-D models)."""
-    lin = scene.analysis.linearization.model_copy(update=dict.fromkeys(SET_DROPS_RESIDUALS, False))
-    upd: dict[str, Any] = {
-        "analysis": scene.analysis.model_copy(update={"timeseries": None, "linearization": lin})
-    }
+    """The scene a set's engine is built from: no time series, the scene's closed-form
+    residuals as it asks for them (``analysis.linearization.drag_residual``,
+    ``geometric_residual``: each case's end statistics and end damage are then those of
+    the corrected spectrum, :meth:`stochcable.results.documents.LineResult.end_tension_density`),
+    and the sea of an out-of-plane state when there is one (the models are then 3-D,
+    and in-plane states are solved by them exactly as by 2-D models)."""
+    upd: dict[str, Any] = {"analysis": scene.analysis.model_copy(update={"timeseries": None})}
     for state in states:
         if abs(math.sin(math.radians(state.heading))) > 1e-9:
             upd["sea"] = case_sea(scene, state, family)
@@ -282,6 +274,7 @@ def solve_chunk(
         damage = {ln: np.full((k, 2 + n), np.nan) for ln, n in lines.items()}
         spectra: dict[str, list[np.ndarray]] = {ln: [] for ln in fatigue}
         have: dict[str, list[int]] = {ln: [] for ln in fatigue}
+        corrected: dict[str, dict[int, list]] = {ln: {} for ln in fatigue}
         s_el: dict[str, np.ndarray] = {}
         omega = None
         rows = []
@@ -308,6 +301,9 @@ def solve_chunk(
                     stats[name][e][j] = (st.mean, st.std, st.tz, st.mpm_3h)
                 if name in fatigue:
                     ends = np.stack([lr.end_tension_spectrum(e) for e in ENDS])
+                    if lr.corrected_spectra is not None:  # the ends' on their own grid
+                        corrected[name][j] = [lr.end_tension_density(e) for e in ENDS]
+                        ends = np.zeros_like(ends)
                     spectra[name].append(np.concatenate([ends, lr.tension_spectrum]))
                     have[name].append(j)
         for name, settings in fatigue.items():
@@ -315,6 +311,10 @@ def solve_chunk(
                 curve, factor = curve_factor(settings, template.environment.g, name)
                 dens = np.stack(spectra[name]) * factor**2
                 damage[name][have[name]] = damage_rate(omega, dens, curve, settings.method)
+                for j, ends_c in corrected[name].items():
+                    damage[name][j, :2] = [
+                        damage_rate(om, d * factor**2, curve, settings.method) for om, d in ends_c
+                    ]
                 strum = _strumming_damage(engine, name, curve, factor)
                 if strum is not None:
                     damage[name][have[name]] += strum[0]

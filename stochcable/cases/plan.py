@@ -18,7 +18,6 @@ from typing import Any
 import numpy as np
 
 from stochcable.cases.chunk import (
-    SET_DROPS_RESIDUALS,
     WARM_RUN,
     CaseRow,
     ChunkResult,
@@ -154,14 +153,15 @@ def plan_cases(
     if not isinstance(chunk_size, int) or isinstance(chunk_size, bool) or chunk_size < 1:
         raise InputError("chunk_size", chunk_size, "-", "must be an integer >= 1")
     template = engine_template(scene, scatter.states, scatter.family)
-    asked = [k for k in SET_DROPS_RESIDUALS if getattr(scene.analysis.linearization, k)]
+    asked = [k for k in ("drag_residual", "geometric_residual")
+             if getattr(scene.analysis.linearization, k)]  # fmt: skip
     if asked:
         warn(
-            "load-case sets use the linear model's statistics and damage: "
+            "load-case sets apply "
             + ", ".join(f"analysis.linearization.{k}" for k in asked)
-            + " is not applied to the set's cases (on the chain example the residuals "
-            "add ≈ 4–7 % to the end-tension σ; see them with analyze() on the governing "
-            "cases, or add that margin to the set's extremes)",
+            + " to the end tensions only (their statistics and damage: the corrected "
+            "spectrum); the set's along-line damage is the linear model's, and a line "
+            "on free bodies carries no residual",
             PhysicsWarning,
         )
     chunks = tuple(

@@ -144,6 +144,12 @@ class LineResult:
         the residuals (their spectra's moments added:
         :mod:`stochcable.dynamics.residuals.corrected`) and these the linear model's
         alone; None otherwise (``end_a`` and ``end_b`` are the linear model's).
+    corrected_spectra : dict {"end_a", "end_b"} of CorrectedSpectrum or None
+        Where a residual was computed, the end tensions' spectral densities with the
+        residuals' spectra (``omega``, ``density``: the analysis grid extended by the
+        residual lines outside it;
+        :mod:`stochcable.dynamics.residuals.corrected_spectrum`), whose area is the
+        corrected σ²; None otherwise (:meth:`end_tension_density`).
     """
 
     name: str
@@ -174,6 +180,7 @@ class LineResult:
     drag_residual: ResidualRecord | None = None
     geometric_residual: ResidualRecord | None = None
     linear: dict[str, ResponseStats] | None = None
+    corrected_spectra: dict[str, Any] | None = None
 
     def linear_end(self, end: str) -> ResponseStats:
         """The linear model's statistics of the tension at ``end`` ("end_a" or
@@ -205,6 +212,16 @@ class LineResult:
             (self.input_spectra.shape[0],) + (1,) * (transfer.ndim - 2) + (-1,)
         )
         return np.sum(np.abs(transfer) ** 2 * s, axis=0)
+
+    def end_tension_density(self, end: str) -> tuple[np.ndarray, np.ndarray]:
+        """The frequencies [rad/s] and one-sided spectral density [N²·s/rad] of the
+        tension at ``end`` that the end statistics are of: with the residuals' spectra
+        where they were computed (``corrected_spectra``), else the linear
+        :meth:`end_tension_spectrum` on ``omega``."""
+        if self.corrected_spectra is None:
+            return self.omega, self.end_tension_spectrum(end)
+        spec = self.corrected_spectra[end]
+        return spec.omega, spec.density
 
     def end_force_std(self, end: str) -> np.ndarray:
         """σ of the x, y, z force on the support at ``end``, shape (3,). [N]"""
@@ -264,6 +281,16 @@ class LineResult:
                 {}
                 if self.linear is None
                 else {"linear": {e: {"tension": s.as_dict()} for e, s in self.linear.items()}}
+            ),
+            **(
+                {}
+                if self.corrected_spectra is None
+                else {
+                    "corrected_spectra": {
+                        e: {"omega": c.omega.tolist(), "tension": c.density.tolist()}
+                        for e, c in self.corrected_spectra.items()
+                    }
+                }
             ),
         }
 

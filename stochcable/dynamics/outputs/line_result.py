@@ -40,6 +40,7 @@ from stochcable.dynamics.outputs.resolution import (
     tail_check,
 )
 from stochcable.dynamics.residuals.corrected import corrected_stats
+from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
 from stochcable.dynamics.residuals.drag_residual import drag_residual
 from stochcable.dynamics.residuals.geometric_residual import geometric_residual
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
@@ -152,12 +153,12 @@ def line_result(
 
     st = system.statics
     s0 = model.mesh.s0
-    stats = {}
+    stats, dens = {}, {}
     input_end = excitation_end(channels, w)
     for end, mean in (("end_a", st.tension_a), ("end_b", st.tension_b)):
-        dens = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
-        stats[end] = stats_from_spectrum_unchecked(w, dens, float(mean), settings.duration)
-        tail_check(system.name, end, w, dens, stats[end].m0, input_end)
+        dens[end] = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
+        stats[end] = stats_from_spectrum_unchecked(w, dens[end], float(mean), settings.duration)
+        tail_check(system.name, end, w, dens[end], stats[end].m0, input_end)
     if np.any(spectra > 0):  # nothing to resolve without excitation
         resolution_check(system, linearization.damping, w, modes)
         surface_resolution_check(system, channels, w, q)
@@ -191,8 +192,10 @@ def line_result(
             )
     applied = [r for r in residual.values() if r.computed]
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
-    if applied:  # the end statistics with the residuals (their spectra's moments added)
+    corrected = None
+    if applied:  # the end statistics and densities with the residuals' spectra
         stats = {e: corrected_stats(stats[e], e, applied, settings.duration) for e in linear}
+        corrected = {e: corrected_spectrum(w, dens[e], e, applied) for e in linear}
     return LineResult(
         name=system.name,
         omega=w,
@@ -211,6 +214,7 @@ def line_result(
         end_a=stats["end_a"],
         end_b=stats["end_b"],
         linear=linear,
+        corrected_spectra=corrected,
         linearization=linearization.record,
         modes_omega=np.asarray(system.modes.omega).copy(),
         modes_listed=_listed_modes(system.modes.omega, float(w[-1])),
