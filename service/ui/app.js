@@ -230,6 +230,8 @@ async function convertMoorDyn(text) {
     headers: headers({ "Content-Type": "text/plain", Accept: "application/json" }) });
   if (!resp.ok) {
     $("run-status").textContent = "Not read.";
+    const item = await resp.clone().json().then((b) => b.detail[0], () => null);
+    if (item && item.line) selectLine(text, item.line);
     throw new Error(await errorText(resp));
   }
   const scene = await resp.json();
@@ -240,6 +242,16 @@ async function convertMoorDyn(text) {
   showNotes();
   $("run-status").textContent = "MoorDyn file read into a scene document.";
   return scene;
+}
+
+// select line `n` (1-based) of the editor, scrolled into view: where the file is wrong
+function selectLine(text, n) {
+  const lines = text.split("\n");
+  const start = lines.slice(0, n - 1).reduce((a, l) => a + l.length + 1, 0);
+  const area = $("scene-text");
+  area.setSelectionRange(start, start + (lines[n - 1] || "").length);
+  const lh = parseFloat(getComputedStyle(area).lineHeight) || 16;
+  area.scrollTop = Math.max(0, (n - 3) * lh);
 }
 
 // the editor's text changed (typed, pasted, a file): convert a MoorDyn file

@@ -255,12 +255,12 @@ def test_moordyn_file_uploaded_read_and_run(browser, server):
     assert len(reader) >= 1 and notes[: len(reader)] == [f"MoorDyn file: {n}" for n in reader]
     assert any("bodies[vessel].prescribed is a zero motion RAO" in n for n in notes)
     assert any("no sea" in n for n in notes)
+    _shot(page, "web_moordyn", "#analysis")
     # Run without a sea: the service's 422 beside the input, the notes stay
     page.click("#run")
     page.locator("#scene-error").wait_for(state="visible")
     assert "the scene needs a 'sea'" in page.inner_text("#scene-error")
     assert page.locator("#result").is_hidden() and page.locator("#scene-notes").is_visible()
-    _shot(page, "web_moordyn", "#analysis")
     # the user adds a sea: the no-sea note goes, the zero-RAO one stays
     scene["sea"] = {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 8.0}, "heading": 0.0}
     page.fill("#scene-text", json.dumps(scene, indent=1))
@@ -295,7 +295,12 @@ def test_bad_moordyn_file_pasted_shows_its_line_and_column(browser, server):
     assert "MoorDyn file line 19, column 1 (RODS)" in text
     area, err = page.locator("#scene-text").bounding_box(), box.bounding_box()
     assert err["x"] >= area["x"] + area["width"] - 1  # beside the input, as for JSON
-    # the editor keeps the file for the user to fix; Run says the same
+    # the editor keeps the file for the user to fix, its line 19 selected; Run says the same
+    selected = page.evaluate(
+        "(() => { const a = document.getElementById('scene-text');"
+        " return a.value.slice(a.selectionStart, a.selectionEnd); })()"
+    )
+    assert selected == (MOORDYN / "bodies_and_rods.dat").read_text().splitlines()[18]
     assert page.input_value("#scene-text").startswith("MoorDyn v2 input file")
     page.click("#run")
     page.wait_for_function("document.getElementById('run-status').textContent === 'Failed.'")
