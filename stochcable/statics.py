@@ -1,12 +1,16 @@
-"""The statics stage of the pipeline: static equilibrium of a scene (seed 001 §4.1).
+"""The statics stage of the pipeline: static equilibrium of a scene (Tuah (1982), §4.1).
 
 Above :mod:`stochcable.line` (one line's statics) and :mod:`stochcable.bodies` (the
 body poses): a scene without bodies is its lines, each solved alone
-(:func:`stochcable.line.statics.line_statics`); a scene with bodies is solved by
+(:func:`stochcable.line.statics.solve_line_statics`); a scene with bodies is solved by
 Newton on the free body poses with the lines attached
 (:func:`stochcable.bodies.statics.solve_body_statics`).  Then, about the static shape,
 the finite-element model and the natural modes of every line
 (:func:`scene_fe_models`, :func:`modes_of_scene`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -17,7 +21,12 @@ from typing import TYPE_CHECKING, Any, Literal
 from stochcable.line.fem import FEModel, build_fe_model, check_dim
 from stochcable.line.mesh import mesh_line
 from stochcable.line.modes import Modes, natural_modes
-from stochcable.line.statics import LineStatics, Method, check_statics_options, line_statics
+from stochcable.line.statics import (
+    LineStatics,
+    Method,
+    check_statics_options,
+    solve_line_statics_unchecked,
+)
 from stochcable.scene.model import Scene, load_scene
 from stochcable.validation import positive_int
 
@@ -88,7 +97,9 @@ def solve_statics(
     out = {}
     for line in scene.lines:
         mesh = mesh_line(line, env.rho, env.g)
-        out[line.name] = line_statics(mesh, env, method, None, tolerance, max_iterations)
+        out[line.name] = solve_line_statics_unchecked(
+            mesh, env, method, None, tolerance, max_iterations
+        )
     return StaticsResult(lines=out)
 
 

@@ -938,24 +938,6 @@ def test_result_document_names_si_units() -> None:
     assert doc["units"] == {"system": "SI", "length": "m", "mass": "kg", "force": "N", "time": "s"}
 
 
-def test_pipeline_statistics_equal_the_validated_public_function() -> None:
-    """The analysis' end statistics skip the second validation of its grid
-    (results.stats_from_validated) and equal results.stats_from_spectrum to the bit; the
-    public function still rejects a bad grid with its message."""
-    from stochcable.results.documents import stats_from_spectrum, stats_from_validated
-
-    rng = np.random.default_rng(5)
-    w = np.linspace(0.05, 2.0, 120)
-    dens = rng.uniform(0.0, 1.0, w.size) ** 2
-    for duration in (10800.0, 3600.0):
-        assert (
-            stats_from_validated(w, dens, 12.5, duration).as_dict()
-            == stats_from_spectrum(w, dens, 12.5, duration).as_dict()
-        )
-    with pytest.raises(InputError, match="omega"):
-        stats_from_spectrum(w[::-1], dens, 0.0, 10800.0)
-
-
 def test_nearest_spacing_equals_argmin_and_gradient():
     """The resolution check's nearest grid point and local spacing (searchsorted, pass
     E7) against the dense argmin and np.gradient they replace: the same bits, on a

@@ -138,7 +138,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Drag residual large (``analysis.linearization.drag_residual``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.drag_residual:_warn_large",),
+        ("stochcable.dynamics.residuals.drag_residual:_warn_large",),
         "the end-tension σ with the drag residual beyond RESIDUAL_WARN_RATIO times the "
         "linear σ (or below its inverse)",
         "The quadratic drag is far from its Gaussian linear fit: the first-order residual "
@@ -146,7 +146,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "time domain (up to +18 %: the taut wire and the inclined guy, within the "
         "time domain's 95 % interval).",
         "Check with the nonlinear time-domain reference (:mod:`stochcable.reference.cable`).",
-        ("stochcable.dynamics.drag_residual:RESIDUAL_WARN_RATIO",),
+        ("stochcable.dynamics.residuals.drag_residual:RESIDUAL_WARN_RATIO",),
     ),
     WarningEntry(
         "Residuals not applied to a load-case set",
@@ -166,7 +166,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Second-order stretching tension large (indicator ``second_order``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.second_order:with_second_order",),
+        ("stochcable.dynamics.residuals.second_order:with_second_order",),
         "σ of the second-order stretching tension above SECOND_ORDER_WARN_RATIO of the "
         "line's largest linear tension σ",
         "Transverse motion lengthens a line to second order, ½∫(∂u⊥/∂s)² ds; a taut line "
@@ -176,7 +176,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Use the corrected moments in ``indicators.second_order`` as an estimate; for a "
         "design value check with the nonlinear time-domain reference "
         "(:mod:`stochcable.reference.cable`).",
-        ("stochcable.dynamics.second_order:SECOND_ORDER_WARN_RATIO",),
+        ("stochcable.dynamics.residuals.second_order:SECOND_ORDER_WARN_RATIO",),
     ),
     WarningEntry(
         "Drag linearization did not converge",

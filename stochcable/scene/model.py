@@ -19,6 +19,10 @@ hydrodynamic tables) and :mod:`~stochcable.scene.analysis_settings`; this module
 the :class:`Scene`, :func:`load_scene` and the conversion of validation errors, and
 re-exports every model (``from stochcable.scene.model import Line`` and
 ``from stochcable.scene import Line`` both work).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -230,7 +234,7 @@ class Scene(_Doc):
         Returns
         -------
         ndarray, shape (3,)
-            ``end.position``, or for an attached end X + R(θ)·r (seed 001 eq. 3.3.6
+            ``end.position``, or for an attached end X + R(θ)·r (Tuah (1982), eq. 3.3.6
             to first order), X, θ the body pose and r ``attach.point``. [m]
         """
         if isinstance(line, str):
