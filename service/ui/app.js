@@ -4,7 +4,7 @@
 
 const $ = (id) => document.getElementById(id);
 const state = { key: sessionStorage.getItem("stochcable-key") || "", keys: false,
-  doc: null, sceneText: "", job: null, timer: null, plots: [] };
+  doc: null, sceneText: "", job: null, timer: null, plots: [], readerNotes: [] };
 const COLORS = ["#0b5fa5", "#d95f02", "#1b9e77", "#7570b3", "#e7298a", "#66a61e", "#a6761d"];
 const VIRIDIS = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
 const YEAR_S = 365.25 * 86400;
@@ -46,7 +46,8 @@ async function errorText(resp) {
   try {
     const detail = JSON.parse(body).detail;
     if (Array.isArray(detail)) {
-      lines = detail.map((d) => ((d.loc || []).join(".") ? (d.loc || []).join(".") + ": " : "") + d.msg);
+      // an item with the line of a file (a MoorDyn file) names it in its message
+      lines = detail.map((d) => (d.line == null && (d.loc || []).join(".") ? d.loc.join(".") + ": " : "") + d.msg);
     } else if (detail) lines = [String(detail)];
   } catch (e) { if (body) lines = [body.slice(0, 2000)]; }
   if (resp.status === 401) {
@@ -183,6 +184,86 @@ function drawSpectra(doc, units) {
 
 function sceneInput() { return $("scene-text").value; }
 
+// a MoorDyn input file, recognised as stochcable.io.moordyn_file.is_moordyn_text does
+function isMoorDyn(text) {
+  const lines = text.split(/\r?\n/);
+  const first = (lines.find((l) => l.trim()) || "").trim();
+  if (!first || first.startsWith("{")) return false;
+  if (first.includes("---") && /moordyn/i.test(first)) return true;
+  return lines.some((l) => l.includes("---") && /LINE TYPES|LINE DICTIONARY/i.test(l));
+}
+
+const DOFS = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+
+// what a scene read from a MoorDyn file lacks: the vessels' motion (a zero RAO) and a sea
+function sceneNotes(scene) {
+  const notes = [];
+  const moved = ((scene && scene.bodies) || []).filter((b) => b && b.prescribed);
+  for (const b of moved) {
+    const tables = DOFS.map((k) => b.prescribed[k]).filter(Boolean);
+    if (tables.every((t) => [t.re, t.im].flat(2).every((v) => v === 0))) {
+      notes.push(`bodies[${b.name}].prescribed is a zero motion RAO: the body does not move, ` +
+        "and the lines answer to the waves on them alone. Give the vessel's RAO (per unit wave " +
+        `amplitude over omega) in bodies[${b.name}].prescribed.`);
+    }
+  }
+  if (moved.length && !scene.sea) {
+    notes.push('The scene has no sea: add one (e.g. "sea": {"spectrum": {"type": "jonswap", ' +
+      '"hs": 2, "tp": 8}, "heading": 0}) before Run analysis.');
+  }
+  return notes;
+}
+
+function showNotes() {
+  let scene = null;
+  try { scene = JSON.parse(sceneInput()); } catch (e) { /* not JSON (yet) */ }
+  const notes = [...state.readerNotes, ...sceneNotes(scene)];
+  $("scene-notes").replaceChildren(...notes.map((n) => el("li", { class: "warn" }, n)));
+  $("scene-notes").hidden = !notes.length;
+}
+
+// a MoorDyn file -> its scene document in the editor (POST /v1/scenes/moordyn), with the
+// reader's warnings (its X-Stochcable-Warnings header); a bad file: the 422 beside the input
+async function convertMoorDyn(text) {
+  $("run-status").textContent = "Reading the MoorDyn file…";
+  const resp = await fetch("/v1/scenes/moordyn", { method: "POST", body: text,
+    headers: headers({ "Content-Type": "text/plain", Accept: "application/json" }) });
+  if (!resp.ok) {
+    $("run-status").textContent = "Not read.";
+    const item = await resp.clone().json().then((b) => b.detail[0], () => null);
+    if (item && item.line) selectLine(text, item.line);
+    throw new Error(await errorText(resp));
+  }
+  const scene = await resp.json();
+  let notes = [];
+  try { notes = JSON.parse(resp.headers.get("X-Stochcable-Warnings") || "[]"); } catch (e) { /* none */ }
+  state.readerNotes = notes.map((n) => `MoorDyn file: ${n}`);
+  $("scene-text").value = JSON.stringify(scene, null, 1);
+  showNotes();
+  $("run-status").textContent = "MoorDyn file read into a scene document.";
+  return scene;
+}
+
+// select line `n` (1-based) of the editor, scrolled into view: where the file is wrong
+function selectLine(text, n) {
+  const lines = text.split("\n");
+  const start = lines.slice(0, n - 1).reduce((a, l) => a + l.length + 1, 0);
+  const area = $("scene-text");
+  area.setSelectionRange(start, start + (lines[n - 1] || "").length);
+  const lh = parseFloat(getComputedStyle(area).lineHeight) || 16;
+  area.scrollTop = Math.max(0, (n - 3) * lh);
+}
+
+// the editor's text changed (typed, pasted, a file): convert a MoorDyn file
+async function sceneChanged() {
+  const text = sceneInput();
+  if (!isMoorDyn(text)) { showNotes(); return; }
+  showError($("scene-error"), null);
+  try { await convertMoorDyn(text); } catch (e) { showError($("scene-error"), e); }
+}
+
+function clearNotes() { state.readerNotes = []; showNotes(); }
+
 async function loadExamples() {
   const list = await api("GET", "/v1/examples");
   const sel = $("example-select");
@@ -197,23 +278,28 @@ async function loadExample() {
     const scene = await api("GET", `/v1/examples/${encodeURIComponent(name)}`);
     $("scene-text").value = JSON.stringify(scene, null, 1);
     showError($("scene-error"), null);
+    clearNotes();
   } catch (e) { showError($("scene-error"), e); }
 }
 
-function readFileInto(input, target) {
+function readFileInto(input, target, then) {
   const f = input.files && input.files[0];
   if (!f) return;
-  f.text().then((t) => { $(target).value = t; });
+  f.text().then((t) => { $(target).value = t; if (then) then(); });
 }
 
 async function runAnalysis() {
-  const text = sceneInput();
+  let text = sceneInput();
   const btn = $("run");
   btn.disabled = true;
-  $("run-status").textContent = "Running…";
   showError($("scene-error"), null);
   const t0 = performance.now();
   try {
+    if (isMoorDyn(text)) {
+      await convertMoorDyn(text);
+      text = sceneInput();
+    }
+    $("run-status").textContent = "Running…";
     const doc = await api("POST", "/v1/analyses?timeseries=none", { body: text });
     state.doc = doc; state.sceneText = text;
     let scene = null;
@@ -252,7 +338,8 @@ function showResult(doc, scene) {
   table($("stats-table"), ["line", "end", `mean [${F}]`, `σ [${F}]`, `Tz [${T}]`, `MPM 3 h [${F}]`], rows);
   drawProfile(doc, scene, units);
   drawSpectra(doc, units);
-  const warnings = doc.warnings || [];
+  // the service does not know a zero RAO is a placeholder: the page says so
+  const warnings = [...(doc.warnings || []), ...sceneNotes(scene).map((n) => `page: ${n}`)];
   $("warnings-list").replaceChildren(...(warnings.length
     ? warnings.map((w) => el("li", { class: "warn" }, w)) : [el("li", { class: "ok" }, "None.")]));
   const fid = doc.fidelity;
@@ -533,7 +620,15 @@ function bind() {
   });
   $("example-load").addEventListener("click", loadExample);
   $("example-select").addEventListener("change", loadExample);
-  $("scene-file").addEventListener("change", () => readFileInto($("scene-file"), "scene-text"));
+  $("scene-file").addEventListener("change", () => {
+    clearNotes();
+    readFileInto($("scene-file"), "scene-text", sceneChanged);
+  });
+  let typed = null;
+  $("scene-text").addEventListener("input", () => {
+    clearTimeout(typed);
+    typed = setTimeout(sceneChanged, 400);
+  });
   $("scatter-file").addEventListener("change", () => readFileInto($("scatter-file"), "scatter-text"));
   $("scatter-example").addEventListener("click", async () => {
     $("scatter-text").value = await (await fetch("/ui/scatter.csv")).text();

@@ -1,7 +1,8 @@
 """The web page at ``/`` (service/routers/ui.py, service/ui): its assets in-process, and
 its flows in a real browser (Debian's chromium driven by Playwright) against a real
 ``stochcable serve``: an example analysed and drawn with the σ the API answers, the 422
-message of invalid JSON beside the input, a batch from submission to its heat map,
+message of invalid JSON beside the input, a MoorDyn file read into a scene and run (and
+a bad one's line-numbered message), a batch from submission to its heat map,
 keyboard-only use, and API keys.
 
 Set ``STOCHCABLE_SCREENSHOTS=DIR`` to keep the screenshots the manual shows
@@ -28,6 +29,7 @@ from stochcable.cases import read_scatter
 
 UI = Path(__file__).resolve().parents[2] / "service" / "ui"
 EXAMPLES = UI.parents[1] / "stochcable" / "examples"
+MOORDYN = UI.parents[1] / "tests" / "data" / "moordyn"
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = [
     "--headless",
@@ -220,9 +222,90 @@ def test_invalid_json_shows_the_422_message_beside_the_input(browser, server):
     # beside the input: to its right, and named by the textarea's aria-describedby
     area, err = page.locator("#scene-text").bounding_box(), box.bounding_box()
     assert err["x"] >= area["x"] + area["width"] - 1
-    assert page.get_attribute("#scene-text", "aria-describedby") == "scene-error"
+    assert "scene-error" in page.get_attribute("#scene-text", "aria-describedby").split()
     assert page.locator("#result").is_hidden()
     _shot(page, "web_invalid_json", "#analysis")
+    assert errors == []
+    page.close()
+
+
+def _moordyn(server, name: str) -> httpx.Response:
+    """The service's own answer to a MoorDyn file (POST /v1/scenes/moordyn)."""
+    return httpx.post(
+        server.url + "/v1/scenes/moordyn",
+        content=(MOORDYN / name).read_bytes(),
+        headers={"Content-Type": "text/plain"},
+        timeout=60,
+    )
+
+
+@pytest.mark.slow
+def test_moordyn_file_uploaded_read_and_run(browser, server):
+    page, errors = _page(browser, server.url + "/")
+    page.wait_for_selector(f"#example-select option[value={EXAMPLE}]", state="attached")
+    page.set_input_files("#scene-file", str(MOORDYN / "wd0050_chain.txt"))
+    page.wait_for_function("document.getElementById('scene-text').value.startsWith('{')")
+    scene = json.loads(page.input_value("#scene-text"))
+    answer = _moordyn(server, "wd0050_chain.txt")
+    assert scene == answer.json()  # the service's scene document, as it answered it
+    # the reader's warnings (its header), then what the file cannot give: the vessel's
+    # motion (a zero RAO) and a sea
+    notes = page.locator("#scene-notes li").all_inner_texts()
+    reader = json.loads(answer.headers["X-Stochcable-Warnings"])
+    assert len(reader) >= 1 and notes[: len(reader)] == [f"MoorDyn file: {n}" for n in reader]
+    assert any("bodies[vessel].prescribed is a zero motion RAO" in n for n in notes)
+    assert any("no sea" in n for n in notes)
+    _shot(page, "web_moordyn", "#analysis")
+    # Run without a sea: the service's 422 beside the input, the notes stay
+    page.click("#run")
+    page.locator("#scene-error").wait_for(state="visible")
+    assert "the scene needs a 'sea'" in page.inner_text("#scene-error")
+    assert page.locator("#result").is_hidden() and page.locator("#scene-notes").is_visible()
+    # the user adds a sea: the no-sea note goes, the zero-RAO one stays
+    scene["sea"] = {"spectrum": {"type": "jonswap", "hs": 2.0, "tp": 8.0}, "heading": 0.0}
+    page.fill("#scene-text", json.dumps(scene, indent=1))
+    page.wait_for_function("!document.getElementById('scene-notes').textContent.includes('no sea')")
+    assert "zero motion RAO" in page.inner_text("#scene-notes")
+    page.click("#run")
+    page.wait_for_selector("#result:not([hidden])")
+    shown = float(page.get_attribute("#stats-table td[data-name='line1.end_b.std']", "data-value"))
+    expected = server.post(scene, timeout=180).json()["lines"]["line1"]["end_b"]["tension"]
+    assert shown == pytest.approx(expected["std"], rel=1e-12)  # float printing only
+    # the response is the waves' on the chain alone (the vessel does not move): the page
+    # says why among the warnings rather than showing a small sigma silently
+    listed = page.locator("#warnings-list li").all_inner_texts()
+    assert any(w.startswith("page: bodies[vessel].prescribed is a zero motion RAO") for w in listed)
+    assert errors == []
+    page.close()
+
+
+@pytest.mark.slow
+def test_bad_moordyn_file_pasted_shows_its_line_and_column(browser, server):
+    # a shipped file MoorDyn reads but a scene cannot hold (rods): refused at its line
+    page, errors = _page(browser, server.url + "/")
+    page.fill("#scene-text", (MOORDYN / "bodies_and_rods.dat").read_text())
+    box = page.locator("#scene-error")
+    box.wait_for(state="visible")
+    text = box.inner_text()
+    answer = _moordyn(server, "bodies_and_rods.dat")
+    assert answer.status_code == 422
+    item = answer.json()["detail"][0]
+    assert item["line"] == 19 and item["column"] == 1
+    assert text.startswith("422") and item["msg"] in text
+    assert "MoorDyn file line 19, column 1 (RODS)" in text
+    area, err = page.locator("#scene-text").bounding_box(), box.bounding_box()
+    assert err["x"] >= area["x"] + area["width"] - 1  # beside the input, as for JSON
+    # the editor keeps the file for the user to fix, its line 19 selected; Run says the same
+    selected = page.evaluate(
+        "(() => { const a = document.getElementById('scene-text');"
+        " return a.value.slice(a.selectionStart, a.selectionEnd); })()"
+    )
+    assert selected == (MOORDYN / "bodies_and_rods.dat").read_text().splitlines()[18]
+    assert page.input_value("#scene-text").startswith("MoorDyn v2 input file")
+    page.click("#run")
+    page.wait_for_function("document.getElementById('run-status').textContent === 'Failed.'")
+    assert "line 19, column 1" in box.inner_text() and page.locator("#result").is_hidden()
+    _shot(page, "web_moordyn_error", "#analysis")
     assert errors == []
     page.close()
 
