@@ -341,15 +341,6 @@ def test_statics_axial_drag_on_the_relative_axial_velocity():
         assert change == pytest.approx(np.sign(c) * coef * c * c * between, rel=1e-6)
 
 
-def test_time_domain_reference_refuses_transport():
-    """The TD reference has no transport terms: a travelling line is refused, not
-    simulated at rest."""
-    from stochcable.reference.cable import simulate_line_timedomain
-
-    with pytest.raises(InputError, match="axial_speed"):
-        simulate_line_timedomain(_taut_scene(1.0), "taut")
-
-
 def test_real_modes_of_a_travelling_line_warn():
     from stochcable.errors import PhysicsWarning
     from stochcable.statics import modes_of_scene
