@@ -231,16 +231,16 @@ def test_cli_refuses_critical_speed_in_one_line(tmp_path, capsys, command):
     assert "\n" not in err
 
 
-def test_analyze_refuses_transport_below_critical():
-    """No silent response without the transport terms: the engine has none yet."""
-    from stochcable.analysis import analyze
+def test_engine_refuses_a_travelling_line_on_a_body():
+    """Lines on bodies are solved by the coupled solve, which has no transport terms:
+    refused in one message naming the body (free lines travel: test_transport_solve)."""
     from stochcable.dynamics.engine import build_engine
+    from stochcable.examples import load_example
 
-    with pytest.raises(InputError, match="not in the engine yet"):
-        analyze(_taut_scene(1.0))
-    # the engine itself refuses, so load-case sets (which build it directly) do too
-    with pytest.raises(InputError, match=r"lines\[0\].axial_speed.*not in the engine yet"):
-        build_engine(_taut_scene(-1.0))
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
+    doc["lines"][0]["axial_speed"] = 0.1
+    with pytest.raises(InputError, match=r"lines\[0\].axial_speed.*body \('disc'\)"):
+        build_engine(doc)
 
 
 def test_flutter_reported_not_solved():
