@@ -112,8 +112,8 @@ def run_fd(line: str, variant: str) -> dict:
     an = sc.analysis
     k = list(lr.channels).index(next(c for c in lr.channels if "surge" in c))
     out = {
-        "reaction_b": float(lr.end_b.std),
-        "reaction_a": float(lr.end_a.std),
+        "reaction_b": float(lr.linear_end("end_b").std),
+        "reaction_a": float(lr.linear_end("end_a").std),
         "motion_std": float(math.sqrt(np.trapezoid(lr.input_spectra[k], lr.omega))),
         # on the TD's lines: σ as the DSA sums it (every line with its full weight)
         **dict(zip(("lines_b", "lines_a"), fd_budget.line_sum_std(lr).tolist())),
@@ -129,7 +129,7 @@ def run_fd(line: str, variant: str) -> dict:
     if parts and all(r.computed for r in parts):  # (uncorrelated: the variances add)
         for k, end in enumerate(("end_b", "end_a")):
             extra = sum(r.variance[end] for r in parts)
-            out["residual_" + end[-1]] = math.sqrt(getattr(lr, end).std ** 2 + extra)
+            out["residual_" + end[-1]] = math.sqrt(lr.linear_end(end).std ** 2 + extra)
             out["lines_residual_" + end[-1]] = math.sqrt(
                 out[("lines_b", "lines_a")[k]] ** 2 + extra
             )

@@ -48,7 +48,7 @@ SEA_SKIP = 200.0
 def corrected(line, end: str) -> float:
     """σ with both residuals: their variances add (zero-mean flow: uncorrelated). [N]"""
     extra = sum(getattr(line, k).variance[end] for k in RESIDUALS)
-    return math.sqrt(getattr(line, end).std ** 2 + extra)
+    return math.sqrt(line.linear_end(end).std ** 2 + extra)
 
 
 def fd(elements: int, scale: float) -> dict:
@@ -158,7 +158,7 @@ says so beyond ×1.25.
             "|---|---|---|---|---|---|---|---|",
         ]
         for k, (end, label) in enumerate(ENDS):
-            s_fd = getattr(line, end).std
+            s_fd = line.linear_end(end).std
             quad = ci((sig["quad_st"][:, k] - sig["lin_amp"][:, k]) / s_fd)
             geo = ci((sig["lin_amp"][:, k] - sig["lin"][:, k]) / s_fd)
             rows.append(
@@ -189,7 +189,7 @@ def sea_table(res: dict, seeds: tuple[int, ...]) -> str:
         line = r["line"]
         for k, (end, label) in enumerate(ENDS):
             m, h = ci(r["td"][:, k])
-            fd_, cor = getattr(line, end).std, corrected(line, end)
+            fd_, cor = line.linear_end(end).std, corrected(line, end)
             quad = ci((r["td"][:, k] - r["td_lin"][:, k]) / fd_)
             rows.append(
                 f"| {name} | {label} | {fd_:.4g} | {_pct(line.drag_residual.ratio(end) - 1)} "
@@ -220,7 +220,7 @@ evenly (as the old closed form).  The linear model has the same defect (one B pe
 element): its misfit (B(ξ) − B_e)·v is linear, correlated with the linear response, and
 lowers the fairlead σ² by 22 % here.  Now the elements whose wave-velocity variance
 varies by more than ×1.5 along them are split into pieces (up to half the panel
-budget, `stochcable.dynamics.drag_segments`), whole elements are grouped into panels
+budget, `stochcable.dynamics.residuals.drag_segments`), whole elements are grouped into panels
 only where the variance is uniform enough, the misfit enters with its cross term, and
 the guy's corrected σ lands within the TD's interval.  Splitting finer (×1.05, 186
 panels) moves it by 0.2 %; on 160 elements (linear σ −7.5 %) the corrected σ is 3 %

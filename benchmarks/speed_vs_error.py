@@ -289,7 +289,7 @@ def fd_with_residuals(doc: dict[str, Any]) -> dict[str, float]:
     line = next(iter(stochcable.analyze(d).lines.values()))
     out = {}
     for q, e in (("T_fairlead", "end_b"), ("T_anchor", "end_a")):
-        var = getattr(line, e).std ** 2
+        var = line.linear_end(e).std ** 2
         for rec in (line.drag_residual, line.geometric_residual):
             var = var + (rec.variance[e] if rec is not None and rec.computed else math.nan)
         out[q] = math.sqrt(var) if var >= 0 else math.nan

@@ -52,7 +52,6 @@ from typing import Any
 from stochcable.dynamics.engine import Engine, build_engine
 from stochcable.dynamics.model.system import Progress, noop_progress
 from stochcable.errors import PhysicsWarning, warn
-from stochcable.fidelity import apply_fidelity, choose_fidelity
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, load_scene
 from stochcable.statics import StaticsResult
@@ -118,6 +117,8 @@ def analyze(
 
 def _plan_fidelity(scene: Scene, progress: Progress) -> tuple[Scene, Any]:
     """The scene with the settings adaptive fidelity chose, and the plan."""
+    from stochcable.fidelity import apply_fidelity, choose_fidelity  # (only when asked)
+
     progress("fidelity", {})
     target = scene.analysis.fidelity.target_error
     # the planner runs pilot analyses of the scene: without the request itself

@@ -34,6 +34,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
+from pathlib import Path
 from typing import Any
 
 import httpx
@@ -42,7 +43,7 @@ import numpy as np
 from stochcable.client_batches import BatchJob, BatchMethods
 from stochcable.errors import StochcableError
 from stochcable.results.views import AnalysisDocument, LineDocument, TimeSeriesWindow
-from stochcable.scene.model import G_STANDARD, OmegaGrid, Scene
+from stochcable.scene.model import G_STANDARD, OmegaGrid, Scene, load_scene
 from stochcable.sea.spectra import SpectrumStatistics
 
 __all__ = [
@@ -433,15 +434,17 @@ class Client(BatchMethods):
         return Scene.model_validate(data)
 
     def analyze(
-        self, scene: Scene | Mapping[str, Any], timeseries: str = "window"
+        self, scene: Scene | Mapping[str, Any] | str | Path, timeseries: str = "window"
     ) -> AnalysisDocument:
         """``POST /v1/analyses``: run the analysis of a scene on the service.
 
         Parameters
         ----------
-        scene : Scene or mapping
-            The scene document (:class:`~stochcable.scene.model.Scene`, a dict, or
-            ``client.example(name)``).
+        scene : Scene, mapping, JSON string or path
+            The scene document (:class:`~stochcable.scene.model.Scene`, a dict,
+            ``client.example(name)``, JSON text or a file), validated here first by
+            :func:`~stochcable.scene.model.load_scene` (bodies' hydrodynamics inline:
+            the service reads no files).
         timeseries : {"window", "full", "none"}
             Time series in the document: the first 2048 samples, all, or none.
 
@@ -453,6 +456,8 @@ class Client(BatchMethods):
 
         Raises
         ------
+        InputError
+            An invalid scene, found here before any request.
         ClientError
             422: invalid scene (field path, unit, constraint), a size bound exceeded,
             or the solver failed (e.g. the drag linearization did not converge: the
@@ -465,6 +470,6 @@ class Client(BatchMethods):
             from stochcable.errors import InputError
 
             raise InputError("timeseries", timeseries, "-", "must be 'window', 'full' or 'none'")
-        body = scene.model_dump(mode="json") if isinstance(scene, Scene) else _document(scene)
+        body = load_scene(scene, allow_files=False).model_dump(mode="json")
         resp = self._request("POST", f"/v1/analyses?timeseries={timeseries}", json_body=body)
         return AnalysisDocument(resp.json())

@@ -25,7 +25,7 @@ from typing import Any
 from stochcable.cases import LineFatigue, ScatterDiagram, read_scatter
 from stochcable.errors import InputError, PhysicsWarning, StochcableError
 from stochcable.results.display import batch_status_html, batch_status_text
-from stochcable.scene.model import Scene
+from stochcable.scene.model import Scene, load_scene
 
 __all__ = ["BatchJob", "BatchMethods", "BatchTimeout"]
 
@@ -117,7 +117,7 @@ class BatchMethods:
 
     def submit_batch(
         self,
-        scene: Scene | Mapping[str, Any],
+        scene: Scene | Mapping[str, Any] | str | Path,
         scatter: ScatterDiagram | str | Path | Sequence[Mapping[str, Any]] | Mapping[str, Any],
         *,
         headings: Sequence[float] | None = None,
@@ -130,8 +130,9 @@ class BatchMethods:
 
         Parameters
         ----------
-        scene : Scene or mapping
-            The scene template.
+        scene : Scene, mapping, JSON string or path
+            The scene template, validated here first
+            (:func:`~stochcable.scene.model.load_scene`).
         scatter : ScatterDiagram, path, or a scatter document
             As :func:`stochcable.cases.read_scatter` reads (a CSV or JSON file is read
             here and sent as rows).
@@ -160,9 +161,9 @@ class BatchMethods:
             (``STOCHCABLE_MAX_BATCH_CASES``, ...); 401 without a valid API key.
         """
         body: dict[str, Any] = {
-            "scene": scene.model_dump(mode="json", exclude_unset=True)
-            if isinstance(scene, Scene)
-            else dict(scene),
+            "scene": load_scene(scene, allow_files=False).model_dump(
+                mode="json", exclude_unset=True
+            ),
             "scatter": _scatter_document(scatter),
             "years": years,
         }

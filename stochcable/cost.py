@@ -129,19 +129,20 @@ _BODY_TIME_FACTOR = 1.0  # extra time per free body (coupled solves): 2.6 µs vs
 
 #: The residuals of the linear model (``analysis.linearization.drag_residual`` and
 #: ``.geometric_residual``): their peak memory (bounded by their blocks: the drag's
-#: ≤ 128 components on ≤ 1024 lines, the geometric covariance blocks of 64 MiB and its
+#: ≤ 64 components on ≤ 128 lines (≤ 1024 and 128 before issue 31, when the times
+#: below were measured), the geometric covariance blocks of 64 MiB and its
 #: transfer functions) and their time per component pair and FFT sample·log₂ — an
 #: analysis of the chain, the inclined guy and the taut wire with both measured 0.53,
 #: 0.65 and 0.16 s against 0.72, 0.79 and 0.18 s estimated (the chain at 160 elements:
-#: 0.90 against 0.80 s); the caps are those of :mod:`stochcable.dynamics.residual_lines`
+#: 0.90 against 0.80 s); the caps are those of :mod:`stochcable.dynamics.residuals.residual_lines`
 #: and the two residual modules.  In a sea the drag residual splits the elements near
-#: the surface (:mod:`stochcable.dynamics.drag_segments`; 40 elements: the chain 54
+#: the surface (:mod:`stochcable.dynamics.residuals.drag_segments`; 40 elements: the chain 54
 #: panels, the guy 53), counted as a quarter of the panel cap more in every sea (the
 #: chain and the guy: 1.12 and 1.43 s measured against 1.29 and 1.36 s estimated, on a
 #: loaded host; the taut wire, 10 m below the surface, splits none: 0.21 against 0.52 s,
 #: on the safe side).
 _RESIDUAL_BYTES = 256 * 2**20
-_RESIDUAL_LINES, _DRAG_PANELS, _GEOMETRIC_ELEMENTS = 1024, 64, 400
+_RESIDUAL_LINES, _DRAG_PANELS, _GEOMETRIC_ELEMENTS, _GEOMETRIC_LINES = 63, 32, 400, 63
 _DRAG_SECONDS, _GEOMETRIC_SECONDS = 2.0e-9, 3.0e-10
 
 
@@ -157,11 +158,12 @@ def _residual_seconds(scene: Scene) -> float:
     for line in scene.lines:
         n_el = sum(int(s.elements) for s in line.segments)
         if lin.drag_residual:
-            fft = 2 ** math.ceil(math.log2(10 * n_j + 2))
+            fft = 2 ** math.ceil(math.log2(6 * n_j + 2))  # (orders 2 and 3)
             panels = min(n_el + (_DRAG_PANELS // 4 if scene.sea is not None else 0), _DRAG_PANELS)
-            out += _DRAG_SECONDS * (2 * panels) ** 2 * fft * math.log2(fft)
+            # (the pairs f ≥ e: half of them)
+            out += _DRAG_SECONDS * 2 * panels**2 * fft * math.log2(fft)
         if lin.geometric_residual and n_el <= _GEOMETRIC_ELEMENTS:
-            fft = 2 ** math.ceil(math.log2(4 * n_j + 2))
+            fft = 2 ** math.ceil(math.log2(4 * min(n_j, _GEOMETRIC_LINES + 1) + 2))
             out += _GEOMETRIC_SECONDS * 12 * n_el**2 * fft * math.log2(fft)
     return out
 

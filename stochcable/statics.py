@@ -1,30 +1,48 @@
-"""The statics stage of the pipeline: static equilibrium of a scene (seed 001 §4.1).
+"""The statics stage of the pipeline: static equilibrium of a scene (Tuah (1982), §4.1).
 
 Above :mod:`stochcable.line` (one line's statics) and :mod:`stochcable.bodies` (the
 body poses): a scene without bodies is its lines, each solved alone
-(:func:`stochcable.line.statics.line_statics`); a scene with bodies is solved by
+(:func:`stochcable.line.statics.solve_line_statics`); a scene with bodies is solved by
 Newton on the free body poses with the lines attached
 (:func:`stochcable.bodies.statics.solve_body_statics`).  Then, about the static shape,
 the finite-element model and the natural modes of every line
-(:func:`scene_fe_models`, :func:`modes_of_scene`).
+(:func:`scene_fe_models`, :func:`natural_modes`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from stochcable.line.fem import FEModel, build_fe_model, check_dim
 from stochcable.line.mesh import mesh_line
-from stochcable.line.modes import Modes, natural_modes
-from stochcable.line.statics import LineStatics, Method, check_statics_options, line_statics
+from stochcable.line.modes import Modes
+from stochcable.line.modes import natural_modes as line_modes
+from stochcable.line.statics import (
+    LineStatics,
+    Method,
+    check_statics_options,
+    solve_line_statics_unchecked,
+)
 from stochcable.scene.model import Scene, load_scene
 from stochcable.validation import positive_int
 
 if TYPE_CHECKING:  # pragma: no cover
     from stochcable.bodies.statics import BodyStatics
 
-__all__ = ["StaticsResult", "solve_statics", "scene_fe_models", "modes_of_scene"]
+__all__ = [
+    "StaticsResult",
+    "solve_statics",
+    "scene_fe_models",
+    "natural_modes",
+    "modes_of_scene",
+]
 
 
 @dataclass(frozen=True)
@@ -45,14 +63,18 @@ class StaticsResult:
 
 
 def solve_statics(
-    scene: Scene, method: Method = "auto", *, tolerance: float = 1e-10, max_iterations: int = 500
+    scene: Scene | Mapping[str, Any] | str | Path,
+    method: Method = "auto",
+    *,
+    tolerance: float = 1e-10,
+    max_iterations: int = 500,
 ) -> StaticsResult:
     """Static equilibrium of every line of a scene.
 
     Parameters
     ----------
-    scene : Scene
-        The validated scene (see :func:`stochcable.scene.model.load_scene`).
+    scene : Scene, mapping, JSON string or path
+        The scene document (validated by :func:`stochcable.scene.model.load_scene`).
     method : {"auto", "fe", "catenary"}, optional
         Solution method, see :func:`stochcable.line.statics.solve_line_statics`.
     tolerance : float, optional
@@ -76,6 +98,7 @@ def solve_statics(
     ConvergenceError
         A line or the body poses did not converge.
     """
+    scene = load_scene(scene)
     method, tolerance, max_iterations = check_statics_options(method, tolerance, max_iterations)
     env = scene.environment
     if scene.bodies:
@@ -88,7 +111,9 @@ def solve_statics(
     out = {}
     for line in scene.lines:
         mesh = mesh_line(line, env.rho, env.g)
-        out[line.name] = line_statics(mesh, env, method, None, tolerance, max_iterations)
+        out[line.name] = solve_line_statics_unchecked(
+            mesh, env, method, None, tolerance, max_iterations
+        )
     return StaticsResult(lines=out)
 
 
@@ -126,18 +151,20 @@ def scene_fe_models(
     }
 
 
-def modes_of_scene(
-    scene: Any,
+def natural_modes(
+    scene: Scene | Mapping[str, Any] | str | Path | FEModel,
     count: int | None = None,
     dim: int = 3,
     added_mass: bool = True,
-) -> dict[str, Modes]:
+) -> dict[str, Modes] | Modes:
     """Natural modes of every line of a scene about its static equilibrium.
 
     Parameters
     ----------
-    scene : Scene, mapping, JSON string or path
-        The scene document (:func:`stochcable.scene.model.load_scene`).
+    scene : Scene, mapping, JSON string, path or FEModel
+        The scene document (:func:`stochcable.scene.model.load_scene`); an
+        :class:`~stochcable.line.fem.FEModel` gives that one model's modes
+        (:func:`stochcable.line.modes.natural_modes`, ``dim`` unused).
     count : int, optional
         Modes per line; default all.
     dim : {2, 3}
@@ -149,12 +176,19 @@ def modes_of_scene(
     Returns
     -------
     dict of str to Modes
-        Per line name, in scene order.
+        Per line name, in scene order (a :class:`~stochcable.line.modes.Modes` for an
+        FEModel).
     """
     if count is not None:
         count = positive_int("count", count)
+    if isinstance(scene, FEModel):
+        return line_modes(scene, count=count, added_mass=added_mass)
     models = scene_fe_models(scene, dim=dim)
     return {
-        name: natural_modes(model, count=count, added_mass=added_mass)
+        name: line_modes(model, count=count, added_mass=added_mass)
         for name, model in models.items()
     }
+
+
+#: The former name of :func:`natural_modes` on a scene (kept for the callers of it).
+modes_of_scene = natural_modes

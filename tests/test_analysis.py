@@ -32,7 +32,10 @@ from stochcable.statics import solve_statics
 # The fairlead surge spectra below have a PM ω⁻⁵ tail, so the tension spectra are cut by
 # the 2 rad/s grids (ResolutionWarning, tested in test_grid_cutting_the_response_warns);
 # the tests compare methods on the same grid, so the warning is silenced elsewhere.
-pytestmark = pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning")
+pytestmark = [
+    pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning"),
+    pytest.mark.xdist_group("test_analysis"),
+]
 
 PM_SEA = {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}
 PM_SURGE = {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}
@@ -936,24 +939,6 @@ def test_warnings_and_document_use_the_scene_units_in_feet(monkeypatch) -> None:
 def test_result_document_names_si_units() -> None:
     doc = analysis.analyze(_scene_without_timeseries("taut_wire")).to_document()
     assert doc["units"] == {"system": "SI", "length": "m", "mass": "kg", "force": "N", "time": "s"}
-
-
-def test_pipeline_statistics_equal_the_validated_public_function() -> None:
-    """The analysis' end statistics skip the second validation of its grid
-    (results.stats_from_validated) and equal results.stats_from_spectrum to the bit; the
-    public function still rejects a bad grid with its message."""
-    from stochcable.results.documents import stats_from_spectrum, stats_from_validated
-
-    rng = np.random.default_rng(5)
-    w = np.linspace(0.05, 2.0, 120)
-    dens = rng.uniform(0.0, 1.0, w.size) ** 2
-    for duration in (10800.0, 3600.0):
-        assert (
-            stats_from_validated(w, dens, 12.5, duration).as_dict()
-            == stats_from_spectrum(w, dens, 12.5, duration).as_dict()
-        )
-    with pytest.raises(InputError, match="omega"):
-        stats_from_spectrum(w[::-1], dens, 0.0, 10800.0)
 
 
 def test_nearest_spacing_equals_argmin_and_gradient():

@@ -22,7 +22,10 @@ from stochcable.sea.realization import simulate_sea, synthesize
 
 # Undamped and lightly damped test cases put natural frequencies inside the grid on
 # purpose; the ResolutionWarning they raise is tested in tests/test_analysis.py.
-pytestmark = pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning")
+pytestmark = [
+    pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning"),
+    pytest.mark.xdist_group("test_analysis_validation"),
+]
 
 PM_SEA = {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}
 

@@ -8,7 +8,9 @@ source of ``stochcable/`` and ``service/``:
     is imported only inside its own package.  Imports inside functions count.
 (b) no module of ``stochcable/`` is longer than :data:`MODULE_LIMIT` lines;
 (c) no function is longer than :data:`FUNCTION_LIMIT` lines of code (from its ``def``
-    to its end, the docstring not counted: documentation is read apart from the code).
+    to its end, the docstring not counted: documentation is read apart from the code);
+(d) a function ``<name>_unchecked`` (a trusted kernel) has its checked twin ``<name>``
+    in the same module, which calls it (docs/ARCHITECTURE.md, "Conventions").
 
 Each rule has an explicit allow-list of today's offenders (the restructure of issue 13
 is in progress) that may only shrink: an entry is also an upper bound (an allowed
@@ -343,3 +345,47 @@ def test_private_import_rule_on_snippets(monkeypatch, source, importer, expected
     monkeypatch.setattr(this, "MODULES", [m])
     monkeypatch.setattr(this, "MODULE_NAMES", MODULE_NAMES | {"stochcable.cli._output"})
     assert len(_private_import_violations() + _private_attribute_violations()) == expected
+
+
+# ------------------------------------------------------- checked and unchecked functions
+
+
+def _unchecked_pair_violations(modules: list[Module]) -> list[str]:
+    """(d) docs/ARCHITECTURE.md "Conventions": a trusted kernel ``<name>_unchecked`` sits
+    in the module of its checked twin ``<name>``, which validates and then calls it."""
+    problems = []
+    for m in modules:
+        defs = {n.name: n for n in m.tree.body if isinstance(n, ast.FunctionDef)}
+        for name, node in defs.items():
+            if not name.endswith("_unchecked"):
+                continue
+            twin = defs.get(name.removesuffix("_unchecked"))
+            calls = twin is not None and any(
+                isinstance(c, ast.Call) and getattr(c.func, "id", None) == name
+                for c in ast.walk(twin)
+            )
+            if not calls:
+                problems.append(
+                    f"{m.rel}:{node.lineno}: {name} needs its checked twin "
+                    f"{name.removesuffix('_unchecked')}() in this module, calling it after "
+                    "the input checks"
+                )
+    return problems
+
+
+def test_every_unchecked_kernel_has_its_checked_twin():
+    problems = _unchecked_pair_violations(MODULES)
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize(
+    "source, expected",
+    [
+        ("def f(x):\n    return f_unchecked(x)\ndef f_unchecked(x):\n    return x", 0),
+        ("def f_unchecked(x):\n    return x", 1),
+        ("def f(x):\n    return x\ndef f_unchecked(x):\n    return x", 1),
+    ],
+)
+def test_unchecked_pair_rule_on_snippets(source, expected):
+    m = Module("stochcable.x", Path("x.py"), "stochcable/x.py", ast.parse(source), False)
+    assert len(_unchecked_pair_violations([m])) == expected

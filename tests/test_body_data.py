@@ -145,6 +145,7 @@ def _cylinder_dataset(center_x):
     return cpt.BEMSolver().fill_dataset(test, body, hydrostatics=True)
 
 
+@pytest.mark.slow
 def test_capytaine_cylinder_phase_convention(tmp_path):
     """The same cylinder meshed at x = 0 and at x = 5, both placed at x = 5: the
     excitation agrees after the wave-phase shift e^{−ik x cos β} only with the

@@ -247,6 +247,7 @@ def _fd_series_fem(scene, hist):
     return synthesize(real, U), kin, real
 
 
+@pytest.mark.slow
 def test_linear_limit_same_realization_equals_fe_synthesis():
     # Tiny waves (Hs 0.1 m) on a 1 m/s current: the drag ½ρCdD|U+v|(U+v) is linear in
     # v to O(v/U) (the seed's Taylor expansion, eq. 3.2.a.6), and the current's linear
@@ -272,6 +273,7 @@ def test_linear_limit_same_realization_equals_fe_synthesis():
         assert np.corrcoef(a, b)[0, 1] > 1 - tol
 
 
+@pytest.mark.slow
 def test_linear_limit_same_realization_equals_analysis_series():
     # The product's own synthesized end-tension series (analyze, same seed, same
     # band) against the TD end tension: the same realization drives both.
@@ -299,6 +301,7 @@ def _assert_series_match(ts, hist) -> np.ndarray:
     return b
 
 
+@pytest.mark.slow
 def test_linear_limit_short_crested_sea_equals_analysis_series():
     # A spread sea (cos-2s, s = 4, 8 directions about 30°: the tether in 3-D): each
     # direction realized with the analysis' rule (simulate_sea_directional, same seed)
@@ -530,6 +533,7 @@ def test_stationarity_ratio_of_stationary_and_diverged_records():
     assert w_dom == pytest.approx(18.9, abs=bin_)
 
 
+@pytest.mark.slow
 def test_nonstationary_record_warning_is_wired(monkeypatch):
     """tuah_1982_single_leg on its 3-element mesh at Δt = 0.125 s (the automatic step)
     goes slack and taut at every wave crest.  In some seeds the two inner nodes then

@@ -14,6 +14,9 @@ from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
 from stochcable.errors import InputError
 from stochcable.examples import load_example
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_cases_executors")
+
 FATIGUE = LineFatigue("dnv-studless", nominal_diameter=0.084)
 
 
@@ -61,6 +64,7 @@ def test_chunking_does_not_change_a_bit(scene, scatter, serial):
     assert done == [(5, 12), (10, 12), (12, 12)]
 
 
+@pytest.mark.slow
 def test_process_pool_gives_the_same_bits(scene, scatter, serial):
     ctx = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=2, mp_context=ctx) as pool:
@@ -68,6 +72,7 @@ def test_process_pool_gives_the_same_bits(scene, scatter, serial):
     _assert_same_bits(serial, pooled)
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_gives_the_same_bits(scene, scatter, serial):
     distributed = pytest.importorskip("distributed")
     with (
@@ -95,6 +100,7 @@ def test_chunk_size_is_validated(scene, scatter):
         run_cases(scene, scatter, chunk_size=0)
 
 
+@pytest.mark.slow
 def test_a_killed_dask_worker_costs_nothing(scene, scatter, serial):
     # One worker process is killed (SIGKILL) after the first chunks finish: its nanny
     # restarts it, the scheduler reruns the chunks it held, and the set completes with

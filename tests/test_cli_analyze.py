@@ -52,6 +52,7 @@ def scene_file(tmp_path):
     return p
 
 
+@pytest.mark.slow
 def test_analyze_writes_the_v1_result_document_and_plots(scene_file, tmp_path, capsys):
     out = tmp_path / "result.json"
     figs = tmp_path / "figs"
@@ -161,6 +162,7 @@ def _run_on_a_terminal(args: list[str]) -> tuple[str, str]:
     return ANSI.sub("", b"".join(chunks).decode()), err
 
 
+@pytest.mark.slow
 def test_analyze_on_a_terminal_prints_a_summary(scene_file, capsys):
     text, err = _run_on_a_terminal(["analyze", str(scene_file), "--timeseries", "none"])
     assert main(["analyze", str(scene_file), "--timeseries", "none"]) == 0
@@ -178,6 +180,7 @@ def test_analyze_on_a_terminal_prints_a_summary(scene_file, capsys):
         assert (text + err).count(msg[:60]) == 1, msg
 
 
+@pytest.mark.slow
 def test_analyze_summary_of_a_foot_slug_second_scene_is_in_ft_and_lbf():
     scene = ROOT / "stochcable" / "examples" / "tuah_1982_disc_buoy_three_legs.json"
     text, _ = _run_on_a_terminal(["analyze", str(scene)])

@@ -50,6 +50,7 @@ def test_csv_and_netcdf_outputs(scatter, tmp_path):
     np.testing.assert_array_equal(got, ds["damage_rate"].sel(line="wire", end="end_b").values)
 
 
+@pytest.mark.slow
 def test_bundled_north_atlantic_diagram_runs(tmp_path):
     out = tmp_path / "na.json"
     args = ["cases", WIRE, "--scatter", NORTH_ATLANTIC, "--curve", "dnv-six-strand",
@@ -76,6 +77,7 @@ def test_errors_are_one_line(scatter, capsys, extra, message):
     assert err.count("\n") == 1
 
 
+@pytest.mark.slow
 def test_local_cluster_from_the_command_line(scatter, tmp_path):
     pytest.importorskip("distributed")
     a, b = tmp_path / "a.json", tmp_path / "b.json"

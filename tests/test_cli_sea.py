@@ -197,8 +197,8 @@ def test_plot(capsys, tmp_path):
 @pytest.mark.parametrize(
     "argv,flag",
     [
-        (["spectrum", "pm", "--hs", "-6", "--tp", "10"], "--hs = -6.0 [m]: must be > 0"),
-        (["spectrum", "pm", "--hs", "6", "--tp", "0"], "--tp = 0.0 [s]: must be > 0"),
+        (["spectrum", "pm", "--hs", "-6", "--tp", "10"], "--hs = -6.0 [m]: must be >= 1e-06"),
+        (["spectrum", "pm", "--hs", "6", "--tp", "0"], "--tp = 0.0 [s]: must be >= 0.001"),
         (["spectrum", "pm", "--hs", "6"], "--tp = None [s]: is required for the pm spectrum"),
         (["spectrum", "pm", "--tp", "10"], "--hs = None: is required for the pm spectrum"),
         (

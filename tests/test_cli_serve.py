@@ -85,6 +85,7 @@ def test_bad_port_is_a_one_line_error(capsys):
     assert err.strip() == "stochcable serve: error: --port = 70000: must be in 0 … 65535"
 
 
+@pytest.mark.slow
 def test_serve_starts_uvicorn_and_answers():
     port = _free_port()
     env = {**os.environ, "STOCHCABLE_MAX_SAMPLES": "4096"}

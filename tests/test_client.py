@@ -28,6 +28,9 @@ from stochcable.sea.kinematics import kinematics_timeseries
 from stochcable.sea.realization import simulate_sea
 from stochcable.sea.spectra import SpectrumStatistics, spectrum_statistics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_client")
+
 JONSWAP = Jonswap(hs=4.0, tp=8.0)
 
 

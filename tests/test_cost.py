@@ -75,6 +75,7 @@ def _measured_peak(doc: dict) -> int:
     return int(out.stdout.split()[-1])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("name", "elements", "count"),
     [
@@ -137,6 +138,7 @@ def test_cli_refuses_a_scene_too_large_in_one_sentence(tmp_path, capsys):
     assert "estimated peak memory" in err and "reduce analysis.omega.count" in err
 
 
+@pytest.mark.slow
 def test_residuals_are_in_the_estimate_and_bound_their_peak():
     """The residuals of the linear model add their time and a bounded memory
     (≤ 256 MiB: blocked covariance functions) to the estimate, which bounds the measured
@@ -162,8 +164,9 @@ def test_residual_caps_are_the_modules():
     """The cost model's copies of the residuals' caps (it sits below the dynamics layer)
     are the caps the residual modules apply."""
     from stochcable import cost
-    from stochcable.dynamics import drag_residual, geometric_residual, residual_lines
+    from stochcable.dynamics.residuals import drag_residual, geometric_residual, residual_lines
 
     assert cost._RESIDUAL_LINES == residual_lines.MAX_LINES
     assert cost._DRAG_PANELS == drag_residual.MAX_PANELS
     assert cost._GEOMETRIC_ELEMENTS == geometric_residual.MAX_ELEMENTS
+    assert cost._GEOMETRIC_LINES == geometric_residual.MAX_LINES

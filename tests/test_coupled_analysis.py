@@ -41,6 +41,9 @@ from stochcable.reference.bodies import solve_coupled_direct
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_coupled_analysis")
+
 RHO = 1025.0
 
 

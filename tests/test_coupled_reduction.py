@@ -42,6 +42,9 @@ from stochcable.dynamics.model.system import build_line_system, noop_progress
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_coupled_reduction")
+
 sys.path.insert(0, str(Path(__file__).parent))
 from test_coupled_analysis import RHO, _buoy, _group, _mooring_doc  # noqa: E402
 

@@ -36,6 +36,7 @@ from stochcable.sea.realization import simulate_sea
 # The example's 3-element leg has large motions (its warnings are the subject of
 # other tests); the grid cuts the PM end-motion tail on purpose.
 pytestmark = [
+    pytest.mark.xdist_group("test_coupled_timeseries"),
     pytest.mark.filterwarnings("ignore::stochcable.errors.PhysicsWarning"),
     pytest.mark.filterwarnings("ignore::stochcable.errors.ResolutionWarning"),
 ]

@@ -13,6 +13,9 @@ from stochcable.analysis import analyze
 from stochcable.results.datasets import dataset_from_document, netcdf_bytes
 from stochcable.scene.model import load_scene
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_datasets")
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "stochcable" / "examples"
 xr = pytest.importorskip("xarray")
 pytest.importorskip("netCDF4")

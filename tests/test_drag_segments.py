@@ -1,4 +1,4 @@
-"""Where the drag residual is evaluated (stochcable.dynamics.drag_segments) and the
+"""Where the drag residual is evaluated (stochcable.dynamics.residuals.drag_segments) and the
 linear part it gains there: the pieces of split elements integrate to their element's
 kinematics, their loads to a unit force at their centroid; the decomposition of the
 pointwise dropped drag (the linear misfit of the element-constant B, correlated with
@@ -16,10 +16,12 @@ import numpy as np
 import pytest
 from scipy import stats
 
-import stochcable.dynamics.drag_residual as dr
+import stochcable.dynamics.residuals.drag_residual as dr
 from stochcable import analyze, load_example, load_scene
-from stochcable.dynamics.drag_residual import hermite_coefficients, residual_output_lines
-from stochcable.dynamics.drag_segments import (
+from stochcable.dynamics.loads.channels import line_channels
+from stochcable.dynamics.model.system import build_line_system
+from stochcable.dynamics.residuals.drag_residual import hermite_coefficients, residual_output_lines
+from stochcable.dynamics.residuals.drag_segments import (
     MAX_SUB,
     Segments,
     panel_groups,
@@ -27,9 +29,7 @@ from stochcable.dynamics.drag_segments import (
     segment_velocity,
     segments,
 )
-from stochcable.dynamics.loads.channels import line_channels
-from stochcable.dynamics.model.system import build_line_system
-from stochcable.dynamics.residual_lines import element_directions
+from stochcable.dynamics.residuals.residual_lines import element_directions
 from stochcable.reference.cable import simulate_line_timedomain
 from stochcable.statics import solve_statics
 
@@ -73,8 +73,8 @@ def test_pieces_integrate_to_their_elements_kinematics():
 def test_panel_loads_are_unit_forces_at_the_panels_centroids():
     """Every panel's nodal loads add up to the unit force along its direction, and their
     first moment puts it at the length-weighted centroid of its pieces; the pieces of a
-    split element are panels of their own, whole elements are grouped (three at a time
-    for 160 elements, as before the split)."""
+    split element are panels of their own, whole elements are grouped (⌈160/32⌉ = 5 at
+    a time for 160 elements)."""
     system, chans, scale = _line("inclined_guy")
     model = system.model
     seg = segments(system, chans, scale, dr.MAX_PANELS)
@@ -93,11 +93,14 @@ def test_panel_loads_are_unit_forces_at_the_panels_centroids():
         )
         at = x[e] + seg.xi[g, None] * (x[e + 1] - x[e])
         mag = np.linalg.norm(unit[:, :, q], axis=1)
-        np.testing.assert_allclose(mag @ x / mag.sum(), share @ at, rtol=1e-9)
+        # (the normals of a group's neighbouring elements differ slightly: a shared node's
+        # load magnitude is not quite the sum of its shares, 1e-9 on 5-element groups)
+        np.testing.assert_allclose(mag @ x / mag.sum(), share @ at, rtol=1e-8)
     whole = Segments(np.arange(160), np.zeros(160), np.ones(160), np.ones(160), np.zeros(160, bool))
-    assert len(panel_groups(whole, dr.MAX_PANELS)) == 54
+    assert len(panel_groups(whole, dr.MAX_PANELS)) == 32
 
 
+@pytest.mark.slow
 def test_corrected_sigma_holds_under_mesh_refinement():
     """The inclined guy's FD σ with the drag residual on 40 and 160 elements: the linear
     σ falls by 7.5 % (one B per element on the 14 m deep top element), the corrected
@@ -112,7 +115,7 @@ def test_corrected_sigma_holds_under_mesh_refinement():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             out[n] = analyze(doc).lines["guy"]
-    assert out[160].end_b.std / out[40].end_b.std < 0.94
+    assert out[160].linear_end("end_b").std / out[40].linear_end("end_b").std < 0.94
     for end in ("end_a", "end_b"):
         cor = out[160].drag_residual.std[end] / out[40].drag_residual.std[end]
         assert 1.0 < cor < 1.04

@@ -238,6 +238,7 @@ def test_chosen_settings_meet_the_target_against_a_finer_reference(name, target)
     assert err.max() < target, err  # the target
 
 
+@pytest.mark.slow
 def test_chain_surge_tail_is_bounded_once_the_pilot_reaches_the_axial_regime():
     # chain_catenary: the PM (ω⁻⁵) fairlead surge drives inertia tension loads whose
     # spectrum decays like ω⁻¹ up to the axial resonances (first at ≈ 15 rad/s: c =

@@ -29,6 +29,9 @@ from stochcable.fidelity.limits import (
 )
 from stochcable.scene.model import OmegaGrid, Segment
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_fidelity_limits")
+
 
 def _chain(target: float | None = None) -> dict:
     """The chain example with DESIGN.md's untapered PM fairlead surge (ω⁻⁵ tail; the
@@ -60,6 +63,7 @@ def test_limits_are_read_from_the_scene_model():
     assert elements_limit() == le[0]
 
 
+@pytest.mark.slow
 def test_plan_at_0_3_percent_stays_within_the_limits_and_says_what_it_leaves(plan_03):
     plan = plan_03
     assert plan.omega_count <= omega_count_limit()
@@ -94,6 +98,7 @@ def test_plan_at_0_3_percent_stays_within_the_limits_and_says_what_it_leaves(pla
     assert "left unresolved" in text and "analysis.fidelity.target_error" in text
 
 
+@pytest.mark.slow
 def test_an_inadmissible_plan_is_an_input_error_naming_the_request(plan_03):
     bad = replace(plan_03, omega_count=omega_count_limit() + 1)
     with pytest.raises(InputError) as info:
@@ -118,6 +123,7 @@ def test_elements_are_clipped_to_the_model_with_a_larger_estimate(monkeypatch):
     apply_fidelity(scene, plan)  # admissible
 
 
+@pytest.mark.slow
 def test_unbounded_tail_warning_names_the_cause_and_the_fix(plan_03):
     (text, _, _) = fidelity_warnings(replace(plan_03, tail_bounded=False))
     assert "could not bound the response tail" in text
@@ -125,6 +131,7 @@ def test_unbounded_tail_warning_names_the_cause_and_the_fix(plan_03):
         assert part in text
 
 
+@pytest.mark.slow
 def test_met_targets_have_no_limits_and_unchanged_documents():
     # where the limits are not hit the plan is the one of the rules alone (no new keys)
     plan = choose_fidelity(_chain(), 0.05, evaluate=analyze)
@@ -163,6 +170,7 @@ def _model_error_said(texts: list[str], target: float) -> None:
     assert "0.077" in text and "touchdown" in text and "fd_budget" in text
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target", TARGETS)
 def test_library_entrance_meets_the_target(target):
     res = analyze(_chain(target))
@@ -185,6 +193,7 @@ def _cli(tmp_path, doc, capsys) -> tuple[int, str, dict | None]:
     return rc, err, (json.loads(out.read_text()) if rc == 0 else None)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target", TARGETS)
 def test_cli_entrance_meets_the_target(target, tmp_path, capsys):
     rc, err, out = _cli(tmp_path, _chain(target), capsys)
@@ -206,6 +215,7 @@ def client():
         yield c
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("target", TARGETS)
 def test_http_entrance_meets_the_target(target, client):
     resp = client.post("/v1/analyses", json=_chain(target))
@@ -244,6 +254,7 @@ def _check_limit_warning(texts: list[str]) -> None:
     assert "estimated σ error" in text and "analysis.fidelity.target_error" in text
 
 
+@pytest.mark.slow
 def test_entrances_at_the_limit_answer_with_the_warning(low_limit, tmp_path, capsys):
     res = analyze(_chain(0.05))
     assert res.fidelity.omega_count == 200 and not res.fidelity.grid_resolved
@@ -267,6 +278,7 @@ def no_limit(monkeypatch):
     monkeypatch.setattr(planner, "omega_count_limit", lambda: 10**9)
 
 
+@pytest.mark.slow
 def test_entrances_refuse_an_inadmissible_plan(no_limit, tmp_path, capsys):
     with pytest.raises(InputError) as info:
         analyze(_chain(0.003))
@@ -284,6 +296,7 @@ def test_entrances_refuse_an_inadmissible_plan(no_limit, tmp_path, capsys):
     assert "analysis.omega.count" in json.dumps(detail)
 
 
+@pytest.mark.slow
 def test_a_plan_beyond_the_memory_available_is_refused(monkeypatch):
     # a machine with 1 MiB free: the 5 % plan of the chain (≈ 10² MB by the cost
     # model) is refused before any work, naming the target and the estimate

@@ -27,6 +27,7 @@ def test_gallery_has_a_script_per_bundled_example():
         assert f'load_example("{name}")' in text, name
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "script",
     [pytest.param(p, marks=pytest.mark.slow) if p.name in SLOW else p for p in SCRIPTS],

@@ -1,4 +1,4 @@
-"""The geometric residual (stochcable.dynamics.geometric_residual): the end-tension
+"""The geometric residual (stochcable.dynamics.residuals.geometric_residual): the end-tension
 variance of the second-order geometric forces of the linear response.
 
 Independent checks: the quadratic forms' output lines against Monte-Carlo Gaussian
@@ -18,9 +18,9 @@ import pytest
 from _scenes import chain_surge_doc, td_end_sigma
 from scipy import stats
 
-import stochcable.dynamics.geometric_residual as gr
+import stochcable.dynamics.residuals.geometric_residual as gr
 from stochcable import analyze
-from stochcable.dynamics.geometric_residual import quadratic_output_lines
+from stochcable.dynamics.residuals.geometric_residual import quadratic_output_lines
 
 #: planar components of an element: ½b² along t, a·b along n (a, b: processes 0, 1)
 TERMS = [[(0.5, 1, 1)], [(1.0, 0, 1)]]
@@ -110,7 +110,7 @@ def test_chain_correction_matches_the_time_domain_geometric_shift():
     res = line.geometric_residual
     assert res.computed and res.order == 2 and res.panels == 40
     pred = np.array([res.ratio("end_b"), res.ratio("end_a")]) - 1.0
-    fd = np.array([line.end_b.std, line.end_a.std])
+    fd = np.array([line.linear_end("end_b").std, line.linear_end("end_a").std])
     b = (np.asarray(line.linearization.b_normal), np.asarray(line.linearization.b_axial))
     doc = chain_surge_doc(40, residual=False)
     kw = {"drag": "linear", "linear_drag": b, "seabed": "linear"}

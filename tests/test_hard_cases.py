@@ -26,6 +26,9 @@ from stochcable.errors import InputError, PhysicsWarning, ResolutionWarning, Sol
 from stochcable.examples import load_example
 from stochcable.sea.kinematics import wavenumber
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_hard_cases")
+
 PM = {"type": "pierson_moskowitz", "hs": 4.0, "tp": 9.0}
 
 

@@ -29,6 +29,9 @@ from stochcable.dynamics.solve import line_solve as dsolve
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_linearization_start")
+
 EXAMPLE = Path(dsystem.__file__).resolve().parents[2] / "examples" / "chain_catenary.json"
 
 

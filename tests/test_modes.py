@@ -23,6 +23,9 @@ from stochcable.errors import InputError
 from stochcable.line.fem import assemble
 from stochcable.line.modes import Modes, natural_modes
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_modes")
+
 # Bliet 1984, §7.2 string (T = 1.0e6 N, m = 48.7 kg/m, L = 1036.32 m), eq. 3.5 values
 # (the thesis prints 0.434, 0.861: 0.861 is a misprint of nπ/L√(T/m) = 0.8688).
 BLIET_1984_EQ_3_5 = (0.4344, 0.8688, 1.3032)
@@ -535,7 +538,7 @@ def taut_scene_reference(n: int = 3) -> np.ndarray:
 
 def test_modes_of_scene_weightless_string():
     pytest.importorskip("stochcable.statics")
-    from stochcable.statics import modes_of_scene
+    from stochcable.statics import natural_modes as modes_of_scene
 
     m = modes_of_scene(TAUT_SCENE, count=6)["taut"]
     ref = np.repeat(taut_scene_reference(3), 2)

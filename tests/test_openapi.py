@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from service.openapi import DEFAULT_PATH, REGENERATE_COMMAND, main, openapi_document, render
 
 OPERATIONS = {
@@ -28,6 +30,7 @@ def test_committed_document_matches_the_app():
     )
 
 
+@pytest.mark.slow
 def test_check_mode_detects_drift(tmp_path, capsys):
     out = tmp_path / "openapi.json"
     out.write_text(render(openapi_document()), encoding="utf-8")

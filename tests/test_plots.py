@@ -11,6 +11,9 @@ import pytest
 from stochcable.analysis import analyze
 from stochcable.examples import load_example
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_plots")
+
 matplotlib = pytest.importorskip("matplotlib")
 matplotlib.use("Agg")
 
@@ -101,6 +104,7 @@ def test_timeseries_window_labels(chain):
     plt.close("all")
 
 
+@pytest.mark.slow
 def test_plot_result_writes_every_figure(fss, tmp_path):
     paths = plots.plot_result(fss, tmp_path)
     names = sorted(p.name for p in paths)

@@ -14,6 +14,9 @@ from stochcable.design import SECONDS_PER_YEAR
 from stochcable.errors import InputError
 from stochcable.examples import load_example, resources
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_plots_cases")
+
 pytest.importorskip("matplotlib")
 
 

@@ -18,10 +18,10 @@ import stochcable
 EXPECTED = {
     "analyze": "stochcable.analysis",
     "build_engine": "stochcable.dynamics.engine",
-    "load_scene": "stochcable.scene.model",
+    "load_scene": "stochcable.io",  # (also reads MoorDyn input files)
     "Scene": "stochcable.scene.model",
     "solve_statics": "stochcable.statics",
-    "natural_modes": "stochcable.line.modes",
+    "natural_modes": "stochcable.statics",
     "simulate_sea": "stochcable.sea.realization",
     "load_example": "stochcable.examples",
 }
@@ -58,3 +58,23 @@ def test_import_is_light():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "False"
+
+
+def test_the_first_analysis_imports_what_the_scene_uses():
+    # the chain (current: strumming screening; no fidelity target, no bodies' fits):
+    # its candidate modes are proven without a lock-in start by the NumPy bound and its
+    # grids are below the compiled kernels' threshold, so numba is not loaded, nor the
+    # fidelity planner or scipy.optimize, and its 2,400-sample record is transformed by
+    # numpy.fft, not pyfftw (docs/benchmarks/first_analysis.md)
+    code = (
+        "import sys, warnings; warnings.simplefilter('ignore'); import stochcable; "
+        "stochcable.analyze('stochcable/examples/chain_catenary.json'); "
+        "print(sorted(m for m in ('numba', 'pyfftw', 'stochcable.fidelity', 'scipy.optimize') "
+        "if m in sys.modules))"
+    )
+    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=root
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"

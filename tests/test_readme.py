@@ -45,3 +45,17 @@ def test_readme_python_block_runs(index, monkeypatch):
         for d in (fresh, got):
             d.pop("timing")
         assert_close_documents(got, fresh, rtol=1e-12)
+
+
+def test_readme_test_command_is_the_fast_tier_ci_runs():
+    # the README's first two commands set up: install and serve, then install the test
+    # extras and run the fast tier; .ci/run runs the same command, then the slow tier
+    first = re.search(r"```bash\n(.*?)```", (ROOT / "README.md").read_text(), re.S)
+    commands = first.group(1).strip().splitlines()
+    assert commands[0].startswith("python3 -m pip install -e . && stochcable serve")
+    install, _, tests = commands[1].partition(" && ")
+    assert install == 'python3 -m pip install -e ".[test]"'
+    assert tests == 'python3 -m pytest -q -n auto -m "not slow"'
+    ci = (ROOT / ".ci" / "run").read_text()
+    fast, slow = f"tier {tests}\n", "tier python3 -m pytest -q -n auto -m slow\n"
+    assert fast in ci and slow in ci and ci.index(fast) < ci.index(slow)

@@ -23,6 +23,9 @@ from stochcable.reference.moordyn_compare import compare_line, student_interval
 from stochcable.sea.spectra import spectrum_pierson_moskowitz
 from stochcable.statics import solve_statics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_reference_moordyn")
+
 
 def _pm(w: np.ndarray) -> np.ndarray:
     return spectrum_pierson_moskowitz(w, 2.0, 10.0)
@@ -82,14 +85,15 @@ def test_input_file_maps_the_conventions(chain):
     sc = comparison_scene(chain, elements=12)
     text = moordyn_input_file(sc, internal_damping=-0.5)
     seg = sc.lines[0].segments[0]
-    row = next(r for r in text.splitlines() if r.startswith("lt "))
+    row = next(r for r in text.splitlines() if r.startswith("type1 "))
     vals = [float(v) for v in row.split()[1:]]
     # Diam Mass/m EA BA EI Cd Ca CdAx CaAx: CdAx on π·d as ours -> unchanged
     assert vals == [seg.diameter, seg.mass, seg.ea, -0.5, 0.0, 1.333, 1.0, 0.2034, 0.0]
     opts = {r.split()[1]: float(r.split()[0]) for r in text.splitlines() if r[:1].isdigit()}
     assert opts["kBot"] == 3.0e6 and opts["cBot"] == 3.0e5  # per contact area in both
     assert opts["WtrDpth"] == 200.0 and opts["rho"] == 1025.0 and opts["g"] == 9.80665
-    assert "1 lt 1 2 850 12 -" in text
+    assert "1 type1 1 2 850 12 -" in text  # point 1 = end_a (Fixed), 2 = end_b (Coupled)
+    assert "2 Coupled " in text and "1 Fixed " in text
     # no sea, no current, no motions left in the comparison scene
     assert sc.sea is None and not sc.environment.current
     assert sc.lines[0].end_b.motion is None

@@ -18,6 +18,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import fd_budget as fb  # noqa: E402
 
 
+@pytest.mark.slow
 def test_linear_td_reproduces_the_fd_end_tension():
     """The chain's line at 160 elements, the TD with the FD's converged linear drag, a
     bilateral linear bed and 1e-3 of the motion, over one whole period of a periodic

@@ -76,3 +76,60 @@ def test_the_guys_lightly_damped_mode_warns_and_the_named_count_cures_it():
     finer = copy.deepcopy(doc)
     finer["analysis"]["omega"]["count"] = count
     assert _guy_warning(finer) is None
+
+
+# ------------------------------------------------------------ the grid-top (tail) warning
+def _tail_scene(sea_top: float, motion_top: float) -> dict:
+    """The taut wire on the grid 0.2–3 rad/s, its sea and its top end's surge flat
+    tables from 0.2 rad/s to the given tops: white inputs, so the tension spectrum is
+    still ≈ 1.1 m0 at the grid's top (measured), 20 times the threshold."""
+    doc = load_example("taut_wire").model_dump(mode="json", exclude_none=True)
+
+    def table(top):
+        w = np.linspace(0.2, top, 30)
+        return {"type": "table", "omega": w.tolist(), "density": [1e-4] * 30}
+
+    doc["sea"]["spectrum"] = table(sea_top)
+    doc["lines"][0]["end_b"]["motion"] = {"surge": table(motion_top)}
+    return doc
+
+
+def _tail_warnings(doc) -> list[str]:
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        analyze(doc)
+    return [str(r.message) for r in rec if "top of the grid" in str(r.message)]
+
+
+def test_grid_top_warning_is_quiet_when_the_inputs_end_at_the_grid_top():
+    assert _tail_warnings(_tail_scene(3.0, 3.0)) == []
+
+
+@pytest.mark.parametrize("sea_top, motion_top", [(3.0, 4.0), (5.0, 3.0)])
+def test_grid_top_warning_says_where_the_input_ends(sea_top, motion_top):
+    messages = _tail_warnings(_tail_scene(sea_top, motion_top))
+    assert len(messages) == 2  # end_a and end_b
+    top = max(sea_top, motion_top)
+    assert all(f"the excitation goes on to {top:.4g} rad/s" in m for m in messages)
+
+
+def test_excitation_end_of_tables_and_of_an_analytic_spectrum():
+    from stochcable.dynamics.loads.channels import Channel
+    from stochcable.dynamics.outputs.resolution import excitation_end
+
+    omega = np.linspace(0.2, 3.0, 50)
+
+    def channel(density):
+        return Channel(
+            name="sea", kind="sea", omega=omega, spectrum=density(omega), density=density
+        )
+
+    def flat(top):
+        return lambda w: np.where((w >= 0.2) & (w <= top), 1.0, 0.0)
+
+    assert excitation_end((channel(flat(3.0)),), omega) == 3.0
+    assert excitation_end((channel(flat(2.0)),), omega) == omega[omega <= 2.0][-1]
+    assert excitation_end((channel(flat(7.5)),), omega) == pytest.approx(7.5, rel=1e-8)
+    assert excitation_end((channel(flat(2.0)), channel(flat(7.5))), omega) == pytest.approx(7.5)
+    assert excitation_end((channel(lambda w: w**-5.0),), omega) == np.inf
+    assert excitation_end((), omega) == 3.0  # no input: nothing beyond the grid

@@ -213,6 +213,7 @@ def test_configure_switches_and_env_policy_respected(monkeypatch):
         runtime._settings.update(saved)
 
 
+@pytest.mark.slow
 def test_cli_and_service_configure_the_process():
     # the command line and the service apply the settings at start
     code = (
@@ -244,6 +245,7 @@ print(json.dumps((resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0) / 20)
 """
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(
     not sys.platform.startswith("linux") or platform.libc_ver()[0] != "glibc",
     reason="glibc's malloc only",
@@ -295,7 +297,9 @@ if sys.argv[1] == "dask-first":
     import dask.array
 import stochcable
 from stochcable.examples import load_example
-r = stochcable.analyze(load_example("chain_catenary"))  # (a DSA record of 600 s)
+doc = load_example("chain_catenary").model_dump(mode="json")
+doc["analysis"]["timeseries"]["duration"] = 9000.0  # 36,000 samples: pyfftw (sea.fft)
+r = stochcable.analyze(doc)
 import pyfftw
 print(json.dumps({"dask_array": "dask.array" in sys.modules,
                   "dask_interface": hasattr(pyfftw.interfaces, "dask_fft"),
@@ -303,6 +307,7 @@ print(json.dumps({"dask_array": "dask.array" in sys.modules,
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("order", ["alone", "dask-first"])
 def test_records_load_pyfftw_without_its_dask_interface(order):
     # pyfftw's optional dask interface imports dask.array (≈ 0.5 s of the first record of

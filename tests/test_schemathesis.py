@@ -19,6 +19,7 @@ next iteration); ≈ 1.5 min in all.
 
 from __future__ import annotations
 
+import pytest
 import schemathesis
 from hypothesis import HealthCheck, settings
 from schemathesis.checks import CHECKS as REGISTRY
@@ -47,6 +48,8 @@ CONFIG = SchemathesisConfig.from_dict(
     }
 )
 schema = schemathesis.openapi.from_asgi("/openapi.json", APP, config=CONFIG)
+# property-based runs over every operation: minutes (the slow tier, docs/manual/testing.md)
+pytestmark = pytest.mark.slow
 load_all_checks()
 CHECKS = REGISTRY.get_all()
 

@@ -631,9 +631,12 @@ def test_grid_is_shared_read_only_and_exact():
 
 @pytest.fixture
 def fresh_fft_state(monkeypatch, tmp_path):
-    """Plans and wisdom of this test only (file under tmp_path, nothing in ~/.cache)."""
+    """Plans and wisdom of this test only (file under tmp_path, nothing in ~/.cache);
+    FFTW runs every length (the small lengths of these tests go to numpy.fft otherwise:
+    PYFFTW_MIN_SIZE)."""
     path = tmp_path / "cache" / "fftw_wisdom.txt"
     monkeypatch.setenv("STOCHCABLE_FFTW_WISDOM", str(path))
+    monkeypatch.setattr(_fft, "PYFFTW_MIN_SIZE", 1)
     monkeypatch.setattr(_fft, "_wisdom_loaded", False)
     _fft.clear_cache()
     yield path
@@ -898,6 +901,7 @@ print("after", "numba" in sys.modules, sea._compiled_state[0] is not None)
 """
 
 
+@pytest.mark.slow
 def test_numba_imported_only_by_large_realizations():
     # import stochcable, the CLI's `spectrum`, the service app and realizations below
     # 2^16 lines must not pay numba's import (~0.2 s) and kernel load (~0.4 s)
@@ -926,6 +930,7 @@ def test_numba_imported_only_by_large_realizations():
     ]
 
 
+@pytest.mark.slow
 def test_unwritable_numba_cache_compiles_in_memory(tmp_path):
     # a read-only install: no writable __pycache__ next to _kernels.py (here a file of that
     # name, which even root cannot write into), NUMBA_CACHE_DIR and the user cache
@@ -1050,3 +1055,18 @@ def test_cpu_count_is_asked_again_when_replaced(monkeypatch):
     assert sea._cpu_count() == 7
     monkeypatch.setattr(sea.os, "cpu_count", lambda: None)
     assert sea._cpu_count() == 1
+
+
+def test_short_transforms_go_to_numpy_and_long_ones_to_fftw():
+    # below PYFFTW_MIN_SIZE numpy.fft (no pyfftw import for a short record), from it
+    # FFTW: the same numbers to round-off either way
+    rng = np.random.default_rng(3)
+    for n in (_fft.PYFFTW_MIN_SIZE - 2, _fft.PYFFTW_MIN_SIZE):
+        x = rng.standard_normal(n)
+        X = _fft.rfft(x)
+        np.testing.assert_allclose(X, np.fft.rfft(x), rtol=0, atol=1e-10)
+        np.testing.assert_allclose(_fft.irfft(X, n), x, rtol=0, atol=1e-12)
+        work = _fft.irfft_input(n)
+        work[:] = X
+        np.testing.assert_allclose(_fft.irfft_overwrite(work, n), n * x, rtol=0, atol=1e-8)
+    assert _fft._lib_for(_fft.PYFFTW_MIN_SIZE - 1) is None

@@ -1,4 +1,4 @@
-"""Second-order stretching tension (stochcable.dynamics.second_order): the Gaussian
+"""Second-order stretching tension (stochcable.dynamics.residuals.second_order): the Gaussian
 quadratic form against Monte Carlo, a quasi-static taut line against its closed form,
 Irvine's λ*² and the indicator in the result."""
 
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import stochcable
-from stochcable.dynamics import second_order as so
+from stochcable.dynamics.residuals import second_order as so
 from stochcable.errors import PhysicsWarning
 from stochcable.examples import load_example
 from stochcable.scene.model import load_scene

@@ -35,6 +35,9 @@ import pytest
 from stochcable.analysis import analyze
 from stochcable.examples import load_example
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_seed_tuah_1982_ex5")
+
 # Seed 001 §6.5 (quoted in the module docstring).
 TUAH_1982_EX5 = {
     "m0": 28.0,  # [ft²]

@@ -24,6 +24,9 @@ from stochcable.sea.kinematics import kinematics_timeseries
 from stochcable.sea.realization import simulate_sea
 from stochcable.sea.spectra import spectrum_statistics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_service")
+
 PM = {"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0}
 SPECTRA = [
     PM,

@@ -26,6 +26,9 @@ from stochcable.analysis import analyze
 from stochcable.cli import main as cli_main
 from stochcable.examples import list_examples, load_example
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_service_analyses")
+
 CHAIN = "chain_catenary"  # the README / banner example: sea + end motion, time series
 SMALL = "tuah_1982_single_leg"  # 3 elements, time series, ~20 ms: for the limit tests
 
@@ -108,6 +111,7 @@ def test_document_conforms_to_the_response_model(chain_answer):
     }
 
 
+@pytest.mark.slow
 def test_residuals_of_the_linear_model_through_http(client):
     """The chain example with both residuals asked for: the service answers the core's
     residual records (the closed forms are deterministic: round-off only) and the
@@ -349,6 +353,7 @@ def _perturbed_scenes(draw):
 _GENERATED_APP = create_app(Settings(max_run_seconds=10.0))
 
 
+@pytest.mark.slow
 @settings(
     max_examples=8,
     deadline=None,

@@ -18,6 +18,9 @@ from service.settings import Settings
 from stochcable.analysis import analyze
 from stochcable.examples import load_example
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_service_bodies")
+
 THREE_LEGS = "tuah_1982_disc_buoy_three_legs"
 
 

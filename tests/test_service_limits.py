@@ -15,6 +15,9 @@ from service.errors import LimitExceeded
 from service.limits import check_elements
 from service.settings import Settings
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_service_limits")
+
 PM = {"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0}
 
 

@@ -12,6 +12,9 @@ from service.settings import Settings
 from stochcable.examples import load_example
 from stochcable.results.datasets import dataset_from_document
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_service_netcdf")
+
 
 @pytest.fixture(scope="module")
 def client():

@@ -84,6 +84,7 @@ def test_zero_width_spreading_is_the_long_crested_sea_with_bodies(spreading):
 # -------------------------------------------------------------- superposition
 
 
+@pytest.mark.slow
 def test_spread_response_is_the_sum_of_long_crested_responses_without_drag():
     """Drag off (lines and the disc): the system does not depend on the response, so
     the directions are independent inputs of one linear system and the spread

@@ -13,6 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+# an accuracy study against the time domain (seconds of fixtures): the slow tier
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("test_speed_vs_error")]
+
 SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "speed_vs_error.py"
 
 

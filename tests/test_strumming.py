@@ -37,6 +37,9 @@ from stochcable.reference.wake_oscillator import simulate_wake_oscillator
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_strumming")
+
 FT = 0.3048
 EXAMPLE = "tuah_1982_strumming_string"
 #: seed 001 §6.6: Strouhal frequency, fundamental, maximum transverse displacement
@@ -173,6 +176,26 @@ def test_compiled_start_grid_equals_the_wake_closed_form(xi):
     np.testing.assert_allclose(grid[~proven], ref[~proven], rtol=0, atol=1e-9)
     assert proven.any() and (~proven).sum() > 10  # both paths taken
     assert ref.min() < 0.15 < 0.5 < ref.max()  # near a root and far from one
+
+
+@pytest.mark.parametrize("xi, amp_scale", [(0.02, 1.0), (0.2, 1.0), (5.0, 1.0), (0.2, 1e-6)])
+def test_numpy_bound_proves_what_the_kernel_proves(xi, amp_scale):
+    """grid_is_proven (NumPy, checked before numba is imported) is True exactly when the
+    compiled grid is proven at every point (all 1.0): the locking mode of the test above
+    (not proven), a heavily damped one and tiny amplitudes (proven)."""
+    from stochcable.line.strumming_bound import grid_is_proven
+    from stochcable.line.strumming_kernels import balance_grid
+
+    psi, q, d, ws, mstar, st = _string_mode()
+    rng = np.random.default_rng(7)
+    ws = ws * rng.uniform(0.98, 1.02, ws.size)
+    lift0 = rng.uniform(0.18, 0.22, ws.size)
+    wn = float(np.mean(ws))
+    params = wake_parameters(reduced_damping(mstar, xi, 1.0, 1.0, st), xi)
+    amps = amp_scale * np.geomspace(1e-3, 3.0, 20) / np.max(np.abs(psi) / d)
+    args = (amps, np.linspace(0.65, 1.35, 29) * wn, wn, xi, psi, q, d, ws, lift0)
+    grid = balance_grid(*args, params.g, params.big_h, params.f)
+    assert grid_is_proven(*args, params.g, params.big_h, params.f) == bool(np.all(grid == 1.0))
 
 
 # ------------------------------------------------------------------ Example 6

@@ -183,6 +183,7 @@ def _linearized_sigma_x(scale=1.0):
     return response_statistics(w, np.abs(x) ** 2 * s_v).std
 
 
+@pytest.mark.slow
 def test_drag_sdof_monte_carlo_against_statistical_linearization():
     # nonlinear Newmark reference over n_seeds DSA flow realizations (random phases,
     # deterministic amplitudes: every realization has variance m0, which removes the

@@ -150,7 +150,21 @@ _MODES_LIN = {
 _LINES = {
     "lines.<line>.<end>.tension": (
         "",
-        "Statistics of the end tension (table of statistics below; U = force).",
+        "Statistics of the end tension (table of statistics below; U = force).  With "
+        "``analysis.linearization.drag_residual`` or ``geometric_residual``: with the "
+        "residuals, their spectra's moments added to the linear spectrum's (the "
+        "superharmonics above the band included), the linear model's alone in "
+        "``lines.<line>.linear``; the spectra below stay the linear model's.",
+    ),
+    "lines.<line>.linear": (
+        "",
+        "Only where a residual of the linear model was computed: the linear model's own "
+        "end statistics, beside the corrected ones of ``lines.<line>.<end>``.",
+    ),
+    "lines.<line>.linear.<end>": ("", "The end."),
+    "lines.<line>.linear.<end>.tension": (
+        "",
+        "Statistics of the linear model's end tension (table of statistics below).",
     ),
     "lines.<line>.<end>.force_std": ("{F}", "σ of the x, y, z force on the support."),
     "lines.<line>.tension.s": (
@@ -336,7 +350,7 @@ _LINES = {
     "lines.<line>.indicators.second_order": (
         "",
         "Second-order stretching tension T₂ = κ·½∫(∂u⊥/∂s)² ds of the linear response, "
-        "a Gaussian quadratic form (:mod:`stochcable.dynamics.second_order`).",
+        "a Gaussian quadratic form (:mod:`stochcable.dynamics.residuals.second_order`).",
     ),
     "lines.<line>.indicators.second_order.mean": ("N", "Mean of T₂: a shift of the mean tension."),
     "lines.<line>.indicators.second_order.std": (
@@ -520,7 +534,11 @@ _NAMED = {
     "fidelity.segments": "<line>",
 }
 _DOFS = frozenset({"surge", "sway", "heave", "roll", "pitch", "yaw"})
-_STATS_PARENTS = ("lines.<line>.<end>.tension", "bodies.<body>.motion.<dof>")
+_STATS_PARENTS = (
+    "lines.<line>.<end>.tension",
+    "lines.<line>.linear.<end>.tension",
+    "bodies.<body>.motion.<dof>",
+)
 
 
 def _child(parent: str, key: str) -> str:

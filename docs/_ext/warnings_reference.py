@@ -46,12 +46,15 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Response spectrum cut by the top of the grid",
         "ResolutionWarning",
         ("stochcable.dynamics.outputs.resolution:tail_check",),
-        "S(ω_max)·ω_max > TAIL_FRACTION · m0 of an end-tension spectrum",
+        "S(ω_max)·ω_max > TAIL_FRACTION · m0 of an end-tension spectrum, and an input "
+        "goes on above ω_max (quiet when every input, a band-limited motion or a "
+        "spectrum table, ends at the grid's top: nothing excites the line above it)",
         "The end-tension spectrum is still large at ``analysis.omega.max``: the variance "
         "beyond the grid is lost, so σ and every maximum are underestimated. Typical "
         "cause: an end-motion spectrum with an ω⁻⁵ tail, whose inertia loads give a "
         "tension spectrum that decays only like ω⁻¹.",
-        "Raise ``analysis.omega.max`` until the warning goes; give a fairlead motion as a "
+        "The message says where the input ends. Raise ``analysis.omega.max`` to there, "
+        "or until the warning goes; give a fairlead motion as a "
         "vessel RAO over the sea (``motion.rao``) or as a band-limited spectrum instead "
         "of an unbounded one.",
         ("stochcable.dynamics.outputs.resolution:TAIL_FRACTION",),
@@ -138,7 +141,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Drag residual large (``analysis.linearization.drag_residual``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.drag_residual:_warn_large",),
+        ("stochcable.dynamics.residuals.drag_residual:_warn_large",),
         "the end-tension σ with the drag residual beyond RESIDUAL_WARN_RATIO times the "
         "linear σ (or below its inverse)",
         "The quadratic drag is far from its Gaussian linear fit: the first-order residual "
@@ -146,7 +149,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "time domain (up to +18 %: the taut wire and the inclined guy, within the "
         "time domain's 95 % interval).",
         "Check with the nonlinear time-domain reference (:mod:`stochcable.reference.cable`).",
-        ("stochcable.dynamics.drag_residual:RESIDUAL_WARN_RATIO",),
+        ("stochcable.dynamics.residuals.drag_residual:RESIDUAL_WARN_RATIO",),
     ),
     WarningEntry(
         "Residuals not applied to a load-case set",
@@ -166,7 +169,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Second-order stretching tension large (indicator ``second_order``)",
         "PhysicsWarning",
-        ("stochcable.dynamics.second_order:with_second_order",),
+        ("stochcable.dynamics.residuals.second_order:with_second_order",),
         "σ of the second-order stretching tension above SECOND_ORDER_WARN_RATIO of the "
         "line's largest linear tension σ",
         "Transverse motion lengthens a line to second order, ½∫(∂u⊥/∂s)² ds; a taut line "
@@ -176,7 +179,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Use the corrected moments in ``indicators.second_order`` as an estimate; for a "
         "design value check with the nonlinear time-domain reference "
         "(:mod:`stochcable.reference.cable`).",
-        ("stochcable.dynamics.second_order:SECOND_ORDER_WARN_RATIO",),
+        ("stochcable.dynamics.residuals.second_order:SECOND_ORDER_WARN_RATIO",),
     ),
     WarningEntry(
         "Drag linearization did not converge",
@@ -343,6 +346,44 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Results are the same; the NumPy sea kernel is slower, or the kernel is compiled "
         "again in each process (about 1 s at its first use).",
         "Set ``NUMBA_CACHE_DIR`` to a writable directory, or ``STOCHCABLE_NUMBA=0`` to skip numba.",
+    ),
+    WarningEntry(
+        "MoorDyn file: parts read with a loss",
+        "PhysicsWarning",
+        (
+            "stochcable.io.moordyn_read:read_moordyn",
+            "stochcable.io.moordyn_read:_structural_beta",
+            "stochcable.io.moordyn_read:_warn_ignored",
+            "stochcable.io.moordyn_parts:_type_columns",
+        ),
+        "a MoorDyn file (docs/manual/moordyn.md) with options other than WtrDpth, rho, "
+        "g, kBot and cBot; non-zero EI, CaAx or Cl; lines whose BA/−ζ give different "
+        "β = BA/EA; sections other than line types, bodies, rods, points, lines, "
+        "options and outputs; a free point joined to no line; or LINE TYPES columns "
+        "named in v1's order",
+        "The scene holds what it can of the file: the options MoorDyn uses for its own "
+        "time stepping and initial conditions are dropped, bending stiffness, axial added "
+        "mass and VIV lift have no counterpart, and the scene's one stiffness-proportional "
+        "damping β takes the smallest of the lines'.",
+        "Nothing, when the options listed are numerics; for a bending-stiff line "
+        "(umbilical, riser) check that tension dominates; give "
+        "``analysis.structural_damping.beta`` yourself if the lines' damping differs.",
+    ),
+    WarningEntry(
+        "MoorDyn file written with a loss",
+        "PhysicsWarning",
+        (
+            "stochcable.io.moordyn_write:write_moordyn",
+            "stochcable.io.moordyn_write:_body_rows",
+            "stochcable.io.moordyn_write:_joint_point",
+            "stochcable.io.moordyn_pieces:line_pieces",
+        ),
+        "a scene written with write_moordyn that has a prescribed motion, a current, "
+        "mass-proportional structural damping, an attachment at a line end, or added "
+        "mass without buoyancy",
+        "MoorDyn takes motions and currents from its driver and its own files; the file "
+        "holds the mooring only.",
+        "Drive the Coupled points from the program that runs MoorDyn.",
     ),
 )
 

@@ -1,10 +1,14 @@
 """The data of a coupled line–body system: :class:`LineLink` (a line model and the
 bodies its ends are attached to) and :class:`CoupledSystem` (the assembled matrices
-and DOF maps, seed 001 eq. 3.3.10).
+and DOF maps, Tuah (1982), eq. 3.3.10).
 
 Assembled by :func:`stochcable.bodies.coupling.couple`, which documents the system;
 loaded and expanded by :func:`~stochcable.bodies.coupling.coupled_load` and
 :func:`~stochcable.bodies.coupling.expand_line` (both names are re-exported there).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -57,7 +61,7 @@ class LineLink:
 
 @dataclass(frozen=True, eq=False)
 class CoupledSystem:
-    """Lines and bodies assembled into one linear system (seed 001 eq. 3.3.10).
+    """Lines and bodies assembled into one linear system (Tuah (1982), eq. 3.3.10).
 
     Attributes
     ----------

@@ -1,4 +1,4 @@
-"""Lines and rigid bodies assembled into one linear system (seed 001 §3.3, Tuah 1982).
+"""Lines and rigid bodies assembled into one linear system (Tuah (1982), §3.3).
 
 The coupled system
 ------------------
@@ -7,13 +7,17 @@ linear system over x = [line free DOFs …, body DOFs …].  With L_ℓ the spar
 x to all DOFs of line ℓ (identity on its free DOFs, T(r) on a body-attached end,
 zero on a still-prescribed end) and P_ℓ the map from the prescribed DOFs p,
 
-    K = Σ L_ℓᵀ K_ℓ L_ℓ + K_body,   K_p = Σ L_ℓᵀ K_ℓ P_ℓ      (seed 001 eq. 3.3.10)
+    K = Σ L_ℓᵀ K_ℓ L_ℓ + K_body,   K_p = Σ L_ℓᵀ K_ℓ P_ℓ      (Tuah (1982), eq. 3.3.10)
 
 and the same for M and C: the line end DOFs are eliminated in favour of the body DOFs
 (K_cc = Tᵀ K_bb T, K_fc = K_fb T).  The frequency response is
 Z(ω) x = F with Z(ω) = K − ω²(M + A(ω)) + iω(C + B(ω))
 (:func:`stochcable.reference.bodies.solve_coupled_direct`, the independent dense/Schur
 check of the engine).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -106,7 +110,7 @@ def couple(
 
     Notes
     -----
-    Seed 001 §3.3: the attached end node's displacement is slaved to the body by
+    Tuah (1982), §3.3: the attached end node's displacement is slaved to the body by
     u_end = T(r) ξ (eqs. 3.3.6–3.3.7, :func:`rigid_link_matrix`), and the line's
     equations are premultiplied by the transpose of the transformation (eqs.
     3.3.8–3.3.10): with L_ℓ the map from x to the line's DOFs,
@@ -277,7 +281,7 @@ def _link_maps(
     n: int,
 ) -> tuple[sp.csr_array, sp.csr_array]:
     """The sparse maps u_line = L x + P p of a line: identity from its free DOFs,
-    T(r) from the body DOFs on an attached end node (seed 001 eqs. 3.3.6–3.3.7), P on
+    T(r) from the body DOFs on an attached end node (Tuah (1982), eqs. 3.3.6–3.3.7), P on
     its still-prescribed DOFs (model order)."""
     d = model.dim
     rows, cols, vals = [], [], []
@@ -319,7 +323,7 @@ def _sum_links(
     n: int,
     n_p: int,
 ) -> tuple[sp.csr_array, sp.csr_array]:
-    """Σ L_ℓᵀ A_ℓ L_ℓ + the body blocks, and Σ L_ℓᵀ A_ℓ P_ℓ (seed 001 eq. 3.3.10),
+    """Σ L_ℓᵀ A_ℓ L_ℓ + the body blocks, and Σ L_ℓᵀ A_ℓ P_ℓ (Tuah (1982), eq. 3.3.10),
     A_ℓ = ``getter(line)``, the body blocks ``body_part(body)``."""
     acc = sp.csr_array((n, n))
     acc_p = sp.csr_array((n, n_p))
@@ -502,7 +506,7 @@ def constant_matrices(
 
     Notes
     -----
-    Modal superposition and the Foss decomposition (seed 001 §5.3) need constant
+    Modal superposition and the Foss decomposition (Tuah (1982), §5.3) need constant
     matrices; with A(ω), B(ω) varying they are exact only at ω_ref, so the direct
     solve (:func:`stochcable.reference.bodies.solve_coupled_direct`) is the reference
     whenever ``system.frequency_dependent``.

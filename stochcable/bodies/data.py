@@ -1,6 +1,6 @@
-"""Hydrodynamic coefficients of large bodies from files (seed 001 §3.2.c).
+"""Hydrodynamic coefficients of large bodies from files (Tuah (1982), §3.2.c).
 
-Seed 001 leaves the added mass m_a, radiation damping c and exciting force C_l of a
+Tuah (1982) leaves the added mass m_a, radiation damping c and exciting force C_l of a
 large body to a diffraction–radiation code (eqs. 3.2.c.16–3.2.c.19: "no attempt is
 made to evaluate [them]").  Two sources are read here into one
 :class:`Hydrodynamics` record:
@@ -15,6 +15,10 @@ Conventions of the record (those of the library, DESIGN.md): ω in rad/s, headin
 rad (direction of travel from +x toward +y), DOFs (surge, sway, heave, roll, pitch, yaw)
 about the reference point (or (surge, heave, pitch) for a planar table), complex
 amplitudes of Re{X e^{iωt}}, excitation per unit wave amplitude.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -183,7 +187,7 @@ def read_capytaine(
     real wave as the library's Re{e^{iωt} e^{−ik(x cos β + y sin β)}}, so the
     excitation is conjugated, X = conj(X_capytaine), and its phase is referred to the
     origin of the dataset's frame (``excitation_point`` = −rotation_center in x, y).
-    Added mass and damping are real and need no change.  Seed 001 eqs. 3.2.c.16–17
+    Added mass and damping are real and need no change.  Tuah (1982), eqs. 3.2.c.16–17
     define the same quantities (f_lj = −ω² m_a + iω c, C_l).
     """
     ds, name = _open_dataset(source)

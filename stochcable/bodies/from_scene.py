@@ -1,10 +1,14 @@
 """Scene bodies to :class:`stochcable.bodies.rigid.RigidBody` (docs/BODIES.md).
 
 The scene document's :class:`stochcable.scene.model.Body` carries the data as given; the
-numerical code works on :class:`~stochcable.bodies.rigid.RigidBody` (seed 001 eq. 3.2.c.20
+numerical code works on :class:`~stochcable.bodies.rigid.RigidBody` (Tuah (1982), eq. 3.2.c.20
 coefficients about the body reference point).  The hydrodynamic table (inline or a
 file) is read with :mod:`stochcable.bodies.data`; explicit constant matrices of the body
 replace the table's corresponding matrix.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

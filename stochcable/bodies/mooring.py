@@ -4,10 +4,14 @@ The condensed end stiffness of every line attached to a free body, K_e = −dF_e
 for an FE-solved line the Schur complement K_bb − K_bf K_ff⁻¹ K_fb of its FE tangent
 over the interior DOFs (one banded solve, :mod:`stochcable.line.banded`), for a
 catenary-solved line the central differences of the closed form; carried to the body
-DOFs through the rigid link T(r) with the attachment geometric term −[F]×[r]× (seed 001
-eqs. 3.3.8–3.3.10).  The interior map S = K_ff⁻¹ K_fb is the first-order interior motion
+DOFs through the rigid link T(r) with the attachment geometric term −[F]×[r]× (Tuah
+(1982), eqs. 3.3.8–3.3.10).  The interior map S = K_ff⁻¹ K_fb is the first-order interior motion
 −S δx_ends of an FE line when its ends move, the predictor of the body statics' warm
 start.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ import numpy as np
 from stochcable.bodies.rigid import geometric_stiffness, link_matrix
 from stochcable.line.banded import banded_solve, block_band_indices
 from stochcable.line.elements import stiffness_blocks
-from stochcable.line.statics import check_statics_options, line_statics
+from stochcable.line.statics import check_statics_options, solve_line_statics_unchecked
 from stochcable.scene.model import Scene
 
 __all__ = ["mooring_stiffness", "mooring_stiffness_and_maps", "end_condensation", "pose_map"]
@@ -55,7 +59,7 @@ def mooring_stiffness(
     Returns
     -------
     ndarray, shape (n_b·d, n_b·d)
-        −dQ_lines/dq = Σ Tᵀ K_e T − [F]×[r]× (seed 001 eqs. 3.3.8–3.3.10 and the
+        −dQ_lines/dq = Σ Tᵀ K_e T − [F]×[r]× (Tuah (1982), eqs. 3.3.8–3.3.10 and the
         attachment geometric term, :func:`stochcable.bodies.rigid.attachment_geometric_stiffness`),
         K_e = −dF_end/dx_end the condensed end stiffness of each line: the Schur
         complement of its FE tangent over the interior DOFs for an FE-solved line, the
@@ -153,7 +157,7 @@ def end_condensation(
                 pos = getattr(mesh, e).copy()
                 pos[comp] += sgn * h
                 m2 = dataclasses.replace(mesh, **{e: pos})
-                l2 = line_statics(m2, env, method, None, tolerance, 500)
+                l2 = solve_line_statics_unchecked(m2, env, method, None, tolerance, 500)
                 fs.append(
                     np.concatenate(
                         [(l2.force_a if p == "end_a" else l2.force_b)[comps] for p in ends]

@@ -1,7 +1,7 @@
-"""Large rigid bodies coupled to lines (seed 001 §3.2.c and §3.3, Tuah 1982).
+"""Large rigid bodies coupled to lines (Tuah (1982), §3.2.c and §3.3).
 
 A large body (a buoy, a disc, a vessel) has six rigid degrees of freedom (three in a
-planar x–z analysis); its equation of motion is seed 001 eq. 3.2.c.20,
+planar x–z analysis); its equation of motion is Tuah (1982), eq. 3.2.c.20,
 
     (M_B + A(ω)) ξ̈ + B(ω) ξ̇ + (K_R + K_C) ξ = F_exc(ω) e^{iωt} + F̄,
 
@@ -9,7 +9,7 @@ with the rigid-body mass M_B, the added mass A(ω) and radiation damping B(ω) o
 diffraction–radiation theory, the hydrostatic restoring K_R, the stiffness of the
 attached cables K_C, and the wave excitation F_exc (per unit wave amplitude).  Lines
 attached to the body at a point r (relative to the body reference point) follow it
-through the rigid link of seed 001 eqs. 3.3.6–3.3.7, u_end = T(r)·ξ, and their
+through the rigid link of Tuah (1982), eqs. 3.3.6–3.3.7, u_end = T(r)·ξ, and their
 equations are transformed with Tᵀ (eqs. 3.3.8–3.3.10) and assembled with the body's.
 
 Degrees of freedom and signs
@@ -17,7 +17,7 @@ Degrees of freedom and signs
 - 6 DOF (3-D): ξ = (surge, sway, heave, roll, pitch, yaw) = (u_x, u_y, u_z, θ_x, θ_y,
   θ_z): translations of the reference point along the global axes [m] and small
   rotations about the global axes through the reference point [rad], right-handed.
-  (The seed's own order, surge–heave–sway in a y-up frame, is mapped onto this by its
+  (Tuah's (1982) own order, surge–heave–sway in a y-up frame, is mapped onto this by its
   eq. 3.3.5; here z is up and no such map is needed.)
 - 3 DOF (planar, in the x–z plane): ξ = (surge, heave, pitch) = (u_x, u_z, θ_y), pitch
   positive about +y (right-handed): a point ahead of the reference (+x) moves *down*
@@ -28,6 +28,10 @@ Degrees of freedom and signs
 
 Lines and bodies are assembled into one linear system by
 :func:`stochcable.bodies.coupling.couple`.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -100,8 +104,8 @@ def rigid_body_mass_matrix(
     Notes
     -----
     The kinetic energy ½m|v_G|² + ½ωᵀI_Gω with v_G = T(c)·[v; ω] (the rigid link of
-    seed 001 eq. 3.3.7 to the centre of gravity) gives m T(c)ᵀT(c) + diag(0, I_G);
-    −[c]×[c]× = |c|²I − c cᵀ is the parallel-axis term.  Seed 001 m_B of eq. 3.2.14.
+    Tuah (1982), eq. 3.3.7 to the centre of gravity) gives m T(c)ᵀT(c) + diag(0, I_G);
+    −[c]×[c]× = |c|²I − c cᵀ is the parallel-axis term.  Tuah's (1982) m_B of eq. 3.2.14.
     """
     c = np.asarray(cog, dtype=float)
     s = skew(c)
@@ -153,7 +157,7 @@ def _vec3(name: str, value: Any, unit: str, default: float = 0.0) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class RigidBody:
-    """A large rigid body (seed 001 §3.2.c, eq. 3.2.c.20).
+    """A large rigid body (Tuah (1982), §3.2.c, eq. 3.2.c.20).
 
     Parameters
     ----------
@@ -177,7 +181,7 @@ class RigidBody:
         Hydrostatic and gravity restoring about the reference point (the weight's
         −m g z_G terms included, as WAMIT and Capytaine give it). [N/m, N, N·m]
     excitation : ExcitationTable, optional
-        Wave excitation force per unit amplitude over ω and heading (seed 001 C_l of
+        Wave excitation force per unit amplitude over ω and heading (Tuah's (1982) C_l of
         eq. 3.2.c.17).
     excitation_point : array_like, shape (2,), optional
         Horizontal offset (x, y) from the reference point of the point where the
@@ -413,7 +417,7 @@ def rigid_link_matrix(r: Any, planar: bool = False) -> np.ndarray:
 
     Notes
     -----
-    Seed 001 eqs. 3.3.6–3.3.7: the translation rows of Λ₁ = [[I, R], [0, I]] with R
+    Tuah (1982), eqs. 3.3.6–3.3.7: the translation rows of Λ₁ = [[I, R], [0, I]] with R
     = −[r]× for r = X_2 − X_1 (eq. 3.3.7.b).  First order in the rotation: the finite
     rotation gives R(θ) r − r = θ × r + O(|θ|²|r|).  Forces F at the point map to the
     generalized force Tᵀ F = [F; r × F].
@@ -466,7 +470,7 @@ def attachment_geometric_stiffness(force: Any, r: Any, planar: bool = False) -> 
     The moment about the reference of F at the rotated arm R(θ)r is
     M = (R r) × F; dM/dθ at θ = 0 with F held is (θ × r) × F = [F]×[r]× θ, and the
     restoring stiffness is its negative (the "moment of the end tension" term of the
-    transformed body equation, seed 001 §3.3, eq. 3.3.4.e's K̄_B about the static
+    transformed body equation, Tuah (1982), §3.3, eq. 3.3.4.e's K̄_B about the static
     state).  It is the exact Jacobian of the moment with respect to the rotation
     vector; it is not symmetric unless r ∥ F.  Summed over every static force on a
     body in equilibrium (lines, weight, buoyancy, environment) the antisymmetric

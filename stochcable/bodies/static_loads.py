@@ -1,6 +1,6 @@
 """The static load on a body from everything but its lines (docs/BODIES.md §Statics).
 
-Body loads (seed 001 eq. 3.2.c.20, the static F̄):
+Body loads (Tuah (1982), eq. 3.2.c.20, the static F̄):
 
 - with ``displaced_volume`` ∇ and a non-zero ``hydrostatic_stiffness`` K_h (a floating
   body): weight −m g ẑ at the CoG and buoyancy ρ g ∇ ẑ at the CoB evaluated at zero
@@ -10,12 +10,16 @@ Body loads (seed 001 eq. 3.2.c.20, the static F̄):
 - without ∇ but with K_h: the body is taken as freely floating in equilibrium at
   ``position`` (weight balanced by buoyancy), restored by −K_h (q − q₀) only;
 - without ∇ and K_h: the weight alone at R·r_G (no buoyancy);
-- ``wind_force``/``wind_moment`` at the reference point (seed 001 §6.5's 100 lb wind);
+- ``wind_force``/``wind_moment`` at the reference point (Tuah (1982), §6.5's 100 lb wind);
 - current drag ½ ρ (Cd·A)_i |U| U_i at R·``drag_point`` with U the current there.
 
 The load is a generalized force (F, M) about the body's reference point in global axes,
 with its stiffness −d load/d pose; :func:`stochcable.bodies.statics.solve_body_statics`
 adds the lines' forces and solves the equilibrium.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

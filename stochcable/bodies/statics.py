@@ -11,7 +11,7 @@ F_ℓ the static force a line exerts on its end at X + R(θ)·r_ℓ (each line s
 method solves Q = 0 with the tangent stiffness K = −dQ/dq: the condensed end stiffness
 of every line (Schur complement K_bb − K_bf K_ff⁻¹ K_fb of its FE tangent, the matrix
 of :func:`stochcable.line.fem.build_fe_model`, over the interior DOFs: one banded solve)
-including the attachment geometric term −[F]×[r]× (seed 001 eqs. 3.3.8–3.3.10
+including the attachment geometric term −[F]×[r]× (Tuah (1982), eqs. 3.3.8–3.3.10
 linearized about the static state), the hydrostatic matrix, and the geometric terms
 of the point forces whose moment arm rotates (weight, buoyancy, drag).  K is exact, so
 the iteration converges quadratically.  K at the solution is reported as the
@@ -24,6 +24,10 @@ Body loads: :mod:`stochcable.bodies.static_loads` (weight, buoyancy, hydrostatic
 restoring, wind and current drag; :func:`body_static_load`).
 
 Prescribed bodies (vessels) are not solved for: their pose is ``position``, no rotation.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -43,7 +47,7 @@ from stochcable.bodies.rigid import (
 from stochcable.bodies.static_loads import _cross3, _full, _reduce, body_static_load
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.mesh import mesh_line
-from stochcable.line.statics import check_statics_options, line_statics
+from stochcable.line.statics import check_statics_options, solve_line_statics_unchecked
 from stochcable.scene.model import Scene
 from stochcable.validation import positive, positive_int
 
@@ -150,7 +154,7 @@ def solve_body_statics(
 
     Notes
     -----
-    Module docstring; docs/BODIES.md §Statics.  Seed 001 §4.1 (static configuration
+    Module docstring; docs/BODIES.md §Statics.  Tuah (1982), §4.1 (static configuration
     as the starting state), eq. 3.2.c.20 (static force F̄), eqs. 3.3.6–3.3.10.
     """
     body_tolerance = positive("body_tolerance", body_tolerance, "-")
@@ -273,7 +277,7 @@ class _BodyPoses:
         return fref, (lref if lref > 0.0 else 1.0)
 
     def _line(self, mesh: Any, initial: np.ndarray | None = None) -> Any:
-        return line_statics(
+        return solve_line_statics_unchecked(
             mesh, self.env, self.method, initial, self.tolerance, self.max_iterations
         )
 

@@ -132,7 +132,7 @@ def run_cases(
 
     Parameters
     ----------
-    scene : Scene, mapping or path
+    scene : Scene, mapping, JSON string or path
         The scene template; its sea is replaced by each state's, its time-series
         settings are dropped (a set needs spectra, not records).
     scatter : ScatterDiagram

@@ -14,7 +14,7 @@ import importlib
 import pkgutil
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from stochcable import runtime
 from stochcable.errors import StochcableError
@@ -43,15 +43,26 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _warning_to_stderr(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
-    sys.stderr.write(f"stochcable: warning: {message}\n")
+def warning_printer() -> Callable[..., None]:
+    """A ``warnings.showwarning`` that writes each message once on stderr
+    (``stochcable: warning: ...``), however often it is issued, as the summary lists
+    the result's warnings once."""
+    seen: set[str] = set()
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+        text = str(message)
+        if text not in seen:
+            seen.add(text)
+            sys.stderr.write(f"stochcable: warning: {text}\n")
+
+    return show
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the process exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    warnings.showwarning = _warning_to_stderr
+    warnings.showwarning = warning_printer()
     runtime.configure()  # the command line's process settings (stochcable.runtime)
     try:
         return int(args.func(args) or 0)

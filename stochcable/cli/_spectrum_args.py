@@ -18,6 +18,16 @@ import numpy as np
 from stochcable import validation as v
 from stochcable.errors import InputError
 from stochcable.sea import spectra
+from stochcable.sea.limits import (
+    GAMMA_RANGE,
+    HEIGHT_RANGE,
+    M0_RANGE,
+    OMEGA_P_RANGE,
+    PERIOD_RANGE,
+    SHAPE_RANGE,
+    SIGMA_RANGE,
+    WIND_SPEED_RANGE,
+)
 
 __all__ = ["SPECTRUM_TYPES", "add_spectrum_arguments", "SpectrumChoice", "spectrum_from_args"]
 
@@ -52,14 +62,20 @@ def add_spectrum_arguments(parser: argparse.ArgumentParser) -> None:
         help="gravity for --wind-speed [m/s^2] (default 9.80665)",
     )
     grp.add_argument(
-        "--gamma", type=float, default=3.3, help="jonswap: peak enhancement [-] (default 3.3)"
+        "--gamma",
+        type=float,
+        default=3.3,
+        help=f"jonswap: peak enhancement in [{GAMMA_RANGE[0]:g}, {GAMMA_RANGE[1]:g}] [-] "
+        "(default 3.3)",
     )
-    grp.add_argument(
-        "--sigma-a", type=float, default=0.07, help="jonswap: width below peak [-] (default 0.07)"
-    )
-    grp.add_argument(
-        "--sigma-b", type=float, default=0.09, help="jonswap: width above peak [-] (default 0.09)"
-    )
+    for side, where, default in (("a", "below", 0.07), ("b", "above", 0.09)):
+        grp.add_argument(
+            f"--sigma-{side}",
+            type=float,
+            default=default,
+            help=f"jonswap: width {where} peak in [{SIGMA_RANGE[0]:g}, {SIGMA_RANGE[1]:g}] "
+            f"[-] (default {default})",
+        )
     grp.add_argument("--t1", type=float, help="issc: mean period T1 = Tm01 [s]")
     for j, what in ((1, "swell (low-frequency)"), (2, "wind sea (high-frequency)")):
         grp.add_argument(f"--hs{j}", type=float, help=f"ochi-hubble: {what} Hs [m]")
@@ -90,6 +106,13 @@ def _need(args: argparse.Namespace, attr: str, flag: str, kind: str) -> Any:
     return value
 
 
+def _height(args: argparse.Namespace, attr: str, kind: str, zero: bool = False) -> float:
+    """``--<attr>``, a significant wave height in ``HEIGHT_RANGE`` (or 0 with ``zero``). [m]"""
+    flag = f"--{attr}"
+    hs = _need(args, attr, flag, kind)
+    return 0.0 if zero and hs == 0.0 else v.in_range(flag, hs, "m", *HEIGHT_RANGE)
+
+
 def _peak_omega(args: argparse.Namespace, kind: str, required: bool = True) -> float | None:
     given = [
         (f, x)
@@ -111,10 +134,10 @@ def _peak_omega(args: argparse.Namespace, kind: str, required: bool = True) -> f
         return None
     flag, x = given[0]
     if flag == "--tp":
-        return 2.0 * math.pi / v.positive("--tp", x, "s")
+        return 2.0 * math.pi / v.in_range("--tp", x, "s", *PERIOD_RANGE)
     if flag == "--fp":
-        return 2.0 * math.pi * v.positive("--fp", x, "Hz")
-    return v.positive("--omega-p", x, "rad/s")
+        return 2.0 * math.pi * v.in_range("--fp", x, "Hz", *(1.0 / t for t in PERIOD_RANGE[::-1]))
+    return v.in_range("--omega-p", x, "rad/s", *OMEGA_P_RANGE)
 
 
 def _read_table(path: str) -> tuple[np.ndarray, np.ndarray]:
@@ -154,7 +177,7 @@ def spectrum_from_args(args: argparse.Namespace) -> SpectrumChoice:
     kind = args.type
     if kind in ("pm", "bretschneider"):
         if kind == "pm" and args.wind_speed is not None:
-            u = v.positive("--wind-speed", args.wind_speed, "m/s")
+            u = v.in_range("--wind-speed", args.wind_speed, "m/s", *WIND_SPEED_RANGE)
             g = v.positive("--g", args.g, "m/s²")
             m0 = 0.0081 * u**4 / (4.0 * 0.74 * g * g)
             return SpectrumChoice(
@@ -167,9 +190,9 @@ def spectrum_from_args(args: argparse.Namespace) -> SpectrumChoice:
         if kind == "pm" and args.m0 is not None:
             if args.hs is not None:
                 raise InputError("--m0", args.m0, "m²", "give either --hs or --m0, not both")
-            m0 = v.positive("--m0", args.m0, "m²")
+            m0 = v.in_range("--m0", args.m0, "m²", *M0_RANGE)
         else:
-            m0 = v.positive("--hs", _need(args, "hs", "--hs", kind), "m") ** 2 / 16.0
+            m0 = _height(args, "hs", kind) ** 2 / 16.0
         name = "pierson_moskowitz" if kind == "pm" else "bretschneider"
         return SpectrumChoice(
             name,
@@ -178,11 +201,12 @@ def spectrum_from_args(args: argparse.Namespace) -> SpectrumChoice:
             {"m0": m0, "hs": 4.0 * math.sqrt(m0), "omega_p": wp, "tp": 2.0 * math.pi / wp},
         )
     if kind == "jonswap":
-        hs = v.positive("--hs", _need(args, "hs", "--hs", kind), "m")
-        tp = 2.0 * math.pi / _peak_omega(args, kind)
-        gamma = v.in_range("--gamma", args.gamma, "-", lo=1.0)
-        sa = v.positive("--sigma-a", args.sigma_a, "-")
-        sb = v.positive("--sigma-b", args.sigma_b, "-")
+        hs = _height(args, "hs", kind)
+        wp = _peak_omega(args, kind)
+        tp = args.tp if args.tp is not None else 2.0 * math.pi / wp  # --tp kept exactly
+        gamma = v.in_range("--gamma", args.gamma, "-", *GAMMA_RANGE)
+        sa = v.in_range("--sigma-a", args.sigma_a, "-", *SIGMA_RANGE)
+        sb = v.in_range("--sigma-b", args.sigma_b, "-", *SIGMA_RANGE)
         return SpectrumChoice(
             "jonswap",
             lambda w: spectra.spectrum_jonswap(w, hs, tp, gamma, sa, sb),
@@ -190,19 +214,19 @@ def spectrum_from_args(args: argparse.Namespace) -> SpectrumChoice:
             {"hs": hs, "tp": tp, "gamma": gamma, "sigma_a": sa, "sigma_b": sb},
         )
     if kind == "issc":
-        hs = v.positive("--hs", _need(args, "hs", "--hs", kind), "m")
-        t1 = v.positive("--t1", _need(args, "t1", "--t1", kind), "s")
+        hs = _height(args, "hs", kind)
+        t1 = v.in_range("--t1", _need(args, "t1", "--t1", kind), "s", *PERIOD_RANGE)
         return SpectrumChoice(
             "issc", lambda w: spectra.spectrum_issc(w, hs, t1), hs * hs / 16.0, {"hs": hs, "t1": t1}
         )
     if kind == "ochi-hubble":
         p = {}
         for j in (1, 2):
-            p[f"hs{j}"] = v.nonnegative(f"--hs{j}", _need(args, f"hs{j}", f"--hs{j}", kind), "m")
-            p[f"tp{j}"] = v.positive(f"--tp{j}", _need(args, f"tp{j}", f"--tp{j}", kind), "s")
-            p[f"lambda{j}"] = v.positive(
-                f"--lambda{j}", _need(args, f"lambda{j}", f"--lambda{j}", kind), "-"
-            )
+            p[f"hs{j}"] = _height(args, f"hs{j}", kind, zero=True)
+            tp = _need(args, f"tp{j}", f"--tp{j}", kind)
+            p[f"tp{j}"] = v.in_range(f"--tp{j}", tp, "s", *PERIOD_RANGE)
+            lam = _need(args, f"lambda{j}", f"--lambda{j}", kind)
+            p[f"lambda{j}"] = v.in_range(f"--lambda{j}", lam, "-", *SHAPE_RANGE)
         if p["hs1"] == 0.0 and p["hs2"] == 0.0:
             raise InputError("--hs1", 0.0, "m", "--hs1 and --hs2 must not both be 0")
         return SpectrumChoice(

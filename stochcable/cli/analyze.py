@@ -31,6 +31,7 @@ from stochcable.cli._output import (
     write_netcdf_document,
     write_summary,
 )
+from stochcable.cli._scene_args import add_scene_arguments, scene_from_args
 
 __all__ = ["register", "run"]
 
@@ -44,7 +45,8 @@ def register(subparsers: Any) -> None:
         "a scene document; print a summary on a terminal, else the v1 result document "
         "as JSON.",
     )
-    p.add_argument("scene", help="scene document (JSON file)")
+    p.add_argument("scene", help="scene document (JSON file) or MoorDyn input file")
+    add_scene_arguments(p)
     p.add_argument(
         "--format",
         choices=["summary", "json", "netcdf"],
@@ -99,10 +101,9 @@ def run(args: argparse.Namespace) -> int:
     """Run the analysis and write the summary, the result document or NetCDF (and figures)."""
     from stochcable.analysis import analyze
     from stochcable.cost import available_memory, check_memory, estimate_cost
-    from stochcable.scene.model import load_scene
 
     fmt = output_format(args.format, args.output)
-    scene = load_scene(Path(args.scene))
+    scene = scene_from_args(args)
     # a scene too large for this machine: one sentence naming what to reduce, at once
     check_memory(estimate_cost(scene), available_memory(), "the memory available now")
     plt = require_matplotlib() if args.plot is not None else None

@@ -26,9 +26,9 @@ from pathlib import Path
 from stochcable.cases import LineFatigue, ScatterDiagram, read_scatter, run_cases
 from stochcable.cases.chunk import prepare_worker
 from stochcable.cases.results import case_dataset, case_document, case_summary_csv
+from stochcable.cli._scene_args import add_scene_arguments, scene_from_args
 from stochcable.design import curve_names
 from stochcable.errors import InputError
-from stochcable.scene.model import load_scene
 
 __all__ = ["register", "run"]
 
@@ -42,7 +42,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "built once), then the spectral fatigue damage of every line and the long-term "
         "most probable maximum tension.",
     )
-    p.add_argument("scene", metavar="SCENE.json", help="scene template")
+    p.add_argument("scene", metavar="SCENE.json", help="scene template (or a MoorDyn file)")
+    add_scene_arguments(p, sea=False)
     p.add_argument("--scatter", required=True, help="scatter diagram (CSV or JSON)")
     p.add_argument("--headings", default=None, help="comma-separated headings [deg]")
     p.add_argument(
@@ -113,7 +114,7 @@ def _executor(args: argparse.Namespace):
 
 def run(args: argparse.Namespace) -> int:
     """Run the set and write its results."""
-    scene = load_scene(args.scene)
+    scene = scene_from_args(args)
     scatter = read_scatter(args.scatter, family=args.spectrum)
     if args.headings is not None:
         scatter = _with_headings(scatter, args.headings)

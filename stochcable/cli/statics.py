@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from stochcable.cli._output import require_matplotlib, write_json
-from stochcable.scene.model import load_scene
+from stochcable.io import load_scene
 from stochcable.statics import StaticsResult, solve_statics
 
 __all__ = ["register", "run"]
@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "the 'statics' part of the result document (effective tensions, node positions, "
         "touchdown).",
     )
-    p.add_argument("scene", help="scene document (JSON file)")
+    p.add_argument("scene", help="scene document (JSON file) or MoorDyn input file")
     p.add_argument("--format", choices=["json"], default="json", help="output format")
     p.add_argument("-o", "--output", default=None, help="output file (default stdout)")
     p.add_argument(

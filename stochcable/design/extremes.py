@@ -21,7 +21,6 @@ import math
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import brentq
 from scipy.special import ndtr
 
 from stochcable import validation as v
@@ -368,6 +367,8 @@ def _solve_level(d: _Diagram, years: float) -> float:
     if not g(hi) < 0.0:
         return hi  # the states with p > 0 have σ = 0: the level is their largest mean
     scale = max(abs(lo), abs(hi), float(np.max(d.std)))
+    from scipy.optimize import brentq  # (imported here: the package stays light)
+
     return brentq(g, lo, hi, xtol=1e-15 * scale, rtol=4.0 * np.finfo(float).eps, maxiter=500)
 
 

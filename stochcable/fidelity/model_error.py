@@ -13,7 +13,7 @@ Two terms, the larger counts:
 
 - **Second-order stretching** of near-straight lines: the linear tension misses the
   quadratic term EA/(2L)∫(∂u⊥/∂s)² ds; the pilot's indicators carry its σ as the
-  factor √(1 + r²) on the linear σ (:mod:`stochcable.dynamics.second_order`), so the
+  factor √(1 + r²) on the linear σ (:mod:`stochcable.dynamics.residuals.second_order`), so the
   shortfall is 1 − 1/√(1 + r²).
 - **Calibrated shortfall** of the linear answer against the reconciled time-domain
   reference (the project's nonlinear reference simulator, itself within 0.26 % of
@@ -117,7 +117,7 @@ def linearization_model_error(
                 why = (
                     f"line {name!r}: second-order stretching of a near-straight line, "
                     f"the linear σ low by the factor {factor:.3f} "
-                    "(stochcable.dynamics.second_order)"
+                    "(stochcable.dynamics.residuals.second_order)"
                 )
         if err > best:
             best, basis = err, why

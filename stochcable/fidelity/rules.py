@@ -49,7 +49,7 @@ Grid (count and spacing)
 Elements
     Transverse string waves c = √(T/m_t), m_t = m + C_a ρ πD²/4: linear elements with
     consistent mass have the dispersion ω_h = ω(1 + (kh)²/24) (Rayleigh quotient of
-    the string, seed 001 eq. 3.1.12).  The frequency error that matters is the
+    the string, Tuah (1982), eq. 3.1.12).  The frequency error that matters is the
     variance-weighted one, so k is taken at the response's mean frequency
     ω₂ = √(m₂/m₀) (pilot) with ⟨1/c²⟩ over the suspended length: h ≤ √(24 ε_el)/(ω₂
     √⟨1/c²⟩), and h ≤ :data:`CUTOFF_KH`/k(ω_max) so no resonance of the band is
@@ -77,6 +77,10 @@ Linearization
     Tolerance = ε_lin: the fixed point's remaining error is at most about the last
     relative change of the σ, and the response σ is at most inversely proportional to
     the drag.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -261,7 +265,7 @@ def elements_wavelength(
 
     Notes
     -----
-    A string discretized by linear elements with consistent mass (seed 001 eq. 3.1.12)
+    A string discretized by linear elements with consistent mass (Tuah (1982), eq. 3.1.12)
     has ω_h² = (c²/h²)·6(1 − cos kh)/(2 + cos kh) = c²k²(1 + (kh)²/12 + O(kh)⁴), so
     ω_h/ω − 1 = (kh)²/24.
     """

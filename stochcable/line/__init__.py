@@ -1,5 +1,5 @@
 """One line: mesh, closed-form catenary, static equilibrium, finite-element model and
-natural modes (seed 001 ch. 4; seed 000 for the modes).
+natural modes (Tuah (1982), ch. 4; Bliet (1984) for the modes).
 
 ``mesh`` (elements and nodes) · ``catenary`` (closed-form elastic catenary; its closure
 integrals in ``catenary_kernel``, the multi-segment chain in ``multisegment``) ·
@@ -8,4 +8,10 @@ and Newton solver, ``chain`` its start, ``banded`` the banded solves) · ``eleme
 and ``fem`` (the finite-element model about the static shape; ``seabed`` its bed contact,
 the touchdown element split at the static touchdown) · ``modes``.  The
 scene-level statics, with bodies, is :mod:`stochcable.statics`.
+
+References
+----------
+Bliet, A. (1984), Dynamic analysis of single span cables, PhD thesis, Massachusetts
+Institute of Technology.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """

@@ -7,7 +7,7 @@ end_a toward end_b, z up.  Unstretched arc length s runs from end_a (s = 0) to e
 vertical component V(s) = V_a + w s, w the net submerged weight per unit length
 (positive downward).  The tension is T(s) = sqrt(H² + V(s)²) (effective tension).
 
-Closure: seed 000 (Bliet 1984) eqs. (2.5)–(2.6), the 2-D static equations without
+Closure: Bliet (1984), eqs. (2.5)–(2.6), the 2-D static equations without
 current, integrated in closed form as in Irvine (1981), *Cable Structures*, ch. 2::
 
     x(s) = H s / EA + ∫₀ˢ H / T ds'   = H s/EA + (H/w)[asinh(V(s)/H) − asinh(V_a/H)]
@@ -22,6 +22,12 @@ iteration on (H, V_a) covers both regimes.
 The integrals are evaluated as divided differences (no 1/w cancellation), so the
 weightless limit w → 0, the vertical limit H → 0 and taut lines (EA/T up to 1e6 and
 more) are all accurate to round-off.
+
+References
+----------
+Bliet, A. (1984), Dynamic analysis of single span cables, PhD thesis, Massachusetts
+Institute of Technology.
+Irvine, H. M. (1981), Cable structures, MIT Press, Cambridge, MA.
 """
 
 from __future__ import annotations
@@ -59,9 +65,9 @@ __all__ = [
     "CatenarySolution",
     "CatenaryLine",
     "catenary_solve",
+    "catenary_solve_unchecked",
     "catenary_from_top_tension",
     "catenary_line",
-    "elastic_catenary",
     "catenary_on_mesh",
     "check_reach",
     "newton_start",
@@ -280,7 +286,7 @@ def catenary_solve(
 
     Notes
     -----
-    Closure equations of the elastic catenary (Irvine 1981, ch. 2; seed 000 eqs.
+    Closure equations of the elastic catenary (Irvine 1981, ch. 2; Bliet (1984), eqs.
     (2.5)–(2.6) integrated with T = H/cos φ, eq. (3.28)) with the seabed extension of
     the grounded length L_B = L − V_b/w carrying the constant tension H.  Solved by
     Newton on (H, V_a) with
@@ -292,10 +298,10 @@ def catenary_solve(
     A horizontal span of exactly 0 gives H = 0 (vertical, possibly folded line).
     """
     X, Z, L, w, ea = _check_common(horizontal_span, vertical_span, length, weight, ea)
-    return elastic_catenary(X, Z, L, w, ea, bool(seabed))
+    return catenary_solve_unchecked(X, Z, L, w, ea, bool(seabed))
 
 
-def elastic_catenary(
+def catenary_solve_unchecked(
     X: float, Z: float, L: float, w: float, ea: float, seabed: bool
 ) -> CatenarySolution:
     """:func:`catenary_solve` for inputs already checked: floats, X >= 0 and Z, w
@@ -447,7 +453,7 @@ def catenary_from_top_tension(
         )
     H = brentq(lambda h: spans(h)[1] - Z, lo, hi, xtol=1e-14 * Tb, rtol=1e-15, maxiter=500)
     X = spans(H)[0]
-    return elastic_catenary(X, Z, L, w, ea, bool(seabed))
+    return catenary_solve_unchecked(X, Z, L, w, ea, bool(seabed))
 
 
 # ------------------------------------------------------------------------------ 3-D
@@ -528,7 +534,7 @@ def catenary_on_mesh(mesh: LineMesh, environment: Environment) -> CatenaryLine:
     e_h = np.array([d[0], d[1], 0.0]) / X if X > 0.0 else np.array([1.0, 0.0, 0.0])
     depth = environment.depth
     on_seabed = abs(a[2] + depth) <= 1e-9 * depth
-    sol = elastic_catenary(
+    sol = catenary_solve_unchecked(
         X, Z, float(mesh.length), float(mesh.weight[0]), float(mesh.ea[0]), bool(on_seabed)
     )
     x, z, t = sol.profile(mesh.s0)
@@ -536,3 +542,7 @@ def catenary_on_mesh(mesh: LineMesh, environment: Environment) -> CatenaryLine:
     mid = 0.5 * (mesh.s0[1:] + mesh.s0[:-1])
     _, _, t_mid = sol.profile(mid)
     return CatenaryLine(solution=sol, positions=pos, element_tension=t_mid, node_tension=t)
+
+
+# Former name of catenary_solve_unchecked (ARCHITECTURE.md "Conventions"), kept importable.
+elastic_catenary = catenary_solve_unchecked

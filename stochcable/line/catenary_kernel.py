@@ -1,4 +1,4 @@
-"""The closure integrals of the elastic catenary (Irvine 1981, ch. 2; seed 000 eqs.
+"""The closure integrals of the elastic catenary (Irvine 1981, ch. 2; Bliet (1984), eqs.
 (2.5)–(2.6)), shared by the single- and multi-segment solvers.
 
 For a suspended stretch of unstretched length l_s starting with vertical force V_0 under
@@ -8,6 +8,12 @@ horizontal force H and weight w per length, the spans
 
 and their Jacobian in (H, V_0), evaluated as divided differences (no 1/w cancellation):
 exact in the weightless (w → 0) and vertical (H → 0) limits and for taut lines.
+
+References
+----------
+Bliet, A. (1984), Dynamic analysis of single span cables, PhD thesis, Massachusetts
+Institute of Technology.
+Irvine, H. M. (1981), Cable structures, MIT Press, Cambridge, MA.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Input checks, the Newton start and the vertical-line solve of the elastic catenary.
 
-Shared by :func:`stochcable.line.catenary.elastic_catenary` (whose damped Newton
+Shared by :func:`stochcable.line.catenary.catenary_solve_unchecked` (whose damped Newton
 iteration on (H, V_a) starts here) and the multi-segment solver
 (:mod:`stochcable.line.multisegment`): the scalar checks of :func:`catenary_solve
 <stochcable.line.catenary.catenary_solve>`, the reach check (a line may stretch at most

@@ -2,8 +2,8 @@
 
 A two-unknown shooting on (H, V_0) (:func:`chain_guess`), with seabed contact from
 end_a, solved by damped Newton from the continuous elastic catenary
-(:func:`stochcable.line.catenary.elastic_catenary`) or by nested bracketing; a parabola
-(:func:`initial_guess`) where it does not apply.
+(:func:`stochcable.line.catenary.catenary_solve_unchecked`) or by nested bracketing; a
+parabola (:func:`initial_guess`) where it does not apply.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.line.catenary import elastic_catenary
+from stochcable.line.catenary import catenary_solve_unchecked
 from stochcable.line.equilibrium import LocalFrame, StaticsModel
 from stochcable.line.mesh import LineMesh
 from stochcable.scene.model import Environment
@@ -167,10 +167,11 @@ def chain_guess(
     bed (V_k -> 0, the virtual-V_a form of :mod:`stochcable.line.catenary`, continuous at
     first contact), each grounded node at its contact penetration (load / (k·D·l)).
     (H, V_0) are found by damped Newton on the closure at end_b, started from the
-    continuous catenary of the mean weight (:func:`stochcable.line.catenary.elastic_catenary`),
-    or, when the kinks of the closure stall it, by nested bracketing
-    (:func:`chain_closure`).  The weights follow the wet fraction of each element at
-    the shape found (re-solved up to three times).  Drag is ignored (a start only).
+    continuous catenary of the mean weight
+    (:func:`stochcable.line.catenary.catenary_solve_unchecked`), or, when the kinks of
+    the closure stall it, by nested bracketing (:func:`chain_closure`).  The weights
+    follow the wet fraction of each element at the shape found (re-solved up to three
+    times).  Drag is ignored (a start only).
 
     Unlike the continuous catenary sampled at the nodes, whose chords are shorter than
     its arcs by l0³κ²/24 (strains of -5e-3 near a sharp touchdown, i.e. slack elements
@@ -257,7 +258,7 @@ def chain_newton(
     of the central-difference Jacobian in one call, the same numbers)."""
     w_mean = float(np.sum(P)) / L
     try:
-        sol = elastic_catenary(
+        sol = catenary_solve_unchecked(
             X, Z, float(L), w_mean, L / float(np.sum(l0 / ea)), bool(on_bed and w_mean > 0.0)
         )
     except (InputError, ConvergenceError, ValueError):

@@ -1,10 +1,14 @@
-"""Element matrices of the line's finite-element model (seed 001 §3.1; DESIGN.md
+"""Element matrices of the line's finite-element model (Tuah (1982), §3.1; DESIGN.md
 "Cable model"): 2-node straight cable elements about their static shape.
 
 Exact tangent stiffness K_e = [(EA/l0) e eᵀ + (T/l)(I − e eᵀ)] ⊗ [[1, −1], [−1, 1]],
 consistent mass m l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ I (eq. 3.1.12) or lumped, and the normal
 added mass Ca ρ πD²/4 l0 (I − e eᵀ) ⊗ the same pattern.  Element blocks are
 (n_el, 2d, 2d), node-a DOFs first; :mod:`stochcable.line.fem` assembles them.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -96,8 +100,8 @@ def element_stiffness(
 
         K_e = [(EA/l0) e eᵀ + (T/l)(I − e eᵀ)] ⊗ [[1, −1], [−1, 1]],
 
-    the derivative of the element end force T(l) e with T = EA (l − l0)/l0 (seed 001
-    eqs. 3.1.8–3.1.11 with the pseudo-Hookean law; DESIGN.md "Cable model").  A slack
+    the derivative of the element end force T(l) e with T = EA (l − l0)/l0 (Tuah
+    (1982), eqs. 3.1.8–3.1.11 with the pseudo-Hookean law; DESIGN.md "Cable model").  A slack
     element (T <= 0) gets T -> 0 and EA -> ``SLACK_EA_RATIO``·EA: it carries no
     geometric stiffness and nearly no axial stiffness, and K stays positive
     semi-definite.
@@ -152,7 +156,7 @@ def element_mass(
 
     Notes
     -----
-    Consistent mass m l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ I (seed 001 eq. 3.1.12, whose
+    Consistent mass m l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ I (Tuah (1982), eq. 3.1.12, whose
     C_L·ρA/λ_C is m·l0).  Lumped mass m l0 [[1/2, 0], [0, 1/2]] ⊗ I.
     """
     l0 = float_array("l0", l0, "m", positive=True)
@@ -194,7 +198,7 @@ def element_added_mass(
 
     Notes
     -----
-    Per unit length Can ρ πD²/4 (I − e eᵀ) (seed 001 eq. 3.2.a.2, the −(C_M − 1) ü_N
+    Per unit length Can ρ πD²/4 (I − e eᵀ) (Tuah (1982), eq. 3.2.a.2, the −(C_M − 1) ü_N
     term; DESIGN.md "Cable model"), distributed like the structural mass (consistent
     [[1/3, 1/6], [1/6, 1/3]] or lumped) over the unstretched length, as the mass per
     length is.  No tangential added mass.

@@ -1,12 +1,16 @@
 """The finite-element statics of one line: residual, tangent and the Newton solver
-(seed 001 §4.1, §3.1).
+(Tuah (1982), §4.1, §3.1).
 
 :class:`LocalFrame` is the line's local frame (planar problems with two DOFs per
 node); :class:`StaticsModel` the nodal residual forces of the 2-node elastic bars with
 their lumped loads (weight by wet fraction, attachments, current drag, seabed springs)
 and the exact banded tangent; :class:`StaticsSolver` Newton–Raphson with a
-backtracking line search, falling back to the viscous relaxation of seed 001 eqs.
+backtracking line search, falling back to the viscous relaxation of Tuah (1982), eqs.
 4.1.5–4.1.8.  The model is described in :func:`stochcable.line.statics.solve_line_statics`.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from stochcable.scene.model import Environment
 
 __all__ = ["SLACK_FACTOR", "LocalFrame", "StaticsModel", "StaticsSolver", "reference_force"]
 
-#: Axial stiffness factor of a slack (compressed) element: E -> eps E (seed 001 §6.2).
+#: Axial stiffness factor of a slack (compressed) element: E -> eps E (Tuah (1982), §6.2).
 SLACK_FACTOR = 1e-6
 
 _EPS = np.finfo(float).eps
@@ -339,7 +343,7 @@ def reference_force(model: StaticsModel, T: np.ndarray, drag: float) -> float:
 
 
 class StaticsSolver:
-    """Newton with line search, then viscous relaxation (seed 001 eqs. 4.1.5-4.1.8)."""
+    """Newton with line search, then viscous relaxation (Tuah (1982), eqs. 4.1.5-4.1.8)."""
 
     def __init__(self, model: StaticsModel, tol: float, budget: int) -> None:
         self.m = model
@@ -431,7 +435,7 @@ class StaticsSolver:
                 t *= 0.5
             if not accepted:
                 # Newton stalls: viscous relaxation, artificial damping C ∝ diag(K)
-                # (seed 001 eqs. 4.1.5-4.1.8), stiffened until a step is taken
+                # (Tuah (1982), eqs. 4.1.5-4.1.8), stiffened until a step is taken
                 lam = max(4.0 * lam, 1e-2)
                 continue
             X = Xt

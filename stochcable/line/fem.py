@@ -1,4 +1,4 @@
-"""Linear finite-element model of a line about its static shape (seed 001 ch. 3.1).
+"""Linear finite-element model of a line about its static shape (Tuah (1982), ch. 3.1).
 
 The line is discretized into 2-node straight elements (:mod:`stochcable.line.mesh`); about a
 static shape (node positions and element effective tensions) the small-motion model is
@@ -6,7 +6,7 @@ static shape (node positions and element effective tensions) the small-motion mo
     M_T ü + C u̇ + K u = F,   M_T = M + Ma,
 
 with K the exact tangent stiffness (elastic + geometric) plus linear seabed springs, M the
-structural mass (consistent, seed 001 eq. 3.1.12) plus lumped attachment masses, Ma the
+structural mass (consistent, Tuah (1982), eq. 3.1.12) plus lumped attachment masses, Ma the
 normal added mass of the line plus attachment added masses, and Cs the seabed contact
 damping.  The response engine adds drag damping and loads; :mod:`stochcable.line.modes` solves
 K φ = ω² M_T φ.
@@ -19,6 +19,10 @@ with ``dim × dim`` blocks: its half-bandwidth (number of super-diagonals) is
 nodes, so the free–free block keeps that bandwidth.  Matrices are stored as
 ``scipy.sparse.csr_array`` (assembly and partitioning are O(n)); :meth:`FEModel.banded`
 gives LAPACK upper banded storage and :meth:`FEModel.dense` a dense copy.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -400,7 +404,7 @@ def assemble(
 
     Notes
     -----
-    Element stiffness: :func:`element_stiffness` (seed 001 eqs. 3.1.8–3.1.11);
+    Element stiffness: :func:`element_stiffness` (Tuah (1982), eqs. 3.1.8–3.1.11);
     structural mass: :func:`element_mass` (eq. 3.1.12); normal added mass:
     :func:`element_added_mass`; attachment masses and added masses (isotropic) are
     lumped on their nodes.  Seabed: see :class:`FEModel` and

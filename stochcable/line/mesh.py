@@ -1,10 +1,14 @@
-"""Discretization of a line into 2-node straight elements (seed 001 §3.1).
+"""Discretization of a line into 2-node straight elements (Tuah (1982), §3.1).
 
 A :class:`LineMesh` holds, per element, the unstretched length and the section and
 hydrodynamic properties, and, per node, the lumped attachments.  Nodes sit at segment
 boundaries, at the uniform subdivision of each segment into its ``elements`` count, and
 at every attachment's arc length (the element containing it is split, so an attachment
 is never smeared).  Node 0 is ``end_a``, node ``n_nodes - 1`` is ``end_b``.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

@@ -22,6 +22,11 @@ degeneracies harmless.  The Lanczos results are checked with a
 Sturm count (the inertia of K − θM_T, Sylvester's law): if the number of eigenvalues
 below the gap after the last requested mode differs from the number found, the block is
 re-solved densely, so modes near a crossover are never dropped or duplicated.
+
+References
+----------
+Bliet, A. (1984), Dynamic analysis of single span cables, PhD thesis, Massachusetts
+Institute of Technology.
 """
 
 from __future__ import annotations
@@ -374,7 +379,7 @@ def natural_modes(
 
     Notes
     -----
-    Solves K_ff φ = ω² M_T,ff φ on the free DOFs (DESIGN.md "Modes"; seed 000 ch. 3
+    Solves K_ff φ = ω² M_T,ff φ on the free DOFs (DESIGN.md "Modes"; Bliet (1984), ch. 3
     for the closed forms it reproduces).  Eigenvalues below zero by round-off are
     reported as ω = 0.  The out-of-plane fraction of a mode is
     E_n/(E_n + E_p), E = uᵀ M_T u of the displacement projected on the plane normal n

@@ -1,6 +1,11 @@
 """A chain of elastic catenary segments with point loads at the junctions (Irvine 1981,
-ch. 2; seed 001 §6.2's buoy), no seabed contact: the reference of the FE statics of
+ch. 2; Tuah's (1982) §6.2 buoy), no seabed contact: the reference of the FE statics of
 multi-segment lines.
+
+References
+----------
+Irvine, H. M. (1981), Cable structures, MIT Press, Cambridge, MA.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -13,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from stochcable import validation as v
 from stochcable.errors import ConvergenceError, InputError
-from stochcable.line.catenary import elastic_catenary
+from stochcable.line.catenary import catenary_solve_unchecked
 from stochcable.line.catenary_kernel import CLOSURE_TOL, MAX_NEWTON, kernel
 from stochcable.line.catenary_start import check_reach, newton_start
 
@@ -116,7 +121,7 @@ def catenary_multisegment(
     Notes
     -----
     The vertical tension component jumps by the junction load across each junction
-    (node equilibrium, seed 001 §6.2 buoy of 900 lb); H is constant.  The spans are
+    (node equilibrium, Tuah (1982), §6.2 buoy of 900 lb); H is constant.  The spans are
     the sums of the segments' closures (Irvine 1981, ch. 2) and the Jacobian the
     sum of theirs; damped Newton on (H, V_a) as in :func:`catenary_solve`, started from
     the single-segment solution with the average weight.  No seabed contact.
@@ -161,7 +166,7 @@ def catenary_multisegment(
     if abs(w_avg) <= 1e-6 * float(np.max(np.abs(ws), initial=0.0)):
         w_avg = float(np.mean(np.abs(ws))) or 1.0  # a start only
     try:
-        s0 = elastic_catenary(X, Z, L, w_avg, ea_eq, False)
+        s0 = catenary_solve_unchecked(X, Z, L, w_avg, ea_eq, False)
         H, Va = s0.H, s0.V_a
     except (InputError, ConvergenceError):
         H, Va = newton_start(X, Z, L, w_avg if w_avg != 0 else 1.0, 1.0 / ea_eq)

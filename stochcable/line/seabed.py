@@ -9,6 +9,11 @@ element that contains the static touchdown point is split there by an internal n
 that carries the bed of the grounded part of the element; that node has no mass and is
 condensed out, so the mesh, the matrices' band and every output stay those of the
 user's elements (:func:`touchdown_element`).
+
+References
+----------
+Bliet, A. (1984), Dynamic analysis of single span cables, PhD thesis, Massachusetts
+Institute of Technology.
 """
 
 from __future__ import annotations
@@ -201,7 +206,7 @@ def bed_contact(
     an amount of second order in the motion: the one-sided contact is a second-order
     effect and the suspended span ends at the static touchdown point (the boundary
     condition of the linear cable dynamics of catenary moorings and risers with a
-    grounded length: Triantafyllou, Bliek & Shin 1985, §3; Bliek 1984, seed 000 ch. 3,
+    grounded length: Triantafyllou, Bliek & Shin 1985, §3; Bliet (1984), ch. 3,
     for a chain tangential to the bottom; Aranha, Martins & Pinto 1997).  A model that
     springs only the nodes grounded in statics moves that point to the last grounded
     node, lengthening the span by up to one element: an O(h) error whose sign depends on

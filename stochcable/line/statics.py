@@ -1,19 +1,23 @@
-"""Static equilibrium of lines: elastic catenary or finite-element Newton (seed 001 §4.1).
+"""Static equilibrium of lines: elastic catenary or finite-element Newton (Tuah (1982), §4.1).
 
-The static shape is the configuration the dynamic analysis linearizes about (seed 001
-ch. 4: "provide a stable starting configuration for a dynamic problem").  Two methods:
+The static shape is the configuration the dynamic analysis linearizes about (Tuah
+(1982), ch. 4: "provide a stable starting configuration for a dynamic problem").  Two methods:
 
 - ``"catenary"``: the closed-form elastic catenary (:mod:`stochcable.line.catenary`) for a
   single homogeneous segment between fixed points in a vertical plane, without current
   or attachments, with seabed contact when end_a lies on the seabed;
 - ``"fe"``: a finite-element Newton solve over the mesh of 2-node straight elastic bars
-  (seed 001 §3.1) with lumped loads, for everything: several segments, clump weights
+  (Tuah (1982), §3.1) with lumped loads, for everything: several segments, clump weights
   and buoys, current drag, seabed contact, 3-D geometry.
 
 ``"auto"`` takes the catenary where it applies and the FE otherwise.  Both solve for
 the *effective* tension: the weight is the net submerged weight per unit length
 (weight in air minus the weight of displaced water), so the hydrostatic pressure field
 is folded into the load and the tension reported is the effective tension.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -34,7 +38,7 @@ __all__ = [
     "Method",
     "LineStatics",
     "solve_line_statics",
-    "line_statics",
+    "solve_line_statics_unchecked",
     "check_statics_options",
     "solve_fe",
 ]
@@ -189,11 +193,11 @@ def solve_line_statics(
 
     Notes
     -----
-    The FE model (seed 001 §3.1, DESIGN.md "Cable model") has the interior node
+    The FE model (Tuah (1982), §3.1, DESIGN.md "Cable model") has the interior node
     positions as unknowns; the ends are fixed at their static positions (end motions
     are dynamic only).  Element force from the exact elastic bar,
     T = EA (l/l0 - 1) for l > l0 and T = eps EA (l/l0 - 1), eps = 1e-6, for a slack
-    element (E -> eps, seed 001 §6.2); consistent tangent
+    element (E -> eps, Tuah (1982), §6.2); consistent tangent
     K_e = [(EA/l0) e eᵀ + (T/l)(I - e eᵀ)] ⊗ [[1, -1], [-1, 1]].
 
     Loads, lumped half to each node of an element:
@@ -217,7 +221,7 @@ def solve_line_statics(
     which is the FE solution itself for planar lines without current; a parabola when
     it does not apply (vertical span, contact away from end_a).
 
-    Solution (seed 001 §4.1): Newton–Raphson on the residual feedback form
+    Solution (Tuah (1982), §4.1): Newton–Raphson on the residual feedback form
     (eq. 4.1.2) with a backtracking line search that accepts a decrease of the residual
     norm or of the potential energy with the drag frozen at the current iterate (the
     exact energy without current); when no step is accepted, the viscous relaxation
@@ -245,10 +249,12 @@ def solve_line_statics(
             raise InputError(
                 "initial", initial, "m", f"must be finite with shape ({mesh.n_nodes}, 3)"
             )
-    return line_statics(mesh, environment, method, initial, tolerance, max_iterations)
+    return solve_line_statics_unchecked(
+        mesh, environment, method, initial, tolerance, max_iterations
+    )
 
 
-def line_statics(
+def solve_line_statics_unchecked(
     mesh: LineMesh,
     environment: Environment,
     method: Method,
@@ -394,7 +400,7 @@ def solve_fe(
 def _drag_stepping(
     solver: StaticsSolver, model: StaticsModel, X0: np.ndarray, budget: int
 ) -> tuple[np.ndarray, float, bool]:
-    """Load stepping of the current (seed 001 §4.1, eq. 4.1.2 applied per increment).
+    """Load stepping of the current (Tuah (1982), §4.1, eq. 4.1.2 applied per increment).
 
     The drag is scaled by a factor beta (model.beta) raised from 0 (the equilibrium
     without current, whose start is the exact lumped chain) to 1; each increment is
@@ -553,3 +559,7 @@ def _solve_catenary(mesh: LineMesh, env: Environment) -> LineStatics | str:
         residual=float(sol.residual) / max(mesh.length, float(np.linalg.norm(d))),
         method="catenary",
     )
+
+
+# Former name of solve_line_statics_unchecked (ARCHITECTURE.md "Conventions"), kept importable.
+line_statics = solve_line_statics_unchecked

@@ -1,20 +1,26 @@
 """Strumming (vortex-induced vibration) of a line in a steady current, in the
-frequency domain (seed 001 §3.2.b).
+frequency domain (Tuah (1982), §3.2.b).
 
 A steady normal flow U_n past an element of diameter D sheds vortices at
-ω_s = 2π·St·U_n/D (seed 001 eq. 3.2.b.4).  A natural mode ω_n is a lock-in candidate
+ω_s = 2π·St·U_n/D (Tuah (1982), eq. 3.2.b.4).  A natural mode ω_n is a lock-in candidate
 when its reduced velocity V_R = 2π U_n/(ω_n D) lies in the cross-flow band
 3 ≤ V_R ≤ 16 of DNV-RP-C205 (2010) ch. 9 (:data:`CROSS_FLOW_BAND`); the nearest
 candidates are balanced with the Skop–Griffin wake oscillator
 (:mod:`stochcable.line.strumming_balance`).  A mode with a first-harmonic solution is
 *locked in* and vibrates at its steady amplitude; one without is an *unlocked* mode
 driven by the free wakes (C_L = C_L0 at ω_s), whose response is bounded by twice the
-forced amplitude (the beat from rest, seed 001 Example 6).  The vibration of a
+forced amplitude (the beat from rest, Tuah (1982), Example 6).  The vibration of a
 locked-in mode magnifies the in-line drag: C_d/C_d0 = 1 + 1.043 (2 Y_rms/D)^0.65
 (Vandiver 1983, :func:`drag_amplification_vandiver`).
 
 :func:`strumming_screen` is the one entry point: one line's static shape, sections,
 current and natural modes in, a :class:`StrummingTable` out.
+
+References
+----------
+Griffin, O. M., Skop, R. A. and Ramberg, S. E. (1975), The resonant, vortex-excited
+vibrations of structures and cable systems, Offshore Technology Conference, OTC 2319.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -61,8 +67,8 @@ __all__ = [
     "strumming_screen",
 ]
 
-#: Candidate modes balanced per line (nearest to the shedding frequency, seed 001
-#: §3.2.b: "the natural frequency having a value closest to the shedding frequency"). [-]
+#: Candidate modes balanced per line (nearest to the shedding frequency, Tuah
+#: (1982), §3.2.b: "the natural frequency having a value closest to the shedding frequency"). [-]
 _CANDIDATES = 3
 #: Least share of a mode's modal mass that moves across the flow on shedding elements
 #: for it to be a candidate (an in-line or axial mode is not excited by the lift). [-]
@@ -233,7 +239,7 @@ class StrummingTable:
         Position in ``modes`` of the mode whose amplitude amplifies the drag: the
         strumming (locked-in or resonant) mode of largest amplitude.  None when no mode
         strums: an unlocked, non-resonant mode's wakes drift in phase along the line
-        and its response decays (seed 001 Example 6, tests/test_strumming.py), so the
+        and its response decays (Tuah (1982), Example 6, tests/test_strumming.py), so the
         drag is not amplified.
     """
 
@@ -492,9 +498,9 @@ def amplitude_griffin(reduced_damping_sg: float, shape_factor: float = 1.0) -> f
 
     Notes
     -----
-    Griffin, Skop & Ramberg (1975), OTC 2319 (seed 001 ref. 20): the fit of measured
+    Griffin, Skop & Ramberg (1975), OTC 2319 (Tuah (1982), ref. 20): the fit of measured
     resonant amplitudes of cylinders and cables against S_G that the wake oscillator's
-    parameters (seed 001 eq. 3.2.b.5) were calibrated to.
+    parameters (Tuah (1982), eq. 3.2.b.5) were calibrated to.
     """
     sg = finite_scalar("reduced_damping", reduced_damping_sg, "-")
     if sg < 0:

@@ -1,28 +1,34 @@
 """The closed forms of strumming (shedding, reduced velocity, damping, drag
-amplification) and the Skop–Griffin wake oscillator of seed 001 §3.2.b with its
+amplification) and the Skop–Griffin wake oscillator of Tuah (1982), §3.2.b with its
 harmonic balance.
 
 The lift coefficient C_L(s, t) of every element obeys the wake oscillator of
-Griffin, Skop & Ramberg (1975) (seed 001 eq. 3.2.b.3)::
+Griffin, Skop & Ramberg (1975) (Tuah (1982), eq. 3.2.b.3)::
 
     C̈ + ω_s² C − [C_L0² − C² − (Ċ/ω_s)²]·(ω_s G Ċ − ω_s² H C) = ω_s F Ẏ/D
 
 driven by the transverse velocity Ẏ of the element, and the cable responds in one
-natural mode (seed 001 eqs. 3.2.b.7–9)::
+natural mode (Tuah (1982), eqs. 3.2.b.7–9)::
 
     z̈ + 2ξω_n ż + ω_n² z = Σ_e q_e ψ_e C_e,     q_e = ½ρ D_e U_e² L_e,
 
 with ψ_e the mode's displacement at element e along its lift direction (mass-normalized
-shapes, φᵀM_Tφ = 1).  The seed prints C_L0 in the bracket; C_L0² is meant: with it the
+shapes, φᵀM_Tφ = 1).  Tuah (1982) prints C_L0 in the bracket; C_L0² is meant: with it the
 free wake (Ẏ = 0) has the limit cycle C = C_L0 cos ω_s t exactly (C² + (Ċ/ω_s)² is then
 constant), which is the definition of C_L0 ("lift amplitude of the fixed cylinder");
 with C_L0 the free amplitude would be √C_L0.
 
-:func:`wake_parameters` gives G, H, F from the reduced damping (seed 001 eqs.
+:func:`wake_parameters` gives G, H, F from the reduced damping (Tuah (1982), eqs.
 3.2.b.5–6); :func:`wake_response` solves the first-harmonic balance of the wake of
 every element at a response frequency; :func:`lock_in_balance` solves the coupled
 balance of a mode for its amplitude and frequency.  The time-domain check is
 :mod:`stochcable.reference.wake_oscillator`.
+
+References
+----------
+Griffin, O. M., Skop, R. A. and Ramberg, S. E. (1975), The resonant, vortex-excited
+vibrations of structures and cable systems, Offshore Technology Conference, OTC 2319.
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -31,9 +37,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from stochcable.errors import InputError
+from stochcable.line.strumming_bound import grid_is_proven
 from stochcable.validation import finite_scalar
 
 __all__ = [
@@ -70,7 +76,7 @@ CROSS_FLOW_BAND = (3.0, 16.0)
 #: Strouhal number of a circular cylinder, subcritical 300 < Re < 2·10⁵ (Blevins 1990
 #: Fig. 3-5; DNV-RP-C205 Fig. 9-2). [-]
 STROUHAL_DEFAULT = 0.2
-#: Lift-coefficient amplitude of the fixed cylinder (seed 001 Example 6). [-]
+#: Lift-coefficient amplitude of the fixed cylinder (Tuah (1982), Example 6). [-]
 LIFT_DEFAULT = 0.2
 
 
@@ -93,7 +99,7 @@ def shedding_frequency(speed, diameter, strouhal=STROUHAL_DEFAULT):
 
     Notes
     -----
-    Seed 001 eq. 3.2.b.4.
+    Tuah (1982), eq. 3.2.b.4.
     """
     u = np.asarray(speed, dtype=float)
     d = np.asarray(diameter, dtype=float)
@@ -182,7 +188,7 @@ def hydrodynamic_damping_ratio(rho, diameter, mass, viscosity, omega_n):
 
     Notes
     -----
-    Seed 001 eq. 3.2.b.8.
+    Tuah (1982), eq. 3.2.b.8.
     """
     for name, v, unit in (
         ("rho", rho, "kg/m³"),
@@ -219,7 +225,7 @@ def reduced_damping(mass, damping_ratio, rho, diameter, strouhal=STROUHAL_DEFAUL
 
     Notes
     -----
-    Seed 001 eq. 3.2.b.6 (Griffin, Skop & Ramberg 1975).
+    Tuah (1982), eq. 3.2.b.6 (Griffin, Skop & Ramberg 1975).
     """
     if not finite_scalar("damping_ratio", damping_ratio, "-") > 0:
         raise InputError("damping_ratio", damping_ratio, "-", "must be > 0")
@@ -243,8 +249,8 @@ def drag_amplification_vandiver(y_rms_over_d):
     Notes
     -----
     Vandiver, J. K. (1983), "Drag coefficients of long flexible cylinders", OTC 4490,
-    fitted to field data of strumming cables; the magnification the seed names (Skop,
-    Griffin and Ramberg 1977) and leaves for future study (seed 001 ch. 7).
+    fitted to field data of strumming cables; the magnification Tuah (1982) names (Skop,
+    Griffin and Ramberg 1977) and leaves for future study (Tuah (1982), ch. 7).
     """
     y = np.asarray(y_rms_over_d, dtype=float)
     if np.any(~np.isfinite(y)) or np.any(y < 0):
@@ -261,7 +267,7 @@ def _check_positive(name: str, value: np.ndarray, unit: str) -> None:
 
 @dataclass(frozen=True)
 class WakeParameters:
-    """Empirical parameters of the wake oscillator (seed 001 eqs. 3.2.b.5–6).
+    """Empirical parameters of the wake oscillator (Tuah (1982), eqs. 3.2.b.5–6).
 
     Attributes
     ----------
@@ -296,7 +302,7 @@ def wake_parameters(reduced_damping: float, damping_ratio: float) -> WakeParamet
 
     Notes
     -----
-    Seed 001 eqs. 3.2.b.5–6 (Griffin, Skop & Ramberg 1975, OTC 2319):
+    Tuah (1982), eqs. 3.2.b.5–6 (Griffin, Skop & Ramberg 1975, OTC 2319):
     log₁₀ Ḡ = 0.25 − 0.21 S_G, log₁₀(h S_G²) = −0.24 + 0.66 S_G, H̄ = ξ h,
     F̄ = 4 Ḡ S_G/h.
     """
@@ -473,6 +479,9 @@ def lock_in_balance(
 
     ln_a = np.log(np.geomspace(1e-3, 3.0, 20) / y_scale)
     ratio = np.linspace(0.65, 1.35, 29)
+    args = (np.exp(ln_a), ratio * omega_n, omega_n, damping_ratio, ps, qs, ds, ws, c0)
+    if grid_is_proven(*args, params.g, params.big_h, params.f):
+        return none  # every point proven: no start, and no compiled kernel needed
     from stochcable.line.strumming_kernels import balance_grid  # numba: lazily
 
     grid = balance_grid(
@@ -504,6 +513,8 @@ def lock_in_balance(
     roots = []
     for flat in starts:
         i, j = np.unravel_index(flat, grid.shape)
+        from scipy.optimize import least_squares  # (only where a start is refined)
+
         sol = least_squares(
             resid,
             np.array([ln_a[i], ratio[j]]),

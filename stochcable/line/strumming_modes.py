@@ -8,7 +8,11 @@ modes are added here from the out-of-plane part of the same FE model: the geomet
 stiffness (T/l)·[[1, −1], [−1, 1]] per element (the elastic part EA e eᵀ has no
 out-of-plane component for an in-plane element) with the consistent mass
 m l0 [[1/3, 1/6], [1/6, 1/3]] plus the normal added mass Ca ρ πD²/4 the same way
-(DESIGN.md "Finite elements"; seed 001 eq. 3.1.12) and the attachments' lumped masses.
+(DESIGN.md "Finite elements"; Tuah (1982), eq. 3.1.12) and the attachments' lumped masses.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Independent checks of the coupled lines–bodies dynamics (seed 001 §3.3).
+"""Independent checks of the coupled lines–bodies dynamics (Tuah (1982), §3.3).
 
 The engine (:mod:`stochcable.dynamics.groups`) solves the coupled system by its own
 paths (modal lines, Foss, the coarse-start drag fixed point); the solvers here take the
@@ -7,6 +7,10 @@ directly at every frequency (dense, or line blocks banded with the bodies' Schur
 complement), with the bodies' frequency-dependent added mass and radiation damping
 exact at every ω — the reference the tests and benchmarks compare the engine with.
 :func:`body_drag_damping` is the reference form of a body's linearized drag.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -53,8 +57,8 @@ def body_drag_damping(
     Notes
     -----
     Per direction b = ρ CdA E|v| for v ~ N(U, σ²) (DESIGN.md "Drag linearization",
-    :func:`stochcable.dynamics.linearization.formulas.drag_linear_current`); for U = 0 this is the
-    seed form √(8/π)·½ρ CdA σ (seed 001 eq. 5.2.2).  The fluid load that goes with it is
+    :func:`stochcable.dynamics.linearization.formulas.drag_linear_current`); for U = 0 this is
+    √(8/π)·½ρ CdA σ (Tuah (1982), eq. 5.2.2).  The fluid load that goes with it is
     Tᵀ diag(b) v_fluid (wave velocity at the drag point).
     """
     rho = finite_scalar("rho", rho, "kg/m³")
@@ -109,7 +113,7 @@ def solve_coupled_direct(
     Notes
     -----
     The direct solve of DESIGN.md "Solution" with the body's frequency-dependent added
-    mass and radiation damping (seed 001 eq. 3.2.c.20) exact at every ω.  A body's
+    mass and radiation damping (Tuah (1982), eq. 3.2.c.20) exact at every ω.  A body's
     ``fixed_dofs`` are constraints: those DOFs are removed from the system and their
     motion is exactly zero (their loads are reactions, not inputs).  The Foss
     decomposition needs constant matrices

@@ -1,41 +1,45 @@
-"""Nonlinear time-domain reference simulation of one line (seed 001 §4.2, §3.1–3.2).
+"""Nonlinear time-domain reference simulation of one line (Tuah (1982), §4.2, §3.1–3.2).
 
 This is the yardstick of the frequency-domain method, not its main path: tests and
 benchmarks run it with the *same* sea realization (the same FFT coefficients X_m of
 :mod:`stochcable.sea.realization`) as the linear analysis and compare statistics and
-time series, which measures the error of the statistical drag linearization and of the small-motion
-assumption.
+time series, which measures the error of the statistical drag linearization and of
+the small-motion assumption.
 
 Modules: :mod:`~stochcable.reference.cable_model` (the nonlinear finite-element model:
 elements, drag, seabed, static start), :mod:`~stochcable.reference.cable_excitation`
 (realizations and their time series), :mod:`~stochcable.reference.cable_newmark` (the
 integrator) and this one (:func:`simulate_line_timedomain` and its result).
 
-Time stepping: Newmark average acceleration (β = 1/4, γ = 1/2; seed eqs. 4.2.7–4.2.11)
-with full Newton iterations per step on the residual
-R = M ü + F_int(x) − F_ext(t, x, u̇) of the free DOFs, Jacobian
-4/Δt² M + K_T + 2/Δt C_T (C_T the drag and seabed velocity Jacobians; the drag's
-dependence on the tangent's rotation is left out of the Jacobian — seed eq. 3.2.a.6's
-S_ij, "negligible" — so Newton converges linearly-fast rather than quadratically when
-the current is strong), with a backtracking line search on the residual norm.  Linear
-solves are banded LAPACK (half-bandwidth 2·dim − 1).  End tensions are the support
-reactions (the residual rows of the prescribed end nodes), the quantity of the
-statics' ``tension_a``/``tension_b`` and of the frequency-domain end tension.  The
-excitation starts from the static equilibrium of this same model and is ramped in by a
-half-cosine over ``ramp`` seconds; statistics skip the ramp.
+Time stepping: Newmark average acceleration (β = 1/4, γ = 1/2; Tuah (1982), eqs.
+4.2.7–4.2.11) with full Newton iterations per step on the residual R = M ü + F_int(x) −
+F_ext(t, x, u̇) of the free DOFs, Jacobian 4/Δt² M + K_T + 2/Δt C_T (C_T the drag and
+seabed velocity Jacobians; the drag's dependence on the tangent's rotation is left out
+of the Jacobian — the S_ij of Tuah (1982), eq. 3.2.a.6, "negligible" — so Newton
+converges linearly-fast rather than quadratically when the current is strong), with a
+backtracking line search on the residual norm. Linear solves are banded LAPACK
+(half-bandwidth 2·dim − 1). End tensions are the support reactions (the residual rows of
+the prescribed end nodes), the quantity of the statics' ``tension_a``/``tension_b`` and
+of the frequency-domain end tension. The excitation starts from the static equilibrium
+of this same model and is ramped in by a half-cosine over ``ramp`` seconds; statistics
+skip the ramp.
 
-The integrator (:mod:`stochcable.reference.cable_newmark`) is written here rather
-than taken from :mod:`stochcable.sea.timeseries` because the ends are *prescribed*
-and time-dependent: the internal force of the elements next to the ends depends on t,
-which the generic protocol's
-``internal_force(u)`` cannot express without losing the consistent tangent, and the
-banded Jacobian assembly is specific to the line topology.
+The integrator (:mod:`stochcable.reference.cable_newmark`) is written here rather than
+taken from :mod:`stochcable.sea.timeseries` because the ends are *prescribed* and
+time-dependent: the internal force of the elements next to the ends depends on t, which
+the generic protocol's ``internal_force(u)`` cannot express without losing the
+consistent tangent, and the banded Jacobian assembly is specific to the line topology.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -248,7 +252,7 @@ class CableTimeHistory:
 
 
 def simulate_line_timedomain(
-    scene: Scene | dict | str,
+    scene: Scene | dict[str, Any] | str | Path,
     line_name: str | None = None,
     *,
     realization: Any = None,
@@ -274,8 +278,8 @@ def simulate_line_timedomain(
 
     Parameters
     ----------
-    scene : Scene, mapping or JSON
-        The scene document.
+    scene : Scene, mapping, JSON string or path
+        The scene document (validated by :func:`stochcable.scene.model.load_scene`).
     line_name : str, optional
         Which line (default: the first). [-]
     realization : SeaRealization, optional
@@ -359,7 +363,7 @@ def simulate_line_timedomain(
 
     Notes
     -----
-    Newmark average acceleration (seed 001 eqs. 4.2.7a,b) with Newton iterations
+    Newmark average acceleration (Tuah (1982), eqs. 4.2.7a,b) with Newton iterations
     (eqs. 4.2.8–4.2.11, but with the full tangent re-formed at every iteration) on the
     element equations of seed §3.1 and the Morison loads of eqs. 3.2.a.2–3.2.a.5.  See
     the module docstring for the modelling choices.

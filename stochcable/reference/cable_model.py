@@ -9,8 +9,8 @@ Model (the same finite-element discretization as the frequency-domain model):
   tension is T = EA (l/l0 − 1); a slack element (l < l0) keeps the small stiffness
   ε·EA (ε = :data:`SLACK_STIFFNESS_RATIO`), so T → 0⁻ instead of a compression strut.
   Tangent stiffness K_e = [(EA/l0) e eᵀ + (T/l)(I − e eᵀ)] ⊗ [[1, −1], [−1, 1]]
-  (DESIGN.md; seed 001 eqs. 3.1.8–3.1.11).
-- Consistent mass m l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ I (seed eq. 3.1.12) plus the normal
+  (DESIGN.md; Tuah (1982), eqs. 3.1.8–3.1.11).
+- Consistent mass m l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ I (Tuah (1982), eq. 3.1.12) plus the normal
   added mass Can ρ (πD²/4) l0 [[1/3, 1/6], [1/6, 1/3]] ⊗ (I − e₀e₀ᵀ) and attachment
   masses.  The added mass is evaluated about the *static* tangents e₀ so the mass
   matrix is constant (as in the frequency-domain model).
@@ -33,8 +33,9 @@ Model (the same finite-element discretization as the frequency-domain model):
     waterline), synthesized in time with the realization's coefficients like any transfer
     function; attachments get (buoyancy/g + added mass)·a at their node.
   * Morison drag with the relative velocity v_r = U_current + v_wave − u̇ − c e (c e:
-    the transport of a travelling line, :mod:`~stochcable.reference.cable_transport`; seed eqs.
-    3.2.a.2–3.2.a.5), normal ½ρ Cdn D |v_rn| v_rn and axial ½ρ Cdt πD |v_rt| v_rt with
+    the transport of a travelling line, :mod:`~stochcable.reference.cable_transport`;
+    Tuah (1982), eqs. 3.2.a.2–3.2.a.5), normal ½ρ Cdn D |v_rn| v_rn and axial
+    ½ρ Cdt πD |v_rt| v_rt with
     the *instantaneous* element tangent e — **quadrature**: v_r is formed at
     :data:`GAUSS_POINTS` Gauss–Legendre points ξ_g per element (fluid velocity of
     :func:`stochcable.sea.kinematics.wave_kinematics` and the current profile at the
@@ -53,6 +54,10 @@ Model (the same finite-element discretization as the frequency-domain model):
 - Ends are prescribed: end-motion spectra are realized per channel with independent
   seeds (``SeedSequence(seed).spawn``) or RAO × sea coefficients, synthesized by FFT to
   displacement, velocity (iω) and acceleration (−ω²) on the simulation grid.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations

@@ -1,7 +1,12 @@
 """Time integration of the time-domain reference (:mod:`stochcable.reference.cable`):
-Newmark average acceleration (β = 1/4, γ = 1/2; seed 001 eqs. 4.2.7–4.2.11) with full
+Newmark average acceleration (β = 1/4, γ = 1/2; Tuah (1982), eqs. 4.2.7–4.2.11) with full
 Newton iterations per step, a backtracking line search on the residual and banded
-LAPACK solves; the end tensions are the support reactions."""
+LAPACK solves; the end tensions are the support reactions.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
@@ -66,7 +71,7 @@ def integrate(
     max_it: int,
     every: int,
 ):
-    """Newmark average acceleration with Newton iterations (seed 001 eqs. 4.2.7–4.2.11).
+    """Newmark average acceleration with Newton iterations (Tuah (1982), eqs. 4.2.7–4.2.11).
 
     Parameters
     ----------

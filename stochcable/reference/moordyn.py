@@ -83,6 +83,7 @@ import numpy as np
 
 from stochcable import validation as _v
 from stochcable.errors import InputError, SolverError
+from stochcable.io import write_moordyn
 from stochcable.reference.cable import _select_line
 from stochcable.reference.cable_excitation import half_cosine
 from stochcable.reference.periodic_motion import SurgeMotion, periodic_dsa_surge
@@ -205,50 +206,17 @@ def moordyn_input_file(
         The file's text (point 1 = end_a, fixed; point 2 = end_b, coupled).
     """
     sc = load_scene(scene)
-    line = sc.lines[0]
-    sg = line.segments[0]
-    env = sc.environment
-    dt = _v.positive("dt", dt, "s")
-    ic_threshold = _v.positive("ic_threshold", ic_threshold, "-")
-    ic_tmax = _v.positive("ic_tmax", ic_tmax, "s")
     ba = _v.finite_scalar("internal_damping", internal_damping, "N·s")
-    pa, pb = line.end_a.position, line.end_b.position
-    f = "{:.10g}".format
-    rows = [
-        "--------------------- MoorDyn Input File ------------------------------------",
-        f"stochcable comparison: line {line.name}",
-        "---------------------- LINE TYPES -----------------------------------------",
-        "TypeName Diam Mass/m EA BA/-zeta EI Cd Ca CdAx CaAx",
-        "(name) (m) (kg/m) (N) (N-s/-) (N-m^2) (-) (-) (-) (-)",
-        f"lt {f(sg.diameter)} {f(sg.mass)} {f(sg.ea)} {f(ba)} 0 {f(sg.cd_normal)} "
-        f"{f(sg.ca_normal)} {f(sg.cd_axial)} 0",
-        "---------------------- POINTS ---------------------------------------------",
-        "ID Attachment X Y Z Mass Volume CdA Ca",
-        "(#) (-) (m) (m) (m) (kg) (m^3) (m^2) (-)",
-        f"1 Fixed {f(pa[0])} {f(pa[1])} {f(pa[2])} 0 0 0 0",
-        f"2 Coupled {f(pb[0])} {f(pb[1])} {f(pb[2])} 0 0 0 0",
-        "---------------------- LINES ----------------------------------------------",
-        "ID LineType AttachA AttachB UnstrLen NumSegs Outputs",
-        "(#) (name) (#) (#) (m) (-) (-)",
-        f"1 lt 1 2 {f(sg.length)} {sg.elements} -",
-        "---------------------- OPTIONS --------------------------------------------",
-        f"{f(dt)} dtM",
-        f"{f(env.seabed.stiffness)} kBot",
-        f"{f(env.seabed.damping)} cBot",
-        f"{f(env.depth)} WtrDpth",
-        f"{f(env.rho)} rho",
-        f"{f(env.g)} g",
-        "0 WaveKin",
-        "0 Currents",
-        f"{scheme} tScheme",
-        f"{f(ic_threshold)} threshIC",
-        f"{f(ic_tmax)} TmaxIC",
-        "0 writeLog",
-        "1 disableOutput",
-        "------------------------- need this line ---------------------------------",
-        "",
-    ]
-    return "\n".join(rows)
+    return write_moordyn(
+        sc,
+        dt=dt,
+        internal_damping=ba,
+        coupled_ends=[(sc.lines[0].name, "end_b")],
+        ic_threshold=ic_threshold,
+        ic_tmax=ic_tmax,
+        scheme=scheme,
+        static_positions=False,
+    )
 
 
 def internal_damping_coefficient(scene: Scene | dict | str, ba: float) -> float:

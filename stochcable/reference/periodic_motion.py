@@ -1,7 +1,12 @@
 """A periodic fairlead motion for checks of the time-domain reference: a deterministic
 spectral amplitude (DSA) realization whose variance over one whole period is the
 spectrum's Riemann sum exactly, with its closed-form derivatives and its FFT
-coefficients on any record of whole periods (:mod:`stochcable.reference.moordyn`)."""
+coefficients on any record of whole periods (:mod:`stochcable.reference.moordyn`).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
@@ -100,7 +105,7 @@ def periodic_dsa_surge(
 
     Notes
     -----
-    DSA (seed 001 eq. 5.1.1 with DESIGN.md's correction): a_j = √(2 S(ω_j) Δω), so the
+    DSA (Tuah (1982), eq. 5.1.1 with DESIGN.md's correction): a_j = √(2 S(ω_j) Δω), so the
     variance over a whole period is Σ S(ω_j)Δω exactly, for every seed.
     """
     period = _v.positive("period", period, "s")

@@ -1,14 +1,18 @@
 """Time-domain wake oscillator coupled to one natural mode: the independent check of
 the frequency-domain strumming balance (a validation tool, not a pipeline stage).
 
-The same equations as :mod:`stochcable.line.strumming_balance` (seed 001 eqs.
+The same equations as :mod:`stochcable.line.strumming_balance` (Tuah (1982), eqs.
 3.2.b.3 and 3.2.b.7–9, C_L0² in the bracket), integrated in time by
-:func:`scipy.integrate.solve_ivp` (DOP853) as the seed integrates them (by mode
+:func:`scipy.integrate.solve_ivp` (DOP853) as Tuah (1982) integrates them (by mode
 superposition, its §3.2.b steps (5)–(10)) instead of balanced by harmonics::
 
     z̈ + 2ξω_n ż + ω_n² z = Σ_e q_e ψ_e C_e
     C̈_e + ω_s,e² C_e − [C_L0,e² − C_e² − (Ċ_e/ω_s,e)²]·(ω_s,e Ḡ Ċ_e − ω_s,e² H̄ C_e)
         = ω_s,e F̄ ψ_e ż / D_e
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -78,7 +82,7 @@ def simulate_wake_oscillator(
     z0 : float, optional
         Initial modal displacement (velocity zero). [kg^1/2·m]
     lift_start : ndarray, optional
-        Initial lift coefficients (default C_L0, rates zero: the seed's start). [-]
+        Initial lift coefficients (default C_L0, rates zero: Tuah's (1982) start). [-]
 
     Returns
     -------

@@ -32,7 +32,8 @@ from stochcable.results.records import (
     ResidualRecord,
     ResponseStats,
     stats_from_spectrum,
-    stats_from_validated,
+    stats_from_spectrum_unchecked,
+    stats_from_validated,  # noqa: F401  (former name, kept importable)
 )
 from stochcable.scene.units import unit_labels
 
@@ -47,7 +48,7 @@ __all__ = [
     "TimeSeries",
     "Result",
     "stats_from_spectrum",
-    "stats_from_validated",
+    "stats_from_spectrum_unchecked",
 ]
 
 # Number of time samples of the time-series window put in the result document.
@@ -138,6 +139,11 @@ class LineResult:
         The end-tension variance of the second-order geometric forces
         (``analysis.linearization.geometric_residual``; None when not asked for).  With
         a zero-mean flow the residuals are uncorrelated: their variances add.
+    linear : dict {"end_a", "end_b"} of ResponseStats or None
+        Where a residual was computed, ``end_a`` and ``end_b`` are the statistics with
+        the residuals (their spectra's moments added:
+        :mod:`stochcable.dynamics.residuals.corrected`) and these the linear model's
+        alone; None otherwise (``end_a`` and ``end_b`` are the linear model's).
     """
 
     name: str
@@ -167,6 +173,12 @@ class LineResult:
     strumming: StrummingTable | None = None
     drag_residual: ResidualRecord | None = None
     geometric_residual: ResidualRecord | None = None
+    linear: dict[str, ResponseStats] | None = None
+
+    def linear_end(self, end: str) -> ResponseStats:
+        """The linear model's statistics of the tension at ``end`` ("end_a" or
+        "end_b"): the end's own without residuals, ``linear[end]`` with them."""
+        return getattr(self, end) if self.linear is None else self.linear[end]
 
     def with_strumming(self, strumming: StrummingTable | None) -> LineResult:
         """This result with ``strumming`` (a shallow copy: the transfer functions stay
@@ -248,6 +260,11 @@ class LineResult:
                 )
                 if r is not None
             },
+            **(
+                {}
+                if self.linear is None
+                else {"linear": {e: {"tension": s.as_dict()} for e, s in self.linear.items()}}
+            ),
         }
 
 

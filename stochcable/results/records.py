@@ -6,6 +6,10 @@ into the result document by their ``as_dict`` (:mod:`stochcable.results.document
 holds the result objects that carry them).  :func:`stats_from_spectrum` turns a
 one-sided response spectrum on the analysis grid into :class:`ResponseStats`
 (DESIGN.md "Outputs").
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -16,14 +20,17 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.errors import InputError
+
 __all__ = [
     "THREE_HOURS",
+    "stats_from_moments",
     "ResponseStats",
     "LinearizationRecord",
     "LineIndicators",
     "ResidualRecord",
     "stats_from_spectrum",
-    "stats_from_validated",
+    "stats_from_spectrum_unchecked",
 ]
 
 THREE_HOURS = 10800.0
@@ -116,23 +123,35 @@ def stats_from_spectrum(
     :func:`stochcable.results.statistics.response_statistics` (trapezoid moments, Rayleigh
     maxima); mpm_3h = mean + σ√(2 ln(10800/Tz)) (DESIGN.md "Outputs").
     """
-    from stochcable.results.statistics import response_statistics
+    from stochcable.results.statistics import check_response_spectrum
 
-    st = response_statistics(omega, density, THREE_HOURS)
-    sd = st if duration == THREE_HOURS else response_statistics(omega, density, duration)
-    return _response_stats(st, sd, mean)
+    w, s, dur = check_response_spectrum(omega, density, duration)
+    if s.ndim != 1:
+        raise InputError("density", density, "unit^2*s/rad", f"must be 1-D of {w.size} entries")
+    return stats_from_spectrum_unchecked(w, s, mean, dur)
 
 
-def stats_from_validated(
+def stats_from_spectrum_unchecked(
     omega: np.ndarray, density: np.ndarray, mean: float, duration: float
 ) -> ResponseStats:
     """:func:`stats_from_spectrum` of a validated grid and spectrum (the analysis grid,
     validated once at the boundary; a 1-D float density >= 0 of its size, duration
     > 0): no second validation per call."""
-    from stochcable.results.statistics import _statistics
+    from stochcable.results.statistics import response_statistics_unchecked as stats
 
-    st = _statistics(omega, density, THREE_HOURS)
-    sd = st if duration == THREE_HOURS else _statistics(omega, density, float(duration))
+    st = stats(omega, density, THREE_HOURS)
+    sd = st if duration == THREE_HOURS else stats(omega, density, float(duration))
+    return _response_stats(st, sd, mean)
+
+
+def stats_from_moments(moments: Any, mean: float, duration: float) -> ResponseStats:
+    """Statistics of a Gaussian response from its spectral moments (m0, m1, m2, m4)
+    [unit²·(rad/s)ⁿ], e.g. of a spectrum in parts on different grids whose moments
+    add; ``mean`` and ``duration`` as in :func:`stats_from_spectrum`."""
+    from stochcable.results.statistics import statistics_from_moments
+
+    st = statistics_from_moments(*moments, THREE_HOURS)
+    sd = st if duration == THREE_HOURS else statistics_from_moments(*moments, float(duration))
     return _response_stats(st, sd, mean)
 
 
@@ -157,7 +176,7 @@ def _response_stats(st: Any, sd: Any, mean: float) -> ResponseStats:
 
 @dataclass(frozen=True, eq=False)
 class LinearizationRecord:
-    """The drag-linearization fixed point of one line (seed 001 §5.3 steps 5–13).
+    """The drag-linearization fixed point of one line (Tuah (1982), §5.3 steps 5–13).
 
     Attributes
     ----------
@@ -245,7 +264,7 @@ class LineIndicators:
         ``"second_order"``.
     second_order : object or None
         Moments of the second-order stretching tension
-        (:class:`stochcable.dynamics.second_order.SecondOrderTension`; its ``as_dict``).
+        (:class:`stochcable.dynamics.residuals.second_order.SecondOrderTension`; its ``as_dict``).
     """
 
     borgman_ratio: np.ndarray
@@ -291,8 +310,8 @@ class LineIndicators:
 class ResidualRecord:
     """The end-tension variance a closed-form residual of the linear model adds, and σ
     with it: the drag the linearization drops
-    (:func:`stochcable.dynamics.drag_residual.drag_residual`) or the second-order
-    geometric forces (:func:`stochcable.dynamics.geometric_residual.geometric_residual`).
+    (:func:`stochcable.dynamics.residuals.drag_residual.drag_residual`) or the second-order
+    geometric forces (:func:`stochcable.dynamics.residuals.geometric_residual.geometric_residual`).
 
     Attributes
     ----------
@@ -302,7 +321,7 @@ class ResidualRecord:
         Why not computed ("" when computed).
     variance : dict {"end_a", "end_b"} of float
         Variance the residual adds to the end tension (negative where it lowers it:
-        the drag residual's linear part, :mod:`stochcable.dynamics.drag_segments`). [N²]
+        the drag residual's linear part, :mod:`stochcable.dynamics.residuals.drag_segments`). [N²]
     in_band : dict {"end_a", "end_b"} of float
         Its part on the analysis band (the rest: superharmonics above ω_max, and
         difference frequencies below ω_min). [N²]
@@ -316,6 +335,11 @@ class ResidualRecord:
     panels : int
         Element groups the residual was evaluated on (the elements for the geometric
         forces). [-]
+    lines : tuple of (ndarray, dict {"end_a", "end_b"} of ndarray)
+        The variance as spectral lines: parts (ω [rad/s], the end tensions' variance at
+        each ω [N²]) whose sums are ``variance`` (the residual's uniform lines up to
+        its highest order times ω_max; the drag's linear misfit on the analysis grid).
+        Empty when not computed.
     """
 
     computed: bool
@@ -326,6 +350,7 @@ class ResidualRecord:
     std: dict[str, float]
     order: int = 0
     panels: int = 0
+    lines: tuple = ()
 
     @classmethod
     def not_computed(cls, reason: str, std: dict[str, float]) -> ResidualRecord:
@@ -341,13 +366,14 @@ class ResidualRecord:
         std: dict[str, float],
         order: int,
         panels: int,
+        lines: tuple = (),
     ) -> ResidualRecord:
         """The record of computed residual variances (a variance change may be
-        negative: it is clipped at −σ_linear², σ with it at 0)."""
+        negative: it is clipped at −σ_linear², σ with it at 0) and their ``lines``."""
         var = {e: max(-(float(std[e]) ** 2), float(v)) for e, v in variance.items()}
         band = {e: max(-(float(std[e]) ** 2), float(v)) for e, v in in_band.items()}
         total = {e: math.sqrt(max(0.0, float(std[e]) ** 2 + var[e])) for e in var}
-        return cls(True, "", var, band, dict(std), total, order, panels)
+        return cls(True, "", var, band, dict(std), total, order, panels, tuple(lines))
 
     def ratio(self, end: str) -> float:
         """σ with the residual over the linear σ at ``end`` (1 when not computed). [-]"""
@@ -373,3 +399,7 @@ class ResidualRecord:
             "panels": self.panels,
             **ends,
         }
+
+
+# Former name of stats_from_spectrum_unchecked (ARCHITECTURE.md "Conventions"), kept importable.
+stats_from_validated = stats_from_spectrum_unchecked

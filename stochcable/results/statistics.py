@@ -25,7 +25,9 @@ __all__ = [
     "response_spectrum",
     "cross_spectrum",
     "ResponseStatistics",
+    "response_statistics_unchecked",
     "response_statistics",
+    "statistics_from_moments",
 ]
 
 _EULER_GAMMA = 0.5772156649015329
@@ -171,6 +173,14 @@ def response_statistics(
     ``N < 1`` the most probable maximum is 0; the asymptotic expected maximum is
     held at its value at ``2 ln N = 1`` (``1.577 std``) for ``N < e^{1/2}``.
     """
+    return response_statistics_unchecked(*check_response_spectrum(omega, density, duration))
+
+
+def check_response_spectrum(
+    omega: np.ndarray, density: np.ndarray, duration: float
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """The checks of :func:`response_statistics` (its parameters, same units): float
+    arrays and the duration, or an InputError naming the parameter."""
     w = _v.float_array("omega", omega, "rad/s", nonnegative=True, increasing=True, min_size=2)
     s = _v.float_array("density", density, "unit^2*s/rad", ndim=None, nonnegative=True)
     dur = _v.positive("duration", duration, "s")
@@ -178,10 +188,10 @@ def response_statistics(
         raise InputError(
             "density", s, "unit^2*s/rad", f"must have the frequency axis last with {w.size} entries"
         )
-    return _statistics(w, s, dur)
+    return w, s, dur
 
 
-def _statistics(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
+def response_statistics_unchecked(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
     """:func:`response_statistics` of validated float arrays (w increasing, s >= 0 with
     the frequency axis last of w's size, dur > 0): the pipeline's grids are validated
     once at the boundary."""
@@ -227,7 +237,7 @@ def _statistics(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
 
 
 def _statistics_1d(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatistics:
-    """:func:`_statistics` of one spectrum (s of shape (n,)): the four trapezoid
+    """:func:`response_statistics_unchecked` of one spectrum (s of shape (n,)): the four trapezoid
     moments as ONE row-wise reduction of the same products and sums as
     ``np.trapezoid`` (the same bits), and the scalar formulas on floats (numpy's
     0-d array operations were most of the time of a call)."""
@@ -238,7 +248,18 @@ def _statistics_1d(w: np.ndarray, s: np.ndarray, dur: float) -> ResponseStatisti
     np.multiply(s, w**2, out=y[2])
     np.multiply(s, w**4, out=y[3])
     m0, m1, m2, m4 = (float(m) for m in (d * (y[:, 1:] + y[:, :-1]) / 2.0).sum(axis=-1))
-    std = math.sqrt(m0)
+    return statistics_from_moments(m0, m1, m2, m4, dur)
+
+
+def statistics_from_moments(
+    m0: float, m1: float, m2: float, m4: float, dur: float
+) -> ResponseStatistics:
+    """The statistics of a Gaussian response with spectral moments ``m0`` … ``m4``
+    [unit²·(rad/s)ⁿ] over a storm of ``dur`` [s] (the formulas of
+    :func:`response_statistics`), e.g. of a spectrum in parts on different grids whose
+    moments add."""
+    m0, m1, m2, m4 = (float(m) for m in (m0, m1, m2, m4))
+    std = math.sqrt(max(m0, 0.0))
     ok = m0 > 0 and m2 > 0
     tz = 2.0 * math.pi * math.sqrt(m0 / m2) if ok else 0.0
     n_cyc = dur / tz if ok else 0.0

@@ -1,5 +1,10 @@
 """Analysis settings of the scene: frequency grid, solver, modes, drag linearization,
-structural damping, adaptive fidelity and time series."""
+structural damping, adaptive fidelity and time series.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
@@ -42,7 +47,7 @@ class OmegaGrid(_Doc):
 
 
 class LinearizationSettings(_Doc):
-    """Statistical drag linearization and its fixed-point iteration (seed 001 §5.2)."""
+    """Statistical drag linearization and its fixed-point iteration (Tuah (1982), §5.2)."""
 
     method: Literal["seed", "vector", "harmonic"] = Field(
         default="seed",
@@ -79,7 +84,7 @@ class LinearizationSettings(_Doc):
 
 
 class TimeSeriesSettings(_Doc):
-    """Time series synthesized from the response spectra (seed 001 §5.1)."""
+    """Time series synthesized from the response spectra (Tuah (1982), §5.1)."""
 
     method: Literal["dsa", "nsa"] = Field(default="dsa", description="Spectral amplitude model")
     duration: float = _f("Record length", "s", gt=0, le=1.0e7, default=600.0)

@@ -1,5 +1,10 @@
 """Bodies of the scene: large rigid bodies (buoys, discs, vessels), their mass,
-hydrodynamic coefficients (inline table or file) and prescribed motions."""
+hydrodynamic coefficients (inline table or file) and prescribed motions.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
@@ -102,7 +107,7 @@ def _hydro_kind(v: Any) -> str:
 
 
 class Body(_Doc):
-    """A large rigid body (buoy, disc, vessel; seed 001 §3.2.c, eq. 3.2.c.20).
+    """A large rigid body (buoy, disc, vessel; Tuah (1982), §3.2.c, eq. 3.2.c.20).
 
     DOFs and signs as :mod:`stochcable.bodies.rigid`: (surge, sway, heave, roll, pitch, yaw)
     about the reference point ``position``, global axes; in a planar scene (surge,
@@ -171,7 +176,7 @@ class Body(_Doc):
         default=(0.0, 0.0, 0.0),
     )
     wind_force: Vec3 = _f(
-        "Static wind force at the reference point (seed 001 §6.5)", "N", default=(0.0, 0.0, 0.0)
+        "Static wind force at the reference point (Tuah (1982), §6.5)", "N", default=(0.0, 0.0, 0.0)
     )
     wind_moment: Vec3 = _f(
         "Static wind moment about the reference point", "N·m", default=(0.0, 0.0, 0.0)

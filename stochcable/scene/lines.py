@@ -1,5 +1,10 @@
 """Lines of the scene: ends (fixed, moving or attached to a body), segments and
-attachments (clump weights, buoys)."""
+attachments (clump weights, buoys).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
@@ -61,7 +66,7 @@ class BodyAttachment(_Doc):
 
 class End(_Doc):
     """A line end: fixed at ``position`` unless a ``motion`` is prescribed about it, or
-    attached to a body (``attach``), which then carries it (seed 001 eqs. 3.3.6–3.3.7)."""
+    attached to a body (``attach``), which then carries it (Tuah (1982), eqs. 3.3.6–3.3.7)."""
 
     position: tuple[float, float, float] | None = _f(
         "Position (x, y, z), z up from the still-water level; end_a: z <= 0 (the part of "

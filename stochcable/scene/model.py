@@ -19,6 +19,10 @@ hydrodynamic tables) and :mod:`~stochcable.scene.analysis_settings`; this module
 the :class:`Scene`, :func:`load_scene` and the conversion of validation errors, and
 re-exports every model (``from stochcable.scene.model import Line`` and
 ``from stochcable.scene import Line`` both work).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -230,7 +234,7 @@ class Scene(_Doc):
         Returns
         -------
         ndarray, shape (3,)
-            ``end.position``, or for an attached end X + R(θ)·r (seed 001 eq. 3.3.6
+            ``end.position``, or for an attached end X + R(θ)·r (Tuah (1982), eq. 3.3.6
             to first order), X, θ the body pose and r ``attach.point``. [m]
         """
         if isinstance(line, str):
@@ -436,9 +440,17 @@ def rotate(rotation: np.ndarray, r: np.ndarray) -> np.ndarray:
 
 
 def load_scene(
-    source: Scene | Mapping[str, Any] | str | Path, *, allow_files: bool = True
+    source: Scene | Mapping[str, Any] | str | Path,
+    *,
+    allow_files: bool = True,
+    parameter: str = "scene",
 ) -> Scene:
     """Validate a scene given as a model, a mapping, a JSON string or a path to a file.
+
+    The one coercion of every public entry point that takes a scene (``analyze``,
+    ``build_engine``, ``solve_statics``, ``natural_modes``,
+    ``simulate_line_timedomain``, ``run_cases``, the client): a :class:`Scene` is
+    returned as it is (validated once, when it was made).
 
     Parameters
     ----------
@@ -448,6 +460,9 @@ def load_scene(
         Accept bodies whose ``hydrodynamics`` is a ``{"file": ...}`` (the HTTP
         service passes False).  Relative paths are made absolute against the scene
         file's folder (a path source) or the working folder; the file must exist.
+    parameter : str, optional
+        The caller's name of the argument, named by the errors about the source itself
+        (its type, an unreadable file, text that is not JSON).
 
     Returns
     -------
@@ -461,6 +476,13 @@ def load_scene(
     """
     if isinstance(source, Scene):
         return _check_files(source, allow_files)
+    if not isinstance(source, (Mapping, str, Path)):
+        raise InputError(
+            parameter,
+            type(source).__name__,
+            "-",
+            "must be a Scene, a mapping (the scene document), a path or JSON text",
+        )
     base = Path.cwd()
     if isinstance(source, (str, Path)):
         text = str(source)
@@ -470,13 +492,13 @@ def load_scene(
                 base = Path(source).resolve().parent
             except OSError as exc:
                 raise InputError(
-                    "scene", str(source), "-", f"cannot be read ({exc.strerror})"
+                    parameter, str(source), "-", f"cannot be read ({exc.strerror})"
                 ) from None
         try:
             data = json.loads(text)
         except json.JSONDecodeError as exc:
             raise InputError(
-                "scene",
+                parameter,
                 str(source)[:80],
                 "-",
                 f"is not valid JSON ({exc.msg} at line {exc.lineno})",

@@ -9,6 +9,10 @@ in its real and imaginary parts between the two neighbouring headings (as the bo
 excitation tables, :func:`stochcable.scene.tables.heading_weights`; a table covering
 the full circle wraps around).  So a scatter diagram over headings, or a short-crested
 sea, moves the vessel as its RAOs say for each direction.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -169,7 +173,7 @@ class VesselMotion(_RaoTable):
     ``heading`` the table is for the sea's heading and applies to every direction; with
     it, interpolated per direction of the sea.
     The body is not solved for: lines attached to it see the end motion T(r)·ξ
-    (seed 001 eqs. 3.3.6–3.3.7), nothing couples back.
+    (Tuah (1982), eqs. 3.3.6–3.3.7), nothing couples back.
     """
 
     DOFS: ClassVar[tuple[str, ...]] = BODY_DOFS

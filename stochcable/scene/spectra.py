@@ -1,15 +1,29 @@
 """Spectrum documents of the scene: a sea state or an end motion as a spectrum
-(the formulas are :mod:`stochcable.sea.spectra`'s; ``type`` is the discriminator)."""
+(the formulas are :mod:`stochcable.sea.spectra`'s; ``type`` is the discriminator).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
+"""
 
 from __future__ import annotations
 
-import math
 from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import ConfigDict, Field, model_validator
 
-from stochcable.scene.base import G_STANDARD, _Doc, _f
+from stochcable.scene.base import G_STANDARD, LocatedValueError, _Doc, _f
+from stochcable.sea.limits import (
+    GAMMA_RANGE,
+    HEIGHT_RANGE,
+    M0_RANGE,
+    OMEGA_P_RANGE,
+    PERIOD_RANGE,
+    SHAPE_RANGE,
+    SIGMA_RANGE,
+    WIND_SPEED_RANGE,
+)
 
 __all__ = [
     "PiersonMoskowitz",
@@ -20,6 +34,12 @@ __all__ = [
     "TableSpectrum",
     "Spectrum",
 ]
+
+
+def _in(description: str, unit: str, limits: tuple[float, float], **kw: Any) -> Any:
+    """A field of :func:`stochcable.scene.base._f` in ``limits`` (both ends accepted):
+    one of the ranges of :mod:`stochcable.sea.limits`, which the sea's functions check."""
+    return _f(description, unit, ge=limits[0], le=limits[1], **kw)
 
 
 def _type_required(schema: dict[str, Any]) -> None:
@@ -48,19 +68,15 @@ class _SpectrumBase(_Doc):
 class PiersonMoskowitz(_SpectrumBase):
     """Pierson–Moskowitz spectrum, given by (hs, tp), (m0, omega_p) or wind_speed.
 
-    The (m0, omega_p) form is seed 001's example (m0 = 28 ft², omega_p = 0.5 rad/s).
+    The (m0, omega_p) form is Tuah's (1982) example (m0 = 28 ft², omega_p = 0.5 rad/s).
     """
 
     type: Literal["pierson_moskowitz"] = "pierson_moskowitz"
-    hs: float | None = _f("Significant wave height", "m", ge=1e-6, le=1e4, default=None)
-    tp: float | None = _f("Peak period", "s", ge=1e-3, le=1e5, default=None)
-    m0: float | None = _f(
-        "Zeroth spectral moment (variance)", "m²", ge=6.25e-14, le=6.25e6, default=None
-    )
-    omega_p: float | None = _f(
-        "Peak angular frequency", "rad/s", ge=2 * math.pi * 1e-5, le=2 * math.pi * 1e3, default=None
-    )
-    wind_speed: float | None = _f("Wind speed at 19.5 m", "m/s", ge=1e-3, le=1e3, default=None)
+    hs: float | None = _in("Significant wave height", "m", HEIGHT_RANGE, default=None)
+    tp: float | None = _in("Peak period", "s", PERIOD_RANGE, default=None)
+    m0: float | None = _in("Zeroth spectral moment (variance)", "m²", M0_RANGE, default=None)
+    omega_p: float | None = _in("Peak angular frequency", "rad/s", OMEGA_P_RANGE, default=None)
+    wind_speed: float | None = _in("Wind speed at 19.5 m", "m/s", WIND_SPEED_RANGE, default=None)
 
     @model_validator(mode="after")
     def _one_form(self) -> PiersonMoskowitz:
@@ -91,23 +107,19 @@ class Jonswap(_SpectrumBase):
     """JONSWAP spectrum normalized so that Hs is exact for any gamma."""
 
     type: Literal["jonswap"] = "jonswap"
-    hs: float = _f("Significant wave height", "m", ge=1e-6, le=1e4)
-    tp: float = _f("Peak period", "s", ge=1e-3, le=1e5)
-    gamma: float = _f("Peak enhancement factor", "-", ge=1, le=20, default=3.3)
-    # σ >= 1e-3: a narrower peak is resolved by no frequency grid of the service's size,
-    # and σ below ~1e-150 overflows ((ω/ωp − 1)/σ)² in the peak shape
-    sigma_a: float = _f(
+    hs: float = _in("Significant wave height", "m", HEIGHT_RANGE)
+    tp: float = _in("Peak period", "s", PERIOD_RANGE)
+    gamma: float = _in("Peak enhancement factor", "-", GAMMA_RANGE, default=3.3)
+    sigma_a: float = _in(
         "Peak width below the peak (>= 0.001: a narrower peak is resolved by no grid)",
         "-",
-        ge=1e-3,
-        le=1,
+        SIGMA_RANGE,
         default=0.07,
     )
-    sigma_b: float = _f(
+    sigma_b: float = _in(
         "Peak width above the peak (>= 0.001: a narrower peak is resolved by no grid)",
         "-",
-        ge=1e-3,
-        le=1,
+        SIGMA_RANGE,
         default=0.09,
     )
 
@@ -123,8 +135,8 @@ class Bretschneider(_SpectrumBase):
     """Bretschneider (two-parameter) spectrum in (hs, tp)."""
 
     type: Literal["bretschneider"] = "bretschneider"
-    hs: float = _f("Significant wave height", "m", ge=1e-6, le=1e4)
-    tp: float = _f("Peak period", "s", ge=1e-3, le=1e5)
+    hs: float = _in("Significant wave height", "m", HEIGHT_RANGE)
+    tp: float = _in("Peak period", "s", PERIOD_RANGE)
 
     def spectral_density(self, omega: np.ndarray, g: float = G_STANDARD) -> np.ndarray:
         from stochcable.sea import spectra
@@ -136,8 +148,8 @@ class Issc(_SpectrumBase):
     """ISSC spectrum in (hs, t1), t1 the mean period Tm01."""
 
     type: Literal["issc"] = "issc"
-    hs: float = _f("Significant wave height", "m", ge=1e-6, le=1e4)
-    t1: float = _f("Mean period Tm01", "s", ge=1e-3, le=1e5)
+    hs: float = _in("Significant wave height", "m", HEIGHT_RANGE)
+    t1: float = _in("Mean period Tm01", "s", PERIOD_RANGE)
 
     def spectral_density(self, omega: np.ndarray, g: float = G_STANDARD) -> np.ndarray:
         from stochcable.sea import spectra
@@ -149,12 +161,32 @@ class OchiHubble(_SpectrumBase):
     """Ochi–Hubble two-peak spectrum (swell + wind sea)."""
 
     type: Literal["ochi_hubble"] = "ochi_hubble"
-    hs1: float = _f("Significant wave height of the low-frequency part", "m", ge=1e-6, le=1e4)
-    tp1: float = _f("Peak period of the low-frequency part", "s", ge=1e-3, le=1e5)
-    lambda1: float = _f("Shape factor of the low-frequency part", "-", ge=0.01, le=100)
-    hs2: float = _f("Significant wave height of the high-frequency part", "m", ge=1e-6, le=1e4)
-    tp2: float = _f("Peak period of the high-frequency part", "s", ge=1e-3, le=1e5)
-    lambda2: float = _f("Shape factor of the high-frequency part", "-", ge=0.01, le=100)
+    hs1: float = _f(
+        "Significant wave height of the low-frequency part (0: none)",
+        "m",
+        ge=0,
+        le=HEIGHT_RANGE[1],
+    )
+    tp1: float = _in("Peak period of the low-frequency part", "s", PERIOD_RANGE)
+    lambda1: float = _in("Shape factor of the low-frequency part", "-", SHAPE_RANGE)
+    hs2: float = _f(
+        "Significant wave height of the high-frequency part (0: none)",
+        "m",
+        ge=0,
+        le=HEIGHT_RANGE[1],
+    )
+    tp2: float = _in("Peak period of the high-frequency part", "s", PERIOD_RANGE)
+    lambda2: float = _in("Shape factor of the high-frequency part", "-", SHAPE_RANGE)
+
+    @model_validator(mode="after")
+    def _heights(self) -> OchiHubble:
+        for key in ("hs1", "hs2"):  # as spectrum_ochi_hubble: 0 (no part) or in HEIGHT_RANGE
+            hs = getattr(self, key)
+            if 0.0 < hs < HEIGHT_RANGE[0]:
+                raise LocatedValueError((key,), hs, f"{key} must be 0 or >= {HEIGHT_RANGE[0]:g}")
+        if self.hs1 == 0.0 and self.hs2 == 0.0:
+            raise LocatedValueError(("hs1",), 0.0, "hs1 and hs2 must not both be 0")
+        return self
 
     def spectral_density(self, omega: np.ndarray, g: float = G_STANDARD) -> np.ndarray:
         from stochcable.sea import spectra

@@ -11,6 +11,7 @@ from pydantic import ConfigDict, Field, model_validator
 
 from stochcable.scene.base import _Doc, _f
 from stochcable.scene.spectra import _type_required
+from stochcable.sea.limits import SPREADING_EXPONENT_MAX
 
 __all__ = ["MAX_DIRECTIONS", "Cos2sSpreading", "CosnSpreading", "TableSpreading", "Spreading"]
 
@@ -43,7 +44,7 @@ class Cos2sSpreading(_SpreadingBase):
     (Longuet-Higgins et al. 1963; DNV-RP-C205 §3.5.8)."""
 
     type: Literal["cos2s"] = "cos2s"
-    s: float = _f("Spreading exponent s (larger: narrower)", "-", gt=0, le=1e6)
+    s: float = _f("Spreading exponent s (larger: narrower)", "-", gt=0, le=SPREADING_EXPONENT_MAX)
     directions: int = _directions()
 
     def direction_set(self, mean_deg: float):
@@ -57,7 +58,7 @@ class CosnSpreading(_SpreadingBase):
     §3.5.8: n = 2–4 wind sea, n ≥ 6 swell)."""
 
     type: Literal["cosn"] = "cosn"
-    n: float = _f("Spreading exponent n (larger: narrower)", "-", gt=0, le=1e6)
+    n: float = _f("Spreading exponent n (larger: narrower)", "-", gt=0, le=SPREADING_EXPONENT_MAX)
     directions: int = _directions()
 
     def direction_set(self, mean_deg: float):

@@ -39,7 +39,7 @@ def _work_arrays(n_t: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     page-fault 16 MiB of fresh memory in, call after call.  A call owns its set until
     it gives it back; concurrent calls get different sets.
     """
-    key = (n_t, _fft.backend())  # the FFT input must suit the backend's alignment
+    key = (n_t, _fft.backend(n_t))  # the FFT input must suit the backend's alignment
     with _work_lock:
         for i in range(len(_work_pool) - 1, -1, -1):
             if _work_pool[i][0] == key:
@@ -51,7 +51,7 @@ def _work_arrays(n_t: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def _give_back(n_t: int, arrays: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
     """Keep a call's work arrays for reuse (the 8 most recent sets, ≤ 64 MiB in all)."""
     with _work_lock:
-        _work_pool.append(((n_t, _fft.backend()), arrays))
+        _work_pool.append(((n_t, _fft.backend(n_t)), arrays))
         while (
             len(_work_pool) > 8
             or sum(a.nbytes for _, arrs in _work_pool for a in arrs) > _WORK_POOL_BYTES

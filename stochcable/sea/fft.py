@@ -40,6 +40,11 @@ _UNLOADED: Any = object()
 _pyfftw: Any = _UNLOADED  # the module, None without pyfftw (tests patch None in)
 
 
+def _lib_for(n: int) -> Any:
+    """pyfftw for transforms of ``PYFFTW_MIN_SIZE`` points or more, else None (numpy)."""
+    return _lib() if n >= PYFFTW_MIN_SIZE else None
+
+
 def _lib() -> Any:
     """pyfftw, imported on the first call (None when it is not installed); dask.array,
     when nothing has imported it yet, is hidden from pyfftw's import (its
@@ -73,6 +78,11 @@ __all__ = [
 ]
 
 _MAX_PLANS = 16
+#: Transform length from which pyfftw runs the transforms; shorter ones go to numpy.fft
+#: (as fast there, and importing pyfftw costs ≈ 0.2 s of a process's first record: the
+#: 2,400 samples of the chain example's record).  The choice depends on the length only,
+#: so a given length always rounds the same way.
+PYFFTW_MIN_SIZE = 2**15
 _THREAD_MIN_SIZE = 2**15
 _EFFORT = os.environ.get("STOCHCABLE_FFTW_EFFORT", "FFTW_ESTIMATE")
 
@@ -128,9 +138,11 @@ def _save_wisdom() -> str | None:
     return path
 
 
-def backend() -> str:
-    """Name of the FFT backend in use: ``"pyfftw"`` or ``"numpy"``."""
-    return "numpy" if _lib() is None else "pyfftw"
+def backend(n: int | None = None) -> str:
+    """Name of the FFT backend in use: ``"pyfftw"`` or ``"numpy"`` (for transforms of
+    ``n`` points when given: numpy below ``PYFFTW_MIN_SIZE``)."""
+    lib = _lib() if n is None else _lib_for(n)
+    return "numpy" if lib is None else "pyfftw"
 
 
 def clear_cache() -> None:
@@ -266,7 +278,7 @@ def irfft(x: np.ndarray, n: int, axis: int = -1) -> np.ndarray:
         float64 array, ``x[k]`` → ``(1/n) Σ_k X_k e^{2πi k j/n}`` (numpy convention). [unit]
     """
     x = np.asarray(x)
-    if _lib() is None:
+    if _lib_for(n) is None:
         return np.fft.irfft(x, n, axis=axis)
     if x.shape[axis] != n // 2 + 1:
         return np.fft.irfft(x, n, axis=axis)  # padding/truncation: rare, let numpy do it
@@ -280,7 +292,7 @@ def irfft_input(n: int) -> np.ndarray:
 
     SIMD-aligned as the FFTW plans require (a plain array with the numpy backend).
     """
-    if _lib() is None:
+    if _lib_for(n) is None:
         return np.empty(n // 2 + 1, dtype=np.complex128)
     return _lib().empty_aligned(n // 2 + 1, dtype="complex128")
 
@@ -309,7 +321,7 @@ def irfft_overwrite(x: np.ndarray, n: int) -> np.ndarray:
     on the caller's array was tried: 1–3 ms slower for 2^20 points than this
     input-destroying plan plus the fused copy.
     """
-    if _lib() is None:
+    if _lib_for(n) is None:
         return np.fft.irfft(x, n, norm="forward")
     return _plan(x.shape, int(n), True).run(x)
 
@@ -330,7 +342,7 @@ def rfft(x: np.ndarray, axis: int = -1) -> np.ndarray:
         complex128 half-spectrum with ``n // 2 + 1`` entries along ``axis``. [unit]
     """
     x = np.asarray(x)
-    if _lib() is None or np.iscomplexobj(x):
+    if np.iscomplexobj(x) or _lib_for(np.shape(x)[axis]) is None:
         return np.fft.rfft(x, axis=axis)
     xm = np.moveaxis(x, axis, -1)
     out = _plan(xm.shape, xm.shape[-1], False)(xm)

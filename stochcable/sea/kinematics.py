@@ -1,8 +1,12 @@
-"""Linear (Airy) wave kinematics: dispersion and transfer functions (seed 001 §5.2).
+"""Linear (Airy) wave kinematics: dispersion and transfer functions (Tuah (1982), §5.2).
 
 Conventions (DESIGN.md "Linear wave kinematics"): z up, z = 0 still water level,
 seabed z = −h; heading β from +x toward +y; a harmonic quantity is Re{X e^{iωt}}; transfer
 functions are per unit wave amplitude, with the elevation phase P = e^{−ik(x cos β + y sin β)}.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ __all__ = [
     "wavenumber",
     "WaveKinematics",
     "wave_kinematics",
-    "nodal_kinematics",
+    "wave_kinematics_unchecked",
     "kinematics_timeseries",
 ]
 
@@ -92,7 +96,7 @@ def wavenumber(omega: ArrayLike, depth: float = np.inf, g: float = G_STANDARD) -
 
     Notes
     -----
-    Seed 001 eq. 5.2.11 ff.  Deep water k = ω²/g.  Finite depth: y = kh solves
+    Tuah (1982), eq. 5.2.11 ff.  Deep water k = ω²/g.  Finite depth: y = kh solves
     y tanh y = ω²h/g by the Fenton–McKee (1990) explicit start and Newton iterations
     to a relative correction < 1e-15; valid for kh from below 1e-6 (shallow limit
     k → ω/√(gh)) to beyond 1e6 (tanh = 1) without overflow.
@@ -185,7 +189,7 @@ def _depth_ratios(
     return ch, sh, cc
 
 
-def nodal_kinematics(
+def wave_kinematics_unchecked(
     w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float, h: float, g: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """:func:`wave_kinematics` on inputs already validated, without the pressure.
@@ -282,10 +286,10 @@ def wave_kinematics(
 
     Notes
     -----
-    Seed 001 eqs. 5.2.8–5.2.11 (Wheeler 1969) in the DESIGN.md convention:
+    Tuah (1982), eqs. 5.2.8–5.2.11 (Wheeler 1969) in the DESIGN.md convention:
     P = e^{−ik(x cos β + y sin β)}, horizontal velocity ω cosh k(z+h)/sinh kh · P along
     β, vertical velocity iω sinh k(z+h)/sinh kh · P, acceleration iω × velocity
-    (the seed's g k/ω · cosh/cosh equals ω cosh/sinh by the dispersion relation).
+    (Tuah's (1982) g k/ω · cosh/cosh equals ω cosh/sinh by the dispersion relation).
     At the surface w = iω P = ∂η/∂t.  Points above z = 0 get zero velocity,
     acceleration and pressure.  At ω = 0 the finite-depth horizontal velocity takes
     its limit √(g/h) (shallow-water long wave); everything else is 0.
@@ -308,7 +312,7 @@ def wave_kinematics(
         )
 
     k = _wavenumber(w, h, g)
-    phase, cc, dry, vel, acc = nodal_kinematics(w, k, pts, beta, h, g)
+    phase, cc, dry, vel, acc = wave_kinematics_unchecked(w, k, pts, beta, h, g)
     pressure = cc * phase
     pressure[dry] = 0.0
     for a in (w, k, pts, phase, vel, acc, pressure):
@@ -357,7 +361,11 @@ def kinematics_timeseries(
 
     Notes
     -----
-    Seed 001 eqs. 5.2.8–5.2.9: V_j(t_n) = irfft(H_Vj X), a_j(t_n) = irfft(H_aj X).
+    Tuah (1982), eqs. 5.2.8–5.2.9: V_j(t_n) = irfft(H_Vj X), a_j(t_n) = irfft(H_aj X).
     """
     kin = wave_kinematics(realization.omega, points, heading, depth, g)
     return synthesize(realization, kin.velocity), synthesize(realization, kin.acceleration)
+
+
+# Former name of wave_kinematics_unchecked (ARCHITECTURE.md "Conventions"), kept importable.
+nodal_kinematics = wave_kinematics_unchecked

@@ -1,14 +1,14 @@
-"""Random sea realizations by the DSA and NSA methods (seed 001 §5.1) and FFT synthesis.
+"""Random sea realizations by the DSA and NSA methods (Tuah (1982), §5.1) and FFT synthesis.
 
 A realization of length T_L = N_t Δt (N_t = 2N, even) lives on the grid
 ω_m = mΔω, Δω = 2π/T_L, m = 0 … N (:func:`frequency_grid`).  Its rfft-domain
 coefficients X_m = (N_t/2) a_m e^{−iθ_m} (X_0 = X_N = 0) give the elevation
-η_n = Σ_{m=1}^{N−1} a_m cos(ω_m t_n − θ_m) = irfft(X, N_t) (seed eqs. 5.1.1, 5.1.4,
+η_n = Σ_{m=1}^{N−1} a_m cos(ω_m t_n − θ_m) = irfft(X, N_t) (Tuah (1982), eqs. 5.1.1, 5.1.4,
 5.1.5), and any linear response with transfer function H (per unit amplitude,
 Re{H e^{iωt}} convention) is irfft(H X, N_t) (:func:`synthesize`), so elevation,
 kinematics, motions and tensions of one realization are mutually consistent.
 
-Amplitudes (DESIGN.md; the seed's eqs. 5.1.3a,b print the two-sided coefficient
+Amplitudes (DESIGN.md; Tuah's (1982) eqs. 5.1.3a,b print the two-sided coefficient
 magnitudes √(0.5 SΔω) and √(0.25 SΔω)(α²+β²)^½, half the cosine amplitude):
 
 - DSA: a_m = √(2 S(ω_m) Δω); the variance of every realization is Σ S(ω_m)Δω.
@@ -18,6 +18,10 @@ Random numbers (reproducible on every machine with numpy's PCG64 Generator): fir
 u_m = ``rng.random()`` for m = 1 … N−1 in increasing m, θ_m = π − 2πu_m ∈ (−π, π];
 then, for NSA only, α_1 … α_{N−1} = ``rng.standard_normal``, then β_1 … β_{N−1}.
 DSA and NSA realizations with the same seed therefore share their phases.
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -145,7 +149,7 @@ def frequency_grid(duration: float, dt: float) -> tuple[np.ndarray, float]:
     Returns
     -------
     omega : numpy.ndarray
-        ω_m = mΔω, m = 0 … N, N = N_t/2 (seed eq. 5.1.2b). [rad/s]
+        ω_m = mΔω, m = 0 … N, N = N_t/2 (Tuah (1982), eq. 5.1.2b). [rad/s]
     d_omega : float
         Δω = 2π/T_L. [rad/s]
     """
@@ -326,7 +330,7 @@ def simulate_sea(
     method: str = "dsa",
     rng: np.random.Generator | int | None = None,
 ) -> SeaRealization:
-    """Simulate a random sea realization by DSA or NSA (seed 001 §5.1).
+    """Simulate a random sea realization by DSA or NSA (Tuah (1982), §5.1).
 
     Parameters
     ----------
@@ -357,7 +361,7 @@ def simulate_sea(
 
     Notes
     -----
-    Seed eqs. 5.1.1–5.1.5 with the amplitude constants of DESIGN.md (the seed's
+    Tuah (1982), eqs. 5.1.1–5.1.5 with the amplitude constants of DESIGN.md (Tuah's eqs.
     5.1.3a,b are the two-sided magnitudes, half of a_m): DSA a_m = √(2SΔω),
     NSA a_m = √(SΔω)√(α²+β²); X_m = (N_t/2) a_m e^{−iθ_m}; η = irfft(X, N_t).
     The order of the random draws is given in the module docstring.  For 2^16 lines or
@@ -508,7 +512,7 @@ def synthesize(realization: SeaRealization, transfer: ArrayLike) -> np.ndarray:
 
     Notes
     -----
-    Seed eqs. 5.2.8–5.2.9: the response is Σ_m a_m Re{H(ω_m) e^{i(ω_m t − θ_m)}};
+    Tuah (1982), eqs. 5.2.8–5.2.9: the response is Σ_m a_m Re{H(ω_m) e^{i(ω_m t − θ_m)}};
     with DSA its variance is Σ |H|² S Δω exactly.
     """
     if not isinstance(realization, SeaRealization):

@@ -6,13 +6,16 @@ same shape as ``omega``.  Frequencies ω <= 0 give zero density (no NaN, no warn
 Conventions (DESIGN.md "Wave spectra"): m_n = ∫₀^∞ ωⁿ S(ω) dω, Hs = 4√m0,
 Tz = 2π√(m0/m2), Tm01 = 2π m0/m1.  The moments and statistics of a sampled spectrum
 (:func:`spectral_moments`, :func:`spectrum_statistics`) are in :mod:`stochcable.sea.moments`
-and re-exported here.
+and re-exported here; the accepted ranges of the parameters in :mod:`stochcable.sea.limits`.
 
 References
 ----------
-Tuah, H. (1982), seed 001, §5.1 and §6.5 (Pierson–Moskowitz, m0 = 28 ft², ωp = 0.5 rad/s).
-Pierson, W. J. and Moskowitz, L. (1964), J. Geophys. Res. 69(24).
-Hasselmann, K. et al. (1973), JONSWAP, Dtsch. Hydrogr. Z. A8(12).
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State
+University, §5.1 and §6.5 (Pierson–Moskowitz, m0 = 28 ft², ωp = 0.5 rad/s).
+Pierson, W. J. and Moskowitz, L. (1964), A proposed spectral form for fully developed
+wind seas based on the similarity theory of S. A. Kitaigorodskii, J. Geophys. Res. 69(24).
+Hasselmann, K. et al. (1973), Measurements of wind-wave growth and swell decay during
+the Joint North Sea Wave Project (JONSWAP), Dtsch. Hydrogr. Z. A8(12).
 Ochi, M. K. and Hubble, E. N. (1976), Six-parameter wave spectra, Proc. 15th ICCE.
 ITTC (1978), 15th ITTC Seakeeping Committee (ISSC / ITTC two-parameter spectrum).
 """
@@ -26,6 +29,16 @@ from numpy.typing import ArrayLike
 
 from stochcable import validation as v
 from stochcable.errors import InputError
+from stochcable.sea.limits import (
+    GAMMA_RANGE,
+    HEIGHT_RANGE,
+    M0_RANGE,
+    OMEGA_P_RANGE,
+    PERIOD_RANGE,
+    SHAPE_RANGE,
+    SIGMA_RANGE,
+    WIND_SPEED_RANGE,
+)
 from stochcable.sea.moments import SpectrumStatistics, spectral_moments, spectrum_statistics
 
 __all__ = [
@@ -49,18 +62,6 @@ __all__ = [
 
 G_STANDARD = 9.80665
 """Standard gravity. [m/s²]"""
-
-# Accepted parameter ranges.  Far wider than any sea (model basin to swell, metres or
-# feet), narrow enough that ωp⁴, Hs² and Γ(λ) stay finite in float64: a value outside
-# is a data error, reported as such instead of as an overflow.
-HEIGHT_RANGE = (1e-6, 1e4)
-"""Accepted significant wave heights. [m] (or the scene's length unit)"""
-PERIOD_RANGE = (1e-3, 1e5)
-"""Accepted periods (Tp, T1). [s]"""
-OMEGA_P_RANGE = (2 * math.pi / PERIOD_RANGE[1], 2 * math.pi / PERIOD_RANGE[0])
-"""Accepted peak frequencies. [rad/s]"""
-SHAPE_RANGE = (1e-2, 100.0)
-"""Accepted Ochi–Hubble shape factors λ. [-]"""
 
 PM_TZ_OVER_TP = (5.0 * math.pi / 4.0) ** -0.25
 """Tz/Tp of the Pierson–Moskowitz shape, (5π/4)^(-1/4) = 0.71040... [-]"""
@@ -128,7 +129,7 @@ def spectrum_pierson_moskowitz(omega: ArrayLike, hs: float, tp: float) -> np.nda
     Notes
     -----
     S(ω) = (5/16) Hs² ωp⁴ ω⁻⁵ exp[−(5/4)(ωp/ω)⁴], ωp = 2π/Tp (DESIGN.md; the
-    two-parameter form of Pierson & Moskowitz 1964 used by seed 001 §6.5).
+    two-parameter form of Pierson & Moskowitz 1964 used by Tuah (1982), §6.5).
     Closed forms: m0 = Hs²/16, m_n = (Hs²/64) ωpⁿ (5/4)^(n/4) Γ(1 − n/4) for n < 4
     (:func:`moments_pierson_moskowitz`), Tz = (5π/4)^(−1/4) Tp = 0.7104 Tp, peak at ωp.
     """
@@ -140,7 +141,7 @@ def spectrum_pierson_moskowitz(omega: ArrayLike, hs: float, tp: float) -> np.nda
 
 
 def spectrum_pierson_moskowitz_m0(omega: ArrayLike, m0: float, omega_p: float) -> np.ndarray:
-    """Pierson–Moskowitz spectrum in zeroth moment and peak frequency (seed 001 form).
+    """Pierson–Moskowitz spectrum in zeroth moment and peak frequency (Tuah's (1982) form).
 
     Parameters
     ----------
@@ -158,10 +159,10 @@ def spectrum_pierson_moskowitz_m0(omega: ArrayLike, m0: float, omega_p: float) -
 
     Notes
     -----
-    S(ω) = 5 m0 ωp⁴ ω⁻⁵ exp[−(5/4)(ωp/ω)⁴], the PM shape with Hs = 4√m0; seed 001
-    §6.5 (Fig. 6.5-6) uses m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla record).
+    S(ω) = 5 m0 ωp⁴ ω⁻⁵ exp[−(5/4)(ωp/ω)⁴], the PM shape with Hs = 4√m0; Tuah
+    (1982), §6.5 (Fig. 6.5-6) uses m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla record).
     """
-    m0 = v.in_range("m0", m0, "m²", HEIGHT_RANGE[0] ** 2 / 16, HEIGHT_RANGE[1] ** 2 / 16)
+    m0 = v.in_range("m0", m0, "m²", *M0_RANGE)
     wp = v.in_range("omega_p", omega_p, "rad/s", *OMEGA_P_RANGE)
     w = _omega_array(omega)
     return _pm_shape(w, wp, 5.0 * m0 / wp)
@@ -191,7 +192,7 @@ def spectrum_pierson_moskowitz_wind(
     S(ω) = α g² ω⁻⁵ exp[−0.74 (g/(U ω))⁴], α = 0.0081 (Pierson & Moskowitz 1964).
     This is the PM shape with ωp = (0.74·4/5)^(1/4) g/U and m0 = α g²/(4·0.74) (g/U)⁻⁴.
     """
-    u = v.in_range("wind_speed", wind_speed, "m/s", 1e-3, 1e3)
+    u = v.in_range("wind_speed", wind_speed, "m/s", *WIND_SPEED_RANGE)
     g = v.positive("g", g, "m/s²")
     w = _omega_array(omega)
     alpha = 0.0081
@@ -248,11 +249,11 @@ def spectrum_jonswap(
     tp : float
         Peak period. [s]
     gamma : float, default 3.3
-        Peak enhancement factor, >= 1 (γ = 1 is Pierson–Moskowitz). [-]
+        Peak enhancement factor, in [1, 20] (γ = 1 is Pierson–Moskowitz). [-]
     sigma_a : float, default 0.07
-        Spectral width below the peak (ω <= ωp). [-]
+        Spectral width below the peak (ω <= ωp), in [0.001, 1]. [-]
     sigma_b : float, default 0.09
-        Spectral width above the peak (ω > ωp). [-]
+        Spectral width above the peak (ω > ωp), in [0.001, 1]. [-]
 
     Returns
     -------
@@ -268,9 +269,9 @@ def spectrum_jonswap(
     """
     hs = v.in_range("hs", hs, "m", *HEIGHT_RANGE)
     tp = v.in_range("tp", tp, "s", *PERIOD_RANGE)
-    gamma = v.in_range("gamma", gamma, "-", lo=1.0)
-    sigma_a = v.positive("sigma_a", sigma_a, "-")
-    sigma_b = v.positive("sigma_b", sigma_b, "-")
+    gamma = v.in_range("gamma", gamma, "-", *GAMMA_RANGE)
+    sigma_a = v.in_range("sigma_a", sigma_a, "-", *SIGMA_RANGE)
+    sigma_b = v.in_range("sigma_b", sigma_b, "-", *SIGMA_RANGE)
     w = _omega_array(omega)
     wp = 2.0 * math.pi / tp
     c = (1.0 / 16.0) / _jonswap_integral(gamma, sigma_a, sigma_b)
@@ -331,7 +332,9 @@ def spectrum_issc(omega: ArrayLike, hs: float, t1: float) -> np.ndarray:
     """
     hs = v.in_range("hs", hs, "m", *HEIGHT_RANGE)
     t1 = v.in_range("t1", t1, "s", *PERIOD_RANGE)
-    return spectrum_pierson_moskowitz(omega, hs, t1 / PM_TM01_OVER_TP)
+    w = _omega_array(omega)
+    wp = 2.0 * math.pi / (t1 / PM_TM01_OVER_TP)  # Tp = T1/0.77154 may pass PERIOD_RANGE
+    return _pm_shape(w, wp, 5.0 / 16.0 * hs * hs / wp)
 
 
 def spectrum_ochi_hubble(

@@ -11,10 +11,14 @@ D-weighted centroid of its bin, so that direction sums of smooth functions
 err by O(Δθ²) and a spreading that narrows to zero width puts all its weight at the
 mean heading: the long-crested sea), the directional moments, and the realization of a
 short-crested sea as independent long-crested components, one per direction, each
-with the spectrum w_k S(ω) (the "double sum" of DSA/NSA, seed 001 §5.1 per direction).
+with the spectrum w_k S(ω) (the "double sum" of DSA/NSA, Tuah (1982), §5.1 per direction).
 
 Angles are in radians here; headings follow DESIGN.md (from +x toward +y, the
 direction the waves travel).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ from scipy.special import betainc, gammaln
 from stochcable import validation as v
 from stochcable.errors import InputError
 from stochcable.sea.kinematics import G_STANDARD, wave_kinematics
+from stochcable.sea.limits import SPREADING_EXPONENT_MAX
 from stochcable.sea.realization import SeaRealization, simulate_sea, synthesize
 
 __all__ = [
@@ -108,7 +113,7 @@ def spreading_cos2s(theta: ArrayLike, mean: float, s: float) -> np.ndarray:
     mean : float
         Mean heading θ̄. [rad]
     s : float
-        Spreading exponent, > 0 (larger: narrower). [-]
+        Spreading exponent, in (0, 1e6] (larger: narrower). [-]
 
     Returns
     -------
@@ -120,7 +125,7 @@ def spreading_cos2s(theta: ArrayLike, mean: float, s: float) -> np.ndarray:
     Longuet-Higgins, Cartwright & Smith (1963); DNV-RP-C205 (2021) §3.5.8.  Its
     moments are a1 = s/(s + 1), a2 = s(s − 1)/((s + 1)(s + 2)) (:func:`moments_cos2s`).
     """
-    s = v.positive("s", s, "-")
+    s = _exponent("s", s)
     mean = v.finite_scalar("mean", mean, "rad")
     th = v.float_array("theta", theta, "rad", ndim=None)
     c = np.abs(np.cos(0.5 * _wrap(th - mean)))
@@ -137,7 +142,7 @@ def spreading_cosn(theta: ArrayLike, mean: float, n: float) -> np.ndarray:
     mean : float
         Mean heading θ̄. [rad]
     n : float
-        Spreading exponent, > 0 (DNV-RP-C205: 2–4 wind sea, ≥ 6 swell). [-]
+        Spreading exponent, in (0, 1e6] (DNV-RP-C205: 2–4 wind sea, ≥ 6 swell). [-]
 
     Returns
     -------
@@ -150,7 +155,7 @@ def spreading_cosn(theta: ArrayLike, mean: float, n: float) -> np.ndarray:
     DNV-RP-C205 (2021) eq. 3.5.21.  Moments a1 = Γ(n/2 + 1)²/(Γ(n/2 + ½)Γ(n/2 + 3/2)),
     a2 = n/(n + 2) (:func:`moments_cosn`).
     """
-    n = v.positive("n", n, "-")
+    n = _exponent("n", n)
     mean = v.finite_scalar("mean", mean, "rad")
     th = v.float_array("theta", theta, "rad", ndim=None)
     d = _wrap(th - mean)
@@ -160,7 +165,7 @@ def spreading_cosn(theta: ArrayLike, mean: float, n: float) -> np.ndarray:
 
 def moments_cos2s(s: float) -> dict[str, float]:
     """Directional moments of :func:`spreading_cos2s` about its mean (closed form). [-]"""
-    s = v.positive("s", s, "-")
+    s = _exponent("s", s)
     return {
         "a1": s / (s + 1.0),
         "b1": 0.0,
@@ -171,7 +176,7 @@ def moments_cos2s(s: float) -> dict[str, float]:
 
 def moments_cosn(n: float) -> dict[str, float]:
     """Directional moments of :func:`spreading_cosn` about its mean (closed form). [-]"""
-    n = v.positive("n", n, "-")
+    n = _exponent("n", n)
     a1 = math.exp(2.0 * gammaln(0.5 * n + 1.0) - gammaln(0.5 * n + 0.5) - gammaln(0.5 * n + 1.5))
     return {"a1": a1, "b1": 0.0, "a2": n / (n + 2.0), "b2": 0.0}
 
@@ -201,6 +206,11 @@ def _binned(
     return DirectionSet(heading=centroid[keep], weight=w[keep] / w.sum())
 
 
+def _exponent(name: str, value: float) -> float:
+    """A spreading exponent (s of cos-2s, n of cosⁿ): in (0, SPREADING_EXPONENT_MAX]. [-]"""
+    return v.in_range(name, value, "-", 0.0, SPREADING_EXPONENT_MAX, lo_open=True)
+
+
 def _count(count: int) -> int:
     return v.positive_int("count", count)
 
@@ -208,7 +218,7 @@ def _count(count: int) -> int:
 def directions_cos2s(mean: float, s: float, count: int = 16) -> DirectionSet:
     """Discrete directions of :func:`spreading_cos2s`: ``count`` equal bins over the
     circle centred on the mean (an odd count puts a bin on the mean). [rad, -]"""
-    s = v.positive("s", s, "-")
+    s = _exponent("s", s)
     mean = v.finite_scalar("mean", mean, "rad")
     count = _count(count)
 
@@ -223,7 +233,7 @@ def directions_cos2s(mean: float, s: float, count: int = 16) -> DirectionSet:
 def directions_cosn(mean: float, n: float, count: int = 16) -> DirectionSet:
     """Discrete directions of :func:`spreading_cosn`: ``count`` equal bins over its
     support |θ − θ̄| ≤ π/2 (an odd count puts a bin on the mean). [rad, -]"""
-    n = v.positive("n", n, "-")
+    n = _exponent("n", n)
     mean = v.finite_scalar("mean", mean, "rad")
     count = _count(count)
 
@@ -315,7 +325,7 @@ def velocity_timeseries_directional(
     g: float = G_STANDARD,
 ) -> np.ndarray:
     """Fluid velocity at points in a short-crested sea: the sum over directions of
-    each direction's linear kinematics (seed 001 eqs. 5.2.8–5.2.9) driven by its
+    each direction's linear kinematics (Tuah (1982), eqs. 5.2.8–5.2.9) driven by its
     realization, shape (n_points, 3, N_t). [m/s]"""
     if len(realizations) != directions.count:
         raise InputError(

@@ -1,6 +1,6 @@
 """Nonlinear time-domain reference: Newmark average acceleration with Newton iterations.
 
-Seed 001 §4.2: the single-step implicit Newmark operator with beta = 1/4, gamma = 1/2
+Tuah (1982), §4.2: the single-step implicit Newmark operator with beta = 1/4, gamma = 1/2
 (constant average acceleration, unconditionally stable for linear systems, eqs.
 4.2.7.a,b), with the nonlinear stiffness and the velocity-dependent drag iterated
 to equilibrium at every step (incremental-iterative Newton, eqs. 4.2.5, 4.2.8).
@@ -12,6 +12,10 @@ The system is anything that implements :class:`NonlinearSystem`:
 with constant mass ``M`` (structural + added mass), internal (elastic) force
 ``f_int`` and its tangent ``K_t``, and an external force that may depend on the
 displacement and the velocity (drag on the relative velocity).
+
+References
+----------
+Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.
 """
 
 from __future__ import annotations
@@ -147,7 +151,7 @@ def newmark(
 
     Notes
     -----
-    Seed 001 eqs. (4.2.7.a,b): with ``du = u_{n+1} - u_n`` and step ``h``,
+    Tuah (1982), eqs. (4.2.7.a,b): with ``du = u_{n+1} - u_n`` and step ``h``,
     ``v_{n+1} = 2 du / h - v_n`` and ``a_{n+1} = 4 du / h^2 - 4 v_n / h - a_n``.
     The residual ``R = M a_{n+1} + f_int(u_{n+1}) - f_ext(t_{n+1}, u_{n+1}, v_{n+1})``
     is driven to zero with the tangent

@@ -20,6 +20,9 @@ from stochcable.client import Client, ClientError
 from stochcable.errors import PhysicsWarning
 from stochcable.examples import load_example
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_batches")
+
 CHAIN = load_example("chain_catenary").model_dump(mode="json", exclude_unset=True)
 ROWS = [
     {"hs": hs, "tp": tp, "probability": p}
@@ -96,6 +99,7 @@ def test_results_equal_the_library_bit_for_bit(service, finished, reference, tmp
     )
 
 
+@pytest.mark.slow
 def test_results_before_done_answer_409(tmp_path):
     app = create_app(_settings(tmp_path, batch_workers=1))
     with TestClient(app) as client:
@@ -266,6 +270,7 @@ def test_python_client_submit_wait_results(service, reference):
         client.submit_batch(CHAIN, [{"hs": 1.0, "tp": 9.0, "probability": 0.5}])
 
 
+@pytest.mark.slow
 def test_batches_on_a_dask_scheduler(tmp_path, reference):
     distributed = pytest.importorskip("distributed")
     with (
@@ -300,6 +305,7 @@ def test_a_huge_matrix_is_refused_before_it_is_expanded(tmp_path):
     assert "48000000 cases" in resp.json()["detail"][0]["msg"]
 
 
+@pytest.mark.slow
 def test_a_killed_batch_worker_costs_only_its_chunks(tmp_path):
     import os
     import signal

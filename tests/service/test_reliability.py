@@ -24,6 +24,10 @@ from _server import Server
 
 from stochcable.examples import load_example
 
+# reliability: servers killed and restarted, run limits (the slow tier; one worker: its
+# module servers start once)
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("test_reliability")]
+
 ROOT = Path(__file__).resolve().parents[2]
 CHAIN = load_example("chain_catenary").model_dump(mode="json", exclude_unset=True)
 GB = 1e9
@@ -44,7 +48,10 @@ LONG = _chain(600, 6000, timeseries=False)  # ≈ 6 s and ≈ 0.7 GB on the 2-co
 
 @pytest.fixture(scope="module")
 def two_workers():
-    server = Server(analysis_workers=2)
+    # the heavy analysis (≈ 6 s alone) beside the slow tier's other heavy tests on a
+    # shared machine took over the default 60 s run limit (measured: 60.5 s, a 504);
+    # what is tested here is that it holds up no other request, not the limit
+    server = Server(analysis_workers=2, max_run_seconds=240)
     yield server
     server.stop()
 
@@ -74,10 +81,11 @@ def test_heavy_document_is_refused_before_any_work(two_workers):
     assert all(w.memory_info().rss < 1 * GB for w in two_workers.workers())
 
 
+@pytest.mark.slow
 def test_heavy_analysis_does_not_hold_up_the_others(two_workers):
     heavy: dict[str, httpx.Response] = {}
     thread = threading.Thread(
-        target=lambda: heavy.setdefault("r", two_workers.post(LONG, timeout=120.0))
+        target=lambda: heavy.setdefault("r", two_workers.post(LONG, timeout=240.0))
     )
     thread.start()
     time.sleep(0.5)  # the heavy analysis has its worker
@@ -101,7 +109,7 @@ def test_heavy_analysis_does_not_hold_up_the_others(two_workers):
         t.join(60.0)
     assert not errors, errors
     assert results == [200] * 20
-    thread.join(120.0)
+    thread.join(240.0)
     assert heavy["r"].status_code == 200, heavy["r"].text
 
 

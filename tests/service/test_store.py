@@ -17,6 +17,9 @@ import pytest
 
 from service.store import JobStore
 
+# one worker runs the module: its module fixtures run once (--dist loadgroup)
+pytestmark = pytest.mark.xdist_group("test_store")
+
 
 def _free_port() -> int:
     with socket.socket() as s:

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.compiled import optional_kernel
+from stochcable.compiled import KERNEL_MIN_ENTRIES, optional_kernel
 from stochcable.dynamics.linearization.formulas import (
     drag_linear_current,
     drag_linear_harmonic,
@@ -306,9 +306,9 @@ def _element_variance(
     if u_nodes is None and u_free is None:
         return c0
     pr = _proj_rows(system, method)
-    kernel = element_variance_kernel()
     n_el, k, d = pr.shape
     n_w, n_ch = inp.weights.shape
+    kernel = element_variance_kernel() if n_el * n_w * n_ch >= KERNEL_MIN_ENTRIES else None
     if kernel is not None:  # the same sums in one compiled pass (variance_kernels)
         var = c0.copy()
         # over blocks of frequencies: the block's moments (gathered from the channels)

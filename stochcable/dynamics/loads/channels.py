@@ -72,7 +72,7 @@ from stochcable.dynamics.loads.sea_channels import sea_channel_densities, spectr
 from stochcable.errors import InputError
 from stochcable.line.fem import FEModel
 from stochcable.scene.model import Environment, Line, MotionRao, Scene
-from stochcable.sea.kinematics import G_STANDARD, nodal_kinematics
+from stochcable.sea.kinematics import G_STANDARD, wave_kinematics_unchecked
 
 __all__ = [
     "Channel",
@@ -169,7 +169,7 @@ class Channel:
     heading : float or None
         Wave heading β of a sea channel with element kinematics (the drag residual
         integrates them over parts of elements,
-        :mod:`stochcable.dynamics.drag_segments`); None otherwise. [rad]
+        :mod:`stochcable.dynamics.residuals.drag_segments`); None otherwise. [rad]
     """
 
     name: str
@@ -296,12 +296,12 @@ def _end_rao(rao: MotionRao | None, omega: np.ndarray, heading: float) -> np.nda
 
 def _sea_nodal(el: ElementKinematics, g: float) -> Callable[[], tuple[np.ndarray, np.ndarray]]:
     """The sea channel's nodal velocity and acceleration (n_omega, n_nodes, 3), on
-    demand: :func:`stochcable.sea.kinematics.wave_kinematics` from the validated
+    demand: :func:`stochcable.sea.kinematics.wave_kinematics_unchecked` of the validated
     frequencies, points and wavenumbers of the element kinematics (no second
     validation, wavenumber solve or pressure)."""
 
     def nodal() -> tuple[np.ndarray, np.ndarray]:
-        _, _, _, vel, acc = nodal_kinematics(
+        _, _, _, vel, acc = wave_kinematics_unchecked(
             el.omega, el.wavenumber, el.positions, el.heading, el.depth, g
         )
         return (

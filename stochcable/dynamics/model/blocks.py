@@ -22,7 +22,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from stochcable.compiled import optional_kernel
+from stochcable.compiled import KERNEL_MIN_ENTRIES, optional_kernel
 from stochcable.dynamics.model.solvers import MatrixLike, band_from_blocks, tridiagonal_blocks
 from stochcable.dynamics.model.system import (
     LineSystem,
@@ -293,7 +293,7 @@ class LinePrep:
                 raise SolverError(
                     "static correction: K_ff is not positive definite (check the static tensions)"
                 ) from None
-        kernel = _band_kernel()
+        kernel = _band_kernel() if rhs.size >= KERNEL_MIN_ENTRIES else None
         if kernel is not None and rhs.ndim == 2:  # row sweeps, no transposes (band_kernels)
             return kernel(self._chol, rhs)
         c = (self._chol, False)

@@ -35,7 +35,7 @@ from stochcable.dynamics.model.system import (
     LineSystem,
 )
 from stochcable.dynamics.outputs.resolution import LineModes, own_modes
-from stochcable.dynamics.second_order import irvine_lambda2
+from stochcable.dynamics.residuals.second_order import irvine_lambda2
 from stochcable.errors import (
     PhysicsWarning,
     warn,

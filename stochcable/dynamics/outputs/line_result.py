@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from stochcable.dynamics.drag_residual import drag_residual
-from stochcable.dynamics.geometric_residual import geometric_residual
 from stochcable.dynamics.loads.channels import (
     Channel,
 )
@@ -36,15 +34,20 @@ from stochcable.dynamics.model.system import (
 from stochcable.dynamics.outputs.indicators import line_indicators
 from stochcable.dynamics.outputs.resolution import (
     LineModes,
+    excitation_end,
     resolution_check,
     surface_resolution_check,
     tail_check,
 )
-from stochcable.dynamics.second_order import second_order_tension, with_second_order
+from stochcable.dynamics.residuals.corrected import corrected_stats
+from stochcable.dynamics.residuals.drag_residual import drag_residual
+from stochcable.dynamics.residuals.geometric_residual import geometric_residual
+from stochcable.dynamics.residuals.residual_lines import EndInfluence
+from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
 from stochcable.line.fem import SLACK_EA_RATIO, FEModel
 from stochcable.results.documents import (
     LineResult,
-    stats_from_validated,
+    stats_from_spectrum_unchecked,
 )
 from stochcable.results.records import ResidualRecord
 from stochcable.scene.model import AnalysisSettings
@@ -150,10 +153,11 @@ def line_result(
     st = system.statics
     s0 = model.mesh.s0
     stats = {}
+    input_end = excitation_end(channels, w)
     for end, mean in (("end_a", st.tension_a), ("end_b", st.tension_b)):
         dens = np.einsum("cw,cw->w", np.abs(resp.end_tension[end]) ** 2, spectra)
-        stats[end] = stats_from_validated(w, dens, float(mean), settings.duration)
-        tail_check(system.name, end, w, dens, stats[end].m0)
+        stats[end] = stats_from_spectrum_unchecked(w, dens, float(mean), settings.duration)
+        tail_check(system.name, end, w, dens, stats[end].m0, input_end)
     if np.any(spectra > 0):  # nothing to resolve without excitation
         resolution_check(system, linearization.damping, w, modes)
         surface_resolution_check(system, channels, w, q)
@@ -177,13 +181,18 @@ def line_result(
     end_force = _end_force_transfer(model, resp, n_ch)
     residual = {}
     std = {e: stats[e].std for e in stats}
+    shared = EndInfluence(system, linearization.damping)  # (one solve for both)
     for key, fn in (("drag_residual", drag_residual), ("geometric_residual", geometric_residual)):
         if getattr(settings.linearization, key) and linearization.record is not None:
             residual[key] = (
-                fn(system, channels, linearization, std)
+                fn(system, channels, linearization, std, influence=shared)
                 if alone
                 else ResidualRecord.not_computed("a line on free bodies is not covered", std)
             )
+    applied = [r for r in residual.values() if r.computed]
+    linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
+    if applied:  # the end statistics with the residuals (their spectra's moments added)
+        stats = {e: corrected_stats(stats[e], e, applied, settings.duration) for e in linear}
     return LineResult(
         name=system.name,
         omega=w,
@@ -201,6 +210,7 @@ def line_result(
         motion_std=motion_std,
         end_a=stats["end_a"],
         end_b=stats["end_b"],
+        linear=linear,
         linearization=linearization.record,
         modes_omega=np.asarray(system.modes.omega).copy(),
         modes_listed=_listed_modes(system.modes.omega, float(w[-1])),

@@ -2,7 +2,8 @@
 natural frequencies by the frequency grid (:func:`resolution_check`, the trapezoid
 rule's error on a resonant peak: :func:`peak_quadrature_error`), of the wave kinematics
 by the mesh near the surface (:func:`surface_resolution_check`) and of the response
-tail by ω_max (:func:`tail_check`).  The quality indicators of the response are in
+tail by ω_max where the excitation goes on above it (:func:`tail_check`,
+:func:`excitation_end`).  The quality indicators of the response are in
 :mod:`stochcable.dynamics.outputs.indicators`.
 
 References
@@ -258,18 +259,60 @@ def surface_resolution_check(
 TAIL_FRACTION = 0.05
 
 
-def tail_check(line: str, end: str, w: np.ndarray, dens: np.ndarray, m0: float) -> None:
-    """ResolutionWarning when the end-tension spectrum is still large at ω_max."""
-    if m0 <= 0.0:
+def excitation_end(channels: tuple[Channel, ...], omega: np.ndarray) -> float:
+    """The frequency above which no input of the line excites it. [rad/s]
+
+    An input whose density (``Channel.density``) vanishes above the grid ends at its
+    last non-zero frequency on the grid; one that does not is followed on a geometric
+    probe grid up to 1000 ω_max and bisected to where it vanishes: inf when it does not
+    (an analytic spectrum).  The largest over the inputs (ω_max without any)."""
+    top = float(omega[-1])
+    probe = top * np.geomspace(1.0 + 1e-9, 1e3, 400)
+    end = 0.0
+    for ch in channels:
+        spectrum = np.asarray(ch.spectrum)
+        if not np.any(spectrum > 0):
+            continue
+        above = np.flatnonzero(np.asarray(ch.density(probe)) > 0)
+        if above.size == 0:
+            end = max(end, float(omega[np.flatnonzero(spectrum > 0)[-1]]))
+        elif above[-1] == probe.size - 1:
+            return math.inf
+        else:  # bisect to where it vanishes (to 1e-9 relative)
+            lo, hi = float(probe[above[-1]]), float(probe[above[-1] + 1])
+            while hi - lo > 1e-9 * hi:
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if ch.density(np.array([mid]))[0] > 0 else (lo, mid)
+            end = max(end, hi)
+    return end if end > 0.0 else top
+
+
+def tail_check(
+    line: str,
+    end: str,
+    w: np.ndarray,
+    dens: np.ndarray,
+    m0: float,
+    input_end: float = math.inf,
+) -> None:
+    """ResolutionWarning when the end-tension spectrum is still large at ω_max and the
+    excitation goes on above it (``input_end``, :func:`excitation_end`: a band-limited
+    input that ends at the grid's top excites nothing the grid cuts). [rad/s]"""
+    if m0 <= 0.0 or input_end <= w[-1] * (1.0 + 1e-9):
         return
     ratio = float(dens[-1] * w[-1] / m0)
     if ratio > TAIL_FRACTION:
+        where = (
+            f"the excitation goes on to {input_end:.4g} rad/s: raise analysis.omega.max to it"
+            if math.isfinite(input_end)
+            else "the excitation has no upper end (an analytic spectrum): raise analysis.omega.max"
+        )
         warn(
             f"line '{line}': the {end} tension spectrum at the top of the grid "
             f"(omega.max = {w[-1]:.4g} rad/s) is still S·ω = {ratio:.2g} m0 "
             f"(threshold {TAIL_FRACTION:g}): the grid cuts the response and σ is "
-            "underestimated; raise analysis.omega.max (end motion spectra with an ω⁻⁵ "
-            "tail drive inertia loads whose spectrum decays only like ω⁻¹)",
+            f"underestimated; {where} (end motion spectra with an ω⁻⁵ tail drive inertia "
+            "loads whose spectrum decays only like ω⁻¹), or band-limit the input there",
             ResolutionWarning,
             stacklevel=3,
         )

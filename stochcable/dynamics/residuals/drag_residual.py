@@ -32,7 +32,7 @@ vary along an element (near the surface) the dropped drag has a linear part as w
 instead of 0): it is correlated with the linear response, so its end tension H_c
 enters with its cross term, Σ_c ∫ S_c (|H_L + H_c|² − |H_L|²) dω, and may lower σ.
 Such elements are split into pieces evaluated one by one, each loading its element's
-nodes where it lies (:mod:`stochcable.dynamics.drag_segments`); the orders k ≥ 2 stay
+nodes where it lies (:mod:`stochcable.dynamics.residuals.drag_segments`); the orders k ≥ 2 stay
 uncorrelated with both linear parts.  Without the split, the inclined guy's 26 m top
 element at z = 0 took the residual as one mean velocity spread evenly over its two
 nodes, and the correction read +38 % at the fairlead, mostly on the line's 0.7 %-damped
@@ -56,12 +56,15 @@ most :data:`MAX_PANELS` panels (the cost is O(panels² · n_fft log n_fft)).
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.drag_segments import (
+from stochcable.dynamics.linearization.variance import current_split
+from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals.drag_segments import (
     Segments,
     panel_groups,
     panel_loads,
@@ -69,12 +72,10 @@ from stochcable.dynamics.drag_segments import (
     segment_velocity,
     segments,
 )
-from stochcable.dynamics.linearization.variance import current_split
-from stochcable.dynamics.model.blocks import trapezoid_weights
-from stochcable.dynamics.residual_lines import (
-    covariance_lines,
-    cross_covariance,
+from stochcable.dynamics.residuals.residual_lines import (
+    EndInfluence,
     element_directions,
+    fft_length,
     load_transfer,
     residual_record,
     uniform_grid,
@@ -88,6 +89,7 @@ __all__ = [
     "RESIDUAL_WARN_RATIO",
     "drag_residual",
     "hermite_coefficients",
+    "lumped_coefficients",
     "residual_output_lines",
 ]
 
@@ -97,12 +99,23 @@ HERMITE_ORDER = 5
 #: Most panels (groups of consecutive elements) the residual is evaluated on: the cost
 #: grows with their square; 54 panels of the chain's 160 elements give the
 #: element-by-element variance within 1 % (tests/test_drag_residual.py). [-]
-MAX_PANELS = 64
+MAX_PANELS = 32
 #: σ ratio (with / without the residual) beyond which (above it, or below its inverse)
 #: a PhysicsWarning says the correction is larger than any checked against the nonlinear
 #: time domain: +18 % on the taut wire and on the inclined guy, +4 / +7 % on the chain
 #: (docs/benchmarks/drag_residual.md). [-]
 RESIDUAL_WARN_RATIO = 1.25
+#: Orders of the default evaluation: 2 and 3, each carrying the variance of the higher
+#: orders of its parity (:func:`lumped_coefficients`). [-]
+LUMPED_ORDER = 3
+#: Points across a line's cell where the transfer functions of the residual loads are
+#: taken where the lines do not resolve them (:func:`cell_factor`). [-]
+SUB_SAMPLES = 5
+#: Bend of the log power between neighbouring lines (|Δ² ln P|) above which a cell's
+#: transfer functions are sub-sampled (:func:`cell_factor`). [-]
+CELL_BEND = 0.1
+#: Memory of the covariance functions held at a time (a block of panel pairs). [bytes]
+_BLOCK_BYTES = 32 * 2**20
 
 
 def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
@@ -125,23 +138,61 @@ def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
         no longer change (a₂ = ±1, a_k = 0 for k ≥ 3).
     """
     m = np.atleast_1d(np.asarray(mu, dtype=float))
-    # g(μ + x) is ±(μ + x)², a polynomial on each side of the kink x = −μ: Gauss–Legendre
-    # on each side of it over ±12 (the Gaussian tail beyond is e^-72) is exact to
-    # round-off for |μ| < 12
-    t, wt = np.polynomial.legendre.leggauss(64)
-    lo, hi = -12.0, 12.0
-    kink = np.clip(-m, lo, hi)[:, None]
-    x = np.concatenate(
-        [0.5 * (kink - lo) * t + 0.5 * (kink + lo), 0.5 * (hi - kink) * t + 0.5 * (hi + kink)], 1
-    )
-    w = np.concatenate([0.5 * (kink - lo) * wt, 0.5 * (hi - kink) * wt], 1)
-    w = w * np.exp(-0.5 * x * x) / math.sqrt(2.0 * math.pi)
+    x, w = _gauss_points(-m)
     y = m[:, None] + x
     g = np.abs(y) * y * w
     out = np.empty((m.size, order + 1))
     for k in range(order + 1):
         he = np.polynomial.hermite_e.hermeval(x, [0.0] * k + [1.0])
         out[:, k] = np.sum(g * he, axis=1) / math.factorial(k)
+    return out
+
+
+@functools.lru_cache(maxsize=1)
+def _legendre(n: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre nodes and weights on [−1, 1] (formed once)."""
+    return np.polynomial.legendre.leggauss(n)
+
+
+def _gauss_points(*kinks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Points and weights (n, m) of E[f(x)], x ~ N(0, 1), for f a polynomial on each
+    side of the ``kinks`` (each (n,)): Gauss–Legendre between the kinks over ±12 (the
+    Gaussian tail beyond is e^-72), exact to round-off for kinks within ±12."""
+    t, wt = _legendre()
+    lo, hi = -12.0, 12.0
+    edges = np.sort(np.stack([np.full(kinks[0].shape, lo)] + [np.clip(k, lo, hi) for k in kinks]
+                             + [np.full(kinks[0].shape, hi)], 1), axis=1)  # fmt: skip
+    a, b = edges[:, :-1, None], edges[:, 1:, None]
+    x = (0.5 * (b - a) * t + 0.5 * (b + a)).reshape(edges.shape[0], -1)
+    w = (0.5 * (b - a) * wt).reshape(edges.shape[0], -1)
+    return x, w * np.exp(-0.5 * x * x) / math.sqrt(2.0 * math.pi)
+
+
+def lumped_coefficients(mu: Any, order: int = LUMPED_ORDER) -> np.ndarray:
+    """Hermite coefficients (as :func:`hermite_coefficients`) up to ``order`` whose two
+    highest (one odd, one even) carry the variance of all higher orders of their
+    parity: k!·a_k² of the top odd order is Σ_{j odd ≥ k} j!·a_j², of the top even order
+    likewise (sign of a_k kept).
+
+    The sums are closed: Σ_j j!·a_j² = E[g(μ + x)²] = μ⁴ + 6μ² + 3 over all orders, its
+    even part E[g(μ + x)·(g(μ + x) + g(μ − x))]/2 (He_j(−x) = (−1)^j He_j(x)).  A panel's
+    residual variance is then exact, and the lags' shape of the orders above ``order``
+    is that of the top order of their parity (their cross-covariances are taken as
+    ρ^order, not ρ^j: tested against the orders kept one by one)."""
+    m = np.atleast_1d(np.asarray(mu, dtype=float))
+    out = hermite_coefficients(m, order)
+    x, w = _gauss_points(-m, m)
+    gp, gm = (np.abs(m[:, None] + x) * (m[:, None] + x), np.abs(m[:, None] - x) * (m[:, None] - x))
+    total = m**4 + 6.0 * m**2 + 3.0
+    even = 0.5 * (total + np.sum(gp * gm * w, axis=1))
+    tails = {0: even - out[:, 0] ** 2, 1: total - even - out[:, 1] ** 2}
+    for k in (order, order - 1):
+        if k < 2:
+            continue
+        below = sum(math.factorial(j) * out[:, j] ** 2 for j in range(k % 2 + 2, k, 2))
+        tail = np.maximum(tails[k % 2] - below, 0.0)
+        sign = np.where(out[:, k] < 0.0, -1.0, 1.0)
+        out[:, k] = sign * np.sqrt(tail / math.factorial(k))
     return out
 
 
@@ -167,7 +218,8 @@ def residual_output_lines(
     transfer : ndarray, complex, shape (n_out, n_p, n_o)
         Outputs per unit force on each panel at ω_j, j = 1 … n_o. [N/N]
     n_fft : int
-        Samples of the lag grid, ≥ 2·K·n_j (no aliasing of the k-fold convolutions).
+        Samples of the lag grid, ≥ 2·K·(n_j − 1) + 1 (no aliasing of the k-fold
+        convolutions, whose lines reach K·(n_j − 1)).
 
     Returns
     -------
@@ -176,24 +228,47 @@ def residual_output_lines(
         residual adds). [N²]
     """
     order = coeffs.shape[1] - 1
+    n_p, n_j = lines.shape[1], lines.shape[2]
     sig = np.sqrt(np.einsum("cpj,cpj->p", lines.real, lines.real) + np.einsum(
         "cpj,cpj->p", lines.imag, lines.imag
     ))  # fmt: skip
     live = sig > 0
     force = np.where(live, scale * sig**2, 0.0)  # cσ²L
     inv = np.where(live, 1.0 / np.where(live, sig, 1.0), 0.0)
+    z = lines * inv[None, :, None]  # unit-variance lines: their covariance is ρ
+    # k!·a_k^e·a_k^f·F_e·F_f = b_k^e·b_k^f, b_k = √k!·a_k·F
+    b = np.sqrt([float(math.factorial(k)) for k in range(order + 1)]) * coeffs * force[:, None]
     n_o = transfer.shape[2]
     out = np.zeros((transfer.shape[0], n_o))
-    for e in np.flatnonzero(live):
-        rho = cross_covariance(lines[:, e], lines, n_fft) * (inv[e] * inv[:, None])
-        rr = np.zeros_like(rho)
-        power = rho.copy()
-        for k in range(2, order + 1):
-            power *= rho
-            rr += (math.factorial(k) * coeffs[e, k]) * coeffs[:, k, None] * power
-        rr *= force[e] * force[:, None]
-        cr = covariance_lines(rr, n_o)  # (n_p, n_o)
-        out += np.real(np.conj(transfer[:, e]) * np.einsum("opj,pj->oj", transfer, cr))
+    # the pairs f ≥ e, the panels e in blocks (G_fe = conj(G_ef): the pairs f > e count
+    # twice), their covariance functions at a time
+    size = max(1, int(_BLOCK_BYTES // (24 * n_fft * max(n_p, 1))))
+    for start in range(0, n_p, size):
+        blk = slice(start, min(start + size, n_p))
+        f_all = slice(start, n_p)
+        cross = np.zeros((blk.stop - start, n_p - start, n_fft // 2 + 1), dtype=complex)
+        # Σ_c conj(z_ce)·z_cf per line: one matrix product per line
+        zz = np.conj(z[:, blk]).transpose(2, 1, 0) @ z[:, f_all].transpose(2, 0, 1)
+        cross[:, :, :n_j] = np.moveaxis(zz, 0, 2)
+        cross[:, :, 0] *= 2.0  # (irfft halves the zero-frequency line)
+        rho = np.fft.irfft(cross, n=n_fft, axis=2) * (0.5 * n_fft)
+        # Σ_{k≥2} b_k^e b_k^f ρ^k by Horner's rule
+        rr = b[blk, order, None, None] * b[None, f_all, order, None] * rho
+        for k in range(order - 1, 1, -1):
+            rr += b[blk, k, None, None] * b[None, f_all, k, None]
+            rr *= rho
+        rr *= rho
+        cr = (2.0 / n_fft) * np.fft.rfft(rr, axis=2)[:, :, 1 : n_o + 1]  # (n_b, n_f, n_o)
+        # weight 2 on the pairs above the diagonal, 1 on it
+        cr *= 2.0
+        diag = np.arange(blk.stop - start)
+        cr[diag, diag] *= 0.5
+        cr[np.arange(cr.shape[0])[:, None] > np.arange(cr.shape[1])[None, :]] = 0.0
+        # Σ_ef conj(T_e) G_ef T_f per line: G_j T_j as one matrix product per line
+        t_f = np.transpose(transfer[:, f_all], (2, 1, 0))  # (n_o, n_f, n_out)
+        tf = np.moveaxis(cr, 2, 0) @ t_f  # (n_o, n_b, n_out)
+        t_e = np.transpose(np.conj(transfer[:, blk]), (2, 1, 0))
+        out += np.einsum("jek,jek->kj", t_e, tf).real
     return out
 
 
@@ -202,7 +277,9 @@ def drag_residual(
     channels: Any,
     linearization: Any,
     std: dict[str, float],
-    order: int = HERMITE_ORDER,
+    order: int = LUMPED_ORDER,
+    lumped: bool = True,
+    influence: EndInfluence | None = None,
 ) -> ResidualRecord:
     """The end-tension variance the drag linearization of one line drops (module notes).
 
@@ -218,6 +295,12 @@ def drag_residual(
         The linear end-tension σ. [N]
     order : int
         Highest Hermite order.
+    lumped : bool
+        The two highest orders carry the variance of all higher ones of their parity
+        (:func:`lumped_coefficients`); False: the orders above ``order`` dropped (the
+        evaluation before issue 31, with ``order`` :data:`HERMITE_ORDER`).
+    influence : EndInfluence, optional
+        The line's end influence, shared with its other residual.
 
     Returns
     -------
@@ -258,10 +341,10 @@ def drag_residual(
     spectra = np.stack([ch.spectrum for ch in channels])
     n_o = order * (grid.n_j - 1)
     w_out = grid.step * np.arange(1, n_o + 1)
-    n_fft = int(2 ** math.ceil(math.log2(2 * order * grid.n_j + 2)))
-    h_all = load_transfer(
-        system, damping, panel_loads(model, seg, groups, [parts[n][2] for n in live]), w_out
-    )
+    # (ρ^K reaches line K·(n_j − 1): a lag grid of 2·K·(n_j − 1) + 1 samples resolves it)
+    n_fft = fft_length(2 * order * (grid.n_j - 1) + 1)
+    unit = panel_loads(model, seg, groups, [parts[n][2] for n in live])
+    h_all = load_transfer(system, damping, unit, w_out, influence)
     # the normal and axial residuals of every panel are one set of components: they are
     # functions of jointly Gaussian velocities, so their cross terms count too (where
     # the linear tensions of the two cancel, so do the residuals' in part)
@@ -276,7 +359,8 @@ def drag_residual(
         v = grid.lines(pan, spectra)
         sig = np.sqrt(np.sum(np.abs(v) ** 2, axis=(0, 2)))
         mu = np.where(sig > 0, mean / np.where(sig > 0, sig, 1.0), 0.0)
-        coeffs.append(hermite_coefficients(np.clip(mu, -10.0, 10.0), order))
+        coef = lumped_coefficients if lumped else hermite_coefficients
+        coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
         lines.append(v)
         misfit.append((pan, _misfit(seg, groups, c_el, mean_el, b_el, sig)))
     lines_t = residual_output_lines(
@@ -285,10 +369,43 @@ def drag_residual(
         np.concatenate(coeffs),
         h_all,
         n_fft,
-    )
+    ) * cell_factor(system, damping, unit, w_out, h_all)
     linear = _misfit_variance(system, damping, resp, spectra, seg, groups, live, parts, misfit)
     out = residual_record(lines_t, w_out, w, std, order, len(groups), linear)
     _warn_large(system.name, out)
+    return out
+
+
+def cell_factor(
+    system: Any, damping: Any, unit: np.ndarray, w_out: np.ndarray, h: np.ndarray
+) -> np.ndarray:
+    """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
+    panel force over its value at ω_j, where the lines do not resolve it: shape
+    (n_out, n_o).
+
+    Near a lightly damped mode every panel's transfer function is the mode's resonance
+    times its shape, T_e(ω) ≈ φ_e·R(ω): the cell mean of every product conj(T_e)·T_f is
+    then the line's times this one factor, and the residual's variance line is
+    integrated over the cell, not sampled (the inclined guy's 0.7 %-damped mode, half-
+    power width 0.016 rad/s, on lines 0.03 rad/s apart: its corrected σ moved ±2 % with
+    the line count, within 0.2 % with the factor).  The cells are those where the log
+    power (``h``'s, summed over the panels) bends by more than :data:`CELL_BEND`
+    between neighbours, and theirs; elsewhere the factor is 1 (no solve)."""
+    power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
+    out = np.ones_like(power)
+    logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
+    bend = np.zeros(power.shape[1], dtype=bool)
+    bend[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > CELL_BEND, 0)
+    cells = np.flatnonzero(bend | np.roll(bend, 1) | np.roll(bend, -1))
+    if cells.size == 0:
+        return out
+    step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
+    sub = step * ((np.arange(SUB_SAMPLES) + 0.5) / SUB_SAMPLES - 0.5)
+    w_sub = (w_out[cells, None] + sub[None]).ravel()
+    h_sub = load_transfer(system, damping, unit, w_sub)
+    p_sub = np.sum(np.abs(h_sub) ** 2, axis=1).reshape(power.shape[0], cells.size, -1)
+    at = power[:, cells]
+    out[:, cells] = np.where(at > 0, p_sub.mean(axis=2) / np.where(at > 0, at, 1.0), 1.0)
     return out
 
 
@@ -330,15 +447,16 @@ def _misfit_variance(
     live: list[str],
     parts: dict[str, Any],
     misfit: list[tuple[np.ndarray, np.ndarray]],
-) -> dict[str, float]:
-    """The end-tension variance the linear misfit of the element-constant drag changes:
-    its load δB·l·v on the pieces of split elements is linear in the response, so its
-    end tension H_c adds to the linear H_L (Σ_c ∫ S_c (|H_L + H_c|² − |H_L|²) dω on the
-    analysis grid, the trapezoid of the linear σ; it may be negative). [N²]"""
+) -> dict[str, np.ndarray]:
+    """The end-tension variance the linear misfit of the element-constant drag changes,
+    as lines on the analysis grid (empty without split elements): its load δB·l·v on
+    the pieces of split elements is linear in the response, so its end tension H_c
+    adds to the linear H_L (Σ_c S_c (|H_L + H_c|² − |H_L|²) times the trapezoid
+    weights of the linear σ; it may be negative). [N²]"""
     w = np.asarray(resp.omega, dtype=float)
     keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
     if not keep:
-        return {"end_a": 0.0, "end_b": 0.0}
+        return {}
     sel = [[groups[i] for i in idx] for _, idx in keep]
     unit = np.concatenate(
         [panel_loads(system.model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
@@ -353,7 +471,7 @@ def _misfit_variance(
     for o, end in enumerate(("end_a", "end_b")):
         h_l = np.asarray(resp.end_tension[end])
         h_c = np.einsum("pw,cpw->cw", h[o], load)
-        out[end] = float(np.sum(q * (np.abs(h_l + h_c) ** 2 - np.abs(h_l) ** 2)))
+        out[end] = np.sum(q * (np.abs(h_l + h_c) ** 2 - np.abs(h_l) ** 2), axis=0)
     return out
 
 

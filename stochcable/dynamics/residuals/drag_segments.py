@@ -1,4 +1,4 @@
-"""Where the drag residual (:mod:`stochcable.dynamics.drag_residual`) is evaluated along
+"""Where the drag residual (:mod:`stochcable.dynamics.residuals.drag_residual`) is evaluated along
 a line: elements split where the wave kinematics vary along them, grouped into panels.
 
 The drag is a pointwise load, c|v(ξ)|v(ξ) along each element, while the linear model
@@ -303,13 +303,14 @@ def panel_loads(
     n_directions · n_panels), direction-major."""
     comps = list(model.components)
     unit = np.zeros((model.n_nodes, model.dim, len(groups) * len(directions)))
-    xi = seg.xi
+    # every piece: its panel, its share of the panel's length, its element's two nodes
+    piece = np.concatenate(groups)
+    panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
+    share = seg.length[piece] / np.bincount(panel, weights=seg.length[piece])[panel]
+    e, xi = seg.element[piece], seg.xi[piece]
     for k, direction in enumerate(directions):
-        for q, g in enumerate(groups):
-            p = k * len(groups) + q
-            share = seg.length[g] / seg.length[g].sum()
-            for s_, s_share in zip(g, share):
-                e = seg.element[s_]
-                unit[e, :, p] += (1.0 - xi[s_]) * s_share * direction[e, comps]
-                unit[e + 1, :, p] += xi[s_] * s_share * direction[e, comps]
+        col = k * len(groups) + panel
+        vec = direction[e][:, comps] * share[:, None]  # (n_pieces, d)
+        np.add.at(unit, (e, slice(None), col), (1.0 - xi)[:, None] * vec)
+        np.add.at(unit, (e + 1, slice(None), col), xi[:, None] * vec)
     return unit

@@ -1,0 +1,187 @@
+"""Cost of the closed-form residuals of the linear model (issue 31): the linear analysis
+against the same analysis with the drag residual, the geometric residual and both
+(``analysis.linearization.drag_residual`` / ``geometric_residual``), on four lines:
+
+- chain: the bundled example (its sea, 0.5 m/s current and fairlead surge; its time
+  series dropped: they cost the same with and without the residuals);
+- taut: the bundled taut wire in its sea;
+- deep: the accuracy page's deep-water wire catenary (benchmarks/accuracy_lines.py,
+  its default FD scene: fairlead surge, 20 elements);
+- two-segment: chain on the bed and synthetic rope to the fairlead, the chain
+  example's sea, current and surge.
+
+Each variant is timed as one ``analyze`` of a scene document (statics, engine, fixed
+point, outputs, residuals), the four variants interleaved, ``--repeat`` rounds in one
+process after one warm-up round; the fastest of the rounds is reported with the ratio
+to the linear one, and the residual σ ratios (σ with / σ without) at the fairlead.
+
+    OPENBLAS_NUM_THREADS=1 python3 benchmarks/residual_cost.py [--repeat 3] [--profile LINE]
+
+Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
+analysis before issue 31 and 1.8–4.4× after (chain 4.4×, two-segment 3.2×, deep 2.5×,
+taut 1.8×; loaded host, ±1): exact steps (adjoint end tensions, pairs f ≥ e, the lag
+grid at the alias bound, one end influence) and approximate ones (Hermite orders 2
+and 3 carrying the higher orders' variance, 32 panels, 64 lines with resonant cells
+integrated, the geometric residual on 64 lines): corrected σ within −0.20…+0.33 % of
+before on the four lines and the inclined guy (tests/test_drag_residual.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import cProfile
+import json
+import math
+import os
+import pstats
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from accuracy_lines import fd_document  # noqa: E402 (sibling benchmark script)
+
+from stochcable import analyze, load_example  # noqa: E402
+
+VARIANTS = {
+    "linear": {},
+    "drag": {"drag_residual": True},
+    "geometric": {"geometric_residual": True},
+    "both": {"drag_residual": True, "geometric_residual": True},
+}
+
+
+def _example(name: str) -> dict:
+    doc = load_example(name).model_dump(mode="json", exclude_none=True)
+    doc.get("analysis", {}).pop("timeseries", None)
+    return doc
+
+
+def two_segment() -> dict:
+    """Chain on the bed (450 m) and synthetic rope (420 m) to the fairlead, in the
+    chain example's depth, sea, current and surge."""
+    doc = _example("chain_catenary")
+    chain = dict(doc["lines"][0]["segments"][0], length=450.0, elements=20)
+    rope = {"length": 420.0, "ea": 1.5e8, "mass": 25.0, "diameter": 0.16,
+            "cd_normal": 1.2, "cd_axial": 0.008, "ca_normal": 1.0, "elements": 20}  # fmt: skip
+    doc["lines"][0]["segments"] = [chain, rope]
+    doc["title"] = "two-segment line: chain on the bed, synthetic rope to the fairlead"
+    return doc
+
+
+def lines(guy: bool = False) -> dict[str, dict]:
+    """The four scene documents, linear (switches off); with ``guy`` the inclined guy
+    too (the line whose split elements the drag residual needs)."""
+    out = {
+        "chain": _example("chain_catenary"),
+        "taut": _example("taut_wire"),
+        "deep": fd_document("deep", "default"),
+        "two-segment": two_segment(),
+    }
+    if guy:
+        out["guy"] = _example("inclined_guy")
+    return out
+
+
+def residual_variances() -> dict:
+    """The drag and geometric residuals' end-tension variances of every line (and the
+    guy), both switches on: line → {"drag"|"geometric": {end: variance [N²]},
+    "std_linear": {end: σ [N]}}."""
+    out = {}
+    for name, doc in lines(guy=True).items():
+        lr = next(iter(analyze(with_variant(doc, "both")).lines.values()))
+        out[name] = {
+            key: {end: float(rec.variance[end]) for end in ("end_a", "end_b")}
+            for key, rec in (("drag", lr.drag_residual), ("geometric", lr.geometric_residual))
+        }
+        out[name]["std_linear"] = {end: float(lr.linear_end(end).std) for end in ("end_a", "end_b")}
+    return out
+
+
+def with_variant(doc: dict, variant: str) -> dict:
+    out = copy.deepcopy(doc)
+    lin = out.setdefault("analysis", {}).setdefault("linearization", {})
+    lin.update({"drag_residual": False, "geometric_residual": False, **VARIANTS[variant]})
+    return out
+
+
+def _fairlead_ratio(res, variant: str) -> float:
+    """σ with the variant's residuals over the linear σ at end_b (the records' sum)."""
+    lr = next(iter(res.lines.values()))
+    recs = [r for r in (lr.drag_residual, lr.geometric_residual) if r is not None and r.computed]
+    extra = sum(r.variance["end_b"] for r in recs)
+    return math.sqrt(1.0 + extra / lr.linear_end("end_b").std ** 2) if recs else 1.0
+
+
+def measure(repeat: int) -> dict[str, dict[str, tuple[float, float]]]:
+    """Fastest wall time [s] and fairlead σ ratio of every line and variant."""
+    docs = {name: {v: with_variant(d, v) for v in VARIANTS} for name, d in lines().items()}
+    best: dict[str, dict[str, list]] = {n: {v: [math.inf, 1.0] for v in VARIANTS} for n in docs}
+    for r in range(repeat + 1):  # round 0: warm-up (imports, numba caches)
+        for name, by_v in docs.items():
+            for v, doc in by_v.items():
+                t0 = time.perf_counter()
+                res = analyze(doc)
+                dt = time.perf_counter() - t0
+                if r > 0:
+                    best[name][v][0] = min(best[name][v][0], dt)
+                best[name][v][1] = _fairlead_ratio(res, v)
+    return {n: {v: tuple(x) for v, x in by.items()} for n, by in best.items()}
+
+
+def report(best: dict) -> str:
+    rows = [
+        "| line | linear [s] | drag [s] (×) | geometric [s] (×) | both [s] (×) "
+        "| σ ratio drag | σ ratio geometric | σ ratio both |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for name, by in best.items():
+        t0 = by["linear"][0]
+        cells = [f"{by['linear'][0]:.3f}"]
+        for v in ("drag", "geometric", "both"):
+            cells.append(f"{by[v][0]:.3f} ({by[v][0] / t0:.1f}×)")
+        ratios = [f"{by[v][1]:.4f}" for v in ("drag", "geometric", "both")]
+        rows.append(f"| {name} | " + " | ".join(cells + ratios) + " |")
+    return "\n".join(rows)
+
+
+def profile(name: str, variant: str = "both") -> str:
+    doc = with_variant(lines()[name], variant)
+    analyze(doc)
+    prof = cProfile.Profile()
+    prof.enable()
+    analyze(doc)
+    prof.disable()
+    out = []
+
+    class _W:
+        def write(self, s):
+            out.append(s)
+
+    pstats.Stats(prof, stream=_W()).sort_stats(os.environ.get("SORT", "cumulative")).print_stats(45)
+    return "".join(out)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--profile", default=None, help="cProfile one line's 'both' analysis")
+    ap.add_argument("--only", default=None, help="comma-separated lines")
+    ap.add_argument("--record", default=None, help="write the residual variances (JSON)")
+    args = ap.parse_args()
+    if args.record:
+        Path(args.record).write_text(json.dumps(residual_variances(), indent=1) + "\n")
+        return
+    if args.profile:
+        print(profile(args.profile))
+        return
+    best = measure(args.repeat)
+    if args.only:
+        best = {k: v for k, v in best.items() if k in args.only.split(",")}
+    print(report(best))
+
+
+if __name__ == "__main__":
+    main()
