@@ -63,6 +63,7 @@ def _free_decay(speed: float, duration: float, h: float, n_el: int = 40):
     return t, pos, model
 
 
+@pytest.mark.slow  # 6000 Newmark steps: 3–5 s each
 @pytest.mark.parametrize("ratio", [0.0, 0.3, 0.6])
 def test_free_decay_of_travelling_string_wickert_mote(ratio):
     """FFT peaks of a free decay at ω_n = nπ(c_w² − c²)/(L c_w), n = 1, 2, within the

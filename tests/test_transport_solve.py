@@ -112,6 +112,7 @@ def test_direct_solve_equals_complex_modal_receptance(speed):
         np.testing.assert_allclose(got, U, rtol=0, atol=1e-9 * np.abs(U).max())
 
 
+@pytest.mark.slow  # two analyses and a 300 s time-domain simulation: ≈ 5 s
 def test_laying_example_frequency_domain_equals_time_domain_with_transport():
     """The bundled laying example in its linear limit (Hs 0.2 m; strakes: the TD has
     no vortex shedding), 300 s: the analysis' synthesized end tensions against the
