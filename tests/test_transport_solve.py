@@ -153,3 +153,34 @@ def test_laying_example_frequency_domain_equals_time_domain_with_transport():
         assert a.std() == pytest.approx(getattr(lr, f"end_{end}").std, rel=tol)
     fd0 = np.asarray(ts0.end_tension["cable"]["end_b"])[sel]
     assert (a - (fd0 - fd0.mean())).std() > tol * b.std()
+
+
+def test_end_influence_of_a_travelling_line_by_the_adjoint():
+    """The residuals' end influence (end tension per unit node force, by the adjoint:
+    Aᵀ with C − G) equals the forward solve with the full impedance, to 1e-9."""
+    from stochcable.dynamics.residuals.residual_lines import end_influence
+    from stochcable.dynamics.solve.line_solve import end_tension_from_support
+
+    with pytest.warns(Warning):
+        scene, system = _system(-5.0)
+    damping = _damping(system, np.random.default_rng(7))
+    w = np.array([0.3, 1.7])
+    got = end_influence(system, damping, w)  # (2, n_nodes, d, n_w)
+    rest = build_fe_model(system.statics, scene.environment, dim=2)
+    tr = transport_matrices(rest, -5.0)
+    K, M = tr.K.toarray(), (rest.M + rest.Ma).toarray()
+    C = damping.matrix.toarray() + rest.Cs.toarray() + tr.G.toarray()
+    fr, fx, d = rest.free, rest.fixed, rest.dim
+    e_hat = end_tension_from_support(system, np.eye(2 * d)[None].astype(complex))
+    for i, x in enumerate(w):
+        Z = K - x * x * M + 1j * x * C
+        for dof in fr[[0, 5, -1]]:
+            f = np.zeros(K.shape[0])
+            f[dof] = 1.0
+            u = np.zeros(K.shape[0], complex)
+            u[fr] = np.linalg.solve(Z[np.ix_(fr, fr)], f[fr])
+            support = -(Z @ u - f)[fx]
+            for k, end in enumerate(("end_a", "end_b")):
+                t = np.real(e_hat[end][:, 0]) @ support
+                g = got[k, dof // d, dof % d, i]
+                assert abs(g - t) <= 1e-9 * max(abs(t), 1e-12), (end, dof, g, t)
