@@ -243,6 +243,15 @@ def test_engine_refuses_a_travelling_line_on_a_body():
         build_engine(doc)
 
 
+def test_harmonic_linearization_refused_for_a_travelling_line():
+    from stochcable.dynamics.engine import build_engine
+
+    doc = _taut_scene(1.0)
+    doc["analysis"] = {"linearization": {"method": "harmonic"}}
+    with pytest.raises(InputError, match=r"line 'taut' travels.*use 'seed' or 'vector'"):
+        build_engine(doc)
+
+
 def test_flutter_reported_not_solved():
     """A negative damping −εM (a stand-in for a non-conservative fluid load) makes the
     string's oscillating modes grow: complex pairs with Re λ > 0 are a flutter (at rest

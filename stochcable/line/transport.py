@@ -264,7 +264,8 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
     ------
     InputError
         ``lines[i].axial_speed``: at or above the critical speed (named), or on a line
-        with an end attached to a body (the coupled solve of lines and bodies has no
+        with an end attached to a body; ``analysis.linearization.method`` "harmonic"
+        (no mean-flow term) with a travelling line (the coupled solve of lines and bodies has no
         transport terms; docs/travelling.md).
     """
     from stochcable.line.fem import build_fe_model
@@ -274,6 +275,15 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
             continue
         model = build_fe_model(statics.lines[line.name], scene.environment, dim=3)
         check_axial_speed(model, line.axial_speed, f"lines[{i}].axial_speed")
+        if scene.analysis.linearization.method == "harmonic":
+            raise InputError(
+                "analysis.linearization.method",
+                "harmonic",
+                "-",
+                f"line '{line.name}' travels (lines[{i}].axial_speed = {line.axial_speed:g} "
+                "m/s): its drag acts on the mean relative flow U − c e, which the harmonic "
+                "(regular-wave) form has no term for; use 'seed' or 'vector'",
+            )
         bodies = [e.attach.body for e in (line.end_a, line.end_b) if e.attach is not None]
         if bodies:
             raise InputError(
