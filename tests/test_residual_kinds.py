@@ -7,11 +7,16 @@ the load-case plan."""
 from __future__ import annotations
 
 import math
+import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
 from _scenes import chain_surge_doc
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "_ext"))
+import results_reference  # noqa: E402  (the manual's result reference)
 
 from stochcable import analyze, estimate_cost
 from stochcable.cases import LineFatigue, scatter_from_rows
@@ -99,6 +104,10 @@ def test_toy_kind_reaches_outputs_document_cost_and_cases(toy_kind):
         math.sqrt(1 + TOY_SHARE), rel=1e-9
     )
     assert TOY not in base.to_document()
+    # the manual's result reference documents its keys
+    paths = results_reference.document_paths({"lines": {"leg1": out}})
+    toy_paths = {p for p in paths if p.startswith(f"lines.<line>.{TOY}")}
+    assert len(toy_paths) > 5 and toy_paths <= set(results_reference.residual_keys())
     # the cost model: the toy's memory (the largest) and its time on the one line
     cost, cost0 = estimate_cost(scene), estimate_cost(plain)
     assert cost.memory_bytes - cost0.memory_bytes == TOY_MEMORY

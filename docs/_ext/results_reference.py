@@ -184,8 +184,8 @@ _LINES = {
     "lines.<line>.<end>.tension": (
         "",
         "Statistics of the end tension (table of statistics below; U = force).  With "
-        "``analysis.linearization.drag_residual`` or ``geometric_residual``: with the "
-        "residuals, their spectra's moments added to the linear spectrum's (the "
+        + " or ".join(f"``analysis.linearization.{k}``" for k in RESIDUAL_KINDS)
+        + ": with the residuals, their spectra's moments added to the linear spectrum's (the "
         "superharmonics above the band included), the linear model's alone in "
         "``lines.<line>.linear``; their spectral density in "
         "``lines.<line>.corrected_spectra`` (``lines.<line>.spectra`` stays the linear "
