@@ -79,6 +79,9 @@ class ResidualKind:
 # stochcable.cost's notes on the residuals.
 _DRAG_PANELS, _GEOMETRIC_ELEMENTS, _GEOMETRIC_LINES = 32, 400, 63
 _DRAG_SECONDS, _GEOMETRIC_SECONDS = 2.0e-9, 3.0e-10
+# peak memory bounded by the blocks: the drag's ≤ 64 components on ≤ 128 lines (≤ 1024
+# and 128 before issue 31, when the times were measured), the geometric covariance
+# blocks of 64 MiB and its transfer functions
 _RESIDUAL_BYTES = 256 * 2**20
 
 
