@@ -83,13 +83,13 @@ bounds a planned analysis beyond the service's budget.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from stochcable.errors import InputError
 from stochcable.scene.model import Scene, load_scene
+from stochcable.scene.residual_kinds import asked_residuals
 
 __all__ = [
     "CostEstimate",
@@ -127,44 +127,35 @@ SECONDS_PER_SAMPLE_CHANNEL = 1.7e-6
 
 _BODY_TIME_FACTOR = 1.0  # extra time per free body (coupled solves): 2.6 µs vs 1.2 µs
 
-#: The residuals of the linear model (``analysis.linearization.drag_residual`` and
-#: ``.geometric_residual``): their peak memory (bounded by their blocks: the drag's
-#: ≤ 64 components on ≤ 128 lines (≤ 1024 and 128 before issue 31, when the times
-#: below were measured), the geometric covariance blocks of 64 MiB and its
-#: transfer functions) and their time per component pair and FFT sample·log₂ — an
+#: The residuals of the linear model (every kind of
+#: :mod:`stochcable.scene.residual_kinds` the scene asks for): their peak memory and
+#: time are the kinds' cost terms (``memory_bytes``, ``seconds``; the largest memory,
+#: the sum of the times).  Measured with the drag and geometric residuals: an
 #: analysis of the chain, the inclined guy and the taut wire with both measured 0.53,
 #: 0.65 and 0.16 s against 0.72, 0.79 and 0.18 s estimated (the chain at 160 elements:
 #: 0.90 against 0.80 s); the caps are those of :mod:`stochcable.dynamics.residuals.residual_lines`
-#: and the two residual modules.  In a sea the drag residual splits the elements near
+#: and the residual modules.  In a sea the drag residual splits the elements near
 #: the surface (:mod:`stochcable.dynamics.residuals.drag_segments`; 40 elements: the chain 54
 #: panels, the guy 53), counted as a quarter of the panel cap more in every sea (the
 #: chain and the guy: 1.12 and 1.43 s measured against 1.29 and 1.36 s estimated, on a
 #: loaded host; the taut wire, 10 m below the surface, splits none: 0.21 against 0.52 s,
 #: on the safe side).
-_RESIDUAL_BYTES = 256 * 2**20
-_RESIDUAL_LINES, _DRAG_PANELS, _GEOMETRIC_ELEMENTS, _GEOMETRIC_LINES = 63, 32, 400, 63
-_DRAG_SECONDS, _GEOMETRIC_SECONDS = 2.0e-9, 3.0e-10
+_RESIDUAL_LINES = 63
 
 
 def _residual_seconds(scene: Scene) -> float:
     """Estimated time of the residuals the scene asks for. [s]"""
-    lin = scene.analysis.linearization
-    if not (lin.drag_residual or lin.geometric_residual):
+    kinds = asked_residuals(scene.analysis.linearization)
+    if not kinds:
         return 0.0
     w = scene.analysis.omega.values()
     step = float(min(w[1:] - w[:-1])) if w.size > 1 else float(w[0])
     n_j = min(_RESIDUAL_LINES, max(2, int(w[-1] / max(step, 1e-12)) + 1))
+    in_sea = scene.sea is not None
     out = 0.0
     for line in scene.lines:
         n_el = sum(int(s.elements) for s in line.segments)
-        if lin.drag_residual:
-            fft = 2 ** math.ceil(math.log2(6 * n_j + 2))  # (orders 2 and 3)
-            panels = min(n_el + (_DRAG_PANELS // 4 if scene.sea is not None else 0), _DRAG_PANELS)
-            # (the pairs f ≥ e: half of them)
-            out += _DRAG_SECONDS * 2 * panels**2 * fft * math.log2(fft)
-        if lin.geometric_residual and n_el <= _GEOMETRIC_ELEMENTS:
-            fft = 2 ** math.ceil(math.log2(4 * min(n_j, _GEOMETRIC_LINES + 1) + 2))
-            out += _GEOMETRIC_SECONDS * 12 * n_el**2 * fft * math.log2(fft)
+        out += sum(k.seconds(n_el, n_j, in_sea) for k in kinds)
     return out
 
 
@@ -330,8 +321,8 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
         + SECONDS_PER_SAMPLE_CHANNEL * ops_series
         + _residual_seconds(scene)
     )
-    lin = scene.analysis.linearization
-    residual_bytes = _RESIDUAL_BYTES if lin.drag_residual or lin.geometric_residual else 0
+    kinds = asked_residuals(scene.analysis.linearization)
+    residual_bytes = max((k.memory_bytes for k in kinds), default=0)
     return CostEstimate(
         memory_bytes=int(BASE_BYTES + spectral + series + residual_bytes),
         seconds=seconds,

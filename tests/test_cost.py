@@ -165,8 +165,9 @@ def test_residual_caps_are_the_modules():
     are the caps the residual modules apply."""
     from stochcable import cost
     from stochcable.dynamics.residuals import drag_residual, geometric_residual, residual_lines
+    from stochcable.scene import residual_kinds as kinds
 
     assert cost._RESIDUAL_LINES == residual_lines.MAX_LINES
-    assert cost._DRAG_PANELS == drag_residual.MAX_PANELS
-    assert cost._GEOMETRIC_ELEMENTS == geometric_residual.MAX_ELEMENTS
-    assert cost._GEOMETRIC_LINES == geometric_residual.MAX_LINES
+    assert kinds._DRAG_PANELS == drag_residual.MAX_PANELS
+    assert kinds._GEOMETRIC_ELEMENTS == geometric_residual.MAX_ELEMENTS
+    assert kinds._GEOMETRIC_LINES == geometric_residual.MAX_LINES

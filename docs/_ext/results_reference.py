@@ -22,6 +22,8 @@ from typing import Any
 
 from scene_reference import escape_bars
 
+from stochcable.scene.residual_kinds import RESIDUAL_KINDS
+
 __all__ = [
     "KEYS",
     "OPAQUE",
@@ -147,12 +149,43 @@ _MODES_LIN = {
     "linearization.lines.<line>.history": ("-", "Relative change at each iteration."),
 }
 
+
+def residual_keys() -> dict[str, tuple[str, str]]:
+    """The document keys ``lines.<line>.<name>`` of every registered residual kind
+    (:mod:`stochcable.scene.residual_kinds`): (unit, meaning)."""
+    out: dict[str, tuple[str, str]] = {}
+    for name, kind in RESIDUAL_KINDS.items():
+        key = f"lines.<line>.{name}"
+        out[key] = ("", kind.document)
+        out[f"{key}.computed"] = (
+            "-",
+            f"False where the line is outside the closed form's scope ({kind.scope}).",
+        )
+        out[f"{key}.reason"] = ("-", "Why not computed; empty when computed.")
+        out[f"{key}.order"] = ("-", kind.order)
+        out[f"{key}.panels"] = ("-", kind.panels)
+        out[f"{key}.<end>"] = ("", "The residual at the end.")
+        out[f"{key}.<end>.variance"] = (
+            "{F}²",
+            "Variance the residual adds to the end tension (in band, superharmonics and "
+            "difference frequencies).",
+        )
+        out[f"{key}.<end>.in_band"] = ("{F}²", "Its part on the analysis band [ω_min, ω_max].")
+        out[f"{key}.<end>.std_linear"] = ("{F}", "σ of the linear model.")
+        out[f"{key}.<end>.std"] = (
+            "{F}",
+            "√(σ_linear² + variance): the end-tension σ with the residual.",
+        )
+        out[f"{key}.<end>.ratio"] = ("-", "std / std_linear.")
+    return out
+
+
 _LINES = {
     "lines.<line>.<end>.tension": (
         "",
         "Statistics of the end tension (table of statistics below; U = force).  With "
-        "``analysis.linearization.drag_residual`` or ``geometric_residual``: with the "
-        "residuals, their spectra's moments added to the linear spectrum's (the "
+        + " or ".join(f"``analysis.linearization.{k}``" for k in RESIDUAL_KINDS)
+        + ": with the residuals, their spectra's moments added to the linear spectrum's (the "
         "superharmonics above the band included), the linear model's alone in "
         "``lines.<line>.linear``; their spectral density in "
         "``lines.<line>.corrected_spectra`` (``lines.<line>.spectra`` stays the linear "
@@ -208,67 +241,7 @@ _LINES = {
     ),
     "lines.<line>.modes.omega": ("rad/s", "Natural frequencies listed for the line."),
     "lines.<line>.modes.kept": ("-", "Modes kept by the Foss solve; null for the direct solve."),
-    "lines.<line>.drag_residual": (
-        "",
-        "The end-tension variance the statistical drag linearization drops, in closed "
-        "form (the Hermite residual of the quadratic drag; present with "
-        "``analysis.linearization.drag_residual``); see :doc:`../benchmarks/drag_residual`.",
-    ),
-    "lines.<line>.drag_residual.computed": (
-        "-",
-        "False where the line is outside the closed form's scope (3-D lines, the vector "
-        "or harmonic linearization, lines on free bodies).",
-    ),
-    "lines.<line>.drag_residual.reason": ("-", "Why not computed; empty when computed."),
-    "lines.<line>.drag_residual.order": ("-", "Highest Hermite order kept."),
-    "lines.<line>.drag_residual.panels": ("-", "Element groups the residual was evaluated on."),
-    "lines.<line>.drag_residual.<end>": ("", "The residual at the end."),
-    "lines.<line>.drag_residual.<end>.variance": (
-        "{F}²",
-        "Variance the residual adds to the end tension (in band, superharmonics and "
-        "difference frequencies).",
-    ),
-    "lines.<line>.drag_residual.<end>.in_band": (
-        "{F}²",
-        "Its part on the analysis band [ω_min, ω_max].",
-    ),
-    "lines.<line>.drag_residual.<end>.std_linear": ("{F}", "σ of the linear model."),
-    "lines.<line>.drag_residual.<end>.std": (
-        "{F}",
-        "√(σ_linear² + variance): the end-tension σ with the residual.",
-    ),
-    "lines.<line>.drag_residual.<end>.ratio": ("-", "std / std_linear."),
-    "lines.<line>.geometric_residual": (
-        "",
-        "The end-tension variance of the second-order geometric forces of the linear "
-        "response (stretching and rotation of the tension; present with "
-        "``analysis.linearization.geometric_residual``); see "
-        ":doc:`../benchmarks/drag_residual`.",
-    ),
-    "lines.<line>.geometric_residual.computed": (
-        "-",
-        "False where the line is outside the closed form's scope (more than 400 "
-        "elements, lines on free bodies).",
-    ),
-    "lines.<line>.geometric_residual.reason": ("-", "Why not computed; empty when computed."),
-    "lines.<line>.geometric_residual.order": ("-", "2: the forces are quadratic in the response."),
-    "lines.<line>.geometric_residual.panels": ("-", "The elements the residual was evaluated on."),
-    "lines.<line>.geometric_residual.<end>": ("", "The residual at the end."),
-    "lines.<line>.geometric_residual.<end>.variance": (
-        "{F}²",
-        "Variance the residual adds to the end tension (in band, superharmonics and "
-        "difference frequencies).",
-    ),
-    "lines.<line>.geometric_residual.<end>.in_band": (
-        "{F}²",
-        "Its part on the analysis band [ω_min, ω_max].",
-    ),
-    "lines.<line>.geometric_residual.<end>.std_linear": ("{F}", "σ of the linear model."),
-    "lines.<line>.geometric_residual.<end>.std": (
-        "{F}",
-        "√(σ_linear² + variance): the end-tension σ with the residual.",
-    ),
-    "lines.<line>.geometric_residual.<end>.ratio": ("-", "std / std_linear."),
+    **residual_keys(),
     "lines.<line>.strumming": (
         "",
         "Strumming screening of the line in the current (present only with a current "
@@ -619,8 +592,8 @@ def example_documents() -> dict[str, dict[str, Any]]:
             docs[name] = stochcable.analyze(stochcable.load_example(name)).to_document()
         scene = stochcable.load_example("taut_wire").model_dump()
         scene["analysis"]["fidelity"] = {"target_error": 0.05}
-        scene["analysis"]["linearization"]["drag_residual"] = True
-        scene["analysis"]["linearization"]["geometric_residual"] = True
+        for name in RESIDUAL_KINDS:  # every residual kind in the reference
+            scene["analysis"]["linearization"][name] = True
         result = stochcable.analyze(stochcable.Scene.model_validate(scene))
         docs["taut_wire with analysis.fidelity"] = result.to_document()
     return docs

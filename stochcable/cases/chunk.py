@@ -143,8 +143,8 @@ def case_sea(scene: Scene, state: SeaState, family: Family) -> Sea:
 
 def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) -> Scene:
     """The scene a set's engine is built from: no time series, the scene's closed-form
-    residuals as it asks for them (``analysis.linearization.drag_residual``,
-    ``geometric_residual``: each case's end statistics and end damage are then those of
+    residuals as it asks for them (every kind of :mod:`stochcable.scene.residual_kinds`
+    switched on: each case's end statistics and end damage are then those of
     the corrected spectrum, :meth:`stochcable.results.documents.LineResult.end_tension_density`),
     and the sea of an out-of-plane state when there is one (the models are then 3-D,
     and in-plane states are solved by them exactly as by 2-D models)."""

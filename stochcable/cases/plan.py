@@ -29,6 +29,7 @@ from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import ScatterDiagram, SeaState
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.scene.model import Scene, load_scene
+from stochcable.scene.residual_kinds import asked_residuals
 
 __all__ = [
     "CasePlan",
@@ -153,8 +154,7 @@ def plan_cases(
     if not isinstance(chunk_size, int) or isinstance(chunk_size, bool) or chunk_size < 1:
         raise InputError("chunk_size", chunk_size, "-", "must be an integer >= 1")
     template = engine_template(scene, scatter.states, scatter.family)
-    asked = [k for k in ("drag_residual", "geometric_residual")
-             if getattr(scene.analysis.linearization, k)]  # fmt: skip
+    asked = [k.name for k in asked_residuals(scene.analysis.linearization)]
     if asked:
         warn(
             "load-case sets apply "

@@ -286,6 +286,13 @@ def parse_points(tables: MoorDynTables, bodies: dict) -> dict[int, MoorDynPoint]
                 p.kind = "coupled"
                 p.body = f"body{coupled_bodies.index(bid) + 1}"
                 p.point = tuple(float(v) for v in rel)
+        elif word == "TURBINE":
+            raise row.error(
+                sec,
+                1,
+                "Turbine<n> points (FAST.Farm farm-level mooring) are not supported: "
+                "their X, Y, Z are relative to turbine n, placed by the FAST.Farm input",
+            )
         else:
             raise row.error(
                 sec,

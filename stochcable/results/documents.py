@@ -35,6 +35,7 @@ from stochcable.results.records import (
     stats_from_spectrum_unchecked,
     stats_from_validated,  # noqa: F401  (former name, kept importable)
 )
+from stochcable.scene.residual_kinds import RESIDUAL_KINDS
 from stochcable.scene.units import unit_labels
 
 __all__ = [
@@ -132,13 +133,13 @@ class LineResult:
     strumming : StrummingTable or None
         Strumming screening of the line in the current (None without current;
         docs/strumming.md).
-    drag_residual : ResidualRecord or None
-        The end-tension variance the drag linearization drops
-        (``analysis.linearization.drag_residual``; None when not asked for).
-    geometric_residual : ResidualRecord or None
-        The end-tension variance of the second-order geometric forces
-        (``analysis.linearization.geometric_residual``; None when not asked for).  With
-        a zero-mean flow the residuals are uncorrelated: their variances add.
+    residuals : dict of ResidualRecord
+        The residuals of the linear model asked for, by kind
+        (:mod:`stochcable.scene.residual_kinds`, in registry order; a kind not asked
+        for is absent).  Each is also an attribute: ``drag_residual`` (the end-tension
+        variance the drag linearization drops), ``geometric_residual`` (that of the
+        second-order geometric forces), None when not asked for.  With a zero-mean
+        flow the residuals are uncorrelated: their variances add.
     linear : dict {"end_a", "end_b"} of ResponseStats or None
         Where a residual was computed, ``end_a`` and ``end_b`` are the statistics with
         the residuals (their spectra's moments added:
@@ -177,10 +178,15 @@ class LineResult:
     modes: Any = None
     indicators: LineIndicators | None = None
     strumming: StrummingTable | None = None
-    drag_residual: ResidualRecord | None = None
-    geometric_residual: ResidualRecord | None = None
+    residuals: dict[str, ResidualRecord] = field(default_factory=dict)
     linear: dict[str, ResponseStats] | None = None
     corrected_spectra: dict[str, Any] | None = None
+
+    def __getattr__(self, name: str) -> ResidualRecord | None:
+        """A registered residual kind's record by its name (None when not asked for)."""
+        if name in RESIDUAL_KINDS:
+            return self.__dict__.get("residuals", {}).get(name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def linear_end(self, end: str) -> ResponseStats:
         """The linear model's statistics of the tension at ``end`` ("end_a" or
@@ -269,14 +275,7 @@ class LineResult:
             "modes": {"omega": self.listed_modes.tolist(), "kept": self.n_modes},
             "indicators": None if self.indicators is None else self.indicators.as_dict(),
             **({} if self.strumming is None else {"strumming": self.strumming.as_dict()}),
-            **{
-                k: r.as_dict()
-                for k, r in (
-                    ("drag_residual", self.drag_residual),
-                    ("geometric_residual", self.geometric_residual),
-                )
-                if r is not None
-            },
+            **{k: r.as_dict() for k, r in self.residuals.items()},
             **(
                 {}
                 if self.linear is None

@@ -14,6 +14,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from stochcable.scene.base import _Doc, _f
+from stochcable.scene.residual_kinds import residual_switch
 
 __all__ = [
     "OmegaGrid",
@@ -69,18 +70,9 @@ class LinearizationSettings(_Doc):
         description="Return a flagged partial result instead of an error when the "
         "iteration does not converge",
     )
-    drag_residual: bool = Field(
-        default=False,
-        description="Also compute the end-tension variance the linearization drops: the "
-        "closed-form Hermite residual of the quadratic drag (lines.<name>.drag_residual; "
-        "planar lines, seed method, lines not on free bodies)",
-    )
-    geometric_residual: bool = Field(
-        default=False,
-        description="Also compute the end-tension variance of the second-order geometric "
-        "forces of the linear response (stretching and rotation of the tension; "
-        "lines.<name>.geometric_residual; lines not on free bodies, at most 400 elements)",
-    )
+    # the residual kinds' switches (stochcable.scene.residual_kinds: one line a kind)
+    drag_residual: bool = residual_switch("drag_residual")
+    geometric_residual: bool = residual_switch("geometric_residual")
 
 
 class TimeSeriesSettings(_Doc):

@@ -24,6 +24,13 @@ READABLE = [
     "stochcable_clump_buoy.txt",
     "stochcable_buoy_network.txt",
     "stochcable_openfast_v1_counts.txt",
+    # OpenFAST's regression-test inputs (tests/data/moordyn/openfast/SOURCE.md)
+    "openfast/OC3Hywind_MoorDyn.dat",
+    "openfast/OC4DeepCwindSemi_MoorDyn.dat",
+    "openfast/MRSemi_MoorDyn.dat",
+    "openfast/ITIBarge4_MoorDyn.dat",
+    "openfast/MIT_NREL_TLP_MoorDyn.dat",
+    "openfast/MHK_RM1_Floating_MoorDyn.dat",
 ]
 
 
@@ -158,6 +165,32 @@ def test_rods_are_refused_naming_the_row():
         read_moordyn(DATA / "bodies_and_rods.dat")
 
 
+def test_openfast_inputs_read_as_their_platforms():
+    # (file, lines, fairlead depth [m], water depth [m]: the deepest anchor)
+    for name, n, z, depth in (
+        ("OC3Hywind_MoorDyn.dat", 3, -70.0, 320.0),
+        ("OC4DeepCwindSemi_MoorDyn.dat", 3, -14.0, 200.0),
+        ("MRSemi_MoorDyn.dat", 6, -14.0, 200.0),
+        ("ITIBarge4_MoorDyn.dat", 8, -4.0, 150.0),
+        ("MIT_NREL_TLP_MoorDyn.dat", 8, -47.89, 200.0),
+        ("MHK_RM1_Floating_MoorDyn.dat", 6, -10.0, 50.0),
+    ):
+        sc = _read(f"openfast/{name}")
+        assert len(sc.lines) == n and [b.name for b in sc.bodies] == ["vessel"], name
+        assert sc.environment.depth == depth, name
+        for ln in sc.lines:
+            assert ln.end_b.attach.body == "vessel" and ln.end_b.attach.point[2] == z, name
+    # the TLP's BA is in N·s: β = BA/EA = 6e6 / 1.5e9 s
+    tlp = _read("openfast/MIT_NREL_TLP_MoorDyn.dat")
+    assert tlp.analysis.structural_damping.beta == pytest.approx(4e-3, rel=1e-12)
+
+
+def test_fast_farm_turbine_points_are_refused_naming_the_row():
+    # FAST.Farm's Turbine<n> points are relative to a turbine placed by the .fstf file
+    with pytest.raises(MoorDynInputError, match=r"line 21, column 6 \(POINTS\).*Turbine<n>"):
+        read_moordyn(DATA / "openfast" / "SharedMooring2.dat")
+
+
 def test_ignored_options_and_properties_are_named():
     with pytest.warns(PhysicsWarning) as rec:
         read_moordyn(DATA / "wd0050_chain.txt")
@@ -244,7 +277,7 @@ def test_unknown_attachment():
     assert (err.line, err.column) == (19, 10) and "there is no point 9" in str(err)
     err = _bad(GOOD.replace("2 poly 2 3 260 26 -", "2 poly 2 R1A 260 26 -"))
     assert "no rod 1" in str(err)
-    err = _bad(GOOD.replace("4 Coupled", "4 Turbine1"))
+    err = _bad(GOOD.replace("4 Coupled", "4 Winch1"))
     assert err.line == 14 and "unknown point attachment" in str(err)
 
 

@@ -41,8 +41,7 @@ from stochcable.dynamics.outputs.resolution import (
 )
 from stochcable.dynamics.residuals.corrected import corrected_stats
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
-from stochcable.dynamics.residuals.drag_residual import drag_residual
-from stochcable.dynamics.residuals.geometric_residual import geometric_residual
+from stochcable.dynamics.residuals.registry import residual_parts
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
 from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
 from stochcable.line.fem import SLACK_EA_RATIO, FEModel
@@ -122,9 +121,9 @@ def line_result(
         (default the line's fixed-end modes; a line on bodies: the coupled modes that
         count for it, :func:`stochcable.dynamics.groups.results.line_modes`).
     alone : bool
-        False for a line of a coupled group (on free bodies): its residuals
-        (``settings.linearization.drag_residual`` and ``.geometric_residual``) are not
-        computed.
+        False for a line of a coupled group (on free bodies): its residuals (the kinds
+        of :mod:`stochcable.scene.residual_kinds` ``settings.linearization`` asks
+        for) are not computed.
 
     Returns
     -------
@@ -183,13 +182,14 @@ def line_result(
     residual = {}
     std = {e: stats[e].std for e in stats}
     shared = EndInfluence(system, linearization.damping)  # (one solve for both)
-    for key, fn in (("drag_residual", drag_residual), ("geometric_residual", geometric_residual)):
-        if getattr(settings.linearization, key) and linearization.record is not None:
-            residual[key] = (
-                fn(system, channels, linearization, std, influence=shared)
-                if alone
-                else ResidualRecord.not_computed("a line on free bodies is not covered", std)
-            )
+    for kind, fn in (
+        residual_parts(settings.linearization) if linearization.record is not None else ()
+    ):
+        residual[kind.name] = (
+            fn(system, channels, linearization, std, influence=shared)
+            if alone
+            else ResidualRecord.not_computed("a line on free bodies is not covered", std)
+        )
     applied = [r for r in residual.values() if r.computed]
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None
@@ -223,7 +223,7 @@ def line_result(
         model=model,
         modes=system.modes,
         indicators=indicators,
-        **residual,
+        residuals=residual,
     )
 
 
