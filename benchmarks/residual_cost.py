@@ -23,7 +23,7 @@ taut 1.8×; loaded host, ±1): exact steps (adjoint end tensions, pairs f ≥ e,
 grid at the alias bound, one end influence) and approximate ones (Hermite orders 2
 and 3 carrying the higher orders' variance, 32 panels, 64 lines with resonant cells
 integrated, the geometric residual on 64 lines): corrected σ within −0.20…+0.33 % of
-before on the four lines and the inclined guy (tests/test_drag_residual.py).
+before on the four lines and the inclined guy (tests/dynamics/test_drag_residual.py).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Writes ``openapi/openapi.json`` at the repository root (or ``--output PATH``); with
 ``--check`` it writes nothing and exits 1 when the file differs from the app's
-document.  ``tests/test_openapi.py`` fails when code and file disagree.
+document.  ``tests/service/test_openapi.py`` fails when code and file disagree.
 """
 
 from __future__ import annotations

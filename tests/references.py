@@ -59,7 +59,7 @@ TUAH_1982_EX2 = MappingProxyType(
 
 # The elastic two-segment catenary solution of TUAH_1982_EX2 computed by
 # stochcable.line.catenary.catenary_multisegment (w = (3.35 - 2.0) * 0.0218 * 32.174 lbf/ft,
-# EA = 177016 lbf), checked in tests/test_catenary.py by numerical quadrature of the
+# EA = 177016 lbf), checked in tests/line/test_catenary.py by numerical quadrature of the
 # cable equations and node equilibrium.  The FE statics must reproduce it.
 TUAH_1982_EX2_ELASTIC_CATENARY = MappingProxyType(
     {

@@ -1,5 +1,5 @@
 """The HTTP reference of the manual, rendered from the committed OpenAPI document
-(``openapi/openapi.json``, generated from the FastAPI app; ``tests/test_openapi.py``
+(``openapi/openapi.json``, generated from the FastAPI app; ``tests/service/test_openapi.py``
 keeps file and app equal).
 
 Every operation with its parameters, request body, examples and answers, then every

@@ -238,7 +238,7 @@ def bed_contact(
     above, so the model is continuous in the touchdown's position; the suspended span
     ends at the touchdown whatever the mesh, as on a mesh with a node there (the
     fidelity planner's node at the touchdown), and the tension σ of the grounded chain
-    example converges monotonically with the elements (tests/test_seabed.py).  Slack
+    example converges monotonically with the elements (tests/line/test_seabed.py).  Slack
     touchdown elements (T <= 0) keep the nodal contact.
 
     The statistical linearization of the one-sided contact (k_eq = k·P(contact) for a

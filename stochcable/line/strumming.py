@@ -239,7 +239,7 @@ class StrummingTable:
         Position in ``modes`` of the mode whose amplitude amplifies the drag: the
         strumming (locked-in or resonant) mode of largest amplitude.  None when no mode
         strums: an unlocked, non-resonant mode's wakes drift in phase along the line
-        and its response decays (Tuah (1982), Example 6, tests/test_strumming.py), so the
+        and its response decays (Tuah (1982), Example 6, tests/line/test_strumming.py), so the
         drag is not amplified.
     """
 

@@ -531,7 +531,7 @@ def lock_in_balance(
             roots.append((sol.x, res))
     if roots:
         # several branches: the largest amplitude is the one a run from rest reaches
-        # (the wakes are self-excited; tests/test_strumming.py)
+        # (the wakes are self-excited; tests/line/test_strumming.py)
         best = max(roots, key=lambda r: r[0][0])
     x, res = best
     if res >= _ROOT_TOL:

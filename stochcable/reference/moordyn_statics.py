@@ -3,7 +3,7 @@
 coupled points and bodies held at their static positions, and the end-segment
 tensions of every MoorDyn line read back, next to the element of the scene line they
 belong to.  The check of :func:`stochcable.statics.solve_statics` on MoorDyn files
-(tests/test_io_moordyn_statics.py, docs/manual/moordyn.md).
+(tests/io/test_io_moordyn_statics.py, docs/manual/moordyn.md).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Write the scene document's JSON Schema (committed as ``openapi/scene.schema.json``).
 
 Run ``python -m stochcable.scene.schema [path]`` after changing the scene models;
-``tests/test_scene.py`` fails when the committed file and the models disagree.
+``tests/scene/test_scene.py`` fails when the committed file and the models disagree.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ sets up the grid, the seed and the spectrum, hands the work to :class:`_Synthesi
 then runs the FFT.  Here: the phasor table and chunk size shared with the compiled
 kernel (:mod:`stochcable.sea.kernels`), the NumPy kernel :func:`_phasor_chunk`, the
 per-thread scratch and the reused work arrays of one call.  The operations and their
-order are the realization's bit-exact contract (tests/test_sea.py pins the bits).
+order are the realization's bit-exact contract (tests/sea/test_sea.py pins the bits).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ kernel ``coefficients._phasor_chunk``, in the same order, without fast-math and 
 contraction except for the complex product T·e, which is written with explicit fused
 multiply-adds in the form NumPy's SIMD complex multiply uses on x86-64 with FMA3
 (re = fma(T_r, e_r, −T_i e_i), im = fma(T_r, e_i, T_i e_r); checked against exact
-rational arithmetic in tests/test_sea.py).  There both kernels give the same bits;
+rational arithmetic in tests/sea/test_sea.py).  There both kernels give the same bits;
 where numpy's loop is not fused they differ by ≲ 1 ulp of |X|.  The compiled
 kernel's bits do not depend on the CPU (``llvm.fma`` is correctly rounded everywhere).
 

@@ -9,7 +9,7 @@ motion u_e of its attached end nodes,
 U_0, R_0 with the attached ends held, G, R_e those of unit end motions (the "unit
 channels", :func:`stochcable.dynamics.groups.inputs.unit_channels`).  A *line part*
 holds them until the body solve has given u_e, then forms the combined response.
-Three forms, the same linear system to round-off (tests/test_coupled_reduction.py):
+Three forms, the same linear system to round-off (tests/dynamics/test_coupled_reduction.py):
 
 - node level (``solver="direct"``, and the reference): the banded direct solve of the
   physical and the unit channels, or under Foss :func:`foss_unit_split` (one Foss

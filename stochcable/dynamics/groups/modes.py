@@ -135,7 +135,7 @@ def coupled_modes(
     static following of the attached ends, T the rigid links; the eigenproblem of
     Lᵀ K L, Lᵀ M L over (q of every line, ξ) is a Rayleigh–Ritz projection of the
     full one (upper bounds; on the three-leg benchmark the listed frequencies agree
-    within 1e-4 relative, tests/test_coupled_analysis.py).
+    within 1e-4 relative, tests/dynamics/test_coupled_analysis.py).
     """
     if method not in ("auto", "full", "reduced"):
         raise InputError("method", method, "-", "must be 'auto', 'full' or 'reduced'")

@@ -43,9 +43,9 @@ domain with the FD's linear drag plus the dropped drag of the fluid velocity rea
 
 Validation: the closed form of the residual's cross-spectrum, and of the split
 element's misfit plus residual, against Monte-Carlo Gaussian realizations
-(tests/test_drag_residual.py, tests/test_drag_segments.py), and the corrected σ against
-the nonlinear time domain (the chain's quadratic-drag shift, the taut wire and the
-inclined guy in their seas: docs/benchmarks/drag_residual.md).
+(tests/dynamics/test_drag_residual.py, tests/dynamics/test_drag_segments.py), and the
+corrected σ against the nonlinear time domain (the chain's quadratic-drag shift, the
+taut wire and the inclined guy in their seas: docs/benchmarks/drag_residual.md).
 
 Scope: planar lines (the normal velocity a scalar), the seed linearization, normal and
 axial drag of the line elements (attachment drag is not included), each element at
@@ -98,7 +98,7 @@ __all__ = [
 HERMITE_ORDER = 5
 #: Most panels (groups of consecutive elements) the residual is evaluated on: the cost
 #: grows with their square; 54 panels of the chain's 160 elements give the
-#: element-by-element variance within 1 % (tests/test_drag_residual.py). [-]
+#: element-by-element variance within 1 % (tests/dynamics/test_drag_residual.py). [-]
 MAX_PANELS = 32
 #: σ ratio (with / without the residual) beyond which (above it, or below its inverse)
 #: a PhysicsWarning says the correction is larger than any checked against the nonlinear

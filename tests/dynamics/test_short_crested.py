@@ -3,7 +3,7 @@ to zero width is the long-crested analysis, mirrored spreadings give mirrored
 responses on a line symmetric about the mean heading, sea states of one spreading
 reuse their inputs, the time series realize every direction independently, and bad
 documents are refused naming the parameter.  Scenes with bodies and vessels:
-tests/test_short_crested_bodies.py."""
+tests/dynamics/test_short_crested_bodies.py."""
 
 from __future__ import annotations
 

@@ -3,7 +3,7 @@ NumPy form (kinematics_closed_forms.kinematics_block, ``STOCHCABLE_NUMBA=0``): t
 formulas, so equal to a few ulps of each element's largest value.
 
 The closed forms themselves are checked against quadrature of the nodal kinematics
-along the elements in tests/test_wave_loads.py (test_closed_form_element_integrals_
+along the elements in tests/dynamics/test_wave_loads.py (test_closed_form_element_integrals_
 equal_quadrature), which runs with either path."""
 
 from __future__ import annotations

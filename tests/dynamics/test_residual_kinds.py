@@ -9,13 +9,13 @@ from __future__ import annotations
 import math
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 from _scenes import chain_surge_doc
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "_ext"))
+sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 import results_reference  # noqa: E402  (the manual's result reference)
 
 from stochcable import analyze, estimate_cost

@@ -119,7 +119,7 @@ def test_laying_example_frequency_domain_equals_time_domain_with_transport():
     nonlinear time-domain reference with transport on the same realization.  The
     allowance is the drag nonlinearity σ_vr/U_n (σ of the relative normal velocity
     against the 0.5 m/s cross-current, ≈ 7 %) plus the Newmark period error, as in
-    tests/test_cable_timedomain.py's linear-limit tests (measured: 2.8 % and 2.0 %).
+    tests/reference/test_cable_timedomain.py's linear-limit tests (measured: 2.8 % and 2.0 %).
     The transport is resolved: the time domain with transport is further than that from
     the frequency domain at rest (end_b: 11 %)."""
     from stochcable.analysis import analyze

@@ -36,7 +36,7 @@ def _wire(cd: float = 1.2) -> dict:
 
 
 def test_set_equals_one_at_a_time_analyses():
-    # engine.solve(sea) is analyze() of the scene with that sea (tests/test_engine.py,
+    # engine.solve(sea) is analyze() of the scene with that sea (tests/dynamics/test_engine.py,
     # 1e-12) when both use the same model.  Here the set's headings include 30°, so its
     # engine is 3-D while analyze() of the 0° case is 2-D: both drag fixed points stop
     # within the linearization tolerance tol of their own limit, so σ agrees to a few

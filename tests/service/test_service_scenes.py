@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import json
 import warnings
-from pathlib import Path
 
 import pytest
+from _paths import MOORDYN_DATA
 from fastapi.testclient import TestClient
 
 from service.app import create_app
@@ -16,7 +16,7 @@ from stochcable.errors import PhysicsWarning
 from stochcable.io import read_moordyn
 from stochcable.scene.model import load_scene
 
-DATA = Path(__file__).parent / "data" / "moordyn"
+DATA = MOORDYN_DATA
 
 
 @pytest.fixture(scope="module")

@@ -13,10 +13,10 @@ import json
 import math
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT, TESTS
 from _scenes import chain_surge_doc, td_end_sigma
 from scipy import stats
 
@@ -27,7 +27,7 @@ from stochcable import analyze, load_example
 from stochcable.dynamics.linearization.formulas import mean_abs_gaussian
 from stochcable.dynamics.residuals.drag_residual import hermite_coefficients, residual_output_lines
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 import residual_cost  # noqa: E402
 
 
@@ -192,7 +192,7 @@ def test_large_correction_warns(monkeypatch):
 #: The residual variances of the evaluation before issue 31 (Hermite orders 2–5, 64
 #: panels, 1,024 lines, one banded solve per panel load), recorded by
 #: ``benchmarks/residual_cost.py --record`` before the change.
-_V1 = Path(__file__).parent / "residual_variances_v1.json"
+_V1 = TESTS / "residual_variances_v1.json"
 
 
 def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import numpy as np
 import pytest
+from _paths import TESTS
 
 from stochcable.cli import main
 
 pytest.importorskip("stochcable.line.statics")
 
+# the taut scene and its reference are tests/line/test_modes.py's
+sys.path.insert(0, str(TESTS / "line"))
 from test_modes import TAUT_SCENE, taut_scene_reference  # noqa: E402
 
 

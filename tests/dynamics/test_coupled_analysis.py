@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 import pytest
+from _paths import ROOT
 from _scenes import three_chain_legs
 from scipy.spatial.transform import Rotation
 
@@ -783,14 +784,7 @@ def test_scene_three_leg_example_mirror_symmetry():
     """The seed §6.7 disc on three legs (stochcable/examples, helper A1's statics):
     heading 0 is a mirror about x, so leg2 = leg3 and the buoy has no sway, roll or
     yaw; the statics pose is the statistics' mean."""
-    from pathlib import Path
-
-    path = (
-        Path(__file__).resolve().parents[1]
-        / "stochcable"
-        / "examples"
-        / "tuah_1982_disc_buoy_three_legs.json"
-    )
+    path = ROOT / "stochcable" / "examples" / "tuah_1982_disc_buoy_three_legs.json"
     scene = load_scene(path)
     if scene.sea is None or abs(scene.sea.heading) > 0:
         pytest.skip("the example is not at heading 0")
@@ -1080,7 +1074,7 @@ def test_fixed_dofs_modes_are_the_constrained_eigenproblem(mooring_direct, metho
     assert n >= 10
     # full: the same dense eigenproblem; reduced: Craig–Bampton with all 27 modes of
     # each 10-element leg, an exact change of basis: both round-off of eigh (the
-    # truncated reduction is tested in tests/test_coupled_reduction.py)
+    # truncated reduction is tested in tests/dynamics/test_coupled_reduction.py)
     tol = 1e-9
     np.testing.assert_allclose(got.omega, ref[:n], rtol=tol)
     assert np.all(got.omega >= ref[:n] * (1 - 1e-9))

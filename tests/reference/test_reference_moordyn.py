@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from _paths import ROOT
 
 from stochcable.errors import InputError
 from stochcable.examples import load_example
@@ -233,9 +234,8 @@ def test_reference_agrees_with_moordyn_on_a_short_chain_record(moordyn, chain):
 def _load_benchmark():
     import importlib.util
     import sys
-    from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "moordyn_check.py"
+    path = ROOT / "benchmarks" / "moordyn_check.py"
     spec = importlib.util.spec_from_file_location("moordyn_check", path)
     mod = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = mod

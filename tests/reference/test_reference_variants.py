@@ -5,16 +5,16 @@ frequency-domain model, the TD reproduces the FD end tension σ."""
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 
 from stochcable import load_scene
 from stochcable.errors import InputError
 from stochcable.reference.cable import simulate_line_timedomain
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 import fd_budget as fb  # noqa: E402
 
 

@@ -4,7 +4,6 @@ domain (stochcable.reference.moordyn_vessel) against the frequency domain."""
 from __future__ import annotations
 
 import warnings
-from pathlib import Path
 
 import pytest
 
@@ -13,9 +12,11 @@ from stochcable.io import read_moordyn
 
 pytest.importorskip("moordyn")
 
+from _paths import MOORDYN_DATA
+
 from stochcable.reference.moordyn_vessel import simulate_vessel_moordyn  # noqa: E402
 
-DATA = Path(__file__).parent / "data" / "moordyn"
+DATA = MOORDYN_DATA
 
 
 @pytest.fixture(scope="module")

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import json
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 
 from stochcable.analysis import analyze
 from stochcable.results.datasets import dataset_from_document, netcdf_bytes
@@ -16,7 +16,7 @@ from stochcable.scene.model import load_scene
 # one worker runs the module: its module fixtures run once (--dist loadgroup)
 pytestmark = pytest.mark.xdist_group("test_datasets")
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "stochcable" / "examples"
+EXAMPLES = ROOT / "stochcable" / "examples"
 xr = pytest.importorskip("xarray")
 pytest.importorskip("netCDF4")
 

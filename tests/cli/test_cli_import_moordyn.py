@@ -4,16 +4,16 @@ from __future__ import annotations
 
 import json
 import warnings
-from pathlib import Path
 
 import pytest
+from _paths import MOORDYN_DATA
 
 from stochcable.cli import main
 from stochcable.errors import PhysicsWarning
 from stochcable.io import read_moordyn
 from stochcable.scene.model import load_scene
 
-DATA = Path(__file__).parent / "data" / "moordyn"
+DATA = MOORDYN_DATA
 RAO = {
     "omega": [0.0, 0.5, 1.0, 2.0],
     "surge": {"re": [1.0, 0.6, 0.2, 0.0], "im": [0.0, 0.0, 0.0, 0.0]},

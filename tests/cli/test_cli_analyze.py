@@ -8,9 +8,9 @@ import os
 import re
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
 from stochcable.cli import main
 
@@ -127,7 +127,6 @@ def test_analyze_missing_file(tmp_path, capsys):
     assert "cannot be read" in capsys.readouterr().err
 
 
-ROOT = Path(__file__).resolve().parents[1]
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
 

@@ -5,17 +5,15 @@ from __future__ import annotations
 import copy
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 
 from stochcable.errors import InputError
 from stochcable.examples import list_examples, load_example
 from stochcable.scene.model import Scene, load_scene, scene_json_schema
 from stochcable.scene.schema import DEFAULT_SCHEMA_PATH, scene_schema_text, write_scene_schema
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture()

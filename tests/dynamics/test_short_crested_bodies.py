@@ -1,7 +1,7 @@
 """Short-crested seas with bodies and vessels (``sea.spreading``, issue 20): each
 direction channel drives the bodies' wave excitation at its own heading and the
 vessel's fairleads with the vessel RAO (a table without headings: the same in every
-direction; tables over heading: tests/test_vessels.py), and the drag linearization
+direction; tables over heading: tests/dynamics/test_vessels.py), and the drag linearization
 stays one fixed point over all directions.
 
 Independent checks: a spreading that narrows to zero width is the long-crested

@@ -4,7 +4,6 @@ tensions equal stochcable's statics on every MoorDyn line of every test model.""
 from __future__ import annotations
 
 import warnings
-from pathlib import Path
 
 import pytest
 
@@ -14,15 +13,17 @@ from stochcable.statics import solve_statics
 
 pytest.importorskip("moordyn")
 
+from _paths import MOORDYN_DATA
+
 from stochcable.reference.moordyn_statics import moordyn_static_tensions  # noqa: E402
 
-DATA = Path(__file__).parent / "data" / "moordyn"
+DATA = MOORDYN_DATA
 
 # Files whose statics stochcable solves.  Not here: clump_weight_lifting.txt (a
 # neutrally buoyant, slack line holding the weight: the line statics of a weightless
 # slack line are undetermined at the first body pose) and tripod_network.txt (the body
 # statics of its floats and four-line junction do not converge from the file's
-# positions); both are read and written back in tests/test_io_moordyn.py.
+# positions); both are read and written back in tests/io/test_io_moordyn.py.
 MODELS = [
     "oc3_hywind_v1.txt",
     "oc3_hywind_v2.txt",

@@ -8,10 +8,10 @@ import dataclasses
 import json
 import math
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from _paths import ROOT
 from scipy import integrate
 
 from stochcable.analysis import analyze
@@ -24,7 +24,7 @@ from stochcable.errors import InputError, PhysicsWarning
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "stochcable" / "examples"
+EXAMPLES = ROOT / "stochcable" / "examples"
 # Zero-mean Gaussian: Var(Bv)/Var(c v|v|) = (8/pi) c² σ⁴ / (3 c² σ⁴) (Borgman 1972)
 BORGMAN_ZERO_MEAN = 8.0 / (3.0 * math.pi)
 

@@ -3,7 +3,7 @@ worker processes): the result document equals the core's analyze(scene).to_docum
 and the CLI's output, every published OpenAPI example answers 200, the limits answer
 413/422 naming the bound, solver failures answer 422 with the reason, and concurrent
 analyses keep their own warnings.  The run limit and worker failures:
-tests/test_service_workers.py and tests/service/."""
+tests/service/test_service_workers.py and tests/service/."""
 
 from __future__ import annotations
 

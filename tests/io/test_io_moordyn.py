@@ -5,15 +5,15 @@ from __future__ import annotations
 
 import math
 import warnings
-from pathlib import Path
 
 import pytest
+from _paths import MOORDYN_DATA
 
 from stochcable.errors import InputError, PhysicsWarning
 from stochcable.io import is_moordyn, load_scene, read_moordyn, write_moordyn
 from stochcable.io.moordyn_file import MoorDynInputError
 
-DATA = Path(__file__).parent / "data" / "moordyn"
+DATA = MOORDYN_DATA
 READABLE = [
     "oc3_hywind_v1.txt",
     "oc3_hywind_v2.txt",
