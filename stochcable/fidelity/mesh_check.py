@@ -198,7 +198,7 @@ def mesh_warnings(
             fix = f"use elements = {e.needed} (or omit the field: the default meets it)"
         out.append(
             f"{where}: the estimated discretization error of the end-tension σ is "
-            f"{100 * e.error:.2g} %, above {100 * limit:g} % (string-wave, "
+            f"{100 * e.error:.3g} %, above {100 * limit:g} % (string-wave, "
             f"touchdown and wave-load element rules of the fidelity planner); {fix}"
         )
     return out
