@@ -28,6 +28,7 @@ EXPECTED = {
     "tuah_1982_disc_buoy_single_leg",
     "tuah_1982_disc_buoy_three_legs",
     "tuah_1982_strumming_string",
+    "cable_laying",
 }
 
 
@@ -41,7 +42,7 @@ def test_list_and_load():
     with pytest.raises(
         InputError,
         match=r"example = 'nope': is not a known example; known: "
-        r"chain_catenary, inclined_guy",
+        r"cable_laying, chain_catenary, inclined_guy",
     ):
         load_example("nope")
 

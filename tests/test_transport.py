@@ -231,16 +231,25 @@ def test_cli_refuses_critical_speed_in_one_line(tmp_path, capsys, command):
     assert "\n" not in err
 
 
-def test_analyze_refuses_transport_below_critical():
-    """No silent response without the transport terms: the engine has none yet."""
-    from stochcable.analysis import analyze
+def test_engine_refuses_a_travelling_line_on_a_body():
+    """Lines on bodies are solved by the coupled solve, which has no transport terms:
+    refused in one message naming the body (free lines travel: test_transport_solve)."""
+    from stochcable.dynamics.engine import build_engine
+    from stochcable.examples import load_example
+
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
+    doc["lines"][0]["axial_speed"] = 0.1
+    with pytest.raises(InputError, match=r"lines\[0\].axial_speed.*body \('disc'\)"):
+        build_engine(doc)
+
+
+def test_harmonic_linearization_refused_for_a_travelling_line():
     from stochcable.dynamics.engine import build_engine
 
-    with pytest.raises(InputError, match="not in the engine yet"):
-        analyze(_taut_scene(1.0))
-    # the engine itself refuses, so load-case sets (which build it directly) do too
-    with pytest.raises(InputError, match=r"lines\[0\].axial_speed.*not in the engine yet"):
-        build_engine(_taut_scene(-1.0))
+    doc = _taut_scene(1.0)
+    doc["analysis"] = {"linearization": {"method": "harmonic"}}
+    with pytest.raises(InputError, match=r"line 'taut' travels.*use 'seed' or 'vector'"):
+        build_engine(doc)
 
 
 def test_flutter_reported_not_solved():
@@ -339,15 +348,6 @@ def test_statics_axial_drag_on_the_relative_axial_velocity():
         change = (line.tension[-1] - line.tension[0]) - span
         # the solver's tolerance on the tensions (~1e-9 of 8e4 N) against 440 N
         assert change == pytest.approx(np.sign(c) * coef * c * c * between, rel=1e-6)
-
-
-def test_time_domain_reference_refuses_transport():
-    """The TD reference has no transport terms: a travelling line is refused, not
-    simulated at rest."""
-    from stochcable.reference.cable import simulate_line_timedomain
-
-    with pytest.raises(InputError, match="axial_speed"):
-        simulate_line_timedomain(_taut_scene(1.0), "taut")
 
 
 def test_real_modes_of_a_travelling_line_warn():

@@ -52,7 +52,7 @@ from stochcable.dynamics.model.system import (
 from stochcable.dynamics.timeseries.synthesis import simulate_timeseries
 from stochcable.errors import InputError, collect_warnings
 from stochcable.line.strumming import StrummingTable
-from stochcable.line.transport import refuse_travelling_lines
+from stochcable.line.transport import check_travelling_lines
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, Sea, input_error_from_validation, load_scene
 from stochcable.statics import StaticsResult, solve_statics
@@ -225,7 +225,7 @@ def build_engine(
             # linearized about it, so it must be an equilibrium of the same FE model
             statics = solve_statics(scene, method="fe")
         timing["statics_s"] = time.perf_counter() - t0
-        refuse_travelling_lines(scene, statics)  # no transport in the response yet
+        check_travelling_lines(scene, statics)  # below c_crit, not on a body
         for line in scene.lines:
             progress("model", {"line": line.name})
             t0 = time.perf_counter()

@@ -67,6 +67,16 @@ Each ``<name>.json`` is a scene document (DESIGN.md "Scene and result documents"
   St 0.18 (the seed's ω_s = 15.73 rad/s back-computed: 2π·0.18·0.695/0.05 = 15.72),
   C_a 1, C_d 1.2, the string 0.5 m deep in 1 m of water.  No sea: the example is the
   strumming screening (docs/strumming.md).
+- ``cable_laying``: a cable being laid (docs/travelling.md, "A laying example"):
+  a 100 mm power cable, 20 kg/m (submerged weight 117.2 N/m), EA 5e8 N, C_d 1.2,
+  C_t 0.02, C_a 1, 155 m paid out at 1 m/s (``axial_speed`` −1: from the vessel's
+  chute, end_b at (110, 0, −5) m, to its touchdown, end_a on the seabed 100 m down,
+  held there as a fixed point: the cable already laid is not modelled), 30 elements.
+  JONSWAP sea Hs 2 m, Tp 8 s, γ 3.3, heading 0; the chute follows the vessel with an
+  assumed surge and heave RAO (in phase with the waves, 1 at long waves, falling to 0
+  at 3 rad/s); a 0.5 m/s current across the laying plane (heading 90°), hence the
+  vector form of the drag linearization.  Critical speed
+  √(T/m) = 20.2 m/s.
 """
 
 from __future__ import annotations
@@ -121,6 +131,13 @@ DOCUMENTED_WARNINGS: dict[str, dict[str, str]] = {
     "tuah_1982_strumming_string": {
         "has no excitation": "a strumming example (seed 001 §6.6 Example 6): no sea, no "
         "end motion; its result is the strumming table of the line in the current",
+    },
+    "cable_laying": {
+        "travels: these are its modes at rest": "the result lists the natural modes of "
+        "the line at rest; a travelling line's complex modes and stability are those "
+        "of 'stochcable modes' (docs/travelling.md)",
+        "strumming lock-in predicted": "the cross-current locks in a high mode of the "
+        "cable (A/D ≈ 0.01, drag x1.07): the screening's finding, negligible here",
     },
     "tuah_1982_disc_buoy_three_legs": {
         "error of the end-tension σ": "the seed's 3 elements are kept: the element rules "

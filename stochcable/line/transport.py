@@ -47,7 +47,7 @@ __all__ = [
     "check_axial_speed",
     "transport_matrices",
     "check_line_speeds",
-    "refuse_travelling_lines",
+    "check_travelling_lines",
 ]
 
 #: The 2×2 node pattern of the consistent skew-symmetric gyroscopic element.
@@ -250,8 +250,8 @@ def check_line_speeds(lines: Any, models: dict[str, FEModel]) -> dict[str, float
     return out
 
 
-def refuse_travelling_lines(scene: Any, statics: Any) -> None:
-    """Refuse the response of a scene with a travelling line (no transport in it yet).
+def check_travelling_lines(scene: Any, statics: Any) -> None:
+    """Check the travelling lines of a scene before its response is solved.
 
     Parameters
     ----------
@@ -263,23 +263,35 @@ def refuse_travelling_lines(scene: Any, statics: Any) -> None:
     Raises
     ------
     InputError
-        ``lines[i].axial_speed``: at or above the critical speed (named), or, below it,
-        because the response engine has no transport terms yet (docs/travelling.md).
+        ``lines[i].axial_speed``: at or above the critical speed (named), or on a line
+        with an end attached to a body; ``analysis.linearization.method`` "harmonic"
+        (no mean-flow term) with a travelling line (the coupled solve of lines and bodies has no
+        transport terms; docs/travelling.md).
     """
     from stochcable.line.fem import build_fe_model
 
-    moving = [(i, ln) for i, ln in enumerate(scene.lines) if ln.axial_speed != 0.0]
-    if not moving:
-        return
-    for i, line in moving:
+    for i, line in enumerate(scene.lines):
+        if line.axial_speed == 0.0:
+            continue
         model = build_fe_model(statics.lines[line.name], scene.environment, dim=3)
         check_axial_speed(model, line.axial_speed, f"lines[{i}].axial_speed")
-    i, line = moving[0]
-    raise InputError(
-        f"lines[{i}].axial_speed",
-        line.axial_speed,
-        "m/s",
-        "the stochastic response of a travelling line is not in the engine yet (its "
-        "complex modes and stability are: 'stochcable modes', docs/travelling.md); "
-        "set 0 for the line at rest",
-    )
+        if scene.analysis.linearization.method == "harmonic":
+            raise InputError(
+                "analysis.linearization.method",
+                "harmonic",
+                "-",
+                f"line '{line.name}' travels (lines[{i}].axial_speed = {line.axial_speed:g} "
+                "m/s): its drag acts on the mean relative flow U − c e, which the harmonic "
+                "(regular-wave) form has no term for; use 'seed' or 'vector'",
+            )
+        bodies = [e.attach.body for e in (line.end_a, line.end_b) if e.attach is not None]
+        if bodies:
+            raise InputError(
+                f"lines[{i}].axial_speed",
+                line.axial_speed,
+                "m/s",
+                f"a line attached to a body ('{bodies[0]}') cannot travel: the coupled "
+                "solve of lines and bodies has no transport terms (docs/travelling.md); "
+                "give its end a position and a prescribed motion (e.g. the vessel's "
+                "RAO), or set 0 for the line at rest",
+            )

@@ -370,8 +370,6 @@ def simulate_line_timedomain(
     """
     scene = load_scene(scene)
     line = _select_line(scene, line_name)
-    if line.axial_speed != 0.0:  # no transport terms here yet (docs/travelling.md)
-        raise InputError("axial_speed", line.axial_speed, "m/s", "must be 0 (no transport in TD)")
     ts = scene.analysis.timeseries
     tolerance = _v.positive("tolerance", tolerance, "-")
     max_iterations = _v.positive_int("max_iterations", max_iterations)

@@ -32,8 +32,10 @@ Model (the same finite-element discretization as the frequency-domain model):
     :func:`stochcable.dynamics.loads.element_kinematics.element_wave_kinematics` (split at the
     waterline), synthesized in time with the realization's coefficients like any transfer
     function; attachments get (buoyancy/g + added mass)·a at their node.
-  * Morison drag with the relative velocity v_r = U_current + v_wave − u̇ (Tuah
-    (1982), eqs. 3.2.a.2–3.2.a.5), normal ½ρ Cdn D |v_rn| v_rn and axial ½ρ Cdt πD |v_rt| v_rt with
+  * Morison drag with the relative velocity v_r = U_current + v_wave − u̇ − c e (c e:
+    the transport of a travelling line, :mod:`~stochcable.reference.cable_transport`;
+    Tuah (1982), eqs. 3.2.a.2–3.2.a.5), normal ½ρ Cdn D |v_rn| v_rn and axial
+    ½ρ Cdt πD |v_rt| v_rt with
     the *instantaneous* element tangent e — **quadrature**: v_r is formed at
     :data:`GAUSS_POINTS` Gauss–Legendre points ξ_g per element (fluid velocity of
     :func:`stochcable.sea.kinematics.wave_kinematics` and the current profile at the
@@ -69,6 +71,7 @@ from scipy import sparse
 
 from stochcable.errors import ConvergenceError
 from stochcable.line.mesh import LineMesh
+from stochcable.reference.cable_transport import transport_terms
 from stochcable.scene.model import Environment, Line, Scene
 from stochcable.statics import solve_statics
 
@@ -218,6 +221,9 @@ class LineModel:
         self.drag_tangent = "instantaneous"
         self.linear_drag: tuple[np.ndarray, np.ndarray] | None = None
         self.bed_linear: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+        # a travelling line (reference.cable_transport): the material velocity u̇ + c e
+        self.speed = float(getattr(mesh, "axial_speed", 0.0))
+        self.transport = transport_terms(self, self.speed) if self.speed else None
 
     def set_variant(
         self,
@@ -354,7 +360,7 @@ class LineModel:
             F, c_el = self._linear_drag(V, e, u_gauss, jacobian)
         elif np.any(self.cn) or np.any(self.ct):
             # relative velocity at the quadrature points: (ne, ng, d)
-            w = u_gauss - self.gauss_points(V)
+            w = u_gauss - self.gauss_points(V) - self.speed * e[:, None, :]
             s = np.einsum("egd,ed->eg", w, e)  # axial component
             wn = w - s[:, :, None] * e[:, None, :]
             mag = np.sqrt(np.einsum("egd,egd->eg", wn, wn) + DRAG_EPS**2)
@@ -398,7 +404,7 @@ class LineModel:
         nodal forces (n, d) and the constant element blocks l0 B ⊗ [[1/3, 1/6], ...]."""
         d = self.dim
         b_n, b_t = self.linear_drag
-        w = u_gauss - self.gauss_points(V)
+        w = u_gauss - self.gauss_points(V) - self.speed * e[:, None, :]
         s = np.einsum("egd,ed->eg", w, e)
         wn = w - s[:, :, None] * e[:, None, :]
         f = b_n[:, None, None] * wn + (b_t[:, None] * s)[:, :, None] * e[:, None, :]

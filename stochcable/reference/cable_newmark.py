@@ -17,6 +17,7 @@ from scipy import linalg as sla
 
 from stochcable.errors import ConvergenceError
 from stochcable.reference.cable_model import LineModel
+from stochcable.reference.cable_transport import check_transport_speed
 
 __all__ = ["newmark_period_error", "newmark_step_for", "integrate"]
 
@@ -127,8 +128,12 @@ def integrate(
     ten_a[0] = np.linalg.norm(R0[:d] + carry_a)
     ten_b[0] = np.linalg.norm(R0[N - d :] + carry_b)
     ten_el[0] = T
-    M_band_f = model.M_band[:, fr]
     c1, c2 = 4.0 / h**2, 2.0 / h
+    M_band_f = model.M_band[:, fr]
+    if model.transport is not None:  # G u̇ + K_c (x − x_s) (reference.cable_transport):
+        # its constant Jacobian c2·G + K_c rides in the mass band, c1·(M + J/c1) = c1 M + J
+        check_transport_speed(model.transport, T, model.mesh.name)
+        M_band_f = M_band_f + model.transport.jacobian_band(c2, fr) / c1
     maxres = 0.0
     xs_flat = xs.reshape(-1)
     # initial acceleration: static start with zero excitation at t = 0 -> A = 0, except a
@@ -229,6 +234,8 @@ class _Step:
         ).reshape(-1)
         if self.fi is not None:
             R -= self.fi
+        if model.transport is not None:
+            R += model.transport.force(Xn, Vn, model.x_static.reshape(-1))
         rn = float(np.abs(R[fr]).max()) if model.N - 2 * d else 0.0
         return rn, R, T, (e, l, ea, c_el, c_nd, kb, cb)
 

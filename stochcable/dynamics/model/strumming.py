@@ -14,6 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from stochcable.dynamics.loads.channels import current_at_elements
 from stochcable.dynamics.model.system import LineSystem
 from stochcable.errors import ResolutionWarning, warn
 from stochcable.line.modes import natural_modes
@@ -62,7 +63,12 @@ def strumming_inputs(
         vals = [default if s is None else getattr(s, attr) for s in settings]
         return np.array([math.nan if v == "reynolds" else v for v in vals], dtype=float)[pick]
 
-    u_max = float(np.max(np.linalg.norm(system.current_el, axis=1)))
+    # the current itself (a travelling line's current_el is the relative flow U − c e,
+    # whose axial part sheds no vortices)
+    current = system.current_el
+    if system.gyro is not None:
+        current = current_at_elements(system.environment, model.positions)
+    u_max = float(np.max(np.linalg.norm(current, axis=1)))
     w_top = 2.0 * math.pi * u_max / (3.0 * float(np.min(mesh.diameter)))
     modes = system.modes
     n_free = int(model.free.size)
@@ -85,7 +91,7 @@ def strumming_inputs(
         shapes = np.concatenate([shapes, s_out], axis=2)[:, :, order]
     inp = StrummingInput(
         positions=model.positions,
-        current=system.current_el,
+        current=current,
         diameter=mesh.diameter,
         cd_normal=mesh.cd_normal,
         mass=mesh.mass,

@@ -31,6 +31,7 @@ from stochcable.dynamics.loads.channels import (
     inertia_matrix,
 )
 from stochcable.dynamics.model.modal_solvers import auto_mode_count
+from stochcable.dynamics.model.transport import travelling_system
 from stochcable.line.fem import FEModel, build_fe_model
 from stochcable.line.modes import Modes, natural_modes
 from stochcable.line.statics import LineStatics
@@ -101,6 +102,10 @@ class LineSystem:
         Rayleigh coefficients (alpha [1/s], beta [s]) of C_s = alpha·M_T + beta·K,
         M_T = structural + added mass, K the full tangent stiffness (seabed springs
         included); added to the drag and the seabed damping.
+    gyro : ndarray, shape (n_el,), or None
+        A travelling line's gyroscopic coefficient m c per element (its K holds K_c and
+        ``current_el`` the relative flow U − c e; :mod:`stochcable.dynamics.model.
+        transport`); None at rest. [N·s/m]
 
     Notes
     -----
@@ -121,6 +126,7 @@ class LineSystem:
     drag_nodes: np.ndarray
     environment: Environment
     structural_damping: tuple[float, float] = (0.0, 0.0)
+    gyro: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_cache", {})
@@ -296,15 +302,19 @@ def build_line_system(
     modes, n_modes = _choose_modes(model, settings)
     frames = element_frames(model.positions)
     mesh = model.mesh
+    current_el, gyro, solver = current_at_elements(env, model.positions), None, settings.solver
+    if line.axial_speed != 0.0:  # transport terms, the direct solve (docs/travelling.md)
+        model, current_el, gyro = travelling_system(model, line.axial_speed, frames[0], current_el)
+        solver = "direct"
     return LineSystem(
         line=line,
         statics=line_statics,
         model=model,
         modes=modes,
         n_modes=n_modes,
-        solver=settings.solver,
+        solver=solver,
         frames=frames,
-        current_el=current_at_elements(env, model.positions),
+        current_el=current_el,
         current_node=current_at_nodes(env, model.positions),
         drag_nodes=np.flatnonzero(mesh.node_drag_area > 0),
         environment=env,
@@ -312,4 +322,5 @@ def build_line_system(
             float(settings.structural_damping.alpha),
             float(settings.structural_damping.beta),
         ),
+        gyro=gyro,
     )

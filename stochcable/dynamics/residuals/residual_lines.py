@@ -26,6 +26,7 @@ from stochcable.dynamics.model.blocks import (
     trapezoid_weights,
 )
 from stochcable.dynamics.model.solvers import solve_band_stacked
+from stochcable.dynamics.model.transport import gyro_band
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
 from stochcable.results.records import ResidualRecord
@@ -158,7 +159,9 @@ def end_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
     By the adjoint: with the ends held, T = ê·F_end − ê·Z_end,f u_f and u_f = A⁻¹F_f,
     A = Z_ff = K − ω²M + iωC the free–free impedance; A is symmetric (not Hermitian),
     so T = ê·F_end − (A⁻¹g)ᵀF_f, g = Z_f,end ê: two solves per frequency (one
-    factorization) whatever the number of load cases."""
+    factorization) whatever the number of load cases.  A travelling line's A has the
+    skew G (:mod:`stochcable.dynamics.model.transport`): then Aᵀ (C − G) is solved, with
+    g = Z_end,fᵀ ê."""
     model = system.model
     prep = line_prep(system)
     d = model.dim
@@ -166,6 +169,8 @@ def end_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
     cd = drag_blocks(system, damping)
     c = add_blocks(prep.S, cd)
     b_c = prep.bS + free_band(cd)
+    if system.gyro is not None:  # a travelling line: Aᵀ has C − G (dynamics.model.transport)
+        b_c = b_c - gyro_band(system.gyro, d)
     # ê of each end: the end tension of a unit support force along each component
     eye = np.eye(2 * d)[None].astype(complex)
     ten = end_tension_from_support(system, eye)
@@ -188,6 +193,9 @@ def end_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
             rhs[:, rows, k] = (
                 g[0][None] - (ws * ws)[:, None] * g[1][None] + (1j * ws)[:, None] * g[2][None]
             )
+            if system.gyro is not None:  # Z_end,fᵀ ê: G[0, 1]ᵀ = g_0 I, G[n−1, n−2]ᵀ = −g I
+                gy = system.gyro[-1 if tr else 0] * (-1.0 if tr else 1.0)
+                rhs[:, rows, k] += (1j * ws)[:, None] * gy * vec[None]
         x = solve_band_stacked(
             prep.bK, prep.bM, b_c, rhs, ws, 2 * d - 1, 2 * d - 1, (model.K, model.M)
         )  # (n_w, n_f·d, 2)

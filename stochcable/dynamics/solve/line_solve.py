@@ -53,6 +53,7 @@ from stochcable.dynamics.model.system import (
     LineSystem,
     Response,
 )
+from stochcable.dynamics.model.transport import gyro_band, gyro_end_load, gyro_end_rows
 from stochcable.dynamics.solve.line_loads import (
     LineInputs,
     drag_blocks,
@@ -95,8 +96,15 @@ def solve_free(
     slices = frequency_slices(n_w, 8 * 16 * prep.n * d * max(n_ch, 1))
     if system.solver == "direct":
         bC = prep.bS + free_band(cd)
+        if system.gyro is not None:  # a travelling line: + G (dynamics.model.transport)
+            bC = bC + gyro_band(system.gyro, d)
         for sl in slices:
-            rhs_f = to_freq(free_load(system, prep, inp, damping, sl)[1:-1])
+            rhs_all = free_load(system, prep, inp, damping, sl)
+            if system.gyro is not None and inp.ub is not None:
+                ga, gb = gyro_end_load(system.gyro, inp.ub[:, :, sl], w[sl])
+                rhs_all[1] += ga
+                rhs_all[-2] += gb
+            rhs_f = to_freq(rhs_all[1:-1])
             u = solve_band_stacked(
                 prep.bK,
                 prep.bM,
@@ -259,8 +267,11 @@ def reactions(
     ww = (w * w)[:, None]
     iw = (1j * w)[:, None]
     out = []
+    rg = None if system.gyro is None else gyro_end_rows(system.gyro, (u[1], u[-2]), w)
     for k, (rk, rm, rc) in enumerate(zip(rows(prep.K), rows(prep.MT), rows(c))):
         r = rk - ww * rm + iw * rc - f_all[0 if k == 0 else -1]
+        if rg is not None:  # a travelling line's iω(G U) rows (dynamics.model.transport)
+            r = r + rg[k]
         out.append(np.moveaxis(r, 1, 0))  # (n_w, d, n_ch)
     return -np.concatenate(out, axis=1)
 
