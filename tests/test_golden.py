@@ -66,8 +66,9 @@ _ADDED_SINCE = {"second_order"}
 
 
 #: Warnings the library gives since the pre-unification record (a phrase of each): the
-#: trapezoid rule's error on a resonant peak (stochcable.dynamics.outputs.resolution).
-_WARNINGS_ADDED_SINCE = ("the trapezoid rule is off by",)
+#: trapezoid rule's error on a resonant peak (stochcable.dynamics.outputs.resolution),
+#: the element rules' estimate above 1 % (stochcable.fidelity.mesh_check).
+_WARNINGS_ADDED_SINCE = ("the trapezoid rule is off by", "error of the end-tension σ")
 
 
 def _numbers_close(a: Any, b: Any, rtol: float, path: str) -> None:

@@ -64,12 +64,14 @@ def test_the_first_analysis_imports_what_the_scene_uses():
     # the chain (current: strumming screening; no fidelity target, no bodies' fits):
     # its candidate modes are proven without a lock-in start by the NumPy bound and its
     # grids are below the compiled kernels' threshold, so numba is not loaded, nor the
-    # fidelity planner or scipy.optimize, and its 2,400-sample record is transformed by
+    # fidelity planner (its element check, fidelity.mesh_check, is) or scipy.optimize,
+    # and its 2,400-sample record is transformed by
     # numpy.fft, not pyfftw (docs/benchmarks/first_analysis.md)
     code = (
         "import sys, warnings; warnings.simplefilter('ignore'); import stochcable; "
         "stochcable.analyze('stochcable/examples/chain_catenary.json'); "
-        "print(sorted(m for m in ('numba', 'pyfftw', 'stochcable.fidelity', 'scipy.optimize') "
+        "print(sorted(m for m in ('numba', 'pyfftw', 'stochcable.fidelity.planner', "
+        "'scipy.optimize') "
         "if m in sys.modules))"
     )
     root = __import__("pathlib").Path(__file__).resolve().parents[1]

@@ -152,7 +152,17 @@ class Segment(_Doc):
         "N/m",
         default=None,
     )
-    elements: int = _f("Number of finite elements", "-", ge=1, le=100_000, default=20)
+    elements: int = _f(
+        "Number of finite elements.  Left out: the analysis runs once at 20 and again "
+        "at the count whose estimated discretization error of the end-tension σ is at "
+        "most 1 % (the fidelity planner's string-wave and touchdown element rules, "
+        "stochcable.fidelity.mesh_check), when 20 does not meet it; an explicit count "
+        "above that estimate gives a ResolutionWarning naming the count that does",
+        "-",
+        ge=1,
+        le=100_000,
+        default=20,
+    )
     strumming: SegmentStrumming | None = Field(
         default=None,
         description="Strumming settings (default: St 0.2, C_L0 0.2, no suppression)",
