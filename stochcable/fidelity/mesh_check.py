@@ -19,7 +19,7 @@ put the relative error (kh)²/24 on the frequency of a transverse string wave (T
 and a segment wholly in the wave zone (every node above the depth where e^{kz} < the
 limit, k the sea's wavenumber at its ω₂) (kh)²/12 (nodal wave kinematics interpolated
 linearly); a segment partly in it is left to ``analysis.fidelity``, which splits it.
-Checked by mesh convergence against 160 elements (tests/test_fidelity_mesh_check.py):
+Checked by mesh convergence against 160 elements (tests/fidelity/test_mesh_check.py):
 a bound at 20 elements, 1.9× the measured error on the chain example (1.84 % vs
 0.97 %) and on the accuracy page's deep catenary (11.8 % vs 6.1 %), 7× on the taut
 wire (wave-load rule, 1.41 % vs 0.20 %); more conservative on finer meshes (deep

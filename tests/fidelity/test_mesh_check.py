@@ -8,14 +8,14 @@ import math
 import re
 import sys
 import warnings
-from pathlib import Path
 
 import pytest
+from _paths import ROOT
 
 from stochcable import analyze, load_example
 from stochcable.fidelity.mesh_check import MESH_ERROR_LIMIT, mesh_estimates
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 import accuracy_lines  # noqa: E402
 
 _PHRASE = "error of the end-tension σ"
