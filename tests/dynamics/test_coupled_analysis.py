@@ -527,6 +527,7 @@ def _attached_scene(scene, attach, bodies):
                 attachments=ln.attachments,
                 elements=ln.elements,
                 length=ln.length,
+                axial_speed=ln.axial_speed,
                 **ends,
             )
         )
