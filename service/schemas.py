@@ -212,7 +212,7 @@ Point = Annotated[
 
 
 class RealizationRequest(TimeSeriesSettings):
-    """A random sea realization (seed 001 §5.1) and, optionally, its wave kinematics.
+    """A random sea realization (Tuah 1982, §5.1) and, optionally, its wave kinematics.
 
     ``method``, ``duration``, ``dt`` and ``seed`` are those of the scene's
     ``analysis.timeseries``.  The number of samples is duration/dt.
@@ -291,7 +291,7 @@ class ExampleSummary(_Response):
 
 class TensionStatistics(_Open):
     """Statistics of an end's effective tension: static mean plus Gaussian dynamic part
-    (seed 001 §5.3; stochcable.results.documents.ResponseStats)."""
+    (Tuah 1982, §5.3; stochcable.results.documents.ResponseStats)."""
 
     mean: float = _f("Static (mean) effective tension", "N")
     std: float = _f("Standard deviation σ = √m0 of the dynamic tension", "N")
@@ -336,7 +336,7 @@ class MotionAlongLine(_Open):
 
 
 class LineLinearization(_Open):
-    """Drag-linearization fixed point of one line (seed 001 §5.3 steps 5–13)."""
+    """Drag-linearization fixed point of one line (Tuah 1982, §5.3 steps 5–13)."""
 
     converged: bool = Field(description="Whether every σ changed less than the tolerance")
     iterations: int = _f("Number of response evaluations", "-")

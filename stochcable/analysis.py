@@ -1,4 +1,4 @@
-"""The analysis pipeline (seed 001 ch. 5, Tuah 1982): scene -> statics -> FE model ->
+"""The analysis pipeline (Tuah 1982, ch. 5): scene -> statics -> FE model ->
 excitation -> drag linearization -> solve -> results.
 
 :func:`analyze` runs the whole pipeline through the engine seam
@@ -65,7 +65,7 @@ def analyze(
     statics: StaticsResult | None = None,
     progress: Progress | None = None,
 ) -> Result:
-    """Stochastic response of every line of a scene (seed 001 ch. 5).
+    """Stochastic response of every line of a scene (Tuah 1982, ch. 5).
 
     Parameters
     ----------

@@ -131,7 +131,7 @@ _MODES_LIN = {
     ),
     "linearization.lines.<line>.method": (
         "",
-        'Iteration used (``"seed"``: the fixed point of seed 001 §5.2, or an accelerated variant).',
+        'Iteration used (``"seed"``: the fixed point of Tuah (1982), §5.2, or an accelerated variant).',
     ),
     "linearization.lines.<line>.converged": (
         "",
@@ -357,7 +357,7 @@ _LINES = {
     ),
     "lines.<line>.indicators.second_order.lambda2": (
         "-",
-        "Irvine's λ*² of the static shape (seed 000 eq. 4.3); the sag relieves T₂ by "
+        "Irvine's λ*² of the static shape (Bliet 1984, eq. 4.3); the sag relieves T₂ by "
         "1/(1 + λ*²/12) (null: no positive tension).",
     ),
     "lines.<line>.indicators.second_order.std_factor": (

@@ -76,7 +76,7 @@ async def run_analysis(
         ),
     ] = "window",
 ) -> Response:
-    """The v1 result document of :func:`stochcable.analysis.analyze` (seed 001 ch. 5):
+    """The v1 result document of :func:`stochcable.analysis.analyze` (Tuah 1982, ch. 5):
     identical to ``stochcable analyze SCENE.json`` and ``analyze(scene).to_document()``
     apart from the ``timing`` values.
 

@@ -37,7 +37,7 @@ _LAYOUT = (
 async def simulate_sea_realization(
     body: RealizationRequest, settings: SettingsDep, runner: RunnerDep, media: MediaTypeDep
 ) -> Response:
-    """η(t) by :func:`stochcable.sea.realization.simulate_sea` (seed 001 §5.1; duration/dt must be an
+    """η(t) by :func:`stochcable.sea.realization.simulate_sea` (Tuah 1982, §5.1; duration/dt must be an
     even number of samples) and, at ``points``, the velocity and acceleration by
     :func:`stochcable.sea.kinematics.kinematics_timeseries` from the same amplitudes.
     Use ``Accept: application/x-npy`` for long records."""  # noqa: E501 - the OpenAPI description, kept verbatim

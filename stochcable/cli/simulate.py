@@ -1,4 +1,4 @@
-"""``stochcable simulate``: a random sea elevation record by DSA or NSA (seed 001 §5.1)."""
+"""``stochcable simulate``: a random sea elevation record by DSA or NSA (Tuah 1982, §5.1)."""
 
 from __future__ import annotations
 

@@ -157,7 +157,7 @@ def complex_modes(
     Notes
     -----
     The first-order form of the module docstring generalizes the Foss decomposition
-    (seed 001 §3.3; Foss 1958) to a non-symmetric A: with G the right and left
+    (Tuah 1982, §3.3; Foss 1958) to a non-symmetric A: with G the right and left
     eigenvectors differ.  For D = G (no damping) and K + K_c positive definite the
     eigenvalues are imaginary (Thomson–Tait–Chetaev), and ψ = φ̄ for λ = iω.
     """

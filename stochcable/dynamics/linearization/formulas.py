@@ -85,7 +85,7 @@ def drag_linear_seed(
 
     Notes
     -----
-    Seed 001 eq. (5.2.2.a): ``B = sqrt(8/pi) * 1/2 rho Cd D sigma
+    Tuah (1982), eq. (5.2.2.a): ``B = sqrt(8/pi) * 1/2 rho Cd D sigma
     = sqrt(2/pi) rho Cd D sigma``.  Eq. (5.2.2.b) is the same formula with
     ``D -> pi D``: ``sqrt(2 pi) Ct rho D sigma = sqrt(2/pi) rho Ct (pi D) sigma``.
     This is ``E[d f/d v]`` for ``f = 1/2 rho Cd D |v| v`` and ``v ~ N(0, sigma^2)``

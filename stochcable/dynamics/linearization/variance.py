@@ -206,7 +206,7 @@ def relative_velocity_sigmas(
 
     Notes
     -----
-    Seed 001 eqs. 5.2.3–5.2.5 with an element mean in place of the seed's nodal value:
+    Tuah (1982), eqs. 5.2.3–5.2.5 with an element mean in place of Tuah's nodal value:
     σ² = Σ_i ∫ S_i(ω) ∫₀¹ |r·H_{v,i}(ξ, ω)|² dξ dω (trapezoid on the grid), H_v the
     transfer function of the relative velocity v(ξ) − iωU(ξ) along the element, r
     the element's e (axial) or normals n1, n2; the scalar form uses

@@ -214,7 +214,7 @@ def foss_decomposition(Mhat: np.ndarray, Chat: np.ndarray, Khat: np.ndarray) -> 
 
     Notes
     -----
-    Seed 001 eqs. (5.3.4)-(5.3.20), as fixed in DESIGN.md: ``q = [z'; z]``,
+    Tuah (1982), eqs. (5.3.4)-(5.3.20), as fixed in DESIGN.md: ``q = [z'; z]``,
     ``A = [[0, M], [M, C]]``, ``B = [[-M, 0], [0, K]]``, ``A q' + B q = [0; F]``.
     Eigenpairs of ``lambda A theta + B theta = 0``, computed as the standard
     eigenproblem of ``A^{-1}(-B) = [[-M^{-1} C, -M^{-1} K], [I, 0]]`` (``Mhat`` is
@@ -435,7 +435,7 @@ def solve_modal(
 
     Notes
     -----
-    Seed 001 §5.3: ``U = Phi z`` (eq. 5.3.1), ``Mhat = Phi^T M Phi``, ``Chat =
+    Tuah (1982), §5.3: ``U = Phi z`` (eq. 5.3.1), ``Mhat = Phi^T M Phi``, ``Chat =
     Phi^T C Phi`` (full), ``Khat = Phi^T K Phi`` (eq. 5.3.3).  With all modes kept
     this equals :func:`solve_direct` to round-off.  The static correction is the
     residual-flexibility (mode-acceleration) correction; it neglects the damping

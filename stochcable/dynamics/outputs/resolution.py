@@ -245,7 +245,7 @@ def surface_resolution_check(
         f"line '{system.name}': the wave-velocity σ varies by a factor {r:.3g} along "
         f"element {j + 1} (z from {za:.4g} to {zb:.4g} {units.length}; threshold "
         f"{SURFACE_SIGMA_RATIO:g}){others}, but the drag linearization takes one drag "
-        "coefficient per element (seed 001 eq. 5.2.2): the element is long against the "
+        "coefficient per element (Tuah 1982, eq. 5.2.2): the element is long against the "
         "decay depth of the wave kinematics and the response there carries an error of "
         f"several %; use {need}, or elements spanning at most {dz * shrink:.3g} "
         f"{units.length} of depth near the surface",

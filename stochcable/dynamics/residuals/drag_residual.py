@@ -1,6 +1,6 @@
 """The end-tension variance the statistical drag linearization drops, in closed form.
 
-The statistical linearization (seed 001 eqs. 5.2.2–5.2.5; Borgman 1972) replaces the
+The statistical linearization (Tuah 1982, eqs. 5.2.2–5.2.5; Borgman 1972) replaces the
 Morison drag c|v|v of a Gaussian relative velocity v ~ N(U, σ²) by its best linear
 fit a₀ + B·(v − U).  The rest, the drag residual r, is a known function of the
 linear response: with x = (v − U)/σ and the Hermite expansion of

@@ -3,7 +3,7 @@ a line: elements split where the wave kinematics vary along them, grouped into p
 
 The drag is a pointwise load, c|v(ξ)|v(ξ) along each element, while the linear model
 takes one drag coefficient B per element (from the element mean of the pointwise
-variance, seed 001 eq. 5.2.2) and the residual a Hermite expansion of one velocity per
+variance, Tuah 1982, eq. 5.2.2) and the residual a Hermite expansion of one velocity per
 panel.  Where the kinematics decay or turn along an element (an element near the
 surface: e^{kz} over its depth span, e^{−ikχ} over its horizontal span) both lump what
 the time domain resolves: the panel mean velocity and a residual load split evenly

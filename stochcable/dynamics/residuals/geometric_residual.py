@@ -7,7 +7,7 @@ l)/L₀ (L₀ the unstretched length).  To second order in Δu = a·t + b (a = t
 
     T·ℓ̂ = T₀t + [(EA/L₀)·a·t + (T₀/l)·b] + κ·[½|b|²·t + a·b],   κ = (EA/L₀ − T₀/l)/l,
 
-the bracket being the model's linear (elastic and geometric) stiffness (seed 001 §3.1)
+the bracket being the model's linear (elastic and geometric) stiffness (Tuah 1982, §3.1)
 and the last term the quadratic force it drops: Green–Lagrange stretching ½|b|²/l under
 the axial stiffness and the rotation of the axial force by the transverse motion.  With
 the linear response Gaussian, every component of κ[½|b|²·t + a·b] is a Gaussian

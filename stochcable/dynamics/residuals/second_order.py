@@ -9,7 +9,7 @@ that lengthening as a uniform tension increment, reduced by the sag's flexibilit
     T₂ = κ · ½ Σ_e |Δu⊥_e|² / l_e,    κ = 1 / (Σ_e l_e/EA_e · (1 + λ*²/12))
 
 (Irvine 1981, *Cable Structures*, §2.4 and §3.3: the chord stiffness of a shallow
-elastic cable; λ*² = (w₀L/H*)²·(EA/H*)·cos²φ_a for an inclined cable, seed 000 eq. 4.3).
+elastic cable; λ*² = (w₀L/H*)²·(EA/H*)·cos²φ_a for an inclined cable, Bliet 1984, eq. 4.3).
 For a taut, near-straight line λ*² ≪ 1 and T₂ is the full stretching term; for a
 catenary (λ*² ≫ 1, a grounded length) the sag absorbs the lengthening and T₂ vanishes.
 
@@ -90,7 +90,7 @@ def _finite(x: float) -> float | None:
 def irvine_lambda2(
     positions: np.ndarray, l0: np.ndarray, ea: np.ndarray, weight: np.ndarray, tension: np.ndarray
 ) -> float:
-    """Irvine's λ*² of a line's static shape (seed 000 eq. 4.3). [-]
+    """Irvine's λ*² of a line's static shape (Bliet 1984, eq. 4.3). [-]
 
     Parameters
     ----------
