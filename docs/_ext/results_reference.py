@@ -131,7 +131,7 @@ _MODES_LIN = {
     ),
     "linearization.lines.<line>.method": (
         "",
-        'Iteration used (``"seed"``: the fixed point of Tuah (1982), §5.2, or an accelerated variant).',
+        'Iteration used (``"seed"``: Tuah (1982), §5.2, or an accelerated variant).',
     ),
     "linearization.lines.<line>.converged": (
         "",
