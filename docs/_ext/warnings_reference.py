@@ -330,7 +330,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "The real modes K φ = ω² M φ leave out the transport terms (the gyroscopic "
         "matrix and the centripetal stiffness): they are the line's modes at rest.",
         "Use ``stochcable modes`` (which lists the complex modes of a travelling line) "
-        "or ``stochcable.line.transport_modes.complex_modes``. See :doc:`../travelling`.",
+        "or ``stochcable.line.transport.modes.complex_modes``. See :doc:`../travelling`.",
     ),
     WarningEntry(
         "Strumming lock-in (or resonance) predicted",
