@@ -1,5 +1,5 @@
 """Strumming in the frequency domain (docs/strumming.md): the wake-oscillator harmonic
-balance against time integration, seed 001 §6.6 Example 6 (Ramberg et al. 1980) and
+balance against time integration, Tuah 1982, §6.6 Example 6 (Ramberg et al. 1980) and
 the hook-up (scene settings, drag amplification, warning, result document)."""
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ pytestmark = pytest.mark.xdist_group("test_strumming")
 
 FT = 0.3048
 EXAMPLE = "tuah_1982_strumming_string"
-#: seed 001 §6.6: Strouhal frequency, fundamental, maximum transverse displacement
+#: Tuah 1982, §6.6: Strouhal frequency, fundamental, maximum transverse displacement
 SEED_OMEGA_S = 15.73  # [rad/s]
 SEED_OMEGA_1 = 14.6  # [rad/s]
 SEED_AMPLITUDE = 0.016 * FT  # [m] (seed and the experiment of Ramberg et al. 1980)
@@ -52,7 +52,7 @@ SEED_AMPLITUDE = 0.016 * FT  # [m] (seed and the experiment of Ramberg et al. 19
 
 
 def test_shedding_band_damping_and_drag_closed_forms():
-    # ω_s = 2π St U/D (seed 001 eq. 3.2.b.4)
+    # ω_s = 2π St U/D (Tuah 1982, eq. 3.2.b.4)
     assert shedding_frequency(1.0, 0.1, 0.2) == pytest.approx(2 * math.pi * 2.0, rel=1e-15)
     # V_R = 2πU/(ω_n D): at ω_n = ω_s it is 1/St
     ws = shedding_frequency(0.7, 0.05, 0.18)
