@@ -1,6 +1,6 @@
 """Cost of a short-crested sea: the chain example at a 30° mean heading (3-D models),
 long-crested against cos-2s spreading (s = 4) in 4, 8 and 16 directions; and the
-three-leg disc buoy example (a free body on three legs, seed 001 §6.7) at 30°, its
+three-leg disc buoy example (a free body on three legs, Tuah 1982, §6.7) at 30°, its
 excitation table extended over the whole circle (the disc is axisymmetric: the
 heading-0 force and moment turned by the heading), long-crested against 4 and 16
 directions.

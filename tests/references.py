@@ -10,7 +10,7 @@ from __future__ import annotations
 from types import MappingProxyType
 
 # --------------------------------------------------------------------------------
-# Seed 000: Bliet (1984), §7.3 "Linear cable model with the non-linear drag force":
+# Bliet 1984: Bliet (1984), §7.3 "Linear cable model with the non-linear drag force":
 # the guy of a guyed tower (SI units).  Printed data and static results.
 # Note: the printed "net weight 494.98 N/m" is inconsistent with the printed tensions
 # and angles (V_top - V_bot = w L needs w = 415 N/m = (48.7 - 6.3) kg/m x g, i.e. mass
@@ -35,11 +35,11 @@ BLIET_1984_GUY = MappingProxyType(
     }
 )
 
-# Seed 000, Table 7-II: eigenfrequencies of the guy above [rad/s].
+# Bliet 1984, Table 7-II: eigenfrequencies of the guy above [rad/s].
 BLIET_1984_TABLE_7_II = (0.9011, 1.1949, 1.6086, 1.8228, 2.3115, 2.7527, 3.2335, 3.7059)
 
 # --------------------------------------------------------------------------------
-# Seed 001: Tuah (1982) §6.2 Example 2, static response of a suspended cable
+# Tuah 1982: Tuah (1982) §6.2 Example 2, static response of a suspended cable
 # (ft, slug, s, lbf).  Two segments 500 ft + 1000 ft from (0, 0) to (1200, 500) ft with
 # a 900 lb buoy at the junction.
 TUAH_1982_EX2 = MappingProxyType(
@@ -75,7 +75,7 @@ TUAH_1982_EX2_ELASTIC_CATENARY = MappingProxyType(
 )
 
 # --------------------------------------------------------------------------------
-# Seed 001: Tuah (1982) §6.5 Example 5, one-leg single point mooring (ft, slug, s, lbf).
+# Tuah 1982: Tuah (1982) §6.5 Example 5, one-leg single point mooring (ft, slug, s, lbf).
 TUAH_1982_EX5 = MappingProxyType(
     {
         "m0": 28.0,  # [ft^2] (Hurricane Carla record)

@@ -1,6 +1,6 @@
 """Validation of :func:`stochcable.analysis.analyze` against independent references
 (GitHub issue 4, "Must be shown by tests"): the realization's convolution identity,
-Foss at a mode crossover (Irvine's λ² = 4π², seed 000) and with exactly repeated
+Foss at a mode crossover (Irvine's λ² = 4π², Bliet 1984) and with exactly repeated
 eigenvalues (taut wire), the Cd = 0 limit against the closed-form transfer function of
 a taut string (undamped and Rayleigh-damped), and the harmonic drag linearization
 against the (8/3π) form rebuilt from the result's own transfer functions.
@@ -113,7 +113,7 @@ def test_grids_coincide_and_the_series_used_the_result_transfer(conv_result):
 
 @pytest.mark.parametrize("end", ["end_a", "end_b"])
 def test_tension_series_is_the_circular_convolution_of_eta(conv_result, end):
-    """DESIGN.md "Random sea simulation" / seed 001 §5.1: the response of one
+    """DESIGN.md "Random sea simulation" / Tuah 1982, §5.1: the response of one
     realization is η ⊛ h with h = irfft(H(ω_m)) — η and tensions are consistent."""
     res = conv_result
     ts = res.timeseries
@@ -170,7 +170,7 @@ def test_node_surge_synthesized_is_the_circular_convolution_of_eta(conv_result):
 
 # ======================================================== 2. Foss at mode crossover
 
-# Seed 000 (Bliet 1984, Irvine–Caughey theory): for a horizontal shallow-sag cable,
+# Bliet (1984, Irvine–Caughey theory): for a horizontal shallow-sag cable,
 # λ² = (wL/H)² L/(H L_e/EA); at λ² = 4π² the first symmetric in-plane frequency equals
 # the first antisymmetric one, 2π/L √(H/m).  Span L = 1000 m, H ≈ 1e5 N, w = 8 N/m
 # (sag/span = wL/8H = 1 %), so λ² = 0.0064 EA/H and EA ≈ 6168.5 H.  EA below is the

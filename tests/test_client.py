@@ -87,7 +87,7 @@ def test_spectrum_returns_the_core_statistics(client):
 
 def test_spectrum_from_a_plain_document(client):
     res = client.spectrum({"type": "pierson_moskowitz", "m0": 28.0, "omega_p": 0.5})
-    # seed 001 §6.5: m0 = 28 ft²; the default grid (to 6 wp) keeps all but ~0.05 %
+    # Tuah 1982, §6.5: m0 = 28 ft²; the default grid (to 6 wp) keeps all but ~0.05 %
     assert res.stats.m0 == pytest.approx(28.0, rel=1e-3)
 
 

@@ -4,7 +4,7 @@ with finite, checked numbers or a clear error — never inf/NaN or a silent wron
 Cases: nearly taut line (sag/span 1e-3), very slack line (most of it on the seabed),
 tension → 0 at the anchor (the line's length at the limit span + drop), nearly vertical
 tether, mode crossover (horizontal) against veering (inclined cable, Irvine–Caughey,
-seed 000 §3.8.7), very light and very heavy drag, deep (3000 m) and very shallow (10 m,
+Bliet 1984, §3.8.7), very light and very heavy drag, deep (3000 m) and very shallow (10 m,
 small kh) water, a log frequency grid from 1e-4 to 1e2 rad/s, 2^20- and 2^22-sample time
 series, 400- and 800-element lines, imperial units with a buoy.  Budget: the whole file
 under ~40 s on 2 cores (durations in the comments are measured on the CI machine).
@@ -254,7 +254,7 @@ def test_nearly_vertical_tether():
 
 # ------------------------------------------------------------- crossover / veering
 
-# Seed 000 (Bliet 1984) §3.8.7, eq. 3.116 and figure 3-11: Irvine's shallow-sag theory
+# Bliet (1984) §3.8.7, eq. 3.116 and figure 3-11: Irvine's shallow-sag theory
 # applied to an inclined cable with H* = H/cos φ (tension along the chord) and
 # λ*² = (w₀L/H*)² (EA/H*) cos²φ predicts the crossover of the first symmetric and
 # antisymmetric in-plane modes at λ*² = 4π², as for a horizontal cable; the
@@ -351,7 +351,7 @@ def test_horizontal_cable_modes_cross_at_lambda2_4pi2(veering):
     assert np.count_nonzero(np.diff(np.sign(s1))) == 1
     # the signed gap ω_sym − ω_anti changes sign at the crossover; its root
     # (linear interpolation) is 4π² up to the shallow-sag theory's neglected
-    # O(8 (d/L)²) = 3 % (d/L = w₀L/8H* = 1/16; seed 000 eq. 3.116)
+    # O(8 (d/L)²) = 3 % (d/L = w₀L/8H* = 1/16; Bliet 1984, eq. 3.116)
     gap = np.where(s1 > 0, w1 - w2, w2 - w1)
     k = int(np.flatnonzero(np.diff(np.sign(gap)))[0])
     root = lam2[k] - gap[k] * (lam2[k + 1] - lam2[k]) / (gap[k + 1] - gap[k])
@@ -634,7 +634,7 @@ def test_800_element_line_converges_to_the_200_element_answer():
 
 
 def test_imperial_suspended_cable_with_buoy_in_a_sea():
-    """Seed 001 §6.2 cable (ft, slug, lbf; g = 32.174) with its 900 lb buoy, excited by
+    """Tuah 1982, §6.2 cable (ft, slug, lbf; g = 32.174) with its 900 lb buoy, excited by
     the seed's §6.5 sea (PM m0 = 28 ft², ωp = 0.5 rad/s) in deep water."""
     doc = load_example("tuah_1982_suspended_cable").model_dump()
     doc["sea"] = {

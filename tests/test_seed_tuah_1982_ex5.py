@@ -1,4 +1,4 @@
-"""Seed 001 (Tuah 1982) §6.5 Example 5, the one-leg single-point mooring in feet,
+"""Tuah (1982) §6.5 Example 5, the one-leg single-point mooring in feet,
 through :func:`stochcable.analysis.analyze` (example ``tuah_1982_single_leg``).
 
 The example scene is lines only: the disc buoy is end_b heaving with the sea (RAO 1),
@@ -38,7 +38,7 @@ from stochcable.examples import load_example
 # one worker runs the module: its module fixtures run once (--dist loadgroup)
 pytestmark = pytest.mark.xdist_group("test_seed_tuah_1982_ex5")
 
-# Seed 001 §6.5 (quoted in the module docstring).
+# Tuah 1982, §6.5 (quoted in the module docstring).
 TUAH_1982_EX5 = {
     "m0": 28.0,  # [ft²]
     "omega_p": 0.5,  # [rad/s]

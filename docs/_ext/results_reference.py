@@ -272,7 +272,7 @@ _LINES = {
     ),
     "lines.<line>.strumming.modes[].damping_ratio": (
         "-",
-        "Modal damping ratio ξ: structural + viscous (seed 001 eq. 3.2.b.8).",
+        "Modal damping ratio ξ: structural + viscous (Tuah 1982, eq. 3.2.b.8).",
     ),
     "lines.<line>.strumming.modes[].reduced_damping": ("-", "Skop–Griffin S_G = 2π St² k_s."),
     "lines.<line>.strumming.modes[].tension_range": (

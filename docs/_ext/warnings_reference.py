@@ -106,7 +106,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "σ of the wave velocity varies by more than SURFACE_SIGMA_RATIO along an "
         "element whose larger end σ is at least SURFACE_MATTERS_FRACTION of the line's "
         "largest",
-        "The drag linearization takes one drag coefficient per element (seed 001 eq. "
+        "The drag linearization takes one drag coefficient per element (Tuah 1982, eq. "
         "5.2.2) while the wave kinematics decay like e^{kz}; on such an element the "
         "response carries an error of several per cent.",
         "Use the number of elements the message gives on that segment (the fix aims at a "
@@ -330,7 +330,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "The real modes K φ = ω² M φ leave out the transport terms (the gyroscopic "
         "matrix and the centripetal stiffness): they are the line's modes at rest.",
         "Use ``stochcable modes`` (which lists the complex modes of a travelling line) "
-        "or ``stochcable.line.transport_modes.complex_modes``. See :doc:`../travelling`.",
+        "or ``stochcable.line.transport.modes.complex_modes``. See :doc:`../travelling`.",
     ),
     WarningEntry(
         "Strumming lock-in (or resonance) predicted",

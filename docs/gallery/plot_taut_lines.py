@@ -3,7 +3,7 @@ Taut lines: a spiral strand and an inclined guy
 ===============================================
 
 Two bundled examples of taut lines: ``taut_wire``, a 52 mm spiral strand at about
-1.3 MN, and ``inclined_guy``, the guy of seed 000 (Bliet 1984) §7.3.  A taut line's
+1.3 MN, and ``inclined_guy``, the guy of Bliet (1984), §7.3.  A taut line's
 tension response is quasi-static over much of the sea's band, its first modes are
 high, and its touchdown is absent.
 

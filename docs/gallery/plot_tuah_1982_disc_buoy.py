@@ -3,7 +3,7 @@ Disc buoy on one and three legs (foot–slug–second)
 ==================================================
 
 The bundled examples ``tuah_1982_disc_buoy_single_leg`` and
-``tuah_1982_disc_buoy_three_legs`` (seed 001, Tuah 1982, §6.5 and §6.7): a disc buoy,
+``tuah_1982_disc_buoy_three_legs`` (Tuah 1982, §6.5 and §6.7): a disc buoy,
 a rigid body, on slack cable legs in 100 ft of water.  The scenes are in feet, slugs
 and pounds-force, and so are the plots' labels.
 

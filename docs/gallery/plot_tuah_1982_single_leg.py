@@ -2,7 +2,7 @@
 Seed examples: a suspended cable and a buoy on one leg (foot–slug–second)
 =========================================================================
 
-Two bundled examples of seed 001 (Tuah 1982) in feet, slugs and pounds-force:
+Two bundled examples of Tuah (1982) in feet, slugs and pounds-force:
 ``tuah_1982_suspended_cable`` (§6.2 Example 2, statics: a cable with a 900 lb buoy
 between two points) and ``tuah_1982_single_leg`` (§6.5 Example 5, a leg whose top
 heaves with the sea surface, with the seed's DSA time series).

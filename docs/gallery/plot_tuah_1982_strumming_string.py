@@ -1,9 +1,9 @@
 """
-Strumming of a string in a steady flow (seed 001 Example 6)
+Strumming of a string in a steady flow (Tuah 1982, Example 6)
 ===========================================================
 
 The bundled example ``tuah_1982_strumming_string``: the horizontal string of Ramberg
-and Griffin's experiment as seed 001 (Tuah 1982) §6.6 models it with a wake
+and Griffin's experiment as Tuah (1982), §6.6 models it with a wake
 oscillator (docs/strumming.md).  The screening gives, per mode near the shedding
 frequency, the reduced velocity, whether the wake locks in and the cross-flow
 amplitude; this string's first cross-flow mode is not locked in (ω_s/ω_n ≈ 1.11), so

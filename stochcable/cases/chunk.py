@@ -131,7 +131,7 @@ def prepare_worker() -> None:
     warnings.simplefilter("ignore")
     element_variance_kernel()
     with contextlib.suppress(ImportError):  # (no numba: the NumPy paths)
-        import stochcable.line.strumming_kernels  # noqa: F401
+        import stochcable.line.strumming.kernels  # noqa: F401
 
 
 def case_sea(scene: Scene, state: SeaState, family: Family) -> Sea:

@@ -71,8 +71,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``stochcable modes``; returns the exit code."""
     from stochcable.line.modes import natural_modes
-    from stochcable.line.transport import check_line_speeds
-    from stochcable.line.transport_modes import modes_document
+    from stochcable.line.transport.matrices import check_line_speeds
+    from stochcable.line.transport.modes import modes_document
     from stochcable.statics import scene_fe_models
     from stochcable.validation import positive_int
 

@@ -51,8 +51,8 @@ from stochcable.dynamics.model.system import (
 )
 from stochcable.dynamics.timeseries.synthesis import simulate_timeseries
 from stochcable.errors import InputError, collect_warnings
-from stochcable.line.strumming import StrummingTable
-from stochcable.line.transport import check_travelling_lines
+from stochcable.line.strumming.screen import StrummingTable
+from stochcable.line.transport.matrices import check_travelling_lines
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, Sea, input_error_from_validation, load_scene
 from stochcable.statics import StaticsResult, solve_statics

@@ -6,7 +6,9 @@ integrals in ``catenary_kernel``, the multi-segment chain in ``multisegment``) �
 ``statics`` (one line's static equilibrium: ``equilibrium`` the FE residual, tangent
 and Newton solver, ``chain`` its start, ``banded`` the banded solves) · ``elements``
 and ``fem`` (the finite-element model about the static shape; ``seabed`` its bed contact,
-the touchdown element split at the static touchdown) · ``modes``.  The
+the touchdown element split at the static touchdown) · ``modes`` · the rooms
+``strumming`` (shedding, lock-in, the wake oscillator's balance) and ``transport`` (a
+line travelling along itself).  The
 scene-level statics, with bodies, is :mod:`stochcable.statics`.
 
 References

@@ -13,7 +13,7 @@ the material derivative
 
 and m D²x/Dt² puts, beside M ẍ, the gyroscopic (Coriolis) force 2 m c ẋ′ and the
 centripetal force m c² x″.  Their Galerkin forms on the 2-node elements are those of
-:mod:`stochcable.line.transport` (Wickert & Mote 1990, eq. 1): per element
+:mod:`stochcable.line.transport.matrices` (Wickert & Mote 1990, eq. 1): per element
 G_e = m c [[0, 1], [−1, 0]] ⊗ I and K_c,e = −(m c²/l) [[1, −1], [−1, 1]] ⊗ I, with m
 the structural mass per unit current length m₀ l0/l and l the static element length;
 the water's added mass does not travel.  Both are linear in the motion and are added to
@@ -22,7 +22,7 @@ nonlinearity of the elements is untouched).
 
 They act on the displacement from the static shape x_s, not on x: the centripetal load
 m c² κ of the steady travel on the curved static shape is left out here as it is in the
-statics and in the frequency-domain model (:mod:`stochcable.line.transport`; exact for
+statics and in the frequency-domain model (:mod:`stochcable.line.transport.matrices`; exact for
 a straight line, an error of order m c²/T on a sagged one), so the time-domain model
 starts from the same equilibrium the frequency-domain model linearizes about.
 
@@ -51,7 +51,7 @@ import scipy.sparse as sp
 
 from stochcable.errors import InputError
 from stochcable.line.elements import STIFFNESS_PATTERN, expand_blocks
-from stochcable.line.transport import GYRO_PATTERN
+from stochcable.line.transport.matrices import GYRO_PATTERN
 
 __all__ = ["TransportTerms", "transport_terms", "check_transport_speed"]
 

@@ -1,7 +1,7 @@
 """Time-domain wake oscillator coupled to one natural mode: the independent check of
 the frequency-domain strumming balance (a validation tool, not a pipeline stage).
 
-The same equations as :mod:`stochcable.line.strumming_balance` (Tuah (1982), eqs.
+The same equations as :mod:`stochcable.line.strumming.balance` (Tuah (1982), eqs.
 3.2.b.3 and 3.2.b.7–9, C_L0² in the bracket), integrated in time by
 :func:`scipy.integrate.solve_ivp` (DOP853) as Tuah (1982) integrates them (by mode
 superposition, its §3.2.b steps (5)–(10)) instead of balanced by harmonics::
@@ -23,7 +23,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from stochcable.errors import InputError
-from stochcable.line.strumming_balance import WakeParameters
+from stochcable.line.strumming.balance import WakeParameters
 
 __all__ = ["WakeHistory", "simulate_wake_oscillator"]
 
@@ -73,7 +73,7 @@ def simulate_wake_oscillator(
     omega_n, damping_ratio : float
         Natural frequency [rad/s] and damping ratio [-] of the mode.
     psi, q, diameter, omega_s, lift0 : ndarray, shape (n_el,)
-        As :func:`stochcable.line.strumming_balance.lock_in_balance`.
+        As :func:`stochcable.line.strumming.balance.lock_in_balance`.
     params : WakeParameters
     duration : float
         Simulated time (> 0). [s]

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.line.strumming import StrummingTable
+from stochcable.line.strumming.screen import StrummingTable
 from stochcable.results.display import result_html, result_text
 from stochcable.results.records import (
     THREE_HOURS,

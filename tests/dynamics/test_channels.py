@@ -72,7 +72,7 @@ def built(doc):
 
 def test_inertia_matrix_rigid_acceleration_gives_morison_force():
     """A uniform fluid acceleration a on a straight line: total force
-    ρ(πD²/4)(1+Ca)·L0·(I − eeᵀ)a (seed 001 eq. 5.2.1), plus the attachment's
+    ρ(πD²/4)(1+Ca)·L0·(I − eeᵀ)a (Tuah 1982, eq. 5.2.1), plus the attachment's
     (buoyancy/g + added mass)·a."""
     # neutrally buoyant attachment, so the weightless line stays straight
     att = {"at": 40.0, "mass": 500.0, "buoyancy": 500.0 * G, "added_mass": 300.0}

@@ -126,7 +126,7 @@ def _sea_channel(w, spectrum):
 def test_planar_body_on_springs_closed_form():
     """Planar body (surge, heave, pitch) with CoG offset, coupled added mass and
     damping on springs, excited by a tabulated force: H = Z⁻¹F with Z written out by
-    hand (pitch about +y, seed 001 eq. 3.2.c.20)."""
+    hand (pitch about +y, Tuah 1982, eq. 3.2.c.20)."""
     m, iyy, cx, cz = 5.0e3, 2.0e4, 0.3, -0.8
     A = np.array([[800.0, 0.0, 150.0], [0.0, 1200.0, 0.0], [150.0, 0.0, 3000.0]])
     B = np.array([[60.0, 0.0, 5.0], [0.0, 90.0, 0.0], [5.0, 0.0, 200.0]])
@@ -174,7 +174,7 @@ def test_planar_body_on_springs_closed_form():
 
 def test_body_drag_fixed_point_seed_form():
     """Heave of a body with quadratic drag in a wave velocity field: at the fixed
-    point b = ρ·CdA·σ·√(2/π) (seed 001 eq. 5.2.2 form, E|v| of a Gaussian) with σ the
+    point b = ρ·CdA·σ·√(2/π) (Tuah 1982, eq. 5.2.2 form, E|v| of a Gaussian) with σ the
     σ of the relative velocity, and H = (F + b v)/(K − ω²(m + A) + iω(B + b))."""
     w = np.linspace(0.2, 2.0, 60)
     m, a33, b33, k33, cda = 1.0e4, 5e3, 2e3, 1.2e5, 10.0

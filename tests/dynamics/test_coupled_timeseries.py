@@ -6,7 +6,7 @@ Independent checks: the DSA variance of every series against the band sum of the
 response spectrum of the transfer synthesized (Parseval, round-off) and against the
 frequency-domain σ of the Result (a separate solve on the analysis grid); the series
 against the direct O(N²) circular convolution of η and of the end-motion realization
-with the impulse responses of the Result's transfer functions (seed 001 §5.1: one
+with the impulse responses of the Result's transfer functions (Tuah 1982, §5.1: one
 realization drives everything); the infinitely heavy (fixed) body against the line
 with a fixed fairlead (a line alone, the group without bodies); NSA variances
 against their exact sampling distribution; the chunked solve against the one-piece

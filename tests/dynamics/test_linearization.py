@@ -22,9 +22,9 @@ from stochcable.errors import ConvergenceError, InputError
 RHO, CD, DIAM = 1025.0, 1.2, 0.1
 KAPPA = 0.5 * RHO * CD * DIAM  # 1/2 rho Cd D [N s^2/m^3]
 
-# Seed 001 eq. (5.2.2.a): B = (2/pi)^(1/2) Cd rho D sigma (printed form).
+# Tuah 1982, eq. (5.2.2.a): B = (2/pi)^(1/2) Cd rho D sigma (printed form).
 TUAH_1982_EQ_5_2_2_A = math.sqrt(2.0 / math.pi)
-# Seed 001 eq. (5.2.2.b): B = (2 pi)^(1/2) Ct rho D sigma (printed form).
+# Tuah 1982, eq. (5.2.2.b): B = (2 pi)^(1/2) Ct rho D sigma (printed form).
 TUAH_1982_EQ_5_2_2_B = math.sqrt(2.0 * math.pi)
 
 

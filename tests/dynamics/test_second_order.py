@@ -111,7 +111,7 @@ def test_bundled_examples_are_not_flagged(name):
 
 
 def test_irvine_lambda2_of_a_shallow_horizontal_cable():
-    # λ² = (wL/H)²·EA/H for a horizontal chord (seed 000 eq. 3.79's parameter)
+    # λ² = (wL/H)²·EA/H for a horizontal chord (Bliet 1984, eq. 3.79's parameter)
     n = 10
     x = np.linspace(0.0, 100.0, n + 1)
     pos = np.stack([x, np.zeros_like(x), np.zeros_like(x)], axis=1)

@@ -2,7 +2,7 @@
 
 The engine's direct solve with the transport terms (G in the band, K_c in K, the end
 motion's gyroscopic load and reaction rows) against an independent second method: the
-complex-modal receptance with left eigenvectors (stochcable.line.transport_modes) and
+complex-modal receptance with left eigenvectors (stochcable.line.transport.modes) and
 the full sparse impedance.
 """
 
@@ -17,8 +17,8 @@ from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.model.system import Damping, build_line_system
 from stochcable.dynamics.solve.line_solve import solve
 from stochcable.line.fem import build_fe_model
-from stochcable.line.transport import transport_matrices
-from stochcable.line.transport_modes import complex_modes, receptance_modal
+from stochcable.line.transport.matrices import transport_matrices
+from stochcable.line.transport.modes import complex_modes, receptance_modal
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
 

@@ -2,8 +2,8 @@
 
 Independent references: numerical quadrature of the cable equations dx/ds = H/T + H/EA,
 dz/ds = V/T + V/EA (a second method for every closure), the classic inextensible
-catenary formulas, exact equilibrium identities, seed 000 §7.3 (Bliet 1984 guy) and
-seed 001 §6.2 (Tuah 1982 suspended cable).
+catenary formulas, exact equilibrium identities, Bliet 1984, §7.3 (Bliet 1984 guy) and
+Tuah 1982, §6.2 (Tuah 1982 suspended cable).
 """
 
 from __future__ import annotations
@@ -305,7 +305,7 @@ def test_convergence_error_reports_residual(monkeypatch):
 
 
 def test_bliet_1984_inclined_guy():
-    """Seed 000 §7.3: with T_top, EA, L, depth and w = (m - rho pi D^2/4) g, the elastic
+    """Bliet 1984, §7.3: with T_top, EA, L, depth and w = (m - rho pi D^2/4) g, the elastic
     catenary reproduces the thesis's static angles, span and bottom tension."""
     g = BLIET_1984_GUY
     w = (g["mass"] - 1025.0 * math.pi * g["diameter"] ** 2 / 4.0) * 9.80665
@@ -335,7 +335,7 @@ def tuah_ex2_inputs(ea_scale=1.0):
 
 
 def test_tuah_1982_ex2_two_segment_cable():
-    """Seed 001 §6.2: two catenary segments joined at a 900 lb buoy (ft, lbf)."""
+    """Tuah 1982, §6.2: two catenary segments joined at a 900 lb buoy (ft, lbf)."""
     (X, Z), (L1, L2), w, ea, buoy = tuah_ex2_inputs()
     sol = catenary_multisegment(X, Z, [L1, L2], [w, w], [ea, ea], [-buoy])
     ref = TUAH_1982_EX2_ELASTIC_CATENARY

@@ -1,9 +1,9 @@
 """Finite-element model (stochcable.line.fem): element matrices, assembly, partition.
 
 Independent checks: the element stiffness against a central finite difference of the
-element end force T(l)·e with T = EA(l − l0)/l0 (its exact derivative, seed 001
+element end force T(l)·e with T = EA(l − l0)/l0 (its exact derivative, Tuah 1982
 eqs. 3.1.8–3.1.11); the consistent mass against the integral of the linear shape
-functions (seed 001 eq. 3.1.12) and conservation of total mass; rigid-body modes;
+functions (Tuah 1982, eq. 3.1.12) and conservation of total mass; rigid-body modes;
 the 2-D model against the in-plane part of the 3-D one.
 """
 

@@ -75,7 +75,7 @@ def test_weight_is_mass_minus_displaced_times_g():
     # a given weight overrides the formula
     seg = SEG_A.model_copy(update={"weight": 123.0})
     assert np.all(mesh_line(make_line([seg]), RHO, G).weight == 123.0)
-    # imperial units: seed 001 §6.2 cable, w = (3.35 - 2.0) A g lbf/ft
+    # imperial units: Tuah 1982, §6.2 cable, w = (3.35 - 2.0) A g lbf/ft
     a = 0.0218
     imp = Segment(
         length=500.0, ea=8.12e6 * a, mass=3.35 * a, diameter=math.sqrt(4 * a / math.pi), elements=3

@@ -2,7 +2,7 @@
 
 References
 ----------
-- Bliet 1984 (seed 000) eq. 3.5: taut string, ω_n = nπ/L √(T/m); axial √(EA/m) nπ/L.
+- Bliet (1984) eq. 3.5: taut string, ω_n = nπ/L √(T/m); axial √(EA/m) nπ/L.
 - Bliet 1984 eq. 3.9: hanging chain with a free lower end, J0(2ω√(L/g)) = 0.
 - Bliet 1984 eqs. 3.78–3.79 (Irvine & Caughey 1974): horizontal shallow-sag elastic
   cable, antisymmetric kL/2 = nπ, symmetric tan(kL/2) = kL/2 − (4/λ²)(kL/2)³.

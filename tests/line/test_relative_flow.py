@@ -1,5 +1,5 @@
 """Loads of the relative flow on a travelling line and its static shape in them
-(stochcable.line.relative_flow), against Hu & Jin (2001)'s eq. (6) and closed form."""
+(stochcable.line.transport.relative_flow), against Hu & Jin (2001)'s eq. (6) and closed form."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from stochcable.errors import InputError
-from stochcable.line.relative_flow import hu_jin_flow_force, static_shape_in_flow
+from stochcable.line.transport.relative_flow import hu_jin_flow_force, static_shape_in_flow
 from stochcable.reference.travelling_cable import equilibrium_hu_jin
 
 RHO, DC, CD, CF = 1025.0, 0.02, 1.2, 0.5

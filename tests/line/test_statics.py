@@ -1,5 +1,5 @@
 """Tests of stochcable.line.statics: FE statics against the closed-form elastic catenary
-(stochcable.line.catenary, Irvine 1981), conservation of force, symmetry, seed 001 §6.2."""
+(stochcable.line.catenary, Irvine 1981), conservation of force, symmetry, Tuah 1982, §6.2."""
 
 from __future__ import annotations
 
@@ -174,7 +174,7 @@ def test_symmetric_u_shape():
     assert r.tension_a == pytest.approx(r.tension_b, rel=1e-9)
 
 
-# Seed 001 §6.2 (Tuah 1982): two segments, 500 ft and 1000 ft, from (0, 0) to
+# Tuah 1982, §6.2 (Tuah 1982): two segments, 500 ft and 1000 ft, from (0, 0) to
 # (1200, 500) ft, A0 = 0.0218 ft², E = 8.12e6 psf, cable 3.35 slug/ft³, water
 # 2.0 slug/ft³, a 900 lb buoy at the junction (imperial units, g = 32.174 ft/s²).
 TUAH_1982_6_2 = dict(

@@ -1,5 +1,5 @@
 """Strumming in the frequency domain (docs/strumming.md): the wake-oscillator harmonic
-balance against time integration, seed 001 §6.6 Example 6 (Ramberg et al. 1980) and
+balance against time integration, Tuah 1982, §6.6 Example 6 (Ramberg et al. 1980) and
 the hook-up (scene settings, drag amplification, warning, result document)."""
 
 from __future__ import annotations
@@ -19,7 +19,9 @@ from stochcable.errors import InputError, ResolutionWarning
 from stochcable.examples import load_example
 from stochcable.line.fem import build_fe_model
 from stochcable.line.modes import natural_modes
-from stochcable.line.strumming import (
+from stochcable.line.strumming.balance import lock_in_balance, wake_parameters, wake_response
+from stochcable.line.strumming.modes import out_of_plane_modes
+from stochcable.line.strumming.screen import (
     StrummingInput,
     amplitude_griffin,
     drag_amplification_vandiver,
@@ -31,8 +33,6 @@ from stochcable.line.strumming import (
     strouhal_roshko,
     strumming_screen,
 )
-from stochcable.line.strumming_balance import lock_in_balance, wake_parameters, wake_response
-from stochcable.line.strumming_modes import out_of_plane_modes
 from stochcable.reference.wake_oscillator import simulate_wake_oscillator
 from stochcable.scene.model import load_scene
 from stochcable.statics import solve_statics
@@ -42,7 +42,7 @@ pytestmark = pytest.mark.xdist_group("test_strumming")
 
 FT = 0.3048
 EXAMPLE = "tuah_1982_strumming_string"
-#: seed 001 §6.6: Strouhal frequency, fundamental, maximum transverse displacement
+#: Tuah 1982, §6.6: Strouhal frequency, fundamental, maximum transverse displacement
 SEED_OMEGA_S = 15.73  # [rad/s]
 SEED_OMEGA_1 = 14.6  # [rad/s]
 SEED_AMPLITUDE = 0.016 * FT  # [m] (seed and the experiment of Ramberg et al. 1980)
@@ -52,7 +52,7 @@ SEED_AMPLITUDE = 0.016 * FT  # [m] (seed and the experiment of Ramberg et al. 19
 
 
 def test_shedding_band_damping_and_drag_closed_forms():
-    # ω_s = 2π St U/D (seed 001 eq. 3.2.b.4)
+    # ω_s = 2π St U/D (Tuah 1982, eq. 3.2.b.4)
     assert shedding_frequency(1.0, 0.1, 0.2) == pytest.approx(2 * math.pi * 2.0, rel=1e-15)
     # V_R = 2πU/(ω_n D): at ω_n = ω_s it is 1/St
     ws = shedding_frequency(0.7, 0.05, 0.18)
@@ -152,7 +152,7 @@ def test_compiled_start_grid_equals_the_wake_closed_form(xi):
     Cardano roots) at every grid point: the same closed form, round-off apart (1e-9: the
     residual is a ratio of sums of ~40 terms; any wrong coefficient moves it by O(1));
     where the kernel's bound skips a point (marked 1.0), the residual is at least 0.5."""
-    from stochcable.line.strumming_kernels import balance_grid
+    from stochcable.line.strumming.kernels import balance_grid
 
     psi, q, d, ws, mstar, st = _string_mode()  # a mode that locks in (test above)
     rng = np.random.default_rng(7)  # and wakes that differ element by element
@@ -183,8 +183,8 @@ def test_numpy_bound_proves_what_the_kernel_proves(xi, amp_scale):
     """grid_is_proven (NumPy, checked before numba is imported) is True exactly when the
     compiled grid is proven at every point (all 1.0): the locking mode of the test above
     (not proven), a heavily damped one and tiny amplitudes (proven)."""
-    from stochcable.line.strumming_bound import grid_is_proven
-    from stochcable.line.strumming_kernels import balance_grid
+    from stochcable.line.strumming.bound import grid_is_proven
+    from stochcable.line.strumming.kernels import balance_grid
 
     psi, q, d, ws, mstar, st = _string_mode()
     rng = np.random.default_rng(7)
@@ -387,7 +387,7 @@ def test_out_of_plane_modes_of_a_2d_model_match_the_3d_model():
 
 
 def test_out_of_plane_modes_sparse_path_matches_dense(monkeypatch):
-    import stochcable.line.strumming_modes as sm
+    import stochcable.line.strumming.modes as sm
 
     scene = load_example("chain_catenary")
     statics = solve_statics(scene, method="fe")

@@ -1,4 +1,4 @@
-"""Transport terms of a travelling line (stochcable.line.transport).
+"""Transport terms of a travelling line (stochcable.line.transport.matrices).
 
 References: Wickert & Mote (1990), "Classical vibration analysis of axially moving
 continua", J. Appl. Mech. 57, 738–744 (the travelling string's frequencies and mode
@@ -16,8 +16,8 @@ from fem_cases import shallow_parabola, taut_string
 
 from stochcable.errors import InputError
 from stochcable.line.fem import assemble
-from stochcable.line.transport import check_axial_speed, critical_speed, transport_matrices
-from stochcable.line.transport_modes import (
+from stochcable.line.transport.matrices import check_axial_speed, critical_speed, transport_matrices
+from stochcable.line.transport.modes import (
     complex_modes,
     divergence_speed,
     receptance_direct,

@@ -359,7 +359,8 @@ def test_sigma_frequency_domain_vs_time_domain(case):
     record = duration - hists[0].ramp
     # Linearization error allowed: 10 % on σ of end tension and in-plane motion of the
     # node next to the fairlead — the accuracy the statistical linearization is
-    # expected to have for drag-dominated response (seed 004; measured here 1–5 %).
+    # expected to have for drag-dominated response (Behbahani-Nejad & Perkins 1997;
+    # measured here 1–5 %).
     lin = 0.10
     for end in ("a", "b"):
         s_fd = getattr(lr, f"end_{end}").std

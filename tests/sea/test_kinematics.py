@@ -1,4 +1,4 @@
-"""Tests of stochcable.sea.kinematics: dispersion and linear wave kinematics (seed 001 §5.2)."""
+"""Tests of stochcable.sea.kinematics: dispersion and linear wave kinematics (Tuah 1982, §5.2)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Tests of stochcable.sea.realization (DSA/NSA simulation, seed 001 §5.1) and
+"""Tests of stochcable.sea.realization (DSA/NSA simulation, Tuah 1982, §5.1) and
 stochcable.sea.fft."""
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from stochcable.sea.spectra import (
     spectrum_pierson_moskowitz_m0,
 )
 
-# Seed 001 §6.5 (Tuah 1982): PM with m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla),
+# Tuah 1982, §6.5 (Tuah 1982): PM with m0 = 28 ft², ωp = 0.5 rad/s (Hurricane Carla),
 # 256 s at Δt = 0.25 s = 1024 points, Δω = 0.0245 rad/s; imperial units, g = 32.174 ft/s².
 TUAH_1982_M0_FT2 = 28.0
 TUAH_1982_OMEGA_P = 0.5

@@ -30,7 +30,7 @@ pytestmark = pytest.mark.xdist_group("test_service")
 PM = {"type": "pierson_moskowitz", "hs": 6.0, "tp": 10.0}
 SPECTRA = [
     PM,
-    {"type": "pierson_moskowitz", "m0": 28.0, "omega_p": 0.5},  # seed 001 §6.5 example
+    {"type": "pierson_moskowitz", "m0": 28.0, "omega_p": 0.5},  # Tuah 1982, §6.5 example
     {"type": "pierson_moskowitz", "wind_speed": 15.0},
     {"type": "jonswap", "hs": 4.0, "tp": 8.0, "gamma": 3.3},
     {"type": "bretschneider", "hs": 3.0, "tp": 9.0},

@@ -2,7 +2,7 @@
 
 One function, :func:`with_strumming`, called once per line by
 :func:`stochcable.dynamics.engine.build_engine`: the current is sea-independent, so the
-screening (:func:`stochcable.line.strumming.strumming_screen`) runs once, and the
+screening (:func:`stochcable.line.strumming.screen.strumming_screen`) runs once, and the
 amplified normal drag coefficient it returns replaces the mesh's in the line system
 every drag linearization reads (``system.model.mesh.cd_normal``).
 """
@@ -18,14 +18,14 @@ from stochcable.dynamics.loads.channels import current_at_elements
 from stochcable.dynamics.model.system import LineSystem
 from stochcable.errors import ResolutionWarning, warn
 from stochcable.line.modes import natural_modes
-from stochcable.line.strumming import (
+from stochcable.line.strumming.modes import modes_by_node, out_of_plane_modes
+from stochcable.line.strumming.screen import (
     LIFT_DEFAULT,
     STROUHAL_DEFAULT,
     StrummingInput,
     StrummingTable,
     strumming_screen,
 )
-from stochcable.line.strumming_modes import modes_by_node, out_of_plane_modes
 from stochcable.scene.model import Scene
 
 __all__ = ["MAX_MODES", "strumming_inputs", "with_strumming"]
@@ -130,7 +130,7 @@ def with_strumming(scene: Scene, system: LineSystem) -> tuple[LineSystem, Strumm
     Modes: the system's (global x, y, z per node), computed further up when they stop
     below the highest frequency a lock-in band can reach (V_R = 3: ω_n = 2π U/(3D));
     a 2-D model adds its out-of-plane modes
-    (:func:`~stochcable.line.strumming_modes.out_of_plane_modes`).  A physics warning
+    (:func:`~stochcable.line.strumming.modes.out_of_plane_modes`).  A physics warning
     names every locked-in mode, the band and the fix.
     """
     got = strumming_inputs(scene, system)

@@ -1,7 +1,7 @@
 """The transport terms of a travelling line in the frequency-domain engine.
 
 A line whose material travels at speed c along its static shape
-(:mod:`stochcable.line.transport`) has the small-motion impedance
+(:mod:`stochcable.line.transport.matrices`) has the small-motion impedance
 
     Z(ω) = K + K_c − ω² M_T + iω (C + G),
 
@@ -18,7 +18,7 @@ matrices, so the two enter differently:
   prescribed end motion (:func:`gyro_end_load`) and the reaction rows
   (:func:`gyro_end_rows`).  A travelling line is solved by the direct solve (the Foss
   form of the engine assumes symmetric matrices; the complex modes with left
-  eigenvectors are in :mod:`stochcable.line.transport_modes`, the check of this solve).
+  eigenvectors are in :mod:`stochcable.line.transport.modes`, the check of this solve).
 
 The drag is linearized about the relative flow of the fluid and the *material*,
 U − c e (Hu & Jin 2001, eq. 6): the line's mean current at the elements becomes
@@ -43,7 +43,7 @@ import numpy as np
 
 from stochcable.dynamics.model.solvers import band_from_blocks
 from stochcable.line.fem import FEModel
-from stochcable.line.transport import transport_matrices
+from stochcable.line.transport.matrices import transport_matrices
 
 __all__ = ["travelling_system", "gyro_band", "gyro_end_load", "gyro_end_rows"]
 

@@ -1,10 +1,10 @@
-"""Compiled (numba) start grid of :func:`stochcable.line.strumming_balance.lock_in_balance`.
+"""Compiled (numba) start grid of :func:`stochcable.line.strumming.balance.lock_in_balance`.
 
 Imported lazily, by the first lock-in balance a process runs (importing numba costs
 ~0.2 s; ``import stochcable``, the CLI and the service start do not import it).  The
 kernel evaluates the scale-free modal residual |Z A − L|/(|Z A| + |L|) of the balance
 on the (amplitude × frequency) start grid, every element's wake by the same closed form
-as :func:`~stochcable.line.strumming_balance.wake_response` (the largest root of the
+as :func:`~stochcable.line.strumming.balance.wake_response` (the largest root of the
 cubic x|a0 + a1 x|² = |rhs|², Cardano or the trigonometric form, two Newton steps).
 The coefficients a0, a1 and the cubic's normalized x², x¹ coefficients depend on the
 frequency and the element only, so they are formed once per grid column; NumPy's
@@ -18,7 +18,7 @@ x ≥ 2α/β, so |c| = √x ≤ √(2α/β) + (4|rhs|²/β²)^(1/6); and |c| ≤
 distance from 0 to the ray a0 + a1x, x ≥ 0.  Summed over the elements (|rhs| ∝ A),
 |L| ≤ min(S₁ + S₂A^(1/3), S_lin A) per frequency; where that is at most |Z A|/3 the
 residual is at least 0.5, above the start threshold of
-:func:`~stochcable.line.strumming_balance.lock_in_balance`, and the point holds 1.0
+:func:`~stochcable.line.strumming.balance.lock_in_balance`, and the point holds 1.0
 (no start, and no local minimum beside it changes).  On the chain example every point
 of its three candidate modes is proven so (no lock-in: no cube root at all).
 

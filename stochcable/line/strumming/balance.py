@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stochcable.errors import InputError
-from stochcable.line.strumming_bound import grid_is_proven
+from stochcable.line.strumming.bound import grid_is_proven
 from stochcable.validation import finite_scalar
 
 __all__ = [
@@ -482,7 +482,7 @@ def lock_in_balance(
     args = (np.exp(ln_a), ratio * omega_n, omega_n, damping_ratio, ps, qs, ds, ws, c0)
     if grid_is_proven(*args, params.g, params.big_h, params.f):
         return none  # every point proven: no start, and no compiled kernel needed
-    from stochcable.line.strumming_kernels import balance_grid  # numba: lazily
+    from stochcable.line.strumming.kernels import balance_grid  # numba: lazily
 
     grid = balance_grid(
         np.exp(ln_a), ratio * omega_n, omega_n, damping_ratio, ps, qs, ds, ws, c0,

@@ -23,7 +23,7 @@ shape is not in the statics (docs/travelling.md: exact for a straight line, an e
 order m c²/T elsewhere).
 
 The complex modes and the stability of the gyroscopic system are in
-:mod:`stochcable.line.transport_modes`.
+:mod:`stochcable.line.transport.modes`.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The natural modes the strumming screening needs, from a line's FE model.
 
-The screening (:func:`stochcable.line.strumming.strumming_screen`) takes mode shapes as
+The screening (:func:`stochcable.line.strumming.screen.strumming_screen`) takes mode shapes as
 global x, y, z displacements per node.  A 3-D model's modes are that already.  A 2-D
 model (the in-plane x–z model of a planar scene) has no out-of-plane modes, but a
 current in the plane of the line sheds vortices that lift it *out* of the plane; those

@@ -1,6 +1,6 @@
 """The bound that proves a lock-in start grid holds no start, in NumPy (no numba).
 
-:func:`stochcable.line.strumming_kernels.balance_grid` evaluates the modal residual of
+:func:`stochcable.line.strumming.kernels.balance_grid` evaluates the modal residual of
 the lock-in balance on an (amplitude × frequency) grid, except where a bound proves it
 is at least 0.5 (its module notes): |L| ≤ min(S₁ + S₂A^(1/3), S_lin A) per frequency,
 and a point where that is at most |Z A|/3 holds 1.0.  :func:`grid_is_proven` checks
@@ -36,7 +36,7 @@ def grid_is_proven(
     Parameters
     ----------
     amps, omegas, omega_n, damping_ratio, psi, q, diameter, omega_s, lift0, g, big_h, f
-        As :func:`stochcable.line.strumming_kernels.balance_grid`.
+        As :func:`stochcable.line.strumming.kernels.balance_grid`.
 
     Returns
     -------

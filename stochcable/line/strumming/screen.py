@@ -6,7 +6,7 @@ A steady normal flow U_n past an element of diameter D sheds vortices at
 when its reduced velocity V_R = 2π U_n/(ω_n D) lies in the cross-flow band
 3 ≤ V_R ≤ 16 of DNV-RP-C205 (2010) ch. 9 (:data:`CROSS_FLOW_BAND`); the nearest
 candidates are balanced with the Skop–Griffin wake oscillator
-(:mod:`stochcable.line.strumming_balance`).  A mode with a first-harmonic solution is
+(:mod:`stochcable.line.strumming.balance`).  A mode with a first-harmonic solution is
 *locked in* and vibrates at its steady amplitude; one without is an *unlocked* mode
 driven by the free wakes (C_L = C_L0 at ω_s), whose response is bounded by twice the
 forced amplitude (the beat from rest, Tuah (1982), Example 6).  The vibration of a
@@ -32,7 +32,7 @@ import numpy as np
 
 from stochcable.design.curves import FatigueCurve
 from stochcable.errors import InputError
-from stochcable.line.strumming_balance import (
+from stochcable.line.strumming.balance import (
     CROSS_FLOW_BAND,
     LIFT_DEFAULT,
     STROUHAL_DEFAULT,
@@ -355,7 +355,7 @@ def strumming_screen(line: StrummingInput, omega_n, shapes) -> StrummingTable:
     of its modal mass Σ m_T L ψ² across the flow and has V_R (:func:`reduced_velocity`)
     in :data:`CROSS_FLOW_BAND`; ξ = structural + :func:`hydrodynamic_damping_ratio`;
     S_G (:func:`reduced_damping`); the balance
-    (:func:`~stochcable.line.strumming_balance.lock_in_balance`).  Unlocked: free wakes
+    (:func:`~stochcable.line.strumming.balance.lock_in_balance`).  Unlocked: free wakes
     C_L0 at ω_s, A_f = |Σ q ψ C_L0|/|ω_n² − ω_s² + 2iξω_nω_s|, reported 2A_f.  The
     tension amplitude of element e is (EA/l0)·t·(φ_b − φ_a)·A (linear), its range twice
     that.  The drag of element e is amplified with Y_rms = A|ψ_e|/√2 of the governing

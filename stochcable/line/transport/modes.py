@@ -21,8 +21,8 @@ import scipy.sparse as sp
 from stochcable.errors import InputError, SolverError
 from stochcable.line.fem import FEModel
 from stochcable.line.modes import PLANE_TOL, _out_of_plane_fraction, plane_normal
-from stochcable.line.transport import _check_model, critical_speed, transport_matrices
-from stochcable.line.transport_sparse import lowest_complex_modes
+from stochcable.line.transport.matrices import _check_model, critical_speed, transport_matrices
+from stochcable.line.transport.sparse import lowest_complex_modes
 from stochcable.validation import float_array, positive_int
 
 __all__ = [
@@ -140,7 +140,7 @@ def complex_modes(
     method : {"auto", "dense", "sparse"}
         "dense": QZ on the first-order pencil (up to ``DENSE_MAX_STATES`` states);
         "sparse": shift-invert Arnoldi for the lowest ``count``
-        (:mod:`stochcable.line.transport_sparse`); "auto": dense up to
+        (:mod:`stochcable.line.transport.sparse`); "auto": dense up to
         ``DENSE_AUTO_STATES`` states or when ``count`` is None, sparse above.
 
     Returns
