@@ -9,7 +9,8 @@ high, and its touchdown is absent.
 
 ``inclined_guy`` warns on purpose (its description in :mod:`stochcable.examples` says
 why): it keeps the thesis's 40 elements, coarse near the surface, and its second mode
-lies in the sea's band with drag damping only.
+lies in the sea's band with drag damping only.  ``taut_wire`` keeps its 20 elements,
+whose discretization error the mesh check estimates above 1 % (measured: 0.2 %).
 """
 
 import warnings
@@ -19,11 +20,11 @@ import matplotlib.pyplot as plt
 import stochcable
 from stochcable import plots
 
-wire = stochcable.analyze(stochcable.load_example("taut_wire"))
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")  # the documented warnings, listed below
+    wire = stochcable.analyze(stochcable.load_example("taut_wire"))
     guy = stochcable.analyze(stochcable.load_example("inclined_guy"))
-for message in guy.warnings:
+for message in (*wire.warnings, *guy.warnings):
     print("warning:", message[:110], "...")
 
 # %%
