@@ -1,6 +1,6 @@
 """
 Strumming of a string in a steady flow (Tuah 1982, Example 6)
-===========================================================
+=============================================================
 
 The bundled example ``tuah_1982_strumming_string``: the horizontal string of Ramberg
 and Griffin's experiment as Tuah (1982), §6.6 models it with a wake
