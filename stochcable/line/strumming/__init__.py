@@ -12,40 +12,5 @@ University, §6.6.
 
 from __future__ import annotations
 
-from stochcable.line.strumming.screen import (  # noqa: F401  (the room's public names)
-    CROSS_FLOW_BAND,
-    LIFT_DEFAULT,
-    STROUHAL_DEFAULT,
-    ElementFlow,
-    StrummingInput,
-    StrummingMode,
-    StrummingTable,
-    amplitude_griffin,
-    drag_amplification_vandiver,
-    element_flow,
-    hydrodynamic_damping_ratio,
-    reduced_damping,
-    reduced_velocity,
-    shedding_frequency,
-    strouhal_roshko,
-    strumming_screen,
-)
-
-__all__ = [
-    "CROSS_FLOW_BAND",
-    "STROUHAL_DEFAULT",
-    "LIFT_DEFAULT",
-    "shedding_frequency",
-    "strouhal_roshko",
-    "reduced_velocity",
-    "hydrodynamic_damping_ratio",
-    "reduced_damping",
-    "drag_amplification_vandiver",
-    "amplitude_griffin",
-    "StrummingInput",
-    "ElementFlow",
-    "element_flow",
-    "StrummingMode",
-    "StrummingTable",
-    "strumming_screen",
-]
+from stochcable.line.strumming.screen import *  # noqa: F403  (the room's public names)
+from stochcable.line.strumming.screen import __all__  # noqa: F401

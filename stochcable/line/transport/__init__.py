@@ -15,24 +15,5 @@ continua, Journal of Applied Mechanics 57, 738–744.
 
 from __future__ import annotations
 
-from stochcable.line.transport.matrices import (  # noqa: F401  (the room's public names)
-    GYRO_PATTERN,
-    CriticalSpeed,
-    TransportMatrices,
-    check_axial_speed,
-    check_line_speeds,
-    check_travelling_lines,
-    critical_speed,
-    transport_matrices,
-)
-
-__all__ = [
-    "GYRO_PATTERN",
-    "TransportMatrices",
-    "CriticalSpeed",
-    "critical_speed",
-    "check_axial_speed",
-    "transport_matrices",
-    "check_line_speeds",
-    "check_travelling_lines",
-]
+from stochcable.line.transport.matrices import *  # noqa: F403  (the room's public names)
+from stochcable.line.transport.matrices import __all__  # noqa: F401
