@@ -27,7 +27,7 @@ from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.elements import STIFFNESS_PATTERN, expand_blocks, stiffness_blocks
 from stochcable.validation import finite_scalar, float_array, nonnegative, positive
 
-__all__ = ["FlowShape", "hu_jin_flow_force", "static_shape_in_flow"]
+__all__ = ["FlowShape", "hu_jin_flow_force", "steady_lift_force", "static_shape_in_flow"]
 
 _Y = np.array([0.0, 1.0, 0.0])
 _Z = np.array([0.0, 0.0, 1.0])
@@ -88,6 +88,52 @@ def hu_jin_flow_force(
         q * (cd * mag * vr[:, 1])[:, None] * _Y[None, :]
         + q * (cl * mag * mag)[:, None] * _Z[None, :]
     )
+
+
+def steady_lift_force(
+    tangents: np.ndarray, current: np.ndarray, speed: np.ndarray | float, coef: np.ndarray
+) -> np.ndarray:
+    """Steady lift per unit length of the relative flow on a line's elements, as the
+    scene statics apply it (docs/travelling.md).
+
+    Parameters
+    ----------
+    tangents : array_like, shape (n_el, 3)
+        Unit tangents e of the elements, end_a → end_b; z up. [-]
+    current : array_like, shape (n_el, 3)
+        Current U at the elements. [m/s]
+    speed : float or array_like, shape (n_el,)
+        Axial speed c of the material along e (0 on dry elements). [m/s]
+    coef : array_like, shape (n_el,)
+        ½ ρ C_L D of each element. [kg/m²]
+
+    Returns
+    -------
+    ndarray, shape (n_el, 3)
+        Force per unit current length; 0 where the current has no component normal
+        to the element (no cross-flow: no lift direction). [N/m]
+
+    Notes
+    -----
+    f_L = ½ρC_L D |V_r|² (ẑ·m̂) m̂, with V_r = U − c e the relative flow and
+    m̂ = e × U_n/|U_n| the unit normal to the element and the cross-flow
+    U_n = U − (U·e) e: the lift of Hu & Jin (2001, eq. 6), ½ρC_L D |V_r|², across the
+    flow and the element, on its upward side.  On their chord along x̂ in a flow V_f ŷ
+    it is ½ρC_L D (V_f² − 2cV_f v′ + c²) ẑ (1 + O(w′²)): eq. (6)'s b²(1 − k̄v′)² to
+    first order in the slopes.  The factor ẑ·m̂ keeps it continuous where m̂ turns
+    horizontal (a vertical element: no up side, no lift); a planar problem (current in
+    the vertical plane of the line) has m̂ horizontal and normal to it: no lift.
+    """
+    e = np.asarray(tangents, dtype=float)
+    u = np.asarray(current, dtype=float)
+    ua = np.einsum("ij,ij->i", u, e)
+    un = u - ua[:, None] * e
+    un2 = np.einsum("ij,ij->i", un, un)
+    m = np.cross(e, un)
+    rel = ua - speed
+    vr2 = un2 + rel * rel
+    scale = np.divide(coef * vr2 * m[:, 2], un2, out=np.zeros_like(un2), where=un2 > 0.0)
+    return scale[:, None] * m
 
 
 @dataclass(frozen=True, eq=False)
