@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from stochcable.errors import InputError
+from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.line.elements import STIFFNESS_PATTERN, expand_blocks
 from stochcable.line.fem import FEModel, chain_csr
 from stochcable.validation import finite_scalar
@@ -263,10 +263,15 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
     Raises
     ------
     InputError
-        ``lines[i].axial_speed``: at or above the critical speed (named), or on a line
-        with an end attached to a body; ``analysis.linearization.method`` "harmonic"
-        (no mean-flow term) with a travelling line (the coupled solve of lines and bodies has no
-        transport terms; docs/travelling.md).
+        ``lines[i].axial_speed`` at or above the critical speed (named);
+        ``analysis.linearization.method`` "harmonic" (no mean-flow term) with a
+        travelling line (docs/travelling.md).
+
+    Warns
+    -----
+    PhysicsWarning
+        A travelling line on a body: the coupled modes of its group are those without
+        the gyroscopic term (the coupled response has it: the line's direct solve).
     """
     from stochcable.line.fem import build_fe_model
 
@@ -286,12 +291,10 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
             )
         bodies = [e.attach.body for e in (line.end_a, line.end_b) if e.attach is not None]
         if bodies:
-            raise InputError(
-                f"lines[{i}].axial_speed",
-                line.axial_speed,
-                "m/s",
-                f"a line attached to a body ('{bodies[0]}') cannot travel: the coupled "
-                "solve of lines and bodies has no transport terms (docs/travelling.md); "
-                "give its end a position and a prescribed motion (e.g. the vessel's "
-                "RAO), or set 0 for the line at rest",
+            warn(
+                f"line '{line.name}' travels (lines[{i}].axial_speed = "
+                f"{line.axial_speed:g} m/s) on body '{bodies[0]}': the coupled modes of its "
+                "group leave out the gyroscopic term (K + K_c and M only); the response "
+                "has it",
+                PhysicsWarning,
             )
