@@ -27,7 +27,13 @@ from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.elements import STIFFNESS_PATTERN, expand_blocks, stiffness_blocks
 from stochcable.validation import finite_scalar, float_array, nonnegative, positive
 
-__all__ = ["FlowShape", "hu_jin_flow_force", "steady_lift_force", "static_shape_in_flow"]
+__all__ = [
+    "FlowShape",
+    "hu_jin_flow_force",
+    "steady_lift_force",
+    "lift_velocity_jacobian",
+    "static_shape_in_flow",
+]
 
 _Y = np.array([0.0, 1.0, 0.0])
 _Z = np.array([0.0, 0.0, 1.0])
@@ -134,6 +140,46 @@ def steady_lift_force(
     vr2 = un2 + rel * rel
     scale = np.divide(coef * vr2 * m[:, 2], un2, out=np.zeros_like(un2), where=un2 > 0.0)
     return scale[:, None] * m
+
+
+def lift_velocity_jacobian(
+    tangents: np.ndarray, current: np.ndarray, speed: np.ndarray | float, coef: np.ndarray
+) -> np.ndarray:
+    """∂f_L/∂U of :func:`steady_lift_force`: the linearized lift of a change of the
+    relative flow (the fluid's velocity minus the line's), at fixed tangents.
+
+    Parameters
+    ----------
+    tangents, current, speed, coef
+        As :func:`steady_lift_force`.
+
+    Returns
+    -------
+    ndarray, shape (n_el, 3, 3)
+        A with δf_L = A δV per unit length [N·s/m²]; zero where the mean flow has no
+        normal component (no lift direction to linearize about).
+
+    Notes
+    -----
+    Central differences with a step 1e-6 of the normal flow speed (f_L is smooth
+    where U_n ≠ 0; the truncation error is of order 1e-12 relative).  A check: f_L
+    is homogeneous of degree 2 in (U, c), so A U + c ∂f_L/∂c = 2 f_L.
+    """
+    e = np.asarray(tangents, dtype=float)
+    u = np.asarray(current, dtype=float)
+    coef = np.asarray(coef, dtype=float)
+    un = u - np.einsum("ij,ij->i", u, e)[:, None] * e
+    unorm = np.linalg.norm(un, axis=1)
+    h = 1e-6 * np.where(unorm > 0.0, unorm, 1.0)
+    jac = np.zeros(e.shape + (3,))
+    for k in range(3):
+        du = np.zeros_like(u)
+        du[:, k] = h
+        fp = steady_lift_force(e, u + du, speed, coef)
+        fm = steady_lift_force(e, u - du, speed, coef)
+        jac[:, :, k] = (fp - fm) / (2.0 * h)[:, None]
+    jac[unorm <= 0.0] = 0.0
+    return jac
 
 
 @dataclass(frozen=True, eq=False)
