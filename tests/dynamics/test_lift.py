@@ -155,7 +155,7 @@ def test_laying_example_with_lift_frequency_domain_equals_time_domain(monkeypatc
     period error (≈ 3.6 %; measured 2.8 % and 2.6 %).  The dynamic lift is resolved:
     without it (its static part kept) the frequency domain is 60 % of σ away; with it
     the end σ is 2.8× that without (the lift across the flow turns with the normal
-    flow's angle and takes damping away)."""
+    flow's angle: its gain ½ρC_L D|V|²/|U_n| exceeds the drag's)."""
     from stochcable.analysis import analyze
     from stochcable.examples import load_example
     from stochcable.reference.cable import newmark_period_error, simulate_line_timedomain
