@@ -410,7 +410,7 @@ def _start_in_resultant_plane(model: StaticsModel, X0: np.ndarray) -> np.ndarray
     a, b = X0[0], X0[-1]
     chord = (b - a) / np.linalg.norm(b - a)
     down = np.array([0.0, 0.0, -1.0]) - chord[2] * chord
-    if np.linalg.norm(down) < 0.4 or np.any(X0[:, 2] <= model.zbed):
+    if np.linalg.norm(down) < math.sin(math.radians(25.0)) or np.any(X0[:, 2] <= model.zbed):
         return X0
     st = model._residual(X0)
     w = np.where(0.5 * (X0[:-1, 2] + X0[1:, 2]) <= 0.0, model.w_sub, model.w_dry)
