@@ -203,3 +203,24 @@ def test_residuals_refused_for_a_line_with_lift():
     doc["analysis"] = {"linearization": {"drag_residual": True}}
     with pytest.raises(InputError, match=r"drag_residual.*cl_steady = 0.6"):
         build_engine(doc)
+
+
+@pytest.mark.filterwarnings("ignore::Warning")
+def test_galloping_line_is_refused_not_solved():
+    """A lift coefficient large against a small drag (C_D 0.05, C_L 2 at 3 m/s) makes
+    the linearized line flutter with its converged drag damping: refused, naming the
+    coefficient and the growth rate (the time-domain reference diverges on it within
+    25 s); C_D 0.1 and C_L 1 is stable and solved."""
+    from stochcable.analysis import analyze
+    from stochcable.errors import InputError
+
+    def doc(cd, cl):
+        d = json.loads(json.dumps(CABLE))
+        d["sea"] = {"spectrum": {"type": "jonswap", "hs": 1.0, "tp": 8.0}}
+        seg = d["lines"][0]["segments"][0]
+        seg["cl_steady"], seg["cd_normal"] = cl, cd
+        return d
+
+    assert analyze(doc(0.1, 1.0)).lines["cable"].end_b.std > 0.0
+    with pytest.raises(InputError, match=r"segments\[0\]\.cl_steady = 2.*flutter: growth"):
+        analyze(doc(0.05, 2.0))

@@ -25,6 +25,10 @@ load of the prescribed end motion (:func:`lift_end_load`), the reaction rows
 l0·A ⊗ P with P the pattern of the drag (consistent [[1/3, 1/6], [1/6, 1/3]], or
 lumped).
 
+A lift whose damping is not dominated by the drag's can make the linear system
+unstable (galloping); a stationary response does not exist then, and
+:func:`check_lift_stability` refuses it with the converged drag damping.
+
 References
 ----------
 Hu, H. Y. & Jin, D. P. (2001), Non-linear dynamics of a suspended travelling cable
@@ -34,13 +38,23 @@ subject to transverse fluid excitation, Journal of Sound and Vibration 239(3),
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from stochcable.dynamics.model.solvers import band_from_blocks
-from stochcable.line.fem import FEModel
+from stochcable.errors import InputError
+from stochcable.line.fem import FEModel, build_fe_model, chain_csr
 from stochcable.line.transport.relative_flow import lift_velocity_jacobian
 
-__all__ = ["lift_blocks", "lift_pattern", "lift_band", "lift_end_load", "lift_end_rows"]
+__all__ = [
+    "lift_blocks",
+    "lift_pattern",
+    "lift_band",
+    "lift_end_load",
+    "lift_end_rows",
+    "check_lift_stability",
+]
 
 
 def lift_blocks(
@@ -161,3 +175,67 @@ def lift_end_rows(
         "ij,jwc->iwc", pat[1, 0] * el[-1], u2
     )
     return iw * ra, iw * rb
+
+
+def check_lift_stability(system: Any, damping: Any, index: int | None = None) -> None:
+    """InputError when the linearized lift makes a line's linear system unstable.
+
+    Parameters
+    ----------
+    system : LineSystem
+        The line (its ``lift``, statics, speed).
+    damping : Damping
+        Its converged drag damping.
+    index : int, optional
+        The line's index in the scene, for the message.
+
+    Raises
+    ------
+    InputError
+        ``lines[i].segments[j].cl_steady``: an eigenvalue of the line with its drag,
+        seabed and lift damping (and its transport terms) has Re λ > 0 (a flutter or
+        divergence: galloping), named with the growth rate and frequency.
+
+    Notes
+    -----
+    The complex modes (:func:`stochcable.line.transport.modes.complex_modes`) with
+    C = C_d + C_seabed + C_L on the line's model at rest (its speed adds G and K_c),
+    unstable when an eigenvalue has Re λ > 1e-8 max|λ| (as
+    :func:`~stochcable.line.transport.modes.stability_transport`); the Rayleigh
+    structural damping is left out (it only adds damping).  Every mode up to 600 free
+    DOFs, the lowest 60 above.
+    """
+    from stochcable.line.transport.modes import DENSE_AUTO_STATES, complex_modes
+
+    if system.lift is None:
+        return
+    rest = build_fe_model(system.statics, system.environment, dim=system.model.dim)
+    d = rest.dim
+    pat = lift_pattern(rest)
+    el = system.lift
+    blocks = np.zeros((el.shape[0], 2 * d, 2 * d))
+    for a in range(2):
+        for b in range(2):
+            blocks[:, a * d : (a + 1) * d, b * d : (b + 1) * d] = pat[a, b] * el
+    c = (damping.matrix + rest.Cs + chain_csr(blocks, rest.n_nodes, d)).toarray()
+    fr = rest.free
+    speed = float(system.line.axial_speed)
+    # every mode up to DENSE_AUTO_STATES states (QZ), the lowest 60 above (Arnoldi)
+    count = None if 2 * fr.size <= DENSE_AUTO_STATES else min(60, fr.size)
+    lam = complex_modes(rest, speed, count=count, damping=c[np.ix_(fr, fr)]).eigenvalues
+    tol = 1e-8 * float(np.abs(lam).max())  # stability_transport's: above the QZ round-off
+    lead = complex(lam[int(np.argmax(lam.real))])
+    if lead.real <= tol:
+        return
+    kind = "divergence" if abs(lead.imag) <= tol else "flutter"
+    seg = next(j for j, sg in enumerate(system.line.segments) if sg.cl_steady != 0.0)
+    where = f"lines[{index}]" if index is not None else f"lines['{system.name}']"
+    raise InputError(
+        f"{where}.segments[{seg}].cl_steady",
+        system.line.segments[seg].cl_steady,
+        "-",
+        f"the linearized lift makes line '{system.name}' unstable with its converged drag "
+        f"damping ({kind}: growth Re λ = {lead.real:.3g} 1/s at {abs(lead.imag):.3g} "
+        "rad/s; galloping): it has no stationary response; lower the lift coefficient "
+        "or simulate it with the time-domain reference (docs/travelling.md)",
+    )
