@@ -212,7 +212,8 @@ def _leg_doc(speed: float, motion=None) -> dict:
         "analysis": {
             "omega": {"min": 0.2, "max": 2.5, "count": 50},
             "solver": "direct",
-            "linearization": {"tolerance": 1e-11, "max_iterations": 200},
+            "linearization": {"tolerance": 1e-11, "max_iterations": 200,
+                              "drag_residual": False, "geometric_residual": False},
         },
     }  # fmt: skip
 

@@ -290,7 +290,8 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
                 f"(lines[{i}].segments[{lift[0]}].cl_steady = "
                 f"{line.segments[lift[0]].cl_steady:g}): the residuals' adjoint solve has "
                 "no term for the lift's non-symmetric damping (docs/travelling.md); "
-                "switch the residual off or set cl_steady to 0",
+                "set analysis.linearization.drag_residual and geometric_residual to "
+                "false (the linear answer) or cl_steady to 0",
             )
         if line.axial_speed == 0.0:
             continue
