@@ -167,17 +167,19 @@ def solve_body_statics(
     }
     fixed = pb.fixed_lines(poses)
     try:
-        state, it = _solve_poses(pb, fixed, poses, body_tolerance, max_body_iterations)
+        state, it, stalled = _solve_poses(pb, fixed, poses, body_tolerance, max_body_iterations)
     except (ConvergenceError, InputError) as exc:
         # the lines cannot be solved at the input poses: from the bar model's poses
         retry = _from_bar_start(pb, fixed, poses, body_tolerance, max_body_iterations)
         if retry is None:
             raise exc from None
-        state, it = retry
-    if state.r > body_tolerance:
-        retry = _from_bar_start(pb, fixed, poses, body_tolerance, max_body_iterations)
-        if retry is not None and retry[0].r < state.r:
-            state, it = retry
+        state, it, stalled = retry
+    else:
+        if stalled:
+            # no Newton step lowers the residual: once more from the bar model's poses
+            retry = _from_bar_start(pb, fixed, poses, body_tolerance, max_body_iterations)
+            if retry is not None and retry[0].r < state.r:
+                state, it, stalled = retry
     if state.r > body_tolerance:
         raise ConvergenceError(
             "body statics Newton",
@@ -203,8 +205,9 @@ def _solve_poses(
     poses: dict[str, np.ndarray],
     body_tolerance: float,
     max_body_iterations: int,
-) -> tuple[_State, int]:
-    """The Newton from ``poses``: its last state and iteration count."""
+) -> tuple[_State, int, bool]:
+    """The Newton from ``poses``: its last state, iteration count and whether it
+    stalled (no step accepted) short of the tolerance."""
     state = pb.first_state(poses, fixed)
     if pb.free and pb.sel.size:
         _check_determined(state.K, pb.sel, pb.active, pb.free, pb.d, pb.planar, pb.lref, pb.dofs)
@@ -213,9 +216,9 @@ def _solve_poses(
         it += 1
         trial = _newton_step(pb, fixed, state)
         if trial is None:
-            break
+            return state, it, True
         state = trial
-    return state, it
+    return state, it, False
 
 
 def _from_bar_start(
@@ -224,7 +227,7 @@ def _from_bar_start(
     poses: dict[str, np.ndarray],
     body_tolerance: float,
     max_body_iterations: int,
-) -> tuple[_State, int] | None:
+) -> tuple[_State, int, bool] | None:
     """The Newton from the straight-bar model's poses (:mod:`stochcable.bodies.start`),
     or None when that start is the input or the lines cannot be solved there either."""
     if not pb.free or not pb.sel.size:

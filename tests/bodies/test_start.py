@@ -22,12 +22,13 @@ RHO, G = 1000.0, 9.80665
 L, EA, M = 100.5, 1.0e9, 1000.0
 
 
-def _lifting(line_mass: float) -> dict:
-    """A 1 t clump at z = -100 m on a 100.5 m line from the origin (0.5 m of slack)."""
+def _lifting(line_mass: float, position=(0.0, 0.0, -100.0)) -> dict:
+    """A 1 t clump (default at z = -100 m) on a 100.5 m line from the origin (0.5 m of
+    slack)."""
     return {
         "environment": {"depth": 500.0, "rho": RHO, "g": G},
         "bodies": [
-            {"name": "clump", "position": [0.0, 0.0, -100.0], "mass": M, "fixed_dofs": ["pitch"]}
+            {"name": "clump", "position": list(position), "mass": M, "fixed_dofs": ["pitch"]}
         ],
         "lines": [
             {
@@ -67,3 +68,15 @@ def test_bar_start_is_the_taut_bar_equilibrium():
     start = bar_start_poses(scene, poses, ["clump"], meshes, scene_rigid_bodies(scene))
     np.testing.assert_allclose(start["clump"], [0.0, 0.0, -L * (1.0 + M * G / EA), 0, 0, 0])
     assert poses["clump"][2] == -100.0  # the input is not modified
+
+
+# started off the vertical, the line slack: 5 m aside, and 60 m aside 20 m deep (a
+# slack line of 100.5 m over a 63 m chord); the bar start's stiffness continuation
+# swings the pendulum down (a stiff bar alone took 200 trust-region steps to go 19 m
+# further off, and a compressive slack law pushed the clump through the anchor)
+@pytest.mark.parametrize("position", [(5.0, 0.0, -95.0), (-60.0, 0.0, -20.0)])
+def test_a_weight_started_off_the_vertical_hangs_below_the_anchor(position):
+    st = solve_statics(load_scene(_lifting(7.85398, position)), "fe")
+    np.testing.assert_allclose(
+        st.bodies["clump"].position, [0.0, 0.0, -L * (1.0 + M * G / EA)], rtol=0, atol=1e-8
+    )
