@@ -106,11 +106,12 @@ RESIDUAL_KINDS: dict[str, ResidualKind] = {
             name="drag_residual",
             switch="Also compute the end-tension variance the linearization drops: the "
             "closed-form Hermite residual of the quadratic drag (lines.<name>.drag_residual; "
-            "planar lines, seed method, lines not on free bodies)",
+            "seed method, or vector on 3-D lines; lines on free bodies through the group)",
             document="The end-tension variance the statistical drag linearization drops, "
             "in closed form (the Hermite residual of the quadratic drag; present with "
             "``analysis.linearization.drag_residual``); see :doc:`../benchmarks/drag_residual`.",
-            scope="3-D lines, the vector or harmonic linearization, lines on free bodies",
+            scope="the harmonic linearization; the vector linearization of a planar line; "
+            "a travelling line on free bodies",
             order="Highest Hermite order kept.",
             panels="Element groups the residual was evaluated on.",
             memory_bytes=_RESIDUAL_BYTES,
@@ -120,12 +121,12 @@ RESIDUAL_KINDS: dict[str, ResidualKind] = {
             name="geometric_residual",
             switch="Also compute the end-tension variance of the second-order geometric "
             "forces of the linear response (stretching and rotation of the tension; "
-            "lines.<name>.geometric_residual; lines not on free bodies, at most 400 elements)",
+            "lines.<name>.geometric_residual; at most 400 elements)",
             document="The end-tension variance of the second-order geometric forces of the "
             "linear response (stretching and rotation of the tension; present with "
             "``analysis.linearization.geometric_residual``); see "
             ":doc:`../benchmarks/drag_residual`.",
-            scope="more than 400 elements, lines on free bodies",
+            scope="more than 400 elements, a travelling line on free bodies",
             order="2: the forces are quadratic in the response.",
             panels="The elements the residual was evaluated on.",
             memory_bytes=_RESIDUAL_BYTES,
