@@ -23,7 +23,7 @@ from stochcable.dynamics.groups import CoupledLine, body_loads, linearize_couple
 from stochcable.dynamics.groups.group import linear_body_drag
 from stochcable.dynamics.loads.channels import line_channels
 from stochcable.dynamics.model.system import build_line_system
-from stochcable.dynamics.residuals.body_residual import coupled_influences
+from stochcable.dynamics.residuals.body_residual import CoupledInfluence, coupled_influences
 from stochcable.dynamics.residuals.residual_lines import end_influence
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
 from stochcable.reference.bodies import solve_coupled_direct
@@ -76,7 +76,8 @@ def test_coupled_influence_equals_the_assembled_system(buoy_group):
     of the assembled lines–body system solved directly (its support forces −[Z u − F]
     at the end rows, ê·R), to round-off (measured 7e-13; bound 1e-9 for the dense
     solve's conditioning, ~1e8); the body's motion changes them (the ends-held
-    influence differs by more than 1e-3)."""
+    influence differs by more than 1e-3); another leg's end tensions under the same
+    loads (the ``target`` influence, through the buoy only) likewise."""
     scene, cls, loads, body, lin = buoy_group
     w = np.linspace(0.1, 6.0, 25)
     damp = {cl.name: lin.lines[cl.name].damping for cl in cls}
@@ -110,6 +111,22 @@ def test_coupled_influence_equals_the_assembled_system(buoy_group):
     held = np.einsum("enkw,nkc->ewc", end_influence(cl.system, damp[cl.name], w),
                      f.reshape(n, d, 3))  # fmt: skip
     assert np.abs(held - ref).max() > 1e-3 * np.abs(ref).max()
+    # another leg's end tensions under the same loads: through the buoy only
+    other = cls[1]
+    cross = CoupledInfluence(cl.name, infl[cl.name].lines, [body], lin.body_drag, other.name)
+    got = np.einsum("enkw,nkc->ewc", cross.on(w), f.reshape(n, d, 3))
+    mo = other.system.model
+    u2 = expand_line(system, other.name, x)
+    c2 = mo.Cs + damp[other.name].matrix
+    ends2 = np.r_[np.arange(d), np.arange((mo.n_nodes - 1) * d, mo.n_nodes * d)]
+    r2 = np.stack(
+        [-((mo.K - w[i] ** 2 * (mo.M + mo.Ma) + 1j * w[i] * c2) @ u2[i])[ends2]
+         for i in range(w.size)]
+    )  # fmt: skip
+    ten2 = end_tension_from_support(other.system, r2)
+    ref2 = np.stack([ten2["end_a"].T, ten2["end_b"].T])
+    assert np.abs(ref2).max() > 1e-3 * np.abs(ref).max()
+    np.testing.assert_allclose(got, ref2, rtol=1e-9, atol=1e-9 * np.abs(ref2).max())
 
 
 def test_a_line_without_attached_ends_keeps_the_held_influence(buoy_group):

@@ -129,7 +129,8 @@ def end_solves(system: Any, damping: Any, w: np.ndarray) -> tuple[np.ndarray, np
 
 class CoupledInfluence:
     """The end influence of one line of a coupled group (module notes): end tensions
-    per unit force on each node and component, through the group.
+    (of this line, or of another ``target`` line) per unit force on each node and
+    component of this line, through the group.
 
     Parameters
     ----------
@@ -141,6 +142,9 @@ class CoupledInfluence:
         The group's free bodies at their static pose.
     body_drag : mapping of str to ndarray, shape (3,)
         Linear drag per direction of each body with a drag area. [N·s/m]
+    target : str, optional
+        The line whose end tensions are the outputs (default ``name``: its own); another
+        line of the group is reached through the bodies only.
 
     Notes
     -----
@@ -155,8 +159,10 @@ class CoupledInfluence:
         lines: Sequence[GroupLine],
         bodies: Sequence[RigidBody],
         body_drag: Mapping[str, np.ndarray],
+        target: str | None = None,
     ) -> None:
         self.name = name
+        self.target = name if target is None else target
         self.lines = tuple(lines)
         self.line = next(ln for ln in self.lines if ln.name == name)
         self.bodies = tuple(bodies)
@@ -195,21 +201,24 @@ class CoupledInfluence:
                 s = s - t.T[None] @ r_e[:, att[:, None], att[None, :]] @ t[None]
         system = self.line.system
         d, n = system.model.dim, system.model.n_nodes
-        x, r_e = solved[self.name]
+        x = solved[self.name][0]
         t, att = links[self.name]
+        target = next(ln for ln in self.lines if ln.name == self.target).system
         eye = np.eye(2 * d)[None].astype(complex)
-        ten = end_tension_from_support(system, eye)
+        ten = end_tension_from_support(target, eye)
         e_hat = np.zeros((2, 2 * d))
         e_hat[0] = np.real(ten["end_a"][:, 0])
         e_hat[1] = np.real(ten["end_b"][:, 0])
-        y = np.broadcast_to(e_hat, (w.size, 2, 2 * d)).astype(complex)
-        if att.size:
+        y = np.zeros((w.size, 2, 2 * d), dtype=complex)
+        if self.target == self.name:
+            y += e_hat[None]
+        t_l, att_l = links[self.target]
+        if att.size and att_l.size:
             free = np.array([off[b.name] + i for b in self.bodies for i in b.free_index], int)
             tf = t[:, free]
             xi = np.linalg.solve(s[:, free[:, None], free[None, :]], np.broadcast_to(
                 tf.T, (w.size,) + tf.T.shape))  # fmt: skip
-            p = r_e[:, :, att] @ tf[None] @ xi  # (n_w, 2d, |att|)
-            y = y.copy()
+            p = solved[self.target][1][:, :, att_l] @ t_l[:, free][None] @ xi  # (n_w, 2d, |att|)
             y[:, :, att] += e_hat[None] @ p
         # G_R: e_i on the end nodes, −x_i on the free nodes
         g = np.zeros((2, n, d, w.size), dtype=complex)
