@@ -232,21 +232,26 @@ def test_planar_line_in_a_3d_model_gives_the_2d_residual():
 
 
 @pytest.mark.slow
-def test_inclined_guy_at_45_degrees_within_the_time_domain_interval():
-    """The inclined guy in its sea turned to 45° (a 3-D model: the waves load it in and
-    out of its plane): the FD end σ with the 3-D drag residual lies within the 95 %
-    interval of the reference TD's mean (seeds 1–5, 1200 s records without the first
-    200 s, the analysis band; Student t: ±16 N about 507 / 526 N), where the linear FD
-    (−15 %) does not; measured −1.5 % / −1.3 % (end_b / end_a) off the TD means.
-    ≈ 100 s."""
-    doc = load_example("inclined_guy").model_dump(mode="json")
+@pytest.mark.parametrize("example", ["inclined_guy", "taut_wire"])
+def test_lines_at_45_degrees_within_the_time_domain_interval(example):
+    """The inclined guy and the taut wire in their seas turned to 45° (3-D models: the
+    waves load them in and out of their planes): the FD end σ with the 3-D drag
+    residual lies within the 95 % interval of the reference TD's mean (seeds 1–5,
+    1200 s records without the first 200 s, the analysis band; Student t: ±3 % on the
+    guy, ±5 % on the wire), where the linear FD does not (more than two half-widths
+    off).  Measured (end_b / end_a, against the TD means): the guy's linear FD −15 %,
+    with the residual −1.5 / −1.3 % (the Hermite orders ≥ 2 add, the seed form's
+    misfit takes a little back); the wire's linear FD +29 / +14 % — the seed form's
+    isotropic B over-drives a drag-excited line whose normal velocity is far from
+    isotropic — with the residual +1.0 / +1.1 % (the misfit lowers σ).  ≈ 100 s each."""
+    doc = load_example(example).model_dump(mode="json")
     doc["analysis"].pop("timeseries", None)
     doc["analysis"]["linearization"].update(tolerance=1e-8, drag_residual=True)
     doc["sea"]["heading"] = 45.0
     scene = load_scene(doc)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        line = analyze(scene).lines["guy"]
+        line = next(iter(analyze(scene).lines.values()))
         band = (float(line.omega[0]), float(line.omega[-1]))
         td = []
         for seed in range(1, 6):
