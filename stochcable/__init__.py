@@ -35,10 +35,21 @@ _LAZY = {
 
 def __getattr__(name: str):
     if name in _LAZY:
+        import gc
         import importlib
 
         module, attr = _LAZY[name]
-        value = getattr(importlib.import_module(f".{module}", __name__), attr)
+        # no cyclic garbage collection while the pipeline imports: its ~800 modules
+        # (NumPy, SciPy, pydantic and ours) leave ~50,000 tracked objects that live as
+        # long as the process, and the collector ran ~130 times over them (20–40 ms of
+        # the first analysis, docs/benchmarks/first_analysis.md); restored as it was
+        enabled = gc.isenabled()
+        gc.disable()
+        try:
+            value = getattr(importlib.import_module(f".{module}", __name__), attr)
+        finally:
+            if enabled:
+                gc.enable()
         globals()[name] = value
         return value
     raise AttributeError(f"module 'stochcable' has no attribute {name!r}")

@@ -60,6 +60,17 @@ def test_import_is_light():
     assert out.stdout.strip() == "False"
 
 
+def test_lazy_entry_points_leave_the_collector_as_they_found_it():
+    # the lazy import runs without cyclic garbage collection, then restores it
+    code = (
+        "import gc, stochcable; stochcable.build_engine; on = gc.isenabled(); "
+        "gc.disable(); stochcable.analyze; print(on, gc.isenabled())"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "False"]
+
+
 _FIRST_ANALYSIS = """
 import json, sys, warnings
 warnings.simplefilter("ignore")
