@@ -31,6 +31,9 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+#: The children's environment: this process's, before the host probe configures it.
+ENV = dict(os.environ, PYTHONPATH=str(ROOT))
+ENV.pop("PYTHONDONTWRITEBYTECODE", None)
 EXAMPLE = "stochcable/examples/chain_catenary.json"
 LIMIT_S = 0.5
 #: Modules the chain's first analysis should not load (as tests/test_public_api.py checks).
@@ -73,11 +76,9 @@ print(json.dumps({{"wall": wall, "cpu": cpu,
 
 def run_once(scene: str) -> dict:
     """One fresh interpreter's first analysis of ``scene`` (a key of :data:`SCENES`)."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
     code = CODE.format(scene=SCENES[scene].format(example=EXAMPLE), heavy=HEAVY)
     out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env,
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=ENV,
         timeout=120, check=True,
     )  # fmt: skip
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -88,14 +89,17 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=9)
     parser.add_argument("--write", action="store_true")
     args = parser.parse_args()
-    load_start = os.getloadavg()[0]
+    sys.path.insert(0, str(ROOT))  # (the probe configures this tree's stochcable.runtime)
+    from host_probe import host_line  # (benchmarks/: the host's speed state)
+
+    load_start, probe_start = os.getloadavg()[0], host_line()
     for scene in SCENES:
         run_once(scene)  # (the bytecode cache, not counted)
     runs: dict[str, list[dict]] = {scene: [] for scene in SCENES}
     for _ in range(args.runs):  # (interleaved: a load burst hits both scenes alike)
         for scene in SCENES:
             runs[scene].append(run_once(scene))
-    load_end = os.getloadavg()[0]
+    load_end, probe_end = os.getloadavg()[0], host_line()
     rows = []
     for scene, rs in runs.items():
         wall = [r["wall"] for r in rs]
@@ -112,6 +116,8 @@ def main() -> None:
         f"python benchmarks/first_analysis.py --runs {args.runs} --write` on "
         f"{platform.machine()}, Python {platform.python_version()}, {os.cpu_count()} cores "
         f"(load average {load_start:.1f} at the start, {load_end:.1f} at the end).",
+        "",
+        f"At the start, {probe_start}; at the end, {probe_end}.",
         "",
         "The first `stochcable.analyze()` of the chain example in a fresh interpreter, "
         "from after the interpreter's start to its return (imports included, the bytecode "
