@@ -46,6 +46,7 @@ HEAVY = (
     "scipy.special",
     "scipy.fft",
     "scipy.optimize",
+    "scipy.sparse.linalg",
     "scipy.stats",
     "scipy.integrate",
     "scipy.interpolate",

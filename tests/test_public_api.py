@@ -100,7 +100,7 @@ def test_the_first_analysis_imports_what_the_scene_uses(residuals):
     # no scipy.fft, so scipy.special (~25 ms of import) is not loaded either, with the
     # residual switches on or off (docs/benchmarks/first_analysis.md)
     heavy = ("numba", "pyfftw", "xarray", "pandas", "matplotlib", "scipy.special", "scipy.fft")
-    heavy += ("scipy.optimize", "scipy.stats", "stochcable.fidelity.planner")
+    heavy += ("scipy.optimize", "scipy.stats", "scipy.sparse.linalg", "stochcable.fidelity.planner")
     code = _FIRST_ANALYSIS.format(on=residuals, heavy=heavy)
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
     out = subprocess.run(
