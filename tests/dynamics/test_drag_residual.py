@@ -31,6 +31,16 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 import residual_cost  # noqa: E402
 
 
+def test_fft_length_equals_scipy_next_fast_len():
+    """The residuals' lag-grid length is SciPy's fast real-FFT length, for every length
+    up to 2·10⁴ and for large ones (it avoids importing scipy.fft)."""
+    import scipy.fft
+
+    rng = np.random.default_rng(5)
+    ns = [*range(1, 20_001), *(int(x) for x in rng.integers(1, 10**15, 500)), 2**40 + 1]
+    assert [rl.fft_length(n) for n in ns] == [scipy.fft.next_fast_len(n, real=True) for n in ns]
+
+
 def test_hermite_coefficients_closed_forms():
     """a₁ = 2E|μ + x| (the Borgman coefficient over cσ), a₀ = E[g]; zero mean: the even
     coefficients vanish and 3!·a₃² = 4/(3π); Parseval: Σ_{k≥1} k! a_k² = Var g(μ + x)
