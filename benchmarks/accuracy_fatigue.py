@@ -35,6 +35,7 @@ __all__ = [
     "gaussian_expected_maximum",
     "damage_rates",
     "phase_randomized",
+    "low_passed",
 ]
 
 
@@ -86,6 +87,16 @@ def phase_randomized(x: np.ndarray, rng: np.random.Generator, count: int) -> np.
     if x.size % 2 == 0:
         out[:, -1] = c[-1]  # the Nyquist line stays real
     return np.fft.irfft(out, n=x.size)
+
+
+def low_passed(x: np.ndarray, dt: float, omega_max: float) -> np.ndarray:
+    """Periodic records (last axis one period each) without their lines above
+    ``omega_max`` [rad/s]. [unit]"""
+    x = np.asarray(x, dtype=float)
+    c = np.fft.rfft(x, axis=-1)
+    w = 2.0 * math.pi * np.arange(c.shape[-1]) / (x.shape[-1] * dt)
+    c[..., w > omega_max] = 0.0
+    return np.fft.irfft(c, n=x.shape[-1], axis=-1)
 
 
 def moments_of_record(x: np.ndarray) -> dict[str, float]:
@@ -226,6 +237,11 @@ def _paired(a: np.ndarray, b: np.ndarray) -> str:
     return f"{100 * m:+.1f} ± {100 * h:.1f} %"
 
 
+def _share_above(x: np.ndarray, dt: float, omega: float) -> float:
+    w, s = periodic_density(x, dt)
+    return float(s[w > omega].sum() / s.sum())
+
+
 def analyse_end(item: dict, rng: np.random.Generator) -> dict:
     """Every fatigue and non-Gaussian statistic of one line end (see :func:`sections`)."""
     curve = fatigue_curve(item["curve"])
@@ -237,7 +253,9 @@ def analyse_end(item: dict, rng: np.random.Generator) -> dict:
     mom = [moments_of_record(x) for x in recs]
     skew = float(np.mean([d["skewness"] for d in mom]))
     kurt = float(np.mean([d["kurtosis"] for d in mom]))
-    gauss_rain, gauss_max, td_max, sur_skew, sur_kurt = [], [], [], [], []
+    w_top = float(np.max(item["default"][0]))
+    gauss_rain, gauss_low, above = [], [], []
+    gauss_max, td_max, sur_skew, sur_kurt = [], [], [], []
     for x, d in zip(recs, mom):
         sur = phase_randomized(x, rng, SURROGATES)
         sur_skew.append(float(np.mean(stats.skew(sur, axis=1))))
@@ -245,6 +263,11 @@ def analyse_end(item: dict, rng: np.random.Generator) -> dict:
         gauss_rain.append(
             np.mean([damage_rainflow(y * k, curve, duration=y.size * dt) for y in sur])
         )
+        low = low_passed(sur, dt, w_top)
+        gauss_low.append(
+            np.mean([damage_rainflow(y * k, curve, duration=y.size * dt) for y in low])
+        )
+        above.append(_share_above(x, dt, w_top))
         gauss_max.append(float(np.mean((sur.max(axis=1) - d["mean"]) / d["std"])))
         td_max.append((float(x.max()) - d["mean"]) / d["std"])
     # a DSA record's own moments are not a Gaussian's (deterministic amplitudes: a few
@@ -275,6 +298,14 @@ def analyse_end(item: dict, rng: np.random.Generator) -> dict:
         "h4": h4,
         "factor": factor,
         "gauss_rain": np.array(gauss_rain),
+        "gauss_low": np.array(gauss_low),
+        "above": float(np.mean(above)),
+        "above_md": (
+            float(np.mean([_share_above(x, dt, w_top) for x in item["md_records"]]))
+            if item.get("md_records")
+            else None
+        ),
+        "w_top": w_top,
         "gauss_max": u,
         "td_max": np.array(td_max),
         "herm_max": herm_max,
@@ -295,7 +326,8 @@ def sections(items: list[dict], seed: int = 31) -> list[str]:
         Per line end: ``line``, ``end`` (names), ``records`` (the reference TD's
         support-reaction records, one period per seed) [N], ``dt`` [s], ``default`` and
         ``linear`` ((omega [rad/s], density [N²·s/rad]) of the FD's end tension:
-        corrected and linear), ``curve`` (a catalogue curve name).
+        corrected and linear), ``curve`` (a catalogue curve name), optionally
+        ``md_records`` (MoorDyn's records of the same seeds) [N].
     seed : int
         Seed of the Gaussian surrogates' phases.
     """
@@ -335,32 +367,40 @@ def sections(items: list[dict], seed: int = 31) -> list[str]:
         )
     out += [
         "",
-        "The FD's error split into its three factors (they multiply): the **spectrum** "
-        "(Dirlik on the FD default's density over Dirlik on the TD's own spectrum, the "
-        "records' periodograms — exact lines of a periodic record — up to the top of the "
-        "FD's corrected density, 3× the band: above it the TD records hold < 0.1 % of "
-        "the variance but enough of the fourth moment, up to the 63 rad/s Nyquist "
-        "frequency of the 0.05 s samples, to move Dirlik's peak rate); **Dirlik's "
-        "method** (Dirlik on the TD's spectrum over the rainflow damage of Gaussian "
-        "surrogates "
-        f"of the records: their Fourier amplitudes with random phases, {SURROGATES} per "
-        "seed); the **non-Gaussian** part (rainflow of the TD records over that of their "
-        "Gaussian surrogates: the same spectrum, line by line, the phase coupling "
-        "removed).  Paired per seed.",
+        "The FD default's error split into four factors (they multiply to the first "
+        "column above; each a contribution to FD/TD − 1, paired per seed): the "
+        "**spectrum** (Dirlik on the FD default's density over Dirlik on the TD's own "
+        "spectrum — the records' periodograms, exact lines of a periodic record — up to "
+        "the top ω_top of the FD's corrected density, 3× the band; with the part σ^m of "
+        "it that the σ error alone gives); **Dirlik's method** (Dirlik on that TD "
+        "spectrum over the rainflow damage of Gaussian surrogates of the records — their "
+        f"Fourier amplitudes with random phases, {SURROGATES} per seed — low-passed at "
+        "ω_top); the TD's content **above ω_top** (the surrogates low-passed over the "
+        "full ones: a small variance, but it rides on the large cycles and lengthens "
+        "their ranges); the **Gaussian assumption** (the full surrogates' rainflow "
+        "damage over the TD records': the same spectrum line by line, the records' phase "
+        "coupling — their non-Gaussian part — removed).  Winterstein's prediction of the "
+        "last: 1/factor − 1 of the Hermite model with the records' excess moments "
+        "(next section).",
         "",
-        "| line | end | spectrum | … of which σ^m | Dirlik's method | non-Gaussian "
-        "(measured) | non-Gaussian, Winterstein's prediction |",
-        "|---|---|---|---|---|---|---|",
+        "| line | end | spectrum | … of which σ^m | Dirlik's method | TD above ω_top "
+        "(its share of the variance; MoorDyn's) | Gaussian assumption, measured | Gaussian "
+        "assumption, Winterstein's prediction |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for it, r in res:
         rt = r["rates"]
         sig_m = r["sigma_ratio"] ** r["curve"].slopes[0] - 1.0
         n = rt["dirlik_td"].size
         out.append(
-            f"| {it['line']} | {it['end']} | {_paired(np.full(n, rt['dirlik']), rt['dirlik_td'])} "
-            f"| {100 * sig_m:+.1f} % "
-            f"| {_paired(rt['dirlik_td'], r['gauss_rain'])} "
-            f"| {_paired(rt['rainflow'], r['gauss_rain'])} | {100 * (r['factor'] - 1):+.1f} % |"
+            f"| {it['line']} | {it['end']} "
+            f"| {_paired(np.full(n, rt['dirlik']), rt['dirlik_td'])} | {100 * sig_m:+.1f} % "
+            f"| {_paired(rt['dirlik_td'], r['gauss_low'])} "
+            f"| {_paired(r['gauss_low'], r['gauss_rain'])} ({100 * r['above']:.2f} %; "
+            + (f"{100 * r['above_md']:.2f} %" if r["above_md"] is not None else "–")
+            + ") "
+            f"| {_paired(r['gauss_rain'], rt['rainflow'])} "
+            f"| {100 * (1.0 / r['factor'] - 1):+.1f} % |"
         )
     out += [
         "",

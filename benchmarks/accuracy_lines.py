@@ -678,18 +678,23 @@ def _fatigue_inputs(cache: dict, records: Path) -> list[dict]:
         fd0, fdl = _fd(cache, line, "default"), _fd(cache, line, "linear")
         for q, end in ENDS:
             e = "end_" + q[-1]
-            recs = []
+            recs, md = [], []
             for s in mc.SEEDS:
                 run = {"line": line, "sim": "reference", "seed": s, **mc.BASE}
                 with np.load(record_path(records, run)) as f:
                     recs.append(np.array(f[q]))
                     dt = float(f["t"][1] - f["t"][0])
+                if line in MOORDYN_LINES:
+                    run["sim"] = "moordyn"
+                    with np.load(record_path(records, run)) as f:
+                        md.append(np.array(f[q]))
             out.append(
                 {
                     "line": line,
                     "end": end,
                     "key": e,
                     "records": recs,
+                    "md_records": md,
                     "dt": dt,
                     "default": [np.asarray(x) for x in fd0["density"][e]["answer"]],
                     "linear": [np.asarray(x) for x in fdl["density"][e]["linear"]],
