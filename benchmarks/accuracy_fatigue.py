@@ -443,5 +443,63 @@ def sections(items: list[dict], seed: int = 31) -> list[str]:
             f"| {100 * m_t:+.2f} ± {100 * h_t:.2f} % "
             f"| {r['u3h']:.2f}: {100 * (r['herm_3h'] / r['u3h'] - 1):+.1f} % |"
         )
-    out += [""]
-    return out
+    return out + [""] + _reading(res)
+
+
+def _pct_range(values: list[float]) -> str:
+    return f"{100 * min(values):+.1f} … {100 * max(values):+.1f} %"
+
+
+def _reading(res: list[tuple[dict, dict]]) -> list[str]:
+    """The conclusions of the two sections, their numbers read from the results."""
+    gap = {(it["line"], it["end"]): r["rates"]["dirlik"] / r["rates"]["rainflow"].mean() - 1.0
+           for it, r in res}  # fmt: skip
+    lin = [r["linear"] / r["rates"]["rainflow"].mean() - 1.0 for _, r in res]
+    miss = {k: v for k, v in gap.items() if abs(v) > TARGET}
+    wint = {(it["line"], it["end"]): 1.0 / r["factor"] - 1.0 for it, r in res}
+    meas = [float(np.mean(r["gauss_rain"] / r["rates"]["rainflow"]) - 1.0) for _, r in res]
+    with_h = {(it["line"], it["end"]): r["rates"]["dirlik"] * r["factor"]
+              / r["rates"]["rainflow"].mean() - 1.0 for it, r in res}  # fmt: skip
+    sig_m = [r["sigma_ratio"] ** r["curve"].slopes[0] - 1.0 for _, r in res]
+    band = [float(np.mean(r["gauss_low"] / r["gauss_rain"]) - 1.0) for _, r in res]
+    ext = [r["herm_3h"] / r["u3h"] - 1.0 for _, r in res]
+    out = [
+        "### Reading",
+        "",
+        f"- **Fatigue, FD default against the TD's rainflow**: within {100 * TARGET:.0f} % "
+        f"on {len(gap) - len(miss)} of {len(gap)} ends (mean over the seeds: "
+        f"{_pct_range(list(gap.values()))}; the linear model {_pct_range(lin)})"
+        + (
+            "; outside: "
+            + ", ".join(f"{ln} {e} {100 * v:+.1f} %" for (ln, e), v in miss.items())
+            + " (see the CI: 5 records of 200 s)."
+            if miss
+            else "."
+        ),
+        f"- **What the FD's damage misses**, by factor: the σ error raised to the S–N "
+        f"slope ({_pct_range(sig_m)}: a 1 % σ error is 3–4 % of damage), the TD's "
+        f"content above the FD's top frequency ({_pct_range(band)}; present in MoorDyn's "
+        "records too, so not an artefact of the reference's integrator), Dirlik's method "
+        "itself and the Gaussian assumption (next).",
+        f"- **The non-Gaussian part**: the records' excess skewness and kurtosis are small "
+        f"(|h3|, |h4| ≤ {max(max(abs(r['h3']), abs(r['h4'])) for _, r in res):.3f}); the "
+        f"Gaussian assumption's measured effect on the damage is {_pct_range(meas)} with "
+        "half-widths of 4–20 % (one 200 s record per seed: rainflow damage is itself a "
+        "noisy statistic), Winterstein's Hermite model with the measured moments "
+        f"predicts {_pct_range(list(wint.values()))}.  On the largest 200 s maximum the "
+        "effect is below the seeds' scatter; at the 3-h level the Hermite model moves "
+        f"the dynamic part of the expected maximum by {_pct_range(ext)}.",
+    ]
+    if miss:
+        out.append(
+            "- **Would the Winterstein transform close the gap?**  Applied to the FD "
+            "default's damage it gives "
+            + ", ".join(f"{ln} {e} {100 * with_h[(ln, e)]:+.1f} %" for ln, e in miss)
+            + " on the ends outside the target: "
+            + (
+                "it closes them."
+                if all(abs(with_h[k]) <= TARGET for k in miss)
+                else "it does not close them (the split above shows where their gap is)."
+            )
+        )
+    return out + [""]

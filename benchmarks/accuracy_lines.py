@@ -307,9 +307,13 @@ def _header(cache: dict) -> list[str]:
         "budget` lets two processes share the work) and then `python3 "
         "benchmarks/accuracy_lines.py --write`.  Do not edit by hand: re-run the script.  "
         "It shares its run cache with `benchmarks/moordyn_check.py` "
-        "([the reference against MoorDyn](../benchmarks/moordyn.md)) and re-runs the "
-        "steps of `benchmarks/fd_budget.py` ([the FD error budget]"
-        "(../benchmarks/fd_budget.md)) for this page's motion.",
+        "([the reference against MoorDyn](../benchmarks/moordyn.md))"
+        + (
+            " and re-runs the steps of `benchmarks/fd_budget.py` ([the FD error budget]"
+            "(../benchmarks/fd_budget.md)) for this page's motion."
+            if _budget_complete(cache)
+            else "; the fatigue and non-Gaussian statistics are `benchmarks/accuracy_fatigue.py`'s."
+        ),
         "",
         f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python "
         f"{platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}, "
@@ -462,20 +466,23 @@ def _sigma_tables(cache: dict) -> list[str]:
     out += [
         "",
         "Converged (320 elements, direct, drag to 1e-8, on the TD's lines) against the "
-        "160-element reference TD, with and without the residuals:",
+        "160-element reference TD, with and without the residuals; and the default "
+        "against the 160-element TD (the reference's own mesh error removed):",
         "",
-        "| line | end | FD converged, linear / TD − 1 | FD converged, corrected / TD − 1 |",
-        "|---|---|---|---|",
+        "| line | end | FD converged, linear / TD − 1 | FD converged, corrected / TD − 1 "
+        "| FD default / TD 160 − 1 |",
+        "|---|---|---|---|---|",
     ]
     for line in BUDGET_LINES:
         fdc, fdr = _fd(cache, line, "lines320"), _fd(cache, line, "residuals320")
+        fd0 = _fd(cache, line, "default")
         td2 = _seeds(cache, line, "reference", FINE)
         for q, end in ENDS:
             lq = q.replace("reaction", "lines")
             rq = q.replace("reaction", "lines_residual")
             out.append(
                 f"| {line} | {end} | {_pct(_over(fdc[lq], td2, q))} "
-                f"| {_pct(_over(fdr[rq], td2, q))} |"
+                f"| {_pct(_over(fdr[rq], td2, q))} | {_pct(_over(fd0[q], td2, q))} |"
             )
     out += [
         "",
@@ -664,7 +671,9 @@ def _reading(cache: dict) -> list[str]:
                     f"{100 * np.mean([r2[q] / r[q] - 1.0 for r, r2 in zip(td, td2)]):+.2f} %"
                     for q, _ in ENDS
                 )
-                + " from 80 to 160 elements."
+                + " from 80 to 160 elements; the default against the 160-element TD: "
+                + " / ".join(f"{_mean_ratio(fd0[q], td2, q):+.2f} %" for q, _ in ENDS)
+                + "."
             )
         out.append(text)
     return out + [""]
