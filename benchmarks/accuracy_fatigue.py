@@ -360,7 +360,7 @@ def sections(items: list[dict], seed: int = 31) -> list[str]:
     for it, r in res:
         rain = r["rates"]["rainflow"]
         d0 = r["rates"]["dirlik"]
-        ok = "yes" if abs(d0 / rain.mean() - 1.0) <= TARGET else "**no**"
+        ok = "yes" if abs(round(d0 / rain.mean() - 1.0, 3)) <= TARGET else "**no**"
         out.append(
             f"| {it['line']} | {it['end']} | `{r['curve'].name}` | {_vs_mean(d0, rain)} "
             f"| {ok} | {_vs_mean(r['linear'], rain)} | {_vs_mean(d0 * r['factor'], rain)} |"
