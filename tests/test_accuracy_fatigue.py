@@ -15,6 +15,7 @@ from _paths import ROOT
 from scipy import integrate, special
 
 from stochcable.design.curves import fatigue_curve, tension_to_curve_quantity
+from stochcable.design.spectral_fatigue import damage_rate_dirlik
 
 SCRIPT = ROOT / "benchmarks" / "accuracy_fatigue.py"
 
@@ -119,3 +120,14 @@ def test_expected_maximum_of_n_rayleigh_maxima():
     for n, tol in ((20, 0.015), (1000, 0.005)):
         exact = integrate.quad(lambda x, n=n: 1.0 - (1.0 - math.exp(-x * x / 2)) ** n, 0, 20)[0]
         assert af.gaussian_expected_maximum(10.0, 10.0 * n) == pytest.approx(exact, rel=tol)
+
+
+def test_flife_dirlik_is_the_library_s_on_a_broad_band():
+    """Two peaks (α2 ≈ 0.5): FLife's Dirlik with the amplitude intercept a/2^m is the
+    library's to round-off (the page's check column)."""
+    curve = fatigue_curve("dnv-six-strand")
+    w = np.linspace(0.05, 6.0, 600)
+    s = np.exp(-(((w - 0.6) / 0.1) ** 2)) + 0.3 * np.exp(-(((w - 3.0) / 0.3) ** 2))
+    s = s * 1e14  # [Pa²·s/rad]
+    want = float(damage_rate_dirlik(w, s, curve))
+    assert af.dirlik_flife(w, s, curve) == pytest.approx(want, rel=1e-9)
