@@ -310,10 +310,11 @@ def _header(cache: dict) -> list[str]:
         "([the reference against MoorDyn](../benchmarks/moordyn.md))"
         + (
             " and re-runs the steps of `benchmarks/fd_budget.py` ([the FD error budget]"
-            "(../benchmarks/fd_budget.md)) for this page's motion."
+            "(../benchmarks/fd_budget.md)) for this page's motion"
             if _budget_complete(cache)
-            else "; the fatigue and non-Gaussian statistics are `benchmarks/accuracy_fatigue.py`'s."
-        ),
+            else ""
+        )
+        + "; the fatigue and non-Gaussian statistics are `benchmarks/accuracy_fatigue.py`'s.",
         "",
         f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python "
         f"{platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}, "
