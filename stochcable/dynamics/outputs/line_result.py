@@ -194,7 +194,11 @@ def line_result(
         residual[kind.name] = (
             fn(system, channels, linearization, std, influence=shared)
             if alone or influence is not None
-            else ResidualRecord.not_computed("a line on free bodies is not covered", std)
+            else ResidualRecord.not_computed(
+                "a travelling line on free bodies is not covered (the coupled influence "
+                "leaves out the transport terms)",
+                std,
+            )
         )
     applied = [r for r in residual.values() if r.computed]
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
