@@ -74,9 +74,13 @@ from stochcable.dynamics.residuals.drag_segments import (
 )
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
+    covariance_lines,
     element_directions,
     fft_length,
     load_transfer,
+    pair_blocks,
+    pair_lags,
+    pair_output_lines,
     residual_record,
     uniform_grid,
 )
@@ -114,8 +118,6 @@ SUB_SAMPLES = 5
 #: Bend of the log power between neighbouring lines (|Δ² ln P|) above which a cell's
 #: transfer functions are sub-sampled (:func:`cell_factor`). [-]
 CELL_BEND = 0.1
-#: Memory of the covariance functions held at a time (a block of panel pairs). [bytes]
-_BLOCK_BYTES = 32 * 2**20
 
 
 def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
@@ -228,7 +230,7 @@ def residual_output_lines(
         residual adds). [N²]
     """
     order = coeffs.shape[1] - 1
-    n_p, n_j = lines.shape[1], lines.shape[2]
+    n_p = lines.shape[1]
     sig = np.sqrt(np.einsum("cpj,cpj->p", lines.real, lines.real) + np.einsum(
         "cpj,cpj->p", lines.imag, lines.imag
     ))  # fmt: skip
@@ -239,37 +241,23 @@ def residual_output_lines(
     # k!·a_k^e·a_k^f·F_e·F_f = b_k^e·b_k^f, b_k = √k!·a_k·F
     b = np.sqrt([float(math.factorial(k)) for k in range(order + 1)]) * coeffs * force[:, None]
     n_o = transfer.shape[2]
-    out = np.zeros((transfer.shape[0], n_o))
-    # the pairs f ≥ e, the panels e in blocks (G_fe = conj(G_ef): the pairs f > e count
-    # twice), their covariance functions at a time
-    size = max(1, int(_BLOCK_BYTES // (24 * n_fft * max(n_p, 1))))
-    for start in range(0, n_p, size):
-        blk = slice(start, min(start + size, n_p))
-        f_all = slice(start, n_p)
-        cross = np.zeros((blk.stop - start, n_p - start, n_fft // 2 + 1), dtype=complex)
-        # Σ_c conj(z_ce)·z_cf per line: one matrix product per line
-        zz = np.conj(z[:, blk]).transpose(2, 1, 0) @ z[:, f_all].transpose(2, 0, 1)
-        cross[:, :, :n_j] = np.moveaxis(zz, 0, 2)
-        cross[:, :, 0] *= 2.0  # (irfft halves the zero-frequency line)
-        rho = np.fft.irfft(cross, n=n_fft, axis=2) * (0.5 * n_fft)
-        # Σ_{k≥2} b_k^e b_k^f ρ^k by Horner's rule
-        rr = b[blk, order, None, None] * b[None, f_all, order, None] * rho
-        for k in range(order - 1, 1, -1):
-            rr += b[blk, k, None, None] * b[None, f_all, k, None]
+    ks = [k for k in range(2, order + 1) if np.any(b[:, k] != 0.0)]  # (zero mean: no evens)
+    if not ks:
+        return np.zeros((transfer.shape[0], n_o))
+    # the pairs f ≥ e (G_fe = conj(G_ef)) in blocks: ρ_ef, Σ_k b_k^e b_k^f ρ^k by
+    # Horner's rule, its lines
+    zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
+    g = np.zeros((n_p, n_p, n_o), dtype=complex)
+    for e, f in pair_blocks(n_p, n_fft):
+        rho = pair_lags(zz, e, f, n_fft)
+        rr = (b[e, ks[-1]] * b[f, ks[-1]])[:, None] * rho
+        for k in range(ks[-1] - 1, ks[0] - 1, -1):
+            rr += (b[e, k] * b[f, k])[:, None]
             rr *= rho
-        rr *= rho
-        cr = (2.0 / n_fft) * np.fft.rfft(rr, axis=2)[:, :, 1 : n_o + 1]  # (n_b, n_f, n_o)
-        # weight 2 on the pairs above the diagonal, 1 on it
-        cr *= 2.0
-        diag = np.arange(blk.stop - start)
-        cr[diag, diag] *= 0.5
-        cr[np.arange(cr.shape[0])[:, None] > np.arange(cr.shape[1])[None, :]] = 0.0
-        # Σ_ef conj(T_e) G_ef T_f per line: G_j T_j as one matrix product per line
-        t_f = np.transpose(transfer[:, f_all], (2, 1, 0))  # (n_o, n_f, n_out)
-        tf = np.moveaxis(cr, 2, 0) @ t_f  # (n_o, n_b, n_out)
-        t_e = np.transpose(np.conj(transfer[:, blk]), (2, 1, 0))
-        out += np.einsum("jek,jek->kj", t_e, tf).real
-    return out
+        for _ in range(ks[0] - 1):
+            rr *= rho
+        g[e, f] = covariance_lines(rr, n_o) * np.where(f > e, 2.0, 1.0)[:, None]
+    return pair_output_lines(g, transfer)
 
 
 def drag_residual(
