@@ -37,10 +37,12 @@ import numpy as np
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     covariance_lines,
-    cross_covariance,
     element_directions,
     fft_length,
     load_transfer,
+    pair_blocks,
+    pair_lags,
+    pair_output_lines,
     residual_record,
     uniform_grid,
 )
@@ -54,8 +56,6 @@ __all__ = ["MAX_ELEMENTS", "geometric_residual", "quadratic_output_lines"]
 MAX_LINES = 63
 #: Most elements the residual is computed for. [-]
 MAX_ELEMENTS = 400
-#: Memory of the covariance functions held at a time (a block of element pairs). [bytes]
-_BLOCK_BYTES = 64 * 2**20
 
 
 def geometric_residual(
@@ -159,25 +159,24 @@ def quadratic_output_lines(
     n_p = len(processes)
     n_el = processes[0].shape[1]
     n_o = transfer.shape[2]
-    out = np.zeros((transfer.shape[0], n_o))
-    # the elements f ≥ e paired with e (G_fe = conj(G_ef): the pairs f > e count twice)
-    # in blocks: n_p² covariance functions of a block at a time
-    size = max(1, int(_BLOCK_BYTES // (8 * n_fft * (n_p * n_p + 2))))
-    for e in range(n_el):
-        for start in range(e, n_el, size):
-            blk = slice(start, min(start + size, n_el))
-            r = [[cross_covariance(processes[x][:, e], processes[y][:, blk], n_fft)
-                  for y in range(n_p)] for x in range(n_p)]  # fmt: skip
-            twice = np.where(np.arange(blk.start, blk.stop) > e, 2.0, 1.0)[:, None]
-            for i, terms_i in enumerate(terms):
-                h_i = np.conj(transfer[:, i * n_el + e])
-                for j, terms_j in enumerate(terms):
-                    cov = sum(
-                        ci * cj * (r[x1][x2] * r[y1][y2] + r[x1][y2] * r[y1][x2])
-                        for ci, x1, y1 in terms_i
-                        for cj, x2, y2 in terms_j
-                    )
-                    cl = covariance_lines(cov, n_o) * twice  # e's component i, the block's j
-                    h_j = transfer[:, j * n_el : (j + 1) * n_el][:, blk]
-                    out += np.real(h_i * np.einsum("opj,pj->oj", h_j, cl))
-    return out
+    # Σ_c conj(x_ce)·y_cf per line of every two processes and elements
+    cross = {
+        (x, y): np.conj(processes[x]).transpose(2, 1, 0) @ processes[y].transpose(2, 0, 1)
+        for x in range(n_p)
+        for y in range(n_p)
+    }
+    # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks
+    g = np.zeros((len(terms), n_el, len(terms), n_el, n_o), dtype=complex)
+    for e, f in pair_blocks(n_el, n_fft, 2):
+        r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}
+        twice = np.where(f > e, 2.0, 1.0)[:, None]
+        for i, terms_i in enumerate(terms):
+            for j, terms_j in enumerate(terms):
+                cov = sum(
+                    ci * cj * (r[x1, x2] * r[y1, y2] + r[x1, y2] * r[y1, x2])
+                    for ci, x1, y1 in terms_i
+                    for cj, x2, y2 in terms_j
+                )
+                g[i, e, j, f] = covariance_lines(cov, n_o) * twice  # e's component i, f's j
+    n = len(terms) * n_el
+    return pair_output_lines(g.reshape(n, n, n_o), transfer)

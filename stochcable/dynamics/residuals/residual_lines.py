@@ -131,10 +131,10 @@ def pair_lags(cross: np.ndarray, e: np.ndarray, f: np.ndarray, n_fft: int) -> np
 
 def pair_output_lines(lines: np.ndarray, transfer: np.ndarray) -> np.ndarray:
     """Variance lines Re Σ_cd conj(T_c) G_cd T_d of outputs driven by components with
-    cross-spectral lines G, ``lines`` (n, n, n_o), given on and above the diagonal and
-    zero below it, the pairs c < d weighted 2 (they stand for (d, c) too: G_dc =
-    conj(G_cd)); ``transfer`` (n_out, n, n_o) the outputs per unit component: shape
-    (n_out, n_o).  One matrix product per line."""
+    cross-spectral lines G, ``lines`` (n, n, n_o); ``transfer`` (n_out, n, n_o) the
+    outputs per unit component: shape (n_out, n_o).  One matrix product per line.  The
+    callers give G on one of (c, d) and (d, c) only, weighted 2 where they differ (G_dc
+    = conj(G_cd): the two terms' real parts are equal), zero on the other."""
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
     tc = np.conj(np.transpose(transfer, (2, 0, 1)))  # (n_o, n_out, n)
     gt = np.moveaxis(lines, 2, 0) @ t  # (n_o, n, n_out)
