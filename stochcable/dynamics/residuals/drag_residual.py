@@ -382,7 +382,12 @@ def drag_residual(
 
 
 def cell_factor(
-    system: Any, damping: Any, unit: np.ndarray, w_out: np.ndarray, h: np.ndarray
+    system: Any,
+    damping: Any,
+    unit: np.ndarray,
+    w_out: np.ndarray,
+    h: np.ndarray,
+    bend: float = CELL_BEND,
 ) -> np.ndarray:
     """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
     panel force over its value at ω_j, where the lines do not resolve it: shape
@@ -398,7 +403,7 @@ def cell_factor(
     between neighbours, and theirs; elsewhere the factor is 1 (no solve)."""
     power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
     out = np.ones_like(power)
-    cells = np.flatnonzero(_bent(h))
+    cells = np.flatnonzero(_bent(h, bend))
     if cells.size == 0:
         return out
     step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
@@ -411,14 +416,14 @@ def cell_factor(
     return out
 
 
-def _bent(h: np.ndarray) -> np.ndarray:
+def _bent(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
-    panels, bends by more than :data:`CELL_BEND` between neighbours, and theirs."""
+    panels, bends by more than ``bend`` between neighbours, and theirs."""
     power = np.sum(np.abs(h) ** 2, axis=1)
     logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
-    bend = np.zeros(power.shape[1], dtype=bool)
-    bend[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > CELL_BEND, 0)
-    return bend | np.roll(bend, 1) | np.roll(bend, -1)
+    out = np.zeros(power.shape[1], dtype=bool)
+    out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
+    return out | np.roll(out, 1) | np.roll(out, -1)
 
 
 def _misfit(

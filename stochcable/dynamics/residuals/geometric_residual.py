@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
+from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     covariance_lines,
@@ -50,10 +52,13 @@ from stochcable.results.records import ResidualRecord
 
 __all__ = ["MAX_ELEMENTS", "geometric_residual", "quadratic_output_lines"]
 
-#: Most lines of its uniform grid (63: 64 lines, a lag grid of 256): its share of the
-#: corrected σ is small (≤ 0.6 % on the benchmark lines), so its own error matters less
-#: than the drag's. [-]
-MAX_LINES = 63
+#: Its uniform grid: every LINE_STRIDE-th line of the drag residual's (2: 32 lines, a
+#: lag grid of 125, against 64 and 256; its end influence a part of the drag's): its
+#: share of the corrected σ is small (≤ 0.6 % on the benchmark lines), so its own error
+#: matters less than the drag's. [-]
+LINE_STRIDE = 2
+#: Most lines of its grid (every second of the drag residual's at most 64). [-]
+MAX_LINES = RESIDUAL_LINES // LINE_STRIDE
 #: Most elements the residual is computed for. [-]
 MAX_ELEMENTS = 400
 
@@ -95,7 +100,7 @@ def geometric_residual(
         )
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
-    grid = uniform_grid(w, MAX_LINES)
+    grid = uniform_grid(w, None, LINE_STRIDE)
     comps = list(model.components)
     d = model.dim
     n_ch = len(channels)
@@ -115,17 +120,25 @@ def geometric_residual(
     comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [
         [(1.0, 0, k)] for k in range(1, len(frames))
     ]
-    unit = np.zeros((model.n_nodes, d, len(comp_terms) * n_el))
+    # unit pairs κ·f_e: + on node e + 1, − on node e (component-major columns)
+    unit = np.zeros((model.n_nodes, d, len(comp_terms), n_el))
+    el = np.arange(n_el)
     for i, f in enumerate(frames):
-        for e in range(n_el):
-            unit[e + 1, :, i * n_el + e] += kappa[e] * f[e, comps]
-            unit[e, :, i * n_el + e] -= kappa[e] * f[e, comps]
+        force = kappa[:, None] * f[:, comps]  # (n_el, d)
+        unit[el + 1, :, i, el] += force
+        unit[el, :, i, el] -= force
+    unit = unit.reshape(model.n_nodes, d, -1)
     n_o = 2 * (grid.n_j - 1)
     w_out = grid.step * np.arange(1, n_o + 1)
     # (2, n_comp·n_el, n_o)
     h = load_transfer(system, linearization.damping, unit, w_out, influence)
     n_fft = fft_length(4 * (grid.n_j - 1) + 1)  # (products reach line 2·(n_j − 1))
-    lines = quadratic_output_lines(proc, comp_terms, h, n_fft)
+    # the cells of a resonance narrower than a line integrated, as the drag's (a bend
+    # of the log power scales with the line spacing squared: the drag's threshold at
+    # its lines; chain: 26 cells at the drag's threshold, none at this one)
+    lines = quadratic_output_lines(proc, comp_terms, h, n_fft) * cell_factor(
+        system, linearization.damping, unit, w_out, h, CELL_BEND * LINE_STRIDE**2
+    )
     return residual_record(lines, w_out, w, std, 2, n_el)
 
 

@@ -64,14 +64,17 @@ class UniformGrid:
     frequency moved to its nearest line, its trapezoid weight kept).
 
     Frequencies sharing a line (a grid finer than the step) add their cross-spectra,
-    not their amplitudes: each one of a line becomes its own channel (``ranks``)."""
+    not their amplitudes: each one of a line becomes its own channel (``ranks``).
+    ``stride``: every stride-th line of that grid (a coarser grid whose lines are among
+    its lines)."""
 
-    def __init__(self, w: np.ndarray, max_lines: int | None = None) -> None:
+    def __init__(self, w: np.ndarray, max_lines: int | None = None, stride: int = 1) -> None:
         w = np.asarray(w, dtype=float)
         steps = np.diff(w)
         self.omega = w
         top = MAX_LINES if max_lines is None else max_lines
-        self.step = max(float(steps.min()) if steps.size else float(w[0]), float(w[-1]) / top)
+        base = max(float(steps.min()) if steps.size else float(w[0]), float(w[-1]) / top)
+        self.step = stride * base
         self.n_j = int(np.rint(w[-1] / self.step)) + 1
         self.index = np.clip(np.rint(w / self.step).astype(int), 0, self.n_j - 1)
         rank = np.zeros(w.size, dtype=int)
@@ -91,10 +94,10 @@ class UniformGrid:
         return out.reshape(n_ch * self.ranks, n_x, self.n_j)
 
 
-def uniform_grid(w: Any, max_lines: int | None = None) -> UniformGrid:
+def uniform_grid(w: Any, max_lines: int | None = None, stride: int = 1) -> UniformGrid:
     """The :class:`UniformGrid` of the analysis frequencies ``w`` [rad/s], of at most
-    ``max_lines`` lines (:data:`MAX_LINES` by default)."""
-    return UniformGrid(np.asarray(w, dtype=float), max_lines)
+    ``max_lines`` lines (:data:`MAX_LINES` by default), or every ``stride``-th of them."""
+    return UniformGrid(np.asarray(w, dtype=float), max_lines, stride)
 
 
 def cross_covariance(x: np.ndarray, y: np.ndarray, n_fft: int) -> np.ndarray:
@@ -175,8 +178,8 @@ def load_transfer(
 
 class EndInfluence:
     """The end influence (:func:`end_influence`) of one line and drag, kept for the
-    last frequencies asked: a later request for a leading part of them (the geometric
-    residual's 2·n_j lines after the drag residual's 3·n_j) is a slice of it."""
+    last frequencies asked: a later request for some of them (the geometric residual's
+    lines, every second of the drag residual's) is taken from it."""
 
     def __init__(self, system: Any, damping: Any) -> None:
         self.system = system
@@ -187,8 +190,11 @@ class EndInfluence:
         """The influence on ``w``, shape (2, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
         kept = self._kept
-        if kept is not None and w.size <= kept[0].size and np.array_equal(kept[0][: w.size], w):
-            return kept[1][..., : w.size]
+        if kept is not None and w.size:
+            at = np.clip(np.searchsorted(kept[0], w), 0, kept[0].size - 1)
+            near = np.where(np.abs(kept[0][at - 1] - w) < np.abs(kept[0][at] - w), at - 1, at)
+            if np.allclose(kept[0][near], w, rtol=1e-12, atol=0.0):
+                return kept[1][..., near]
         g = end_influence(self.system, self.damping, w)
         self._kept = (w.copy(), g)
         return g
