@@ -198,6 +198,7 @@ _V1 = TESTS / "residual_variances_v1.json"
 def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     """The settings of the evaluation before issue 31."""
     monkeypatch.setattr(rl, "MAX_LINES", 1024)
+    monkeypatch.setattr(rl, "LIVE_SHARE", 0.0)  # (the whole analysis grid on the lines)
     monkeypatch.setattr(gr, "LINE_STRIDE", 1)  # (its grid: the drag's)
     monkeypatch.setattr(dr, "MAX_PANELS", 64)
     monkeypatch.setattr(dr, "SUB_SAMPLES", 1)

@@ -100,7 +100,6 @@ def geometric_residual(
         )
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
-    grid = uniform_grid(w, None, LINE_STRIDE)
     comps = list(model.components)
     d = model.dim
     n_ch = len(channels)
@@ -112,6 +111,7 @@ def geometric_residual(
     u[:, :, comps] = resp.displacement.reshape(w.size, model.n_nodes, d, n_ch)
     du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, 3, n_ch)
     spectra = np.stack([ch.spectrum for ch in channels])
+    grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
     proc = [grid.lines(np.einsum("wedc,ed->cew", du, f), spectra) for f in frames]
     mesh = model.mesh
