@@ -203,7 +203,6 @@ def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(dr, "MAX_PANELS", 64)
     monkeypatch.setattr(dr, "SUB_SAMPLES", 1)
     monkeypatch.setattr(dr, "MISFIT_EXACT", True)
-    monkeypatch.setattr(dr, "AXIAL_MERGE", 0)
     monkeypatch.setattr(dr.drag_residual, "__defaults__", (dr.HERMITE_ORDER, False, None))
 
 
@@ -225,13 +224,12 @@ def test_old_settings_reproduce_the_recorded_variances(monkeypatch: pytest.Monke
 @pytest.mark.slow
 def test_fast_evaluation_against_the_recorded_variances() -> None:
     """The default evaluation (orders 2 and 3 carrying the higher orders' variance, 32
-    panels, the axial drag on coarser ones, 64 lines over the inputs' band, the cells
-    of unresolved resonances integrated, the geometric residual on every second line)
-    against the recorded one on the benchmark lines and the inclined guy: corrected σ
-    within 0.35 % (issue 31's bound; measured −0.20 … +0.26 %; the guy, whose +18 %
-    rides on a 0.7 %-damped mode: +0.26 %, and ±2 % with the lines sampled, not
-    integrated); the geometric residual's part within 0.1 % on σ (measured ≤ 0.02 %;
-    its own variance moves by up to 45 % on the guy, but it is ≤ 0.6 % of σ)."""
+    panels, 64 lines, the cells of unresolved resonances integrated) against the
+    recorded one on the benchmark lines and the inclined guy: corrected σ within 0.5 %
+    (measured −0.20 … +0.33 %; the guy, whose +18 % rides on a 0.7 %-damped mode:
+    +0.16 %, and ±2 % with the lines sampled, not integrated); the geometric residual's
+    part within 0.1 % on σ (its own variance moves by up to 45 % on the guy, 12 % on
+    the taut wire, 1 % on the others, but it is ≤ 0.6 % of σ)."""
     ref = json.loads(_V1.read_text())
     got = residual_cost.residual_variances()
     for name, by in ref.items():
@@ -239,7 +237,7 @@ def test_fast_evaluation_against_the_recorded_variances() -> None:
             lin = got[name]["std_linear"][end] ** 2
             fast = math.sqrt(lin + got[name]["drag"][end] + got[name]["geometric"][end])
             old = math.sqrt(lin + by["drag"][end] + by["geometric"][end])
-            assert fast == pytest.approx(old, rel=0.0035), (name, end)
+            assert fast == pytest.approx(old, rel=0.005), (name, end)
             geo_f = math.sqrt(lin + got[name]["geometric"][end])
             geo_o = math.sqrt(lin + by["geometric"][end])
             assert geo_f == pytest.approx(geo_o, rel=1e-3), (name, end)

@@ -117,13 +117,6 @@ LUMPED_ORDER = 3
 #: evaluation before issue 31), not taken at the residual's nearest line
 #: (:func:`_misfit_variance`). [-]
 MISFIT_EXACT = False
-#: The axial drag's panels: the normal drag's with every split element whole and every
-#: AXIAL_MERGE consecutive panels joined (0: the normal drag's panels); the axial drag
-#: alone carries ≤ 0.3 % of the chain's residual variance, with its cross terms with the
-#: normal drag 3 %: the chain's 56 panel components become 35 (pairs 1,596 → 630), the
-#: taut wire's 40 → 30; corrected σ within 0.03 % (chain, taut wire, deep) and 0.3 %
-#: (inclined guy) of the normal drag's panels. [-]
-AXIAL_MERGE = 2
 #: Points across a line's cell where the transfer functions of the residual loads are
 #: taken where the lines do not resolve them (:func:`cell_factor`). [-]
 SUB_SAMPLES = 5
@@ -343,9 +336,7 @@ def drag_residual(
     w_out = grid.step * np.arange(1, n_o + 1)
     # (ρ^K reaches line K·(n_j − 1): a lag grid of 2·K·(n_j − 1) + 1 samples resolves it)
     n_fft = fft_length(2 * order * (grid.n_j - 1) + 1)
-    axial = _axial_groups(seg, groups) if AXIAL_MERGE else groups
-    by_dir = {n: axial if n == "axial" else groups for n in live}
-    unit = np.concatenate([panel_loads(model, seg, by_dir[n], [parts[n][2]]) for n in live], 2)
+    unit = panel_loads(model, seg, groups, [parts[n][2] for n in live])
     influence = EndInfluence(system, damping) if influence is None else influence
     h_all = load_transfer(system, damping, unit, w_out, influence)
     # the normal and axial residuals of every panel are one set of components: they are
@@ -354,7 +345,6 @@ def drag_residual(
     scales, coeffs, lines, misfit = [], [], [], []
     for name in live:
         c_el, mean_el, _, b_el = parts[name]
-        groups = by_dir[name]
         scales.append(
             np.array([float(np.sum(c_el[seg.element[g]] * seg.length[g])) for g in groups])
         )
@@ -380,13 +370,13 @@ def drag_residual(
         resp,
         spectra,
         seg,
-        [by_dir[n] for n in live],
+        groups,
         live,
         parts,
         misfit,
         (grid, w_out, influence, _bent(h_all)),
     )
-    out = residual_record(lines_t, w_out, w, std, order, len(by_dir[live[0]]), linear)
+    out = residual_record(lines_t, w_out, w, std, order, len(groups), linear)
     _warn_large(system.name, out)
     return out
 
@@ -426,18 +416,6 @@ def cell_factor(
     return out
 
 
-def _axial_groups(seg: Segments, groups: list[np.ndarray]) -> list[np.ndarray]:
-    """The axial drag's panels: ``groups`` with the pieces of every split element joined
-    into one panel, then every :data:`AXIAL_MERGE` consecutive panels joined."""
-    out: list[np.ndarray] = []
-    for g in groups:
-        if out and seg.fine[g[0]] and seg.element[g[0]] == seg.element[out[-1][-1]]:
-            out[-1] = np.concatenate([out[-1], g])
-        else:
-            out.append(g)
-    return [np.concatenate(out[i : i + AXIAL_MERGE]) for i in range(0, len(out), AXIAL_MERGE)]
-
-
 def _bent(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
     panels, bends by more than ``bend`` between neighbours, and theirs."""
@@ -464,8 +442,6 @@ def _misfit(
     first = np.array([int(g[0]) for g in groups])
     for e in np.unique(seg.element[seg.fine]):
         idx = np.flatnonzero(seg.element[first] == e)  # its pieces: one panel each
-        if idx.size < 2:  # (whole in one panel, the axial drag's: no misfit)
-            continue
         s_ = first[idx]
         var = float(np.sum(seg.length[s_] * sig[idx] ** 2) / np.sum(seg.length[s_]))
         if var <= 0.0 or b_el[e] <= 0.0:
@@ -484,7 +460,7 @@ def _misfit_variance(
     resp: Any,
     spectra: np.ndarray,
     seg: Segments,
-    groups: list[list[np.ndarray]],
+    groups: list[np.ndarray],
     live: list[str],
     parts: dict[str, Any],
     misfit: list[tuple[np.ndarray, np.ndarray]],
@@ -505,7 +481,7 @@ def _misfit_variance(
     keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
     if not keep:
         return {}
-    sel = [[groups[k][i] for i in idx] for k, idx in keep]
+    sel = [[groups[i] for i in idx] for _, idx in keep]
     unit = np.concatenate(
         [panel_loads(system.model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
         axis=2,
