@@ -204,6 +204,7 @@ def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(dr, "MAX_PANELS", 64)
     monkeypatch.setattr(dr, "SUB_SAMPLES", 1)
     monkeypatch.setattr(dr, "MISFIT_EXACT", True)
+    monkeypatch.setattr(dr, "PANEL_FLOOR", 0.0)
     monkeypatch.setattr(dr.drag_residual, "__defaults__", (dr.HERMITE_ORDER, False, None))
 
 

@@ -117,6 +117,11 @@ LUMPED_ORDER = 3
 #: evaluation before issue 31), not taken at the residual's nearest line
 #: (:func:`_misfit_variance`). [-]
 MISFIT_EXACT = False
+#: Panel components whose residual force times their largest end tension per unit force
+#: is below this fraction of the line's largest are left out (:func:`_live_panels`):
+#: the chain's 10 of 56 (pairs 1,596 → 1,081; residual variance −3e-5), the two-segment
+#: line's 12 of 54 (2e-6). [-]
+PANEL_FLOOR = 1e-4
 #: Points across a line's cell where the transfer functions of the residual loads are
 #: taken where the lines do not resolve them (:func:`cell_factor`). [-]
 SUB_SAMPLES = 5
@@ -357,12 +362,11 @@ def drag_residual(
         coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
         lines.append(v)
         misfit.append((pan, _misfit(seg, groups, c_el, mean_el, b_el, sig)))
+    lines_all, scale_all, coeff_all = (np.concatenate(lines, axis=1), np.concatenate(scales),
+                                       np.concatenate(coeffs))  # fmt: skip
+    keep = _live_panels(lines_all, scale_all, coeff_all, h_all)
     lines_t = residual_output_lines(
-        np.concatenate(lines, axis=1),
-        np.concatenate(scales),
-        np.concatenate(coeffs),
-        h_all,
-        n_fft,
+        lines_all[:, keep], scale_all[keep], coeff_all[keep], h_all[:, keep], n_fft
     ) * cell_factor(system, damping, unit, w_out, h_all)
     linear = _misfit_variance(
         system,
@@ -414,6 +418,19 @@ def cell_factor(
     at = power[:, cells]
     out[:, cells] = np.where(at > 0, p_sub.mean(axis=2) / np.where(at > 0, at, 1.0), 1.0)
     return out
+
+
+def _live_panels(
+    lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray, h: np.ndarray
+) -> np.ndarray:
+    """The panel components (indices) whose residual force can reach the ends: the
+    largest |a_k| (k ≥ 2) times cσ²L times the largest end tension per unit force at
+    least :data:`PANEL_FLOOR` of the line's largest."""
+    sig2 = np.einsum("cpj,cpj->p", lines.real, lines.real) + np.einsum(
+        "cpj,cpj->p", lines.imag, lines.imag
+    )
+    score = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2 * np.abs(h).max(axis=(0, 2))
+    return np.flatnonzero(score >= PANEL_FLOOR * np.max(score, initial=0.0))
 
 
 def _bent(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
