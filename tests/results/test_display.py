@@ -236,7 +236,13 @@ def test_a_result_with_residuals_says_so_with_the_linear_sigma_beside(chain):
     assert (om == want[0]).all() and (dens == want[1]).all()
 
 
-def test_a_linear_result_has_no_residual_line(disc):
-    """A scene whose lines are on a free body carries no residual: no line, no column."""
-    assert "residuals" not in repr(disc)
-    assert "linear σ" not in disc._repr_html_()
+def test_a_linear_result_has_no_residual_line():
+    """A scene with both residual switches false carries no residual: no line, no
+    column (the disc buoy's leg on its free body carries them by default)."""
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
+    doc["analysis"]["linearization"].update(drag_residual=False, geometric_residual=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        linear = analyze(doc)
+    assert "residuals" not in repr(linear)
+    assert "linear σ" not in linear._repr_html_()

@@ -49,8 +49,8 @@ taut wire and the inclined guy in their seas: docs/benchmarks/drag_residual.md).
 
 Scope: planar lines (the normal velocity a scalar), the seed linearization, normal and
 axial drag of the line elements (attachment drag is not included), each element at
-its mean relative velocity; lines attached to free bodies are not covered (their
-residual would load the coupled system).  Elements (and pieces) are grouped into at
+its mean relative velocity; 3-D lines: :mod:`.drag_residual_3d`; a line on free bodies
+through its coupled influence (:mod:`.body_residual`).  Elements (and pieces) are grouped into at
 most :data:`MAX_PANELS` panels (the cost is O(panels² · n_fft log n_fft)).
 """
 
@@ -362,12 +362,14 @@ def drag_residual(
         coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
         lines.append(v)
         misfit.append((pan, _misfit(seg, groups, c_el, mean_el, b_el, sig)))
+    # a line on bodies: its coupled influence on every grid (body_residual)
+    coupled = None if isinstance(influence, EndInfluence) else influence
     lines_all, scale_all, coeff_all = (np.concatenate(lines, axis=1), np.concatenate(scales),
                                        np.concatenate(coeffs))  # fmt: skip
     keep = _live_panels(lines_all, scale_all, coeff_all, h_all)
     lines_t = residual_output_lines(
         lines_all[:, keep], scale_all[keep], coeff_all[keep], h_all[:, keep], n_fft
-    ) * cell_factor(system, damping, unit, w_out, h_all)
+    ) * cell_factor(system, damping, unit, w_out, h_all, influence=coupled)
     linear = _misfit_variance(
         system,
         damping,
@@ -379,6 +381,7 @@ def drag_residual(
         parts,
         misfit,
         (grid, w_out, influence, _bent(h_all)),
+        coupled,
     )
     out = residual_record(lines_t, w_out, w, std, order, len(groups), linear)
     _warn_large(system.name, out)
@@ -392,6 +395,7 @@ def cell_factor(
     w_out: np.ndarray,
     h: np.ndarray,
     bend: float = CELL_BEND,
+    influence: Any = None,
 ) -> np.ndarray:
     """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
     panel force over its value at ω_j, where the lines do not resolve it: shape
@@ -413,7 +417,7 @@ def cell_factor(
     step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
     sub = step * ((np.arange(SUB_SAMPLES) + 0.5) / SUB_SAMPLES - 0.5)
     w_sub = (w_out[cells, None] + sub[None]).ravel()
-    h_sub = load_transfer(system, damping, unit, w_sub)
+    h_sub = load_transfer(system, damping, unit, w_sub, influence)
     p_sub = np.sum(np.abs(h_sub) ** 2, axis=1).reshape(power.shape[0], cells.size, -1)
     at = power[:, cells]
     out[:, cells] = np.where(at > 0, p_sub.mean(axis=2) / np.where(at > 0, at, 1.0), 1.0)
@@ -481,7 +485,8 @@ def _misfit_variance(
     live: list[str],
     parts: dict[str, Any],
     misfit: list[tuple[np.ndarray, np.ndarray]],
-    lines: tuple[UniformGrid, np.ndarray, EndInfluence, np.ndarray],
+    lines: tuple[UniformGrid, np.ndarray, Any, np.ndarray],
+    coupled: Any = None,
 ) -> dict[str, np.ndarray]:
     """The end-tension variance the linear misfit of the element-constant drag changes,
     as lines on the analysis grid (empty without split elements): its load δB·l·v on
@@ -493,7 +498,8 @@ def _misfit_variance(
     at the residual's line nearest each analysis frequency (no solve of their own:
     chain 0.2 % of the misfit's variance, itself 0.04 % of the residual's), and solved
     at the frequency itself where the line's cell is ``bent`` (:func:`_bent`: a
-    resonance narrower than a line; on the inclined guy 253 of its 300 frequencies)."""
+    resonance narrower than a line; on the inclined guy 253 of its 300 frequencies),
+    through ``coupled`` (a line on bodies: its coupled influence) where given."""
     w = np.asarray(resp.omega, dtype=float)
     keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
     if not keep:
@@ -508,7 +514,7 @@ def _misfit_variance(
     h = load_transfer(system, damping, unit, w_out, influence)[:, :, at]  # (2, n_load, n_w)
     exact = np.arange(w.size) if MISFIT_EXACT else np.flatnonzero(bent[at])
     if exact.size:
-        h[:, :, exact] = load_transfer(system, damping, unit, w[exact])
+        h[:, :, exact] = load_transfer(system, damping, unit, w[exact], coupled)
     load = np.concatenate(
         [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
     )  # (n_ch, n_load, n_w)
