@@ -526,12 +526,6 @@ def test_log_grid_from_1e_minus_4_to_1e2():
     assert line.linear_end("end_b").std == pytest.approx(ref.linear_end("end_b").std, rel=0.02)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 31: the drag residual on a log grid is 43 % below the linear grid's "
-    "(fairlead variance 2.80e4 against 4.89e4 N² on this chain; the linear σ agree to "
-    "0.1 %): its variance lines assume a uniform analysis grid",
-)
 def test_the_drag_residual_on_a_log_grid_equals_a_linear_grids():
     """The drag residual's fairlead variance on the log grid above and on a fine linear
     grid over the sea's band: within 5 % (the linear σ² agree to 0.2 %, the residual
