@@ -195,8 +195,8 @@ def line_result(
             fn(system, channels, linearization, std, influence=shared)
             if alone or influence is not None
             else ResidualRecord.not_computed(
-                "a travelling line on free bodies is not covered (the coupled influence "
-                "leaves out the transport terms)",
+                "a travelling line or a line with a steady lift on free bodies is not "
+                "covered (the coupled influence leaves out the transport and lift terms)",
                 std,
             )
         )

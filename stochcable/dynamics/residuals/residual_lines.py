@@ -25,6 +25,7 @@ from stochcable.dynamics.model.blocks import (
     line_prep,
     trapezoid_weights,
 )
+from stochcable.dynamics.model.lift import lift_band, lift_pattern
 from stochcable.dynamics.model.solvers import solve_band_stacked
 from stochcable.dynamics.model.transport import gyro_band
 from stochcable.dynamics.solve.line_loads import drag_blocks
@@ -258,8 +259,9 @@ def end_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
     A = Z_ff = K − ω²M + iωC the free–free impedance; A is symmetric (not Hermitian),
     so T = ê·F_end − (A⁻¹g)ᵀF_f, g = Z_f,end ê: two solves per frequency (one
     factorization) whatever the number of load cases.  A travelling line's A has the
-    skew G (:mod:`stochcable.dynamics.model.transport`): then Aᵀ (C − G) is solved, with
-    g = Z_end,fᵀ ê."""
+    skew G (:mod:`stochcable.dynamics.model.transport`), a line with a steady lift the
+    non-symmetric C_L (:mod:`stochcable.dynamics.model.lift`): then Aᵀ (C − G + C_Lᵀ) is
+    solved, with g = Z_end,fᵀ ê."""
     model = system.model
     prep = line_prep(system)
     d = model.dim
@@ -269,6 +271,10 @@ def end_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
     b_c = prep.bS + free_band(cd)
     if system.gyro is not None:  # a travelling line: Aᵀ has C − G (dynamics.model.transport)
         b_c = b_c - gyro_band(system.gyro, d)
+    lift_t = None if system.lift is None else np.transpose(system.lift, (0, 2, 1))
+    if lift_t is not None:  # a steady lift: Aᵀ has C_Lᵀ (dynamics.model.lift)
+        pat = lift_pattern(model)
+        b_c = b_c + lift_band(lift_t, pat)
     # ê of each end: the end tension of a unit support force along each component
     eye = np.eye(2 * d)[None].astype(complex)
     ten = end_tension_from_support(system, eye)
@@ -294,6 +300,9 @@ def end_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
             if system.gyro is not None:  # Z_end,fᵀ ê: G[0, 1]ᵀ = g_0 I, G[n−1, n−2]ᵀ = −g I
                 gy = system.gyro[-1 if tr else 0] * (-1.0 if tr else 1.0)
                 rhs[:, rows, k] += (1j * ws)[:, None] * gy * vec[None]
+            if lift_t is not None:  # C_L[0, 1]ᵀ ê_a, C_L[n−1, n−2]ᵀ ê_b
+                cl = pat[1, 0] * lift_t[-1 if tr else 0] @ vec
+                rhs[:, rows, k] += (1j * ws)[:, None] * cl[None]
         x = solve_band_stacked(
             prep.bK, prep.bM, b_c, rhs, ws, 2 * d - 1, 2 * d - 1, (model.K, model.M)
         )  # (n_w, n_f·d, 2)
