@@ -35,7 +35,7 @@ __all__ = ["RESIDUAL_VARIANCE_LIMIT", "corrected_stats", "residuals_in_range"]
 #: (drag, taut wire) and 1.12 (geometric, cable laying); a slack chain's geometric
 #: residual runs away (2.5 / 6.3 at the anchor / fairlead 10 m short of vertical,
 #: 8·10⁵ at 2 m) where the nonlinear time domain stays near the linear σ
-#: (docs/manual/results.rst, "Residuals out of their range"). [-]
+#: (docs/manual/scene.rst, "Residuals out of their range"). [-]
 RESIDUAL_VARIANCE_LIMIT = 2.0
 
 
