@@ -159,6 +159,9 @@ def test_only_when_asked_and_out_of_scope_says_why():
         assert off.drag_residual is None and "drag_residual" not in off.to_document()
         doc = chain_surge_doc(20)
         doc["lines"][0]["segments"][0].update(cd_normal=0.0, cd_axial=0.0)
+        # (undamped, the geometric residual is 93 × the linear variance: out of range,
+        # it would leave no residual applied)
+        doc["analysis"]["linearization"]["geometric_residual"] = False
         zero = analyze(doc).lines["leg1"].drag_residual
         assert zero.computed and zero.variance == {"end_a": 0.0, "end_b": 0.0}
         doc = chain_surge_doc(20)

@@ -40,7 +40,7 @@ from stochcable.dynamics.outputs.resolution import (
     tail_check,
 )
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
-from stochcable.dynamics.residuals.corrected import corrected_stats
+from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
 from stochcable.dynamics.residuals.registry import residual_parts
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
@@ -200,6 +200,7 @@ def line_result(
                 std,
             )
         )
+    residual = residuals_in_range(system.name, residual, std)
     applied = [r for r in residual.values() if r.computed]
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None
