@@ -630,7 +630,8 @@ def test_long_record_2_pow_22_samples_nsa_variance_within_sampling_error():
     assert 1e-3 < sd < 1e-2
     assert np.mean(dyn**2) == pytest.approx(m0, rel=4.0 * sd)
     # ... and the analysis σ: the 60-point trapezoid (1 %, see the 2^20 test) plus the
-    # sampling error of σ (half that of the variance)
+    # sampling error of σ (half that of the variance); the linear model's (the series
+    # are synthesized from the linear transfer functions)
     assert math.sqrt(np.mean(dyn**2)) == pytest.approx(
         res.lines["l"].linear_end("end_b").std, rel=0.01 + 2.0 * sd
     )
