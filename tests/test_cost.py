@@ -91,9 +91,11 @@ def test_estimate_bounds_the_measured_peak(name, elements, count):
     # the linear model's arrays (the residuals' flat 256 MiB a kind neither bounds nor
     # tracks their peak yet: 0.11 GB measured at 150 x 600, 0.61 GB at 400 x 2000;
     # issue 31)
-    doc["analysis"].setdefault("linearization", {}).update(
-        drag_residual=False, geometric_residual=False
-    )
+    if name == "chain_catenary":  # (the chain's residual peak, above; the others
+        # are bounded by the flat constant with the residuals on, measured)
+        doc["analysis"].setdefault("linearization", {}).update(
+            drag_residual=False, geometric_residual=False
+        )
     estimate = estimate_cost(doc)
     measured = _measured_peak(doc)
     # the constant is the largest calibration ratio rounded up, so the estimate is an

@@ -281,10 +281,12 @@ def _faults_per_case(residuals: bool) -> float:
 
 @pytest.mark.slow
 @pytest.mark.xfail(
-    strict=True,
-    reason="issue 31: with the residuals (the default) a chain case takes ≈ 1200 minor "
+    strict=False,
+    reason="issue 31: with the residuals (the default) a chain case took ≈ 1200 minor "
     "page faults under a nanny (≈ 1700 without), against 0.4 for the linear model: the "
-    "residuals' temporaries are above the configured mmap threshold",
+    "residuals' temporaries are above the configured mmap threshold; since their pairs "
+    "are formed in 512 kB blocks it passes on some runs and not others (not strict "
+    "until it passes every run)",
 )
 @pytest.mark.skipif(
     not sys.platform.startswith("linux") or platform.libc_ver()[0] != "glibc",
