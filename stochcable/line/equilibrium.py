@@ -119,6 +119,8 @@ class StaticsModel:
         self.c_node = 0.5 * env.rho * mesh.node_drag_area
         # a travelling line: its axial drag acts on the relative axial velocity u_t − c
         self.speed = float(mesh.axial_speed)
+        # the normal drag's magnitude: |V_n| (cross flow) or |V| (Hu & Jin 2001, eq. 6)
+        self.hu_jin = getattr(mesh, "drag_form", "cross_flow") == "hu_jin"
         # the steady lift of the relative flow (3-D only: planar, it is zero)
         cl = mesh.cl_steady
         self.has_lift = self.has_current and dim == 3 and cl is not None and bool(cl.any())
@@ -246,7 +248,8 @@ class StaticsModel:
             unn = np.sqrt(np.einsum("ij,ij->i", un, un))
             # relative axial velocity of the water past the travelling line (wet part)
             rel = ua - self.speed * (0.5 * (za + zb) <= 0.0)
-            g = (self.c_n * unn)[:, None] * un + (self.c_t * np.abs(rel) * rel)[:, None] * e
+            vmag = np.sqrt(unn * unn + rel * rel) if self.hu_jin else unn
+            g = (self.c_n * vmag)[:, None] * un + (self.c_t * np.abs(rel) * rel)[:, None] * e
             if self.has_lift:  # docs/travelling.md
                 g = g + steady_lift_force(e, u, ua - rel, self.c_l)
             Fd = beta * l[:, None] * g
@@ -280,6 +283,7 @@ class StaticsModel:
             st["dfa"], st["dfb"] = dfa, dfb
         if self.has_drag:
             st.update(u=u, ua=ua, rel=rel, un=un, unn=unn, g=g, drag_nodes=self.drag_nodes.copy())
+            st["vmag"] = vmag
         return st
 
     def _tangent(self, st: dict) -> tuple:
@@ -291,6 +295,7 @@ class StaticsModel:
         w_sub, w_dry = self.w_sub, self.w_dry
         if self.has_drag:
             u, ua, rel, un, unn, g = (st[k] for k in ("u", "ua", "rel", "un", "unn", "g"))
+            vmag = st["vmag"]
         if mixed.any():
             dfa, dfb = st["dfa"], st["dfb"]
         I = np.eye(dim)
@@ -303,17 +308,18 @@ class StaticsModel:
         Kl = -k.copy()
         if self.has_drag:
             # D = dF/dd = g eᵀ + (dg/de)(I - e eᵀ)
-            safe = np.where(unn > 0.0, unn, 1.0)
-            A = (
-                unn[:, None, None] * I
-                + np.where(unn > 0.0, 1.0 / safe, 0.0)[:, None, None]
-                * un[:, :, None]
-                * un[:, None, :]
-            )
+            # with |V| = vmag (|V_n| or √(|V_n|² + rel²)): d(|V| V_n)/de =
+            # −(|V| I + V_n V_nᵀ/|V|) B + (rel/|V|) V_n uᵀ, B = −dV_n/de = e uᵀ + (U·e) I
+            # (d rel/de = uᵀ; the second term is zero for the cross-flow form)
+            safe = np.where(vmag > 0.0, vmag, 1.0)
+            inv = np.where(vmag > 0.0, 1.0 / safe, 0.0)
+            A = vmag[:, None, None] * I + inv[:, None, None] * un[:, :, None] * un[:, None, :]
             B = e[:, :, None] * u[:, None, :] + ua[:, None, None] * I
             dg = -self.c_n[:, None, None] * (A @ B) + (self.c_t * np.abs(rel))[:, None, None] * (
                 2.0 * e[:, :, None] * u[:, None, :] + rel[:, None, None] * I
             )
+            if self.hu_jin:
+                dg = dg + (self.c_n * rel * inv)[:, None, None] * un[:, :, None] * u[:, None, :]
             if self.has_lift:
                 dg = dg + self._lift_jacobian(e, u, ua - rel)
             D = beta * (g[:, :, None] * e[:, None, :] + dg @ (I - ee))

@@ -64,6 +64,9 @@ class LineMesh:
         End positions. [m]
     axial_speed : float
         Transport speed of the line's material, end_a → end_b (docs/travelling.md). [m/s]
+    drag_form : {"cross_flow", "hu_jin"}
+        Normal-drag form of the relative flow V: ½ρC_dD|V_n|V_n or ½ρC_dD|V|V_n
+        (Hu & Jin 2001, eq. 6; docs/travelling.md).
     """
 
     name: str
@@ -85,6 +88,7 @@ class LineMesh:
     end_b: np.ndarray
     axial_speed: float = 0.0
     cl_steady: np.ndarray | None = None
+    drag_form: str = "cross_flow"
 
     @property
     def n_nodes(self) -> int:
@@ -184,4 +188,5 @@ def mesh_line(line: Line, rho: float, g: float) -> LineMesh:
         end_b=np.asarray(line.end_b.position, dtype=float),
         axial_speed=float(line.axial_speed),
         cl_steady=per_el("cl_steady") if any(sg.cl_steady for sg in segs) else None,
+        drag_form=str(getattr(line, "drag_form", "cross_flow")),
     )

@@ -219,6 +219,14 @@ class Line(_Doc):
         le=1000.0,
         default=0.0,
     )
+    drag_form: Literal["cross_flow", "hu_jin"] = Field(
+        default="cross_flow",
+        description="Normal drag of the relative flow V (current minus the line's "
+        "velocity and its transport): 'cross_flow' ½ρC_dD|V_n|V_n (the cross-flow "
+        "principle: the transport does not change the normal drag), 'hu_jin' "
+        "½ρC_dD|V|V_n (Hu & Jin 2001, eq. 6: an axial relative flow raises the normal "
+        "drag); the same on a line at rest without axial current (docs/travelling.md)",
+    )
 
     @property
     def length(self) -> float:

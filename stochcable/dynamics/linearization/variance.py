@@ -28,6 +28,7 @@ from stochcable.dynamics.linearization.formulas import (
     drag_linear_vector,
     mean_abs_gaussian,
 )
+from stochcable.dynamics.linearization.hu_jin import drag_linear_hu_jin
 from stochcable.dynamics.linearization.iteration import FixedPointResult
 from stochcable.dynamics.loads.channels import (
     Channel,
@@ -49,6 +50,7 @@ from stochcable.dynamics.solve.line_loads import (
     end_nodes,
     line_inputs,
 )
+from stochcable.errors import InputError
 from stochcable.results.documents import LinearizationRecord
 
 # ------------------------------------------------------------------------- damping
@@ -126,6 +128,15 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
     parts = split_sigma(system, np.asarray(sigma, dtype=float), method)
     u_t, u_nvec, u_n = current_split(system)
     d = mesh.diameter
+    hu_jin = getattr(mesh, "drag_form", "cross_flow") == "hu_jin"
+    if hu_jin and method != "seed":
+        raise InputError(
+            "analysis.linearization.method",
+            method,
+            "-",
+            f"must be 'seed' on line '{system.name}' with drag_form 'hu_jin' (the "
+            "½ρC_dD|V|V_n linearization is the one-component form, docs/travelling.md)",
+        )
     if method == "vector":
         s1, s2, s3 = parts["normal"]
         c12 = s3**2 - 0.5 * (s1**2 + s2**2)
@@ -155,6 +166,8 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
         current = _drag_current if clean else drag_linear_current
         b_n = current(rho, mesh.cd_normal, d, parts["normal"][0], u_n)
         b_t = current(rho, mesh.cd_axial, math.pi * d, parts["axial"], u_t)
+        if hu_jin:  # ½ρC_dD|V|V_n with W = U·e − c (linearization.hu_jin)
+            b_n = drag_linear_hu_jin(rho, mesh.cd_normal, d, parts["normal"][0], u_n, u_t)
     b_node = np.zeros(model.n_nodes)
     if system.drag_nodes.size:
         idx = system.drag_nodes
