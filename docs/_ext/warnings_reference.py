@@ -351,6 +351,17 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "or ``stochcable.line.transport.modes.complex_modes``. See :doc:`../travelling`.",
     ),
     WarningEntry(
+        "Drag residual not computed on a Hu & Jin drag line",
+        "PhysicsWarning",
+        ("stochcable.dynamics.residuals.drag_form_guard:guarded",),
+        '``lines[i].drag_form`` is ``"hu_jin"`` and the drag residual is on',
+        "The drag residual expands the cross-flow drag |v|v only; the Hu & Jin form "
+        "|V|V_n is not expanded, so the line's residual record is not computed (its "
+        "reason says why) and its end-tension σ is the linear model's.",
+        'Use ``drag_form`` ``"cross_flow"`` for a residual-corrected σ, or read the '
+        "linear σ. See :doc:`../travelling`.",
+    ),
+    WarningEntry(
         "Coupled modes of a travelling line on a body",
         "PhysicsWarning",
         ("stochcable.line.transport.matrices:check_travelling_lines",),

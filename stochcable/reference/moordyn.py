@@ -145,6 +145,13 @@ def comparison_scene(
         )
     if line.attachments:
         raise InputError(f"{name}.attachments", len(line.attachments), "-", "must be empty")
+    if getattr(line, "drag_form", "cross_flow") != "cross_flow":
+        raise InputError(
+            f"{name}.drag_form",
+            line.drag_form,
+            "-",
+            "must be 'cross_flow' (MoorDyn has only the cross-flow drag ½ρC_dD|V_n|V_n)",
+        )
     if line.segments[0].weight is not None:
         raise InputError(
             f"{name}.segments[0].weight",
