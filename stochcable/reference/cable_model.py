@@ -223,6 +223,8 @@ class LineModel:
         self.bed_linear: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
         # a travelling line (reference.cable_transport): the material velocity u̇ + c e
         self.speed = float(getattr(mesh, "axial_speed", 0.0))
+        # normal drag on |V_n| (cross flow) or |V| (Hu & Jin 2001, eq. 6; docs/travelling.md)
+        self.hu_jin = getattr(mesh, "drag_form", "cross_flow") == "hu_jin"
         self.transport = transport_terms(self, self.speed) if self.speed else None
 
     def set_variant(
@@ -363,7 +365,7 @@ class LineModel:
             w = u_gauss - self.gauss_points(V) - self.speed * e[:, None, :]
             s = np.einsum("egd,ed->eg", w, e)  # axial component
             wn = w - s[:, :, None] * e[:, None, :]
-            mag = np.sqrt(np.einsum("egd,egd->eg", wn, wn) + DRAG_EPS**2)
+            mag = np.sqrt(np.einsum("egd,egd->eg", wn, wn) + DRAG_EPS**2 + self.hu_jin * s * s)
             f = (self.cn[:, None] * mag)[:, :, None] * wn + (self.ct[:, None] * np.abs(s) * s)[
                 :, :, None
             ] * e[:, None, :]
@@ -379,7 +381,7 @@ class LineModel:
                     + (
                         self.cn[:, None, None, None]
                         * wn[:, :, :, None]
-                        * wn[:, :, None, :]
+                        * (w if self.hu_jin else wn)[:, :, None, :]  # ∂|V|/∂v_r = (V or V_n)/|V|
                         / mag[:, :, None, None]
                     )
                     + (2.0 * self.ct[:, None] * np.abs(s))[:, :, None, None]

@@ -327,9 +327,10 @@ def _graded_gauss_nodes(
     return nodes, w
 
 
-def _vector_quadrature(s1, s2, mu1, mu2, chunk: int = 64):
+def _vector_quadrature(s1, s2, mu1, mu2, chunk: int = 64, axial=None):
     """E[|v| I + v v^T/|v|] (3 entries: 11, 12, 22) in the principal frame by graded
-    tensor Gauss-Legendre quadrature against the Gaussian weight."""
+    tensor Gauss-Legendre quadrature against the Gaussian weight; with ``axial`` W per
+    element, |v| → √(|v|² + W²) (the Hu & Jin form, :mod:`.hu_jin`)."""
     n = s1.shape[0]
     out = np.empty((n, 3))
     radius, step, ratio, levels, order = 8.5, 1.5, 0.15, 10, 5
@@ -342,7 +343,11 @@ def _vector_quadrature(s1, s2, mu1, mu2, chunk: int = 64):
         y, wy = _graded_gauss_nodes(c2, radius, step, ratio, levels, order)
         v1 = (m1[:, None] + a1[:, None] * x)[:, :, None]
         v2 = (m2[:, None] + a2[:, None] * y)[:, None, :]
-        r = np.sqrt(v1**2 + v2**2)
+        r = (
+            np.sqrt(v1**2 + v2**2)
+            if axial is None
+            else np.sqrt(v1**2 + v2**2 + (axial[sl] ** 2)[:, None, None])
+        )
         inv = np.divide(1.0, r, out=np.zeros_like(r), where=r > 0)
         w = wx[:, :, None] * wy[:, None, :]
         e_abs = np.einsum("kij,kij->k", w, r)
@@ -358,6 +363,7 @@ def drag_linear_vector(
     diameter: float | np.ndarray,
     cov: np.ndarray,
     mean: np.ndarray | None = None,
+    axial: np.ndarray | None = None,
 ) -> np.ndarray:
     r"""Exact linearized drag matrix for a Gaussian velocity in the plane normal to an element.
 
@@ -375,6 +381,11 @@ def drag_linear_vector(
     mean : array_like, shape (..., 2), optional
         Mean relative velocity in the normal plane (current).  ``None`` means zero
         mean and selects the closed form. [m/s]
+    axial : array_like, shape (...), optional
+        Mean axial relative velocity W for the Hu & Jin drag ``1/2 rho Cd D |V| v``,
+        ``|V| = sqrt(|v|² + W²)`` (:mod:`stochcable.dynamics.linearization.hu_jin`):
+        ``B = 1/2 rho Cd D E[|V| I + v v^T/|V|]`` by the same quadrature.  ``None``:
+        the cross-flow drag. [m/s]
 
     Returns
     -------
@@ -425,6 +436,9 @@ def drag_linear_vector(
     lam = np.clip(lam, 0.0, None)
     s2, s1 = np.sqrt(lam[:, 0]), np.sqrt(lam[:, 1])
     qm = q[:, :, ::-1]  # columns: major, minor principal directions
+    if axial is not None:
+        w_ax = np.broadcast_to(_finite_array("axial", axial, "m/s"), lead).reshape(-1)
+        mean = np.zeros(lead + (2,)) if mean is None else mean
     if mean is None:
         d11, d22 = _vector_zero_mean(s1, s2)
         e = np.zeros((s1.size, 2, 2))
@@ -435,7 +449,9 @@ def drag_linear_vector(
             raise InputError("mean", mu, "m/s", "must have shape (..., 2)")
         mu = np.broadcast_to(mu, lead + (2,)).reshape(-1, 2)
         mu_p = np.einsum("kji,kj->ki", qm, mu)
-        ent = _vector_quadrature(s1, s2, mu_p[:, 0], mu_p[:, 1])
+        ent = _vector_quadrature(
+            s1, s2, mu_p[:, 0], mu_p[:, 1], axial=None if axial is None else w_ax
+        )
         e = np.empty((s1.size, 2, 2))
         e[:, 0, 0], e[:, 0, 1], e[:, 1, 0], e[:, 1, 1] = ent[:, 0], ent[:, 1], ent[:, 1], ent[:, 2]
     b = qm @ e @ np.swapaxes(qm, -1, -2)

@@ -129,13 +129,13 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
     u_t, u_nvec, u_n = current_split(system)
     d = mesh.diameter
     hu_jin = getattr(mesh, "drag_form", "cross_flow") == "hu_jin"
-    if hu_jin and method != "seed":
+    if hu_jin and method == "harmonic":
         raise InputError(
             "analysis.linearization.method",
             method,
             "-",
-            f"must be 'seed' on line '{system.name}' with drag_form 'hu_jin' (the "
-            "½ρC_dD|V|V_n linearization is the one-component form, docs/travelling.md)",
+            f"must be 'seed' or 'vector' on line '{system.name}' with drag_form 'hu_jin' "
+            "(½ρC_dD|V|V_n has no harmonic linearization here, docs/travelling.md)",
         )
     if method == "vector":
         s1, s2, s3 = parts["normal"]
@@ -149,7 +149,7 @@ def drag_coefficients(system: LineSystem, sigma: np.ndarray, method: str) -> Dam
             mean = np.column_stack(
                 [np.einsum("ij,ij->i", u_nvec, n1), np.einsum("ij,ij->i", u_nvec, n2)]
             )
-        b_n = drag_linear_vector(rho, mesh.cd_normal, d, cov, mean)
+        b_n = drag_linear_vector(rho, mesh.cd_normal, d, cov, mean, u_t if hu_jin else None)
         b_t = drag_linear_current(rho, mesh.cd_axial, math.pi * d, parts["axial"], u_t)
     elif method == "harmonic":
         b_n = drag_linear_harmonic(rho, mesh.cd_normal, d, math.sqrt(2.0) * parts["normal"][0])
