@@ -82,3 +82,28 @@ def test_hu_jin_without_axial_flow_is_cross_flow():
         d["environment"]["current"][0]["heading"] = 90.0  # along y, normal to the chord
     a, b = (solve_statics(d).lines["taut"].positions for d in docs)
     np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-9)
+
+
+def test_cli_statics_carries_the_drag_form(tmp_path, capsys):
+    """``stochcable statics`` reads the field: with transport the Hu & Jin normal drag
+    (|V|/|V_n| = 2.4 here) raises the end tension of the taut cable."""
+    import json
+
+    from stochcable.cli import main
+
+    tension = {}
+    for form in ("cross_flow", "hu_jin"):
+        f = tmp_path / f"{form}.json"
+        f.write_text(json.dumps(_scene(form, 2.0)))
+        assert main(["statics", str(f), "--format", "json"]) == 0
+        doc = json.loads(capsys.readouterr().out)
+        tension[form] = doc["statics"]["lines"]["taut"]["end_b"]["tension"]
+    assert tension["hu_jin"] > tension["cross_flow"]
+
+
+def test_bad_drag_form_names_the_field():
+    from stochcable.errors import InputError
+    from stochcable.scene.model import load_scene
+
+    with pytest.raises(InputError, match=r"lines\[0\]\.drag_form.*'cross_flow' or 'hu_jin'"):
+        load_scene(_scene("morison", 0.0))
