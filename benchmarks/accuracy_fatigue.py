@@ -375,6 +375,8 @@ def analyse_end(item: dict, rng: np.random.Generator) -> dict:
         "u3h": u3h,
         "herm_3h": float(hermite_level(u3h, h3, h4, kappa)),
         "sigma_ratio": sigma_fd / math.sqrt(m0),
+        "sigma_fd": sigma_fd,
+        "var_td": float(np.mean([d["std"] ** 2 for d in mom])),
         "std": float(np.mean([d["std"] for d in mom])),
         "mean": float(np.mean([d["mean"] for d in mom])),
     }
@@ -497,7 +499,22 @@ def sections(items: list[dict], seed: int = 31) -> list[str]:
                 + " | ".join(f"{100 * v:.3f}" for v in sh)
                 + " |"
             )
+    above = []
+    for it, r in res:
+        if it["line"] not in CHECK_LINES:
+            continue
+        fd = r["bands"]["FD default (corrected)"][1:].sum() * r["sigma_fd"] ** 2
+        td = r["bands"][f"reference TD, {it.get('elements', 80)} elements"][1:3].sum()
+        above.append(f"{it['line']} {it['end']} {fd / (td * r['var_td']):.2f}")
     out += [
+        "",
+        "Above ω_max the FD's corrected density holds this multiple of the TD's variance "
+        "in 2–6 rad/s (FD σ² × its share over the TD records' mean σ² × theirs): "
+        + ", ".join(above)
+        + ".  The residuals' superharmonic lines carry more than the time domain has "
+        "there, while σ agrees: the residual's split between the band and its "
+        "superharmonics, not the corrected spectrum's support, is where the FD and the "
+        "TD differ.",
         "",
         "## Non-Gaussian tension: how it enters extremes and fatigue",
         "",
