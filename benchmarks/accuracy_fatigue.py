@@ -22,6 +22,8 @@ import numpy as np
 from scipy import stats
 
 from stochcable.design.curves import FatigueCurve, fatigue_curve, tension_to_curve_quantity
+from stochcable.design.hermite import HermiteModel, hermite_model_winterstein
+from stochcable.design.hermite import hermite_level as _level
 from stochcable.design.rainflow_fatigue import damage_rainflow
 from stochcable.design.spectral_fatigue import damage_rate_dirlik
 
@@ -114,10 +116,9 @@ def moments_of_record(x: np.ndarray) -> dict[str, float]:
 def hermite_coefficients(skewness: float, kurtosis: float) -> tuple[float, float, float]:
     """Winterstein's (1988) first-order Hermite coefficients (h3, h4, κ) of a process
     with skewness α3 and kurtosis α4: h3 = α3/6, h4 = (α4 − 3)/24,
-    κ = 1/√(1 + 2h3² + 6h4²). [-]"""
-    h3 = skewness / 6.0
-    h4 = (kurtosis - 3.0) / 24.0
-    return h3, h4, 1.0 / math.sqrt(1.0 + 2.0 * h3 * h3 + 6.0 * h4 * h4)
+    κ = 1/√(1 + 2h3² + 6h4²) (:func:`stochcable.design.hermite_model_winterstein`). [-]"""
+    model = hermite_model_winterstein(skewness, kurtosis)
+    return model.h3, model.h4, model.kappa
 
 
 def hermite_amplitude(u: np.ndarray, h4: float, kappa: float) -> np.ndarray:
@@ -130,9 +131,9 @@ def hermite_amplitude(u: np.ndarray, h4: float, kappa: float) -> np.ndarray:
 
 def hermite_level(u: np.ndarray | float, h3: float, h4: float, kappa: float) -> np.ndarray:
     """Winterstein's (1988) Hermite model: the standardized non-Gaussian level
-    κ[u + h3(u² − 1) + h4(u³ − 3u)] of the standard Gaussian level u. [σ]"""
-    u = np.asarray(u, dtype=float)
-    return kappa * (u + h3 * (u * u - 1.0) + h4 * (u**3 - 3.0 * u))
+    κ[u + h3(u² − 1) + h4(u³ − 3u)] of the standard Gaussian level u
+    (:func:`stochcable.design.hermite_level`). [σ]"""
+    return _level(u, HermiteModel(h3, h4, kappa))
 
 
 def hermite_damage_factor(
@@ -530,7 +531,8 @@ def sections(items: list[dict], seed: int = 31) -> list[str]:
         "non-Gaussian moments are the records' in excess of it, α3 − α3,s and "
         "3 + α4 − α4,s), and what Winterstein's (1988) Hermite model with those two "
         "moments predicts "
-        "(`benchmarks/accuracy_fatigue.py`: x = κ[u + h3(u² − 1) + h4(u³ − 3u)], "
+        "(`stochcable.design.hermite_model_winterstein` and `hermite_level`: "
+        "x = κ[u + h3(u² − 1) + h4(u³ − 3u)], "
         "h3 = α3/6, h4 = (α4 − 3)/24; fatigue: each Gaussian rainflow cycle of Dirlik's "
         "amplitude density mapped through the model; maximum: the Gaussian surrogates' "
         "maximum u mapped through it):",
