@@ -62,6 +62,7 @@ from stochcable.statics import solve_statics
 __all__ = ["BodyLineHistory", "simulate_line_on_body"]
 
 _BACKTRACK = 12  # largest number of halvings in a Newton line search
+_SUBSTEPS = 4  # a failed step is retried in up to 2**_SUBSTEPS substeps
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,6 +94,31 @@ class BodyLineHistory:
     iterations: np.ndarray
     dt: float
     ramp: float
+    excitation: tuple = ()
+
+    def linear(self, omega: np.ndarray, transfer: np.ndarray) -> np.ndarray:
+        """The linear response of transfer function ``transfer`` (per unit wave
+        amplitude on ``omega``, e.g. a frequency-domain result's end tension) to this
+        record's sea, ramp and steps: the paired linear record of the same waves.
+
+        Parameters
+        ----------
+        omega : ndarray, shape (n_w,)
+            [rad/s]
+        transfer : ndarray, complex, shape (n_w,)
+            Interpolated (real and imaginary parts) on the realization's grid, zero
+            outside ``omega``. [unit/m]
+
+        Returns
+        -------
+        ndarray, shape (n_t,)
+        """
+        w_grid, x_sea, n_samples, k_up, sl, r = self.excitation
+        w = np.asarray(omega, dtype=float)
+        hh = np.asarray(transfer)
+        inside = (w_grid >= w[0]) & (w_grid <= w[-1])
+        h_grid = (np.interp(w_grid, w, hh.real) + 1j * np.interp(w_grid, w, hh.imag)) * inside
+        return upsample(h_grid * x_sea, n_samples, k_up)[sl] * r
 
     def std(self, start: float | None = None) -> dict[str, float]:
         """σ of the end tensions and body DOFs after ``start`` (default the ramp). [N, m, rad]"""
@@ -139,6 +165,9 @@ def simulate_line_on_body(
     method: str = "dsa",
     tolerance: float = 1e-7,
     max_iterations: int = 30,
+    linear_drag: tuple[Any, Any, Any] | None = None,
+    seabed: str = "one_sided",
+    internal_damping: float = 0.0,
 ) -> BodyLineHistory:
     """Nonlinear time-domain response of a line with end_b on a free planar body.
 
@@ -167,6 +196,19 @@ def simulate_line_on_body(
         Newton tolerance on max |residual| relative to the largest static force. [-]
     max_iterations : int
         Newton iterations per step before a ConvergenceError. [-]
+    linear_drag : (array_like, array_like, array_like), optional
+        A controlled experiment: the line's drag linear with (B_n, B_t) per element
+        (:func:`stochcable.reference.cable.simulate_line_timedomain`'s ``drag="linear"``)
+        and the body's with the linear coefficient per direction (x, y, z) at the drag
+        point (a frequency-domain result's ``linearization.b_normal``, ``b_axial`` and
+        the body's ``drag_coefficient``): what is left nonlinear is the geometry and
+        the seabed. [N·s/m², N·s/m², N·s/m]
+    seabed : {"one_sided", "linear"}
+        The one-sided penalty bed, or its tangent at the static start (the frequency
+        domain's kind of bed; :meth:`stochcable.reference.cable_model.LineModel.set_variant`). [-]
+    internal_damping : float
+        Axial internal damping BA of every element, T_d = BA·(dl/dt)/l0
+        (:func:`stochcable.reference.cable.simulate_line_timedomain`'s); 0: none. [N·s]
 
     Returns
     -------
@@ -227,7 +269,16 @@ def simulate_line_on_body(
     mesh = mesh_line(line, env.rho, env.g)
     ax = axes(2)
     x3 = statics_guess(sc, line, mesh, statics)
-    model, xs, u_cur, u_cur_g, tol_abs = _static_start(sc, mesh, x3, 2, tolerance)
+    internal_damping = _v.nonnegative("internal_damping", internal_damping, "N·s")
+    model, xs, u_cur, u_cur_g, tol_abs = _static_start(sc, mesh, x3, 2, tolerance, internal_damping)
+    b_lin = None
+    if seabed not in ("one_sided", "linear"):
+        raise InputError("seabed", seabed, "-", "must be 'one_sided' or 'linear'")
+    if linear_drag is not None:
+        model.set_variant(drag="linear", linear_drag=linear_drag[:2], seabed=seabed)
+        b_lin = np.asarray(linear_drag[2], dtype=float)[[0, 2]]
+    else:
+        model.set_variant(seabed=seabed)
     ((heading, x_sea),) = seas
     u_wave, u_wave_g, f_in = wave_series(
         model, xs @ ax.T, grid.omega, x_sea, heading, env, ax, grid.n_samples, k_up, sl, r[0]
@@ -257,12 +308,16 @@ def simulate_line_on_body(
         """Generalized drag force and its Jacobian on q̇."""
         g = _link(_rot(q[2], p0))
         u = u_body_cur + vf - g @ qd
+        if b_lin is not None:
+            return g.T @ (b_lin * u), g.T @ np.diag(b_lin) @ g
         f = half_rho_cda * np.abs(u) * u
         return g.T @ f, g.T @ np.diag(2.0 * half_rho_cda * np.abs(u)) @ g
 
+    excitation = (grid.omega, x_sea, grid.n_samples, k_up, sl, r[0])
     return _integrate(
         model, xs, u_cur, u_cur_g, u_wave, u_wave_g, f_in, f_body, v_fluid, body_drag,
         (m_b, c_b, k_b, r0, free_q), t, h, tol_abs, max_iterations, line.name, body.name, ramp,
+        excitation,
     )  # fmt: skip
 
 
@@ -272,15 +327,16 @@ def _bodies_of(ln: Any) -> tuple[str, ...]:
 
 def _integrate(
     model, xs, u_cur, u_cur_g, u_wave, u_wave_g, f_in, f_body, v_fluid, body_drag, bmat,
-    t, h, tol, max_it, line_name, body_name, ramp,
+    t, h, tol, max_it, line_name, body_name, ramp, excitation,
 ) -> BodyLineHistory:  # fmt: skip
-    """Newmark average acceleration of the line and the body (module notes)."""
+    """Newmark average acceleration of the line and the body (module notes); a step
+    whose Newton iteration fails is retried as 2, 4, … :data:`_SUBSTEPS` substeps
+    with the excitation interpolated linearly (a slack line snapping taut)."""
     m_b, c_b, k_b, r0, free_q = bmat
     d, n, nn = model.dim, model.n, model.N
     fr, ub = model.free, model.u
     ib = np.arange(nn - d, nn)
     ifr = np.arange(d, nn - d)
-    c1, c2 = 4.0 / h**2, 2.0 / h
     nt = t.size
     ten_a, ten_b = np.empty(nt), np.empty(nt)
     motion = np.zeros((nt, 3))
@@ -288,10 +344,14 @@ def _integrate(
     xs_flat = xs.reshape(-1)
     fgr = model.f_gravity.reshape(n, d)
     carry_a = fgr[0] if xs[0, -1] <= -model.depth + 1e-9 * max(model.depth, 1.0) else 0.0
+    fixed_q = np.setdiff1d(np.arange(3), free_q)
 
     def line_residual(xf, vf_, af, uf, ug, fi, s_bed):
         xm, vm = xf.reshape(n, d), vf_.reshape(n, d)
         e, ln, tt, ea = model.elements(xm)
+        td = model.damping_tension(vm, e)
+        if td is not None:
+            tt = tt + td  # the element's total axial force
         fd, c_el, c_nd = model.drag(xm, vm, e, uf, ug, jacobian=True)
         fb, kb, cb = model.seabed(xm, vm, s_bed)
         res = model.M_sparse @ af + (
@@ -301,9 +361,16 @@ def _integrate(
             res = res - fi
         return res, (e, ln, tt, ea, c_el, c_nd, kb, cb)
 
-    def evaluate(du_, dq_, prev, load):
+    x0 = xs_flat.copy()
+    zero = np.zeros(nn)
+    r_start, _ = line_residual(x0, zero, zero, u_cur, u_cur_g, None, model.contact_blend(xs))
+    rb0 = r_start[ib].copy()
+    f_static = -_link(r0).T @ rb0  # the line's static pull on the body
+    fd0, _ = body_drag(np.zeros(3), np.zeros(3), np.zeros(2))
+
+    def evaluate(du_, dq_, prev, load, c1, c2):
         q, qd, qdd, X, V, A = prev
-        uf, ug, fi, s_bed, f_b, v_f = load
+        uf, ug, fi, f_b, v_f, s_bed = load
         qn = q + dq_
         qdn = c2 * dq_ - qd
         qddn = c1 * dq_ - 2.0 * c2 * qd - qdd
@@ -320,32 +387,18 @@ def _integrate(
         fdg, cdj = body_drag(qn, qdn, v_f)
         rq = m_b @ qddn + c_b @ qdn + k_b @ qn - f_b - (fdg - fd0)
         rq = rq + g.T @ res[ib] + f_static
-        rq[np.setdiff1d(np.arange(3), free_q)] = 0.0
+        rq[fixed_q] = 0.0
         norm = max(float(np.abs(res[fr]).max()), float(np.abs(rq).max()))
         return norm, res, rq, st, (qn, qdn, qddn, xn, vn, an, rr, g, cdj)
 
-    x0 = xs_flat.copy()
-    zero = np.zeros(nn)
-    r_start, _ = line_residual(x0, zero, zero, u_cur, u_cur_g, None, model.contact_blend(xs))
-    rb0 = r_start[ib].copy()
-    g0 = _link(r0)
-    f_static = -g0.T @ rb0  # the line's static pull on the body
-    fd0, _ = body_drag(np.zeros(3), np.zeros(3), np.zeros(2))
-    ten_a[0] = np.linalg.norm(r_start[:d] + carry_a)
-    ten_b[0] = np.linalg.norm(rb0)
-    X, V, A = x0.copy(), zero.copy(), zero.copy()
-    q, qd, qdd = np.zeros(3), np.zeros(3), np.zeros(3)
-    for kstep in range(1, nt):
-        uf = u_cur + u_wave[kstep]
-        ug = u_cur_g + u_wave_g[kstep]
-        fi = f_in[kstep]
-        s_bed = model.contact_blend(X.reshape(n, d))
-        du = h * V[fr] + 0.25 * h * h * A[fr]
-        dq = h * qd + 0.25 * h * h * qdd
-
-        prev = (q, qd, qdd, X, V, A)
-        load = (uf, ug, fi, s_bed, f_body[kstep], v_fluid[kstep])
-        rn, res, rq, st, aux = evaluate(du, dq, prev, load)
+    def step(prev, load, hh):
+        """One Newmark step of length hh: (max residual, iterations, residual, state)."""
+        c1, c2 = 4.0 / hh**2, 2.0 / hh
+        _, qd, qdd, X, V, A = prev
+        du = hh * V[fr] + 0.25 * hh * hh * A[fr]
+        dq = hh * qd + 0.25 * hh * hh * qdd
+        load = load + (model.contact_blend(X.reshape(n, d)),)
+        rn, res, rq, st, aux = evaluate(du, dq, prev, load, c1, c2)
         it = 0
         while rn > tol and it < max_it:
             e, ln, tt, ea, c_el, c_nd, kb, cb = st
@@ -353,29 +406,31 @@ def _integrate(
             kel = model.stiffness_blocks(e, ln, tt, ea)
             if c_el is not None:
                 kel = kel + c2 * c_el
+            c_int = model.damping_blocks(e)
+            if c_int is not None:
+                kel = kel + c2 * c_int
+            c_nd = c2 * c_nd
             c_nd[:, -1, -1] += c2 * cb + kb
             full = model.band_matrix(kel, c_nd) + c1 * model.M_band
-            ab = full[:, fr]
             j_fb = _band_entries(full, ub, ifr[-ub:], ib)
             j_bf = _band_entries(full, ub, ib, ifr[-ub:])
             j_bb = _band_entries(full, ub, ib, ib)
             rhs = np.zeros((ifr.size, 4))
             rhs[:, 0] = -res[fr]
             rhs[-ub:, 1:] = -j_fb @ g
-            sol = sla.solve_banded((ub, ub), ab, rhs, check_finite=False)
+            sol = sla.solve_banded((ub, ub), full[:, fr], rhs, check_finite=False)
             y0, yq = sol[:, 0], sol[:, 1:]
             kq = c1 * m_b + c2 * (c_b + cdj) + k_b + g.T @ j_bb @ g
             kq[2, 2] -= float(rr @ res[ib])
             kq = kq + g.T @ j_bf @ yq[-ub:]
             bq = -rq - g.T @ j_bf @ y0[-ub:]
             ddq = np.zeros(3)
-            fq = free_q
-            ddq[fq] = np.linalg.solve(kq[np.ix_(fq, fq)], bq[fq])
+            ddq[free_q] = np.linalg.solve(kq[np.ix_(free_q, free_q)], bq[free_q])
             ddu = y0 + yq @ ddq
             lam = 1.0
             r2 = float(res[fr] @ res[fr] + rq @ rq)
             for _ in range(_BACKTRACK):
-                out = evaluate(du + lam * ddu, dq + lam * ddq, prev, load)
+                out = evaluate(du + lam * ddu, dq + lam * ddq, prev, load, c1, c2)
                 n2 = float(out[1][fr] @ out[1][fr] + out[2] @ out[2])
                 if out[0] <= tol or n2 < r2 or lam < 2.0 ** (1 - _BACKTRACK):
                     break
@@ -383,17 +438,52 @@ def _integrate(
             du, dq = du + lam * ddu, dq + lam * ddq
             rn, res, rq, st, aux = out
             it += 1
-        if rn > tol:
+        return rn, it, res, aux
+
+    ten_a[0] = np.linalg.norm(r_start[:d] + carry_a)
+    ten_b[0] = np.linalg.norm(rb0)
+    state = (np.zeros(3), np.zeros(3), np.zeros(3), x0.copy(), zero.copy(), zero.copy())
+
+    def load_at(k: int) -> tuple:
+        return (
+            u_cur + u_wave[k], u_cur_g + u_wave_g[k], f_in[k], f_body[k], v_fluid[k]
+        )  # fmt: skip
+
+    for kstep in range(1, nt):
+        a_load, b_load = load_at(kstep - 1), load_at(kstep)
+        for level in range(_SUBSTEPS + 1):
+            m = 2**level
+            sub, total, ok = state, 0, True
+            for j in range(1, m + 1):
+                frac = j / m
+                ld = tuple((1.0 - frac) * a + frac * b for a, b in zip(a_load, b_load))
+                rn, it, res, aux = step(sub, ld, h / m)
+                total += it
+                if rn > tol:
+                    ok = False
+                    break
+                sub = aux[:6]
+            if ok:
+                break
+        if not ok:
             raise ConvergenceError(
                 f"line-on-body time-domain Newton at step {kstep} (t = {t[kstep]:.6g} s)",
-                it,
+                total,
                 rn,
                 tol,
-                hint=f"reduce dt (now {h:.4g} s)",
+                hint=f"reduce dt (now {h:.4g} s, {2**_SUBSTEPS} substeps tried)",
+                partial={
+                    "t": t[:kstep],
+                    "motion": motion[:kstep],
+                    "tension_a": ten_a[:kstep],
+                    "tension_b": ten_b[:kstep],
+                },
             )
-        q, qd, qdd, X, V, A = aux[0], aux[1], aux[2], aux[3], aux[4], aux[5]
-        iters[kstep] = it
-        motion[kstep] = q
+        state = sub
+        iters[kstep] = total
+        motion[kstep] = state[0]
         ten_a[kstep] = np.linalg.norm(res[:d] + carry_a)
         ten_b[kstep] = np.linalg.norm(res[ib])
-    return BodyLineHistory(line_name, body_name, t, ten_a, ten_b, motion, iters, h, ramp)
+    return BodyLineHistory(
+        line_name, body_name, t, ten_a, ten_b, motion, iters, h, ramp, excitation
+    )
