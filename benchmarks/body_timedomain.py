@@ -19,6 +19,7 @@ import time
 import warnings
 
 from stochcable import analyze, load_example
+from stochcable.errors import ConvergenceError
 from stochcable.reference.cable_body_compare import ENDS, compare_body_line
 
 
@@ -47,6 +48,7 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--duration", type=float, default=600.0)
     ap.add_argument("--seabed", default="linear")
+    ap.add_argument("--internal-damping", type=float, default=0.0)
     a = ap.parse_args()
     print(  # noqa: T201
         "| elements | m0 [ft²] | end | FD default | FD linear | TD (95 %) | default/TD − 1 "
@@ -56,10 +58,14 @@ def main() -> None:
         nel, m0 = case.split(":")
         doc = scene(float(m0), int(nel))
         t0 = time.perf_counter()
-        r = compare_body_line(
-            doc, fd(doc, True)[0], fd(doc, False), seeds=a.seeds, duration=a.duration,
-            seabed=a.seabed,
-        )  # fmt: skip
+        try:
+            r = compare_body_line(
+                doc, fd(doc, True)[0], fd(doc, False), seeds=a.seeds, duration=a.duration,
+                seabed=a.seabed, internal_damping=a.internal_damping,
+            )  # fmt: skip
+        except ConvergenceError as exc:
+            print(f"| {nel} | {m0} | TD failed: {exc} |", flush=True)  # noqa: T201
+            continue
         for e in ENDS:
             td, half = r.td[e]
             print(  # noqa: T201
