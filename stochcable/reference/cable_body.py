@@ -325,6 +325,44 @@ def _bodies_of(ln: Any) -> tuple[str, ...]:
     return tuple(e.attach.body for e in (ln.end_a, ln.end_b) if e.attach is not None)
 
 
+def _correction(model, st, aux, res, rq, c12, bmat) -> tuple[np.ndarray, np.ndarray]:
+    """The Newton correction (line free DOFs, body DOFs) of the coupled step: the line's
+    band solved for the residual and the three unit body motions, then the 3×3 body
+    system (bordered band; module notes)."""
+    c1, c2 = c12
+    m_b, c_b, k_b, free_q = bmat
+    d, nn, fr, ub = model.dim, model.N, model.free, model.u
+    ib = np.arange(nn - d, nn)
+    ifr = np.arange(d, nn - d)
+    e, ln, tt, ea, c_el, c_nd, kb, cb = st
+    rr, g, cdj = aux[6], aux[7], aux[8]
+    kel = model.stiffness_blocks(e, ln, tt, ea)
+    if c_el is not None:
+        kel = kel + c2 * c_el
+    c_int = model.damping_blocks(e)
+    if c_int is not None:
+        kel = kel + c2 * c_int
+    c_nd = c2 * c_nd
+    c_nd[:, -1, -1] += c2 * cb + kb
+    full = model.band_matrix(kel, c_nd) + c1 * model.M_band
+    j_fb = _band_entries(full, ub, ifr[-ub:], ib)
+    j_bf = _band_entries(full, ub, ib, ifr[-ub:])
+    j_bb = _band_entries(full, ub, ib, ib)
+    rhs = np.zeros((ifr.size, 4))
+    rhs[:, 0] = -res[fr]
+    rhs[-ub:, 1:] = -j_fb @ g
+    sol = sla.solve_banded((ub, ub), full[:, fr], rhs, check_finite=False)
+    y0, yq = sol[:, 0], sol[:, 1:]
+    kq = c1 * m_b + c2 * (c_b + cdj) + k_b + g.T @ j_bb @ g
+    kq[2, 2] -= float(rr @ res[ib])
+    kq = kq + g.T @ j_bf @ yq[-ub:]
+    bq = -rq - g.T @ j_bf @ y0[-ub:]
+    ddq = np.zeros(3)
+    ddq[free_q] = np.linalg.solve(kq[np.ix_(free_q, free_q)], bq[free_q])
+    ddu = y0 + yq @ ddq
+    return ddu, ddq
+
+
 def _integrate(
     model, xs, u_cur, u_cur_g, u_wave, u_wave_g, f_in, f_body, v_fluid, body_drag, bmat,
     t, h, tol, max_it, line_name, body_name, ramp, excitation,
@@ -334,9 +372,8 @@ def _integrate(
     with the excitation interpolated linearly (a slack line snapping taut)."""
     m_b, c_b, k_b, r0, free_q = bmat
     d, n, nn = model.dim, model.n, model.N
-    fr, ub = model.free, model.u
+    fr = model.free
     ib = np.arange(nn - d, nn)
-    ifr = np.arange(d, nn - d)
     nt = t.size
     ten_a, ten_b = np.empty(nt), np.empty(nt)
     motion = np.zeros((nt, 3))
@@ -401,32 +438,7 @@ def _integrate(
         rn, res, rq, st, aux = evaluate(du, dq, prev, load, c1, c2)
         it = 0
         while rn > tol and it < max_it:
-            e, ln, tt, ea, c_el, c_nd, kb, cb = st
-            rr, g, cdj = aux[6], aux[7], aux[8]
-            kel = model.stiffness_blocks(e, ln, tt, ea)
-            if c_el is not None:
-                kel = kel + c2 * c_el
-            c_int = model.damping_blocks(e)
-            if c_int is not None:
-                kel = kel + c2 * c_int
-            c_nd = c2 * c_nd
-            c_nd[:, -1, -1] += c2 * cb + kb
-            full = model.band_matrix(kel, c_nd) + c1 * model.M_band
-            j_fb = _band_entries(full, ub, ifr[-ub:], ib)
-            j_bf = _band_entries(full, ub, ib, ifr[-ub:])
-            j_bb = _band_entries(full, ub, ib, ib)
-            rhs = np.zeros((ifr.size, 4))
-            rhs[:, 0] = -res[fr]
-            rhs[-ub:, 1:] = -j_fb @ g
-            sol = sla.solve_banded((ub, ub), full[:, fr], rhs, check_finite=False)
-            y0, yq = sol[:, 0], sol[:, 1:]
-            kq = c1 * m_b + c2 * (c_b + cdj) + k_b + g.T @ j_bb @ g
-            kq[2, 2] -= float(rr @ res[ib])
-            kq = kq + g.T @ j_bf @ yq[-ub:]
-            bq = -rq - g.T @ j_bf @ y0[-ub:]
-            ddq = np.zeros(3)
-            ddq[free_q] = np.linalg.solve(kq[np.ix_(free_q, free_q)], bq[free_q])
-            ddu = y0 + yq @ ddq
+            ddu, ddq = _correction(model, st, aux, res, rq, (c1, c2), (m_b, c_b, k_b, free_q))
             lam = 1.0
             r2 = float(res[fr] @ res[fr] + rq @ rq)
             for _ in range(_BACKTRACK):
