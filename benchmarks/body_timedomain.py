@@ -75,6 +75,13 @@ def main() -> None:
                 f"{r.raw[e].mean():.4g} |",
                 flush=True,
             )
+        for k, (f, td, half) in r.motion.items():
+            print(  # noqa: T201
+                f"| {nel} | {m0} | {k} | {f:.4g} | | {td:.4g} ± {half:.2g} | "
+                f"{100 * (f / td - 1):+.1f} % | | {100 * r.offset[k]:+.1f} % | "
+                f"{r.raw[k].mean():.4g} |",
+                flush=True,
+            )
         print(f"<!-- {case}: {time.perf_counter() - t0:.0f} s -->", flush=True)  # noqa: T201
 
 

@@ -26,6 +26,13 @@ for the residual and for the three unit body motions, then the 3×3 body system
 the static start: its residual is written about the start, with the line's static
 reaction R_b,0 and the static drag (current) subtracted.
 
+Known limit: with the one-sided penalty bed a light slack line whose nodes lift off
+and land gains energy in the non-dissipative scheme (the disc buoy's 20-element leg
+at m0 = 0.1 ft²: element tensions above 10⁴ lbf on a 10² lbf mean before Newton
+fails); ``seabed="linear"`` (the bed frozen at its static contact, the frequency
+domain's kind) or axial ``internal_damping`` keeps such records bounded
+(docs/accuracy/bodies.md).
+
 References
 ----------
 Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon State University.

@@ -33,9 +33,10 @@ import numpy as np
 from stochcable.reference.cable_body import simulate_line_on_body
 from stochcable.reference.moordyn_compare import student_interval
 
-__all__ = ["BodyComparison", "compare_body_line"]
+__all__ = ["DOFS", "ENDS", "BodyComparison", "compare_body_line"]
 
 ENDS = ("end_a", "end_b")
+DOFS = ("surge", "heave", "pitch")
 
 #: Amplitude factor of the linear-offset run: geometric terms scale with it, so at
 #: 10⁻³ the time domain with linear drag and bed is linear to ~0.1 % of σ. [-]
@@ -58,6 +59,10 @@ class BodyComparison:
         q_s per seed. [-]
     raw : dict of str to ndarray
         σ_TD,s per seed (no control variate, no offset). [N]
+    motion : dict of str to (float, float, float)
+        Per body DOF: the frequency domain's σ (the residuals do not change it), the
+        time domain's estimate and its 95 % half-width (the same estimator with the
+        motion transfer functions). [m, rad]
     """
 
     fd_default: dict[str, float]
@@ -66,6 +71,7 @@ class BodyComparison:
     offset: dict[str, float]
     ratios: dict[str, np.ndarray]
     raw: dict[str, np.ndarray]
+    motion: dict[str, tuple[float, float, float]]
 
 
 def _scaled(doc: dict, factor: float) -> dict:
@@ -133,6 +139,9 @@ def compare_body_line(
         leg_c = fd_default
         leg_l, body_l = fd_linear
         transfer = {e: (leg_l.omega, leg_l.end_tension_transfer[e][0]) for e in ENDS}
+        transfer.update(
+            {k: (body_l.omega, body_l.motion_transfer[0, i]) for i, k in enumerate(DOFS)}
+        )
         lz = leg_l.linearization
         small = _scaled(doc, LINEAR_AMPLITUDE)
         h = simulate_line_on_body(
@@ -141,28 +150,38 @@ def compare_body_line(
         )  # fmt: skip
         keep = h.t >= h.ramp
         offset = {
-            e: float(np.std(ten[keep]) / np.std(h.linear(*transfer[e])[keep]) - 1.0)
-            for e, ten in zip(ENDS, (h.tension_a, h.tension_b))
+            k: float(np.std(x[keep]) / np.std(h.linear(*transfer[k])[keep]) - 1.0)
+            for k, x in _records(h).items()
         }
-        ratios: dict[str, list[float]] = {e: [] for e in ENDS}
-        raw: dict[str, list[float]] = {e: [] for e in ENDS}
+        ratios: dict[str, list[float]] = {k: [] for k in ENDS + DOFS}
+        raw: dict[str, list[float]] = {k: [] for k in ENDS + DOFS}
         for seed in range(1, seeds + 1):
             h = simulate_line_on_body(doc, seed=seed, seabed=seabed, **kw)
             keep = h.t >= h.ramp
-            for e, ten in zip(ENDS, (h.tension_a, h.tension_b)):
-                s_td = float(np.std(ten[keep]))
-                raw[e].append(s_td)
-                ratios[e].append(s_td / float(np.std(h.linear(*transfer[e])[keep])))
+            for k, x in _records(h).items():
+                s_td = float(np.std(x[keep]))
+                raw[k].append(s_td)
+                ratios[k].append(s_td / float(np.std(h.linear(*transfer[k])[keep])))
+    fd_sigma = {e: getattr(leg_l, e).std for e in ENDS}
+    fd_sigma.update({k: body_l.motion[k].std for k in DOFS})
     td = {}
-    for e in ENDS:
-        mean, half = student_interval(np.array(ratios[e]))
-        scale = getattr(leg_l, e).std / (1.0 + offset[e])
-        td[e] = (mean * scale, half * scale)
+    for k in ENDS + DOFS:
+        mean, half = student_interval(np.array(ratios[k]))
+        scale = fd_sigma[k] / (1.0 + offset[k])
+        td[k] = (mean * scale, half * scale)
     return BodyComparison(
         fd_default={e: getattr(leg_c, e).std for e in ENDS},
         fd_linear={e: getattr(leg_l, e).std for e in ENDS},
-        td=td,
+        td={e: td[e] for e in ENDS},
         offset=offset,
         ratios={e: np.array(v) for e, v in ratios.items()},
         raw={e: np.array(v) for e, v in raw.items()},
+        motion={k: (fd_sigma[k],) + td[k] for k in DOFS},
     )
+
+
+def _records(h: Any) -> dict[str, np.ndarray]:
+    """The end tensions and body DOFs of a record by name."""
+    out = {"end_a": h.tension_a, "end_b": h.tension_b}
+    out.update({k: h.motion[:, i] for i, k in enumerate(DOFS)})
+    return out
