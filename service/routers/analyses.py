@@ -75,6 +75,13 @@ async def run_analysis(
             "all of them (full) or none; only when the scene has analysis.timeseries"
         ),
     ] = "window",
+    timeseries_linear: Annotated[
+        bool,
+        Query(
+            description="Also the linear model's end tensions (tension_linear) beside the "
+            "time series that carry the residuals' component"
+        ),
+    ] = False,
 ) -> Response:
     """The v1 result document of :func:`stochcable.analysis.analyze` (Tuah 1982, ch. 5):
     identical to ``stochcable analyze SCENE.json`` and ``analyze(scene).to_document()``
@@ -108,6 +115,7 @@ async def run_analysis(
         scene,
         timeseries,
         media == NETCDF,
+        timeseries_linear,
         deadline=time.monotonic() + limit,
         limit=limit,
     )

@@ -1,0 +1,109 @@
+"""The residuals of the linear model in the end-tension time series: an independent
+Gaussian component with the residuals' spectral density.
+
+The end tension's spectrum with the residuals is the linear spectrum plus the
+residuals' spectra (:mod:`stochcable.dynamics.residuals.corrected`): the residuals are
+uncorrelated with the linear response at every lag (Hermite orthogonality for the drag's
+orders ≥ 2, odd Gaussian moments for the geometric forces; Roberts and Spanos, "Random
+Vibration and Statistical Linearization", §5).  A record whose σ and spectrum are the
+corrected ones is therefore the linear record (the transfer functions times the sea's
+and end motions' realizations, :mod:`.synthesis`) plus a process with the residuals'
+density S_r = S_corrected − S_linear, uncorrelated with it.  It is synthesized here as a
+Gaussian process (random phases, DSA or NSA amplitudes as the record's method,
+:func:`stochcable.sea.realization.simulate_sea`) from its own generator: its second-order
+statistics are the residuals', its skewness and kurtosis are not (the residuals are
+non-Gaussian: a record for extremes or rainflow counting carries the corrected σ and
+spectrum, not the residuals' higher moments).  Each end's component is drawn
+independently (the residuals' cross-spectrum between the ends is not formed).
+
+S_r is read from the line's corrected density
+(:meth:`stochcable.results.documents.LineResult.end_tension_density`, the analysis grid
+and the residual lines outside it) less its linear density on the analysis grid (zero
+outside it), clipped at zero: the drag's linear misfit may lower the density at a
+frequency (a change of the linear part, not an independent process), which the
+component cannot; its share is below 1e-3 of the residual variance on the bundled lines.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from stochcable.sea.realization import simulate_sea
+
+__all__ = ["residual_density", "residual_tension_series"]
+
+
+def residual_density(line: Any, end: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """The residuals' spectral density of the tension at ``end`` (module notes).
+
+    Parameters
+    ----------
+    line : LineResult
+        The line's result (its ``corrected_spectra`` and linear end-tension spectrum).
+    end : str
+        "end_a" or "end_b".
+
+    Returns
+    -------
+    tuple of ndarray or None
+        Frequencies [rad/s] and one-sided density S_r ≥ 0 [N²·s/rad]; None where no
+        residual was applied (the series is the linear one).
+    """
+    if getattr(line, "corrected_spectra", None) is None:
+        return None
+    omega, density = line.end_tension_density(end)
+    w = np.asarray(line.omega, dtype=float)
+    linear = np.interp(omega, w, line.end_tension_spectrum(end), left=0.0, right=0.0)
+    inside = (omega >= w[0]) & (omega <= w[-1])
+    return np.asarray(omega, dtype=float), np.maximum(
+        np.asarray(density, dtype=float) - np.where(inside, linear, 0.0), 0.0
+    )
+
+
+def residual_tension_series(
+    line: Any,
+    end: str,
+    duration: float,
+    dt: float,
+    method: str,
+    rng: np.random.Generator,
+) -> np.ndarray | None:
+    """One Gaussian realization of the residuals' part of the tension at ``end``.
+
+    Parameters
+    ----------
+    line : LineResult
+        The line's result.
+    end : str
+        "end_a" or "end_b".
+    duration : float
+        Record length. [s]
+    dt : float
+        Time step. [s]
+    method : {"dsa", "nsa"}
+        Spectral amplitude model of the record.
+    rng : numpy.random.Generator
+        The component's generator (its phases, and its amplitudes with NSA).
+
+    Returns
+    -------
+    ndarray, shape (duration/dt,) or None
+        The zero-mean component [N], None where no residual was applied.
+
+    Warns
+    -----
+    ResolutionWarning
+        When more than 0.1 % of the residuals' variance lies above the Nyquist
+        frequency π/dt (their superharmonics reach three times the analysis grid's top).
+    """
+    dens = residual_density(line, end)
+    if dens is None or not np.any(dens[1] > 0):
+        return None
+    omega, s_r = dens
+
+    def density(w: np.ndarray) -> np.ndarray:
+        return np.interp(w, omega, s_r, left=0.0, right=0.0)
+
+    return np.asarray(simulate_sea(density, duration, dt, method, rng=rng).elevation)
