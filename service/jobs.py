@@ -60,7 +60,8 @@ def analysis_job(
         if netcdf:
             from stochcable.results.datasets import dataset_from_result, netcdf_bytes
 
-            return netcdf_bytes(dataset_from_result(result)), len(doc.get("warnings", ()))
+            dataset = dataset_from_result(result, timeseries_linear=timeseries_linear)
+            return netcdf_bytes(dataset), len(doc.get("warnings", ()))
         return dumps(doc), len(doc.get("warnings", ()))
     except MemoryError as exc:
         hint = estimate_cost(scene).reduce_hint()

@@ -30,7 +30,9 @@ therefore
 with c_M the free lines' constant or the attached lines' one, M_0 the blocks'
 temporaries and the small arrays, N_t = duration/dt the time-series samples (the
 realization, the transfer functions interpolated onto the N_t/2 FFT frequencies and
-the synthesized records), and the time
+the synthesized records; with the residuals two more channels a line, each end
+tension's Gaussian residual component, :mod:`stochcable.dynamics.timeseries.residual_series`),
+and the time
 
     t ≈ k_M · n_ω · Σ_lines n_nodes · n_ch · (1 + n_bodies)  +  k_T · N_t · (1 + Σ n_ch).
 
@@ -392,10 +394,15 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
         ratio = ts.duration / ts.dt
         samples = int(round(ratio)) if ratio < 2**62 else 2**62
     spectral = n_w * node_bytes
-    series = BYTES_PER_SAMPLE_CHANNEL * samples * (1 + channels)
+    # the residuals' Gaussian component of each end tension: one more series per end
+    # (its realization's work arrays and the component, as a channel's)
+    series_channels = 1 + channels
+    if asked_residuals(scene.analysis.linearization):
+        series_channels += 2 * len(scene.lines)
+    series = BYTES_PER_SAMPLE_CHANNEL * samples * series_channels
     n_bodies = len(scene.bodies)
     ops_spectral = float(n_w) * node_channels
-    ops_series = float(samples) * (1 + channels)
+    ops_series = float(samples) * series_channels
     residual_seconds, residual_bytes = _residual_cost(scene)
     seconds = (
         SECONDS_PER_NODE_FREQUENCY_CHANNEL * ops_spectral * (1.0 + _BODY_TIME_FACTOR * n_bodies)

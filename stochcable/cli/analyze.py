@@ -128,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
         plots = [str(p) for p in plot_result(result, Path(args.plot))]
         doc["plots"] = plots
     if fmt == "netcdf":
-        write_netcdf_document(result, args.output)
+        write_netcdf_document(result, args.output, args.timeseries_linear)
     elif fmt == "summary":
         write_summary(doc, args.output, title=str(args.scene), plots=plots)
     else:

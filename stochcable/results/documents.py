@@ -551,17 +551,18 @@ class Result:
             "relative_change": max((r.relative_change for r in recs), default=0.0),
         }
 
-    def to_xarray(self) -> Any:
-        """The result as an :class:`xarray.Dataset` (:mod:`stochcable.results.datasets`)."""
+    def to_xarray(self, timeseries_linear: bool = False) -> Any:
+        """The result as an :class:`xarray.Dataset` (:mod:`stochcable.results.datasets`;
+        ``timeseries_linear``: with the linear model's end-tension series)."""
         from stochcable.results.datasets import dataset_from_result
 
-        return dataset_from_result(self)
+        return dataset_from_result(self, timeseries_linear=timeseries_linear)
 
-    def to_netcdf(self, path: Any) -> Any:
+    def to_netcdf(self, path: Any, timeseries_linear: bool = False) -> Any:
         """Write :meth:`to_xarray` as a NetCDF-4 file; returns its path."""
         from stochcable.results.datasets import write_netcdf
 
-        return write_netcdf(self.to_xarray(), path)
+        return write_netcdf(self.to_xarray(timeseries_linear), path)
 
     def to_document(
         self, timeseries: str = "window", timeseries_linear: bool = False
