@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from stochcable import analyze
+from stochcable import ResolutionWarning, analyze
 from stochcable.dynamics.timeseries.residual_series import residual_density
 from stochcable.examples import load_example
 
@@ -122,3 +122,20 @@ def test_document_gives_the_linear_series_when_asked(runs):
     assert set(off.to_document(timeseries_linear=True)["timeseries"]["lines"]["wire"]["end_b"]) == {
         "tension"
     }
+
+
+def test_residuals_above_the_nyquist_frequency_are_said():
+    """dt = 1.5 s: π/dt = 2.1 rad/s, below the top of the taut wire's residual spectrum
+    (in band to 3 rad/s, its superharmonics beyond): a ResolutionWarning in the
+    residuals' terms gives the dt, and the residuals-off analysis has no such warning."""
+    doc = _doc()
+    doc["analysis"]["timeseries"] = {"duration": 2**10 * 1.5, "dt": 1.5, "seed": 3}
+    with pytest.warns(ResolutionWarning, match="residuals' variance .* above the time series"):
+        res = analyze(doc)
+    assert any("use analysis.timeseries.dt ≤" in w for w in res.warnings)
+    doc["analysis"].setdefault("linearization", {}).update(
+        drag_residual=False, geometric_residual=False
+    )
+    with pytest.warns(Warning):
+        off = analyze(doc)
+    assert not any("residuals' variance" in w for w in off.warnings)

@@ -26,13 +26,20 @@ component cannot; its share is below 1e-3 of the residual variance on the bundle
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 
-from stochcable.sea.realization import simulate_sea
+from stochcable.errors import ResolutionWarning, warn
+from stochcable.sea.realization import frequency_grid, simulate_sea
 
-__all__ = ["residual_density", "residual_tension_series"]
+__all__ = ["NYQUIST_SHARE", "residual_density", "residual_tension_series"]
+
+#: Share of the residuals' variance above the Nyquist frequency π/dt of the record
+#: beyond which a ResolutionWarning says the record's σ falls short of the corrected
+#: one (as the sea realization's own check). [-]
+NYQUIST_SHARE = 1e-3
 
 
 def residual_density(line: Any, end: str) -> tuple[np.ndarray, np.ndarray] | None:
@@ -103,7 +110,37 @@ def residual_tension_series(
         return None
     omega, s_r = dens
 
-    def density(w: np.ndarray) -> np.ndarray:
-        return np.interp(w, omega, s_r, left=0.0, right=0.0)
+    grid, _ = frequency_grid(duration, dt)
+    top = float(grid[-1])  # (π/dt: what lies above is said in the residuals' terms)
 
+    def density(w: np.ndarray) -> np.ndarray:
+        w = np.asarray(w, dtype=float)
+        return np.where(w <= top, np.interp(w, omega, s_r, left=0.0, right=0.0), 0.0)
+
+    if not np.any(density(grid[1:-1]) > 0):  # (nothing on the record's lines)
+        return None
+    _nyquist_check(line, end, omega, s_r, dt)
     return np.asarray(simulate_sea(density, duration, dt, method, rng=rng).elevation)
+
+
+def _nyquist_check(line: Any, end: str, omega: np.ndarray, s_r: np.ndarray, dt: float) -> None:
+    """ResolutionWarning when more than :data:`NYQUIST_SHARE` of the residuals'
+    variance lies above π/dt."""
+    top = math.pi / dt
+    total = float(np.trapezoid(s_r, omega))
+    above = omega >= top
+    if total <= 0.0 or not np.any(above):
+        return
+    w = np.concatenate(([top], omega[above]))
+    share = float(np.trapezoid(np.interp(w, omega, s_r), w)) / total
+    if share > NYQUIST_SHARE:
+        keep = float(omega[np.flatnonzero(s_r > 0)[-1]])
+        warn(
+            f"line '{getattr(line, 'name', '?')}' {end}: {share:.2%} of the residuals' "
+            f"variance (their superharmonics, up to {keep:.3g} rad/s) lies above the "
+            f"time series' Nyquist frequency π/dt = {top:.3g} rad/s: the record's σ is "
+            "below the corrected one; use analysis.timeseries.dt ≤ "
+            f"{math.pi / keep:.3g} s",
+            ResolutionWarning,
+            stacklevel=4,
+        )
