@@ -90,8 +90,8 @@ async def run_analysis(
     Bounds checked before solving (422 ``limit_exceeded``): total finite elements
     (``STOCHCABLE_MAX_ELEMENTS``), ``analysis.omega.count``
     (``STOCHCABLE_MAX_FREQUENCIES``), the estimated peak memory
-    (``STOCHCABLE_MAX_MEMORY_BYTES``, from frequencies × nodes × channels and the
-    time-series samples), an estimated run time over ten times
+    (``STOCHCABLE_MAX_MEMORY_BYTES``, from frequencies × nodes × channels, the
+    residuals' temporaries and the time-series samples), an estimated run time over ten times
     ``STOCHCABLE_MAX_RUN_SECONDS`` and ``analysis.timeseries`` duration/dt
     (``STOCHCABLE_MAX_SAMPLES``).  The analysis runs in a worker process: the run time is
     bounded by ``STOCHCABLE_MAX_RUN_SECONDS`` (504, the worker is ended); every worker
