@@ -419,7 +419,10 @@ class TimeSeriesDocument(_Open):
         "Prescribed end motions by channel (line.end_b.surge, ...)", "m or rad"
     )
     lines: dict[str, dict[str, dict[str, list[float]]]] = _f(
-        "Total end tensions {line: {end_a: {tension: [...]}, end_b: ...}}", "N"
+        "Total end tensions {line: {end_a: {tension: [...]}, end_b: ...}}, with the "
+        "residuals' Gaussian component where they were applied; with the query "
+        "timeseries_linear, the linear model's beside them (tension_linear)",
+        "N",
     )
     bodies: dict[str, dict[str, dict[str, list[float]]]] | None = Field(
         default=None,

@@ -440,7 +440,18 @@ _REST = {
     "timeseries.time": ("s", "Sample times."),
     "timeseries.elevation": ("{L}", "Wave elevation at the origin (null without a sea)."),
     "timeseries.end_motion.<channel>": ("{L}", "Prescribed end motion of each end-motion channel."),
-    "timeseries.lines.<line>.<end>.tension": ("{F}", "Total end tension, mean + dynamic."),
+    "timeseries.lines.<line>.<end>.tension": (
+        "{F}",
+        "Total end tension, mean + dynamic; with the residuals of the linear model where "
+        "they were applied: an independent Gaussian component with their spectral "
+        "density, so the record's σ and spectrum are the corrected ones.",
+    ),
+    "timeseries.lines.<line>.<end>.tension_linear": (
+        "{F}",
+        "The linear model's end tension (without the residuals' component), beside "
+        "``tension`` where that carries it, when asked for (``timeseries_linear``: "
+        "``--timeseries-linear``, ``?timeseries_linear=true``).",
+    ),
     "timeseries.bodies.<body>.motion.<dof>": (
         "{L} or rad",
         "Body motion, static pose + dynamic part.",
@@ -589,7 +600,9 @@ def example_documents() -> dict[str, dict[str, Any]]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the examples' warnings belong to their pages
         for name in ("chain_catenary", "tuah_1982_disc_buoy_single_leg"):
-            docs[name] = stochcable.analyze(stochcable.load_example(name)).to_document()
+            docs[name] = stochcable.analyze(stochcable.load_example(name)).to_document(
+                timeseries_linear=True
+            )
         scene = stochcable.load_example("taut_wire").model_dump()
         scene["analysis"]["fidelity"] = {"target_error": 0.05}
         for name in RESIDUAL_KINDS:  # every residual kind in the reference

@@ -402,7 +402,9 @@ class TimeSeries:
     end_motion : dict
         ``{"line.end_b.surge": series}`` for end-motion spectrum channels. [m]
     end_tension : dict
-        ``{line: {"end_a": series, "end_b": series}}`` total tension mean + dynamic. [N]
+        ``{line: {"end_a": series, "end_b": series}}`` total tension mean + dynamic,
+        with the residuals of the linear model where they were applied (their
+        independent Gaussian component, ``end_tension_residual``). [N]
     omega : ndarray, shape (N+1,)
         Realization grid ω_m = mΔω. [rad/s]
     channels : dict
@@ -424,6 +426,11 @@ class TimeSeries:
     body_motion_transfer : dict
         ``{body: H}``, H of shape (n_ch, d, N+1) on ``omega`` (zero outside the
         analysis band), the transfer functions synthesized. [m/unit, rad/unit]
+    end_tension_residual : dict
+        ``{line: {"end_a": series, ...}}``, the residuals' Gaussian component of the end
+        tensions (:mod:`stochcable.dynamics.timeseries.residual_series`), for the lines
+        and ends where the residuals were applied (empty with
+        ``analysis.linearization.drag_residual`` and ``geometric_residual`` false). [N]
     """
 
     time: np.ndarray
@@ -438,9 +445,23 @@ class TimeSeries:
     body_motion: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
     body_channels: dict[str, tuple[str, ...]] = field(default_factory=dict)
     body_motion_transfer: dict[str, np.ndarray] = field(default_factory=dict)
+    end_tension_residual: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
 
-    def to_document(self, full: bool = False) -> dict[str, Any]:
-        """Document part: the first :data:`DOCUMENT_WINDOW` samples, or all if ``full``."""
+    @property
+    def end_tension_linear(self) -> dict[str, dict[str, np.ndarray]]:
+        """``{line: {"end_a": series, "end_b": series}}``, the linear model's end
+        tensions: ``end_tension`` without the residuals' component. [N]"""
+        return {
+            name: {
+                e: s - self.end_tension_residual.get(name, {}).get(e, 0.0) for e, s in ends.items()
+            }
+            for name, ends in self.end_tension.items()
+        }
+
+    def to_document(self, full: bool = False, linear: bool = False) -> dict[str, Any]:
+        """Document part: the first :data:`DOCUMENT_WINDOW` samples, or all if ``full``;
+        with ``linear``, the linear model's end tensions (``tension_linear``) beside the
+        tensions of the lines and ends that carry the residuals' component."""
         n = self.time.size if full else min(self.time.size, DOCUMENT_WINDOW)
         doc: dict[str, Any] = {
             "method": self.method,
@@ -456,6 +477,11 @@ class TimeSeries:
                 for name, ends in self.end_tension.items()
             },
         }
+        if linear:
+            for name, ends in self.end_tension_residual.items():
+                for end, comp in ends.items():
+                    base = self.end_tension[name][end][:n] - comp[:n]
+                    doc["lines"][name][end]["tension_linear"] = base.tolist()
         if self.body_motion:
             # {body: {"motion": {dof: [...]}}} (rad for rotations), as the result's
             # "bodies" part
@@ -525,25 +551,31 @@ class Result:
             "relative_change": max((r.relative_change for r in recs), default=0.0),
         }
 
-    def to_xarray(self) -> Any:
-        """The result as an :class:`xarray.Dataset` (:mod:`stochcable.results.datasets`)."""
+    def to_xarray(self, timeseries_linear: bool = False) -> Any:
+        """The result as an :class:`xarray.Dataset` (:mod:`stochcable.results.datasets`;
+        ``timeseries_linear``: with the linear model's end-tension series)."""
         from stochcable.results.datasets import dataset_from_result
 
-        return dataset_from_result(self)
+        return dataset_from_result(self, timeseries_linear=timeseries_linear)
 
-    def to_netcdf(self, path: Any) -> Any:
+    def to_netcdf(self, path: Any, timeseries_linear: bool = False) -> Any:
         """Write :meth:`to_xarray` as a NetCDF-4 file; returns its path."""
         from stochcable.results.datasets import write_netcdf
 
-        return write_netcdf(self.to_xarray(), path)
+        return write_netcdf(self.to_xarray(timeseries_linear), path)
 
-    def to_document(self, timeseries: str = "window") -> dict[str, Any]:
+    def to_document(
+        self, timeseries: str = "window", timeseries_linear: bool = False
+    ) -> dict[str, Any]:
         """The v1 result document (DESIGN.md), JSON-ready.
 
         Parameters
         ----------
         timeseries : {"window", "full", "none"}
             Put the first 2048 samples of the time series, all of them, or none.
+        timeseries_linear : bool
+            Put the linear model's end tensions (``tension_linear``) beside the series
+            that carry the residuals' component.
 
         Notes
         -----
@@ -580,5 +612,7 @@ class Result:
         if self.bodies:
             doc["bodies"] = {k: v.to_document() for k, v in self.bodies.items()}
         if self.timeseries is not None and timeseries != "none":
-            doc["timeseries"] = self.timeseries.to_document(full=timeseries == "full")
+            doc["timeseries"] = self.timeseries.to_document(
+                full=timeseries == "full", linear=timeseries_linear
+            )
         return doc

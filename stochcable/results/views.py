@@ -164,7 +164,8 @@ class TimeSeriesWindow:
     end_motion : dict of numpy.ndarray
         ``{"line.end_b.surge": series}`` prescribed end motions. [m or rad]
     end_tension : dict
-        ``{line: {"end_a": series, "end_b": series}}`` total tensions. [N]
+        ``{line: {"end_a": series, "end_b": series}}`` total tensions (with the
+        residuals' Gaussian component where they were applied). [N]
     body_motion : dict
         ``{body: {dof: series}}`` body motions, static pose plus dynamic part (empty
         for scenes without bodies). [m, rad]
@@ -176,6 +177,9 @@ class TimeSeriesWindow:
         Time step. [s]
     samples : int
         Length of the whole realization (the window may be shorter). [-]
+    end_tension_linear : dict
+        ``{line: {end: series}}`` the linear model's tensions, where the document holds
+        them (``tension_linear``, asked for with ``timeseries_linear``). [N]
     """
 
     time: np.ndarray
@@ -187,6 +191,7 @@ class TimeSeriesWindow:
     dt: float
     samples: int
     body_motion: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    end_tension_linear: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
 
     @classmethod
     def from_document(cls, doc: Mapping[str, Any]) -> TimeSeriesWindow:
@@ -207,6 +212,15 @@ class TimeSeriesWindow:
             body_motion={
                 name: {dof: _array(v) for dof, v in b.get("motion", {}).items()}
                 for name, b in (doc.get("bodies") or {}).items()
+            },
+            end_tension_linear={
+                line: {
+                    end: _array(v["tension_linear"])
+                    for end, v in ends.items()
+                    if "tension_linear" in v
+                }  # fmt: skip
+                for line, ends in doc.get("lines", {}).items()
+                if any("tension_linear" in v for v in ends.values())
             },
         )
 
