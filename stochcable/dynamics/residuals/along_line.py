@@ -63,10 +63,16 @@ __all__ = [
     "element_influence",
     "element_lines",
     "residual_tap",
+    "station_weights",
+    "stations",
 ]
 
 #: The bend threshold of the resonant cells of each covered kind (as the kind's own
 #: :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor` call). [-]
+#: Elements the residuals are evaluated at (:func:`stations`; the others interpolated
+#: linearly in arc length between them): its cost is one banded solve per line per
+#: station (every element: chain +75 ms on a 26 ms linear analysis). [-]
+MAX_STATIONS = 9
 CELL_BENDS = {
     "drag_residual": CELL_BEND,
     "geometric_residual": CELL_BEND * LINE_STRIDE**2,
@@ -136,9 +142,12 @@ def element_rows(model: Any) -> np.ndarray:
     return np.asarray(rows, dtype=float)
 
 
-def element_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
-    """The element tensions per unit force on each node and component, ends prescribed,
-    the line's linear system with ``damping``: shape (n_el, n_nodes, d, n_w). [N/N]
+def element_influence(
+    system: Any, damping: Any, w: np.ndarray, elements: np.ndarray | None = None
+) -> np.ndarray:
+    """The tensions of ``elements`` (indices; default all) per unit force on each node
+    and component, ends prescribed, the line's linear system with ``damping``: shape
+    (n_out, n_nodes, d, n_w). [N/N]
 
     By the adjoint (module notes): x_e = A⁻ᵀ r_e on the free nodes, one banded solve
     per frequency with the n_el right-hand sides; zero on the end nodes.  A travelling
@@ -155,10 +164,12 @@ def element_influence(system: Any, damping: Any, w: np.ndarray) -> np.ndarray:
     if system.lift is not None:
         b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
     rows = element_rows(model)
-    n_el = rows.shape[0]
+    idx = np.arange(rows.shape[0]) if elements is None else np.asarray(elements, dtype=int)
+    rows = rows[idx]
+    n_el = idx.size
     rhs = np.zeros(((n - 2) * d, n_el), dtype=complex)
     for k in (0, 1):  # node e + k of element e, free nodes 1 … n − 2
-        node = np.arange(n_el) + k
+        node = idx + k
         free = (node >= 1) & (node <= n - 2)
         for c in range(d):
             rhs[(node[free] - 1) * d + c, np.flatnonzero(free)] = rows[free, k, c]
@@ -184,20 +195,21 @@ class ElementInfluence:
     (the geometric residual's lines are among the drag residual's): the ``influence``
     of :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`."""
 
-    def __init__(self, system: Any, damping: Any) -> None:
+    def __init__(self, system: Any, damping: Any, elements: np.ndarray | None = None) -> None:
         self.system = system
         self.damping = damping
+        self.elements = elements
         self._kept: list[tuple[np.ndarray, np.ndarray]] = []
 
     def on(self, w: np.ndarray) -> np.ndarray:
-        """The influence on ``w``, shape (n_el, n_nodes, d, n_w). [N/N]"""
+        """The influence on ``w``, shape (n_out, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
         for om, g in self._kept if w.size else ():
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
             near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
             if np.allclose(om[near], w, rtol=1e-12, atol=0.0):
                 return g[..., near]
-        g = element_influence(self.system, self.damping, w)
+        g = element_influence(self.system, self.damping, w, self.elements)
         self._kept.append((w.copy(), g))
         return g
 
@@ -219,7 +231,9 @@ def element_lines(
     for cap in captures:
         full = load_transfer(system, damping, cap.unit, cap.w, influence)  # (n_out, n_all, n_o)
         if feedthrough and kind == "geometric_residual":
-            full = full + geometric_feedthrough(system, cap.unit.shape[2])[:, :, None]
+            own = geometric_feedthrough(system, cap.unit.shape[2])
+            sel = getattr(influence, "elements", None)
+            full = full + own[slice(None) if sel is None else sel, :, None]
         lines = pair_output_lines(cap.g, full[:, cap.kept])
         lines = lines * cell_factor(
             system, damping, cap.unit, cap.w, full, CELL_BENDS[kind], influence=influence
@@ -247,6 +261,37 @@ def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
     return out
 
 
+def stations(model: Any, max_stations: int = MAX_STATIONS) -> np.ndarray:
+    """The elements (indices, increasing) the residuals are evaluated at: every
+    element of a line of at most ``max_stations``, else both end elements, both
+    elements of every segment junction and ``max_stations`` evenly spaced ones."""
+    n_el = model.n_elements
+    if n_el <= max_stations:
+        return np.arange(n_el)
+    seg = np.asarray(model.mesh.segment)
+    junction = np.flatnonzero(np.diff(seg) != 0)
+    even = np.rint(np.linspace(0, n_el - 1, max_stations)).astype(int)
+    return np.unique(np.concatenate([even, junction, junction + 1]))
+
+
+def station_weights(s: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Linear interpolation in the arc length ``s`` (n_el,) of the elements from the
+    station elements ``at`` (increasing, both end elements among them): shape (n_el,
+    n_st), rows summing to 1."""
+    s = np.asarray(s, dtype=float)
+    xs = s[at]
+    k = np.clip(np.searchsorted(xs, s, side="right") - 1, 0, max(at.size - 2, 0))
+    out = np.zeros((s.size, at.size))
+    if at.size == 1:
+        out[:, 0] = 1.0
+        return out
+    t = np.clip((s - xs[k]) / (xs[k + 1] - xs[k]), 0.0, 1.0)
+    rows = np.arange(s.size)
+    out[rows, k] = 1.0 - t
+    out[rows, k + 1] = t
+    return out
+
+
 @dataclass(frozen=True)
 class AlongLineResidual:
     """The residuals' variance of every element's dynamic effective tension.
@@ -263,12 +308,16 @@ class AlongLineResidual:
         (n_el, n_o) [N²].
     variance : ndarray, shape (n_el,)
         The variance the residuals add to each element tension (their lines' sum). [N²]
+    stations : ndarray of int
+        The elements they were evaluated at (:func:`stations`); the others'
+        interpolated linearly in arc length.
     """
 
     computed: bool
     reason: str = ""
     lines: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
     variance: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    stations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
     def std(self, linear_std: np.ndarray) -> np.ndarray:
         """σ of the element tensions with the residuals, from the linear σ (n_el,)
@@ -284,16 +333,21 @@ def along_line_residual(
     damping: Any,
     applied: Mapping[str, Any],
     taps: Mapping[str, ResidualTap],
+    max_stations: int = MAX_STATIONS,
 ) -> AlongLineResidual:
     """The element tensions' residual variance lines of the ``applied`` records (by
     kind, computed and in range) from what their ``taps`` collected (module notes).
 
-    A kind without captures adds nothing where its record's lines are all zero (no
-    drag, no order ≥ 2), and is not covered otherwise (the result not computed)."""
+    ``max_stations``: :func:`stations`.  A kind without captures adds nothing where its
+    record's lines are all zero (no drag, no order ≥ 2), and is not covered otherwise
+    (the result not computed)."""
     n_el = system.model.n_elements
     if not applied:
         return AlongLineResidual(False, "no residual applied")
-    influence = ElementInfluence(system, damping)
+    model = system.model
+    at = stations(model, max_stations)
+    weights = station_weights(0.5 * (model.mesh.s0[1:] + model.mesh.s0[:-1]), at)
+    influence = ElementInfluence(system, damping, at)
     lines: dict[str, tuple[np.ndarray, np.ndarray]] = {}
     total = np.zeros(n_el)
     for kind, rec in applied.items():
@@ -309,7 +363,7 @@ def along_line_residual(
                 f"the {kind.replace('_', ' ')} of this line is not covered along the line "
                 "(3-D drag, or a line on free bodies): the element tensions are linear",
             )
-        v = element_lines(system, damping, kind, caps, influence)
+        v = weights @ element_lines(system, damping, kind, caps, influence)
         lines[kind] = (np.asarray(caps[0].w, dtype=float), v)
         total += v.sum(axis=1)
-    return AlongLineResidual(True, "", lines, total)
+    return AlongLineResidual(True, "", lines, total, at)
