@@ -119,7 +119,7 @@ def test_end_elements_carry_the_end_residuals(chain):
     line, _ = chain
     al = line.along_line
     assert al.computed
-    for kind, (_, v) in al.lines.items():
+    for kind, ((_, v), *_) in al.lines.items():
         rec = line.residuals[kind]
         for el, end in ((0, "end_a"), (-1, "end_b")):
             ref = rec.lines[0][1][end].sum()

@@ -213,7 +213,7 @@ def line_result(
     if applied:  # the element tensions with the residuals (a line on bodies: linear)
         computed = {k: r for k, r in residual.items() if r.computed}
         along = (
-            along_line_residual(system, linearization.damping, computed, taps)
+            along_line_residual(system, linearization.damping, computed, taps, resp, spectra)
             if influence is None
             else AlongLineResidual(False, "a line on free bodies: not covered along the line")
         )

@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.loads.freqblocks import frequency_slices
-from stochcable.dynamics.model.blocks import free_band, line_prep
+from stochcable.dynamics.model.blocks import free_band, line_prep, trapezoid_weights
 from stochcable.dynamics.model.lift import lift_band, lift_pattern
 from stochcable.dynamics.model.solvers import solve_band_stacked
 from stochcable.dynamics.model.transport import gyro_band
@@ -65,6 +65,7 @@ __all__ = [
     "residual_tap",
     "station_weights",
     "stations",
+    "top_line",
 ]
 
 #: The bend threshold of the resonant cells of each covered kind (as the kind's own
@@ -73,6 +74,10 @@ __all__ = [
 #: linearly in arc length between them): its cost is one banded solve per line per
 #: station (every element: chain +75 ms on a 26 ms linear analysis). [-]
 MAX_STATIONS = 9
+#: The element tensions' residual lines are formed up to the highest line where an end
+#: tension's exceeds this fraction of its largest (:func:`top_line`): the superharmonic
+#: tail above carries nothing at the ends (chain: lines 120 of 189, taut wire 55). [-]
+LINE_FLOOR = 1e-8
 CELL_BENDS = {
     "drag_residual": CELL_BEND,
     "geometric_residual": CELL_BEND * LINE_STRIDE**2,
@@ -99,6 +104,13 @@ class ResidualTap:
         self._loads: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         self.captures: list[Capture] = []
         self.unmatched = 0
+        self.misfits: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+
+    def misfit(self, unit: np.ndarray, load: np.ndarray, w: np.ndarray) -> None:
+        """The drag residual's linear misfit: its loads ``unit`` (n_nodes, d, n_load),
+        their values per unit input ``load`` (n_ch, n_load, n_w) on the analysis grid
+        ``w``."""
+        self.misfits.append((unit, load, np.asarray(w, dtype=float)))
 
     def loads(self, unit: np.ndarray, w: np.ndarray, h: np.ndarray) -> None:
         """A :func:`load_transfer` call: its loads, frequencies and end transfer."""
@@ -221,22 +233,26 @@ def element_lines(
     captures: list[Capture],
     influence: Any,
     feedthrough: bool = True,
+    top_line: int | None = None,
 ) -> np.ndarray | None:
     """The variance lines (n_out, n_o) of the outputs of ``influence`` (n_out rows)
     driven by the loads of one kind's ``captures`` (module notes), on the captures'
     lines (the kinds form one each); None where there is none.  ``feedthrough``: the
     outputs are the element tensions, and the geometric forces' own second-order
-    stretch enters each element's tension directly (:func:`geometric_feedthrough`)."""
+    stretch enters each element's tension directly (:func:`geometric_feedthrough`).
+    ``top_line``: the lines from it up are left out (zero; :func:`top_line`)."""
     out = None
     for cap in captures:
-        full = load_transfer(system, damping, cap.unit, cap.w, influence)  # (n_out, n_all, n_o)
+        top = cap.w.size if top_line is None else min(top_line, cap.w.size)
+        w, g = cap.w[:top], cap.g[..., :top]
+        full = load_transfer(system, damping, cap.unit, w, influence)  # (n_out, n_all, top)
         if feedthrough and kind == "geometric_residual":
             own = geometric_feedthrough(system, cap.unit.shape[2])
             sel = getattr(influence, "elements", None)
             full = full + own[slice(None) if sel is None else sel, :, None]
-        lines = pair_output_lines(cap.g, full[:, cap.kept])
-        lines = lines * cell_factor(
-            system, damping, cap.unit, cap.w, full, CELL_BENDS[kind], influence=influence
+        lines = np.zeros((full.shape[0], cap.w.size))
+        lines[:, :top] = pair_output_lines(g, full[:, cap.kept]) * cell_factor(
+            system, damping, cap.unit, w, full, CELL_BENDS[kind], influence=influence
         )
         out = lines if out is None else out + lines
     return out
@@ -259,6 +275,18 @@ def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
     el = np.arange(n_el)
     out[el, el] = -np.linalg.norm(rows[:, 1], axis=1) / length
     return out
+
+
+def top_line(record: Any, floor: float = LINE_FLOOR) -> int | None:
+    """One past the highest of the uniform residual lines of ``record`` (its first
+    part) where an end's variance line exceeds ``floor`` times the largest (None
+    without lines)."""
+    if not record.lines:
+        return None
+    _, part = record.lines[0]
+    v = np.max(np.abs(np.stack([np.asarray(x, dtype=float) for x in part.values()])), axis=0)
+    live = np.flatnonzero(v > floor * np.max(v, initial=0.0))
+    return int(live[-1]) + 1 if live.size else 0
 
 
 def stations(model: Any, max_stations: int = MAX_STATIONS) -> np.ndarray:
@@ -292,6 +320,60 @@ def station_weights(s: np.ndarray, at: np.ndarray) -> np.ndarray:
     return out
 
 
+def misfit_lines(
+    system: Any,
+    damping: Any,
+    misfit: tuple[np.ndarray, np.ndarray, np.ndarray],
+    w_lines: np.ndarray,
+    influence: Any,
+    linear: np.ndarray,
+    spectra: np.ndarray,
+) -> np.ndarray:
+    """The variance change (n_out, n_w) of the outputs of ``influence`` (their linear
+    transfer ``linear`` (n_ch, n_out, n_w)) by the drag residual's linear ``misfit``
+    (:meth:`ResidualTap.misfit`), Σ_c q·S_c(|H_L + H_c|² − |H_L|²) on the analysis grid,
+    as :mod:`.drag_residual` forms the ends': the outputs per unit misfit load at the
+    residual line ``w_lines`` nearest each frequency, solved at the frequency itself
+    where the line's cell bends (:func:`bent_cells`). [N²]"""
+    unit, load, w = misfit
+    step = float(w_lines[0])
+    at = np.clip(np.rint(w / step).astype(int) - 1, 0, w_lines.size - 1)
+    # (the lines up to the band's top: among those the influence holds)
+    on_lines = load_transfer(system, damping, unit, w_lines[: at.max() + 2], influence)
+    h = on_lines[:, :, at]
+    exact = np.flatnonzero(bent_cells(on_lines)[at])
+    if exact.size:
+        h[:, :, exact] = load_transfer(system, damping, unit, w[exact], influence)
+    h_c = np.einsum("opw,cpw->cow", h, load)
+    q = trapezoid_weights(w)[None, None] * spectra[:, None]
+    return np.sum(q * (np.abs(linear + h_c) ** 2 - np.abs(linear) ** 2), axis=0)
+
+
+def bent_cells(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
+    """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
+    loads, bends by more than ``bend`` between neighbours, and their neighbours (as
+    :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`'s cells)."""
+    power = np.sum(np.abs(h) ** 2, axis=1)
+    logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
+    out = np.zeros(power.shape[1], dtype=bool)
+    out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
+    return out | np.roll(out, 1) | np.roll(out, -1)
+
+
+def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:
+    """The linear tension transfer (n_ch, n_st, n_w) of the elements ``at`` from the
+    line's ``response`` (as
+    :func:`stochcable.dynamics.outputs.line_result.element_tension_transfer`). [N/unit]"""
+    model = system.model
+    n_w = np.asarray(response.omega).size
+    u = np.asarray(response.displacement).reshape(n_w, model.n_nodes, model.dim, -1)
+    rows = element_rows(model)[at]
+    out = np.einsum("ed,wedc->cew", rows[:, 0], u[:, at]) + np.einsum(
+        "ed,wedc->cew", rows[:, 1], u[:, at + 1]
+    )
+    return out
+
+
 @dataclass(frozen=True)
 class AlongLineResidual:
     """The residuals' variance of every element's dynamic effective tension.
@@ -303,9 +385,11 @@ class AlongLineResidual:
         (``reason`` says why): the element tensions are the linear model's.
     reason : str
         Why not computed ("" when computed).
-    lines : dict of str to (ndarray, ndarray)
-        By kind: the lines ω_j [rad/s] (n_o,) and each element's variance at them
-        (n_el, n_o) [N²].
+    lines : dict of str to tuple of (ndarray, ndarray)
+        By kind, parts (as :class:`~stochcable.results.records.ResidualRecord`
+        ``lines``): the frequencies [rad/s] (n,) and each element's variance at them
+        (n_el, n) [N²] — the uniform residual lines, and the drag residual's linear
+        misfit on the analysis grid (which may be negative) where there is one.
     variance : ndarray, shape (n_el,)
         The variance the residuals add to each element tension (their lines' sum). [N²]
     stations : ndarray of int
@@ -315,7 +399,7 @@ class AlongLineResidual:
 
     computed: bool
     reason: str = ""
-    lines: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = field(default_factory=dict)
     variance: np.ndarray = field(default_factory=lambda: np.zeros(0))
     stations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
@@ -333,14 +417,17 @@ def along_line_residual(
     damping: Any,
     applied: Mapping[str, Any],
     taps: Mapping[str, ResidualTap],
+    response: Any,
+    spectra: np.ndarray,
     max_stations: int = MAX_STATIONS,
 ) -> AlongLineResidual:
     """The element tensions' residual variance lines of the ``applied`` records (by
     kind, computed and in range) from what their ``taps`` collected (module notes).
 
-    ``max_stations``: :func:`stations`.  A kind without captures adds nothing where its
-    record's lines are all zero (no drag, no order ≥ 2), and is not covered otherwise
-    (the result not computed)."""
+    ``response``, ``spectra`` (n_ch, n_w): the line's linear response and its inputs'
+    spectra (the misfit's cross term).  ``max_stations``: :func:`stations`.  A kind
+    without captures adds nothing where its record's lines are all zero (no drag, no
+    order ≥ 2), and is not covered otherwise (the result not computed)."""
     n_el = system.model.n_elements
     if not applied:
         return AlongLineResidual(False, "no residual applied")
@@ -348,8 +435,9 @@ def along_line_residual(
     at = stations(model, max_stations)
     weights = station_weights(0.5 * (model.mesh.s0[1:] + model.mesh.s0[:-1]), at)
     influence = ElementInfluence(system, damping, at)
-    lines: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = {}
     total = np.zeros(n_el)
+    linear = None
     for kind, rec in applied.items():
         tap = taps.get(kind)
         caps = [] if tap is None else tap.captures
@@ -363,7 +451,14 @@ def along_line_residual(
                 f"the {kind.replace('_', ' ')} of this line is not covered along the line "
                 "(3-D drag, or a line on free bodies): the element tensions are linear",
             )
-        v = weights @ element_lines(system, damping, kind, caps, influence)
-        lines[kind] = (np.asarray(caps[0].w, dtype=float), v)
-        total += v.sum(axis=1)
+        w_lines = np.asarray(caps[0].w, dtype=float)
+        v = element_lines(system, damping, kind, caps, influence, top_line=top_line(rec))
+        parts = [(w_lines, weights @ v)]
+        for mis in tap.misfits if tap is not None else ():
+            if linear is None:
+                linear = station_transfer(system, response, at)
+            dv = misfit_lines(system, damping, mis, w_lines, influence, linear, spectra)
+            parts.append((mis[2], weights @ dv))
+        lines[kind] = tuple(parts)
+        total += sum(v.sum(axis=1) for _, v in parts)
     return AlongLineResidual(True, "", lines, total, at)
