@@ -235,7 +235,7 @@ _LINES = {
         "σ of the dynamic effective tension per element of the linear model alone; present "
         "where the residuals were computed along the line "
         "(:mod:`stochcable.dynamics.residuals.along_line`: the end kinds' load "
-        "cross-spectra through each element's tension, at up to 9 stations, interpolated "
+        "cross-spectra through each element's tension, at up to 7 stations, interpolated "
         "in arc length between them).",
     ),
     "lines.<line>.tension.mean": ("{F}", "Static effective tension per element."),

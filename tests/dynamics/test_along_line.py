@@ -162,3 +162,62 @@ def test_switches_off_leave_the_linear_element_tensions(chain):
     assert "std_linear" not in off.to_document()["tension"]
     doc = copy.deepcopy(line.to_document()["tension"])
     assert doc["std_linear"] == line.tension_std_linear.tolist()
+
+
+def _td_element_sigma(doc: dict, seed: int, elements: list[int], **variant) -> np.ndarray:
+    """TD σ of the ``elements``' tension over the second of two periods of the periodic
+    fairlead surge of :func:`_scenes.td_end_sigma` (the same phases)."""
+    import math
+
+    from _scenes import CHAIN_BAND, CHAIN_PERIOD
+
+    from stochcable.reference.cable import simulate_line_timedomain
+    from stochcable.scene.model import load_scene
+
+    scene = load_scene(doc)
+    dt = 0.05
+    n_t = int(round(2 * CHAIN_PERIOD / dt))
+    dw = 2 * math.pi / CHAIN_PERIOD
+    w = scene.analysis.omega.values()
+    s = scene.lines[0].end_b.motion.surge.spectral_density(w, scene.environment.g)
+    phase = np.random.default_rng(seed).uniform(-np.pi, np.pi, w.size)
+    c = np.zeros((3, n_t // 2 + 1), dtype=complex)
+    c[0, 2 * np.rint(w / dw).astype(int)] = 0.5 * n_t * np.sqrt(2 * s * dw) * np.exp(-1j * phase)
+    h = simulate_line_timedomain(
+        scene,
+        duration=2 * CHAIN_PERIOD,
+        end_realizations={"b": c},
+        band=CHAIN_BAND,
+        dt=dt,
+        **variant,
+    )
+    return h.element_tension_std(start=CHAIN_PERIOD - 1e-9)[elements]
+
+
+@pytest.mark.slow
+def test_mid_line_drag_correction_matches_the_time_domain_quadratic_drag_shift():
+    """The chain's line at 40 elements, fairlead surge (as the end test of
+    tests/dynamics/test_drag_residual.py): the TD with the FD's linear drag against the
+    TD with quadratic drag (same phases, linear bed) measures the quadratic drag's own
+    effect on the tension of elements 10, 20 and 30; the drag residual along the line
+    predicts it within the 95 % CI of the paired shift over seeds 1–4 (Student t)."""
+    from scipy import stats
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        line = analyze(chain_surge_doc(40)).lines["leg1"]
+    els = [10, 20, 30]
+    lin = line.tension_std_linear[els]
+    drag = sum(v.sum(axis=1) for _, v in line.along_line.lines["drag_residual"])[els]
+    pred = np.sqrt(1.0 + drag / lin**2) - 1.0
+    b = (np.asarray(line.linearization.b_normal), np.asarray(line.linearization.b_axial))
+    doc = chain_surge_doc(40, residual=False)
+    shifts = []
+    for seed in (1, 2, 3, 4):
+        td_lin = _td_element_sigma(doc, seed, els, drag="linear", linear_drag=b, seabed="linear")
+        td_quad = _td_element_sigma(doc, seed, els, drag="static_tangent", seabed="linear")
+        shifts.append((td_quad - td_lin) / lin)
+    shifts = np.array(shifts)
+    half = stats.t.ppf(0.975, len(shifts) - 1) * shifts.std(axis=0, ddof=1) / 2.0
+    assert np.all(pred > 0.02)
+    np.testing.assert_array_less(np.abs(pred - shifts.mean(axis=0)), half)
