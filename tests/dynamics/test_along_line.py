@@ -130,6 +130,20 @@ def test_end_elements_carry_the_end_residuals(chain):
         assert ratio_el == pytest.approx(ratio_end, rel=3e-3)
 
 
+def test_element_density_integrates_to_the_corrected_variance(chain):
+    """Each element's density with the residuals (linear density from the element
+    tension transfer, plus the residual lines) integrates by the trapezoid rule to its
+    corrected σ² (1e-9: the corrected spectrum's scale makes it so to round-off) and
+    reaches the superharmonics above the analysis band."""
+    line, _ = chain
+    lin = line.tension_spectrum
+    for el in (0, 7, line.tension_std.size - 1):
+        spec = line.along_line.density(el, line.omega, lin[el])
+        area = np.trapezoid(spec.density, spec.omega)
+        assert area == pytest.approx(line.tension_std[el] ** 2, rel=1e-9)
+        assert spec.omega[-1] > 2.0 * line.omega[-1]
+
+
 def test_stations_interpolate_every_element():
     """Stations: every element of a short line; else both ends, the segment junctions
     and evenly spaced ones; the weights interpolate a linear function exactly."""

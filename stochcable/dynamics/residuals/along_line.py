@@ -45,6 +45,7 @@ from stochcable.dynamics.model.blocks import free_band, line_prep, trapezoid_wei
 from stochcable.dynamics.model.lift import lift_band, lift_pattern
 from stochcable.dynamics.model.solvers import solve_band_stacked
 from stochcable.dynamics.model.transport import gyro_band
+from stochcable.dynamics.residuals.corrected_spectrum import CorrectedSpectrum, corrected_spectrum
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
 from stochcable.dynamics.residuals.residual_lines import (
@@ -377,6 +378,13 @@ def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:
 
 
 @dataclass(frozen=True)
+class _Lines:
+    """The ``lines`` of one kind at one element, as a record's (for corrected_spectrum)."""
+
+    lines: tuple
+
+
+@dataclass(frozen=True)
 class AlongLineResidual:
     """The residuals' variance of every element's dynamic effective tension.
 
@@ -404,6 +412,17 @@ class AlongLineResidual:
     lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = field(default_factory=dict)
     variance: np.ndarray = field(default_factory=lambda: np.zeros(0))
     stations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    def density(self, element: int, omega: np.ndarray, linear: np.ndarray) -> CorrectedSpectrum:
+        """The spectral density of ``element``'s tension with the residuals, from its
+        linear density ``linear`` on the analysis grid ``omega`` (as the ends',
+        :func:`~stochcable.dynamics.residuals.corrected_spectrum.corrected_spectrum`:
+        its area is the corrected σ²). [N²·s/rad]"""
+        parts = [
+            _Lines(tuple((om, {"element": v[element]}) for om, v in kind_parts))
+            for kind_parts in self.lines.values()
+        ]
+        return corrected_spectrum(omega, linear, "element", parts if self.computed else [])
 
     def std(self, linear_std: np.ndarray) -> np.ndarray:
         """σ of the element tensions with the residuals, from the linear σ (n_el,)
