@@ -467,10 +467,15 @@ def along_line_residual(
         if not caps:
             if all(not np.any(np.asarray(v)) for _, part in rec.lines for v in part.values()):
                 continue
+            why = (
+                "its loads were not matched to their load transfer (RESIDUAL_TAP)"
+                if tap is not None and tap.unmatched
+                else "its loads do not pass through the pair lines (3-D drag)"
+            )
             return AlongLineResidual(
                 False,
-                f"the {kind.replace('_', ' ')} of this line is not covered along the line "
-                "(3-D drag, or a line on free bodies): the element tensions are linear",
+                f"the {kind.replace('_', ' ')} of this line is not covered along the line: "
+                f"{why}; the element tensions are linear",
             )
         w_lines = np.asarray(caps[0].w, dtype=float)
         v = element_lines(system, damping, kind, caps, influence, top_line=top_line(rec))
