@@ -237,3 +237,36 @@ def test_mid_line_drag_correction_matches_the_time_domain_quadratic_drag_shift()
     half = stats.t.ppf(0.975, len(shifts) - 1) * shifts.std(axis=0, ddof=1) / 2.0
     assert np.all(pred > 0.02)
     np.testing.assert_array_less(np.abs(pred - shifts.mean(axis=0)), half)
+
+
+def test_element_influence_of_a_travelling_line_by_the_adjoint():
+    """A travelling line (speed −5 m/s: the skew gyroscopic G, so Aᵀ has C − G): the
+    element influence equals the forward dense solve with the full impedance
+    (tests/dynamics/test_transport_solve.py's end influence check), to 1e-9."""
+    from test_transport_solve import _damping, _system
+
+    from stochcable.line.fem import build_fe_model
+    from stochcable.line.transport.matrices import transport_matrices
+
+    with pytest.warns(Warning):
+        scene, system = _system(-5.0)
+    damping = _damping(system, np.random.default_rng(7))
+    w = np.array([0.3, 1.7])
+    got = element_influence(system, damping, w)  # (n_el, n_nodes, d, n_w)
+    rest = build_fe_model(system.statics, scene.environment, dim=2)
+    tr = transport_matrices(rest, -5.0)
+    k, m = tr.K.toarray(), (rest.M + rest.Ma).toarray()
+    c = damping.matrix.toarray() + rest.Cs.toarray() + tr.G.toarray()
+    fr, d = rest.free, rest.dim
+    rows = element_rows(system.model)
+    for i, x in enumerate(w):
+        z = k - x * x * m + 1j * x * c
+        for dof in fr[[0, 5, -1]]:
+            f = np.zeros(k.shape[0])
+            f[dof] = 1.0
+            u = np.zeros(k.shape[0], complex)
+            u[fr] = np.linalg.solve(z[np.ix_(fr, fr)], f[fr])
+            u = u.reshape(-1, d)
+            t = np.einsum("ed,ed->e", rows[:, 0], u[:-1]) + np.einsum("ed,ed->e", rows[:, 1], u[1:])
+            g = got[:, dof // d, dof % d, i]
+            assert np.max(np.abs(g - t)) <= 1e-9 * np.max(np.abs(t))
