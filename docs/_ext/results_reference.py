@@ -225,7 +225,19 @@ _LINES = {
         "{L}",
         "Unstretched arc length of the element midpoints from end_a.",
     ),
-    "lines.<line>.tension.std": ("{F}", "σ of the dynamic effective tension per element."),
+    "lines.<line>.tension.std": (
+        "{F}",
+        "σ of the dynamic effective tension per element (with the residuals of the linear "
+        "model where ``std_linear`` is present).",
+    ),
+    "lines.<line>.tension.std_linear": (
+        "{F}",
+        "σ of the dynamic effective tension per element of the linear model alone; present "
+        "where the residuals were computed along the line "
+        "(:mod:`stochcable.dynamics.residuals.along_line`: the end kinds' load "
+        "cross-spectra through each element's tension, at up to 7 stations, interpolated "
+        "in arc length between them).",
+    ),
     "lines.<line>.tension.mean": ("{F}", "Static effective tension per element."),
     "lines.<line>.motion.s": ("{L}", "Unstretched arc length of the nodes from end_a."),
     "lines.<line>.motion.std": ("{L}", "σ of the x, y, z node displacements, shape (n_nodes, 3)."),

@@ -151,6 +151,15 @@ class LineResult:
         residual lines outside it;
         :mod:`stochcable.dynamics.residuals.corrected_spectrum`), whose area is the
         corrected σ²; None otherwise (:meth:`end_tension_density`).
+    tension_std_linear : ndarray, shape (n_el,) or None
+        Where the residuals were computed along the line (``along_line.computed``),
+        ``tension_std`` is σ of the element tensions with the residuals and this the
+        linear model's alone; None otherwise (``tension_std`` is the linear model's).
+    along_line : AlongLineResidual or None
+        The residuals' variance lines of every element tension
+        (:mod:`stochcable.dynamics.residuals.along_line`; ``computed`` False with the
+        reason where a residual applied at the ends is not covered along the line);
+        None where no residual was applied.
     """
 
     name: str
@@ -181,6 +190,8 @@ class LineResult:
     residuals: dict[str, ResidualRecord] = field(default_factory=dict)
     linear: dict[str, ResponseStats] | None = None
     corrected_spectra: dict[str, Any] | None = None
+    tension_std_linear: np.ndarray | None = None
+    along_line: Any = None
 
     def __getattr__(self, name: str) -> ResidualRecord | None:
         """A registered residual kind's record by its name (None when not asked for)."""
@@ -263,6 +274,11 @@ class LineResult:
                 "s": self.s_elements.tolist(),
                 "std": self.tension_std.tolist(),
                 "mean": self.tension_mean.tolist(),
+                **(
+                    {}
+                    if self.tension_std_linear is None
+                    else {"std_linear": self.tension_std_linear.tolist()}
+                ),
             },
             "motion": {"s": self.s_nodes.tolist(), "std": self.motion_std.tolist()},
             "spectra": {

@@ -74,6 +74,9 @@ class LineDocument:
     linear : dict {"end_a", "end_b"} of ResponseStats or None
         The linear model's end statistics where a residual was computed (``end_a`` and
         ``end_b`` carry the residuals), None otherwise.
+    tension_std_linear : numpy.ndarray or None
+        The linear model's element tension σ where the residuals were computed along
+        the line (``tension_std`` carries them), None otherwise. [N]
     """
 
     name: str
@@ -94,6 +97,7 @@ class LineDocument:
     document: Mapping[str, Any]
     residuals: dict[str, ResidualRecord] = field(default_factory=dict)
     linear: dict[str, ResponseStats] | None = None
+    tension_std_linear: np.ndarray | None = None
 
     def linear_end(self, end: str) -> ResponseStats:
         """The linear model's statistics of the tension at ``end``, as on ``LineResult``."""
@@ -148,6 +152,9 @@ class LineDocument:
             linear=None
             if doc.get("linear") is None
             else {e: _response_stats(v["tension"]) for e, v in doc["linear"].items()},
+            tension_std_linear=None
+            if tension.get("std_linear") is None
+            else _array(tension["std_linear"]),
         )
 
 
