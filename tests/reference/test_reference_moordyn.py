@@ -116,6 +116,10 @@ def test_comparison_scene_refuses_what_moordyn_line_types_cannot_hold(chain):
         comparison_scene(doc)
     with pytest.raises(InputError, match="line_name"):
         comparison_scene(chain, "nope")
+    doc = copy.deepcopy(chain.model_dump(mode="json", exclude_none=True))
+    doc["lines"][0]["drag_form"] = "hu_jin"  # MoorDyn has only the cross-flow drag
+    with pytest.raises(InputError, match=r"drag_form.*cross_flow"):
+        comparison_scene(doc)
 
 
 # ------------------------------------------------------------------ reference options
