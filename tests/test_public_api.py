@@ -104,6 +104,8 @@ def test_the_first_analysis_imports_what_the_scene_uses(residuals):
     heavy += ("scipy.optimize", "scipy.stats", "scipy.sparse.linalg", "stochcable.fidelity.planner")
     # nor NumPy's tool submodules that SciPy's import binds (stochcable.lazy_numpy)
     heavy += ("numpy.f2py.f2py2e", "numpy.testing._private.utils", "charset_normalizer")
+    # nor the fatigue curves (a strumming fatigue rate's) or the result's display
+    heavy += ("stochcable.design.curves", "stochcable.results.display")
     code = _FIRST_ANALYSIS.format(on=residuals, heavy=heavy)
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
     out = subprocess.run(
