@@ -106,6 +106,7 @@ def test_the_first_analysis_imports_what_the_scene_uses(residuals):
     heavy += ("numpy.f2py.f2py2e", "numpy.testing._private.utils", "charset_normalizer")
     # nor the fatigue curves (a strumming fatigue rate's) or the result's display
     heavy += ("stochcable.design.curves", "stochcable.results.display")
+    heavy += ("concurrent.futures",)  # (stochcable.runtime's pool: not started)
     code = _FIRST_ANALYSIS.format(on=residuals, heavy=heavy)
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
     out = subprocess.run(
