@@ -63,6 +63,14 @@ LINES = ("chain", "taut", "deep", "twoseg", "current")
 BUDGET_LINES = ("chain", "taut", "deep")  # with the error budget and the converged FD
 MOORDYN_LINES = ("chain", "taut", "deep", "twoseg")  # (the harness writes no current)
 FINE = 160  # elements of the converged TD and of the budget
+# the TD's mesh study: elements run per line (5 seeds each).  The yardstick of a line
+# is its reference TD at the coarsest mesh whose doubling moves σ by less than
+# CONVERGED at both ends (paired mean over the seeds); see reference_mesh()
+TD_MESHES = {
+    "chain": (80, 160), "taut": (80, 160), "deep": (80, 160, 320), "twoseg": (80, 160),
+    "current": (80, 160),
+}  # fmt: skip
+CONVERGED = 0.002
 FD_VARIANTS = (
     "default", "linear", "adaptive", "lines80", "lines160", "lines320", "fine320",
     "residuals320",
@@ -199,9 +207,10 @@ def runs() -> list[dict]:
     for line in LINES:
         for variant in FD_VARIANTS if line in BUDGET_LINES else NEW_LINE_VARIANTS:
             out.append({"line": line, "sim": "fd", "variant": variant})
-    for line in BUDGET_LINES:
-        for s in mc.SEEDS:
-            out.append({"line": line, "sim": "reference", "seed": s, "elements": FINE})
+    for line, meshes in TD_MESHES.items():
+        for n in meshes[1:]:
+            for s in mc.SEEDS:
+                out.append({"line": line, "sim": "reference", "seed": s, "elements": n})
     for line in BUDGET_LINES:
         for name, _, _ in fd_budget.VARIANTS:
             for s in mc.SEEDS:
@@ -259,6 +268,37 @@ def _seeds(cache: dict, line: str, sim: str, elements: int = 80) -> list[dict]:
 
 def _fd(cache: dict, line: str, variant: str) -> dict:
     return _get(cache, {"line": line, "sim": "fd", "variant": variant})
+
+
+def mesh_moves(cache: dict, line: str) -> list[tuple[int, int, list[float]]]:
+    """The reference TD's mesh study of ``line``: (n, 2n, [fairlead, anchor] paired mean
+    σ(2n)/σ(n) − 1 over the seeds) for each step of :data:`TD_MESHES` that has run."""
+    meshes = TD_MESHES.get(line, (mc.BASE["elements"],))
+    out = []
+    for n, n2 in zip(meshes, meshes[1:]):
+        try:
+            a, b = _seeds(cache, line, "reference", n), _seeds(cache, line, "reference", n2)
+        except KeyError:
+            break
+        out.append((n, n2, [float(np.mean([y[q] / x[q] - 1.0 for x, y in zip(a, b)]))
+                            for q, _ in ENDS]))  # fmt: skip
+    return out
+
+
+def reference_mesh(cache: dict, line: str) -> int:
+    """The yardstick's mesh: the coarsest reference TD mesh whose doubling moves σ by
+    less than :data:`CONVERGED` at both ends (paired mean); the finest run if none
+    does (then the page says so)."""
+    steps = mesh_moves(cache, line)
+    for n, _, moves in steps:
+        if max(abs(m) for m in moves) < CONVERGED:
+            return n
+    return steps[-1][1] if steps else mc.BASE["elements"]
+
+
+def _ref(cache: dict, line: str) -> list[dict]:
+    """The yardstick: the reference TD at :func:`reference_mesh`."""
+    return _seeds(cache, line, "reference", reference_mesh(cache, line))
 
 
 def _kn(x: list[float]) -> str:
@@ -378,7 +418,9 @@ def _setup(cache: dict) -> list[str]:
         "for the budget, on the TD's own lines 2πj/T (80, 160 and 320 elements), its σ "
         "summed as the DSA sums them (every line with its full weight, not the trapezoid).",
         "- **Reference TD**: `simulate_line_timedomain`, 80 elements (two segments: 46 + "
-        "34, in proportion to their lengths; and 160 on the first three lines), Newmark "
+        "34, in proportion to their lengths) and finer meshes for its mesh study ("
+        + "; ".join(f"`{ln}`: {', '.join(map(str, ns[1:]))}" for ln, ns in TD_MESHES.items())
+        + "; the yardstick is the converged one: 'The yardstick's mesh' below), Newmark "
         "Δt 0.05 s, quadratic drag (on the velocity relative to the current), one-sided "
         "seabed, geometric nonlinearity.",
         "- **MoorDyn**: MoorDyn-C, 80 segments (46 + 34), dtM 1 ms, RK4, coupling every "
@@ -419,50 +461,83 @@ def _sigma_tables(cache: dict) -> list[str]:
         "## End tension σ",
         "",
         "| line | end | FD default [kN] | FD linear [kN] | FD adaptive [kN] "
-        "| reference TD [kN] | MoorDyn [kN] | TD, 160 elements [kN] |",
-        "|---|---|---|---|---|---|---|---|",
+        "| reference TD, 80 elements [kN] | TD, 160 elements [kN] | TD, 320 elements [kN] "
+        "| MoorDyn, 80 segments [kN] |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for line in LINES:
         fd0, fdl = _fd(cache, line, "default"), _fd(cache, line, "linear")
         fda = _fd(cache, line, "adaptive")
-        td, md = _seeds(cache, line, "reference"), _md(cache, line)
-        td2 = _seeds(cache, line, "reference", FINE) if line in BUDGET_LINES else None
+        md = _md(cache, line)
+        tds = {
+            n: _seeds(cache, line, "reference", n)
+            for n in TD_MESHES.get(line, (80,))
+            if all(mc.run_key({"line": line, "sim": "reference", "seed": s, "elements": n})
+                   in cache for s in mc.SEEDS)
+        }  # fmt: skip
         for q, end in ENDS:
+            cells = " | ".join(
+                (_kn([r[q] for r in tds[n]]) + (" (yardstick)" if n == reference_mesh(
+                    cache, line) else "")) if n in tds else "–"
+                for n in (80, 160, 320)
+            )  # fmt: skip
             out.append(
                 f"| {line} | {end} | {fd0[q] / 1e3:.2f} | {fdl[q] / 1e3:.2f} "
-                f"| {fda[q] / 1e3:.2f} | {_kn([r[q] for r in td])} "
-                f"| {_kn([r[q] for r in md]) if md else '–'} "
-                f"| {_kn([r[q] for r in td2]) if td2 else '–'} |"
+                f"| {fda[q] / 1e3:.2f} | {cells} "
+                f"| {_kn([r[q] for r in md]) if md else '–'} |"
+            )
+    out += [
+        "",
+        "## The yardstick's mesh",
+        "",
+        "The reference TD of a line is taken at the coarsest mesh whose doubling moves "
+        f"σ by less than {100 * CONVERGED:.1f} % at both ends (paired mean over the "
+        "seeds); MoorDyn runs 80 segments on every line (its comparison with the "
+        "reference is paired at 80 elements).",
+        "",
+        "| line | mesh step | fairlead σ moves | anchor σ moves | yardstick |",
+        "|---|---|---|---|---|",
+    ]
+    for line in LINES:
+        n_ref = reference_mesh(cache, line)
+        for n, n2, moves in mesh_moves(cache, line):
+            out.append(
+                f"| {line} | {n} → {n2} elements | {100 * moves[0]:+.2f} % "
+                f"| {100 * moves[1]:+.2f} % | {n_ref} elements |"
             )
     out += [
         "",
         "## Ratios",
         "",
         "Target (issue 31): the default σ within 1 % of the reference TD at the fairlead "
-        "and 2 % at the anchor.",
+        "and 2 % at the anchor.  'TD' is the yardstick (the reference TD at its "
+        "converged mesh, above); the 80-element ratio is the previous page's.",
         "",
-        "| line | end | FD default / TD − 1 | target met | FD linear / TD − 1 "
+        "| line | end | FD default / TD − 1 | target met | FD default / TD 80 − 1 "
+        "| FD linear / TD − 1 "
         "| FD adaptive / TD − 1 | FD default / MoorDyn − 1 | FD linear / MoorDyn − 1 "
-        "| TD / MoorDyn − 1 (paired) |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| TD 80 / MoorDyn − 1 (paired) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for line in LINES:
         fd0, fdl = _fd(cache, line, "default"), _fd(cache, line, "linear")
         fda = _fd(cache, line, "adaptive")
-        td, md = _seeds(cache, line, "reference"), _md(cache, line)
+        td, md = _ref(cache, line), _md(cache, line)
+        td80 = _seeds(cache, line, "reference")
         for q, end in ENDS:
             mine = 100.0 * float(np.mean(_over(fd0[q], td, q)))
             # (at the table's precision)
             ok = "yes" if abs(round(mine, 2)) <= (1.0 if q == "reaction_b" else 2.0) else "**no**"
             md_cells = (
                 f"{_pct(_over(fd0[q], md, q))} | {_pct(_over(fdl[q], md, q))} "
-                f"| {_pct(_over([r[q] for r in td], md, q))}"
+                f"| {_pct(_over([r[q] for r in td80], md, q))}"
                 if md
                 else "– | – | –"
             )
             out.append(
                 f"| {line} | {end} | {_pct(_over(fd0[q], td, q))} | {ok} "
-                f"| {_pct(_over(fdl[q], td, q))} | {_pct(_over(fda[q], td, q))} "
+                f"| {_pct(_over(fd0[q], td80, q))} | {_pct(_over(fdl[q], td, q))} "
+                f"| {_pct(_over(fda[q], td, q))} "
                 f"| {md_cells} |"
             )
     out += [
@@ -645,24 +720,33 @@ def _reading(cache: dict) -> list[str]:
         "yardstick."
     )
     worst = {q: max(abs(_mean_ratio(_fd(cache, line, "default")[q],
-                                     _seeds(cache, line, "reference"), q)) for line in LINES)
+                                     _ref(cache, line), q)) for line in LINES)
              for q, _ in ENDS}  # fmt: skip
     out.append(
-        f"- **Default (corrected) σ against the TD**: worst line {worst['reaction_b']:.2f} % "
+        f"- **Default (corrected) σ against the TD** (the yardstick: the reference TD at "
+        f"its converged mesh, see 'The yardstick's mesh'): worst line {worst['reaction_b']:.2f} % "
         f"at the fairlead (target 1 %), {worst['reaction_a']:.2f} % at the anchor "
         "(target 2 %); per line:"
     )
     for line in LINES:
-        td = _seeds(cache, line, "reference")
+        td, n_ref = _ref(cache, line), reference_mesh(cache, line)
         fd0, fdl = _fd(cache, line, "default"), _fd(cache, line, "linear")
         f = {q: (_mean_ratio(fd0[q], td, q), _mean_ratio(fdl[q], td, q)) for q, _ in ENDS}
+        ci = {q: _pct(_over(fd0[q], td, q)) for q, _ in ENDS}
         text = (
-            f"  - **{line}**: default / TD − 1 = {f['reaction_b'][0]:+.2f} % (fairlead), "
-            f"{f['reaction_a'][0]:+.2f} % (anchor); linear {f['reaction_b'][1]:+.2f} % / "
-            f"{f['reaction_a'][1]:+.2f} %."
+            f"  - **{line}** (TD at {n_ref} elements): default / TD − 1 = "
+            f"{ci['reaction_b']} (fairlead), {ci['reaction_a']} (anchor); linear "
+            f"{f['reaction_b'][1]:+.2f} % / {f['reaction_a'][1]:+.2f} %."
         )
+        if n_ref != mc.BASE["elements"]:
+            td80 = _seeds(cache, line, "reference")
+            text += (
+                "  Against the 80-element TD (the previous yardstick, not mesh-converged): "
+                + " / ".join(f"{_mean_ratio(fd0[q], td80, q):+.2f} %" for q, _ in ENDS)
+                + "."
+            )
         if line in BUDGET_LINES:
-            td2 = _seeds(cache, line, "reference", FINE)
+            td2, td = _seeds(cache, line, "reference", FINE), _seeds(cache, line, "reference")
             fine = _fd(cache, line, "fine320")
             disc = [100.0 * (fd0[f"linear_{q[-1]}"] / fine[q] - 1.0) for q, _ in ENDS]
             text += (
@@ -689,12 +773,16 @@ def _fatigue_inputs(cache: dict, records: Path) -> list[dict]:
         fd0, fdl = _fd(cache, line, "default"), _fd(cache, line, "linear")
         for q, end in ENDS:
             e = "end_" + q[-1]
-            recs, md = [], []
+            recs, md, td80 = [], [], []
+            n_ref = reference_mesh(cache, line)
             for s in mc.SEEDS:
-                run = {"line": line, "sim": "reference", "seed": s, **mc.BASE}
+                run = {"line": line, "sim": "reference", "seed": s, "elements": n_ref}
                 with np.load(record_path(records, run)) as f:
                     recs.append(np.array(f[q]))
                     dt = float(f["t"][1] - f["t"][0])
+                run = {"line": line, "sim": "reference", "seed": s, **mc.BASE}
+                with np.load(record_path(records, run)) as f:
+                    td80.append(np.array(f[q]))
                 if line in MOORDYN_LINES:
                     run["sim"] = "moordyn"
                     with np.load(record_path(records, run)) as f:
@@ -706,6 +794,8 @@ def _fatigue_inputs(cache: dict, records: Path) -> list[dict]:
                     "key": e,
                     "records": recs,
                     "md_records": md,
+                    "td80_records": td80,
+                    "elements": n_ref,
                     "dt": dt,
                     "default": [np.asarray(x) for x in fd0["density"][e]["answer"]],
                     "linear": [np.asarray(x) for x in fdl["density"][e]["linear"]],

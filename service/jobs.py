@@ -16,7 +16,9 @@ from .limits import checked_call
 __all__ = ["analysis_job", "non_finite_error"]
 
 
-def analysis_job(scene: Scene, timeseries: str, netcdf: bool = False) -> tuple[bytes, int]:
+def analysis_job(
+    scene: Scene, timeseries: str, netcdf: bool = False, timeseries_linear: bool = False
+) -> tuple[bytes, int]:
     """Analyse a scene and encode its result document (in a worker process).
 
     Parameters
@@ -27,6 +29,9 @@ def analysis_job(scene: Scene, timeseries: str, netcdf: bool = False) -> tuple[b
         Time series in the document.
     netcdf : bool
         Answer the result as a NetCDF-4 file (its Dataset) instead of JSON.
+    timeseries_linear : bool
+        Also the linear model's end tensions beside the series that carry the
+        residuals' component.
 
     Returns
     -------
@@ -49,13 +54,14 @@ def analysis_job(scene: Scene, timeseries: str, netcdf: bool = False) -> tuple[b
         # the core's own floating-point policy (the result equals analyze()'s);
         # arithmetic failures escaping it become NumericalError (422)
         result = checked_call(False, analyze, scene)
-        doc = result.to_document(timeseries=timeseries)
+        doc = result.to_document(timeseries=timeseries, timeseries_linear=timeseries_linear)
         if not all_finite(doc):
             raise non_finite_error(scene, doc)
         if netcdf:
             from stochcable.results.datasets import dataset_from_result, netcdf_bytes
 
-            return netcdf_bytes(dataset_from_result(result)), len(doc.get("warnings", ()))
+            dataset = dataset_from_result(result, timeseries_linear=timeseries_linear)
+            return netcdf_bytes(dataset), len(doc.get("warnings", ()))
         return dumps(doc), len(doc.get("warnings", ()))
     except MemoryError as exc:
         hint = estimate_cost(scene).reduce_hint()

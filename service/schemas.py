@@ -325,8 +325,18 @@ class TensionAlongLine(_Open):
     """Effective tension along the line, per element."""
 
     s: list[float] = _f("Unstretched arc length of the element midpoints from end_a", "m")
-    std: list[float] = _f("σ of the dynamic effective tension", "N")
+    std: list[float] = _f(
+        "σ of the dynamic effective tension (with the residuals of the linear model "
+        "where std_linear is present)",
+        "N",
+    )
     mean: list[float] | None = _f("Static effective tension", "N", default=None)
+    std_linear: list[float] | None = _f(
+        "σ of the dynamic effective tension of the linear model alone; present where the "
+        "residuals were computed along the line",
+        "N",
+        default=None,
+    )
 
 
 class MotionAlongLine(_Open):
@@ -419,7 +429,10 @@ class TimeSeriesDocument(_Open):
         "Prescribed end motions by channel (line.end_b.surge, ...)", "m or rad"
     )
     lines: dict[str, dict[str, dict[str, list[float]]]] = _f(
-        "Total end tensions {line: {end_a: {tension: [...]}, end_b: ...}}", "N"
+        "Total end tensions {line: {end_a: {tension: [...]}, end_b: ...}}, with the "
+        "residuals' Gaussian component where they were applied; with the query "
+        "timeseries_linear, the linear model's beside them (tension_linear)",
+        "N",
     )
     bodies: dict[str, dict[str, dict[str, list[float]]]] | None = Field(
         default=None,

@@ -434,7 +434,10 @@ class Client(BatchMethods):
         return Scene.model_validate(data)
 
     def analyze(
-        self, scene: Scene | Mapping[str, Any] | str | Path, timeseries: str = "window"
+        self,
+        scene: Scene | Mapping[str, Any] | str | Path,
+        timeseries: str = "window",
+        timeseries_linear: bool = False,
     ) -> AnalysisDocument:
         """``POST /v1/analyses``: run the analysis of a scene on the service.
 
@@ -447,6 +450,9 @@ class Client(BatchMethods):
             the service reads no files).
         timeseries : {"window", "full", "none"}
             Time series in the document: the first 2048 samples, all, or none.
+        timeseries_linear : bool
+            Also the linear model's end tensions beside the series that carry the
+            residuals' component (``timeseries.end_tension_linear``).
 
         Returns
         -------
@@ -471,5 +477,8 @@ class Client(BatchMethods):
 
             raise InputError("timeseries", timeseries, "-", "must be 'window', 'full' or 'none'")
         body = load_scene(scene, allow_files=False).model_dump(mode="json")
-        resp = self._request("POST", f"/v1/analyses?timeseries={timeseries}", json_body=body)
+        query = f"timeseries={timeseries}" + (
+            "&timeseries_linear=true" if timeseries_linear else ""
+        )
+        resp = self._request("POST", f"/v1/analyses?{query}", json_body=body)
         return AnalysisDocument(resp.json())

@@ -30,7 +30,9 @@ therefore
 with c_M the free lines' constant or the attached lines' one, M_0 the blocks'
 temporaries and the small arrays, N_t = duration/dt the time-series samples (the
 realization, the transfer functions interpolated onto the N_t/2 FFT frequencies and
-the synthesized records), and the time
+the synthesized records; with the residuals two more channels a line, each end
+tension's Gaussian residual component, :mod:`stochcable.dynamics.timeseries.residual_series`),
+and the time
 
     t ≈ k_M · n_ω · Σ_lines n_nodes · n_ch · (1 + n_bodies)  +  k_T · N_t · (1 + Σ n_ch).
 
@@ -89,9 +91,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from stochcable.errors import InputError
 from stochcable.scene.model import Scene, load_scene
-from stochcable.scene.residual_kinds import asked_residuals
+from stochcable.scene.residual_kinds import ResidualSize, asked_residuals
 
 __all__ = [
     "CostEstimate",
@@ -131,8 +135,25 @@ _BODY_TIME_FACTOR = 1.0  # extra time per free body (coupled solves): 2.6 µs vs
 
 #: The residuals of the linear model (every kind of
 #: :mod:`stochcable.scene.residual_kinds` the scene asks for): their peak memory and
-#: time are the kinds' cost terms (``memory_bytes``, ``seconds``; the largest memory,
-#: the sum of the times).  Measured with the drag and geometric residuals: an
+#: time are the kinds' cost terms (``memory``, ``seconds``; the largest memory of one
+#: kind on one line, the sum of the times).
+#:
+#: Memory (issue 31): an upper bound, the residual's arrays counted from the sizes
+#: (``ResidualSize``: elements, frequencies, channels, dimension, the uniform grid's
+#: lines and amplitude lines) times 1.25 (``RESIDUAL_MEMORY_MARGIN``): copies of the
+#: response per node, frequency and channel (drag: its pieces' velocities, 208 B planar,
+#: 288 B in 3-D per piece·ω·channel; geometric: the node displacements and their
+#: differences, 96 B per node·ω·channel, and its processes' lines) and pair terms
+#: (geometric: d² element pairs on its ~3·32 lines, every element counted, up to 400
+#: elements; planar drag: 64 panel components squared; 3-D drag: its covariance blocks).
+#: Peak RSS above the warmed-up process measured against the whole estimate (MB): taut
+#: wire 200 × 600: 305 / 412, 400 × 600: 1081 / 1379; chain 150 × 600: 108 / 294, in
+#: 3-D 288 / 516, 400 × 2000: 611 / 1770; three-leg buoy 100 × 600: 267 / 476
+#: (tests/test_cost.py).  On a line with seabed contact the geometric residual skips
+#: the elements on the bed (their forces do not reach the ends), which the bound counts:
+#: it is then up to 3× the measured peak.
+#:
+#: Time: measured with the drag and geometric residuals: an
 #: analysis of the chain, the inclined guy and the taut wire with both measured 0.53,
 #: 0.65 and 0.16 s against 0.72, 0.79 and 0.18 s estimated (the chain at 160 elements:
 #: 0.90 against 0.80 s); the caps are those of :mod:`stochcable.dynamics.residuals.residual_lines`
@@ -141,24 +162,71 @@ _BODY_TIME_FACTOR = 1.0  # extra time per free body (coupled solves): 2.6 µs vs
 #: panels, the guy 53), counted as a quarter of the panel cap more in every sea (the
 #: chain and the guy: 1.12 and 1.43 s measured against 1.29 and 1.36 s estimated, on a
 #: loaded host; the taut wire, 10 m below the surface, splits none: 0.21 against 0.52 s,
-#: on the safe side).
+#: on the safe side).  A 3-D line (``seconds_3d``): the vector drag residual measured
+#: 8.7–14× the planar formula (the taut wire at heading 45°, 10–80 elements: 0.05–0.27 s;
+#: the three-leg buoy's legs at 20 and 40 elements; the chain at 45°: 0.34 s against
+#: 0.023 s planar), 14 taken; the geometric 2.3–3.2× (3 taken).  A line with an end on a
+#: free body: its residuals through the coupled influence, 1.14–1.15× (1.25 taken).
 _RESIDUAL_LINES = 63
 
 
-def _residual_seconds(scene: Scene) -> float:
-    """Estimated time of the residuals the scene asks for. [s]"""
+#: Factor on a line's residual times where an end is on a free body: the coupled
+#: influence (body_residual) solved on the residual's lines, measured 1.14 on the
+#: three-leg buoy (3-D legs of 40 elements) and 1.15 on the single leg on the disc
+#: buoy (40 elements). [-]
+_BODY_RESIDUAL_FACTOR = 1.25
+
+
+def _uniform_lines(w: np.ndarray, stride: int = 1) -> tuple[int, int]:
+    """Lines n_j of the residuals' uniform grid of the analysis frequencies ``w``
+    (every ``stride``-th of at most ``_RESIDUAL_LINES`` + 1) and its amplitude lines
+    n_j · ranks (the most frequencies on one line: each its own channel), as
+    :class:`stochcable.dynamics.residuals.residual_lines.UniformGrid` forms them
+    without the inputs' tails (tests/test_cost.py checks they agree). [-]"""
+    w = np.asarray(w, dtype=float)
+    steps = np.diff(w)
+    base = max(float(steps.min()) if steps.size else float(w[0]), float(w[-1]) / _RESIDUAL_LINES)
+    step = stride * base
+    n_j = int(np.rint(w[-1] / step)) + 1
+    index = np.clip(np.rint(w / step).astype(int), 0, n_j - 1)
+    ranks = int(np.bincount(index).max())
+    return n_j, n_j * ranks
+
+
+def _residual_cost(scene: Scene) -> tuple[float, int]:
+    """Estimated time [s] and peak memory [B] of the residuals the scene asks for: the
+    time summed over the lines and kinds, the memory the largest of one kind on one
+    line (the kinds run one after the other, line by line, and free their
+    temporaries)."""
     kinds = asked_residuals(scene.analysis.linearization)
     if not kinds:
-        return 0.0
+        return 0.0, 0
     w = scene.analysis.omega.values()
-    step = float(min(w[1:] - w[:-1])) if w.size > 1 else float(w[0])
-    n_j = min(_RESIDUAL_LINES, max(2, int(w[-1] / max(step, 1e-12)) + 1))
+    n_j, samples = _uniform_lines(w)
+    half_j, half_samples = _uniform_lines(w, 2)
     in_sea = scene.sea is not None
-    out = 0.0
+    dim = 2 if scene.is_planar else 3
+    seconds, memory = 0.0, 0
     for line in scene.lines:
         n_el = sum(int(s.elements) for s in line.segments)
-        out += sum(k.seconds(n_el, n_j, in_sea) for k in kinds)
-    return out
+        size = ResidualSize(
+            elements=n_el,
+            frequencies=w.size,
+            channels=1 + _end_channels(line.end_a) + _end_channels(line.end_b),
+            dim=dim,
+            lines=n_j,
+            samples=samples,
+            half_lines=half_j,
+            half_samples=half_samples,
+        )
+        on_body = any(getattr(e, "attach", None) is not None for e in (line.end_a, line.end_b))
+        line_s = sum(
+            k.seconds(n_el, min(n_j, _RESIDUAL_LINES), in_sea) * (k.seconds_3d if dim == 3 else 1.0)
+            for k in kinds
+        )
+        seconds += line_s * (_BODY_RESIDUAL_FACTOR if on_body else 1.0)
+        memory = max(memory, *(k.memory(size) for k in kinds))
+    return seconds, memory
 
 
 @dataclass(frozen=True)
@@ -188,6 +256,9 @@ class CostEstimate:
         Part of ``memory_bytes`` in the frequency-domain arrays. [B]
     timeseries_bytes : int
         Part of ``memory_bytes`` in the time series. [B]
+    residual_bytes : int
+        Part of ``memory_bytes`` in the residuals' temporaries (the largest of one
+        kind on one line). [B]
     largest_line : str
         Field path of the segment with the most elements (``lines[i].segments[j].elements``).
     largest_elements : int
@@ -204,13 +275,14 @@ class CostEstimate:
     bodies: int
     spectral_bytes: int
     timeseries_bytes: int
+    residual_bytes: int
     largest_line: str
     largest_elements: int
 
     @property
     def parameter(self) -> str:
         """The input whose reduction lowers the memory most (a field path)."""
-        if self.timeseries_bytes > self.spectral_bytes:
+        if self.timeseries_bytes > max(self.spectral_bytes, self.residual_bytes):
             return "analysis.timeseries.duration"
         if self.frequencies >= self.nodes:
             return "analysis.omega.count"
@@ -226,12 +298,19 @@ class CostEstimate:
         series = (
             f"analysis.timeseries duration/dt ({self.samples} samples) or drop analysis.timeseries"
         )
-        if not self.samples:
-            parts = [spectral]
-        elif self.spectral_bytes >= self.timeseries_bytes:
-            parts = [spectral, series]
-        else:
-            parts = [series, spectral]
+        residual = (
+            f"analysis.omega.count ({self.frequencies}) or the elements of the lines "
+            f"({self.nodes} nodes; most in {self.largest_line}) for the residuals' "
+            "temporaries (∝ elements × "
+            "frequencies, and elements² up to 400 elements), or set "
+            "analysis.linearization.drag_residual / geometric_residual false"
+        )
+        shares = [(self.spectral_bytes, spectral)]
+        if self.samples:
+            shares.append((self.timeseries_bytes, series))
+        if self.residual_bytes:
+            shares.append((self.residual_bytes, residual))
+        parts = [text for _, text in sorted(shares, key=lambda p: -p[0])]
         return "reduce " + "; then ".join(parts)
 
     def describe(self) -> str:
@@ -241,6 +320,7 @@ class CostEstimate:
             f"({self.frequencies} frequencies × {self.nodes} nodes × channels "
             f"{self.channels}"
             + (f"; {self.samples} time-series samples" if self.samples else "")
+            + (f"; residuals {_fmt_bytes(self.residual_bytes)}" if self.residual_bytes else "")
             + ")"
         )
 
@@ -314,17 +394,21 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
         ratio = ts.duration / ts.dt
         samples = int(round(ratio)) if ratio < 2**62 else 2**62
     spectral = n_w * node_bytes
-    series = BYTES_PER_SAMPLE_CHANNEL * samples * (1 + channels)
+    # the residuals' Gaussian component of each end tension: one more series per end
+    # (its realization's work arrays and the component, as a channel's)
+    series_channels = 1 + channels
+    if asked_residuals(scene.analysis.linearization):
+        series_channels += 2 * len(scene.lines)
+    series = BYTES_PER_SAMPLE_CHANNEL * samples * series_channels
     n_bodies = len(scene.bodies)
     ops_spectral = float(n_w) * node_channels
-    ops_series = float(samples) * (1 + channels)
+    ops_series = float(samples) * series_channels
+    residual_seconds, residual_bytes = _residual_cost(scene)
     seconds = (
         SECONDS_PER_NODE_FREQUENCY_CHANNEL * ops_spectral * (1.0 + _BODY_TIME_FACTOR * n_bodies)
         + SECONDS_PER_SAMPLE_CHANNEL * ops_series
-        + _residual_seconds(scene)
+        + residual_seconds
     )
-    kinds = asked_residuals(scene.analysis.linearization)
-    residual_bytes = max((k.memory_bytes for k in kinds), default=0)
     return CostEstimate(
         memory_bytes=int(BASE_BYTES + spectral + series + residual_bytes),
         seconds=seconds,
@@ -336,6 +420,7 @@ def estimate_cost(scene: Scene | Mapping[str, Any]) -> CostEstimate:
         bodies=n_bodies,
         spectral_bytes=int(spectral),
         timeseries_bytes=int(series),
+        residual_bytes=int(residual_bytes),
         largest_line=largest_path,
         largest_elements=max(largest, 0),
     )

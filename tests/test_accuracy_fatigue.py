@@ -48,6 +48,20 @@ def test_periodic_density_is_parseval_and_puts_a_line_on_its_frequency():
     assert np.max(s) * (w[1] - w[0]) == pytest.approx(2.0, rel=1e-12)  # A²/2
 
 
+def test_band_shares_put_each_line_in_its_band_and_sum_to_one():
+    """Two lines, 0.63 rad/s (A = 3) and 3.14 rad/s (A = 1): σ² shares 9/10 and 1/10 in
+    their bands, from the periodogram; a flat density on 0–6 rad/s: a third in each of
+    the first three bands, to half a cell (the trapezoid's split at a band's node)."""
+    x = _sine(3.0, 20) + _sine(1.0, 100)
+    sh = af.band_shares(*af.periodic_density(x, DT))
+    np.testing.assert_allclose(sh, [0.9, 0.1, 0.0, 0.0, 0.0], atol=1e-12)
+    w = np.linspace(0.0, 6.0, 601)
+    sh = af.band_shares(w, np.ones_like(w))
+    assert sh.sum() == pytest.approx(1.0, rel=1e-12)
+    np.testing.assert_allclose(sh[:3], 1.0 / 3.0, atol=0.01 / 6.0)  # half a cell
+    assert sh[3:].sum() == 0.0
+
+
 def test_surrogates_keep_the_spectrum_line_by_line_and_the_mean():
     rng = np.random.default_rng(7)
     x = np.cumsum(rng.normal(size=N))

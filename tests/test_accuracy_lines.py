@@ -104,10 +104,32 @@ def test_page_reads_the_ratios_and_the_fatigue_split_from_the_runs(tmp_path, mon
     ]
     assert len(rows) == 1
     split = [r.split("|") for r in page.splitlines() if r.startswith("| deep | anchor | ")]
-    spectrum = [c for c in split if "(" in c[6]][0]  # the fatigue split's row
+    spectrum = [c for c in split if "%;" in c[6]][0]  # the fatigue split's row
     assert abs(float(spectrum[3].split("%")[0].split("±")[0])) < 0.05  # densities equal
     assert abs(float(spectrum[4].split("%")[0])) < 0.05  # its σ^m part (σ from the density)
     assert "| current | anchor |" in page and "Not re-run for this regeneration" in page
+
+
+def test_reference_mesh_is_the_coarsest_whose_doubling_moves_less_than_the_rule():
+    """deep: 80 → 160 moves σ by −1 %, 160 → 320 by +0.1 % (< 0.2 %): the yardstick is
+    the 160-element TD and the ratios are taken against it; chain: 80 → 160 moves 0 %:
+    80; a line whose finer mesh has not run: 80."""
+    cache = {}
+    for line, moves in (("deep", {160: 0.99, 320: 0.99 * 1.001}), ("chain", {160: 1.0})):
+        for s in moordyn_check.SEEDS:
+            for n, f in {80: 1.0, **moves}.items():
+                run = {"line": line, "sim": "reference", "seed": s, "elements": n}
+                cache[moordyn_check.run_key(run)] = {"reaction_b": f * 100.0 + s,
+                                                     "reaction_a": f * 50.0 + s}  # fmt: skip
+    assert accuracy_lines.reference_mesh(cache, "deep") == 160
+    steps = accuracy_lines.mesh_moves(cache, "deep")
+    assert [(n, n2) for n, n2, _ in steps] == [(80, 160), (160, 320)]
+    assert steps[0][2][0] == pytest.approx(
+        -0.01 * 100 / np.mean([100 + s for s in moordyn_check.SEEDS]), rel=0.02
+    )
+    assert accuracy_lines.reference_mesh(cache, "chain") == 80
+    assert accuracy_lines.reference_mesh(cache, "twoseg") == 80  # (no 160 runs)
+    assert accuracy_lines._ref(cache, "deep")[0]["reaction_b"] == pytest.approx(0.99 * 100 + 1)
 
 
 # the slow test: four 400 s reference simulations of the chain at 80 elements (≈ 10 s

@@ -259,12 +259,17 @@ def test_dsa_timeseries_variance_equals_spectrum_sum():
         ("end_a", res.statics.lines["chain"].tension_a),
         ("end_b", res.statics.lines["chain"].tension_b),
     ):
-        x = ts.end_tension["chain"][end] - mean
+        # the linear model's part of the record (the residuals' independent Gaussian
+        # component aside: tests/dynamics/test_residual_series.py)
+        x = ts.end_tension_linear["chain"][end] - mean
         h = ts.end_tension_transfer["chain"][end][0]
         expected = float(np.sum(np.abs(h) ** 2 * s) * d_omega)
         # DSA: the realization's variance is the grid sum exactly (round-off only)
         assert np.mean(x**2) == pytest.approx(expected, rel=1e-10)
         assert abs(np.mean(x)) < 1e-9 * math.sqrt(expected)
+        # the residuals' component: zero-mean, DSA, its own grid sum
+        r = ts.end_tension_residual["chain"][end]
+        assert abs(np.mean(r)) < 1e-9 * math.sqrt(np.mean(r**2))
     # the elevation is the stand-alone realization with the same seed
     from stochcable.sea.realization import simulate_sea
 
@@ -326,7 +331,12 @@ def test_vector_form_equals_seed_form_for_in_plane_velocity():
         rtol=1e-7,
         atol=1e-9 * a.linearization.b_normal.max(),
     )
-    np.testing.assert_allclose(b.tension_std, a.tension_std, rtol=1e-7)
+
+    # the linear model's element σ (the residuals along the line: the seed form only)
+    def linear(x):
+        return x.tension_std if x.tension_std_linear is None else x.tension_std_linear
+
+    np.testing.assert_allclose(linear(b), linear(a), rtol=1e-7)
 
 
 # ------------------------------------------------------------ chain end to end

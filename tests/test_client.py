@@ -252,6 +252,20 @@ def test_analyze_bodies_scene_returns_body_motion_series(client):
     assert np.std(ts.body_motion["disc"]["heave"]) > 0
 
 
+def test_analyze_gives_the_linear_series_when_asked(client):
+    """timeseries_linear: the window's linear end tensions beside the corrected ones
+    (the local result's, round-off from BLAS)."""
+    doc = load_example("tuah_1982_single_leg").model_dump(mode="json")
+    ts = client.analyze(doc, timeseries_linear=True).timeseries
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        local = analyze(doc).timeseries
+    for end, series in ts.end_tension_linear["leg"].items():
+        want = local.end_tension_linear["leg"][end][: series.size]
+        np.testing.assert_allclose(series, want, rtol=1e-10, atol=1e-10 * np.abs(want).max())
+    assert client.analyze(doc).timeseries.end_tension_linear == {}
+
+
 def test_analyze_unconverged_raises_client_error_with_the_reason(client):
     # CPU-independent by a wide margin: the first iteration's relative change is 0.81
     # (measured), 80 times the example's tolerance 1e-2

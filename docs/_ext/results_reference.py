@@ -225,7 +225,19 @@ _LINES = {
         "{L}",
         "Unstretched arc length of the element midpoints from end_a.",
     ),
-    "lines.<line>.tension.std": ("{F}", "σ of the dynamic effective tension per element."),
+    "lines.<line>.tension.std": (
+        "{F}",
+        "σ of the dynamic effective tension per element (with the residuals of the linear "
+        "model where ``std_linear`` is present).",
+    ),
+    "lines.<line>.tension.std_linear": (
+        "{F}",
+        "σ of the dynamic effective tension per element of the linear model alone; present "
+        "where the residuals were computed along the line "
+        "(:mod:`stochcable.dynamics.residuals.along_line`: the end kinds' load "
+        "cross-spectra through each element's tension, at up to 7 stations, interpolated "
+        "in arc length between them).",
+    ),
     "lines.<line>.tension.mean": ("{F}", "Static effective tension per element."),
     "lines.<line>.motion.s": ("{L}", "Unstretched arc length of the nodes from end_a."),
     "lines.<line>.motion.std": ("{L}", "σ of the x, y, z node displacements, shape (n_nodes, 3)."),
@@ -440,7 +452,18 @@ _REST = {
     "timeseries.time": ("s", "Sample times."),
     "timeseries.elevation": ("{L}", "Wave elevation at the origin (null without a sea)."),
     "timeseries.end_motion.<channel>": ("{L}", "Prescribed end motion of each end-motion channel."),
-    "timeseries.lines.<line>.<end>.tension": ("{F}", "Total end tension, mean + dynamic."),
+    "timeseries.lines.<line>.<end>.tension": (
+        "{F}",
+        "Total end tension, mean + dynamic; with the residuals of the linear model where "
+        "they were applied: an independent Gaussian component with their spectral "
+        "density, so the record's σ and spectrum are the corrected ones.",
+    ),
+    "timeseries.lines.<line>.<end>.tension_linear": (
+        "{F}",
+        "The linear model's end tension (without the residuals' component), beside "
+        "``tension`` where that carries it, when asked for (``timeseries_linear``: "
+        "``--timeseries-linear``, ``?timeseries_linear=true``).",
+    ),
     "timeseries.bodies.<body>.motion.<dof>": (
         "{L} or rad",
         "Body motion, static pose + dynamic part.",
@@ -589,7 +612,9 @@ def example_documents() -> dict[str, dict[str, Any]]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the examples' warnings belong to their pages
         for name in ("chain_catenary", "tuah_1982_disc_buoy_single_leg"):
-            docs[name] = stochcable.analyze(stochcable.load_example(name)).to_document()
+            docs[name] = stochcable.analyze(stochcable.load_example(name)).to_document(
+                timeseries_linear=True
+            )
         scene = stochcable.load_example("taut_wire").model_dump()
         scene["analysis"]["fidelity"] = {"target_error": 0.05}
         for name in RESIDUAL_KINDS:  # every residual kind in the reference

@@ -300,6 +300,18 @@ WARNINGS: tuple[WarningEntry, ...] = (
         ("stochcable.sea.realization:NYQUIST_LOSS_TOLERANCE",),
     ),
     WarningEntry(
+        "Residuals above the time series' Nyquist frequency",
+        "ResolutionWarning",
+        ("stochcable.dynamics.timeseries.residual_series:_nyquist_check",),
+        "more than NYQUIST_SHARE of a line end's residual variance above π/dt",
+        "The end-tension time series carry the residuals' Gaussian component up to "
+        "π/dt only: the residuals' superharmonics (up to three times "
+        "``analysis.omega.max``) above it are left out, and the record's σ is below "
+        "the corrected σ of the statistics.",
+        "Use the time step the message gives.",
+        ("stochcable.dynamics.timeseries.residual_series:NYQUIST_SHARE",),
+    ),
+    WarningEntry(
         "Undamped seabed contact under-resolved by the nonlinear reference",
         "ResolutionWarning",
         ("stochcable.reference.cable_checks:check_seabed_contact",),

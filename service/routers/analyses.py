@@ -75,6 +75,13 @@ async def run_analysis(
             "all of them (full) or none; only when the scene has analysis.timeseries"
         ),
     ] = "window",
+    timeseries_linear: Annotated[
+        bool,
+        Query(
+            description="Also the linear model's end tensions (tension_linear) beside the "
+            "time series that carry the residuals' component"
+        ),
+    ] = False,
 ) -> Response:
     """The v1 result document of :func:`stochcable.analysis.analyze` (Tuah 1982, ch. 5):
     identical to ``stochcable analyze SCENE.json`` and ``analyze(scene).to_document()``
@@ -83,8 +90,8 @@ async def run_analysis(
     Bounds checked before solving (422 ``limit_exceeded``): total finite elements
     (``STOCHCABLE_MAX_ELEMENTS``), ``analysis.omega.count``
     (``STOCHCABLE_MAX_FREQUENCIES``), the estimated peak memory
-    (``STOCHCABLE_MAX_MEMORY_BYTES``, from frequencies × nodes × channels and the
-    time-series samples), an estimated run time over ten times
+    (``STOCHCABLE_MAX_MEMORY_BYTES``, from frequencies × nodes × channels, the
+    residuals' temporaries and the time-series samples), an estimated run time over ten times
     ``STOCHCABLE_MAX_RUN_SECONDS`` and ``analysis.timeseries`` duration/dt
     (``STOCHCABLE_MAX_SAMPLES``).  The analysis runs in a worker process: the run time is
     bounded by ``STOCHCABLE_MAX_RUN_SECONDS`` (504, the worker is ended); every worker
@@ -108,6 +115,7 @@ async def run_analysis(
         scene,
         timeseries,
         media == NETCDF,
+        timeseries_linear,
         deadline=time.monotonic() + limit,
         limit=limit,
     )

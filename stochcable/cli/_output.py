@@ -133,10 +133,10 @@ def output_format(fmt: str | None, output: str | None) -> str:
     return "summary" if sys.stdout.isatty() else "json"
 
 
-def write_netcdf_document(result: Any, output: str) -> None:
+def write_netcdf_document(result: Any, output: str, timeseries_linear: bool = False) -> None:
     """Write a result as NetCDF (:meth:`Result.to_netcdf`)."""
     try:
-        result.to_netcdf(Path(output))
+        result.to_netcdf(Path(output), timeseries_linear)
     except ImportError as exc:
         raise InputError(
             "--output",

@@ -69,6 +69,12 @@ def register(subparsers: Any) -> None:
         help="time series in the document: first 2048 samples (default), all, or none",
     )
     p.add_argument(
+        "--timeseries-linear",
+        action="store_true",
+        help="also put the linear model's end tensions (tension_linear) beside the "
+        "time series that carry the residuals' component",
+    )
+    p.add_argument(
         "--progress",
         action="store_true",
         help="report stages on stderr even when it is not a terminal",
@@ -114,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
             # not echoed on stderr as well
             warnings.simplefilter("ignore")
         result = analyze(scene, progress=_StderrProgress() if show else None)
-    doc = result.to_document(timeseries=args.timeseries)
+    doc = result.to_document(timeseries=args.timeseries, timeseries_linear=args.timeseries_linear)
     plots: list[str] = []
     if plt is not None:
         from stochcable.plots import plot_result
@@ -122,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
         plots = [str(p) for p in plot_result(result, Path(args.plot))]
         doc["plots"] = plots
     if fmt == "netcdf":
-        write_netcdf_document(result, args.output)
+        write_netcdf_document(result, args.output, args.timeseries_linear)
     elif fmt == "summary":
         write_summary(doc, args.output, title=str(args.scene), plots=plots)
     else:

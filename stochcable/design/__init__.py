@@ -5,8 +5,9 @@ Pure functions on spectra, time series and sea-state statistics; the load-case s
 that call them over a scatter diagram live above this package.
 
 Modules: :mod:`~stochcable.design.curves` (S-N and T-N curves),
-:mod:`~stochcable.design.spectral_fatigue`, :mod:`~stochcable.design.rainflow_fatigue`
-and :mod:`~stochcable.design.extremes`.  Their names below are imported on first use:
+:mod:`~stochcable.design.spectral_fatigue`, :mod:`~stochcable.design.rainflow_fatigue`,
+:mod:`~stochcable.design.extremes` and :mod:`~stochcable.design.hermite` (a mildly
+non-Gaussian response).  Their names below are imported on first use:
 an analysis needs only the curves (the strumming screen), not the special functions of
 SciPy that fatigue and extremes need.
 """
@@ -33,6 +34,12 @@ if TYPE_CHECKING:
         mpm_short_term,
         return_level,
     )
+    from .hermite import (
+        HermiteModel,
+        hermite_fatigue_factor_narrow_band,
+        hermite_level,
+        hermite_model_winterstein,
+    )
     from .rainflow_fatigue import damage_rainflow, rainflow_ranges
     from .spectral_fatigue import (
         damage_rate,
@@ -57,6 +64,10 @@ _MODULE = {
     "maximum_exceedance_rayleigh": "extremes",
     "mpm_short_term": "extremes",
     "return_level": "extremes",
+    "HermiteModel": "hermite",
+    "hermite_fatigue_factor_narrow_band": "hermite",
+    "hermite_level": "hermite",
+    "hermite_model_winterstein": "hermite",
     "damage_rainflow": "rainflow_fatigue",
     "rainflow_ranges": "rainflow_fatigue",
     "damage_rate": "spectral_fatigue",
@@ -88,6 +99,10 @@ __all__ = [
     "mpm_short_term",
     "long_term_exceedance",
     "return_level",
+    "HermiteModel",
+    "hermite_model_winterstein",
+    "hermite_level",
+    "hermite_fatigue_factor_narrow_band",
 ]
 
 

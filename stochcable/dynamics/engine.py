@@ -156,6 +156,7 @@ class Engine:
                     scene.analysis.timeseries,
                     solved.alone + solved.groups,
                     timing=timing,
+                    lines=solved.lines,
                 )
                 timing["timeseries_s"] = time.perf_counter() - t0
         messages = _messages(self.warnings, caught)

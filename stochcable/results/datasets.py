@@ -247,6 +247,19 @@ def _timeseries_parts(doc: Mapping[str, Any], u: dict[str, str]) -> tuple[dict, 
             u["force"],
             "end tension (mean + dynamic), one realization",
         )
+        if any("tension_linear" in tl[n][e] for n in names for e in ENDS):
+            # the linear model's beside it (asked for): where no residual component was
+            # added, the tension itself
+            out["end_tension_series_linear"] = _var(
+                ("line", "end", "time"),
+                [
+                    [tl[n][e].get("tension_linear", tl[n][e]["tension"]) for e in ENDS]
+                    for n in names
+                ],
+                u["force"],
+                "end tension of the linear model (without the residuals' component), "
+                "one realization",
+            )
     return coords, out
 
 
@@ -286,7 +299,7 @@ def dataset_from_document(doc: Mapping[str, Any]):
     return xr.Dataset(data_vars=data, coords=coords, attrs=attrs)
 
 
-def dataset_from_result(result: Any):
+def dataset_from_result(result: Any, timeseries_linear: bool = False):
     """:func:`dataset_from_document` of a result, with the spectra along the lines.
 
     Adds ``tension_spectrum`` (line, element, omega) and ``motion_spectrum`` (line,
@@ -296,12 +309,15 @@ def dataset_from_result(result: Any):
     ----------
     result : Result
         A result of :func:`stochcable.analysis.analyze`.
+    timeseries_linear : bool
+        Add ``end_tension_series_linear``, the linear model's end-tension series,
+        where the series carry the residuals' component.
 
     Returns
     -------
     xarray.Dataset
     """
-    doc = result.to_document(timeseries="full")
+    doc = result.to_document(timeseries="full", timeseries_linear=timeseries_linear)
     ds = dataset_from_document(doc)
     u = _units(doc)
     lines = list(result.lines.values())

@@ -106,6 +106,7 @@ class _Summary:
     target_error: float | None = None
     linear: tuple[float | None, ...] = ()  # the linear model's σ beside each end's
     residuals: tuple[str, ...] = ()  # the residual kinds the end statistics carry
+    along: tuple[tuple[str, float, float], ...] = ()  # line, largest element σ, its linear σ
 
 
 def _ends(lines: Any) -> list[tuple[str, str, float, float, float, float]]:
@@ -128,7 +129,12 @@ def _residuals(lines: Any) -> dict[str, Any]:
         if getattr(line, end, None) is not None
     ]
     kinds = {k: None for line in lines.values() for k, r in line.residuals.items() if r.computed}
-    return {"linear": tuple(linear), "residuals": tuple(kinds)}
+    along = tuple(
+        (name, float(line.tension_std.max()), float(lin[int(line.tension_std.argmax())]))
+        for name, line in lines.items()
+        if (lin := getattr(line, "tension_std_linear", None)) is not None and lin.size
+    )
+    return {"linear": tuple(linear), "residuals": tuple(kinds), "along": along}
 
 
 def _of_result(result: Any) -> _Summary:
@@ -191,6 +197,11 @@ def _text(s: _Summary) -> str:
             f"{e[0]} {e[1]} {format_value(v)}" for e, v in zip(s.ends, s.linear) if v is not None
         )
         out.append(f"  residuals included: {', '.join(s.residuals)} (linear σ: {lin})")
+    if s.along:
+        top = "; ".join(
+            f"{n} {format_value(v)} (linear {format_value(lv)})" for n, v, lv in s.along
+        )
+        out.append(f"  largest element tension σ [{s.force}], with the residuals: {top}")
     out.append(f"  warnings: {n}" + (" (.warnings)" if n else ""))
     if s.target_error is not None:
         out.append(f"  fidelity: target error {format_value(s.target_error)}")

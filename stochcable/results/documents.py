@@ -34,6 +34,7 @@ from stochcable.results.records import (
     stats_from_spectrum_unchecked,
     stats_from_validated,  # noqa: F401  (former name, kept importable)
 )
+from stochcable.results.time_series import DOCUMENT_WINDOW, TimeSeries  # noqa: F401
 from stochcable.scene.residual_kinds import RESIDUAL_KINDS
 from stochcable.scene.units import unit_labels
 
@@ -50,9 +51,6 @@ __all__ = [
     "stats_from_spectrum",
     "stats_from_spectrum_unchecked",
 ]
-
-# Number of time samples of the time-series window put in the result document.
-DOCUMENT_WINDOW = 2048
 
 
 class FormedOnAccess:
@@ -150,6 +148,15 @@ class LineResult:
         residual lines outside it;
         :mod:`stochcable.dynamics.residuals.corrected_spectrum`), whose area is the
         corrected σ²; None otherwise (:meth:`end_tension_density`).
+    tension_std_linear : ndarray, shape (n_el,) or None
+        Where the residuals were computed along the line (``along_line.computed``),
+        ``tension_std`` is σ of the element tensions with the residuals and this the
+        linear model's alone; None otherwise (``tension_std`` is the linear model's).
+    along_line : AlongLineResidual or None
+        The residuals' variance lines of every element tension
+        (:mod:`stochcable.dynamics.residuals.along_line`; ``computed`` False with the
+        reason where a residual applied at the ends is not covered along the line);
+        None where no residual was applied.
     """
 
     name: str
@@ -180,6 +187,8 @@ class LineResult:
     residuals: dict[str, ResidualRecord] = field(default_factory=dict)
     linear: dict[str, ResponseStats] | None = None
     corrected_spectra: dict[str, Any] | None = None
+    tension_std_linear: np.ndarray | None = None
+    along_line: Any = None
 
     def __getattr__(self, name: str) -> ResidualRecord | None:
         """A registered residual kind's record by its name (None when not asked for)."""
@@ -262,6 +271,11 @@ class LineResult:
                 "s": self.s_elements.tolist(),
                 "std": self.tension_std.tolist(),
                 "mean": self.tension_mean.tolist(),
+                **(
+                    {}
+                    if self.tension_std_linear is None
+                    else {"std_linear": self.tension_std_linear.tolist()}
+                ),
             },
             "motion": {"s": self.s_nodes.tolist(), "std": self.motion_std.tolist()},
             "spectra": {
@@ -379,93 +393,6 @@ class BodyResult:
 
 
 @dataclass(frozen=True, eq=False)
-class TimeSeries:
-    """One realization of the sea (and of each end-motion channel) and the responses.
-
-    All series share the time axis and the complex amplitudes of their channels, so
-    elevation, motions and tensions are mutually consistent (DESIGN.md "Random sea
-    simulation").
-
-    Attributes
-    ----------
-    time : ndarray, shape (N_t,)
-        Sample times. [s]
-    method : str
-        ``"dsa"`` or ``"nsa"``.
-    seed : int
-        Root seed: the sea uses ``rng=seed``; end-motion spectrum channel k (every
-        line in scene order × end_a, end_b × surge, sway, heave) uses
-        ``np.random.SeedSequence(seed).spawn(n)[k]``.
-    elevation : ndarray or None, shape (N_t,)
-        Wave elevation at the origin (None without a sea). [m]
-    end_motion : dict
-        ``{"line.end_b.surge": series}`` for end-motion spectrum channels. [m]
-    end_tension : dict
-        ``{line: {"end_a": series, "end_b": series}}`` total tension mean + dynamic. [N]
-    omega : ndarray, shape (N+1,)
-        Realization grid ω_m = mΔω. [rad/s]
-    channels : dict
-        ``{line: (channel names)}``, the order of the transfer arrays: the line's
-        own (``"sea"``, ``"end_b.surge"``) for an independent line, its coupled
-        group's (``"sea"``, ``"<line>.<end>.<dof>"``) for a line on a free body.
-    end_tension_transfer : dict
-        ``{line: {"end_a": H, "end_b": H}}``, H of shape (n_ch, N+1) on ``omega``
-        (zero outside the analysis band), the transfer functions synthesized. [N/unit]
-    body_motion : dict
-        ``{body: {dof: series}}`` motion of each body's reference point, static pose
-        plus dynamic part, in the body's DOF names (``BodyResult.dofs``): positions
-        [m], small rotations about the global axes [rad].  Free bodies from the
-        coupled solve, prescribed bodies (vessels) from their RAO.
-    body_channels : dict
-        ``{body: (channel names)}``, the order of the body transfer arrays (the
-        coupled group's channels; the sea's for a vessel: ``("sea",)``, or one
-        ``"sea@<deg>"`` per direction of a short-crested sea).
-    body_motion_transfer : dict
-        ``{body: H}``, H of shape (n_ch, d, N+1) on ``omega`` (zero outside the
-        analysis band), the transfer functions synthesized. [m/unit, rad/unit]
-    """
-
-    time: np.ndarray
-    method: str
-    seed: int
-    elevation: np.ndarray | None
-    end_motion: dict[str, np.ndarray]
-    end_tension: dict[str, dict[str, np.ndarray]]
-    omega: np.ndarray
-    channels: dict[str, tuple[str, ...]]
-    end_tension_transfer: dict[str, dict[str, np.ndarray]]
-    body_motion: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
-    body_channels: dict[str, tuple[str, ...]] = field(default_factory=dict)
-    body_motion_transfer: dict[str, np.ndarray] = field(default_factory=dict)
-
-    def to_document(self, full: bool = False) -> dict[str, Any]:
-        """Document part: the first :data:`DOCUMENT_WINDOW` samples, or all if ``full``."""
-        n = self.time.size if full else min(self.time.size, DOCUMENT_WINDOW)
-        doc: dict[str, Any] = {
-            "method": self.method,
-            "seed": int(self.seed),
-            "dt": float(self.time[1] - self.time[0]) if self.time.size > 1 else 0.0,
-            "samples": int(self.time.size),
-            "window": int(n),
-            "time": self.time[:n].tolist(),
-            "elevation": None if self.elevation is None else self.elevation[:n].tolist(),
-            "end_motion": {k: v[:n].tolist() for k, v in self.end_motion.items()},
-            "lines": {
-                name: {end: {"tension": s[:n].tolist()} for end, s in ends.items()}
-                for name, ends in self.end_tension.items()
-            },
-        }
-        if self.body_motion:
-            # {body: {"motion": {dof: [...]}}} (rad for rotations), as the result's
-            # "bodies" part
-            doc["bodies"] = {
-                name: {"motion": {k: s[:n].tolist() for k, s in dofs.items()}}
-                for name, dofs in self.body_motion.items()
-            }
-        return doc
-
-
-@dataclass(frozen=True, eq=False)
 class Result:
     """Result of :func:`stochcable.analysis.analyze`.
 
@@ -528,25 +455,31 @@ class Result:
             "relative_change": max((r.relative_change for r in recs), default=0.0),
         }
 
-    def to_xarray(self) -> Any:
-        """The result as an :class:`xarray.Dataset` (:mod:`stochcable.results.datasets`)."""
+    def to_xarray(self, timeseries_linear: bool = False) -> Any:
+        """The result as an :class:`xarray.Dataset` (:mod:`stochcable.results.datasets`;
+        ``timeseries_linear``: with the linear model's end-tension series)."""
         from stochcable.results.datasets import dataset_from_result
 
-        return dataset_from_result(self)
+        return dataset_from_result(self, timeseries_linear=timeseries_linear)
 
-    def to_netcdf(self, path: Any) -> Any:
+    def to_netcdf(self, path: Any, timeseries_linear: bool = False) -> Any:
         """Write :meth:`to_xarray` as a NetCDF-4 file; returns its path."""
         from stochcable.results.datasets import write_netcdf
 
-        return write_netcdf(self.to_xarray(), path)
+        return write_netcdf(self.to_xarray(timeseries_linear), path)
 
-    def to_document(self, timeseries: str = "window") -> dict[str, Any]:
+    def to_document(
+        self, timeseries: str = "window", timeseries_linear: bool = False
+    ) -> dict[str, Any]:
         """The v1 result document (DESIGN.md), JSON-ready.
 
         Parameters
         ----------
         timeseries : {"window", "full", "none"}
             Put the first 2048 samples of the time series, all of them, or none.
+        timeseries_linear : bool
+            Put the linear model's end tensions (``tension_linear``) beside the series
+            that carry the residuals' component.
 
         Notes
         -----
@@ -583,5 +516,7 @@ class Result:
         if self.bodies:
             doc["bodies"] = {k: v.to_document() for k, v in self.bodies.items()}
         if self.timeseries is not None and timeseries != "none":
-            doc["timeseries"] = self.timeseries.to_document(full=timeseries == "full")
+            doc["timeseries"] = self.timeseries.to_document(
+                full=timeseries == "full", linear=timeseries_linear
+            )
         return doc

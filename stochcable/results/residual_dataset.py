@@ -90,7 +90,9 @@ def residual_parts(
         ``omega_corrected`` and ``end_tension_corrected_spectrum`` (line, end,
         omega_corrected); ``linear_end_tension_<statistic>`` (line, end): the linear
         model's, NaN for a line without residuals (its ``end_tension_<statistic>``
-        is the linear model's); ``<kind>_variance`` (line, end) and
+        is the linear model's); ``tension_std_linear`` (line, element): the element
+        tensions' linear σ where the residuals were computed along the line (NaN
+        elsewhere); ``<kind>_variance`` (line, end) and
         ``<kind>_computed`` (line) of every residual kind present.
     """
     lines = doc["lines"]
@@ -107,6 +109,20 @@ def residual_parts(
             out[f"linear_end_tension_{key}"] = _var(
                 ("line", "end"), data, unit, f"end tension of the linear model alone: {long}"
             )
+    if any("std_linear" in lines[n]["tension"] for n in names):
+        n_el = max(len(lines[n]["tension"]["s"]) for n in names)
+        data = np.full((len(names), n_el), np.nan)
+        for i, n in enumerate(names):
+            lin = lines[n]["tension"].get("std_linear")
+            if lin is not None:
+                data[i, : len(lin)] = lin
+        out["tension_std_linear"] = _var(
+            ("line", "element"),
+            data,
+            u["force"],
+            "standard deviation of the dynamic effective tension of the linear model alone "
+            "(NaN for a line whose tension_std is the linear model's)",
+        )
     for kind in RESIDUAL_KINDS:
         if not any(kind in lines[n] for n in names):
             continue

@@ -74,6 +74,9 @@ class LineDocument:
     linear : dict {"end_a", "end_b"} of ResponseStats or None
         The linear model's end statistics where a residual was computed (``end_a`` and
         ``end_b`` carry the residuals), None otherwise.
+    tension_std_linear : numpy.ndarray or None
+        The linear model's element tension σ where the residuals were computed along
+        the line (``tension_std`` carries them), None otherwise. [N]
     """
 
     name: str
@@ -94,6 +97,7 @@ class LineDocument:
     document: Mapping[str, Any]
     residuals: dict[str, ResidualRecord] = field(default_factory=dict)
     linear: dict[str, ResponseStats] | None = None
+    tension_std_linear: np.ndarray | None = None
 
     def linear_end(self, end: str) -> ResponseStats:
         """The linear model's statistics of the tension at ``end``, as on ``LineResult``."""
@@ -148,6 +152,9 @@ class LineDocument:
             linear=None
             if doc.get("linear") is None
             else {e: _response_stats(v["tension"]) for e, v in doc["linear"].items()},
+            tension_std_linear=None
+            if tension.get("std_linear") is None
+            else _array(tension["std_linear"]),
         )
 
 
@@ -164,7 +171,8 @@ class TimeSeriesWindow:
     end_motion : dict of numpy.ndarray
         ``{"line.end_b.surge": series}`` prescribed end motions. [m or rad]
     end_tension : dict
-        ``{line: {"end_a": series, "end_b": series}}`` total tensions. [N]
+        ``{line: {"end_a": series, "end_b": series}}`` total tensions (with the
+        residuals' Gaussian component where they were applied). [N]
     body_motion : dict
         ``{body: {dof: series}}`` body motions, static pose plus dynamic part (empty
         for scenes without bodies). [m, rad]
@@ -176,6 +184,9 @@ class TimeSeriesWindow:
         Time step. [s]
     samples : int
         Length of the whole realization (the window may be shorter). [-]
+    end_tension_linear : dict
+        ``{line: {end: series}}`` the linear model's tensions, where the document holds
+        them (``tension_linear``, asked for with ``timeseries_linear``). [N]
     """
 
     time: np.ndarray
@@ -187,6 +198,7 @@ class TimeSeriesWindow:
     dt: float
     samples: int
     body_motion: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    end_tension_linear: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
 
     @classmethod
     def from_document(cls, doc: Mapping[str, Any]) -> TimeSeriesWindow:
@@ -207,6 +219,15 @@ class TimeSeriesWindow:
             body_motion={
                 name: {dof: _array(v) for dof, v in b.get("motion", {}).items()}
                 for name, b in (doc.get("bodies") or {}).items()
+            },
+            end_tension_linear={
+                line: {
+                    end: _array(v["tension_linear"])
+                    for end, v in ends.items()
+                    if "tension_linear" in v
+                }  # fmt: skip
+                for line, ends in doc.get("lines", {}).items()
+                if any("tension_linear" in v for v in ends.values())
             },
         )
 

@@ -29,7 +29,47 @@ from typing import Any
 
 from pydantic import Field
 
-__all__ = ["RESIDUAL_KINDS", "ResidualKind", "asked_residuals", "residual_switch"]
+__all__ = [
+    "RESIDUAL_KINDS",
+    "RESIDUAL_MEMORY_MARGIN",
+    "ResidualKind",
+    "ResidualSize",
+    "asked_residuals",
+    "residual_switch",
+]
+
+
+@dataclass(frozen=True)
+class ResidualSize:
+    """The sizes of one line that its residuals' cost terms read (from the scene alone).
+
+    Attributes
+    ----------
+    elements : int
+        Finite elements of the line. [-]
+    frequencies : int
+        ``analysis.omega.count``. [-]
+    channels : int
+        Input channels of the line. [-]
+    dim : int
+        Model dimension: 2 for a planar scene, 3 otherwise. [-]
+    lines : int
+        Lines n_j of the drag residual's uniform grid. [-]
+    samples : int
+        Amplitude lines n_j · ranks of that grid (every analysis frequency on its own
+        channel of its line; ≥ ``frequencies``). [-]
+    half_lines, half_samples : int
+        The same of the geometric residual's grid (every second line). [-]
+    """
+
+    elements: int
+    frequencies: int
+    channels: int
+    dim: int
+    lines: int
+    samples: int
+    half_lines: int
+    half_samples: int
 
 
 @dataclass(frozen=True)
@@ -51,11 +91,14 @@ class ResidualKind:
         Description of its ``order``.
     panels : str
         Description of its ``panels``.
-    memory_bytes : int
-        Peak memory of the residual, bounded by its blocks. [B]
+    memory_bytes : int or callable (ResidualSize) -> float
+        Peak memory of the residual's temporaries on one line above what the linear
+        model holds (:meth:`memory`; an int: a constant). [B]
     seconds : callable (n_elements, n_lines, in_sea) -> float
-        Estimated time of the residual on one line of ``n_elements`` elements with
-        ``n_lines`` variance lines, in a sea or not (calibration machine). [s]
+        Estimated time of the residual on one planar line of ``n_elements`` elements
+        with ``n_lines`` variance lines, in a sea or not (calibration machine). [s]
+    seconds_3d : float
+        Factor on ``seconds`` for a line of a 3-D model. [-]
     """
 
     name: str
@@ -64,8 +107,14 @@ class ResidualKind:
     scope: str
     order: str
     panels: str
-    memory_bytes: int
+    memory_bytes: int | Callable[[ResidualSize], float]
     seconds: Callable[[int, int, bool], float]
+    seconds_3d: float = 1.0
+
+    def memory(self, size: ResidualSize) -> int:
+        """Peak memory of the residual on a line of ``size``. [B]"""
+        m = self.memory_bytes
+        return int(m) if isinstance(m, int) else int(math.ceil(m(size)))
 
     def asked(self, linearization: Any) -> bool:
         """Whether ``linearization`` (the scene's ``analysis.linearization``) asks for
@@ -79,10 +128,61 @@ class ResidualKind:
 # stochcable.cost's notes on the residuals.
 _DRAG_PANELS, _GEOMETRIC_ELEMENTS, _GEOMETRIC_LINES = 32, 400, 31
 _DRAG_SECONDS, _GEOMETRIC_SECONDS = 2.0e-9, 3.0e-10
-# peak memory bounded by the blocks: the drag's ≤ 64 components on ≤ 128 lines (≤ 1024
-# and 128 before issue 31, when the times were measured), the geometric covariance
-# blocks of 64 MiB and its transfer functions
-_RESIDUAL_BYTES = 256 * 2**20
+#: Factor on the counted arrays of a residual's peak memory (:meth:`ResidualKind.memory`):
+#: numpy's temporaries of the expressions not counted one by one and the allocator's
+#: slack (tests/test_cost.py measures the bound). [-]
+RESIDUAL_MEMORY_MARGIN = 1.25
+_WORD = 16  # bytes of a complex amplitude
+# the vector drag residual's covariance blocks (drag_residual_3d._BLOCK_BYTES) and what
+# is formed from them at once: twice the block
+_DRAG_3D_BLOCKS = 2 * 48 * 2**20
+
+
+def _drag_memory(size: ResidualSize) -> float:
+    """Peak memory of the drag residual of one line (issue 31). [B]
+
+    Counted in complex words: the pieces' relative velocity per channel on the
+    analysis grid (drag_segments.segment_velocity: the array, four interpolation
+    temporaries of d components, one output per direction, and the sea's element
+    moments: (3 + 4d + directions)·n_ch + 9 per piece and frequency; a sea splits at
+    most half the panel cap more pieces), the panels' amplitude lines (three
+    copies), and the panel pairs' covariance lines (planar: 2 directions × the panel
+    cap squared on n_j + 3(n_j − 1) lines; 3-D: the covariance blocks)."""
+    d, c, w = size.dim, size.channels, size.frequencies
+    pieces = size.elements + _DRAG_PANELS // 2
+    directions = 2 if d == 2 else 3
+    components = directions * _DRAG_PANELS
+    words = ((3 + 4 * d + directions) * c + 9) * pieces * w
+    words += 3 * components * c * max(size.samples, w)
+    words += components**2 * (size.lines + 3 * max(size.lines - 1, 1))
+    extra = _DRAG_3D_BLOCKS if d == 3 else 0
+    return RESIDUAL_MEMORY_MARGIN * (_WORD * words + extra)
+
+
+def _geometric_memory(size: ResidualSize) -> float:
+    """Peak memory of the geometric residual of one line (issue 31): none above its
+    element cap (not computed). [B]
+
+    Counted in complex words: the node displacements and their differences per channel
+    on the analysis grid (2 × 3 per node, frequency and channel), each of the d
+    processes' element values with two temporaries while it is put on its lines, the d
+    processes' amplitude lines, and the element pairs' cross-spectral lines (d² on
+    n_j) and covariance lines (d² components on 2(n_j − 1) lines) of every element
+    (those whose forces do not reach the ends, skipped at run time, are counted: on a
+    line with seabed contact the bound is the more pessimistic)."""
+    n = size.elements
+    if n > _GEOMETRIC_ELEMENTS:
+        return 0.0
+    d, c, w = size.dim, size.channels, size.frequencies
+    n_j = size.half_lines
+    words = 6 * c * (n + 1) * w + 3 * c * n * w + d * c * n * max(size.half_samples, w)
+    words += d * d * n * n * (n_j + 2 * max(n_j - 1, 1))
+    return RESIDUAL_MEMORY_MARGIN * _WORD * words
+
+
+# a 3-D line (measured in stochcable.cost's notes): the vector drag residual's bivariate
+# Hermite monomials on three outputs per panel, the geometric residual's three processes
+_DRAG_SECONDS_3D, _GEOMETRIC_SECONDS_3D = 14.0, 3.0
 
 
 def _drag_seconds(n_el: int, n_j: int, in_sea: bool) -> float:
@@ -116,8 +216,9 @@ RESIDUAL_KINDS: dict[str, ResidualKind] = {
             "a travelling line on free bodies",
             order="Highest Hermite order kept.",
             panels="Element groups the residual was evaluated on.",
-            memory_bytes=_RESIDUAL_BYTES,
+            memory_bytes=_drag_memory,
             seconds=_drag_seconds,
+            seconds_3d=_DRAG_SECONDS_3D,
         ),
         ResidualKind(
             name="geometric_residual",
@@ -132,8 +233,9 @@ RESIDUAL_KINDS: dict[str, ResidualKind] = {
             scope="more than 400 elements, a travelling line on free bodies",
             order="2: the forces are quadratic in the response.",
             panels="The elements the residual was evaluated on.",
-            memory_bytes=_RESIDUAL_BYTES,
+            memory_bytes=_geometric_memory,
             seconds=_geometric_seconds,
+            seconds_3d=_GEOMETRIC_SECONDS_3D,
         ),
     )
 }

@@ -107,6 +107,15 @@ def test_analyze_prints_to_stdout_without_progress(scene_file, capsys):
     assert "stochcable analyze:" not in captured.err  # no progress: stderr not a TTY
 
 
+def test_analyze_gives_the_linear_series_when_asked(scene_file, capsys):
+    """--timeseries-linear: tension_linear beside the tension that carries the
+    residuals' component (their Gaussian component is the difference)."""
+    assert main(["analyze", str(scene_file), "--timeseries-linear"]) == 0
+    ends = json.loads(capsys.readouterr().out)["timeseries"]["lines"]["leg1"]
+    assert set(ends["end_b"]) == {"tension", "tension_linear"}
+    assert ends["end_b"]["tension"] != ends["end_b"]["tension_linear"]
+
+
 def test_analyze_bad_scene_is_one_line_error(tmp_path, capsys):
     bad = dict(
         SCENE,

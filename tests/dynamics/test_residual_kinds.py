@@ -79,7 +79,8 @@ def test_registered_kinds_are_complete():
         field = LinearizationSettings.model_fields[name]
         assert field.annotation in (bool, "bool") and field.default is True
         assert field.description == kind.switch
-        assert kind.memory_bytes > 0 and kind.seconds(40, 32, True) > 0
+        size = residual_kinds.ResidualSize(40, 200, 2, 2, 64, 200, 32, 200)
+        assert kind.memory(size) > 0 and kind.seconds(40, 32, True) > 0
 
 
 def test_toy_kind_reaches_outputs_document_cost_and_cases(toy_kind):

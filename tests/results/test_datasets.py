@@ -115,3 +115,19 @@ def test_netcdf_bytes_of_a_document_read_back(three_legs, tmp_path):
     path.write_bytes(data)
     with xr.open_dataset(path) as back:
         xr.testing.assert_identical(back.load(), ds)
+
+
+def test_linear_series_beside_when_asked(three_legs):
+    """timeseries_linear: ``end_tension_series_linear`` holds the linear model's end
+    tensions (the document's ``tension_linear``); not asked for, it is absent."""
+    assert "end_tension_series_linear" not in three_legs.to_xarray()
+    ds = three_legs.to_xarray(timeseries_linear=True)
+    ts = three_legs.timeseries
+    assert ts.end_tension_residual  # (the legs carry the residuals' component)
+    for name in three_legs.lines:
+        for end in ("end_a", "end_b"):
+            np.testing.assert_allclose(
+                ds["end_tension_series_linear"].sel(line=name, end=end).values,
+                ts.end_tension_linear[name][end],
+                rtol=1e-12,
+            )

@@ -179,6 +179,20 @@ def test_timeseries_query_parameter(small, mode):
         assert doc["timeseries"]["window"] == doc["timeseries"]["samples"] == 1024
 
 
+def test_timeseries_linear_query_parameter(small):
+    """?timeseries_linear=true: the linear model's end tensions beside the series that
+    carry the residuals' component, as the library's document."""
+    scene = _doc(SMALL)
+    doc = small.post("/v1/analyses?timeseries_linear=true", json=scene).json()
+    local = analyze(load_example(SMALL)).to_document(timeseries_linear=True)
+    assert _plain(doc) == _plain(local)
+    ends = [e for ln in doc["timeseries"]["lines"].values() for e in ln.values()]
+    assert ends and all("tension_linear" in e for e in ends)
+    plain = small.post("/v1/analyses", json=scene).json()
+    assert all("tension_linear" not in e for ln in plain["timeseries"]["lines"].values()
+               for e in ln.values())  # fmt: skip
+
+
 def test_bad_timeseries_parameter_names_it(small):
     err = _err(small.post("/v1/analyses?timeseries=all", json=_doc(SMALL)))
     assert err["loc"] == ["query", "timeseries"] and err["parameter"] == "timeseries"

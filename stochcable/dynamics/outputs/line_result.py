@@ -39,6 +39,11 @@ from stochcable.dynamics.outputs.resolution import (
     surface_resolution_check,
     tail_check,
 )
+from stochcable.dynamics.residuals.along_line import (
+    AlongLineResidual,
+    along_line_residual,
+    residual_tap,
+)
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
@@ -188,20 +193,30 @@ def line_result(
     std = {e: stats[e].std for e in stats}
     # (one solve for both; a line on bodies: through the coupled group)
     shared = EndInfluence(system, linearization.damping) if influence is None else influence
+    taps = {}  # (each kind's loads and load cross-spectra, for the element tensions)
     for kind, fn in (
         residual_parts(settings.linearization) if linearization.record is not None else ()
     ):
-        residual[kind.name] = (
-            fn(system, channels, linearization, std, influence=shared)
-            if alone or influence is not None
-            else ResidualRecord.not_computed(
-                "a travelling line or a line with a steady lift on free bodies is not "
-                "covered (the coupled influence leaves out the transport and lift terms)",
-                std,
+        with residual_tap() as taps[kind.name]:
+            residual[kind.name] = (
+                fn(system, channels, linearization, std, influence=shared)
+                if alone or influence is not None
+                else ResidualRecord.not_computed(
+                    "a travelling line or a line with a steady lift on free bodies is not "
+                    "covered (the coupled influence leaves out the transport and lift terms)",
+                    std,
+                )
             )
-        )
     residual = residuals_in_range(system.name, residual, std)
     applied = [r for r in residual.values() if r.computed]
+    along = None
+    if applied:  # the element tensions with the residuals (a line on bodies: linear)
+        computed = {k: r for k, r in residual.items() if r.computed}
+        along = (
+            along_line_residual(system, linearization.damping, computed, taps, resp, spectra)
+            if influence is None
+            else AlongLineResidual(False, "a line on free bodies: not covered along the line")
+        )
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None
     if applied:  # the end statistics and densities with the residuals' spectra
@@ -220,7 +235,7 @@ def line_result(
         end_tension_transfer=dict(resp.end_tension),
         end_force_transfer=end_force,
         tension_mean=np.asarray(st.tension, dtype=float).copy(),
-        tension_std=tension_std,
+        tension_std=tension_std if along is None else along.std(tension_std),
         motion_std=motion_std,
         end_a=stats["end_a"],
         end_b=stats["end_b"],
@@ -235,6 +250,8 @@ def line_result(
         modes=system.modes,
         indicators=indicators,
         residuals=residual,
+        tension_std_linear=None if along is None or not along.computed else tension_std,
+        along_line=along,
     )
 
 

@@ -9,13 +9,20 @@ v_k/q_k (q the trapezoid weights the linear σ is summed with).  The corrected d
 lives on the analysis grid extended by the residual lines outside its band (the
 superharmonics above ω_max, difference frequencies below ω_min): the linear density
 and the misfit's on the analysis frequencies, the uniform lines' densities
-interpolated linearly onto every frequency.  The interpolation and the linear
-density's last trapezoid beyond ω_max change the area by a fraction of a cell; one
-factor on the uniform lines' density (:attr:`CorrectedSpectrum.scale`, within 2 % of
-1 on the bundled chain) makes ∫S dω by the trapezoid rule equal to the corrected
-variance of :func:`stochcable.dynamics.residuals.corrected.corrected_stats` to
-round-off.  Its higher moments (m2, m4) then differ from the statistics' line sums by
-the interpolation's error only (the fatigue methods read them).
+interpolated linearly onto every frequency.  The linear density stops at the grid's
+ends (the linear model integrates it there): where the grid is extended, a node a
+millionth of the end cell beyond ω_max (and below ω_min) carries the residuals'
+density alone, so that the trapezoid does not spread the linear density's last value
+over the first residual cell outside the band (on the deep catenary of the accuracy
+page, whose tension density is largest at ω_max, that triangle held half the
+residuals' variance, and the scale below then halved their density everywhere).  The
+interpolation changes the area by a fraction of a cell; one factor on the uniform
+lines' density (:attr:`CorrectedSpectrum.scale`, within 1 % of 1 on the bundled chain
+and the accuracy page's lines) makes ∫S dω by the trapezoid rule equal to the
+corrected variance of :func:`stochcable.dynamics.residuals.corrected.corrected_stats`
+to round-off.  Its higher moments (m2, m4) then differ from the statistics' line sums
+by the interpolation's error only (the fatigue methods read them), and so does its
+variance above ω_max from the lines' there.
 """
 
 from __future__ import annotations
@@ -29,6 +36,11 @@ from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.results.records import ResidualRecord
 
 __all__ = ["CorrectedSpectrum", "corrected_spectrum"]
+
+#: The gap between a grid end and the node beyond it where the linear density is zero,
+#: in units of the end cell: the linear density's trapezoid over it adds this fraction
+#: of a half cell (absorbed by the scale). [-]
+STEP = 1e-6
 
 
 @dataclass(frozen=True)
@@ -95,6 +107,7 @@ def corrected_spectrum(
     target = max(target, 0.0)
     outside = [om[(om < w[0]) | (om > w[-1])] for om, _ in uniform]
     grid = np.union1d(w, np.concatenate(outside)) if outside else w
+    grid = _with_steps(grid, w)
     at = np.searchsorted(grid, w)
     dens = np.zeros(grid.size)
     dens[at] = np.maximum(base, 0.0)  # (a misfit change below the linear density: 0)
@@ -106,3 +119,18 @@ def corrected_spectrum(
     scale = (target - float(np.sum(qg * dens))) / area if area > 0 else 1.0
     out = np.maximum(dens + scale * res, 0.0)
     return CorrectedSpectrum(grid, out, float(scale))
+
+
+def _with_steps(grid: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """``grid`` with a node just outside each end of ``w`` that ``grid`` extends past
+    (:data:`STEP` of the end cell, or half the gap to the next node if that is closer),
+    where the linear density is zero."""
+    if w.size < 2:
+        return grid
+    extra = []
+    above, below = grid[grid > w[-1]], grid[grid < w[0]]
+    if above.size:
+        extra.append(w[-1] + min(STEP * (w[-1] - w[-2]), 0.5 * (above[0] - w[-1])))
+    if below.size:
+        extra.append(w[0] - min(STEP * (w[1] - w[0]), 0.5 * (w[0] - below[-1])))
+    return np.union1d(grid, extra) if extra else grid

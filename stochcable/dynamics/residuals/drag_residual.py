@@ -73,6 +73,7 @@ from stochcable.dynamics.residuals.drag_segments import (
     segments,
 )
 from stochcable.dynamics.residuals.residual_lines import (
+    RESIDUAL_TAP,
     EndInfluence,
     UniformGrid,
     covariance_lines,
@@ -518,6 +519,8 @@ def _misfit_variance(
     load = np.concatenate(
         [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
     )  # (n_ch, n_load, n_w)
+    if (tap := RESIDUAL_TAP.get()) is not None:  # (the element tensions': .along_line)
+        tap.misfit(unit, load, w)
     q = trapezoid_weights(w)[None] * spectra
     out = {}
     for o, end in enumerate(("end_a", "end_b")):

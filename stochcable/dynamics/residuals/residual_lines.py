@@ -14,6 +14,7 @@ the highest line they reach.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from contextvars import ContextVar
 from typing import Any
 
 import numpy as np
@@ -36,6 +37,7 @@ __all__ = [
     "LIVE_SHARE",
     "MAX_LINES",
     "PAIR_BLOCK_BYTES",
+    "RESIDUAL_TAP",
     "UniformGrid",
     "covariance_lines",
     "cross_covariance",
@@ -58,6 +60,10 @@ MAX_LINES = 63
 #: stay in a core's cache (1 MB of L2 on the development host: blocks of 2 MB and more
 #: ran 2–3× slower). [bytes]
 PAIR_BLOCK_BYTES = 2**19
+#: An observer of the residual loads (:mod:`.along_line`): None, or an object whose
+#: ``loads(unit, w, h)`` :func:`load_transfer` and ``lines(g, transfer)``
+#: :func:`pair_output_lines` call with what they are given and return.
+RESIDUAL_TAP: ContextVar[Any] = ContextVar("residual_tap", default=None)
 
 
 #: Share of each channel's variance in the upper tail of the analysis grid left off the
@@ -177,6 +183,8 @@ def pair_output_lines(lines: np.ndarray, transfer: np.ndarray) -> np.ndarray:
     outputs per unit component: shape (n_out, n_o).  One matrix product per line.  The
     callers give G on one of (c, d) and (d, c) only, weighted 2 where they differ (G_dc
     = conj(G_cd): the two terms' real parts are equal), zero on the other."""
+    if (tap := RESIDUAL_TAP.get()) is not None:
+        tap.lines(lines, transfer)
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
     tc = np.conj(np.transpose(transfer, (2, 0, 1)))  # (n_o, n_out, n)
     gt = np.moveaxis(lines, 2, 0) @ t  # (n_o, n, n_out)
@@ -219,11 +227,15 @@ def load_transfer(
     n_load) (node forces on the model's components), ends prescribed, the line's
     linear system with ``damping``, on ``w``: the load cases contracted with the end
     tensions' influence (:func:`end_influence`; from ``influence`` where given, shared
-    by the residuals of one line), shape (2, n_load, n_w). [N/unit]"""
+    by the residuals of one line), shape (2, n_load, n_w) (n_out rows for an
+    ``influence`` of other outputs). [N/unit]"""
     g = end_influence(system, damping, w) if influence is None else influence.on(w)
     n = g.shape[1] * g.shape[2]
-    flat = np.moveaxis(g.reshape(2, n, w.size), 2, 1)  # (2, n_w, n_nodes·d)
-    return np.moveaxis(flat @ unit.reshape(n, -1).astype(complex), 2, 1)
+    flat = np.moveaxis(g.reshape(g.shape[0], n, w.size), 2, 1)  # (n_out, n_w, n_nodes·d)
+    h = np.moveaxis(flat @ unit.reshape(n, -1).astype(complex), 2, 1)
+    if (tap := RESIDUAL_TAP.get()) is not None:
+        tap.loads(unit, w, h)
+    return h
 
 
 class EndInfluence:

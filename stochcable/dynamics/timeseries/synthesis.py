@@ -11,6 +11,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -18,6 +19,7 @@ from stochcable.dynamics.groups.analysis import CoupledGroup
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.loads.sea_channels import direction_channel, sea_channel_headings
 from stochcable.dynamics.model.system import LineSystem
+from stochcable.dynamics.timeseries.residual_series import residual_tension_series
 from stochcable.line.statics import LineStatics
 from stochcable.results.documents import (
     TimeSeries,
@@ -35,6 +37,7 @@ def simulate_timeseries(
     groups: tuple[CoupledGroup, ...],
     *,
     timing: dict[str, float] | None = None,
+    lines: Mapping[str, Any] | None = None,
 ) -> TimeSeries:
     """One realization of every input channel and the end-tension and body-motion
     time series.
@@ -51,6 +54,12 @@ def simulate_timeseries(
         their lines' end tensions and their free bodies' motions are synthesized.
     timing : dict, optional
         Accumulates ``solve_s``.
+    lines : mapping of str to LineResult, optional
+        The lines' frequency-domain results: where their residuals were applied
+        (``corrected_spectra``), each end tension gets an independent Gaussian
+        component with the residuals' spectral density
+        (:mod:`stochcable.dynamics.timeseries.residual_series`), so the record's σ and
+        spectrum are the corrected ones; none given: the linear model's series.
 
     Returns
     -------
@@ -111,6 +120,10 @@ def simulate_timeseries(
             sea_names,
         )
     order = [n for n in names if n in out.end_tension]
+    residual = _residual_components(syn, order, lines or {})
+    for name, ends in residual.items():
+        for end, comp in ends.items():
+            out.end_tension[name][end] = out.end_tension[name][end] + comp
     body_order = [b.name for b in (getattr(scene, "bodies", ()) or ()) if b.name in out.body_motion]
     return TimeSeries(
         time=syn.time_axis(),
@@ -123,6 +136,7 @@ def simulate_timeseries(
             f"{name}.{cname}": np.asarray(r.elevation) for (name, cname), r in syn.reals.items()
         },
         end_tension={n: out.end_tension[n] for n in order},
+        end_tension_residual=residual,
         omega=syn.omega,
         channels={n: out.channels[n] for n in order},
         end_tension_transfer={n: out.transfer[n] for n in order},
@@ -130,6 +144,29 @@ def simulate_timeseries(
         body_channels={n: out.body_channels[n] for n in body_order},
         body_motion_transfer={n: out.body_transfer[n] for n in body_order},
     )
+
+
+def _residual_components(
+    syn: _Synthesis, order: list[str], lines: Mapping[str, Any]
+) -> dict[str, dict[str, np.ndarray]]:
+    """The residuals' Gaussian component of every end tension of the lines of
+    ``order`` whose result in ``lines`` has them (module notes of
+    :mod:`stochcable.dynamics.timeseries.residual_series`), from the seed's children
+    after the end motions'."""
+    names = [n for n in order if getattr(lines.get(n), "corrected_spectra", None) is not None]
+    if not names:
+        return {}
+    st = syn.settings
+    n_motion = len(syn.reals)
+    children = np.random.SeedSequence(syn.seed).spawn(n_motion + 2 * len(names))[n_motion:]
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for i, name in enumerate(names):
+        for k, end in enumerate(("end_a", "end_b")):
+            rng = np.random.default_rng(children[2 * i + k])
+            comp = residual_tension_series(lines[name], end, st.duration, st.dt, st.method, rng)
+            if comp is not None:
+                out.setdefault(name, {})[end] = comp
+    return out
 
 
 class _Synthesis:

@@ -1,0 +1,490 @@
+"""The residuals of the linear model in the element tensions along the line: the
+variance lines of every element's dynamic effective tension driven by the residual
+loads whose end-tension lines :mod:`.drag_residual` and :mod:`.geometric_residual`
+form, from the same load cross-spectra.
+
+Each residual kind forms the cross-spectral lines G_cd(ω_j) of its loads (the drag
+residual's panel forces, the geometric forces' element pairs) once and contracts them
+with the end tensions per unit load, Var_j = Re Σ_cd conj(H_c) G_cd H_d
+(:func:`~stochcable.dynamics.residuals.residual_lines.pair_output_lines`).  The
+element tension δT_e = r_e·u
+(:func:`stochcable.dynamics.outputs.line_result.element_tension_transfer`) is another
+linear output of the same loads: with the ends held, u_f = A⁻¹F_f and
+δT_e = (A⁻ᵀr_e)ᵀF_f (the adjoint, as the end influence: one banded solve per
+frequency for all elements, whatever the number of loads; a load on an end node goes
+to the support and leaves the line's tensions unchanged).  The loads and G are read
+as the kinds form them (:data:`~stochcable.dynamics.residuals.residual_lines.RESIDUAL_TAP`,
+:func:`residual_tap`): no second pass of the convolutions.  The resonant cells are
+integrated as the kinds' (:func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`,
+their bend thresholds) with the element tensions' own transfer functions.
+
+The element tensions' residual variance adds to their linear variance as the end
+tensions' does (:mod:`.corrected`; uncorrelated with the linear response).  With the
+two end rows in place of the elements the same steps give the kinds' end lines to
+round-off (tests/dynamics/test_along_line.py).
+
+Scope: the kinds' uniform lines; the drag residual's linear misfit of split elements
+(:mod:`.drag_segments`, a variance change on the analysis grid: on the chain 0.04 %
+of the drag residual's variance at the ends) is left out along the line; lines on
+free bodies (coupled influence) and 3-D lines' drag residual (its vector form does not
+pass through the pair lines) are not covered: their element tensions stay linear and
+the record says why.  The node motions stay linear (their residual is not formed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from stochcable.dynamics.loads.freqblocks import frequency_slices
+from stochcable.dynamics.model.blocks import free_band, line_prep, trapezoid_weights
+from stochcable.dynamics.model.lift import lift_band, lift_pattern
+from stochcable.dynamics.model.solvers import solve_band_stacked
+from stochcable.dynamics.model.transport import gyro_band
+from stochcable.dynamics.residuals.corrected_spectrum import CorrectedSpectrum, corrected_spectrum
+from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
+from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
+from stochcable.dynamics.residuals.residual_lines import (
+    RESIDUAL_TAP,
+    load_transfer,
+    pair_output_lines,
+)
+from stochcable.dynamics.solve.line_loads import drag_blocks
+from stochcable.line.fem import SLACK_EA_RATIO
+
+__all__ = [
+    "AlongLineResidual",
+    "ElementInfluence",
+    "ResidualTap",
+    "along_line_residual",
+    "element_influence",
+    "element_lines",
+    "residual_tap",
+    "station_weights",
+    "stations",
+    "top_line",
+]
+
+#: The bend threshold of the resonant cells of each covered kind (as the kind's own
+#: :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor` call). [-]
+#: Elements the residuals are evaluated at (:func:`stations`; the others interpolated
+#: linearly in arc length between them): its cost is one banded solve per line per
+#: station (every element: chain +75 ms on a 26 ms linear analysis); 7 give every
+#: element's σ within 0.13 % of all elements' on the chain, taut wire, deep wire,
+#: two-segment line and inclined guy. [-]
+MAX_STATIONS = 7
+#: The element tensions' residual lines are formed up to the highest line where an end
+#: tension's exceeds this fraction of its largest (:func:`top_line`): the superharmonic
+#: tail above carries nothing at the ends (chain: lines 120 of 189, taut wire 55). [-]
+LINE_FLOOR = 1e-8
+CELL_BENDS = {
+    "drag_residual": CELL_BEND,
+    "geometric_residual": CELL_BEND * LINE_STRIDE**2,
+}
+
+
+@dataclass
+class Capture:
+    """One contraction of a kind's load cross-spectra: the lines ``w`` [rad/s], every
+    load of the kind's :func:`load_transfer` call ``unit`` (n_nodes, d, n_all), the
+    loads ``kept`` (indices into it) whose cross-spectral lines ``g`` (n, n, n_o) are."""
+
+    w: np.ndarray
+    unit: np.ndarray
+    kept: np.ndarray
+    g: np.ndarray
+
+
+class ResidualTap:
+    """Collects the loads and load cross-spectra of the residual kinds computed while
+    it is active (:func:`residual_tap`)."""
+
+    def __init__(self) -> None:
+        self._loads: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        self.captures: list[Capture] = []
+        self.unmatched = 0
+        self.misfits: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+
+    def misfit(self, unit: np.ndarray, load: np.ndarray, w: np.ndarray) -> None:
+        """The drag residual's linear misfit: its loads ``unit`` (n_nodes, d, n_load),
+        their values per unit input ``load`` (n_ch, n_load, n_w) on the analysis grid
+        ``w``."""
+        self.misfits.append((unit, load, np.asarray(w, dtype=float)))
+
+    def loads(self, unit: np.ndarray, w: np.ndarray, h: np.ndarray) -> None:
+        """A :func:`load_transfer` call: its loads, frequencies and end transfer."""
+        self._loads.append((unit, np.asarray(w, dtype=float), h))
+
+    def lines(self, g: np.ndarray, transfer: np.ndarray) -> None:
+        """A :func:`pair_output_lines` call: G and the loads' end transfer, matched
+        column by column to the load transfer they were taken from."""
+        n_o = transfer.shape[2]
+        cols = [np.ascontiguousarray(transfer[:, c]).tobytes() for c in range(transfer.shape[1])]
+        for unit, w, h in reversed(self._loads):
+            if h.shape[2] != n_o or h.shape[0] != transfer.shape[0]:
+                continue
+            index = {np.ascontiguousarray(h[:, j]).tobytes(): j for j in range(h.shape[1])}
+            if all(c in index for c in cols):
+                kept = np.array([index[c] for c in cols], dtype=int)
+                self.captures.append(Capture(w, unit, kept, g))
+                return
+        self.unmatched += 1
+
+
+@contextmanager
+def residual_tap() -> Iterator[ResidualTap]:
+    """A :class:`ResidualTap` active in the block (the kinds computed in it report to it)."""
+    tap = ResidualTap()
+    token = RESIDUAL_TAP.set(tap)
+    try:
+        yield tap
+    finally:
+        RESIDUAL_TAP.reset(token)
+
+
+def element_rows(model: Any) -> np.ndarray:
+    """The element tension rows (n_el, 2, d): δT_e = rows[e, 0]·u_e + rows[e, 1]·u_{e+1}
+    (as :func:`stochcable.dynamics.outputs.line_result.element_tension_transfer`). [N/m]"""
+    rows = model.tension_rows
+    if rows is None:
+        ea = np.where(model.slack, SLACK_EA_RATIO * model.mesh.ea, model.mesh.ea)
+        t = model.tangents * (ea / model.l0)[:, None]
+        rows = np.stack([-t, t], axis=1)
+    return np.asarray(rows, dtype=float)
+
+
+def element_influence(
+    system: Any, damping: Any, w: np.ndarray, elements: np.ndarray | None = None
+) -> np.ndarray:
+    """The tensions of ``elements`` (indices; default all) per unit force on each node
+    and component, ends prescribed, the line's linear system with ``damping``: shape
+    (n_out, n_nodes, d, n_w). [N/N]
+
+    By the adjoint (module notes): x_e = A⁻ᵀ r_e on the free nodes, one banded solve
+    per frequency with the n_el right-hand sides; zero on the end nodes.  A travelling
+    line's Aᵀ has C − G, a line with a steady lift C_Lᵀ (as
+    :func:`~stochcable.dynamics.residuals.residual_lines.end_influence`)."""
+    w = np.asarray(w, dtype=float)
+    model = system.model
+    prep = line_prep(system)
+    d, n = model.dim, model.n_nodes
+    cd = drag_blocks(system, damping)
+    b_c = prep.bS + free_band(cd)
+    if system.gyro is not None:
+        b_c = b_c - gyro_band(system.gyro, d)
+    if system.lift is not None:
+        b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
+    rows = element_rows(model)
+    idx = np.arange(rows.shape[0]) if elements is None else np.asarray(elements, dtype=int)
+    rows = rows[idx]
+    n_el = idx.size
+    rhs = np.zeros(((n - 2) * d, n_el), dtype=complex)
+    for k in (0, 1):  # node e + k of element e, free nodes 1 … n − 2
+        node = idx + k
+        free = (node >= 1) & (node <= n - 2)
+        for c in range(d):
+            rhs[(node[free] - 1) * d + c, np.flatnonzero(free)] = rows[free, k, c]
+    out = np.zeros((n_el, n, d, w.size), dtype=complex)
+    for sl in frequency_slices(w.size, 16 * n * d * max(n_el, 1)):
+        ws = w[sl]
+        x = solve_band_stacked(
+            prep.bK,
+            prep.bM,
+            b_c,
+            np.broadcast_to(rhs, (ws.size,) + rhs.shape),
+            ws,
+            2 * d - 1,
+            2 * d - 1,
+            (model.K, model.M),
+        )  # (n_w, (n − 2)·d, n_el)
+        out[:, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, n_el), (3, 1, 2, 0))
+    return out
+
+
+class ElementInfluence:
+    """:func:`element_influence` of one line and drag, kept for the frequencies asked
+    (the geometric residual's lines are among the drag residual's): the ``influence``
+    of :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`."""
+
+    def __init__(self, system: Any, damping: Any, elements: np.ndarray | None = None) -> None:
+        self.system = system
+        self.damping = damping
+        self.elements = elements
+        self._kept: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def on(self, w: np.ndarray) -> np.ndarray:
+        """The influence on ``w``, shape (n_out, n_nodes, d, n_w). [N/N]"""
+        w = np.asarray(w, dtype=float)
+        for om, g in self._kept if w.size else ():
+            at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
+            near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
+            if np.allclose(om[near], w, rtol=1e-12, atol=0.0):
+                return g[..., near]
+        g = element_influence(self.system, self.damping, w, self.elements)
+        self._kept.append((w.copy(), g))
+        return g
+
+
+def element_lines(
+    system: Any,
+    damping: Any,
+    kind: str,
+    captures: list[Capture],
+    influence: Any,
+    feedthrough: bool = True,
+    top_line: int | None = None,
+) -> np.ndarray | None:
+    """The variance lines (n_out, n_o) of the outputs of ``influence`` (n_out rows)
+    driven by the loads of one kind's ``captures`` (module notes), on the captures'
+    lines (the kinds form one each); None where there is none.  ``feedthrough``: the
+    outputs are the element tensions, and the geometric forces' own second-order
+    stretch enters each element's tension directly (:func:`geometric_feedthrough`).
+    ``top_line``: the lines from it up are left out (zero; :func:`top_line`)."""
+    out = None
+    for cap in captures:
+        top = cap.w.size if top_line is None else min(top_line, cap.w.size)
+        w, g = cap.w[:top], cap.g[..., :top]
+        full = load_transfer(system, damping, cap.unit, w, influence)  # (n_out, n_all, top)
+        if feedthrough and kind == "geometric_residual":
+            own = geometric_feedthrough(system, cap.unit.shape[2])
+            sel = getattr(influence, "elements", None)
+            full = full + own[slice(None) if sel is None else sel, :, None]
+        lines = np.zeros((full.shape[0], cap.w.size))
+        lines[:, :top] = pair_output_lines(g, full[:, cap.kept]) * cell_factor(
+            system, damping, cap.unit, w, full, CELL_BENDS[kind], influence=influence
+        )
+        out = lines if out is None else out + lines
+    return out
+
+
+def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
+    """Each element tension per unit of the geometric residual's components (its
+    :func:`load_transfer` columns, component-major: ½|b_e|² first), shape (n_el, n_all).
+    [N/m]
+
+    To second order the stretch of element e is a + |b|²/(2l) (|ℓ| = |l·t + Δu|, Δu =
+    a·t + b): the linear model's tension (EA/L₀)·a (the rows of
+    :func:`element_rows`) misses (EA/L₀)·½|b|²/l, the element's own share of the
+    quadratic force κ·½|b|² it applies as a node pair (the pair's response through
+    the line, r_e·A⁻¹F, is the rest).  The products a·b_k do not stretch it."""
+    rows = element_rows(system.model)
+    n_el = rows.shape[0]
+    length = np.linalg.norm(np.diff(np.asarray(system.positions, dtype=float), axis=0), axis=1)
+    out = np.zeros((n_el, n_all))
+    el = np.arange(n_el)
+    out[el, el] = -np.linalg.norm(rows[:, 1], axis=1) / length
+    return out
+
+
+def top_line(record: Any, floor: float = LINE_FLOOR) -> int | None:
+    """One past the highest of the uniform residual lines of ``record`` (its first
+    part) where an end's variance line exceeds ``floor`` times the largest (None
+    without lines)."""
+    if not record.lines:
+        return None
+    _, part = record.lines[0]
+    v = np.max(np.abs(np.stack([np.asarray(x, dtype=float) for x in part.values()])), axis=0)
+    live = np.flatnonzero(v > floor * np.max(v, initial=0.0))
+    return int(live[-1]) + 1 if live.size else 0
+
+
+def stations(model: Any, max_stations: int = MAX_STATIONS) -> np.ndarray:
+    """The elements (indices, increasing) the residuals are evaluated at: every
+    element of a line of at most ``max_stations``, else both end elements, both
+    elements of every segment junction and ``max_stations`` evenly spaced ones."""
+    n_el = model.n_elements
+    if n_el <= max_stations:
+        return np.arange(n_el)
+    seg = np.asarray(model.mesh.segment)
+    junction = np.flatnonzero(np.diff(seg) != 0)
+    even = np.rint(np.linspace(0, n_el - 1, max_stations)).astype(int)
+    return np.unique(np.concatenate([even, junction, junction + 1]))
+
+
+def station_weights(s: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Linear interpolation in the arc length ``s`` (n_el,) of the elements from the
+    station elements ``at`` (increasing, both end elements among them): shape (n_el,
+    n_st), rows summing to 1."""
+    s = np.asarray(s, dtype=float)
+    xs = s[at]
+    k = np.clip(np.searchsorted(xs, s, side="right") - 1, 0, max(at.size - 2, 0))
+    out = np.zeros((s.size, at.size))
+    if at.size == 1:
+        out[:, 0] = 1.0
+        return out
+    t = np.clip((s - xs[k]) / (xs[k + 1] - xs[k]), 0.0, 1.0)
+    rows = np.arange(s.size)
+    out[rows, k] = 1.0 - t
+    out[rows, k + 1] = t
+    return out
+
+
+def misfit_lines(
+    system: Any,
+    damping: Any,
+    misfit: tuple[np.ndarray, np.ndarray, np.ndarray],
+    w_lines: np.ndarray,
+    influence: Any,
+    linear: np.ndarray,
+    spectra: np.ndarray,
+) -> np.ndarray:
+    """The variance change (n_out, n_w) of the outputs of ``influence`` (their linear
+    transfer ``linear`` (n_ch, n_out, n_w)) by the drag residual's linear ``misfit``
+    (:meth:`ResidualTap.misfit`), Σ_c q·S_c(|H_L + H_c|² − |H_L|²) on the analysis grid,
+    as :mod:`.drag_residual` forms the ends': the outputs per unit misfit load at the
+    residual line ``w_lines`` nearest each frequency, solved at the frequency itself
+    where the line's cell bends (:func:`bent_cells`). [N²]"""
+    unit, load, w = misfit
+    step = float(w_lines[0])
+    at = np.clip(np.rint(w / step).astype(int) - 1, 0, w_lines.size - 1)
+    # (the lines up to the band's top: among those the influence holds)
+    on_lines = load_transfer(system, damping, unit, w_lines[: at.max() + 2], influence)
+    h = on_lines[:, :, at]
+    exact = np.flatnonzero(bent_cells(on_lines)[at])
+    if exact.size:
+        h[:, :, exact] = load_transfer(system, damping, unit, w[exact], influence)
+    h_c = np.einsum("opw,cpw->cow", h, load)
+    q = trapezoid_weights(w)[None, None] * spectra[:, None]
+    return np.sum(q * (np.abs(linear + h_c) ** 2 - np.abs(linear) ** 2), axis=0)
+
+
+def bent_cells(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
+    """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
+    loads, bends by more than ``bend`` between neighbours, and their neighbours (as
+    :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`'s cells)."""
+    power = np.sum(np.abs(h) ** 2, axis=1)
+    logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
+    out = np.zeros(power.shape[1], dtype=bool)
+    out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
+    return out | np.roll(out, 1) | np.roll(out, -1)
+
+
+def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:
+    """The linear tension transfer (n_ch, n_st, n_w) of the elements ``at`` from the
+    line's ``response`` (as
+    :func:`stochcable.dynamics.outputs.line_result.element_tension_transfer`). [N/unit]"""
+    model = system.model
+    n_w = np.asarray(response.omega).size
+    u = np.asarray(response.displacement).reshape(n_w, model.n_nodes, model.dim, -1)
+    rows = element_rows(model)[at]
+    out = np.einsum("ed,wedc->cew", rows[:, 0], u[:, at]) + np.einsum(
+        "ed,wedc->cew", rows[:, 1], u[:, at + 1]
+    )
+    return out
+
+
+@dataclass(frozen=True)
+class _Lines:
+    """The ``lines`` of one kind at one element, as a record's (for corrected_spectrum)."""
+
+    lines: tuple
+
+
+@dataclass(frozen=True)
+class AlongLineResidual:
+    """The residuals' variance of every element's dynamic effective tension.
+
+    Attributes
+    ----------
+    computed : bool
+        False where a residual applied at the ends is not covered along the line
+        (``reason`` says why): the element tensions are the linear model's.
+    reason : str
+        Why not computed ("" when computed).
+    lines : dict of str to tuple of (ndarray, ndarray)
+        By kind, parts (as :class:`~stochcable.results.records.ResidualRecord`
+        ``lines``): the frequencies [rad/s] (n,) and each element's variance at them
+        (n_el, n) [N²] — the uniform residual lines, and the drag residual's linear
+        misfit on the analysis grid (which may be negative) where there is one.
+    variance : ndarray, shape (n_el,)
+        The variance the residuals add to each element tension (their lines' sum). [N²]
+    stations : ndarray of int
+        The elements they were evaluated at (:func:`stations`); the others'
+        interpolated linearly in arc length.
+    """
+
+    computed: bool
+    reason: str = ""
+    lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = field(default_factory=dict)
+    variance: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    stations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    def density(self, element: int, omega: np.ndarray, linear: np.ndarray) -> CorrectedSpectrum:
+        """The spectral density of ``element``'s tension with the residuals, from its
+        linear density ``linear`` on the analysis grid ``omega`` (as the ends',
+        :func:`~stochcable.dynamics.residuals.corrected_spectrum.corrected_spectrum`:
+        its area is the corrected σ²). [N²·s/rad]"""
+        parts = [
+            _Lines(tuple((om, {"element": v[element]}) for om, v in kind_parts))
+            for kind_parts in self.lines.values()
+        ]
+        return corrected_spectrum(omega, linear, "element", parts if self.computed else [])
+
+    def std(self, linear_std: np.ndarray) -> np.ndarray:
+        """σ of the element tensions with the residuals, from the linear σ (n_el,)
+        (a negative total clipped at 0, as the ends'). [N]"""
+        lin = np.asarray(linear_std, dtype=float)
+        if not self.computed:
+            return lin
+        return np.sqrt(np.maximum(lin**2 + self.variance, 0.0))
+
+
+def along_line_residual(
+    system: Any,
+    damping: Any,
+    applied: Mapping[str, Any],
+    taps: Mapping[str, ResidualTap],
+    response: Any,
+    spectra: np.ndarray,
+    max_stations: int = MAX_STATIONS,
+) -> AlongLineResidual:
+    """The element tensions' residual variance lines of the ``applied`` records (by
+    kind, computed and in range) from what their ``taps`` collected (module notes).
+
+    ``response``, ``spectra`` (n_ch, n_w): the line's linear response and its inputs'
+    spectra (the misfit's cross term).  ``max_stations``: :func:`stations`.  A kind
+    without captures adds nothing where its record's lines are all zero (no drag, no
+    order ≥ 2), and is not covered otherwise (the result not computed)."""
+    n_el = system.model.n_elements
+    if not applied:
+        return AlongLineResidual(False, "no residual applied")
+    model = system.model
+    at = stations(model, max_stations)
+    weights = station_weights(0.5 * (model.mesh.s0[1:] + model.mesh.s0[:-1]), at)
+    influence = ElementInfluence(system, damping, at)
+    lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = {}
+    total = np.zeros(n_el)
+    linear = None
+    for kind, rec in applied.items():
+        tap = taps.get(kind)
+        caps = [] if tap is None else tap.captures
+        if kind not in CELL_BENDS or (tap is not None and tap.unmatched):
+            caps = []
+        if not caps:
+            if all(not np.any(np.asarray(v)) for _, part in rec.lines for v in part.values()):
+                continue
+            why = (
+                "its loads were not matched to their load transfer (RESIDUAL_TAP)"
+                if tap is not None and tap.unmatched
+                else "its loads do not pass through the pair lines (3-D drag)"
+            )
+            return AlongLineResidual(
+                False,
+                f"the {kind.replace('_', ' ')} of this line is not covered along the line: "
+                f"{why}; the element tensions are linear",
+            )
+        w_lines = np.asarray(caps[0].w, dtype=float)
+        v = element_lines(system, damping, kind, caps, influence, top_line=top_line(rec))
+        parts = [(w_lines, weights @ v)]
+        for mis in tap.misfits if tap is not None else ():
+            if linear is None:
+                linear = station_transfer(system, response, at)
+            dv = misfit_lines(system, damping, mis, w_lines, influence, linear, spectra)
+            parts.append((mis[2], weights @ dv))
+        lines[kind] = tuple(parts)
+        total += sum(v.sum(axis=1) for _, v in parts)
+    return AlongLineResidual(True, "", lines, total, at)

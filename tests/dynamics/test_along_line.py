@@ -1,0 +1,272 @@
+"""The residuals along the line (stochcable.dynamics.residuals.along_line): the element
+tensions' residual variance from the residual kinds' own load cross-spectra.
+
+Independent checks: the element influence against a forward dense solve of the
+finite-element equations with a random load (no adjoint, no band storage, no LAPACK
+band solver); the same contraction with the end rows in place of the elements against
+the kinds' own end lines (the plumbing of the captured loads); the end elements'
+residual against the ends' (a different output: the element's stretch, not the
+support reaction; they differ by the half element's inertia and drag); the stations'
+interpolation against every element; the switches off leave the linear σ."""
+
+from __future__ import annotations
+
+import copy
+import warnings
+
+import numpy as np
+import pytest
+from _scenes import chain_surge_doc
+
+import stochcable.dynamics.outputs.line_result as line_result_module
+from stochcable import analyze
+from stochcable.dynamics.model.blocks import add_blocks, line_prep
+from stochcable.dynamics.residuals.along_line import (
+    element_influence,
+    element_lines,
+    element_rows,
+    station_weights,
+    stations,
+)
+from stochcable.dynamics.residuals.residual_lines import EndInfluence
+from stochcable.dynamics.solve.line_loads import drag_blocks
+
+
+@pytest.fixture(scope="module")
+def chain():
+    """The chain's line at 20 elements, fairlead surge, both residuals; the arguments
+    of its along-line evaluation kept (system, damping, records, taps)."""
+    seen = {}
+    orig = line_result_module.along_line_residual
+
+    def spy(system, damping, applied, taps, *args, **kw):
+        seen.update(system=system, damping=damping, applied=applied, taps=taps)
+        return orig(system, damping, applied, taps, *args, **kw)
+
+    line_result_module.along_line_residual = spy
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            line = analyze(chain_surge_doc(20)).lines["leg1"]
+    finally:
+        line_result_module.along_line_residual = orig
+    return line, seen
+
+
+def _dense(blocks, n: int, d: int) -> np.ndarray:
+    """The dense matrix of node blocks (D (n, d, d), O (n − 1, d, d) below the diagonal)."""
+    diag, off = blocks
+    a = np.zeros((n * d, n * d))
+    for k in range(n):
+        a[k * d : (k + 1) * d, k * d : (k + 1) * d] = diag[k]
+    for k in range(n - 1):
+        a[(k + 1) * d : (k + 2) * d, k * d : (k + 1) * d] = off[k]
+        a[k * d : (k + 1) * d, (k + 1) * d : (k + 2) * d] = off[k].T
+    return a
+
+
+def test_element_influence_equals_a_forward_dense_solve(chain):
+    """A random node load at three frequencies (one near the line's first mode): the
+    element tensions of the forward solve u_f = A⁻¹F_f (dense, numpy.linalg), δT_e =
+    r_e·(u_e, u_e+1), against the adjoint influence times the load, within 1e-9 of the
+    largest (round-off of two well-conditioned solves of 42 unknowns)."""
+    _, seen = chain
+    system, damping = seen["system"], seen["damping"]
+    model = system.model
+    n, d = model.n_nodes, model.dim
+    prep = line_prep(system)
+    k, m = _dense(prep.K, n, d), _dense(prep.MT, n, d)
+    c = _dense(add_blocks(prep.S, drag_blocks(system, damping)), n, d)
+    rng = np.random.default_rng(11)
+    load = rng.standard_normal((n, d)) + 1j * rng.standard_normal((n, d))
+    w = np.array([0.05, float(system.modes.omega[0]), 1.3])
+    g = element_influence(system, damping, w)  # (n_el, n, d, n_w)
+    rows = element_rows(model)
+    for j, om in enumerate(w):
+        a = (k - om**2 * m + 1j * om * c)[d:-d, d:-d]
+        u = np.zeros((n, d), dtype=complex)
+        u[1:-1] = np.linalg.solve(a, load[1:-1].ravel()).reshape(n - 2, d)
+        direct = np.einsum("ed,ed->e", rows[:, 0], u[:-1]) + np.einsum(
+            "ed,ed->e", rows[:, 1], u[1:]
+        )
+        adjoint = np.einsum("end,nd->e", g[..., j], load)
+        assert np.max(np.abs(adjoint - direct)) < 1e-9 * np.max(np.abs(direct))
+
+
+def test_end_rows_reproduce_the_kinds_end_lines(chain):
+    """The captured load cross-spectra contracted with the end influence (in place of
+    the elements' and without the geometric forces' own stretch) give each kind's end
+    lines to round-off: the loads, their columns and the cell factors are the kinds'."""
+    line, seen = chain
+    system, damping = seen["system"], seen["damping"]
+    for kind, tap in seen["taps"].items():
+        assert len(tap.captures) == 1 and tap.unmatched == 0
+        got = element_lines(
+            system, damping, kind, tap.captures, EndInfluence(system, damping), feedthrough=False
+        )
+        _, ref = line.residuals[kind].lines[0]
+        for k, end in enumerate(("end_a", "end_b")):
+            assert np.allclose(got[k], ref[end], rtol=1e-10, atol=1e-12 * np.abs(ref[end]).max())
+
+
+def test_end_elements_carry_the_end_residuals(chain):
+    """Each kind's residual variance at the first and last element against its end
+    tension's (the chain at 40 elements: 2e-4 / 3e-4 apart; here at 20 elements within
+    8e-4, the half element's inertia and drag between the support and the element:
+    3e-3 allowed), and the corrected σ ratio alike (1.1e-3 measured); the geometric
+    forces' own stretch is what makes them agree (without it the kept elements'
+    residuals jump ×10 along the line)."""
+    line, _ = chain
+    al = line.along_line
+    assert al.computed
+    for kind, ((_, v), *_) in al.lines.items():
+        rec = line.residuals[kind]
+        for el, end in ((0, "end_a"), (-1, "end_b")):
+            ref = rec.lines[0][1][end].sum()
+            assert v[el].sum() == pytest.approx(ref, rel=3e-3)
+    for el, end in ((0, "end_a"), (-1, "end_b")):
+        ratio_el = line.tension_std[el] / line.tension_std_linear[el]
+        ratio_end = getattr(line, end).std / line.linear[end].std
+        assert ratio_el == pytest.approx(ratio_end, rel=3e-3)
+
+
+def test_element_density_integrates_to_the_corrected_variance(chain):
+    """Each element's density with the residuals (linear density from the element
+    tension transfer, plus the residual lines) integrates by the trapezoid rule to its
+    corrected σ² (1e-9: the corrected spectrum's scale makes it so to round-off) and
+    reaches the superharmonics above the analysis band."""
+    line, _ = chain
+    lin = line.tension_spectrum
+    for el in (0, 7, line.tension_std.size - 1):
+        spec = line.along_line.density(el, line.omega, lin[el])
+        area = np.trapezoid(spec.density, spec.omega)
+        assert area == pytest.approx(line.tension_std[el] ** 2, rel=1e-9)
+        assert spec.omega[-1] > 2.0 * line.omega[-1]
+
+
+def test_stations_interpolate_every_element():
+    """Stations: every element of a short line; else both ends, the segment junctions
+    and evenly spaced ones; the weights interpolate a linear function exactly."""
+
+    class _Mesh:
+        segment = np.r_[np.zeros(12, int), np.ones(18, int)]
+
+    class _Model:
+        n_elements = 30
+        mesh = _Mesh()
+
+    at = stations(_Model(), 5)
+    assert at[0] == 0 and at[-1] == 29 and {11, 12} <= set(at.tolist())
+    assert np.array_equal(stations(_Model(), 40), np.arange(30))
+    s = np.sort(np.random.default_rng(2).uniform(0, 100, 30))
+    wts = station_weights(s, at)
+    assert np.allclose(wts.sum(axis=1), 1.0)
+    assert np.allclose(wts @ (3.0 * s[at] - 1.0), 3.0 * s - 1.0)
+
+
+def test_switches_off_leave_the_linear_element_tensions(chain):
+    """Residuals off: no along-line record, the element σ the linear one to the bit;
+    on: the linear σ kept beside (the same numbers)."""
+    line, _ = chain
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        off = analyze(chain_surge_doc(20, residual=False)).lines["leg1"]
+    assert off.along_line is None and off.tension_std_linear is None
+    assert np.array_equal(off.tension_std, line.tension_std_linear)
+    assert "std_linear" not in off.to_document()["tension"]
+    doc = copy.deepcopy(line.to_document()["tension"])
+    assert doc["std_linear"] == line.tension_std_linear.tolist()
+
+
+def _td_element_sigma(doc: dict, seed: int, elements: list[int], **variant) -> np.ndarray:
+    """TD σ of the ``elements``' tension over the second of two periods of the periodic
+    fairlead surge of :func:`_scenes.td_end_sigma` (the same phases)."""
+    import math
+
+    from _scenes import CHAIN_BAND, CHAIN_PERIOD
+
+    from stochcable.reference.cable import simulate_line_timedomain
+    from stochcable.scene.model import load_scene
+
+    scene = load_scene(doc)
+    dt = 0.05
+    n_t = int(round(2 * CHAIN_PERIOD / dt))
+    dw = 2 * math.pi / CHAIN_PERIOD
+    w = scene.analysis.omega.values()
+    s = scene.lines[0].end_b.motion.surge.spectral_density(w, scene.environment.g)
+    phase = np.random.default_rng(seed).uniform(-np.pi, np.pi, w.size)
+    c = np.zeros((3, n_t // 2 + 1), dtype=complex)
+    c[0, 2 * np.rint(w / dw).astype(int)] = 0.5 * n_t * np.sqrt(2 * s * dw) * np.exp(-1j * phase)
+    h = simulate_line_timedomain(
+        scene,
+        duration=2 * CHAIN_PERIOD,
+        end_realizations={"b": c},
+        band=CHAIN_BAND,
+        dt=dt,
+        **variant,
+    )
+    return h.element_tension_std(start=CHAIN_PERIOD - 1e-9)[elements]
+
+
+@pytest.mark.slow
+def test_mid_line_drag_correction_matches_the_time_domain_quadratic_drag_shift():
+    """The chain's line at 40 elements, fairlead surge (as the end test of
+    tests/dynamics/test_drag_residual.py): the TD with the FD's linear drag against the
+    TD with quadratic drag (same phases, linear bed) measures the quadratic drag's own
+    effect on the tension of elements 10, 20 and 30; the drag residual along the line
+    predicts it within the 95 % CI of the paired shift over seeds 1–4 (Student t:
+    ±2 %).  Measured: +7.1 / +6.6 / +5.8 % in the TD against +6.6 / +6.0 / +5.4 %
+    predicted (the ends: +7.4 / +4.7 % against +6.8 / +4.1 %, the same 0.5 % short)."""
+    from scipy import stats
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        line = analyze(chain_surge_doc(40)).lines["leg1"]
+    els = [10, 20, 30]
+    lin = line.tension_std_linear[els]
+    drag = sum(v.sum(axis=1) for _, v in line.along_line.lines["drag_residual"])[els]
+    pred = np.sqrt(1.0 + drag / lin**2) - 1.0
+    b = (np.asarray(line.linearization.b_normal), np.asarray(line.linearization.b_axial))
+    doc = chain_surge_doc(40, residual=False)
+    shifts = []
+    for seed in (1, 2, 3, 4):
+        td_lin = _td_element_sigma(doc, seed, els, drag="linear", linear_drag=b, seabed="linear")
+        td_quad = _td_element_sigma(doc, seed, els, drag="static_tangent", seabed="linear")
+        shifts.append((td_quad - td_lin) / lin)
+    shifts = np.array(shifts)
+    half = stats.t.ppf(0.975, len(shifts) - 1) * shifts.std(axis=0, ddof=1) / 2.0
+    assert np.all(pred > 0.02)
+    np.testing.assert_array_less(np.abs(pred - shifts.mean(axis=0)), half)
+
+
+def test_element_influence_of_a_travelling_line_by_the_adjoint():
+    """A travelling line (speed −5 m/s: the skew gyroscopic G, so Aᵀ has C − G): the
+    element influence equals the forward dense solve with the full impedance
+    (tests/dynamics/test_transport_solve.py's end influence check), to 1e-9."""
+    from test_transport_solve import _damping, _system
+
+    from stochcable.line.fem import build_fe_model
+    from stochcable.line.transport.matrices import transport_matrices
+
+    with pytest.warns(Warning):
+        scene, system = _system(-5.0)
+    damping = _damping(system, np.random.default_rng(7))
+    w = np.array([0.3, 1.7])
+    got = element_influence(system, damping, w)  # (n_el, n_nodes, d, n_w)
+    rest = build_fe_model(system.statics, scene.environment, dim=2)
+    tr = transport_matrices(rest, -5.0)
+    k, m = tr.K.toarray(), (rest.M + rest.Ma).toarray()
+    c = damping.matrix.toarray() + rest.Cs.toarray() + tr.G.toarray()
+    fr, d = rest.free, rest.dim
+    rows = element_rows(system.model)
+    for i, x in enumerate(w):
+        z = k - x * x * m + 1j * x * c
+        for dof in fr[[0, 5, -1]]:
+            f = np.zeros(k.shape[0])
+            f[dof] = 1.0
+            u = np.zeros(k.shape[0], complex)
+            u[fr] = np.linalg.solve(z[np.ix_(fr, fr)], f[fr])
+            u = u.reshape(-1, d)
+            t = np.einsum("ed,ed->e", rows[:, 0], u[:-1]) + np.einsum("ed,ed->e", rows[:, 1], u[1:])
+            g = got[:, dof // d, dof % d, i]
+            assert np.max(np.abs(g - t)) <= 1e-9 * np.max(np.abs(t))
