@@ -51,6 +51,8 @@ HEAVY = (
     "scipy.integrate",
     "scipy.interpolate",
     "scipy.signal",
+    "numpy.f2py.f2py2e",
+    "numpy.testing._private.utils",
 )
 #: The chain example with the residual switches set either way (whatever their default).
 SCENES = {

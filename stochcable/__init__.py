@@ -49,6 +49,9 @@ def __getattr__(name: str):
         enabled = gc.isenabled()
         gc.disable()
         try:
+            from stochcable import lazy_numpy
+
+            lazy_numpy.defer()  # (numpy.f2py and numpy.testing, that SciPy's import loads)
             value = getattr(importlib.import_module(f".{module}", __name__), attr)
         finally:
             if gc.get_freeze_count() == 0:

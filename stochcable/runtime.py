@@ -93,10 +93,12 @@ import contextlib
 import os
 import threading
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from stochcable import errors as _errors
+
+if TYPE_CHECKING:
+    from concurrent.futures import ThreadPoolExecutor
 
 __all__ = [
     "configure",
@@ -348,6 +350,9 @@ def _blas_single() -> bool:
 
 def _executor(n: int) -> ThreadPoolExecutor:
     global _pool, _pool_size
+    # (imported with the first pool: concurrent.futures loads logging, ≈ 4 ms)
+    from concurrent.futures import ThreadPoolExecutor
+
     with _pool_lock:
         if _pool is None or _pool_size < n:
             old = _pool

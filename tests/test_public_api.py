@@ -98,9 +98,15 @@ def test_the_first_analysis_imports_what_the_scene_uses(residuals):
     # its 2,400-sample record is transformed by numpy.fft, not pyfftw (nor xarray,
     # pandas); the drag formulas' erf is math.erf and the residuals' FFT length needs
     # no scipy.fft, so scipy.special (~25 ms of import) is not loaded either, with the
-    # residual switches on or off (docs/benchmarks/first_analysis.md)
+    # residual switches on or off; numpy.f2py and numpy.testing stay unexecuted
+    # (docs/benchmarks/first_analysis.md)
     heavy = ("numba", "pyfftw", "xarray", "pandas", "matplotlib", "scipy.special", "scipy.fft")
     heavy += ("scipy.optimize", "scipy.stats", "scipy.sparse.linalg", "stochcable.fidelity.planner")
+    # nor NumPy's tool submodules that SciPy's import binds (stochcable.lazy_numpy)
+    heavy += ("numpy.f2py.f2py2e", "numpy.testing._private.utils", "charset_normalizer")
+    # nor the fatigue curves (a strumming fatigue rate's) or the result's display
+    heavy += ("stochcable.design.curves", "stochcable.results.display")
+    heavy += ("concurrent.futures",)  # (stochcable.runtime's pool: not started)
     code = _FIRST_ANALYSIS.format(on=residuals, heavy=heavy)
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
     out = subprocess.run(

@@ -24,7 +24,6 @@ from typing import Any
 import numpy as np
 
 from stochcable.line.strumming.screen import StrummingTable
-from stochcable.results.display import result_html, result_text
 from stochcable.results.records import (
     THREE_HOURS,
     LinearizationRecord,
@@ -431,10 +430,14 @@ class Result:
 
     def __repr__(self) -> str:
         """A few lines: title, lines, end-tension σ with units, number of warnings."""
+        from stochcable.results.display import result_text  # (shown, not computed)
+
         return result_text(self)
 
     def _repr_html_(self) -> str:
         """The summary table a notebook shows (:mod:`stochcable.results.display`)."""
+        from stochcable.results.display import result_html
+
         return result_html(self)
 
     @property

@@ -27,10 +27,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from stochcable.design.curves import FatigueCurve
 from stochcable.errors import InputError
 from stochcable.line.strumming.balance import (
     CROSS_FLOW_BAND,
@@ -47,6 +47,9 @@ from stochcable.line.strumming.balance import (
     wake_parameters,
 )
 from stochcable.validation import finite_scalar
+
+if TYPE_CHECKING:
+    from stochcable.design.curves import FatigueCurve
 
 __all__ = [
     "CROSS_FLOW_BAND",
@@ -200,6 +203,8 @@ class StrummingMode:
             ν / N(S), S = ``to_quantity`` · tension range: the constant-amplitude
             narrow-band component to add to the wave-frequency damage rate. [1/s]
         """
+        from stochcable.design.curves import FatigueCurve  # (fatigue only: not at import)
+
         if not isinstance(curve, FatigueCurve):
             raise InputError("curve", type(curve).__name__, "-", "must be a FatigueCurve")
         ranges = finite_scalar("to_quantity", to_quantity, "-") * self.tension_range
