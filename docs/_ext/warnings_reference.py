@@ -45,7 +45,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Too few elements for the end-tension σ",
         "ResolutionWarning",
-        ("stochcable.analysis:_checked_mesh",),
+        ("stochcable.fidelity.mesh_engine:__call__",),
         "A segment's estimated discretization error of the end-tension σ above "
         "MESH_ERROR_LIMIT: the larger of (kh)²/24, k = ω₂√⟨1/c²⟩ (string wave at the "
         "end tension's mean frequency ω₂ = √(m₂/m₀)), and (h/suspended length)² on a "
@@ -53,7 +53,10 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "wavenumber, on a segment wholly in the wave zone (nodal wave kinematics). "
         "Explicit ``elements`` only; "
         "a segment without ``elements`` gets a count that meets the limit, and warns "
-        "only when that count hits the scene model's limit",
+        "only when that count hits the scene model's limit — or, on an engine "
+        "(``stochcable.build_engine``) or a load-case set, for a sea state other than "
+        "the one the count was chosen for, when that sea needs more (every solve and "
+        "every case is checked)",
         "The segment's elements are too long for the string waves the end tension "
         "carries (or for its touchdown): σ is off by up to the estimate. The estimate "
         "is a bound: measured 0.4–0.5× it at 20 elements on the chain example and the "

@@ -34,9 +34,10 @@ from threadpoolctl import threadpool_limits
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import Family, SeaState
 from stochcable.design import damage_rate
-from stochcable.dynamics.engine import Engine, build_engine
+from stochcable.dynamics.engine import Engine
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
 from stochcable.errors import StochcableError, collect_warnings
+from stochcable.fidelity.mesh_engine import checked_engine
 from stochcable.scene.model import Scene, Sea
 
 __all__ = [
@@ -45,7 +46,9 @@ __all__ = [
     "solve_chunk",
     "case_sea",
     "engine_template",
+    "pilot_state",
     "prepare_worker",
+    "set_engine",
     "ENDS",
     "WARM_RUN",
     "run_lead",
@@ -146,14 +149,23 @@ def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) 
     residuals as it asks for them (every kind of :mod:`stochcable.scene.residual_kinds`
     switched on: each case's end statistics and end damage are then those of
     the corrected spectrum, :meth:`stochcable.results.documents.LineResult.end_tension_density`),
-    and the sea of an out-of-plane state when there is one (the models are then 3-D,
-    and in-plane states are solved by them exactly as by 2-D models)."""
+    and the sea of its :func:`pilot_state` (an out-of-plane state when there is one:
+    the models are then 3-D, and in-plane states are solved by them exactly as by 2-D
+    models; the element check chooses the default element counts for it,
+    :mod:`stochcable.fidelity.mesh_engine`)."""
     upd: dict[str, Any] = {"analysis": scene.analysis.model_copy(update={"timeseries": None})}
-    for state in states:
-        if abs(math.sin(math.radians(state.heading))) > 1e-9:
-            upd["sea"] = case_sea(scene, state, family)
-            break
+    if states:
+        upd["sea"] = case_sea(scene, pilot_state(states), family)
     return scene.model_copy(update=upd)
+
+
+def pilot_state(states: tuple[SeaState, ...]) -> SeaState:
+    """The state a set's default element counts are chosen for: of the out-of-plane
+    states if there are any (else of all), the shortest peak period (the highest
+    response frequencies, which the element rules scale with), then the highest Hs,
+    then the first.  The other states' estimates are checked case by case."""
+    out = [s for s in states if abs(math.sin(math.radians(s.heading))) > 1e-9] or list(states)
+    return min(out, key=lambda s: (s.tp, -s.hs))
 
 
 def run_lead(states: tuple[SeaState, ...], first: int) -> tuple[tuple[int, SeaState], ...]:
@@ -162,12 +174,20 @@ def run_lead(states: tuple[SeaState, ...], first: int) -> tuple[tuple[int, SeaSt
     return tuple((i, states[i]) for i in range(first - first % WARM_RUN, first))
 
 
+def set_engine(template: Scene) -> Engine:
+    """The engine of a set's :func:`engine_template`, with the element check
+    (:func:`stochcable.fidelity.mesh_engine.checked_engine`: default counts chosen for
+    the template's sea, a warning in the row of every case a count does not meet the
+    element rules for); the same wherever it is built."""
+    return checked_engine(template)
+
+
 def _engine(template: Scene) -> Engine:
     key = hashlib.sha256(template.model_dump_json().encode()).hexdigest()
     if key in _ENGINES:
         _ENGINES.move_to_end(key, last=False)
         return _ENGINES[key]
-    engine = build_engine(template)
+    engine = set_engine(template)
     _ENGINES[key] = engine
     _ENGINES.move_to_end(key, last=False)
     while len(_ENGINES) > _ENGINE_CACHE_SIZE:
@@ -268,7 +288,8 @@ def solve_chunk(
     """
     with threadpool_limits(limits=1):
         engine = _engine(template) if engine is None else engine
-        lines = {ln.name: sum(s.elements for s in ln.segments) for ln in template.lines}
+        # (the engine's counts: the element check may have raised the defaults)
+        lines = {ln.name: sum(s.elements for s in ln.segments) for ln in engine.scene.lines}
         k = len(cases)
         stats = {ln: {e: np.full((k, 4), np.nan) for e in ENDS} for ln in lines}
         damage = {ln: np.full((k, 2 + n), np.nan) for ln, n in lines.items()}

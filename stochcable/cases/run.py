@@ -3,7 +3,8 @@ damage and extremes per case, and the totals over the scatter diagram.
 
 The sea-independent work — statics (with current), the finite-element models, modes,
 factorizations and drag-independent arrays — is built once
-(:func:`stochcable.dynamics.engine.build_engine`) and shared by every sea state; each
+(:func:`stochcable.cases.chunk.set_engine`, with the element check of
+:mod:`stochcable.fidelity.mesh_engine`) and shared by every sea state; each
 case is ``engine.solve(sea)``, which equals ``analyze`` of the scene with that sea.  A
 case that fails or does not converge is a row with its status and reason, never a lost
 set.
@@ -19,13 +20,13 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, solve_chunk
+from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, set_engine, solve_chunk
 from stochcable.cases.display import case_set_html, case_set_text
 from stochcable.cases.fatigue_settings import LineFatigue
 from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
 from stochcable.cases.scatter import ScatterDiagram
 from stochcable.design import SECONDS_PER_YEAR, return_level
-from stochcable.dynamics.engine import Engine, build_engine
+from stochcable.dynamics.engine import Engine
 from stochcable.errors import InputError
 from stochcable.scene.model import Scene
 
@@ -143,7 +144,8 @@ def run_cases(
     progress : callable, optional
         ``progress(done, total)`` as cases finish (after every chunk).
     engine : Engine, optional
-        A built engine of the same scene, used by the in-process executor.
+        A built engine of the same scene, used by the in-process executor
+        (``stochcable.build_engine``'s carries the element check into every case).
     executor : concurrent.futures.Executor or dask.distributed.Client, optional
         Where the chunks run (None: in this process, one after the other).  With a
         Dask client the scene template is scattered to every worker once; a worker
@@ -192,7 +194,7 @@ def _run_chunks(plan: CasePlan, engine: Engine | None, executor: Any):
     family, settings = plan.scatter.family, plan.fatigue
     if executor is None:
         if engine is None:
-            engine = build_engine(plan.template)
+            engine = set_engine(plan.template)
         for k in range(len(plan.chunks)):
             yield plan.solve(k, engine)
         return
@@ -229,8 +231,11 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     """
     scene, scatter, settings, years = plan.scene, plan.scatter, plan.fatigue, plan.years
     n = len(scatter.states)
+    results = list(results)
     names = tuple(ln.name for ln in scene.lines)
     n_el = {ln.name: sum(seg.elements for seg in ln.segments) for ln in scene.lines}
+    for res in results[:1]:  # the engine's counts (the element check may raise defaults)
+        n_el = {ln: res.damage[ln].shape[1] - 2 for ln in names}
     stats = {ln: {e: np.full((n, 4), np.nan) for e in ENDS} for ln in names}
     damage = {ln: np.full((n, 2 + n_el[ln]), np.nan) for ln in names}
     rows: list[CaseRow | None] = [None] * n

@@ -41,7 +41,7 @@ import numpy as np
 
 from stochcable.fidelity.limits import elements_limit
 from stochcable.fidelity.meshing import segment_geometry
-from stochcable.fidelity.pilot import input_summary
+from stochcable.fidelity.pilot import sea_load_wavenumber
 from stochcable.scene.model import Scene
 
 __all__ = [
@@ -117,7 +117,7 @@ def mesh_estimates(result: Any, limit: float = MESH_ERROR_LIMIT) -> list[MeshEst
         One per segment, in scene order.
     """
     geo = segment_geometry(result.scene, result.statics)
-    k_sea = input_summary(result.scene).k_load
+    k_sea = sea_load_wavenumber(result.scene)
     cap = elements_limit()
     out = []
     for line in result.scene.lines:
@@ -180,22 +180,33 @@ def default_counts(
 
 def mesh_warnings(
     estimates: list[MeshEstimate],
-    omitted: set[tuple[str, int]],
+    omitted: set[tuple[str, int]] | frozenset[tuple[str, int]],
     limit: float = MESH_ERROR_LIMIT,
+    *,
+    other_sea: bool = False,
 ) -> list[str]:
     """One message per segment whose estimate exceeds ``limit``: an explicit count
     (with the count that fixes it), or a default count clipped by the scene model's
-    limit."""
+    limit — or, with ``other_sea`` (a sea other than the one the default counts were
+    chosen for), a default count this sea needs more than."""
     out = []
     cap = elements_limit()
     for e in estimates:
         default = (e.line, e.segment) in omitted
-        # a default count was chosen from the pilot's ω₂: it warns only when clipped
-        if e.error <= limit or (default and e.needed < cap):
+        # a default count was chosen from the pilot's ω₂: for the pilot's sea it warns
+        # only when clipped (the finer mesh's own ω₂ moves its estimate a little)
+        if e.error <= limit or (default and e.needed < cap and not other_sea):
+            continue
+        if default and other_sea and e.needed <= e.elements:
             continue
         where = f"lines[{e.line}].segments[{e.segment}].elements = {e.elements}"
-        if default:
+        if default and e.needed >= cap:
             fix = "the default count is clipped to the scene model's limit"
+        elif default:
+            fix = (
+                f"the default count was chosen for the engine's pilot sea; this sea "
+                f"needs elements = {e.needed} (build the engine with it)"
+            )
         else:
             fix = f"use elements = {e.needed} (or omit the field: the default meets it)"
         out.append(

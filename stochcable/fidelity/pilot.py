@@ -46,6 +46,7 @@ __all__ = [
     "input_densities",
     "input_band",
     "input_summary",
+    "sea_load_wavenumber",
     "base_count",
     "base_error",
     "response_spectra",
@@ -143,14 +144,27 @@ class InputBand:
 
 def input_summary(scene: Scene) -> InputBand:
     """The :class:`InputBand` of a scene."""
-    env = scene.environment
     w_lo, w_hi, per = input_band(scene, PILOT_INPUT_FRACTION)
     w_lo = min(w_lo, input_band(scene, PILOT_LOW_FRACTION)[0])
-    k_load = None
-    if scene.sea is not None and "sea" in per:
-        k_load = float(wavenumber(per["sea"][2], env.depth, env.g))
     w2 = max((v[2] for v in per.values()), default=1.0)
-    return InputBand(w_lo, w_hi, w2, k_load)
+    return InputBand(w_lo, w_hi, w2, sea_load_wavenumber(scene))
+
+
+def sea_load_wavenumber(scene: Scene) -> float | None:
+    """:attr:`InputBand.k_load` alone: the wavenumber at the sea spectrum's ω₂ (None
+    without a sea), from one evaluation of the sea's density (what the element check
+    of every sea state of an engine needs, :mod:`stochcable.fidelity.mesh_check`).
+    [rad/m]"""
+    if scene.sea is None:
+        return None
+    env = scene.environment
+    s = np.asarray(scene.sea.spectrum.spectral_density(_WIDE, env.g), dtype=float)
+    s = np.where(np.isfinite(s), s, 0.0)
+    m0 = np.trapezoid(s, _WIDE)
+    if not m0 > 0.0:
+        return None
+    w2 = math.sqrt(np.trapezoid(_WIDE**2 * s, _WIDE) / m0)
+    return float(wavenumber(w2, env.depth, env.g))
 
 
 def base_error(scene: Scene, w_min: float, w_max: float, n: int) -> float:
