@@ -35,6 +35,7 @@ from stochcable.fidelity.mesh_check import (
     mesh_warnings,
     omitted_counts,
 )
+from stochcable.fidelity.meshing import segment_geometry
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, Sea, load_scene
 from stochcable.statics import StaticsResult
@@ -59,14 +60,18 @@ class MeshCheck:
     omitted: frozenset[tuple[str, int]]
     pilot: Sea | None
     limit: float = MESH_ERROR_LIMIT
+    #: (statics, its segment geometry) of the last result: an engine's every result
+    #: has the same statics
+    _kept: list[Any] = dataclasses.field(default_factory=list, compare=False, repr=False)
 
     def __call__(self, result: Result) -> Result:
         """``result`` with a ResolutionWarning (raised and listed first in its
         ``warnings``) per segment above the limit (module notes)."""
+        if not (self._kept and self._kept[0] is result.statics):
+            self._kept[:] = [result.statics, segment_geometry(result.scene, result.statics)]
         other = bool(self.omitted) and result.scene.sea != self.pilot
-        texts = mesh_warnings(
-            mesh_estimates(result, self.limit), self.omitted, self.limit, other_sea=other
-        )
+        est = mesh_estimates(result, self.limit, self._kept[1])
+        texts = mesh_warnings(est, self.omitted, self.limit, other_sea=other)
         if not texts:
             return result
         for text in texts:

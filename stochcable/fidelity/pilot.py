@@ -47,6 +47,7 @@ __all__ = [
     "input_band",
     "input_summary",
     "sea_load_wavenumber",
+    "sea_omega2",
     "base_count",
     "base_error",
     "response_spectra",
@@ -151,20 +152,26 @@ def input_summary(scene: Scene) -> InputBand:
 
 
 def sea_load_wavenumber(scene: Scene) -> float | None:
-    """:attr:`InputBand.k_load` alone: the wavenumber at the sea spectrum's ω₂ (None
-    without a sea), from one evaluation of the sea's density (what the element check
-    of every sea state of an engine needs, :mod:`stochcable.fidelity.mesh_check`).
-    [rad/m]"""
+    """:attr:`InputBand.k_load` alone: the wavenumber at the sea spectrum's ω₂
+    (:func:`sea_omega2`; None without a sea). [rad/m]"""
+    w2 = sea_omega2(scene)
+    if w2 is None:
+        return None
+    return float(wavenumber(w2, scene.environment.depth, scene.environment.g))
+
+
+def sea_omega2(scene: Scene) -> float | None:
+    """ω₂ = √(m₂/m₀) of the scene's sea spectrum, from one evaluation of its density
+    (what the element check of every sea state of an engine needs,
+    :mod:`stochcable.fidelity.mesh_check`); None without a sea. [rad/s]"""
     if scene.sea is None:
         return None
-    env = scene.environment
-    s = np.asarray(scene.sea.spectrum.spectral_density(_WIDE, env.g), dtype=float)
+    s = np.asarray(scene.sea.spectrum.spectral_density(_WIDE, scene.environment.g), dtype=float)
     s = np.where(np.isfinite(s), s, 0.0)
     m0 = np.trapezoid(s, _WIDE)
     if not m0 > 0.0:
         return None
-    w2 = math.sqrt(np.trapezoid(_WIDE**2 * s, _WIDE) / m0)
-    return float(wavenumber(w2, env.depth, env.g))
+    return math.sqrt(np.trapezoid(_WIDE**2 * s, _WIDE) / m0)
 
 
 def base_error(scene: Scene, w_min: float, w_max: float, n: int) -> float:
