@@ -30,7 +30,14 @@ from host_probe import host_line
 
 from stochcable import runtime
 from stochcable.analysis import analyze
-from stochcable.cases import LineFatigue, plan_cases, run_cases, scatter_from_rows
+from stochcable.cases import (
+    LineFatigue,
+    assemble_cases,
+    plan_cases,
+    run_cases,
+    scatter_from_rows,
+)
+from stochcable.cases.chunk import set_engine
 from stochcable.cases.run import _line_totals  # noqa: PLC2701 - the sums timed alone
 from stochcable.examples import load_example
 from stochcable.scene.model import Sea, load_scene
@@ -103,7 +110,7 @@ def main() -> None:
         worst = max(worst, abs(res.stats["leg1"]["end_b"][i, 1] / one.lines["leg1"].end_b.std - 1))
     per_case = t_set / len(rows)
     an = min(t_an)
-    cor = _corrected(scene, sd, fatigue, 1 if args.quick else 2)
+    cor = _corrected(scene, sd, fatigue, 1 if args.quick else 3)
     lines = [
         "# Load-case sets: speed",
         "",
@@ -143,7 +150,10 @@ def main() -> None:
         "The same set and scene with `analysis.linearization.drag_residual` and",
         "`geometric_residual` set true (every case's end statistics and end damage then",
         "those of the corrected spectrum); the fastest of interleaved rounds of one",
-        f"`analyze()` (×{cor['n_an']}) and of each set (×{cor['n_set']}).  By default a",
+        f"`analyze()` (×{cor['n_an']}) and of each set's engine build and of each of its",
+        f"chunks of 16 cases (×{cor['n_set']}; a set's time is the fastest build plus the",
+        "sum of its chunks' fastest rounds, so that the host's load moves a set and an",
+        "`analyze()` alike).  By default a",
         "set computes the residuals on the anchor cases — per Tp, γ and heading the",
         "smallest and largest Hs and at most 5 Hs steps apart — and interpolates their",
         "corrections in Hs on the others (`stochcable.cases.residual_anchors`; here",
@@ -222,22 +232,41 @@ def _corrected(scene, sd, fatigue, n_set: int) -> dict:
     on, off = _switched(scene, True), _switched(scene, False)
     n_an = 5
     analyze(on)
-    t: dict[str, list[float]] = {
-        k: [] for k in ("analyze", "analyze_linear", "case", "case_exact", "case_linear")
+    t: dict[str, list[float]] = {k: [] for k in ("analyze", "analyze_linear")}
+    # a set's time as the sum over its chunks of each chunk's fastest round (chunks of
+    # 16 cases: whole warm-start runs, so the same solves as in one chunk), plus the
+    # fastest engine build: a set is timed as finely as an analysis, so that the
+    # host's load moves both alike
+    plans = {
+        "case": plan_cases(on, sd, fatigue=fatigue, chunk_size=16),
+        "case_exact": plan_cases(on, sd, fatigue=fatigue, chunk_size=16, residual_span=None),
+        "case_linear": plan_cases(off, sd, fatigue=fatigue, chunk_size=16),
     }
+    chunk_t = {k: [[] for _ in p.chunks] for k, p in plans.items()}
     sets = {}
-    runs = (("case", on, 5), ("case_exact", on, None), ("case_linear", off, 5))
+    build_t = {k: [] for k in plans}
+    parts: dict[str, list] = {}
     for r in range(max(n_an, n_set)):
         for key, sc in (("analyze", on), ("analyze_linear", off)):
             if r < n_an:
                 t0 = time.process_time()
                 analyze(sc)
                 t[key].append(time.process_time() - t0)
-        for key, sc, span in runs:
+        for key, plan in plans.items():
             if r < n_set:
                 t0 = time.process_time()
-                sets[key] = run_cases(sc, sd, fatigue=fatigue, residual_span=span)
-                t[key].append((time.process_time() - t0) / len(sd.states))
+                engine = set_engine(plan.template)
+                build_t[key].append(time.process_time() - t0)
+                parts[key] = []
+                for k in range(len(plan.chunks)):
+                    t0 = time.process_time()
+                    parts[key].append(plan.solve(k, engine))
+                    chunk_t[key][k].append(time.process_time() - t0)
+    for key, plan in plans.items():
+        t0 = time.process_time()
+        sets[key] = assemble_cases(plan, parts[key])
+        total = time.process_time() - t0 + min(build_t[key])
+        t[key] = [(total + sum(min(c) for c in chunk_t[key])) / len(sd.states)]
     out: dict = {k: min(v) for k, v in t.items()}
     worst = 0.0
     n = len(sd.states)
