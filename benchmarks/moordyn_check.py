@@ -20,6 +20,11 @@ Lines (one homogeneous segment each, 80 elements = 80 MoorDyn segments):
   0.008, Can 1; 2200 m from (−1800, 0, −1000) to (0, 0, −20), depth 1000 m, touchdown
   484 m from the anchor; seabed as the chain's).
 
+The accuracy page (benchmarks/accuracy_lines.py) adds ``twoseg`` (420 m of the chain's
+chain from the anchor, 315 m of the taut line's rope to the fairlead, anchor at
+(−700, 0, −200)) and ``current`` (the chain in the example's 0.5 m/s current; the
+reference only: :func:`run_scene` keeps the current, MoorDyn's input file has none).
+
 Motion: fairlead surge, periodic DSA of a Pierson–Moskowitz spectrum Hs 2 m, Tp 10 s on
 0.05–2 rad/s, period T = 200 s; record = one warm-up period (30 s half-cosine ramp)
 and one measured period; seeds 1–5; no sea, no current.  Reference: Newmark Δt
@@ -53,6 +58,7 @@ from stochcable.reference.moordyn_compare import (
     student_interval,
     window_std,
 )
+from stochcable.scene.model import load_scene
 from stochcable.sea.spectra import spectrum_pierson_moskowitz
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -90,14 +96,34 @@ DEEP = {
         }
     ],
 }  # fmt: skip
+TWO_SEGMENT = {
+    "environment": {"depth": 200.0, "rho": 1025.0, "g": 9.80665, "seabed": SEABED},
+    "lines": [
+        {
+            "name": "chain_rope",
+            "end_a": {"position": [-700.0, 0.0, -200.0]},
+            "end_b": {"position": [0.0, 0.0, -20.0]},
+            "segments": [
+                {"length": 420.0, "ea": 1.2326e9, "mass": 288.0, "diameter": 0.216,
+                 "cd_normal": 1.333, "cd_axial": 0.2034, "ca_normal": 1.0},
+                {"length": 315.0, "ea": 1.5e8, "mass": 25.0, "diameter": 0.16,
+                 "cd_normal": 1.2, "cd_axial": 0.008, "ca_normal": 1.0},
+            ],
+        }
+    ],
+}  # fmt: skip
 
 
 def line_document(name: str, seabed_damping: float | None = None) -> dict:
-    """The scene document of a benchmark line (seabed damping overridden if given)."""
-    if name == "chain":
+    """The scene document of a benchmark line (seabed damping overridden if given):
+    ``chain``, ``taut``, ``deep``, ``twoseg`` (chain on the bed, synthetic rope to the
+    fairlead) or ``current`` (the chain in the example's 0.5 m/s current)."""
+    if name in ("chain", "current"):  # "current": the example keeps its 0.5 m/s current
         doc = load_example("chain_catenary").model_dump(mode="json", exclude_none=True)
+        if name == "chain":
+            doc["environment"]["current"] = []
     else:
-        doc = json.loads(json.dumps({"taut": TAUT, "deep": DEEP}[name]))
+        doc = json.loads(json.dumps({"taut": TAUT, "deep": DEEP, "twoseg": TWO_SEGMENT}[name]))
     if seabed_damping is not None:
         doc["environment"]["seabed"] = dict(doc["environment"]["seabed"], damping=seabed_damping)
     return doc
@@ -159,10 +185,31 @@ def run_key(run: dict) -> str:
     return json.dumps(run, sort_keys=True)
 
 
-def execute(run: dict) -> dict:
-    """One simulation: σ over the measured period, static tensions, wall time."""
+def run_scene(run: dict):
+    """The scene a run simulates: :func:`comparison_scene` of the line at the run's
+    element count (a line of several segments: the count shared in proportion to their
+    lengths; a line with a current: the current kept, which comparison_scene drops)."""
     doc = line_document(run["line"], run.get("cbot"))
-    sc = comparison_scene(doc, elements=run["elements"])
+    segs = doc["lines"][0]["segments"]
+    if len(segs) == 1 and not (doc["environment"].get("current") and run["sim"] == "reference"):
+        return comparison_scene(doc, elements=run["elements"])
+    total = sum(sg["length"] for sg in segs)
+    for sg in segs:
+        sg["elements"] = max(1, round(run["elements"] * sg["length"] / total))
+    ln = doc["lines"][0]
+    for end in ("end_a", "end_b"):
+        ln[end].pop("motion", None)
+    doc.pop("sea", None)
+    doc.setdefault("analysis", {}).pop("timeseries", None)
+    doc["analysis"].pop("fidelity", None)
+    if run["sim"] == "moordyn":
+        doc["environment"]["current"] = []  # (not reached: no MoorDyn run with a current)
+    return load_scene(doc)
+
+
+def simulate(run: dict):
+    """One simulation: the end-tension history, the motion and the wall time [s]."""
+    sc = run_scene(run)
     motion = periodic_dsa_surge(
         lambda w: spectrum_pierson_moskowitz(w, HS, TP), PERIOD, BAND, run["seed"]
     )
@@ -188,7 +235,11 @@ def execute(run: dict) -> dict:
             internal_damping=run.get("ba", 0.0),
             scheme=run.get("scheme", "RK4"),
         )
-    wall = time.perf_counter() - t0
+    return h, motion, ba, time.perf_counter() - t0
+
+
+def summarize(h, motion, ba: float, wall: float) -> dict:
+    """σ over the measured period, static tensions, wall time of one simulation."""
     sig, xs = window_std(h, PERIOD, 2 * PERIOD)
     return {
         **sig,
@@ -199,6 +250,11 @@ def execute(run: dict) -> dict:
         "ba_ns": ba,
         "wall": wall,
     }
+
+
+def execute(run: dict) -> dict:
+    """One simulation: σ over the measured period, static tensions, wall time."""
+    return summarize(*simulate(run))
 
 
 def load_cache(path: Path) -> dict:

@@ -16,6 +16,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from service.residual_schemas import ResidualParts
 from stochcable.scene import model as sc
 from stochcable.scene.model import G_STANDARD, OmegaGrid, Spectrum, TimeSeriesSettings
 
@@ -355,8 +356,9 @@ class LineModes(_Open):
     )
 
 
-class LineDocument(_Open):
-    """Frequency-domain response of one line: statistics, distributions, spectra."""
+class LineDocument(ResidualParts):
+    """Frequency-domain response of one line: statistics, distributions, spectra; with
+    the residuals of the linear model by default (the end statistics carry them)."""
 
     end_a: EndResult
     end_b: EndResult
@@ -372,6 +374,10 @@ class LineDocument(_Open):
     )
     linearization: LineLinearization | None = None
     modes: LineModes | None = None
+    linear: dict[str, EndResult] | None = Field(
+        default=None, description="The linear model's end statistics where a residual was "
+        "computed {end_a: {tension}, end_b: ...} (end_a and end_b carry the residuals)"
+    )  # fmt: skip
 
 
 class ModesSummary(_Open):

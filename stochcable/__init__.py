@@ -35,10 +35,27 @@ _LAZY = {
 
 def __getattr__(name: str):
     if name in _LAZY:
+        import gc
         import importlib
 
         module, attr = _LAZY[name]
-        value = getattr(importlib.import_module(f".{module}", __name__), attr)
+        # no cyclic garbage collection while the pipeline imports: its ~800 modules
+        # (NumPy, SciPy, pydantic and ours) leave ~50,000 tracked objects that live as
+        # long as the process, and the collector traversed them ~130 times (20–40 ms
+        # of the first analysis, docs/benchmarks/first_analysis.md).  After it, they
+        # join the oldest generation as if they had survived (freeze then unfreeze,
+        # unless the process keeps objects frozen itself) rather than being traversed
+        # by the next young collections; the collector's state is restored.
+        enabled = gc.isenabled()
+        gc.disable()
+        try:
+            value = getattr(importlib.import_module(f".{module}", __name__), attr)
+        finally:
+            if gc.get_freeze_count() == 0:
+                gc.freeze()
+                gc.unfreeze()
+            if enabled:
+                gc.enable()
         globals()[name] = value
         return value
     raise AttributeError(f"module 'stochcable' has no attribute {name!r}")

@@ -11,6 +11,12 @@ from stochcable.examples import load_example
 from stochcable.reference.cable import simulate_line_timedomain
 from stochcable.scene.model import load_scene
 
+#: ``analysis.linearization`` switches of the linear model alone (the residuals of
+#: stochcable.scene.residual_kinds are on by default since issue 31): for tests of the
+#: linear model's own properties (two solvers, closed forms, a line on a body against
+#: the same line alone, conservation), which the residuals' closed forms do not share.
+LINEAR_ONLY = {"drag_residual": False, "geometric_residual": False}
+
 
 def three_chain_legs(n_el: int, attach: str | None = None) -> list[dict]:
     """Three 330 m chain legs (EA 5e8 N, 100 kg/m, D 0.1 m) at 0/120/240° from anchors

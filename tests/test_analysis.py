@@ -11,6 +11,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _scenes import LINEAR_ONLY
 
 from stochcable import analysis
 from stochcable.dynamics.groups import line_fixed_point as dfixedpoint
@@ -286,6 +287,8 @@ def test_dsa_timeseries_variance_equals_spectrum_sum():
 
 def test_planar_scene_in_3d_equals_2d_and_has_no_out_of_plane_motion():
     doc = chain_doc(elements=16, omega_count=40)
+    # the linear model: the drag residual is computed on the planar model only
+    doc["analysis"]["linearization"] = LINEAR_ONLY
     scene, sys2, chans = system_and_channels(doc, dim=2)
     _, sys3, _ = system_and_channels(doc, dim=3)
     # all modes in both (auto would truncate the 45-DOF 3-D model but not the 2-D one)

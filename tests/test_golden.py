@@ -40,6 +40,15 @@ def test_golden_documents_unchanged(case: str, tmp_path: Path) -> None:
     assert_close_documents(got, expected)
 
 
+@pytest.mark.parametrize("case", sorted(record.cases()))
+def test_switches_off_reproduce_the_linear_record(case: str, tmp_path: Path) -> None:
+    """Both residual switches false (the defaults before issue 31): the documents the
+    linear model recorded before the flip (golden/linear), to the same 1e-10."""
+    expected = _without_clock(record.load(case, record.LINEAR))
+    got = _without_clock(record.compute(record.linear(record.cases()[case]), tmp_path))
+    assert_close_documents(got, expected)
+
+
 # ------------------------------------------- single lines: the one drag fixed point
 
 #: The single-line cases were re-recorded when a line became the group of one line
@@ -116,7 +125,7 @@ def test_single_lines_agree_with_the_pre_unification_record(case: str) -> None:
 
     with gzip.open(PRE_UNIFICATION / f"{case}.json.gz", "rt") as f:
         old = _without_clock(json.load(f))
-    new = _without_clock(record.load(case))
+    new = _without_clock(record.load(case, record.LINEAR))  # (the linear model's)
     assert_close_documents(new["statics"], old["statics"])
     if any(ln.get("touchdown") is not None for ln in new["statics"]["statics"]["lines"].values()):
         # the linear model of a line with a touchdown changed after this record: the

@@ -207,8 +207,13 @@ def test_tension_to_zero_at_the_anchor_end_flags_snap():
     assert snap and "at element 1 (" in snap[0], [str(w_.message) for w_ in caught]
     # ... and not at the taut 480 m line
     assert "snap" not in taut.lines["l"].indicators.flags
-    # the fairlead tension σ hardly notices (the hanging part is the same 90 m)
-    assert line.end_b.std == pytest.approx(taut.lines["l"].end_b.std, rel=0.2)
+    # the linear model's fairlead tension σ hardly notices (the hanging part is the
+    # same 90 m); the residuals' first-order closed forms, out of their depth on a
+    # slack line, do not (corrected/linear σ 2.7 at 480 m, 78 at 488 m), so the
+    # linear σ are compared
+    assert line.linear_end("end_b").std == pytest.approx(
+        taut.lines["l"].linear_end("end_b").std, rel=0.2
+    )
 
 
 def test_nearly_vertical_tether():
@@ -515,10 +520,29 @@ def test_log_grid_from_1e_minus_4_to_1e2():
     # no sea energy at either end: the tension spectrum vanishes there
     s = line.end_tension_spectrum("end_b")
     assert s[0] < 1e-12 * s.max() and s[-1] < 1e-12 * s.max()
-    # the log grid gives the same σ as a fine linear grid over the sea's band (the
-    # trapezoid on 120 log points: 2 %)
+    # the log grid gives the same linear σ as a fine linear grid over the sea's band
+    # (the trapezoid on 120 log points: 2 %); the residuals: see the next test
     ref = analyze(chain(elements=16, omega={"min": 0.1, "max": 3.0, "count": 300})).lines["l"]
-    assert line.end_b.std == pytest.approx(ref.end_b.std, rel=0.02)
+    assert line.linear_end("end_b").std == pytest.approx(ref.linear_end("end_b").std, rel=0.02)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 31: the drag residual on a log grid is 43 % below the linear grid's "
+    "(fairlead variance 2.80e4 against 4.89e4 N² on this chain; the linear σ agree to "
+    "0.1 %): its variance lines assume a uniform analysis grid",
+)
+def test_the_drag_residual_on_a_log_grid_equals_a_linear_grids():
+    """The drag residual's fairlead variance on the log grid above and on a fine linear
+    grid over the sea's band: within 5 % (the linear σ² agree to 0.2 %, the residual
+    is a smooth functional of the same response)."""
+    log = {"min": 1e-4, "max": 1e2, "count": 120, "spacing": "log"}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ResolutionWarning)
+        got = analyze(chain(elements=16, omega=log)).lines["l"]
+    ref = analyze(chain(elements=16, omega={"min": 0.1, "max": 3.0, "count": 300})).lines["l"]
+    v = got.drag_residual.as_dict()["end_b"]["variance"]
+    assert v == pytest.approx(ref.drag_residual.as_dict()["end_b"]["variance"], rel=0.05)
 
 
 # ---------------------------------------------------------------------- time series

@@ -92,5 +92,7 @@ def test_dynamic_tension_sigma_matches_moorpy_within_discretization():
         omega, s_surge, rao_a, rao_b, DEPTH, K_BED * DIAMETER * ds, C_BED * DIAMETER * ds, tol=1e-4
     )
     t_std = out[2]
-    assert res.end_a.std == pytest.approx(float(t_std[0]), rel=0.03)
-    assert res.end_b.std == pytest.approx(float(t_std[-1]), rel=0.03)
+    # MoorPy's frequency domain is a linear model: our linear model's σ is compared
+    # (the default's carry the residuals: +4.7 % fairlead, +8.1 % anchor here)
+    assert res.linear_end("end_a").std == pytest.approx(float(t_std[0]), rel=0.03)
+    assert res.linear_end("end_b").std == pytest.approx(float(t_std[-1]), rel=0.03)

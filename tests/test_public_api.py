@@ -60,20 +60,48 @@ def test_import_is_light():
     assert out.stdout.strip() == "False"
 
 
-def test_the_first_analysis_imports_what_the_scene_uses():
+def test_lazy_entry_points_leave_the_collector_as_they_found_it():
+    # the lazy import runs without cyclic garbage collection, then restores it; its
+    # ~50,000 objects join the oldest generation (otherwise the young ones hold them
+    # until collections traverse them), nothing stays frozen, and objects the process
+    # froze itself stay frozen
+    code = (
+        "import gc, stochcable; stochcable.build_engine; on = gc.isenabled(); "
+        "young = sum(len(gc.get_objects(generation=g)) for g in (0, 1)); "
+        "frozen = gc.get_freeze_count(); gc.disable(); "
+        "x = [[] for _ in range(100)]; gc.freeze(); n = gc.get_freeze_count(); "
+        "stochcable.analyze; print(on, gc.isenabled(), young < 1000, frozen, "
+        "gc.get_freeze_count() == n > 0)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "False", "True", "0", "True"]
+
+
+_FIRST_ANALYSIS = """
+import json, sys, warnings
+warnings.simplefilter("ignore")
+import stochcable
+scene = json.load(open("stochcable/examples/chain_catenary.json"))
+scene["analysis"]["linearization"].update(drag_residual={on}, geometric_residual={on})
+stochcable.analyze(scene)
+print(json.dumps(sorted(m for m in {heavy!r} if m in sys.modules)))
+"""
+
+
+@pytest.mark.parametrize("residuals", [False, True], ids=["residuals_off", "residuals_on"])
+def test_the_first_analysis_imports_what_the_scene_uses(residuals):
     # the chain (current: strumming screening; no fidelity target, no bodies' fits):
     # its candidate modes are proven without a lock-in start by the NumPy bound and its
     # grids are below the compiled kernels' threshold, so numba is not loaded, nor the
-    # fidelity planner (its element check, fidelity.mesh_check, is) or scipy.optimize,
-    # and its 2,400-sample record is transformed by
-    # numpy.fft, not pyfftw (docs/benchmarks/first_analysis.md)
-    code = (
-        "import sys, warnings; warnings.simplefilter('ignore'); import stochcable; "
-        "stochcable.analyze('stochcable/examples/chain_catenary.json'); "
-        "print(sorted(m for m in ('numba', 'pyfftw', 'stochcable.fidelity.planner', "
-        "'scipy.optimize') "
-        "if m in sys.modules))"
-    )
+    # fidelity planner (its element check, fidelity.mesh_check, is) or scipy.optimize;
+    # its 2,400-sample record is transformed by numpy.fft, not pyfftw (nor xarray,
+    # pandas); the drag formulas' erf is math.erf and the residuals' FFT length needs
+    # no scipy.fft, so scipy.special (~25 ms of import) is not loaded either, with the
+    # residual switches on or off (docs/benchmarks/first_analysis.md)
+    heavy = ("numba", "pyfftw", "xarray", "pandas", "matplotlib", "scipy.special", "scipy.fft")
+    heavy += ("scipy.optimize", "scipy.stats", "scipy.sparse.linalg", "stochcable.fidelity.planner")
+    code = _FIRST_ANALYSIS.format(on=residuals, heavy=heavy)
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
     out = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=root

@@ -342,6 +342,18 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "or ``stochcable.line.transport.modes.complex_modes``. See :doc:`../travelling`.",
     ),
     WarningEntry(
+        "Coupled modes of a travelling line on a body",
+        "PhysicsWarning",
+        ("stochcable.line.transport.matrices:check_travelling_lines",),
+        "a line with ``axial_speed`` ≠ 0 has an end attached to a body",
+        "The coupled modes of lines and bodies (``bodies.<name>.modes``) solve the "
+        "symmetric problem with the line's centripetal stiffness K + K_c but without "
+        "its gyroscopic matrix G; the coupled response (the line's direct solve) has "
+        "both.",
+        "Read the line's complex modes with its ends held from ``stochcable modes``. "
+        "See :doc:`../travelling`.",
+    ),
+    WarningEntry(
         "Strumming lock-in (or resonance) predicted",
         "PhysicsWarning",
         ("stochcable.dynamics.model.strumming:with_strumming",),

@@ -170,7 +170,13 @@ def end_condensation(
 def _fe_condensation(
     ls: Any, env: Any, ends: list[str], comps: list[int]
 ) -> tuple[np.ndarray, np.ndarray]:
-    """K_e and S of :func:`end_condensation` for an FE-solved line."""
+    """K_e and S of :func:`end_condensation` for an FE-solved line.
+
+    Besides the FE tangent, the vertical derivative of the weight of the elements
+    that cross the water surface (their wet fraction moves with their end heights,
+    the term of the statics' own tangent, :class:`stochcable.line.equilibrium.StaticsModel`):
+    without it the stiffness of a float piercing the surface was a tenth of the true
+    one and the body Newton of a float on a tether stalled."""
     c = len(comps)
     mesh = ls.mesh
     n = mesh.n_nodes
@@ -183,12 +189,27 @@ def _fe_condensation(
     diag = np.zeros((n, c, c))
     diag[:-1] += k
     diag[1:] += k
+    upper, lower = -k, -k.copy()  # K[i, i+1] and K[i+1, i] of element i
     trib = np.zeros(n)
     half = 0.5 * mesh.diameter * mesh.l0
     trib[:-1] += half
     trib[1:] += half
     zc = comps.index(2)
     diag[:, zc, zc] += env.seabed.stiffness * np.where(ls.grounded, trib, 0.0)
+    z = np.asarray(ls.positions, dtype=float)[:, 2]
+    za, zb = z[:-1], z[1:]
+    mixed = (np.minimum(za, zb) < 0.0) & (np.maximum(za, zb) > 0.0)
+    if mixed.any():
+        # W = l0 (w_dry + f (w_sub − w_dry)), f = −min(za, zb)/|zb − za| lumped half
+        # to each node: −dR/dz as in StaticsModel._tangent
+        dz = np.where(mixed, zb - za, 1.0)
+        dw = 0.5 * mesh.l0 * (mesh.weight - mesh.mass * env.g)
+        dwa = dw * np.where(mixed, np.where(za < zb, -zb, zb) / dz**2, 0.0)
+        dwb = dw * np.where(mixed, np.where(za < zb, za, -za) / dz**2, 0.0)
+        diag[:-1, zc, zc] += dwa
+        diag[1:, zc, zc] += dwb
+        upper[:, zc, zc] += dwb
+        lower[:, zc, zc] += dwa
     node = {"end_a": 0, "end_b": n - 1}
     ne = len(ends)
     kbb = np.zeros((ne * c, ne * c))
@@ -197,25 +218,28 @@ def _fe_condensation(
     nf = n - 2
     if nf == 0:
         if ne == 2:
-            kbb[:c, c:] = -k[0]
-            kbb[c:, :c] = -k[0]
+            kbb[:c, c:] = upper[0]
+            kbb[c:, :c] = lower[0]
         return kbb, np.zeros((0, ne * c))
-    # K_fb: the element next to each end couples it to its neighbour node
+    # K_fb and K_bf: the element next to each end couples it to its neighbour node
     kfb = np.zeros((nf * c, ne * c))
+    kbf = np.zeros((ne * c, nf * c))
     for p_, e in enumerate(ends):
         if e == "end_a":
-            kfb[:c, p_ * c : (p_ + 1) * c] = -k[0]
+            kfb[:c, p_ * c : (p_ + 1) * c] = lower[0]
+            kbf[p_ * c : (p_ + 1) * c, :c] = upper[0]
         else:
-            kfb[(nf - 1) * c :, p_ * c : (p_ + 1) * c] = -k[-1]
+            kfb[(nf - 1) * c :, p_ * c : (p_ + 1) * c] = upper[-1]
+            kbf[p_ * c : (p_ + 1) * c, (nf - 1) * c :] = lower[-1]
     bw = 2 * c - 1
     rows, cols = block_band_indices(nf, c)
     ab = np.zeros((3 * bw + 1, nf * c), order="F")  # gbsv's layout (banded_solve)
-    # diagonal blocks of the interior nodes, then the couplings −k_i (i = 1 … n−3)
+    # diagonal blocks of the interior nodes, then the couplings of elements 1 … n−3
     ab[rows + bw, cols] = np.concatenate(
-        [diag[1:-1].ravel(), (-k[1:-1]).ravel(), (-k[1:-1]).ravel()]
+        [diag[1:-1].ravel(), upper[1:-1].ravel(), lower[1:-1].ravel()]
     )
     S = banded_solve(ab, kfb, bw)
-    return kbb - kfb.T @ S, S
+    return kbb - kbf @ S, S
 
 
 def pose_map(poses: dict[str, np.ndarray]) -> dict[str, tuple[np.ndarray, np.ndarray]]:

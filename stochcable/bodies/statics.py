@@ -44,6 +44,7 @@ from stochcable.bodies.rigid import (
     PLANAR_INDEX,
     SPATIAL_DOFS,
 )
+from stochcable.bodies.start import bar_start_poses
 from stochcable.bodies.static_loads import _cross3, _full, _reduce, body_static_load
 from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.mesh import mesh_line
@@ -165,16 +166,20 @@ def solve_body_statics(
         b.name: np.concatenate([np.asarray(b.position, float), np.zeros(3)]) for b in scene.bodies
     }
     fixed = pb.fixed_lines(poses)
-    state = pb.first_state(poses, fixed)
-    if pb.free and pb.sel.size:
-        _check_determined(state.K, pb.sel, pb.active, pb.free, pb.d, pb.planar, pb.lref, pb.dofs)
-    it = 0
-    while state.r > body_tolerance and it < max_body_iterations and pb.sel.size:
-        it += 1
-        trial = _newton_step(pb, fixed, state)
-        if trial is None:
-            break
-        state = trial
+    try:
+        state, it, stalled = _solve_poses(pb, fixed, poses, body_tolerance, max_body_iterations)
+    except (ConvergenceError, InputError) as exc:
+        # the lines cannot be solved at the input poses: from the bar model's poses
+        retry = _from_bar_start(pb, fixed, poses, body_tolerance, max_body_iterations)
+        if retry is None:
+            raise exc from None
+        state, it, stalled = retry
+    else:
+        if stalled:
+            # no Newton step lowers the residual: once more from the bar model's poses
+            retry = _from_bar_start(pb, fixed, poses, body_tolerance, max_body_iterations)
+            if retry is not None and retry[0].r < state.r:
+                state, it, stalled = retry
     if state.r > body_tolerance:
         raise ConvergenceError(
             "body statics Newton",
@@ -192,6 +197,48 @@ def solve_body_statics(
         )
     lines = {**fixed, **state.lines}
     return {ln.name: lines[ln.name] for ln in scene.lines}, pb.results(state, it)
+
+
+def _solve_poses(
+    pb: _BodyPoses,
+    fixed: dict[str, Any],
+    poses: dict[str, np.ndarray],
+    body_tolerance: float,
+    max_body_iterations: int,
+) -> tuple[_State, int, bool]:
+    """The Newton from ``poses``: its last state, iteration count and whether it
+    stalled (no step accepted) short of the tolerance."""
+    state = pb.first_state(poses, fixed)
+    if pb.free and pb.sel.size:
+        _check_determined(state.K, pb.sel, pb.active, pb.free, pb.d, pb.planar, pb.lref, pb.dofs)
+    it = 0
+    while state.r > body_tolerance and it < max_body_iterations and pb.sel.size:
+        it += 1
+        trial = _newton_step(pb, fixed, state)
+        if trial is None:
+            return state, it, True
+        state = trial
+    return state, it, False
+
+
+def _from_bar_start(
+    pb: _BodyPoses,
+    fixed: dict[str, Any],
+    poses: dict[str, np.ndarray],
+    body_tolerance: float,
+    max_body_iterations: int,
+) -> tuple[_State, int, bool] | None:
+    """The Newton from the straight-bar model's poses (:mod:`stochcable.bodies.start`),
+    or None when that start is the input or the lines cannot be solved there either."""
+    if not pb.free or not pb.sel.size:
+        return None
+    start = bar_start_poses(pb.scene, poses, pb.free, pb.meshes, pb.rigid)
+    if all(np.array_equal(start[nm], poses[nm]) for nm in pb.free):
+        return None
+    try:
+        return _solve_poses(pb, fixed, start, body_tolerance, max_body_iterations)
+    except (ConvergenceError, InputError):
+        return None
 
 
 @dataclass(frozen=True, eq=False)

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.errors import InputError
+from stochcable.scene.residual_kinds import RESIDUAL_KINDS
 
 __all__ = [
     "to_jsonable",
@@ -22,6 +23,7 @@ __all__ = [
     "read_json_file",
     "output_format",
     "write_summary",
+    "residuals_included",
     "write_netcdf_document",
 ]
 
@@ -148,13 +150,23 @@ def _g(x: Any) -> str:
     return "-" if x is None else f"{float(x):.4g}"
 
 
+def residuals_included(doc: Mapping[str, Any]) -> tuple[str, ...]:
+    """The residual kinds a result document's end statistics carry (computed on some
+    line), in registry order."""
+    lines = doc["lines"].values()
+    return tuple(
+        k for k in RESIDUAL_KINDS if any((ln.get(k) or {}).get("computed") for ln in lines)
+    )
+
+
 def write_summary(
     doc: Mapping[str, Any], output: str | None, title: str = "", plots: Any = ()
 ) -> None:
     """Print the summary of a result document a person reads (rich tables).
 
     Per line and end the tension statistics (mean, σ, Tz, 3-hour most probable
-    maximum), the largest motion σ along each line, the bodies' motion, the drag
+    maximum; with the residuals of the linear model, a line saying so and the linear
+    σ beside), the largest motion σ along each line, the bodies' motion, the drag
     linearization, the warnings (each once) and the figures written.
     """
     from rich.console import Console
@@ -173,14 +185,22 @@ def write_summary(
             f"drag linearization: {state} in {lin['iterations']} iterations "
             f"(last relative change {lin['relative_change']:.2e})"
         )
+        kinds = residuals_included(doc)
         table = Table(title=escape(f"end tension [{f}]; Tz [s]"))
-        for col in ("line", "end", "mean", "σ", "Tz", "MPM 3 h"):
+        for col in ("line", "end", "mean", "σ", "Tz", "MPM 3 h") + (("linear σ",) if kinds else ()):
             table.add_column(col, justify="left" if col in ("line", "end") else "right")
         for name, line in doc["lines"].items():
             for end in ("end_a", "end_b"):
-                t = line[end]["tension"]
-                table.add_row(name, end, _g(t["mean"]), _g(t["std"]), _g(t["tz"]), _g(t["mpm_3h"]))
+                t, lin = line[end]["tension"], (line.get("linear") or {}).get(end)
+                row = [_g(t["mean"]), _g(t["std"]), _g(t["tz"]), _g(t["mpm_3h"])]
+                row += [_g(lin and lin["tension"]["std"])] if kinds else []
+                table.add_row(name, end, *row)
         console.print(table)
+        if kinds:
+            console.print(
+                f"the end tensions include the residuals of the linear model "
+                f"({', '.join(kinds)}); linear σ: the linear model alone"
+            )
         table = Table(title=escape(f"largest motion σ along each line [{ln}]"))
         for col in ("line", "σx", "σy", "σz", "iterations", "converged"):
             table.add_column(col, justify="left" if col == "line" else "right")

@@ -48,6 +48,7 @@ def write_moordyn(
     ic_tmax: float = 300.0,
     scheme: str = "RK4",
     static_positions: bool = True,
+    ic_dynamic: bool = False,
 ) -> str:
     """The MoorDyn v2 input file of a scene.
 
@@ -72,6 +73,11 @@ def write_moordyn(
     static_positions : bool, default True
         Place the free points at stochcable's static solution (else on the straight
         line between the ends); MoorDyn starts its own solve from them.
+    ic_dynamic : bool, default False
+        ``ICgenDynamic 1``: MoorDyn's initial conditions by dynamic relaxation (drag
+        scaled by ``ICDfac``, converged when the fairlead tensions change by less than
+        ``threshIC``) instead of its stationary solver (MoorDyn-C 2.x's default, whose
+        relaxation of a long grounded chain is slow: docs/manual/moordyn.md).
 
     Returns
     -------
@@ -110,6 +116,7 @@ def write_moordyn(
         f"{scheme} tScheme",
         f"{_f(ic_threshold)} threshIC",
         f"{_f(ic_tmax)} TmaxIC",
+        *(["1 ICgenDynamic"] if ic_dynamic else []),
         "0 writeLog",
         "1 disableOutput",
     ]

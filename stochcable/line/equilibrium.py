@@ -3,7 +3,8 @@
 
 :class:`LocalFrame` is the line's local frame (planar problems with two DOFs per
 node); :class:`StaticsModel` the nodal residual forces of the 2-node elastic bars with
-their lumped loads (weight by wet fraction, attachments, current drag, seabed springs)
+their lumped loads (weight by wet fraction, attachments, current drag and lift, seabed
+springs)
 and the exact banded tangent; :class:`StaticsSolver` Newton–Raphson with a
 backtracking line search, falling back to the viscous relaxation of Tuah (1982), eqs.
 4.1.5–4.1.8.  The model is described in :func:`stochcable.line.statics.solve_line_statics`.
@@ -22,6 +23,7 @@ from scipy.linalg import LinAlgError
 
 from stochcable.line.banded import banded_solve, block_band_indices
 from stochcable.line.mesh import LineMesh
+from stochcable.line.transport.relative_flow import steady_lift_force
 from stochcable.scene.model import Environment
 
 __all__ = ["SLACK_FACTOR", "LocalFrame", "StaticsModel", "StaticsSolver", "reference_force"]
@@ -117,8 +119,14 @@ class StaticsModel:
         self.c_node = 0.5 * env.rho * mesh.node_drag_area
         # a travelling line: its axial drag acts on the relative axial velocity u_t − c
         self.speed = float(mesh.axial_speed)
+        # the steady lift of the relative flow (3-D only: planar, it is zero)
+        cl = mesh.cl_steady
+        self.has_lift = self.has_current and dim == 3 and cl is not None and bool(cl.any())
+        if self.has_lift:
+            self.c_l = 0.5 * env.rho * cl * mesh.diameter
         coefs = np.concatenate([self.c_n, self.c_t, self.c_node])
         self.has_drag = (self.has_current or self.speed != 0.0) and bool((coefs > 0).any())
+        self.has_drag = self.has_drag or self.has_lift
         # load-stepping factor of the drag (1 = full current)
         self.beta = 1.0
         self._band_index()
@@ -239,6 +247,8 @@ class StaticsModel:
             # relative axial velocity of the water past the travelling line (wet part)
             rel = ua - self.speed * (0.5 * (za + zb) <= 0.0)
             g = (self.c_n * unn)[:, None] * un + (self.c_t * np.abs(rel) * rel)[:, None] * e
+            if self.has_lift:  # docs/travelling.md
+                g = g + steady_lift_force(e, u, ua - rel, self.c_l)
             Fd = beta * l[:, None] * g
             R[:-1] += 0.5 * Fd
             R[1:] += 0.5 * Fd
@@ -304,6 +314,8 @@ class StaticsModel:
             dg = -self.c_n[:, None, None] * (A @ B) + (self.c_t * np.abs(rel))[:, None, None] * (
                 2.0 * e[:, :, None] * u[:, None, :] + rel[:, None, None] * I
             )
+            if self.has_lift:
+                dg = dg + self._lift_jacobian(e, u, ua - rel)
             D = beta * (g[:, :, None] * e[:, None, :] + dg @ (I - ee))
             Kd[:-1] += 0.5 * D
             Kd[1:] -= 0.5 * D
@@ -319,6 +331,19 @@ class StaticsModel:
         # nodes resting exactly on the bed get the contact stiffness too
         Kd[:, zi, zi] += np.where(pen >= 0.0, self.kb, 0.0)
         return Kd, Ku, Kl
+
+    def _lift_jacobian(self, e: np.ndarray, u: np.ndarray, speed: np.ndarray) -> np.ndarray:
+        """∂f_L/∂e (n_el, 3, 3) by central differences (a tangent: the residual is
+        exact)."""
+        h = 1e-6
+        jac = np.empty(e.shape + (3,))
+        for k in range(3):
+            de = np.zeros(3)
+            de[k] = h
+            fp = steady_lift_force(e + de, u, speed, self.c_l)
+            fm = steady_lift_force(e - de, u, speed, self.c_l)
+            jac[:, :, k] = (fp - fm) / (2.0 * h)
+        return jac
 
     def band(self, K: tuple, lam: float) -> np.ndarray:
         """The free–free tangent (+ the relaxation λ) in the layout of

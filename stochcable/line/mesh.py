@@ -46,6 +46,8 @@ class LineMesh:
         Hydrodynamic diameter. [m]
     cd_normal, cd_axial, ca_normal : ndarray, shape (n_el,)
         Normal drag (on D), axial drag (on πD) and normal added-mass coefficients. [-]
+    cl_steady : ndarray, shape (n_el,) or None
+        Steady lift coefficient on D and |V_r|² (docs/travelling.md); None: 0. [-]
     weight : ndarray, shape (n_el,)
         Net submerged weight per unit length, positive downward. [N/m]
     segment : ndarray of int, shape (n_el,)
@@ -82,6 +84,7 @@ class LineMesh:
     end_a: np.ndarray
     end_b: np.ndarray
     axial_speed: float = 0.0
+    cl_steady: np.ndarray | None = None
 
     @property
     def n_nodes(self) -> int:
@@ -180,4 +183,5 @@ def mesh_line(line: Line, rho: float, g: float) -> LineMesh:
         end_a=np.asarray(line.end_a.position, dtype=float),
         end_b=np.asarray(line.end_b.position, dtype=float),
         axial_speed=float(line.axial_speed),
+        cl_steady=per_el("cl_steady") if any(sg.cl_steady for sg in segs) else None,
     )

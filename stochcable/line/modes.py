@@ -37,7 +37,6 @@ from typing import Any, Literal
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from stochcable.errors import InputError, PhysicsWarning, SolverError, warn
 from stochcable.line.fem import FEModel
@@ -241,6 +240,8 @@ def _shift(a: sp.csr_array, b: sp.csr_array) -> float:
 
 
 def _banded_opinv(a: sp.csr_array, b: sp.csr_array, sigma: float, u: int) -> Any:
+    import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
     from stochcable.line.fem import _to_upper_banded
 
     ab = _to_upper_banded((a - sigma * b).tocsr(), u)
@@ -256,6 +257,8 @@ def _banded_opinv(a: sp.csr_array, b: sp.csr_array, sigma: float, u: int) -> Any
 def _solve_lanczos(
     a: sp.csr_array, b: sp.csr_array, k: int, method: str, u: int
 ) -> tuple[np.ndarray, np.ndarray]:
+    import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
     n = a.shape[0]
     sigma = _shift(a, b)
     kk = min(k + 2, n - 1)  # two beyond the request: a gap for the Sturm check
@@ -286,6 +289,8 @@ class _SturmMismatch(Exception):
 
 def _count_below(a: sp.csr_array, b: sp.csr_array, theta: float) -> int:
     """Number of eigenvalues of (A, B) below theta: negative pivots of LDLᵀ(A − θB)."""
+    import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
     s = (a - theta * b).tocsc()
     lu = spla.splu(s, permc_spec="NATURAL", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
     if not (
@@ -303,6 +308,8 @@ def _solve_block(a, b, k, method, u):
     if method == "dense" or k >= n - 2:
         lam, vec = _solve_dense(a, b, k)
         return lam, vec, "dense"
+    import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
     try:
         lam, vec = _solve_lanczos(a, b, k, method, u)
         return lam, vec, method

@@ -366,6 +366,8 @@ def solve_fe(
         X0 = initial_guess(mesh, env, frame, model)
     X0[0] = frame.to_local(mesh.end_a[None, :])[0]
     X0[-1] = frame.to_local(mesh.end_b[None, :])[0]
+    if model.has_lift and initial is None:
+        X0 = _start_in_resultant_plane(model, X0)
     solver = StaticsSolver(model, tol, budget)
     # with current, a first attempt at full load gets a quarter of the budget; the
     # rest goes to load stepping of the drag from the equilibrium without current
@@ -395,6 +397,31 @@ def solve_fe(
             partial=frame.to_global(X),
         )
     return _fe_result(mesh, env, frame, model, X, solver.used, r)
+
+
+def _start_in_resultant_plane(model: StaticsModel, X0: np.ndarray) -> np.ndarray:
+    """The start turned about its chord into the plane of the resultant of the weight
+    and the flow loads (drag and lift) on it: a lift that exceeds the weight puts the
+    equilibrium above the chord, where Newton from the hanging start does not get
+    (docs/travelling.md).  Unchanged when the line touches the seabed or its chord is
+    within 25° of vertical."""
+    from scipy.spatial.transform import Rotation  # only lines with lift
+
+    a, b = X0[0], X0[-1]
+    chord = (b - a) / np.linalg.norm(b - a)
+    down = np.array([0.0, 0.0, -1.0]) - chord[2] * chord
+    if np.linalg.norm(down) < math.sin(math.radians(25.0)) or np.any(X0[:, 2] <= model.zbed):
+        return X0
+    st = model._residual(X0)
+    w = np.where(0.5 * (X0[:-1, 2] + X0[1:, 2]) <= 0.0, model.w_sub, model.w_dry)
+    res = (st["l"][:, None] * st["g"]).sum(axis=0) - np.array([0.0, 0.0, float(w @ model.l0)])
+    res = res - (res @ chord) * chord
+    if np.linalg.norm(res) <= 0.0:
+        return X0
+    down /= np.linalg.norm(down)
+    angle = math.atan2(float(np.cross(down, res) @ chord), float(down @ res))
+    rot = Rotation.from_rotvec(angle * chord).as_matrix()
+    return a + (X0 - a) @ rot.T
 
 
 def _drag_stepping(

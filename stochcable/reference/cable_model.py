@@ -71,7 +71,7 @@ from scipy import sparse
 
 from stochcable.errors import ConvergenceError
 from stochcable.line.mesh import LineMesh
-from stochcable.reference.cable_transport import transport_terms
+from stochcable.reference.cable_transport import lift_nodal_forces, transport_terms
 from stochcable.scene.model import Environment, Line, Scene
 from stochcable.statics import solve_statics
 
@@ -388,6 +388,11 @@ class LineModel:
                 # block (a, c) = l0 Σ_g w_g N_a N_c J_g
                 blk = np.einsum("gac,egij->eaicj", self._gauss_wNN, J)
                 c_el = self.l0[:, None, None] * blk.reshape(self.ne, 2 * d, 2 * d)
+        lift = lift_nodal_forces(  # the steady lift of the relative flow (cl_steady)
+            self, e, u_gauss - self.gauss_points(V) - self.speed * e[:, None, :]
+        )
+        if lift is not None:
+            F += lift
         c_nd = np.zeros((self.n, d, d)) if jacobian else None
         if np.any(self.node_cda):
             vr = u_fluid - V

@@ -52,8 +52,9 @@ import scipy.sparse as sp
 from stochcable.errors import InputError
 from stochcable.line.elements import STIFFNESS_PATTERN, expand_blocks
 from stochcable.line.transport.matrices import GYRO_PATTERN
+from stochcable.line.transport.relative_flow import steady_lift_force
 
-__all__ = ["TransportTerms", "transport_terms", "check_transport_speed"]
+__all__ = ["TransportTerms", "transport_terms", "check_transport_speed", "lift_nodal_forces"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -141,3 +142,48 @@ def check_transport_speed(terms: TransportTerms, tension: np.ndarray, name: str)
             f"|c| must be below the critical speed √(T/m) = {crit:.4g} m/s of line "
             f"'{name}' (element {j}): above it the travelling line diverges",
         )
+
+
+def lift_nodal_forces(model: Any, e: np.ndarray, w: np.ndarray) -> np.ndarray | None:
+    """Nodal forces of the steady lift of the relative flow in the time-domain model.
+
+    Parameters
+    ----------
+    model : LineModel
+        The time-domain model (its ``mesh.cl_steady``, quadrature, static shape).
+    e : ndarray, shape (n_el, d)
+        Element unit tangents the drag uses. [-]
+    w : ndarray, shape (n_el, n_g, d)
+        Relative velocity of the fluid and the material at the quadrature points,
+        U + v − u̇ − c e. [m/s]
+
+    Returns
+    -------
+    ndarray, shape (n_nodes, d), or None
+        The consistent nodal forces l0 Σ_g w_g N_a f_L(w_g) [N]; None without lift
+        (no coefficient, or a planar model: no lift in the plane).
+
+    Notes
+    -----
+    f_L = ½ρC_L D |w|² (ẑ·m̂) m̂, m̂ ∥ e × w_n (:func:`stochcable.line.transport.
+    relative_flow.steady_lift_force`), evaluated with the instantaneous relative flow,
+    on the elements whose static midpoint is under water (as the frequency-domain
+    model, whose dry elements see no current); no Jacobian (the Newton iterations
+    converge on the drag's).
+    """
+    cl = getattr(model.mesh, "cl_steady", None)
+    if cl is None or model.dim != 3 or not np.any(cl):
+        return None
+    wet = 0.5 * (model.x_static[:-1, 2] + model.x_static[1:, 2]) <= 0.0
+    coef = 0.5 * model.rho * cl * model.mesh.diameter * wet
+    ne, ng, d = w.shape
+    ee = np.repeat(e, ng, axis=0)
+    c = model.speed
+    f = steady_lift_force(ee, w.reshape(-1, d) + c * ee, c, np.repeat(coef, ng))
+    nodal = model.l0[:, None, None] * np.einsum(
+        "g,ga,egd->ead", model.gauss_w, model.gauss_N, f.reshape(ne, ng, d)
+    )
+    out = np.zeros((ne + 1, d))
+    out[:-1] += nodal[:, 0]
+    out[1:] += nodal[:, 1]
+    return out

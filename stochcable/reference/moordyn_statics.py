@@ -50,6 +50,7 @@ def moordyn_static_tensions(
     ic_threshold: float = 1e-6,
     ic_tmax: float = 300.0,
     dt: float = 1e-3,
+    ic_dynamic: bool = False,
 ) -> list[MoorDynSegmentTension]:
     """Run MoorDyn's initial-condition solve of ``scene`` and read its segment tensions.
 
@@ -64,6 +65,9 @@ def moordyn_static_tensions(
         ``TmaxIC``. [s]
     dt : float, default 1e-3
         ``dtM``. [s]
+    ic_dynamic : bool, default False
+        MoorDyn's dynamic relaxation (``ICgenDynamic 1``) instead of its stationary
+        solver (:func:`stochcable.io.write_moordyn`).
 
     Returns
     -------
@@ -72,7 +76,9 @@ def moordyn_static_tensions(
     """
     md = import_moordyn()
     sc = load_scene(scene)
-    text = write_moordyn(sc, dt=dt, ic_threshold=ic_threshold, ic_tmax=ic_tmax)
+    text = write_moordyn(
+        sc, dt=dt, ic_threshold=ic_threshold, ic_tmax=ic_tmax, ic_dynamic=ic_dynamic
+    )
     pieces = moordyn_lines(sc)
     out = []
     with tempfile.TemporaryDirectory(prefix="stochcable_moordyn_") as tmp:

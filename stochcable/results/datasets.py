@@ -6,7 +6,8 @@ the CLI's and the service's answer, or one read back from a file) into an
 :class:`xarray.Dataset`; :func:`dataset_from_result` adds what only the Python result
 holds (the tension spectrum of every element and the motion spectrum of every node).
 
-Dimensions: ``line``, ``end`` (end_a, end_b), ``omega`` (the analysis grid),
+Dimensions: ``line``, ``end`` (end_a, end_b), ``omega`` (the analysis grid; and
+``omega_corrected``, :mod:`stochcable.results.residual_dataset`),
 ``element`` and ``node`` (index along each line; lines with fewer elements are padded
 with NaN; the arc lengths are the coordinates ``element_arclength`` and
 ``node_arclength``), ``axis`` (x, y, z), ``mode``; with bodies ``body`` and ``dof``;
@@ -23,6 +24,8 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.results.residual_dataset import ENDS, _var, residual_parts
+
 __all__ = [
     "dataset_from_document",
     "dataset_from_result",
@@ -30,7 +33,6 @@ __all__ = [
     "netcdf_bytes",
 ]
 
-ENDS = ("end_a", "end_b")
 AXES = ("x", "y", "z")
 #: The statistics of a response the Dataset carries, with their long names.
 STATISTICS = {
@@ -68,10 +70,6 @@ def _units(doc: Mapping[str, Any]) -> dict[str, str]:
         "force_spectrum": f"{force}2 s rad-1",
         "length_spectrum": f"{length}2 s rad-1",
     }
-
-
-def _var(dims: tuple[str, ...], data: Any, units: str, long_name: str) -> tuple:
-    return (dims, np.asarray(data), {"units": units, "long_name": long_name})
 
 
 def _omega(lines: Mapping[str, Any]) -> np.ndarray:
@@ -272,7 +270,8 @@ def dataset_from_document(doc: Mapping[str, Any]):
     u = _units(doc)
     coords = _line_coords(doc, u)
     data = _line_variables(doc, u)
-    for part in (_body_parts(doc, u), _timeseries_parts(doc, u)):
+    parts = (_body_parts(doc, u), _timeseries_parts(doc, u), residual_parts(doc, u, STATISTICS))
+    for part in parts:
         coords.update(part[0])
         data.update(part[1])
     units = doc.get("units") or {}

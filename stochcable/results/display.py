@@ -104,6 +104,8 @@ class _Summary:
     warnings: tuple[str, ...]
     bodies: tuple[str, ...] = ()
     target_error: float | None = None
+    linear: tuple[float | None, ...] = ()  # the linear model's σ beside each end's
+    residuals: tuple[str, ...] = ()  # the residual kinds the end statistics carry
 
 
 def _ends(lines: Any) -> list[tuple[str, str, float, float, float, float]]:
@@ -114,6 +116,19 @@ def _ends(lines: Any) -> list[tuple[str, str, float, float, float, float]]:
             if st is not None:
                 rows.append((name, end, st.mean, st.std, st.tz, st.mpm_3h))
     return rows
+
+
+def _residuals(lines: Any) -> dict[str, Any]:
+    """The linear σ beside every end (None where a line has no residual) and the
+    residual kinds computed on some line (LineResult or the document's view)."""
+    linear = [
+        None if line.linear is None else line.linear[end].std
+        for line in lines.values()
+        for end in ENDS
+        if getattr(line, end, None) is not None
+    ]
+    kinds = {k: None for line in lines.values() for k, r in line.residuals.items() if r.computed}
+    return {"linear": tuple(linear), "residuals": tuple(kinds)}
 
 
 def _of_result(result: Any) -> _Summary:
@@ -134,6 +149,7 @@ def _of_result(result: Any) -> _Summary:
         tuple(result.warnings),
         tuple(result.bodies),
         None if fid is None else float(fid.target_error),
+        **_residuals(result.lines),
     )
 
 
@@ -155,6 +171,7 @@ def _of_document(doc: Any) -> _Summary:
         tuple(doc.warnings),
         tuple(doc.get("bodies") or ()),
         None if fid is None else float(fid["target_error"]),
+        **_residuals(doc.lines),
     )
 
 
@@ -169,6 +186,11 @@ def _text(s: _Summary) -> str:
     if s.bodies:
         out.append(f"  bodies: {', '.join(s.bodies)}")
     out.append(f"  end tension σ [{s.force}]: {sigma}")
+    if s.residuals:
+        lin = "; ".join(
+            f"{e[0]} {e[1]} {format_value(v)}" for e, v in zip(s.ends, s.linear) if v is not None
+        )
+        out.append(f"  residuals included: {', '.join(s.residuals)} (linear σ: {lin})")
     out.append(f"  warnings: {n}" + (" (.warnings)" if n else ""))
     if s.target_error is not None:
         out.append(f"  fidelity: target error {format_value(s.target_error)}")
@@ -177,11 +199,12 @@ def _text(s: _Summary) -> str:
 
 def _html(s: _Summary) -> str:
     f, t = s.force, s.time
-    stats = html_table(
-        ["line", "end", f"mean [{f}]", f"σ [{f}]", f"Tz [{t}]", f"MPM 3 h [{f}]"],
-        s.ends,
-        caption="End-tension statistics",
-    )
+    cols = ["line", "end", f"mean [{f}]", f"σ [{f}]", f"Tz [{t}]", f"MPM 3 h [{f}]"]
+    rows, caption = s.ends, "End-tension statistics"
+    if s.residuals:  # the linear model's σ beside
+        cols, rows = cols + [f"linear σ [{f}]"], [(*e, v) for e, v in zip(s.ends, s.linear)]
+        caption += f" with the residuals ({', '.join(s.residuals)})"
+    stats = html_table(cols, rows, caption=caption)
     lin = html_table(
         ["line", "linearization", "iterations", "relative change [-]"],
         [(n, "converged" if ok else "NOT converged", it, ch) for n, ok, it, ch in s.lines],

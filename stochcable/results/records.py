@@ -15,6 +15,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -374,6 +375,14 @@ class ResidualRecord:
         band = {e: max(-(float(std[e]) ** 2), float(v)) for e, v in in_band.items()}
         total = {e: math.sqrt(max(0.0, float(std[e]) ** 2 + var[e])) for e in var}
         return cls(True, "", var, band, dict(std), total, order, panels, tuple(lines))
+
+    @classmethod
+    def from_document(cls, doc: Mapping[str, Any]) -> ResidualRecord:
+        """The record of its :meth:`as_dict` (without its spectral ``lines``)."""
+        ends = {k: {e: float(doc[e][k]) for e in ("end_a", "end_b")}
+                for k in ("variance", "in_band", "std_linear", "std")}  # fmt: skip
+        return cls(bool(doc["computed"]), str(doc["reason"]), **ends,
+                   order=int(doc["order"]), panels=int(doc["panels"]))  # fmt: skip
 
     def ratio(self, end: str) -> float:
         """σ with the residual over the linear σ at ``end`` (1 when not computed). [-]"""

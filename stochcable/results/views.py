@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 
 from stochcable.results.display import document_html, document_text
-from stochcable.results.records import ResponseStats
+from stochcable.results.records import ResidualRecord, ResponseStats
+from stochcable.scene.residual_kinds import RESIDUAL_KINDS
 
 __all__ = ["AnalysisDocument", "LineDocument", "TimeSeriesWindow"]
 
@@ -67,6 +68,12 @@ class LineDocument:
         The line's drag-linearization record (converged, iterations, ...).
     document : dict
         The line's part of the result document.
+    residuals : dict of ResidualRecord
+        The residuals of the linear model by kind, as on ``LineResult`` (without their
+        spectral lines: the document's ``corrected_spectra`` hold their densities).
+    linear : dict {"end_a", "end_b"} of ResponseStats or None
+        The linear model's end statistics where a residual was computed (``end_a`` and
+        ``end_b`` carry the residuals), None otherwise.
     """
 
     name: str
@@ -85,6 +92,20 @@ class LineDocument:
     n_modes: int | None
     linearization: Mapping[str, Any]
     document: Mapping[str, Any]
+    residuals: dict[str, ResidualRecord] = field(default_factory=dict)
+    linear: dict[str, ResponseStats] | None = None
+
+    def linear_end(self, end: str) -> ResponseStats:
+        """The linear model's statistics of the tension at ``end``, as on ``LineResult``."""
+        return getattr(self, end) if self.linear is None else self.linear[end]
+
+    def end_tension_density(self, end: str) -> tuple[np.ndarray, np.ndarray]:
+        """Frequencies [rad/s] and density [N²·s/rad] of the tension at ``end`` the end
+        statistics are of (with the residuals where computed), as on ``LineResult``."""
+        spec = (self.document.get("corrected_spectra") or {}).get(end)
+        if spec is None:
+            return self.omega, self.end_tension_spectrum(end)
+        return _array(spec["omega"]), _array(spec["tension"])
 
     def end_tension_spectrum(self, end: str) -> np.ndarray:
         """One-sided spectrum of the tension at ``end`` ("end_a" or "end_b"). [N²·s/rad]"""
@@ -123,6 +144,10 @@ class LineDocument:
             n_modes=modes.get("kept"),
             linearization=doc.get("linearization", {}),
             document=doc,
+            residuals={k: ResidualRecord.from_document(doc[k]) for k in RESIDUAL_KINDS if k in doc},
+            linear=None
+            if doc.get("linear") is None
+            else {e: _response_stats(v["tension"]) for e, v in doc["linear"].items()},
         )
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import ConfigDict, Field, model_validator
 
 from stochcable.scene.base import _Doc, _f
 from stochcable.scene.residual_kinds import residual_switch
@@ -78,6 +78,7 @@ class LinearizationSettings(_Doc):
 class TimeSeriesSettings(_Doc):
     """Time series synthesized from the response spectra (Tuah (1982), §5.1)."""
 
+    model_config = ConfigDict(defer_build=False)  # (:class:`_Doc`: an HTTP body extends it)
     method: Literal["dsa", "nsa"] = Field(default="dsa", description="Spectral amplitude model")
     duration: float = _f("Record length", "s", gt=0, le=1.0e7, default=600.0)
     dt: float = _f("Time step", "s", gt=0, default=0.25)

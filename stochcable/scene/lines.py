@@ -146,6 +146,16 @@ class Segment(_Doc):
         "Axial drag coefficient, on pi·diameter (as MoorDyn's CdAx)", "-", ge=0, default=0.0
     )
     ca_normal: float = _f("Normal added-mass coefficient", "-", ge=0, default=1.0)
+    cl_steady: float = _f(
+        "Steady lift coefficient, on the diameter and the relative flow speed squared: "
+        "½ρ·C_L·D·|U − c·t|² per length, across the element and the cross-flow, "
+        "upward for C_L > 0 (Hu & Jin 2001, eq. 6; only where a current crosses the "
+        "element; docs/travelling.md)",
+        "-",
+        ge=-5,
+        le=5,
+        default=0.0,
+    )
     weight: float | None = _f(
         "Net submerged weight per unit length, overriding (mass - rho·pi·D²/4)·g; "
         "negative for buoyant line",

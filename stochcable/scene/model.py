@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from stochcable.errors import InputError
 from stochcable.scene.analysis_settings import (
@@ -125,6 +125,7 @@ __all__ = [
 class Scene(_Doc):
     """A complete analysis: environment, sea, lines and settings (DESIGN.md v1)."""
 
+    model_config = ConfigDict(defer_build=False)  # (:class:`_Doc`)
     title: str = Field(default="", max_length=2000, description="Free text: source and assumptions")
     environment: Environment
     sea: Sea | None = None

@@ -104,13 +104,16 @@ RESIDUAL_KINDS: dict[str, ResidualKind] = {
     for k in (
         ResidualKind(
             name="drag_residual",
-            switch="Also compute the end-tension variance the linearization drops: the "
-            "closed-form Hermite residual of the quadratic drag (lines.<name>.drag_residual; "
-            "planar lines, seed method, lines not on free bodies)",
+            switch="Compute the end-tension variance the linearization drops: the "
+            "closed-form Hermite residual of the quadratic drag, and carry it in the end "
+            "statistics (lines.<name>.drag_residual; seed method, or vector on 3-D lines; "
+            "lines on free bodies through the group; false: the linear model alone)",
             document="The end-tension variance the statistical drag linearization drops, "
-            "in closed form (the Hermite residual of the quadratic drag; present with "
-            "``analysis.linearization.drag_residual``); see :doc:`../benchmarks/drag_residual`.",
-            scope="3-D lines, the vector or harmonic linearization, lines on free bodies",
+            "in closed form (the Hermite residual of the quadratic drag; present unless "
+            "``analysis.linearization.drag_residual`` is false); see "
+            ":doc:`../benchmarks/drag_residual`.",
+            scope="the harmonic linearization; the vector linearization of a planar line; "
+            "a travelling line on free bodies",
             order="Highest Hermite order kept.",
             panels="Element groups the residual was evaluated on.",
             memory_bytes=_RESIDUAL_BYTES,
@@ -118,14 +121,15 @@ RESIDUAL_KINDS: dict[str, ResidualKind] = {
         ),
         ResidualKind(
             name="geometric_residual",
-            switch="Also compute the end-tension variance of the second-order geometric "
-            "forces of the linear response (stretching and rotation of the tension; "
-            "lines.<name>.geometric_residual; lines not on free bodies, at most 400 elements)",
+            switch="Compute the end-tension variance of the second-order geometric "
+            "forces of the linear response (stretching and rotation of the tension), "
+            "and carry it in the end statistics (lines.<name>.geometric_residual; at most "
+            "400 elements; false: the linear model alone)",
             document="The end-tension variance of the second-order geometric forces of the "
-            "linear response (stretching and rotation of the tension; present with "
-            "``analysis.linearization.geometric_residual``); see "
+            "linear response (stretching and rotation of the tension; present unless "
+            "``analysis.linearization.geometric_residual`` is false); see "
             ":doc:`../benchmarks/drag_residual`.",
-            scope="more than 400 elements, lines on free bodies",
+            scope="more than 400 elements, a travelling line on free bodies",
             order="2: the forces are quadratic in the response.",
             panels="The elements the residual was evaluated on.",
             memory_bytes=_RESIDUAL_BYTES,
@@ -138,8 +142,9 @@ RESIDUAL_KINDS: dict[str, ResidualKind] = {
 
 def residual_switch(name: str) -> Any:
     """The pydantic field of the scene switch ``analysis.linearization.<name>``
-    (default off, described by the kind's ``switch``)."""
-    return Field(default=False, description=RESIDUAL_KINDS[name].switch)
+    (default on since issue 31: the corrected answer is the answer; described by the
+    kind's ``switch``)."""
+    return Field(default=True, description=RESIDUAL_KINDS[name].switch)
 
 
 def asked_residuals(linearization: Any) -> tuple[ResidualKind, ...]:

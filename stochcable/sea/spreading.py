@@ -29,7 +29,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.special import betainc, gammaln
 
 from stochcable import validation as v
 from stochcable.errors import InputError
@@ -90,11 +89,15 @@ class DirectionSet:
 
 def _cos2s_norm(s: float) -> float:
     """C(s) = Γ(s + 1)/(2√π Γ(s + ½)), ∫_{−π}^{π} C cos^{2s}(θ/2) dθ = 1. [1/rad]"""
+    from scipy.special import gammaln  # (here: a long-crested sea does without)
+
     return math.exp(gammaln(s + 1.0) - gammaln(s + 0.5)) / (2.0 * math.sqrt(math.pi))
 
 
 def _cosn_norm(n: float) -> float:
     """C(n) = Γ(n/2 + 1)/(√π Γ(n/2 + ½)), ∫_{−π/2}^{π/2} C cosⁿθ dθ = 1. [1/rad]"""
+    from scipy.special import gammaln  # (here: a long-crested sea does without)
+
     return math.exp(gammaln(0.5 * n + 1.0) - gammaln(0.5 * n + 0.5)) / math.sqrt(math.pi)
 
 
@@ -176,6 +179,8 @@ def moments_cos2s(s: float) -> dict[str, float]:
 
 def moments_cosn(n: float) -> dict[str, float]:
     """Directional moments of :func:`spreading_cosn` about its mean (closed form). [-]"""
+    from scipy.special import gammaln  # (here: a long-crested sea does without)
+
     n = _exponent("n", n)
     a1 = math.exp(2.0 * gammaln(0.5 * n + 1.0) - gammaln(0.5 * n + 0.5) - gammaln(0.5 * n + 1.5))
     return {"a1": a1, "b1": 0.0, "a2": n / (n + 2.0), "b2": 0.0}
@@ -218,6 +223,8 @@ def _count(count: int) -> int:
 def directions_cos2s(mean: float, s: float, count: int = 16) -> DirectionSet:
     """Discrete directions of :func:`spreading_cos2s`: ``count`` equal bins over the
     circle centred on the mean (an odd count puts a bin on the mean). [rad, -]"""
+    from scipy.special import betainc  # (here: a long-crested sea does without)
+
     s = _exponent("s", s)
     mean = v.finite_scalar("mean", mean, "rad")
     count = _count(count)
@@ -233,6 +240,8 @@ def directions_cos2s(mean: float, s: float, count: int = 16) -> DirectionSet:
 def directions_cosn(mean: float, n: float, count: int = 16) -> DirectionSet:
     """Discrete directions of :func:`spreading_cosn`: ``count`` equal bins over its
     support |θ − θ̄| ≤ π/2 (an odd count puts a bin on the mean). [rad, -]"""
+    from scipy.special import betainc  # (here: a long-crested sea does without)
+
     n = _exponent("n", n)
     mean = v.finite_scalar("mean", mean, "rad")
     count = _count(count)

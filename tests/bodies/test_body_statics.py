@@ -349,17 +349,16 @@ def test_body_statics_document():
 
 
 def test_slack_start_and_unheld_body_errors():
-    """A tether slack at the initial position: InputError naming the line, with the
-    body context; a one-leg buoy without wind (line slack on the frictionless bed,
+    """A tether slack at the initial position: the statics start again from the
+    straight-bar model's pose (stochcable.bodies.start) and find the equilibrium of a
+    start near it; a one-leg buoy without wind (line slack on the frictionless bed,
     no horizontal restoring): ConvergenceError with the residual."""
+    near = solve_statics(load_scene(_tether_doc())).bodies["buoy"].position
     doc = _tether_doc()
     doc["bodies"][0]["position"] = [0.0, 0.0, -20.5]
-    with pytest.raises(
-        InputError,
-        match=r"lines\['tether'\]\.length = 79.*at the initial "
-        r"body positions: buoy at \[0\.0, 0\.0, -20\.5\]",
-    ):
-        solve_statics(load_scene(doc))
+    slack = solve_statics(load_scene(doc)).bodies["buoy"].position
+    # both converged to the body tolerance 1e-8 of the ~20 kN loads: ~1e-9 m here
+    np.testing.assert_allclose(slack, near, rtol=0, atol=1e-7)
     from stochcable.errors import ConvergenceError
 
     d = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json", exclude_none=True)

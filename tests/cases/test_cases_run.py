@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from _scenes import LINEAR_ONLY
 
 from stochcable.analysis import analyze
 from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
@@ -41,7 +42,11 @@ def test_set_equals_one_at_a_time_analyses():
     # engine is 3-D while analyze() of the 0° case is 2-D: both drag fixed points stop
     # within the linearization tolerance tol of their own limit, so σ agrees to a few
     # tol (10·tol allowed) and a damage (∝ σ^m, m = 4) to m times that.
-    scene = load_scene(_wire())
+    # The linear model: the 3-D engine carries no drag residual (3-D lines are not
+    # covered yet, issue 31), the 2-D analyze() would.
+    doc = _wire()
+    doc["analysis"]["linearization"].update(LINEAR_ONLY)
+    scene = load_scene(doc)
     tol = scene.analysis.linearization.tolerance
     rows = [
         {"hs": 2.0, "tp": 8.0, "gamma": 2.0, "heading": 0, "probability": 0.5},
@@ -110,8 +115,11 @@ def test_annual_damage_life_and_one_state_long_term_limit():
 def test_damage_scales_as_hs_to_the_slope_for_a_linear_response():
     # Without drag the response is linear in the wave amplitude: the tension spectrum
     # goes as Hs² (same Tp and γ), σ as Hs, and the damage of a single-slope curve as
-    # Hs^m for every method (each is homogeneous of degree m in σ).
-    scene = load_scene(_wire(cd=0.0))
+    # Hs^m for every method (each is homogeneous of degree m in σ).  The linear model:
+    # the geometric residual is quadratic in the response (σ² ∝ Hs⁴).
+    doc = _wire(cd=0.0)
+    doc["analysis"]["linearization"].update(LINEAR_ONLY)
+    scene = load_scene(doc)
     rows = [{"hs": h, "tp": 9.0, "gamma": 3.3, "probability": 0.5} for h in (1.0, 2.5)]
     for method, m in (("dirlik", 4.0), ("narrow_band", 4.0)):
         f = LineFatigue("dnv-six-strand", nominal_area=1.2e-3, method=method)
@@ -240,6 +248,9 @@ def test_a_template_without_a_sea_takes_every_state_long_crested():
     doc = load_example("chain_catenary").model_dump(mode="json", exclude_none=True)
     doc["analysis"].pop("timeseries", None)
     doc["sea"] = None
+    # the linear model: the set's 3-D engine carries no drag residual (3-D lines are not
+    # covered yet, issue 31), the 2-D analyze() of the 0° state would
+    doc["analysis"].setdefault("linearization", {}).update(LINEAR_ONLY)
     rows = [{"hs": 2.0, "tp": 8.0, "heading": h, "probability": 0.5} for h in (0.0, 30.0)]
     res = run_cases(load_scene(doc), scatter_from_rows(rows))
     assert [r.status for r in res.rows] == ["ok", "ok"]

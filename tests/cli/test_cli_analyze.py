@@ -187,6 +187,36 @@ def test_analyze_summary_of_a_foot_slug_second_scene_is_in_ft_and_lbf():
     assert "foot-slug-second" in text and "disc" in text
 
 
+def test_summary_says_the_residuals_are_included_with_the_linear_sigma(tmp_path):
+    """At the defaults the summary's end-tension table has the linear model's σ beside
+    and a line names the residuals included; both switches false: neither."""
+    import copy
+
+    for asked in (True, False):
+        scene = copy.deepcopy(SCENE)
+        scene["analysis"].pop("timeseries")
+        scene["analysis"]["linearization"] = dict.fromkeys(
+            ("drag_residual", "geometric_residual"), asked
+        )
+        path, out, doc_out = tmp_path / "s.json", tmp_path / "s.txt", tmp_path / "s.out.json"
+        path.write_text(json.dumps(scene))
+        assert main(["analyze", str(path), "--format", "summary", "-o", str(out)]) == 0
+        assert main(["analyze", str(path), "--format", "json", "-o", str(doc_out)]) == 0
+        text = out.read_text(encoding="utf-8")
+        flat = " ".join(text.split())  # (rich wraps the line at its width)
+        said = (
+            "the end tensions include the residuals of the linear model "
+            "(drag_residual, geometric_residual); linear σ: the linear model alone"
+        )
+        assert (said in flat) is asked and ("linear σ" in text) is asked
+        if asked:
+            line = json.loads(doc_out.read_text(encoding="utf-8"))["lines"]["leg1"]
+            row = next(ln for ln in text.splitlines() if "leg1" in ln and "end_b" in ln)
+            linear = line["linear"]["end_b"]["tension"]["std"]
+            assert f"{linear:.4g}" in row and f"{line['end_b']['tension']['std']:.4g}" in row
+            assert linear < line["end_b"]["tension"]["std"]
+
+
 def test_analyze_writes_netcdf_for_a_nc_output(scene_file, tmp_path, capsys):
     xr = pytest.importorskip("xarray")
     pytest.importorskip("netCDF4")

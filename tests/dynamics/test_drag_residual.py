@@ -31,6 +31,16 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 import residual_cost  # noqa: E402
 
 
+def test_fft_length_equals_scipy_next_fast_len():
+    """The residuals' lag-grid length is SciPy's fast real-FFT length, for every length
+    up to 2·10⁴ and for large ones (it avoids importing scipy.fft)."""
+    import scipy.fft
+
+    rng = np.random.default_rng(5)
+    ns = [*range(1, 20_001), *(int(x) for x in rng.integers(1, 10**15, 500)), 2**40 + 1]
+    assert [rl.fft_length(n) for n in ns] == [scipy.fft.next_fast_len(n, real=True) for n in ns]
+
+
 def test_hermite_coefficients_closed_forms():
     """a₁ = 2E|μ + x| (the Borgman coefficient over cσ), a₀ = E[g]; zero mean: the even
     coefficients vanish and 3!·a₃² = 4/(3π); Parseval: Σ_{k≥1} k! a_k² = Var g(μ + x)
@@ -141,8 +151,8 @@ def test_panels_converge_to_the_element_by_element_residual(monkeypatch):
 
 
 def test_only_when_asked_and_out_of_scope_says_why():
-    """Off by default (no document key); no drag: zero; a line on a free body and the
-    vector linearization: not computed, with the reason."""
+    """Off by default (no document key); no drag: zero; the vector linearization of a
+    planar line: not computed, with the reason; a line on a free body: computed."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         off = analyze(chain_surge_doc(20, residual=False)).lines["leg1"]
@@ -159,8 +169,8 @@ def test_only_when_asked_and_out_of_scope_says_why():
         buoy["analysis"]["linearization"]["drag_residual"] = True
         buoy["analysis"].pop("timeseries", None)
         leg = next(iter(analyze(buoy).lines.values()))
-    assert not leg.drag_residual.computed and "free bodies" in leg.drag_residual.reason
-    assert leg.to_document()["drag_residual"]["computed"] is False
+    # a line on a free body: through the coupled group (tests/dynamics/test_body_residual.py)
+    assert leg.drag_residual.computed and leg.to_document()["drag_residual"]["computed"]
 
 
 @pytest.mark.slow

@@ -9,6 +9,8 @@ import numpy as np
 import pytest
 
 from stochcable.dynamics.linearization.formulas import (
+    _erf,
+    borgman_variance_ratio,
     drag_linear_current,
     drag_linear_harmonic,
     drag_linear_seed,
@@ -66,6 +68,60 @@ def test_current_form_limits():
     # sigma = U = 0 together: zero, no NaN (RuntimeWarnings are errors in this suite)
     assert drag_linear_current(RHO, CD, DIAM, 0.0, 0.0) == 0.0
     assert mean_drag_gaussian(RHO, CD, DIAM, 0.0, 0.0) == 0.0
+
+
+def test_erf_equals_scipy_erf():
+    """The formulas' erf (the C library's, without importing scipy.special) against
+    scipy.special.erf over the arguments the drag formulas meet (U/(σ√2) of any size,
+    signed zeros, tiny and saturated values, infinities, NaN)."""
+    special = pytest.importorskip("scipy.special")
+    rng = np.random.default_rng(20261128)
+    x = np.concatenate(
+        [
+            rng.normal(0.0, 3.0, 100_000),
+            rng.uniform(-1e-3, 1e-3, 10_000),
+            np.linspace(-7.0, 7.0, 10_001),
+            [0.0, -0.0, 1e-300, -5e-324, 5.9, 6.0, 27.0, np.inf, -np.inf],
+        ]
+    ).reshape(-1, 10)
+    new, old = _erf(x), special.erf(x)
+    assert new.shape == x.shape and new.dtype == np.float64
+    # two implementations of a correctly rounded-to-1-ulp function: 2 ulp = 4.4e-16
+    np.testing.assert_allclose(new, old, rtol=1e-15, atol=0.0)
+    assert np.array_equal(np.signbit(new), np.signbit(old))  # erf(-0) = -0
+    assert np.isnan(_erf(np.array([np.nan]))).all()
+    assert _erf(np.float64(0.5)).shape == ()
+
+
+def test_current_forms_equal_the_scipy_erf_forms():
+    """drag_linear_current, mean_drag_gaussian and borgman_variance_ratio equal their
+    closed forms evaluated with scipy.special.erf (the formulas' erf before it was the C
+    library's)."""
+    special = pytest.importorskip("scipy.special")
+    rng = np.random.default_rng(7)
+    sigma = rng.uniform(0.01, 2.0, 2000)
+    u = rng.normal(0.0, 1.5, 2000)
+    r = u / sigma
+    c = math.sqrt(2.0 / math.pi)
+    e_abs = sigma * c * np.exp(-0.5 * r**2) + u * special.erf(r / math.sqrt(2.0))
+    e_vv = (u**2 + sigma**2) * special.erf(r / math.sqrt(2.0)) + u * sigma * c * np.exp(-0.5 * r**2)
+    # both terms of E|v| and of E[v|v|] have the sign of U: no cancellation, the 2 ulp
+    # of erf stay a few ulp
+    np.testing.assert_allclose(
+        drag_linear_current(RHO, CD, DIAM, sigma, u), RHO * CD * DIAM * e_abs, rtol=2e-15
+    )
+    np.testing.assert_allclose(
+        mean_drag_gaussian(RHO, CD, DIAM, sigma, u), KAPPA * e_vv, rtol=2e-15
+    )
+    m = np.abs(r)
+    m = m[m <= 8.5]  # below the large-|μ| asymptote of borgman_variance_ratio
+    erf = special.erf(m / math.sqrt(2.0))
+    ex = c * np.exp(-0.5 * m**2)
+    mvv = (m**2 + 1.0) * erf + m * ex
+    ratio = 4.0 * (m * erf + ex) ** 2 / (m**4 + 6.0 * m**2 + 3.0 - mvv**2)
+    # Var(v|v|) = μ⁴ + 6μ² + 3 - E[v|v|]² cancels down to ≈ 4μ² + 2: the erf's ulp
+    # grow by up to (μ⁴ + 6μ² + 3)/(4μ² + 2) ≈ 19 at μ = 8.5, hence 1e-14
+    np.testing.assert_allclose(borgman_variance_ratio(1.0, m), ratio, rtol=1e-14)
 
 
 def test_current_form_and_mean_force_monte_carlo():

@@ -72,12 +72,12 @@ def _with_toy(doc: dict) -> Scene:
 
 
 def test_registered_kinds_are_complete():
-    """Every registered kind has its scene switch (described by the registry), its
-    compute function and positive cost terms."""
+    """Every registered kind has its scene switch (described by the registry, on by
+    default since issue 31), its compute function and positive cost terms."""
     assert list(residual_kinds.RESIDUAL_KINDS) == list(registry.COMPUTE)
     for name, kind in residual_kinds.RESIDUAL_KINDS.items():
         field = LinearizationSettings.model_fields[name]
-        assert field.annotation in (bool, "bool") and field.default is False
+        assert field.annotation in (bool, "bool") and field.default is True
         assert field.description == kind.switch
         assert kind.memory_bytes > 0 and kind.seconds(40, 32, True) > 0
 

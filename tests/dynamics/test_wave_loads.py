@@ -9,6 +9,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _scenes import LINEAR_ONLY
 from scipy.integrate import quad_vec
 
 from stochcable import analysis
@@ -359,8 +360,11 @@ def test_element_mean_sigma_with_moving_structure_equals_quadrature():
 
 
 def guy_doc(elements: int) -> dict:
+    """The inclined guy with ``elements``, the linear model (the wave loads' mesh
+    convergence; the residuals' is theirs)."""
     d = load_example("inclined_guy").model_dump(mode="json")
     d["analysis"]["timeseries"] = None
+    d["analysis"]["linearization"].update(LINEAR_ONLY)
     d["lines"][0]["segments"][0]["elements"] = elements
     return d
 
@@ -415,6 +419,7 @@ def test_chain_changes_less_than_its_discretization_error():
         "surge": {"type": "pierson_moskowitz", "hs": 2.0, "tp": 10.0}
     }
     doc["analysis"]["timeseries"] = None
+    doc["analysis"]["linearization"].update(LINEAR_ONLY)  # (the wave loads' change)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ResolutionWarning)
         res = analysis.analyze(copy.deepcopy(doc))

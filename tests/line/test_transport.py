@@ -231,18 +231,6 @@ def test_cli_refuses_critical_speed_in_one_line(tmp_path, capsys, command):
     assert "\n" not in err
 
 
-def test_engine_refuses_a_travelling_line_on_a_body():
-    """Lines on bodies are solved by the coupled solve, which has no transport terms:
-    refused in one message naming the body (free lines travel: test_transport_solve)."""
-    from stochcable.dynamics.engine import build_engine
-    from stochcable.examples import load_example
-
-    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
-    doc["lines"][0]["axial_speed"] = 0.1
-    with pytest.raises(InputError, match=r"lines\[0\].axial_speed.*body \('disc'\)"):
-        build_engine(doc)
-
-
 def test_harmonic_linearization_refused_for_a_travelling_line():
     from stochcable.dynamics.engine import build_engine
 

@@ -110,3 +110,41 @@ def test_speed_at_critical_refused():
     cw = _wave_speed()
     with pytest.raises(InputError, match="critical speed"):
         _free_decay(1.01 * cw, 1.0, 0.1, 8)
+
+
+def test_normal_drag_has_no_slope_term():
+    """The Morison normal drag of the material moving at c e along the *deformed*
+    tangent e: P(e)(U − u̇ − c e) = P(e)(U − u̇), so the normal drag of a deformed,
+    moving travelling line does not depend on c at all (docs/travelling.md, "Limits":
+    the slope term −c δe of a projection on the static normal is cancelled by the
+    rotation of the projection, δP(−c e₀) = +c δe).  Without axial drag the time-domain
+    drag forces at c = 0, 2 and −3 m/s are equal to round-off."""
+    doc = _string_scene(0.0, 10)
+    doc["lines"][0]["segments"][0].update({"cd_normal": 1.2, "cd_axial": 0.0})
+    scene = load_scene(doc)
+    env, line = scene.environment, scene.lines[0]
+    mesh = mesh_line(line, env.rho, env.g)
+    rng = np.random.default_rng(34)
+    xs = np.stack(
+        [
+            np.linspace(0.0, SPAN, mesh.n_nodes),
+            np.zeros(mesh.n_nodes),
+            np.full(mesh.n_nodes, -300.0),
+        ],
+        1,
+    )
+    model = LineModel(mesh, env, xs, 3)
+    X = xs + rng.normal(0.0, 5.0, xs.shape) * np.array([0.2, 1.0, 1.0])
+    X[0], X[-1] = xs[0], xs[-1]
+    V = rng.normal(0.0, 0.3, xs.shape)
+    d = np.diff(X, axis=0)
+    e = d / np.linalg.norm(d, axis=1)[:, None]
+    u_gauss = np.broadcast_to([0.0, 0.5, 0.0], (mesh.n_elements, model.gauss_N.shape[0], 3))
+    forces = []
+    for c in (0.0, 2.0, -3.0):
+        model.speed = c
+        forces.append(model.drag(X, V, e, np.zeros_like(X), np.array(u_gauss), False)[0])
+    scale = np.abs(forces[0]).max()
+    assert scale > 1.0  # the drag is there
+    for f in forces[1:]:
+        np.testing.assert_allclose(f, forces[0], atol=1e-12 * scale)

@@ -209,6 +209,43 @@ def test_moordyn_statics_match_the_closed_form_catenary(moordyn, chain):
 
 
 @pytest.mark.slow
+def test_moordyn_reads_both_ends_of_a_two_segment_line(moordyn):
+    """Chain on the bed, rope to the fairlead (two MoorDyn lines joined at a free
+    point; the accuracy page's ``twoseg``): the anchor tension is read on the first
+    line, the fairlead's on the last, and both agree with stochcable's statics (0.01 %
+    measured with 46 + 34 segments, 0.5 % with 23 + 17; the joint starts at that static
+    solution: from the straight line MoorDyn's initial-condition solve stops with the
+    anchor slack).  About 30 s on the loaded 2-core VM (MoorDyn's 300 s
+    initial-condition relaxation)."""
+    chain_sg = {"ea": 1.2326e9, "mass": 288.0, "diameter": 0.216, "cd_normal": 1.333,
+                "cd_axial": 0.2034, "ca_normal": 1.0}  # fmt: skip
+    rope_sg = {"ea": 1.5e8, "mass": 25.0, "diameter": 0.16, "cd_normal": 1.2,
+               "cd_axial": 0.008, "ca_normal": 1.0}  # fmt: skip
+    doc = {
+        "environment": {"depth": 200.0, "seabed": {"stiffness": 3e6, "damping": 3e5}},
+        "lines": [
+            {
+                "name": "chain_rope",
+                "end_a": {"position": [-700.0, 0.0, -200.0]},
+                "end_b": {"position": [0.0, 0.0, -20.0]},
+                "segments": [
+                    {"length": 420.0, "elements": 46, **chain_sg},
+                    {"length": 315.0, "elements": 34, **rope_sg},
+                ],
+            }
+        ],
+    }
+    motion = periodic_dsa_surge(_pm, 60.0, (0.05, 2.0), 1)
+    md = simulate_line_moordyn(doc, motion, duration=0.01, ramp=1.0, sample_dt=0.005)
+    ls = solve_statics(doc).lines["chain_rope"]
+    # 10× the measured 1e-4 (MoorDyn's lumped weight on 9 m chain segments, its
+    # initial-condition residual 1.7e-4 m/s² after TmaxIC = 300 s)
+    assert md.static_a == pytest.approx(ls.tension[0], rel=1e-3)
+    assert md.static_b == pytest.approx(ls.tension[-1], rel=1e-3)
+    assert md.static_b > 1.05 * md.static_a  # the fairlead's: the suspended weight
+
+
+@pytest.mark.slow
 def test_reference_agrees_with_moordyn_on_a_short_chain_record(moordyn, chain):
     """40 elements, a 60 s period (one warm-up, one measured), three seeds (two give a
     Student-t factor of 12.7 and a useless interval)."""

@@ -206,3 +206,43 @@ def test_service_document_summary_matches_the_result(disc):
     page = doc._repr_html_()
     body = "".join(_parse(page).text)
     assert "σ [lbf]" in body and all(w in body for w in disc.warnings)
+
+
+def test_a_result_with_residuals_says_so_with_the_linear_sigma_beside(chain):
+    """The chain at the defaults (both residuals on): a line of the text summary and
+    a column of the table name the residuals included and give the linear model's σ
+    (4 significant digits: 5e-4); the document read back shows the same."""
+    from stochcable.results.views import AnalysisDocument
+
+    line = chain.lines["leg1"]
+    text = repr(chain)
+    shown = re.search(
+        r"residuals included: drag_residual, geometric_residual "
+        r"\(linear σ: leg1 end_a ([\d,.]+); leg1 end_b ([\d,.]+)\)",
+        text,
+    )
+    assert shown, text
+    for value, end in zip(shown.groups(), ("end_a", "end_b")):
+        assert float(value.replace(",", "")) == pytest.approx(line.linear[end].std, rel=5e-4)
+        assert line.linear[end].std < getattr(line, end).std
+    body = "".join(_parse(chain._repr_html_()).text)
+    assert "linear σ [N]" in body and format_value(line.linear["end_b"].std) in body
+    doc = AnalysisDocument(chain.to_document())
+    assert repr(doc).splitlines()[1:] == text.splitlines()[1:]
+    assert doc.lines["leg1"].linear_end("end_b") == line.linear["end_b"]
+    assert doc.lines["leg1"].residuals["drag_residual"].std == line.drag_residual.std
+    om, dens = doc.lines["leg1"].end_tension_density("end_b")
+    want = line.end_tension_density("end_b")
+    assert (om == want[0]).all() and (dens == want[1]).all()
+
+
+def test_a_linear_result_has_no_residual_line():
+    """A scene with both residual switches false carries no residual: no line, no
+    column (the disc buoy's leg on its free body carries them by default)."""
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
+    doc["analysis"]["linearization"].update(drag_residual=False, geometric_residual=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        linear = analyze(doc)
+    assert "residuals" not in repr(linear)
+    assert "linear σ" not in linear._repr_html_()

@@ -12,6 +12,7 @@ import json
 import threading
 import warnings
 
+import numpy as np
 import pytest
 from _compare import assert_close_documents
 from fastapi.testclient import TestClient
@@ -109,6 +110,25 @@ def test_document_conforms_to_the_response_model(chain_answer):
         "warnings",
         "timeseries",
     }
+
+
+def test_the_default_answer_carries_the_residuals_and_the_linear_model(chain_answer):
+    """The chain at the defaults (both residuals on): the response model reads the
+    residual records, the linear block and the corrected densities as typed parts,
+    whose area is the corrected σ² the end statistics carry (1e-9: the trapezoid's
+    summation order), above the linear model's σ."""
+    model = AnalysisResponse.model_validate(chain_answer.json())
+    line = model.lines["leg1"]
+    assert line.drag_residual.computed and line.geometric_residual.computed
+    for end in ("end_a", "end_b"):
+        spec = line.corrected_spectra[end]
+        std = getattr(line, end).tension.std
+        assert np.trapezoid(spec.tension, spec.omega) == pytest.approx(std**2, rel=1e-9)
+        assert line.linear[end].tension.std < std
+        assert getattr(line.drag_residual, end).variance > 0
+    schemas = AnalysisResponse.model_json_schema()["$defs"]
+    props = schemas["LineDocument"]["properties"]
+    assert {"linear", "corrected_spectra", "drag_residual", "geometric_residual"} <= set(props)
 
 
 @pytest.mark.slow

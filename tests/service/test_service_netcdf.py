@@ -47,6 +47,14 @@ def test_netcdf_answer_carries_the_json_numbers(client, tmp_path):
             np.testing.assert_allclose(ds[name].values, ref[name].values, rtol=1e-10)
             compared += 1
     assert compared >= 10, sorted(ref.data_vars)
+    # the default answer's residuals: the corrected densities on their own grid, the
+    # linear model's statistics, each residual's variance
+    residuals = {
+        "end_tension_corrected_spectrum",
+        "linear_end_tension_std",
+        "drag_residual_variance",
+    }
+    assert residuals <= set(ds.data_vars) and "omega_corrected" in ds.coords
 
 
 def test_unsupported_accept_is_406(client):

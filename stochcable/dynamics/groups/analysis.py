@@ -40,6 +40,7 @@ from stochcable.dynamics.groups.results import body_result, coupled_results
 from stochcable.dynamics.groups.seainputs import group_line_channels, heading_inputs
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.loads.sea_channels import sea_channel_densities
+from stochcable.dynamics.model.lift import check_lift_stability
 from stochcable.dynamics.model.system import Damping, LineSystem, Progress, noop_progress
 from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.solve.line_loads import LineInputs, silent_channel
@@ -236,6 +237,9 @@ def solve_coupled(
         )
         dampings[name] = state.dampings[name]
         alone.append(state)
+    index = {line.name: i for i, line in enumerate(scene.lines)}
+    for name in model.independent:  # a galloping line has no stationary response
+        check_lift_stability(model.systems[name], dampings[name], index[name])
     states: list[CoupledGroup] = []
     for group in model.groups:
         lo, bo, state = _solve_group(model, scene, group, chans, settings, progress, timing)

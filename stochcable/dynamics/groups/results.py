@@ -23,8 +23,10 @@ from stochcable.dynamics.groups.modes import (
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.outputs.resolution import LineModes
+from stochcable.dynamics.residuals.body_residual import coupled_influences
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 from stochcable.scene.model import AnalysisSettings
+from stochcable.scene.residual_kinds import asked_residuals
 
 __all__ = ["LINE_MODE_SHARE", "body_result", "coupled_results", "line_modes"]
 
@@ -71,6 +73,17 @@ def coupled_results(
     (lines, bodies) : dict of LineResult, dict of BodyResult
     """
     counted = {} if modes is None else line_modes(modes, lines, bodies, linearization)
+    # the lines' residuals through the group (residuals.body_residual)
+    influence = (
+        coupled_influences(
+            lines,
+            bodies,
+            {cl.name: linearization.lines[cl.name].damping for cl in lines},
+            linearization.body_drag,
+        )
+        if asked_residuals(settings.linearization)
+        else {}
+    )
     out_lines = {}
     for cl in lines:
         out_lines[cl.name] = line_result(
@@ -80,6 +93,7 @@ def coupled_results(
             settings,
             counted.get(cl.name),
             alone=False,
+            influence=influence.get(cl.name),
         )
     ch = tuple(lines[0].channels if channels is None else channels)
     spectra = np.stack([c.spectrum for c in ch])

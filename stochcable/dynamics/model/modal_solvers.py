@@ -25,7 +25,6 @@ from typing import Literal
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from stochcable import validation as _v
@@ -97,6 +96,8 @@ def modal_basis(K: Matrix, M: Matrix, n_modes: int | None = None) -> tuple[np.nd
     sparse up to 2000 DOF, or more than half the modes) uses LAPACK ``eigh``
     with an index subset; larger sparse models use ARPACK shift-invert about 0.
     """
+    import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
     K_ = as_matrix("K", K)
     n = K_.shape[0]
     M_ = as_matrix("M", M, n)
@@ -369,6 +370,8 @@ def _residual_flexibility_times(
     K: Matrix, phi: np.ndarray, Kh: np.ndarray, f: np.ndarray
 ) -> np.ndarray:
     """(K^{-1} - phi Kh^{-1} phi^T) f for f of shape (n_omega, n, r)."""
+    import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
     n = K.shape[0]
     modal = phi @ np.linalg.solve(Kh, phi.T)
     if sp.issparse(K) and n > 2000:

@@ -36,7 +36,6 @@ from typing import Literal
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike
 
 from stochcable import validation as _v
@@ -169,6 +168,8 @@ def _fro(a: Matrix | None) -> float:
 
 def _nearest_mode_text(K: Matrix, M: Matrix, w: float) -> str:
     """Describe the natural frequency nearest to ``w`` (used in error messages only)."""
+    import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
     try:
         n = K.shape[0]
         if n <= 2000:
@@ -245,6 +246,8 @@ def _solve_banded(K, M, C, F, omega, lo_bw, up_bw):
 
 
 def _solve_sparse(K, M, C, F, omega):
+    import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
     Ks, Ms = sp.csc_matrix(K), sp.csc_matrix(M)
     Cs = None if C is None else sp.csc_matrix(C)
     out = np.empty_like(F)

@@ -30,6 +30,7 @@ from stochcable.dynamics.loads.channels import (
     element_frames,
     inertia_matrix,
 )
+from stochcable.dynamics.model.lift import lift_blocks
 from stochcable.dynamics.model.modal_solvers import auto_mode_count
 from stochcable.dynamics.model.transport import travelling_system
 from stochcable.line.fem import FEModel, build_fe_model
@@ -106,6 +107,9 @@ class LineSystem:
         A travelling line's gyroscopic coefficient m c per element (its K holds K_c and
         ``current_el`` the relative flow U − c e; :mod:`stochcable.dynamics.model.
         transport`); None at rest. [N·s/m]
+    lift : ndarray, shape (n_el, d, d), or None
+        Element blocks l0·A of the linearized steady lift (``cl_steady`` in a current;
+        :mod:`stochcable.dynamics.model.lift`); None without. [N·s/m]
 
     Notes
     -----
@@ -127,6 +131,7 @@ class LineSystem:
     environment: Environment
     structural_damping: tuple[float, float] = (0.0, 0.0)
     gyro: np.ndarray | None = None
+    lift: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_cache", {})
@@ -306,6 +311,9 @@ def build_line_system(
     if line.axial_speed != 0.0:  # transport terms, the direct solve (docs/travelling.md)
         model, current_el, gyro = travelling_system(model, line.axial_speed, frames[0], current_el)
         solver = "direct"
+    lift = lift_blocks(model, frames[0], current_el, mesh.cl_steady)
+    if lift is not None:  # not symmetric: the direct solve (dynamics.model.lift)
+        solver = "direct"
     return LineSystem(
         line=line,
         statics=line_statics,
@@ -323,4 +331,5 @@ def build_line_system(
             float(settings.structural_damping.beta),
         ),
         gyro=gyro,
+        lift=lift,
     )

@@ -39,6 +39,7 @@ from stochcable.dynamics.outputs.resolution import (
     surface_resolution_check,
     tail_check,
 )
+from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
 from stochcable.dynamics.residuals.registry import residual_parts
@@ -105,6 +106,7 @@ def line_result(
     modes: LineModes | None = None,
     *,
     alone: bool = True,
+    influence: CoupledInfluence | None = None,
 ) -> LineResult:
     """Transfer functions, spectra and statistics of one line.
 
@@ -123,7 +125,10 @@ def line_result(
     alone : bool
         False for a line of a coupled group (on free bodies): its residuals (the kinds
         of :mod:`stochcable.scene.residual_kinds` ``settings.linearization`` asks
-        for) are not computed.
+        for) are computed through ``influence``, not computed without it.
+    influence : CoupledInfluence, optional
+        A line on free bodies: its end influence through the coupled group
+        (:mod:`stochcable.dynamics.residuals.body_residual`).
 
     Returns
     -------
@@ -181,13 +186,14 @@ def line_result(
     end_force = _end_force_transfer(model, resp, n_ch)
     residual = {}
     std = {e: stats[e].std for e in stats}
-    shared = EndInfluence(system, linearization.damping)  # (one solve for both)
+    # (one solve for both; a line on bodies: through the coupled group)
+    shared = EndInfluence(system, linearization.damping) if influence is None else influence
     for kind, fn in (
         residual_parts(settings.linearization) if linearization.record is not None else ()
     ):
         residual[kind.name] = (
             fn(system, channels, linearization, std, influence=shared)
-            if alone
+            if alone or influence is not None
             else ResidualRecord.not_computed("a line on free bodies is not covered", std)
         )
     applied = [r for r in residual.values() if r.computed]

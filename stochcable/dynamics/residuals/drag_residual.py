@@ -49,8 +49,8 @@ taut wire and the inclined guy in their seas: docs/benchmarks/drag_residual.md).
 
 Scope: planar lines (the normal velocity a scalar), the seed linearization, normal and
 axial drag of the line elements (attachment drag is not included), each element at
-its mean relative velocity; lines attached to free bodies are not covered (their
-residual would load the coupled system).  Elements (and pieces) are grouped into at
+its mean relative velocity; 3-D lines: :mod:`.drag_residual_3d`; a line on free bodies
+through its coupled influence (:mod:`.body_residual`).  Elements (and pieces) are grouped into at
 most :data:`MAX_PANELS` panels (the cost is O(panels² · n_fft log n_fft)).
 """
 
@@ -363,21 +363,30 @@ def drag_residual(
         coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
         lines.append(v)
         misfit.append((pan, _misfit(seg, groups, c_el, mean_el, b_el, sig)))
+    # a line on bodies: its coupled influence on every grid (body_residual)
+    coupled = None if isinstance(influence, EndInfluence) else influence
     lines_t = residual_output_lines(
         np.concatenate(lines, axis=1),
         np.concatenate(scales),
         np.concatenate(coeffs),
         h_all,
         n_fft,
-    ) * cell_factor(system, damping, unit, w_out, h_all)
-    linear = _misfit_variance(system, damping, resp, spectra, seg, groups, live, parts, misfit)
+    ) * cell_factor(system, damping, unit, w_out, h_all, influence=coupled)
+    linear = _misfit_variance(
+        system, damping, resp, spectra, seg, groups, live, parts, misfit, coupled
+    )
     out = residual_record(lines_t, w_out, w, std, order, len(groups), linear)
     _warn_large(system.name, out)
     return out
 
 
 def cell_factor(
-    system: Any, damping: Any, unit: np.ndarray, w_out: np.ndarray, h: np.ndarray
+    system: Any,
+    damping: Any,
+    unit: np.ndarray,
+    w_out: np.ndarray,
+    h: np.ndarray,
+    influence: Any = None,
 ) -> np.ndarray:
     """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
     panel force over its value at ω_j, where the lines do not resolve it: shape
@@ -402,7 +411,7 @@ def cell_factor(
     step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
     sub = step * ((np.arange(SUB_SAMPLES) + 0.5) / SUB_SAMPLES - 0.5)
     w_sub = (w_out[cells, None] + sub[None]).ravel()
-    h_sub = load_transfer(system, damping, unit, w_sub)
+    h_sub = load_transfer(system, damping, unit, w_sub, influence)
     p_sub = np.sum(np.abs(h_sub) ** 2, axis=1).reshape(power.shape[0], cells.size, -1)
     at = power[:, cells]
     out[:, cells] = np.where(at > 0, p_sub.mean(axis=2) / np.where(at > 0, at, 1.0), 1.0)
@@ -447,6 +456,7 @@ def _misfit_variance(
     live: list[str],
     parts: dict[str, Any],
     misfit: list[tuple[np.ndarray, np.ndarray]],
+    influence: Any = None,
 ) -> dict[str, np.ndarray]:
     """The end-tension variance the linear misfit of the element-constant drag changes,
     as lines on the analysis grid (empty without split elements): its load δB·l·v on
@@ -462,7 +472,7 @@ def _misfit_variance(
         [panel_loads(system.model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
         axis=2,
     )
-    h = load_transfer(system, damping, unit, w)  # (2, n_load, n_w)
+    h = load_transfer(system, damping, unit, w, influence)  # (2, n_load, n_w)
     load = np.concatenate(
         [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
     )  # (n_ch, n_load, n_w)

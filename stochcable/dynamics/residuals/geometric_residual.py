@@ -24,8 +24,9 @@ response to them).  It acts at the sum and difference frequencies of the respons
 
 Validation: the chain's line (fairlead surge) against the nonlinear time domain with the
 frequency domain's linear drag, i.e. geometric nonlinearity alone
-(docs/benchmarks/drag_residual.md).  Scope: lines not on free bodies, at most
-:data:`MAX_ELEMENTS` elements (the cost is O(elements² · n_fft log n_fft)).
+(docs/benchmarks/drag_residual.md).  Scope: at most
+:data:`MAX_ELEMENTS` elements (the cost is O(elements² · n_fft log n_fft)); a line on
+free bodies through its coupled influence (:mod:`.body_residual`).
 """
 
 from __future__ import annotations

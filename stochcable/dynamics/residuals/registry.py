@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Any, Protocol
 
-from stochcable.dynamics.residuals.drag_residual import drag_residual
+from stochcable.dynamics.residuals.drag_residual_3d import drag_residual_lines
 from stochcable.dynamics.residuals.geometric_residual import geometric_residual
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
 from stochcable.results.records import ResidualRecord
@@ -38,7 +38,7 @@ class ResidualFunction(Protocol):
 
 
 COMPUTE: dict[str, ResidualFunction] = {
-    "drag_residual": drag_residual,
+    "drag_residual": drag_residual_lines,
     "geometric_residual": geometric_residual,
 }
 """The compute function of every registered residual kind, by its name."""

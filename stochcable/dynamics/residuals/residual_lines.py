@@ -16,7 +16,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.fft
 
 from stochcable.dynamics.loads.freqblocks import frequency_slices
 from stochcable.dynamics.model.blocks import (
@@ -99,9 +98,20 @@ def cross_covariance(x: np.ndarray, y: np.ndarray, n_fft: int) -> np.ndarray:
 
 
 def fft_length(n: int) -> int:
-    """The shortest lag grid of at least ``n`` samples whose real FFT is fast (a
-    5-smooth length: 763 → 768, 769 → 800)."""
-    return int(scipy.fft.next_fast_len(int(n), real=True))
+    """The shortest lag grid of at least ``n`` ≥ 1 samples whose real FFT is fast: the
+    least 5-smooth number ≥ n (763 → 768, 769 → 800), as ``scipy.fft.next_fast_len(n,
+    real=True)`` gives it (equal for every n, tests/dynamics/test_drag_residual.py),
+    without importing ``scipy.fft`` and the ``scipy.special`` it loads (~35 ms)."""
+    n = int(n)
+    best = 1 << (n - 1).bit_length()  # the least power of two ≥ n
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:  # p35 = 3^b 5^c: the least p35·2^a ≥ n
+            best = min(best, p35 << max(0, -(-n // p35) - 1).bit_length())
+            p35 *= 3
+        p5 *= 5
+    return best
 
 
 def covariance_lines(cov: np.ndarray, n_o: int) -> np.ndarray:

@@ -98,7 +98,8 @@ def _drag_load(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndar
         return None
     drag_blocks(system, damping)
     if inp.has_fluid:
-        f = element_load(damping._cache["elements"], inp.moments)
+        el = damping._cache["elements"]
+        f = element_load(el if system.lift is None else el + system.lift, inp.moments)
     else:
         f = np.zeros(inp.velocity.shape, dtype=complex)
     if inp.velocity is not None and np.any(damping.b_node):
@@ -122,6 +123,8 @@ def end_loads(system: LineSystem, inp: LineInputs, damping: Damping) -> np.ndarr
     if ends is not None:
         drag_blocks(system, damping)
         b = damping._cache["elements"]
+        if system.lift is not None:  # the lift of the waves (dynamics.model.lift)
+            b = b[[0, -1]] + system.lift[[0, -1]]
         f = np.stack(
             [
                 np.einsum("ij,jwc->iwc", b[0], ends[0]),
@@ -350,7 +353,10 @@ def free_load(
     el = damping._cache["elements"]
     for i, f in enumerate(inp.fluid):
         if f is not None:
-            rhs[..., i] += element_load(el, inp.fluid_block(i, freq))
+            mom = inp.fluid_block(i, freq)
+            rhs[..., i] += element_load(el, mom)
+            if system.lift is not None:  # the lift of the waves (dynamics.model.lift)
+                rhs[..., i] += element_load(system.lift, mom)
     if inp.ub is not None:
         act = _moving_channels(inp)
         ub = inp.ub[:, :, freq] if act is None else inp.ub[:, :, freq][..., act]

@@ -37,6 +37,7 @@ from stochcable.dynamics.model.blocks import (
     real_gemm,
     to_freq,
 )
+from stochcable.dynamics.model.lift import lift_band, lift_end_load, lift_end_rows, lift_pattern
 from stochcable.dynamics.model.modal_solvers import (
     DefectivePencilWarning,
     foss_modes,
@@ -98,12 +99,19 @@ def solve_free(
         bC = prep.bS + free_band(cd)
         if system.gyro is not None:  # a travelling line: + G (dynamics.model.transport)
             bC = bC + gyro_band(system.gyro, d)
+        if system.lift is not None:  # the linearized lift: + C_L (dynamics.model.lift)
+            pat = lift_pattern(system.model)
+            bC = bC + lift_band(system.lift, pat)
         for sl in slices:
             rhs_all = free_load(system, prep, inp, damping, sl)
             if system.gyro is not None and inp.ub is not None:
                 ga, gb = gyro_end_load(system.gyro, inp.ub[:, :, sl], w[sl])
                 rhs_all[1] += ga
                 rhs_all[-2] += gb
+            if system.lift is not None and inp.ub is not None:
+                la, lb = lift_end_load(system.lift, pat, inp.ub[:, :, sl], w[sl])
+                rhs_all[1] += la
+                rhs_all[-2] += lb
             rhs_f = to_freq(rhs_all[1:-1])
             u = solve_band_stacked(
                 prep.bK,
@@ -268,9 +276,12 @@ def reactions(
     iw = (1j * w)[:, None]
     out = []
     rg = None if system.gyro is None else gyro_end_rows(system.gyro, (u[1], u[-2]), w)
+    if system.lift is not None:  # the linearized lift's iω(C_L U) rows (dynamics.model.lift)
+        rl = lift_end_rows(system.lift, lift_pattern(system.model), (u[0], u[1], u[-2], u[-1]), w)
+        rg = rl if rg is None else (rg[0] + rl[0], rg[1] + rl[1])
     for k, (rk, rm, rc) in enumerate(zip(rows(prep.K), rows(prep.MT), rows(c))):
         r = rk - ww * rm + iw * rc - f_all[0 if k == 0 else -1]
-        if rg is not None:  # a travelling line's iω(G U) rows (dynamics.model.transport)
+        if rg is not None:  # iω(G U) and iω(C_L U) rows (dynamics.model.transport, lift)
             r = r + rg[k]
         out.append(np.moveaxis(r, 1, 0))  # (n_w, d, n_ch)
     return -np.concatenate(out, axis=1)

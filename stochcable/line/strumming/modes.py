@@ -22,7 +22,6 @@ import math
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from stochcable.line.fem import FEModel
 from stochcable.line.modes import Modes
@@ -90,6 +89,8 @@ def out_of_plane_modes(model: FEModel, omega_max: float) -> tuple[np.ndarray, np
         mf = m[sub]
         lam, vec = sla.eigh(k[sub], mf, subset_by_value=(-np.inf, top))
     else:
+        import scipy.sparse.linalg as spla  # (here: ~10 ms of import most analyses skip)
+
         i = np.arange(n - 1)
         rows = np.concatenate([i, i + 1, i, i + 1])
         cols = np.concatenate([i, i + 1, i + 1, i])

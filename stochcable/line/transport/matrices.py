@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from stochcable.errors import InputError
+from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.line.elements import STIFFNESS_PATTERN, expand_blocks
 from stochcable.line.fem import FEModel, chain_csr
 from stochcable.validation import finite_scalar
@@ -263,14 +263,36 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
     Raises
     ------
     InputError
-        ``lines[i].axial_speed``: at or above the critical speed (named), or on a line
-        with an end attached to a body; ``analysis.linearization.method`` "harmonic"
-        (no mean-flow term) with a travelling line (the coupled solve of lines and bodies has no
-        transport terms; docs/travelling.md).
+        ``lines[i].axial_speed`` at or above the critical speed (named);
+        ``analysis.linearization.method`` "harmonic" (no mean-flow term) with a
+        travelling line; a residual switched on for a line with a steady lift in a
+        current (the residuals' adjoint has no lift term; docs/travelling.md).
+
+    Warns
+    -----
+    PhysicsWarning
+        A travelling line on a body: the coupled modes of its group are those without
+        the gyroscopic term (the coupled response has it: the line's direct solve).
     """
     from stochcable.line.fem import build_fe_model
+    from stochcable.scene.residual_kinds import asked_residuals
 
+    asked = asked_residuals(scene.analysis.linearization)
+    current = any(p.speed > 0.0 for p in scene.environment.current)
     for i, line in enumerate(scene.lines):
+        lift = [j for j, seg in enumerate(line.segments) if seg.cl_steady != 0.0]
+        if asked and lift and current:
+            raise InputError(
+                f"analysis.linearization.{asked[0].name}",
+                True,
+                "-",
+                f"line '{line.name}' has a steady lift in the current "
+                f"(lines[{i}].segments[{lift[0]}].cl_steady = "
+                f"{line.segments[lift[0]].cl_steady:g}): the residuals' adjoint solve has "
+                "no term for the lift's non-symmetric damping (docs/travelling.md); "
+                "set analysis.linearization.drag_residual and geometric_residual to "
+                "false (the linear answer) or cl_steady to 0",
+            )
         if line.axial_speed == 0.0:
             continue
         model = build_fe_model(statics.lines[line.name], scene.environment, dim=3)
@@ -286,12 +308,10 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
             )
         bodies = [e.attach.body for e in (line.end_a, line.end_b) if e.attach is not None]
         if bodies:
-            raise InputError(
-                f"lines[{i}].axial_speed",
-                line.axial_speed,
-                "m/s",
-                f"a line attached to a body ('{bodies[0]}') cannot travel: the coupled "
-                "solve of lines and bodies has no transport terms (docs/travelling.md); "
-                "give its end a position and a prescribed motion (e.g. the vessel's "
-                "RAO), or set 0 for the line at rest",
+            warn(
+                f"line '{line.name}' travels (lines[{i}].axial_speed = "
+                f"{line.axial_speed:g} m/s) on body '{bodies[0]}': the coupled modes of its "
+                "group leave out the gyroscopic term (K + K_c and M only); the response "
+                "has it",
+                PhysicsWarning,
             )

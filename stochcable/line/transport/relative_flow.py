@@ -27,7 +27,13 @@ from stochcable.errors import ConvergenceError, InputError
 from stochcable.line.elements import STIFFNESS_PATTERN, expand_blocks, stiffness_blocks
 from stochcable.validation import finite_scalar, float_array, nonnegative, positive
 
-__all__ = ["FlowShape", "hu_jin_flow_force", "static_shape_in_flow"]
+__all__ = [
+    "FlowShape",
+    "hu_jin_flow_force",
+    "steady_lift_force",
+    "lift_velocity_jacobian",
+    "static_shape_in_flow",
+]
 
 _Y = np.array([0.0, 1.0, 0.0])
 _Z = np.array([0.0, 0.0, 1.0])
@@ -88,6 +94,92 @@ def hu_jin_flow_force(
         q * (cd * mag * vr[:, 1])[:, None] * _Y[None, :]
         + q * (cl * mag * mag)[:, None] * _Z[None, :]
     )
+
+
+def steady_lift_force(
+    tangents: np.ndarray, current: np.ndarray, speed: np.ndarray | float, coef: np.ndarray
+) -> np.ndarray:
+    """Steady lift per unit length of the relative flow on a line's elements, as the
+    scene statics apply it (docs/travelling.md).
+
+    Parameters
+    ----------
+    tangents : array_like, shape (n_el, 3)
+        Unit tangents e of the elements, end_a → end_b; z up. [-]
+    current : array_like, shape (n_el, 3)
+        Current U at the elements. [m/s]
+    speed : float or array_like, shape (n_el,)
+        Axial speed c of the material along e (0 on dry elements). [m/s]
+    coef : array_like, shape (n_el,)
+        ½ ρ C_L D of each element. [kg/m²]
+
+    Returns
+    -------
+    ndarray, shape (n_el, 3)
+        Force per unit current length; 0 where the current has no component normal
+        to the element (no cross-flow: no lift direction). [N/m]
+
+    Notes
+    -----
+    f_L = ½ρC_L D |V_r|² (ẑ·m̂) m̂, with V_r = U − c e the relative flow and
+    m̂ = e × U_n/|U_n| the unit normal to the element and the cross-flow
+    U_n = U − (U·e) e: the lift of Hu & Jin (2001, eq. 6), ½ρC_L D |V_r|², across the
+    flow and the element, on its upward side.  On their chord along x̂ in a flow V_f ŷ
+    it is ½ρC_L D (V_f² − 2cV_f v′ + c²) ẑ (1 + O(w′²)): eq. (6)'s b²(1 − k̄v′)² to
+    first order in the slopes.  The factor ẑ·m̂ keeps it continuous where m̂ turns
+    horizontal (a vertical element: no up side, no lift); a planar problem (current in
+    the vertical plane of the line) has m̂ horizontal and normal to it: no lift.
+    """
+    e = np.asarray(tangents, dtype=float)
+    u = np.asarray(current, dtype=float)
+    ua = np.einsum("ij,ij->i", u, e)
+    un = u - ua[:, None] * e
+    un2 = np.einsum("ij,ij->i", un, un)
+    m = np.cross(e, un)
+    rel = ua - speed
+    vr2 = un2 + rel * rel
+    scale = np.divide(coef * vr2 * m[:, 2], un2, out=np.zeros_like(un2), where=un2 > 0.0)
+    return scale[:, None] * m
+
+
+def lift_velocity_jacobian(
+    tangents: np.ndarray, current: np.ndarray, speed: np.ndarray | float, coef: np.ndarray
+) -> np.ndarray:
+    """∂f_L/∂U of :func:`steady_lift_force`: the linearized lift of a change of the
+    relative flow (the fluid's velocity minus the line's), at fixed tangents.
+
+    Parameters
+    ----------
+    tangents, current, speed, coef
+        As :func:`steady_lift_force`.
+
+    Returns
+    -------
+    ndarray, shape (n_el, 3, 3)
+        A with δf_L = A δV per unit length [N·s/m²]; zero where the mean flow has no
+        normal component (no lift direction to linearize about).
+
+    Notes
+    -----
+    Central differences with a step 1e-6 of the normal flow speed (f_L is smooth
+    where U_n ≠ 0; the truncation error is of order 1e-12 relative).  A check: f_L
+    is homogeneous of degree 2 in (U, c), so A U + c ∂f_L/∂c = 2 f_L.
+    """
+    e = np.asarray(tangents, dtype=float)
+    u = np.asarray(current, dtype=float)
+    coef = np.asarray(coef, dtype=float)
+    un = u - np.einsum("ij,ij->i", u, e)[:, None] * e
+    unorm = np.linalg.norm(un, axis=1)
+    h = 1e-6 * np.where(unorm > 0.0, unorm, 1.0)
+    jac = np.zeros(e.shape + (3,))
+    for k in range(3):
+        du = np.zeros_like(u)
+        du[:, k] = h
+        fp = steady_lift_force(e, u + du, speed, coef)
+        fm = steady_lift_force(e, u - du, speed, coef)
+        jac[:, :, k] = (fp - fm) / (2.0 * h)[:, None]
+    jac[unorm <= 0.0] = 0.0
+    return jac
 
 
 @dataclass(frozen=True, eq=False)
