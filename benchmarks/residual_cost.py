@@ -18,12 +18,15 @@ to the linear one, and the residual σ ratios (σ with / σ without) at the fair
     OPENBLAS_NUM_THREADS=1 python3 benchmarks/residual_cost.py [--repeat 3] [--profile LINE]
 
 Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
-analysis before issue 31 and 1.8–4.4× after (chain 4.4×, two-segment 3.2×, deep 2.5×,
-taut 1.8×; loaded host, ±1): exact steps (adjoint end tensions, pairs f ≥ e, the lag
-grid at the alias bound, one end influence) and approximate ones (Hermite orders 2
-and 3 carrying the higher orders' variance, 32 panels, 64 lines with resonant cells
-integrated, the geometric residual on 64 lines): corrected σ within −0.20…+0.33 % of
-before on the four lines and the inclined guy (tests/dynamics/test_drag_residual.py).
+analysis before issue 31, 1.8–4.4× after its first steps, and 1.6–2.2× now on a quiet
+host (chain 2.0–2.2×, two-segment 1.8×, taut 1.7×, deep 1.6–1.7×): exact steps
+(adjoint end tensions, pairs f ≥ e in cache-sized blocks, the lag grid at the alias
+bound, one end influence) and approximate ones (Hermite orders 2 and 3 carrying the
+higher orders' variance, 32 panels, 64 lines over the inputs' band with resonant cells
+integrated, the geometric residual on every second line, only the panels and elements
+whose forces reach the ends, the misfit on the residual's lines): corrected σ within
+−0.20…+0.33 % of before on the four lines and the inclined guy
+(tests/dynamics/test_drag_residual.py).
 """
 
 from __future__ import annotations

@@ -158,6 +158,10 @@ def scene_document(
     if sum(seg["elements"] for seg in d["lines"][0]["segments"]) < 2:
         d["lines"][0]["segments"][0]["elements"] = 2
     a = d["analysis"]
+    # the study's FD is the linear model (its settings' errors; the residuals are the
+    # separate "FD + residuals" column, fd_with_residuals): both switches false, the
+    # defaults since issue 31 being true
+    a.setdefault("linearization", {}).update(drag_residual=False, geometric_residual=False)
     a["modes"] = 100_000 if s.modes == "all" else s.modes  # clamped to the free DOFs
     om = a["omega"]
     om["max"] = om["max"] * s.omega_max_factor

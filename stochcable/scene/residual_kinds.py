@@ -77,7 +77,7 @@ class ResidualKind:
 # stochcable.dynamics.residuals (drag_residual.MAX_PANELS, geometric_residual.MAX_ELEMENTS
 # and .MAX_LINES; tests/test_cost.py checks they agree) — measured as told in
 # stochcable.cost's notes on the residuals.
-_DRAG_PANELS, _GEOMETRIC_ELEMENTS, _GEOMETRIC_LINES = 32, 400, 63
+_DRAG_PANELS, _GEOMETRIC_ELEMENTS, _GEOMETRIC_LINES = 32, 400, 31
 _DRAG_SECONDS, _GEOMETRIC_SECONDS = 2.0e-9, 3.0e-10
 # peak memory bounded by the blocks: the drag's ≤ 64 components on ≤ 128 lines (≤ 1024
 # and 128 before issue 31, when the times were measured), the geometric covariance

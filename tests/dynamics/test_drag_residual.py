@@ -159,6 +159,9 @@ def test_only_when_asked_and_out_of_scope_says_why():
         assert off.drag_residual is None and "drag_residual" not in off.to_document()
         doc = chain_surge_doc(20)
         doc["lines"][0]["segments"][0].update(cd_normal=0.0, cd_axial=0.0)
+        # (undamped, the geometric residual is 93 × the linear variance: out of range,
+        # it would leave no residual applied)
+        doc["analysis"]["linearization"]["geometric_residual"] = False
         zero = analyze(doc).lines["leg1"].drag_residual
         assert zero.computed and zero.variance == {"end_a": 0.0, "end_b": 0.0}
         doc = chain_surge_doc(20)
@@ -208,9 +211,13 @@ _V1 = TESTS / "residual_variances_v1.json"
 def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     """The settings of the evaluation before issue 31."""
     monkeypatch.setattr(rl, "MAX_LINES", 1024)
-    monkeypatch.setattr(gr, "MAX_LINES", None)  # (its grid: the drag's)
+    monkeypatch.setattr(rl, "LIVE_SHARE", 0.0)  # (the whole analysis grid on the lines)
+    monkeypatch.setattr(gr, "LINE_STRIDE", 1)  # (its grid: the drag's)
+    monkeypatch.setattr(gr, "ELEMENT_FLOOR", 0.0)  # (every element)
     monkeypatch.setattr(dr, "MAX_PANELS", 64)
     monkeypatch.setattr(dr, "SUB_SAMPLES", 1)
+    monkeypatch.setattr(dr, "MISFIT_EXACT", True)
+    monkeypatch.setattr(dr, "PANEL_FLOOR", 0.0)
     monkeypatch.setattr(dr.drag_residual, "__defaults__", (dr.HERMITE_ORDER, False, None))
 
 
@@ -233,8 +240,8 @@ def test_old_settings_reproduce_the_recorded_variances(monkeypatch: pytest.Monke
 def test_fast_evaluation_against_the_recorded_variances() -> None:
     """The default evaluation (orders 2 and 3 carrying the higher orders' variance, 32
     panels, 64 lines, the cells of unresolved resonances integrated) against the
-    recorded one on the benchmark lines and the inclined guy: corrected σ within 0.5 %
-    (measured −0.20 … +0.33 %; the guy, whose +18 % rides on a 0.7 %-damped mode:
+    recorded one on the benchmark lines and the inclined guy: corrected σ within 0.35 %
+    (issue 31's bound; measured −0.20 … +0.33 %; the guy, whose +18 % rides on a 0.7 %-damped mode:
     +0.16 %, and ±2 % with the lines sampled, not integrated); the geometric residual's
     part within 0.1 % on σ (its own variance moves by up to 45 % on the guy, 12 % on
     the taut wire, 1 % on the others, but it is ≤ 0.6 % of σ)."""
@@ -245,7 +252,7 @@ def test_fast_evaluation_against_the_recorded_variances() -> None:
             lin = got[name]["std_linear"][end] ** 2
             fast = math.sqrt(lin + got[name]["drag"][end] + got[name]["geometric"][end])
             old = math.sqrt(lin + by["drag"][end] + by["geometric"][end])
-            assert fast == pytest.approx(old, rel=0.005), (name, end)
+            assert fast == pytest.approx(old, rel=0.0035), (name, end)
             geo_f = math.sqrt(lin + got[name]["geometric"][end])
             geo_o = math.sqrt(lin + by["geometric"][end])
             assert geo_f == pytest.approx(geo_o, rel=1e-3), (name, end)

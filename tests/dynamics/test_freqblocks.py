@@ -150,6 +150,9 @@ def doc(n_el, n_w):
     d["analysis"].pop("timeseries", None)
     d["lines"][0]["segments"][0]["elements"] = n_el
     d["analysis"]["omega"]["count"] = n_w
+    # the linear model's blocking is the subject (the residuals' own peak, 0.61 GB
+    # extra at 400 elements x 2000 frequencies, is not yet bounded: issue 31)
+    d["analysis"]["linearization"] = {"drag_residual": False, "geometric_residual": False}
     return d
 stochcable.analyze(doc(10, 50))  # imports, compiled kernels, caches
 import stochcable.dynamics.loads.kinematics_kernels  # (large grids' compiled kinematics)

@@ -18,6 +18,7 @@ import pytest
 from _scenes import chain_surge_doc, td_end_sigma
 from scipy import stats
 
+import stochcable.dynamics.residuals.corrected as corrected
 import stochcable.dynamics.residuals.geometric_residual as gr
 from stochcable import analyze
 from stochcable.dynamics.residuals.geometric_residual import quadratic_output_lines
@@ -79,11 +80,14 @@ def _chain_no_drag(scale: float) -> dict:
     return doc
 
 
-def test_quadratic_forces_scale_with_the_motion_squared():
+def test_quadratic_forces_scale_with_the_motion_squared(monkeypatch):
     """No drag: the linear response is proportional to the motion and the geometric
     forces to its square, so (σ_with/σ_linear)² − 1 grows as the motion squared (×2 in
     motion: ×4; 1e-8 allows the round-off of ratio² − 1 ≈ 1e-3, formed from σ's of
-    1e-16 relative error, with margin)."""
+    1e-16 relative error, with margin).  The undamped resonance makes the variance
+    ratio 159, far beyond the range where the residuals are applied: the guard is lifted
+    (this checks the closed form's algebra, not its range)."""
+    monkeypatch.setattr(corrected, "RESIDUAL_VARIANCE_LIMIT", math.inf)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         one = analyze(_chain_no_drag(1.0)).lines["leg1"].geometric_residual

@@ -38,7 +38,7 @@ CABLE = {
 }  # fmt: skip
 
 
-#: The residuals' adjoint has no lift term (refused with lift): the linear answer.
+#: The linear answer (the tests of the linearized lift itself).
 LINEAR = {"drag_residual": False, "geometric_residual": False}
 
 
@@ -69,6 +69,66 @@ def _system(speed: float, cl: float = 0.6):
     return scene, build_line_system(scene, line, statics.lines[line.name], dim=3)
 
 
+def _dense_lift_and_gyro(system) -> tuple[np.ndarray, np.ndarray]:
+    """C_L and G assembled densely from the element blocks l0·A ⊗ P and m c."""
+    model = system.model
+    n, d, pat = model.n_nodes, model.dim, lift_pattern(model)
+    cl = np.zeros((n * d, n * d))
+    g = np.zeros((n * d, n * d))
+    for j in range(model.l0.size):
+        for a in range(2):
+            for b in range(2):
+                r, c = slice((j + a) * d, (j + a + 1) * d), slice((j + b) * d, (j + b + 1) * d)
+                cl[r, c] += pat[a, b] * system.lift[j]
+                if system.gyro is not None:
+                    g[r, c] += system.gyro[j] * [[0.0, 1.0], [-1.0, 0.0]][a][b] * np.eye(d)
+    return cl, g
+
+
+def _random_damping(model, rng) -> Damping:
+    n_el = model.l0.size
+    return Damping(
+        method="seed",
+        sigma=np.zeros(2 * n_el),
+        b_normal=rng.uniform(20.0, 60.0, n_el),
+        b_axial=rng.uniform(1.0, 5.0, n_el),
+        b_node=np.zeros(model.n_nodes),
+        model=model,
+    )
+
+
+@pytest.mark.filterwarnings("ignore::stochcable.errors.PhysicsWarning")
+@pytest.mark.parametrize("speed", [0.0, 3.0])
+def test_end_influence_with_lift_by_the_adjoint(speed):
+    """The residuals' end influence (end tension per unit node force, by the adjoint
+    solve with Aᵀ: C_Lᵀ and −G) equals the forward solve with the full non-symmetric
+    impedance, to 1e-9 (round-off), on the first, a middle and the last free DOF."""
+    from stochcable.dynamics.residuals.residual_lines import end_influence
+    from stochcable.dynamics.solve.line_solve import end_tension_from_support
+
+    scene, system = _system(speed)
+    model = system.model
+    damping = _random_damping(model, np.random.default_rng(35))
+    w = np.array([0.3, 1.7])
+    got = end_influence(system, damping, w)  # (2, n_nodes, d, n_w)
+    cl, g = _dense_lift_and_gyro(system)
+    K, M = model.K.toarray(), (model.M + model.Ma).toarray()
+    C = damping.matrix.toarray() + model.Cs.toarray() + g + cl
+    fr, fx, d = model.free, model.fixed, model.dim
+    e_hat = end_tension_from_support(system, np.eye(2 * d)[None].astype(complex))
+    for i, x in enumerate(w):
+        Z = K - x * x * M + 1j * x * C
+        for dof in fr[[0, 1, fr.size // 2, -2, -1]]:
+            f = np.zeros(K.shape[0])
+            f[dof] = 1.0
+            u = np.zeros(K.shape[0], complex)
+            u[fr] = np.linalg.solve(Z[np.ix_(fr, fr)], f[fr])
+            support = -(Z @ u - f)[fx]
+            for k, end in enumerate(("end_a", "end_b")):
+                t = np.real(e_hat[end][:, 0]) @ support
+                assert abs(got[k, dof // d, dof % d, i] - t) <= 1e-9 * max(abs(t), 1e-12)
+
+
 @pytest.mark.filterwarnings("ignore::stochcable.errors.PhysicsWarning")
 @pytest.mark.parametrize("speed", [0.0, 3.0])
 def test_direct_solve_with_lift_equals_the_assembled_impedance(speed):
@@ -79,16 +139,8 @@ def test_direct_solve_with_lift_equals_the_assembled_impedance(speed):
     scene, system = _system(speed)
     assert system.solver == "direct" and system.lift is not None
     model = system.model
-    rng = np.random.default_rng(34)
-    n_el, d = model.l0.size, model.dim
-    damping = Damping(
-        method="seed",
-        sigma=np.zeros(2 * n_el),
-        b_normal=rng.uniform(20.0, 60.0, n_el),
-        b_axial=rng.uniform(1.0, 5.0, n_el),
-        b_node=np.zeros(model.n_nodes),
-        model=model,
-    )
+    d = model.dim
+    damping = _random_damping(model, np.random.default_rng(34))
     w = np.array([0.05, 0.4, 1.3, 3.0])
     chans = []
     for k, name in ((2, "end_b.heave"), (0, "end_b.surge"), (1, "end_b.sway")):
@@ -99,16 +151,7 @@ def test_direct_solve_with_lift_equals_the_assembled_impedance(speed):
     resp = solve(system, tuple(chans), damping)
 
     n = model.n_nodes
-    pat = lift_pattern(model)
-    cl = np.zeros((n * d, n * d))
-    g = np.zeros((n * d, n * d))
-    for j in range(n_el):
-        for a in range(2):
-            for b in range(2):
-                r, c = slice((j + a) * d, (j + a + 1) * d), slice((j + b) * d, (j + b + 1) * d)
-                cl[r, c] += pat[a, b] * system.lift[j]
-                if system.gyro is not None:
-                    g[r, c] += system.gyro[j] * [[0.0, 1.0], [-1.0, 0.0]][a][b] * np.eye(d)
+    cl, g = _dense_lift_and_gyro(system)
     assert np.abs(cl).max() > 0.0 and not np.allclose(cl, cl.T)
     K = model.K.toarray()
     M = (model.M + model.Ma).toarray()
@@ -198,16 +241,29 @@ def test_laying_example_with_lift_frequency_domain_equals_time_domain(monkeypatc
         assert b.std() > 2.0 * b0.std()
 
 
-def test_residuals_refused_for_a_line_with_lift():
-    """The residuals' adjoint solve has no lift term: asked for on a line with lift in
-    a current, refused in one message naming the switch and the coefficient."""
-    from stochcable.dynamics.engine import build_engine
-    from stochcable.errors import InputError
+@pytest.mark.filterwarnings("ignore::Warning")
+def test_residuals_of_a_line_with_lift_are_computed(monkeypatch):
+    """The residuals' adjoint has the lift's Aᵀ (test above): a line with lift in a
+    current gets both residuals by default; their variance is finite and positive and
+    the corrected σ² is the linear σ² plus their variances (to round-off).  (This
+    light cable's residual variance is 2.3× its linear one at end_a, above the range
+    the residuals are applied in, RESIDUAL_VARIANCE_LIMIT, tested in test_hard_cases:
+    lifted here, the subject being the lift's path through the residuals.)"""
+    from stochcable.analysis import analyze
+    from stochcable.dynamics.residuals import corrected
 
+    monkeypatch.setattr(corrected, "RESIDUAL_VARIANCE_LIMIT", float("inf"))
     doc = json.loads(json.dumps(CABLE))
-    doc["analysis"] = {"linearization": {"drag_residual": True}}
-    with pytest.raises(InputError, match=r"drag_residual.*cl_steady = 0.6"):
-        build_engine(doc)
+    doc["sea"] = {"spectrum": {"type": "jonswap", "hs": 0.5, "tp": 8.0}}
+    line = analyze(doc).lines[doc["lines"][0]["name"]]
+    added = 0.0
+    for kind in ("drag_residual", "geometric_residual"):
+        rec = getattr(line, kind)
+        assert rec.computed, rec.reason
+        added += rec.variance["end_b"]
+    assert np.isfinite(added) and added > 0.0
+    lin = line.linear_end("end_b").std
+    assert line.end_b.std == pytest.approx(np.sqrt(lin**2 + added), rel=1e-9)
 
 
 @pytest.mark.filterwarnings("ignore::Warning")

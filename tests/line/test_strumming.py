@@ -152,6 +152,7 @@ def test_compiled_start_grid_equals_the_wake_closed_form(xi):
     Cardano roots) at every grid point: the same closed form, round-off apart (1e-9: the
     residual is a ratio of sums of ~40 terms; any wrong coefficient moves it by O(1));
     where the kernel's bound skips a point (marked 1.0), the residual is at least 0.5."""
+    from stochcable.line.strumming.bound import LockInGrid
     from stochcable.line.strumming.kernels import balance_grid
 
     psi, q, d, ws, mstar, st = _string_mode()  # a mode that locks in (test above)
@@ -163,7 +164,7 @@ def test_compiled_start_grid_equals_the_wake_closed_form(xi):
     amps = np.geomspace(1e-3, 3.0, 20) / np.max(np.abs(psi) / d)
     omegas = np.linspace(0.65, 1.35, 29) * wn
     grid = balance_grid(
-        amps, omegas, wn, xi, psi, q, d, ws, lift0, params.g, params.big_h, params.f
+        LockInGrid(amps, omegas, wn, xi, psi, q, d, ws, lift0, params.g, params.big_h, params.f)
     )
     a_, w_ = np.meshgrid(amps, omegas, indexing="ij")
     a_, w_ = a_.reshape(-1, 1), w_.reshape(-1, 1)
@@ -183,7 +184,7 @@ def test_numpy_bound_proves_what_the_kernel_proves(xi, amp_scale):
     """grid_is_proven (NumPy, checked before numba is imported) is True exactly when the
     compiled grid is proven at every point (all 1.0): the locking mode of the test above
     (not proven), a heavily damped one and tiny amplitudes (proven)."""
-    from stochcable.line.strumming.bound import grid_is_proven
+    from stochcable.line.strumming.bound import LockInGrid, grid_is_proven
     from stochcable.line.strumming.kernels import balance_grid
 
     psi, q, d, ws, mstar, st = _string_mode()
@@ -194,8 +195,8 @@ def test_numpy_bound_proves_what_the_kernel_proves(xi, amp_scale):
     params = wake_parameters(reduced_damping(mstar, xi, 1.0, 1.0, st), xi)
     amps = amp_scale * np.geomspace(1e-3, 3.0, 20) / np.max(np.abs(psi) / d)
     args = (amps, np.linspace(0.65, 1.35, 29) * wn, wn, xi, psi, q, d, ws, lift0)
-    grid = balance_grid(*args, params.g, params.big_h, params.f)
-    assert grid_is_proven(*args, params.g, params.big_h, params.f) == bool(np.all(grid == 1.0))
+    start = LockInGrid(*args, params.g, params.big_h, params.f)
+    assert grid_is_proven(start) == bool(np.all(balance_grid(start) == 1.0))
 
 
 # ------------------------------------------------------------------ Example 6

@@ -205,10 +205,10 @@ def check_lift_stability(system: Any, damping: Any, index: int | None = None) ->
     structural damping is left out (it only adds damping).  Every mode up to 600 free
     DOFs, the lowest 60 above.
     """
-    from stochcable.line.transport.modes import DENSE_AUTO_STATES, complex_modes
-
     if system.lift is None:
         return
+    from stochcable.line.transport.modes import DENSE_AUTO_STATES, complex_modes
+
     rest = build_fe_model(system.statics, system.environment, dim=system.model.dim)
     d = rest.dim
     pat = lift_pattern(rest)

@@ -40,7 +40,7 @@ from stochcable.dynamics.outputs.resolution import (
     tail_check,
 )
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
-from stochcable.dynamics.residuals.corrected import corrected_stats
+from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
 from stochcable.dynamics.residuals.registry import residual_parts
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
@@ -194,8 +194,13 @@ def line_result(
         residual[kind.name] = (
             fn(system, channels, linearization, std, influence=shared)
             if alone or influence is not None
-            else ResidualRecord.not_computed("a line on free bodies is not covered", std)
+            else ResidualRecord.not_computed(
+                "a travelling line or a line with a steady lift on free bodies is not "
+                "covered (the coupled influence leaves out the transport and lift terms)",
+                std,
+            )
         )
+    residual = residuals_in_range(system.name, residual, std)
     applied = [r for r in residual.values() if r.computed]
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None

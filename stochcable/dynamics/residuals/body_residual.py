@@ -27,7 +27,7 @@ Validation: against the assembled coupled system (:func:`stochcable.bodies.coupl
 :func:`stochcable.reference.bodies.solve_coupled_direct`) loaded by unit node forces
 (tests/dynamics/test_body_residual.py).
 
-Scope: lines that do not travel (no gyroscopic term).
+Scope: lines that do not travel (no gyroscopic term) and have no steady lift.
 
 References
 ----------
@@ -280,7 +280,7 @@ def coupled_influences(
     body_drag: Mapping[str, np.ndarray],
 ) -> dict[str, CoupledInfluence]:
     """The coupled influence of every line of a group (none for a group with a
-    travelling line: not covered).
+    travelling line or a line with a steady lift: not covered).
 
     Parameters
     ----------
@@ -297,7 +297,7 @@ def coupled_influences(
     -------
     dict of str to CoupledInfluence
     """
-    if any(cl.system.gyro is not None for cl in lines):
+    if any(cl.system.gyro is not None or cl.system.lift is not None for cl in lines):
         return {}
     group = [GroupLine(cl.name, cl.system, dampings[cl.name], tuple(cl.attached())) for cl in lines]
     return {ln.name: CoupledInfluence(ln.name, group, bodies, body_drag) for ln in group}

@@ -74,9 +74,14 @@ from stochcable.dynamics.residuals.drag_segments import (
 )
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
+    UniformGrid,
+    covariance_lines,
     element_directions,
     fft_length,
     load_transfer,
+    pair_blocks,
+    pair_lags,
+    pair_output_lines,
     residual_record,
     uniform_grid,
 )
@@ -108,14 +113,21 @@ RESIDUAL_WARN_RATIO = 1.25
 #: Orders of the default evaluation: 2 and 3, each carrying the variance of the higher
 #: orders of its parity (:func:`lumped_coefficients`). [-]
 LUMPED_ORDER = 3
+#: The misfit's end tensions per unit load solved at every analysis frequency (the
+#: evaluation before issue 31), not taken at the residual's nearest line
+#: (:func:`_misfit_variance`). [-]
+MISFIT_EXACT = False
+#: Panel components whose residual force times their largest end tension per unit force
+#: is below this fraction of the line's largest are left out (:func:`_live_panels`):
+#: the chain's 10 of 56 (pairs 1,596 → 1,081; residual variance −3e-5), the two-segment
+#: line's 12 of 54 (2e-6). [-]
+PANEL_FLOOR = 1e-4
 #: Points across a line's cell where the transfer functions of the residual loads are
 #: taken where the lines do not resolve them (:func:`cell_factor`). [-]
 SUB_SAMPLES = 5
 #: Bend of the log power between neighbouring lines (|Δ² ln P|) above which a cell's
 #: transfer functions are sub-sampled (:func:`cell_factor`). [-]
 CELL_BEND = 0.1
-#: Memory of the covariance functions held at a time (a block of panel pairs). [bytes]
-_BLOCK_BYTES = 32 * 2**20
 
 
 def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
@@ -228,7 +240,7 @@ def residual_output_lines(
         residual adds). [N²]
     """
     order = coeffs.shape[1] - 1
-    n_p, n_j = lines.shape[1], lines.shape[2]
+    n_p = lines.shape[1]
     sig = np.sqrt(np.einsum("cpj,cpj->p", lines.real, lines.real) + np.einsum(
         "cpj,cpj->p", lines.imag, lines.imag
     ))  # fmt: skip
@@ -239,37 +251,23 @@ def residual_output_lines(
     # k!·a_k^e·a_k^f·F_e·F_f = b_k^e·b_k^f, b_k = √k!·a_k·F
     b = np.sqrt([float(math.factorial(k)) for k in range(order + 1)]) * coeffs * force[:, None]
     n_o = transfer.shape[2]
-    out = np.zeros((transfer.shape[0], n_o))
-    # the pairs f ≥ e, the panels e in blocks (G_fe = conj(G_ef): the pairs f > e count
-    # twice), their covariance functions at a time
-    size = max(1, int(_BLOCK_BYTES // (24 * n_fft * max(n_p, 1))))
-    for start in range(0, n_p, size):
-        blk = slice(start, min(start + size, n_p))
-        f_all = slice(start, n_p)
-        cross = np.zeros((blk.stop - start, n_p - start, n_fft // 2 + 1), dtype=complex)
-        # Σ_c conj(z_ce)·z_cf per line: one matrix product per line
-        zz = np.conj(z[:, blk]).transpose(2, 1, 0) @ z[:, f_all].transpose(2, 0, 1)
-        cross[:, :, :n_j] = np.moveaxis(zz, 0, 2)
-        cross[:, :, 0] *= 2.0  # (irfft halves the zero-frequency line)
-        rho = np.fft.irfft(cross, n=n_fft, axis=2) * (0.5 * n_fft)
-        # Σ_{k≥2} b_k^e b_k^f ρ^k by Horner's rule
-        rr = b[blk, order, None, None] * b[None, f_all, order, None] * rho
-        for k in range(order - 1, 1, -1):
-            rr += b[blk, k, None, None] * b[None, f_all, k, None]
+    ks = [k for k in range(2, order + 1) if np.any(b[:, k] != 0.0)]  # (zero mean: no evens)
+    if not ks:
+        return np.zeros((transfer.shape[0], n_o))
+    # the pairs f ≥ e (G_fe = conj(G_ef)) in blocks: ρ_ef, Σ_k b_k^e b_k^f ρ^k by
+    # Horner's rule, its lines
+    zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
+    g = np.zeros((n_p, n_p, n_o), dtype=complex)
+    for e, f in pair_blocks(n_p, n_fft):
+        rho = pair_lags(zz, e, f, n_fft)
+        rr = (b[e, ks[-1]] * b[f, ks[-1]])[:, None] * rho
+        for k in range(ks[-1] - 1, ks[0] - 1, -1):
+            rr += (b[e, k] * b[f, k])[:, None]
             rr *= rho
-        rr *= rho
-        cr = (2.0 / n_fft) * np.fft.rfft(rr, axis=2)[:, :, 1 : n_o + 1]  # (n_b, n_f, n_o)
-        # weight 2 on the pairs above the diagonal, 1 on it
-        cr *= 2.0
-        diag = np.arange(blk.stop - start)
-        cr[diag, diag] *= 0.5
-        cr[np.arange(cr.shape[0])[:, None] > np.arange(cr.shape[1])[None, :]] = 0.0
-        # Σ_ef conj(T_e) G_ef T_f per line: G_j T_j as one matrix product per line
-        t_f = np.transpose(transfer[:, f_all], (2, 1, 0))  # (n_o, n_f, n_out)
-        tf = np.moveaxis(cr, 2, 0) @ t_f  # (n_o, n_b, n_out)
-        t_e = np.transpose(np.conj(transfer[:, blk]), (2, 1, 0))
-        out += np.einsum("jek,jek->kj", t_e, tf).real
-    return out
+        for _ in range(ks[0] - 1):
+            rr *= rho
+        g[e, f] = covariance_lines(rr, n_o) * np.where(f > e, 2.0, 1.0)[:, None]
+    return pair_output_lines(g, transfer)
 
 
 def drag_residual(
@@ -336,14 +334,15 @@ def drag_residual(
         return ResidualRecord.from_variances(zero, zero, std, order, 0)
     seg = segments(system, channels, sum(parts[n][0] for n in live), MAX_PANELS)
     groups = panel_groups(seg, MAX_PANELS)
-    grid = uniform_grid(w)
     seg_v = segment_velocity(system, channels, resp, seg, {n: parts[n][2] for n in live})
     spectra = np.stack([ch.spectrum for ch in channels])
+    grid = uniform_grid(w, spectra=spectra)
     n_o = order * (grid.n_j - 1)
     w_out = grid.step * np.arange(1, n_o + 1)
     # (ρ^K reaches line K·(n_j − 1): a lag grid of 2·K·(n_j − 1) + 1 samples resolves it)
     n_fft = fft_length(2 * order * (grid.n_j - 1) + 1)
     unit = panel_loads(model, seg, groups, [parts[n][2] for n in live])
+    influence = EndInfluence(system, damping) if influence is None else influence
     h_all = load_transfer(system, damping, unit, w_out, influence)
     # the normal and axial residuals of every panel are one set of components: they are
     # functions of jointly Gaussian velocities, so their cross terms count too (where
@@ -365,15 +364,24 @@ def drag_residual(
         misfit.append((pan, _misfit(seg, groups, c_el, mean_el, b_el, sig)))
     # a line on bodies: its coupled influence on every grid (body_residual)
     coupled = None if isinstance(influence, EndInfluence) else influence
+    lines_all, scale_all, coeff_all = (np.concatenate(lines, axis=1), np.concatenate(scales),
+                                       np.concatenate(coeffs))  # fmt: skip
+    keep = _live_panels(lines_all, scale_all, coeff_all, h_all)
     lines_t = residual_output_lines(
-        np.concatenate(lines, axis=1),
-        np.concatenate(scales),
-        np.concatenate(coeffs),
-        h_all,
-        n_fft,
+        lines_all[:, keep], scale_all[keep], coeff_all[keep], h_all[:, keep], n_fft
     ) * cell_factor(system, damping, unit, w_out, h_all, influence=coupled)
     linear = _misfit_variance(
-        system, damping, resp, spectra, seg, groups, live, parts, misfit, coupled
+        system,
+        damping,
+        resp,
+        spectra,
+        seg,
+        groups,
+        live,
+        parts,
+        misfit,
+        (grid, w_out, influence, _bent(h_all)),
+        coupled,
     )
     out = residual_record(lines_t, w_out, w, std, order, len(groups), linear)
     _warn_large(system.name, out)
@@ -386,6 +394,7 @@ def cell_factor(
     unit: np.ndarray,
     w_out: np.ndarray,
     h: np.ndarray,
+    bend: float = CELL_BEND,
     influence: Any = None,
 ) -> np.ndarray:
     """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
@@ -402,10 +411,7 @@ def cell_factor(
     between neighbours, and theirs; elsewhere the factor is 1 (no solve)."""
     power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
     out = np.ones_like(power)
-    logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
-    bend = np.zeros(power.shape[1], dtype=bool)
-    bend[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > CELL_BEND, 0)
-    cells = np.flatnonzero(bend | np.roll(bend, 1) | np.roll(bend, -1))
+    cells = np.flatnonzero(_bent(h, bend))
     if cells.size == 0:
         return out
     step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
@@ -416,6 +422,29 @@ def cell_factor(
     at = power[:, cells]
     out[:, cells] = np.where(at > 0, p_sub.mean(axis=2) / np.where(at > 0, at, 1.0), 1.0)
     return out
+
+
+def _live_panels(
+    lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray, h: np.ndarray
+) -> np.ndarray:
+    """The panel components (indices) whose residual force can reach the ends: the
+    largest |a_k| (k ≥ 2) times cσ²L times the largest end tension per unit force at
+    least :data:`PANEL_FLOOR` of the line's largest."""
+    sig2 = np.einsum("cpj,cpj->p", lines.real, lines.real) + np.einsum(
+        "cpj,cpj->p", lines.imag, lines.imag
+    )
+    score = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2 * np.abs(h).max(axis=(0, 2))
+    return np.flatnonzero(score >= PANEL_FLOOR * np.max(score, initial=0.0))
+
+
+def _bent(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
+    """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
+    panels, bends by more than ``bend`` between neighbours, and theirs."""
+    power = np.sum(np.abs(h) ** 2, axis=1)
+    logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
+    out = np.zeros(power.shape[1], dtype=bool)
+    out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
+    return out | np.roll(out, 1) | np.roll(out, -1)
 
 
 def _misfit(
@@ -456,13 +485,21 @@ def _misfit_variance(
     live: list[str],
     parts: dict[str, Any],
     misfit: list[tuple[np.ndarray, np.ndarray]],
-    influence: Any = None,
+    lines: tuple[UniformGrid, np.ndarray, Any, np.ndarray],
+    coupled: Any = None,
 ) -> dict[str, np.ndarray]:
     """The end-tension variance the linear misfit of the element-constant drag changes,
     as lines on the analysis grid (empty without split elements): its load δB·l·v on
     the pieces of split elements is linear in the response, so its end tension H_c
     adds to the linear H_L (Σ_c S_c (|H_L + H_c|² − |H_L|²) times the trapezoid
-    weights of the linear σ; it may be negative). [N²]"""
+    weights of the linear σ; it may be negative). [N²]
+
+    ``lines`` (grid, w_out, influence, bent): the end tensions per unit load are taken
+    at the residual's line nearest each analysis frequency (no solve of their own:
+    chain 0.2 % of the misfit's variance, itself 0.04 % of the residual's), and solved
+    at the frequency itself where the line's cell is ``bent`` (:func:`_bent`: a
+    resonance narrower than a line; on the inclined guy 253 of its 300 frequencies),
+    through ``coupled`` (a line on bodies: its coupled influence) where given."""
     w = np.asarray(resp.omega, dtype=float)
     keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
     if not keep:
@@ -472,7 +509,12 @@ def _misfit_variance(
         [panel_loads(system.model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
         axis=2,
     )
-    h = load_transfer(system, damping, unit, w, influence)  # (2, n_load, n_w)
+    grid, w_out, influence, bent = lines
+    at = np.clip(grid.index - 1, 0, w_out.size - 1)  # (line j is w_out[j − 1])
+    h = load_transfer(system, damping, unit, w_out, influence)[:, :, at]  # (2, n_load, n_w)
+    exact = np.arange(w.size) if MISFIT_EXACT else np.flatnonzero(bent[at])
+    if exact.size:
+        h[:, :, exact] = load_transfer(system, damping, unit, w[exact], coupled)
     load = np.concatenate(
         [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
     )  # (n_ch, n_load, n_w)

@@ -26,9 +26,8 @@ Orders ≥ 2 are uncorrelated with the linear response; their end-tension varian
 lines follow as in 2-D (:func:`vector_residual_output_lines`).  The orders kept are
 2 and 3, each output's top order of each parity carrying the variance of the higher
 ones of its parity (as :func:`~stochcable.dynamics.residuals.drag_residual.lumped_coefficients`;
-across the two normal components and across panels the lumped orders keep the
-lag shape of the top order: within 3 % of Monte Carlo where orders to 9 are within
-0.1 %).
+across normal components and panels they keep the top order's lag shape: within 3 %
+of Monte Carlo, where orders to 9 are within 0.1 %).
 
 The linear model of a 3-D line differs from the exact fit where the ``seed`` method
 is used: it damps the normal plane isotropically with B = ρC_dD·E|w|, w ~ N(|m|,
@@ -40,13 +39,9 @@ misfit of split elements does in 2-D (with which it is formed here: the pieces o
 split element against their element's mean covariance).  The ``vector`` method has
 no form misfit.
 
-Validation: the covariance functions and the filtered output variance against
-Monte-Carlo realizations of correlated Gaussian normal and axial velocities with a
-mean (tests/dynamics/test_drag_residual_3d.py); a 3-D model of a planar line gives
-the 2-D residual; against the nonlinear time domain's end σ (5 seeds; end_b / end_a):
-the inclined guy in its sea turned to 45°, linear FD −15 %, with the residual −1.5 /
-−1.3 % (95 % interval ±3 %); the taut wire turned to 45°, linear FD +29 / +14 % (the
-seed form over-drives it), with the residual +1.0 / +1.1 % (interval ±5 %).
+Validation: Monte Carlo of correlated Gaussian velocities with a mean
+(tests/dynamics/test_drag_residual_3d.py), the 2-D residual from a 3-D planar line, and
+the nonlinear time domain (figures in docs/benchmarks/drag_residual.md).
 
 Scope: 3-D lines, ``seed`` and ``vector`` methods (not ``harmonic``), the line
 elements' drag (not attachments'), at most

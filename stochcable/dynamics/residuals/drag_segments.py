@@ -254,11 +254,24 @@ def segment_velocity(
         if moments is None and ch.element_velocity_parts is not None:  # (the sea's parts)
             moments = ch.element_velocity_parts
         if ch.kind == "sea" and ch.heading is not None and moments is not None:
-            if sub is None:
-                sub = _subdivided_points(system, seg)
-            env = system.environment
-            kin = element_wave_kinematics(np.asarray(ch.omega), sub, ch.heading, env.depth, env.g)
-            vel[..., c] += kin.velocity.sum(axis=2)
+            # the split elements' pieces (a run of them: from the first to the last)
+            # integrated on the subdivided shape, the whole elements' from the channel
+            fine = np.flatnonzero(seg.fine)
+            run = slice(int(fine[0]), int(fine[-1]) + 1) if fine.size else slice(0, 0)
+            if run.stop > run.start:
+                if sub is None:
+                    sub = _subdivided_points(system, seg)[run.start : run.stop + 1]
+                env = system.environment
+                kin = element_wave_kinematics(
+                    np.asarray(ch.omega), sub, ch.heading, env.depth, env.g
+                )
+                vel[:, run, :, c] += kin.velocity.sum(axis=2)
+            rest = np.ones(seg.size, dtype=bool)
+            rest[run] = False
+            if rest.any():
+                full = moments if isinstance(moments, np.ndarray) else moments.full()
+                v_c = vel[..., c]  # (a view)
+                v_c[:, rest] += full.sum(axis=2)[:, e[rest]]
         elif moments is not None:
             full = moments if isinstance(moments, np.ndarray) else moments.full()
             vel[..., c] += full.sum(axis=2)[:, e]

@@ -35,13 +35,17 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
+from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     covariance_lines,
-    cross_covariance,
     element_directions,
     fft_length,
     load_transfer,
+    pair_blocks,
+    pair_lags,
+    pair_output_lines,
     residual_record,
     uniform_grid,
 )
@@ -49,14 +53,20 @@ from stochcable.results.records import ResidualRecord
 
 __all__ = ["MAX_ELEMENTS", "geometric_residual", "quadratic_output_lines"]
 
-#: Most lines of its uniform grid (63: 64 lines, a lag grid of 256): its share of the
-#: corrected σ is small (≤ 0.6 % on the benchmark lines), so its own error matters less
-#: than the drag's. [-]
-MAX_LINES = 63
+#: Its uniform grid: every LINE_STRIDE-th line of the drag residual's (2: 32 lines, a
+#: lag grid of 125, against 64 and 256; its end influence a part of the drag's): its
+#: share of the corrected σ is small (≤ 0.6 % on the benchmark lines), so its own error
+#: matters less than the drag's. [-]
+LINE_STRIDE = 2
+#: Most lines of its grid (every second of the drag residual's at most 64). [-]
+MAX_LINES = RESIDUAL_LINES // LINE_STRIDE
+#: Elements whose quadratic force σ times their largest end tension per unit force is
+#: below this fraction of the line's largest are left out (:func:`_live_elements`): the
+#: chain's 19 grounded elements of 40 (their share of its variance 5e-8), the
+#: two-segment line's 23 (4e-11); pairs 820 → 231 and 153. [-]
+ELEMENT_FLOOR = 1e-4
 #: Most elements the residual is computed for. [-]
 MAX_ELEMENTS = 400
-#: Memory of the covariance functions held at a time (a block of element pairs). [bytes]
-_BLOCK_BYTES = 64 * 2**20
 
 
 def geometric_residual(
@@ -96,7 +106,6 @@ def geometric_residual(
         )
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
-    grid = uniform_grid(w, MAX_LINES)
     comps = list(model.components)
     d = model.dim
     n_ch = len(channels)
@@ -108,6 +117,7 @@ def geometric_residual(
     u[:, :, comps] = resp.displacement.reshape(w.size, model.n_nodes, d, n_ch)
     du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, 3, n_ch)
     spectra = np.stack([ch.spectrum for ch in channels])
+    grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
     proc = [grid.lines(np.einsum("wedc,ed->cew", du, f), spectra) for f in frames]
     mesh = model.mesh
@@ -116,18 +126,45 @@ def geometric_residual(
     comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [
         [(1.0, 0, k)] for k in range(1, len(frames))
     ]
-    unit = np.zeros((model.n_nodes, d, len(comp_terms) * n_el))
+    # unit pairs κ·f_e: + on node e + 1, − on node e (component-major columns)
+    unit = np.zeros((model.n_nodes, d, len(comp_terms), n_el))
+    el = np.arange(n_el)
     for i, f in enumerate(frames):
-        for e in range(n_el):
-            unit[e + 1, :, i * n_el + e] += kappa[e] * f[e, comps]
-            unit[e, :, i * n_el + e] -= kappa[e] * f[e, comps]
+        force = kappa[:, None] * f[:, comps]  # (n_el, d)
+        unit[el + 1, :, i, el] += force
+        unit[el, :, i, el] -= force
+    unit = unit.reshape(model.n_nodes, d, -1)
     n_o = 2 * (grid.n_j - 1)
     w_out = grid.step * np.arange(1, n_o + 1)
     # (2, n_comp·n_el, n_o)
     h = load_transfer(system, linearization.damping, unit, w_out, influence)
     n_fft = fft_length(4 * (grid.n_j - 1) + 1)  # (products reach line 2·(n_j − 1))
-    lines = quadratic_output_lines(proc, comp_terms, h, n_fft)
+    keep = _live_elements(proc, comp_terms, h)
+    cols = (np.arange(len(comp_terms))[:, None] * n_el + keep[None]).ravel()
+    proc, h, unit = [x[:, keep] for x in proc], h[:, cols], unit[:, :, cols]
+    # the cells of a resonance narrower than a line integrated, as the drag's (a bend
+    # of the log power scales with the line spacing squared: the drag's threshold at
+    # its lines; chain: 26 cells at the drag's threshold, none at this one)
+    lines = quadratic_output_lines(proc, comp_terms, h, n_fft) * cell_factor(
+        system, linearization.damping, unit, w_out, h, CELL_BEND * LINE_STRIDE**2
+    )
     return residual_record(lines, w_out, w, std, 2, n_el)
+
+
+def _live_elements(
+    processes: list[np.ndarray], terms: list[list[tuple[float, int, int]]], h: np.ndarray
+) -> np.ndarray:
+    """The elements (indices) whose quadratic forces can reach the ends: the largest
+    over their components of Σ|coef|·σ_x·σ_y times the largest end tension per unit
+    component at least :data:`ELEMENT_FLOOR` of the line's largest."""
+    sig = [np.sqrt(np.sum(np.abs(p) ** 2, axis=(0, 2))) for p in processes]
+    n_el = sig[0].size
+    reach = np.abs(h).max(axis=(0, 2)).reshape(len(terms), n_el)
+    score = np.max(
+        [sum(abs(c) * sig[x] * sig[y] for c, x, y in t) * reach[i] for i, t in enumerate(terms)],
+        axis=0,
+    )
+    return np.flatnonzero(score >= ELEMENT_FLOOR * np.max(score, initial=0.0))
 
 
 def quadratic_output_lines(
@@ -160,25 +197,24 @@ def quadratic_output_lines(
     n_p = len(processes)
     n_el = processes[0].shape[1]
     n_o = transfer.shape[2]
-    out = np.zeros((transfer.shape[0], n_o))
-    # the elements f ≥ e paired with e (G_fe = conj(G_ef): the pairs f > e count twice)
-    # in blocks: n_p² covariance functions of a block at a time
-    size = max(1, int(_BLOCK_BYTES // (8 * n_fft * (n_p * n_p + 2))))
-    for e in range(n_el):
-        for start in range(e, n_el, size):
-            blk = slice(start, min(start + size, n_el))
-            r = [[cross_covariance(processes[x][:, e], processes[y][:, blk], n_fft)
-                  for y in range(n_p)] for x in range(n_p)]  # fmt: skip
-            twice = np.where(np.arange(blk.start, blk.stop) > e, 2.0, 1.0)[:, None]
-            for i, terms_i in enumerate(terms):
-                h_i = np.conj(transfer[:, i * n_el + e])
-                for j, terms_j in enumerate(terms):
-                    cov = sum(
-                        ci * cj * (r[x1][x2] * r[y1][y2] + r[x1][y2] * r[y1][x2])
-                        for ci, x1, y1 in terms_i
-                        for cj, x2, y2 in terms_j
-                    )
-                    cl = covariance_lines(cov, n_o) * twice  # e's component i, the block's j
-                    h_j = transfer[:, j * n_el : (j + 1) * n_el][:, blk]
-                    out += np.real(h_i * np.einsum("opj,pj->oj", h_j, cl))
-    return out
+    # Σ_c conj(x_ce)·y_cf per line of every two processes and elements
+    cross = {
+        (x, y): np.conj(processes[x]).transpose(2, 1, 0) @ processes[y].transpose(2, 0, 1)
+        for x in range(n_p)
+        for y in range(n_p)
+    }
+    # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks
+    g = np.zeros((len(terms), n_el, len(terms), n_el, n_o), dtype=complex)
+    for e, f in pair_blocks(n_el, n_fft, 2):
+        r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}
+        twice = np.where(f > e, 2.0, 1.0)[:, None]
+        for i, terms_i in enumerate(terms):
+            for j, terms_j in enumerate(terms):
+                cov = sum(
+                    ci * cj * (r[x1, x2] * r[y1, y2] + r[x1, y2] * r[y1, x2])
+                    for ci, x1, y1 in terms_i
+                    for cj, x2, y2 in terms_j
+                )
+                g[i, e, j, f] = covariance_lines(cov, n_o) * twice  # e's component i, f's j
+    n = len(terms) * n_el
+    return pair_output_lines(g.reshape(n, n, n_o), transfer)

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stochcable.errors import InputError
-from stochcable.line.strumming.bound import grid_is_proven
+from stochcable.line.strumming.bound import LockInGrid, grid_is_proven
 from stochcable.validation import finite_scalar
 
 __all__ = [
@@ -479,15 +479,15 @@ def lock_in_balance(
 
     ln_a = np.log(np.geomspace(1e-3, 3.0, 20) / y_scale)
     ratio = np.linspace(0.65, 1.35, 29)
-    args = (np.exp(ln_a), ratio * omega_n, omega_n, damping_ratio, ps, qs, ds, ws, c0)
-    if grid_is_proven(*args, params.g, params.big_h, params.f):
-        return none  # every point proven: no start, and no compiled kernel needed
-    from stochcable.line.strumming.kernels import balance_grid  # numba: lazily
-
-    grid = balance_grid(
+    start = LockInGrid(
         np.exp(ln_a), ratio * omega_n, omega_n, damping_ratio, ps, qs, ds, ws, c0,
         params.g, params.big_h, params.f,
     )  # fmt: skip
+    if grid_is_proven(start):
+        return none  # every point proven: no start, and no compiled kernel needed
+    from stochcable.line.strumming.kernels import balance_grid  # numba: lazily
+
+    grid = balance_grid(start)
     if not grid.min() < _START_TOL:  # no start: no root is refined (the common case)
         return none
     # starts: the grid's local minima below _START_TOL (a grid point farther than that

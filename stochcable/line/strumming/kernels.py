@@ -35,6 +35,7 @@ import numpy as np
 from numba import types
 
 from stochcable.compiled import jit_cached
+from stochcable.line.strumming.bound import LockInGrid
 
 __all__ = ["balance_grid"]
 
@@ -159,58 +160,35 @@ _SIGNATURE = types.void(
 _kernel, _ = jit_cached(_balance_grid, _SIGNATURE, "strumming lock-in start grid")
 
 
-def balance_grid(
-    amps: np.ndarray,
-    omegas: np.ndarray,
-    omega_n: float,
-    damping_ratio: float,
-    psi: np.ndarray,
-    q: np.ndarray,
-    diameter: np.ndarray,
-    omega_s: np.ndarray,
-    lift0: np.ndarray,
-    g: float,
-    big_h: float,
-    f: float,
-) -> np.ndarray:
+def balance_grid(grid: LockInGrid) -> np.ndarray:
     """Relative residual of the modal lock-in balance on a grid.
 
     Parameters
     ----------
-    amps : ndarray, shape (n_a,)
-        Modal amplitudes A. [kg^1/2·m]
-    omegas : ndarray, shape (n_w,)
-        Response frequencies ω. [rad/s]
-    omega_n : float
-        Natural frequency. [rad/s]
-    damping_ratio : float
-        ξ of the mode. [-]
-    psi, q, diameter, omega_s, lift0 : ndarray, shape (n,)
-        Mode displacement along the lift [kg^-1/2], ½ρDU_n²L [N], diameter [m],
-        shedding frequency [rad/s] and C_L0 [-] of the shedding elements.
-    g, big_h, f : float
-        Ḡ, H̄, F̄ of the wake oscillator. [-]
+    grid : LockInGrid
+        The start grid and the mode's shedding elements.
 
     Returns
     -------
     ndarray, shape (n_a, n_w)
         |Z A − L|/(|Z A| + |L|), or 1.0 where a bound proves it is at least 0.5. [-]
     """
-    out = np.empty((amps.size, omegas.size))
     as_f = np.ascontiguousarray
+    amps, omegas = as_f(grid.amps, float), as_f(grid.omegas, float)
+    out = np.empty((amps.size, omegas.size))
     _kernel(
-        as_f(amps, float),
-        as_f(omegas, float),
-        float(omega_n),
-        float(damping_ratio),
-        as_f(psi, float),
-        as_f(q, float),
-        as_f(diameter, float),
-        as_f(omega_s, float),
-        as_f(np.asarray(lift0, float) ** 2),
-        float(g),
-        float(big_h),
-        float(f),
+        amps,
+        omegas,
+        float(grid.omega_n),
+        float(grid.damping_ratio),
+        as_f(grid.psi, float),
+        as_f(grid.q, float),
+        as_f(grid.diameter, float),
+        as_f(grid.omega_s, float),
+        as_f(np.asarray(grid.lift0, float) ** 2),
+        float(grid.g),
+        float(grid.big_h),
+        float(grid.f),
         out,
     )
     return out

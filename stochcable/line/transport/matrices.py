@@ -265,8 +265,7 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
     InputError
         ``lines[i].axial_speed`` at or above the critical speed (named);
         ``analysis.linearization.method`` "harmonic" (no mean-flow term) with a
-        travelling line; a residual switched on for a line with a steady lift in a
-        current (the residuals' adjoint has no lift term; docs/travelling.md).
+        travelling line.
 
     Warns
     -----
@@ -275,24 +274,8 @@ def check_travelling_lines(scene: Any, statics: Any) -> None:
         the gyroscopic term (the coupled response has it: the line's direct solve).
     """
     from stochcable.line.fem import build_fe_model
-    from stochcable.scene.residual_kinds import asked_residuals
 
-    asked = asked_residuals(scene.analysis.linearization)
-    current = any(p.speed > 0.0 for p in scene.environment.current)
     for i, line in enumerate(scene.lines):
-        lift = [j for j, seg in enumerate(line.segments) if seg.cl_steady != 0.0]
-        if asked and lift and current:
-            raise InputError(
-                f"analysis.linearization.{asked[0].name}",
-                True,
-                "-",
-                f"line '{line.name}' has a steady lift in the current "
-                f"(lines[{i}].segments[{lift[0]}].cl_steady = "
-                f"{line.segments[lift[0]].cl_steady:g}): the residuals' adjoint solve has "
-                "no term for the lift's non-symmetric damping (docs/travelling.md); "
-                "set analysis.linearization.drag_residual and geometric_residual to "
-                "false (the linear answer) or cl_steady to 0",
-            )
         if line.axial_speed == 0.0:
             continue
         model = build_fe_model(statics.lines[line.name], scene.environment, dim=3)
