@@ -20,7 +20,7 @@ from stochcable.errors import (
 # ``import stochcable`` (and the CLI's start-up) stays light.
 _LAZY = {
     "analyze": ("analysis", "analyze"),
-    "build_engine": ("dynamics.engine", "build_engine"),
+    "build_engine": ("analysis", "build_engine"),
     "load_scene": ("io", "load_scene"),
     "read_moordyn": ("io", "read_moordyn"),
     "write_moordyn": ("io", "write_moordyn"),

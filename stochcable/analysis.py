@@ -49,9 +49,12 @@ import time
 from collections.abc import Mapping
 from typing import Any
 
-from stochcable.dynamics.engine import Engine, build_engine
+from stochcable.dynamics.engine import Engine
+from stochcable.dynamics.engine import build_engine as _build_unchecked
 from stochcable.dynamics.model.system import Progress, noop_progress
-from stochcable.errors import PhysicsWarning, ResolutionWarning, warn
+from stochcable.errors import PhysicsWarning, warn
+from stochcable.fidelity.mesh_engine import checked_build
+from stochcable.fidelity.mesh_engine import checked_engine as build_engine
 from stochcable.results.documents import Result
 from stochcable.scene.model import Scene, load_scene
 from stochcable.statics import StaticsResult
@@ -109,32 +112,19 @@ def analyze(
     if scene.analysis.fidelity is not None:
         scene, plan = _plan_fidelity(scene, progress)
         statics = None  # the mesh changed
-    result = build_engine(scene, statics=statics, progress=progress).solve(progress=progress)
-    if plan is None:
-        return _checked_mesh(scene, result, progress, t_start)
-    return _with_plan(result, plan, time.perf_counter() - t_start)
-
-
-def _checked_mesh(scene: Scene, result: Result, progress: Progress, t_start: float) -> Result:
-    """The analysis again with the default element counts of the segments that left
-    ``elements`` out, when the pilot's count is too coarse, and a ResolutionWarning
-    per explicit count above the limit (:mod:`stochcable.fidelity.mesh_check`)."""
-    from stochcable.fidelity import mesh_check as mc
-
-    omitted = mc.omitted_counts(scene)
-    est = mc.mesh_estimates(result)
-    finer = mc.default_counts(scene, est, omitted) if omitted else None
-    if finer is not None:
-        result = build_engine(finer, progress=progress).solve(progress=progress)
-        est = mc.mesh_estimates(result)
-    texts = mc.mesh_warnings(est, omitted)
-    if finer is None and not texts:
+    if plan is not None:  # (the planned counts: no element check)
+        result = _build_unchecked(scene, progress=progress).solve(progress=progress)
+        return _with_plan(result, plan, time.perf_counter() - t_start)
+    # the element check (stochcable.fidelity.mesh_engine): default counts that meet
+    # the element rules, a warning on the counts that do not
+    engine, result = checked_build(scene, statics=statics, progress=progress)
+    if result is None:
+        result = engine.solve(progress=progress)
+    if engine.scene is scene:
         return result
-    for text in texts:
-        warn(text, ResolutionWarning)
-    timing = dict(result.timing)
+    timing = dict(result.timing)  # (with the pilot on the default mesh)
     timing["total_s"] = time.perf_counter() - t_start
-    return dataclasses.replace(result, warnings=(*texts, *result.warnings), timing=timing)
+    return dataclasses.replace(result, timing=timing)
 
 
 def _plan_fidelity(scene: Scene, progress: Progress) -> tuple[Scene, Any]:

@@ -176,7 +176,8 @@ def collect_warnings() -> Iterator[list[Warning]]:
     try:
         yield sink
     finally:
-        sinks.remove(sink)
+        # by identity: nested sinks holding the same warnings compare equal
+        del sinks[next(i for i in range(len(sinks) - 1, -1, -1) if sinks[i] is sink)]
 
 
 def forward_warnings(caught: Iterable[Warning]) -> None:

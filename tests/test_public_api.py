@@ -17,7 +17,7 @@ import stochcable
 
 EXPECTED = {
     "analyze": "stochcable.analysis",
-    "build_engine": "stochcable.dynamics.engine",
+    "build_engine": "stochcable.fidelity.mesh_engine",  # (with the element check)
     "load_scene": "stochcable.io",  # (also reads MoorDyn input files)
     "Scene": "stochcable.scene.model",
     "solve_statics": "stochcable.statics",

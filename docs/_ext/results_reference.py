@@ -495,12 +495,15 @@ _REST = {
         "-",
         "Estimated relative error per part of the discretization (band, grid, elements, "
         "modes, linearization: the fixed point's tolerance), their sum ``discretization``, "
-        "``linearization_model`` (the linear model's own error against the nonlinear time "
-        "domain, calibrated: ``stochcable.fidelity.model_error``) and ``total``.",
+        "``linearization_model`` (the model's own error against the nonlinear time "
+        "domain: with the residuals computed, the square of the σ change they make plus "
+        "the one-sided bed's share on a grounded line; otherwise calibrated per class "
+        "of line: ``stochcable.fidelity.model_error``) and ``total``.",
     ),
     "fidelity.model_error_basis": (
         "",
-        "Which line and term give ``linearization_model``, and the source of its calibration.",
+        "Which line and term give ``linearization_model``: the residuals' σ change, or "
+        "the source of its calibration.",
     ),
     "fidelity.cost": ("-", "Elements, frequencies and their product of the plan applied."),
     "fidelity.tail_bounded": ("", "Whether the response variance above the band could be bounded."),

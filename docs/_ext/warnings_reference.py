@@ -45,7 +45,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "Too few elements for the end-tension σ",
         "ResolutionWarning",
-        ("stochcable.analysis:_checked_mesh",),
+        ("stochcable.fidelity.mesh_engine:__call__",),
         "A segment's estimated discretization error of the end-tension σ above "
         "MESH_ERROR_LIMIT: the larger of (kh)²/24, k = ω₂√⟨1/c²⟩ (string wave at the "
         "end tension's mean frequency ω₂ = √(m₂/m₀)), and (h/suspended length)² on a "
@@ -53,7 +53,10 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "wavenumber, on a segment wholly in the wave zone (nodal wave kinematics). "
         "Explicit ``elements`` only; "
         "a segment without ``elements`` gets a count that meets the limit, and warns "
-        "only when that count hits the scene model's limit",
+        "only when that count hits the scene model's limit — or, on an engine "
+        "(``stochcable.build_engine``) or a load-case set, for a sea state other than "
+        "the one the count was chosen for, when that sea needs more (every solve and "
+        "every case is checked)",
         "The segment's elements are too long for the string waves the end tension "
         "carries (or for its touchdown): σ is off by up to the estimate. The estimate "
         "is a bound: measured 0.4–0.5× it at 20 elements on the chain example and the "
@@ -202,7 +205,13 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "(the linear spectrum plus the residuals', "
         ":mod:`stochcable.dynamics.residuals.corrected_spectrum`); the along-line "
         "damage comes from the linear model's element tension spectra, and lines on "
-        "free bodies carry no residual.",
+        "free bodies carry no residual.  The residuals are computed on the anchor "
+        "cases (per period and heading the smallest and largest Hs and at most "
+        "``residual_span`` Hs steps apart) and their corrections interpolated in Hs² on "
+        "the others (:mod:`stochcable.cases.residual_anchors`: within 2e-3 on σ and 1 % "
+        "on a case's end damage, 5e-5 on the annual damage, on the chain example); "
+        "the warning says how many cases computed them.",
+        "Pass ``residual_span=None`` to compute them on every case. "
         "Read the along-line damage as the linear model's; where it governs, run "
         "``analyze()`` on the governing cases and scale it by the end's σ ratio "
         "(``linear`` block) to the power of the curve's slope.",

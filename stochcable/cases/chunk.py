@@ -21,6 +21,7 @@ the linearization tolerance.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import hashlib
 import math
 import traceback
@@ -34,10 +35,12 @@ from threadpoolctl import threadpool_limits
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import Family, SeaState
 from stochcable.design import damage_rate
-from stochcable.dynamics.engine import Engine, build_engine
+from stochcable.dynamics.engine import Engine
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
 from stochcable.errors import StochcableError, collect_warnings
+from stochcable.fidelity.mesh_engine import checked_engine
 from stochcable.scene.model import Scene, Sea
+from stochcable.scene.residual_kinds import asked_residuals
 
 __all__ = [
     "CaseRow",
@@ -45,10 +48,13 @@ __all__ = [
     "solve_chunk",
     "case_sea",
     "engine_template",
+    "pilot_state",
     "prepare_worker",
+    "set_engine",
     "ENDS",
     "WARM_RUN",
     "run_lead",
+    "without_residuals",
 ]
 
 ENDS = ("end_a", "end_b")
@@ -106,6 +112,13 @@ class ChunkResult:
         (NaN: failed case or no fatigue settings). [1/s]
     s_elements : dict of ndarray
         Element midpoint arc length per line. [m]
+    linear : dict of ndarray
+        ``[line]`` shape (k, 2, 4): per end the linear model's σ, Tz, 3-h MPM and
+        damage rate (NaN: failed case, or no fatigue settings).
+    exact : ndarray of bool or None
+        Per case, whether its residuals were computed (else ``stats`` and ``damage``
+        hold its linear values, until :func:`stochcable.cases.run.assemble_cases`
+        interpolates the residuals' corrections); None: every case's.
     """
 
     indices: np.ndarray
@@ -113,6 +126,8 @@ class ChunkResult:
     stats: dict[str, dict[str, np.ndarray]]
     damage: dict[str, np.ndarray]
     s_elements: dict[str, np.ndarray]
+    linear: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+    exact: np.ndarray | None = None
 
 
 def prepare_worker() -> None:
@@ -146,14 +161,23 @@ def engine_template(scene: Scene, states: tuple[SeaState, ...], family: Family) 
     residuals as it asks for them (every kind of :mod:`stochcable.scene.residual_kinds`
     switched on: each case's end statistics and end damage are then those of
     the corrected spectrum, :meth:`stochcable.results.documents.LineResult.end_tension_density`),
-    and the sea of an out-of-plane state when there is one (the models are then 3-D,
-    and in-plane states are solved by them exactly as by 2-D models)."""
+    and the sea of its :func:`pilot_state` (an out-of-plane state when there is one:
+    the models are then 3-D, and in-plane states are solved by them exactly as by 2-D
+    models; the element check chooses the default element counts for it,
+    :mod:`stochcable.fidelity.mesh_engine`)."""
     upd: dict[str, Any] = {"analysis": scene.analysis.model_copy(update={"timeseries": None})}
-    for state in states:
-        if abs(math.sin(math.radians(state.heading))) > 1e-9:
-            upd["sea"] = case_sea(scene, state, family)
-            break
+    if states:
+        upd["sea"] = case_sea(scene, pilot_state(states), family)
     return scene.model_copy(update=upd)
+
+
+def pilot_state(states: tuple[SeaState, ...]) -> SeaState:
+    """The state a set's default element counts are chosen for: of the out-of-plane
+    states if there are any (else of all), the shortest peak period (the highest
+    response frequencies, which the element rules scale with), then the highest Hs,
+    then the first.  The other states' estimates are checked case by case."""
+    out = [s for s in states if abs(math.sin(math.radians(s.heading))) > 1e-9] or list(states)
+    return min(out, key=lambda s: (s.tp, -s.hs))
 
 
 def run_lead(states: tuple[SeaState, ...], first: int) -> tuple[tuple[int, SeaState], ...]:
@@ -162,12 +186,20 @@ def run_lead(states: tuple[SeaState, ...], first: int) -> tuple[tuple[int, SeaSt
     return tuple((i, states[i]) for i in range(first - first % WARM_RUN, first))
 
 
+def set_engine(template: Scene) -> Engine:
+    """The engine of a set's :func:`engine_template`, with the element check
+    (:func:`stochcable.fidelity.mesh_engine.checked_engine`: default counts chosen for
+    the template's sea, a warning in the row of every case a count does not meet the
+    element rules for); the same wherever it is built."""
+    return checked_engine(template)
+
+
 def _engine(template: Scene) -> Engine:
     key = hashlib.sha256(template.model_dump_json().encode()).hexdigest()
     if key in _ENGINES:
         _ENGINES.move_to_end(key, last=False)
         return _ENGINES[key]
-    engine = build_engine(template)
+    engine = set_engine(template)
     _ENGINES[key] = engine
     _ENGINES.move_to_end(key, last=False)
     while len(_ENGINES) > _ENGINE_CACHE_SIZE:
@@ -252,8 +284,11 @@ def solve_chunk(
         :func:`engine_template` of the set's scene (its engine is built once per
         worker and kept).
     family : {"pierson_moskowitz", "jonswap"}
-    cases : tuple of (int, SeaState)
-        The cases and their positions in the diagram.
+    cases : tuple of (int, SeaState) or (int, SeaState, bool)
+        The cases and their positions in the diagram, and whether a case computes the
+        residuals of the linear model the scene asks for (default True; False: it is
+        solved without them, its corrections interpolated by
+        :func:`stochcable.cases.run.assemble_cases`).
     fatigue : dict of LineFatigue
         Settings per line with a fatigue check (validated).
     engine : Engine, optional
@@ -268,10 +303,14 @@ def solve_chunk(
     """
     with threadpool_limits(limits=1):
         engine = _engine(template) if engine is None else engine
-        lines = {ln.name: sum(s.elements for s in ln.segments) for ln in template.lines}
+        linear_engine = None  # (the same engine without the residuals, when needed)
+        # (the engine's counts: the element check may have raised the defaults)
+        lines = {ln.name: sum(s.elements for s in ln.segments) for ln in engine.scene.lines}
         k = len(cases)
         stats = {ln: {e: np.full((k, 4), np.nan) for e in ENDS} for ln in lines}
         damage = {ln: np.full((k, 2 + n), np.nan) for ln, n in lines.items()}
+        linear = {ln: np.full((k, 2, 4), np.nan) for ln in lines}
+        exact = np.ones(k, dtype=bool)
         spectra: dict[str, list[np.ndarray]] = {ln: [] for ln in fatigue}
         have: dict[str, list[int]] = {ln: [] for ln in fatigue}
         corrected: dict[str, dict[int, list]] = {ln: {} for ln in fatigue}
@@ -280,15 +319,21 @@ def solve_chunk(
         rows = []
         store: dict[str, np.ndarray] = {}
         prev: tuple[int, float] | None = None
-        for i, state in lead:
+        for i, state, *_ in lead:  # (discarded: the residuals are not needed)
+            linear_engine = linear_engine or without_residuals(engine)
             store = _warm_store(store, prev, i, state)
             with warm_starts(store):
-                _solve_case(engine, case_sea(template, state, family), i)
+                _solve_case(linear_engine, case_sea(template, state, family), i)
             prev = (i, state.heading)
-        for j, (i, state) in enumerate(cases):
+        for j, (i, state, *flag) in enumerate(cases):
+            exact[j] = not flag or bool(flag[0])
+            if not exact[j]:
+                linear_engine = linear_engine or without_residuals(engine)
             store = _warm_store(store, prev, i, state)
             with warm_starts(store):
-                row, res = _solve_case(engine, case_sea(template, state, family), i)
+                row, res = _solve_case(
+                    engine if exact[j] else linear_engine, case_sea(template, state, family), i
+                )
             prev = (i, state.heading)
             rows.append(row)
             if res is None:
@@ -296,14 +341,14 @@ def solve_chunk(
             for name, lr in res.lines.items():
                 s_el.setdefault(name, lr.s_elements)
                 omega = lr.omega
-                for e in ENDS:
-                    st = getattr(lr, e)
-                    stats[name][e][j] = (st.mean, st.std, st.tz, st.mpm_3h)
+                for e, end in enumerate(ENDS):
+                    st, lin = getattr(lr, end), lr.linear_end(end)
+                    stats[name][end][j] = (st.mean, st.std, st.tz, st.mpm_3h)
+                    linear[name][j, e, :3] = (lin.std, lin.tz, lin.mpm_3h)
                 if name in fatigue:
                     ends = np.stack([lr.end_tension_spectrum(e) for e in ENDS])
                     if lr.corrected_spectra is not None:  # the ends' on their own grid
                         corrected[name][j] = [lr.end_tension_density(e) for e in ENDS]
-                        ends = np.zeros_like(ends)
                     spectra[name].append(np.concatenate([ends, lr.tension_spectrum]))
                     have[name].append(j)
         for name, settings in fatigue.items():
@@ -311,14 +356,30 @@ def solve_chunk(
                 curve, factor = curve_factor(settings, template.environment.g, name)
                 dens = np.stack(spectra[name]) * factor**2
                 damage[name][have[name]] = damage_rate(omega, dens, curve, settings.method)
-                for j, ends_c in corrected[name].items():
-                    damage[name][j, :2] = [
-                        damage_rate(om, d * factor**2, curve, settings.method) for om, d in ends_c
-                    ]
                 strum = _strumming_damage(engine, name, curve, factor)
                 if strum is not None:
                     damage[name][have[name]] += strum[0]
                     for j in have[name]:
                         rows[j] = replace(rows[j], warnings=(*rows[j].warnings, strum[1]))
-    idx = np.array([i for i, _ in cases], dtype=int)
-    return ChunkResult(idx, tuple(rows), stats, damage, s_el)
+                linear[name][have[name], :, 3] = damage[name][have[name], :2]
+                for j, ends_c in corrected[name].items():
+                    damage[name][j, :2] = [
+                        damage_rate(om, d * factor**2, curve, settings.method) for om, d in ends_c
+                    ]
+                    if strum is not None:
+                        damage[name][j, :2] += strum[0][:2]
+    idx = np.array([c[0] for c in cases], dtype=int)
+    return ChunkResult(idx, tuple(rows), stats, damage, s_el, linear, exact)
+
+
+def without_residuals(engine: Engine) -> Engine:
+    """``engine`` solving without the residuals of the linear model (the same models
+    and caches; its linear results are those of ``engine`` to the bit): for the cases
+    whose residuals are interpolated (:mod:`stochcable.cases.residual_anchors`)."""
+    analysis = engine.scene.analysis
+    off = {kind.name: False for kind in asked_residuals(analysis.linearization)}
+    lin = analysis.linearization.model_copy(update=off)
+    scene = engine.scene.model_copy(
+        update={"analysis": analysis.model_copy(update={"linearization": lin})}
+    )
+    return dataclasses.replace(engine, scene=scene)

@@ -26,6 +26,7 @@ from stochcable.cases.chunk import (
     solve_chunk,
 )
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
+from stochcable.cases.residual_anchors import RESIDUAL_SPAN, residual_anchors
 from stochcable.cases.scatter import ScatterDiagram, SeaState
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.scene.model import Scene, load_scene
@@ -60,8 +61,9 @@ class CasePlan:
         Validated settings per line with a fatigue check.
     years : float
         Return period of the long-term extremes. [years]
-    chunks : tuple of tuple of (int, SeaState)
-        The cases of every chunk with their positions in the diagram.
+    chunks : tuple of tuple of (int, SeaState, bool)
+        The cases of every chunk with their positions in the diagram, and whether the
+        case computes the residuals (:mod:`stochcable.cases.residual_anchors`).
     leads : tuple of tuple of (int, SeaState)
         Per chunk, the cases solved before its own and discarded
         (:func:`~stochcable.cases.chunk.run_lead`: the earlier cases of the warm-start
@@ -116,6 +118,7 @@ def plan_cases(
     fatigue: LineFatigue | Mapping[str, LineFatigue] | None = None,
     years: float = 100.0,
     chunk_size: int | None = None,
+    residual_span: int | None = RESIDUAL_SPAN,
 ) -> CasePlan:
     """Validate a load-case set and split it into chunks.
 
@@ -131,12 +134,20 @@ def plan_cases(
         Return period of the long-term extremes. [years]
     chunk_size : int, optional
         Cases per chunk; default all cases in one chunk.
+    residual_span : int or None
+        With residuals asked for: most steps of a column's sorted Hs between the cases
+        that compute them, the others interpolated
+        (:mod:`stochcable.cases.residual_anchors`); None: every case computes them.
 
     Returns
     -------
     CasePlan
     """
     scene = load_scene(scene)
+    if residual_span is not None and (
+        not isinstance(residual_span, int) or isinstance(residual_span, bool) or residual_span < 1
+    ):
+        raise InputError("residual_span", residual_span, "-", "must be an integer >= 1 or None")
     if not (
         isinstance(years, (int, float))
         and not isinstance(years, bool)
@@ -155,17 +166,26 @@ def plan_cases(
         raise InputError("chunk_size", chunk_size, "-", "must be an integer >= 1")
     template = engine_template(scene, scatter.states, scatter.family)
     asked = [k.name for k in asked_residuals(scene.analysis.linearization)]
+    exact = residual_anchors(scatter.states, residual_span if asked else None)
     if asked:
+        interp = (
+            ""
+            if exact.all()
+            else f"; they are computed on {int(exact.sum())} of the {n} cases (per Tp, γ "
+            f"and heading the smallest and largest Hs and at most {residual_span} Hs "
+            "steps apart) and their corrections interpolated in Hs on the others "
+            "(stochcable.cases.residual_anchors; residual_span=None computes every case)"
+        )
         warn(
             "load-case sets apply "
             + ", ".join(f"analysis.linearization.{k}" for k in asked)
             + " to the end tensions only (their statistics and damage: the corrected "
             "spectrum); the set's along-line damage is the linear model's, and a line "
-            "on free bodies carries no residual",
+            "on free bodies carries no residual" + interp,
             PhysicsWarning,
         )
     chunks = tuple(
-        tuple((i, scatter.states[i]) for i in range(a, min(a + chunk_size, n)))
+        tuple((i, scatter.states[i], bool(exact[i])) for i in range(a, min(a + chunk_size, n)))
         for a in range(0, n, chunk_size)
     )
     leads = tuple(run_lead(scatter.states, part[0][0]) for part in chunks)
@@ -191,6 +211,10 @@ def chunk_to_bytes(result: ChunkResult) -> bytes:
         for e in header["ends"]:
             arrays[f"stats_{k}_{e}"] = result.stats[ln][e]
         arrays[f"damage_{k}"] = result.damage[ln]
+        if ln in result.linear:
+            arrays[f"linear_{k}"] = result.linear[ln]
+    if result.exact is not None:
+        arrays["exact"] = np.asarray(result.exact, dtype=bool)
     for k, ln in enumerate(header["s_elements"]):
         arrays[f"s_{k}"] = result.s_elements[ln]
     buf = io.BytesIO()
@@ -208,9 +232,13 @@ def chunk_from_bytes(data: bytes) -> ChunkResult:
         }
         damage = {ln: z[f"damage_{k}"] for k, ln in enumerate(header["lines"])}
         s_el = {ln: z[f"s_{k}"] for k, ln in enumerate(header["s_elements"])}
+        linear = {
+            ln: z[f"linear_{k}"] for k, ln in enumerate(header["lines"]) if f"linear_{k}" in z
+        }
+        exact = z["exact"] if "exact" in z else None
         indices = z["indices"]
     rows = tuple(
         CaseRow(int(i), st, reason, tuple(flags), tuple(warns))
         for i, st, reason, flags, warns in header["rows"]
     )
-    return ChunkResult(indices, rows, stats, damage, s_el)
+    return ChunkResult(indices, rows, stats, damage, s_el, linear, exact)

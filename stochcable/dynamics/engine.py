@@ -32,7 +32,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -91,6 +91,10 @@ class Engine:
         Messages of the warnings raised by the build (repeated in every result).
     strumming : mapping of StrummingTable or None by line name
         The strumming screening of every line (:mod:`stochcable.dynamics.model.strumming`).
+    check : callable, optional
+        ``check(result) -> result``, applied to every result of :meth:`solve` (the
+        element check of :func:`stochcable.fidelity.mesh_engine.checked_engine`, which
+        this layer does not import; None: none).
     """
 
     scene: Scene
@@ -100,6 +104,7 @@ class Engine:
     timing: Mapping[str, float]
     warnings: tuple[str, ...]
     strumming: Mapping[str, StrummingTable | None] = field(default_factory=dict)
+    check: Callable[[Result], Result] | None = None
 
     def solve(
         self, sea: Sea | Mapping[str, Any] | None = None, *, progress: Progress | None = None
@@ -162,7 +167,7 @@ class Engine:
         messages = _messages(self.warnings, caught)
         timing["total_s"] = timing.pop("build_s") + time.perf_counter() - t_start
         progress("done", {"total_s": timing["total_s"]})
-        return Result(
+        result = Result(
             scene=scene,
             statics=self.statics,
             lines={k: v.with_strumming(self.strumming.get(k)) for k, v in solved.lines.items()},
@@ -171,6 +176,7 @@ class Engine:
             warnings=tuple(messages),
             bodies=solved.bodies,
         )
+        return result if self.check is None else self.check(result)
 
 
 def build_engine(

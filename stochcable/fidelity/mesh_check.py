@@ -41,8 +41,9 @@ import numpy as np
 
 from stochcable.fidelity.limits import elements_limit
 from stochcable.fidelity.meshing import segment_geometry
-from stochcable.fidelity.pilot import input_summary
+from stochcable.fidelity.pilot import sea_omega2
 from stochcable.scene.model import Scene
+from stochcable.sea.kinematics import wavenumber
 
 __all__ = [
     "MESH_ERROR_LIMIT",
@@ -91,16 +92,39 @@ def _needed(g: dict[str, Any], w2: float, k_load: float, limit: float) -> int:
     return max(1, int(math.ceil(g["length"] / h - 1e-9)))
 
 
-def _load_wavenumber(lg: Any, g: dict[str, Any], k: float | None, limit: float) -> float:
+def _load_wavenumber(lg: Any, g: dict[str, Any], sea: _SeaWave, limit: float) -> float:
     """The wave-load rule's wavenumber for a segment wholly in the wave zone (every
     node above the depth where e^{kz} < ``limit``), else 0. [rad/m]"""
-    if not k:
-        return 0.0
     sel = (lg.s_nodes >= g["s0"] - 1e-9) & (lg.s_nodes <= g["s1"] + 1e-9)
-    return float(k) if bool(np.all(lg.z_nodes[sel] > -math.log(1.0 / limit) / k)) else 0.0
+    depth = math.log(1.0 / limit)
+    z_min = float(np.min(lg.z_nodes[sel], initial=np.inf))
+    # k ≥ ω²/g (ω² = gk·tanh kd): a node below depth·g/ω² is below depth/k too, and
+    # the wavenumber need not be solved
+    if not sea.omega2 or z_min <= -depth * sea.gravity / sea.omega2**2:
+        return 0.0
+    k = sea.k()
+    return float(k) if z_min > -depth / k else 0.0
 
 
-def mesh_estimates(result: Any, limit: float = MESH_ERROR_LIMIT) -> list[MeshEstimate]:
+class _SeaWave:
+    """The sea's ω₂ and, solved on first use, its wavenumber."""
+
+    def __init__(self, scene: Scene) -> None:
+        self.scene = scene
+        self.gravity = scene.environment.g
+        self.omega2 = sea_omega2(scene)
+        self._k: float | None = None
+
+    def k(self) -> float:
+        if self._k is None:
+            env = self.scene.environment
+            self._k = float(wavenumber(self.omega2, env.depth, env.g))
+        return self._k
+
+
+def mesh_estimates(
+    result: Any, limit: float = MESH_ERROR_LIMIT, geometry: dict[str, Any] | None = None
+) -> list[MeshEstimate]:
     """The element rule on every segment of an analysis.
 
     Parameters
@@ -110,14 +134,17 @@ def mesh_estimates(result: Any, limit: float = MESH_ERROR_LIMIT) -> list[MeshEst
         statistics.
     limit : float
         Relative σ error the needed count is for. [-]
+    geometry : dict, optional
+        :func:`stochcable.fidelity.meshing.segment_geometry` of the result's scene and
+        statics, when already formed (an engine's, the same for every sea state).
 
     Returns
     -------
     list of MeshEstimate
         One per segment, in scene order.
     """
-    geo = segment_geometry(result.scene, result.statics)
-    k_sea = input_summary(result.scene).k_load
+    geo = segment_geometry(result.scene, result.statics) if geometry is None else geometry
+    sea = _SeaWave(result.scene)
     cap = elements_limit()
     out = []
     for line in result.scene.lines:
@@ -131,7 +158,7 @@ def mesh_estimates(result: Any, limit: float = MESH_ERROR_LIMIT) -> list[MeshEst
                 w2 = max(w2, math.sqrt(st.m2 / st.m0))
         lg = geo[line.name]
         for i, (seg, g) in enumerate(zip(line.segments, lg.segments)):
-            k = _load_wavenumber(lg, g, k_sea, limit)
+            k = _load_wavenumber(lg, g, sea, limit)
             out.append(
                 MeshEstimate(
                     line.name,
@@ -180,22 +207,33 @@ def default_counts(
 
 def mesh_warnings(
     estimates: list[MeshEstimate],
-    omitted: set[tuple[str, int]],
+    omitted: set[tuple[str, int]] | frozenset[tuple[str, int]],
     limit: float = MESH_ERROR_LIMIT,
+    *,
+    other_sea: bool = False,
 ) -> list[str]:
     """One message per segment whose estimate exceeds ``limit``: an explicit count
     (with the count that fixes it), or a default count clipped by the scene model's
-    limit."""
+    limit — or, with ``other_sea`` (a sea other than the one the default counts were
+    chosen for), a default count this sea needs more than."""
     out = []
     cap = elements_limit()
     for e in estimates:
         default = (e.line, e.segment) in omitted
-        # a default count was chosen from the pilot's ω₂: it warns only when clipped
-        if e.error <= limit or (default and e.needed < cap):
+        # a default count was chosen from the pilot's ω₂: for the pilot's sea it warns
+        # only when clipped (the finer mesh's own ω₂ moves its estimate a little)
+        if e.error <= limit or (default and e.needed < cap and not other_sea):
+            continue
+        if default and other_sea and e.needed <= e.elements:
             continue
         where = f"lines[{e.line}].segments[{e.segment}].elements = {e.elements}"
-        if default:
+        if default and e.needed >= cap:
             fix = "the default count is clipped to the scene model's limit"
+        elif default:
+            fix = (
+                f"the default count was chosen for the engine's pilot sea; this sea "
+                f"needs elements = {e.needed} (build the engine with it)"
+            )
         else:
             fix = f"use elements = {e.needed} (or omit the field: the default meets it)"
         out.append(

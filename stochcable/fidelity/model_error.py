@@ -9,6 +9,29 @@ module estimates it per line, from what the pilot analysis shows of the line, so
 a target below it is reported as not met instead of claimed
 (:func:`linearization_model_error`).
 
+Where the analysis computes the residuals of the linear model
+(``analysis.linearization.drag_residual``, :mod:`stochcable.dynamics.residuals`) its
+answer is the corrected σ, and the estimate is what the computed residuals leave, not a
+calibration constant (:func:`residual_model_error`):
+
+- the residuals are the first-order term of the response's Wiener–Hermite expansion
+  about the equivalent linear system (Roberts and Spanos, §5): what they drop — their
+  feedback on the linearized damping and on themselves — is one order higher, so a line
+  whose computed residuals move its end-tension σ by the share r is left with ≈ r²
+  (the larger end).  Against the nonlinear time domain (docs/benchmarks/drag_residual.md,
+  TD / (FD + residuals) − 1): the chain's line +0.40 ± 1.9 / +0.17 ± 2.6 % (r = 4.7 /
+  8.2 %, r² = 0.2 / 0.7 %), the taut wire +1.5 ± 2.9 % (r = 18 %, r² = 3.4 %), the
+  inclined guy −0.6 ± 3.7 % (r = 19 %, r² = 3.5 %): every measured remainder within r²
+  and its interval, none resolving it — an order estimate, not a calibrated bound;
+- a line with a static grounded length adds what no residual covers, the one-sided
+  bed: +0.30 ± 0.14 / +0.45 ± 0.23 % (fairlead / anchor, docs/benchmarks/fd_budget.md,
+  the reference TD with it against without), :data:`BED_ERROR`;
+- without the geometric residual, the second-order stretching term below still counts
+  (it is part of the geometric residual when that is computed).
+
+A line whose drag residual was not computed (not asked, or out of its scope: the
+record's reason) keeps the linear model's estimate:
+
 Two terms, the larger counts:
 
 - **Second-order stretching** of near-straight lines: the linear tension misses the
@@ -23,6 +46,12 @@ Two terms, the larger counts:
   bed and the quadratic drag of the transverse motion act) and lines that do not.
   The figures are the measured relative errors of the fairlead and anchor tension σ
   with their source; the estimate takes the larger end.
+
+References
+----------
+Roberts, J. B. and Spanos, P. D. (2003), Random Vibration and Statistical
+Linearization, Dover, §5 (the Wiener–Hermite expansion about the equivalent linear
+system).
 """
 
 from __future__ import annotations
@@ -32,7 +61,19 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["CALIBRATION", "Calibration", "linearization_model_error"]
+__all__ = [
+    "BED_ERROR",
+    "CALIBRATION",
+    "Calibration",
+    "linearization_model_error",
+    "residual_model_error",
+]
+
+#: The one-sided seabed's share of the σ error, which no residual covers: +0.30 ± 0.14 %
+#: / +0.45 ± 0.23 % at the fairlead / anchor (docs/benchmarks/fd_budget.md, the chain's
+#: line at 160 elements, the reference TD with the one-sided bed against the bilateral
+#: one); the larger end. [-]
+BED_ERROR = 0.0045
 
 
 @dataclass(frozen=True)
@@ -108,8 +149,17 @@ def linearization_model_error(
         klass = "touchdown" if touchdown.get(name) is not None else "suspended"
         cal = CALIBRATION[klass]
         err, why = cal.error, f"line {name!r} ({klass}): calibrated on {cal.lines}; {cal.source}"
+        residuals = getattr(lr, "residuals", None) or {}
+        drag = residuals.get("drag_residual")
+        if drag is not None and drag.computed:
+            err, why = residual_model_error(name, lr, klass == "touchdown")
+        elif drag is not None:
+            why += f" (the drag residual was not computed: {drag.reason})"
+        geometric = residuals.get("geometric_residual")
         so = getattr(getattr(lr, "indicators", None), "second_order", None)
         factor = getattr(so, "std_factor", None)
+        if geometric is not None and geometric.computed:
+            factor = None  # (the stretching is part of the geometric residual)
         if factor is not None and math.isfinite(factor) and factor > 1.0:
             stretch = 1.0 - 1.0 / factor
             if stretch > err:
@@ -122,3 +172,44 @@ def linearization_model_error(
         if err > best:
             best, basis = err, why
     return best, basis
+
+
+def residual_model_error(name: str, line_result: Any, grounded: bool) -> tuple[float, str]:
+    """The error the computed residuals leave of one line's corrected end-tension σ
+    (module notes): r² of the residuals' share r = max over the ends of |σ/σ_linear −
+    1|, plus :data:`BED_ERROR` on a line with a grounded length.
+
+    Parameters
+    ----------
+    name : str
+        The line's name (for the basis).
+    line_result : LineResult
+        A line result whose drag residual was computed (its ``end_a``/``end_b`` the
+        corrected statistics, ``linear_end(end)`` the linear ones).
+    grounded : bool
+        Whether the line has a static grounded length.
+
+    Returns
+    -------
+    error : float
+        The estimate (relative σ error). [-]
+    basis : str
+        The share, the end and the terms.
+    """
+    share, end = 0.0, "end_b"
+    for e in ("end_a", "end_b"):
+        lin = line_result.linear_end(e).std
+        if lin > 0.0:
+            r = abs(getattr(line_result, e).std / lin - 1.0)
+            if r > share:
+                share, end = r, e
+    err = share * share + (BED_ERROR if grounded else 0.0)
+    why = (
+        f"line {name!r}: the computed residuals change the {end} tension σ by "
+        f"{100 * share:.3g} %; the corrected σ's remaining error is estimated as its "
+        f"square, {100 * share * share:.2g} % (the next order of the residuals' "
+        "expansion; stochcable.fidelity.model_error)"
+    )
+    if grounded:
+        why += f", plus the one-sided bed's {100 * BED_ERROR:.2g} % (docs/benchmarks/fd_budget.md)"
+    return err, why

@@ -46,11 +46,14 @@ __all__ = [
     "input_densities",
     "input_band",
     "input_summary",
+    "sea_load_wavenumber",
+    "sea_omega2",
     "base_count",
     "base_error",
     "response_spectra",
     "modal_bandwidths",
     "pilot_analysis",
+    "pilot_suffices",
     "run_pilot",
 ]
 
@@ -143,14 +146,33 @@ class InputBand:
 
 def input_summary(scene: Scene) -> InputBand:
     """The :class:`InputBand` of a scene."""
-    env = scene.environment
     w_lo, w_hi, per = input_band(scene, PILOT_INPUT_FRACTION)
     w_lo = min(w_lo, input_band(scene, PILOT_LOW_FRACTION)[0])
-    k_load = None
-    if scene.sea is not None and "sea" in per:
-        k_load = float(wavenumber(per["sea"][2], env.depth, env.g))
     w2 = max((v[2] for v in per.values()), default=1.0)
-    return InputBand(w_lo, w_hi, w2, k_load)
+    return InputBand(w_lo, w_hi, w2, sea_load_wavenumber(scene))
+
+
+def sea_load_wavenumber(scene: Scene) -> float | None:
+    """:attr:`InputBand.k_load` alone: the wavenumber at the sea spectrum's ω₂
+    (:func:`sea_omega2`; None without a sea). [rad/m]"""
+    w2 = sea_omega2(scene)
+    if w2 is None:
+        return None
+    return float(wavenumber(w2, scene.environment.depth, scene.environment.g))
+
+
+def sea_omega2(scene: Scene) -> float | None:
+    """ω₂ = √(m₂/m₀) of the scene's sea spectrum, from one evaluation of its density
+    (what the element check of every sea state of an engine needs,
+    :mod:`stochcable.fidelity.mesh_check`); None without a sea. [rad/s]"""
+    if scene.sea is None:
+        return None
+    s = np.asarray(scene.sea.spectrum.spectral_density(_WIDE, scene.environment.g), dtype=float)
+    s = np.where(np.isfinite(s), s, 0.0)
+    m0 = np.trapezoid(s, _WIDE)
+    if not m0 > 0.0:
+        return None
+    return math.sqrt(np.trapezoid(_WIDE**2 * s, _WIDE) / m0)
 
 
 def base_error(scene: Scene, w_min: float, w_max: float, n: int) -> float:
@@ -294,13 +316,23 @@ def run_pilot(
     band_share: float,
     exact: bool,
     evaluate: Evaluate,
+    after: Pilot | None = None,
 ) -> Pilot:
     """Pilots from the input band, the top doubled up to :data:`PILOT_EXTENSIONS` times
     while a response tail beyond it holds more than ``band_share`` of the variance
-    or the pilot does not cover twice the ω_max it gives."""
-    w_top = inputs.omega_hi
-    pilot_wall = 0.0
-    for ext in range(PILOT_EXTENSIONS + 1):
+    or the pilot does not cover twice the ω_max it gives.  ``after``: a pilot run
+    for a larger ``band_share`` (the target's, before the model's own error was known
+    from it), returned if it suffices for this one, else extended from its top, one
+    doubling more allowed (the smaller share reaches further: the chain's PM surge at
+    1 %, whose model leaves 0.5 %, needs the band to 83 rad/s, the pilot to 166)."""
+    w_top, pilot_wall, first, cap = inputs.omega_hi, 0.0, 0, PILOT_EXTENSIONS
+    if after is not None:
+        cap += 1
+        if pilot_suffices(after, band_share) or after.info["extensions"] >= cap:
+            return after
+        w_top = 2.0 * float(after.omega[-1])
+        pilot_wall, first = after.info["wall_s"], after.info["extensions"] + 1
+    for ext in range(first, cap + 1):
         res, info, wall = pilot_analysis(
             scene, geo, inputs.omega_lo, w_top, inputs.k_load, exact, evaluate
         )
@@ -314,10 +346,19 @@ def run_pilot(
         # the pilot must also *cover* [ω_max, 2·ω_max] (resonances in the tail make a
         # power-law extrapolation unreliable: on the chain it missed 3 % of the variance)
         covered = bounded and _covers_twice_omega_max(w, spectra, band_share)
-        if (bounded and covered) or ext == PILOT_EXTENSIONS:
+        if (bounded and covered) or ext == cap:
             break
         w_top *= 2.0
     return Pilot(res, spectra, w, bounded, pilot_info)
+
+
+def pilot_suffices(pilot: Pilot, band_share: float) -> bool:
+    """Whether ``pilot`` bounds every response tail within ``band_share`` of its
+    variance and covers twice the ω_max that share gives."""
+    w, spectra = pilot.omega, pilot.spectra
+    return _tails_bounded(w, spectra, band_share) and _covers_twice_omega_max(
+        w, spectra, band_share
+    )
 
 
 def _tails_bounded(w: np.ndarray, spectra: dict[str, np.ndarray], band_share: float) -> bool:

@@ -70,8 +70,9 @@ class FidelityPlan:
     error_estimate : dict of str to float
         Estimate per part of the discretization ("band", "grid", "elements", "modes",
         "linearization": the fixed point's tolerance), "discretization" (their sum),
-        "linearization_model" (the linear model's own error against the nonlinear time
-        domain, which no fidelity removes: :mod:`stochcable.fidelity.model_error`) and
+        "linearization_model" (the model's own error against the nonlinear time
+        domain, which no fidelity removes; with the residuals computed, what they
+        leave of it: :mod:`stochcable.fidelity.model_error`) and
         "total" (discretization + model). [-]
     cost : dict of str to float
         "elements", "frequencies" (of the grid applied) and "elements_x_frequencies".
@@ -91,8 +92,8 @@ class FidelityPlan:
         Every limit of the scene model the plan hit, with what it leaves unmet (empty
         when the target was met within them).
     model_error_basis : str
-        Which line and term give ``error_estimate["linearization_model"]``, and the
-        source of its calibration.
+        Which line and term give ``error_estimate["linearization_model"]``: the σ
+        change of the computed residuals, or the source of its calibration.
     """
 
     target_error: float

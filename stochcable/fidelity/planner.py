@@ -139,19 +139,15 @@ def _plan(
     statics = solve_statics(scene, method="fe")
     geo = segment_geometry(scene, statics, tds := static_touchdowns(scene))
     inputs = input_summary(scene)
-    pilot = run_pilot(scene, geo, inputs, BUDGET["band"] * eps, exact_wave_integration, evaluate)
+    pilot_args = (exact_wave_integration, evaluate)
+    pilot = run_pilot(scene, geo, inputs, BUDGET["band"] * eps, *pilot_args)
     model, basis = linearization_model_error(pilot.result.lines, tds)
-    share = {k: v * (eps - model if model < eps else eps) for k, v in BUDGET.items()}
+    disc = eps - model if model < eps else eps  # a smaller band share: a pilot further
+    pilot = run_pilot(scene, geo, inputs, BUDGET["band"] * disc, *pilot_args, after=pilot)
+    share = {k: v * disc for k, v in BUDGET.items()}
     band = _choose_band(pilot, inputs, share["band"])
-    segs, el_choices, el_err = mesh_rules(
-        scene,
-        geo,
-        band.omega2,
-        band.omega_max,
-        share["elements"],
-        inputs.k_load,
-        exact_wave_integration,
-    )
+    el_args = (band.omega2, band.omega_max, share["elements"], inputs.k_load)
+    segs, el_choices, el_err = mesh_rules(scene, geo, *el_args, exact_wave_integration)
     segs, el_limit, el_factor = _clip_elements(segs)
     el_err *= el_factor  # the element error grows like h²
     solver, modes, mode_err, mode_choices = _choose_modes(
@@ -214,8 +210,7 @@ def _clip_elements(segs: Segments) -> tuple[Segments, str, float]:
     (n/limit)² of the element error estimate (it grows like h²; 1 when none was)."""
     limit = elements_limit()
     out: Segments = {}
-    clipped = []
-    factor = 1.0
+    clipped, factor = [], 1.0
     for name, parts in segs.items():
         out[name] = tuple((i, L, min(n, limit)) for i, L, n in parts)
         clipped += [f"lines[{name}].segments[{i}]" for i, _, n in parts if n > limit]

@@ -148,7 +148,7 @@ class _FailsOn:
 
     def __init__(self, engine, bad_hs):
         self.engine, self.bad_hs = engine, bad_hs
-        self.strumming = engine.strumming
+        self.strumming, self.scene = engine.strumming, engine.scene
 
     def solve(self, sea):
         if sea.spectrum.hs == self.bad_hs:

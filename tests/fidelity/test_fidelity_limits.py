@@ -138,36 +138,43 @@ def test_met_targets_have_no_limits_and_unchanged_documents():
     assert plan.grid_resolved and plan.limits == () and plan.tail_bounded
     assert "grid_unresolved" not in plan.error_estimate
     assert {"limits", "grid_resolved"}.isdisjoint(plan.to_document())
-    # only the linear model's own error is said (7.7 % on this seabed line, > 5 %)
-    (text,) = fidelity_warnings(plan)
-    assert text.startswith("adaptive fidelity cannot meet the target error 0.05")
-    loose = choose_fidelity(_chain(), 0.11, evaluate=analyze)  # the model leaves 3.3 %
-    assert loose.error_estimate["total"] <= 0.11 and fidelity_warnings(loose) == []
+    # nothing to say: with the residuals computed (the default) the model's own error is
+    # what they leave (r² + the one-sided bed's 0.45 %, ≈ 0.5 % on this seabed line,
+    # stochcable.fidelity.model_error), below 5 %, not the linear model's calibrated 7.7 %
+    assert "computed residuals" in plan.model_error_basis
+    assert plan.error_estimate["linearization_model"] < 0.05
+    assert plan.error_estimate["total"] <= 0.05 and fidelity_warnings(plan) == []
 
 
 # ------------------------------------------------------------- the entrances
 #
-# The chain at 5 % and 1 % runs in 5-13 s per entrance (pilots + the planned analysis).
+# The chain at 5 % and 2 % runs in 5-20 s per entrance (pilots + the planned analysis).
+# (Not 1 %: with the residuals on by default the model leaves ≈ 0.5 % of it, the
+# discretization's 0.5 % needs the band past the lightly damped axial modes at ≈ 45 rad/s,
+# and the grid's limit is hit, the path the tests at 0.3 % and at the limit cover.)
 # At 0.3 % the planned analysis (2553 frequencies × 959 elements, direct) takes ≈ 40 s
 # on a shared 2-core host: its plan is asserted above (``plan_03``), and the entrances'
 # limit paths are exercised at 5 % with the limit lowered (the same code path, cheap)
 # and, for the refusal, at 0.3 % with the limit the planner believes raised past the
 # model's (what the planner asked before this change: 4.2 million frequencies).
 
-TARGETS = (0.05, 0.01)
+TARGETS = (0.05, 0.02)
 
 
 def _fidelity_texts(warnings) -> list[str]:
     return [w for w in warnings if w.startswith("adaptive fidelity")]
 
 
-def _model_error_said(texts: list[str], target: float) -> None:
-    """The chain touches the seabed: its calibrated linear-model error (7.7 %, anchor)
-    exceeds both targets, so the one fidelity warning says the target cannot be met and
-    why (never claimed), while the discretization meets it."""
-    (text,) = texts
-    assert text.startswith(f"adaptive fidelity cannot meet the target error {target:g}")
-    assert "0.077" in text and "touchdown" in text and "fd_budget" in text
+def _target_met(fidelity: dict, texts: list[str], target: float) -> None:
+    """The chain touches the seabed, but with the residuals computed (the default) the
+    model's own error is what they leave (r² + the one-sided bed's 0.45 %: ≈ 0.5 %, not
+    the linear model's calibrated 7.7 %), below both targets: the estimate meets the
+    target with the model error in it, and no fidelity warning is said."""
+    est = fidelity["error_estimate"]
+    assert 0.0045 <= est["linearization_model"] < target
+    assert est["total"] == pytest.approx(est["discretization"] + est["linearization_model"])
+    assert est["total"] <= target and texts == []
+    assert "computed residuals" in fidelity["model_error_basis"]
 
 
 @pytest.mark.slow
@@ -176,10 +183,7 @@ def test_library_entrance_meets_the_target(target):
     res = analyze(_chain(target))
     plan = res.fidelity
     assert plan.target_error == target and plan.limits == () and plan.tail_bounded
-    est = plan.error_estimate
-    assert est["discretization"] <= target < est["linearization_model"]
-    assert est["total"] == pytest.approx(est["discretization"] + est["linearization_model"])
-    _model_error_said(_fidelity_texts(res.warnings), target)
+    _target_met(plan.to_document(), _fidelity_texts(res.warnings), target)
 
 
 def _cli(tmp_path, doc, capsys) -> tuple[int, str, dict | None]:
@@ -201,7 +205,7 @@ def test_cli_entrance_meets_the_target(target, tmp_path, capsys):
     assert out["fidelity"]["target_error"] == target
     assert out["fidelity"]["error_estimate"]["discretization"] <= target
     assert "limits" not in out["fidelity"]
-    _model_error_said(_fidelity_texts(out["warnings"]), target)
+    _target_met(out["fidelity"], _fidelity_texts(out["warnings"]), target)
 
 
 @pytest.fixture(scope="module")
@@ -226,7 +230,7 @@ def test_http_entrance_meets_the_target(target, client):
     assert doc["fidelity"]["target_error"] == target
     assert doc["fidelity"]["error_estimate"]["discretization"] <= target
     assert "limits" not in doc["fidelity"]
-    _model_error_said(_fidelity_texts(doc["warnings"]), target)
+    _target_met(doc["fidelity"], _fidelity_texts(doc["warnings"]), target)
 
 
 def _patched_client():
