@@ -26,7 +26,7 @@ from stochcable.cases.chunk import (
     solve_chunk,
 )
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
-from stochcable.cases.residual_anchors import RESIDUAL_SPAN, residual_anchors
+from stochcable.cases.residual_anchors import residual_anchors
 from stochcable.cases.scatter import ScatterDiagram, SeaState
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.scene.model import Scene, load_scene
@@ -118,7 +118,7 @@ def plan_cases(
     fatigue: LineFatigue | Mapping[str, LineFatigue] | None = None,
     years: float = 100.0,
     chunk_size: int | None = None,
-    residual_span: int | None = RESIDUAL_SPAN,
+    residual_span: int | None = None,
 ) -> CasePlan:
     """Validate a load-case set and split it into chunks.
 
@@ -137,7 +137,8 @@ def plan_cases(
     residual_span : int or None
         With residuals asked for: most steps of a column's sorted Hs between the cases
         that compute them, the others interpolated
-        (:mod:`stochcable.cases.residual_anchors`); None: every case computes them.
+        (:mod:`stochcable.cases.residual_anchors`; opt-in, its measured error in the
+        module notes); None (default): every case computes them.
 
     Returns
     -------
