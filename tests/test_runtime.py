@@ -280,19 +280,14 @@ def _faults_per_case(residuals: bool) -> float:
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=False,
-    reason="issue 31: with the residuals (the default) a chain case took ≈ 1200 minor "
-    "page faults under a nanny (≈ 1700 without), against 0.4 for the linear model: the "
-    "residuals' temporaries are above the configured mmap threshold; since their pairs "
-    "are formed in 512 kB blocks it passes on some runs and not others (not strict "
-    "until it passes every run)",
-)
 @pytest.mark.skipif(
     not sys.platform.startswith("linux") or platform.libc_ver()[0] != "glibc",
     reason="glibc's malloc only",
 )
 def test_the_residuals_temporaries_stay_mapped_too():
+    # issue 31: ≈ 1200 faults per case once (the residuals' temporaries above the mmap
+    # threshold); 0.1–1.8 in 24 runs since the pairs and their outputs are formed in
+    # 512 kB blocks (no (n, n, n_o) array of every pair)
     assert _faults_per_case(residuals=True) < 35
 
 

@@ -6,7 +6,7 @@ form, from the same load cross-spectra.
 Each residual kind forms the cross-spectral lines G_cd(ω_j) of its loads (the drag
 residual's panel forces, the geometric forces' element pairs) once and contracts them
 with the end tensions per unit load, Var_j = Re Σ_cd conj(H_c) G_cd H_d
-(:func:`~stochcable.dynamics.residuals.residual_lines.pair_output_lines`).  The
+(:func:`~stochcable.dynamics.residuals.residual_lines.pair_outputs`).  The
 element tension δT_e = r_e·u
 (:func:`stochcable.dynamics.outputs.line_result.element_tension_transfer`) is another
 linear output of the same loads: with the ends held, u_f = A⁻¹F_f and
@@ -51,7 +51,7 @@ from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
 from stochcable.dynamics.residuals.residual_lines import (
     RESIDUAL_TAP,
     load_transfer,
-    pair_output_lines,
+    pair_outputs,
 )
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.line.fem import SLACK_EA_RATIO
@@ -91,12 +91,15 @@ CELL_BENDS = {
 class Capture:
     """One contraction of a kind's load cross-spectra: the lines ``w`` [rad/s], every
     load of the kind's :func:`load_transfer` call ``unit`` (n_nodes, d, n_all), the
-    loads ``kept`` (indices into it) whose cross-spectral lines ``g`` (n, n, n_o) are."""
+    loads ``kept`` (indices into it) and the blocks of pairs (g, e, f) of their
+    cross-spectral lines ``g`` (n_pairs, n_o) between loads e and f (indices into
+    ``kept``), as :func:`pair_outputs` takes them."""
 
     w: np.ndarray
     unit: np.ndarray
     kept: np.ndarray
-    g: np.ndarray
+    transfer: np.ndarray
+    blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
 
 
 class ResidualTap:
@@ -119,9 +122,14 @@ class ResidualTap:
         """A :func:`load_transfer` call: its loads, frequencies and end transfer."""
         self._loads.append((unit, np.asarray(w, dtype=float), h))
 
-    def lines(self, g: np.ndarray, transfer: np.ndarray) -> None:
-        """A :func:`pair_output_lines` call: G and the loads' end transfer, matched
-        column by column to the load transfer they were taken from."""
+    def lines(self, g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
+        """A :func:`pair_outputs` call: a block of pairs' lines G and the loads' end
+        transfer, matched column by column to the load transfer they were taken from
+        (the blocks of one contraction share its transfer array)."""
+        block = (g, np.asarray(e), np.asarray(f))
+        if self.captures and self.captures[-1].transfer is transfer:
+            self.captures[-1].blocks.append(block)
+            return
         n_o = transfer.shape[2]
         cols = [np.ascontiguousarray(transfer[:, c]).tobytes() for c in range(transfer.shape[1])]
         for unit, w, h in reversed(self._loads):
@@ -130,7 +138,7 @@ class ResidualTap:
             index = {np.ascontiguousarray(h[:, j]).tobytes(): j for j in range(h.shape[1])}
             if all(c in index for c in cols):
                 kept = np.array([index[c] for c in cols], dtype=int)
-                self.captures.append(Capture(w, unit, kept, g))
+                self.captures.append(Capture(w, unit, kept, transfer, [block]))
                 return
         self.unmatched += 1
 
@@ -247,14 +255,16 @@ def element_lines(
     out = None
     for cap in captures:
         top = cap.w.size if top_line is None else min(top_line, cap.w.size)
-        w, g = cap.w[:top], cap.g[..., :top]
+        w = cap.w[:top]
         full = load_transfer(system, damping, cap.unit, w, influence)  # (n_out, n_all, top)
         if feedthrough and kind == "geometric_residual":
             own = geometric_feedthrough(system, cap.unit.shape[2])
             sel = getattr(influence, "elements", None)
             full = full + own[slice(None) if sel is None else sel, :, None]
         lines = np.zeros((full.shape[0], cap.w.size))
-        lines[:, :top] = pair_output_lines(g, full[:, cap.kept]) * cell_factor(
+        kept = full[:, cap.kept]
+        lines[:, :top] = sum(pair_outputs(g[:, :top], kept, e, f) for g, e, f in cap.blocks)
+        lines[:, :top] *= cell_factor(
             system, damping, cap.unit, w, full, CELL_BENDS[kind], influence=influence
         )
         out = lines if out is None else out + lines

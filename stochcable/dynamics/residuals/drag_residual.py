@@ -82,7 +82,7 @@ from stochcable.dynamics.residuals.residual_lines import (
     load_transfer,
     pair_blocks,
     pair_lags,
-    pair_output_lines,
+    pair_outputs,
     residual_record,
     uniform_grid,
 )
@@ -242,9 +242,7 @@ def residual_output_lines(
     """
     order = coeffs.shape[1] - 1
     n_p = lines.shape[1]
-    sig = np.sqrt(np.einsum("cpj,cpj->p", lines.real, lines.real) + np.einsum(
-        "cpj,cpj->p", lines.imag, lines.imag
-    ))  # fmt: skip
+    sig = np.sqrt(np.sum(lines.real**2 + lines.imag**2, axis=(0, 2)))
     live = sig > 0
     force = np.where(live, scale * sig**2, 0.0)  # cσ²L
     inv = np.where(live, 1.0 / np.where(live, sig, 1.0), 0.0)
@@ -258,7 +256,7 @@ def residual_output_lines(
     # the pairs f ≥ e (G_fe = conj(G_ef)) in blocks: ρ_ef, Σ_k b_k^e b_k^f ρ^k by
     # Horner's rule, its lines
     zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
-    g = np.zeros((n_p, n_p, n_o), dtype=complex)
+    out = np.zeros((transfer.shape[0], n_o))
     for e, f in pair_blocks(n_p, n_fft):
         rho = pair_lags(zz, e, f, n_fft)
         rr = (b[e, ks[-1]] * b[f, ks[-1]])[:, None] * rho
@@ -267,8 +265,10 @@ def residual_output_lines(
             rr *= rho
         for _ in range(ks[0] - 1):
             rr *= rho
-        g[e, f] = covariance_lines(rr, n_o) * np.where(f > e, 2.0, 1.0)[:, None]
-    return pair_output_lines(g, transfer)
+        g = covariance_lines(rr, n_o)
+        g[f > e] *= 2.0
+        out += pair_outputs(g, transfer, e, f)  # (no (n_p, n_p, n_o) array formed)
+    return out
 
 
 def drag_residual(
@@ -431,9 +431,7 @@ def _live_panels(
     """The panel components (indices) whose residual force can reach the ends: the
     largest |a_k| (k ≥ 2) times cσ²L times the largest end tension per unit force at
     least :data:`PANEL_FLOOR` of the line's largest."""
-    sig2 = np.einsum("cpj,cpj->p", lines.real, lines.real) + np.einsum(
-        "cpj,cpj->p", lines.imag, lines.imag
-    )
+    sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
     score = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2 * np.abs(h).max(axis=(0, 2))
     return np.flatnonzero(score >= PANEL_FLOOR * np.max(score, initial=0.0))
 
@@ -462,17 +460,21 @@ def _misfit(
     length-weighted mean variance, the linear model's σ² in the pieces' terms). [N·s/m]"""
     out = np.zeros(len(groups))
     first = np.array([int(g[0]) for g in groups])
+    runs = []
     for e in np.unique(seg.element[seg.fine]):
         idx = np.flatnonzero(seg.element[first] == e)  # its pieces: one panel each
         s_ = first[idx]
         var = float(np.sum(seg.length[s_] * sig[idx] ** 2) / np.sum(seg.length[s_]))
-        if var <= 0.0 or b_el[e] <= 0.0:
-            continue
-        sig_e = math.sqrt(var)
-        mu = np.clip(np.append(mean_el[e] / np.where(sig[idx] > 0, sig[idx], np.inf),
-                               mean_el[e] / sig_e), -10.0, 10.0)  # fmt: skip
-        a1 = hermite_coefficients(mu, 1)[:, 1]
-        out[idx] = b_el[e] * (sig[idx] * a1[:-1] / (sig_e * a1[-1]) - 1.0) * seg.length[s_]
+        if var > 0.0 and b_el[e] > 0.0:
+            runs.append((e, idx, s_, math.sqrt(var)))
+    # a₁ of every piece and of each element's mean variance: one evaluation
+    mu = [np.append(mean_el[e] / np.where(sig[i] > 0, sig[i], np.inf), mean_el[e] / v)
+          for e, i, _, v in runs]  # fmt: skip
+    if not runs:
+        return out
+    a1 = hermite_coefficients(np.clip(np.concatenate(mu), -10.0, 10.0), 1)[:, 1]
+    for (e, idx, s_, sig_e), a in zip(runs, np.split(a1, np.cumsum([m.size for m in mu]))):
+        out[idx] = b_el[e] * (sig[idx] * a[:-1] / (sig_e * a[-1]) - 1.0) * seg.length[s_]
     return out
 
 

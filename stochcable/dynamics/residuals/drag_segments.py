@@ -296,14 +296,14 @@ def _subdivided_points(system: Any, seg: Segments) -> np.ndarray:
 
 def panel_mean(values: np.ndarray, seg: Segments, groups: list[np.ndarray]) -> np.ndarray:
     """Length-weighted mean of per-piece ``values`` (…, n_s, …) over each panel: the
-    piece axis is axis 1 of a 3-D array or axis 0 of a 1-D one."""
-    out = []
-    for g in groups:
-        share = seg.length[g] / seg.length[g].sum()
-        out.append(
-            np.einsum("csw,s->cw", values[:, g], share) if values.ndim == 3 else values[g] @ share
-        )
-    return np.stack(out, axis=1 if values.ndim == 3 else 0)
+    piece axis is axis 1 of a 3-D array or axis 0 of a 1-D one (one matrix product)."""
+    piece = np.concatenate(groups)
+    panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
+    share = np.zeros((values.shape[1 if values.ndim == 3 else 0], len(groups)))
+    share[piece, panel] = seg.length[piece] / np.bincount(panel, weights=seg.length[piece])[panel]
+    if values.ndim == 3:
+        return np.moveaxis(np.moveaxis(values, 1, 2) @ share, 2, 1)
+    return values @ share
 
 
 def panel_loads(

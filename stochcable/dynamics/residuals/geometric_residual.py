@@ -45,7 +45,7 @@ from stochcable.dynamics.residuals.residual_lines import (
     load_transfer,
     pair_blocks,
     pair_lags,
-    pair_output_lines,
+    pair_outputs,
     residual_record,
     uniform_grid,
 )
@@ -204,7 +204,7 @@ def quadratic_output_lines(
         for y in range(n_p)
     }
     # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks
-    g = np.zeros((len(terms), n_el, len(terms), n_el, n_o), dtype=complex)
+    out = np.zeros((transfer.shape[0], n_o))
     for e, f in pair_blocks(n_el, n_fft, 2):
         r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}
         twice = np.where(f > e, 2.0, 1.0)[:, None]
@@ -215,6 +215,7 @@ def quadratic_output_lines(
                     for ci, x1, y1 in terms_i
                     for cj, x2, y2 in terms_j
                 )
-                g[i, e, j, f] = covariance_lines(cov, n_o) * twice  # e's component i, f's j
-    n = len(terms) * n_el
-    return pair_output_lines(g.reshape(n, n, n_o), transfer)
+                # e's component i, f's j (transfer columns component-major)
+                g = covariance_lines(cov, n_o) * twice
+                out += pair_outputs(g, transfer, i * n_el + e, j * n_el + f)
+    return out

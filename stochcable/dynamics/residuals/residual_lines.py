@@ -48,7 +48,7 @@ __all__ = [
     "load_transfer",
     "pair_blocks",
     "pair_lags",
-    "pair_output_lines",
+    "pair_outputs",
     "residual_record",
     "uniform_grid",
 ]
@@ -61,8 +61,8 @@ MAX_LINES = 63
 #: ran 2–3× slower). [bytes]
 PAIR_BLOCK_BYTES = 2**19
 #: An observer of the residual loads (:mod:`.along_line`): None, or an object whose
-#: ``loads(unit, w, h)`` :func:`load_transfer` and ``lines(g, transfer)``
-#: :func:`pair_output_lines` call with what they are given and return.
+#: ``loads(unit, w, h)`` :func:`load_transfer` and ``lines(g, transfer, e, f)``
+#: :func:`pair_outputs` call with what they are given and return.
 RESIDUAL_TAP: ContextVar[Any] = ContextVar("residual_tap", default=None)
 
 
@@ -177,18 +177,17 @@ def pair_lags(cross: np.ndarray, e: np.ndarray, f: np.ndarray, n_fft: int) -> np
     return out
 
 
-def pair_output_lines(lines: np.ndarray, transfer: np.ndarray) -> np.ndarray:
-    """Variance lines Re Σ_cd conj(T_c) G_cd T_d of outputs driven by components with
-    cross-spectral lines G, ``lines`` (n, n, n_o); ``transfer`` (n_out, n, n_o) the
-    outputs per unit component: shape (n_out, n_o).  One matrix product per line.  The
-    callers give G on one of (c, d) and (d, c) only, weighted 2 where they differ (G_dc
-    = conj(G_cd): the two terms' real parts are equal), zero on the other."""
+def pair_outputs(g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Variance lines Re Σ_p conj(T_{e_p}) g_p T_{f_p} of outputs driven by the pairs
+    (e, f) of components with cross-spectral lines ``g`` (n_pairs, n_o); ``transfer``
+    (n_out, n, n_o) the outputs per unit component: shape (n_out, n_o).  A block of
+    pairs at a time (no (n, n, n_o) array of every pair: the drag's chain 6.4 MB); the
+    callers give one of (c, d) and (d, c) only, weighted 2 where they differ (G_dc =
+    conj(G_cd): the two terms' real parts are equal)."""
     if (tap := RESIDUAL_TAP.get()) is not None:
-        tap.lines(lines, transfer)
-    t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
-    tc = np.conj(np.transpose(transfer, (2, 0, 1)))  # (n_o, n_out, n)
-    gt = np.moveaxis(lines, 2, 0) @ t  # (n_o, n, n_out)
-    return np.einsum("jon,jno->oj", tc, gt).real
+        tap.lines(g, transfer, e, f)
+    tt = np.conj(transfer[:, e]) * transfer[:, f]
+    return np.einsum("opj,pj->oj", tt.real, g.real) - np.einsum("opj,pj->oj", tt.imag, g.imag)
 
 
 def fft_length(n: int) -> int:
