@@ -52,9 +52,17 @@ def test_zero_width_spreading_is_the_long_crested_sea():
         np.testing.assert_allclose(a[key], b[key], rtol=1e-10, atol=0)
     for end in ("end_a", "end_b"):
         np.testing.assert_allclose(
-            got.timeseries.end_tension["leg1"][end],
-            ref.timeseries.end_tension["leg1"][end],
+            got.timeseries.end_tension_linear["leg1"][end],
+            ref.timeseries.end_tension_linear["leg1"][end],
             rtol=1e-10,
+        )
+        # with the residuals' component: its density is the corrected less the linear
+        # one, formed by sums in another order on the two paths (round-off of a
+        # difference: 1.4e-10 of the total tension measured), so held to 1e-8 of the
+        # dynamic tension's σ
+        total = got.timeseries.end_tension["leg1"][end]
+        np.testing.assert_allclose(
+            total, ref.timeseries.end_tension["leg1"][end], rtol=0, atol=1e-8 * np.std(total)
         )
     np.testing.assert_array_equal(got.timeseries.elevation, ref.timeseries.elevation)
 
