@@ -96,7 +96,8 @@ def test_element_influence_equals_a_forward_dense_solve(chain):
 def test_end_rows_reproduce_the_kinds_end_lines(chain):
     """The captured load cross-spectra contracted with the end influence (in place of
     the elements' and without the geometric forces' own stretch) give each kind's end
-    lines to round-off: the loads, their columns and the cell factors are the kinds'."""
+    lines to round-off: the loads, their columns and the cell factors are the kinds', and
+    each pair is contracted once (the dense form adds a repeated pair once)."""
     line, seen = chain
     system, damping = seen["system"], seen["damping"]
     for kind, tap in seen["taps"].items():

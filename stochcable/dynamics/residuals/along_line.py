@@ -280,11 +280,8 @@ def dense_outputs(
     ``transfer`` (n_out, n, n_o); shape (n_out, n_o)."""
     n_out, n, n_o = transfer.shape
     g_all = np.zeros((n_o, n, n), dtype=complex)
-    for g, e, f in blocks:
-        if np.unique(e * n + f).size == e.size:
-            g_all[:, e, f] += g[:, :n_o].T
-        else:  # a pair twice in one block: added once per occurrence
-            np.add.at(g_all, (slice(None), e, f), g[:, :n_o].T)
+    for g, e, f in blocks:  # each pair once (pair_outputs' callers: f ≥ e, or (i, j) blocks)
+        g_all[:, e, f] += g[:, :n_o].T
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
     gt = g_all @ t  # (n_o, n, n_out)
     return np.einsum("jno,jno->oj", np.conj(t), gt).real
