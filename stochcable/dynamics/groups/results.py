@@ -80,6 +80,7 @@ def coupled_results(
             bodies,
             {cl.name: linearization.lines[cl.name].damping for cl in lines},
             linearization.body_drag,
+            {cl.name: linearization.lines[cl.name] for cl in lines},
         )
         if asked_residuals(settings.linearization)
         else {}

@@ -19,9 +19,17 @@ adjoint solves x_i = A⁻¹ Z_f,end e_i for the 2d end components (A the free–
 impedance, symmetric), G_R = [e_i on the end node; −x_i on the free nodes] and
 R_e,ij = (Z_f,end e_i)ᵀ x_j − Z_end,end,ij.
 
-The residual of a line then loads its own ends through the coupled system; the residual
-loads of the group's other lines reach its ends as well (through the bodies), which is
-not included: each line carries its own residual only.
+The residual loads of the group's other lines reach a line's ends as well, through the
+bodies: :meth:`CoupledInfluence.sources` gives every other line with the coupled
+influence of its node forces on this line's end tensions (the ``target`` form: R_e,L
+T_L S⁻¹ T_Sᵀ (G_R,S F)_att).  The planar drag residual
+(:mod:`.drag_residual`) takes all the lines' panels as one set of jointly Gaussian
+components: the cross terms between panels of different lines follow Mehler's formula
+with their cross-correlation like any pair of one line (the lines' velocities are
+correlated through the common sea and the common body motion, not independent), and
+its linear misfit loads of every line are summed through their influences before the
+variance is formed.  The other kinds (3-D drag, geometric) still carry their own line's
+residual only.
 
 Validation: against the assembled coupled system (:func:`stochcable.bodies.coupling.couple`,
 :func:`stochcable.reference.bodies.solve_coupled_direct`) loaded by unit node forces
@@ -56,6 +64,10 @@ from stochcable.dynamics.solve.line_solve import end_tension_from_support
 
 __all__ = ["CoupledInfluence", "GroupLine", "coupled_influences", "end_solves"]
 
+#: Grids whose group solves (:meth:`CoupledInfluence._state`) a group keeps: the drag
+#: residual's lines, a cell sub-sample and the analysis grid of the misfit. [-]
+_KEPT_GRIDS = 3
+
 
 @dataclass(frozen=True, eq=False)
 class GroupLine:
@@ -70,12 +82,19 @@ class GroupLine:
         Its converged linear drag.
     attached : tuple of (int, str)
         Its ends on free bodies: (0 for end_a, 1 for end_b; the body's name).
+    channels : tuple of Channel
+        Its inputs, the group's channels in the group order (empty: its residual loads
+        are not given to the other lines).
+    linearization : Linearization, optional
+        Its converged fixed point (None: as empty ``channels``).
     """
 
     name: str
     system: Any
     damping: Any
     attached: tuple[tuple[int, str], ...]
+    channels: tuple[Any, ...] = ()
+    linearization: Any = None
 
 
 def end_solves(system: Any, damping: Any, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -160,6 +179,7 @@ class CoupledInfluence:
         bodies: Sequence[RigidBody],
         body_drag: Mapping[str, np.ndarray],
         target: str | None = None,
+        shared: dict[str, Any] | None = None,
     ) -> None:
         self.name = name
         self.target = name if target is None else target
@@ -167,7 +187,27 @@ class CoupledInfluence:
         self.line = next(ln for ln in self.lines if ln.name == name)
         self.bodies = tuple(bodies)
         self.body_drag = dict(body_drag)
+        # (the group's solves per grid and the lines' residual components, shared by
+        # the influences of one group)
+        self.shared: dict[str, Any] = {} if shared is None else shared
         self._kept: tuple[np.ndarray, np.ndarray] | None = None
+
+    def sources(self) -> list[tuple[GroupLine, CoupledInfluence]]:
+        """The group's other lines whose loads reach this line's end tensions (an end on
+        a body, channels and linearization given), each with the coupled influence of
+        its node forces on this line's end tensions (``target`` this line)."""
+        if not self.line.attached:
+            return []
+        return [
+            (
+                ln,
+                CoupledInfluence(
+                    ln.name, self.lines, self.bodies, self.body_drag, self.name, self.shared
+                ),
+            )  # fmt: skip
+            for ln in self.lines
+            if ln.name != self.name and ln.attached and ln.channels and ln.linearization
+        ]
 
     def on(self, w: np.ndarray) -> np.ndarray:
         """The coupled influence on ``w``, shape (2, n_nodes, d, n_w). [N/N]"""
@@ -183,22 +223,9 @@ class CoupledInfluence:
     def compute(self, w: np.ndarray) -> np.ndarray:
         """The coupled influence on ``w`` (not kept), shape (2, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
-        off, nb = {}, 0
-        for b in self.bodies:
-            off[b.name] = nb
-            nb += b.n_dof
-        by_name = {b.name: b for b in self.bodies}
-        s = self._body_impedance(w, off, nb)
-        links, solved = {}, {}
-        for ln in self.lines:
-            t, att = self._link(ln, by_name, off, nb)
-            links[ln.name] = (t, att)
-            if not att.size and ln.name != self.name:
-                continue
-            x, r_e = end_solves(ln.system, ln.damping, w)
-            solved[ln.name] = (x, r_e)
-            if att.size:
-                s = s - t.T[None] @ r_e[:, att[:, None], att[None, :]] @ t[None]
+        off, s, links, solved = self._state(w)
+        if self.name not in solved:  # (a line on no body: its own solve)
+            solved[self.name] = end_solves(self.line.system, self.line.damping, w)
         system = self.line.system
         d, n = system.model.dim, system.model.n_nodes
         x = solved[self.name][0]
@@ -226,6 +253,34 @@ class CoupledInfluence:
         g[:, -1] = np.transpose(y[:, :, d:], (1, 2, 0))
         g[:, 1:-1] = -np.einsum("wei,wnki->enkw", y, x)
         return g
+
+    def _state(self, w: np.ndarray) -> tuple[dict[str, int], np.ndarray, dict, dict]:
+        """The group's body offsets, condensed body impedance S, links and the attached
+        lines' end solves on ``w``, shared by the group's influences (the last
+        :data:`_KEPT_GRIDS` grids)."""
+        cache = self.shared.setdefault("state", {})
+        key = w.tobytes()
+        if key in cache:
+            return cache[key]
+        off, nb = {}, 0
+        for b in self.bodies:
+            off[b.name] = nb
+            nb += b.n_dof
+        by_name = {b.name: b for b in self.bodies}
+        s = self._body_impedance(w, off, nb)
+        links, solved = {}, {}
+        for ln in self.lines:
+            t, att = self._link(ln, by_name, off, nb)
+            links[ln.name] = (t, att)
+            if not att.size:
+                continue
+            x, r_e = end_solves(ln.system, ln.damping, w)
+            solved[ln.name] = (x, r_e)
+            s = s - t.T[None] @ r_e[:, att[:, None], att[None, :]] @ t[None]
+        if len(cache) >= _KEPT_GRIDS:
+            cache.pop(next(iter(cache)))
+        cache[key] = (off, s, links, solved)
+        return cache[key]
 
     def _body_impedance(self, w: np.ndarray, off: dict[str, int], nb: int) -> np.ndarray:
         """Z_B + iω C_drag of the bodies with the lines' attachment geometric stiffness,
@@ -278,6 +333,7 @@ def coupled_influences(
     bodies: Sequence[RigidBody],
     dampings: Mapping[str, Any],
     body_drag: Mapping[str, np.ndarray],
+    linearizations: Mapping[str, Any] | None = None,
 ) -> dict[str, CoupledInfluence]:
     """The coupled influence of every line of a group (none for a group with a
     travelling line or a line with a steady lift: not covered).
@@ -292,6 +348,10 @@ def coupled_influences(
         The converged linear drag of each line.
     body_drag : mapping of str to ndarray, shape (3,)
         The bodies' linear drag. [N·s/m]
+    linearizations : mapping of str to Linearization, optional
+        The lines' converged fixed points: with them (and the lines' ``channels``) the
+        residual loads of every line reach the others' end tensions
+        (:meth:`CoupledInfluence.sources`); without, each line carries its own.
 
     Returns
     -------
@@ -299,5 +359,12 @@ def coupled_influences(
     """
     if any(cl.system.gyro is not None or cl.system.lift is not None for cl in lines):
         return {}
-    group = [GroupLine(cl.name, cl.system, dampings[cl.name], tuple(cl.attached())) for cl in lines]
-    return {ln.name: CoupledInfluence(ln.name, group, bodies, body_drag) for ln in group}
+    lin = {} if linearizations is None else linearizations
+    group = [
+        GroupLine(cl.name, cl.system, dampings[cl.name], tuple(cl.attached()),
+                  tuple(cl.channels) if cl.name in lin else (), lin.get(cl.name))
+        for cl in lines
+    ]  # fmt: skip
+    shared: dict[str, Any] = {}
+    return {ln.name: CoupledInfluence(ln.name, group, bodies, body_drag, shared=shared)
+            for ln in group}  # fmt: skip

@@ -56,8 +56,10 @@ most :data:`MAX_PANELS` panels (the cost is O(panels² · n_fft log n_fft)).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -315,6 +317,94 @@ def drag_residual(
         why = f"linearization method {damping.method!r}: only 'seed' is covered"
     if why is not None:
         return ResidualRecord.not_computed(why, std)
+    comp = drag_components(system, channels, linearization, order, lumped)
+    if comp is None:  # no drag: nothing dropped
+        zero = {"end_a": 0.0, "end_b": 0.0}
+        return ResidualRecord.from_variances(zero, zero, std, order, 0)
+    resp = linearization.response
+    w = np.asarray(resp.omega, dtype=float)
+    influence = EndInfluence(system, damping) if influence is None else influence
+    h_all = load_transfer(system, damping, comp.unit, comp.w_out, influence)
+    # a line on bodies: its coupled influence on every grid (body_residual), and the
+    # group's other lines' panels through the bodies (one set of components with this
+    # line's: their cross terms count, the lines' velocities share the sea and bodies)
+    coupled = None if isinstance(influence, EndInfluence) else influence
+    others = _other_lines(coupled, comp, order, lumped)
+    lines_all, scale_all, coeff_all, h_src = (
+        np.concatenate([comp.lines] + [c.lines for c, _, _ in others], axis=1),
+        np.concatenate([comp.scale] + [c.scale for c, _, _ in others]),
+        np.concatenate([comp.coeffs] + [c.coeffs for c, _, _ in others]),
+        np.concatenate([h_all] + [h for _, h, _ in others], axis=1),
+    )
+    keep = _live_panels(lines_all, scale_all, coeff_all, h_src)
+    lines_t = residual_output_lines(
+        lines_all[:, keep], scale_all[keep], coeff_all[keep], h_src[:, keep], comp.n_fft
+    ) * cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled)
+    linear = _misfit_variance(
+        system,
+        damping,
+        resp,
+        comp.spectra,
+        comp.seg,
+        comp.groups,
+        comp.live,
+        comp.parts,
+        comp.misfit,
+        (comp.grid, comp.w_out, influence, _bent(h_all)),
+        coupled,
+        [(c, src) for c, _, src in others],
+    )
+    out = residual_record(lines_t, comp.w_out, w, std, order, len(comp.groups), linear)
+    _warn_large(system.name, out)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class DragComponents:
+    """The drag residual's panel components of one planar line (:func:`drag_components`).
+
+    Attributes
+    ----------
+    seg, groups : Segments, list of ndarray
+        The pieces and their panels.
+    live : list of str
+        The drag directions with a drag ("normal", "axial").
+    parts : dict
+        Per direction: ½ρC_dD per length, the mean flow, the element directions, B.
+    spectra : ndarray, shape (n_ch, n_w)
+    grid : UniformGrid
+    w_out : ndarray, shape (n_o,)
+        The residual's lines. [rad/s]
+    n_fft : int
+    unit : ndarray, shape (n_nodes, d, n_comp)
+        Node forces per unit panel force (direction-major columns). [N/N]
+    lines, scale, coeffs : ndarray
+        Velocity lines (n_ch, n_comp, n_j), c·L and Hermite coefficients per component.
+    misfit : list of (ndarray, ndarray)
+        Per direction: the panels' velocities (n_ch, n_p, n_w) and their δB·l.
+    """
+
+    seg: Segments
+    groups: list[np.ndarray]
+    live: list[str]
+    parts: dict[str, Any]
+    spectra: np.ndarray
+    grid: UniformGrid
+    w_out: np.ndarray
+    n_fft: int
+    unit: np.ndarray
+    lines: np.ndarray
+    scale: np.ndarray
+    coeffs: np.ndarray
+    misfit: list[tuple[np.ndarray, np.ndarray]]
+
+
+def drag_components(
+    system: Any, channels: Any, linearization: Any, order: int, lumped: bool
+) -> DragComponents | None:
+    """The panel components of a planar line's drag residual (None: no drag)."""
+    model = system.model
+    damping = linearization.damping
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
     mesh = model.mesh
@@ -330,9 +420,8 @@ def drag_residual(
         "axial": (c_t, u_t, tang, damping.b_axial),
     }
     live = [name for name, p in parts.items() if np.any(p[0] > 0)]
-    if not live:  # no drag: nothing dropped
-        zero = {"end_a": 0.0, "end_b": 0.0}
-        return ResidualRecord.from_variances(zero, zero, std, order, 0)
+    if not live:
+        return None
     seg = segments(system, channels, sum(parts[n][0] for n in live), MAX_PANELS)
     groups = panel_groups(seg, MAX_PANELS)
     seg_v = segment_velocity(system, channels, resp, seg, {n: parts[n][2] for n in live})
@@ -343,8 +432,6 @@ def drag_residual(
     # (ρ^K reaches line K·(n_j − 1): a lag grid of 2·K·(n_j − 1) + 1 samples resolves it)
     n_fft = fft_length(2 * order * (grid.n_j - 1) + 1)
     unit = panel_loads(model, seg, groups, [parts[n][2] for n in live])
-    influence = EndInfluence(system, damping) if influence is None else influence
-    h_all = load_transfer(system, damping, unit, w_out, influence)
     # the normal and axial residuals of every panel are one set of components: they are
     # functions of jointly Gaussian velocities, so their cross terms count too (where
     # the linear tensions of the two cancel, so do the residuals' in part)
@@ -363,30 +450,43 @@ def drag_residual(
         coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
         lines.append(v)
         misfit.append((pan, _misfit(seg, groups, c_el, mean_el, b_el, sig)))
-    # a line on bodies: its coupled influence on every grid (body_residual)
-    coupled = None if isinstance(influence, EndInfluence) else influence
-    lines_all, scale_all, coeff_all = (np.concatenate(lines, axis=1), np.concatenate(scales),
-                                       np.concatenate(coeffs))  # fmt: skip
-    keep = _live_panels(lines_all, scale_all, coeff_all, h_all)
-    lines_t = residual_output_lines(
-        lines_all[:, keep], scale_all[keep], coeff_all[keep], h_all[:, keep], n_fft
-    ) * cell_factor(system, damping, unit, w_out, h_all, influence=coupled)
-    linear = _misfit_variance(
-        system,
-        damping,
-        resp,
-        spectra,
-        seg,
-        groups,
-        live,
-        parts,
-        misfit,
-        (grid, w_out, influence, _bent(h_all)),
-        coupled,
-    )
-    out = residual_record(lines_t, w_out, w, std, order, len(groups), linear)
-    _warn_large(system.name, out)
+    return DragComponents(seg, groups, live, parts, spectra, grid, w_out, n_fft, unit,
+                          np.concatenate(lines, axis=1), np.concatenate(scales),
+                          np.concatenate(coeffs), misfit)  # fmt: skip
+
+
+def _other_lines(
+    coupled: Any, comp: DragComponents, order: int, lumped: bool
+) -> list[tuple[DragComponents, np.ndarray, Any]]:
+    """The group's other lines of a line on bodies (``coupled`` its coupled influence,
+    None: none): their components (kept on the group), their panels' end tensions of
+    this line through the bodies on this line's residual lines, and their influence."""
+    out = []
+    for src, infl in coupled.sources() if coupled is not None else ():
+        if src.system.model.dim != 2 or src.linearization.damping.method != "seed":
+            continue
+        kept = infl.shared.setdefault("drag", {})
+        key = (src.name, order, lumped)
+        if key not in kept:
+            kept[key] = drag_components(src.system, src.channels, src.linearization, order,
+                                        lumped)  # fmt: skip
+        c = kept[key]
+        if c is None or not np.array_equal(c.w_out, comp.w_out):
+            continue  # (no drag; another grid: the group's lines share one)
+        with _untapped():
+            h = load_transfer(src.system, src.damping, c.unit, comp.w_out, infl)
+        out.append((c, h, infl))
     return out
+
+
+@contextlib.contextmanager
+def _untapped() -> Any:
+    """No :data:`RESIDUAL_TAP` inside (another line's loads are not this line's)."""
+    token = RESIDUAL_TAP.set(None)
+    try:
+        yield
+    finally:
+        RESIDUAL_TAP.reset(token)
 
 
 def cell_factor(
@@ -490,6 +590,7 @@ def _misfit_variance(
     misfit: list[tuple[np.ndarray, np.ndarray]],
     lines: tuple[UniformGrid, np.ndarray, Any, np.ndarray],
     coupled: Any = None,
+    others: list[tuple[DragComponents, Any]] | None = None,
 ) -> dict[str, np.ndarray]:
     """The end-tension variance the linear misfit of the element-constant drag changes,
     as lines on the analysis grid (empty without split elements): its load δB·l·v on
@@ -502,34 +603,62 @@ def _misfit_variance(
     chain 0.2 % of the misfit's variance, itself 0.04 % of the residual's), and solved
     at the frequency itself where the line's cell is ``bent`` (:func:`_bent`: a
     resonance narrower than a line; on the inclined guy 253 of its 300 frequencies),
-    through ``coupled`` (a line on bodies: its coupled influence) where given."""
+    through ``coupled`` (a line on bodies: its coupled influence) where given.
+    ``others`` (a line on bodies): the group's other lines' components with their
+    influence on this line's end tensions; their misfit loads add to H_c (taken at
+    the analysis frequencies) before the variance is formed."""
     w = np.asarray(resp.omega, dtype=float)
-    keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
-    if not keep:
+    h_c = np.zeros((2, spectra.shape[0], w.size), dtype=complex)
+    mis = _misfit_loads(system.model, seg, groups, live, parts, misfit)
+    if mis is not None:
+        unit, load = mis
+        grid, w_out, influence, bent = lines
+        at = np.clip(grid.index - 1, 0, w_out.size - 1)  # (line j is w_out[j − 1])
+        h = load_transfer(system, damping, unit, w_out, influence)[:, :, at]  # (2, n_load, n_w)
+        exact = np.arange(w.size) if MISFIT_EXACT else np.flatnonzero(bent[at])
+        if exact.size:
+            h[:, :, exact] = load_transfer(system, damping, unit, w[exact], coupled)
+        if (tap := RESIDUAL_TAP.get()) is not None:  # (the element tensions': .along_line)
+            tap.misfit(unit, load, w)
+        h_c += np.einsum("opw,cpw->ocw", h, load)
+    for c, infl in others or ():  # (through the bodies: H_c of this line's ends)
+        mis = _misfit_loads(infl.line.system.model, c.seg, c.groups, c.live, c.parts, c.misfit)
+        if mis is not None:
+            with _untapped():
+                h = load_transfer(infl.line.system, infl.line.damping, mis[0], w, infl)
+            h_c += np.einsum("opw,cpw->ocw", h, mis[1])
+    if not np.any(h_c):
         return {}
-    sel = [[groups[i] for i in idx] for _, idx in keep]
-    unit = np.concatenate(
-        [panel_loads(system.model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
-        axis=2,
-    )
-    grid, w_out, influence, bent = lines
-    at = np.clip(grid.index - 1, 0, w_out.size - 1)  # (line j is w_out[j − 1])
-    h = load_transfer(system, damping, unit, w_out, influence)[:, :, at]  # (2, n_load, n_w)
-    exact = np.arange(w.size) if MISFIT_EXACT else np.flatnonzero(bent[at])
-    if exact.size:
-        h[:, :, exact] = load_transfer(system, damping, unit, w[exact], coupled)
-    load = np.concatenate(
-        [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
-    )  # (n_ch, n_load, n_w)
-    if (tap := RESIDUAL_TAP.get()) is not None:  # (the element tensions': .along_line)
-        tap.misfit(unit, load, w)
     q = trapezoid_weights(w)[None] * spectra
     out = {}
     for o, end in enumerate(("end_a", "end_b")):
         h_l = np.asarray(resp.end_tension[end])
-        h_c = np.einsum("pw,cpw->cw", h[o], load)
-        out[end] = np.sum(q * (np.abs(h_l + h_c) ** 2 - np.abs(h_l) ** 2), axis=0)
+        out[end] = np.sum(q * (np.abs(h_l + h_c[o]) ** 2 - np.abs(h_l) ** 2), axis=0)
     return out
+
+
+def _misfit_loads(
+    model: Any,
+    seg: Segments,
+    groups: list[np.ndarray],
+    live: list[str],
+    parts: dict[str, Any],
+    misfit: list[tuple[np.ndarray, np.ndarray]],
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The misfit's unit node loads (n_nodes, d, n_load) and its loads per channel
+    (n_ch, n_load, n_w) on the panels with a δB (None: none)."""
+    keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
+    if not keep:
+        return None
+    sel = [[groups[i] for i in idx] for _, idx in keep]
+    unit = np.concatenate(
+        [panel_loads(model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
+        axis=2,
+    )
+    load = np.concatenate(
+        [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
+    )  # (n_ch, n_load, n_w)
+    return unit, load
 
 
 def _warn_large(name: str, res: ResidualRecord) -> None:
