@@ -60,6 +60,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -70,6 +71,7 @@ from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.residuals.drag_residual import (
     LUMPED_ORDER,
     MAX_PANELS,
+    _untapped,
     _warn_large,
     cell_factor,
     drag_residual,
@@ -439,6 +441,72 @@ def drag_residual_3d(
         return ResidualRecord.not_computed(
             f"linearization method {damping.method!r}: only 'seed' and 'vector' are covered", std
         )
+    comp = drag_components_3d(system, channels, linearization, order, lumped)
+    if comp is None:  # no drag: nothing dropped
+        zero = {"end_a": 0.0, "end_b": 0.0}
+        return ResidualRecord.from_variances(zero, zero, std, order, 0)
+    resp = linearization.response
+    w = np.asarray(resp.omega, dtype=float)
+    n_p, n_o = comp.z.shape[1], comp.w_out.size
+    h = load_transfer(system, damping, comp.unit, comp.w_out, influence)  # (2, 3·n_p, n_o)
+    transfer = np.transpose(h.reshape(2, 3, n_p, n_o), (0, 2, 1, 3))
+    coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
+    # a line on bodies: the group's other lines' panels through the bodies, one set of
+    # components with this line's (body_residual)
+    others = []
+    for src, infl in coupled.sources() if coupled is not None else ():
+        if src.system.model.dim != 3 or src.linearization.damping.method not in ("seed", "vector"):
+            continue
+        kept = infl.shared.setdefault("drag_3d", {})
+        if (key := (src.name, order, lumped)) not in kept:
+            kept[key] = drag_components_3d(src.system, src.channels, src.linearization, order,
+                                           lumped)  # fmt: skip
+        c = kept[key]
+        if c is None or not np.array_equal(c.w_out, comp.w_out):
+            continue
+        with _untapped():
+            hs = load_transfer(src.system, src.damping, c.unit, comp.w_out, infl)
+        ts = np.transpose(hs.reshape(2, 3, c.z.shape[1], n_o), (0, 2, 1, 3))
+        others.append((src, infl, c, ts))
+    z_all = np.concatenate([comp.z] + [c.z for _, _, c, _ in others], axis=1)
+    co_all = np.concatenate([comp.coeffs] + [c.coeffs for _, _, c, _ in others])
+    t_all = np.concatenate([transfer] + [t for *_, t in others], axis=1)
+    lines_t = vector_residual_output_lines(z_all, co_all, t_all, comp.n_fft) * cell_factor(
+        system, damping, comp.unit, comp.w_out, h, influence=coupled
+    )
+    mis = [(system, damping, comp, coupled)] + [
+        (s_.system, s_.damping, c, i) for s_, i, c, _ in others
+    ]
+    linear = _misfit_variance(resp, comp.spectra, [m for m in mis if m[2].db is not None])
+    out = residual_record(lines_t, comp.w_out, w, std, order, n_p, linear)
+    _warn_large(system.name, out)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class DragComponents3D:
+    """The drag residual's panel components of one 3-D line (:func:`drag_components_3d`):
+    the whitened velocity lines ``z`` (n_ch, n_p, 3, n_j), the coefficients (n_p, 3,
+    K + 1, K + 1, K + 1), the unit node loads (n_nodes, 3, 3·n_p), the residual's lines
+    ``w_out`` [rad/s] and lag grid ``n_fft``, the spectra, the panels' velocities ``pan``
+    and their misfit ``db`` (None: none)."""
+
+    z: np.ndarray
+    coeffs: np.ndarray
+    unit: np.ndarray
+    w_out: np.ndarray
+    n_fft: int
+    spectra: np.ndarray
+    pan: dict[str, np.ndarray]
+    db: np.ndarray | None
+
+
+def drag_components_3d(
+    system: Any, channels: Any, linearization: Any, order: int, lumped: bool
+) -> DragComponents3D | None:
+    """The panel components of a 3-D line's drag residual (None: no drag)."""
+    model = system.model
+    damping = linearization.damping
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
     mesh = model.mesh
@@ -446,9 +514,8 @@ def drag_residual_3d(
     u_t, u_nvec, _ = current_split(system)
     c_n = 0.5 * model.rho * mesh.cd_normal * mesh.diameter
     c_t = 0.5 * model.rho * mesh.cd_axial * math.pi * mesh.diameter
-    if not (np.any(c_n > 0) or np.any(c_t > 0)):  # no drag: nothing dropped
-        zero = {"end_a": 0.0, "end_b": 0.0}
-        return ResidualRecord.from_variances(zero, zero, std, order, 0)
+    if not (np.any(c_n > 0) or np.any(c_t > 0)):
+        return None
     seg = segments(system, channels, c_n + c_t, MAX_PANELS)
     groups = panel_groups(seg, MAX_PANELS)
     n_p = len(groups)
@@ -485,21 +552,8 @@ def drag_residual_3d(
     w_out = grid.step * np.arange(1, n_o + 1)
     n_fft = fft_length(2 * order * (grid.n_j - 1) + 1)
     unit = panel_loads(model, seg, groups, [n1, n2, tang])  # columns direction-major
-    h = load_transfer(system, damping, unit, w_out, influence)  # (2, 3·n_p, n_o)
-    transfer = np.transpose(h.reshape(2, 3, n_p, n_o), (0, 2, 1, 3))
-    coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
-    lines_t = vector_residual_output_lines(z, coeffs, transfer, n_fft) * cell_factor(
-        system, damping, unit, w_out, h, influence=coupled
-    )
     db = _misfit(damping, seg, groups, c_n, c_t, cov, mean, sig_t, mean_t, scale_n, scale_t)
-    linear = (
-        _misfit_variance(system, damping, resp, spectra, unit, pan, db, coupled)
-        if db is not None
-        else {}
-    )
-    out = residual_record(lines_t, w_out, w, std, order, n_p, linear)
-    _warn_large(system.name, out)
-    return out
+    return DragComponents3D(z, coeffs, unit, w_out, n_fft, spectra, pan, db)
 
 
 def _panel_sum(c_el: np.ndarray, seg: Any, groups: list[np.ndarray]) -> np.ndarray:
@@ -574,27 +628,29 @@ def _misfit(
 
 
 def _misfit_variance(
-    system: Any,
-    damping: Any,
-    resp: Any,
-    spectra: np.ndarray,
-    unit: np.ndarray,
-    pan: dict[str, np.ndarray],
-    db: np.ndarray,
-    coupled: Any,
+    resp: Any, spectra: np.ndarray, sources: list[tuple[Any, Any, DragComponents3D, Any]]
 ) -> dict[str, np.ndarray]:
     """The end-tension variance change of the linear misfit loads δB·v of every panel
     (Σ_c S_c(|H_L + H_c|² − |H_L|²) times the trapezoid weights), as lines on the
-    analysis grid. [N²]"""
+    analysis grid; ``sources`` (system, damping, components, influence) the line's own
+    (influence None: ends held, or its coupled influence) and, on bodies, the group's
+    other lines with their influence on its end tensions: their H_c add. [N²]"""
+    if not sources:
+        return {}
     w = np.asarray(resp.omega, dtype=float)
-    v = np.stack([pan["n1"], pan["n2"], pan["t"]], axis=1)  # (n_ch, 3, n_p, n_w)
-    load = np.einsum("pab,cbpw->capw", db, v)  # along n₁, n₂, t
-    h = load_transfer(system, damping, unit, w, coupled)  # (2, 3·n_p, n_w)
-    n_ch = load.shape[0]
+    h_c = 0.0
+    for k, (system, damping, c, infl) in enumerate(sources):
+        v = np.stack([c.pan["n1"], c.pan["n2"], c.pan["t"]], axis=1)  # (n_ch, 3, n_p, n_w)
+        load = np.einsum("pab,cbpw->capw", c.db, v)  # along n₁, n₂, t
+        if k == 0:
+            h = load_transfer(system, damping, c.unit, w, infl)  # (2, 3·n_p, n_w)
+        else:
+            with _untapped():
+                h = load_transfer(system, damping, c.unit, w, infl)
+        h_c = h_c + np.einsum("okw,ckw->ocw", h, load.reshape(load.shape[0], -1, w.size))
     q = trapezoid_weights(w)[None] * spectra
     out = {}
     for o, end in enumerate(("end_a", "end_b")):
         h_l = np.asarray(resp.end_tension[end])
-        h_c = np.einsum("kw,ckw->cw", h[o], load.reshape(n_ch, -1, w.size))
-        out[end] = np.sum(q * (np.abs(h_l + h_c) ** 2 - np.abs(h_l) ** 2), axis=0)
+        out[end] = np.sum(q * (np.abs(h_l + h_c[o]) ** 2 - np.abs(h_l) ** 2), axis=0)
     return out
