@@ -435,6 +435,7 @@ def test_mirrored_two_leg_buoy_mirrors_the_legs_residuals():
 
     mp = pytest.MonkeyPatch()
     mp.setattr(br.CoupledInfluence, "sources", lambda self: [])
+    mp.setattr(br.CoupledInfluence, "joint_lines", lambda self, *a: None)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

@@ -44,7 +44,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -208,6 +208,64 @@ class CoupledInfluence:
             for ln in self.lines
             if ln.name != self.name and ln.attached and ln.channels and ln.linearization
         ]
+
+    def joint_lines(
+        self,
+        key: Any,
+        components: Callable[[GroupLine], Any],
+        transfer: Callable[[GroupLine, Any, CoupledInfluence], np.ndarray],
+        outputs: Callable[[list[Any], np.ndarray], np.ndarray],
+    ) -> tuple[np.ndarray, list[tuple[GroupLine, Any, CoupledInfluence]]] | None:
+        """A residual's variance lines of this line's end tensions from the panels of
+        every line of the group that ``components`` gives (None: a line left out), as
+        one set of components, formed once for every line of the group and kept on it
+        (``key``: the residual and its options).
+
+        ``transfer(source, its components, influence)`` gives the source's end
+        tensions of the influence's target per unit component, (2, n_comp, …);
+        ``outputs(components, transfer)`` the variance lines of the stacked outputs,
+        (2·n_lines, n_o), from the sources' transfers concatenated along axis 1.
+        Returns (the lines (2, n_o), the other sources with their components and
+        influence on this line), or None where this line is not among them (or alone).
+        """
+        joint = self.shared.setdefault("joint", {})
+        if key not in joint:
+            kept = self.shared.setdefault("components", {})
+            parts = []
+            for ln in self.lines:
+                if not (ln.attached and ln.channels and ln.linearization):
+                    continue
+                if (key, ln.name) not in kept:
+                    kept[key, ln.name] = components(ln)
+                if kept[key, ln.name] is not None:
+                    parts.append((ln, kept[key, ln.name]))
+            if len(parts) < 2:
+                joint[key] = {}
+            else:
+                infl = {
+                    (src.name, tgt.name): CoupledInfluence(
+                        src.name, self.lines, self.bodies, self.body_drag, tgt.name, self.shared
+                    )
+                    for src, _ in parts
+                    for tgt, _ in parts
+                }
+                h = np.concatenate(
+                    [
+                        np.concatenate(
+                            [transfer(src, c, infl[src.name, tgt.name]) for src, c in parts], 1
+                        )
+                        for tgt, _ in parts
+                    ]
+                )
+                lines = outputs([c for _, c in parts], h)
+                joint[key] = {
+                    tgt.name: (
+                        lines[2 * i : 2 * i + 2],
+                        [(s_, c, infl[s_.name, tgt.name]) for s_, c in parts if s_ is not tgt],
+                    )
+                    for i, (tgt, _) in enumerate(parts)
+                }
+        return joint[key].get(self.name)
 
     def on(self, w: np.ndarray) -> np.ndarray:
         """The coupled influence on ``w``, shape (2, n_nodes, d, n_w). [N/N]"""

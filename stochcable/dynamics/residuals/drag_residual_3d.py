@@ -451,36 +451,49 @@ def drag_residual_3d(
     h = load_transfer(system, damping, comp.unit, comp.w_out, influence)  # (2, 3·n_p, n_o)
     transfer = np.transpose(h.reshape(2, 3, n_p, n_o), (0, 2, 1, 3))
     coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
-    # a line on bodies: the group's other lines' panels through the bodies, one set of
-    # components with this line's (body_residual)
-    others = []
-    for src, infl in coupled.sources() if coupled is not None else ():
-        if src.system.model.dim != 3 or src.linearization.damping.method not in ("seed", "vector"):
-            continue
-        kept = infl.shared.setdefault("drag_3d", {})
-        if (key := (src.name, order, lumped)) not in kept:
-            kept[key] = drag_components_3d(src.system, src.channels, src.linearization, order,
-                                           lumped)  # fmt: skip
-        c = kept[key]
-        if c is None or not np.array_equal(c.w_out, comp.w_out):
-            continue
-        with _untapped():
-            hs = load_transfer(src.system, src.damping, c.unit, comp.w_out, infl)
-        ts = np.transpose(hs.reshape(2, 3, c.z.shape[1], n_o), (0, 2, 1, 3))
-        others.append((src, infl, c, ts))
-    z_all = np.concatenate([comp.z] + [c.z for _, _, c, _ in others], axis=1)
-    co_all = np.concatenate([comp.coeffs] + [c.coeffs for _, _, c, _ in others])
-    t_all = np.concatenate([transfer] + [t for *_, t in others], axis=1)
-    lines_t = vector_residual_output_lines(z_all, co_all, t_all, comp.n_fft) * cell_factor(
-        system, damping, comp.unit, comp.w_out, h, influence=coupled
-    )
+    # a line on bodies: the group's lines' panels through the bodies as one set of
+    # components (body_residual; formed once for the group)
+    joint = None if coupled is None else _joint(coupled, order, lumped)
+    if joint is None:
+        lines_t, others = (
+            vector_residual_output_lines(comp.z, comp.coeffs, transfer, comp.n_fft),
+            [],
+        )
+    else:
+        lines_t, others = joint
+    lines_t = lines_t * cell_factor(system, damping, comp.unit, comp.w_out, h, influence=coupled)
     mis = [(system, damping, comp, coupled)] + [
-        (s_.system, s_.damping, c, i) for s_, i, c, _ in others
+        (s_.system, s_.damping, c, i) for s_, c, i in others
     ]
     linear = _misfit_variance(resp, comp.spectra, [m for m in mis if m[2].db is not None])
     out = residual_record(lines_t, comp.w_out, w, std, order, n_p, linear)
     _warn_large(system.name, out)
     return out
+
+
+def _joint(coupled: Any, order: int, lumped: bool) -> Any:
+    """The joint drag residual lines of a line on bodies over its group's 3-D lines
+    (:meth:`~stochcable.dynamics.residuals.body_residual.CoupledInfluence.joint_lines`)."""
+
+    def components(ln: Any) -> DragComponents3D | None:
+        if ln.system.model.dim != 3 or ln.linearization.damping.method not in ("seed", "vector"):
+            return None
+        return drag_components_3d(ln.system, ln.channels, ln.linearization, order, lumped)
+
+    def transfer(ln: Any, c: DragComponents3D, infl: Any) -> np.ndarray:
+        with _untapped():
+            h = load_transfer(ln.system, ln.damping, c.unit, c.w_out, infl)
+        return np.transpose(h.reshape(2, 3, c.z.shape[1], c.w_out.size), (0, 2, 1, 3))
+
+    def outputs(cs: list[DragComponents3D], t: np.ndarray) -> np.ndarray:
+        if any(not np.array_equal(c.w_out, cs[0].w_out) for c in cs):
+            raise ValueError("the group's lines have different residual grids")
+        z = np.concatenate([c.z for c in cs], axis=1)
+        co = np.concatenate([c.coeffs for c in cs])
+        with _untapped():
+            return vector_residual_output_lines(z, co, t, cs[0].n_fft)
+
+    return coupled.joint_lines(("drag_3d", order, lumped), components, transfer, outputs)
 
 
 @dataclass(frozen=True, eq=False)
