@@ -311,7 +311,8 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     rows, stats, damage, names = m.rows, m.stats, m.damage, m.names
     d_ends = m.d_ends
     # the residuals' corrections of the cases that did not compute them
-    interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear)
+    law = "hs2" if plan.residual_tolerance is None else "power"
+    interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear, law)
     s_el = m.s_el
     d_along = {ln: damage[ln][:, 2:] for ln in names}
     p = np.array([s.probability for s in scatter.states])
