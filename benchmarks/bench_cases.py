@@ -233,8 +233,10 @@ def main() -> None:
         "leave ≈ 10 % of the cases computed, below the three per column the checks need",
         "(smallest, middle, largest Hs) on this diagram's 10 Hs a column.  Where the",
         "corrections bend (the taut wire at Tp 10 s, Tuah's leg whose σ correction",
-        "rises to +40 % and falls) the checks compute most cases, and the set costs",
-        "nearly as much as computing every case — the price of the stated accuracy.",
+        "reaches +35 … +49 % and falls again at Tp 6 s) the checks compute most cases,",
+        "and the set costs about as much as computing every case, or more (one run each,",
+        "its time ±20 % on this host: a case computed in a later pass is solved twice) —",
+        "the price of the stated accuracy.",
     ]
     text = "\n".join(lines) + "\n"
     print(text)

@@ -210,8 +210,8 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "and largest Hs, then the middle Hs of every interval where the interpolated "
         "corrections miss the computed ones by more than ``residual_tolerance``, "
         "default 2e-3) and interpolates their corrections in Hs on the others "
-        "(:mod:`stochcable.cases.residual_anchors`: measured within 5.5e-4 on σ and "
-        "3e-3 on end damage of every case computed); with ``residual_span`` and "
+        "(:mod:`stochcable.cases.residual_anchors`: measured within 8.7e-4 on σ and "
+        "4.4e-3 on end damage of every case computed); with ``residual_span`` and "
         "``residual_tolerance=None`` on fixed anchors (up to 4.2 % on σ on the taut "
         "wire at Tp 10 s); a plan (the service's batches) computes every case.  The "
         "warning says which.",

@@ -177,7 +177,7 @@ def run_cases(
         linear ones; the end damage rate's, with 3 × the tolerance) are within
         ``residual_tolerance`` of the computed ones; the other cases get interpolated
         corrections.  Default :data:`~stochcable.cases.residual_anchors.RESIDUAL_TOLERANCE`
-        (2e-3: measured within 5.5e-4 on σ and 3e-3 on the end damage of the cases
+        (2e-3: measured within 8.7e-4 on σ and 4.4e-3 on the end damage of the cases
         computed one by one, on the chain, the taut wire and Tuah's single leg,
         docs/benchmarks/cases.md; never finer than the scene's
         ``analysis.linearization.tolerance``, to which the ratios are known).

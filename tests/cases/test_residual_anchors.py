@@ -282,7 +282,7 @@ def _misses(got, ref, line: str) -> tuple[float, float]:
 def test_adaptive_set_on_the_chain_against_every_case_computed():
     """The chain example (in current, seabed contact) in one column of 10 Hs at Tp 9 s
     with DNV γ: within 3e-3 on σ, Tz and MPM and 1e-2 on the end damage of every case
-    computed (measured 2.1e-4 and 1.1e-3 over the benchmark's 200 cases)."""
+    computed (measured 8.7e-4 and 4.4e-3 over the benchmark's 200 cases)."""
     rows = [{"hs": float(h), "tp": 9.0, "hours": 1.0} for h in range(1, 11)]
     sd = scatter_from_rows(rows)
     fatigue = LineFatigue("dnv-studless", nominal_diameter=0.084)
