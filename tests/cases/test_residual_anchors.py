@@ -319,3 +319,13 @@ def test_adaptive_sets_across_diagrams(name, hs, tps, fatigue):
         got = run_cases(doc, sd, fatigue=fatigue)
     stats, damage = _misses(got, ref, ref.lines[0])
     assert stats < 3e-3 and damage < 1e-2
+
+
+def test_next_anchors_bisect_around_a_case_without_response():
+    """A check without a response (a failed case) cannot judge its interval: both
+    halves are checked, whatever the ratios."""
+    states, stats, linear, rows = _column(lambda h: 1 + 0.01 * h**2.7)
+    exact = first_anchors(states, None)
+    rows[4] = CaseRow(4, "failed", "SolverError: x")
+    more = next_anchors(states, None, 1e-3, exact, rows, stats, {}, linear)
+    assert more.tolist() == [False, False, True, False, False, False, True, False, False]
