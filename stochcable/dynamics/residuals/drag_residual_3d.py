@@ -84,6 +84,7 @@ from stochcable.dynamics.residuals.drag_segments import (
     segments,
 )
 from stochcable.dynamics.residuals.residual_lines import (
+    RESIDUAL_TAP,
     EndInfluence,
     element_directions,
     fft_length,
@@ -352,7 +353,11 @@ def vector_residual_covariance(z: np.ndarray, coeffs: np.ndarray, n_fft: int) ->
 
 
 def vector_residual_output_lines(
-    z: np.ndarray, coeffs: np.ndarray, transfer: np.ndarray, n_fft: int
+    z: np.ndarray,
+    coeffs: np.ndarray,
+    transfer: np.ndarray,
+    n_fft: int,
+    keep: list[tuple[np.ndarray, slice, slice]] | None = None,
 ) -> np.ndarray:
     """Spectral lines of outputs driven by the vector drag residual of jointly Gaussian
     panels (module notes).
@@ -364,6 +369,10 @@ def vector_residual_output_lines(
     transfer : ndarray, complex, shape (n_out, n_p, 3, n_o)
         Outputs per unit force on each panel along each output direction at ω_j,
         j = 1 … n_o. [N/N]
+    keep : list, optional
+        Receives each block's force cross-spectral lines (g (n_o, 3·n_b, 3·n_f),
+        panel-major, pairs weighted; its panels e, f as slices): other outputs' lines
+        are Re Σ conj(T_e) g T_f over the blocks (:mod:`.along_line_3d`). [N²]
 
     Returns
     -------
@@ -387,6 +396,8 @@ def vector_residual_output_lines(
         n_b, n_f = cr.shape[2], cr.shape[3]
         # (n_o, n_b·3, n_f·3), panel-major
         g = np.transpose(cr, (4, 2, 0, 3, 1)).reshape(n_o, n_b * 3, n_f * 3)
+        if keep is not None:
+            keep.append((g, blk, f_all))
         t_f = np.transpose(transfer[:, f_all].reshape(n_out, n_f * 3, n_o), (2, 1, 0))
         t_e = np.transpose(np.conj(transfer[:, blk]).reshape(n_out, n_b * 3, n_o), (2, 1, 0))
         out += np.einsum("jek,jek->kj", t_e, g @ t_f).real
@@ -488,9 +499,13 @@ def drag_residual_3d(
     h = load_transfer(system, damping, unit, w_out, influence)  # (2, 3·n_p, n_o)
     transfer = np.transpose(h.reshape(2, 3, n_p, n_o), (0, 2, 1, 3))
     coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
-    lines_t = vector_residual_output_lines(z, coeffs, transfer, n_fft) * cell_factor(
+    tap = RESIDUAL_TAP.get()  # (the element tensions': .along_line_3d)
+    keep = [] if tap is not None else None
+    lines_t = vector_residual_output_lines(z, coeffs, transfer, n_fft, keep) * cell_factor(
         system, damping, unit, w_out, h, influence=coupled
     )
+    if tap is not None:
+        tap.vector(unit, w_out, keep)
     db = _misfit(damping, seg, groups, c_n, c_t, cov, mean, sig_t, mean_t, scale_n, scale_t)
     linear = (
         _misfit_variance(system, damping, resp, spectra, unit, pan, db, coupled)
@@ -591,6 +606,8 @@ def _misfit_variance(
     load = np.einsum("pab,cbpw->capw", db, v)  # along n₁, n₂, t
     h = load_transfer(system, damping, unit, w, coupled)  # (2, 3·n_p, n_w)
     n_ch = load.shape[0]
+    if (tap := RESIDUAL_TAP.get()) is not None:  # (the element tensions': .along_line_3d)
+        tap.misfit(unit, load.reshape(n_ch, -1, w.size), w)
     q = trapezoid_weights(w)[None] * spectra
     out = {}
     for o, end in enumerate(("end_a", "end_b")):
