@@ -39,11 +39,8 @@ from stochcable.dynamics.outputs.resolution import (
     surface_resolution_check,
     tail_check,
 )
-from stochcable.dynamics.residuals.along_line import (
-    AlongLineResidual,
-    along_line_residual,
-    residual_tap,
-)
+from stochcable.dynamics.residuals.along_line import along_line_residual, residual_tap
+from stochcable.dynamics.residuals.along_line_bodies import station_influence
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
@@ -210,12 +207,16 @@ def line_result(
     residual = residuals_in_range(system.name, residual, std)
     applied = [r for r in residual.values() if r.computed]
     along = None
-    if applied:  # the element tensions with the residuals (a line on bodies: linear)
+    if applied:  # the element tensions with the residuals (a line on bodies: through them)
         computed = {k: r for k, r in residual.items() if r.computed}
-        along = (
-            along_line_residual(system, linearization.damping, computed, taps, resp, spectra)
-            if influence is None
-            else AlongLineResidual(False, "a line on free bodies: not covered along the line")
+        along = along_line_residual(
+            system,
+            linearization.damping,
+            computed,
+            taps,
+            resp,
+            spectra,
+            influence_of=None if influence is None else station_influence(influence),
         )
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None
