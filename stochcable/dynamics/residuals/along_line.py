@@ -25,10 +25,11 @@ round-off (tests/dynamics/test_along_line.py).
 
 Scope: the kinds' uniform lines; the drag residual's linear misfit of split elements
 (:mod:`.drag_segments`, a variance change on the analysis grid: on the chain 0.04 %
-of the drag residual's variance at the ends) is left out along the line; lines on
-free bodies (coupled influence) and 3-D lines' drag residual (its vector form does not
-pass through the pair lines) are not covered: their element tensions stay linear and
-the record says why.  The node motions stay linear (their residual is not formed).
+of the drag residual's variance at the ends) is left out along the line.  A 3-D
+line's drag residual (its vector form does not pass through the pair lines) is
+contracted by :mod:`.along_line_3d`; a line on free bodies reaches its stations
+through the coupled group (:mod:`.along_line_bodies`, ``influence_of``).  The node
+motions stay linear (their residual is not formed).
 """
 
 from __future__ import annotations
