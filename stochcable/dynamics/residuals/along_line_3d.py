@@ -75,6 +75,8 @@ def vector_lines(
     (:func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`). [N²]"""
     top = cap.w.size if top_line is None else min(top_line, cap.w.size)
     w = cap.w[:top]
+    if top == 0:  # no live line (the outputs' count from one frequency)
+        return np.zeros((influence.on(cap.w[:1]).shape[0], cap.w.size))
     full = load_transfer(system, damping, cap.unit, w, influence)  # (n_out, 3·n_p, top)
     n_out = full.shape[0]
     n_p = cap.unit.shape[2] // 3

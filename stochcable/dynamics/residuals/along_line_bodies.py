@@ -32,9 +32,15 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.residuals.along_line import element_influence, element_rows
+from stochcable.dynamics.residuals.along_line_motion import node_influence
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence, end_solves
 
-__all__ = ["ElementCoupledInfluence", "station_influence"]
+__all__ = [
+    "ElementCoupledInfluence",
+    "NodeCoupledInfluence",
+    "node_station_influence",
+    "station_influence",
+]
 
 
 class ElementCoupledInfluence(CoupledInfluence):
@@ -70,8 +76,8 @@ class ElementCoupledInfluence(CoupledInfluence):
     def compute(self, w: np.ndarray) -> np.ndarray:
         """The influence on ``w`` (not kept), shape (n_el, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
-        system, damping = self.line.system, self.line.damping
-        held = element_influence(system, damping, w, self.elements)
+        system = self.line.system
+        held = self.held(w)
         off, nb = {}, 0
         for b in self.bodies:
             off[b.name] = nb
@@ -97,23 +103,59 @@ class ElementCoupledInfluence(CoupledInfluence):
         u[:, 0, :, :d] = np.eye(d)
         u[:, -1, :, d:] = np.eye(d)
         u[:, 1:-1] = -x
-        rows = element_rows(model)[self.elements]
-        el = self.elements
-        c = np.einsum("ed,wedi->wei", rows[:, 0], u[:, el]) + np.einsum(
-            "ed,wedi->wei", rows[:, 1], u[:, el + 1]
-        )  # (n_w, n_el, 2d)
+        c = self.per_end_motion(u)  # (n_w, n_out, 2d)
         free = np.array([off[b.name] + i for b in self.bodies for i in b.free_index], int)
         tf = t[:, free]
         xi = np.linalg.solve(
             s[:, free[:, None], free[None, :]], np.broadcast_to(tf.T, (w.size,) + tf.T.shape)
         )  # (n_w, n_free, |att|)
-        y = np.zeros((w.size, el.size, 2 * d), dtype=complex)
+        y = np.zeros((w.size, c.shape[1], 2 * d), dtype=complex)
         y[:, :, att] = c[:, :, att] @ tf[None] @ xi
         g = held
         g[:, 0] += np.transpose(y[:, :, :d], (1, 2, 0))
         g[:, -1] += np.transpose(y[:, :, d:], (1, 2, 0))
         g[:, 1:-1] -= np.einsum("wei,wnki->enkw", y, x)
         return g
+
+    def held(self, w: np.ndarray) -> np.ndarray:
+        """The outputs per unit node force with the ends held, (n_out, n_nodes, d, n_w)."""
+        return element_influence(self.line.system, self.line.damping, w, self.elements)
+
+    def per_end_motion(self, u: np.ndarray) -> np.ndarray:
+        """The outputs (n_w, n_out, 2d) of the node motions ``u`` (n_w, n_nodes, d, 2d)
+        per unit motion of each end component."""
+        rows = element_rows(self.line.system.model)[self.elements]
+        el = self.elements
+        return np.einsum("ed,wedi->wei", rows[:, 0], u[:, el]) + np.einsum(
+            "ed,wedi->wei", rows[:, 1], u[:, el + 1]
+        )
+
+
+class NodeCoupledInfluence(ElementCoupledInfluence):
+    """The displacements of ``nodes`` (node-major, the model's d components) of a line
+    of a coupled group per unit force on each node and component of the line (module
+    notes, with the node rows in place of the element tensions'; ``elements`` holds
+    the nodes). [m/N]"""
+
+    def held(self, w: np.ndarray) -> np.ndarray:
+        """The displacements per unit node force with the ends held,
+        (n_out, n_nodes, d, n_w) (:func:`.along_line_motion.node_influence`)."""
+        return node_influence(self.line.system, self.line.damping, w, self.elements)
+
+    def per_end_motion(self, u: np.ndarray) -> np.ndarray:
+        """The nodes' displacements (n_w, n_out, 2d) per unit end motion."""
+        return u[:, self.elements].reshape(u.shape[0], -1, u.shape[3])
+
+
+def node_station_influence(base: CoupledInfluence) -> Callable[[np.ndarray], Any]:
+    """The ``influence_of`` of
+    :func:`~stochcable.dynamics.residuals.along_line_motion.motion_residual` for a line
+    on free bodies: its station nodes' :class:`NodeCoupledInfluence`."""
+
+    def make(nodes: np.ndarray) -> NodeCoupledInfluence:
+        return NodeCoupledInfluence(base, nodes)
+
+    return make
 
 
 def station_influence(base: CoupledInfluence) -> Callable[[np.ndarray], Any]:
