@@ -67,12 +67,14 @@ def vector_lines(
     cap: VectorCapture,
     influence: Any,
     top_line: int | None = None,
+    cells: Callable[..., np.ndarray] = cell_factor,
 ) -> np.ndarray:
     """The variance lines (n_out, n_o) on ``cap.w`` of the outputs of ``influence``
     (an object whose ``on(w)`` gives them per unit node force, (n_out, n_nodes, d,
     n_w)) driven by the vector drag residual of ``cap``; the lines from ``top_line``
     up left out (zero), the resonant cells integrated as the kind's
-    (:func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`). [N²]"""
+    (``cells``: :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`'s
+    signature). [N²]"""
     top = cap.w.size if top_line is None else min(top_line, cap.w.size)
     w = cap.w[:top]
     if top == 0:  # no live line (the outputs' count from one frequency)
@@ -86,7 +88,7 @@ def vector_lines(
         t_f = t[:, f_all].reshape(top, -1, n_out)
         t_e = np.conj(t[:, blk]).reshape(top, -1, n_out)
         out[:, :top] += np.einsum("jek,jek->kj", t_e, g[:top] @ t_f).real
-    out[:, :top] *= cell_factor(system, damping, cap.unit, w, full, influence=influence)
+    out[:, :top] *= cells(system, damping, cap.unit, w, full, influence=influence)
     return out
 
 
@@ -119,14 +121,17 @@ def vector_parts(
     top_line: int | None,
     spectra: np.ndarray,
     linear: Callable[[], np.ndarray],
+    cells: Callable[..., np.ndarray] = cell_factor,
 ) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
     """The parts (frequencies [rad/s], variance lines of every element (n_el, n) [N²])
     of a 3-D line's drag residual from what ``tap`` collected: each capture's
     :func:`vector_lines` and each misfit's :func:`vector_misfit_lines` at the stations
     of ``influence``, interpolated to the elements by ``weights`` (n_el, n_st);
-    ``linear()`` the stations' linear tension transfer (n_ch, n_st, n_w)."""
+    ``linear()`` the stations' linear transfer (n_ch, n_st, n_w); ``cells`` as
+    :func:`vector_lines`'."""
     parts = [
-        (c.w, weights @ vector_lines(system, damping, c, influence, top_line)) for c in tap.vectors
+        (c.w, weights @ vector_lines(system, damping, c, influence, top_line, cells))
+        for c in tap.vectors
     ]
     lin = linear() if tap.misfits else None
     for m in tap.misfits:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from scipy import sparse
 
 from stochcable.dynamics.loads.freqblocks import frequency_slices
 from stochcable.dynamics.model.blocks import free_band, line_prep
@@ -35,21 +36,25 @@ from stochcable.dynamics.model.transport import gyro_band
 from stochcable.dynamics.residuals.along_line import (
     CELL_BENDS,
     MAX_STATIONS,
-    element_lines,
+    bent_cells,
+    dense_outputs,
     misfit_lines,
     station_weights,
     top_line,
 )
 from stochcable.dynamics.residuals.along_line_3d import vector_parts
+from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.solve.line_loads import drag_blocks
 
 __all__ = [
     "MotionResidual",
     "NodeInfluence",
+    "motion_lines",
     "motion_residual",
     "motion_weights",
     "motion_stations",
     "node_influence",
+    "sparse_transfer",
 ]
 
 
@@ -68,33 +73,24 @@ def motion_stations(model: Any, max_stations: int = MAX_STATIONS) -> np.ndarray:
     return np.unique(np.concatenate([[0, n - 1], even, junction]))
 
 
-def node_influence(system: Any, damping: Any, w: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-    """The displacements of ``nodes`` (each of the model's d components, node-major:
-    row k·d + c) per unit force on each node and component, ends held, the line's
-    linear system with ``damping``: shape (n_nodes_out·d, n_nodes, d, n_w); zero rows
-    for an end node. [m/N]
-
-    By the adjoint (module notes), as
-    :func:`~stochcable.dynamics.residuals.along_line.element_influence` (Aᵀ: a
-    travelling line's C − G, a steady lift's C_Lᵀ)."""
+def adjoint_solve(system: Any, damping: Any, w: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """x = A⁻ᵀ r on the free nodes for the right-hand sides ``rhs`` ((n_nodes − 2)·d,
+    n_rhs), the line's linear system with ``damping`` (Aᵀ: a travelling line's C − G,
+    a steady lift's C_Lᵀ, as
+    :func:`~stochcable.dynamics.residuals.along_line.element_influence`): shape
+    (n_rhs, n_nodes, d, n_w), zero on the end nodes."""
     w = np.asarray(w, dtype=float)
-    nodes = np.asarray(nodes, dtype=int)
     model = system.model
     prep = line_prep(system)
     d, n = model.dim, model.n_nodes
-    cd = drag_blocks(system, damping)
-    b_c = prep.bS + free_band(cd)
+    b_c = prep.bS + free_band(drag_blocks(system, damping))
     if system.gyro is not None:
         b_c = b_c - gyro_band(system.gyro, d)
     if system.lift is not None:
         b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
-    n_out = nodes.size * d
-    inner = np.flatnonzero((nodes >= 1) & (nodes <= n - 2))  # (an end node's rows: zero)
-    cols = (inner[:, None] * d + np.arange(d)[None]).ravel()
-    rhs = np.zeros(((n - 2) * d, cols.size), dtype=complex)
-    rhs[((nodes[inner] - 1)[:, None] * d + np.arange(d)[None]).ravel(), np.arange(cols.size)] = 1.0
-    out = np.zeros((n_out, n, d, w.size), dtype=complex)
-    for sl in frequency_slices(w.size, 16 * n * d * max(cols.size, 1)):
+    r = rhs.shape[1]
+    out = np.zeros((r, n, d, w.size), dtype=complex)
+    for sl in frequency_slices(w.size, 16 * n * d * max(r, 1)):
         ws = w[sl]
         x = solve_band_stacked(
             prep.bK,
@@ -105,15 +101,57 @@ def node_influence(system: Any, damping: Any, w: np.ndarray, nodes: np.ndarray) 
             2 * d - 1,
             2 * d - 1,
             (model.K, model.M),
-        )  # (n_w, (n − 2)·d, n_inner·d)
-        out[cols, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, cols.size), (3, 1, 2, 0))
+        )  # (n_w, (n − 2)·d, r)
+        out[:, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, r), (3, 1, 2, 0))
     return out
+
+
+def node_rows(model: Any, nodes: np.ndarray) -> np.ndarray:
+    """The right-hand sides ((n_nodes − 2)·d, n_nodes_out·d) of the displacements of
+    ``nodes`` (node-major, each of the model's d components; zero for an end node)."""
+    d, n = model.dim, model.n_nodes
+    nodes = np.asarray(nodes, dtype=int)
+    rhs = np.zeros(((n - 2) * d, nodes.size * d), dtype=complex)
+    inner = np.flatnonzero((nodes >= 1) & (nodes <= n - 2))
+    for c in range(d):
+        rhs[(nodes[inner] - 1) * d + c, inner * d + c] = 1.0
+    return rhs
+
+
+def node_influence(system: Any, damping: Any, w: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """The displacements of ``nodes`` (each of the model's d components, node-major:
+    row k·d + c) per unit force on each node and component, ends held, the line's
+    linear system with ``damping``: shape (n_nodes_out·d, n_nodes, d, n_w); zero rows
+    for an end node. [m/N]
+
+    By the adjoint (module notes): :func:`adjoint_solve` of :func:`node_rows` (an end
+    node's rows, zero, not solved)."""
+    model = system.model
+    d = model.dim
+    nodes = np.asarray(nodes, dtype=int)
+    rhs = node_rows(model, nodes)
+    live = np.flatnonzero(np.any(rhs != 0, axis=0))
+    out = np.zeros((rhs.shape[1], model.n_nodes, d, np.size(w)), dtype=complex)
+    out[live] = adjoint_solve(system, damping, w, rhs[:, live])
+    return out
+
+
+def _near(om: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The index of each of ``w`` among the kept frequencies ``om`` (sorted; −1 where
+    not kept)."""
+    if om.size == 0:
+        return np.full(w.size, -1)
+    at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
+    lo = np.clip(at - 1, 0, om.size - 1)
+    best = np.where(np.abs(om[lo] - w) < np.abs(om[at] - w), lo, at)
+    return np.where(np.abs(om[best] - w) <= 1e-12 * np.abs(w), best, -1)
 
 
 class NodeInfluence:
     """:func:`node_influence` of one line and drag at ``nodes``, kept for the
     frequencies asked (an ``influence`` of
-    :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`)."""
+    :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`; a request all
+    of whose frequencies one kept grid holds is taken from it)."""
 
     def __init__(self, system: Any, damping: Any, nodes: np.ndarray) -> None:
         self.system = system
@@ -124,10 +162,11 @@ class NodeInfluence:
     def on(self, w: np.ndarray) -> np.ndarray:
         """The influence on ``w``, shape (n_nodes_out·d, n_nodes, d, n_w). [m/N]"""
         w = np.asarray(w, dtype=float)
-        for om, g in self._kept if w.size else ():
-            at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
-            near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
-            if np.allclose(om[near], w, rtol=1e-12, atol=0.0):
+        for om, g in self._kept:
+            if om.size == w.size and np.allclose(om, w, rtol=1e-12, atol=0.0):
+                return g
+            near = _near(om, w)
+            if w.size and np.all(near >= 0):
                 return g[..., near]
         g = node_influence(self.system, self.damping, w, self.nodes)
         self._kept.append((w.copy(), g))
@@ -168,6 +207,90 @@ class MotionResidual:
         if not self.computed:
             return lin
         return np.sqrt(np.maximum(lin**2 + self.variance, 0.0))
+
+
+def sparse_transfer(g: np.ndarray, unit: np.ndarray) -> np.ndarray:
+    """The outputs per unit load case (n_out, n_load, n_w) from the outputs per unit
+    node force ``g`` (n_out, n_nodes, d, n_w) and the load cases ``unit`` (n_nodes,
+    d, n_load), through the cases' nonzero entries only (a geometric force pair: two
+    nodes of the line; the dense product of
+    :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer` costs every
+    node per case: the 800-element chain's 1600 cases ×50). [unit/unit]"""
+    n_out, n, d, n_w = g.shape
+    flat = unit.reshape(n * d, -1)
+    rows, cols = np.nonzero(flat)
+    u = sparse.csr_matrix((flat[rows, cols], (cols, rows)), shape=(flat.shape[1], n * d))
+    gf = np.transpose(g.reshape(n_out, n * d, n_w), (1, 0, 2)).reshape(n * d, n_out * n_w)
+    return np.transpose(np.asarray(u @ gf).reshape(flat.shape[1], n_out, n_w), (1, 0, 2))
+
+
+def motion_lines(
+    system: Any,
+    damping: Any,
+    kind: str,
+    captures: list[Any],
+    influence: Any,
+    top: int | None,
+) -> np.ndarray:
+    """The variance lines (n_out, n_o) of the outputs of ``influence`` driven by one
+    kind's pair ``captures`` (as
+    :func:`~stochcable.dynamics.residuals.along_line.element_lines` without the
+    geometric feedthrough), the loads the kind kept only, contracted sparsely
+    (:func:`sparse_transfer`); the lines from ``top`` up left out (zero). [m²]"""
+    out = None
+    for cap in captures:
+        n_top = cap.w.size if top is None else min(top, cap.w.size)
+        w = cap.w[:n_top]
+        unit = cap.unit[:, :, cap.kept]
+        if n_top == 0:
+            lines = np.zeros((influence.on(cap.w[:1]).shape[0], cap.w.size))
+        else:
+            full = sparse_transfer(influence.on(w), unit)  # (n_out, n_kept, n_top)
+            lines = np.zeros((full.shape[0], cap.w.size))
+            lines[:, :n_top] = dense_outputs(cap.blocks, full) * motion_cells(
+                system, damping, unit, w, full, CELL_BENDS[kind], influence
+            )
+        out = lines if out is None else out + lines
+    return out
+
+
+def motion_cells(
+    system: Any,
+    damping: Any,
+    unit: np.ndarray,
+    w: np.ndarray,
+    h: np.ndarray,
+    bend: float = CELL_BEND,
+    influence: Any = None,
+) -> np.ndarray:
+    """:func:`~stochcable.dynamics.residuals.drag_residual.cell_factor` of the node
+    motions ``h`` (n_out, n_load, n_o) per unit load on ``w``, its sub-samples solved
+    for one station node only: near a lightly damped mode every output is the
+    resonance times its shape (the factor's own premise), so in each component the
+    node with the largest power in the bent cells gives every node's factor (at most
+    d nodes' rows instead of every station's: the sub-samples' solves were most of
+    the motions' cost on the 800-element chain).  A
+    line on free bodies (an ``influence`` other than :class:`NodeInfluence`): every
+    output's own factor. [-]"""
+    if not isinstance(influence, NodeInfluence):
+        return cell_factor(system, damping, unit, w, h, bend, influence=influence)
+    cells = np.flatnonzero(bent_cells(h, bend))
+    power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
+    out = np.ones_like(power)
+    if cells.size == 0:
+        return out
+    d = system.model.dim
+    # each component: the station node moving most in it (one solve for them all)
+    top = [int(np.argmax(power[c::d][:, cells].sum(axis=1))) for c in range(d)]
+    keep = np.unique(top)
+    node = NodeInfluence(system, damping, influence.nodes[keep])
+    rows = (keep[:, None] * d + np.arange(d)[None]).ravel()
+    sub = cell_factor(system, damping, unit, w, h[rows], bend, influence=node)
+    for c, k in enumerate(top):
+        out[np.ix_(np.arange(c, power.shape[0], d), cells)] = sub[
+            int(np.flatnonzero(keep == k)[0]) * d + c, cells
+        ][None]
+    return out
 
 
 def motion_weights(s: np.ndarray, at: np.ndarray, linear_var: np.ndarray) -> np.ndarray:
@@ -233,7 +356,15 @@ def motion_residual(
         tap = taps.get(kind)
         if getattr(tap, "vectors", None):  # a 3-D line's drag
             parts = vector_parts(
-                system, damping, tap, influence, weights, top_line(rec), spectra, station_motion
+                system,
+                damping,
+                tap,
+                influence,
+                weights,
+                top_line(rec),
+                spectra,
+                station_motion,
+                motion_cells,
             )
         else:
             caps = [] if tap is None or tap.unmatched or kind not in CELL_BENDS else tap.captures
@@ -246,7 +377,7 @@ def motion_residual(
                     "motions: its loads were not captured; the motions are linear",
                 )
             w_lines = np.asarray(caps[0].w, dtype=float)
-            v = element_lines(system, damping, kind, caps, influence, False, top_line(rec))
+            v = motion_lines(system, damping, kind, caps, influence, top_line(rec))
             parts = ((w_lines, weights @ v),)
             for mis in tap.misfits:
                 if linear is None:
