@@ -159,3 +159,19 @@ def test_3d_node_motions_against_the_time_domain():
     err = np.abs(line.motion_std[nodes] / mean - 1.0)
     err_lin = np.abs(line.motion_std_linear[nodes] / mean - 1.0)
     assert err.mean() < err_lin.mean()
+
+
+def test_sparse_transfer_equals_the_dense_load_transfer(guy):  # noqa: F811
+    """The geometric pairs' outputs per unit load through the loads' nonzero entries
+    against load_transfer's dense product (round-off, 1e-12)."""
+    from stochcable.dynamics.residuals.along_line_motion import NodeInfluence, sparse_transfer
+    from stochcable.dynamics.residuals.residual_lines import load_transfer
+
+    _, seen = guy
+    system, damping = seen["system"], seen["damping"]
+    cap = seen["taps"]["geometric_residual"].captures[0]
+    infl = NodeInfluence(system, damping, np.array([5, 20, 33]))
+    w = cap.w[:9]
+    ref = load_transfer(system, damping, cap.unit, w, infl)
+    got = sparse_transfer(infl.on(w), cap.unit)
+    np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())

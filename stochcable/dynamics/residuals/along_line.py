@@ -29,7 +29,7 @@ of the drag residual's variance at the ends) is left out along the line.  A 3-D
 line's drag residual (its vector form does not pass through the pair lines) is
 contracted by :mod:`.along_line_3d`; a line on free bodies reaches its stations
 through the coupled group (:mod:`.along_line_bodies`, ``influence_of``).  The node
-motions stay linear (their residual is not formed).
+motions' residuals: :mod:`.along_line_motion`.
 """
 
 from __future__ import annotations
