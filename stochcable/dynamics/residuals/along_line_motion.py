@@ -16,7 +16,11 @@ node and component (uncorrelated with the linear response); the stations are up 
 :data:`~stochcable.dynamics.residuals.along_line.MAX_STATIONS` nodes (both end nodes,
 the segment junctions, evenly spaced ones), the other nodes' from the ratio of residual
 to linear variance interpolated linearly in arc length (:func:`motion_weights`).  A
-held end node moves with its prescribed motion only: no residual.
+held end node moves with its prescribed motion only: no residual.  As at the ends
+(:data:`~stochcable.dynamics.residuals.corrected.RESIDUAL_VARIANCE_LIMIT`), a residual
+variance above twice the linear one at a station (a component moving at least 1 % of
+the line's largest) leaves every motion linear, the record saying why: the cable-laying
+line's out-of-plane motion, ×5.7 in σ by the 3-D drag residual.
 """
 
 from __future__ import annotations
@@ -43,6 +47,7 @@ from stochcable.dynamics.residuals.along_line import (
     top_line,
 )
 from stochcable.dynamics.residuals.along_line_3d import vector_parts
+from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.solve.line_loads import drag_blocks
 
@@ -391,4 +396,16 @@ def motion_residual(
             full.append((om, out))
             total += out.sum(axis=2)
         lines[kind] = tuple(full)
+    lin = np.asarray(linear_std, dtype=float)[at] ** 2  # (n_st, 3)
+    live = lin > 1e-4 * np.max(lin, initial=0.0)
+    ratio = np.where(live, total[at] / np.where(live, lin, 1.0), 0.0)
+    if np.max(ratio, initial=0.0) > RESIDUAL_VARIANCE_LIMIT:
+        k, c = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        return MotionResidual(
+            False,
+            f"the residuals' variance of node {int(at[k])}'s {'xyz'[c]} motion is "
+            f"{ratio[k, c]:.3g} × its linear variance, above the residuals' range "
+            f"{RESIDUAL_VARIANCE_LIMIT:g} (RESIDUAL_VARIANCE_LIMIT): the first-order "
+            "closed forms are out of their depth there; the motions are linear",
+        )
     return MotionResidual(True, "", lines, total, at)
