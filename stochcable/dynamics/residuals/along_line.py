@@ -500,7 +500,7 @@ def along_line_residual(
         caps = [] if tap is None else tap.captures
         if kind not in CELL_BENDS or (tap is not None and tap.unmatched):
             caps = []
-        if getattr(tap, "vectors", None):  # a 3-D line's drag (.along_line_3d)
+        if getattr(tap, "vectors", None) and not tap.unmatched:  # 3-D drag (.along_line_3d)
             lines[kind] = vector_parts(
                 system,
                 damping,

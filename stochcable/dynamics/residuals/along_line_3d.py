@@ -36,29 +36,45 @@ __all__ = ["VectorCapture", "VectorTapMixin", "vector_lines", "vector_misfit_lin
 class VectorCapture:
     """One evaluation of the 3-D drag residual's force cross-spectra: its output lines
     ``w`` [rad/s] (n_o,), its panel loads ``unit`` (n_nodes, d, 3·n_p; columns
-    direction-major: n₁, n₂, t) and the ``blocks`` (g, e, f) of
-    :func:`~stochcable.dynamics.residuals.drag_residual_3d.vector_residual_output_lines`'s
-    ``keep``."""
+    direction-major: n₁, n₂, t), the blocks (g, e, f) of
+    :func:`~stochcable.dynamics.residuals.drag_residual_3d.vector_residual_output_lines`
+    (g (n_o, 3·n_b, 3·n_f) panel-major, pairs weighted; panels e, f as slices) and the
+    end ``transfer`` they were contracted with (the evaluation's mark)."""
 
     w: np.ndarray
     unit: np.ndarray
     blocks: list[tuple[np.ndarray, slice, slice]]
+    transfer: np.ndarray
 
 
 class VectorTapMixin:
     """The 3-D drag residual's part of a residual tap: ``vectors`` collects a
-    :class:`VectorCapture` per evaluation."""
+    :class:`VectorCapture` per evaluation, its loads and lines those of the tap's last
+    :meth:`loads` whose transfer the blocks' end ``transfer`` is."""
 
     vectors: list[VectorCapture]
+    unmatched: int
+    _loads: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
 
-    def vector(
-        self, unit: np.ndarray, w: np.ndarray, blocks: list[tuple[np.ndarray, slice, slice]]
-    ) -> None:
-        """A :func:`~stochcable.dynamics.residuals.drag_residual_3d.drag_residual_3d`
-        evaluation: its panel loads, output lines and kept blocks."""
+    def vector_block(self, g: np.ndarray, e: slice, f: slice, transfer: np.ndarray) -> None:
+        """A block of
+        :func:`~stochcable.dynamics.residuals.drag_residual_3d.vector_residual_output_lines`:
+        its force cross-spectral lines ``g`` between panels ``e`` and ``f`` and the
+        end ``transfer`` (n_out, n_p, 3, n_o) they were contracted with."""
         if not hasattr(self, "vectors"):
             self.vectors = []
-        self.vectors.append(VectorCapture(np.asarray(w, dtype=float), unit, blocks))
+        if not self.vectors or self.vectors[-1].transfer is not transfer:
+            n_out, n_p, _, n_o = transfer.shape
+            for unit, w, h in reversed(self._loads):  # (h: n_out, 3·n_p direction-major, n_o)
+                if h.shape == (n_out, 3 * n_p, n_o) and np.array_equal(
+                    np.transpose(h.reshape(n_out, 3, n_p, n_o), (0, 2, 1, 3)), transfer
+                ):
+                    self.vectors.append(VectorCapture(w, unit, [], transfer))
+                    break
+            else:
+                self.unmatched += 1
+                return
+        self.vectors[-1].blocks.append((g, e, f))
 
 
 def vector_lines(

@@ -359,7 +359,7 @@ def motion_residual(
     total = np.zeros((model.n_nodes, 3))
     for kind, rec in applied.items():
         tap = taps.get(kind)
-        if getattr(tap, "vectors", None):  # a 3-D line's drag
+        if getattr(tap, "vectors", None) and not tap.unmatched:  # a 3-D line's drag
             parts = vector_parts(
                 system,
                 damping,

@@ -72,7 +72,6 @@ from stochcable.dynamics.residuals.drag_residual import (
     MAX_PANELS,
     _warn_large,
     cell_factor,
-    drag_residual,
     hermite_coefficients,
     lumped_coefficients,
 )
@@ -96,7 +95,6 @@ from stochcable.results.records import ResidualRecord
 
 __all__ = [
     "drag_residual_3d",
-    "drag_residual_lines",
     "vector_hermite_coefficients",
     "vector_residual_covariance",
     "vector_residual_output_lines",
@@ -111,21 +109,6 @@ _BLOCK_BYTES = 48 * 2**20
 _RADIUS, _GL, _RATIO, _LEVELS = 10.0, 4, 0.2, 6
 #: Panels whose quadrature grids are formed at a time. [-]
 _CHUNK = 8
-
-
-def drag_residual_lines(
-    system: Any,
-    channels: Any,
-    linearization: Any,
-    std: dict[str, float],
-    *,
-    influence: Any = None,
-) -> ResidualRecord:
-    """The drag residual of a line of either dimension: :func:`drag_residual_3d` for a
-    3-D model, else :func:`~stochcable.dynamics.residuals.drag_residual.drag_residual`
-    (the registered compute function of ``drag_residual``)."""
-    fn = drag_residual_3d if system.model.dim == 3 else drag_residual
-    return fn(system, channels, linearization, std, influence=influence)
 
 
 # ------------------------------------------------------------------ coefficients
@@ -353,11 +336,7 @@ def vector_residual_covariance(z: np.ndarray, coeffs: np.ndarray, n_fft: int) ->
 
 
 def vector_residual_output_lines(
-    z: np.ndarray,
-    coeffs: np.ndarray,
-    transfer: np.ndarray,
-    n_fft: int,
-    keep: list[tuple[np.ndarray, slice, slice]] | None = None,
+    z: np.ndarray, coeffs: np.ndarray, transfer: np.ndarray, n_fft: int
 ) -> np.ndarray:
     """Spectral lines of outputs driven by the vector drag residual of jointly Gaussian
     panels (module notes).
@@ -369,10 +348,6 @@ def vector_residual_output_lines(
     transfer : ndarray, complex, shape (n_out, n_p, 3, n_o)
         Outputs per unit force on each panel along each output direction at ω_j,
         j = 1 … n_o. [N/N]
-    keep : list, optional
-        Receives each block's force cross-spectral lines (g (n_o, 3·n_b, 3·n_f),
-        panel-major, pairs weighted; its panels e, f as slices): other outputs' lines
-        are Re Σ conj(T_e) g T_f over the blocks (:mod:`.along_line_3d`). [N²]
 
     Returns
     -------
@@ -396,8 +371,8 @@ def vector_residual_output_lines(
         n_b, n_f = cr.shape[2], cr.shape[3]
         # (n_o, n_b·3, n_f·3), panel-major
         g = np.transpose(cr, (4, 2, 0, 3, 1)).reshape(n_o, n_b * 3, n_f * 3)
-        if keep is not None:
-            keep.append((g, blk, f_all))
+        if (tap := RESIDUAL_TAP.get()) is not None:  # (other outputs': .along_line_3d)
+            tap.vector_block(g, blk, f_all, transfer)
         t_f = np.transpose(transfer[:, f_all].reshape(n_out, n_f * 3, n_o), (2, 1, 0))
         t_e = np.transpose(np.conj(transfer[:, blk]).reshape(n_out, n_b * 3, n_o), (2, 1, 0))
         out += np.einsum("jek,jek->kj", t_e, g @ t_f).real
@@ -499,13 +474,9 @@ def drag_residual_3d(
     h = load_transfer(system, damping, unit, w_out, influence)  # (2, 3·n_p, n_o)
     transfer = np.transpose(h.reshape(2, 3, n_p, n_o), (0, 2, 1, 3))
     coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
-    tap = RESIDUAL_TAP.get()  # (the element tensions': .along_line_3d)
-    keep = [] if tap is not None else None
-    lines_t = vector_residual_output_lines(z, coeffs, transfer, n_fft, keep) * cell_factor(
+    lines_t = vector_residual_output_lines(z, coeffs, transfer, n_fft) * cell_factor(
         system, damping, unit, w_out, h, influence=coupled
     )
-    if tap is not None:
-        tap.vector(unit, w_out, keep)
     db = _misfit(damping, seg, groups, c_n, c_t, cov, mean, sig_t, mean_t, scale_n, scale_t)
     linear = (
         _misfit_variance(system, damping, resp, spectra, unit, pan, db, coupled)
