@@ -164,7 +164,8 @@ def test_3d_node_motions_against_the_time_domain():
 def test_sparse_transfer_equals_the_dense_load_transfer(guy):  # noqa: F811
     """The geometric pairs' outputs per unit load through the loads' nonzero entries
     against load_transfer's dense product (round-off, 1e-12)."""
-    from stochcable.dynamics.residuals.along_line_motion import NodeInfluence, sparse_transfer
+    from stochcable.dynamics.residuals.along_line_3d import sparse_transfer
+    from stochcable.dynamics.residuals.along_line_motion import NodeInfluence
     from stochcable.dynamics.residuals.residual_lines import load_transfer
 
     _, seen = guy

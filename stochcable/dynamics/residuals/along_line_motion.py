@@ -30,7 +30,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy import sparse
 
 from stochcable.dynamics.loads.freqblocks import frequency_slices
 from stochcable.dynamics.model.blocks import free_band, line_prep
@@ -46,7 +45,7 @@ from stochcable.dynamics.residuals.along_line import (
     station_weights,
     top_line,
 )
-from stochcable.dynamics.residuals.along_line_3d import vector_parts
+from stochcable.dynamics.residuals.along_line_3d import sparse_transfer, vector_parts
 from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.solve.line_loads import drag_blocks
@@ -59,7 +58,6 @@ __all__ = [
     "motion_weights",
     "motion_stations",
     "node_influence",
-    "sparse_transfer",
 ]
 
 
@@ -212,21 +210,6 @@ class MotionResidual:
         if not self.computed:
             return lin
         return np.sqrt(np.maximum(lin**2 + self.variance, 0.0))
-
-
-def sparse_transfer(g: np.ndarray, unit: np.ndarray) -> np.ndarray:
-    """The outputs per unit load case (n_out, n_load, n_w) from the outputs per unit
-    node force ``g`` (n_out, n_nodes, d, n_w) and the load cases ``unit`` (n_nodes,
-    d, n_load), through the cases' nonzero entries only (a geometric force pair: two
-    nodes of the line; the dense product of
-    :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer` costs every
-    node per case: the 800-element chain's 1600 cases ×50). [unit/unit]"""
-    n_out, n, d, n_w = g.shape
-    flat = unit.reshape(n * d, -1)
-    rows, cols = np.nonzero(flat)
-    u = sparse.csr_matrix((flat[rows, cols], (cols, rows)), shape=(flat.shape[1], n * d))
-    gf = np.transpose(g.reshape(n_out, n * d, n_w), (1, 0, 2)).reshape(n * d, n_out * n_w)
-    return np.transpose(np.asarray(u @ gf).reshape(flat.shape[1], n_out, n_w), (1, 0, 2))
 
 
 def motion_lines(
