@@ -39,11 +39,12 @@ from stochcable.dynamics.outputs.resolution import (
     surface_resolution_check,
     tail_check,
 )
-from stochcable.dynamics.residuals.along_line import (
-    AlongLineResidual,
-    along_line_residual,
-    residual_tap,
+from stochcable.dynamics.residuals.along_line import along_line_residual, residual_tap
+from stochcable.dynamics.residuals.along_line_bodies import (
+    node_station_influence,
+    station_influence,
 )
+from stochcable.dynamics.residuals.along_line_motion import motion_residual
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
@@ -209,13 +210,27 @@ def line_result(
             )
     residual = residuals_in_range(system.name, residual, std)
     applied = [r for r in residual.values() if r.computed]
-    along = None
-    if applied:  # the element tensions with the residuals (a line on bodies: linear)
+    along = moves = None
+    if applied:  # the element tensions with the residuals (a line on bodies: through them)
         computed = {k: r for k, r in residual.items() if r.computed}
-        along = (
-            along_line_residual(system, linearization.damping, computed, taps, resp, spectra)
-            if influence is None
-            else AlongLineResidual(False, "a line on free bodies: not covered along the line")
+        along = along_line_residual(
+            system,
+            linearization.damping,
+            computed,
+            taps,
+            resp,
+            spectra,
+            influence_of=None if influence is None else station_influence(influence),
+        )
+        moves = motion_residual(
+            system,
+            linearization.damping,
+            computed,
+            taps,
+            motion,
+            spectra,
+            motion_std,
+            influence_of=None if influence is None else node_station_influence(influence),
         )
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None
@@ -236,7 +251,7 @@ def line_result(
         end_force_transfer=end_force,
         tension_mean=np.asarray(st.tension, dtype=float).copy(),
         tension_std=tension_std if along is None else along.std(tension_std),
-        motion_std=motion_std,
+        motion_std=motion_std if moves is None else moves.std(motion_std),
         end_a=stats["end_a"],
         end_b=stats["end_b"],
         linear=linear,
@@ -252,6 +267,8 @@ def line_result(
         residuals=residual,
         tension_std_linear=None if along is None or not along.computed else tension_std,
         along_line=along,
+        motion_std_linear=None if moves is None or not moves.computed else motion_std,
+        motion_residual=moves,
     )
 
 

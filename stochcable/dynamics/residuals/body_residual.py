@@ -61,8 +61,15 @@ from stochcable.dynamics.model.blocks import add_blocks, free_band, line_prep
 from stochcable.dynamics.model.solvers import solve_band_stacked
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
+from stochcable.results.records import ResidualRecord
 
-__all__ = ["CoupledInfluence", "GroupLine", "coupled_influences", "end_solves"]
+__all__ = [
+    "CoupledInfluence",
+    "GroupLine",
+    "coupled_influences",
+    "end_solves",
+    "with_group_lines",
+]
 
 #: Grids whose group solves (:meth:`CoupledInfluence._state`) a group keeps: the drag
 #: residual's lines, a cell sub-sample and the analysis grid of the misfit. [-]
@@ -426,3 +433,24 @@ def coupled_influences(
     shared: dict[str, Any] = {}
     return {ln.name: CoupledInfluence(ln.name, group, bodies, body_drag, shared=shared)
             for ln in group}  # fmt: skip
+
+
+def with_group_lines(
+    record: ResidualRecord,
+    w_out: np.ndarray,
+    lines: np.ndarray,
+    w: np.ndarray,
+    std: dict[str, float],
+) -> ResidualRecord:
+    """``record`` (a line's own residual) with the variance lines ``lines`` (end_a,
+    end_b) at ``w_out`` the group's other lines add through the bodies (their panels
+    and the cross terms with this line's) as one more part of its ``lines``; the
+    variances and in-band parts summed. [N²]"""
+    keep = (w_out >= w[0] * (1 - 1e-9)) & (w_out <= w[-1] * (1 + 1e-9))
+    ends = ("end_a", "end_b")
+    variance = {e: record.variance[e] + float(lines[k].sum()) for k, e in enumerate(ends)}
+    in_band = {e: record.in_band[e] + float(lines[k][keep].sum()) for k, e in enumerate(ends)}
+    part = (np.asarray(w_out, dtype=float), {e: lines[k] for k, e in enumerate(ends)})
+    return ResidualRecord.from_variances(
+        variance, in_band, std, record.order, record.panels, record.lines + (part,)
+    )

@@ -66,6 +66,7 @@ import numpy as np
 
 from stochcable.dynamics.linearization.variance import current_split
 from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals.body_residual import with_group_lines
 from stochcable.dynamics.residuals.drag_segments import (
     Segments,
     panel_groups,
@@ -326,20 +327,17 @@ def drag_residual(
     influence = EndInfluence(system, damping) if influence is None else influence
     h_all = load_transfer(system, damping, comp.unit, comp.w_out, influence)
     # a line on bodies: its coupled influence on every grid (body_residual), and the
-    # group's other lines' panels through the bodies (one set of components with this
-    # line's: their cross terms count, the lines' velocities share the sea and bodies)
+    # group's lines' panels through the bodies as one set of components (their cross
+    # terms count: the lines' velocities share the sea and the bodies), formed once for
+    # the group and kept apart from the line's own lines (those of its element tensions)
     coupled = None if isinstance(influence, EndInfluence) else influence
-    others = _other_lines(coupled, comp, order, lumped)
-    lines_all, scale_all, coeff_all, h_src = (
-        np.concatenate([comp.lines] + [c.lines for c, _, _ in others], axis=1),
-        np.concatenate([comp.scale] + [c.scale for c, _, _ in others]),
-        np.concatenate([comp.coeffs] + [c.coeffs for c, _, _ in others]),
-        np.concatenate([h_all] + [h for _, h, _ in others], axis=1),
+    joint = None if coupled is None else _joint(coupled, order, lumped)
+    others = [] if joint is None else joint[1]
+    keep = _live_panels(comp.lines, comp.scale, comp.coeffs, h_all)
+    cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled)
+    own = residual_output_lines(
+        comp.lines[:, keep], comp.scale[keep], comp.coeffs[keep], h_all[:, keep], comp.n_fft
     )
-    keep = _live_panels(lines_all, scale_all, coeff_all, h_src)
-    lines_t = residual_output_lines(
-        lines_all[:, keep], scale_all[keep], coeff_all[keep], h_src[:, keep], comp.n_fft
-    ) * cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled)
     linear = _misfit_variance(
         system,
         damping,
@@ -352,9 +350,11 @@ def drag_residual(
         comp.misfit,
         (comp.grid, comp.w_out, influence, _bent(h_all)),
         coupled,
-        [(c, src) for c, _, src in others],
+        [(c, src) for _, c, src in others],
     )
-    out = residual_record(lines_t, comp.w_out, w, std, order, len(comp.groups), linear)
+    out = residual_record(own * cf, comp.w_out, w, std, order, len(comp.groups), linear)
+    if joint is not None:
+        out = with_group_lines(out, comp.w_out, (joint[0] - own) * cf, w, std)
     _warn_large(system.name, out)
     return out
 
@@ -455,28 +455,33 @@ def drag_components(
                           np.concatenate(coeffs), misfit)  # fmt: skip
 
 
-def _other_lines(
-    coupled: Any, comp: DragComponents, order: int, lumped: bool
-) -> list[tuple[DragComponents, np.ndarray, Any]]:
-    """The group's other lines of a line on bodies (``coupled`` its coupled influence,
-    None: none): their components (kept on the group), their panels' end tensions of
-    this line through the bodies on this line's residual lines, and their influence."""
-    out = []
-    for src, infl in coupled.sources() if coupled is not None else ():
-        if src.system.model.dim != 2 or src.linearization.damping.method != "seed":
-            continue
-        kept = infl.shared.setdefault("drag", {})
-        key = (src.name, order, lumped)
-        if key not in kept:
-            kept[key] = drag_components(src.system, src.channels, src.linearization, order,
-                                        lumped)  # fmt: skip
-        c = kept[key]
-        if c is None or not np.array_equal(c.w_out, comp.w_out):
-            continue  # (no drag; another grid: the group's lines share one)
+def _joint(coupled: Any, order: int, lumped: bool) -> Any:
+    """The joint drag residual lines of a line on bodies over its group's planar lines
+    (:meth:`~stochcable.dynamics.residuals.body_residual.CoupledInfluence.joint_lines`;
+    the panel components below :data:`PANEL_FLOOR` of every output left out)."""
+
+    def components(ln: Any) -> DragComponents | None:
+        if ln.system.model.dim != 2 or ln.linearization.damping.method != "seed":
+            return None
+        return drag_components(ln.system, ln.channels, ln.linearization, order, lumped)
+
+    def transfer(ln: Any, c: DragComponents, infl: Any) -> np.ndarray:
         with _untapped():
-            h = load_transfer(src.system, src.damping, c.unit, comp.w_out, infl)
-        out.append((c, h, infl))
-    return out
+            return load_transfer(ln.system, ln.damping, c.unit, c.w_out, infl)
+
+    def outputs(cs: list[DragComponents], t: np.ndarray) -> np.ndarray:
+        if any(not np.array_equal(c.w_out, cs[0].w_out) for c in cs):
+            raise ValueError("the group's lines have different residual grids")
+        lines = np.concatenate([c.lines for c in cs], axis=1)
+        scale = np.concatenate([c.scale for c in cs])
+        coeffs = np.concatenate([c.coeffs for c in cs])
+        keep = _live_panels(lines, scale, coeffs, t)
+        with _untapped():
+            return residual_output_lines(
+                lines[:, keep], scale[keep], coeffs[keep], t[:, keep], cs[0].n_fft
+            )
+
+    return coupled.joint_lines(("drag", order, lumped), components, transfer, outputs)
 
 
 @contextlib.contextmanager
@@ -605,7 +610,7 @@ def _misfit_variance(
     resonance narrower than a line; on the inclined guy 253 of its 300 frequencies),
     through ``coupled`` (a line on bodies: its coupled influence) where given.
     ``others`` (a line on bodies): the group's other lines' components with their
-    influence on this line's end tensions; their misfit loads add to H_c (taken at
+    influence on this line's end tensions (:func:`_joint`); their misfit loads add to H_c (taken at
     the analysis frequencies) before the variance is formed."""
     w = np.asarray(resp.omega, dtype=float)
     h_c = np.zeros((2, spectra.shape[0], w.size), dtype=complex)

@@ -68,13 +68,13 @@ import numpy as np
 from stochcable.dynamics.linearization.formulas import drag_linear_vector, mean_abs_gaussian
 from stochcable.dynamics.linearization.variance import current_split
 from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals.body_residual import with_group_lines
 from stochcable.dynamics.residuals.drag_residual import (
     LUMPED_ORDER,
     MAX_PANELS,
     _untapped,
     _warn_large,
     cell_factor,
-    drag_residual,
     hermite_coefficients,
     lumped_coefficients,
 )
@@ -86,6 +86,7 @@ from stochcable.dynamics.residuals.drag_segments import (
     segments,
 )
 from stochcable.dynamics.residuals.residual_lines import (
+    RESIDUAL_TAP,
     EndInfluence,
     element_directions,
     fft_length,
@@ -97,7 +98,6 @@ from stochcable.results.records import ResidualRecord
 
 __all__ = [
     "drag_residual_3d",
-    "drag_residual_lines",
     "vector_hermite_coefficients",
     "vector_residual_covariance",
     "vector_residual_output_lines",
@@ -112,21 +112,6 @@ _BLOCK_BYTES = 48 * 2**20
 _RADIUS, _GL, _RATIO, _LEVELS = 10.0, 4, 0.2, 6
 #: Panels whose quadrature grids are formed at a time. [-]
 _CHUNK = 8
-
-
-def drag_residual_lines(
-    system: Any,
-    channels: Any,
-    linearization: Any,
-    std: dict[str, float],
-    *,
-    influence: Any = None,
-) -> ResidualRecord:
-    """The drag residual of a line of either dimension: :func:`drag_residual_3d` for a
-    3-D model, else :func:`~stochcable.dynamics.residuals.drag_residual.drag_residual`
-    (the registered compute function of ``drag_residual``)."""
-    fn = drag_residual_3d if system.model.dim == 3 else drag_residual
-    return fn(system, channels, linearization, std, influence=influence)
 
 
 # ------------------------------------------------------------------ coefficients
@@ -389,6 +374,8 @@ def vector_residual_output_lines(
         n_b, n_f = cr.shape[2], cr.shape[3]
         # (n_o, n_b·3, n_f·3), panel-major
         g = np.transpose(cr, (4, 2, 0, 3, 1)).reshape(n_o, n_b * 3, n_f * 3)
+        if (tap := RESIDUAL_TAP.get()) is not None:  # (other outputs': .along_line_3d)
+            tap.vector_block(g, blk, f_all, transfer)
         t_f = np.transpose(transfer[:, f_all].reshape(n_out, n_f * 3, n_o), (2, 1, 0))
         t_e = np.transpose(np.conj(transfer[:, blk]).reshape(n_out, n_b * 3, n_o), (2, 1, 0))
         out += np.einsum("jek,jek->kj", t_e, g @ t_f).real
@@ -454,19 +441,16 @@ def drag_residual_3d(
     # a line on bodies: the group's lines' panels through the bodies as one set of
     # components (body_residual; formed once for the group)
     joint = None if coupled is None else _joint(coupled, order, lumped)
-    if joint is None:
-        lines_t, others = (
-            vector_residual_output_lines(comp.z, comp.coeffs, transfer, comp.n_fft),
-            [],
-        )
-    else:
-        lines_t, others = joint
-    lines_t = lines_t * cell_factor(system, damping, comp.unit, comp.w_out, h, influence=coupled)
+    cf = cell_factor(system, damping, comp.unit, comp.w_out, h, influence=coupled)
+    own = vector_residual_output_lines(comp.z, comp.coeffs, transfer, comp.n_fft)
+    others = [] if joint is None else joint[1]
     mis = [(system, damping, comp, coupled)] + [
         (s_.system, s_.damping, c, i) for s_, c, i in others
     ]
     linear = _misfit_variance(resp, comp.spectra, [m for m in mis if m[2].db is not None])
-    out = residual_record(lines_t, comp.w_out, w, std, order, n_p, linear)
+    out = residual_record(own * cf, comp.w_out, w, std, order, n_p, linear)
+    if joint is not None:  # (the own lines first: the along-line residuals' loads)
+        out = with_group_lines(out, comp.w_out, (joint[0] - own) * cf, w, std)
     _warn_large(system.name, out)
     return out
 
@@ -657,6 +641,8 @@ def _misfit_variance(
         load = np.einsum("pab,cbpw->capw", c.db, v)  # along n₁, n₂, t
         if k == 0:
             h = load_transfer(system, damping, c.unit, w, infl)  # (2, 3·n_p, n_w)
+            if (tap := RESIDUAL_TAP.get()) is not None:  # (the element tensions': .along_line_3d)
+                tap.misfit(c.unit, load.reshape(load.shape[0], -1, w.size), w)
         else:
             with _untapped():
                 h = load_transfer(system, damping, c.unit, w, infl)
