@@ -20,16 +20,19 @@ impedance, symmetric), G_R = [e_i on the end node; −x_i on the free nodes] and
 R_e,ij = (Z_f,end e_i)ᵀ x_j − Z_end,end,ij.
 
 The residual loads of the group's other lines reach a line's ends as well, through the
-bodies: :meth:`CoupledInfluence.sources` gives every other line with the coupled
-influence of its node forces on this line's end tensions (the ``target`` form: R_e,L
-T_L S⁻¹ T_Sᵀ (G_R,S F)_att).  The planar drag residual
-(:mod:`.drag_residual`) takes all the lines' panels as one set of jointly Gaussian
-components: the cross terms between panels of different lines follow Mehler's formula
-with their cross-correlation like any pair of one line (the lines' velocities are
-correlated through the common sea and the common body motion, not independent), and
-its linear misfit loads of every line are summed through their influences before the
-variance is formed.  The other kinds (3-D drag, geometric) still carry their own line's
-residual only.
+bodies (the ``target`` form: R_e,L T_L S⁻¹ T_Sᵀ (G_R,S F)_att).  The drag residuals
+(:mod:`.drag_residual`, :mod:`.drag_residual_3d`) take all the lines' panels as one set
+of jointly Gaussian components with every line's end tensions as outputs
+(:meth:`CoupledInfluence.joint_lines`, formed once for the group): the cross terms
+between panels of different lines follow Mehler's formula with their
+cross-correlation like any pair of one line (the lines' velocities are correlated
+through the common sea and the common body motion, not independent: on a planar
+two-leg buoy the cross terms move a leg's part by −10 to −14 %, Monte Carlo agrees).
+The linear misfit loads of every line are summed through their influences
+(:meth:`CoupledInfluence.sources`) before the variance is formed.  A line's own lines
+stay its record's first part (its element tensions carry its own loads); the group's
+part is one more (:func:`with_group_lines`).  The geometric residual carries its own
+line's loads only.
 
 Validation: against the assembled coupled system (:func:`stochcable.bodies.coupling.couple`,
 :func:`stochcable.reference.bodies.solve_coupled_direct`) loaded by unit node forces

@@ -50,8 +50,10 @@ taut wire and the inclined guy in their seas: docs/benchmarks/drag_residual.md).
 Scope: planar lines (the normal velocity a scalar), the seed linearization, normal and
 axial drag of the line elements (attachment drag is not included), each element at
 its mean relative velocity; 3-D lines: :mod:`.drag_residual_3d`; a line on free bodies
-through its coupled influence (:mod:`.body_residual`).  Elements (and pieces) are grouped into at
-most :data:`MAX_PANELS` panels (the cost is O(panels² · n_fft log n_fft)).
+through its coupled influence, with the panels of the group's other lines as components
+of one sum (cross terms included) and their misfit loads (:mod:`.body_residual`).
+Elements (and pieces) are grouped into at most :data:`MAX_PANELS` panels (the cost is
+O(panels² · n_fft log n_fft)).
 """
 
 from __future__ import annotations
