@@ -320,7 +320,19 @@ def drag_residual(
         why = f"linearization method {damping.method!r}: only 'seed' is covered"
     if why is not None:
         return ResidualRecord.not_computed(why, std)
-    comp = drag_components(system, channels, linearization, order, lumped)
+    # a line on bodies: its coupled influence on every grid (body_residual), and the
+    # group's lines' panels through the bodies as one set of components (their cross
+    # terms count: the lines' velocities share the sea and the bodies), formed once for
+    # the group (its components kept there) and kept apart from the line's own lines
+    # (those of its element tensions)
+    coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
+    joint = None if coupled is None else _joint(coupled, order, lumped)
+    others = [] if joint is None else joint[1]
+    comp = (
+        None if joint is None else coupled.shared["components"][_KEY + (order, lumped), system.name]
+    )
+    if comp is None:
+        comp = drag_components(system, channels, linearization, order, lumped)
     if comp is None:  # no drag: nothing dropped
         zero = {"end_a": 0.0, "end_b": 0.0}
         return ResidualRecord.from_variances(zero, zero, std, order, 0)
@@ -328,13 +340,6 @@ def drag_residual(
     w = np.asarray(resp.omega, dtype=float)
     influence = EndInfluence(system, damping) if influence is None else influence
     h_all = load_transfer(system, damping, comp.unit, comp.w_out, influence)
-    # a line on bodies: its coupled influence on every grid (body_residual), and the
-    # group's lines' panels through the bodies as one set of components (their cross
-    # terms count: the lines' velocities share the sea and the bodies), formed once for
-    # the group and kept apart from the line's own lines (those of its element tensions)
-    coupled = None if isinstance(influence, EndInfluence) else influence
-    joint = None if coupled is None else _joint(coupled, order, lumped)
-    others = [] if joint is None else joint[1]
     keep = _live_panels(comp.lines, comp.scale, comp.coeffs, h_all)
     cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled)
     own = residual_output_lines(
@@ -457,6 +462,10 @@ def drag_components(
                           np.concatenate(coeffs), misfit)  # fmt: skip
 
 
+#: The key of the joint group computation (body_residual.CoupledInfluence.joint_lines).
+_KEY = ("drag",)
+
+
 def _joint(coupled: Any, order: int, lumped: bool) -> Any:
     """The joint drag residual lines of a line on bodies over its group's planar lines
     (:meth:`~stochcable.dynamics.residuals.body_residual.CoupledInfluence.joint_lines`;
@@ -483,7 +492,7 @@ def _joint(coupled: Any, order: int, lumped: bool) -> Any:
                 lines[:, keep], scale[keep], coeffs[keep], t[:, keep], cs[0].n_fft
             )
 
-    return coupled.joint_lines(("drag", order, lumped), components, transfer, outputs)
+    return coupled.joint_lines(_KEY + (order, lumped), components, transfer, outputs)
 
 
 @contextlib.contextmanager

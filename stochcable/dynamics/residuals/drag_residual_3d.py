@@ -428,7 +428,15 @@ def drag_residual_3d(
         return ResidualRecord.not_computed(
             f"linearization method {damping.method!r}: only 'seed' and 'vector' are covered", std
         )
-    comp = drag_components_3d(system, channels, linearization, order, lumped)
+    coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
+    # a line on bodies: the group's lines' panels through the bodies as one set of
+    # components (body_residual; formed once for the group, its components kept there)
+    joint = None if coupled is None else _joint(coupled, order, lumped)
+    comp = (
+        None if joint is None else coupled.shared["components"][_KEY + (order, lumped), system.name]
+    )
+    if comp is None:
+        comp = drag_components_3d(system, channels, linearization, order, lumped)
     if comp is None:  # no drag: nothing dropped
         zero = {"end_a": 0.0, "end_b": 0.0}
         return ResidualRecord.from_variances(zero, zero, std, order, 0)
@@ -437,10 +445,6 @@ def drag_residual_3d(
     n_p, n_o = comp.z.shape[1], comp.w_out.size
     h = load_transfer(system, damping, comp.unit, comp.w_out, influence)  # (2, 3·n_p, n_o)
     transfer = np.transpose(h.reshape(2, 3, n_p, n_o), (0, 2, 1, 3))
-    coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
-    # a line on bodies: the group's lines' panels through the bodies as one set of
-    # components (body_residual; formed once for the group)
-    joint = None if coupled is None else _joint(coupled, order, lumped)
     cf = cell_factor(system, damping, comp.unit, comp.w_out, h, influence=coupled)
     own = vector_residual_output_lines(comp.z, comp.coeffs, transfer, comp.n_fft)
     others = [] if joint is None else joint[1]
@@ -453,6 +457,10 @@ def drag_residual_3d(
         out = with_group_lines(out, comp.w_out, (joint[0] - own) * cf, w, std)
     _warn_large(system.name, out)
     return out
+
+
+#: The key of the joint group computation (body_residual.CoupledInfluence.joint_lines).
+_KEY = ("drag_3d",)
 
 
 def _joint(coupled: Any, order: int, lumped: bool) -> Any:
@@ -477,7 +485,7 @@ def _joint(coupled: Any, order: int, lumped: bool) -> Any:
         with _untapped():
             return vector_residual_output_lines(z, co, t, cs[0].n_fft)
 
-    return coupled.joint_lines(("drag_3d", order, lumped), components, transfer, outputs)
+    return coupled.joint_lines(_KEY + (order, lumped), components, transfer, outputs)
 
 
 @dataclass(frozen=True, eq=False)
