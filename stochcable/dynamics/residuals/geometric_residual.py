@@ -31,11 +31,13 @@ free bodies through its coupled influence (:mod:`.body_residual`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
+from stochcable.dynamics.residuals.body_residual import with_group_lines
+from stochcable.dynamics.residuals.drag_residual import CELL_BEND, _untapped, cell_factor
 from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
@@ -106,6 +108,48 @@ def geometric_residual(
         )
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
+    c = geometric_components(system, channels, linearization)
+    proc, comp_terms, unit, w_out, n_fft = c.proc, c.terms, c.unit, c.w_out, c.n_fft
+    # (2, n_comp·n_el, n_o)
+    h = load_transfer(system, linearization.damping, unit, w_out, influence)
+    keep = _live_elements(proc, comp_terms, h)
+    cols = (np.arange(len(comp_terms))[:, None] * n_el + keep[None]).ravel()
+    proc, h_k, unit_k = [x[:, keep] for x in proc], h[:, cols], unit[:, :, cols]
+    # the cells of a resonance narrower than a line integrated, as the drag's (a bend
+    # of the log power scales with the line spacing squared: the drag's threshold at
+    # its lines; chain: 26 cells at the drag's threshold, none at this one)
+    own = quadratic_output_lines(proc, comp_terms, h_k, n_fft)
+    cf = cell_factor(system, linearization.damping, unit_k, w_out, h_k, CELL_BEND * LINE_STRIDE**2)
+    out = residual_record(own * cf, w_out, w, std, 2, n_el)
+    # a line on bodies: the group's lines' quadratic forces through the bodies as one
+    # set of components (their cross terms count), formed once for the group
+    coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
+    joint = None if coupled is None else _joint(coupled)
+    if joint is not None:
+        out = with_group_lines(out, w_out, joint[0] * cf, w, std)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class GeometricComponents:
+    """The quadratic force components of one line (:func:`geometric_components`): the
+    processes' lines (each (n_ch, n_el, n_j)), the components' terms, the unit node
+    loads (n_nodes, d, n_comp·n_el, component-major), the lines ``w_out`` [rad/s] and
+    the lag grid ``n_fft``."""
+
+    proc: list[np.ndarray]
+    terms: list[list[tuple[float, int, int]]]
+    unit: np.ndarray
+    w_out: np.ndarray
+    n_fft: int
+
+
+def geometric_components(system: Any, channels: Any, linearization: Any) -> GeometricComponents:
+    """The quadratic force components of a line's geometric residual (module notes)."""
+    model = system.model
+    n_el = model.n_elements
+    resp = linearization.response
+    w = np.asarray(resp.omega, dtype=float)
     comps = list(model.components)
     d = model.dim
     n_ch = len(channels)
@@ -136,19 +180,49 @@ def geometric_residual(
     unit = unit.reshape(model.n_nodes, d, -1)
     n_o = 2 * (grid.n_j - 1)
     w_out = grid.step * np.arange(1, n_o + 1)
-    # (2, n_comp·n_el, n_o)
-    h = load_transfer(system, linearization.damping, unit, w_out, influence)
     n_fft = fft_length(4 * (grid.n_j - 1) + 1)  # (products reach line 2·(n_j − 1))
-    keep = _live_elements(proc, comp_terms, h)
-    cols = (np.arange(len(comp_terms))[:, None] * n_el + keep[None]).ravel()
-    proc, h, unit = [x[:, keep] for x in proc], h[:, cols], unit[:, :, cols]
-    # the cells of a resonance narrower than a line integrated, as the drag's (a bend
-    # of the log power scales with the line spacing squared: the drag's threshold at
-    # its lines; chain: 26 cells at the drag's threshold, none at this one)
-    lines = quadratic_output_lines(proc, comp_terms, h, n_fft) * cell_factor(
-        system, linearization.damping, unit, w_out, h, CELL_BEND * LINE_STRIDE**2
-    )
-    return residual_record(lines, w_out, w, std, 2, n_el)
+    return GeometricComponents(proc, comp_terms, unit, w_out, n_fft)
+
+
+def _joint(coupled: Any) -> Any:
+    """The group's part of the geometric residual of a line on bodies: the lines of the
+    joint sum over every line's elements less the line's own elements' pairs
+    (:meth:`~stochcable.dynamics.residuals.body_residual.CoupledInfluence.joint_lines`)."""
+
+    def components(ln: Any) -> GeometricComponents | None:
+        if ln.system.model.n_elements > MAX_ELEMENTS:
+            return None
+        return geometric_components(ln.system, ln.channels, ln.linearization)
+
+    def transfer(ln: Any, c: GeometricComponents, infl: Any) -> np.ndarray:
+        with _untapped():
+            h = load_transfer(ln.system, ln.damping, c.unit, c.w_out, infl)
+        n_el = c.proc[0].shape[1]
+        return np.swapaxes(h.reshape(2, len(c.terms), n_el, -1), 1, 2)  # element-major
+
+    def outputs(cs: list[GeometricComponents], t: np.ndarray) -> np.ndarray:
+        if any(not np.array_equal(c.w_out, cs[0].w_out) or len(c.terms) != len(cs[0].terms)
+               for c in cs):  # fmt: skip
+            raise ValueError("the group's lines have different residual grids or forms")
+        proc = [np.concatenate([c.proc[k] for c in cs], axis=1) for k in range(len(cs[0].proc))]
+        n_tot = proc[0].shape[1]
+        flat = np.swapaxes(t, 1, 2).reshape(t.shape[0], -1, t.shape[3])
+        with _untapped():
+            out = quadratic_output_lines(proc, cs[0].terms, flat, cs[0].n_fft)
+            at = 0  # (less each target's own elements' pairs: its own lines)
+            for i, c in enumerate(cs):
+                n_el = c.proc[0].shape[1]
+                own_cols = (np.arange(len(c.terms))[:, None] * n_tot + at + np.arange(n_el)).ravel()
+                out[2 * i : 2 * i + 2] -= quadratic_output_lines(
+                    [p[:, at : at + n_el] for p in proc],
+                    c.terms,
+                    flat[2 * i : 2 * i + 2][:, own_cols],
+                    c.n_fft,
+                )
+                at += n_el
+        return out
+
+    return coupled.joint_lines(("geometric",), components, transfer, outputs)
 
 
 def _live_elements(
