@@ -31,8 +31,8 @@ two-leg buoy the cross terms move a leg's part by −10 to −14 %, Monte Carlo 
 The linear misfit loads of every line are summed through their influences
 (:meth:`CoupledInfluence.sources`) before the variance is formed.  A line's own lines
 stay its record's first part (its element tensions carry its own loads); the group's
-part is one more (:func:`with_group_lines`).  The geometric residual carries its own
-line's loads only.
+part is one more (:func:`with_group_lines`).  The geometric residual
+(:mod:`.geometric_residual`) joins the lines' quadratic forces alike.
 
 Validation: against the assembled coupled system (:func:`stochcable.bodies.coupling.couple`,
 :func:`stochcable.reference.bodies.solve_coupled_direct`) loaded by unit node forces
