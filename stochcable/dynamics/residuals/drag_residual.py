@@ -361,7 +361,7 @@ def drag_residual(
     )
     out = residual_record(own * cf, comp.w_out, w, std, order, len(comp.groups), linear)
     if joint is not None:
-        out = with_group_lines(out, comp.w_out, (joint[0] - own) * cf, w, std)
+        out = with_group_lines(out, comp.w_out, joint[0] * cf, w, std)
     _warn_large(system.name, out)
     return out
 
@@ -467,7 +467,8 @@ _KEY = ("drag",)
 
 
 def _joint(coupled: Any, order: int, lumped: bool) -> Any:
-    """The joint drag residual lines of a line on bodies over its group's planar lines
+    """The group's part of the drag residual of a line on bodies: the lines of the joint
+    sum over its group's planar lines' panels less the line's own panels' pairs
     (:meth:`~stochcable.dynamics.residuals.body_residual.CoupledInfluence.joint_lines`;
     the panel components below :data:`PANEL_FLOOR` of every output left out)."""
 
@@ -488,9 +489,18 @@ def _joint(coupled: Any, order: int, lumped: bool) -> Any:
         coeffs = np.concatenate([c.coeffs for c in cs])
         keep = _live_panels(lines, scale, coeffs, t)
         with _untapped():
-            return residual_output_lines(
+            out = residual_output_lines(
                 lines[:, keep], scale[keep], coeffs[keep], t[:, keep], cs[0].n_fft
             )
+            at = 0
+            for i, c in enumerate(cs):  # (less each target's own panels' pairs)
+                own = keep[(keep >= at) & (keep < at + c.scale.size)]
+                rows = slice(2 * i, 2 * i + 2)
+                out[rows] -= residual_output_lines(
+                    lines[:, own], scale[own], coeffs[own], t[rows][:, own], c.n_fft
+                )
+                at += c.scale.size
+        return out
 
     return coupled.joint_lines(_KEY + (order, lumped), components, transfer, outputs)
 
