@@ -108,7 +108,16 @@ def geometric_residual(
         )
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
-    c = geometric_components(system, channels, linearization)
+    # a line on bodies: the group's lines' quadratic forces through the bodies as one
+    # set of components (their cross terms count), formed once for the group (the
+    # lines' components kept there)
+    coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
+    joint = None if coupled is None else _joint(coupled)
+    c = (
+        geometric_components(system, channels, linearization)
+        if joint is None
+        else coupled.shared["components"][("geometric",), system.name]
+    )
     proc, comp_terms, unit, w_out, n_fft = c.proc, c.terms, c.unit, c.w_out, c.n_fft
     # (2, n_comp·n_el, n_o)
     h = load_transfer(system, linearization.damping, unit, w_out, influence)
@@ -121,10 +130,6 @@ def geometric_residual(
     own = quadratic_output_lines(proc, comp_terms, h_k, n_fft)
     cf = cell_factor(system, linearization.damping, unit_k, w_out, h_k, CELL_BEND * LINE_STRIDE**2)
     out = residual_record(own * cf, w_out, w, std, 2, n_el)
-    # a line on bodies: the group's lines' quadratic forces through the bodies as one
-    # set of components (their cross terms count), formed once for the group
-    coupled = None if influence is None or isinstance(influence, EndInfluence) else influence
-    joint = None if coupled is None else _joint(coupled)
     if joint is not None:
         out = with_group_lines(out, w_out, joint[0] * cf, w, std)
     return out
