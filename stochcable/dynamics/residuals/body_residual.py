@@ -47,7 +47,8 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+import contextlib
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -62,6 +63,7 @@ from stochcable.dynamics.linearization.bodydrag import body_drag_matrix
 from stochcable.dynamics.loads.freqblocks import frequency_slices
 from stochcable.dynamics.model.blocks import add_blocks, free_band, line_prep
 from stochcable.dynamics.model.solvers import solve_band_stacked
+from stochcable.dynamics.residuals.residual_lines import RESIDUAL_TAP
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
 from stochcable.results.records import ResidualRecord
@@ -71,6 +73,7 @@ __all__ = [
     "GroupLine",
     "coupled_influences",
     "end_solves",
+    "untapped",
     "with_group_lines",
 ]
 
@@ -457,3 +460,15 @@ def with_group_lines(
     return ResidualRecord.from_variances(
         variance, in_band, std, record.order, record.panels, record.lines + (part,)
     )
+
+
+@contextlib.contextmanager
+def untapped() -> Iterator[None]:
+    """No :data:`~stochcable.dynamics.residuals.residual_lines.RESIDUAL_TAP` inside:
+    another line's loads, and the group's joint sums, are not a line's own (its element
+    tensions take its own loads only)."""
+    token = RESIDUAL_TAP.set(None)
+    try:
+        yield
+    finally:
+        RESIDUAL_TAP.reset(token)

@@ -58,7 +58,6 @@ O(panels² · n_fft log n_fft)).
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import math
 from dataclasses import dataclass
@@ -67,8 +66,8 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.linearization.variance import current_split
-from stochcable.dynamics.model.blocks import trapezoid_weights
-from stochcable.dynamics.residuals.body_residual import with_group_lines
+from stochcable.dynamics.residuals.body_residual import untapped, with_group_lines
+from stochcable.dynamics.residuals.drag_misfit import misfit_variance
 from stochcable.dynamics.residuals.drag_segments import (
     Segments,
     panel_groups,
@@ -78,7 +77,6 @@ from stochcable.dynamics.residuals.drag_segments import (
     segments,
 )
 from stochcable.dynamics.residuals.residual_lines import (
-    RESIDUAL_TAP,
     EndInfluence,
     UniformGrid,
     covariance_lines,
@@ -121,7 +119,7 @@ RESIDUAL_WARN_RATIO = 1.25
 LUMPED_ORDER = 3
 #: The misfit's end tensions per unit load solved at every analysis frequency (the
 #: evaluation before issue 31), not taken at the residual's nearest line
-#: (:func:`_misfit_variance`). [-]
+#: (:func:`~stochcable.dynamics.residuals.drag_misfit.misfit_variance`). [-]
 MISFIT_EXACT = False
 #: Panel components whose residual force times their largest end tension per unit force
 #: is below this fraction of the line's largest are left out (:func:`_live_panels`):
@@ -345,7 +343,7 @@ def drag_residual(
     own = residual_output_lines(
         comp.lines[:, keep], comp.scale[keep], comp.coeffs[keep], h_all[:, keep], comp.n_fft
     )
-    linear = _misfit_variance(
+    linear = misfit_variance(
         system,
         damping,
         resp,
@@ -358,6 +356,7 @@ def drag_residual(
         (comp.grid, comp.w_out, influence, _bent(h_all)),
         coupled,
         [(c, src) for _, c, src in others],
+        MISFIT_EXACT,
     )
     out = residual_record(own * cf, comp.w_out, w, std, order, len(comp.groups), linear)
     if joint is not None:
@@ -368,28 +367,12 @@ def drag_residual(
 
 @dataclass(frozen=True, eq=False)
 class DragComponents:
-    """The drag residual's panel components of one planar line (:func:`drag_components`).
-
-    Attributes
-    ----------
-    seg, groups : Segments, list of ndarray
-        The pieces and their panels.
-    live : list of str
-        The drag directions with a drag ("normal", "axial").
-    parts : dict
-        Per direction: ½ρC_dD per length, the mean flow, the element directions, B.
-    spectra : ndarray, shape (n_ch, n_w)
-    grid : UniformGrid
-    w_out : ndarray, shape (n_o,)
-        The residual's lines. [rad/s]
-    n_fft : int
-    unit : ndarray, shape (n_nodes, d, n_comp)
-        Node forces per unit panel force (direction-major columns). [N/N]
-    lines, scale, coeffs : ndarray
-        Velocity lines (n_ch, n_comp, n_j), c·L and Hermite coefficients per component.
-    misfit : list of (ndarray, ndarray)
-        Per direction: the panels' velocities (n_ch, n_p, n_w) and their δB·l.
-    """
+    """The drag residual's panel components of one planar line (:func:`drag_components`):
+    its pieces and panels, drag directions ``live`` and their ``parts`` (½ρC_dD per
+    length, mean flow, element directions, B), the spectra, the uniform grid and the
+    residual's lines ``w_out`` [rad/s] with their lag grid, the node loads per unit
+    component (n_nodes, d, n_comp), the components' velocity lines (n_ch, n_comp, n_j),
+    c·L and Hermite coefficients, and per direction the panels' velocities and δB·l."""
 
     seg: Segments
     groups: list[np.ndarray]
@@ -478,7 +461,7 @@ def _joint(coupled: Any, order: int, lumped: bool) -> Any:
         return drag_components(ln.system, ln.channels, ln.linearization, order, lumped)
 
     def transfer(ln: Any, c: DragComponents, infl: Any) -> np.ndarray:
-        with _untapped():
+        with untapped():
             return load_transfer(ln.system, ln.damping, c.unit, c.w_out, infl)
 
     def outputs(cs: list[DragComponents], t: np.ndarray) -> np.ndarray:
@@ -488,7 +471,7 @@ def _joint(coupled: Any, order: int, lumped: bool) -> Any:
         scale = np.concatenate([c.scale for c in cs])
         coeffs = np.concatenate([c.coeffs for c in cs])
         keep = _live_panels(lines, scale, coeffs, t)
-        with _untapped():
+        with untapped():
             out = residual_output_lines(
                 lines[:, keep], scale[keep], coeffs[keep], t[:, keep], cs[0].n_fft
             )
@@ -503,16 +486,6 @@ def _joint(coupled: Any, order: int, lumped: bool) -> Any:
         return out
 
     return coupled.joint_lines(_KEY + (order, lumped), components, transfer, outputs)
-
-
-@contextlib.contextmanager
-def _untapped() -> Any:
-    """No :data:`RESIDUAL_TAP` inside (another line's loads are not this line's)."""
-    token = RESIDUAL_TAP.set(None)
-    try:
-        yield
-    finally:
-        RESIDUAL_TAP.reset(token)
 
 
 def cell_factor(
@@ -602,89 +575,6 @@ def _misfit(
     for (e, idx, s_, sig_e), a in zip(runs, np.split(a1, np.cumsum([m.size for m in mu]))):
         out[idx] = b_el[e] * (sig[idx] * a[:-1] / (sig_e * a[-1]) - 1.0) * seg.length[s_]
     return out
-
-
-def _misfit_variance(
-    system: Any,
-    damping: Any,
-    resp: Any,
-    spectra: np.ndarray,
-    seg: Segments,
-    groups: list[np.ndarray],
-    live: list[str],
-    parts: dict[str, Any],
-    misfit: list[tuple[np.ndarray, np.ndarray]],
-    lines: tuple[UniformGrid, np.ndarray, Any, np.ndarray],
-    coupled: Any = None,
-    others: list[tuple[DragComponents, Any]] | None = None,
-) -> dict[str, np.ndarray]:
-    """The end-tension variance the linear misfit of the element-constant drag changes,
-    as lines on the analysis grid (empty without split elements): its load δB·l·v on
-    the pieces of split elements is linear in the response, so its end tension H_c
-    adds to the linear H_L (Σ_c S_c (|H_L + H_c|² − |H_L|²) times the trapezoid
-    weights of the linear σ; it may be negative). [N²]
-
-    ``lines`` (grid, w_out, influence, bent): the end tensions per unit load are taken
-    at the residual's line nearest each analysis frequency (no solve of their own:
-    chain 0.2 % of the misfit's variance, itself 0.04 % of the residual's), and solved
-    at the frequency itself where the line's cell is ``bent`` (:func:`_bent`: a
-    resonance narrower than a line; on the inclined guy 253 of its 300 frequencies),
-    through ``coupled`` (a line on bodies: its coupled influence) where given.
-    ``others`` (a line on bodies): the group's other lines' components with their
-    influence on this line's end tensions (:func:`_joint`); their misfit loads add to H_c (taken at
-    the analysis frequencies) before the variance is formed."""
-    w = np.asarray(resp.omega, dtype=float)
-    h_c = np.zeros((2, spectra.shape[0], w.size), dtype=complex)
-    mis = _misfit_loads(system.model, seg, groups, live, parts, misfit)
-    if mis is not None:
-        unit, load = mis
-        grid, w_out, influence, bent = lines
-        at = np.clip(grid.index - 1, 0, w_out.size - 1)  # (line j is w_out[j − 1])
-        h = load_transfer(system, damping, unit, w_out, influence)[:, :, at]  # (2, n_load, n_w)
-        exact = np.arange(w.size) if MISFIT_EXACT else np.flatnonzero(bent[at])
-        if exact.size:
-            h[:, :, exact] = load_transfer(system, damping, unit, w[exact], coupled)
-        if (tap := RESIDUAL_TAP.get()) is not None:  # (the element tensions': .along_line)
-            tap.misfit(unit, load, w)
-        h_c += np.einsum("opw,cpw->ocw", h, load)
-    for c, infl in others or ():  # (through the bodies: H_c of this line's ends)
-        mis = _misfit_loads(infl.line.system.model, c.seg, c.groups, c.live, c.parts, c.misfit)
-        if mis is not None:
-            with _untapped():
-                h = load_transfer(infl.line.system, infl.line.damping, mis[0], w, infl)
-            h_c += np.einsum("opw,cpw->ocw", h, mis[1])
-    if not np.any(h_c):
-        return {}
-    q = trapezoid_weights(w)[None] * spectra
-    out = {}
-    for o, end in enumerate(("end_a", "end_b")):
-        h_l = np.asarray(resp.end_tension[end])
-        out[end] = np.sum(q * (np.abs(h_l + h_c[o]) ** 2 - np.abs(h_l) ** 2), axis=0)
-    return out
-
-
-def _misfit_loads(
-    model: Any,
-    seg: Segments,
-    groups: list[np.ndarray],
-    live: list[str],
-    parts: dict[str, Any],
-    misfit: list[tuple[np.ndarray, np.ndarray]],
-) -> tuple[np.ndarray, np.ndarray] | None:
-    """The misfit's unit node loads (n_nodes, d, n_load) and its loads per channel
-    (n_ch, n_load, n_w) on the panels with a δB (None: none)."""
-    keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
-    if not keep:
-        return None
-    sel = [[groups[i] for i in idx] for _, idx in keep]
-    unit = np.concatenate(
-        [panel_loads(model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
-        axis=2,
-    )
-    load = np.concatenate(
-        [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
-    )  # (n_ch, n_load, n_w)
-    return unit, load
 
 
 def _warn_large(name: str, res: ResidualRecord) -> None:

@@ -36,8 +36,8 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.residuals.body_residual import with_group_lines
-from stochcable.dynamics.residuals.drag_residual import CELL_BEND, _untapped, cell_factor
+from stochcable.dynamics.residuals.body_residual import untapped, with_group_lines
+from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
@@ -200,7 +200,7 @@ def _joint(coupled: Any) -> Any:
         return geometric_components(ln.system, ln.channels, ln.linearization)
 
     def transfer(ln: Any, c: GeometricComponents, infl: Any) -> np.ndarray:
-        with _untapped():
+        with untapped():
             h = load_transfer(ln.system, ln.damping, c.unit, c.w_out, infl)
         n_el = c.proc[0].shape[1]
         return np.swapaxes(h.reshape(2, len(c.terms), n_el, -1), 1, 2)  # element-major
@@ -212,7 +212,7 @@ def _joint(coupled: Any) -> Any:
         proc = [np.concatenate([c.proc[k] for c in cs], axis=1) for k in range(len(cs[0].proc))]
         n_tot = proc[0].shape[1]
         flat = np.swapaxes(t, 1, 2).reshape(t.shape[0], -1, t.shape[3])
-        with _untapped():
+        with untapped():
             out = quadratic_output_lines(proc, cs[0].terms, flat, cs[0].n_fft)
             at = 0  # (less each target's own elements' pairs: its own lines)
             for i, c in enumerate(cs):
