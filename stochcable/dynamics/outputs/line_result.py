@@ -43,6 +43,7 @@ from stochcable.dynamics.residuals.along_line import (
     AlongLineResidual,
     along_line_residual,
     residual_tap,
+    station_influence,
 )
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
@@ -192,7 +193,14 @@ def line_result(
     residual = {}
     std = {e: stats[e].std for e in stats}
     # (one solve for both; a line on bodies: through the coupled group)
-    shared = EndInfluence(system, linearization.damping) if influence is None else influence
+    # (a line alone: the element tensions' station rows in the same factorization)
+    shared = (
+        station_influence(system, linearization.damping)
+        if influence is None and alone and model.dim == 2
+        else EndInfluence(system, linearization.damping)
+        if influence is None
+        else influence
+    )
     taps = {}  # (each kind's loads and load cross-spectra, for the element tensions)
     for kind, fn in (
         residual_parts(settings.linearization) if linearization.record is not None else ()
@@ -213,7 +221,9 @@ def line_result(
     if applied:  # the element tensions with the residuals (a line on bodies: linear)
         computed = {k: r for k, r in residual.items() if r.computed}
         along = (
-            along_line_residual(system, linearization.damping, computed, taps, resp, spectra)
+            along_line_residual(
+                system, linearization.damping, computed, taps, resp, spectra, shared=shared
+            )
             if influence is None
             else AlongLineResidual(False, "a line on free bodies: not covered along the line")
         )

@@ -49,7 +49,9 @@ from stochcable.dynamics.residuals.corrected_spectrum import CorrectedSpectrum, 
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
 from stochcable.dynamics.residuals.residual_lines import (
+    BAND_STACK,
     RESIDUAL_TAP,
+    EndInfluence,
     load_transfer,
 )
 from stochcable.dynamics.solve.line_loads import drag_blocks
@@ -62,8 +64,10 @@ __all__ = [
     "along_line_residual",
     "element_influence",
     "element_lines",
+    "element_rhs",
     "residual_tap",
     "station_weights",
+    "station_influence",
     "stations",
     "top_line",
 ]
@@ -164,6 +168,24 @@ def element_rows(model: Any) -> np.ndarray:
     return np.asarray(rows, dtype=float)
 
 
+def element_rhs(model: Any, elements: np.ndarray | None = None) -> np.ndarray:
+    """The adjoint right-hand sides of the tensions of ``elements`` (indices; default
+    all): r_e on the free nodes 1 … n − 2, shape ((n_nodes − 2)·d, n_out) (the
+    ``extra`` of :func:`~stochcable.dynamics.residuals.residual_lines.end_influence`).
+    [N/m]"""
+    d, n = model.dim, model.n_nodes
+    rows = element_rows(model)
+    idx = np.arange(rows.shape[0]) if elements is None else np.asarray(elements, dtype=int)
+    rows = rows[idx]
+    rhs = np.zeros(((n - 2) * d, idx.size), dtype=complex)
+    for k in (0, 1):  # node e + k of element e, free nodes 1 … n − 2
+        node = idx + k
+        free = (node >= 1) & (node <= n - 2)
+        for c in range(d):
+            rhs[(node[free] - 1) * d + c, np.flatnonzero(free)] = rows[free, k, c]
+    return rhs
+
+
 def element_influence(
     system: Any, damping: Any, w: np.ndarray, elements: np.ndarray | None = None
 ) -> np.ndarray:
@@ -185,18 +207,11 @@ def element_influence(
         b_c = b_c - gyro_band(system.gyro, d)
     if system.lift is not None:
         b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
-    rows = element_rows(model)
-    idx = np.arange(rows.shape[0]) if elements is None else np.asarray(elements, dtype=int)
-    rows = rows[idx]
-    n_el = idx.size
-    rhs = np.zeros(((n - 2) * d, n_el), dtype=complex)
-    for k in (0, 1):  # node e + k of element e, free nodes 1 … n − 2
-        node = idx + k
-        free = (node >= 1) & (node <= n - 2)
-        for c in range(d):
-            rhs[(node[free] - 1) * d + c, np.flatnonzero(free)] = rows[free, k, c]
+    rhs = element_rhs(model, elements)
+    n_el = rhs.shape[1]
     out = np.zeros((n_el, n, d, w.size), dtype=complex)
-    for sl in frequency_slices(w.size, 16 * n * d * max(n_el, 1)):
+    step = max(1, min(BAND_STACK, frequency_slices(w.size, 16 * n * d * max(n_el, 1))[0].stop))
+    for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
         ws = w[sl]
         x = solve_band_stacked(
             prep.bK,
@@ -212,20 +227,40 @@ def element_influence(
     return out
 
 
+def station_influence(system: Any, damping: Any, max_stations: int = MAX_STATIONS) -> EndInfluence:
+    """The line's end influence with its :func:`stations`' tension rows solved in the
+    same factorization (their :func:`element_rhs` its ``extra``): the kinds' shared
+    influence where the element tensions are formed too (:func:`along_line_residual`'s
+    ``shared``; one factorization per line and frequency for the 2 + 7 rows, not two)."""
+    rhs = element_rhs(system.model, stations(system.model, max_stations))
+    return EndInfluence(system, damping, rhs)
+
+
 class ElementInfluence:
     """:func:`element_influence` of one line and drag, kept for the frequencies asked
     (the geometric residual's lines are among the drag residual's): the ``influence``
-    of :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`."""
+    of :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`.  With
+    ``shared`` (a :func:`station_influence` of the same elements) its rows are taken
+    from it, solved with the end rows where it does not hold them."""
 
-    def __init__(self, system: Any, damping: Any, elements: np.ndarray | None = None) -> None:
+    def __init__(
+        self,
+        system: Any,
+        damping: Any,
+        elements: np.ndarray | None = None,
+        shared: EndInfluence | None = None,
+    ) -> None:
         self.system = system
         self.damping = damping
         self.elements = elements
+        self.shared = shared
         self._kept: list[tuple[np.ndarray, np.ndarray]] = []
 
     def on(self, w: np.ndarray) -> np.ndarray:
         """The influence on ``w``, shape (n_out, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
+        if self.shared is not None:
+            return self.shared.extra_on(w)
         for om, g in self._kept if w.size else ():
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
             near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
@@ -467,6 +502,7 @@ def along_line_residual(
     response: Any,
     spectra: np.ndarray,
     max_stations: int = MAX_STATIONS,
+    shared: EndInfluence | None = None,
 ) -> AlongLineResidual:
     """The element tensions' residual variance lines of the ``applied`` records (by
     kind, computed and in range) from what their ``taps`` collected (module notes).
@@ -474,14 +510,17 @@ def along_line_residual(
     ``response``, ``spectra`` (n_ch, n_w): the line's linear response and its inputs'
     spectra (the misfit's cross term).  ``max_stations``: :func:`stations`.  A kind
     without captures adds nothing where its record's lines are all zero (no drag, no
-    order ≥ 2), and is not covered otherwise (the result not computed)."""
+    order ≥ 2), and is not covered otherwise (the result not computed).  ``shared``: the
+    kinds' :func:`station_influence` (the stations' rows taken from it), if any."""
     n_el = system.model.n_elements
     if not applied:
         return AlongLineResidual(False, "no residual applied")
     model = system.model
     at = stations(model, max_stations)
     weights = station_weights(0.5 * (model.mesh.s0[1:] + model.mesh.s0[:-1]), at)
-    influence = ElementInfluence(system, damping, at)
+    extra = None if shared is None else getattr(shared, "extra", None)
+    same = extra is not None and np.array_equal(extra, element_rhs(model, at))
+    influence = ElementInfluence(system, damping, at, shared if same else None)
     lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = {}
     total = np.zeros(n_el)
     linear = None
