@@ -52,6 +52,7 @@ from stochcable.dynamics.residuals.residual_lines import (
     BAND_STACK,
     RESIDUAL_TAP,
     EndInfluence,
+    dense_pair_outputs,
     load_transfer,
 )
 from stochcable.dynamics.solve.line_loads import drag_blocks
@@ -314,12 +315,10 @@ def dense_outputs(
     per line (the 7 stations: 3.5× the ends'), this one n² × n_out in BLAS.
     ``transfer`` (n_out, n, n_o); shape (n_out, n_o)."""
     n_out, n, n_o = transfer.shape
-    g_all = np.zeros((n_o, n, n), dtype=complex)
+    g_all = np.zeros((n_o, n * n), dtype=complex)
     for g, e, f in blocks:  # each pair once (pair_outputs' callers: f ≥ e, or (i, j) blocks)
-        g_all[:, e, f] += g[:, :n_o].T
-    t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
-    gt = g_all @ t  # (n_o, n, n_out)
-    return np.einsum("jno,jno->oj", np.conj(t), gt).real
+        g_all[:, e * n + f] += g[:, :n_o].T
+    return dense_pair_outputs(g_all, transfer)
 
 
 def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:

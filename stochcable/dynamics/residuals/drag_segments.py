@@ -279,7 +279,12 @@ def segment_velocity(
             vel[..., c] += (1.0 - xi)[None, :, None] * ch.velocity[:, e] + xi[
                 None, :, None
             ] * ch.velocity[:, e + 1]
-    return {name: np.einsum("wsdc,sd->csw", vel, vec[e]) for name, vec in directions.items()}
+    # each direction's component: one batched product per piece ((c, w, 3) @ (3,))
+    v_t = np.ascontiguousarray(np.transpose(vel, (1, 3, 0, 2)))  # (n_s, n_ch, n_w, 3)
+    return {
+        name: np.transpose(v_t @ vec[e][:, None, :, None].astype(complex), (1, 0, 2, 3))[..., 0]
+        for name, vec in directions.items()
+    }
 
 
 def _subdivided_points(system: Any, seg: Segments) -> np.ndarray:
