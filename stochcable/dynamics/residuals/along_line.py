@@ -52,6 +52,7 @@ from stochcable.dynamics.residuals.residual_lines import (
     BAND_STACK,
     RESIDUAL_TAP,
     EndInfluence,
+    along,
     dense_pair_outputs,
     load_transfer,
 )
@@ -431,10 +432,7 @@ def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:
     n_w = np.asarray(response.omega).size
     u = np.asarray(response.displacement).reshape(n_w, model.n_nodes, model.dim, -1)
     rows = element_rows(model)[at]
-    out = np.einsum("ed,wedc->cew", rows[:, 0], u[:, at]) + np.einsum(
-        "ed,wedc->cew", rows[:, 1], u[:, at + 1]
-    )
-    return out
+    return along(u[:, at], rows[:, 0]) + along(u[:, at + 1], rows[:, 1])
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,7 @@ import numpy as np
 
 from stochcable.dynamics.loads.element_kinematics import element_wave_kinematics
 from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals.residual_lines import along
 
 __all__ = [
     "MAX_SUB",
@@ -279,12 +280,7 @@ def segment_velocity(
             vel[..., c] += (1.0 - xi)[None, :, None] * ch.velocity[:, e] + xi[
                 None, :, None
             ] * ch.velocity[:, e + 1]
-    # each direction's component: one batched product per piece ((c, w, 3) @ (3,))
-    v_t = np.ascontiguousarray(np.transpose(vel, (1, 3, 0, 2)))  # (n_s, n_ch, n_w, 3)
-    return {
-        name: np.transpose(v_t @ vec[e][:, None, :, None].astype(complex), (1, 0, 2, 3))[..., 0]
-        for name, vec in directions.items()
-    }
+    return {name: along(vel, vec[e]) for name, vec in directions.items()}
 
 
 def _subdivided_points(system: Any, seg: Segments) -> np.ndarray:

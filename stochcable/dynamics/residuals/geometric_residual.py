@@ -39,6 +39,7 @@ from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
+    along,
     covariance_lines,
     element_directions,
     fft_length,
@@ -119,7 +120,7 @@ def geometric_residual(
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
-    proc = [grid.lines(np.einsum("wedc,ed->cew", du, f), spectra) for f in frames]
+    proc = [grid.lines(along(du, f), spectra) for f in frames]
     mesh = model.mesh
     kappa = (mesh.ea / mesh.l0 - np.asarray(system.statics.tension) / length) / length
     # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms

@@ -47,6 +47,7 @@ __all__ = [
     "PAIR_BLOCK_BYTES",
     "RESIDUAL_TAP",
     "UniformGrid",
+    "along",
     "covariance_lines",
     "dense_pair_outputs",
     "cross_covariance",
@@ -213,8 +214,10 @@ def pair_outputs(g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarr
     conj(G_cd): the two terms' real parts are equal)."""
     if (tap := RESIDUAL_TAP.get()) is not None:
         tap.lines(g, transfer, e, f)
-    tt = np.conj(transfer[:, e]) * transfer[:, f]
-    return np.einsum("opj,pj->oj", tt.real, g.real) - np.einsum("opj,pj->oj", tt.imag, g.imag)
+    tt = np.conj(transfer[:, e])
+    tt *= transfer[:, f]
+    tt *= g  # (in place: one temporary)
+    return tt.real.sum(axis=1)
 
 
 def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray) -> np.ndarray:
@@ -226,6 +229,15 @@ def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray) -> np.ndarray:
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
     gt = g_all.reshape(n_o, n, n) @ t  # (n_o, n, n_out)
     return (t.real * gt.real + t.imag * gt.imag).sum(axis=1).T  # Re(conj(t)·gt)
+
+
+def along(x: np.ndarray, vec: np.ndarray) -> np.ndarray:
+    """Σ_d x[w, e, d, c]·vec[e, d] of per-element vectors ``x`` (n_w, n_e, k, n_ch) along
+    ``vec`` (n_e, k): shape (n_ch, n_e, n_w), as ``np.einsum("wedc,ed->cew", x, vec)``
+    by one batched product per element (4× faster on the chain's pieces)."""
+    x_t = np.ascontiguousarray(np.transpose(x, (1, 3, 0, 2)))  # (n_e, n_ch, n_w, k)
+    v = np.asarray(vec)[:, None, :, None].astype(x_t.dtype)
+    return np.transpose(x_t @ v, (1, 0, 2, 3))[..., 0]
 
 
 def fft_length(n: int) -> int:
