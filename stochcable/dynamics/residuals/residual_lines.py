@@ -487,31 +487,13 @@ def _modal_rows(
     """:func:`modal_influence` on ``w`` (all below its limit); None for a defective
     Foss pencil."""
     model = system.model
-    prep = line_prep(system)
     d, n = model.dim, model.n_nodes
-    c = add_blocks(prep.S, drag_blocks(system, damping))
-    phi, mh, kh = _influence_modes(system, prep, float(w[-1]) if w.size else 0.0)
-    held = prep.cache.get("influence_foss")
-    # (the same linearization's decomposition on at least these modes: the cells' and
-    # the misfit's frequencies after the lines')
-    if held is not None and held[0] is damping and held[1][0].shape[1] >= phi.shape[1]:
-        (phi, mh, kh), foss = held[1], held[2]
-    else:
-        ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
-        try:
-            foss = foss_modes(mh, 0.5 * (ch + ch.T), kh)
-        except SolverError:
-            return None
-        prep.cache["influence_foss"] = (damping, (phi, mh, kh), foss)
-    e_a, e_b = _end_directions(system)
-    g = _end_coupling(system, prep, c, (e_a, e_b), None)  # (3, n_f·d, 2)
-    k_x = 0 if extra is None else extra.shape[1]
-    cols = np.concatenate([g[0], g[1], g[2]] + ([extra] if k_x else []), axis=1)
-    cols = np.ascontiguousarray(cols, dtype=complex)  # (n_f·d, 6 + k)
+    held = _modal_projection(system, damping, float(w[-1]) if w.size else 0.0, extra)
+    if held is None:
+        return None
+    phi, foss, p, r, (e_a, e_b) = held
     nf, m = phi.shape
-    sign = np.ones(6 + k_x)
-    sign[:6] = -1.0  # the end rows: T = ê·F_end − (A⁻¹g)ᵀF_f
-    p = (foss.weights @ real_gemm(phi.T, cols)) * sign  # (2m, 6 + k)
+    k_x = p.shape[1] - 6
     inv = 1.0 / (1j * w[None, :] - foss.lambdas[:, None])  # (2m, n_w)
     ww, iw = w * w, 1j * w
     # the modal coordinates (2m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
@@ -521,15 +503,57 @@ def _modal_rows(
     q *= inv[:, None, :]
     z = np.ascontiguousarray(foss.chi @ q.reshape(2 * m, -1))  # (m, (2 + k)·n_w)
     x = real_gemm(phi, z).reshape(nf, 2 + k_x, w.size)
-    if m < nf:  # the truncated modes' static correction, fixed vectors
-        zh = np.linalg.solve(kh, real_gemm(phi.T, cols).view(float))
-        r = (prep.k_solve(cols) - real_gemm(phi, np.ascontiguousarray(zh).view(complex))) * sign
+    if r is not None:  # the truncated modes' static correction, fixed vectors
         x[:, :2] += r[:, 0:2, None] - r[:, 2:4, None] * ww + r[:, 4:6, None] * iw
         x[:, 2:] += r[:, 6:, None]
     out = np.zeros((2 + k_x, n, d, w.size), dtype=complex)
     out[0, 0] = e_a[:, None]
     out[1, -1] = e_b[:, None]
     out[:, 1:-1] = np.transpose(x.reshape(n - 2, d, 2 + k_x, w.size), (2, 0, 1, 3))
+    return out
+
+
+def _modal_projection(
+    system: Any, damping: Any, w_top: float, extra: np.ndarray | None
+) -> tuple | None:
+    """The frequency-independent part of :func:`_modal_rows`, kept on the line for
+    its later calls with the same ``damping`` and ``extra`` (the cells' and the
+    misfit's frequencies after the lines'): (Φ_f, the Foss modes, the right-hand
+    sides' modal loads p (2m, 6 + k), their static corrections (n_f·d, 6 + k) or None,
+    ê of both ends).  None for a defective Foss pencil."""
+    prep = line_prep(system)
+    phi, mh, kh = _influence_modes(system, prep, w_top)
+    key = ("influence_projection", extra is None)
+    held = prep.cache.get(key)
+    if (
+        held is not None
+        and held[0] is damping
+        and held[1] is extra
+        and held[2][0].shape[1] >= phi.shape[1]
+    ):
+        return held[2]
+    c = add_blocks(prep.S, drag_blocks(system, damping))
+    ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
+    try:
+        foss = foss_modes(mh, 0.5 * (ch + ch.T), kh)
+    except SolverError:
+        return None
+    e_a, e_b = _end_directions(system)
+    g = _end_coupling(system, prep, c, (e_a, e_b), None)  # (3, n_f·d, 2)
+    k_x = 0 if extra is None else extra.shape[1]
+    cols = np.concatenate([g[0], g[1], g[2]] + ([extra] if k_x else []), axis=1)
+    cols = np.ascontiguousarray(cols, dtype=complex)  # (n_f·d, 6 + k)
+    nf, m = phi.shape
+    sign = np.ones(6 + k_x)
+    sign[:6] = -1.0  # the end rows: T = ê·F_end − (A⁻¹g)ᵀF_f
+    modal = real_gemm(phi.T, cols)
+    p = (foss.weights @ modal) * sign  # (2m, 6 + k)
+    r = None
+    if m < nf:
+        zh = np.linalg.solve(kh, modal.view(float))
+        r = (prep.k_solve(cols) - real_gemm(phi, np.ascontiguousarray(zh).view(complex))) * sign
+    out = (phi, foss, p, r, (e_a, e_b))
+    prep.cache[key] = (damping, extra, out)
     return out
 
 
