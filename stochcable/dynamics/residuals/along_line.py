@@ -98,13 +98,16 @@ class Capture:
     load of the kind's :func:`load_transfer` call ``unit`` (n_nodes, d, n_all), the
     loads ``kept`` (indices into it) and the blocks of pairs (g, e, f) of their
     cross-spectral lines ``g`` (n_pairs, n_o) between loads e and f (indices into
-    ``kept``), as :func:`pair_outputs` takes them."""
+    ``kept``), as :func:`pair_outputs` takes them; ``g_all`` (n_o, n·n), where the kind
+    gathered them into one dense matrix (:class:`~.residual_lines.PairLines`), G_ef in
+    column e·n + f."""
 
     w: np.ndarray
     unit: np.ndarray
     kept: np.ndarray
     transfer: np.ndarray
     blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
+    g_all: np.ndarray | None = None
 
 
 class ResidualTap:
@@ -126,6 +129,12 @@ class ResidualTap:
     def loads(self, unit: np.ndarray, w: np.ndarray, h: np.ndarray) -> None:
         """A :func:`load_transfer` call: its loads, frequencies and end transfer."""
         self._loads.append((unit, np.asarray(w, dtype=float), h))
+
+    def dense(self, g_all: np.ndarray, transfer: np.ndarray) -> None:
+        """A :class:`~.residual_lines.PairLines` contraction's dense lines (n_o, n·n),
+        kept with the capture of its blocks (same ``transfer``)."""
+        if self.captures and self.captures[-1].transfer is transfer:
+            self.captures[-1].g_all = g_all
 
     def lines(self, g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
         """A :func:`pair_outputs` call: a block of pairs' lines G and the loads' end
@@ -298,7 +307,11 @@ def element_lines(
             sel = getattr(influence, "elements", None)
             full = full + own[slice(None) if sel is None else sel, :, None]
         lines = np.zeros((full.shape[0], cap.w.size))
-        lines[:, :top] = dense_outputs(cap.blocks, full[:, cap.kept])
+        lines[:, :top] = (
+            dense_outputs(cap.blocks, full[:, cap.kept])
+            if cap.g_all is None
+            else dense_pair_outputs(cap.g_all[:top], full[:, cap.kept])
+        )
         lines[:, :top] *= cell_factor(
             system, damping, cap.unit, w, full, CELL_BENDS[kind], influence=influence
         )

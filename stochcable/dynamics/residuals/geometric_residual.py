@@ -39,6 +39,7 @@ from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
+    PairLines,
     along,
     covariance_lines,
     element_directions,
@@ -46,7 +47,6 @@ from stochcable.dynamics.residuals.residual_lines import (
     load_transfer,
     pair_blocks,
     pair_lags,
-    pair_outputs,
     residual_record,
     uniform_grid,
 )
@@ -205,7 +205,7 @@ def quadratic_output_lines(
         for y in range(n_p)
     }
     # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks
-    out = np.zeros((transfer.shape[0], n_o))
+    out = PairLines(transfer)
     for e, f in pair_blocks(n_el, n_fft, 2):
         r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}
         twice = np.where(f > e, 2.0, 1.0)[:, None]
@@ -218,5 +218,5 @@ def quadratic_output_lines(
                 )
                 # e's component i, f's j (transfer columns component-major)
                 g = covariance_lines(cov, n_o) * twice
-                out += pair_outputs(g, transfer, i * n_el + e, j * n_el + f)
-    return out
+                out.add(g, i * n_el + e, j * n_el + f)
+    return out.outputs()

@@ -47,6 +47,8 @@ __all__ = [
     "PAIR_BLOCK_BYTES",
     "RESIDUAL_TAP",
     "UniformGrid",
+    "DENSE_PAIR_BYTES",
+    "PairLines",
     "along",
     "covariance_lines",
     "dense_pair_outputs",
@@ -229,6 +231,47 @@ def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray) -> np.ndarray:
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
     gt = g_all.reshape(n_o, n, n) @ t  # (n_o, n, n_out)
     return (t.real * gt.real + t.imag * gt.imag).sum(axis=1).T  # Re(conj(t)·gt)
+
+
+#: Largest dense matrix of one contraction's pair lines (:class:`PairLines`, n² × n_o
+#: complex; the chain's drag 6.4 MB): beyond it the outputs are summed block by block
+#: (:func:`pair_outputs`). [bytes]
+DENSE_PAIR_BYTES = 24 * 2**20
+
+
+class PairLines:
+    """The outputs of one contraction of pair lines (:func:`pair_outputs` summed over
+    its blocks): the blocks' lines gathered into one dense matrix G (n_o, n·n), G_ef in
+    column e·n + f, and contracted once (:func:`dense_pair_outputs`), or block by block
+    where G would exceed :data:`DENSE_PAIR_BYTES`.  The blocks are shown to
+    :data:`RESIDUAL_TAP` as :func:`pair_outputs` shows them, and G with them (the
+    element tensions' contraction then reads it: :mod:`.along_line`)."""
+
+    def __init__(self, transfer: np.ndarray) -> None:
+        self.transfer = transfer
+        n_out, n, n_o = transfer.shape
+        dense = 16 * n * n * n_o <= DENSE_PAIR_BYTES
+        self._g = np.zeros((n_o, n * n), dtype=complex) if dense else None
+        self._out = None if dense else np.zeros((n_out, n_o))
+
+    def add(self, g: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
+        """A block of pairs (e, f) and their lines ``g`` (n_pairs, n_o) (one of (c, d)
+        and (d, c) only, weighted 2 where they differ, as :func:`pair_outputs`)."""
+        if self._g is None:
+            self._out += pair_outputs(g, self.transfer, e, f)
+            return
+        if (tap := RESIDUAL_TAP.get()) is not None:
+            tap.lines(g, self.transfer, e, f)
+        n = self.transfer.shape[1]
+        self._g[:, np.asarray(e) * n + np.asarray(f)] += g.T
+
+    def outputs(self) -> np.ndarray:
+        """The variance lines (n_out, n_o) of the outputs."""
+        if self._g is None:
+            return self._out
+        if (tap := RESIDUAL_TAP.get()) is not None and hasattr(tap, "dense"):
+            tap.dense(self._g, self.transfer)
+        return dense_pair_outputs(self._g, self.transfer)
 
 
 def along(x: np.ndarray, vec: np.ndarray) -> np.ndarray:
