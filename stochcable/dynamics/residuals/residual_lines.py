@@ -576,11 +576,16 @@ def _modal_projection(
     ):
         return held[2]
     c = add_blocks(prep.S, drag_blocks(system, damping))
-    ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
-    try:
-        foss = foss_modes(mh, 0.5 * (ch + ch.T), kh)
-    except SolverError:
-        return None
+    fk = prep.cache.get("influence_foss")  # (one decomposition for both right-hand sides)
+    if fk is not None and fk[0] is damping and fk[1][0].shape[1] >= phi.shape[1]:
+        (phi, mh, kh), foss = fk[1], fk[2]
+    else:
+        ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
+        try:
+            foss = foss_modes(mh, 0.5 * (ch + ch.T), kh)
+        except SolverError:
+            return None
+        prep.cache["influence_foss"] = (damping, (phi, mh, kh), foss)
     e_a, e_b = _end_directions(system)
     g = _end_coupling(system, prep, c, (e_a, e_b), None)  # (3, n_f·d, 2)
     k_x = 0 if extra is None else extra.shape[1]
