@@ -90,10 +90,11 @@ MODAL_SPAN = 4.0
 #: more than its banded solve, 6.6 against 5.3 ms; the chain's 23 of 78: 2.3 against
 #: 6.9 ms). [-]
 MODAL_SHARE = 0.5
-#: Frequencies per banded solve of :func:`end_influence` (a stack of many frequencies
-#: outgrows the cache: the chain's 9 right-hand sides on 189 lines took 12 ms in one
-#: stack, 6 ms in stacks of 16–32). [-]
-BAND_STACK = 24
+#: Most frequencies per banded solve of :func:`end_influence` (a stack of many
+#: frequencies and right-hand sides outgrows the cache: the chain's 9 on 189 lines took
+#: 12 ms in one stack, 6–9 ms in stacks of 16–128; the taut wire's 2 on 189 lines 2.4 ms
+#: in stacks of 16–32, 1.6 ms in 64–256). [-]
+BAND_STACK = 128
 
 
 #: Share of each channel's variance in the upper tail of the analysis grid left off the
@@ -343,19 +344,24 @@ class EndInfluence:
     frequencies asked: a later request for some of them (the geometric residual's
     lines, every second of the drag residual's) is taken from it.
 
-    ``extra`` (optional, ((n_nodes − 2)·d, k)): adjoint right-hand sides solved with
-    the end rows in the same factorization (:func:`end_influence`; the element
-    tensions' rows of :mod:`.along_line`), their rows kept beside the ends'
-    (:meth:`extra_on`)."""
+    ``extra`` (optional, ((n_nodes − 2)·d, k)): more adjoint right-hand sides (the
+    element tensions' rows of :mod:`.along_line`), their rows kept beside the ends'
+    (:meth:`extra_on`): through the modal basis both at once (:func:`modal_influence`);
+    by the banded solve the end rows alone first (on all the residual's lines) and the
+    extra rows where asked (the lines they are formed on), each with both sets in one
+    factorization."""
 
     def __init__(self, system: Any, damping: Any, extra: np.ndarray | None = None) -> None:
         self.system = system
         self.damping = damping
         self.extra = extra
-        self._kept: list[tuple[np.ndarray, np.ndarray]] = []
+        self._kept: list[tuple[np.ndarray, np.ndarray]] = []  # (the end rows)
+        self._kept_x: list[tuple[np.ndarray, np.ndarray]] = []  # (the extra rows)
+        self._modal = MODAL_INFLUENCE
 
-    def _find(self, w: np.ndarray) -> np.ndarray | None:
-        for om, g in self._kept if w.size else ():
+    @staticmethod
+    def _find(kept: list, w: np.ndarray) -> np.ndarray | None:
+        for om, g in kept if w.size else ():
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
             near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
             if np.allclose(om[near], w, rtol=1e-12, atol=0.0):
@@ -365,32 +371,32 @@ class EndInfluence:
                 return g[..., near]
         return None
 
-    def rows(self, w: np.ndarray) -> np.ndarray:
-        """The end rows and the ``extra`` rows on ``w``: shape (2 + k, n_nodes, d, n_w).
-        [N/N]"""
-        w = np.asarray(w, dtype=float)
-        g = self._find(w)
+    def _solve(self, w: np.ndarray, extra: bool) -> None:
+        g = modal_influence(self.system, self.damping, w, self.extra) if self._modal else None
         if g is None:
-            g = (
-                modal_influence(self.system, self.damping, w, self.extra)
-                if MODAL_INFLUENCE
-                else None
-            )
-            if g is None:
-                g = end_influence(self.system, self.damping, w, self.extra)
-            self._kept.append((w.copy(), g))
-        return g
+            self._modal = False
+            g = end_influence(self.system, self.damping, w, self.extra if extra else None)
+        self._kept.append((w.copy(), g[:2]))
+        if g.shape[0] > 2:
+            self._kept_x.append((w.copy(), g[2:]))
 
     def on(self, w: np.ndarray) -> np.ndarray:
         """The influence on ``w``, shape (2, n_nodes, d, n_w). [N/N]"""
-        return self.rows(w)[:2]
-
-    def extra_on(self, w: np.ndarray, solve: bool = True) -> np.ndarray | None:
-        """The ``extra`` rows on ``w`` (k, n_nodes, d, n_w), solved with the end rows
-        where not kept; with ``solve`` False None where not kept. [N/N]"""
         w = np.asarray(w, dtype=float)
-        g = self._find(w) if not solve else self.rows(w)
-        return None if g is None else g[2:]
+        g = self._find(self._kept, w)
+        if g is None:
+            self._solve(w, extra=False)
+            g = self._kept[-1][1]
+        return g
+
+    def extra_on(self, w: np.ndarray) -> np.ndarray:
+        """The ``extra`` rows on ``w``, shape (k, n_nodes, d, n_w). [N/N]"""
+        w = np.asarray(w, dtype=float)
+        g = self._find(self._kept_x, w)
+        if g is None:
+            self._solve(w, extra=True)
+            g = self._kept_x[-1][1]
+        return g
 
 
 def end_influence(
