@@ -343,7 +343,17 @@ class MotionAlongLine(_Open):
     """Node motions along the line."""
 
     s: list[float] = _f("Unstretched arc length of the nodes from end_a", "m")
-    std: list[list[float]] = _f("σ of the x, y, z node displacements, per node", "m")
+    std: list[list[float]] = _f(
+        "σ of the x, y, z node displacements, per node (with the residuals of the linear "
+        "model where std_linear is present)",
+        "m",
+    )
+    std_linear: list[list[float]] | None = _f(
+        "σ of the x, y, z node displacements of the linear model alone; present where the "
+        "residuals were computed in the motions",
+        "m",
+        default=None,
+    )
 
 
 class LineLinearization(_Open):

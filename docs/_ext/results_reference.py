@@ -240,7 +240,18 @@ _LINES = {
     ),
     "lines.<line>.tension.mean": ("{F}", "Static effective tension per element."),
     "lines.<line>.motion.s": ("{L}", "Unstretched arc length of the nodes from end_a."),
-    "lines.<line>.motion.std": ("{L}", "σ of the x, y, z node displacements, shape (n_nodes, 3)."),
+    "lines.<line>.motion.std": (
+        "{L}",
+        "σ of the x, y, z node displacements, shape (n_nodes, 3) (with the residuals of the "
+        "linear model where ``std_linear`` is present).",
+    ),
+    "lines.<line>.motion.std_linear": (
+        "{L}",
+        "σ of the x, y, z node displacements of the linear model alone; present where the "
+        "residuals were computed in the motions "
+        "(:mod:`stochcable.dynamics.residuals.along_line_motion`: at up to 7 station nodes, "
+        "interpolated in arc length between them).",
+    ),
     "lines.<line>.spectra.omega": ("rad/s", "Analysis frequencies."),
     "lines.<line>.spectra.<end>.tension": ("{F}²·s/rad", "One-sided spectrum of the end tension."),
     "lines.<line>.channels": (

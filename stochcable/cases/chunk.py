@@ -119,6 +119,12 @@ class ChunkResult:
         Per case, whether its residuals were computed (else ``stats`` and ``damage``
         hold its linear values, until :func:`stochcable.cases.run.assemble_cases`
         interpolates the residuals' corrections); None: every case's.
+    starts : tuple of dict or None
+        Per case, the converged σ of its drag fixed points (per group, as
+        :func:`~stochcable.dynamics.groups.group_fixed_point.warm_starts` keeps them;
+        None: not kept): the start of the case's solve when the adaptive anchors
+        compute its residuals later (:func:`solve_chunk`'s ``starts``).  Not stored
+        by :func:`stochcable.cases.plan.chunk_to_bytes`. [m/s]
     """
 
     indices: np.ndarray
@@ -128,6 +134,7 @@ class ChunkResult:
     s_elements: dict[str, np.ndarray]
     linear: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
     exact: np.ndarray | None = None
+    starts: tuple[dict[str, np.ndarray] | None, ...] = ()
 
 
 def prepare_worker() -> None:
@@ -275,6 +282,7 @@ def solve_chunk(
     fatigue: dict[str, LineFatigue],
     engine: Any = None,
     lead: tuple[tuple[int, SeaState], ...] = (),
+    starts: tuple[dict[str, np.ndarray], ...] = (),
 ) -> ChunkResult:
     """Solve the cases of one chunk on the engine of ``template``.
 
@@ -296,6 +304,11 @@ def solve_chunk(
     lead : tuple of (int, SeaState), optional
         :func:`run_lead` of the chunk's first case: solved first and discarded (their
         σ start the chunk's first cases, as when the set runs in one chunk).
+    starts : tuple of dict, optional
+        Per case, the σ its drag fixed points start from (a case's own converged σ
+        from an earlier pass, :attr:`ChunkResult.starts`: the adaptive anchors'
+        later passes, :func:`stochcable.cases.run.run_cases`), instead of the run's
+        warm starts: each case then depends on its own start only.
 
     Returns
     -------
@@ -319,6 +332,7 @@ def solve_chunk(
         rows = []
         store: dict[str, np.ndarray] = {}
         prev: tuple[int, float] | None = None
+        kept: list[dict[str, np.ndarray]] = []
         for i, state, *_ in lead:  # (discarded: the residuals are not needed)
             linear_engine = linear_engine or without_residuals(engine)
             store = _warm_store(store, prev, i, state)
@@ -329,11 +343,15 @@ def solve_chunk(
             exact[j] = not flag or bool(flag[0])
             if not exact[j]:
                 linear_engine = linear_engine or without_residuals(engine)
-            store = _warm_store(store, prev, i, state)
+            if starts:  # (its own start: the newest of a warm-start history)
+                store = {g: x[None] for g, x in starts[j].items()}
+            else:
+                store = _warm_store(store, prev, i, state)
             with warm_starts(store):
                 row, res = _solve_case(
                     engine if exact[j] else linear_engine, case_sea(template, state, family), i
                 )
+            kept.append({g: x[0].copy() for g, x in store.items()})
             prev = (i, state.heading)
             rows.append(row)
             if res is None:
@@ -369,7 +387,7 @@ def solve_chunk(
                     if strum is not None:
                         damage[name][j, :2] += strum[0][:2]
     idx = np.array([c[0] for c in cases], dtype=int)
-    return ChunkResult(idx, tuple(rows), stats, damage, s_el, linear, exact)
+    return ChunkResult(idx, tuple(rows), stats, damage, s_el, linear, exact, tuple(kept))
 
 
 def without_residuals(engine: Engine) -> Engine:

@@ -26,7 +26,7 @@ from stochcable.cases.chunk import (
     solve_chunk,
 )
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
-from stochcable.cases.residual_anchors import residual_anchors
+from stochcable.cases.residual_anchors import first_anchors, residual_anchors
 from stochcable.cases.scatter import ScatterDiagram, SeaState
 from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.scene.model import Scene, load_scene
@@ -68,6 +68,14 @@ class CasePlan:
         Per chunk, the cases solved before its own and discarded
         (:func:`~stochcable.cases.chunk.run_lead`: the earlier cases of the warm-start
         run its first case is in); executors pass ``leads[k]`` with ``chunks[k]``.
+    residual_span : int or None
+    residual_tolerance : float or None
+        The adaptive anchors' settings (:func:`plan_cases`); ``chunks`` hold their
+        first pass, :func:`stochcable.cases.run.run_cases` runs the others.
+    starts : tuple of tuple of dict
+        Per chunk, per case, the σ its drag fixed points start from (a later pass of
+        the adaptive anchors; empty: the warm-start runs); executors pass
+        ``starts[k]`` with ``chunks[k]`` when not empty.
     """
 
     scene: Scene
@@ -77,13 +85,24 @@ class CasePlan:
     years: float
     chunks: tuple[tuple[tuple[int, SeaState], ...], ...]
     leads: tuple[tuple[tuple[int, SeaState], ...], ...] = ()
+    residual_span: int | None = None
+    residual_tolerance: float | None = None
+    starts: tuple[tuple[dict[str, np.ndarray], ...], ...] = ()
+
+    @property
+    def adaptive(self) -> bool:
+        """Whether the set's residuals take the adaptive anchors' later passes."""
+        return self.residual_tolerance is not None and not all(
+            c[2] for chunk in self.chunks for c in chunk
+        )
 
     def solve(self, k: int, engine: Any = None) -> ChunkResult:
         """Solve chunk ``k`` (here; executors call :func:`solve_chunk` with the same
         arguments)."""
         lead = self.leads[k] if self.leads else ()
+        start = self.starts[k] if self.starts else ()
         return solve_chunk(
-            self.template, self.scatter.family, self.chunks[k], self.fatigue, engine, lead
+            self.template, self.scatter.family, self.chunks[k], self.fatigue, engine, lead, start
         )
 
 
@@ -119,6 +138,7 @@ def plan_cases(
     years: float = 100.0,
     chunk_size: int | None = None,
     residual_span: int | None = None,
+    residual_tolerance: float | None = None,
 ) -> CasePlan:
     """Validate a load-case set and split it into chunks.
 
@@ -138,7 +158,14 @@ def plan_cases(
         With residuals asked for: most steps of a column's sorted Hs between the cases
         that compute them, the others interpolated
         (:mod:`stochcable.cases.residual_anchors`; opt-in, its measured error in the
-        module notes); None (default): every case computes them.
+        module notes); None (default): every case computes them, unless
+        ``residual_tolerance`` is given.
+    residual_tolerance : float or None
+        The adaptive anchors' tolerance (:func:`stochcable.cases.run.run_cases`):
+        ``chunks`` then hold their first pass
+        (:func:`~stochcable.cases.residual_anchors.first_anchors`), and the set needs
+        the later passes :func:`~stochcable.cases.run.run_cases` runs
+        (:attr:`CasePlan.adaptive`).  None (default): no checks.
 
     Returns
     -------
@@ -149,6 +176,12 @@ def plan_cases(
         not isinstance(residual_span, int) or isinstance(residual_span, bool) or residual_span < 1
     ):
         raise InputError("residual_span", residual_span, "-", "must be an integer >= 1 or None")
+    if residual_tolerance is not None and not (
+        isinstance(residual_tolerance, (int, float))
+        and not isinstance(residual_tolerance, bool)
+        and 0 < residual_tolerance < 1
+    ):
+        raise InputError("residual_tolerance", residual_tolerance, "-", "must be in (0, 1) or None")
     if not (
         isinstance(years, (int, float))
         and not isinstance(years, bool)
@@ -167,16 +200,30 @@ def plan_cases(
         raise InputError("chunk_size", chunk_size, "-", "must be an integer >= 1")
     template = engine_template(scene, scatter.states, scatter.family)
     asked = [k.name for k in asked_residuals(scene.analysis.linearization)]
-    exact = residual_anchors(scatter.states, residual_span if asked else None)
+    adaptive = bool(asked) and residual_tolerance is not None
+    if adaptive:
+        exact = first_anchors(scatter.states, residual_span)
+    else:
+        exact = residual_anchors(scatter.states, residual_span if asked else None)
     if asked:
-        interp = (
-            ""
-            if exact.all()
-            else f"; they are computed on {int(exact.sum())} of the {n} cases (per Tp, γ "
-            f"and heading the smallest and largest Hs and at most {residual_span} Hs "
-            "steps apart) and their corrections interpolated in Hs on the others "
-            "(stochcable.cases.residual_anchors; residual_span=None computes every case)"
-        )
+        if adaptive:
+            interp = (
+                "; they are computed on the cases the adaptive anchors choose (per Tp, γ "
+                "and heading the smallest and largest Hs, then the middle Hs of every "
+                "interval where the interpolated corrections miss the computed ones by "
+                f"more than {residual_tolerance:g}) and their corrections interpolated "
+                "in Hs on the others (stochcable.cases.residual_anchors; "
+                "residual_tolerance=None computes every case)"
+            )
+        else:
+            interp = (
+                ""
+                if exact.all()
+                else f"; they are computed on {int(exact.sum())} of the {n} cases (per Tp, "
+                f"γ and heading the smallest and largest Hs and at most {residual_span} Hs "
+                "steps apart) and their corrections interpolated in Hs on the others "
+                "(stochcable.cases.residual_anchors; residual_span=None computes every case)"
+            )
         warn(
             "load-case sets apply "
             + ", ".join(f"analysis.linearization.{k}" for k in asked)
@@ -190,7 +237,10 @@ def plan_cases(
         for a in range(0, n, chunk_size)
     )
     leads = tuple(run_lead(scatter.states, part[0][0]) for part in chunks)
-    return CasePlan(scene, scatter, template, settings, float(years), chunks, leads)
+    return CasePlan(
+        scene, scatter, template, settings, float(years), chunks, leads,
+        residual_span, residual_tolerance if adaptive else None,
+    )  # fmt: skip
 
 
 def chunk_to_bytes(result: ChunkResult) -> bytes:

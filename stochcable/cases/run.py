@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -24,7 +24,11 @@ from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, set_engine, solve
 from stochcable.cases.display import case_set_html, case_set_text
 from stochcable.cases.fatigue_settings import LineFatigue
 from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
-from stochcable.cases.residual_anchors import interpolate_corrections
+from stochcable.cases.residual_anchors import (
+    RESIDUAL_TOLERANCE,
+    interpolate_corrections,
+    next_anchors,
+)
 from stochcable.cases.scatter import ScatterDiagram
 from stochcable.design import SECONDS_PER_YEAR, return_level
 from stochcable.dynamics.engine import Engine
@@ -130,6 +134,7 @@ def run_cases(
     chunk_size: int | None = None,
     client: Any = None,
     residual_span: int | None = None,
+    residual_tolerance: float | None = RESIDUAL_TOLERANCE,
 ) -> CaseSetResult:
     """Solve every sea state of a scatter diagram on one scene.
 
@@ -162,12 +167,24 @@ def run_cases(
         The same as ``executor=client`` (give one of the two).
     residual_span : int or None
         With the residuals of the linear model asked for: most steps of a column's
-        sorted Hs (one Tp, γ and heading) between the cases that compute them; the
-        others get their corrections interpolated in Hs
-        (:mod:`stochcable.cases.residual_anchors`: opt-in; within 1.7e-3 on σ on the
-        chain example, but up to 4.2 % on σ and a factor 2.8 on end damage where the
-        correction grows fast with Hs, the taut wire at Tp 10 s).  None (default):
-        every case computes them.
+        sorted Hs (one Tp, γ and heading) between the first cases that compute them
+        (None: the column's smallest and largest Hs); see ``residual_tolerance``.
+    residual_tolerance : float or None
+        With the residuals asked for, the adaptive anchors
+        (:mod:`stochcable.cases.residual_anchors`): each column's intervals between
+        the cases that compute the residuals are checked at their middle Hs and
+        bisected until the corrections interpolated there (σ, Tz and 3-h MPM over the
+        linear ones; the end damage rate's, with 3 × the tolerance) are within
+        ``residual_tolerance`` of the computed ones; the other cases get interpolated
+        corrections.  Default :data:`~stochcable.cases.residual_anchors.RESIDUAL_TOLERANCE`
+        (2e-3: measured within 8.7e-4 on σ and 4.4e-3 on the end damage of the cases
+        computed one by one, on the chain, the taut wire and Tuah's single leg,
+        docs/benchmarks/cases.md; never finer than the scene's
+        ``analysis.linearization.tolerance``, to which the ratios are known).
+        None: no check — with ``residual_span`` the fixed anchors of
+        :func:`~stochcable.cases.residual_anchors.residual_anchors` (σ within 1.7e-3
+        on the chain example, but 4.2 % and a factor 2.8 on end damage on the taut
+        wire at Tp 10 s), without it every case computes them.
 
     Returns
     -------
@@ -182,17 +199,62 @@ def run_cases(
         chunk_size = default_chunk_size(len(scatter.states), _worker_count(executor))
     plan = plan_cases(
         scene, scatter, fatigue=fatigue, years=years, chunk_size=chunk_size,
-        residual_span=residual_span,
+        residual_span=residual_span, residual_tolerance=residual_tolerance,
     )  # fmt: skip
     n = len(scatter.states)
     done = 0
     results: list[ChunkResult] = []
+    if executor is None and engine is None:
+        engine = set_engine(plan.template)
     for res in _run_chunks(plan, engine, executor):
         results.append(res)
         done += len(res.rows)
         if progress is not None:
             progress(done, n)
+    if plan.adaptive:
+        results = _refine(plan, results, engine, executor, chunk_size)
     return assemble_cases(plan, results)
+
+
+def _refine(
+    plan: CasePlan,
+    results: list[ChunkResult],
+    engine: Engine | None,
+    executor: Any,
+    chunk_size: int | None,
+) -> list[ChunkResult]:
+    """The adaptive anchors' later passes (:func:`~stochcable.cases.residual_anchors.next_anchors`):
+    each computes the residuals of the cases the checks ask for, every case from its
+    own converged σ of the first pass (so its numbers do not depend on the chunking),
+    until no check asks for more; the results in the order to assemble them (a case
+    computed later replaces its first-pass numbers)."""
+    states = plan.scatter.states
+    starts: dict[int, dict[str, np.ndarray]] = {}
+    for res in results:
+        for j, i in enumerate(res.indices):
+            if j < len(res.starts):
+                starts[int(i)] = res.starts[j]
+    # (the ratios are known to the fixed point's tolerance only: no finer checks)
+    tol = max(float(plan.residual_tolerance or 0.0), plan.template.analysis.linearization.tolerance)
+    while True:
+        merged = _merge(plan, results)
+        todo = next_anchors(
+            states, plan.residual_span, tol, merged.exact,
+            merged.rows, merged.stats, merged.d_ends, merged.linear,
+        )  # fmt: skip
+        idx = np.flatnonzero(todo)
+        if idx.size == 0:
+            return results
+        size = len(idx) if chunk_size is None else chunk_size
+        parts = [idx[a : a + size] for a in range(0, len(idx), size)]
+        cases = tuple(tuple((int(i), states[i], True) for i in part) for part in parts)
+        seeds = tuple(tuple(starts.get(int(i), {}) for i in part) for part in parts)
+        sub = replace(plan, chunks=cases, leads=tuple(() for _ in cases), starts=seeds)
+        results = [*results, *sorted(_run_chunks(sub, engine, executor), key=_first_index)]
+
+
+def _first_index(res: ChunkResult) -> int:
+    return int(res.indices[0]) if len(res.indices) else -1
 
 
 def _worker_count(executor: Any) -> int:
@@ -211,19 +273,20 @@ def _run_chunks(plan: CasePlan, engine: Engine | None, executor: Any):
         for k in range(len(plan.chunks)):
             yield plan.solve(k, engine)
         return
+    starts = plan.starts or tuple(() for _ in plan.chunks)
     if hasattr(executor, "scatter") and hasattr(executor, "gather"):  # dask client
         from distributed import as_completed as dask_completed
 
         shared = executor.scatter(plan.template, broadcast=True, hash=False)
         futures = [executor.submit(solve_chunk, shared, family, part, settings, None, lead,
-                                   pure=False)
-                   for part, lead in zip(plan.chunks, plan.leads)]  # fmt: skip
+                                   start, pure=False)
+                   for part, lead, start in zip(plan.chunks, plan.leads, starts)]  # fmt: skip
         for fut in dask_completed(futures):
             yield fut.result()
         return
     futures = [
-        executor.submit(solve_chunk, plan.template, family, part, settings, None, lead)
-        for part, lead in zip(plan.chunks, plan.leads)
+        executor.submit(solve_chunk, plan.template, family, part, settings, None, lead, start)
+        for part, lead, start in zip(plan.chunks, plan.leads, starts)
     ]
     for fut in as_completed(futures):
         yield fut.result()
@@ -236,41 +299,21 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     ----------
     plan : CasePlan
     results : iterable of ChunkResult
-        Every chunk of ``plan`` once.
+        Every chunk of ``plan`` once (and, after them, those of the adaptive anchors'
+        later passes, in order: a case's later numbers replace its earlier ones).
 
     Returns
     -------
     CaseSetResult
     """
-    scene, scatter, settings, years = plan.scene, plan.scatter, plan.fatigue, plan.years
-    n = len(scatter.states)
-    results = list(results)
-    names = tuple(ln.name for ln in scene.lines)
-    n_el = {ln.name: sum(seg.elements for seg in ln.segments) for ln in scene.lines}
-    for res in results[:1]:  # the engine's counts (the element check may raise defaults)
-        n_el = {ln: res.damage[ln].shape[1] - 2 for ln in names}
-    stats = {ln: {e: np.full((n, 4), np.nan) for e in ENDS} for ln in names}
-    damage = {ln: np.full((n, 2 + n_el[ln]), np.nan) for ln in names}
-    rows: list[CaseRow | None] = [None] * n
-    s_el: dict[str, np.ndarray] = {}
-    linear = {ln: np.full((n, 2, 4), np.nan) for ln in names}
-    exact = np.ones(n, dtype=bool)
-    for res in results:
-        for j, i in enumerate(res.indices):
-            rows[i] = res.rows[j]
-        for ln in names:
-            for e in ENDS:
-                stats[ln][e][res.indices] = res.stats[ln][e]
-            damage[ln][res.indices] = res.damage[ln]
-            if ln in res.linear:
-                linear[ln][res.indices] = res.linear[ln]
-        if res.exact is not None:
-            exact[res.indices] = res.exact
-        for ln, s in res.s_elements.items():
-            s_el.setdefault(ln, s)
-    d_ends = {ln: damage[ln][:, :2] for ln in names}
+    scatter, settings, years = plan.scatter, plan.fatigue, plan.years
+    m = _merge(plan, list(results))
+    rows, stats, damage, names = m.rows, m.stats, m.damage, m.names
+    d_ends = m.d_ends
     # the residuals' corrections of the cases that did not compute them
-    interpolate_corrections(scatter.states, exact, rows, stats, d_ends, linear)
+    law = "hs2" if plan.residual_tolerance is None else "power"
+    interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear, law)
+    s_el = m.s_el
     d_along = {ln: damage[ln][:, 2:] for ln in names}
     p = np.array([s.probability for s in scatter.states])
     has = np.array([r.has_numbers for r in rows])
@@ -288,6 +331,51 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
         scatter, tuple(rows), names, s_el, stats, d_ends, d_along, totals, coverage,
         years, settings,
     )  # fmt: skip
+
+
+@dataclass
+class _Merged:
+    """The chunks' numbers in the diagram's order (:func:`_merge`)."""
+
+    names: tuple[str, ...]
+    rows: list[Any]
+    stats: dict[str, dict[str, np.ndarray]]
+    damage: dict[str, np.ndarray]
+    d_ends: dict[str, np.ndarray]
+    linear: dict[str, np.ndarray]
+    exact: np.ndarray
+    s_el: dict[str, np.ndarray]
+
+
+def _merge(plan: CasePlan, results: list[ChunkResult]) -> _Merged:
+    """The numbers of ``results`` by case (a later result of a case replaces an
+    earlier one); ``d_ends`` views the end columns of ``damage``."""
+    scene, n = plan.scene, len(plan.scatter.states)
+    names = tuple(ln.name for ln in scene.lines)
+    n_el = {ln.name: sum(seg.elements for seg in ln.segments) for ln in scene.lines}
+    for res in results[:1]:  # the engine's counts (the element check may raise defaults)
+        n_el = {ln: res.damage[ln].shape[1] - 2 for ln in names}
+    stats = {ln: {e: np.full((n, 4), np.nan) for e in ENDS} for ln in names}
+    damage = {ln: np.full((n, 2 + n_el[ln]), np.nan) for ln in names}
+    rows: list[Any] = [None] * n
+    s_el: dict[str, np.ndarray] = {}
+    linear = {ln: np.full((n, 2, 4), np.nan) for ln in names}
+    exact = np.ones(n, dtype=bool)
+    for res in results:
+        for j, i in enumerate(res.indices):
+            rows[i] = res.rows[j]
+        for ln in names:
+            for e in ENDS:
+                stats[ln][e][res.indices] = res.stats[ln][e]
+            damage[ln][res.indices] = res.damage[ln]
+            if ln in res.linear:
+                linear[ln][res.indices] = res.linear[ln]
+        if res.exact is not None:
+            exact[res.indices] = res.exact
+        for ln, s in res.s_elements.items():
+            s_el.setdefault(ln, s)
+    d_ends = {ln: damage[ln][:, :2] for ln in names}
+    return _Merged(names, rows, stats, damage, d_ends, linear, exact, s_el)
 
 
 def _line_totals(

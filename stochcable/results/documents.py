@@ -157,6 +157,14 @@ class LineResult:
         (:mod:`stochcable.dynamics.residuals.along_line`; ``computed`` False with the
         reason where a residual applied at the ends is not covered along the line);
         None where no residual was applied.
+    motion_std_linear : ndarray, shape (n_nodes, 3) or None
+        Where the residuals were computed in the node motions
+        (``motion_residual.computed``), ``motion_std`` is σ of the node displacements
+        with the residuals and this the linear model's alone; None otherwise.
+    motion_residual : MotionResidual or None
+        The residuals' variance lines of every node's displacement
+        (:mod:`stochcable.dynamics.residuals.along_line_motion`); None where no residual
+        was applied.
     """
 
     name: str
@@ -189,6 +197,8 @@ class LineResult:
     corrected_spectra: dict[str, Any] | None = None
     tension_std_linear: np.ndarray | None = None
     along_line: Any = None
+    motion_std_linear: np.ndarray | None = None
+    motion_residual: Any = None
 
     def __getattr__(self, name: str) -> ResidualRecord | None:
         """A registered residual kind's record by its name (None when not asked for)."""
@@ -277,7 +287,15 @@ class LineResult:
                     else {"std_linear": self.tension_std_linear.tolist()}
                 ),
             },
-            "motion": {"s": self.s_nodes.tolist(), "std": self.motion_std.tolist()},
+            "motion": {
+                "s": self.s_nodes.tolist(),
+                "std": self.motion_std.tolist(),
+                **(
+                    {}
+                    if self.motion_std_linear is None
+                    else {"std_linear": self.motion_std_linear.tolist()}
+                ),
+            },
             "spectra": {
                 "omega": self.omega.tolist(),
                 "end_a": {"tension": self.end_tension_spectrum("end_a").tolist()},

@@ -92,7 +92,8 @@ def residual_parts(
         model's, NaN for a line without residuals (its ``end_tension_<statistic>``
         is the linear model's); ``tension_std_linear`` (line, element): the element
         tensions' linear σ where the residuals were computed along the line (NaN
-        elsewhere); ``<kind>_variance`` (line, end) and
+        elsewhere); ``motion_std_linear`` (line, node, axis) likewise for the node
+        motions; ``<kind>_variance`` (line, end) and
         ``<kind>_computed`` (line) of every residual kind present.
     """
     lines = doc["lines"]
@@ -122,6 +123,20 @@ def residual_parts(
             u["force"],
             "standard deviation of the dynamic effective tension of the linear model alone "
             "(NaN for a line whose tension_std is the linear model's)",
+        )
+    if any("std_linear" in lines[n]["motion"] for n in names):
+        n_nd = max(len(lines[n]["motion"]["s"]) for n in names)
+        data = np.full((len(names), n_nd, 3), np.nan)
+        for i, n in enumerate(names):
+            lin = lines[n]["motion"].get("std_linear")
+            if lin is not None:
+                data[i, : len(lin)] = lin
+        out["motion_std_linear"] = _var(
+            ("line", "node", "axis"),
+            data,
+            u["length"],
+            "standard deviation of the node displacement of the linear model alone, global "
+            "axes (NaN for a line whose motion_std is the linear model's)",
         )
     for kind in RESIDUAL_KINDS:
         if not any(kind in lines[n] for n in names):

@@ -207,6 +207,6 @@ def test_transfer_functions_are_formed_when_read():
     np.testing.assert_allclose(lr.tension_std_linear, np.sqrt(var), rtol=1e-12)
     m = lr.motion_transfer
     var = np.einsum("cnkw,cw->nk", np.abs(m) ** 2, sq)
-    np.testing.assert_allclose(lr.motion_std, np.sqrt(var), rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(lr.motion_std_linear, np.sqrt(var), rtol=1e-12, atol=1e-15)
     again = pickle.loads(pickle.dumps(analyze(load_example("chain_catenary")).lines["leg1"]))
     np.testing.assert_array_equal(again.tension_transfer, h)

@@ -17,6 +17,8 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from stochcable.dynamics.loads.channels import (
@@ -40,16 +42,25 @@ from stochcable.dynamics.outputs.resolution import (
     tail_check,
 )
 from stochcable.dynamics.residuals.along_line import (
-    AlongLineResidual,
     along_line_residual,
+    end_station_influence,
     residual_tap,
+)
+from stochcable.dynamics.residuals.along_line_bodies import (
+    node_station_influence,
     station_influence,
+)
+from stochcable.dynamics.residuals.along_line_motion import (
+    NodeInfluence,
+    motion_residual,
+    motion_stations,
+    node_rows,
 )
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
 from stochcable.dynamics.residuals.registry import residual_parts
-from stochcable.dynamics.residuals.residual_lines import EndInfluence
+from stochcable.dynamics.residuals.residual_lines import EndInfluence, shared_rows
 from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
 from stochcable.line.fem import SLACK_EA_RATIO, FEModel
 from stochcable.results.documents import (
@@ -195,7 +206,9 @@ def line_result(
     # (one solve for both; a line on bodies: through the coupled group)
     # (a line alone: the element tensions' station rows in the same factorization)
     shared = (
-        station_influence(system, linearization.damping)
+        end_station_influence(
+            system, linearization.damping, more=node_rows(model, motion_stations(model))
+        )
         if influence is None and alone and model.dim == 2
         else EndInfluence(system, linearization.damping)
         if influence is None
@@ -217,15 +230,32 @@ def line_result(
             )
     residual = residuals_in_range(system.name, residual, std)
     applied = [r for r in residual.values() if r.computed]
-    along = None
-    if applied:  # the element tensions with the residuals (a line on bodies: linear)
+    along = moves = None
+    if applied:  # the element tensions with the residuals (a line on bodies: through them)
         computed = {k: r for k, r in residual.items() if r.computed}
-        along = (
-            along_line_residual(
-                system, linearization.damping, computed, taps, resp, spectra, shared=shared
-            )
-            if influence is None
-            else AlongLineResidual(False, "a line on free bodies: not covered along the line")
+        along = along_line_residual(
+            system,
+            linearization.damping,
+            computed,
+            taps,
+            resp,
+            spectra,
+            influence_of=None if influence is None else station_influence(influence),
+            shared=shared if influence is None else None,
+        )
+        moves = motion_residual(
+            system,
+            linearization.damping,
+            computed,
+            taps,
+            motion,
+            spectra,
+            motion_std,
+            influence_of=(
+                node_station_influence(influence)
+                if influence is not None
+                else _shared_nodes(shared, system, linearization.damping)
+            ),
         )
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None
@@ -246,7 +276,7 @@ def line_result(
         end_force_transfer=end_force,
         tension_mean=np.asarray(st.tension, dtype=float).copy(),
         tension_std=tension_std if along is None else along.std(tension_std),
-        motion_std=motion_std,
+        motion_std=motion_std if moves is None else moves.std(motion_std),
         end_a=stats["end_a"],
         end_b=stats["end_b"],
         linear=linear,
@@ -262,6 +292,8 @@ def line_result(
         residuals=residual,
         tension_std_linear=None if along is None or not along.computed else tension_std,
         along_line=along,
+        motion_std_linear=None if moves is None or not moves.computed else motion_std,
+        motion_residual=moves,
     )
 
 
@@ -330,3 +362,18 @@ def _end_force_transfer(model: FEModel, resp: Response, n_ch: int) -> dict[str, 
         f[:, comps, :] = np.transpose(resp.support_force[:, k * d : (k + 1) * d, :], (2, 1, 0))
         end_force[end] = f
     return end_force
+
+
+def _shared_nodes(shared: EndInfluence, system: LineSystem, damping: Any) -> Any:
+    """The node motions' stations' influence (from their node indices) taken from the
+    kinds' shared one (their rows solved with the end and element rows:
+    :func:`end_station_influence`'s ``more``), their own solve where it does not hold
+    them (:class:`NodeInfluence`)."""
+    extra = getattr(shared, "extra", None)
+
+    def of(nodes: np.ndarray) -> Any:
+        rhs = node_rows(system.model, nodes)
+        rows = None if extra is None else shared_rows(shared, rhs, extra.shape[1] - rhs.shape[1])
+        return NodeInfluence(system, damping, nodes) if rows is None else rows
+
+    return of

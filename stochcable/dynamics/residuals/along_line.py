@@ -25,15 +25,16 @@ round-off (tests/dynamics/test_along_line.py).
 
 Scope: the kinds' uniform lines; the drag residual's linear misfit of split elements
 (:mod:`.drag_segments`, a variance change on the analysis grid: on the chain 0.04 %
-of the drag residual's variance at the ends) is left out along the line; lines on
-free bodies (coupled influence) and 3-D lines' drag residual (its vector form does not
-pass through the pair lines) are not covered: their element tensions stay linear and
-the record says why.  The node motions stay linear (their residual is not formed).
+of the drag residual's variance at the ends) is left out along the line.  A 3-D
+line's drag residual (its vector form does not pass through the pair lines) is
+contracted by :mod:`.along_line_3d`; a line on free bodies reaches its stations
+through the coupled group (:mod:`.along_line_bodies`, ``influence_of``).  The node
+motions' residuals: :mod:`.along_line_motion`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
@@ -45,6 +46,10 @@ from stochcable.dynamics.model.blocks import free_band, line_prep, trapezoid_wei
 from stochcable.dynamics.model.lift import lift_band, lift_pattern
 from stochcable.dynamics.model.solvers import solve_band_stacked
 from stochcable.dynamics.model.transport import gyro_band
+from stochcable.dynamics.residuals.along_line_3d import (
+    VectorTapMixin,
+    vector_parts,
+)
 from stochcable.dynamics.residuals.corrected_spectrum import CorrectedSpectrum, corrected_spectrum
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
@@ -55,6 +60,7 @@ from stochcable.dynamics.residuals.residual_lines import (
     along,
     dense_pair_outputs,
     load_transfer,
+    shared_rows,
 )
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.line.fem import SLACK_EA_RATIO
@@ -69,7 +75,7 @@ __all__ = [
     "element_rhs",
     "residual_tap",
     "station_weights",
-    "station_influence",
+    "end_station_influence",
     "stations",
     "top_line",
 ]
@@ -110,9 +116,10 @@ class Capture:
     g_all: np.ndarray | None = None
 
 
-class ResidualTap:
+class ResidualTap(VectorTapMixin):
     """Collects the loads and load cross-spectra of the residual kinds computed while
-    it is active (:func:`residual_tap`)."""
+    it is active (:func:`residual_tap`; a 3-D line's drag residual:
+    :class:`~stochcable.dynamics.residuals.along_line_3d.VectorTapMixin`)."""
 
     def __init__(self) -> None:
         self._loads: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
@@ -238,12 +245,17 @@ def element_influence(
     return out
 
 
-def station_influence(system: Any, damping: Any, max_stations: int = MAX_STATIONS) -> EndInfluence:
+def end_station_influence(
+    system: Any, damping: Any, max_stations: int = MAX_STATIONS, more: np.ndarray | None = None
+) -> EndInfluence:
     """The line's end influence with its :func:`stations`' tension rows solved in the
-    same factorization (their :func:`element_rhs` its ``extra``): the kinds' shared
+    same factorization or modal sum (their :func:`element_rhs` first in its ``extra``,
+    then ``more`` right-hand sides: the node motions' stations): the kinds' shared
     influence where the element tensions are formed too (:func:`along_line_residual`'s
-    ``shared``; one factorization per line and frequency for the 2 + 7 rows, not two)."""
+    ``shared``; one solve per line for the 2 + 7 (+ more) rows, not one per set)."""
     rhs = element_rhs(system.model, stations(system.model, max_stations))
+    if more is not None:
+        rhs = np.hstack([rhs, more])
     return EndInfluence(system, damping, rhs)
 
 
@@ -251,7 +263,7 @@ class ElementInfluence:
     """:func:`element_influence` of one line and drag, kept for the frequencies asked
     (the geometric residual's lines are among the drag residual's): the ``influence``
     of :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`.  With
-    ``shared`` (a :func:`station_influence` of the same elements) its rows are taken
+    ``shared`` (an :func:`end_station_influence` of the same elements) its rows are taken
     from it, solved with the end rows where it does not hold them."""
 
     def __init__(
@@ -512,6 +524,7 @@ def along_line_residual(
     response: Any,
     spectra: np.ndarray,
     max_stations: int = MAX_STATIONS,
+    influence_of: Callable[[np.ndarray], Any] | None = None,
     shared: EndInfluence | None = None,
 ) -> AlongLineResidual:
     """The element tensions' residual variance lines of the ``applied`` records (by
@@ -520,17 +533,25 @@ def along_line_residual(
     ``response``, ``spectra`` (n_ch, n_w): the line's linear response and its inputs'
     spectra (the misfit's cross term).  ``max_stations``: :func:`stations`.  A kind
     without captures adds nothing where its record's lines are all zero (no drag, no
-    order ≥ 2), and is not covered otherwise (the result not computed).  ``shared``: the
-    kinds' :func:`station_influence` (the stations' rows taken from it), if any."""
+    order ≥ 2), and is not covered otherwise (the result not computed).
+    ``influence_of``: the stations' influence (an ``on(w)`` object) from their indices
+    (default :class:`ElementInfluence`, ends held; a line on free bodies:
+    :mod:`.along_line_bodies`).  ``shared``: the kinds' :func:`end_station_influence`
+    (the stations' rows taken from it, ends held), if any."""
     n_el = system.model.n_elements
     if not applied:
         return AlongLineResidual(False, "no residual applied")
     model = system.model
     at = stations(model, max_stations)
     weights = station_weights(0.5 * (model.mesh.s0[1:] + model.mesh.s0[:-1]), at)
-    extra = None if shared is None else getattr(shared, "extra", None)
-    same = extra is not None and np.array_equal(extra, element_rhs(model, at))
-    influence = ElementInfluence(system, damping, at, shared if same else None)
+    rows = None if shared is None else shared_rows(shared, element_rhs(model, at), 0)
+    if rows is not None:
+        rows.elements = at  # (the geometric feedthrough's rows: element_lines)
+    influence = (
+        (ElementInfluence(system, damping, at) if rows is None else rows)
+        if influence_of is None
+        else influence_of(at)
+    )
     lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = {}
     total = np.zeros(n_el)
     linear = None
@@ -539,13 +560,26 @@ def along_line_residual(
         caps = [] if tap is None else tap.captures
         if kind not in CELL_BENDS or (tap is not None and tap.unmatched):
             caps = []
+        if getattr(tap, "vectors", None) and not tap.unmatched:  # 3-D drag (.along_line_3d)
+            lines[kind] = vector_parts(
+                system,
+                damping,
+                tap,
+                influence,
+                weights,
+                top_line(rec),
+                spectra,
+                lambda: station_transfer(system, response, at),
+            )
+            total += sum(v.sum(axis=1) for _, v in lines[kind])
+            continue
         if not caps:
             if all(not np.any(np.asarray(v)) for _, part in rec.lines for v in part.values()):
                 continue
             why = (
                 "its loads were not matched to their load transfer (RESIDUAL_TAP)"
                 if tap is not None and tap.unmatched
-                else "its loads do not pass through the pair lines (3-D drag)"
+                else "its loads were not captured (no pair lines)"
             )
             return AlongLineResidual(
                 False,

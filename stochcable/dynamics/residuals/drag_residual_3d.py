@@ -72,7 +72,6 @@ from stochcable.dynamics.residuals.drag_residual import (
     MAX_PANELS,
     _warn_large,
     cell_factor,
-    drag_residual,
     hermite_coefficients,
     lumped_coefficients,
 )
@@ -84,6 +83,7 @@ from stochcable.dynamics.residuals.drag_segments import (
     segments,
 )
 from stochcable.dynamics.residuals.residual_lines import (
+    RESIDUAL_TAP,
     EndInfluence,
     element_directions,
     fft_length,
@@ -95,7 +95,6 @@ from stochcable.results.records import ResidualRecord
 
 __all__ = [
     "drag_residual_3d",
-    "drag_residual_lines",
     "vector_hermite_coefficients",
     "vector_residual_covariance",
     "vector_residual_output_lines",
@@ -110,21 +109,6 @@ _BLOCK_BYTES = 48 * 2**20
 _RADIUS, _GL, _RATIO, _LEVELS = 10.0, 4, 0.2, 6
 #: Panels whose quadrature grids are formed at a time. [-]
 _CHUNK = 8
-
-
-def drag_residual_lines(
-    system: Any,
-    channels: Any,
-    linearization: Any,
-    std: dict[str, float],
-    *,
-    influence: Any = None,
-) -> ResidualRecord:
-    """The drag residual of a line of either dimension: :func:`drag_residual_3d` for a
-    3-D model, else :func:`~stochcable.dynamics.residuals.drag_residual.drag_residual`
-    (the registered compute function of ``drag_residual``)."""
-    fn = drag_residual_3d if system.model.dim == 3 else drag_residual
-    return fn(system, channels, linearization, std, influence=influence)
 
 
 # ------------------------------------------------------------------ coefficients
@@ -387,6 +371,8 @@ def vector_residual_output_lines(
         n_b, n_f = cr.shape[2], cr.shape[3]
         # (n_o, n_b·3, n_f·3), panel-major
         g = np.transpose(cr, (4, 2, 0, 3, 1)).reshape(n_o, n_b * 3, n_f * 3)
+        if (tap := RESIDUAL_TAP.get()) is not None:  # (other outputs': .along_line_3d)
+            tap.vector_block(g, blk, f_all, transfer)
         t_f = np.transpose(transfer[:, f_all].reshape(n_out, n_f * 3, n_o), (2, 1, 0))
         t_e = np.transpose(np.conj(transfer[:, blk]).reshape(n_out, n_b * 3, n_o), (2, 1, 0))
         out += np.einsum("jek,jek->kj", t_e, g @ t_f).real
@@ -591,6 +577,8 @@ def _misfit_variance(
     load = np.einsum("pab,cbpw->capw", db, v)  # along n₁, n₂, t
     h = load_transfer(system, damping, unit, w, coupled)  # (2, 3·n_p, n_w)
     n_ch = load.shape[0]
+    if (tap := RESIDUAL_TAP.get()) is not None:  # (the element tensions': .along_line_3d)
+        tap.misfit(unit, load.reshape(n_ch, -1, w.size), w)
     q = trapezoid_weights(w)[None] * spectra
     out = {}
     for o, end in enumerate(("end_a", "end_b")):

@@ -15,13 +15,14 @@ from __future__ import annotations
 from typing import Any, Protocol
 
 from stochcable.dynamics.residuals.drag_form_guard import guard_drag_form
-from stochcable.dynamics.residuals.drag_residual_3d import drag_residual_lines
+from stochcable.dynamics.residuals.drag_residual import drag_residual
+from stochcable.dynamics.residuals.drag_residual_3d import drag_residual_3d
 from stochcable.dynamics.residuals.geometric_residual import geometric_residual
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
 from stochcable.results.records import ResidualRecord
 from stochcable.scene.residual_kinds import RESIDUAL_KINDS, ResidualKind
 
-__all__ = ["COMPUTE", "ResidualFunction", "residual_parts"]
+__all__ = ["COMPUTE", "ResidualFunction", "drag_residual_lines", "residual_parts"]
 
 
 class ResidualFunction(Protocol):
@@ -36,6 +37,22 @@ class ResidualFunction(Protocol):
         *,
         influence: EndInfluence | None = None,
     ) -> ResidualRecord: ...
+
+
+def drag_residual_lines(
+    system: Any,
+    channels: Any,
+    linearization: Any,
+    std: dict[str, float],
+    *,
+    influence: Any = None,
+) -> ResidualRecord:
+    """The drag residual of a line of either dimension:
+    :func:`~stochcable.dynamics.residuals.drag_residual_3d.drag_residual_3d` for a 3-D
+    model, else :func:`~stochcable.dynamics.residuals.drag_residual.drag_residual` (the
+    registered compute function of ``drag_residual``)."""
+    fn = drag_residual_3d if system.model.dim == 3 else drag_residual
+    return fn(system, channels, linearization, std, influence=influence)
 
 
 COMPUTE: dict[str, ResidualFunction] = {

@@ -49,6 +49,7 @@ __all__ = [
     "UniformGrid",
     "DENSE_PAIR_BYTES",
     "PairLines",
+    "SharedRows",
     "along",
     "covariance_lines",
     "dense_pair_outputs",
@@ -63,6 +64,7 @@ __all__ = [
     "pair_lags",
     "pair_outputs",
     "residual_record",
+    "shared_rows",
     "uniform_grid",
 ]
 
@@ -89,7 +91,7 @@ MODAL_SPAN = 4.0
 #: free DOFs as modes (its cost grows with their cube: the taut wire's 38 of 38 cost
 #: more than its banded solve, 6.6 against 5.3 ms; the chain's 23 of 78: 2.3 against
 #: 6.9 ms). [-]
-MODAL_SHARE = 0.5
+MODAL_SHARE = 0.4
 #: Most frequencies per banded solve of :func:`end_influence` (a stack of many
 #: frequencies and right-hand sides outgrows the cache: the chain's 9 on 189 lines took
 #: 12 ms in one stack, 6–9 ms in stacks of 16–128; the taut wire's 2 on 189 lines 2.4 ms
@@ -389,14 +391,40 @@ class EndInfluence:
             g = self._kept[-1][1]
         return g
 
-    def extra_on(self, w: np.ndarray) -> np.ndarray:
-        """The ``extra`` rows on ``w``, shape (k, n_nodes, d, n_w). [N/N]"""
+    def extra_on(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray:
+        """The ``extra`` rows ``cols`` on ``w``, shape (k, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
         g = self._find(self._kept_x, w)
         if g is None:
             self._solve(w, extra=True)
             g = self._kept_x[-1][1]
-        return g
+        return g[cols]
+
+
+class SharedRows:
+    """Rows ``cols`` of a shared :class:`EndInfluence`'s ``extra`` rows as an
+    ``influence`` of :func:`load_transfer` (``on(w)``): the element tensions' and the
+    node motions' stations solved with the end rows (:mod:`.along_line`,
+    :mod:`.along_line_motion`)."""
+
+    def __init__(self, shared: EndInfluence, cols: slice) -> None:
+        self.shared = shared
+        self.cols = cols
+        self.elements: np.ndarray | None = None  # (the element tensions' stations, if so)
+
+    def on(self, w: np.ndarray) -> np.ndarray:
+        """The rows on ``w``, shape (k, n_nodes, d, n_w)."""
+        return self.shared.extra_on(w, self.cols)
+
+
+def shared_rows(shared: Any, rhs: np.ndarray, start: int) -> SharedRows | None:
+    """The :class:`SharedRows` of ``shared`` whose ``extra`` columns from ``start`` are
+    ``rhs`` ((n_nodes − 2)·d, k), None where they are not (or ``shared`` has none)."""
+    extra = getattr(shared, "extra", None)
+    cols = slice(start, start + rhs.shape[1])
+    if extra is None or extra.shape[1] < cols.stop or not np.array_equal(extra[:, cols], rhs):
+        return None
+    return SharedRows(shared, cols)
 
 
 def end_influence(
