@@ -72,6 +72,7 @@ __all__ = [
     "along_line_residual",
     "element_influence",
     "element_lines",
+    "capture_outputs",
     "element_rhs",
     "residual_tap",
     "station_weights",
@@ -319,16 +320,22 @@ def element_lines(
             sel = getattr(influence, "elements", None)
             full = full + own[slice(None) if sel is None else sel, :, None]
         lines = np.zeros((full.shape[0], cap.w.size))
-        lines[:, :top] = (
-            dense_outputs(cap.blocks, full[:, cap.kept])
-            if cap.g_all is None
-            else dense_pair_outputs(cap.g_all[:top], full[:, cap.kept])
-        )
+        lines[:, :top] = capture_outputs(cap, full[:, cap.kept])
         lines[:, :top] *= cell_factor(
             system, damping, cap.unit, w, full, CELL_BENDS[kind], influence=influence
         )
         out = lines if out is None else out + lines
     return out
+
+
+def capture_outputs(cap: Capture, transfer: np.ndarray) -> np.ndarray:
+    """The variance lines (n_out, n_o) of outputs with transfer ``transfer`` (n_out,
+    n_kept, n_o) per unit load of ``cap``'s kept loads on its first n_o lines: from the
+    kind's dense pair lines where it kept them (``cap.g_all``), else its blocks
+    (:func:`dense_outputs`)."""
+    if cap.g_all is None:
+        return dense_outputs(cap.blocks, transfer)
+    return dense_pair_outputs(cap.g_all[: transfer.shape[2]], transfer)
 
 
 def dense_outputs(
