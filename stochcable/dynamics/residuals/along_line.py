@@ -41,7 +41,6 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.loads.freqblocks import frequency_slices
 from stochcable.dynamics.model.blocks import free_band, line_prep, trapezoid_weights
 from stochcable.dynamics.model.lift import lift_band, lift_pattern
 from stochcable.dynamics.model.solvers import solve_band_stacked
@@ -54,10 +53,10 @@ from stochcable.dynamics.residuals.corrected_spectrum import CorrectedSpectrum, 
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
 from stochcable.dynamics.residuals.residual_lines import (
-    BAND_STACK,
     RESIDUAL_TAP,
     EndInfluence,
     along,
+    band_stack,
     dense_pair_outputs,
     load_transfer,
     shared_rows,
@@ -229,7 +228,7 @@ def element_influence(
     rhs = element_rhs(model, elements)
     n_el = rhs.shape[1]
     out = np.zeros((n_el, n, d, w.size), dtype=complex)
-    step = max(1, min(BAND_STACK, frequency_slices(w.size, 16 * n * d * max(n_el, 1))[0].stop))
+    step = band_stack((n - 2) * d, d, max(n_el, 1))
     for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
         ws = w[sl]
         x = solve_band_stacked(

@@ -19,7 +19,6 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.loads.freqblocks import frequency_slices
 from stochcable.dynamics.model.blocks import (
     add_blocks,
     block_matvec,
@@ -38,7 +37,7 @@ from stochcable.errors import SolverError
 from stochcable.results.records import ResidualRecord
 
 __all__ = [
-    "BAND_STACK",
+    "BAND_STACK_BYTES",
     "LIVE_SHARE",
     "MAX_LINES",
     "MODAL_INFLUENCE",
@@ -51,6 +50,7 @@ __all__ = [
     "PairLines",
     "SharedRows",
     "along",
+    "band_stack",
     "covariance_lines",
     "dense_pair_outputs",
     "cross_covariance",
@@ -92,11 +92,19 @@ MODAL_SPAN = 4.0
 #: more than its banded solve, 6.6 against 5.3 ms; the chain's 23 of 78: 2.3 against
 #: 6.9 ms). [-]
 MODAL_SHARE = 0.4
-#: Most frequencies per banded solve of :func:`end_influence` (a stack of many
-#: frequencies and right-hand sides outgrows the cache: the chain's 9 on 189 lines took
-#: 12 ms in one stack, 6–9 ms in stacks of 16–128; the taut wire's 2 on 189 lines 2.4 ms
-#: in stacks of 16–32, 1.6 ms in 64–256). [-]
-BAND_STACK = 128
+#: Memory of one stack of frequencies of the banded solves of :func:`end_influence`
+#: (:func:`band_stack`): a stack of many frequencies and right-hand sides outgrows the
+#: cache (the deep wire's 2 + 23 rows on 189 lines: 5.9 ms in stacks of 16–32, 11 ms
+#: in stacks of 128; its 2 end rows alone: 1.6 ms in stacks of 64–128, 1.8 in 16). [bytes]
+BAND_STACK_BYTES = 640 * 2**10
+
+
+def band_stack(n_dof: int, d: int, r: int) -> int:
+    """Frequencies per stacked banded solve of ``n_dof`` unknowns (blocks of ``d``) and
+    ``r`` right-hand sides: its band storage and right-hand sides within
+    :data:`BAND_STACK_BYTES` (at least 4)."""
+    per = 16 * n_dof * (3 * (2 * d - 1) + 1 + r)
+    return max(4, int(BAND_STACK_BYTES // per))
 
 
 #: Share of each channel's variance in the upper tail of the analysis grid left off the
@@ -466,7 +474,7 @@ def end_influence(
     out[1, -1] = e_b[:, None]
     # the end rows' coupling blocks Z(1, 0) and Z(n − 2, n − 1)
     g = _end_coupling(system, prep, c, (e_a, e_b), lift_t)  # (3, n_f·d, 2)
-    step = max(1, min(BAND_STACK, frequency_slices(w.size, 8 * 16 * n * d * (2 + k_x))[0].stop))
+    step = band_stack((n - 2) * d, d, 2 + k_x)
     for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
         ws = w[sl]
         rhs = np.zeros((ws.size, (n - 2) * d, 2 + k_x), dtype=complex)
