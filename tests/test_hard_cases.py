@@ -662,6 +662,9 @@ def test_400_element_line_direct_vs_foss():
     np.testing.assert_allclose(a.tension_mean, b.tension_mean, rtol=1e-12)
 
 
+# 4–5 s of CPU with the residuals on every element (along-line, motions): over the fast
+# tier's 4 s budget on a loaded host
+@pytest.mark.slow
 def test_800_element_line_converges_to_the_200_element_answer():
     """800 elements (1598 free DOFs), direct solve: finite, and the σ of the end
     tensions agree with 200- and 400-element models within the discretization error.

@@ -331,12 +331,19 @@ def motion_residual(
         return MotionResidual(False, "no residual applied")
     at = motion_stations(model, max_stations)
     weights = motion_weights(model.mesh.s0, at, np.asarray(linear_std)[:, comps] ** 2)
-    influence = NodeInfluence(system, damping, at) if influence_of is None else influence_of(at)
+    # a held end node's residual is zero: its rows are not solved (its weights kept:
+    # near a moving held end the ratio falls to its 0)
+    solve = np.ones(at.size, dtype=bool)
+    if influence_of is None:
+        solve = (at > 0) & (at < model.n_nodes - 1)
+    weights = weights.reshape(-1, at.size, d)[:, solve].reshape(weights.shape[0], -1)
+    at_s = at[solve]
+    influence = NodeInfluence(system, damping, at_s) if influence_of is None else influence_of(at_s)
     linear = None
 
     def station_motion() -> np.ndarray:
-        u = motion()[:, at][:, :, comps]  # (n_ch, n_st, d, n_w)
-        return u.reshape(u.shape[0], at.size * d, u.shape[3])
+        u = motion()[:, at_s][:, :, comps]  # (n_ch, n_solved, d, n_w)
+        return u.reshape(u.shape[0], at_s.size * d, u.shape[3])
 
     lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = {}
     total = np.zeros((model.n_nodes, 3))
