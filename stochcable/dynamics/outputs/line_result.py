@@ -365,15 +365,34 @@ def _end_force_transfer(model: FEModel, resp: Response, n_ch: int) -> dict[str, 
 
 
 def _shared_nodes(shared: EndInfluence, system: LineSystem, damping: Any) -> Any:
-    """The node motions' stations' influence (from their node indices) taken from the
-    kinds' shared one (their rows solved with the end and element rows:
-    :func:`end_station_influence`'s ``more``), their own solve where it does not hold
-    them (:class:`NodeInfluence`)."""
+    """The node motions' stations' influence (from their node indices): a
+    :class:`NodeInfluence` that takes its rows from the kinds' shared influence where
+    it holds them (solved with the end and element rows:
+    :func:`end_station_influence`'s ``more``), its own solve elsewhere (the motions'
+    cells: one node's rows, :func:`~stochcable.dynamics.residuals.along_line_motion.
+    motion_cells`)."""
     extra = getattr(shared, "extra", None)
 
     def of(nodes: np.ndarray) -> Any:
         rhs = node_rows(system.model, nodes)
         rows = None if extra is None else shared_rows(shared, rhs, extra.shape[1] - rhs.shape[1])
-        return NodeInfluence(system, damping, nodes) if rows is None else rows
+        return _SharedNodeInfluence(system, damping, nodes, rows)
 
     return of
+
+
+class _SharedNodeInfluence(NodeInfluence):
+    """A :class:`NodeInfluence` reading the shared rows ``rows`` (a
+    :class:`~stochcable.dynamics.residuals.residual_lines.SharedRows`) where they are
+    kept (or modal), solving its own elsewhere."""
+
+    def __init__(self, system: Any, damping: Any, nodes: np.ndarray, rows: Any) -> None:
+        super().__init__(system, damping, nodes)
+        self.rows = rows
+
+    def on(self, w: np.ndarray) -> np.ndarray:
+        if self.rows is not None:
+            g = self.rows.shared.extra_kept(w, self.rows.cols)
+            if g is not None:
+                return g
+        return super().on(w)

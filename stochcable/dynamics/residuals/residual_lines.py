@@ -408,6 +408,17 @@ class EndInfluence:
             g = self._kept_x[-1][1]
         return g[cols]
 
+    def extra_kept(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray | None:
+        """The ``extra`` rows ``cols`` on ``w`` where they are kept, or solved by the
+        modal basis (no factorization); None otherwise (the caller's own solve of its
+        rows: a banded solve of all the rows where one set is asked, e.g. at a set's
+        cells, costs the others' right-hand sides for nothing). [N/N]"""
+        w = np.asarray(w, dtype=float)
+        g = self._find(self._kept_x, w)
+        if g is None and self._modal:
+            return self.extra_on(w, cols)
+        return None if g is None else g[cols]
+
 
 class SharedRows:
     """Rows ``cols`` of a shared :class:`EndInfluence`'s ``extra`` rows as an
@@ -419,10 +430,21 @@ class SharedRows:
         self.shared = shared
         self.cols = cols
         self.elements: np.ndarray | None = None  # (the element tensions' stations, if so)
+        self._own: list[tuple[np.ndarray, np.ndarray]] = []
 
     def on(self, w: np.ndarray) -> np.ndarray:
-        """The rows on ``w``, shape (k, n_nodes, d, n_w)."""
-        return self.shared.extra_on(w, self.cols)
+        """The rows on ``w``, shape (k, n_nodes, d, n_w): the shared ones where kept
+        (or modal), else these rows alone by the banded solve (kept here)."""
+        w = np.asarray(w, dtype=float)
+        g = self.shared.extra_kept(w, self.cols)
+        if g is not None:
+            return g
+        g = EndInfluence._find(self._own, w)
+        if g is None:
+            sh = self.shared
+            g = end_influence(sh.system, sh.damping, w, sh.extra[:, self.cols])[2:]
+            self._own.append((w.copy(), g))
+        return g
 
 
 def shared_rows(shared: Any, rhs: np.ndarray, start: int) -> SharedRows | None:
