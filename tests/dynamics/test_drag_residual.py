@@ -212,6 +212,7 @@ def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     """The settings of the evaluation before issue 31."""
     monkeypatch.setattr(rl, "MAX_LINES", 1024)
     monkeypatch.setattr(rl, "LIVE_SHARE", 0.0)  # (the whole analysis grid on the lines)
+    monkeypatch.setattr(rl, "MODAL_INFLUENCE", False)  # (the banded adjoint solve)
     monkeypatch.setattr(gr, "LINE_STRIDE", 1)  # (its grid: the drag's)
     monkeypatch.setattr(gr, "ELEMENT_FLOOR", 0.0)  # (every element)
     monkeypatch.setattr(dr, "MAX_PANELS", 64)

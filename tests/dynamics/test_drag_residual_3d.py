@@ -209,12 +209,18 @@ def test_filtered_outputs_equal_monte_carlo(lumped):
     assert np.all(misfit > 0.05 * closed)  # (the seed form's misfit is not negligible)
 
 
-def test_planar_line_in_a_3d_model_gives_the_2d_residual():
+def test_planar_line_in_a_3d_model_gives_the_2d_residual(monkeypatch):
     """The chain in its sea at heading 0 (planar: a 2-D model) and with its current
     turned by 1e-6 deg (a 3-D model of the same planar motion): the same drag
     residual (the out-of-plane variance is zero, the seed form's out-of-plane misfit
     loads nothing); within 1e-4 (the 3-D quadrature of the coefficients: 2e-7 of σ²,
-    and the fixed point's tolerance)."""
+    and the fixed point's tolerance).  Both with the banded end influence: the modal
+    one's static correction differs between the models' mode sets (2-D: 22 of 78
+    modes kept, −2.2e-4 of this variance; 3-D: −2.5e-5), tested on its own in
+    tests/dynamics/test_residual_lines.py."""
+    import stochcable.dynamics.residuals.residual_lines as rl
+
+    monkeypatch.setattr(rl, "MODAL_INFLUENCE", False)
     doc = load_example("chain_catenary").model_dump(mode="json")
     doc["analysis"].pop("timeseries", None)
     doc["analysis"]["linearization"].update(drag_residual=True, tolerance=1e-9)

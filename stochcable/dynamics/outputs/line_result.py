@@ -17,6 +17,8 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from stochcable.dynamics.loads.channels import (
@@ -39,17 +41,26 @@ from stochcable.dynamics.outputs.resolution import (
     surface_resolution_check,
     tail_check,
 )
-from stochcable.dynamics.residuals.along_line import along_line_residual, residual_tap
+from stochcable.dynamics.residuals.along_line import (
+    along_line_residual,
+    end_station_influence,
+    residual_tap,
+)
 from stochcable.dynamics.residuals.along_line_bodies import (
     node_station_influence,
     station_influence,
 )
-from stochcable.dynamics.residuals.along_line_motion import motion_residual
+from stochcable.dynamics.residuals.along_line_motion import (
+    NodeInfluence,
+    motion_residual,
+    motion_stations,
+    node_rows,
+)
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
 from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
 from stochcable.dynamics.residuals.registry import residual_parts
-from stochcable.dynamics.residuals.residual_lines import EndInfluence
+from stochcable.dynamics.residuals.residual_lines import EndInfluence, shared_rows
 from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
 from stochcable.line.fem import SLACK_EA_RATIO, FEModel
 from stochcable.results.documents import (
@@ -193,7 +204,16 @@ def line_result(
     residual = {}
     std = {e: stats[e].std for e in stats}
     # (one solve for both; a line on bodies: through the coupled group)
-    shared = EndInfluence(system, linearization.damping) if influence is None else influence
+    # (a line alone: the element tensions' station rows in the same factorization)
+    shared = (
+        end_station_influence(
+            system, linearization.damping, more=node_rows(model, motion_stations(model))
+        )
+        if influence is None and alone and model.dim == 2
+        else EndInfluence(system, linearization.damping)
+        if influence is None
+        else influence
+    )
     taps = {}  # (each kind's loads and load cross-spectra, for the element tensions)
     for kind, fn in (
         residual_parts(settings.linearization) if linearization.record is not None else ()
@@ -221,6 +241,7 @@ def line_result(
             resp,
             spectra,
             influence_of=None if influence is None else station_influence(influence),
+            shared=shared if influence is None else None,
         )
         moves = motion_residual(
             system,
@@ -230,7 +251,11 @@ def line_result(
             motion,
             spectra,
             motion_std,
-            influence_of=None if influence is None else node_station_influence(influence),
+            influence_of=(
+                node_station_influence(influence)
+                if influence is not None
+                else _shared_nodes(shared, system, linearization.damping)
+            ),
         )
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None
@@ -337,3 +362,37 @@ def _end_force_transfer(model: FEModel, resp: Response, n_ch: int) -> dict[str, 
         f[:, comps, :] = np.transpose(resp.support_force[:, k * d : (k + 1) * d, :], (2, 1, 0))
         end_force[end] = f
     return end_force
+
+
+def _shared_nodes(shared: EndInfluence, system: LineSystem, damping: Any) -> Any:
+    """The node motions' stations' influence (from their node indices): a
+    :class:`NodeInfluence` that takes its rows from the kinds' shared influence where
+    it holds them (solved with the end and element rows:
+    :func:`end_station_influence`'s ``more``), its own solve elsewhere (the motions'
+    cells: one node's rows, :func:`~stochcable.dynamics.residuals.along_line_motion.
+    motion_cells`)."""
+    extra = getattr(shared, "extra", None)
+
+    def of(nodes: np.ndarray) -> Any:
+        rhs = node_rows(system.model, nodes)
+        rows = None if extra is None else shared_rows(shared, rhs, extra.shape[1] - rhs.shape[1])
+        return _SharedNodeInfluence(system, damping, nodes, rows)
+
+    return of
+
+
+class _SharedNodeInfluence(NodeInfluence):
+    """A :class:`NodeInfluence` reading the shared rows ``rows`` (a
+    :class:`~stochcable.dynamics.residuals.residual_lines.SharedRows`) where they are
+    kept (or modal), solving its own elsewhere."""
+
+    def __init__(self, system: Any, damping: Any, nodes: np.ndarray, rows: Any) -> None:
+        super().__init__(system, damping, nodes)
+        self.rows = rows
+
+    def on(self, w: np.ndarray) -> np.ndarray:
+        if self.rows is not None:
+            g = self.rows.shared.extra_kept(w, self.rows.cols)
+            if g is not None:
+                return g
+        return super().on(w)

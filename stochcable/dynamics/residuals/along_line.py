@@ -41,7 +41,6 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.loads.freqblocks import frequency_slices
 from stochcable.dynamics.model.blocks import free_band, line_prep, trapezoid_weights
 from stochcable.dynamics.model.lift import lift_band, lift_pattern
 from stochcable.dynamics.model.solvers import solve_band_stacked
@@ -55,7 +54,12 @@ from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
 from stochcable.dynamics.residuals.residual_lines import (
     RESIDUAL_TAP,
+    EndInfluence,
+    along,
+    band_stack,
+    dense_pair_outputs,
     load_transfer,
+    shared_rows,
 )
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.line.fem import SLACK_EA_RATIO
@@ -67,8 +71,11 @@ __all__ = [
     "along_line_residual",
     "element_influence",
     "element_lines",
+    "capture_outputs",
+    "element_rhs",
     "residual_tap",
     "station_weights",
+    "end_station_influence",
     "stations",
     "top_line",
 ]
@@ -97,13 +104,16 @@ class Capture:
     load of the kind's :func:`load_transfer` call ``unit`` (n_nodes, d, n_all), the
     loads ``kept`` (indices into it) and the blocks of pairs (g, e, f) of their
     cross-spectral lines ``g`` (n_pairs, n_o) between loads e and f (indices into
-    ``kept``), as :func:`pair_outputs` takes them."""
+    ``kept``), as :func:`pair_outputs` takes them; ``g_all`` (n_o, n·n), where the kind
+    gathered them into one dense matrix (:class:`~.residual_lines.PairLines`), G_ef in
+    column e·n + f."""
 
     w: np.ndarray
     unit: np.ndarray
     kept: np.ndarray
     transfer: np.ndarray
     blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
+    g_all: np.ndarray | None = None
 
 
 class ResidualTap(VectorTapMixin):
@@ -126,6 +136,12 @@ class ResidualTap(VectorTapMixin):
     def loads(self, unit: np.ndarray, w: np.ndarray, h: np.ndarray) -> None:
         """A :func:`load_transfer` call: its loads, frequencies and end transfer."""
         self._loads.append((unit, np.asarray(w, dtype=float), h))
+
+    def dense(self, g_all: np.ndarray, transfer: np.ndarray) -> None:
+        """A :class:`~.residual_lines.PairLines` contraction's dense lines (n_o, n·n),
+        kept with the capture of its blocks (same ``transfer``)."""
+        if self.captures and self.captures[-1].transfer is transfer:
+            self.captures[-1].g_all = g_all
 
     def lines(self, g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
         """A :func:`pair_outputs` call: a block of pairs' lines G and the loads' end
@@ -170,6 +186,24 @@ def element_rows(model: Any) -> np.ndarray:
     return np.asarray(rows, dtype=float)
 
 
+def element_rhs(model: Any, elements: np.ndarray | None = None) -> np.ndarray:
+    """The adjoint right-hand sides of the tensions of ``elements`` (indices; default
+    all): r_e on the free nodes 1 … n − 2, shape ((n_nodes − 2)·d, n_out) (the
+    ``extra`` of :func:`~stochcable.dynamics.residuals.residual_lines.end_influence`).
+    [N/m]"""
+    d, n = model.dim, model.n_nodes
+    rows = element_rows(model)
+    idx = np.arange(rows.shape[0]) if elements is None else np.asarray(elements, dtype=int)
+    rows = rows[idx]
+    rhs = np.zeros(((n - 2) * d, idx.size), dtype=complex)
+    for k in (0, 1):  # node e + k of element e, free nodes 1 … n − 2
+        node = idx + k
+        free = (node >= 1) & (node <= n - 2)
+        for c in range(d):
+            rhs[(node[free] - 1) * d + c, np.flatnonzero(free)] = rows[free, k, c]
+    return rhs
+
+
 def element_influence(
     system: Any, damping: Any, w: np.ndarray, elements: np.ndarray | None = None
 ) -> np.ndarray:
@@ -191,18 +225,11 @@ def element_influence(
         b_c = b_c - gyro_band(system.gyro, d)
     if system.lift is not None:
         b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
-    rows = element_rows(model)
-    idx = np.arange(rows.shape[0]) if elements is None else np.asarray(elements, dtype=int)
-    rows = rows[idx]
-    n_el = idx.size
-    rhs = np.zeros(((n - 2) * d, n_el), dtype=complex)
-    for k in (0, 1):  # node e + k of element e, free nodes 1 … n − 2
-        node = idx + k
-        free = (node >= 1) & (node <= n - 2)
-        for c in range(d):
-            rhs[(node[free] - 1) * d + c, np.flatnonzero(free)] = rows[free, k, c]
+    rhs = element_rhs(model, elements)
+    n_el = rhs.shape[1]
     out = np.zeros((n_el, n, d, w.size), dtype=complex)
-    for sl in frequency_slices(w.size, 16 * n * d * max(n_el, 1)):
+    step = band_stack((n - 2) * d, d, max(n_el, 1))
+    for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
         ws = w[sl]
         x = solve_band_stacked(
             prep.bK,
@@ -218,20 +245,45 @@ def element_influence(
     return out
 
 
+def end_station_influence(
+    system: Any, damping: Any, max_stations: int = MAX_STATIONS, more: np.ndarray | None = None
+) -> EndInfluence:
+    """The line's end influence with its :func:`stations`' tension rows solved in the
+    same factorization or modal sum (their :func:`element_rhs` first in its ``extra``,
+    then ``more`` right-hand sides: the node motions' stations): the kinds' shared
+    influence where the element tensions are formed too (:func:`along_line_residual`'s
+    ``shared``; one solve per line for the 2 + 7 (+ more) rows, not one per set)."""
+    rhs = element_rhs(system.model, stations(system.model, max_stations))
+    if more is not None:
+        rhs = np.hstack([rhs, more])
+    return EndInfluence(system, damping, rhs)
+
+
 class ElementInfluence:
     """:func:`element_influence` of one line and drag, kept for the frequencies asked
     (the geometric residual's lines are among the drag residual's): the ``influence``
-    of :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`."""
+    of :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`.  With
+    ``shared`` (an :func:`end_station_influence` of the same elements) its rows are taken
+    from it, solved with the end rows where it does not hold them."""
 
-    def __init__(self, system: Any, damping: Any, elements: np.ndarray | None = None) -> None:
+    def __init__(
+        self,
+        system: Any,
+        damping: Any,
+        elements: np.ndarray | None = None,
+        shared: EndInfluence | None = None,
+    ) -> None:
         self.system = system
         self.damping = damping
         self.elements = elements
+        self.shared = shared
         self._kept: list[tuple[np.ndarray, np.ndarray]] = []
 
     def on(self, w: np.ndarray) -> np.ndarray:
         """The influence on ``w``, shape (n_out, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
+        if self.shared is not None:
+            return self.shared.extra_on(w)
         for om, g in self._kept if w.size else ():
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
             near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
@@ -267,12 +319,22 @@ def element_lines(
             sel = getattr(influence, "elements", None)
             full = full + own[slice(None) if sel is None else sel, :, None]
         lines = np.zeros((full.shape[0], cap.w.size))
-        lines[:, :top] = dense_outputs(cap.blocks, full[:, cap.kept])
+        lines[:, :top] = capture_outputs(cap, full[:, cap.kept])
         lines[:, :top] *= cell_factor(
             system, damping, cap.unit, w, full, CELL_BENDS[kind], influence=influence
         )
         out = lines if out is None else out + lines
     return out
+
+
+def capture_outputs(cap: Capture, transfer: np.ndarray) -> np.ndarray:
+    """The variance lines (n_out, n_o) of outputs with transfer ``transfer`` (n_out,
+    n_kept, n_o) per unit load of ``cap``'s kept loads on its first n_o lines: from the
+    kind's dense pair lines where it kept them (``cap.g_all``), else its blocks
+    (:func:`dense_outputs`)."""
+    if cap.g_all is None:
+        return dense_outputs(cap.blocks, transfer)
+    return dense_pair_outputs(cap.g_all[: transfer.shape[2]], transfer)
 
 
 def dense_outputs(
@@ -285,12 +347,10 @@ def dense_outputs(
     per line (the 7 stations: 3.5× the ends'), this one n² × n_out in BLAS.
     ``transfer`` (n_out, n, n_o); shape (n_out, n_o)."""
     n_out, n, n_o = transfer.shape
-    g_all = np.zeros((n_o, n, n), dtype=complex)
+    g_all = np.zeros((n_o, n * n), dtype=complex)
     for g, e, f in blocks:  # each pair once (pair_outputs' callers: f ≥ e, or (i, j) blocks)
-        g_all[:, e, f] += g[:, :n_o].T
-    t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
-    gt = g_all @ t  # (n_o, n, n_out)
-    return np.einsum("jno,jno->oj", np.conj(t), gt).real
+        g_all[:, e * n + f] += g[:, :n_o].T
+    return dense_pair_outputs(g_all, transfer)
 
 
 def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
@@ -403,10 +463,7 @@ def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:
     n_w = np.asarray(response.omega).size
     u = np.asarray(response.displacement).reshape(n_w, model.n_nodes, model.dim, -1)
     rows = element_rows(model)[at]
-    out = np.einsum("ed,wedc->cew", rows[:, 0], u[:, at]) + np.einsum(
-        "ed,wedc->cew", rows[:, 1], u[:, at + 1]
-    )
-    return out
+    return along(u[:, at], rows[:, 0]) + along(u[:, at + 1], rows[:, 1])
 
 
 @dataclass(frozen=True)
@@ -474,6 +531,7 @@ def along_line_residual(
     spectra: np.ndarray,
     max_stations: int = MAX_STATIONS,
     influence_of: Callable[[np.ndarray], Any] | None = None,
+    shared: EndInfluence | None = None,
 ) -> AlongLineResidual:
     """The element tensions' residual variance lines of the ``applied`` records (by
     kind, computed and in range) from what their ``taps`` collected (module notes).
@@ -484,14 +542,22 @@ def along_line_residual(
     order ≥ 2), and is not covered otherwise (the result not computed).
     ``influence_of``: the stations' influence (an ``on(w)`` object) from their indices
     (default :class:`ElementInfluence`, ends held; a line on free bodies:
-    :mod:`.along_line_bodies`)."""
+    :mod:`.along_line_bodies`).  ``shared``: the kinds' :func:`end_station_influence`
+    (the stations' rows taken from it, ends held), if any."""
     n_el = system.model.n_elements
     if not applied:
         return AlongLineResidual(False, "no residual applied")
     model = system.model
     at = stations(model, max_stations)
     weights = station_weights(0.5 * (model.mesh.s0[1:] + model.mesh.s0[:-1]), at)
-    influence = ElementInfluence(system, damping, at) if influence_of is None else influence_of(at)
+    rows = None if shared is None else shared_rows(shared, element_rhs(model, at), 0)
+    if rows is not None:
+        rows.elements = at  # (the geometric feedthrough's rows: element_lines)
+    influence = (
+        (ElementInfluence(system, damping, at) if rows is None else rows)
+        if influence_of is None
+        else influence_of(at)
+    )
     lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = {}
     total = np.zeros(n_el)
     linear = None

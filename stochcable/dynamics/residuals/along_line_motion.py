@@ -40,7 +40,7 @@ from stochcable.dynamics.residuals.along_line import (
     CELL_BENDS,
     MAX_STATIONS,
     bent_cells,
-    dense_outputs,
+    capture_outputs,
     misfit_lines,
     station_weights,
     top_line,
@@ -235,7 +235,7 @@ def motion_lines(
         else:
             full = sparse_transfer(influence.on(w), unit)  # (n_out, n_kept, n_top)
             lines = np.zeros((full.shape[0], cap.w.size))
-            lines[:, :n_top] = dense_outputs(cap.blocks, full) * motion_cells(
+            lines[:, :n_top] = capture_outputs(cap, full) * motion_cells(
                 system, damping, unit, w, full, CELL_BENDS[kind], influence
             )
         out = lines if out is None else out + lines

@@ -78,6 +78,7 @@ from stochcable.dynamics.residuals.drag_segments import (
 )
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
+    PairLines,
     UniformGrid,
     covariance_lines,
     element_directions,
@@ -85,7 +86,6 @@ from stochcable.dynamics.residuals.residual_lines import (
     load_transfer,
     pair_blocks,
     pair_lags,
-    pair_outputs,
     residual_record,
     uniform_grid,
 )
@@ -259,7 +259,7 @@ def residual_output_lines(
     # the pairs f ≥ e (G_fe = conj(G_ef)) in blocks: ρ_ef, Σ_k b_k^e b_k^f ρ^k by
     # Horner's rule, its lines
     zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
-    out = np.zeros((transfer.shape[0], n_o))
+    out = PairLines(transfer)  # (the element tensions read its dense lines: .along_line)
     for e, f in pair_blocks(n_p, n_fft):
         rho = pair_lags(zz, e, f, n_fft)
         rr = (b[e, ks[-1]] * b[f, ks[-1]])[:, None] * rho
@@ -270,8 +270,8 @@ def residual_output_lines(
             rr *= rho
         g = covariance_lines(rr, n_o)
         g[f > e] *= 2.0
-        out += pair_outputs(g, transfer, e, f)  # (no (n_p, n_p, n_o) array formed)
-    return out
+        out.add(g, e, f)
+    return out.outputs()
 
 
 def drag_residual(

@@ -33,6 +33,7 @@ import numpy as np
 
 from stochcable.dynamics.loads.element_kinematics import element_wave_kinematics
 from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals.residual_lines import along
 
 __all__ = [
     "MAX_SUB",
@@ -206,21 +207,37 @@ def panel_groups(seg: Segments, max_panels: int) -> list[np.ndarray]:
 
 def _grouped_all(runs: list[np.ndarray], size: int, ends: np.ndarray, ratio: float) -> list:
     """The groups of every run (:func:`_grouped`)."""
-    return [g for run in runs for g in _grouped(run, size, ends, ratio)]
+    span = _spans(ends)
+    return [g for run in runs for g in _grouped(run, size, span, ratio)]
 
 
-def _grouped(run: np.ndarray, size: int, ends: np.ndarray, ratio: float) -> list[np.ndarray]:
+def _spans(ends: np.ndarray) -> list[tuple[float, float] | None]:
+    """Each piece's (least, largest) finite end variance, None where none is finite
+    (plain floats: :func:`_grouped` walks them one by one)."""
+    finite = np.isfinite(ends)
+    lo = np.where(finite, ends, np.inf).min(axis=1)
+    hi = np.where(finite, ends, -np.inf).max(axis=1)
+    return [
+        (float(a), float(b)) if any_ else None
+        for a, b, any_ in zip(lo, hi, finite.any(axis=1), strict=True)
+    ]
+
+
+def _grouped(
+    run: np.ndarray, size: int, span: list[tuple[float, float] | None], ratio: float
+) -> list[np.ndarray]:
     """Consecutive groups of ``run`` of at most ``size``, closed where the variance
-    ``ends`` (NaN: no matter) would span more than ``ratio``."""
+    ``span`` of the pieces (:func:`_spans`; None: no matter) would span more than
+    ``ratio``."""
     out, cur, lo, hi = [], [], math.inf, 0.0
-    for i in run:
-        v = ends[i][np.isfinite(ends[i])]
-        lo_i, hi_i = (min(lo, float(v.min())), max(hi, float(v.max()))) if v.size else (lo, hi)
+    for i in run.tolist():
+        v = span[i]
+        lo_i, hi_i = (min(lo, v[0]), max(hi, v[1])) if v is not None else (lo, hi)
         if cur and (len(cur) == size or (hi_i > 0 and hi_i > ratio * lo_i)):
             out.append(np.array(cur))
             cur, lo, hi = [], math.inf, 0.0
-            lo_i, hi_i = (float(v.min()), float(v.max())) if v.size else (lo, hi)
-        cur.append(int(i))
+            lo_i, hi_i = v if v is not None else (lo, hi)
+        cur.append(i)
         lo, hi = lo_i, hi_i
     if cur:
         out.append(np.array(cur))
@@ -279,7 +296,7 @@ def segment_velocity(
             vel[..., c] += (1.0 - xi)[None, :, None] * ch.velocity[:, e] + xi[
                 None, :, None
             ] * ch.velocity[:, e + 1]
-    return {name: np.einsum("wsdc,sd->csw", vel, vec[e]) for name, vec in directions.items()}
+    return {name: along(vel, vec[e]) for name, vec in directions.items()}
 
 
 def _subdivided_points(system: Any, seg: Segments) -> np.ndarray:

@@ -41,13 +41,14 @@ from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
+    PairLines,
+    along,
     covariance_lines,
     element_directions,
     fft_length,
     load_transfer,
     pair_blocks,
     pair_lags,
-    pair_outputs,
     residual_record,
     uniform_grid,
 )
@@ -168,7 +169,7 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
-    proc = [grid.lines(np.einsum("wedc,ed->cew", du, f), spectra) for f in frames]
+    proc = [grid.lines(along(du, f), spectra) for f in frames]
     mesh = model.mesh
     kappa = (mesh.ea / mesh.l0 - np.asarray(system.statics.tension) / length) / length
     # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms
@@ -283,7 +284,7 @@ def quadratic_output_lines(
         for y in range(n_p)
     }
     # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks
-    out = np.zeros((transfer.shape[0], n_o))
+    out = PairLines(transfer)
     for e, f in pair_blocks(n_el, n_fft, 2):
         r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}
         twice = np.where(f > e, 2.0, 1.0)[:, None]
@@ -296,5 +297,5 @@ def quadratic_output_lines(
                 )
                 # e's component i, f's j (transfer columns component-major)
                 g = covariance_lines(cov, n_o) * twice
-                out += pair_outputs(g, transfer, i * n_el + e, j * n_el + f)
-    return out
+                out.add(g, i * n_el + e, j * n_el + f)
+    return out.outputs()
