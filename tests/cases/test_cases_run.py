@@ -311,3 +311,33 @@ def test_a_warm_start_that_does_not_converge_falls_back_to_rest(monkeypatch):
         fallback = engine.solve(sea).lines["wire"]
     assert len(starts) == 2 and not np.array_equal(starts[0], starts[1])
     assert fallback.end_b.std == cold.end_b.std
+
+
+@pytest.mark.parametrize("example", ["chain_catenary", "tuah_1982_disc_buoy_single_leg"])
+def test_a_fixed_point_started_at_its_own_answer_costs_one_evaluation(example):
+    # warm_starts(own=True): the adaptive anchors' later passes start a case from its own
+    # converged σ; the full grid alone (no coarse stage, whose coarse fixed point is a
+    # defect away) then converges at its first evaluation.  The answer moves by one
+    # more step of a contracting map from a point already within the tolerance tol:
+    # σ within tol (the chain's 7 evaluations from rest, the leg with its buoy too)
+    from stochcable.dynamics.engine import build_engine
+    from stochcable.dynamics.groups.group_fixed_point import warm_starts
+
+    doc = _doc(example)
+    doc["analysis"]["linearization"].update(LINEAR_ONLY)
+    scene = load_scene(doc)
+    tol = scene.analysis.linearization.tolerance
+    engine = build_engine(scene)
+    sea = Sea(spectrum=Jonswap(hs=4.0, tp=10.0, gamma=3.3))
+    store: dict = {}
+    with warm_starts(store):
+        cold = engine.solve(sea)
+    own = {key: x[:1] for key, x in store.items()}
+    with warm_starts(own, own=True):
+        again = engine.solve(sea)
+    for name, line in again.lines.items():
+        assert cold.lines[name].linearization.iterations > 2
+        assert line.linearization.iterations == 1
+        assert line.linearization.converged
+        ref = cold.lines[name].end_b.std
+        assert line.end_b.std == pytest.approx(ref, rel=tol)

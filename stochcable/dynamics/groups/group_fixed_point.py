@@ -65,6 +65,9 @@ __all__ = ["CoupledLinearization", "linearize_coupled", "warm_starts"]
 #: The store of :func:`warm_starts` open in this context (None: every fixed point
 #: starts at rest).
 _WARM: ContextVar[dict[str, np.ndarray] | None] = ContextVar("warm_starts", default=None)
+#: Whether that store holds each group's own converged σ of the sea being solved
+#: (:func:`warm_starts` ``own``): the full grid alone, from that σ.
+_OWN: ContextVar[bool] = ContextVar("warm_starts_own", default=False)
 #: Converged σ a :func:`warm_starts` store keeps per group, and the weights of the
 #: polynomial extrapolation of 1, 2 and 3 of them (newest first). [-]
 _WARM_ORDER = 3
@@ -108,7 +111,7 @@ class CoupledLinearization:
 
 
 @contextmanager
-def warm_starts(store: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]:
+def warm_starts(store: dict[str, np.ndarray], own: bool = False) -> Iterator[dict[str, np.ndarray]]:
     """Warm starts of the drag fixed points solved inside the block: each group's
     iteration starts from the σ its last converged fixed points left in ``store``
     (keyed by the group's lines and bodies: extrapolated from the last three) instead
@@ -126,16 +129,24 @@ def warm_starts(store: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]
     store : dict of str to ndarray
         The last converged σ vectors per group (newest first), filled and read
         here. [m/s]
+    own : bool, optional
+        The store's newest σ are each group's own converged σ of the very sea solved
+        in the block (a case solved again, :func:`stochcable.cases.chunk.solve_chunk`
+        ``starts``): the iteration then runs on the full grid alone from there, with
+        no coarse stage (whose fixed point is the coarse model's, a defect away from
+        the full grid's: 3 evaluations instead of 1 on the chain example, up to 8 on
+        Tuah's leg), so a start still converged costs one evaluation.
 
     Yields
     ------
     dict
         ``store``.
     """
-    token = _WARM.set(store)
+    token, token_own = _WARM.set(store), _OWN.set(bool(own))
     try:
         yield store
     finally:
+        _OWN.reset(token_own)
         _WARM.reset(token)
 
 
@@ -232,9 +243,14 @@ def linearize_coupled(
     warm = None if store is None or lin.max_iterations == 1 else _warm_start(store, gname)
     x_rest, fp = None, None
     if warm is not None and np.all(np.isfinite(warm)):
-        idx = _warm_subset(g, method, coarse, warm)
+        own = _OWN.get()
+        idx = None if own else _warm_subset(g, method, coarse, warm)
         gc = None
-        if idx is None:  # the subset from the rest start's drag, as without a warm start
+        if own and len(g.lines) == 1 and not g.bodies:
+            g.sizes = {g.lines[0].name: warm.size}  # (the σ layout: the line's alone)
+        elif own:  # (the σ layout, from the rest start; the full grid alone)
+            x_rest = _start(g, method, False)[0]
+        elif idx is None:  # the subset from the rest start's drag, as without a warm start
             x_rest, idx, gc = _start(g, method, coarse)
         if x_rest is None or (warm.shape == x_rest.shape and x_rest.size):
             try:  # a start that does not converge: the rest start, as without one
