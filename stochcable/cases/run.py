@@ -149,7 +149,10 @@ def run_cases(
     years : float
         Return period of the long-term extremes. [years]
     progress : callable, optional
-        ``progress(done, total)`` as cases finish (after every chunk).
+        ``progress(done, total)`` as cases finish (after every chunk); the adaptive
+        anchors' later passes count too: each adds the cases it computes again to
+        ``total`` when it starts (a set's total grows pass by pass, and ``done``
+        reaches it at the end).
     engine : Engine, optional
         A built engine of the same scene, used by the in-process executor
         (``stochcable.build_engine``'s carries the element check into every case).
@@ -212,7 +215,7 @@ def run_cases(
         if progress is not None:
             progress(done, n)
     if plan.adaptive:
-        results = _refine(plan, results, engine, executor, chunk_size)
+        results = _refine(plan, results, engine, executor, chunk_size, progress, done)
     return assemble_cases(plan, results)
 
 
@@ -222,12 +225,15 @@ def _refine(
     engine: Engine | None,
     executor: Any,
     chunk_size: int | None,
+    progress: Progress | None = None,
+    done: int = 0,
 ) -> list[ChunkResult]:
     """The adaptive anchors' later passes (:func:`~stochcable.cases.residual_anchors.next_anchors`):
     each computes the residuals of the cases the checks ask for, every case from its
     own converged σ of the first pass (so its numbers do not depend on the chunking),
     until no check asks for more; the results in the order to assemble them (a case
-    computed later replaces its first-pass numbers)."""
+    computed later replaces its first-pass numbers).  ``progress(done, total)`` after
+    each chunk, ``total`` grown by each pass's cases (``done`` solved so far)."""
     states = plan.scatter.states
     starts: dict[int, dict[str, np.ndarray]] = {}
     for res in results:
@@ -236,6 +242,7 @@ def _refine(
                 starts[int(i)] = res.starts[j]
     # (the ratios are known to the fixed point's tolerance only: no finer checks)
     tol = max(float(plan.residual_tolerance or 0.0), plan.template.analysis.linearization.tolerance)
+    total = len(states)
     while True:
         merged = _merge(plan, results)
         todo = next_anchors(
@@ -250,7 +257,16 @@ def _refine(
         cases = tuple(tuple((int(i), states[i], True) for i in part) for part in parts)
         seeds = tuple(tuple(starts.get(int(i), {}) for i in part) for part in parts)
         sub = replace(plan, chunks=cases, leads=tuple(() for _ in cases), starts=seeds)
-        results = [*results, *sorted(_run_chunks(sub, engine, executor), key=_first_index)]
+        total += idx.size
+        if progress is not None:  # (the pass's cases join the total as it starts)
+            progress(done, total)
+        new = []
+        for res in _run_chunks(sub, engine, executor):
+            new.append(res)
+            done += len(res.rows)
+            if progress is not None:
+                progress(done, total)
+        results = [*results, *sorted(new, key=_first_index)]
 
 
 def _first_index(res: ChunkResult) -> int:

@@ -136,6 +136,9 @@ def run(args: argparse.Namespace) -> int:
 
     def progress(done: int, total: int) -> None:
         if bar is not None:
+            if total != bar.total:  # (the adaptive anchors' later passes add cases)
+                bar.total = total
+                bar.refresh()
             bar.update(done - bar.n)
 
     try:

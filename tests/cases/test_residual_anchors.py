@@ -253,11 +253,20 @@ def test_adaptive_set_is_the_same_whatever_the_executor_and_chunking():
 
     rows = _rows(hs=WIDE, tps=(10.0,))
     one = _run(_wire(), rows)
+    calls: list[tuple[int, int]] = []
     with ThreadPoolExecutor(max_workers=1) as pool:
-        many = _run(_wire(), rows, executor=pool, chunk_size=3)
+        many = _run(
+            _wire(), rows, executor=pool, chunk_size=3, progress=lambda d, t: calls.append((d, t))
+        )
     for e in ("end_a", "end_b"):
         assert np.array_equal(one.stats["wire"][e], many.stats["wire"][e])
     assert np.array_equal(one.damage_rate_ends["wire"], many.damage_rate_ends["wire"])
+    # progress: the first pass reaches the diagram's size, the later passes add their
+    # cases to the total as they start and count them as they finish
+    n = len(rows)
+    assert (n, n) in calls and calls[-1][0] == calls[-1][1] > n
+    assert all(a[0] <= b[0] and a[1] <= b[1] for a, b in zip(calls, calls[1:]))
+    assert all(d <= t for d, t in calls)
 
 
 def _example(name: str, **linearization) -> dict:
