@@ -135,6 +135,7 @@ class ChunkResult:
     linear: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
     exact: np.ndarray | None = None
     starts: tuple[dict[str, np.ndarray] | None, ...] = ()
+    linear_along: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
 
 
 def prepare_worker() -> None:
@@ -327,6 +328,8 @@ def solve_chunk(
         spectra: dict[str, list[np.ndarray]] = {ln: [] for ln in fatigue}
         have: dict[str, list[int]] = {ln: [] for ln in fatigue}
         corrected: dict[str, dict[int, list]] = {ln: {} for ln in fatigue}
+        along: dict[str, dict[int, tuple]] = {ln: {} for ln in fatigue}
+        linear_along = {ln: np.full((k, n), np.nan) for ln, n in lines.items() if ln in fatigue}
         s_el: dict[str, np.ndarray] = {}
         omega = None
         rows = []
@@ -367,6 +370,8 @@ def solve_chunk(
                     ends = np.stack([lr.end_tension_spectrum(e) for e in ENDS])
                     if lr.corrected_spectra is not None:  # the ends' on their own grid
                         corrected[name][j] = [lr.end_tension_density(e) for e in ENDS]
+                    if lr.along_line is not None and lr.along_line.computed:
+                        along[name][j] = _along_densities(lr)
                     spectra[name].append(np.concatenate([ends, lr.tension_spectrum]))
                     have[name].append(j)
         for name, settings in fatigue.items():
@@ -380,6 +385,11 @@ def solve_chunk(
                     for j in have[name]:
                         rows[j] = replace(rows[j], warnings=(*rows[j].warnings, strum[1]))
                 linear[name][have[name], :, 3] = damage[name][have[name], :2]
+                linear_along[name][have[name]] = damage[name][have[name], 2:]
+                for j, (om, dens) in along[name].items():  # the elements' corrected spectra
+                    damage[name][j, 2:] = damage_rate(om, dens * factor**2, curve, settings.method)
+                    if strum is not None:
+                        damage[name][j, 2:] += strum[0][2:]
                 for j, ends_c in corrected[name].items():
                     damage[name][j, :2] = [
                         damage_rate(om, d * factor**2, curve, settings.method) for om, d in ends_c
@@ -387,7 +397,19 @@ def solve_chunk(
                     if strum is not None:
                         damage[name][j, :2] += strum[0][:2]
     idx = np.array([c[0] for c in cases], dtype=int)
-    return ChunkResult(idx, tuple(rows), stats, damage, s_el, linear, exact, tuple(kept))
+    return ChunkResult(
+        idx, tuple(rows), stats, damage, s_el, linear, exact, tuple(kept), linear_along
+    )
+
+
+def _along_densities(lr: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The element tensions' spectral densities with the residuals (their
+    :class:`~stochcable.dynamics.residuals.along_line.AlongLineResidual` lines on the
+    analysis grid extended as the ends', the same grid for every element), stacked
+    (n_el, n): the along-line damage of a case that computed them."""
+    lin = lr.tension_spectrum
+    parts = [lr.along_line.density(e, lr.omega, lin[e]) for e in range(lin.shape[0])]
+    return parts[0].omega, np.stack([p.density for p in parts])
 
 
 def without_residuals(engine: Engine) -> Engine:

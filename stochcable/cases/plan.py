@@ -228,8 +228,9 @@ def plan_cases(
             "load-case sets apply "
             + ", ".join(f"analysis.linearization.{k}" for k in asked)
             + " to the end tensions only (their statistics and damage: the corrected "
-            "spectrum); the set's along-line damage is the linear model's, and a line "
-            "on free bodies carries no residual" + interp,
+            "spectrum), and to the along-line damage where the analysis computes them "
+            "along the line (the elements' corrected spectra); a line on free bodies "
+            "carries no residual" + interp,
             PhysicsWarning,
         )
     chunks = tuple(

@@ -37,8 +37,11 @@ diagram, but up to 4.2 % on σ and a factor 2.8 on end damage on the taut wire a
 Tp 10 s.  ``residual_tolerance=None`` without a span computes every case, as does a
 plan by default (the service's batch jobs, one pass).
 
-The along-line damage is the linear model's in every mode (the residuals act on the
-end tensions).
+The along-line damage of a case that computes the residuals is that of the element
+tensions' corrected spectra (where the analysis computes them along the line); the
+other cases' is interpolated per element as the ends' (:func:`interpolate_along`; the
+checks test the ends only: 4.1e-3 from every case computed on the taut wire's hardest
+column, where the linear model's missed by 85 %).
 """
 
 from __future__ import annotations
@@ -60,6 +63,7 @@ __all__ = [
     "residual_anchors",
     "first_anchors",
     "next_anchors",
+    "interpolate_along",
     "interpolate_corrections",
 ]
 
@@ -310,6 +314,44 @@ def interpolate_corrections(
                 if name in damage_ends and np.all(np.isfinite(lin[a, e, 3])):
                     ratio = _ratios(damage_ends[name][a, e], lin[a, e, 3])
                     damage_ends[name][i, e] = lin[i, e, 3] * correction(hs[i], hs[a], ratio, law)
+
+
+def interpolate_along(
+    states: tuple[SeaState, ...],
+    exact: np.ndarray,
+    rows: list[Any],
+    damage: dict[str, np.ndarray],
+    linear_along: dict[str, np.ndarray],
+    law: str = "hs2",
+) -> None:
+    """The along-line damage rates of the cases whose residuals were not computed, in
+    place: per element, the linear damage times the ratio corrected/linear of the
+    anchors of its column interpolated as :func:`interpolate_corrections` does the
+    ends' (``damage[line]`` (n, 2 + n_el): the element columns; ``linear_along``
+    (n, n_el) the linear model's along-line damage, NaN where not formed).  Anchors
+    without along-line residuals (``along_line`` not computed: the ratio 1) leave the
+    linear damage."""
+    todo = np.flatnonzero(~np.asarray(exact, dtype=bool))
+    if todo.size == 0:
+        return
+    key = _columns(states)
+    columns: dict[tuple[float, float], list[int]] = defaultdict(list)
+    for i in range(len(states)):
+        if exact[i] and rows[i].has_numbers:
+            columns[key[i]].append(i)
+    hs = np.array([s.hs for s in states])
+    for name, lin in linear_along.items():
+        d = damage[name][:, 2:]
+        for i in todo:
+            anchors = columns.get(key[i], [])
+            if not anchors or not np.all(np.isfinite(lin[i])):
+                continue
+            _, first = np.unique(hs[anchors], return_index=True)
+            a = np.asarray(anchors)[first]
+            if not np.all(np.isfinite(lin[a])):
+                continue
+            ratio = _ratios(d[a], lin[a])  # (n_anchors, n_el)
+            d[i] = lin[i] * [correction(hs[i], hs[a], ratio[:, k], law) for k in range(d.shape[1])]
 
 
 def correction(hs: float, anchors: np.ndarray, ratios: np.ndarray, law: str = "power") -> float:

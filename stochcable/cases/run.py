@@ -26,6 +26,7 @@ from stochcable.cases.fatigue_settings import LineFatigue
 from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
 from stochcable.cases.residual_anchors import (
     RESIDUAL_TOLERANCE,
+    interpolate_along,
     interpolate_corrections,
     next_anchors,
 )
@@ -329,6 +330,7 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     # the residuals' corrections of the cases that did not compute them
     law = "hs2" if plan.residual_tolerance is None else "power"
     interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear, law)
+    interpolate_along(scatter.states, m.exact, rows, damage, m.linear_along, law)
     s_el = m.s_el
     d_along = {ln: damage[ln][:, 2:] for ln in names}
     p = np.array([s.probability for s in scatter.states])
@@ -361,6 +363,7 @@ class _Merged:
     linear: dict[str, np.ndarray]
     exact: np.ndarray
     s_el: dict[str, np.ndarray]
+    linear_along: dict[str, np.ndarray]
 
 
 def _merge(plan: CasePlan, results: list[ChunkResult]) -> _Merged:
@@ -377,6 +380,7 @@ def _merge(plan: CasePlan, results: list[ChunkResult]) -> _Merged:
     s_el: dict[str, np.ndarray] = {}
     linear = {ln: np.full((n, 2, 4), np.nan) for ln in names}
     exact = np.ones(n, dtype=bool)
+    along = {ln: np.full((n, n_el[ln]), np.nan) for ln in names}
     for res in results:
         for j, i in enumerate(res.indices):
             rows[i] = res.rows[j]
@@ -386,12 +390,14 @@ def _merge(plan: CasePlan, results: list[ChunkResult]) -> _Merged:
             damage[ln][res.indices] = res.damage[ln]
             if ln in res.linear:
                 linear[ln][res.indices] = res.linear[ln]
+            if ln in res.linear_along:
+                along[ln][res.indices] = res.linear_along[ln]
         if res.exact is not None:
             exact[res.indices] = res.exact
         for ln, s in res.s_elements.items():
             s_el.setdefault(ln, s)
     d_ends = {ln: damage[ln][:, :2] for ln in names}
-    return _Merged(names, rows, stats, damage, d_ends, linear, exact, s_el)
+    return _Merged(names, rows, stats, damage, d_ends, linear, exact, s_el, along)
 
 
 def _line_totals(
