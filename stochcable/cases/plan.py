@@ -229,8 +229,8 @@ def plan_cases(
             + ", ".join(f"analysis.linearization.{k}" for k in asked)
             + " to the end tensions only (their statistics and damage: the corrected "
             "spectrum), and to the along-line damage where the analysis computes them "
-            "along the line (the elements' corrected spectra); a line on free bodies "
-            "carries no residual" + interp,
+            "along the line (the elements' corrected spectra), lines on free bodies "
+            "included" + interp,
             PhysicsWarning,
         )
     chunks = tuple(

@@ -371,3 +371,31 @@ def test_along_line_damage_of_a_computed_case_is_analyze_corrected_one():
     along = got.damage_rate_along["wire"][2]
     assert np.max(np.abs(ref / lin - 1)) > 0.05  # the correction is there to see
     np.testing.assert_allclose(along, ref, rtol=1e-9)
+
+
+def test_a_line_on_a_free_body_carries_the_residuals_in_a_set():
+    """Tuah's disc buoy on one leg: a set computing every case gives the corrected end
+    σ of analyze() of its first sea (the same engine, both from rest: to 1e-12), not
+    the linear one (+3.9 % here), and its along-line damage from corrected spectra."""
+    from stochcable.analysis import analyze
+    from stochcable.cases.chunk import case_sea
+
+    doc = _example("tuah_1982_disc_buoy_single_leg")
+    rows = [{"hs": h, "tp": 8.0, "heading": 0.0, "probability": 0.5} for h in (1.0, 2.0)]
+    fat = LineFatigue("api-studless", mbs=2000.0)  # (lbf: the scene's force unit)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        got = run_cases(doc, scatter_from_rows(rows), fatigue=fat, residual_tolerance=None)
+        off = _example("tuah_1982_disc_buoy_single_leg")
+        off["analysis"]["linearization"].update(drag_residual=False, geometric_residual=False)
+        lin = run_cases(off, scatter_from_rows(rows), fatigue=fat)
+        from stochcable.scene.model import load_scene
+
+        scene = load_scene(doc)
+        sea = case_sea(scene, got.scatter.states[0], "jonswap")
+        ref = analyze(scene.model_copy(update={"sea": sea})).lines["leg"]
+    assert ref.linear is not None
+    sigma = got.stats["leg"]["end_b"][0, 1]
+    assert sigma == pytest.approx(ref.end_b.std, rel=1e-12)
+    assert abs(ref.end_b.std / ref.linear["end_b"].std - 1) > 0.01
+    assert np.all(got.damage_rate_along["leg"][0] > 1.01 * lin.damage_rate_along["leg"][0])
