@@ -195,7 +195,7 @@ WARNINGS: tuple[WarningEntry, ...] = (
         ("stochcable.dynamics.residuals.corrected:RESIDUAL_VARIANCE_LIMIT",),
     ),
     WarningEntry(
-        "Residuals applied to a load-case set's end tensions only",
+        "How a load-case set applies the residuals",
         "PhysicsWarning",
         ("stochcable.cases.plan:plan_cases", "stochcable.client_batches:submit_batch"),
         "the set's scene sets ``analysis.linearization.drag_residual`` or "

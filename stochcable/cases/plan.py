@@ -227,10 +227,10 @@ def plan_cases(
         warn(
             "load-case sets apply "
             + ", ".join(f"analysis.linearization.{k}" for k in asked)
-            + " to the end tensions only (their statistics and damage: the corrected "
-            "spectrum), and to the along-line damage where the analysis computes them "
+            + " to the end tensions (their statistics and damage: the corrected "
+            "spectrum) and to the along-line damage where the analysis computes them "
             "along the line (the elements' corrected spectra), lines on free bodies "
-            "included" + interp,
+            "included; a set reports no node motions" + interp,
             PhysicsWarning,
         )
     chunks = tuple(

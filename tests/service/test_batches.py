@@ -206,7 +206,7 @@ def test_failing_cases_are_rows_not_a_lost_batch(service):
 
 
 def test_planning_warnings_are_in_the_status(service, finished):
-    # a residual the set applies to the end tensions only is said in the 202 and in
+    # how a set applies the residuals is said in the 202 and in
     # every later status (stored with the job); the plain set has none
     scene = copy.deepcopy(CHAIN)
     scene["analysis"]["linearization"] = {"drag_residual": True, "geometric_residual": False}
@@ -214,12 +214,12 @@ def test_planning_warnings_are_in_the_status(service, finished):
     resp = service.post("/v1/batches", json={"scene": scene, "scatter": one})
     assert resp.status_code == 202, resp.text
     (msg,) = resp.json()["warnings"]
-    assert "analysis.linearization.drag_residual to the end tensions only" in msg
+    assert "analysis.linearization.drag_residual to the end tensions (" in msg
     assert _wait(service, resp.json()["id"])["warnings"] == [msg]
     assert finished["warnings"] == []
     client = Client("http://testserver")
     client._http = service  # the Python client issues them as the library does
-    with pytest.warns(PhysicsWarning, match="drag_residual to the end tensions only"):
+    with pytest.warns(PhysicsWarning, match="drag_residual to the end tensions"):
         job = client.submit_batch(scene, one)
     assert job.warnings == [msg]
     client.wait(job, timeout=120)
