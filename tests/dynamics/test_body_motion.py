@@ -132,3 +132,19 @@ def test_several_legs_and_prescribed_bodies_stay_linear(example):
         res = analyze(doc)
     for b in res.bodies.values():
         assert b.motion_linear is None
+
+
+def test_dataset_carries_the_linear_body_sigma():
+    """The xarray view: body_motion_std_linear beside body_motion_std (the document's
+    std_linear)."""
+    pytest.importorskip("xarray")
+    from stochcable.results.datasets import dataset_from_result
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = analyze(_disc(True))
+    ds = dataset_from_result(res)
+    body = next(iter(res.bodies.values()))
+    got = float(ds["body_motion_std_linear"].sel(body=body.name, dof="surge"))
+    assert got == body.motion_linear["surge"].std
+    assert float(ds["body_motion_std"].sel(body=body.name, dof="surge")) == body.motion["surge"].std
