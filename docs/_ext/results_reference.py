@@ -398,6 +398,12 @@ _BODIES = {
         "static pose.",
     ),
     "bodies.<body>.motion.<dof>.std_deg": ("deg", "σ of a rotation in degrees."),
+    "bodies.<body>.motion.<dof>.std_linear": (
+        "U",
+        "A free body whose motion carries its line's residuals (a group of one line with "
+        "them, docs/BODIES.md): σ of the linear model; the other statistics are then the "
+        "corrected ones.",
+    ),
     "bodies.<body>.spectra.omega": ("rad/s", "Analysis frequencies."),
     "bodies.<body>.spectra.<dof>": (
         "{L}²·s/rad or rad²·s/rad",

@@ -208,6 +208,13 @@ def _body_parts(doc: Mapping[str, Any], u: dict[str, str]) -> tuple[dict, dict]:
                     data[i, j] = stats[key]
         unit = "s" if key == "tz" else "see dof_units"
         out[f"body_motion_{key}"] = _var(("body", "dof"), data, unit, f"body motion: {long}")
+    lin = [[bodies[n]["motion"].get(d, {}).get("std_linear", np.nan) for d in dofs] for n in names]
+    if not np.all(np.isnan(lin)):  # a body whose motion carries its line's residuals
+        out["body_motion_std_linear"] = _var(
+            ("body", "dof"), np.array(lin, dtype=float), "see dof_units",
+            "body motion: standard deviation of the linear model (NaN where the motion is "
+            "the linear model's)",
+        )  # fmt: skip
     spec = np.full((len(names), len(dofs), len(_doc_omega(doc))), np.nan)
     for i, n in enumerate(names):
         for j, d in enumerate(dofs):

@@ -356,6 +356,10 @@ class BodyResult:
         Linear drag coefficient per direction at the drag point. [N·s/m]
     modes : CoupledModes or None
         Natural modes of the coupled group the body belongs to.
+    motion_linear : dict of str to ResponseStats or None
+        A free body whose motions carry the lines' residuals
+        (:mod:`stochcable.dynamics.residuals.body_motion`): the linear model's
+        statistics per DOF (``motion`` then holds the corrected ones); else None.
     """
 
     name: str
@@ -369,6 +373,7 @@ class BodyResult:
     drag_sigma: np.ndarray | None = None
     drag_coefficient: np.ndarray | None = None
     modes: Any = None
+    motion_linear: dict[str, ResponseStats] | None = None
 
     @property
     def motion_spectrum(self) -> np.ndarray:
@@ -386,6 +391,8 @@ class BodyResult:
         motion = {}
         for k in self.dofs:
             d = self.motion[k].as_dict()
+            if self.motion_linear is not None:
+                d["std_linear"] = self.motion_linear[k].std
             if k in ("roll", "pitch", "yaw"):
                 d["std_deg"] = math.degrees(d["std"])
             motion[k] = d

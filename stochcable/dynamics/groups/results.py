@@ -23,8 +23,14 @@ from stochcable.dynamics.groups.modes import (
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.outputs.resolution import LineModes
+from stochcable.dynamics.residuals.body_motion import (
+    BodyCoupledInfluence,
+    body_motion_parts,
+    body_rows,
+)
 from stochcable.dynamics.residuals.body_residual import coupled_influences
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
+from stochcable.results.records import stats_from_moments
 from stochcable.scene.model import AnalysisSettings
 from stochcable.scene.residual_kinds import asked_residuals
 
@@ -85,8 +91,31 @@ def coupled_results(
         if asked_residuals(settings.linearization)
         else {}
     )
+    ch = tuple(lines[0].channels if channels is None else channels)
+    spectra = np.stack([c.spectrum for c in ch])
+    w = ch[0].omega
+    rows = body_rows(bodies)
+    transfer = np.concatenate(
+        [np.transpose(linearization.body_motion[b.name], (2, 1, 0)) for b in bodies], axis=1
+    ) if bodies else np.zeros((len(ch), 0, w.size))  # fmt: skip
+    # the bodies' residual lines by line (a group of one line with residuals only: the
+    # cross terms between lines' residual loads, which the end tensions take from
+    # body_residual's joint sums, are not formed for the body DOFs; summing the lines'
+    # variances would lose the cancellation of symmetric legs, e.g. a three-leg buoy's
+    # linear sway 0 would read 1.5 ft)
+    by_line: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     out_lines = {}
     for cl in lines:
+
+        def collect(applied, taps, cl=cl):  # noqa: ANN001, ANN202
+            lin = linearization.lines[cl.name]
+            by_line[cl.name] = list(
+                body_motion_parts(
+                    cl.system, lin.damping, applied, taps,
+                    BodyCoupledInfluence(influence[cl.name]), transfer, spectra,
+                )
+            )  # fmt: skip
+
         out_lines[cl.name] = line_result(
             cl.system,
             cl.channels,
@@ -95,10 +124,9 @@ def coupled_results(
             counted.get(cl.name),
             alone=False,
             influence=influence.get(cl.name),
+            on_residuals=collect if cl.name in influence and bodies else None,
         )
-    ch = tuple(lines[0].channels if channels is None else channels)
-    spectra = np.stack([c.spectrum for c in ch])
-    w = ch[0].omega
+    parts = next(iter(by_line.values())) if len(by_line) == 1 else []
     out_bodies = {}
     for b in bodies:
         h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)
@@ -120,6 +148,7 @@ def coupled_results(
             drag=linearization.body_drag.get(b.name),
             modes=modes,
             prescribed=False,
+            residual=[(om, v[rows[b.name]]) for om, v in parts],
         )
     return out_lines, out_bodies
 
@@ -175,13 +204,29 @@ def body_result(
     drag: np.ndarray | None = None,
     modes: CoupledModes | None = None,
     prescribed: bool = False,
+    residual: Sequence[tuple[np.ndarray, np.ndarray]] = (),
 ) -> BodyResult:
-    """Statistics of a body's motion from its transfer functions (see BodyResult)."""
+    """Statistics of a body's motion from its transfer functions (see BodyResult);
+    ``residual``: the residuals' variance lines of its DOFs, parts (frequencies
+    [rad/s] (n,), variance (d, n) [m², rad²]) added to the spectral moments
+    (:mod:`stochcable.dynamics.residuals.body_motion`; a DOF whose total variance
+    would not be positive keeps its linear statistics)."""
     dens = np.einsum("cdw,cw->dw", np.abs(transfer) ** 2, spectra)
     stats = {
         dof: stats_from_spectrum(omega, dens[i], float(mean[i]), duration)
         for i, dof in enumerate(dofs)
     }
+    linear = None
+    if len(residual):
+        linear = stats
+        stats = dict(stats)
+        for i, dof in enumerate(dofs):
+            lin = linear[dof]
+            m = np.array([lin.m0, lin.m1, lin.m2, lin.m4])
+            for om, v in residual:
+                m = m + np.array([np.sum(v[i] * om**k) for k in (0, 1, 2, 4)])
+            if np.all(m[[0, 2, 3]] > 0.0):
+                stats[dof] = stats_from_moments(tuple(m), float(mean[i]), duration)
     return BodyResult(
         name=name,
         dofs=tuple(dofs),
@@ -190,6 +235,7 @@ def body_result(
         input_spectra=np.asarray(spectra).copy(),
         motion_transfer=transfer,
         motion=stats,
+        motion_linear=linear,
         prescribed=prescribed,
         drag_sigma=None if sigma is None else np.asarray(sigma).copy(),
         drag_coefficient=None if drag is None else np.asarray(drag).copy(),

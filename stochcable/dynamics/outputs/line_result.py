@@ -17,6 +17,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -124,6 +125,7 @@ def line_result(
     *,
     alone: bool = True,
     influence: CoupledInfluence | None = None,
+    on_residuals: Callable[[Mapping[str, Any], Mapping[str, Any]], None] | None = None,
 ) -> LineResult:
     """Transfer functions, spectra and statistics of one line.
 
@@ -146,6 +148,10 @@ def line_result(
     influence : CoupledInfluence, optional
         A line on free bodies: its end influence through the coupled group
         (:mod:`stochcable.dynamics.residuals.body_residual`).
+    on_residuals : callable, optional
+        Called with the computed residual records and their taps (by kind) when the
+        node motions carry the residuals (the bodies' motions:
+        :mod:`stochcable.dynamics.residuals.body_motion`).
 
     Returns
     -------
@@ -257,6 +263,8 @@ def line_result(
                 else _shared_nodes(shared, system, linearization.damping)
             ),
         )
+        if on_residuals is not None and moves.computed:
+            on_residuals(computed, taps)
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None
     if applied:  # the end statistics and densities with the residuals' spectra

@@ -110,12 +110,21 @@ class ElementCoupledInfluence(CoupledInfluence):
             s[:, free[:, None], free[None, :]], np.broadcast_to(tf.T, (w.size,) + tf.T.shape)
         )  # (n_w, n_free, |att|)
         y = np.zeros((w.size, c.shape[1], 2 * d), dtype=complex)
-        y[:, :, att] = c[:, :, att] @ tf[None] @ xi
+        y[:, :, att] = self.through_bodies(c[:, :, att], tf, xi, free)
         g = held
         g[:, 0] += np.transpose(y[:, :, :d], (1, 2, 0))
         g[:, -1] += np.transpose(y[:, :, d:], (1, 2, 0))
         g[:, 1:-1] -= np.einsum("wei,wnki->enkw", y, x)
         return g
+
+    def through_bodies(
+        self, c: np.ndarray, tf: np.ndarray, xi: np.ndarray, free: np.ndarray
+    ) -> np.ndarray:
+        """The outputs (n_w, n_out, |att|) per unit support force on the attached ends
+        through the bodies: ``c`` (n_w, n_out, |att|) per unit end motion, ``tf`` the
+        rigid links on the free body DOFs ``free`` (group-wide indices), ``xi``
+        (n_w, n_free, |att|) the free DOFs per unit support force."""
+        return c @ tf[None] @ xi
 
     def held(self, w: np.ndarray) -> np.ndarray:
         """The outputs per unit node force with the ends held, (n_out, n_nodes, d, n_w)."""
