@@ -22,6 +22,7 @@ from scipy import stats
 
 import stochcable.dynamics.residuals.drag_residual as dr
 import stochcable.dynamics.residuals.geometric_residual as gr
+import stochcable.dynamics.residuals.influence as influence
 import stochcable.dynamics.residuals.residual_lines as rl
 from stochcable import analyze, load_example
 from stochcable.dynamics.linearization.formulas import mean_abs_gaussian
@@ -212,7 +213,7 @@ def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     """The settings of the evaluation before issue 31."""
     monkeypatch.setattr(rl, "MAX_LINES", 1024)
     monkeypatch.setattr(rl, "LIVE_SHARE", 0.0)  # (the whole analysis grid on the lines)
-    monkeypatch.setattr(rl, "MODAL_INFLUENCE", False)  # (the banded adjoint solve)
+    monkeypatch.setattr(influence, "MODAL_INFLUENCE", False)  # (the banded adjoint solve)
     monkeypatch.setattr(gr, "LINE_STRIDE", 1)  # (its grid: the drag's)
     monkeypatch.setattr(gr, "ELEMENT_FLOOR", 0.0)  # (every element)
     monkeypatch.setattr(dr, "MAX_PANELS", 64)

@@ -218,7 +218,7 @@ def test_planar_line_in_a_3d_model_gives_the_2d_residual(monkeypatch):
     one's static correction differs between the models' mode sets (2-D: 22 of 78
     modes kept, −2.2e-4 of this variance; 3-D: −2.5e-5), tested on its own in
     tests/dynamics/test_residual_lines.py."""
-    import stochcable.dynamics.residuals.residual_lines as rl
+    import stochcable.dynamics.residuals.influence as rl
 
     monkeypatch.setattr(rl, "MODAL_INFLUENCE", False)
     doc = load_example("chain_catenary").model_dump(mode="json")

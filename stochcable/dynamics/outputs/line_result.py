@@ -116,6 +116,28 @@ def _listed_modes(omega_n: np.ndarray, w_top: float) -> int:
     return int(max(np.count_nonzero(wn <= 2.5 * w_top), min(10, wn.size)))
 
 
+#: Why a travelling line or a line with a steady lift on free bodies has no residuals.
+NOT_ON_BODIES = (
+    "a travelling line or a line with a steady lift on free bodies is not covered (the "
+    "coupled influence leaves out the transport and lift terms)"
+)
+
+
+def _shared_influence(
+    system: LineSystem, damping: Any, influence: CoupledInfluence | None, alone: bool
+) -> Any:
+    """The residual kinds' shared influence: one solve for both kinds; a planar line
+    alone with the element tensions' and node motions' station rows in the same
+    factorization; a line on bodies through the coupled group (``influence``)."""
+    if influence is not None:
+        return influence
+    model = system.model
+    if alone and model.dim == 2:
+        more = node_rows(model, motion_stations(model))
+        return end_station_influence(system, damping, more=more)
+    return EndInfluence(system, damping)
+
+
 def line_result(
     system: LineSystem,
     channels: tuple[Channel, ...],
@@ -209,17 +231,7 @@ def line_result(
     end_force = _end_force_transfer(model, resp, n_ch)
     residual = {}
     std = {e: stats[e].std for e in stats}
-    # (one solve for both; a line on bodies: through the coupled group)
-    # (a line alone: the element tensions' station rows in the same factorization)
-    shared = (
-        end_station_influence(
-            system, linearization.damping, more=node_rows(model, motion_stations(model))
-        )
-        if influence is None and alone and model.dim == 2
-        else EndInfluence(system, linearization.damping)
-        if influence is None
-        else influence
-    )
+    shared = _shared_influence(system, linearization.damping, influence, alone)
     taps = {}  # (each kind's loads and load cross-spectra, for the element tensions)
     for kind, fn in (
         residual_parts(settings.linearization) if linearization.record is not None else ()
@@ -228,11 +240,7 @@ def line_result(
             residual[kind.name] = (
                 fn(system, channels, linearization, std, influence=shared)
                 if alone or influence is not None
-                else ResidualRecord.not_computed(
-                    "a travelling line or a line with a steady lift on free bodies is not "
-                    "covered (the coupled influence leaves out the transport and lift terms)",
-                    std,
-                )
+                else ResidualRecord.not_computed(NOT_ON_BODIES, std)
             )
     residual = residuals_in_range(system.name, residual, std)
     applied = [r for r in residual.values() if r.computed]

@@ -52,6 +52,7 @@ from stochcable.dynamics.residuals.along_line_3d import (
 from stochcable.dynamics.residuals.corrected_spectrum import CorrectedSpectrum, corrected_spectrum
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
+from stochcable.dynamics.residuals.influence import element_rows, geometric_feedthrough
 from stochcable.dynamics.residuals.residual_lines import (
     RESIDUAL_TAP,
     EndInfluence,
@@ -62,7 +63,6 @@ from stochcable.dynamics.residuals.residual_lines import (
     shared_rows,
 )
 from stochcable.dynamics.solve.line_loads import drag_blocks
-from stochcable.line.fem import SLACK_EA_RATIO
 
 __all__ = [
     "AlongLineResidual",
@@ -173,17 +173,6 @@ def residual_tap() -> Iterator[ResidualTap]:
         yield tap
     finally:
         RESIDUAL_TAP.reset(token)
-
-
-def element_rows(model: Any) -> np.ndarray:
-    """The element tension rows (n_el, 2, d): δT_e = rows[e, 0]·u_e + rows[e, 1]·u_{e+1}
-    (as :func:`stochcable.dynamics.outputs.line_result.element_tension_transfer`). [N/m]"""
-    rows = model.tension_rows
-    if rows is None:
-        ea = np.where(model.slack, SLACK_EA_RATIO * model.mesh.ea, model.mesh.ea)
-        t = model.tangents * (ea / model.l0)[:, None]
-        rows = np.stack([-t, t], axis=1)
-    return np.asarray(rows, dtype=float)
 
 
 def element_rhs(model: Any, elements: np.ndarray | None = None) -> np.ndarray:
@@ -351,25 +340,6 @@ def dense_outputs(
     for g, e, f in blocks:  # each pair once (pair_outputs' callers: f ≥ e, or (i, j) blocks)
         g_all[:, e * n + f] += g[:, :n_o].T
     return dense_pair_outputs(g_all, transfer)
-
-
-def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
-    """Each element tension per unit of the geometric residual's components (its
-    :func:`load_transfer` columns, component-major: ½|b_e|² first), shape (n_el, n_all).
-    [N/m]
-
-    To second order the stretch of element e is a + |b|²/(2l) (|ℓ| = |l·t + Δu|, Δu =
-    a·t + b): the linear model's tension (EA/L₀)·a (the rows of
-    :func:`element_rows`) misses (EA/L₀)·½|b|²/l, the element's own share of the
-    quadratic force κ·½|b|² it applies as a node pair (the pair's response through
-    the line, r_e·A⁻¹F, is the rest).  The products a·b_k do not stretch it."""
-    rows = element_rows(system.model)
-    n_el = rows.shape[0]
-    length = np.linalg.norm(np.diff(np.asarray(system.positions, dtype=float), axis=0), axis=1)
-    out = np.zeros((n_el, n_all))
-    el = np.arange(n_el)
-    out[el, el] = -np.linalg.norm(rows[:, 1], axis=1) / length
-    return out
 
 
 def top_line(record: Any, floor: float = LINE_FLOOR) -> int | None:

@@ -19,28 +19,26 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.model.blocks import (
-    add_blocks,
-    block_matvec,
-    free_band,
-    line_prep,
-    real_gemm,
-    trapezoid_weights,
+from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals import influence as _influence
+from stochcable.dynamics.residuals.influence import (
+    BAND_STACK_BYTES,
+    MODAL_SHARE,
+    MODAL_SPAN,
+    EndInfluence,
+    SharedRows,
+    band_stack,
+    element_directions,
+    end_influence,
+    modal_influence,
+    shared_rows,
 )
-from stochcable.dynamics.model.lift import lift_band, lift_pattern
-from stochcable.dynamics.model.modal_solvers import foss_modes
-from stochcable.dynamics.model.solvers import solve_band_stacked
-from stochcable.dynamics.model.transport import gyro_band
-from stochcable.dynamics.solve.line_loads import drag_blocks
-from stochcable.dynamics.solve.line_solve import end_tension_from_support
-from stochcable.errors import SolverError
 from stochcable.results.records import ResidualRecord
 
 __all__ = [
     "BAND_STACK_BYTES",
     "LIVE_SHARE",
     "MAX_LINES",
-    "MODAL_INFLUENCE",
     "MODAL_SHARE",
     "MODAL_SPAN",
     "PAIR_BLOCK_BYTES",
@@ -79,34 +77,6 @@ PAIR_BLOCK_BYTES = 2**19
 #: ``loads(unit, w, h)`` :func:`load_transfer` and ``lines(g, transfer, e, f)``
 #: :func:`pair_outputs` call with what they are given and return.
 RESIDUAL_TAP: ContextVar[Any] = ContextVar("residual_tap", default=None)
-#: The shared end influence (:class:`EndInfluence`) taken through the linear solve's
-#: modal basis where the line is solved that way (:func:`modal_influence`), not by a
-#: banded solve per frequency (:func:`end_influence`). [-]
-MODAL_INFLUENCE = True
-#: The modes :func:`modal_influence` keeps: the linear solve's and every computed mode
-#: up to this multiple of the highest residual line (the rest by their static
-#: correction, whose error grows as (ω/ω_n)²). [-]
-MODAL_SPAN = 4.0
-#: :func:`modal_influence` is used where it keeps at most this share of the line's
-#: free DOFs as modes (its cost grows with their cube: the taut wire's 38 of 38 cost
-#: more than its banded solve, 6.6 against 5.3 ms; the chain's 23 of 78: 2.3 against
-#: 6.9 ms). [-]
-MODAL_SHARE = 0.4
-#: Memory of one stack of frequencies of the banded solves of :func:`end_influence`
-#: (:func:`band_stack`): a stack of many frequencies and right-hand sides outgrows the
-#: cache (the deep wire's 2 + 23 rows on 189 lines: 5.9 ms in stacks of 16–32, 11 ms
-#: in stacks of 128; its 2 end rows alone: 1.6 ms in stacks of 64–128, 1.8 in 16). [bytes]
-BAND_STACK_BYTES = 640 * 2**10
-
-
-def band_stack(n_dof: int, d: int, r: int) -> int:
-    """Frequencies per stacked banded solve of ``n_dof`` unknowns (blocks of ``d``) and
-    ``r`` right-hand sides: its band storage and right-hand sides within
-    :data:`BAND_STACK_BYTES` (at least 4)."""
-    per = 16 * n_dof * (3 * (2 * d - 1) + 1 + r)
-    return max(4, int(BAND_STACK_BYTES // per))
-
-
 #: Share of each channel's variance in the upper tail of the analysis grid left off the
 #: uniform grid, whose lines then span the frequencies that carry the inputs (a log
 #: grid to 100 rad/s put a sea's band on two lines: the chain's drag residual read 43 %
@@ -334,7 +304,7 @@ def load_transfer(
     by the residuals of one line), shape (2, n_load, n_w) (n_out rows for an
     ``influence`` of other outputs). [N/unit]"""
     if influence is None:
-        g = modal_influence(system, damping, w) if MODAL_INFLUENCE else None
+        g = modal_influence(system, damping, w) if _influence.MODAL_INFLUENCE else None
         g = end_influence(system, damping, w) if g is None else g
     else:
         g = influence.on(w)
@@ -347,358 +317,6 @@ def load_transfer(
     if (tap := RESIDUAL_TAP.get()) is not None:
         tap.loads(unit, w, h)
     return h
-
-
-class EndInfluence:
-    """The end influence (:func:`end_influence`) of one line and drag, kept for the
-    frequencies asked: a later request for some of them (the geometric residual's
-    lines, every second of the drag residual's) is taken from it.
-
-    ``extra`` (optional, ((n_nodes − 2)·d, k)): more adjoint right-hand sides (the
-    element tensions' rows of :mod:`.along_line`), their rows kept beside the ends'
-    (:meth:`extra_on`): through the modal basis both at once (:func:`modal_influence`);
-    by the banded solve the end rows alone first (on all the residual's lines) and the
-    extra rows where asked (the lines they are formed on), each with both sets in one
-    factorization."""
-
-    def __init__(self, system: Any, damping: Any, extra: np.ndarray | None = None) -> None:
-        self.system = system
-        self.damping = damping
-        self.extra = extra
-        self._kept: list[tuple[np.ndarray, np.ndarray]] = []  # (the end rows)
-        self._kept_x: list[tuple[np.ndarray, np.ndarray]] = []  # (the extra rows)
-        self._modal = MODAL_INFLUENCE
-
-    @staticmethod
-    def _find(kept: list, w: np.ndarray) -> np.ndarray | None:
-        for om, g in kept if w.size else ():
-            at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
-            near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
-            if np.allclose(om[near], w, rtol=1e-12, atol=0.0):
-                step = near[1] - near[0] if near.size > 1 else 1
-                if step > 0 and np.array_equal(near, near[0] + step * np.arange(near.size)):
-                    return g[..., near[0] : near[-1] + 1 : step]  # (a view: every step-th line)
-                return g[..., near]
-        return None
-
-    def _solve(self, w: np.ndarray, extra: bool) -> None:
-        g = modal_influence(self.system, self.damping, w, self.extra) if self._modal else None
-        if g is None:
-            self._modal = False
-            g = end_influence(self.system, self.damping, w, self.extra if extra else None)
-        self._kept.append((w.copy(), g[:2]))
-        if g.shape[0] > 2:
-            self._kept_x.append((w.copy(), g[2:]))
-
-    def on(self, w: np.ndarray) -> np.ndarray:
-        """The influence on ``w``, shape (2, n_nodes, d, n_w). [N/N]"""
-        w = np.asarray(w, dtype=float)
-        g = self._find(self._kept, w)
-        if g is None:
-            self._solve(w, extra=False)
-            g = self._kept[-1][1]
-        return g
-
-    def extra_on(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray:
-        """The ``extra`` rows ``cols`` on ``w``, shape (k, n_nodes, d, n_w). [N/N]"""
-        w = np.asarray(w, dtype=float)
-        g = self._find(self._kept_x, w)
-        if g is None:
-            self._solve(w, extra=True)
-            g = self._kept_x[-1][1]
-        return g[cols]
-
-    def extra_kept(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray | None:
-        """The ``extra`` rows ``cols`` on ``w`` where they are kept, or solved by the
-        modal basis (no factorization); None otherwise (the caller's own solve of its
-        rows: a banded solve of all the rows where one set is asked, e.g. at a set's
-        cells, costs the others' right-hand sides for nothing). [N/N]"""
-        w = np.asarray(w, dtype=float)
-        g = self._find(self._kept_x, w)
-        if g is None and self._modal:
-            return self.extra_on(w, cols)
-        return None if g is None else g[cols]
-
-
-class SharedRows:
-    """Rows ``cols`` of a shared :class:`EndInfluence`'s ``extra`` rows as an
-    ``influence`` of :func:`load_transfer` (``on(w)``): the element tensions' and the
-    node motions' stations solved with the end rows (:mod:`.along_line`,
-    :mod:`.along_line_motion`)."""
-
-    def __init__(self, shared: EndInfluence, cols: slice) -> None:
-        self.shared = shared
-        self.cols = cols
-        self.elements: np.ndarray | None = None  # (the element tensions' stations, if so)
-        self._own: list[tuple[np.ndarray, np.ndarray]] = []
-
-    def on(self, w: np.ndarray) -> np.ndarray:
-        """The rows on ``w``, shape (k, n_nodes, d, n_w): the shared ones where kept
-        (or modal), else these rows alone by the banded solve (kept here)."""
-        w = np.asarray(w, dtype=float)
-        g = self.shared.extra_kept(w, self.cols)
-        if g is not None:
-            return g
-        g = EndInfluence._find(self._own, w)
-        if g is None:
-            sh = self.shared
-            g = end_influence(sh.system, sh.damping, w, sh.extra[:, self.cols])[2:]
-            self._own.append((w.copy(), g))
-        return g
-
-
-def shared_rows(shared: Any, rhs: np.ndarray, start: int) -> SharedRows | None:
-    """The :class:`SharedRows` of ``shared`` whose ``extra`` columns from ``start`` are
-    ``rhs`` ((n_nodes − 2)·d, k), None where they are not (or ``shared`` has none)."""
-    extra = getattr(shared, "extra", None)
-    cols = slice(start, start + rhs.shape[1])
-    if extra is None or extra.shape[1] < cols.stop or not np.array_equal(extra[:, cols], rhs):
-        return None
-    return SharedRows(shared, cols)
-
-
-def end_influence(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None = None
-) -> np.ndarray:
-    """End tensions (end_a, end_b) per unit force on each node and component, ends
-    prescribed, the line's linear system with ``damping``: shape (2, n_nodes, d, n_w).
-    [N/N]
-
-    ``extra`` ((n_nodes − 2)·d, k), optional: more adjoint right-hand sides r (constant
-    in ω, on the free nodes), solved in the same factorization: rows 2 … 2 + k − 1 of
-    the result are (A⁻ᵀr)ᵀ on the free nodes and zero on the end nodes (the outputs r·u
-    per unit node force: the element tensions of :mod:`.along_line`).
-
-    By the adjoint: with the ends held, T = ê·F_end − ê·Z_end,f u_f and u_f = A⁻¹F_f,
-    A = Z_ff = K − ω²M + iωC the free–free impedance; A is symmetric (not Hermitian),
-    so T = ê·F_end − (A⁻¹g)ᵀF_f, g = Z_f,end ê: two solves per frequency (one
-    factorization) whatever the number of load cases.  A travelling line's A has the
-    skew G (:mod:`stochcable.dynamics.model.transport`), a line with a steady lift the
-    non-symmetric C_L (:mod:`stochcable.dynamics.model.lift`): then Aᵀ (C − G + C_Lᵀ) is
-    solved, with g = Z_end,fᵀ ê."""
-    model = system.model
-    prep = line_prep(system)
-    d = model.dim
-    n = model.n_nodes
-    cd = drag_blocks(system, damping)
-    c = add_blocks(prep.S, cd)
-    b_c = prep.bS + free_band(cd)
-    if system.gyro is not None:  # a travelling line: Aᵀ has C − G (dynamics.model.transport)
-        b_c = b_c - gyro_band(system.gyro, d)
-    lift_t = None if system.lift is None else np.transpose(system.lift, (0, 2, 1))
-    if lift_t is not None:  # a steady lift: Aᵀ has C_Lᵀ (dynamics.model.lift)
-        pat = lift_pattern(model)
-        b_c = b_c + lift_band(lift_t, pat)
-    e_a, e_b = _end_directions(system)
-    k_x = 0 if extra is None else extra.shape[1]
-    out = np.zeros((2 + k_x, n, d, w.size), dtype=complex)
-    out[0, 0] = e_a[:, None]
-    out[1, -1] = e_b[:, None]
-    # the end rows' coupling blocks Z(1, 0) and Z(n − 2, n − 1)
-    g = _end_coupling(system, prep, c, (e_a, e_b), lift_t)  # (3, n_f·d, 2)
-    step = band_stack((n - 2) * d, d, 2 + k_x)
-    for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
-        ws = w[sl]
-        rhs = np.zeros((ws.size, (n - 2) * d, 2 + k_x), dtype=complex)
-        if k_x:
-            rhs[:, :, 2:] = extra
-        rhs[:, :, :2] = (
-            g[0][None] - (ws * ws)[:, None, None] * g[1][None] + (1j * ws)[:, None, None] * g[2]
-        )
-        x = solve_band_stacked(
-            prep.bK, prep.bM, b_c, rhs, ws, 2 * d - 1, 2 * d - 1, (model.K, model.M)
-        )  # (n_w, n_f·d, 2 + k)
-        out[:, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, 2 + k_x), (3, 1, 2, 0))
-        out[:2, 1:-1, :, sl] *= -1.0
-    return out
-
-
-def _end_directions(system: Any) -> tuple[np.ndarray, np.ndarray]:
-    """ê of each end (d,): the end tension of a unit support force along each component."""
-    d = system.model.dim
-    eye = np.eye(2 * d)[None].astype(complex)
-    ten = end_tension_from_support(system, eye)
-    e_hat = [np.real(ten[end][:, 0]) for end in ("end_a", "end_b")]  # (2d,) each
-    return e_hat[0][:d], e_hat[1][d:]
-
-
-def _end_coupling(
-    system: Any, prep: Any, c: Any, e_hat: tuple[np.ndarray, np.ndarray], lift_t: Any
-) -> np.ndarray:
-    """The adjoint right-hand sides of the end rows, g = Z_end,fᵀ ê = g_K − ω²g_M + iωg_C,
-    as (g_K, g_M, g_C) on the free DOFs: shape (3, (n_nodes − 2)·d, 2) (g_C complex
-    where the transport or lift terms enter)."""
-    model = system.model
-    d, n = model.dim, model.n_nodes
-    out = np.zeros((3, (n - 2) * d, 2), dtype=complex)
-    o_first = [blk[1][0] for blk in (prep.K, prep.MT, c)]
-    o_last = [blk[1][-1] for blk in (prep.K, prep.MT, c)]
-    last = slice((n - 3) * d, None)
-    for k, (o, vec, rows, tr) in enumerate(
-        ((o_first, e_hat[0], slice(0, d), False), (o_last, e_hat[1], last, True))
-    ):
-        blocks = [b.T if tr else b for b in o]
-        for j, b in enumerate(blocks):  # (d,) of K, M, C
-            out[j, rows, k] = b @ vec
-        if system.gyro is not None:  # Z_end,fᵀ ê: G[0, 1]ᵀ = g_0 I, G[n−1, n−2]ᵀ = −g I
-            gy = system.gyro[-1 if tr else 0] * (-1.0 if tr else 1.0)
-            out[2, rows, k] += gy * vec
-        if lift_t is not None:  # C_L[0, 1]ᵀ ê_a, C_L[n−1, n−2]ᵀ ê_b
-            cl = lift_pattern(model)[1, 0] * lift_t[-1 if tr else 0] @ vec
-            out[2, rows, k] += cl
-    return out
-
-
-def modal_influence(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None = None
-) -> np.ndarray | None:
-    """:func:`end_influence` through the linear solve's own modal (Foss) basis: the
-    kept modes' complex-mode sum plus the static correction of the truncated ones
-    (Tuah 1982, §5.3), the transfer the linear response itself is solved with, its
-    basis widened to every computed mode up to :data:`MODAL_SPAN` times the highest
-    frequency (:func:`_influence_modes`).  Every right-hand side is a fixed vector or,
-    for the end rows, g_K − ω²g_M + iωg_C (:func:`_end_coupling`), so each is projected
-    once and the frequencies enter through the modal denominators only: no
-    factorization per frequency (the chain's 2 + 7 rows on 189 lines: 2.3 against
-    6.9 ms).  Frequencies above the highest computed mode over :data:`MODAL_SPAN`
-    (where not every mode is computed) by the banded solve; None where the line is not
-    solved that way (the direct solver, a travelling line or a steady lift: Aᵀ ≠ A, a
-    defective Foss pencil): the caller's banded solve then. [N/N]"""
-    if system.solver != "foss" or system.gyro is not None or system.lift is not None:
-        return None
-    w = np.asarray(w, dtype=float)
-    om = np.asarray(system.modes.omega, dtype=float)
-    n_comp = min(system.modes.shapes.shape[1], om.size)
-    nf = (system.model.n_nodes - 2) * system.model.dim
-    limit = np.inf if n_comp >= nf else float(om[n_comp - 1]) / MODAL_SPAN
-    low = w <= limit
-    kept = _influence_modes(system, line_prep(system), float(np.max(w[low], initial=0.0)))
-    if MODAL_SHARE * nf < kept[0].shape[1]:  # (a short line: its banded solve is cheaper)
-        return None
-    if not low.any():
-        return None
-    if low.all():
-        return _modal_rows(system, damping, w, extra)
-    lo = _modal_rows(system, damping, w[low], extra)
-    if lo is None:
-        return None
-    out = np.empty(lo.shape[:-1] + (w.size,), dtype=complex)
-    out[..., low] = lo
-    out[..., ~low] = end_influence(system, damping, w[~low], extra)
-    return out
-
-
-def _modal_rows(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None
-) -> np.ndarray | None:
-    """:func:`modal_influence` on ``w`` (all below its limit); None for a defective
-    Foss pencil."""
-    model = system.model
-    d, n = model.dim, model.n_nodes
-    held = _modal_projection(system, damping, float(w[-1]) if w.size else 0.0, extra)
-    if held is None:
-        return None
-    phi, foss, p, r, (e_a, e_b) = held
-    nf, m = phi.shape
-    k_x = p.shape[1] - 6
-    inv = 1.0 / (1j * w[None, :] - foss.lambdas[:, None])  # (2m, n_w)
-    ww, iw = w * w, 1j * w
-    # the modal coordinates (2m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
-    q = np.empty((2 * m, 2 + k_x, w.size), dtype=complex)
-    q[:, :2] = p[:, 0:2, None] - p[:, 2:4, None] * ww + p[:, 4:6, None] * iw
-    q[:, 2:] = p[:, 6:, None]
-    q *= inv[:, None, :]
-    z = np.ascontiguousarray(foss.chi @ q.reshape(2 * m, -1))  # (m, (2 + k)·n_w)
-    x = real_gemm(phi, z).reshape(nf, 2 + k_x, w.size)
-    if r is not None:  # the truncated modes' static correction, fixed vectors
-        x[:, :2] += r[:, 0:2, None] - r[:, 2:4, None] * ww + r[:, 4:6, None] * iw
-        x[:, 2:] += r[:, 6:, None]
-    out = np.zeros((2 + k_x, n, d, w.size), dtype=complex)
-    out[0, 0] = e_a[:, None]
-    out[1, -1] = e_b[:, None]
-    out[:, 1:-1] = np.transpose(x.reshape(n - 2, d, 2 + k_x, w.size), (2, 0, 1, 3))
-    return out
-
-
-def _modal_projection(
-    system: Any, damping: Any, w_top: float, extra: np.ndarray | None
-) -> tuple | None:
-    """The frequency-independent part of :func:`_modal_rows`, kept on the line for
-    its later calls with the same ``damping`` and ``extra`` (the cells' and the
-    misfit's frequencies after the lines'): (Φ_f, the Foss modes, the right-hand
-    sides' modal loads p (2m, 6 + k), their static corrections (n_f·d, 6 + k) or None,
-    ê of both ends).  None for a defective Foss pencil."""
-    prep = line_prep(system)
-    phi, mh, kh = _influence_modes(system, prep, w_top)
-    key = ("influence_projection", extra is None)
-    held = prep.cache.get(key)
-    if (
-        held is not None
-        and held[0] is damping
-        and held[1] is extra
-        and held[2][0].shape[1] >= phi.shape[1]
-    ):
-        return held[2]
-    c = add_blocks(prep.S, drag_blocks(system, damping))
-    fk = prep.cache.get("influence_foss")  # (one decomposition for both right-hand sides)
-    if fk is not None and fk[0] is damping and fk[1][0].shape[1] >= phi.shape[1]:
-        (phi, mh, kh), foss = fk[1], fk[2]
-    else:
-        ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
-        try:
-            foss = foss_modes(mh, 0.5 * (ch + ch.T), kh)
-        except SolverError:
-            return None
-        prep.cache["influence_foss"] = (damping, (phi, mh, kh), foss)
-    e_a, e_b = _end_directions(system)
-    g = _end_coupling(system, prep, c, (e_a, e_b), None)  # (3, n_f·d, 2)
-    k_x = 0 if extra is None else extra.shape[1]
-    cols = np.concatenate([g[0], g[1], g[2]] + ([extra] if k_x else []), axis=1)
-    cols = np.ascontiguousarray(cols, dtype=complex)  # (n_f·d, 6 + k)
-    nf, m = phi.shape
-    sign = np.ones(6 + k_x)
-    sign[:6] = -1.0  # the end rows: T = ê·F_end − (A⁻¹g)ᵀF_f
-    modal = real_gemm(phi.T, cols)
-    p = (foss.weights @ modal) * sign  # (2m, 6 + k)
-    r = None
-    if m < nf:
-        zh = np.linalg.solve(kh, modal.view(float))
-        r = (prep.k_solve(cols) - real_gemm(phi, np.ascontiguousarray(zh).view(complex))) * sign
-    out = (phi, foss, p, r, (e_a, e_b))
-    prep.cache[key] = (damping, extra, out)
-    return out
-
-
-def _influence_modes(
-    system: Any, prep: Any, w_top: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(Φ_f, M̂, K̂) of the modes :func:`modal_influence` keeps: the linear solve's, and
-    every computed mode up to :data:`MODAL_SPAN` times the highest frequency asked."""
-    om = np.asarray(system.modes.omega, dtype=float)
-    m = max(int(system.n_modes), int(np.count_nonzero(om <= MODAL_SPAN * w_top)))
-    m = min(m, system.modes.shapes.shape[1], (system.model.n_nodes - 2) * system.model.dim)
-    key = ("influence_modes", m)
-    if key not in prep.cache:
-        phi = np.ascontiguousarray(system.modes.shapes[system.model.free][:, :m])
-        x = prep.nodes(phi)
-        mh = phi.T @ prep.free_rows(block_matvec(prep.MT, x))
-        kh = phi.T @ prep.free_rows(block_matvec(prep.K, x))
-        prep.cache[key] = (phi, 0.5 * (mh + mh.T), 0.5 * (kh + kh.T))
-    return prep.cache[key]
-
-
-def element_directions(system: Any) -> list[np.ndarray]:
-    """The element tangent and the normals the line's model moves along, each (n_el, 3):
-    (t, n) with n the normal in the plane of a planar model (t × the out-of-plane
-    axis), (t, n₁, n₂) in 3-D."""
-    t, n1, n2 = system.frames
-    comps = list(system.model.components)
-    if len(comps) == 3:
-        return [t, n1, n2]
-    plane = np.zeros(3)
-    plane[[i for i in range(3) if i not in comps][0]] = 1.0
-    normal = np.cross(plane, t)
-    return [t, normal / np.linalg.norm(normal, axis=1)[:, None]]
 
 
 def residual_record(

@@ -1,5 +1,5 @@
 """The end influence through the linear solve's modal basis
-(stochcable.dynamics.residuals.residual_lines.modal_influence) against the banded
+(stochcable.dynamics.residuals.influence.modal_influence) against the banded
 adjoint solve (end_influence): equal to round-off where every mode is kept (the taut
 wire: 38 modes on 38 free DOFs), close where the truncated ones enter by their static
 correction (the bundled chain, the two-segment line of benchmarks/residual_cost.py),
@@ -15,7 +15,7 @@ import pytest
 from _paths import ROOT
 
 import stochcable.dynamics.outputs.line_result as line_result_module
-import stochcable.dynamics.residuals.residual_lines as rl
+import stochcable.dynamics.residuals.influence as rl
 from stochcable import analyze
 from stochcable.dynamics.residuals.along_line import element_rhs, stations
 
