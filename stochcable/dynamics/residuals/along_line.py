@@ -41,10 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.model.blocks import free_band, line_prep, trapezoid_weights
-from stochcable.dynamics.model.lift import lift_band, lift_pattern
-from stochcable.dynamics.model.solvers import solve_band_stacked
-from stochcable.dynamics.model.transport import gyro_band
+from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.residuals.along_line_3d import (
     VectorTapMixin,
     vector_parts,
@@ -52,17 +49,19 @@ from stochcable.dynamics.residuals.along_line_3d import (
 from stochcable.dynamics.residuals.corrected_spectrum import CorrectedSpectrum, corrected_spectrum
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
-from stochcable.dynamics.residuals.influence import element_rows, geometric_feedthrough
+from stochcable.dynamics.residuals.influence import (
+    adjoint_rows,
+    element_rows,
+    geometric_feedthrough,
+)
 from stochcable.dynamics.residuals.residual_lines import (
     RESIDUAL_TAP,
     EndInfluence,
     along,
-    band_stack,
     dense_pair_outputs,
     load_transfer,
     shared_rows,
 )
-from stochcable.dynamics.solve.line_loads import drag_blocks
 
 __all__ = [
     "AlongLineResidual",
@@ -204,34 +203,7 @@ def element_influence(
     per frequency with the n_el right-hand sides; zero on the end nodes.  A travelling
     line's Aᵀ has C − G, a line with a steady lift C_Lᵀ (as
     :func:`~stochcable.dynamics.residuals.residual_lines.end_influence`)."""
-    w = np.asarray(w, dtype=float)
-    model = system.model
-    prep = line_prep(system)
-    d, n = model.dim, model.n_nodes
-    cd = drag_blocks(system, damping)
-    b_c = prep.bS + free_band(cd)
-    if system.gyro is not None:
-        b_c = b_c - gyro_band(system.gyro, d)
-    if system.lift is not None:
-        b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
-    rhs = element_rhs(model, elements)
-    n_el = rhs.shape[1]
-    out = np.zeros((n_el, n, d, w.size), dtype=complex)
-    step = band_stack((n - 2) * d, d, max(n_el, 1))
-    for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
-        ws = w[sl]
-        x = solve_band_stacked(
-            prep.bK,
-            prep.bM,
-            b_c,
-            np.broadcast_to(rhs, (ws.size,) + rhs.shape),
-            ws,
-            2 * d - 1,
-            2 * d - 1,
-            (model.K, model.M),
-        )  # (n_w, (n − 2)·d, n_el)
-        out[:, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, n_el), (3, 1, 2, 0))
-    return out
+    return adjoint_rows(system, damping, element_rhs(system.model, elements), w)
 
 
 def end_station_influence(

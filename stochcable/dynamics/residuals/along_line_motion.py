@@ -31,11 +31,6 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.loads.freqblocks import frequency_slices
-from stochcable.dynamics.model.blocks import free_band, line_prep
-from stochcable.dynamics.model.lift import lift_band, lift_pattern
-from stochcable.dynamics.model.solvers import solve_band_stacked
-from stochcable.dynamics.model.transport import gyro_band
 from stochcable.dynamics.residuals.along_line import (
     CELL_BENDS,
     MAX_STATIONS,
@@ -48,7 +43,7 @@ from stochcable.dynamics.residuals.along_line import (
 from stochcable.dynamics.residuals.along_line_3d import sparse_transfer, vector_parts
 from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
-from stochcable.dynamics.solve.line_loads import drag_blocks
+from stochcable.dynamics.residuals.influence import adjoint_rows
 
 __all__ = [
     "MotionResidual",
@@ -82,31 +77,7 @@ def adjoint_solve(system: Any, damping: Any, w: np.ndarray, rhs: np.ndarray) -> 
     a steady lift's C_Lᵀ, as
     :func:`~stochcable.dynamics.residuals.along_line.element_influence`): shape
     (n_rhs, n_nodes, d, n_w), zero on the end nodes."""
-    w = np.asarray(w, dtype=float)
-    model = system.model
-    prep = line_prep(system)
-    d, n = model.dim, model.n_nodes
-    b_c = prep.bS + free_band(drag_blocks(system, damping))
-    if system.gyro is not None:
-        b_c = b_c - gyro_band(system.gyro, d)
-    if system.lift is not None:
-        b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
-    r = rhs.shape[1]
-    out = np.zeros((r, n, d, w.size), dtype=complex)
-    for sl in frequency_slices(w.size, 16 * n * d * max(r, 1)):
-        ws = w[sl]
-        x = solve_band_stacked(
-            prep.bK,
-            prep.bM,
-            b_c,
-            np.broadcast_to(rhs, (ws.size,) + rhs.shape),
-            ws,
-            2 * d - 1,
-            2 * d - 1,
-            (model.K, model.M),
-        )  # (n_w, (n − 2)·d, r)
-        out[:, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, r), (3, 1, 2, 0))
-    return out
+    return adjoint_rows(system, damping, rhs, w)
 
 
 def node_rows(model: Any, nodes: np.ndarray) -> np.ndarray:

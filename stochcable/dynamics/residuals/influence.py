@@ -32,6 +32,7 @@ __all__ = [
     "MODAL_INFLUENCE",
     "MODAL_SHARE",
     "MODAL_SPAN",
+    "adjoint_rows",
     "EndInfluence",
     "SharedRows",
     "band_stack",
@@ -451,4 +452,31 @@ def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
     out = np.zeros((n_el, n_all))
     el = np.arange(n_el)
     out[el, el] = -np.linalg.norm(rows[:, 1], axis=1) / length
+    return out
+
+
+def adjoint_rows(system: Any, damping: Any, rhs: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The adjoint system's solution for the right-hand sides ``rhs`` ((n − 2)·d, r) on
+    ``w``, ends held, shape (r, n_nodes, d, n_w): each output row's answer per unit
+    force on every node (Aᵀ has C − G for a travelling line, C_Lᵀ with a steady lift, as
+    :func:`end_influence`), in stacks of :func:`band_stack` frequencies. [unit/N]"""
+    w = np.asarray(w, dtype=float)
+    model = system.model
+    prep = line_prep(system)
+    d, n = model.dim, model.n_nodes
+    b_c = prep.bS + free_band(drag_blocks(system, damping))
+    if system.gyro is not None:
+        b_c = b_c - gyro_band(system.gyro, d)
+    if system.lift is not None:
+        b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
+    r = rhs.shape[1]
+    out = np.zeros((r, n, d, w.size), dtype=complex)
+    step = band_stack((n - 2) * d, d, max(r, 1))
+    for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
+        ws = w[sl]
+        x = solve_band_stacked(
+            prep.bK, prep.bM, b_c, np.broadcast_to(rhs, (ws.size,) + rhs.shape), ws,
+            2 * d - 1, 2 * d - 1, (model.K, model.M),
+        )  # (n_w, (n − 2)·d, r)  # fmt: skip
+        out[:, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, r), (3, 1, 2, 0))
     return out
