@@ -37,6 +37,7 @@ from stochcable.cases.scatter import Family, SeaState
 from stochcable.design import damage_rate
 from stochcable.dynamics.engine import Engine
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
+from stochcable.dynamics.outputs.line_result import MOTION_RESIDUALS
 from stochcable.errors import StochcableError, collect_warnings
 from stochcable.fidelity.mesh_engine import checked_engine
 from stochcable.scene.model import Scene, Sea
@@ -315,7 +316,7 @@ def solve_chunk(
     -------
     ChunkResult
     """
-    with threadpool_limits(limits=1):
+    with threadpool_limits(limits=1), _no_motion_residuals():
         engine = _engine(template) if engine is None else engine
         linear_engine = None  # (the same engine without the residuals, when needed)
         # (the engine's counts: the element check may have raised the defaults)
@@ -400,6 +401,18 @@ def solve_chunk(
     return ChunkResult(
         idx, tuple(rows), stats, damage, s_el, linear, exact, tuple(kept), linear_along
     )
+
+
+@contextlib.contextmanager
+def _no_motion_residuals():
+    """A set reports no node or body motions: their residuals are not computed (the
+    end and element tensions the same; on the chain example ≈ 12 ms of a computed
+    case's ≈ 53 ms of residuals, docs/benchmarks/cases.md)."""
+    token = MOTION_RESIDUALS.set(False)
+    try:
+        yield
+    finally:
+        MOTION_RESIDUALS.reset(token)
 
 
 def _along_densities(lr: Any) -> tuple[np.ndarray, np.ndarray]:
