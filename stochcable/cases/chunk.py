@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from stochcable.cases.along_spectra import element_densities
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import Family, SeaState
 from stochcable.design import damage_rate
@@ -419,10 +420,9 @@ def _along_densities(lr: Any) -> tuple[np.ndarray, np.ndarray]:
     """The element tensions' spectral densities with the residuals (their
     :class:`~stochcable.dynamics.residuals.along_line.AlongLineResidual` lines on the
     analysis grid extended as the ends', the same grid for every element), stacked
-    (n_el, n): the along-line damage of a case that computed them."""
-    lin = lr.tension_spectrum
-    parts = [lr.along_line.density(e, lr.omega, lin[e]) for e in range(lin.shape[0])]
-    return parts[0].omega, np.stack([p.density for p in parts])
+    (n_el, n): the along-line damage of a case that computed them
+    (:func:`~stochcable.cases.along_spectra.element_densities`)."""
+    return element_densities(lr.along_line, lr.omega, lr.tension_spectrum)
 
 
 def without_residuals(engine: Engine) -> Engine:
