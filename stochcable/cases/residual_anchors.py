@@ -173,8 +173,8 @@ def first_anchors(states: tuple[SeaState, ...], span: int | None) -> np.ndarray:
     """
     out = np.zeros(len(states), dtype=bool)
     for cols in layout(states).values():
-        n = len(cols)
-        for j in range(n) if n <= 2 else {0, n - 1, (n - 1) // 2}:
+        opened = {k for a, b in _roots(len(cols), None) for k in (a, b, (a + b) // 2)}
+        for j in opened or {0}:
             _open(cols[j], span, out)
     return out
 
@@ -264,7 +264,7 @@ def _period_checks(
     """The columns of one heading to compute next by the checks in the period
     (:func:`next_anchors`)."""
     out = []
-    stack = [(0, len(cols) - 1)] if len(cols) > 2 else []
+    stack = _roots(len(cols), None)
     while stack:
         a, b = stack.pop()
         if b - a < 2:
