@@ -270,7 +270,13 @@ class CoupledInfluence:
                         for tgt, _ in parts
                     ]
                 )
-                lines = outputs([c for _, c in parts], h)
+                # (more output rows a registered hook asks for: group_motion.BodyRows)
+                rows = self.shared.get("extra_rows")
+                more = [] if rows is None else rows.transfers(key, parts, transfer, h)
+                lines = outputs([c for _, c in parts], np.concatenate([h, *more]))
+                if more:
+                    rows.keep(key, lines[h.shape[0] :])
+                    lines = lines[: h.shape[0]]
                 joint[key] = {
                     tgt.name: (
                         lines[2 * i : 2 * i + 2],
