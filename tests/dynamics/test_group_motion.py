@@ -45,9 +45,9 @@ def _body_rows(system, name, unit, w, bodies):
 
 def test_body_rows_of_every_leg_equal_the_assembled_system():
     """Two-leg planar buoy: the body DOFs per unit drag panel load of each leg through
-    the group (the rows the joint sums take) against the assembled lines–body system
-    solved directly, at the residual's lines: to 1e-9 of the largest (measured ~1e-13;
-    the dense solve's conditioning)."""
+    the group (the rows the joint sums take, and the single-line path's) against the
+    assembled lines–body system solved directly, at the residual's lines: to 1e-9 of
+    the largest (measured ~1e-13; the dense solve's conditioning)."""
     from stochcable.dynamics.residuals.drag_residual import drag_components
 
     _, cls, bodies, clin = _group_of(_two_leg_doc())
@@ -56,12 +56,11 @@ def test_body_rows_of_every_leg_equal_the_assembled_system():
     for c in cls:
         comp = drag_components(c.system, c.channels, clin.lines[c.name], 3, True)
         w = comp.w_out[:: max(1, comp.w_out.size // 30)]
-        got = load_transfer(
-            c.system, damp[c.name], comp.unit, w, BodyCoupledInfluence(infl[c.name])
-        )
         ref = _body_rows(system, c.name, comp.unit, w, bodies)
         assert np.abs(ref).max() > 0
-        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
+        for through in (BodyCoupledInfluence(infl[c.name]), BodyRows(infl).body(c.name)):
+            got = load_transfer(c.system, damp[c.name], comp.unit, w, through)
+            np.testing.assert_allclose(got, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
 
 
 def test_three_leg_body_rows_equal_the_assembled_system(buoy_group):  # noqa: F811
@@ -86,7 +85,7 @@ def test_three_leg_body_rows_equal_the_assembled_system(buoy_group):  # noqa: F8
     for c in cls:
         m = c.system.model
         unit = rng.standard_normal((m.n_nodes, m.dim, 3))
-        got = load_transfer(c.system, damp[c.name], unit, w, BodyCoupledInfluence(infl[c.name]))
+        got = load_transfer(c.system, damp[c.name], unit, w, BodyRows(infl).body(c.name))
         ref = _body_rows(system, c.name, unit, w, [body])
         np.testing.assert_allclose(got, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
 

@@ -7,7 +7,8 @@ geometric residual; :meth:`~.body_residual.CoupledInfluence.joint_lines`): the c
 terms between panels of different lines count, their velocities being correlated
 through the common sea and the common body motion.  The body DOFs are more outputs of
 the same components: a load F on line ℓ moves them by ξ = S⁻¹T_ℓᵀ(G_R,ℓ F)_att
-(:class:`~.body_motion.BodyCoupledInfluence`).  :class:`BodyRows`, registered on the
+(:class:`GroupBodyInfluence`, from the group's solves the end tensions' influences
+hold).  :class:`BodyRows`, registered on the
 group's shared state, gives the joint sums these rows, two at a time as the kinds'
 transfers take an influence of two outputs (end_a, end_b), and keeps their lines:
 the full sum over every line's components, cross terms included (a body row has no
@@ -39,14 +40,13 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.model.blocks import trapezoid_weights
-from stochcable.dynamics.residuals.body_motion import BodyCoupledInfluence
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence, untapped
 from stochcable.dynamics.residuals.drag_misfit import misfit_loads
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, SUB_SAMPLES
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
 from stochcable.dynamics.residuals.residual_lines import load_transfer
 
-__all__ = ["ROW_SCALE", "BodyRows", "body_rows_of", "misfit_parts"]
+__all__ = ["ROW_SCALE", "BodyRows", "GroupBodyInfluence", "body_rows_of", "misfit_parts"]
 
 #: The body rows' largest transfer in a joint sum relative to the end tensions'
 #: largest (module notes): the kinds keep a component whose largest output transfer
@@ -58,10 +58,58 @@ ROW_SCALE = 1e-9
 _BENDS = {"drag": CELL_BEND, "drag_3d": CELL_BEND, "geometric": CELL_BEND * LINE_STRIDE**2}
 
 
+class GroupBodyInfluence:
+    """The body DOFs of the group (group order; zero on the held ones) per unit force on
+    each node and component of one line (as :class:`~.body_motion.BodyCoupledInfluence`)
+    from the group's solves on each grid, shared by its lines (``state``: the group's
+    body offsets, condensed impedance, links and end solves on a grid, as
+    :class:`~.body_residual.CoupledInfluence` keeps them), kept for the grids asked.
+    [m/N, rad/N]"""
+
+    def __init__(self, base: CoupledInfluence, state: Callable[[np.ndarray], tuple]) -> None:
+        self.base = base
+        self.line = base.line
+        self.state = state
+        self._kept: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def on(self, w: np.ndarray) -> np.ndarray:
+        """The influence on ``w``, shape (n_dof, n_nodes, d, n_w)."""
+        w = np.asarray(w, dtype=float)
+        for om, g in self._kept:
+            if om.size == w.size and np.array_equal(om, w):
+                return g
+        g = self.compute(w)
+        self._kept.append((w.copy(), g))
+        return g
+
+    def compute(self, w: np.ndarray) -> np.ndarray:
+        """ξ = S⁻¹T_Lᵀ(G_R F)_att per unit node force (module notes), not kept."""
+        w = np.asarray(w, dtype=float)
+        off, s, links, solved = self.state(w)
+        model = self.line.system.model
+        d, n = model.dim, model.n_nodes
+        nb = s.shape[1]
+        g = np.zeros((nb, n, d, w.size), dtype=complex)
+        t, att = links[self.line.name]
+        if not att.size:
+            return g
+        free = np.array([off[b.name] + i for b in self.base.bodies for i in b.free_index], int)
+        tf = t[:, free]
+        xi = np.linalg.solve(
+            s[:, free[:, None], free[None, :]], np.broadcast_to(tf.T, (w.size,) + tf.T.shape)
+        )  # (n_w, n_free, |att|)
+        y = np.zeros((w.size, nb, 2 * d), dtype=complex)
+        y[:, free[:, None], att[None, :]] = xi
+        g[:, 0] = np.transpose(y[:, :, :d], (1, 2, 0))
+        g[:, -1] = np.transpose(y[:, :, d:], (1, 2, 0))
+        g[:, 1:-1] = -np.einsum("wei,wnki->enkw", y, solved[self.line.name][0])
+        return g
+
+
 class _Rows:
     """Two rows (zero-padded) of a body influence: an influence of two outputs."""
 
-    def __init__(self, body: BodyCoupledInfluence, rows: np.ndarray) -> None:
+    def __init__(self, body: GroupBodyInfluence, rows: np.ndarray) -> None:
         self.body = body
         self.rows = rows
         self.line = body.line
@@ -88,17 +136,30 @@ class BodyRows:
         self.influences = dict(influences)
         first = next(iter(self.influences.values()))
         self.n_dof = sum(b.n_dof for b in first.bodies)
-        self._body: dict[str, BodyCoupledInfluence] = {}
+        self._body: dict[str, GroupBodyInfluence] = {}
+        self._own: dict[str, Any] = {}  # (the grids' solves the end tensions did not ask)
         self._scale: dict[Any, np.ndarray] = {}
         self._parts: dict[Any, tuple[list[tuple[Any, Any]], Callable]] = {}
         #: by joint key: (frequencies [rad/s] (n_o,), variance lines (n_dof, n_o))
         self.lines: dict[Any, tuple[np.ndarray, np.ndarray]] = {}
 
-    def body(self, name: str) -> BodyCoupledInfluence:
+    def body(self, name: str) -> GroupBodyInfluence:
         """The body influence of line ``name`` (kept: its grids are kept on it)."""
         if name not in self._body:
-            self._body[name] = BodyCoupledInfluence(self.influences[name])
+            self._body[name] = GroupBodyInfluence(self.influences[name], self._state)
         return self._body[name]
+
+    def _state(self, w: np.ndarray) -> tuple:
+        """The group's solves on ``w``: the end tensions' where they hold the grid,
+        else kept here (:meth:`~.body_residual.CoupledInfluence._state`)."""
+        base = next(iter(self.influences.values()))
+        held = base.shared.get("state", {}).get(np.asarray(w, dtype=float).tobytes())
+        if held is not None:
+            return held
+        probe = CoupledInfluence(
+            base.name, base.lines, base.bodies, base.body_drag, None, self._own
+        )
+        return probe._state(np.asarray(w, dtype=float))
 
     def _pairs(self, name: str) -> list[_Rows]:
         b = self.body(name)
