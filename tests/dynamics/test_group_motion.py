@@ -116,7 +116,7 @@ def test_joint_body_lines_equal_the_sums_of_the_assembled_transfers(monkeypatch)
 
     monkeypatch.setattr(drag_residual, "PANEL_FLOOR", 0.0)
     monkeypatch.setattr(geometric_residual, "ELEMENT_FLOOR", 0.0)
-    monkeypatch.setattr(BodyRows, "_cells", lambda self, p, t, w, b: np.ones((self.n_dof, w.size)))
+    monkeypatch.setattr(BodyRows, "_cells", lambda self, p, t, w, b, of, n: np.ones((n, w.size)))
     _, cls, bodies, clin, rows = _rows_run(_two_leg_doc(), monkeypatch)
     system, _ = _assembled(cls, bodies, clin)
     kept = next(iter(rows.influences.values())).shared["components"]

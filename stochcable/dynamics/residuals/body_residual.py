@@ -275,7 +275,7 @@ class CoupledInfluence:
                 more = [] if rows is None else rows.transfers(key, parts, transfer, h)
                 lines = outputs([c for _, c in parts], np.concatenate([h, *more]))
                 if more:
-                    rows.keep(key, lines[h.shape[0] :])
+                    rows.keep(key, lines[h.shape[0] :], outputs)
                     lines = lines[: h.shape[0]]
                 joint[key] = {
                     tgt.name: (

@@ -40,13 +40,22 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals.along_line_bodies import (
+    ElementCoupledInfluence,
+    NodeCoupledInfluence,
+)
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence, untapped
 from stochcable.dynamics.residuals.drag_misfit import misfit_loads
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, SUB_SAMPLES
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
+from stochcable.dynamics.residuals.group_influence import (
+    GroupBodyInfluence,
+    Rows,
+    StationInfluence,
+)
 from stochcable.dynamics.residuals.residual_lines import load_transfer
 
-__all__ = ["ROW_SCALE", "BodyRows", "GroupBodyInfluence", "body_rows_of", "misfit_parts"]
+__all__ = ["ROW_SCALE", "BodyRows", "body_rows_of", "misfit_parts"]
 
 #: The body rows' largest transfer in a joint sum relative to the end tensions'
 #: largest (module notes): the kinds keep a component whose largest output transfer
@@ -58,96 +67,65 @@ ROW_SCALE = 1e-9
 _BENDS = {"drag": CELL_BEND, "drag_3d": CELL_BEND, "geometric": CELL_BEND * LINE_STRIDE**2}
 
 
-class GroupBodyInfluence:
-    """The body DOFs of the group (group order; zero on the held ones) per unit force on
-    each node and component of one line (as :class:`~.body_motion.BodyCoupledInfluence`)
-    from the group's solves on each grid, shared by its lines (``state``: the group's
-    body offsets, condensed impedance, links and end solves on a grid, as
-    :class:`~.body_residual.CoupledInfluence` keeps them), kept for the grids asked.
-    [m/N, rad/N]"""
-
-    def __init__(self, base: CoupledInfluence, state: Callable[[np.ndarray], tuple]) -> None:
-        self.base = base
-        self.line = base.line
-        self.state = state
-        self._kept: list[tuple[np.ndarray, np.ndarray]] = []
-
-    def on(self, w: np.ndarray) -> np.ndarray:
-        """The influence on ``w``, shape (n_dof, n_nodes, d, n_w)."""
-        w = np.asarray(w, dtype=float)
-        for om, g in self._kept:
-            if om.size == w.size and np.array_equal(om, w):
-                return g
-        g = self.compute(w)
-        self._kept.append((w.copy(), g))
-        return g
-
-    def compute(self, w: np.ndarray) -> np.ndarray:
-        """ξ = S⁻¹T_Lᵀ(G_R F)_att per unit node force (module notes), not kept."""
-        w = np.asarray(w, dtype=float)
-        off, s, links, solved = self.state(w)
-        model = self.line.system.model
-        d, n = model.dim, model.n_nodes
-        nb = s.shape[1]
-        g = np.zeros((nb, n, d, w.size), dtype=complex)
-        t, att = links[self.line.name]
-        if not att.size:
-            return g
-        free = np.array([off[b.name] + i for b in self.base.bodies for i in b.free_index], int)
-        tf = t[:, free]
-        xi = np.linalg.solve(
-            s[:, free[:, None], free[None, :]], np.broadcast_to(tf.T, (w.size,) + tf.T.shape)
-        )  # (n_w, n_free, |att|)
-        y = np.zeros((w.size, nb, 2 * d), dtype=complex)
-        y[:, free[:, None], att[None, :]] = xi
-        g[:, 0] = np.transpose(y[:, :, :d], (1, 2, 0))
-        g[:, -1] = np.transpose(y[:, :, d:], (1, 2, 0))
-        g[:, 1:-1] = -np.einsum("wei,wnki->enkw", y, solved[self.line.name][0])
-        return g
-
-
-class _Rows:
-    """Two rows (zero-padded) of a body influence: an influence of two outputs."""
-
-    def __init__(self, body: GroupBodyInfluence, rows: np.ndarray) -> None:
-        self.body = body
-        self.rows = rows
-        self.line = body.line
-
-    def on(self, w: np.ndarray) -> np.ndarray:
-        g = self.body.on(w)
-        out = np.zeros((2,) + g.shape[1:], dtype=complex)
-        out[: self.rows.size] = g[self.rows]
-        return out
-
-
 class BodyRows:
-    """The body DOFs of a group as extra output rows of its joint sums (module notes):
-    registered as ``shared["extra_rows"]`` of the group's coupled influences
-    (:func:`body_rows_of`).
+    """The body DOFs of a group, and the stations of its lines, as extra output rows of
+    its joint sums (module notes): registered as ``shared["extra_rows"]`` of the
+    group's coupled influences (:func:`body_rows_of`).
 
     Parameters
     ----------
     influences : mapping of str to CoupledInfluence
         The group's coupled influences (one per line, one shared state).
+    stations : mapping of str to (ndarray, ndarray), optional
+        Per line its element stations and its node stations (indices): their tensions
+        and motions (the model's d components a node, node-major) are rows too, and
+        the group's part of their lines (the sum over every line's components less the
+        line's own pairs) kept (:meth:`station_parts`).
     """
 
-    def __init__(self, influences: Mapping[str, CoupledInfluence]) -> None:
+    def __init__(
+        self,
+        influences: Mapping[str, CoupledInfluence],
+        stations: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    ) -> None:
         self.influences = dict(influences)
         first = next(iter(self.influences.values()))
         self.n_dof = sum(b.n_dof for b in first.bodies)
         self._body: dict[str, GroupBodyInfluence] = {}
         self._own: dict[str, Any] = {}  # (the grids' solves the end tensions did not ask)
-        self._scale: dict[Any, np.ndarray] = {}
-        self._parts: dict[Any, tuple[list[tuple[Any, Any]], Callable]] = {}
-        #: by joint key: (frequencies [rad/s] (n_o,), variance lines (n_dof, n_o))
+        # the row sets: (set, target line or None, rows, influence of a source's forces)
+        self.sets: list[tuple[str, str | None, int, Callable[[str], Any]]] = []
+        if self.n_dof:
+            self.sets.append(("body", None, self.n_dof, self.body))
+        for name, (el, nodes) in (stations or {}).items():
+            base = self.influences[name]
+            d = base.line.system.model.dim
+            for kind, target, n in (
+                ("elements", ElementCoupledInfluence(base, el), el.size),
+                ("nodes", NodeCoupledInfluence(base, nodes), nodes.size * d),
+            ):
+                self.sets.append((kind, name, n, self._station(target)))
+        self._kept: dict[Any, dict] = {}
+        #: by joint key: (frequencies [rad/s] (n_o,), body variance lines (n_dof, n_o))
         self.lines: dict[Any, tuple[np.ndarray, np.ndarray]] = {}
+        #: by joint key and (set, line): the group's part of the stations' lines
+        self.stations: dict[Any, dict[tuple[str, str], np.ndarray]] = {}
 
     def body(self, name: str) -> GroupBodyInfluence:
         """The body influence of line ``name`` (kept: its grids are kept on it)."""
         if name not in self._body:
             self._body[name] = GroupBodyInfluence(self.influences[name], self._state)
         return self._body[name]
+
+    def _station(self, target: Any) -> Callable[[str], StationInfluence]:
+        made: dict[str, StationInfluence] = {}
+
+        def of(name: str) -> StationInfluence:
+            if name not in made:
+                made[name] = StationInfluence(target, self.body(name), self._state)
+            return made[name]
+
+        return of
 
     def _state(self, w: np.ndarray) -> tuple:
         """The group's solves on ``w``: the end tensions' where they hold the grid,
@@ -161,10 +139,6 @@ class BodyRows:
         )
         return probe._state(np.asarray(w, dtype=float))
 
-    def _pairs(self, name: str) -> list[_Rows]:
-        b = self.body(name)
-        return [_Rows(b, np.arange(k, min(k + 2, self.n_dof))) for k in range(0, self.n_dof, 2)]
-
     def transfers(
         self,
         key: Any,
@@ -172,13 +146,18 @@ class BodyRows:
         transfer: Callable[[Any, Any, Any], np.ndarray],
         h: np.ndarray,
     ) -> list[np.ndarray]:
-        """The body rows' transfers (two rows each, the sources along axis 1 as the
+        """The extra rows' transfers (two rows each, the sources along axis 1 as the
         targets' ``h``), scaled to :data:`ROW_SCALE` of ``h``'s largest."""
-        pairs = {src.name: self._pairs(src.name) for src, _ in parts}
-        out = [
-            np.concatenate([transfer(src, c, pairs[src.name][k]) for src, c in parts], 1)
-            for k in range(len(pairs[parts[0][0].name]))
-        ]
+        names = [src.name for src, _ in parts]
+        sets = [st for st in self.sets if st[1] is None or st[1] in names]
+        out, layout = [], []
+        for kind, line, n, of in sets:
+            for k in range(0, n, 2):
+                rows = np.arange(k, min(k + 2, n))
+                per = [transfer(src, c, Rows(of(src.name), rows)) for src, c in parts]
+                out.append(np.concatenate(per, 1))
+                layout.append((kind, line, rows))
+        widths = np.cumsum([0] + [t.shape[1] for t in per]) if out else np.zeros(1, int)
         top = float(np.abs(h).max(initial=0.0))
         scale = np.ones(2 * len(out))
         for k, t in enumerate(out):
@@ -187,36 +166,62 @@ class BodyRows:
                 if m > 0.0 and top > 0.0:
                     scale[2 * k + r] = ROW_SCALE * top / m
             t *= scale[2 * k : 2 * k + 2].reshape((2,) + (1,) * (t.ndim - 1))
-        self._scale[key] = scale
-        self._parts[key] = (list(parts), transfer)
+        self._kept[key] = {
+            "parts": list(parts), "transfer": transfer, "h": h, "scale": scale,
+            "layout": layout, "t": out, "widths": widths,
+        }  # fmt: skip
         return out
 
-    def keep(self, key: Any, lines: np.ndarray) -> None:
-        """The joint sum's lines of the body rows (scaled as :meth:`transfers` gave
-        them): unscaled, integrated over the cells, kept by ``key``."""
-        v = (lines / self._scale[key][:, None] ** 2)[: self.n_dof]
-        parts, transfer = self._parts[key]
+    def keep(self, key: Any, lines: np.ndarray, outputs: Callable) -> None:
+        """The joint sum's lines of the extra rows (scaled as :meth:`transfers` gave
+        them): unscaled; the stations' less their line's own pairs (``outputs``: the
+        kind's, over the line's components alone); integrated over the cells; kept by
+        ``key``."""
+        kept = self._kept.pop(key)
+        parts, transfer, scale = kept["parts"], kept["transfer"], kept["scale"]
+        v = lines / scale[:, None] ** 2
         w_out = np.asarray(parts[0][1].w_out, dtype=float)
-        v = v * self._cells(parts, transfer, w_out, _BENDS.get(key[0], CELL_BEND))
-        self.lines[key] = (w_out, v)
+        bend = _BENDS.get(key[0], CELL_BEND)
+        names = [src.name for src, _ in parts]
+        by_set: dict[tuple[str, str | None], list[int]] = {}
+        for k, (kind, line, _) in enumerate(kept["layout"]):
+            by_set.setdefault((kind, line), []).append(k)
+        for (kind, line), pairs in by_set.items():
+            _, _, n, of = next(st for st in self.sets if st[0] == kind and st[1] == line)
+            rows = (2 * np.asarray(pairs)[:, None] + np.arange(2)).ravel()  # (real rows first)
+            lines_set = v[rows]
+            if kind != "body":  # less the line's own pairs (its along-line record's)
+                i = names.index(line)
+                cols = slice(int(kept["widths"][i]), int(kept["widths"][i + 1]))
+                t_own = np.concatenate(
+                    [kept["h"][2 * i : 2 * i + 2][:, cols]] + [kept["t"][k][:, cols] for k in pairs]
+                )
+                with untapped():
+                    own = outputs([parts[i][1]], t_own)[2:]
+                lines_set = lines_set - own / scale[rows, None] ** 2
+            lines_set = lines_set[:n] * self._cells(parts, transfer, w_out, bend, of, n)
+            if kind == "body":
+                self.lines[key] = (w_out, lines_set)
+            else:
+                self.stations.setdefault(key, {})[kind, line] = (w_out, lines_set)
 
-    def _power(self, parts: Sequence[tuple[Any, Any]], transfer: Callable, w: np.ndarray):
-        """Σ over every line's components of |body DOFs per unit component|², on
-        ``w``: (n_dof, n)."""
-        p = np.zeros((self.n_dof, w.size))
+    def _power(self, parts, transfer, w: np.ndarray, of, n: int) -> np.ndarray:  # noqa: ANN001
+        """Σ over every line's components of |rows per unit component|², on ``w``:
+        (n, n_w)."""
+        p = np.zeros((n, w.size))
         for src, c in parts:
             cw = c if np.array_equal(c.w_out, w) else dataclasses.replace(c, w_out=w)
-            for pair in self._pairs(src.name):
+            for k in range(0, n, 2):
+                rows = np.arange(k, min(k + 2, n))
                 with untapped():
-                    t = transfer(src, cw, pair)
-                t = np.abs(t.reshape(2, -1, w.size)) ** 2
-                p[pair.rows] += t.sum(axis=1)[: pair.rows.size]
+                    t = transfer(src, cw, Rows(of(src.name), rows))
+                p[rows] += (np.abs(t.reshape(2, -1, w.size)) ** 2).sum(axis=1)[: rows.size]
         return p
 
-    def _cells(self, parts, transfer, w_out: np.ndarray, bend: float) -> np.ndarray:  # noqa: ANN001
-        """The cell factor (n_dof, n_o) of the body rows (module notes; as
+    def _cells(self, parts, transfer, w_out: np.ndarray, bend: float, of, n: int) -> np.ndarray:  # noqa: ANN001
+        """The cell factor (n, n_o) of a row set (module notes; as
         :func:`~.drag_residual.cell_factor`, over every line's components)."""
-        power = self._power(parts, transfer, w_out)
+        power = self._power(parts, transfer, w_out, of, n)
         out = np.ones_like(power)
         logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
         bent = np.zeros(power.shape[1], dtype=bool)
@@ -227,7 +232,7 @@ class BodyRows:
         step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
         sub = step * ((np.arange(SUB_SAMPLES) + 0.5) / SUB_SAMPLES - 0.5)
         w_sub = (w_out[cells, None] + sub[None]).ravel()
-        p_sub = self._power(parts, transfer, w_sub).reshape(self.n_dof, cells.size, -1)
+        p_sub = self._power(parts, transfer, w_sub, of, n).reshape(n, cells.size, -1)
         at = power[:, cells]
         out[:, cells] = np.where(at > 0, p_sub.mean(axis=2) / np.where(at > 0, at, 1.0), 1.0)
         return out
