@@ -95,8 +95,8 @@ def _rows_run(doc: dict, monkeypatch) -> tuple:
     seen = {}
     real = group_results.body_rows_of
 
-    def keep(influences):  # noqa: ANN001, ANN202
-        seen["rows"] = real(influences)
+    def keep(influences, stations=None):  # noqa: ANN001, ANN202
+        seen["rows"] = real(influences, stations)
         return seen["rows"]
 
     monkeypatch.setattr(group_results, "body_rows_of", keep)

@@ -23,13 +23,19 @@ from stochcable.dynamics.groups.modes import (
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.outputs.resolution import LineModes
+from stochcable.dynamics.residuals.along_line import stations
+from stochcable.dynamics.residuals.along_line_motion import motion_stations
 from stochcable.dynamics.residuals.body_motion import (
     BodyCoupledInfluence,
     body_motion_parts,
     body_rows,
 )
 from stochcable.dynamics.residuals.body_residual import coupled_influences
-from stochcable.dynamics.residuals.group_motion import body_rows_of, misfit_parts
+from stochcable.dynamics.residuals.group_motion import (
+    body_rows_of,
+    misfit_parts,
+    with_group_stations,
+)
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 from stochcable.results.records import stats_from_moments
 from stochcable.scene.model import AnalysisSettings
@@ -103,7 +109,20 @@ def coupled_results(
     # (residuals.body_motion); of several, as output rows of the joint sums over every
     # line's loads, cross terms included (residuals.group_motion: summing the lines'
     # variances would lose the cancellation of symmetric legs)
-    group_rows = body_rows_of(influence) if bodies else None
+    # (and the lines' stations: their element tensions and node motions take every
+    # line's loads, the line's own from its along-line records, the others' and the
+    # cross terms as the group's part)
+    group_rows = (
+        body_rows_of(
+            influence,
+            {
+                cl.name: (stations(cl.system.model), motion_stations(cl.system.model))
+                for cl in lines
+            },
+        )  # fmt: skip
+        if bodies
+        else None
+    )
     by_line: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     out_lines = {}
     for cl in lines:
@@ -130,6 +149,8 @@ def coupled_results(
             else None,
         )
     parts = next(iter(by_line.values())) if len(by_line) == 1 else []
+    if group_rows is not None:
+        out_lines = {k: with_group_stations(r, group_rows) for k, r in out_lines.items()}
     if group_rows is not None:  # (several lines: the joint sums' body rows)
         parts = group_rows.parts()
         parts += misfit_parts(group_rows, transfer, spectra, w) if parts else []

@@ -123,8 +123,11 @@ class StationInfluence(_Kept):
         u[:, 0, :, :d] = np.eye(d)
         u[:, -1, :, d:] = np.eye(d)
         u[:, 1:-1] = -solved[tl.name][0]
-        c = self.target.per_end_motion(u)[:, :, att]  # (n_w, n_out, |att|)
-        return g + np.einsum("woa,ab,bnkw->onkw", c, t_l, self.body.on(w), optimize=True)
+        c = self.target.per_end_motion(u)[:, :, att] @ t_l[None]  # (n_w, n_out, nb)
+        b = self.body.on(w)  # (nb, n_S, d, n_w)
+        b_w = np.ascontiguousarray(np.moveaxis(b.reshape(b.shape[0], -1, w.size), 2, 0))
+        cross = np.moveaxis(c @ b_w, 0, 2)  # (n_out, n_S·d, n_w)
+        return g + cross.reshape(g.shape)
 
 
 def _nodes(target: ElementCoupledInfluence) -> bool:

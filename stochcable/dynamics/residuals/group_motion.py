@@ -40,11 +40,14 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals.along_line import station_weights
 from stochcable.dynamics.residuals.along_line_bodies import (
     ElementCoupledInfluence,
     NodeCoupledInfluence,
 )
+from stochcable.dynamics.residuals.along_line_motion import motion_weights
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence, untapped
+from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
 from stochcable.dynamics.residuals.drag_misfit import misfit_loads
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, SUB_SAMPLES
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
@@ -55,13 +58,39 @@ from stochcable.dynamics.residuals.group_influence import (
 )
 from stochcable.dynamics.residuals.residual_lines import load_transfer
 
-__all__ = ["ROW_SCALE", "BodyRows", "body_rows_of", "misfit_parts"]
+__all__ = [
+    "ROW_SCALE",
+    "STATION_CELLS",
+    "STATION_KINDS",
+    "BodyRows",
+    "body_rows_of",
+    "group_station_parts",
+    "misfit_parts",
+    "with_group_stations",
+]
 
 #: The body rows' largest transfer in a joint sum relative to the end tensions'
 #: largest (module notes): the kinds keep a component whose largest output transfer
 #: is at least 1e-4 of the largest (PANEL_FLOOR, ELEMENT_FLOOR); rows at 1e-9 of it
 #: cannot raise a component there. [-]
 ROW_SCALE = 1e-9
+
+#: The joint sums (their key's first item) that give the lines' stations the group's
+#: part: the drag residuals'.  The geometric residual's joint sum over every line's
+#: elements runs block by block (its pair lines beyond DENSE_PAIR_BYTES), at a cost
+#: proportional to its outputs: on benchmarks/bench_bodies.py's mooring (3 × 40
+#: elements) the stations' 132 rows took 6.5 s against an analysis of 7 s; its group
+#: part at the ends is +0.3 % of σ (docs/accuracy/bodies.md).
+STATION_KINDS = ("drag", "drag_3d")
+
+#: Whether the stations' group parts are integrated over the cells (False: taken on the
+#: lines, not integrated over the cells of
+#: a resonance narrower than a line as the body rows' (and the lines' own parts): the
+#: integration's sub-samples through every line's station rows cost 5 s on
+#: benchmarks/bench_bodies.py's mooring (an analysis of 7 s) and move its σ by at
+#: most 2e-4 (node motions; element tensions 5e-5), the three-leg disc buoy's node
+#: motions by 0.7 % of the line's largest σ (its tensions not at all).
+STATION_CELLS = False
 
 #: The cell bend of each joint sum's kind (its key's first item), as the ends'. [-]
 _BENDS = {"drag": CELL_BEND, "drag_3d": CELL_BEND, "geometric": CELL_BEND * LINE_STRIDE**2}
@@ -149,7 +178,9 @@ class BodyRows:
         """The extra rows' transfers (two rows each, the sources along axis 1 as the
         targets' ``h``), scaled to :data:`ROW_SCALE` of ``h``'s largest."""
         names = [src.name for src, _ in parts]
-        sets = [st for st in self.sets if st[1] is None or st[1] in names]
+        sets = [
+            st for st in self.sets if st[1] is None or (st[1] in names and key[0] in STATION_KINDS)
+        ]
         out, layout = [], []
         for kind, line, n, of in sets:
             for k in range(0, n, 2):
@@ -199,7 +230,9 @@ class BodyRows:
                 with untapped():
                     own = outputs([parts[i][1]], t_own)[2:]
                 lines_set = lines_set - own / scale[rows, None] ** 2
-            lines_set = lines_set[:n] * self._cells(parts, transfer, w_out, bend, of, n)
+            lines_set = lines_set[:n]
+            if kind == "body" or STATION_CELLS:
+                lines_set = lines_set * self._cells(parts, transfer, w_out, bend, of, n)
             if kind == "body":
                 self.lines[key] = (w_out, lines_set)
             else:
@@ -247,15 +280,19 @@ class BodyRows:
         return out
 
 
-def body_rows_of(influences: Mapping[str, CoupledInfluence]) -> BodyRows | None:
-    """The :class:`BodyRows` of a group of several lines on free bodies, registered on
-    its influences' shared state (None: a group of one line, or no bodies)."""
+def body_rows_of(
+    influences: Mapping[str, CoupledInfluence],
+    stations: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
+) -> BodyRows | None:
+    """The :class:`BodyRows` of a group of several lines on free bodies (with the lines'
+    ``stations``, as :class:`BodyRows` takes them), registered on its influences'
+    shared state (None: a group of one line, or no bodies)."""
     if len(influences) < 2:
         return None
     first = next(iter(influences.values()))
     if not first.bodies or sum(b.n_dof for b in first.bodies) == 0:
         return None
-    rows = BodyRows(influences)
+    rows = BodyRows(influences, stations)
     first.shared["extra_rows"] = rows
     return rows
 
@@ -298,3 +335,62 @@ def misfit_parts(
         return []
     q = trapezoid_weights(w)[None, None] * spectra[:, None]
     return [(w, np.sum(q * (np.abs(linear + h_c) ** 2 - np.abs(linear) ** 2), axis=0))]
+
+
+#: The along-line record's kind of each joint sum (its key's first item).
+_KINDS = {"drag": "drag_residual", "drag_3d": "drag_residual", "geometric": "geometric_residual"}
+
+
+def group_station_parts(rows: BodyRows, name: str) -> dict[str, dict[str, tuple]]:
+    """The group's parts of line ``name``'s stations by set ("elements", "nodes") and
+    kind: (frequencies [rad/s] (n_o,), variance lines (n_rows, n_o)), one joint key
+    per kind."""
+    out: dict[str, dict[str, tuple]] = {"elements": {}, "nodes": {}}
+    for key, sets in rows.stations.items():
+        kind = _KINDS.get(key[0])
+        for st in ("elements", "nodes"):
+            if kind is not None and (st, name) in sets and kind not in out[st]:
+                out[st][kind] = sets[st, name]
+    return out
+
+
+def with_group_stations(result: Any, rows: BodyRows) -> Any:
+    """``result`` (a line's LineResult) with the group's parts of its stations added to
+    its element tensions' and node motions' residual records (each a part of the kind's
+    lines, carried to every element and node as the line's own parts: the stations'
+    weights), and their σ; unchanged where a record is not computed, lacks the kind, or
+    the motions' total would leave the closed forms' range."""
+    parts = group_station_parts(rows, result.name)
+    model = result.model
+    s0 = np.asarray(model.mesh.s0, dtype=float)
+    changes: dict[str, Any] = {}
+    along = result.along_line
+    if along is not None and along.computed and parts["elements"]:
+        weights = station_weights(0.5 * (s0[1:] + s0[:-1]), along.stations)
+        lines, var = dict(along.lines), along.variance.copy()
+        for kind, (w, v) in parts["elements"].items():
+            if kind in lines:
+                lines[kind] = lines[kind] + ((w, weights @ v),)
+                var = var + (weights @ v).sum(axis=1)
+        new = dataclasses.replace(along, lines=lines, variance=var)
+        changes.update(along_line=new, tension_std=new.std(result.tension_std_linear))
+    moves = result.motion_residual
+    if moves is not None and moves.computed and parts["nodes"]:
+        comps, d = list(model.components), model.dim
+        lin = np.asarray(result.motion_std_linear, dtype=float)
+        weights = motion_weights(s0, moves.stations, lin[:, comps] ** 2)
+        lines, total = dict(moves.lines), moves.variance.copy()
+        for kind, (w, v) in parts["nodes"].items():
+            if kind in lines:
+                full = np.zeros((model.n_nodes, 3, w.size))
+                full[:, comps] = (weights @ v).reshape(model.n_nodes, d, w.size)
+                lines[kind] = lines[kind] + ((w, full),)
+                total = total + full.sum(axis=2)
+        at = moves.stations
+        lv = lin[at] ** 2
+        live = lv > 1e-4 * np.max(lv, initial=0.0)
+        ratio = np.where(live, total[at] / np.where(live, lv, 1.0), 0.0)
+        if np.max(ratio, initial=0.0) <= RESIDUAL_VARIANCE_LIMIT:
+            new = dataclasses.replace(moves, lines=lines, variance=total)
+            changes.update(motion_residual=new, motion_std=new.std(lin))
+    return dataclasses.replace(result, **changes) if changes else result
