@@ -31,11 +31,7 @@ from stochcable.dynamics.residuals.body_motion import (
     body_rows,
 )
 from stochcable.dynamics.residuals.body_residual import coupled_influences
-from stochcable.dynamics.residuals.group_motion import (
-    body_rows_of,
-    misfit_parts,
-    with_group_stations,
-)
+from stochcable.dynamics.residuals.group_motion import body_rows_of, with_group_stations
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 from stochcable.results.records import stats_from_moments
 from stochcable.scene.model import AnalysisSettings
@@ -152,8 +148,7 @@ def coupled_results(
     if group_rows is not None:
         out_lines = {k: with_group_stations(r, group_rows) for k, r in out_lines.items()}
     if group_rows is not None:  # (several lines: the joint sums' body rows)
-        parts = group_rows.parts()
-        parts += misfit_parts(group_rows, transfer, spectra, w) if parts else []
+        parts = group_rows.body_parts(transfer, spectra, w)
     out_bodies = {}
     for b in bodies:
         h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)

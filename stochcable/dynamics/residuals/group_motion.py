@@ -59,6 +59,7 @@ from stochcable.dynamics.residuals.group_influence import (
 from stochcable.dynamics.residuals.residual_lines import load_transfer
 
 __all__ = [
+    "ROUND_OFF",
     "ROW_SCALE",
     "STATION_CELLS",
     "STATION_KINDS",
@@ -74,6 +75,10 @@ __all__ = [
 #: is at least 1e-4 of the largest (PANEL_FLOOR, ELEMENT_FLOOR); rows at 1e-9 of it
 #: cannot raise a component there. [-]
 ROW_SCALE = 1e-9
+
+#: A body DOF's residual variance at most this share of the body's largest is
+#: round-off (:meth:`BodyRows.body_parts`). [-]
+ROUND_OFF = 1e-12
 
 #: The joint sums (their key's first item) that give the lines' stations the group's
 #: part: the drag residuals'.  The geometric residual's joint sum over every line's
@@ -278,6 +283,22 @@ class BodyRows:
                 seen.add(key[0])
                 out.append(part)
         return out
+
+    def body_parts(
+        self, linear: np.ndarray, spectra: np.ndarray, w: np.ndarray
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The body DOFs' residual lines: the kinds' (:meth:`parts`) and the misfit's
+        (:func:`misfit_parts`, the bodies' ``linear`` transfer (n_ch, n_dof, n_w) on
+        ``w`` with the inputs' ``spectra``); a DOF whose total is round-off, at most
+        :data:`ROUND_OFF` of the largest DOF's (a symmetric mooring's sway and roll,
+        ~1e-17 against ~1: the legs' parts cancel), gets none."""
+        out = self.parts()
+        if not out:
+            return []
+        out += misfit_parts(self, linear, spectra, w)
+        total = np.abs(sum(v.sum(axis=1) for _, v in out))
+        noise = total <= ROUND_OFF * np.max(total, initial=0.0)
+        return [(om, np.where(noise[:, None], 0.0, v)) for om, v in out]
 
 
 def body_rows_of(
