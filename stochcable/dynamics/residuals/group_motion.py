@@ -56,7 +56,7 @@ from stochcable.dynamics.residuals.group_influence import (
     Rows,
     StationInfluence,
 )
-from stochcable.dynamics.residuals.residual_lines import load_transfer
+from stochcable.dynamics.residuals.residual_lines import DENSE_PAIR_BYTES, load_transfer
 
 __all__ = [
     "ROUND_OFF",
@@ -81,8 +81,9 @@ ROW_SCALE = 1e-9
 ROUND_OFF = 1e-12
 
 #: The joint sums (their key's first item) that give the lines' stations the group's
-#: part: the drag residuals'.  The geometric residual's joint sum over every line's
-#: elements runs block by block (its pair lines beyond DENSE_PAIR_BYTES), at a cost
+#: part: the drag residuals'; the geometric residual's only where its pair lines form
+#: one dense matrix (DENSE_PAIR_BYTES: the bundled three-leg buoy's 3 elements a leg).
+#: Beyond, its joint sum over every line's elements runs block by block at a cost
 #: proportional to its outputs: on benchmarks/bench_bodies.py's mooring (3 × 40
 #: elements) the stations' 132 rows took 6.5 s against an analysis of 7 s; its group
 #: part at the ends is +0.3 % of σ (docs/accuracy/bodies.md).
@@ -183,9 +184,10 @@ class BodyRows:
         """The extra rows' transfers (two rows each, the sources along axis 1 as the
         targets' ``h``), scaled to :data:`ROW_SCALE` of ``h``'s largest."""
         names = [src.name for src, _ in parts]
-        sets = [
-            st for st in self.sets if st[1] is None or (st[1] in names and key[0] in STATION_KINDS)
-        ]
+        n = int(np.prod(h.shape[1:-1]))  # (the sums' components)
+        dense = 16 * n * n * h.shape[-1] <= DENSE_PAIR_BYTES
+        lines = key[0] in STATION_KINDS or (key[0] == "geometric" and dense)
+        sets = [st for st in self.sets if st[1] is None or (st[1] in names and lines)]
         out, layout = [], []
         for kind, line, n, of in sets:
             for k in range(0, n, 2):
