@@ -56,6 +56,7 @@ from stochcable.dynamics.residuals.group_influence import (
     Rows,
     StationInfluence,
 )
+from stochcable.dynamics.residuals.influence import geometric_feedthrough
 from stochcable.dynamics.residuals.residual_lines import DENSE_PAIR_BYTES, load_transfer
 
 __all__ = [
@@ -66,7 +67,9 @@ __all__ = [
     "BodyRows",
     "body_rows_of",
     "group_station_parts",
+    "misfit_loads_of",
     "misfit_parts",
+    "station_misfit",
     "with_group_stations",
 ]
 
@@ -193,6 +196,9 @@ class BodyRows:
             for k in range(0, n, 2):
                 rows = np.arange(k, min(k + 2, n))
                 per = [transfer(src, c, Rows(of(src.name), rows)) for src, c in parts]
+                if key[0] == "geometric" and kind == "elements":
+                    i = names.index(line)
+                    per[i] = per[i] + _feedthrough(parts[i], of(line).target.elements[rows])
                 out.append(np.concatenate(per, 1))
                 layout.append((kind, line, rows))
         widths = np.cumsum([0] + [t.shape[1] for t in per]) if out else np.zeros(1, int)
@@ -303,6 +309,20 @@ class BodyRows:
         return [(om, np.where(noise[:, None], 0.0, v)) for om, v in out]
 
 
+def _feedthrough(part: tuple[Any, Any], elements: np.ndarray) -> np.ndarray:
+    """The geometric residual's own stretch of ``elements`` per unit of their line's
+    components (:func:`~.influence.geometric_feedthrough`), in the layout of the
+    kind's joint transfers (2, n_el, n_terms, 1; the second row zero where one
+    element): the element tensions' direct term, as the line's own record takes it
+    (:func:`~.along_line.element_lines`)."""
+    ln, c = part
+    n_terms, n_el = len(c.terms), c.proc[0].shape[1]
+    ft = geometric_feedthrough(ln.system, n_terms * n_el)[elements]  # (r, n_terms·n_el)
+    out = np.zeros((2, n_el, n_terms, 1))
+    out[: elements.size] = np.swapaxes(ft.reshape(-1, n_terms, n_el), 1, 2)[..., None]
+    return out
+
+
 def body_rows_of(
     influences: Mapping[str, CoupledInfluence],
     stations: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
@@ -320,44 +340,83 @@ def body_rows_of(
     return rows
 
 
-def misfit_parts(
-    rows: BodyRows, linear: np.ndarray, spectra: np.ndarray, w: np.ndarray
-) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The drag residual's linear misfit in the body DOFs: every line's misfit loads δB·v
-    (the components the joint sums kept) through its body influence added to the
-    bodies' ``linear`` transfer (n_ch, n_dof, n_w) on ``w`` before the variance is
-    formed, Σ_c q·S_c(|H_L + H_c|² − |H_L|²): parts (``w``, (n_dof, n_w)) (empty
-    without misfit loads). [m², rad²]"""
-    w = np.asarray(w, dtype=float)
+def misfit_loads_of(rows: BodyRows, w: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Every line's drag residual misfit loads δB·v (the components the body lines'
+    joint sums kept, one key per kind): per line its unit loads (n_nodes, d, n_load)
+    and their values per unit input (n_ch, n_load, n_w) on the analysis grid ``w``."""
     kept = next(iter(rows.influences.values())).shared.get("components", {})
-    keys = {}  # (one joint key per kind: those of the body lines)
-    for key in rows.lines:
+    keys: dict[str, Any] = {}
+    for key in list(rows.lines) + list(rows.stations):
         keys.setdefault(key[0], key)
-    h_c = np.zeros_like(linear)
-    found = False
+    out = {}
     for key, name in list(kept):
         c = kept[key, name]
         if c is None or keys.get(key[0]) != key or key[0] not in ("drag", "drag_3d"):
             continue
-        line = rows.influences[name].line
         if key[0] == "drag":
-            mis = misfit_loads(line.system.model, c.seg, c.groups, c.live, c.parts, c.misfit)
+            model = rows.influences[name].line.system.model
+            mis = misfit_loads(model, c.seg, c.groups, c.live, c.parts, c.misfit)
         elif c.db is not None:
             v = np.stack([c.pan["n1"], c.pan["n2"], c.pan["t"]], axis=1)
             load = np.einsum("pab,cbpw->capw", c.db, v)
-            mis = (c.unit, load.reshape(load.shape[0], -1, w.size))
+            mis = (c.unit, load.reshape(load.shape[0], -1, np.size(w)))
         else:
             mis = None
-        if mis is None:
-            continue
+        if mis is not None:
+            out[name] = mis
+    return out
+
+
+def _through(rows: BodyRows, loads: Mapping[str, tuple], w: np.ndarray, of: Callable) -> Any:
+    """Σ over the lines' misfit ``loads`` of their outputs through ``of(line)``,
+    (n_ch, n_out, n_w) (0 without loads)."""
+    h_c: Any = 0.0
+    for name, (unit, load) in loads.items():
+        line = rows.influences[name].line
         with untapped():
-            h = load_transfer(line.system, line.damping, mis[0], w, rows.body(name))
-        h_c += np.einsum("okw,ckw->cow", h, mis[1])
-        found = True
-    if not found:
-        return []
+            h = load_transfer(line.system, line.damping, unit, w, of(name))
+        h_c = h_c + np.einsum("okw,ckw->cow", h, load)
+    return h_c
+
+
+def _change(base: np.ndarray, more: Any, spectra: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Σ_c q·S_c(|H + H_c|² − |H|²) of transfers ``base`` (n_ch, n_out, n_w) and their
+    change ``more``: (n_out, n_w)."""
     q = trapezoid_weights(w)[None, None] * spectra[:, None]
-    return [(w, np.sum(q * (np.abs(linear + h_c) ** 2 - np.abs(linear) ** 2), axis=0))]
+    return np.sum(q * (np.abs(base + more) ** 2 - np.abs(base) ** 2), axis=0)
+
+
+def misfit_parts(
+    rows: BodyRows, linear: np.ndarray, spectra: np.ndarray, w: np.ndarray
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The drag residual's linear misfit in the body DOFs: every line's misfit loads δB·v
+    (:func:`misfit_loads_of`) through its body influence added to the bodies' ``linear``
+    transfer (n_ch, n_dof, n_w) on ``w`` before the variance is formed,
+    Σ_c q·S_c(|H_L + H_c|² − |H_L|²): parts (``w``, (n_dof, n_w)) (empty without misfit
+    loads). [m², rad²]"""
+    w = np.asarray(w, dtype=float)
+    loads = misfit_loads_of(rows, w)
+    if not loads:
+        return []
+    return [(w, _change(linear, _through(rows, loads, w, rows.body), spectra, w))]
+
+
+def station_misfit(
+    rows: BodyRows, name: str, kind: str, linear: np.ndarray, spectra: np.ndarray, w: np.ndarray
+) -> np.ndarray | None:
+    """The group's part of the drag residual's misfit at line ``name``'s stations
+    (``kind`` "elements" or "nodes", their linear transfer ``linear`` (n_ch, n_out,
+    n_w) on ``w``): the other lines' misfit loads added to the line's own before the
+    variance is formed, Σ_c q·S_c(|H_L + H_own + H_oth|² − |H_L + H_own|²), (n_out,
+    n_w) (None: no other line's loads). [N², m²]"""
+    w = np.asarray(w, dtype=float)
+    loads = misfit_loads_of(rows, w)
+    of = next((st[3] for st in rows.sets if st[0] == kind and st[1] == name), None)
+    others = {k: v for k, v in loads.items() if k != name}
+    if of is None or not others:
+        return None
+    own = _through(rows, {k: v for k, v in loads.items() if k == name}, w, of)
+    return _change(linear + own, _through(rows, others, w, of), spectra, w)
 
 
 #: The along-line record's kind of each joint sum (its key's first item).
@@ -377,6 +436,16 @@ def group_station_parts(rows: BodyRows, name: str) -> dict[str, dict[str, tuple]
     return out
 
 
+def _with_misfit(
+    parts: Mapping[str, tuple], misfit: np.ndarray | None, omega: np.ndarray
+) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
+    """The kinds' group parts as lists, the drag residual's with its misfit part."""
+    out = {kind: [part] for kind, part in parts.items()}
+    if misfit is not None and "drag_residual" in out:
+        out["drag_residual"].append((omega, misfit))
+    return out
+
+
 def with_group_stations(result: Any, rows: BodyRows) -> Any:
     """``result`` (a line's LineResult) with the group's parts of its stations added to
     its element tensions' and node motions' residual records (each a part of the kind's
@@ -385,16 +454,20 @@ def with_group_stations(result: Any, rows: BodyRows) -> Any:
     the motions' total would leave the closed forms' range."""
     parts = group_station_parts(rows, result.name)
     model = result.model
+    omega = np.asarray(result.omega, dtype=float)
+    spectra = np.asarray(result.input_spectra, dtype=float)
     s0 = np.asarray(model.mesh.s0, dtype=float)
     changes: dict[str, Any] = {}
     along = result.along_line
     if along is not None and along.computed and parts["elements"]:
         weights = station_weights(0.5 * (s0[1:] + s0[:-1]), along.stations)
         lines, var = dict(along.lines), along.variance.copy()
-        for kind, (w, v) in parts["elements"].items():
+        lin = np.asarray(result.tension_transfer)[:, along.stations]
+        mis = station_misfit(rows, result.name, "elements", lin, spectra, omega)
+        for kind, v in _with_misfit(parts["elements"], mis, omega).items():
             if kind in lines:
-                lines[kind] = lines[kind] + ((w, weights @ v),)
-                var = var + (weights @ v).sum(axis=1)
+                lines[kind] = lines[kind] + tuple((om, weights @ x) for om, x in v)
+                var = var + sum((weights @ x).sum(axis=1) for _, x in v)
         new = dataclasses.replace(along, lines=lines, variance=var)
         changes.update(along_line=new, tension_std=new.std(result.tension_std_linear))
     moves = result.motion_residual
@@ -403,12 +476,16 @@ def with_group_stations(result: Any, rows: BodyRows) -> Any:
         lin = np.asarray(result.motion_std_linear, dtype=float)
         weights = motion_weights(s0, moves.stations, lin[:, comps] ** 2)
         lines, total = dict(moves.lines), moves.variance.copy()
-        for kind, (w, v) in parts["nodes"].items():
+        u = np.asarray(result.motion_transfer)[:, moves.stations][:, :, comps]
+        u = u.reshape(u.shape[0], -1, u.shape[3])
+        mis = station_misfit(rows, result.name, "nodes", u, spectra, omega)
+        for kind, v in _with_misfit(parts["nodes"], mis, omega).items():
             if kind in lines:
-                full = np.zeros((model.n_nodes, 3, w.size))
-                full[:, comps] = (weights @ v).reshape(model.n_nodes, d, w.size)
-                lines[kind] = lines[kind] + ((w, full),)
-                total = total + full.sum(axis=2)
+                for om, x in v:
+                    full = np.zeros((model.n_nodes, 3, om.size))
+                    full[:, comps] = (weights @ x).reshape(model.n_nodes, d, om.size)
+                    lines[kind] = lines[kind] + ((om, full),)
+                    total = total + full.sum(axis=2)
         at = moves.stations
         lv = lin[at] ** 2
         live = lv > 1e-4 * np.max(lv, initial=0.0)
