@@ -19,7 +19,7 @@ import numpy as np
 from stochcable.dynamics.residuals.along_line_bodies import ElementCoupledInfluence
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 
-__all__ = ["GroupBodyInfluence", "Rows", "StationInfluence"]
+__all__ = ["Fresh", "GroupBodyInfluence", "Rows", "StationInfluence"]
 
 
 class _Kept:
@@ -40,6 +40,22 @@ class _Kept:
 
     def compute(self, w: np.ndarray) -> np.ndarray:  # pragma: no cover (abstract)
         raise NotImplementedError
+
+    def release(self) -> None:
+        """Forget the kept grids (their arrays: n_out × n_nodes × d × n_w each)."""
+        self._kept.clear()
+
+
+class Fresh:
+    """An influence's ``compute`` as its ``on``: nothing kept (a grid asked once)."""
+
+    def __init__(self, of: _Kept) -> None:
+        self.of = of
+        self.line = of.line
+
+    def on(self, w: np.ndarray) -> np.ndarray:
+        """The influence on ``w``, not kept."""
+        return self.of.compute(w)
 
 
 class GroupBodyInfluence(_Kept):

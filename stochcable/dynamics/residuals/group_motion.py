@@ -52,6 +52,7 @@ from stochcable.dynamics.residuals.drag_misfit import misfit_loads
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, SUB_SAMPLES
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
 from stochcable.dynamics.residuals.group_influence import (
+    Fresh,
     GroupBodyInfluence,
     Rows,
     StationInfluence,
@@ -60,6 +61,7 @@ from stochcable.dynamics.residuals.influence import geometric_feedthrough
 from stochcable.dynamics.residuals.residual_lines import DENSE_PAIR_BYTES, load_transfer
 
 __all__ = [
+    "MISFIT_CHUNK",
     "ROUND_OFF",
     "ROW_SCALE",
     "STATION_CELLS",
@@ -101,6 +103,11 @@ STATION_KINDS = ("drag", "drag_3d")
 #: motions by 0.7 % of the line's largest σ (its tensions not at all).
 STATION_CELLS = False
 
+#: Frequencies per block of the misfits' transfers on the analysis grid (each block's
+#: station influence n_out × n_nodes × d of them: the three-leg buoy at 100 elements
+#: and 600 frequencies kept 96 MB a line pair at once). [-]
+MISFIT_CHUNK = 64
+
 #: The cell bend of each joint sum's kind (its key's first item), as the ends'. [-]
 _BENDS = {"drag": CELL_BEND, "drag_3d": CELL_BEND, "geometric": CELL_BEND * LINE_STRIDE**2}
 
@@ -131,6 +138,7 @@ class BodyRows:
         self.n_dof = sum(b.n_dof for b in first.bodies)
         self._body: dict[str, GroupBodyInfluence] = {}
         self._own: dict[str, Any] = {}  # (the grids' solves the end tensions did not ask)
+        self._made: list[Any] = []  # (the station influences)
         # the row sets: (set, target line or None, rows, influence of a source's forces)
         self.sets: list[tuple[str, str | None, int, Callable[[str], Any]]] = []
         if self.n_dof:
@@ -161,6 +169,7 @@ class BodyRows:
         def of(name: str) -> StationInfluence:
             if name not in made:
                 made[name] = StationInfluence(target, self.body(name), self._state)
+                self._made.append(made[name])
             return made[name]
 
         return of
@@ -250,6 +259,8 @@ class BodyRows:
                 self.lines[key] = (w_out, lines_set)
             else:
                 self.stations.setdefault(key, {})[kind, line] = (w_out, lines_set)
+        for infl in self._made:  # (their grids are this sum's: not asked again)
+            infl.release()
 
     def _power(self, parts, transfer, w: np.ndarray, of, n: int) -> np.ndarray:  # noqa: ANN001
         """Σ over every line's components of |rows per unit component|², on ``w``:
@@ -373,9 +384,14 @@ def _through(rows: BodyRows, loads: Mapping[str, tuple], w: np.ndarray, of: Call
     h_c: Any = 0.0
     for name, (unit, load) in loads.items():
         line = rows.influences[name].line
-        with untapped():
-            h = load_transfer(line.system, line.damping, unit, w, of(name))
-        h_c = h_c + np.einsum("okw,ckw->cow", h, load)
+        for start in range(0, w.size, MISFIT_CHUNK):  # (not kept: asked once)
+            sl = slice(start, start + MISFIT_CHUNK)
+            with untapped():
+                h = load_transfer(line.system, line.damping, unit, w[sl], Fresh(of(name)))
+            part = np.einsum("okw,ckw->cow", h, load[..., sl])
+            if np.ndim(h_c) == 0:
+                h_c = np.zeros(part.shape[:2] + (w.size,), dtype=complex)
+            h_c[..., sl] += part
     return h_c
 
 
