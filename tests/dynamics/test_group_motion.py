@@ -15,12 +15,10 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from test_body_residual import (  # noqa: F401  (a fixture)
-    _assembled,
-    _group_of,
-    _two_leg_doc,
-    buoy_group,
-)
+from _scenes import analyzed_group as _group_of
+from _scenes import assembled_group as _assembled
+from _scenes import two_leg_buoy_doc as _two_leg_doc
+from test_body_residual import buoy_group  # noqa: F401  (a fixture)
 
 import stochcable.dynamics.groups.results as group_results
 from stochcable import analyze, load_example
@@ -67,18 +65,7 @@ def test_three_leg_body_rows_equal_the_assembled_system(buoy_group):  # noqa: F8
     """Three 3-D legs on a 6-DOF buoy: each leg's unit node forces (random, fixed seed)
     to the body DOFs, as above: to 1e-9 of the largest."""
     _, cls, _, body, lin = buoy_group
-    from stochcable.bodies.coupling import LineLink, couple
-    from stochcable.dynamics.linearization.bodydrag import body_drag_matrix
-
-    damp = {c.name: lin.lines[c.name].damping for c in cls}
-    links = [
-        LineLink(c.name, c.system.model, end_a=c.end_a, end_b=c.end_b,
-                 force_a=c.system.statics.force_a, force_b=c.system.statics.force_b,
-                 damping=damp[c.name].matrix)
-        for c in cls
-    ]  # fmt: skip
-    bd = {body.name: body_drag_matrix(body, lin.body_drag[body.name])}
-    system = couple(links, [body], body_damping=bd)
+    system, damp = _assembled(cls, [body], lin)
     infl = coupled_influences(cls, [body], damp, lin.body_drag)
     rng = np.random.default_rng(5)
     w = np.linspace(0.1, 4.0, 12)
