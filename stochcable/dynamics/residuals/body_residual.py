@@ -30,8 +30,10 @@ through the common sea and the common body motion, not independent: on a planar
 two-leg buoy the cross terms move a leg's part by −10 to −14 %, Monte Carlo agrees).
 The linear misfit loads of every line are summed through their influences
 (:meth:`CoupledInfluence.sources`) before the variance is formed.  A line's own lines
-stay its record's first part (its element tensions carry its own loads); the group's
-part is one more (:func:`with_group_lines`).  The geometric residual
+stay its record's first part (its element tensions' own records carry its own loads,
+the others' reach them as the group's part of :mod:`.group_motion`, which also gives
+the bodies' DOFs as more rows of these joint sums); the group's part is one more
+(:func:`with_group_lines`).  The geometric residual
 (:mod:`.geometric_residual`) joins the lines' quadratic forces alike.
 
 Validation: against the assembled coupled system (:func:`stochcable.bodies.coupling.couple`,
@@ -472,7 +474,7 @@ def with_group_lines(
 def untapped() -> Iterator[None]:
     """No :data:`~stochcable.dynamics.residuals.residual_lines.RESIDUAL_TAP` inside:
     another line's loads, and the group's joint sums, are not a line's own (its element
-    tensions take its own loads only)."""
+    tensions' records take its own loads; the group's part: :mod:`.group_motion`)."""
     token = RESIDUAL_TAP.set(None)
     try:
         yield
