@@ -64,7 +64,7 @@ __all__ = [
     "MISFIT_CHUNK",
     "ROUND_OFF",
     "ROW_SCALE",
-    "STATION_CELLS",
+    "STATION_CELL_NODES",
     "STATION_KINDS",
     "BodyRows",
     "body_rows_of",
@@ -94,14 +94,14 @@ ROUND_OFF = 1e-12
 #: part at the ends is +0.3 % of σ (docs/accuracy/bodies.md).
 STATION_KINDS = ("drag", "drag_3d")
 
-#: Whether the stations' group parts are integrated over the cells (False: taken on the
-#: lines, not integrated over the cells of
-#: a resonance narrower than a line as the body rows' (and the lines' own parts): the
-#: integration's sub-samples through every line's station rows cost 5 s on
-#: benchmarks/bench_bodies.py's mooring (an analysis of 7 s) and move its σ by at
-#: most 2e-4 (node motions; element tensions 5e-5), the three-leg disc buoy's node
-#: motions by 0.7 % of the line's largest σ (its tensions not at all).
-STATION_CELLS = False
+#: The stations' group parts are integrated over the cells of a resonance narrower
+#: than a line (as the body rows' and the lines' own parts) in groups of at most this
+#: many nodes over their lines; above, taken on the lines.  The integration's
+#: sub-samples pass through every line's station rows: the three-leg disc buoy (12
+#: nodes) +0.03 s, its fairlead nodes' surge-direction σ 2.96 / 2.87 ft (front / side
+#: legs, which move alike with the buoy) → 2.92 / 2.92; benchmarks/bench_bodies.py's
+#: mooring (123 nodes) +5 s on an analysis of 7 s, for at most 2e-4 of σ. [-]
+STATION_CELL_NODES = 60
 
 #: Frequencies per block of the misfits' transfers on the analysis grid (each block's
 #: station influence n_out × n_nodes × d of them: the three-leg buoy at 100 elements
@@ -139,6 +139,7 @@ class BodyRows:
         self._body: dict[str, GroupBodyInfluence] = {}
         self._own: dict[str, Any] = {}  # (the grids' solves the end tensions did not ask)
         self._made: list[Any] = []  # (the station influences)
+        self.n_nodes = sum(i.line.system.model.n_nodes for i in self.influences.values())
         # the row sets: (set, target line or None, rows, influence of a source's forces)
         self.sets: list[tuple[str, str | None, int, Callable[[str], Any]]] = []
         if self.n_dof:
@@ -253,7 +254,7 @@ class BodyRows:
                     own = outputs([parts[i][1]], t_own)[2:]
                 lines_set = lines_set - own / scale[rows, None] ** 2
             lines_set = lines_set[:n]
-            if kind == "body" or STATION_CELLS:
+            if kind == "body" or self.n_nodes <= STATION_CELL_NODES:
                 lines_set = lines_set * self._cells(parts, transfer, w_out, bend, of, n)
             if kind == "body":
                 self.lines[key] = (w_out, lines_set)
