@@ -26,6 +26,7 @@ from stochcable.dynamics.residuals.influence import (
     MODAL_SHARE,
     MODAL_SPAN,
     EndInfluence,
+    ModalRows,
     SharedRows,
     band_stack,
     element_directions,
@@ -308,6 +309,11 @@ def load_transfer(
         g = end_influence(system, damping, w) if g is None else g
     else:
         g = influence.on(w)
+    if isinstance(g, ModalRows):  # (through the modes: the rows never formed)
+        h = g.transfer(unit)
+        if (tap := RESIDUAL_TAP.get()) is not None:
+            tap.loads(unit, w, h)
+        return h
     n = g.shape[1] * g.shape[2]
     # the real loads times the complex influence as one real product per output on the
     # interleaved view (a complex product would upcast the loads: 4× the work)
