@@ -57,6 +57,8 @@ __all__ = [
     "fft_length",
     "EndInfluence",
     "end_influence",
+    "fill_lines",
+    "line_subset",
     "load_transfer",
     "modal_influence",
     "pair_blocks",
@@ -254,6 +256,25 @@ class PairLines:
         if (tap := RESIDUAL_TAP.get()) is not None and hasattr(tap, "dense"):
             tap.dense(self._g, self.transfer)
         return dense_pair_outputs(self._g, self.transfer)
+
+
+def line_subset(top: int, stride: int = 1) -> np.ndarray:
+    """The lines (indices) of the first ``top`` the along-line outputs are formed on:
+    every ``stride``-th and the last (:func:`fill_lines` the others)."""
+    sel = np.arange(0, top, stride)
+    return sel if top == 0 or sel[-1] == top - 1 else np.append(sel, top - 1)
+
+
+def fill_lines(part: np.ndarray, sel: np.ndarray, top: int) -> np.ndarray:
+    """The variance lines (n_out, top) from those on the lines ``sel``
+    (:func:`line_subset`) ``part`` (n_out, n_sel), the others interpolated linearly
+    between their neighbours. [unit²]"""
+    if sel.size == top:
+        return part
+    out = np.empty((part.shape[0], top))
+    for k, row in enumerate(part):
+        out[k] = np.interp(np.arange(top), sel, row)
+    return out
 
 
 def along(x: np.ndarray, vec: np.ndarray) -> np.ndarray:
