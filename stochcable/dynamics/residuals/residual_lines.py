@@ -206,15 +206,16 @@ def pair_outputs(g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarr
     return tt.real.sum(axis=1)
 
 
-def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray) -> np.ndarray:
+def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, dtype: Any = complex) -> np.ndarray:
     """Re Σ_ef conj(T_e) G_ef T_f of outputs with transfer ``transfer`` (n_out, n, n_o)
     from the dense lines ``g_all`` (n_o, n·n) (G_ef in column e·n + f) as one matrix
     product per line (BLAS; the per-pair form costs n_pairs × n_out elementwise
-    products): shape (n_out, n_o)."""
+    products), in ``dtype`` (``np.complex64``: single precision, summed in double):
+    shape (n_out, n_o)."""
     n_out, n, n_o = transfer.shape
-    t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)))  # (n_o, n, n_out)
-    gt = g_all.reshape(n_o, n, n) @ t  # (n_o, n, n_out)
-    return (t.real * gt.real + t.imag * gt.imag).sum(axis=1).T  # Re(conj(t)·gt)
+    t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)), dtype=dtype)  # (n_o, n, n_out)
+    gt = g_all.reshape(n_o, n, n).astype(dtype, copy=False) @ t  # (n_o, n, n_out)
+    return (t.real * gt.real + t.imag * gt.imag).sum(axis=1, dtype=float).T  # Re(conj(t)·gt)
 
 
 #: Largest dense matrix of one contraction's pair lines (:class:`PairLines`, n² × n_o
