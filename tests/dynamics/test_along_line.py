@@ -199,7 +199,7 @@ def test_element_tensions_on_every_second_line(monkeypatch):
     element's corrected σ within 1e-4 on the chain (measured 1.3e-5; 3.9e-5 on the
     two-segment line); the inclined guy, whose 0.7 %-damped mode fails the ends' check,
     keeps every line (bitwise)."""
-    import stochcable.dynamics.residuals.along_line as al
+    import stochcable.dynamics.residuals.residual_lines as rl
 
     sys.path.insert(0, str(ROOT / "benchmarks"))
     import residual_cost
@@ -208,7 +208,7 @@ def test_element_tensions_on_every_second_line(monkeypatch):
             for n in ("chain", "guy")}  # fmt: skip
     got = {}
     for stride in (1, 2):
-        monkeypatch.setattr(al, "ALONG_STRIDE", stride)
+        monkeypatch.setattr(rl, "ALONG_STRIDE", stride)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             got[stride] = {n: next(iter(analyze(d).lines.values())).tension_std

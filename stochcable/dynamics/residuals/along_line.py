@@ -60,6 +60,7 @@ from stochcable.dynamics.residuals.residual_lines import (
     along,
     dense_pair_outputs,
     fill_lines,
+    line_stride,
     line_subset,
     load_transfer,
     shared_rows,
@@ -96,19 +97,11 @@ MAX_STATIONS = 7
 #: tension's exceeds this fraction of its largest (:func:`top_line`): the superharmonic
 #: tail above carries nothing at the ends (chain: lines 120 of 189, taut wire 55). [-]
 LINE_FLOOR = 1e-8
-#: The element tensions' and node motions' residual lines are formed on every
-#: ALONG_STRIDE-th line of the kind's (and its last), the others interpolated
-#: (:func:`line_subset`, :func:`fill_lines`) where the ends' lines allow it
-#: (:func:`line_stride`): their rows' transfer and contraction cost in proportion. [-]
-ALONG_STRIDE = 2
 #: The element tensions' and node motions' contraction of the kinds' dense pair lines
-#: (:func:`capture_outputs`) in single precision: 1.4 of 8 ms on the chain; their σ
+#: (:func:`capture_outputs`) in single precision: 8.0 -> 4.4 ms on the chain; their σ
 #: within 2e-7 of double precision on the benchmark lines (a quadratic form of a
 #: positive semi-definite cross-spectrum: no cancellation). [-]
 ALONG_DTYPE = np.complex64
-#: :func:`line_stride`'s tolerance on the ends' residual variance summed on the
-#: strided lines (its σ share: half of it). [-]
-STRIDE_TOL = 2e-3
 CELL_BENDS = {
     "drag_residual": CELL_BEND,
     "geometric_residual": CELL_BEND * LINE_STRIDE**2,
@@ -131,6 +124,7 @@ class Capture:
     transfer: np.ndarray
     blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]]
     g_all: np.ndarray | None = None
+    g_low: np.ndarray | None = None  # (``g_all`` in :data:`ALONG_DTYPE`, once asked)
 
 
 class ResidualTap(VectorTapMixin):
@@ -156,10 +150,9 @@ class ResidualTap(VectorTapMixin):
 
     def dense(self, g_all: np.ndarray, transfer: np.ndarray) -> None:
         """A :class:`~.residual_lines.PairLines` contraction's dense lines (n_o, n·n),
-        kept with the capture of its blocks (same ``transfer``) in single precision
-        (:data:`ALONG_DTYPE`)."""
+        kept with the capture of its blocks (same ``transfer``)."""
         if self.captures and self.captures[-1].transfer is transfer:
-            self.captures[-1].g_all = g_all.astype(ALONG_DTYPE)
+            self.captures[-1].g_all = g_all
 
     def lines(self, g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
         """A :func:`pair_outputs` call: a block of pairs' lines G and the loads' end
@@ -283,6 +276,7 @@ def element_lines(
     feedthrough: bool = True,
     top_line: int | None = None,
     stride: int = 1,
+    dtype: Any = complex,
 ) -> np.ndarray | None:
     """The variance lines (n_out, n_o) of the outputs of ``influence`` (n_out rows)
     driven by the loads of one kind's ``captures`` (module notes), on the captures'
@@ -290,7 +284,8 @@ def element_lines(
     outputs are the element tensions, and the geometric forces' own second-order
     stretch enters each element's tension directly (:func:`geometric_feedthrough`).
     ``top_line``: the lines from it up are left out (zero; :func:`top_line`);
-    ``stride``: formed on every stride-th line (:func:`line_stride`)."""
+    ``stride``: formed on every stride-th line (:func:`line_stride`); ``dtype``: of
+    the contraction (:func:`capture_outputs`)."""
     out = None
     for cap in captures:
         top = cap.w.size if top_line is None else min(top_line, cap.w.size)
@@ -301,7 +296,7 @@ def element_lines(
             own = geometric_feedthrough(system, cap.unit.shape[2])
             at = getattr(influence, "elements", None)
             full = full + own[slice(None) if at is None else at, :, None]
-        part = capture_outputs(cap, full[:, cap.kept], sel)
+        part = capture_outputs(cap, full[:, cap.kept], sel, dtype)
         part *= cell_factor(
             system, damping, cap.unit, w, full, CELL_BENDS[kind] * stride**2, influence=influence
         )
@@ -311,32 +306,23 @@ def element_lines(
     return out
 
 
-def line_stride(record: Any, top: int | None, tol: float = STRIDE_TOL) -> int:
-    """:data:`ALONG_STRIDE` where the record's end variance lines (their first part, up
-    to ``top``) summed on every stride-th line (:func:`fill_lines`' weights) are within
-    ``tol`` of their sum on all lines at both ends (the along-line outputs share their
-    loads and resonances: the inclined guy's 0.7 %-damped mode fails it), else 1."""
-    if ALONG_STRIDE == 1 or not record.lines:
-        return 1
-    _, part = record.lines[0]
-    v = np.stack([np.asarray(x, dtype=float) for x in part.values()])[:, :top]
-    if v.shape[1] < 4 * ALONG_STRIDE:
-        return 1
-    sel = line_subset(v.shape[1], ALONG_STRIDE)
-    dec = fill_lines(v[:, sel], sel, v.shape[1]).sum(axis=1)
-    full = v.sum(axis=1)
-    return ALONG_STRIDE if np.all(np.abs(dec - full) <= tol * np.abs(full)) else 1
-
-
-def capture_outputs(cap: Capture, transfer: np.ndarray, sel: Any = None) -> np.ndarray:
+def capture_outputs(
+    cap: Capture, transfer: np.ndarray, sel: Any = None, dtype: Any = complex
+) -> np.ndarray:
     """The variance lines (n_out, n_o) of outputs with transfer ``transfer`` (n_out,
     n_kept, n_o) per unit load of ``cap``'s kept loads on its first n_o lines, or on
     its lines ``sel`` (:func:`line_subset`): from the kind's dense pair lines where it
-    kept them (``cap.g_all``), else its blocks (:func:`dense_outputs`)."""
+    kept them (``cap.g_all``; contracted in ``dtype``, :data:`ALONG_DTYPE` converted
+    once per capture), else its blocks (:func:`dense_outputs`)."""
     sel = slice(0, transfer.shape[2]) if sel is None else sel
     if cap.g_all is None:
         return dense_outputs(cap.blocks, transfer, sel)
-    return dense_pair_outputs(cap.g_all[sel], transfer, ALONG_DTYPE)
+    g = cap.g_all
+    if np.dtype(dtype) != g.dtype:
+        if cap.g_low is None or cap.g_low.dtype != np.dtype(dtype):
+            cap.g_low = g.astype(dtype)
+        g = cap.g_low
+    return dense_pair_outputs(g[sel], transfer, dtype)
 
 
 def dense_outputs(
@@ -580,9 +566,8 @@ def along_line_residual(
             )
         w_lines = np.asarray(caps[0].w, dtype=float)
         top = top_line(rec)
-        v = element_lines(
-            system, damping, kind, caps, influence, top_line=top, stride=line_stride(rec, top)
-        )
+        stride = line_stride(rec, top)
+        v = element_lines(system, damping, kind, caps, influence, True, top, stride, ALONG_DTYPE)
         parts = [(w_lines, weights @ v)]
         for mis in tap.misfits if tap is not None else ():
             if linear is None:

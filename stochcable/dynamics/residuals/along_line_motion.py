@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.residuals.along_line import (
+    ALONG_DTYPE,
     CELL_BENDS,
     MAX_STATIONS,
     bent_cells,
@@ -193,14 +194,15 @@ def motion_lines(
     influence: Any,
     top: int | None,
     stride: int = 1,
+    dtype: Any = complex,
 ) -> np.ndarray:
     """The variance lines (n_out, n_o) of the outputs of ``influence`` driven by one
     kind's pair ``captures`` (as
     :func:`~stochcable.dynamics.residuals.along_line.element_lines` without the
     geometric feedthrough), the loads the kind kept only, contracted sparsely
     (:func:`sparse_transfer`); the lines from ``top`` up left out (zero), formed on
-    every ``stride``-th (:func:`~stochcable.dynamics.residuals.along_line.line_stride`).
-    [m²]"""
+    every ``stride``-th (:func:`~stochcable.dynamics.residuals.along_line.line_stride`),
+    contracted in ``dtype``. [m²]"""
     out = None
     for cap in captures:
         n_top = cap.w.size if top is None else min(top, cap.w.size)
@@ -212,7 +214,7 @@ def motion_lines(
         else:
             full = sparse_transfer(influence.on(w), unit)  # (n_out, n_kept, n_sel)
             lines = np.zeros((full.shape[0], cap.w.size))
-            part = capture_outputs(cap, full, sel) * motion_cells(
+            part = capture_outputs(cap, full, sel, dtype) * motion_cells(
                 system, damping, unit, w, full, CELL_BENDS[kind] * stride**2, influence
             )
             lines[:, :n_top] = fill_lines(part, sel, n_top)
@@ -352,7 +354,7 @@ def motion_residual(
             w_lines = np.asarray(caps[0].w, dtype=float)
             # (every line: on the two-segment line's rope every second one moved the
             # node motions' residual by up to 7 % where the ends' moved 0.2 %)
-            v = motion_lines(system, damping, kind, caps, influence, top_line(rec))
+            v = motion_lines(system, damping, kind, caps, influence, top_line(rec), 1, ALONG_DTYPE)
             parts = ((w_lines, weights @ v),)
             for mis in tap.misfits:
                 if linear is None:
