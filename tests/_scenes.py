@@ -203,3 +203,111 @@ def td_end_sigma(doc: dict, seed: int, scale: float = 1.0, **variant) -> np.ndar
     )
     keep = (h.t >= CHAIN_PERIOD - 1e-9) & (h.t < 2 * CHAIN_PERIOD - 1e-9)
     return np.array([h.tension_b[keep].std(), h.tension_a[keep].std()]) / scale
+
+
+#: Sea water density of the buoy groups' drag linearization. [kg/m³]
+RHO = 1025.0
+
+
+def three_leg_buoy_group() -> tuple:
+    """Three 3-D chain legs (10 elements) on a 6-DOF buoy (tests/dynamics/
+    test_coupled_analysis.py's mooring), the coupled drag fixed point converged:
+    (scene, coupled lines, body loads, body, CoupledLinearization)."""
+    from stochcable.bodies.rigid import RigidBody
+    from stochcable.dynamics.groups import CoupledLine, body_loads, linearize_coupled
+    from stochcable.dynamics.loads.channels import line_channels
+    from stochcable.dynamics.model.system import build_line_system
+    from stochcable.statics import solve_statics
+
+    doc = {
+        "environment": {"depth": 100.0},
+        "sea": {"spectrum": {"type": "jonswap", "hs": 3.0, "tp": 9.0}, "heading": 30.0},
+        "lines": three_chain_legs(10),
+        "analysis": {
+            "omega": {"min": 0.1, "max": 2.0, "count": 30},
+            "solver": "direct",
+            "linearization": {"tolerance": 1e-7, "max_iterations": 200},
+        },
+    }
+    body = RigidBody(
+        name="buoy",
+        position=[0.0, 0.0, 0.0],
+        mass=2.0e4,
+        inertia=np.diag([5e4, 5e4, 8e4]),
+        added_mass=np.diag([1e4, 1e4, 2e4, 2e4, 2e4, 1e3]),
+        radiation_damping=np.diag([1e3, 1e3, 5e3, 1e3, 1e3, 1e2]),
+        hydrostatic_stiffness=np.diag([0.0, 0.0, 1.26e5, 1e5, 1e5, 0.0]),
+        drag_area=[4.0, 4.0, 8.0],
+        drag_point=[0.0, 0.0, -1.0],
+    )
+    scene = load_scene(doc)
+    statics = solve_statics(scene, method="fe")
+    omega = scene.analysis.omega.values()
+    cls = []
+    for line in scene.lines:
+        s = build_line_system(scene, line, statics.lines[line.name])
+        cls.append(CoupledLine(s, line_channels(scene, line, s.positions, omega), end_b="buoy"))
+    loads = {"buoy": body_loads(body, cls[0].channels, omega, scene.sea, scene.environment)}
+    lin = linearize_coupled(cls, [body], scene.analysis, rho=RHO, loads=loads)
+    return scene, cls, loads, body, lin
+
+
+def two_leg_buoy_doc(heading: float = 0.0, wind: float = 100.0) -> dict:
+    """The planar disc buoy (Tuah 1982 §6.5 example) on two legs mirrored about x = 0."""
+    doc = load_example("tuah_1982_disc_buoy_single_leg").model_dump(mode="json")
+    leg2 = copy.deepcopy(doc["lines"][0])
+    leg2["name"] = "leg2"
+    leg2["end_a"]["position"] = [300.0, 0.0, -100.0]
+    doc["lines"].append(leg2)
+    doc["sea"]["heading"] = heading
+    doc["bodies"][0]["wind_force"] = [wind, 0.0, 0.0]
+    if heading != 0.0:  # (the excitation table has heading 0 only: the Froude–Krylov form)
+        doc["bodies"][0].pop("hydrodynamics")
+    return doc
+
+
+def analyzed_group(doc: dict) -> tuple:
+    """``doc`` analysed (warnings silenced), with its (first) group's lines, bodies and
+    fixed point as the analysis gave them to the results: (result, coupled lines,
+    bodies, CoupledLinearization)."""
+    import warnings
+
+    import pytest
+
+    from stochcable import analyze
+    from stochcable.dynamics.groups import analysis as group_analysis
+
+    seen = {}
+    real = group_analysis.coupled_results
+
+    def capture(cls, bodies, clin, settings, **kw):  # noqa: ANN001, ANN202
+        seen.setdefault("group", (cls, bodies, clin))
+        return real(cls, bodies, clin, settings, **kw)
+
+    mp = pytest.MonkeyPatch()
+    mp.setattr(group_analysis, "coupled_results", capture)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = analyze(doc)
+    finally:
+        mp.undo()
+    return (res, *seen["group"])
+
+
+def assembled_group(cls, bodies, clin) -> tuple:  # noqa: ANN001
+    """The group's lines and bodies assembled (stochcable.bodies.coupling), at the
+    converged line and body drag of ``clin``: (CoupledSystem, the lines' Damping)."""
+    from stochcable.bodies.coupling import LineLink, couple
+    from stochcable.dynamics.linearization.bodydrag import body_drag_matrix
+
+    damp = {c.name: clin.lines[c.name].damping for c in cls}
+    links = [
+        LineLink(c.name, c.system.model, end_a=c.end_a, end_b=c.end_b,
+                 force_a=c.system.statics.force_a, force_b=c.system.statics.force_b,
+                 damping=damp[c.name].matrix)
+        for c in cls
+    ]  # fmt: skip
+    bd = {b.name: body_drag_matrix(b, clin.body_drag[b.name]) for b in bodies
+          if b.name in clin.body_drag}  # fmt: skip
+    return couple(links, bodies, body_damping=bd), damp

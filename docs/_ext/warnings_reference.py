@@ -197,30 +197,29 @@ WARNINGS: tuple[WarningEntry, ...] = (
     WarningEntry(
         "How a load-case set applies the residuals",
         "PhysicsWarning",
-        ("stochcable.cases.plan:plan_cases", "stochcable.client_batches:submit_batch"),
+        ("stochcable.cases.run:_warn_interpolated", "stochcable.client_batches:submit_batch"),
         "the set's scene sets ``analysis.linearization.drag_residual`` or "
-        "``geometric_residual`` (over HTTP: the batch status's ``warnings``, which the "
-        "Python client's ``submit_batch`` issues)",
+        "``geometric_residual`` (the default) and some cases' corrections are "
+        "interpolated, not computed (``run_cases``'s default; a set that computes every "
+        "case, as the service's batches do, does not warn; the Python client's "
+        "``submit_batch`` issues a batch's planning warnings)",
         "Every case's end statistics and end damage are those of the corrected spectrum "
         "(the linear spectrum plus the residuals', "
         ":mod:`stochcable.dynamics.residuals.corrected_spectrum`); the along-line "
         "damage comes from the element tensions' corrected spectra where the analysis "
-        "computes the residuals along the line (interpolated as the ends'), lines on "
-        "free bodies included (their residuals through the coupled response, as "
-        "``analyze()``'s).  ``run_cases`` computes the residuals on the "
-        "cases its adaptive anchors choose (per period and heading the smallest, middle "
-        "and largest Hs, then the middle Hs of every interval where the interpolated "
-        "corrections miss the computed ones by more than ``residual_tolerance``, "
-        "default 2e-3) and interpolates their corrections in Hs on the others "
-        "(:mod:`stochcable.cases.residual_anchors`: measured within 8.7e-4 on σ and "
-        "4.4e-3 on end damage of every case computed); with ``residual_span`` and "
-        "``residual_tolerance=None`` on fixed anchors (up to 4.2 % on σ on the taut "
-        "wire at Tp 10 s); a plan (the service's batches) computes every case.  The "
-        "warning says which.",
-        "Keep the defaults; ``residual_tolerance=None`` computes every case. "
-        "Read the along-line damage as the linear model's; where it governs, run "
-        "``analyze()`` on the governing cases and scale it by the end's σ ratio "
-        "(``linear`` block) to the power of the curve's slope.",
+        "computes the residuals along the line, lines on free bodies included (their "
+        "residuals through the coupled response, as ``analyze()``'s).  ``run_cases`` "
+        "computes the residuals on the cases its adaptive anchors choose (per heading "
+        "the shortest, middle and longest period, then the middle period of every "
+        "interval where the corrections interpolated in the period miss the computed "
+        "ones; in every computed period the smallest, middle and largest Hs, then the "
+        "middle Hs of every interval where the corrections interpolated in Hs miss — "
+        "by more than ``residual_tolerance``, default 2e-3) and interpolates their "
+        "corrections on the others (:mod:`stochcable.cases.residual_anchors`: the "
+        "measured error is in the benchmarks' load-case page); with ``residual_span`` "
+        "and ``residual_tolerance=None`` on fixed anchors (up to 4.2 % on σ on the taut "
+        "wire at Tp 10 s).  The warning says how many cases computed them.",
+        "Keep the defaults; ``residual_tolerance=None`` computes every case.",
     ),
     WarningEntry(
         "Second-order stretching tension large (indicator ``second_order``)",

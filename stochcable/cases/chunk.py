@@ -32,11 +32,13 @@ from typing import Any
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from stochcable.cases.along_spectra import element_densities
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import Family, SeaState
 from stochcable.design import damage_rate
 from stochcable.dynamics.engine import Engine
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
+from stochcable.dynamics.outputs.line_result import MOTION_RESIDUALS
 from stochcable.errors import StochcableError, collect_warnings
 from stochcable.fidelity.mesh_engine import checked_engine
 from stochcable.scene.model import Scene, Sea
@@ -315,7 +317,7 @@ def solve_chunk(
     -------
     ChunkResult
     """
-    with threadpool_limits(limits=1):
+    with threadpool_limits(limits=1), _no_motion_residuals():
         engine = _engine(template) if engine is None else engine
         linear_engine = None  # (the same engine without the residuals, when needed)
         # (the engine's counts: the element check may have raised the defaults)
@@ -402,14 +404,25 @@ def solve_chunk(
     )
 
 
+@contextlib.contextmanager
+def _no_motion_residuals():
+    """A set reports no node or body motions: their residuals are not computed (the
+    end and element tensions the same; on the chain example ≈ 12 ms of a computed
+    case's ≈ 53 ms of residuals, docs/benchmarks/cases.md)."""
+    token = MOTION_RESIDUALS.set(False)
+    try:
+        yield
+    finally:
+        MOTION_RESIDUALS.reset(token)
+
+
 def _along_densities(lr: Any) -> tuple[np.ndarray, np.ndarray]:
     """The element tensions' spectral densities with the residuals (their
     :class:`~stochcable.dynamics.residuals.along_line.AlongLineResidual` lines on the
     analysis grid extended as the ends', the same grid for every element), stacked
-    (n_el, n): the along-line damage of a case that computed them."""
-    lin = lr.tension_spectrum
-    parts = [lr.along_line.density(e, lr.omega, lin[e]) for e in range(lin.shape[0])]
-    return parts[0].omega, np.stack([p.density for p in parts])
+    (n_el, n): the along-line damage of a case that computed them
+    (:func:`~stochcable.cases.along_spectra.element_densities`)."""
+    return element_densities(lr.along_line, lr.omega, lr.tension_spectrum)
 
 
 def without_residuals(engine: Engine) -> Engine:

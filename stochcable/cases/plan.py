@@ -28,7 +28,7 @@ from stochcable.cases.chunk import (
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.residual_anchors import first_anchors, residual_anchors
 from stochcable.cases.scatter import ScatterDiagram, SeaState
-from stochcable.errors import InputError, PhysicsWarning, warn
+from stochcable.errors import InputError
 from stochcable.scene.model import Scene, load_scene
 from stochcable.scene.residual_kinds import asked_residuals
 
@@ -205,34 +205,6 @@ def plan_cases(
         exact = first_anchors(scatter.states, residual_span)
     else:
         exact = residual_anchors(scatter.states, residual_span if asked else None)
-    if asked:
-        if adaptive:
-            interp = (
-                "; they are computed on the cases the adaptive anchors choose (per Tp, γ "
-                "and heading the smallest and largest Hs, then the middle Hs of every "
-                "interval where the interpolated corrections miss the computed ones by "
-                f"more than {residual_tolerance:g}) and their corrections interpolated "
-                "in Hs on the others (stochcable.cases.residual_anchors; "
-                "residual_tolerance=None computes every case)"
-            )
-        else:
-            interp = (
-                ""
-                if exact.all()
-                else f"; they are computed on {int(exact.sum())} of the {n} cases (per Tp, "
-                f"γ and heading the smallest and largest Hs and at most {residual_span} Hs "
-                "steps apart) and their corrections interpolated in Hs on the others "
-                "(stochcable.cases.residual_anchors; residual_span=None computes every case)"
-            )
-        warn(
-            "load-case sets apply "
-            + ", ".join(f"analysis.linearization.{k}" for k in asked)
-            + " to the end tensions (their statistics and damage: the corrected "
-            "spectrum) and to the along-line damage where the analysis computes them "
-            "along the line (the elements' corrected spectra), lines on free bodies "
-            "included; a set reports no node motions" + interp,
-            PhysicsWarning,
-        )
     chunks = tuple(
         tuple((i, scatter.states[i], bool(exact[i])) for i in range(a, min(a + chunk_size, n)))
         for a in range(0, n, chunk_size)

@@ -33,8 +33,9 @@ from stochcable.cases.residual_anchors import (
 from stochcable.cases.scatter import ScatterDiagram
 from stochcable.design import SECONDS_PER_YEAR, return_level
 from stochcable.dynamics.engine import Engine
-from stochcable.errors import InputError
+from stochcable.errors import InputError, PhysicsWarning, warn
 from stochcable.scene.model import Scene
+from stochcable.scene.residual_kinds import asked_residuals
 
 __all__ = ["CaseRow", "LineTotals", "CaseSetResult", "run_cases", "assemble_cases", "ENDS"]
 
@@ -171,18 +172,19 @@ def run_cases(
         The same as ``executor=client`` (give one of the two).
     residual_span : int or None
         With the residuals of the linear model asked for: most steps of a column's
-        sorted Hs (one Tp, γ and heading) between the first cases that compute them
+        sorted Hs (one period and heading) between the first cases that compute them
         (None: the column's smallest and largest Hs); see ``residual_tolerance``.
     residual_tolerance : float or None
         With the residuals asked for, the adaptive anchors
-        (:mod:`stochcable.cases.residual_anchors`): each column's intervals between
-        the cases that compute the residuals are checked at their middle Hs and
-        bisected until the corrections interpolated there (σ, Tz and 3-h MPM over the
-        linear ones; the end damage rate's, with 3 × the tolerance) are within
-        ``residual_tolerance`` of the computed ones; the other cases get interpolated
-        corrections.  Default :data:`~stochcable.cases.residual_anchors.RESIDUAL_TOLERANCE`
-        (2e-3: measured within 8.7e-4 on σ and 4.4e-3 on the end damage of the cases
-        computed one by one, on the chain, the taut wire and Tuah's single leg,
+        (:mod:`stochcable.cases.residual_anchors`): per heading the periods are
+        bisected from the shortest, middle and longest, each computed period's Hs from
+        its smallest, middle and largest, until the corrections interpolated at every
+        checked middle (σ, Tz and 3-h MPM over the linear ones; the end and element
+        damage rates', with 3 × the tolerance) are within ``residual_tolerance`` of
+        the computed ones; the other cases get interpolated corrections, and a
+        PhysicsWarning says how many cases computed them.  Default
+        :data:`~stochcable.cases.residual_anchors.RESIDUAL_TOLERANCE` (2e-3; the
+        measured error on the chain, the taut wire and Tuah's single leg is in
         docs/benchmarks/cases.md; never finer than the scene's
         ``analysis.linearization.tolerance``, to which the ratios are known).
         None: no check — with ``residual_span`` the fixed anchors of
@@ -247,8 +249,8 @@ def _refine(
     while True:
         merged = _merge(plan, results)
         todo = next_anchors(
-            states, plan.residual_span, tol, merged.exact,
-            merged.rows, merged.stats, merged.d_ends, merged.linear,
+            states, plan.residual_span, tol, merged.exact, merged.rows, merged.stats,
+            merged.d_ends, merged.linear, (merged.damage, merged.linear_along),
         )  # fmt: skip
         idx = np.flatnonzero(todo)
         if idx.size == 0:
@@ -331,6 +333,7 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     law = "hs2" if plan.residual_tolerance is None else "power"
     interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear, law)
     interpolate_along(scatter.states, m.exact, rows, damage, m.linear_along, law)
+    _warn_interpolated(plan, m.exact)
     s_el = m.s_el
     d_along = {ln: damage[ln][:, 2:] for ln in names}
     p = np.array([s.probability for s in scatter.states])
@@ -349,6 +352,31 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
         scatter, tuple(rows), names, s_el, stats, d_ends, d_along, totals, coverage,
         years, settings,
     )  # fmt: skip
+
+
+def _warn_interpolated(plan: CasePlan, exact: np.ndarray) -> None:
+    """The set's PhysicsWarning when some cases' residuals were interpolated (none
+    when every case computed them): how many computed them, and how."""
+    asked = [k.name for k in asked_residuals(plan.template.analysis.linearization)]
+    n, k = exact.size, int(np.sum(exact))
+    if not asked or k == n:
+        return
+    how = (
+        "the adaptive anchors' columns (period and heading) and Hs, checked to "
+        f"{plan.residual_tolerance:g} (stochcable.cases.residual_anchors)"
+        if plan.residual_tolerance is not None
+        else f"per period and heading the smallest and largest Hs and at most "
+        f"{plan.residual_span} Hs steps apart (stochcable.cases.residual_anchors)"
+    )
+    warn(
+        "load-case set: "
+        + ", ".join(f"analysis.linearization.{a}" for a in asked)
+        + f" computed on {k} of the {n} cases ({how}); the other {n - k} cases' end "
+        "statistics, end damage and along-line damage are their linear values times "
+        "the computed cases' corrections interpolated in Hs along a period and linearly "
+        "in the period between periods (residual_tolerance=None computes every case)",
+        PhysicsWarning,
+    )
 
 
 @dataclass

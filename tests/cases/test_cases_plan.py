@@ -46,7 +46,8 @@ def test_assembled_from_stored_chunks_in_any_order_equals_run_cases():
     assert [len(c) for c in plan.chunks] == [2, 2, 1]
     stored = [chunk_to_bytes(plan.solve(k)) for k in range(len(plan.chunks))]
     got = assemble_cases(plan, [chunk_from_bytes(b) for b in reversed(stored)])
-    ref = run_cases(SCENE, SCATTER, fatigue=fatigue)
+    # (a plan computes every case's residuals: run_cases so, not on its adaptive anchors)
+    ref = run_cases(SCENE, SCATTER, fatigue=fatigue, residual_tolerance=None)
     np.testing.assert_array_equal(got.stats["leg1"]["end_a"], ref.stats["leg1"]["end_a"])
     np.testing.assert_array_equal(got.damage_rate_along["leg1"], ref.damage_rate_along["leg1"])
     assert got.totals["leg1"].return_level == ref.totals["leg1"].return_level
@@ -89,13 +90,15 @@ def test_a_set_applies_the_scenes_residuals():
     rows = [{"hs": 2, "tp": 8, "probability": 0.5}, {"hs": 3, "tp": 9, "probability": 0.5}]
     small = scatter_from_rows(rows)
     fatigue = LineFatigue("dnv-studless", nominal_diameter=0.076)
-    from stochcable.errors import PhysicsWarning
-
-    with pytest.warns(PhysicsWarning, match="drag_residual, .*geometric_residual to the end"):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         plan = plan_cases(doc, small, fatigue=fatigue)
+        asked = run_cases(doc, small, fatigue=fatigue)
+    # (two periods of one Hs each: every case computes its residuals, and the set's
+    # warning on interpolated corrections stays silent)
+    assert not [w for w in caught if "load-case set:" in str(w.message)]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        asked = run_cases(doc, small, fatigue=fatigue)
         linear = SCENE.model_dump(mode="json", exclude_unset=True)
         linear["analysis"].setdefault("linearization", {}).update(LINEAR_ONLY)
         plain = run_cases(linear, small, fatigue=fatigue)

@@ -341,3 +341,32 @@ def test_a_fixed_point_started_at_its_own_answer_costs_one_evaluation(example):
         assert line.linearization.converged
         ref = cold.lines[name].end_b.std
         assert line.end_b.std == pytest.approx(ref, rel=tol)
+
+
+def test_a_set_skips_the_node_motion_residuals_only():
+    """A set reports no node motions: its cases skip their residuals
+    (``MOTION_RESIDUALS`` off inside a chunk, restored after), and the corrected end
+    tensions, their spectra and the elements' σ are those of the engine's full solve
+    to the bit (the shared influence's end and element rows are solved alone)."""
+    import warnings
+
+    from stochcable.cases.chunk import _no_motion_residuals, case_sea, engine_template, set_engine
+    from stochcable.dynamics.outputs.line_result import MOTION_RESIDUALS
+
+    scene = load_scene(_wire())
+    sd = scatter_from_rows([{"hs": 2.0, "tp": 9.0, "hours": 1.0}])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        engine = set_engine(engine_template(scene, sd.states, "jonswap"))
+        sea = case_sea(scene, sd.states[0], "jonswap")
+        full = engine.solve(sea).lines["wire"]
+        with _no_motion_residuals():
+            assert not MOTION_RESIDUALS.get()
+            part = engine.solve(sea).lines["wire"]
+    assert MOTION_RESIDUALS.get()
+    assert full.motion_residual is not None and part.motion_residual is None
+    assert full.linear is not None  # (the residuals are on)
+    for e in ("end_a", "end_b"):
+        assert getattr(part, e) == getattr(full, e)
+        assert np.array_equal(part.end_tension_density(e)[1], full.end_tension_density(e)[1])
+    assert np.array_equal(part.tension_std, full.tension_std)

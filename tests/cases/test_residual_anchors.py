@@ -17,10 +17,11 @@ from stochcable.cases.plan import chunk_from_bytes, chunk_to_bytes
 from stochcable.cases.residual_anchors import (
     correction,
     first_anchors,
+    interpolate_corrections,
     next_anchors,
     residual_anchors,
 )
-from stochcable.errors import InputError
+from stochcable.errors import InputError, PhysicsWarning
 
 WIRE = LineFatigue("dnv-six-strand", nominal_area=1.2e-3)
 HS = (0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5)
@@ -121,6 +122,73 @@ def _bisect(ratio, tolerance=1e-3):
         exact = exact | more
 
 
+def _field(ratio, hs=(1.0, 2.0, 3.0, 4.0, 5.0), tps=tuple(6.0 + k for k in range(9)), rows=None):
+    """A synthetic diagram (every Hs at every Tp, or ``rows``): linear σ, Tz and MPM 1,
+    corrected ones ``ratio(hs, tp)``, no damage (NaN)."""
+    rows = rows or [{"hs": h, "tp": t, "hours": 1.0} for t in tps for h in hs]
+    states = scatter_from_rows(rows).states
+    n = len(states)
+    r = np.array([ratio(s.hs, s.tp) for s in states])
+    stats = {"l": {e: np.column_stack([np.zeros(n), r, r, r]) for e in ("end_a", "end_b")}}
+    linear = {"l": np.concatenate([np.ones((n, 2, 3)), np.full((n, 2, 1), np.nan)], axis=2)}
+    return states, stats, linear, [CaseRow(i, "ok") for i in range(n)]
+
+
+def _adapt(ratio, tolerance=1e-3, **kw):
+    """The adaptive anchors of a synthetic diagram, pass after pass, and the largest
+    miss of the interpolated σ from ``ratio`` over the diagram."""
+    states, stats, linear, rows = _field(ratio, **kw)
+    exact = first_anchors(states, None)
+    while True:
+        more = next_anchors(states, None, tolerance, exact, rows, stats, {}, linear)
+        if not more.any():
+            break
+        assert not (more & exact).any()  # (a case is computed once)
+        exact = exact | more
+    got = {"l": {e: v.copy() for e, v in stats["l"].items()}}
+    interpolate_corrections(states, exact, rows, got, {}, linear, "power")
+    miss = np.max(np.abs(got["l"]["end_b"][:, 1] / stats["l"]["end_b"][:, 1] - 1))
+    return states, exact, float(miss)
+
+
+def test_anchors_across_periods_where_the_corrections_are_flat_in_tp():
+    """Corrections nearly flat in Tp (a power of Hs, 0.07 % more over the 8 s) are
+    interpolated in Tp: the first pass's periods — the shortest, middle and longest of
+    9 — are checked (the middle: linear in Tp between the others; the ends within
+    PERIOD_SPREAD tolerances of it) and suffice, within the tolerance; a trend in Tp
+    steeper than that is bisected (here down to every column: 2.2e-3 per s of Tp)."""
+    states, exact, miss = _adapt(lambda h, t: 1 + 0.004 * h**1.5 * (1 + 0.002 * t))
+    assert sorted({s.tp for s, e in zip(states, exact) if e}) == [6.0, 10.0, 14.0]
+    assert exact.sum() == 9 and miss < 1e-3
+    states, exact, miss = _adapt(lambda h, t: 1 + 0.004 * h**1.5 * (1 + 0.05 * t))
+    assert len({s.tp for s, e in zip(states, exact) if e}) == 9 and miss < 1e-3
+
+
+def test_anchors_across_periods_compute_around_a_step():
+    """A step of 1 % in Tp (between 10 and 11 s, as the drag residual's panels step)
+    is bisected down to the two periods beside it, both computed, and met everywhere
+    to the tolerance; the flat side far from it stays interpolated."""
+
+    def step(h, t):
+        return 1.05 + 0.001 * h + (0.01 if t >= 11.0 else 0.0)
+
+    states, exact, miss = _adapt(step)
+    tps = {s.tp for s, e in zip(states, exact) if e}
+    assert {10.0, 11.0} <= tps and len(tps) < 9 and miss < 1e-3
+
+
+def test_a_column_beyond_its_neighbours_hs_is_computed():
+    """A column reaching Hs its computed neighbours do not (a real diagram's longer
+    periods carry higher seas) is computed, not extrapolated, even with corrections
+    smooth everywhere."""
+    rows = [{"hs": h, "tp": t, "hours": 1.0} for t in (6.0, 7.0, 8.0, 9.0, 10.0)
+            for h in (1.0, 2.0, 3.0)]  # fmt: skip
+    rows += [{"hs": 4.0, "tp": 9.0, "hours": 1.0}]  # Tp 9 s reaches Hs 4 m
+    states, exact, miss = _adapt(lambda h, t: 1 + 0.004 * h**1.5 * (1 + 0.05 * t), rows=rows)
+    tp9 = [e for s, e in zip(states, exact) if s.tp == 9.0]
+    assert all(tp9[i] for i in (0, 1, 3)) and miss < 1e-3  # (Hs 1, 2 and 4 m)
+
+
 def test_next_anchors_bisect_where_the_interpolation_misses():
     """A correction growing as a power of Hs is interpolated exactly (log–log): the
     first pass's 3 anchors of 9 suffice; one with a step of 1 % between Hs 6 and 7 is
@@ -163,7 +231,9 @@ def test_interpolated_set_against_every_case_computed():
     on σ and 4.9e-3 on the end damage, measured; tolerances 2e-3 and 1e-2); the
     along-line damage as the end damage."""
     rows = _rows()
-    got = _run(_wire(), rows, residual_span=5, residual_tolerance=None)
+    with pytest.warns(PhysicsWarning, match="computed on 3 of the 7 cases"):
+        got = run_cases(_wire(), scatter_from_rows(rows), fatigue=WIRE, residual_span=5,
+                        residual_tolerance=None)  # fmt: skip
     ref = _run(_wire(), rows, residual_tolerance=None)
     lin = _run(_wire(False), rows)
     anchors = residual_anchors(scatter_from_rows(rows).states)

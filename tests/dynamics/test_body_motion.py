@@ -121,11 +121,10 @@ def test_switches_off_give_the_linear_body_motion():
     assert "std_linear" not in off.to_document()["motion"]["surge"]
 
 
-@pytest.mark.parametrize("example", ["tuah_1982_disc_buoy_three_legs", "cable_laying"])
-def test_several_legs_and_prescribed_bodies_stay_linear(example):
-    """A group of several lines with residuals (no inter-line cross terms for the body
-    DOFs) and a vessel moving by its RAO keep the linear motion."""
-    doc = load_example(example).model_dump(mode="json")
+def test_prescribed_bodies_stay_linear():
+    """A vessel moving by its RAO keeps the linear motion (a group of several lines:
+    tests/dynamics/test_group_motion.py)."""
+    doc = load_example("cable_laying").model_dump(mode="json")
     doc["analysis"].pop("timeseries", None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -19,8 +19,7 @@ sys.path.insert(0, str(ROOT / "docs" / "_ext"))
 import results_reference  # noqa: E402  (the manual's result reference)
 
 from stochcable import analyze, estimate_cost
-from stochcable.cases import LineFatigue, scatter_from_rows
-from stochcable.cases.plan import plan_cases
+from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
 from stochcable.dynamics.residuals import registry
 from stochcable.errors import PhysicsWarning
 from stochcable.results.records import ResidualRecord
@@ -113,11 +112,12 @@ def test_toy_kind_reaches_outputs_document_cost_and_cases(toy_kind):
     cost, cost0 = estimate_cost(scene), estimate_cost(plain)
     assert cost.memory_bytes - cost0.memory_bytes == TOY_MEMORY
     assert cost.seconds - cost0.seconds == pytest.approx(TOY_SECONDS, rel=1e-12)
-    # the load-case plan names it among the residuals it applies to the end tensions
-    small = scatter_from_rows([{"hs": 2, "tp": 8, "probability": 1.0}])
+    # a load-case set that interpolates the corrections names it among the residuals
+    # it computed on the anchors (fixed anchors 4 Hs steps apart: 2 of 5 cases)
+    small = scatter_from_rows([{"hs": h, "tp": 8, "probability": 0.2} for h in (1, 2, 3, 4, 5)])
     fatigue = LineFatigue("dnv-studless", nominal_diameter=0.076)
-    with pytest.warns(PhysicsWarning, match=f"analysis.linearization.{TOY} to the end"):
-        plan_cases(scene, small, fatigue=fatigue)
+    with pytest.warns(PhysicsWarning, match=rf"analysis.linearization.{TOY} computed on 2 of"):
+        run_cases(scene, small, fatigue=fatigue, residual_span=4, residual_tolerance=None)
 
 
 def test_kind_without_compute_function_is_refused(toy_kind, monkeypatch):

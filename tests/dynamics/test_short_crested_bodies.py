@@ -138,6 +138,7 @@ def test_vessel_rao_applies_to_every_direction():
     assert got.lines["riser"].end_a.std != pytest.approx(ref.lines["riser"].end_a.std, rel=1e-3)
 
 
+@pytest.mark.slow  # the three-leg buoy's group residuals at the stations: 4.9 s of CPU
 def test_engine_solves_spread_sea_states_as_analyze():
     """An engine built for the long-crested scene (3-D models) solves spread sea
     states as ``analyze`` of the scene with each: the same numbers (1e-11: round-off).

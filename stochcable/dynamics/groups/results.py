@@ -23,12 +23,15 @@ from stochcable.dynamics.groups.modes import (
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.outputs.resolution import LineModes
+from stochcable.dynamics.residuals.along_line import stations
+from stochcable.dynamics.residuals.along_line_motion import motion_stations
 from stochcable.dynamics.residuals.body_motion import (
     BodyCoupledInfluence,
     body_motion_parts,
     body_rows,
 )
 from stochcable.dynamics.residuals.body_residual import coupled_influences
+from stochcable.dynamics.residuals.group_motion import body_rows_of, with_group_stations
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 from stochcable.results.records import stats_from_moments
 from stochcable.scene.model import AnalysisSettings
@@ -98,11 +101,24 @@ def coupled_results(
     transfer = np.concatenate(
         [np.transpose(linearization.body_motion[b.name], (2, 1, 0)) for b in bodies], axis=1
     ) if bodies else np.zeros((len(ch), 0, w.size))  # fmt: skip
-    # the bodies' residual lines by line (a group of one line with residuals only: the
-    # cross terms between lines' residual loads, which the end tensions take from
-    # body_residual's joint sums, are not formed for the body DOFs; summing the lines'
-    # variances would lose the cancellation of symmetric legs, e.g. a three-leg buoy's
-    # linear sway 0 would read 1.5 ft)
+    # the bodies' residual lines: a group of one line from its own loads
+    # (residuals.body_motion); of several, as output rows of the joint sums over every
+    # line's loads, cross terms included (residuals.group_motion: summing the lines'
+    # variances would lose the cancellation of symmetric legs)
+    # (and the lines' stations: their element tensions and node motions take every
+    # line's loads, the line's own from its along-line records, the others' and the
+    # cross terms as the group's part)
+    group_rows = (
+        body_rows_of(
+            influence,
+            {
+                cl.name: (stations(cl.system.model), motion_stations(cl.system.model))
+                for cl in lines
+            },
+        )  # fmt: skip
+        if bodies
+        else None
+    )
     by_line: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
     out_lines = {}
     for cl in lines:
@@ -124,9 +140,15 @@ def coupled_results(
             counted.get(cl.name),
             alone=False,
             influence=influence.get(cl.name),
-            on_residuals=collect if cl.name in influence and bodies else None,
+            on_residuals=collect
+            if cl.name in influence and bodies and group_rows is None
+            else None,
         )
     parts = next(iter(by_line.values())) if len(by_line) == 1 else []
+    if group_rows is not None:
+        out_lines = {k: with_group_stations(r, group_rows) for k, r in out_lines.items()}
+    if group_rows is not None:  # (several lines: the joint sums' body rows)
+        parts = group_rows.body_parts(transfer, spectra, w)
     out_bodies = {}
     for b in bodies:
         h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)

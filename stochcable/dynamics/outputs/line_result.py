@@ -18,6 +18,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from contextvars import ContextVar
 from typing import Any
 
 import numpy as np
@@ -70,6 +71,11 @@ from stochcable.results.documents import (
 )
 from stochcable.results.records import ResidualRecord
 from stochcable.scene.model import AnalysisSettings
+
+#: Whether :func:`line_result` computes the node motions' residuals (and through them
+#: a free body's): a load-case set, which reports neither, switches them off
+#: (:mod:`stochcable.cases.chunk`); the end and element tensions are the same.
+MOTION_RESIDUALS: ContextVar[bool] = ContextVar("motion_residuals", default=True)
 
 # ------------------------------------------------------------------------- outputs
 
@@ -133,7 +139,7 @@ def _shared_influence(
         return influence
     model = system.model
     if alone and model.dim == 2:
-        more = node_rows(model, motion_stations(model))
+        more = node_rows(model, motion_stations(model)) if MOTION_RESIDUALS.get() else None
         return end_station_influence(system, damping, more=more)
     return EndInfluence(system, damping)
 
@@ -257,21 +263,22 @@ def line_result(
             influence_of=None if influence is None else station_influence(influence),
             shared=shared if influence is None else None,
         )
-        moves = motion_residual(
-            system,
-            linearization.damping,
-            computed,
-            taps,
-            motion,
-            spectra,
-            motion_std,
-            influence_of=(
-                node_station_influence(influence)
-                if influence is not None
-                else _shared_nodes(shared, system, linearization.damping)
-            ),
-        )
-        if on_residuals is not None and moves.computed:
+        if MOTION_RESIDUALS.get():  # (not in a load-case set)
+            moves = motion_residual(
+                system,
+                linearization.damping,
+                computed,
+                taps,
+                motion,
+                spectra,
+                motion_std,
+                influence_of=(
+                    node_station_influence(influence)
+                    if influence is not None
+                    else _shared_nodes(shared, system, linearization.damping)
+                ),
+            )
+        if on_residuals is not None and moves is not None and moves.computed:
             on_residuals(computed, taps)
     linear = {e: stats[e] for e in ("end_a", "end_b")} if applied else None
     corrected = None

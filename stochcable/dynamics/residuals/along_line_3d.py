@@ -28,6 +28,7 @@ from scipy import sparse
 
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.residuals.drag_residual import cell_factor
+from stochcable.dynamics.residuals.influence import ModalRows
 
 __all__ = [
     "VectorCapture",
@@ -95,6 +96,8 @@ def sparse_transfer(g: np.ndarray, unit: np.ndarray) -> np.ndarray:
     flat = unit.reshape(n * d, -1)
     rows, cols = np.nonzero(flat)
     u = sparse.csr_matrix((flat[rows, cols], (cols, rows)), shape=(flat.shape[1], n * d))
+    if isinstance(g, ModalRows):  # (through the modes: the rows never formed)
+        return g.transfer(u)
     gf = np.transpose(g.reshape(n_out, n * d, n_w), (1, 0, 2)).reshape(n * d, n_out * n_w)
     return np.transpose(np.asarray(u @ gf).reshape(flat.shape[1], n_out, n_w), (1, 0, 2))
 

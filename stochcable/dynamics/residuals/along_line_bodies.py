@@ -17,7 +17,8 @@ a unit end motion i).  Per unit node force the element's coupled influence is th
 (:class:`ElementCoupledInfluence`), with the shape and ``on`` of the stations'
 influence of :mod:`.along_line`: the residual kinds' captured loads pass through it
 unchanged (:func:`~stochcable.dynamics.residuals.along_line.along_line_residual`
-``influence_of``).  As the ends', each line carries its own residual loads only.
+``influence_of``): each line's records carry its own residual loads; the other lines'
+and the cross terms are the group's part (:mod:`.group_motion`).
 
 Validation: against the assembled coupled system loaded by the same node forces
 (tests/dynamics/test_along_line_bodies.py); the coupled end influence in place of

@@ -32,10 +32,13 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.residuals.along_line import (
+    ALONG_DTYPE,
     CELL_BENDS,
     MAX_STATIONS,
     bent_cells,
     capture_outputs,
+    fill_lines,
+    line_subset,
     misfit_lines,
     station_weights,
     top_line,
@@ -190,25 +193,31 @@ def motion_lines(
     captures: list[Any],
     influence: Any,
     top: int | None,
+    stride: int = 1,
+    dtype: Any = complex,
 ) -> np.ndarray:
     """The variance lines (n_out, n_o) of the outputs of ``influence`` driven by one
     kind's pair ``captures`` (as
     :func:`~stochcable.dynamics.residuals.along_line.element_lines` without the
     geometric feedthrough), the loads the kind kept only, contracted sparsely
-    (:func:`sparse_transfer`); the lines from ``top`` up left out (zero). [m²]"""
+    (:func:`sparse_transfer`); the lines from ``top`` up left out (zero), formed on
+    every ``stride``-th (:func:`~stochcable.dynamics.residuals.along_line.line_stride`),
+    contracted in ``dtype``. [m²]"""
     out = None
     for cap in captures:
         n_top = cap.w.size if top is None else min(top, cap.w.size)
-        w = cap.w[:n_top]
+        sel = line_subset(n_top, stride)
+        w = cap.w[sel]
         unit = cap.unit[:, :, cap.kept]
         if n_top == 0:
             lines = np.zeros((influence.on(cap.w[:1]).shape[0], cap.w.size))
         else:
-            full = sparse_transfer(influence.on(w), unit)  # (n_out, n_kept, n_top)
+            full = sparse_transfer(influence.on(w), unit)  # (n_out, n_kept, n_sel)
             lines = np.zeros((full.shape[0], cap.w.size))
-            lines[:, :n_top] = capture_outputs(cap, full) * motion_cells(
-                system, damping, unit, w, full, CELL_BENDS[kind], influence
+            part = capture_outputs(cap, full, sel, dtype) * motion_cells(
+                system, damping, unit, w, full, CELL_BENDS[kind] * stride**2, influence
             )
+            lines[:, :n_top] = fill_lines(part, sel, n_top)
         out = lines if out is None else out + lines
     return out
 
@@ -343,7 +352,9 @@ def motion_residual(
                     "motions: its loads were not captured; the motions are linear",
                 )
             w_lines = np.asarray(caps[0].w, dtype=float)
-            v = motion_lines(system, damping, kind, caps, influence, top_line(rec))
+            # (every line: on the two-segment line's rope every second one moved the
+            # node motions' residual by up to 7 % where the ends' moved 0.2 %)
+            v = motion_lines(system, damping, kind, caps, influence, top_line(rec), 1, ALONG_DTYPE)
             parts = ((w_lines, weights @ v),)
             for mis in tap.misfits:
                 if linear is None:

@@ -9,11 +9,12 @@ T_L ξ, so its residual motion is the body's carried to the attachment point by
 rigid-body kinematics (translation + rotation × arm).  Each line's captured residual
 loads pass through these rows as through its node stations
 (:func:`~stochcable.dynamics.residuals.along_line_motion.motion_lines`, the misfits,
-a 3-D line's drag parts); the body's residual variance is the sum over the group's
-lines (their residual loads taken as uncorrelated, as each line's residual is
-formed from its own loads), added to the linear variance (uncorrelated with the
+a 3-D line's drag parts), for a group of one line (its loads are the group's); the
+body's residual variance is added to the linear variance (uncorrelated with the
 linear response).  A line whose node motions carry no residual (not computed,
-out of range) lends none, so a body and its lines' end nodes agree.
+out of range) lends none, so a body and its lines' end nodes agree.  A group of
+several lines: :mod:`.group_motion` (the body DOFs as rows of the joint sums over
+every line's loads, their cross terms included).
 """
 
 from __future__ import annotations

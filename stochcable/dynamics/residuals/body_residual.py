@@ -30,8 +30,10 @@ through the common sea and the common body motion, not independent: on a planar
 two-leg buoy the cross terms move a leg's part by −10 to −14 %, Monte Carlo agrees).
 The linear misfit loads of every line are summed through their influences
 (:meth:`CoupledInfluence.sources`) before the variance is formed.  A line's own lines
-stay its record's first part (its element tensions carry its own loads); the group's
-part is one more (:func:`with_group_lines`).  The geometric residual
+stay its record's first part (its element tensions' own records carry its own loads,
+the others' reach them as the group's part of :mod:`.group_motion`, which also gives
+the bodies' DOFs as more rows of these joint sums); the group's part is one more
+(:func:`with_group_lines`).  The geometric residual
 (:mod:`.geometric_residual`) joins the lines' quadratic forces alike.
 
 Validation: against the assembled coupled system (:func:`stochcable.bodies.coupling.couple`,
@@ -270,7 +272,13 @@ class CoupledInfluence:
                         for tgt, _ in parts
                     ]
                 )
-                lines = outputs([c for _, c in parts], h)
+                # (more output rows a registered hook asks for: group_motion.BodyRows)
+                rows = self.shared.get("extra_rows")
+                more = [] if rows is None else rows.transfers(key, parts, transfer, h)
+                lines = outputs([c for _, c in parts], np.concatenate([h, *more]))
+                if more:
+                    rows.keep(key, lines[h.shape[0] :], outputs)
+                    lines = lines[: h.shape[0]]
                 joint[key] = {
                     tgt.name: (
                         lines[2 * i : 2 * i + 2],
@@ -466,7 +474,7 @@ def with_group_lines(
 def untapped() -> Iterator[None]:
     """No :data:`~stochcable.dynamics.residuals.residual_lines.RESIDUAL_TAP` inside:
     another line's loads, and the group's joint sums, are not a line's own (its element
-    tensions take its own loads only)."""
+    tensions' records take its own loads; the group's part: :mod:`.group_motion`)."""
     token = RESIDUAL_TAP.set(None)
     try:
         yield
