@@ -20,7 +20,14 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, set_engine, solve_chunk
+from stochcable.cases.chunk import (
+    ENDS,
+    CaseRow,
+    ChunkResult,
+    release_linearizations,
+    set_engine,
+    solve_chunk,
+)
 from stochcable.cases.display import case_set_html, case_set_text
 from stochcable.cases.fatigue_settings import LineFatigue
 from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
@@ -219,6 +226,7 @@ def run_cases(
             progress(done, n)
     if plan.adaptive:
         results = _refine(plan, results, engine, executor, chunk_size, progress, done)
+    release_linearizations()  # (the first pass's, held for the later passes)
     return assemble_cases(plan, results)
 
 
