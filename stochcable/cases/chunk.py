@@ -322,7 +322,9 @@ def solve_chunk(
         Per case, the σ its drag fixed points start from (a case's own converged σ
         from an earlier pass, :attr:`ChunkResult.starts`: the adaptive anchors'
         later passes, :func:`stochcable.cases.run.run_cases`), instead of the run's
-        warm starts: each case then depends on its own start only.
+        warm starts: each case then depends on its own start only.  A case whose
+        first-pass drag linearization this process holds takes its residuals on it
+        instead (no fixed point).
 
     Returns
     -------

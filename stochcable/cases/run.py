@@ -240,8 +240,9 @@ def _refine(
     done: int = 0,
 ) -> list[ChunkResult]:
     """The adaptive anchors' later passes (:func:`~stochcable.cases.residual_anchors.next_anchors`):
-    each computes the residuals of the cases the checks ask for, every case from its
-    own converged σ of the first pass (so its numbers do not depend on the chunking),
+    each computes the residuals of the cases the checks ask for, every case on its
+    first-pass drag linearization where its process holds it, else from its own
+    converged σ of the first pass (so its numbers do not depend on the chunking),
     until no check asks for more; the results in the order to assemble them (a case
     computed later replaces its first-pass numbers).  ``progress(done, total)`` after
     each chunk, ``total`` grown by each pass's cases (``done`` solved so far)."""
