@@ -253,7 +253,7 @@ def main() -> None:
         "(`stochcable.cases.along_spectra`, 7 ms of a computed chain case before).",
         "The default set's cost is the linear set's plus, per computed case, its",
         f"residuals (≈ {extra:.0f} ms a computed case",
-        "here).  What stands between it and the 1/3 of `analyze()` asked (issue 31):",
+        "here).  What bounds it against the 1/3 of `analyze()` asked (issue 31):",
         f"(1) the linear set alone is {lin_share:.2f} × the corrected `analyze()`, leaving",
         f"≈ {room:.1f} ms a case for the residuals, i.e. ≈ {room * len(rows) / extra:.0f} "
         "computed cases of",
