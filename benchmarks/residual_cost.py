@@ -18,11 +18,8 @@ to the linear one, and the residual σ ratios (σ with / σ without) at the fair
     OPENBLAS_NUM_THREADS=1 python3 benchmarks/residual_cost.py [--repeat 3] [--profile LINE]
 
 Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
-analysis before issue 31, 1.8–4.4× after its first steps, 1.6–2.2× with the end
-residuals alone; with the element tensions' residuals 2.0–2.5× and with the node
-motions' too 2.1–3.3× (main, 28 Nov), 2.1–3.0× (chain 2.8–3.0×, taut 2.1–2.2×,
-deep 2.4×, two-segment 2.1×; load ≈ 1), now chain 2.5–2.6×, taut 2.1–2.2×, deep
-2.3×, two-segment 2.0× (session 17, load ≈ 0.9): exact steps (adjoint end tensions, pairs
+analysis before issue 31; with the end, element-tension and node-motion residuals
+now chain 2.5×, taut 2.1×, deep 2.4×, two-segment 2.0× (load ≈ 1): exact steps (adjoint end tensions, pairs
 f ≥ e in cache-sized blocks, the lag grid at the alias bound, one end influence, the
 element and node rows in the same solve, one dense matrix of pair lines per kind) and
 approximate ones (Hermite orders 2 and 3 carrying the higher orders' variance, 32
