@@ -24,7 +24,6 @@ import contextlib
 import dataclasses
 import hashlib
 import math
-import threading
 import traceback
 from collections import OrderedDict
 from dataclasses import dataclass, replace
@@ -38,7 +37,6 @@ from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import Family, SeaState
 from stochcable.design import damage_rate
 from stochcable.dynamics.engine import Engine
-from stochcable.dynamics.groups.analysis import LINEARIZATIONS
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
 from stochcable.dynamics.outputs.line_result import MOTION_RESIDUALS
 from stochcable.errors import StochcableError, collect_warnings
@@ -59,7 +57,6 @@ __all__ = [
     "WARM_RUN",
     "run_lead",
     "without_residuals",
-    "release_linearizations",
 ]
 
 ENDS = ("end_a", "end_b")
@@ -69,14 +66,6 @@ WARM_RUN = 16
 #: Engines a worker keeps, most recent first (a set's scene, and the one before). [-]
 _ENGINE_CACHE_SIZE = 2
 _ENGINES: OrderedDict[str, Engine] = OrderedDict()
-#: The first pass's converged drag linearizations of the cases it did not compute,
-#: by (engine id, position, sea state), of one engine at a time: a later pass
-#: computes such a case's residuals on them instead of solving it again (in the
-#: process that solved it; elsewhere it is solved from its own σ).  ≈ 0.56 MB a
-#: case on the chain example; at most ``_HELD_CASES`` (the oldest dropped).
-_HELD: OrderedDict[tuple, tuple[Any, dict]] = OrderedDict()
-_HELD_CASES = 256
-_HELD_LOCK = threading.Lock()  # (a thread pool's chunks share them)
 
 
 @dataclass(frozen=True)
@@ -322,9 +311,7 @@ def solve_chunk(
         Per case, the σ its drag fixed points start from (a case's own converged σ
         from an earlier pass, :attr:`ChunkResult.starts`: the adaptive anchors'
         later passes, :func:`stochcable.cases.run.run_cases`), instead of the run's
-        warm starts: each case then depends on its own start only.  A case whose
-        first-pass drag linearization this process holds takes its residuals on it
-        instead (no fixed point).
+        warm starts: each case then depends on its own start only.
 
     Returns
     -------
@@ -365,17 +352,10 @@ def solve_chunk(
                 store = {g: x[None] for g, x in starts[j].items()}
             else:
                 store = _warm_store(store, prev, i, state)
-            held = _held(engine, i, state, bool(starts), exact[j])
-            token = LINEARIZATIONS.set(held)
-            try:
-                with warm_starts(store, own=bool(starts)):
-                    row, res = _solve_case(
-                        engine if exact[j] else linear_engine, case_sea(template, state, family), i
-                    )
-            finally:
-                LINEARIZATIONS.reset(token)
-            if held and not exact[j] and res is not None and res.converged:
-                _hold(engine, i, state, held)
+            with warm_starts(store, own=bool(starts)):
+                row, res = _solve_case(
+                    engine if exact[j] else linear_engine, case_sea(template, state, family), i
+                )
             kept.append({g: x[0].copy() for g, x in store.items()})
             prev = (i, state.heading)
             rows.append(row)
@@ -422,34 +402,6 @@ def solve_chunk(
     return ChunkResult(
         idx, tuple(rows), stats, damage, s_el, linear, exact, tuple(kept), linear_along
     )
-
-
-def _held(engine: Any, i: int, state: SeaState, later: bool, exact: bool) -> dict | None:
-    """Where case ``i`` keeps or finds its lines' drag linearizations
-    (:data:`~stochcable.dynamics.groups.analysis.LINEARIZATIONS`): a later pass's
-    case those of its first pass when held (taken out), a first-pass case that does
-    not compute the residuals an empty dict to keep them, else None."""
-    if later:
-        with _HELD_LOCK:
-            got = _HELD.pop((id(engine), i, state), None)
-        return got[1] if got is not None and got[0] is engine else None
-    return None if exact else {}
-
-
-def _hold(engine: Any, i: int, state: SeaState, held: dict) -> None:
-    """Keep case ``i``'s first-pass linearizations (of ``engine`` alone)."""
-    with _HELD_LOCK:
-        for key in [k for k, v in _HELD.items() if v[0] is not engine]:
-            del _HELD[key]
-        _HELD[(id(engine), i, state)] = (engine, held)
-        while len(_HELD) > _HELD_CASES:
-            _HELD.popitem(last=False)
-
-
-def release_linearizations() -> None:
-    """Drop the held first-pass linearizations (after a set's later passes)."""
-    with _HELD_LOCK:
-        _HELD.clear()
 
 
 @contextlib.contextmanager

@@ -20,14 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.cases.chunk import (
-    ENDS,
-    CaseRow,
-    ChunkResult,
-    release_linearizations,
-    set_engine,
-    solve_chunk,
-)
+from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, set_engine, solve_chunk
 from stochcable.cases.display import case_set_html, case_set_text
 from stochcable.cases.fatigue_settings import LineFatigue
 from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
@@ -226,7 +219,6 @@ def run_cases(
             progress(done, n)
     if plan.adaptive:
         results = _refine(plan, results, engine, executor, chunk_size, progress, done)
-    release_linearizations()  # (the first pass's, held for the later passes)
     return assemble_cases(plan, results)
 
 
@@ -240,9 +232,8 @@ def _refine(
     done: int = 0,
 ) -> list[ChunkResult]:
     """The adaptive anchors' later passes (:func:`~stochcable.cases.residual_anchors.next_anchors`):
-    each computes the residuals of the cases the checks ask for, every case on its
-    first-pass drag linearization where its process holds it, else from its own
-    converged σ of the first pass (so its numbers do not depend on the chunking),
+    each computes the residuals of the cases the checks ask for, every case from its
+    own converged σ of the first pass (so its numbers do not depend on the chunking),
     until no check asks for more; the results in the order to assemble them (a case
     computed later replaces its first-pass numbers).  ``progress(done, total)`` after
     each chunk, ``total`` grown by each pass's cases (``done`` solved so far)."""

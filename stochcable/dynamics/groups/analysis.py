@@ -18,7 +18,6 @@ import copy
 import dataclasses
 import time
 from collections.abc import Iterator, Mapping, Sequence
-from contextvars import ContextVar
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,14 +52,6 @@ from stochcable.statics import StaticsResult
 __all__ = ["CoupledAnalysis", "CoupledGroup", "analyze_coupled", "solve_coupled"]
 
 _TIMES = ("model_s", "linearization_s", "solve_s", "outputs_s")
-
-#: A line's converged drag linearization by line name (lines without free bodies):
-#: kept there when solved, and used instead of a new fixed point when already there
-#: (a load-case set's later passes: the residuals of a case's first-pass
-#: linearization, :mod:`stochcable.cases.chunk`).  None: neither.
-LINEARIZATIONS: ContextVar[dict[str, CoupledLinearization] | None] = ContextVar(
-    "linearizations", default=None
-)
 
 
 @dataclass(frozen=True, eq=False)
@@ -304,20 +295,15 @@ def _solve_line(
     cl = CoupledLine(model.systems[name], ch)
     progress("linearization", {"line": name, "iteration": 0})
     t1 = time.perf_counter()
-    held = LINEARIZATIONS.get()
-    clin = None if held is None else held.get(name)
-    if clin is None:
-        clin = linearize_coupled(
-            [cl],
-            [],
-            settings,
-            rho=model.scene.environment.rho,
-            progress=progress,
-            timing=timing,
-            inputs=None if inputs is None or not ch else {name: inputs},
-        )
-        if held is not None:
-            held[name] = clin
+    clin = linearize_coupled(
+        [cl],
+        [],
+        settings,
+        rho=model.scene.environment.rho,
+        progress=progress,
+        timing=timing,
+        inputs=None if inputs is None or not ch else {name: inputs},
+    )
     inputs = None  # (not held through the outputs: the heading cache keeps small ones)
     timing["linearization_s"] += time.perf_counter() - t1
     progress("outputs", {"line": name})
