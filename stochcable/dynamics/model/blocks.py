@@ -364,9 +364,12 @@ class LinePrep:
             )
         return self.cache[key]
 
-    def modal(self, system: LineSystem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(Φ_f, M̂, K̂) of the kept modes on the free DOFs."""
-        m = int(system.n_modes)
+    def modal(
+        self, system: LineSystem, m: int | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(Φ_f, M̂, K̂) of the first ``m`` computed modes on the free DOFs (default the
+        kept ones, ``system.n_modes``)."""
+        m = int(system.n_modes) if m is None else int(m)
         if m not in self.cache:
             phi = np.ascontiguousarray(system.modes.shapes[system.model.free][:, :m])
             x = self.nodes(phi)

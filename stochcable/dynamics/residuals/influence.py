@@ -473,14 +473,7 @@ def _influence_modes(
     om = np.asarray(system.modes.omega, dtype=float)
     m = max(int(system.n_modes), int(np.count_nonzero(om <= MODAL_SPAN * w_top)))
     m = min(m, system.modes.shapes.shape[1], (system.model.n_nodes - 2) * system.model.dim)
-    key = ("influence_modes", m)
-    if key not in prep.cache:
-        phi = np.ascontiguousarray(system.modes.shapes[system.model.free][:, :m])
-        x = prep.nodes(phi)
-        mh = phi.T @ prep.free_rows(block_matvec(prep.MT, x))
-        kh = phi.T @ prep.free_rows(block_matvec(prep.K, x))
-        prep.cache[key] = (phi, 0.5 * (mh + mh.T), 0.5 * (kh + kh.T))
-    return prep.cache[key]
+    return prep.modal(system, m)
 
 
 def element_directions(system: Any) -> list[np.ndarray]:
