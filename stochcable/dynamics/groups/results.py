@@ -31,6 +31,7 @@ from stochcable.dynamics.residuals.body_motion import (
     body_rows,
 )
 from stochcable.dynamics.residuals.body_residual import coupled_influences
+from stochcable.dynamics.residuals.corrected_spectrum import spectrum_with_lines
 from stochcable.dynamics.residuals.group_motion import body_rows_of, with_group_stations
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 from stochcable.results.records import stats_from_moments
@@ -232,23 +233,28 @@ def body_result(
     ``residual``: the residuals' variance lines of its DOFs, parts (frequencies
     [rad/s] (n,), variance (d, n) [m², rad²]) added to the spectral moments
     (:mod:`stochcable.dynamics.residuals.body_motion`; a DOF whose total variance
-    would not be positive keeps its linear statistics)."""
+    would not be positive keeps its linear statistics) and folded into each DOF's
+    spectral density (``corrected_spectra``,
+    :func:`~stochcable.dynamics.residuals.corrected_spectrum.spectrum_with_lines`)."""
     dens = np.einsum("cdw,cw->dw", np.abs(transfer) ** 2, spectra)
     stats = {
         dof: stats_from_spectrum(omega, dens[i], float(mean[i]), duration)
         for i, dof in enumerate(dofs)
     }
-    linear = None
+    linear = corrected = None
     if len(residual):
         linear = stats
-        stats = dict(stats)
+        stats, corrected = dict(stats), {}
         for i, dof in enumerate(dofs):
             lin = linear[dof]
             m = np.array([lin.m0, lin.m1, lin.m2, lin.m4])
             for om, v in residual:
                 m = m + np.array([np.sum(v[i] * om**k) for k in (0, 1, 2, 4)])
-            if np.all(m[[0, 2, 3]] > 0.0):
+            kept = bool(np.all(m[[0, 2, 3]] > 0.0))
+            if kept:
                 stats[dof] = stats_from_moments(tuple(m), float(mean[i]), duration)
+            lines = [(om, v[i]) for om, v in residual] if kept else []
+            corrected[dof] = spectrum_with_lines(omega, dens[i], lines)
     return BodyResult(
         name=name,
         dofs=tuple(dofs),
@@ -262,4 +268,5 @@ def body_result(
         drag_sigma=None if sigma is None else np.asarray(sigma).copy(),
         drag_coefficient=None if drag is None else np.asarray(drag).copy(),
         modes=modes,
+        corrected_spectra=corrected,
     )
