@@ -9,6 +9,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -25,6 +26,7 @@ from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.outputs.resolution import LineModes
 from stochcable.dynamics.residuals.along_line import stations
 from stochcable.dynamics.residuals.along_line_motion import motion_stations
+from stochcable.dynamics.residuals.body_drag_residual import body_drag_residual, with_body_drag
 from stochcable.dynamics.residuals.body_motion import (
     BodyCoupledInfluence,
     body_motion_parts,
@@ -59,6 +61,7 @@ def coupled_results(
     static_pose: Mapping[str, np.ndarray] | None = None,
     modes: CoupledModes | None = None,
     channels: Sequence[Channel] | None = None,
+    loads: Mapping[str, Any] | None = None,
 ) -> tuple[dict[str, LineResult], dict[str, BodyResult]]:
     """Line and body results of a coupled group.
 
@@ -77,6 +80,11 @@ def coupled_results(
         resonance indicator (:func:`line_modes`; default each line's fixed-end modes).
     channels : sequence of Channel, optional
         The group's channels (default those of the first line).
+    loads : mapping of str to BodyLoads, optional
+        The bodies' wave inputs (their drag points' fluid velocity and current): with
+        them and the drag residual asked for, the residual of the bodies' own drag
+        enters their motions and the lines' end tensions
+        (:mod:`stochcable.dynamics.residuals.body_drag_residual`).
 
     Returns
     -------
@@ -150,6 +158,16 @@ def coupled_results(
         out_lines = {k: with_group_stations(r, group_rows) for k, r in out_lines.items()}
     if group_rows is not None:  # (several lines: the joint sums' body rows)
         parts = group_rows.body_parts(transfer, spectra, w)
+    if loads is not None and influence and settings.linearization.drag_residual:
+        own = body_drag_residual(
+            influence, lines[0].system.model.rho, loads, linearization.body_motion, w, spectra
+        )
+        if own is not None:  # the bodies' own drag: one more part of every body DOF
+            parts = [*parts, (own.w_out, own.body)] if parts else [(own.w_out, own.body)]
+            out_lines = {
+                k: with_body_drag(r, own.ends[k], own.w_out, settings.duration)
+                for k, r in out_lines.items()
+            }
     out_bodies = {}
     for b in bodies:
         h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)
