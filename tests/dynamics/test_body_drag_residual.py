@@ -244,3 +244,102 @@ def test_without_cross_terms_is_the_bodys_own_sum(two_leg):
     ref = residual_output_lines(comp.lines, comp.scale, comp.coeffs, t, comp.n_fft)
     assert alone.panels == 0
     np.testing.assert_allclose(alone.body, ref[4:], rtol=1e-12, atol=0)
+
+
+def test_three_leg_vector_form_equals_monte_carlo(monkeypatch):
+    """The three-leg buoy (3-D legs): the body's x drag component joined as a panel of
+    the vector form (its velocity the third variable, its drag the third direction)
+    with the front leg's largest-σ panel (normal 2-vector and tangent; orders to 7,
+    as the group's kept panel set), through the three legs' end tensions and the six
+    body DOFs: the function's lines against the mean over Gaussian realizations (fixed
+    seed, 2000) of the sampled forces — the body's c|v|v less b·v (b the fixed
+    point's), the panel's c_n|v_n|v_n less its vector fit B·v_n (vector Borgman) and
+    c_t|v_t|v_t less its fit — filtered alike, the variance with the body's less
+    without: within 4 standard errors plus 1e-3 of the largest of the tensions'
+    and of the DOFs' (the orders above 7)."""
+    import stochcable.dynamics.residuals.body_drag_residual as bdr
+    from stochcable.dynamics.linearization.formulas import drag_linear_vector
+    from stochcable.dynamics.residuals.drag_residual_3d import (
+        drag_components_3d,
+        vector_hermite_coefficients,
+    )
+    from stochcable.dynamics.residuals.residual_lines import uniform_grid
+
+    doc = load_example("tuah_1982_disc_buoy_three_legs").model_dump(mode="json")
+    res, cls, bodies, clin = _group_of(doc)
+    (body,) = bodies
+    w = np.asarray(cls[0].channels[0].omega)
+    scene = res.scene
+    loads = {body.name: body_loads(body, cls[0].channels, w, scene.sea, scene.environment)}
+    damp = {c.name: clin.lines[c.name].damping for c in cls}
+    infl = coupled_influences(cls, bodies, damp, clin.body_drag, clin.lines)
+    spectra = np.stack([ch.spectrum for ch in cls[0].channels])
+    order, front = 7, cls[0]
+    comp = drag_components_3d(front.system, front.channels, clin.lines[front.name], order, False)
+    n_p = comp.z.shape[1]
+    sig_n = np.sqrt(np.sum(np.abs(comp.z[:, :, :2]) ** 2, axis=(0, 3)))
+    grid = uniform_grid(w)
+    raw = {k: grid.lines(v, spectra) for k, v in comp.pan.items()}  # (n_ch', n_p, n_j)
+    var_n = sum(np.sum(np.abs(raw[k]) ** 2, axis=(0, 2)) for k in ("n1", "n2"))
+    p = int(np.argmax(var_n))
+    assert sig_n[p].max() > 0  # (the front leg moves in the sea's plane: n2 at rest)
+    cols = [p, n_p + p, 2 * n_p + p]
+    one = bdr.dataclasses.replace(
+        comp, z=comp.z[:, [p]], coeffs=comp.coeffs[[p]], unit=comp.unit[:, :, cols]
+    )
+    monkeypatch.setattr(bdr, "_panel_sets", lambda _: (("drag_3d",), [(front.name, one)]))
+    got = body_drag_residual(infl, 2.0, loads, clin.body_motion, w, spectra, order=order)
+    assert got.panels == 1
+    closed = np.concatenate([np.concatenate(list(got.ends.values())), got.body]).sum(axis=1)
+    # the same forces sampled: the body's x and the panel's (n1, n2, t) velocities
+    bc = got.components
+    kb = [k for k, wh in enumerate(bc.where) if wh[1] == 0][0]
+    lines = np.concatenate(
+        [bc.lines[:, [kb]], raw["n1"][:, [p]], raw["n2"][:, [p]], raw["t"][:, [p]]], axis=1
+    )
+    sig = np.sqrt(np.sum(np.abs(lines) ** 2, axis=(0, 2)))
+    vn = lines[:, 1:3]
+    cov = np.einsum("caj,cbj->ab", vn.conj(), vn).real
+    a_unit = vector_hermite_coefficients(np.zeros((1, 2)), cov[None], order, False)[0][0]
+    big = np.unravel_index(np.argmax(np.abs(a_unit)), a_unit.shape)
+    scale_n = float(one.coeffs[0, :2, :, :, 0][big] / a_unit[big])
+    np.testing.assert_allclose(
+        one.coeffs[0, :2, :, :, 0], scale_n * a_unit, rtol=0, atol=1e-9 * abs(scale_n)
+    )
+    a_t = hermite_coefficients([0.0], order)[0]
+    scale_t = one.coeffs[0, 2, 0, 0, 1] / (sig[3] ** 2 * a_t[1])
+    b_n = drag_linear_vector(1.0, 1.0, 2.0, cov, np.zeros(2))
+    b_x = clin.body_drag[body.name][0]
+    c_x = bc.scale[kb]
+    t_body = drag_point_transfer(infl, [bc.where[kb]], bc.w_out)  # (12, 1, n_o)
+    names = [c.name for c in cls]
+    h = [load_transfer(front.system, damp[front.name], one.unit, bc.w_out, infl[t]
+                       if t == front.name else dict((s.name, i) for s, i in
+                                                    infl[t].sources())[front.name])
+         for t in names]  # fmt: skip
+    h.append(load_transfer(front.system, damp[front.name], one.unit, bc.w_out,
+                           BodyCoupledInfluence(infl[front.name])))  # fmt: skip
+    h_all = np.concatenate([t_body, np.concatenate(h)], axis=1)  # (12, 4, n_o)
+    n_fft, n_o = bc.n_fft, h_all.shape[2]
+    n_ch, n_j = lines.shape[0], lines.shape[2]
+    rng = np.random.default_rng(181)
+    samples = []
+    for _ in range(2000):
+        amp = rng.standard_normal((n_ch, n_j)) + 1j * rng.standard_normal((n_ch, n_j))
+        amp /= np.sqrt(2.0)
+        spec = np.zeros((4, n_fft // 2 + 1), dtype=complex)
+        spec[:, :n_j] = np.einsum("cj,cpj->pj", np.sqrt(2.0) * amp, lines)
+        v = np.fft.irfft(spec, n=n_fft, axis=1) * (0.5 * n_fft)  # zero-mean velocities
+        r = np.empty_like(v)
+        r[0] = c_x * np.abs(v[0]) * v[0] - b_x * v[0]
+        r[1:3] = scale_n * (np.linalg.norm(v[1:3], axis=0) * v[1:3] - b_n @ v[1:3])
+        r[3] = scale_t * (np.abs(v[3]) * v[3] - sig[3] ** 2 * a_t[1] * v[3] / sig[3])
+        rf = np.fft.rfft(r, axis=1)[:, 1 : n_o + 1]
+        y_all = np.einsum("epw,pw->ew", h_all, rf)
+        y_pan = np.einsum("epw,pw->ew", h_all[:, 1:], rf[1:])
+        samples.append(2.0 * (np.abs(y_all) ** 2 - np.abs(y_pan) ** 2).sum(axis=1) / n_fft**2)
+    samples = np.array(samples)
+    mc, se = samples.mean(axis=0), samples.std(axis=0, ddof=1) / np.sqrt(len(samples))
+    for rows in (slice(0, 6), slice(6, None)):
+        top = np.abs(closed[rows]).max()
+        np.testing.assert_array_less(np.abs(closed[rows] - mc[rows]), 4.0 * se[rows] + 1e-3 * top)

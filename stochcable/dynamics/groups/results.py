@@ -158,7 +158,8 @@ def coupled_results(
         out_lines = {k: with_group_stations(r, group_rows) for k, r in out_lines.items()}
     if group_rows is not None:  # (several lines: the joint sums' body rows)
         parts = group_rows.body_parts(transfer, spectra, w)
-    if loads is not None and influence and settings.linearization.drag_residual:
+    lin_set = settings.linearization
+    if loads is not None and influence and lin_set.drag_residual and lin_set.method != "harmonic":
         own = body_drag_residual(
             influence, lines[0].system.model.rho, loads, linearization.body_motion, w, spectra
         )

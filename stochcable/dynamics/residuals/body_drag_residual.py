@@ -253,6 +253,8 @@ def _planar_sum(
 ) -> tuple[np.ndarray, int]:
     """The body's lines with the planar lines' panels (module notes): (n_out, n_o) and
     how many panels joined."""
+    k1 = comp.coeffs.shape[1]
+    panels = [(n, c) for n, c in panels if c.coeffs.shape[1] == k1]  # (another order: not)
     lines = np.concatenate([comp.lines, *[c.lines for _, c in panels]], axis=1)
     scale = np.concatenate([comp.scale, *[c.scale for _, c in panels]])
     coeffs = np.concatenate([comp.coeffs, *[c.coeffs for _, c in panels]])
@@ -325,6 +327,7 @@ def body_drag_residual(
     spectra: np.ndarray,
     *,
     cross_terms: bool = True,
+    order: int = LUMPED_ORDER,
 ) -> BodyDragResidual | None:
     """The body drag residual's lines in a group's body DOFs and end tensions (module
     notes; None: no body drag).
@@ -338,6 +341,9 @@ def body_drag_residual(
     cross_terms : bool
         Join the lines' drag panels the group's drag residual kept (their cross terms
         with the body's components); False: the body's components alone.
+    order : int
+        Highest Hermite order of the body's components (the lines' panels of another
+        order are not joined).
     """
     if not influences:
         return None
@@ -345,7 +351,7 @@ def body_drag_residual(
     key, panels = _panel_sets(influences) if cross_terms else (None, [])
     vector = key is not None and key[0] == "drag_3d"
     comp = body_drag_components(
-        base.bodies, rho, loads, motion, omega, spectra, by_spectra=not vector
+        base.bodies, rho, loads, motion, omega, spectra, order, by_spectra=not vector
     )
     if comp is None:
         return None
