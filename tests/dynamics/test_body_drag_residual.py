@@ -204,8 +204,9 @@ def _single_leg(residuals: bool) -> dict:
 def test_the_analysis_adds_the_body_drag_residual(monkeypatch):
     """The single-leg buoy: with the body's drag residual the body's surge variance and
     the leg's end tensions' drag residual lines gain the function's lines (exactly:
-    they are one more part), its corrected spectra keep their area = σ²; without it
-    (the function answering None) the analysis of before; switches off: none."""
+    they are one more part), its corrected spectra keep their area = σ², its end
+    element and fairlead node move alike; without it (the function answering None)
+    the analysis of before; switches off: none."""
     seen = []
     real = group_results.body_drag_residual
 
@@ -230,6 +231,15 @@ def test_the_analysis_adds_the_body_drag_residual(monkeypatch):
         assert v1 == pytest.approx(v0 + float(own.ends["leg"][k].sum()), rel=1e-12)
         om, dens = leg1.end_tension_density(end)
         assert np.trapezoid(dens, om) == pytest.approx(getattr(leg1, end).std ** 2, rel=1e-12)
+    # the stations take it too: the end elements' tension variance and the fairlead
+    # node's x variance move with the end tensions' and the body's surge (within 3 %:
+    # the half element between support and element, the arm's pitch part)
+    d_end = leg1.end_a.std**2 - leg0.end_a.std**2
+    d_el = leg1.tension_std[0] ** 2 - leg0.tension_std[0] ** 2
+    assert d_el == pytest.approx(d_end, rel=3e-2) and abs(d_end) > 100.0
+    d_x = leg1.motion_std[-1][0] ** 2 - leg0.motion_std[-1][0] ** 2
+    d_surge = b1.motion["surge"].std ** 2 - b0.motion["surge"].std ** 2
+    assert d_x == pytest.approx(d_surge, rel=3e-2)
     monkeypatch.setattr(group_results, "body_drag_residual", real)
     off = next(iter(_quiet(_single_leg(False)).bodies.values()))
     assert off.motion_linear is None

@@ -34,7 +34,8 @@ from stochcable.dynamics.residuals.body_motion import (
 )
 from stochcable.dynamics.residuals.body_residual import coupled_influences
 from stochcable.dynamics.residuals.corrected_spectrum import spectrum_with_lines
-from stochcable.dynamics.residuals.group_motion import body_rows_of, with_group_stations
+from stochcable.dynamics.residuals.group_motion import body_rows_of
+from stochcable.dynamics.residuals.group_stations import with_group_stations
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 from stochcable.results.records import stats_from_moments
 from stochcable.scene.model import AnalysisSettings
@@ -161,14 +162,12 @@ def coupled_results(
     lin_set = settings.linearization
     if loads is not None and influence and lin_set.drag_residual and lin_set.method != "harmonic":
         own = body_drag_residual(
-            influence, lines[0].system.model.rho, loads, linearization.body_motion, w, spectra
-        )
+            influence, lines[0].system.model.rho, loads, linearization.body_motion, w, spectra,
+            stations={k: _stations(r) for k, r in out_lines.items()},
+        )  # fmt: skip
         if own is not None:  # the bodies' own drag: one more part of every body DOF
             parts = [*parts, (own.w_out, own.body)] if parts else [(own.w_out, own.body)]
-            out_lines = {
-                k: with_body_drag(r, own.ends[k], own.w_out, settings.duration)
-                for k, r in out_lines.items()
-            }
+            out_lines = {k: with_body_drag(r, own, settings.duration) for k, r in out_lines.items()}
     out_bodies = {}
     for b in bodies:
         h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)
@@ -193,6 +192,17 @@ def coupled_results(
             residual=[(om, v[rows[b.name]]) for om, v in parts],
         )
     return out_lines, out_bodies
+
+
+def _stations(result: LineResult) -> tuple[np.ndarray, np.ndarray]:
+    """A line result's element and node stations where its along-line residuals were
+    computed (empty where not)."""
+    along, moves = result.along_line, result.motion_residual
+    none = np.zeros(0, dtype=int)
+    return (
+        along.stations if along is not None and along.computed else none,
+        moves.stations if moves is not None and moves.computed else none,
+    )
 
 
 def line_modes(

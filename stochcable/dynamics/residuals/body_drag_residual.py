@@ -49,6 +49,10 @@ from typing import Any
 import numpy as np
 
 from stochcable.bodies.rigid import PLANAR_INDEX, RigidBody, rigid_link_matrix
+from stochcable.dynamics.residuals.along_line_bodies import (
+    ElementCoupledInfluence,
+    NodeCoupledInfluence,
+)
 from stochcable.dynamics.residuals.body_residual import (
     CoupledInfluence,
     end_tension_rows,
@@ -64,7 +68,12 @@ from stochcable.dynamics.residuals.drag_residual import (
     residual_output_lines,
 )
 from stochcable.dynamics.residuals.drag_residual_3d import vector_residual_output_lines
-from stochcable.dynamics.residuals.group_influence import GroupBodyInfluence
+from stochcable.dynamics.residuals.group_influence import (
+    GroupBodyInfluence,
+    StationInfluence,
+    station_body_rows,
+)
+from stochcable.dynamics.residuals.group_stations import with_station_parts
 from stochcable.dynamics.residuals.residual_lines import fft_length, load_transfer, uniform_grid
 
 __all__ = [
@@ -98,14 +107,16 @@ class BodyDragComponents:
 class BodyDragResidual:
     """The body drag residual's variance lines at ``w_out`` [rad/s]: of every body DOF
     (group order) ``body`` (nb, n_o) [m², rad²] and of each line's end tensions
-    ``ends`` {line: (2, n_o)} [N²]; ``components`` the bodies' components and
-    ``panels`` how many line panel components joined the sum."""
+    ``ends`` {line: (2, n_o)} [N²]; ``components`` the bodies' components, ``panels``
+    how many line panel components joined the sum, ``stations`` {line: {"elements":
+    (n_st, n_o) [N²], "nodes": (n_st·d, n_o) [m²]}} of the stations asked for."""
 
     w_out: np.ndarray
     body: np.ndarray
     ends: dict[str, np.ndarray]
     components: BodyDragComponents
     panels: int
+    stations: dict[str, dict[str, np.ndarray]] = dataclasses.field(default_factory=dict)
 
 
 def drag_point_link(body: RigidBody) -> np.ndarray:
@@ -181,11 +192,15 @@ def drag_point_transfer(
     influences: Mapping[str, CoupledInfluence],
     where: Sequence[tuple[str, int]],
     w: np.ndarray,
+    targets: Sequence[Any] = (),
 ) -> np.ndarray:
     """The outputs per unit force at the drag points (module notes): rows every line's
-    end tensions (end_a, end_b; in the order of ``influences``) then every body DOF
-    (group order, zero on the held ones), columns the components ``where`` (body,
-    direction): shape (2·n_lines + nb, n_c, n_w). [N/N, m/N, rad/N]"""
+    end tensions (end_a, end_b; in the order of ``influences``), every body DOF (group
+    order, zero on the held ones), then the rows of each of ``targets`` (the stations
+    of a line: :class:`~.along_line_bodies.ElementCoupledInfluence`,
+    :class:`~.along_line_bodies.NodeCoupledInfluence`), columns the components
+    ``where`` (body, direction): shape (2·n_lines + nb + n_st, n_c, n_w). [N/N, m/N,
+    rad/N]"""
     w = np.asarray(w, dtype=float)
     base = next(iter(influences.values()))
     off, s, links, solved = base._state(w)
@@ -208,7 +223,18 @@ def drag_point_transfer(
             y = e_hat[None] @ solved[name][1][:, :, att] @ t[None] @ xi
         rows.append(np.transpose(y, (1, 2, 0)))
     rows.append(np.transpose(xi, (1, 2, 0)))
+    for target in targets:
+        c = station_body_rows(target, (links, solved), w)  # (n_w, n_out, nb)
+        if c is None:
+            c = np.zeros((w.size, _rows(target), nb), dtype=complex)
+        rows.append(np.transpose(c @ xi, (1, 2, 0)))
     return np.concatenate(rows)
+
+
+def _rows(target: Any) -> int:
+    """The output rows of a station target (an element a row, a node d rows)."""
+    n = target.elements.size
+    return n * target.line.system.model.dim if isinstance(target, NodeCoupledInfluence) else n
 
 
 def _panel_sets(
@@ -228,7 +254,11 @@ def _panel_sets(
 
 
 def _panel_transfer(
-    influences: Mapping[str, CoupledInfluence], src: str, c: Any, w_out: np.ndarray
+    influences: Mapping[str, CoupledInfluence],
+    src: str,
+    c: Any,
+    w_out: np.ndarray,
+    targets: Sequence[Any] = (),
 ) -> np.ndarray:
     """Every output of :func:`drag_point_transfer` per unit load of line ``src``'s
     panel components ``c`` on ``w_out``: (n_out, n_load, n_o)."""
@@ -242,6 +272,11 @@ def _panel_transfer(
             for tgt in influences
         ]  # fmt: skip
         h.append(load_transfer(ln.system, ln.damping, c.unit, w_out, body))
+        h += [
+            load_transfer(ln.system, ln.damping, c.unit, w_out,
+                          StationInfluence(t, body, base._state))
+            for t in targets
+        ]  # fmt: skip
     return np.concatenate(h)
 
 
@@ -250,6 +285,7 @@ def _planar_sum(
     comp: BodyDragComponents,
     t_body: np.ndarray,
     panels: list[tuple[str, Any]],
+    targets: Sequence[Any] = (),
 ) -> tuple[np.ndarray, int]:
     """The body's lines with the planar lines' panels (module notes): (n_out, n_o) and
     how many panels joined."""
@@ -259,7 +295,8 @@ def _planar_sum(
     scale = np.concatenate([comp.scale, *[c.scale for _, c in panels]])
     coeffs = np.concatenate([comp.coeffs, *[c.coeffs for _, c in panels]])
     t = np.concatenate(
-        [t_body, *[_panel_transfer(influences, n, c, comp.w_out) for n, c in panels]], axis=1
+        [t_body, *[_panel_transfer(influences, n, c, comp.w_out, targets) for n, c in panels]],
+        axis=1,
     )
     n_c = comp.scale.size
     # the panels the lines' own sum keeps (their end tensions' floor), every body component
@@ -282,6 +319,7 @@ def _vector_sum(
     comp: BodyDragComponents,
     t_body: np.ndarray,
     panels: list[tuple[str, Any]],
+    targets: Sequence[Any] = (),
 ) -> tuple[np.ndarray, int]:
     """The body's lines with the 3-D lines' panels: each body component a panel of the
     vector form (:func:`~.drag_residual_3d.vector_residual_output_lines`) whose third
@@ -302,7 +340,7 @@ def _vector_sum(
         if c.coeffs.shape[2] != k1 or c.z.shape[0] != z.shape[0] or c.z.shape[3] != n_j:
             continue  # (another order or grid: not joined)
         n_p = c.z.shape[1]
-        h = _panel_transfer(influences, name, c, comp.w_out)
+        h = _panel_transfer(influences, name, c, comp.w_out, targets)
         zs.append(c.z)
         cs.append(c.coeffs)
         ts.append(np.transpose(h.reshape(h.shape[0], 3, n_p, -1), (0, 2, 1, 3)))
@@ -328,6 +366,7 @@ def body_drag_residual(
     *,
     cross_terms: bool = True,
     order: int = LUMPED_ORDER,
+    stations: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
 ) -> BodyDragResidual | None:
     """The body drag residual's lines in a group's body DOFs and end tensions (module
     notes; None: no body drag).
@@ -344,6 +383,9 @@ def body_drag_residual(
     order : int
         Highest Hermite order of the body's components (the lines' panels of another
         order are not joined).
+    stations : mapping of str to (ndarray, ndarray), optional
+        Per line its element stations and node stations (indices; either may be
+        empty): their tensions and motions are outputs too (``stations``).
     """
     if not influences:
         return None
@@ -355,29 +397,48 @@ def body_drag_residual(
     )
     if comp is None:
         return None
-    t_body = drag_point_transfer(influences, comp.where, comp.w_out)
+    targets, layout = [], []
+    for name, (el, nodes) in (stations or {}).items():
+        for kind, idx, cls in (("elements", el, ElementCoupledInfluence),
+                               ("nodes", nodes, NodeCoupledInfluence)):  # fmt: skip
+            if np.size(idx):
+                targets.append(cls(influences[name], np.asarray(idx, dtype=int)))
+                layout.append((name, kind))
+    t_body = drag_point_transfer(influences, comp.where, comp.w_out, targets)
     if vector:
-        out, joined = _vector_sum(influences, comp, t_body, panels)
+        out, joined = _vector_sum(influences, comp, t_body, panels, targets)
     else:
-        out, joined = _planar_sum(influences, comp, t_body, panels)
+        out, joined = _planar_sum(influences, comp, t_body, panels, targets)
     n_l = 2 * len(influences)
+    nb = sum(b.n_dof for b in base.bodies)
     ends = {name: out[2 * i : 2 * i + 2] for i, name in enumerate(influences)}
-    return BodyDragResidual(comp.w_out, out[n_l:], ends, comp, joined)
+    at, st = n_l + nb, {}
+    for (name, kind), target in zip(layout, targets):
+        st.setdefault(name, {})[kind] = out[at : at + _rows(target)]
+        at += _rows(target)
+    return BodyDragResidual(comp.w_out, out[n_l : n_l + nb], ends, comp, joined, st)
 
 
-def with_body_drag(result: Any, lines: np.ndarray, w_out: np.ndarray, duration: float) -> Any:
-    """``result`` (a line's LineResult on the bodies) with the body drag residual's end
-    lines ``lines`` (2, n_o) at ``w_out`` as one more part of its drag residual record,
-    its end statistics and corrected spectra formed again with it; unchanged where the
-    line's drag residual is not applied."""
+def with_body_drag(result: Any, own: BodyDragResidual, duration: float) -> Any:
+    """``result`` (a line's LineResult on the bodies) with the body drag residual
+    ``own``'s lines of its end tensions as one more part of its drag residual record,
+    its end statistics and corrected spectra formed again with it, and those of its
+    stations added to its element tensions' and node motions' drag residual records
+    (:func:`~.group_stations.with_station_parts`); unchanged where the line's drag
+    residual is not applied."""
     rec = result.residuals.get("drag_residual")
     if rec is None or not rec.computed or result.linear is None:
         return result
     w = np.asarray(result.omega, dtype=float)
     std = {e: result.linear[e].std for e in ("end_a", "end_b")}
     residuals = dict(result.residuals)
-    residuals["drag_residual"] = with_group_lines(rec, w_out, lines, w, std)
+    residuals["drag_residual"] = with_group_lines(rec, own.w_out, own.ends[result.name], w, std)
     applied = [r for r in residuals.values() if r.computed]
     stats = {e: corrected_stats(result.linear[e], e, applied, duration) for e in std}
     spectra = {e: corrected_spectrum(w, result.end_tension_spectrum(e), e, applied) for e in std}
-    return dataclasses.replace(result, residuals=residuals, corrected_spectra=spectra, **stats)
+    out = dataclasses.replace(result, residuals=residuals, corrected_spectra=spectra, **stats)
+    parts = {
+        kind: {"drag_residual": (own.w_out, x)}
+        for kind, x in own.stations.get(result.name, {}).items()
+    }
+    return with_station_parts(out, parts) if parts else out
