@@ -353,3 +353,22 @@ def test_three_leg_vector_form_equals_monte_carlo(monkeypatch):
     for rows in (slice(0, 6), slice(6, None)):
         top = np.abs(closed[rows]).max()
         np.testing.assert_array_less(np.abs(closed[rows] - mc[rows]), 4.0 * se[rows] + 1e-3 * top)
+
+
+def test_first_pairs_are_the_growth_of_the_vector_sum():
+    """``vector_residual_output_lines(..., first=k)`` (the pairs whose first panel is
+    one of the first k) equals the full sum less the sum over the other panels, to
+    round-off (1e-10 of the largest line), on random jointly Gaussian panels."""
+    from stochcable.dynamics.residuals.drag_residual_3d import vector_residual_output_lines
+
+    rng = np.random.default_rng(7)
+    n_ch, n_p, n_j, k1, n_fft = 3, 5, 12, 4, 96
+    z = rng.standard_normal((n_ch, n_p, 3, n_j)) + 1j * rng.standard_normal((n_ch, n_p, 3, n_j))
+    z /= np.sqrt(np.sum(np.abs(z) ** 2, axis=(0, 3)))[None, :, :, None]
+    coeffs = rng.standard_normal((n_p, 3) + (k1,) * 3)
+    coeffs[..., :2, :2, :2] = 0.0  # (orders ≥ 2 only, as the residual's)
+    t = rng.standard_normal((4, n_p, 3, 30)) + 1j * rng.standard_normal((4, n_p, 3, 30))
+    full = vector_residual_output_lines(z, coeffs, t, n_fft)
+    rest = vector_residual_output_lines(z[:, 2:], coeffs[2:], t[:, 2:], n_fft)
+    got = vector_residual_output_lines(z, coeffs, t, n_fft, first=2)
+    np.testing.assert_allclose(got, full - rest, rtol=0, atol=1e-10 * np.abs(full).max())

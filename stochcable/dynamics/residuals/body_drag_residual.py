@@ -14,16 +14,24 @@ motion).  Each direction is one more load channel of the coupled group: a force 
 the drag point along i moves the free body DOFs by ξ = S⁻¹T_dᵀe_i f (S the group's
 condensed body impedance, T_d the drag point's rigid link; Tuah 1982, eqs. 3.3.6,
 3.3.8–3.3.10) and every line's support forces by R_e,L T_L ξ
-(:class:`~.body_residual.CoupledInfluence`'s solves).  Its lines are the joint sum over
-the lines' drag panels and the body's components less the sum over the lines' panels
-alone (:func:`~.drag_residual.residual_output_lines` twice, the same panels kept):
-the body's own pairs and its cross terms with every panel.  The residual is
+(:class:`~.body_residual.CoupledInfluence`'s solves).  Its lines are what the body's
+components add to the joint sum over the lines' drag panels: the body's own pairs and
+its cross terms with every panel (planar lines: the joint sum less the panels' own,
+:func:`~.drag_residual.residual_output_lines` twice, the same panels kept; 3-D lines:
+the pairs whose first component is the body's,
+:func:`~.drag_residual_3d.vector_residual_output_lines` with ``first``).  The residual is
 uncorrelated with the linear response (Hermite orthogonality), so its variance lines
-add to the body DOFs' and the end tensions' as the lines' residuals do.
+add to the body DOFs' and the end tensions' as the lines' residuals do, and to the
+lines' element tensions and node motions at their stations (a line's stations move
+with its ends on the bodies, c_att·T_L ξ: :func:`~.group_influence.station_body_rows`;
+the panels' through :class:`~.group_influence.StationInfluence`), one more part of
+their along-line records (:func:`~.group_stations.with_station_parts`).
 
 Validation: the drag point's transfer against the assembled lines–body system loaded
 at the drag point, the linearization's b against c·σ·a₁, and the closed form against a
-Monte Carlo of the Hermite expansion (tests/dynamics/test_body_drag_residual.py).
+Monte Carlo of the Hermite expansion (tests/dynamics/test_body_drag_residual.py); the
+answer against the nonlinear time domain of a drag-driven planar buoy
+(docs/accuracy/bodies.md, "The body's own drag residual").
 
 Scope: the drag residual asked for, a body with a drag area and the stochastic
 linearization (``method`` not "harmonic"), lines without gyroscopic or lift terms.
@@ -31,8 +39,7 @@ The cross terms with the lines' panels are those of planar lines (a 3-D line's v
 drag components, :mod:`.drag_residual_3d`, are left out of the joint sum: the body's
 residual alone, its three directions jointly).  The lines are summed on the lines'
 uniform grid without the cell integration of narrow resonances
-(:func:`~.drag_residual.cell_factor`), and the element tensions and node motions along
-the lines do not take it.
+(:func:`~.drag_residual.cell_factor`).
 
 References
 ----------
@@ -344,15 +351,11 @@ def _vector_sum(
         zs.append(c.z)
         cs.append(c.coeffs)
         ts.append(np.transpose(h.reshape(h.shape[0], 3, n_p, -1), (0, 2, 1, 3)))
-    with untapped():
+    with untapped():  # (the pairs with a body component: the sum's growth by them)
         out = vector_residual_output_lines(
-            np.concatenate(zs, axis=1), np.concatenate(cs), np.concatenate(ts, axis=1), comp.n_fft
-        )
-        if len(zs) > 1:
-            out = out - vector_residual_output_lines(
-                np.concatenate(zs[1:], axis=1), np.concatenate(cs[1:]),
-                np.concatenate(ts[1:], axis=1), comp.n_fft,
-            )  # fmt: skip
+            np.concatenate(zs, axis=1), np.concatenate(cs), np.concatenate(ts, axis=1),
+            comp.n_fft, first=n_c,
+        )  # fmt: skip
     return out, int(sum(x.shape[1] for x in zs[1:]))
 
 
