@@ -80,6 +80,7 @@ from stochcable.dynamics.residuals.group_influence import (
     StationInfluence,
     station_body_rows,
 )
+from stochcable.dynamics.residuals.group_motion import ROUND_OFF
 from stochcable.dynamics.residuals.group_stations import with_station_parts
 from stochcable.dynamics.residuals.residual_lines import fft_length, load_transfer, uniform_grid
 
@@ -419,7 +420,11 @@ def body_drag_residual(
     for (name, kind), target in zip(layout, targets):
         st.setdefault(name, {})[kind] = out[at : at + _rows(target)]
         at += _rows(target)
-    return BodyDragResidual(comp.w_out, out[n_l : n_l + nb], ends, comp, joined, st)
+    body = out[n_l : n_l + nb]
+    # a DOF whose part is round-off (a symmetric mooring's sway, roll, yaw) gets none
+    total = np.abs(body.sum(axis=1))
+    body = np.where((total <= ROUND_OFF * np.max(total, initial=0.0))[:, None], 0.0, body)
+    return BodyDragResidual(comp.w_out, body, ends, comp, joined, st)
 
 
 def with_body_drag(result: Any, own: BodyDragResidual, duration: float) -> Any:
