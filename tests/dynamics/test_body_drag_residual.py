@@ -39,6 +39,39 @@ from stochcable.dynamics.solve.line_solve import end_tension_from_support
 from stochcable.reference.bodies import solve_coupled_direct
 
 
+def _velocities(rng: np.random.Generator, lines: np.ndarray, n_fft: int) -> np.ndarray:
+    """One Gaussian realization (n_p, n_fft) of zero-mean velocities whose amplitude
+    lines are ``lines`` (n_ch, n_p, n_j) (complex Gaussian amplitudes per channel)."""
+    n_ch, n_p, n_j = lines.shape
+    amp = rng.standard_normal((n_ch, n_j)) + 1j * rng.standard_normal((n_ch, n_j))
+    amp /= np.sqrt(2.0)
+    spec = np.zeros((n_p, n_fft // 2 + 1), dtype=complex)
+    spec[:, :n_j] = np.einsum("cj,cpj->pj", np.sqrt(2.0) * amp, lines)
+    return np.fft.irfft(spec, n=n_fft, axis=1) * (0.5 * n_fft)
+
+
+def _body_growth(h: np.ndarray, r: np.ndarray, n_fft: int) -> np.ndarray:
+    """The outputs' variance (n_out,) of one realization of the forces ``r`` (n_p,
+    n_fft) through ``h`` (n_out, n_p, n_o), less that without the first (the body's)."""
+    n_o = h.shape[2]
+    rf = np.fft.rfft(r, axis=1)[:, 1 : n_o + 1]
+    y_all = np.einsum("epw,pw->ew", h, rf)
+    y_pan = np.einsum("epw,pw->ew", h[:, 1:], rf[1:])
+    return 2.0 * (np.abs(y_all) ** 2 - np.abs(y_pan) ** 2).sum(axis=1) / n_fft**2
+
+
+def _agree(closed: np.ndarray, samples: np.ndarray, n_ends: int) -> np.ndarray:
+    """Assert the closed form within 4 standard errors of the samples' mean plus 1e-3
+    of the largest of the end tensions (the first ``n_ends`` rows) and of the DOFs
+    (the orders above 7); the standard errors."""
+    mc = samples.mean(axis=0)
+    se = samples.std(axis=0, ddof=1) / np.sqrt(len(samples))
+    for rows in (slice(0, n_ends), slice(n_ends, None)):
+        top = np.abs(closed[rows]).max()
+        np.testing.assert_array_less(np.abs(closed[rows] - mc[rows]), 4.0 * se[rows] + 1e-3 * top)
+    return se
+
+
 @pytest.fixture(scope="module")
 def two_leg():
     """The planar two-leg buoy analysed: its group, the bodies' loads and influences."""
@@ -161,14 +194,9 @@ def test_body_drag_residual_with_leg_panels_equals_monte_carlo(two_leg):
     sigs = [bc_sig[kb]] + [s for _, _, s in pick]
     b_lin = clin.body_drag[body.name][0]
     rng = np.random.default_rng(18)
-    n_o, n_ch, n_j = h_all.shape[2], lines_all.shape[0], lines_all.shape[2]
     samples = []
     for _ in range(2000):
-        amp = rng.standard_normal((n_ch, n_j)) + 1j * rng.standard_normal((n_ch, n_j))
-        amp /= np.sqrt(2.0)
-        spec = np.zeros((3, n_fft // 2 + 1), dtype=complex)
-        spec[:, :n_j] = np.einsum("cj,cpj->pj", np.sqrt(2.0) * amp, lines_all)
-        x = np.fft.irfft(spec, n=n_fft, axis=1) * (0.5 * n_fft)  # zero-mean velocities
+        x = _velocities(rng, lines_all, n_fft)
         r = np.empty_like(x)
         for p in range(3):
             sg, s = sigs[p], scale[p]
@@ -176,15 +204,8 @@ def test_body_drag_residual_with_leg_panels_equals_monte_carlo(two_leg):
             a = hermite_coefficients([mu[p]], 1)[0]
             fit = s * sg**2 * a[0] + (b_lin if p == 0 else s * sg * a[1]) * x[p]
             r[p] = s * np.abs(v) * v - fit
-        rf = np.fft.rfft(r, axis=1)[:, 1 : n_o + 1]
-        y_all = np.einsum("epw,pw->ew", h_all, rf)
-        y_pan = np.einsum("epw,pw->ew", h_all[:, 1:], rf[1:])
-        samples.append(2.0 * ((np.abs(y_all) ** 2) - np.abs(y_pan) ** 2).sum(axis=1) / n_fft**2)
-    samples = np.array(samples)
-    mc, se = samples.mean(axis=0), samples.std(axis=0, ddof=1) / np.sqrt(len(samples))
-    for rows in (slice(0, 4), slice(4, None)):
-        top = np.abs(closed[rows]).max()
-        np.testing.assert_array_less(np.abs(closed[rows] - mc[rows]), 4.0 * se[rows] + 1e-3 * top)
+        samples.append(_body_growth(h_all, r, n_fft))
+    se = _agree(closed, np.array(samples), 4)
     assert abs(closed[4] - own[4]) > 4.0 * se[4]  # (surge: the cross terms count)
 
 
@@ -330,29 +351,17 @@ def test_three_leg_vector_form_equals_monte_carlo(monkeypatch):
     h.append(load_transfer(front.system, damp[front.name], one.unit, bc.w_out,
                            BodyCoupledInfluence(infl[front.name])))  # fmt: skip
     h_all = np.concatenate([t_body, np.concatenate(h)], axis=1)  # (12, 4, n_o)
-    n_fft, n_o = bc.n_fft, h_all.shape[2]
-    n_ch, n_j = lines.shape[0], lines.shape[2]
+    n_fft = bc.n_fft
     rng = np.random.default_rng(181)
     samples = []
     for _ in range(2000):
-        amp = rng.standard_normal((n_ch, n_j)) + 1j * rng.standard_normal((n_ch, n_j))
-        amp /= np.sqrt(2.0)
-        spec = np.zeros((4, n_fft // 2 + 1), dtype=complex)
-        spec[:, :n_j] = np.einsum("cj,cpj->pj", np.sqrt(2.0) * amp, lines)
-        v = np.fft.irfft(spec, n=n_fft, axis=1) * (0.5 * n_fft)  # zero-mean velocities
+        v = _velocities(rng, lines, n_fft)
         r = np.empty_like(v)
         r[0] = c_x * np.abs(v[0]) * v[0] - b_x * v[0]
         r[1:3] = scale_n * (np.linalg.norm(v[1:3], axis=0) * v[1:3] - b_n @ v[1:3])
         r[3] = scale_t * (np.abs(v[3]) * v[3] - sig[3] ** 2 * a_t[1] * v[3] / sig[3])
-        rf = np.fft.rfft(r, axis=1)[:, 1 : n_o + 1]
-        y_all = np.einsum("epw,pw->ew", h_all, rf)
-        y_pan = np.einsum("epw,pw->ew", h_all[:, 1:], rf[1:])
-        samples.append(2.0 * (np.abs(y_all) ** 2 - np.abs(y_pan) ** 2).sum(axis=1) / n_fft**2)
-    samples = np.array(samples)
-    mc, se = samples.mean(axis=0), samples.std(axis=0, ddof=1) / np.sqrt(len(samples))
-    for rows in (slice(0, 6), slice(6, None)):
-        top = np.abs(closed[rows]).max()
-        np.testing.assert_array_less(np.abs(closed[rows] - mc[rows]), 4.0 * se[rows] + 1e-3 * top)
+        samples.append(_body_growth(h_all, r, n_fft))
+    _agree(closed, np.array(samples), 6)
 
 
 def test_first_pairs_are_the_growth_of_the_vector_sum():
