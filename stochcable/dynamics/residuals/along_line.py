@@ -154,13 +154,18 @@ class ResidualTap(VectorTapMixin):
         if self.captures and self.captures[-1].transfer is transfer:
             self.captures[-1].g_all = g_all
 
-    def lines(self, g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
+    def lines(
+        self, g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray, keep: bool = True
+    ) -> None:
         """A :func:`pair_outputs` call: a block of pairs' lines G and the loads' end
         transfer, matched column by column to the load transfer they were taken from
-        (the blocks of one contraction share its transfer array)."""
+        (the blocks of one contraction share its transfer array).  ``keep`` False: the
+        block is not kept (its lines come in the contraction's dense G, :meth:`dense`:
+        the chain's drag blocks, 3.3 MB, were held twice)."""
         block = (g, np.asarray(e), np.asarray(f))
         if self.captures and self.captures[-1].transfer is transfer:
-            self.captures[-1].blocks.append(block)
+            if keep:
+                self.captures[-1].blocks.append(block)
             return
         n_o = transfer.shape[2]
         cols = [np.ascontiguousarray(transfer[:, c]).tobytes() for c in range(transfer.shape[1])]
@@ -170,7 +175,7 @@ class ResidualTap(VectorTapMixin):
             index = {np.ascontiguousarray(h[:, j]).tobytes(): j for j in range(h.shape[1])}
             if all(c in index for c in cols):
                 kept = np.array([index[c] for c in cols], dtype=int)
-                self.captures.append(Capture(w, unit, kept, transfer, [block]))
+                self.captures.append(Capture(w, unit, kept, transfer, [block] if keep else []))
                 return
         self.unmatched += 1
 
@@ -322,7 +327,38 @@ def capture_outputs(
         if cap.g_low is None or cap.g_low.dtype != np.dtype(dtype):
             cap.g_low = g.astype(dtype)
         g = cap.g_low
-    return dense_pair_outputs(g[sel], transfer, dtype)
+    # the lines as views of G, run by evenly spaced run (:func:`line_subset`: its first
+    # and last lines apart), not a copy of G's rows (the chain's node motions: 2.3 MB)
+    idx = np.arange(g.shape[0])[sel]
+    parts, at = [], 0
+    for run in _runs(idx):
+        lines = g[run] if isinstance(run, slice) else g[run : run + 1]
+        n_run = lines.shape[0]
+        parts.append(dense_pair_outputs(lines, transfer[:, :, at : at + n_run], dtype))
+        at += n_run
+    return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
+
+
+def _runs(idx: np.ndarray) -> list[slice | int]:
+    """``idx`` (increasing) as evenly spaced runs: a slice for each of at least two
+    lines, the index of a line alone."""
+    out: list[slice | int] = []
+    i = 0
+    while i < idx.size:
+        if i + 1 == idx.size:
+            out.append(int(idx[i]))
+            break
+        step = int(idx[i + 1] - idx[i])
+        j = i + 1
+        while j + 1 < idx.size and idx[j + 1] - idx[j] == step:
+            j += 1
+        if j - i + 1 >= 3 or i + 2 >= idx.size:
+            out.append(slice(int(idx[i]), int(idx[j]) + 1, step))
+            i = j + 1
+        else:  # (a pair that breaks a run: the first alone)
+            out.append(int(idx[i]))
+            i += 1
+    return out
 
 
 def dense_outputs(

@@ -217,14 +217,27 @@ def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, dtype: Any = com
     shape (n_out, n_o)."""
     n_out, n, n_o = transfer.shape
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)), dtype=dtype)  # (n_o, n, n_out)
-    gt = g_all.reshape(n_o, n, n).astype(dtype, copy=False) @ t  # (n_o, n, n_out)
+    g = g_all.reshape(n_o, n, n)
+    if g.dtype == t.dtype:
+        gt = g @ t  # (n_o, n, n_out)
+    else:  # (G in single precision, contracted in double: a cache-sized run of lines at a time)
+        gt = np.empty_like(t)
+        step = max(1, PAIR_BLOCK_BYTES // (16 * n * n))
+        for i in range(0, n_o, step):
+            np.matmul(g[i : i + step].astype(t.dtype), t[i : i + step], out=gt[i : i + step])
     return (t.real * gt.real + t.imag * gt.imag).sum(axis=1, dtype=float).T  # Re(conj(t)·gt)
 
 
 #: Largest dense matrix of one contraction's pair lines (:class:`PairLines`, n² × n_o
-#: complex; the chain's drag 6.4 MB): beyond it the outputs are summed block by block
-#: (:func:`pair_outputs`). [bytes]
+#: of :data:`PAIR_DTYPE`; the chain's drag 3.2 MB): beyond it the outputs are summed
+#: block by block (:func:`pair_outputs`). [bytes]
 DENSE_PAIR_BYTES = 24 * 2**20
+#: The dense pair lines held in single precision (contracted in double, a cache-sized
+#: run of lines at a time: :func:`dense_pair_outputs`), the along-line contractions'
+#: precision (:data:`~stochcable.dynamics.residuals.along_line.ALONG_DTYPE`): half the
+#: memory and no second copy for them (the chain's 6.4 + 3.2 MB were 9.6 MB held and
+#: first touched in every analysis); end σ within 3e-9 of double on the five lines. [-]
+PAIR_DTYPE = np.complex64
 
 
 class PairLines:
@@ -238,20 +251,21 @@ class PairLines:
     def __init__(self, transfer: np.ndarray) -> None:
         self.transfer = transfer
         n_out, n, n_o = transfer.shape
-        dense = 16 * n * n * n_o <= DENSE_PAIR_BYTES
-        self._g = np.zeros((n_o, n * n), dtype=complex) if dense else None
+        dense = np.dtype(PAIR_DTYPE).itemsize * n * n * n_o <= DENSE_PAIR_BYTES
+        self._g = np.zeros((n_o, n * n), dtype=PAIR_DTYPE) if dense else None
         self._out = None if dense else np.zeros((n_out, n_o))
 
     def add(self, g: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
         """A block of pairs (e, f) and their lines ``g`` (n_pairs, n_o) (one of (c, d)
-        and (d, c) only, weighted 2 where they differ, as :func:`pair_outputs`)."""
+        and (d, c) only, weighted 2 where they differ, as :func:`pair_outputs`; each
+        pair in one block only: its column is set, not summed)."""
         if self._g is None:
             self._out += pair_outputs(g, self.transfer, e, f)
             return
         if (tap := RESIDUAL_TAP.get()) is not None:
-            tap.lines(g, self.transfer, e, f)
+            tap.lines(g, self.transfer, e, f, keep=False)  # (the tap reads G: outputs)
         n = self.transfer.shape[1]
-        self._g[:, np.asarray(e) * n + np.asarray(f)] += g.T
+        self._g[:, np.asarray(e) * n + np.asarray(f)] = g.T
 
     def outputs(self) -> np.ndarray:
         """The variance lines (n_out, n_o) of the outputs."""
@@ -274,8 +288,16 @@ STRIDE_TOL = 2e-3
 
 def line_subset(top: int, stride: int = 1) -> np.ndarray:
     """The lines (indices) of the first ``top`` the along-line outputs are formed on:
-    every ``stride``-th and the last (:func:`fill_lines` the others)."""
-    sel = np.arange(0, top, stride)
+    the first, every ``stride``-th from line ``stride − 1`` and the last
+    (:func:`fill_lines` the others).  With the kinds' grids (the lines j·Δ, j ≥ 1;
+    the geometric residual's every second of them) every second line is then a
+    multiple of 2Δ: the geometric residual's lines are among the drag residual's,
+    their rows solved once on a short line (the deep wire's banded solve of 7 rows
+    on 64 more frequencies)."""
+    if stride == 1:
+        return np.arange(top)
+    sel = np.arange(stride - 1, top, stride)
+    sel = np.append(0, sel) if top else sel
     return sel if top == 0 or sel[-1] == top - 1 else np.append(sel, top - 1)
 
 
