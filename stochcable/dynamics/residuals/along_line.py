@@ -58,8 +58,9 @@ from stochcable.dynamics.residuals.residual_lines import (
     RESIDUAL_TAP,
     EndInfluence,
     along,
-    dense_pair_outputs,
+    dense_outputs,
     fill_lines,
+    line_pair_outputs,
     line_stride,
     line_subset,
     load_transfer,
@@ -318,7 +319,7 @@ def capture_outputs(
     n_kept, n_o) per unit load of ``cap``'s kept loads on its first n_o lines, or on
     its lines ``sel`` (:func:`line_subset`): from the kind's dense pair lines where it
     kept them (``cap.g_all``; contracted in ``dtype``, :data:`ALONG_DTYPE` converted
-    once per capture), else its blocks (:func:`dense_outputs`)."""
+    once per capture), else its blocks (:func:`~.residual_lines.dense_outputs`)."""
     sel = slice(0, transfer.shape[2]) if sel is None else sel
     if cap.g_all is None:
         return dense_outputs(cap.blocks, transfer, sel)
@@ -327,57 +328,7 @@ def capture_outputs(
         if cap.g_low is None or cap.g_low.dtype != np.dtype(dtype):
             cap.g_low = g.astype(dtype)
         g = cap.g_low
-    # the lines as views of G, run by evenly spaced run (:func:`line_subset`: its first
-    # and last lines apart), not a copy of G's rows (the chain's node motions: 2.3 MB)
-    idx = np.arange(g.shape[0])[sel]
-    parts, at = [], 0
-    for run in _runs(idx):
-        lines = g[run] if isinstance(run, slice) else g[run : run + 1]
-        n_run = lines.shape[0]
-        parts.append(dense_pair_outputs(lines, transfer[:, :, at : at + n_run], dtype))
-        at += n_run
-    return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
-
-
-def _runs(idx: np.ndarray) -> list[slice | int]:
-    """``idx`` (increasing) as evenly spaced runs: a slice for each of at least two
-    lines, the index of a line alone."""
-    out: list[slice | int] = []
-    i = 0
-    while i < idx.size:
-        if i + 1 == idx.size:
-            out.append(int(idx[i]))
-            break
-        step = int(idx[i + 1] - idx[i])
-        j = i + 1
-        while j + 1 < idx.size and idx[j + 1] - idx[j] == step:
-            j += 1
-        if j - i + 1 >= 3 or i + 2 >= idx.size:
-            out.append(slice(int(idx[i]), int(idx[j]) + 1, step))
-            i = j + 1
-        else:  # (a pair that breaks a run: the first alone)
-            out.append(int(idx[i]))
-            i += 1
-    return out
-
-
-def dense_outputs(
-    blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
-    transfer: np.ndarray,
-    sel: Any = None,
-) -> np.ndarray:
-    """:func:`~stochcable.dynamics.residuals.residual_lines.pair_outputs` summed over a
-    capture's ``blocks``, for many outputs: the
-    pairs' lines put into one (n_o, n, n) matrix G (G_ef = g_p), then Re Σ_ef conj(T_e)
-    G_ef T_f as one matrix product per line — the per-pair form costs n_pairs × n_out
-    per line (the 7 stations: 3.5× the ends'), this one n² × n_out in BLAS.
-    ``transfer`` (n_out, n, n_o) on the lines ``sel`` (the first n_o by default);
-    shape (n_out, n_o)."""
-    n_out, n, n_o = transfer.shape
-    g_all = np.zeros((n_o, n * n), dtype=complex)
-    for g, e, f in blocks:  # each pair once (pair_outputs' callers: f ≥ e, or (i, j) blocks)
-        g_all[:, e * n + f] += g[:, slice(0, n_o) if sel is None else sel].T
-    return dense_pair_outputs(g_all, transfer)
+    return line_pair_outputs(g, transfer, sel, dtype)
 
 
 def top_line(record: Any, floor: float = LINE_FLOOR) -> int | None:

@@ -51,7 +51,10 @@ __all__ = [
     "along",
     "band_stack",
     "covariance_lines",
+    "dense_outputs",
     "dense_pair_outputs",
+    "line_pair_outputs",
+    "line_runs",
     "cross_covariance",
     "element_directions",
     "fft_length",
@@ -226,6 +229,62 @@ def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, dtype: Any = com
         for i in range(0, n_o, step):
             np.matmul(g[i : i + step].astype(t.dtype), t[i : i + step], out=gt[i : i + step])
     return (t.real * gt.real + t.imag * gt.imag).sum(axis=1, dtype=float).T  # Re(conj(t)·gt)
+
+
+def line_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, sel: Any, dtype: Any) -> np.ndarray:
+    """:func:`dense_pair_outputs` of the dense lines ``g_all``'s rows ``sel`` (an index
+    or slice; ``transfer`` on them), the rows read as views run by evenly spaced run
+    (:func:`line_subset`'s first and last lines apart), not gathered into a copy (the
+    chain's node motions: 2.3 MB a kind, first touched in every analysis)."""
+    idx = np.arange(g_all.shape[0])[sel]
+    parts, at = [], 0
+    for run in line_runs(idx):
+        lines = g_all[run] if isinstance(run, slice) else g_all[run : run + 1]
+        n_run = lines.shape[0]
+        parts.append(dense_pair_outputs(lines, transfer[:, :, at : at + n_run], dtype))
+        at += n_run
+    return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
+
+
+def line_runs(idx: np.ndarray) -> list[slice | int]:
+    """``idx`` (increasing) as evenly spaced runs: a slice for each run of at least
+    three lines (or two at the end), the index of a line alone."""
+    out: list[slice | int] = []
+    i = 0
+    while i < idx.size:
+        if i + 1 == idx.size:
+            out.append(int(idx[i]))
+            break
+        step = int(idx[i + 1] - idx[i])
+        j = i + 1
+        while j + 1 < idx.size and idx[j + 1] - idx[j] == step:
+            j += 1
+        if j - i + 1 >= 3 or i + 2 >= idx.size:
+            out.append(slice(int(idx[i]), int(idx[j]) + 1, step))
+            i = j + 1
+        else:  # (a pair that breaks a run: the first alone)
+            out.append(int(idx[i]))
+            i += 1
+    return out
+
+
+def dense_outputs(
+    blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
+    transfer: np.ndarray,
+    sel: Any = None,
+) -> np.ndarray:
+    """:func:`~stochcable.dynamics.residuals.residual_lines.pair_outputs` summed over a
+    capture's ``blocks``, for many outputs: the
+    pairs' lines put into one (n_o, n, n) matrix G (G_ef = g_p), then Re Σ_ef conj(T_e)
+    G_ef T_f as one matrix product per line — the per-pair form costs n_pairs × n_out
+    per line (the 7 stations: 3.5× the ends'), this one n² × n_out in BLAS.
+    ``transfer`` (n_out, n, n_o) on the lines ``sel`` (the first n_o by default);
+    shape (n_out, n_o)."""
+    n_out, n, n_o = transfer.shape
+    g_all = np.zeros((n_o, n * n), dtype=complex)
+    for g, e, f in blocks:  # each pair once (pair_outputs' callers: f ≥ e, or (i, j) blocks)
+        g_all[:, e * n + f] += g[:, slice(0, n_o) if sel is None else sel].T
+    return dense_pair_outputs(g_all, transfer)
 
 
 #: Largest dense matrix of one contraction's pair lines (:class:`PairLines`, n² × n_o
