@@ -243,6 +243,8 @@ def line_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, sel: Any, dtype: 
         n_run = lines.shape[0]
         parts.append(dense_pair_outputs(lines, transfer[:, :, at : at + n_run], dtype))
         at += n_run
+    if not parts:  # (no line)
+        return np.zeros((transfer.shape[0], 0))
     return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
 
 
