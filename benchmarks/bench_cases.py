@@ -411,6 +411,7 @@ def _hs_only():
     """The adaptive anchors in Hs only, as before the checks across periods: every
     period's first anchors in the first pass (so no period is interpolated)."""
     import stochcable.cases.plan as plan_mod
+    import stochcable.cases.run as run_mod
     from stochcable.cases.anchor_layout import layout
     from stochcable.cases.residual_anchors import _open as open_column  # noqa: PLC2701
 
@@ -423,11 +424,11 @@ def _hs_only():
                 open_column(col, span, out)
         return out
 
-    plan_mod.first_anchors = every_period
+    plan_mod.first_anchors = run_mod.first_anchors = every_period
     try:
         yield
     finally:
-        plan_mod.first_anchors = real
+        plan_mod.first_anchors = run_mod.first_anchors = real
 
 
 def _computed(scene, sd, fatigue) -> int:
