@@ -178,8 +178,10 @@ def main() -> None:
         "likewise from the smallest, middle and largest (a power law of Hs); every",
         "other case gets its linear values times the interpolated ratios.  Here",
         f"{cor['computed']} of {len(rows)} cases computed them ({cor['first']} in the first",
-        f"pass, {cor['computed'] - cor['first']} in the checks' later passes, each solved",
-        "twice: linear in the first pass, then from its own σ with the residuals).",
+        f"pass, {cor['computed'] - cor['first']} in the checks' later passes).  Every case is",
+        "solved once (`stochcable.cases.anchor_passes`): the anchors pass after pass with",
+        "the residuals, each from the converged σ of the nearest case computed before it,",
+        "then the others linear, in warm-start runs across the anchors' positions.",
         "`residual_tolerance=None` computes every case (a plan's default: the service's",
         f"batches); `residual_span=5, residual_tolerance=None` the fixed anchors ({cor['anchors']}",
         "cases, no check).",
@@ -205,9 +207,9 @@ def main() -> None:
         f"{cor['worst']:.1e} |",
         "",
         "What the interpolation costs in accuracy: each set against every case computed",
-        "(largest relative difference over the cases and both ends; a case computed in a",
-        "later pass starts its fixed point from its own first-pass σ, so even computed",
-        "cases differ within the linearization tolerance, 1e-4):",
+        "(largest relative difference over the cases and both ends; an anchor starts its",
+        "fixed point from a neighbour's σ, so even computed cases differ within the",
+        "linearization tolerance, 1e-4):",
         "",
         "| quantity | adaptive (default) | adaptive in Hs only | fixed anchors |",
         "|---|---|---|---|",
@@ -252,26 +254,25 @@ def main() -> None:
         "densities of a computed case in one array operation",
         "(`stochcable.cases.along_spectra`, 7 ms of a computed chain case before).",
         "The default set's cost is the linear set's plus, per computed case, its",
-        f"residuals and, in a later pass, its second solve (≈ {extra:.0f} ms a computed case",
-        "here).  What stands between it and the 1/3 of `analyze()` asked (issue 31):",
-        f"(1) the linear set alone is {lin_share:.2f} × the corrected `analyze()`, leaving",
-        f"≈ {room:.1f} ms a case for the residuals, i.e. ≈ {room * len(rows) / extra:.0f} "
-        "computed cases of",
-        f"{len(rows)} at that cost; (2) the chain's corrections step between neighbouring",
-        "periods (the drag residual's pieces and their panels, grouped by wave-velocity",
-        "variance, change with Tp: 28 or 32 panels, its variance 3 % apart, 0.3 % of σ;",
-        "with one panel grouping for every case the checks computed 63 cases, 57 without",
-        "the spread guard, at the same accuracy: the pieces still step),",
-        "so the checks in the period compute most periods (interpolated across the",
-        "steps, the misses grew to 5.7e-3 on Tz and 9.9e-3 on damage with 41 cases",
-        "computed, against 2.1e-3 and 4.1e-3 now); (3) a case computed in a later pass",
-        "is solved twice, so that on the chain the periods the checks leave to",
-        "interpolation save about what the later passes' second solves cost (the",
-        "adaptive anchors in Hs only: more cases computed, nearly all in the first",
-        "pass).  Where the corrections bend (the taut wire at Tp 10 s, Tuah's",
-        "leg whose σ correction reaches +35 … +49 % and falls again at Tp 6 s) the",
-        "checks compute most cases, and the set costs about as much as computing every",
-        "case — the price of the stated accuracy.",
+        f"residuals (≈ {extra:.0f} ms a computed case here).  What sets it against the 1/3",
+        f"of `analyze()` asked (issue 31): (1) the linear set alone is {lin_share:.2f} ×",
+        f"the corrected `analyze()`, leaving ≈ {room:.1f} ms a case for the residuals,",
+        f"i.e. ≈ {room * len(rows) / extra:.0f} computed cases of {len(rows)} at that cost;",
+        "(2) the chain's corrections step between neighbouring periods: the drag",
+        "residual's pieces and panels (`drag_segments`, grouped by wave-velocity",
+        "variance) change with Tp (27 to 32 panels, 44 to 53 pieces over Tp 6–16 s at",
+        "Hs 5 m; σ's correction 1.0697 … 1.0763, up to 0.45 % between periods 0.5 s",
+        "apart), so the checks in the period compute most periods.  One set-wide",
+        "discretization (the pieces and panels of one pilot sea for every case) makes",
+        "the corrections smooth in the period (second differences ≈ 1e-5 against",
+        "7e-3) but moves them from each case's own `analyze()` by up to 4.2e-3 on σ and",
+        "1.2e-2 on Tz with the middle period's (6.7e-3 and 1.9e-2 with the shortest or",
+        "longest period's), beyond the set's tolerance: the steps are `analyze()`'s own",
+        "discretization, which the set, checked against it, keeps.  Where the",
+        "corrections bend (the taut wire at Tp 10 s, Tuah's leg whose σ correction",
+        "reaches +35 … +49 % and falls again at Tp 6 s) the checks compute most cases,",
+        "and the set costs about as much as computing every case — the price of the",
+        "stated accuracy.",
     ]
     text = "\n".join(lines) + "\n"
     print(text)
@@ -411,6 +412,7 @@ def _hs_only():
     """The adaptive anchors in Hs only, as before the checks across periods: every
     period's first anchors in the first pass (so no period is interpolated)."""
     import stochcable.cases.plan as plan_mod
+    import stochcable.cases.run as run_mod
     from stochcable.cases.anchor_layout import layout
     from stochcable.cases.residual_anchors import _open as open_column  # noqa: PLC2701
 
@@ -423,11 +425,11 @@ def _hs_only():
                 open_column(col, span, out)
         return out
 
-    plan_mod.first_anchors = every_period
+    plan_mod.first_anchors = run_mod.first_anchors = every_period
     try:
         yield
     finally:
-        plan_mod.first_anchors = real
+        plan_mod.first_anchors = run_mod.first_anchors = real
 
 
 def _computed(scene, sd, fatigue) -> int:

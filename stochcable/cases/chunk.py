@@ -6,12 +6,13 @@ scenes it saw, so chunks of the same set on one worker reuse it — solves its s
 and turns the tension spectra into damage rates in one batched call per line.
 
 The cases of a set form runs of ``WARM_RUN`` consecutive positions of the diagram
-(0–15, 16–31, …): the first case of a run, and a case whose heading differs from the
-case before it, starts its drag fixed point at rest, each other from the converged σ
-of the cases before it (:func:`stochcable.dynamics.groups.group_fixed_point.warm_starts`;
+(0–15, 16–31, …): the first case of a run that a pass solves, and a case whose
+heading differs from the case before it, starts its drag fixed point at rest, each
+other from the converged σ of the pass's cases before it
+(:func:`stochcable.dynamics.groups.group_fixed_point.warm_starts`;
 neighbouring sea states of a diagram have neighbouring σ: ≈ 4.7 evaluations a case
 instead of 7.6 on the chain example's 200 cases).  A chunk that starts inside a run
-solves that run's earlier cases first (its ``lead``, discarded).  So each case's
+solves the pass's earlier cases of that run first (its ``lead``, discarded).  So each case's
 numbers depend only on its run and the engine, and the engine is the same wherever it
 is built (one BLAS thread per chunk): a set gives the same bits whichever executor ran
 it and however it was chunked, and each case equals ``analyze()`` of its sea within
@@ -124,8 +125,8 @@ class ChunkResult:
     starts : tuple of dict or None
         Per case, the converged σ of its drag fixed points (per group, as
         :func:`~stochcable.dynamics.groups.group_fixed_point.warm_starts` keeps them;
-        None: not kept): the start of the case's solve when the adaptive anchors
-        compute its residuals later (:func:`solve_chunk`'s ``starts``).  Not stored
+        None: not kept): the start of the solves of the cases the adaptive anchors
+        compute later near it (:func:`solve_chunk`'s ``starts``).  Not stored
         by :func:`stochcable.cases.plan.chunk_to_bytes`. [m/s]
     """
 
@@ -190,10 +191,15 @@ def pilot_state(states: tuple[SeaState, ...]) -> SeaState:
     return min(out, key=lambda s: (s.tp, -s.hs))
 
 
-def run_lead(states: tuple[SeaState, ...], first: int) -> tuple[tuple[int, SeaState], ...]:
+def run_lead(
+    states: tuple[SeaState, ...], first: int, members: Any = None
+) -> tuple[tuple[int, SeaState], ...]:
     """The cases a chunk starting at position ``first`` solves before its own: the
-    earlier cases of the warm-start run it starts in (none at a run's start)."""
-    return tuple((i, states[i]) for i in range(first - first % WARM_RUN, first))
+    earlier cases of the warm-start run it starts in (none at a run's start); of
+    ``members`` only (the positions a pass solves) where given."""
+    run = range(first - first % WARM_RUN, first)
+    keep = run if members is None else sorted(set(run) & {int(i) for i in members})
+    return tuple((i, states[i]) for i in keep)
 
 
 def set_engine(template: Scene) -> Engine:
@@ -249,9 +255,9 @@ def _warm_store(
     store: dict[str, np.ndarray], prev: tuple[int, float] | None, i: int, state: SeaState
 ) -> dict[str, np.ndarray]:
     """The warm starts of case ``i`` (``state``) after the case ``prev`` (position,
-    heading): kept within a run and a heading, empty at a run's start, after a gap or
-    at a change of heading."""
-    if prev is None or prev != (i - 1, state.heading) or i % WARM_RUN == 0:
+    heading) solved before it: kept within a run and a heading (across the positions
+    a pass leaves out), empty at a run's start or at a change of heading."""
+    if prev is None or prev[1] != state.heading or prev[0] // WARM_RUN != i // WARM_RUN:
         return {}
     return store
 
@@ -308,10 +314,10 @@ def solve_chunk(
         :func:`run_lead` of the chunk's first case: solved first and discarded (their
         σ start the chunk's first cases, as when the set runs in one chunk).
     starts : tuple of dict, optional
-        Per case, the σ its drag fixed points start from (a case's own converged σ
-        from an earlier pass, :attr:`ChunkResult.starts`: the adaptive anchors'
-        later passes, :func:`stochcable.cases.run.run_cases`), instead of the run's
-        warm starts: each case then depends on its own start only.
+        Per case, the σ its drag fixed points start from (the converged σ of a case
+        computed in an earlier pass, :attr:`ChunkResult.starts`; empty: at rest: the
+        adaptive anchors' passes, :mod:`stochcable.cases.anchor_passes`), instead of
+        the run's warm starts: each case then depends on its own start only.
 
     Returns
     -------

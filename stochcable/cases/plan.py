@@ -70,11 +70,12 @@ class CasePlan:
         run its first case is in); executors pass ``leads[k]`` with ``chunks[k]``.
     residual_span : int or None
     residual_tolerance : float or None
-        The adaptive anchors' settings (:func:`plan_cases`); ``chunks`` hold their
-        first pass, :func:`stochcable.cases.run.run_cases` runs the others.
+        The adaptive anchors' settings (:func:`plan_cases`); ``chunks`` hold every
+        case with their first anchors flagged, :func:`stochcable.cases.run.run_cases`
+        runs the anchors' passes instead (:mod:`stochcable.cases.anchor_passes`).
     starts : tuple of tuple of dict
-        Per chunk, per case, the σ its drag fixed points start from (a later pass of
-        the adaptive anchors; empty: the warm-start runs); executors pass
+        Per chunk, per case, the σ its drag fixed points start from (a pass of the
+        adaptive anchors; empty: the warm-start runs); executors pass
         ``starts[k]`` with ``chunks[k]`` when not empty.
     """
 

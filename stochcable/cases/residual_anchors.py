@@ -37,9 +37,11 @@ tolerance: ``residual_tolerance`` on σ, Tz and 3-h MPM, :data:`DAMAGE_TOLERANCE
 × it on the end and the elements' damage rates.  So the error is measured where it is
 made, not assumed: a correction that grows fast with Hs (the taut wire at Tp 10 s,
 +0.1 … +35 % on σ at end_b, ×3.4 on the end damage), or steps (the panels), gets
-anchors there.  A case computed in a later pass starts its drag fixed point from its
-own converged σ of the first pass, so the anchors and every number depend on the
-diagram and the computed numbers only, never on the executor or the chunking.
+anchors there.  Every case is solved once (:mod:`stochcable.cases.anchor_passes`):
+the anchors pass after pass with the residuals, each from the converged σ of the
+nearest case computed before it, then every other case linear; so the anchors and
+every number depend on the diagram and the computed numbers only, never on the
+executor or the chunking.
 
 **Fixed anchors** (``residual_span=k, residual_tolerance=None``, opt-in, no check):
 in every column the smallest and largest Hs and Hs values at most ``k`` steps of the

@@ -20,12 +20,14 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.cases.anchor_passes import neighbour_starts, pass_chunks
 from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, set_engine, solve_chunk
 from stochcable.cases.display import case_set_html, case_set_text
 from stochcable.cases.fatigue_settings import LineFatigue
 from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
 from stochcable.cases.residual_anchors import (
     RESIDUAL_TOLERANCE,
+    first_anchors,
     interpolate_along,
     interpolate_corrections,
     next_anchors,
@@ -151,10 +153,9 @@ def run_cases(
     years : float
         Return period of the long-term extremes. [years]
     progress : callable, optional
-        ``progress(done, total)`` as cases finish (after every chunk); the adaptive
-        anchors' later passes count too: each adds the cases it computes again to
-        ``total`` when it starts (a set's total grows pass by pass, and ``done``
-        reaches it at the end).
+        ``progress(done, total)`` as cases finish (after every chunk); ``total`` the
+        diagram's size (every case is solved once, the adaptive anchors' passes
+        first).
     engine : Engine, optional
         A built engine of the same scene, used by the in-process executor
         (``stochcable.build_engine``'s carries the element check into every case).
@@ -207,73 +208,66 @@ def run_cases(
         scene, scatter, fatigue=fatigue, years=years, chunk_size=chunk_size,
         residual_span=residual_span, residual_tolerance=residual_tolerance,
     )  # fmt: skip
-    n = len(scatter.states)
-    done = 0
-    results: list[ChunkResult] = []
     if executor is None and engine is None:
         engine = set_engine(plan.template)
+    if plan.adaptive:
+        return assemble_cases(plan, _anchored(plan, engine, executor, chunk_size, progress))
+    n, done = len(scatter.states), 0
+    results: list[ChunkResult] = []
     for res in _run_chunks(plan, engine, executor):
         results.append(res)
         done += len(res.rows)
         if progress is not None:
             progress(done, n)
-    if plan.adaptive:
-        results = _refine(plan, results, engine, executor, chunk_size, progress, done)
     return assemble_cases(plan, results)
 
 
-def _refine(
+def _anchored(
     plan: CasePlan,
-    results: list[ChunkResult],
     engine: Engine | None,
     executor: Any,
     chunk_size: int | None,
     progress: Progress | None = None,
-    done: int = 0,
 ) -> list[ChunkResult]:
-    """The adaptive anchors' later passes (:func:`~stochcable.cases.residual_anchors.next_anchors`):
-    each computes the residuals of the cases the checks ask for, every case from its
-    own converged σ of the first pass (so its numbers do not depend on the chunking),
-    until no check asks for more; the results in the order to assemble them (a case
-    computed later replaces its first-pass numbers).  ``progress(done, total)`` after
-    each chunk, ``total`` grown by each pass's cases (``done`` solved so far)."""
+    """The passes of the adaptive anchors (:mod:`stochcable.cases.anchor_passes`): the
+    anchors' passes with the residuals, pass after pass until
+    :func:`~stochcable.cases.residual_anchors.next_anchors` asks for no more, then
+    every other case linear, each case once; ``progress(done, n)`` after each chunk."""
     states = plan.scatter.states
-    starts: dict[int, dict[str, np.ndarray]] = {}
-    for res in results:
-        for j, i in enumerate(res.indices):
-            if j < len(res.starts):
-                starts[int(i)] = res.starts[j]
+    n, done = len(states), 0
     # (the ratios are known to the fixed point's tolerance only: no finer checks)
     tol = max(float(plan.residual_tolerance or 0.0), plan.template.analysis.linearization.tolerance)
-    total = len(states)
+    exact = np.zeros(n, dtype=bool)
+    known: dict[int, dict[str, np.ndarray]] = {}
+    results: list[ChunkResult] = []
+    todo = np.flatnonzero(first_anchors(states, plan.residual_span))
+    starts = tuple({} for _ in todo)  # (the first pass: at rest)
     while True:
-        merged = _merge(plan, results)
-        todo = next_anchors(
-            states, plan.residual_span, tol, merged.exact, merged.rows, merged.stats,
-            merged.d_ends, merged.linear, (merged.damage, merged.linear_along),
-        )  # fmt: skip
-        idx = np.flatnonzero(todo)
-        if idx.size == 0:
+        if todo.size == 0 and exact.all():
             return results
-        size = len(idx) if chunk_size is None else chunk_size
-        parts = [idx[a : a + size] for a in range(0, len(idx), size)]
-        cases = tuple(tuple((int(i), states[i], True) for i in part) for part in parts)
-        seeds = tuple(tuple(starts.get(int(i), {}) for i in part) for part in parts)
-        sub = replace(plan, chunks=cases, leads=tuple(() for _ in cases), starts=seeds)
-        total += idx.size
-        if progress is not None:  # (the pass's cases join the total as it starts)
-            progress(done, total)
-        new = []
+        last = todo.size == 0
+        idx = np.flatnonzero(~exact) if last else todo
+        chunks, leads, seeds = pass_chunks(
+            states, idx, not last, chunk_size, None if last else starts
+        )
+        sub = replace(plan, chunks=chunks, leads=leads, starts=() if last else seeds)
         for res in _run_chunks(sub, engine, executor):
-            new.append(res)
+            results.append(res)
+            for j, i in enumerate(res.indices):
+                if j < len(res.starts):
+                    known[int(i)] = res.starts[j]
             done += len(res.rows)
             if progress is not None:
-                progress(done, total)
-        results = [*results, *sorted(new, key=_first_index)]
-
-
-def _first_index(res: ChunkResult) -> int:
-    return int(res.indices[0]) if len(res.indices) else -1
+                progress(done, n)
+        if last:
+            return results
+        exact[idx] = True
+        m = _merge(plan, results)
+        todo = np.flatnonzero(next_anchors(
+            states, plan.residual_span, tol, exact, m.rows, m.stats, m.d_ends, m.linear,
+            (m.damage, m.linear_along),
+        ))  # fmt: skip
+        starts = neighbour_starts(states, todo, {i: x for i, x in known.items() if exact[i]})
 
 
 def _worker_count(executor: Any) -> int:
@@ -318,8 +312,8 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     ----------
     plan : CasePlan
     results : iterable of ChunkResult
-        Every chunk of ``plan`` once (and, after them, those of the adaptive anchors'
-        later passes, in order: a case's later numbers replace its earlier ones).
+        Every chunk of ``plan`` once, or every case of the adaptive anchors' passes
+        once (a case's later numbers replace its earlier ones).
 
     Returns
     -------
@@ -424,6 +418,8 @@ def _merge(plan: CasePlan, results: list[ChunkResult]) -> _Merged:
             exact[res.indices] = res.exact
         for ln, s in res.s_elements.items():
             s_el.setdefault(ln, s)
+    for i in range(n):  # (a case not solved yet: the adaptive anchors' passes)
+        rows[i] = rows[i] or CaseRow(i, "pending", "not solved yet")
     d_ends = {ln: damage[ln][:, :2] for ln in names}
     return _Merged(names, rows, stats, damage, d_ends, linear, exact, s_el, along)
 

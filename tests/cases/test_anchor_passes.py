@@ -1,0 +1,81 @@
+"""The passes of a set with adaptive residual anchors (stochcable.cases.anchor_passes):
+the anchors' starts, the passes' chunks and leads, and every case solved once."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+import stochcable.cases.chunk as chunk_mod
+from stochcable import load_example
+from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
+from stochcable.cases.anchor_passes import neighbour_starts, pass_chunks
+from stochcable.cases.chunk import WARM_RUN
+
+WIRE = LineFatigue("dnv-six-strand", nominal_area=1.2e-3)
+
+
+def _states(hs=(1.0, 2.0, 3.0), tps=(6.0, 8.0, 10.0), heading=0.0):
+    rows = [{"hs": h, "tp": tp, "heading": heading, "hours": 1.0} for h in hs for tp in tps]
+    return scatter_from_rows(rows).states
+
+
+def test_neighbour_starts_prefer_the_same_hs_then_the_nearest_period():
+    """Of the computed cases of its heading: the same Hs at the nearest period, else
+    the nearest Hs; none (at rest) without one; ties to the first."""
+    states = _states()  # positions: 3·(Hs index) + (Tp index)
+    known = {0: {"g": np.array([0.0])}, 2: {"g": np.array([2.0])}, 7: {"g": np.array([7.0])}}
+    got = neighbour_starts(states, [1, 5, 6], known)
+    assert got[0]["g"][0] == 0.0  # Hs 1, Tp 8: same Hs, Tp 6 and 10 tie: the first
+    assert got[1]["g"][0] == 7.0  # Hs 2, Tp 10: none at Hs 2; Hs 3 Tp 8 (ln 1.5 < ln 2)
+    assert got[2]["g"][0] == 7.0  # Hs 3, Tp 6: the same Hs
+    other = _states(heading=90.0)
+    assert neighbour_starts(other, [0], {}) == ({},)
+
+
+def test_pass_chunks_lead_with_the_pass_cases_of_the_run():
+    """A pass's chunk that starts inside a warm-start run first solves the pass's earlier
+    cases of that run only (the positions the pass leaves out are not solved)."""
+    states = _states(hs=tuple(float(h) for h in range(1, 9)), tps=(6.0, 8.0, 10.0, 12.0))
+    idx = [i for i in range(len(states)) if i % 3 != 0]
+    chunks, leads, starts = pass_chunks(states, idx, False, 5)
+    assert [c[0] for ch in chunks for c in ch] == idx
+    assert all(not c[2] for ch in chunks for c in ch)
+    for ch, lead in zip(chunks, leads):
+        first = ch[0][0]
+        assert [i for i, _ in lead] == [i for i in idx if first - first % WARM_RUN <= i < first]
+    assert starts == tuple(() for _ in chunks)
+    seeds = tuple({"g": np.array([float(i)])} for i in idx)
+    chunks, leads, starts = pass_chunks(states, idx, True, 4, seeds)
+    assert all(lead == () for lead in leads)
+    assert [s["g"][0] for part in starts for s in part] == [float(i) for i in idx]
+
+
+def test_every_case_of_an_adaptive_set_is_solved_once():
+    """The anchors' passes and the last linear pass solve each case exactly once (no
+    lead in one chunk), and the anchors are the cases computed with the residuals."""
+    doc = load_example("taut_wire").model_dump(mode="json", exclude_none=True)
+    doc["analysis"].pop("timeseries", None)
+    doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
+    rows = [
+        {"hs": h, "tp": tp, "gamma": 3.3, "hours": 1.0}
+        for tp in (8.0, 10.0, 12.0)
+        for h in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
+    ]
+    seen: list[int] = []
+    real = chunk_mod._solve_case  # noqa: SLF001 - counted, not replaced
+
+    def counted(engine, sea, index):
+        seen.append(index)
+        return real(engine, sea, index)
+
+    chunk_mod._solve_case = counted  # noqa: SLF001
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = run_cases(doc, scatter_from_rows(rows), fatigue=WIRE)
+    finally:
+        chunk_mod._solve_case = real  # noqa: SLF001
+    assert sorted(seen) == list(range(len(rows)))
+    assert all(r.status != "pending" for r in res.rows)
