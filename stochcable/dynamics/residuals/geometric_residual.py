@@ -38,6 +38,7 @@ import numpy as np
 
 from stochcable.dynamics.residuals.body_residual import untapped, with_group_lines
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
+from stochcable.dynamics.residuals.influence import element_rows
 from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
@@ -52,6 +53,7 @@ from stochcable.dynamics.residuals.residual_lines import (
     residual_record,
     uniform_grid,
 )
+from stochcable.line.elements import SLACK_EA_RATIO
 from stochcable.results.records import ResidualRecord
 
 __all__ = ["MAX_ELEMENTS", "geometric_residual", "quadratic_output_lines"]
@@ -168,9 +170,13 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, 3, n_ch)
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
-    # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
-    proc = [grid.lines(along(du, f), spectra) for f in frames]
+    # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each; a as the model's
+    # dynamic tension L₀·δT/EA (equal for a plain element; the split touchdown
+    # element's suspended part, not its chord: the chord's a picks up the node's
+    # heave, ×7 on a leg whose first suspended node is 0.7 ft above the bed)
     mesh = model.mesh
+    proc = [grid.lines(_model_stretch(model, u, mesh), spectra)]
+    proc += [grid.lines(along(du, f), spectra) for f in frames[1:]]
     kappa = (mesh.ea / mesh.l0 - np.asarray(system.statics.tension) / length) / length
     # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms
     comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [
@@ -188,6 +194,20 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     w_out = grid.step * np.arange(1, n_o + 1)
     n_fft = fft_length(4 * (grid.n_j - 1) + 1)  # (products reach line 2·(n_j − 1))
     return GeometricComponents(proc, comp_terms, unit, w_out, n_fft)
+
+
+def _model_stretch(model: Any, u: np.ndarray, mesh: Any) -> np.ndarray:
+    """The elements' axial stretch a = L₀·δT/EA of the model's dynamic tension rows
+    (:attr:`stochcable.line.fem.FEModel.tension_rows`), δT = rows[e, 0]·u_e +
+    rows[e, 1]·u_e+1, of the node motions ``u`` (n_w, n_nodes, 3, n_ch): shape (n_ch,
+    n_el, n_w) as :func:`along`'s."""
+    rows = element_rows(model)  # (n_el, 2, d)
+    uc = u[:, :, list(model.components)]  # (n_w, n_nodes, d, n_ch)
+    dt = np.einsum("ed,wedc->cew", rows[:, 0], uc[:, :-1]) + np.einsum(
+        "ed,wedc->cew", rows[:, 1], uc[:, 1:]
+    )
+    ea = np.where(model.slack, SLACK_EA_RATIO * mesh.ea, mesh.ea)  # (as the rows')
+    return dt * (mesh.l0 / ea)[None, :, None]
 
 
 def _joint(coupled: Any) -> Any:
