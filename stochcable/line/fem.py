@@ -122,6 +122,8 @@ class FEModel:
         rows[j, 1]·u_j+1: (EA/l0)(−e, e), EA reduced for slack elements, and for the
         touchdown element split at the touchdown its suspended part's
         (:attr:`stochcable.line.seabed.BedContact.tension_row`). [N/m]
+    bed : BedContact or None
+        The seabed's share (its split touchdown element's parts and condensation).
 
     Notes
     -----
@@ -155,6 +157,7 @@ class FEModel:
     rho: float
     mass_matrix: str = "consistent"
     tension_rows: np.ndarray | None = None
+    bed: Any = None
 
     @property
     def n_dof(self) -> int:
@@ -544,6 +547,7 @@ def assemble(
         rho=rho,
         mass_matrix=mass_matrix,
         tension_rows=tension_rows(e, mesh.l0, mesh.ea, ten, bed),
+        bed=bed,
     )
 
 
