@@ -155,18 +155,20 @@ def _slack_leg(elements: int) -> dict:
     return doc
 
 
-def test_split_touchdown_element_stretches_as_the_model():
+def test_split_touchdown_element_moves_as_the_model():
     """At 20 elements the leg's touchdown falls inside element 9 (its upper node 0.68 ft
-    above the bed, the chord 2.7° against the suspended part's 3.6°): the chord's axial
-    motion picked up that node's heave (σ_a ×7) and the residual read +5.2 % of σ at
-    the anchor against +0.2 % at 21 (touchdown at a node) and 40 elements, +2.3 % /
-    +4.2 % above the nonlinear time domain (docs/accuracy/bodies.md).  With the model's
-    own stretch (its tension rows) every mesh reads +0.2 … +0.5 %."""
+    above the bed, the chord 2.7° against the suspended part's 3.6°), at 21 at a node.
+    Taken along its chord, the element's axial motion picked up that node's heave
+    (σ_a ×7) and the residual read +5.2 % of σ at the anchor at 20 elements against
+    +0.2 % at 21, +2.3 % / +4.2 % above the nonlinear time domain
+    (docs/accuracy/bodies.md).  Taken on its suspended part (the model's split) it is
+    the same on both meshes (16–40 elements: +0.3 %)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         share = {
             n: analyze(_slack_leg(n)).lines["leg"].geometric_residual.ratio("end_a") - 1.0
             for n in (20, 21)
         }
-    # both within the meshes' spread (0.2 … 0.5 % over 19–40 elements); before: 5.2 %
-    assert 0.0 < share[21] < 0.01 and 0.0 < share[20] < 0.01, share
+    # measured 0.33 / 0.28 % (16–40 elements: 0.25 … 0.35 %, the meshes' own spread):
+    # agreeing to 0.15 % of σ; before the split was followed: 5.2 / 0.2 %
+    assert 0.0 < share[21] < 0.005 and abs(share[20] - share[21]) < 1.5e-3, share
