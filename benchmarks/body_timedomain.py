@@ -32,10 +32,12 @@ def scene(m0: float, elements: int) -> dict:
     return doc
 
 
-def fd(doc: dict, residuals: bool):
-    """The leg's and the buoy's results with the residuals on or off."""
+def fd(doc: dict, residuals: bool, geometric: bool | None = None):
+    """The leg's and the buoy's results with the residuals on or off (the geometric one
+    as ``geometric`` when given)."""
     d = copy.deepcopy(doc)
-    d["analysis"]["linearization"].update(drag_residual=residuals, geometric_residual=residuals)
+    geo = residuals if geometric is None else geometric
+    d["analysis"]["linearization"].update(drag_residual=residuals, geometric_residual=geo)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = analyze(d)

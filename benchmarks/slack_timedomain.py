@@ -17,11 +17,11 @@ buoy in lbf).  Figures: docs/accuracy/bodies.md, "The slack leg's geometric resi
 from __future__ import annotations
 
 import argparse
-import copy
 import time
-import warnings
 
-from stochcable import analyze, load_example
+from body_timedomain import fd
+
+from stochcable import load_example
 from stochcable.errors import ConvergenceError
 from stochcable.reference.cable_body_compare import ENDS, compare_body_line
 
@@ -37,16 +37,6 @@ def leg_scene(m0: float, elements: int, span: float, length: float, wind: float)
     doc["lines"][0]["end_a"]["position"][0] = doc["lines"][0]["end_b"]["attach"]["point"][0] - span
     doc["bodies"][0]["wind_force"][0] = wind
     return doc
-
-
-def fd(doc: dict, drag: bool, geometric: bool):
-    """The leg's and the buoy's results with the residuals asked for."""
-    d = copy.deepcopy(doc)
-    d["analysis"]["linearization"].update(drag_residual=drag, geometric_residual=geometric)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        res = analyze(d)
-    return next(iter(res.lines.values())), next(iter(res.bodies.values()))
 
 
 def main() -> None:
