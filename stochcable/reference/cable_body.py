@@ -82,16 +82,16 @@ class BodyLineHistory:
         """
         return paired_linear(self.excitation, omega, transfer)
 
+    def records(self) -> dict[str, np.ndarray]:
+        """Every record by name: "end_a", "end_b", "surge", "heave", "pitch"."""
+        out = {"end_a": self.tension_a, "end_b": self.tension_b}
+        out.update({k: self.motion[:, i] for i, k in enumerate(("surge", "heave", "pitch"))})
+        return out
+
     def std(self, start: float | None = None) -> dict[str, float]:
         """σ of the end tensions and body DOFs after ``start`` (default the ramp). [N, m, rad]"""
         keep = self.t >= (self.ramp if start is None else start)
-        out = {
-            "end_a": float(np.std(self.tension_a[keep])),
-            "end_b": float(np.std(self.tension_b[keep])),
-        }
-        for i, dof in enumerate(("surge", "heave", "pitch")):
-            out[dof] = float(np.std(self.motion[keep, i]))
-        return out
+        return {k: float(np.std(x[keep])) for k, x in self.records().items()}
 
 
 def simulate_line_on_body(
