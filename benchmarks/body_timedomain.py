@@ -44,11 +44,18 @@ def fd(doc: dict, residuals: bool, geometric: bool | None = None):
     return next(iter(res.lines.values())), next(iter(res.bodies.values()))
 
 
+def parser(doc: str, cases: list[str], seeds: int, duration: float) -> argparse.ArgumentParser:
+    """The time-domain benchmarks' arguments: --cases, --seeds, --duration (defaults
+    given), the description the module docstring's first paragraph."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--cases", nargs="+", default=cases)
+    ap.add_argument("--seeds", type=int, default=seeds)
+    ap.add_argument("--duration", type=float, default=duration)
+    return ap
+
+
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", nargs="+", default=["20:0.1", "20:0.5", "3:0.5", "3:28"])
-    ap.add_argument("--seeds", type=int, default=5)
-    ap.add_argument("--duration", type=float, default=600.0)
+    ap = parser(__doc__, ["20:0.1", "20:0.5", "3:0.5", "3:28"], 5, 600.0)
     ap.add_argument("--seabed", default="linear")
     ap.add_argument("--internal-damping", type=float, default=0.0)
     a = ap.parse_args()

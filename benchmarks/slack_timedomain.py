@@ -16,10 +16,9 @@ buoy in lbf).  Figures: docs/accuracy/bodies.md, "The slack leg's geometric resi
 
 from __future__ import annotations
 
-import argparse
 import time
 
-from body_timedomain import fd
+from body_timedomain import fd, parser
 
 from stochcable import load_example
 from stochcable.errors import ConvergenceError
@@ -40,10 +39,7 @@ def leg_scene(m0: float, elements: int, span: float, length: float, wind: float)
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", nargs="+", default=["20:0.25:250:289:71", "21:0.25:250:289:71"])
-    ap.add_argument("--seeds", type=int, default=3)
-    ap.add_argument("--duration", type=float, default=400.0)
+    ap = parser(__doc__, ["20:0.25:250:289:71", "21:0.25:250:289:71"], 3, 400.0)
     ap.add_argument("--fd-only", action="store_true")
     a = ap.parse_args()
     print(  # noqa: T201
