@@ -140,18 +140,8 @@ def compare_lines_on_body(
     ----------
     doc : dict
         The scene document.
-    seeds : int
-        Seeds 1 … ``seeds`` of the sea realization. [-]
-    duration : float
-        Record length per seed. [s]
-    dt : float
-        Time step. [s]
-    ramp : float
-        Excitation ramp, excluded from the statistics. [s]
-    seabed : {"linear", "one_sided"}
-        The time domain's bed in the nonlinear runs. [-]
-    internal_damping : float
-        The time domain's axial internal damping BA. [N·s]
+    seeds, duration, dt, ramp, seabed, internal_damping
+        As :func:`~stochcable.reference.cable_body_compare.compare_body_line`'s.
 
     Returns
     -------
