@@ -118,9 +118,8 @@ class FEModel:
     mass_matrix : str
         "consistent" or "lumped".
     tension_rows : ndarray, shape (n_el, 2, dim) or None
-        The dynamic effective tension of each element, δT_j = rows[j, 0]·u_j +
-        rows[j, 1]·u_j+1: (EA/l0)(−e, e), EA reduced for slack elements, and for the
-        touchdown element split at the touchdown its suspended part's
+        Dynamic effective tension δT_j = rows[j, 0]·u_j + rows[j, 1]·u_j+1: (EA/l0)(−e, e),
+        EA reduced when slack; the element split at the touchdown its suspended part's
         (:attr:`stochcable.line.seabed.BedContact.tension_row`). [N/m]
     bed : BedContact or None
         The seabed's share (its split touchdown element's parts and condensation).
