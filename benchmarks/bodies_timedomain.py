@@ -14,18 +14,16 @@ docs/accuracy/bodies.md, "Several legs on one buoy".
 
 from __future__ import annotations
 
-import argparse
 import time
+
+from body_timedomain import parser
 
 from stochcable.errors import ConvergenceError
 from stochcable.reference.cable_bodies_compare import compare_lines_on_body, planar_buoy
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", nargs="+", default=["2:3:0.1", "2:3:0.5", "3:3:0.1", "3:3:0.5"])
-    ap.add_argument("--seeds", type=int, default=4)
-    ap.add_argument("--duration", type=float, default=600.0)
+    ap = parser(__doc__, ["2:3:0.1", "2:3:0.5", "3:3:0.1", "3:3:0.5"], 4, 600.0)
     a = ap.parse_args()
     print(  # noqa: T201
         "| legs | elements | m0 [ft²] | record | FD default | FD linear | TD (95 %) "

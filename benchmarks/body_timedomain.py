@@ -32,21 +32,30 @@ def scene(m0: float, elements: int) -> dict:
     return doc
 
 
-def fd(doc: dict, residuals: bool):
-    """The leg's and the buoy's results with the residuals on or off."""
+def fd(doc: dict, residuals: bool, geometric: bool | None = None):
+    """The leg's and the buoy's results with the residuals on or off (the geometric one
+    as ``geometric`` when given)."""
     d = copy.deepcopy(doc)
-    d["analysis"]["linearization"].update(drag_residual=residuals, geometric_residual=residuals)
+    geo = residuals if geometric is None else geometric
+    d["analysis"]["linearization"].update(drag_residual=residuals, geometric_residual=geo)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = analyze(d)
     return next(iter(res.lines.values())), next(iter(res.bodies.values()))
 
 
+def parser(doc: str, cases: list[str], seeds: int, duration: float) -> argparse.ArgumentParser:
+    """The time-domain benchmarks' arguments: --cases, --seeds, --duration (defaults
+    given), the description the module docstring's first paragraph."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--cases", nargs="+", default=cases)
+    ap.add_argument("--seeds", type=int, default=seeds)
+    ap.add_argument("--duration", type=float, default=duration)
+    return ap
+
+
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", nargs="+", default=["20:0.1", "20:0.5", "3:0.5", "3:28"])
-    ap.add_argument("--seeds", type=int, default=5)
-    ap.add_argument("--duration", type=float, default=600.0)
+    ap = parser(__doc__, ["20:0.1", "20:0.5", "3:0.5", "3:28"], 5, 600.0)
     ap.add_argument("--seabed", default="linear")
     ap.add_argument("--internal-damping", type=float, default=0.0)
     a = ap.parse_args()

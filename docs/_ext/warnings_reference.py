@@ -183,12 +183,12 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "a computed residual's end-tension variance beyond RESIDUAL_VARIANCE_LIMIT times "
         "the linear model's variance at that end",
         "The first-order closed forms of the residuals are out of their depth, typically "
-        "on a slack line (the geometric residual of a chain near its vertical limit: "
-        "6.3× at 10 m short of it, 8·10⁵× at 2 m, where the nonlinear time domain's σ "
-        "lies at or below the linear one).  No residual is applied on that line: its "
+        "on a line going slack (the geometric residual of a chain 2 m short of its "
+        "vertical limit, 8·10⁵×, where the time domain snaps).  No residual is applied "
+        "on that line: its "
         "statistics and spectra are the linear model's (no ``linear`` block), and every "
         "residual record says ``not applied: variance ratio X above its range Y``.  The "
-        "bundled examples reach 1.1 (geometric, cable laying) and 0.41 (drag).",
+        "bundled examples reach 0.41 (drag).",
         "Check with the nonlinear time-domain reference "
         "(:mod:`stochcable.reference.cable`); or make the line tauter (pretension), or "
         "its mesh finer.",

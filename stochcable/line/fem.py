@@ -118,10 +118,11 @@ class FEModel:
     mass_matrix : str
         "consistent" or "lumped".
     tension_rows : ndarray, shape (n_el, 2, dim) or None
-        The dynamic effective tension of each element, δT_j = rows[j, 0]·u_j +
-        rows[j, 1]·u_j+1: (EA/l0)(−e, e), EA reduced for slack elements, and for the
-        touchdown element split at the touchdown its suspended part's
+        Dynamic effective tension δT_j = rows[j, 0]·u_j + rows[j, 1]·u_j+1: (EA/l0)(−e, e),
+        EA reduced when slack; the element split at the touchdown its suspended part's
         (:attr:`stochcable.line.seabed.BedContact.tension_row`). [N/m]
+    bed : BedContact or None
+        The seabed's share (its split touchdown element's parts and condensation).
 
     Notes
     -----
@@ -155,6 +156,7 @@ class FEModel:
     rho: float
     mass_matrix: str = "consistent"
     tension_rows: np.ndarray | None = None
+    bed: Any = None
 
     @property
     def n_dof(self) -> int:
@@ -544,6 +546,7 @@ def assemble(
         rho=rho,
         mass_matrix=mass_matrix,
         tension_rows=tension_rows(e, mesh.l0, mesh.ea, ten, bed),
+        bed=bed,
     )
 
 

@@ -25,8 +25,7 @@ import numpy as np
 from stochcable import analyze, load_example
 from stochcable.errors import InputError
 from stochcable.reference.cable_bodies import simulate_lines_on_body
-from stochcable.reference.cable_body_compare import DOFS, ENDS, LINEAR_AMPLITUDE, _scaled
-from stochcable.reference.moordyn_compare import student_interval
+from stochcable.reference.cable_body_compare import DOFS, ENDS, paired_estimate
 
 __all__ = ["BodiesComparison", "compare_lines_on_body", "planar_buoy"]
 
@@ -141,18 +140,8 @@ def compare_lines_on_body(
     ----------
     doc : dict
         The scene document.
-    seeds : int
-        Seeds 1 … ``seeds`` of the sea realization. [-]
-    duration : float
-        Record length per seed. [s]
-    dt : float
-        Time step. [s]
-    ramp : float
-        Excitation ramp, excluded from the statistics. [s]
-    seabed : {"linear", "one_sided"}
-        The time domain's bed in the nonlinear runs. [-]
-    internal_damping : float
-        The time domain's axial internal damping BA. [N·s]
+    seeds, duration, dt, ramp, seabed, internal_damping
+        As :func:`~stochcable.reference.cable_body_compare.compare_body_line`'s.
 
     Returns
     -------
@@ -160,41 +149,13 @@ def compare_lines_on_body(
     """
     fd_default, _, _ = _fd(doc, True)
     fd_linear, transfer, res_l = _fd(doc, False)
-    w = doc["analysis"]["omega"]
-    kw = dict(duration=duration, dt=dt, band=(w["min"], w["max"]), ramp=ramp,
-              tolerance=1e-6, max_iterations=60, internal_damping=internal_damping)  # fmt: skip
     body_l = next(iter(res_l.bodies.values()))
     lin = {n: (r.linearization.b_normal, r.linearization.b_axial) for n, r in res_l.lines.items()}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        h = simulate_lines_on_body(
-            _scaled(doc, LINEAR_AMPLITUDE), seed=1, seabed="linear",
-            linear_drag=(lin, body_l.drag_coefficient), **kw,
-        )  # fmt: skip
-        keep = h.t >= h.ramp
-        offset = {
-            k: float(np.std(x[keep]) / np.std(h.linear(*transfer[k])[keep]) - 1.0)
-            for k, x in h.records().items()
-        }
-        ratios: dict[str, list[float]] = {k: [] for k in offset}
-        raw: dict[str, list[float]] = {k: [] for k in offset}
-        for seed in range(1, seeds + 1):
-            h = simulate_lines_on_body(doc, seed=seed, seabed=seabed, **kw)
-            keep = h.t >= h.ramp
-            for k, x in h.records().items():
-                s_td = float(np.std(x[keep]))
-                raw[k].append(s_td)
-                ratios[k].append(s_td / float(np.std(h.linear(*transfer[k])[keep])))
-    td = {}
-    for k in offset:
-        mean, half = student_interval(np.array(ratios[k]))
-        scale = fd_linear[k] / (1.0 + offset[k])
-        td[k] = (mean * scale, half * scale)
+    offset, td, ratios, raw = paired_estimate(
+        simulate_lines_on_body, doc, (lin, body_l.drag_coefficient), transfer, fd_linear,
+        seeds=seeds, duration=duration, dt=dt, ramp=ramp, seabed=seabed,
+        internal_damping=internal_damping,
+    )  # fmt: skip
     return BodiesComparison(
-        fd_default=fd_default,
-        fd_linear=fd_linear,
-        td=td,
-        offset=offset,
-        ratios={k: np.array(v) for k, v in ratios.items()},
-        raw={k: np.array(v) for k, v in raw.items()},
+        fd_default=fd_default, fd_linear=fd_linear, td=td, offset=offset, ratios=ratios, raw=raw
     )

@@ -82,16 +82,16 @@ class BodyLineHistory:
         """
         return paired_linear(self.excitation, omega, transfer)
 
+    def records(self) -> dict[str, np.ndarray]:
+        """Every record by name: "end_a", "end_b", "surge", "heave", "pitch"."""
+        out = {"end_a": self.tension_a, "end_b": self.tension_b}
+        out.update({k: self.motion[:, i] for i, k in enumerate(("surge", "heave", "pitch"))})
+        return out
+
     def std(self, start: float | None = None) -> dict[str, float]:
         """σ of the end tensions and body DOFs after ``start`` (default the ramp). [N, m, rad]"""
         keep = self.t >= (self.ramp if start is None else start)
-        out = {
-            "end_a": float(np.std(self.tension_a[keep])),
-            "end_b": float(np.std(self.tension_b[keep])),
-        }
-        for i, dof in enumerate(("surge", "heave", "pitch")):
-            out[dof] = float(np.std(self.motion[keep, i]))
-        return out
+        return {k: float(np.std(x[keep])) for k, x in self.records().items()}
 
 
 def simulate_line_on_body(
@@ -121,22 +121,8 @@ def simulate_line_on_body(
         The line (default the first). [-]
     duration : float
         Length of the sea realization and of the record. [s]
-    seed : int
-        Seed of the sea realization (:func:`stochcable.sea.realization.simulate_sea`). [-]
-    dt : float, optional
-        Integration step (default: the period error (ωΔt)²/12 ≤ 0.5 % at the highest
-        excitation frequency). [s]
-    ramp : float, optional
-        Half-cosine ramp of the excitation (default 3 peak periods). [s]
-    band : (float, float), optional
-        Wave components kept (the frequency domain's ω range reproduces its
-        excitation). [rad/s]
-    method : {"dsa", "nsa"}
-        Spectral amplitude method of the realization. [-]
-    tolerance : float
-        Newton tolerance on max |residual| relative to the largest static force. [-]
-    max_iterations : int
-        Newton iterations per step before a ConvergenceError. [-]
+    seed, dt, ramp, band, method, tolerance, max_iterations
+        As :func:`~stochcable.reference.cable_bodies.simulate_lines_on_body`'s.
     linear_drag : (array_like, array_like, array_like), optional
         A controlled experiment: the line's drag linear with (B_n, B_t) per element
         (:func:`stochcable.reference.cable.simulate_line_timedomain`'s ``drag="linear"``)
@@ -144,12 +130,8 @@ def simulate_line_on_body(
         point (a frequency-domain result's ``linearization.b_normal``, ``b_axial`` and
         the body's ``drag_coefficient``): what is left nonlinear is the geometry and
         the seabed. [N·s/m², N·s/m², N·s/m]
-    seabed : {"one_sided", "linear"}
-        The one-sided penalty bed, or its tangent at the static start (the frequency
-        domain's kind of bed; :meth:`stochcable.reference.cable_model.LineModel.set_variant`). [-]
-    internal_damping : float
-        Axial internal damping BA of every element, T_d = BA·(dl/dt)/l0
-        (:func:`stochcable.reference.cable.simulate_line_timedomain`'s); 0: none. [N·s]
+    seabed, internal_damping
+        As :func:`~stochcable.reference.cable_bodies.simulate_lines_on_body`'s.
 
     Returns
     -------

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import copy
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -33,7 +34,7 @@ import numpy as np
 from stochcable.reference.cable_body import simulate_line_on_body
 from stochcable.reference.moordyn_compare import student_interval
 
-__all__ = ["DOFS", "ENDS", "BodyComparison", "compare_body_line"]
+__all__ = ["DOFS", "ENDS", "BodyComparison", "compare_body_line", "paired_estimate"]
 
 ENDS = ("end_a", "end_b")
 DOFS = ("surge", "heave", "pitch")
@@ -130,58 +131,97 @@ def compare_body_line(
     -------
     BodyComparison
     """
-    w = doc["analysis"]["omega"]
-    band = (w["min"], w["max"])
-    kw = dict(duration=duration, dt=dt, band=band, ramp=ramp, tolerance=1e-6,
-              max_iterations=60, internal_damping=internal_damping)  # fmt: skip
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        leg_c = fd_default
-        leg_l, body_l = fd_linear
-        transfer = {e: (leg_l.omega, leg_l.end_tension_transfer[e][0]) for e in ENDS}
-        transfer.update(
-            {k: (body_l.omega, body_l.motion_transfer[0, i]) for i, k in enumerate(DOFS)}
-        )
-        lz = leg_l.linearization
-        small = _scaled(doc, LINEAR_AMPLITUDE)
-        h = simulate_line_on_body(
-            small, seed=1, seabed="linear",
-            linear_drag=(lz.b_normal, lz.b_axial, body_l.drag_coefficient), **kw,
-        )  # fmt: skip
-        keep = h.t >= h.ramp
-        offset = {
-            k: float(np.std(x[keep]) / np.std(h.linear(*transfer[k])[keep]) - 1.0)
-            for k, x in _records(h).items()
-        }
-        ratios: dict[str, list[float]] = {k: [] for k in ENDS + DOFS}
-        raw: dict[str, list[float]] = {k: [] for k in ENDS + DOFS}
-        for seed in range(1, seeds + 1):
-            h = simulate_line_on_body(doc, seed=seed, seabed=seabed, **kw)
-            keep = h.t >= h.ramp
-            for k, x in _records(h).items():
-                s_td = float(np.std(x[keep]))
-                raw[k].append(s_td)
-                ratios[k].append(s_td / float(np.std(h.linear(*transfer[k])[keep])))
+    leg_l, body_l = fd_linear
+    transfer = {e: (leg_l.omega, leg_l.end_tension_transfer[e][0]) for e in ENDS}
+    transfer.update({k: (body_l.omega, body_l.motion_transfer[0, i]) for i, k in enumerate(DOFS)})
     fd_sigma = {e: getattr(leg_l, e).std for e in ENDS}
     fd_sigma.update({k: body_l.motion[k].std for k in DOFS})
-    td = {}
-    for k in ENDS + DOFS:
-        mean, half = student_interval(np.array(ratios[k]))
-        scale = fd_sigma[k] / (1.0 + offset[k])
-        td[k] = (mean * scale, half * scale)
+    lz = leg_l.linearization
+    offset, td, ratios, raw = paired_estimate(
+        simulate_line_on_body, doc, (lz.b_normal, lz.b_axial, body_l.drag_coefficient),
+        transfer, fd_sigma, seeds=seeds, duration=duration, dt=dt, ramp=ramp,
+        seabed=seabed, internal_damping=internal_damping,
+    )  # fmt: skip
     return BodyComparison(
-        fd_default={e: getattr(leg_c, e).std for e in ENDS},
+        fd_default={e: getattr(fd_default, e).std for e in ENDS},
         fd_linear={e: getattr(leg_l, e).std for e in ENDS},
         td={e: td[e] for e in ENDS},
         offset=offset,
-        ratios={e: np.array(v) for e, v in ratios.items()},
-        raw={e: np.array(v) for e, v in raw.items()},
+        ratios={e: ratios[e] for e in ENDS + DOFS},
+        raw={e: raw[e] for e in ENDS + DOFS},
         motion={k: (fd_sigma[k],) + td[k] for k in DOFS},
     )
 
 
-def _records(h: Any) -> dict[str, np.ndarray]:
-    """The end tensions and body DOFs of a record by name."""
-    out = {"end_a": h.tension_a, "end_b": h.tension_b}
-    out.update({k: h.motion[:, i] for i, k in enumerate(DOFS)})
-    return out
+def paired_estimate(
+    simulate: Callable[..., Any],
+    doc: dict,
+    linear_drag: Any,
+    transfer: dict[str, tuple[np.ndarray, np.ndarray]],
+    fd_sigma: dict[str, float],
+    *,
+    seeds: int,
+    duration: float,
+    dt: float,
+    ramp: float,
+    seabed: str,
+    internal_damping: float,
+) -> tuple[dict[str, float], dict[str, tuple[float, float]], dict, dict]:
+    """The estimator of module notes for a time domain ``simulate`` (:func:`simulate_line_on_body`
+    or :func:`~stochcable.reference.cable_bodies.simulate_lines_on_body`: its history's
+    ``records()`` and ``linear(omega, transfer)``).
+
+    Parameters
+    ----------
+    simulate : callable
+        The time domain (scene, seed=, seabed=, linear_drag=, and the run's keywords).
+    doc : dict
+        The scene document.
+    linear_drag : object
+        ``simulate``'s ``linear_drag`` for the linear-offset run (the frequency domain's
+        converged drag).
+    transfer : dict of str to (ndarray, ndarray)
+        Per record: ω [rad/s] and the frequency domain's linear transfer function.
+    fd_sigma : dict of str to float
+        Per record: the frequency domain's linear σ. [N, m, rad]
+    seeds, duration, dt, ramp, seabed, internal_damping
+        As :func:`compare_body_line`'s.
+
+    Returns
+    -------
+    offset, td, ratios, raw : dict of str
+        δ; (σ̂_TD, its 95 % half-width); q per seed; σ_TD per seed (ndarrays).
+    """
+    w = doc["analysis"]["omega"]
+    kw = dict(duration=duration, dt=dt, band=(w["min"], w["max"]), ramp=ramp,
+              tolerance=1e-6, max_iterations=60, internal_damping=internal_damping)  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        h = simulate(
+            _scaled(doc, LINEAR_AMPLITUDE), seed=1, seabed="linear", linear_drag=linear_drag, **kw
+        )
+        keep = h.t >= h.ramp
+        offset = {
+            k: float(np.std(x[keep]) / np.std(h.linear(*transfer[k])[keep]) - 1.0)
+            for k, x in h.records().items()
+        }
+        ratios: dict[str, list[float]] = {k: [] for k in offset}
+        raw: dict[str, list[float]] = {k: [] for k in offset}
+        for seed in range(1, seeds + 1):
+            h = simulate(doc, seed=seed, seabed=seabed, **kw)
+            keep = h.t >= h.ramp
+            for k, x in h.records().items():
+                s_td = float(np.std(x[keep]))
+                raw[k].append(s_td)
+                ratios[k].append(s_td / float(np.std(h.linear(*transfer[k])[keep])))
+    td = {}
+    for k in offset:
+        mean, half = student_interval(np.array(ratios[k]))
+        scale = fd_sigma[k] / (1.0 + offset[k])
+        td[k] = (mean * scale, half * scale)
+    return (
+        offset,
+        td,
+        {k: np.array(v) for k, v in ratios.items()},
+        {k: np.array(v) for k, v in raw.items()},
+    )

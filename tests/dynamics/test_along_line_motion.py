@@ -180,8 +180,8 @@ def test_sparse_transfer_equals_the_dense_load_transfer(guy):  # noqa: F811
 
 def test_motions_beyond_the_residuals_range_stay_linear():
     """The cable-laying line (3-D, travelling): its residuals would raise a station's
-    motion σ more than √2-fold (the out-of-plane motion ×5.7 by the drag residual, the
-    in-plane ×6.5 by the geometric one), beyond RESIDUAL_VARIANCE_LIMIT as at the ends:
+    motion σ more than √2-fold (the out-of-plane motion ×5.7 by the drag residual),
+    beyond RESIDUAL_VARIANCE_LIMIT as at the ends:
     the motions stay linear and the record says why; the element tensions still carry
     the residuals."""
     with warnings.catch_warnings():

@@ -86,6 +86,29 @@ def test_default_end_tension_on_the_buoy_within_the_time_domain():
         assert abs(r.fd_linear[e] - td) > half + 0.05 * td, (e, r.fd_linear[e], td, half)
 
 
+@pytest.mark.slow
+def test_slack_short_leg_not_over_corrected():
+    """The three-leg buoy's short slack leg alone (anchor 250 ft out, 289 ft, wind 71
+    lbf: its 71 lbf anchor tension), 20 elements, m0 = 0.25 ft², 3 seeds × 400 s: the
+    static touchdown falls inside element 9, whose geometric residual, taken along the
+    element's chord, put the default +7.6 / +4.9 % above the time domain (10.56 ± 0.40
+    / 12.26 ± 0.28 lbf; benchmarks/slack_timedomain.py, docs/accuracy/bodies.md).  On
+    the model's suspended part the default is within the TD's 95 % interval plus 2 %
+    (the closed forms' first order, as above; measured +3.0 / +1.9 %) at both ends,
+    the geometric residual's share under 1 % of σ (measured 0.3 %)."""
+    doc = _buoy(0.25)
+    leg = doc["lines"][0]
+    leg["segments"][0].update(elements=20, length=289.0)
+    leg["end_a"]["position"][0] = -250.0
+    doc["bodies"][0]["wind_force"][0] = 71.0
+    default = _fd(doc, True)[0]
+    assert all(default.geometric_residual.ratio(e) < 1.01 for e in ENDS)
+    r = compare_body_line(doc, default, _fd(doc, False), seeds=3, duration=400.0)
+    for e in ENDS:
+        td, half = r.td[e]
+        assert abs(r.fd_default[e] - td) <= half + 0.02 * td, (e, r.fd_default[e], td, half)
+
+
 def test_scope_is_checked_before_the_run():
     """A line with no body at end_b, and a body with frequency-dependent radiation
     damping, are refused with the parameter named."""

@@ -14,8 +14,8 @@ non-Gaussian part (skewness, kurtosis) does not enter them.
 
 The closed forms are first-order corrections: :func:`residuals_in_range` keeps a
 residual out of the statistics where its variance exceeds
-:data:`RESIDUAL_VARIANCE_LIMIT` times the linear one at an end (a slack line's
-geometric residual runs away), and says so.
+:data:`RESIDUAL_VARIANCE_LIMIT` times the linear one at an end (a line going slack),
+and says so.
 """
 
 from __future__ import annotations
@@ -32,10 +32,10 @@ __all__ = ["RESIDUAL_VARIANCE_LIMIT", "corrected_stats", "residuals_in_range"]
 
 #: |residual variance| / linear variance of an end tension above which a residual is not
 #: applied (the statistics stay the linear model's).  The bundled examples reach 0.41
-#: (drag, taut wire) and 1.12 (geometric, cable laying); a slack chain's geometric
-#: residual runs away (2.5 / 6.3 at the anchor / fairlead 10 m short of vertical,
-#: 8·10⁵ at 2 m) where the nonlinear time domain stays near the linear σ
-#: (docs/manual/scene.rst, "Residuals out of their range"). [-]
+#: (drag, taut wire); the time domain confirms the residuals up to 0.55 (a slack
+#: chain's drag, anchor); the chain 2 m short of vertical (H → 0) reaches 8·10⁵
+#: (geometric), where the time domain snaps (docs/manual/scene.rst, "Residuals out of
+#: their range"). [-]
 RESIDUAL_VARIANCE_LIMIT = 2.0
 
 
