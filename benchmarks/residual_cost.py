@@ -13,7 +13,8 @@ against the same analysis with the drag residual, the geometric residual and bot
 Each variant is timed as one ``analyze`` of a scene document (statics, engine, fixed
 point, outputs, residuals), the four variants interleaved, ``--repeat`` rounds in one
 process after one warm-up round; the fastest of the rounds is reported with the ratio
-to the linear one, and the residual σ ratios (σ with / σ without) at the fairlead.
+to the linear one, and the residual σ ratios (σ with / σ without) at the fairlead; and
+the minor page faults (``ru_minflt``) of the fastest round and their median.
 
     OPENBLAS_NUM_THREADS=1 python3 benchmarks/residual_cost.py [--repeat 3] [--profile LINE]
 
@@ -39,9 +40,12 @@ import json
 import math
 import os
 import pstats
+import resource
 import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -128,20 +132,31 @@ def _fairlead_ratio(res, variant: str) -> float:
     return math.sqrt(1.0 + extra / lr.linear_end("end_b").std ** 2) if recs else 1.0
 
 
-def measure(repeat: int) -> dict[str, dict[str, tuple[float, float]]]:
-    """Fastest wall time [s] and fairlead σ ratio of every line and variant."""
+def _faults() -> int:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+
+
+def measure(repeat: int) -> dict[str, dict[str, tuple[float, float, int, float]]]:
+    """Fastest wall time [s], fairlead σ ratio, minor page faults in the fastest round
+    and their median over the rounds of every line and variant."""
     docs = {name: {v: with_variant(d, v) for v in VARIANTS} for name, d in lines().items()}
-    best: dict[str, dict[str, list]] = {n: {v: [math.inf, 1.0] for v in VARIANTS} for n in docs}
+    best: dict[str, dict[str, list]] = {n: {v: [math.inf, 1.0, 0] for v in VARIANTS} for n in docs}
+    faults: dict[tuple[str, str], list[int]] = {(n, v): [] for n in docs for v in VARIANTS}
     for r in range(repeat + 1):  # round 0: warm-up (imports, numba caches)
         for name, by_v in docs.items():
             for v, doc in by_v.items():
-                t0 = time.perf_counter()
+                f0, t0 = _faults(), time.perf_counter()
                 res = analyze(doc)
-                dt = time.perf_counter() - t0
+                dt, df = time.perf_counter() - t0, _faults() - f0
                 if r > 0:
-                    best[name][v][0] = min(best[name][v][0], dt)
+                    faults[name, v].append(df)
+                    if dt < best[name][v][0]:
+                        best[name][v][0], best[name][v][2] = dt, df
                 best[name][v][1] = _fairlead_ratio(res, v)
-    return {n: {v: tuple(x) for v, x in by.items()} for n, by in best.items()}
+    return {
+        n: {v: (*x, float(np.median(faults[n, v]))) for v, x in by.items()}
+        for n, by in best.items()
+    }
 
 
 def report(best: dict) -> str:
@@ -157,6 +172,14 @@ def report(best: dict) -> str:
             cells.append(f"{by[v][0]:.3f} ({by[v][0] / t0:.1f}×)")
         ratios = [f"{by[v][1]:.4f}" for v in ("drag", "geometric", "both")]
         rows.append(f"| {name} | " + " | ".join(cells + ratios) + " |")
+    rows += [
+        "",
+        "| line | minor page faults, linear: fastest round (median) | both |",
+        "|---|---|---|",
+    ]
+    for name, by in best.items():
+        cells = [f"{by[v][2]} ({by[v][3]:.0f})" for v in ("linear", "both")]
+        rows.append(f"| {name} | " + " | ".join(cells) + " |")
     return "\n".join(rows)
 
 
