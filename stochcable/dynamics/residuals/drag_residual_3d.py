@@ -39,20 +39,18 @@ misfit of split elements does in 2-D (with which it is formed here: the pieces o
 split element against their element's mean covariance).  The ``vector`` method has
 no form misfit.
 
-Validation: Monte Carlo of correlated Gaussian velocities with a mean
-(tests/dynamics/test_drag_residual_3d.py), the 2-D residual from a 3-D planar line, and
-the nonlinear time domain (figures in docs/benchmarks/drag_residual.md).
+Validation: Monte Carlo of correlated Gaussian velocities with a mean (tests/dynamics/
+test_drag_residual_3d.py), the 2-D residual from a 3-D planar line, the nonlinear time
+domain (docs/benchmarks/drag_residual.md).
 
-Scope: 3-D lines, ``seed`` and ``vector`` methods (not ``harmonic``), the line
-elements' drag (not attachments'), at most
-:data:`~stochcable.dynamics.residuals.drag_residual.MAX_PANELS` panels.
+Scope: 3-D lines, ``seed`` and ``vector`` methods (not ``harmonic``), the line elements'
+drag, at most :data:`~stochcable.dynamics.residuals.drag_residual.MAX_PANELS` panels.
 
 References
 ----------
 Borgman, L. E. (1972), Statistical models for ocean waves and wave forces, Advances in
 Hydroscience 8, 139–181.
-Roberts, J. B. and Spanos, P. D. (1990), Random Vibration and Statistical
-Linearization, Wiley, §5.
+Roberts, J. B. and Spanos, P. D. (1990), Random Vibration and Statistical Linearization, Wiley, §5.
 """
 
 from __future__ import annotations
@@ -350,9 +348,8 @@ def vector_residual_output_lines(
         Outputs per unit force on each panel along each output direction at ω_j,
         j = 1 … n_o. [N/N]
     first : int, optional
-        Only the pairs (e ≤ f) whose first panel e is one of the ``first`` panels: what
-        they add to the sum over the others (a body's drag components ahead of the
-        lines' panels, :mod:`.body_drag_residual`); default every pair.
+        Only the pairs e ≤ f with e among the ``first`` panels (a body's drag components
+        ahead of the lines' panels, :mod:`.body_drag_residual`); default every pair.
 
     Returns
     -------
