@@ -42,7 +42,9 @@ def test_component_carries_the_residual_variance(runs):
     assert np.var(comp) == pytest.approx(np.trapezoid(s_r, om), rel=5e-2)
     series = ts.body_motion[name]["surge"]
     assert np.std(series) == pytest.approx(body.motion["surge"].std, rel=5e-2)
-    assert body.motion["surge"].std > 1.2 * body.motion_linear["surge"].std
+    # the residual a visible share, so that the 5 % checks above can tell it is there
+    # (σ ratio 1.13 once the touchdown element's geometric residual is its suspended part)
+    assert body.motion["surge"].std > 1.08 * body.motion_linear["surge"].std
 
 
 def test_linear_series_and_the_others_are_the_switches_off_runs(runs):
