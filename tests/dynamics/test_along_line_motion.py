@@ -8,15 +8,18 @@ time domain (slow)."""
 from __future__ import annotations
 
 import math
+import sys
 import warnings
 
 import numpy as np
 import pytest
+from _paths import ROOT
 from _scenes import chain_surge_doc
 from test_along_line import _dense
 from test_along_line_3d import _guy_doc, guy  # noqa: F401  (the fixture)
 from test_body_residual import buoy_group  # noqa: F401  (the fixture)
 
+import stochcable.dynamics.residuals.along_line_motion as alm
 from stochcable import analyze, load_example
 from stochcable.bodies.coupling import LineLink, couple, coupled_load, expand_line
 from stochcable.dynamics.groups.group import linear_body_drag
@@ -24,8 +27,12 @@ from stochcable.dynamics.model.blocks import add_blocks, line_prep
 from stochcable.dynamics.residuals.along_line_bodies import NodeCoupledInfluence
 from stochcable.dynamics.residuals.along_line_motion import motion_weights, node_influence
 from stochcable.dynamics.residuals.body_residual import coupled_influences
+from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.reference.bodies import solve_coupled_direct
+
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import residual_cost  # noqa: E402
 
 RHO = 1025.0
 
@@ -179,17 +186,57 @@ def test_sparse_transfer_equals_the_dense_load_transfer(guy):  # noqa: F811
 
 
 def test_motions_beyond_the_residuals_range_stay_linear():
-    """The cable-laying line (3-D, travelling): its residuals would raise a station's
-    motion σ more than √2-fold (the out-of-plane motion ×5.7 by the drag residual, the
+    """The cable-laying line (3-D, travelling): its residuals would raise some node
+    motions' σ more than √3-fold (the out-of-plane motion ×5.7 by the drag residual, the
     in-plane ×6.5 by the geometric one), beyond RESIDUAL_VARIANCE_LIMIT as at the ends:
-    the motions stay linear and the record says why; the element tensions still carry
-    the residuals."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        doc = load_example("cable_laying").model_dump(mode="json")
-        doc["analysis"].pop("timeseries", None)
+    those motions stay linear (to the bit), named by a warning, and the others keep
+    their residuals; the element tensions still carry the residuals."""
+    doc = load_example("cable_laying").model_dump(mode="json")
+    doc["analysis"].pop("timeseries", None)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         line = next(iter(analyze(doc).lines.values()))
     mr = line.motion_residual
-    assert not mr.computed and "RESIDUAL_VARIANCE_LIMIT" in mr.reason
-    assert line.motion_std_linear is None and "std_linear" not in line.to_document()["motion"]
+    said = [str(w.message) for w in caught if "of the node motions" in str(w.message)]
+    assert mr.computed and said == [mr.reason]
+    assert "RESIDUAL_VARIANCE_LIMIT" in mr.reason and "x at nodes 3–25" in mr.reason
+    lin = line.motion_std_linear
+    assert np.array_equal(line.motion_std[mr.beyond], lin[mr.beyond])
+    assert not np.any(mr.variance[mr.beyond])
+    kept = ~mr.beyond & (lin > 0.01 * lin.max())
+    assert np.all(line.motion_std[kept] ** 2 <= (1.0 + RESIDUAL_VARIANCE_LIMIT) * lin[kept] ** 2)
+    assert np.any(line.motion_std[kept] > 1.01 * lin[kept])  # (the others move)
     assert line.along_line.computed
+
+
+def _two_segment(monkeypatch, limit: float) -> tuple:
+    """The two-segment line of benchmarks/residual_cost.py, both residuals, the node
+    motions' RESIDUAL_VARIANCE_LIMIT at ``limit``: its line result and the node
+    motions' warnings."""
+    monkeypatch.setattr(alm, "RESIDUAL_VARIANCE_LIMIT", limit)
+    doc = residual_cost.with_variant(residual_cost.two_segment(), "both")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        line = next(iter(analyze(doc).lines.values()))
+    return line, [str(w.message) for w in caught if "of the node motions" in str(w.message)]
+
+
+def test_a_node_beyond_the_range_falls_back_alone(monkeypatch):
+    """The two-segment line's node 33 (a station) has the largest ratio of residual to
+    linear variance of its motions, 1.92 (its x): below the limit 2 nothing falls back;
+    with the limit at 1.9, between it and the next largest node's 1.67, node 33's x
+    motion alone is the linear model's, with a warning naming it, its ratio and the
+    limit, and every other motion keeps its σ to the bit (the whole line fell back
+    before: σ down by up to 41 %)."""
+    below, said = _two_segment(monkeypatch, 2.0)
+    lin = below.motion_std_linear
+    ratio = below.motion_residual.variance / np.where(lin > 0, lin**2, 1.0)
+    assert ratio[33, 0] == pytest.approx(1.92, abs=0.01) and said == []
+    assert np.sort(ratio.ravel())[-2] < 1.9 and not below.motion_residual.beyond.any()
+    above, said = _two_segment(monkeypatch, 1.9)
+    beyond = above.motion_residual.beyond
+    assert np.argwhere(beyond).tolist() == [[33, 0]]
+    assert len(said) == 1 and "up to 1.92 × the linear variance (node 33's x motion)" in said[0]
+    assert "range 1.9 (RESIDUAL_VARIANCE_LIMIT) (x at node 33)" in said[0]
+    assert above.motion_std[33, 0] == lin[33, 0] < below.motion_std[33, 0] / 1.6
+    assert np.array_equal(above.motion_std[~beyond], below.motion_std[~beyond])
