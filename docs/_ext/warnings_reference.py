@@ -198,8 +198,9 @@ WARNINGS: tuple[WarningEntry, ...] = (
         "Node motions out of the residuals' range (those left linear)",
         "PhysicsWarning",
         ("stochcable.dynamics.residuals.along_line_motion:_beyond_range",),
-        "a node motion component (moving at least 1 % of the line's largest σ) whose "
-        "residual variance is beyond RESIDUAL_VARIANCE_LIMIT times its linear variance",
+        "a node motion component whose residual variance is beyond "
+        "RESIDUAL_VARIANCE_LIMIT times its linear variance (said where one of them moves "
+        "at least 1 % of the line's largest σ; nearly at rest, silently)",
         "As at the ends, the first-order closed forms are out of their depth there: those "
         "node motions are the linear model's (no residual), node by node; the line's other "
         "motions keep their residuals.  The message names the nodes per axis, the largest "

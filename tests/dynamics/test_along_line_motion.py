@@ -189,8 +189,9 @@ def test_motions_beyond_the_residuals_range_stay_linear():
     """The cable-laying line (3-D, travelling): its residuals would raise some node
     motions' σ more than √3-fold (the out-of-plane motion ×5.7 by the drag residual, the
     in-plane ×6.5 by the geometric one), beyond RESIDUAL_VARIANCE_LIMIT as at the ends:
-    those motions stay linear (to the bit), named by a warning, and the others keep
-    their residuals; the element tensions still carry the residuals."""
+    those motions stay linear (to the bit), named by a warning (nodes 1 and 2's x too,
+    nearly at rest: ×13 where the whole line fell back), and the others keep their
+    residuals; the element tensions still carry the residuals."""
     doc = load_example("cable_laying").model_dump(mode="json")
     doc["analysis"].pop("timeseries", None)
     with warnings.catch_warnings(record=True) as caught:
@@ -199,13 +200,14 @@ def test_motions_beyond_the_residuals_range_stay_linear():
     mr = line.motion_residual
     said = [str(w.message) for w in caught if "of the node motions" in str(w.message)]
     assert mr.computed and said == [mr.reason]
-    assert "RESIDUAL_VARIANCE_LIMIT" in mr.reason and "x at nodes 3–25" in mr.reason
+    assert "RESIDUAL_VARIANCE_LIMIT" in mr.reason
+    assert "(x at nodes 1–25; y at nodes 1–29)" in mr.reason
     lin = line.motion_std_linear
     assert np.array_equal(line.motion_std[mr.beyond], lin[mr.beyond])
     assert not np.any(mr.variance[mr.beyond])
-    kept = ~mr.beyond & (lin > 0.01 * lin.max())
-    assert np.all(line.motion_std[kept] ** 2 <= (1.0 + RESIDUAL_VARIANCE_LIMIT) * lin[kept] ** 2)
-    assert np.any(line.motion_std[kept] > 1.01 * lin[kept])  # (the others move)
+    kept = line.motion_std[~mr.beyond] ** 2
+    assert np.all(kept <= (1.0 + RESIDUAL_VARIANCE_LIMIT) * lin[~mr.beyond] ** 2)
+    assert np.any(kept > 1.1 * lin[~mr.beyond] ** 2)  # (the others carry their residuals)
     assert line.along_line.computed
 
 

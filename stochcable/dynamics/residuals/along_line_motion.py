@@ -18,8 +18,8 @@ the segment junctions, evenly spaced ones), the other nodes' from the ratio of r
 to linear variance interpolated linearly in arc length (:func:`motion_weights`).  A
 held end node moves with its prescribed motion only: no residual.  As at the ends
 (:data:`~stochcable.dynamics.residuals.corrected.RESIDUAL_VARIANCE_LIMIT`), a node
-motion whose residual variance is above twice its linear one (a component moving at
-least 1 % of the line's largest) stays linear, with a warning naming the nodes: node by
+motion whose residual variance is above twice its linear one stays linear, with a
+warning naming the nodes (where one moves at least 1 % of the line's largest): node by
 node, the others keep their residuals (the cable-laying line's out-of-plane motion, ×5.7
 in σ by the 3-D drag residual; the two-segment line's node 33 sits at 1.92×).
 """
@@ -392,19 +392,20 @@ def _node_list(nodes: np.ndarray) -> str:
 
 def _beyond_range(name: str, total: np.ndarray, linear_std: np.ndarray) -> tuple[np.ndarray, str]:
     """The node motion components (n_nodes, 3) whose residual variance ``total`` is
-    above RESIDUAL_VARIANCE_LIMIT times the linear one (a component moving at least
-    1 % of the line's largest), and the warning issued naming them ("" when none).
+    above RESIDUAL_VARIANCE_LIMIT times the linear one, and the warning naming them,
+    issued where one of them moves at least 1 % of the line's largest σ ("" when none:
+    a component nearly at rest falls back silently, its ratio one of two small numbers).
 
     Node by node: the line's other motions keep their residuals (a whole line falling
     back for one node moved every node's σ by up to 41 % when that node's ratio
     crossed the limit)."""
     lin = np.asarray(linear_std, dtype=float) ** 2
-    live = lin > 1e-4 * np.max(lin, initial=0.0)
-    ratio = np.where(live, total / np.where(live, lin, 1.0), 0.0)
+    ratio = np.where(lin > 0.0, total / np.where(lin > 0.0, lin, 1.0), 0.0)
     beyond = ratio > RESIDUAL_VARIANCE_LIMIT
-    if not beyond.any():
+    live = lin > 1e-4 * np.max(lin, initial=0.0)
+    if not np.any(beyond & live):
         return beyond, ""
-    k, c = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+    k, c = np.unravel_index(int(np.argmax(np.where(live, ratio, 0.0))), ratio.shape)
     where = "; ".join(
         f"{'xyz'[j]} at node{'s' if np.count_nonzero(beyond[:, j]) > 1 else ''} "
         f"{_node_list(np.flatnonzero(beyond[:, j]))}"
