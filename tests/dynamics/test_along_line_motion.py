@@ -14,31 +14,34 @@ import warnings
 import numpy as np
 import pytest
 from _paths import ROOT
-from _scenes import chain_surge_doc
-from test_along_line import _dense
-from test_along_line_3d import _guy_doc, guy  # noqa: F401  (the fixture)
+from _scenes import (
+    along_line_arguments,
+    chain_surge_doc,
+    coupled_leg_motions,
+    forward_dense_motions,
+    guy_3d_doc,
+)
 from test_body_residual import buoy_group  # noqa: F401  (the fixture)
 
 import stochcable.dynamics.outputs.line_result as line_result_module
 import stochcable.dynamics.residuals.along_line_motion as alm
 from stochcable import analyze, load_example
-from stochcable.bodies.coupling import LineLink, couple, coupled_load, expand_line
-from stochcable.dynamics.groups.group import linear_body_drag
-from stochcable.dynamics.model.blocks import add_blocks, line_prep
 from stochcable.dynamics.residuals.along_line_bodies import NodeCoupledInfluence
 from stochcable.dynamics.residuals.along_line_motion import motion_weights, node_influence
 from stochcable.dynamics.residuals.body_residual import coupled_influences
 from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
-from stochcable.dynamics.solve.line_loads import drag_blocks
-from stochcable.reference.bodies import solve_coupled_direct
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import residual_cost  # noqa: E402
 
-RHO = 1025.0
+
+@pytest.fixture(scope="module")
+def guy():
+    """The 3-D guy's line and the arguments of its along-line evaluation."""
+    return along_line_arguments(guy_3d_doc(), "")
 
 
-def test_node_influence_equals_a_forward_dense_solve(guy):  # noqa: F811
+def test_node_influence_equals_a_forward_dense_solve(guy):
     """The 3-D guy, a random node load at three frequencies (one at the first mode):
     the station nodes' displacements of the dense forward solve against the adjoint
     influence, within 1e-9 of the largest; zero rows on the held end nodes."""
@@ -46,18 +49,12 @@ def test_node_influence_equals_a_forward_dense_solve(guy):  # noqa: F811
     system, damping = seen["system"], seen["damping"]
     model = system.model
     n, d = model.n_nodes, model.dim
-    prep = line_prep(system)
-    k, m = _dense(prep.K, n, d), _dense(prep.MT, n, d)
-    c = _dense(add_blocks(prep.S, drag_blocks(system, damping)), n, d)
     rng = np.random.default_rng(8)
     load = rng.standard_normal((n, d)) + 1j * rng.standard_normal((n, d))
     nodes = np.array([0, 3, 20, n - 2, n - 1])
     w = np.array([0.2, float(system.modes.omega[0]), 2.1])
     g = node_influence(system, damping, w, nodes)  # (n_st·d, n, d, n_w)
-    for j, om in enumerate(w):
-        a = (k - om**2 * m + 1j * om * c)[d:-d, d:-d]
-        u = np.zeros((n, d), dtype=complex)
-        u[1:-1] = np.linalg.solve(a, load[1:-1].ravel()).reshape(n - 2, d)
+    for j, u in enumerate(forward_dense_motions(system, damping, load, w)):
         direct = u[nodes].ravel()
         adjoint = np.einsum("ond,nd->o", g[..., j], load)
         assert np.max(np.abs(adjoint - direct)) < 1e-9 * np.max(np.abs(direct))
@@ -81,16 +78,7 @@ def test_node_influence_through_the_body_equals_the_assembled_system(buoy_group)
     f = rng.standard_normal((model.n_dof, 3)) + 1j * rng.standard_normal((model.n_dof, 3))
     g = NodeCoupledInfluence(infl[cl.name], nodes).on(w)
     got = np.einsum("onkw,nkc->owc", g, f.reshape(n, d, 3))
-    links = [
-        LineLink(c.name, c.system.model, end_b="buoy", force_b=c.system.statics.force_b,
-                 damping=damp[c.name].matrix)
-        for c in cls
-    ]  # fmt: skip
-    _, cdrag = linear_body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
-    system = couple(links, [body], body_damping={"buoy": cdrag})
-    fw = np.broadcast_to(f, (w.size,) + f.shape)
-    x = solve_coupled_direct(system, coupled_load(system, w, line_loads={cl.name: fw}), w, "dense")
-    u = expand_line(system, cl.name, x).reshape(w.size, n, d, 3)
+    u = coupled_leg_motions(buoy_group, f, w)  # (n_w, n, d, 3)
     ref = np.transpose(u[:, nodes], (1, 2, 0, 3)).reshape(nodes.size * d, w.size, 3)
     np.testing.assert_allclose(got, ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
     assert np.abs(ref[-d:]).max() > 1e-3 * np.abs(ref).max()  # (the fairlead moves)
@@ -146,7 +134,7 @@ def test_3d_node_motions_against_the_time_domain():
     from stochcable.reference.cable import simulate_line_timedomain
     from stochcable.scene.model import load_scene
 
-    doc = _guy_doc()
+    doc = guy_3d_doc()
     doc["analysis"]["linearization"]["tolerance"] = 1e-8
     scene = load_scene(doc)
     nodes = [10, 20, 30]
@@ -169,7 +157,7 @@ def test_3d_node_motions_against_the_time_domain():
     assert err.mean() < err_lin.mean()
 
 
-def test_sparse_transfer_equals_the_dense_load_transfer(guy):  # noqa: F811
+def test_sparse_transfer_equals_the_dense_load_transfer(guy):
     """The geometric pairs' outputs per unit load through the loads' nonzero entries
     against load_transfer's dense product (round-off, 1e-12)."""
     from stochcable.dynamics.residuals.along_line_3d import sparse_transfer
