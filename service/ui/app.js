@@ -463,7 +463,10 @@ async function cancelJob(id, status) {
     const j = await api("DELETE", `/v1/batches/${id}${del ? "" : "?cancel_only=true"}`);
     if (open && state.job === id) {
       if (del) { $("job").hidden = true; state.job = null; }
-      else await showJob(j, j.status === "cancelled" ? "" : "the cancel came too late: the batch had already finished");
+      else {
+        const late = finished(j.status) && j.status !== "cancelled";
+        await showJob(j, late ? "the cancel came too late: the batch had already finished" : "");
+      }
     }
     refreshJobs();
   } catch (e) {
