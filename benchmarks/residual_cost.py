@@ -19,7 +19,7 @@ to the linear one, and the residual σ ratios (σ with / σ without) at the fair
 
 Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
 analysis before issue 31; with the end, element-tension and node-motion residuals now
-chain 2.5×, taut 2.1×, deep 2.4×, two-segment 2.0× (load ≈ 1): exact steps (adjoint end
+chain 2.3–2.4×, taut 2.0×, deep 2.3×, two-segment 1.9–2.0× (load ≈ 2): exact steps (adjoint end
 tensions, pairs f ≥ e in cache-sized blocks, the lag grid at the alias bound, one end
 influence, the element and node rows in the same solve, one dense matrix of pair lines
 per kind) and approximate ones (Hermite orders 2 and 3 carrying the higher orders'

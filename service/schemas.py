@@ -16,6 +16,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from service.body_schemas import BodyDocument
 from service.residual_schemas import ResidualParts
 from stochcable.scene import model as sc
 from stochcable.scene.model import G_STANDARD, OmegaGrid, Spectrum, TimeSeriesSettings
@@ -475,8 +476,9 @@ class AnalysisResponse(_Open):
         "off environment.g (stochcable.scene.units): system (SI, foot-slug-second or "
         "consistent), length, mass, force, time",
     )
-    bodies: dict[str, dict[str, Any]] | None = Field(
+    bodies: dict[str, BodyDocument] | None = Field(
         default=None,
         description="Motion of each body (scenes with bodies): per DOF the "
-        "statistics, spectra and RAOs, plus the coupled modes (docs/BODIES.md)",
+        "statistics and spectra (with the residuals' where computed), plus the coupled "
+        "modes (docs/BODIES.md)",
     )

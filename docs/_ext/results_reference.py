@@ -400,9 +400,26 @@ _BODIES = {
     "bodies.<body>.motion.<dof>.std_deg": ("deg", "σ of a rotation in degrees."),
     "bodies.<body>.motion.<dof>.std_linear": (
         "U",
-        "A free body whose motion carries its line's residuals (a group of one line with "
-        "them, docs/BODIES.md): σ of the linear model; the other statistics are then the "
-        "corrected ones.",
+        "A free body whose motion carries its lines' residuals (docs/BODIES.md): σ of the "
+        "linear model; the other statistics are then the corrected ones.",
+    ),
+    "bodies.<body>.corrected_spectra": (
+        "",
+        "Only where the motion carries the residuals (``std_linear`` given): each DOF's "
+        "spectral density with the residuals' spectra "
+        "(:mod:`stochcable.dynamics.residuals.corrected_spectrum`; "
+        "``BodyResult.motion_density``), whose area is the corrected σ² of "
+        "``bodies.<body>.motion.<dof>`` (to round-off; ``bodies.<body>.spectra`` stays "
+        "the linear model's).",
+    ),
+    "bodies.<body>.corrected_spectra.<dof>": ("", "The DOF."),
+    "bodies.<body>.corrected_spectra.<dof>.omega": (
+        "rad/s",
+        "The analysis frequencies and the residual lines outside them.",
+    ),
+    "bodies.<body>.corrected_spectra.<dof>.motion": (
+        "{L}²·s/rad or rad²·s/rad",
+        "One-sided spectral density of the DOF's motion with the residuals.",
     ),
     "bodies.<body>.spectra.omega": ("rad/s", "Analysis frequencies."),
     "bodies.<body>.spectra.<dof>": (
@@ -583,7 +600,7 @@ def _child(parent: str, key: str) -> str:
         name = _NAMED[parent]
     elif key in ("end_a", "end_b"):
         name = "<end>"
-    elif parent == "bodies.<body>.spectra" and key in _DOFS:
+    elif parent in ("bodies.<body>.spectra", "bodies.<body>.corrected_spectra") and key in _DOFS:
         name = "<dof>"
     else:
         name = key

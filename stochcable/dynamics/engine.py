@@ -162,6 +162,7 @@ class Engine:
                     solved.alone + solved.groups,
                     timing=timing,
                     lines=solved.lines,
+                    bodies=solved.bodies,
                 )
                 timing["timeseries_s"] = time.perf_counter() - t0
         messages = _messages(self.warnings, caught)

@@ -7,7 +7,8 @@ the CLI's and the service's answer, or one read back from a file) into an
 holds (the tension spectrum of every element and the motion spectrum of every node).
 
 Dimensions: ``line``, ``end`` (end_a, end_b), ``omega`` (the analysis grid; and
-``omega_corrected``, :mod:`stochcable.results.residual_dataset`),
+``omega_corrected``, :mod:`stochcable.results.residual_dataset`, and
+``omega_body_corrected`` for the bodies' densities with the residuals),
 ``element`` and ``node`` (index along each line; lines with fewer elements are padded
 with NaN; the arc lengths are the coordinates ``element_arclength`` and
 ``node_arclength``), ``axis`` (x, y, z), ``mode``; with bodies ``body`` and ``dof``;
@@ -227,6 +228,51 @@ def _body_parts(doc: Mapping[str, Any], u: dict[str, str]) -> tuple[dict, dict]:
         f"({u['length']}2 or rad2) s rad-1",
         "one-sided spectrum of the body motion (see dof_units)",
     )
+    coords_c, out_c = _body_corrected(bodies, names, dofs, u)
+    coords.update(coords_c)
+    out.update(out_c)
+    return coords, out
+
+
+def _body_corrected(
+    bodies: Mapping[str, Any], names: list[str], dofs: list[str], u: dict[str, str]
+) -> tuple[dict, dict]:
+    """``body_motion_corrected_spectrum`` (body, dof, omega_body_corrected): each DOF's
+    density with the residuals (the document's ``corrected_spectra``) on the union of
+    their grids, NaN off a DOF's own points (as the end tensions',
+    :mod:`stochcable.results.residual_dataset`)."""
+    have = [n for n in names if bodies[n].get("corrected_spectra")]
+    if not have:
+        return {}, {}
+    grid = np.unique(
+        np.concatenate(
+            [np.asarray(s["omega"], dtype=float)
+             for n in have for s in bodies[n]["corrected_spectra"].values()]
+        )
+    )  # fmt: skip
+    data = np.full((len(names), len(dofs), grid.size), np.nan)
+    for i, n in enumerate(names):
+        for j, d in enumerate(dofs):
+            s = (bodies[n].get("corrected_spectra") or {}).get(d)
+            if s is not None:
+                data[i, j, np.searchsorted(grid, np.asarray(s["omega"], dtype=float))] = s["motion"]
+    coords = {
+        "omega_body_corrected": _var(
+            ("omega_body_corrected",), grid, "rad s-1",
+            "angular frequency of the body-motion densities with the residuals (the "
+            "analysis grid and the residual lines outside it)",
+        )
+    }  # fmt: skip
+    out = {
+        "body_motion_corrected_spectrum": _var(
+            ("body", "dof", "omega_body_corrected"), data,
+            f"({u['length']}2 or rad2) s rad-1",
+            "one-sided spectral density of the body motion with the residuals of the "
+            "linear model (see dof_units; NaN off the DOF's own grid and for a body "
+            "without residuals; over its finite values its area is body_motion_std "
+            "squared)",
+        )
+    }  # fmt: skip
     return coords, out
 
 

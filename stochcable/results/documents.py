@@ -360,6 +360,12 @@ class BodyResult:
         A free body whose motions carry the lines' residuals
         (:mod:`stochcable.dynamics.residuals.body_motion`): the linear model's
         statistics per DOF (``motion`` then holds the corrected ones); else None.
+    corrected_spectra : dict of str to CorrectedSpectrum or None
+        Where ``motion_linear`` is given: each DOF's spectral density with the
+        residuals' spectra (``omega``, ``density``: the analysis grid extended by the
+        residual lines outside it;
+        :mod:`stochcable.dynamics.residuals.corrected_spectrum`), whose area is the
+        corrected σ² of ``motion``; None otherwise (:meth:`motion_density`).
     """
 
     name: str
@@ -374,11 +380,23 @@ class BodyResult:
     drag_coefficient: np.ndarray | None = None
     modes: Any = None
     motion_linear: dict[str, ResponseStats] | None = None
+    corrected_spectra: dict[str, Any] | None = None
 
     @property
     def motion_spectrum(self) -> np.ndarray:
-        """Spectrum of each DOF, shape (d, n_omega). [m²·s/rad, rad²·s/rad]"""
+        """Linear model's spectrum of each DOF, shape (d, n_omega) (with the residuals:
+        :meth:`motion_density`). [m²·s/rad, rad²·s/rad]"""
         return np.einsum("cdw,cw->dw", np.abs(self.motion_transfer) ** 2, self.input_spectra)
+
+    def motion_density(self, dof: str) -> tuple[np.ndarray, np.ndarray]:
+        """The frequencies [rad/s] and one-sided spectral density [m²·s/rad, rad²·s/rad]
+        of ``dof`` that its statistics ``motion[dof]`` are of: with the residuals'
+        spectra where they were computed (``corrected_spectra``), else the linear
+        :attr:`motion_spectrum` on ``omega``."""
+        if self.corrected_spectra is None:
+            return self.omega, self.motion_spectrum[self.dofs.index(dof)]
+        spec = self.corrected_spectra[dof]
+        return spec.omega, spec.density
 
     @property
     def motion_std(self) -> np.ndarray:
@@ -387,7 +405,8 @@ class BodyResult:
 
     def to_document(self) -> dict[str, Any]:
         """The body's part of the result document: per DOF the statistics (rotations
-        in rad, plus ``std_deg`` in degrees), the spectra, the modes."""
+        in rad, plus ``std_deg`` in degrees), the linear spectra (and the densities with
+        the residuals, ``corrected_spectra``), the modes."""
         motion = {}
         for k in self.dofs:
             d = self.motion[k].as_dict()
@@ -404,6 +423,16 @@ class BodyResult:
                 "omega": self.omega.tolist(),
                 **{k: s.tolist() for k, s in zip(self.dofs, self.motion_spectrum)},
             },
+            **(
+                {}
+                if self.corrected_spectra is None
+                else {
+                    "corrected_spectra": {
+                        k: {"omega": c.omega.tolist(), "motion": c.density.tolist()}
+                        for k, c in self.corrected_spectra.items()
+                    }
+                }
+            ),
             "channels": list(self.channels),
             "drag": None
             if self.drag_sigma is None

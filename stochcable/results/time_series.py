@@ -69,6 +69,9 @@ class TimeSeries:
         tensions (:mod:`stochcable.dynamics.timeseries.residual_series`), for the lines
         and ends where the residuals were applied (empty with
         ``analysis.linearization.drag_residual`` and ``geometric_residual`` false). [N]
+    body_motion_residual : dict
+        ``{body: {dof: series}}``, the residuals' Gaussian component of the free bodies'
+        motions whose statistics carry them (``body_motion`` includes it). [m, rad]
     """
 
     time: np.ndarray
@@ -84,6 +87,18 @@ class TimeSeries:
     body_channels: dict[str, tuple[str, ...]] = field(default_factory=dict)
     body_motion_transfer: dict[str, np.ndarray] = field(default_factory=dict)
     end_tension_residual: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    body_motion_residual: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+
+    @property
+    def body_motion_linear(self) -> dict[str, dict[str, np.ndarray]]:
+        """``{body: {dof: series}}``, the linear model's body motions: ``body_motion``
+        without the residuals' component. [m, rad]"""
+        return {
+            name: {
+                k: s - self.body_motion_residual.get(name, {}).get(k, 0.0) for k, s in dofs.items()
+            }
+            for name, dofs in self.body_motion.items()
+        }
 
     @property
     def end_tension_linear(self) -> dict[str, dict[str, np.ndarray]]:

@@ -28,6 +28,8 @@ from _scenes import (
 
 from stochcable import analyze
 from stochcable.dynamics.residuals.along_line import (
+    Capture,
+    capture_outputs,
     element_influence,
     element_lines,
     element_rows,
@@ -36,7 +38,7 @@ from stochcable.dynamics.residuals.along_line import (
     station_weights,
     stations,
 )
-from stochcable.dynamics.residuals.residual_lines import EndInfluence
+from stochcable.dynamics.residuals.residual_lines import EndInfluence, dense_pair_outputs
 
 
 @pytest.fixture(scope="module")
@@ -155,10 +157,11 @@ def test_switches_off_leave_the_linear_element_tensions(chain):
 
 
 def test_lines_on_a_stride_fill_the_others():
-    """Every second line and the last; the others interpolated linearly (exact for a
-    linear spectrum, its sum the trapezoid's)."""
+    """The first line, every second from line 1 (the multiples of 2Δ) and the last; the
+    others interpolated linearly (exact for a linear spectrum, its sum the
+    trapezoid's)."""
     sel = line_subset(9, 2)
-    assert sel.tolist() == [0, 2, 4, 6, 8] and line_subset(8, 2).tolist() == [0, 2, 4, 6, 7]
+    assert sel.tolist() == [0, 1, 3, 5, 7, 8] and line_subset(8, 2).tolist() == [0, 1, 3, 5, 7]
     ramp = 3.0 + 0.5 * np.arange(8.0)
     at = line_subset(8, 2)
     assert np.allclose(fill_lines(ramp[None, at], at, 8)[0], ramp, rtol=0, atol=1e-15)
@@ -258,3 +261,28 @@ def test_element_influence_of_a_travelling_line_by_the_adjoint():
             t = np.einsum("ed,ed->e", rows[:, 0], u[:-1]) + np.einsum("ed,ed->e", rows[:, 1], u[1:])
             g = got[:, dof // d, dof % d, i]
             assert np.max(np.abs(g - t)) <= 1e-9 * np.max(np.abs(t))
+
+
+def test_capture_outputs_read_the_lines_as_views():
+    """The lines of a capture's dense G read run by run as views (every line, every
+    second with the first and last apart, single lines) give the contraction of the
+    rows gathered by index, bitwise; G in single precision contracted in double gives
+    the double contraction of the same (widened) numbers to round-off."""
+    rng = np.random.default_rng(7)
+    n, n_o, n_out = 5, 23, 3
+    g = (rng.normal(size=(n_o, n * n)) + 1j * rng.normal(size=(n_o, n * n))).astype(np.complex64)
+    cap = Capture(np.arange(1.0, n_o + 1), np.zeros((2, 1, n)), np.arange(n), None, [], g)
+    for sel in (
+        line_subset(n_o, 1),
+        line_subset(n_o, 2),
+        line_subset(22, 2),
+        line_subset(1, 2),
+        line_subset(0, 2),
+        np.array([0, 4, 5, 9]),
+    ):
+        t = rng.normal(size=(n_out, n, sel.size)) + 1j * rng.normal(size=(n_out, n, sel.size))
+        got = capture_outputs(cap, t, sel, np.complex64)
+        assert np.array_equal(got, dense_pair_outputs(g[sel], t, np.complex64))
+        wide = capture_outputs(cap, t, sel, complex)
+        ref = dense_pair_outputs(g[sel].astype(complex), t)
+        assert np.allclose(wide, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max(initial=0.0))

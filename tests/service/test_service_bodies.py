@@ -45,6 +45,10 @@ def test_three_leg_buoy_document_equals_core(client):
         warnings.simplefilter("ignore")
         want = _plain(analyze(scene).to_document())
     assert set(got["bodies"]) == {"disc"}
+    # the body's motion densities with the residuals (the default) are in the answer
+    spec = got["bodies"]["disc"]["corrected_spectra"]["surge"]
+    area = np.trapezoid(spec["motion"], spec["omega"])
+    assert area == pytest.approx(got["bodies"]["disc"]["motion"]["surge"]["std"] ** 2, rel=1e-12)
     # the service thread may run BLAS with other threads than the caller: round-off only
     assert_close_documents(got, want)
 

@@ -349,7 +349,9 @@ def _solve_group(
         modes = coupled_modes(cls, gbodies, w_ref, float(omega[-1]))
     else:  # sea-independent (constant added mass): the model's, at this sea's ω_ref
         modes = dataclasses.replace(group.modes, omega_ref=float(w_ref))
-    lo, bo = coupled_results(cls, gbodies, clin, settings, static_pose=model.pose, modes=modes)
+    lo, bo = coupled_results(
+        cls, gbodies, clin, settings, static_pose=model.pose, modes=modes, loads=loads
+    )
     timing["outputs_s"] += time.perf_counter() - t1
     return lo, bo, _group_state(lnames, model, gbodies, clin)
 

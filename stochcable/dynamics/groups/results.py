@@ -9,6 +9,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -25,13 +26,16 @@ from stochcable.dynamics.outputs.line_result import line_result
 from stochcable.dynamics.outputs.resolution import LineModes
 from stochcable.dynamics.residuals.along_line import stations
 from stochcable.dynamics.residuals.along_line_motion import motion_stations
+from stochcable.dynamics.residuals.body_drag_residual import body_drag_residual, with_body_drag
 from stochcable.dynamics.residuals.body_motion import (
     BodyCoupledInfluence,
     body_motion_parts,
     body_rows,
 )
 from stochcable.dynamics.residuals.body_residual import coupled_influences
-from stochcable.dynamics.residuals.group_motion import body_rows_of, with_group_stations
+from stochcable.dynamics.residuals.corrected_spectrum import spectrum_with_lines
+from stochcable.dynamics.residuals.group_motion import body_rows_of
+from stochcable.dynamics.residuals.group_stations import with_group_stations
 from stochcable.results.documents import BodyResult, LineResult, stats_from_spectrum
 from stochcable.results.records import stats_from_moments
 from stochcable.scene.model import AnalysisSettings
@@ -58,6 +62,7 @@ def coupled_results(
     static_pose: Mapping[str, np.ndarray] | None = None,
     modes: CoupledModes | None = None,
     channels: Sequence[Channel] | None = None,
+    loads: Mapping[str, Any] | None = None,
 ) -> tuple[dict[str, LineResult], dict[str, BodyResult]]:
     """Line and body results of a coupled group.
 
@@ -76,6 +81,11 @@ def coupled_results(
         resonance indicator (:func:`line_modes`; default each line's fixed-end modes).
     channels : sequence of Channel, optional
         The group's channels (default those of the first line).
+    loads : mapping of str to BodyLoads, optional
+        The bodies' wave inputs (their drag points' fluid velocity and current): with
+        them and the drag residual asked for, the residual of the bodies' own drag
+        enters their motions and the lines' end tensions
+        (:mod:`stochcable.dynamics.residuals.body_drag_residual`).
 
     Returns
     -------
@@ -149,6 +159,15 @@ def coupled_results(
         out_lines = {k: with_group_stations(r, group_rows) for k, r in out_lines.items()}
     if group_rows is not None:  # (several lines: the joint sums' body rows)
         parts = group_rows.body_parts(transfer, spectra, w)
+    lin_set = settings.linearization
+    if loads is not None and influence and lin_set.drag_residual and lin_set.method != "harmonic":
+        own = body_drag_residual(
+            influence, lines[0].system.model.rho, loads, linearization.body_motion, w, spectra,
+            stations={k: _stations(r) for k, r in out_lines.items()},
+        )  # fmt: skip
+        if own is not None:  # the bodies' own drag: one more part of every body DOF
+            parts = [*parts, (own.w_out, own.body)] if parts else [(own.w_out, own.body)]
+            out_lines = {k: with_body_drag(r, own, settings.duration) for k, r in out_lines.items()}
     out_bodies = {}
     for b in bodies:
         h = np.transpose(linearization.body_motion[b.name], (2, 1, 0))  # (n_ch, d, n_w)
@@ -173,6 +192,17 @@ def coupled_results(
             residual=[(om, v[rows[b.name]]) for om, v in parts],
         )
     return out_lines, out_bodies
+
+
+def _stations(result: LineResult) -> tuple[np.ndarray, np.ndarray]:
+    """A line result's element and node stations where its along-line residuals were
+    computed (empty where not)."""
+    along, moves = result.along_line, result.motion_residual
+    none = np.zeros(0, dtype=int)
+    return (
+        along.stations if along is not None and along.computed else none,
+        moves.stations if moves is not None and moves.computed else none,
+    )
 
 
 def line_modes(
@@ -232,23 +262,28 @@ def body_result(
     ``residual``: the residuals' variance lines of its DOFs, parts (frequencies
     [rad/s] (n,), variance (d, n) [m², rad²]) added to the spectral moments
     (:mod:`stochcable.dynamics.residuals.body_motion`; a DOF whose total variance
-    would not be positive keeps its linear statistics)."""
+    would not be positive keeps its linear statistics) and folded into each DOF's
+    spectral density (``corrected_spectra``,
+    :func:`~stochcable.dynamics.residuals.corrected_spectrum.spectrum_with_lines`)."""
     dens = np.einsum("cdw,cw->dw", np.abs(transfer) ** 2, spectra)
     stats = {
         dof: stats_from_spectrum(omega, dens[i], float(mean[i]), duration)
         for i, dof in enumerate(dofs)
     }
-    linear = None
+    linear = corrected = None
     if len(residual):
         linear = stats
-        stats = dict(stats)
+        stats, corrected = dict(stats), {}
         for i, dof in enumerate(dofs):
             lin = linear[dof]
             m = np.array([lin.m0, lin.m1, lin.m2, lin.m4])
             for om, v in residual:
                 m = m + np.array([np.sum(v[i] * om**k) for k in (0, 1, 2, 4)])
-            if np.all(m[[0, 2, 3]] > 0.0):
+            kept = bool(np.all(m[[0, 2, 3]] > 0.0))
+            if kept:
                 stats[dof] = stats_from_moments(tuple(m), float(mean[i]), duration)
+            lines = [(om, v[i]) for om, v in residual] if kept else []
+            corrected[dof] = spectrum_with_lines(omega, dens[i], lines)
     return BodyResult(
         name=name,
         dofs=tuple(dofs),
@@ -262,4 +297,5 @@ def body_result(
         drag_sigma=None if sigma is None else np.asarray(sigma).copy(),
         drag_coefficient=None if drag is None else np.asarray(drag).copy(),
         modes=modes,
+        corrected_spectra=corrected,
     )

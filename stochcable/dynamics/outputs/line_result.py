@@ -55,8 +55,8 @@ from stochcable.dynamics.residuals.along_line_bodies import (
 from stochcable.dynamics.residuals.along_line_motion import (
     NodeInfluence,
     motion_residual,
-    motion_stations,
     node_rows,
+    solved_stations,
 )
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
@@ -139,7 +139,7 @@ def _shared_influence(
         return influence
     model = system.model
     if alone and model.dim == 2:
-        more = node_rows(model, motion_stations(model)) if MOTION_RESIDUALS.get() else None
+        more = node_rows(model, solved_stations(model)) if MOTION_RESIDUALS.get() else None
         return end_station_influence(system, damping, more=more)
     return EndInfluence(system, damping)
 
@@ -277,6 +277,7 @@ def line_result(
                     if influence is not None
                     else _shared_nodes(shared, system, linearization.damping)
                 ),
+                ends_held=influence is None,
             )
         if on_residuals is not None and moves is not None and moves.computed:
             on_residuals(computed, taps)

@@ -58,8 +58,9 @@ from stochcable.dynamics.residuals.residual_lines import (
     RESIDUAL_TAP,
     EndInfluence,
     along,
-    dense_pair_outputs,
+    dense_outputs,
     fill_lines,
+    line_pair_outputs,
     line_stride,
     line_subset,
     load_transfer,
@@ -157,13 +158,18 @@ class ResidualTap(VectorTapMixin):
         if self.captures and self.captures[-1].transfer is transfer:
             self.captures[-1].g_all = g_all
 
-    def lines(self, g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
+    def lines(
+        self, g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray, keep: bool = True
+    ) -> None:
         """A :func:`pair_outputs` call: a block of pairs' lines G and the loads' end
         transfer, matched column by column to the load transfer they were taken from
-        (the blocks of one contraction share its transfer array)."""
+        (the blocks of one contraction share its transfer array).  ``keep`` False: the
+        block is not kept (its lines come in the contraction's dense G, :meth:`dense`:
+        the chain's drag blocks, 3.3 MB, were held twice)."""
         block = (g, np.asarray(e), np.asarray(f))
         if self.captures and self.captures[-1].transfer is transfer:
-            self.captures[-1].blocks.append(block)
+            if keep:
+                self.captures[-1].blocks.append(block)
             return
         n_o = transfer.shape[2]
         cols = [np.ascontiguousarray(transfer[:, c]).tobytes() for c in range(transfer.shape[1])]
@@ -173,7 +179,7 @@ class ResidualTap(VectorTapMixin):
             index = {np.ascontiguousarray(h[:, j]).tobytes(): j for j in range(h.shape[1])}
             if all(c in index for c in cols):
                 kept = np.array([index[c] for c in cols], dtype=int)
-                self.captures.append(Capture(w, unit, kept, transfer, [block]))
+                self.captures.append(Capture(w, unit, kept, transfer, [block] if keep else []))
                 return
         self.unmatched += 1
 
@@ -316,7 +322,7 @@ def capture_outputs(
     n_kept, n_o) per unit load of ``cap``'s kept loads on its first n_o lines, or on
     its lines ``sel`` (:func:`line_subset`): from the kind's dense pair lines where it
     kept them (``cap.g_all``; contracted in ``dtype``, :data:`ALONG_DTYPE` converted
-    once per capture), else its blocks (:func:`dense_outputs`)."""
+    once per capture), else its blocks (:func:`~.residual_lines.dense_outputs`)."""
     sel = slice(0, transfer.shape[2]) if sel is None else sel
     if cap.g_all is None:
         return dense_outputs(cap.blocks, transfer, sel)
@@ -325,26 +331,7 @@ def capture_outputs(
         if cap.g_low is None or cap.g_low.dtype != np.dtype(dtype):
             cap.g_low = g.astype(dtype)
         g = cap.g_low
-    return dense_pair_outputs(g[sel], transfer, dtype)
-
-
-def dense_outputs(
-    blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
-    transfer: np.ndarray,
-    sel: Any = None,
-) -> np.ndarray:
-    """:func:`~stochcable.dynamics.residuals.residual_lines.pair_outputs` summed over a
-    capture's ``blocks``, for many outputs: the
-    pairs' lines put into one (n_o, n, n) matrix G (G_ef = g_p), then Re Σ_ef conj(T_e)
-    G_ef T_f as one matrix product per line — the per-pair form costs n_pairs × n_out
-    per line (the 7 stations: 3.5× the ends'), this one n² × n_out in BLAS.
-    ``transfer`` (n_out, n, n_o) on the lines ``sel`` (the first n_o by default);
-    shape (n_out, n_o)."""
-    n_out, n, n_o = transfer.shape
-    g_all = np.zeros((n_o, n * n), dtype=complex)
-    for g, e, f in blocks:  # each pair once (pair_outputs' callers: f ≥ e, or (i, j) blocks)
-        g_all[:, e * n + f] += g[:, slice(0, n_o) if sel is None else sel].T
-    return dense_pair_outputs(g_all, transfer)
+    return line_pair_outputs(g, transfer, sel, dtype)
 
 
 def top_line(record: Any, floor: float = LINE_FLOOR) -> int | None:

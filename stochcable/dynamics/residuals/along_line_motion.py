@@ -57,6 +57,7 @@ __all__ = [
     "motion_residual",
     "motion_weights",
     "motion_stations",
+    "solved_stations",
     "node_influence",
 ]
 
@@ -74,6 +75,13 @@ def motion_stations(model: Any, max_stations: int = MAX_STATIONS) -> np.ndarray:
     junction = np.flatnonzero(np.diff(seg) != 0) + 1
     even = np.rint(np.linspace(1, n - 2, max_stations)).astype(int)
     return np.unique(np.concatenate([[0, n - 1], even, junction]))
+
+
+def solved_stations(model: Any, max_stations: int = MAX_STATIONS) -> np.ndarray:
+    """The :func:`motion_stations` whose rows are solved on a line with held ends: the
+    inner ones (a held end node's residual is zero: the chain's 4 of 18 rows)."""
+    at = motion_stations(model, max_stations)
+    return at[(at > 0) & (at < model.n_nodes - 1)]
 
 
 def adjoint_solve(system: Any, damping: Any, w: np.ndarray, rhs: np.ndarray) -> np.ndarray:
@@ -302,6 +310,7 @@ def motion_residual(
     linear_std: np.ndarray,
     max_stations: int = MAX_STATIONS,
     influence_of: Callable[[np.ndarray], Any] | None = None,
+    ends_held: bool = False,
 ) -> MotionResidual:
     """The node motions' residual variance of the ``applied`` records (by kind) from
     what their ``taps`` (:func:`~stochcable.dynamics.residuals.along_line.residual_tap`)
@@ -312,7 +321,10 @@ def motion_residual(
     ``linear_std`` (n_nodes, 3) its linear σ (:func:`motion_weights`).
     ``influence_of``: the stations' influence from their node indices (default
     :class:`NodeInfluence`, ends held; a line on free bodies:
-    :func:`~stochcable.dynamics.residuals.along_line_bodies.node_station_influence`)."""
+    :func:`~stochcable.dynamics.residuals.along_line_bodies.node_station_influence`);
+    ``ends_held``: the line's end nodes are held (a line alone) with an
+    ``influence_of``: its rows are asked for the inner stations only
+    (:func:`solved_stations`)."""
     model = system.model
     d, comps = model.dim, list(model.components)
     if not applied:
@@ -322,7 +334,7 @@ def motion_residual(
     # a held end node's residual is zero: its rows are not solved (its weights kept:
     # near a moving held end the ratio falls to its 0)
     solve = np.ones(at.size, dtype=bool)
-    if influence_of is None:
+    if influence_of is None or ends_held:
         solve = (at > 0) & (at < model.n_nodes - 1)
     weights = weights.reshape(-1, at.size, d)[:, solve].reshape(weights.shape[0], -1)
     at_s = at[solve]

@@ -75,6 +75,7 @@ __all__ = [
     "GroupLine",
     "coupled_influences",
     "end_solves",
+    "end_tension_rows",
     "untapped",
     "with_group_lines",
 ]
@@ -159,6 +160,15 @@ def end_solves(system: Any, damping: Any, w: np.ndarray) -> tuple[np.ndarray, np
         x_all[sl] = x.reshape(ws.size, n - 2, d, 2 * d)
         r_e[sl] = np.swapaxes(rhs, 1, 2) @ x - zee
     return x_all, r_e
+
+
+def end_tension_rows(system: Any) -> np.ndarray:
+    """The end tensions (end_a, end_b) per unit support force (end_a's d components
+    then end_b's), shape (2, 2d): the dynamic change of the magnitude of each support
+    force (:func:`~stochcable.dynamics.solve.line_solve.end_tension_from_support`). [N/N]"""
+    d = system.model.dim
+    ten = end_tension_from_support(system, np.eye(2 * d)[None].astype(complex))
+    return np.real(np.stack([ten["end_a"][:, 0], ten["end_b"][:, 0]]))
 
 
 class CoupledInfluence:
@@ -310,11 +320,7 @@ class CoupledInfluence:
         x = solved[self.name][0]
         t, att = links[self.name]
         target = next(ln for ln in self.lines if ln.name == self.target).system
-        eye = np.eye(2 * d)[None].astype(complex)
-        ten = end_tension_from_support(target, eye)
-        e_hat = np.zeros((2, 2 * d))
-        e_hat[0] = np.real(ten["end_a"][:, 0])
-        e_hat[1] = np.real(ten["end_b"][:, 0])
+        e_hat = end_tension_rows(target)
         y = np.zeros((w.size, 2, 2 * d), dtype=complex)
         if self.target == self.name:
             y += e_hat[None]

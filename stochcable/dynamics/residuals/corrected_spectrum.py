@@ -35,7 +35,7 @@ import numpy as np
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.results.records import ResidualRecord
 
-__all__ = ["CorrectedSpectrum", "corrected_spectrum"]
+__all__ = ["CorrectedSpectrum", "corrected_spectrum", "spectrum_with_lines"]
 
 #: The gap between a grid end and the node beyond it where the linear density is zero,
 #: in units of the end cell: the linear density's trapezoid over it adds this fraction
@@ -89,21 +89,48 @@ def corrected_spectrum(
         ∫S dω (trapezoid) = ∫S_linear dω + Σ the residuals' variances (clipped at 0, as
         the statistics' σ²).
     """
+    return spectrum_with_lines(
+        omega, linear, [(om, lines[end]) for rec in records for om, lines in rec.lines]
+    )
+
+
+def spectrum_with_lines(
+    omega: np.ndarray,
+    linear: np.ndarray,
+    parts: Iterable[tuple[np.ndarray, np.ndarray]],
+) -> CorrectedSpectrum:
+    """The spectral density of one response with the residuals' variance lines
+    ``parts`` (module notes; :func:`corrected_spectrum` of one end, a free body's DOF).
+
+    Parameters
+    ----------
+    omega : ndarray, shape (n_omega,)
+        The analysis grid. [rad/s]
+    linear : ndarray, shape (n_omega,)
+        The linear model's spectral density on it. [unit²·s/rad]
+    parts : iterable of (ndarray (n,), ndarray (n,))
+        The residuals' variance lines: frequencies [rad/s] and variances [unit²]
+        (uniform lines, or the misfit's on ``omega`` itself).
+
+    Returns
+    -------
+    CorrectedSpectrum
+        ∫S dω (trapezoid) = ∫S_linear dω + Σ the lines' variances (clipped at 0).
+    """
     w = np.asarray(omega, dtype=float)
     q = trapezoid_weights(w)
     base = np.asarray(linear, dtype=float).copy()
     target = float(np.sum(q * base))
     uniform: list[tuple[np.ndarray, np.ndarray]] = []
-    for rec in records:
-        for om, lines in rec.lines:
-            om = np.asarray(om, dtype=float)
-            v = np.asarray(lines[end], dtype=float)
-            target += float(np.sum(v))
-            if om.size == w.size and np.array_equal(om, w):  # the misfit: exact density
-                base += np.divide(v, q, out=np.zeros_like(v), where=q > 0)
-            elif om.size:
-                step = float(om[1] - om[0]) if om.size > 1 else float(om[0])
-                uniform.append((om, v / step))
+    for om, v in parts:
+        om = np.asarray(om, dtype=float)
+        v = np.asarray(v, dtype=float)
+        target += float(np.sum(v))
+        if om.size == w.size and np.array_equal(om, w):  # the misfit: exact density
+            base += np.divide(v, q, out=np.zeros_like(v), where=q > 0)
+        elif om.size:
+            step = float(om[1] - om[0]) if om.size > 1 else float(om[0])
+            uniform.append((om, v / step))
     target = max(target, 0.0)
     outside = [om[(om < w[0]) | (om > w[-1])] for om, _ in uniform]
     grid = np.union1d(w, np.concatenate(outside)) if outside else w

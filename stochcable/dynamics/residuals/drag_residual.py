@@ -155,12 +155,12 @@ def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
     """
     m = np.atleast_1d(np.asarray(mu, dtype=float))
     x, w = _gauss_points(-m)
-    y = m[:, None] + x
-    g = np.abs(y) * y * w
+    g = np.abs(m[:, None] + x) * (m[:, None] + x) * w
     out = np.empty((m.size, order + 1))
+    he_prev, he = np.zeros_like(x), np.ones_like(x)  # He_{k+1} = x·He_k − k·He_{k−1}
     for k in range(order + 1):
-        he = np.polynomial.hermite_e.hermeval(x, [0.0] * k + [1.0])
         out[:, k] = np.sum(g * he, axis=1) / math.factorial(k)
+        he_prev, he = he, x * he - k * he_prev
     return out
 
 

@@ -337,7 +337,7 @@ def vector_residual_covariance(z: np.ndarray, coeffs: np.ndarray, n_fft: int) ->
 
 
 def vector_residual_output_lines(
-    z: np.ndarray, coeffs: np.ndarray, transfer: np.ndarray, n_fft: int
+    z: np.ndarray, coeffs: np.ndarray, transfer: np.ndarray, n_fft: int, first: int | None = None
 ) -> np.ndarray:
     """Spectral lines of outputs driven by the vector drag residual of jointly Gaussian
     panels (module notes).
@@ -349,6 +349,10 @@ def vector_residual_output_lines(
     transfer : ndarray, complex, shape (n_out, n_p, 3, n_o)
         Outputs per unit force on each panel along each output direction at ω_j,
         j = 1 … n_o. [N/N]
+    first : int, optional
+        Only the pairs (e ≤ f) whose first panel e is one of the ``first`` panels: what
+        they add to the sum over the others (a body's drag components ahead of the
+        lines' panels, :mod:`.body_drag_residual`); default every pair.
 
     Returns
     -------
@@ -360,8 +364,9 @@ def vector_residual_output_lines(
     n_out, n_o = transfer.shape[0], transfer.shape[3]
     out = np.zeros((n_out, n_o))
     size = max(1, int(_BLOCK_BYTES // (8 * 30 * n_fft * max(n_p, 1))))
-    for start in range(0, n_p, size):
-        blk = slice(start, min(start + size, n_p))
+    stop = n_p if first is None else min(int(first), n_p)
+    for start in range(0, stop, size):
+        blk = slice(start, min(start + size, stop))
         f_all = slice(start, n_p)
         cov = _block_covariance(z, coeffs, blk, f_all, n_fft, order)  # (3, 3, n_b, n_f, ·)
         cr = (2.0 / n_fft) * np.fft.rfft(cov, axis=-1)[..., 1 : n_o + 1]

@@ -19,7 +19,7 @@ import numpy as np
 from stochcable.dynamics.residuals.along_line_bodies import ElementCoupledInfluence
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 
-__all__ = ["Fresh", "GroupBodyInfluence", "Rows", "StationInfluence"]
+__all__ = ["Fresh", "GroupBodyInfluence", "Rows", "StationInfluence", "station_body_rows"]
 
 
 class _Kept:
@@ -121,8 +121,7 @@ class StationInfluence(_Kept):
         w = np.asarray(w, dtype=float)
         off, s, links, solved = self.state(w)
         tl = self.target.line
-        model = tl.system.model
-        d, n = model.dim, model.n_nodes
+        d = tl.system.model.dim
         ms = self.line.system.model
         own = tl.name == self.line.name
         n_out = self.target.elements.size
@@ -132,18 +131,34 @@ class StationInfluence(_Kept):
             else np.zeros((n_out * (d if _nodes(self.target) else 1), ms.n_nodes, ms.dim, w.size),
                           dtype=complex)
         )  # fmt: skip
-        t_l, att = links[tl.name]
-        if not att.size:
+        c = station_body_rows(self.target, (links, solved), w)  # (n_w, n_out, nb)
+        if c is None:
             return g
-        u = np.zeros((w.size, n, d, 2 * d), dtype=complex)
-        u[:, 0, :, :d] = np.eye(d)
-        u[:, -1, :, d:] = np.eye(d)
-        u[:, 1:-1] = -solved[tl.name][0]
-        c = self.target.per_end_motion(u)[:, :, att] @ t_l[None]  # (n_w, n_out, nb)
         b = self.body.on(w)  # (nb, n_S, d, n_w)
         b_w = np.ascontiguousarray(np.moveaxis(b.reshape(b.shape[0], -1, w.size), 2, 0))
         cross = np.moveaxis(c @ b_w, 0, 2)  # (n_out, n_S·d, n_w)
         return g + cross.reshape(g.shape)
+
+
+def station_body_rows(
+    target: ElementCoupledInfluence, solves: tuple[dict, dict], w: np.ndarray
+) -> np.ndarray | None:
+    """The outputs of ``target`` (stations of line L) per unit motion of the group's
+    body DOFs, c_att·T_L (module notes), from the group's ``solves`` on ``w`` (its
+    links and end solves): shape (n_w, n_out, nb); None where L has no end on a
+    body. [N/m, m/m]"""
+    links, solved = solves
+    tl = target.line
+    model = tl.system.model
+    d, n = model.dim, model.n_nodes
+    t_l, att = links[tl.name]
+    if not att.size:
+        return None
+    u = np.zeros((np.size(w), n, d, 2 * d), dtype=complex)
+    u[:, 0, :, :d] = np.eye(d)
+    u[:, -1, :, d:] = np.eye(d)
+    u[:, 1:-1] = -solved[tl.name][0]
+    return target.per_end_motion(u)[:, :, att] @ t_l[None]
 
 
 def _nodes(target: ElementCoupledInfluence) -> bool:

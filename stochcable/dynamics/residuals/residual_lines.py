@@ -51,7 +51,10 @@ __all__ = [
     "along",
     "band_stack",
     "covariance_lines",
+    "dense_outputs",
     "dense_pair_outputs",
+    "line_pair_outputs",
+    "line_runs",
     "cross_covariance",
     "element_directions",
     "fft_length",
@@ -217,14 +220,85 @@ def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, dtype: Any = com
     shape (n_out, n_o)."""
     n_out, n, n_o = transfer.shape
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)), dtype=dtype)  # (n_o, n, n_out)
-    gt = g_all.reshape(n_o, n, n).astype(dtype, copy=False) @ t  # (n_o, n, n_out)
+    g = g_all.reshape(n_o, n, n)
+    if g.dtype == t.dtype:
+        gt = g @ t  # (n_o, n, n_out)
+    else:  # (G in single precision, contracted in double: a cache-sized run of lines at a time)
+        gt = np.empty_like(t)
+        step = max(1, PAIR_BLOCK_BYTES // (16 * n * n))
+        for i in range(0, n_o, step):
+            np.matmul(g[i : i + step].astype(t.dtype), t[i : i + step], out=gt[i : i + step])
     return (t.real * gt.real + t.imag * gt.imag).sum(axis=1, dtype=float).T  # Re(conj(t)·gt)
 
 
+def line_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, sel: Any, dtype: Any) -> np.ndarray:
+    """:func:`dense_pair_outputs` of the dense lines ``g_all``'s rows ``sel`` (an index
+    or slice; ``transfer`` on them), the rows read as views run by evenly spaced run
+    (:func:`line_subset`'s first and last lines apart), not gathered into a copy (the
+    chain's node motions: 2.3 MB a kind, first touched in every analysis)."""
+    idx = np.arange(g_all.shape[0])[sel]
+    parts, at = [], 0
+    for run in line_runs(idx):
+        lines = g_all[run] if isinstance(run, slice) else g_all[run : run + 1]
+        n_run = lines.shape[0]
+        parts.append(dense_pair_outputs(lines, transfer[:, :, at : at + n_run], dtype))
+        at += n_run
+    if not parts:  # (no line)
+        return np.zeros((transfer.shape[0], 0))
+    return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
+
+
+def line_runs(idx: np.ndarray) -> list[slice | int]:
+    """``idx`` (increasing) as evenly spaced runs: a slice for each run of at least
+    three lines (or two at the end), the index of a line alone."""
+    out: list[slice | int] = []
+    i = 0
+    while i < idx.size:
+        if i + 1 == idx.size:
+            out.append(int(idx[i]))
+            break
+        step = int(idx[i + 1] - idx[i])
+        j = i + 1
+        while j + 1 < idx.size and idx[j + 1] - idx[j] == step:
+            j += 1
+        if j - i + 1 >= 3 or i + 2 >= idx.size:
+            out.append(slice(int(idx[i]), int(idx[j]) + 1, step))
+            i = j + 1
+        else:  # (a pair that breaks a run: the first alone)
+            out.append(int(idx[i]))
+            i += 1
+    return out
+
+
+def dense_outputs(
+    blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]],
+    transfer: np.ndarray,
+    sel: Any = None,
+) -> np.ndarray:
+    """:func:`~stochcable.dynamics.residuals.residual_lines.pair_outputs` summed over a
+    capture's ``blocks``, for many outputs: the
+    pairs' lines put into one (n_o, n, n) matrix G (G_ef = g_p), then Re Σ_ef conj(T_e)
+    G_ef T_f as one matrix product per line — the per-pair form costs n_pairs × n_out
+    per line (the 7 stations: 3.5× the ends'), this one n² × n_out in BLAS.
+    ``transfer`` (n_out, n, n_o) on the lines ``sel`` (the first n_o by default);
+    shape (n_out, n_o)."""
+    n_out, n, n_o = transfer.shape
+    g_all = np.zeros((n_o, n * n), dtype=complex)
+    for g, e, f in blocks:  # each pair once (pair_outputs' callers: f ≥ e, or (i, j) blocks)
+        g_all[:, e * n + f] += g[:, slice(0, n_o) if sel is None else sel].T
+    return dense_pair_outputs(g_all, transfer)
+
+
 #: Largest dense matrix of one contraction's pair lines (:class:`PairLines`, n² × n_o
-#: complex; the chain's drag 6.4 MB): beyond it the outputs are summed block by block
-#: (:func:`pair_outputs`). [bytes]
+#: of :data:`PAIR_DTYPE`; the chain's drag 3.2 MB): beyond it the outputs are summed
+#: block by block (:func:`pair_outputs`). [bytes]
 DENSE_PAIR_BYTES = 24 * 2**20
+#: The dense pair lines held in single precision (contracted in double, a cache-sized
+#: run of lines at a time: :func:`dense_pair_outputs`), the along-line contractions'
+#: precision (:data:`~stochcable.dynamics.residuals.along_line.ALONG_DTYPE`): half the
+#: memory and no second copy for them (the chain's 6.4 + 3.2 MB were 9.6 MB held and
+#: first touched in every analysis); end σ within 3e-9 of double on the five lines. [-]
+PAIR_DTYPE = np.complex64
 
 
 class PairLines:
@@ -238,20 +312,21 @@ class PairLines:
     def __init__(self, transfer: np.ndarray) -> None:
         self.transfer = transfer
         n_out, n, n_o = transfer.shape
-        dense = 16 * n * n * n_o <= DENSE_PAIR_BYTES
-        self._g = np.zeros((n_o, n * n), dtype=complex) if dense else None
+        dense = np.dtype(PAIR_DTYPE).itemsize * n * n * n_o <= DENSE_PAIR_BYTES
+        self._g = np.zeros((n_o, n * n), dtype=PAIR_DTYPE) if dense else None
         self._out = None if dense else np.zeros((n_out, n_o))
 
     def add(self, g: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
         """A block of pairs (e, f) and their lines ``g`` (n_pairs, n_o) (one of (c, d)
-        and (d, c) only, weighted 2 where they differ, as :func:`pair_outputs`)."""
+        and (d, c) only, weighted 2 where they differ, as :func:`pair_outputs`; each
+        pair in one block only: its column is set, not summed)."""
         if self._g is None:
             self._out += pair_outputs(g, self.transfer, e, f)
             return
         if (tap := RESIDUAL_TAP.get()) is not None:
-            tap.lines(g, self.transfer, e, f)
+            tap.lines(g, self.transfer, e, f, keep=False)  # (the tap reads G: outputs)
         n = self.transfer.shape[1]
-        self._g[:, np.asarray(e) * n + np.asarray(f)] += g.T
+        self._g[:, np.asarray(e) * n + np.asarray(f)] = g.T
 
     def outputs(self) -> np.ndarray:
         """The variance lines (n_out, n_o) of the outputs."""
@@ -274,8 +349,16 @@ STRIDE_TOL = 2e-3
 
 def line_subset(top: int, stride: int = 1) -> np.ndarray:
     """The lines (indices) of the first ``top`` the along-line outputs are formed on:
-    every ``stride``-th and the last (:func:`fill_lines` the others)."""
-    sel = np.arange(0, top, stride)
+    the first, every ``stride``-th from line ``stride − 1`` and the last
+    (:func:`fill_lines` the others).  With the kinds' grids (the lines j·Δ, j ≥ 1;
+    the geometric residual's every second of them) every second line is then a
+    multiple of 2Δ: the geometric residual's lines are among the drag residual's,
+    their rows solved once on a short line (the deep wire's banded solve of 7 rows
+    on 64 more frequencies)."""
+    if stride == 1:
+        return np.arange(top)
+    sel = np.arange(stride - 1, top, stride)
+    sel = np.append(0, sel) if top else sel
     return sel if top == 0 or sel[-1] == top - 1 else np.append(sel, top - 1)
 
 

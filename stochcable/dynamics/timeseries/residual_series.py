@@ -34,7 +34,13 @@ import numpy as np
 from stochcable.errors import ResolutionWarning, warn
 from stochcable.sea.realization import frequency_grid, simulate_sea
 
-__all__ = ["NYQUIST_SHARE", "residual_density", "residual_tension_series"]
+__all__ = [
+    "NYQUIST_SHARE",
+    "residual_density",
+    "residual_motion_density",
+    "residual_series",
+    "residual_tension_series",
+]
 
 #: Share of the residuals' variance above the Nyquist frequency π/dt of the record
 #: beyond which a ResolutionWarning says the record's σ falls short of the corrected
@@ -60,13 +66,7 @@ def residual_density(line: Any, end: str) -> tuple[np.ndarray, np.ndarray] | Non
     """
     if getattr(line, "corrected_spectra", None) is None:
         return None
-    omega, density = line.end_tension_density(end)
-    w = np.asarray(line.omega, dtype=float)
-    linear = np.interp(omega, w, line.end_tension_spectrum(end), left=0.0, right=0.0)
-    inside = (omega >= w[0]) & (omega <= w[-1])
-    return np.asarray(omega, dtype=float), np.maximum(
-        np.asarray(density, dtype=float) - np.where(inside, linear, 0.0), 0.0
-    )
+    return _less_linear(*line.end_tension_density(end), line.omega, line.end_tension_spectrum(end))
 
 
 def residual_tension_series(
@@ -106,10 +106,50 @@ def residual_tension_series(
         frequency π/dt (their superharmonics reach three times the analysis grid's top).
     """
     dens = residual_density(line, end)
-    if dens is None or not np.any(dens[1] > 0):
+    if dens is None:
         return None
-    omega, s_r = dens
+    label = f"line '{getattr(line, 'name', '?')}' {end}"
+    return residual_series(dens[0], dens[1], duration, dt, method, rng, label)
 
+
+def residual_motion_density(body: Any, dof: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """The residuals' spectral density of a free body's ``dof`` (as
+    :func:`residual_density` of an end: its density with the residuals,
+    :meth:`stochcable.results.documents.BodyResult.motion_density`, less its linear
+    one, clipped at zero); None where its motion carries no residual."""
+    if getattr(body, "corrected_spectra", None) is None:
+        return None
+    linear = body.motion_spectrum[body.dofs.index(dof)]
+    return _less_linear(*body.motion_density(dof), body.omega, linear)
+
+
+def _less_linear(
+    omega: np.ndarray, density: np.ndarray, w: np.ndarray, linear: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``density`` on ``omega`` less the ``linear`` density on the analysis grid ``w``
+    (zero outside it), clipped at zero (module notes)."""
+    omega = np.asarray(omega, dtype=float)
+    w = np.asarray(w, dtype=float)
+    lin = np.interp(omega, w, linear, left=0.0, right=0.0)
+    inside = (omega >= w[0]) & (omega <= w[-1])
+    return omega, np.maximum(np.asarray(density, dtype=float) - np.where(inside, lin, 0.0), 0.0)
+
+
+def residual_series(
+    omega: np.ndarray,
+    s_r: np.ndarray,
+    duration: float,
+    dt: float,
+    method: str,
+    rng: np.random.Generator,
+    label: str,
+) -> np.ndarray | None:
+    """One Gaussian realization of a process of one-sided density ``s_r`` on ``omega``
+    (the residuals' part of a response, module notes): as
+    :func:`residual_tension_series`, ``label`` naming the response in the warning;
+    None where the density has nothing on the record's lines."""
+    if not np.any(s_r > 0):
+        return None
     grid, _ = frequency_grid(duration, dt)
     top = float(grid[-1])  # (π/dt: what lies above is said in the residuals' terms)
 
@@ -119,11 +159,11 @@ def residual_tension_series(
 
     if not np.any(density(grid[1:-1]) > 0):  # (nothing on the record's lines)
         return None
-    _nyquist_check(line, end, omega, s_r, dt)
+    _nyquist_check(label, omega, s_r, dt)
     return np.asarray(simulate_sea(density, duration, dt, method, rng=rng).elevation)
 
 
-def _nyquist_check(line: Any, end: str, omega: np.ndarray, s_r: np.ndarray, dt: float) -> None:
+def _nyquist_check(label: str, omega: np.ndarray, s_r: np.ndarray, dt: float) -> None:
     """ResolutionWarning when more than :data:`NYQUIST_SHARE` of the residuals'
     variance lies above π/dt."""
     top = math.pi / dt
@@ -136,7 +176,7 @@ def _nyquist_check(line: Any, end: str, omega: np.ndarray, s_r: np.ndarray, dt: 
     if share > NYQUIST_SHARE:
         keep = float(omega[np.flatnonzero(s_r > 0)[-1]])
         warn(
-            f"line '{getattr(line, 'name', '?')}' {end}: {share:.2%} of the residuals' "
+            f"{label}: {share:.2%} of the residuals' "
             f"variance (their superharmonics, up to {keep:.3g} rad/s) lies above the "
             f"time series' Nyquist frequency π/dt = {top:.3g} rad/s: the record's σ is "
             "below the corrected one; use analysis.timeseries.dt ≤ "

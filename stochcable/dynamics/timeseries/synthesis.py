@@ -19,7 +19,11 @@ from stochcable.dynamics.groups.analysis import CoupledGroup
 from stochcable.dynamics.loads.channels import Channel
 from stochcable.dynamics.loads.sea_channels import direction_channel, sea_channel_headings
 from stochcable.dynamics.model.system import LineSystem
-from stochcable.dynamics.timeseries.residual_series import residual_tension_series
+from stochcable.dynamics.timeseries.residual_series import (
+    residual_motion_density,
+    residual_series,
+    residual_tension_series,
+)
 from stochcable.line.statics import LineStatics
 from stochcable.results.documents import (
     TimeSeries,
@@ -38,6 +42,7 @@ def simulate_timeseries(
     *,
     timing: dict[str, float] | None = None,
     lines: Mapping[str, Any] | None = None,
+    bodies: Mapping[str, Any] | None = None,
 ) -> TimeSeries:
     """One realization of every input channel and the end-tension and body-motion
     time series.
@@ -60,6 +65,13 @@ def simulate_timeseries(
         component with the residuals' spectral density
         (:mod:`stochcable.dynamics.timeseries.residual_series`), so the record's σ and
         spectrum are the corrected ones; none given: the linear model's series.
+    bodies : mapping of str to BodyResult, optional
+        The bodies' results: a free body whose motion carries the residuals
+        (``corrected_spectra``) gets in every DOF an independent Gaussian component
+        with the residuals' density likewise
+        (:func:`~stochcable.dynamics.timeseries.residual_series.residual_motion_density`),
+        from the seed's children after the lines' components (the other series are
+        unchanged by it).
 
     Returns
     -------
@@ -125,6 +137,10 @@ def simulate_timeseries(
         for end, comp in ends.items():
             out.end_tension[name][end] = out.end_tension[name][end] + comp
     body_order = [b.name for b in (getattr(scene, "bodies", ()) or ()) if b.name in out.body_motion]
+    moved = _body_components(syn, body_order, bodies or {}, 2 * len(order))
+    for name, dofs in moved.items():
+        for dof, comp in dofs.items():
+            out.body_motion[name][dof] = out.body_motion[name][dof] + comp
     return TimeSeries(
         time=syn.time_axis(),
         method=settings.method,
@@ -143,7 +159,35 @@ def simulate_timeseries(
         body_motion={n: out.body_motion[n] for n in body_order},
         body_channels={n: out.body_channels[n] for n in body_order},
         body_motion_transfer={n: out.body_transfer[n] for n in body_order},
+        body_motion_residual=moved,
     )
+
+
+def _body_components(
+    syn: _Synthesis, order: list[str], bodies: Mapping[str, Any], after: int
+) -> dict[str, dict[str, np.ndarray]]:
+    """The residuals' Gaussian component of every DOF of the bodies of ``order`` whose
+    result in ``bodies`` has them, from the seed's children after the end motions' and
+    the ``after`` lines' components'."""
+    names = [n for n in order if getattr(bodies.get(n), "corrected_spectra", None) is not None]
+    if not names:
+        return {}
+    st = syn.settings
+    start = len(syn.reals) + after
+    count = sum(len(bodies[n].dofs) for n in names)
+    children = iter(np.random.SeedSequence(syn.seed).spawn(start + count)[start:])
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for name in names:
+        body = bodies[name]
+        for dof in body.dofs:
+            rng = np.random.default_rng(next(children))
+            dens = residual_motion_density(body, dof)
+            comp = None if dens is None else residual_series(
+                *dens, st.duration, st.dt, st.method, rng, f"body '{name}' {dof}"
+            )  # fmt: skip
+            if comp is not None:
+                out.setdefault(name, {})[dof] = comp
+    return out
 
 
 def _residual_components(
