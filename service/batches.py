@@ -273,12 +273,19 @@ class BatchService:
             results=f"/v1/batches/{job.id}/results", warnings=job.request.get("warnings", []),
         )  # fmt: skip
 
-    def cancel(self, job: JobRecord) -> bool:
-        """Cancel an active job (True), or delete a finished one and its results (False)."""
-        if job.status in ACTIVE and self.store.finish(job.id, None, "cancelled"):
-            return True
-        self.store.delete(job.id)
-        return False
+    def cancel(self, job: JobRecord, *, delete_finished: bool = True) -> JobRecord | None:
+        """Cancel an active job, or delete a finished one and its results (None); with
+        ``delete_finished`` False a finished job is left as it is.
+
+        A job seen active that finished before the cancel reached the store (its last
+        chunk stored just then) is left as it finished: never deleted by a cancel."""
+        if job.status in ACTIVE:
+            self.store.finish(job.id, None, "cancelled")
+            return self.get(job.id, job.owner)
+        if delete_finished:
+            self.store.delete(job.id)
+            return None
+        return job
 
     def results(self, job: JobRecord, media: str) -> bytes:
         """The result table of a finished job as JSON, CSV or NetCDF."""

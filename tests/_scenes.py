@@ -178,10 +178,10 @@ def chain_surge_doc(elements: int, residual: bool = True, scale: float = 1.0) ->
     return doc
 
 
-def td_end_sigma(doc: dict, seed: int, scale: float = 1.0, **variant) -> np.ndarray:
-    """TD end σ (fairlead, anchor) over the second of two periods of a periodic DSA
-    fairlead surge on the FD's lines (the input variance exact), the motion × ``scale``
-    and the σ divided by it (a small scale: the linear limit)."""
+def periodic_surge_td(doc: dict, seed: int, scale: float = 1.0, **variant):  # noqa: ANN201
+    """The reference TD of ``doc`` (a :func:`chain_surge_doc`) over two periods of a
+    periodic DSA fairlead surge on the FD's lines (the input variance exact; phases from
+    ``seed``), the motion × ``scale``: its history (``variant``: the TD's options)."""
     scene = load_scene(doc)
     dt = 0.05
     n_t = int(round(2 * CHAIN_PERIOD / dt))
@@ -193,7 +193,7 @@ def td_end_sigma(doc: dict, seed: int, scale: float = 1.0, **variant) -> np.ndar
     c[0, 2 * np.rint(w / dw).astype(int)] = (
         0.5 * n_t * scale * np.sqrt(2 * s * dw) * np.exp(-1j * phase)
     )
-    h = simulate_line_timedomain(
+    return simulate_line_timedomain(
         scene,
         duration=2 * CHAIN_PERIOD,
         end_realizations={"b": c},
@@ -201,6 +201,12 @@ def td_end_sigma(doc: dict, seed: int, scale: float = 1.0, **variant) -> np.ndar
         dt=dt,
         **variant,
     )
+
+
+def td_end_sigma(doc: dict, seed: int, scale: float = 1.0, **variant) -> np.ndarray:
+    """TD end σ (fairlead, anchor) over the second period of :func:`periodic_surge_td`
+    and the σ divided by ``scale`` (a small scale: the linear limit)."""
+    h = periodic_surge_td(doc, seed, scale, **variant)
     keep = (h.t >= CHAIN_PERIOD - 1e-9) & (h.t < 2 * CHAIN_PERIOD - 1e-9)
     return np.array([h.tension_b[keep].std(), h.tension_a[keep].std()]) / scale
 
@@ -311,3 +317,105 @@ def assembled_group(cls, bodies, clin) -> tuple:  # noqa: ANN001
     bd = {b.name: body_drag_matrix(b, clin.body_drag[b.name]) for b in bodies
           if b.name in clin.body_drag}  # fmt: skip
     return couple(links, bodies, body_damping=bd), damp
+
+
+# ------------------------------------------------- the residuals along a line (tests/dynamics)
+
+
+def guy_3d_doc() -> dict:
+    """The inclined guy in its sea turned to 45° (a 3-D model), both residuals."""
+    doc = load_example("inclined_guy").model_dump(mode="json")
+    doc["analysis"].pop("timeseries", None)
+    doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
+    doc["sea"]["heading"] = 45.0
+    return doc
+
+
+def along_line_arguments(doc: dict, line: str | None = None) -> tuple:
+    """``doc`` analysed (warnings silenced) with the arguments of each line's along-line
+    evaluation kept, ``{system, damping, applied, taps, **keywords}``: (its result, the
+    arguments by line name), or with ``line`` (a name; "" the first) that line's
+    result and arguments."""
+    import warnings
+
+    import pytest
+
+    import stochcable.dynamics.outputs.line_result as line_result_module
+    from stochcable import analyze
+
+    seen = {}
+    orig = line_result_module.along_line_residual
+
+    def spy(system, damping, applied, taps, *args, **kw):  # noqa: ANN001, ANN202
+        seen[system.name] = dict(system=system, damping=damping, applied=applied, taps=taps, **kw)
+        return orig(system, damping, applied, taps, *args, **kw)
+
+    mp = pytest.MonkeyPatch()
+    mp.setattr(line_result_module, "along_line_residual", spy)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = analyze(doc)
+    finally:
+        mp.undo()
+    if line is None:
+        return result, seen
+    name = line or next(iter(result.lines))
+    return result.lines[name], seen[name]
+
+
+def _dense(blocks, n: int, d: int) -> np.ndarray:  # noqa: ANN001
+    """The dense matrix of node blocks (D (n, d, d), O (n − 1, d, d) below the diagonal)."""
+    diag, off = blocks
+    a = np.zeros((n * d, n * d))
+    for k in range(n):
+        a[k * d : (k + 1) * d, k * d : (k + 1) * d] = diag[k]
+    for k in range(n - 1):
+        a[(k + 1) * d : (k + 2) * d, k * d : (k + 1) * d] = off[k]
+        a[k * d : (k + 1) * d, (k + 1) * d : (k + 2) * d] = off[k].T
+    return a
+
+
+def forward_dense_motions(system, damping, load: np.ndarray, w: np.ndarray) -> np.ndarray:  # noqa: ANN001
+    """The node displacements (n_w, n, d) of a line, ends held, under the node ``load``
+    (n, d) at ``w``: its finite-element equations (K − ω²M + iωC) assembled dense from
+    the line's blocks and solved by numpy.linalg (no adjoint, no band storage, no LAPACK
+    band solver: the influences' independent check)."""
+    from stochcable.dynamics.model.blocks import add_blocks, line_prep
+    from stochcable.dynamics.solve.line_loads import drag_blocks
+
+    model = system.model
+    n, d = model.n_nodes, model.dim
+    prep = line_prep(system)
+    k, m = _dense(prep.K, n, d), _dense(prep.MT, n, d)
+    c = _dense(add_blocks(prep.S, drag_blocks(system, damping)), n, d)
+    u = np.zeros((np.size(w), n, d), dtype=complex)
+    for j, om in enumerate(np.atleast_1d(w)):
+        a = (k - om**2 * m + 1j * om * c)[d:-d, d:-d]
+        u[j, 1:-1] = np.linalg.solve(a, load[1:-1].ravel()).reshape(n - 2, d)
+    return u
+
+
+def coupled_leg_motions(group: tuple, f: np.ndarray, w: np.ndarray, leg: int = 0) -> np.ndarray:
+    """The displacements (n_w, n, d, n_load) of leg ``leg`` of a
+    :func:`three_leg_buoy_group` under its node forces ``f`` (n_dof, n_load) at ``w``:
+    the assembled lines–body system (stochcable.bodies.coupling, at the converged line
+    and body drag) solved directly and densely (stochcable.reference.bodies)."""
+    from stochcable.bodies.coupling import LineLink, couple, coupled_load, expand_line
+    from stochcable.dynamics.groups.group import linear_body_drag
+    from stochcable.reference.bodies import solve_coupled_direct
+
+    scene, cls, loads, body, lin = group
+    damp = {c.name: lin.lines[c.name].damping for c in cls}
+    links = [
+        LineLink(c.name, c.system.model, end_b="buoy", force_b=c.system.statics.force_b,
+                 damping=damp[c.name].matrix)
+        for c in cls
+    ]  # fmt: skip
+    _, cdrag = linear_body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
+    system = couple(links, [body], body_damping={"buoy": cdrag})
+    cl = cls[leg]
+    fw = np.broadcast_to(f, (w.size,) + f.shape)
+    x = solve_coupled_direct(system, coupled_load(system, w, line_loads={cl.name: fw}), w, "dense")
+    model = cl.system.model
+    return expand_line(system, cl.name, x).reshape(w.size, model.n_nodes, model.dim, -1)

@@ -195,6 +195,23 @@ WARNINGS: tuple[WarningEntry, ...] = (
         ("stochcable.dynamics.residuals.corrected:RESIDUAL_VARIANCE_LIMIT",),
     ),
     WarningEntry(
+        "Node motions out of the residuals' range (those left linear)",
+        "PhysicsWarning",
+        ("stochcable.dynamics.residuals.along_line_motion:_beyond_range",),
+        "a node motion component whose residual variance is beyond "
+        "RESIDUAL_VARIANCE_LIMIT times its linear variance (said where one of them moves "
+        "at least 1 % of the line's largest σ; nearly at rest, silently)",
+        "As at the ends, the first-order closed forms are out of their depth there: those "
+        "node motions are the linear model's (no residual), node by node; the line's other "
+        "motions keep their residuals.  The message names the nodes per axis, the largest "
+        "ratio and the limit.  The cable-laying example reaches 42.8 in the x motion of "
+        "its middle nodes.",
+        "Check with the nonlinear time-domain reference "
+        "(:mod:`stochcable.reference.cable`); or make the line tauter (pretension), or "
+        "its mesh finer.",
+        ("stochcable.dynamics.residuals.corrected:RESIDUAL_VARIANCE_LIMIT",),
+    ),
+    WarningEntry(
         "How a load-case set applies the residuals",
         "PhysicsWarning",
         ("stochcable.cases.run:_warn_interpolated", "stochcable.client_batches:submit_batch"),

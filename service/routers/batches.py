@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Path, Request, Response
+from fastapi import APIRouter, Body, Path, Query, Request, Response
 
 from service.batch_schemas import BatchList, BatchRequest, BatchStatus
 from service.dependencies import BatchesDep, CallerDep
@@ -133,10 +133,24 @@ def get_batch_results(
     response_model=BatchStatus,
     summary="Cancel a batch (or delete a finished one)",
 )
-def cancel_batch(job_id: JobId, batches: BatchesDep, caller: CallerDep) -> Response | BatchStatus:
+def cancel_batch(
+    job_id: JobId,
+    batches: BatchesDep,
+    caller: CallerDep,
+    cancel_only: Annotated[
+        bool,
+        Query(
+            description="Only cancel: a batch that has already finished is left as it is "
+            "(200 with its status), so a cancel that arrives after the last chunk never "
+            "deletes the results"
+        ),
+    ] = False,
+) -> Response | BatchStatus:
     """A queued or running batch is cancelled (200 with its status; the chunks in flight
-    finish, nothing more starts); a finished batch is deleted with its results (204)."""
+    finish, nothing more starts); a finished batch is deleted with its results (204), or
+    with ``cancel_only`` left as it is (200 with its status: the cancel came too late).
+    A batch that finishes while its cancel is on the way stays finished (200 with its
+    status)."""
     job = batches.get(job_id, caller)
-    if batches.cancel(job):
-        return batches.status(batches.get(job_id, caller))
-    return Response(status_code=204)
+    after = batches.cancel(job, delete_finished=not cancel_only)
+    return Response(status_code=204) if after is None else batches.status(after)

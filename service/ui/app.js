@@ -4,7 +4,7 @@
 
 const $ = (id) => document.getElementById(id);
 const state = { key: sessionStorage.getItem("stochcable-key") || "", keys: false,
-  doc: null, sceneText: "", job: null, timer: null, plots: [], readerNotes: [] };
+  doc: null, sceneText: "", job: null, timer: null, poll: 0, plots: [], readerNotes: [] };
 const COLORS = ["#0b5fa5", "#d95f02", "#1b9e77", "#7570b3", "#e7298a", "#66a61e", "#a6761d"];
 const VIRIDIS = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
 const YEAR_S = 365.25 * 86400;
@@ -453,39 +453,59 @@ async function refreshJobs() {
 
 const finished = (s) => s === "done" || s === "failed" || s === "cancelled";
 
+// Cancel (of a job last seen queued or running) never deletes: a job that finished before
+// the cancel arrived is left as it finished and the page says the cancel came too late.
+// Delete (of a finished job) removes it with its results.
 async function cancelJob(id, status) {
+  const del = finished(status), open = state.job === id;
+  if (open) stopPolling();
   try {
-    await api("DELETE", `/v1/batches/${id}`);
-    if (state.job === id && finished(status)) { $("job").hidden = true; state.job = null; stopPolling(); }
-    else if (state.job === id) await pollJob();
+    const j = await api("DELETE", `/v1/batches/${id}${del ? "" : "?cancel_only=true"}`);
+    if (open && state.job === id) {
+      if (del) { $("job").hidden = true; state.job = null; }
+      else {
+        const late = finished(j.status) && j.status !== "cancelled";
+        await showJob(j, late ? "the cancel came too late: the batch had already finished" : "");
+      }
+    }
     refreshJobs();
-  } catch (e) { showError($("batch-error"), e); }
+  } catch (e) {
+    showError($("batch-error"), e);
+    if (open && state.job === id) pollJob();
+  }
 }
 
-function stopPolling() { if (state.timer) clearTimeout(state.timer); state.timer = null; }
+// a poll answered after a newer one was started, or after a cancel, is dropped
+function stopPolling() { if (state.timer) clearTimeout(state.timer); state.timer = null; state.poll++; }
 
 function openJob(id) {
   stopPolling();
   state.job = id;
   $("job").hidden = false;
   $("job-results").hidden = true;
+  $("job-cancel").disabled = true;  // until the job's status tells Cancel from Delete
   $("job-title").textContent = `Job ${id}`;
   pollJob().then(() => $("job-title").focus());
 }
 
 async function pollJob() {
-  const id = state.job;
+  const id = state.job, poll = state.poll;
   if (!id) return;
   let j;
   try { j = await api("GET", `/v1/batches/${id}`); } catch (e) { showError($("batch-error"), e); return; }
-  if (state.job !== id) return;
-  const p = j.progress;
+  if (state.job === id && state.poll === poll) await showJob(j);
+}
+
+async function showJob(j, note = "") {
+  const id = j.id, p = j.progress;
   $("job-progress").value = p.fraction;
   const eta = p.eta_seconds != null ? `, about ${Math.round(p.eta_seconds)} s left` : "";
   $("job-progress-text").textContent = `${j.status}: ${p.done} of ${p.total} cases` +
-    (p.not_ok ? ` (${p.not_ok} not ok)` : "") + (finished(j.status) ? "" : eta) + (j.error ? ` — ${j.error}` : "");
+    (p.not_ok ? ` (${p.not_ok} not ok)` : "") + (finished(j.status) ? "" : eta) + (j.error ? ` — ${j.error}` : "") +
+    (note ? ` — ${note}` : "");
   $("job-cancel").textContent = finished(j.status) ? "Delete" : "Cancel";
   $("job-cancel").onclick = () => cancelJob(id, j.status);
+  $("job-cancel").disabled = false;
   $("job-warnings").replaceChildren(...(j.warnings || []).map((w) => el("li", { class: "warn" }, w)),
     ...(j.problems || []).map((c) => el("li", { class: "warn" }, `case ${c.index}: ${c.status} — ${c.reason}`)));
   for (const b of ["job-csv", "job-netcdf", "job-json"]) $(b).hidden = j.status !== "done";

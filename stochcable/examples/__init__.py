@@ -138,6 +138,9 @@ DOCUMENTED_WARNINGS: dict[str, dict[str, str]] = {
         "of 'stochcable modes' (docs/travelling.md)",
         "strumming lock-in predicted": "the cross-current locks in a high mode of the "
         "cable (A/D ≈ 0.01, drag x1.07): the screening's finding, negligible here",
+        "of the node motions is up to": "the residuals would raise the suspended middle "
+        "nodes' motions beyond their range (x variance up to 42.8-fold): those stay "
+        "linear, the others and the end tensions keep the residuals",
     },
     "tuah_1982_disc_buoy_three_legs": {
         "error of the end-tension σ": "Tuah's 3 elements are kept: the element rules "

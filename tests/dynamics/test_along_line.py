@@ -18,11 +18,15 @@ import warnings
 import numpy as np
 import pytest
 from _paths import ROOT
-from _scenes import chain_surge_doc
+from _scenes import (
+    CHAIN_PERIOD,
+    along_line_arguments,
+    chain_surge_doc,
+    forward_dense_motions,
+    periodic_surge_td,
+)
 
-import stochcable.dynamics.outputs.line_result as line_result_module
 from stochcable import analyze
-from stochcable.dynamics.model.blocks import add_blocks, line_prep
 from stochcable.dynamics.residuals.along_line import (
     Capture,
     capture_outputs,
@@ -35,40 +39,13 @@ from stochcable.dynamics.residuals.along_line import (
     stations,
 )
 from stochcable.dynamics.residuals.residual_lines import EndInfluence, dense_pair_outputs
-from stochcable.dynamics.solve.line_loads import drag_blocks
 
 
 @pytest.fixture(scope="module")
 def chain():
     """The chain's line at 20 elements, fairlead surge, both residuals; the arguments
-    of its along-line evaluation kept (system, damping, records, taps)."""
-    seen = {}
-    orig = line_result_module.along_line_residual
-
-    def spy(system, damping, applied, taps, *args, **kw):
-        seen.update(system=system, damping=damping, applied=applied, taps=taps)
-        return orig(system, damping, applied, taps, *args, **kw)
-
-    line_result_module.along_line_residual = spy
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            line = analyze(chain_surge_doc(20)).lines["leg1"]
-    finally:
-        line_result_module.along_line_residual = orig
-    return line, seen
-
-
-def _dense(blocks, n: int, d: int) -> np.ndarray:
-    """The dense matrix of node blocks (D (n, d, d), O (n − 1, d, d) below the diagonal)."""
-    diag, off = blocks
-    a = np.zeros((n * d, n * d))
-    for k in range(n):
-        a[k * d : (k + 1) * d, k * d : (k + 1) * d] = diag[k]
-    for k in range(n - 1):
-        a[(k + 1) * d : (k + 2) * d, k * d : (k + 1) * d] = off[k]
-        a[k * d : (k + 1) * d, (k + 1) * d : (k + 2) * d] = off[k].T
-    return a
+    of its along-line evaluation kept (system, damping, applied, taps)."""
+    return along_line_arguments(chain_surge_doc(20), "")
 
 
 def test_element_influence_equals_a_forward_dense_solve(chain):
@@ -80,18 +57,12 @@ def test_element_influence_equals_a_forward_dense_solve(chain):
     system, damping = seen["system"], seen["damping"]
     model = system.model
     n, d = model.n_nodes, model.dim
-    prep = line_prep(system)
-    k, m = _dense(prep.K, n, d), _dense(prep.MT, n, d)
-    c = _dense(add_blocks(prep.S, drag_blocks(system, damping)), n, d)
     rng = np.random.default_rng(11)
     load = rng.standard_normal((n, d)) + 1j * rng.standard_normal((n, d))
     w = np.array([0.05, float(system.modes.omega[0]), 1.3])
     g = element_influence(system, damping, w)  # (n_el, n, d, n_w)
     rows = element_rows(model)
-    for j, om in enumerate(w):
-        a = (k - om**2 * m + 1j * om * c)[d:-d, d:-d]
-        u = np.zeros((n, d), dtype=complex)
-        u[1:-1] = np.linalg.solve(a, load[1:-1].ravel()).reshape(n - 2, d)
+    for j, u in enumerate(forward_dense_motions(system, damping, load, w)):
         direct = np.einsum("ed,ed->e", rows[:, 0], u[:-1]) + np.einsum(
             "ed,ed->e", rows[:, 1], u[1:]
         )
@@ -222,32 +193,9 @@ def test_element_tensions_on_every_second_line(monkeypatch):
 
 
 def _td_element_sigma(doc: dict, seed: int, elements: list[int], **variant) -> np.ndarray:
-    """TD σ of the ``elements``' tension over the second of two periods of the periodic
-    fairlead surge of :func:`_scenes.td_end_sigma` (the same phases)."""
-    import math
-
-    from _scenes import CHAIN_BAND, CHAIN_PERIOD
-
-    from stochcable.reference.cable import simulate_line_timedomain
-    from stochcable.scene.model import load_scene
-
-    scene = load_scene(doc)
-    dt = 0.05
-    n_t = int(round(2 * CHAIN_PERIOD / dt))
-    dw = 2 * math.pi / CHAIN_PERIOD
-    w = scene.analysis.omega.values()
-    s = scene.lines[0].end_b.motion.surge.spectral_density(w, scene.environment.g)
-    phase = np.random.default_rng(seed).uniform(-np.pi, np.pi, w.size)
-    c = np.zeros((3, n_t // 2 + 1), dtype=complex)
-    c[0, 2 * np.rint(w / dw).astype(int)] = 0.5 * n_t * np.sqrt(2 * s * dw) * np.exp(-1j * phase)
-    h = simulate_line_timedomain(
-        scene,
-        duration=2 * CHAIN_PERIOD,
-        end_realizations={"b": c},
-        band=CHAIN_BAND,
-        dt=dt,
-        **variant,
-    )
+    """TD σ of the ``elements``' tension over the second of the two periods of
+    :func:`_scenes.periodic_surge_td` (the phases of the ends' TD)."""
+    h = periodic_surge_td(doc, seed, **variant)
     return h.element_tension_std(start=CHAIN_PERIOD - 1e-9)[elements]
 
 

@@ -14,46 +14,20 @@ import warnings
 
 import numpy as np
 import pytest
-from test_along_line import _dense
+from _scenes import along_line_arguments, forward_dense_motions, guy_3d_doc
 
-import stochcable.dynamics.outputs.line_result as line_result_module
-from stochcable import analyze, load_example
-from stochcable.dynamics.model.blocks import add_blocks, line_prep
+from stochcable import analyze
 from stochcable.dynamics.residuals.along_line import element_influence, element_lines, element_rows
 from stochcable.dynamics.residuals.along_line_3d import vector_lines, vector_misfit_lines
 from stochcable.dynamics.residuals.residual_lines import EndInfluence
-from stochcable.dynamics.solve.line_loads import drag_blocks
 
 ENDS = ("end_a", "end_b")
-
-
-def _guy_doc() -> dict:
-    """The inclined guy in its sea turned to 45° (a 3-D model), both residuals."""
-    doc = load_example("inclined_guy").model_dump(mode="json")
-    doc["analysis"].pop("timeseries", None)
-    doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
-    doc["sea"]["heading"] = 45.0
-    return doc
 
 
 @pytest.fixture(scope="module")
 def guy():
     """The 3-D guy's line and the arguments of its along-line evaluation."""
-    seen = {}
-    orig = line_result_module.along_line_residual
-
-    def spy(system, damping, applied, taps, *args, **kw):
-        seen.update(system=system, damping=damping, applied=applied, taps=taps)
-        return orig(system, damping, applied, taps, *args, **kw)
-
-    line_result_module.along_line_residual = spy
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            line = next(iter(analyze(_guy_doc()).lines.values()))
-    finally:
-        line_result_module.along_line_residual = orig
-    return line, seen
+    return along_line_arguments(guy_3d_doc(), "")
 
 
 def test_element_influence_of_a_3d_line_equals_a_forward_dense_solve(guy):
@@ -65,18 +39,12 @@ def test_element_influence_of_a_3d_line_equals_a_forward_dense_solve(guy):
     model = system.model
     n, d = model.n_nodes, model.dim
     assert d == 3
-    prep = line_prep(system)
-    k, m = _dense(prep.K, n, d), _dense(prep.MT, n, d)
-    c = _dense(add_blocks(prep.S, drag_blocks(system, damping)), n, d)
     rng = np.random.default_rng(5)
     load = rng.standard_normal((n, d)) + 1j * rng.standard_normal((n, d))
     w = np.array([0.2, float(system.modes.omega[0]), 2.1])
     g = element_influence(system, damping, w)
     rows = element_rows(model)
-    for j, om in enumerate(w):
-        a = (k - om**2 * m + 1j * om * c)[d:-d, d:-d]
-        u = np.zeros((n, d), dtype=complex)
-        u[1:-1] = np.linalg.solve(a, load[1:-1].ravel()).reshape(n - 2, d)
+    for j, u in enumerate(forward_dense_motions(system, damping, load, w)):
         direct = np.einsum("ed,ed->e", rows[:, 0], u[:-1]) + np.einsum(
             "ed,ed->e", rows[:, 1], u[1:]
         )
@@ -136,7 +104,7 @@ def test_3d_element_tensions_within_the_time_domain_interval():
     from stochcable.reference.cable import simulate_line_timedomain
     from stochcable.scene.model import load_scene
 
-    doc = _guy_doc()
+    doc = guy_3d_doc()
     doc["analysis"]["linearization"]["tolerance"] = 1e-8
     scene = load_scene(doc)
     els = [10, 20, 30]

@@ -11,22 +11,17 @@ against the anchor's."""
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
+from _scenes import along_line_arguments, coupled_leg_motions
 from test_body_residual import buoy_group  # noqa: F401  (the fixture)
 
-import stochcable.dynamics.outputs.line_result as line_result_module
-from stochcable import analyze, load_example
-from stochcable.bodies.coupling import LineLink, couple, coupled_load, expand_line
+from stochcable import load_example
 from stochcable.dynamics.groups import CoupledLine
-from stochcable.dynamics.groups.group import linear_body_drag
 from stochcable.dynamics.residuals.along_line import element_influence, element_lines, element_rows
 from stochcable.dynamics.residuals.along_line_3d import vector_lines
 from stochcable.dynamics.residuals.along_line_bodies import ElementCoupledInfluence
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence, coupled_influences
-from stochcable.reference.bodies import solve_coupled_direct
 
 RHO = 1025.0
 
@@ -49,16 +44,7 @@ def test_element_influence_through_the_body_equals_the_assembled_system(buoy_gro
     f = rng.standard_normal((model.n_dof, 3)) + 1j * rng.standard_normal((model.n_dof, 3))
     g = ElementCoupledInfluence(infl[cl.name], elements).on(w)  # (n_el, n, d, n_w)
     got = np.einsum("enkw,nkc->ewc", g, f.reshape(n, d, 3))
-    links = [
-        LineLink(c.name, c.system.model, end_b="buoy", force_b=c.system.statics.force_b,
-                 damping=damp[c.name].matrix)
-        for c in cls
-    ]  # fmt: skip
-    _, cdrag = linear_body_drag(body, RHO, lin.body_sigma["buoy"], loads["buoy"].current, "seed")
-    system = couple(links, [body], body_damping={"buoy": cdrag})
-    fw = np.broadcast_to(f, (w.size,) + f.shape)
-    x = solve_coupled_direct(system, coupled_load(system, w, line_loads={cl.name: fw}), w, "dense")
-    u = expand_line(system, cl.name, x).reshape(w.size, n, d, 3)
+    u = coupled_leg_motions(buoy_group, f, w)  # (n_w, n, d, 3)
     rows = element_rows(model)[elements]
     ref = np.einsum("ed,wedc->ewc", rows[:, 0], u[:, elements]) + np.einsum(
         "ed,wedc->ewc", rows[:, 1], u[:, elements + 1]
@@ -91,21 +77,7 @@ def buoy(request):
     doc = load_example(name).model_dump(mode="json")
     doc["analysis"].pop("timeseries", None)
     doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
-    seen = {}
-    orig = line_result_module.along_line_residual
-
-    def spy(system, damping, applied, taps, *args, **kw):
-        seen[system.name] = dict(system=system, damping=damping, taps=taps, **kw)
-        return orig(system, damping, applied, taps, *args, **kw)
-
-    line_result_module.along_line_residual = spy
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            result = analyze(doc)
-    finally:
-        line_result_module.along_line_residual = orig
-    return result, seen
+    return along_line_arguments(doc)
 
 
 def test_coupled_end_rows_reproduce_the_kinds_end_lines(buoy):

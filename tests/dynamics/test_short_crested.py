@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from _scenes import LINEAR_ONLY
 
 from stochcable.analysis import analyze
 from stochcable.dynamics.engine import build_engine
@@ -102,12 +103,13 @@ def test_time_series_realize_the_directions_independently():
     scatters about the spectrum's sum Σ S(ω_m)Δω (its expectation: the directions'
     cross terms at one frequency average out), four seeds within 4 standard errors of
     it.  Directions sharing one realization would give (Σ_k √w_k)² times that (≈ 5.6
-    here), far outside."""
+    here), far outside.  The linear model: the sea's realization, not the residuals."""
     from stochcable.sea.realization import frequency_grid
     from stochcable.sea.spectra import spectrum_pierson_moskowitz
 
     spread = {"type": "cos2s", "s": 2.0, "directions": 8}
     doc = _chain(45.0, spread, timeseries=True)
+    doc["analysis"].setdefault("linearization", {}).update(LINEAR_ONLY)
     ts = doc["analysis"]["timeseries"]
     ts["duration"] = 400.0
     w, dw = frequency_grid(ts["duration"], ts["dt"])
@@ -149,6 +151,8 @@ def test_load_case_sets_keep_the_scene_spreading():
 
     def still(doc: dict) -> dict:  # no fairlead motion: the sea's share shows
         doc["lines"][0]["end_b"].pop("motion")
+        # the linear model: the set's seas, not its residuals (tests/cases)
+        doc["analysis"].setdefault("linearization", {}).update(LINEAR_ONLY)
         return doc
 
     spread = {"type": "cos2s", "s": 2.0, "directions": 8}

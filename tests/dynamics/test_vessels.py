@@ -170,17 +170,19 @@ def test_sea_heading_selects_and_interpolates_the_rao(heading, rows, weights):
     circle equals the analysis with the heading-free table of the row (or of the
     rows' linear interpolation, 350° = 2/3 of 0° and 1/3 of 330°) — the vessel's
     motion spectrum and every line's tension σ, drag on (1e-10: the same numbers; the
-    interpolation weights round differently)."""
-    got = analyze(_buoy(heading, full_circle=True, vessel=True, vessel_headings=CIRCLE))
-    ref_doc = _with_vessel_table(
-        _buoy(heading, full_circle=True, vessel=True), _row_table(rows, weights)
-    )
-    ref = analyze(ref_doc)
+    interpolation weights round differently).  The linear model: the table's heading,
+    not the residuals (on: 2.7–2.9 s of CPU each, the three legs' group residuals)."""
+
+    def buoy(**kw) -> dict:
+        doc = _buoy(heading, full_circle=True, vessel=True, **kw)
+        doc["analysis"].setdefault("linearization", {}).update(LINEAR_ONLY)
+        return doc
+
+    got = analyze(buoy(vessel_headings=CIRCLE))
+    ref = analyze(_with_vessel_table(buoy(), _row_table(rows, weights)))
     _assert_same(got, ref, 1e-10)
     # and the heading matters: the 0° row (no sway) moves the ship otherwise
-    other = analyze(
-        _with_vessel_table(_buoy(heading, full_circle=True, vessel=True), _row_table([0.0], [1.0]))
-    )
+    other = analyze(_with_vessel_table(buoy(), _row_table([0.0], [1.0])))
     sway = _ship_spectrum(got)[1].sum()
     assert abs(_ship_spectrum(other)[1].sum() - sway) > 0.1 * sway
 
@@ -188,7 +190,8 @@ def test_sea_heading_selects_and_interpolates_the_rao(heading, rows, weights):
 def test_line_end_rao_over_heading():
     """A line end moving with an RAO table over heading (MotionRao with ``heading``):
     the sea toward 45° gives the analysis of the heading-free table interpolated
-    between 30° and 60°, written out here."""
+    between 30° and 60°, written out here (the linear model: the end's table, not the
+    residuals)."""
     table = vessel_rao_table(CIRCLE)
     end = {k: table[k] for k in ("omega", "heading", "surge", "sway", "heave")}
     half = _row_table([30.0, 60.0], [0.5, 0.5])
@@ -198,6 +201,7 @@ def test_line_end_rao_over_heading():
         d = _buoy(45.0, full_circle=True, vessel=True)
         d["lines"][3]["end_b"] = {"position": [610.0, 0.0, -5.0], "motion": {"rao": rao}}
         d["bodies"].pop(1)
+        d["analysis"].setdefault("linearization", {}).update(LINEAR_ONLY)
         return d
 
     got, ref = analyze(doc(end)), analyze(doc(flat))
@@ -216,7 +220,9 @@ def test_spread_vessel_motion_is_the_directional_sum():
     and w_k S from the analysis' sea channels (round-off only: 1e-12).  The sway of the
     spread sea differs from the mean heading's by more than 5 %."""
     spread = {"type": "cos2s", "s": 2.0, "directions": 9}
+    # the linear model: the vessel's motion, not the lines' residuals
     doc = _buoy(40.0, spread, full_circle=True, vessel=True, vessel_headings=CIRCLE)
+    doc["analysis"].setdefault("linearization", {}).update(LINEAR_ONLY)
     res = analyze(doc)
     ds = load_scene(doc).sea.direction_set()
     ship = res.bodies["ship"]
@@ -239,7 +245,9 @@ def test_spread_vessel_motion_is_the_directional_sum():
             want[d] += np.abs(h) ** 2 * ship.input_spectra[k]
     np.testing.assert_allclose(_ship_spectrum(res), want, rtol=1e-12, atol=1e-300)
     # the spreading matters: the mean heading's RAO on the whole spectrum differs
-    mean = analyze(_buoy(40.0, full_circle=True, vessel=True, vessel_headings=CIRCLE))
+    mean_doc = _buoy(40.0, full_circle=True, vessel=True, vessel_headings=CIRCLE)
+    mean_doc["analysis"].setdefault("linearization", {}).update(LINEAR_ONLY)
+    mean = analyze(mean_doc)
     sway = (_ship_spectrum(res)[1].sum(), _ship_spectrum(mean)[1].sum())
     assert abs(sway[0] / sway[1] - 1) > 0.05
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 import copy
 import time
 import warnings
+from datetime import datetime
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ from _scenes import LINEAR_ONLY
 from fastapi.testclient import TestClient
 
 from service.app import create_app
+from service.batches import BatchService
 from service.settings import Settings
 from stochcable.cases import LineFatigue, case_document, case_summary_csv, read_scatter, run_cases
 from stochcable.client import Client, ClientError
@@ -80,8 +82,37 @@ def finished(service):
 def test_a_batch_runs_to_done_with_progress(finished):
     assert finished["status"] == "done", finished
     p = finished["progress"]
-    assert (p["total"], p["done"], p["failed"], p["fraction"]) == (8, 8, 0, 1.0)
-    assert finished["finished"] >= finished["started"] >= finished["created"]
+    assert (p["total"], p["done"], p["failed"], p["fraction"]) == (8, 8, 0, 1.0), finished
+    # as times, not as ISO texts (a time on the second has no fraction: ':05+00:00' <
+    # ':05.1+00:00' as text but not as time)
+    times = [datetime.fromisoformat(finished[k]) for k in ("created", "started", "finished")]
+    assert times == sorted(times), finished
+
+
+def test_a_cancel_after_the_last_chunk_keeps_the_batch(service, finished, tmp_path):
+    # the page's Cancel of a batch it last saw running asks cancel_only: a batch that
+    # has finished since is left as it is (200 with its status), never deleted
+    url = f"/v1/batches/{finished['id']}"
+    late = service.delete(url + "?cancel_only=true")
+    assert late.status_code == 200 and late.json()["status"] == "done"
+    assert late.json()["progress"] == finished["progress"]
+    assert service.get(url + "/results").status_code == 200
+    # a cancel of a job seen running whose last chunk was stored (and the job marked
+    # done) before the cancel reached the store: done, kept (it was deleted)
+    batches = BatchService(_settings(tmp_path))
+    job = batches.store.create("", {"warnings": []}, 1, 1, 1, 10)
+    running = batches.store.claim("runner", 30.0)
+    assert running is not None and running.id == job.id and running.status == "running"
+    assert batches.store.finish(job.id, "runner", "done")
+    after = batches.cancel(running)
+    assert after is not None and after.status == "done"
+    assert batches.store.get(job.id).status == "done"
+    # a queued one is cancelled; a finished one deleted when asked (the Delete button)
+    queued = batches.store.create("", {"warnings": []}, 1, 1, 1, 10)
+    assert batches.cancel(queued).status == "cancelled"
+    assert batches.cancel(batches.store.get(queued.id)) is None
+    assert batches.store.get(queued.id) is None
+    batches.close()
 
 
 def test_results_equal_the_library_bit_for_bit(service, finished, reference, tmp_path):

@@ -92,7 +92,10 @@ __all__ = [
 #: linearly in arc length between them): its cost is one banded solve per line per
 #: station (every element: chain +75 ms on a 26 ms linear analysis); 7 give every
 #: element's σ within 0.13 % of all elements' on the chain, taut wire, deep wire,
-#: two-segment line and inclined guy. [-]
+#: two-segment line and inclined guy.  The node motions' stations (the same count:
+#: along_line_motion.motion_stations) are coarser: every node's σ within 2.5 % (chain)
+#: and 3.0 % (deep wire) of all nodes', the two-segment rope's x motion near the bed
+#: 7.2 % of its largest σ (tests/dynamics/test_along_line_motion.py). [-]
 MAX_STATIONS = 7
 #: The element tensions' residual lines are formed up to the highest line where an end
 #: tension's exceeds this fraction of its largest (:func:`top_line`): the superharmonic

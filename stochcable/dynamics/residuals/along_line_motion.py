@@ -17,10 +17,11 @@ node and component (uncorrelated with the linear response); the stations are up 
 the segment junctions, evenly spaced ones), the other nodes' from the ratio of residual
 to linear variance interpolated linearly in arc length (:func:`motion_weights`).  A
 held end node moves with its prescribed motion only: no residual.  As at the ends
-(:data:`~stochcable.dynamics.residuals.corrected.RESIDUAL_VARIANCE_LIMIT`), a residual
-variance above twice the linear one at a station (a component moving at least 1 % of
-the line's largest) leaves every motion linear, the record saying why: the cable-laying
-line's out-of-plane motion, ×5.7 in σ by the 3-D drag residual.
+(:data:`~stochcable.dynamics.residuals.corrected.RESIDUAL_VARIANCE_LIMIT`), a node
+motion whose residual variance is above twice its linear one stays linear, with a
+warning naming the nodes (where one moves at least 1 % of the line's largest): node by
+node, the others keep their residuals (the cable-laying line's out-of-plane motion, ×5.7
+in σ by the 3-D drag residual; the two-segment line's node 33 sits at 1.92×).
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ from stochcable.dynamics.residuals.along_line_3d import sparse_transfer, vector_
 from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
 from stochcable.dynamics.residuals.influence import adjoint_rows
+from stochcable.errors import PhysicsWarning, warn
 
 __all__ = [
     "MotionResidual",
@@ -168,7 +170,8 @@ class MotionResidual:
         False where a residual applied at the ends is not covered (``reason``): the
         motions are the linear model's.
     reason : str
-        Why not computed ("" when computed).
+        Why not computed; computed, the warning naming the motions left linear
+        (``beyond``; "" when none).
     lines : dict of str to tuple of (ndarray, ndarray)
         By kind, parts: the frequencies [rad/s] (n,) and each node's variance at them
         along x, y, z (n_nodes, 3, n) [m²] (the drag residual's linear misfit on the
@@ -177,6 +180,10 @@ class MotionResidual:
         The variance the residuals add to each node's displacement. [m²]
     stations : ndarray of int
         The nodes they were evaluated at (:func:`motion_stations`).
+    beyond : ndarray of bool, shape (n_nodes, 3)
+        The node motion components left linear: their residual variance above
+        :data:`~stochcable.dynamics.residuals.corrected.RESIDUAL_VARIANCE_LIMIT` times
+        the linear one (``reason`` names them; zero ``variance`` and ``lines`` there).
     """
 
     computed: bool
@@ -184,6 +191,7 @@ class MotionResidual:
     lines: dict[str, tuple[tuple[np.ndarray, np.ndarray], ...]] = field(default_factory=dict)
     variance: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     stations: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    beyond: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=bool))
 
     def std(self, linear_std: np.ndarray) -> np.ndarray:
         """σ of the node displacements with the residuals from the linear σ (n_nodes,
@@ -380,16 +388,50 @@ def motion_residual(
             full.append((om, out))
             total += out.sum(axis=2)
         lines[kind] = tuple(full)
-    lin = np.asarray(linear_std, dtype=float)[at] ** 2  # (n_st, 3)
+    beyond, reason = _beyond_range(system.name, total, linear_std)
+    total[beyond] = 0.0
+    for parts_k in lines.values():
+        for _, v in parts_k:
+            v[beyond] = 0.0
+    return MotionResidual(True, reason, lines, total, at, beyond)
+
+
+def _node_list(nodes: np.ndarray) -> str:
+    """Node indices as runs: "3, 7–9". [-]"""
+    runs = np.split(nodes, np.flatnonzero(np.diff(nodes) != 1) + 1)
+    return ", ".join(f"{r[0]}" if r.size == 1 else f"{r[0]}–{r[-1]}" for r in runs)
+
+
+def _beyond_range(name: str, total: np.ndarray, linear_std: np.ndarray) -> tuple[np.ndarray, str]:
+    """The node motion components (n_nodes, 3) whose residual variance ``total`` is
+    above RESIDUAL_VARIANCE_LIMIT times the linear one, and the warning naming them,
+    issued where one of them moves at least 1 % of the line's largest σ ("" when none:
+    a component nearly at rest falls back silently, its ratio one of two small numbers).
+
+    Node by node: the line's other motions keep their residuals (a whole line falling
+    back for one node moved every node's σ by up to 41 % when that node's ratio
+    crossed the limit)."""
+    lin = np.asarray(linear_std, dtype=float) ** 2
+    ratio = np.where(lin > 0.0, total / np.where(lin > 0.0, lin, 1.0), 0.0)
+    beyond = ratio > RESIDUAL_VARIANCE_LIMIT
     live = lin > 1e-4 * np.max(lin, initial=0.0)
-    ratio = np.where(live, total[at] / np.where(live, lin, 1.0), 0.0)
-    if np.max(ratio, initial=0.0) > RESIDUAL_VARIANCE_LIMIT:
-        k, c = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-        return MotionResidual(
-            False,
-            f"the residuals' variance of node {int(at[k])}'s {'xyz'[c]} motion is "
-            f"{ratio[k, c]:.3g} × its linear variance, above the residuals' range "
-            f"{RESIDUAL_VARIANCE_LIMIT:g} (RESIDUAL_VARIANCE_LIMIT): the first-order "
-            "closed forms are out of their depth there; the motions are linear",
-        )
-    return MotionResidual(True, "", lines, total, at)
+    if not np.any(beyond & live):
+        return beyond, ""
+    k, c = np.unravel_index(int(np.argmax(np.where(live, ratio, 0.0))), ratio.shape)
+    where = "; ".join(
+        f"{'xyz'[j]} at node{'s' if np.count_nonzero(beyond[:, j]) > 1 else ''} "
+        f"{_node_list(np.flatnonzero(beyond[:, j]))}"
+        for j in range(3)
+        if beyond[:, j].any()
+    )
+    reason = (
+        f"line '{name}': the residuals' variance of the node motions is up to "
+        f"{ratio[k, c]:.3g} × the linear variance (node {int(k)}'s {'xyz'[c]} motion), "
+        f"above the residuals' range {RESIDUAL_VARIANCE_LIMIT:g} (RESIDUAL_VARIANCE_LIMIT) "
+        f"({where}): the first-order closed forms are out of their depth there and those "
+        "motions are the linear model's, the other nodes' keep the residuals; check with "
+        "the nonlinear time-domain reference (stochcable.reference.cable), or make the "
+        "line tauter (pretension) or its mesh finer"
+    )
+    warn(reason, PhysicsWarning, stacklevel=4)
+    return beyond, reason
