@@ -232,6 +232,9 @@ class JobStore:
                 sa.select(_jobs.c.id, _jobs.c.status).where(free).order_by(_jobs.c.created).limit(8)
             ).all()
             for job_id, status in candidates:
+                # the time after the select: a job created (committed) since ``now`` was
+                # taken would start before it was created (seen under load)
+                at = max(now, time.time())
                 done = sa.select(sa.func.coalesce(sa.func.sum(_chunks.c.n_cases), 0)).where(
                     _chunks.c.job_id == job_id
                 )
@@ -239,9 +242,9 @@ class JobStore:
                     _jobs.update()
                     .where(_jobs.c.id == job_id, free)
                     .values(
-                        status="running", holder=holder, lease_until=now + lease,
-                        started=sa.func.coalesce(_jobs.c.started, now),
-                        resumed=now if status == "running" else None,
+                        status="running", holder=holder, lease_until=at + lease,
+                        started=sa.func.coalesce(_jobs.c.started, at),
+                        resumed=at if status == "running" else None,
                         resumed_at_cases=done.scalar_subquery(),
                     )
                 )  # fmt: skip

@@ -123,3 +123,23 @@ def test_queue_limit_and_retention(store):
     assert store.expire(time.time() - 60) == 0  # finished just now: kept
     assert store.expire(time.time() + 1) == 1
     assert store.get(first.id) is None
+
+
+def test_a_job_created_as_the_runner_claims_starts_after_it(tmp_path, monkeypatch):
+    """The runner takes its time before it selects the queued jobs; a job created and
+    committed in between (the runner descheduled under load: test_batches saw
+    started < created once in 3 loaded runs) is claimed with the time after the
+    select, never before its creation."""
+    import types
+
+    import service.store as store_module
+
+    store = JobStore(str(tmp_path / "jobs.sqlite"))
+    job = store.create("", {"warnings": []}, 1, 1, 1, 10)
+    early = [job.created - 1.0]  # the claim's first reading: before the job existed
+    clock = types.SimpleNamespace(time=lambda: early.pop() if early else time.time())
+    monkeypatch.setattr(store_module, "time", clock)
+    claimed = store.claim("runner", 30.0)
+    assert claimed is not None and claimed.id == job.id and not early
+    assert claimed.started >= claimed.created
+    store.close()
