@@ -311,3 +311,36 @@ def test_mirrored_two_leg_buoy_mirrors_the_legs_along_line():
         assert along.computed and len(along.lines["drag_residual"]) >= 2
         group = along.lines["drag_residual"][-1][1].sum(axis=1)
         assert np.max(np.abs(group)) > 1e-3 * np.max(np.abs(along.variance))
+
+
+def test_group_station_motions_beyond_the_range_fall_back_node_by_node(monkeypatch):
+    """A multi-line group adds its share to a leg's node motions
+    (``group_stations.with_station_parts``): with the range limit lowered (0.02, so that
+    some of the two-leg buoy's node motions cross it and others do not), the motions
+    beyond it — the leg's own and those the group's share pushes over — are the linear
+    model's to the bit, zero in every variance line, and the others keep their
+    residuals (the group's path once checked the stations as a whole and added its
+    share onto the nodes the line had left linear).  12 elements a leg: their motions'
+    residual shares run 0.3–1.2 of the linear variance at the default limit, on both
+    sides of 0.5."""
+    import stochcable.dynamics.residuals.along_line_motion as alm
+
+    monkeypatch.setattr(alm, "RESIDUAL_VARIANCE_LIMIT", 0.5)
+    doc = _two_leg_doc()
+    doc["bodies"][0].pop("hydrodynamics")
+    for leg in doc["lines"]:
+        leg["segments"][0]["elements"] = 12
+    doc["analysis"].pop("timeseries", None)
+    res = _quiet(doc)
+    for line in res.lines.values():
+        mr, lin = line.motion_residual, line.motion_std_linear
+        assert mr.computed and mr.beyond.shape == lin.shape
+        assert mr.beyond.any() and (~mr.beyond & (lin > 0)).any()
+        np.testing.assert_array_equal(line.motion_std[mr.beyond], lin[mr.beyond])
+        assert not np.any(mr.variance[mr.beyond])
+        for parts in mr.lines.values():
+            for _, v in parts:
+                assert not np.any(v[mr.beyond])
+        kept = ~mr.beyond & (lin > 0)
+        ratio = line.motion_std[kept] ** 2 / lin[kept] ** 2 - 1.0
+        assert np.all(ratio <= 0.5 + 1e-12) and np.any(ratio > 0.1)

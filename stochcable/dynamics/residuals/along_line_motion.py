@@ -54,6 +54,7 @@ __all__ = [
     "MotionResidual",
     "NodeInfluence",
     "motion_lines",
+    "motions_in_range",
     "motion_residual",
     "motion_weights",
     "motion_stations",
@@ -388,12 +389,27 @@ def motion_residual(
             full.append((om, out))
             total += out.sum(axis=2)
         lines[kind] = tuple(full)
-    beyond, reason = _beyond_range(system.name, total, linear_std)
+    beyond, reason = motions_in_range(system.name, lines, total, linear_std)
+    return MotionResidual(True, reason, lines, total, at, beyond)
+
+
+def motions_in_range(
+    name: str,
+    lines: dict[str, tuple],
+    total: np.ndarray,
+    linear_std: np.ndarray,
+    known: np.ndarray | None = None,
+) -> tuple[np.ndarray, str]:
+    """The node motion components (n_nodes, 3) beyond the residuals' range (those of
+    ``known`` too), their residual ``total`` and ``lines`` zeroed in place (the caller's
+    own arrays), and the warning's text; warned only where a moving component is newly
+    beyond (``known``: already said)."""
+    beyond, reason = _beyond_range(name, total, linear_std, known)
     total[beyond] = 0.0
     for parts_k in lines.values():
         for _, v in parts_k:
             v[beyond] = 0.0
-    return MotionResidual(True, reason, lines, total, at, beyond)
+    return beyond, reason
 
 
 def _node_list(nodes: np.ndarray) -> str:
@@ -402,7 +418,9 @@ def _node_list(nodes: np.ndarray) -> str:
     return ", ".join(f"{r[0]}" if r.size == 1 else f"{r[0]}–{r[-1]}" for r in runs)
 
 
-def _beyond_range(name: str, total: np.ndarray, linear_std: np.ndarray) -> tuple[np.ndarray, str]:
+def _beyond_range(
+    name: str, total: np.ndarray, linear_std: np.ndarray, known: np.ndarray | None = None
+) -> tuple[np.ndarray, str]:
     """The node motion components (n_nodes, 3) whose residual variance ``total`` is
     above RESIDUAL_VARIANCE_LIMIT times the linear one, and the warning naming them,
     issued where one of them moves at least 1 % of the line's largest σ ("" when none:
@@ -414,6 +432,10 @@ def _beyond_range(name: str, total: np.ndarray, linear_std: np.ndarray) -> tuple
     lin = np.asarray(linear_std, dtype=float) ** 2
     ratio = np.where(lin > 0.0, total / np.where(lin > 0.0, lin, 1.0), 0.0)
     beyond = ratio > RESIDUAL_VARIANCE_LIMIT
+    if known is not None and known.shape != beyond.shape:
+        known = None  # (a record without the mask: none known)
+    if known is not None:
+        beyond = beyond | known
     live = lin > 1e-4 * np.max(lin, initial=0.0)
     if not np.any(beyond & live):
         return beyond, ""
@@ -433,5 +455,6 @@ def _beyond_range(name: str, total: np.ndarray, linear_std: np.ndarray) -> tuple
         "the nonlinear time-domain reference (stochcable.reference.cable), or make the "
         "line tauter (pretension) or its mesh finer"
     )
-    warn(reason, PhysicsWarning, stacklevel=4)
+    if known is None or np.any(beyond & live & ~known):
+        warn(reason, PhysicsWarning, stacklevel=5)
     return beyond, reason

@@ -15,8 +15,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.residuals.along_line import station_weights
-from stochcable.dynamics.residuals.along_line_motion import motion_weights
-from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
+from stochcable.dynamics.residuals.along_line_motion import motion_weights, motions_in_range
 from stochcable.dynamics.residuals.group_motion import BodyRows, station_misfit
 
 __all__ = ["group_station_parts", "with_group_stations", "with_station_parts"]
@@ -68,8 +67,9 @@ def with_station_parts(
     (each a part of the kind's lines, carried to every element and node as the line's
     own parts: the stations' weights), and their σ; ``misfit(set, linear transfer,
     spectra, ω)`` the drag residual's misfit part of a set's stations (None: none);
-    unchanged where a record is not computed, lacks the kind, or the motions' total
-    would leave the closed forms' range."""
+    unchanged where a record is not computed or lacks the kind; a node motion whose
+    total would leave the closed forms' range is the linear model's, node by node
+    (:func:`~.along_line_motion.motions_in_range`)."""
     model = result.model
     omega = np.asarray(result.omega, dtype=float)
     spectra = np.asarray(result.input_spectra, dtype=float)
@@ -92,7 +92,8 @@ def with_station_parts(
         comps, d = list(model.components), model.dim
         lin = np.asarray(result.motion_std_linear, dtype=float)
         weights = motion_weights(s0, moves.stations, lin[:, comps] ** 2)
-        lines, total = dict(moves.lines), moves.variance.copy()
+        lines = {k: tuple((om, v.copy()) for om, v in p) for k, p in moves.lines.items()}
+        total = moves.variance.copy()
         u = np.asarray(result.motion_transfer)[:, moves.stations][:, :, comps]
         u = u.reshape(u.shape[0], -1, u.shape[3])
         mis = None if misfit is None else misfit("nodes", u, spectra, omega)
@@ -103,11 +104,9 @@ def with_station_parts(
                     full[:, comps] = (weights @ x).reshape(model.n_nodes, d, om.size)
                     lines[kind] = lines[kind] + ((om, full),)
                     total = total + full.sum(axis=2)
-        at = moves.stations
-        lv = lin[at] ** 2
-        live = lv > 1e-4 * np.max(lv, initial=0.0)
-        ratio = np.where(live, total[at] / np.where(live, lv, 1.0), 0.0)
-        if np.max(ratio, initial=0.0) <= RESIDUAL_VARIANCE_LIMIT:
-            new = dataclasses.replace(moves, lines=lines, variance=total)
-            changes.update(motion_residual=new, motion_std=new.std(lin))
+        beyond, reason = motions_in_range(result.name, lines, total, lin, moves.beyond)
+        new = dataclasses.replace(
+            moves, lines=lines, variance=total, beyond=beyond, reason=reason or moves.reason
+        )
+        changes.update(motion_residual=new, motion_std=new.std(lin))
     return dataclasses.replace(result, **changes) if changes else result
