@@ -172,3 +172,30 @@ def test_split_touchdown_element_moves_as_the_model():
     # measured 0.33 / 0.28 % (16–40 elements: 0.25 … 0.35 %, the meshes' own spread):
     # agreeing to 0.15 % of σ; before the split was followed: 5.2 / 0.2 %
     assert 0.0 < share[21] < 0.005 and abs(share[20] - share[21]) < 1.5e-3, share
+
+
+def test_split_touchdown_element_tension_continuous_with_its_neighbours(monkeypatch):
+    """The leg's element 9 is split at the touchdown at 20 and 21 elements; with every
+    element a station (its own along-line residual, not interpolated) its corrected σ
+    ratio lies with its neighbours'.  Before the element tensions' own term followed the
+    split (its suspended part's stretch EA/(L₀l) and the force on the massless split
+    node, (R_b e_s)·f) it read 2.89 / 3.86 against the neighbours' 1.003."""
+    import stochcable.dynamics.groups.results as group_results
+    import stochcable.dynamics.residuals.along_line as along_line
+
+    def every(model, max_stations=along_line.MAX_STATIONS):
+        return np.arange(model.n_elements)
+
+    monkeypatch.setattr(along_line, "stations", every)
+    monkeypatch.setattr(group_results, "stations", every)
+    for n in (20, 21):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            line = analyze(_slack_leg(n)).lines["leg"]
+        k = line.model.bed.element
+        assert k is not None and 1 <= k < n - 1
+        ratio = np.asarray(line.tension_std) / np.asarray(line.tension_std_linear)
+        # measured 1.0034 among 1.0033 / 1.0034 (20) and 1.0030 among 1.0027 / 1.0029
+        # (21): within 0.1 % of σ of the neighbours' span (their own step ≤ 0.03 %)
+        lo, hi = min(ratio[k - 1], ratio[k + 1]), max(ratio[k - 1], ratio[k + 1])
+        assert lo - 1e-3 < ratio[k] < hi + 1e-3, (n, ratio[k - 2 : k + 3])

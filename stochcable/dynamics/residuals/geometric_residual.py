@@ -38,13 +38,13 @@ import numpy as np
 
 from stochcable.dynamics.residuals.body_residual import untapped, with_group_lines
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
+from stochcable.dynamics.residuals.influence import element_frames, element_lengths
 from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_LINES
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     PairLines,
     along,
     covariance_lines,
-    element_directions,
     fft_length,
     load_transfer,
     pair_blocks,
@@ -159,17 +159,16 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     comps = list(model.components)
     d = model.dim
     n_ch = len(channels)
-    pos = np.asarray(system.positions, dtype=float)
-    chord = np.diff(pos, axis=0)
-    length = np.linalg.norm(chord, axis=1)
-    frames = element_directions(system)
+    # the split touchdown element's suspended part's l and L₀ (shared with the
+    # element tensions' own stretch, influence.geometric_feedthrough)
+    length, l0 = element_lengths(system)
+    frames = element_frames(system)  # the split element along its suspended part
     u = np.zeros((w.size, model.n_nodes, 3, n_ch), dtype=complex)
     u[:, :, comps] = resp.displacement.reshape(w.size, model.n_nodes, d, n_ch)
     du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, 3, n_ch)
     mesh = model.mesh
-    l0 = np.array(mesh.l0, dtype=float)
     # the element split at the touchdown: its suspended part, as the linear model's
-    split = _suspended_part(model, u, du, frames, length, l0)
+    split = _suspended_part(model, u, du)
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
@@ -202,14 +201,12 @@ def _suspended_part(
     model: Any,
     u: np.ndarray,
     du: np.ndarray,
-    frames: list[np.ndarray],
-    length: np.ndarray,
-    l0: np.ndarray,
 ) -> tuple[int, np.ndarray] | None:
     """The element that the linear model splits at the static touchdown
     (:attr:`stochcable.line.fem.FEModel.bed`) as its suspended part t–b, in place:
     ``du`` its u_b − u_t (u_t = R·[u_a; u_b] the condensed touchdown node's motion),
-    ``frames`` its part's tangent and normals, ``length`` and ``l0`` its part's.  The
+    (its frames and l, L₀: :func:`~stochcable.dynamics.residuals.influence.element_frames`,
+    :func:`~stochcable.dynamics.residuals.influence.element_lengths`).  The
     chord a–b instead picks up the upper node's heave in its axial motion (×7 on a leg
     whose first suspended node is 0.7 ft above the bed: +5 % of σ at 20 elements,
     +0.2 % at 21, docs/accuracy/bodies.md); the grounded part, held by the bed, is left
@@ -222,17 +219,6 @@ def _suspended_part(
     ab = np.concatenate([u[:, k, comps], u[:, k + 1, comps]], axis=1)  # (n_w, 2d, n_ch)
     du[:, k] = 0.0
     du[:, k, comps] = u[:, k + 1, comps] - np.einsum("ij,wjc->wic", r_t, ab)
-    share = 1.0 - bed.fraction
-    length[k] *= share
-    l0[k] *= share
-    t = np.zeros(3)
-    t[comps] = bed.sub_tangents[1]
-    frames[0] = frames[0].copy()
-    frames[0][k] = t
-    for j in range(1, len(frames)):  # the normals made normal to it (Gram–Schmidt)
-        frames[j] = frames[j].copy()
-        n = frames[j][k] - sum((frames[i][k] @ frames[j][k]) * frames[i][k] for i in range(j))
-        frames[j][k] = n / np.linalg.norm(n)
     return k, r_t
 
 

@@ -39,6 +39,8 @@ __all__ = [
     "SharedRows",
     "band_stack",
     "element_directions",
+    "element_frames",
+    "element_lengths",
     "element_rows",
     "end_influence",
     "geometric_feedthrough",
@@ -501,6 +503,39 @@ def element_rows(model: Any) -> np.ndarray:
     return np.asarray(rows, dtype=float)
 
 
+def element_lengths(system: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The static length l and the unstretched length L₀ of each element (n_el each) as
+    the geometric residual takes them: the chord, and for the element the linear model
+    splits at the static touchdown (:attr:`stochcable.line.fem.FEModel.bed`) its
+    suspended part's share 1 − ξ of each. [m]"""
+    model = system.model
+    length = np.linalg.norm(np.diff(np.asarray(system.positions, dtype=float), axis=0), axis=1)
+    l0 = np.array(model.mesh.l0, dtype=float)
+    bed = getattr(model, "bed", None)
+    if bed is not None and bed.element is not None:
+        length[bed.element] *= 1.0 - bed.fraction
+        l0[bed.element] *= 1.0 - bed.fraction
+    return length, l0
+
+
+def element_frames(system: Any) -> list[np.ndarray]:
+    """:func:`element_directions` with the element split at the static touchdown
+    (:attr:`stochcable.line.fem.FEModel.bed`) along its suspended part: its tangent, the
+    normals made normal to it (Gram–Schmidt)."""
+    frames = element_directions(system)
+    bed = getattr(system.model, "bed", None)
+    if bed is None or bed.element is None:
+        return frames
+    k = bed.element
+    frames = [f.copy() for f in frames]
+    frames[0][k] = 0.0
+    frames[0][k, list(system.model.components)] = bed.sub_tangents[1]
+    for j in range(1, len(frames)):
+        n = frames[j][k] - sum((frames[i][k] @ frames[j][k]) * frames[i][k] for i in range(j))
+        frames[j][k] = n / np.linalg.norm(n)
+    return frames
+
+
 def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
     """Each element tension per unit of the geometric residual's components (its
     :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer` columns,
@@ -511,13 +546,28 @@ def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
     a·t + b): the linear model's tension (EA/L₀)·a (the rows of
     :func:`element_rows`) misses (EA/L₀)·½|b|²/l, the element's own share of the
     quadratic force κ·½|b|² it applies as a node pair (the pair's response through
-    the line, r_e·A⁻¹F, is the rest).  The products a·b_k do not stretch it."""
-    rows = element_rows(system.model)
-    n_el = rows.shape[0]
-    length = np.linalg.norm(np.diff(np.asarray(system.positions, dtype=float), axis=0), axis=1)
+    the line, r_e·A⁻¹F, is the rest).  The products a·b_k do not stretch it.  The
+    element split at the touchdown: its suspended part's, l and L₀ those of
+    :func:`element_lengths` (its row's norm is not EA/L₀: it holds the split node's
+    motion too)."""
+    model = system.model
+    stiff = np.linalg.norm(element_rows(model)[:, 1], axis=1)
+    length, l0 = element_lengths(system)
+    n_el = stiff.size
     out = np.zeros((n_el, n_all))
     el = np.arange(n_el)
-    out[el, el] = -np.linalg.norm(rows[:, 1], axis=1) / length
+    bed = getattr(model, "bed", None)
+    if bed is not None and bed.element is not None:
+        k, d, comps = bed.element, model.dim, list(model.components)
+        ea = float(np.asarray(model.mesh.ea, dtype=float)[k])
+        stiff[k] = ea / l0[k]
+        # the pair's − on the massless split node t moves it by K_tt⁻¹F_t besides
+        # R·u_ab: (EA/L₀)e_s·K_tt⁻¹ = (R_b e_s)ᵀ (R_b = K_tt⁻¹k_b, k_b e_s = (EA/L₀)e_s)
+        kappa = (stiff[k] - float(system.statics.tension[k]) / length[k]) / length[k]
+        r_e = np.asarray(bed.transform, dtype=float)[d : 2 * d, d:] @ bed.sub_tangents[1]
+        for i, f in enumerate(element_frames(system)):
+            out[k, i * n_el + k] += kappa * (r_e @ f[k, comps])
+    out[el, el] -= stiff / length
     return out
 
 
