@@ -235,13 +235,17 @@ def test_http_entrance_meets_the_target(target, client):
 
 def _patched_client():
     """A service whose analysis workers are forked from this process after the
-    planner was patched (forkserver workers would not see the patch)."""
+    planner was patched (forkserver workers would not see the patch), its run limit
+    300 s: the refused 0.3 % plan takes its planner 17–21 s of wall time on a quiet
+    2-core host (29–33 s CPU), and a CI dry run under other work took it past the
+    default 60 s (a 504 where the test asks what the entrance answers, 422)."""
     from fastapi.testclient import TestClient
 
     from service.app import create_app
     from service.settings import Settings
 
-    return TestClient(create_app(Settings(analysis_workers=1, worker_start_method="fork")))
+    settings = Settings(analysis_workers=1, worker_start_method="fork", max_run_seconds=300.0)
+    return TestClient(create_app(settings))
 
 
 @pytest.fixture
