@@ -269,9 +269,12 @@ class BatchMethods:
             f.flush()
             return xr.load_dataset(f.name)
 
-    def cancel(self, job: BatchJob | str) -> BatchJob | None:
+    def cancel(self, job: BatchJob | str, *, keep_finished: bool = False) -> BatchJob | None:
         """``DELETE /v1/batches/{id}``: cancel an active batch (its status), or delete a
-        finished one and its results (None)."""
+        finished one and its results (None); ``keep_finished``: only cancel
+        (``?cancel_only=true``), a batch that finished meanwhile is left as it is (its
+        status: the cancel came too late, its results kept)."""
         job_id = job.id if isinstance(job, BatchJob) else str(job)
-        resp = self._request("DELETE", f"/v1/batches/{job_id}")
+        query = "?cancel_only=true" if keep_finished else ""
+        resp = self._request("DELETE", f"/v1/batches/{job_id}{query}")
         return None if resp.status_code == 204 else BatchJob.from_document(resp.json())

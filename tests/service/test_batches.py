@@ -303,6 +303,11 @@ def test_python_client_submit_wait_results(service, reference):
         reference.stats["leg1"]["end_b"][:, 1],
     )
     assert client.results(done, "json")["totals"] == case_document(reference)["totals"]
+    late = client.cancel(done, keep_finished=True)  # a cancel that came too late
+    assert late is not None and late.status == "done" and client.results(done, "json")
+    assert client.cancel(done) is None  # a plain DELETE removes a finished batch
+    with pytest.raises(ClientError):
+        client.batch(done)
     with pytest.raises(ClientError, match="scatter.probability"):
         client.submit_batch(CHAIN, [{"hs": 1.0, "tp": 9.0, "probability": 0.5}])
 
