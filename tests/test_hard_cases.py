@@ -211,9 +211,12 @@ def test_tension_to_zero_at_the_anchor_end_flags_snap():
     assert snap and "at element 1 (" in snap[0], [str(w_.message) for w_ in caught]
     # ... and not at the taut 480 m line
     assert "snap" not in taut.lines["l"].indicators.flags
-    # the linear model's fairlead tension σ hardly notices (the hanging part is the
-    # same 90 m)
-    assert line.end_b.std == pytest.approx(taut.lines["l"].linear["end_b"].std, rel=0.2)
+    # the linear model's fairlead tension σ stays of the same size (the hanging part is
+    # the same 90 m): measured 0.82 of the 480 m line's (the slacker line's lower mean
+    # tension, a softer fairlead); both deterministic linear analyses, the band only
+    # says "same size, lower", not a figure to hold
+    r = line.end_b.std / taut.lines["l"].linear["end_b"].std
+    assert 0.7 < r < 1.0
     # at 480 m the residuals are in their range (the geometric one +0.01 % of σ; it read
     # 6.3 × the linear variance when the element split at the touchdown was taken along
     # its chord, docs/accuracy/bodies.md): applied, the fairlead σ 0.49 kN against the

@@ -244,7 +244,9 @@ def test_the_analysis_adds_the_body_drag_residual(monkeypatch):
     (b1,), (b0,) = on.bodies.values(), before.bodies.values()
     added = float(own.body[0].sum())
     assert b1.motion["surge"].std ** 2 == pytest.approx(b0.motion["surge"].std ** 2 + added)
-    assert b1.motion["heave"].std == pytest.approx(b0.motion["heave"].std, rel=1e-3)
+    # heave hardly moves (measured −9e-7 relative): the residual's load is the drag
+    # point's, whose heave share the stiff, radiation-damped heave takes up
+    assert b1.motion["heave"].std == pytest.approx(b0.motion["heave"].std, rel=1e-5)
     leg1, leg0 = on.lines["leg"], before.lines["leg"]
     for k, end in enumerate(("end_a", "end_b")):
         v1 = leg1.residuals["drag_residual"].variance[end]
