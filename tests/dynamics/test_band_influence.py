@@ -1,0 +1,81 @@
+"""The residuals' banded adjoint rows (stochcable.dynamics.residuals.band_influence):
+the compiled path (factors kept, rows by substitution) against LAPACK's stacked gbsv
+path on the accuracy page's deep catenary (banded: 20 elements, 38 free DOFs), the
+rows a shared influence hands out from its kept factors against a fresh solve, and
+STOCHCABLE_NUMBA=0 taking the LAPACK path."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_influence import _system
+
+import stochcable.dynamics.residuals.band_influence as bi
+from stochcable.dynamics.residuals.along_line import element_rhs, stations
+from stochcable.dynamics.residuals.along_line_motion import node_rows, solved_stations
+from stochcable.dynamics.residuals.influence import EndInfluence
+
+pytest.importorskip("stochcable.dynamics.model.band_lu_kernels")
+
+import residual_cost  # noqa: E402 (benchmarks/, on the path through test_influence)
+
+
+@pytest.fixture(scope="module")
+def deep():
+    system, damping = _system(residual_cost.lines()["deep"])
+    model = system.model
+    extra = np.hstack(
+        [element_rhs(model, stations(model)), node_rows(model, solved_stations(model))]
+    )
+    return system, damping, extra
+
+
+def _lapack(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(bi, "compiled_band_lu", lambda entries: False)
+
+
+def test_compiled_rows_equal_lapack(deep, monkeypatch):
+    """End rows with the element and node rows (2 + 7 + 14) on 189 lines across the
+    line's resonances: the compiled LU equals gbsv's to round-off (measured 4e-15 of
+    each row's scale)."""
+    system, damping, extra = deep
+    w = np.linspace(0.02, 6.0, 189)
+    got = bi.LineAdjoint(system, damping, entries=2**20).rows(w, extra)
+    _lapack(monkeypatch)
+    ref = bi.end_influence(system, damping, w, extra)
+    scale = np.abs(ref).reshape(ref.shape[0], -1).max(axis=1)
+    err = np.abs(got - ref).reshape(ref.shape[0], -1).max(axis=1) / scale
+    assert np.all(err < 1e-12), err
+    np.testing.assert_array_equal(got[:, [0, -1]], ref[:, [0, -1]])  # (ê and zeros)
+    adj = bi.adjoint_rows(system, damping, extra, w)
+    np.testing.assert_allclose(adj, ref[2:], rtol=0, atol=1e-12 * scale.max())
+
+
+def test_kept_factors_give_the_other_rows(deep):
+    """A shared influence solved by the banded path keeps its factors: the element and
+    node rows asked later on some of its lines (every second one, any subset) are
+    substitutions equal to a solve of all rows at once; on lines it did not factor:
+    None (the caller's own solve)."""
+    system, damping, extra = deep
+    w = np.linspace(0.02, 6.0, 189)
+    shared = EndInfluence(system, damping, extra)
+    shared._modal = False  # (the deep wire is banded anyway: MODAL_SHARE)
+    ends = shared.on(w)
+    full = bi.LineAdjoint(system, damping, entries=2**20).rows(w, extra)
+    np.testing.assert_array_equal(ends, full[:2])
+    sub = w[::2]
+    rows = shared.extra_kept(sub, slice(7, 21))  # (the node rows)
+    np.testing.assert_allclose(rows, full[9:23, ..., ::2], rtol=0, atol=1e-14 * np.abs(full).max())
+    assert np.shares_memory(shared.extra_kept(sub, slice(7, 21)), rows)  # (kept)
+    np.testing.assert_array_equal(shared.extra_kept(w[[3, 7]], slice(0, 7)), full[2:9, ..., [3, 7]])
+    assert shared.extra_kept(np.array([0.0301]), slice(0, 7)) is None
+
+
+def test_numba_off_takes_lapack(deep, monkeypatch):
+    """STOCHCABLE_NUMBA=0: no compiled path (gbsv in stacks; no factors kept)."""
+    system, damping, extra = deep
+    monkeypatch.setenv("STOCHCABLE_NUMBA", "0")
+    adj = bi.LineAdjoint(system, damping, entries=2**20)
+    w = np.linspace(0.02, 6.0, 40)
+    adj.rows(w, extra)
+    assert adj.kept_rows(w, extra) is None
