@@ -79,3 +79,28 @@ def test_numba_off_takes_lapack(deep, monkeypatch):
     w = np.linspace(0.02, 6.0, 40)
     adj.rows(w, extra)
     assert adj.kept_rows(w, extra) is None
+
+
+def test_kept_transfer_is_the_rows_times_the_loads(deep):
+    """The node rows contracted with load cases as they are solved
+    (EndInfluence.extra_transfer, never formed) equal sparse_transfer of the rows
+    themselves (the motions' product: round-off, the sums in another order); None
+    once the rows are formed (the caller's product then) and on lines not factored."""
+    from stochcable.dynamics.residuals.along_line_3d import sparse_transfer
+
+    system, damping, extra = deep
+    n = system.model.n_nodes
+    rng = np.random.default_rng(3)
+    unit = np.zeros((n, 2, 12))  # load cases on node pairs, the end nodes' included
+    for load, k in enumerate(rng.integers(0, n - 1, size=12)):
+        unit[k : k + 2, :, load] = rng.normal(size=(2, 2))
+    w = np.linspace(0.02, 6.0, 189)
+    shared = EndInfluence(system, damping, extra)
+    shared._modal = False
+    shared.on(w)
+    sub = w[1::3]
+    got = shared.extra_transfer(sub, unit, slice(7, 21))
+    ref = sparse_transfer(shared.extra_kept(sub, slice(7, 21)), unit)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-14 * np.abs(ref).max())
+    assert shared.extra_transfer(sub, unit, slice(7, 21)) is None  # (rows formed now)
+    assert shared.extra_transfer(np.array([0.0301]), unit, slice(0, 7)) is None

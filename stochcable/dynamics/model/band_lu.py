@@ -15,9 +15,10 @@ refactored and substituted one column at a time (docs/benchmarks/residual_cost.m
 
 from __future__ import annotations
 
-import sys
+from typing import Any
 
 import numpy as np
+from scipy import sparse
 
 from stochcable.compiled import KERNEL_MIN_ENTRIES, optional_kernel
 from stochcable.dynamics.model.solvers import singular_error
@@ -28,11 +29,12 @@ _KERNELS = "stochcable.dynamics.model.band_lu_kernels"
 
 
 def compiled_band_lu(entries: int) -> bool:
-    """Whether a banded solve of ``entries`` right-hand-side entries (n_w · n · r) takes
-    the compiled kernels: numba available (and not ``STOCHCABLE_NUMBA=0``) and either
-    ``entries`` ≥ :data:`~stochcable.compiled.KERNEL_MIN_ENTRIES` or the kernels
-    already loaded in this process (no import to pay). [-]"""
-    if entries < KERNEL_MIN_ENTRIES and _KERNELS not in sys.modules:
+    """Whether a banded job of ``entries`` right-hand-side entries (n_w · n · r) takes
+    the compiled kernels: numba available (and not ``STOCHCABLE_NUMBA=0``) and
+    ``entries`` ≥ :data:`~stochcable.compiled.KERNEL_MIN_ENTRIES` (numba's import, ≈
+    0.3–0.6 s once per process, is paid above it only; by the job's size alone, so the
+    same document takes the same path, to the bit, in any process). [-]"""
+    if entries < KERNEL_MIN_ENTRIES:
         return False
     return optional_kernel(_KERNELS, "band_lu_factor") is not None
 
@@ -53,16 +55,27 @@ class BandFactors:
         self.kl = kl
 
     def solve_into(
-        self, terms: np.ndarray, out: np.ndarray, at: np.ndarray | None = None, offset: int = 0
+        self,
+        terms: np.ndarray,
+        out: np.ndarray,
+        at: np.ndarray | None = None,
+        offset: int = 0,
+        loads: Any = None,
     ) -> np.ndarray:
         """Z(ω)⁻¹b(ω), b = T₀ − ω²T₁ + iωT₂ of ``terms`` (3, n, r), at the frequencies
         ``at`` (indices into :attr:`omega`; all by default), written into rows
         ``offset`` … ``offset + n − 1`` of ``out`` (r, N, n_at), complex and
-        C-contiguous (returned). [m]"""
+        C-contiguous (returned); with ``loads`` (a real scipy.sparse (L, n) matrix of
+        load cases on the n unknowns) their products instead, ``out`` (r, L, n_at).
+        [m] or [m·unit/N]"""
         at = np.arange(self.omega.size) if at is None else np.asarray(at, dtype=np.int64)
+        csr = None
+        if loads is not None:
+            loads = sparse.csr_matrix(loads)
+            csr = (loads.indptr, loads.indices, loads.data)
         if out.size:
             kernel = optional_kernel(_KERNELS, "band_lu_substitute")
-            kernel(self.factors, self.kl, self.omega, at, terms, out, offset)
+            kernel(self.factors, self.kl, self.omega, at, terms, out, offset, csr)
         return out
 
 

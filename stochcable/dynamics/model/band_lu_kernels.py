@@ -89,12 +89,15 @@ def _factor(bk, bm, bc, w, kl, ku, lu, inv, piv):  # noqa: ANN001 - numba kernel
     return 0
 
 
-def _substitute(lu, inv, piv, kl, at, w, terms, out, offset):  # noqa: ANN001 - numba kernel
-    """out[c, offset + i, m] (as (Re, Im) pairs along the last axis) ← (Z⁻¹b)_i,c at ω =
-    w[at[m]] from :func:`_factor`'s factors, b = T₀ − ω²T₁ + iωT₂ of ``terms`` (3, n,
-    2r), the complex right-hand sides as (Re, Im) pairs; the substitutions in scratch
-    rows of one frequency (real and imaginary parts apart: contiguous runs over all
-    right-hand sides, 20–25 % faster than pairs at 14–23 of them)."""
+def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, data):  # noqa: ANN001, PLR0913 - numba kernel
+    """out[c, offset + i, m] (as (Re, Im) pairs along the last axis) ← x_i,c = (Z⁻¹b)_i,c
+    at ω = w[at[m]] from :func:`_factor`'s factors, b = T₀ − ω²T₁ + iωT₂ of ``terms``
+    (3, n, 2r), the complex right-hand sides as (Re, Im) pairs; the substitutions in
+    scratch rows of one frequency (real and imaginary parts apart: contiguous runs over
+    all right-hand sides, 20–25 % faster than pairs at 14–23 of them).  With a load
+    matrix (CSR ``indptr``, ``indices``, ``data``: L rows over the n unknowns, not
+    empty): out[c, l, m] ← Σ_p data[p]·x_indices[p],c over row l instead (the rows
+    contracted with the loads, never written)."""
     n = lu.shape[2]
     kv = lu.shape[3] - 1 - kl
     r = terms.shape[2] // 2
@@ -141,6 +144,17 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset):  # noqa: ANN001 - 
                     yr, yi = xr[i, c], xi[i, c]
                     xr[i - q, c] -= ur * yr - ui * yi
                     xi[i - q, c] -= ur * yi + ui * yr
+        if indptr.size:
+            for c in range(r):
+                for load in range(indptr.size - 1):
+                    sr = 0.0
+                    si = 0.0
+                    for p in range(indptr[load], indptr[load + 1]):
+                        sr += data[p] * xr[indices[p], c]
+                        si += data[p] * xi[indices[p], c]
+                    out[c, load, 2 * m] = sr
+                    out[c, load, 2 * m + 1] = si
+            continue
         for i in range(n):
             for c in range(r):
                 out[c, offset + i, 2 * m] = xr[i, c]
@@ -171,10 +185,13 @@ _SUBSTITUTE_SIGNATURE = types.void(
     types.Array(types.float64, 3, "C", readonly=True),
     types.Array(types.float64, 3, "C"),
     types.int64,
+    types.Array(types.int64, 1, "C", readonly=True),
+    types.Array(types.int64, 1, "C", readonly=True),
+    types.Array(types.float64, 1, "C", readonly=True),
 )
 """(the factors, the reciprocal pivots, the interchanges, kl, the frequencies solved
 (indices), the frequencies factored, the right-hand sides' terms, the solutions, the
-first row written)."""
+first row written, the loads' CSR arrays or empty ones)."""
 
 _factor_kernel, _ = jit_cached(_factor, _FACTOR_SIGNATURE, "banded LU factorization")
 _substitute_kernel, _ = jit_cached(_substitute, _SUBSTITUTE_SIGNATURE, "banded LU substitution")
@@ -239,9 +256,11 @@ def band_lu_substitute(
     terms: np.ndarray,
     out: np.ndarray,
     offset: int = 0,
+    loads: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> None:
     """Z(ω)⁻¹b(ω) at the frequencies ``omega[at]`` from :func:`band_lu_factor`'s
-    ``factors``, b(ω) = T₀ − ω²T₁ + iωT₂, written into ``out``.
+    ``factors``, b(ω) = T₀ − ω²T₁ + iωT₂, written into ``out`` (or contracted with
+    ``loads`` first).
 
     Parameters
     ----------
@@ -257,14 +276,23 @@ def band_lu_substitute(
         (T₀, T₁, T₂) of the right-hand sides. [N, N·s²/m², N·s/m]
     out : ndarray, complex, shape (r, N, n_at), C-contiguous
         Rows ``offset`` … ``offset + n − 1`` overwritten by the solutions (the others
-        untouched). [m]
+        untouched); with ``loads``, shape (r, L, n_at), all overwritten by the
+        solutions' products with the loads. [m] or [m·unit/N]
     offset : int
-        The first row of ``out`` written. [-]
+        The first row of ``out`` written (without ``loads``). [-]
+    loads : tuple of ndarray, optional
+        A real (L, n) CSR matrix (``indptr``, ``indices``, ``data``): each load case's
+        weights on the n unknowns. [unit]
     """
     if not out.flags.c_contiguous or out.dtype != complex:
         raise ValueError("band_lu_substitute: out must be a C-contiguous complex array")
     lu, inv, piv = factors
     t = np.ascontiguousarray(terms, dtype=complex)
+    if loads is not None and len(loads[0]) < 2:
+        return  # (no load case: nothing to write)
+    if loads is None:
+        none = np.zeros(0, dtype=np.int64)
+        loads = (none, none, np.zeros(0))
     _substitute_kernel(
         lu,
         inv,
@@ -275,4 +303,7 @@ def band_lu_substitute(
         t.view(float).reshape(3, t.shape[1], -1),
         out.view(float).reshape(out.shape[0], out.shape[1], -1),
         int(offset),
+        np.ascontiguousarray(loads[0], dtype=np.int64),
+        np.ascontiguousarray(loads[1], dtype=np.int64),
+        np.ascontiguousarray(loads[2], dtype=float),
     )

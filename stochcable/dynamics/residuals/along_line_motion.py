@@ -160,6 +160,25 @@ class NodeInfluence:
         self._kept.append((w.copy(), g))
         return g
 
+    def transfer_on(self, w: np.ndarray, unit: np.ndarray) -> np.ndarray | None:
+        """The outputs per unit load case ``unit`` (n_nodes, d, n_load) on ``w``, shape
+        (n_out, n_load, n_w), without forming the rows where they are a shared banded
+        influence's (``rows``, a :class:`~.influence.SharedRows`: line_result's shared
+        node influence) whose kept factors hold ``w``
+        (:meth:`~.influence.EndInfluence.extra_transfer`); None otherwise. [m/unit]"""
+        rows = getattr(self, "rows", None)
+        extra_transfer = getattr(getattr(rows, "shared", None), "extra_transfer", None)
+        return None if extra_transfer is None else extra_transfer(w, unit, rows.cols)
+
+
+def node_transfer(influence: Any, w: np.ndarray, unit: np.ndarray) -> np.ndarray:
+    """:func:`sparse_transfer` of ``influence.on(w)`` and the load cases ``unit``, or the
+    influence's own product where it has one (:meth:`NodeInfluence.transfer_on`),
+    shape (n_out, n_load, n_w). [m/unit]"""
+    transfer_on = getattr(influence, "transfer_on", None)
+    h = None if transfer_on is None else transfer_on(w, unit)
+    return sparse_transfer(influence.on(w), unit) if h is None else h
+
 
 @dataclass(frozen=True)
 class MotionResidual:
@@ -229,7 +248,7 @@ def motion_lines(
         if n_top == 0:
             lines = np.zeros((influence.on(cap.w[:1]).shape[0], cap.w.size))
         else:
-            full = sparse_transfer(influence.on(w), unit)  # (n_out, n_kept, n_sel)
+            full = node_transfer(influence, w, unit)  # (n_out, n_kept, n_sel)
             lines = np.zeros((full.shape[0], cap.w.size))
             part = capture_outputs(cap, full, sel, dtype) * motion_cells(
                 system, damping, unit, w, full, CELL_BENDS[kind] * stride**2, influence

@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from scipy import sparse
 
 from stochcable.dynamics.model.band_lu import BandFactors, band_factors, compiled_band_lu
 from stochcable.dynamics.model.blocks import add_blocks, free_band, line_prep
@@ -55,7 +56,7 @@ def grid_indices(om: np.ndarray, w: np.ndarray) -> np.ndarray | None:
         return None if w.size else np.zeros(0, dtype=np.int64)
     at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
     near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
-    return near if np.allclose(om[near], w, rtol=1e-12, atol=0.0) else None
+    return near if np.all(np.abs(om[near] - w) <= 1e-12 * np.abs(w)) else None  # (allclose's)
 
 
 class LineAdjoint:
@@ -136,14 +137,17 @@ class LineAdjoint:
             terms[0, :, k_e:] = extra
         return terms
 
-    def rows(self, w: np.ndarray, extra: np.ndarray | None = None, ends: bool = True) -> np.ndarray:
+    def rows(
+        self, w: np.ndarray, extra: np.ndarray | None = None, ends: bool = True, kept: Any = None
+    ) -> np.ndarray:
         """The end rows (if ``ends``) and the rows of ``extra`` ((n − 2)·d, k) on ``w``,
-        shape (2 + k or k, n_nodes, d, n_w) (:func:`end_influence`). [N/N]"""
+        shape (2 + k or k, n_nodes, d, n_w) (:func:`end_influence`); ``kept``: the
+        factors holding ``w`` and its indices there, if known (:meth:`_kept`). [N/N]"""
         w = np.asarray(w, dtype=float)
         out = self._output(w, extra, ends)
         nf = (self.n - 2) * self.d
         if compiled_band_lu(max(self.entries, w.size * nf * out.shape[0])):
-            kept = self._kept(w)
+            kept = self._kept(w) if kept is None else kept
             if kept is None:
                 model = self.system.model
                 lo = 2 * self.d - 1
@@ -177,9 +181,26 @@ class LineAdjoint:
         """The rows of ``extra`` on ``w`` by substitution in factors kept, shape (k,
         n_nodes, d, n_w); None where none hold ``w`` (no factorization here). [N/N]"""
         w = np.asarray(w, dtype=float)
-        if self._kept(w) is None:
+        kept = self._kept(w)
+        return None if kept is None else self.rows(w, extra, ends=False, kept=kept)
+
+    def kept_transfer(
+        self, w: np.ndarray, extra: np.ndarray, unit: np.ndarray
+    ) -> np.ndarray | None:
+        """The rows of ``extra`` on ``w`` per unit load case ``unit`` (n_nodes, d,
+        n_load) (real node forces), shape (k, n_load, n_w), by substitution in factors
+        kept, the rows contracted with the loads' nonzero entries as they are solved
+        (never formed: as :func:`~.along_line_3d.sparse_transfer` of :meth:`kept_rows`,
+        to round-off); None where none hold ``w``. [unit/unit]"""
+        w = np.asarray(w, dtype=float)
+        kept = self._kept(w)
+        if kept is None or not compiled_band_lu(self.entries):
             return None
-        return self.rows(w, extra, ends=False)
+        d = self.d
+        free = np.asarray(unit).reshape(self.n * d, -1)[d:-d]  # (the end nodes' rows: 0)
+        out = np.empty((extra.shape[1], free.shape[1], w.size), dtype=complex)
+        terms = self._terms(extra, ends=False)
+        return kept[0].solve_into(terms, out, kept[1], loads=sparse.csr_matrix(free.T))
 
 
 def end_influence(

@@ -151,6 +151,22 @@ class EndInfluence:
                 self._kept_c.setdefault(key, []).append((w.copy(), g))
         return g
 
+    def extra_transfer(
+        self, w: np.ndarray, unit: np.ndarray, cols: slice = slice(None)
+    ) -> np.ndarray | None:
+        """The ``extra`` rows ``cols`` on ``w`` per unit load case ``unit`` (n_nodes, d,
+        n_load), shape (k, n_load, n_w), where the banded path's kept factors hold ``w``
+        and the rows are not formed yet: contracted with the loads as they are solved
+        (:meth:`~.band_influence.LineAdjoint.kept_transfer`; the deep wire's node rows:
+        1.6 MB never written nor transposed); None otherwise (the caller's product of
+        :meth:`extra_kept`'s rows). [unit/unit]"""
+        w = np.asarray(w, dtype=float)
+        if self._modal or self._adjoint is None or self._find(self._kept_x, w) is not None:
+            return None
+        if self._find(self._kept_c.get((cols.start, cols.stop), []), w) is not None:
+            return None
+        return self._adjoint.kept_transfer(w, self.extra[:, cols], unit)
+
 
 class SharedRows:
     """Rows ``cols`` of a shared :class:`EndInfluence`'s ``extra`` rows as an
