@@ -128,6 +128,8 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
                     xi[p, c] = t
             for q in range(1, min(kl, n - 1 - j) + 1):
                 lr, li = a_re[j, kv + q], a_im[j, kv + q]
+                if lr == 0.0 and li == 0.0:  # (outside the blocks, or no fill-in)
+                    continue
                 for c in range(r):
                     yr, yi = xr[j, c], xi[j, c]
                     xr[j + q, c] -= lr * yr - li * yi
@@ -140,6 +142,8 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
                 xi[i, c] = yr * ii + yi * ir
             for q in range(1, min(kv, i) + 1):
                 ur, ui = a_re[i, kv - q], a_im[i, kv - q]
+                if ur == 0.0 and ui == 0.0:
+                    continue
                 for c in range(r):
                     yr, yi = xr[i, c], xi[i, c]
                     xr[i - q, c] -= ur * yr - ui * yi
