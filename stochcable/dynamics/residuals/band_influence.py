@@ -83,14 +83,21 @@ class LineAdjoint:
         self.b_c = b_c
         self.entries = entries
         self._coupling: np.ndarray | None = None
+        self._e_hat: tuple[np.ndarray, np.ndarray] | None = None
         self._factors: list[BandFactors] = []
+
+    @property
+    def e_hat(self) -> tuple[np.ndarray, np.ndarray]:
+        """ê of each end (:func:`end_directions`), computed once."""
+        if self._e_hat is None:
+            self._e_hat = end_directions(self.system)
+        return self._e_hat
 
     def coupling(self) -> np.ndarray:
         """The end rows' right-hand sides (:func:`end_coupling`), (3, n_f·d, 2)."""
         if self._coupling is None:
             c = add_blocks(self.prep.S, self.cd)
-            e_hat = end_directions(self.system)
-            self._coupling = end_coupling(self.system, self.prep, c, e_hat, self.lift_t)
+            self._coupling = end_coupling(self.system, self.prep, c, self.e_hat, self.lift_t)
         return self._coupling
 
     def _rhs(self, ws: np.ndarray, extra: np.ndarray | None, ends: bool) -> np.ndarray:
@@ -120,7 +127,7 @@ class LineAdjoint:
         out[:, 0] = 0.0
         out[:, -1] = 0.0
         if ends:
-            e_a, e_b = end_directions(self.system)
+            e_a, e_b = self.e_hat
             out[0, 0] = e_a[:, None]
             out[1, -1] = e_b[:, None]
         return out
