@@ -103,6 +103,17 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
     r = terms.shape[2] // 2
     xr = np.empty((n, r))
     xi = np.empty((n, r))
+    t0r = np.empty((n, r))  # (T₀ apart, once; the columns with ω terms listed)
+    t0i = np.empty((n, r))
+    dyn = np.zeros(r, dtype=np.bool_)
+    for i in range(n):
+        for c in range(r):
+            t0r[i, c] = terms[0, i, 2 * c]
+            t0i[i, c] = terms[0, i, 2 * c + 1]
+            for h in range(2 * c, 2 * c + 2):
+                if terms[1, i, h] != 0.0 or terms[2, i, h] != 0.0:
+                    dyn[c] = True
+    cols = np.flatnonzero(dyn)
     for m in range(at.size):
         k = at[m]
         wk = w[k]
@@ -111,11 +122,14 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
         a_im = lu[k, 1]
         for i in range(n):
             for c in range(r):
-                t0r, t0i = terms[0, i, 2 * c], terms[0, i, 2 * c + 1]
+                xr[i, c] = t0r[i, c]
+                xi[i, c] = t0i[i, c]
+        for c in cols:
+            for i in range(n):
                 t1r, t1i = terms[1, i, 2 * c], terms[1, i, 2 * c + 1]
                 t2r, t2i = terms[2, i, 2 * c], terms[2, i, 2 * c + 1]
-                xr[i, c] = (t0r - w2 * t1r) - wk * t2i
-                xi[i, c] = (t0i - w2 * t1i) + wk * t2r
+                xr[i, c] = (t0r[i, c] - w2 * t1r) - wk * t2i
+                xi[i, c] = (t0i[i, c] - w2 * t1i) + wk * t2r
         for j in range(n - 1):  # L y = P b
             p = piv[k, j]
             if p != j:
