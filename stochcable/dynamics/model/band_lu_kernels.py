@@ -101,10 +101,13 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
     n = lu.shape[2]
     kv = lu.shape[3] - 1 - kl
     r = terms.shape[2] // 2
-    xr = np.empty((n, r))
-    xi = np.empty((n, r))
-    t0r = np.empty((n, r))  # (T₀ apart, once; the columns with ω terms listed)
-    t0i = np.empty((n, r))
+    # the scratch rows padded to whole runs of 4 (no remainder loop: 14 rows 0.77 → 0.68
+    # ms on 189 lines, 7 rows 0.63 → 0.50; 2 rows not: twice the work)
+    rp = r if r < 4 else ((r + 3) // 4) * 4
+    xr = np.empty((n, rp))
+    xi = np.empty((n, rp))
+    t0r = np.zeros((n, rp))  # (T₀ apart, once; the columns with ω terms listed)
+    t0i = np.zeros((n, rp))
     dyn = np.zeros(r, dtype=np.bool_)
     for i in range(n):
         for c in range(r):
@@ -121,7 +124,7 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
         a_re = lu[k, 0]
         a_im = lu[k, 1]
         for i in range(n):
-            for c in range(r):
+            for c in range(rp):
                 xr[i, c] = t0r[i, c]
                 xi[i, c] = t0i[i, c]
         for c in cols:
@@ -133,7 +136,7 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
         for j in range(n - 1):  # L y = P b
             p = piv[k, j]
             if p != j:
-                for c in range(r):
+                for c in range(rp):
                     t = xr[j, c]
                     xr[j, c] = xr[p, c]
                     xr[p, c] = t
@@ -144,13 +147,13 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
                 lr, li = a_re[j, kv + q], a_im[j, kv + q]
                 if lr == 0.0 and li == 0.0:  # (outside the blocks, or no fill-in)
                     continue
-                for c in range(r):
+                for c in range(rp):
                     yr, yi = xr[j, c], xi[j, c]
                     xr[j + q, c] -= lr * yr - li * yi
                     xi[j + q, c] -= lr * yi + li * yr
         for i in range(n - 1, -1, -1):  # U x = y
             ir, ii = inv[k, 0, i], inv[k, 1, i]
-            for c in range(r):
+            for c in range(rp):
                 yr, yi = xr[i, c], xi[i, c]
                 xr[i, c] = yr * ir - yi * ii
                 xi[i, c] = yr * ii + yi * ir
@@ -158,7 +161,7 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
                 ur, ui = a_re[i, kv - q], a_im[i, kv - q]
                 if ur == 0.0 and ui == 0.0:
                     continue
-                for c in range(r):
+                for c in range(rp):
                     yr, yi = xr[i, c], xi[i, c]
                     xr[i - q, c] -= ur * yr - ui * yi
                     xi[i - q, c] -= ur * yi + ui * yr
