@@ -108,6 +108,8 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
     xi = np.empty((n, rp))
     t0r = np.zeros((n, rp))  # (T₀ apart, once; the columns with ω terms listed)
     t0i = np.zeros((n, rp))
+    sum_r = np.empty(rp)  # (a load's sums over its entries, with loads)
+    sum_i = np.empty(rp)
     dyn = np.zeros(r, dtype=np.bool_)
     for i in range(n):
         for c in range(r):
@@ -166,15 +168,18 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
                     xr[i - q, c] -= ur * yr - ui * yi
                     xi[i - q, c] -= ur * yi + ui * yr
         if indptr.size:
-            for c in range(r):
-                for load in range(indptr.size - 1):
-                    sr = 0.0
-                    si = 0.0
-                    for p in range(indptr[load], indptr[load + 1]):
-                        sr += data[p] * xr[indices[p], c]
-                        si += data[p] * xi[indices[p], c]
-                    out[c, load, 2 * m] = sr
-                    out[c, load, 2 * m + 1] = si
+            for load in range(indptr.size - 1):
+                for c in range(rp):
+                    sum_r[c] = 0.0
+                    sum_i[c] = 0.0
+                for p in range(indptr[load], indptr[load + 1]):
+                    v, i = data[p], indices[p]
+                    for c in range(rp):
+                        sum_r[c] += v * xr[i, c]
+                        sum_i[c] += v * xi[i, c]
+                for c in range(r):
+                    out[c, load, 2 * m] = sum_r[c]
+                    out[c, load, 2 * m + 1] = sum_i[c]
             continue
         for i in range(n):
             for c in range(r):

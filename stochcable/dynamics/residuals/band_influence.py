@@ -13,7 +13,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy import sparse
 
 from stochcable.dynamics.model.band_lu import BandFactors, band_factors, compiled_band_lu
 from stochcable.dynamics.model.blocks import add_blocks, free_band, line_prep
@@ -207,7 +206,7 @@ class LineAdjoint:
         free = np.asarray(unit).reshape(self.n * d, -1)[d:-d]  # (the end nodes' rows: 0)
         out = np.empty((extra.shape[1], free.shape[1], w.size), dtype=complex)
         terms = self._terms(extra, ends=False)
-        return kept[0].solve_into(terms, out, kept[1], loads=sparse.csr_matrix(free.T))
+        return kept[0].solve_into(terms, out, kept[1], loads=free.T)
 
 
 def end_influence(
