@@ -104,3 +104,16 @@ def test_kept_transfer_is_the_rows_times_the_loads(deep):
     np.testing.assert_allclose(got, ref, rtol=0, atol=1e-14 * np.abs(ref).max())
     assert shared.extra_transfer(sub, unit, slice(7, 21)) is None  # (rows formed now)
     assert shared.extra_transfer(np.array([0.0301]), unit, slice(0, 7)) is None
+
+
+def test_long_line_factored_in_stacks(deep, monkeypatch):
+    """Factors beyond KEPT_FACTOR_BYTES (a long line solved directly) are made and used
+    stack by stack, not kept: the same rows (bitwise: the same kernels per frequency),
+    and no substitution from kept factors afterwards."""
+    system, damping, extra = deep
+    w = np.linspace(0.02, 6.0, 50)
+    ref = bi.LineAdjoint(system, damping, entries=2**20).rows(w, extra)
+    monkeypatch.setattr(bi, "KEPT_FACTOR_BYTES", 7 * 16 * 38 * 10)  # (7 frequencies)
+    adj = bi.LineAdjoint(system, damping, entries=2**20)
+    np.testing.assert_array_equal(adj.rows(w, extra), ref)
+    assert adj.kept_rows(w, extra) is None

@@ -24,6 +24,7 @@ from stochcable.dynamics.solve.line_solve import end_tension_from_support
 
 __all__ = [
     "BAND_STACK_BYTES",
+    "KEPT_FACTOR_BYTES",
     "LineAdjoint",
     "adjoint_rows",
     "band_stack",
@@ -38,6 +39,13 @@ __all__ = [
 #: 2 + 23 rows on 189 lines: 5.9 ms in stacks of 16–32, 11 ms in stacks of 128; its 2
 #: end rows alone: 1.6 ms in stacks of 64–128, 1.8 in 16). [bytes]
 BAND_STACK_BYTES = 640 * 2**10
+
+
+#: Memory of the LU factors :class:`LineAdjoint` keeps per frequency grid (the deep
+#: wire's 189 lines: 1.2 MB); a grid whose factors need more (a long line solved
+#: directly) is factored and solved in stacks within it, nothing kept (its other rows
+#: then each solved on their own). [bytes]
+KEPT_FACTOR_BYTES = 32 * 2**20
 
 
 def band_stack(n_dof: int, d: int, r: int) -> int:
@@ -154,14 +162,18 @@ class LineAdjoint:
         nf = (self.n - 2) * self.d
         if compiled_band_lu(max(self.entries, w.size * nf * out.shape[0])):
             kept = self._kept(w) if kept is None else kept
+            step = max(1, KEPT_FACTOR_BYTES // (16 * nf * (3 * (2 * self.d - 1) + 1)))
+            if kept is None and w.size > step:  # (a long line: in stacks, nothing kept)
+                for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
+                    x = self._factor(w[sl]).solve_into(
+                        self._terms(extra, ends),
+                        np.empty((out.shape[0], nf, sl.stop - sl.start), dtype=complex),
+                    )
+                    out[:, 1:-1, :, sl] = x.reshape(out.shape[0], self.n - 2, self.d, -1)
+                return out
             if kept is None:
-                model = self.system.model
-                lo = 2 * self.d - 1
-                fac = band_factors(
-                    self.prep.bK, self.prep.bM, self.b_c, w, lo, lo, (model.K, model.M)
-                )
-                self._factors.append(fac)
-                kept = (fac, None)
+                kept = (self._factor(w), None)
+                self._factors.append(kept[0])
             flat = out.reshape(out.shape[0], self.n * self.d, w.size)  # (a view)
             kept[0].solve_into(self._terms(extra, ends), flat, kept[1], offset=self.d)
             return out
@@ -174,6 +186,12 @@ class LineAdjoint:
             )  # fmt: skip
             self._rows(x, sl, out)
         return out
+
+    def _factor(self, w: np.ndarray) -> BandFactors:
+        """Aᵀ factored on ``w`` by the compiled LU."""
+        lo = 2 * self.d - 1
+        mats = (self.system.model.K, self.system.model.M)
+        return band_factors(self.prep.bK, self.prep.bM, self.b_c, w, lo, lo, mats)
 
     def _kept(self, w: np.ndarray) -> tuple[BandFactors, np.ndarray] | None:
         """The kept factors holding every frequency of ``w`` and their indices there."""
