@@ -46,7 +46,7 @@ from stochcable.dynamics.residuals.along_line import (
 from stochcable.dynamics.residuals.along_line_3d import sparse_transfer, vector_parts
 from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
-from stochcable.dynamics.residuals.influence import adjoint_rows
+from stochcable.dynamics.residuals.influence import ModalRows, adjoint_rows
 from stochcable.errors import PhysicsWarning, warn
 
 __all__ = [
@@ -106,11 +106,9 @@ def node_influence(system: Any, damping: Any, w: np.ndarray, nodes: np.ndarray) 
     By the adjoint (module notes): :func:`~.band_influence.adjoint_rows` of
     :func:`node_rows` (an end node's rows, zero, not solved)."""
     model = system.model
-    d = model.dim
-    nodes = np.asarray(nodes, dtype=int)
     rhs = node_rows(model, nodes)
     live = np.flatnonzero(np.any(rhs != 0, axis=0))
-    out = np.zeros((rhs.shape[1], model.n_nodes, d, np.size(w)), dtype=complex)
+    out = np.zeros((rhs.shape[1], model.n_nodes, model.dim, np.size(w)), dtype=complex)
     out[live] = adjoint_rows(system, damping, rhs[:, live], w)
     return out
 
@@ -157,8 +155,10 @@ def node_transfer(influence: Any, w: np.ndarray, unit: np.ndarray) -> np.ndarray
     are solved (:meth:`~.influence.EndInfluence.extra_transfer`). [m/unit]"""
     rows = getattr(influence, "rows", None)
     fused = getattr(getattr(rows, "shared", None), "extra_transfer", None)
-    h = None if fused is None else fused(w, unit, rows.cols)
-    return sparse_transfer(influence.on(w), unit) if h is None else h
+    if (h := None if fused is None else fused(w, unit, rows.cols)) is not None:
+        return h
+    g = influence.on(w)  # (the modal rows: the loads projected on the modes)
+    return g.transfer(unit) if isinstance(g, ModalRows) else sparse_transfer(g, unit)
 
 
 @dataclass(frozen=True)

@@ -212,7 +212,7 @@ def modal_influence(
     (Tuah 1982, §5.3), the transfer the linear response itself is solved with, its
     basis widened to every computed mode up to :data:`MODAL_SPAN` times the highest
     frequency (:func:`_influence_modes`).  Every right-hand side is a fixed vector or,
-    for the end rows, g_K − ω²g_M + iωg_C (:func:`_end_coupling`), so each is projected
+    for the end rows, g_K − ω²g_M + iωg_C (:func:`end_coupling`), so each is projected
     once and the frequencies enter through the modal denominators only: no
     factorization per frequency (the chain's 2 + 7 rows on 189 lines: 2.3 against
     6.9 ms).  Frequencies above the highest computed mode over :data:`MODAL_SPAN`
