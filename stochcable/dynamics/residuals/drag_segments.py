@@ -129,9 +129,10 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
     """
     mesh = system.model.mesh
     n_el = system.model.n_elements
-    parts = np.ones(n_el, dtype=int)
+    want = np.ones(n_el)
     kin = _kinematic_channels(channels)
     ends_el = np.full((n_el, 2), np.nan)
+    high_first = np.ones(n_el, dtype=bool)
     if kin:
         ends = np.zeros((n_el, 2))
         for ch in kin:
@@ -145,75 +146,121 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
         live = (hi > 0) & (weight >= WEIGHT_FLOOR * weight.max(initial=0.0))
         with np.errstate(divide="ignore"):
             ratio = np.where(lo > 0, hi / np.where(lo > 0, lo, 1.0), np.inf)
-        want = np.ceil(np.log(np.minimum(ratio, 1e300)) / math.log(SUB_RATIO))
-        parts = np.where(live, np.clip(want, 1, MAX_SUB), 1).astype(int)
+        want = np.log(np.minimum(ratio, 1e300)) / math.log(SUB_RATIO)
+        want = np.where(live, np.clip(want, 1.0, MAX_SUB), 1.0)
         ends_el[live] = ends[live]
-        budget = max_panels // 2
-        while parts[parts > 1].sum() > budget:
-            parts[int(np.argmax(parts))] -= 1
-    element = np.repeat(np.arange(n_el), parts)
-    k = np.concatenate([np.arange(p) for p in parts])
-    m = parts[element].astype(float)
+        high_first = ends[:, 0] >= ends[:, 1]
+        want = _capped(want, weight, max_panels // 2)
+    return _pieces(mesh.l0, want, high_first, ends_el)
+
+
+#: Pieces that move continuously with the sea (:func:`_pieces`); False: ⌈want⌉ equal
+#: pieces (the evaluation before issue 31's load-case sets; the chain's fairlead drag
+#: residual variance moves by 3.6e-4 between them). [-]
+CONTINUOUS_PIECES = True
+#: Shortest piece kept, as a fraction of its element (a shorter remainder joins its
+#: neighbour: a step of that order in the residual). [-]
+MIN_PIECE = 1e-6
+
+
+def _capped(want: np.ndarray, weight: np.ndarray, budget: int) -> np.ndarray:
+    """The pieces wanted per element, capped so that the split elements' pieces,
+    ⌈want⌉ each, fit in ``budget``: the largest cap that fits (the largest wants
+    reduced first; it moves continuously with them, an order statistic), and where
+    even two pieces each do not fit, only the ``budget // 2`` heaviest split."""
+    split = want > 1.0
+    if np.ceil(want[split]).sum() <= budget:
+        return want
+    if 2 * int(split.sum()) > budget:
+        keep = np.flatnonzero(split)[np.argsort(-weight[split], kind="stable")[: budget // 2]]
+        want = np.where(np.isin(np.arange(want.size), keep), want, 1.0)
+        split = want > 1.0
+    lo, hi = 1.0, float(want.max())
+    for _ in range(60):  # (bisection on the cap: Σ ⌈min(want, cap)⌉ falls with it)
+        mid = 0.5 * (lo + hi)
+        if np.ceil(np.minimum(want[split], mid) - 1e-12).sum() <= budget:
+            lo = mid
+        else:
+            hi = mid
+    return np.where(split, np.minimum(want, lo), want)
+
+
+def _pieces(l0: np.ndarray, want: np.ndarray, high_first: np.ndarray, ends_el: np.ndarray):
+    """The pieces of every element: ⌈want⌉ of them, all but the last 1/want of the
+    element long from its high-variance end, the last the rest (so that they move
+    continuously with ``want``: a new piece appears at zero length)."""
+    lo_l, hi_l, el = [], [], []
+    for e, w in enumerate(want.tolist()):
+        if w <= 1.0:
+            edges = [0.0, 1.0]
+        else:
+            step = w if CONTINUOUS_PIECES else math.ceil(w)
+            cuts = list(np.arange(1, math.ceil(w)) / step)
+            if 1.0 - cuts[-1] < MIN_PIECE:
+                cuts = cuts[:-1]
+            edges = (
+                [0.0, *cuts, 1.0] if high_first[e] else [0.0, *(1.0 - c for c in cuts[::-1]), 1.0]
+            )
+        lo_l.extend(edges[:-1])
+        hi_l.extend(edges[1:])
+        el.extend([e] * (len(edges) - 1))
+    element = np.array(el, dtype=int)
+    lo, hi = np.array(lo_l), np.array(hi_l)
+    parts = np.bincount(element, minlength=l0.size)
     return Segments(
         element=element,
-        lo=k / m,
-        hi=(k + 1) / m,
-        length=mesh.l0[element] / m,
+        lo=lo,
+        hi=hi,
+        length=l0[element] * (hi - lo),
         fine=parts[element] > 1,
         ends=ends_el[element],
     )
 
 
-#: Variance ratios a group of whole elements may span, tried in turn (the finest whose
-#: panels fit in the budget wins): the reason to split an element holds for a group. [-]
-GROUP_RATIOS = (1.05, 1.1, 1.25, 1.5, 2.0, 4.0, 16.0, math.inf)
+#: Largest ratio of the wave-velocity variance a group of whole elements may span: an
+#: element that varies more is split (:data:`SUB_RATIO`), two neighbours that do not
+#: (each ≤ SUB_RATIO) span at most its square and stay one group. [-]
+GROUP_RATIO = SUB_RATIO
 
 
 def panel_groups(seg: Segments, max_panels: int) -> list[np.ndarray]:
-    """Pieces grouped into panels: every split element's pieces alone; the runs of
-    whole elements between them in consecutive groups, closed where the group's
-    wave-velocity variance would vary by more than a ratio of :data:`GROUP_RATIOS` (the
-    finest that fits in ``max_panels``) or where it reaches a length (the least that
-    fits; ⌈n/max_panels⌉ for a line without wave kinematics, as equal groups)."""
-    runs: list[np.ndarray] = []
-    start = None
-    for i in range(seg.size + 1):
-        coarse = i < seg.size and not seg.fine[i]
-        if coarse and start is None:
-            start = i
-        elif not coarse and start is not None:
-            runs.append(np.arange(start, i))
-            start = None
-    n_fine = int(seg.fine.sum())
-    n_coarse = seg.size - n_fine
-    room = max(1, max_panels - n_fine - (len(runs) - 1 if runs else 0))
-    ends = np.full((seg.size, 2), np.nan) if seg.ends is None else seg.ends
-    fine = [np.array([i]) for i in np.flatnonzero(seg.fine)]
-    budget = max_panels - n_fine
-    size = max(1, math.ceil(n_coarse / room))
-    for ratio in GROUP_RATIOS:
-        if ratio < math.inf and len(_grouped_all(runs, max(n_coarse, 1), ends, ratio)) > budget:
-            continue  # the ratio alone needs more panels than there are
-        lo, hi = size, max(size, n_coarse)  # the count falls as the length grows: bisect
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if len(_grouped_all(runs, mid, ends, ratio)) <= budget:
-                hi = mid
-            else:
-                lo = mid + 1
-        return sorted(fine + _grouped_all(runs, lo, ends, ratio), key=lambda g: int(g[0]))
-    raise AssertionError("unreachable: GROUP_RATIOS ends with inf")
-
-
-def _grouped_all(runs: list[np.ndarray], size: int, ends: np.ndarray, ratio: float) -> list:
-    """The groups of every run (:func:`_grouped`)."""
-    span = _spans(ends)
-    return [g for run in runs for g in _grouped(run, size, span, ratio)]
+    """Pieces grouped into panels: every split element's pieces alone; the whole
+    elements in fixed tiles of ⌈n_el / max_panels⌉ consecutive elements from the first
+    (set by the mesh, not by the sea: the grouping, and with it the residual, does not
+    step as the sea changes; a tile is cut where a split element interrupts it or where
+    its wave-velocity variance would span more than :data:`GROUP_RATIO`).  Panels:
+    at most ``max_panels`` tiles plus the split elements' pieces (at most half of
+    ``max_panels``, :func:`segments`) and the cuts."""
+    n_el = int(seg.element[-1]) + 1 if seg.size else 0
+    size = max(1, math.ceil(n_el / max_panels))
+    span = _spans(np.full((seg.size, 2), np.nan) if seg.ends is None else seg.ends)
+    out: list[np.ndarray] = []
+    cur: list[int] = []
+    tile, lo, hi = -1, math.inf, 0.0
+    for i in range(seg.size):
+        if seg.fine[i]:
+            if cur:
+                out.append(np.array(cur))
+            out.append(np.array([i]))
+            cur, lo, hi = [], math.inf, 0.0
+            continue
+        t = int(seg.element[i]) // size
+        v = span[i]
+        lo_i, hi_i = (min(lo, v[0]), max(hi, v[1])) if v is not None else (lo, hi)
+        if cur and (t != tile or (hi_i > 0 and hi_i > GROUP_RATIO * lo_i)):
+            out.append(np.array(cur))
+            cur = []
+            lo_i, hi_i = v if v is not None else (math.inf, 0.0)
+        cur.append(i)
+        tile, lo, hi = t, lo_i, hi_i
+    if cur:
+        out.append(np.array(cur))
+    return out
 
 
 def _spans(ends: np.ndarray) -> list[tuple[float, float] | None]:
     """Each piece's (least, largest) finite end variance, None where none is finite
-    (plain floats: :func:`_grouped` walks them one by one)."""
+    (plain floats: :func:`panel_groups` walks them one by one)."""
     finite = np.isfinite(ends)
     lo = np.where(finite, ends, np.inf).min(axis=1)
     hi = np.where(finite, ends, -np.inf).max(axis=1)
@@ -221,27 +268,6 @@ def _spans(ends: np.ndarray) -> list[tuple[float, float] | None]:
         (float(a), float(b)) if any_ else None
         for a, b, any_ in zip(lo, hi, finite.any(axis=1), strict=True)
     ]
-
-
-def _grouped(
-    run: np.ndarray, size: int, span: list[tuple[float, float] | None], ratio: float
-) -> list[np.ndarray]:
-    """Consecutive groups of ``run`` of at most ``size``, closed where the variance
-    ``span`` of the pieces (:func:`_spans`; None: no matter) would span more than
-    ``ratio``."""
-    out, cur, lo, hi = [], [], math.inf, 0.0
-    for i in run.tolist():
-        v = span[i]
-        lo_i, hi_i = (min(lo, v[0]), max(hi, v[1])) if v is not None else (lo, hi)
-        if cur and (len(cur) == size or (hi_i > 0 and hi_i > ratio * lo_i)):
-            out.append(np.array(cur))
-            cur, lo, hi = [], math.inf, 0.0
-            lo_i, hi_i = v if v is not None else (lo, hi)
-        cur.append(i)
-        lo, hi = lo_i, hi_i
-    if cur:
-        out.append(np.array(cur))
-    return out
 
 
 def segment_velocity(
