@@ -165,9 +165,10 @@ MIN_PIECE = 1e-6
 
 def _capped(want: np.ndarray, weight: np.ndarray, budget: int) -> np.ndarray:
     """The pieces wanted per element, capped so that the split elements' pieces,
-    ⌈want⌉ each, fit in ``budget``: the largest cap that fits (the largest wants
-    reduced first; it moves continuously with them, an order statistic), and where
-    even two pieces each do not fit, only the ``budget // 2`` heaviest split."""
+    ⌈want⌉ each, fit in ``budget``: at the largest whole number of pieces that fits
+    (the largest wants reduced first), and where even two pieces each do not fit,
+    only the ``budget // 2`` heaviest split.  (A real cap, Σ min(want, c) = budget,
+    moves continuously but its ⌈·⌉ passes the budget: the chain's panels 34 → 37.)"""
     split = want > 1.0
     if np.ceil(want[split]).sum() <= budget:
         return want
@@ -175,14 +176,8 @@ def _capped(want: np.ndarray, weight: np.ndarray, budget: int) -> np.ndarray:
         keep = np.flatnonzero(split)[np.argsort(-weight[split], kind="stable")[: budget // 2]]
         want = np.where(np.isin(np.arange(want.size), keep), want, 1.0)
         split = want > 1.0
-    lo, hi = 1.0, float(want.max())
-    for _ in range(60):  # (bisection on the cap: Σ ⌈min(want, cap)⌉ falls with it)
-        mid = 0.5 * (lo + hi)
-        if np.ceil(np.minimum(want[split], mid) - 1e-12).sum() <= budget:
-            lo = mid
-        else:
-            hi = mid
-    return np.where(split, np.minimum(want, lo), want)
+    fits = [n for n in range(2, MAX_SUB + 1) if np.ceil(np.minimum(want[split], n)).sum() <= budget]
+    return np.where(split, np.minimum(want, max(fits, default=2)), want)
 
 
 def _pieces(l0: np.ndarray, want: np.ndarray, high_first: np.ndarray, ends_el: np.ndarray):
