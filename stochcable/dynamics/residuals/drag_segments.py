@@ -21,12 +21,9 @@ subdivided static shape).  Whole elements are grouped into panels (the cost of t
 residual grows with their square) in fixed tiles of the mesh, cut where the variance
 is not nearly uniform over them (:func:`panel_groups`): on a fine mesh, groups of
 elements near the surface would bring the even split back (the guy on 160 elements in
-groups of three: +38 % again).  Neither the tiles nor the pieces step with the sea
-(a new piece appears at zero length), so the residual is smooth in Hs and Tp where
-no element starts to split: what lets a load-case set interpolate it
-(:mod:`stochcable.cases.residual_anchors`; the chain's σ correction over Tp 6–16 s
-steps by ≤ 4e-4 between periods 0.5 s apart, 2.4e-3 with the groups chosen by the
-sea's variance before).
+groups of three: +38 % again).  Neither step with the sea, so a load-case set can
+interpolate the residual (the chain's σ correction steps ≤ 4e-4 between periods 0.5 s
+apart, 2.4e-3 with groups chosen by the sea before; docs/benchmarks/cases.md).
 """
 
 from __future__ import annotations
@@ -161,8 +158,7 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
 
 
 #: Pieces that move continuously with the sea (:func:`_pieces`); False: ⌈want⌉ equal
-#: pieces (the evaluation before issue 31's load-case sets; the chain's fairlead drag
-#: residual variance moves by 3.6e-4 between them). [-]
+#: ones, as before (the chain's fairlead drag residual variance −3.6e-4). [-]
 CONTINUOUS_PIECES = True
 #: Shortest piece kept, as a fraction of its element (a shorter remainder joins its
 #: neighbour: a step of that order in the residual). [-]
@@ -170,11 +166,9 @@ MIN_PIECE = 1e-6
 
 
 def _capped(want: np.ndarray, weight: np.ndarray, budget: int) -> np.ndarray:
-    """The pieces wanted per element, capped so that the split elements' pieces,
-    ⌈want⌉ each, fit in ``budget``: at the largest whole number of pieces that fits
-    (the largest wants reduced first), and where even two pieces each do not fit,
-    only the ``budget // 2`` heaviest split.  (A real cap, Σ min(want, c) = budget,
-    moves continuously but its ⌈·⌉ passes the budget: the chain's panels 34 → 37.)"""
+    """The wants capped at the largest whole number of pieces whose ⌈want⌉ fit in
+    ``budget``; at most the ``budget // 2`` heaviest split.  (A real cap, Σ min(want,
+    c) = budget, is continuous but passes the budget: the chain's panels 34 → 37.)"""
     split = want > 1.0
     if np.ceil(want[split]).sum() <= budget:
         return want
@@ -190,23 +184,16 @@ def _pieces(l0: np.ndarray, want: np.ndarray, high_first: np.ndarray, ends_el: n
     """The pieces of every element: ⌈want⌉ of them, all but the last 1/want of the
     element long from its high-variance end, the last the rest (so that they move
     continuously with ``want``: a new piece appears at zero length)."""
-    lo_l, hi_l, el = [], [], []
-    for e, w in enumerate(want.tolist()):
-        if w <= 1.0:
-            edges = [0.0, 1.0]
-        else:
-            step = w if CONTINUOUS_PIECES else math.ceil(w)
-            cuts = list(np.arange(1, math.ceil(w)) / step)
-            if 1.0 - cuts[-1] < MIN_PIECE:
-                cuts = cuts[:-1]
-            edges = (
-                [0.0, *cuts, 1.0] if high_first[e] else [0.0, *(1.0 - c for c in cuts[::-1]), 1.0]
-            )
-        lo_l.extend(edges[:-1])
-        hi_l.extend(edges[1:])
-        el.extend([e] * (len(edges) - 1))
-    element = np.array(el, dtype=int)
-    lo, hi = np.array(lo_l), np.array(hi_l)
+    w = np.where(want > 1.0, want, 1.0)
+    n = np.ceil(w).astype(int)
+    step = w if CONTINUOUS_PIECES else n.astype(float)
+    n = np.where(1.0 - (n - 1) / step < MIN_PIECE, n - 1, n)  # (too short a rest joins)
+    element = np.repeat(np.arange(w.size), n)
+    j = np.arange(element.size) - np.repeat(np.cumsum(n) - n, n)  # (along ξ)
+    m, st, first = n[element], step[element], high_first[element]
+    k = np.where(first, j, m - 1 - j)  # (from the high-variance end)
+    a, b = k / st, np.where(k == m - 1, 1.0, (k + 1) / st)
+    lo, hi = np.where(first, a, 1.0 - b), np.where(first, b, 1.0 - a)
     parts = np.bincount(element, minlength=l0.size)
     return Segments(
         element=element,
@@ -218,9 +205,8 @@ def _pieces(l0: np.ndarray, want: np.ndarray, high_first: np.ndarray, ends_el: n
     )
 
 
-#: Largest ratio of the wave-velocity variance a group of whole elements may span: an
-#: element that varies more is split (:data:`SUB_RATIO`), two neighbours that do not
-#: (each ≤ SUB_RATIO) span at most its square and stay one group. [-]
+#: Largest ratio of the wave-velocity variance a tile of whole elements may span, as an
+#: element (the guy on 160 elements: σ 1.024 × its 40 elements'; 1.043 at 2.25). [-]
 GROUP_RATIO = SUB_RATIO
 
 
