@@ -21,9 +21,8 @@ subdivided static shape).  Whole elements are grouped into panels (the cost of t
 residual grows with their square) in fixed tiles of the mesh, cut where the variance
 is not nearly uniform over them (:func:`panel_groups`): on a fine mesh, groups of
 elements near the surface would bring the even split back (the guy on 160 elements in
-groups of three: +38 % again).  Neither step with the sea, so a load-case set can
-interpolate the residual (the chain's σ correction steps ≤ 4e-4 between periods 0.5 s
-apart, 2.4e-3 with groups chosen by the sea before; docs/benchmarks/cases.md).
+groups of three: +38 % again).  Neither steps with the sea: a load-case set interpolates
+the residual (docs/benchmarks/cases.md).
 """
 
 from __future__ import annotations
@@ -123,8 +122,7 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
     drag_scale : ndarray, shape (n_el,)
         c per unit length of each element (normal plus axial, ½ρC_dD). [N·s²/m³]
     max_panels : int
-        The panel budget: split elements take at most half of it (the largest
-        splits are reduced first).
+        The panel budget: split elements take at most half of it (:func:`_capped`).
 
     Returns
     -------
@@ -160,8 +158,7 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
 #: Pieces that move continuously with the sea (:func:`_pieces`); False: ⌈want⌉ equal
 #: ones, as before (the chain's fairlead drag residual variance −3.6e-4). [-]
 CONTINUOUS_PIECES = True
-#: Shortest piece kept, as a fraction of its element (a shorter remainder joins its
-#: neighbour: a step of that order in the residual). [-]
+#: Shortest piece kept, as a fraction of its element (a shorter rest joins its neighbour). [-]
 MIN_PIECE = 1e-6
 
 
@@ -211,33 +208,24 @@ GROUP_RATIO = SUB_RATIO
 
 
 def panel_groups(seg: Segments, max_panels: int) -> list[np.ndarray]:
-    """Pieces grouped into panels: every split element's pieces alone; the whole
-    elements in fixed tiles of ⌈n_el / max_panels⌉ consecutive elements from the first
-    (set by the mesh, not by the sea: the grouping, and with it the residual, does not
-    step as the sea changes; a tile is cut where a split element interrupts it or where
-    its wave-velocity variance would span more than :data:`GROUP_RATIO`).  Panels:
-    at most ``max_panels`` tiles plus the split elements' pieces (at most half of
-    ``max_panels``, :func:`segments`) and the cuts."""
+    """Pieces grouped into panels: every split element's pieces alone, the whole
+    elements in fixed tiles of ⌈n_el / max_panels⌉ (the mesh's, not the sea's), cut
+    where a split element interrupts one or its wave-velocity variance would span more
+    than :data:`GROUP_RATIO`: ``max_panels`` tiles, the pieces (:func:`segments`)."""
     n_el = int(seg.element[-1]) + 1 if seg.size else 0
     size = max(1, math.ceil(n_el / max_panels))
     span = _spans(np.full((seg.size, 2), np.nan) if seg.ends is None else seg.ends)
     out: list[np.ndarray] = []
     cur: list[int] = []
-    tile, lo, hi = -1, math.inf, 0.0
+    tile, lo, hi = 0, math.inf, 0.0
     for i in range(seg.size):
-        if seg.fine[i]:
-            if cur:
-                out.append(np.array(cur))
-            out.append(np.array([i]))
-            cur, lo, hi = [], math.inf, 0.0
-            continue
-        t = int(seg.element[i]) // size
-        v = span[i]
-        lo_i, hi_i = (min(lo, v[0]), max(hi, v[1])) if v is not None else (lo, hi)
-        if cur and (t != tile or (hi_i > 0 and hi_i > GROUP_RATIO * lo_i)):
+        t = ~i if seg.fine[i] else int(seg.element[i]) // size  # (a piece: a tile alone)
+        v = span[i] if span[i] is not None else (lo, hi)
+        lo_i, hi_i = min(lo, v[0]), max(hi, v[1])
+        if cur and (t != tile or hi_i > max(GROUP_RATIO * lo_i, 0.0)):
             out.append(np.array(cur))
             cur = []
-            lo_i, hi_i = v if v is not None else (math.inf, 0.0)
+            lo_i, hi_i = span[i] if span[i] is not None else (math.inf, 0.0)
         cur.append(i)
         tile, lo, hi = t, lo_i, hi_i
     if cur:
@@ -246,8 +234,7 @@ def panel_groups(seg: Segments, max_panels: int) -> list[np.ndarray]:
 
 
 def _spans(ends: np.ndarray) -> list[tuple[float, float] | None]:
-    """Each piece's (least, largest) finite end variance, None where none is finite
-    (plain floats: :func:`panel_groups` walks them one by one)."""
+    """Each piece's (least, largest) finite end variance as floats (None: none finite)."""
     finite = np.isfinite(ends)
     lo = np.where(finite, ends, np.inf).min(axis=1)
     hi = np.where(finite, ends, -np.inf).max(axis=1)
