@@ -481,8 +481,10 @@ def sections(items: list[dict], seed: int = 31) -> list[str]:
         "motion stops at ω_max = 2 rad/s; the FD's corrected density carries the "
         "residuals' lines up to the support of their convolutions, 3·ω_max (the drag "
         "residual's third order; the geometric residual's second order reaches 2·ω_max); "
-        "the drag's fifth and higher orders (5·ω_max) and the seabed's impacts are not "
-        "in it.",
+        "the drag's higher orders are evaluated lumped into its second and third "
+        "(`stochcable.dynamics.residuals.drag_residual.LUMPED_ORDER`): their variance is "
+        "in it, on those orders' lines, but nothing above 3·ω_max is; nor are the "
+        "seabed's impacts.",
         "",
         "| line | end | source | "
         + " | ".join(

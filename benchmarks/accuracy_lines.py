@@ -575,6 +575,12 @@ def _first_clause(text: str) -> str:
     return (text[:cut] + " …") if cut > 0 else text
 
 
+def _basis(r: dict) -> str:
+    """What the plan's model-error estimate rests on (``model_error_basis``)."""
+    basis = r["plan"]["model_error_basis"]
+    return "residuals" if "computed residuals" in basis else "calibration"
+
+
 def _adaptive(cache: dict) -> list[str]:
     out = [
         "## Adaptive fidelity (target error 1 %)",
@@ -583,9 +589,13 @@ def _adaptive(cache: dict) -> list[str]:
         "'discretization, measured' is |FD adaptive / FD converged − 1| of the linear σ "
         "(320 elements, "
         f"{FINE_GRID} frequencies on the band, direct, tolerance 1e-8), the larger end; "
-        "'model' is the calibrated error of the linear model against the nonlinear time domain "
-        "(`stochcable.fidelity.model_error.CALIBRATION`), compared with the measured "
-        "FD/TD below.",
+        "'model' is the plan's estimate of the answer's own error against the nonlinear "
+        "time domain (`stochcable.fidelity.model_error`): with the residuals computed "
+        "(the switches true), what they leave — the square of their share of σ, plus "
+        "the one-sided bed's share on a line with a grounded length ('residuals'); "
+        "without them, the linear model's calibrated error "
+        "(`CALIBRATION`, 'calibration'); compare the measured FD adaptive / TD in the "
+        "ratio table.",
         "",
         "| line | settings chosen | est. discretization | discretization, measured "
         "| est. model | est. total | wall [s] |",
@@ -601,7 +611,7 @@ def _adaptive(cache: dict) -> list[str]:
             meas = f"{100 * err:.2f} %"
         out.append(
             f"| {line} | {_settings(fda)} | {100 * est['discretization']:.2f} % "
-            f"| {meas} | {100 * est['linearization_model']:.2f} % "
+            f"| {meas} | {100 * est['linearization_model']:.2f} % ({_basis(fda)}) "
             f"| {100 * est['total']:.2f} % | {fda['wall']:.2f} |"
         )
     out += [
@@ -697,7 +707,7 @@ def _budget_section(cache: dict, line: str) -> list[str]:
     out.append(
         f"| fidelity plan's model-error calibration (`{klass}`) | ±{100 * cal.fairlead:.2f} % "
         f"| ±{100 * cal.anchor:.2f} % | `CALIBRATION['{klass}']`, what `target_error` "
-        "plans assume for this line |"
+        "plans assume for this line with the residual switches false |"
     )
     return out + [""]
 
@@ -842,8 +852,9 @@ def write_page(cache: dict, records: Path | None = None) -> str:
         "own discretization at 80 elements; the terms multiply, (1 + a)(1 + b)(1 + c) − "
         "1, and add to first order.  The residuals (the default) recover the drag and "
         "geometric terms: compare the ratio table.  Next to them: the model error the "
-        "fidelity plan assumes for the line's class "
-        "(`stochcable/fidelity/model_error.py`).",
+        "fidelity plan assumes for the line's class when the residuals are not computed "
+        "(`stochcable/fidelity/model_error.py`; with them, the default, it estimates "
+        "what they leave instead: the adaptive table).",
         "",
     ]
     for line in BUDGET_LINES:

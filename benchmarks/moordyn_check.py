@@ -35,6 +35,7 @@ coupling calls every 5 ms, BA = 0 unless stated.
 from __future__ import annotations
 
 import argparse
+import fcntl
 import json
 import math
 import os
@@ -281,12 +282,16 @@ def run_missing(
             continue
         print(f"run {run_key(run)}", flush=True)
         result = (execute_run or execute)(run)
-        cache = load_cache(cache_path)  # another process may have added runs meanwhile
-        cache[run_key(run)] = result
         cache_path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = cache_path.with_name(f"{cache_path.name}.{os.getpid()}")
-        tmp.write_text(json.dumps(cache, indent=1))
-        os.replace(tmp, cache_path)  # atomic: a reader never sees half a file
+        # read-add-write under a lock: without it two processes finishing together each
+        # wrote the cache they had read, and one run was lost
+        with open(cache_path.with_name(cache_path.name + ".lock"), "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            cache = load_cache(cache_path)  # another process may have added runs
+            cache[run_key(run)] = result
+            tmp = cache_path.with_name(f"{cache_path.name}.{os.getpid()}")
+            tmp.write_text(json.dumps(cache, indent=1))
+            os.replace(tmp, cache_path)  # atomic: a reader never sees half a file
         print(f"  {cache[run_key(run)]['wall']:.1f} s", flush=True)
     return 0
 

@@ -84,7 +84,9 @@ def _synthetic(tmp_path) -> tuple[dict, object]:
                     "discretization": 0.01,
                     "linearization_model": 0.02,
                     "total": 0.03,
-                }
+                },
+                "model_error_basis": "line 'x': the computed residuals change the end_a "
+                "tension σ by 14 %; the corrected σ's remaining error is its square",
             },
             "wall": 1.0,
             "load": [1.0, 1.0, 1.0],
@@ -108,6 +110,7 @@ def test_page_reads_the_ratios_and_the_fatigue_split_from_the_runs(tmp_path, mon
     assert abs(float(spectrum[3].split("%")[0].split("±")[0])) < 0.05  # densities equal
     assert abs(float(spectrum[4].split("%")[0])) < 0.05  # its σ^m part (σ from the density)
     assert "| current | anchor |" in page and "Not re-run for this regeneration" in page
+    assert "| 2.00 % (residuals) | 3.00 % |" in page  # the plan's model estimate, its basis
 
 
 def test_reference_mesh_is_the_coarsest_whose_doubling_moves_less_than_the_rule():
