@@ -147,20 +147,26 @@ def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
     Returns
     -------
     ndarray, shape (n, order + 1)
-        a_k = E[g(μ + x) He_k(x)]/k! (probabilists' Hermite polynomials); a₁ = 2E|μ + x|
-        (Stein's lemma: the Borgman coefficient over cσ); exact to round-off for
-        |μ| < 12.  The callers clip μ to ±10: beyond, the kink lies more than 10σ out
-        (weight e^-50) and g is the polynomial ±(μ + x)², whose residual coefficients
-        no longer change (a₂ = ±1, a_k = 0 for k ≥ 3).
+        a_k = E[g(μ + x) He_k(x)]/k! (probabilists' Hermite polynomials) in closed form
+        (Stein's lemma, a_k = E[g⁽ᵏ⁾(μ + x)]/k!, with g' = 2|y|, g'' = 2 sgn y and
+        g⁽³⁾ = 4δ(y)): a₀ = (μ² + 1)s + 2μφ(μ), a₁ = 2(μs + 2φ(μ)) = 2E|μ + x| (the
+        Borgman coefficient over cσ), a₂ = s and a_k = 4He_{k−3}(−μ)φ(μ)/k! for k ≥ 3,
+        s = 2Φ(μ) − 1 = erf(μ/√2) (equal to the quadrature of E[g·He_k]/k! to
+        round-off).  The callers clip μ to ±10: beyond, the kink lies more than 10σ out
+        (weight e^-50) and g is the polynomial ±(μ + x)², whose residual coefficients no
+        longer change (a₂ = ±1, a_k = 0 for k ≥ 3).
     """
     m = np.atleast_1d(np.asarray(mu, dtype=float))
-    x, w = _gauss_points(-m)
-    g = np.abs(m[:, None] + x) * (m[:, None] + x) * w
+    s = np.array([math.erf(x / math.sqrt(2.0)) for x in m.tolist()]).reshape(m.shape)
+    phi = np.exp(-0.5 * m * m) / math.sqrt(2.0 * math.pi)
     out = np.empty((m.size, order + 1))
-    he_prev, he = np.zeros_like(x), np.ones_like(x)  # He_{k+1} = x·He_k − k·He_{k−1}
-    for k in range(order + 1):
-        out[:, k] = np.sum(g * he, axis=1) / math.factorial(k)
-        he_prev, he = he, x * he - k * he_prev
+    firsts = [(m * m + 1.0) * s + 2.0 * m * phi, 2.0 * (m * s + 2.0 * phi), s]
+    for k in range(min(order, 2) + 1):
+        out[:, k] = firsts[k]
+    he_prev, he = np.zeros_like(m), np.ones_like(m)  # He_n(−μ): He_{n+1} = x·He_n − n·He_{n−1}
+    for k in range(3, order + 1):
+        out[:, k] = 4.0 * he * phi / math.factorial(k)
+        he_prev, he = he, -m * he - (k - 3) * he_prev
     return out
 
 
@@ -559,21 +565,29 @@ def _misfit(
     length-weighted mean variance, the linear model's σ² in the pieces' terms). [N·s/m]"""
     out = np.zeros(len(groups))
     first = np.array([int(g[0]) for g in groups])
-    runs = []
-    for e in np.unique(seg.element[seg.fine]):
-        idx = np.flatnonzero(seg.element[first] == e)  # its pieces: one panel each
-        s_ = first[idx]
-        var = float(np.sum(seg.length[s_] * sig[idx] ** 2) / np.sum(seg.length[s_]))
-        if var > 0.0 and b_el[e] > 0.0:
-            runs.append((e, idx, s_, math.sqrt(var)))
-    # a₁ of every piece and of each element's mean variance: one evaluation
-    mu = [np.append(mean_el[e] / np.where(sig[i] > 0, sig[i], np.inf), mean_el[e] / v)
-          for e, i, _, v in runs]  # fmt: skip
-    if not runs:
+    el = seg.element[first]
+    # the panels of split elements (one piece each), by element
+    pan = np.flatnonzero(np.isin(el, seg.element[seg.fine]))
+    if pan.size == 0:
         return out
-    a1 = hermite_coefficients(np.clip(np.concatenate(mu), -10.0, 10.0), 1)[:, 1]
-    for (e, idx, s_, sig_e), a in zip(runs, np.split(a1, np.cumsum([m.size for m in mu]))):
-        out[idx] = b_el[e] * (sig[idx] * a[:-1] / (sig_e * a[-1]) - 1.0) * seg.length[s_]
+    els, at = np.unique(el[pan], return_inverse=True)
+    length = seg.length[first[pan]]
+    var = np.bincount(at, length * sig[pan] ** 2) / np.bincount(at, length)
+    ok = (var > 0.0) & (b_el[els] > 0.0)
+    use = ok[at]
+    pan, at, length = pan[use], at[use], length[use]
+    if pan.size == 0:
+        return out
+    sig_e = np.sqrt(np.where(ok, var, 1.0))
+    # a₁ of every piece and of each element's mean variance: one evaluation
+    mu = np.concatenate(
+        [mean_el[el[pan]] / np.where(sig[pan] > 0, sig[pan], np.inf), mean_el[els[ok]] / sig_e[ok]]
+    )
+    a1 = hermite_coefficients(np.clip(mu, -10.0, 10.0), 1)[:, 1]
+    a_e = np.zeros(els.size)
+    a_e[ok] = a1[pan.size :]
+    ratio = sig[pan] * a1[: pan.size] / (sig_e[at] * a_e[at])
+    out[pan] = b_el[els[at]] * (ratio - 1.0) * length
     return out
 
 

@@ -329,12 +329,16 @@ def _modal_rows(
     nf, m = phi.shape
     k_x = p.shape[1] - 6
     inv = 1.0 / (1j * w[None, :] - foss.lambdas[:, None])  # (2m, n_w)
-    # the modal coordinates (2m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
-    q = np.empty((2 * m, 2 + k_x, w.size), dtype=complex)
-    q[:, :2] = p[:, 0:2, None] - p[:, 2:4, None] * (w * w) + p[:, 4:6, None] * (1j * w)
-    q[:, 2:] = p[:, 6:, None]
-    q *= inv[:, None, :]
-    z = (foss.chi @ q.reshape(2 * m, -1)).reshape(m, 2 + k_x, w.size)
+    # the modal coordinates z = Σ_j χ_j p_j/(iω − λ_j) as one product over the modes
+    # of χ_j p_j (m·rows, 2m) and the denominators (2m, n_w): the end rows'
+    # p = g_K − ω²g_M + iωg_C with its three terms stacked (no (2m, rows, n_w) array)
+    z = np.empty((m, 2 + k_x, w.size), dtype=complex)
+    ends = (foss.chi[:, None, None, :] * p[:, :6].reshape(-1, 3, 2).T[None]).reshape(2 * m, -1)
+    den = np.concatenate([inv, inv * -(w * w), inv * (1j * w)])  # (3·2m, n_w)
+    z[:, :2] = (ends @ den).reshape(m, 2, w.size)
+    if k_x:
+        x = (foss.chi[:, None, :] * p[:, 6:].T[None]).reshape(m * k_x, -1)
+        z[:, 2:] = (x @ inv).reshape(m, k_x, w.size)
     rc = None
     if r is not None:  # the truncated modes' static correction, fixed vectors
         rc = np.zeros((3, nf, 2 + k_x), dtype=complex)
