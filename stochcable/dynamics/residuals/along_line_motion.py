@@ -47,7 +47,7 @@ from stochcable.dynamics.residuals.along_line import (
 from stochcable.dynamics.residuals.along_line_3d import sparse_transfer, vector_parts
 from stochcable.dynamics.residuals.corrected import RESIDUAL_VARIANCE_LIMIT
 from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
-from stochcable.dynamics.residuals.influence import adjoint_rows
+from stochcable.dynamics.residuals.influence import ModalRows, adjoint_rows
 from stochcable.errors import PhysicsWarning, warn
 
 __all__ = [
@@ -229,7 +229,8 @@ def motion_lines(
         if n_top == 0:
             lines = np.zeros((influence.on(cap.w[:1]).shape[0], cap.w.size))
         else:
-            full = sparse_transfer(influence.on(w), unit)  # (n_out, n_kept, n_sel)
+            g = influence.on(w)  # (the modal rows: the loads projected on the modes)
+            full = g.transfer(unit) if isinstance(g, ModalRows) else sparse_transfer(g, unit)
             lines = np.zeros((full.shape[0], cap.w.size))
             part = capture_outputs(cap, full, sel, dtype) * motion_cells(
                 system, damping, unit, w, full, CELL_BENDS[kind] * stride**2, influence

@@ -80,7 +80,6 @@ from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     PairLines,
     UniformGrid,
-    covariance_lines,
     element_directions,
     fft_length,
     load_transfer,
@@ -266,17 +265,19 @@ def residual_output_lines(
     # Horner's rule, its lines
     zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
     out = PairLines(transfer)  # (the element tensions read its dense lines: .along_line)
+    lo, hi = ks[0], ks[-1]
     for e, f in pair_blocks(n_p, n_fft):
         rho = pair_lags(zz, e, f, n_fft)
-        rr = (b[e, ks[-1]] * b[f, ks[-1]])[:, None] * rho
-        for k in range(ks[-1] - 1, ks[0] - 1, -1):
-            rr += (b[e, k] * b[f, k])[:, None]
+        # b_k^e·b_k^f with the pairs f > e weighted 2 and covariance_lines' 2/n_fft in
+        c = b[e, lo : hi + 1] * b[f, lo : hi + 1]
+        c *= np.where(f > e, 4.0 / n_fft, 2.0 / n_fft)[:, None]
+        rr = c[:, -1:] * rho
+        for i in range(hi - lo - 1, -1, -1):
+            rr += c[:, i : i + 1]
             rr *= rho
-        for _ in range(ks[0] - 1):
+        for _ in range(lo - 1):
             rr *= rho
-        g = covariance_lines(rr, n_o)
-        g[f > e] *= 2.0
-        out.add(g, e, f)
+        out.add(np.fft.rfft(rr, axis=1)[:, 1 : n_o + 1], e, f)  # (covariance_lines)
     return out.outputs()
 
 

@@ -101,7 +101,7 @@ class EndInfluence:
         for om, g in kept if w.size else ():
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
             near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
-            if np.allclose(om[near], w, rtol=1e-12, atol=0.0):
+            if np.all(np.abs(om[near] - w) <= 1e-12 * np.abs(w)):  # (np.allclose's test)
                 step = near[1] - near[0] if near.size > 1 else 1
                 if step > 0 and np.array_equal(near, near[0] + step * np.arange(near.size)):
                     return g[..., near[0] : near[-1] + 1 : step]  # (a view: every step-th line)
