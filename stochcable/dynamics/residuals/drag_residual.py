@@ -202,10 +202,8 @@ def lumped_coefficients(mu: Any, order: int = LUMPED_ORDER) -> np.ndarray:
     ρ^order, not ρ^j: tested against the orders kept one by one)."""
     m = np.atleast_1d(np.asarray(mu, dtype=float))
     out = hermite_coefficients(m, order)
-    x, w = _gauss_points(-m, m)
-    gp, gm = (np.abs(m[:, None] + x) * (m[:, None] + x), np.abs(m[:, None] - x) * (m[:, None] - x))
     total = m**4 + 6.0 * m**2 + 3.0
-    even = 0.5 * (total + np.sum(gp * gm * w, axis=1))
+    even = 0.5 * (total + _mirror_moment(m))
     tails = {0: even - out[:, 0] ** 2, 1: total - even - out[:, 1] ** 2}
     for k in (order, order - 1):
         if k < 2:
@@ -215,6 +213,19 @@ def lumped_coefficients(mu: Any, order: int = LUMPED_ORDER) -> np.ndarray:
         sign = np.where(out[:, k] < 0.0, -1.0, 1.0)
         out[:, k] = sign * np.sqrt(tail / math.factorial(k))
     return out
+
+
+def _mirror_moment(m: np.ndarray) -> np.ndarray:
+    """E[g(μ + x)·g(μ − x)] = E[sgn(μ² − x²)(μ² − x²)²], x ~ N(0, 1), in closed form:
+    E[(μ² − x²)²] = μ⁴ − 2μ² + 3 less twice its part over |x| > |μ|, whose moments are
+    T₀ = erfc(a/√2), T₂ = 2aφ(a) + T₀, T₄ = 2(a³ + 3a)φ(a) + 3T₀ (a = |μ|)."""
+    a = np.abs(m)
+    t0 = np.array([math.erfc(x / math.sqrt(2.0)) for x in a.tolist()]).reshape(a.shape)
+    phi = np.exp(-0.5 * a * a) / math.sqrt(2.0 * math.pi)
+    t2 = 2.0 * a * phi + t0
+    t4 = 2.0 * (a**3 + 3.0 * a) * phi + 3.0 * t0
+    m2 = m * m
+    return m2 * m2 - 2.0 * m2 + 3.0 - 2.0 * (m2 * m2 * t0 - 2.0 * m2 * t2 + t4)
 
 
 def residual_output_lines(
@@ -346,7 +357,8 @@ def drag_residual(
     influence = EndInfluence(system, damping) if influence is None else influence
     h_all = load_transfer(system, damping, comp.unit, comp.w_out, influence)
     keep = _live_panels(comp.lines, comp.scale, comp.coeffs, h_all)
-    cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled)
+    bent = _bent(h_all)  # (the cells: the residual's and the misfit's)
+    cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled, cells=bent)
     own = residual_output_lines(
         comp.lines[:, keep], comp.scale[keep], comp.coeffs[keep], h_all[:, keep], comp.n_fft
     )
@@ -360,7 +372,7 @@ def drag_residual(
         comp.live,
         comp.parts,
         comp.misfit,
-        (comp.grid, comp.w_out, influence, _bent(h_all)),
+        (comp.grid, comp.w_out, influence, bent),
         coupled,
         [(c, src) for _, c, src in others],
         MISFIT_EXACT,
@@ -503,6 +515,7 @@ def cell_factor(
     h: np.ndarray,
     bend: float = CELL_BEND,
     influence: Any = None,
+    cells: np.ndarray | None = None,
 ) -> np.ndarray:
     """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
     panel force over its value at ω_j, where the lines do not resolve it: shape
@@ -515,10 +528,11 @@ def cell_factor(
     power width 0.016 rad/s, on lines 0.03 rad/s apart: its corrected σ moved ±2 % with
     the line count, within 0.2 % with the factor).  The cells are those where the log
     power (``h``'s, summed over the panels) bends by more than :data:`CELL_BEND`
-    between neighbours, and theirs; elsewhere the factor is 1 (no solve)."""
+    between neighbours, and theirs (``cells``: those lines, (n_o,) bool, where the caller
+    has them); elsewhere the factor is 1 (no solve)."""
     power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
     out = np.ones_like(power)
-    cells = np.flatnonzero(_bent(h, bend))
+    cells = np.flatnonzero(_bent(h, bend) if cells is None else cells)
     if cells.size == 0:
         return out
     step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
