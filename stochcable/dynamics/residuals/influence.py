@@ -10,7 +10,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy import sparse
 
 from stochcable.dynamics.model.blocks import (
     add_blocks,
@@ -23,6 +22,7 @@ from stochcable.dynamics.model.lift import lift_band, lift_pattern
 from stochcable.dynamics.model.modal_solvers import foss_modes
 from stochcable.dynamics.model.solvers import solve_band_stacked
 from stochcable.dynamics.model.transport import gyro_band
+from stochcable.dynamics.residuals.modal_rows import ModalRows, modal_sums
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
 from stochcable.errors import SolverError
@@ -328,17 +328,11 @@ def _modal_rows(
     phi, foss, p, r, (e_a, e_b) = held
     nf, m = phi.shape
     k_x = p.shape[1] - 6
-    inv = 1.0 / (1j * w[None, :] - foss.lambdas[:, None])  # (2m, n_w)
-    # the modal coordinates z = Σ_j χ_j p_j/(iω − λ_j) as one product over the modes
-    # of χ_j p_j (m·rows, 2m) and the denominators (2m, n_w): the end rows'
-    # p = g_K − ω²g_M + iωg_C with its three terms stacked (no (2m, rows, n_w) array)
+    # the modal coordinates (m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
     z = np.empty((m, 2 + k_x, w.size), dtype=complex)
-    ends = (foss.chi[:, None, None, :] * p[:, :6].reshape(-1, 3, 2).T[None]).reshape(2 * m, -1)
-    den = np.concatenate([inv, inv * -(w * w), inv * (1j * w)])  # (3·2m, n_w)
-    z[:, :2] = (ends @ den).reshape(m, 2, w.size)
-    if k_x:
-        x = (foss.chi[:, None, :] * p[:, 6:].T[None]).reshape(m * k_x, -1)
-        z[:, 2:] = (x @ inv).reshape(m, k_x, w.size)
+    sums = modal_sums(foss.chi, p, foss.lambdas, w)  # (m, 6 + k, n_w)
+    z[:, :2] = sums[:, 0:2] - sums[:, 2:4] * (w * w) + sums[:, 4:6] * (1j * w)
+    z[:, 2:] = sums[:, 6:]
     rc = None
     if r is not None:  # the truncated modes' static correction, fixed vectors
         rc = np.zeros((3, nf, 2 + k_x), dtype=complex)
@@ -347,79 +341,6 @@ def _modal_rows(
     ends = np.zeros((2, 2 + k_x, d))
     ends[0, 0], ends[1, 1] = e_a, e_b
     return ModalRows(phi, z, w, rc, ends, n)
-
-
-class ModalRows:
-    """The rows of :func:`modal_influence` kept factored, x(ω) = Φ_f z(ω) + r₀ − ω²r₁
-    + iωr₂ on the free nodes and ê on the end nodes (the end rows'), shape (R, n_nodes,
-    d, n_w) as an array (``np.asarray``) but sliced by rows (``g[a:b]``) and lines
-    (``g[..., idx]``) without forming it, and contracted with load cases through the m
-    modes (:meth:`transfer`: the chain's 27 rows on 189 lines, 6.7 MB, never formed).
-    [N/N]"""
-
-    def __init__(self, phi, z, w, rc, ends, n_nodes) -> None:  # noqa: ANN001
-        self.phi, self.z, self.w, self.rc, self.ends = phi, z, w, rc, ends
-        self.n_nodes = n_nodes
-        d = ends.shape[2]
-        self.shape = (z.shape[1], n_nodes, d, w.size)
-        self.ndim, self.dtype = 4, np.dtype(complex)
-
-    def __getitem__(self, key: Any) -> ModalRows:
-        rows, lines = (slice(None), key[1]) if isinstance(key, tuple) else (key, slice(None))
-        if isinstance(key, tuple) and key[0] is not Ellipsis:
-            raise IndexError("ModalRows: g[rows] or g[..., lines] only")
-        rc = None if self.rc is None else self.rc[:, :, rows]
-        return ModalRows(
-            self.phi, self.z[:, rows][:, :, lines], self.w[lines], rc,
-            self.ends[:, rows], self.n_nodes,
-        )  # fmt: skip
-
-    def _add_static(self, x: np.ndarray, rc: np.ndarray) -> np.ndarray:
-        """``x`` (X, R, n_w) plus r₀ − ω²r₁ + iωr₂ of static rows ``rc`` (3, X, R), in
-        place (r₁, r₂ on the end rows only)."""
-        x += rc[0][..., None]
-        dyn = np.flatnonzero(np.any(self.rc[1:] != 0, axis=(0, 1)))
-        if dyn.size:
-            w = self.w
-            x[:, dyn] += rc[2][:, dyn, None] * (1j * w) - rc[1][:, dyn, None] * (w * w)
-        return x
-
-    def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
-        n_r, n, d, n_w = self.shape
-        m = self.phi.shape[1]
-        out = np.zeros(self.shape, dtype=complex)
-        out[:, 0] = self.ends[0][..., None]
-        out[:, -1] = self.ends[1][..., None]
-        zt = np.ascontiguousarray(self.z).reshape(m, -1)
-        x = real_gemm(self.phi, zt).reshape(-1, n_r, n_w)  # (n_f·d, R, n_w)
-        if self.rc is not None:
-            self._add_static(x, self.rc)
-        out[:, 1:-1] = np.transpose(x, (1, 0, 2)).reshape(n_r, n - 2, d, n_w)
-        return out if dtype is None else out.astype(dtype)
-
-    def transfer(self, unit: np.ndarray) -> np.ndarray:
-        """The rows per unit load case ``unit`` (n_nodes, d, n_load) (real node forces,
-        dense or a scipy sparse (n_load, n_nodes·d) matrix of them): shape (R, n_load,
-        n_w), the cases projected on the modes first. [N/unit]"""
-        n_r, n, d, n_w = self.shape
-        m = self.phi.shape[1]
-        if sparse.issparse(unit):
-            u_t = sparse.csr_matrix(unit)
-            u_end = (u_t[:, :d].toarray(), u_t[:, (n - 1) * d :].toarray())  # (L, d)
-            u_f = u_t[:, d : (n - 1) * d]
-            a = np.asarray(u_f @ self.phi)  # (L, m)
-        else:
-            unit = np.asarray(unit, dtype=float)
-            u_end = (unit[0].T, unit[-1].T)
-            u_f = unit[1:-1].reshape((n - 2) * d, -1).T  # (L, n_f·d)
-            a = u_f @ self.phi
-        zt = np.ascontiguousarray(self.z).reshape(m, -1)
-        h = real_gemm(a, zt).reshape(a.shape[0], n_r, n_w)  # (L, R, n_w)
-        h += (u_end[0] @ self.ends[0].T + u_end[1] @ self.ends[1].T)[..., None]
-        if self.rc is not None:
-            rc = np.stack([np.asarray(u_f @ self.rc[k]) for k in range(3)])  # (3, L, R)
-            self._add_static(h, rc)
-        return np.transpose(h, (1, 0, 2))
 
 
 def _modal_projection(
