@@ -58,7 +58,6 @@ O(panels² · n_fft log n_fft)).
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -67,6 +66,12 @@ import numpy as np
 
 from stochcable.dynamics.linearization.variance import current_split
 from stochcable.dynamics.residuals.body_residual import untapped, with_group_lines
+from stochcable.dynamics.residuals.drag_hermite import (
+    HERMITE_ORDER,
+    LUMPED_ORDER,
+    hermite_coefficients,
+    lumped_coefficients,
+)
 from stochcable.dynamics.residuals.drag_misfit import misfit_variance
 from stochcable.dynamics.residuals.drag_segments import (
     Segments,
@@ -101,9 +106,6 @@ __all__ = [
     "residual_output_lines",
 ]
 
-#: Highest Hermite order kept: k = 2 … 5 carry all but 0.7 % of the residual variance
-#: of zero-mean drag (k = 3: 4/(3π) = 0.424 of 3 − 8/π = 0.454). [-]
-HERMITE_ORDER = 5
 #: Most panels (groups of consecutive elements) the residual is evaluated on: the cost
 #: grows with their square; 54 panels of the chain's 160 elements give the
 #: element-by-element variance within 1 % (tests/dynamics/test_drag_residual.py). [-]
@@ -113,9 +115,6 @@ MAX_PANELS = 32
 #: time domain: +18 % on the taut wire and on the inclined guy, +4 / +7 % on the chain
 #: (docs/benchmarks/drag_residual.md). [-]
 RESIDUAL_WARN_RATIO = 1.25
-#: Orders of the default evaluation: 2 and 3, each carrying the variance of the higher
-#: orders of its parity (:func:`lumped_coefficients`). [-]
-LUMPED_ORDER = 3
 #: The misfit's end tensions per unit load solved at every analysis frequency (the
 #: evaluation before issue 31), not taken at the residual's nearest line
 #: (:func:`~stochcable.dynamics.residuals.drag_misfit.misfit_variance`). [-]
@@ -131,101 +130,6 @@ SUB_SAMPLES = 5
 #: Bend of the log power between neighbouring lines (|Δ² ln P|) above which a cell's
 #: transfer functions are sub-sampled (:func:`cell_factor`). [-]
 CELL_BEND = 0.1
-
-
-def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
-    """Hermite coefficients a_k(μ) of g(μ + x) = |μ + x|(μ + x), x ~ N(0, 1).
-
-    Parameters
-    ----------
-    mu : array_like, shape (n,)
-        Mean over standard deviation of the relative velocity, U/σ. [-]
-    order : int
-        Highest order k.
-
-    Returns
-    -------
-    ndarray, shape (n, order + 1)
-        a_k = E[g(μ + x) He_k(x)]/k! (probabilists' Hermite polynomials) in closed form
-        (Stein's lemma, a_k = E[g⁽ᵏ⁾(μ + x)]/k!, with g' = 2|y|, g'' = 2 sgn y and
-        g⁽³⁾ = 4δ(y)): a₀ = (μ² + 1)s + 2μφ(μ), a₁ = 2(μs + 2φ(μ)) = 2E|μ + x| (the
-        Borgman coefficient over cσ), a₂ = s and a_k = 4He_{k−3}(−μ)φ(μ)/k! for k ≥ 3,
-        s = 2Φ(μ) − 1 = erf(μ/√2) (equal to the quadrature of E[g·He_k]/k! to
-        round-off).  The callers clip μ to ±10: beyond, the kink lies more than 10σ out
-        (weight e^-50) and g is the polynomial ±(μ + x)², whose residual coefficients no
-        longer change (a₂ = ±1, a_k = 0 for k ≥ 3).
-    """
-    m = np.atleast_1d(np.asarray(mu, dtype=float))
-    s = np.array([math.erf(x / math.sqrt(2.0)) for x in m.tolist()]).reshape(m.shape)
-    phi = np.exp(-0.5 * m * m) / math.sqrt(2.0 * math.pi)
-    out = np.empty((m.size, order + 1))
-    firsts = [(m * m + 1.0) * s + 2.0 * m * phi, 2.0 * (m * s + 2.0 * phi), s]
-    for k in range(min(order, 2) + 1):
-        out[:, k] = firsts[k]
-    he_prev, he = np.zeros_like(m), np.ones_like(m)  # He_n(−μ): He_{n+1} = x·He_n − n·He_{n−1}
-    for k in range(3, order + 1):
-        out[:, k] = 4.0 * he * phi / math.factorial(k)
-        he_prev, he = he, -m * he - (k - 3) * he_prev
-    return out
-
-
-@functools.lru_cache(maxsize=1)
-def _legendre(n: int = 64) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss–Legendre nodes and weights on [−1, 1] (formed once)."""
-    return np.polynomial.legendre.leggauss(n)
-
-
-def _gauss_points(*kinks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Points and weights (n, m) of E[f(x)], x ~ N(0, 1), for f a polynomial on each
-    side of the ``kinks`` (each (n,)): Gauss–Legendre between the kinks over ±12 (the
-    Gaussian tail beyond is e^-72), exact to round-off for kinks within ±12."""
-    t, wt = _legendre()
-    lo, hi = -12.0, 12.0
-    edges = np.sort(np.stack([np.full(kinks[0].shape, lo)] + [np.clip(k, lo, hi) for k in kinks]
-                             + [np.full(kinks[0].shape, hi)], 1), axis=1)  # fmt: skip
-    a, b = edges[:, :-1, None], edges[:, 1:, None]
-    x = (0.5 * (b - a) * t + 0.5 * (b + a)).reshape(edges.shape[0], -1)
-    w = (0.5 * (b - a) * wt).reshape(edges.shape[0], -1)
-    return x, w * np.exp(-0.5 * x * x) / math.sqrt(2.0 * math.pi)
-
-
-def lumped_coefficients(mu: Any, order: int = LUMPED_ORDER) -> np.ndarray:
-    """Hermite coefficients (as :func:`hermite_coefficients`) up to ``order`` whose two
-    highest (one odd, one even) carry the variance of all higher orders of their
-    parity: k!·a_k² of the top odd order is Σ_{j odd ≥ k} j!·a_j², of the top even order
-    likewise (sign of a_k kept).
-
-    The sums are closed: Σ_j j!·a_j² = E[g(μ + x)²] = μ⁴ + 6μ² + 3 over all orders, its
-    even part E[g(μ + x)·(g(μ + x) + g(μ − x))]/2 (He_j(−x) = (−1)^j He_j(x)).  A panel's
-    residual variance is then exact, and the lags' shape of the orders above ``order``
-    is that of the top order of their parity (their cross-covariances are taken as
-    ρ^order, not ρ^j: tested against the orders kept one by one)."""
-    m = np.atleast_1d(np.asarray(mu, dtype=float))
-    out = hermite_coefficients(m, order)
-    total = m**4 + 6.0 * m**2 + 3.0
-    even = 0.5 * (total + _mirror_moment(m))
-    tails = {0: even - out[:, 0] ** 2, 1: total - even - out[:, 1] ** 2}
-    for k in (order, order - 1):
-        if k < 2:
-            continue
-        below = sum(math.factorial(j) * out[:, j] ** 2 for j in range(k % 2 + 2, k, 2))
-        tail = np.maximum(tails[k % 2] - below, 0.0)
-        sign = np.where(out[:, k] < 0.0, -1.0, 1.0)
-        out[:, k] = sign * np.sqrt(tail / math.factorial(k))
-    return out
-
-
-def _mirror_moment(m: np.ndarray) -> np.ndarray:
-    """E[g(μ + x)·g(μ − x)] = E[sgn(μ² − x²)(μ² − x²)²], x ~ N(0, 1), in closed form:
-    E[(μ² − x²)²] = μ⁴ − 2μ² + 3 less twice its part over |x| > |μ|, whose moments are
-    T₀ = erfc(a/√2), T₂ = 2aφ(a) + T₀, T₄ = 2(a³ + 3a)φ(a) + 3T₀ (a = |μ|)."""
-    a = np.abs(m)
-    t0 = np.array([math.erfc(x / math.sqrt(2.0)) for x in a.tolist()]).reshape(a.shape)
-    phi = np.exp(-0.5 * a * a) / math.sqrt(2.0 * math.pi)
-    t2 = 2.0 * a * phi + t0
-    t4 = 2.0 * (a**3 + 3.0 * a) * phi + 3.0 * t0
-    m2 = m * m
-    return m2 * m2 - 2.0 * m2 + 3.0 - 2.0 * (m2 * m2 * t0 - 2.0 * m2 * t2 + t4)
 
 
 def residual_output_lines(
