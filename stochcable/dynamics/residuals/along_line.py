@@ -421,11 +421,11 @@ def misfit_lines(
     return np.sum(q * (np.abs(linear + h_c) ** 2 - np.abs(linear) ** 2), axis=0)
 
 
-def bent_cells(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
+def bent_cells(h: np.ndarray, bend: float = CELL_BEND, power: Any = None) -> np.ndarray:
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
     loads, bends by more than ``bend`` between neighbours, and their neighbours (as
     :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`'s cells)."""
-    power = np.sum(np.abs(h) ** 2, axis=1)
+    power = np.sum(np.abs(h) ** 2, axis=1) if power is None else power  # (n_out, n_o)
     logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
     out = np.zeros(power.shape[1], dtype=bool)
     out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)

@@ -260,8 +260,8 @@ def motion_cells(
     output's own factor. [-]"""
     if not isinstance(influence, NodeInfluence):
         return cell_factor(system, damping, unit, w, h, bend, influence=influence)
-    cells = np.flatnonzero(bent_cells(h, bend))
     power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
+    cells = np.flatnonzero(bent_cells(h, bend, power))
     out = np.ones_like(power)
     if cells.size == 0:
         return out

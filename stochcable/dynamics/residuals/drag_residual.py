@@ -78,6 +78,7 @@ from stochcable.dynamics.residuals.drag_segments import (
     panel_groups,
     panel_loads,
     panel_mean,
+    panel_share,
     segment_velocity,
     segments,
 )
@@ -349,13 +350,14 @@ def drag_components(
     # functions of jointly Gaussian velocities, so their cross terms count too (where
     # the linear tensions of the two cancel, so do the residuals' in part)
     scales, coeffs, lines, misfit = [], [], [], []
+    share = panel_share(seg, groups)
     for name in live:
         c_el, mean_el, _, b_el = parts[name]
         scales.append(
             np.array([float(np.sum(c_el[seg.element[g]] * seg.length[g])) for g in groups])
         )
-        mean = panel_mean(mean_el[seg.element], seg, groups)
-        pan = panel_mean(seg_v[name], seg, groups)  # (n_ch, n_p, n_w)
+        mean = panel_mean(mean_el[seg.element], seg, groups, share)
+        pan = panel_mean(seg_v[name], seg, groups, share)  # (n_ch, n_p, n_w)
         v = grid.lines(pan, spectra)
         sig = np.sqrt(np.sum(np.abs(v) ** 2, axis=(0, 2)))
         mu = np.where(sig > 0, mean / np.where(sig > 0, sig, 1.0), 0.0)
@@ -436,7 +438,7 @@ def cell_factor(
     has them); elsewhere the factor is 1 (no solve)."""
     power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
     out = np.ones_like(power)
-    cells = np.flatnonzero(_bent(h, bend) if cells is None else cells)
+    cells = np.flatnonzero(_bent(h, bend, power) if cells is None else cells)
     if cells.size == 0:
         return out
     step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
@@ -460,10 +462,11 @@ def _live_panels(
     return np.flatnonzero(score >= PANEL_FLOOR * np.max(score, initial=0.0))
 
 
-def _bent(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
+def _bent(h: np.ndarray, bend: float = CELL_BEND, power: np.ndarray | None = None) -> np.ndarray:
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
-    panels, bends by more than ``bend`` between neighbours, and theirs."""
-    power = np.sum(np.abs(h) ** 2, axis=1)
+    panels (``power``, where the caller has it), bends by more than ``bend`` between
+    neighbours, and theirs."""
+    power = np.sum(np.abs(h) ** 2, axis=1) if power is None else power
     logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
     out = np.zeros(power.shape[1], dtype=bool)
     out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)

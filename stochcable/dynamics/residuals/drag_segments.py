@@ -42,6 +42,7 @@ __all__ = [
     "panel_groups",
     "panel_loads",
     "panel_mean",
+    "panel_share",
     "segment_velocity",
     "segments",
 ]
@@ -338,16 +339,26 @@ def _subdivided_points(system: Any, seg: Segments) -> np.ndarray:
     return pts
 
 
-def panel_mean(values: np.ndarray, seg: Segments, groups: list[np.ndarray]) -> np.ndarray:
+def panel_mean(
+    values: np.ndarray, seg: Segments, groups: list[np.ndarray], share: Any = None
+) -> np.ndarray:
     """Length-weighted mean of per-piece ``values`` (…, n_s, …) over each panel: the
-    piece axis is axis 1 of a 3-D array or axis 0 of a 1-D one (one matrix product)."""
-    piece = np.concatenate(groups)
-    panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
-    share = np.zeros((values.shape[1 if values.ndim == 3 else 0], len(groups)))
-    share[piece, panel] = seg.length[piece] / np.bincount(panel, weights=seg.length[piece])[panel]
+    piece axis is axis 1 of a 3-D array or axis 0 of a 1-D one (one matrix product;
+    ``share``: :func:`panel_share`, where the caller has it)."""
+    if share is None:
+        share = panel_share(seg, groups)
     if values.ndim == 3:
         return np.moveaxis(np.moveaxis(values, 1, 2) @ share, 2, 1)
     return values @ share
+
+
+def panel_share(seg: Segments, groups: list[np.ndarray]) -> np.ndarray:
+    """Each piece's share of its panel's length, shape (n_s, n_panels) (:func:`panel_mean`)."""
+    piece = np.concatenate(groups)
+    panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
+    share = np.zeros((seg.size, len(groups)))
+    share[piece, panel] = seg.length[piece] / np.bincount(panel, weights=seg.length[piece])[panel]
+    return share
 
 
 def panel_loads(

@@ -95,8 +95,10 @@ class ModalRows:
         """``x`` (X, R, n_w) plus r₀ − ω²r₁ + iωr₂ of static rows ``rc`` (3, X, R), in
         place (r₁, r₂ on the end rows only)."""
         x += rc[0][..., None]
-        dyn = np.flatnonzero(np.any(self.rc[1:] != 0, axis=(0, 1)))
-        if dyn.size:
+        dyn: Any = np.flatnonzero(np.any(self.rc[1:] != 0, axis=(0, 1)))
+        if dyn.size and dyn[-1] - dyn[0] + 1 == dyn.size:  # (a run: a view, not a copy)
+            dyn = slice(int(dyn[0]), int(dyn[-1]) + 1)
+        if not isinstance(dyn, np.ndarray) or dyn.size:
             w = self.w
             x[:, dyn] += rc[2][:, dyn, None] * (1j * w) - rc[1][:, dyn, None] * (w * w)
         return x
@@ -134,6 +136,7 @@ class ModalRows:
         h = real_gemm(a, zt).reshape(a.shape[0], n_r, n_w)  # (L, R, n_w)
         h += (u_end[0] @ self.ends[0].T + u_end[1] @ self.ends[1].T)[..., None]
         if self.rc is not None:
-            rc = np.stack([np.asarray(u_f @ self.rc[k]) for k in range(3)])  # (3, L, R)
+            three = np.transpose(self.rc, (1, 0, 2)).reshape(self.rc.shape[1], -1)
+            rc = np.asarray(u_f @ three).reshape(-1, 3, n_r).transpose(1, 0, 2)  # (3, L, R)
             self._add_static(h, rc)
         return np.transpose(h, (1, 0, 2))
