@@ -22,7 +22,7 @@ from stochcable.dynamics.model.lift import lift_band, lift_pattern
 from stochcable.dynamics.model.modal_solvers import foss_modes
 from stochcable.dynamics.model.solvers import solve_band_stacked
 from stochcable.dynamics.model.transport import gyro_band
-from stochcable.dynamics.residuals.modal_rows import ModalRows, modal_sums
+from stochcable.dynamics.residuals.modal_rows import ModalRows, ModalSums
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.dynamics.solve.line_solve import end_tension_from_support
 from stochcable.errors import SolverError
@@ -320,26 +320,18 @@ def _modal_rows(
 ) -> ModalRows | None:
     """:func:`modal_influence` on ``w`` (all below its limit); None for a defective
     Foss pencil."""
-    model = system.model
-    d, n = model.dim, model.n_nodes
+    n = system.model.n_nodes
     held = _modal_projection(system, damping, float(w[-1]) if w.size else 0.0, extra)
     if held is None:
         return None
-    phi, foss, p, r, (e_a, e_b) = held
-    nf, m = phi.shape
+    phi, foss, p, r, (sums, rc, ends) = held
+    m = phi.shape[1]
     k_x = p.shape[1] - 6
     # the modal coordinates (m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
     z = np.empty((m, 2 + k_x, w.size), dtype=complex)
-    sums = modal_sums(foss.chi, p, foss.lambdas, w)  # (m, 6 + k, n_w)
-    z[:, :2] = sums[:, 0:2] - sums[:, 2:4] * (w * w) + sums[:, 4:6] * (1j * w)
-    z[:, 2:] = sums[:, 6:]
-    rc = None
-    if r is not None:  # the truncated modes' static correction, fixed vectors
-        rc = np.zeros((3, nf, 2 + k_x), dtype=complex)
-        rc[:, :, :2] = np.stack([r[:, 0:2], r[:, 2:4], r[:, 4:6]])
-        rc[0, :, 2:] = r[:, 6:]
-    ends = np.zeros((2, 2 + k_x, d))
-    ends[0, 0], ends[1, 1] = e_a, e_b
+    s = sums(w)  # (m, 6 + k, n_w)
+    z[:, :2] = s[:, 0:2] - s[:, 2:4] * (w * w) + s[:, 4:6] * (1j * w)
+    z[:, 2:] = s[:, 6:]
     return ModalRows(phi, z, w, rc, ends, n)
 
 
@@ -350,7 +342,9 @@ def _modal_projection(
     its later calls with the same ``damping`` and ``extra`` (the cells' and the
     misfit's frequencies after the lines'): (Φ_f, the Foss modes, the right-hand
     sides' modal loads p (2m, 6 + k), their static corrections (n_f·d, 6 + k) or None,
-    ê of both ends).  None for a defective Foss pencil."""
+    and the rows' fixed parts: the modal sums' terms (:class:`ModalSums`), the static
+    rows (3, n_f·d, 2 + k) or None, ê of both ends (2, 2 + k, d)).  None for a
+    defective Foss pencil."""
     prep = line_prep(system)
     phi, mh, kh = _influence_modes(system, prep, w_top)
     key = ("influence_projection", extra is None)
@@ -387,7 +381,17 @@ def _modal_projection(
     if m < nf:
         zh = np.linalg.solve(kh, modal.view(float))
         r = (prep.k_solve(cols) - real_gemm(phi, np.ascontiguousarray(zh).view(complex))) * sign
-    out = (phi, foss, p, r, (e_a, e_b))
+    # the rows' frequency-independent parts: the modal sums' terms, the static rows
+    # (r₀, r₁, r₂; the end rows' three, the others' r₀) and ê of both ends
+    rc = None
+    if r is not None:
+        rc = np.zeros((3, nf, 2 + k_x), dtype=complex)
+        rc[:, :, :2] = np.stack([r[:, 0:2], r[:, 2:4], r[:, 4:6]])
+        rc[0, :, 2:] = r[:, 6:]
+    d = system.model.dim
+    ends = np.zeros((2, 2 + k_x, d))
+    ends[0, 0], ends[1, 1] = e_a, e_b
+    out = (phi, foss, p, r, (ModalSums(foss.chi, p, foss.lambdas), rc, ends))
     prep.cache[key] = (damping, extra, out)
     return out
 

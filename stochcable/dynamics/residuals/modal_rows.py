@@ -12,7 +12,7 @@ from scipy import sparse
 
 from stochcable.dynamics.model.blocks import real_gemm
 
-__all__ = ["PAIR_TOL", "ModalRows", "modal_sums"]
+__all__ = ["PAIR_TOL", "ModalRows", "ModalSums", "modal_sums"]
 
 #: Relative tolerance to which two modes are taken as a complex-conjugate pair
 #: (eigenvalues and χ_j p_j) in :func:`modal_sums`. [-]
@@ -21,31 +21,46 @@ PAIR_TOL = 1e-10
 
 def modal_sums(chi: np.ndarray, p: np.ndarray, lambdas: np.ndarray, w: np.ndarray) -> np.ndarray:
     """z_k(ω) = Σ_j χ_j p_jk/(iω − λ_j) of the complex modes (χ (m, 2m), λ (2m,)) and the
-    modal loads ``p`` (2m, k) of real right-hand sides on ``w``: shape (m, k, n_w).
+    modal loads ``p`` (2m, k) of real right-hand sides on ``w``: shape (m, k, n_w)
+    (:class:`ModalSums`)."""
+    return ModalSums(chi, p, lambdas)(w)
 
-    One product over the modes of the terms χ_j p_j (m·k, 2m) and the denominators (no
-    (2m, k, n_w) array), in real arithmetic: a real system's modes come in conjugate
-    pairs (λ', χ' p') = (λ̄, conj(χ p)) (the underdamped ones), whose two terms are
-    Re(χp)·(d + d') + Im(χp)·i(d − d'), d = 1/(iω − λ), d' = 1/(iω − λ̄): half the
-    work of the complex product.  The modes without such a partner (overdamped: real
-    λ) keep their own term.  [as χ·p]"""
-    m, k = chi.shape[0], p.shape[1]
-    terms = (chi[:, None, :] * p.T[None]).reshape(m * k, -1)  # (m·k, 2m): χ_j p_j
-    inv = 1.0 / (1j * np.asarray(w, dtype=float)[None, :] - lambdas[:, None])  # (2m, n_w)
-    first, second = _conjugate_pairs(terms, lambdas)
-    alone = np.setdiff1d(np.arange(lambdas.size), np.concatenate([first, second]))
-    coef = np.concatenate([terms[:, first], terms[:, alone]], axis=1)
-    den = np.concatenate(
-        [
-            inv[first] + inv[second],
-            inv[alone],
-            1j * (inv[first] - inv[second]),
-            1j * inv[alone],
-        ]
-    )  # (2·n_terms, n_w): the real parts' factors, then the imaginary parts'
-    lhs = np.ascontiguousarray(np.concatenate([coef.real, coef.imag], axis=1))
-    out = (lhs @ np.ascontiguousarray(den).view(float)).view(complex)
-    return out.reshape(m, k, -1)
+
+class ModalSums:
+    """z_k(ω) = Σ_j χ_j p_jk/(iω − λ_j) (:func:`modal_sums`), its frequency-independent
+    part formed once: the terms χ_j p_j (m·k, 2m), paired.
+
+    One product over the modes of the terms and the denominators (no (2m, k, n_w)
+    array), in real arithmetic: a real system's modes come in conjugate pairs (λ', χ'
+    p') = (λ̄, conj(χ p)) (the underdamped ones), whose two terms are Re(χp)·(d + d') +
+    Im(χp)·i(d − d'), d = 1/(iω − λ), d' = 1/(iω − λ̄): half the work of the complex
+    product.  The modes without such a partner (overdamped: real λ; complex right-hand
+    sides) keep their own term.  [as χ·p]"""
+
+    def __init__(self, chi: np.ndarray, p: np.ndarray, lambdas: np.ndarray) -> None:
+        m, k = chi.shape[0], p.shape[1]
+        terms = (chi[:, None, :] * p.T[None]).reshape(m * k, -1)  # (m·k, 2m): χ_j p_j
+        first, second = _conjugate_pairs(terms, lambdas)
+        alone = np.setdiff1d(np.arange(lambdas.size), np.concatenate([first, second]))
+        coef = np.concatenate([terms[:, first], terms[:, alone]], axis=1)
+        self.lhs = np.ascontiguousarray(np.concatenate([coef.real, coef.imag], axis=1))
+        self.lambdas, self.first, self.second, self.alone = lambdas, first, second, alone
+        self.shape = (m, k)
+
+    def __call__(self, w: np.ndarray) -> np.ndarray:
+        """The sums on ``w``, shape (m, k, n_w)."""
+        inv = 1.0 / (1j * np.asarray(w, dtype=float)[None, :] - self.lambdas[:, None])
+        first, second, alone = self.first, self.second, self.alone
+        den = np.concatenate(
+            [
+                inv[first] + inv[second],
+                inv[alone],
+                1j * (inv[first] - inv[second]),
+                1j * inv[alone],
+            ]
+        )  # (2·n_terms, n_w): the real parts' factors, then the imaginary parts'
+        out = (self.lhs @ np.ascontiguousarray(den).view(float)).view(complex)
+        return out.reshape(self.shape + (-1,))
 
 
 def _conjugate_pairs(terms: np.ndarray, lambdas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
