@@ -351,11 +351,11 @@ def drag_components(
     # the linear tensions of the two cancel, so do the residuals' in part)
     scales, coeffs, lines, misfit = [], [], [], []
     share = panel_share(seg, groups)
+    piece = np.concatenate(groups)  # (each piece's panel: the panels' c·L by one sum)
+    panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
     for name in live:
         c_el, mean_el, _, b_el = parts[name]
-        scales.append(
-            np.array([float(np.sum(c_el[seg.element[g]] * seg.length[g])) for g in groups])
-        )
+        scales.append(np.bincount(panel, (c_el[seg.element] * seg.length)[piece], len(groups)))
         mean = panel_mean(mean_el[seg.element], seg, groups, share)
         pan = panel_mean(seg_v[name], seg, groups, share)  # (n_ch, n_p, n_w)
         v = grid.lines(pan, spectra)
