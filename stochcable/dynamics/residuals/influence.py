@@ -97,11 +97,12 @@ class EndInfluence:
         self._modal = MODAL_INFLUENCE
 
     @staticmethod
-    def _find(kept: list, w: np.ndarray) -> np.ndarray | None:
+    def _find(kept: list, w: np.ndarray, rows: slice = slice(None)) -> np.ndarray | None:
         for om, g in kept if w.size else ():
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
             near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
             if np.all(np.abs(om[near] - w) <= 1e-12 * np.abs(w)):  # (np.allclose's test)
+                g = g if rows == slice(None) else g[rows]  # (the rows first: fewer gathered)
                 step = near[1] - near[0] if near.size > 1 else 1
                 if step > 0 and np.array_equal(near, near[0] + step * np.arange(near.size)):
                     return g[..., near[0] : near[-1] + 1 : step]  # (a view: every step-th line)
@@ -129,11 +130,11 @@ class EndInfluence:
     def extra_on(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray:
         """The ``extra`` rows ``cols`` on ``w``, shape (k, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
-        g = self._find(self._kept_x, w)
+        g = self._find(self._kept_x, w, cols)
         if g is None:
             self._solve(w, extra=True)
-            g = self._kept_x[-1][1]
-        return g[cols]
+            g = self._kept_x[-1][1][cols]
+        return g
 
     def extra_kept(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray | None:
         """The ``extra`` rows ``cols`` on ``w`` where they are kept, or solved by the
@@ -141,10 +142,10 @@ class EndInfluence:
         rows: a banded solve of all the rows where one set is asked, e.g. at a set's
         cells, costs the others' right-hand sides for nothing). [N/N]"""
         w = np.asarray(w, dtype=float)
-        g = self._find(self._kept_x, w)
+        g = self._find(self._kept_x, w, cols)
         if g is None and self._modal:
             return self.extra_on(w, cols)
-        return None if g is None else g[cols]
+        return g
 
 
 class SharedRows:
