@@ -8,10 +8,12 @@ solve (docs/benchmarks/cases.md).  What they change — the corrections' ratios,
 the linear σ, Tz and 3-h MPM over the linear ones, the end and element damage rates
 over the linear ones — is smooth along a *column* of the diagram (the sea states of
 one period and heading, which differ by Hs and by the γ DNV-RP-C205 derives from Hs
-and Tp), and varies little from one period to the next, but in steps: the drag
-residual's panels (groups of elements by wave-velocity variance) change with the
-period, and with them the chain example's corrections by up to 0.3 % of σ between
-neighbouring Tp 0.5 s apart.  Every case is solved by the linear model (the set's
+and Tp), and varies little and smoothly from one period to the next: the drag
+residual's panels are fixed tiles of the mesh and its split elements' pieces move
+continuously with the sea (:mod:`stochcable.dynamics.residuals.drag_segments`), so the
+chain example's corrections step by at most 4e-4 of σ between neighbouring Tp 0.5 s
+apart (where an element starts to split; 2.4e-3 with the panels grouped by the sea's
+wave-velocity variance before).  Every case is solved by the linear model (the set's
 reused engine); the anchors compute the residuals too, and every other case gets its
 linear values times the ratios interpolated from the anchors
 (:func:`interpolate_corrections`, :func:`interpolate_along`; the layout and the laws
@@ -36,7 +38,7 @@ middle Hs, computed, against the ratios interpolated in Hs between its ends.  Th
 tolerance: ``residual_tolerance`` on σ, Tz and 3-h MPM, :data:`DAMAGE_TOLERANCE_FACTOR`
 × it on the end and the elements' damage rates.  So the error is measured where it is
 made, not assumed: a correction that grows fast with Hs (the taut wire at Tp 10 s,
-+0.1 … +35 % on σ at end_b, ×3.4 on the end damage), or steps (the panels), gets
++0.1 … +35 % on σ at end_b, ×3.4 on the end damage), or steps, gets
 anchors there.  Every case is solved once (:mod:`stochcable.cases.anchor_passes`):
 the anchors pass after pass with the residuals, each from the converged σ of the
 nearest case computed before it, then every other case linear; so the anchors and
@@ -102,8 +104,8 @@ RESIDUAL_SPAN = 5
 #: docs/benchmarks/cases.md). [-]
 RESIDUAL_TOLERANCE = 2e-3
 #: Most spread of the ratios between a column checked in the period and either end
-#: of its interval, in tolerances (:func:`next_anchors`): the corrections step in the
-#: period (module notes), and a step between a computed column and an interpolated
+#: of its interval, in tolerances (:func:`next_anchors`): the corrections may step in
+#: the period (module notes), and a step between a computed column and an interpolated
 #: one misses by up to the spread: 1.5 × 2e-3 = 3e-3 on σ, Tz and MPM and 9e-3 on
 #: damage at most, the set's targets. [-]
 PERIOD_SPREAD = 1.5

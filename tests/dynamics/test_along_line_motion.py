@@ -214,22 +214,23 @@ def _two_segment(monkeypatch, limit: float) -> tuple:
 
 def test_a_node_beyond_the_range_falls_back_alone(monkeypatch):
     """The two-segment line's node 33 (a station) has the largest ratio of residual to
-    linear variance of its motions, 1.96 (its x): below the limit 2 nothing falls back;
-    with the limit at 1.9, between it and the next largest node's 1.74, node 33's x
+    linear variance of its motions, 1.62 (its x; 1.70 with every element a panel, 1.96
+    with the panels grouped by the sea before): below the limit 2 nothing falls back;
+    with the limit at 1.5, between it and the next largest node's 1.45, node 33's x
     motion alone is the linear model's, with a warning naming it, its ratio and the
     limit, and every other motion keeps its σ to the bit (the whole line fell back
     before: σ down by up to 41 %)."""
     below, said = _two_segment(monkeypatch, 2.0)
     lin = below.motion_std_linear
     ratio = below.motion_residual.variance / np.where(lin > 0, lin**2, 1.0)
-    assert ratio[33, 0] == pytest.approx(1.96, abs=0.01) and said == []
-    assert np.sort(ratio.ravel())[-2] < 1.9 and not below.motion_residual.beyond.any()
-    above, said = _two_segment(monkeypatch, 1.9)
+    assert ratio[33, 0] == pytest.approx(1.62, abs=0.01) and said == []
+    assert np.sort(ratio.ravel())[-2] < 1.5 and not below.motion_residual.beyond.any()
+    above, said = _two_segment(monkeypatch, 1.5)
     beyond = above.motion_residual.beyond
     assert np.argwhere(beyond).tolist() == [[33, 0]]
-    assert len(said) == 1 and "up to 1.96 × the linear variance (node 33's x motion)" in said[0]
-    assert "range 1.9 (RESIDUAL_VARIANCE_LIMIT) (x at node 33)" in said[0]
-    assert above.motion_std[33, 0] == lin[33, 0] < below.motion_std[33, 0] / 1.6
+    assert len(said) == 1 and "up to 1.62 × the linear variance (node 33's x motion)" in said[0]
+    assert "range 1.5 (RESIDUAL_VARIANCE_LIMIT) (x at node 33)" in said[0]
+    assert above.motion_std[33, 0] == lin[33, 0] < below.motion_std[33, 0] / 1.55
     assert np.array_equal(above.motion_std[~beyond], below.motion_std[~beyond])
 
 
@@ -260,7 +261,7 @@ def _motions_every_node(monkeypatch, name: str) -> tuple:
 
 @pytest.mark.parametrize(
     ("name", "node_bound", "line_bound"),
-    [("chain", 0.03, 0.015), ("deep", 0.035, 0.01), ("two-segment", None, 0.08)],
+    [("chain", 0.03, 0.015), ("deep", 0.035, 0.01), ("two-segment", None, 0.1)],
 )
 def test_motions_between_stations_against_every_node(monkeypatch, name, node_bound, line_bound):
     """The node motions' residual is evaluated at 2 + 7 station nodes and interpolated
@@ -270,9 +271,10 @@ def test_motions_between_stations_against_every_node(monkeypatch, name, node_bou
     3.0 % (node 12's x); the bounds add a fifth.  The two-segment line's rope near the
     bed (nodes 29–35) is where the interpolation is coarse: its linear x σ wiggles
     between 0.018 and 0.038 m from node to node and the residual does not, so the
-    ratio per node runs 0.2–10 where the stations 26 and 33 give 0.19 and 1.96 (up to
+    ratio per node runs 0.2–10 where the stations 26 and 33 give 0.19 and 1.62 (up to
     56 % off in σ at a node): bounded there against the x motion's largest σ (the
-    fairlead's 0.47 m): 7.2 % measured.  Over the components moving at least 1 % of
+    fairlead's 0.47 m): 8.4 % measured (7.2 % with the drag residual's panels grouped
+    by the sea before the fixed tiles).  Over the components moving at least 1 % of
     the line's largest σ (the held ends: no residual)."""
     lin, got, ref = _motions_every_node(monkeypatch, name)
     live = lin > 0.01 * lin.max()

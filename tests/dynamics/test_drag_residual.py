@@ -21,6 +21,7 @@ from _scenes import chain_surge_doc, td_end_sigma
 from scipy import stats
 
 import stochcable.dynamics.residuals.drag_residual as dr
+import stochcable.dynamics.residuals.drag_segments as drag_segments
 import stochcable.dynamics.residuals.geometric_residual as gr
 import stochcable.dynamics.residuals.influence as influence
 import stochcable.dynamics.residuals.residual_lines as rl
@@ -217,6 +218,7 @@ def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(gr, "LINE_STRIDE", 1)  # (its grid: the drag's)
     monkeypatch.setattr(gr, "ELEMENT_FLOOR", 0.0)  # (every element)
     monkeypatch.setattr(dr, "MAX_PANELS", 64)
+    monkeypatch.setattr(drag_segments, "CONTINUOUS_PIECES", False)  # (equal pieces)
     monkeypatch.setattr(dr, "SUB_SAMPLES", 1)
     monkeypatch.setattr(dr, "MISFIT_EXACT", True)
     monkeypatch.setattr(dr, "PANEL_FLOOR", 0.0)

@@ -17,7 +17,9 @@ import pytest
 from scipy import stats
 
 import stochcable.dynamics.residuals.drag_residual as dr
+import stochcable.dynamics.residuals.drag_segments as drag_segments
 from stochcable import analyze, load_example, load_scene
+from stochcable.cases import run_cases, scatter_from_rows
 from stochcable.dynamics.loads.channels import line_channels
 from stochcable.dynamics.model.system import build_line_system
 from stochcable.dynamics.residuals.drag_residual import hermite_coefficients, residual_output_lines
@@ -98,6 +100,66 @@ def test_panel_loads_are_unit_forces_at_the_panels_centroids():
         np.testing.assert_allclose(mag @ x / mag.sum(), share @ at, rtol=1e-8)
     whole = Segments(np.arange(160), np.zeros(160), np.ones(160), np.ones(160), np.zeros(160, bool))
     assert len(panel_groups(whole, dr.MAX_PANELS)) == 32
+
+
+def _chain_in(tp: float):
+    """The chain example's system and channels in a JONSWAP sea, Hs 5 m, Tp ``tp``."""
+    doc = load_example("chain_catenary").model_dump(mode="json")
+    doc["sea"]["spectrum"] = {"type": "jonswap", "hs": 5.0, "tp": tp}
+    scene = load_scene(doc)
+    line = scene.lines[0]
+    system = build_line_system(scene, line, solve_statics(scene).lines[line.name])
+    chans = line_channels(scene, line, system.positions, scene.analysis.omega.values())
+    mesh = system.model.mesh
+    scale = 0.5 * system.model.rho * mesh.diameter * (mesh.cd_normal + math.pi * mesh.cd_axial)
+    return system, chans, scale
+
+
+def test_the_grouping_is_the_meshs_and_the_pieces_move_continuously():
+    """The chain (40 elements) in seas of Tp 8 and 14 s: its whole elements are grouped
+    within the same tiles of ⌈40/32⌉ = 2 elements whatever the sea (before: groups of
+    2 or 3 by the sea's variance, the fairlead σ's correction stepping by 2.4e-3
+    between periods 0.5 s apart); a split element's pieces, but for the last, are
+    1/want of it long, so a piece appears at zero length (a sea between two whole
+    numbers of pieces: its last piece shorter than the others)."""
+    for tp in (8.0, 14.0):
+        system, chans, scale = _chain_in(tp)
+        seg = segments(system, chans, scale, dr.MAX_PANELS)
+        groups = panel_groups(seg, dr.MAX_PANELS)
+        for g in groups:
+            assert np.unique(seg.element[g] // 2).size == 1
+        split = np.flatnonzero(np.bincount(seg.element) > 1)
+        assert split.size > 0
+        lengths = [(seg.hi - seg.lo)[seg.element == e] for e in split]
+        # Tp 8 s: six elements want 2.4–4.3 pieces, the budget (16) caps them at two equal
+        # pieces; Tp 14 s: seven, uneven (want not whole)
+        assert any(np.ptp(x) > 0.05 for x in lengths) == (tp == 14.0)
+    # equal pieces with the evaluation before (CONTINUOUS_PIECES false)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(drag_segments, "CONTINUOUS_PIECES", False)
+        seg = segments(system, chans, scale, dr.MAX_PANELS)
+    for e in np.flatnonzero(np.bincount(seg.element) > 1):
+        assert np.ptp((seg.hi - seg.lo)[seg.element == e]) < 1e-12
+
+
+def test_corrections_are_smooth_in_the_period():
+    """The chain's fairlead σ correction (corrected over linear σ) at Hs 5 m over Tp
+    8–12 s in steps of 0.5 s: neighbours within 6e-4 (measured ≤ 4.3e-4, where an
+    element starts to split or a tile is cut; before the fixed tiles 2.4e-3): what
+    lets a load-case set interpolate the corrections between few computed periods
+    (docs/benchmarks/cases.md)."""
+    tps = np.arange(8.0, 12.01, 0.5)
+    rows = [{"hs": 5.0, "tp": t, "heading": 0.0, "probability": 1 / tps.size} for t in tps]
+    sd = scatter_from_rows(rows)
+    doc = load_example("chain_catenary").model_dump(mode="json")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        on = run_cases(doc, sd, residual_tolerance=None).stats["leg1"]["end_b"][:, 1]
+        doc["analysis"]["linearization"].update(drag_residual=False, geometric_residual=False)
+        off = run_cases(doc, sd).stats["leg1"]["end_b"][:, 1]
+    ratio = on / off
+    assert np.all(ratio > 1.03)
+    assert np.abs(np.diff(ratio)).max() < 6e-4
 
 
 @pytest.mark.slow

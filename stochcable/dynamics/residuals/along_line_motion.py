@@ -4,24 +4,23 @@ form for the end tensions (as :mod:`.along_line` does for the element tensions).
 
 A node's displacement component u_n,c = e_n,cᵀ u is another linear output of the
 residual loads: with the ends held, u_f = A⁻¹F_f and u_n,c = (A⁻ᵀe_n,c)ᵀF_f (the
-adjoint: one banded solve per frequency for the d components of every station node,
-:func:`node_influence`).  The captured loads pass through these rows unchanged
-(:func:`~stochcable.dynamics.residuals.along_line.element_lines` without the geometric
-feedthrough — a stretch term of the tension, not a displacement;
-:func:`~stochcable.dynamics.residuals.along_line_3d.vector_parts` for a 3-D line's
-drag); a line on free bodies reaches its stations through the coupled group
-(:class:`~stochcable.dynamics.residuals.along_line_bodies.NodeCoupledInfluence`: its
-ends move with the bodies).  The residual variance adds to the linear variance per
-node and component (uncorrelated with the linear response); the stations are up to
-:data:`~stochcable.dynamics.residuals.along_line.MAX_STATIONS` nodes (both end nodes,
-the segment junctions, evenly spaced ones), the other nodes' from the ratio of residual
-to linear variance interpolated linearly in arc length (:func:`motion_weights`).  A
-held end node moves with its prescribed motion only: no residual.  As at the ends
-(:data:`~stochcable.dynamics.residuals.corrected.RESIDUAL_VARIANCE_LIMIT`), a node
-motion whose residual variance is above twice its linear one stays linear, with a
-warning naming the nodes (where one moves at least 1 % of the line's largest): node by
-node, the others keep their residuals (the cable-laying line's out-of-plane motion, ×5.7
-in σ by the 3-D drag residual; the two-segment line's node 33 sits at 1.92×).
+adjoint: the d components of every station node, :func:`node_influence`; on a banded
+line contracted with the loads as solved, :func:`node_transfer`). The captured loads
+pass through these rows unchanged (:func:`~.along_line.element_lines` without the
+geometric feedthrough — a stretch term of the tension, not a displacement;
+:func:`~.along_line_3d.vector_parts` for a 3-D line's drag); a line on free bodies
+reaches its stations through the coupled group
+(:class:`~.along_line_bodies.NodeCoupledInfluence`: its ends move with the bodies). The
+residual variance adds to the linear variance per node and component (uncorrelated with
+the linear response); the stations are up to :data:`~.along_line.MAX_STATIONS` nodes
+(both end nodes, the segment junctions, evenly spaced ones), the other nodes' from the
+ratio of residual to linear variance interpolated linearly in arc length
+(:func:`motion_weights`). A held end node moves with its prescribed motion only: no
+residual. As at the ends (:data:`~.corrected.RESIDUAL_VARIANCE_LIMIT`), a node motion
+whose residual variance is above twice its linear one stays linear, with a warning
+naming the nodes (where one moves at least 1 % of the line's largest): node by node, the
+others keep their residuals (the cable-laying line's out-of-plane motion, ×5.7 in σ by
+the 3-D drag residual; the two-segment line's node 33 sits at 1.92×).
 """
 
 from __future__ import annotations
@@ -60,6 +59,7 @@ __all__ = [
     "motion_stations",
     "solved_stations",
     "node_influence",
+    "node_transfer",
 ]
 
 
@@ -85,15 +85,6 @@ def solved_stations(model: Any, max_stations: int = MAX_STATIONS) -> np.ndarray:
     return at[(at > 0) & (at < model.n_nodes - 1)]
 
 
-def adjoint_solve(system: Any, damping: Any, w: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """x = A⁻ᵀ r on the free nodes for the right-hand sides ``rhs`` ((n_nodes − 2)·d,
-    n_rhs), the line's linear system with ``damping`` (Aᵀ: a travelling line's C − G,
-    a steady lift's C_Lᵀ, as
-    :func:`~stochcable.dynamics.residuals.along_line.element_influence`): shape
-    (n_rhs, n_nodes, d, n_w), zero on the end nodes."""
-    return adjoint_rows(system, damping, rhs, w)
-
-
 def node_rows(model: Any, nodes: np.ndarray) -> np.ndarray:
     """The right-hand sides ((n_nodes − 2)·d, n_nodes_out·d) of the displacements of
     ``nodes`` (node-major, each of the model's d components; zero for an end node)."""
@@ -112,15 +103,13 @@ def node_influence(system: Any, damping: Any, w: np.ndarray, nodes: np.ndarray) 
     linear system with ``damping``: shape (n_nodes_out·d, n_nodes, d, n_w); zero rows
     for an end node. [m/N]
 
-    By the adjoint (module notes): :func:`adjoint_solve` of :func:`node_rows` (an end
-    node's rows, zero, not solved)."""
+    By the adjoint (module notes): :func:`~.band_influence.adjoint_rows` of
+    :func:`node_rows` (an end node's rows, zero, not solved)."""
     model = system.model
-    d = model.dim
-    nodes = np.asarray(nodes, dtype=int)
     rhs = node_rows(model, nodes)
     live = np.flatnonzero(np.any(rhs != 0, axis=0))
-    out = np.zeros((rhs.shape[1], model.n_nodes, d, np.size(w)), dtype=complex)
-    out[live] = adjoint_solve(system, damping, w, rhs[:, live])
+    out = np.zeros((rhs.shape[1], model.n_nodes, model.dim, np.size(w)), dtype=complex)
+    out[live] = adjoint_rows(system, damping, rhs[:, live], w)
     return out
 
 
@@ -136,10 +125,9 @@ def _near(om: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 
 class NodeInfluence:
-    """:func:`node_influence` of one line and drag at ``nodes``, kept for the
-    frequencies asked (an ``influence`` of
-    :func:`~stochcable.dynamics.residuals.residual_lines.load_transfer`; a request all
-    of whose frequencies one kept grid holds is taken from it)."""
+    """:func:`node_influence` of one line and drag at ``nodes``, kept for the frequencies
+    asked (an ``influence`` of :func:`~.residual_lines.load_transfer`; a request all of
+    whose frequencies one kept grid holds is taken from it)."""
 
     def __init__(self, system: Any, damping: Any, nodes: np.ndarray) -> None:
         self.system = system
@@ -159,6 +147,18 @@ class NodeInfluence:
         g = node_influence(self.system, self.damping, w, self.nodes)
         self._kept.append((w.copy(), g))
         return g
+
+
+def node_transfer(influence: Any, w: np.ndarray, unit: np.ndarray) -> np.ndarray:
+    """:func:`sparse_transfer` of ``influence.on(w)`` and the load cases ``unit``, or, where
+    it reads a shared banded influence's ``rows`` (line_result's), their product as they
+    are solved (:meth:`~.influence.EndInfluence.extra_transfer`). [m/unit]"""
+    rows = getattr(influence, "rows", None)
+    fused = getattr(getattr(rows, "shared", None), "extra_transfer", None)
+    if (h := None if fused is None else fused(w, unit, rows.cols)) is not None:
+        return h
+    g = influence.on(w)  # (the modal rows: the loads projected on the modes)
+    return g.transfer(unit) if isinstance(g, ModalRows) else sparse_transfer(g, unit)
 
 
 @dataclass(frozen=True)
@@ -229,8 +229,7 @@ def motion_lines(
         if n_top == 0:
             lines = np.zeros((influence.on(cap.w[:1]).shape[0], cap.w.size))
         else:
-            g = influence.on(w)  # (the modal rows: the loads projected on the modes)
-            full = g.transfer(unit) if isinstance(g, ModalRows) else sparse_transfer(g, unit)
+            full = node_transfer(influence, w, unit)  # (n_out, n_kept, n_sel)
             lines = np.zeros((full.shape[0], cap.w.size))
             part = capture_outputs(cap, full, sel, dtype) * motion_cells(
                 system, damping, unit, w, full, CELL_BENDS[kind] * stride**2, influence

@@ -18,9 +18,11 @@ the velocity variance along the element (its wet part's end values,
 many.  The fluid velocity of a sub-segment is integrated exactly over it
 (:func:`~stochcable.dynamics.element_kinematics.element_wave_kinematics` on the
 subdivided static shape).  Whole elements are grouped into panels (the cost of the
-residual grows with their square) only where the variance is nearly uniform over the
-group (:func:`panel_groups`): on a fine mesh, groups of elements near the surface would
-bring the even split back (the guy on 160 elements in groups of three: +38 % again).
+residual grows with their square) in fixed tiles of the mesh, cut where the variance
+is not nearly uniform over them (:func:`panel_groups`): on a fine mesh, groups of
+elements near the surface would bring the even split back (the guy on 160 elements in
+groups of three: +38 % again).  Neither steps with the sea: a load-case set interpolates
+the residual (docs/benchmarks/cases.md).
 """
 
 from __future__ import annotations
@@ -120,8 +122,7 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
     drag_scale : ndarray, shape (n_el,)
         c per unit length of each element (normal plus axial, ½ρC_dD). [N·s²/m³]
     max_panels : int
-        The panel budget: split elements take at most half of it (the largest
-        splits are reduced first).
+        The panel budget: split elements take at most half of it (:func:`_capped`).
 
     Returns
     -------
@@ -129,9 +130,10 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
     """
     mesh = system.model.mesh
     n_el = system.model.n_elements
-    parts = np.ones(n_el, dtype=int)
+    want = np.ones(n_el)
     kin = _kinematic_channels(channels)
     ends_el = np.full((n_el, 2), np.nan)
+    high_first = np.ones(n_el, dtype=bool)
     if kin:
         ends = np.zeros((n_el, 2))
         for ch in kin:
@@ -145,75 +147,94 @@ def segments(system: Any, channels: Any, drag_scale: np.ndarray, max_panels: int
         live = (hi > 0) & (weight >= WEIGHT_FLOOR * weight.max(initial=0.0))
         with np.errstate(divide="ignore"):
             ratio = np.where(lo > 0, hi / np.where(lo > 0, lo, 1.0), np.inf)
-        want = np.ceil(np.log(np.minimum(ratio, 1e300)) / math.log(SUB_RATIO))
-        parts = np.where(live, np.clip(want, 1, MAX_SUB), 1).astype(int)
+        want = np.log(np.minimum(ratio, 1e300)) / math.log(SUB_RATIO)
+        want = np.where(live, np.clip(want, 1.0, MAX_SUB), 1.0)
         ends_el[live] = ends[live]
-        budget = max_panels // 2
-        while parts[parts > 1].sum() > budget:
-            parts[int(np.argmax(parts))] -= 1
-    element = np.repeat(np.arange(n_el), parts)
-    k = np.concatenate([np.arange(p) for p in parts])
-    m = parts[element].astype(float)
+        high_first = ends[:, 0] >= ends[:, 1]
+        want = _capped(want, weight, max_panels // 2)
+    return _pieces(mesh.l0, want, high_first, ends_el)
+
+
+#: Pieces that move continuously with the sea (:func:`_pieces`); False: ⌈want⌉ equal
+#: ones, as before (the chain's fairlead drag residual variance −3.6e-4). [-]
+CONTINUOUS_PIECES = True
+#: Shortest piece kept, as a fraction of its element (a shorter rest joins its neighbour). [-]
+MIN_PIECE = 1e-6
+
+
+def _capped(want: np.ndarray, weight: np.ndarray, budget: int) -> np.ndarray:
+    """The wants capped at the largest whole number of pieces whose ⌈want⌉ fit in
+    ``budget``; at most the ``budget // 2`` heaviest split.  (A real cap, Σ min(want,
+    c) = budget, is continuous but passes the budget: the chain's panels 34 → 37.)"""
+    split = want > 1.0
+    if np.ceil(want[split]).sum() <= budget:
+        return want
+    if 2 * int(split.sum()) > budget:
+        keep = np.flatnonzero(split)[np.argsort(-weight[split], kind="stable")[: budget // 2]]
+        want = np.where(np.isin(np.arange(want.size), keep), want, 1.0)
+        split = want > 1.0
+    fits = [n for n in range(2, MAX_SUB + 1) if np.ceil(np.minimum(want[split], n)).sum() <= budget]
+    return np.where(split, np.minimum(want, max(fits, default=2)), want)
+
+
+def _pieces(l0: np.ndarray, want: np.ndarray, high_first: np.ndarray, ends_el: np.ndarray):
+    """The pieces of every element: ⌈want⌉ of them, all but the last 1/want of the
+    element long from its high-variance end, the last the rest (so that they move
+    continuously with ``want``: a new piece appears at zero length)."""
+    w = np.where(want > 1.0, want, 1.0)
+    n = np.ceil(w).astype(int)
+    step = w if CONTINUOUS_PIECES else n.astype(float)
+    n = np.where(1.0 - (n - 1) / step < MIN_PIECE, n - 1, n)  # (too short a rest joins)
+    element = np.repeat(np.arange(w.size), n)
+    j = np.arange(element.size) - np.repeat(np.cumsum(n) - n, n)  # (along ξ)
+    m, st, first = n[element], step[element], high_first[element]
+    k = np.where(first, j, m - 1 - j)  # (from the high-variance end)
+    a, b = k / st, np.where(k == m - 1, 1.0, (k + 1) / st)
+    lo, hi = np.where(first, a, 1.0 - b), np.where(first, b, 1.0 - a)
+    parts = np.bincount(element, minlength=l0.size)
     return Segments(
         element=element,
-        lo=k / m,
-        hi=(k + 1) / m,
-        length=mesh.l0[element] / m,
+        lo=lo,
+        hi=hi,
+        length=l0[element] * (hi - lo),
         fine=parts[element] > 1,
         ends=ends_el[element],
     )
 
 
-#: Variance ratios a group of whole elements may span, tried in turn (the finest whose
-#: panels fit in the budget wins): the reason to split an element holds for a group. [-]
-GROUP_RATIOS = (1.05, 1.1, 1.25, 1.5, 2.0, 4.0, 16.0, math.inf)
+#: Largest ratio of the wave-velocity variance a tile of whole elements may span, as an
+#: element (the guy on 160 elements: σ 1.024 × its 40 elements'; 1.043 at 2.25). [-]
+GROUP_RATIO = SUB_RATIO
 
 
 def panel_groups(seg: Segments, max_panels: int) -> list[np.ndarray]:
-    """Pieces grouped into panels: every split element's pieces alone; the runs of
-    whole elements between them in consecutive groups, closed where the group's
-    wave-velocity variance would vary by more than a ratio of :data:`GROUP_RATIOS` (the
-    finest that fits in ``max_panels``) or where it reaches a length (the least that
-    fits; ⌈n/max_panels⌉ for a line without wave kinematics, as equal groups)."""
-    runs: list[np.ndarray] = []
-    start = None
-    for i in range(seg.size + 1):
-        coarse = i < seg.size and not seg.fine[i]
-        if coarse and start is None:
-            start = i
-        elif not coarse and start is not None:
-            runs.append(np.arange(start, i))
-            start = None
-    n_fine = int(seg.fine.sum())
-    n_coarse = seg.size - n_fine
-    room = max(1, max_panels - n_fine - (len(runs) - 1 if runs else 0))
-    ends = np.full((seg.size, 2), np.nan) if seg.ends is None else seg.ends
-    fine = [np.array([i]) for i in np.flatnonzero(seg.fine)]
-    budget = max_panels - n_fine
-    size = max(1, math.ceil(n_coarse / room))
-    for ratio in GROUP_RATIOS:
-        if ratio < math.inf and len(_grouped_all(runs, max(n_coarse, 1), ends, ratio)) > budget:
-            continue  # the ratio alone needs more panels than there are
-        lo, hi = size, max(size, n_coarse)  # the count falls as the length grows: bisect
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if len(_grouped_all(runs, mid, ends, ratio)) <= budget:
-                hi = mid
-            else:
-                lo = mid + 1
-        return sorted(fine + _grouped_all(runs, lo, ends, ratio), key=lambda g: int(g[0]))
-    raise AssertionError("unreachable: GROUP_RATIOS ends with inf")
-
-
-def _grouped_all(runs: list[np.ndarray], size: int, ends: np.ndarray, ratio: float) -> list:
-    """The groups of every run (:func:`_grouped`)."""
-    span = _spans(ends)
-    return [g for run in runs for g in _grouped(run, size, span, ratio)]
+    """Pieces grouped into panels: every split element's pieces alone, the whole
+    elements in fixed tiles of ⌈n_el / max_panels⌉ (the mesh's, not the sea's), cut
+    where a split element interrupts one or its wave-velocity variance would span more
+    than :data:`GROUP_RATIO`: ``max_panels`` tiles, the pieces (:func:`segments`)."""
+    n_el = int(seg.element[-1]) + 1 if seg.size else 0
+    size = max(1, math.ceil(n_el / max_panels))
+    span = _spans(np.full((seg.size, 2), np.nan) if seg.ends is None else seg.ends)
+    out: list[np.ndarray] = []
+    cur: list[int] = []
+    tile, lo, hi = 0, math.inf, 0.0
+    for i in range(seg.size):
+        t = ~i if seg.fine[i] else int(seg.element[i]) // size  # (a piece: a tile alone)
+        v = span[i] if span[i] is not None else (lo, hi)
+        lo_i, hi_i = min(lo, v[0]), max(hi, v[1])
+        if cur and (t != tile or hi_i > max(GROUP_RATIO * lo_i, 0.0)):
+            out.append(np.array(cur))
+            cur = []
+            lo_i, hi_i = span[i] if span[i] is not None else (math.inf, 0.0)
+        cur.append(i)
+        tile, lo, hi = t, lo_i, hi_i
+    if cur:
+        out.append(np.array(cur))
+    return out
 
 
 def _spans(ends: np.ndarray) -> list[tuple[float, float] | None]:
-    """Each piece's (least, largest) finite end variance, None where none is finite
-    (plain floats: :func:`_grouped` walks them one by one)."""
+    """Each piece's (least, largest) finite end variance as floats (None: none finite)."""
     finite = np.isfinite(ends)
     lo = np.where(finite, ends, np.inf).min(axis=1)
     hi = np.where(finite, ends, -np.inf).max(axis=1)
@@ -221,27 +242,6 @@ def _spans(ends: np.ndarray) -> list[tuple[float, float] | None]:
         (float(a), float(b)) if any_ else None
         for a, b, any_ in zip(lo, hi, finite.any(axis=1), strict=True)
     ]
-
-
-def _grouped(
-    run: np.ndarray, size: int, span: list[tuple[float, float] | None], ratio: float
-) -> list[np.ndarray]:
-    """Consecutive groups of ``run`` of at most ``size``, closed where the variance
-    ``span`` of the pieces (:func:`_spans`; None: no matter) would span more than
-    ``ratio``."""
-    out, cur, lo, hi = [], [], math.inf, 0.0
-    for i in run.tolist():
-        v = span[i]
-        lo_i, hi_i = (min(lo, v[0]), max(hi, v[1])) if v is not None else (lo, hi)
-        if cur and (len(cur) == size or (hi_i > 0 and hi_i > ratio * lo_i)):
-            out.append(np.array(cur))
-            cur, lo, hi = [], math.inf, 0.0
-            lo_i, hi_i = v if v is not None else (lo, hi)
-        cur.append(i)
-        lo, hi = lo_i, hi_i
-    if cur:
-        out.append(np.array(cur))
-    return out
 
 
 def segment_velocity(

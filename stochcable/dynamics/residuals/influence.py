@@ -11,20 +11,19 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.model.blocks import (
-    add_blocks,
-    block_matvec,
-    free_band,
-    line_prep,
-    real_gemm,
-)
-from stochcable.dynamics.model.lift import lift_band, lift_pattern
+from stochcable.dynamics.model.blocks import add_blocks, block_matvec, line_prep, real_gemm
 from stochcable.dynamics.model.modal_solvers import foss_modes
-from stochcable.dynamics.model.solvers import solve_band_stacked
-from stochcable.dynamics.model.transport import gyro_band
+from stochcable.dynamics.residuals.band_influence import (
+    BAND_STACK_BYTES,
+    LineAdjoint,
+    adjoint_rows,
+    band_stack,
+    end_coupling,
+    end_directions,
+    end_influence,
+)
 from stochcable.dynamics.residuals.modal_rows import ModalRows, ModalSums
 from stochcable.dynamics.solve.line_loads import drag_blocks
-from stochcable.dynamics.solve.line_solve import end_tension_from_support
 from stochcable.errors import SolverError
 from stochcable.line.fem import SLACK_EA_RATIO
 
@@ -61,19 +60,6 @@ MODAL_SPAN = 4.0
 #: more than its banded solve, 6.6 against 5.3 ms; the chain's 23 of 78: 2.3 against
 #: 6.9 ms). [-]
 MODAL_SHARE = 0.4
-#: Memory of one stack of frequencies of the banded solves of :func:`end_influence`
-#: (:func:`band_stack`): a stack of many frequencies and right-hand sides outgrows the
-#: cache (the deep wire's 2 + 23 rows on 189 lines: 5.9 ms in stacks of 16–32, 11 ms
-#: in stacks of 128; its 2 end rows alone: 1.6 ms in stacks of 64–128, 1.8 in 16). [bytes]
-BAND_STACK_BYTES = 640 * 2**10
-
-
-def band_stack(n_dof: int, d: int, r: int) -> int:
-    """Frequencies per stacked banded solve of ``n_dof`` unknowns (blocks of ``d``) and
-    ``r`` right-hand sides: its band storage and right-hand sides within
-    :data:`BAND_STACK_BYTES` (at least 4)."""
-    per = 16 * n_dof * (3 * (2 * d - 1) + 1 + r)
-    return max(4, int(BAND_STACK_BYTES // per))
 
 
 class EndInfluence:
@@ -94,7 +80,18 @@ class EndInfluence:
         self.extra = extra
         self._kept: list[tuple[np.ndarray, np.ndarray]] = []  # (the end rows)
         self._kept_x: list[tuple[np.ndarray, np.ndarray]] = []  # (the extra rows)
+        self._kept_c: dict[tuple, list] = {}  # (some extra rows, by their columns)
         self._modal = MODAL_INFLUENCE
+        self._adjoint: LineAdjoint | None = None
+
+    def adjoint(self, w: np.ndarray) -> LineAdjoint:
+        """The line's banded adjoint, its factors kept (made at the first solve, the job
+        all rows on ``w``)."""
+        if self._adjoint is None:
+            k = 2 + (0 if self.extra is None else self.extra.shape[1])
+            nf = (self.system.model.n_nodes - 2) * self.system.model.dim
+            self._adjoint = LineAdjoint(self.system, self.damping, w.size * nf * k)
+        return self._adjoint
 
     @staticmethod
     def _find(kept: list, w: np.ndarray, rows: slice = slice(None)) -> np.ndarray | None:
@@ -113,7 +110,7 @@ class EndInfluence:
         g = modal_influence(self.system, self.damping, w, self.extra) if self._modal else None
         if g is None:
             self._modal = False
-            g = end_influence(self.system, self.damping, w, self.extra if extra else None)
+            g = self.adjoint(w).rows(w, self.extra if extra else None)
         self._kept.append((w.copy(), g[:2]))
         if g.shape[0] > 2:
             self._kept_x.append((w.copy(), g[2:]))
@@ -145,7 +142,31 @@ class EndInfluence:
         g = self._find(self._kept_x, w, cols)
         if g is None and self._modal:
             return self.extra_on(w, cols)
+        if g is not None:
+            return g
+        key = (cols.start, cols.stop)
+        g = self._find(self._kept_c.get(key, []), w)
+        if g is None and self._adjoint is not None:  # (by substitution in kept factors)
+            g = self._adjoint.kept_rows(w, self.extra[:, cols])
+            if g is not None:
+                self._kept_c.setdefault(key, []).append((w.copy(), g))
         return g
+
+    def extra_transfer(
+        self, w: np.ndarray, unit: np.ndarray, cols: slice = slice(None)
+    ) -> np.ndarray | None:
+        """The ``extra`` rows ``cols`` on ``w`` per unit load case ``unit`` (n_nodes, d,
+        n_load), shape (k, n_load, n_w), where the banded path's kept factors hold ``w``
+        and the rows are not formed yet: contracted with the loads as they are solved
+        (:meth:`~.band_influence.LineAdjoint.kept_transfer`; the deep wire's node rows:
+        1.6 MB never written nor transposed); None otherwise (the caller's product of
+        :meth:`extra_kept`'s rows). [unit/unit]"""
+        w = np.asarray(w, dtype=float)
+        if self._modal or self._adjoint is None or self._find(self._kept_x, w) is not None:
+            return None
+        if self._find(self._kept_c.get((cols.start, cols.stop), []), w) is not None:
+            return None
+        return self._adjoint.kept_transfer(w, self.extra[:, cols], unit)
 
 
 class SharedRows:
@@ -169,8 +190,7 @@ class SharedRows:
             return g
         g = EndInfluence._find(self._own, w)
         if g is None:
-            sh = self.shared
-            g = end_influence(sh.system, sh.damping, w, sh.extra[:, self.cols])[2:]
+            g = self.shared.adjoint(w).rows(w, self.shared.extra[:, self.cols], ends=False)
             self._own.append((w.copy(), g))
         return g
 
@@ -185,98 +205,6 @@ def shared_rows(shared: Any, rhs: np.ndarray, start: int) -> SharedRows | None:
     return SharedRows(shared, cols)
 
 
-def end_influence(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None = None
-) -> np.ndarray:
-    """End tensions (end_a, end_b) per unit force on each node and component, ends
-    prescribed, the line's linear system with ``damping``: shape (2, n_nodes, d, n_w).
-    [N/N]
-
-    ``extra`` ((n_nodes − 2)·d, k), optional: more adjoint right-hand sides r (constant
-    in ω, on the free nodes), solved in the same factorization: rows 2 … 2 + k − 1 of
-    the result are (A⁻ᵀr)ᵀ on the free nodes and zero on the end nodes (the outputs r·u
-    per unit node force: the element tensions of :mod:`.along_line`).
-
-    By the adjoint: with the ends held, T = ê·F_end − ê·Z_end,f u_f and u_f = A⁻¹F_f,
-    A = Z_ff = K − ω²M + iωC the free–free impedance; A is symmetric (not Hermitian),
-    so T = ê·F_end − (A⁻¹g)ᵀF_f, g = Z_f,end ê: two solves per frequency (one
-    factorization) whatever the number of load cases.  A travelling line's A has the
-    skew G (:mod:`stochcable.dynamics.model.transport`), a line with a steady lift the
-    non-symmetric C_L (:mod:`stochcable.dynamics.model.lift`): then Aᵀ (C − G + C_Lᵀ) is
-    solved, with g = Z_end,fᵀ ê."""
-    model = system.model
-    prep = line_prep(system)
-    d = model.dim
-    n = model.n_nodes
-    cd = drag_blocks(system, damping)
-    c = add_blocks(prep.S, cd)
-    b_c = prep.bS + free_band(cd)
-    if system.gyro is not None:  # a travelling line: Aᵀ has C − G (dynamics.model.transport)
-        b_c = b_c - gyro_band(system.gyro, d)
-    lift_t = None if system.lift is None else np.transpose(system.lift, (0, 2, 1))
-    if lift_t is not None:  # a steady lift: Aᵀ has C_Lᵀ (dynamics.model.lift)
-        pat = lift_pattern(model)
-        b_c = b_c + lift_band(lift_t, pat)
-    e_a, e_b = _end_directions(system)
-    k_x = 0 if extra is None else extra.shape[1]
-    out = np.zeros((2 + k_x, n, d, w.size), dtype=complex)
-    out[0, 0] = e_a[:, None]
-    out[1, -1] = e_b[:, None]
-    # the end rows' coupling blocks Z(1, 0) and Z(n − 2, n − 1)
-    g = _end_coupling(system, prep, c, (e_a, e_b), lift_t)  # (3, n_f·d, 2)
-    step = band_stack((n - 2) * d, d, 2 + k_x)
-    for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
-        ws = w[sl]
-        rhs = np.zeros((ws.size, (n - 2) * d, 2 + k_x), dtype=complex)
-        if k_x:
-            rhs[:, :, 2:] = extra
-        rhs[:, :, :2] = (
-            g[0][None] - (ws * ws)[:, None, None] * g[1][None] + (1j * ws)[:, None, None] * g[2]
-        )
-        x = solve_band_stacked(
-            prep.bK, prep.bM, b_c, rhs, ws, 2 * d - 1, 2 * d - 1, (model.K, model.M)
-        )  # (n_w, n_f·d, 2 + k)
-        out[:, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, 2 + k_x), (3, 1, 2, 0))
-        out[:2, 1:-1, :, sl] *= -1.0
-    return out
-
-
-def _end_directions(system: Any) -> tuple[np.ndarray, np.ndarray]:
-    """ê of each end (d,): the end tension of a unit support force along each component."""
-    d = system.model.dim
-    eye = np.eye(2 * d)[None].astype(complex)
-    ten = end_tension_from_support(system, eye)
-    e_hat = [np.real(ten[end][:, 0]) for end in ("end_a", "end_b")]  # (2d,) each
-    return e_hat[0][:d], e_hat[1][d:]
-
-
-def _end_coupling(
-    system: Any, prep: Any, c: Any, e_hat: tuple[np.ndarray, np.ndarray], lift_t: Any
-) -> np.ndarray:
-    """The adjoint right-hand sides of the end rows, g = Z_end,fᵀ ê = g_K − ω²g_M + iωg_C,
-    as (g_K, g_M, g_C) on the free DOFs: shape (3, (n_nodes − 2)·d, 2) (g_C complex
-    where the transport or lift terms enter)."""
-    model = system.model
-    d, n = model.dim, model.n_nodes
-    out = np.zeros((3, (n - 2) * d, 2), dtype=complex)
-    o_first = [blk[1][0] for blk in (prep.K, prep.MT, c)]
-    o_last = [blk[1][-1] for blk in (prep.K, prep.MT, c)]
-    last = slice((n - 3) * d, None)
-    for k, (o, vec, rows, tr) in enumerate(
-        ((o_first, e_hat[0], slice(0, d), False), (o_last, e_hat[1], last, True))
-    ):
-        blocks = [b.T if tr else b for b in o]
-        for j, b in enumerate(blocks):  # (d,) of K, M, C
-            out[j, rows, k] = b @ vec
-        if system.gyro is not None:  # Z_end,fᵀ ê: G[0, 1]ᵀ = g_0 I, G[n−1, n−2]ᵀ = −g I
-            gy = system.gyro[-1 if tr else 0] * (-1.0 if tr else 1.0)
-            out[2, rows, k] += gy * vec
-        if lift_t is not None:  # C_L[0, 1]ᵀ ê_a, C_L[n−1, n−2]ᵀ ê_b
-            cl = lift_pattern(model)[1, 0] * lift_t[-1 if tr else 0] @ vec
-            out[2, rows, k] += cl
-    return out
-
-
 def modal_influence(
     system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None = None
 ) -> np.ndarray | None:
@@ -285,7 +213,7 @@ def modal_influence(
     (Tuah 1982, §5.3), the transfer the linear response itself is solved with, its
     basis widened to every computed mode up to :data:`MODAL_SPAN` times the highest
     frequency (:func:`_influence_modes`).  Every right-hand side is a fixed vector or,
-    for the end rows, g_K − ω²g_M + iωg_C (:func:`_end_coupling`), so each is projected
+    for the end rows, g_K − ω²g_M + iωg_C (:func:`end_coupling`), so each is projected
     once and the frequencies enter through the modal denominators only: no
     factorization per frequency (the chain's 2 + 7 rows on 189 lines: 2.3 against
     6.9 ms).  Frequencies above the highest computed mode over :data:`MODAL_SPAN`
@@ -368,8 +296,8 @@ def _modal_projection(
         except SolverError:
             return None
         prep.cache["influence_foss"] = (damping, (phi, mh, kh), foss)
-    e_a, e_b = _end_directions(system)
-    g = _end_coupling(system, prep, c, (e_a, e_b), None)  # (3, n_f·d, 2)
+    e_a, e_b = end_directions(system)
+    g = end_coupling(system, prep, c, (e_a, e_b), None)  # (3, n_f·d, 2)
     k_x = 0 if extra is None else extra.shape[1]
     cols = np.concatenate([g[0], g[1], g[2]] + ([extra] if k_x else []), axis=1)
     cols = np.ascontiguousarray(cols, dtype=complex)  # (n_f·d, 6 + k)
@@ -498,31 +426,4 @@ def geometric_feedthrough(system: Any, n_all: int) -> np.ndarray:
         for i, f in enumerate(element_frames(system)):
             out[k, i * n_el + k] += kappa * (r_e @ f[k, comps])
     out[el, el] -= stiff / length
-    return out
-
-
-def adjoint_rows(system: Any, damping: Any, rhs: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """The adjoint system's solution for the right-hand sides ``rhs`` ((n − 2)·d, r) on
-    ``w``, ends held, shape (r, n_nodes, d, n_w): each output row's answer per unit
-    force on every node (Aᵀ has C − G for a travelling line, C_Lᵀ with a steady lift, as
-    :func:`end_influence`), in stacks of :func:`band_stack` frequencies. [unit/N]"""
-    w = np.asarray(w, dtype=float)
-    model = system.model
-    prep = line_prep(system)
-    d, n = model.dim, model.n_nodes
-    b_c = prep.bS + free_band(drag_blocks(system, damping))
-    if system.gyro is not None:
-        b_c = b_c - gyro_band(system.gyro, d)
-    if system.lift is not None:
-        b_c = b_c + lift_band(np.transpose(system.lift, (0, 2, 1)), lift_pattern(model))
-    r = rhs.shape[1]
-    out = np.zeros((r, n, d, w.size), dtype=complex)
-    step = band_stack((n - 2) * d, d, max(r, 1))
-    for sl in (slice(i, min(i + step, w.size)) for i in range(0, w.size, step)):
-        ws = w[sl]
-        x = solve_band_stacked(
-            prep.bK, prep.bM, b_c, np.broadcast_to(rhs, (ws.size,) + rhs.shape), ws,
-            2 * d - 1, 2 * d - 1, (model.K, model.M),
-        )  # (n_w, (n − 2)·d, r)  # fmt: skip
-        out[:, 1:-1, :, sl] = np.transpose(x.reshape(ws.size, n - 2, d, r), (3, 1, 2, 0))
     return out
