@@ -171,17 +171,32 @@ class ResidualTap(VectorTapMixin):
             if keep:
                 self.captures[-1].blocks.append(block)
             return
-        n_o = transfer.shape[2]
-        cols = [np.ascontiguousarray(transfer[:, c]).tobytes() for c in range(transfer.shape[1])]
         for unit, w, h in reversed(self._loads):
-            if h.shape[2] != n_o or h.shape[0] != transfer.shape[0]:
-                continue
-            index = {np.ascontiguousarray(h[:, j]).tobytes(): j for j in range(h.shape[1])}
-            if all(c in index for c in cols):
-                kept = np.array([index[c] for c in cols], dtype=int)
+            kept = _columns_of(transfer, h)
+            if kept is not None:
                 self.captures.append(Capture(w, unit, kept, transfer, [block] if keep else []))
                 return
         self.unmatched += 1
+
+
+def _columns_of(transfer: np.ndarray, h: np.ndarray) -> np.ndarray | None:
+    """The columns of ``h`` (n_out, n_all, n_o) that ``transfer`` (n_out, n, n_o) holds,
+    in its order (indices), or None where it is not made of them: matched by their
+    first line, then every column checked whole at once (column by column where the
+    first lines repeat)."""
+    if h.shape[0] != transfer.shape[0] or h.shape[2] != transfer.shape[2]:
+        return None
+    first = {np.ascontiguousarray(h[:, j, 0]).tobytes(): j for j in range(h.shape[1])}
+    keys = [np.ascontiguousarray(transfer[:, c, 0]).tobytes() for c in range(transfer.shape[1])]
+    if len(first) == h.shape[1] and all(k in first for k in keys):
+        kept = np.array([first[k] for k in keys], dtype=int)
+        if np.array_equal(h[:, kept], transfer):
+            return kept
+    cols = [np.ascontiguousarray(transfer[:, c]).tobytes() for c in range(transfer.shape[1])]
+    index = {np.ascontiguousarray(h[:, j]).tobytes(): j for j in range(h.shape[1])}
+    if all(c in index for c in cols):
+        return np.array([index[c] for c in cols], dtype=int)
+    return None
 
 
 @contextmanager
@@ -401,16 +416,16 @@ def misfit_lines(
     exact = np.flatnonzero(bent_cells(on_lines)[at])
     if exact.size:
         h[:, :, exact] = load_transfer(system, damping, unit, w[exact], influence)
-    h_c = np.einsum("opw,cpw->cow", h, load)
+    h_c = np.transpose(np.transpose(h, (2, 0, 1)) @ np.transpose(load, (2, 1, 0)), (2, 1, 0))
     q = trapezoid_weights(w)[None, None] * spectra[:, None]
     return np.sum(q * (np.abs(linear + h_c) ** 2 - np.abs(linear) ** 2), axis=0)
 
 
-def bent_cells(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
+def bent_cells(h: np.ndarray, bend: float = CELL_BEND, power: Any = None) -> np.ndarray:
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
     loads, bends by more than ``bend`` between neighbours, and their neighbours (as
     :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`'s cells)."""
-    power = np.sum(np.abs(h) ** 2, axis=1)
+    power = np.sum(np.abs(h) ** 2, axis=1) if power is None else power  # (n_out, n_o)
     logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
     out = np.zeros(power.shape[1], dtype=bool)
     out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)

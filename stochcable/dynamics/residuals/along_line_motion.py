@@ -259,11 +259,11 @@ def motion_cells(
     output's own factor. [-]"""
     if not isinstance(influence, NodeInfluence):
         return cell_factor(system, damping, unit, w, h, bend, influence=influence)
-    cells = np.flatnonzero(bent_cells(h, bend))
-    if cells.size == 0:
-        return np.ones(h.shape[::2])  # (n_out, n_o)
     power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
+    cells = np.flatnonzero(bent_cells(h, bend, power))
     out = np.ones_like(power)
+    if cells.size == 0:
+        return out
     d = system.model.dim
     # each component: the station node moving most in it (one solve for them all)
     top = [int(np.argmax(power[c::d][:, cells].sum(axis=1))) for c in range(d)]

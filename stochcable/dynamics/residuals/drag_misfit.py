@@ -62,19 +62,19 @@ def misfit_variance(
         unit, load = mis
         grid, w_out, influence, bent = lines
         at = np.clip(grid.index - 1, 0, w_out.size - 1)  # (line j is w_out[j − 1])
-        h = load_transfer(system, damping, unit, w_out, influence)[:, :, at]  # (2, n_load, n_w)
+        h = load_transfer(system, damping, unit, w_out[: at.max() + 1], influence)[:, :, at]
         solved = np.arange(w.size) if exact else np.flatnonzero(bent[at])
         if solved.size:
             h[:, :, solved] = load_transfer(system, damping, unit, w[solved], coupled)
         if (tap := RESIDUAL_TAP.get()) is not None:  # (the element tensions': .along_line)
             tap.misfit(unit, load, w)
-        h_c += np.einsum("opw,cpw->ocw", h, load)
+        h_c += _outputs(h, load)
     for c, infl in others or ():  # (through the bodies: H_c of this line's ends)
         mis = misfit_loads(infl.line.system.model, c.seg, c.groups, c.live, c.parts, c.misfit)
         if mis is not None:
             with untapped():
                 h = load_transfer(infl.line.system, infl.line.damping, mis[0], w, infl)
-            h_c += np.einsum("opw,cpw->ocw", h, mis[1])
+            h_c += _outputs(h, mis[1])
     if not np.any(h_c):
         return {}
     q = trapezoid_weights(w)[None] * spectra
@@ -83,6 +83,12 @@ def misfit_variance(
         h_l = np.asarray(resp.end_tension[end])
         out[end] = np.sum(q * (np.abs(h_l + h_c[o]) ** 2 - np.abs(h_l) ** 2), axis=0)
     return out
+
+
+def _outputs(h: np.ndarray, load: np.ndarray) -> np.ndarray:
+    """Σ_p h[o, p, w]·load[c, p, w], shape (n_out, n_ch, n_w) (``np.einsum("opw,cpw->ocw")``
+    as one batched product over the frequencies)."""
+    return np.transpose(np.transpose(h, (2, 0, 1)) @ np.transpose(load, (2, 1, 0)), (1, 2, 0))
 
 
 def misfit_loads(

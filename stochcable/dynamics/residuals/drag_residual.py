@@ -58,7 +58,6 @@ O(panels² · n_fft log n_fft)).
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -67,12 +66,19 @@ import numpy as np
 
 from stochcable.dynamics.linearization.variance import current_split
 from stochcable.dynamics.residuals.body_residual import untapped, with_group_lines
+from stochcable.dynamics.residuals.drag_hermite import (
+    HERMITE_ORDER,
+    LUMPED_ORDER,
+    hermite_coefficients,
+    lumped_coefficients,
+)
 from stochcable.dynamics.residuals.drag_misfit import misfit_variance
 from stochcable.dynamics.residuals.drag_segments import (
     Segments,
     panel_groups,
     panel_loads,
     panel_mean,
+    panel_share,
     segment_velocity,
     segments,
 )
@@ -80,7 +86,6 @@ from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     PairLines,
     UniformGrid,
-    covariance_lines,
     element_directions,
     fft_length,
     load_transfer,
@@ -102,9 +107,6 @@ __all__ = [
     "residual_output_lines",
 ]
 
-#: Highest Hermite order kept: k = 2 … 5 carry all but 0.7 % of the residual variance
-#: of zero-mean drag (k = 3: 4/(3π) = 0.424 of 3 − 8/π = 0.454). [-]
-HERMITE_ORDER = 5
 #: Most panels (groups of consecutive elements) the residual is evaluated on: the cost
 #: grows with their square; 54 panels of the chain's 160 elements give the
 #: element-by-element variance within 1 % (tests/dynamics/test_drag_residual.py). [-]
@@ -114,9 +116,6 @@ MAX_PANELS = 32
 #: time domain: +18 % on the taut wire and on the inclined guy, +4 / +7 % on the chain
 #: (docs/benchmarks/drag_residual.md). [-]
 RESIDUAL_WARN_RATIO = 1.25
-#: Orders of the default evaluation: 2 and 3, each carrying the variance of the higher
-#: orders of its parity (:func:`lumped_coefficients`). [-]
-LUMPED_ORDER = 3
 #: The misfit's end tensions per unit load solved at every analysis frequency (the
 #: evaluation before issue 31), not taken at the residual's nearest line
 #: (:func:`~stochcable.dynamics.residuals.drag_misfit.misfit_variance`). [-]
@@ -132,84 +131,6 @@ SUB_SAMPLES = 5
 #: Bend of the log power between neighbouring lines (|Δ² ln P|) above which a cell's
 #: transfer functions are sub-sampled (:func:`cell_factor`). [-]
 CELL_BEND = 0.1
-
-
-def hermite_coefficients(mu: Any, order: int = HERMITE_ORDER) -> np.ndarray:
-    """Hermite coefficients a_k(μ) of g(μ + x) = |μ + x|(μ + x), x ~ N(0, 1).
-
-    Parameters
-    ----------
-    mu : array_like, shape (n,)
-        Mean over standard deviation of the relative velocity, U/σ. [-]
-    order : int
-        Highest order k.
-
-    Returns
-    -------
-    ndarray, shape (n, order + 1)
-        a_k = E[g(μ + x) He_k(x)]/k! (probabilists' Hermite polynomials); a₁ = 2E|μ + x|
-        (Stein's lemma: the Borgman coefficient over cσ); exact to round-off for
-        |μ| < 12.  The callers clip μ to ±10: beyond, the kink lies more than 10σ out
-        (weight e^-50) and g is the polynomial ±(μ + x)², whose residual coefficients
-        no longer change (a₂ = ±1, a_k = 0 for k ≥ 3).
-    """
-    m = np.atleast_1d(np.asarray(mu, dtype=float))
-    x, w = _gauss_points(-m)
-    g = np.abs(m[:, None] + x) * (m[:, None] + x) * w
-    out = np.empty((m.size, order + 1))
-    he_prev, he = np.zeros_like(x), np.ones_like(x)  # He_{k+1} = x·He_k − k·He_{k−1}
-    for k in range(order + 1):
-        out[:, k] = np.sum(g * he, axis=1) / math.factorial(k)
-        he_prev, he = he, x * he - k * he_prev
-    return out
-
-
-@functools.lru_cache(maxsize=1)
-def _legendre(n: int = 64) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss–Legendre nodes and weights on [−1, 1] (formed once)."""
-    return np.polynomial.legendre.leggauss(n)
-
-
-def _gauss_points(*kinks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Points and weights (n, m) of E[f(x)], x ~ N(0, 1), for f a polynomial on each
-    side of the ``kinks`` (each (n,)): Gauss–Legendre between the kinks over ±12 (the
-    Gaussian tail beyond is e^-72), exact to round-off for kinks within ±12."""
-    t, wt = _legendre()
-    lo, hi = -12.0, 12.0
-    edges = np.sort(np.stack([np.full(kinks[0].shape, lo)] + [np.clip(k, lo, hi) for k in kinks]
-                             + [np.full(kinks[0].shape, hi)], 1), axis=1)  # fmt: skip
-    a, b = edges[:, :-1, None], edges[:, 1:, None]
-    x = (0.5 * (b - a) * t + 0.5 * (b + a)).reshape(edges.shape[0], -1)
-    w = (0.5 * (b - a) * wt).reshape(edges.shape[0], -1)
-    return x, w * np.exp(-0.5 * x * x) / math.sqrt(2.0 * math.pi)
-
-
-def lumped_coefficients(mu: Any, order: int = LUMPED_ORDER) -> np.ndarray:
-    """Hermite coefficients (as :func:`hermite_coefficients`) up to ``order`` whose two
-    highest (one odd, one even) carry the variance of all higher orders of their
-    parity: k!·a_k² of the top odd order is Σ_{j odd ≥ k} j!·a_j², of the top even order
-    likewise (sign of a_k kept).
-
-    The sums are closed: Σ_j j!·a_j² = E[g(μ + x)²] = μ⁴ + 6μ² + 3 over all orders, its
-    even part E[g(μ + x)·(g(μ + x) + g(μ − x))]/2 (He_j(−x) = (−1)^j He_j(x)).  A panel's
-    residual variance is then exact, and the lags' shape of the orders above ``order``
-    is that of the top order of their parity (their cross-covariances are taken as
-    ρ^order, not ρ^j: tested against the orders kept one by one)."""
-    m = np.atleast_1d(np.asarray(mu, dtype=float))
-    out = hermite_coefficients(m, order)
-    x, w = _gauss_points(-m, m)
-    gp, gm = (np.abs(m[:, None] + x) * (m[:, None] + x), np.abs(m[:, None] - x) * (m[:, None] - x))
-    total = m**4 + 6.0 * m**2 + 3.0
-    even = 0.5 * (total + np.sum(gp * gm * w, axis=1))
-    tails = {0: even - out[:, 0] ** 2, 1: total - even - out[:, 1] ** 2}
-    for k in (order, order - 1):
-        if k < 2:
-            continue
-        below = sum(math.factorial(j) * out[:, j] ** 2 for j in range(k % 2 + 2, k, 2))
-        tail = np.maximum(tails[k % 2] - below, 0.0)
-        sign = np.where(out[:, k] < 0.0, -1.0, 1.0)
-        out[:, k] = sign * np.sqrt(tail / math.factorial(k))
-    return out
 
 
 def residual_output_lines(
@@ -260,17 +181,19 @@ def residual_output_lines(
     # Horner's rule, its lines
     zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
     out = PairLines(transfer)  # (the element tensions read its dense lines: .along_line)
+    lo, hi = ks[0], ks[-1]
     for e, f in pair_blocks(n_p, n_fft):
         rho = pair_lags(zz, e, f, n_fft)
-        rr = (b[e, ks[-1]] * b[f, ks[-1]])[:, None] * rho
-        for k in range(ks[-1] - 1, ks[0] - 1, -1):
-            rr += (b[e, k] * b[f, k])[:, None]
+        # b_k^e·b_k^f with the pairs f > e weighted 2 and covariance_lines' 2/n_fft in
+        c = b[e, lo : hi + 1] * b[f, lo : hi + 1]
+        c *= np.where(f > e, 4.0 / n_fft, 2.0 / n_fft)[:, None]
+        rr = c[:, -1:] * rho
+        for i in range(hi - lo - 1, -1, -1):
+            rr += c[:, i : i + 1]
             rr *= rho
-        for _ in range(ks[0] - 1):
+        for _ in range(lo - 1):
             rr *= rho
-        g = covariance_lines(rr, n_o)
-        g[f > e] *= 2.0
-        out.add(g, e, f)
+        out.add(np.fft.rfft(rr, axis=1)[:, 1 : n_o + 1], e, f)  # (covariance_lines)
     return out.outputs()
 
 
@@ -339,7 +262,8 @@ def drag_residual(
     influence = EndInfluence(system, damping) if influence is None else influence
     h_all = load_transfer(system, damping, comp.unit, comp.w_out, influence)
     keep = _live_panels(comp.lines, comp.scale, comp.coeffs, h_all)
-    cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled)
+    bent = _bent(h_all)  # (the cells: the residual's and the misfit's)
+    cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled, cells=bent)
     own = residual_output_lines(
         comp.lines[:, keep], comp.scale[keep], comp.coeffs[keep], h_all[:, keep], comp.n_fft
     )
@@ -353,7 +277,7 @@ def drag_residual(
         comp.live,
         comp.parts,
         comp.misfit,
-        (comp.grid, comp.w_out, influence, _bent(h_all)),
+        (comp.grid, comp.w_out, influence, bent),
         coupled,
         [(c, src) for _, c, src in others],
         MISFIT_EXACT,
@@ -426,13 +350,14 @@ def drag_components(
     # functions of jointly Gaussian velocities, so their cross terms count too (where
     # the linear tensions of the two cancel, so do the residuals' in part)
     scales, coeffs, lines, misfit = [], [], [], []
+    share = panel_share(seg, groups)
+    piece = np.concatenate(groups)  # (each piece's panel: the panels' c·L by one sum)
+    panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
     for name in live:
         c_el, mean_el, _, b_el = parts[name]
-        scales.append(
-            np.array([float(np.sum(c_el[seg.element[g]] * seg.length[g])) for g in groups])
-        )
-        mean = panel_mean(mean_el[seg.element], seg, groups)
-        pan = panel_mean(seg_v[name], seg, groups)  # (n_ch, n_p, n_w)
+        scales.append(np.bincount(panel, (c_el[seg.element] * seg.length)[piece], len(groups)))
+        mean = panel_mean(mean_el[seg.element], seg, groups, share)
+        pan = panel_mean(seg_v[name], seg, groups, share)  # (n_ch, n_p, n_w)
         v = grid.lines(pan, spectra)
         sig = np.sqrt(np.sum(np.abs(v) ** 2, axis=(0, 2)))
         mu = np.where(sig > 0, mean / np.where(sig > 0, sig, 1.0), 0.0)
@@ -496,6 +421,7 @@ def cell_factor(
     h: np.ndarray,
     bend: float = CELL_BEND,
     influence: Any = None,
+    cells: np.ndarray | None = None,
 ) -> np.ndarray:
     """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
     panel force over its value at ω_j, where the lines do not resolve it: shape
@@ -508,10 +434,11 @@ def cell_factor(
     power width 0.016 rad/s, on lines 0.03 rad/s apart: its corrected σ moved ±2 % with
     the line count, within 0.2 % with the factor).  The cells are those where the log
     power (``h``'s, summed over the panels) bends by more than :data:`CELL_BEND`
-    between neighbours, and theirs; elsewhere the factor is 1 (no solve)."""
+    between neighbours, and theirs (``cells``: those lines, (n_o,) bool, where the caller
+    has them); elsewhere the factor is 1 (no solve)."""
     power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
     out = np.ones_like(power)
-    cells = np.flatnonzero(_bent(h, bend))
+    cells = np.flatnonzero(_bent(h, bend, power) if cells is None else cells)
     if cells.size == 0:
         return out
     step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
@@ -535,10 +462,11 @@ def _live_panels(
     return np.flatnonzero(score >= PANEL_FLOOR * np.max(score, initial=0.0))
 
 
-def _bent(h: np.ndarray, bend: float = CELL_BEND) -> np.ndarray:
+def _bent(h: np.ndarray, bend: float = CELL_BEND, power: np.ndarray | None = None) -> np.ndarray:
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
-    panels, bends by more than ``bend`` between neighbours, and theirs."""
-    power = np.sum(np.abs(h) ** 2, axis=1)
+    panels (``power``, where the caller has it), bends by more than ``bend`` between
+    neighbours, and theirs."""
+    power = np.sum(np.abs(h) ** 2, axis=1) if power is None else power
     logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
     out = np.zeros(power.shape[1], dtype=bool)
     out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
@@ -559,21 +487,29 @@ def _misfit(
     length-weighted mean variance, the linear model's σ² in the pieces' terms). [N·s/m]"""
     out = np.zeros(len(groups))
     first = np.array([int(g[0]) for g in groups])
-    runs = []
-    for e in np.unique(seg.element[seg.fine]):
-        idx = np.flatnonzero(seg.element[first] == e)  # its pieces: one panel each
-        s_ = first[idx]
-        var = float(np.sum(seg.length[s_] * sig[idx] ** 2) / np.sum(seg.length[s_]))
-        if var > 0.0 and b_el[e] > 0.0:
-            runs.append((e, idx, s_, math.sqrt(var)))
-    # a₁ of every piece and of each element's mean variance: one evaluation
-    mu = [np.append(mean_el[e] / np.where(sig[i] > 0, sig[i], np.inf), mean_el[e] / v)
-          for e, i, _, v in runs]  # fmt: skip
-    if not runs:
+    el = seg.element[first]
+    # the panels of split elements (one piece each), by element
+    pan = np.flatnonzero(np.isin(el, seg.element[seg.fine]))
+    if pan.size == 0:
         return out
-    a1 = hermite_coefficients(np.clip(np.concatenate(mu), -10.0, 10.0), 1)[:, 1]
-    for (e, idx, s_, sig_e), a in zip(runs, np.split(a1, np.cumsum([m.size for m in mu]))):
-        out[idx] = b_el[e] * (sig[idx] * a[:-1] / (sig_e * a[-1]) - 1.0) * seg.length[s_]
+    els, at = np.unique(el[pan], return_inverse=True)
+    length = seg.length[first[pan]]
+    var = np.bincount(at, length * sig[pan] ** 2) / np.bincount(at, length)
+    ok = (var > 0.0) & (b_el[els] > 0.0)
+    use = ok[at]
+    pan, at, length = pan[use], at[use], length[use]
+    if pan.size == 0:
+        return out
+    sig_e = np.sqrt(np.where(ok, var, 1.0))
+    # a₁ of every piece and of each element's mean variance: one evaluation
+    mu = np.concatenate(
+        [mean_el[el[pan]] / np.where(sig[pan] > 0, sig[pan], np.inf), mean_el[els[ok]] / sig_e[ok]]
+    )
+    a1 = hermite_coefficients(np.clip(mu, -10.0, 10.0), 1)[:, 1]
+    a_e = np.zeros(els.size)
+    a_e[ok] = a1[pan.size :]
+    ratio = sig[pan] * a1[: pan.size] / (sig_e[at] * a_e[at])
+    out[pan] = b_el[els[at]] * (ratio - 1.0) * length
     return out
 
 

@@ -35,7 +35,6 @@ import numpy as np
 
 from stochcable.dynamics.loads.element_kinematics import element_wave_kinematics
 from stochcable.dynamics.model.blocks import trapezoid_weights
-from stochcable.dynamics.residuals.residual_lines import along
 
 __all__ = [
     "MAX_SUB",
@@ -45,6 +44,7 @@ __all__ = [
     "panel_groups",
     "panel_loads",
     "panel_mean",
+    "panel_share",
     "segment_velocity",
     "segments",
 ]
@@ -252,19 +252,30 @@ def segment_velocity(
     the analysis grid: name → (n_ch, n_s, n_w).  The structure's at the piece's
     midpoint (linear interpolation), the fluid's its mean over the piece (exact for the
     sea channels with element kinematics, else the element mean or the nodal
-    interpolation). [(m/s)/unit]"""
+    interpolation); each projected on the directions as it is formed (no (n_w, n_s, 3,
+    n_ch) array of the velocity vectors). [(m/s)/unit]"""
     model = system.model
     w = np.asarray(resp.omega, dtype=float)
     n_n, d = model.n_nodes, model.dim
     comps = list(model.components)
     e, xi = seg.element, seg.xi
-    u = resp.displacement.reshape(w.size, n_n, d, len(channels))
-    vel = np.zeros((w.size, seg.size, 3, len(channels)), dtype=complex)
-    vel[:, :, comps] = (
-        -1j
-        * w[:, None, None, None]
-        * ((1.0 - xi)[None, :, None, None] * u[:, e] + xi[None, :, None, None] * u[:, e + 1])
-    )
+    n_ch, n_s = len(channels), seg.size
+    # the structure's displacement at the pieces' midpoints, (n_s, d, n_w, n_ch): the
+    # shape functions as one real product on the interleaved complex values
+    u = np.transpose(resp.displacement.reshape(w.size, n_n, d, n_ch), (1, 2, 0, 3))
+    u = np.ascontiguousarray(u, dtype=complex).reshape(n_n, -1)
+    interp = np.zeros((n_s, n_n))
+    interp[np.arange(n_s), e] = 1.0 - xi
+    interp[np.arange(n_s), e + 1] = xi
+    u_s = (interp @ u.view(float)).view(complex).reshape(n_s, d, w.size, n_ch)
+    vecs = {name: np.asarray(vec, dtype=float)[e] for name, vec in directions.items()}
+    out = {}
+    for name, ve in vecs.items():
+        s = np.einsum("sdwc,sd->csw", u_s, ve[:, comps])
+        s *= -1j * w  # (relative: fluid − structure, the structure's velocity −iω·u)
+        out[name] = s
+    fine = np.flatnonzero(seg.fine)
+    run = slice(int(fine[0]), int(fine[-1]) + 1) if fine.size else slice(0, 0)
     sub = None
     for c, ch in enumerate(channels):
         moments = ch.element_velocity
@@ -273,8 +284,6 @@ def segment_velocity(
         if ch.kind == "sea" and ch.heading is not None and moments is not None:
             # the split elements' pieces (a run of them: from the first to the last)
             # integrated on the subdivided shape, the whole elements' from the channel
-            fine = np.flatnonzero(seg.fine)
-            run = slice(int(fine[0]), int(fine[-1]) + 1) if fine.size else slice(0, 0)
             if run.stop > run.start:
                 if sub is None:
                     sub = _subdivided_points(system, seg)[run.start : run.stop + 1]
@@ -282,21 +291,40 @@ def segment_velocity(
                 kin = element_wave_kinematics(
                     np.asarray(ch.omega), sub, ch.heading, env.depth, env.g
                 )
-                vel[:, run, :, c] += kin.velocity.sum(axis=2)
-            rest = np.ones(seg.size, dtype=bool)
+                v_run = kin.velocity.sum(axis=2)  # (n_w, n_run, 3)
+                for name, ve in vecs.items():
+                    out[name][c, run] += np.einsum("wsd,sd->sw", v_run, ve[run])
+            rest = np.ones(n_s, dtype=bool)
             rest[run] = False
             if rest.any():
-                full = moments if isinstance(moments, np.ndarray) else moments.full()
-                v_c = vel[..., c]  # (a view)
-                v_c[:, rest] += full.sum(axis=2)[:, e[rest]]
+                for name, ve in vecs.items():
+                    out[name][c, rest] += _element_mean_along(moments, e[rest], ve[rest])
         elif moments is not None:
-            full = moments if isinstance(moments, np.ndarray) else moments.full()
-            vel[..., c] += full.sum(axis=2)[:, e]
+            for name, ve in vecs.items():
+                out[name][c] += _element_mean_along(moments, e, ve)
         elif ch.kind == "sea" and ch.velocity is not None:
-            vel[..., c] += (1.0 - xi)[None, :, None] * ch.velocity[:, e] + xi[
-                None, :, None
-            ] * ch.velocity[:, e + 1]
-    return {name: along(vel, vec[e]) for name, vec in directions.items()}
+            v_n = np.asarray(ch.velocity)  # (n_w, n_nodes, 3)
+            v_s = (1.0 - xi)[None, :, None] * v_n[:, e] + xi[None, :, None] * v_n[:, e + 1]
+            for name, ve in vecs.items():
+                out[name][c] += np.einsum("wsd,sd->sw", v_s, ve)
+    return out
+
+
+def _element_mean_along(moments: Any, el: np.ndarray, vec: np.ndarray) -> np.ndarray:
+    """The fluid velocity of the elements ``el`` (their mean: both shape functions'
+    moments summed) along ``vec`` (n, 3), shape (n, n_w): from a channel's moments
+    (an array (n_w, n_el, 2, 3), or parts with ``full()``); a sea's kept parts (the
+    horizontal and vertical velocities, :class:`~stochcable.dynamics.loads.element_parts.
+    MomentParts`) projected as they are (no (n_w, n_el, 2, 3) array). [(m/s)/unit]"""
+    parts = getattr(moments, "parts", None)
+    heading = getattr(moments, "heading", None)
+    if parts is not None and heading is not None:  # (n_el, 2, 2, n_w): h and v parts
+        cb, sb = math.cos(heading), math.sin(heading)
+        h = parts[el, 0, 0] + parts[el, 1, 0]
+        v = parts[el, 0, 1] + parts[el, 1, 1]
+        return h * (cb * vec[:, 0] + sb * vec[:, 1])[:, None] + v * vec[:, 2][:, None]
+    full = moments if isinstance(moments, np.ndarray) else moments.full()
+    return np.einsum("wsd,sd->sw", full.sum(axis=2)[:, el], vec)
 
 
 def _subdivided_points(system: Any, seg: Segments) -> np.ndarray:
@@ -311,16 +339,26 @@ def _subdivided_points(system: Any, seg: Segments) -> np.ndarray:
     return pts
 
 
-def panel_mean(values: np.ndarray, seg: Segments, groups: list[np.ndarray]) -> np.ndarray:
+def panel_mean(
+    values: np.ndarray, seg: Segments, groups: list[np.ndarray], share: Any = None
+) -> np.ndarray:
     """Length-weighted mean of per-piece ``values`` (…, n_s, …) over each panel: the
-    piece axis is axis 1 of a 3-D array or axis 0 of a 1-D one (one matrix product)."""
-    piece = np.concatenate(groups)
-    panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
-    share = np.zeros((values.shape[1 if values.ndim == 3 else 0], len(groups)))
-    share[piece, panel] = seg.length[piece] / np.bincount(panel, weights=seg.length[piece])[panel]
+    piece axis is axis 1 of a 3-D array or axis 0 of a 1-D one (one matrix product;
+    ``share``: :func:`panel_share`, where the caller has it)."""
+    if share is None:
+        share = panel_share(seg, groups)
     if values.ndim == 3:
         return np.moveaxis(np.moveaxis(values, 1, 2) @ share, 2, 1)
     return values @ share
+
+
+def panel_share(seg: Segments, groups: list[np.ndarray]) -> np.ndarray:
+    """Each piece's share of its panel's length, shape (n_s, n_panels) (:func:`panel_mean`)."""
+    piece = np.concatenate(groups)
+    panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
+    share = np.zeros((seg.size, len(groups)))
+    share[piece, panel] = seg.length[piece] / np.bincount(panel, weights=seg.length[piece])[panel]
+    return share
 
 
 def panel_loads(

@@ -44,7 +44,6 @@ from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     PairLines,
     along,
-    covariance_lines,
     fft_length,
     load_transfer,
     pair_blocks,
@@ -319,7 +318,8 @@ def quadratic_output_lines(
     out = PairLines(transfer)
     for e, f in pair_blocks(n_el, n_fft, 2):
         r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}
-        twice = np.where(f > e, 2.0, 1.0)[:, None]
+        # the pairs f > e weighted 2, and covariance_lines' 2/n_fft, on the lags
+        twice = np.where(f > e, 4.0 / n_fft, 2.0 / n_fft)[:, None]
         for i, terms_i in enumerate(terms):
             for j, terms_j in enumerate(terms):
                 cov = sum(
@@ -327,7 +327,7 @@ def quadratic_output_lines(
                     for ci, x1, y1 in terms_i
                     for cj, x2, y2 in terms_j
                 )
+                cov *= twice
                 # e's component i, f's j (transfer columns component-major)
-                g = covariance_lines(cov, n_o) * twice
-                out.add(g, i * n_el + e, j * n_el + f)
+                out.add(np.fft.rfft(cov, axis=1)[:, 1 : n_o + 1], i * n_el + e, j * n_el + f)
     return out.outputs()

@@ -10,7 +10,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy import sparse
 
 from stochcable.dynamics.model.blocks import add_blocks, block_matvec, line_prep, real_gemm
 from stochcable.dynamics.model.modal_solvers import foss_modes
@@ -23,6 +22,7 @@ from stochcable.dynamics.residuals.band_influence import (
     end_directions,
     end_influence,
 )
+from stochcable.dynamics.residuals.modal_rows import ModalRows, ModalSums
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.errors import SolverError
 from stochcable.line.fem import SLACK_EA_RATIO
@@ -94,11 +94,12 @@ class EndInfluence:
         return self._adjoint
 
     @staticmethod
-    def _find(kept: list, w: np.ndarray) -> np.ndarray | None:
+    def _find(kept: list, w: np.ndarray, rows: slice = slice(None)) -> np.ndarray | None:
         for om, g in kept if w.size else ():
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
             near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
-            if np.allclose(om[near], w, rtol=1e-12, atol=0.0):
+            if np.all(np.abs(om[near] - w) <= 1e-12 * np.abs(w)):  # (np.allclose's test)
+                g = g if rows == slice(None) else g[rows]  # (the rows first: fewer gathered)
                 step = near[1] - near[0] if near.size > 1 else 1
                 if step > 0 and np.array_equal(near, near[0] + step * np.arange(near.size)):
                     return g[..., near[0] : near[-1] + 1 : step]  # (a view: every step-th line)
@@ -126,11 +127,11 @@ class EndInfluence:
     def extra_on(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray:
         """The ``extra`` rows ``cols`` on ``w``, shape (k, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
-        g = self._find(self._kept_x, w)
+        g = self._find(self._kept_x, w, cols)
         if g is None:
             self._solve(w, extra=True)
-            g = self._kept_x[-1][1]
-        return g[cols]
+            g = self._kept_x[-1][1][cols]
+        return g
 
     def extra_kept(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray | None:
         """The ``extra`` rows ``cols`` on ``w`` where they are kept, or solved by the
@@ -138,11 +139,11 @@ class EndInfluence:
         rows: a banded solve of all the rows where one set is asked, e.g. at a set's
         cells, costs the others' right-hand sides for nothing). [N/N]"""
         w = np.asarray(w, dtype=float)
-        g = self._find(self._kept_x, w)
+        g = self._find(self._kept_x, w, cols)
         if g is None and self._modal:
             return self.extra_on(w, cols)
         if g is not None:
-            return g[cols]
+            return g
         key = (cols.start, cols.stop)
         g = self._find(self._kept_c.get(key, []), w)
         if g is None and self._adjoint is not None:  # (by substitution in kept factors)
@@ -248,102 +249,19 @@ def _modal_rows(
 ) -> ModalRows | None:
     """:func:`modal_influence` on ``w`` (all below its limit); None for a defective
     Foss pencil."""
-    model = system.model
-    d, n = model.dim, model.n_nodes
+    n = system.model.n_nodes
     held = _modal_projection(system, damping, float(w[-1]) if w.size else 0.0, extra)
     if held is None:
         return None
-    phi, foss, p, r, (e_a, e_b) = held
-    nf, m = phi.shape
+    phi, foss, p, r, (sums, rc, ends) = held
+    m = phi.shape[1]
     k_x = p.shape[1] - 6
-    inv = 1.0 / (1j * w[None, :] - foss.lambdas[:, None])  # (2m, n_w)
-    # the modal coordinates (2m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
-    q = np.empty((2 * m, 2 + k_x, w.size), dtype=complex)
-    q[:, :2] = p[:, 0:2, None] - p[:, 2:4, None] * (w * w) + p[:, 4:6, None] * (1j * w)
-    q[:, 2:] = p[:, 6:, None]
-    q *= inv[:, None, :]
-    z = (foss.chi @ q.reshape(2 * m, -1)).reshape(m, 2 + k_x, w.size)
-    rc = None
-    if r is not None:  # the truncated modes' static correction, fixed vectors
-        rc = np.zeros((3, nf, 2 + k_x), dtype=complex)
-        rc[:, :, :2] = np.stack([r[:, 0:2], r[:, 2:4], r[:, 4:6]])
-        rc[0, :, 2:] = r[:, 6:]
-    ends = np.zeros((2, 2 + k_x, d))
-    ends[0, 0], ends[1, 1] = e_a, e_b
+    # the modal coordinates (m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
+    z = np.empty((m, 2 + k_x, w.size), dtype=complex)
+    s = sums(w)  # (m, 6 + k, n_w)
+    z[:, :2] = s[:, 0:2] - s[:, 2:4] * (w * w) + s[:, 4:6] * (1j * w)
+    z[:, 2:] = s[:, 6:]
     return ModalRows(phi, z, w, rc, ends, n)
-
-
-class ModalRows:
-    """The rows of :func:`modal_influence` kept factored, x(ω) = Φ_f z(ω) + r₀ − ω²r₁
-    + iωr₂ on the free nodes and ê on the end nodes (the end rows'), shape (R, n_nodes,
-    d, n_w) as an array (``np.asarray``) but sliced by rows (``g[a:b]``) and lines
-    (``g[..., idx]``) without forming it, and contracted with load cases through the m
-    modes (:meth:`transfer`: the chain's 27 rows on 189 lines, 6.7 MB, never formed).
-    [N/N]"""
-
-    def __init__(self, phi, z, w, rc, ends, n_nodes) -> None:  # noqa: ANN001
-        self.phi, self.z, self.w, self.rc, self.ends = phi, z, w, rc, ends
-        self.n_nodes = n_nodes
-        d = ends.shape[2]
-        self.shape = (z.shape[1], n_nodes, d, w.size)
-        self.ndim, self.dtype = 4, np.dtype(complex)
-
-    def __getitem__(self, key: Any) -> ModalRows:
-        rows, lines = (slice(None), key[1]) if isinstance(key, tuple) else (key, slice(None))
-        if isinstance(key, tuple) and key[0] is not Ellipsis:
-            raise IndexError("ModalRows: g[rows] or g[..., lines] only")
-        rc = None if self.rc is None else self.rc[:, :, rows]
-        return ModalRows(
-            self.phi, self.z[:, rows][:, :, lines], self.w[lines], rc,
-            self.ends[:, rows], self.n_nodes,
-        )  # fmt: skip
-
-    def _add_static(self, x: np.ndarray, rc: np.ndarray) -> np.ndarray:
-        """``x`` (X, R, n_w) plus r₀ − ω²r₁ + iωr₂ of static rows ``rc`` (3, X, R), in
-        place (r₁, r₂ on the end rows only)."""
-        x += rc[0][..., None]
-        dyn = np.flatnonzero(np.any(self.rc[1:] != 0, axis=(0, 1)))
-        if dyn.size:
-            w = self.w
-            x[:, dyn] += rc[2][:, dyn, None] * (1j * w) - rc[1][:, dyn, None] * (w * w)
-        return x
-
-    def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
-        n_r, n, d, n_w = self.shape
-        m = self.phi.shape[1]
-        out = np.zeros(self.shape, dtype=complex)
-        out[:, 0] = self.ends[0][..., None]
-        out[:, -1] = self.ends[1][..., None]
-        zt = np.ascontiguousarray(self.z).reshape(m, -1)
-        x = real_gemm(self.phi, zt).reshape(-1, n_r, n_w)  # (n_f·d, R, n_w)
-        if self.rc is not None:
-            self._add_static(x, self.rc)
-        out[:, 1:-1] = np.transpose(x, (1, 0, 2)).reshape(n_r, n - 2, d, n_w)
-        return out if dtype is None else out.astype(dtype)
-
-    def transfer(self, unit: np.ndarray) -> np.ndarray:
-        """The rows per unit load case ``unit`` (n_nodes, d, n_load) (real node forces,
-        dense or a scipy sparse (n_load, n_nodes·d) matrix of them): shape (R, n_load,
-        n_w), the cases projected on the modes first. [N/unit]"""
-        n_r, n, d, n_w = self.shape
-        m = self.phi.shape[1]
-        if sparse.issparse(unit):
-            u_t = sparse.csr_matrix(unit)
-            u_end = (u_t[:, :d].toarray(), u_t[:, (n - 1) * d :].toarray())  # (L, d)
-            u_f = u_t[:, d : (n - 1) * d]
-            a = np.asarray(u_f @ self.phi)  # (L, m)
-        else:
-            unit = np.asarray(unit, dtype=float)
-            u_end = (unit[0].T, unit[-1].T)
-            u_f = unit[1:-1].reshape((n - 2) * d, -1).T  # (L, n_f·d)
-            a = u_f @ self.phi
-        zt = np.ascontiguousarray(self.z).reshape(m, -1)
-        h = real_gemm(a, zt).reshape(a.shape[0], n_r, n_w)  # (L, R, n_w)
-        h += (u_end[0] @ self.ends[0].T + u_end[1] @ self.ends[1].T)[..., None]
-        if self.rc is not None:
-            rc = np.stack([np.asarray(u_f @ self.rc[k]) for k in range(3)])  # (3, L, R)
-            self._add_static(h, rc)
-        return np.transpose(h, (1, 0, 2))
 
 
 def _modal_projection(
@@ -353,7 +271,9 @@ def _modal_projection(
     its later calls with the same ``damping`` and ``extra`` (the cells' and the
     misfit's frequencies after the lines'): (Φ_f, the Foss modes, the right-hand
     sides' modal loads p (2m, 6 + k), their static corrections (n_f·d, 6 + k) or None,
-    ê of both ends).  None for a defective Foss pencil."""
+    and the rows' fixed parts: the modal sums' terms (:class:`ModalSums`), the static
+    rows (3, n_f·d, 2 + k) or None, ê of both ends (2, 2 + k, d)).  None for a
+    defective Foss pencil."""
     prep = line_prep(system)
     phi, mh, kh = _influence_modes(system, prep, w_top)
     key = ("influence_projection", extra is None)
@@ -390,7 +310,17 @@ def _modal_projection(
     if m < nf:
         zh = np.linalg.solve(kh, modal.view(float))
         r = (prep.k_solve(cols) - real_gemm(phi, np.ascontiguousarray(zh).view(complex))) * sign
-    out = (phi, foss, p, r, (e_a, e_b))
+    # the rows' frequency-independent parts: the modal sums' terms, the static rows
+    # (r₀, r₁, r₂; the end rows' three, the others' r₀) and ê of both ends
+    rc = None
+    if r is not None:
+        rc = np.zeros((3, nf, 2 + k_x), dtype=complex)
+        rc[:, :, :2] = np.stack([r[:, 0:2], r[:, 2:4], r[:, 4:6]])
+        rc[0, :, 2:] = r[:, 6:]
+    d = system.model.dim
+    ends = np.zeros((2, 2 + k_x, d))
+    ends[0, 0], ends[1, 1] = e_a, e_b
+    out = (phi, foss, p, r, (ModalSums(foss.chi, p, foss.lambdas), rc, ends))
     prep.cache[key] = (damping, extra, out)
     return out
 

@@ -134,11 +134,12 @@ class UniformGrid:
         self.step = stride * base
         self.n_j = int(np.rint(wl[-1] / self.step)) + 1
         self.index = np.clip(np.rint(w / self.step).astype(int), 0, self.n_j - 1)
+        # each live frequency's place in its run of consecutive live ones on one line
         rank = np.zeros(w.size, dtype=int)
-        prev = -1
-        for i in np.flatnonzero(self.live):
-            rank[i] = rank[prev] + 1 if prev >= 0 and self.index[i] == self.index[prev] else 0
-            prev = i
+        live_at = np.flatnonzero(self.live)
+        on = self.index[live_at]
+        first = np.flatnonzero(np.append(True, on[1:] != on[:-1]))
+        rank[live_at] = np.arange(on.size) - np.repeat(first, np.diff(np.append(first, on.size)))
         self.rank = rank
         self.ranks = int(rank.max()) + 1
 

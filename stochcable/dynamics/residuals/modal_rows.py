@@ -1,0 +1,157 @@
+"""The rows of the end tensions' and stations' influence through a line's complex
+(Foss) modes (:func:`~stochcable.dynamics.residuals.influence.modal_influence`): the
+modal sums of fixed right-hand sides over the frequencies (:func:`modal_sums`) and the
+rows kept factored (:class:`ModalRows`)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy import sparse
+
+from stochcable.dynamics.model.blocks import real_gemm
+
+__all__ = ["PAIR_TOL", "ModalRows", "ModalSums", "modal_sums"]
+
+#: Relative tolerance to which two modes are taken as a complex-conjugate pair
+#: (eigenvalues and χ_j p_j) in :func:`modal_sums`. [-]
+PAIR_TOL = 1e-10
+
+
+def modal_sums(chi: np.ndarray, p: np.ndarray, lambdas: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """z_k(ω) = Σ_j χ_j p_jk/(iω − λ_j) of the complex modes (χ (m, 2m), λ (2m,)) and the
+    modal loads ``p`` (2m, k) of real right-hand sides on ``w``: shape (m, k, n_w)
+    (:class:`ModalSums`)."""
+    return ModalSums(chi, p, lambdas)(w)
+
+
+class ModalSums:
+    """z_k(ω) = Σ_j χ_j p_jk/(iω − λ_j) (:func:`modal_sums`), its frequency-independent
+    part formed once: the terms χ_j p_j (m·k, 2m), paired.
+
+    One product over the modes of the terms and the denominators (no (2m, k, n_w)
+    array), in real arithmetic: a real system's modes come in conjugate pairs (λ', χ'
+    p') = (λ̄, conj(χ p)) (the underdamped ones), whose two terms are Re(χp)·(d + d') +
+    Im(χp)·i(d − d'), d = 1/(iω − λ), d' = 1/(iω − λ̄): half the work of the complex
+    product.  The modes without such a partner (overdamped: real λ; complex right-hand
+    sides) keep their own term.  [as χ·p]"""
+
+    def __init__(self, chi: np.ndarray, p: np.ndarray, lambdas: np.ndarray) -> None:
+        m, k = chi.shape[0], p.shape[1]
+        terms = (chi[:, None, :] * p.T[None]).reshape(m * k, -1)  # (m·k, 2m): χ_j p_j
+        first, second = _conjugate_pairs(terms, lambdas)
+        alone = np.setdiff1d(np.arange(lambdas.size), np.concatenate([first, second]))
+        coef = np.concatenate([terms[:, first], terms[:, alone]], axis=1)
+        self.lhs = np.ascontiguousarray(np.concatenate([coef.real, coef.imag], axis=1))
+        self.lambdas, self.first, self.second, self.alone = lambdas, first, second, alone
+        self.shape = (m, k)
+
+    def __call__(self, w: np.ndarray) -> np.ndarray:
+        """The sums on ``w``, shape (m, k, n_w)."""
+        inv = 1.0 / (1j * np.asarray(w, dtype=float)[None, :] - self.lambdas[:, None])
+        first, second, alone = self.first, self.second, self.alone
+        den = np.concatenate(
+            [
+                inv[first] + inv[second],
+                inv[alone],
+                1j * (inv[first] - inv[second]),
+                1j * inv[alone],
+            ]
+        )  # (2·n_terms, n_w): the real parts' factors, then the imaginary parts'
+        out = (self.lhs @ np.ascontiguousarray(den).view(float)).view(complex)
+        return out.reshape(self.shape + (-1,))
+
+
+def _conjugate_pairs(terms: np.ndarray, lambdas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The modes (j, j') that are conjugate pairs: λ_j' = conj(λ_j) and the terms
+    χ_j' p_j' = conj(χ_j p_j) to :data:`PAIR_TOL` (indices, Im λ_j > 0)."""
+    pos = np.flatnonzero(lambdas.imag > 0)
+    if pos.size == 0:
+        return pos, pos
+    gap = np.abs(lambdas[None, :] - np.conj(lambdas[pos])[:, None])  # (n_pos, 2m)
+    partner = np.argmin(gap, axis=1)
+    scale = np.abs(lambdas[pos])
+    ok = (gap[np.arange(pos.size), partner] <= PAIR_TOL * scale) & (lambdas[partner].imag < 0)
+    size = np.max(np.abs(terms), axis=0)
+    ok &= np.all(
+        np.abs(terms[:, partner] - np.conj(terms[:, pos])) <= PAIR_TOL * size[pos][None], axis=0
+    )
+    ok &= np.bincount(partner[ok], minlength=lambdas.size)[partner] <= 1  # (each one partner)
+    return pos[ok], partner[ok]
+
+
+class ModalRows:
+    """The rows of :func:`modal_influence` kept factored, x(ω) = Φ_f z(ω) + r₀ − ω²r₁
+    + iωr₂ on the free nodes and ê on the end nodes (the end rows'), shape (R, n_nodes,
+    d, n_w) as an array (``np.asarray``) but sliced by rows (``g[a:b]``) and lines
+    (``g[..., idx]``) without forming it, and contracted with load cases through the m
+    modes (:meth:`transfer`: the chain's 27 rows on 189 lines, 6.7 MB, never formed).
+    [N/N]"""
+
+    def __init__(self, phi, z, w, rc, ends, n_nodes) -> None:  # noqa: ANN001
+        self.phi, self.z, self.w, self.rc, self.ends = phi, z, w, rc, ends
+        self.n_nodes = n_nodes
+        d = ends.shape[2]
+        self.shape = (z.shape[1], n_nodes, d, w.size)
+        self.ndim, self.dtype = 4, np.dtype(complex)
+
+    def __getitem__(self, key: Any) -> ModalRows:
+        rows, lines = (slice(None), key[1]) if isinstance(key, tuple) else (key, slice(None))
+        if isinstance(key, tuple) and key[0] is not Ellipsis:
+            raise IndexError("ModalRows: g[rows] or g[..., lines] only")
+        rc = None if self.rc is None else self.rc[:, :, rows]
+        return ModalRows(
+            self.phi, self.z[:, rows][:, :, lines], self.w[lines], rc,
+            self.ends[:, rows], self.n_nodes,
+        )  # fmt: skip
+
+    def _add_static(self, x: np.ndarray, rc: np.ndarray) -> np.ndarray:
+        """``x`` (X, R, n_w) plus r₀ − ω²r₁ + iωr₂ of static rows ``rc`` (3, X, R), in
+        place (r₁, r₂ on the end rows only)."""
+        x += rc[0][..., None]
+        dyn: Any = np.flatnonzero(np.any(self.rc[1:] != 0, axis=(0, 1)))
+        if dyn.size and dyn[-1] - dyn[0] + 1 == dyn.size:  # (a run: a view, not a copy)
+            dyn = slice(int(dyn[0]), int(dyn[-1]) + 1)
+        if not isinstance(dyn, np.ndarray) or dyn.size:
+            w = self.w
+            x[:, dyn] += rc[2][:, dyn, None] * (1j * w) - rc[1][:, dyn, None] * (w * w)
+        return x
+
+    def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
+        n_r, n, d, n_w = self.shape
+        m = self.phi.shape[1]
+        out = np.zeros(self.shape, dtype=complex)
+        out[:, 0] = self.ends[0][..., None]
+        out[:, -1] = self.ends[1][..., None]
+        zt = np.ascontiguousarray(self.z).reshape(m, -1)
+        x = real_gemm(self.phi, zt).reshape(-1, n_r, n_w)  # (n_f·d, R, n_w)
+        if self.rc is not None:
+            self._add_static(x, self.rc)
+        out[:, 1:-1] = np.transpose(x, (1, 0, 2)).reshape(n_r, n - 2, d, n_w)
+        return out if dtype is None else out.astype(dtype)
+
+    def transfer(self, unit: np.ndarray) -> np.ndarray:
+        """The rows per unit load case ``unit`` (n_nodes, d, n_load) (real node forces,
+        dense or a scipy sparse (n_load, n_nodes·d) matrix of them): shape (R, n_load,
+        n_w), the cases projected on the modes first. [N/unit]"""
+        n_r, n, d, n_w = self.shape
+        m = self.phi.shape[1]
+        if sparse.issparse(unit):
+            u_t = sparse.csr_matrix(unit)
+            u_end = (u_t[:, :d].toarray(), u_t[:, (n - 1) * d :].toarray())  # (L, d)
+            u_f = u_t[:, d : (n - 1) * d]
+            a = np.asarray(u_f @ self.phi)  # (L, m)
+        else:
+            unit = np.asarray(unit, dtype=float)
+            u_end = (unit[0].T, unit[-1].T)
+            u_f = unit[1:-1].reshape((n - 2) * d, -1).T  # (L, n_f·d)
+            a = u_f @ self.phi
+        zt = np.ascontiguousarray(self.z).reshape(m, -1)
+        h = real_gemm(a, zt).reshape(a.shape[0], n_r, n_w)  # (L, R, n_w)
+        h += (u_end[0] @ self.ends[0].T + u_end[1] @ self.ends[1].T)[..., None]
+        if self.rc is not None:
+            three = np.transpose(self.rc, (1, 0, 2)).reshape(self.rc.shape[1], -1)
+            rc = np.asarray(u_f @ three).reshape(-1, 3, n_r).transpose(1, 0, 2)  # (3, L, R)
+            self._add_static(h, rc)
+        return np.transpose(h, (1, 0, 2))
