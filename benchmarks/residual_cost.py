@@ -20,7 +20,7 @@ the minor page faults (``ru_minflt``) of the fastest round and their median.
 
 Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
 analysis before issue 31; with the end, element-tension and node-motion residuals now
-chain 2.3–2.4×, taut 2.0×, deep 2.3×, two-segment 1.9–2.0× (load ≈ 2): exact steps (adjoint end
+chain 2.2–2.3×, taut 1.8×, deep 1.8–1.9×, two-segment 1.8–1.9× (load ≈ 1): exact steps (adjoint end
 tensions, pairs f ≥ e in cache-sized blocks, the lag grid at the alias bound, one end
 influence, the element and node rows in the same solve, one dense matrix of pair lines
 per kind) and approximate ones (Hermite orders 2 and 3 carrying the higher orders'
