@@ -347,7 +347,7 @@ def test_a_set_skips_the_node_motion_residuals_only():
     """A set reports no node motions: its cases skip their residuals
     (``MOTION_RESIDUALS`` off inside a chunk, restored after), and the corrected end
     tensions, their spectra and the elements' σ are those of the engine's full solve
-    to the bit (the shared influence's end and element rows are solved alone)."""
+    to round-off (the shared influence's end and element rows are solved alone)."""
     import warnings
 
     from stochcable.cases.chunk import _no_motion_residuals, case_sea, engine_template, set_engine
@@ -366,7 +366,14 @@ def test_a_set_skips_the_node_motion_residuals_only():
     assert MOTION_RESIDUALS.get()
     assert full.motion_residual is not None and part.motion_residual is None
     assert full.linear is not None  # (the residuals are on)
+    # (to round-off, not bitwise: the compiled banded LU substitutes the right-hand sides
+    # of a row in runs whose split depends on how many rows are solved — here the end
+    # and element rows alone against those and the node rows; measured 2e-16 relative)
     for e in ("end_a", "end_b"):
-        assert getattr(part, e) == getattr(full, e)
-        assert np.array_equal(part.end_tension_density(e)[1], full.end_tension_density(e)[1])
-    assert np.array_equal(part.tension_std, full.tension_std)
+        a, b = getattr(part, e), getattr(full, e)
+        for name in ("std", "m0", "m1", "m2", "m4", "bandwidth"):
+            assert getattr(a, name) == pytest.approx(getattr(b, name), rel=1e-12, abs=0)
+        got, ref = part.end_tension_density(e)[1], full.end_tension_density(e)[1]
+        # (against the density's peak: its tail lines of 1e-20 differ by 3e-12 of themselves)
+        np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-14 * ref.max())
+    np.testing.assert_allclose(part.tension_std, full.tension_std, rtol=1e-12)

@@ -197,11 +197,11 @@ def test_zero_width_time_series_with_bodies_are_the_long_crested_ones():
     assert set(got.end_tension) == set(ref.end_tension) == {"leg1", "leg2", "leg3", "riser"}
     for line in ref.end_tension:
         for end in ("end_a", "end_b"):
-            # (round-off of the residuals' sums over 15 channels against 1: measured
-            # 1.01e-10 since the split touchdown element's condensation enters them)
-            np.testing.assert_allclose(
-                got.end_tension[line][end], ref.end_tension[line][end], rtol=1e-9
-            )
+            # (round-off of the residuals' sums over 15 channels against 1, against the
+            # series' range as for the bodies: pointwise it reaches 2.1e-9 relative on a
+            # 0.31 N sample of a 190–340 N record, 2e-12 of its range)
+            a, b = got.end_tension[line][end], ref.end_tension[line][end]
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-10 * np.ptp(b), err_msg=line)
 
 
 def test_time_series_drive_each_direction_with_its_own_realization():
