@@ -36,8 +36,9 @@ from stochcable.reference.cable import simulate_line_timedomain
 from stochcable.statics import solve_statics
 
 
-def _line(name: str):
-    scene = load_scene(load_example(name).model_dump(mode="json"))
+def _line(name: str, doc: dict | None = None):
+    """The example ``name``'s (or ``doc``'s) first line: system, channels, drag scale."""
+    scene = load_scene(doc if doc is not None else load_example(name).model_dump(mode="json"))
     line = scene.lines[0]
     system = build_line_system(scene, line, solve_statics(scene).lines[line.name])
     chans = line_channels(scene, line, system.positions, scene.analysis.omega.values())
@@ -106,13 +107,7 @@ def _chain_in(tp: float):
     """The chain example's system and channels in a JONSWAP sea, Hs 5 m, Tp ``tp``."""
     doc = load_example("chain_catenary").model_dump(mode="json")
     doc["sea"]["spectrum"] = {"type": "jonswap", "hs": 5.0, "tp": tp}
-    scene = load_scene(doc)
-    line = scene.lines[0]
-    system = build_line_system(scene, line, solve_statics(scene).lines[line.name])
-    chans = line_channels(scene, line, system.positions, scene.analysis.omega.values())
-    mesh = system.model.mesh
-    scale = 0.5 * system.model.rho * mesh.diameter * (mesh.cd_normal + math.pi * mesh.cd_axial)
-    return system, chans, scale
+    return _line("chain_catenary", doc)
 
 
 def test_the_grouping_is_the_meshs_and_the_pieces_move_continuously():
