@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.cases.anchor_passes import neighbour_starts, pass_chunks
+from stochcable.cases.anchor_passes import neighbour_starts, pass_chunks, split_last_pass
 from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, set_engine, solve_chunk
 from stochcable.cases.display import case_set_html, case_set_text
 from stochcable.cases.fatigue_settings import LineFatigue
@@ -246,21 +246,28 @@ def _anchored(
         if todo.size == 0 and exact.all():
             return results
         last = todo.size == 0
-        idx = np.flatnonzero(~exact) if last else todo
-        chunks, leads, seeds = pass_chunks(
-            states, idx, not last, chunk_size, None if last else starts
-        )
-        sub = replace(plan, chunks=chunks, leads=leads, starts=() if last else seeds)
-        for res in _run_chunks(sub, engine, executor):
-            results.append(res)
-            for j, i in enumerate(res.indices):
-                if j < len(res.starts):
-                    known[int(i)] = res.starts[j]
-            done += len(res.rows)
-            if progress is not None:
-                progress(done, n)
+        if last:  # (the linear cases: those with a column start, then the others)
+            ready = {i: x for i, x in known.items() if exact[i]}
+            first, seeds, rest = split_last_pass(states, np.flatnonzero(~exact), ready)
+            passes = [(first, seeds), (rest, None)]
+        else:
+            passes = [(todo.tolist(), starts)]
+        for idx, begin in passes:
+            if not idx:
+                continue
+            chunks, leads, seeds = pass_chunks(states, idx, not last, chunk_size, begin)
+            sub = replace(plan, chunks=chunks, leads=leads, starts=seeds)
+            for res in _run_chunks(sub, engine, executor):
+                results.append(res)
+                for j, i in enumerate(res.indices):
+                    if j < len(res.starts):
+                        known[int(i)] = res.starts[j]
+                done += len(res.rows)
+                if progress is not None:
+                    progress(done, n)
         if last:
             return results
+        idx = todo
         exact[idx] = True
         m = _merge(plan, results)
         todo = np.flatnonzero(next_anchors(

@@ -6,11 +6,18 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 import stochcable.cases.chunk as chunk_mod
 from stochcable import load_example
 from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
-from stochcable.cases.anchor_passes import neighbour_starts, pass_chunks
+from stochcable.cases.anchor_passes import (
+    START_TOLERANCE,
+    column_start,
+    neighbour_starts,
+    pass_chunks,
+    split_last_pass,
+)
 from stochcable.cases.chunk import WARM_RUN
 
 WIRE = LineFatigue("dnv-six-strand", nominal_area=1.2e-3)
@@ -32,6 +39,49 @@ def test_neighbour_starts_prefer_the_same_hs_then_the_nearest_period():
     assert got[2]["g"][0] == 7.0  # Hs 3, Tp 6: the same Hs
     other = _states(heading=90.0)
     assert neighbour_starts(other, [0], {}) == ({},)
+
+
+def test_column_start_is_exact_for_a_power_of_hs():
+    """σ = a·Hs^p per component (p within the bounds 0…2) is met to round-off between
+    two cases of a column and beyond them; an exponent outside is clipped to the bound;
+    a σ that is not positive takes the nearer case's."""
+    a, p = np.array([0.3, 1.2, 0.0]), np.array([0.7, 1.6, 1.0])
+    known = {j: {"g": a * h**p} for j, h in ((0, 1.0), (1, 3.0), (2, 4.0))}
+    column = [(1.0, 0), (3.0, 1), (4.0, 2)]
+    for hs in (2.0, 3.5, 6.0):  # between, between, beyond the largest
+        got = column_start(hs, column, known)["g"]
+        np.testing.assert_allclose(got[:2], (a * hs**p)[:2], rtol=1e-13)
+        assert got[2] == 0.0
+    steep = {0: {"g": np.array([1.0])}, 1: {"g": np.array([27.0])}}  # Hs^3 between 1 and 3
+    got = column_start(2.0, [(1.0, 0), (3.0, 1)], steep)["g"][0]
+    assert got == pytest.approx(2.0**2, rel=1e-13)  # the exponent clipped to 2
+
+
+def test_neighbour_starts_interpolate_in_the_column():
+    """With two computed cases of its column a case starts from their σ interpolated
+    in Hs (log–log), not from the nearest one's."""
+    states = _states(hs=(1.0, 2.0, 4.0), tps=(6.0,))
+    known = {0: {"g": np.array([1.0])}, 2: {"g": np.array([4.0])}}
+    got = neighbour_starts(states, [1], known)
+    assert got[0]["g"][0] == pytest.approx(2.0, rel=1e-13)  # σ ∝ Hs between 1 and 4
+
+
+def test_split_last_pass_starts_where_the_column_law_holds():
+    """The last pass's cases between computed Hs of a column whose σ follow the law
+    (checked on its interior computed case) start there; with the law missed by more
+    than START_TOLERANCE only a case that would start its warm-start run at rest does;
+    cases beyond the computed Hs and in columns without computed cases run warm."""
+    states = _states(hs=(1.0, 2.0, 3.0, 4.0, 5.0), tps=(6.0, 8.0))  # pos 2·(Hs) + Tp
+    law = {j: {"g": np.array([0.5 * states[j].hs])} for j in (0, 4, 6)}  # Tp 6 s: Hs 1, 3, 4
+    first, starts, rest = split_last_pass(states, [2, 8, 1, 3], law)
+    assert first == [2] and rest == [1, 3, 8]  # Hs 2 between; Hs 5 beyond; Tp 8: none
+    assert starts[0]["g"][0] == pytest.approx(1.0, rel=1e-13)
+    bent = dict(law)
+    bent[4] = {"g": np.array([1.5 * (1.0 + 10 * START_TOLERANCE)])}
+    first, _, rest = split_last_pass(states, [1, 2, 3], bent)
+    assert first == [] and rest == [1, 2, 3]  # (2 continues the warm run after 1)
+    first, _, rest = split_last_pass(states, [2, 3], bent)
+    assert first == [2] and rest == [3]  # (2 would start its run at rest)
 
 
 def test_pass_chunks_lead_with_the_pass_cases_of_the_run():
