@@ -7,11 +7,14 @@ the checks ask for (the first anchors, then pass after pass those
 :func:`~stochcable.cases.residual_anchors.next_anchors` asks for, with the residuals),
 and a last pass every other case (linear, its corrections interpolated).  An anchor
 of the first pass starts at rest; one of a later pass from the converged σ of the
-nearest case computed before it (:func:`neighbour_starts`: of its heading, the same
-Hs at the nearest period, else the nearest Hs), and the last pass in the warm-start
-runs of :mod:`stochcable.cases.chunk` over the cases it solves.  So a case's start,
-and its numbers, depend on the diagram and the computed numbers only, never on the
-executor or the chunking.
+cases computed before it (:func:`neighbour_starts`: where its column has two, their
+σ interpolated in Hs, :func:`column_start`; else the nearest one's, of its heading,
+the same Hs at the nearest period, else the nearest Hs).  The last pass solves
+first the cases a column start serves well (:func:`split_last_pass`: between
+computed Hs of a column whose σ follow the law, or that would start a warm-start run
+at rest), each from its own start, then the others in the warm-start runs of
+:mod:`stochcable.cases.chunk` over them.  So a case's start, and its numbers, depend
+on the diagram and the computed numbers only, never on the executor or the chunking.
 """
 
 from __future__ import annotations

@@ -41,7 +41,8 @@ made, not assumed: a correction that grows fast with Hs (the taut wire at Tp 10 
 +0.1 … +35 % on σ at end_b, ×3.4 on the end damage), or steps, gets
 anchors there.  Every case is solved once (:mod:`stochcable.cases.anchor_passes`):
 the anchors pass after pass with the residuals, each from the converged σ of the
-nearest case computed before it, then every other case linear; so the anchors and
+cases computed before it (interpolated in Hs along its period where two are), then
+every other case linear; so the anchors and
 every number depend on the diagram and the computed numbers only, never on the
 executor or the chunking.
 
