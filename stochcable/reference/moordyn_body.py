@@ -81,6 +81,8 @@ class BodyRecord:
         Sample times of the measured period. [s]
     fairlead, anchor : ndarray, shape (n_t, n_lines)
         Support reactions at end_b (on the body) and end_a. [N]
+    fairlead_segment : ndarray, shape (n_t, n_lines)
+        Tension of the last segment (MoorDyn ``GetLineFairTen``). [N]
     motion : ndarray, shape (n_t, 6)
         Body position and MoorDyn's orientation angles (roll, pitch, yaw) less their
         static values. [m, rad]
@@ -94,6 +96,7 @@ class BodyRecord:
     t: np.ndarray
     fairlead: np.ndarray
     anchor: np.ndarray
+    fairlead_segment: np.ndarray
     motion: np.ndarray
     static_fairlead: np.ndarray
     static_anchor: np.ndarray
@@ -279,6 +282,7 @@ def simulate_body_moordyn(
             m_end = np.empty((n_s, len(names), 3, 3))
             x_end = np.empty((n_s, len(names), 3))
             anchor = np.empty((n_s, len(names)))
+            segment = np.empty((n_s, len(names)))
             pose = np.empty((n_s, 6))
             for k in range(n_steps + 1):
                 if k % every == 0:
@@ -289,6 +293,7 @@ def simulate_body_moordyn(
                         m_end[s, i] = md.GetLineNodeM(h, n)
                         x_end[s, i] = md.GetLineNodePos(h, n)
                         anchor[s, i] = np.linalg.norm(md.GetLineNodeForce(h, 0))
+                        segment[s, i] = md.GetLineFairTen(h)
                 if k == n_steps:
                     break
                 t = coupling_dt * k
@@ -316,6 +321,7 @@ def simulate_body_moordyn(
         ts[keep],
         fair[keep],
         anchor[keep],
+        segment[keep],
         pose[keep] - pose[0],
         fair[0],
         anchor[0],
