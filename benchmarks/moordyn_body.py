@@ -13,11 +13,12 @@ three legs and of the buoy's surge, heave and pitch, MoorDyn's with its Student-
 95 % interval over the seeds.
 
     OPENBLAS_NUM_THREADS=1 nice -n 19 python3 benchmarks/moordyn_body.py \
-        [--seeds 6] [--period 600] [--hs 3]
+        [--seeds 16] [--period 900] [--hs 3]
 
-CPU: ≈ 75 s per seed at T = 600 s (a 1200 s record, dtM 2.5 ms, 20 elements per leg)
-plus ≈ 20 s for the two frequency-domain analyses and the statics (measured on the
-shared 2-core machine at load ≈ 4).
+CPU: ≈ 38 s per seed at T = 900 s, 25 s at T = 600 s (dtM 2.5 ms, 20 elements per leg)
+plus ≈ 6 s for the statics, the two frequency-domain analyses and a calm run (the
+table of docs/accuracy/bodies.md: 607 s of MoorDyn for 16 × 900 s, on the shared 2-core
+machine at load ≈ 3).
 """
 
 from __future__ import annotations
@@ -78,8 +79,8 @@ def td_sigmas(rec) -> dict[str, float]:  # noqa: ANN001
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--seeds", type=int, default=6)
-    ap.add_argument("--period", type=float, default=600.0)
+    ap.add_argument("--seeds", type=int, default=16)
+    ap.add_argument("--period", type=float, default=900.0)
     ap.add_argument("--hs", type=float, default=3.0)
     args = ap.parse_args()
     doc = three_leg_buoy_scene(hs=args.hs)

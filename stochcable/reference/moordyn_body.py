@@ -204,6 +204,10 @@ def _sea_components(
         return np.zeros(0), np.zeros(0, complex)
     if sc.sea.spreading is not None:
         raise InputError("sea.spreading", "given", "-", "must be absent (long-crested)")
+    if abs(math.sin(sc.sea.heading_rad)) > 1e-12:
+        # the drag rod's transverse drag is ½ρ·Cd·d·l·|u_n|·u_n on the horizontal
+        # vector u_n: the per-direction law only while u_y = 0
+        raise InputError("sea.heading", sc.sea.heading, "deg", "must be along x (0 or 180)")
     om = sc.analysis.omega.values()
     dw = 2.0 * math.pi / period
     j = np.arange(max(1, math.ceil(om.min() / dw)), math.floor(om.max() / dw) + 1)

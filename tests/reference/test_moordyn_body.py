@@ -142,3 +142,10 @@ def test_moordyn_buoy_sigma_agrees_with_the_default_frequency_domain():
         assert default[k] == pytest.approx(v, rel=0.11), k
     # what the residuals correct: the linear answer is 30 % low at the fairlead
     assert linear["leg2.end_b"] < 0.85 * md["leg2.end_b"]
+
+
+def test_moordyn_body_refuses_oblique_seas():
+    doc = three_leg_buoy_scene(elements=4)
+    doc["sea"]["heading"] = 30.0
+    with pytest.raises(InputError, match="heading"):
+        simulate_body_moordyn(doc, period=10.0, rng=0)
