@@ -87,9 +87,12 @@ class BodyRecord:
         Body position and MoorDyn's orientation angles (roll, pitch, yaw) less their
         static values. [m, rad]
     static_fairlead, static_anchor : ndarray, shape (n_lines,)
-        MoorDyn's static end reactions. [N]
+        The end reactions at t = 0, after MoorDyn's initial-condition solve. [N]
     static_pose : ndarray, shape (6,)
-        MoorDyn's static body position and angles. [m, rad]
+        The body position and angles at t = 0.  The stationary solve stops at TmaxIC
+        with the buoy of :func:`three_leg_buoy_scene` 0.05 m below its equilibrium (it
+        then rings in heave without a sea): MoorDyn's statics are a calm run's means.
+        [m, rad]
     """
 
     lines: tuple[str, ...]
