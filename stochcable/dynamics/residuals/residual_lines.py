@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.compiled import KERNEL_MIN_ENTRIES, optional_kernel
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.residuals import influence as _influence
 from stochcable.dynamics.residuals.influence import (
@@ -300,6 +301,10 @@ DENSE_PAIR_BYTES = 24 * 2**20
 #: memory and no second copy for them (the chain's 6.4 + 3.2 MB were 9.6 MB held and
 #: first touched in every analysis); end σ within 3e-9 of double on the five lines. [-]
 PAIR_DTYPE = np.complex64
+#: The compiled ends' contraction of an upper triangular G (:class:`PairLines`; NumPy's
+#: :func:`dense_pair_outputs` without numba, with ``STOCHCABLE_NUMBA=0`` and below
+#: ``KERNEL_MIN_ENTRIES`` products).
+_FORM_KERNELS = "stochcable.dynamics.residuals.pair_form_kernels"
 
 
 class PairLines:
@@ -316,6 +321,7 @@ class PairLines:
         dense = np.dtype(PAIR_DTYPE).itemsize * n * n * n_o <= DENSE_PAIR_BYTES
         self._g = np.zeros((n_o, n * n), dtype=PAIR_DTYPE) if dense else None
         self._out = None if dense else np.zeros((n_out, n_o))
+        self._upper = True  # (every pair e ≤ f: G upper triangular)
 
     def add(self, g: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
         """A block of pairs (e, f) and their lines ``g`` (n_pairs, n_o) (one of (c, d)
@@ -327,7 +333,9 @@ class PairLines:
         if (tap := RESIDUAL_TAP.get()) is not None:
             tap.lines(g, self.transfer, e, f, keep=False)  # (the tap reads G: outputs)
         n = self.transfer.shape[1]
-        self._g[:, np.asarray(e) * n + np.asarray(f)] = g.T
+        e, f = np.asarray(e), np.asarray(f)
+        self._upper = self._upper and bool(np.all(e <= f))
+        self._g[:, e * n + f] = g.T
 
     def outputs(self) -> np.ndarray:
         """The variance lines (n_out, n_o) of the outputs."""
@@ -335,6 +343,11 @@ class PairLines:
             return self._out
         if (tap := RESIDUAL_TAP.get()) is not None and hasattr(tap, "dense"):
             tap.dense(self._g, self.transfer)
+        n_out, n, n_o = self.transfer.shape
+        if self._upper and n_o * n * (n + 1) // 2 * n_out >= KERNEL_MIN_ENTRIES:
+            kernel = optional_kernel(_FORM_KERNELS, "upper_forms")
+            if kernel is not None:  # (the upper triangle only, G read in place)
+                return kernel(self._g, self.transfer)
         return dense_pair_outputs(self._g, self.transfer)
 
 
