@@ -50,3 +50,21 @@ def test_pair_lines_with_and_without_numba(monkeypatch: pytest.MonkeyPatch) -> N
     monkeypatch.setenv("STOCHCABLE_NUMBA", "0")
     plain = outputs()
     assert np.max(np.abs(compiled - plain)) <= 1e-13 * np.max(np.abs(plain))
+
+
+def test_upper_forms_by_blocks() -> None:
+    """G upper triangular by blocks (the geometric residual's two components of the
+    element pairs f ≥ e): the same as the dense contraction."""
+    rng = np.random.default_rng(3)
+    n_el, n_comp, n_o, n_out = 9, 2, 30, 2
+    n = n_el * n_comp
+    e, f = np.triu_indices(n_el)
+    g = np.zeros((n_o, n * n), dtype=np.complex64)
+    for i in range(n_comp):
+        for j in range(n_comp):
+            cols = (i * n_el + e) * n + j * n_el + f
+            g[:, cols] = rng.normal(size=(n_o, e.size)) + 1j * rng.normal(size=(n_o, e.size))
+    t = rng.normal(size=(n_out, n, n_o)) + 1j * rng.normal(size=(n_out, n, n_o))
+    ref = dense_pair_outputs(g, t)
+    got = kernels.upper_forms(g, t, n_el)
+    assert np.max(np.abs(got - ref)) <= 1e-13 * np.max(np.abs(ref))

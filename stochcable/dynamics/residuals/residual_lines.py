@@ -313,15 +313,20 @@ class PairLines:
     column e·n + f, and contracted once (:func:`dense_pair_outputs`), or block by block
     where G would exceed :data:`DENSE_PAIR_BYTES`.  The blocks are shown to
     :data:`RESIDUAL_TAP` as :func:`pair_outputs` shows them, and G with them (the
-    element tensions' contraction then reads it: :mod:`.along_line`)."""
+    element tensions' contraction then reads it: :mod:`.along_line`).  Where every
+    pair (e, f) added has f's place in its ``block`` of items at least e's (the drag's
+    pairs f ≥ e, ``block`` n; the geometric residual's components of the element pairs,
+    ``block`` n_el), the ends' contraction reads G's nonzero part only, compiled
+    (:func:`~.pair_form_kernels.upper_forms`)."""
 
-    def __init__(self, transfer: np.ndarray) -> None:
+    def __init__(self, transfer: np.ndarray, block: int | None = None) -> None:
         self.transfer = transfer
         n_out, n, n_o = transfer.shape
+        self._block = n if block is None else int(block)  # (components of block items)
         dense = np.dtype(PAIR_DTYPE).itemsize * n * n * n_o <= DENSE_PAIR_BYTES
         self._g = np.zeros((n_o, n * n), dtype=PAIR_DTYPE) if dense else None
         self._out = None if dense else np.zeros((n_out, n_o))
-        self._upper = True  # (every pair e ≤ f: G upper triangular)
+        self._upper = True  # (every pair e ≤ f within its block: G upper triangular)
 
     def add(self, g: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
         """A block of pairs (e, f) and their lines ``g`` (n_pairs, n_o) (one of (c, d)
@@ -334,7 +339,7 @@ class PairLines:
             tap.lines(g, self.transfer, e, f, keep=False)  # (the tap reads G: outputs)
         n = self.transfer.shape[1]
         e, f = np.asarray(e), np.asarray(f)
-        self._upper = self._upper and bool(np.all(e <= f))
+        self._upper = self._upper and bool(np.all(e % self._block <= f % self._block))
         self._g[:, e * n + f] = g.T
 
     def outputs(self) -> np.ndarray:
@@ -347,7 +352,7 @@ class PairLines:
         if self._upper and n_o * n * (n + 1) // 2 * n_out >= KERNEL_MIN_ENTRIES:
             kernel = optional_kernel(_FORM_KERNELS, "upper_forms")
             if kernel is not None:  # (the upper triangle only, G read in place)
-                return kernel(self._g, self.transfer)
+                return kernel(self._g, self.transfer, self._block)
         return dense_pair_outputs(self._g, self.transfer)
 
 
