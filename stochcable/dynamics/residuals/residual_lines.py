@@ -13,6 +13,7 @@ the highest line they reach.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterator
 from contextvars import ContextVar
 from typing import Any
@@ -301,9 +302,10 @@ DENSE_PAIR_BYTES = 24 * 2**20
 #: memory and no second copy for them (the chain's 6.4 + 3.2 MB were 9.6 MB held and
 #: first touched in every analysis); end σ within 3e-9 of double on the five lines. [-]
 PAIR_DTYPE = np.complex64
-#: The compiled ends' contraction of an upper triangular G (:class:`PairLines`; NumPy's
-#: :func:`dense_pair_outputs` without numba, with ``STOCHCABLE_NUMBA=0`` and below
-#: ``KERNEL_MIN_ENTRIES`` products).
+#: The compiled ends' contraction of an upper triangular G (:class:`PairLines`, in a
+#: process that has loaded numba already, e.g. for a banded line's LU; NumPy's
+#: :func:`dense_pair_outputs` otherwise, with ``STOCHCABLE_NUMBA=0`` and below
+#: ``KERNEL_MIN_ENTRIES`` products: the same sums to round-off).
 _FORM_KERNELS = "stochcable.dynamics.residuals.pair_form_kernels"
 
 
@@ -349,7 +351,10 @@ class PairLines:
         if (tap := RESIDUAL_TAP.get()) is not None and hasattr(tap, "dense"):
             tap.dense(self._g, self.transfer)
         n_out, n, n_o = self.transfer.shape
-        if self._upper and n_o * n * (n + 1) // 2 * n_out >= KERNEL_MIN_ENTRIES:
+        # (compiled where numba is loaded already: ≈ 1 ms of the chain's analysis
+        # against 0.5 s of importing numba and the kernel in its first)
+        loaded = "numba" in sys.modules
+        if self._upper and loaded and n_o * n * (n + 1) // 2 * n_out >= KERNEL_MIN_ENTRIES:
             kernel = optional_kernel(_FORM_KERNELS, "upper_forms")
             if kernel is not None:  # (the upper triangle only, G read in place)
                 return kernel(self._g, self.transfer, self._block)
