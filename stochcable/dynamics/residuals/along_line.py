@@ -186,9 +186,8 @@ def _columns_of(transfer: np.ndarray, h: np.ndarray) -> np.ndarray | None:
     first lines repeat)."""
     if h.shape[0] != transfer.shape[0] or h.shape[2] != transfer.shape[2]:
         return None
-    # (each column's first line as the bytes of a contiguous row: one copy per array)
-    first = {row.tobytes(): j for j, row in enumerate(np.ascontiguousarray(h[:, :, 0].T))}
-    keys = [row.tobytes() for row in np.ascontiguousarray(transfer[:, :, 0].T)]
+    first = {np.ascontiguousarray(h[:, j, 0]).tobytes(): j for j in range(h.shape[1])}
+    keys = [np.ascontiguousarray(transfer[:, c, 0]).tobytes() for c in range(transfer.shape[1])]
     if len(first) == h.shape[1] and all(k in first for k in keys):
         kept = np.array([first[k] for k in keys], dtype=int)
         if np.array_equal(h[:, kept], transfer):
@@ -430,10 +429,7 @@ def bent_cells(h: np.ndarray, bend: float = CELL_BEND, power: Any = None) -> np.
     logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
     out = np.zeros(power.shape[1], dtype=bool)
     out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
-    grown = out.copy()  # (and the neighbours: out[0], out[-1] are False)
-    grown[1:] |= out[:-1]
-    grown[:-1] |= out[1:]
-    return grown
+    return out | np.roll(out, 1) | np.roll(out, -1)
 
 
 def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:

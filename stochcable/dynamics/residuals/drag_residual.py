@@ -470,10 +470,7 @@ def _bent(h: np.ndarray, bend: float = CELL_BEND, power: np.ndarray | None = Non
     logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
     out = np.zeros(power.shape[1], dtype=bool)
     out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
-    grown = out.copy()  # (and the neighbours: out[0], out[-1] are False)
-    grown[1:] |= out[:-1]
-    grown[:-1] |= out[1:]
-    return grown
+    return out | np.roll(out, 1) | np.roll(out, -1)
 
 
 def _misfit(

@@ -315,7 +315,7 @@ def quadratic_output_lines(
         for y in range(n_p)
     }
     # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks
-    out = PairLines(transfer, block=n_el)
+    out = PairLines(transfer)
     for e, f in pair_blocks(n_el, n_fft, 2):
         r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}
         # the pairs f > e weighted 2, and covariance_lines' 2/n_fft, on the lags

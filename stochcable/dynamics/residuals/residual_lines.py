@@ -13,14 +13,12 @@ the highest line they reach.
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Iterator
 from contextvars import ContextVar
 from typing import Any
 
 import numpy as np
 
-from stochcable.compiled import KERNEL_MIN_ENTRIES, optional_kernel
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.residuals import influence as _influence
 from stochcable.dynamics.residuals.influence import (
@@ -302,11 +300,6 @@ DENSE_PAIR_BYTES = 24 * 2**20
 #: memory and no second copy for them (the chain's 6.4 + 3.2 MB were 9.6 MB held and
 #: first touched in every analysis); end σ within 3e-9 of double on the five lines. [-]
 PAIR_DTYPE = np.complex64
-#: The compiled ends' contraction of an upper triangular G (:class:`PairLines`, in a
-#: process that has loaded numba already, e.g. for a banded line's LU; NumPy's
-#: :func:`dense_pair_outputs` otherwise, with ``STOCHCABLE_NUMBA=0`` and below
-#: ``KERNEL_MIN_ENTRIES`` products: the same sums to round-off).
-_FORM_KERNELS = "stochcable.dynamics.residuals.pair_form_kernels"
 
 
 class PairLines:
@@ -315,20 +308,14 @@ class PairLines:
     column e·n + f, and contracted once (:func:`dense_pair_outputs`), or block by block
     where G would exceed :data:`DENSE_PAIR_BYTES`.  The blocks are shown to
     :data:`RESIDUAL_TAP` as :func:`pair_outputs` shows them, and G with them (the
-    element tensions' contraction then reads it: :mod:`.along_line`).  Where every
-    pair (e, f) added has f's place in its ``block`` of items at least e's (the drag's
-    pairs f ≥ e, ``block`` n; the geometric residual's components of the element pairs,
-    ``block`` n_el), the ends' contraction reads G's nonzero part only, compiled
-    (:func:`~.pair_form_kernels.upper_forms`)."""
+    element tensions' contraction then reads it: :mod:`.along_line`)."""
 
-    def __init__(self, transfer: np.ndarray, block: int | None = None) -> None:
+    def __init__(self, transfer: np.ndarray) -> None:
         self.transfer = transfer
         n_out, n, n_o = transfer.shape
-        self._block = n if block is None else int(block)  # (components of block items)
         dense = np.dtype(PAIR_DTYPE).itemsize * n * n * n_o <= DENSE_PAIR_BYTES
         self._g = np.zeros((n_o, n * n), dtype=PAIR_DTYPE) if dense else None
         self._out = None if dense else np.zeros((n_out, n_o))
-        self._upper = True  # (every pair e ≤ f within its block: G upper triangular)
 
     def add(self, g: np.ndarray, e: np.ndarray, f: np.ndarray) -> None:
         """A block of pairs (e, f) and their lines ``g`` (n_pairs, n_o) (one of (c, d)
@@ -340,9 +327,7 @@ class PairLines:
         if (tap := RESIDUAL_TAP.get()) is not None:
             tap.lines(g, self.transfer, e, f, keep=False)  # (the tap reads G: outputs)
         n = self.transfer.shape[1]
-        e, f = np.asarray(e), np.asarray(f)
-        self._upper = self._upper and bool(np.all(e % self._block <= f % self._block))
-        self._g[:, e * n + f] = g.T
+        self._g[:, np.asarray(e) * n + np.asarray(f)] = g.T
 
     def outputs(self) -> np.ndarray:
         """The variance lines (n_out, n_o) of the outputs."""
@@ -350,14 +335,6 @@ class PairLines:
             return self._out
         if (tap := RESIDUAL_TAP.get()) is not None and hasattr(tap, "dense"):
             tap.dense(self._g, self.transfer)
-        n_out, n, n_o = self.transfer.shape
-        # (compiled where numba is loaded already: ≈ 1 ms of the chain's analysis
-        # against 0.5 s of importing numba and the kernel in its first)
-        loaded = "numba" in sys.modules
-        if self._upper and loaded and n_o * n * (n + 1) // 2 * n_out >= KERNEL_MIN_ENTRIES:
-            kernel = optional_kernel(_FORM_KERNELS, "upper_forms")
-            if kernel is not None:  # (the upper triangle only, G read in place)
-                return kernel(self._g, self.transfer, self._block)
         return dense_pair_outputs(self._g, self.transfer)
 
 
