@@ -222,6 +222,7 @@ def _v1_settings(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(dr, "SUB_SAMPLES", 1)
     monkeypatch.setattr(dr, "MISFIT_EXACT", True)
     monkeypatch.setattr(dr, "PANEL_FLOOR", 0.0)
+    monkeypatch.setattr(dr, "LINE_TOL", 0.0)  # (every line)
     monkeypatch.setattr(dr.drag_residual, "__defaults__", (dr.HERMITE_ORDER, False, None))
     monkeypatch.setattr(rl, "PAIR_DTYPE", complex)  # (the pair lines in double: 1.2e-9 else)
 

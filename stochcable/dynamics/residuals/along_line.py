@@ -173,19 +173,22 @@ class ResidualTap(VectorTapMixin):
             return
         for unit, w, h in reversed(self._loads):
             kept = _columns_of(transfer, h)
-            if kept is not None:
+            if kept is not None:  # (on the leading lines the contraction kept)
+                w = w[: transfer.shape[2]]
                 self.captures.append(Capture(w, unit, kept, transfer, [block] if keep else []))
                 return
         self.unmatched += 1
 
 
 def _columns_of(transfer: np.ndarray, h: np.ndarray) -> np.ndarray | None:
-    """The columns of ``h`` (n_out, n_all, n_o) that ``transfer`` (n_out, n, n_o) holds,
-    in its order (indices), or None where it is not made of them: matched by their
-    first line, then every column checked whole at once (column by column where the
-    first lines repeat)."""
-    if h.shape[0] != transfer.shape[0] or h.shape[2] != transfer.shape[2]:
+    """The columns of ``h`` (n_out, n_all, n_h) that ``transfer`` (n_out, n, n_o) holds
+    on its leading n_o ≤ n_h lines (a contraction of the lines the outputs need:
+    :mod:`.line_top`), in its order (indices), or None where it is not made of them:
+    matched by their first line, then every column checked whole at once (column by
+    column where the first lines repeat)."""
+    if h.shape[0] != transfer.shape[0] or h.shape[2] < transfer.shape[2]:
         return None
+    h = h[:, :, : transfer.shape[2]]
     first = {np.ascontiguousarray(h[:, j, 0]).tobytes(): j for j in range(h.shape[1])}
     keys = [np.ascontiguousarray(transfer[:, c, 0]).tobytes() for c in range(transfer.shape[1])]
     if len(first) == h.shape[1] and all(k in first for k in keys):

@@ -82,6 +82,7 @@ from stochcable.dynamics.residuals.drag_segments import (
     segment_velocity,
     segments,
 )
+from stochcable.dynamics.residuals.line_top import line_bound, line_top
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     PairLines,
@@ -121,10 +122,15 @@ RESIDUAL_WARN_RATIO = 1.25
 #: (:func:`~stochcable.dynamics.residuals.drag_misfit.misfit_variance`). [-]
 MISFIT_EXACT = False
 #: Panel components whose residual force times their largest end tension per unit force
-#: is below this fraction of the line's largest are left out (:func:`_live_panels`):
-#: the chain's 10 of 56 (pairs 1,596 → 1,081; residual variance −3e-5), the two-segment
-#: line's 12 of 54 (2e-6). [-]
-PANEL_FLOOR = 1e-4
+#: is below this fraction of the line's largest are left out (:func:`_live_panels`).
+#: Corrected σ against 1e-4 (ends, elements, nodes): chain ≤ 5e-6, deep ≤ 7e-7,
+#: two-segment ends 2.8e-4 / nodes 5.2e-4, the inclined guy 5.3e-4, taut unchanged
+#: (docs/benchmarks/residual_cost.md). [-]
+PANEL_FLOOR = 1e-3
+#: Variance, as a share of each end's linear variance, the residual lines left out
+#: above those the ends need may carry at most (a bound: :mod:`.line_top`; σ within
+#: half of it); 0: every line. [-]
+LINE_TOL = 2e-4
 #: Points across a line's cell where the transfer functions of the residual loads are
 #: taken where the lines do not resolve them (:func:`cell_factor`). [-]
 SUB_SAMPLES = 5
@@ -139,6 +145,9 @@ def residual_output_lines(
     coeffs: np.ndarray,
     transfer: np.ndarray,
     n_fft: int,
+    budget: np.ndarray | None = None,
+    weight: np.ndarray | None = None,
+    floor: int = 0,
 ) -> np.ndarray:
     """Spectral lines of outputs driven by the drag residual of jointly Gaussian panels.
 
@@ -157,12 +166,17 @@ def residual_output_lines(
     n_fft : int
         Samples of the lag grid, ≥ 2·K·(n_j − 1) + 1 (no aliasing of the k-fold
         convolutions, whose lines reach K·(n_j − 1)).
+    budget : ndarray, shape (n_out,), optional
+        Variance each output may leave out above its lines' top (:func:`.line_top`,
+        a bound from the panels' own lines, times ``weight`` (n_out, n_o) where given:
+        the cells' factors); the first ``floor`` lines always kept.  None: every line.
+        [N²]
 
     Returns
     -------
-    ndarray, shape (n_out, n_o)
-        The outputs' variance lines at ω_j, j = 1 … n_o (their sum is the variance the
-        residual adds). [N²]
+    ndarray, shape (n_out, n_top)
+        The outputs' variance lines at ω_j, j = 1 … n_top (n_o without ``budget``;
+        their sum is the variance the residual adds). [N²]
     """
     order = coeffs.shape[1] - 1
     n_p = lines.shape[1]
@@ -180,9 +194,9 @@ def residual_output_lines(
     # the pairs f ≥ e (G_fe = conj(G_ef)) in blocks: ρ_ef, Σ_k b_k^e b_k^f ρ^k by
     # Horner's rule, its lines
     zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
-    out = PairLines(transfer)  # (the element tensions read its dense lines: .along_line)
     lo, hi = ks[0], ks[-1]
-    for e, f in pair_blocks(n_p, n_fft):
+
+    def pair_lines(e: np.ndarray, f: np.ndarray, n_fft: int, top: int) -> np.ndarray:
         rho = pair_lags(zz, e, f, n_fft)
         # b_k^e·b_k^f with the pairs f > e weighted 2 and covariance_lines' 2/n_fft in
         c = b[e, lo : hi + 1] * b[f, lo : hi + 1]
@@ -193,7 +207,25 @@ def residual_output_lines(
             rr *= rho
         for _ in range(lo - 1):
             rr *= rho
-        out.add(np.fft.rfft(rr, axis=1)[:, 1 : n_o + 1], e, f)  # (covariance_lines)
+        return np.fft.rfft(rr, axis=1)[:, 1 : top + 1]  # (covariance_lines)
+
+    if budget is None:  # the pairs f ≥ e (G_fe = conj(G_ef)) in blocks
+        out = PairLines(transfer)  # (the element tensions read its dense lines: .along_line)
+        for e, f in pair_blocks(n_p, n_fft):
+            out.add(pair_lines(e, f, n_fft, n_o), e, f)
+        return out.outputs()
+    # the panels' own lines first: the lines the outputs need (line_top), the pairs
+    # e < f on those only, their lag grid free of aliases up to the top line alone
+    diag = np.arange(n_p)
+    g_diag = pair_lines(diag, diag, n_fft, n_o)
+    bound = line_bound(g_diag, transfer) * (1.0 if weight is None else weight)
+    top = line_top(bound, budget, floor)
+    reach = hi * (lines.shape[2] - 1)  # (the top order's highest line)
+    n_top = min(n_fft, fft_length(max(top + reach, 2 * top) + 1))
+    out = PairLines(np.ascontiguousarray(transfer[:, :, :top]))
+    out.add(g_diag[:, :top], diag, diag)
+    for e, f in pair_blocks(n_p, n_top, first=1):
+        out.add(pair_lines(e, f, n_top, top), e, f)
     return out.outputs()
 
 
@@ -264,9 +296,13 @@ def drag_residual(
     keep = _live_panels(comp.lines, comp.scale, comp.coeffs, h_all)
     bent = _bent(h_all)  # (the cells: the residual's and the misfit's)
     cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled, cells=bent)
+    # the lines above those the ends need left out (LINE_TOL of the linear variance)
+    budget = LINE_TOL * np.array([std["end_a"], std["end_b"]], dtype=float) ** 2
     own = residual_output_lines(
-        comp.lines[:, keep], comp.scale[keep], comp.coeffs[keep], h_all[:, keep], comp.n_fft
-    )
+        comp.lines[:, keep], comp.scale[keep], comp.coeffs[keep], h_all[:, keep], comp.n_fft,
+        budget if coupled is None and LINE_TOL > 0 else None, cf, comp.grid.n_j,
+    )  # fmt: skip
+    top = own.shape[1]
     linear = misfit_variance(
         system,
         damping,
@@ -282,7 +318,9 @@ def drag_residual(
         [(c, src) for _, c, src in others],
         MISFIT_EXACT,
     )
-    out = residual_record(own * cf, comp.w_out, w, std, order, len(comp.groups), linear)
+    out = residual_record(
+        own * cf[:, :top], comp.w_out[:top], w, std, order, len(comp.groups), linear
+    )
     if joint is not None:
         out = with_group_lines(out, comp.w_out, joint[0] * cf, w, std)
     _warn_large(system.name, out)

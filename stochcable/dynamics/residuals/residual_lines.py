@@ -176,10 +176,13 @@ def cross_covariance(x: np.ndarray, y: np.ndarray, n_fft: int) -> np.ndarray:
     return np.fft.irfft(cross, n=n_fft, axis=1) * (0.5 * n_fft)
 
 
-def pair_blocks(n: int, n_fft: int, per_pair: int = 1) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    """The pairs e ≤ f of ``n`` items, (e, f) index arrays in blocks of at most
-    :data:`PAIR_BLOCK_BYTES` of ``per_pair`` lag functions of ``n_fft`` samples each."""
-    e, f = np.triu_indices(n)
+def pair_blocks(
+    n: int, n_fft: int, per_pair: int = 1, first: int = 0
+) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """The pairs e ≤ f of ``n`` items (f ≥ e + ``first``: 1, the pairs e < f), (e, f)
+    index arrays in blocks of at most :data:`PAIR_BLOCK_BYTES` of ``per_pair`` lag
+    functions of ``n_fft`` samples each."""
+    e, f = np.triu_indices(n, first)
     size = max(1, PAIR_BLOCK_BYTES // (8 * n_fft * per_pair))
     for start in range(0, e.size, size):
         yield e[start : start + size], f[start : start + size]
