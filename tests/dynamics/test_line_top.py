@@ -15,7 +15,7 @@ import pytest
 import stochcable.dynamics.residuals.residual_lines as rl
 from stochcable.dynamics.residuals.drag_hermite import lumped_coefficients
 from stochcable.dynamics.residuals.drag_residual import residual_output_lines
-from stochcable.dynamics.residuals.line_top import line_bound, line_top
+from stochcable.dynamics.residuals.line_top import line_bound, line_top, spectral_moments
 from stochcable.dynamics.residuals.residual_lines import fft_length
 
 
@@ -89,3 +89,39 @@ def test_cut_lines_equal_the_full_evaluation_and_the_tail_fits(monkeypatch, seed
     weight[:, 30:] = 0.0
     cut0 = residual_output_lines(lines, scale, coeffs, transfer, n_fft, np.zeros(2), weight, n_j)
     assert cut0.shape[1] == 30
+
+
+def test_moment_budget_bounds_the_left_out_moments(monkeypatch):
+    """With a budget on m0, m2 and m4 (the lines' ω^0, ω², ω⁴), the left-out lines'
+    moments are each within theirs, and the top is at least the variance's alone (the
+    superharmonics weigh more in m4)."""
+    monkeypatch.setattr(rl, "PAIR_DTYPE", complex)
+    lines, scale, coeffs, transfer, n_fft, n_j = _panels(2)
+    full = residual_output_lines(lines, scale, coeffs, transfer, n_fft)
+    w = np.arange(1, full.shape[1] + 1) * 0.1
+    powers = w[None] ** np.array([0.0, 2.0, 4.0])[:, None]
+    budget = 1e-3 * full @ powers.T  # (n_out, 3)
+    cut = residual_output_lines(lines, scale, coeffs, transfer, n_fft, budget, None, n_j, powers)
+    top = cut.shape[1]
+    assert np.all(full[:, top:] @ powers[:, top:].T <= budget)
+    alone = residual_output_lines(lines, scale, coeffs, transfer, n_fft, budget[:, 0], None, n_j)
+    assert alone.shape[1] <= top < full.shape[1]
+
+
+def test_spectral_moments_are_the_trapezoid_rule_of_the_linear_spectrum():
+    """m_k of the ends against numpy's trapezoid rule of ω^k Σ_c |H_c|² S_c."""
+
+    class _Resp:
+        omega = np.linspace(0.1, 2.0, 57) ** 1.3
+        end_tension = {
+            "end_a": np.vstack([np.exp(1j * omega), 2.0 / (1.0 + omega)]),
+            "end_b": np.vstack([omega + 0j, 1j * np.ones_like(omega)]),
+        }
+
+    spectra = np.vstack([np.exp(-_Resp.omega), 0.5 * np.ones_like(_Resp.omega)])
+    got = spectral_moments(_Resp, spectra, np.array([0.0, 2.0, 4.0]))
+    for i, end in enumerate(("end_a", "end_b")):
+        dens = np.sum(np.abs(_Resp.end_tension[end]) ** 2 * spectra, axis=0)
+        for j, k in enumerate((0, 2, 4)):
+            ref = np.trapezoid(dens * _Resp.omega**k, _Resp.omega)
+            assert got[i, j] == pytest.approx(ref, rel=1e-12)

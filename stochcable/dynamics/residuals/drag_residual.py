@@ -82,7 +82,7 @@ from stochcable.dynamics.residuals.drag_segments import (
     segment_velocity,
     segments,
 )
-from stochcable.dynamics.residuals.line_top import line_bound, line_top
+from stochcable.dynamics.residuals.line_top import line_bound, line_top, spectral_moments
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     PairLines,
@@ -127,7 +127,7 @@ MISFIT_EXACT = False
 #: two-segment ends 2.8e-4 / nodes 5.2e-4, the inclined guy 5.3e-4, taut unchanged
 #: (docs/benchmarks/residual_cost.md). [-]
 PANEL_FLOOR = 1e-3
-#: Variance, as a share of each end's linear variance, the residual lines left out
+#: Share of each end's linear spectral moments m0, m2, m4 the residual lines left out
 #: above those the ends need may carry at most (a bound: :mod:`.line_top`; σ within
 #: half of it); 0: every line. [-]
 LINE_TOL = 2e-4
@@ -148,6 +148,7 @@ def residual_output_lines(
     budget: np.ndarray | None = None,
     weight: np.ndarray | None = None,
     floor: int = 0,
+    powers: np.ndarray | None = None,
 ) -> np.ndarray:
     """Spectral lines of outputs driven by the drag residual of jointly Gaussian panels.
 
@@ -166,11 +167,12 @@ def residual_output_lines(
     n_fft : int
         Samples of the lag grid, ≥ 2·K·(n_j − 1) + 1 (no aliasing of the k-fold
         convolutions, whose lines reach K·(n_j − 1)).
-    budget : ndarray, shape (n_out,), optional
-        Variance each output may leave out above its lines' top (:func:`.line_top`,
-        a bound from the panels' own lines, times ``weight`` (n_out, n_o) where given:
-        the cells' factors); the first ``floor`` lines always kept.  None: every line.
-        [N²]
+    budget : ndarray, shape (n_out,) or (n_out, n_mom), optional
+        Variance (or spectral moments, with ``powers`` (n_mom, n_o): the lines' ω^k)
+        each output may leave out above its lines' top (:func:`.line_top`, a bound
+        from the panels' own lines, times ``weight`` (n_out, n_o) where given: the
+        cells' factors); the first ``floor`` lines always kept.  None: every line.
+        [N²·(rad/s)^k]
 
     Returns
     -------
@@ -219,7 +221,9 @@ def residual_output_lines(
     diag = np.arange(n_p)
     g_diag = pair_lines(diag, diag, n_fft, n_o)
     bound = line_bound(g_diag, transfer) * (1.0 if weight is None else weight)
-    top = line_top(bound, budget, floor)
+    if powers is not None:  # (a bound of each moment: the lines' ω^k)
+        bound = (bound[:, None, :] * powers[None]).reshape(-1, n_o)
+    top = line_top(bound, np.ravel(budget), floor)
     reach = hi * (lines.shape[2] - 1)  # (the top order's highest line)
     n_top = min(n_fft, fft_length(max(top + reach, 2 * top) + 1))
     out = PairLines(np.ascontiguousarray(transfer[:, :, :top]))
@@ -296,11 +300,14 @@ def drag_residual(
     keep = _live_panels(comp.lines, comp.scale, comp.coeffs, h_all)
     bent = _bent(h_all)  # (the cells: the residual's and the misfit's)
     cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled, cells=bent)
-    # the lines above those the ends need left out (LINE_TOL of the linear variance)
-    budget = LINE_TOL * np.array([std["end_a"], std["end_b"]], dtype=float) ** 2
+    # the lines above those the ends need left out: within LINE_TOL of the linear
+    # spectrum's m0, m2 and m4 at each end (σ, Tz and the bandwidth)
+    orders = np.array([0.0, 2.0, 4.0])
+    budget = LINE_TOL * spectral_moments(resp, comp.spectra, orders)
     own = residual_output_lines(
         comp.lines[:, keep], comp.scale[keep], comp.coeffs[keep], h_all[:, keep], comp.n_fft,
         budget if coupled is None and LINE_TOL > 0 else None, cf, comp.grid.n_j,
+        comp.w_out[None] ** orders[:, None],
     )  # fmt: skip
     top = own.shape[1]
     linear = misfit_variance(

@@ -17,9 +17,13 @@ are then not formed, contracted nor read by the stations.  Used by
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-__all__ = ["line_bound", "line_top"]
+from stochcable.dynamics.model.blocks import trapezoid_weights
+
+__all__ = ["line_bound", "line_top", "spectral_moments"]
 
 
 def line_bound(g_diag: np.ndarray, transfer: np.ndarray) -> np.ndarray:
@@ -59,3 +63,19 @@ def line_top(bound: np.ndarray, budget: np.ndarray, floor: int = 0) -> int:
     fits = np.all(tail <= np.asarray(budget, dtype=float)[:, None], axis=0)  # (n_o + 1,)
     top = int(np.argmax(fits))  # (fits[n_o] is True: the first J that fits)
     return min(max(top, floor), n_o)
+
+
+def spectral_moments(resp: Any, spectra: np.ndarray, orders: np.ndarray) -> np.ndarray:
+    """The linear end tensions' spectral moments m_k = Σ_c ∫ ω^k |H_c|² S_c dω (the
+    trapezoid rule of the linear σ) of a line's ``resp`` (its ``omega`` and
+    ``end_tension`` transfer per end (n_ch, n_w)) and inputs ``spectra`` (n_ch, n_w):
+    shape (2, n_orders), end_a then end_b. [N²·(rad/s)^k]"""
+    w = np.asarray(resp.omega, dtype=float)
+    q = trapezoid_weights(w)[None] * spectra  # (n_ch, n_w)
+    power = np.stack(
+        [
+            np.sum(q * np.abs(np.asarray(resp.end_tension[e])) ** 2, axis=0)
+            for e in ("end_a", "end_b")
+        ]
+    )  # (2, n_w)
+    return power @ (w[:, None] ** np.asarray(orders, dtype=float)[None])
