@@ -217,10 +217,15 @@ def test_planar_line_in_a_3d_model_gives_the_2d_residual(monkeypatch):
     and the fixed point's tolerance).  Both with the banded end influence: the modal
     one's static correction differs between the models' mode sets (2-D: 22 of 78
     modes kept, −2.2e-4 of this variance; 3-D: −2.5e-5), tested on its own in
-    tests/dynamics/test_residual_lines.py."""
+    tests/dynamics/test_residual_lines.py; and the 2-D path with every panel and every
+    line, as the 3-D path forms them (its panel floor at 1e-3 and its lines cut at
+    the ends' need move this variance by −1.2e-4 / +5e-5: tests/dynamics/test_line_top.py)."""
+    import stochcable.dynamics.residuals.drag_residual as dr
     import stochcable.dynamics.residuals.influence as rl
 
     monkeypatch.setattr(rl, "MODAL_INFLUENCE", False)
+    monkeypatch.setattr(dr, "PANEL_FLOOR", 0.0)
+    monkeypatch.setattr(dr, "LINE_TOL", 0.0)
     doc = load_example("chain_catenary").model_dump(mode="json")
     doc["analysis"].pop("timeseries", None)
     doc["analysis"]["linearization"].update(drag_residual=True, tolerance=1e-9)
