@@ -20,15 +20,16 @@ the minor page faults (``ru_minflt``) of the fastest round and their median.
 
 Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
 analysis before issue 31; with the end, element-tension and node-motion residuals now
-chain 2.2–2.3×, taut 1.8×, deep 1.8–1.9×, two-segment 1.8–1.9× (load ≈ 1): exact steps (adjoint end
-tensions, pairs f ≥ e in cache-sized blocks, the lag grid at the alias bound, one end
-influence, the element and node rows in the same solve, one dense matrix of pair lines
-per kind) and approximate ones (Hermite orders 2 and 3 carrying the higher orders'
-variance, 32 panels, 64 lines over the inputs' band with resonant cells integrated, the
-geometric residual on every second line, only the panels and elements whose forces reach
-the ends, the misfit on the residual's lines, the end influence through the linear
-solve's modal basis on long lines): corrected σ within −0.19…+0.33 % of before on the
-four lines and the inclined guy (tests/dynamics/test_drag_residual.py).
+chain 2.1×, taut 1.6–1.7×, deep 1.7–1.8×, two-segment 1.6× (load ≈ 2): exact steps
+(adjoint end tensions, pairs f ≥ e in cache-sized blocks, the lag grid at the alias
+bound, one end influence, the element and node rows in the same solve, one dense
+matrix of pair lines per kind) and approximate ones (Hermite orders 2 and 3 carrying
+the higher orders' variance, 32 panels, 64 lines over the inputs' band with resonant
+cells integrated, the geometric residual on every second line, only the panels and
+elements whose forces reach the ends, the lines above those the ends need by a bound,
+the misfit on the residual's lines, the end influence through the linear solve's
+modal basis on long lines): corrected σ within −0.0…+0.33 % of before on the four
+lines and the inclined guy (tests/dynamics/test_drag_residual.py).
 """
 
 from __future__ import annotations
