@@ -28,7 +28,7 @@ the higher orders' variance, 32 panels, 64 lines over the inputs' band with reso
 cells integrated, the geometric residual on every second line, only the panels and
 elements whose forces reach the ends, the lines above those the ends need by a bound,
 the misfit on the residual's lines, the end influence through the linear solve's
-modal basis on long lines): corrected σ within −0.0…+0.33 % of before on the four
+modal basis on long lines): corrected σ within +0.02…+0.33 % of before on the four
 lines and the inclined guy (tests/dynamics/test_drag_residual.py).
 """
 
