@@ -358,7 +358,7 @@ def solve_chunk(
                 store = {g: x[None] for g, x in starts[j].items()}
             else:
                 store = _warm_store(store, prev, i, state)
-            with warm_starts(store, own=bool(starts)):
+            with warm_starts(store):
                 row, res = _solve_case(
                     engine if exact[j] else linear_engine, case_sea(template, state, family), i
                 )

@@ -65,9 +65,6 @@ __all__ = ["CoupledLinearization", "linearize_coupled", "warm_starts"]
 #: The store of :func:`warm_starts` open in this context (None: every fixed point
 #: starts at rest).
 _WARM: ContextVar[dict[str, np.ndarray] | None] = ContextVar("warm_starts", default=None)
-#: Whether that store holds each group's own converged σ of the sea being solved
-#: (:func:`warm_starts` ``own``): the full grid alone, from that σ.
-_OWN: ContextVar[bool] = ContextVar("warm_starts_own", default=False)
 #: Converged σ a :func:`warm_starts` store keeps per group, and the weights of the
 #: polynomial extrapolation of 1, 2 and 3 of them (newest first). [-]
 _WARM_ORDER = 3
@@ -111,7 +108,7 @@ class CoupledLinearization:
 
 
 @contextmanager
-def warm_starts(store: dict[str, np.ndarray], own: bool = False) -> Iterator[dict[str, np.ndarray]]:
+def warm_starts(store: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]:
     """Warm starts of the drag fixed points solved inside the block: each group's
     iteration starts from the σ its last converged fixed points left in ``store``
     (keyed by the group's lines and bodies: extrapolated from the last three) instead
@@ -124,29 +121,30 @@ def warm_starts(store: dict[str, np.ndarray], own: bool = False) -> Iterator[dic
     that does not converge is dropped for the rest start; a single evaluation
     (``max_iterations`` 1) always starts at rest.
 
+    A warm start iterates on the full grid alone, with no coarse stage
+    (:mod:`~stochcable.dynamics.groups.coarse`): the coarse fixed point is the coarse
+    model's, a defect away from the full grid's, and from a start already near the
+    answer its coarse evaluations and correction rounds cost more than the full-grid
+    evaluations they save (the linear sets of docs/benchmarks/cases.md: −7 % a case
+    on the chain example, −20 % on the taut wire and Tuah's leg); a start that is a
+    case's own converged σ (:func:`stochcable.cases.chunk.solve_chunk` ``starts``)
+    then costs one evaluation.
+
     Parameters
     ----------
     store : dict of str to ndarray
         The last converged σ vectors per group (newest first), filled and read
         here. [m/s]
-    own : bool, optional
-        The store's newest σ are each group's own converged σ of the very sea solved
-        in the block (a case solved again, :func:`stochcable.cases.chunk.solve_chunk`
-        ``starts``): the iteration then runs on the full grid alone from there, with
-        no coarse stage (whose fixed point is the coarse model's, a defect away from
-        the full grid's: 3 evaluations instead of 1 on the chain example, up to 8 on
-        Tuah's leg), so a start still converged costs one evaluation.
 
     Yields
     ------
     dict
         ``store``.
     """
-    token, token_own = _WARM.set(store), _OWN.set(bool(own))
+    token = _WARM.set(store)
     try:
         yield store
     finally:
-        _OWN.reset(token_own)
         _WARM.reset(token)
 
 
@@ -243,23 +241,20 @@ def linearize_coupled(
     warm = None if store is None or lin.max_iterations == 1 else _warm_start(store, gname)
     x_rest, fp = None, None
     if warm is not None and np.all(np.isfinite(warm)):
-        own = _OWN.get()
-        idx = None if own else _warm_subset(g, method, coarse, warm)
-        gc = None
-        if own and len(g.lines) == 1 and not g.bodies:
+        # a warm start: the full grid alone (no coarse stage, see warm_starts)
+        if len(g.lines) == 1 and not g.bodies:
             g.sizes = {g.lines[0].name: warm.size}  # (the σ layout: the line's alone)
-        elif own:  # (the σ layout, from the rest start; the full grid alone)
+            shape_ok = True
+        else:  # (the σ layout, from the rest start)
             x_rest = _start(g, method, False)[0]
-        elif idx is None:  # the subset from the rest start's drag, as without a warm start
-            x_rest, idx, gc = _start(g, method, coarse)
-        if x_rest is None or (warm.shape == x_rest.shape and x_rest.size):
+            shape_ok = warm.shape == x_rest.shape and x_rest.size > 0
+        if shape_ok:
             try:  # a start that does not converge: the rest start, as without one
-                fp, last = _iterate(g, warm, idx, _CoarseGroupSlot(gc), run)
+                fp, last = _iterate(g, warm, None, _CoarseGroupSlot(None), run)
             except (ConvergenceError, SolverError):
                 fp = None
     if fp is None or not fp.converged:
-        if x_rest is None:
-            x_rest, idx, gc = _start(g, method, coarse)
+        x_rest, idx, gc = _start(g, method, coarse)
         # (the coarse group in a slot: released by _iterate when its stage is over)
         slot, gc = _CoarseGroupSlot(gc), None
         fp, last = _iterate(g, x_rest, idx, slot, run)
@@ -384,20 +379,6 @@ def _start(
         return _rest_start(g, method), None, None
     x_rest = _rest_start(g, method)
     return x_rest, (coarse_subset(g, x_rest, method) if coarse and x_rest.size else None), None
-
-
-def _warm_subset(g: GroupSystem, method: str, coarse: bool, warm: np.ndarray) -> np.ndarray | None:
-    """The coarse subset of a warm start of a line alone: the narrow features of the
-    warm start's drag (:func:`~stochcable.dynamics.groups.coarse.coarse_subset`; the
-    at-rest σ are then not needed); None where :func:`_start` decides (bodies, no
-    coarse stage, or none on this drag)."""
-    if not (coarse and not g.bodies and len(g.lines) == 1 and warm.size):
-        return None
-    if g.omega.size < COARSE_MIN_FREQUENCIES:
-        return None
-    full_grid_arrays(g, method)
-    g.sizes = {g.lines[0].name: warm.size}
-    return coarse_subset(g, warm, method)
 
 
 def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
