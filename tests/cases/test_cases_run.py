@@ -300,11 +300,11 @@ def test_a_warm_start_that_does_not_converge_falls_back_to_rest(monkeypatch):
         engine.solve(sea)
     iterate, starts = fixedpoint._iterate, []
 
-    def first_diverges(g, x_start, *args):
+    def first_diverges(g, x_start, *args, **kwargs):
         starts.append(x_start)
         if len(starts) == 1:  # the warm attempt
             raise ConvergenceError("drag linearization (test)", 3, 1.0, 1e-4)
-        return iterate(g, x_start, *args)
+        return iterate(g, x_start, *args, **kwargs)
 
     monkeypatch.setattr(fixedpoint, "_iterate", first_diverges)
     with fixedpoint.warm_starts(store):

@@ -250,7 +250,7 @@ def linearize_coupled(
             shape_ok = warm.shape == x_rest.shape and x_rest.size > 0
         if shape_ok:
             try:  # a start that does not converge: the rest start, as without one
-                fp, last = _iterate(g, warm, None, _CoarseGroupSlot(None), run)
+                fp, last = _iterate(g, warm, None, _CoarseGroupSlot(None), run, warm=True)
             except (ConvergenceError, SolverError):
                 fp = None
     if fp is None or not fp.converged:
@@ -305,10 +305,13 @@ def _iterate(
     idx: np.ndarray | None,
     slot: _CoarseGroupSlot,
     run: FixedPointRun,
+    warm: bool = False,
 ) -> tuple[FixedPointResult, Evaluation]:
     """The fixed point from ``x_start`` (the coarse stage on ``idx`` first when not
     None, on the coarse group in ``slot`` when built: taken, so the coarse group's
-    inputs are released once its stage is over) and its last evaluation."""
+    inputs are released once its stage is over) and its last evaluation.  ``warm``
+    (a warm start, :func:`warm_starts`): the first evaluation opens the Anderson
+    memory, so the next step is a secant step rather than a relaxed one."""
     gc = slot.take()
     count = EvaluationCount()
     stage = None
@@ -321,6 +324,7 @@ def _iterate(
         else:
             x_start = x_coarse
     update = SigmaMap(g, run.method, run.rho, count, run.progress, run.names, run.timing)
+    stage_free = stage is None  # (x0 is then the map of x_start itself)
     x0 = update(x_start)
     change0 = count.change
     rounds = 0
@@ -328,7 +332,8 @@ def _iterate(
         x0, change0, rounds = stage.correct(update, x0, change0)
     coarse_hist = () if stage is None else stage.history
     stage = None  # (its coarse group and inputs released before the full-grid iteration)
-    fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), run)
+    before = (x_start, x0) if warm and stage_free else None
+    fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), run, before)
     fp = FixedPointResult(
         fp.x,
         len(coarse_hist) + fp.iterations,
@@ -410,10 +415,12 @@ def _full_grid(
     rounds: int,
     n_c: int,
     run: FixedPointRun,
+    before: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> FixedPointResult:
     """The full-grid iteration from the output ``x0`` (relative change ``change0``) of
     its first evaluation after ``rounds`` correction rounds and ``n_c`` coarse-stage
-    entries: its record (first evaluation included, coarse stage not)."""
+    entries: its record (first evaluation included, coarse stage not); ``before``, that
+    first evaluation (input, ``x0``), opens the Anderson memory."""
     lin, gname = run.lin, run.gname
     if not np.all(np.isfinite(x0)):
         raise ConvergenceError(
@@ -432,6 +439,7 @@ def _full_grid(
             max_iterations=lin.max_iterations - 1 - rounds,
             allow_unconverged=lin.allow_unconverged,
             name=gname,
+            before=before,
         )
     except ConvergenceError as exc:
         raise ConvergenceError(
