@@ -341,6 +341,56 @@ _PARTS = {
 }
 
 
+#: cProfile (file suffix, function) per part of a case (cumulative times); the
+#: residuals' parts are subtracted from the outputs' (line_result holds them).
+_CASE_PARTS = {
+    "fixed point": ("group_fixed_point.py", "linearize_coupled"),
+    "Foss eigenproblems": ("modal_solvers.py", "foss_modes"),
+    "outputs": ("line_result.py", "line_result"),
+    "residuals": ("drag_form_guard.py", "guarded"),
+    "geometric": ("geometric_residual.py", "geometric_residual"),
+    "along": ("along_line.py", "along_line_residual"),
+    "densities": ("chunk.py", "_along_densities"),
+    "mesh check": ("mesh_engine.py", "__call__"),
+    "damage rates": ("spectral_fatigue.py", "damage_rate"),
+    "evaluations": ("group.py", "__call__"),
+}
+
+
+def _breakdown(src, sd, fat, **kw) -> dict:
+    """Where a set's case time goes (cProfile of one set after a warm-up): per case,
+    the drag fixed point (its evaluations and Foss eigenproblems, counts), the
+    residuals, the other outputs, the mesh check and the damage rates [ms]."""
+    run_cases(src, sd, fatigue=fat, **kw)
+    prof = cProfile.Profile()
+    prof.enable()
+    run_cases(src, sd, fatigue=fat, **kw)
+    prof.disable()
+    st = pstats.Stats(prof).stats
+    n = len(sd.states)
+
+    def get(part, col=3):
+        suffix, fn = _CASE_PARTS[part]
+        return sum(v[col] for k, v in st.items() if k[0].endswith(suffix) and k[2] == fn)
+
+    res = sum(get(k) for k in ("residuals", "geometric", "along", "densities"))
+    out = {
+        "case": max(v[3] for v in st.values()) / n * 1e3,
+        "fixed point": get("fixed point") / n * 1e3,
+        "eig": get("Foss eigenproblems") / n * 1e3,
+        "evaluations": get("evaluations", 1) / n,
+        "eigenproblems": get("Foss eigenproblems", 1) / n,
+        "residuals": res / n * 1e3,
+        "outputs": (get("outputs") - res + get("densities")) / n * 1e3,
+        "mesh check": get("mesh check") / n * 1e3,
+        "damage rates": get("damage rates") / n * 1e3,
+    }
+    out["rest"] = out["case"] - sum(
+        out[k] for k in ("fixed point", "residuals", "outputs", "mesh check", "damage rates")
+    )
+    return out
+
+
 def _corrected(scene, sd, fatigue, n_set: int) -> dict:
     """The corrected set — the default (adaptive anchors), every case computed
     (residual_tolerance=None) and the fixed anchors (residual_span=5,
@@ -557,6 +607,11 @@ def _other_lines() -> dict:
                 t["linear"].append((time.process_time() - t2) / len(rows))
             an = min(t["analyze"])
             line = exact.lines[0]
+            prof = {}
+            if len(tps) <= 4:  # (where a case's time goes: the linear, every-case sets)
+                prof = {"linear": _breakdown(off, sd, fat),
+                        "every case computed": _breakdown(doc, sd, fat, residual_tolerance=None),
+                        "analyze": an * 1e3}  # fmt: skip
             periods = (
                 ", ".join(f"{t:g}" for t in tps)
                 if len(tps) <= 4
@@ -567,7 +622,7 @@ def _other_lines() -> dict:
                 "misses": _misses(got, exact, line),
                 "default": min(t["default"]) / an, "exact": min(t["exact"]) / an,
                 "linear": min(t["linear"]) / an,
-                "diagram": f"Hs {h0:g}–{h1:g} m ({nh}) × Tp {periods} s",
+                "diagram": f"Hs {h0:g}–{h1:g} m ({nh}) × Tp {periods} s", "profile": prof,
             }  # fmt: skip
     return out
 
