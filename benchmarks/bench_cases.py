@@ -268,7 +268,6 @@ def main() -> None:
         "",
         *_why(others),
         "",
-        "",
         "Where a corrected case's time goes when every case computes the residuals",
         "(cProfile of one set, cumulative shares of the set; the rest: the linear",
         "outputs, the corrected end statistics and densities, the fatigue sums):",
