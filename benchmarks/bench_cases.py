@@ -147,8 +147,9 @@ def main() -> None:
         "heading (kept within 128 MiB a line); a case costs its spectrum's weights, the",
         "drag fixed point and the outputs.  The drag fixed point of a case starts from the",
         "converged σ of the cases before it (extrapolated from the last three) within runs",
-        "of 16 cases of the diagram (`stochcable.cases.chunk`): ≈ 4.7 evaluations a case",
-        "instead of 7.6 from rest; the σ differ from `analyze()`'s (which starts at rest)",
+        "of 16 cases of the diagram (`stochcable.cases.chunk`): ≈ 2.7 evaluations a case,",
+        "all on the full grid, instead of 7.6 from rest (most of them on a coarse",
+        "subset); the σ differ from `analyze()`'s (which starts at rest)",
         "within the linearization tolerance (the last row: a run's first case, then warm",
         "cases), and not at all between executors or chunkings.",
         "Timings are of one run on the machine of docs/BENCHMARKS.md; they move with its",
@@ -241,32 +242,31 @@ def main() -> None:
             for o in others.values()
         ],
         "",
-        "Why the taut wire and Tuah's leg stay above the 1/3 of issue 31: (1) the",
-        "linear set alone (the last column: every case solved, no residual) already",
-        "costs more than 1/3 of a corrected `analyze()` on them — their `analyze()` is",
-        "cheap, the residuals a smaller share of it than on the chain, and a set saves",
-        "only the build: a case's drag fixed point (a Foss eigenproblem per full-grid",
-        "evaluation, its coarse stage's modal solves) and outputs remain — so no",
-        "choice of computed cases can meet it; (2) a computed case costs about as",
-        "much as an `analyze()` (every case computed: the column before), its residuals",
-        "depending on its own converged response; (3) the checks compute most cases",
-        "because the corrections bend: between computed Hs one step apart the power",
-        "law misses Tuah's end σ, Tz and damage ratios by 3e-3 … 8e-3 (its",
-        "corrections rise and fall with Hs), and the taut wire's element damage ratios",
-        "near end_b at Tp 10–12 s by 2e-2 … 1e-1 (Hs 0.25 m apart).  Other laws,",
-        "replayed on the every-case sets (the passes re-run on their numbers): PCHIP,",
-        "Akima and makima through all of a column's computed Hs miss at most half as",
-        "much and compute no case fewer; the residual variance σ² − σ_lin² a power of",
-        "Hs meets the taut wire's σ to 1e-6 (from 3e-3), Tz through the residual",
-        "spectral moments m0, m2 to 1e-7, the end damage over its narrow-band proxy",
-        "σ^m/Tz 3–10 × closer, but the elements' damage ratios no closer: no case",
-        "fewer either, so not adopted.  What the set now saves: each fixed point starts",
-        "from the σ of the computed cases of its column interpolated in Hs",
-        "(`stochcable.cases.anchor_passes.column_start`): the taut wire's anchors take",
-        "2.0 evaluations instead of 2.7, its linear cases 1.7 instead of 3.6, Tuah's",
-        "linear cases 3.8 instead of 8.3 (from rest); interleaved against the nearest",
-        "computed case's σ as the start: taut wire −11 %, Tuah −5 %, chain −2 % a case,",
-        "σ within 2e-5.",
+        "A taut wire's case is solved directly (`stochcable.cases.chunk.set_engine`):",
+        "its Foss solve keeps every mode (38 free DOFs: no static correction), so the",
+        "banded solve per frequency gives the same σ (to 3e-12) without a 76-state",
+        "eigenproblem at every fixed-point evaluation.  Where a case's time goes",
+        "(cProfile of one set on the 4-period diagrams after a warm-up, ms a case with",
+        "the profiler's overhead; the fixed point's evaluations and Foss eigenproblems a",
+        "case; outputs: the linear outputs, indicators and the corrected statistics; the",
+        "residuals: drag, geometric and along-line, and the elements' corrected",
+        "densities):",
+        "",
+        "| line | set | case | fixed point (evaluations, eigenproblems) | residuals "
+        "| outputs | mesh check | damage rates | rest | `analyze()` |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+        *[
+            f"| {o['name']} | {k} | {b['case']:.1f} | {b['fixed point']:.1f} "
+            f"({b['evaluations']:.1f}, {b['eigenproblems']:.1f}) | {b['residuals']:.1f} | "
+            f"{b['outputs']:.1f} | {b['mesh check']:.1f} | {b['damage rates']:.2f} | "
+            f"{b['rest']:.1f} | {o['profile']['analyze']:.1f} |"
+            for o in others.values()
+            if o["profile"]
+            for k, b in o["profile"].items()
+            if k != "analyze"
+        ],
+        "",
+        *_why(others),
         "",
         "Where a corrected case's time goes when every case computes the residuals",
         "(cProfile of one set, cumulative shares of the set; the rest: the linear",
@@ -322,6 +322,59 @@ def main() -> None:
         DOC.write_text(text, encoding="utf-8")
 
 
+def _why(others: dict) -> list[str]:
+    """Why the taut wire and Tuah's leg stay above 1/3 (the text, with the figures of
+    the realistic diagrams): the residual cost a computed case may have at most."""
+    rows = []
+    for o in others.values():
+        if o["profile"]:
+            continue
+        frac = o["computed"] / o["cases"]
+        room = (1.0 / 3.0 - o["linear"]) / frac
+        rows.append(
+            f"{o['name']}: linear set {o['linear']:.2f}, {o['computed']} of {o['cases']} "
+            f"computed, a computed case's residuals {o['exact'] - o['linear']:.2f} × "
+            f"`analyze()` where ≤ {room:.2f} would meet 1/3"
+        )
+    return [
+        "Why the taut wire and Tuah's leg stay above the 1/3 of issue 31: the linear",
+        "set (every case solved, no residual) is below it, but a computed case costs",
+        "its residuals on top (every case computed: the column before it), and the",
+        "checks compute most cases, so the set's cost is the linear set's plus the",
+        "computed share times a computed case's residuals — on the realistic",
+        "diagrams " + "; ".join(rows) + ".",
+        "The residuals are evaluated on a case's own converged response (covariances,",
+        "convolutions, Hermite coefficients, end tensions per unit panel load;",
+        "`stochcable.dynamics.residuals`), their transfer functions by the banded",
+        "solve on these short lines; the checks compute most cases because the",
+        "corrections bend: between computed Hs one step apart the power law misses",
+        "Tuah's end σ, Tz and damage ratios by 3e-3 … 8e-3 (its corrections rise and",
+        "fall with Hs), and the taut wire's element damage ratios near end_b at",
+        "Tp 10–12 s by 2e-2 … 1e-1 (Hs 0.25 m apart).  Other laws, replayed on the",
+        "every-case sets (the passes re-run on their numbers): PCHIP, Akima and makima",
+        "through all of a column's computed Hs miss at most half as much and compute",
+        "no case fewer; the residual variance σ² − σ_lin² a power of Hs meets the taut",
+        "wire's σ to 1e-6 (from 3e-3), Tz through the residual spectral moments m0, m2",
+        "to 1e-7, the end damage over its narrow-band proxy σ^m/Tz 3–10 × closer, but",
+        "the elements' damage ratios no closer: no case fewer either, so not adopted.",
+        "",
+        "What a case's fixed point saves in a set: each anchor starts from the σ of the",
+        "computed cases of its column interpolated in Hs",
+        "(`stochcable.cases.anchor_passes.column_start`), every other case from those",
+        "or its run's neighbours; a warm start iterates on the full grid alone (no",
+        "coarse stage: from a start already near, its coarse evaluations cost more",
+        "than they save: the chain's linear set 2.7 evaluations a case instead of 4.7,",
+        "−7 % a case, the taut wire's and Tuah's −20 … −25 %; σ within 2e-5), and its",
+        "first evaluation opens the Anderson memory, so the next step is a secant",
+        "step (Tuah's started cases 104 evaluations instead of 121).  Tried and not",
+        "kept: the first pass's anchors in warm-start runs instead of at rest (Tuah",
+        "−13 % evaluations, within the timing noise, and re-solved leads on chunked",
+        "executors).  `analyze()` itself would be faster without the coarse stage on",
+        "these two lines (taut wire 25.5 against 30.4 ms: 2 evaluations from rest;",
+        "Tuah 16.8 against 18.2 ms), which would raise the ratios above.",
+    ]
+
+
 def _switched(scene, on: bool):
     lin = scene.analysis.linearization.model_copy(
         update={"drag_residual": on, "geometric_residual": on}
@@ -339,6 +392,56 @@ _PARTS = {
     "element tensions' corrected densities (element_densities)": "element_densities",
     "drag fixed point (linearize_coupled)": "linearize_coupled",
 }
+
+
+#: cProfile (file suffix, function) per part of a case (cumulative times); the
+#: residuals' parts are subtracted from the outputs' (line_result holds them).
+_CASE_PARTS = {
+    "fixed point": ("group_fixed_point.py", "linearize_coupled"),
+    "Foss eigenproblems": ("modal_solvers.py", "foss_modes"),
+    "outputs": ("line_result.py", "line_result"),
+    "residuals": ("drag_form_guard.py", "guarded"),
+    "geometric": ("geometric_residual.py", "geometric_residual"),
+    "along": ("along_line.py", "along_line_residual"),
+    "densities": ("chunk.py", "_along_densities"),
+    "mesh check": ("mesh_engine.py", "__call__"),
+    "damage rates": ("spectral_fatigue.py", "damage_rate"),
+    "evaluations": ("group.py", "__call__"),
+}
+
+
+def _breakdown(src, sd, fat, **kw) -> dict:
+    """Where a set's case time goes (cProfile of one set after a warm-up): per case,
+    the drag fixed point (its evaluations and Foss eigenproblems, counts), the
+    residuals, the other outputs, the mesh check and the damage rates [ms]."""
+    run_cases(src, sd, fatigue=fat, **kw)
+    prof = cProfile.Profile()
+    prof.enable()
+    run_cases(src, sd, fatigue=fat, **kw)
+    prof.disable()
+    st = pstats.Stats(prof).stats
+    n = len(sd.states)
+
+    def get(part, col=3):
+        suffix, fn = _CASE_PARTS[part]
+        return sum(v[col] for k, v in st.items() if k[0].endswith(suffix) and k[2] == fn)
+
+    res = sum(get(k) for k in ("residuals", "geometric", "along", "densities"))
+    out = {
+        "case": max(v[3] for v in st.values()) / n * 1e3,
+        "fixed point": get("fixed point") / n * 1e3,
+        "eig": get("Foss eigenproblems") / n * 1e3,
+        "evaluations": get("evaluations", 1) / n,
+        "eigenproblems": get("Foss eigenproblems", 1) / n,
+        "residuals": res / n * 1e3,
+        "outputs": (get("outputs") - res + get("densities")) / n * 1e3,
+        "mesh check": get("mesh check") / n * 1e3,
+        "damage rates": get("damage rates") / n * 1e3,
+    }
+    out["rest"] = out["case"] - sum(
+        out[k] for k in ("fixed point", "residuals", "outputs", "mesh check", "damage rates")
+    )
+    return out
 
 
 def _corrected(scene, sd, fatigue, n_set: int) -> dict:
@@ -557,6 +660,11 @@ def _other_lines() -> dict:
                 t["linear"].append((time.process_time() - t2) / len(rows))
             an = min(t["analyze"])
             line = exact.lines[0]
+            prof = {}
+            if len(tps) <= 4:  # (where a case's time goes: the linear, every-case sets)
+                prof = {"linear": _breakdown(off, sd, fat),
+                        "every case computed": _breakdown(doc, sd, fat, residual_tolerance=None),
+                        "analyze": an * 1e3}  # fmt: skip
             periods = (
                 ", ".join(f"{t:g}" for t in tps)
                 if len(tps) <= 4
@@ -567,7 +675,7 @@ def _other_lines() -> dict:
                 "misses": _misses(got, exact, line),
                 "default": min(t["default"]) / an, "exact": min(t["exact"]) / an,
                 "linear": min(t["linear"]) / an,
-                "diagram": f"Hs {h0:g}–{h1:g} m ({nh}) × Tp {periods} s",
+                "diagram": f"Hs {h0:g}–{h1:g} m ({nh}) × Tp {periods} s", "profile": prof,
             }  # fmt: skip
     return out
 

@@ -142,10 +142,9 @@ def split_last_pass(
     cases) or that would start its warm-start run at rest (no case of the run and
     heading before it left), each started from there (its fixed point on the full
     grid alone: on Tuah's single leg 3.8 evaluations instead of 8.3 from rest), and
-    the others in the warm-start runs over them (whose coarse stage costs less than
-    full-grid evaluations from a farther start: on the chain example a column start
-    between anchors several Hs apart takes 3.3 full-grid evaluations, a warm case 4.9,
-    mostly coarse).  Returns the first cases, their starts, and the others."""
+    the others in the warm-start runs over them (on the chain example a column start
+    between anchors several Hs apart takes 3.3 evaluations, a case of a warm-start run
+    from its neighbours 2.7).  Returns the first cases, their starts, and the others."""
     first, starts, rest = [], [], []
     holds: dict[tuple[float, float], bool] = {}
     for i in sorted(int(i) for i in idx):

@@ -10,8 +10,9 @@ The cases of a set form runs of ``WARM_RUN`` consecutive positions of the diagra
 heading differs from the case before it, starts its drag fixed point at rest, each
 other from the converged σ of the pass's cases before it
 (:func:`stochcable.dynamics.groups.group_fixed_point.warm_starts`;
-neighbouring sea states of a diagram have neighbouring σ: ≈ 4.7 evaluations a case
-instead of 7.6 on the chain example's 200 cases).  A chunk that starts inside a run
+neighbouring sea states of a diagram have neighbouring σ: ≈ 2.7 evaluations a
+case, all on the full grid, instead of 7.6 from rest, most of them on a coarse
+subset, on the chain example's 200 cases).  A chunk that starts inside a run
 solves the pass's earlier cases of that run first (its ``lead``, discarded).  So each case's
 numbers depend only on its run and the engine, and the engine is the same wherever it
 is built (one BLAS thread per chunk): a set gives the same bits whichever executor ran
@@ -202,12 +203,32 @@ def run_lead(
     return tuple((i, states[i]) for i in keep)
 
 
+#: Fewest free DOFs of a line for a set to solve it directly when its Foss solve keeps
+#: every mode (:func:`set_engine`): the taut wire (38, every mode kept) costs 31 % less
+#: a linear case by the banded direct solve than by its 76-state Foss eigenproblem per
+#: evaluation; Tuah's leg (4) the same either way.
+DIRECT_MIN_DOFS = 20
+
+
 def set_engine(template: Scene) -> Engine:
     """The engine of a set's :func:`engine_template`, with the element check
     (:func:`stochcable.fidelity.mesh_engine.checked_engine`: default counts chosen for
     the template's sea, a warning in the row of every case a count does not meet the
-    element rules for); the same wherever it is built."""
-    return checked_engine(template)
+    element rules for); the same wherever it is built.
+
+    Where the Foss solve of every line keeps every mode (no static correction: the
+    same linear equations as the direct solve, to round-off: σ within 1e-11 on the
+    taut wire) and a line has at least :data:`DIRECT_MIN_DOFS` free DOFs, the engine
+    is built again with ``analysis.solver = "direct"``: its banded solve per frequency
+    costs less than a Foss eigenproblem of all modes at every fixed-point evaluation
+    (docs/benchmarks/cases.md)."""
+    engine = checked_engine(template)
+    systems = list(engine.systems.values())
+    full = all(sys.solver == "foss" and sys.n_modes >= sys.model.free.size for sys in systems)
+    if not (full and any(sys.model.free.size >= DIRECT_MIN_DOFS for sys in systems)):
+        return engine
+    analysis = template.analysis.model_copy(update={"solver": "direct"})
+    return checked_engine(template.model_copy(update={"analysis": analysis}))
 
 
 def _engine(template: Scene) -> Engine:
@@ -358,7 +379,7 @@ def solve_chunk(
                 store = {g: x[None] for g, x in starts[j].items()}
             else:
                 store = _warm_store(store, prev, i, state)
-            with warm_starts(store, own=bool(starts)):
+            with warm_starts(store):
                 row, res = _solve_case(
                     engine if exact[j] else linear_engine, case_sea(template, state, family), i
                 )

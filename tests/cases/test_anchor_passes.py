@@ -154,7 +154,7 @@ def test_a_column_start_meets_the_rest_start_in_fewer_evaluations():
 
     def solve(hs, start=None):
         store = {} if start is None else {g: x[None] for g, x in start.items()}
-        with warm_starts(store, own=start is not None):
+        with warm_starts(store):
             line = engine.solve(Sea(spectrum=Jonswap(hs=hs, tp=10.0, gamma=2.0))).lines
         return next(iter(line.values())), {g: x[0].copy() for g, x in store.items()}
 

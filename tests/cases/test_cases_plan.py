@@ -74,8 +74,9 @@ def test_default_chunk_size():
 def test_a_set_applies_the_scenes_residuals():
     """With the scene's residuals on, every case's end statistics are analyze()'s
     corrected ones for its sea state and its end damage is that of analyze()'s
-    corrected density (1e-5 on σ: fixed points started elsewhere, both within the
-    tolerance 1e-4; 1e-4 on the damage, ∝ σ³); the along-line damage stays the linear
+    corrected density (σ and Tz within the linearization tolerance 1e-4: the second
+    case's fixed point starts from the first's σ, analyze()'s at rest, both within
+    it; measured 1.3e-5 on Tz; 3e-4 on the damage, ∝ σ³); the along-line damage stays the linear
     spectrum's, and the corrected σ exceed the linear set's (the chain: 4–7 %)."""
     from stochcable.analysis import analyze
     from stochcable.cases.chunk import case_sea
@@ -114,10 +115,10 @@ def test_a_set_applies_the_scenes_residuals():
         for k, e in enumerate(("end_a", "end_b")):
             st = getattr(one, e)
             got = asked.stats["leg1"][e][i]
-            assert got[1] == pytest.approx(st.std, rel=1e-5)
-            assert got[2] == pytest.approx(st.tz, rel=1e-5)
+            assert got[1] == pytest.approx(st.std, rel=lin.tolerance)
+            assert got[2] == pytest.approx(st.tz, rel=lin.tolerance)
             assert got[1] > 1.02 * plain.stats["leg1"][e][i, 1]
             om, dens = one.end_tension_density(e)
             d = float(damage_rate(om, dens * factor**2, curve, "dirlik"))
-            assert asked.damage_rate_ends["leg1"][i, k] == pytest.approx(d, rel=1e-4)
+            assert asked.damage_rate_ends["leg1"][i, k] == pytest.approx(d, rel=3 * lin.tolerance)
             assert asked.damage_rate_ends["leg1"][i, k] > plain.damage_rate_ends["leg1"][i, k]

@@ -300,11 +300,11 @@ def test_a_warm_start_that_does_not_converge_falls_back_to_rest(monkeypatch):
         engine.solve(sea)
     iterate, starts = fixedpoint._iterate, []
 
-    def first_diverges(g, x_start, *args):
+    def first_diverges(g, x_start, *args, **kwargs):
         starts.append(x_start)
         if len(starts) == 1:  # the warm attempt
             raise ConvergenceError("drag linearization (test)", 3, 1.0, 1e-4)
-        return iterate(g, x_start, *args)
+        return iterate(g, x_start, *args, **kwargs)
 
     monkeypatch.setattr(fixedpoint, "_iterate", first_diverges)
     with fixedpoint.warm_starts(store):
@@ -315,10 +315,11 @@ def test_a_warm_start_that_does_not_converge_falls_back_to_rest(monkeypatch):
 
 @pytest.mark.parametrize("example", ["chain_catenary", "tuah_1982_disc_buoy_single_leg"])
 def test_a_fixed_point_started_at_its_own_answer_costs_one_evaluation(example):
-    # warm_starts(own=True): the adaptive anchors' later passes start a case from its own
-    # converged σ; the full grid alone (no coarse stage, whose coarse fixed point is a
-    # defect away) then converges at its first evaluation.  The answer moves by one
-    # more step of a contracting map from a point already within the tolerance tol:
+    # warm_starts: the adaptive anchors' later passes start a case from its own
+    # converged σ; a warm start runs the full grid alone (no coarse stage, whose coarse
+    # fixed point is a defect away), which then converges at its first evaluation.
+    # The answer moves by one more step of a contracting map from a point already
+    # within the tolerance tol:
     # σ within tol (the chain's 7 evaluations from rest, the leg with its buoy too)
     from stochcable.dynamics.engine import build_engine
     from stochcable.dynamics.groups.group_fixed_point import warm_starts
@@ -333,7 +334,7 @@ def test_a_fixed_point_started_at_its_own_answer_costs_one_evaluation(example):
     with warm_starts(store):
         cold = engine.solve(sea)
     own = {key: x[:1] for key, x in store.items()}
-    with warm_starts(own, own=True):
+    with warm_starts(own):
         again = engine.solve(sea)
     for name, line in again.lines.items():
         assert cold.lines[name].linearization.iterations > 2

@@ -69,9 +69,11 @@ class FixedPointRun:
         max_iterations: int,
         allow_unconverged: bool,
         name: str,
+        before: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> FixedPointResult:
         """:func:`~stochcable.dynamics.linearization.iteration.fixed_point` with this
-        run's relaxation and acceleration (Anderson mixing ``ANDERSON_MIXING``)."""
+        run's relaxation and acceleration (Anderson mixing ``ANDERSON_MIXING``;
+        ``before``: an earlier evaluation opening its memory)."""
         return fixed_point(
             update,
             x0,
@@ -82,6 +84,7 @@ class FixedPointRun:
             mixing=ANDERSON_MIXING,
             allow_unconverged=allow_unconverged,
             name=name,
+            before=before,
         )
 
 

@@ -65,9 +65,6 @@ __all__ = ["CoupledLinearization", "linearize_coupled", "warm_starts"]
 #: The store of :func:`warm_starts` open in this context (None: every fixed point
 #: starts at rest).
 _WARM: ContextVar[dict[str, np.ndarray] | None] = ContextVar("warm_starts", default=None)
-#: Whether that store holds each group's own converged σ of the sea being solved
-#: (:func:`warm_starts` ``own``): the full grid alone, from that σ.
-_OWN: ContextVar[bool] = ContextVar("warm_starts_own", default=False)
 #: Converged σ a :func:`warm_starts` store keeps per group, and the weights of the
 #: polynomial extrapolation of 1, 2 and 3 of them (newest first). [-]
 _WARM_ORDER = 3
@@ -111,7 +108,7 @@ class CoupledLinearization:
 
 
 @contextmanager
-def warm_starts(store: dict[str, np.ndarray], own: bool = False) -> Iterator[dict[str, np.ndarray]]:
+def warm_starts(store: dict[str, np.ndarray]) -> Iterator[dict[str, np.ndarray]]:
     """Warm starts of the drag fixed points solved inside the block: each group's
     iteration starts from the σ its last converged fixed points left in ``store``
     (keyed by the group's lines and bodies: extrapolated from the last three) instead
@@ -124,29 +121,30 @@ def warm_starts(store: dict[str, np.ndarray], own: bool = False) -> Iterator[dic
     that does not converge is dropped for the rest start; a single evaluation
     (``max_iterations`` 1) always starts at rest.
 
+    A warm start iterates on the full grid alone, with no coarse stage
+    (:mod:`~stochcable.dynamics.groups.coarse`): the coarse fixed point is the coarse
+    model's, a defect away from the full grid's, and from a start already near the
+    answer its coarse evaluations and correction rounds cost more than the full-grid
+    evaluations they save (the linear sets of docs/benchmarks/cases.md: −7 % a case
+    on the chain example, −20 % on the taut wire and Tuah's leg); a start that is a
+    case's own converged σ (:func:`stochcable.cases.chunk.solve_chunk` ``starts``)
+    then costs one evaluation.
+
     Parameters
     ----------
     store : dict of str to ndarray
         The last converged σ vectors per group (newest first), filled and read
         here. [m/s]
-    own : bool, optional
-        The store's newest σ are each group's own converged σ of the very sea solved
-        in the block (a case solved again, :func:`stochcable.cases.chunk.solve_chunk`
-        ``starts``): the iteration then runs on the full grid alone from there, with
-        no coarse stage (whose fixed point is the coarse model's, a defect away from
-        the full grid's: 3 evaluations instead of 1 on the chain example, up to 8 on
-        Tuah's leg), so a start still converged costs one evaluation.
 
     Yields
     ------
     dict
         ``store``.
     """
-    token, token_own = _WARM.set(store), _OWN.set(bool(own))
+    token = _WARM.set(store)
     try:
         yield store
     finally:
-        _OWN.reset(token_own)
         _WARM.reset(token)
 
 
@@ -243,23 +241,20 @@ def linearize_coupled(
     warm = None if store is None or lin.max_iterations == 1 else _warm_start(store, gname)
     x_rest, fp = None, None
     if warm is not None and np.all(np.isfinite(warm)):
-        own = _OWN.get()
-        idx = None if own else _warm_subset(g, method, coarse, warm)
-        gc = None
-        if own and len(g.lines) == 1 and not g.bodies:
+        # a warm start: the full grid alone (no coarse stage, see warm_starts)
+        if len(g.lines) == 1 and not g.bodies:
             g.sizes = {g.lines[0].name: warm.size}  # (the σ layout: the line's alone)
-        elif own:  # (the σ layout, from the rest start; the full grid alone)
+            shape_ok = True
+        else:  # (the σ layout, from the rest start)
             x_rest = _start(g, method, False)[0]
-        elif idx is None:  # the subset from the rest start's drag, as without a warm start
-            x_rest, idx, gc = _start(g, method, coarse)
-        if x_rest is None or (warm.shape == x_rest.shape and x_rest.size):
+            shape_ok = warm.shape == x_rest.shape and x_rest.size > 0
+        if shape_ok:
             try:  # a start that does not converge: the rest start, as without one
-                fp, last = _iterate(g, warm, idx, _CoarseGroupSlot(gc), run)
+                fp, last = _iterate(g, warm, None, _CoarseGroupSlot(None), run, warm=True)
             except (ConvergenceError, SolverError):
                 fp = None
     if fp is None or not fp.converged:
-        if x_rest is None:
-            x_rest, idx, gc = _start(g, method, coarse)
+        x_rest, idx, gc = _start(g, method, coarse)
         # (the coarse group in a slot: released by _iterate when its stage is over)
         slot, gc = _CoarseGroupSlot(gc), None
         fp, last = _iterate(g, x_rest, idx, slot, run)
@@ -310,10 +305,13 @@ def _iterate(
     idx: np.ndarray | None,
     slot: _CoarseGroupSlot,
     run: FixedPointRun,
+    warm: bool = False,
 ) -> tuple[FixedPointResult, Evaluation]:
     """The fixed point from ``x_start`` (the coarse stage on ``idx`` first when not
     None, on the coarse group in ``slot`` when built: taken, so the coarse group's
-    inputs are released once its stage is over) and its last evaluation."""
+    inputs are released once its stage is over) and its last evaluation.  ``warm``
+    (a warm start, :func:`warm_starts`): the first evaluation opens the Anderson
+    memory, so the next step is a secant step rather than a relaxed one."""
     gc = slot.take()
     count = EvaluationCount()
     stage = None
@@ -326,6 +324,7 @@ def _iterate(
         else:
             x_start = x_coarse
     update = SigmaMap(g, run.method, run.rho, count, run.progress, run.names, run.timing)
+    stage_free = stage is None  # (x0 is then the map of x_start itself)
     x0 = update(x_start)
     change0 = count.change
     rounds = 0
@@ -333,7 +332,8 @@ def _iterate(
         x0, change0, rounds = stage.correct(update, x0, change0)
     coarse_hist = () if stage is None else stage.history
     stage = None  # (its coarse group and inputs released before the full-grid iteration)
-    fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), run)
+    before = (x_start, x0) if warm and stage_free else None
+    fp = _full_grid(update, x0, change0, rounds, len(coarse_hist), run, before)
     fp = FixedPointResult(
         fp.x,
         len(coarse_hist) + fp.iterations,
@@ -386,20 +386,6 @@ def _start(
     return x_rest, (coarse_subset(g, x_rest, method) if coarse and x_rest.size else None), None
 
 
-def _warm_subset(g: GroupSystem, method: str, coarse: bool, warm: np.ndarray) -> np.ndarray | None:
-    """The coarse subset of a warm start of a line alone: the narrow features of the
-    warm start's drag (:func:`~stochcable.dynamics.groups.coarse.coarse_subset`; the
-    at-rest σ are then not needed); None where :func:`_start` decides (bodies, no
-    coarse stage, or none on this drag)."""
-    if not (coarse and not g.bodies and len(g.lines) == 1 and warm.size):
-        return None
-    if g.omega.size < COARSE_MIN_FREQUENCIES:
-        return None
-    full_grid_arrays(g, method)
-    g.sizes = {g.lines[0].name: warm.size}
-    return coarse_subset(g, warm, method)
-
-
 def _rest_start(g: GroupSystem, method: str) -> np.ndarray:
     """σ of lines at rest (quasi-static on their moving ends) and bodies at rest;
     sets ``g.sizes``. [m/s]"""
@@ -429,10 +415,12 @@ def _full_grid(
     rounds: int,
     n_c: int,
     run: FixedPointRun,
+    before: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> FixedPointResult:
     """The full-grid iteration from the output ``x0`` (relative change ``change0``) of
     its first evaluation after ``rounds`` correction rounds and ``n_c`` coarse-stage
-    entries: its record (first evaluation included, coarse stage not)."""
+    entries: its record (first evaluation included, coarse stage not); ``before``, that
+    first evaluation (input, ``x0``), opens the Anderson memory."""
     lin, gname = run.lin, run.gname
     if not np.all(np.isfinite(x0)):
         raise ConvergenceError(
@@ -451,6 +439,7 @@ def _full_grid(
             max_iterations=lin.max_iterations - 1 - rounds,
             allow_unconverged=lin.allow_unconverged,
             name=gname,
+            before=before,
         )
     except ConvergenceError as exc:
         raise ConvergenceError(

@@ -90,6 +90,7 @@ def fixed_point(
     mixing: float | None = None,
     allow_unconverged: bool = False,
     name: str = "drag linearization",
+    before: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> FixedPointResult:
     r"""Solve ``x = update(x)`` for a non-negative vector (the drag linearization loop).
 
@@ -131,6 +132,10 @@ def fixed_point(
         Return an unconverged result (``converged=False``) instead of raising.
     name : str, optional
         Solver name used in the error message.
+    before : (ndarray, ndarray), optional
+        An evaluation made before ``x0``, ``(x_prev, update(x_prev))`` (typically
+        ``x0 = update(x_prev)``): with ``"anderson"`` it opens the memory, so the
+        first step is already a secant step instead of a relaxed one. [unit of x]
 
     Returns
     -------
@@ -171,6 +176,12 @@ def fixed_point(
     xs: list[np.ndarray] = []
     fs: list[np.ndarray] = []
     prev_norm = np.inf
+    if before is not None and method == "anderson":
+        x_prev = np.asarray(before[0], dtype=float).ravel()
+        f_prev = np.asarray(before[1], dtype=float).ravel() - x_prev
+        if x_prev.shape == x.shape and f_prev.shape == x.shape and np.all(np.isfinite(f_prev)):
+            xs, fs = [x_prev.copy()], [f_prev]
+            prev_norm = float(np.linalg.norm(f_prev))
     g = x
     change = np.inf
     for it in range(1, max_it + 1):
