@@ -5,7 +5,7 @@ with the drag and geometric residuals; linear: without) against MoorDyn's time d
 The mooring of benchmarks/bench_bodies.py made MoorDyn-representable
 (:func:`stochcable.reference.moordyn_body.three_leg_buoy_scene`: a submerged buoy,
 constant buoyancy, translational added mass, per-direction drag carried in MoorDyn by
-a drag rod; no radiation damping, no hydrostatic matrix); MoorDyn runs the same DSA
+three drag rods; no radiation damping, no hydrostatic matrix); MoorDyn runs the same DSA
 sea components as the frequency domain (externally set linear kinematics at the
 static positions, :func:`stochcable.reference.moordyn_body.simulate_body_moordyn`)
 for several seeds; the table gives the σ of the fairlead and anchor tensions of the
