@@ -5,7 +5,7 @@ with the drag and geometric residuals; linear: without) against MoorDyn's time d
 The mooring of benchmarks/bench_bodies.py made MoorDyn-representable
 (:func:`stochcable.reference.moordyn_body.three_leg_buoy_scene`: a submerged buoy,
 constant buoyancy, translational added mass, per-direction drag carried in MoorDyn by
-a drag rod; no radiation damping, no hydrostatic matrix); MoorDyn runs the same DSA
+three drag rods; no radiation damping, no hydrostatic matrix); MoorDyn runs the same DSA
 sea components as the frequency domain (externally set linear kinematics at the
 static positions, :func:`stochcable.reference.moordyn_body.simulate_body_moordyn`)
 for several seeds; the table gives the σ of the fairlead and anchor tensions of the
@@ -13,7 +13,12 @@ three legs and of the buoy's surge, heave and pitch, MoorDyn's with its Student-
 95 % interval over the seeds.
 
     OPENBLAS_NUM_THREADS=1 nice -n 19 python3 benchmarks/moordyn_body.py \
-        [--seeds 16] [--period 900] [--hs 3] [--elements 20]
+        [--seeds 16] [--period 900] [--hs 3] [--elements 20] [--bands]
+
+``--bands``: the variance of the tensions per frequency band, the frequency domain's
+(the density with the residuals, ``end_tension_density``; the linear one) against
+MoorDyn's periodograms (mean over the seeds, the 95 % half-width): where the residual's
+variance goes (docs/accuracy/bodies.md, "Where the downwave fairlead's excess is").
 
 CPU: ≈ 38 s per seed at T = 900 s, 25 s at T = 600 s (dtM 2.5 ms, 20 elements per leg)
 plus ≈ 6 s for the statics, the two frequency-domain analyses and a calm run (the
@@ -77,12 +82,55 @@ def td_sigmas(rec) -> dict[str, float]:  # noqa: ANN001
     return out | {k: rec.motion[:, j].std() for k, j in (("surge", 0), ("heave", 2), ("pitch", 4))}
 
 
+BANDS = (0.0, 0.3, 0.6, 1.0, 1.5, 1.9, 2.0, 2.1, 2.2, 2.3, 2.5, 3.0, 20.0)
+
+
+def band_table(doc: dict, runs: list) -> None:  # noqa: ANN001
+    """Print the tensions' variance per band of :data:`BANDS` [rad/s]: the frequency
+    domain's default (its density with the residuals) and linear, MoorDyn's mean
+    periodogram over ``runs`` with its Student-t 95 % half-width. [kN²]"""
+    res = {}
+    for residuals in (True, False):
+        d = {**doc, "analysis": {**doc["analysis"]}}
+        d["analysis"]["linearization"] = {
+            "drag_residual": residuals,
+            "geometric_residual": residuals,
+        }
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res[residuals] = stochcable.analyze(stochcable.load_scene(d))
+    edges = np.asarray(BANDS)
+    for i, n in enumerate(LEGS[:2]):
+        for end, field in (("end_b", "fairlead"), ("end_a", "anchor")):
+            fd = []
+            for residuals in (True, False):
+                w, s = res[residuals].lines[n].end_tension_density(end)
+                area = np.concatenate([[0.0], np.cumsum(0.5 * (s[1:] + s[:-1]) * np.diff(w))])
+                fd.append(np.diff(np.interp(edges, w, area)))  # (the trapezoid's, cut at edges)
+            td = []
+            for r in runs:
+                x = getattr(r, field)[:, i]
+                x = x - x.mean()
+                wf = 2.0 * np.pi * np.fft.rfftfreq(x.size, r.t[1] - r.t[0])
+                p = 2.0 * np.abs(np.fft.rfft(x)) ** 2 / x.size**2
+                td.append([p[(wf >= a) & (wf < b)].sum() for a, b in zip(edges[:-1], edges[1:])])
+            td = np.asarray(td)
+            print(f"{n}.{end} [kN²]: band [rad/s] | FD default | FD linear | MoorDyn (95 %)")
+            for k, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+                m, h = student_interval(td[:, k])
+                print(
+                    f"  [{a:g}, {b:g}) | {1e-6 * fd[0][k]:.4g} | {1e-6 * fd[1][k]:.4g} | "
+                    f"{1e-6 * m:.4g} ± {1e-6 * h:.2g}"
+                )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=16)
     ap.add_argument("--period", type=float, default=900.0)
     ap.add_argument("--hs", type=float, default=3.0)
     ap.add_argument("--elements", type=int, default=20, help="elements (segments) per leg")
+    ap.add_argument("--bands", action="store_true", help="the tensions' variance per band")
     args = ap.parse_args()
     doc = three_leg_buoy_scene(hs=args.hs, elements=args.elements)
     t0 = time.process_time()
@@ -123,6 +171,8 @@ def main() -> None:
             f"| {100 * (fd_l[k] / m - 1):+.1f} % | {100 * (fd_d[k] / m - 1):+.1f} % "
             f"(± {100 * h / m:.1f} %) |"
         )
+    if args.bands:
+        band_table(doc, runs)
 
 
 if __name__ == "__main__":

@@ -13,13 +13,12 @@ as a Coupled body; the row is then made Free).  Same physics on both sides:
   CG; ``centre_of_buoyancy`` must be zero), no hydrostatic matrix: a submerged body;
 - body drag per direction ½ρ·CdA_i·|u_i|·u_i at the reference point (``drag_point``
   zero).  MoorDyn's own body drag uses the vector norm (½ρ·CdA_i·u_i·|u|, MoorDyn-C
-  2.7 ``Body::doRHS``), so the body's CdA is 0 and the drag is carried by a short
-  vertical Rod fixed to the body (``Body1``), centred on the reference point: its
-  transverse drag ½ρ·Cd·d·l·|u_n|·u_n (u_n = (u_x, u_y): |u_x|·u_x in head seas on a
-  mooring symmetric about the x axis, where u_y = 0) gives CdA_x = Cd·d·l, its two end
-  drags ½ρ·CdEnd·(πd²/4)·|u_z|·u_z give CdA_z = 2·CdEnd·πd²/4.  Its diameter is tiny
-  (its volume, Froude–Krylov and added-mass terms of ``Rod::doRHS`` ∝ d², negligible:
-  ``ROD_DIAMETER``), Ca = CaEnd = 0.
+  2.7 ``Body::doRHS``), so the body's CdA is 0 and the drag is carried by three short
+  Rods fixed to the body (``Body1``) along x, y and z, centred on the reference
+  point, with no transverse drag (Cd = 0): the two end drags of the rod along i,
+  ½ρ·CdEnd·(πd²/4)·|u_i|·u_i each, give CdA_i = 2·CdEnd_i·πd²/4 — the per-direction
+  law at any heading.  Their diameter is tiny (their volume, Froude–Krylov and
+  added-mass terms of ``Rod::doRHS`` ∝ d², negligible: ``ROD_DIAMETER``), Ca = CaEnd = 0.
 - waves: MoorDyn's externally driven kinematics (``WaveKin 1``), set every coupling
   step to the linear (Airy) kinematics of the same DSA sea components as the frequency
   domain (:func:`stochcable.sea.kinematics.wave_kinematics`), evaluated at the
@@ -61,10 +60,10 @@ __all__ = [
     "three_leg_buoy_scene",
 ]
 
-#: Diameter of the drag rod: its volume π/4·d²·l (3 N of buoyancy per metre at 0.02 m)
+#: Diameter of the drag rods: its volume π/4·d²·l (3 N of buoyancy per metre at 0.02 m)
 #: and its Froude–Krylov load ρ·V·a are negligible against the lines' tensions. [m]
 ROD_DIAMETER = 0.02
-#: Length of the drag rod, centred on the body reference point. [m]
+#: Length of the drag rods, centred on the body reference point. [m]
 ROD_LENGTH = 1.0
 _NO_MOTION = {"omega": [0.0, 100.0], "surge": {"re": [0.0, 0.0], "im": [0.0, 0.0]}}
 
@@ -148,7 +147,7 @@ def moordyn_body_input_file(
     Returns
     -------
     str
-        The file's text: body 1 Free, rod 1 its drag rod.
+        The file's text: body 1 Free, rods 1–3 its drag rods along x, y, z.
     """
     sc = load_scene(scene)
     i, b = _free_body(sc)
@@ -168,7 +167,8 @@ def moordyn_body_input_file(
         warnings.simplefilter("ignore", PhysicsWarning)
         text = write_moordyn(load_scene(doc), dt=dt, ic_threshold=1e-7, ic_tmax=300.0)
     inertia = np.zeros(3) if b.inertia is None else np.diag(np.asarray(b.inertia, float))
-    vol = float(b.displaced_volume)
+    # the rods' own volume (buoyant in MoorDyn: 3·πd²/4·l) taken from the body's
+    vol = float(b.displaced_volume) - 3.0 * 0.25 * math.pi * ROD_DIAMETER**2 * ROD_LENGTH
     am = np.zeros((6, 6)) if b.added_mass is None else np.asarray(b.added_mass, float)
     ca = np.diag(am)[:3] / (env.rho * vol)
     row = (
@@ -178,18 +178,25 @@ def moordyn_body_input_file(
     )
     head = next(r for r in text.splitlines() if r.startswith("1 Coupled "))
     area = 0.25 * math.pi * ROD_DIAMETER**2
-    cd = b.drag_area[0] / (ROD_DIAMETER * ROD_LENGTH)
-    cd_end = b.drag_area[2] / (2.0 * area)
     h = 0.5 * ROD_LENGTH
     rods = [
         "---------------------- ROD TYPES ------------------------------------------",
         "TypeName Diam Mass/m Cd Ca CdEnd CaEnd",
         "(name) (m) (kg/m) (-) (-) (-) (-)",
-        f"dragrod {ROD_DIAMETER:.10g} 0 {cd:.10g} 0 {cd_end:.10g} 0",
+    ]
+    rows = []
+    for i, axis in enumerate("xyz"):  # the rod along axis i: its end drags carry CdA_i
+        rods.append(f"drag{axis} {ROD_DIAMETER:.10g} 0 0 0 {b.drag_area[i] / (2.0 * area):.10g} 0")
+        end = np.eye(3)[i] * h
+        rows.append(
+            f"{i + 1} drag{axis} Body1 {-end[0]:.10g} {-end[1]:.10g} {-end[2]:.10g} "
+            f"{end[0]:.10g} {end[1]:.10g} {end[2]:.10g} 2 -"
+        )
+    rods += [
         "---------------------- RODS -----------------------------------------------",
         "ID RodType Attachment Xa Ya Za Xb Yb Zb NumSegs RodOutputs",
         "(#) (name) (word/ID) (m) (m) (m) (m) (m) (m) (-) (-)",
-        f"1 dragrod Body1 0 0 {-h:.10g} 0 0 {h:.10g} 2 -",
+        *rows,
     ]
     points = "---------------------- POINTS"
     text = text.replace(head, row)
@@ -207,10 +214,6 @@ def _sea_components(
         return np.zeros(0), np.zeros(0, complex)
     if sc.sea.spreading is not None:
         raise InputError("sea.spreading", "given", "-", "must be absent (long-crested)")
-    if abs(math.sin(sc.sea.heading_rad)) > 1e-12:
-        # the drag rod's transverse drag is ½ρ·Cd·d·l·|u_n|·u_n on the horizontal
-        # vector u_n: the per-direction law only while u_y = 0
-        raise InputError("sea.heading", sc.sea.heading, "deg", "must be along x (0 or 180)")
     om = sc.analysis.omega.values()
     dw = 2.0 * math.pi / period
     j = np.arange(max(1, math.ceil(om.min() / dw)), math.floor(om.max() / dw) + 1)
