@@ -97,6 +97,9 @@ __all__ = [
     "moordyn_input_file",
     "simulate_line_moordyn",
     "import_moordyn",
+    "moordyn_system",
+    "quiet_moordyn",
+    "sample_stride",
     "internal_damping_coefficient",
 ]
 
@@ -297,7 +300,7 @@ class EndTensionHistory:
 
 
 @contextlib.contextmanager
-def _quiet() -> Iterator[None]:
+def quiet_moordyn() -> Iterator[None]:
     """Silence MoorDyn's console log (written by C++ to file descriptor 1)."""
     try:
         fd = sys.stdout.fileno()
@@ -313,6 +316,36 @@ def _quiet() -> Iterator[None]:
     finally:
         os.dup2(saved, fd)
         os.close(saved)
+
+
+@contextlib.contextmanager
+def moordyn_system(text: str, name: str) -> Iterator[Any]:
+    """MoorDyn's system of the input file ``text`` (written as ``name`` in a temporary
+    directory), created and closed with its console log silenced; yields the system
+    handle of the ``moordyn`` module."""
+    md = import_moordyn()
+    with tempfile.TemporaryDirectory(prefix="stochcable_moordyn_") as tmp:
+        path = Path(tmp) / name
+        path.write_text(text)
+        with quiet_moordyn():
+            system = md.Create(str(path))
+        try:
+            yield system
+        finally:
+            with quiet_moordyn():
+                md.Close(system)
+
+
+def sample_stride(sample_dt: float, coupling_dt: float) -> int:
+    """Coupling steps per sample of a record: ``sample_dt`` must be a positive multiple
+    of ``coupling_dt`` (within 1e-9 of it, the round-off of a decimal step). [-]"""
+    coupling_dt = _v.positive("coupling_dt", coupling_dt, "s")
+    every = int(round(_v.positive("sample_dt", sample_dt, "s") / coupling_dt))
+    if every < 1 or abs(every * coupling_dt - sample_dt) > 1e-9 * sample_dt:
+        raise InputError(
+            "sample_dt", sample_dt, "s", f"must be a multiple of coupling_dt = {coupling_dt} s"
+        )
+    return every
 
 
 def simulate_line_moordyn(
@@ -363,13 +396,8 @@ def simulate_line_moordyn(
     sc = load_scene(scene)
     duration = _v.positive("duration", duration, "s")
     ramp = _v.nonnegative("ramp", ramp, "s")
-    sample_dt = _v.positive("sample_dt", sample_dt, "s")
     coupling_dt = _v.positive("coupling_dt", coupling_dt, "s")
-    every = int(round(sample_dt / coupling_dt))
-    if every < 1 or abs(every * coupling_dt - sample_dt) > 1e-9 * sample_dt:
-        raise InputError(
-            "sample_dt", sample_dt, "s", f"must be a multiple of coupling_dt = {coupling_dt} s"
-        )
+    every = sample_stride(sample_dt, coupling_dt)
     n_steps = int(round(duration / coupling_dt))
     tc = coupling_dt * np.arange(n_steps + 1)
     r, r1, r2 = half_cosine(tc, ramp)
@@ -383,41 +411,33 @@ def simulate_line_moordyn(
     a_ramped = (
         r * motion.acceleration(tc) + 2.0 * r1 * motion.velocity(tc) + r2 * motion.displacement(tc)
     )
-    with tempfile.TemporaryDirectory(prefix="stochcable_moordyn_") as tmp:
-        path = Path(tmp) / "line.txt"
-        path.write_text(text)
-        with _quiet():
-            system = md.Create(str(path))
-        try:
-            with _quiet():
-                err = md.Init(system, list(p0), [0.0, 0.0, 0.0])
-            if err:
-                raise InputError("scene", "MoorDyn Init", "-", f"failed with error code {err}")
-            # a segment per MoorDyn line, in order from end_a: the first line holds
-            # end_a, the last end_b
-            line = md.GetLine(system, 1)
-            last = md.GetLine(system, md.GetNumberLines(system))
-            n_node = md.GetLineNumberNodes(last) - 1
-            static_a = float(np.linalg.norm(md.GetLineNodeTen(line, 0)))
-            static_b = float(md.GetLineFairTen(last))
-            for k in range(n_steps + 1):
-                if k % every == 0:
-                    j = k // every
-                    ta[j] = np.linalg.norm(md.GetLineNodeTen(line, 0))
-                    tb[j] = md.GetLineFairTen(last)
-                    f_end = np.asarray(md.GetLineNodeForce(last, n_node))
-                    m_end = np.asarray(md.GetLineNodeM(last, n_node))
-                    rb[j] = np.linalg.norm(m_end[:, 0] * a_ramped[k] - f_end)
-                    # the anchor node does not move: its reaction is its net force
-                    ra[j] = np.linalg.norm(md.GetLineNodeForce(line, 0))
-                if k == n_steps:
-                    break
-                x = p0 + np.array([xs[k], 0.0, 0.0])
-                v = np.array([(xs[k + 1] - xs[k]) / coupling_dt, 0.0, 0.0])
-                md.Step(system, list(x), list(v), float(tc[k]), coupling_dt)
-        finally:
-            with _quiet():
-                md.Close(system)
+    with moordyn_system(text, "line.txt") as system:
+        with quiet_moordyn():
+            err = md.Init(system, list(p0), [0.0, 0.0, 0.0])
+        if err:
+            raise InputError("scene", "MoorDyn Init", "-", f"failed with error code {err}")
+        # a segment per MoorDyn line, in order from end_a: the first line holds
+        # end_a, the last end_b
+        line = md.GetLine(system, 1)
+        last = md.GetLine(system, md.GetNumberLines(system))
+        n_node = md.GetLineNumberNodes(last) - 1
+        static_a = float(np.linalg.norm(md.GetLineNodeTen(line, 0)))
+        static_b = float(md.GetLineFairTen(last))
+        for k in range(n_steps + 1):
+            if k % every == 0:
+                j = k // every
+                ta[j] = np.linalg.norm(md.GetLineNodeTen(line, 0))
+                tb[j] = md.GetLineFairTen(last)
+                f_end = np.asarray(md.GetLineNodeForce(last, n_node))
+                m_end = np.asarray(md.GetLineNodeM(last, n_node))
+                rb[j] = np.linalg.norm(m_end[:, 0] * a_ramped[k] - f_end)
+                # the anchor node does not move: its reaction is its net force
+                ra[j] = np.linalg.norm(md.GetLineNodeForce(line, 0))
+            if k == n_steps:
+                break
+            x = p0 + np.array([xs[k], 0.0, 0.0])
+            v = np.array([(xs[k + 1] - xs[k]) / coupling_dt, 0.0, 0.0])
+            md.Step(system, list(x), list(v), float(tc[k]), coupling_dt)
     if not (np.all(np.isfinite(ta)) and np.all(np.isfinite(tb))):
         raise SolverError(
             f"MoorDyn's end tensions are not finite (dtM {dt} s, tScheme {scheme}, BA "

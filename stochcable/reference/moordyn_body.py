@@ -36,10 +36,8 @@ force), and the body's surge, heave and pitch.
 from __future__ import annotations
 
 import math
-import tempfile
 import warnings
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -47,7 +45,12 @@ from stochcable import validation as _v
 from stochcable.errors import InputError, PhysicsWarning, SolverError
 from stochcable.io import moordyn_lines, write_moordyn
 from stochcable.reference.cable_excitation import half_cosine
-from stochcable.reference.moordyn import _quiet, import_moordyn
+from stochcable.reference.moordyn import (
+    import_moordyn,
+    moordyn_system,
+    quiet_moordyn,
+    sample_stride,
+)
 from stochcable.scene.model import Scene, load_scene
 from stochcable.sea.kinematics import wave_kinematics
 from stochcable.statics import solve_statics
@@ -256,9 +259,7 @@ def simulate_body_moordyn(
     sc = load_scene(scene)
     period = _v.positive("period", period, "s")
     coupling_dt = _v.positive("coupling_dt", coupling_dt, "s")
-    every = int(round(_v.positive("sample_dt", sample_dt, "s") / coupling_dt))
-    if every < 1 or abs(every * coupling_dt - sample_dt) > 1e-9 * sample_dt:
-        raise InputError("sample_dt", sample_dt, "s", f"must be a multiple of {coupling_dt} s")
+    every = sample_stride(sample_dt, coupling_dt)
     if any(len(ln.segments) != 1 for ln in sc.lines):
         raise InputError("lines", "segments", "-", "each line must be one segment")
     w, amp = _sea_components(sc, period, rng)
@@ -267,57 +268,49 @@ def simulate_body_moordyn(
     n_steps = int(round(2.0 * period / coupling_dt))
     names = tuple(p[0] for p in moordyn_lines(sc))
     text = moordyn_body_input_file(sc, dt=dt, waves=w.size > 0)
-    with tempfile.TemporaryDirectory(prefix="stochcable_moordyn_") as tmp:
-        path = Path(tmp) / "body.txt"
-        path.write_text(text)
-        with _quiet():
-            system = md.Create(str(path))
-        try:
-            with _quiet():
-                err = md.Init(system, [], [])
-            if err:
-                raise InputError("scene", "MoorDyn Init", "-", f"failed with error code {err}")
-            kin = None
-            if w.size:
-                md.ExternalWaveKinInit(system)
-                pts = np.asarray(md.ExternalWaveKinGetCoordinates(system), float)
-                pts[:, 2] = np.maximum(pts[:, 2], -env.depth)  # nodes sunk into the bed
-                wk = wave_kinematics(w, pts, heading, env.depth, env.g)
-                kin = (wk.velocity * amp, wk.acceleration * amp)  # (n_p, 3, n_w)
-            body = md.GetBody(system, 1)
-            handles = [md.GetLine(system, k + 1) for k in range(len(names))]
-            last = [md.GetLineNumberNodes(h) - 1 for h in handles]
-            n_s = n_steps // every + 1
-            f_end = np.empty((n_s, len(names), 3))
-            m_end = np.empty((n_s, len(names), 3, 3))
-            x_end = np.empty((n_s, len(names), 3))
-            anchor = np.empty((n_s, len(names)))
-            segment = np.empty((n_s, len(names)))
-            pose = np.empty((n_s, 6))
-            for k in range(n_steps + 1):
-                if k % every == 0:
-                    s = k // every
-                    pose[s] = np.asarray(md.GetBodyState(body)[0], float)
-                    for i, (h, n) in enumerate(zip(handles, last)):
-                        f_end[s, i] = md.GetLineNodeForce(h, n)
-                        m_end[s, i] = md.GetLineNodeM(h, n)
-                        x_end[s, i] = md.GetLineNodePos(h, n)
-                        anchor[s, i] = np.linalg.norm(md.GetLineNodeForce(h, 0))
-                        segment[s, i] = md.GetLineFairTen(h)
-                if k == n_steps:
-                    break
-                t = coupling_dt * k
-                if kin is not None:
-                    tm = t + 0.5 * coupling_dt
-                    r = float(half_cosine(np.array([tm]), 0.5 * period)[0][0])
-                    e = r * np.exp(1j * w * tm)
-                    u = (kin[0] @ e).real
-                    a = (kin[1] @ e).real  # the ramp's derivative left out: O(1/T)
-                    md.ExternalWaveKinSet(system, u.tolist(), a.tolist(), t)
-                md.Step(system, [], [], t, coupling_dt)
-        finally:
-            with _quiet():
-                md.Close(system)
+    with moordyn_system(text, "body.txt") as system:
+        with quiet_moordyn():
+            err = md.Init(system, [], [])
+        if err:
+            raise InputError("scene", "MoorDyn Init", "-", f"failed with error code {err}")
+        kin = None
+        if w.size:
+            md.ExternalWaveKinInit(system)
+            pts = np.asarray(md.ExternalWaveKinGetCoordinates(system), float)
+            pts[:, 2] = np.maximum(pts[:, 2], -env.depth)  # nodes sunk into the bed
+            wk = wave_kinematics(w, pts, heading, env.depth, env.g)
+            kin = (wk.velocity * amp, wk.acceleration * amp)  # (n_p, 3, n_w)
+        body = md.GetBody(system, 1)
+        handles = [md.GetLine(system, k + 1) for k in range(len(names))]
+        last = [md.GetLineNumberNodes(h) - 1 for h in handles]
+        n_s = n_steps // every + 1
+        f_end = np.empty((n_s, len(names), 3))
+        m_end = np.empty((n_s, len(names), 3, 3))
+        x_end = np.empty((n_s, len(names), 3))
+        anchor = np.empty((n_s, len(names)))
+        segment = np.empty((n_s, len(names)))
+        pose = np.empty((n_s, 6))
+        for k in range(n_steps + 1):
+            if k % every == 0:
+                s = k // every
+                pose[s] = np.asarray(md.GetBodyState(body)[0], float)
+                for i, (h, n) in enumerate(zip(handles, last)):
+                    f_end[s, i] = md.GetLineNodeForce(h, n)
+                    m_end[s, i] = md.GetLineNodeM(h, n)
+                    x_end[s, i] = md.GetLineNodePos(h, n)
+                    anchor[s, i] = np.linalg.norm(md.GetLineNodeForce(h, 0))
+                    segment[s, i] = md.GetLineFairTen(h)
+            if k == n_steps:
+                break
+            t = coupling_dt * k
+            if kin is not None:
+                tm = t + 0.5 * coupling_dt
+                r = float(half_cosine(np.array([tm]), 0.5 * period)[0][0])
+                e = r * np.exp(1j * w * tm)
+                u = (kin[0] @ e).real
+                a = (kin[1] @ e).real  # the ramp's derivative left out: O(1/T)
+                md.ExternalWaveKinSet(system, u.tolist(), a.tolist(), t)
+            md.Step(system, [], [], t, coupling_dt)
     if not (np.all(np.isfinite(f_end)) and np.all(np.isfinite(pose))):
         raise SolverError(f"MoorDyn's body run is not finite (dtM {dt} s)")
     ts = sample_dt * np.arange(n_s)

@@ -8,15 +8,13 @@ belong to.  The check of :func:`stochcable.statics.solve_statics` on MoorDyn fil
 
 from __future__ import annotations
 
-import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from stochcable.errors import InputError
 from stochcable.io import moordyn_lines, write_moordyn
-from stochcable.reference.moordyn import _quiet, import_moordyn
+from stochcable.reference.moordyn import import_moordyn, moordyn_system, quiet_moordyn
 from stochcable.scene.model import Scene, load_scene
 
 __all__ = ["MoorDynSegmentTension", "moordyn_static_tensions"]
@@ -81,31 +79,23 @@ def moordyn_static_tensions(
     )
     pieces = moordyn_lines(sc)
     out = []
-    with tempfile.TemporaryDirectory(prefix="stochcable_moordyn_") as tmp:
-        path = Path(tmp) / "scene.txt"
-        path.write_text(text)
-        with _quiet():
-            system = md.Create(str(path))
-        try:
-            x: list[float] = []
-            for i in range(md.GetNumberBodies(system)):
-                b = md.GetBody(system, i + 1)
-                if md.GetBodyType(b) == md.BODY_TYPE_COUPLED:
-                    x += list(md.GetBodyPos(b)) + [0.0, 0.0, 0.0]
-            for i in range(md.GetNumberPoints(system)):
-                p = md.GetPoint(system, i + 1)
-                if md.GetPointType(p) == md.POINT_TYPE_COUPLED:
-                    x += list(md.GetPointPos(p))
-            with _quiet():
-                err = md.Init(system, x, [0.0] * len(x))
-            if err:
-                raise InputError("scene", "MoorDyn Init", "-", f"failed with error code {err}")
-            for k, (name, e0, n) in enumerate(pieces, start=1):
-                line = md.GetLine(system, k)
-                ta = float(np.linalg.norm(md.GetLineNodeTen(line, 0)))
-                tb = float(md.GetLineFairTen(line))
-                out.append(MoorDynSegmentTension(name, e0, e0 + n - 1, ta, tb))
-        finally:
-            with _quiet():
-                md.Close(system)
+    with moordyn_system(text, "scene.txt") as system:
+        x: list[float] = []
+        for i in range(md.GetNumberBodies(system)):
+            b = md.GetBody(system, i + 1)
+            if md.GetBodyType(b) == md.BODY_TYPE_COUPLED:
+                x += list(md.GetBodyPos(b)) + [0.0, 0.0, 0.0]
+        for i in range(md.GetNumberPoints(system)):
+            p = md.GetPoint(system, i + 1)
+            if md.GetPointType(p) == md.POINT_TYPE_COUPLED:
+                x += list(md.GetPointPos(p))
+        with quiet_moordyn():
+            err = md.Init(system, x, [0.0] * len(x))
+        if err:
+            raise InputError("scene", "MoorDyn Init", "-", f"failed with error code {err}")
+        for k, (name, e0, n) in enumerate(pieces, start=1):
+            line = md.GetLine(system, k)
+            ta = float(np.linalg.norm(md.GetLineNodeTen(line, 0)))
+            tb = float(md.GetLineFairTen(line))
+            out.append(MoorDynSegmentTension(name, e0, e0 + n - 1, ta, tb))
     return out

@@ -16,10 +16,8 @@ half) and one measured period, over which the motion's variance is exact.
 from __future__ import annotations
 
 import math
-import tempfile
 import warnings
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -27,7 +25,12 @@ from stochcable import validation as _v
 from stochcable.errors import InputError, PhysicsWarning, SolverError
 from stochcable.io import moordyn_lines, write_moordyn
 from stochcable.reference.cable_excitation import half_cosine
-from stochcable.reference.moordyn import _quiet, import_moordyn
+from stochcable.reference.moordyn import (
+    import_moordyn,
+    moordyn_system,
+    quiet_moordyn,
+    sample_stride,
+)
 from stochcable.scene.model import Scene, load_scene
 
 __all__ = ["VesselRecord", "simulate_vessel_moordyn"]
@@ -102,7 +105,8 @@ def simulate_vessel_moordyn(
     theta = np.random.default_rng(rng).uniform(-math.pi, math.pi, w.size)
     rao = vessel.prescribed.transfer(w, sc.sea.heading_rad if vessel.prescribed.heading else None)
     amp = rao * (a * np.exp(-1j * theta))  # (6, n): ξ(t) = Re Σ amp e^{iωt}
-    every = int(round(sample_dt / coupling_dt))
+    coupling_dt = _v.positive("coupling_dt", coupling_dt, "s")
+    every = sample_stride(sample_dt, coupling_dt)
     n_steps = int(round(2.0 * period / coupling_dt))
     tc = coupling_dt * np.arange(n_steps + 1)
 
@@ -121,58 +125,50 @@ def simulate_vessel_moordyn(
         warnings.simplefilter("ignore", PhysicsWarning)
         text = write_moordyn(sc, dt=dt, ic_threshold=1e-6, ic_tmax=300.0)
     pieces = moordyn_lines(sc)
-    with tempfile.TemporaryDirectory(prefix="stochcable_moordyn_") as tmp:
-        path = Path(tmp) / "vessel.txt"
-        path.write_text(text)
-        with _quiet():
-            system = md.Create(str(path))
-        try:
-            pts = []
-            for i in range(md.GetNumberPoints(system)):
-                p = md.GetPoint(system, i + 1)
-                if md.GetPointType(p) == md.POINT_TYPE_COUPLED:
-                    pts.append(np.asarray(md.GetPointPos(p), float))
-            if md.GetNumberBodies(system):
-                raise InputError("scene", vessel.name, "-", "the vessel must be Coupled points")
-            arm = np.array(pts) - np.asarray(vessel.position, float)  # (n_p, 3)
+    with moordyn_system(text, "vessel.txt") as system:
+        pts = []
+        for i in range(md.GetNumberPoints(system)):
+            p = md.GetPoint(system, i + 1)
+            if md.GetPointType(p) == md.POINT_TYPE_COUPLED:
+                pts.append(np.asarray(md.GetPointPos(p), float))
+        if md.GetNumberBodies(system):
+            raise InputError("scene", vessel.name, "-", "the vessel must be Coupled points")
+        arm = np.array(pts) - np.asarray(vessel.position, float)  # (n_p, 3)
 
-            def fairleads(xi: np.ndarray) -> np.ndarray:
-                return np.array(pts) + xi[:3] + np.cross(xi[3:], arm)
+        def fairleads(xi: np.ndarray) -> np.ndarray:
+            return np.array(pts) + xi[:3] + np.cross(xi[3:], arm)
 
-            with _quiet():
-                err = md.Init(system, list(fairleads(xs[0]).ravel()), [0.0] * 3 * len(pts))
-            if err:
-                raise InputError("scene", "MoorDyn Init", "-", f"failed with error code {err}")
-            # the MoorDyn lines that end on the vessel: the last piece of each scene line
-            ends = [k for k in range(len(pieces)) if k + 1 == len(pieces) or
-                    pieces[k + 1][0] != pieces[k][0]]  # fmt: skip
-            ends = [k for k in ends if sc.lines[[ln.name for ln in sc.lines].index(
-                pieces[k][0])].end_b.attach is not None]  # fmt: skip
-            if len(ends) != len(pts):
-                raise InputError(
-                    "scene", len(pts), "-", "every Coupled point must end one line on the vessel"
-                )
-            handles = [md.GetLine(system, k + 1) for k in ends]
-            nodes = [md.GetLineNumberNodes(h) - 1 for h in handles]
-            static = np.array([md.GetLineFairTen(h) for h in handles])
-            n_s = n_steps // every + 1
-            rec = np.empty((n_s, len(handles)))
-            for k in range(n_steps + 1):
-                if k % every == 0:
-                    a_f = acc[k, :3] + np.cross(acc[k, 3:], arm)  # fairlead accelerations
-                    for i, (h, n) in enumerate(zip(handles, nodes)):
-                        f = np.asarray(md.GetLineNodeForce(h, n))
-                        m = np.asarray(md.GetLineNodeM(h, n))
-                        # the i-th vessel line's fairlead is the i-th Coupled point
-                        rec[k // every, i] = np.linalg.norm(m @ a_f[i] - f)
-                if k == n_steps:
-                    break
-                x = fairleads(xs[k])
-                v = (fairleads(xs[k + 1]) - x) / coupling_dt
-                md.Step(system, list(x.ravel()), list(v.ravel()), float(tc[k]), coupling_dt)
-        finally:
-            with _quiet():
-                md.Close(system)
+        with quiet_moordyn():
+            err = md.Init(system, list(fairleads(xs[0]).ravel()), [0.0] * 3 * len(pts))
+        if err:
+            raise InputError("scene", "MoorDyn Init", "-", f"failed with error code {err}")
+        # the MoorDyn lines that end on the vessel: the last piece of each scene line
+        ends = [k for k in range(len(pieces)) if k + 1 == len(pieces) or
+                pieces[k + 1][0] != pieces[k][0]]  # fmt: skip
+        ends = [k for k in ends if sc.lines[[ln.name for ln in sc.lines].index(
+            pieces[k][0])].end_b.attach is not None]  # fmt: skip
+        if len(ends) != len(pts):
+            raise InputError(
+                "scene", len(pts), "-", "every Coupled point must end one line on the vessel"
+            )
+        handles = [md.GetLine(system, k + 1) for k in ends]
+        nodes = [md.GetLineNumberNodes(h) - 1 for h in handles]
+        static = np.array([md.GetLineFairTen(h) for h in handles])
+        n_s = n_steps // every + 1
+        rec = np.empty((n_s, len(handles)))
+        for k in range(n_steps + 1):
+            if k % every == 0:
+                a_f = acc[k, :3] + np.cross(acc[k, 3:], arm)  # fairlead accelerations
+                for i, (h, n) in enumerate(zip(handles, nodes)):
+                    f = np.asarray(md.GetLineNodeForce(h, n))
+                    m = np.asarray(md.GetLineNodeM(h, n))
+                    # the i-th vessel line's fairlead is the i-th Coupled point
+                    rec[k // every, i] = np.linalg.norm(m @ a_f[i] - f)
+            if k == n_steps:
+                break
+            x = fairleads(xs[k])
+            v = (fairleads(xs[k + 1]) - x) / coupling_dt
+            md.Step(system, list(x.ravel()), list(v.ravel()), float(tc[k]), coupling_dt)
     if not np.all(np.isfinite(rec)):
         raise SolverError(f"MoorDyn's fairlead tensions are not finite (dtM {dt} s)")
     ts = tc[::every]

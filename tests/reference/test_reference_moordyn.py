@@ -18,6 +18,7 @@ from stochcable.reference.moordyn import (
     internal_damping_coefficient,
     moordyn_input_file,
     periodic_dsa_surge,
+    sample_stride,
     simulate_line_moordyn,
 )
 from stochcable.reference.moordyn_compare import compare_line, student_interval
@@ -332,3 +333,20 @@ def test_lumped_mass_explains_most_of_the_coarse_mesh_difference(moordyn, chain)
         assert r_cons < -0.015, (q, r_cons)
         # the mass matrix is most of it
         assert abs(r_lump) < 0.5 * abs(r_cons), (q, r_cons, r_lump)
+
+
+@pytest.mark.parametrize(
+    ("sample_dt", "coupling_dt"), [(0.05, 0.02), (0.01, 0.05), (0.1, 0.0), (-0.1, 0.01)]
+)
+def test_sample_stride_refuses_a_sampling_that_is_not_a_multiple(sample_dt, coupling_dt):
+    # every MoorDyn run of the package (line, vessel, body) samples its record through
+    # this check: a record must be sampled at whole coupling steps
+    with pytest.raises(InputError, match=r"(sample_dt|coupling_dt) = .* \[s\]"):
+        sample_stride(sample_dt, coupling_dt)
+
+
+def test_sample_stride_counts_coupling_steps_despite_decimal_round_off():
+    # 0.1 / 0.01 is 9.999999999999998 in binary floating point: rounded, not truncated
+    assert sample_stride(0.1, 0.01) == 10
+    assert sample_stride(0.05, 0.025) == 2
+    assert sample_stride(0.025, 0.025) == 1
