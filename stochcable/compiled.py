@@ -11,12 +11,21 @@ costs ~0.2 s), so ``import stochcable``, the CLI and the service start do not lo
 
 from __future__ import annotations
 
+import contextlib
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextvars import ContextVar
 from typing import Any
 
-__all__ = ["KERNEL_MIN_ENTRIES", "compile_cpu_seconds", "jit_cached", "optional_kernel"]
+__all__ = [
+    "KERNEL_MIN_ENTRIES",
+    "compile_cpu_seconds",
+    "jit_cached",
+    "kernel_min_entries",
+    "kernels_paid",
+    "optional_kernel",
+]
 
 #: Problem size (array entries: elements × frequencies × inputs of the variance sums,
 #: right-hand-side entries of the banded solves) from which the dynamics use their
@@ -24,6 +33,34 @@ __all__ = ["KERNEL_MIN_ENTRIES", "compile_cpu_seconds", "jit_cached", "optional_
 #: than NumPy and SciPy spend on the bundled examples (the chain, 40 elements × 200 ω:
 #: 10 ms more per analysis without them, against 0.3–0.5 s for the first).
 KERNEL_MIN_ENTRIES = 2**16
+
+_PAID: ContextVar[bool] = ContextVar("stochcable_kernels_paid", default=False)
+
+
+def kernel_min_entries() -> int:
+    """The problem size from which the banded LU takes its compiled kernels here
+    (:func:`stochcable.dynamics.model.band_lu.compiled_band_lu`):
+    :data:`KERNEL_MIN_ENTRIES`, or 1 inside :func:`kernels_paid`. [-]"""
+    return 1 if _PAID.get() else KERNEL_MIN_ENTRIES
+
+
+@contextlib.contextmanager
+def kernels_paid() -> Iterator[None]:
+    """The banded LU takes its compiled kernels (where numba is available) whatever
+    the job's size: for work that solves many sea states on one engine (a load-case
+    set's chunk, :func:`stochcable.cases.chunk.solve_chunk`), which pays numba's import
+    once for all of them.  Set by the caller, never by process state, so the same work
+    takes the same path, to the bit, in any process.  (The taut wire's computed case
+    in a set: its residuals' adjoint rows, 189 lines × 38 DOFs × 9 rows without the
+    node motions', just under :data:`KERNEL_MIN_ENTRIES`, cost ≈ 1 ms more by LAPACK's
+    stacked ``gbsv``; the variance sums' kernel measured no faster at a set's sizes,
+    so it keeps its threshold.)"""
+    token = _PAID.set(True)
+    try:
+        yield
+    finally:
+        _PAID.reset(token)
+
 
 _KERNELS: dict[tuple[str, str], Any] = {}
 _COMPILE_CPU_S = [0.0]  # (compile_cpu_seconds)

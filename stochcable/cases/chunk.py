@@ -17,7 +17,8 @@ solves the pass's earlier cases of that run first (its ``lead``, discarded).  So
 numbers depend only on its run and the engine, and the engine is the same wherever it
 is built (one BLAS thread per chunk): a set gives the same bits whichever executor ran
 it and however it was chunked, and each case equals ``analyze()`` of its sea within
-the linearization tolerance.
+the linearization tolerance.  A chunk pays numba's import once for all its cases: its
+banded solves take the compiled LU at any size (:func:`stochcable.compiled.kernels_paid`).
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from threadpoolctl import threadpool_limits
 from stochcable.cases.along_spectra import element_densities
 from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import Family, SeaState
+from stochcable.compiled import kernels_paid
 from stochcable.design import damage_rate
 from stochcable.dynamics.engine import Engine
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
@@ -344,7 +346,7 @@ def solve_chunk(
     -------
     ChunkResult
     """
-    with threadpool_limits(limits=1), _no_motion_residuals():
+    with threadpool_limits(limits=1), _no_motion_residuals(), kernels_paid():
         engine = _engine(template) if engine is None else engine
         linear_engine = None  # (the same engine without the residuals, when needed)
         # (the engine's counts: the element check may have raised the defaults)

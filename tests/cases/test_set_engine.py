@@ -5,6 +5,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 from stochcable.analysis import analyze
 from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
@@ -41,6 +42,51 @@ def test_a_line_whose_foss_solve_keeps_every_mode_is_solved_directly_in_a_set():
     assert line.n_modes == system.n_modes  # (analyze(): the Foss solve)
     for e in ("end_a", "end_b"):
         st = getattr(line, e)
+        np.testing.assert_allclose(
+            got.stats["wire"][e][0], (st.mean, st.std, st.tz, st.mpm_3h), rtol=1e-10
+        )
+
+
+def test_a_chunk_takes_the_compiled_banded_lu_at_any_size(monkeypatch):
+    """Inside a chunk (``compiled.kernels_paid``) the residuals' banded adjoint rows
+    take the compiled LU whatever their size — the taut wire's without the node
+    motions' rows (189 lines × 38 DOFs × 9 rows) are under ``KERNEL_MIN_ENTRIES``,
+    which ``analyze()`` keeps — and the case equals the engine's own solve of its sea
+    on LAPACK's path to round-off (the same equations factored by two LU codes:
+    1e-10, the set's agreement with ``analyze()`` in tests/cases/test_cases_run.py)."""
+    pytest.importorskip("stochcable.dynamics.model.band_lu_kernels")
+    import stochcable.dynamics.residuals.band_influence as bi
+    from stochcable.cases.chunk import _no_motion_residuals, solve_chunk
+    from stochcable.compiled import KERNEL_MIN_ENTRIES, kernels_paid
+    from stochcable.dynamics.model.band_lu import compiled_band_lu
+
+    small = KERNEL_MIN_ENTRIES // 2
+    assert not compiled_band_lu(small)
+    with kernels_paid():
+        assert compiled_band_lu(small)
+        monkeypatch.setenv("STOCHCABLE_NUMBA", "0")
+        assert not compiled_band_lu(small)  # (no numba: LAPACK's, as outside)
+        monkeypatch.delenv("STOCHCABLE_NUMBA")
+    assert not compiled_band_lu(small)
+    doc = _wire()
+    doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
+    scene = load_scene(doc)
+    sd = scatter_from_rows([{"hs": 2.0, "tp": 9.0, "hours": 1.0}])
+    calls = []
+    real = bi.band_factors
+    monkeypatch.setattr(bi, "band_factors", lambda *a, **k: calls.append(1) or real(*a, **k))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        template = engine_template(scene, sd.states, "jonswap")
+        engine = set_engine(template)
+        with _no_motion_residuals():  # (as in a chunk, but LAPACK's gbsv: under the size)
+            ref = engine.solve(case_sea(scene, sd.states[0], "jonswap")).lines["wire"]
+        assert not calls
+        fat = {"wire": LineFatigue("dnv-six-strand", nominal_area=1.2e-3)}
+        got = solve_chunk(template, "jonswap", ((0, sd.states[0]),), fat, engine)
+    assert calls
+    for e in ("end_a", "end_b"):
+        st = getattr(ref, e)
         np.testing.assert_allclose(
             got.stats["wire"][e][0], (st.mean, st.std, st.tz, st.mpm_3h), rtol=1e-10
         )

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.compiled import KERNEL_MIN_ENTRIES, optional_kernel
+from stochcable.compiled import kernel_min_entries, optional_kernel
 from stochcable.dynamics.model.solvers import singular_error
 
 __all__ = ["BandFactors", "band_factors", "compiled_band_lu"]
@@ -32,8 +32,9 @@ def compiled_band_lu(entries: int) -> bool:
     the compiled kernels: numba available (and not ``STOCHCABLE_NUMBA=0``) and
     ``entries`` ≥ :data:`~stochcable.compiled.KERNEL_MIN_ENTRIES` (numba's import, ≈
     0.3–0.6 s once per process, is paid above it only; by the job's size alone, so the
-    same document takes the same path, to the bit, in any process). [-]"""
-    if entries < KERNEL_MIN_ENTRIES:
+    same document takes the same path, to the bit, in any process), or any size inside
+    :func:`~stochcable.compiled.kernels_paid` (a load-case set's chunk). [-]"""
+    if entries < kernel_min_entries():
         return False
     return optional_kernel(_KERNELS, "band_lu_factor") is not None
 
