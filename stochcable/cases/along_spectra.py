@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.residuals.corrected_spectrum import extended_grid
 
 __all__ = ["element_densities"]
 
@@ -61,7 +62,7 @@ def element_densities(
                 step = float(om[1] - om[0]) if om.size > 1 else float(om[0])
                 uniform.append((om, v / step))
     target = np.maximum(target, 0.0)
-    grid = along.density(0, w, linear[0]).omega  # (the grid every element shares)
+    grid = extended_grid(w, [om for om, _ in uniform])  # (every element's: the ends')
     dens = np.zeros((base.shape[0], grid.size))
     dens[:, np.searchsorted(grid, w)] = np.maximum(base, 0.0)
     res = np.zeros_like(dens)

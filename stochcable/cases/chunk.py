@@ -417,20 +417,38 @@ def solve_chunk(
                         rows[j] = replace(rows[j], warnings=(*rows[j].warnings, strum[1]))
                 linear[name][have[name], :, 3] = damage[name][have[name], :2]
                 linear_along[name][have[name]] = damage[name][have[name], 2:]
-                for j, (om, dens) in along[name].items():  # the elements' corrected spectra
-                    damage[name][j, 2:] = damage_rate(om, dens * factor**2, curve, settings.method)
-                    if strum is not None:
-                        damage[name][j, 2:] += strum[0][2:]
-                for j, ends_c in corrected[name].items():
-                    damage[name][j, :2] = [
-                        damage_rate(om, d * factor**2, curve, settings.method) for om, d in ends_c
-                    ]
-                    if strum is not None:
-                        damage[name][j, :2] += strum[0][:2]
+                for j in sorted(corrected[name].keys() | along[name].keys()):
+                    ends_c, el = corrected[name].get(j), along[name].get(j)
+                    for at, om, dens in _corrected_rows(ends_c, el):
+                        damage[name][j, at] = damage_rate(
+                            om, dens * factor**2, curve, settings.method
+                        )
+                        if strum is not None:
+                            damage[name][j, at] += strum[0][at]
     idx = np.array([c[0] for c in cases], dtype=int)
     return ChunkResult(
         idx, tuple(rows), stats, damage, s_el, linear, exact, tuple(kept), linear_along
     )
+
+
+def _corrected_rows(
+    ends: list[tuple[np.ndarray, np.ndarray]] | None,
+    elements: tuple[np.ndarray, np.ndarray] | None,
+) -> list[tuple[slice, np.ndarray, np.ndarray]]:
+    """A computed case's corrected densities as damage-rate jobs (columns of its
+    damage row, grid, densities (k, n)): the ends' (end_a, end_b: columns 0, 1) and
+    the elements' (columns 2 …) in one job where they share a grid (the residual
+    lines outside the analysis grid are the same for the ends and the elements: on the
+    taut wire, Tuah's leg and the chain always), else one job each."""
+    jobs: list[tuple[slice, np.ndarray, np.ndarray]] = []
+    if ends is not None:
+        jobs += [(slice(k, k + 1), om, d[None]) for k, (om, d) in enumerate(ends)]
+    if elements is not None:
+        jobs.append((slice(2, None), elements[0], elements[1]))
+    if len(jobs) > 1 and all(np.array_equal(om, jobs[0][1]) for _, om, _ in jobs[1:]):
+        cols = slice(jobs[0][0].start, jobs[-1][0].stop)  # (contiguous: 0, 1, 2 …)
+        return [(cols, jobs[0][1], np.concatenate([d for _, _, d in jobs]))]
+    return jobs
 
 
 @contextlib.contextmanager

@@ -90,3 +90,30 @@ def test_a_chunk_takes_the_compiled_banded_lu_at_any_size(monkeypatch):
         np.testing.assert_allclose(
             got.stats["wire"][e][0], (st.mean, st.std, st.tz, st.mpm_3h), rtol=1e-10
         )
+
+
+def test_a_computed_cases_corrected_densities_are_one_damage_job_on_one_grid():
+    """``chunk._corrected_rows``: the ends' and the elements' corrected densities on
+    one grid are one damage-rate job over columns 0 … 2 + n_el (end_a, end_b, the
+    elements: the row layout of ``ChunkResult.damage``), and its damage equals each
+    row's alone to round-off (1e-12: the moments' products in another order); on
+    different grids, one job each."""
+    from stochcable.cases.chunk import _corrected_rows
+    from stochcable.cases.fatigue_settings import curve_factor
+    from stochcable.design import damage_rate
+
+    rng = np.random.default_rng(5)
+    om = np.linspace(0.1, 3.0, 60)
+    ends = [(om, rng.random(60)), (om, rng.random(60))]
+    el = (om, rng.random((3, 60)))
+    (job,) = _corrected_rows(ends, el)
+    assert job[0] == slice(0, None) and np.array_equal(job[1], om)
+    np.testing.assert_array_equal(job[2], np.vstack([ends[0][1], ends[1][1], el[1]]))
+    curve, _ = curve_factor(LineFatigue("dnv-six-strand", nominal_area=1.2e-3), 9.81, "wire")
+    alone = [damage_rate(o, d, curve) for o, d in ends] + list(damage_rate(*el, curve))
+    np.testing.assert_allclose(damage_rate(job[1], job[2], curve), alone, rtol=1e-12)
+    other = (om * 1.01, el[1])
+    jobs = _corrected_rows(ends, other)
+    assert [j[0] for j in jobs] == [slice(0, 1), slice(1, 2), slice(2, None)]
+    assert [j[0] for j in _corrected_rows(ends, None)] == [slice(0, 2)]
+    assert [j[0] for j in _corrected_rows(None, el)] == [slice(2, None)]

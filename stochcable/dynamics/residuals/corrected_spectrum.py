@@ -35,7 +35,7 @@ import numpy as np
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.results.records import ResidualRecord
 
-__all__ = ["CorrectedSpectrum", "corrected_spectrum", "spectrum_with_lines"]
+__all__ = ["CorrectedSpectrum", "corrected_spectrum", "extended_grid", "spectrum_with_lines"]
 
 #: The gap between a grid end and the node beyond it where the linear density is zero,
 #: in units of the end cell: the linear density's trapezoid over it adds this fraction
@@ -132,9 +132,7 @@ def spectrum_with_lines(
             step = float(om[1] - om[0]) if om.size > 1 else float(om[0])
             uniform.append((om, v / step))
     target = max(target, 0.0)
-    outside = [om[(om < w[0]) | (om > w[-1])] for om, _ in uniform]
-    grid = np.union1d(w, np.concatenate(outside)) if outside else w
-    grid = _with_steps(grid, w)
+    grid = extended_grid(w, [om for om, _ in uniform])
     at = np.searchsorted(grid, w)
     dens = np.zeros(grid.size)
     dens[at] = np.maximum(base, 0.0)  # (a misfit change below the linear density: 0)
@@ -146,6 +144,17 @@ def spectrum_with_lines(
     scale = (target - float(np.sum(qg * dens))) / area if area > 0 else 1.0
     out = np.maximum(dens + scale * res, 0.0)
     return CorrectedSpectrum(grid, out, float(scale))
+
+
+def extended_grid(omega: np.ndarray, lines: list[np.ndarray]) -> np.ndarray:
+    """The frequencies of a corrected density (module notes): the analysis grid
+    ``omega``, the uniform residual lines ``lines`` (their frequencies, each an array)
+    outside it, and a node just beyond each end of ``omega`` the grid extends past.
+    [rad/s]"""
+    w = omega
+    outside = [om[(om < w[0]) | (om > w[-1])] for om in lines]
+    grid = np.union1d(w, np.concatenate(outside)) if outside else w
+    return _with_steps(grid, w)
 
 
 def _with_steps(grid: np.ndarray, w: np.ndarray) -> np.ndarray:
