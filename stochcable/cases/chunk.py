@@ -40,7 +40,7 @@ from stochcable.cases.fatigue_settings import LineFatigue, curve_factor
 from stochcable.cases.scatter import Family, SeaState
 from stochcable.compiled import kernels_paid
 from stochcable.design import damage_rate
-from stochcable.dynamics.engine import Engine
+from stochcable.dynamics.engine import Engine, build_engine
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
 from stochcable.dynamics.outputs.line_result import MOTION_RESIDUALS
 from stochcable.errors import StochcableError, collect_warnings
@@ -206,9 +206,11 @@ def run_lead(
 
 
 #: Fewest free DOFs of a line for a set to solve it directly when its Foss solve keeps
-#: every mode (:func:`set_engine`): the taut wire (38, every mode kept) costs 31 % less
-#: a linear case by the banded direct solve than by its 76-state Foss eigenproblem per
-#: evaluation; Tuah's leg (4) the same either way.
+#: every mode (:func:`set_engine`).  A linear set's case by the banded direct solve
+#: over the Foss solve's (interleaved, benchmarks/case_cost.py): the taut wire (38
+#: free DOFs, every mode kept) 0.67, Tuah's leg (4, every mode kept) 1.05; the chain
+#: and the two-segment line (78; 20 and 17 modes kept, not the same equations) 1.5
+#: and 1.6. [-]
 DIRECT_MIN_DOFS = 20
 
 
@@ -220,17 +222,21 @@ def set_engine(template: Scene) -> Engine:
 
     Where the Foss solve of every line keeps every mode (no static correction: the
     same linear equations as the direct solve, to round-off: σ within 1e-11 on the
-    taut wire) and a line has at least :data:`DIRECT_MIN_DOFS` free DOFs, the engine
-    is built again with ``analysis.solver = "direct"``: its banded solve per frequency
-    costs less than a Foss eigenproblem of all modes at every fixed-point evaluation
+    taut wire) and a line has at least :data:`DIRECT_MIN_DOFS` free DOFs, its models
+    are built again with ``analysis.solver = "direct"`` on the same statics, element
+    counts and element check: its banded solve per frequency costs less than a Foss
+    eigenproblem of all modes at every fixed-point evaluation
     (docs/benchmarks/cases.md)."""
     engine = checked_engine(template)
     systems = list(engine.systems.values())
     full = all(sys.solver == "foss" and sys.n_modes >= sys.model.free.size for sys in systems)
     if not (full and any(sys.model.free.size >= DIRECT_MIN_DOFS for sys in systems)):
         return engine
-    analysis = template.analysis.model_copy(update={"solver": "direct"})
-    return checked_engine(template.model_copy(update={"analysis": analysis}))
+    # (the same statics, element counts and element check: only the solver changes)
+    scene = engine.scene
+    analysis = scene.analysis.model_copy(update={"solver": "direct"})
+    direct = build_engine(scene.model_copy(update={"analysis": analysis}), statics=engine.statics)
+    return dataclasses.replace(direct, check=engine.check)
 
 
 def _engine(template: Scene) -> Engine:

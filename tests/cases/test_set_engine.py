@@ -27,8 +27,10 @@ def test_a_line_whose_foss_solve_keeps_every_mode_is_solved_directly_in_a_set():
     analyze()'s Foss answer to round-off (1e-10: the same equations solved two ways);
     the chain (20 of 78 modes, a static correction) keeps its Foss solve."""
     scene = load_scene(_wire())
-    (system,) = set_engine(engine_template(scene, (), "jonswap")).systems.values()
-    assert system.solver == "direct"
+    engine = set_engine(engine_template(scene, (), "jonswap"))
+    (system,) = engine.systems.values()
+    assert system.solver == "direct" and engine.scene.analysis.solver == "direct"
+    assert engine.check is not None  # (the element check carried over: no second pilot)
     assert system.n_modes == system.model.free.size
     (chain,) = set_engine(load_example("chain_catenary")).systems.values()
     assert chain.solver == "foss" and chain.n_modes < chain.model.free.size
