@@ -405,11 +405,12 @@ def solve_chunk(
                     linear[name][j, e, :3] = (lin.std, lin.tz, lin.mpm_3h)
                 if name in fatigue:
                     ends = np.stack([lr.end_tension_spectrum(e) for e in ENDS])
+                    el_spec = lr.tension_spectrum  # (formed at each read: once here)
                     if lr.corrected_spectra is not None:  # the ends' on their own grid
                         corrected[name][j] = [lr.end_tension_density(e) for e in ENDS]
                     if lr.along_line is not None and lr.along_line.computed:
-                        along[name][j] = _along_densities(lr)
-                    spectra[name].append(np.concatenate([ends, lr.tension_spectrum]))
+                        along[name][j] = _along_densities(lr, el_spec)
+                    spectra[name].append(np.concatenate([ends, el_spec]))
                     have[name].append(j)
         for name, settings in fatigue.items():
             if have[name]:
@@ -469,13 +470,14 @@ def _no_motion_residuals():
         MOTION_RESIDUALS.reset(token)
 
 
-def _along_densities(lr: Any) -> tuple[np.ndarray, np.ndarray]:
+def _along_densities(lr: Any, linear: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The element tensions' spectral densities with the residuals (their
     :class:`~stochcable.dynamics.residuals.along_line.AlongLineResidual` lines on the
     analysis grid extended as the ends', the same grid for every element), stacked
-    (n_el, n): the along-line damage of a case that computed them
+    (n_el, n), from their linear densities ``linear`` (n_el, n_w): the along-line
+    damage of a case that computed them
     (:func:`~stochcable.cases.along_spectra.element_densities`)."""
-    return element_densities(lr.along_line, lr.omega, lr.tension_spectrum)
+    return element_densities(lr.along_line, lr.omega, linear)
 
 
 def without_residuals(engine: Engine) -> Engine:
