@@ -23,6 +23,7 @@ __all__ = [
     "compile_cpu_seconds",
     "jit_cached",
     "kernel_min_entries",
+    "kernels_are_paid",
     "kernels_paid",
     "optional_kernel",
 ]
@@ -44,13 +45,21 @@ def kernel_min_entries() -> int:
     return 1 if _PAID.get() else KERNEL_MIN_ENTRIES
 
 
+def kernels_are_paid() -> bool:
+    """Whether this runs inside :func:`kernels_paid` (a load-case set's chunk): the
+    drag fixed point's direct solves then take the compiled banded LU too
+    (:func:`stochcable.dynamics.solve.line_solve.solve_free`)."""
+    return _PAID.get()
+
+
 @contextlib.contextmanager
 def kernels_paid() -> Iterator[None]:
     """The banded LU takes its compiled kernels (where numba is available) whatever
     the job's size: for work that solves many sea states on one engine (a load-case
     set's chunk, :func:`stochcable.cases.chunk.solve_chunk`), which pays numba's import
     once for all of them.  Set by the caller, never by process state, so the same work
-    takes the same path, to the bit, in any process.  (The taut wire's computed case
+    takes the same path, to the bit, in any process; the drag fixed point's direct
+    solves take it too (:func:`kernels_are_paid`).  (The taut wire's computed case
     in a set: its residuals' adjoint rows, 189 lines × 38 DOFs × 9 rows without the
     node motions', just under :data:`KERNEL_MIN_ENTRIES`, cost ≈ 1 ms more by LAPACK's
     stacked ``gbsv``; the variance sums' kernel measured no faster at a set's sizes,

@@ -53,11 +53,13 @@ def test_a_chunk_takes_the_compiled_banded_lu_at_any_size(monkeypatch):
     """Inside a chunk (``compiled.kernels_paid``) the residuals' banded adjoint rows
     take the compiled LU whatever their size — the taut wire's without the node
     motions' rows (189 lines × 38 DOFs × 9 rows) are under ``KERNEL_MIN_ENTRIES``,
-    which ``analyze()`` keeps — and the case equals the engine's own solve of its sea
-    on LAPACK's path to round-off (the same equations factored by two LU codes:
+    which ``analyze()`` keeps — and so do the direct fixed point's solves (LAPACK's
+    gbsv outside a chunk); the case equals the engine's own solve of its sea on
+    LAPACK's path to round-off (the same equations factored by two LU codes:
     1e-10, the set's agreement with ``analyze()`` in tests/cases/test_cases_run.py)."""
     pytest.importorskip("stochcable.dynamics.model.band_lu_kernels")
     import stochcable.dynamics.residuals.band_influence as bi
+    import stochcable.dynamics.solve.line_solve as line_solve
     from stochcable.cases.chunk import _no_motion_residuals, solve_chunk
     from stochcable.compiled import KERNEL_MIN_ENTRIES, kernels_paid
     from stochcable.dynamics.model.band_lu import compiled_band_lu
@@ -74,19 +76,22 @@ def test_a_chunk_takes_the_compiled_banded_lu_at_any_size(monkeypatch):
     doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
     scene = load_scene(doc)
     sd = scatter_from_rows([{"hs": 2.0, "tp": 9.0, "hours": 1.0}])
-    calls = []
-    real = bi.band_factors
+    calls, solves = [], []
+    real, real_solve = bi.band_factors, line_solve.band_solve
     monkeypatch.setattr(bi, "band_factors", lambda *a, **k: calls.append(1) or real(*a, **k))
+    monkeypatch.setattr(
+        line_solve, "band_solve", lambda *a, **k: solves.append(1) or real_solve(*a, **k)
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         template = engine_template(scene, sd.states, "jonswap")
         engine = set_engine(template)
         with _no_motion_residuals():  # (as in a chunk, but LAPACK's gbsv: under the size)
             ref = engine.solve(case_sea(scene, sd.states[0], "jonswap")).lines["wire"]
-        assert not calls
+        assert not calls and not solves
         fat = {"wire": LineFatigue("dnv-six-strand", nominal_area=1.2e-3)}
         got = solve_chunk(template, "jonswap", ((0, sd.states[0]),), fat, engine)
-    assert calls
+    assert calls and solves  # (the residuals' rows and the direct fixed point's solves)
     for e in ("end_a", "end_b"):
         st = getattr(ref, e)
         np.testing.assert_allclose(

@@ -102,3 +102,25 @@ def test_band_lu_singular_names_the_frequency():
         band_factors(bk, bm, None, w, kl, ku)
     with pytest.raises(SolverError, match=r"singular at omega = 2 rad/s"):  # (gbsv's own)
         solve_band_stacked(bk, bm, None, np.ones((3, n, 1), dtype=complex), w, kl, ku)
+
+
+@pytest.mark.parametrize("n, kl, ku, r", [(1, 0, 0, 1), (7, 2, 1, 4), (38, 3, 3, 3)])
+def test_band_solve_of_a_right_hand_side_per_frequency_equals_gbsv(n, kl, ku, r):
+    """band_lu.band_solve (a load-case set's drag fixed point, a different right-hand
+    side at each frequency: band_lu_solve_each) against gbsv on the stack: round-off of
+    the solution's scale, as the substitutions of the terms above; an exactly singular
+    frequency raises as gbsv's."""
+    from stochcable.dynamics.model.band_lu import band_solve
+
+    rng = np.random.default_rng(7 * n + kl)
+    bk, bm = _band(rng, n, kl, ku), _band(rng, n, kl, ku)
+    bc = _band(rng, n, kl, ku) + 1j * _band(rng, n, kl, ku)
+    w = np.linspace(0.1, 4.0, 41)
+    f = rng.normal(size=(w.size, n, r)) + 1j * rng.normal(size=(w.size, n, r))
+    ref = solve_band_stacked(bk, bm, bc, f, w, kl, ku)
+    got = band_solve(bk, bm, bc, f, w, kl, ku)
+    assert got.shape == ref.shape
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-11 * np.abs(ref).max())
+    zero = np.zeros_like(bk)
+    with pytest.raises(SolverError):
+        band_solve(zero, zero, None, f, w, kl, ku)

@@ -22,7 +22,7 @@ import numpy as np
 from stochcable.compiled import kernel_min_entries, optional_kernel
 from stochcable.dynamics.model.solvers import singular_error
 
-__all__ = ["BandFactors", "band_factors", "compiled_band_lu"]
+__all__ = ["BandFactors", "band_factors", "band_solve", "compiled_band_lu"]
 
 _KERNELS = "stochcable.dynamics.model.band_lu_kernels"
 
@@ -120,3 +120,39 @@ def band_factors(
         K, M = mats if mats is not None else (np.zeros((1, 1)), np.eye(1))
         raise singular_error(K, M, float(w[(info - 1) // np.shape(bk)[1]]), None)
     return BandFactors(factors, w, kl)
+
+
+def band_solve(
+    bk: np.ndarray,
+    bm: np.ndarray,
+    bc: np.ndarray | None,
+    f: np.ndarray,
+    omega: np.ndarray,
+    kl: int,
+    ku: int,
+    mats: tuple | None = None,
+) -> np.ndarray:
+    """Z(ω_k)⁻¹F_k at every frequency by the compiled LU (the caller checks
+    :func:`compiled_band_lu`): what :func:`~stochcable.dynamics.model.solvers.
+    solve_band_stacked` gives (its arguments), to round-off.
+
+    Parameters
+    ----------
+    bk, bm, bc, omega, kl, ku, mats
+        As :func:`band_factors`.
+    f : ndarray, complex, shape (n_w, n, r)
+        The right-hand sides per frequency. [N]
+
+    Returns
+    -------
+    ndarray, complex, shape (n_w, n, r)
+        The solutions. [m]
+
+    Raises
+    ------
+    SolverError
+        Where Z(ω_k) is exactly singular.
+    """
+    fac = band_factors(bk, bm, bc, omega, kl, ku, mats)
+    solve = optional_kernel(_KERNELS, "band_lu_solve_each")
+    return solve(fac.factors, kl, f)

@@ -25,7 +25,7 @@ from numba import types
 
 from stochcable.compiled import jit_cached
 
-__all__ = ["band_lu_factor", "band_lu_substitute"]
+__all__ = ["band_lu_factor", "band_lu_solve_each", "band_lu_substitute"]
 
 
 def _factor(bk, bm, bc, w, kl, ku, lu, inv, piv):  # noqa: ANN001 - numba kernel
@@ -187,6 +187,61 @@ def _substitute(lu, inv, piv, kl, at, w, terms, out, offset, indptr, indices, da
                 out[c, offset + i, 2 * m + 1] = xi[i, c]
 
 
+def _solve_each(lu, inv, piv, kl, rhs, out):  # noqa: ANN001 - numba kernel
+    """out[k, i, (Re, Im) of c] ← (Z(ω_k)⁻¹b_k)_i,c from :func:`_factor`'s factors of
+    every frequency k, b_k = rhs[k] ((n, 2r): the complex right-hand sides as (Re, Im)
+    pairs, a different one at each frequency: the drag fixed point's loads); the
+    substitutions of :func:`_substitute`, in scratch rows of one frequency."""
+    n = lu.shape[2]
+    kv = lu.shape[3] - 1 - kl
+    r = rhs.shape[2] // 2
+    xr = np.empty((n, r))
+    xi = np.empty((n, r))
+    for k in range(rhs.shape[0]):
+        a_re = lu[k, 0]
+        a_im = lu[k, 1]
+        for i in range(n):
+            for c in range(r):
+                xr[i, c] = rhs[k, i, 2 * c]
+                xi[i, c] = rhs[k, i, 2 * c + 1]
+        for j in range(n - 1):  # L y = P b
+            p = piv[k, j]
+            if p != j:
+                for c in range(r):
+                    t = xr[j, c]
+                    xr[j, c] = xr[p, c]
+                    xr[p, c] = t
+                    t = xi[j, c]
+                    xi[j, c] = xi[p, c]
+                    xi[p, c] = t
+            for q in range(1, min(kl, n - 1 - j) + 1):
+                lr, li = a_re[j, kv + q], a_im[j, kv + q]
+                if lr == 0.0 and li == 0.0:
+                    continue
+                for c in range(r):
+                    yr, yi = xr[j, c], xi[j, c]
+                    xr[j + q, c] -= lr * yr - li * yi
+                    xi[j + q, c] -= lr * yi + li * yr
+        for i in range(n - 1, -1, -1):  # U x = y
+            ir, ii = inv[k, 0, i], inv[k, 1, i]
+            for c in range(r):
+                yr, yi = xr[i, c], xi[i, c]
+                xr[i, c] = yr * ir - yi * ii
+                xi[i, c] = yr * ii + yi * ir
+            for q in range(1, min(kv, i) + 1):
+                ur, ui = a_re[i, kv - q], a_im[i, kv - q]
+                if ur == 0.0 and ui == 0.0:
+                    continue
+                for c in range(r):
+                    yr, yi = xr[i, c], xi[i, c]
+                    xr[i - q, c] -= ur * yr - ui * yi
+                    xi[i - q, c] -= ur * yi + ui * yr
+        for i in range(n):
+            for c in range(r):
+                out[k, i, 2 * c] = xr[i, c]
+                out[k, i, 2 * c + 1] = xi[i, c]
+
+
 _F2 = types.Array(types.float64, 2, "C", readonly=True)
 _FACTOR_SIGNATURE = types.int64(
     _F2,
@@ -219,7 +274,19 @@ _SUBSTITUTE_SIGNATURE = types.void(
 (indices), the frequencies factored, the right-hand sides' terms, the solutions, the
 first row written, the loads' CSR arrays or empty ones)."""
 
+_SOLVE_EACH_SIGNATURE = types.void(
+    types.Array(types.float64, 4, "C", readonly=True),
+    types.Array(types.float64, 3, "C", readonly=True),
+    types.Array(types.int64, 2, "C", readonly=True),
+    types.int64,
+    types.Array(types.float64, 3, "C", readonly=True),
+    types.Array(types.float64, 3, "C"),
+)
+"""(the factors, the reciprocal pivots, the interchanges, kl, the right-hand sides per
+frequency, the solutions)."""
+
 _factor_kernel, _ = jit_cached(_factor, _FACTOR_SIGNATURE, "banded LU factorization")
+_solve_each_kernel, _ = jit_cached(_solve_each, _SOLVE_EACH_SIGNATURE, "banded LU solves")
 _substitute_kernel, _ = jit_cached(_substitute, _SUBSTITUTE_SIGNATURE, "banded LU substitution")
 
 
@@ -333,3 +400,38 @@ def band_lu_substitute(
         np.ascontiguousarray(loads[1], dtype=np.int64),
         np.ascontiguousarray(loads[2], dtype=float),
     )
+
+
+def band_lu_solve_each(
+    factors: tuple[np.ndarray, np.ndarray, np.ndarray], kl: int, rhs: np.ndarray
+) -> np.ndarray:
+    """Z(ω_k)⁻¹b_k at every frequency factored by :func:`band_lu_factor`, a different
+    right-hand side block b_k at each.
+
+    Parameters
+    ----------
+    factors : tuple of ndarray
+        :func:`band_lu_factor`'s, of n_w frequencies.
+    kl : int
+        The lower bandwidth they were factored with. [-]
+    rhs : ndarray, complex, shape (n_w, n, r)
+        The right-hand sides per frequency. [N]
+
+    Returns
+    -------
+    ndarray, complex, shape (n_w, n, r)
+        The solutions. [m]
+    """
+    lu, inv, piv = factors
+    b = np.ascontiguousarray(rhs, dtype=complex)
+    out = np.empty(b.shape, dtype=complex)
+    n_w, n = b.shape[:2]
+    _solve_each_kernel(
+        lu,
+        inv,
+        piv,
+        int(kl),
+        b.view(float).reshape(n_w, n, -1),
+        out.view(float).reshape(n_w, n, -1),
+    )
+    return out
