@@ -14,8 +14,8 @@ case's residuals are the every-case set's case less the linear set's; what they 
 held against is ``analyze()``'s residuals less the node motions'.
 
 ``--solvers``: the linear set per case by the Foss and the direct solve (the rule of
-:data:`stochcable.cases.chunk.DIRECT_MIN_DOFS`) on the chain, the taut wire, Tuah's
-leg and the two-segment line, and their largest σ difference.
+:func:`stochcable.cases.chunk.set_engine`) on the chain, the taut wire, Tuah's leg
+and the two-segment line, and their largest σ difference.
 """
 
 from __future__ import annotations
@@ -114,10 +114,11 @@ def costs(name: str, rounds: int) -> dict[str, float]:
     return {k: v * 1e3 for k, v in best.items()}
 
 
-def solvers(rounds: int) -> None:
-    """The linear set per case by the Foss and the direct solve (module notes)."""
+def solvers(rounds: int, names: list[str]) -> None:
+    """The linear set per case by the Foss and the direct solve (module notes) on the
+    lines ``names`` (of ``LINES`` and "two-segment")."""
     examples = {"two-segment": "two-segment", **{k: v[0] for k, v in LINES.items()}}
-    for name, example in examples.items():
+    for name, example in ((k, v) for k, v in examples.items() if k in names):
         _, h0, h1, nh, tps, _ = LINES.get(name, LINES["chain"])
         doc, sd = _doc(example, False), _diagram(h0, h1, nh, tps)
         tmpl = plan_cases(doc, sd).template
@@ -150,16 +151,16 @@ def solvers(rounds: int) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=4)
-    ap.add_argument("--lines", nargs="*", default=list(LINES))
+    ap.add_argument("--lines", nargs="*", default=[*LINES, "two-segment"])
     ap.add_argument("--solvers", action="store_true")
     args = ap.parse_args()
     runtime.configure()
     warnings.simplefilter("ignore")
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; {host_line()}")
     if args.solvers:
-        solvers(args.rounds)
+        solvers(args.rounds, args.lines)
         return
-    for name in args.lines:
+    for name in (n for n in args.lines if n in LINES):
         c = costs(name, args.rounds)
         an = c["analyze"]
         resid = c["every case computed"] - c["linear set"]

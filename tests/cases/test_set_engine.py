@@ -25,7 +25,8 @@ def test_a_line_whose_foss_solve_keeps_every_mode_is_solved_directly_in_a_set():
     """The taut wire (38 free DOFs, every mode kept by the Foss solve): its set's
     engine solves it directly, and a set's first case (at rest, as analyze()) is
     analyze()'s Foss answer to round-off (1e-10: the same equations solved two ways);
-    the chain (20 of 78 modes, a static correction) keeps its Foss solve."""
+    the chain (20 of 78 modes, a static correction) keeps its Foss solve; Tuah's
+    single leg (4 free DOFs, every mode) is solved directly too."""
     scene = load_scene(_wire())
     engine = set_engine(engine_template(scene, (), "jonswap"))
     (system,) = engine.systems.values()
@@ -34,6 +35,8 @@ def test_a_line_whose_foss_solve_keeps_every_mode_is_solved_directly_in_a_set():
     assert system.n_modes == system.model.free.size
     (chain,) = set_engine(load_example("chain_catenary")).systems.values()
     assert chain.solver == "foss" and chain.n_modes < chain.model.free.size
+    (leg,) = set_engine(load_example("tuah_1982_single_leg")).systems.values()
+    assert leg.solver == "direct" and leg.n_modes == leg.model.free.size == 4  # (any size)
     rows = [{"hs": hs, "tp": 9.0, "probability": 0.5} for hs in (2.0, 3.0)]
     sd = scatter_from_rows(rows)
     with warnings.catch_warnings():
