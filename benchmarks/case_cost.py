@@ -4,12 +4,13 @@
     OPENBLAS_NUM_THREADS=1 python3 benchmarks/case_cost.py --solvers
 
 Per line (the chain, the taut wire and Tuah's single leg on the 4-period diagrams of
-docs/benchmarks/cases.md, the linearization tolerance 1e-4, both residuals on), the
-fastest of interleaved rounds in one process (CPU time) of: one ``analyze()`` with the
-residuals, the same without the node motions' residuals (``MOTION_RESIDUALS`` off, as a
-set's cases) and without any residual; per case, the linear set (residuals off), the
-set with every case computed (``residual_tolerance=None``) — both on an engine built
-once — and the default set (adaptive anchors, its engine built inside).  A computed
+docs/benchmarks/cases.md, ``--realistic`` Tp every 1 s; the linearization tolerance
+1e-4, both residuals on), the fastest of interleaved rounds in one process (CPU time)
+of: one ``analyze()`` with the residuals, the same without the node motions' residuals
+(``MOTION_RESIDUALS`` off, as a set's cases) and without any residual; per case, the
+linear set (residuals off), the set with every case computed
+(``residual_tolerance=None``) — both on an engine built once — and the default set
+(adaptive anchors, its engine built inside).  A computed
 case's residuals are the every-case set's case less the linear set's; what they are
 held against is ``analyze()``'s residuals less the node motions'.
 
@@ -77,9 +78,15 @@ def _clock(fn) -> float:
     return time.process_time() - t0
 
 
-def costs(name: str, rounds: int) -> dict[str, float]:
+#: the realistic diagrams of docs/benchmarks/cases.md (``--realistic``): Tp every 1 s
+REALISTIC = {"chain": tuple(range(6, 17)), "taut": tuple(range(6, 14)), "tuah": tuple(range(6, 16))}
+
+
+def costs(name: str, rounds: int, realistic: bool = False) -> dict[str, float]:
     """The fastest CPU time [ms] of each part (module notes); per case for the sets."""
     example, h0, h1, nh, tps, (curve, kw) = LINES[name]
+    if realistic:
+        tps = tuple(float(t) for t in REALISTIC[name])
     on, off = _doc(example, True), _doc(example, False)
     scene, linear = load_scene(on), load_scene(off)
     sd, fat = _diagram(h0, h1, nh, tps), LineFatigue(curve, **kw)
@@ -153,6 +160,7 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=4)
     ap.add_argument("--lines", nargs="*", default=[*LINES, "two-segment"])
     ap.add_argument("--solvers", action="store_true")
+    ap.add_argument("--realistic", action="store_true", help="Tp every 1 s")
     args = ap.parse_args()
     runtime.configure()
     warnings.simplefilter("ignore")
@@ -161,7 +169,7 @@ def main() -> None:
         solvers(args.rounds, args.lines)
         return
     for name in (n for n in args.lines if n in LINES):
-        c = costs(name, args.rounds)
+        c = costs(name, args.rounds, args.realistic)
         an = c["analyze"]
         resid = c["every case computed"] - c["linear set"]
         target = (
