@@ -20,6 +20,7 @@ from typing import Any
 
 __all__ = [
     "KERNEL_MIN_ENTRIES",
+    "SET_KERNEL_MIN_ENTRIES",
     "compile_cpu_seconds",
     "jit_cached",
     "kernel_min_entries",
@@ -38,11 +39,20 @@ KERNEL_MIN_ENTRIES = 2**16
 _PAID: ContextVar[bool] = ContextVar("stochcable_kernels_paid", default=False)
 
 
+#: The same inside :func:`kernels_paid` (a load-case set's chunk), where numba's import
+#: is paid once for every case: the taut wire's banded jobs (its residuals' adjoint rows
+#: without the node motions', 64,638 entries; its direct fixed point's solves, 7,600)
+#: take the kernels, Tuah's single leg's (3,780 and 800: a few µs a case to gain) do
+#: not, and its set loads no numba. [-]
+SET_KERNEL_MIN_ENTRIES = 2**12
+
+
 def kernel_min_entries() -> int:
     """The problem size from which the banded LU takes its compiled kernels here
     (:func:`stochcable.dynamics.model.band_lu.compiled_band_lu`):
-    :data:`KERNEL_MIN_ENTRIES`, or 1 inside :func:`kernels_paid`. [-]"""
-    return 1 if _PAID.get() else KERNEL_MIN_ENTRIES
+    :data:`KERNEL_MIN_ENTRIES`, or :data:`SET_KERNEL_MIN_ENTRIES` inside
+    :func:`kernels_paid`. [-]"""
+    return SET_KERNEL_MIN_ENTRIES if _PAID.get() else KERNEL_MIN_ENTRIES
 
 
 def kernels_are_paid() -> bool:
@@ -54,16 +64,16 @@ def kernels_are_paid() -> bool:
 
 @contextlib.contextmanager
 def kernels_paid() -> Iterator[None]:
-    """The banded LU takes its compiled kernels (where numba is available) whatever
-    the job's size: for work that solves many sea states on one engine (a load-case
-    set's chunk, :func:`stochcable.cases.chunk.solve_chunk`), which pays numba's import
-    once for all of them.  Set by the caller, never by process state, so the same work
-    takes the same path, to the bit, in any process; the drag fixed point's direct
-    solves take it too (:func:`kernels_are_paid`).  (The taut wire's computed case
-    in a set: its residuals' adjoint rows, 189 lines × 38 DOFs × 9 rows without the
-    node motions', just under :data:`KERNEL_MIN_ENTRIES`, cost ≈ 1 ms more by LAPACK's
-    stacked ``gbsv``; the variance sums' kernel measured no faster at a set's sizes,
-    so it keeps its threshold.)"""
+    """The banded LU takes its compiled kernels (where numba is available) from
+    :data:`SET_KERNEL_MIN_ENTRIES` on, and the drag fixed point's direct solves take
+    them too (:func:`kernels_are_paid`): for work that solves many sea states on one
+    engine (a load-case set's chunk, :func:`stochcable.cases.chunk.solve_chunk`), which
+    pays numba's import once for all of them.  Set by the caller, never by process
+    state, so the same work takes the same path, to the bit, in any process.  (The
+    taut wire's computed case in a set: its residuals' adjoint rows, 189 lines × 38
+    DOFs × 9 rows without the node motions', just under :data:`KERNEL_MIN_ENTRIES`,
+    cost ≈ 1 ms more by LAPACK's stacked ``gbsv``; the variance sums' kernel measured
+    no faster at a set's sizes, so it keeps its threshold.)"""
     token = _PAID.set(True)
     try:
         yield

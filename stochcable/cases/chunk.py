@@ -205,6 +205,17 @@ def run_lead(
     return tuple((i, states[i]) for i in keep)
 
 
+#: Fewest free DOFs of a line for a set to solve it directly when its Foss solve keeps
+#: every mode (:func:`set_engine`).  A linear set's case by the direct solve over the
+#: Foss solve's (interleaved, ``benchmarks/case_cost.py --solvers``): the taut wire
+#: (38 free DOFs, every mode kept) 0.55 by the chunk's compiled banded LU; Tuah's single
+#: leg (4, every mode kept) 1.05 by LAPACK's gbsv (its jobs are under
+#: :data:`~stochcable.compiled.SET_KERNEL_MIN_ENTRIES`; 0.95 by the compiled LU, not
+#: worth numba's import); the chain and the two-segment line (78; 20 and 17 modes
+#: kept, not the same equations) 1.1 and 1.2. [-]
+DIRECT_MIN_DOFS = 20
+
+
 def set_engine(template: Scene) -> Engine:
     """The engine of a set's :func:`engine_template`, with the element check
     (:func:`stochcable.fidelity.mesh_engine.checked_engine`: default counts chosen for
@@ -213,17 +224,15 @@ def set_engine(template: Scene) -> Engine:
 
     Where the Foss solve of every line keeps every mode (no static correction: the
     same linear equations as the direct solve, to round-off: σ within 1e-11 on the
-    taut wire), its models are built again with ``analysis.solver = "direct"`` on the
-    same statics, element counts and element check: a chunk's banded solves by the
-    compiled LU (:func:`stochcable.compiled.kernels_paid`) cost less than a Foss
-    eigenproblem of all modes at every fixed-point evaluation.  A linear set's case by
-    the direct solve over the Foss solve's (interleaved, ``benchmarks/case_cost.py
-    --solvers``): the taut wire (38 free DOFs) 0.55, Tuah's single leg (4) 0.95; on
-    the chain and the two-segment line (78; 20 and 17 modes kept: not the same
-    equations) 1.1 and 1.2."""
+    taut wire) and a line has at least :data:`DIRECT_MIN_DOFS` free DOFs, its models
+    are built again with ``analysis.solver = "direct"`` on the same statics, element
+    counts and element check: its banded solve per frequency costs less than a Foss
+    eigenproblem of all modes at every fixed-point evaluation
+    (docs/benchmarks/cases.md)."""
     engine = checked_engine(template)
     systems = list(engine.systems.values())
-    if not all(sys.solver == "foss" and sys.n_modes >= sys.model.free.size for sys in systems):
+    full = all(sys.solver == "foss" and sys.n_modes >= sys.model.free.size for sys in systems)
+    if not (full and any(sys.model.free.size >= DIRECT_MIN_DOFS for sys in systems)):
         return engine
     # (the same statics, element counts and element check: only the solver changes)
     scene = engine.scene

@@ -9,7 +9,7 @@ import pytest
 
 from stochcable.analysis import analyze
 from stochcable.cases import LineFatigue, run_cases, scatter_from_rows
-from stochcable.cases.chunk import case_sea, engine_template, set_engine
+from stochcable.cases.chunk import DIRECT_MIN_DOFS, case_sea, engine_template, set_engine
 from stochcable.examples import load_example
 from stochcable.scene.model import load_scene
 
@@ -25,8 +25,8 @@ def test_a_line_whose_foss_solve_keeps_every_mode_is_solved_directly_in_a_set():
     """The taut wire (38 free DOFs, every mode kept by the Foss solve): its set's
     engine solves it directly, and a set's first case (at rest, as analyze()) is
     analyze()'s Foss answer to round-off (1e-10: the same equations solved two ways);
-    the chain (20 of 78 modes, a static correction) keeps its Foss solve; Tuah's
-    single leg (4 free DOFs, every mode) is solved directly too."""
+    the chain (20 of 78 modes, a static correction) keeps its Foss solve, and so does
+    Tuah's single leg (4 free DOFs, every mode: under DIRECT_MIN_DOFS)."""
     scene = load_scene(_wire())
     engine = set_engine(engine_template(scene, (), "jonswap"))
     (system,) = engine.systems.values()
@@ -36,7 +36,7 @@ def test_a_line_whose_foss_solve_keeps_every_mode_is_solved_directly_in_a_set():
     (chain,) = set_engine(load_example("chain_catenary")).systems.values()
     assert chain.solver == "foss" and chain.n_modes < chain.model.free.size
     (leg,) = set_engine(load_example("tuah_1982_single_leg")).systems.values()
-    assert leg.solver == "direct" and leg.n_modes == leg.model.free.size == 4  # (any size)
+    assert leg.solver == "foss" and leg.n_modes == leg.model.free.size < DIRECT_MIN_DOFS
     rows = [{"hs": hs, "tp": 9.0, "probability": 0.5} for hs in (2.0, 3.0)]
     sd = scatter_from_rows(rows)
     with warnings.catch_warnings():
@@ -64,13 +64,14 @@ def test_a_chunk_takes_the_compiled_banded_lu_at_any_size(monkeypatch):
     import stochcable.dynamics.residuals.band_influence as bi
     import stochcable.dynamics.solve.line_solve as line_solve
     from stochcable.cases.chunk import _no_motion_residuals, solve_chunk
-    from stochcable.compiled import KERNEL_MIN_ENTRIES, kernels_paid
+    from stochcable.compiled import KERNEL_MIN_ENTRIES, SET_KERNEL_MIN_ENTRIES, kernels_paid
     from stochcable.dynamics.model.band_lu import compiled_band_lu
 
     small = KERNEL_MIN_ENTRIES // 2
     assert not compiled_band_lu(small)
     with kernels_paid():
-        assert compiled_band_lu(small)
+        assert compiled_band_lu(small) and compiled_band_lu(SET_KERNEL_MIN_ENTRIES)
+        assert not compiled_band_lu(SET_KERNEL_MIN_ENTRIES - 1)
         monkeypatch.setenv("STOCHCABLE_NUMBA", "0")
         assert not compiled_band_lu(small)  # (no numba: LAPACK's, as outside)
         monkeypatch.delenv("STOCHCABLE_NUMBA")

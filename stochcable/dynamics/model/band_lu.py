@@ -32,8 +32,9 @@ def compiled_band_lu(entries: int) -> bool:
     the compiled kernels: numba available (and not ``STOCHCABLE_NUMBA=0``) and
     ``entries`` ≥ :data:`~stochcable.compiled.KERNEL_MIN_ENTRIES` (numba's import, ≈
     0.3–0.6 s once per process, is paid above it only; by the job's size alone, so the
-    same document takes the same path, to the bit, in any process), or any size inside
-    :func:`~stochcable.compiled.kernels_paid` (a load-case set's chunk). [-]"""
+    same document takes the same path, to the bit, in any process); inside
+    :func:`~stochcable.compiled.kernels_paid` (a load-case set's chunk) from
+    :data:`~stochcable.compiled.SET_KERNEL_MIN_ENTRIES`. [-]"""
     if entries < kernel_min_entries():
         return False
     return optional_kernel(_KERNELS, "band_lu_factor") is not None

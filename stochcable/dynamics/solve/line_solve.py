@@ -117,7 +117,8 @@ def solve_free(
             rhs_f = to_freq(rhs_all[1:-1])
             # (in a load-case set's chunk: the compiled LU, ≈ 4× LAPACK's stacked gbsv
             # on the taut wire's 38 DOFs; analyze() keeps gbsv, its numbers unchanged)
-            solve = band_solve if kernels_are_paid() and compiled_band_lu(1) else solve_band_stacked
+            paid = kernels_are_paid() and compiled_band_lu(rhs_f.size)
+            solve = band_solve if paid else solve_band_stacked
             u = solve(
                 prep.bK,
                 prep.bM,
