@@ -160,6 +160,7 @@ def prepare_worker() -> None:
     warnings.simplefilter("ignore")
     element_variance_kernel()
     with contextlib.suppress(ImportError):  # (no numba: the NumPy paths)
+        import stochcable.dynamics.model.band_lu_kernels  # noqa: F401 (kernels_paid)
         import stochcable.line.strumming.kernels  # noqa: F401
 
 
