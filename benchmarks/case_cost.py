@@ -12,7 +12,9 @@ linear set (residuals off), the set with every case computed
 (``residual_tolerance=None``) — both on an engine built once — and the default set
 (adaptive anchors, its engine built inside).  A computed
 case's residuals are the every-case set's case less the linear set's; what they are
-held against is ``analyze()``'s residuals less the node motions'.
+held against is ``analyze()``'s residuals less the node motions' (``--same-seas``:
+also of ``analyze()`` of every sea of the set, which split more elements than the
+scene's own sea where the set's Hs are larger).
 
 ``--solvers``: the linear set per case by the Foss and the direct solve (the rule of
 :func:`stochcable.cases.chunk.set_engine`) on the chain, the taut wire, Tuah's leg
@@ -82,8 +84,12 @@ def _clock(fn) -> float:
 REALISTIC = {"chain": tuple(range(6, 17)), "taut": tuple(range(6, 14)), "tuah": tuple(range(6, 16))}
 
 
-def costs(name: str, rounds: int, realistic: bool = False) -> dict[str, float]:
-    """The fastest CPU time [ms] of each part (module notes); per case for the sets."""
+def costs(
+    name: str, rounds: int, realistic: bool = False, same_seas: bool = False
+) -> dict[str, float]:
+    """The fastest CPU time [ms] of each part (module notes); per case for the sets;
+    ``same_seas``: also ``analyze()`` of every sea of the set (per case: with the
+    residuals, without the node motions', linear)."""
     example, h0, h1, nh, tps, (curve, kw) = LINES[name]
     if realistic:
         tps = tuple(float(t) for t in REALISTIC[name])
@@ -112,6 +118,25 @@ def costs(name: str, rounds: int, realistic: bool = False) -> dict[str, float]:
         "default set": lambda: run_cases(on, sd, fatigue=fat),
     }
     per_case = {"linear set", "every case computed", "default set"}
+    if same_seas:
+        from stochcable.cases.chunk import case_sea
+
+        seas = [case_sea(scene, st, sd.family) for st in sd.states]
+        each = [scene.model_copy(update={"sea": sea}) for sea in seas]
+        each_lin = [linear.model_copy(update={"sea": sea}) for sea in seas]
+
+        def each_no_motions() -> None:
+            token = MOTION_RESIDUALS.set(False)
+            try:
+                for sc in each:
+                    analyze(sc)
+            finally:
+                MOTION_RESIDUALS.reset(token)
+
+        parts["its seas"] = lambda: [analyze(sc) for sc in each]
+        parts["its seas, no node motions"] = each_no_motions
+        parts["its seas, linear"] = lambda: [analyze(sc) for sc in each_lin]
+        per_case |= {"its seas", "its seas, no node motions", "its seas, linear"}
     for fn in parts.values():  # (warm-up: imports, kernels)
         fn()
     best = {k: np.inf for k in parts}
@@ -161,6 +186,7 @@ def main() -> None:
     ap.add_argument("--lines", nargs="*", default=[*LINES, "two-segment"])
     ap.add_argument("--solvers", action="store_true")
     ap.add_argument("--realistic", action="store_true", help="Tp every 1 s")
+    ap.add_argument("--same-seas", action="store_true", help="analyze() of the set's seas")
     args = ap.parse_args()
     runtime.configure()
     warnings.simplefilter("ignore")
@@ -169,7 +195,7 @@ def main() -> None:
         solvers(args.rounds, args.lines)
         return
     for name in (n for n in args.lines if n in LINES):
-        c = costs(name, args.rounds, args.realistic)
+        c = costs(name, args.rounds, args.realistic, args.same_seas)
         an = c["analyze"]
         resid = c["every case computed"] - c["linear set"]
         target = (
@@ -182,6 +208,13 @@ def main() -> None:
             f"default set {c['default set'] / an:.3f}; a computed case's residuals {resid:.2f} ms "
             f"({resid / an:.3f} x), analyze()'s less the node motions' {target:.2f} ms"
         )
+        if args.same_seas:
+            own = c["its seas, no node motions"] - c["its seas, linear"]
+            print(
+                f"  analyze() of the set's seas, per case: {c['its seas']:.2f} ms (linear "
+                f"{c['its seas, linear']:.2f}); its residuals less the node motions' {own:.2f} "
+                f"ms against a computed case's {resid:.2f} ms in the set"
+            )
     print(f"load average at the end {os.getloadavg()[0]:.2f}")
 
 
