@@ -28,7 +28,6 @@ from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
 from stochcable.cases.residual_anchors import (
     RESIDUAL_TOLERANCE,
     first_anchors,
-    interpolate_along,
     interpolate_corrections,
     next_anchors,
 )
@@ -332,8 +331,8 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     d_ends = m.d_ends
     # the residuals' corrections of the cases that did not compute them
     law = "hs2" if plan.residual_tolerance is None else "power"
-    interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear, law)
-    interpolate_along(scatter.states, m.exact, rows, damage, m.linear_along, law)
+    along = (damage, m.linear_along)
+    interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear, law, along)
     _warn_interpolated(plan, m.exact)
     s_el = m.s_el
     d_along = {ln: damage[ln][:, 2:] for ln in names}

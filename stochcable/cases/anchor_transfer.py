@@ -1,0 +1,170 @@
+"""The interpolated corrections of one heading of a load-case set with adaptive residual
+anchors (:mod:`stochcable.cases.residual_anchors`): each column's ratios at any Hs from
+its computed cases, and a column without computed cases' linearly in the period from
+its neighbours'.
+
+A column (one period and heading) interpolates its ratios in Hs between its computed
+cases by the power law of :func:`~stochcable.cases.anchor_layout.correction_rows` —
+its *own* curve.  Where the corrections bend along a column (Tuah's single leg: the
+end σ correction rises from +5 % at Hs 1 m to +12 % at 4 m and falls again, so that a
+power law between computed Hs one step apart misses by 3e-3 … 8e-3) but vary
+smoothly from one period to the next, a column can borrow the shape of its
+neighbours instead: the *transferred* curve of column j is the own curves of the
+nearest *own* columns on either side (the heading's shortest, middle and longest
+periods: those of the first pass, :func:`~stochcable.cases.residual_anchors.first_anchors`)
+interpolated linearly in the period to j's period — the *base* — plus j's own
+departure from it, measured at j's computed Hs and interpolated linearly in Hs.  The
+base carries the bend; what j adds to it is nearly linear in Hs, so a column needs a
+few computed Hs instead of all.  A column that is not an own column takes the
+transferred curve where it meets the middle of its first three computed Hs (smallest,
+middle, largest: always computed together) closer than its own curve from the other
+two, else its own curve (the taut wire: its corrections change fast with the period
+near resonance, and the transferred curve would need more computed Hs than the own).
+The checks in Hs of :func:`~stochcable.cases.residual_anchors.next_anchors` test the
+curve a column uses, so the error is measured on what is interpolated.  Everything
+depends on the computed numbers only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stochcable.cases.anchor_layout import Column, correction_rows
+
+__all__ = ["HeadingCurves"]
+
+
+class HeadingCurves:
+    """The ratios of one heading's columns (module notes).
+
+    Parameters
+    ----------
+    cols : list of Column
+        The heading's columns, ordered by period.
+    ok : ndarray of bool, shape (n,)
+        Whether a case's residuals were computed (and it has a response).
+    r : ndarray, shape (n, q)
+        The cases' ratios (:func:`~stochcable.cases.anchor_layout.check_ratios`). [-]
+    scale : ndarray, shape (q,)
+        Each ratio's tolerance in units of σ's. [-]
+    law : str
+        "power" (the adaptive anchors': transferred curves where they serve) or "hs2"
+        (the fixed anchors': own curves, linear in Hs², only).
+    """
+
+    def __init__(
+        self, cols: list[Column], ok: np.ndarray, r: np.ndarray, scale: np.ndarray, law: str
+    ) -> None:
+        self.cols, self.ok, self.r, self.scale, self.law = cols, ok, r, scale, law
+        n = len(cols)
+        if law != "power" or n <= 2:
+            self.own = set(range(n))
+        else:
+            self.own = {0, (n - 1) // 2, n - 1}
+        self._anchors = [c.anchors(ok) for c in cols]
+        self._transferred: dict[int, bool] = {}
+
+    def has(self, j: int) -> bool:
+        """Whether column ``j`` has computed cases."""
+        return bool(self._anchors[j][1].size)
+
+    def own_curve(self, j: int, hs: float) -> np.ndarray | None:
+        """Column ``j``'s own curve at ``hs`` [m] (None: no computed case)."""
+        h, idx = self._anchors[j]
+        return None if idx.size == 0 else correction_rows(hs, h, self.r[idx], self.law)
+
+    def base(self, j: int, hs: float) -> np.ndarray | None:
+        """The own curves of the nearest own columns on either side of ``j`` at ``hs``,
+        linear in the period (None: not on both sides, or one without anchors)."""
+        lo = max((k for k in self.own if k < j), default=None)
+        hi = min((k for k in self.own if k > j), default=None)
+        if lo is None or hi is None:
+            return None
+        ra, rb = self.own_curve(lo, hs), self.own_curve(hi, hs)
+        if ra is None or rb is None:
+            return None
+        pa, pb = self.cols[lo].period, self.cols[hi].period
+        t = (self.cols[j].period - pa) / (pb - pa)
+        return (1.0 - t) * ra + t * rb
+
+    def _departure(self, j: int, hs: float, at: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        """The base at ``hs`` plus column ``j``'s departures from it at the Hs ``at``
+        (its cases ``idx``), linear in Hs between them (constant beyond)."""
+        dep = np.array([self.r[i] - self.base(j, float(h)) for h, i in zip(at, idx)])
+        k = int(np.clip(np.searchsorted(at, hs, side="right") - 1, 0, max(at.size - 2, 0)))
+        if at.size == 1 or hs <= at[0]:
+            d = dep[0]
+        elif hs >= at[-1]:
+            d = dep[-1]
+        else:
+            t = (hs - at[k]) / (at[k + 1] - at[k])
+            d = (1.0 - t) * dep[k] + t * dep[k + 1]
+        return self.base(j, hs) + d
+
+    def transferred(self, j: int) -> bool:
+        """Whether column ``j`` uses the transferred curve (module notes)."""
+        if j not in self._transferred:
+            self._transferred[j] = self._prefer(j)
+        return self._transferred[j]
+
+    def _prefer(self, j: int) -> bool:
+        col = self.cols[j]
+        n = len(col.hs)
+        if j in self.own or n < 3 or self.base(j, float(col.hs[0])) is None:
+            return False
+        first = [col.members[k][0] for k in (0, (n - 1) // 2, n - 1)]
+        if not all(self.ok[i] for i in first):
+            return False
+        hs = col.hs[[0, (n - 1) // 2, n - 1]]
+        got = self.r[first[1]]
+        ends = np.array([first[0], first[2]])
+        own = correction_rows(float(hs[1]), hs[[0, 2]], self.r[ends], self.law)
+        moved = self._departure(j, float(hs[1]), hs[[0, 2]], ends)
+        live = got != 0
+        miss = [np.max(np.abs(g[live] / got[live] - 1.0) / self.scale[live]) for g in (own, moved)]
+        return bool(miss[1] < miss[0])
+
+    def curve(self, j: int, hs: float) -> np.ndarray | None:
+        """Column ``j``'s ratios at ``hs`` [m] from its computed cases: its transferred
+        or its own curve (None: no computed case)."""
+        h, idx = self._anchors[j]
+        if idx.size == 0:
+            return None
+        if self.transferred(j):
+            return self._departure(j, hs, h, idx)
+        return correction_rows(hs, h, self.r[idx], self.law)
+
+    def interval(self, j: int, a: int, b: int) -> np.ndarray:
+        """Column ``j``'s ratios at the middle Hs of its interval (a, b) (indices of its
+        sorted Hs) from the interval's ends alone: the check in Hs."""
+        col = self.cols[j]
+        m = (a + b) // 2
+        ends = np.array([col.members[a][0], col.members[b][0]])
+        if self.transferred(j):
+            return self._departure(j, float(col.hs[m]), col.hs[[a, b]], ends)
+        return correction_rows(float(col.hs[m]), col.hs[[a, b]], self.r[ends], self.law)
+
+    def between(self, a: int, b: int, j: int, hs: float) -> np.ndarray | None:
+        """Column ``j``'s ratios at ``hs`` linear in the period between columns ``a``
+        and ``b``'s curves (None: either has no computed case)."""
+        ra, rb = self.curve(a, hs), self.curve(b, hs)
+        if ra is None or rb is None:
+            return None
+        pa, pb = self.cols[a].period, self.cols[b].period
+        t = (self.cols[j].period - pa) / (pb - pa)
+        return (1.0 - t) * ra + t * rb
+
+    def estimate(self, j: int, hs: float) -> np.ndarray | None:
+        """The ratios of a case of column ``j`` at ``hs`` [m]: its column's curve where
+        it has computed cases, else linear in the period between the nearest columns
+        with some on either side (the one side's at the diagram's edge); None: no
+        column of the heading has one."""
+        own = self.curve(j, hs)
+        if own is not None:
+            return own
+        lo = next((k for k in range(j - 1, -1, -1) if self.has(k)), None)
+        hi = next((k for k in range(j + 1, len(self.cols)) if self.has(k)), None)
+        if lo is not None and hi is not None:
+            return self.between(lo, hi, j, hs)
+        side = lo if lo is not None else hi
+        return None if side is None else self.curve(side, hs)
