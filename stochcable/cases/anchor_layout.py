@@ -1,10 +1,10 @@
 """The layout the residual anchors of a load-case set work on: the diagram's columns
 (the sea states of one heading and period, which differ by Hs) ordered by period per
-heading, the corrections' ratios of the cases as one matrix, and the interpolation of
-those ratios at a case from the cases that computed them — a power law in Hs along a
-column (:func:`correction_rows`), linear in the period between the nearest columns
-that computed some (:func:`estimate`).  Used by
-:mod:`stochcable.cases.residual_anchors`, whose notes say what is checked where.
+heading, the corrections' ratios of the cases as one matrix, and the power law in Hs
+of a column's ratios between the cases that computed them (:func:`correction_rows`;
+the curves of a heading's columns from it in :mod:`stochcable.cases.anchor_transfer`).
+Used by :mod:`stochcable.cases.residual_anchors`, whose notes say what is checked
+where.
 """
 
 from __future__ import annotations
@@ -21,12 +21,9 @@ from stochcable.cases.scatter import SeaState, tz_over_tp
 __all__ = [
     "DAMAGE_TOLERANCE_FACTOR",
     "Column",
-    "between",
     "check_ratios",
     "column_keys",
     "correction_rows",
-    "curve",
-    "estimate",
     "layout",
     "neighbours",
     "ratios",
@@ -170,47 +167,8 @@ def correction_rows(
     return out
 
 
-def curve(col: Column, ok: np.ndarray, r: np.ndarray, hs: float, law: str) -> np.ndarray | None:
-    """Column ``col``'s ratios at ``hs`` from its anchors (None: it has none)."""
-    h, idx = col.anchors(ok)
-    return None if idx.size == 0 else correction_rows(hs, h, r[idx], law)
-
-
-def between(
-    cols: list[Column], a: int, b: int, j: int, hs: float, ok: np.ndarray, r: np.ndarray, law: str
-) -> np.ndarray | None:
-    """The ratios at ``hs`` of column ``j`` interpolated linearly in the period between
-    columns ``a`` and ``b``'s own (each from its anchors at ``hs``); None when either
-    has no anchor."""
-    ra = curve(cols[a], ok, r, hs, law)
-    rb = curve(cols[b], ok, r, hs, law)
-    if ra is None or rb is None:
-        return None
-    pa, pb = cols[a].period, cols[b].period
-    t = (cols[j].period - pa) / (pb - pa)
-    return (1.0 - t) * ra + t * rb
-
-
 def neighbours(active: list[bool], j: int) -> tuple[int | None, int | None]:
     """The nearest active columns below and above column ``j``."""
     lo = next((k for k in range(j - 1, -1, -1) if active[k]), None)
     hi = next((k for k in range(j + 1, len(active)) if active[k]), None)
     return lo, hi
-
-
-def estimate(
-    cols: list[Column], j: int, hs: float, ok: np.ndarray, r: np.ndarray, law: str
-) -> np.ndarray | None:
-    """The ratios (q,) of a case of column ``j`` at ``hs``: from its column's anchors
-    where it has some, else linear in the period between the nearest columns with
-    anchors on either side (the one side's at the diagram's edge); None: no column of
-    the heading has one."""
-    own = curve(cols[j], ok, r, hs, law)
-    if own is not None:
-        return own
-    has = [bool(c.anchors(ok)[1].size) for c in cols]
-    lo, hi = neighbours(has, j)
-    if lo is not None and hi is not None:
-        return between(cols, lo, hi, j, hs, ok, r, law)
-    side = lo if lo is not None else hi
-    return None if side is None else curve(cols[side], ok, r, hs, law)

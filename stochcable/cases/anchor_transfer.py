@@ -5,24 +5,26 @@ its neighbours'.
 
 A column (one period and heading) interpolates its ratios in Hs between its computed
 cases by the power law of :func:`~stochcable.cases.anchor_layout.correction_rows` —
-its *own* curve.  Where the corrections bend along a column (Tuah's single leg: the
-end σ correction rises from +5 % at Hs 1 m to +12 % at 4 m and falls again, so that a
-power law between computed Hs one step apart misses by 3e-3 … 8e-3) but vary
-smoothly from one period to the next, a column can borrow the shape of its
-neighbours instead: the *transferred* curve of column j is the own curves of the
-nearest *own* columns on either side (the heading's shortest, middle and longest
-periods: those of the first pass, :func:`~stochcable.cases.residual_anchors.first_anchors`)
-interpolated linearly in the period to j's period — the *base* — plus j's own
-departure from it, measured at j's computed Hs and interpolated linearly in Hs.  The
-base carries the bend; what j adds to it is nearly linear in Hs, so a column needs a
-few computed Hs instead of all.  A column that is not an own column takes the
-transferred curve where it meets the middle of its first three computed Hs (smallest,
-middle, largest: always computed together) closer than its own curve from the other
-two, else its own curve (the taut wire: its corrections change fast with the period
-near resonance, and the transferred curve would need more computed Hs than the own).
-The checks in Hs of :func:`~stochcable.cases.residual_anchors.next_anchors` test the
-curve a column uses, so the error is measured on what is interpolated.  Everything
-depends on the computed numbers only.
+its *own* curve.  Where the corrections bend along a column but vary smoothly from one
+period to the next (Tuah's single leg: its end σ correction rises from +5 % at Hs 1 m
+to +12 % at 4 m and falls again, and a power law between computed Hs one step apart
+misses σ, Tz and damage ratios by 3e-3 … 8e-3, where linear in Tp between periods
+1 s apart misses by 3.5e-3 at most), a column can borrow the shape of its
+*parents* instead: the two columns whose middle it is in the bisection of the
+heading's periods (:meth:`HeadingCurves.parents`; the shortest and longest period
+have none).  Its *transferred* curve is its parents' curves interpolated linearly in
+the period to its own — the *base*, which carries the bend — plus its own departure
+from the base at its computed Hs, interpolated linearly in Hs (constant beyond
+them): what a column adds to its parents is nearly linear in Hs, so it needs a few
+computed Hs instead of all (Tuah, Tp 6–15 s every 1 s: 54 of 100 cases computed
+instead of 91, docs/benchmarks/cases.md).  A column takes the transferred curve where
+it meets the middle of its first three computed Hs (smallest, middle, largest: always
+computed together) closer than its own curve from the other two, else its own (the
+taut wire near resonance, whose corrections change fast with the period).  The
+checks in Hs of :func:`~stochcable.cases.residual_anchors.next_anchors` test the curve
+a column uses, so the error is measured on what is interpolated; a parent's curve may
+itself be transferred (from its own parents, up to the heading's shortest and longest
+periods).  Everything depends on the computed numbers only.
 """
 
 from __future__ import annotations
@@ -50,6 +52,9 @@ class HeadingCurves:
     law : str
         "power" (the adaptive anchors': transferred curves where they serve) or "hs2"
         (the fixed anchors': own curves, linear in Hs², only).
+
+    Curves are kept per column and Hs once formed: an instance serves one set of
+    computed cases (``ok``, ``r``).
     """
 
     def __init__(
@@ -57,35 +62,33 @@ class HeadingCurves:
     ) -> None:
         self.cols, self.ok, self.r, self.scale, self.law = cols, ok, r, scale, law
         n = len(cols)
-        if law != "power" or n <= 2:
-            self.own = set(range(n))
-        else:
-            self.own = {0, (n - 1) // 2, n - 1}
+        # (columns that never transfer: every one for the fixed anchors)
+        self.own = set(range(n)) if law != "power" else {0, n - 1}
         self._anchors = [c.anchors(ok) for c in cols]
         self._transferred: dict[int, bool] = {}
+        self._curves: dict[tuple[int, float], np.ndarray | None] = {}
 
     def has(self, j: int) -> bool:
         """Whether column ``j`` has computed cases."""
         return bool(self._anchors[j][1].size)
 
-    def own_curve(self, j: int, hs: float) -> np.ndarray | None:
-        """Column ``j``'s own curve at ``hs`` [m] (None: no computed case)."""
-        h, idx = self._anchors[j]
-        return None if idx.size == 0 else correction_rows(hs, h, self.r[idx], self.law)
+    def parents(self, j: int) -> tuple[int, int] | None:
+        """The ends of the interval of columns whose middle ``j`` is in the bisection
+        of the heading's periods (:func:`~stochcable.cases.residual_anchors.next_anchors`);
+        None for the shortest and longest period."""
+        a, b = 0, len(self.cols) - 1
+        while b - a >= 2:
+            m = (a + b) // 2
+            if m == j:
+                return a, b
+            a, b = (a, m) if j < m else (m, b)
+        return None
 
     def base(self, j: int, hs: float) -> np.ndarray | None:
-        """The own curves of the nearest own columns on either side of ``j`` at ``hs``,
-        linear in the period (None: not on both sides, or one without anchors)."""
-        lo = max((k for k in self.own if k < j), default=None)
-        hi = min((k for k in self.own if k > j), default=None)
-        if lo is None or hi is None:
-            return None
-        ra, rb = self.own_curve(lo, hs), self.own_curve(hi, hs)
-        if ra is None or rb is None:
-            return None
-        pa, pb = self.cols[lo].period, self.cols[hi].period
-        t = (self.cols[j].period - pa) / (pb - pa)
-        return (1.0 - t) * ra + t * rb
+        """The curves of column ``j``'s parents (:meth:`parents`) at ``hs`` [m], linear
+        in the period (None: a root, or a parent without computed cases)."""
+        p = self.parents(j)
+        return None if p is None else self.between(p[0], p[1], j, hs)
 
     def _departure(self, j: int, hs: float, at: np.ndarray, idx: np.ndarray) -> np.ndarray:
         """The base at ``hs`` plus column ``j``'s departures from it at the Hs ``at``
@@ -127,12 +130,16 @@ class HeadingCurves:
     def curve(self, j: int, hs: float) -> np.ndarray | None:
         """Column ``j``'s ratios at ``hs`` [m] from its computed cases: its transferred
         or its own curve (None: no computed case)."""
-        h, idx = self._anchors[j]
-        if idx.size == 0:
-            return None
-        if self.transferred(j):
-            return self._departure(j, hs, h, idx)
-        return correction_rows(hs, h, self.r[idx], self.law)
+        key = (j, hs)
+        if key not in self._curves:
+            h, idx = self._anchors[j]
+            if idx.size == 0:
+                self._curves[key] = None
+            elif self.transferred(j):
+                self._curves[key] = self._departure(j, hs, h, idx)
+            else:
+                self._curves[key] = correction_rows(hs, h, self.r[idx], self.law)
+        return self._curves[key]
 
     def interval(self, j: int, a: int, b: int) -> np.ndarray:
         """Column ``j``'s ratios at the middle Hs of its interval (a, b) (indices of its
