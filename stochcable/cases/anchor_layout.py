@@ -24,6 +24,7 @@ __all__ = [
     "check_ratios",
     "column_keys",
     "correction_rows",
+    "element_scale",
     "layout",
     "neighbours",
     "ratios",
@@ -111,16 +112,19 @@ def check_ratios(
         As in :func:`stochcable.cases.residual_anchors.interpolate_corrections`.
     along : (damage, linear_along), optional
         The along-line damage rates ``damage[line]`` (n, 2 + n_el) and the linear
-        model's ``linear_along[line]`` (n, n_el): their ratios join, with the end
-        damage's tolerance.
+        model's ``linear_along[line]`` (n, n_el): their ratios join, each element's
+        tolerance the end damage's relative to the line's largest damage rate of the
+        case (its ends' and elements'): :data:`DAMAGE_TOLERANCE_FACTOR` times the ratio
+        of that largest to the element's.
 
     Returns
     -------
     R : ndarray, shape (n, q)
         Per end of every line σ, Tz and 3-h MPM over the linear ones, the end damage
         rate over the linear one, then the elements' damage ratios. [-]
-    scale : ndarray, shape (q,)
-        1, or :data:`DAMAGE_TOLERANCE_FACTOR` for the damage rates. [-]
+    scale : ndarray, shape (n, q)
+        Per case, 1, or :data:`DAMAGE_TOLERANCE_FACTOR` for the end damage rates, or
+        the elements' (inf for an element without damage). [-]
     """
     cols, scale = [], []
     for name, lin in linear.items():
@@ -131,15 +135,29 @@ def check_ratios(
             if name in damage_ends:
                 cols.append(ratios(damage_ends[name][:, e], lin[:, e, 3]))
                 scale.append(DAMAGE_TOLERANCE_FACTOR)
+    n = next(iter(linear.values())).shape[0] if linear else 0
+    scale = [np.full(n, x) for x in scale]
     if along is not None:
         damage, lin_along = along
         for name, lin in lin_along.items():
             r = ratios(damage[name][:, 2:], lin)
             cols.extend(r.T)
-            scale.extend([DAMAGE_TOLERANCE_FACTOR] * r.shape[1])
-    n = next(iter(linear.values())).shape[0] if linear else 0
+            scale.extend(element_scale(damage[name]).T)
     r_all = np.column_stack(cols) if cols else np.ones((n, 0))
-    return r_all, np.asarray(scale, dtype=float)
+    s_all = np.column_stack(scale) if scale else np.ones((n, 0))
+    return r_all, s_all
+
+
+def element_scale(damage: np.ndarray) -> np.ndarray:
+    """The elements' damage tolerances in units of σ's (n, n_el): the end damage's
+    (:data:`DAMAGE_TOLERANCE_FACTOR`) relative to the line's largest damage rate of
+    each case, ``damage`` (n, 2 + n_el) its ends' and elements' (module notes of
+    :mod:`stochcable.cases.residual_anchors`); inf where an element has none. [-]"""
+    d = np.where(np.isfinite(damage), damage, 0.0)
+    big = np.max(d, axis=1, keepdims=True) if d.size else np.zeros((d.shape[0], 1))
+    el = d[:, 2:]
+    ratio = np.divide(big, el, out=np.full_like(el, np.inf), where=el > 0)
+    return DAMAGE_TOLERANCE_FACTOR * np.maximum(ratio, 1.0)
 
 
 def correction_rows(

@@ -32,6 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from stochcable.cases.anchor_layout import Column, correction_rows
+from stochcable.cases.anchor_moments import MomentCoordinates, power_rows
 
 __all__ = ["HeadingCurves"]
 
@@ -47,8 +48,8 @@ class HeadingCurves:
         Whether a case's residuals were computed (and it has a response).
     r : ndarray, shape (n, q)
         The cases' ratios (:func:`~stochcable.cases.anchor_layout.check_ratios`). [-]
-    scale : ndarray, shape (q,)
-        Each ratio's tolerance in units of σ's. [-]
+    scale : ndarray, shape (n, q)
+        Each case's ratios' tolerances in units of σ's. [-]
     law : str
         "power" (the adaptive anchors': transferred curves where they serve) or "hs2"
         (the fixed anchors': own curves, linear in Hs², only).
@@ -58,14 +59,21 @@ class HeadingCurves:
     """
 
     def __init__(
-        self, cols: list[Column], ok: np.ndarray, r: np.ndarray, scale: np.ndarray, law: str
+        self,
+        cols: list[Column],
+        ok: np.ndarray,
+        r: np.ndarray,
+        scale: np.ndarray,
+        law: str,
+        moments: MomentCoordinates | None = None,
     ) -> None:
         self.cols, self.ok, self.r, self.scale, self.law = cols, ok, r, scale, law
+        self.moments = moments if law == "power" else None
         n = len(cols)
         # (columns that never transfer: every one for the fixed anchors)
         self.own = set(range(n)) if law != "power" else {0, n - 1}
         self._anchors = [c.anchors(ok) for c in cols]
-        self._transferred: dict[int, bool] = {}
+        self._laws: dict[int, str] = {}
         self._curves: dict[tuple[int, float], np.ndarray | None] = {}
 
     def has(self, j: int) -> bool:
@@ -106,50 +114,90 @@ class HeadingCurves:
 
     def transferred(self, j: int) -> bool:
         """Whether column ``j`` uses the transferred curve (module notes)."""
-        if j not in self._transferred:
-            self._transferred[j] = self._prefer(j)
-        return self._transferred[j]
+        return self.column_law(j) == "transfer"
 
-    def _prefer(self, j: int) -> bool:
+    def column_law(self, j: int) -> str:
+        """The curve column ``j`` uses: "ratios" (its own, of the ratios), "moments"
+        (its own, of the end tensions' residual moments,
+        :mod:`stochcable.cases.anchor_moments`) or "transfer" (module notes)."""
+        if j not in self._laws:
+            self._laws[j] = self._choose(j)
+        return self._laws[j]
+
+    def _choose(self, j: int) -> str:
+        """The law that meets column ``j``'s middle computed Hs of its first three
+        best from the other two (ties: the earlier of ratios, moments, transfer)."""
         col = self.cols[j]
         n = len(col.hs)
-        if j in self.own or n < 3 or self.base(j, float(col.hs[0])) is None:
-            return False
-        first = [col.members[k][0] for k in (0, (n - 1) // 2, n - 1)]
+        if self.law != "power" or n < 3:
+            return "ratios"
+        k = (0, (n - 1) // 2, n - 1)
+        first = [col.members[x][0] for x in k]
         if not all(self.ok[i] for i in first):
-            return False
-        hs = col.hs[[0, (n - 1) // 2, n - 1]]
-        got = self.r[first[1]]
-        ends = np.array([first[0], first[2]])
-        own = correction_rows(float(hs[1]), hs[[0, 2]], self.r[ends], self.law)
-        moved = self._departure(j, float(hs[1]), hs[[0, 2]], ends)
-        live = got != 0
-        miss = [np.max(np.abs(g[live] / got[live] - 1.0) / self.scale[live]) for g in (own, moved)]
-        return bool(miss[1] < miss[0])
+            return "ratios"
+        got, sc = self.r[first[1]], self.scale[first[1]]
+        live = (got != 0) & np.isfinite(sc)
+        best, law = np.inf, "ratios"
+        for name in ("ratios", "moments", "transfer"):
+            guess = self._guess(j, name, k[0], k[2])
+            if guess is None:
+                continue
+            miss = np.max(np.abs(guess[live] / got[live] - 1.0) / sc[live], initial=0.0)
+            if miss < best:  # (NaN never)
+                best, law = miss, name
+        return law
+
+    def _guess(self, j: int, law: str, a: int, b: int) -> np.ndarray | None:
+        """Column ``j``'s ratios at the middle Hs of its interval (a, b) (indices of its
+        sorted Hs) by ``law`` from the interval's ends alone (None: not available)."""
+        col = self.cols[j]
+        m = (a + b) // 2
+        hs, at = float(col.hs[m]), col.hs[[a, b]]
+        ends = np.array([col.members[a][0], col.members[b][0]])
+        if law == "transfer":
+            if j in self.own or self.base(j, float(col.hs[a])) is None:
+                return None
+            return self._departure(j, hs, at, ends)
+        ratio = correction_rows(hs, at, self.r[ends], self.law)
+        if law == "ratios":
+            return ratio
+        if self.moments is None:
+            return None
+        got = self.moments.ratios(power_rows(hs, at, self.moments.y[ends]), col.members[m][0])
+        return np.where(np.isfinite(got), got, ratio)
 
     def curve(self, j: int, hs: float) -> np.ndarray | None:
-        """Column ``j``'s ratios at ``hs`` [m] from its computed cases: its transferred
-        or its own curve (None: no computed case)."""
+        """Column ``j``'s ratios at ``hs`` [m] from its computed cases by the law it
+        uses (:meth:`column_law`; a column of moments at an Hs it has no case of: its
+        ratios') (None: no computed case)."""
         key = (j, hs)
         if key not in self._curves:
             h, idx = self._anchors[j]
-            if idx.size == 0:
-                self._curves[key] = None
-            elif self.transferred(j):
-                self._curves[key] = self._departure(j, hs, h, idx)
-            else:
-                self._curves[key] = correction_rows(hs, h, self.r[idx], self.law)
+            law = self.column_law(j) if idx.size else ""
+            out = None
+            if law == "transfer":
+                out = self._departure(j, hs, h, idx)
+            elif idx.size:
+                out = correction_rows(hs, h, self.r[idx], self.law)
+                case = self._case(j, hs)
+                if law == "moments" and case is not None and self.moments is not None:
+                    got = self.moments.ratios(power_rows(hs, h, self.moments.y[idx]), case)
+                    out = np.where(np.isfinite(got), got, out)
+            self._curves[key] = out
         return self._curves[key]
+
+    def _case(self, j: int, hs: float) -> int | None:
+        """A case of column ``j`` at ``hs`` [m] (None: none)."""
+        col = self.cols[j]
+        k = int(np.searchsorted(col.hs, hs))
+        return col.members[k][0] if k < col.hs.size and col.hs[k] == hs else None
 
     def interval(self, j: int, a: int, b: int) -> np.ndarray:
         """Column ``j``'s ratios at the middle Hs of its interval (a, b) (indices of its
-        sorted Hs) from the interval's ends alone: the check in Hs."""
-        col = self.cols[j]
-        m = (a + b) // 2
-        ends = np.array([col.members[a][0], col.members[b][0]])
-        if self.transferred(j):
-            return self._departure(j, float(col.hs[m]), col.hs[[a, b]], ends)
-        return correction_rows(float(col.hs[m]), col.hs[[a, b]], self.r[ends], self.law)
+        sorted Hs) from the interval's ends alone, by the law it uses: the check in
+        Hs."""
+        guess = self._guess(j, self.column_law(j), a, b)
+        return self._guess(j, "ratios", a, b) if guess is None else guess
 
     def between(self, a: int, b: int, j: int, hs: float) -> np.ndarray | None:
         """Column ``j``'s ratios at ``hs`` linear in the period between columns ``a``

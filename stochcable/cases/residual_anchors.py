@@ -64,6 +64,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
+from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
 
@@ -75,10 +76,12 @@ from stochcable.cases.anchor_layout import (
     check_ratios,
     column_keys,
     correction_rows,
+    element_scale,
     layout,
     neighbours,
     ratios,
 )
+from stochcable.cases.anchor_moments import MomentCoordinates
 from stochcable.cases.anchor_transfer import HeadingCurves
 from stochcable.cases.scatter import SeaState
 
@@ -192,6 +195,7 @@ def next_anchors(
     damage_ends: dict[str, np.ndarray],
     linear: dict[str, np.ndarray],
     along: tuple[dict[str, np.ndarray], dict[str, np.ndarray]] | None = None,
+    slopes: Mapping[str, float] | None = None,
 ) -> np.ndarray:
     """The cases whose residuals the adaptive anchors compute next (none: done).
 
@@ -224,18 +228,22 @@ def next_anchors(
         As in :func:`interpolate_corrections`.
     along : (damage, linear_along), optional
         The along-line damage rates checked too (:func:`interpolate_along`'s).
+    slopes : mapping of str to float, optional
+        The S-N slope of each line's curve (the end damage's proxy,
+        :mod:`stochcable.cases.anchor_moments`).
 
     Returns
     -------
     ndarray of bool, shape (n_states,)
     """
     r, scale = check_ratios(stats, damage_ends, linear, along)
+    moments = MomentCoordinates.of(r, linear, damage_ends, slopes)
     has = np.array([row.has_numbers for row in rows], dtype=bool)
     ok = np.asarray(exact, dtype=bool) & has
     out = np.zeros(len(states), dtype=bool)
     for cols in layout(states).values():
         active = [bool(np.any(exact[c.cases])) for c in cols]
-        curves = HeadingCurves(cols, ok, r, scale, "power")
+        curves = HeadingCurves(cols, ok, r, scale, "power", moments)
         for j in _period_checks(curves, active, ok, tolerance):
             _open(cols[j], span, out)
         for j in _beyond_neighbours(cols, active):
@@ -251,7 +259,7 @@ def _miss(guess: np.ndarray | None, got: np.ndarray, scale: np.ndarray) -> float
     (inf without a guess). [-]"""
     if guess is None:
         return math.inf
-    live = got != 0
+    live = (got != 0) & np.isfinite(scale)
     if not np.any(live):
         return 0.0
     return float(np.max(np.abs(guess[live] / got[live] - 1.0) / scale[live]))
@@ -276,9 +284,9 @@ def _period_checks(
         hs, idx = cols[m].anchors(ok)
         worst = math.inf if idx.size == 0 else 0.0
         for h, i in zip(hs, idx):
-            worst = max(worst, _miss(curves.between(a, b, m, h), r[i], scale))
+            worst = max(worst, _miss(curves.between(a, b, m, h), r[i], scale[i]))
             for k in (a, b):  # (flat: a step between them misses by at most the spread)
-                spread = _miss(curves.curve(k, h), r[i], scale)
+                spread = _miss(curves.curve(k, h), r[i], scale[i])
                 worst = max(worst, spread / PERIOD_SPREAD)
         if worst > tolerance:
             stack += [(a, m), (m, b)]
@@ -329,7 +337,7 @@ def _hs_checks(
         if not (has[ia] and has[im] and has[ib]):
             stack += [(a, m), (m, b)]
             continue
-        if _miss(curves.interval(j, a, b), curves.r[im], curves.scale) > tolerance:
+        if _miss(curves.interval(j, a, b), curves.r[im], curves.scale[im]) > tolerance:
             stack += [(a, m), (m, b)]
 
 
@@ -342,6 +350,7 @@ def interpolate_corrections(
     linear: dict[str, np.ndarray],
     law: str = "hs2",
     along: tuple[dict[str, np.ndarray], dict[str, np.ndarray]] | None = None,
+    slopes: Mapping[str, float] | None = None,
 ) -> None:
     """Give the cases whose residuals were not computed the anchors' corrections, in
     place (module notes; ``law`` of :func:`correction`: "power" for the adaptive
@@ -369,9 +378,12 @@ def interpolate_corrections(
         linear model's, NaN where not formed: such a case keeps its own); the columns'
         curves are chosen on every ratio at once (ends and elements), as the checks
         test them.
+    slopes : mapping of str to float, optional
+        As in :func:`next_anchors`.
     """
     r, scale = check_ratios(stats, damage_ends, linear, along)
-    est = _estimates(states, exact, rows, r, scale, law)
+    moments = MomentCoordinates.of(r, linear, damage_ends, slopes)
+    est = _estimates(states, exact, rows, r, scale, law, moments)
     for i, got in est.items():
         if got is None:
             rows[i] = replace(
@@ -409,6 +421,7 @@ def _estimates(
     r: np.ndarray,
     scale: np.ndarray,
     law: str,
+    moments: MomentCoordinates | None = None,
 ) -> dict[int, np.ndarray | None]:
     """The interpolated ratios (:meth:`HeadingCurves.estimate`) of every case with a
     response whose residuals were not computed."""
@@ -416,7 +429,7 @@ def _estimates(
     ok = np.asarray(exact, dtype=bool) & has
     out: dict[int, np.ndarray | None] = {}
     for cols in layout(states).values():
-        curves = HeadingCurves(cols, ok, r, scale, law)
+        curves = HeadingCurves(cols, ok, r, scale, law, moments)
         for j, col in enumerate(cols):
             for h, members in zip(col.hs, col.members):
                 todo = [i for i in members if not exact[i] and has[i]]
@@ -444,7 +457,7 @@ def interpolate_along(
     for name, lin in linear_along.items():
         d = damage[name][:, 2:]
         r = ratios(d, lin)
-        scale = np.full(r.shape[1], DAMAGE_TOLERANCE_FACTOR)
+        scale = element_scale(damage[name])
         for i, got in _estimates(states, exact, rows, r, scale, law).items():
             if got is not None and np.all(np.isfinite(lin[i])):
                 d[i] = lin[i] * got

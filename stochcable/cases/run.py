@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.cases.anchor_moments import damage_slopes
 from stochcable.cases.anchor_passes import neighbour_starts, pass_chunks, split_last_pass
 from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, set_engine, solve_chunk
 from stochcable.cases.display import case_set_html, case_set_text
@@ -271,7 +272,7 @@ def _anchored(
         m = _merge(plan, results)
         todo = np.flatnonzero(next_anchors(
             states, plan.residual_span, tol, exact, m.rows, m.stats, m.d_ends, m.linear,
-            (m.damage, m.linear_along),
+            (m.damage, m.linear_along), damage_slopes(plan.fatigue),
         ))  # fmt: skip
         starts = neighbour_starts(states, todo, {i: x for i, x in known.items() if exact[i]})
 
@@ -332,7 +333,10 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     # the residuals' corrections of the cases that did not compute them
     law = "hs2" if plan.residual_tolerance is None else "power"
     along = (damage, m.linear_along)
-    interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear, law, along)
+    slopes = damage_slopes(settings)
+    interpolate_corrections(
+        scatter.states, m.exact, rows, stats, d_ends, m.linear, law, along, slopes
+    )
     _warn_interpolated(plan, m.exact)
     s_el = m.s_el
     d_along = {ln: damage[ln][:, 2:] for ln in names}

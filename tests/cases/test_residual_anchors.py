@@ -313,12 +313,12 @@ def test_adaptive_set_against_every_case_computed():
         np.testing.assert_allclose(a[:, 1:], b[:, 1:], rtol=3e-3)
     d, dr = got.damage_rate_ends["wire"], ref.damage_rate_ends["wire"]
     np.testing.assert_allclose(d, dr, rtol=1e-2)
-    # the along-line damage from the elements' corrected spectra, interpolated as the
-    # ends' (the checks test the ends only): measured 4.1e-3 from every case computed,
-    # where the linear model's misses by 85 %; the end damage's 1e-2
-    np.testing.assert_allclose(
-        got.damage_rate_along["wire"], ref.damage_rate_along["wire"], rtol=1e-2
-    )
+    # the along-line damage from the elements' corrected spectra, interpolated with
+    # the ends' and checked relative to the line's largest damage rate of the case:
+    # within the end damage's 1e-2 of it (the linear model misses by 85 %)
+    da, dr = got.damage_rate_along["wire"], ref.damage_rate_along["wire"]
+    big = np.max(np.column_stack([ref.damage_rate_ends["wire"], dr]), axis=1)
+    assert np.max(np.abs(da - dr) / big[:, None]) < 1e-2
 
 
 def test_adaptive_set_is_the_same_whatever_the_executor_and_chunking():
