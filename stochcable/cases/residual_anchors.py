@@ -16,12 +16,14 @@ apart (where an element starts to split; 2.4e-3 with the panels grouped by the s
 wave-velocity variance before).  Every case is solved by the linear model (the set's
 reused engine); the anchors compute the residuals too, and every other case gets its
 linear values times the ratios interpolated from the anchors
-(:func:`interpolate_corrections`, :func:`interpolate_along`; the layout and the laws
-in :mod:`stochcable.cases.anchor_layout`): in Hs between the anchors of its own
-column (:func:`correction`: a power law of Hs between two anchors whose corrections
-share a sign, else linear in Hs²), and a column without anchors linearly in the
-period between the nearest columns with anchors on either side (each at the case's
-Hs).
+(:func:`interpolate_corrections`; the layout in :mod:`stochcable.cases.anchor_layout`,
+the curves in :mod:`stochcable.cases.anchor_transfer`): in Hs between the anchors of
+its own column — the ratios a power of Hs between two anchors whose corrections share
+a sign, else linear in Hs² (:func:`correction`), or, with the adaptive anchors, the
+end tensions' residual moments powers of Hs (:mod:`stochcable.cases.anchor_moments`)
+or the column's parents' shape plus its departure from it, whichever meets the
+column's first middle Hs best — and a column without anchors linearly in the period
+between the nearest columns with anchors on either side (each at the case's Hs).
 
 **Adaptive anchors** (``run_cases``'s default, ``residual_tolerance`` =
 :data:`RESIDUAL_TOLERANCE`): a first pass computes, per heading, the columns of the
@@ -36,7 +38,10 @@ whose Hs reach beyond its computed neighbours' is computed; and in every compute
 column each interval between anchors more than one Hs step wide is checked at its
 middle Hs, computed, against the ratios interpolated in Hs between its ends.  The
 tolerance: ``residual_tolerance`` on σ, Tz and 3-h MPM, :data:`DAMAGE_TOLERANCE_FACTOR`
-× it on the end and the elements' damage rates.  So the error is measured where it is
+× it on the end damage rates and on the elements' relative to the line's largest
+damage rate of the case (:func:`~stochcable.cases.anchor_layout.element_scale`: what
+a designer reads of the line; an element with a hundredth of it is reported to its
+own damage within a hundred times that).  So the error is measured where it is
 made, not assumed: a correction that grows fast with Hs (the taut wire at Tp 10 s,
 +0.1 … +35 % on σ at end_b, ×3.4 on the end damage), or steps, gets
 anchors there.  Every case is solved once (:mod:`stochcable.cases.anchor_passes`):
@@ -57,7 +62,7 @@ as does a plan by default (the service's batch jobs, one pass).
 The along-line damage of a case that computes the residuals is that of the element
 tensions' corrected spectra (where the analysis computes them along the line,
 :mod:`stochcable.cases.along_spectra`); the other cases' is interpolated per element
-as the ends', and checked as the end damage.
+with the ends' (their ratios, by the curve their column uses).
 """
 
 from __future__ import annotations

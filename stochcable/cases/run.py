@@ -180,9 +180,10 @@ def run_cases(
         (:mod:`stochcable.cases.residual_anchors`): per heading the periods are
         bisected from the shortest, middle and longest, each computed period's Hs from
         its smallest, middle and largest, until the corrections interpolated at every
-        checked middle (σ, Tz and 3-h MPM over the linear ones; the end and element
-        damage rates', with 3 × the tolerance) are within ``residual_tolerance`` of
-        the computed ones; the other cases get interpolated corrections, and a
+        checked middle (σ, Tz and 3-h MPM over the linear ones; the end damage rates',
+        with 3 × the tolerance, and the elements' with 3 × the tolerance relative to
+        the line's largest damage rate of the case) are within ``residual_tolerance``
+        of the computed ones; the other cases get interpolated corrections, and a
         PhysicsWarning says how many cases computed them.  Default
         :data:`~stochcable.cases.residual_anchors.RESIDUAL_TOLERANCE` (2e-3; the
         measured error on the chain, the taut wire and Tuah's single leg is in
@@ -378,7 +379,13 @@ def _warn_interpolated(plan: CasePlan, exact: np.ndarray) -> None:
         + f" computed on {k} of the {n} cases ({how}); the other {n - k} cases' end "
         "statistics, end damage and along-line damage are their linear values times "
         "the computed cases' corrections interpolated in Hs along a period and linearly "
-        "in the period between periods (residual_tolerance=None computes every case)",
+        "in the period between periods ("
+        + (
+            "the elements' damage checked relative to the line's largest; "
+            if plan.residual_tolerance is not None
+            else ""
+        )
+        + "residual_tolerance=None computes every case)",
         PhysicsWarning,
     )
 
