@@ -17,14 +17,17 @@ the period to its own — the *base*, which carries the bend — plus its own de
 from the base at its computed Hs, interpolated linearly in Hs (constant beyond
 them): what a column adds to its parents is nearly linear in Hs, so it needs a few
 computed Hs instead of all (Tuah, Tp 6–15 s every 1 s: 54 of 100 cases computed
-instead of 91, docs/benchmarks/cases.md).  A column takes the transferred curve where
-it meets the middle of its first three computed Hs (smallest, middle, largest: always
-computed together) closer than its own curve from the other two, else its own (the
-taut wire near resonance, whose corrections change fast with the period).  The
-checks in Hs of :func:`~stochcable.cases.residual_anchors.next_anchors` test the curve
-a column uses, so the error is measured on what is interpolated; a parent's curve may
-itself be transferred (from its own parents, up to the heading's shortest and longest
-periods).  Everything depends on the computed numbers only.
+instead of 91, docs/benchmarks/cases.md).  A third curve interpolates the end
+tensions' residual moments instead of their ratios
+(:mod:`stochcable.cases.anchor_moments`: where the linear response bends with Hs and
+the residuals do not, the taut wire near resonance).  Each column takes the curve —
+its ratios', its moments', or the transferred one (not the shortest and longest
+period's) — that meets the middle of its first three computed Hs (smallest, middle,
+largest: always computed together) best from the other two.  The checks in Hs of
+:func:`~stochcable.cases.residual_anchors.next_anchors` test the curve a column uses,
+so the error is measured on what is interpolated; a parent's curve may itself be
+transferred (from its own parents, up to the heading's shortest and longest periods).
+Everything depends on the computed numbers only.
 """
 
 from __future__ import annotations
@@ -51,8 +54,11 @@ class HeadingCurves:
     scale : ndarray, shape (n, q)
         Each case's ratios' tolerances in units of σ's. [-]
     law : str
-        "power" (the adaptive anchors': transferred curves where they serve) or "hs2"
-        (the fixed anchors': own curves, linear in Hs², only).
+        "power" (the adaptive anchors': each column's curve chosen, :meth:`column_law`)
+        or "hs2" (the fixed anchors': the ratios linear in Hs² only).
+    moments : MomentCoordinates, optional
+        The ratios in the residual moments' coordinates (without: no column of
+        moments).
 
     Curves are kept per column and Hs once formed: an instance serves one set of
     computed cases (``ok``, ``r``).
