@@ -394,7 +394,7 @@ def _why(others: dict) -> list[str]:
         "(its residual variance no power of Hs: σ missed by 1e-2 between Hs 1 m apart,",
         "the ratios' law 7e-3), so each period chooses.  Not tried: interpolating each",
         "computed case's residual spectral density line by line (the chunks would return",
-        "them); the moments are its first two integrals.",
+        "them); the moments m0 and m2 are two of its integrals.",
         "",
         "What a case's fixed point saves in a set: each anchor starts from the σ of the",
         "computed cases of its column interpolated in Hs",
