@@ -12,12 +12,14 @@ misses σ, Tz and damage ratios by 3e-3 … 8e-3, where linear in Tp between per
 1 s apart misses by 3.5e-3 at most), a column can borrow the shape of its
 *parents* instead: the two columns whose middle it is in the bisection of the
 heading's periods (:meth:`HeadingCurves.parents`; the shortest and longest period
-have none).  Its *transferred* curve is its parents' curves interpolated linearly in
-the period to its own — the *base*, which carries the bend — plus its own departure
-from the base at its computed Hs, interpolated linearly in Hs (constant beyond
-them): what a column adds to its parents is nearly linear in Hs, so it needs a few
-computed Hs instead of all (Tuah, Tp 6–15 s every 1 s: 54 of 100 cases computed
-instead of 91, docs/benchmarks/cases.md).  A third curve interpolates the end
+have none).  Its *transferred* curve is its parents' curves interpolated to its
+period — quadratic in the period through them and the other end of the interval
+whose middle one of them is, where there is one, else linear between them — the
+*base*, which carries the bend, plus its own departure from the base at its computed
+Hs, interpolated linearly in Hs (constant beyond them): what a column adds to its
+parents is nearly linear in Hs, so it needs a few computed Hs instead of all (Tuah,
+Tp 6–15 s every 1 s: 47 of 100 cases computed instead of 91,
+docs/benchmarks/cases.md).  A third curve interpolates the end
 tensions' residual moments instead of their ratios
 (:mod:`stochcable.cases.anchor_moments`: where the linear response bends with Hs and
 the residuals do not, the taut wire near resonance).  Each column takes the curve —
@@ -99,10 +101,34 @@ class HeadingCurves:
         return None
 
     def base(self, j: int, hs: float) -> np.ndarray | None:
-        """The curves of column ``j``'s parents (:meth:`parents`) at ``hs`` [m], linear
-        in the period (None: a root, or a parent without computed cases)."""
+        """The curves of column ``j``'s parents (:meth:`parents`) at ``hs`` [m],
+        quadratic in the period through them and the other end of the interval whose
+        middle one of them is (j lies between the parents, so this interpolates);
+        linear between the parents where there is no such column or it has no
+        computed case (None: a root, or a parent without computed cases)."""
         p = self.parents(j)
-        return None if p is None else self.between(p[0], p[1], j, hs)
+        if p is None:
+            return None
+        a, b = p
+        third = None
+        for x in (a, b):
+            up = self.parents(x)
+            if up is not None:
+                third = next((y for y in up if y not in (a, b)), third)
+        c = None if third is None else self.curve(third, hs)
+        if c is None:
+            return self.between(a, b, j, hs)
+        ra, rb = self.curve(a, hs), self.curve(b, hs)
+        if ra is None or rb is None:
+            return None
+        t = [self.cols[k].period for k in (a, b, third)]
+        x = self.cols[j].period
+        w = [
+            (x - t[1]) * (x - t[2]) / ((t[0] - t[1]) * (t[0] - t[2])),
+            (x - t[0]) * (x - t[2]) / ((t[1] - t[0]) * (t[1] - t[2])),
+            (x - t[0]) * (x - t[1]) / ((t[2] - t[0]) * (t[2] - t[1])),
+        ]
+        return w[0] * ra + w[1] * rb + w[2] * c
 
     def _departure(self, j: int, hs: float, at: np.ndarray, idx: np.ndarray) -> np.ndarray:
         """The base at ``hs`` plus column ``j``'s departures from it at the Hs ``at``

@@ -168,3 +168,30 @@ def test_damage_slopes_of_the_curves():
         }
     )
     assert got == {"wire": 4.0, "chain": 3.0}
+
+
+def test_the_base_is_quadratic_in_the_period_through_the_parents_and_their_parent():
+    """Every case computed, ratios quadratic in Tp at each Hs: a column whose parents
+    have a parent interval of their own (Tp 8 s: parents 6 and 10 s, 10 s the middle of
+    6 … 14 s) gets its ratios back to round-off from theirs; the middle column (parents
+    the shortest and longest period) linearly between them, missing by the quadratic's
+    term q·(t − 6)(t − 14) exactly."""
+    q = 1e-3
+
+    def ratio(h, t):
+        return 1 + 0.05 * h + q * (t - 6.0) * (t - 14.0) * (1 + 0.1 * h)
+
+    tps = tuple(6.0 + k for k in range(9))
+    states, stats, dam, linear, _ = _field(
+        lambda h, t: 1.0, lambda h, t: 1.0, ratio, lambda h, t: 1.0, tps=tps
+    )
+    r, scale = check_ratios(stats, dam, linear)
+    ok = np.ones(len(states), dtype=bool)
+    curves = HeadingCurves(layout(states)[0.0], ok, r, scale, "power")
+    for h in (1.0, 4.0, 9.0):
+        assert curves.base(2, h)[0] == pytest.approx(ratio(h, 8.0), rel=1e-13)
+        lin = 1 + 0.05 * h  # (the quadratic term vanishes at 6 and 14 s)
+        assert curves.base(4, h)[0] == pytest.approx(lin, rel=1e-13)
+        assert abs(curves.base(4, h)[0] - ratio(h, 10.0)) == pytest.approx(
+            q * 16 * (1 + 0.1 * h), rel=1e-9
+        )
