@@ -28,6 +28,8 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.design import FatigueCurve, fatigue_curve
+
 __all__ = ["MomentCoordinates", "damage_slopes", "power_rows"]
 
 
@@ -135,18 +137,14 @@ def power_rows(hs: float, anchors: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def damage_slopes(fatigue: Mapping[str, Any]) -> dict[str, float]:
-    """The S-N slope of each line's curve (the first segment's; a line whose curve
-    cannot be formed is left out: its damage keeps its ratio). [-]"""
-    from stochcable.design import FatigueCurve, fatigue_curve
-
+    """The S-N slope of each line's curve (``fatigue``: the set's validated
+    :class:`~stochcable.cases.fatigue_settings.LineFatigue` per line; the first
+    segment's slope of a curve with two). [-]"""
     out = {}
     for name, settings in fatigue.items():
-        curve = getattr(settings, "curve", None)
-        try:
-            if isinstance(curve, str):
-                curve = fatigue_curve(curve, mean_load_ratio=settings.mean_load_ratio)
-        except Exception:  # noqa: BLE001 - the set reports the curve's error itself
-            continue
+        curve = settings.curve
+        if isinstance(curve, str):
+            curve = fatigue_curve(curve, mean_load_ratio=settings.mean_load_ratio)
         if isinstance(curve, FatigueCurve) and curve.slopes:
             out[name] = float(curve.slopes[0])
     return out
