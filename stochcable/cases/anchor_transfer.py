@@ -104,10 +104,10 @@ class HeadingCurves:
         """The curves of column ``j``'s parents (:meth:`parents`) at ``hs`` [m],
         quadratic in the period through them and the other end of the interval whose
         middle one of them is (j lies between the parents, so this interpolates);
-        linear between the parents where there is no such column or it has no
-        computed case (None: a root, or a parent without computed cases)."""
+        linear between the parents where there is no such column or its computed Hs
+        do not reach over j's (None: a root, or a parent whose computed Hs do not)."""
         p = self.parents(j)
-        if p is None:
+        if p is None or not (self._covers(p[0], j) and self._covers(p[1], j)):
             return None
         a, b = p
         third = None
@@ -115,7 +115,7 @@ class HeadingCurves:
             up = self.parents(x)
             if up is not None:
                 third = next((y for y in up if y not in (a, b)), third)
-        c = None if third is None else self.curve(third, hs)
+        c = None if third is None or not self._covers(third, j) else self.curve(third, hs)
         if c is None:
             return self.between(a, b, j, hs)
         ra, rb = self.curve(a, hs), self.curve(b, hs)
@@ -129,6 +129,13 @@ class HeadingCurves:
             (x - t[0]) * (x - t[1]) / ((t[2] - t[0]) * (t[2] - t[1])),
         ]
         return w[0] * ra + w[1] * rb + w[2] * c
+
+    def _covers(self, k: int, j: int) -> bool:
+        """Whether column ``k``'s computed Hs reach over column ``j``'s Hs (no curve is
+        extrapolated into a base)."""
+        h = self._anchors[k][0]
+        col = self.cols[j]
+        return bool(h.size) and h[0] <= col.hs[0] and h[-1] >= col.hs[-1]
 
     def _departure(self, j: int, hs: float, at: np.ndarray, idx: np.ndarray) -> np.ndarray:
         """The base at ``hs`` plus column ``j``'s departures from it at the Hs ``at``
@@ -207,7 +214,7 @@ class HeadingCurves:
             h, idx = self._anchors[j]
             law = self.column_law(j) if idx.size else ""
             out = None
-            if law == "transfer":
+            if law == "transfer" and self.base(j, hs) is not None:
                 out = self._departure(j, hs, h, idx)
             elif idx.size:
                 out = correction_rows(hs, h, self.r[idx], self.law)

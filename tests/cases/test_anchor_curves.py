@@ -22,11 +22,12 @@ from stochcable.cases.residual_anchors import (
 HS = tuple(float(h) for h in range(1, 10))
 
 
-def _field(std, tz, sigma, tzc, hs=HS, tps=(8.0,), damage=None):
-    """A synthetic diagram of one line: the linear σ and Tz ``std(h, t)``, ``tz(h, t)``
-    and the corrected ``sigma(h, t)``, ``tzc(h, t)`` (MPM ratio 1; the end damage
-    ``damage(h, t)`` as (corrected, linear), or none)."""
-    rows = [{"hs": h, "tp": t, "hours": 1.0} for t in tps for h in hs]
+def _field(std, tz, sigma, tzc, hs=HS, tps=(8.0,), damage=None, rows=None):
+    """A synthetic diagram of one line (every Hs at every Tp, or ``rows``): the linear
+    σ and Tz ``std(h, t)``, ``tz(h, t)`` and the corrected ``sigma(h, t)``,
+    ``tzc(h, t)`` (MPM ratio 1; the end damage ``damage(h, t)`` as (corrected,
+    linear), or none)."""
+    rows = rows or [{"hs": h, "tp": t, "hours": 1.0} for t in tps for h in hs]
     states = scatter_from_rows(rows).states
     n = len(states)
     lin = np.zeros((n, 2, 4))
@@ -195,3 +196,28 @@ def test_the_base_is_quadratic_in_the_period_through_the_parents_and_their_paren
         assert abs(curves.base(4, h)[0] - ratio(h, 10.0)) == pytest.approx(
             q * 16 * (1 + 0.1 * h), rel=1e-9
         )
+
+
+def test_no_base_is_extrapolated_beyond_a_parents_computed_hs():
+    """A column borrows its parents' shape only where their computed Hs reach over its
+    own (a real diagram's short periods stop at lower Hs): with the shortest period's
+    column ending at Hs 5 m, the columns whose parents include it interpolate their
+    own ratios (every Hs checked), the others still borrow; every σ within the
+    tolerance."""
+
+    def ratio(h, t):
+        return 1 + 0.1 * h * np.exp(-h / 3) * (1 + 0.02 * t) + 0.001 * t
+
+    tps = tuple(6.0 + k for k in range(9))
+    rows = [{"hs": h, "tp": t, "hours": 1.0} for t in tps for h in HS if t > 6.0 or h <= 5.0]
+    states, stats, dam, linear, rws = _field(
+        lambda h, t: 1.0, lambda h, t: 1.0, ratio, lambda h, t: 1.0, rows=rows
+    )
+    exact, miss = _adapt(states, stats, dam, linear, rws, slopes={})
+    r, scale = check_ratios(stats, dam, linear)
+    curves = HeadingCurves(layout(states)[0.0], exact, r, scale, "power",
+                           MomentCoordinates.of(r, linear, dam))  # fmt: skip
+    laws = [curves.column_law(j) for j in range(9)]
+    assert curves.parents(1) == (0, 2) and laws[1] != "transfer"
+    assert curves.parents(6) == (4, 8) and laws[6] == "transfer"
+    assert miss < 1e-3
