@@ -229,7 +229,7 @@ def main() -> None:
         "",
         "The default set on two more lines, against every case computed (the scenes'",
         "linearization tolerance set to 1e-4; per case CPU time over one corrected",
-        "`analyze()` of the same scene and its own sea, fastest of 2 interleaved rounds;",
+        "`analyze()` of the same scene and its own sea, fastest of 3 interleaved rounds;",
         "each line on a 4-period diagram and on a realistic one, Tp every 1 s; the",
         "linear set: the residuals off, the floor of any set whose cases all carry",
         "corrections interpolated from computed ones):",
@@ -692,7 +692,7 @@ def _other_lines() -> dict:
             run_cases(doc, sd, fatigue=fat)  # (warm-up: the line's kernels)
             analyze(scene)
             t = {"analyze": [], "exact": [], "default": [], "linear": []}
-            for _ in range(2):  # interleaved rounds, the fastest of each
+            for _ in range(3):  # interleaved rounds, the fastest of each
                 for _ in range(3):
                     t0 = time.process_time()
                     analyze(scene)
