@@ -1,7 +1,7 @@
 """Load-case set speed: the chain example over a 200-case Hs × Tp diagram, one heading,
 one core.
 
-    python3 benchmarks/bench_cases.py [--quick] [--write]
+    python3 benchmarks/bench_cases.py [--quick] [--write] [--north-atlantic]
 
 Reports the time per case of ``run_cases`` against one ``analyze()`` of the same scene,
 the share of the fatigue and long-term sums, and the largest difference of a case's
@@ -11,7 +11,9 @@ with the residuals of the linear model (``analysis.linearization.drag_residual``
 case computed and the fixed anchors, fastest of interleaved runs, their accuracy
 against every case computed (also on the taut wire and Tuah's single leg), and where
 a corrected case's time goes (cProfile of one set).  ``--write`` writes
-docs/benchmarks/cases.md; ``--quick`` runs 20 cases and never writes.
+docs/benchmarks/cases.md; ``--quick`` runs 20 cases and never writes;
+``--north-atlantic`` only prints the default set's cases computed and misses on the
+bundled North Atlantic diagram (docs/cases.md).
 """
 
 from __future__ import annotations
@@ -53,7 +55,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--write", action="store_true")
+    ap.add_argument("--north-atlantic", action="store_true")
     args = ap.parse_args()
+    if args.north_atlantic:
+        runtime.configure()
+        warnings.simplefilter("ignore")
+        _north_atlantic()
+        return
     load0 = os.getloadavg()[0]
     runtime.configure()
     warnings.simplefilter("ignore")
@@ -726,6 +734,35 @@ def _other_lines() -> dict:
                 "diagram": f"Hs {h0:g}–{h1:g} m ({nh}) × Tp {periods} s", "profile": prof,
             }  # fmt: skip
     return out
+
+
+def _north_atlantic() -> None:
+    """The default set against every case computed on the bundled North Atlantic
+    diagram (111 cases, columns of Tz reaching different Hs) for the three lines:
+    cases computed and the largest misses (``--north-atlantic``; printed only)."""
+    from stochcable.cases import read_scatter
+    from stochcable.examples import resources
+
+    path = resources.files("stochcable.examples") / "scatter_north_atlantic.csv"
+    sd = read_scatter(str(path))
+    lines = {"chain_catenary": ("dnv-studless", {"nominal_diameter": 0.084}),
+             **{k: v[4] for k, v in _OTHERS.items()}}  # fmt: skip
+    print("| line | cases computed | σ | Tz | 3-h MPM | end damage rate | element damage "
+          "rate, of the line's largest (of its own) |\n|---|---|---|---|---|---|---|")  # fmt: skip
+    for name, (curve, kw) in lines.items():
+        doc = load_example(name).model_dump(mode="json", exclude_none=True)
+        doc["analysis"].pop("timeseries", None)
+        doc["analysis"].setdefault("linearization", {}).update(
+            drag_residual=True, geometric_residual=True, tolerance=1e-4
+        )
+        fat = LineFatigue(curve, **kw)
+        ref = run_cases(doc, sd, fatigue=fat, residual_tolerance=None)
+        got = run_cases(doc, sd, fatigue=fat)
+        m = _misses(got, ref, ref.lines[0])
+        print(f"| {name} | {_computed(load_scene(doc), sd, fat)} of {len(sd.states)} | "
+              f"{m['σ']:.1e} | {m['Tz']:.1e} | {m['3-h MPM']:.1e} | "
+              f"{m['end damage rate']:.1e} | {m[_EL_BIG]:.1e} "
+              f"({m['element damage rate, of its own']:.1e}) |")  # fmt: skip
 
 
 if __name__ == "__main__":
