@@ -82,7 +82,7 @@ class HeadingCurves:
         self.own = set(range(n)) if law != "power" else {0, n - 1}
         self._anchors = [c.anchors(ok) for c in cols]
         self._laws: dict[int, str] = {}
-        self._curves: dict[tuple[int, float], np.ndarray | None] = {}
+        self._curves: dict[tuple[int, float, bool], np.ndarray | None] = {}
 
     def has(self, j: int) -> bool:
         """Whether column ``j`` has computed cases."""
@@ -205,11 +205,14 @@ class HeadingCurves:
         got = self.moments.ratios(power_rows(hs, at, self.moments.y[ends]), col.members[m][0])
         return np.where(np.isfinite(got), got, ratio)
 
-    def curve(self, j: int, hs: float) -> np.ndarray | None:
+    def curve(self, j: int, hs: float, own: bool = False) -> np.ndarray | None:
         """Column ``j``'s ratios at ``hs`` [m] from its computed cases by the law it
-        uses (:meth:`column_law`; a column of moments at an Hs it has no case of: its
-        ratios') (None: no computed case)."""
-        key = (j, hs)
+        uses (:meth:`column_law`) (None: no computed case).  A column of moments turns
+        its moments into ratios with the linear σ and Tz of its case at ``hs``: for
+        another column's use (``own`` False: a base, or linear in the period) only at
+        a computed case's Hs, else its ratios' law — the checks, made before the other
+        cases are solved, test what is then interpolated."""
+        key = (j, hs, own)
         if key not in self._curves:
             h, idx = self._anchors[j]
             law = self.column_law(j) if idx.size else ""
@@ -219,6 +222,8 @@ class HeadingCurves:
             elif idx.size:
                 out = correction_rows(hs, h, self.r[idx], self.law)
                 case = self._case(j, hs)
+                if case is not None and not (own or self.ok[case]):
+                    case = None
                 if law == "moments" and case is not None and self.moments is not None:
                     got = self.moments.ratios(power_rows(hs, h, self.moments.y[idx]), case)
                     out = np.where(np.isfinite(got), got, out)
@@ -253,7 +258,7 @@ class HeadingCurves:
         it has computed cases, else linear in the period between the nearest columns
         with some on either side (the one side's at the diagram's edge); None: no
         column of the heading has one."""
-        own = self.curve(j, hs)
+        own = self.curve(j, hs, own=True)
         if own is not None:
             return own
         lo = next((k for k in range(j - 1, -1, -1) if self.has(k)), None)
