@@ -1,10 +1,10 @@
 """The layout the residual anchors of a load-case set work on: the diagram's columns
 (the sea states of one heading and period, which differ by Hs) ordered by period per
-heading, the corrections' ratios of the cases as one matrix, and the interpolation of
-those ratios at a case from the cases that computed them — a power law in Hs along a
-column (:func:`correction_rows`), linear in the period between the nearest columns
-that computed some (:func:`estimate`).  Used by
-:mod:`stochcable.cases.residual_anchors`, whose notes say what is checked where.
+heading, the corrections' ratios of the cases as one matrix, and the power law in Hs
+of a column's ratios between the cases that computed them (:func:`correction_rows`;
+the curves of a heading's columns from it in :mod:`stochcable.cases.anchor_transfer`).
+Used by :mod:`stochcable.cases.residual_anchors`, whose notes say what is checked
+where.
 """
 
 from __future__ import annotations
@@ -21,12 +21,10 @@ from stochcable.cases.scatter import SeaState, tz_over_tp
 __all__ = [
     "DAMAGE_TOLERANCE_FACTOR",
     "Column",
-    "between",
     "check_ratios",
     "column_keys",
     "correction_rows",
-    "curve",
-    "estimate",
+    "element_scale",
     "layout",
     "neighbours",
     "ratios",
@@ -114,16 +112,19 @@ def check_ratios(
         As in :func:`stochcable.cases.residual_anchors.interpolate_corrections`.
     along : (damage, linear_along), optional
         The along-line damage rates ``damage[line]`` (n, 2 + n_el) and the linear
-        model's ``linear_along[line]`` (n, n_el): their ratios join, with the end
-        damage's tolerance.
+        model's ``linear_along[line]`` (n, n_el): their ratios join, each element's
+        tolerance the end damage's relative to the line's largest damage rate of the
+        case (its ends' and elements'): :data:`DAMAGE_TOLERANCE_FACTOR` times the ratio
+        of that largest to the element's.
 
     Returns
     -------
     R : ndarray, shape (n, q)
         Per end of every line σ, Tz and 3-h MPM over the linear ones, the end damage
         rate over the linear one, then the elements' damage ratios. [-]
-    scale : ndarray, shape (q,)
-        1, or :data:`DAMAGE_TOLERANCE_FACTOR` for the damage rates. [-]
+    scale : ndarray, shape (n, q)
+        Per case, 1, or :data:`DAMAGE_TOLERANCE_FACTOR` for the end damage rates, or
+        the elements' (inf for an element without damage). [-]
     """
     cols, scale = [], []
     for name, lin in linear.items():
@@ -134,15 +135,29 @@ def check_ratios(
             if name in damage_ends:
                 cols.append(ratios(damage_ends[name][:, e], lin[:, e, 3]))
                 scale.append(DAMAGE_TOLERANCE_FACTOR)
+    n = next(iter(linear.values())).shape[0] if linear else 0
+    scale = [np.full(n, x) for x in scale]
     if along is not None:
         damage, lin_along = along
         for name, lin in lin_along.items():
             r = ratios(damage[name][:, 2:], lin)
             cols.extend(r.T)
-            scale.extend([DAMAGE_TOLERANCE_FACTOR] * r.shape[1])
-    n = next(iter(linear.values())).shape[0] if linear else 0
+            scale.extend(element_scale(damage[name]).T)
     r_all = np.column_stack(cols) if cols else np.ones((n, 0))
-    return r_all, np.asarray(scale, dtype=float)
+    s_all = np.column_stack(scale) if scale else np.ones((n, 0))
+    return r_all, s_all
+
+
+def element_scale(damage: np.ndarray) -> np.ndarray:
+    """The elements' damage tolerances in units of σ's (n, n_el): the end damage's
+    (:data:`DAMAGE_TOLERANCE_FACTOR`) relative to the line's largest damage rate of
+    each case, ``damage`` (n, 2 + n_el) its ends' and elements' (module notes of
+    :mod:`stochcable.cases.residual_anchors`); inf where an element has none. [-]"""
+    d = np.where(np.isfinite(damage), damage, 0.0)
+    big = np.max(d, axis=1, keepdims=True) if d.size else np.zeros((d.shape[0], 1))
+    el = d[:, 2:]
+    ratio = np.divide(big, el, out=np.full_like(el, np.inf), where=el > 0)
+    return DAMAGE_TOLERANCE_FACTOR * np.maximum(ratio, 1.0)
 
 
 def correction_rows(
@@ -170,47 +185,8 @@ def correction_rows(
     return out
 
 
-def curve(col: Column, ok: np.ndarray, r: np.ndarray, hs: float, law: str) -> np.ndarray | None:
-    """Column ``col``'s ratios at ``hs`` from its anchors (None: it has none)."""
-    h, idx = col.anchors(ok)
-    return None if idx.size == 0 else correction_rows(hs, h, r[idx], law)
-
-
-def between(
-    cols: list[Column], a: int, b: int, j: int, hs: float, ok: np.ndarray, r: np.ndarray, law: str
-) -> np.ndarray | None:
-    """The ratios at ``hs`` of column ``j`` interpolated linearly in the period between
-    columns ``a`` and ``b``'s own (each from its anchors at ``hs``); None when either
-    has no anchor."""
-    ra = curve(cols[a], ok, r, hs, law)
-    rb = curve(cols[b], ok, r, hs, law)
-    if ra is None or rb is None:
-        return None
-    pa, pb = cols[a].period, cols[b].period
-    t = (cols[j].period - pa) / (pb - pa)
-    return (1.0 - t) * ra + t * rb
-
-
 def neighbours(active: list[bool], j: int) -> tuple[int | None, int | None]:
     """The nearest active columns below and above column ``j``."""
     lo = next((k for k in range(j - 1, -1, -1) if active[k]), None)
     hi = next((k for k in range(j + 1, len(active)) if active[k]), None)
     return lo, hi
-
-
-def estimate(
-    cols: list[Column], j: int, hs: float, ok: np.ndarray, r: np.ndarray, law: str
-) -> np.ndarray | None:
-    """The ratios (q,) of a case of column ``j`` at ``hs``: from its column's anchors
-    where it has some, else linear in the period between the nearest columns with
-    anchors on either side (the one side's at the diagram's edge); None: no column of
-    the heading has one."""
-    own = curve(cols[j], ok, r, hs, law)
-    if own is not None:
-        return own
-    has = [bool(c.anchors(ok)[1].size) for c in cols]
-    lo, hi = neighbours(has, j)
-    if lo is not None and hi is not None:
-        return between(cols, lo, hi, j, hs, ok, r, law)
-    side = lo if lo is not None else hi
-    return None if side is None else curve(cols[side], ok, r, hs, law)

@@ -16,12 +16,14 @@ apart (where an element starts to split; 2.4e-3 with the panels grouped by the s
 wave-velocity variance before).  Every case is solved by the linear model (the set's
 reused engine); the anchors compute the residuals too, and every other case gets its
 linear values times the ratios interpolated from the anchors
-(:func:`interpolate_corrections`, :func:`interpolate_along`; the layout and the laws
-in :mod:`stochcable.cases.anchor_layout`): in Hs between the anchors of its own
-column (:func:`correction`: a power law of Hs between two anchors whose corrections
-share a sign, else linear in Hs²), and a column without anchors linearly in the
-period between the nearest columns with anchors on either side (each at the case's
-Hs).
+(:func:`interpolate_corrections`; the layout in :mod:`stochcable.cases.anchor_layout`,
+the curves in :mod:`stochcable.cases.anchor_transfer`): in Hs between the anchors of
+its own column — the ratios a power of Hs between two anchors whose corrections share
+a sign, else linear in Hs² (:func:`correction`), or, with the adaptive anchors, the
+end tensions' residual moments powers of Hs (:mod:`stochcable.cases.anchor_moments`)
+or the column's parents' shape plus its departure from it, whichever meets the
+column's first middle Hs best — and a column without anchors linearly in the period
+between the nearest columns with anchors on either side (each at the case's Hs).
 
 **Adaptive anchors** (``run_cases``'s default, ``residual_tolerance`` =
 :data:`RESIDUAL_TOLERANCE`): a first pass computes, per heading, the columns of the
@@ -36,7 +38,10 @@ whose Hs reach beyond its computed neighbours' is computed; and in every compute
 column each interval between anchors more than one Hs step wide is checked at its
 middle Hs, computed, against the ratios interpolated in Hs between its ends.  The
 tolerance: ``residual_tolerance`` on σ, Tz and 3-h MPM, :data:`DAMAGE_TOLERANCE_FACTOR`
-× it on the end and the elements' damage rates.  So the error is measured where it is
+× it on the end damage rates and on the elements' relative to the line's largest
+damage rate of the case (:func:`~stochcable.cases.anchor_layout.element_scale`: what
+a designer reads of the line; an element with a hundredth of it is reported to its
+own damage within a hundred times that).  So the error is measured where it is
 made, not assumed: a correction that grows fast with Hs (the taut wire at Tp 10 s,
 +0.1 … +35 % on σ at end_b, ×3.4 on the end damage), or steps, gets
 anchors there.  Every case is solved once (:mod:`stochcable.cases.anchor_passes`):
@@ -57,13 +62,14 @@ as does a plan by default (the service's batch jobs, one pass).
 The along-line damage of a case that computes the residuals is that of the element
 tensions' corrected spectra (where the analysis computes them along the line,
 :mod:`stochcable.cases.along_spectra`); the other cases' is interpolated per element
-as the ends', and checked as the end damage.
+with the ends' (their ratios, by the curve their column uses).
 """
 
 from __future__ import annotations
 
 import math
 from collections import defaultdict
+from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
 
@@ -72,16 +78,16 @@ import numpy as np
 from stochcable.cases.anchor_layout import (
     DAMAGE_TOLERANCE_FACTOR,
     Column,
-    between,
     check_ratios,
     column_keys,
     correction_rows,
-    curve,
-    estimate,
+    element_scale,
     layout,
     neighbours,
     ratios,
 )
+from stochcable.cases.anchor_moments import MomentCoordinates
+from stochcable.cases.anchor_transfer import HeadingCurves
 from stochcable.cases.scatter import SeaState
 
 __all__ = [
@@ -194,6 +200,7 @@ def next_anchors(
     damage_ends: dict[str, np.ndarray],
     linear: dict[str, np.ndarray],
     along: tuple[dict[str, np.ndarray], dict[str, np.ndarray]] | None = None,
+    slopes: Mapping[str, float] | None = None,
 ) -> np.ndarray:
     """The cases whose residuals the adaptive anchors compute next (none: done).
 
@@ -226,24 +233,29 @@ def next_anchors(
         As in :func:`interpolate_corrections`.
     along : (damage, linear_along), optional
         The along-line damage rates checked too (:func:`interpolate_along`'s).
+    slopes : mapping of str to float, optional
+        The S-N slope of each line's curve (the end damage's proxy,
+        :mod:`stochcable.cases.anchor_moments`).
 
     Returns
     -------
     ndarray of bool, shape (n_states,)
     """
     r, scale = check_ratios(stats, damage_ends, linear, along)
+    moments = MomentCoordinates.of(r, linear, damage_ends, slopes)
     has = np.array([row.has_numbers for row in rows], dtype=bool)
     ok = np.asarray(exact, dtype=bool) & has
     out = np.zeros(len(states), dtype=bool)
     for cols in layout(states).values():
         active = [bool(np.any(exact[c.cases])) for c in cols]
-        for j in _period_checks(cols, active, ok, r, scale, tolerance):
+        curves = HeadingCurves(cols, ok, r, scale, "power", moments)
+        for j in _period_checks(curves, active, ok, tolerance):
             _open(cols[j], span, out)
         for j in _beyond_neighbours(cols, active):
             _open(cols[j], span, out)
-        for col, on in zip(cols, active):
+        for j, on in enumerate(active):
             if on:
-                _hs_checks(col, span, tolerance, exact, has, r, scale, out)
+                _hs_checks(curves, j, span, tolerance, exact, has, out)
     return out & ~np.asarray(exact, dtype=bool)
 
 
@@ -252,22 +264,18 @@ def _miss(guess: np.ndarray | None, got: np.ndarray, scale: np.ndarray) -> float
     (inf without a guess). [-]"""
     if guess is None:
         return math.inf
-    live = got != 0
+    live = (got != 0) & np.isfinite(scale)
     if not np.any(live):
         return 0.0
     return float(np.max(np.abs(guess[live] / got[live] - 1.0) / scale[live]))
 
 
 def _period_checks(
-    cols: list[Column],
-    active: list[bool],
-    ok: np.ndarray,
-    r: np.ndarray,
-    scale: np.ndarray,
-    tolerance: float,
+    curves: HeadingCurves, active: list[bool], ok: np.ndarray, tolerance: float
 ) -> list[int]:
     """The columns of one heading to compute next by the checks in the period
     (:func:`next_anchors`)."""
+    cols, r, scale = curves.cols, curves.r, curves.scale
     out = []
     stack = _roots(len(cols), None)
     while stack:
@@ -281,9 +289,9 @@ def _period_checks(
         hs, idx = cols[m].anchors(ok)
         worst = math.inf if idx.size == 0 else 0.0
         for h, i in zip(hs, idx):
-            worst = max(worst, _miss(between(cols, a, b, m, h, ok, r, "power"), r[i], scale))
+            worst = max(worst, _miss(curves.between(a, b, m, h), r[i], scale[i]))
             for k in (a, b):  # (flat: a step between them misses by at most the spread)
-                spread = _miss(curve(cols[k], ok, r, h, "power"), r[i], scale)
+                spread = _miss(curves.curve(k, h), r[i], scale[i])
                 worst = max(worst, spread / PERIOD_SPREAD)
         if worst > tolerance:
             stack += [(a, m), (m, b)]
@@ -309,18 +317,18 @@ def _beyond_neighbours(cols: list[Column], active: list[bool]) -> list[int]:
 
 
 def _hs_checks(
-    col: Column,
+    curves: HeadingCurves,
+    j: int,
     span: int | None,
     tolerance: float,
     exact: np.ndarray,
     has: np.ndarray,
-    r: np.ndarray,
-    scale: np.ndarray,
     out: np.ndarray,
 ) -> None:
-    """Mark in ``out`` the cases of a computed column its checks in Hs ask for next
-    (:func:`next_anchors`)."""
-    hs, members = col.hs, col.members
+    """Mark in ``out`` the cases of computed column ``j`` its checks in Hs ask for
+    next (:func:`next_anchors`), each of the curve the column uses
+    (:class:`~stochcable.cases.anchor_transfer.HeadingCurves`)."""
+    hs, members = curves.cols[j].hs, curves.cols[j].members
     stack = _roots(len(hs), span)
     while stack:
         a, b = stack.pop()
@@ -334,8 +342,7 @@ def _hs_checks(
         if not (has[ia] and has[im] and has[ib]):
             stack += [(a, m), (m, b)]
             continue
-        guess = correction_rows(hs[m], hs[[a, b]], r[[ia, ib]])
-        if _miss(guess, r[im], scale) > tolerance:
+        if _miss(curves.interval(j, a, b), curves.r[im], curves.scale[im]) > tolerance:
             stack += [(a, m), (m, b)]
 
 
@@ -347,10 +354,13 @@ def interpolate_corrections(
     damage_ends: dict[str, np.ndarray],
     linear: dict[str, np.ndarray],
     law: str = "hs2",
+    along: tuple[dict[str, np.ndarray], dict[str, np.ndarray]] | None = None,
+    slopes: Mapping[str, float] | None = None,
 ) -> None:
     """Give the cases whose residuals were not computed the anchors' corrections, in
     place (module notes; ``law`` of :func:`correction`: "power" for the adaptive
-    anchors, "hs2" for the fixed ones).
+    anchors, with the transferred curves of
+    :class:`~stochcable.cases.anchor_transfer.HeadingCurves`, "hs2" for the fixed ones).
 
     Parameters
     ----------
@@ -367,9 +377,18 @@ def interpolate_corrections(
         ``[line]`` shape (n, 2): end damage rates, corrected likewise.
     linear : dict of ndarray
         ``[line]`` shape (n, 2, 4): per end the linear σ, Tz, MPM and damage rate.
+    along : (damage, linear_along), optional
+        The along-line damage rates corrected too, in place (``damage[line]``
+        (n, 2 + n_el): the element columns; ``linear_along[line]`` (n, n_el) the
+        linear model's, NaN where not formed: such a case keeps its own); the columns'
+        curves are chosen on every ratio at once (ends and elements), as the checks
+        test them.
+    slopes : mapping of str to float, optional
+        As in :func:`next_anchors`.
     """
-    r, _ = check_ratios(stats, damage_ends, linear)
-    est = _estimates(states, exact, rows, r, law)
+    r, scale = check_ratios(stats, damage_ends, linear, along)
+    moments = MomentCoordinates.of(r, linear, damage_ends, slopes)
+    est = _estimates(states, exact, rows, r, scale, law, moments)
     for i, got in est.items():
         if got is None:
             rows[i] = replace(
@@ -390,23 +409,37 @@ def interpolate_corrections(
                 if name in damage_ends:
                     damage_ends[name][i, e] = lin[i, e, 3] * got[k]
                     k += 1
+        if along is None:
+            continue
+        damage, linear_along = along
+        for name, lin in linear_along.items():
+            n_el = lin.shape[1]
+            if np.all(np.isfinite(lin[i])):  # (anchors without along-line residuals: 1)
+                damage[name][i, 2:] = lin[i] * got[k : k + n_el]
+            k += n_el
 
 
 def _estimates(
-    states: tuple[SeaState, ...], exact: np.ndarray, rows: list[Any], r: np.ndarray, law: str
+    states: tuple[SeaState, ...],
+    exact: np.ndarray,
+    rows: list[Any],
+    r: np.ndarray,
+    scale: np.ndarray,
+    law: str,
+    moments: MomentCoordinates | None = None,
 ) -> dict[int, np.ndarray | None]:
-    """The interpolated ratios (:func:`~stochcable.cases.anchor_layout.estimate`) of
-    every case with a response whose residuals were not computed."""
+    """The interpolated ratios (:meth:`HeadingCurves.estimate`) of every case with a
+    response whose residuals were not computed."""
     has = np.array([row.has_numbers for row in rows], dtype=bool)
     ok = np.asarray(exact, dtype=bool) & has
     out: dict[int, np.ndarray | None] = {}
     for cols in layout(states).values():
+        curves = HeadingCurves(cols, ok, r, scale, law, moments)
         for j, col in enumerate(cols):
             for h, members in zip(col.hs, col.members):
                 todo = [i for i in members if not exact[i] and has[i]]
                 if todo:
-                    got = estimate(cols, j, float(h), ok, r, law)
-                    out.update(dict.fromkeys(todo, got))
+                    out.update(dict.fromkeys(todo, curves.estimate(j, float(h))))
     return out
 
 
@@ -419,16 +452,18 @@ def interpolate_along(
     law: str = "hs2",
 ) -> None:
     """The along-line damage rates of the cases whose residuals were not computed, in
-    place: per element, the linear damage times the ratio corrected/linear of the
-    anchors interpolated as :func:`interpolate_corrections` does the ends'
-    (``damage[line]`` (n, 2 + n_el): the element columns; ``linear_along`` (n, n_el)
-    the linear model's along-line damage, NaN where not formed).  Anchors without
-    along-line residuals (``along_line`` not computed: the ratio 1) leave the linear
-    damage."""
+    place, from the elements' ratios alone (each element's own curves; the default
+    set corrects them with the ends', :func:`interpolate_corrections`'s ``along``):
+    per element, the linear damage times the ratio corrected/linear of the anchors
+    interpolated as the ends' (``damage[line]`` (n, 2 + n_el): the element columns;
+    ``linear_along`` (n, n_el) the linear model's along-line damage, NaN where not
+    formed).  Anchors without along-line residuals (``along_line`` not computed: the
+    ratio 1) leave the linear damage."""
     for name, lin in linear_along.items():
         d = damage[name][:, 2:]
         r = ratios(d, lin)
-        for i, got in _estimates(states, exact, rows, r, law).items():
+        scale = element_scale(damage[name])
+        for i, got in _estimates(states, exact, rows, r, scale, law).items():
             if got is not None and np.all(np.isfinite(lin[i])):
                 d[i] = lin[i] * got
 

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from stochcable.cases.anchor_moments import damage_slopes
 from stochcable.cases.anchor_passes import neighbour_starts, pass_chunks, split_last_pass
 from stochcable.cases.chunk import ENDS, CaseRow, ChunkResult, set_engine, solve_chunk
 from stochcable.cases.display import case_set_html, case_set_text
@@ -28,7 +29,6 @@ from stochcable.cases.plan import CasePlan, default_chunk_size, plan_cases
 from stochcable.cases.residual_anchors import (
     RESIDUAL_TOLERANCE,
     first_anchors,
-    interpolate_along,
     interpolate_corrections,
     next_anchors,
 )
@@ -180,9 +180,10 @@ def run_cases(
         (:mod:`stochcable.cases.residual_anchors`): per heading the periods are
         bisected from the shortest, middle and longest, each computed period's Hs from
         its smallest, middle and largest, until the corrections interpolated at every
-        checked middle (σ, Tz and 3-h MPM over the linear ones; the end and element
-        damage rates', with 3 × the tolerance) are within ``residual_tolerance`` of
-        the computed ones; the other cases get interpolated corrections, and a
+        checked middle (σ, Tz and 3-h MPM over the linear ones; the end damage rates',
+        with 3 × the tolerance, and the elements' with 3 × the tolerance relative to
+        the line's largest damage rate of the case) are within ``residual_tolerance``
+        of the computed ones; the other cases get interpolated corrections, and a
         PhysicsWarning says how many cases computed them.  Default
         :data:`~stochcable.cases.residual_anchors.RESIDUAL_TOLERANCE` (2e-3; the
         measured error on the chain, the taut wire and Tuah's single leg is in
@@ -272,7 +273,7 @@ def _anchored(
         m = _merge(plan, results)
         todo = np.flatnonzero(next_anchors(
             states, plan.residual_span, tol, exact, m.rows, m.stats, m.d_ends, m.linear,
-            (m.damage, m.linear_along),
+            (m.damage, m.linear_along), damage_slopes(plan.fatigue),
         ))  # fmt: skip
         starts = neighbour_starts(states, todo, {i: x for i, x in known.items() if exact[i]})
 
@@ -332,8 +333,11 @@ def assemble_cases(plan: CasePlan, results: Iterable[ChunkResult]) -> CaseSetRes
     d_ends = m.d_ends
     # the residuals' corrections of the cases that did not compute them
     law = "hs2" if plan.residual_tolerance is None else "power"
-    interpolate_corrections(scatter.states, m.exact, rows, stats, d_ends, m.linear, law)
-    interpolate_along(scatter.states, m.exact, rows, damage, m.linear_along, law)
+    along = (damage, m.linear_along)
+    slopes = damage_slopes(settings)
+    interpolate_corrections(
+        scatter.states, m.exact, rows, stats, d_ends, m.linear, law, along, slopes
+    )
     _warn_interpolated(plan, m.exact)
     s_el = m.s_el
     d_along = {ln: damage[ln][:, 2:] for ln in names}
@@ -375,7 +379,13 @@ def _warn_interpolated(plan: CasePlan, exact: np.ndarray) -> None:
         + f" computed on {k} of the {n} cases ({how}); the other {n - k} cases' end "
         "statistics, end damage and along-line damage are their linear values times "
         "the computed cases' corrections interpolated in Hs along a period and linearly "
-        "in the period between periods (residual_tolerance=None computes every case)",
+        "in the period between periods ("
+        + (
+            "the elements' damage checked relative to the line's largest; "
+            if plan.residual_tolerance is not None
+            else ""
+        )
+        + "residual_tolerance=None computes every case)",
         PhysicsWarning,
     )
 

@@ -313,12 +313,12 @@ def test_adaptive_set_against_every_case_computed():
         np.testing.assert_allclose(a[:, 1:], b[:, 1:], rtol=3e-3)
     d, dr = got.damage_rate_ends["wire"], ref.damage_rate_ends["wire"]
     np.testing.assert_allclose(d, dr, rtol=1e-2)
-    # the along-line damage from the elements' corrected spectra, interpolated as the
-    # ends' (the checks test the ends only): measured 4.1e-3 from every case computed,
-    # where the linear model's misses by 85 %; the end damage's 1e-2
-    np.testing.assert_allclose(
-        got.damage_rate_along["wire"], ref.damage_rate_along["wire"], rtol=1e-2
-    )
+    # the along-line damage from the elements' corrected spectra, interpolated with
+    # the ends' and checked relative to the line's largest damage rate of the case:
+    # within the end damage's 1e-2 of it (the linear model misses by 85 %)
+    da, dr = got.damage_rate_along["wire"], ref.damage_rate_along["wire"]
+    big = np.max(np.column_stack([ref.damage_rate_ends["wire"], dr]), axis=1)
+    assert np.max(np.abs(da - dr) / big[:, None]) < 1e-2
 
 
 def test_adaptive_set_is_the_same_whatever_the_executor_and_chunking():
@@ -393,16 +393,39 @@ def test_adaptive_sets_across_diagrams(name, hs, tps, fatigue):
     """Three lines across their diagrams (Tuah's leg at the linearization tolerance
     1e-4, not its scene's 1e-2: the ratios carry that noise, and the checks are never
     finer than it): the default set within 3e-3 on σ, Tz and MPM and 1e-2 on the end
-    damage rate of every case computed (measured: docs/benchmarks/cases.md)."""
+    damage rate of every case computed, and 1e-2 of the line's largest damage rate of
+    the case on the elements' (measured: docs/benchmarks/cases.md); the taut wire,
+    whose periods near resonance interpolate the residual moments, computes at most
+    half its cases (measured 20 of 52; 31 with the ratios' law alone)."""
     rows = [{"hs": float(h), "tp": tp, "hours": 1.0} for tp in tps for h in hs]
     sd = scatter_from_rows(rows)
     doc = _example(name, tolerance=1e-4)
+    counted = {}
+    import stochcable.cases.run as run_mod
+
+    real = run_mod.next_anchors
+
+    def spy(*a, **k):
+        out = real(*a, **k)
+        counted["exact"] = a[3] | out
+        return out
+
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ref = run_cases(doc, sd, fatigue=fatigue, residual_tolerance=None)
-        got = run_cases(doc, sd, fatigue=fatigue)
-    stats, damage = _misses(got, ref, ref.lines[0])
+        run_mod.next_anchors = spy
+        try:
+            got = run_cases(doc, sd, fatigue=fatigue)
+        finally:
+            run_mod.next_anchors = real
+    line = ref.lines[0]
+    stats, damage = _misses(got, ref, line)
     assert stats < 3e-3 and damage < 1e-2
+    a, b = got.damage_rate_along[line], ref.damage_rate_along[line]
+    big = np.max(np.column_stack([ref.damage_rate_ends[line], b]), axis=1)
+    assert np.max(np.abs(a - b) / big[:, None]) < 1e-2
+    if name == "taut_wire":
+        assert counted["exact"].sum() <= len(rows) // 2
 
 
 def test_next_anchors_bisect_around_a_case_without_response():
