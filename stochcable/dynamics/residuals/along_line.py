@@ -189,8 +189,9 @@ def _columns_of(transfer: np.ndarray, h: np.ndarray) -> np.ndarray | None:
     if h.shape[0] != transfer.shape[0] or h.shape[2] < transfer.shape[2]:
         return None
     h = h[:, :, : transfer.shape[2]]
-    first = {np.ascontiguousarray(h[:, j, 0]).tobytes(): j for j in range(h.shape[1])}
-    keys = [np.ascontiguousarray(transfer[:, c, 0]).tobytes() for c in range(transfer.shape[1])]
+    # (the first lines' bytes: rows of contiguous (n_all, n_out) and (n, n_out) arrays)
+    first = {r.tobytes(): j for j, r in enumerate(np.ascontiguousarray(h[:, :, 0].T))}
+    keys = [r.tobytes() for r in np.ascontiguousarray(transfer[:, :, 0].T)]
     if len(first) == h.shape[1] and all(k in first for k in keys):
         kept = np.array([first[k] for k in keys], dtype=int)
         if np.array_equal(h[:, kept], transfer):
