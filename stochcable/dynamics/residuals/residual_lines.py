@@ -149,12 +149,14 @@ class UniformGrid:
         E[x(t) y(t + τ)] = Σ_j Re(Σ_c x̄_{c,j} y_{c,j} e^{iω_j τ}) (:func:`cross_covariance`)."""
         n_ch, n_x, _ = values.shape
         amp = np.sqrt(np.asarray(spectra, dtype=float) * trapezoid_weights(self.omega)[None])
-        out = np.zeros((n_ch, self.ranks, n_x, self.n_j), dtype=complex)
         live = self.live
-        out[:, self.rank[live], :, self.index[live]] = np.moveaxis(
-            (values * amp[:, None, :])[:, :, live], 2, 0
-        )
-        return out.reshape(n_ch * self.ranks, n_x, self.n_j)
+        # each live frequency's (rank, line) as one index of a (rank·line, n_ch, n_x)
+        # scratch (one leading advanced index: a plain row scatter), then transposed
+        at = self.rank[live] * self.n_j + self.index[live]
+        out = np.zeros((self.ranks * self.n_j, n_ch, n_x), dtype=complex)
+        out[at] = np.moveaxis((values * amp[:, None, :])[:, :, live], 2, 0)
+        out = out.reshape(self.ranks, self.n_j, n_ch, n_x).transpose(2, 0, 3, 1)
+        return np.ascontiguousarray(out).reshape(n_ch * self.ranks, n_x, self.n_j)
 
 
 def uniform_grid(
