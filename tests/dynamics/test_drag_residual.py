@@ -359,3 +359,30 @@ def test_uniform_grid_lines_are_the_former_scatter():
         got = grid.lines(values, spectra)
         assert grid.ranks > 1 and np.array_equal(got, ref.reshape(2 * grid.ranks, 5, grid.n_j))
     assert not grid.live.all()
+
+
+def test_misfit_loads_as_columns_of_the_components_loads(monkeypatch):
+    """The misfit's unit loads taken as the columns of the drag components' panel loads
+    (misfit_loads(unit_all=...)) are the loads formed for its panels alone, bitwise,
+    on the chain and the inclined guy (their split elements: δB on both directions)."""
+    import stochcable.dynamics.residuals.drag_misfit as dm
+
+    orig = dm.misfit_loads
+    seen = []
+
+    def both(model, seg, groups, live, parts, misfit, unit_all=None):
+        got = orig(model, seg, groups, live, parts, misfit, unit_all)
+        ref = orig(model, seg, groups, live, parts, misfit)
+        seen.append(got is not None and unit_all is not None)
+        assert (got is None) == (ref is None)
+        if got is not None:
+            assert all(np.array_equal(a, b) for a, b in zip(got, ref, strict=True))
+        return got
+
+    monkeypatch.setattr(dm, "misfit_loads", both)
+    lines = residual_cost.lines(guy=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name in ("chain", "guy"):
+            analyze(residual_cost.with_variant(lines[name], "drag"))
+    assert sum(seen) == 2

@@ -325,6 +325,7 @@ def drag_residual(
         coupled,
         [(c, src) for _, c, src in others],
         MISFIT_EXACT,
+        comp.unit,
     )
     out = residual_record(
         own * cf[:, :top], comp.w_out[:top], w, std, order, len(comp.groups), linear

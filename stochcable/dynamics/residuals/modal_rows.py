@@ -99,12 +99,25 @@ class ModalRows:
             dyn = np.zeros(z.shape[1], dtype=bool) if rc is None else np.any(rc[1:] != 0, (0, 1))
             marks = (dyn, np.any(ends != 0, axis=(0, 2)))
         self.marks = marks
-        self._dyn, self._ends = (_rows_of(m) for m in marks)
+        self._rows: tuple | None = None  # (the marked rows, when first asked: _marked)
+
+    def _marked(self) -> tuple[Any, Any]:
+        """The rows with r₁, r₂ and those with ê (:func:`_rows_of` of the marks)."""
+        if self._rows is None:
+            self._rows = (_rows_of(self.marks[0]), _rows_of(self.marks[1]))
+        return self._rows
 
     def __getitem__(self, key: Any) -> ModalRows:
         rows, lines = (slice(None), key[1]) if isinstance(key, tuple) else (key, slice(None))
         if isinstance(key, tuple) and key[0] is not Ellipsis:
             raise IndexError("ModalRows: g[rows] or g[..., lines] only")
+        if isinstance(rows, slice) and rows == slice(None):  # (the lines only: the same rows)
+            out = ModalRows(
+                self.phi, self.z[:, :, lines], self.w[lines], self.rc, self.ends, self.n_nodes,
+                self.marks,
+            )  # fmt: skip
+            out._rows = self._rows
+            return out
         rc = None if self.rc is None else self.rc[:, :, rows]
         return ModalRows(
             self.phi, self.z[:, rows][:, :, lines], self.w[lines], rc,
@@ -115,7 +128,7 @@ class ModalRows:
         """``x`` (X, R, n_w) plus r₀ − ω²r₁ + iωr₂ of static rows ``rc`` (3, X, R), in
         place (r₁, r₂ on the end rows only)."""
         x += rc[0][..., None]
-        dyn = self._dyn
+        dyn = self._marked()[0]
         if dyn is not None:
             w = self.w
             x[:, dyn] += rc[2][:, dyn, None] * (1j * w) - rc[1][:, dyn, None] * (w * w)
@@ -152,7 +165,7 @@ class ModalRows:
             a = u_f @ self.phi
         zt = np.ascontiguousarray(self.z).reshape(m, -1)
         h = real_gemm(a, zt).reshape(a.shape[0], n_r, n_w)  # (L, R, n_w)
-        if (rows := self._ends) is not None:  # (ê on the end rows only: the others' are 0)
+        if (rows := self._marked()[1]) is not None:  # (ê on the end rows only: the others' are 0)
             end = self.ends[:, rows]
             h[:, rows] += (u_end[0] @ end[0].T + u_end[1] @ end[1].T)[..., None]
         if self.rc is not None:

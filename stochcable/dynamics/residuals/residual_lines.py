@@ -49,6 +49,7 @@ __all__ = [
     "PairLines",
     "SharedRows",
     "along",
+    "along_each",
     "band_stack",
     "covariance_lines",
     "dense_outputs",
@@ -401,9 +402,18 @@ def along(x: np.ndarray, vec: np.ndarray) -> np.ndarray:
     """Σ_d x[w, e, d, c]·vec[e, d] of per-element vectors ``x`` (n_w, n_e, k, n_ch) along
     ``vec`` (n_e, k): shape (n_ch, n_e, n_w), as ``np.einsum("wedc,ed->cew", x, vec)``
     by one batched product per element (4× faster on the chain's pieces)."""
+    return along_each(x, [vec])[0]
+
+
+def along_each(x: np.ndarray, vecs: list[np.ndarray]) -> list[np.ndarray]:
+    """:func:`along` of ``x`` along each of ``vecs`` (the per-element layout of ``x``
+    formed once for them all): a list of (n_ch, n_e, n_w)."""
     x_t = np.ascontiguousarray(np.transpose(x, (1, 3, 0, 2)))  # (n_e, n_ch, n_w, k)
-    v = np.asarray(vec)[:, None, :, None].astype(x_t.dtype)
-    return np.transpose(x_t @ v, (1, 0, 2, 3))[..., 0]
+    out = []
+    for vec in vecs:
+        v = np.asarray(vec)[:, None, :, None].astype(x_t.dtype)
+        out.append(np.transpose(x_t @ v, (1, 0, 2, 3))[..., 0])
+    return out
 
 
 def fft_length(n: int) -> int:
