@@ -109,3 +109,25 @@ def test_squares_alone_are_those_formed_with_the_moments(depth, monkeypatch):
     np.testing.assert_array_equal(src.square(), both)
     np.testing.assert_array_equal(src.square(slice(40, 77)), both[:, 40:77])
     assert np.all(both[:, :, ek.wet_fraction == 0.0] == 0.0) and np.all(both >= 0.0)
+
+
+@pytest.mark.parametrize("depth", [60.0, np.inf], ids=["depth60", "deep"])
+def test_velocity_alone_is_the_kinematics_velocity(depth, monkeypatch) -> None:
+    """element_wave_velocity (the moments formed without the mean square) gives
+    element_wave_kinematics(...).velocity bitwise — elements crossing the waterline and
+    dry ones, ω = 0 — and a source's moments alone (KinematicsBlocks.moments) those it
+    forms with the squares; its arguments are checked as the kinematics' are."""
+    from stochcable.dynamics.loads.element_kinematics import element_wave_velocity
+    from stochcable.errors import InputError
+
+    w = np.linspace(0.0, 4.0, 61)
+    ref = element_wave_kinematics(w, _line(), heading=0.4, depth=depth)
+    got = element_wave_velocity(w, _line(), heading=0.4, depth=depth)
+    assert np.array_equal(got, ref.velocity) and np.any(got != 0.0)
+    monkeypatch.setenv("STOCHCABLE_WORKING_MEMORY_MB", "0.01")  # (a source kept, no parts)
+    src = element_wave_kinematics(w, _line(), heading=0.4, depth=depth).moments.source
+    for freq in (slice(None), slice(3, 40), np.array([0, 9, 60])):
+        parts, square = src.form(freq)
+        assert np.array_equal(src.moments(freq), parts) and square is not None
+    with pytest.raises(InputError, match="depth"):
+        element_wave_velocity(w, _line(), heading=0.4, depth=30.0)
