@@ -131,3 +131,20 @@ def test_velocity_alone_is_the_kinematics_velocity(depth, monkeypatch) -> None:
         assert np.array_equal(src.moments(freq), parts) and square is not None
     with pytest.raises(InputError, match="depth"):
         element_wave_velocity(w, _line(), heading=0.4, depth=30.0)
+
+
+def test_end_square_weighted_sum_kept_for_the_same_weights() -> None:
+    """EndSquare.weighted keeps its last sum: asked again with equal weights (another
+    array) it returns the same numbers as a fresh evaluation, as a copy (the caller's
+    in-place sums do not reach the kept one); other weights are summed anew."""
+    w = np.linspace(0.0, 4.0, 61)
+    ends = element_wave_kinematics(w, _line(), heading=0.4, depth=60.0).ends
+    fresh = element_wave_kinematics(w, _line(), heading=0.4, depth=60.0).ends
+    q = np.random.default_rng(1).uniform(size=w.size)
+    first = ends.weighted(q)
+    first += 1.0  # (a caller's in-place sum)
+    again = ends.weighted(q.copy())
+    assert np.array_equal(again, fresh.weighted(q)) and np.any(again != first)
+    other = ends.weighted(2.0 * q)
+    assert np.array_equal(other, fresh.weighted(2.0 * q))
+    assert np.array_equal(ends.weighted(q), again)
