@@ -169,8 +169,12 @@ class ModalRows:
             end = self.ends[:, rows]
             h[:, rows] += (u_end[0] @ end[0].T + u_end[1] @ end[1].T)[..., None]
         if self.rc is not None:
-            three = np.transpose(self.rc, (1, 0, 2)).reshape(self.rc.shape[1], -1)
-            rc = np.asarray(u_f @ three).reshape(-1, 3, n_r).transpose(1, 0, 2)  # (3, L, R)
+            three = np.ascontiguousarray(np.transpose(self.rc, (1, 0, 2))).reshape(
+                self.rc.shape[1], -1
+            )
+            # (the real loads times the complex rows: one real product, dense cases)
+            prod = u_f @ three if sparse.issparse(u_f) else real_gemm(u_f, three)
+            rc = np.asarray(prod).reshape(-1, 3, n_r).transpose(1, 0, 2)  # (3, L, R)
             self._add_static(h, rc)
         return np.transpose(h, (1, 0, 2))
 
