@@ -20,7 +20,7 @@ the minor page faults (``ru_minflt``) of the fastest round and their median.
 
 Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
 analysis before issue 31; with the end, element-tension and node-motion residuals now
-chain 2.1×, taut 1.6–1.7×, deep 1.7–1.8×, two-segment 1.6× (load ≈ 2): exact steps
+chain 1.9–2.0×, taut 1.6×, deep 1.7×, two-segment 1.6× (load ≈ 1.5): exact steps
 (adjoint end tensions, pairs f ≥ e in cache-sized blocks, the lag grid at the alias
 bound, one end influence, the element and node rows in the same solve, one dense
 matrix of pair lines per kind) and approximate ones (Hermite orders 2 and 3 carrying

@@ -290,3 +290,57 @@ def test_capture_outputs_read_the_lines_as_views():
         wide = capture_outputs(cap, t, sel, complex)
         ref = dense_pair_outputs(g[sel].astype(complex), t)
         assert np.allclose(wide, ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max(initial=0.0))
+
+
+def _columns_by_column_bytes(transfer: np.ndarray, h: np.ndarray) -> np.ndarray | None:
+    """The former matching of _columns_of: each column's first line and then the whole
+    column as the bytes of its own contiguous copy."""
+    if h.shape[0] != transfer.shape[0] or h.shape[2] < transfer.shape[2]:
+        return None
+    h = h[:, :, : transfer.shape[2]]
+    first = {np.ascontiguousarray(h[:, j, 0]).tobytes(): j for j in range(h.shape[1])}
+    keys = [np.ascontiguousarray(transfer[:, c, 0]).tobytes() for c in range(transfer.shape[1])]
+    if len(first) == h.shape[1] and all(k in first for k in keys):
+        kept = np.array([first[k] for k in keys], dtype=int)
+        if np.array_equal(h[:, kept], transfer):
+            return kept
+    cols = [np.ascontiguousarray(transfer[:, c]).tobytes() for c in range(transfer.shape[1])]
+    index = {np.ascontiguousarray(h[:, j]).tobytes(): j for j in range(h.shape[1])}
+    if all(c in index for c in cols):
+        return np.array([index[c] for c in cols], dtype=int)
+    return None
+
+
+def test_columns_of_match_the_former_column_by_column_bytes():
+    """The tap's matching of a contraction's transfer to its load transfer (the first
+    lines' bytes taken as rows of one contiguous array) gives the former per-column
+    matching's columns: a permuted subset of a transposed (load-major) ``h`` on its
+    leading lines, first lines that repeat (whole columns then), a column not in ``h``
+    and a transfer longer than ``h`` (None)."""
+    from stochcable.dynamics.residuals.along_line import _columns_of
+
+    rng = np.random.default_rng(11)
+    n_out, n_all, n_h = 2, 30, 40
+    raw = rng.normal(size=(n_all, n_out, n_h)) + 1j * rng.normal(size=(n_all, n_out, n_h))
+    h = np.transpose(raw, (1, 0, 2))  # (the load transfer's layout: a transposed view)
+    pick = rng.permutation(n_all)[:17]
+    repeat = h.copy()
+    repeat[:, 5, 0] = repeat[:, 9, 0]  # (two first lines equal, the columns not)
+    other = h[:, pick, :25].copy()
+    other[1, 3, 7] += 1.0  # (a column that is not in h)
+    cases = [
+        (np.ascontiguousarray(h[:, pick, :25]), h),
+        (np.ascontiguousarray(h[:, pick]), h),
+        (repeat[:, [9, 5, 2], :12].copy(), repeat),
+        (other, h),
+        (np.ascontiguousarray(h[:, pick]), h[:, :, :20]),
+    ]
+    for transfer, hh in cases:
+        ref = _columns_by_column_bytes(transfer, hh)
+        got = _columns_of(transfer, hh)
+        assert (got is None) == (ref is None)
+        if ref is not None:
+            assert np.array_equal(got, ref)
+    assert np.array_equal(_columns_of(*cases[0]), pick)
+    assert np.array_equal(_columns_of(*cases[2]), [9, 5, 2])
+    assert _columns_of(*cases[3]) is None

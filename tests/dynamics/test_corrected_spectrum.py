@@ -142,3 +142,67 @@ def test_fatigue_damage_of_the_corrected_spectrum(chain, method):
         np.testing.assert_array_equal(dens0, plain.end_tension_spectrum(end))
     assert "corrected_spectra" not in plain.to_document()
     assert math.isclose(plain.end_b.std, line.linear["end_b"].std)
+
+
+def _former_spectrum_with_lines(omega, linear, parts):
+    """The former one-response form of spectrum_with_lines (its grid formed per call)."""
+    from stochcable.dynamics.model.blocks import trapezoid_weights
+    from stochcable.dynamics.residuals.corrected_spectrum import _with_steps
+
+    w = np.asarray(omega, dtype=float)
+    q = trapezoid_weights(w)
+    base = np.asarray(linear, dtype=float).copy()
+    target = float(np.sum(q * base))
+    uniform = []
+    for om, v in parts:
+        om, v = np.asarray(om, dtype=float), np.asarray(v, dtype=float)
+        target += float(np.sum(v))
+        if om.size == w.size and np.array_equal(om, w):
+            base += np.divide(v, q, out=np.zeros_like(v), where=q > 0)
+        elif om.size:
+            step = float(om[1] - om[0]) if om.size > 1 else float(om[0])
+            uniform.append((om, v / step))
+    target = max(target, 0.0)
+    outside = [om[(om < w[0]) | (om > w[-1])] for om, _ in uniform]
+    grid = np.union1d(w, np.concatenate(outside)) if outside else w
+    grid = _with_steps(grid, w)
+    dens = np.zeros(grid.size)
+    dens[np.searchsorted(grid, w)] = np.maximum(base, 0.0)
+    res = np.zeros(grid.size)
+    for om, d in uniform:
+        res += np.interp(grid, om, d, left=d[0], right=0.0)
+    qg = trapezoid_weights(grid)
+    area = float(np.sum(qg * res))
+    scale = (target - float(np.sum(qg * dens))) / area if area > 0 else 1.0
+    return grid, np.maximum(dens + scale * res, 0.0), scale
+
+
+def test_both_ends_on_one_grid_are_the_former_per_end_spectra(chain):
+    """corrected_spectra (the extended grid formed once for both ends) gives each
+    end's former per-end spectrum bitwise: the chain's records (uniform lines beyond
+    the analysis band, the drag misfit on the analysis grid), and synthetic ones with a
+    single line, an empty part and a negative misfit below the linear density."""
+    from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectra
+
+    on, _ = chain
+    w = on.omega
+    dens = {e: np.asarray(on.end_tension_spectrum(e), dtype=float) for e in ENDS}
+    records = [r for r in on.residuals.values() if r.computed]
+    rng = np.random.default_rng(9)
+    synthetic = ResidualRecord.from_variances(
+        {e: 1.0 for e in ENDS}, {e: 1.0 for e in ENDS}, {e: 1.0 for e in ENDS}, 2, 1,
+        (
+            (np.array([w[-1] * 1.7]), {e: np.array([3.0]) for e in ENDS}),
+            (np.zeros(0), {e: np.zeros(0) for e in ENDS}),
+            (w, {e: -50.0 * rng.uniform(size=w.size) * dens[e] for e in ENDS}),
+        ),
+    )  # fmt: skip
+    for recs in (records, records + [synthetic]):
+        got = corrected_spectra(w, dens, recs)
+        for e in ENDS:
+            parts = [(om, lines[e]) for r in recs for om, lines in r.lines]
+            grid, density, scale = _former_spectrum_with_lines(w, dens[e], parts)
+            assert np.array_equal(got[e].omega, grid) and np.array_equal(got[e].density, density)
+            assert got[e].scale == scale
+            one = corrected_spectrum(w, dens[e], e, recs)
+            assert np.array_equal(one.density, density) and one.scale == scale

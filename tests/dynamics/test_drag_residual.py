@@ -311,3 +311,78 @@ def test_end_statistics_carry_the_residuals_moments():
         plain = analyze(doc).lines["leg1"]
     assert plain.linear is None and "linear" not in plain.to_document()
     assert plain.end_b.std == line.linear["end_b"].std
+
+
+def test_bent_lines_are_the_former_rolled_neighbours():
+    """The cells' lines (drag_residual.bent_lines: the bent lines and their neighbours
+    by slices) equal the former form with the mask rolled both ways (np.roll, whose
+    wrap-around adds nothing: the first and last lines never bend themselves), on
+    random powers with bends at the edges, none, and grids of 0–3 lines."""
+    rng = np.random.default_rng(4)
+
+    def former(power: np.ndarray, bend: float) -> np.ndarray:
+        logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
+        out = np.zeros(power.shape[1], dtype=bool)
+        out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
+        return out | np.roll(out, 1) | np.roll(out, -1)
+
+    cases = [np.exp(rng.normal(scale=s, size=(3, n))) for s in (0.01, 0.3, 2.0) for n in (40, 7)]
+    cases += [np.ones((2, n)) for n in range(4)] + [np.zeros((2, 9))]
+    spike = np.ones((2, 12))
+    spike[0, 1], spike[1, -2] = 50.0, 50.0  # (bends next to both edges)
+    cases.append(spike)
+    for power in cases:
+        h = np.sqrt(power)[:, None, :] * np.exp(1j * rng.uniform(size=power.shape))[:, None, :]
+        for bend in (0.0, dr.CELL_BEND, 5.0):
+            ref = former(power, bend)
+            assert np.array_equal(dr.bent_lines(h, bend, power), ref)
+            summed = former(np.sum(np.abs(h) ** 2, axis=1), bend)
+            assert np.array_equal(dr.bent_lines(h, bend), summed)
+    assert dr.bent_lines(spike[:, None], 1.0, spike)[[0, 1, 2, -3, -2, -1]].all()
+
+
+def test_uniform_grid_lines_are_the_former_scatter():
+    """UniformGrid.lines (each live frequency's rank and line as one row index of a
+    scratch array) equals the former two-index scatter into (n_ch, ranks, n_x, n_j),
+    bitwise: a grid finer than its lines (ranks > 1), a stride, the inputs' tails off."""
+    rng = np.random.default_rng(8)
+    w = np.sort(rng.uniform(0.05, 3.0, 150))
+    spectra = np.exp(-((w[None] - np.array([[0.8], [1.5]])) ** 2) / 0.05)
+    values = rng.normal(size=(2, 5, w.size)) + 1j * rng.normal(size=(2, 5, w.size))
+    for grid in (rl.uniform_grid(w), rl.uniform_grid(w, 40, 2, spectra)):
+        amp = np.sqrt(spectra * rl.trapezoid_weights(w)[None])
+        ref = np.zeros((2, grid.ranks, 5, grid.n_j), dtype=complex)
+        live = grid.live
+        ref[:, grid.rank[live], :, grid.index[live]] = np.moveaxis(
+            (values * amp[:, None, :])[:, :, live], 2, 0
+        )
+        got = grid.lines(values, spectra)
+        assert grid.ranks > 1 and np.array_equal(got, ref.reshape(2 * grid.ranks, 5, grid.n_j))
+    assert not grid.live.all()
+
+
+def test_misfit_loads_as_columns_of_the_components_loads(monkeypatch):
+    """The misfit's unit loads taken as the columns of the drag components' panel loads
+    (misfit_loads(unit_all=...)) are the loads formed for its panels alone, bitwise,
+    on the chain and the inclined guy (their split elements: δB on both directions)."""
+    import stochcable.dynamics.residuals.drag_misfit as dm
+
+    orig = dm.misfit_loads
+    seen = []
+
+    def both(model, seg, groups, live, parts, misfit, unit_all=None):
+        got = orig(model, seg, groups, live, parts, misfit, unit_all)
+        ref = orig(model, seg, groups, live, parts, misfit)
+        seen.append(got is not None and unit_all is not None)
+        assert (got is None) == (ref is None)
+        if got is not None:
+            assert all(np.array_equal(a, b) for a, b in zip(got, ref, strict=True))
+        return got
+
+    monkeypatch.setattr(dm, "misfit_loads", both)
+    lines = residual_cost.lines(guy=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name in ("chain", "guy"):
+            analyze(residual_cost.with_variant(lines[name], "drag"))
+    assert sum(seen) == 2

@@ -109,3 +109,42 @@ def test_squares_alone_are_those_formed_with_the_moments(depth, monkeypatch):
     np.testing.assert_array_equal(src.square(), both)
     np.testing.assert_array_equal(src.square(slice(40, 77)), both[:, 40:77])
     assert np.all(both[:, :, ek.wet_fraction == 0.0] == 0.0) and np.all(both >= 0.0)
+
+
+@pytest.mark.parametrize("depth", [60.0, np.inf], ids=["depth60", "deep"])
+def test_velocity_alone_is_the_kinematics_velocity(depth, monkeypatch) -> None:
+    """element_wave_velocity (the moments formed without the mean square) gives
+    element_wave_kinematics(...).velocity bitwise — elements crossing the waterline and
+    dry ones, ω = 0 — and a source's moments alone (KinematicsBlocks.moments) those it
+    forms with the squares; its arguments are checked as the kinematics' are."""
+    from stochcable.dynamics.loads.element_kinematics import element_wave_velocity
+    from stochcable.errors import InputError
+
+    w = np.linspace(0.0, 4.0, 61)
+    ref = element_wave_kinematics(w, _line(), heading=0.4, depth=depth)
+    got = element_wave_velocity(w, _line(), heading=0.4, depth=depth)
+    assert np.array_equal(got, ref.velocity) and np.any(got != 0.0)
+    monkeypatch.setenv("STOCHCABLE_WORKING_MEMORY_MB", "0.01")  # (a source kept, no parts)
+    src = element_wave_kinematics(w, _line(), heading=0.4, depth=depth).moments.source
+    for freq in (slice(None), slice(3, 40), np.array([0, 9, 60])):
+        parts, square = src.form(freq)
+        assert np.array_equal(src.moments(freq), parts) and square is not None
+    with pytest.raises(InputError, match="depth"):
+        element_wave_velocity(w, _line(), heading=0.4, depth=30.0)
+
+
+def test_end_square_weighted_sum_kept_for_the_same_weights() -> None:
+    """EndSquare.weighted keeps its last sum: asked again with equal weights (another
+    array) it returns the same numbers as a fresh evaluation, as a copy (the caller's
+    in-place sums do not reach the kept one); other weights are summed anew."""
+    w = np.linspace(0.0, 4.0, 61)
+    ends = element_wave_kinematics(w, _line(), heading=0.4, depth=60.0).ends
+    fresh = element_wave_kinematics(w, _line(), heading=0.4, depth=60.0).ends
+    q = np.random.default_rng(1).uniform(size=w.size)
+    first = ends.weighted(q)
+    first += 1.0  # (a caller's in-place sum)
+    again = ends.weighted(q.copy())
+    assert np.array_equal(again, fresh.weighted(q)) and np.any(again != first)
+    other = ends.weighted(2.0 * q)
+    assert np.array_equal(other, fresh.weighted(2.0 * q))
+    assert np.array_equal(ends.weighted(q), again)

@@ -106,3 +106,21 @@ def test_modal_rows_transfer_is_the_dense_contraction():
         flat = sparse.csr_matrix(unit.reshape(n * d, -1).T)
         assert np.abs(g.transfer(flat) - ref).max() < 1e-12 * scale
     assert np.abs(np.asarray(rows[2:][..., 5:40:3]) - np.asarray(rows)[2:, ..., 5:40:3]).max() == 0
+
+
+def test_kept_influence_on_the_same_lines_is_the_general_lookup():
+    """EndInfluence._find on the very lines it keeps (the shortcut: the kept rows
+    themselves) gives what the nearest-line lookup gives on lines within its 1e-12
+    tolerance of them, for all rows and a slice of rows."""
+    rng = np.random.default_rng(2)
+    om = np.linspace(0.1, 5.0, 30)
+    g = rng.normal(size=(4, 3, 2, om.size)) + 1j * rng.normal(size=(4, 3, 2, om.size))
+    kept = [(om[::2].copy(), g[..., ::2].copy()), (om.copy(), g)]
+    near = om * (1.0 + 1e-14)  # (not equal: the general lookup)
+    for rows in (slice(None), slice(1, 3)):
+        same = rl.EndInfluence._find(kept, om.copy(), rows)
+        ref = rl.EndInfluence._find(kept, near, rows)
+        assert same is not None and ref is not None
+        assert np.array_equal(np.asarray(same), np.asarray(ref))
+        assert np.array_equal(np.asarray(same), g[rows])
+    assert rl.EndInfluence._find(kept, om[:5] + 0.01) is None

@@ -60,6 +60,7 @@ __all__ = [
     "SquareParts",
     "element_frames",
     "element_wave_kinematics",
+    "element_wave_velocity",
 ]
 
 
@@ -186,6 +187,13 @@ def element_wave_kinematics(
     error ~1e-16/(kh)²).  At ω = 0 the finite-depth horizontal velocity takes its limit
     √(g/h), as in :func:`~stochcable.sea.kinematics.wave_kinematics`.
     """
+    return _element_kinematics(*_checked(omega, positions, heading, depth, g))
+
+
+def _checked(
+    omega: ArrayLike, positions: ArrayLike, heading: float, depth: float, g: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float, float]:
+    """:func:`element_wave_kinematics`' arguments checked: (ω, k, positions, β, h, g)."""
     w = v.float_array("omega", omega, "rad/s", nonnegative=True)
     pts = np.asarray(positions, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 3 or pts.shape[0] < 2:
@@ -201,26 +209,29 @@ def element_wave_kinematics(
         raise InputError(
             "positions", positions, "m", f"z must be >= -depth = {-h:g} (node {i} has z = {z[i]:g})"
         )
-    return _element_kinematics(w, k, pts, beta, h, g)
+    return w, k, pts, beta, h, g
+
+
+def element_wave_velocity(
+    omega: ArrayLike,
+    positions: ArrayLike,
+    heading: float = 0.0,
+    depth: float = np.inf,
+    g: float = G_STANDARD,
+) -> np.ndarray:
+    """:attr:`ElementKinematics.velocity` of :func:`element_wave_kinematics` (the same
+    arguments, checks and numbers) alone: the moments without the mean square and the
+    wet ends' squares, shape (n_omega, n_el, 2, 3). [(m/s)/m]"""
+    w, k, pts, beta, h, g = _checked(omega, positions, heading, depth, g)
+    src = _source(w, k, pts, beta, h, g)[0]
+    return MomentParts(src.moments(), beta).full()
 
 
 def _element_kinematics(
     w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float, h: float, g: float
 ) -> ElementKinematics:
     """:func:`element_wave_kinematics` without validation."""
-    cb, sb = math.cos(beta), math.sin(beta)
-    za, zb = pts[:-1, 2], pts[1:, 2]
-    chi = pts[:, 0] * cb + pts[:, 1] * sb
-    # wet part ξ ∈ [p, q] of each element (z <= 0 wet, as the nodal kinematics)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cross = np.where(za != zb, za / (za - zb), 0.0)
-    wet_a, wet_b = za <= 0.0, zb <= 0.0
-    p = np.where(wet_a, 0.0, np.where(wet_b, cross, 0.0))
-    q = np.where(wet_b, 1.0, np.where(wet_a, cross, 0.0))
-    p, q = np.clip(p, 0.0, 1.0)[None, :], np.clip(q, 0.0, 1.0)[None, :]
-    for a in (w, k, pts):
-        a.setflags(write=False)
-    src = KinematicsBlocks(w, k, (za, zb, chi, p, q, cb, sb, h, g), beta)
+    src, za, zb, p, q = _source(w, k, pts, beta, h, g)
     moments, square = src.parts()
     wet = (q - p)[0]
     z_ends = za[:, None] + (zb - za)[:, None] * np.hstack([p.T, q.T])  # (n_el, 2)
@@ -238,6 +249,26 @@ def _element_kinematics(
         square=square,
         ends=EndSquare(w, k, z_ends, wet > 0.0, h, g),
     )
+
+
+def _source(
+    w: np.ndarray, k: np.ndarray, pts: np.ndarray, beta: float, h: float, g: float
+) -> tuple[KinematicsBlocks, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The kinematics source of the elements of ``pts`` and their ends' depths and wet
+    parts ξ ∈ [p, q] (p, q of shape (1, n_el))."""
+    cb, sb = math.cos(beta), math.sin(beta)
+    za, zb = pts[:-1, 2], pts[1:, 2]
+    chi = pts[:, 0] * cb + pts[:, 1] * sb
+    # wet part ξ ∈ [p, q] of each element (z <= 0 wet, as the nodal kinematics)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cross = np.where(za != zb, za / (za - zb), 0.0)
+    wet_a, wet_b = za <= 0.0, zb <= 0.0
+    p = np.where(wet_a, 0.0, np.where(wet_b, cross, 0.0))
+    q = np.where(wet_b, 1.0, np.where(wet_a, cross, 0.0))
+    p, q = np.clip(p, 0.0, 1.0)[None, :], np.clip(q, 0.0, 1.0)[None, :]
+    for a in (w, k, pts):
+        a.setflags(write=False)
+    return KinematicsBlocks(w, k, (za, zb, chi, p, q, cb, sb, h, g), beta), za, zb, p, q
 
 
 @dataclass(frozen=True, eq=False)
@@ -285,9 +316,12 @@ class KinematicsBlocks:
         need = KINEMATICS_BYTES * self.n_elements * self.n_omega
         return need <= working_memory_bytes() // 4
 
-    def form(self, freq: FrequencyIndex = slice(None)) -> tuple[np.ndarray, np.ndarray]:
+    def form(
+        self, freq: FrequencyIndex = slice(None), square: bool = True
+    ) -> tuple[np.ndarray, np.ndarray | None]:
         """The moments' parts (n_el, 2, 2, n_f) and the mean square's (2, n_f, n_el)
-        on the frequencies ``freq``. [(m/s)/m, (m/s)²/m²]"""
+        on the frequencies ``freq`` (``square`` False: None for the squares where the
+        NumPy form skips them, a fifth of its work). [(m/s)/m, (m/s)²/m²]"""
         w, k = self.omega[freq], self.wavenumber[freq]
         n_w, n_el = w.size, self.n_elements
         # the moments' horizontal and vertical parts stored element-major: the loads
@@ -303,12 +337,13 @@ class KinematicsBlocks:
             kern(w, k, *self.geometry, parts, sq)
             return parts, sq
         for sl in sub_blocks(n_w, n_el):
-            kinematics_block(w[sl], k[sl], self.geometry, parts[..., sl], sq[:, sl])
-        return parts, sq
+            block = sq[:, sl] if square else None
+            kinematics_block(w[sl], k[sl], self.geometry, parts[..., sl], block)
+        return parts, sq if square else None
 
     def moments(self, freq: FrequencyIndex = slice(None)) -> np.ndarray:
         """The moments' parts on ``freq``, (n_el, 2, 2, n_f). [(m/s)/m]"""
-        return self.form(freq)[0]
+        return self.form(freq, square=False)[0]
 
     def square(self, freq: FrequencyIndex = slice(None)) -> np.ndarray:
         """The mean square's parts on ``freq``, (2, n_f, n_el), alone (NumPy,

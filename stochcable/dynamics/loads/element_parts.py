@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
@@ -316,6 +316,9 @@ class EndSquare:
     wet: np.ndarray
     depth: float
     g: float
+    # (the last weighted sum and its weights' bytes: the line's resolution check and its
+    # drag residual's pieces ask for the same one)
+    _last: list = field(default_factory=list, init=False, repr=False)
 
     @property
     def nbytes(self) -> int:
@@ -346,10 +349,15 @@ class EndSquare:
         return self.block()
 
     def weighted(self, weights: np.ndarray) -> np.ndarray:
-        """Σ_ω weight·|v|² per element end, (n_el, 2), over blocks of frequencies."""
+        """Σ_ω weight·|v|² per element end, (n_el, 2), over blocks of frequencies (the
+        last weights' sum kept: asked again with the same weights, a copy of it)."""
+        key = np.ascontiguousarray(weights, dtype=float).tobytes()
+        if self._last and self._last[0] == key:
+            return self._last[1].copy()
         out = np.zeros(self.z_ends.shape)
         for sl in sub_blocks(self.omega.size, self.z_ends.shape[0]):
             out += np.einsum("wes,w->es", self.block(sl), weights[sl])
+        self._last[:] = [key, out.copy()]
         return out
 
     def __getitem__(self, idx: FrequencyIndex) -> EndSquare:

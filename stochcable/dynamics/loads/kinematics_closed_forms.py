@@ -141,13 +141,14 @@ def kinematics_block(
     k: np.ndarray,
     geo: tuple,
     vel: np.ndarray,
-    sq: np.ndarray,
+    sq: np.ndarray | None,
 ) -> None:
     """The element kinematics of the frequencies ``w`` (wavenumbers ``k``) written into
     ``vel`` (the moments' parts, (n_el, 2, 2, n_w):
     :class:`~stochcable.dynamics.loads.element_parts.MomentParts`) and ``sq`` (the mean
     square's h and v, (2, n_w, n_el):
-    :class:`~stochcable.dynamics.loads.element_parts.SquareParts`) on one block; ``geo`` =
+    :class:`~stochcable.dynamics.loads.element_parts.SquareParts`; None: the moments
+    alone, the same numbers) on one block; ``geo`` =
     (z_a, z_b, χ, p, q, cos β, sin β, h, g).  Frequency-major (n_w, n_el) arrays
     throughout.  The NumPy form of
     :func:`stochcable.dynamics.loads.kinematics_kernels.kinematics_block`, the compiled loop
@@ -191,10 +192,12 @@ def kinematics_block(
     for side in range(2):  # (n_el, n_w) each: the transposed block
         vel[:, side, 0] = mh[side].T
         vel[:, side, 1] = mz[side].T
-    _squares(w, k, za, kza, dz, p, q, h, g, sq)
+    if sq is not None:  # (None: the moments alone)
+        _squares(w, k, za, kza, dz, p, q, h, g, sq)
     if dry.any():  # (zeros, not e^{kz}·0: NaN once kz > 709 high above the water)
         vel[dry] = 0.0
-        sq[:, :, dry] = 0.0
+        if sq is not None:
+            sq[:, :, dry] = 0.0
 
 
 def square_block(w: np.ndarray, k: np.ndarray, geo: tuple, sq: np.ndarray) -> None:

@@ -60,7 +60,7 @@ from stochcable.dynamics.residuals.along_line_motion import (
 )
 from stochcable.dynamics.residuals.body_residual import CoupledInfluence
 from stochcable.dynamics.residuals.corrected import corrected_stats, residuals_in_range
-from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectrum
+from stochcable.dynamics.residuals.corrected_spectrum import corrected_spectra
 from stochcable.dynamics.residuals.registry import residual_parts
 from stochcable.dynamics.residuals.residual_lines import EndInfluence, shared_rows
 from stochcable.dynamics.residuals.second_order import second_order_tension, with_second_order
@@ -285,7 +285,7 @@ def line_result(
     corrected = None
     if applied:  # the end statistics and densities with the residuals' spectra
         stats = {e: corrected_stats(stats[e], e, applied, settings.duration) for e in linear}
-        corrected = {e: corrected_spectrum(w, dens[e], e, applied) for e in linear}
+        corrected = corrected_spectra(w, {e: dens[e] for e in linear}, applied)
     return LineResult(
         name=system.name,
         omega=w,

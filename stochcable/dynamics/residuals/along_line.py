@@ -47,7 +47,7 @@ from stochcable.dynamics.residuals.along_line_3d import (
     vector_parts,
 )
 from stochcable.dynamics.residuals.corrected_spectrum import CorrectedSpectrum, corrected_spectrum
-from stochcable.dynamics.residuals.drag_residual import CELL_BEND, cell_factor
+from stochcable.dynamics.residuals.drag_residual import CELL_BEND, bent_lines, cell_factor
 from stochcable.dynamics.residuals.geometric_residual import LINE_STRIDE
 from stochcable.dynamics.residuals.influence import (
     adjoint_rows,
@@ -189,8 +189,9 @@ def _columns_of(transfer: np.ndarray, h: np.ndarray) -> np.ndarray | None:
     if h.shape[0] != transfer.shape[0] or h.shape[2] < transfer.shape[2]:
         return None
     h = h[:, :, : transfer.shape[2]]
-    first = {np.ascontiguousarray(h[:, j, 0]).tobytes(): j for j in range(h.shape[1])}
-    keys = [np.ascontiguousarray(transfer[:, c, 0]).tobytes() for c in range(transfer.shape[1])]
+    # (the first lines' bytes: rows of contiguous (n_all, n_out) and (n, n_out) arrays)
+    first = {r.tobytes(): j for j, r in enumerate(np.ascontiguousarray(h[:, :, 0].T))}
+    keys = [r.tobytes() for r in np.ascontiguousarray(transfer[:, :, 0].T)]
     if len(first) == h.shape[1] and all(k in first for k in keys):
         kept = np.array([first[k] for k in keys], dtype=int)
         if np.array_equal(h[:, kept], transfer):
@@ -428,11 +429,7 @@ def bent_cells(h: np.ndarray, bend: float = CELL_BEND, power: Any = None) -> np.
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
     loads, bends by more than ``bend`` between neighbours, and their neighbours (as
     :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`'s cells)."""
-    power = np.sum(np.abs(h) ** 2, axis=1) if power is None else power  # (n_out, n_o)
-    logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
-    out = np.zeros(power.shape[1], dtype=bool)
-    out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
-    return out | np.roll(out, 1) | np.roll(out, -1)
+    return bent_lines(h, bend, power)
 
 
 def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:

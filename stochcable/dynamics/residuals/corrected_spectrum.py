@@ -35,7 +35,14 @@ import numpy as np
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.results.records import ResidualRecord
 
-__all__ = ["CorrectedSpectrum", "corrected_spectrum", "extended_grid", "spectrum_with_lines"]
+__all__ = [
+    "CorrectedSpectrum",
+    "corrected_spectra",
+    "corrected_spectrum",
+    "extended_grid",
+    "spectra_with_lines",
+    "spectrum_with_lines",
+]
 
 #: The gap between a grid end and the node beyond it where the linear density is zero,
 #: in units of the end cell: the linear density's trapezoid over it adds this fraction
@@ -117,33 +124,69 @@ def spectrum_with_lines(
     CorrectedSpectrum
         ∫S dω (trapezoid) = ∫S_linear dω + Σ the lines' variances (clipped at 0).
     """
+    return spectra_with_lines(omega, [linear], [list(parts)])[0]
+
+
+def corrected_spectra(
+    omega: np.ndarray,
+    linear: dict[str, np.ndarray],
+    records: Iterable[ResidualRecord],
+) -> dict[str, CorrectedSpectrum]:
+    """:func:`corrected_spectrum` of every end of ``linear`` (end → its linear
+    density), the extended grid formed once for them all (the ends' lines share their
+    frequencies): the same numbers."""
+    records = list(records)
+    ends = list(linear)
+    parts = [[(om, lines[e]) for rec in records for om, lines in rec.lines] for e in ends]
+    return dict(zip(ends, spectra_with_lines(omega, [linear[e] for e in ends], parts)))
+
+
+def spectra_with_lines(
+    omega: np.ndarray,
+    linear: list[np.ndarray],
+    parts: list[list[tuple[np.ndarray, np.ndarray]]],
+) -> list[CorrectedSpectrum]:
+    """:func:`spectrum_with_lines` of several responses whose ``parts`` have the same
+    frequencies, response by response (their lines' values differ), the extended grid
+    formed once."""
     w = np.asarray(omega, dtype=float)
     q = trapezoid_weights(w)
-    base = np.asarray(linear, dtype=float).copy()
-    target = float(np.sum(q * base))
-    uniform: list[tuple[np.ndarray, np.ndarray]] = []
-    for om, v in parts:
-        om = np.asarray(om, dtype=float)
-        v = np.asarray(v, dtype=float)
-        target += float(np.sum(v))
-        if om.size == w.size and np.array_equal(om, w):  # the misfit: exact density
-            base += np.divide(v, q, out=np.zeros_like(v), where=q > 0)
+    shape = [(np.asarray(om, dtype=float), None) for om, _ in parts[0]] if parts else []
+    kinds: list[float | str] = []  # (each part: "misfit" on the grid, "empty", a step)
+    for om, _ in shape:
+        if om.size == w.size and np.array_equal(om, w):
+            kinds.append("misfit")
         elif om.size:
-            step = float(om[1] - om[0]) if om.size > 1 else float(om[0])
-            uniform.append((om, v / step))
-    target = max(target, 0.0)
-    grid = extended_grid(w, [om for om, _ in uniform])
+            kinds.append(float(om[1] - om[0]) if om.size > 1 else float(om[0]))
+        else:
+            kinds.append("empty")
+    uniform_om = [om for (om, _), k in zip(shape, kinds, strict=True) if not isinstance(k, str)]
+    grid = extended_grid(w, uniform_om)
     at = np.searchsorted(grid, w)
-    dens = np.zeros(grid.size)
-    dens[at] = np.maximum(base, 0.0)  # (a misfit change below the linear density: 0)
-    res = np.zeros(grid.size)
-    for om, d in uniform:
-        res += np.interp(grid, om, d, left=d[0], right=0.0)
     qg = trapezoid_weights(grid)
-    area = float(np.sum(qg * res))
-    scale = (target - float(np.sum(qg * dens))) / area if area > 0 else 1.0
-    out = np.maximum(dens + scale * res, 0.0)
-    return CorrectedSpectrum(grid, out, float(scale))
+    out = []
+    for lin, own in zip(linear, parts, strict=True):
+        base = np.asarray(lin, dtype=float).copy()
+        target = float(np.sum(q * base))
+        uniform: list[tuple[np.ndarray, np.ndarray]] = []
+        for (om, v), kind in zip(own, kinds, strict=True):
+            om = np.asarray(om, dtype=float)
+            v = np.asarray(v, dtype=float)
+            target += float(np.sum(v))
+            if kind == "misfit":  # exact density
+                base += np.divide(v, q, out=np.zeros_like(v), where=q > 0)
+            elif not isinstance(kind, str):
+                uniform.append((om, v / kind))
+        target = max(target, 0.0)
+        dens = np.zeros(grid.size)
+        dens[at] = np.maximum(base, 0.0)  # (a misfit change below the linear density: 0)
+        res = np.zeros(grid.size)
+        for om, d in uniform:
+            res += np.interp(grid, om, d, left=d[0], right=0.0)
+        area = float(np.sum(qg * res))
+        scale = (target - float(np.sum(qg * dens))) / area if area > 0 else 1.0
+        out.append(CorrectedSpectrum(grid, np.maximum(dens + scale * res, 0.0), float(scale)))
+    return out
 
 
 def extended_grid(omega: np.ndarray, lines: list[np.ndarray]) -> np.ndarray:

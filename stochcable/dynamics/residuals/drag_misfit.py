@@ -38,6 +38,7 @@ def misfit_variance(
     coupled: Any = None,
     others: list[tuple[Any, Any]] | None = None,
     exact: bool = False,
+    unit_all: np.ndarray | None = None,
 ) -> dict[str, np.ndarray]:
     """The end-tension variance the linear misfit of the element-constant drag changes,
     as lines on the analysis grid (empty without split elements): its load δB·l·v on
@@ -54,10 +55,11 @@ def misfit_variance(
     through ``coupled`` (a line on bodies: its coupled influence) where given.
     ``others`` (a line on bodies): the group's other lines' components with their
     influence on this line's end tensions (:mod:`.drag_residual`); their misfit loads
-    add to H_c (taken at the analysis frequencies) before the variance is formed."""
+    add to H_c (taken at the analysis frequencies) before the variance is formed.
+    ``unit_all``: the components' unit loads (:func:`misfit_loads`)."""
     w = np.asarray(resp.omega, dtype=float)
     h_c = np.zeros((2, spectra.shape[0], w.size), dtype=complex)
-    mis = misfit_loads(system.model, seg, groups, live, parts, misfit)
+    mis = misfit_loads(system.model, seg, groups, live, parts, misfit, unit_all)
     if mis is not None:
         unit, load = mis
         grid, w_out, influence, bent = lines
@@ -70,7 +72,9 @@ def misfit_variance(
             tap.misfit(unit, load, w)
         h_c += _outputs(h, load)
     for c, infl in others or ():  # (through the bodies: H_c of this line's ends)
-        mis = misfit_loads(infl.line.system.model, c.seg, c.groups, c.live, c.parts, c.misfit)
+        mis = misfit_loads(
+            infl.line.system.model, c.seg, c.groups, c.live, c.parts, c.misfit, c.unit
+        )
         if mis is not None:
             with untapped():
                 h = load_transfer(infl.line.system, infl.line.damping, mis[0], w, infl)
@@ -98,17 +102,25 @@ def misfit_loads(
     live: list[str],
     parts: dict[str, Any],
     misfit: list[tuple[np.ndarray, np.ndarray]],
+    unit_all: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """The misfit's unit node loads (n_nodes, d, n_load) and its loads per channel
-    (n_ch, n_load, n_w) on the panels with a δB (None: none)."""
+    (n_ch, n_load, n_w) on the panels with a δB (None: none); ``unit_all``: every
+    panel's unit loads along every direction of ``live`` (direction-major, the drag
+    components' :func:`~.drag_segments.panel_loads`), whose columns they are (a panel's
+    loads are its pieces' alone: the same numbers formed with any set of panels)."""
     keep = [(k, np.flatnonzero(m)) for k, (_, m) in enumerate(misfit) if np.any(m)]
     if not keep:
         return None
-    sel = [[groups[i] for i in idx] for _, idx in keep]
-    unit = np.concatenate(
-        [panel_loads(model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
-        axis=2,
-    )
+    if unit_all is not None:
+        cols = np.concatenate([k * len(groups) + idx for k, idx in keep])
+        unit = unit_all[:, :, cols]
+    else:
+        sel = [[groups[i] for i in idx] for _, idx in keep]
+        unit = np.concatenate(
+            [panel_loads(model, seg, g, [parts[live[k]][2]]) for (k, _), g in zip(keep, sel)],
+            axis=2,
+        )
     load = np.concatenate(
         [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
     )  # (n_ch, n_load, n_w)

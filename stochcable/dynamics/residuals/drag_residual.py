@@ -102,6 +102,7 @@ __all__ = [
     "HERMITE_ORDER",
     "MAX_PANELS",
     "RESIDUAL_WARN_RATIO",
+    "bent_lines",
     "drag_residual",
     "hermite_coefficients",
     "lumped_coefficients",
@@ -298,7 +299,7 @@ def drag_residual(
     influence = EndInfluence(system, damping) if influence is None else influence
     h_all = load_transfer(system, damping, comp.unit, comp.w_out, influence)
     keep = _live_panels(comp.lines, comp.scale, comp.coeffs, h_all)
-    bent = _bent(h_all)  # (the cells: the residual's and the misfit's)
+    bent = bent_lines(h_all)  # (the cells: the residual's and the misfit's)
     cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled, cells=bent)
     # the lines above those the ends need left out: within LINE_TOL of the linear
     # spectrum's m0, m2 and m4 at each end (σ, Tz and the bandwidth)
@@ -324,6 +325,7 @@ def drag_residual(
         coupled,
         [(c, src) for _, c, src in others],
         MISFIT_EXACT,
+        comp.unit,
     )
     out = residual_record(
         own * cf[:, :top], comp.w_out[:top], w, std, order, len(comp.groups), linear
@@ -481,9 +483,11 @@ def cell_factor(
     power (``h``'s, summed over the panels) bends by more than :data:`CELL_BEND`
     between neighbours, and theirs (``cells``: those lines, (n_o,) bool, where the caller
     has them); elsewhere the factor is 1 (no solve)."""
+    if cells is not None and not np.any(cells):  # (no cell: no power needed)
+        return np.ones((h.shape[0], h.shape[2]))
     power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
     out = np.ones_like(power)
-    cells = np.flatnonzero(_bent(h, bend, power) if cells is None else cells)
+    cells = np.flatnonzero(bent_lines(h, bend, power) if cells is None else cells)
     if cells.size == 0:
         return out
     step = float(w_out[1] - w_out[0]) if w_out.size > 1 else float(w_out[0])
@@ -507,15 +511,23 @@ def _live_panels(
     return np.flatnonzero(score >= PANEL_FLOOR * np.max(score, initial=0.0))
 
 
-def _bent(h: np.ndarray, bend: float = CELL_BEND, power: np.ndarray | None = None) -> np.ndarray:
+def bent_lines(
+    h: np.ndarray, bend: float = CELL_BEND, power: np.ndarray | None = None
+) -> np.ndarray:
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
     panels (``power``, where the caller has it), bends by more than ``bend`` between
     neighbours, and theirs."""
     power = np.sum(np.abs(h) ** 2, axis=1) if power is None else power
     logp = np.log(np.maximum(power, np.max(power, initial=0.0) * 1e-300 + 1e-300))
-    out = np.zeros(power.shape[1], dtype=bool)
-    out[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
-    return out | np.roll(out, 1) | np.roll(out, -1)
+    n = power.shape[1]
+    mid = np.zeros(n, dtype=bool)
+    if n > 2:
+        mid[1:-1] = np.any(np.abs(logp[:, 2:] - 2.0 * logp[:, 1:-1] + logp[:, :-2]) > bend, 0)
+    # the lines and their neighbours (the first and last lines never bend themselves)
+    out = mid.copy()
+    out[1:] |= mid[:-1]
+    out[:-1] |= mid[1:]
+    return out
 
 
 def _misfit(

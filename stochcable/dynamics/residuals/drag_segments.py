@@ -16,7 +16,7 @@ loading its element's nodes with the shape functions at its midpoint; the variat
 the velocity variance along the element (its wet part's end values,
 :attr:`stochcable.dynamics.element_kinematics.ElementKinematics.end_square`) sets how
 many.  The fluid velocity of a sub-segment is integrated exactly over it
-(:func:`~stochcable.dynamics.element_kinematics.element_wave_kinematics` on the
+(:func:`~stochcable.dynamics.element_kinematics.element_wave_velocity` on the
 subdivided static shape).  Whole elements are grouped into panels (the cost of the
 residual grows with their square) in fixed tiles of the mesh, cut where the variance
 is not nearly uniform over them (:func:`panel_groups`): on a fine mesh, groups of
@@ -33,8 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.loads.element_kinematics import element_wave_kinematics
-from stochcable.dynamics.model.blocks import trapezoid_weights
+from stochcable.dynamics.loads.element_kinematics import element_wave_velocity
+from stochcable.dynamics.model.blocks import real_gemm, trapezoid_weights
 
 __all__ = [
     "MAX_SUB",
@@ -288,10 +288,8 @@ def segment_velocity(
                 if sub is None:
                     sub = _subdivided_points(system, seg)[run.start : run.stop + 1]
                 env = system.environment
-                kin = element_wave_kinematics(
-                    np.asarray(ch.omega), sub, ch.heading, env.depth, env.g
-                )
-                v_run = kin.velocity.sum(axis=2)  # (n_w, n_run, 3)
+                vel = element_wave_velocity(np.asarray(ch.omega), sub, ch.heading, env.depth, env.g)
+                v_run = vel.sum(axis=2)  # (n_w, n_run, 3)
                 for name, ve in vecs.items():
                     out[name][c, run] += np.einsum("wsd,sd->sw", v_run, ve[run])
             rest = np.ones(n_s, dtype=bool)
@@ -347,6 +345,13 @@ def panel_mean(
     ``share``: :func:`panel_share`, where the caller has it)."""
     if share is None:
         share = panel_share(seg, groups)
+    if values.ndim == 3 and np.iscomplexobj(values):
+        # the real shares times the complex values as one real product on their
+        # interleaved view (a complex product upcasts the shares: 4× the work)
+        n_a, n_s, n_w = values.shape
+        flat = np.ascontiguousarray(np.moveaxis(values, 1, 0), dtype=complex).reshape(n_s, -1)
+        out = real_gemm(np.ascontiguousarray(share.T), flat)  # (n_p, n_a·n_w)
+        return np.moveaxis(out.reshape(-1, n_a, n_w), 0, 1)
     if values.ndim == 3:
         return np.moveaxis(np.moveaxis(values, 1, 2) @ share, 2, 1)
     return values @ share

@@ -43,7 +43,7 @@ from stochcable.dynamics.residuals.residual_lines import MAX_LINES as RESIDUAL_L
 from stochcable.dynamics.residuals.residual_lines import (
     EndInfluence,
     PairLines,
-    along,
+    along_each,
     fft_length,
     load_transfer,
     pair_blocks,
@@ -171,7 +171,7 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
-    proc = [grid.lines(along(du, f), spectra) for f in frames]
+    proc = [grid.lines(x, spectra) for x in along_each(du, frames)]
     kappa = (mesh.ea / l0 - np.asarray(system.statics.tension) / length) / length
     # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms
     comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [

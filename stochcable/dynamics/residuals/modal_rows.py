@@ -89,31 +89,47 @@ class ModalRows:
     modes (:meth:`transfer`: the chain's 27 rows on 189 lines, 6.7 MB, never formed).
     [N/N]"""
 
-    def __init__(self, phi, z, w, rc, ends, n_nodes) -> None:  # noqa: ANN001
+    def __init__(self, phi, z, w, rc, ends, n_nodes, marks=None) -> None:  # noqa: ANN001
         self.phi, self.z, self.w, self.rc, self.ends = phi, z, w, rc, ends
         self.n_nodes = n_nodes
         d = ends.shape[2]
         self.shape = (z.shape[1], n_nodes, d, w.size)
         self.ndim, self.dtype = 4, np.dtype(complex)
+        if marks is None:  # (the rows with r₁, r₂ and those with ê: the end rows)
+            dyn = np.zeros(z.shape[1], dtype=bool) if rc is None else np.any(rc[1:] != 0, (0, 1))
+            marks = (dyn, np.any(ends != 0, axis=(0, 2)))
+        self.marks = marks
+        self._rows: tuple | None = None  # (the marked rows, when first asked: _marked)
+
+    def _marked(self) -> tuple[Any, Any]:
+        """The rows with r₁, r₂ and those with ê (:func:`_rows_of` of the marks)."""
+        if self._rows is None:
+            self._rows = (_rows_of(self.marks[0]), _rows_of(self.marks[1]))
+        return self._rows
 
     def __getitem__(self, key: Any) -> ModalRows:
         rows, lines = (slice(None), key[1]) if isinstance(key, tuple) else (key, slice(None))
         if isinstance(key, tuple) and key[0] is not Ellipsis:
             raise IndexError("ModalRows: g[rows] or g[..., lines] only")
+        if isinstance(rows, slice) and rows == slice(None):  # (the lines only: the same rows)
+            out = ModalRows(
+                self.phi, self.z[:, :, lines], self.w[lines], self.rc, self.ends, self.n_nodes,
+                self.marks,
+            )  # fmt: skip
+            out._rows = self._rows
+            return out
         rc = None if self.rc is None else self.rc[:, :, rows]
         return ModalRows(
             self.phi, self.z[:, rows][:, :, lines], self.w[lines], rc,
-            self.ends[:, rows], self.n_nodes,
+            self.ends[:, rows], self.n_nodes, (self.marks[0][rows], self.marks[1][rows]),
         )  # fmt: skip
 
     def _add_static(self, x: np.ndarray, rc: np.ndarray) -> np.ndarray:
         """``x`` (X, R, n_w) plus r₀ − ω²r₁ + iωr₂ of static rows ``rc`` (3, X, R), in
         place (r₁, r₂ on the end rows only)."""
         x += rc[0][..., None]
-        dyn: Any = np.flatnonzero(np.any(self.rc[1:] != 0, axis=(0, 1)))
-        if dyn.size and dyn[-1] - dyn[0] + 1 == dyn.size:  # (a run: a view, not a copy)
-            dyn = slice(int(dyn[0]), int(dyn[-1]) + 1)
-        if not isinstance(dyn, np.ndarray) or dyn.size:
+        dyn = self._marked()[0]
+        if dyn is not None:
             w = self.w
             x[:, dyn] += rc[2][:, dyn, None] * (1j * w) - rc[1][:, dyn, None] * (w * w)
         return x
@@ -149,9 +165,26 @@ class ModalRows:
             a = u_f @ self.phi
         zt = np.ascontiguousarray(self.z).reshape(m, -1)
         h = real_gemm(a, zt).reshape(a.shape[0], n_r, n_w)  # (L, R, n_w)
-        h += (u_end[0] @ self.ends[0].T + u_end[1] @ self.ends[1].T)[..., None]
+        if (rows := self._marked()[1]) is not None:  # (ê on the end rows only: the others' are 0)
+            end = self.ends[:, rows]
+            h[:, rows] += (u_end[0] @ end[0].T + u_end[1] @ end[1].T)[..., None]
         if self.rc is not None:
-            three = np.transpose(self.rc, (1, 0, 2)).reshape(self.rc.shape[1], -1)
-            rc = np.asarray(u_f @ three).reshape(-1, 3, n_r).transpose(1, 0, 2)  # (3, L, R)
+            three = np.ascontiguousarray(np.transpose(self.rc, (1, 0, 2))).reshape(
+                self.rc.shape[1], -1
+            )
+            # (the real loads times the complex rows: one real product, dense cases)
+            prod = u_f @ three if sparse.issparse(u_f) else real_gemm(u_f, three)
+            rc = np.asarray(prod).reshape(-1, 3, n_r).transpose(1, 0, 2)  # (3, L, R)
             self._add_static(h, rc)
         return np.transpose(h, (1, 0, 2))
+
+
+def _rows_of(mark: np.ndarray) -> slice | np.ndarray | None:
+    """The rows ``mark`` (bool) holds: None where none, a slice where they are a run (a
+    view, not a copy), else their indices."""
+    at = np.flatnonzero(mark)
+    if at.size == 0:
+        return None
+    if at[-1] - at[0] + 1 == at.size:
+        return slice(int(at[0]), int(at[-1]) + 1)
+    return at

@@ -49,6 +49,7 @@ __all__ = [
     "PairLines",
     "SharedRows",
     "along",
+    "along_each",
     "band_stack",
     "covariance_lines",
     "dense_outputs",
@@ -149,12 +150,14 @@ class UniformGrid:
         E[x(t) y(t + τ)] = Σ_j Re(Σ_c x̄_{c,j} y_{c,j} e^{iω_j τ}) (:func:`cross_covariance`)."""
         n_ch, n_x, _ = values.shape
         amp = np.sqrt(np.asarray(spectra, dtype=float) * trapezoid_weights(self.omega)[None])
-        out = np.zeros((n_ch, self.ranks, n_x, self.n_j), dtype=complex)
         live = self.live
-        out[:, self.rank[live], :, self.index[live]] = np.moveaxis(
-            (values * amp[:, None, :])[:, :, live], 2, 0
-        )
-        return out.reshape(n_ch * self.ranks, n_x, self.n_j)
+        # each live frequency's (rank, line) as one index of a (rank·line, n_ch, n_x)
+        # scratch (one leading advanced index: a plain row scatter), then transposed
+        at = self.rank[live] * self.n_j + self.index[live]
+        out = np.zeros((self.ranks * self.n_j, n_ch, n_x), dtype=complex)
+        out[at] = np.moveaxis((values * amp[:, None, :])[:, :, live], 2, 0)
+        out = out.reshape(self.ranks, self.n_j, n_ch, n_x).transpose(2, 0, 3, 1)
+        return np.ascontiguousarray(out).reshape(n_ch * self.ranks, n_x, self.n_j)
 
 
 def uniform_grid(
@@ -399,9 +402,18 @@ def along(x: np.ndarray, vec: np.ndarray) -> np.ndarray:
     """Σ_d x[w, e, d, c]·vec[e, d] of per-element vectors ``x`` (n_w, n_e, k, n_ch) along
     ``vec`` (n_e, k): shape (n_ch, n_e, n_w), as ``np.einsum("wedc,ed->cew", x, vec)``
     by one batched product per element (4× faster on the chain's pieces)."""
+    return along_each(x, [vec])[0]
+
+
+def along_each(x: np.ndarray, vecs: list[np.ndarray]) -> list[np.ndarray]:
+    """:func:`along` of ``x`` along each of ``vecs`` (the per-element layout of ``x``
+    formed once for them all): a list of (n_ch, n_e, n_w)."""
     x_t = np.ascontiguousarray(np.transpose(x, (1, 3, 0, 2)))  # (n_e, n_ch, n_w, k)
-    v = np.asarray(vec)[:, None, :, None].astype(x_t.dtype)
-    return np.transpose(x_t @ v, (1, 0, 2, 3))[..., 0]
+    out = []
+    for vec in vecs:
+        v = np.asarray(vec)[:, None, :, None].astype(x_t.dtype)
+        out.append(np.transpose(x_t @ v, (1, 0, 2, 3))[..., 0])
+    return out
 
 
 def fft_length(n: int) -> int:
