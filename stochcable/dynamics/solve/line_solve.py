@@ -220,10 +220,7 @@ def _foss_solver(
     ch = 0.5 * (ch + ch.T)
     # the truncated modes' static response to the kept modes' damping forces, R C Φ
     # (n_free_dof, m): see the notes of :func:`_foss_solver`
-    rcphi = None
-    if m < nf:
-        rcphi = prep.residual(system, np.ascontiguousarray(cphi, dtype=complex)).real
-        rcphi = np.ascontiguousarray(rcphi)
+    rcphi = damping_coupling(system, prep, c, cphi)
     foss = None
     if not modal_direct:
         try:
@@ -268,6 +265,24 @@ def _foss_solver(
         return u.reshape(nf, n_w, n_ch)
 
     return solve
+
+
+def damping_coupling(
+    system: LineSystem, prep: LinePrep, c: NodeBlocks, cphi: np.ndarray | None = None
+) -> np.ndarray | None:
+    """R C Φ (n_free_dof, m), real: the truncated modes' static response to unit
+    damping forces of the kept modes (R = K⁻¹ − Φ K̂⁻¹ Φᵀ the residual flexibility, C
+    the damping blocks ``c``); a modal response z then adds −iω R C Φ z (mode
+    acceleration with the damping coupling: the notes of :func:`_foss_solver`).  None
+    when the line keeps every mode.  ``cphi``: the free rows of C Φ when the caller
+    has them."""
+    phi = prep.modal(system)[0]
+    if phi.shape[1] >= phi.shape[0]:
+        return None
+    if cphi is None:
+        cphi = prep.free_rows(block_matvec(c, prep.nodes(phi)))
+    rc = prep.residual(system, np.ascontiguousarray(cphi, dtype=complex)).real
+    return np.ascontiguousarray(rc)
 
 
 def reactions(
