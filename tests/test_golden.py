@@ -67,6 +67,27 @@ PRE_UNIFICATION = Path(__file__).parent / "golden" / "pre_unification"
 #: number, the chain's per-element drag/inertia ratio).
 PRE_UNIFICATION_K = 2.0
 
+#: Since this record the truncated modes of a Foss line also take the kept modes'
+#: damping forces (mode acceleration with the damping coupling,
+#: stochcable.dynamics.solve.line_solve.damping_coupling): a change of the linear
+#: model, not of the fixed point, measured 3.0e-4 on the inclined guy's end m0 (39 of
+#: 78 modes kept) and nothing on lines that keep every mode; allowed on top where a
+#: line's Foss solve truncates (:func:`_truncates`).
+DAMPING_COUPLING_SHIFT = 5e-4
+
+
+def _truncates(case: str, analyze_doc: dict) -> bool:
+    """Whether a line of the case keeps fewer Foss modes than the 2(n_el − 1) in-plane
+    free DOFs of its elements (a 3-D line has more: then it truncates too)."""
+    lines = {ln["name"]: ln for ln in record.cases()[case]["lines"]}
+    for name, out in analyze_doc["lines"].items():
+        kept = out["modes"].get("kept")
+        n_el = sum(seg.get("elements", 0) for seg in lines[name]["segments"])
+        if kept is not None and kept < 2 * (n_el - 1):
+            return True
+    return False
+
+
 #: The iteration record itself: the coarse evaluations are now counted in it.
 _ITERATION_RECORD = {"iterations", "relative_change", "history"}
 
@@ -142,4 +163,5 @@ def test_single_lines_agree_with_the_pre_unification_record(case: str) -> None:
     new["analyze"]["warnings"] = [
         w for w in new["analyze"]["warnings"] if not any(t in w for t in _WARNINGS_ADDED_SINCE)
     ]
-    _numbers_close(new["analyze"], old["analyze"], PRE_UNIFICATION_K * tol, f"{case}.analyze")
+    rtol = PRE_UNIFICATION_K * tol + DAMPING_COUPLING_SHIFT * _truncates(case, new["analyze"])
+    _numbers_close(new["analyze"], old["analyze"], rtol, f"{case}.analyze")

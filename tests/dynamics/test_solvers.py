@@ -277,6 +277,29 @@ def test_truncation_error_decreases_monotonically_with_static_correction():
     assert np.all(err_sc[10:-1] < 0.7 * np.array(err_plain)[10:-1])
 
 
+@pytest.mark.parametrize("scale", [1.0, 0.5, 0.25])
+def test_truncated_modes_take_the_kept_modes_damping_forces(scale):
+    """Mode acceleration with the damping coupling (solve_modal, Notes): loads on the
+    kept modes only (R F = 0), heavy non-proportional damping (truncated modes' ζ
+    0.1–0.5): the former plain static correction misses the truncated modes' static
+    response to the kept modes' damping forces, −iω R C Φz (first order in C·ω/K), the
+    term takes it; what is left is second order (measured 10×, 22×, 46× closer)."""
+    n, m = 30, 6
+    K, M = _chain(n)
+    wn, phi = modal_basis(K, M)
+    C = np.diag(np.linspace(5.0, 40.0, n))
+    C[0, 1] = C[1, 0] = 3.0
+    C = scale * C
+    w = np.linspace(0.05, 0.5 * wn[0], 40)
+    F = np.tile(M @ (phi[:, 0] + 0.5 * phi[:, 1] - 0.3 * phi[:, 3]), (w.size, 1)) * (1 + 0.3j)
+    ref = solve_direct(K, M, C, F, w)
+    new = solve_modal(K, M, C, F, w, n_modes=m, basis=(wn, phi))
+    plain = solve_modal(K, M, C, F, w, n_modes=m, basis=(wn, phi), static_correction=False)
+    r = np.linalg.inv(K) - phi[:, :m] @ np.diag(wn[:m] ** -2.0) @ phi[:, :m].T
+    former = plain + (r @ F.T).T  # Φz + R F: the static correction without the coupling
+    assert _rel(new, ref) < 0.1 * _rel(former, ref)
+
+
 # ------------------------------------------------------------------ singular / errors
 
 

@@ -53,7 +53,12 @@ from stochcable.dynamics.model.blocks import (
 from stochcable.dynamics.model.modal_solvers import foss_transfer_modal
 from stochcable.dynamics.model.system import Damping, LineSystem
 from stochcable.dynamics.solve.line_loads import end_following, end_loads, free_load
-from stochcable.dynamics.solve.line_solve import reactions, solve_free, total_displacement
+from stochcable.dynamics.solve.line_solve import (
+    damping_coupling,
+    reactions,
+    solve_free,
+    total_displacement,
+)
 from stochcable.dynamics.solve.node_inputs import LineInputs
 from stochcable.errors import SolverError
 from stochcable.runtime import line_map
@@ -200,9 +205,9 @@ def foss_unit_split(
     # physical channels: the free-row load of solve_free
     rhs = free_load(system, prep, inp_phys, damping)
     flat = np.ascontiguousarray(prep.free_rows(rhs)).reshape(nf, n_w * n_ch)
-    u_p = real_gemm(
-        phi, np.ascontiguousarray(foss_transfer_modal(foss, real_gemm(phi.T, flat), w, n_ch))
-    )
+    rc = damping_coupling(system, prep, c)  # (−iω R C Φ z: mode acceleration)
+    z_p = np.ascontiguousarray(foss_transfer_modal(foss, real_gemm(phi.T, flat), w, n_ch))
+    u_p = real_gemm(phi, z_p)
     # unit channels: U_p,j constant (node vectors (n, d, n_e))
     key = ("unit_up", n_ch)
     if key not in inp.cache:
@@ -214,12 +219,12 @@ def foss_unit_split(
     fe = (w * w)[None, :, None] * ah[:, None, :] - (1j * w)[None, :, None] * bh[
         :, None, :
     ]  # (m, n_w, n_e)
-    u_e = real_gemm(
-        phi, np.ascontiguousarray(foss_transfer_modal(foss, fe.reshape(m, n_w * n_e), w, n_e))
-    )
-    u_e = u_e.reshape(nf, n_w, n_e)
-    if m < nf:
+    z_e = np.ascontiguousarray(foss_transfer_modal(foss, fe.reshape(m, n_w * n_e), w, n_e))
+    u_e = real_gemm(phi, z_e).reshape(nf, n_w, n_e)
+    if rc is not None:
         u_p += prep.residual(system, flat)
+        u_p -= real_gemm(rc, z_p * np.repeat(1j * w, n_ch))
+        u_e -= real_gemm(rc, z_e * np.repeat(1j * w, n_e)).reshape(nf, n_w, n_e)
         st = prep.residual(system, np.concatenate([a, b], axis=1).astype(complex))
         u_e += (w * w)[None, :, None] * st[:, None, :n_e] - (1j * w)[None, :, None] * st[
             :, None, n_e:

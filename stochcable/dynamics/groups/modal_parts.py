@@ -27,7 +27,7 @@ from stochcable.dynamics.model.blocks import (
 from stochcable.dynamics.model.modal_solvers import FossModes, foss_modes, foss_transfer_modal
 from stochcable.dynamics.model.system import Damping, LineSystem
 from stochcable.dynamics.solve.line_loads import drag_blocks, end_following, end_loads, free_load
-from stochcable.dynamics.solve.line_solve import reactions
+from stochcable.dynamics.solve.line_solve import damping_coupling, reactions
 from stochcable.dynamics.solve.node_inputs import LineInputs
 from stochcable.errors import SolverError
 
@@ -166,11 +166,18 @@ class FossLine:
             self.res0 = prep.residual(system, flat).reshape(nf, n_w, n_ch)
             st_b = prep.residual(system, b.astype(complex)).real
             self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))  # (nf, 2 n_e)
+        # the truncated modes' response to the kept modes' damping forces, −iω R C Φ z
+        # (line_solve.damping_coupling): Φ z read through Φ − iω R C Φ
+        self.rc = damping_coupling(system, prep, c)
         y_adj = cache["pa"] @ foss.chi  # (2d, 2m)
         u4 = cache["u4"].copy()
         v = (y_adj @ p0.reshape(2 * m, -1)).reshape(2, d, n_w, n_ch)
         if self.res0 is not None:
             v += self.res0[adj].reshape(2, d, n_w, n_ch)
+        if self.rc is not None:
+            rc_adj = self.rc[adj] @ foss.chi  # (2d, 2m)
+            vr = (rc_adj @ p0.reshape(2 * m, -1)).reshape(2, d, n_w, n_ch)
+            v -= iw[:, None] * vr
         u4[1:3] += v
         u4e = cache["up4"].copy()
         # the unit columns' P_e = (ω² W âh − iω W b̂h)/(iω − λ) seen through y_adj, the
@@ -181,6 +188,12 @@ class FossLine:
         ) @ rden
         ya, yb = y2[: 2 * d * n_e], y2[2 * d * n_e :]
         ve = (w2 * ya - iw * yb).reshape(2, d, n_e, n_w)
+        if self.rc is not None:
+            r2 = (rc_adj[None, :, None, :] * wab.T.reshape(2, 1, n_e, 2 * m)).reshape(
+                2 * 2 * d * n_e, 2 * m
+            ) @ rden
+            ra, rb = r2[: 2 * d * n_e], r2[2 * d * n_e :]
+            ve -= (iw * (w2 * ra - iw * rb)).reshape(2, d, n_e, n_w)
         if self.st is not None:
             sb = st_b[adj]  # (2d, n_e)
             ve += (cache["w2sa"] - iw[None, None] * sb[:, :, None]).reshape(2, d, n_e, n_w)
@@ -212,7 +225,10 @@ class FossLine:
         pc -= self.iw * gb
         pc *= self.rden[:, :, None]
         pc += self.p0
-        uf = real_gemm(self.phi, np.ascontiguousarray(self.chi @ pc.reshape(m2, -1)))
+        z = np.ascontiguousarray(self.chi @ pc.reshape(m2, -1))
+        uf = real_gemm(self.phi, z)
+        if self.rc is not None:
+            uf -= real_gemm(self.rc, z * np.repeat(self.iw.ravel(), n_ch))
         return _assemble_line(self, uf, ue, uet)
 
 
@@ -284,6 +300,10 @@ class ModalLine:
             st_b = prep.residual(system, b.astype(complex)).real
             self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))  # (nf, 2 n_e)
         adj, pa = cache["adj"], cache["pa"]  # (2d,), (2d, m)
+        # Φ z read through Φ − iω R C Φ (line_solve.damping_coupling), as FossLine
+        self.rc = damping_coupling(system, prep, c)
+        if self.rc is not None:
+            pa = pa - iw[:, None, None] * self.rc[adj][None]  # (n_w, 2d, m)
         u4 = cache["u4"].copy()
         v = np.transpose(pa @ z0, (1, 0, 2)).reshape(2, d, n_w, n_ch)
         if self.res0 is not None:
@@ -311,6 +331,8 @@ class ModalLine:
         z = self.z0 + self.ze @ ue  # (n_w, m, n_ch)
         zf = np.ascontiguousarray(np.transpose(z, (1, 0, 2))).reshape(m, n_w * n_ch)
         uf = real_gemm(self.phi, zf)
+        if self.rc is not None:
+            uf -= real_gemm(self.rc, zf * np.repeat(1j * self.inp.omega, n_ch))
         uet = np.ascontiguousarray(np.transpose(ue, (1, 0, 2)))  # (n_e, n_w, n_ch)
         return _assemble_line(self, uf, ue, uet)
 

@@ -49,13 +49,15 @@ iteration, relative change, …)."""
 
 # Modes kept for "auto" (Foss): every mode when the line has at most AUTO_ALL_MODES free
 # DOFs, else the natural frequencies up to AUTO_MODE_FACTOR times the grid's top, with
-# the static correction of the rest.  The Foss eigenproblem (2n states) is re-solved at
-# every linearization iteration, so n sets the cost: on the DESIGN.md chain (40
-# elements, 78 free DOFs, ω_max = 2 rad/s) all 78 modes cost ~20 ms per iteration, the
-# 20 modes up to 5·ω_max ~1 ms, for an end-tension σ error of 0.05 % (end_a) and
-# 0.24 % (end_b); 10 modes (2.4·ω_max) 0.2–0.4 %, 30 modes 0.02 %
-# (benchmarks/bench_analysis.py, docs/BENCHMARKS.md "Response analysis").  The direct
-# solver is exact and costs about as much as 20-mode Foss.
+# the rest by mode acceleration (their static response to the loads and to the kept
+# modes' damping forces: dynamics.solve.line_solve.damping_coupling).  The Foss
+# eigenproblem (2n states) is re-solved at every linearization iteration, so n sets the
+# cost: on the DESIGN.md chain (40 elements, 78 free DOFs, ω_max = 2 rad/s) all 78
+# modes cost ~20 ms per iteration, the 20 modes up to 5·ω_max ~1 ms; on the bundled
+# chain their end-tension σ is within 0.02 % of the direct solve (0.2 % without the
+# damping coupling), on a chain + synthetic rope line (17 of 78 modes) within 0.02 %
+# (4.7 % without it: tests/test_hard_cases.py).  The direct solver is exact and costs
+# about as much as 20-mode Foss.
 AUTO_ALL_MODES = 40
 AUTO_MODE_FACTOR = 5.0
 # First batch of modes computed when looking for the auto count (doubled as needed).
