@@ -271,15 +271,22 @@ async function loadExamples() {
     ...list.map((e) => el("option", { value: e.name, title: e.title }, e.name)));
 }
 
+// Each choice of an example asks for its scene; arrowing through a closed select asks
+// for every example passed, and the answers may come back in any order: only the
+// latest choice's answer is shown.
+let exampleTicket = 0;
+
 async function loadExample() {
   const name = $("example-select").value;
   if (!name) return;
+  const ticket = ++exampleTicket;
   try {
     const scene = await api("GET", `/v1/examples/${encodeURIComponent(name)}`);
+    if (ticket !== exampleTicket) return;  // a later choice superseded this one
     $("scene-text").value = JSON.stringify(scene, null, 1);
     showError($("scene-error"), null);
     clearNotes();
-  } catch (e) { showError($("scene-error"), e); }
+  } catch (e) { if (ticket === exampleTicket) showError($("scene-error"), e); }
 }
 
 function readFileInto(input, target, then) {

@@ -473,6 +473,26 @@ def _tab_to(page, element_id: str, limit: int = 60) -> None:
 
 
 @pytest.mark.slow
+def test_a_late_answer_for_an_earlier_example_does_not_replace_the_latest(browser, server):
+    """Arrowing through the closed select asks for every example passed; the answer for
+    an earlier one, held back here until the latest has been shown, must not replace
+    it (the keyboard test lost its example to this race on a loaded host)."""
+    page, errors = _page(browser, server.url + "/")
+    page.wait_for_selector("#example-select option[value=taut_wire]", state="attached")
+    held = []
+    page.route("**/v1/examples/taut_wire", lambda route: held.append(route))
+    page.select_option("#example-select", "taut_wire")
+    page.select_option("#example-select", "chain_catenary")
+    page.wait_for_function("document.getElementById('scene-text').value.includes('chain')")
+    assert len(held) == 1
+    held[0].continue_()
+    page.wait_for_timeout(500)  # the held answer has arrived (local server: milliseconds)
+    text = page.locator("#scene-text").input_value()
+    assert "chain" in text and "taut" not in text.lower()
+    assert errors == []
+
+
+@pytest.mark.slow
 def test_keyboard_only(browser, server):
     # the disc buoy: a body, warnings with their fixes, foot-slug-second units
     example = "tuah_1982_disc_buoy_single_leg"
