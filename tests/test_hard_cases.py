@@ -689,11 +689,12 @@ def test_400_element_line_direct_vs_foss():
     assert_finite(res_f)
     a, b = res_f.lines["l"], res_d.lines["l"]
     assert a.n_modes < a.model.free.size
-    # truncation of the drag-coupled modes above 10 ω_max (module note in analysis.py:
-    # up to 4-5 % on drag-dominated chains); measured 1.0 % (end_b), 0.06 % (end_a)
-    # with 16 modes
-    assert a.end_b.std == pytest.approx(b.end_b.std, rel=0.05)
-    assert a.end_a.std == pytest.approx(b.end_a.std, rel=0.05)
+    # the truncated modes by mode acceleration with the damping coupling
+    # (line_solve.damping_coupling): measured −0.10 % (end_b), −0.002 % (end_a) with 16
+    # modes (1.0 % and 0.06 % with the plain static correction); what is left is
+    # second order, R(ω²M − iωC)R F
+    assert a.end_b.std == pytest.approx(b.end_b.std, rel=5e-3)
+    assert a.end_a.std == pytest.approx(b.end_a.std, rel=5e-3)
     np.testing.assert_allclose(a.tension_mean, b.tension_mean, rtol=1e-12)
 
 
