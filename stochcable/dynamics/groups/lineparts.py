@@ -54,7 +54,6 @@ from stochcable.dynamics.model.modal_solvers import foss_transfer_modal
 from stochcable.dynamics.model.system import Damping, LineSystem
 from stochcable.dynamics.solve.line_loads import end_following, end_loads, free_load
 from stochcable.dynamics.solve.line_solve import (
-    damping_coupling,
     reactions,
     solve_free,
     total_displacement,
@@ -196,7 +195,7 @@ def foss_unit_split(
     w = inp.omega
     n_ch = inp_phys.weights.shape[1]
     n_e = inp.weights.shape[1] - n_ch
-    _, c, foss = foss_state(system, damping)
+    _, c, foss, rc = foss_state(system, damping)
     if foss is None:
         return None
     phi, _, _ = prep.modal(system)
@@ -205,7 +204,6 @@ def foss_unit_split(
     # physical channels: the free-row load of solve_free
     rhs = free_load(system, prep, inp_phys, damping)
     flat = np.ascontiguousarray(prep.free_rows(rhs)).reshape(nf, n_w * n_ch)
-    rc = damping_coupling(system, prep, c)  # (−iω R C Φ z: mode acceleration)
     z_p = np.ascontiguousarray(foss_transfer_modal(foss, real_gemm(phi.T, flat), w, n_ch))
     u_p = real_gemm(phi, z_p)
     # unit channels: U_p,j constant (node vectors (n, d, n_e))

@@ -34,8 +34,9 @@ from stochcable.errors import SolverError
 __all__ = ["FossLine", "FossState", "ModalLine", "PartCache", "foss_state"]
 
 #: The drag-dependent, frequency-independent start of a Foss line
-#: (:func:`foss_state`): the drag blocks C_d, the damping C and the Foss decomposition.
-FossState = tuple[NodeBlocks, NodeBlocks, FossModes | None]
+#: (:func:`foss_state`): the drag blocks C_d, the damping C, the Foss decomposition and
+#: the truncated modes' damping coupling R C Φ (None with every mode kept).
+FossState = tuple[NodeBlocks, NodeBlocks, FossModes | None, np.ndarray | None]
 #: The drag-independent arrays of one line's part, kept across the evaluations of
 #: the fixed point (:class:`FossLine`, :class:`ModalLine`): arrays and tuples of
 #: arrays by name.
@@ -52,10 +53,12 @@ def foss_state(system: LineSystem, damping: Damping) -> FossState:
 
     Returns
     -------
-    (C_d, C, foss)
-        The drag blocks C_d, the damping C = S + C_d [N·s/m] and the Foss
+    (C_d, C, foss, rc)
+        The drag blocks C_d, the damping C = S + C_d [N·s/m], the Foss
         decomposition of the line's kept modes (None when the pencil is defective,
-        Tuah (1982), §5.3).
+        Tuah (1982), §5.3) and R C Φ of
+        :func:`~stochcable.dynamics.solve.line_solve.damping_coupling` (None with
+        every mode kept).
 
     Notes
     -----
@@ -66,12 +69,13 @@ def foss_state(system: LineSystem, damping: Damping) -> FossState:
     cd = drag_blocks(system, damping)
     c = add_blocks(prep.S, cd)
     phi, mh, kh = prep.modal(system)
-    ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
+    cphi = prep.free_rows(block_matvec(c, prep.nodes(phi)))
+    ch = phi.T @ cphi
     try:
         foss = foss_modes(mh, 0.5 * (ch + ch.T), kh)
     except SolverError:
         foss = None
-    return cd, c, foss
+    return cd, c, foss, damping_coupling(system, prep, c, cphi)
 
 
 def _unit_follow(
@@ -134,7 +138,7 @@ class FossLine:
         w = inp.omega
         n_w, n_ch = inp.weights.shape
         d = prep.d
-        _, c, foss = foss_state(system, damping) if state is None else state
+        _, c, foss, rc = foss_state(system, damping) if state is None else state
         if foss is None:
             raise SolverError("Foss eigenproblem is (nearly) defective")
         phi, _, _ = prep.modal(system)
@@ -168,7 +172,7 @@ class FossLine:
             self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))  # (nf, 2 n_e)
         # the truncated modes' response to the kept modes' damping forces, −iω R C Φ z
         # (line_solve.damping_coupling): Φ z read through Φ − iω R C Φ
-        self.rc = damping_coupling(system, prep, c)
+        self.rc = rc
         y_adj = cache["pa"] @ foss.chi  # (2d, 2m)
         u4 = cache["u4"].copy()
         v = (y_adj @ p0.reshape(2 * m, -1)).reshape(2, d, n_w, n_ch)
@@ -273,7 +277,8 @@ class ModalLine:
         cache = _modal_cache(system, prep, inp, ends, cache)
         u_p = cache["u_p"]
         up, _, st_a = cache["follow"]
-        ch = phi.T @ prep.free_rows(block_matvec(c, prep.nodes(phi)))
+        cphi = prep.free_rows(block_matvec(c, prep.nodes(phi)))
+        ch = phi.T @ cphi
         rhs = free_load(system, prep, inp, damping)
         flat = np.ascontiguousarray(prep.free_rows(rhs)).reshape(nf, n_w * n_ch)
         b = prep.free_rows(block_matvec(c, up))
@@ -301,7 +306,7 @@ class ModalLine:
             self.st = np.ascontiguousarray(np.hstack([st_a, st_b]))  # (nf, 2 n_e)
         adj, pa = cache["adj"], cache["pa"]  # (2d,), (2d, m)
         # Φ z read through Φ − iω R C Φ (line_solve.damping_coupling), as FossLine
-        self.rc = damping_coupling(system, prep, c)
+        self.rc = damping_coupling(system, prep, c, cphi)
         if self.rc is not None:
             pa = pa - iw[:, None, None] * self.rc[adj][None]  # (n_w, 2d, m)
         u4 = cache["u4"].copy()
