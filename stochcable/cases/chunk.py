@@ -42,6 +42,7 @@ from stochcable.compiled import kernels_paid
 from stochcable.design import damage_rate
 from stochcable.dynamics.engine import Engine, build_engine
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
+from stochcable.dynamics.groups.lineparts import SMALL_MODAL_DOFS
 from stochcable.dynamics.outputs.line_result import MOTION_RESIDUALS
 from stochcable.errors import StochcableError, collect_warnings
 from stochcable.fidelity.mesh_engine import checked_engine
@@ -355,7 +356,7 @@ def solve_chunk(
     -------
     ChunkResult
     """
-    with threadpool_limits(limits=1), _no_motion_residuals(), kernels_paid():
+    with threadpool_limits(limits=1), _set_solves(), kernels_paid():
         engine = _engine(template) if engine is None else engine
         linear_engine = None  # (the same engine without the residuals, when needed)
         # (the engine's counts: the element check may have raised the defaults)
@@ -462,14 +463,20 @@ def _corrected_rows(
 
 
 @contextlib.contextmanager
-def _no_motion_residuals():
+def _set_solves():
     """A set reports no node or body motions: their residuals are not computed (the
     end and element tensions the same; on the chain example ≈ 12 ms of a computed
-    case's ≈ 53 ms of residuals, docs/benchmarks/cases.md)."""
+    case's ≈ 53 ms of residuals, docs/benchmarks/cases.md); and a line alone below
+    :data:`DIRECT_MIN_DOFS` free DOFs whose Foss solve keeps every mode solves its
+    modal equations per frequency
+    (:data:`~stochcable.dynamics.groups.lineparts.SMALL_MODAL_DOFS`: the same σ to
+    round-off, no eigenproblem at each fixed-point evaluation)."""
     token = MOTION_RESIDUALS.set(False)
+    small = SMALL_MODAL_DOFS.set(DIRECT_MIN_DOFS)
     try:
         yield
     finally:
+        SMALL_MODAL_DOFS.reset(small)
         MOTION_RESIDUALS.reset(token)
 
 
