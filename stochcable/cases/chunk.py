@@ -208,13 +208,16 @@ def run_lead(
 
 
 #: Fewest free DOFs of a line for a set to solve it directly when its Foss solve keeps
-#: every mode (:func:`set_engine`).  A linear set's case by the direct solve over the
-#: Foss solve's (interleaved, ``benchmarks/case_cost.py --solvers``): the taut wire
-#: (38 free DOFs, every mode kept) 0.55 by the chunk's compiled banded LU; Tuah's single
-#: leg (4, every mode kept) 1.05 by LAPACK's gbsv (its jobs are under
-#: :data:`~stochcable.compiled.SET_KERNEL_MIN_ENTRIES`; 0.95 by the compiled LU, not
-#: worth numba's import); the chain and the two-segment line (78; 20 and 17 modes
-#: kept, not the same equations) 1.1 and 1.2. [-]
+#: every mode (:func:`set_engine`); below it such a line alone solves its modal
+#: equations per frequency in a chunk instead
+#: (:data:`~stochcable.dynamics.groups.lineparts.SMALL_MODAL_DOFS`).  A linear set's
+#: case by the direct solve over the Foss solve's (interleaved,
+#: ``benchmarks/case_cost.py --solvers``): the taut wire (38 free DOFs, every mode kept)
+#: 0.55 by the chunk's compiled banded LU; Tuah's single leg (4, every mode kept) 1.05
+#: by LAPACK's gbsv (its jobs are under :data:`~stochcable.compiled.SET_KERNEL_MIN_ENTRIES`;
+#: 0.95 by the compiled LU, not worth numba's import), 0.90 by its modal equations (one
+#: batched 4 × 4 LU per evaluation, no eigenproblem); the chain and the two-segment
+#: line (78; 20 and 17 modes kept, not the same equations) 1.1 and 1.2. [-]
 DIRECT_MIN_DOFS = 20
 
 
