@@ -407,7 +407,13 @@ def _why(others: dict) -> list[str]:
         "(its residual variance no power of Hs: σ missed by 1e-2 between Hs 1 m apart,",
         "the ratios' law 7e-3), so each period chooses.  Not tried: interpolating each",
         "computed case's residual spectral density line by line (the chunks would return",
-        "them); the moments m0 and m2 are two of its integrals.",
+        "them); the moments m0 and m2 are two of its integrals.  On Tuah's realistic",
+        "diagram every period is computed: its corrections move with the period by",
+        "more than the tolerance between periods 2–3 s apart (the middle period missed",
+        "by 2.2e-3 … 7.4e-3 linear in Tp, 2.6e-3 … 3.3e-3 quadratic through a third",
+        "computed period; replayed on the every-case set), so neither that law nor",
+        "leaving out the spread test computes fewer than 44 of 100, and its end periods",
+        "taking the middle period's or the other end's shape none fewer.",
         "",
         "What a case's fixed point saves in a set: each anchor starts from the σ of the",
         "computed cases of its column interpolated in Hs",
@@ -422,7 +428,12 @@ def _why(others: dict) -> list[str]:
         "−13 % evaluations, within the timing noise, and re-solved leads on chunked",
         "executors).  `analyze()` itself would be faster without the coarse stage on",
         "these two lines (taut wire 25.5 against 30.4 ms: 2 evaluations from rest;",
-        "Tuah 16.8 against 18.2 ms), which would raise the ratios above.",
+        "Tuah 16.8 against 18.2 ms), which would raise the ratios above.  Tried on",
+        "Tuah's realistic set and not kept: Anderson's memory opened with the case",
+        "before's last secant pair (−0.17 evaluations a case), a relaxed or",
+        "over-relaxed second point (0.5 … 2: more evaluations), a column start",
+        "corrected by a fully computed period's shape (no closer: its σ's shape in Hs",
+        "changes with the period).",
     ]
 
 
