@@ -42,6 +42,7 @@ from stochcable.compiled import kernels_paid
 from stochcable.design import damage_rate
 from stochcable.dynamics.engine import Engine, build_engine
 from stochcable.dynamics.groups.group_fixed_point import warm_starts
+from stochcable.dynamics.groups.lineparts import SMALL_MODAL_DOFS
 from stochcable.dynamics.outputs.line_result import MOTION_RESIDUALS
 from stochcable.errors import StochcableError, collect_warnings
 from stochcable.fidelity.mesh_engine import checked_engine
@@ -207,13 +208,16 @@ def run_lead(
 
 
 #: Fewest free DOFs of a line for a set to solve it directly when its Foss solve keeps
-#: every mode (:func:`set_engine`).  A linear set's case by the direct solve over the
-#: Foss solve's (interleaved, ``benchmarks/case_cost.py --solvers``): the taut wire
-#: (38 free DOFs, every mode kept) 0.55 by the chunk's compiled banded LU; Tuah's single
-#: leg (4, every mode kept) 1.05 by LAPACK's gbsv (its jobs are under
-#: :data:`~stochcable.compiled.SET_KERNEL_MIN_ENTRIES`; 0.95 by the compiled LU, not
-#: worth numba's import); the chain and the two-segment line (78; 20 and 17 modes
-#: kept, not the same equations) 1.1 and 1.2. [-]
+#: every mode (:func:`set_engine`); below it such a line alone solves its modal
+#: equations per frequency in a chunk instead
+#: (:data:`~stochcable.dynamics.groups.lineparts.SMALL_MODAL_DOFS`).  A linear set's
+#: case by the direct solve over the Foss solve's (interleaved,
+#: ``benchmarks/case_cost.py --solvers``): the taut wire (38 free DOFs, every mode kept)
+#: 0.55 by the chunk's compiled banded LU; Tuah's single leg (4, every mode kept) 1.05
+#: by LAPACK's gbsv (its jobs are under :data:`~stochcable.compiled.SET_KERNEL_MIN_ENTRIES`;
+#: 0.95 by the compiled LU, not worth numba's import), 0.90 by its modal equations (one
+#: batched 4 × 4 LU per evaluation, no eigenproblem); the chain and the two-segment
+#: line (78; 20 and 17 modes kept, not the same equations) 1.1 and 1.2. [-]
 DIRECT_MIN_DOFS = 20
 
 
@@ -355,7 +359,7 @@ def solve_chunk(
     -------
     ChunkResult
     """
-    with threadpool_limits(limits=1), _no_motion_residuals(), kernels_paid():
+    with threadpool_limits(limits=1), _set_solves(), kernels_paid():
         engine = _engine(template) if engine is None else engine
         linear_engine = None  # (the same engine without the residuals, when needed)
         # (the engine's counts: the element check may have raised the defaults)
@@ -462,14 +466,20 @@ def _corrected_rows(
 
 
 @contextlib.contextmanager
-def _no_motion_residuals():
+def _set_solves():
     """A set reports no node or body motions: their residuals are not computed (the
     end and element tensions the same; on the chain example ≈ 12 ms of a computed
-    case's ≈ 53 ms of residuals, docs/benchmarks/cases.md)."""
+    case's ≈ 53 ms of residuals, docs/benchmarks/cases.md); and a line alone below
+    :data:`DIRECT_MIN_DOFS` free DOFs whose Foss solve keeps every mode solves its
+    modal equations per frequency
+    (:data:`~stochcable.dynamics.groups.lineparts.SMALL_MODAL_DOFS`: the same σ to
+    round-off, no eigenproblem at each fixed-point evaluation)."""
     token = MOTION_RESIDUALS.set(False)
+    small = SMALL_MODAL_DOFS.set(DIRECT_MIN_DOFS)
     try:
         yield
     finally:
+        SMALL_MODAL_DOFS.reset(small)
         MOTION_RESIDUALS.reset(token)
 
 

@@ -105,6 +105,8 @@ def input_densities(scene: Scene) -> list[tuple[str, Callable[[np.ndarray], np.n
 
 
 _WIDE = np.geomspace(1e-4, 1e4, 16001)
+#: ω² on :data:`_WIDE` (formed once: :func:`sea_omega2` runs for every sea state of a set)
+_WIDE_SQ = _WIDE**2
 
 
 def input_band(scene: Scene, fraction: float) -> tuple[float, float, dict[str, tuple]]:
@@ -172,7 +174,7 @@ def sea_omega2(scene: Scene) -> float | None:
     m0 = np.trapezoid(s, _WIDE)
     if not m0 > 0.0:
         return None
-    return math.sqrt(np.trapezoid(_WIDE**2 * s, _WIDE) / m0)
+    return math.sqrt(np.trapezoid(_WIDE_SQ * s, _WIDE) / m0)
 
 
 def base_error(scene: Scene, w_min: float, w_max: float, n: int) -> float:

@@ -351,7 +351,7 @@ def test_a_set_skips_the_node_motion_residuals_only():
     to round-off (the shared influence's end and element rows are solved alone)."""
     import warnings
 
-    from stochcable.cases.chunk import _no_motion_residuals, case_sea, engine_template, set_engine
+    from stochcable.cases.chunk import _set_solves, case_sea, engine_template, set_engine
     from stochcable.dynamics.outputs.line_result import MOTION_RESIDUALS
 
     scene = load_scene(_wire())
@@ -361,7 +361,7 @@ def test_a_set_skips_the_node_motion_residuals_only():
         engine = set_engine(engine_template(scene, sd.states, "jonswap"))
         sea = case_sea(scene, sd.states[0], "jonswap")
         full = engine.solve(sea).lines["wire"]
-        with _no_motion_residuals():
+        with _set_solves():
             assert not MOTION_RESIDUALS.get()
             part = engine.solve(sea).lines["wire"]
     assert MOTION_RESIDUALS.get()

@@ -63,7 +63,7 @@ def test_a_chunk_takes_the_compiled_banded_lu_at_any_size(monkeypatch):
     pytest.importorskip("stochcable.dynamics.model.band_lu_kernels")
     import stochcable.dynamics.residuals.band_influence as bi
     import stochcable.dynamics.solve.line_solve as line_solve
-    from stochcable.cases.chunk import _no_motion_residuals, solve_chunk
+    from stochcable.cases.chunk import _set_solves, solve_chunk
     from stochcable.compiled import KERNEL_MIN_ENTRIES, SET_KERNEL_MIN_ENTRIES, kernels_paid
     from stochcable.dynamics.model.band_lu import compiled_band_lu
 
@@ -90,7 +90,7 @@ def test_a_chunk_takes_the_compiled_banded_lu_at_any_size(monkeypatch):
         warnings.simplefilter("ignore")
         template = engine_template(scene, sd.states, "jonswap")
         engine = set_engine(template)
-        with _no_motion_residuals():  # (as in a chunk, but LAPACK's gbsv: under the size)
+        with _set_solves():  # (as in a chunk, but LAPACK's gbsv: under the size)
             ref = engine.solve(case_sea(scene, sd.states[0], "jonswap")).lines["wire"]
         assert not calls and not solves
         fat = {"wire": LineFatigue("dnv-six-strand", nominal_area=1.2e-3)}
@@ -128,3 +128,56 @@ def test_a_computed_cases_corrected_densities_are_one_damage_job_on_one_grid():
     assert [j[0] for j in jobs] == [slice(0, 1), slice(1, 2), slice(2, None)]
     assert [j[0] for j in _corrected_rows(ends, None)] == [slice(0, 2)]
     assert [j[0] for j in _corrected_rows(None, el)] == [slice(2, None)]
+
+
+def _leg() -> dict:
+    doc = load_example("tuah_1982_single_leg").model_dump(mode="json", exclude_none=True)
+    doc["analysis"].pop("timeseries", None)
+    doc["analysis"]["linearization"].update(drag_residual=True, geometric_residual=True)
+    return doc
+
+
+def test_a_small_line_keeping_every_mode_solves_its_modal_equations_in_a_set(monkeypatch):
+    """Tuah's single leg (4 free DOFs, every mode kept, under DIRECT_MIN_DOFS): inside a
+    chunk its fixed point solves the modal equations per frequency (no Foss
+    eigenproblem); the case equals the engine's own Foss solve of its sea, σ, Tz and
+    MPM, to round-off (1e-12: the same equations, every mode kept, solved two ways;
+    measured 2e-14), with the residuals on; outside a chunk (analyze()) the Foss solve
+    stays.  Where the batched LU fails (a singular frequency) the Foss solve takes the
+    evaluation, with the same numbers."""
+    import stochcable.dynamics.groups.lineparts as lineparts
+    import stochcable.dynamics.solve.line_solve as ms
+    from stochcable.cases.chunk import solve_chunk
+    from stochcable.dynamics.groups.lineparts import SMALL_MODAL_DOFS
+
+    scene = load_scene(_leg())
+    sd = scatter_from_rows([{"hs": 4.0, "tp": 9.0, "hours": 1.0}])
+    fat = {"leg": LineFatigue("api-studless", mbs=2.0e5)}
+    eig = []
+    real = ms.foss_modes
+    monkeypatch.setattr(ms, "foss_modes", lambda *a, **k: eig.append(1) or real(*a, **k))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        template = engine_template(scene, sd.states, "jonswap")
+        engine = set_engine(template)
+        ref = engine.solve(case_sea(scene, sd.states[0], "jonswap")).lines["leg"]
+        assert eig and SMALL_MODAL_DOFS.get() == 0  # (outside a chunk: Foss)
+        eig.clear()
+        got = solve_chunk(template, "jonswap", ((0, sd.states[0]),), fat, engine)
+        assert not eig and SMALL_MODAL_DOFS.get() == 0  # (restored after the chunk)
+        calls, real_line = [], lineparts.FreeLine
+
+        def singular(system, inp, damping, modal_direct=False):
+            if modal_direct and inp.omega.size == ref.omega.size:  # (not the coarse stage's)
+                calls.append(1)
+                raise np.linalg.LinAlgError("Singular matrix")
+            return real_line(system, inp, damping, modal_direct)
+
+        monkeypatch.setattr(lineparts, "FreeLine", singular)
+        back = solve_chunk(template, "jonswap", ((0, sd.states[0]),), fat, engine)
+    assert calls and eig  # (the batched LU tried, then the Foss solve)
+    for e in ("end_a", "end_b"):
+        st = getattr(ref, e)
+        want = (st.mean, st.std, st.tz, st.mpm_3h)
+        np.testing.assert_allclose(got.stats["leg"][e][0], want, rtol=1e-12)
+        np.testing.assert_allclose(back.stats["leg"][e][0], want, rtol=1e-12)

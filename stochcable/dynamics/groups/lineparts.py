@@ -32,6 +32,7 @@ Tuah, H. (1982), Cable dynamics in an ocean environment, PhD thesis, Oregon Stat
 from __future__ import annotations
 
 from collections.abc import Mapping
+from contextvars import ContextVar
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -65,7 +66,16 @@ from stochcable.runtime import line_map
 if TYPE_CHECKING:  # pragma: no cover
     from stochcable.dynamics.groups.group import GroupSystem
 
-__all__ = ["LinePart", "foss_unit_split", "line_parts"]
+__all__ = ["LinePart", "SMALL_MODAL_DOFS", "foss_unit_split", "line_parts"]
+
+#: Below this many free DOFs a line alone whose Foss solve keeps every mode solves its
+#: modal equations per frequency (one batched dense LU, :func:`_free_part`) instead of
+#: by the Foss eigenproblem at every evaluation: set by a load-case set's chunk
+#: (:func:`stochcable.cases.chunk.solve_chunk`), 0 (off) elsewhere, so ``analyze()``
+#: keeps its numbers.  The same equations (every mode kept: no static correction), so
+#: the same σ to round-off: Tuah's single leg (4 free DOFs) within 2e-14, its linear
+#: set's case 0.90 × the Foss solve's (docs/benchmarks/cases.md). [-]
+SMALL_MODAL_DOFS: ContextVar[int] = ContextVar("SMALL_MODAL_DOFS", default=0)
 
 
 def line_parts(
@@ -124,7 +134,7 @@ def _line_part(
     rows = g.rows[cl.name]
     n_ch = g.n_ch
     if not cl.attached():  # a line alone: its own response (no end motion to combine)
-        part = FreeLine(system, g.inp_phys[cl.name], damping, g.modal_direct)
+        part = _free_part(system, g.inp_phys[cl.name], damping, g.modal_direct)
         return (part, *part.reactions(rows))
     if system.solver != "direct" and g.modal_direct:
         part = ModalLine(
@@ -159,6 +169,32 @@ def _line_part(
     u = total_displacement(system, inp, u_f)
     sup = reactions(system, line_prep(system), c, u, end_loads(system, inp, damping), g.omega)
     return (u, sup), sup[:, rows, :n_ch], sup[:, rows, n_ch:]
+
+
+def _free_part(
+    system: LineSystem, inp: LineInputs, damping: Damping, modal_direct: bool
+) -> FreeLine:
+    """A line alone (:class:`FreeLine`): by its modal equations per frequency where
+    ``modal_direct`` (the coarse stage) or where :data:`SMALL_MODAL_DOFS` asks for it
+    (a Foss line keeping every mode, fewer free DOFs than it), else by the Foss
+    eigenproblem; the latter also where such a set's solve meets a singular or
+    non-finite frequency (the Foss solve's checks then speak)."""
+    n_free = system.model.free.size
+    small = (
+        not modal_direct
+        and system.solver == "foss"
+        and system.n_modes >= n_free
+        and n_free < SMALL_MODAL_DOFS.get()
+    )
+    if small:
+        try:
+            part = FreeLine(system, inp, damping, True)
+        except np.linalg.LinAlgError:
+            pass
+        else:
+            if np.all(np.isfinite(part.u_free)):
+                return part
+    return FreeLine(system, inp, damping, modal_direct)
 
 
 def foss_unit_split(

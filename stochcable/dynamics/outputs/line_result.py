@@ -237,11 +237,11 @@ def line_result(
     end_force = _end_force_transfer(model, resp, n_ch)
     residual = {}
     std = {e: stats[e].std for e in stats}
-    shared = _shared_influence(system, linearization.damping, influence, alone)
+    kinds = residual_parts(settings.linearization) if linearization.record is not None else ()
+    # (formed only where a kind reads it: a linear case of a set skips the station rows)
+    shared = _shared_influence(system, linearization.damping, influence, alone) if kinds else None
     taps = {}  # (each kind's loads and load cross-spectra, for the element tensions)
-    for kind, fn in (
-        residual_parts(settings.linearization) if linearization.record is not None else ()
-    ):
+    for kind, fn in kinds:
         with residual_tap() as taps[kind.name]:
             residual[kind.name] = (
                 fn(system, channels, linearization, std, influence=shared)

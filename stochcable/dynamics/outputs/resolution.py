@@ -273,6 +273,8 @@ def excitation_end(channels: tuple[Channel, ...], omega: np.ndarray) -> float:
         spectrum = np.asarray(ch.spectrum)
         if not np.any(spectrum > 0):
             continue
+        if np.asarray(ch.density(probe[-1:]))[0] > 0:  # (still on at the probe's top)
+            return math.inf
         above = np.flatnonzero(np.asarray(ch.density(probe)) > 0)
         if above.size == 0:
             end = max(end, float(omega[np.flatnonzero(spectrum > 0)[-1]]))
