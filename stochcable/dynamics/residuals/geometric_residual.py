@@ -308,9 +308,12 @@ def quadratic_output_lines(
     n_p = len(processes)
     n_el = processes[0].shape[1]
     n_o = transfer.shape[2]
-    # Σ_c conj(x_ce)·y_cf per line of every two processes and elements
+    # Σ_c conj(x_ce)·y_cf per line of every two processes and elements: one product of
+    # the processes side by side (per line a (n_p·n_el)² matrix, its blocks views)
+    both = np.ascontiguousarray(np.concatenate(processes, axis=1).transpose(2, 0, 1))
+    every = np.conj(both).transpose(0, 2, 1) @ both  # (n_j, n_p·n_el, n_p·n_el)
     cross = {
-        (x, y): np.conj(processes[x]).transpose(2, 1, 0) @ processes[y].transpose(2, 0, 1)
+        (x, y): every[:, x * n_el : (x + 1) * n_el, y * n_el : (y + 1) * n_el]
         for x in range(n_p)
         for y in range(n_p)
     }
@@ -323,7 +326,7 @@ def quadratic_output_lines(
         for i, terms_i in enumerate(terms):
             for j, terms_j in enumerate(terms):
                 cov = sum(
-                    ci * cj * (r[x1, x2] * r[y1, y2] + r[x1, y2] * r[y1, x2])
+                    ci * cj * _isserlis(r, x1, y1, x2, y2)
                     for ci, x1, y1 in terms_i
                     for cj, x2, y2 in terms_j
                 )
@@ -331,3 +334,14 @@ def quadratic_output_lines(
                 # e's component i, f's j (transfer columns component-major)
                 out.add(np.fft.rfft(cov, axis=1)[:, 1 : n_o + 1], i * n_el + e, j * n_el + f)
     return out.outputs()
+
+
+def _isserlis(r: dict, x1: int, y1: int, x2: int, y2: int) -> np.ndarray:
+    """R_{x₁x₂}R_{y₁y₂} + R_{x₁y₂}R_{y₁x₂} of the lag functions ``r`` (by process pair);
+    where the two products have the same factors (x₁ = y₁ or x₂ = y₂) one is formed and
+    doubled (the same numbers: the products commute and p + p is exact)."""
+    first = r[x1, x2] * r[y1, y2]
+    if x1 == y1 or x2 == y2:
+        first += first
+        return first
+    return first + r[x1, y2] * r[y1, x2]
