@@ -162,16 +162,16 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     # element tensions' own stretch, influence.geometric_feedthrough)
     length, l0 = element_lengths(system)
     frames = element_frames(system)  # the split element along its suspended part
-    u = np.zeros((w.size, model.n_nodes, 3, n_ch), dtype=complex)
-    u[:, :, comps] = resp.displacement.reshape(w.size, model.n_nodes, d, n_ch)
-    du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, 3, n_ch)
+    # the motions on the model's components (a planar line's frames have no third)
+    u = np.asarray(resp.displacement, dtype=complex).reshape(w.size, model.n_nodes, d, n_ch)
+    du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, d, n_ch)
     mesh = model.mesh
     # the element split at the touchdown: its suspended part, as the linear model's
     split = _suspended_part(model, u, du)
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
-    proc = [grid.lines(x, spectra) for x in along_each(du, frames)]
+    proc = [grid.lines(x, spectra) for x in along_each(du, [f[:, comps] for f in frames])]
     kappa = (mesh.ea / l0 - np.asarray(system.statics.tension) / length) / length
     # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms
     comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [
@@ -203,7 +203,8 @@ def _suspended_part(
 ) -> tuple[int, np.ndarray] | None:
     """The element that the linear model splits at the static touchdown
     (:attr:`stochcable.line.fem.FEModel.bed`) as its suspended part t–b, in place:
-    ``du`` its u_b − u_t (u_t = R·[u_a; u_b] the condensed touchdown node's motion),
+    ``du`` (on the model's components) its u_b − u_t (u_t = R·[u_a; u_b] the condensed
+    touchdown node's motion),
     (its frames and l, L₀: :func:`~stochcable.dynamics.residuals.influence.element_frames`,
     :func:`~stochcable.dynamics.residuals.influence.element_lengths`).  The
     chord a–b instead picks up the upper node's heave in its axial motion (×7 on a leg
@@ -213,11 +214,10 @@ def _suspended_part(
     bed = getattr(model, "bed", None)
     if bed is None or bed.element is None:
         return None
-    k, d, comps = bed.element, model.dim, list(model.components)
+    k, d = bed.element, model.dim
     r_t = np.asarray(bed.transform, dtype=float)[d : 2 * d]  # (d, 2d)
-    ab = np.concatenate([u[:, k, comps], u[:, k + 1, comps]], axis=1)  # (n_w, 2d, n_ch)
-    du[:, k] = 0.0
-    du[:, k, comps] = u[:, k + 1, comps] - np.einsum("ij,wjc->wic", r_t, ab)
+    ab = np.concatenate([u[:, k], u[:, k + 1]], axis=1)  # (n_w, 2d, n_ch)
+    du[:, k] = u[:, k + 1] - np.einsum("ij,wjc->wic", r_t, ab)
     return k, r_t
 
 
