@@ -244,8 +244,11 @@ def element_mean_velocity(
     sum in one closed form), in its horizontal part (along the heading) and vertical
     part: shape (n_el, 2, n_omega). [(m/s)/m]"""
     w, k, pts, beta, h, g = _checked(omega, positions, heading, depth, g)
-    src = _source(w, k, pts, beta, h, g)[0]
-    return mean_block(w, k, src.geometry)
+    geo = _source(w, k, pts, beta, h, g)[0].geometry
+    out = np.empty((pts.shape[0] - 1, 2, w.size), dtype=complex)
+    for sl in sub_blocks(w.size, out.shape[0]):  # (blocks of frequencies, as the moments')
+        out[..., sl] = mean_block(w[sl], k[sl], geo)
+    return out
 
 
 def _element_kinematics(
