@@ -130,19 +130,8 @@ class ModalRows:
         x += rc[0][..., None]
         dyn = self._marked()[0]
         if dyn is not None:
-            # iω·r₂ − ω²·r₁ on the real and imaginary parts apart (real temporaries of
-            # the dynamic rows only): (−ω Im r₂ − ω² Re r₁) + i(ω Re r₂ − ω² Im r₁), the
-            # complex products' terms in their order (the same numbers)
             w = self.w
-            w2 = w * w
-            r1, r2 = rc[1][:, dyn, None], rc[2][:, dyn, None]
-            part = np.multiply(r2.imag, w)
-            np.negative(part, out=part)
-            part -= r1.real * w2
-            x.real[:, dyn] += part
-            part = np.multiply(r2.real, w)
-            part -= r1.imag * w2
-            x.imag[:, dyn] += part
+            x[:, dyn] += rc[2][:, dyn, None] * (1j * w) - rc[1][:, dyn, None] * (w * w)
         return x
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
