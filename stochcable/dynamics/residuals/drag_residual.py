@@ -516,9 +516,9 @@ def cell_factor(
 
 #: Panel components whose residual force (largest |a_k|, k ≥ 2, times cσ²L) is below
 #: this fraction of the line's largest are left out before their end transfer: the
-#: grounded panels of a chain (the bundled chain's 21 of 66: 1e-17 and less of its
-#: largest).  Their score (:func:`_live_panels`) would need an end tension per unit
-#: force 10⁹ times the largest panel's to reach :data:`PANEL_FLOOR`. [-]
+#: grounded panels of a chain (the bundled chain's 8 of 66: 2e-14 and less of its
+#: largest, the next 2e-12).  Their score (:func:`_live_panels`) would need an end
+#: tension per unit force 10⁹ times the largest panel's to reach :data:`PANEL_FLOOR`. [-]
 DEAD_FORCE = 1e-12
 
 
