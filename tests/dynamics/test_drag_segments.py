@@ -22,6 +22,7 @@ from stochcable import analyze, load_example, load_scene
 from stochcable.cases import run_cases, scatter_from_rows
 from stochcable.dynamics.loads.channels import line_channels
 from stochcable.dynamics.model.system import build_line_system
+from stochcable.dynamics.residuals.drag_misfit import misfit_scales
 from stochcable.dynamics.residuals.drag_residual import hermite_coefficients, residual_output_lines
 from stochcable.dynamics.residuals.drag_segments import (
     MAX_SUB,
@@ -185,7 +186,7 @@ def test_misfit_plus_hermite_equal_monte_carlo_of_the_pointwise_drag():
     frequency-dependent filters, and a linear response correlated with the
     velocities: the variance the pointwise drag c|v_s|v_s·l_s adds to the linear model
     with the element-constant B_e (its mean-variance fit) — over Gaussian realizations —
-    equals the closed form: the misfit δB_s·l_s·v_s (:func:`drag_residual._misfit`,
+    equals the closed form: the misfit δB_s·l_s·v_s (:func:`drag_misfit.misfit_scales`,
     its cross term with the linear response included) plus the Hermite residual
     (orders 2…9, no cross term).  Tolerance: 4 standard errors of the Monte-Carlo
     mean (paired: the linear part of each realization subtracted)."""
@@ -207,7 +208,7 @@ def test_misfit_plus_hermite_equal_monte_carlo_of_the_pointwise_drag():
     sig = np.sqrt((np.abs(lines) ** 2).sum(axis=(0, 2)))
     var_e = np.array([np.mean(sig[:3] ** 2), sig[3] ** 2])
     b_el = c * math.sqrt(8.0 / math.pi) * np.sqrt(var_e)  # the FD's B of each element
-    misfit = dr._misfit(seg, groups, np.full(2, c), np.zeros(2), b_el, sig)
+    misfit = misfit_scales(seg, groups, np.full(2, c), np.zeros(2), b_el, sig)
     assert misfit[3] == 0.0 and misfit[0] > 0 > misfit[2]
     coeffs = hermite_coefficients(np.zeros(4), order)
     n_o = order * (n_j - 1)

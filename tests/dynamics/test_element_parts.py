@@ -148,3 +148,35 @@ def test_end_square_weighted_sum_kept_for_the_same_weights() -> None:
     other = ends.weighted(2.0 * q)
     assert np.array_equal(other, fresh.weighted(2.0 * q))
     assert np.array_equal(ends.weighted(q), again)
+
+
+@pytest.mark.parametrize("depth", [60.0, np.inf], ids=["depth60", "deep"])
+def test_mean_velocity_is_the_sum_of_the_moments(depth) -> None:
+    """element_mean_velocity (∫ v dξ over the wet part in one closed form, the drag
+    residual's split pieces) equals the sum of element_wave_velocity's two moments to
+    round-off (1e-14 of the largest: the same integral, φ1 alone against φ1 − ψ + ψ) —
+    elements crossing the waterline and dry ones, ω = 0 (the long-wave limit) — in its
+    horizontal part along the heading and its vertical part; its arguments are checked
+    as the kinematics' are."""
+    from stochcable.dynamics.loads.element_kinematics import (
+        element_mean_velocity,
+        element_wave_velocity,
+    )
+    from stochcable.errors import InputError
+
+    w = np.linspace(0.0, 4.0, 61)
+    beta = 0.4
+    pts = np.vstack([_line(), [310.0, 42.0, 8.0]])  # (and a dry element above z = +4 m)
+    got = element_mean_velocity(w, pts, heading=beta, depth=depth)  # (n_el, 2, n_w)
+    ref = element_wave_velocity(w, pts, heading=beta, depth=depth).sum(axis=2)
+    as_xyz = np.stack(
+        [got[:, 0] * np.cos(beta), got[:, 0] * np.sin(beta), got[:, 1]], axis=-1
+    ).transpose(1, 0, 2)  # (n_w, n_el, 3), as the moments' components
+    scale = np.abs(ref).max()
+    assert scale > 0.0 and np.abs(as_xyz - ref).max() <= 1e-14 * scale
+    dry = np.all(ref == 0.0, axis=(0, 2))
+    assert dry[-1] and np.all(got[dry] == 0.0)  # (the dry element: exact zeros)
+    # ω = 0: finite depth's long-wave limit √(g/h) over the wet part, deep water's 0
+    assert np.any(got[:, 0, 0] != 0.0) == np.isfinite(depth)
+    with pytest.raises(InputError, match="depth"):
+        element_mean_velocity(w, _line(), heading=beta, depth=30.0)

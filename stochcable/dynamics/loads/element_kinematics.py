@@ -48,7 +48,11 @@ from stochcable.dynamics.loads.element_parts import (
     sub_blocks,
 )
 from stochcable.dynamics.loads.freqblocks import FrequencyIndex, working_memory_bytes
-from stochcable.dynamics.loads.kinematics_closed_forms import kinematics_block, square_block
+from stochcable.dynamics.loads.kinematics_closed_forms import (
+    kinematics_block,
+    mean_block,
+    square_block,
+)
 from stochcable.errors import InputError
 from stochcable.sea.kinematics import G_STANDARD, wavenumber
 
@@ -60,6 +64,7 @@ __all__ = [
     "SquareParts",
     "element_frames",
     "element_wave_kinematics",
+    "element_mean_velocity",
     "element_wave_velocity",
 ]
 
@@ -225,6 +230,25 @@ def element_wave_velocity(
     w, k, pts, beta, h, g = _checked(omega, positions, heading, depth, g)
     src = _source(w, k, pts, beta, h, g)[0]
     return MomentParts(src.moments(), beta).full()
+
+
+def element_mean_velocity(
+    omega: ArrayLike,
+    positions: ArrayLike,
+    heading: float = 0.0,
+    depth: float = np.inf,
+    g: float = G_STANDARD,
+) -> np.ndarray:
+    """The wave velocity integrated along each element's wet part, ∫ v dξ (the sum of
+    :func:`element_wave_velocity`'s two moments: the same arguments and checks, the
+    sum in one closed form), in its horizontal part (along the heading) and vertical
+    part: shape (n_el, 2, n_omega). [(m/s)/m]"""
+    w, k, pts, beta, h, g = _checked(omega, positions, heading, depth, g)
+    geo = _source(w, k, pts, beta, h, g)[0].geometry
+    out = np.empty((pts.shape[0] - 1, 2, w.size), dtype=complex)
+    for sl in sub_blocks(w.size, out.shape[0]):  # (blocks of frequencies, as the moments')
+        out[..., sl] = mean_block(w[sl], k[sl], geo)
+    return out
 
 
 def _element_kinematics(

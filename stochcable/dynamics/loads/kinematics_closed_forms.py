@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-__all__ = ["kinematics_block", "square_block"]
+__all__ = ["kinematics_block", "mean_block", "square_block"]
 
 # |x| below which φ1 and ψ are summed as series (full relative precision; above it the
 # closed forms lose at most ~1e-16·(1 + |e^x|)/|x| absolutely, harmless as |e^x| <= 1).
@@ -198,6 +198,54 @@ def kinematics_block(
         vel[dry] = 0.0
         if sq is not None:
             sq[:, :, dry] = 0.0
+
+
+def mean_block(w: np.ndarray, k: np.ndarray, geo: tuple) -> np.ndarray:
+    """The wave velocity integrated over each element's wet part, ∫_p^q v dξ (the sum
+    of :func:`kinematics_block`'s two moments, ∫N_a v + ∫N_b v, in one closed form:
+    e^{e0 + αc}·L·φ1(x) of each exponential, no ψ), for the frequencies ``w``
+    (wavenumbers ``k``) and ``geo`` as :func:`kinematics_block`'s: shape (n_el, 2,
+    n_w), the horizontal (along β) and vertical parts.  [(m/s)/unit]"""
+    za, zb, chi, p, q, _, _, h, g = geo
+    length = q - p
+    za, zb, dry = _wet_ends(za, zb, length)
+    dz = np.multiply.outer(k, zb - za)
+    phase0 = -np.multiply.outer(k, chi[:-1])
+    dphase = -np.multiply.outer(k, chi[1:] - chi[:-1])
+    alpha1 = _complex(dz, dphase)
+    f1, _ = _phi1_psi(_moment_argument(alpha1, p, q), want_psi=False)
+    i1 = _exp_mean(_complex(np.multiply.outer(k, za), phase0), alpha1, p, q, f1)
+    if math.isinf(h):
+        mh, mz = i1 * w[:, None], i1 * (1j * w)[:, None]
+    else:
+        e2a = -np.multiply.outer(k, za + 2.0 * h)
+        # (the second exponent's φ1: the first one's conjugate where dz ≠ 0, as in
+        # kinematics_block)
+        f2 = np.where(dz != 0.0, f1.conj(), f1)
+        i2 = _exp_mean(_complex(e2a, phase0), _complex(-dz, dphase), p, q, f2)
+        c = _depth_factor(w, k, h)
+        mh, mz = (i1 + i2) * c[:, None], (i1 - i2) * (1j * c)[:, None]
+        zero_w = w == 0.0
+        if zero_w.any():  # long-wave limit: u_h = √(g/h) uniform, u_z = 0
+            mh[zero_w, :] = math.sqrt(g / h) * length
+    out = np.empty((za.size, 2, w.size), dtype=complex)
+    out[:, 0], out[:, 1] = mh.T, mz.T
+    if dry.any():
+        out[dry] = 0.0
+    return out
+
+
+def _exp_mean(
+    e0: np.ndarray, alpha: np.ndarray, p: np.ndarray, q: np.ndarray, phi: np.ndarray
+) -> np.ndarray:
+    """∫_p^q e^{e0 + αξ} dξ, elementwise, factored at the endpoint where the real part
+    of the exponent is largest (as :func:`_exp_moments`; ``phi`` φ1 of the argument of
+    :func:`_moment_argument`)."""
+    grow = alpha.real >= 0.0
+    if np.all(p == 0.0) and np.all(q == 1.0):
+        return np.exp(np.where(grow, e0 + alpha, e0)) * phi
+    c = np.where(grow, q, p)
+    return np.exp(e0 + alpha * c) * ((q - p) * phi)
 
 
 def square_block(w: np.ndarray, k: np.ndarray, geo: tuple, sq: np.ndarray) -> None:

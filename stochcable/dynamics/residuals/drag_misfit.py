@@ -14,6 +14,7 @@ import numpy as np
 
 from stochcable.dynamics.model.blocks import trapezoid_weights
 from stochcable.dynamics.residuals.body_residual import untapped
+from stochcable.dynamics.residuals.drag_hermite import hermite_coefficients
 from stochcable.dynamics.residuals.drag_segments import Segments, panel_loads
 from stochcable.dynamics.residuals.residual_lines import (
     RESIDUAL_TAP,
@@ -21,7 +22,7 @@ from stochcable.dynamics.residuals.residual_lines import (
     load_transfer,
 )
 
-__all__ = ["misfit_loads", "misfit_variance"]
+__all__ = ["misfit_loads", "misfit_scales", "misfit_variance"]
 
 
 def misfit_variance(
@@ -125,3 +126,43 @@ def misfit_loads(
         [misfit[k][1][idx][None, :, None] * misfit[k][0][:, idx] for k, idx in keep], axis=1
     )  # (n_ch, n_load, n_w)
     return unit, load
+
+
+def misfit_scales(
+    seg: Segments,
+    groups: list[np.ndarray],
+    c_el: np.ndarray,
+    mean_el: np.ndarray,
+    b_el: np.ndarray,
+    sig: np.ndarray,
+) -> np.ndarray:
+    """δB·l of every panel (0 but on the pieces of split elements): the pointwise linear
+    fit B_s = cσ_s a₁(U/σ_s) of each piece against its element's constant B, scaled so
+    that a uniform field gives none (B_e·(B_s/B̂_e − 1), B̂_e the fit of the pieces'
+    length-weighted mean variance, the linear model's σ² in the pieces' terms). [N·s/m]"""
+    out = np.zeros(len(groups))
+    first = np.array([int(g[0]) for g in groups])
+    el = seg.element[first]
+    # the panels of split elements (one piece each), by element
+    pan = np.flatnonzero(np.isin(el, seg.element[seg.fine]))
+    if pan.size == 0:
+        return out
+    els, at = np.unique(el[pan], return_inverse=True)
+    length = seg.length[first[pan]]
+    var = np.bincount(at, length * sig[pan] ** 2) / np.bincount(at, length)
+    ok = (var > 0.0) & (b_el[els] > 0.0)
+    use = ok[at]
+    pan, at, length = pan[use], at[use], length[use]
+    if pan.size == 0:
+        return out
+    sig_e = np.sqrt(np.where(ok, var, 1.0))
+    # a₁ of every piece and of each element's mean variance: one evaluation
+    mu = np.concatenate(
+        [mean_el[el[pan]] / np.where(sig[pan] > 0, sig[pan], np.inf), mean_el[els[ok]] / sig_e[ok]]
+    )
+    a1 = hermite_coefficients(np.clip(mu, -10.0, 10.0), 1)[:, 1]
+    a_e = np.zeros(els.size)
+    a_e[ok] = a1[pan.size :]
+    ratio = sig[pan] * a1[: pan.size] / (sig_e[at] * a_e[at])
+    out[pan] = b_el[els[at]] * (ratio - 1.0) * length
+    return out

@@ -72,7 +72,7 @@ from stochcable.dynamics.residuals.drag_hermite import (
     hermite_coefficients,
     lumped_coefficients,
 )
-from stochcable.dynamics.residuals.drag_misfit import misfit_variance
+from stochcable.dynamics.residuals.drag_misfit import misfit_scales, misfit_variance
 from stochcable.dynamics.residuals.drag_segments import (
     Segments,
     panel_groups,
@@ -297,16 +297,28 @@ def drag_residual(
     resp = linearization.response
     w = np.asarray(resp.omega, dtype=float)
     influence = EndInfluence(system, damping) if influence is None else influence
-    h_all = load_transfer(system, damping, comp.unit, comp.w_out, influence)
-    keep = _live_panels(comp.lines, comp.scale, comp.coeffs, h_all)
-    bent = bent_lines(h_all)  # (the cells: the residual's and the misfit's)
-    cf = cell_factor(system, damping, comp.unit, comp.w_out, h_all, influence=coupled, cells=bent)
+    # the components whose force is nothing against the largest (the grounded panels')
+    # left out before their transfer (their score could not reach PANEL_FLOOR)
+    alive = _loaded_panels(comp.lines, comp.scale, comp.coeffs)
+    unit = comp.unit if alive is None else comp.unit[:, :, alive]
+    h_all = load_transfer(system, damping, unit, comp.w_out, influence)
+    lines, scale, coeffs = (
+        (comp.lines, comp.scale, comp.coeffs)
+        if alive is None
+        else (comp.lines[:, alive], comp.scale[alive], comp.coeffs[alive])
+    )
+    keep = _live_panels(lines, scale, coeffs, h_all)
+    power = np.sum(np.abs(h_all) ** 2, axis=1)  # (the cells' power, formed once)
+    bent = bent_lines(h_all, power=power)  # (the cells: the residual's and the misfit's)
+    cf = cell_factor(
+        system, damping, unit, comp.w_out, h_all, influence=coupled, cells=bent, power=power
+    )
     # the lines above those the ends need left out: within LINE_TOL of the linear
     # spectrum's m0, m2 and m4 at each end (σ, Tz and the bandwidth)
     orders = np.array([0.0, 2.0, 4.0])
     budget = LINE_TOL * spectral_moments(resp, comp.spectra, orders)
     own = residual_output_lines(
-        comp.lines[:, keep], comp.scale[keep], comp.coeffs[keep], h_all[:, keep], comp.n_fft,
+        lines[:, keep], scale[keep], coeffs[keep], h_all[:, keep], comp.n_fft,
         budget if coupled is None and LINE_TOL > 0 else None, cf, comp.grid.n_j,
         comp.w_out[None] ** orders[:, None],
     )  # fmt: skip
@@ -411,7 +423,7 @@ def drag_components(
         coef = lumped_coefficients if lumped else hermite_coefficients
         coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
         lines.append(v)
-        misfit.append((pan, _misfit(seg, groups, c_el, mean_el, b_el, sig)))
+        misfit.append((pan, misfit_scales(seg, groups, c_el, mean_el, b_el, sig)))
     return DragComponents(seg, groups, live, parts, spectra, grid, w_out, n_fft, unit,
                           np.concatenate(lines, axis=1), np.concatenate(scales),
                           np.concatenate(coeffs), misfit)  # fmt: skip
@@ -469,6 +481,7 @@ def cell_factor(
     bend: float = CELL_BEND,
     influence: Any = None,
     cells: np.ndarray | None = None,
+    power: np.ndarray | None = None,
 ) -> np.ndarray:
     """Mean over each line's cell [ω_j − Δ/2, ω_j + Δ/2] of the outputs' power per unit
     panel force over its value at ω_j, where the lines do not resolve it: shape
@@ -482,10 +495,11 @@ def cell_factor(
     the line count, within 0.2 % with the factor).  The cells are those where the log
     power (``h``'s, summed over the panels) bends by more than :data:`CELL_BEND`
     between neighbours, and theirs (``cells``: those lines, (n_o,) bool, where the caller
-    has them); elsewhere the factor is 1 (no solve)."""
+    has them; ``power``: Σ_e |h_e|² (n_out, n_o), where the caller has it); elsewhere
+    the factor is 1 (no solve)."""
     if cells is not None and not np.any(cells):  # (no cell: no power needed)
         return np.ones((h.shape[0], h.shape[2]))
-    power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
+    power = np.sum(np.abs(h) ** 2, axis=1) if power is None else power  # (n_out, n_o)
     out = np.ones_like(power)
     cells = np.flatnonzero(bent_lines(h, bend, power) if cells is None else cells)
     if cells.size == 0:
@@ -498,6 +512,24 @@ def cell_factor(
     at = power[:, cells]
     out[:, cells] = np.where(at > 0, p_sub.mean(axis=2) / np.where(at > 0, at, 1.0), 1.0)
     return out
+
+
+#: Panel components whose residual force (largest |a_k|, k ≥ 2, times cσ²L) is below
+#: this fraction of the line's largest are left out before their end transfer: the
+#: grounded panels of a chain (the bundled chain's 8 of 66: 2e-14 and less of its
+#: largest, the next 2e-12).  Their score (:func:`_live_panels`) would need an end
+#: tension per unit force 10⁹ times the largest panel's to reach :data:`PANEL_FLOOR`. [-]
+DEAD_FORCE = 1e-12
+
+
+def _loaded_panels(lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray) -> np.ndarray | None:
+    """The panel components (indices) whose residual force is at least
+    :data:`DEAD_FORCE` of the line's largest; None where that is all of them (or
+    :data:`PANEL_FLOOR` is 0: every panel kept)."""
+    sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
+    force = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2
+    alive = force >= DEAD_FORCE * np.max(force, initial=0.0)
+    return None if alive.all() or PANEL_FLOOR <= 0 else np.flatnonzero(alive)
 
 
 def _live_panels(
@@ -527,46 +559,6 @@ def bent_lines(
     out = mid.copy()
     out[1:] |= mid[:-1]
     out[:-1] |= mid[1:]
-    return out
-
-
-def _misfit(
-    seg: Segments,
-    groups: list[np.ndarray],
-    c_el: np.ndarray,
-    mean_el: np.ndarray,
-    b_el: np.ndarray,
-    sig: np.ndarray,
-) -> np.ndarray:
-    """δB·l of every panel (0 but on the pieces of split elements): the pointwise linear
-    fit B_s = cσ_s a₁(U/σ_s) of each piece against its element's constant B, scaled so
-    that a uniform field gives none (B_e·(B_s/B̂_e − 1), B̂_e the fit of the pieces'
-    length-weighted mean variance, the linear model's σ² in the pieces' terms). [N·s/m]"""
-    out = np.zeros(len(groups))
-    first = np.array([int(g[0]) for g in groups])
-    el = seg.element[first]
-    # the panels of split elements (one piece each), by element
-    pan = np.flatnonzero(np.isin(el, seg.element[seg.fine]))
-    if pan.size == 0:
-        return out
-    els, at = np.unique(el[pan], return_inverse=True)
-    length = seg.length[first[pan]]
-    var = np.bincount(at, length * sig[pan] ** 2) / np.bincount(at, length)
-    ok = (var > 0.0) & (b_el[els] > 0.0)
-    use = ok[at]
-    pan, at, length = pan[use], at[use], length[use]
-    if pan.size == 0:
-        return out
-    sig_e = np.sqrt(np.where(ok, var, 1.0))
-    # a₁ of every piece and of each element's mean variance: one evaluation
-    mu = np.concatenate(
-        [mean_el[el[pan]] / np.where(sig[pan] > 0, sig[pan], np.inf), mean_el[els[ok]] / sig_e[ok]]
-    )
-    a1 = hermite_coefficients(np.clip(mu, -10.0, 10.0), 1)[:, 1]
-    a_e = np.zeros(els.size)
-    a_e[ok] = a1[pan.size :]
-    ratio = sig[pan] * a1[: pan.size] / (sig_e[at] * a_e[at])
-    out[pan] = b_el[els[at]] * (ratio - 1.0) * length
     return out
 
 

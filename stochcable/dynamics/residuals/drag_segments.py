@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from stochcable.dynamics.loads.element_kinematics import element_wave_velocity
+from stochcable.dynamics.loads.element_kinematics import element_mean_velocity
 from stochcable.dynamics.model.blocks import real_gemm, trapezoid_weights
 
 __all__ = [
@@ -288,10 +288,14 @@ def segment_velocity(
                 if sub is None:
                     sub = _subdivided_points(system, seg)[run.start : run.stop + 1]
                 env = system.environment
-                vel = element_wave_velocity(np.asarray(ch.omega), sub, ch.heading, env.depth, env.g)
-                v_run = vel.sum(axis=2)  # (n_w, n_run, 3)
+                # (the pieces' means: the moments' sum, horizontal and vertical parts)
+                mean = element_mean_velocity(ch.omega, sub, ch.heading, env.depth, env.g)
+                cb, sb = math.cos(ch.heading), math.sin(ch.heading)
                 for name, ve in vecs.items():
-                    out[name][c, run] += np.einsum("wsd,sd->sw", v_run, ve[run])
+                    v = ve[run]
+                    along = mean[:, 0] * (cb * v[:, 0] + sb * v[:, 1])[:, None]
+                    along += mean[:, 1] * v[:, 2][:, None]
+                    out[name][c, run] += along
             rest = np.ones(n_s, dtype=bool)
             rest[run] = False
             if rest.any():

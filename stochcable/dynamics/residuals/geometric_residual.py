@@ -162,16 +162,16 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     # element tensions' own stretch, influence.geometric_feedthrough)
     length, l0 = element_lengths(system)
     frames = element_frames(system)  # the split element along its suspended part
-    u = np.zeros((w.size, model.n_nodes, 3, n_ch), dtype=complex)
-    u[:, :, comps] = resp.displacement.reshape(w.size, model.n_nodes, d, n_ch)
-    du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, 3, n_ch)
+    # the motions on the model's components (a planar line's frames have no third)
+    u = np.asarray(resp.displacement, dtype=complex).reshape(w.size, model.n_nodes, d, n_ch)
+    du = u[:, 1:] - u[:, :-1]  # (n_w, n_el, d, n_ch)
     mesh = model.mesh
     # the element split at the touchdown: its suspended part, as the linear model's
     split = _suspended_part(model, u, du)
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
-    proc = [grid.lines(x, spectra) for x in along_each(du, frames)]
+    proc = [grid.lines(x, spectra) for x in along_each(du, [f[:, comps] for f in frames])]
     kappa = (mesh.ea / l0 - np.asarray(system.statics.tension) / length) / length
     # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms
     comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [
@@ -203,7 +203,8 @@ def _suspended_part(
 ) -> tuple[int, np.ndarray] | None:
     """The element that the linear model splits at the static touchdown
     (:attr:`stochcable.line.fem.FEModel.bed`) as its suspended part t–b, in place:
-    ``du`` its u_b − u_t (u_t = R·[u_a; u_b] the condensed touchdown node's motion),
+    ``du`` (on the model's components) its u_b − u_t (u_t = R·[u_a; u_b] the condensed
+    touchdown node's motion),
     (its frames and l, L₀: :func:`~stochcable.dynamics.residuals.influence.element_frames`,
     :func:`~stochcable.dynamics.residuals.influence.element_lengths`).  The
     chord a–b instead picks up the upper node's heave in its axial motion (×7 on a leg
@@ -213,11 +214,10 @@ def _suspended_part(
     bed = getattr(model, "bed", None)
     if bed is None or bed.element is None:
         return None
-    k, d, comps = bed.element, model.dim, list(model.components)
+    k, d = bed.element, model.dim
     r_t = np.asarray(bed.transform, dtype=float)[d : 2 * d]  # (d, 2d)
-    ab = np.concatenate([u[:, k, comps], u[:, k + 1, comps]], axis=1)  # (n_w, 2d, n_ch)
-    du[:, k] = 0.0
-    du[:, k, comps] = u[:, k + 1, comps] - np.einsum("ij,wjc->wic", r_t, ab)
+    ab = np.concatenate([u[:, k], u[:, k + 1]], axis=1)  # (n_w, 2d, n_ch)
+    du[:, k] = u[:, k + 1] - np.einsum("ij,wjc->wic", r_t, ab)
     return k, r_t
 
 
@@ -308,9 +308,12 @@ def quadratic_output_lines(
     n_p = len(processes)
     n_el = processes[0].shape[1]
     n_o = transfer.shape[2]
-    # Σ_c conj(x_ce)·y_cf per line of every two processes and elements
+    # Σ_c conj(x_ce)·y_cf per line of every two processes and elements: one product of
+    # the processes side by side (per line a (n_p·n_el)² matrix, its blocks views)
+    both = np.ascontiguousarray(np.concatenate(processes, axis=1).transpose(2, 0, 1))
+    every = np.conj(both).transpose(0, 2, 1) @ both  # (n_j, n_p·n_el, n_p·n_el)
     cross = {
-        (x, y): np.conj(processes[x]).transpose(2, 1, 0) @ processes[y].transpose(2, 0, 1)
+        (x, y): every[:, x * n_el : (x + 1) * n_el, y * n_el : (y + 1) * n_el]
         for x in range(n_p)
         for y in range(n_p)
     }
@@ -323,7 +326,7 @@ def quadratic_output_lines(
         for i, terms_i in enumerate(terms):
             for j, terms_j in enumerate(terms):
                 cov = sum(
-                    ci * cj * (r[x1, x2] * r[y1, y2] + r[x1, y2] * r[y1, x2])
+                    ci * cj * _isserlis(r, x1, y1, x2, y2)
                     for ci, x1, y1 in terms_i
                     for cj, x2, y2 in terms_j
                 )
@@ -331,3 +334,14 @@ def quadratic_output_lines(
                 # e's component i, f's j (transfer columns component-major)
                 out.add(np.fft.rfft(cov, axis=1)[:, 1 : n_o + 1], i * n_el + e, j * n_el + f)
     return out.outputs()
+
+
+def _isserlis(r: dict, x1: int, y1: int, x2: int, y2: int) -> np.ndarray:
+    """R_{x₁x₂}R_{y₁y₂} + R_{x₁y₂}R_{y₁x₂} of the lag functions ``r`` (by process pair);
+    where the two products have the same factors (x₁ = y₁ or x₂ = y₂) one is formed and
+    doubled (the same numbers: the products commute and p + p is exact)."""
+    first = r[x1, x2] * r[y1, y2]
+    if x1 == y1 or x2 == y2:
+        first += first
+        return first
+    return first + r[x1, y2] * r[y1, x2]

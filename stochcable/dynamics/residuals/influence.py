@@ -95,9 +95,12 @@ class EndInfluence:
 
     @staticmethod
     def _find(kept: list, w: np.ndarray, rows: slice = slice(None)) -> np.ndarray | None:
+        lo, hi = (float(w.min()), float(w.max())) if w.size else (0.0, 0.0)
         for om, g in kept if w.size else ():
             if om.size == w.size and (om is w or np.array_equal(om, w)):  # (the same lines)
                 return g if rows == slice(None) else g[rows]
+            if lo < om[0] - 1e-12 * abs(lo) or hi > om[-1] + 1e-12 * abs(hi):
+                continue  # (a frequency outside these lines: none nearer than the ends')
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
             near = np.where(np.abs(om[at - 1] - w) < np.abs(om[at] - w), at - 1, at)
             if np.all(np.abs(om[near] - w) <= 1e-12 * np.abs(w)):  # (np.allclose's test)
