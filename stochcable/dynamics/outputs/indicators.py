@@ -75,7 +75,12 @@ def _normal_acceleration_sigma(
     var = np.zeros(n_el)
     # tr S − eᵀSe = Σ_ij S_ij (I − eeᵀ)_ij: one product over the 9 entries (the trace
     # and a three-operand einsum were 0.2 ms on the chain)
-    proj = (np.eye(3)[None] - e[:, :, None] * e[:, None, :]).reshape(n_el, 9)
+    # (of the line's static frames: formed once per line, not at each sea state)
+    if "normal_projector" not in system._cache:
+        system._cache["normal_projector"] = (
+            np.eye(3)[None] - e[:, :, None] * e[:, None, :]
+        ).reshape(n_el, 9)
+    proj = system._cache["normal_projector"]
     for ch in channels:
         wts = q * ch.spectrum * omega**2
         if ch.element_velocity_square is None and ch.element_square is not None:

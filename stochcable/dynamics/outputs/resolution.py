@@ -259,6 +259,11 @@ def surface_resolution_check(
 TAIL_FRACTION = 0.05
 
 
+#: The probe grid of :func:`excitation_end` over ω_max (formed once: it runs for every
+#: sea state of a load-case set). [-]
+_PROBE = np.geomspace(1.0 + 1e-9, 1e3, 400)
+
+
 def excitation_end(channels: tuple[Channel, ...], omega: np.ndarray) -> float:
     """The frequency above which no input of the line excites it. [rad/s]
 
@@ -267,7 +272,7 @@ def excitation_end(channels: tuple[Channel, ...], omega: np.ndarray) -> float:
     probe grid up to 1000 ω_max and bisected to where it vanishes: inf when it does not
     (an analytic spectrum).  The largest over the inputs (ω_max without any)."""
     top = float(omega[-1])
-    probe = top * np.geomspace(1.0 + 1e-9, 1e3, 400)
+    probe = top * _PROBE
     end = 0.0
     for ch in channels:
         spectrum = np.asarray(ch.spectrum)
