@@ -107,9 +107,6 @@ def input_densities(scene: Scene) -> list[tuple[str, Callable[[np.ndarray], np.n
 _WIDE = np.geomspace(1e-4, 1e4, 16001)
 #: ω² on :data:`_WIDE` (formed once: :func:`sea_omega2` runs for every sea state of a set)
 _WIDE_SQ = _WIDE**2
-#: The steps of :data:`_WIDE` (formed once): :func:`sea_omega2`'s trapezoid sums are
-#: NumPy's ``trapezoid`` on them, the same operations in the same order (the same bits)
-_WIDE_STEP = np.diff(_WIDE)
 
 
 def input_band(scene: Scene, fraction: float) -> tuple[float, float, dict[str, tuple]]:
@@ -174,17 +171,10 @@ def sea_omega2(scene: Scene) -> float | None:
         return None
     s = np.asarray(scene.sea.spectrum.spectral_density(_WIDE, scene.environment.g), dtype=float)
     s = np.where(np.isfinite(s), s, 0.0)
-    m0 = _wide_trapezoid(s)
+    m0 = np.trapezoid(s, _WIDE)
     if not m0 > 0.0:
         return None
-    return math.sqrt(_wide_trapezoid(_WIDE_SQ * s) / m0)
-
-
-def _wide_trapezoid(y: np.ndarray) -> float:
-    """``np.trapezoid(y, _WIDE)`` on the steps formed once (:data:`_WIDE_STEP`): the
-    same operations (NumPy 2's), so the same bits, without forming the steps at
-    each of a set's sea states."""
-    return float((_WIDE_STEP * (y[1:] + y[:-1]) / 2.0).sum())
+    return math.sqrt(np.trapezoid(_WIDE_SQ * s, _WIDE) / m0)
 
 
 def base_error(scene: Scene, w_min: float, w_max: float, n: int) -> float:

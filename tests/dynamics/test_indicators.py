@@ -384,3 +384,25 @@ def test_large_motion_only_where_the_sag_governs_the_stiffness():
     assert ind.motion_to_sag > 0.4 and ind.second_order.lambda2 < 0.1
     assert "large_motion" not in ind.flags
     assert not any("of the line's sag" in str(w.message) for w in caught)
+
+
+def test_normal_projector_kept_per_line_gives_the_same_sigma():
+    # the normal-plane projectors of the line's static frames are kept on the line
+    # (formed once for every sea state of a set): P e = 0, P² = P, trace 2, and the
+    # normal-acceleration σ the same bits from the kept and from fresh projectors
+    from stochcable.dynamics.outputs import indicators
+
+    system, chans, lin = _chain_parts()
+    w = lin.response.omega
+    system._cache.pop("normal_projector", None)
+    first = indicators._normal_acceleration_sigma(system, chans, w)
+    kept = system._cache["normal_projector"].reshape(-1, 3, 3)
+    e = system.frames[0]
+    np.testing.assert_allclose(np.einsum("eij,ej->ei", kept, e), 0.0, atol=1e-15)
+    np.testing.assert_allclose(kept @ kept, kept, atol=1e-15)
+    np.testing.assert_allclose(np.trace(kept, axis1=1, axis2=2), 2.0, rtol=1e-15)
+    again = indicators._normal_acceleration_sigma(system, chans, w)  # (from the cache)
+    system._cache.pop("normal_projector")
+    fresh = indicators._normal_acceleration_sigma(system, chans, w)
+    assert np.array_equal(first, again) and np.array_equal(first, fresh)
+    assert first.max() > 0.0  # (the elements near the surface: the waves reach them)

@@ -107,3 +107,19 @@ def test_estimate_bounds_the_chain_and_taut_wire_mesh_error():
         coarse = _run(doc, 20)
         measured = max(abs(g / w - 1.0) for g, w in zip(_ends(coarse), ref))
         assert measured <= mesh_estimates(coarse)[0].error, name
+
+
+def test_sea_omega2_of_pierson_moskowitz_is_its_closed_form():
+    # m_n = (Hs²/64) ωpⁿ (5/4)^(n/4) Γ(1 − n/4): ω₂ = ωp (5/4)^(1/4) √Γ(1/2); the
+    # trapezoid over 16001 geometric points of 8 decades errs by ≈ (Δ ln ω)² ≈ 1e-6
+    from types import SimpleNamespace
+
+    from stochcable.fidelity.pilot import sea_omega2
+    from stochcable.scene.model import Sea
+
+    tp = 9.0
+    wp = 2.0 * math.pi / tp
+    exact = wp * 1.25**0.25 * math.sqrt(math.gamma(0.5))
+    sea = Sea(spectrum={"type": "pierson_moskowitz", "hs": 3.0, "tp": tp})
+    scene = SimpleNamespace(sea=sea, environment=SimpleNamespace(g=9.80665))
+    assert sea_omega2(scene) == pytest.approx(exact, rel=1e-5)

@@ -283,8 +283,6 @@ def excitation_end(channels: tuple[Channel, ...], omega: np.ndarray) -> float:
         above = np.flatnonzero(np.asarray(ch.density(probe)) > 0)
         if above.size == 0:
             end = max(end, float(omega[np.flatnonzero(spectrum > 0)[-1]]))
-        elif above[-1] == probe.size - 1:
-            return math.inf
         else:  # bisect to where it vanishes (to 1e-9 relative)
             lo, hi = float(probe[above[-1]]), float(probe[above[-1] + 1])
             while hi - lo > 1e-9 * hi:
