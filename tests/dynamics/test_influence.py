@@ -124,3 +124,37 @@ def test_kept_influence_on_the_same_lines_is_the_general_lookup():
         assert np.array_equal(np.asarray(same), np.asarray(ref))
         assert np.array_equal(np.asarray(same), g[rows])
     assert rl.EndInfluence._find(kept, om[:5] + 0.01) is None
+
+
+def test_kept_influence_lookup_is_the_nearest_line_of_every_frequency():
+    """EndInfluence._find (its shortcut for every step-th line, then the general search)
+    against a brute-force lookup: each frequency's nearest kept line, None where one is
+    more than 1e-12 relative from every line — strided runs, a run's first and last
+    apart (line_subset's), an offset grid, a frequency between lines, one frequency,
+    a reversed and a shuffled request, frequencies beyond the lines."""
+    rng = np.random.default_rng(5)
+    om = 0.05 * np.arange(1, 41)
+    g = rng.normal(size=(3, 2, 2, om.size)) + 1j * rng.normal(size=(3, 2, 2, om.size))
+    kept = [(om[:7].copy(), g[..., :7].copy()), (om.copy(), g)]
+
+    def brute(w):
+        for o, gk in kept:
+            near = np.argmin(np.abs(o[None, :] - w[:, None]), axis=1)
+            if np.all(np.abs(o[near] - w) <= 1e-12 * np.abs(w)):
+                return gk[..., near]
+        return None
+
+    idx = [
+        np.arange(40), np.arange(3, 40, 3), np.arange(0, 20, 2),
+        np.r_[0, np.arange(1, 30, 2), 30], np.array([7]), np.arange(40)[::-1],
+        rng.permutation(40)[:12], np.arange(2, 6),
+    ]  # fmt: skip
+    asks = [om[i] * (1.0 + 3e-15) for i in idx]
+    asks += [om[4:9] + 0.01, np.r_[om[3:8], 2.5], np.r_[om[30:], 2.05], np.array([0.02])]
+    for w in asks:
+        for rows in (slice(None), slice(1, 3)):
+            ref = brute(w)
+            got = rl.EndInfluence._find(kept, w, rows)
+            assert (got is None) == (ref is None), w
+            if ref is not None:
+                assert np.array_equal(np.asarray(got), ref[rows])

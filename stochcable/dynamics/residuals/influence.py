@@ -95,10 +95,29 @@ class EndInfluence:
 
     @staticmethod
     def _find(kept: list, w: np.ndarray, rows: slice = slice(None)) -> np.ndarray | None:
-        lo, hi = (float(w.min()), float(w.max())) if w.size else (0.0, 0.0)
-        for om, g in kept if w.size else ():
+        """The rows ``rows`` of the kept influence whose lines hold every frequency of
+        ``w`` (to 1e-12 relative: the nearest line's), on them (a view where they are
+        every step-th line), or None."""
+        if not w.size:
+            return None
+        w0, w1 = float(w[0]), float(w[min(1, w.size - 1)])
+        lo = hi = None
+        for om, g in kept:
             if om.size == w.size and (om is w or np.array_equal(om, w)):  # (the same lines)
                 return g if rows == slice(None) else g[rows]
+            # w's first two frequencies on these lines first (scalars, no array pass): a
+            # frequency on none of them, or w every step-th of them (the usual requests)
+            i0, i1 = _nearest(om, w0), _nearest(om, w1)
+            if abs(float(om[i0]) - w0) > 1e-12 * abs(w0):
+                continue  # (the first frequency is on none of these lines)
+            step = i1 - i0 if w.size > 1 else 1
+            if step > 0 and i0 + step * (w.size - 1) < om.size:
+                run = om[i0 : i0 + step * (w.size - 1) + 1 : step]
+                if np.all(np.abs(run - w) <= 1e-12 * np.abs(w)):  # (as the search below)
+                    g = g if rows == slice(None) else g[rows]
+                    return g[..., i0 : i0 + step * (w.size - 1) + 1 : step]
+            if lo is None:
+                lo, hi = float(w.min()), float(w.max())
             if lo < om[0] - 1e-12 * abs(lo) or hi > om[-1] + 1e-12 * abs(hi):
                 continue  # (a frequency outside these lines: none nearer than the ends')
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
@@ -172,6 +191,13 @@ class EndInfluence:
         if self._find(self._kept_c.get((cols.start, cols.stop), []), w) is not None:
             return None
         return self._adjoint.kept_transfer(w, self.extra[:, cols], unit)
+
+
+def _nearest(om: np.ndarray, x: float) -> int:
+    """The index of the line of ``om`` (increasing) nearest ``x`` (the lower of two
+    equally near), as :meth:`EndInfluence._find`'s search takes it."""
+    at = min(int(np.searchsorted(om, x)), om.size - 1)
+    return at - 1 if at > 0 and abs(float(om[at - 1]) - x) < abs(float(om[at]) - x) else at
 
 
 class SharedRows:
