@@ -59,3 +59,39 @@ def test_row_marks_follow_the_rows_sliced():
             assert np.array_equal(a, b)
     assert not rows[2:].marks[0].any() and not rows[2:].marks[1].any()
     assert np.array_equal(rows.marks[0], [True, True, False, False, False, False])
+
+
+def test_pairs_by_their_factors_are_the_pairs_by_their_terms():
+    """_conjugate_pairs with the terms' factors (χ, p: the bound on their products'
+    conjugacy, the terms compared only where it does not settle it) pairs the same
+    modes as comparing every term: partners perturbed from exact conjugates by 0 …
+    100 × PAIR_TOL (in χ, in p, in λ), a mode without a partner."""
+    from stochcable.dynamics.residuals.modal_rows import PAIR_TOL, _conjugate_pairs
+
+    rng = np.random.default_rng(11)
+    m, k = 6, 4
+    half = rng.normal(size=m) * 0.3 - 0.1 + 1j * (1.0 + rng.random(m) * 5)
+    lam = np.empty(2 * m, dtype=complex)
+    lam[0::2], lam[1::2] = half, np.conj(half)
+    chi = rng.normal(size=(m, 2 * m)) + 1j * rng.normal(size=(m, 2 * m))
+    chi[:, 1::2] = np.conj(chi[:, 0::2])
+    p = rng.normal(size=(2 * m, k)) + 1j * rng.normal(size=(2 * m, k))
+    p[1::2] = np.conj(p[0::2])
+    lam[-2] = -0.7  # (an overdamped mode: real, no partner)
+    seen = set()
+    for scale in (0.0, 0.2, 0.45, 0.6, 1.0, 3.0, 100.0):
+        for what in ("chi", "p", "lam"):
+            c, q, la = chi.copy(), p.copy(), lam.copy()
+            kick = scale * PAIR_TOL * (1.0 + 1j)
+            if what == "chi":
+                c[:, 3] += kick * np.abs(c[:, 2]).max()
+            elif what == "p":
+                q[5] += kick * np.abs(q[4]).max()
+            else:
+                la[7] += kick * np.abs(la[6])
+            terms = (c[:, None, :] * q.T[None]).reshape(m * k, -1)
+            a = _conjugate_pairs(terms, la)
+            b = _conjugate_pairs(terms, la, (c, q))
+            assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
+            seen.add(a[0].size)
+    assert len(seen) > 1  # (some kicks broke a pair: the tolerance was crossed)

@@ -40,8 +40,10 @@ class ModalSums:
     def __init__(self, chi: np.ndarray, p: np.ndarray, lambdas: np.ndarray) -> None:
         m, k = chi.shape[0], p.shape[1]
         terms = (chi[:, None, :] * p.T[None]).reshape(m * k, -1)  # (m·k, 2m): χ_j p_j
-        first, second = _conjugate_pairs(terms, lambdas)
-        alone = np.setdiff1d(np.arange(lambdas.size), np.concatenate([first, second]))
+        first, second = _conjugate_pairs(terms, lambdas, (chi, p))
+        used = np.zeros(lambdas.size, dtype=bool)
+        used[first] = used[second] = True
+        alone = np.flatnonzero(~used)
         coef = np.concatenate([terms[:, first], terms[:, alone]], axis=1)
         self.lhs = np.ascontiguousarray(np.concatenate([coef.real, coef.imag], axis=1))
         self.lambdas, self.first, self.second, self.alone = lambdas, first, second, alone
@@ -49,23 +51,31 @@ class ModalSums:
 
     def __call__(self, w: np.ndarray) -> np.ndarray:
         """The sums on ``w``, shape (m, k, n_w)."""
-        inv = 1.0 / (1j * np.asarray(w, dtype=float)[None, :] - self.lambdas[:, None])
-        first, second, alone = self.first, self.second, self.alone
-        den = np.concatenate(
-            [
-                inv[first] + inv[second],
-                inv[alone],
-                1j * (inv[first] - inv[second]),
-                1j * inv[alone],
-            ]
-        )  # (2·n_terms, n_w): the real parts' factors, then the imaginary parts'
-        out = (self.lhs @ np.ascontiguousarray(den).view(float)).view(complex)
+        iw = 1j * np.asarray(w, dtype=float)[None, :]
+        lam = self.lambdas[:, None]
+        first, alone = self.first.size, self.alone.size
+        n_t = first + alone
+        # (2·n_terms, n_w): the real parts' factors, then the imaginary parts'
+        den = np.empty((2 * n_t, iw.size), dtype=complex)
+        d, d2 = 1.0 / (iw - lam[self.first]), 1.0 / (iw - lam[self.second])
+        np.add(d, d2, out=den[:first])
+        np.subtract(d, d2, out=den[n_t : n_t + first])
+        den[n_t : n_t + first] *= 1j
+        if alone:
+            np.divide(1.0, iw - lam[self.alone], out=den[first:n_t])
+            np.multiply(den[first:n_t], 1j, out=den[n_t + first :])
+        out = (self.lhs @ den.view(float)).view(complex)
         return out.reshape(self.shape + (-1,))
 
 
-def _conjugate_pairs(terms: np.ndarray, lambdas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _conjugate_pairs(
+    terms: np.ndarray, lambdas: np.ndarray, factors: tuple | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """The modes (j, j') that are conjugate pairs: λ_j' = conj(λ_j) and the terms
-    χ_j' p_j' = conj(χ_j p_j) to :data:`PAIR_TOL` (indices, Im λ_j > 0)."""
+    χ_j' p_j' = conj(χ_j p_j) to :data:`PAIR_TOL` (indices, Im λ_j > 0).  ``factors``
+    (χ (m, 2m), p (2m, k)) of ``terms``, if given: the terms' test is taken as met
+    where their factors' bound meets it (|χ'p' − conj(χp)| ≤ |χ' − conj χ|·|p'| +
+    |χ|·|p' − conj p| elementwise), every term compared only for the others."""
     pos = np.flatnonzero(lambdas.imag > 0)
     if pos.size == 0:
         return pos, pos
@@ -73,10 +83,18 @@ def _conjugate_pairs(terms: np.ndarray, lambdas: np.ndarray) -> tuple[np.ndarray
     partner = np.argmin(gap, axis=1)
     scale = np.abs(lambdas[pos])
     ok = (gap[np.arange(pos.size), partner] <= PAIR_TOL * scale) & (lambdas[partner].imag < 0)
-    size = np.max(np.abs(terms), axis=0)
-    ok &= np.all(
-        np.abs(terms[:, partner] - np.conj(terms[:, pos])) <= PAIR_TOL * size[pos][None], axis=0
-    )
+    size = np.max(np.abs(terms[:, pos]), axis=0)
+    check = np.ones(pos.size, dtype=bool)
+    if factors is not None:
+        chi, p = factors
+        e_chi = np.max(np.abs(chi[:, partner] - np.conj(chi[:, pos])), axis=0)
+        e_p = np.max(np.abs(p[partner] - np.conj(p[pos])), axis=1)
+        big_chi, big_p = np.max(np.abs(chi[:, pos]), axis=0), np.max(np.abs(p[partner]), axis=1)
+        check = e_chi * big_p + big_chi * e_p > 0.5 * PAIR_TOL * size  # (half: round-off)
+    at = np.flatnonzero(check & ok)
+    if at.size:
+        diff = np.abs(terms[:, partner[at]] - np.conj(terms[:, pos[at]]))
+        ok[at] &= np.all(diff <= PAIR_TOL * size[at][None], axis=0)
     ok &= np.bincount(partner[ok], minlength=lambdas.size)[partner] <= 1  # (each one partner)
     return pos[ok], partner[ok]
 
