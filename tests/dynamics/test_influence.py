@@ -158,3 +158,27 @@ def test_kept_influence_lookup_is_the_nearest_line_of_every_frequency():
             assert (got is None) == (ref is None), w
             if ref is not None:
                 assert np.array_equal(np.asarray(got), ref[rows])
+
+
+def test_modal_rows_of_some_extra_columns_are_those_of_all():
+    """modal_influence's ``cols`` (some of the extra rows alone: their modal sums only,
+    no end rows) equal those rows of the full rows to round-off (the same sums by a
+    smaller product: measured 0), and EndInfluence.extra_kept keeps them apart from the
+    full rows' lines; where a frequency is above the modal limit: None."""
+    system, damping = _system(residual_cost.lines()["chain"])
+    w = np.linspace(0.3, 1.2, 17)
+    extra = element_rhs(system.model, stations(system.model))
+    full = np.asarray(rl.modal_influence(system, damping, w, extra))
+    scale = np.abs(full[2:]).max()
+    for cols in (slice(0, 3), slice(2, 7), slice(None)):
+        part = rl.modal_influence(system, damping, w, extra, cols)
+        assert isinstance(part, rl.ModalRows)
+        ref = full[2:][cols]
+        assert part.shape == ref.shape
+        assert np.abs(np.asarray(part) - ref).max() <= 1e-13 * scale
+    shared = rl.EndInfluence(system, damping, extra)
+    got = shared.extra_kept(w, slice(2, 5))
+    assert np.abs(np.asarray(got) - full[4:7]).max() <= 1e-13 * scale
+    assert not shared._kept_x and shared.extra_kept(w, slice(2, 5)) is got
+    top = float(system.modes.omega[-1])
+    assert rl.modal_influence(system, damping, np.r_[w, 2.0 * top], extra, slice(0, 3)) is None

@@ -164,12 +164,15 @@ class EndInfluence:
         cells, costs the others' right-hand sides for nothing). [N/N]"""
         w = np.asarray(w, dtype=float)
         g = self._find(self._kept_x, w, cols)
-        if g is None and self._modal:
-            return self.extra_on(w, cols)
         if g is not None:
             return g
         key = (cols.start, cols.stop)
         g = self._find(self._kept_c.get(key, []), w)
+        if g is None and self._modal:  # (these rows alone: the misfit's own frequencies)
+            g = modal_influence(self.system, self.damping, w, self.extra, cols)
+            if g is None:
+                return self.extra_on(w, cols)
+            self._kept_c.setdefault(key, []).append((w.copy(), g))
         if g is None and self._adjoint is not None:  # (by substitution in kept factors)
             g = self._adjoint.kept_rows(w, self.extra[:, cols])
             if g is not None:
@@ -237,7 +240,11 @@ def shared_rows(shared: Any, rhs: np.ndarray, start: int) -> SharedRows | None:
 
 
 def modal_influence(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None = None
+    system: Any,
+    damping: Any,
+    w: np.ndarray,
+    extra: np.ndarray | None = None,
+    cols: slice | None = None,
 ) -> np.ndarray | None:
     """:func:`end_influence` through the linear solve's own modal (Foss) basis: the
     kept modes' complex-mode sum plus the static correction of the truncated ones
@@ -250,7 +257,9 @@ def modal_influence(
     6.9 ms).  Frequencies above the highest computed mode over :data:`MODAL_SPAN`
     (where not every mode is computed) by the banded solve; None where the line is not
     solved that way (the direct solver, a travelling line or a steady lift: Aᵀ ≠ A, a
-    defective Foss pencil): the caller's banded solve then. [N/N]"""
+    defective Foss pencil): the caller's banded solve then.  ``cols`` (a slice of the
+    ``extra`` columns): those rows alone (the end rows not formed), where every ``w``
+    is below the limit (None otherwise). [N/N]"""
     if system.solver != "foss" or system.gyro is not None or system.lift is not None:
         return None
     w = np.asarray(w, dtype=float)
@@ -262,10 +271,10 @@ def modal_influence(
     kept = _influence_modes(system, line_prep(system), float(np.max(w[low], initial=0.0)))
     if MODAL_SHARE * nf < kept[0].shape[1]:  # (a short line: its banded solve is cheaper)
         return None
-    if not low.any():
+    if not low.any() or (cols is not None and not low.all()):
         return None
     if low.all():
-        return _modal_rows(system, damping, w, extra)
+        return _modal_rows(system, damping, w, extra, cols)
     lo = _modal_rows(system, damping, w[low], extra)
     if lo is None:
         return None
@@ -276,15 +285,20 @@ def modal_influence(
 
 
 def _modal_rows(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None
+    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None, cols: slice | None = None
 ) -> ModalRows | None:
-    """:func:`modal_influence` on ``w`` (all below its limit); None for a defective
-    Foss pencil."""
+    """:func:`modal_influence` on ``w`` (all below its limit; ``cols``: those of the
+    extra rows alone); None for a defective Foss pencil."""
     n = system.model.n_nodes
     held = _modal_projection(system, damping, float(w[-1]) if w.size else 0.0, extra)
     if held is None:
         return None
     phi, foss, p, r, (sums, rc, ends) = held
+    if cols is not None:  # (their modal sums alone, the static rows and ê sliced)
+        at = range(p.shape[1] - 6)[cols]
+        z = sums(w, slice(6 + at.start, 6 + at.stop))
+        rows = slice(2 + at.start, 2 + at.stop)
+        return ModalRows(phi, z, w, None if rc is None else rc[:, :, rows], ends[:, rows], n)
     m = phi.shape[1]
     k_x = p.shape[1] - 6
     # the modal coordinates (m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω

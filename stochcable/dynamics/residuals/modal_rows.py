@@ -48,9 +48,11 @@ class ModalSums:
         self.lhs = np.ascontiguousarray(np.concatenate([coef.real, coef.imag], axis=1))
         self.lambdas, self.first, self.second, self.alone = lambdas, first, second, alone
         self.shape = (m, k)
+        self._cols: dict[tuple[int, int], np.ndarray] = {}
 
-    def __call__(self, w: np.ndarray) -> np.ndarray:
-        """The sums on ``w``, shape (m, k, n_w)."""
+    def __call__(self, w: np.ndarray, cols: slice | None = None) -> np.ndarray:
+        """The sums on ``w``, shape (m, k, n_w); of the right-hand sides ``cols`` (a
+        slice, step 1) alone, if given: (m, k_cols, n_w)."""
         iw = 1j * np.asarray(w, dtype=float)[None, :]
         lam = self.lambdas[:, None]
         first, alone = self.first.size, self.alone.size
@@ -64,8 +66,16 @@ class ModalSums:
         if alone:
             np.divide(1.0, iw - lam[self.alone], out=den[first:n_t])
             np.multiply(den[first:n_t], 1j, out=den[n_t + first :])
-        out = (self.lhs @ den.view(float)).view(complex)
-        return out.reshape(self.shape + (-1,))
+        lhs, shape = self.lhs, self.shape
+        if cols is not None:
+            at = range(shape[1])[cols]
+            lhs = self._cols.get((at.start, at.stop))
+            if lhs is None:  # (these right-hand sides' terms, kept: one per set of rows)
+                lhs = np.ascontiguousarray(self.lhs.reshape(shape[0], shape[1], -1)[:, cols])
+                lhs = self._cols.setdefault((at.start, at.stop), lhs.reshape(-1, lhs.shape[2]))
+            shape = (shape[0], len(at))
+        out = (lhs @ den.view(float)).view(complex)
+        return out.reshape(shape + (-1,))
 
 
 def _conjugate_pairs(
