@@ -162,9 +162,12 @@ def test_kept_influence_lookup_is_the_nearest_line_of_every_frequency():
 
 def test_modal_rows_of_some_extra_columns_are_those_of_all():
     """modal_influence's ``cols`` (some of the extra rows alone: their modal sums only,
-    no end rows) equal those rows of the full rows to round-off (the same sums by a
-    smaller product: measured 0), and EndInfluence.extra_kept keeps them apart from the
-    full rows' lines; where a frequency is above the modal limit: None."""
+    no end rows; or the end rows alone, ``ENDS``) equal those rows of the full rows to
+    round-off (the same sums by a smaller product: measured 0), and
+    EndInfluence.extra_kept keeps them apart from the full rows' lines; where a
+    frequency is above the modal limit: None.  EndInfluence solves the end rows alone
+    and the extra rows where first asked, on the end rows' lines up to the highest
+    asked."""
     system, damping = _system(residual_cost.lines()["chain"])
     w = np.linspace(0.3, 1.2, 17)
     extra = element_rhs(system.model, stations(system.model))
@@ -182,3 +185,14 @@ def test_modal_rows_of_some_extra_columns_are_those_of_all():
     assert not shared._kept_x and shared.extra_kept(w, slice(2, 5)) is got
     top = float(system.modes.omega[-1])
     assert rl.modal_influence(system, damping, np.r_[w, 2.0 * top], extra, slice(0, 3)) is None
+    # the end rows alone first, the extra rows then on the end rows' lines up to the
+    # highest asked (not on all of them), equal to the rows of all
+    ends = rl.modal_influence(system, damping, w, extra, rl.ENDS)
+    assert np.abs(np.asarray(ends) - full[:2]).max() <= 1e-13 * np.abs(full[:2]).max()
+    shared = rl.EndInfluence(system, damping, extra)
+    assert np.abs(np.asarray(shared.on(w)) - full[:2]).max() <= 1e-13 * np.abs(full[:2]).max()
+    assert not shared._kept_x
+    got = shared.extra_on(w[1:12:2], slice(1, 6))
+    assert shared._kept_x[0][0].size == 12
+    assert np.abs(np.asarray(got) - full[3:8, ..., 1:12:2]).max() <= 1e-13 * scale
+    assert shared.extra_kept(w[:12], slice(0, 2)) is not None and len(shared._kept_x) == 1

@@ -60,6 +60,8 @@ MODAL_SPAN = 4.0
 #: more than its banded solve, 6.6 against 5.3 ms; the chain's 23 of 78: 2.3 against
 #: 6.9 ms). [-]
 MODAL_SHARE = 0.4
+#: :func:`modal_influence`'s ``cols`` for the end rows alone. [-]
+ENDS = "ends"
 
 
 class EndInfluence:
@@ -131,7 +133,10 @@ class EndInfluence:
         return None
 
     def _solve(self, w: np.ndarray, extra: bool) -> None:
-        g = modal_influence(self.system, self.damping, w, self.extra) if self._modal else None
+        g = None
+        if self._modal:  # (the end rows alone first: the extra rows on the lines they need)
+            part = None if extra or self.extra is None else ENDS
+            g = modal_influence(self.system, self.damping, w, self.extra, part)
         if g is None:
             self._modal = False
             g = self.adjoint(w).rows(w, self.extra if extra else None)
@@ -152,10 +157,30 @@ class EndInfluence:
         """The ``extra`` rows ``cols`` on ``w``, shape (k, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
         g = self._find(self._kept_x, w, cols)
+        if g is None and self._extend(w):
+            g = self._find(self._kept_x, w, cols)
         if g is None:
             self._solve(w, extra=True)
             g = self._kept_x[-1][1][cols]
         return g
+
+    def _extend(self, w: np.ndarray) -> bool:
+        """Through the modal basis, the extra rows formed on the kept end rows' lines up
+        to the highest of ``w`` where they hold all of ``w`` (the element tensions' and
+        node motions' lines: the chain's 122 of 189), kept; False where they do not
+        (or the line is not modal)."""
+        if not self._modal or self.extra is None:
+            return False
+        for om, _ in self._kept:
+            at = self._find([(om, np.arange(om.size))], w)  # (w's lines among om's)
+            if at is None:
+                continue
+            top = om[: int(np.max(at)) + 1]
+            g = modal_influence(self.system, self.damping, top, self.extra, slice(None))
+            if g is not None:
+                self._kept_x.append((top.copy(), g))
+                return True
+        return False
 
     def extra_kept(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray | None:
         """The ``extra`` rows ``cols`` on ``w`` where they are kept, or solved by the
@@ -164,6 +189,8 @@ class EndInfluence:
         cells, costs the others' right-hand sides for nothing). [N/N]"""
         w = np.asarray(w, dtype=float)
         g = self._find(self._kept_x, w, cols)
+        if g is None and self._extend(w):
+            g = self._find(self._kept_x, w, cols)
         if g is not None:
             return g
         key = (cols.start, cols.stop)
@@ -244,7 +271,7 @@ def modal_influence(
     damping: Any,
     w: np.ndarray,
     extra: np.ndarray | None = None,
-    cols: slice | None = None,
+    cols: slice | str | None = None,
 ) -> np.ndarray | None:
     """:func:`end_influence` through the linear solve's own modal (Foss) basis: the
     kept modes' complex-mode sum plus the static correction of the truncated ones
@@ -259,7 +286,7 @@ def modal_influence(
     solved that way (the direct solver, a travelling line or a steady lift: Aᵀ ≠ A, a
     defective Foss pencil): the caller's banded solve then.  ``cols`` (a slice of the
     ``extra`` columns): those rows alone (the end rows not formed), where every ``w``
-    is below the limit (None otherwise). [N/N]"""
+    is below the limit (None otherwise); :data:`ENDS`: the end rows alone. [N/N]"""
     if system.solver != "foss" or system.gyro is not None or system.lift is not None:
         return None
     w = np.asarray(w, dtype=float)
@@ -271,29 +298,37 @@ def modal_influence(
     kept = _influence_modes(system, line_prep(system), float(np.max(w[low], initial=0.0)))
     if MODAL_SHARE * nf < kept[0].shape[1]:  # (a short line: its banded solve is cheaper)
         return None
-    if not low.any() or (cols is not None and not low.all()):
+    if not low.any() or (isinstance(cols, slice) and not low.all()):
         return None
     if low.all():
         return _modal_rows(system, damping, w, extra, cols)
-    lo = _modal_rows(system, damping, w[low], extra)
+    lo = _modal_rows(system, damping, w[low], extra, cols)
     if lo is None:
         return None
     out = np.empty(lo.shape[:-1] + (w.size,), dtype=complex)
     out[..., low] = np.asarray(lo)
-    out[..., ~low] = end_influence(system, damping, w[~low], extra)
+    out[..., ~low] = end_influence(system, damping, w[~low], None if cols == ENDS else extra)
     return out
 
 
 def _modal_rows(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None, cols: slice | None = None
+    system: Any,
+    damping: Any,
+    w: np.ndarray,
+    extra: np.ndarray | None,
+    cols: slice | str | None = None,
 ) -> ModalRows | None:
     """:func:`modal_influence` on ``w`` (all below its limit; ``cols``: those of the
-    extra rows alone); None for a defective Foss pencil."""
+    extra rows alone, or :data:`ENDS`); None for a defective Foss pencil."""
     n = system.model.n_nodes
     held = _modal_projection(system, damping, float(w[-1]) if w.size else 0.0, extra)
     if held is None:
         return None
     phi, foss, p, r, (sums, rc, ends) = held
+    if cols == ENDS:  # (the end rows' modal sums alone, their static rows and ê)
+        s = sums(w, slice(0, 6))
+        z = s[:, 0:2] - s[:, 2:4] * (w * w) + s[:, 4:6] * (1j * w)
+        return ModalRows(phi, z, w, None if rc is None else rc[:, :, :2], ends[:, :2], n)
     if cols is not None:  # (their modal sums alone, the static rows and ê sliced)
         at = range(p.shape[1] - 6)[cols]
         z = sums(w, slice(6 + at.start, 6 + at.stop))
