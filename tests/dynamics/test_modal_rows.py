@@ -46,7 +46,7 @@ def test_row_marks_follow_the_rows_sliced():
     rng = np.random.default_rng(5)
     m, k, n_w, n, d = 4, 6, 9, 5, 2
     phi = rng.normal(size=((n - 2) * d, m))
-    z = rng.normal(size=(m, k, n_w)) + 1j * rng.normal(size=(m, k, n_w))
+    z = rng.normal(size=(k, m, n_w)) + 1j * rng.normal(size=(k, m, n_w))  # (rows first)
     rc = np.zeros((3, (n - 2) * d, k), dtype=complex)
     rc[0] = rng.normal(size=rc.shape[1:])
     rc[1:, :, :2] = rng.normal(size=(2, rc.shape[1], 2))  # (ω terms on the end rows only)

@@ -327,7 +327,7 @@ def _modal_rows(
     phi, foss, p, r, (sums, rc, ends) = held
     if cols == ENDS:  # (the end rows' modal sums alone, their static rows and ê)
         s = sums(w, slice(0, 6))
-        z = s[:, 0:2] - s[:, 2:4] * (w * w) + s[:, 4:6] * (1j * w)
+        z = s[0:2] - s[2:4] * (w * w) + s[4:6] * (1j * w)
         return ModalRows(phi, z, w, None if rc is None else rc[:, :, :2], ends[:, :2], n)
     if cols is not None:  # (their modal sums alone, the static rows and ê sliced)
         at = range(p.shape[1] - 6)[cols]
@@ -336,11 +336,11 @@ def _modal_rows(
         return ModalRows(phi, z, w, None if rc is None else rc[:, :, rows], ends[:, rows], n)
     m = phi.shape[1]
     k_x = p.shape[1] - 6
-    # the modal coordinates (m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
-    z = np.empty((m, 2 + k_x, w.size), dtype=complex)
-    s = sums(w)  # (m, 6 + k, n_w)
-    z[:, :2] = s[:, 0:2] - s[:, 2:4] * (w * w) + s[:, 4:6] * (1j * w)
-    z[:, 2:] = s[:, 6:]
+    # the modal coordinates (2 + k, m, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
+    z = np.empty((2 + k_x, m, w.size), dtype=complex)
+    s = sums(w)  # (6 + k, m, n_w)
+    z[:2] = s[0:2] - s[2:4] * (w * w) + s[4:6] * (1j * w)
+    z[2:] = s[6:]
     return ModalRows(phi, z, w, rc, ends, n)
 
 

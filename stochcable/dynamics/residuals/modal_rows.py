@@ -22,13 +22,13 @@ PAIR_TOL = 1e-10
 def modal_sums(chi: np.ndarray, p: np.ndarray, lambdas: np.ndarray, w: np.ndarray) -> np.ndarray:
     """z_k(ω) = Σ_j χ_j p_jk/(iω − λ_j) of the complex modes (χ (m, 2m), λ (2m,)) and the
     modal loads ``p`` (2m, k) of real right-hand sides on ``w``: shape (m, k, n_w)
-    (:class:`ModalSums`)."""
-    return ModalSums(chi, p, lambdas)(w)
+    (:class:`ModalSums`, which gives them right-hand side first)."""
+    return np.moveaxis(ModalSums(chi, p, lambdas)(w), 0, 1)
 
 
 class ModalSums:
     """z_k(ω) = Σ_j χ_j p_jk/(iω − λ_j) (:func:`modal_sums`), its frequency-independent
-    part formed once: the terms χ_j p_j (m·k, 2m), paired.
+    part formed once: the terms χ_j p_j (k·m, 2m: right-hand side first), paired.
 
     One product over the modes of the terms and the denominators (no (2m, k, n_w)
     array), in real arithmetic: a real system's modes come in conjugate pairs (λ', χ'
@@ -39,7 +39,7 @@ class ModalSums:
 
     def __init__(self, chi: np.ndarray, p: np.ndarray, lambdas: np.ndarray) -> None:
         m, k = chi.shape[0], p.shape[1]
-        terms = (chi[:, None, :] * p.T[None]).reshape(m * k, -1)  # (m·k, 2m): χ_j p_j
+        terms = (p.T[:, None, :] * chi[None]).reshape(k * m, -1)  # (k·m, 2m): χ_j p_j
         first, second = _conjugate_pairs(terms, lambdas, (chi, p))
         used = np.zeros(lambdas.size, dtype=bool)
         used[first] = used[second] = True
@@ -47,12 +47,11 @@ class ModalSums:
         coef = np.concatenate([terms[:, first], terms[:, alone]], axis=1)
         self.lhs = np.ascontiguousarray(np.concatenate([coef.real, coef.imag], axis=1))
         self.lambdas, self.first, self.second, self.alone = lambdas, first, second, alone
-        self.shape = (m, k)
-        self._cols: dict[tuple[int, int], np.ndarray] = {}
+        self.shape = (k, m)
 
     def __call__(self, w: np.ndarray, cols: slice | None = None) -> np.ndarray:
-        """The sums on ``w``, shape (m, k, n_w); of the right-hand sides ``cols`` (a
-        slice, step 1) alone, if given: (m, k_cols, n_w)."""
+        """The sums on ``w``, right-hand side first: shape (k, m, n_w); of the
+        right-hand sides ``cols`` (a slice, step 1) alone, if given: (k_cols, m, n_w)."""
         iw = 1j * np.asarray(w, dtype=float)[None, :]
         lam = self.lambdas[:, None]
         first, alone = self.first.size, self.alone.size
@@ -67,13 +66,10 @@ class ModalSums:
             np.divide(1.0, iw - lam[self.alone], out=den[first:n_t])
             np.multiply(den[first:n_t], 1j, out=den[n_t + first :])
         lhs, shape = self.lhs, self.shape
-        if cols is not None:
-            at = range(shape[1])[cols]
-            lhs = self._cols.get((at.start, at.stop))
-            if lhs is None:  # (these right-hand sides' terms, kept: one per set of rows)
-                lhs = np.ascontiguousarray(self.lhs.reshape(shape[0], shape[1], -1)[:, cols])
-                lhs = self._cols.setdefault((at.start, at.stop), lhs.reshape(-1, lhs.shape[2]))
-            shape = (shape[0], len(at))
+        if cols is not None:  # (their terms: a run of rows, a view)
+            at = range(shape[0])[cols]
+            lhs = lhs[at.start * shape[1] : at.stop * shape[1]]
+            shape = (len(at), shape[1])
         out = (lhs @ den.view(float)).view(complex)
         return out.reshape(shape + (-1,))
 
@@ -115,16 +111,17 @@ class ModalRows:
     d, n_w) as an array (``np.asarray``) but sliced by rows (``g[a:b]``) and lines
     (``g[..., idx]``) without forming it, and contracted with load cases through the m
     modes (:meth:`transfer`: the chain's 27 rows on 189 lines, 6.7 MB, never formed).
-    [N/N]"""
+    The modal coordinates ``z`` row first, (R, m, n_w): a run of rows and the leading
+    lines are views the products read in place. [N/N]"""
 
     def __init__(self, phi, z, w, rc, ends, n_nodes, marks=None) -> None:  # noqa: ANN001
         self.phi, self.z, self.w, self.rc, self.ends = phi, z, w, rc, ends
         self.n_nodes = n_nodes
         d = ends.shape[2]
-        self.shape = (z.shape[1], n_nodes, d, w.size)
+        self.shape = (z.shape[0], n_nodes, d, w.size)
         self.ndim, self.dtype = 4, np.dtype(complex)
         if marks is None:  # (the rows with r₁, r₂ and those with ê: the end rows)
-            dyn = np.zeros(z.shape[1], dtype=bool) if rc is None else np.any(rc[1:] != 0, (0, 1))
+            dyn = np.zeros(z.shape[0], dtype=bool) if rc is None else np.any(rc[1:] != 0, (0, 1))
             marks = (dyn, np.any(ends != 0, axis=(0, 2)))
         self.marks = marks
         self._rows: tuple | None = None  # (the marked rows, when first asked: _marked)
@@ -148,31 +145,29 @@ class ModalRows:
             return out
         rc = None if self.rc is None else self.rc[:, :, rows]
         return ModalRows(
-            self.phi, self.z[:, rows][:, :, lines], self.w[lines], rc,
+            self.phi, self.z[rows][:, :, lines], self.w[lines], rc,
             self.ends[:, rows], self.n_nodes, (self.marks[0][rows], self.marks[1][rows]),
         )  # fmt: skip
 
     def _add_static(self, x: np.ndarray, rc: np.ndarray) -> np.ndarray:
-        """``x`` (X, R, n_w) plus r₀ − ω²r₁ + iωr₂ of static rows ``rc`` (3, X, R), in
+        """``x`` (R, X, n_w) plus r₀ − ω²r₁ + iωr₂ of static rows ``rc`` (3, R, X), in
         place (r₁, r₂ on the end rows only)."""
         x += rc[0][..., None]
         dyn = self._marked()[0]
         if dyn is not None:
             w = self.w
-            x[:, dyn] += rc[2][:, dyn, None] * (1j * w) - rc[1][:, dyn, None] * (w * w)
+            x[dyn] += rc[2][dyn, :, None] * (1j * w) - rc[1][dyn, :, None] * (w * w)
         return x
 
     def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
         n_r, n, d, n_w = self.shape
-        m = self.phi.shape[1]
         out = np.zeros(self.shape, dtype=complex)
         out[:, 0] = self.ends[0][..., None]
         out[:, -1] = self.ends[1][..., None]
-        zt = np.ascontiguousarray(self.z).reshape(m, -1)
-        x = real_gemm(self.phi, zt).reshape(-1, n_r, n_w)  # (n_f·d, R, n_w)
+        x = np.matmul(self.phi, _float_view(self.z)).view(complex)  # (R, n_f·d, n_w)
         if self.rc is not None:
-            self._add_static(x, self.rc)
-        out[:, 1:-1] = np.transpose(x, (1, 0, 2)).reshape(n_r, n - 2, d, n_w)
+            self._add_static(x, np.transpose(self.rc, (0, 2, 1)))
+        out[:, 1:-1] = x.reshape(n_r, n - 2, d, n_w)
         return out if dtype is None else out.astype(dtype)
 
     def transfer(self, unit: np.ndarray) -> np.ndarray:
@@ -180,7 +175,6 @@ class ModalRows:
         dense or a scipy sparse (n_load, n_nodes·d) matrix of them): shape (R, n_load,
         n_w), the cases projected on the modes first. [N/unit]"""
         n_r, n, d, n_w = self.shape
-        m = self.phi.shape[1]
         if sparse.issparse(unit):
             u_t = sparse.csr_matrix(unit)
             u_end = (u_t[:, :d].toarray(), u_t[:, (n - 1) * d :].toarray())  # (L, d)
@@ -191,20 +185,28 @@ class ModalRows:
             u_end = (unit[0].T, unit[-1].T)
             u_f = unit[1:-1].reshape((n - 2) * d, -1).T  # (L, n_f·d)
             a = u_f @ self.phi
-        zt = np.ascontiguousarray(self.z).reshape(m, -1)
-        h = real_gemm(a, zt).reshape(a.shape[0], n_r, n_w)  # (L, R, n_w)
+        h = np.matmul(a, _float_view(self.z)).view(complex)  # (R, L, n_w)
         if (rows := self._marked()[1]) is not None:  # (ê on the end rows only: the others' are 0)
             end = self.ends[:, rows]
-            h[:, rows] += (u_end[0] @ end[0].T + u_end[1] @ end[1].T)[..., None]
+            h[rows] += (end[0] @ u_end[0].T + end[1] @ u_end[1].T)[..., None]
         if self.rc is not None:
             three = np.ascontiguousarray(np.transpose(self.rc, (1, 0, 2))).reshape(
                 self.rc.shape[1], -1
             )
             # (the real loads times the complex rows: one real product, dense cases)
             prod = u_f @ three if sparse.issparse(u_f) else real_gemm(u_f, three)
-            rc = np.asarray(prod).reshape(-1, 3, n_r).transpose(1, 0, 2)  # (3, L, R)
+            rc = np.asarray(prod).reshape(-1, 3, n_r).transpose(1, 2, 0)  # (3, R, L)
             self._add_static(h, rc)
-        return np.transpose(h, (1, 0, 2))
+        return h
+
+
+def _float_view(z: np.ndarray) -> np.ndarray:
+    """Complex ``z`` (…, n) as floats (…, 2n), a view where its last axis is contiguous
+    (a run of rows, the leading lines), else of a contiguous copy (every step-th
+    line)."""
+    if z.strides[-1] != z.itemsize:
+        z = np.ascontiguousarray(z)
+    return z.view(float)
 
 
 def _rows_of(mark: np.ndarray) -> slice | np.ndarray | None:
