@@ -95,3 +95,43 @@ def test_pairs_by_their_factors_are_the_pairs_by_their_terms():
             assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
             seen.add(a[0].size)
     assert len(seen) > 1  # (some kicks broke a pair: the tolerance was crossed)
+
+
+def test_static_rows_in_the_product_are_the_rows_formed():
+    """ModalRows.transfer with the static correction as coordinates 1, −ω², iω in the
+    modes' product (real static rows: one real product; complex ones: a complex
+    product; r₀ alone: one static row) equals the formed rows (np.asarray: Φz plus
+    r₀ − ω²r₁ + iωr₂ added) contracted with the loads, dense and sparse, sliced; z
+    without static coordinates gets them, and too few for rc's terms is refused."""
+    import pytest
+    from scipy import sparse
+
+    from stochcable.dynamics.residuals.modal_rows import STATIC_ROWS, ModalRows
+
+    rng = np.random.default_rng(8)
+    m, k, n_w, n, d = 5, 4, 11, 6, 2
+    w = np.linspace(0.1, 3.0, n_w)
+    phi = rng.normal(size=((n - 2) * d, m))
+    z = rng.normal(size=(k, m, n_w)) + 1j * rng.normal(size=(k, m, n_w))
+    ends = np.zeros((2, k, d))
+    ends[0, 0], ends[1, 1] = rng.normal(size=d), rng.normal(size=d)
+    unit = rng.normal(size=(n, d, 7))
+    flat = sparse.csr_matrix(unit.reshape(n * d, -1).T)
+    for real in (True, False):
+        rc = rng.normal(size=(3, (n - 2) * d, k)) + (0.0 if real else 1j) * rng.normal(
+            size=(3, (n - 2) * d, k)
+        )
+        rc[1:, :, 2:] = 0.0  # (ω terms on the end rows only)
+        rows = ModalRows(phi, z, w, rc, ends, n)
+        assert rows.z.shape[1] == m + STATIC_ROWS
+        for g in (rows, rows[1:3], rows[..., 2:9:3], rows[2:][..., np.arange(1, 8)]):
+            ref = np.einsum("onkw,nkl->olw", np.asarray(g), unit)
+            scale = np.abs(ref).max()
+            assert np.abs(g.transfer(unit) - ref).max() < 1e-13 * scale
+            assert np.abs(g.transfer(flat) - ref).max() < 1e-13 * scale
+        # (the rows without ω terms with r₀'s coordinate alone)
+        one = ModalRows(phi, rows.z[2:, : m + 1], w, rc[:, :, 2:], ends[:, 2:], n)
+        ref = np.einsum("onkw,nkl->olw", np.asarray(rows[2:]), unit)
+        assert np.abs(one.transfer(unit) - ref).max() < 1e-13 * np.abs(ref).max()
+    with pytest.raises(ValueError, match="static coordinate rows"):
+        ModalRows(phi, rows.z[:, : m + 1], w, rc, ends, n)

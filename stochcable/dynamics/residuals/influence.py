@@ -22,7 +22,12 @@ from stochcable.dynamics.residuals.band_influence import (
     end_directions,
     end_influence,
 )
-from stochcable.dynamics.residuals.modal_rows import ModalRows, ModalSums
+from stochcable.dynamics.residuals.modal_rows import (
+    STATIC_ROWS,
+    ModalRows,
+    ModalSums,
+    _static_rows,
+)
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.errors import SolverError
 from stochcable.line.fem import SLACK_EA_RATIO
@@ -325,23 +330,24 @@ def _modal_rows(
     if held is None:
         return None
     phi, foss, p, r, (sums, rc, ends) = held
-    if cols == ENDS:  # (the end rows' modal sums alone, their static rows and ê)
-        s = sums(w, slice(0, 6))
-        z = s[0:2] - s[2:4] * (w * w) + s[4:6] * (1j * w)
-        return ModalRows(phi, z, w, None if rc is None else rc[:, :, :2], ends[:, :2], n)
-    if cols is not None:  # (their modal sums alone, the static rows and ê sliced)
+    m = phi.shape[1]
+    if cols is not None and cols != ENDS:  # (their modal sums alone, static rows sliced)
         at = range(p.shape[1] - 6)[cols]
-        z = sums(w, slice(6 + at.start, 6 + at.stop))
+        z = sums(w, slice(6 + at.start, 6 + at.stop), 0 if rc is None else 1)
         rows = slice(2 + at.start, 2 + at.stop)
         return ModalRows(phi, z, w, None if rc is None else rc[:, :, rows], ends[:, rows], n)
-    m = phi.shape[1]
-    k_x = p.shape[1] - 6
-    # the modal coordinates (2 + k, m, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
-    z = np.empty((2 + k_x, m, w.size), dtype=complex)
-    s = sums(w)  # (6 + k, m, n_w)
-    z[:2] = s[0:2] - s[2:4] * (w * w) + s[4:6] * (1j * w)
-    z[2:] = s[6:]
-    return ModalRows(phi, z, w, rc, ends, n)
+    # the modal coordinates (2 + k, m + c, n_w) (the end rows alone: 2): the end rows'
+    # g_K − ω²g_M + iωg_C per ω, then the static coordinates 1, −ω², iω
+    k = 2 if cols == ENDS else p.shape[1] - 4
+    c = 0 if rc is None else STATIC_ROWS
+    z = np.empty((k, m + c, w.size), dtype=complex)
+    s = sums(w, slice(0, 6 if cols == ENDS else None))  # (6 (+ k), m, n_w)
+    z[:2, :m] = s[0:2] - s[2:4] * (w * w) + s[4:6] * (1j * w)
+    z[2:, :m] = s[6:]
+    _static_rows(np.moveaxis(z[:, m:], 1, 0), w)
+    if rc is None:
+        return ModalRows(phi, z, w, None, ends[:, :k], n)
+    return ModalRows(phi, z, w, rc[:, :, :k], ends[:, :k], n)
 
 
 def _modal_projection(
@@ -394,7 +400,9 @@ def _modal_projection(
     # (r₀, r₁, r₂; the end rows' three, the others' r₀) and ê of both ends
     rc = None
     if r is not None:
-        rc = np.zeros((3, nf, 2 + k_x), dtype=complex)
+        if not np.any(r.imag):  # (real right-hand sides: real static rows, real products)
+            r = r.real
+        rc = np.zeros((3, nf, 2 + k_x), dtype=r.dtype)
         rc[:, :, :2] = np.stack([r[:, 0:2], r[:, 2:4], r[:, 4:6]])
         rc[0, :, 2:] = r[:, 6:]
     d = system.model.dim

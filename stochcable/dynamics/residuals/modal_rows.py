@@ -49,10 +49,13 @@ class ModalSums:
         self.lambdas, self.first, self.second, self.alone = lambdas, first, second, alone
         self.shape = (k, m)
 
-    def __call__(self, w: np.ndarray, cols: slice | None = None) -> np.ndarray:
+    def __call__(self, w: np.ndarray, cols: slice | None = None, const: int = 0) -> np.ndarray:
         """The sums on ``w``, right-hand side first: shape (k, m, n_w); of the
-        right-hand sides ``cols`` (a slice, step 1) alone, if given: (k_cols, m, n_w)."""
-        iw = 1j * np.asarray(w, dtype=float)[None, :]
+        right-hand sides ``cols`` (a slice, step 1) alone, if given: (k_cols, m, n_w);
+        with ``const`` (0 … 3) more rows of each, 1, −ω², iω (:data:`STATIC_ROWS`):
+        (k, m + const, n_w), formed by the same product."""
+        w = np.asarray(w, dtype=float)
+        iw = 1j * w[None, :]
         lam = self.lambdas[:, None]
         first, alone = self.first.size, self.alone.size
         n_t = first + alone
@@ -64,14 +67,30 @@ class ModalSums:
         den[n_t : n_t + first] *= 1j
         if alone:
             np.divide(1.0, iw - lam[self.alone], out=den[first:n_t])
-            np.multiply(den[first:n_t], 1j, out=den[n_t + first :])
-        lhs, shape = self.lhs, self.shape
-        if cols is not None:  # (their terms: a run of rows, a view)
-            at = range(shape[0])[cols]
-            lhs = lhs[at.start * shape[1] : at.stop * shape[1]]
-            shape = (len(at), shape[1])
-        out = (lhs @ den.view(float)).view(complex)
-        return out.reshape(shape + (-1,))
+            np.multiply(den[first:n_t], 1j, out=den[n_t + first : 2 * n_t])
+        (k, m), lhs = self.shape, self.lhs
+        at = range(k)[slice(None) if cols is None else cols]
+        lhs = lhs[at.start * m : at.stop * m]  # (their terms: a run of rows, a view)
+        if not const:
+            return (lhs @ den.view(float)).view(complex).reshape((len(at), m, -1))
+        # (each right-hand side's sums written beside its static coordinates)
+        out = np.empty((len(at), m + const, iw.size), dtype=complex)
+        np.matmul(lhs.reshape(len(at), m, -1), den.view(float), out=out.view(float)[:, :m])
+        _static_rows(np.moveaxis(out[:, m:], 1, 0), w)
+        return out
+
+
+#: The modal rows' static coordinates (:class:`ModalRows`): r₀, r₁, r₂ of the static
+#: correction r₀ − ω²r₁ + iωr₂ enter as modes whose coordinates are 1, −ω², iω. [-]
+STATIC_ROWS = 3
+
+
+def _static_rows(out: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The static coordinates 1, −ω², iω (the first ``out.shape[0]``) on ``w``, into
+    ``out`` (c, n_w) complex."""
+    for j, v in enumerate((1.0, -(w * w), 1j * w)[: out.shape[0]]):
+        out[j] = v
+    return out
 
 
 def _conjugate_pairs(
@@ -111,10 +130,23 @@ class ModalRows:
     d, n_w) as an array (``np.asarray``) but sliced by rows (``g[a:b]``) and lines
     (``g[..., idx]``) without forming it, and contracted with load cases through the m
     modes (:meth:`transfer`: the chain's 27 rows on 189 lines, 6.7 MB, never formed).
-    The modal coordinates ``z`` row first, (R, m, n_w): a run of rows and the leading
-    lines are views the products read in place. [N/N]"""
+    The modal coordinates ``z`` row first, (R, m + c, n_w): a run of rows and the
+    leading lines are views the products read in place; its last c rows the static
+    coordinates 1, −ω², iω (:func:`_static_rows`: c = 1 where only r₀ enters, 3 with
+    the end rows' r₁, r₂, 0 without a static correction), so that the static rows
+    contracted with the loads enter the same product as the modes' (:meth:`transfer`).
+    [N/N]"""
 
     def __init__(self, phi, z, w, rc, ends, n_nodes, marks=None) -> None:  # noqa: ANN001
+        m = phi.shape[1]
+        if rc is not None and z.shape[1] == m:  # (no static coordinates given: appended)
+            z = np.concatenate([z, np.zeros((z.shape[0], STATIC_ROWS, w.size), dtype=complex)], 1)
+            _static_rows(np.moveaxis(z[:, m:], 1, 0), w)
+        elif rc is not None and marks is None and np.any(rc[z.shape[1] - m :]):
+            raise ValueError(
+                f"ModalRows: z has {z.shape[1] - m} static coordinate rows (1, −ω², iω) "
+                f"but the static rows rc carry terms beyond them; give all {STATIC_ROWS}"
+            )
         self.phi, self.z, self.w, self.rc, self.ends = phi, z, w, rc, ends
         self.n_nodes = n_nodes
         d = ends.shape[2]
@@ -164,7 +196,8 @@ class ModalRows:
         out = np.zeros(self.shape, dtype=complex)
         out[:, 0] = self.ends[0][..., None]
         out[:, -1] = self.ends[1][..., None]
-        x = np.matmul(self.phi, _float_view(self.z)).view(complex)  # (R, n_f·d, n_w)
+        m = self.phi.shape[1]
+        x = np.matmul(self.phi, _float_view(self.z[:, :m])).view(complex)  # (R, n_f·d, n_w)
         if self.rc is not None:
             self._add_static(x, np.transpose(self.rc, (0, 2, 1)))
         out[:, 1:-1] = x.reshape(n_r, n - 2, d, n_w)
@@ -185,19 +218,31 @@ class ModalRows:
             u_end = (unit[0].T, unit[-1].T)
             u_f = unit[1:-1].reshape((n - 2) * d, -1).T  # (L, n_f·d)
             a = u_f @ self.phi
-        h = np.matmul(a, _float_view(self.z)).view(complex)  # (R, L, n_w)
-        if (rows := self._marked()[1]) is not None:  # (ê on the end rows only: the others' are 0)
+        m = a.shape[1]
+        c = self.z.shape[1] - m  # (the static coordinates' rows)
+        rows = self._marked()[1]  # (ê on the end rows only: the others' are 0)
+        if c == 0:
+            h = np.matmul(a, _float_view(self.z)).view(complex)  # (R, L, n_w)
+            if rows is not None:
+                end = self.ends[:, rows]
+                h[rows] += (end[0] @ u_end[0].T + end[1] @ u_end[1].T)[..., None]
+            return h
+        # each row's loads on the modes and on its static rows r₀ (+ ê), r₁, r₂: their
+        # coordinates z's last c rows, all in one product per row
+        three = np.ascontiguousarray(np.transpose(self.rc[:c], (1, 0, 2))).reshape(
+            self.rc.shape[1], -1
+        )
+        prod = u_f @ three if np.isrealobj(three) or sparse.issparse(u_f) else real_gemm(u_f, three)
+        coef = np.asarray(prod).reshape(-1, c, n_r)  # (L, c, R)
+        a_r = np.empty((n_r, a.shape[0], m + c), dtype=coef.dtype)  # (R, L, m + c)
+        a_r[:, :, :m] = a
+        a_r[:, :, m:] = np.transpose(coef, (2, 0, 1))
+        if rows is not None:
             end = self.ends[:, rows]
-            h[rows] += (end[0] @ u_end[0].T + end[1] @ u_end[1].T)[..., None]
-        if self.rc is not None:
-            three = np.ascontiguousarray(np.transpose(self.rc, (1, 0, 2))).reshape(
-                self.rc.shape[1], -1
-            )
-            # (the real loads times the complex rows: one real product, dense cases)
-            prod = u_f @ three if sparse.issparse(u_f) else real_gemm(u_f, three)
-            rc = np.asarray(prod).reshape(-1, 3, n_r).transpose(1, 2, 0)  # (3, R, L)
-            self._add_static(h, rc)
-        return h
+            a_r[rows, :, m] += end[0] @ u_end[0].T + end[1] @ u_end[1].T
+        if np.isrealobj(a_r):
+            return np.matmul(a_r, _float_view(self.z)).view(complex)  # (R, L, n_w)
+        return np.matmul(a_r, self.z)  # (complex static rows: a complex product)
 
 
 def _float_view(z: np.ndarray) -> np.ndarray:
