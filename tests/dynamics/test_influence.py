@@ -185,6 +185,10 @@ def test_modal_rows_of_some_extra_columns_are_those_of_all():
     assert not shared._kept_x and shared.extra_kept(w, slice(2, 5)) is got
     top = float(system.modes.omega[-1])
     assert rl.modal_influence(system, damping, np.r_[w, 2.0 * top], extra, slice(0, 3)) is None
+    # complex right-hand sides (complex products and static rows): the rows scale with them
+    cplx = np.asarray(rl.modal_influence(system, damping, w, extra * (1.0 + 0.5j)))
+    assert np.abs(cplx[2:] - (1.0 + 0.5j) * full[2:]).max() <= 1e-13 * scale
+    assert np.abs(cplx[:2] - full[:2]).max() <= 1e-13 * np.abs(full[:2]).max()
     # the end rows alone first, the extra rows then on the end rows' lines up to the
     # highest asked (not on all of them), equal to the rows of all
     ends = rl.modal_influence(system, damping, w, extra, rl.ENDS)

@@ -386,22 +386,22 @@ def _modal_projection(
     g = end_coupling(system, prep, c, (e_a, e_b), None)  # (3, n_f·d, 2)
     k_x = 0 if extra is None else extra.shape[1]
     cols = np.concatenate([g[0], g[1], g[2]] + ([extra] if k_x else []), axis=1)
-    cols = np.ascontiguousarray(cols, dtype=complex)  # (n_f·d, 6 + k)
+    real = not np.any(cols.imag)  # (real right-hand sides: real products, real static rows)
+    cols = np.ascontiguousarray(cols.real if real else cols, dtype=float if real else complex)
     nf, m = phi.shape
     sign = np.ones(6 + k_x)
     sign[:6] = -1.0  # the end rows: T = ê·F_end − (A⁻¹g)ᵀF_f
-    modal = real_gemm(phi.T, cols)
+    modal = phi.T @ cols if real else real_gemm(phi.T, cols)  # (m, 6 + k)
     p = (foss.weights @ modal) * sign  # (2m, 6 + k)
     r = None
     if m < nf:
-        zh = np.linalg.solve(kh, modal.view(float))
-        r = (prep.k_solve(cols) - real_gemm(phi, np.ascontiguousarray(zh).view(complex))) * sign
+        zh = np.linalg.solve(kh, modal if real else modal.view(float))
+        back = phi @ zh if real else real_gemm(phi, np.ascontiguousarray(zh).view(complex))
+        r = (prep.k_solve(cols) - back) * sign
     # the rows' frequency-independent parts: the modal sums' terms, the static rows
     # (r₀, r₁, r₂; the end rows' three, the others' r₀) and ê of both ends
     rc = None
     if r is not None:
-        if not np.any(r.imag):  # (real right-hand sides: real static rows, real products)
-            r = r.real
         rc = np.zeros((3, nf, 2 + k_x), dtype=r.dtype)
         rc[:, :, :2] = np.stack([r[:, 0:2], r[:, 2:4], r[:, 4:6]])
         rc[0, :, 2:] = r[:, 6:]
