@@ -76,10 +76,10 @@ class EndInfluence:
 
     ``extra`` (optional, ((n_nodes − 2)·d, k)): more adjoint right-hand sides (the
     element tensions' rows of :mod:`.along_line`), their rows kept beside the ends'
-    (:meth:`extra_on`): through the modal basis both at once (:func:`modal_influence`);
-    by the banded solve the end rows alone first (on all the residual's lines) and the
-    extra rows where asked (the lines they are formed on), each with both sets in one
-    factorization."""
+    (:meth:`extra_on`): the end rows alone first (on all the residual's lines), the
+    extra rows where asked — through the modal basis (:func:`modal_influence`) on the
+    end rows' lines up to the highest asked (:meth:`_extend`), by the banded solve on
+    the lines asked, each with both sets in one factorization."""
 
     def __init__(self, system: Any, damping: Any, extra: np.ndarray | None = None) -> None:
         self.system = system
