@@ -124,3 +124,79 @@ def test_kept_influence_on_the_same_lines_is_the_general_lookup():
         assert np.array_equal(np.asarray(same), np.asarray(ref))
         assert np.array_equal(np.asarray(same), g[rows])
     assert rl.EndInfluence._find(kept, om[:5] + 0.01) is None
+
+
+def test_kept_influence_lookup_is_the_nearest_line_of_every_frequency():
+    """EndInfluence._find (its shortcut for every step-th line, then the general search)
+    against a brute-force lookup: each frequency's nearest kept line, None where one is
+    more than 1e-12 relative from every line — strided runs, a run's first and last
+    apart (line_subset's), an offset grid, a frequency between lines, one frequency,
+    a reversed and a shuffled request, frequencies beyond the lines."""
+    rng = np.random.default_rng(5)
+    om = 0.05 * np.arange(1, 41)
+    g = rng.normal(size=(3, 2, 2, om.size)) + 1j * rng.normal(size=(3, 2, 2, om.size))
+    kept = [(om[:7].copy(), g[..., :7].copy()), (om.copy(), g)]
+
+    def brute(w):
+        for o, gk in kept:
+            near = np.argmin(np.abs(o[None, :] - w[:, None]), axis=1)
+            if np.all(np.abs(o[near] - w) <= 1e-12 * np.abs(w)):
+                return gk[..., near]
+        return None
+
+    idx = [
+        np.arange(40), np.arange(3, 40, 3), np.arange(0, 20, 2),
+        np.r_[0, np.arange(1, 30, 2), 30], np.array([7]), np.arange(40)[::-1],
+        rng.permutation(40)[:12], np.arange(2, 6),
+    ]  # fmt: skip
+    asks = [om[i] * (1.0 + 3e-15) for i in idx]
+    asks += [om[4:9] + 0.01, np.r_[om[3:8], 2.5], np.r_[om[30:], 2.05], np.array([0.02])]
+    for w in asks:
+        for rows in (slice(None), slice(1, 3)):
+            ref = brute(w)
+            got = rl.EndInfluence._find(kept, w, rows)
+            assert (got is None) == (ref is None), w
+            if ref is not None:
+                assert np.array_equal(np.asarray(got), ref[rows])
+
+
+def test_modal_rows_of_some_extra_columns_are_those_of_all():
+    """modal_influence's ``cols`` (some of the extra rows alone: their modal sums only,
+    no end rows; or the end rows alone, ``ENDS``) equal those rows of the full rows to
+    round-off (the same sums by a smaller product: measured 0), and
+    EndInfluence.extra_kept keeps them apart from the full rows' lines; where a
+    frequency is above the modal limit: None.  EndInfluence solves the end rows alone
+    and the extra rows where first asked, on the end rows' lines up to the highest
+    asked."""
+    system, damping = _system(residual_cost.lines()["chain"])
+    w = np.linspace(0.3, 1.2, 17)
+    extra = element_rhs(system.model, stations(system.model))
+    full = np.asarray(rl.modal_influence(system, damping, w, extra))
+    scale = np.abs(full[2:]).max()
+    for cols in (slice(0, 3), slice(2, 7), slice(None)):
+        part = rl.modal_influence(system, damping, w, extra, cols)
+        assert isinstance(part, rl.ModalRows)
+        ref = full[2:][cols]
+        assert part.shape == ref.shape
+        assert np.abs(np.asarray(part) - ref).max() <= 1e-13 * scale
+    shared = rl.EndInfluence(system, damping, extra)
+    got = shared.extra_kept(w, slice(2, 5))
+    assert np.abs(np.asarray(got) - full[4:7]).max() <= 1e-13 * scale
+    assert not shared._kept_x and shared.extra_kept(w, slice(2, 5)) is got
+    top = float(system.modes.omega[-1])
+    assert rl.modal_influence(system, damping, np.r_[w, 2.0 * top], extra, slice(0, 3)) is None
+    # complex right-hand sides (complex products and static rows): the rows scale with them
+    cplx = np.asarray(rl.modal_influence(system, damping, w, extra * (1.0 + 0.5j)))
+    assert np.abs(cplx[2:] - (1.0 + 0.5j) * full[2:]).max() <= 1e-13 * scale
+    assert np.abs(cplx[:2] - full[:2]).max() <= 1e-13 * np.abs(full[:2]).max()
+    # the end rows alone first, the extra rows then on the end rows' lines up to the
+    # highest asked (not on all of them), equal to the rows of all
+    ends = rl.modal_influence(system, damping, w, extra, rl.ENDS)
+    assert np.abs(np.asarray(ends) - full[:2]).max() <= 1e-13 * np.abs(full[:2]).max()
+    shared = rl.EndInfluence(system, damping, extra)
+    assert np.abs(np.asarray(shared.on(w)) - full[:2]).max() <= 1e-13 * np.abs(full[:2]).max()
+    assert not shared._kept_x
+    got = shared.extra_on(w[1:12:2], slice(1, 6))
+    assert shared._kept_x[0][0].size == 12
+    assert np.abs(np.asarray(got) - full[3:8, ..., 1:12:2]).max() <= 1e-13 * scale
+    assert shared.extra_kept(w[:12], slice(0, 2)) is not None and len(shared._kept_x) == 1

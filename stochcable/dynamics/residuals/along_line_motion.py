@@ -266,15 +266,13 @@ def motion_cells(
         return out
     d = system.model.dim
     # each component: the station node moving most in it (one solve for them all)
-    top = [int(np.argmax(power[c::d][:, cells].sum(axis=1))) for c in range(d)]
-    keep = np.unique(top)
+    top = np.argmax(power[:, cells].sum(axis=1).reshape(-1, d), axis=0)  # (d,)
+    keep, slot = np.unique(top, return_inverse=True)
     node = NodeInfluence(system, damping, influence.nodes[keep])
     rows = (keep[:, None] * d + np.arange(d)[None]).ravel()
     sub = cell_factor(system, damping, unit, w, h[rows], bend, influence=node)
-    for c, k in enumerate(top):
-        out[np.ix_(np.arange(c, power.shape[0], d), cells)] = sub[
-            int(np.flatnonzero(keep == k)[0]) * d + c, cells
-        ][None]
+    for c in range(d):
+        out[c::d, cells] = sub[int(slot[c]) * d + c, cells]
     return out
 
 

@@ -22,7 +22,12 @@ from stochcable.dynamics.residuals.band_influence import (
     end_directions,
     end_influence,
 )
-from stochcable.dynamics.residuals.modal_rows import ModalRows, ModalSums
+from stochcable.dynamics.residuals.modal_rows import (
+    STATIC_ROWS,
+    ModalRows,
+    ModalSums,
+    _static_rows,
+)
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.errors import SolverError
 from stochcable.line.fem import SLACK_EA_RATIO
@@ -60,6 +65,8 @@ MODAL_SPAN = 4.0
 #: more than its banded solve, 6.6 against 5.3 ms; the chain's 23 of 78: 2.3 against
 #: 6.9 ms). [-]
 MODAL_SHARE = 0.4
+#: :func:`modal_influence`'s ``cols`` for the end rows alone. [-]
+ENDS = "ends"
 
 
 class EndInfluence:
@@ -69,10 +76,10 @@ class EndInfluence:
 
     ``extra`` (optional, ((n_nodes − 2)·d, k)): more adjoint right-hand sides (the
     element tensions' rows of :mod:`.along_line`), their rows kept beside the ends'
-    (:meth:`extra_on`): through the modal basis both at once (:func:`modal_influence`);
-    by the banded solve the end rows alone first (on all the residual's lines) and the
-    extra rows where asked (the lines they are formed on), each with both sets in one
-    factorization."""
+    (:meth:`extra_on`): the end rows alone first (on all the residual's lines), the
+    extra rows where asked — through the modal basis (:func:`modal_influence`) on the
+    end rows' lines up to the highest asked (:meth:`_extend`), by the banded solve on
+    the lines asked, each with both sets in one factorization."""
 
     def __init__(self, system: Any, damping: Any, extra: np.ndarray | None = None) -> None:
         self.system = system
@@ -95,10 +102,29 @@ class EndInfluence:
 
     @staticmethod
     def _find(kept: list, w: np.ndarray, rows: slice = slice(None)) -> np.ndarray | None:
-        lo, hi = (float(w.min()), float(w.max())) if w.size else (0.0, 0.0)
-        for om, g in kept if w.size else ():
+        """The rows ``rows`` of the kept influence whose lines hold every frequency of
+        ``w`` (to 1e-12 relative: the nearest line's), on them (a view where they are
+        every step-th line), or None."""
+        if not w.size:
+            return None
+        w0, w1 = float(w[0]), float(w[min(1, w.size - 1)])
+        lo = hi = None
+        for om, g in kept:
             if om.size == w.size and (om is w or np.array_equal(om, w)):  # (the same lines)
                 return g if rows == slice(None) else g[rows]
+            # w's first two frequencies on these lines first (scalars, no array pass): a
+            # frequency on none of them, or w every step-th of them (the usual requests)
+            i0, i1 = _nearest(om, w0), _nearest(om, w1)
+            if abs(float(om[i0]) - w0) > 1e-12 * abs(w0):
+                continue  # (the first frequency is on none of these lines)
+            step = i1 - i0 if w.size > 1 else 1
+            if step > 0 and i0 + step * (w.size - 1) < om.size:
+                run = om[i0 : i0 + step * (w.size - 1) + 1 : step]
+                if np.all(np.abs(run - w) <= 1e-12 * np.abs(w)):  # (as the search below)
+                    g = g if rows == slice(None) else g[rows]
+                    return g[..., i0 : i0 + step * (w.size - 1) + 1 : step]
+            if lo is None:
+                lo, hi = float(w.min()), float(w.max())
             if lo < om[0] - 1e-12 * abs(lo) or hi > om[-1] + 1e-12 * abs(hi):
                 continue  # (a frequency outside these lines: none nearer than the ends')
             at = np.clip(np.searchsorted(om, w), 0, om.size - 1)
@@ -112,7 +138,10 @@ class EndInfluence:
         return None
 
     def _solve(self, w: np.ndarray, extra: bool) -> None:
-        g = modal_influence(self.system, self.damping, w, self.extra) if self._modal else None
+        g = None
+        if self._modal:  # (the end rows alone first: the extra rows on the lines they need)
+            part = None if extra or self.extra is None else ENDS
+            g = modal_influence(self.system, self.damping, w, self.extra, part)
         if g is None:
             self._modal = False
             g = self.adjoint(w).rows(w, self.extra if extra else None)
@@ -133,10 +162,30 @@ class EndInfluence:
         """The ``extra`` rows ``cols`` on ``w``, shape (k, n_nodes, d, n_w). [N/N]"""
         w = np.asarray(w, dtype=float)
         g = self._find(self._kept_x, w, cols)
+        if g is None and self._extend(w):
+            g = self._find(self._kept_x, w, cols)
         if g is None:
             self._solve(w, extra=True)
             g = self._kept_x[-1][1][cols]
         return g
+
+    def _extend(self, w: np.ndarray) -> bool:
+        """Through the modal basis, the extra rows formed on the kept end rows' lines up
+        to the highest of ``w`` where they hold all of ``w`` (the element tensions' and
+        node motions' lines: the chain's 122 of 189), kept; False where they do not
+        (or the line is not modal)."""
+        if not self._modal or self.extra is None:
+            return False
+        for om, _ in self._kept:
+            at = self._find([(om, np.arange(om.size))], w)  # (w's lines among om's)
+            if at is None:
+                continue
+            top = om[: int(np.max(at)) + 1]
+            g = modal_influence(self.system, self.damping, top, self.extra, slice(None))
+            if g is not None:
+                self._kept_x.append((top.copy(), g))
+                return True
+        return False
 
     def extra_kept(self, w: np.ndarray, cols: slice = slice(None)) -> np.ndarray | None:
         """The ``extra`` rows ``cols`` on ``w`` where they are kept, or solved by the
@@ -145,12 +194,17 @@ class EndInfluence:
         cells, costs the others' right-hand sides for nothing). [N/N]"""
         w = np.asarray(w, dtype=float)
         g = self._find(self._kept_x, w, cols)
-        if g is None and self._modal:
-            return self.extra_on(w, cols)
+        if g is None and self._extend(w):
+            g = self._find(self._kept_x, w, cols)
         if g is not None:
             return g
         key = (cols.start, cols.stop)
         g = self._find(self._kept_c.get(key, []), w)
+        if g is None and self._modal:  # (these rows alone: the misfit's own frequencies)
+            g = modal_influence(self.system, self.damping, w, self.extra, cols)
+            if g is None:
+                return self.extra_on(w, cols)
+            self._kept_c.setdefault(key, []).append((w.copy(), g))
         if g is None and self._adjoint is not None:  # (by substitution in kept factors)
             g = self._adjoint.kept_rows(w, self.extra[:, cols])
             if g is not None:
@@ -172,6 +226,13 @@ class EndInfluence:
         if self._find(self._kept_c.get((cols.start, cols.stop), []), w) is not None:
             return None
         return self._adjoint.kept_transfer(w, self.extra[:, cols], unit)
+
+
+def _nearest(om: np.ndarray, x: float) -> int:
+    """The index of the line of ``om`` (increasing) nearest ``x`` (the lower of two
+    equally near), as :meth:`EndInfluence._find`'s search takes it."""
+    at = min(int(np.searchsorted(om, x)), om.size - 1)
+    return at - 1 if at > 0 and abs(float(om[at - 1]) - x) < abs(float(om[at]) - x) else at
 
 
 class SharedRows:
@@ -211,7 +272,11 @@ def shared_rows(shared: Any, rhs: np.ndarray, start: int) -> SharedRows | None:
 
 
 def modal_influence(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None = None
+    system: Any,
+    damping: Any,
+    w: np.ndarray,
+    extra: np.ndarray | None = None,
+    cols: slice | str | None = None,
 ) -> np.ndarray | None:
     """:func:`end_influence` through the linear solve's own modal (Foss) basis: the
     kept modes' complex-mode sum plus the static correction of the truncated ones
@@ -224,7 +289,9 @@ def modal_influence(
     6.9 ms).  Frequencies above the highest computed mode over :data:`MODAL_SPAN`
     (where not every mode is computed) by the banded solve; None where the line is not
     solved that way (the direct solver, a travelling line or a steady lift: Aᵀ ≠ A, a
-    defective Foss pencil): the caller's banded solve then. [N/N]"""
+    defective Foss pencil): the caller's banded solve then.  ``cols`` (a slice of the
+    ``extra`` columns): those rows alone (the end rows not formed), where every ``w``
+    is below the limit (None otherwise); :data:`ENDS`: the end rows alone. [N/N]"""
     if system.solver != "foss" or system.gyro is not None or system.lift is not None:
         return None
     w = np.asarray(w, dtype=float)
@@ -236,37 +303,51 @@ def modal_influence(
     kept = _influence_modes(system, line_prep(system), float(np.max(w[low], initial=0.0)))
     if MODAL_SHARE * nf < kept[0].shape[1]:  # (a short line: its banded solve is cheaper)
         return None
-    if not low.any():
+    if not low.any() or (isinstance(cols, slice) and not low.all()):
         return None
     if low.all():
-        return _modal_rows(system, damping, w, extra)
-    lo = _modal_rows(system, damping, w[low], extra)
+        return _modal_rows(system, damping, w, extra, cols)
+    lo = _modal_rows(system, damping, w[low], extra, cols)
     if lo is None:
         return None
     out = np.empty(lo.shape[:-1] + (w.size,), dtype=complex)
     out[..., low] = np.asarray(lo)
-    out[..., ~low] = end_influence(system, damping, w[~low], extra)
+    out[..., ~low] = end_influence(system, damping, w[~low], None if cols == ENDS else extra)
     return out
 
 
 def _modal_rows(
-    system: Any, damping: Any, w: np.ndarray, extra: np.ndarray | None
+    system: Any,
+    damping: Any,
+    w: np.ndarray,
+    extra: np.ndarray | None,
+    cols: slice | str | None = None,
 ) -> ModalRows | None:
-    """:func:`modal_influence` on ``w`` (all below its limit); None for a defective
-    Foss pencil."""
+    """:func:`modal_influence` on ``w`` (all below its limit; ``cols``: those of the
+    extra rows alone, or :data:`ENDS`); None for a defective Foss pencil."""
     n = system.model.n_nodes
     held = _modal_projection(system, damping, float(w[-1]) if w.size else 0.0, extra)
     if held is None:
         return None
     phi, foss, p, r, (sums, rc, ends) = held
     m = phi.shape[1]
-    k_x = p.shape[1] - 6
-    # the modal coordinates (m, 2 + k, n_w); the end rows' g_K − ω²g_M + iωg_C per ω
-    z = np.empty((m, 2 + k_x, w.size), dtype=complex)
-    s = sums(w)  # (m, 6 + k, n_w)
-    z[:, :2] = s[:, 0:2] - s[:, 2:4] * (w * w) + s[:, 4:6] * (1j * w)
-    z[:, 2:] = s[:, 6:]
-    return ModalRows(phi, z, w, rc, ends, n)
+    if cols is not None and cols != ENDS:  # (their modal sums alone, static rows sliced)
+        at = range(p.shape[1] - 6)[cols]
+        z = sums(w, slice(6 + at.start, 6 + at.stop), 0 if rc is None else 1)
+        rows = slice(2 + at.start, 2 + at.stop)
+        return ModalRows(phi, z, w, None if rc is None else rc[:, :, rows], ends[:, rows], n)
+    # the modal coordinates (2 + k, m + c, n_w) (the end rows alone: 2): the end rows'
+    # g_K − ω²g_M + iωg_C per ω, then the static coordinates 1, −ω², iω
+    k = 2 if cols == ENDS else p.shape[1] - 4
+    c = 0 if rc is None else STATIC_ROWS
+    z = np.empty((k, m + c, w.size), dtype=complex)
+    s = sums(w, slice(0, 6 if cols == ENDS else None))  # (6 (+ k), m, n_w)
+    z[:2, :m] = s[0:2] - s[2:4] * (w * w) + s[4:6] * (1j * w)
+    z[2:, :m] = s[6:]
+    _static_rows(np.moveaxis(z[:, m:], 1, 0), w)
+    if rc is None:
+        return ModalRows(phi, z, w, None, ends[:, :k], n)
+    return ModalRows(phi, z, w, rc[:, :, :k], ends[:, :k], n)
 
 
 def _modal_projection(
@@ -305,21 +386,23 @@ def _modal_projection(
     g = end_coupling(system, prep, c, (e_a, e_b), None)  # (3, n_f·d, 2)
     k_x = 0 if extra is None else extra.shape[1]
     cols = np.concatenate([g[0], g[1], g[2]] + ([extra] if k_x else []), axis=1)
-    cols = np.ascontiguousarray(cols, dtype=complex)  # (n_f·d, 6 + k)
+    real = not np.any(cols.imag)  # (real right-hand sides: real products, real static rows)
+    cols = np.ascontiguousarray(cols.real if real else cols, dtype=float if real else complex)
     nf, m = phi.shape
     sign = np.ones(6 + k_x)
     sign[:6] = -1.0  # the end rows: T = ê·F_end − (A⁻¹g)ᵀF_f
-    modal = real_gemm(phi.T, cols)
+    modal = phi.T @ cols if real else real_gemm(phi.T, cols)  # (m, 6 + k)
     p = (foss.weights @ modal) * sign  # (2m, 6 + k)
     r = None
     if m < nf:
-        zh = np.linalg.solve(kh, modal.view(float))
-        r = (prep.k_solve(cols) - real_gemm(phi, np.ascontiguousarray(zh).view(complex))) * sign
+        zh = np.linalg.solve(kh, modal if real else modal.view(float))
+        back = phi @ zh if real else real_gemm(phi, np.ascontiguousarray(zh).view(complex))
+        r = (prep.k_solve(cols) - back) * sign
     # the rows' frequency-independent parts: the modal sums' terms, the static rows
     # (r₀, r₁, r₂; the end rows' three, the others' r₀) and ê of both ends
     rc = None
     if r is not None:
-        rc = np.zeros((3, nf, 2 + k_x), dtype=complex)
+        rc = np.zeros((3, nf, 2 + k_x), dtype=r.dtype)
         rc[:, :, :2] = np.stack([r[:, 0:2], r[:, 2:4], r[:, 4:6]])
         rc[0, :, 2:] = r[:, 6:]
     d = system.model.dim
