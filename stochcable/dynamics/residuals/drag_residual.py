@@ -197,13 +197,17 @@ def residual_output_lines(
     # the pairs f ≥ e (G_fe = conj(G_ef)) in blocks: ρ_ef, Σ_k b_k^e b_k^f ρ^k by
     # Horner's rule, its lines
     zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
+    zz[0] *= 2.0  # (irfft halves the zero-frequency line: pair_lags)
     lo, hi = ks[0], ks[-1]
+    # the lags' n_fft/2 (pair_lags) as (n_fft/2)^k on the orders' coefficients
+    span = np.arange(lo, hi + 1, dtype=float)
 
     def pair_lines(e: np.ndarray, f: np.ndarray, n_fft: int, top: int) -> np.ndarray:
-        rho = pair_lags(zz, e, f, n_fft)
-        # b_k^e·b_k^f with the pairs f > e weighted 2 and covariance_lines' 2/n_fft in
+        rho = pair_lags(zz, e, f, n_fft)  # ρ·2/n_fft
+        # b_k^e·b_k^f·(n_fft/2)^k with the pairs f > e weighted 2 and covariance_lines'
+        # 2/n_fft in
         c = b[e, lo : hi + 1] * b[f, lo : hi + 1]
-        c *= np.where(f > e, 4.0 / n_fft, 2.0 / n_fft)[:, None]
+        c *= np.where(f > e, 4.0 / n_fft, 2.0 / n_fft)[:, None] * (0.5 * n_fft) ** span
         rr = c[:, -1:] * rho
         for i in range(hi - lo - 1, -1, -1):
             rr += c[:, i : i + 1]
