@@ -227,18 +227,26 @@ def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, dtype: Any = com
     n_out, n, n_o = transfer.shape
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)), dtype=dtype)  # (n_o, n, n_out)
     g = g_all.reshape(n_o, n, n)
-    if g.dtype == t.dtype:
-        gt = g @ t  # (n_o, n, n_out)
-    else:  # (G in single precision, contracted in double: a cache-sized run of lines at a time)
-        gt = np.empty_like(t)
-        step = max(1, PAIR_BLOCK_BYTES // (16 * n * n))
-        for i in range(0, n_o, step):
-            np.matmul(g[i : i + step].astype(t.dtype), t[i : i + step], out=gt[i : i + step])
     # Re(conj(t)·gt): the parts' products as one pass on the interleaved views (the
     # same products and sums as on .real and .imag, without their strided temporaries)
     part = np.float32 if t.dtype == np.complex64 else float
-    prod = (t.view(part) * gt.view(part)).reshape(n_o, n, n_out, 2)
-    return (prod[..., 0] + prod[..., 1]).sum(axis=1, dtype=float).T
+    if g.dtype == t.dtype:
+        prod = (t.view(part) * (g @ t).view(part)).reshape(n_o, n, n_out, 2)
+        return (prod[..., 0] + prod[..., 1]).sum(axis=1, dtype=float).T
+    # G in single precision, contracted in double a cache-sized run of lines at a time,
+    # each run's products summed before the next run's cast (the cast after the complex
+    # product alone ran 3–4× slower on the development host: OpenBLAS's zgemm returns
+    # with the vector registers' upper halves in use, which slows numpy's SSE-encoded
+    # cast loops until an AVX loop, here the real products, clears them)
+    out = np.empty((n_o, n_out))
+    step = max(1, PAIR_BLOCK_BYTES // (16 * n * n))
+    for i in range(0, n_o, step):
+        tc = t[i : i + step]
+        prod = (tc.view(part) * (g[i : i + step].astype(t.dtype) @ tc).view(part)).reshape(
+            -1, n, n_out, 2
+        )
+        out[i : i + step] = (prod[..., 0] + prod[..., 1]).sum(axis=1)
+    return out.T
 
 
 def line_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, sel: Any, dtype: Any) -> np.ndarray:
