@@ -313,38 +313,27 @@ def quadratic_output_lines(
     both = np.ascontiguousarray(np.concatenate(processes, axis=1).transpose(2, 0, 1))
     every = np.conj(both).transpose(0, 2, 1) @ both  # (n_j, n_p·n_el, n_p·n_el)
     every[0] *= 2.0  # (irfft halves the zero-frequency line: pair_lags)
-    n_c = len(terms)
-    # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks;
-    # per block every process pair's lags by one transform, every component pair's
-    # lines by one transform and one scatter
+    cross = {
+        (x, y): every[:, x * n_el : (x + 1) * n_el, y * n_el : (y + 1) * n_el]
+        for x in range(n_p)
+        for y in range(n_p)
+    }
+    # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks
     out = PairLines(transfer)
     for e, f in pair_blocks(n_el, n_fft, 2):
-        n_b = e.size
-        rows = (np.arange(n_p)[:, None, None] * n_el + e).repeat(n_p, axis=1).ravel()
-        cols = (np.arange(n_p)[None, :, None] * n_el + f).repeat(n_p, axis=0).ravel()
-        lags = pair_lags(every, rows, cols, n_fft)  # (n_p²·n_b, n_fft): R·2/n_fft
-        r = {
-            (x, y): lags[(x * n_p + y) * n_b : (x * n_p + y + 1) * n_b]
-            for x in range(n_p)
-            for y in range(n_p)
-        }
+        r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}  # R·2/n_fft
         # the pairs f > e weighted 2, covariance_lines' 2/n_fft and the lags' (n_fft/2)²
         twice = np.where(f > e, float(n_fft), 0.5 * n_fft)[:, None]  # (4/n_fft)·(n_fft/2)²
-        cov = np.empty((n_c * n_c * n_b, n_fft))
         for i, terms_i in enumerate(terms):
             for j, terms_j in enumerate(terms):
-                k = i * n_c + j
-                part = sum(
+                cov = sum(
                     ci * cj * _isserlis(r, x1, y1, x2, y2)
                     for ci, x1, y1 in terms_i
                     for cj, x2, y2 in terms_j
                 )
-                np.multiply(part, twice, out=cov[k * n_b : (k + 1) * n_b])
-        # e's component i, f's j (transfer columns component-major)
-        comp = np.arange(n_c) * n_el
-        ce = (comp[:, None, None] + e).repeat(n_c, axis=1).ravel()
-        cf = (comp[None, :, None] + f).repeat(n_c, axis=0).ravel()
-        out.add(np.fft.rfft(cov, axis=1)[:, 1 : n_o + 1], ce, cf)
+                cov *= twice
+                # e's component i, f's j (transfer columns component-major)
+                out.add(np.fft.rfft(cov, axis=1)[:, 1 : n_o + 1], i * n_el + e, j * n_el + f)
     return out.outputs()
 
 
