@@ -412,25 +412,26 @@ def drag_components(
     # the normal and axial residuals of every panel are one set of components: they are
     # functions of jointly Gaussian velocities, so their cross terms count too (where
     # the linear tensions of the two cancel, so do the residuals' in part)
-    scales, coeffs, lines, misfit = [], [], [], []
+    scales, coeffs, misfit = [], [], []
     share = panel_share(seg, groups)
     piece = np.concatenate(groups)  # (each piece's panel: the panels' c·L by one sum)
     panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
-    for name in live:
+    n_p = len(groups)
+    pans = [panel_mean(seg_v[name], seg, groups, share) for name in live]  # (n_ch, n_p, n_w)
+    # every direction's panels placed on the grid at once: the components' lines
+    lines = grid.lines(np.concatenate(pans, axis=1), spectra)  # (n_ch·ranks, n_comp, n_j)
+    sigs = np.sqrt(np.sum(np.abs(lines) ** 2, axis=(0, 2)))
+    coef = lumped_coefficients if lumped else hermite_coefficients
+    for k, name in enumerate(live):
         c_el, mean_el, _, b_el = parts[name]
-        scales.append(np.bincount(panel, (c_el[seg.element] * seg.length)[piece], len(groups)))
+        scales.append(np.bincount(panel, (c_el[seg.element] * seg.length)[piece], n_p))
         mean = panel_mean(mean_el[seg.element], seg, groups, share)
-        pan = panel_mean(seg_v[name], seg, groups, share)  # (n_ch, n_p, n_w)
-        v = grid.lines(pan, spectra)
-        sig = np.sqrt(np.sum(np.abs(v) ** 2, axis=(0, 2)))
+        sig = sigs[k * n_p : (k + 1) * n_p]
         mu = np.where(sig > 0, mean / np.where(sig > 0, sig, 1.0), 0.0)
-        coef = lumped_coefficients if lumped else hermite_coefficients
         coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
-        lines.append(v)
-        misfit.append((pan, misfit_scales(seg, groups, c_el, mean_el, b_el, sig)))
-    return DragComponents(seg, groups, live, parts, spectra, grid, w_out, n_fft, unit,
-                          np.concatenate(lines, axis=1), np.concatenate(scales),
-                          np.concatenate(coeffs), misfit)  # fmt: skip
+        misfit.append((pans[k], misfit_scales(seg, groups, c_el, mean_el, b_el, sig)))
+    return DragComponents(seg, groups, live, parts, spectra, grid, w_out, n_fft, unit, lines,
+                          np.concatenate(scales), np.concatenate(coeffs), misfit)  # fmt: skip
 
 
 #: The key of the joint group computation (body_residual.CoupledInfluence.joint_lines).
