@@ -171,7 +171,10 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
-    proc = [grid.lines(x, spectra) for x in along_each(du, [f[:, comps] for f in frames])]
+    # (both processes placed on the grid at once, each a view of the lines)
+    xs = along_each(du, [f[:, comps] for f in frames])
+    both = grid.lines(np.concatenate(xs, axis=1), spectra)  # (n_ch·ranks, n_p·n_el, n_j)
+    proc = [both[:, k * n_el : (k + 1) * n_el] for k in range(len(xs))]
     kappa = (mesh.ea / l0 - np.asarray(system.statics.tension) / length) / length
     # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms
     comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [
