@@ -303,7 +303,8 @@ def drag_residual(
     influence = EndInfluence(system, damping) if influence is None else influence
     # the components whose force is nothing against the largest (the grounded panels')
     # left out before their transfer (their score could not reach PANEL_FLOOR)
-    alive = _loaded_panels(comp.lines, comp.scale, comp.coeffs)
+    sig2 = np.sum(comp.lines.real**2 + comp.lines.imag**2, axis=(0, 2))  # (formed once)
+    alive = _loaded_panels(comp.lines, comp.scale, comp.coeffs, sig2)
     unit = comp.unit if alive is None else comp.unit[:, :, alive]
     h_all = load_transfer(system, damping, unit, comp.w_out, influence)
     lines, scale, coeffs = (
@@ -311,8 +312,9 @@ def drag_residual(
         if alive is None
         else (comp.lines[:, alive], comp.scale[alive], comp.coeffs[alive])
     )
-    keep = _live_panels(lines, scale, coeffs, h_all)
-    power = np.sum(np.abs(h_all) ** 2, axis=1)  # (the cells' power, formed once)
+    mag = np.abs(h_all)  # (the panels' reach and the cells' power: formed once)
+    keep = _live_panels(lines, scale, coeffs, mag, sig2 if alive is None else sig2[alive])
+    power = np.sum(mag**2, axis=1)
     bent = bent_lines(h_all, power=power)  # (the cells: the residual's and the misfit's)
     cf = cell_factor(
         system, damping, unit, comp.w_out, h_all, influence=coupled, cells=bent, power=power
@@ -527,24 +529,35 @@ def cell_factor(
 DEAD_FORCE = 1e-12
 
 
-def _loaded_panels(lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray) -> np.ndarray | None:
+def _loaded_panels(
+    lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray, sig2: np.ndarray | None = None
+) -> np.ndarray | None:
     """The panel components (indices) whose residual force is at least
     :data:`DEAD_FORCE` of the line's largest; None where that is all of them (or
-    :data:`PANEL_FLOOR` is 0: every panel kept)."""
-    sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
+    :data:`PANEL_FLOOR` is 0: every panel kept).  ``sig2``: the components' variances
+    Σ|lines|², where the caller has them."""
+    if sig2 is None:
+        sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
     force = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2
     alive = force >= DEAD_FORCE * np.max(force, initial=0.0)
     return None if alive.all() or PANEL_FLOOR <= 0 else np.flatnonzero(alive)
 
 
 def _live_panels(
-    lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray, h: np.ndarray
+    lines: np.ndarray,
+    scale: np.ndarray,
+    coeffs: np.ndarray,
+    h: np.ndarray,
+    sig2: np.ndarray | None = None,
 ) -> np.ndarray:
     """The panel components (indices) whose residual force can reach the ends: the
     largest |a_k| (k ≥ 2) times cσ²L times the largest end tension per unit force at
-    least :data:`PANEL_FLOOR` of the line's largest."""
-    sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
-    score = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2 * np.abs(h).max(axis=(0, 2))
+    least :data:`PANEL_FLOOR` of the line's largest.  ``h``: the end tensions per unit
+    force, or their magnitudes (real); ``sig2``: as :func:`_loaded_panels`."""
+    if sig2 is None:
+        sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
+    reach = (np.abs(h) if np.iscomplexobj(h) else h).max(axis=(0, 2))
+    score = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2 * reach
     return np.flatnonzero(score >= PANEL_FLOOR * np.max(score, initial=0.0))
 
 
