@@ -197,13 +197,17 @@ def residual_output_lines(
     # the pairs f ≥ e (G_fe = conj(G_ef)) in blocks: ρ_ef, Σ_k b_k^e b_k^f ρ^k by
     # Horner's rule, its lines
     zz = np.conj(z).transpose(2, 1, 0) @ z.transpose(2, 0, 1)  # (n_j, n_p, n_p)
+    zz[0] *= 2.0  # (irfft halves the zero-frequency line: pair_lags)
     lo, hi = ks[0], ks[-1]
+    # the lags' n_fft/2 (pair_lags) as (n_fft/2)^k on the orders' coefficients
+    span = np.arange(lo, hi + 1, dtype=float)
 
     def pair_lines(e: np.ndarray, f: np.ndarray, n_fft: int, top: int) -> np.ndarray:
-        rho = pair_lags(zz, e, f, n_fft)
-        # b_k^e·b_k^f with the pairs f > e weighted 2 and covariance_lines' 2/n_fft in
+        rho = pair_lags(zz, e, f, n_fft)  # ρ·2/n_fft
+        # b_k^e·b_k^f·(n_fft/2)^k with the pairs f > e weighted 2 and covariance_lines'
+        # 2/n_fft in
         c = b[e, lo : hi + 1] * b[f, lo : hi + 1]
-        c *= np.where(f > e, 4.0 / n_fft, 2.0 / n_fft)[:, None]
+        c *= np.where(f > e, 4.0 / n_fft, 2.0 / n_fft)[:, None] * (0.5 * n_fft) ** span
         rr = c[:, -1:] * rho
         for i in range(hi - lo - 1, -1, -1):
             rr += c[:, i : i + 1]
@@ -299,7 +303,8 @@ def drag_residual(
     influence = EndInfluence(system, damping) if influence is None else influence
     # the components whose force is nothing against the largest (the grounded panels')
     # left out before their transfer (their score could not reach PANEL_FLOOR)
-    alive = _loaded_panels(comp.lines, comp.scale, comp.coeffs)
+    sig2 = np.sum(comp.lines.real**2 + comp.lines.imag**2, axis=(0, 2))  # (formed once)
+    alive = _loaded_panels(comp.lines, comp.scale, comp.coeffs, sig2)
     unit = comp.unit if alive is None else comp.unit[:, :, alive]
     h_all = load_transfer(system, damping, unit, comp.w_out, influence)
     lines, scale, coeffs = (
@@ -307,8 +312,9 @@ def drag_residual(
         if alive is None
         else (comp.lines[:, alive], comp.scale[alive], comp.coeffs[alive])
     )
-    keep = _live_panels(lines, scale, coeffs, h_all)
-    power = np.sum(np.abs(h_all) ** 2, axis=1)  # (the cells' power, formed once)
+    mag = np.abs(h_all)  # (the panels' reach and the cells' power: formed once)
+    keep = _live_panels(lines, scale, coeffs, mag, sig2 if alive is None else sig2[alive])
+    power = np.sum(mag**2, axis=1)
     bent = bent_lines(h_all, power=power)  # (the cells: the residual's and the misfit's)
     cf = cell_factor(
         system, damping, unit, comp.w_out, h_all, influence=coupled, cells=bent, power=power
@@ -408,25 +414,26 @@ def drag_components(
     # the normal and axial residuals of every panel are one set of components: they are
     # functions of jointly Gaussian velocities, so their cross terms count too (where
     # the linear tensions of the two cancel, so do the residuals' in part)
-    scales, coeffs, lines, misfit = [], [], [], []
+    scales, coeffs, misfit = [], [], []
     share = panel_share(seg, groups)
     piece = np.concatenate(groups)  # (each piece's panel: the panels' c·L by one sum)
     panel = np.repeat(np.arange(len(groups)), [g.size for g in groups])
-    for name in live:
+    n_p = len(groups)
+    pans = [panel_mean(seg_v[name], seg, groups, share) for name in live]  # (n_ch, n_p, n_w)
+    # every direction's panels placed on the grid at once: the components' lines
+    lines = grid.lines(np.concatenate(pans, axis=1), spectra)  # (n_ch·ranks, n_comp, n_j)
+    sigs = np.sqrt(np.sum(np.abs(lines) ** 2, axis=(0, 2)))
+    coef = lumped_coefficients if lumped else hermite_coefficients
+    for k, name in enumerate(live):
         c_el, mean_el, _, b_el = parts[name]
-        scales.append(np.bincount(panel, (c_el[seg.element] * seg.length)[piece], len(groups)))
+        scales.append(np.bincount(panel, (c_el[seg.element] * seg.length)[piece], n_p))
         mean = panel_mean(mean_el[seg.element], seg, groups, share)
-        pan = panel_mean(seg_v[name], seg, groups, share)  # (n_ch, n_p, n_w)
-        v = grid.lines(pan, spectra)
-        sig = np.sqrt(np.sum(np.abs(v) ** 2, axis=(0, 2)))
+        sig = sigs[k * n_p : (k + 1) * n_p]
         mu = np.where(sig > 0, mean / np.where(sig > 0, sig, 1.0), 0.0)
-        coef = lumped_coefficients if lumped else hermite_coefficients
         coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
-        lines.append(v)
-        misfit.append((pan, misfit_scales(seg, groups, c_el, mean_el, b_el, sig)))
-    return DragComponents(seg, groups, live, parts, spectra, grid, w_out, n_fft, unit,
-                          np.concatenate(lines, axis=1), np.concatenate(scales),
-                          np.concatenate(coeffs), misfit)  # fmt: skip
+        misfit.append((pans[k], misfit_scales(seg, groups, c_el, mean_el, b_el, sig)))
+    return DragComponents(seg, groups, live, parts, spectra, grid, w_out, n_fft, unit, lines,
+                          np.concatenate(scales), np.concatenate(coeffs), misfit)  # fmt: skip
 
 
 #: The key of the joint group computation (body_residual.CoupledInfluence.joint_lines).
@@ -522,24 +529,35 @@ def cell_factor(
 DEAD_FORCE = 1e-12
 
 
-def _loaded_panels(lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray) -> np.ndarray | None:
+def _loaded_panels(
+    lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray, sig2: np.ndarray | None = None
+) -> np.ndarray | None:
     """The panel components (indices) whose residual force is at least
     :data:`DEAD_FORCE` of the line's largest; None where that is all of them (or
-    :data:`PANEL_FLOOR` is 0: every panel kept)."""
-    sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
+    :data:`PANEL_FLOOR` is 0: every panel kept).  ``sig2``: the components' variances
+    Σ|lines|², where the caller has them."""
+    if sig2 is None:
+        sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
     force = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2
     alive = force >= DEAD_FORCE * np.max(force, initial=0.0)
     return None if alive.all() or PANEL_FLOOR <= 0 else np.flatnonzero(alive)
 
 
 def _live_panels(
-    lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray, h: np.ndarray
+    lines: np.ndarray,
+    scale: np.ndarray,
+    coeffs: np.ndarray,
+    h: np.ndarray,
+    sig2: np.ndarray | None = None,
 ) -> np.ndarray:
     """The panel components (indices) whose residual force can reach the ends: the
     largest |a_k| (k ≥ 2) times cσ²L times the largest end tension per unit force at
-    least :data:`PANEL_FLOOR` of the line's largest."""
-    sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
-    score = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2 * np.abs(h).max(axis=(0, 2))
+    least :data:`PANEL_FLOOR` of the line's largest.  ``h``: the end tensions per unit
+    force, or their magnitudes (real); ``sig2``: as :func:`_loaded_panels`."""
+    if sig2 is None:
+        sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
+    reach = (np.abs(h) if np.iscomplexobj(h) else h).max(axis=(0, 2))
+    score = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2 * reach
     return np.flatnonzero(score >= PANEL_FLOOR * np.max(score, initial=0.0))
 
 

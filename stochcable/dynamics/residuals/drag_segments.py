@@ -260,20 +260,27 @@ def segment_velocity(
     comps = list(model.components)
     e, xi = seg.element, seg.xi
     n_ch, n_s = len(channels), seg.size
-    # the structure's displacement at the pieces' midpoints, (n_s, d, n_w, n_ch): the
-    # shape functions as one real product on the interleaved complex values
-    u = np.transpose(resp.displacement.reshape(w.size, n_n, d, n_ch), (1, 2, 0, 3))
-    u = np.ascontiguousarray(u, dtype=complex).reshape(n_n, -1)
+    # the structure's displacement at the pieces' midpoints, (n_s, d, n_ch, n_w): the
+    # shape functions as one real product on the interleaved complex values; along
+    # each direction by real products on them (no complex einsum); each direction's
+    # (n_ch, n_s, n_w) a view of its (n_s, n_ch, n_w) array (the layout panel_mean
+    # reads)
+    u = np.asarray(resp.displacement).reshape(w.size, n_n * d, n_ch)
+    u = np.ascontiguousarray(np.transpose(u, (1, 2, 0)), dtype=complex).reshape(n_n, -1)
     interp = np.zeros((n_s, n_n))
     interp[np.arange(n_s), e] = 1.0 - xi
     interp[np.arange(n_s), e + 1] = xi
-    u_s = (interp @ u.view(float)).view(complex).reshape(n_s, d, w.size, n_ch)
+    u_s = (interp @ u.view(float)).reshape(n_s, d, n_ch, 2 * w.size)
     vecs = {name: np.asarray(vec, dtype=float)[e] for name, vec in directions.items()}
     out = {}
     for name, ve in vecs.items():
-        s = np.einsum("sdwc,sd->csw", u_s, ve[:, comps])
+        ve_d = ve[:, comps, None, None]  # (n_s, d, 1, 1)
+        s = ve_d[:, 0] * u_s[:, 0]
+        for k in range(1, d):
+            s += ve_d[:, k] * u_s[:, k]
+        s = s.view(complex)
         s *= -1j * w  # (relative: fluid − structure, the structure's velocity −iω·u)
-        out[name] = s
+        out[name] = np.transpose(s, (1, 0, 2))
     fine = np.flatnonzero(seg.fine)
     run = slice(int(fine[0]), int(fine[-1]) + 1) if fine.size else slice(0, 0)
     sub = None

@@ -171,7 +171,10 @@ def geometric_components(system: Any, channels: Any, linearization: Any) -> Geom
     spectra = np.stack([ch.spectrum for ch in channels])
     grid = uniform_grid(w, None, LINE_STRIDE, spectra)
     # a = t·Δu, b_k = n_k·Δu per element: (n_procs, n_el) lines each
-    proc = [grid.lines(x, spectra) for x in along_each(du, [f[:, comps] for f in frames])]
+    # (both processes placed on the grid at once, each a view of the lines)
+    xs = along_each(du, [f[:, comps] for f in frames])
+    both = grid.lines(np.concatenate(xs, axis=1), spectra)  # (n_ch·ranks, n_p·n_el, n_j)
+    proc = [both[:, k * n_el : (k + 1) * n_el] for k in range(len(xs))]
     kappa = (mesh.ea / l0 - np.asarray(system.statics.tension) / length) / length
     # components per element: ½Σ_k b_k² along t, a·b_k along n_k — as (coef, x, y) terms
     comp_terms = [[(0.5, k, k) for k in range(1, len(frames))]] + [
@@ -312,6 +315,7 @@ def quadratic_output_lines(
     # the processes side by side (per line a (n_p·n_el)² matrix, its blocks views)
     both = np.ascontiguousarray(np.concatenate(processes, axis=1).transpose(2, 0, 1))
     every = np.conj(both).transpose(0, 2, 1) @ both  # (n_j, n_p·n_el, n_p·n_el)
+    every[0] *= 2.0  # (irfft halves the zero-frequency line: pair_lags)
     cross = {
         (x, y): every[:, x * n_el : (x + 1) * n_el, y * n_el : (y + 1) * n_el]
         for x in range(n_p)
@@ -320,9 +324,9 @@ def quadratic_output_lines(
     # the elements f ≥ e (G_fe = conj(G_ef): the pairs f > e count twice), in blocks
     out = PairLines(transfer)
     for e, f in pair_blocks(n_el, n_fft, 2):
-        r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}
-        # the pairs f > e weighted 2, and covariance_lines' 2/n_fft, on the lags
-        twice = np.where(f > e, 4.0 / n_fft, 2.0 / n_fft)[:, None]
+        r = {xy: pair_lags(c, e, f, n_fft) for xy, c in cross.items()}  # R·2/n_fft
+        # the pairs f > e weighted 2, covariance_lines' 2/n_fft and the lags' (n_fft/2)²
+        twice = np.where(f > e, float(n_fft), 0.5 * n_fft)[:, None]  # (4/n_fft)·(n_fft/2)²
         for i, terms_i in enumerate(terms):
             for j, terms_j in enumerate(terms):
                 cov = sum(

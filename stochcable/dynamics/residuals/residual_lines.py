@@ -193,15 +193,14 @@ def pair_blocks(
 
 def pair_lags(cross: np.ndarray, e: np.ndarray, f: np.ndarray, n_fft: int) -> np.ndarray:
     """E[x_e(t) y_f(t + τ)] on the lag grid (as :func:`cross_covariance`) of the pairs
-    (e, f), from the cross-spectral lines ``cross`` (n_j, n_x, n_y), Σ_c x̄_{c,e} y_{c,f}
-    per line (``np.conj(x).transpose(2, 1, 0) @ y.transpose(2, 0, 1)`` for lines x, y
-    (n_ch, n, n_j)): shape (n_pairs, n_fft)."""
+    (e, f) times 2/n_fft (the callers fold n_fft/2 into their coefficients: no pass
+    over the lags), from the cross-spectral lines ``cross`` (n_j, n_x, n_y), Σ_c
+    x̄_{c,e} y_{c,f} per line (``np.conj(x).transpose(2, 1, 0) @ y.transpose(2, 0, 1)``
+    for lines x, y (n_ch, n, n_j)) with the zero-frequency line doubled (irfft halves
+    it): shape (n_pairs, n_fft)."""
     half = np.zeros((e.size, n_fft // 2 + 1), dtype=complex)
     half[:, : cross.shape[0]] = cross[:, e, f].T
-    half[:, 0] *= 2.0  # (irfft halves the zero-frequency line)
-    out = np.fft.irfft(half, n=n_fft, axis=1)
-    out *= 0.5 * n_fft
-    return out
+    return np.fft.irfft(half, n=n_fft, axis=1)
 
 
 def pair_outputs(g: np.ndarray, transfer: np.ndarray, e: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -228,14 +227,26 @@ def dense_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, dtype: Any = com
     n_out, n, n_o = transfer.shape
     t = np.ascontiguousarray(np.transpose(transfer, (2, 1, 0)), dtype=dtype)  # (n_o, n, n_out)
     g = g_all.reshape(n_o, n, n)
+    # Re(conj(t)·gt): the parts' products as one pass on the interleaved views (the
+    # same products and sums as on .real and .imag, without their strided temporaries)
+    part = np.float32 if t.dtype == np.complex64 else float
     if g.dtype == t.dtype:
-        gt = g @ t  # (n_o, n, n_out)
-    else:  # (G in single precision, contracted in double: a cache-sized run of lines at a time)
-        gt = np.empty_like(t)
-        step = max(1, PAIR_BLOCK_BYTES // (16 * n * n))
-        for i in range(0, n_o, step):
-            np.matmul(g[i : i + step].astype(t.dtype), t[i : i + step], out=gt[i : i + step])
-    return (t.real * gt.real + t.imag * gt.imag).sum(axis=1, dtype=float).T  # Re(conj(t)·gt)
+        prod = (t.view(part) * (g @ t).view(part)).reshape(n_o, n, n_out, 2)
+        return (prod[..., 0] + prod[..., 1]).sum(axis=1, dtype=float).T
+    # G in single precision, contracted in double a cache-sized run of lines at a time,
+    # each run's products summed before the next run's cast (the cast after the complex
+    # product alone ran 3–4× slower on the development host: OpenBLAS's zgemm returns
+    # with the vector registers' upper halves in use, which slows numpy's SSE-encoded
+    # cast loops until an AVX loop, here the real products, clears them)
+    out = np.empty((n_o, n_out))
+    step = max(1, PAIR_BLOCK_BYTES // (16 * n * n))
+    for i in range(0, n_o, step):
+        tc = t[i : i + step]
+        prod = (tc.view(part) * (g[i : i + step].astype(t.dtype) @ tc).view(part)).reshape(
+            -1, n, n_out, 2
+        )
+        out[i : i + step] = (prod[..., 0] + prod[..., 1]).sum(axis=1)
+    return out.T
 
 
 def line_pair_outputs(g_all: np.ndarray, transfer: np.ndarray, sel: Any, dtype: Any) -> np.ndarray:
