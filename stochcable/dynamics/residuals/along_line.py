@@ -429,7 +429,18 @@ def bent_cells(h: np.ndarray, bend: float = CELL_BEND, power: Any = None) -> np.
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
     loads, bends by more than ``bend`` between neighbours, and their neighbours (as
     :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`'s cells)."""
-    return bent_lines(h, bend, power)
+    return bent_lines(h, bend, load_power(h) if power is None else power)
+
+
+def load_power(h: np.ndarray) -> np.ndarray:
+    """Σ_p |h[o, p, j]|² of ``h`` (n_out, n_p, n_o), shape (n_out, n_o): a complex ``h``
+    by one real contraction of its interleaved parts (the squares of a complex array's
+    moduli by ``np.abs`` cost twice: its hypot). [unit²]"""
+    if h.dtype.kind != "c" or not h.flags.c_contiguous:
+        return np.sum(np.abs(h) ** 2, axis=1)
+    x = h.view(h.real.dtype)  # (n_out, n_p, 2·n_o): Re, Im interleaved
+    s = np.einsum("opj,opj->oj", x, x)
+    return s[:, 0::2] + s[:, 1::2]
 
 
 def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:
