@@ -325,8 +325,9 @@ def element_lines(
             at = getattr(influence, "elements", None)
             full = full + own[slice(None) if at is None else at, :, None]
         part = capture_outputs(cap, full[:, cap.kept], sel, dtype)
+        bend = CELL_BENDS[kind] * stride**2
         part *= cell_factor(
-            system, damping, cap.unit, w, full, CELL_BENDS[kind] * stride**2, influence=influence
+            system, damping, cap.unit, w, full, bend, influence=influence, power=load_power(full)
         )
         lines = np.zeros((full.shape[0], cap.w.size))
         lines[:, :top] = fill_lines(part, sel, top)

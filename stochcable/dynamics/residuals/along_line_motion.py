@@ -271,7 +271,7 @@ def motion_cells(
     keep, slot = np.unique(top, return_inverse=True)
     node = NodeInfluence(system, damping, influence.nodes[keep])
     rows = (keep[:, None] * d + np.arange(d)[None]).ravel()
-    sub = cell_factor(system, damping, unit, w, h[rows], bend, influence=node)
+    sub = cell_factor(system, damping, unit, w, h[rows], bend, influence=node, power=power[rows])
     for c in range(d):
         out[c::d, cells] = sub[int(slot[c]) * d + c, cells]
     return out
