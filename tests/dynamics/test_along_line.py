@@ -35,6 +35,7 @@ from stochcable.dynamics.residuals.along_line import (
     element_rows,
     fill_lines,
     line_subset,
+    load_power,
     station_weights,
     stations,
 )
@@ -344,3 +345,62 @@ def test_columns_of_match_the_former_column_by_column_bytes():
     assert np.array_equal(_columns_of(*cases[0]), pick)
     assert np.array_equal(_columns_of(*cases[2]), [9, 5, 2])
     assert _columns_of(*cases[3]) is None
+
+
+def test_load_power_is_the_moduli_squared() -> None:
+    """load_power's real contraction of the interleaved parts against Σ_p |h|² by
+    np.abs (complex, a strided view, real; round-off: the same squares summed in
+    another order, 16 terms: within 4 ulp of the largest)."""
+    rng = np.random.default_rng(3)
+    h = rng.standard_normal((5, 16, 9)) + 1j * rng.standard_normal((5, 16, 9))
+    h[:, :, 4] *= 1e-150  # (a line of tiny moduli, where hypot and the squares differ)
+    for x in (h, h[:, :, ::2], h.real):
+        ref = np.sum(np.abs(x) ** 2, axis=1)
+        got = load_power(x)
+        assert got.shape == ref.shape
+        np.testing.assert_allclose(got, ref, rtol=1e-15 * x.shape[1], atol=0.0)
+
+
+def test_misfit_lines_against_the_difference_of_squares(monkeypatch) -> None:  # noqa: ANN001
+    """misfit_lines (the bundled chain's element tensions and node motions, both
+    residuals: its misfit on split elements) against Σ_c q·S_c(|H_L + H_c|² − |H_L|²)
+    formed directly: H_c by an einsum over the misfit loads of the transfer at each
+    frequency's line (at the frequency itself where :func:`bent_cells` marks the cell),
+    q the trapezoid weights.  Round-off: the difference of two squares loses the
+    digits of |H_L|² (H_c is 1e-2 of it and less), so the lines agree to 1e-14 of
+    the outputs' linear variance lines, not of their own size."""
+    import stochcable.dynamics.residuals.along_line as al
+    import stochcable.dynamics.residuals.along_line_motion as alm
+    from stochcable.dynamics.model.blocks import trapezoid_weights
+    from stochcable.dynamics.residuals.residual_lines import load_transfer
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import residual_cost
+
+    seen = []
+    orig = al.misfit_lines
+
+    def spy(*args):  # noqa: ANN002, ANN202
+        seen.append(args)
+        return orig(*args)
+
+    monkeypatch.setattr(al, "misfit_lines", spy)
+    monkeypatch.setattr(alm, "misfit_lines", spy)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        analyze(residual_cost.with_variant(residual_cost.lines()["chain"], "both"))
+    assert len(seen) == 2  # (the element tensions' and the node motions')
+    for system, damping, (unit, load, w), w_lines, influence, linear, spectra in seen:
+        at = np.clip(np.rint(w / w_lines[0]).astype(int) - 1, 0, w_lines.size - 1)
+        on_lines = load_transfer(system, damping, unit, w_lines[: at.max() + 2], influence)
+        h = on_lines[:, :, at]
+        bent = np.flatnonzero(al.bent_cells(on_lines)[at])
+        assert bent.size  # (the resonant cells' own frequencies at work)
+        h[:, :, bent] = load_transfer(system, damping, unit, w[bent], influence)
+        h_c = np.einsum("opw,cpw->cow", h, load)
+        q = trapezoid_weights(w)[None, None] * spectra[:, None]
+        ref = np.sum(q * (np.abs(linear + h_c) ** 2 - np.abs(linear) ** 2), axis=0)
+        scale = np.sum(q * np.abs(linear) ** 2, axis=0)
+        got = orig(system, damping, (unit, load, w), w_lines, influence, linear, spectra)
+        assert got.shape == ref.shape and np.any(ref)
+        assert np.max(np.abs(got - ref) / np.max(scale, axis=1, keepdims=True)) < 1e-14

@@ -325,8 +325,9 @@ def element_lines(
             at = getattr(influence, "elements", None)
             full = full + own[slice(None) if at is None else at, :, None]
         part = capture_outputs(cap, full[:, cap.kept], sel, dtype)
+        bend = CELL_BENDS[kind] * stride**2
         part *= cell_factor(
-            system, damping, cap.unit, w, full, CELL_BENDS[kind] * stride**2, influence=influence
+            system, damping, cap.unit, w, full, bend, influence=influence, power=load_power(full)
         )
         lines = np.zeros((full.shape[0], cap.w.size))
         lines[:, :top] = fill_lines(part, sel, top)
@@ -407,7 +408,8 @@ def misfit_lines(
 ) -> np.ndarray:
     """The variance change (n_out, n_w) of the outputs of ``influence`` (their linear
     transfer ``linear`` (n_ch, n_out, n_w)) by the drag residual's linear ``misfit``
-    (:meth:`ResidualTap.misfit`), Σ_c q·S_c(|H_L + H_c|² − |H_L|²) on the analysis grid,
+    (:meth:`ResidualTap.misfit`), Σ_c q·S_c(|H_L + H_c|² − |H_L|²) on the analysis grid
+    (formed as Σ_c q·S_c Re((2H_L + H_c)·conj(H_c))),
     as :mod:`.drag_residual` forms the ends': the outputs per unit misfit load at the
     residual line ``w_lines`` nearest each frequency, solved at the frequency itself
     where the line's cell bends (:func:`bent_cells`). [N²]"""
@@ -416,20 +418,32 @@ def misfit_lines(
     at = np.clip(np.rint(w / step).astype(int) - 1, 0, w_lines.size - 1)
     # (the lines up to the band's top: among those the influence holds)
     on_lines = load_transfer(system, damping, unit, w_lines[: at.max() + 2], influence)
-    h = on_lines[:, :, at]
+    h = on_lines.transpose(2, 0, 1)[at]  # (n_w, n_out, n_p): the product's layout
     exact = np.flatnonzero(bent_cells(on_lines)[at])
     if exact.size:
-        h[:, :, exact] = load_transfer(system, damping, unit, w[exact], influence)
-    h_c = np.transpose(np.transpose(h, (2, 0, 1)) @ np.transpose(load, (2, 1, 0)), (2, 1, 0))
-    q = trapezoid_weights(w)[None, None] * spectra[:, None]
-    return np.sum(q * (np.abs(linear + h_c) ** 2 - np.abs(linear) ** 2), axis=0)
+        h[exact] = load_transfer(system, damping, unit, w[exact], influence).transpose(2, 0, 1)
+    h_c = (h @ load.transpose(2, 1, 0)).transpose(2, 1, 0)  # (n_ch, n_out, n_w)
+    # |H_L + H_c|² − |H_L|² = Re((2H_L + H_c)·conj(H_c)): no difference of two squares
+    x = (linear + linear + h_c) * h_c.conj()
+    return np.einsum("cw,cow->ow", trapezoid_weights(w) * spectra, x.real)
 
 
 def bent_cells(h: np.ndarray, bend: float = CELL_BEND, power: Any = None) -> np.ndarray:
     """The lines (n_o,) where the log power of ``h`` (n_out, n_p, n_o), summed over the
     loads, bends by more than ``bend`` between neighbours, and their neighbours (as
     :func:`~stochcable.dynamics.residuals.drag_residual.cell_factor`'s cells)."""
-    return bent_lines(h, bend, power)
+    return bent_lines(h, bend, load_power(h) if power is None else power)
+
+
+def load_power(h: np.ndarray) -> np.ndarray:
+    """Σ_p |h[o, p, j]|² of ``h`` (n_out, n_p, n_o), shape (n_out, n_o): a complex ``h``
+    by one real contraction of its interleaved parts (the squares of a complex array's
+    moduli by ``np.abs`` cost twice: its hypot). [unit²]"""
+    if h.dtype.kind != "c" or not h.flags.c_contiguous:
+        return np.sum(np.abs(h) ** 2, axis=1)
+    x = h.view(h.real.dtype)  # (n_out, n_p, 2·n_o): Re, Im interleaved
+    s = np.einsum("opj,opj->oj", x, x)
+    return s[:, 0::2] + s[:, 1::2]
 
 
 def station_transfer(system: Any, response: Any, at: np.ndarray) -> np.ndarray:

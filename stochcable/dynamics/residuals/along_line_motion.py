@@ -39,6 +39,7 @@ from stochcable.dynamics.residuals.along_line import (
     capture_outputs,
     fill_lines,
     line_subset,
+    load_power,
     misfit_lines,
     station_weights,
     top_line,
@@ -259,7 +260,7 @@ def motion_cells(
     output's own factor. [-]"""
     if not isinstance(influence, NodeInfluence):
         return cell_factor(system, damping, unit, w, h, bend, influence=influence)
-    power = np.sum(np.abs(h) ** 2, axis=1)  # (n_out, n_o)
+    power = load_power(h)  # (n_out, n_o)
     cells = np.flatnonzero(bent_cells(h, bend, power))
     out = np.ones_like(power)
     if cells.size == 0:
@@ -270,7 +271,7 @@ def motion_cells(
     keep, slot = np.unique(top, return_inverse=True)
     node = NodeInfluence(system, damping, influence.nodes[keep])
     rows = (keep[:, None] * d + np.arange(d)[None]).ravel()
-    sub = cell_factor(system, damping, unit, w, h[rows], bend, influence=node)
+    sub = cell_factor(system, damping, unit, w, h[rows], bend, influence=node, power=power[rows])
     for c in range(d):
         out[c::d, cells] = sub[int(slot[c]) * d + c, cells]
     return out

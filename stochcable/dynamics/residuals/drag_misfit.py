@@ -144,7 +144,9 @@ def misfit_scales(
     first = np.array([int(g[0]) for g in groups])
     el = seg.element[first]
     # the panels of split elements (one piece each), by element
-    pan = np.flatnonzero(np.isin(el, seg.element[seg.fine]))
+    split = np.zeros(int(seg.element.max(initial=0)) + 1, dtype=bool)
+    split[seg.element[seg.fine]] = True  # (a lookup table: np.isin sorts both)
+    pan = np.flatnonzero(split[el])
     if pan.size == 0:
         return out
     els, at = np.unique(el[pan], return_inverse=True)
