@@ -162,15 +162,15 @@ def measure(repeat: int) -> dict[str, dict[str, tuple[float, float, int, float]]
 
 def report(best: dict) -> str:
     rows = [
-        "| line | linear [s] | drag [s] (×) | geometric [s] (×) | both [s] (×) "
+        "| line | linear [ms] | drag [ms] (×) | geometric [ms] (×) | both [ms] (×) "
         "| σ ratio drag | σ ratio geometric | σ ratio both |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for name, by in best.items():
         t0 = by["linear"][0]
-        cells = [f"{by['linear'][0]:.3f}"]
+        cells = [f"{by['linear'][0] * 1e3:.1f}"]
         for v in ("drag", "geometric", "both"):
-            cells.append(f"{by[v][0]:.3f} ({by[v][0] / t0:.1f}×)")
+            cells.append(f"{by[v][0] * 1e3:.1f} ({by[v][0] / t0:.2f}×)")
         ratios = [f"{by[v][1]:.4f}" for v in ("drag", "geometric", "both")]
         rows.append(f"| {name} | " + " | ".join(cells + ratios) + " |")
     rows += [
