@@ -18,18 +18,18 @@ the minor page faults (``ru_minflt``) of the fastest round and their median.
 
     OPENBLAS_NUM_THREADS=1 python3 benchmarks/residual_cost.py [--repeat 3] [--profile LINE]
 
-Measured (docs/benchmarks/residual_cost.md): both residuals cost 11–66× the linear
-analysis before issue 31; with the end, element-tension and node-motion residuals now
-chain 1.9–2.0×, taut 1.6×, deep 1.7×, two-segment 1.6× (load ≈ 1.5): exact steps
-(adjoint end tensions, pairs f ≥ e in cache-sized blocks, the lag grid at the alias
-bound, one end influence, the element and node rows in the same solve, one dense
-matrix of pair lines per kind) and approximate ones (Hermite orders 2 and 3 carrying
-the higher orders' variance, 32 panels, 64 lines over the inputs' band with resonant
-cells integrated, the geometric residual on every second line, only the panels and
-elements whose forces reach the ends, the lines above those the ends need by a bound,
-the misfit on the residual's lines, the end influence through the linear solve's
-modal basis on long lines): corrected σ within +0.02…+0.33 % of before on the four
-lines and the inclined guy (tests/dynamics/test_drag_residual.py).
+Measured (docs/benchmarks/residual_cost.md; the steps in residual_cost_notes.md): both
+residuals cost 11–66× the linear analysis before issue 31; with the end, element-tension
+and node-motion residuals now chain 1.88–1.91×, taut 1.6–1.7×, deep 1.7×, two-segment
+1.5× (load ≈ 1.0): exact steps (adjoint end tensions, pairs f ≥ e in cache-sized blocks,
+the lag grid at the alias bound, one end influence, the element and node rows in the
+same solve, one dense matrix of pair lines per kind) and approximate ones (Hermite
+orders 2 and 3 carrying the higher orders' variance, 32 panels, 64 lines over the
+inputs' band with resonant cells integrated, the geometric residual on every second
+line, only the panels and elements whose forces reach the ends, the lines above those
+the ends need by a bound, the misfit on the residual's lines, the end influence through
+the linear solve's modal basis on long lines): corrected σ within +0.02…+0.33 % of
+before on the four lines and the inclined guy (tests/dynamics/test_drag_residual.py).
 """
 
 from __future__ import annotations
