@@ -271,12 +271,14 @@ def test_td_window_has_the_exact_input_variance(chain_td):
     "linearization's relative error does not shrink with it), geometric nonlinearity "
     "+0.9 / +1.5 % (off band), the one-sided bed +0.3 / +0.45 %, the instantaneous "
     "tangent 0.  The closed-form residuals of the linear model (drag and geometric, "
-    "docs/benchmarks/drag_residual.md) predict those terms and are reported beside the "
-    "linear σ, not in it: test_chain_fd_with_residuals_within_target_of_nonlinear_td",
+    "docs/benchmarks/drag_residual.md) predict those terms and the default σ carries them "
+    "(this test reads the `linear` block): "
+    "test_chain_fd_with_residuals_within_target_of_nonlinear_td",
 )
 def test_chain_fd_within_target_of_nonlinear_td(chain_td):
-    """The converged FD tension σ within 1 % (fairlead) and 2 % (anchor) of the
-    nonlinear TD's mean over seeds, beyond its 95 % confidence interval."""
+    """The converged linear FD tension σ (the ``linear`` block) within 1 % (fairlead)
+    and 2 % (anchor) of the nonlinear TD's mean over seeds, beyond its 95 % confidence
+    interval."""
     _assert_within_target(chain_td["fd"], chain_td["td"])
 
 
