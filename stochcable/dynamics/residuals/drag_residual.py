@@ -303,8 +303,8 @@ def drag_residual(
     influence = EndInfluence(system, damping) if influence is None else influence
     # the components whose force is nothing against the largest (the grounded panels')
     # left out before their transfer (their score could not reach PANEL_FLOOR)
-    sig2 = np.sum(comp.lines.real**2 + comp.lines.imag**2, axis=(0, 2))  # (formed once)
-    alive = _loaded_panels(comp.lines, comp.scale, comp.coeffs, sig2)
+    sig2 = comp.sig2
+    alive = _loaded_panels(sig2, comp.scale, comp.coeffs)
     unit = comp.unit if alive is None else comp.unit[:, :, alive]
     h_all = load_transfer(system, damping, unit, comp.w_out, influence)
     lines, scale, coeffs = (
@@ -360,8 +360,9 @@ class DragComponents:
     its pieces and panels, drag directions ``live`` and their ``parts`` (½ρC_dD per
     length, mean flow, element directions, B), the spectra, the uniform grid and the
     residual's lines ``w_out`` [rad/s] with their lag grid, the node loads per unit
-    component (n_nodes, d, n_comp), the components' velocity lines (n_ch, n_comp, n_j),
-    c·L and Hermite coefficients, and per direction the panels' velocities and δB·l."""
+    component (n_nodes, d, n_comp), the components' velocity lines (n_ch, n_comp, n_j)
+    and their variances Σ|lines|², c·L and Hermite coefficients, and per direction the
+    panels' velocities and δB·l."""
 
     seg: Segments
     groups: list[np.ndarray]
@@ -373,6 +374,7 @@ class DragComponents:
     n_fft: int
     unit: np.ndarray
     lines: np.ndarray
+    sig2: np.ndarray
     scale: np.ndarray
     coeffs: np.ndarray
     misfit: list[tuple[np.ndarray, np.ndarray]]
@@ -422,7 +424,8 @@ def drag_components(
     pans = [panel_mean(seg_v[name], seg, groups, share) for name in live]  # (n_ch, n_p, n_w)
     # every direction's panels placed on the grid at once: the components' lines
     lines = grid.lines(np.concatenate(pans, axis=1), spectra)  # (n_ch·ranks, n_comp, n_j)
-    sigs = np.sqrt(np.sum(np.abs(lines) ** 2, axis=(0, 2)))
+    sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))  # (the panels' choice too)
+    sigs = np.sqrt(sig2)
     coef = lumped_coefficients if lumped else hermite_coefficients
     for k, name in enumerate(live):
         c_el, mean_el, _, b_el = parts[name]
@@ -433,7 +436,8 @@ def drag_components(
         coeffs.append(coef(np.clip(mu, -10.0, 10.0), order))
         misfit.append((pans[k], misfit_scales(seg, groups, c_el, mean_el, b_el, sig)))
     return DragComponents(seg, groups, live, parts, spectra, grid, w_out, n_fft, unit, lines,
-                          np.concatenate(scales), np.concatenate(coeffs), misfit)  # fmt: skip
+                          sig2, np.concatenate(scales), np.concatenate(coeffs),
+                          misfit)  # fmt: skip
 
 
 #: The key of the joint group computation (body_residual.CoupledInfluence.joint_lines).
@@ -529,15 +533,10 @@ def cell_factor(
 DEAD_FORCE = 1e-12
 
 
-def _loaded_panels(
-    lines: np.ndarray, scale: np.ndarray, coeffs: np.ndarray, sig2: np.ndarray | None = None
-) -> np.ndarray | None:
+def _loaded_panels(sig2: np.ndarray, scale: np.ndarray, coeffs: np.ndarray) -> np.ndarray | None:
     """The panel components (indices) whose residual force is at least
-    :data:`DEAD_FORCE` of the line's largest; None where that is all of them (or
-    :data:`PANEL_FLOOR` is 0: every panel kept).  ``sig2``: the components' variances
-    Σ|lines|², where the caller has them."""
-    if sig2 is None:
-        sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
+    :data:`DEAD_FORCE` of the line's largest (``sig2``: their variances Σ|lines|²);
+    None where that is all of them (or :data:`PANEL_FLOOR` is 0: every panel kept)."""
     force = np.abs(coeffs[:, 2:]).max(axis=1) * scale * sig2
     alive = force >= DEAD_FORCE * np.max(force, initial=0.0)
     return None if alive.all() or PANEL_FLOOR <= 0 else np.flatnonzero(alive)
@@ -553,7 +552,8 @@ def _live_panels(
     """The panel components (indices) whose residual force can reach the ends: the
     largest |a_k| (k ≥ 2) times cσ²L times the largest end tension per unit force at
     least :data:`PANEL_FLOOR` of the line's largest.  ``h``: the end tensions per unit
-    force, or their magnitudes (real); ``sig2``: as :func:`_loaded_panels`."""
+    force, or their magnitudes (real); ``sig2``: the components' variances Σ|lines|²
+    where the caller has them."""
     if sig2 is None:
         sig2 = np.sum(lines.real**2 + lines.imag**2, axis=(0, 2))
     reach = (np.abs(h) if np.iscomplexobj(h) else h).max(axis=(0, 2))

@@ -26,7 +26,7 @@ from stochcable.dynamics.residuals.modal_rows import (
     STATIC_ROWS,
     ModalRows,
     ModalSums,
-    _static_rows,
+    static_rows,
 )
 from stochcable.dynamics.solve.line_loads import drag_blocks
 from stochcable.errors import SolverError
@@ -344,7 +344,7 @@ def _modal_rows(
     s = sums(w, slice(0, 6 if cols == ENDS else None))  # (6 (+ k), m, n_w)
     z[:2, :m] = s[0:2] - s[2:4] * (w * w) + s[4:6] * (1j * w)
     z[2:, :m] = s[6:]
-    _static_rows(np.moveaxis(z[:, m:], 1, 0), w)
+    static_rows(np.moveaxis(z[:, m:], 1, 0), w)
     if rc is None:
         return ModalRows(phi, z, w, None, ends[:, :k], n)
     return ModalRows(phi, z, w, rc[:, :, :k], ends[:, :k], n)

@@ -12,7 +12,7 @@ from scipy import sparse
 
 from stochcable.dynamics.model.blocks import real_gemm
 
-__all__ = ["PAIR_TOL", "ModalRows", "ModalSums", "modal_sums"]
+__all__ = ["PAIR_TOL", "STATIC_ROWS", "ModalRows", "ModalSums", "modal_sums", "static_rows"]
 
 #: Relative tolerance to which two modes are taken as a complex-conjugate pair
 #: (eigenvalues and χ_j p_j) in :func:`modal_sums`. [-]
@@ -76,7 +76,7 @@ class ModalSums:
         # (each right-hand side's sums written beside its static coordinates)
         out = np.empty((len(at), m + const, iw.size), dtype=complex)
         np.matmul(lhs.reshape(len(at), m, -1), den.view(float), out=out.view(float)[:, :m])
-        _static_rows(np.moveaxis(out[:, m:], 1, 0), w)
+        static_rows(np.moveaxis(out[:, m:], 1, 0), w)
         return out
 
 
@@ -85,7 +85,7 @@ class ModalSums:
 STATIC_ROWS = 3
 
 
-def _static_rows(out: np.ndarray, w: np.ndarray) -> np.ndarray:
+def static_rows(out: np.ndarray, w: np.ndarray) -> np.ndarray:
     """The static coordinates 1, −ω², iω (the first ``out.shape[0]``) on ``w``, into
     ``out`` (c, n_w) complex."""
     for j, v in enumerate((1.0, -(w * w), 1j * w)[: out.shape[0]]):
@@ -132,7 +132,7 @@ class ModalRows:
     modes (:meth:`transfer`: the chain's 27 rows on 189 lines, 6.7 MB, never formed).
     The modal coordinates ``z`` row first, (R, m + c, n_w): a run of rows and the
     leading lines are views the products read in place; its last c rows the static
-    coordinates 1, −ω², iω (:func:`_static_rows`: c = 1 where only r₀ enters, 3 with
+    coordinates 1, −ω², iω (:func:`static_rows`: c = 1 where only r₀ enters, 3 with
     the end rows' r₁, r₂, 0 without a static correction), so that the static rows
     contracted with the loads enter the same product as the modes' (:meth:`transfer`).
     [N/N]"""
@@ -141,7 +141,7 @@ class ModalRows:
         m = phi.shape[1]
         if rc is not None and z.shape[1] == m:  # (no static coordinates given: appended)
             z = np.concatenate([z, np.zeros((z.shape[0], STATIC_ROWS, w.size), dtype=complex)], 1)
-            _static_rows(np.moveaxis(z[:, m:], 1, 0), w)
+            static_rows(np.moveaxis(z[:, m:], 1, 0), w)
         elif rc is not None and marks is None and np.any(rc[z.shape[1] - m :]):
             raise ValueError(
                 f"ModalRows: z has {z.shape[1] - m} static coordinate rows (1, −ω², iω) "
